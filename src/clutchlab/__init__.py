@@ -1,0 +1,27 @@
+"""clutchlab: modelling, simulation and identification of automotive clutches.
+
+Public API (curated):
+
+- :class:`Curve`, :mod:`clutchlab.curves` -- measured force-deflection characteristics
+- :mod:`clutchlab.eclutch` -- dry clutch-by-wire (Haramina et al. 2024)
+- :mod:`clutchlab.wet` -- wet multi-plate clutch (Shin, Kim, Choi)
+- :mod:`clutchlab.emtc` -- electromagnetic torque-controlled coupling (Processes 2019)
+- :mod:`clutchlab.errors` -- exception hierarchy
+"""
+
+__version__ = "0.1.0"
+
+from .errors import ClutchlabError, DataError, IdentificationError, ParameterError, SimulationError  # noqa: E402
+from .curves import Curve  # noqa: E402
+from . import curves  # noqa: E402
+
+__all__ = [
+    "__version__",
+    "Curve",
+    "curves",
+    "ClutchlabError",
+    "ParameterError",
+    "DataError",
+    "SimulationError",
+    "IdentificationError",
+]

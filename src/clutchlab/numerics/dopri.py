@@ -1,0 +1,96 @@
+"""Dormand-Prince 5(4) pieces for compiled adaptive integrators.
+
+The tableau is that of Dormand & Prince (1980) as used by SciPy's ``RK45``;
+the error estimate is ``h * sum(E_i k_i)`` with the FSAL stage k7.  Subsystem
+kernels compute the stages with their own right-hand side and call
+:func:`error_norm`, :func:`next_step` and :func:`dense_hermite` (cubic Hermite
+dense output, enough to locate an event to the tolerance of the step).
+
+References
+----------
+.. [1] J. R. Dormand, P. J. Prince, "A family of embedded Runge-Kutta
+   formulae", J. Comput. Appl. Math. 6 (1980) 19-26.
+.. [2] E. Hairer, S. P. Nørsett, G. Wanner, Solving Ordinary Differential
+   Equations I, 2nd ed., Springer 1993, Sec. II.4 (step size control).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
+A21 = 1.0 / 5.0
+A31, A32 = 3.0 / 40.0, 9.0 / 40.0
+A41, A42, A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+A51, A52, A53, A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+A61, A62, A63, A64, A65 = 9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0
+B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+# error coefficients: b - b_hat (5th minus 4th order), SciPy RK45 "E"
+E1, E3, E4, E5, E6, E7 = -71.0 / 57600.0, 71.0 / 16695.0, -71.0 / 1920.0, 17253.0 / 339200.0, -22.0 / 525.0, 1.0 / 40.0
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+
+
+@numba.njit(cache=True, nogil=True)
+def error_norm(err, y_old, y_new, rtol, atol):
+    """RMS norm of the local error scaled by ``atol + rtol*max(|y_old|, |y_new|)`` (atol per state)."""
+    s = 0.0
+    n = err.shape[0]
+    for i in range(n):
+        sc = atol[i] + rtol * max(abs(y_old[i]), abs(y_new[i]))
+        r = err[i] / sc
+        s += r * r
+    return math.sqrt(s / n)
+
+
+@numba.njit(cache=True, nogil=True)
+def next_step(h, err_norm, accepted_previous_rejected):
+    """New step size from the error norm (order-5 controller, Hairer & Wanner II.4)."""
+    if err_norm == 0.0:
+        factor = MAX_FACTOR
+    else:
+        factor = SAFETY * err_norm ** (-0.2)
+    if err_norm < 1.0:
+        factor = min(MAX_FACTOR, factor)
+        if accepted_previous_rejected:
+            factor = min(1.0, factor)
+    else:
+        factor = max(MIN_FACTOR, factor)
+    return h * factor
+
+
+@numba.njit(cache=True, nogil=True)
+def dense_hermite(theta, h, y0, f0, y1, f1, out):
+    """Cubic Hermite interpolant between two accepted points at ``t0 + theta*h``."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
+    h10 = t3 - 2.0 * t2 + theta
+    h01 = -2.0 * t3 + 3.0 * t2
+    h11 = t3 - t2
+    for i in range(y0.shape[0]):
+        out[i] = h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i]
+
+
+@numba.njit(cache=True, nogil=True)
+def initial_step(y0, f0, rtol, atol, t_span, order):
+    """Starting step from the scale of the state and its derivative (Hairer & Wanner II.4)."""
+    d0 = 0.0
+    d1 = 0.0
+    n = y0.shape[0]
+    for i in range(n):
+        sc = atol[i] + rtol * abs(y0[i])
+        d0 += (y0[i] / sc) ** 2
+        d1 += (f0[i] / sc) ** 2
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    if d0 < 1e-5 or d1 < 1e-5:
+        h = 1e-6
+    else:
+        h = 0.01 * d0 / d1
+    return min(h, abs(t_span) / 10.0, 1e-2) if order > 0 else h

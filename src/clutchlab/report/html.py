@@ -1,0 +1,165 @@
+"""Write a report folder: PNG figures, CSV tables and a self-contained ``index.html``.
+
+The HTML page embeds every figure as a base64 PNG so it can be read offline
+and mailed as one file; the PNGs and CSVs are written beside it for reuse in
+other documents.  Synthetic data is marked as such in every section that uses it.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+__all__ = ["Figure", "Table", "Text", "Section", "write_report"]
+
+
+@dataclass
+class Figure:
+    """A matplotlib figure with a file stem and a caption."""
+
+    name: str
+    figure: object
+    caption: str = ""
+
+
+@dataclass
+class Table:
+    """A table (DataFrame) with a file stem and a caption."""
+
+    name: str
+    frame: pd.DataFrame
+    caption: str = ""
+    float_format: str = "{:.4g}"
+
+
+@dataclass
+class Text:
+    """A paragraph of plain text (escaped in the HTML)."""
+
+    text: str
+
+
+@dataclass
+class Section:
+    """One chapter of the report, usually one subsystem.
+
+    ``provenance`` says where the data come from; sections built on data from
+    clutchlab's virtual rigs must say "synthetic" there.
+    """
+
+    title: str
+    items: list = field(default_factory=list)
+    provenance: str = ""
+    parameters: dict[str, str] = field(default_factory=dict)
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+h1{border-bottom:2px solid #335}h2{margin-top:2em;border-bottom:1px solid #ccd}
+.prov{background:#fff6d6;border-left:4px solid #e0a800;padding:.5em 1em;margin:1em 0}
+figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}
+figcaption{font-size:.9em;color:#444}
+table{border-collapse:collapse;margin:1em 0;font-size:.9em}
+th,td{border:1px solid #ccc;padding:.25em .6em;text-align:right}th{background:#eef}
+caption{caption-side:top;text-align:left;font-weight:600;padding:.3em 0}
+.meta{color:#666;font-size:.85em}
+"""
+
+
+def _figure_png(fig) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    return buf.getvalue()
+
+
+def _table_html(tab: Table) -> str:
+    frame = tab.frame
+    fmt = {c: (lambda v, f=tab.float_format: f.format(v)) for c in frame.columns if pd.api.types.is_float_dtype(frame[c])}
+    body = frame.to_html(index=False, formatters=fmt, border=0, escape=True)
+    cap = f"<p><b>{html.escape(tab.caption)}</b></p>" if tab.caption else ""
+    return cap + body
+
+
+def write_report(sections: list[Section], outdir, *, title: str = "clutchlab report", overwrite: bool = False) -> Path:
+    """Write ``index.html`` with embedded figures plus PNG/CSV files into ``outdir``.
+
+    The folder is assembled in a temporary sibling and moved into place, so an
+    interrupted run never leaves half a report.  An existing ``outdir`` is
+    replaced only with ``overwrite=True``.
+
+    Returns
+    -------
+    pathlib.Path
+        Path of ``index.html``.
+    """
+    import matplotlib.pyplot as plt
+
+    from .. import __version__
+
+    outdir = Path(outdir)
+    if outdir.exists() and not overwrite:
+        raise FileExistsError(f"{outdir} exists; pass overwrite=True (CLI: --force) to replace it")
+    outdir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", dir=outdir.parent))
+    try:
+        (tmp / "figures").mkdir()
+        (tmp / "tables").mkdir()
+        parts = [
+            "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+            f"<h1>{html.escape(title)}</h1>",
+            f"<p class='meta'>clutchlab {html.escape(__version__)} &middot; generated "
+            f"{_dt.datetime.now().isoformat(timespec='seconds')}</p>",
+            "<nav><ul>" + "".join(f"<li><a href='#s{i}'>{html.escape(s.title)}</a></li>" for i, s in enumerate(sections)) + "</ul></nav>",
+        ]
+        for i, sec in enumerate(sections):
+            parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}</h2>")
+            if sec.provenance:
+                parts.append(f"<div class='prov'><b>Data provenance:</b> {html.escape(sec.provenance)}</div>")
+            for item in sec.items:
+                if isinstance(item, Figure):
+                    png = _figure_png(item.figure)
+                    plt.close(item.figure)
+                    (tmp / "figures" / f"{item.name}.png").write_bytes(png)
+                    b64 = base64.b64encode(png).decode("ascii")
+                    parts.append(
+                        f"<figure><img alt='{html.escape(item.name)}' src='data:image/png;base64,{b64}'>"
+                        f"<figcaption>{html.escape(item.caption)}</figcaption></figure>"
+                    )
+                elif isinstance(item, Table):
+                    item.frame.to_csv(tmp / "tables" / f"{item.name}.csv", index=False)
+                    parts.append(_table_html(item))
+                elif isinstance(item, Text):
+                    parts.append(f"<p>{html.escape(item.text)}</p>")
+                else:
+                    raise TypeError(f"unsupported report item {type(item).__name__}")
+            if sec.parameters:
+                rows = "".join(
+                    f"<tr><td style='text-align:left'>{html.escape(k)}</td><td style='text-align:left'>{html.escape(v)}</td></tr>"
+                    for k, v in sec.parameters.items()
+                )
+                parts.append(f"<details><summary>Parameters used</summary><table><tr><th>name</th><th>value</th></tr>{rows}</table></details>")
+        parts.append("</body></html>")
+        (tmp / "index.html").write_text("\n".join(parts), encoding="utf-8")
+        if outdir.exists():
+            backup = outdir.with_name(f".{outdir.name}.old")
+            if backup.exists():
+                shutil.rmtree(backup)
+            os.replace(outdir, backup)
+            os.replace(tmp, outdir)
+            shutil.rmtree(backup)
+        else:
+            os.replace(tmp, outdir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return outdir / "index.html"
