@@ -36,13 +36,19 @@ EXTRAPOLATION_CODES = {"linear": 0, "error": 1}
 
 
 def _pchip_slopes(x: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Node derivatives of the Fritsch-Carlson monotone cubic (as SciPy's PCHIP)."""
+    """Node derivatives of the Fritsch-Carlson monotone cubic (SciPy's PCHIP inside, secants at the ends)."""
     from scipy.interpolate import PchipInterpolator
 
     if x.size == 2:
         s = (f[1] - f[0]) / (x[1] - x[0])
         return np.array([s, s])
-    return PchipInterpolator(x, f).derivative()(x)
+    d = PchipInterpolator(x, f).derivative()(x)
+    # end derivatives = end-segment secants: keeps the Fritsch-Carlson monotonicity
+    # conditions (alpha, beta <= 3) and gives a C1 linear extrapolation that never
+    # has the zero slope SciPy's one-sided end formula may produce
+    d[0] = (f[1] - f[0]) / (x[1] - x[0])
+    d[-1] = (f[-1] - f[-2]) / (x[-1] - x[-2])
+    return d
 
 
 @numba.njit(cache=True, nogil=True)
@@ -394,27 +400,43 @@ class Curve:
 
 
 def _combined_kind(curves) -> str:
-    return "pchip" if any(c.kind == "pchip" for c in curves) else "linear"
+    """All cubic: cubic; otherwise linear (keeps the kinks of linear parts exactly)."""
+    return "pchip" if all(c.kind == "pchip" for c in curves) else "linear"
 
 
 def _combined_extrap(curves) -> str:
     return "error" if any(c.extrapolation == "error" for c in curves) else "linear"
 
 
-def _dense_grid(values: np.ndarray, lo: float, hi: float, refine: int) -> np.ndarray:
-    v = np.unique(np.concatenate([values[(values > lo) & (values < hi)], [lo, hi]]))
-    if refine > 1:
-        t = np.linspace(0.0, 1.0, refine + 1)[:-1]
-        v = np.unique(np.concatenate([(a + (b - a) * t) for a, b in zip(v[:-1], v[1:])] + [[v[-1]]]))
-    return v
+def _adaptive_samples(func, breakpoints: np.ndarray, lo: float, hi: float, rtol: float = 1e-6, max_rounds: int = 14):
+    """Sample ``func`` on [lo, hi] from the breakpoints, bisecting intervals until linear
+    interpolation reproduces ``func`` at the midpoints to ``rtol`` of its range."""
+    t = np.unique(np.concatenate([breakpoints[(breakpoints > lo) & (breakpoints < hi)], [lo, hi]]))
+    tol_t = 1e-9 * max(abs(lo), abs(hi), 1e-300)
+    t = t[np.concatenate([[True], np.diff(t) > tol_t])]
+    y = func(t)
+    for _ in range(max_rounds):
+        mid = 0.5 * (t[:-1] + t[1:])
+        ym = func(mid)
+        scale = max(np.ptp(y), 1e-300)
+        bad = np.abs(ym - 0.5 * (y[:-1] + y[1:])) > rtol * scale
+        bad &= np.diff(t) > 4 * tol_t
+        if not bad.any():
+            break
+        t = np.concatenate([t, mid[bad]])
+        y = np.concatenate([y, ym[bad]])
+        order = np.argsort(t)
+        t, y = t[order], y[order]
+    return t, y
 
 
-def series(*curves: Curve, name: str = "series", refine: int = 4) -> Curve:
+def series(*curves: Curve, name: str = "series", rtol: float = 1e-6) -> Curve:
     """Springs in series: deflections add at equal force.
 
     Each curve must be strictly increasing (invertible).  The result is
-    sampled at the union of the components' sample forces (refined ``refine``
-    times for cubic curves) over the union of their force ranges, each
+    sampled at the union of the components' sample forces, bisected where a
+    straight line between samples misses the exact sum by more than ``rtol``
+    of the deflection range, over the union of their force ranges, each
     component extrapolating by its own policy; with ``extrapolation='error'``
     on any component, only the common range is used.  Two linear springs give
     ``1/k = 1/k1 + 1/k2``.
@@ -434,16 +456,18 @@ def series(*curves: Curve, name: str = "series", refine: int = 4) -> Curve:
     if not hi > lo:
         raise ParameterError("series(): the curves share no force range")
     kind = _combined_kind(curves)
-    grid = _dense_grid(np.concatenate([c.force for c in curves]), lo, hi, refine if kind == "pchip" else 1)
-    x = sum(c.inverse(grid) for c in curves)
+    grid, x = _adaptive_samples(lambda f: sum(c.inverse(f) for c in curves),
+                                np.concatenate([c.force for c in curves]), lo, hi, rtol)
+    keep = np.concatenate([[True], np.diff(x) > 1e-12 * (np.abs(x).max() + 1e-300)])
+    x, grid = x[keep], grid[keep]
     return Curve(x, grid, kind=kind, extrapolation=extrap, name=name)
 
 
-def parallel(*curves: Curve, name: str = "parallel", refine: int = 4) -> Curve:
+def parallel(*curves: Curve, name: str = "parallel", rtol: float = 1e-6) -> Curve:
     """Springs in parallel: forces add at equal deflection.
 
-    Sampled at the union of the components' deflection samples (refined for
-    cubic curves) over the union (or, with ``extrapolation='error'``, the
+    Sampled at the union of the components' deflection samples (bisected
+    until linear interpolation is within ``rtol`` of the force range) over the union (or, with ``extrapolation='error'``, the
     intersection) of their spans.
     """
     if len(curves) < 1:
@@ -458,6 +482,6 @@ def parallel(*curves: Curve, name: str = "parallel", refine: int = 4) -> Curve:
     if not hi > lo:
         raise ParameterError("parallel(): the curves share no deflection range")
     kind = _combined_kind(curves)
-    grid = _dense_grid(np.concatenate([c.deflection for c in curves]), lo, hi, refine if kind == "pchip" else 1)
-    f = sum(c(grid) for c in curves)
+    grid, f = _adaptive_samples(lambda x: sum(c(x) for c in curves),
+                                np.concatenate([c.deflection for c in curves]), lo, hi, rtol)
     return Curve(grid, f, kind=kind, extrapolation=extrap, name=name)

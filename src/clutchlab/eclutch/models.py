@@ -1,0 +1,354 @@
+"""Clutch axial Models 0-4 of Haramina et al. [1] as configurations of one network.
+
+Each model is an :class:`~clutchlab.eclutch.network.AxialNetwork`; Models 1-4
+are built from Model 0 by adding or replacing elements exactly as the paper's
+Figs. 10-11 add compliances and masses:
+
+========  ===========================================================================
+Model 0   bearing stiffness k_b; diaphragm spring k_ds (tip to surroundings); rigid
+          lever 1/i_ds to the pressure plate m_pp; return springs k_rs; friction
+          plate (cushion) contact k_fp ([1] Sec. 3.2, Fig. 5b)
+Model 1   + lever (finger) compliance k_fl of Eq. (1) from tests 8b-c ([1] Sec. 5.1)
+Model 2   + pressure-plate spring k_pp (wear compensation) between the diaphragm
+          edge (new mass m_pps) and the pressure plate; k_fl from tests 8a/8c ([1] Sec. 5.2)
+Model 3   + equivalent yoke support k_ys.eq (support ring and yoke support spring in
+          series, extrapolated) carrying the lever pivot (new mass m_ds) ([1] Sec. 5.3)
+Model 4   diaphragm spring attached to the yoke support instead of the surroundings;
+          k_ys.eq scaled by 20, diaphragm spring by 1.3 ([1] Sec. 5.4)
+========  ===========================================================================
+
+Friction is off in the static curves, as in [1] Sections 5-6.  The clutch
+torque is ``M_cl = 2 F_n r_eff mu`` ([1] Sec. 3.2: two friction surfaces).
+
+References
+----------
+.. [1] K. Haramina et al., Trans. FAMENA 48 (2024) 21-35, doi:10.21278/TOF.483057923
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..curves import Curve, series
+from ..errors import ParameterError
+from ..io import read_table
+from ..params import ParameterSet, load_toml, quantity
+from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
+
+__all__ = ["EClutchParameters", "ComponentCurves", "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
+
+MODEL_NUMBERS = (0, 1, 2, 3, 4)
+_BUNDLED = "bundled synthetic press-rig data, characterised (src/clutchlab/eclutch/data)"
+_INSPECT = "inspection of the (virtual) assembled clutch, clutchlab.eclutch.virtual"
+_PAPER = "Haramina et al. 2024, Sec. 5.4"
+_REP = "representative (docs/eclutch.md)"
+
+
+def clutch_torque(normal_force, r_eff, mu):
+    """Clutch torque ``M_cl = 2 F_n r_eff mu`` [N·m] ([1], Sec. 3.2).
+
+    Parameters
+    ----------
+    normal_force : array_like
+        Normal (clamp) force F_n [N].
+    r_eff : float
+        Effective friction radius [m].
+    mu : float
+        Friction coefficient [-], constant as in [1].
+
+    Returns
+    -------
+    torque : ndarray or float
+        Transmissible torque [N·m]; the factor 2 counts the two friction
+        surfaces of the single friction plate.
+    """
+    return 2.0 * np.asarray(normal_force, dtype=float) * r_eff * mu
+
+
+@dataclasses.dataclass(frozen=True)
+class EClutchParameters(ParameterSet):
+    """Scalar parameters of the E-clutch axial Models 0-4 (SI units).
+
+    Defaults are those of the bundled (synthetic) data set: lever stiffnesses
+    identified with Eq. (1) from the bundled press-rig records, pre-strains from
+    inspection of the virtual clutch, scale factors from [1] Sec. 5.4, and
+    representative values for a passenger-car clutch otherwise.
+    """
+
+    kind = "eclutch"
+
+    lever_ratio: float = quantity(-4.0, "1", "diaphragm lever ratio i_ds (< 0)", source=_INSPECT, bounds=(-50.0, -0.05))
+    k_fl_model1: float = quantity(1.17577e6, "N/m", "lever stiffness k_fl of Model 1 (Eq. 1, tests 8b-c)", source=_BUNDLED, positive=True)
+    k_fl_model2: float = quantity(1.17549e6, "N/m", "lever stiffness k_fl of Models 2-4 (Eq. 1, tests 8a/8c)", source=_BUNDLED, positive=True)
+    bearing_stiffness: float = quantity(8.0e6, "N/m", "release bearing stiffness k_b", source=_REP, positive=True)
+    bearing_preload: float = quantity(80.0, "N", "CSC preload on the bearing at bearing position 0", source=_REP, nonnegative=True)
+    diaphragm_prestrain: float = quantity(4.2766e-3, "m", "diaphragm tip deflection in the assembled clutch", source=_INSPECT)
+    cushion_prestrain: float = quantity(0.69567e-3, "m", "cushion spring compression in the engaged clutch", source=_INSPECT)
+    return_prestrain: float = quantity(7.9457e-3, "m", "return spring pre-stretch in the engaged clutch", source=_INSPECT)
+    pp_spring_prestrain: float = quantity(0.12432e-3, "m", "pressure-plate spring compression in the engaged clutch", source=_INSPECT)
+    support_prestrain: float = quantity(0.0, "m", "yoke support deflection at zero support load", source=_REP)
+    support_scale: float = quantity(20.0, "1", "Model 4 stiffness scale of the yoke support k_ys.eq", source=_PAPER, positive=True)
+    diaphragm_scale: float = quantity(1.3, "1", "Model 4 stiffness scale of the diaphragm spring", source=_PAPER, positive=True)
+    support_max_force: float = quantity(12e3, "N", "force up to which k_ys.eq is extrapolated", source=_REP, positive=True)
+    r_eff: float = quantity(0.1026, "m", "effective friction radius", source=_REP, positive=True)
+    mu: float = quantity(0.27, "1", "friction coefficient (constant)", source=_REP, positive=True, bounds=(0.0, 1.5))
+    m_pp: float = quantity(3.5, "kg", "pressure plate mass", source=_REP, positive=True)
+    m_pps: float = quantity(0.9, "kg", "diaphragm spring mass (Models 2-4)", source=_REP, positive=True)
+    m_ds: float = quantity(0.3, "kg", "yoke support mass (Models 3-4)", source=_REP, positive=True)
+
+
+COMPONENTS = ("diaphragm", "cushion", "return_springs", "pp_spring", "support_ring", "yoke_spring")
+
+
+@dataclasses.dataclass(frozen=True)
+class ComponentCurves:
+    """The measured component characteristics the models are built from ([1] Fig. 9).
+
+    Attributes
+    ----------
+    diaphragm : Curve
+        Diaphragm spring at the tips, leaning on the pressure plate (Fig. 9a).
+    cushion : Curve
+        Friction plate / cushion spring (Fig. 9d).
+    return_springs : Curve
+        Return leaf springs (Fig. 9e).
+    pp_spring : Curve
+        Pressure plate with wear-compensation mechanism (Fig. 9f).
+    support_ring : Curve
+        Yoke support ring (Fig. 9g, Sec. 4.5).
+    yoke_spring : Curve
+        Yoke support spring (Fig. 9h, Sec. 4.6).
+    """
+
+    diaphragm: Curve
+    cushion: Curve
+    return_springs: Curve
+    pp_spring: Curve
+    support_ring: Curve
+    yoke_spring: Curve
+
+    def __post_init__(self):
+        for name in COMPONENTS:
+            if not isinstance(getattr(self, name), Curve):
+                raise ParameterError(f"component curve {name!r} must be a clutchlab.Curve")
+
+    def support_equivalent(self, max_force: float) -> Curve:
+        """k_ys.eq of Model 3: ring and yoke support spring in series, extrapolated to ``max_force`` [N]."""
+        eq = series(self.support_ring, self.yoke_spring, name="yoke support k_ys.eq")
+        if eq.force[-1] < max_force:
+            x_end = float(eq.inverse(max_force))
+            eq = Curve(np.append(eq.deflection, x_end), np.append(eq.force, max_force), kind=eq.kind, name=eq.name)
+        return eq
+
+    @classmethod
+    def from_folder(cls, folder) -> "ComponentCurves":
+        """Read ``<component>.csv`` files (columns ``deflection_m``, ``force_N``) from a folder."""
+        folder = Path(folder)
+        curves = {}
+        for name in COMPONENTS:
+            path = folder / f"{name}.csv"
+            frame = read_table(path, ["deflection_m", "force_N"])
+            curves[name] = Curve(frame["deflection_m"].to_numpy(), frame["force_N"].to_numpy(), kind="pchip", name=name)
+        return cls(**curves)
+
+    @classmethod
+    def bundled(cls) -> "ComponentCurves":
+        """The characterised curves shipped with clutchlab (synthetic, from the virtual press rig)."""
+        with resources.as_file(resources.files("clutchlab.eclutch") / "data" / "curves") as folder:
+            return cls.from_folder(folder)
+
+
+def _model0(p: EClutchParameters, c: ComponentCurves) -> AxialNetwork:
+    k_b = Curve.linear(p.bearing_stiffness, span=(0.0, 1e-3), name="bearing k_b")
+    nodes = (Node("bearing"), Node("tip"), Node("pp", p.m_pp))
+    elements = (
+        Spring("bearing", "bearing", k_b, b="tip", unilateral=True),
+        Spring("diaphragm", "tip", c.diaphragm, prestrain=p.diaphragm_prestrain),
+        Lever("lever", "tip", "pp", p.lever_ratio),
+        Spring("return", "pp", c.return_springs, prestrain=p.return_prestrain),
+        Spring("cushion", "pp", c.cushion, prestrain=p.cushion_prestrain, unilateral=True),
+    )
+    return AxialNetwork(nodes, elements, input="bearing", normal_force="cushion", name="Model 0")
+
+
+def _engaged_loads(p: EClutchParameters, c: ComponentCurves) -> dict[str, float]:
+    """Forces in the rigid connections of Model 0 at bearing position 0 (engaged, bearing at preload).
+
+    The compliances that Models 1-3 add where Model 0 is rigid are assembled
+    carrying these loads, so every model starts from the same engaged state
+    (same clamp load, same bearing preload) and differs only in its slopes.
+    """
+    net = zero_input(_model0(p, c), "bearing", p.bearing_preload)
+    st = solve_static(net, np.array([0.0]))
+    f = dict(zip(st["element_names"], st["forces"][0]))
+    lever = f["bearing"] - f["diaphragm"]  # tip balance: force the fingers carry (N, < 0: pulled back)
+    return {"lever": lever, "pp_spring": f["cushion"] + f["return"], "support": -(1.0 - p.lever_ratio) * lever,
+            "net": net}
+
+
+def _model1(p, c, loads):
+    # + lever compliance k_fl (Eq. 1): the tip becomes a free, massless node
+    return loads["net"].modified(
+        replace={"lever": Lever("lever", "tip", "pp", p.lever_ratio, stiffness=p.k_fl_model1,
+                                prestrain=loads["lever"] / p.k_fl_model1)}, name="Model 1")
+
+
+def _model2(p, c, loads):
+    # + pressure-plate spring k_pp between the diaphragm edge (mass m_pps) and the pressure plate
+    return _model1(p, c, loads).modified(
+        nodes=(Node("edge", p.m_pps),),
+        replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, stiffness=p.k_fl_model2,
+                                prestrain=loads["lever"] / p.k_fl_model2)},
+        add=(Spring("pp_spring", "edge", c.pp_spring, b="pp", unilateral=True,
+                    prestrain=float(c.pp_spring.inverse(loads["pp_spring"]))),),
+        name="Model 2")
+
+
+def _model3(p, c, loads, support_scale=1.0):
+    # + equivalent yoke support k_ys.eq carrying the lever pivot (mass m_ds)
+    k_ys = c.support_equivalent(p.support_max_force)
+    return _model2(p, c, loads).modified(
+        nodes=(Node("support", p.m_ds),),
+        replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, pivot="support", stiffness=p.k_fl_model2,
+                                prestrain=loads["lever"] / p.k_fl_model2)},
+        add=(Spring("support", GROUND, k_ys, b="support", scale=support_scale,
+                    prestrain=float(k_ys.inverse(loads["support"] / support_scale))),),
+        name="Model 3")
+
+
+def _model4(p, c, loads):
+    # diaphragm spring towards the yoke support; k_ys.eq x20, diaphragm x1.3 (Sec. 5.4)
+    return _model3(p, c, loads, support_scale=p.support_scale).modified(
+        replace={"diaphragm": Spring("diaphragm", "tip", c.diaphragm, b="support",
+                                     prestrain=p.diaphragm_prestrain, scale=p.diaphragm_scale)},
+        name="Model 4")
+
+
+_BUILDERS = {1: _model1, 2: _model2, 3: _model3, 4: _model4}
+
+
+def build_model(number: int, params: EClutchParameters | None = None, curves: ComponentCurves | None = None) -> AxialNetwork:
+    """The axial network of Model ``number`` (0-4), with the bearing zeroed at the CSC preload.
+
+    Parameters
+    ----------
+    number : int
+        Model number of [1] (0, 1, 2, 3 or 4).
+    params : EClutchParameters, optional
+        Scalars (default: the bundled defaults).
+    curves : ComponentCurves, optional
+        Component characteristics (default: the bundled synthetic ones).
+    """
+    if isinstance(number, bool) or not isinstance(number, (int, np.integer)) or int(number) not in MODEL_NUMBERS:
+        raise ParameterError(f"unknown model number {number!r}; Haramina et al. define Models 0, 1, 2, 3 and 4")
+    params = params or EClutchParameters()
+    curves = curves or ComponentCurves.bundled()
+    loads = _engaged_loads(params, curves)
+    if int(number) == 0:
+        return loads["net"]
+    net = _BUILDERS[int(number)](params, curves, loads)
+    if int(number) == 4:  # the scaled diaphragm changes the engaged state: zero the bearing again
+        net = zero_input(net, "bearing", params.bearing_preload)
+    return net
+
+
+@dataclasses.dataclass(frozen=True)
+class ClutchModel:
+    """An E-clutch axial model: network plus torque parameters.
+
+    Use :meth:`preset` for the paper's Models 0-4 or build a variant from an
+    :class:`AxialNetwork` of your own.
+
+    Parameters
+    ----------
+    network : AxialNetwork
+        Nodes and elements, with input node (bearing) and normal-force element.
+    r_eff : float
+        Effective friction radius [m].
+    mu : float
+        Friction coefficient [-].
+    number : int or None
+        Model number of [1] for presets.
+    """
+
+    network: AxialNetwork
+    r_eff: float = 0.1026
+    mu: float = 0.27
+    number: int | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.network, AxialNetwork):
+            raise ParameterError("ClutchModel.network must be an AxialNetwork")
+        for name in ("r_eff", "mu"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ParameterError(f"ClutchModel.{name} = {v!r} must be finite and > 0")
+
+    @classmethod
+    def preset(cls, n: int, params: EClutchParameters | None = None, curves: ComponentCurves | None = None) -> "ClutchModel":
+        """Model ``n`` (0-4) of [1] with the bundled default parameters (or the given ones)."""
+        params = params or EClutchParameters()
+        return cls(build_model(n, params, curves), r_eff=params.r_eff, mu=params.mu, number=int(n))
+
+    @classmethod
+    def from_toml(cls, n: int, path) -> "ClutchModel":
+        """Model ``n`` with parameters from a TOML file.
+
+        The file has an ``[eclutch]`` table of :class:`EClutchParameters`
+        (values may carry units, e.g. ``lever_ratio = -3.8``,
+        ``k_fl_model1 = "1.2 MN/m"``) and optionally an ``[eclutch.curves]``
+        table naming a folder of component CSV files (``folder = "curves/"``,
+        relative to the parameter file).
+        """
+        data = load_toml(path)
+        table = dict(data.get("eclutch", data))
+        curves = None
+        if "curves" in table:
+            spec = table.pop("curves")
+            if not isinstance(spec, dict) or set(spec) != {"folder"}:
+                raise ParameterError(f"{path}: [eclutch.curves] must contain exactly one key 'folder'")
+            curves = ComponentCurves.from_folder(Path(path).parent / spec["folder"])
+        params = EClutchParameters.from_dict(table, source=str(path))
+        return cls.preset(n, params, curves)
+
+    @property
+    def name(self) -> str:
+        """Display name."""
+        return self.network.name
+
+    def static_curve(self, bearing_position_m) -> pd.DataFrame:
+        """Static curves (friction off): bearing force, normal force and torque vs bearing position.
+
+        Solves the static equilibrium directly by Newton continuation along
+        the given bearing positions (see :func:`~clutchlab.eclutch.network.solve_static`).
+
+        Parameters
+        ----------
+        bearing_position_m : array_like
+            Release bearing positions [m], from the engaged clutch (0) in the
+            release direction.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``bearing_position_m``, ``bearing_force_N``,
+            ``normal_force_N``, ``torque_Nm`` and the node positions
+            ``x_<node>_m``.
+        """
+        st = solve_static(self.network, bearing_position_m)
+        fn = st["forces"][:, st["element_names"].index(self.network.normal_force)]
+        out = pd.DataFrame({
+            "bearing_position_m": st["input"],
+            "bearing_force_N": st["input_force"],
+            "normal_force_N": fn,
+            "torque_Nm": clutch_torque(fn, self.r_eff, self.mu),
+        })
+        for j, node in enumerate(st["node_names"]):
+            if node != self.network.input:
+                out[f"x_{node}_m"] = st["node_positions"][:, j]
+        return out

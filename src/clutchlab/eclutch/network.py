@@ -1,0 +1,631 @@
+"""One small description for every axial model of the clutch: nodes and elements.
+
+The clutch of Haramina et al. [1] is a chain of springs, a lever and masses
+along the clutch axis.  Models 0-4 of the paper (Figs. 5b, 10, 11) differ only
+in which elements they contain, so clutchlab describes each model as an
+:class:`AxialNetwork` of
+
+* :class:`Node` -- an axial coordinate (positive towards the flywheel, i.e. in
+  the release direction of the bearing) with an optional mass;
+* :class:`Spring` -- a nonlinear spring (a :class:`~clutchlab.Curve`) between
+  two nodes or a node and the ground, with its pre-strain in the assembled
+  clutch, a stiffness scale and an optional unilateral (contact) law;
+* :class:`Lever` -- the diaphragm-spring lever with ratio ``i_ds < 0`` between
+  its tip (release bearing side), its edge (pressure-plate side) and its pivot
+  (the yoke support), rigid or with the lever compliance ``k_fl`` of Eq. (1).
+
+All positions are displacements from the assembled, engaged clutch with the
+bearing at zero.  The prescribed node (``input``, the release bearing) is the
+abscissa of the static curves; the bearing force is the force needed there.
+
+Static equilibrium is solved directly (:func:`solve_static`): the rigid levers
+and the input are eliminated as linear constraints ``x = A q + b u + c``, the
+remaining coordinates ``q`` are found by a damped Newton method with a
+tangent predictor along the bearing travel (natural-parameter continuation),
+compiled with numba.  The stiffness matrix ``(GA)^T K (GA)`` may be indefinite
+in the negative-stiffness region of the diaphragm spring; Newton solves the
+equilibrium equations there all the same, and the continuation step is halved
+until it converges.
+
+References
+----------
+.. [1] K. Haramina, N. Kranjčević, M. Hoić, J. Deur, A. Tissot, Trans. FAMENA
+   48 (2024) 21-35, doi:10.21278/TOF.483057923
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from ..curves import Curve, curve_eval
+from ..errors import ParameterError, SimulationError
+
+__all__ = ["Node", "Spring", "Lever", "AxialNetwork", "solve_static", "zero_input", "GROUND"]
+
+GROUND = "ground"
+
+
+@dataclass(frozen=True)
+class Node:
+    """An axial coordinate of the clutch.
+
+    Parameters
+    ----------
+    name : str
+        Unique name (``"ground"`` is reserved for the housing/cover/flywheel).
+    mass : float
+        Lumped mass [kg] moving with the node (used by dynamic models; zero
+        means a massless, algebraic node).
+    """
+
+    name: str
+    mass: float = 0.0
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name or self.name == GROUND:
+            raise ParameterError(f"node name {self.name!r} is empty or reserved")
+        if not (np.isfinite(self.mass) and self.mass >= 0):
+            raise ParameterError(f"node {self.name!r}: mass = {self.mass!r} kg must be finite and >= 0")
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A nonlinear spring between node ``a`` and node ``b`` (or the ground).
+
+    Its deflection is ``d = prestrain + gain * (x_a - x_b)`` [m] and its force
+    ``f = scale * curve(d)`` [N] pushes ``a`` back (force on ``a`` is
+    ``-gain*f``, on ``b`` ``+gain*f``).  ``gain`` lets a spring act through a
+    lever (the diaphragm's Belleville body seen at the finger tips has
+    ``gain = i_ds``).
+
+    Parameters
+    ----------
+    name : str
+        Unique element name.
+    a, b : str
+        Node names; ``b`` defaults to the ground.
+    curve : Curve
+        Force-deflection characteristic [m -> N].
+    prestrain : float
+        Deflection in the assembled clutch with all nodes at zero [m].
+    scale : float
+        Stiffness scale (force multiplied at equal deflection); Model 4 of [1]
+        uses 20 for the yoke support and 1.3 for the diaphragm spring.
+    unilateral : bool
+        Contact law: the spring carries only compression,
+        ``f = max(scale*curve(d), 0)``; the contact opens when the force
+        reaches zero (lift-off of the pressure plate from the friction plate).
+    gain : float
+        Kinematic gain from node displacement to deflection (default 1).
+    """
+
+    name: str
+    a: str
+    curve: Curve
+    b: str = GROUND
+    prestrain: float = 0.0
+    scale: float = 1.0
+    unilateral: bool = False
+    gain: float = 1.0
+
+    def __post_init__(self):
+        if not isinstance(self.curve, Curve):
+            raise ParameterError(f"spring {self.name!r}: curve must be a clutchlab.Curve, got {type(self.curve).__name__}")
+        if not np.isfinite(self.prestrain):
+            raise ParameterError(f"spring {self.name!r}: prestrain = {self.prestrain!r} m is not finite")
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise ParameterError(f"spring {self.name!r}: scale = {self.scale!r} must be finite and > 0")
+        if not (np.isfinite(self.gain) and self.gain != 0):
+            raise ParameterError(f"spring {self.name!r}: gain = {self.gain!r} must be finite and non-zero")
+        if self.a == self.b:
+            raise ParameterError(f"spring {self.name!r}: both ends on node {self.a!r}")
+
+    def coefficients(self) -> dict[str, float]:
+        """Deflection gradient ``{node: dd/dx_node}``."""
+        out = {self.a: self.gain}
+        out[self.b] = out.get(self.b, 0.0) - self.gain
+        return out
+
+
+@dataclass(frozen=True)
+class Lever:
+    """Diaphragm-spring lever: ``tip - pivot = i_ds * (edge - pivot)`` when rigid.
+
+    With a finite lever stiffness (the finger compliance ``k_fl`` of [1],
+    Eq. 1) the lever deflection ``d = prestrain + (x_tip - x_pivot)
+    - i_ds (x_edge - x_pivot)`` carries the force ``f = stiffness(d)``, which
+    acts on the tip as ``-f``, on the edge as ``+i_ds f`` and on the pivot as
+    ``+(1 - i_ds) f`` (virtual work).  Rigid levers are eliminated as
+    constraints.
+
+    Parameters
+    ----------
+    name : str
+        Unique element name.
+    tip, edge : str
+        Nodes at the finger tips (release bearing) and at the outer edge
+        (pressure plate).
+    ratio : float
+        Lever ratio ``i_ds`` [-], negative: pushing the tips towards the
+        flywheel lifts the edge away from it.
+    pivot : str
+        Pivot node (yoke support), default the ground.
+    stiffness : float, Curve or None
+        ``None`` for a rigid lever, a constant ``k_fl`` [N/m], or a Curve.
+    prestrain : float
+        Lever deflection in the assembled clutch [m].
+    """
+
+    name: str
+    tip: str
+    edge: str
+    ratio: float
+    pivot: str = GROUND
+    stiffness: float | Curve | None = None
+    prestrain: float = 0.0
+
+    def __post_init__(self):
+        if not (np.isfinite(self.ratio) and self.ratio < 0):
+            raise ParameterError(f"lever {self.name!r}: ratio i_ds = {self.ratio!r} must be finite and < 0")
+        if len({self.tip, self.edge, self.pivot}) != 3:
+            raise ParameterError(f"lever {self.name!r}: tip, edge and pivot must be three different nodes")
+        if not np.isfinite(self.prestrain):
+            raise ParameterError(f"lever {self.name!r}: prestrain = {self.prestrain!r} m is not finite")
+        s = self.stiffness
+        if s is not None and not isinstance(s, Curve):
+            if isinstance(s, bool) or not isinstance(s, (int, float)) or not (np.isfinite(s) and s > 0):
+                raise ParameterError(f"lever {self.name!r}: stiffness k_fl = {s!r} N/m must be finite and > 0 (or None: rigid)")
+
+    @property
+    def rigid(self) -> bool:
+        """True if the lever has no compliance."""
+        return self.stiffness is None
+
+    def curve(self) -> Curve:
+        """The lever compliance as a Curve (linear for a constant ``k_fl``)."""
+        if self.stiffness is None:
+            raise ParameterError(f"lever {self.name!r} is rigid")
+        if isinstance(self.stiffness, Curve):
+            return self.stiffness
+        return Curve.linear(float(self.stiffness), name=f"{self.name} k_fl")
+
+    def coefficients(self) -> dict[str, float]:
+        """Deflection gradient ``{node: dd/dx_node}``."""
+        out = {self.tip: 1.0, self.edge: -self.ratio}
+        out[self.pivot] = out.get(self.pivot, 0.0) - (1.0 - self.ratio)
+        return out
+
+
+@dataclass(frozen=True)
+class AxialNetwork:
+    """A clutch axial model: nodes, elements and the prescribed input node.
+
+    Parameters
+    ----------
+    nodes : tuple of Node
+        Every node except the ground, including the input node.
+    elements : tuple of Spring and Lever
+        The elastic elements and levers.
+    input : str
+        Node whose position is prescribed (the release bearing / CSC).
+    normal_force : str
+        Name of the spring whose force is the clutch normal force F_n (the
+        contact of pressure plate and friction plate: the cushion spring).
+    name : str
+        Label of the model.
+
+    Notes
+    -----
+    Positions are in metres from the assembled, engaged state, positive
+    towards the flywheel (the release direction of the bearing of a push-type
+    diaphragm clutch).
+    """
+
+    nodes: tuple
+    elements: tuple
+    input: str = "bearing"
+    normal_force: str = "cushion"
+    name: str = "axial network"
+    _assembly: dict = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "nodes", tuple(self.nodes))
+        object.__setattr__(self, "elements", tuple(self.elements))
+        names = [n.name for n in self.nodes]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"network {self.name!r}: duplicate node names in {names}")
+        enames = [e.name for e in self.elements]
+        if len(set(enames)) != len(enames):
+            raise ParameterError(f"network {self.name!r}: duplicate element names in {enames}")
+        known = set(names) | {GROUND}
+        for e in self.elements:
+            for node in e.coefficients():
+                if node not in known:
+                    raise ParameterError(f"network {self.name!r}: element {e.name!r} refers to unknown node {node!r}")
+        if self.input not in names:
+            raise ParameterError(f"network {self.name!r}: input node {self.input!r} is not a node")
+        springs = {e.name: e for e in self.elements if isinstance(e, Spring)}
+        if self.normal_force not in springs:
+            raise ParameterError(f"network {self.name!r}: normal_force element {self.normal_force!r} is not a spring")
+        object.__setattr__(self, "_assembly", self._assemble())
+
+    # ------------------------------------------------------------ convenience
+    def element(self, name: str):
+        """Return the element called ``name``."""
+        for e in self.elements:
+            if e.name == name:
+                return e
+        raise ParameterError(f"network {self.name!r}: no element {name!r} (has: {[e.name for e in self.elements]})")
+
+    def node(self, name: str) -> Node:
+        """Return the node called ``name``."""
+        for n in self.nodes:
+            if n.name == name:
+                return n
+        raise ParameterError(f"network {self.name!r}: no node {name!r}")
+
+    def modified(self, *, nodes=(), replace=None, add=(), name: str | None = None) -> "AxialNetwork":
+        """Return a copy with extra ``nodes``, elements replaced (``{name: new}``) and ``add``-ed.
+
+        This is how Models 1-4 extend Model 0: each adds nodes (masses) and
+        compliances or moves an element to another node.  Replacing with
+        ``None`` removes the element.
+        """
+        replace = dict(replace or {})
+        for key in replace:
+            self.element(key)
+        elements = tuple(replace.get(e.name, e) for e in self.elements)
+        elements = tuple(e for e in elements if e is not None) + tuple(add)
+        return AxialNetwork(self.nodes + tuple(nodes), elements, input=self.input, normal_force=self.normal_force,
+                            name=name or self.name)
+
+    def replace_element(self, name: str, new) -> "AxialNetwork":
+        """Return a copy with element ``name`` replaced by ``new`` (``None`` removes it)."""
+        return self.modified(replace={name: new})
+
+    def describe(self) -> str:
+        """Text listing of nodes and elements (topology of the model)."""
+        lines = [f"{self.name}: input node {self.input!r}, normal force from {self.normal_force!r}"]
+        for n in self.nodes:
+            lines.append(f"  node   {n.name:<10} mass {n.mass:.4g} kg")
+        for e in self.elements:
+            if isinstance(e, Lever):
+                k = "rigid" if e.rigid else (f"k_fl = {e.stiffness:.4g} N/m" if not isinstance(e.stiffness, Curve) else "k_fl curve")
+                lines.append(f"  lever  {e.name:<10} tip {e.tip}, edge {e.edge}, pivot {e.pivot}, i_ds = {e.ratio:g}, {k}")
+            else:
+                kind = "contact" if e.unilateral else "spring"
+                lines.append(f"  {kind:<7}{e.name:<10} {e.a} - {e.b}, prestrain {e.prestrain * 1e3:.4g} mm, "
+                             f"scale {e.scale:g}, gain {e.gain:g}, curve {e.curve.name!r}")
+        return "\n".join(lines)
+
+    # ----------------------------------------------------------------- assembly
+    def _assemble(self) -> dict:
+        from scipy.linalg import null_space
+
+        names = [n.name for n in self.nodes]
+        idx = {n: i for i, n in enumerate(names)}
+        N = len(names)
+        rows, rhs_u, rhs_c = [], [], []
+        # input constraint x_in = u
+        r = np.zeros(N)
+        r[idx[self.input]] = 1.0
+        rows.append(r), rhs_u.append(1.0), rhs_c.append(0.0)
+        elastic = []
+        for e in self.elements:
+            g = np.zeros(N)
+            for node, coef in e.coefficients().items():
+                if node != GROUND:
+                    g[idx[node]] += coef
+            if isinstance(e, Lever) and e.rigid:
+                rows.append(g), rhs_u.append(0.0), rhs_c.append(-e.prestrain)
+            else:
+                elastic.append((e, g))
+        C = np.array(rows)
+        if np.linalg.matrix_rank(C) < C.shape[0]:
+            raise ParameterError(f"network {self.name!r}: rigid levers over-constrain the nodes")
+        pinv = np.linalg.pinv(C)
+        b = pinv @ np.array(rhs_u)
+        c = pinv @ np.array(rhs_c)
+        A = null_space(C)
+        if A.shape[1] == 0:
+            raise ParameterError(f"network {self.name!r}: no free coordinate left after the constraints")
+        G = np.array([g for _, g in elastic])
+        GA = G @ A
+        # every free coordinate must be held by some element
+        if np.linalg.matrix_rank(GA) < A.shape[1]:
+            raise ParameterError(f"network {self.name!r}: a node is not connected to any spring (singular network)")
+        curves, prestrain, scale, unilateral = [], [], [], []
+        for e, _ in elastic:
+            if isinstance(e, Lever):
+                curves.append(e.curve()), prestrain.append(e.prestrain), scale.append(1.0), unilateral.append(False)
+            else:
+                curves.append(e.curve), prestrain.append(e.prestrain), scale.append(e.scale), unilateral.append(e.unilateral)
+        offsets = np.zeros(len(curves) + 1, dtype=np.int64)
+        for k, cv in enumerate(curves):
+            offsets[k + 1] = offsets[k] + cv.deflection.size
+        cx = np.concatenate([cv.kernel_data()[0] for cv in curves])
+        cf = np.concatenate([cv.kernel_data()[1] for cv in curves])
+        cd = np.concatenate([cv.kernel_data()[2] for cv in curves])
+        kinds = np.array([cv.kernel_data()[3] for cv in curves], dtype=np.int64)
+        extraps = np.array([cv.kernel_data()[4] for cv in curves], dtype=np.int64)
+        return dict(
+            node_names=names, element_names=[e.name for e, _ in elastic], A=A, b=b, c=c, G=G,
+            GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), d0=np.ascontiguousarray(np.array(prestrain) + G @ c),
+            cx=cx, cf=cf, cd=cd, offsets=offsets, kinds=kinds, extraps=extraps,
+            scale=np.array(scale), unilateral=np.array(unilateral, dtype=np.bool_),
+        )
+
+    @property
+    def n_free(self) -> int:
+        """Number of free coordinates after eliminating the input and the rigid levers."""
+        return self._assembly["A"].shape[1]
+
+    def kernel_data(self) -> tuple:
+        """Arrays for the compiled kernels (see :func:`_static_path`)."""
+        a = self._assembly
+        return (a["GA"], a["Gb"], a["d0"], a["cx"], a["cf"], a["cd"], a["offsets"], a["kinds"], a["extraps"],
+                a["scale"], a["unilateral"])
+
+
+# ---------------------------------------------------------------------------
+# compiled static solver
+# ---------------------------------------------------------------------------
+
+@numba.njit(cache=True, nogil=True)
+def element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d):
+    """Deflections ``d`` [m], forces ``f`` [N] and tangent stiffnesses ``k`` [N/m] of the elastic elements."""
+    n_el = GA.shape[0]
+    n_q = GA.shape[1]
+    for e in range(n_el):
+        de = d0[e] + Gb[e] * u
+        for j in range(n_q):
+            de += GA[e, j] * q[j]
+        d[e] = de
+        lo = offsets[e]
+        hi = offsets[e + 1]
+        fe, ke = curve_eval(cx[lo:hi], cf[lo:hi], cd[lo:hi], kinds[e], extraps[e], de)
+        fe *= scale[e]
+        ke *= scale[e]
+        if unilateral[e] and fe <= 0.0:
+            fe = 0.0
+            ke = 0.0
+        f[e] = fe
+        k[e] = ke
+
+
+@numba.njit(cache=True, nogil=True)
+def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f_tol, x_tol, max_iter):
+    """Damped Newton on ``(GA)^T f(d) = 0``; returns (converged, iterations)."""
+    n_el = GA.shape[0]
+    n_q = GA.shape[1]
+    f = np.empty(n_el)
+    k = np.empty(n_el)
+    d = np.empty(n_el)
+    r = np.empty(n_q)
+    J = np.empty((n_q, n_q))
+    qt = np.empty(n_q)
+    for it in range(max_iter):
+        element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+        rn = 0.0
+        for j in range(n_q):
+            s = 0.0
+            for e in range(n_el):
+                s += GA[e, j] * f[e]
+            r[j] = s
+            rn += s * s
+        rn = np.sqrt(rn)
+        if not np.isfinite(rn):
+            return False, it
+        if rn <= f_tol:
+            return True, it
+        for i in range(n_q):
+            for j in range(n_q):
+                s = 0.0
+                for e in range(n_el):
+                    s += GA[e, i] * k[e] * GA[e, j]
+                J[i, j] = s
+        # regularise a singular tangent (e.g. all contacts open on one node)
+        for i in range(n_q):
+            J[i, i] += 1e-9 * (abs(J[i, i]) + 1.0)
+        dq = np.linalg.solve(J, r)
+        step = 1.0
+        accepted = False
+        for _ls in range(30):
+            for j in range(n_q):
+                qt[j] = q[j] - step * dq[j]
+            element_forces(qt, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+            rt = 0.0
+            for j in range(n_q):
+                s = 0.0
+                for e in range(n_el):
+                    s += GA[e, j] * f[e]
+                rt += s * s
+            rt = np.sqrt(rt)
+            if np.isfinite(rt) and rt < (1.0 - 1e-4 * step) * rn:
+                accepted = True
+                break
+            step *= 0.5
+        if not accepted:
+            # take a small step anyway (non-smooth contact kink); stop if no progress
+            for j in range(n_q):
+                qt[j] = q[j] - step * dq[j]
+        dmax = 0.0
+        for j in range(n_q):
+            dmax = max(dmax, abs(qt[j] - q[j]))
+            q[j] = qt[j]
+        if dmax <= x_tol:
+            element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+            rn = 0.0
+            for j in range(n_q):
+                s = 0.0
+                for e in range(n_el):
+                    s += GA[e, j] * f[e]
+                rn += s * s
+            return np.sqrt(rn) <= 1e3 * f_tol, it
+    return False, max_iter
+
+
+@numba.njit(cache=True, nogil=True)
+def _tangent(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral):
+    """dq/du along the equilibrium path: ``-J^{-1} (GA)^T K Gb``."""
+    n_el = GA.shape[0]
+    n_q = GA.shape[1]
+    f = np.empty(n_el)
+    k = np.empty(n_el)
+    d = np.empty(n_el)
+    element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+    J = np.empty((n_q, n_q))
+    rhs = np.empty(n_q)
+    for i in range(n_q):
+        s = 0.0
+        for e in range(n_el):
+            s += GA[e, i] * k[e] * Gb[e]
+        rhs[i] = -s
+        for j in range(n_q):
+            s = 0.0
+            for e in range(n_el):
+                s += GA[e, i] * k[e] * GA[e, j]
+            J[i, j] = s
+        J[i, i] += 1e-9 * (abs(J[i, i]) + 1.0)
+    return np.linalg.solve(J, rhs)
+
+
+@numba.njit(cache=True, nogil=True)
+def _static_path(u_grid, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f_tol, x_tol):
+    """Equilibria along ``u_grid`` by continuation; returns (q, forces, deflections, status)."""
+    n_u = u_grid.shape[0]
+    n_q = GA.shape[1]
+    n_el = GA.shape[0]
+    Q = np.empty((n_u, n_q))
+    F = np.empty((n_u, n_el))
+    D = np.empty((n_u, n_el))
+    kk = np.empty(n_el)
+    q = q0.copy()
+    u_prev = u_grid[0]
+    status = 0
+    for i in range(n_u):
+        target = u_grid[i]
+        n_sub = 1
+        ok = False
+        q_start = q.copy()
+        while n_sub <= 4096:
+            q[:] = q_start
+            uc = u_prev
+            ok = True
+            for s in range(n_sub):
+                un = u_prev + (target - u_prev) * (s + 1) / n_sub
+                if i > 0 or s > 0:
+                    tq = _tangent(q, uc, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
+                    for j in range(n_q):
+                        q[j] += tq[j] * (un - uc)
+                conv, _it = _newton(q, un, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral,
+                                    f_tol, x_tol, 60)
+                if not conv:
+                    ok = False
+                    break
+                uc = un
+            if ok:
+                break
+            n_sub *= 4
+        if not ok:
+            status = i + 1
+            return Q[:i], F[:i], D[:i], status
+        Q[i, :] = q
+        element_forces(q, target, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, F[i], kk, D[i])
+        u_prev = target
+    return Q, F, D, status
+
+
+def solve_static(network: AxialNetwork, input_positions, *, q0=None, force_tol: float = 1e-7, x_tol: float = 1e-14):
+    """Static equilibria of ``network`` along the prescribed input positions.
+
+    Parameters
+    ----------
+    network : AxialNetwork
+        The clutch model.
+    input_positions : array_like
+        Positions of the input node (release bearing) [m], visited in order
+        (continuation follows this path, so pass a monotone travel; a release
+        followed by an engagement is fine).
+    q0 : array_like, optional
+        Initial guess of the free coordinates at the first position (default
+        zeros: the assembled state).
+    force_tol : float
+        Residual force tolerance [N].
+    x_tol : float
+        Position-increment tolerance [m].
+
+    Returns
+    -------
+    dict
+        ``input`` [m], ``node_positions`` (n x nodes) [m], ``forces`` and
+        ``deflections`` of the elastic elements (n x elements) [N], [m],
+        ``input_force`` [N] (the bearing force), ``node_names``,
+        ``element_names``.
+
+    Raises
+    ------
+    SimulationError
+        If Newton fails even with 4096 continuation sub-steps (e.g. a
+        snap-through that position control cannot follow).
+    """
+    u = np.ascontiguousarray(np.atleast_1d(np.asarray(input_positions, dtype=float)))
+    if u.ndim != 1 or u.size == 0 or not np.all(np.isfinite(u)):
+        raise ParameterError("input positions must be a non-empty 1-D array of finite values [m]")
+    a = network._assembly
+    q = np.zeros(network.n_free) if q0 is None else np.asarray(q0, dtype=float).copy()
+    # first point: walk from the assembled state (u = 0) to u[0] so that Newton starts close
+    if u[0] != 0.0 and q0 is None:
+        pre = np.linspace(0.0, u[0], 9)
+        Qp, _, _, st = _static_path(pre, q, *network.kernel_data(), force_tol, x_tol)
+        if st == 0:
+            q = Qp[-1].copy()
+    Q, F, D, status = _static_path(u, q, *network.kernel_data(), force_tol, x_tol)
+    if status:
+        raise SimulationError(
+            f"{network.name}: static equilibrium not found at input position {u[status - 1]!r} m "
+            "(snap-through or an element without stiffness)"
+        )
+    X = Q @ a["A"].T + np.outer(u, a["b"]) + a["c"]
+    input_force = F @ a["Gb"]
+    return dict(input=u, node_positions=X, forces=F, deflections=D, input_force=input_force,
+                node_names=list(a["node_names"]), element_names=list(a["element_names"]))
+
+
+def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0.05, 0.05)) -> AxialNetwork:
+    """Shift the pre-strain of ``element`` so the input force at input position 0 equals ``force``.
+
+    This sets the origin of the bearing travel to the engaged clutch with the
+    bearing pressed by the CSC preload ``force`` [N], the usual zero of a
+    release-bearing position sensor.  Returns a new network.
+    """
+    from scipy.optimize import brentq
+
+    el = network.element(element)
+    if not isinstance(el, Spring):
+        raise ParameterError(f"zero_input: element {element!r} must be a spring")
+    if not (np.isfinite(force) and force >= 0):
+        raise ParameterError(f"zero_input: force = {force!r} N must be finite and >= 0")
+
+    def residual(p):
+        net = network.replace_element(element, _replace_spring(el, prestrain=p))
+        try:
+            return float(solve_static(net, np.array([0.0]))["input_force"][0]) - force
+        except SimulationError:
+            return np.nan
+
+    lo, hi = bracket
+    r_lo, r_hi = residual(lo), residual(hi)
+    if not (np.isfinite(r_lo) and np.isfinite(r_hi)) or r_lo * r_hi > 0:
+        raise ParameterError(f"zero_input: cannot reach an input force of {force!r} N by shifting {element!r} within {bracket} m")
+    p = brentq(residual, lo, hi, xtol=1e-13, rtol=1e-12)
+    return network.replace_element(element, _replace_spring(el, prestrain=p))
+
+
+def _replace_spring(spring: Spring, **changes) -> Spring:
+    import dataclasses
+
+    return dataclasses.replace(spring, **changes)
