@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..curves import Curve, series
+from ..curves import Curve
 from ..errors import ParameterError
 from ..io import read_table
 from ..params import ParameterSet, load_toml, quantity
@@ -138,12 +138,14 @@ class ComponentCurves:
                 raise ParameterError(f"component curve {name!r} must be a clutchlab.Curve")
 
     def support_equivalent(self, max_force: float) -> Curve:
-        """k_ys.eq of Model 3: ring and yoke support spring in series, extrapolated to ``max_force`` [N]."""
-        eq = series(self.support_ring, self.yoke_spring, name="yoke support k_ys.eq")
-        if eq.force[-1] < max_force:
-            x_end = float(eq.inverse(max_force))
-            eq = Curve(np.append(eq.deflection, x_end), np.append(eq.force, max_force), kind=eq.kind, name=eq.name)
-        return eq
+        """k_ys.eq of Model 3: ring and yoke support spring in series, extrapolated to ``max_force`` [N].
+
+        See :func:`~clutchlab.eclutch.characterize.yoke_support_equivalent` ([1] Sec. 5.3).
+        """
+        from .characterize import yoke_support_equivalent
+
+        return yoke_support_equivalent(self.support_ring, self.yoke_spring, max_force_N=max_force,
+                                       name="yoke support k_ys.eq")
 
     @classmethod
     def from_folder(cls, folder) -> "ComponentCurves":

@@ -290,14 +290,14 @@ class AxialNetwork:
         """Text listing of nodes and elements (topology of the model)."""
         lines = [f"{self.name}: input node {self.input!r}, normal force from {self.normal_force!r}"]
         for n in self.nodes:
-            lines.append(f"  node   {n.name:<10} mass {n.mass:.4g} kg")
+            lines.append(f"  node    {n.name:<10} mass {n.mass:.4g} kg")
         for e in self.elements:
             if isinstance(e, Lever):
                 k = "rigid" if e.rigid else (f"k_fl = {e.stiffness:.4g} N/m" if not isinstance(e.stiffness, Curve) else "k_fl curve")
-                lines.append(f"  lever  {e.name:<10} tip {e.tip}, edge {e.edge}, pivot {e.pivot}, i_ds = {e.ratio:g}, {k}")
+                lines.append(f"  lever   {e.name:<10} tip {e.tip}, edge {e.edge}, pivot {e.pivot}, i_ds = {e.ratio:g}, {k}")
             else:
                 kind = "contact" if e.unilateral else "spring"
-                lines.append(f"  {kind:<7}{e.name:<10} {e.a} - {e.b}, prestrain {e.prestrain * 1e3:.4g} mm, "
+                lines.append(f"  {kind:<8}{e.name:<10} {e.a} - {e.b}, prestrain {e.prestrain * 1e3:.4g} mm, "
                              f"scale {e.scale:g}, gain {e.gain:g}, curve {e.curve.name!r}")
         return "\n".join(lines)
 

@@ -33,14 +33,13 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import pandas as pd
 
-from ..curves import Curve, series
+from ..curves import Curve
 from ..params import ParameterSet, quantity
 from . import components as law
 from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
 
-__all__ = ["VirtualClutch", "stop_operator"]
+__all__ = ["VirtualClutch"]
 
 _REP = "representative (docs/eclutch.md)"
 
@@ -184,36 +183,3 @@ class VirtualClutch(ParameterSet):
         """Force between diaphragm and yoke support [N] along a static solution."""
         names = static["element_names"]
         return static["forces"][:, names.index("ring")] - static["forces"][:, names.index("yoke_spring")]
-
-
-def stop_operator(x, capacity, stiffness, z0=0.0):
-    """Prandtl stop (elastic-perfectly-plastic) operator: compliant Coulomb stiction.
-
-    ``z_k = clip(z_{k-1} + stiffness (x_k - x_{k-1}), -capacity_k, capacity_k)``.
-
-    Parameters
-    ----------
-    x : array_like
-        Input displacement path [m].
-    capacity : array_like or float
-        Sliding force along the path [N] (>= 0).
-    stiffness : float
-        Stick stiffness [N/m].
-    z0 : float
-        Initial friction force [N].
-
-    Returns
-    -------
-    z : ndarray
-        Friction force [N], opposing the motion once sliding.
-    """
-    x = np.asarray(x, dtype=float)
-    cap = np.broadcast_to(np.asarray(capacity, dtype=float), x.shape)
-    z = np.empty_like(x)
-    zk = float(z0)
-    for k in range(x.size):  # data generation only (a few thousand samples), not a simulation hot loop
-        if k:
-            zk += stiffness * (x[k] - x[k - 1])
-        zk = min(max(zk, -cap[k]), cap[k])
-        z[k] = zk
-    return z

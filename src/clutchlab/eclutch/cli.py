@@ -1,0 +1,137 @@
+"""``clutchlab eclutch ...`` sub-commands (thin layer over :mod:`clutchlab.eclutch`)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..io import atomic_to_csv, atomic_write_bytes, check_writable
+from ..units import to_si
+
+
+def _save_figure(fig, path, overwrite):
+    import matplotlib.pyplot as plt
+
+    check_writable(path, overwrite)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
+
+
+def _model(args):
+    from .models import ClutchModel
+
+    if args.params:
+        return ClutchModel.from_toml(args.model, args.params)
+    return ClutchModel.preset(args.model)
+
+
+def _characterize(args) -> int:
+    from ..plotting import press_characterization
+    from .characterize import characterize
+
+    check_writable(args.output, args.force)
+    curve = characterize(args.record, channel=args.channel, n_grid=args.points)
+    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
+                  header_comment=f"characterised from {args.record} by clutchlab eclutch characterize")
+    if args.plot:
+        from ..io import read_table
+
+        rec = read_table(args.record, ["time_s", "force_N", args.channel])
+        fig = press_characterization([dict(title=str(args.record), record=rec, curve=curve, channel=args.channel)],
+                                     ncols=1)
+        _save_figure(fig, args.plot, args.force)
+    print(f"{args.output}: {curve.deflection.size} samples, {curve.n_cycles} cycles, "
+          f"hysteresis half-width {np.median(curve.hysteresis_half_width):.3g} N, "
+          f"cycle scatter <= {np.max(curve.cycle_scatter):.3g} N")
+    return 0
+
+
+def _static(args) -> int:
+    from ..plotting import static_curves_vs_record
+
+    check_writable(args.output, args.force)
+    travel = to_si(args.travel, "m", name="--travel")
+    if not travel > 0:
+        raise ParameterError(f"--travel = {args.travel!r}: must be > 0")
+    if args.points < 2:
+        raise ParameterError(f"--points = {args.points}: need at least 2")
+    model = _model(args)
+    df = model.static_curve(np.linspace(0.0, travel, args.points))
+    atomic_to_csv(df, args.output, overwrite=args.force,
+                  header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static")
+    if args.plot:
+        from .validation import read_full_clutch_record
+
+        record = read_full_clutch_record(args.record) if args.record else None
+        fig = static_curves_vs_record({model.name: df}, record, title=f"{model.name}: release bearing force")
+        _save_figure(fig, args.plot, args.force)
+    peak = df["bearing_force_N"].max()
+    print(f"{args.output}: {model.name}, {len(df)} points, peak bearing force {peak:.1f} N, "
+          f"engaged torque {df['torque_Nm'].iloc[0]:.1f} N*m")
+    return 0
+
+
+def _validate(args) -> int:
+    import pandas as pd
+
+    from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
+    from .validation import compare, read_full_clutch_record
+
+    record = read_full_clutch_record(args.record, name=str(args.record))
+    params = EClutchParameters.from_toml(args.params) if args.params else EClutchParameters()
+    rows = [{"model": n, **compare(ClutchModel.preset(n, params), record)} for n in MODEL_NUMBERS]
+    table = pd.DataFrame(rows)
+    if args.output:
+        atomic_to_csv(table, args.output, overwrite=args.force)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    return 0
+
+
+def _describe(args) -> int:
+    print(_model(args).network.describe())
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``clutchlab eclutch`` with its sub-commands."""
+    p = subparsers.add_parser("eclutch", help="dry clutch-by-wire (E-clutch): press-rig characterisation, Models 0-4",
+                              description="E-clutch after Haramina et al., Trans. FAMENA 48 (2024) 21-35.")
+    sub = p.add_subparsers(dest="eclutch_command", metavar="COMMAND", required=True)
+
+    c = sub.add_parser("characterize", help="characteristic curve from a raw press-rig record (CSV)",
+                       description="Find load cycles, average loading/unloading branches and cycles (Sec. 4).")
+    c.add_argument("record", help="CSV with time_s, force_N, displacement_m (lines starting with # are comments)")
+    c.add_argument("-o", "--output", required=True, help="curve CSV to write")
+    c.add_argument("--channel", default="displacement_m", help="displacement column (default: %(default)s)")
+    c.add_argument("--points", type=int, default=60, help="samples of the returned curve (default: %(default)s)")
+    c.add_argument("--plot", help="also write a PNG figure of raw record and curve")
+    c.add_argument("--force", action="store_true", help="overwrite existing output files")
+    c.set_defaults(func=_characterize)
+
+    s = sub.add_parser("static", help="static curves (bearing force, normal force, torque) of Model N",
+                       description="Static equilibrium by Newton continuation along the bearing travel.")
+    s.add_argument("--model", type=int, required=True, help="model number 0-4 (Haramina et al. 2024)")
+    s.add_argument("--params", help="TOML parameter file ([eclutch] table; values may carry units)")
+    s.add_argument("--travel", default="9 mm", help="release travel, with unit (default: %(default)s)")
+    s.add_argument("--points", type=int, default=200, help="number of bearing positions (default: %(default)s)")
+    s.add_argument("-o", "--output", required=True, help="CSV to write")
+    s.add_argument("--plot", help="also write a PNG figure")
+    s.add_argument("--record", help="full-clutch record CSV to draw in the figure")
+    s.add_argument("--force", action="store_true", help="overwrite existing output files")
+    s.set_defaults(func=_static)
+
+    v = sub.add_parser("validate", help="errors of Models 0-4 against a full-clutch record (Fig. 12)")
+    v.add_argument("record", help="CSV with time_s, bearing_position_m, bearing_force_N, torque_Nm")
+    v.add_argument("--params", help="TOML parameter file")
+    v.add_argument("-o", "--output", help="CSV of the metrics")
+    v.add_argument("--force", action="store_true", help="overwrite the output file")
+    v.set_defaults(func=_validate)
+
+    d = sub.add_parser("describe", help="print the nodes and elements of Model N")
+    d.add_argument("--model", type=int, required=True, help="model number 0-4")
+    d.add_argument("--params", help="TOML parameter file")
+    d.set_defaults(func=_describe)

@@ -1,0 +1,90 @@
+"""Figures for reports (matplotlib, imported lazily so that importing clutchlab stays light).
+
+Every function returns a :class:`matplotlib.figure.Figure`; nothing is shown
+or saved here (the report layer does that).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["new_figure", "press_characterization", "static_curves_vs_record"]
+
+MODEL_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2")
+
+
+def new_figure(nrows=1, ncols=1, *, width=7.0, height=4.5, **kw):
+    """A figure and axes with the Agg backend (safe on machines without a display)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(nrows, ncols, figsize=(width, height), **kw)
+    return fig, axes
+
+
+def press_characterization(panels, *, title: str = "", ncols: int = 4):
+    """Raw press records, averaged branches and the characterised curve (Haramina et al. 2024, Fig. 9 style).
+
+    Parameters
+    ----------
+    panels : list of dict
+        Each with ``title``, ``record`` (DataFrame with ``displacement_m``,
+        ``force_N``), ``curve`` (a Curve or None), optional ``truth`` (Curve,
+        drawn dashed) and ``channel`` (displacement column).
+    """
+    n = len(panels)
+    nrows = int(np.ceil(n / ncols))
+    fig, axes = new_figure(nrows, ncols, width=3.4 * ncols, height=2.9 * nrows, squeeze=False)
+    for ax, panel in zip(axes.ravel(), panels):
+        rec = panel["record"]
+        ch = panel.get("channel", "displacement_m")
+        ax.plot(rec[ch] * 1e3, rec["force_N"], color="#7fa7d9", lw=0.6, label="raw (synthetic)")
+        curve = panel.get("curve")
+        if curve is not None:
+            ax.plot(curve.deflection * 1e3, curve.force, color="k", lw=1.6, label="characterised")
+        truth = panel.get("truth")
+        if truth is not None:
+            x = np.linspace(*(curve.span if curve is not None else truth.span), 200)
+            ax.plot(x * 1e3, truth(x), "--", color="#2ca02c", lw=1.0, label="virtual-clutch law")
+        ax.set_title(panel["title"], fontsize=9)
+        ax.set_xlabel(panel.get("xlabel", "displacement [mm]"), fontsize=8)
+        ax.set_ylabel("force [N]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    for ax in axes.ravel()[n:]:
+        ax.axis("off")
+    axes.ravel()[0].legend(fontsize=7)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def static_curves_vs_record(curves: dict, record=None, *, quantity: str = "bearing_force_N",
+                            ylabel: str = "bearing force [N]", title: str = ""):
+    """Static curves of several models against a recorded release/engagement (Fig. 12 style).
+
+    Parameters
+    ----------
+    curves : dict
+        Label -> DataFrame with ``bearing_position_m`` and ``quantity``.
+    record : DataFrame, optional
+        Recorded ``bearing_position_m`` and ``quantity`` (drawn in grey).
+    """
+    fig, ax = new_figure(width=7.0, height=4.4)
+    if record is not None:
+        ax.plot(record["bearing_position_m"] * 1e3, record[quantity], color="0.55", lw=0.8,
+                label="full-clutch record (synthetic)")
+    for k, (label, df) in enumerate(curves.items()):
+        ax.plot(df["bearing_position_m"] * 1e3, df[quantity], color=MODEL_COLORS[k % len(MODEL_COLORS)],
+                lw=1.4, label=label)
+    ax.set_xlabel("release bearing position [mm]")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig

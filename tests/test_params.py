@@ -1,0 +1,67 @@
+"""ParameterSet base: units metadata, validation, TOML round trip, clear errors."""
+
+import dataclasses
+
+import pytest
+
+from clutchlab.eclutch import EClutchParameters, VirtualClutch
+from clutchlab.errors import ParameterError
+from clutchlab.params import ParameterSet, quantity
+
+
+@dataclasses.dataclass(frozen=True)
+class Toy(ParameterSet):
+    kind = "toy"
+    r_outer: float = quantity(0.08, "m", "outer radius", positive=True)
+    r_inner: float = quantity(0.06, "m", "inner radius", positive=True)
+    n: int = quantity(3, "1", "number of plates", positive=True)
+    visc: tuple = quantity((0.01, 2.0), "1", "coefficients")
+
+    def check(self):
+        if not self.r_inner < self.r_outer:
+            raise ParameterError(f"Toy: r_inner = {self.r_inner!r} m must be < r_outer = {self.r_outer!r} m")
+
+
+@pytest.mark.parametrize("cls", [Toy, EClutchParameters, VirtualClutch])
+def test_every_field_has_unit_and_doc(cls):
+    for name, meta in cls.field_info().items():
+        assert meta["unit"], name
+        assert meta["doc"], name
+
+
+def test_validation_errors():
+    with pytest.raises(ParameterError, match="r_inner = 0.09 m must be < r_outer"):
+        Toy(r_inner=0.09)
+    with pytest.raises(ParameterError, match=r"Toy.r_outer = -1.0: must be > 0"):
+        Toy(r_outer=-1.0)
+    with pytest.raises(ParameterError, match="not finite"):
+        Toy(r_outer=float("nan"))
+    with pytest.raises(ParameterError, match="unknown parameter"):
+        Toy().replace(radius=1.0)
+
+
+def test_toml_round_trip_with_units(tmp_path):
+    t = Toy(r_outer=0.09, n=5, visc=(0.02, 3.0))
+    path = t.to_toml(tmp_path / "toy.toml")
+    text = path.read_text()
+    assert "[toy]" in text and '"0.09 m"' in text
+    assert Toy.from_toml(path) == t
+    with pytest.raises(FileExistsError):
+        t.to_toml(path)
+    t.to_toml(path, overwrite=True)
+
+
+def test_from_dict_converts_units_and_reports_source():
+    t = Toy.from_dict({"r_outer": "83.15 mm", "n": 4, "visc": ["0.5", 1]}, source="x.toml")
+    assert t.r_outer == pytest.approx(0.08315) and t.n == 4 and isinstance(t.n, int)
+    with pytest.raises(ParameterError, match="x.toml: n = 2.5: expected a whole number"):
+        Toy.from_dict({"n": 2.5}, source="x.toml")
+    with pytest.raises(ParameterError, match="x.toml: Toy: r_inner = 0.1 m must be < r_outer"):
+        Toy.from_dict({"r_inner": "100 mm"}, source="x.toml")
+    with pytest.raises(ParameterError, match="x.toml: unknown parameter 'r_out'"):
+        Toy.from_dict({"r_out": 1}, source="x.toml")
+
+
+def test_describe_lists_units():
+    text = EClutchParameters().describe()
+    assert "lever_ratio" in text and "N/m" in text and "Haramina" in text

@@ -1,0 +1,31 @@
+"""HTML report writer: self-contained page, files beside it, atomic, no silent overwrite."""
+
+import base64
+import re
+
+import pandas as pd
+import pytest
+
+from clutchlab.plotting import new_figure
+from clutchlab.report import Figure, Section, Table, Text, write_report
+
+
+def section():
+    fig, ax = new_figure()
+    ax.plot([0, 1], [0, 1])
+    return Section("Test", [Text("hello <b>"), Figure("line", fig, "a line"), Table("t", pd.DataFrame({"a": [1.5]}))],
+                   provenance="synthetic: test data", parameters={"k": "1 N/m"})
+
+
+def test_report_is_self_contained(tmp_path):
+    index = write_report([section()], tmp_path / "rep")
+    html = index.read_text()
+    imgs = re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", html)
+    assert len(imgs) == 1 and base64.b64decode(imgs[0])[:4] == b"\x89PNG"
+    assert "synthetic: test data" in html and "hello &lt;b&gt;" in html
+    assert (tmp_path / "rep" / "figures" / "line.png").exists()
+    assert (tmp_path / "rep" / "tables" / "t.csv").exists()
+    with pytest.raises(FileExistsError):
+        write_report([section()], tmp_path / "rep")
+    write_report([section()], tmp_path / "rep", overwrite=True)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
