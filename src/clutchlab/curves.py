@@ -439,7 +439,7 @@ def series(*curves: Curve, name: str = "series", rtol: float = 1e-6) -> Curve:
     of the deflection range, over the union of their force ranges, each
     component extrapolating by its own policy; with ``extrapolation='error'``
     on any component, only the common range is used.  Two linear springs give
-    ``1/k = 1/k1 + 1/k2``.
+    ``1/k = 1/k1 + 1/k2``.  ``name`` labels the result.
     """
     if len(curves) < 1:
         raise ParameterError("series() needs at least one curve")
@@ -467,7 +467,8 @@ def parallel(*curves: Curve, name: str = "parallel", rtol: float = 1e-6) -> Curv
     """Springs in parallel: forces add at equal deflection.
 
     Sampled at the union of the components' deflection samples (bisected
-    until linear interpolation is within ``rtol`` of the force range) over the union (or, with ``extrapolation='error'``, the
+    until linear interpolation is within ``rtol`` of the force range; ``name``
+    labels the result) over the union (or, with ``extrapolation='error'``, the
     intersection) of their spans.
     """
     if len(curves) < 1:

@@ -33,32 +33,98 @@ _NUMBER_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?
 
 
 def rpm_to_rad_s(speed_rpm):
-    """Convert a rotational speed from rev/min to rad/s."""
+    """Convert a rotational speed from rev/min to rad/s.
+
+    Parameters
+    ----------
+    speed_rpm : float or array_like
+        Value(s) in rev/min.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in rad/s.
+    """
     return np.asarray(speed_rpm, dtype=float) * _RPM if np.ndim(speed_rpm) else float(speed_rpm) * _RPM
 
 
 def rad_s_to_rpm(speed_rad_s):
-    """Convert a rotational speed from rad/s to rev/min."""
+    """Convert a rotational speed from rad/s to rev/min.
+
+    Parameters
+    ----------
+    speed_rad_s : float or array_like
+        Value(s) in rad/s.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in rev/min.
+    """
     return np.asarray(speed_rad_s, dtype=float) / _RPM if np.ndim(speed_rad_s) else float(speed_rad_s) / _RPM
 
 
 def celsius_to_kelvin(temperature_c):
-    """Convert a temperature from °C to K."""
+    """Convert a temperature from °C to K.
+
+    Parameters
+    ----------
+    temperature_c : float or array_like
+        Value(s) in °C.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in K.
+    """
     return np.asarray(temperature_c, dtype=float) + 273.15 if np.ndim(temperature_c) else float(temperature_c) + 273.15
 
 
 def kelvin_to_celsius(temperature_k):
-    """Convert a temperature from K to °C."""
+    """Convert a temperature from K to °C.
+
+    Parameters
+    ----------
+    temperature_k : float or array_like
+        Value(s) in K.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in °C.
+    """
     return np.asarray(temperature_k, dtype=float) - 273.15 if np.ndim(temperature_k) else float(temperature_k) - 273.15
 
 
 def bar_to_pa(pressure_bar):
-    """Convert a pressure from bar to Pa."""
+    """Convert a pressure from bar to Pa.
+
+    Parameters
+    ----------
+    pressure_bar : float or array_like
+        Value(s) in bar.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in Pa.
+    """
     return np.asarray(pressure_bar, dtype=float) * 1e5 if np.ndim(pressure_bar) else float(pressure_bar) * 1e5
 
 
 def pa_to_bar(pressure_pa):
-    """Convert a pressure from Pa to bar."""
+    """Convert a pressure from Pa to bar.
+
+    Parameters
+    ----------
+    pressure_pa : float or array_like
+        Value(s) in Pa.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in bar.
+    """
     return np.asarray(pressure_pa, dtype=float) / 1e5 if np.ndim(pressure_pa) else float(pressure_pa) / 1e5
 
 

@@ -1,16 +1,23 @@
 """E-clutch (dry clutch-by-wire) after Haramina et al., Trans. FAMENA 48 (2024) 21-35.
 
+- :func:`characterize`, :func:`lever_stiffness`, :func:`yoke_support_equivalent` -- press-rig identification
 - :class:`ClutchModel` -- axial Models 0-4 (:meth:`ClutchModel.preset`) and their static curves
 - :class:`AxialNetwork`, :class:`Node`, :class:`Spring`, :class:`Lever` -- describe a model or a variant
 - :class:`EClutchParameters`, :class:`ComponentCurves` -- parameters and measured characteristics
 - :class:`VirtualClutch` -- the synthetic ground truth behind the bundled data
 """
 
+from .characterize import CharacterizedCurve, LeverStiffness, characterize, lever_stiffness, yoke_support_equivalent
 from .models import ClutchModel, ComponentCurves, EClutchParameters, build_model, clutch_torque
 from .network import AxialNetwork, Lever, Node, Spring, solve_static, zero_input
 from .virtual import VirtualClutch
 
 __all__ = [
+    "characterize",
+    "lever_stiffness",
+    "yoke_support_equivalent",
+    "CharacterizedCurve",
+    "LeverStiffness",
     "ClutchModel",
     "ComponentCurves",
     "EClutchParameters",

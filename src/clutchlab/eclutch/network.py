@@ -600,7 +600,23 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
 
     This sets the origin of the bearing travel to the engaged clutch with the
     bearing pressed by the CSC preload ``force`` [N], the usual zero of a
-    release-bearing position sensor.  Returns a new network.
+    release-bearing position sensor.
+
+    Parameters
+    ----------
+    network : AxialNetwork
+        The model.
+    element : str
+        Spring whose pre-strain is shifted (the bearing contact).
+    force : float
+        Input force wanted at input position 0 [N].
+    bracket : (float, float)
+        Pre-strain interval searched by Brent's method [m].
+
+    Returns
+    -------
+    AxialNetwork
+        A new network with the shifted pre-strain.
     """
     from scipy.optimize import brentq
 

@@ -31,7 +31,10 @@ def check_writable(path, overwrite: bool = False) -> Path:
 
 
 def atomic_write_bytes(path, data: bytes, overwrite: bool = False) -> Path:
-    """Write ``data`` to ``path`` atomically (temporary file + rename)."""
+    """Write ``data`` (bytes) to ``path`` atomically (temporary file + rename).
+
+    Refuses to replace an existing file unless ``overwrite`` is true.
+    """
     path = check_writable(path, overwrite)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     umask = os.umask(0)
@@ -51,12 +54,16 @@ def atomic_write_bytes(path, data: bytes, overwrite: bool = False) -> Path:
 
 
 def atomic_write_text(path, text: str, overwrite: bool = False) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    """Write ``text`` (UTF-8) to ``path`` atomically; an existing file only with ``overwrite``."""
     return atomic_write_bytes(path, text.encode("utf-8"), overwrite)
 
 
 def atomic_to_csv(frame: pd.DataFrame, path, overwrite: bool = False, header_comment: str | None = None) -> Path:
-    """Write a DataFrame as CSV atomically; ``header_comment`` lines are prefixed with ``#``."""
+    """Write the DataFrame ``frame`` as CSV to ``path`` atomically.
+
+    ``header_comment`` lines are prefixed with ``#`` (readers skip them); an
+    existing file is replaced only with ``overwrite``.
+    """
     text = frame.to_csv(index=False, float_format="%.9g")
     if header_comment:
         text = "".join(f"# {line}\n" for line in header_comment.splitlines()) + text

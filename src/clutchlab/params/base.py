@@ -184,7 +184,7 @@ class ParameterSet:
 
 
 def load_toml(path) -> dict[str, Any]:
-    """Read a TOML file, turning I/O and syntax errors into :class:`ParameterError`."""
+    """Read the TOML file at ``path``, turning a missing file and syntax errors into :class:`ParameterError`."""
     path = Path(path)
     if not path.exists():
         raise ParameterError(f"{path}: no such parameter file")

@@ -24,7 +24,7 @@ __all__ = ["Figure", "Table", "Text", "Section", "write_report"]
 
 @dataclass
 class Figure:
-    """A matplotlib figure with a file stem and a caption."""
+    """A matplotlib ``figure`` with a file stem ``name`` and a ``caption``."""
 
     name: str
     figure: object
@@ -33,7 +33,7 @@ class Figure:
 
 @dataclass
 class Table:
-    """A table (DataFrame) with a file stem and a caption."""
+    """A table: DataFrame ``frame``, file stem ``name``, ``caption`` and the ``float_format`` of its cells."""
 
     name: str
     frame: pd.DataFrame
@@ -50,7 +50,8 @@ class Text:
 
 @dataclass
 class Section:
-    """One chapter of the report, usually one subsystem.
+    """One chapter of the report, usually one subsystem: a ``title``, its ``items``
+    (Figure, Table, Text), the data ``provenance`` and the ``parameters`` used.
 
     ``provenance`` says where the data come from; sections built on data from
     clutchlab's virtual rigs must say "synthetic" there.
@@ -91,6 +92,8 @@ def _table_html(tab: Table) -> str:
 
 def write_report(sections: list[Section], outdir, *, title: str = "clutchlab report", overwrite: bool = False) -> Path:
     """Write ``index.html`` with embedded figures plus PNG/CSV files into ``outdir``.
+
+    ``sections`` are the report's chapters, ``title`` its heading.
 
     The folder is assembled in a temporary sibling and moved into place, so an
     interrupted run never leaves half a report.  An existing ``outdir`` is
