@@ -105,7 +105,7 @@ def press_records(truth: VirtualClutch | None = None, seed: int = SEED) -> dict[
         finger_law=lambda f: fingers.inverse(f),
         rotation_law=lambda f: bell.inverse(f) / i,
         support_law=lambda f: support.inverse(np.maximum(f, 0.0)),
-        travel_m=5.0e-3, start_m=1e-9, seed=seed + 10, **press)
+        travel_m=5.0e-3, seed=seed + 10, **press)
     out["b"], out["c"] = rec_b, rec_c
     return {k: out[k] for k in sorted(out)}
 

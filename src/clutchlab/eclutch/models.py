@@ -83,8 +83,8 @@ class EClutchParameters(ParameterSet):
     kind = "eclutch"
 
     lever_ratio: float = quantity(-4.0, "1", "diaphragm lever ratio i_ds (< 0)", source=_INSPECT, bounds=(-50.0, -0.05))
-    k_fl_model1: float = quantity(1.17577e6, "N/m", "lever stiffness k_fl of Model 1 (Eq. 1, tests 8b-c)", source=_BUNDLED, positive=True)
-    k_fl_model2: float = quantity(1.17549e6, "N/m", "lever stiffness k_fl of Models 2-4 (Eq. 1, tests 8a/8c)", source=_BUNDLED, positive=True)
+    k_fl_model1: float = quantity(1.17589e6, "N/m", "lever stiffness k_fl of Model 1 (Eq. 1, tests 8b-c)", source=_BUNDLED, positive=True)
+    k_fl_model2: float = quantity(1.1757e6, "N/m", "lever stiffness k_fl of Models 2-4 (Eq. 1, tests 8a/8c)", source=_BUNDLED, positive=True)
     bearing_stiffness: float = quantity(8.0e6, "N/m", "release bearing stiffness k_b", source=_REP, positive=True)
     bearing_preload: float = quantity(80.0, "N", "CSC preload on the bearing at bearing position 0", source=_REP, nonnegative=True)
     diaphragm_prestrain: float = quantity(4.2766e-3, "m", "diaphragm tip deflection in the assembled clutch", source=_INSPECT)
