@@ -397,6 +397,20 @@ def element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
 
 
 @numba.njit(cache=True, nogil=True)
+def _residual(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d, r):
+    """Generalised force residual ``r = (GA)^T f(d)``; returns its Euclidean norm [N]."""
+    element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+    rn = 0.0
+    for j in range(GA.shape[1]):
+        s = 0.0
+        for e in range(GA.shape[0]):
+            s += GA[e, j] * f[e]
+        r[j] = s
+        rn += s * s
+    return np.sqrt(rn)
+
+
+@numba.njit(cache=True, nogil=True)
 def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f_tol, x_tol, max_iter):
     """Damped Newton on ``(GA)^T f(d) = 0``; returns (converged, iterations)."""
     n_el = GA.shape[0]
@@ -405,18 +419,11 @@ def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilat
     k = np.empty(n_el)
     d = np.empty(n_el)
     r = np.empty(n_q)
+    rt = np.empty(n_q)
     J = np.empty((n_q, n_q))
     qt = np.empty(n_q)
     for it in range(max_iter):
-        element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
-        rn = 0.0
-        for j in range(n_q):
-            s = 0.0
-            for e in range(n_el):
-                s += GA[e, j] * f[e]
-            r[j] = s
-            rn += s * s
-        rn = np.sqrt(rn)
+        rn = _residual(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d, r)
         if not np.isfinite(rn):
             return False, it
         if rn <= f_tol:
@@ -432,39 +439,21 @@ def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilat
             J[i, i] += 1e-9 * (abs(J[i, i]) + 1.0)
         dq = np.linalg.solve(J, r)
         step = 1.0
-        accepted = False
         for _ls in range(30):
             for j in range(n_q):
                 qt[j] = q[j] - step * dq[j]
-            element_forces(qt, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
-            rt = 0.0
-            for j in range(n_q):
-                s = 0.0
-                for e in range(n_el):
-                    s += GA[e, j] * f[e]
-                rt += s * s
-            rt = np.sqrt(rt)
-            if np.isfinite(rt) and rt < (1.0 - 1e-4 * step) * rn:
-                accepted = True
+            rtn = _residual(qt, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d, rt)
+            if np.isfinite(rtn) and rtn < (1.0 - 1e-4 * step) * rn:
                 break
             step *= 0.5
-        if not accepted:
-            # take a small step anyway (non-smooth contact kink); stop if no progress
-            for j in range(n_q):
-                qt[j] = q[j] - step * dq[j]
+        # after 30 halvings the (tiny) step is taken anyway: a contact kink may block the line search
         dmax = 0.0
         for j in range(n_q):
             dmax = max(dmax, abs(qt[j] - q[j]))
             q[j] = qt[j]
         if dmax <= x_tol:
-            element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
-            rn = 0.0
-            for j in range(n_q):
-                s = 0.0
-                for e in range(n_el):
-                    s += GA[e, j] * f[e]
-                rn += s * s
-            return np.sqrt(rn) <= 1e3 * f_tol, it
+            rn = _residual(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d, r)
+            return rn <= 1e3 * f_tol, it
     return False, max_iter
 
 
