@@ -10,6 +10,7 @@
 from .characterize import CharacterizedCurve, LeverStiffness, characterize, lever_stiffness, yoke_support_equivalent
 from .models import ClutchModel, ComponentCurves, EClutchParameters, build_model, clutch_torque
 from .network import AxialNetwork, Lever, Node, Spring, solve_static, zero_input
+from .variants import load_variant
 from .virtual import VirtualClutch
 
 __all__ = [
@@ -30,4 +31,5 @@ __all__ = [
     "solve_static",
     "zero_input",
     "VirtualClutch",
+    "load_variant",
 ]

@@ -24,6 +24,14 @@ def _save_figure(fig, path, overwrite):
 def _model(args):
     from .models import ClutchModel
 
+    if getattr(args, "network", None):
+        from .models import EClutchParameters
+        from .variants import load_variant
+
+        params = EClutchParameters.from_toml(args.params) if args.params else None
+        return load_variant(args.network, params)
+    if args.model is None:
+        raise ParameterError("give --model N (0-4) or --network VARIANT.toml")
     if args.params:
         return ClutchModel.from_toml(args.model, args.params)
     return ClutchModel.preset(args.model)
@@ -91,6 +99,17 @@ def _validate(args) -> int:
     return 0
 
 
+def _lever(args) -> int:
+    from .characterize import lever_stiffness
+
+    result = lever_stiffness(args.record_b, args.record_c, args.ratio, reference=args.reference)
+    print(result.report())
+    if args.output:
+        atomic_to_csv(result.points, args.output, overwrite=args.force,
+                      header_comment=result.report())
+    return 0
+
+
 def _describe(args) -> int:
     print(_model(args).network.describe())
     return 0
@@ -114,7 +133,8 @@ def register(subparsers) -> None:
 
     s = sub.add_parser("static", help="static curves (bearing force, normal force, torque) of Model N",
                        description="Static equilibrium by Newton continuation along the bearing travel.")
-    s.add_argument("--model", type=int, required=True, help="model number 0-4 (Haramina et al. 2024)")
+    s.add_argument("--model", type=int, help="model number 0-4 (Haramina et al. 2024)")
+    s.add_argument("--network", help="TOML description of a model variant (see clutchlab.eclutch.variants)")
     s.add_argument("--params", help="TOML parameter file ([eclutch] table; values may carry units)")
     s.add_argument("--travel", default="9 mm", help="release travel, with unit (default: %(default)s)")
     s.add_argument("--points", type=int, default=200, help="number of bearing positions (default: %(default)s)")
@@ -131,7 +151,18 @@ def register(subparsers) -> None:
     v.add_argument("--force", action="store_true", help="overwrite the output file")
     v.set_defaults(func=_validate)
 
+    lv = sub.add_parser("lever", help="finger (lever) stiffness k_fl from the two multi-LVDT records (Eq. 1)")
+    lv.add_argument("record_b", help="test 8b: displacement_m at the tips, displacement2_m at the support")
+    lv.add_argument("record_c", help="test 8c: displacement_m at the tips, displacement2_m at the pressure-plate edge")
+    lv.add_argument("--ratio", type=float, required=True, help="lever ratio i_ds (< 0)")
+    lv.add_argument("--reference", choices=("b", "c"), default="b",
+                    help="record giving force and tip travel: b for Model 1 (Sec. 5.1), c for Models 2-4 (Sec. 5.2)")
+    lv.add_argument("-o", "--output", help="CSV of the Eq. (1) points")
+    lv.add_argument("--force", action="store_true", help="overwrite the output file")
+    lv.set_defaults(func=_lever)
+
     d = sub.add_parser("describe", help="print the nodes and elements of Model N")
-    d.add_argument("--model", type=int, required=True, help="model number 0-4")
+    d.add_argument("--model", type=int, help="model number 0-4")
+    d.add_argument("--network", help="TOML description of a model variant")
     d.add_argument("--params", help="TOML parameter file")
     d.set_defaults(func=_describe)
