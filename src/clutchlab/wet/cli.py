@@ -1,0 +1,108 @@
+"""``clutchlab wet`` sub-commands: a thin layer over :mod:`clutchlab.wet`.
+
+``clutchlab wet simulate PROTOCOL.toml -o record.csv [--force]``
+    run a protocol on the virtual bench and write the measured record;
+``clutchlab wet identify RECORDS... -o map.json [--plot map.png] [--force]``
+    identify the friction map and k1, k2 from bench records;
+``clutchlab wet params [-o wet.toml]``
+    print (or write) the Table 1 parameter set.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import sys
+
+from ..errors import ParameterError
+
+__all__ = ["register"]
+
+
+def register(subparsers) -> None:
+    """Add the ``wet`` command and its sub-commands."""
+    wet = subparsers.add_parser("wet", help="wet multi-plate clutch: virtual bench and friction/thermal identification")
+    sub = wet.add_subparsers(dest="wet_command", metavar="SUBCOMMAND")
+    sim = sub.add_parser("simulate", help="run a protocol TOML on the virtual bench and write a bench record CSV")
+    sim.add_argument("protocol", help="protocol file ([protocol] type = friction_map | engagement | inertia_dynamometer)")
+    sim.add_argument("-o", "--output", required=True, help="record CSV to write")
+    sim.add_argument("--force", action="store_true", help="overwrite the output")
+    sim.set_defaults(func=_simulate)
+    ident = sub.add_parser("identify", help="identify the friction map and k1, k2 from bench records")
+    ident.add_argument("records", nargs="+", help="bench record CSV files")
+    ident.add_argument("-o", "--output", required=True, help="friction map JSON to write")
+    ident.add_argument("--plot", help="also write the map surface as PNG")
+    ident.add_argument("--clutch", help="clutch parameter TOML ([wet] table; default Table 1)")
+    ident.add_argument("--sensor-lag", type=float, default=0.0, help="thermistor time constant to compensate [s]")
+    ident.add_argument("--force", action="store_true", help="overwrite the outputs")
+    ident.set_defaults(func=_identify)
+    par = sub.add_parser("params", help="print the Table 1 parameter set, or write it as TOML")
+    par.add_argument("-o", "--output", help="TOML file to write")
+    par.add_argument("--force", action="store_true", help="overwrite the output")
+    par.set_defaults(func=_params)
+    wet.set_defaults(func=lambda args: (wet.print_help(), 2)[1])
+
+
+def _simulate(args) -> int:
+    from ..io import check_writable
+    from .bench import load_protocol, run_protocol, write_bench_record
+
+    check_writable(args.output, args.force)
+    protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
+    run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype)
+    write_bench_record(run, args.output, overwrite=args.force)
+    events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
+    print(f"{args.output}: {len(run.record)} samples of protocol {ptype}; events: {events}")
+    return 0
+
+
+def _identify(args) -> int:
+    from ..errors import IdentificationError
+    from ..io import atomic_write_bytes, atomic_write_text, check_writable
+    from .identify import friction_samples, identify_friction_map, identify_thermal
+    from .params import WetClutch
+
+    check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
+    if args.sensor_lag < 0:
+        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be >= 0 [s]")
+    clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
+    fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
+    data = fmap.to_dict()
+    try:
+        th = identify_thermal(args.records, clutch, sensor_time_constant=args.sensor_lag)
+        data["thermal"] = {"k1_W_K": th.k1, "k2_W_K": th.k2, "stderr": th.stderr, "ci95": th.ci95,
+                           "rmse_W": th.rmse, "n_samples": th.n_samples}
+        thermal_line = f"k1 = {th.k1:.4g} ± {th.stderr['k1']:.2g} W/K, k2 = {th.k2:.4g} ± {th.stderr['k2']:.2g} W/K"
+    except IdentificationError as exc:
+        data["thermal"] = {"error": str(exc)}
+        thermal_line = f"thermal identification skipped: {exc}"
+    atomic_write_text(args.output, json.dumps(data, indent=1), overwrite=args.force)
+    if args.plot:
+        from .plots import friction_map_figure
+
+        fig = friction_map_figure(fmap, samples=friction_samples(args.records, clutch,
+                                                                 sensor_time_constant=args.sensor_lag))
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+    law = fmap.law
+    print(f"{args.output}: mu_f = {law.mu0:.4g} + {law.mu_t:.3g} (T - {law.t_ref:g}) + {law.mu_e:.3g} exp(-v/{law.v_s:.3g}); "
+          f"rmse {fmap.statistics['rmse']:.2g}, {fmap.statistics['cells_covered']} covered cells; {thermal_line}")
+    return 0
+
+
+def _params(args) -> int:
+    from .params import WetClutch
+
+    clutch = WetClutch.paper()
+    if args.output:
+        clutch.to_toml(args.output, overwrite=args.force)
+        print(args.output)
+    else:
+        sys.stdout.write(clutch.describe() + "\n")
+    return 0

@@ -1,0 +1,270 @@
+"""Asperity friction coefficient mu_f as a pluggable law.
+
+Two interchangeable laws feed the torque model (Shin, Kim and Choi [1],
+Eq. 4) and the compiled engagement kernel:
+
+* :class:`ParametricFriction` -- the form the paper found (Sec. 4): linear in
+  the friction-surface temperature and exponential in the slip speed,
+  ``mu_f = mu0 + mu_t (T - T_ref) + mu_e exp(-|v| / v_s)``;
+* :class:`FrictionMap` -- a measured map, tabulated over slip velocity,
+  temperature and optionally pressing force, interpolated (multi-)linearly.
+
+The paper's "negatively exponential to the slip speed" is read as a term in
+``exp(-v/v_s)``; the sign of ``mu_e`` is free (``mu_e < 0``: friction rising
+with slip towards a plateau, the usual paper-lining shape; ``mu_e > 0``:
+falling).
+
+References
+----------
+.. [1] S. Shin, D.-H. Kim, S. B. Choi, "Apparatus for identification of
+   frictional and thermal characteristics of a wet clutch" (KAIST).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from typing import ClassVar
+
+import numba
+import numpy as np
+
+from ..errors import DataError
+from ..params import ParameterSet, quantity
+
+__all__ = ["ParametricFriction", "FrictionMap", "KIND_PARAMETRIC", "KIND_TABLE", "mu_kernel"]
+
+KIND_PARAMETRIC = 0
+KIND_TABLE = 1
+
+
+@dataclasses.dataclass(frozen=True)
+class ParametricFriction(ParameterSet):
+    """``mu_f(v, T) = mu0 + mu_t (T - t_ref) + mu_e exp(-|v|/v_s)``, clipped at 0 ([1], Sec. 4).
+
+    Defaults are representative of a paper-based lining in ATF (clutchlab's
+    choice, not from the paper, whose Fig. 15 has no printed numbers).
+    """
+
+    kind: ClassVar[str] = "friction"
+
+    mu0: float = quantity(0.12, "1", "friction coefficient at t_ref and high slip", source="clutchlab")
+    mu_t: float = quantity(5e-4, "1/K", "temperature slope of mu_f", source="clutchlab")
+    mu_e: float = quantity(-0.02, "1", "amplitude of the slip-speed exponential", source="clutchlab")
+    v_s: float = quantity(1.0, "m/s", "slip-velocity scale of the exponential", source="clutchlab", positive=True)
+    t_ref: float = quantity(100.0, "degC", "reference temperature", source="clutchlab")
+
+    @classmethod
+    def bench_truth(cls) -> "ParametricFriction":
+        """The map the virtual bench's clutch actually has (differs from the defaults on purpose)."""
+        return cls(mu0=0.135, mu_t=8e-4, mu_e=-0.03, v_s=0.6, t_ref=100.0)
+
+    def mu(self, slip_velocity, temperature_c, force=None):
+        """Friction coefficient [-] at slip velocity [m/s] and temperature [degC] (force ignored)."""
+        v = np.abs(np.asarray(slip_velocity, dtype=float))
+        t = np.asarray(temperature_c, dtype=float)
+        out = self.mu0 + self.mu_t * (t - self.t_ref) + self.mu_e * np.exp(-v / self.v_s)  # [1], Sec. 4
+        out = np.maximum(out, 0.0)
+        return float(out) if out.ndim == 0 else out
+
+    def kernel_data(self):
+        """Arrays for :func:`mu_kernel`: (kind, coef, grid_v, grid_t, grid_f, table)."""
+        coef = np.array([self.mu0, self.mu_t, self.mu_e, self.v_s, self.t_ref])
+        z = np.zeros(1)
+        return KIND_PARAMETRIC, coef, z, z, z, np.zeros(1)
+
+
+def _check_grid(name, grid):
+    g = np.asarray(grid, dtype=float).ravel()
+    if g.size < 1 or not np.all(np.isfinite(g)):
+        raise DataError(f"FrictionMap.{name}: needs finite values, got {grid!r}")
+    if g.size > 1 and np.any(np.diff(g) <= 0):
+        raise DataError(f"FrictionMap.{name}: must be strictly increasing")
+    return g
+
+
+def _interp_weights(grid, x):
+    """Indices and weights of linear interpolation with constant extrapolation."""
+    if grid.size == 1:
+        i = np.zeros(np.shape(x), dtype=int)
+        return i, i, np.zeros(np.shape(x))
+    xc = np.clip(x, grid[0], grid[-1])
+    j = np.clip(np.searchsorted(grid, xc, side="right") - 1, 0, grid.size - 2)
+    w = (xc - grid[j]) / (grid[j + 1] - grid[j])
+    return j, j + 1, w
+
+
+class FrictionMap:
+    """Tabulated friction coefficient ``mu_f(v, T[, F])`` with its provenance.
+
+    Parameters
+    ----------
+    speed_grid : array_like
+        Slip-velocity nodes [m/s], increasing.
+    temperature_grid : array_like
+        Friction-surface temperature nodes [degC], increasing.
+    values : array_like
+        mu_f at the nodes, shape ``(n_T, n_v)`` or ``(n_F, n_T, n_v)``.
+    force_grid : array_like, optional
+        Pressing-force nodes [N] for a 3-D map.
+    covered : array_like of bool, optional
+        Nodes supported by measurements (same shape as ``values``); the rest
+        were filled from ``law``.
+    law : ParametricFriction, optional
+        Parametric fit of the same data.
+    statistics : dict, optional
+        Fit statistics (rmse, r2, standard errors, sample counts).
+    region : dict, optional
+        Covered region (min/max of v, T, F in the data).
+
+    Notes
+    -----
+    Linear interpolation in each axis, constant beyond the grid.
+    """
+
+    def __init__(self, speed_grid, temperature_grid, values, force_grid=None, covered=None, law=None,
+                 statistics=None, region=None):
+        self.speed_grid = _check_grid("speed_grid", speed_grid)
+        self.temperature_grid = _check_grid("temperature_grid", temperature_grid)
+        self.force_grid = _check_grid("force_grid", force_grid) if force_grid is not None else None
+        vals = np.asarray(values, dtype=float)
+        shape = (self.temperature_grid.size, self.speed_grid.size)
+        if self.force_grid is not None:
+            shape = (self.force_grid.size,) + shape
+        if vals.shape != shape:
+            raise DataError(f"FrictionMap.values: shape {vals.shape} does not match the grids {shape}")
+        if not np.all(np.isfinite(vals)) or np.any(vals < 0):
+            raise DataError("FrictionMap.values: must be finite and >= 0")
+        self.values = vals
+        self.covered = np.ones(shape, bool) if covered is None else np.asarray(covered, dtype=bool).reshape(shape)
+        self.law = law
+        self.statistics = dict(statistics or {})
+        self.region = dict(region or {})
+
+    def mu(self, slip_velocity_m_s, temperature_c, force=None):
+        """Friction coefficient [-] at slip velocity [m/s], temperature [degC] and force [N] (vectorised)."""
+        v = np.abs(np.asarray(slip_velocity_m_s, dtype=float))
+        t = np.asarray(temperature_c, dtype=float)
+        v, t = np.broadcast_arrays(v, t)
+        iv0, iv1, wv = _interp_weights(self.speed_grid, v)
+        it0, it1, wt = _interp_weights(self.temperature_grid, t)
+
+        def plane(tab):
+            return ((1 - wt) * ((1 - wv) * tab[it0, iv0] + wv * tab[it0, iv1])
+                    + wt * ((1 - wv) * tab[it1, iv0] + wv * tab[it1, iv1]))
+
+        if self.force_grid is None:
+            out = plane(self.values)
+        else:
+            if force is None:
+                raise DataError("FrictionMap.mu: this map depends on force; pass force=[N]")
+            f = np.broadcast_to(np.asarray(force, dtype=float), v.shape)
+            i0, i1, wf = _interp_weights(self.force_grid, f)
+            lo = np.array([plane(self.values[k]) for k in range(self.force_grid.size)])
+            flat = lo.reshape(self.force_grid.size, -1)
+            idx = np.arange(flat.shape[1])
+            out = ((1 - wf.ravel()) * flat[i0.ravel(), idx] + wf.ravel() * flat[i1.ravel(), idx]).reshape(v.shape)
+        return float(out) if np.ndim(out) == 0 else out
+
+    __call__ = mu
+
+    def kernel_data(self):
+        """Arrays for :func:`mu_kernel`: (kind, coef, grid_v, grid_t, grid_f, table)."""
+        gf = self.force_grid if self.force_grid is not None else np.zeros(1)
+        tab = self.values if self.force_grid is not None else self.values[None, :, :]
+        return (KIND_TABLE, np.zeros(5), self.speed_grid.copy(), self.temperature_grid.copy(), gf.copy(),
+                np.ascontiguousarray(tab).ravel())
+
+    # ------------------------------------------------------------ files
+    def to_dict(self) -> dict:
+        """JSON-ready dict (SI units; temperature in degC)."""
+        return {
+            "format": "clutchlab.wet.FrictionMap/1",
+            "units": {"speed_grid": "m/s", "temperature_grid": "degC", "force_grid": "N", "values": "1"},
+            "speed_grid": self.speed_grid.tolist(),
+            "temperature_grid": self.temperature_grid.tolist(),
+            "force_grid": None if self.force_grid is None else self.force_grid.tolist(),
+            "values": self.values.tolist(),
+            "covered": self.covered.astype(int).tolist(),
+            "law": None if self.law is None else self.law.to_dict(),
+            "statistics": self.statistics,
+            "region": self.region,
+        }
+
+    def to_json(self, path, overwrite: bool = False):
+        """Write the map as JSON, atomically (refuses to overwrite by default)."""
+        from ..io import atomic_write_text
+
+        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1), overwrite=overwrite)
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "map") -> "FrictionMap":
+        """Rebuild a map from :meth:`to_dict` output."""
+        try:
+            law = ParametricFriction.from_dict(data["law"], source=source) if data.get("law") else None
+            return cls(data["speed_grid"], data["temperature_grid"], data["values"], data.get("force_grid"),
+                       data.get("covered"), law, data.get("statistics"), data.get("region"))
+        except KeyError as exc:
+            raise DataError(f"{source}: friction map lacks the key {exc.args[0]!r}") from None
+
+    @classmethod
+    def from_json(cls, path) -> "FrictionMap":
+        """Read a map written by :meth:`to_json`."""
+        try:
+            with open(path, encoding="utf-8") as fh:
+                data = json.load(fh)
+        except FileNotFoundError:
+            raise DataError(f"{path}: no such file") from None
+        except json.JSONDecodeError as exc:
+            raise DataError(f"{path}: not valid JSON ({exc})") from None
+        return cls.from_dict(data, source=str(path))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _lin_index(grid, x):
+    n = grid.shape[0]
+    if n == 1:
+        return 0, 0.0
+    if x <= grid[0]:
+        return 0, 0.0
+    if x >= grid[n - 1]:
+        return n - 2, 1.0
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if grid[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return lo, (x - grid[lo]) / (grid[lo + 1] - grid[lo])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def mu_kernel(v_abs, temperature_c, force, kind, coef, gv, gt, gf, table):
+    """Compiled friction law: parametric (kind 0) or (tri)linear table (kind 1) ([1], Eq. 4 input)."""
+    if kind == 0:
+        mu = coef[0] + coef[1] * (temperature_c - coef[4]) + coef[2] * math.exp(-v_abs / coef[3])
+        return mu if mu > 0.0 else 0.0
+    nv = gv.shape[0]
+    nt = gt.shape[0]
+    iv, wv = _lin_index(gv, v_abs)
+    it, wt = _lin_index(gt, temperature_c)
+    i_f, wf = _lin_index(gf, force)
+    iv1 = iv + 1 if nv > 1 else iv
+    it1 = it + 1 if nt > 1 else it
+    if_1 = i_f + 1 if gf.shape[0] > 1 else i_f
+    out = 0.0
+    for a in range(2):
+        fi = i_f if a == 0 else if_1
+        wa = (1.0 - wf) if a == 0 else wf
+        if wa == 0.0:
+            continue
+        base = fi * nt * nv
+        m00 = table[base + it * nv + iv]
+        m01 = table[base + it * nv + iv1]
+        m10 = table[base + it1 * nv + iv]
+        m11 = table[base + it1 * nv + iv1]
+        out += wa * ((1.0 - wt) * ((1.0 - wv) * m00 + wv * m01) + wt * ((1.0 - wv) * m10 + wv * m11))
+    return out
