@@ -28,6 +28,7 @@ import numba
 import numpy as np
 
 from .errors import DataError, ParameterError
+from .numerics.interp import bracket
 
 __all__ = ["Curve", "series", "parallel", "curve_eval", "KIND_CODES", "EXTRAPOLATION_CODES"]
 
@@ -88,17 +89,9 @@ def curve_eval(xs, fs, ds, kind, extrap, x):
         else:
             s = ds[n - 1]
         return fs[n - 1] + s * (x - xs[n - 1]), s
-    # binary search for the segment xs[i] <= x < xs[i+1]
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xs[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
+    lo, t = bracket(xs, x)  # segment xs[lo] <= x <= xs[lo+1], binary search
+    hi = lo + 1
     h = xs[hi] - xs[lo]
-    t = (x - xs[lo]) / h
     if kind == 0:
         s = (fs[hi] - fs[lo]) / h
         return fs[lo] + s * (x - xs[lo]), s

@@ -53,6 +53,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ParameterError, SimulationError
+from ..numerics.interp import bracket
 from ..numerics.dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
@@ -189,15 +190,7 @@ def _pwl(t, tt, vv):
         return vv[0]
     if t >= tt[n - 1]:
         return vv[n - 1]
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if tt[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
-    w = (t - tt[lo]) / (tt[lo + 1] - tt[lo])
+    lo, w = bracket(tt, t)
     return vv[lo] + w * (vv[lo + 1] - vv[lo])
 
 

@@ -31,6 +31,7 @@ import numba
 import numpy as np
 
 from ..errors import DataError
+from ..numerics.interp import bracket
 from ..params import ParameterSet, quantity
 
 __all__ = ["ParametricFriction", "FrictionMap", "KIND_PARAMETRIC", "KIND_TABLE", "mu_kernel"]
@@ -226,19 +227,7 @@ def _lin_index(grid, x):
     n = grid.shape[0]
     if n == 1:
         return 0, 0.0
-    if x <= grid[0]:
-        return 0, 0.0
-    if x >= grid[n - 1]:
-        return n - 2, 1.0
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if grid[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    return lo, (x - grid[lo]) / (grid[lo + 1] - grid[lo])
+    return bracket(grid, x)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
