@@ -1,0 +1,120 @@
+"""``clutchlab emtc ...``: Preisach identification/run and drum-bench simulation (thin layer over the API)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataError
+from ..io import atomic_to_csv, check_writable, read_table
+
+
+def _identify(args) -> int:
+    from ..hysteresis import identify_forc_family
+
+    check_writable(args.output, args.force)
+    frame = read_table(args.forc, ["current", "force"], name=str(args.forc))
+    if "airgap" in frame.columns:
+        frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
+    grid = None
+    if args.grid:
+        try:
+            grid = np.array([float(v) for v in args.grid.split(",")])
+        except ValueError:
+            raise DataError(f"--grid {args.grid!r}: expected comma-separated currents in A") from None
+    model, results = identify_forc_family(frame, grid=grid, name=str(args.forc))
+    model.to_json(args.output, overwrite=args.force)
+    for gap, res in results:
+        if gap is not None:
+            print(f"airgap {gap * 1e3:g} mm:")
+        print(res.report())
+    print(args.output)
+    return 0
+
+
+def _run(args) -> int:
+    from ..hysteresis import Preisach
+
+    check_writable(args.output, args.force)
+    model = Preisach.from_json(args.model)
+    has_gap = model.n_airgaps > 1
+    if args.inverse:
+        required = ["force"] + (["airgap"] if has_gap else [])
+        frame = read_table(args.input, required, name=str(args.input))
+        res = model.invert(frame["force"].to_numpy(), frame["airgap"].to_numpy() if has_gap else None)
+        out = frame.copy()
+        out["current"] = res.input
+        out["force_model"] = res.output
+        out["feasible"] = res.feasible
+        if not res.all_feasible:
+            print(res.report())
+    else:
+        required = ["current"] + (["airgap"] if has_gap else [])
+        frame = read_table(args.input, required, name=str(args.input))
+        out = frame.copy()
+        out["force_model"] = model.simulate(frame["current"].to_numpy(), frame["airgap"].to_numpy() if has_gap else None)
+    atomic_to_csv(out, args.output, overwrite=args.force,
+                  header_comment=f"clutchlab emtc preisach run: model {args.model}, input {args.input}")
+    print(args.output)
+    return 0
+
+
+def _simulate(args) -> int:
+    from ..hysteresis import Preisach
+    from .bench import load_scenario, simulate_bench
+    from .magnet import bundled_magnet
+
+    check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
+    sc = load_scenario(args.scenario)
+    magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
+    res = simulate_bench(magnet, sc["scenario"], vehicle=sc["vehicle"], actuator=sc["actuator"], coupling=sc["coupling"])
+    frame = res.to_dataframe()
+    atomic_to_csv(frame, args.output, overwrite=args.force,
+                  header_comment=f"clutchlab emtc simulate {args.scenario}; magnet: "
+                                 f"{sc['magnet'] or 'bundled synthetic FORC data (synthetic)'}")
+    if len(res.events):
+        print(res.events.to_string(index=False))
+    if args.plot:
+        from ..io import atomic_write_bytes
+        from .demo import bench_figure
+        import io
+
+        fig = bench_figure(res, "EMTC drum-bench simulation")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+        print(args.plot)
+    print(args.output)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``emtc`` with ``preisach identify``, ``preisach run`` and ``simulate``."""
+    p = subparsers.add_parser("emtc", help="electromagnetic torque-controlled coupling (Processes 2019)")
+    sub = p.add_subparsers(dest="emtc_command", metavar="COMMAND")
+    sub.required = True
+    pre = sub.add_parser("preisach", help="Preisach hysteresis model of the magnet force")
+    psub = pre.add_subparsers(dest="preisach_command", metavar="COMMAND")
+    psub.required = True
+    ident = psub.add_parser("identify", help="identify the FORC table(s) from recorded current/force traces")
+    ident.add_argument("forc", type=Path, help="CSV with columns current [A], force [N] (and airgap [m])")
+    ident.add_argument("-o", "--output", type=Path, required=True, help="model JSON to write")
+    ident.add_argument("--grid", help="comma-separated current grid [A] (default: from the reversal points)")
+    ident.add_argument("--force", action="store_true", help="overwrite the output")
+    ident.set_defaults(func=_identify)
+    run = psub.add_parser("run", help="run a model on an input CSV (current -> force, or --inverse force -> current)")
+    run.add_argument("model", type=Path, help="model JSON from 'identify'")
+    run.add_argument("input", type=Path, help="CSV with current [A] (or force [N] with --inverse), airgap [m] for a family")
+    run.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
+    run.add_argument("--inverse", action="store_true", help="compute the current that produces the force column")
+    run.add_argument("--force", action="store_true", help="overwrite the output")
+    run.set_defaults(func=_run)
+    sim = sub.add_parser("simulate", help="simulate the vehicle with EMTC on the drum bench")
+    sim.add_argument("scenario", type=Path, help="TOML with [scenario], [vehicle], [actuator], [coupling], [magnet]")
+    sim.add_argument("-o", "--output", type=Path, required=True, help="CSV of the run")
+    sim.add_argument("--plot", type=Path, help="PNG figure of the run")
+    sim.add_argument("--force", action="store_true", help="overwrite the outputs")
+    sim.set_defaults(func=_simulate)

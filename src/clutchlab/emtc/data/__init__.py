@@ -1,0 +1,1 @@
+"""Bundled synthetic data of the EMTC subsystem (see ``generate_forc.py``)."""

@@ -1,0 +1,275 @@
+"""Vehicle with EMTC on the drum bench: actuator (Eqs. 8-12, Fig. 15), mode logic (Fig. 11), Eqs. 27-30."""
+
+import math
+
+import numpy as np
+import pytest
+
+from clutchlab.emtc import (
+    ActuatorParameters,
+    BenchScenario,
+    CouplingGeometry,
+    VehicleParameters,
+    bundled_magnet,
+    load_scenario,
+    locked_torques,
+    simulate_bench,
+    slipping_torques,
+)
+from clutchlab.emtc.magnet import synthetic_magnet
+from clutchlab.errors import ParameterError, SimulationError
+
+
+@pytest.fixture(scope="module")
+def magnet():
+    return bundled_magnet()
+
+
+@pytest.fixture(scope="module")
+def slipping_run(magnet):
+    return simulate_bench(magnet, BenchScenario(duration=2.0, speed_difference=0.3, throttle_start=0.1,
+                                                throttle_end=0.6, ramp_start=0.2, ramp_end=1.8))
+
+
+@pytest.fixture(scope="module")
+def locked_run(magnet):
+    sc = BenchScenario(duration=3.0, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9, ramp_start=0.3,
+                       ramp_end=2.8)
+    return simulate_bench(magnet, sc, torque_reference=([0.0, 10.0], [250.0, 250.0]))
+
+
+def test_current_follows_two_first_order_lags(magnet):
+    """Coil current = command through tau1 then tau2 (Fig. 15), exact for a sample-and-hold command."""
+    act = ActuatorParameters()
+    sc = BenchScenario(duration=0.3, sample_time=0.005)
+    ref = ([0.0, 0.1, 0.1001, 0.3], [50.0, 50.0, 250.0, 100.0])
+    res = simulate_bench(magnet, sc, torque_reference=ref)
+    df = res.to_dataframe()
+    u, i1, i2 = df["current_command"].to_numpy(), df["i1"].to_numpy(), df["i2"].to_numpy()
+    h, t1, t2 = sc.sample_time, act.tau1, act.tau2
+    e1, e2 = math.exp(-h / t1), math.exp(-h / t2)
+    p1 = u[:-1] + (i1[:-1] - u[:-1]) * e1
+    p2 = u[:-1] + (i2[:-1] - u[:-1]) * e2 + (i1[:-1] - u[:-1]) * t1 / (t1 - t2) * (e1 - e2)
+    np.testing.assert_allclose(i1[1:], p1, atol=2e-5)
+    np.testing.assert_allclose(i2[1:], p2, atol=2e-5)
+
+
+def test_armature_clamp_force_eq11_and_airgap_eq12(slipping_run):
+    act = ActuatorParameters()
+    df = slipping_run.to_dataframe()
+    at_clutch = df["armature_mode"] == 2
+    assert at_clutch.mean() > 0.9
+    d = df[at_clutch]
+    np.testing.assert_allclose(d["fn1"], d["magnet_force"] - act.preload - act.stiffness * act.free_travel, atol=1e-9)
+    np.testing.assert_allclose(d["airgap"], act.airgap_open - act.free_travel, atol=1e-12)
+    before = df[df["armature_mode"] == 0]
+    assert (before["fn1"] == 0).all() and (before["magnet_force"] <= act.preload + 1e-9).all()
+
+
+def test_slipping_torques_follow_eq15(slipping_run):
+    g = CouplingGeometry()
+    df = slipping_run.to_dataframe()
+    slip = df[df["coupling_mode"] == 1]
+    assert len(slip) > 0.9 * len(df)
+    assert (slip["slip_speed"] > 0).all()  # the drums hold the speed difference: no lock-up
+    expect = np.array([slipping_torques(f, 1.0, g) for f in slip["fn1"]])
+    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), expect, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(slip["t_coupling"], expect.sum(axis=1), rtol=1e-12)
+    assert slipping_run.events["name"].str.contains("lock").sum() == 0
+
+
+def test_torque_reference_tracking_through_inverse_preisach(slipping_run):
+    """In slipping mode the transferred torque follows T_cal through the inverse magnet model (Eqs. 6-7, 31)."""
+    df = slipping_run.to_dataframe()
+    late = df[(df["time"] > 0.3) & df["command_feasible"]]
+    # the plant is the model itself: only the two current lags delay the torque
+    err = (late["t_coupling"] - late["torque_reference"]).abs()
+    assert err.median() < 0.02 * late["torque_reference"].abs().median()
+
+
+def test_locked_mode_logic_fig11(locked_run):
+    ev = locked_run.events
+    names = list(ev["name"])
+    lock = [i for i, n in enumerate(names) if n.startswith("lock-up")]
+    unlock = [i for i, n in enumerate(names) if n.startswith("unlock")]
+    assert len(lock) == 1 and len(unlock) == 1  # no chattering
+    t_lock, t_unlock = ev["time"][lock[0]], ev["time"][unlock[0]]
+    assert t_unlock - t_lock > 1.0
+    df = locked_run.to_dataframe()
+    locked = df[(df["time"] > t_lock) & (df["time"] < t_unlock)]
+    assert (locked["coupling_mode"] == 2).all()
+    assert locked["slip_speed"].abs().max() < 1e-6 * df["omega_f"].mean()
+    np.testing.assert_allclose(locked[["t1", "t2", "t3"]].sum(axis=1), locked["t_coupling"], rtol=1e-10, atol=1e-9)
+    # the locked split is the one of Eqs. 18-21 for the lock torque
+    g = CouplingGeometry()
+    for _, row in locked.iloc[::50].iterrows():
+        assert locked_torques(row["fn1"], row["t_coupling"], g, margin=1.02) == pytest.approx(
+            (row["t1"], row["t2"], row["t3"]), rel=1e-9, abs=1e-9)
+    # the split passes through several cases of Fig. 12
+    assert len(set(locked["locked_case"])) >= 3
+    # unlock exactly where |T_lock| reaches 1.02 T_cap
+    last = locked.iloc[-1]
+    assert abs(last["t_coupling"]) == pytest.approx(1.02 * last["capacity_locked"], rel=2e-2)
+    after = df[df["time"] > t_unlock]
+    assert (after["coupling_mode"] == 1).all()  # stays slipping: no relock
+    assert (after["slip_speed"] > 0).all()
+
+
+def test_results_converge_with_tolerance(magnet):
+    sc = BenchScenario(duration=1.0, speed_difference=0.3, throttle_end=0.5, ramp_start=0.1, ramp_end=0.9)
+    a = simulate_bench(magnet, sc, rtol=1e-6).to_dataframe()
+    b = simulate_bench(magnet, sc, rtol=1e-9).to_dataframe()
+    for col in ("omega_f", "omega_r", "t_coupling", "i2", "x"):
+        np.testing.assert_allclose(a[col], b[col], rtol=1e-4, atol=1e-4 * b[col].abs().max())
+
+
+def test_step_limit_raises(magnet):
+    with pytest.raises(SimulationError, match="max_steps"):
+        simulate_bench(magnet, BenchScenario(duration=0.5), max_steps=50)
+
+
+def test_open_coupling_transfers_drag_torque_eq25_26(magnet):
+    veh = VehicleParameters()
+    res = simulate_bench(magnet, BenchScenario(duration=0.2, speed_difference=0.5), torque_reference=([0, 1], [0, 0]))
+    df = res.to_dataframe()
+    assert (df["coupling_mode"] == 0).all()
+    np.testing.assert_allclose(df["t_coupling"], veh.drag_coefficient() * df["slip_speed"], rtol=1e-12)
+
+
+def test_plant_model_mismatch_runs_with_separate_controller_model(magnet):
+    truth = synthetic_magnet()
+    res = simulate_bench(truth, BenchScenario(duration=1.0), controller_model=magnet)
+    df = res.to_dataframe()
+    late = df[df["time"] > 0.5]
+    rel = (late["t_coupling"] - late["torque_reference"]).abs().median() / late["torque_reference"].median()
+    assert rel < 0.05  # identification error of the model only
+
+
+def test_parameters_table1_and_toml(tmp_path):
+    v = VehicleParameters()
+    assert v.mass == 2162.0 and v.wheelbase == 2.7
+    assert v.gear_ratios == (4.044, 2.371, 1.556, 1.159, 0.852, 0.672)
+    assert (v.front_final_drive, v.rear_final_drive, v.reverse_ratio) == (3.75, 2.533, 3.19)
+    assert v.engine_power == 125e3
+    assert v.tyre_radius == pytest.approx(0.5 * 17 * 0.0254 + 0.65 * 0.225, abs=1e-4)
+    fzf, fzr = v.axle_loads()
+    assert fzf + fzr == pytest.approx(2162 * 9.80665)
+    p = v.to_toml(tmp_path / "v.toml")
+    assert VehicleParameters.from_toml(p) == v
+    with pytest.raises(ParameterError, match="wheelbase"):
+        VehicleParameters(cg_to_front=1.0)
+    with pytest.raises(ParameterError, match="airgap_open"):
+        ActuatorParameters(airgap_open=0.4e-3)
+    with pytest.raises(ParameterError, match="mass"):
+        VehicleParameters(mass=-1.0)
+
+
+def test_load_scenario(tmp_path):
+    p = tmp_path / "s.toml"
+    p.write_text('[scenario]\nduration = "0.5 s"\ndrum_speed = "36 km/h"\n[vehicle]\nmass = "2000 kg"\n')
+    sc = load_scenario(p)
+    assert sc["scenario"].drum_speed == pytest.approx(10.0)
+    assert sc["vehicle"].mass == 2000.0 and sc["magnet"] is None
+    p.write_text("[scenrio]\nduration = 1.0\n")
+    with pytest.raises(ParameterError, match="unknown table"):
+        load_scenario(p)
+    p.write_text("[scenario]\ngear = 9\n")
+    with pytest.raises(ParameterError, match="gear"):
+        load_scenario(p)
+
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+
+@settings(max_examples=12, deadline=None)
+@given(thr_end=st.floats(0.0, 1.0), ref=st.floats(20.0, 400.0), dv=st.floats(-0.2, 0.2))
+def test_no_chattering_property(thr_end, ref, dv):
+    """Whatever the load and reference, lock/unlock events never alternate rapidly (Fig. 11 logic)."""
+    sc = BenchScenario(duration=1.5, speed_difference=dv, throttle_start=0.0, throttle_end=thr_end,
+                       ramp_start=0.1, ramp_end=1.4)
+    res = simulate_bench(_MAGNET, sc, torque_reference=([0.0, 2.0], [ref, ref]))
+    ev = res.events
+    mode_ev = ev[ev["name"].str.startswith(("lock-up", "unlock", "slip reversal"))]
+    assert len(mode_ev) <= 6
+    if len(mode_ev) > 1:
+        assert np.diff(mode_ev["time"].to_numpy()).min() > 0.01
+    df = res.to_dataframe()
+    # locked samples have zero slip; slipping samples never carry more than the kinetic capacity
+    locked = df[df["coupling_mode"] == 2]
+    assert (locked["slip_speed"].abs() < 1e-6 * df["omega_f"].abs().max()).all()
+    assert (locked["t_coupling"].abs() <= 1.02 * locked["capacity_locked"] * (1 + 1e-9) + 1e-9).all()
+
+
+_MAGNET = bundled_magnet()
+
+
+def _eq15(fn1, mu, g):
+    """Eq. 15 with one kinetic coefficient for the three elements."""
+    lam, R = g.cam_ratio, g.cam_radius
+    t1 = 2 / 3 * mu * g.radius1 * fn1 * g.pairs1
+    den = 3 * R - 2 * lam * mu * g.radius3
+    return np.column_stack([t1, 2 * lam * mu * g.radius2 * g.pairs2 / den * t1, 2 * lam * mu * g.radius3 / den * t1])
+
+
+def test_friction_map_in_bench(magnet):
+    from clutchlab.emtc import FrictionMap
+
+    g = CouplingGeometry()
+    fm = FrictionMap([0.0, 5.0, 50.0], [0.0, 100.0], [[0.10, 0.09], [0.08, 0.07], [0.06, 0.05]])
+    sc = BenchScenario(duration=0.6, speed_difference=0.3, temperature_c=50.0)
+    df = simulate_bench(magnet, sc, friction_map=fm).to_dataframe()
+    slip = df[(df["coupling_mode"] == 1) & (df["time"] > 0.1)]
+    mu = np.array([fm(v, 50.0) for v in slip["slip_speed"]])
+    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), _eq15(slip["fn1"].to_numpy(), mu, g), rtol=1e-9)
+
+
+def test_lugre_in_bench_reaches_stribeck_steady_state(magnet):
+    from clutchlab.emtc import LuGreParameters, lugre_steady_state
+
+    g = CouplingGeometry()
+    lp = LuGreParameters()
+    sc = BenchScenario(duration=0.6, speed_difference=0.3)
+    res = simulate_bench(magnet, sc, lugre=lp)
+    df = res.to_dataframe()
+    slip = df[(df["coupling_mode"] == 1) & (df["time"] > 0.1)]
+    mu_ss, _ = lugre_steady_state(slip["slip_speed"].to_numpy(), lp)
+    fn1 = slip["fn1"].to_numpy()
+    mu_eff = slip["t1"].to_numpy() / (2 / 3 * g.radius1 * fn1 * g.pairs1)
+    # quasi-steady slip: the LuGre coefficient sits on the Stribeck curve (bristle lag ~ g/(sigma0 |v|) = 30 us)
+    np.testing.assert_allclose(mu_eff, mu_ss, rtol=5e-3)
+    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), _eq15(fn1, mu_eff, g), rtol=1e-9)
+    with pytest.raises(ParameterError, match="either"):
+        from clutchlab.emtc import FrictionMap
+
+        simulate_bench(magnet, sc, lugre=lp, friction_map=FrictionMap([0, 1], [0, 1], np.ones((2, 2)) * 0.1))
+
+
+def test_lugre_lock_and_unlock_without_chattering(magnet):
+    from clutchlab.emtc import LuGreParameters
+
+    sc = BenchScenario(duration=3.0, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9, ramp_start=0.3,
+                       ramp_end=2.8)
+    res = simulate_bench(magnet, sc, torque_reference=([0.0, 10.0], [150.0, 150.0]), lugre=LuGreParameters())
+    names = list(res.events["name"])
+    assert sum(n.startswith("lock-up") for n in names) == 1
+    assert sum(n.startswith("unlock") for n in names) == 1
+    assert not any(n.startswith("slip reversal") for n in names)
+    df = res.to_dataframe()
+    after = df[df["time"] > res.events["time"].iloc[-1]]
+    assert (after["slip_speed"] > 0).all() and (after["coupling_mode"] == 1).all()
+
+
+def test_magnet_force_is_the_preisach_output_at_coil_current_and_airgap(magnet):
+    """Rising current from zero: the plant force is the limiting ascending branch F(i, i) at the airgap."""
+    act = ActuatorParameters()
+    res = simulate_bench(magnet, BenchScenario(duration=0.5, speed_difference=0.3),
+                         torque_reference=([0.0, 0.5], [20.0, 300.0]))
+    df = res.to_dataframe()
+    assert np.all(np.diff(df["i2"]) >= -1e-12)  # monotone coil current
+    at = df[df["armature_mode"] == 2]
+    gap = act.airgap_open - act.free_travel
+    np.testing.assert_allclose(at["magnet_force"], magnet.forc(at["i2"], at["i2"], airgap=gap), rtol=1e-10, atol=1e-9)
+    rest = df[df["armature_mode"] == 0]
+    np.testing.assert_allclose(rest["magnet_force"], magnet.forc(rest["i2"], rest["i2"], airgap=act.airgap_open),
+                               rtol=1e-10, atol=1e-9)

@@ -1,0 +1,320 @@
+"""Preisach model: grid reproduction, interpolation (Eqs. 4-5), memory properties, inverse (Eqs. 6-7)."""
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from clutchlab.errors import DataError, ParameterError
+from clutchlab.hysteresis import Preisach, PreisachState, forc_table_from_masses
+
+GRID = np.linspace(0.0, 4.5, 10)
+
+
+def random_table(seed, grid=GRID, offset=0.0):
+    rng = np.random.default_rng(seed)
+    n = grid.size - 1
+    return forc_table_from_masses(grid, rng.random((n, n)) * 20.0, rng.random(n) * 30.0, offset)
+
+
+def model(seed=1, grid=GRID):
+    return Preisach(grid, random_table(seed, grid))
+
+
+def brute_force_P(grid, cell, line, i, j):
+    """Relay mass of the triangle b <= beta <= alpha <= a by direct summation."""
+    s = 0.0
+    for p in range(j, i):
+        s += line[p]
+        for q in range(j, p):
+            s += cell[p, q]
+    return s
+
+
+def test_table_from_masses_matches_direct_sum():
+    rng = np.random.default_rng(3)
+    n = GRID.size - 1
+    cell, line = rng.random((n, n)), rng.random(n)
+    F = forc_table_from_masses(GRID, cell, line, offset=2.0)
+    for i in range(GRID.size):
+        for j in range(i + 1):
+            expect = 2.0 + brute_force_P(GRID, cell, line, i, 0) - brute_force_P(GRID, cell, line, i, j)
+            assert F[i, j] == pytest.approx(expect, abs=1e-12)
+
+
+@pytest.mark.parametrize("grid", [GRID, np.array([0.0, 0.3, 1.0, 1.2, 2.5, 4.5])])
+@pytest.mark.parametrize("remanence", [False, True])
+def test_grid_points_reproduced_exactly(grid, remanence):
+    """F(alpha, beta) is the output after rising to alpha and falling to beta (any grid, with remanence)."""
+    F = random_table(5, grid)
+    if remanence:  # a measured table may keep force at the lowest current after a reversal
+        F = F + np.tril(np.outer(np.linspace(0, 7.0, grid.size), np.ones(grid.size)))
+    m = Preisach(grid, F)
+    for i in range(grid.size):
+        for j in range(i + 1):
+            u = np.concatenate([np.linspace(grid[0], grid[i], 5), np.linspace(grid[i], grid[j], 4)[1:]])
+            assert m.simulate(u)[-1] == pytest.approx(F[i, j], abs=1e-10)
+
+
+def test_from_forc_table_long_format_roundtrip():
+    F = random_table(2)
+    i, j = np.tril_indices(GRID.size)
+    m = Preisach.from_forc_table(GRID[i], GRID[j], F[i, j])
+    np.testing.assert_allclose(m.tables[0], F, atol=0)
+
+
+def test_interpolation_square_cell_bilinear_eq4():
+    F = random_table(4)
+    m = Preisach(GRID, F)
+    a, b = 3.2, 1.3  # alpha in cell 5 [2.5, 3.0]? no: [3.0, 3.5] -> i = 6; beta in [1.0, 1.5] -> j = 2
+    i, j = 6, 2
+    s = (a - GRID[i]) / 0.5
+    t = (b - GRID[j]) / 0.5
+    expect = (F[i, j] * (1 - s) * (1 - t) + F[i + 1, j] * s * (1 - t) + F[i, j + 1] * (1 - s) * t
+              + F[i + 1, j + 1] * s * t)
+    out = m.simulate([0.0, a, b])
+    assert out[-1] == pytest.approx(expect, rel=1e-12)
+    # the same value from C0 + C1 a + C2 b + C3 a b fitted to the four vertices (Eq. 4)
+    A = np.array([[1, x, y, x * y] for x, y in [(GRID[i], GRID[j]), (GRID[i + 1], GRID[j]),
+                                                 (GRID[i], GRID[j + 1]), (GRID[i + 1], GRID[j + 1])]])
+    c = np.linalg.solve(A, [F[i, j], F[i + 1, j], F[i, j + 1], F[i + 1, j + 1]])
+    assert out[-1] == pytest.approx(c @ [1, a, b, a * b], rel=1e-12)
+
+
+def test_interpolation_triangular_cell_linear_eq5():
+    F = random_table(6)
+    m = Preisach(GRID, F)
+    a, b = 2.4, 2.15  # both in cell [2.0, 2.5], b <= a
+    k = 4
+    verts = [(GRID[k], GRID[k]), (GRID[k + 1], GRID[k + 1]), (GRID[k + 1], GRID[k])]
+    A = np.array([[1, x, y] for x, y in verts])
+    c = np.linalg.solve(A, [F[k, k], F[k + 1, k + 1], F[k + 1, k]])
+    assert m.simulate([0.0, a, b])[-1] == pytest.approx(c @ [1, a, b], rel=1e-12)
+    assert m.simulate([0.0, a])[-1] == pytest.approx(c @ [1, a, a], rel=1e-12)
+
+
+# ------------------------------------------------------------------ hypothesis properties
+inputs = st.lists(st.floats(0.0, 4.5, allow_nan=False), min_size=1, max_size=25)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 50), history=inputs, top=st.floats(0.0, 4.5), tail=inputs)
+def test_wiping_out(seed, history, top, tail):
+    """An input above every past value erases the memory: the history no longer matters."""
+    top = max(top, max(history))
+    m = model(seed)
+    a = m.simulate(history + [top] + tail)[-len(tail):]
+    b = m.simulate([top] + tail)[-len(tail):]
+    np.testing.assert_allclose(a, b, atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 50), history=inputs, excursion=inputs, tail=inputs)
+def test_return_point_memory(seed, history, excursion, tail):
+    """A closed excursion from the last reversal point leaves no trace (return-point memory).
+
+    The excursion starts at the present input x, moves against the direction
+    of arrival without passing the last stored extremum and returns to x.
+    """
+    m = model(seed)
+    x = history[-1]
+    m.simulate(history)
+    ext = m.state.extrema
+    if ext.size % 2 == 0:  # arrived rising: excursion between the last minimum and x
+        lo, hi = (ext[-1] if ext.size else 0.0), x
+    else:  # arrived falling: excursion between x and the last maximum
+        lo, hi = x, ext[-1]
+    exc = list(np.clip(excursion, lo, hi)) + [x]
+    a = m.simulate(history + exc + tail)
+    b = m.simulate(history + tail)
+    assert a[len(history) + len(exc) - 1] == pytest.approx(b[len(history) - 1], abs=1e-9)
+    np.testing.assert_allclose(a[-len(tail):], b[-len(tail):], atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 50), h1=inputs, h2=inputs, ua=st.floats(0.0, 4.0), width=st.floats(0.05, 2.0),
+       n=st.integers(2, 12))
+def test_congruency_of_minor_loops(seed, h1, h2, ua, width, n):
+    """Minor loops between the same input extrema have the same shape whatever the history."""
+    ub = min(ua + width, 4.5)
+    m = model(seed)
+    loop = list(np.linspace(ua, ub, n)) + list(np.linspace(ub, ua, n))[1:]
+    out = []
+    for h in (h1, h2):
+        top = max(max(h), ub) + 0.0
+        seq = h + [top, ua] + loop
+        y = m.simulate(seq)[-len(loop) - 1:]
+        out.append(y - y[0])
+    np.testing.assert_allclose(out[0], out[1], atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 50), u=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=60))
+def test_output_within_major_loop(seed, u):
+    m = model(seed)
+    y = m.simulate(u)
+    low = m.forc(u, u)  # limiting ascending branch
+    high = m.forc(np.full(len(u), 4.5), u)  # limiting descending branch
+    assert np.all(y >= low - 1e-9)
+    assert np.all(y <= high + 1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 50), u=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=60))
+def test_invert_simulate_identity(seed, u):
+    m = model(seed)
+    target = m.simulate(u)
+    inv = m.invert(target)
+    assert inv.all_feasible
+    np.testing.assert_allclose(inv.output, target, atol=1e-8)
+    np.testing.assert_allclose(m.simulate(inv.input), target, atol=1e-8)
+
+
+def test_invert_recovers_input_for_strictly_increasing_model():
+    m = model(7)
+    u = np.clip(np.cumsum(np.random.default_rng(1).normal(0, 0.3, 300)), 0, 4.5)
+    inv = m.invert(m.simulate(u))
+    np.testing.assert_allclose(inv.input, u, atol=1e-9)
+
+
+def test_invert_reports_infeasible_targets():
+    m = model(8)
+    top = m.forc(4.5, 4.5)
+    inv = m.invert([0.5 * top, 1.2 * top, 0.4 * top, -5.0])
+    np.testing.assert_array_equal(inv.feasible, [True, False, True, False])
+    assert inv.input[1] == 4.5 and inv.output[1] == pytest.approx(top)
+    assert inv.input[3] == 0.0
+    assert inv.reachable_high[1] == pytest.approx(top)
+    rep = inv.report()
+    assert "2 of 4" in rep and "sample 1" in rep and "sample 3" in rep
+
+
+# ------------------------------------------------------------------ state
+def test_step_continues_and_state_restores():
+    m = model(9)
+    u = np.random.default_rng(2).uniform(0, 4.5, 200)
+    full = m.simulate(u)
+    m.simulate(u[:120])
+    st_mid = m.state
+    np.testing.assert_allclose(m.step(u[120:]), full[120:], atol=1e-12)
+    m.reset()
+    m.state = st_mid
+    assert m.step(float(u[120])) == pytest.approx(full[120], abs=1e-12)
+    with pytest.raises(ParameterError, match="alternating"):
+        m.state = PreisachState(np.array([1.0, 2.0]), 1.5)
+
+
+def test_long_decaying_oscillation_grows_memory():
+    m = model(10)
+    k = np.arange(4000)
+    u = 2.25 + 2.25 * np.cos(np.pi * k) * np.exp(-k / 2000)
+    y = m.simulate(u)
+    assert m.state.extrema.size > 100  # the stack grew beyond its initial capacity
+    assert np.all(np.isfinite(y))
+
+
+# ------------------------------------------------------------------ airgap family
+def test_airgap_quadratic_interpolation_exact_for_quadratic_tables():
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
+    A, B, C = random_table(1), random_table(2), random_table(3)
+    tabs = [A + B * (g * 1e3) + C * (g * 1e3) ** 2 for g in gaps]
+    fam = Preisach(GRID, np.array(tabs), gaps)
+    u = np.random.default_rng(4).uniform(0, 4.5, 50)
+    for g in (0.2e-3, 0.33e-3, 0.57e-3, 0.91e-3, 1.0e-3):
+        expect = sum(Preisach(GRID, T).simulate(u) * c for T, c in ((A, 1.0), (B, g * 1e3), (C, (g * 1e3) ** 2)))
+        np.testing.assert_allclose(fam.simulate(u, airgap=g), expect, rtol=1e-9, atol=1e-9)
+
+
+def test_airgap_uses_three_nearest_calibration_points():
+    gaps = np.array([0.2, 0.4, 0.6, 0.8]) * 1e-3
+    tabs = [random_table(s) for s in range(4)]
+    fam = Preisach(GRID, np.array(tabs), gaps)
+    u = [0.0, 3.0, 1.0]
+    g = 0.45e-3  # nearest three: 0.2, 0.4, 0.6 (0.8 is farther than 0.2? 0.35 vs 0.25 -> 0.2, 0.4, 0.6)
+    vals = [Preisach(GRID, T).simulate(u)[-1] for T in tabs[:3]]
+    x = gaps[:3]
+    lag = [np.prod([(g - x[m]) / (x[k] - x[m]) for m in range(3) if m != k]) for k in range(3)]
+    assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(np.dot(lag, vals)), rel=1e-12)
+    g = 0.55e-3  # nearest three: 0.4, 0.6, 0.8
+    vals = [Preisach(GRID, T).simulate(u)[-1] for T in tabs[1:]]
+    x = gaps[1:]
+    lag = [np.prod([(g - x[m]) / (x[k] - x[m]) for m in range(3) if m != k]) for k in range(3)]
+    assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(np.dot(lag, vals)), rel=1e-12)
+
+
+def test_family_inverse_at_off_grid_airgap():
+    gaps = np.array([0.2, 0.6, 1.0, 1.4]) * 1e-3
+    fam = Preisach(GRID, np.array([random_table(s) * (1.5 - 0.3 * k) for k, s in enumerate(range(4))]), gaps)
+    u = np.random.default_rng(5).uniform(0, 4.5, 100)
+    target = fam.simulate(u, airgap=0.7e-3)
+    inv = fam.invert(target, airgap=0.7e-3)
+    assert inv.all_feasible
+    np.testing.assert_allclose(fam.simulate(inv.input, airgap=0.7e-3), target, atol=1e-8)
+
+
+# ------------------------------------------------------------------ errors and files
+def test_bad_input_raises_clear_errors():
+    F = random_table(1)
+    i, j = np.tril_indices(GRID.size)
+    with pytest.raises(DataError, match="missing F"):
+        Preisach.from_forc_table(GRID[i][:-1], GRID[j][:-1], F[i, j][:-1])
+    with pytest.raises(DataError, match="beta = .* > alpha"):
+        Preisach.from_forc_table([1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [1, 2, 3])
+    vals = F[i, j].copy()
+    vals[3] = np.nan
+    with pytest.raises(DataError, match=r"value\[3\]"):
+        Preisach.from_forc_table(GRID[i], GRID[j], vals)
+    with pytest.raises(DataError, match="given twice"):
+        Preisach.from_forc_table(np.r_[GRID[i], 4.5], np.r_[GRID[j], 0.0], np.r_[F[i, j], 1.0])
+    m = Preisach(GRID, F)
+    with pytest.raises(DataError, match=r"u\[2\] = 5.0 A outside the Preisach grid"):
+        m.simulate([0.0, 1.0, 5.0])
+    with pytest.raises(DataError, match="not finite"):
+        m.simulate([0.0, np.nan])
+    with pytest.raises(ParameterError, match="airgap given"):
+        m.simulate([1.0], airgap=1e-3)
+    fam = Preisach(GRID, np.array([F, F * 0.5]), [0.2e-3, 0.4e-3])
+    with pytest.raises(ParameterError, match="pass airgap"):
+        fam.simulate([1.0])
+    with pytest.raises(DataError, match="outside the calibration range"):
+        fam.simulate([1.0], airgap=0.5e-3)
+    with pytest.raises(DataError, match="not strictly increasing"):
+        Preisach([0.0, 1.0, 1.0], np.zeros((3, 3)))
+
+
+def test_json_roundtrip(tmp_path):
+    gaps = np.array([0.2e-3, 0.4e-3, 0.6e-3])
+    fam = Preisach(GRID, np.array([random_table(s) for s in range(3)]), gaps)
+    p = fam.to_json(tmp_path / "m.json")
+    with pytest.raises(FileExistsError):
+        fam.to_json(p)
+    back = Preisach.from_json(p)
+    np.testing.assert_allclose(back.tables, fam.tables)
+    np.testing.assert_allclose(back.airgaps, gaps)
+    (tmp_path / "bad.json").write_text(json.dumps({"kind": "other"}))
+    with pytest.raises(DataError, match="not a clutchlab Preisach model"):
+        Preisach.from_json(tmp_path / "bad.json")
+
+
+@settings(max_examples=60, deadline=None)
+@given(history=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=30), v=st.floats(0.0, 4.5),
+       gap=st.floats(0.2e-3, 1.0e-3))
+def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):
+    """The compiled bench evaluates the family through one airgap-combined table (linearity of Eqs. 2-5)."""
+    from clutchlab.hysteresis import _kernels as K
+
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
+    fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
+    fam.simulate(history, airgap=gap)
+    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    K.gap_weights(fam.airgaps, gap, idx, w)
+    comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
+    K.combine_tables(fam.kernel_tables, idx, w, comb)
+    args = (fam._stack, fam._pref, fam._length, fam._u, v, idx, w)
+    a = K.peek(fam.kernel_tables, fam.grid, *args)
+    b = K.peek_combined(comb, fam.grid, *args)
+    assert b == pytest.approx(a, rel=1e-12, abs=1e-9)
+    # and peek equals committing the step
+    assert a == pytest.approx(fam.step(v, airgap=gap), rel=1e-12, abs=1e-9)
