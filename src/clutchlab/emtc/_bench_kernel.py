@@ -26,6 +26,8 @@ import math
 import numba
 import numpy as np
 
+from ..numerics import FASTMATH
+
 from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek_combined
 from ..numerics.dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
@@ -44,7 +46,7 @@ AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP,
 EV_ARM_REST, EV_ARM_CONTACT, EV_ARM_LEAVE_REST, EV_ARM_LEAVE_CONTACT, EV_LOCK, EV_SLIP_REVERSAL, EV_UNLOCK = range(7)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _interp(tx, ty, t):
     n = tx.shape[0]
     if n == 1:
@@ -53,19 +55,19 @@ def _interp(tx, ty, t):
     return ty[i] + s * (ty[i + 1] - ty[i])
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _bilinear(xg, yg, z, x, y):
     i, s = bracket(xg, x)  # clamped to the map's edges
     j, r = bracket(yg, y)
     return z[i, j] * (1 - s) * (1 - r) + z[i + 1, j] * s * (1 - r) + z[i, j + 1] * (1 - s) * r + z[i + 1, j + 1] * s * r
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _stribeck_pv(v, pv):
     return pv[27] + (pv[28] - pv[27]) * math.exp(-((v / pv[29]) ** 2))  # [1], Eq. 24
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _lugre_advance_pv(z, v, h, pv):
     """Exact bristle update of Eq. 23 at constant slip (see friction.lugre_advance); parameters in pv[24:30]."""
     if v == 0.0 or h <= 0.0:
@@ -75,7 +77,7 @@ def _lugre_advance_pv(z, v, h, pv):
     return zss + (z - zss) * math.exp(-pv[24] * abs(v) * h / g)
 
 
-@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy", fastmath=FASTMATH)
 def _rhs(t, y, dy, aux, imode, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
          thr_t, thr_v, vf_t, vf_v, vr_t, vr_v,
          ptab, pgrid, pgaps, pstack, ppref, plen, pu, tmp3, pidx, pw, pcomb):
@@ -202,7 +204,7 @@ def _rhs(t, y, dy, aux, imode, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
     dy[1] = (tc - a_r) / jr  # [1], Eq. 27 (rows 2 and 4)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _events(y, aux, imode, pv, pa, gv):
     """Event functions; an event occurs when one goes from > 0 to <= 0."""
     for k in range(6):
@@ -222,7 +224,7 @@ def _events(y, aux, imode, pv, pa, gv):
         gv[5] = pv[17] * aux[AUX_CAP] - abs(aux[AUX_TC])  # 1.02 T_cap < |T_lock|
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
                  thr_t, thr_v, vf_t, vf_v, vr_t, vr_v, tm_thr, tm_v, tm_t, t_ref_override,
                  ptab, pgrid, pgaps, pstack, ppref,

@@ -33,8 +33,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ..numerics import FASTMATH
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def locate(grid, x):
     """Index ``i`` of the grid cell ``[grid[i], grid[i+1]]`` containing ``x`` (clamped).
 
@@ -56,7 +58,7 @@ def locate(grid, x):
     return i
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def forc_value_ij(tables, k, grid, a, i, b, j):
     """``F(a, b)`` of table ``k`` with the cells ``i`` of ``a`` and ``j`` of ``b`` located (``b <= a``).
 
@@ -73,13 +75,13 @@ def forc_value_ij(tables, k, grid, a, i, b, j):
             + tables[k, i, j, 3] * a * b)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def forc_value(tables, k, grid, a, b):
     """Interpolated first-order reversal value ``F(a, b)`` (``b <= a``) of table ``k``, Eqs. 4-5 of [1]."""
     return forc_value_ij(tables, k, grid, a, locate(grid, a), b, locate(grid, b))
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def gap_weights(gaps, gap, idx, w):
     """Quadratic Lagrange weights through the three calibration airgaps nearest ``gap``.
 
@@ -120,7 +122,7 @@ def gap_weights(gaps, gap, idx, w):
     w[2] = (gap - x0) * (gap - x1) / ((x2 - x0) * (x2 - x1))
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def table_output(tables, k, grid, stack, length, pref, v):
     """Output of table ``k`` for the memory ``stack[:length]`` and current input ``v``.
 
@@ -144,7 +146,7 @@ def table_output(tables, k, grid, stack, length, pref, v):
     return f
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def weighted_output(tables, grid, stack, length, pref, v, idx, w):
     """Airgap-weighted output of up to three tables for the same current memory.
 
@@ -180,7 +182,7 @@ def weighted_output(tables, grid, stack, length, pref, v, idx, w):
     return f
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def commit(tables, grid, stack, pref, length, u, v):
     """Move the memory from input ``u`` to input ``v``; return the new length.
 
@@ -218,7 +220,7 @@ def commit(tables, grid, stack, pref, length, u, v):
     return length
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def simulate_kernel(tables, grid, gaps, stack, pref, length, u, inputs, airgaps, out, start):
     """Forward model over ``inputs[start:]``; returns ``(n_done, length, u)``.
 
@@ -249,7 +251,7 @@ def simulate_kernel(tables, grid, gaps, stack, pref, length, u, inputs, airgaps,
     return n, length, u
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def peek(tables, grid, stack, pref, length, u, v, idx, w):
     """Output for the next input ``v`` without changing the memory (nothing is written).
 
@@ -301,7 +303,7 @@ def peek(tables, grid, stack, pref, length, u, v, idx, w):
     return weighted_output(tables, grid, stack, L, pref, v, idx, w)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def invert_one(tables, grid, stack, pref, length, u, target, idx, w, tol):
     """Input ``v`` whose output from the current memory equals ``target`` ([1], Eqs. 6-7).
 
@@ -366,7 +368,7 @@ def invert_one(tables, grid, stack, pref, length, u, target, idx, w, tol):
             f0 = fb
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def invert_kernel(tables, grid, gaps, stack, pref, length, u, targets, airgaps, out_u, out_f, feasible,
                   lo_reach, hi_reach, tol, start):
     """Inverse model over ``targets[start:]`` (open-loop compensation, [1], Fig. 7).
@@ -397,7 +399,7 @@ def invert_kernel(tables, grid, gaps, stack, pref, length, u, targets, airgaps, 
     return n, length, u
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def rebuild_prefix(tables, grid, stack, length, pref):
     """Recompute the pair sums ``pref`` for a given memory stack."""
     for k in range(tables.shape[0]):
@@ -445,7 +447,7 @@ def cell_coefficients(grid, table):
     return out
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def combine_tables(tables, idx, w, out):
     """``out[0] = sum_q w[q] * tables[idx[q]]``: one coefficient table for a fixed airgap.
 
@@ -463,7 +465,7 @@ def combine_tables(tables, idx, w, out):
                 out[0, i, j, c] = acc
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _wpref(pref, p, idx, w):
     acc = 0.0
     for q in range(3):
@@ -472,7 +474,7 @@ def _wpref(pref, p, idx, w):
     return acc
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def peek_combined(comb, grid, stack, pref, length, u, v, idx, w):
     """:func:`peek` with the airgap-combined table ``comb`` (from :func:`combine_tables`)."""
     L = length

@@ -16,3 +16,8 @@ from .dopri import (
 __all__ = [
     "error_norm", "next_step", "dense_hermite", "initial_step",
 ]
+
+#: LLVM fast-math flags for the hot kernels: reassociation, contraction (FMA), reciprocal and
+#: approximate functions, no signed zeros -- but *not* 'nnan'/'ninf', so NaN and infinity checks
+#: (infeasible targets, NaN lock-up times) keep their meaning.
+FASTMATH = {"reassoc", "contract", "arcp", "afn", "nsz"}
