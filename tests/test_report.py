@@ -29,3 +29,14 @@ def test_report_is_self_contained(tmp_path):
         write_report([section()], tmp_path / "rep")
     write_report([section()], tmp_path / "rep", overwrite=True)
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_report_folder_has_the_usual_permissions(tmp_path):
+    import os
+    import stat
+
+    index = write_report([section()], tmp_path / "rep2")
+    umask = os.umask(0)
+    os.umask(umask)
+    mode = stat.S_IMODE(os.stat(index.parent).st_mode)
+    assert mode == 0o777 & ~umask

@@ -113,6 +113,9 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
         raise FileExistsError(f"{outdir} exists; pass overwrite=True (CLI: --force) to replace it")
     outdir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", dir=outdir.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp creates 0700; the report folder gets the usual permissions
     try:
         (tmp / "figures").mkdir()
         (tmp / "tables").mkdir()
