@@ -90,6 +90,9 @@ class Model4Fit:
         Residual statistics at the optimum.
     params : EClutchParameters
         The parameter set with the fitted factors.
+    at_bound : tuple of bool
+        Whether each factor ended on a bound of the search (then the record
+        does not determine it, and its standard error is not meaningful).
     """
 
     support_scale: float
@@ -99,12 +102,14 @@ class Model4Fit:
     rmse_force_N: float
     rmse_torque_Nm: float
     params: EClutchParameters
+    at_bound: tuple = (False, False)
 
     def report(self) -> str:
         """Readable summary."""
+        flag = [" (at the search bound: not determined by the record)" if b else "" for b in self.at_bound]
         return (f"Model 4 stiffness factors (least squares on the full-clutch record)\n"
-                f"  support_scale   = {self.support_scale:.4g} +/- {self.standard_errors[0]:.2g}\n"
-                f"  diaphragm_scale = {self.diaphragm_scale:.4g} +/- {self.standard_errors[1]:.2g}\n"
+                f"  support_scale   = {self.support_scale:.4g} +/- {self.standard_errors[0]:.2g}{flag[0]}\n"
+                f"  diaphragm_scale = {self.diaphragm_scale:.4g} +/- {self.standard_errors[1]:.2g}{flag[1]}\n"
                 f"  correlation     = {self.correlation:+.3f}\n"
                 f"  RMSE force {self.rmse_force_N:.4g} N, torque {self.rmse_torque_Nm:.4g} N*m")
 
@@ -180,4 +185,5 @@ def fit_model4_scales(record: pd.DataFrame, params: EClutchParameters | None = N
         correlation=corr, rmse_force_N=float(np.sqrt(np.mean(r[:k] ** 2))),
         rmse_torque_Nm=float(np.sqrt(np.mean((r[k:] / w) ** 2))),
         params=params.replace(support_scale=float(scales[0]), diaphragm_scale=float(scales[1])),
+        at_bound=tuple(bool(min(x - l, h - x) < 1e-6) for x, l, h in zip(sol.x, lo, hi)),
     )
