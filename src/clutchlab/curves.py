@@ -401,9 +401,11 @@ def _combined_extrap(curves) -> str:
     return "error" if any(c.extrapolation == "error" for c in curves) else "linear"
 
 
-def _adaptive_samples(func, breakpoints: np.ndarray, lo: float, hi: float, rtol: float = 1e-6, max_rounds: int = 14):
-    """Sample ``func`` on [lo, hi] from the breakpoints, bisecting intervals until linear
-    interpolation reproduces ``func`` at the midpoints to ``rtol`` of its range."""
+def _adaptive_samples(func, breakpoints: np.ndarray, lo: float, hi: float, rtol: float, interpolate,
+                      max_rounds: int = 30):
+    """Sample ``func`` on [lo, hi] from the breakpoints, bisecting every interval in which the final
+    interpolant ``interpolate(t, y, t_query)`` misses ``func`` by more than ``rtol`` of its range at
+    one third or two thirds of the interval."""
     t = np.unique(np.concatenate([breakpoints[(breakpoints > lo) & (breakpoints < hi)], [lo, hi]]))
     tol_t = 1e-9 * max(abs(lo), abs(hi), 1e-300)
     t = t[np.concatenate([[True], np.diff(t) > tol_t])]
@@ -411,8 +413,12 @@ def _adaptive_samples(func, breakpoints: np.ndarray, lo: float, hi: float, rtol:
     for _ in range(max_rounds):
         mid = 0.5 * (t[:-1] + t[1:])
         ym = func(mid)
-        scale = max(np.ptp(y), 1e-300)
-        bad = np.abs(ym - 0.5 * (y[:-1] + y[1:])) > rtol * scale
+        # probe at 1/3 and 2/3 of each interval: a midpoint alone can be met by chance (symmetric cubics)
+        probes = np.concatenate([t[:-1] + (t[1:] - t[:-1]) / 3.0, t[:-1] + 2.0 * (t[1:] - t[:-1]) / 3.0])
+        yp = func(probes)
+        scale = max(np.ptp(np.concatenate([y, ym, yp])), 1e-300)
+        miss = np.abs(yp - interpolate(t, y, probes)) > rtol * scale
+        bad = miss[: t.size - 1] | miss[t.size - 1:]
         bad &= np.diff(t) > 4 * tol_t
         if not bad.any():
             break
@@ -427,9 +433,9 @@ def series(*curves: Curve, name: str = "series", rtol: float = 1e-6) -> Curve:
     """Springs in series: deflections add at equal force.
 
     Each curve must be strictly increasing (invertible).  The result is
-    sampled at the union of the components' sample forces, bisected where a
-    straight line between samples misses the exact sum by more than ``rtol``
-    of the deflection range, over the union of their force ranges, each
+    sampled at the union of the components' sample forces, bisected where the
+    result's own interpolant misses the exact sum by more than ``rtol`` of the
+    deflection range, over the union of their force ranges, each
     component extrapolating by its own policy; with ``extrapolation='error'``
     on any component, only the common range is used.  Two linear springs give
     ``1/k = 1/k1 + 1/k2``.  ``name`` labels the result.
@@ -449,8 +455,12 @@ def series(*curves: Curve, name: str = "series", rtol: float = 1e-6) -> Curve:
     if not hi > lo:
         raise ParameterError("series(): the curves share no force range")
     kind = _combined_kind(curves)
+
+    def interpolate(f, x, f_query):  # the result's own interpolant, read as deflection(force)
+        return Curve(x, f, kind=kind).inverse(f_query) if np.all(np.diff(x) > 0) else np.full(f_query.shape, np.inf)
+
     grid, x = _adaptive_samples(lambda f: sum(c.inverse(f) for c in curves),
-                                np.concatenate([c.force for c in curves]), lo, hi, rtol)
+                                np.concatenate([c.force for c in curves]), lo, hi, rtol, interpolate)
     keep = np.concatenate([[True], np.diff(x) > 1e-12 * (np.abs(x).max() + 1e-300)])
     x, grid = x[keep], grid[keep]
     return Curve(x, grid, kind=kind, extrapolation=extrap, name=name)
@@ -460,7 +470,7 @@ def parallel(*curves: Curve, name: str = "parallel", rtol: float = 1e-6) -> Curv
     """Springs in parallel: forces add at equal deflection.
 
     Sampled at the union of the components' deflection samples (bisected
-    until linear interpolation is within ``rtol`` of the force range; ``name``
+    until the result's interpolant is within ``rtol`` of the force range; ``name``
     labels the result) over the union (or, with ``extrapolation='error'``, the
     intersection) of their spans.
     """
@@ -477,5 +487,6 @@ def parallel(*curves: Curve, name: str = "parallel", rtol: float = 1e-6) -> Curv
         raise ParameterError("parallel(): the curves share no deflection range")
     kind = _combined_kind(curves)
     grid, f = _adaptive_samples(lambda x: sum(c(x) for c in curves),
-                                np.concatenate([c.deflection for c in curves]), lo, hi, rtol)
+                                np.concatenate([c.deflection for c in curves]), lo, hi, rtol,
+                                lambda x, y, xq: Curve(x, y, kind=kind)(xq))
     return Curve(grid, f, kind=kind, extrapolation=extrap, name=name)
