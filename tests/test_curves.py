@@ -9,7 +9,7 @@ from clutchlab import Curve
 from clutchlab.curves import curve_eval, parallel, series
 from clutchlab.errors import DataError, ParameterError
 
-SETTINGS = settings(max_examples=int(__import__("os").environ.get("CLUTCHLAB_HYPOTHESIS_EXAMPLES", 60)), deadline=None)
+SETTINGS = settings(deadline=None)  # example count from the hypothesis profile (tests/conftest.py)
 
 
 @st.composite
