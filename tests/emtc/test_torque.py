@@ -139,15 +139,26 @@ def test_locked_split_is_continuous_across_case_boundaries(geom):
     assert jumps <= 2.0 * (T[1] - T[0]) * 1.0001  # Lipschitz: no element jumps at a case boundary
 
 
+def test_geometry_signature_of_the_issue_and_toml_round_trip(tmp_path):
+    g = CouplingGeometry(mu_k=(0.11, 0.12, 0.09), mu_s=(0.12, 0.13, 0.10), radius=(0.06, 0.07, 0.05),
+                         pairs=(3, 8), cam_ratio=4.0, cam_radius=0.035)
+    assert (g.mu_k1, g.mu_s3, g.radius2, g.pairs1, g.pairs2) == (0.11, 0.10, 0.07, 3, 8)
+    assert CouplingGeometry.from_toml(g.to_toml(tmp_path / "coupling.toml")) == g
+
+
 def test_geometry_validation():
     with pytest.raises(ParameterError, match="self-lock"):
         CouplingGeometry(cam_ratio=20.0)
     with pytest.raises(ParameterError, match="static friction"):
-        CouplingGeometry(mu_s1=0.1, mu_k1=0.12)
-    with pytest.raises(ParameterError, match="pairs1"):
-        CouplingGeometry(pairs1=-2)
+        CouplingGeometry(mu_s=(0.1, 0.13, 0.11), mu_k=(0.12, 0.12, 0.10))
+    with pytest.raises(ParameterError, match=r"pairs\[0\] = -2.0: must be > 0"):
+        CouplingGeometry(pairs=(-2, 10))
+    with pytest.raises(ParameterError, match="pairs2 = 10.5: expected a whole number"):
+        CouplingGeometry(pairs=(4, 10.5))
+    with pytest.raises(ParameterError, match="mu_k.*expected 3 values"):
+        CouplingGeometry(mu_k=(0.1, 0.1))
     with pytest.raises(ParameterError, match="fn1"):
         slipping_torques(-1.0, 1.0, G)
     with pytest.raises(ParameterError, match="t_lock"):
         locked_torques(1.0, np.nan, G)
-    assert CouplingGeometry.from_dict({"radius1": "65 mm"}).radius1 == pytest.approx(0.065)
+    assert CouplingGeometry.from_dict({"radius": ["65 mm", "70 mm", "6 cm"]}).radius3 == pytest.approx(0.06)

@@ -42,39 +42,61 @@ UNLOCK_MARGIN = 1.02
 class CouplingGeometry(ParameterSet):
     """Friction coefficients and radii of the three friction elements and the ball-cam.
 
+    ``CouplingGeometry(mu_k, mu_s, radius, pairs, cam_ratio, cam_radius)``:
+
+    Parameters
+    ----------
+    mu_k : (float, float, float)
+        Kinetic friction coefficients of the primary clutch, the secondary
+        (main) clutch and the third friction element [-].
+    mu_s : (float, float, float)
+        Static friction coefficients of the same three elements [-] (each
+        ``>= mu_k``).
+    radius : (float, float, float)
+        Effective radii ``R1, R2, R3`` of Eq. 13 [m], where the torque is
+        ``2/3 * mu * R_i * F_n * z``.
+    pairs : (int, int)
+        Friction pairs ``z1, z2`` of the primary and secondary clutch [-].
+    cam_ratio : float
+        Ball-cam amplification ``lambda`` (Eq. 14) [-].
+    cam_radius : float
+        Ball-cam working radius ``R`` (Eq. 14) [m].
+
+    Notes
+    -----
     Defaults are representative values chosen by clutchlab (the paper gives no
     numbers for the coupling): a pilot clutch of four pairs, a main clutch of
     ten pairs, a single third element, ball-cam with ``lambda = 5`` on
-    ``R = 40 mm``.  Radii are the radii ``R_i`` of Eq. 13, where the torque is
-    ``2/3 * mu * R_i * F_n * z``.
+    ``R = 40 mm``.  The per-element values are also available as
+    ``mu_k1 .. mu_k3``, ``mu_s1 .. mu_s3``, ``radius1 .. radius3``,
+    ``pairs1``, ``pairs2``.
     """
 
     kind = "coupling"
 
-    mu_k1: float = quantity(0.12, "1", "kinetic friction coefficient, primary clutch", source="representative", positive=True)
-    mu_k2: float = quantity(0.12, "1", "kinetic friction coefficient, secondary clutch", source="representative", positive=True)
-    mu_k3: float = quantity(0.10, "1", "kinetic friction coefficient, third element", source="representative", positive=True)
-    mu_s1: float = quantity(0.13, "1", "static friction coefficient, primary clutch", source="representative", positive=True)
-    mu_s2: float = quantity(0.13, "1", "static friction coefficient, secondary clutch", source="representative", positive=True)
-    mu_s3: float = quantity(0.11, "1", "static friction coefficient, third element", source="representative", positive=True)
-    radius1: float = quantity(0.065, "m", "radius R1 of the primary clutch (Eq. 13)", source="representative", positive=True)
-    radius2: float = quantity(0.070, "m", "radius R2 of the secondary clutch (Eq. 13)", source="representative", positive=True)
-    radius3: float = quantity(0.060, "m", "radius R3 of the third element (Eq. 13)", source="representative", positive=True)
-    pairs1: int = quantity(4, "1", "friction pairs z1 of the primary clutch", source="representative", positive=True)
-    pairs2: int = quantity(10, "1", "friction pairs z2 of the secondary clutch", source="representative", positive=True)
+    mu_k: tuple = quantity((0.12, 0.12, 0.10), "1", "kinetic friction coefficients (primary, secondary, third)",
+                           source="representative", positive=True)
+    mu_s: tuple = quantity((0.13, 0.13, 0.11), "1", "static friction coefficients (primary, secondary, third)",
+                           source="representative", positive=True)
+    radius: tuple = quantity((0.065, 0.070, 0.060), "m", "radii R1, R2, R3 of Eq. 13", source="representative",
+                             positive=True)
+    pairs: tuple = quantity((4, 10), "1", "friction pairs z1, z2 of the primary and secondary clutch",
+                            source="representative", positive=True)
     cam_ratio: float = quantity(5.0, "1", "ball-cam amplification lambda (Eq. 14)", source="representative", positive=True)
     cam_radius: float = quantity(0.040, "m", "ball-cam working radius R (Eq. 14)", source="representative", positive=True)
 
     def check(self) -> None:
+        for name, n in (("mu_k", 3), ("mu_s", 3), ("radius", 3), ("pairs", 2)):
+            if len(getattr(self, name)) != n:
+                raise ParameterError(f"CouplingGeometry.{name} = {getattr(self, name)!r}: expected {n} values")
         for i in (1, 2, 3):
             if getattr(self, f"mu_s{i}") < getattr(self, f"mu_k{i}"):
                 raise ParameterError(
                     f"CouplingGeometry.mu_s{i} = {getattr(self, f'mu_s{i}')!r} < mu_k{i} = {getattr(self, f'mu_k{i}')!r}:"
                     " static friction must not be below kinetic friction")
-        for name in ("pairs1", "pairs2"):
-            v = getattr(self, name)
-            if isinstance(v, float) and v != int(v):
-                raise ParameterError(f"CouplingGeometry.{name} = {v!r}: expected a whole number")
+        for k, v in enumerate(self.pairs, start=1):
+            if v != int(v):
+                raise ParameterError(f"CouplingGeometry.pairs{k} = {v!r}: expected a whole number")
         for mu_name in ("mu_k3", "mu_s3"):
             g = 2.0 * self.cam_ratio * getattr(self, mu_name) * self.radius3 / (3.0 * self.cam_radius)
             if g >= 1.0:
@@ -82,10 +104,22 @@ class CouplingGeometry(ParameterSet):
                     f"CouplingGeometry: 2*lambda*{mu_name}*R3/(3*R) = {g:.4g} >= 1: the ball-cam would self-lock "
                     "(Eqs. 15, 19, 20 need 3R > 2*lambda*mu3*R3)")
 
+    # per-element views ([1] numbers the elements 1: primary, 2: secondary, 3: third)
+    mu_k1 = property(lambda self: self.mu_k[0], doc="kinetic coefficient of the primary clutch [-]")
+    mu_k2 = property(lambda self: self.mu_k[1], doc="kinetic coefficient of the secondary clutch [-]")
+    mu_k3 = property(lambda self: self.mu_k[2], doc="kinetic coefficient of the third element [-]")
+    mu_s1 = property(lambda self: self.mu_s[0], doc="static coefficient of the primary clutch [-]")
+    mu_s2 = property(lambda self: self.mu_s[1], doc="static coefficient of the secondary clutch [-]")
+    mu_s3 = property(lambda self: self.mu_s[2], doc="static coefficient of the third element [-]")
+    radius1 = property(lambda self: self.radius[0], doc="radius R1 [m]")
+    radius2 = property(lambda self: self.radius[1], doc="radius R2 [m]")
+    radius3 = property(lambda self: self.radius[2], doc="radius R3 [m]")
+    pairs1 = property(lambda self: int(self.pairs[0]), doc="friction pairs z1 [-]")
+    pairs2 = property(lambda self: int(self.pairs[1]), doc="friction pairs z2 [-]")
+
     def kernel_data(self) -> np.ndarray:
         """Array ``[mu_k1..3, mu_s1..3, R1..3, z1, z2, lambda, R]`` for compiled kernels."""
-        return np.array([self.mu_k1, self.mu_k2, self.mu_k3, self.mu_s1, self.mu_s2, self.mu_s3,
-                         self.radius1, self.radius2, self.radius3, float(self.pairs1), float(self.pairs2),
+        return np.array([*self.mu_k, *self.mu_s, *self.radius, float(self.pairs[0]), float(self.pairs[1]),
                          self.cam_ratio, self.cam_radius])
 
 
