@@ -61,3 +61,12 @@ def test_bench_derived_quantities():
     assert b.drive_torque_max == pytest.approx(240.0)           # 120 N*m through the 1:2 gear
     assert b.drive_speed_max == pytest.approx(3000 * math.pi / 30)  # 6000 rpm / 2
     assert b.total_inertia == pytest.approx(b.shaft_inertia + 4 * b.motor_inertia)
+
+
+def test_paper_accepts_the_four_viscosity_parameters_at_once():
+    from clutchlab.wet import WetClutch
+
+    c = WetClutch.paper(viscosity=(0.2, -0.05, 0.03, -0.02))
+    assert c.viscosity == (0.2, -0.05, 0.03, -0.02) and c.mu_v3 == 0.03
+    with pytest.raises(ParameterError, match="four Eq. 7 parameters"):
+        WetClutch.paper(viscosity=(0.2, -0.05))

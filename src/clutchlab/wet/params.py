@@ -83,7 +83,19 @@ class WetClutch(ParameterSet):
 
     @classmethod
     def paper(cls, **overrides) -> "WetClutch":
-        """Table 1 of Shin et al. (SI units), with optional field overrides."""
+        """Table 1 of Shin et al. (SI units), with optional field overrides.
+
+        ``viscosity=(mu_v1, mu_v2, mu_v3, mu_v4)`` sets the four Eq. 7
+        parameters at once ([Pa*s], [1/K], [Pa*s], [1/K]); they are stored as
+        four fields because their units differ.
+        """
+        if "viscosity" in overrides:
+            visc = overrides.pop("viscosity")
+            try:
+                mu1, mu2, mu3, mu4 = visc
+            except (TypeError, ValueError):
+                raise ParameterError(f"WetClutch.viscosity = {visc!r}: expected the four Eq. 7 parameters") from None
+            overrides.update(mu_v1=mu1, mu_v2=mu2, mu_v3=mu3, mu_v4=mu4)
         return cls().replace(**overrides) if overrides else cls()
 
     # ------------------------------------------------------------- derived
