@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from clutchlab.cli import main
-from clutchlab.eclutch import ClutchModel, load_variant
+from clutchlab.eclutch import ClutchModel, EClutchParameters, load_variant
 from clutchlab.errors import ParameterError
 
-VARIANT = """
+_VARIANT = """
 [network]
 name = "Model 2 + compliant support"
 base = 2
@@ -23,7 +23,7 @@ tip = "tip"
 edge = "edge"
 pivot = "support"
 ratio = -4.0
-stiffness = "1.1757 MN/m"
+stiffness = "{k_fl} N/m"
 
 [[network.springs]]
 name = "support"
@@ -31,6 +31,8 @@ a = "ground"
 b = "support"
 stiffness = "1e8 MN/m"
 """
+#: the lever of Model 2 with the default k_fl, now pivoting on the new support node
+VARIANT = _VARIANT.replace("{k_fl}", repr(EClutchParameters().k_fl_model2))
 
 
 def test_variant_from_toml_with_a_stiff_support_equals_its_base(tmp_path):

@@ -67,8 +67,9 @@ class VirtualClutch(ParameterSet):
     return_stiffness: float = quantity(3.0e4, "N/m", "return leaf springs, all three", source=_REP, positive=True)
     return_prestrain: float = quantity(8.0e-3, "m", "return spring pre-stretch in the nominal assembly", source=_REP)
     ring_coefficient: float = quantity(2.0e10, "N/m**1.5", "support ring Hertz coefficient", source=_REP, positive=True)
-    yoke_spring_stiffness: float = quantity(1.5e7, "N/m", "yoke support spring initial stiffness", source=_REP, positive=True)
-    yoke_spring_length: float = quantity(3.0e-4, "m", "yoke support spring stiffening length", source=_REP, positive=True)
+    yoke_spring_stiffness: float = quantity(2.0e7, "N/m", "yoke support spring initial stiffness (Almen-László)", source=_REP, positive=True)
+    yoke_spring_height: float = quantity(0.8e-3, "m", "yoke support spring cone height h (h/t < sqrt(2): monotone)", source=_REP, positive=True)
+    yoke_spring_thickness: float = quantity(0.65e-3, "m", "yoke support spring thickness t", source=_REP, positive=True)
     yoke_spring_preload: float = quantity(1500.0, "N", "preload of the yoke support spring against the support ring", source=_REP, nonnegative=True)
     r_eff: float = quantity(0.1026, "m", "effective friction radius (r_o = 120 mm, r_i = 82.5 mm, uniform pressure)", source=_REP, positive=True)
     mu: float = quantity(0.27, "1", "friction coefficient of the facings", source=_REP, positive=True)
@@ -115,10 +116,10 @@ class VirtualClutch(ParameterSet):
         return Curve(s, law.hertz_contact(s, self.ring_coefficient), kind="pchip", name="support ring (true)")
 
     def yoke_spring(self) -> Curve:
-        """Yoke support spring [m -> N]."""
+        """Yoke support spring, a disk spring like the diaphragm ([1] Sec. 4.6): Almen-László, monotone [m -> N]."""
         s = np.linspace(0.0, 1.0e-3, 101)
-        return Curve(s, law.progressive_quadratic(s, self.yoke_spring_stiffness, self.yoke_spring_length), kind="pchip",
-                     name="yoke support spring (true)")
+        return Curve(s, law.almen_laszlo(s, self.yoke_spring_stiffness, self.yoke_spring_height, self.yoke_spring_thickness),
+                     kind="pchip", name="yoke support spring (true)")
 
     def diaphragm_at_tip(self) -> Curve:
         """What the press measures at the tips with the diaphragm on the pressure plate (test a).
