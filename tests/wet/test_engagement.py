@@ -129,7 +129,9 @@ def test_break_away_event_when_drive_exceeds_capacity():
 def test_energy_conservation_property(force, w0):
     res = dyno(force=force, w0=w0, duration=2.0)
     eb = res.energy_balance()
-    assert eb["friction_work"] == pytest.approx(0.5 * BENCH.total_inertia * w0**2, rel=5e-3)
+    # the kinetic energy lost (a light force may not lock the clutch within 2 s) is the friction work
+    w_end = res.final_state[res.state_names.index("slip_speed_rad_s")]
+    assert eb["friction_work"] == pytest.approx(0.5 * BENCH.total_inertia * (w0**2 - w_end**2), rel=5e-3)
     assert abs(eb["residual"]) < 5e-3
     assert np.all(res.output("friction_power_W") >= -1e-9)
 
