@@ -32,7 +32,6 @@ from clutchlab.hysteresis import _kernels as K
 
 def reference(magnet, sc: BenchScenario, rtol=1e-6):
     veh, act, geo_p, tmap = VehicleParameters(), ActuatorParameters(), CouplingGeometry(), TorqueMap()
-    geo = geo_p.kernel_data()
     ic = veh.rear_final_drive
     jf = veh.inertia_input_shaft + veh.inertia_front_axle / ic**2
     jr = veh.inertia_output_shaft + veh.inertia_rear_axle / ic**2
@@ -50,7 +49,6 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6):
     K.gap_weights(gaps, d - sigma, cidx, cw)
     vdf = sc.drum_speed
     vdr = sc.drum_speed - sc.speed_difference
-    lam_r = geo_p.cam_ratio / geo_p.cam_radius
     den = 3 * geo_p.cam_radius - 2 * geo_p.cam_ratio * geo_p.mu_k3 * geo_p.radius3
     gain = 1 + (2 * geo_p.cam_ratio * geo_p.mu_k2 * geo_p.radius2 * geo_p.pairs2
                 + 2 * geo_p.cam_ratio * geo_p.mu_k3 * geo_p.radius3) / den

@@ -1,6 +1,5 @@
 """The public API polices itself: every public callable has a docstring naming each of its arguments."""
 
-import importlib
 import inspect
 
 import pytest

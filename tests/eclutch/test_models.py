@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from clutchlab import Curve
-from clutchlab.eclutch import (AxialNetwork, ClutchModel, ComponentCurves, EClutchParameters, Lever, Node, Spring,
+from clutchlab.eclutch import (ClutchModel, ComponentCurves, EClutchParameters, Lever, Node, Spring,
                                VirtualClutch, build_model, clutch_torque)
 from clutchlab.errors import ParameterError
 

@@ -273,7 +273,6 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
     n_steps = 0
     t = 0.0
     h = min(1e-4, ts)
-    lam_r = geo[11] / geo[12]
     gain = 1.0 + (2.0 * geo[11] * geo[1] * geo[7] * geo[10] + 2.0 * geo[11] * geo[2] * geo[8]) / (
         3.0 * geo[12] - 2.0 * geo[11] * geo[2] * geo[8])  # T_c / T_k1 by Eq. 15
     gap_c = pa[5] - pa[4]

@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
 A21 = 1.0 / 5.0
