@@ -17,7 +17,16 @@ from . import __version__
 from .errors import ClutchlabError
 
 #: modules that contribute a sub-command (``register(subparsers)``)
-SUBSYSTEM_CLIS = ("clutchlab.eclutch.cli", "clutchlab.wet.cli", "clutchlab.emtc.cli")
+SUBSYSTEM_CLIS = (
+    "clutchlab.eclutch.cli",
+    "clutchlab.wet.cli",
+    "clutchlab.emtc.cli",
+    "clutchlab.params.cli",  # clutchlab params show|check
+    "clutchlab.fmu.cli",  # clutchlab export-fmu
+    "clutchlab.sweep.cli",  # clutchlab sweep
+    "clutchlab.report.cli",  # clutchlab report RUN_DIR
+    "clutchlab.io.cli",  # clutchlab convert (measurement files)
+)
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
 DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo")
 
