@@ -1,0 +1,295 @@
+"""E-clutch dynamics (issue 5): closed forms, static-dynamic consistency, energy, hysteresis, robustness."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from clutchlab.curves import Curve
+from clutchlab.eclutch import ClutchModel
+from clutchlab.eclutch.actuator import ActuatorParameters, static_pressure
+from clutchlab.eclutch.dynamics import (ClutchDynamics, EClutch, FrictionElement, FrictionParameters,
+                                        actuator_test_rig, apply_wear_and_expansion, pedal_reference)
+from clutchlab.eclutch.network import AxialNetwork, Node, Spring
+from clutchlab.errors import ParameterError, SimulationError
+
+
+def smooth_cycle(travel, t_ramp, n=400):
+    """Release then engage along a smooth (C1) profile, sampled finely."""
+    t = np.linspace(0.0, 2 * t_ramp, 2 * n + 1)
+    s = np.where(t <= t_ramp, t / t_ramp, 2.0 - t / t_ramp)
+    return t, travel * (3 * s ** 2 - 2 * s ** 3)
+
+
+@pytest.fixture(scope="module")
+def model4():
+    return ClutchModel.preset(4)
+
+
+# ----------------------------------------------------------------- stick-slip closed form
+def single_mass(k=1e4, m=2.0):
+    net = AxialNetwork((Node("bearing"), Node("pp", m)),
+                       (Spring("drive", "bearing", Curve.linear(k, span=(-0.1, 0.1)), b="pp"),),
+                       input="bearing", normal_force="drive", name="mass on a spring")
+    return ClutchModel(net)
+
+
+def stick_slip_closed_form(k, m, V, Fc, Fs):
+    """Breakaway, re-stick and second breakaway of a mass dragged through a spring at speed V."""
+    w = math.sqrt(k / m)
+    tb = Fs / (k * V)
+    d = (Fs - Fc) / k  # stretch above the kinetic equilibrium at breakaway
+    # mass velocity during slip: V (1 - cos w tau) + d w sin w tau = 0 -> tau* in (pi/w, 2 pi/w)
+    from scipy.optimize import brentq
+
+    def v(tau):
+        return V * (1 - math.cos(w * tau)) + d * w * math.sin(w * tau)
+    tau = brentq(v, math.pi / w * 1.0001, 2 * math.pi / w * 0.9999)
+    xi = d * math.cos(w * tau) + V / w * math.sin(w * tau)
+    f_stick = k * xi + Fc  # spring force when the mass stops
+    x_slip = V * tau - xi + d  # distance slid: spring stretch change plus input travel
+    t2 = tb + tau + (Fs - f_stick) / (k * V)
+    return tb, tb + tau, t2, f_stick, x_slip
+
+
+def test_stick_slip_matches_closed_form():
+    k, m, V, Fc, Fs = 1e4, 2.0, 0.05, 40.0, 60.0
+    dyn = ClutchDynamics(single_mass(k, m), [FrictionElement("R", "pp", coulomb=Fc, static_ratio=Fs / Fc)])
+    res = dyn.simulate(([0.0, 0.8], [0.0, V * 0.8]), rtol=1e-8, atol_scale=1e-3)
+    ev = res.events
+    tb, ts, t2, f_stick, x_slip = stick_slip_closed_form(k, m, V, Fc, Fs)
+    brk = ev[ev.event == "breakaway"].time_s.to_numpy()
+    stk = ev[ev.event == "stick"].time_s.to_numpy()
+    assert brk[0] == pytest.approx(tb, abs=1e-8)
+    assert stk[0] == pytest.approx(ts, abs=1e-8)
+    assert brk[1] == pytest.approx(t2, abs=1e-7)
+    # the mass stands still between stick and the next breakaway, at the predicted position
+    o = res.outputs
+    held = o[(o.time_s > stk[0] + 1e-4) & (o.time_s < brk[1] - 1e-4)]
+    assert len(held) > 0
+    assert np.allclose(held.x_pp_m, x_slip, atol=1e-9)
+    assert np.all(held.stuck_pp)
+    # periodic: every later cycle repeats the first (no chattering, no drift)
+    cycle = t2 - tb
+    assert np.allclose(np.diff(brk), cycle, atol=1e-7)
+    assert len(stk) == len(brk) or len(stk) == len(brk) - 1
+
+
+def test_zero_normal_force_means_free():
+    # friction proportional to the drive spring force: with the spring slack there is no friction at all
+    k, m = 1e4, 2.0
+    el = FrictionElement("R", "pp", coefficient=0.5, normal="drive", static_ratio=1.5)
+    dyn = ClutchDynamics(single_mass(k, m), [el])
+    res = dyn.simulate(([0.0, 0.05], [0.0, 0.0]))
+    # no load, no friction: the mass never sticks against a force and nothing moves
+    assert np.allclose(res.outputs.x_pp_m, 0.0, atol=1e-12)
+    assert np.allclose(res.outputs.friction_pp_N, 0.0, atol=1e-9)
+
+
+# ----------------------------------------------------------------- static-dynamic consistency
+@pytest.mark.parametrize("number", [0, 1, 2, 3, 4])
+def test_slow_cycle_without_friction_reproduces_static_curve(number):
+    model = ClutchModel.preset(number)
+    t, x = smooth_cycle(7.5e-3, 4.0)
+    res = ClutchDynamics(model).simulate((t, x), rtol=1e-6)
+    o = res.outputs
+    static = model.static_curve(o.bearing_position_m.to_numpy())
+    peak = static.bearing_force_N.abs().max()
+    err = np.abs(o.bearing_force_clutch_N.to_numpy() - static.bearing_force_N.to_numpy()).max()
+    assert err < 0.005 * peak, f"Model {number}: max difference {err:.3g} N vs peak {peak:.4g} N"
+    # normal force and torque too
+    errn = np.abs(o.normal_force_N.to_numpy() - static.normal_force_N.to_numpy()).max()
+    assert errn < 0.005 * static.normal_force_N.max()
+
+
+# ----------------------------------------------------------------- hysteresis = friction work
+def test_hysteresis_area_equals_friction_dissipation(model4):
+    t, x = smooth_cycle(7.5e-3, 1.0)
+    res = ClutchDynamics(model4, FrictionParameters()).simulate((t, x), rtol=1e-6)
+    o = res.outputs
+    u = o.bearing_position_m.to_numpy()
+    f = o.bearing_force_clutch_N.to_numpy()
+    loop_area = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(u)))  # closed cycle: integral of F du
+    e = res.energy_balance()
+    assert e["friction_dissipated_J"] > 0.05  # a visible loop
+    ke_end = 0.0  # the cycle ends at rest; kinetic energy at the start is zero too
+    assert loop_area == pytest.approx(e["friction_dissipated_J"] + e["stored_change_J"] + ke_end, rel=5e-3)
+    # the release branch lies above the engage branch at the same position (friction opposes the motion)
+    half = len(u) // 2
+    up = np.interp(4e-3, u[:half], f[:half])
+    down = np.interp(4e-3, u[half:][::-1], f[half:][::-1])
+    assert up > down
+    # friction makes the peak flatter: the loop's release branch exceeds the frictionless static curve
+    assert np.max(f) > model4.static_curve(np.linspace(0, 7.5e-3, 301)).bearing_force_N.max()
+
+
+def test_friction_off_dissipates_nothing(model4):
+    t, x = smooth_cycle(7e-3, 0.5)
+    res = ClutchDynamics(model4).simulate((t, x))
+    assert res.energy_balance()["friction_dissipated_J"] == 0.0
+    assert len(res.events[res.events.event.isin(["stick", "breakaway"])]) == 0
+
+
+# ----------------------------------------------------------------- actuator + clutch energy balance
+@pytest.mark.parametrize("friction", [FrictionParameters.off(), FrictionParameters()], ids=["no friction", "friction"])
+def test_energy_balance_over_a_cycle(friction):
+    ec = EClutch(friction=friction)
+    res = ec.simulate({"voltage": ([0.0, 0.02, 0.35, 0.6], [0.0, 6.0, -3.0, 0.0])}, 0.8)
+    e = res.energy_balance()
+    assert e["input_J"] > 1.0
+    assert abs(e["relative"]) < 0.005, e
+    # it really released and re-engaged the clutch
+    o = res.outputs
+    assert o.bearing_position_m.max() > 5e-3
+    assert o.torque_Nm.iloc[-1] > 0.9 * o.torque_Nm.iloc[0]
+
+
+def test_position_control_tracks_the_pedal_reference():
+    ec = EClutch(friction=FrictionParameters())
+    t = np.array([0.0, 0.1, 0.3, 1.0, 1.2])
+    ref = pedal_reference([0.0, 0.0, 1.0, 1.0, 0.5], release_travel=8e-3)
+    res = ec.simulate({"bearing_reference": (t, ref)}, 2.0)
+    o = res.outputs
+    at = lambda tt: float(np.interp(tt, o.time_s, o.bearing_position_m))  # noqa: E731
+    # seal and diaphragm friction leave a stick-slip tracking error of a few tenths of a millimetre
+    # (the frictionless loop settles to 5 um: test_held_position_pressure_equals_spring_load_over_area)
+    assert at(0.95) == pytest.approx(8e-3, abs=0.4e-3)
+    assert at(1.95) == pytest.approx(4e-3, abs=0.4e-3)
+    # released at 8 mm, partly engaged at 4 mm
+    assert float(np.interp(0.95, o.time_s, o.torque_Nm)) < 1.0
+    assert float(np.interp(1.95, o.time_s, o.torque_Nm)) > 10.0
+    assert abs(e := res.energy_balance()["relative"]) < 0.005, e
+
+
+# ----------------------------------------------------------------- actuator steady states
+def frictionless_actuator(**kw):
+    return ActuatorParameters(master_seal_friction=0.0, slave_seal_friction=0.0, seal_pressure_friction=0.0,
+                              spindle_efficiency=1.0, **kw)
+
+
+def test_rest_is_an_equilibrium_without_flow():
+    ec = EClutch(friction=FrictionParameters())
+    res = ec.simulate({"voltage": 0.0}, 0.5)
+    o = res.outputs
+    assert np.allclose(o.line_flow_m3_s, 0.0, atol=1e-12)
+    assert np.allclose(o.pressure_Pa, 0.0, atol=1e-6)
+    assert np.allclose(o.bearing_position_m, 0.0, atol=1e-12)
+    assert np.allclose(o.bearing_force_clutch_N, 80.0, atol=1e-6)
+
+
+@pytest.mark.parametrize("target", [2e-3, 6e-3])
+def test_held_position_pressure_equals_spring_load_over_area(target):
+    act = frictionless_actuator()
+    rig = actuator_test_rig(stiffness=3e5, preload=act.csc_preload)
+    ec = EClutch(act, rig)
+    res = ec.simulate({"bearing_reference": ([0.0, 0.05, 0.25], [0.0, 0.0, target])}, 2.5)
+    o = res.outputs.iloc[-1]
+    load = act.csc_preload + 3e5 * o.bearing_position_m
+    p_expected = static_pressure(load, o.bearing_position_m, act)
+    assert o.bearing_position_m == pytest.approx(target, abs=5e-6)
+    assert o.pressure_Pa == pytest.approx(p_expected, rel=1e-3)
+    assert o.master_pressure_Pa == pytest.approx(o.pressure_Pa, rel=1e-3)  # no flow: no pressure drop
+    assert abs(o.line_flow_m3_s) < 1e-8  # a release moves ~3e-5 m^3/s
+    # the motor holds the pressure with k_t i / n_s = p A_mc
+    assert o.motor_current_A == pytest.approx(o.master_pressure_Pa * act.master_area * act.spindle_ratio
+                                              / act.torque_constant, rel=1e-2)
+
+
+def test_clutch_steady_state_pressure(model4):
+    act = frictionless_actuator()
+    ec = EClutch(act, model4)
+    res = ec.simulate({"bearing_reference": ([0.0, 0.05, 0.3], [0.0, 0.0, 5e-3])}, 1.5)
+    o = res.outputs.iloc[-1]
+    fb = model4.static_curve([o.bearing_position_m]).bearing_force_N.iloc[0]
+    assert o.pressure_Pa == pytest.approx(static_pressure(fb, o.bearing_position_m, act), rel=2e-3)
+
+
+# ----------------------------------------------------------------- robustness
+def test_voltage_saturation_and_current_limit():
+    act = ActuatorParameters()
+    ec = EClutch(act)
+    res = ec.simulate({"voltage": ([0.0, 0.01, 0.3], [0.0, 1000.0, -1000.0])}, 0.6)
+    o = res.outputs
+    assert np.all(np.isfinite(o.to_numpy(dtype=float)))
+    assert o.motor_voltage_V.abs().max() <= act.supply_voltage + 1e-9
+    assert o.motor_current_A.abs().max() < 1.5 * act.current_limit
+    # the CSC ends on its travel stop instead of running away
+    assert o.bearing_position_m.max() < act.slave_max + 0.5e-3
+    assert (res.events.event == "end stop hit").any()
+
+
+def test_reference_beyond_travel_is_clamped():
+    act = ActuatorParameters()
+    ec = EClutch(act, friction=FrictionParameters())
+    res = ec.simulate({"bearing_reference": ([0.0, 0.1], [0.0, 0.05])}, 1.0)
+    o = res.outputs
+    assert np.all(np.isfinite(o.to_numpy(dtype=float)))
+    assert o.bearing_position_m.iloc[-1] == pytest.approx(act.slave_max, abs=0.3e-3)
+    assert o.motor_current_A.abs().max() < 1.5 * act.current_limit
+
+
+@settings(max_examples=8, deadline=None)
+@given(volts=st.lists(st.floats(-40, 40), min_size=2, max_size=5))
+def test_any_voltage_sequence_stays_bounded(volts):
+    act = ActuatorParameters()
+    ec = EClutch(act)
+    t = np.linspace(0.0, 0.3, len(volts))
+    res = ec.simulate({"voltage": (t, volts)}, 0.35, max_steps=100_000)
+    o = res.outputs
+    assert np.all(np.isfinite(o.to_numpy(dtype=float)))
+    assert act.slave_min - 1e-3 < o.bearing_position_m.min() and o.bearing_position_m.max() < act.slave_max + 1e-3
+    e = res.energy_balance()
+    assert abs(e["residual_J"]) < max(0.01 * e["input_J"], 1e-6), e
+
+
+# ----------------------------------------------------------------- wear and expansion
+def test_wear_shifts_the_characteristic(model4):
+    worn = apply_wear_and_expansion(model4, wear_m=0.3e-3)
+    x = np.linspace(0.0, 7e-3, 141)
+    new = model4.static_curve(x)
+    old = worn.static_curve(x)
+    # less cushion compression: lower clamp load when engaged, and the clutch lifts off earlier
+    assert old.normal_force_N.iloc[0] < new.normal_force_N.iloc[0]
+    lift = lambda c: float(c.bearing_position_m[c.normal_force_N <= 1e-9].min())  # noqa: E731
+    assert lift(old) < lift(new)
+    hot = apply_wear_and_expansion(model4, temperature_rise_k=100.0)
+    assert hot.static_curve(x).normal_force_N.iloc[0] > new.normal_force_N.iloc[0]
+    with pytest.raises(ParameterError, match="wear_m"):
+        apply_wear_and_expansion(model4, wear_m=-1e-3)
+
+
+# ----------------------------------------------------------------- errors
+def test_inconsistent_preload_is_rejected(model4):
+    with pytest.raises(ParameterError, match="csc_preload"):
+        EClutch(ActuatorParameters(csc_preload=200.0), model4)
+
+
+def test_actuator_consistency_errors():
+    with pytest.raises(ParameterError, match="snifting_port"):
+        ActuatorParameters(snifting_port=0.05)
+    with pytest.raises(ParameterError, match="slave_mass"):
+        ActuatorParameters(slave_mass=-1.0)
+
+
+def test_bad_inputs_name_the_field(model4):
+    ec = EClutch(clutch=model4)
+    with pytest.raises(ParameterError, match="unknown input 'current'"):
+        ec.simulate({"current": 1.0}, 0.1)
+    with pytest.raises(ParameterError, match="increase strictly"):
+        ec.simulate({"voltage": ([0.0, 0.2, 0.1], [0, 1, 2])}, 0.3)
+    with pytest.raises(ParameterError, match="not finite"):
+        ec.simulate({"voltage": ([0.0, 0.1], [0.0, np.nan])}, 0.3)
+    with pytest.raises(ParameterError, match="t_end"):
+        ec.simulate({"voltage": 1.0}, -1.0)
+    with pytest.raises(ParameterError, match="massless"):
+        ClutchDynamics(model4, [FrictionElement("R", "tip", coulomb=5.0)])
+    with pytest.raises(ParameterError, match="not a free coordinate"):
+        ClutchDynamics(model4, [FrictionElement("R", "nowhere", coulomb=5.0)])
+
+
+def test_step_budget_is_reported(model4):
+    ec = EClutch(clutch=model4)
+    with pytest.raises(SimulationError, match="max_steps"):
+        ec.simulate({"voltage": ([0.0, 0.01], [0.0, 8.0])}, 0.5, max_steps=10)
