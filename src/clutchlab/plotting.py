@@ -88,3 +88,76 @@ def static_curves_vs_record(curves: dict, record=None, *, quantity: str = "beari
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def eclutch_response(frame, *, title: str = ""):
+    """E-clutch time response: bearing position (and reference), pressure and bearing force, motor current, torque.
+
+    Parameters
+    ----------
+    frame : DataFrame
+        Outputs of :meth:`clutchlab.eclutch.EClutch.simulate` (``time_s``, ``bearing_position_m``,
+        ``pressure_Pa``, ``bearing_force_N``, ``motor_current_A``, ``motor_voltage_V``, ``torque_Nm``).
+    """
+    fig, axes = new_figure(2, 2, width=9.0, height=6.0, sharex=True)
+    t = frame["time_s"].to_numpy()
+    ax = axes[0, 0]
+    ax.plot(t, frame["bearing_position_m"] * 1e3, lw=1.3, label="bearing position")
+    if "reference_m" in frame:
+        ax.plot(t, frame["reference_m"] * 1e3, "--", color="0.4", lw=1.0, label="reference")
+    if "master_position_m" in frame:
+        ax.plot(t, frame["master_position_m"] * 1e3, lw=1.0, label="master piston")
+    ax.set_ylabel("position [mm]")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    if "pressure_Pa" in frame:
+        ax.plot(t, frame["pressure_Pa"] / 1e5, lw=1.3, label="CSC pressure")
+        ax.plot(t, frame["master_pressure_Pa"] / 1e5, lw=0.9, label="master pressure")
+    ax.set_ylabel("pressure [bar]")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    if "motor_current_A" in frame:
+        ax.plot(t, frame["motor_current_A"], lw=1.2, label="current [A]")
+        ax.plot(t, frame["motor_voltage_V"], lw=1.0, label="voltage [V]")
+    ax.set_ylabel("motor")
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=8)
+    ax = axes[1, 1]
+    ax.plot(t, frame["torque_Nm"], lw=1.3, color="C3")
+    ax.set_ylabel("clutch torque [N m]")
+    ax.set_xlabel("time [s]")
+    for a in axes.flat:
+        a.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def hysteresis_loop(loops: dict, static=None, *, title: str = ""):
+    """Bearing force against bearing position for release/engage cycles (hysteresis loops).
+
+    Parameters
+    ----------
+    loops : dict
+        Label -> DataFrame with ``bearing_position_m`` and a force column
+        (``bearing_force_N`` if present, else ``bearing_force_clutch_N``).
+    static : DataFrame, optional
+        Frictionless static curve (``bearing_position_m``, ``bearing_force_N``), drawn dashed.
+    """
+    fig, ax = new_figure(width=7.0, height=4.4)
+    if static is not None:
+        ax.plot(static["bearing_position_m"] * 1e3, static["bearing_force_N"], "--", color="0.3", lw=1.0,
+                label="static curve, friction off")
+    for k, (label, df) in enumerate(loops.items()):
+        col = "bearing_force_N" if "bearing_force_N" in df else "bearing_force_clutch_N"
+        ax.plot(df["bearing_position_m"] * 1e3, df[col], color=MODEL_COLORS[k % len(MODEL_COLORS)], lw=1.3,
+                label=label)
+    ax.set_xlabel("release bearing position [mm]")
+    ax.set_ylabel("bearing force [N]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig

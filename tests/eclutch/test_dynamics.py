@@ -262,8 +262,22 @@ def test_wear_shifts_the_characteristic(model4):
 
 # ----------------------------------------------------------------- errors
 def test_inconsistent_preload_is_rejected(model4):
+    # a preload above the clutch's bearing force everywhere: the clutch could not stay engaged
     with pytest.raises(ParameterError, match="csc_preload"):
-        EClutch(ActuatorParameters(csc_preload=200.0), model4)
+        EClutch(ActuatorParameters(csc_preload=5000.0), model4)
+
+
+def test_worn_clutch_rests_where_the_preload_balances(model4):
+    worn = apply_wear_and_expansion(model4, wear_m=0.3e-3)
+    ec = EClutch(clutch=worn)
+    u0 = ec.rest_position
+    assert u0 != 0.0
+    fb = worn.static_curve([u0]).bearing_force_N.iloc[0]
+    act = ec.actuator
+    assert fb == pytest.approx(act.csc_preload - act.csc_spring_rate * u0, abs=1e-6)
+    res = ec.simulate({"voltage": 0.0}, 0.2)
+    assert np.allclose(res.outputs.bearing_position_m, u0, atol=1e-10)
+    assert np.allclose(res.outputs.pressure_Pa, 0.0, atol=1e-6)
 
 
 def test_actuator_consistency_errors():

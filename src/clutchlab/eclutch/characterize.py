@@ -41,7 +41,7 @@ import pandas as pd
 
 from ..curves import Curve, series
 from ..errors import DataError, IdentificationError, ParameterError
-from ..io import read_table
+from ..io import read_measurement
 
 __all__ = [
     "CharacterizedCurve",
@@ -213,18 +213,13 @@ def _load_record(record, channels, name):
     elif isinstance(record, pd.DataFrame):
         label = name or "record"
     else:
-        raise DataError(f"record must be a pandas.DataFrame or a CSV path, got {type(record).__name__}")
-    frame = read_table(record, ["time_s", "force_N", *channels], name=label)
+        raise DataError(f"record must be a pandas.DataFrame or a file path, got {type(record).__name__}")
+    # CSV, Parquet or MDF 4; units in the file converted to the ones the column names state
+    frame = read_measurement(record, required=["time_s", "force_N", *channels], name=label).frame
     t = frame["time_s"].to_numpy(dtype=float)
     if t.size < MIN_SAMPLES:
         raise DataError(f"{label}: record too short ({t.size} samples, need at least {MIN_SAMPLES})")
-    dt = np.diff(t)
-    if (dt <= 0).any():
-        row = int(np.flatnonzero(dt <= 0)[0]) + 1
-        raise DataError(
-            f"{label}: column 'time_s' must be strictly increasing, but row {row} has {t[row]!r} "
-            f"after {t[row - 1]!r}")
-    return frame, label
+    return frame, label  # time strictly increasing: checked by read_measurement
 
 
 def _cycles(frame: pd.DataFrame, label: str, drive: str, quantities: list[str], n_grid: int) -> _Cycles:

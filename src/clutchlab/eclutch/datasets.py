@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..io import atomic_to_csv, read_table
+from ..io import atomic_to_csv, read_measurement
 from .characterize import characterize, lever_stiffness
 from .models import COMPONENTS, ComponentCurves
 from .pressrig import simulate_lever_tests, simulate_press_test, stop_operator
@@ -193,13 +193,14 @@ def load_press_record(letter: str) -> pd.DataFrame:
         raise DataError(f"unknown press test {letter!r}; tests are {', '.join(PRESS_TESTS)} (Fig. 8)")
     with resources.as_file(_data_root() / "press" / f"{PRESS_TESTS[letter][0]}.csv") as path:
         cols = ["time_s", "force_N", "displacement_m"] + (["displacement2_m"] if letter in "bc" else [])
-        return read_table(path, cols)
+        return read_measurement(path, required=cols).frame
 
 
 def load_full_clutch_record() -> pd.DataFrame:
     """The bundled full-clutch record (bearing force and torque vs bearing position), synthetic."""
     with resources.as_file(_data_root() / "full_clutch.csv") as path:
-        return read_table(path, ["time_s", "bearing_position_m", "pressure_Pa", "bearing_force_N", "torque_Nm"])
+        return read_measurement(path, required=["time_s", "bearing_position_m", "pressure_Pa", "bearing_force_N",
+                                                "torque_Nm"]).frame
 
 
 def write_dataset(folder, truth: VirtualClutch | None = None, seed: int = SEED, overwrite: bool = False) -> Path:

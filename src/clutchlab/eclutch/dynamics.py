@@ -545,17 +545,48 @@ class _System:
         modes[self.fr_on] = 2  # at rest: stuck; the state machine breaks away if the force exceeds the limit
         return y, modes
 
-    def check_consistency(self):
-        """The CSC preload must balance the clutch's bearing force at bearing position 0."""
-        if self.prescribed or self.actuator is None:
-            return
-        st = solve_static(self.model.network, np.array([0.0]))
-        fb = float(st["input_force"][0])
-        if abs(fb - self.actuator.csc_preload) > max(2.0, 0.02 * abs(fb)):
-            raise ParameterError(
-                f"inconsistent parameters: actuator csc_preload = {self.actuator.csc_preload!r} N but the clutch model "
-                f"needs a bearing force of {fb:.4g} N at bearing position 0 (EClutchParameters.bearing_preload); "
-                "make them equal")
+    def rest_position(self) -> float:
+        """Bearing position at rest [m]: the CSC preload spring balances the clutch's bearing force.
+
+        With the bundled parameters this is 0 (the bearing origin is set at the
+        CSC preload); wear and thermal offsets or another preload move it.
+
+        Raises
+        ------
+        ParameterError
+            If no stable rest position lies within the CSC travel (e.g. a CSC
+            preload above the clutch's bearing force everywhere: the clutch
+            could not stay engaged).
+        """
+        a = self.actuator
+        lo, hi = a.slave_min, a.slave_max
+
+        def g(u):
+            return a.csc_preload - a.csc_spring_rate * u - float(solve_static(self.model.network, [u])["input_force"][0])
+
+        if abs(g(0.0)) < 1e-9:
+            return 0.0
+        grid = np.concatenate([np.linspace(0.0, hi, 201), np.linspace(0.0, lo, 41)[1:]])
+        up = solve_static(self.model.network, grid[:201])["input_force"]
+        down = solve_static(self.model.network, grid[201:])["input_force"] if lo < 0 else np.empty(0)
+        gu = a.csc_preload - a.csc_spring_rate * grid[:201] - up
+        gd = a.csc_preload - a.csc_spring_rate * grid[201:] - down
+        from scipy.optimize import brentq
+
+        if gu[0] > 0:  # pushed towards release: first stable root (g from + to -) going up
+            k = np.flatnonzero((gu[:-1] > 0) & (gu[1:] <= 0))
+            if k.size:
+                return float(brentq(g, grid[k[0]], grid[k[0] + 1], xtol=1e-13))
+        else:  # pulled towards the engaged side
+            uu = np.concatenate([[0.0], grid[201:]])
+            gg = np.concatenate([[gu[0]], gd])
+            k = np.flatnonzero((gg[:-1] <= 0) & (gg[1:] > 0))
+            if k.size:
+                return float(brentq(g, uu[k[0] + 1], uu[k[0]], xtol=1e-13))
+        raise ParameterError(
+            f"inconsistent parameters: with csc_preload = {a.csc_preload!r} N the CSC finds no rest position within "
+            f"its travel [{lo:g}, {hi:g}] m (the clutch's bearing force at position 0 is {a.csc_preload - g(0.0):.4g} N; "
+            "EClutchParameters.bearing_preload and ActuatorParameters.csc_preload should match)")
 
     # --------------------------------------------------------------------- run
     def run(self, imode, tin, vin, interp, t_end, *, rtol, h_max, max_steps, t_grid, event_tol, y0=None, modes0=None,
@@ -815,7 +846,8 @@ class EClutch:
             friction = clutch_friction_elements(self.clutch.network, friction)
         self.friction = list(friction) + actuator_friction_elements(self.actuator)
         self.system = _System(self.clutch, self.actuator, self.friction, prescribed=False)
-        self.system.check_consistency()
+        #: bearing position at rest [m] (0 unless offsets or the preload move it)
+        self.rest_position = self.system.rest_position()
 
     def simulate(self, inputs, t_end: float, *, rtol: float = 1e-4, h_max: float = 0.01, max_steps: int = 500_000,
                  output_step: float | None = None, event_tol: float = 1e-8, jac_every: int = 4,
@@ -872,7 +904,7 @@ class EClutch:
         grid = _grid(output_step, t_end)
         T, Y, AUX, MODES, evt, evk, evi, stats, _yf, _mf = self.system.run(
             imode, tin, vin, interp, t_end, rtol=rtol, h_max=h_max, max_steps=max_steps, t_grid=grid,
-            event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
+            event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale, u0=self.rest_position)
         res = self.system.result(imode, tin, vin, interp, T, Y, MODES, evt, evk, evi, stats)
         _raise_status(res)
         return res

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import IdentificationError, SimulationError
-from ..io import read_table
+from ..io import read_measurement
 from .models import ClutchModel, ComponentCurves, EClutchParameters
 
 __all__ = ["FULL_CLUTCH_COLUMNS", "read_full_clutch_record", "compare", "Model4Fit", "fit_model4_scales"]
@@ -27,20 +27,28 @@ __all__ = ["FULL_CLUTCH_COLUMNS", "read_full_clutch_record", "compare", "Model4F
 FULL_CLUTCH_COLUMNS = ("time_s", "bearing_position_m", "bearing_force_N", "torque_Nm")
 
 
-def read_full_clutch_record(source, name: str | None = None) -> pd.DataFrame:
-    """Read and validate a full-clutch record (CSV path or DataFrame).
+def read_full_clutch_record(source, name: str | None = None, channel_map=None, *,
+                            rate: float | None = None) -> pd.DataFrame:
+    """Read and validate a full-clutch record (CSV, Parquet or MDF 4 file, or DataFrame).
 
     Required columns: ``time_s``, ``bearing_position_m``, ``bearing_force_N``,
     ``torque_Nm`` (``pressure_Pa`` optional); time must increase strictly.
-    """
-    frame = read_table(source, FULL_CLUTCH_COLUMNS, name=name)
-    dt = np.diff(frame["time_s"].to_numpy())
-    if (dt <= 0).any():
-        from ..errors import DataError
+    Read through :func:`clutchlab.io.read_measurement`, so units stored in the
+    file are converted to the ones the names state, and ``channel_map`` maps a
+    logger's channel names (and units) onto these names.
 
-        k = int(np.flatnonzero(dt <= 0)[0]) + 1
-        raise DataError(f"{name or 'record'}: time_s must increase strictly, but row {k} has {frame['time_s'].iloc[k]!r}")
-    return frame
+    Parameters
+    ----------
+    source : str, Path or pandas.DataFrame
+        The record.
+    name : str, optional
+        How to call it in error messages (default: the path).
+    channel_map : ChannelMap, mapping or TOML path, optional
+        Logger channel names and units -> the names above.
+    rate : float, optional
+        Resample onto a uniform time base [Hz].
+    """
+    return read_measurement(source, channel_map, required=FULL_CLUTCH_COLUMNS, rate=rate, name=name).frame
 
 
 def compare(model: ClutchModel, record: pd.DataFrame) -> dict[str, float]:

@@ -81,6 +81,15 @@ class VirtualClutch(ParameterSet):
     m_pps: float = quantity(0.9, "kg", "diaphragm spring mass (edge node)", source=_REP, positive=True)
     m_ds: float = quantity(0.3, "kg", "yoke support mass", source=_REP, positive=True)
 
+    def check(self) -> None:
+        from ..errors import ParameterError
+
+        ratio = self.yoke_spring_height / self.yoke_spring_thickness
+        if not ratio < 2.0**0.5:
+            raise ParameterError(
+                f"VirtualClutch: yoke_spring_height / yoke_spring_thickness = {ratio:.4g} must be < sqrt(2) "
+                "(Almen-Laszlo: the yoke support spring must be monotone)")
+
     # ---------------------------------------------------------------- true laws
     def belleville(self) -> Curve:
         """Diaphragm Belleville body, force at the tips vs rigid-lever tip deflection [m -> N]."""

@@ -7,14 +7,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from ..io import atomic_to_csv, check_writable, read_table
+from ..io import atomic_to_csv, check_writable, read_measurement, read_table
 
 
 def _identify(args) -> int:
     from ..hysteresis import identify_forc_family
 
     check_writable(args.output, args.force)
-    frame = read_table(args.forc, ["current", "force"], name=str(args.forc))
+    frame = read_measurement(args.forc, required=["current", "force"], time=None, name=str(args.forc)).frame
     if "airgap" in frame.columns:
         frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
     grid = None
@@ -41,7 +41,7 @@ def _run(args) -> int:
     has_gap = model.n_airgaps > 1
     if args.inverse:
         required = ["force"] + (["airgap"] if has_gap else [])
-        frame = read_table(args.input, required, name=str(args.input))
+        frame = read_measurement(args.input, required=required, time=None, name=str(args.input)).frame
         res = model.invert(frame["force"].to_numpy(), frame["airgap"].to_numpy() if has_gap else None)
         out = frame.copy()
         out["current"] = res.input
@@ -51,7 +51,7 @@ def _run(args) -> int:
             print(res.report())
     else:
         required = ["current"] + (["airgap"] if has_gap else [])
-        frame = read_table(args.input, required, name=str(args.input))
+        frame = read_measurement(args.input, required=required, time=None, name=str(args.input)).frame
         out = frame.copy()
         out["force_model"] = model.simulate(frame["current"].to_numpy(), frame["airgap"].to_numpy() if has_gap else None)
     atomic_to_csv(out, args.output, overwrite=args.force,

@@ -55,6 +55,12 @@ class LuGreParameters(ParameterSet):
     mu_p: float = quantity(0.13, "1", "peak (static) friction coefficient mu_p", source="representative", positive=True)
     v_s: float = quantity(2.0, "rad/s", "Stribeck slip speed v_s", source="representative", positive=True)
 
+    def check(self) -> None:
+        if self.mu_p < self.mu_c:
+            raise ParameterError(
+                f"LuGreParameters: mu_p = {self.mu_p!r} < mu_c = {self.mu_c!r}: the peak (static) coefficient must "
+                "not be below the Coulomb level (Eq. 24: g(v) falls from mu_p to mu_c)")
+
     def kernel_data(self) -> np.ndarray:
         """``[sigma0, sigma1, sigma2, mu_c, mu_p, v_s]`` for compiled kernels."""
         return np.array([self.sigma0, self.sigma1, self.sigma2, self.mu_c, self.mu_p, self.v_s])

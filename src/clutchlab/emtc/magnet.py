@@ -22,7 +22,7 @@ from importlib import resources
 import numpy as np
 
 from ..hysteresis import Preisach, forc_table_from_masses, identify_forc_family
-from ..io import read_table
+from ..io import read_measurement
 
 __all__ = ["CALIBRATION_AIRGAPS", "PAPER_GRID", "synthetic_magnet", "bundled_forc", "bundled_magnet"]
 
@@ -72,7 +72,8 @@ def bundled_forc():
     """The bundled synthetic FORC records (columns ``airgap`` [m], ``current`` [A], ``force`` [N])."""
     ref = resources.files("clutchlab.emtc.data").joinpath(BUNDLED_FILE)
     with resources.as_file(ref) as path:
-        return read_table(path, ["airgap", "current", "force"], name=f"bundled {BUNDLED_FILE}")
+        return read_measurement(path, required=["airgap", "current", "force"], time=None,
+                                name=f"bundled {BUNDLED_FILE}").frame
 
 
 @lru_cache(maxsize=1)

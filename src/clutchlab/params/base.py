@@ -9,7 +9,9 @@ values may carry units (``r_outer = "83.15 mm"``), converted once with pint.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
+import re
 import tomllib
 from pathlib import Path
 from typing import Any, ClassVar
@@ -17,7 +19,10 @@ from typing import Any, ClassVar
 from ..errors import ParameterError
 from ..units import format_quantity, to_si
 
-__all__ = ["quantity", "ParameterSet", "load_toml"]
+__all__ = ["quantity", "ParameterSet", "load_toml", "registered_sets"]
+
+#: every ParameterSet subclass, in definition order (filled by ``ParameterSet.__init_subclass__``)
+_REGISTERED: list[type] = []
 
 
 def quantity(default, unit: str, doc: str, *, source: str = "", positive: bool = False,
@@ -45,22 +50,92 @@ def quantity(default, unit: str, doc: str, *, source: str = "", positive: bool =
     return dataclasses.field(default=default, metadata=meta)
 
 
-def _check_number(cls_name, fname, value, meta, source):
-    where = f"{source}: " if source else ""
-    label = f"{where}{cls_name}.{fname}"
+def _number_problem(value, meta) -> str | None:
+    """Why ``value`` is not acceptable for a field with metadata ``meta`` (None if it is)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ParameterError(f"{label} = {value!r}: expected a number")
+        return "expected a number"
     if not math.isfinite(value):
-        raise ParameterError(f"{label} = {value!r}: not finite")
+        return "not finite"
     if meta.get("positive") and not value > 0:
-        raise ParameterError(f"{label} = {value!r}: must be > 0 [{meta['unit']}]")
+        return f"must be > 0 [{meta['unit']}]"
     if meta.get("nonnegative") and value < 0:
-        raise ParameterError(f"{label} = {value!r}: must be >= 0 [{meta['unit']}]")
+        return f"must be >= 0 [{meta['unit']}]"
     lo, hi = meta.get("bounds", (None, None))
     if lo is not None and value < lo:
-        raise ParameterError(f"{label} = {value!r}: below the lower bound {lo} [{meta['unit']}]")
+        return f"below the lower bound {lo} [{meta['unit']}]"
     if hi is not None and value > hi:
-        raise ParameterError(f"{label} = {value!r}: above the upper bound {hi} [{meta['unit']}]")
+        return f"above the upper bound {hi} [{meta['unit']}]"
+    return None
+
+
+def _check_number(cls_name, fname, value, meta, source):
+    where = f"{source}: " if source else ""
+    problem = _number_problem(value, meta)
+    if problem is not None:
+        raise ParameterError(f"{where}{cls_name}.{fname} = {value!r}: {problem}")
+
+
+def show_value(raw) -> str:
+    """Format a value as it is written in a TOML file (``"83.15 mm"``, ``4``, ``[1, 2]``)."""
+    if isinstance(raw, str):
+        return repr(raw)  # a TOML literal string when it has no quote inside
+    if isinstance(raw, bool):
+        return "true" if raw else "false"
+    if isinstance(raw, (list, tuple)):
+        return "[" + ", ".join(show_value(v) for v in raw) + "]"
+    if isinstance(raw, dict):
+        return "{...}"
+    return repr(raw)
+
+
+#: SI units whose dimension has a name in error messages
+_DIMENSION_NAMES = (
+    ("1", "dimensionless"), ("m", "a length"), ("kg", "a mass"), ("s", "a time"), ("K", "a temperature"),
+    ("Pa", "a pressure"), ("N", "a force"), ("N*m", "a torque (or energy)"), ("m/s", "a speed"),
+    ("rad/s", "an angular speed (or frequency)"), ("N/m", "a stiffness"), ("m^2", "an area"),
+    ("kg*m^2", "a moment of inertia"), ("W", "a power"), ("Pa*s", "a dynamic viscosity"),
+    ("W/K", "a thermal conductance"), ("J/K", "a heat capacity"), ("J/(kg*K)", "a specific heat capacity"),
+    ("1/K", "a temperature coefficient"), ("N*s/m", "a damping coefficient"), ("1/m^2", "a density per area"),
+    ("m/N", "a compliance"), ("A", "a current"), ("V", "a voltage"), ("T", "a magnetic flux density"),
+)
+_NUMBER = re.compile(r"^\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*")
+
+
+def _dimension_name(dimensionality, ureg) -> str | None:
+    for unit, name in _DIMENSION_NAMES:
+        if ureg.Quantity(1.0, unit).dimensionality == dimensionality:
+            return name
+    return None
+
+
+def _unit_mismatch(raw, unit: str) -> str | None:
+    """If ``raw`` is a quantity string whose unit has the wrong dimension, say so in words."""
+    if not isinstance(raw, str):
+        return None
+    from ..units import _registry
+
+    ureg = _registry()
+    given = _NUMBER.sub("", raw, count=1).strip()
+    try:
+        q_given = ureg.Quantity(1.0, given or "dimensionless")
+        q_target = ureg.Quantity(1.0, unit)
+    except Exception:  # unparsable unit: to_si's own message says so
+        return None
+    if q_given.dimensionality == q_target.dimensionality:
+        return None
+    want = _dimension_name(q_target.dimensionality, ureg) or f"convertible to {unit}"
+    got = _dimension_name(q_given.dimensionality, ureg)
+    return f"wrong unit: {given or '(none)'} is not {want}" + (f" (it is {got}; expected {unit})" if got else f" (expected {unit})")
+
+
+def _convert(raw, unit: str, label: str, where: str) -> float:
+    """``to_si`` with an error message naming the file, the (table and) key and the value as written."""
+    try:
+        return to_si(raw, unit, name="value")
+    except ParameterError as exc:
+        reason = str(exc).removeprefix(f"value = {raw!r}: ")
+        reason = _unit_mismatch(raw, unit) or reason
+        raise ParameterError(f"{where}{label} = {show_value(raw)}: {reason}") from None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -73,6 +148,11 @@ class ParameterSet:
 
     #: short name used in files and the CLI (``[eclutch]`` table in TOML)
     kind: ClassVar[str] = "parameters"
+
+    def __init_subclass__(cls, **kwargs):
+        # every subclass is registered, so clutchlab.params.registry finds the sets of each model
+        super().__init_subclass__(**kwargs)
+        _REGISTERED.append(cls)
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
@@ -121,47 +201,73 @@ class ParameterSet:
 
     # ------------------------------------------------------------------ files
     @classmethod
-    def from_dict(cls, data: dict[str, Any], *, source: str | None = None, base: "ParameterSet | None" = None):
+    def from_dict(cls, data: dict[str, Any], *, source: str | None = None, base: "ParameterSet | None" = None,
+                  table: str | None = None):
         """Build a set from a mapping whose values may carry units.
 
-        Unknown keys, unparsable quantities and wrong units raise
-        :class:`ParameterError` naming ``source``, the key and the value.
+        Unknown keys, values of the wrong type or shape (a string that is no
+        quantity, a list for a scalar), unparsable quantities, wrong units and
+        out-of-range values raise :class:`ParameterError` naming ``source``
+        (the file), ``[table] key`` and the value as written, e.g.
+        ``wet.toml: [wet] r_outer = '83.15 kg': wrong unit: kg is not a length``.
         Keys not given are taken from ``base`` (default: the class defaults).
         """
         info = cls.field_info()
         where = f"{source}: " if source else ""
+        prefix = f"[{table}] " if table else ""
+        if not isinstance(data, dict):
+            raise ParameterError(f"{where}{prefix or cls.__name__ + ': '}expected a table of parameters, got {show_value(data)}")
         unknown = [k for k in data if k not in info]
         if unknown:
+            close = difflib.get_close_matches(unknown[0], list(info), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
             raise ParameterError(
-                f"{where}unknown parameter {unknown[0]!r} for {cls.__name__} (known: {', '.join(info)})"
+                f"{where}{prefix}unknown parameter {unknown[0]!r} for {cls.__name__}{hint} (known: {', '.join(info)})"
             )
+        defaults = {f.name: f.default for f in dataclasses.fields(cls)}
         values = {}
         for key, raw in data.items():
-            unit = info[key]["unit"]
-            if isinstance(raw, (list, tuple)):
-                values[key] = tuple(to_si(v, unit, name=f"{key}[{i}]", source=source) for i, v in enumerate(raw))
+            meta = info[key]
+            unit = meta["unit"]
+            label = f"{prefix}{key}"
+            default = getattr(base, key) if base is not None else defaults[key]
+            if isinstance(default, tuple):
+                if not isinstance(raw, (list, tuple)):
+                    raise ParameterError(f"{where}{label} = {show_value(raw)}: expected a list of values [{unit}]")
+                items = [(f"{label}[{i}]", v) for i, v in enumerate(raw)]
             else:
-                values[key] = to_si(raw, unit, name=key, source=source)
-            default = getattr(base, key) if base is not None else dataclasses.fields(cls)[[f.name for f in dataclasses.fields(cls)].index(key)].default
-            if isinstance(default, int) and not isinstance(default, bool):
-                v = values[key]
-                if v != int(v):
-                    raise ParameterError(f"{where}{key} = {raw!r}: expected a whole number")
-                values[key] = int(v)
+                if isinstance(raw, (list, tuple, dict)):
+                    raise ParameterError(f"{where}{label} = {show_value(raw)}: expected a single value [{unit}]")
+                items = [(label, raw)]
+            converted = []
+            for item_label, item in items:
+                v = _convert(item, unit, item_label, where)
+                if isinstance(default, int) and not isinstance(default, bool):
+                    if v != int(v):
+                        raise ParameterError(f"{where}{item_label} = {show_value(item)}: expected a whole number")
+                    v = int(v)
+                problem = _number_problem(v, meta)
+                if problem is not None:  # the SI value, and the value as written where it differs
+                    written = "" if show_value(item) == repr(v) else f" (written {show_value(item)})"
+                    raise ParameterError(f"{where}{item_label} = {v!r}: {problem}{written}")
+                converted.append(v)
+            values[key] = tuple(converted) if isinstance(default, tuple) else converted[0]
         try:
             if base is not None:
                 return dataclasses.replace(base, **values)
             return cls(**values)
         except ParameterError as exc:
-            raise ParameterError(f"{where}{exc}") from None
+            raise ParameterError(f"{where}{prefix}{exc}") from None
 
     @classmethod
     def from_toml(cls, path, *, base: "ParameterSet | None" = None):
         """Load a set from a TOML file (top level, or the ``[<kind>]`` table)."""
         data = load_toml(path)
+        table = None
         if cls.kind in data and isinstance(data[cls.kind], dict):
             data = data[cls.kind]
-        return cls.from_dict(data, source=str(path), base=base)
+            table = cls.kind
+        return cls.from_dict(data, source=str(path), base=base, table=table)
 
     def to_toml(self, path, overwrite: bool = False) -> Path:
         """Write the set to TOML with units, atomically (refuses to overwrite by default)."""
@@ -193,3 +299,8 @@ def load_toml(path) -> dict[str, Any]:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc})") from None
+
+
+def registered_sets() -> tuple[type, ...]:
+    """Every :class:`ParameterSet` subclass defined so far, in definition order."""
+    return tuple(_REGISTERED)

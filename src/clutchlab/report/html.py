@@ -54,13 +54,16 @@ class Section:
     (Figure, Table, Text), the data ``provenance`` and the ``parameters`` used.
 
     ``provenance`` says where the data come from; sections built on data from
-    clutchlab's virtual rigs must say "synthetic" there.
+    clutchlab's virtual rigs must say "synthetic" there.  ``synthetic=True``
+    adds a "SYNTHETIC DATA" badge to the section heading; the default
+    (``None``) adds it when the provenance mentions "synthetic".
     """
 
     title: str
     items: list = field(default_factory=list)
     provenance: str = ""
     parameters: dict[str, str] = field(default_factory=dict)
+    synthetic: bool | None = None
 
 
 _CSS = """
@@ -73,6 +76,7 @@ table{border-collapse:collapse;margin:1em 0;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.25em .6em;text-align:right}th{background:#eef}
 caption{caption-side:top;text-align:left;font-weight:600;padding:.3em 0}
 .meta{color:#666;font-size:.85em}
+.synthetic{background:#b00020;color:#fff;font-size:.6em;padding:.15em .5em;border-radius:3px;vertical-align:middle;margin-left:.6em}
 """
 
 
@@ -90,10 +94,23 @@ def _table_html(tab: Table) -> str:
     return cap + body
 
 
-def write_report(sections: list[Section], outdir, *, title: str = "clutchlab report", overwrite: bool = False) -> Path:
+def _unique(used: set, folder: str, name: str) -> str:
+    stem, k = name, 1
+    while (folder, stem) in used:
+        k += 1
+        stem = f"{name}_{k}"
+    used.add((folder, stem))
+    return stem
+
+
+def write_report(sections: list[Section], outdir, *, title: str = "clutchlab report", overwrite: bool = False,
+                 progress=None) -> Path:
     """Write ``index.html`` with embedded figures plus PNG/CSV files into ``outdir``.
 
-    ``sections`` are the report's chapters, ``title`` its heading.
+    ``sections`` are the report's chapters, ``title`` its heading; ``progress``
+    (a callable taking a message) is told about every figure rendered.
+    The page is self-contained: figures are embedded as base64 PNG ``data:``
+    URIs and the style sheet is inline, so it loads nothing from elsewhere.
 
     The folder is assembled in a temporary sibling and moved into place, so an
     interrupted run never leaves half a report.  An existing ``outdir`` is
@@ -127,22 +144,30 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
             f"{_dt.datetime.now().isoformat(timespec='seconds')}</p>",
             "<nav><ul>" + "".join(f"<li><a href='#s{i}'>{html.escape(s.title)}</a></li>" for i, s in enumerate(sections)) + "</ul></nav>",
         ]
+        used: set = set()  # file names given out: a repeated name gets _2, _3, ... instead of overwriting
+        n_figures = sum(isinstance(item, Figure) for sec in sections for item in sec.items)
+        done = 0
         for i, sec in enumerate(sections):
-            parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}</h2>")
+            synthetic = sec.synthetic if sec.synthetic is not None else "synthetic" in sec.provenance.lower()
+            badge = "<span class='synthetic'>SYNTHETIC DATA</span>" if synthetic else ""
+            parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}{badge}</h2>")
             if sec.provenance:
                 parts.append(f"<div class='prov'><b>Data provenance:</b> {html.escape(sec.provenance)}</div>")
             for item in sec.items:
                 if isinstance(item, Figure):
+                    done += 1
+                    if progress is not None:
+                        progress(f"rendering figure {done}/{n_figures}: {item.name}")
                     png = _figure_png(item.figure)
                     plt.close(item.figure)
-                    (tmp / "figures" / f"{item.name}.png").write_bytes(png)
+                    (tmp / "figures" / f"{_unique(used, 'figures', item.name)}.png").write_bytes(png)
                     b64 = base64.b64encode(png).decode("ascii")
                     parts.append(
                         f"<figure><img alt='{html.escape(item.name)}' src='data:image/png;base64,{b64}'>"
                         f"<figcaption>{html.escape(item.caption)}</figcaption></figure>"
                     )
                 elif isinstance(item, Table):
-                    item.frame.to_csv(tmp / "tables" / f"{item.name}.csv", index=False)
+                    item.frame.to_csv(tmp / "tables" / f"{_unique(used, 'tables', item.name)}.csv", index=False)
                     parts.append(_table_html(item))
                 elif isinstance(item, Text):
                     parts.append(f"<p>{html.escape(item.text)}</p>")

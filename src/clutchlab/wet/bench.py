@@ -37,7 +37,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError, ParameterError
-from ..io import atomic_to_csv, read_table
+from ..io import read_measurement, write_measurement
 from ..params import ParameterSet, load_toml, quantity
 from .engagement import EngagementResult, Scenario, simulate_engagement
 from .friction import ParametricFriction
@@ -270,14 +270,17 @@ def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None 
 
 def write_bench_record(run_or_frame, path, *, overwrite: bool = False, header: str | None = None,
                        every: int = 1):
-    """Write a bench record as CSV (``#`` header marks it synthetic), atomically.
+    """Write a bench record (CSV, Parquet or MDF 4 by the suffix; ``#`` header marks it synthetic), atomically.
+
+    Written through :func:`clutchlab.io.write_measurement`: the units of the
+    channels go into the file (a ``# units:`` line in CSV).
 
     Parameters
     ----------
     run_or_frame : BenchRun or pandas.DataFrame
         A protocol run (its header says what generated it) or a record.
     path : str or Path
-        CSV file to write.
+        File to write (``.csv``, ``.parquet`` or ``.mf4``).
     overwrite : bool
         Replace an existing file.
     header : str, optional
@@ -298,19 +301,31 @@ def write_bench_record(run_or_frame, path, *, overwrite: bool = False, header: s
     missing = [c for c in RECORD_COLUMNS if c not in frame.columns]
     if missing:
         raise DataError(f"bench record lacks column {missing[0]!r}")
-    return atomic_to_csv(frame.loc[:, list(RECORD_COLUMNS)].iloc[::every].reset_index(drop=True), path,
-                         overwrite=overwrite, header_comment=header or "synthetic: clutchlab virtual bench")
+    return write_measurement(frame.loc[:, list(RECORD_COLUMNS)].iloc[::every].reset_index(drop=True), path,
+                             overwrite=overwrite, comment=header or "synthetic: clutchlab virtual bench")
 
 
-def read_bench_record(path) -> pd.DataFrame:
-    """Read a bench record (CSV, ``#`` comment lines skipped) and validate its channels.
+def read_bench_record(path, channel_map=None, *, rate: float | None = None) -> pd.DataFrame:
+    """Read a bench record (CSV, Parquet or MDF 4) and validate its channels.
+
+    Read through :func:`clutchlab.io.read_measurement`: ``#`` comment lines of
+    a CSV are skipped, units stored in the file are converted to the ones the
+    column names state, a logger's channel names are mapped by
+    ``channel_map``.
 
     Parameters
     ----------
     path : str, Path or pandas.DataFrame
-        CSV with the columns ``time_s, slip_speed_rad_s, torque_Nm, force_N,
-        piston_position_m, temperature_C, fluid_temperature_C,
-        housing_temperature_C`` (SI, temperatures in degC).
+        Record with the channels ``time_s, slip_speed_rad_s, torque_Nm,
+        force_N, piston_position_m, temperature_C, fluid_temperature_C,
+        housing_temperature_C`` (SI, temperatures in degC), or a file whose
+        channels ``channel_map`` maps onto them.
+    channel_map : ChannelMap, mapping or TOML path, optional
+        Logger channel names and units -> the names above
+        (:class:`clutchlab.io.ChannelMap`).
+    rate : float, optional
+        Resample onto a uniform time base [Hz] (channels logged at different
+        rates are otherwise put onto the fastest channel's timestamps).
 
     Returns
     -------
@@ -324,15 +339,11 @@ def read_bench_record(path) -> pd.DataFrame:
         the column and the row), time not strictly increasing, fewer than 10
         samples.
     """
-    frame = read_table(path, RECORD_COLUMNS)
+    frame = read_measurement(path, channel_map, required=RECORD_COLUMNS, rate=rate).frame
     label = str(path) if not isinstance(path, pd.DataFrame) else "record"
     t = frame["time_s"].to_numpy()
     if t.size < 10:
         raise DataError(f"{label}: needs at least 10 samples, has {t.size}")
-    bad = np.flatnonzero(np.diff(t) <= 0)
-    if bad.size:
-        raise DataError(f"{label}: column 'time_s' is not strictly increasing at row {int(bad[0]) + 1} "
-                        f"({t[bad[0]]!r} -> {t[bad[0] + 1]!r})")
     return frame.loc[:, list(RECORD_COLUMNS)].reset_index(drop=True)
 
 

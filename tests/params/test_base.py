@@ -65,3 +65,28 @@ def test_from_dict_converts_units_and_reports_source():
 def test_describe_lists_units():
     text = EClutchParameters().describe()
     assert "lever_ratio" in text and "N/m" in text and "Haramina" in text
+
+
+def test_subclasses_register_themselves():
+    from clutchlab.params.base import registered_sets
+
+    assert Toy in registered_sets() and EClutchParameters in registered_sets()
+
+
+def test_from_toml_names_file_table_key_and_value(tmp_path):
+    path = tmp_path / "toy.toml"
+    path.write_text('[toy]\nr_outer = "80 kg"\n')
+    with pytest.raises(ParameterError) as info:
+        Toy.from_toml(path)
+    assert str(info.value) == f"{path}: [toy] r_outer = '80 kg': wrong unit: kg is not a length (it is a mass; expected m)"
+    path.write_text('[toy]\nvisc = 0.5\n')
+    with pytest.raises(ParameterError, match=r"\[toy\] visc = 0.5: expected a list of values \[1\]"):
+        Toy.from_toml(path)
+    path.write_text('[toy]\nvisc = [0.5, "x"]\n')
+    with pytest.raises(ParameterError, match=r"\[toy\] visc\[1\] = 'x': cannot parse quantity"):
+        Toy.from_toml(path)
+    path.write_text('[toy]\nr_inner = "70 mm"\nr_outer = "0.065 m"\n')
+    with pytest.raises(ParameterError, match=r"toy.toml: \[toy\] Toy: r_inner = 0.07 m must be < r_outer = 0.065 m"):
+        Toy.from_toml(path)
+    path.write_text('r_outer = "90 mm"\n')  # a file without the table is read from the top level
+    assert Toy.from_toml(path).r_outer == pytest.approx(0.09)

@@ -40,3 +40,23 @@ def test_report_folder_has_the_usual_permissions(tmp_path):
     os.umask(umask)
     mode = stat.S_IMODE(os.stat(index.parent).st_mode)
     assert mode == 0o777 & ~umask
+
+
+def test_synthetic_badge(tmp_path):
+    sections = [Section("A", [Text("a")], provenance="synthetic: virtual rig"),
+                Section("B", [Text("b")], provenance="rig 3, measured"),
+                Section("C", [Text("c")], provenance="rig 3", synthetic=True),
+                Section("D", [Text("d")], provenance="made with a synthetic oil", synthetic=False)]
+    html = write_report(sections, tmp_path / "rep").read_text()
+    heads = re.findall(r"<h2 id='s\d'>(.*?)</h2>", html)
+    assert ["SYNTHETIC DATA" in h for h in heads] == [True, False, True, False]
+
+
+def test_progress_per_figure(tmp_path):
+    messages = []
+    write_report([section(), section()], tmp_path / "rep", progress=messages.append)
+    assert [m for m in messages if m.startswith("rendering figure")] == ["rendering figure 1/2: line",
+                                                                         "rendering figure 2/2: line"]
+    # two figures (and tables) of the same name: both kept beside the page
+    assert sorted(p.name for p in (tmp_path / "rep" / "figures").iterdir()) == ["line.png", "line_2.png"]
+    assert sorted(p.name for p in (tmp_path / "rep" / "tables").iterdir()) == ["t.csv", "t_2.csv"]

@@ -1,0 +1,199 @@
+"""E-clutch simulation scenarios: a TOML file that says what to simulate.
+
+A scenario names the clutch model, the input (motor voltage, bearing-position
+reference, clutch-pedal signal, or a prescribed bearing motion for the clutch
+alone), the run length and any parameter overrides::
+
+    [scenario]
+    model = 4                     # axial Model 0-4 of Haramina et al. (2024)
+    t_end = "1.2 s"
+    output_step = "1 ms"          # optional: uniform output grid
+    rtol = 1e-4                   # optional
+    friction = true               # clutch friction elements R_f.ds, R_f.pp (default true)
+
+    [input]
+    kind = "pedal"                # "voltage" [V], "bearing_reference" [m], "pedal" [0-1], "bearing_position" [m]
+    time_s = [0.0, 0.1, 0.3, 0.8, 1.0]
+    value = [0, 0, 1, 1, 0]       # quantities may carry units: ["0 mm", "8 mm"]
+    release_travel = "8 mm"       # pedal only
+
+    [eclutch]                     # EClutchParameters overrides (clutch)
+    [eclutch_actuator]            # ActuatorParameters overrides
+    [eclutch_friction]            # FrictionParameters overrides
+    [offsets]                     # wear and thermal expansion (Sec. 7 future work iii)
+    wear = "0.2 mm"
+    temperature_rise = "60 K"
+
+Every value is converted to SI once here; errors name the file, the table and
+key, and the value.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..params import load_toml
+from ..units import to_si
+from .actuator import ActuatorParameters
+from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionParameters, apply_wear_and_expansion,
+                       pedal_reference)
+from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
+
+__all__ = ["Scenario", "load_scenario", "run_scenario", "INPUT_KINDS"]
+
+INPUT_KINDS = {"voltage": "V", "bearing_reference": "m", "pedal": "1", "bearing_position": "m"}
+_TABLES = ("scenario", "input", "eclutch", "eclutch_actuator", "eclutch_friction", "offsets")
+
+
+@dataclasses.dataclass(frozen=True)
+class Scenario:
+    """A parsed scenario (SI units).
+
+    Attributes
+    ----------
+    model : int
+        Axial model number (0-4).
+    t_end : float
+        Simulated time [s].
+    input_kind : str
+        One of :data:`INPUT_KINDS`.
+    time_s, value : ndarray
+        Input table (value in V, m, or pedal fraction).
+    release_travel : float
+        Bearing travel of a fully pressed pedal [m].
+    clutch, actuator, friction : parameter sets
+    wear_m, temperature_rise_k : float
+        Offsets of the characteristics.
+    output_step : float or None
+        Output grid [s].
+    rtol : float
+        Relative tolerance.
+    source : str
+        File it came from.
+    """
+
+    model: int = 4
+    t_end: float = 1.0
+    input_kind: str = "pedal"
+    time_s: np.ndarray = dataclasses.field(default_factory=lambda: np.array([0.0, 0.1, 0.3, 0.7, 0.9]))
+    value: np.ndarray = dataclasses.field(default_factory=lambda: np.array([0.0, 0.0, 1.0, 1.0, 0.0]))
+    release_travel: float = 8e-3
+    clutch: EClutchParameters = dataclasses.field(default_factory=EClutchParameters)
+    actuator: ActuatorParameters = dataclasses.field(default_factory=ActuatorParameters)
+    friction: FrictionParameters = dataclasses.field(default_factory=FrictionParameters)
+    wear_m: float = 0.0
+    temperature_rise_k: float = 0.0
+    output_step: float | None = None
+    rtol: float = 1e-4
+    source: str = "defaults"
+
+    def clutch_model(self) -> ClutchModel:
+        """The clutch model with the scenario's parameters and offsets."""
+        model = ClutchModel.preset(self.model, self.clutch)
+        if self.wear_m or self.temperature_rise_k:
+            model = apply_wear_and_expansion(model, wear_m=self.wear_m, temperature_rise_k=self.temperature_rise_k)
+        return model
+
+    def input_table(self) -> tuple[np.ndarray, np.ndarray]:
+        """Input table in the simulator's units (pedal converted to a bearing reference)."""
+        if self.input_kind == "pedal":
+            return self.time_s, pedal_reference(self.value, self.release_travel)
+        return self.time_s, self.value
+
+
+def _number_list(raw, unit, where):
+    if not isinstance(raw, list) or not raw:
+        raise ParameterError(f"{where} = {raw!r}: expected a non-empty list")
+    return np.array([to_si(v, unit, name=f"{where}[{i}]") for i, v in enumerate(raw)], dtype=float)
+
+
+def load_scenario(path) -> Scenario:
+    """Read a scenario TOML file (see the module documentation for the format)."""
+    data = load_toml(path)
+    src = str(path)
+    unknown = [k for k in data if k not in _TABLES]
+    if unknown:
+        raise ParameterError(f"{src}: unknown table [{unknown[0]}] (known: {', '.join(_TABLES)})")
+    sc = dict(data.get("scenario", {}))
+    known = {"model", "t_end", "output_step", "rtol", "friction"}
+    for k in sc:
+        if k not in known:
+            raise ParameterError(f"{src}: [scenario] unknown key {k!r} (known: {', '.join(sorted(known))})")
+    model = sc.get("model", 4)
+    if isinstance(model, bool) or not isinstance(model, int) or model not in MODEL_NUMBERS:
+        raise ParameterError(f"{src}: [scenario] model = {model!r}: expected one of 0, 1, 2, 3, 4")
+    t_end = to_si(sc.get("t_end", 1.0), "s", name="[scenario] t_end", source=src)
+    if t_end <= 0:
+        raise ParameterError(f"{src}: [scenario] t_end = {sc.get('t_end')!r} must be > 0")
+    output_step = None
+    if "output_step" in sc:
+        output_step = to_si(sc["output_step"], "s", name="[scenario] output_step", source=src)
+        if not 0 < output_step <= t_end:
+            raise ParameterError(f"{src}: [scenario] output_step = {sc['output_step']!r} must be in (0, t_end]")
+    rtol = to_si(sc.get("rtol", 1e-4), "1", name="[scenario] rtol", source=src)
+    use_friction = sc.get("friction", True)
+    if not isinstance(use_friction, bool):
+        raise ParameterError(f"{src}: [scenario] friction = {use_friction!r}: expected true or false")
+    inp = dict(data.get("input", {}))
+    kind = inp.pop("kind", "pedal")
+    if kind not in INPUT_KINDS:
+        raise ParameterError(f"{src}: [input] kind = {kind!r}: expected one of {', '.join(INPUT_KINDS)}")
+    release_travel = to_si(inp.pop("release_travel", 8e-3), "m", name="[input] release_travel", source=src)
+    if "file" in inp:
+        from ..io import read_table
+
+        f = Path(src).parent / inp.pop("file")
+        frame = read_table(f, ["time_s", "value"])
+        t = frame["time_s"].to_numpy(float)
+        v = frame["value"].to_numpy(float)
+    else:
+        if "time_s" not in inp or "value" not in inp:
+            raise ParameterError(f"{src}: [input] needs 'time_s' and 'value' lists (or 'file')")
+        try:
+            t = _number_list(inp.pop("time_s"), "s", "[input] time_s")
+            v = _number_list(inp.pop("value"), INPUT_KINDS[kind], "[input] value")
+        except ParameterError as exc:
+            raise ParameterError(f"{src}: {exc}") from None
+    if inp:
+        raise ParameterError(f"{src}: [input] unknown key {next(iter(inp))!r}")
+    if t.size != v.size:
+        raise ParameterError(f"{src}: [input] time_s has {t.size} values but value has {v.size}")
+    if t.size > 1 and np.any(np.diff(t) <= 0):
+        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise ParameterError(f"{src}: [input] time_s must increase strictly (entry {i}: {t[i]!r} s)")
+    offsets = dict(data.get("offsets", {}))
+    wear = to_si(offsets.pop("wear", 0.0), "m", name="[offsets] wear", source=src)
+    rise = to_si(offsets.pop("temperature_rise", 0.0), "K", name="[offsets] temperature_rise", source=src)
+    if offsets:
+        raise ParameterError(f"{src}: [offsets] unknown key {next(iter(offsets))!r} (known: wear, temperature_rise)")
+    if wear < 0:
+        raise ParameterError(f"{src}: [offsets] wear = {wear!r} m must be >= 0")
+    clutch = EClutchParameters.from_dict(data.get("eclutch", {}), source=src)
+    actuator = ActuatorParameters.from_dict(data.get("eclutch_actuator", {}), source=src)
+    friction = FrictionParameters.from_dict(data.get("eclutch_friction", {}), source=src) if use_friction \
+        else FrictionParameters.off()
+    if "eclutch_actuator" not in data or "csc_preload" not in data.get("eclutch_actuator", {}):
+        actuator = actuator.replace(csc_preload=clutch.bearing_preload)
+    return Scenario(model=model, t_end=t_end, input_kind=kind, time_s=t, value=v, release_travel=release_travel,
+                    clutch=clutch, actuator=actuator, friction=friction, wear_m=wear, temperature_rise_k=rise,
+                    output_step=output_step, rtol=rtol, source=src)
+
+
+def run_scenario(scenario: Scenario, progress=None) -> DynamicsResult:
+    """Simulate a scenario: the E-clutch (actuator + clutch), or the clutch alone for ``bearing_position``."""
+    if progress:
+        progress(f"building Model {scenario.model} and the actuator ...")
+    model = scenario.clutch_model()
+    t, v = scenario.input_table()
+    if progress:
+        progress(f"simulating {scenario.t_end:g} s ({scenario.input_kind} input) ...")
+    if scenario.input_kind == "bearing_position":
+        return ClutchDynamics(model, scenario.friction).simulate((t, v), scenario.t_end, rtol=scenario.rtol,
+                                                                 output_step=scenario.output_step)
+    key = "voltage" if scenario.input_kind == "voltage" else "bearing_reference"
+    ec = EClutch(scenario.actuator, model, scenario.friction)
+    return ec.simulate({key: (t, v)}, scenario.t_end, rtol=scenario.rtol, output_step=scenario.output_step)

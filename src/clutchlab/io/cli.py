@@ -1,0 +1,44 @@
+"""``clutchlab convert``: measurement files between CSV, Parquet and MDF 4 (thin layer over clutchlab.io)."""
+
+from __future__ import annotations
+
+
+def _convert(args) -> int:
+    from .files import check_writable
+    from .measurements import read_measurement, write_measurement
+
+    check_writable(args.output, args.force)  # refuse before reading a large file
+    time = None if args.no_time else args.time
+    meas = read_measurement(args.input, args.channel_map, rate=args.rate, time=time,
+                            interpolation=args.interpolation)
+    out = write_measurement(meas, args.output, overwrite=args.force,
+                            comment=f"converted from {args.input} by clutchlab convert; {meas.source.time_base}")
+    print(meas.source.describe())
+    print(f"{out}: {len(meas)} samples, {len(meas.channels)} channels")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``clutchlab convert`` to the command-line parser.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-command collection of the ``clutchlab`` parser.
+    """
+    p = subparsers.add_parser(
+        "convert", help="convert a measurement file (CSV, Parquet, MDF 4) to clutchlab names and SI units",
+        description="Read a record (.csv, .parquet, .mf4), map the logger's channels to clutchlab names with "
+                    "--channel-map, convert units to those the names state, put channels logged at different "
+                    "rates onto one time base, and write .csv, .parquet or .mf4 with the units in the file.")
+    p.add_argument("input", help="record to read (.csv, .parquet, .mf4/.mdf)")
+    p.add_argument("-o", "--output", required=True, help="file to write (.csv, .parquet, .mf4)")
+    p.add_argument("--channel-map", metavar="MAP.toml",
+                   help="TOML file with [channels.<name>] tables: source, unit, source_unit, group, interpolation")
+    p.add_argument("--rate", type=float, metavar="HZ", help="resample onto a uniform time base at this rate")
+    p.add_argument("--interpolation", choices=("linear", "previous"), default="linear",
+                   help="resampling between samples (default: %(default)s)")
+    p.add_argument("--time", default="time_s", help="name of the time column (default: %(default)s)")
+    p.add_argument("--no-time", action="store_true", help="the input is a table without a time column")
+    p.add_argument("--force", action="store_true", help="replace the output file if it exists")
+    p.set_defaults(func=_convert)

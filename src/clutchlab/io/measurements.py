@@ -1,0 +1,717 @@
+"""Measured records: read CSV, Parquet and ASAM MDF 4 into SI, write them back with units.
+
+Every reader of a bench or vehicle record in clutchlab (wet-clutch bench,
+E-clutch press rig and full clutch, EMTC FORC tables and inputs) goes through
+:func:`read_measurement`, which
+
+1. opens the file by its suffix (``.csv``, ``.parquet``/``.pq``, ``.mf4``/``.mdf``)
+   or takes a DataFrame,
+2. picks the channels named by a :class:`~clutchlab.io.channels.ChannelMap`
+   (or all of them, under their own names),
+3. checks each: present, unambiguous, numeric, finite, timestamps strictly
+   increasing -- a :class:`~clutchlab.errors.DataError` names the file, the
+   channel and the offending sample,
+4. carries channels recorded at different rates onto one time base (the
+   fastest channel's timestamps, a uniform ``rate`` or a given ``time_base``)
+   by linear interpolation or sample-and-hold, and
+5. converts every channel from the unit the file (or the map) states to the
+   unit the clutchlab name states (rpm -> rad/s, kN -> N, degF -> degC).
+
+:func:`write_measurement` writes CSV (a ``# units:`` comment line), Parquet
+(units in the schema metadata) or MDF 4 (units in each channel), atomically and
+never over an existing file unless ``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from ..errors import DataError, ParameterError
+from .channels import INTERPOLATIONS, ChannelMap, ChannelSpec, canonical_unit, unit_conversion
+from .files import atomic_to_csv, atomic_write_bytes, check_writable
+from .mdf import MDF_SUFFIXES, MdfReader, RawChannel, write_mdf
+
+__all__ = [
+    "CSV_SUFFIXES",
+    "PARQUET_SUFFIXES",
+    "ChannelOrigin",
+    "MeasurementSource",
+    "Measurement",
+    "read_measurement",
+    "write_measurement",
+    "resample",
+]
+
+CSV_SUFFIXES = (".csv", ".txt")
+PARQUET_SUFFIXES = (".parquet", ".pq")
+_UNITS_PREFIX = "units:"
+_PARQUET_KEY = b"clutchlab"
+
+
+@dataclass(frozen=True)
+class ChannelOrigin:
+    """Where a column of a :class:`Measurement` came from.
+
+    Parameters
+    ----------
+    source : str
+        Channel name in the file.
+    source_unit : str
+        Unit of the stored values (from the file, the map, or the name).
+    unit : str
+        Unit of the column.
+    group : int or None
+        MDF data group (``None`` for tables).
+    samples : int
+        Number of stored samples.
+    rate_hz : float or None
+        Mean sample rate of the stored channel [Hz] (``None`` without time).
+    interpolation : str or None
+        How it was carried onto the time base (``None`` if not resampled).
+    """
+
+    source: str
+    source_unit: str
+    unit: str
+    group: int | None
+    samples: int
+    rate_hz: float | None
+    interpolation: str | None = None
+
+
+@dataclass(frozen=True)
+class MeasurementSource:
+    """Provenance of a :class:`Measurement`.
+
+    Parameters
+    ----------
+    path : str or None
+        File read (``None`` for a DataFrame).
+    format : str
+        ``"csv"``, ``"parquet"``, ``"mdf"`` or ``"frame"``.
+    comments : tuple of str
+        Header comment lines of the file (CSV ``#`` lines, Parquet metadata,
+        MDF header comment).
+    channels : mapping
+        Column name -> :class:`ChannelOrigin`.
+    time_base : str
+        How the time base was chosen (``"as recorded"``, ``"resampled ..."``).
+    """
+
+    path: str | None
+    format: str
+    comments: tuple[str, ...] = ()
+    channels: Mapping[str, ChannelOrigin] = field(default_factory=dict)
+    time_base: str = "as recorded"
+
+    @property
+    def synthetic(self) -> bool:
+        """True if a header line says the data are synthetic (``synthetic: ...``)."""
+        return any(line.strip().lower().startswith("synthetic") for line in self.comments)
+
+    def describe(self) -> str:
+        """A few lines of provenance for reports and file headers."""
+        lines = [f"source: {self.path or 'in-memory table'} ({self.format}); time base {self.time_base}"]
+        if self.synthetic:
+            lines.append("synthetic data (not measured)")
+        for name, o in self.channels.items():
+            rate = f", {o.rate_hz:.6g} Hz" if o.rate_hz else ""
+            grp = f", group {o.group}" if o.group is not None else ""
+            conv = f" [{o.source_unit or '-'} -> {o.unit or '-'}]" if (o.source_unit or "") != (o.unit or "") else \
+                f" [{o.unit or '-'}]"
+            lines.append(f"{name} <- {o.source}{grp}{rate}{conv}")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A record in clutchlab's names and units.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The time column first (if any), then the channels, all float and in
+        the unit their name states.
+    units : mapping of str to str
+        Column -> unit string (pint syntax; ``""`` dimensionless or unknown).
+    source : MeasurementSource
+        Where the data came from.
+    time_column : str or None
+        Name of the time column [s] (``None`` for a table without time).
+    """
+
+    frame: pd.DataFrame
+    units: Mapping[str, str]
+    source: MeasurementSource
+    time_column: str | None = "time_s"
+
+    @property
+    def time(self) -> np.ndarray | None:
+        """Time of the samples [s] (``None`` for a table without time)."""
+        return None if self.time_column is None else self.frame[self.time_column].to_numpy()
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """Column names other than the time column."""
+        return tuple(c for c in self.frame.columns if c != self.time_column)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self.frame.columns:
+            raise DataError(f"{self.source.path or 'record'}: no channel {name!r} "
+                            f"(has: {', '.join(map(str, self.frame.columns))})")
+        return self.frame[name].to_numpy()
+
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """A copy of the frame, with the units in ``frame.attrs["units"]``."""
+        out = self.frame.copy()
+        out.attrs["units"] = dict(self.units)
+        return out
+
+
+# ---------------------------------------------------------------- raw sources
+
+class _TableReader:
+    """CSV, Parquet or DataFrame: columns sharing one row index."""
+
+    def __init__(self, frame: pd.DataFrame, label: str, fmt: str, path, units: Mapping[str, str],
+                 comments: Sequence[str]):
+        self.frame = frame
+        self.label = label
+        self.format = fmt
+        self.path = path
+        self.units = {str(k): v for k, v in units.items() if v is not None}
+        self.comments = tuple(comments)
+
+    def channel_names(self) -> list[str]:
+        return [str(c) for c in self.frame.columns]
+
+    def has(self, name: str) -> bool:
+        return name in self.frame.columns
+
+    def load(self, name: str, *, target: str | None = None, allow_nan: bool = False,
+             skip_nonnumeric: bool = False) -> RawChannel | None:
+        if name not in self.frame.columns:
+            what = repr(name) + (f" (for {target!r})" if target and target != name else "")
+            raise DataError(f"{self.label}: missing column {what} (has: {', '.join(map(str, self.frame.columns))})")
+        col = self.frame[name]
+        values = pd.to_numeric(col, errors="coerce").to_numpy(dtype=float)
+        text = np.isnan(values) & col.notna().to_numpy()  # present but not a number
+        if text.any() and skip_nonnumeric:
+            return None
+        bad = ~np.isfinite(values) if not allow_nan else text
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            value = col.iloc[row]
+            value = float(value) if isinstance(value, (np.floating, np.integer)) else value
+            raise DataError(f"{self.label}: column {name!r} has a non-finite or non-numeric value "
+                            f"{value!r} at row {row}")
+        return RawChannel(name, values, None, self.units.get(name), None)
+
+    def close(self):
+        pass
+
+
+def _parse_units_line(text: str, label: str) -> dict[str, str]:
+    units = {}
+    body = text.strip()[len(_UNITS_PREFIX):]
+    for item in body.split(","):
+        item = item.strip()
+        if not item:
+            continue
+        if "=" not in item:
+            raise DataError(f"{label}: cannot read the '# units:' line at {item!r} (expected name=unit)")
+        k, v = item.split("=", 1)
+        units[k.strip()] = v.strip()
+    return units
+
+
+def _read_csv(path: Path, label: str) -> _TableReader:
+    comments, units = [], {}
+    try:
+        with open(path, encoding="utf-8") as fh:
+            for line in fh:
+                if not line.startswith("#"):
+                    break
+                text = line[1:].strip()
+                if text.lower().startswith(_UNITS_PREFIX):
+                    units.update(_parse_units_line(text, label))
+                else:
+                    comments.append(text)
+        frame = pd.read_csv(path, comment="#")
+    except UnicodeDecodeError:
+        raise DataError(f"{label}: cannot read as CSV (not UTF-8 text)") from None
+    except DataError:
+        raise
+    except Exception as exc:  # pandas raises several parser errors
+        raise DataError(f"{label}: cannot read as CSV ({exc})") from None
+    return _TableReader(frame, label, "csv", path, units, comments)
+
+
+def _read_parquet(path: Path, label: str) -> _TableReader:
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except Exception as exc:  # ArrowInvalid, OSError on truncated files
+        raise DataError(f"{label}: not a readable Parquet file ({type(exc).__name__}: {exc})") from None
+    meta = table.schema.metadata or {}
+    units, comments = {}, []
+    if _PARQUET_KEY in meta:
+        try:
+            info = json.loads(meta[_PARQUET_KEY])
+            units = dict(info.get("units", {}))
+            comments = [str(c) for c in info.get("comments", [])]
+        except (ValueError, TypeError, AttributeError):
+            raise DataError(f"{label}: the clutchlab metadata of the Parquet schema is not valid JSON") from None
+    for fld in table.schema:
+        fm = fld.metadata or {}
+        if b"unit" in fm:
+            units.setdefault(fld.name, fm[b"unit"].decode("utf-8"))
+    return _TableReader(table.to_pandas(), label, "parquet", path, units, comments)
+
+
+def _open(source, name: str | None):
+    if isinstance(source, Measurement):
+        frame = source.frame
+        return _TableReader(frame, name or source.source.path or "record", "frame", source.source.path,
+                            dict(source.units), source.source.comments)
+    if isinstance(source, pd.DataFrame):
+        return _TableReader(source, name or "record", "frame", None, dict(source.attrs.get("units", {})), ())
+    if not isinstance(source, (str, Path)):
+        raise DataError(f"record must be a file path or a pandas.DataFrame, got {type(source).__name__}")
+    path = Path(source)
+    label = name or str(path)
+    if not path.exists():
+        raise DataError(f"{label}: no such file")
+    if path.is_dir():
+        raise DataError(f"{label}: is a directory, not a record file")
+    suffix = path.suffix.lower()
+    if suffix in MDF_SUFFIXES:
+        return MdfReader(path, label)
+    if suffix in PARQUET_SUFFIXES:
+        return _read_parquet(path, label)
+    if suffix in CSV_SUFFIXES or suffix == "":
+        return _read_csv(path, label)
+    raise DataError(f"{label}: unknown record format {path.suffix!r} (expected "
+                    f"{', '.join(CSV_SUFFIXES + PARQUET_SUFFIXES + MDF_SUFFIXES)})")
+
+
+# ---------------------------------------------------------------- checks and resampling
+
+def _check_time(t: np.ndarray, label: str, what: str, sample_word: str) -> None:
+    bad = ~np.isfinite(t)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise DataError(f"{label}: {what} has a non-finite time {float(t[k])!r} at {sample_word} {k}")
+    dt = np.diff(t)
+    if (dt <= 0).any():
+        k = int(np.flatnonzero(dt <= 0)[0]) + 1
+        raise DataError(f"{label}: {what} must increase strictly, but {sample_word} {k} has {float(t[k])!r} after "
+                        f"{float(t[k - 1])!r} (time not strictly increasing)")
+
+
+def resample(timestamps, samples, time_base, interpolation: str = "linear") -> np.ndarray:
+    """Carry a channel from its own timestamps onto ``time_base``.
+
+    Parameters
+    ----------
+    timestamps : array_like
+        Sample times of the channel [s], strictly increasing.
+    samples : array_like
+        Channel values at ``timestamps``.
+    time_base : array_like
+        Times at which values are wanted [s], within
+        ``[timestamps[0], timestamps[-1]]``.
+    interpolation : {"linear", "previous"}
+        Linear interpolation between neighbouring samples, or the last sample
+        at or before each time (sample-and-hold, for states and set points).
+
+    Returns
+    -------
+    ndarray
+        Values at ``time_base``.
+    """
+    ts = np.asarray(timestamps, dtype=float)
+    ys = np.asarray(samples, dtype=float)
+    tb = np.asarray(time_base, dtype=float)
+    if interpolation == "linear":
+        return np.interp(tb, ts, ys)
+    if interpolation == "previous":
+        idx = np.searchsorted(ts, tb, side="right") - 1
+        return ys[np.clip(idx, 0, ts.size - 1)]
+    raise ParameterError(f"interpolation = {interpolation!r}; expected one of {', '.join(INTERPOLATIONS)}")
+
+
+def _rate(t: np.ndarray | None) -> float | None:
+    if t is None or t.size < 2 or t[-1] <= t[0]:
+        return None
+    return float((t.size - 1) / (t[-1] - t[0]))
+
+
+# ---------------------------------------------------------------- reading
+
+def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), time: str | None = "time_s",
+                     rate: float | None = None, time_base=None, interpolation: str = "linear",
+                     allow_nan: Iterable[str] = (), name: str | None = None) -> Measurement:
+    """Read a record from CSV, Parquet or MDF 4 into clutchlab's names and SI units.
+
+    Parameters
+    ----------
+    source : str, Path, pandas.DataFrame or Measurement
+        ``.csv`` (``#`` comment lines skipped, an optional ``# units: a=s,
+        b=N*m`` line read), ``.parquet`` (units from the schema metadata),
+        ``.mf4``/``.mdf`` (ASAM MDF, units from the channels, conversions
+        applied), or an in-memory table (units from ``frame.attrs["units"]``).
+    channel_map : ChannelMap, mapping, str or Path, optional
+        Which channels to read and under which names (a TOML file or a
+        mapping, see :class:`~clutchlab.io.channels.ChannelMap`).  Without a
+        map every channel is read under its own name; a name with a unit
+        suffix is converted to that unit.
+    required : iterable of str
+        clutchlab names that must be present (with a map: must also be
+        entries of the map).
+    time : str or None
+        Name of the time column [s] (default ``"time_s"``).  In a CSV or
+        Parquet file it is the column of that name (or the map's entry of that
+        name); in an MDF file the groups' master channels.  ``None`` reads a
+        table without time (an MDF file still yields ``time_s``).
+    rate : float, optional
+        Resample every channel onto a uniform time base with this rate [Hz],
+        over the interval all channels cover.
+    time_base : array_like, optional
+        Resample onto these times [s] instead (strictly increasing, within
+        every channel's span).  Give ``rate`` or ``time_base``, not both.
+        Without either, channels sharing one time base keep it and channels of
+        different rates go onto the fastest channel's timestamps within the
+        interval all channels cover.
+    interpolation : {"linear", "previous"}
+        Default resampling method (a map entry may set its own).
+    allow_nan : iterable of str
+        clutchlab names in which NaN samples are allowed.
+    name : str, optional
+        How to call the source in error messages (default: the path).
+
+    Returns
+    -------
+    Measurement
+        The frame (time first), its units and its provenance.
+
+    Raises
+    ------
+    DataError
+        Missing or unreadable file, unknown format, missing or ambiguous
+        channel, unknown unit or unit of the wrong dimension, non-numeric or
+        NaN sample, time not strictly increasing, channels without common time
+        span -- each naming the file and the channel.
+    ParameterError
+        Invalid channel map, ``interpolation``, ``rate`` or ``time_base``.
+    """
+    cmap = ChannelMap.coerce(channel_map)
+    required = [str(r) for r in required]
+    allow_nan = set(allow_nan)
+    if interpolation not in INTERPOLATIONS:
+        raise ParameterError(f"interpolation = {interpolation!r}; expected one of {', '.join(INTERPOLATIONS)}")
+    if rate is not None and time_base is not None:
+        raise ParameterError("give rate or time_base, not both")
+    if rate is not None:
+        number = isinstance(rate, (int, float, np.number)) and not isinstance(rate, bool)
+        if not (number and np.isfinite(rate) and rate > 0):
+            raise ParameterError(f"rate = {rate!r} Hz: must be a positive number")
+        rate = float(rate)
+    if cmap is not None:
+        unmapped = [r for r in required if r not in cmap and r != time]
+        if unmapped:
+            raise ParameterError(f"{cmap.name}: required channel {unmapped[0]!r} is not in the channel map "
+                                 f"(has: {', '.join(cmap.names)})")
+
+    reader = _open(source, name)
+    try:
+        return _read(reader, cmap, required, time, rate, time_base, interpolation, allow_nan)
+    finally:
+        reader.close()
+
+
+def _has(reader, name: str) -> bool:
+    if isinstance(reader, MdfReader):
+        return bool(reader.groups_of(name))
+    return reader.has(name)
+
+
+def _dimensionless(unit: str) -> bool:
+    try:
+        unit_conversion(unit, "", name="", error=DataError)
+    except DataError:
+        return False
+    return True
+
+
+def _table_time(reader, time: str, time_spec: ChannelSpec | None) -> np.ndarray:
+    """The time column of a table, converted to s and checked."""
+    tsrc = time_spec.source if time_spec is not None else time
+    traw = reader.load(tsrc, target=time)
+    tunit = (time_spec.source_unit if time_spec is not None else None) or traw.unit or canonical_unit(tsrc) or "s"
+    scale, offset = unit_conversion(tunit, "s", name=tsrc, where=reader.label)
+    t = traw.samples * scale + offset
+    _check_time(t, reader.label, time if tsrc == time else f"{tsrc} (time)", "row")
+    return t
+
+
+def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_nan) -> Measurement:
+    label = reader.label
+    is_mdf = isinstance(reader, MdfReader)
+    if is_mdf and time is None:
+        time = "time_s"  # an MDF file always has a time base
+    if cmap is None:
+        for r in required:
+            if r != time and not _has(reader, r):
+                reader.load(r, target=r)  # raises the reader's "missing channel/column" error
+        specs = [ChannelSpec(n, unit=canonical_unit(n) or "", optional=n not in required)
+                 for n in reader.channel_names() if n != time]
+        lenient = {s.name for s in specs if s.optional}  # passed through if not numeric, NaN allowed
+    else:
+        specs = list(cmap)
+        lenient = set()
+    time_spec = next((s for s in specs if s.name == time), None)
+    specs = [s for s in specs if s.name != time]
+    if not is_mdf and time_spec is not None and time_spec.group is not None:
+        raise ParameterError(f"channel map entry {time!r}: group only applies to MDF files")
+
+    # ---- channels as stored, checked
+    table_t = _table_time(reader, time, time_spec) if (not is_mdf and time is not None) else None
+    raws: dict[str, RawChannel] = {}
+    used: list[ChannelSpec] = []
+    for spec in specs:
+        if spec.optional and not _has(reader, spec.source):
+            continue
+        nan_ok = spec.name in allow_nan or spec.name in lenient
+        if is_mdf:
+            raw = reader.load(spec.source, spec.group, target=spec.name, skip_nonnumeric=spec.name in lenient)
+            if raw is None:
+                continue
+            bad = ~np.isfinite(raw.samples)
+            if bad.any() and not nan_ok:
+                k = int(np.flatnonzero(bad)[0])
+                raise DataError(f"{label}: channel {spec.source!r} (group {raw.group}) has a non-finite value "
+                                f"{float(raw.samples[k])!r} at sample {k} (t = {float(raw.timestamps[k])!r} s)")
+            _check_time(raw.timestamps, label, f"timestamps of channel {spec.source!r} (group {raw.group})", "sample")
+        else:
+            if spec.group is not None:
+                raise ParameterError(f"channel map entry {spec.name!r}: group = {spec.group} only applies to MDF "
+                                     f"files, but {label} is a {reader.format} table")
+            raw = reader.load(spec.source, target=spec.name, allow_nan=nan_ok, skip_nonnumeric=spec.name in lenient)
+            if raw is None:
+                continue
+            raw.timestamps = table_t
+        raws[spec.name] = raw
+        used.append(spec)
+
+    # ---- one time base
+    resampled = False
+    how = "as recorded"
+    if time is None:
+        timeline = None
+        how = "no time column"
+        if rate is not None or time_base is not None:
+            raise ParameterError(f"{label}: resampling needs a time column, but time=None")
+    else:
+        stamps = [raws[s.name].timestamps for s in used] or ([table_t] if table_t is not None else [])
+        if not stamps:
+            raise DataError(f"{label}: no numeric channels to read")
+        same = all(ts is stamps[0] or (ts.size == stamps[0].size and np.array_equal(ts, stamps[0])) for ts in stamps)
+        t_lo = max(float(ts[0]) for ts in stamps)
+        t_hi = min(float(ts[-1]) for ts in stamps)
+        if time_base is not None:
+            timeline = np.asarray(time_base, dtype=float)
+            if timeline.ndim != 1 or timeline.size == 0:
+                raise ParameterError(f"time_base: expected a non-empty 1-D array, got shape {timeline.shape}")
+            try:
+                _check_time(timeline, "time_base", "time_base", "element")
+            except DataError as exc:
+                raise ParameterError(str(exc)) from None
+            for spec in used:
+                ts = raws[spec.name].timestamps
+                if timeline[0] < ts[0] - 1e-12 or timeline[-1] > ts[-1] + 1e-12:
+                    raise DataError(f"{label}: time_base [{float(timeline[0])!r}, {float(timeline[-1])!r}] s "
+                                    f"exceeds the span of "
+                                    f"channel {spec.source!r} [{float(ts[0])!r}, {float(ts[-1])!r}] s")
+            resampled, how = True, f"given time base ({timeline.size} points)"
+        elif rate is not None or not same:
+            if not t_hi > t_lo:
+                spans = ", ".join(f"{s.source} [{raws[s.name].timestamps[0]:g}, {raws[s.name].timestamps[-1]:g}] s"
+                                  for s in used)
+                raise DataError(f"{label}: the channels share no common time span ({spans})")
+            if rate is not None:
+                n = int(np.floor((t_hi - t_lo) * rate * (1 + 1e-12))) + 1
+                timeline = t_lo + np.arange(n) / rate
+                how = f"resampled at {rate:g} Hz over [{t_lo:g}, {t_hi:g}] s"
+            else:
+                fastest = max(used, key=lambda s: _rate(raws[s.name].timestamps) or 0.0)
+                ts = raws[fastest.name].timestamps
+                timeline = ts[(ts >= t_lo) & (ts <= t_hi)]
+                how = (f"resampled onto the timestamps of {fastest.source!r} ({_rate(ts):.6g} Hz) over "
+                       f"[{t_lo:g}, {t_hi:g}] s")
+            resampled = True
+        else:
+            timeline = stamps[0]
+
+    # ---- units, resampling, assembly
+    columns: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    origins: dict[str, ChannelOrigin] = {}
+    if timeline is not None:
+        columns[time] = np.array(timeline, dtype=float)
+        units[time] = "s"
+    for spec in used:
+        raw = raws[spec.name]
+        src_unit = spec.source_unit or raw.unit or canonical_unit(spec.source)
+        target_unit = spec.unit
+        if cmap is None and not target_unit:
+            target_unit = raw.unit or ""  # a name without unit suffix: keep the file's unit
+        if src_unit is None:
+            if spec.source == spec.name or _dimensionless(target_unit):
+                src_unit = target_unit  # no unit in the file: the clutchlab name's (or a pure number) taken as is
+            else:
+                raise DataError(f"{label}: channel {spec.source!r} (for {spec.name!r}) carries no unit; "
+                                f"give source_unit in the channel map")
+        scale, offset = unit_conversion(src_unit, target_unit, name=spec.source, where=label)
+        values = raw.samples
+        method = None
+        if resampled:
+            method = spec.interpolation or interpolation
+            values = resample(raw.timestamps, values, timeline, method)
+        columns[spec.name] = values * scale + offset if (scale != 1.0 or offset != 0.0) else np.array(values)
+        units[spec.name] = target_unit
+        origins[spec.name] = ChannelOrigin(spec.source, src_unit, target_unit, raw.group, int(raw.samples.size),
+                                           _rate(raw.timestamps), method)
+    frame = pd.DataFrame(columns)
+    if isinstance(reader, _TableReader) and cmap is None:
+        # identity read of a table: other (non-numeric) columns pass through untouched, in the file's order
+        for c in reader.frame.columns:
+            if c not in frame.columns:
+                frame[c] = reader.frame[c].to_numpy()
+        order = [c for c in reader.frame.columns if c in frame.columns]
+        if time is not None:
+            order = [time] + [c for c in order if c != time]
+        frame = frame.loc[:, order]
+    if is_mdf:
+        comments = tuple(line.strip() for line in reader.comment.splitlines() if line.strip())
+        path = str(reader.path)
+    else:
+        comments = reader.comments
+        path = None if reader.path is None else str(reader.path)
+    src = MeasurementSource(path, "mdf" if is_mdf else reader.format, comments, origins, how)
+    return Measurement(frame.reset_index(drop=True), units, src, time if timeline is not None else None)
+
+
+# ---------------------------------------------------------------- writing
+
+def _units_for(frame: pd.DataFrame, units: Mapping[str, str] | None) -> dict[str, str]:
+    given = dict(frame.attrs.get("units", {}))
+    given.update(units or {})
+    out = {}
+    for c in frame.columns:
+        u = given.get(c)
+        if u is None:
+            u = canonical_unit(str(c))
+        out[str(c)] = "" if u is None else str(u)
+    return out
+
+
+def write_measurement(data, path, *, units: Mapping[str, str] | None = None, comment: str | None = None,
+                      time: str | None = None, overwrite: bool = False) -> Path:
+    """Write a record as CSV, Parquet or MDF 4 (by the suffix of ``path``), with units, atomically.
+
+    Parameters
+    ----------
+    data : Measurement or pandas.DataFrame
+        The record.  A Measurement keeps its units and its header comments
+        (``synthetic: ...`` lines stay).
+    path : str or Path
+        ``.csv``: ``#`` comment lines, then ``# units: name=unit, ...``, then
+        the table.  ``.parquet``: units in the schema metadata (per field and
+        as JSON under the key ``clutchlab``).  ``.mf4``: one channel group,
+        every column a channel with its unit, the comment in the header.
+    units : mapping of str to str, optional
+        Units of columns (default: those of the Measurement, of
+        ``frame.attrs["units"]``, or the unit the column name states).
+    comment : str, optional
+        Provenance lines appended to the header.
+    time : str, optional
+        Time column [s] (default: the Measurement's, else ``"time_s"``); an
+        MDF file needs one.
+    overwrite : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is false.
+    DataError
+        Unknown suffix, no time column for MDF, non-numeric column for MDF.
+    """
+    if isinstance(data, Measurement):
+        frame = data.frame
+        all_units = dict(data.units)
+        all_units.update(units or {})
+        comments = list(data.source.comments)
+        time = time or data.time_column
+    elif isinstance(data, pd.DataFrame):
+        frame = data
+        all_units = units
+        comments = []
+        time = time or "time_s"
+    else:
+        raise DataError(f"write_measurement: expected a Measurement or a pandas.DataFrame, got {type(data).__name__}")
+    if comment:
+        comments.extend(line for line in str(comment).splitlines())
+    col_units = _units_for(frame, all_units)
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix in CSV_SUFFIXES:
+        header = "\n".join(comments + [_UNITS_PREFIX + " " + ", ".join(f"{k}={v}" for k, v in col_units.items())])
+        return atomic_to_csv(frame, path, overwrite=overwrite, header_comment=header)
+    if suffix in PARQUET_SUFFIXES:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        check_writable(path, overwrite)
+        table = pa.Table.from_pandas(frame, preserve_index=False)
+        fields = [f.with_metadata({b"unit": col_units.get(f.name, "").encode("utf-8")}) for f in table.schema]
+        meta = dict(table.schema.metadata or {})
+        meta[_PARQUET_KEY] = json.dumps({"units": col_units, "comments": comments}).encode("utf-8")
+        table = table.cast(pa.schema(fields, metadata=meta))
+        buf = io.BytesIO()
+        pq.write_table(table, buf)
+        return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
+    if suffix in MDF_SUFFIXES:
+        if time is None or time not in frame.columns:
+            raise DataError(f"{path}: an MDF file needs a time column; {time!r} is not one of "
+                            f"{', '.join(map(str, frame.columns))}")
+        t = pd.to_numeric(frame[time], errors="coerce").to_numpy(dtype=float)
+        _check_time(t, str(path), time, "row")
+        channels = {}
+        for c in frame.columns:
+            if c == time:
+                continue
+            values = pd.to_numeric(frame[c], errors="coerce").to_numpy(dtype=float)
+            if (np.isnan(values) & frame[c].notna().to_numpy()).any():
+                raise DataError(f"{path}: column {c!r} is not numeric; MDF channels must be")
+            channels[str(c)] = values
+        return write_mdf(path, t, channels, col_units, comment="\n".join(comments), overwrite=overwrite)
+    raise DataError(f"{path}: unknown record format {path.suffix!r} (expected "
+                    f"{', '.join(CSV_SUFFIXES + PARQUET_SUFFIXES + MDF_SUFFIXES)})")

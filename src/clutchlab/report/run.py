@@ -1,0 +1,614 @@
+"""Report of a results folder: ``clutchlab report RUN_DIR``.
+
+A *run directory* is any folder of results: a CSV written by ``clutchlab
+eclutch simulate`` or ``clutchlab wet simulate`` (``#`` comment lines on top,
+``# synthetic: ...`` where the data come from a virtual rig), the Parquet
+chunks and ``manifest.json`` of ``clutchlab sweep``, MDF4 measurement files,
+or files put there by hand.  :func:`report_run_dir` finds every table in it
+and writes a self-contained HTML report with
+
+- for each table, figures: the channels against time where the table has a
+  time column (channels grouped by the unit their names end in), otherwise the
+  outputs scattered against the first (input) columns;
+- a metrics table per table (count, min, max, mean, final value per channel);
+- every ``*.toml`` file in the folder as a table (the parameters used);
+- the clutchlab version and the data's provenance (comment headers, Parquet
+  and MDF metadata, manifest fields), with synthetic data marked as such.
+
+Nothing here is specific to one subsystem; column names are used as found.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from ..errors import DataError
+from .html import Figure, Section, Table, Text, write_report
+
+__all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "DEFAULT_OUTPUT"]
+
+#: report folder written inside RUN_DIR when no output is given (skipped when scanning)
+DEFAULT_OUTPUT = "report"
+
+TABLE_SUFFIXES = {".csv": "CSV", ".parquet": "Parquet", ".mf4": "MDF4", ".mdf": "MDF4"}
+_TIME_NAMES = ("time_s", "time", "t_s", "t", "timestamp_s", "timestamps")
+#: unit suffixes of canonical channel names (longest first), used to group channels into axes
+_UNIT_SUFFIXES = ("rad_s2", "rad_s", "m_s2", "m_s", "kg_m2", "Nm", "N_m", "rpm", "bar", "kPa", "MPa", "Pa", "degC",
+                  "mm", "deg", "rad", "kW", "W", "J", "A", "V", "T", "Hz", "kg", "N", "C", "K", "m", "s", "pct")
+MAX_LINES_PER_AXES = 6
+MAX_AXES_PER_FIGURE = 4
+MAX_PLOT_POINTS = 4000
+MAX_SCATTER_POINTS = 5000
+MAX_SCATTER_OUTPUTS = 8
+MAX_SCATTER_INPUTS = 3
+_INDEX_NAMES = ("variant", "variant_id", "index", "id", "run", "run_id", "row", "chunk", "sample")
+#: a table of at most this many rows whose first column holds labels is shown as it is, not plotted
+MAX_LABELLED_ROWS = 50
+
+
+@dataclass
+class Dataset:
+    """A table found in a run directory.
+
+    Attributes
+    ----------
+    name : str
+        Path relative to the run directory (a folder for chunked Parquet).
+    format : str
+        ``CSV``, ``Parquet`` or ``MDF4``.
+    frame : pandas.DataFrame
+        The data.
+    provenance : list of str
+        Header comment lines, file metadata.
+    files : list of Path
+        The files read (several for Parquet chunks).
+    """
+
+    name: str
+    format: str
+    frame: pd.DataFrame
+    provenance: list[str] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+
+    @property
+    def synthetic(self) -> bool:
+        """Whether the provenance says the data are synthetic."""
+        return any(re.search(r"\bsynthetic\b", line, re.I) for line in self.provenance)
+
+    @property
+    def time_column(self) -> str | None:
+        """The time column (``time_s``, ``time``, ...) if the table has a numeric, increasing one."""
+        lower = {str(c).lower(): c for c in self.frame.columns}
+        for name in _TIME_NAMES:
+            col = lower.get(name)
+            if col is not None and pd.api.types.is_numeric_dtype(self.frame[col]):
+                t = self.frame[col].to_numpy(dtype=float)
+                t = t[np.isfinite(t)]
+                if t.size >= 2 and np.all(np.diff(t) >= 0):
+                    return col
+        return None
+
+    def numeric_columns(self) -> list[str]:
+        """Numeric (non-boolean) columns with at least one finite value."""
+        out = []
+        for c in self.frame.columns:
+            s = self.frame[c]
+            if pd.api.types.is_numeric_dtype(s) and not pd.api.types.is_bool_dtype(s):
+                if np.isfinite(s.to_numpy(dtype=float)).any():
+                    out.append(c)
+        return out
+
+
+# ---------------------------------------------------------------------- reading
+def _csv_header(path: Path) -> list[str]:
+    lines = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            if not line.startswith("#"):
+                break
+            lines.append(line[1:].strip())
+    return [line for line in lines if line]
+
+
+def _read_csv(path: Path, name: str) -> Dataset:
+    header = _csv_header(path)
+    try:
+        frame = pd.read_csv(path, comment="#")
+    except Exception as exc:  # pandas raises several parser errors
+        raise DataError(f"{path}: cannot read as CSV ({exc})") from None
+    return Dataset(name, "CSV", frame, header, [path])
+
+
+def _parquet_provenance(path: Path) -> list[str]:
+    import pyarrow.parquet as pq
+
+    meta = pq.read_schema(path).metadata or {}
+    out = []
+    for key, value in meta.items():
+        k = key.decode("utf-8", "replace")
+        if k == "pandas" or k.startswith("ARROW:"):
+            continue  # pandas' own schema record, not provenance
+        v = value.decode("utf-8", "replace")
+        out.append(f"{k}: {v if len(v) <= 300 else v[:300] + ' ...'}")
+    return out
+
+
+def _read_parquet(paths: list[Path], name: str) -> Dataset:
+    frames, prov = [], []
+    for p in paths:
+        try:
+            frames.append(pd.read_parquet(p))
+            for line in _parquet_provenance(p):
+                if line not in prov:
+                    prov.append(line)
+        except Exception as exc:  # pyarrow raises assorted errors on damaged files
+            raise DataError(f"{p}: cannot read as Parquet ({exc})") from None
+    frame = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
+    if len(paths) > 1:
+        prov.append(f"{len(paths)} Parquet chunks concatenated in file-name order")
+    return Dataset(name, "Parquet", frame, prov, list(paths))
+
+
+def _read_mdf(path: Path, name: str) -> Dataset:
+    try:
+        from asammdf import MDF
+
+        with MDF(path) as mdf:
+            frame = mdf.to_dataframe(time_from_zero=False, raw=False)
+            comment = str(getattr(mdf.header, "comment", "") or "")
+    except Exception as exc:  # asammdf raises many error types on foreign files
+        raise DataError(f"{path}: cannot read as MDF ({exc})") from None
+    frame = frame.reset_index().rename(columns={"timestamps": "time_s"})
+    prov = [line.strip() for line in re.sub(r"<[^>]+>", "\n", comment).splitlines() if line.strip()]
+    return Dataset(name, "MDF4", frame, prov, [path])
+
+
+def _skipped(path: Path, run_dir: Path, output: Path | None) -> bool:
+    rel = path.relative_to(run_dir)
+    if any(part.startswith(".") for part in rel.parts):
+        return True
+    if output is not None:
+        try:
+            path.resolve().relative_to(output.resolve())
+            return True
+        except ValueError:
+            pass
+    return False
+
+
+def find_datasets(run_dir, *, output=None, progress: Callable[[str], None] | None = None):
+    """Read every table in ``run_dir`` (recursively).
+
+    Parquet files of one folder that share their columns are one dataset
+    (the chunks of a sweep); every other file is its own dataset.  A dataset
+    with exactly the rows of another (chunks next to the results file they
+    were joined into) is kept once, the smaller number of files winning.  Files that
+    cannot be read are returned as ``(path, reason)`` in the second list, so a
+    report of a damaged folder still shows what could be read.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        Folder of results.
+    output : str or Path, optional
+        Report folder inside ``run_dir`` to leave out.
+    progress : callable, optional
+        Called with a message per file read.
+
+    Returns
+    -------
+    (list of Dataset, list of (Path, str))
+    """
+    run_dir = Path(run_dir)
+    output = Path(output) if output is not None else None
+    say = progress or (lambda msg: None)
+    files = sorted(p for p in run_dir.rglob("*") if p.is_file() and p.suffix.lower() in TABLE_SUFFIXES
+                   and not _skipped(p, run_dir, output))
+    datasets, failed = [], []
+    parquet_groups: dict[tuple, list[Path]] = {}
+    for n, path in enumerate(files, start=1):
+        rel = path.relative_to(run_dir).as_posix()
+        kind = TABLE_SUFFIXES[path.suffix.lower()]
+        say(f"reading {rel} ({n}/{len(files)})")
+        try:
+            if kind == "Parquet":
+                import pyarrow.parquet as pq
+
+                try:
+                    cols = tuple(pq.read_schema(path).names)
+                except Exception as exc:  # damaged file
+                    raise DataError(f"{path}: cannot read as Parquet ({exc})") from None
+                parquet_groups.setdefault((path.parent, cols), []).append(path)
+            elif kind == "CSV":
+                datasets.append(_read_csv(path, rel))
+            else:
+                datasets.append(_read_mdf(path, rel))
+        except DataError as exc:
+            failed.append((path, str(exc)))
+    for (folder, _cols), paths in parquet_groups.items():
+        name = paths[0].relative_to(run_dir).as_posix() if len(paths) == 1 else \
+            (folder.relative_to(run_dir).as_posix() or ".") + f"/ ({len(paths)} chunks)"
+        try:
+            datasets.append(_read_parquet(paths, name))
+        except DataError as exc:
+            failed.append((paths[0], str(exc)))
+    datasets.sort(key=lambda d: (len(d.files), d.name))
+    unique: list[Dataset] = []
+    for ds in datasets:  # the chunks of a sweep repeat its results file: keep the single file
+        twin = next((u for u in unique if list(u.frame.columns) == list(ds.frame.columns)
+                     and len(u.frame) == len(ds.frame) and u.frame.reset_index(drop=True).equals(ds.frame.reset_index(drop=True))), None)
+        if twin is None:
+            unique.append(ds)
+        else:
+            twin.provenance.append(f"same rows as {ds.name} (not shown again)")
+    unique.sort(key=lambda d: d.name)
+    return unique, failed
+
+
+# ---------------------------------------------------------------------- figures
+def _unit_of(column: str) -> str:
+    name = str(column)
+    for suffix in _UNIT_SUFFIXES:
+        if name.endswith("_" + suffix) or name.endswith("[" + suffix + "]"):
+            return suffix
+    return ""
+
+
+def _stem_of(column: str) -> str:
+    """Name without a trailing index (``i1`` -> ``i``, ``fn2`` -> ``fn``, ``omega_f`` -> ``omega``)."""
+    return re.sub(r"(?:_?\d+|_[A-Za-z])$", "", str(column)) or str(column)
+
+
+def _groups(columns: list[str]) -> list[tuple[str, list[str]]]:
+    """Channels grouped into axes by the unit their names end in.
+
+    Names without a unit suffix are grouped by their stem (``omega_f`` and
+    ``omega_r``, ``t1`` to ``t3``); each group has at most
+    ``MAX_LINES_PER_AXES`` lines.  Returns ``(label, columns)`` pairs, the
+    label being the unit (or ``""`` for a stem group).
+    """
+    keyed: dict[tuple[str, str], list[str]] = {}
+    for c in columns:
+        unit = _unit_of(c)
+        keyed.setdefault(("unit", unit) if unit else ("stem", _stem_of(c)), []).append(c)
+    out: list[tuple[str, list[str]]] = []
+    for (how, key), cols in keyed.items():
+        for i in range(0, len(cols), MAX_LINES_PER_AXES):
+            out.append((key if how == "unit" else "", cols[i:i + MAX_LINES_PER_AXES]))
+    order = {c: i for i, c in enumerate(columns)}
+    out.sort(key=lambda g: order[g[1][0]])
+    return out
+
+
+def _is_index(column) -> bool:
+    return str(column).lower() in _INDEX_NAMES
+
+
+def _labelled(ds: Dataset) -> bool:
+    """A small table whose first column holds labels (a summary such as ``output, unit, mean, ...``)."""
+    frame = ds.frame
+    if frame.empty or len(frame) > MAX_LABELLED_ROWS or ds.time_column is not None:
+        return False
+    first = frame[frame.columns[0]]
+    return not pd.api.types.is_numeric_dtype(first) and first.is_unique
+
+
+def _stem(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "table"
+
+
+def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
+    from ..plotting import new_figure
+
+    tcol = ds.time_column
+    channels = [c for c in ds.numeric_columns() if c != tcol]
+    if not channels:
+        return []
+    frame = ds.frame
+    stride = max(1, math.ceil(len(frame) / MAX_PLOT_POINTS))
+    t = frame[tcol].to_numpy(dtype=float)[::stride]
+    groups = _groups(channels)
+    figures = []
+    for k in range(0, len(groups), MAX_AXES_PER_FIGURE):
+        part = groups[k:k + MAX_AXES_PER_FIGURE]
+        fig, axes = new_figure(len(part), 1, width=8.0, height=1.9 * len(part) + 0.6, sharex=True, squeeze=False)
+        for ax, (unit, cols) in zip(axes[:, 0], part):
+            for c in cols:
+                ax.plot(t, frame[c].to_numpy(dtype=float)[::stride], lw=0.9, label=str(c))
+            ax.set_ylabel(f"[{unit}]" if unit else _stem_of(cols[0]), fontsize=8)
+            ax.legend(fontsize=7, loc="best")
+            ax.grid(alpha=0.3)
+            ax.tick_params(labelsize=7)
+        axes[-1, 0].set_xlabel(f"{tcol}", fontsize=8)
+        n = k // MAX_AXES_PER_FIGURE + 1
+        total = math.ceil(len(groups) / MAX_AXES_PER_FIGURE)
+        names = ", ".join(str(c) for _, cols in part for c in cols)
+        cap = f"{ds.name}: {names} against {tcol}" + (f" (part {n} of {total})" if total > 1 else "")
+        if stride > 1:
+            cap += f"; every {stride}th of {len(frame)} samples plotted"
+        if ds.synthetic:
+            cap += " [synthetic data]"
+        fig.tight_layout()
+        figures.append(Figure(f"{label}_timeseries_{n}", fig, cap))
+    return figures
+
+
+def _io_columns(ds: Dataset, manifest: dict) -> tuple[list[str], list[str]]:
+    numeric = [c for c in ds.numeric_columns() if not _is_index(c)]
+    declared = manifest.get("outputs") if isinstance(manifest.get("outputs"), list) else None
+    params = manifest.get("parameters")
+    params = list(params) if isinstance(params, (dict, list)) else []
+    if declared:
+        outputs = [c for c in numeric if c in declared]
+        if outputs:
+            inputs = [c for c in numeric if c in params] or [c for c in numeric if c not in outputs]
+            return inputs[:MAX_SCATTER_INPUTS], outputs[:MAX_SCATTER_OUTPUTS]
+    if len(numeric) < 2:
+        return [], []
+    n_in = max(1, min(MAX_SCATTER_INPUTS, len(numeric) // 2))
+    return numeric[:n_in], numeric[n_in:n_in + MAX_SCATTER_OUTPUTS]
+
+
+def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
+    from ..plotting import new_figure
+
+    inputs, outputs = _io_columns(ds, manifest)
+    if not inputs or not outputs:
+        return []
+    frame = ds.frame
+    if len(frame) > MAX_SCATTER_POINTS:
+        frame = frame.sample(MAX_SCATTER_POINTS, random_state=0)
+    fig, axes = new_figure(len(outputs), len(inputs), width=2.9 * len(inputs) + 1.0, height=2.1 * len(outputs) + 0.5,
+                           squeeze=False)
+    for i, out in enumerate(outputs):
+        for j, inp in enumerate(inputs):
+            ax = axes[i, j]
+            ax.scatter(frame[inp].to_numpy(dtype=float), frame[out].to_numpy(dtype=float), s=6, alpha=0.6)
+            ax.grid(alpha=0.3)
+            ax.tick_params(labelsize=7)
+            if i == len(outputs) - 1:
+                ax.set_xlabel(str(inp), fontsize=8)
+            if j == 0:
+                ax.set_ylabel(str(out), fontsize=8)
+    fig.tight_layout()
+    cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
+    if len(frame) < len(ds.frame):
+        cap += f"; {len(frame)} of {len(ds.frame)} rows drawn at random (seed 0)"
+    if ds.synthetic:
+        cap += " [synthetic data]"
+    return [Figure(f"{label}_scatter", fig, cap)]
+
+
+# ---------------------------------------------------------------------- tables
+def metrics_table(ds: Dataset) -> pd.DataFrame:
+    """Count of finite values, min, max, mean and final (last finite) value of every numeric channel of ``ds``.
+
+    Parameters
+    ----------
+    ds : Dataset
+        The table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per channel: ``channel, finite, non-finite, min, max, mean, final``.
+    """
+    rows = []
+    for c in ds.numeric_columns():
+        v = ds.frame[c].to_numpy(dtype=float)
+        ok = np.isfinite(v)
+        fin = v[ok]
+        rows.append({"channel": str(c), "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
+                     "min": float(fin.min()), "max": float(fin.max()), "mean": float(fin.mean()),
+                     "final": float(fin[-1])})
+    return pd.DataFrame(rows, columns=["channel", "finite", "non-finite", "min", "max", "mean", "final"])
+
+
+def _flatten(data, prefix=""):
+    for key, value in data.items():
+        name = f"{prefix}.{key}" if prefix else str(key)
+        if isinstance(value, dict):
+            yield from _flatten(value, name)
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for i, item in enumerate(value):
+                yield from _flatten(item, f"{name}[{i}]")
+        else:
+            yield name, value
+
+
+def _toml_value_text(value) -> str:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value_text(v) for v in value) + "]"
+    return str(value)
+
+
+def parameter_tables(run_dir: Path, output: Path | None) -> tuple[list, list[str]]:
+    """One report Table per ``*.toml`` in ``run_dir`` (and messages for files that cannot be read)."""
+    from ..errors import ParameterError
+    from ..params.base import load_toml
+    from ..params.registry import load_model_file
+
+    items, problems = [], []
+    for path in sorted(p for p in run_dir.rglob("*.toml") if p.is_file() and not _skipped(p, run_dir, output)):
+        rel = path.relative_to(run_dir).as_posix()
+        try:
+            data = load_toml(path)
+        except ParameterError as exc:
+            problems.append(str(exc))
+            continue
+        rows = []
+        for key, value in _flatten(data):
+            table, _, name = key.rpartition(".")
+            rows.append({"table": f"[{table}]" if table else "", "key": name, "value": _toml_value_text(value)})
+        try:
+            model, _ = load_model_file(path)
+            note = f"valid {model} parameters (clutchlab params check)"
+        except ParameterError:
+            note = "not a clutchlab model parameter file; shown as written"
+        items.append(Table(f"params_{_stem(rel)}", pd.DataFrame(rows, columns=["table", "key", "value"]),
+                           caption=f"{rel}: {note}"))
+    return items, problems
+
+
+def _read_manifests(run_dir: Path, output: Path | None) -> dict[str, dict]:
+    out = {}
+    for path in sorted(run_dir.rglob("manifest.json")):
+        if _skipped(path, run_dir, output):
+            continue
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise DataError(f"{path}: cannot read as JSON ({exc})") from None
+        if isinstance(data, dict):
+            out[path.relative_to(run_dir).as_posix()] = data
+    return out
+
+
+def _manifest_rows(name: str, data: dict) -> list[dict]:
+    rows = []
+    for key, value in _flatten(data):
+        text = json.dumps(value) if not isinstance(value, str) else value
+        rows.append({"file": name, "field": key, "value": text if len(text) <= 200 else text[:200] + " ..."})
+    return rows
+
+
+def _manifest_synthetic(data: dict) -> bool:
+    return bool(re.search(r"\bsynthetic\b", json.dumps(data), re.I))
+
+
+# ---------------------------------------------------------------------- assembly
+def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None = None) -> list[Section]:
+    """The report sections of a run directory (see the module docstring).
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        Folder of results.
+    output : str or Path, optional
+        Report folder inside ``run_dir`` to leave out when scanning.
+    progress : callable, optional
+        Called with a message per file read and per table plotted.
+
+    Returns
+    -------
+    list of Section
+        Run summary, one section per table, and the parameter files.
+
+    Raises
+    ------
+    DataError
+        ``run_dir`` does not exist or holds no table and no parameter file.
+    """
+    from .. import __version__
+
+    run_dir = Path(run_dir)
+    say = progress or (lambda msg: None)
+    if not run_dir.is_dir():
+        raise DataError(f"{run_dir}: no such run directory")
+    output = Path(output) if output is not None else None
+    say(f"scanning {run_dir}")
+    datasets, failed = find_datasets(run_dir, output=output, progress=progress)
+    manifests = _read_manifests(run_dir, output)
+    params, toml_problems = parameter_tables(run_dir, output)
+    if not datasets and not params and not manifests:
+        why = f"; unreadable: {failed[0][1]}" if failed else ""
+        raise DataError(f"{run_dir}: no result tables (*.csv, *.parquet, *.mf4) or parameter files (*.toml) found{why}")
+    manifest = next(iter(manifests.values()), {})
+    manifest_synth = any(_manifest_synthetic(m) for m in manifests.values())
+
+    for ds in datasets:  # sweep output (Parquet) is synthetic when its manifest says so
+        if ds.format == "Parquet" and manifest_synth and not ds.synthetic:
+            ds.provenance.insert(0, "synthetic according to the run manifest")
+    any_synth = any(d.synthetic for d in datasets) or manifest_synth
+
+    summary_rows = [{"item": "run directory", "value": str(run_dir.resolve())},
+                    {"item": "clutchlab version", "value": __version__}]
+    files = pd.DataFrame([{"dataset": d.name, "format": d.format, "rows": len(d.frame), "columns": len(d.frame.columns),
+                           "time column": d.time_column or "-", "synthetic": "yes" if d.synthetic else "no"}
+                          for d in datasets], columns=["dataset", "format", "rows", "columns", "time column", "synthetic"])
+    items = [Table("summary", pd.DataFrame(summary_rows)), Table("datasets", files, caption="Tables found")]
+    for path, reason in failed:
+        items.append(Text(f"Not read: {reason}"))
+    for problem in toml_problems:
+        items.append(Text(f"Parameter file not read: {problem}"))
+    rows = [r for name, data in manifests.items() for r in _manifest_rows(name, data)]
+    if rows:
+        items.append(Table("manifest", pd.DataFrame(rows), caption="Run manifest"))
+    prov = ("SYNTHETIC DATA: some or all of these results come from clutchlab's virtual rigs or simulations, "
+            "not from measurements (see each table's provenance)." if any_synth else
+            "No file in this folder declares itself synthetic; provenance as given by each table.")
+    sections = [Section("Run summary", items, provenance=prov, synthetic=any_synth)]
+
+    for n, ds in enumerate(datasets, start=1):
+        say(f"figures and metrics of {ds.name} ({n}/{len(datasets)}, {len(ds.frame)} rows)")
+        label = f"d{n}_{_stem(ds.name)}"
+        ds_items: list = []
+        if _labelled(ds):
+            ds_items.append(Table(label, ds.frame, caption=f"{ds.name}: a small labelled table, shown as it is"))
+        else:
+            if ds.time_column is not None:
+                ds_items += _time_series_figures(ds, label)
+            else:
+                ds_items += _scatter_figures(ds, label, manifest)
+            ds_items.append(Table(f"{label}_metrics", metrics_table(ds), caption="Metrics per channel"))
+        synth = ds.synthetic
+        lines = ds.provenance or ["no provenance recorded in the file"]
+        text = ("SYNTHETIC: " if synth else "") + f"{ds.format} {ds.name}; " + " | ".join(lines)
+        sections.append(Section(f"Data: {ds.name}", ds_items, provenance=text, synthetic=synth))
+    if params:
+        sections.append(Section("Parameters used", params))
+    return sections
+
+
+def report_run_dir(run_dir, output=None, *, overwrite: bool = False,
+                   progress: Callable[[str], None] | None = None, title: str | None = None) -> Path:
+    """Write a self-contained HTML report of a results folder.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        Folder of results (CSV, Parquet chunks, MDF4, TOML, manifest.json).
+    output : str or Path, optional
+        Report folder to write; default ``RUN_DIR/report`` (left out when
+        scanning, so a report can be written again with ``overwrite``).
+    overwrite : bool
+        Replace an existing report folder.
+    progress : callable, optional
+        Called with one message per step (``clutchlab report`` prints them on
+        stderr).
+    title : str, optional
+        Page title; default ``"clutchlab report: <RUN_DIR name>"``.
+
+    Returns
+    -------
+    pathlib.Path
+        The report's ``index.html``.
+
+    Raises
+    ------
+    DataError
+        No such folder, or nothing to report in it.
+    FileExistsError
+        The report folder exists and ``overwrite`` is false.
+    """
+    run_dir = Path(run_dir)
+    output = Path(output) if output is not None else run_dir / DEFAULT_OUTPUT
+    if output.exists() and not overwrite:
+        raise FileExistsError(f"{output} exists; pass overwrite=True (CLI: --force) to replace it")
+    sections = run_sections(run_dir, output=output, progress=progress)
+    if progress:
+        progress(f"writing {output}")
+    return write_report(sections, output, title=title or f"clutchlab report: {run_dir.resolve().name}",
+                        overwrite=overwrite, progress=progress)

@@ -1,0 +1,28 @@
+"""Parameter sweeps of any clutchlab model: grid or Monte Carlo, in resumable Parquet chunks.
+
+- :func:`load_spec` -- read and validate a sweep spec TOML, build the deterministic design
+- :func:`run_sweep` -- run (or resume) it locally, in worker processes or on a Dask cluster
+- :func:`read_results`, :func:`summarize` -- read a results folder, statistics per output
+- :data:`TARGETS`, :func:`register_target` -- model name -> ``"module:run_batch"`` registry
+
+See ``docs/sweeps.md``.
+"""
+
+from .targets import TARGETS, Target, register_target, resolve_target
+from .spec import SweepSpec, load_spec, spec_from_dict
+from .runner import SweepResult, compute_chunk, read_results, run_sweep, summarize
+
+__all__ = [
+    "TARGETS",
+    "Target",
+    "register_target",
+    "resolve_target",
+    "SweepSpec",
+    "load_spec",
+    "spec_from_dict",
+    "SweepResult",
+    "run_sweep",
+    "read_results",
+    "summarize",
+    "compute_chunk",
+]

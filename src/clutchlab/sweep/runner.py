@@ -1,0 +1,508 @@
+"""Run a sweep in chunks: locally, in worker processes or on a Dask cluster, resumable.
+
+Layout of a results folder::
+
+    results/
+      manifest.json            spec hash, n variants, chunk size, clutchlab version, provenance
+      chunks/chunk-00000.parquet   variant_id, parameter columns [SI], outputs -- one file per chunk
+      chunks/chunk-00001.parquet
+      ...
+      results.parquet          all chunks, sorted by variant_id (written when every chunk is done)
+      summary.csv              per output: count, n_nan, mean, std, min, quantiles, max
+      summary.png              outputs against the swept parameters
+
+Every file is written to a temporary sibling and moved into place
+(``os.replace``), so a chunk file either exists complete or not at all.  On
+start, a folder holding the same spec (same hash) is resumed: finished chunks
+are kept and only the missing ones run; temporary files left by a killed run
+are removed.  A folder holding a different spec is refused unless ``force``
+(which starts over).  Chunks are computed by the calling process (each chunk a
+compiled batch across the cores, where the model has one), by
+``workers`` processes (:class:`concurrent.futures.ProcessPoolExecutor`), or by
+a ``dask.distributed`` cluster; results are always written by the calling
+process.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import datetime
+import io
+import json
+import math
+import multiprocessing
+import shutil
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from ..errors import ClutchlabError, DataError, ParameterError
+from ..io import atomic_to_csv, atomic_write_bytes, atomic_write_text
+from .spec import VARIANT_ID, SweepSpec, load_spec
+
+__all__ = ["run_sweep", "SweepResult", "compute_chunk", "chunk_path", "read_results", "summarize",
+           "MANIFEST", "CHUNK_DIR", "PROVENANCE"]
+
+MANIFEST = "manifest.json"
+CHUNK_DIR = "chunks"
+RESULTS = "results.parquet"
+SUMMARY_CSV = "summary.csv"
+SUMMARY_PNG = "summary.png"
+FORMAT = "clutchlab-sweep/1"
+PROVENANCE = "synthetic: outputs of clutchlab model simulations (virtual rigs and bundled synthetic data, no measurement)"
+QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+
+#: compiled parallel kernels are not called from two threads at once (Dask workers may be threads)
+_RUN_LOCK = threading.Lock()
+
+
+def chunk_path(output, index: int, n_chunks: int) -> Path:
+    """Path of chunk ``index`` in the results folder ``output``: ``output/chunks/chunk-00017.parquet``.
+
+    The number has at least 5 digits, more if ``n_chunks`` needs them.
+    """
+    width = max(5, len(str(max(n_chunks - 1, 0))))
+    return Path(output) / CHUNK_DIR / f"chunk-{index:0{width}d}.parquet"
+
+
+def compute_chunk(target, scenario, outputs, variants: pd.DataFrame) -> pd.DataFrame:
+    """Run one chunk: ``target`` on ``variants`` in ``scenario``, keeping ``outputs``.
+
+    Returns a table with ``variant_id``, the parameter columns and the
+    outputs.  This is the task shipped to worker processes and Dask workers
+    (it only needs clutchlab and the target module importable there).
+    """
+    with _RUN_LOCK:
+        out = target.run(variants, scenario, outputs)
+    frame = variants.copy()
+    for name in outputs:
+        frame[name] = out[name].to_numpy(dtype=float)
+    frame = frame.reset_index()
+    frame[VARIANT_ID] = frame[VARIANT_ID].astype(np.int64)
+    return frame
+
+
+def _write_chunk(frame: pd.DataFrame, path: Path) -> None:
+    buf = io.BytesIO()
+    frame.to_parquet(buf, index=False, engine="pyarrow")
+    atomic_write_bytes(path, buf.getvalue(), overwrite=True)
+
+
+def _chunk_ok(path: Path, expected_ids: np.ndarray, columns) -> bool:
+    try:
+        frame = pd.read_parquet(path, engine="pyarrow")
+    except Exception:  # a file that does not parse is redone
+        return False
+    if list(frame.columns) != list(columns):
+        return False
+    return np.array_equal(frame[VARIANT_ID].to_numpy(), expected_ids)
+
+
+# ----------------------------------------------------------------- progress
+class _Bar:
+    """Chunks done / total with the time left: tqdm if installed, else a plain line on stderr."""
+
+    def __init__(self, total: int, done: int, enabled: bool):
+        self.total, self.done, self.enabled = total, done, enabled
+        self.t0 = time.perf_counter()
+        self.start_done = done
+        self._tqdm = None
+        if not enabled:
+            return
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            self._draw()
+        else:
+            self._tqdm = tqdm(total=total, initial=done, unit="chunk", desc="sweep", file=sys.stderr,
+                              dynamic_ncols=True, smoothing=0.1)
+
+    def _draw(self):
+        n_new = self.done - self.start_done
+        elapsed = time.perf_counter() - self.t0
+        left = (self.total - self.done) * elapsed / n_new if n_new else float("nan")
+        width = 30
+        filled = int(width * self.done / max(self.total, 1))
+        eta = f"{left:.0f} s left" if math.isfinite(left) else "time left unknown"
+        end = "\n" if self.done >= self.total else ""
+        print(f"\rsweep [{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} chunks, {eta}   ",
+              end=end, file=sys.stderr, flush=True)
+
+    def update(self):
+        self.done += 1
+        if not self.enabled:
+            return
+        if self._tqdm is not None:
+            self._tqdm.update(1)
+        else:
+            self._draw()
+
+    def close(self):
+        if self._tqdm is not None:
+            self._tqdm.close()
+
+
+# ----------------------------------------------------------------- folder handling
+@contextlib.contextmanager
+def _exclusive(output: Path):
+    """Hold an OS lock on ``output/.lock`` (released by the OS if the process dies)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on POSIX: no lock
+        yield
+        return
+    fh = open(output / ".lock", "a+")
+    try:
+        try:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise ClutchlabError(f"{output}: another sweep is running in this folder") from None
+        yield
+    finally:
+        fh.close()
+
+
+def _clean_temporaries(output: Path) -> list[Path]:
+    removed = []
+    for folder in (output, output / CHUNK_DIR):
+        if folder.is_dir():
+            for tmp in folder.glob(".*.tmp"):
+                tmp.unlink(missing_ok=True)
+                removed.append(tmp)
+    return removed
+
+
+def _manifest(spec: SweepSpec) -> dict:
+    return {
+        "format": FORMAT,
+        "spec_hash": spec.hash,
+        "spec_file": str(Path(spec.path).resolve()) if str(spec.path) != "<dict>" else "<dict>",
+        "model": spec.model,
+        "target": spec.target.path,
+        "scenario": spec.scenario.get("_source") if spec.scenario else "bundled default of the model",
+        "design": spec.kind,
+        "seed": spec.seed,
+        "n_variants": spec.n_variants,
+        "chunk_size": spec.chunk_size,
+        "n_chunks": spec.n_chunks,
+        "parameters": dict(spec.units),
+        "outputs": list(spec.outputs),
+        "clutchlab_version": __version__,
+        "provenance": PROVENANCE,
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    }
+
+
+def _prepare(spec: SweepSpec, output: Path, force: bool) -> None:
+    """Create, resume or (with ``force``) reset the results folder."""
+    mpath = output / MANIFEST
+    if output.exists() and not output.is_dir():
+        raise FileExistsError(f"{output} exists and is not a folder")
+    if mpath.exists():
+        try:
+            old = json.loads(mpath.read_text())
+            old_hash = old["spec_hash"]
+        except (ValueError, KeyError, TypeError):
+            old_hash = None
+        if old_hash == spec.hash and not force:
+            (output / CHUNK_DIR).mkdir(exist_ok=True)
+            return
+        if old_hash != spec.hash and not force:
+            raise FileExistsError(f"{output} holds a different sweep (spec hash {str(old_hash)[:12]} != "
+                                  f"{spec.hash[:12]}); pass force=True (CLI: --force) to start over")
+    elif output.exists() and any(p.name != ".lock" for p in output.iterdir()) and not force:
+        raise FileExistsError(f"{output} exists and is not a sweep folder (no {MANIFEST}); "
+                              "pass force=True (CLI: --force) to use it")
+    # start over: remove what a previous sweep wrote
+    if (output / CHUNK_DIR).is_dir():
+        shutil.rmtree(output / CHUNK_DIR)
+    for name in (RESULTS, SUMMARY_CSV, SUMMARY_PNG, MANIFEST):
+        (output / name).unlink(missing_ok=True)
+    (output / CHUNK_DIR).mkdir(parents=True, exist_ok=True)
+    atomic_write_text(mpath, json.dumps(_manifest(spec), indent=2) + "\n", overwrite=True)
+
+
+# ----------------------------------------------------------------- executors
+def _worker_init():
+    """One compiled thread per worker process (the processes are the parallelism)."""
+    try:
+        import numba
+
+        numba.set_num_threads(1)
+    except Exception:  # pragma: no cover - numba missing or layer not yet chosen
+        pass
+
+
+def _run_local(spec, todo, write, bar):
+    for k in todo:
+        write(k, compute_chunk(spec.target, spec.scenario, spec.outputs, spec.chunk(k)))
+        bar.update()
+
+
+def _run_processes(spec, todo, write, bar, workers):
+    ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold compiled thread pools
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+        futures = {pool.submit(compute_chunk, spec.target, spec.scenario, spec.outputs, spec.chunk(k)): k for k in todo}
+        try:
+            for fut in cf.as_completed(futures):
+                write(futures[fut], fut.result())
+                bar.update()
+        except BaseException:
+            for fut in futures:
+                fut.cancel()
+            raise
+
+
+def _run_dask(spec, todo, write, bar, scheduler):
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise ClutchlabError("--scheduler needs dask.distributed: pip install 'clutchlab[dask]'") from None
+    own = not hasattr(scheduler, "submit")
+    try:
+        client = Client(scheduler, timeout="20s") if own else scheduler
+    except OSError as exc:
+        raise ClutchlabError(f"cannot reach the Dask scheduler {scheduler!r} ({exc})") from None
+    try:
+        futures = {}
+        for k in todo:
+            fut = client.submit(compute_chunk, spec.target, spec.scenario, spec.outputs, spec.chunk(k),
+                                key=f"clutchlab-sweep-{spec.hash[:16]}-chunk-{k}", retries=1)
+            futures[fut] = k
+        try:
+            for fut in as_completed(list(futures)):
+                write(futures[fut], fut.result())
+                bar.update()
+        except BaseException:
+            client.cancel(list(futures))
+            raise
+    finally:
+        if own:
+            client.close()
+
+
+# ----------------------------------------------------------------- results
+@dataclass
+class SweepResult:
+    """Result of :func:`run_sweep`.
+
+    Attributes
+    ----------
+    output : Path
+        Results folder.
+    spec : SweepSpec
+        The spec that ran.
+    computed : list of int
+        Chunks computed by this call.
+    reused : list of int
+        Chunks found finished and kept (resume).
+    results : pandas.DataFrame
+        All variants (``variant_id``, parameters [SI], outputs), sorted by id.
+    summary : pandas.DataFrame
+        Statistics per output (index: output name).
+    """
+
+    output: Path
+    spec: SweepSpec
+    computed: list
+    reused: list
+    results: pd.DataFrame
+    summary: pd.DataFrame
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """All variants as a DataFrame (``results``)."""
+        return self.results
+
+
+def read_results(output) -> pd.DataFrame:
+    """Read every chunk of the results folder ``output``, sorted by ``variant_id`` (finished or interrupted sweep)."""
+    folder = Path(output) / CHUNK_DIR
+    files = sorted(folder.glob("chunk-*.parquet"))
+    if not files:
+        raise DataError(f"{output}: no chunk files in {folder}")
+    frame = pd.concat([pd.read_parquet(f, engine="pyarrow") for f in files], ignore_index=True)
+    return frame.sort_values(VARIANT_ID, kind="stable").reset_index(drop=True)
+
+
+def summarize(results: pd.DataFrame, outputs, units: dict | None = None) -> pd.DataFrame:
+    """Statistics of each of ``outputs`` over the rows of ``results``.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        One row per variant.
+    outputs : list of str
+        Columns to summarise.
+    units : dict, optional
+        Unit per output, copied into the table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``output``; columns ``unit``, ``count`` (finite values),
+        ``n_nan``, ``mean``, ``std`` (ddof 1), ``min``, ``q05``, ``q25``,
+        ``median``, ``q75``, ``q95`` (linear interpolation,
+        :func:`numpy.quantile`, over the finite values) and ``max``.
+    """
+    rows = []
+    for name in outputs:
+        v = results[name].to_numpy(dtype=float)
+        f = v[np.isfinite(v)]
+        row = {"output": name, "unit": (units or {}).get(name, ""), "count": int(f.size), "n_nan": int(v.size - f.size)}
+        if f.size:
+            q = np.quantile(f, QUANTILES)
+            row.update(mean=float(f.mean()), std=float(f.std(ddof=1)) if f.size > 1 else float("nan"),
+                       min=float(f.min()), q05=q[0], q25=q[1], median=q[2], q75=q[3], q95=q[4], max=float(f.max()))
+        else:
+            row.update({k: float("nan") for k in ("mean", "std", "min", "q05", "q25", "median", "q75", "q95", "max")})
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("output")
+
+
+def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    params = list(spec.parameters)[:6]
+    outs = list(spec.outputs)[:6]
+    fig, axes = plt.subplots(len(outs), len(params), figsize=(3.4 * len(params) + 0.6, 2.7 * len(outs) + 0.8),
+                             squeeze=False, constrained_layout=True)
+    alpha = float(np.clip(30.0 / max(len(results), 1) ** 0.5, 0.15, 0.9))
+    for i, out in enumerate(outs):
+        for j, par in enumerate(params):
+            ax = axes[i, j]
+            x = results[par].to_numpy(dtype=float)
+            y = results[out].to_numpy(dtype=float)
+            ax.scatter(x, y, s=8, alpha=alpha, color="tab:blue", edgecolors="none")
+            if spec.kind == "grid":
+                means = results.groupby(par)[out].mean()
+                ax.plot(means.index.to_numpy(dtype=float), means.to_numpy(dtype=float), color="tab:red", lw=1.2,
+                        label="mean over the other parameters")
+                if i == 0 and j == 0 and len(params) > 1:
+                    ax.legend(fontsize=7)
+            if i == len(outs) - 1:
+                ax.set_xlabel(f"{par} [{spec.units.get(par, '')}]", fontsize=8)
+            if j == 0:
+                ax.set_ylabel(f"{out} [{units.get(out, '')}]", fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+    fig.suptitle(f"sweep of {spec.model!r}: {spec.n_variants} variants ({spec.kind.replace('_', ' ')}; synthetic)",
+                 fontsize=10)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _finish(spec: SweepSpec, output: Path, make_plot: bool):
+    results = read_results(output)
+    info = spec.target.describe(spec.scenario)
+    units = info.outputs or {}
+    buf = io.BytesIO()
+    results.to_parquet(buf, index=False, engine="pyarrow")
+    atomic_write_bytes(output / RESULTS, buf.getvalue(), overwrite=True)
+    summary = summarize(results, spec.outputs, units)
+    header = (f"{PROVENANCE}\nclutchlab {__version__} sweep of {spec.model!r}, {spec.n_variants} variants, "
+              f"spec hash {spec.hash[:16]}\nquantiles linear over finite values; std with ddof=1")
+    atomic_to_csv(summary.reset_index(), output / SUMMARY_CSV, overwrite=True, header_comment=header)
+    if make_plot:
+        atomic_write_bytes(output / SUMMARY_PNG, _plot(results, spec, units), overwrite=True)
+    return results, summary
+
+
+def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force: bool = False,
+              progress: bool = True, plot: bool = True, log=None) -> SweepResult:
+    """Run (or resume) a sweep and write its results folder.
+
+    Parameters
+    ----------
+    spec : SweepSpec or str or Path
+        The spec (or its TOML file, read with :func:`~clutchlab.sweep.spec.load_spec`).
+    output : str or Path
+        Results folder (created; resumed if it holds the same spec).
+    workers : int, optional
+        Run chunks in this many worker processes (default: in this process,
+        each chunk one compiled batch across the cores where the model has one).
+    scheduler : str or dask.distributed.Client, optional
+        Address of a Dask scheduler (``"tcp://host:8786"``) or a client: the
+        chunks become Dask tasks; results are written here.
+    force : bool
+        Start over in a folder holding another (or the same) sweep.
+    progress : bool
+        Show a progress bar (chunks done / total, time left) on stderr.
+    plot : bool
+        Write ``summary.png``.
+    log : callable, optional
+        Called with one-line messages (resume, cleanup).
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    FileExistsError
+        The folder holds a different sweep (or other files) and ``force`` is false.
+    ParameterError
+        Bad spec, or a variant the model rejects (naming the spec file, chunk and variant).
+    """
+    if not isinstance(spec, SweepSpec):
+        spec = load_spec(spec)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"workers = {workers!r}: expected a whole number >= 1")
+    if workers is not None and scheduler is not None:
+        raise ParameterError("give either workers or scheduler, not both")
+    log = log or (lambda msg: None)
+    output = Path(output)
+    output.mkdir(parents=True, exist_ok=True)
+    with _exclusive(output):
+        _prepare(spec, output, force)
+        removed = _clean_temporaries(output)
+        if removed:
+            log(f"removed {len(removed)} partial file(s) left by an interrupted run")
+        columns = [VARIANT_ID, *spec.parameters, *spec.outputs]
+        done, todo = [], []
+        for k in range(spec.n_chunks):
+            path = chunk_path(output, k, spec.n_chunks)
+            if path.exists():
+                if _chunk_ok(path, spec.chunk(k).index.to_numpy(), columns):
+                    done.append(k)
+                    continue
+                log(f"{path.name} is damaged or foreign: computing it again")
+                path.unlink()
+            todo.append(k)
+        if done:
+            log(f"resuming: {len(done)} of {spec.n_chunks} chunks already done")
+
+        def write(k, frame):
+            _write_chunk(frame, chunk_path(output, k, spec.n_chunks))
+
+        bar = _Bar(spec.n_chunks, len(done), progress)
+        try:
+            if todo:
+                try:
+                    if scheduler is not None:
+                        _run_dask(spec, todo, write, bar, scheduler)
+                    elif workers is not None and workers > 1:
+                        _run_processes(spec, todo, write, bar, workers)
+                    else:
+                        _run_local(spec, todo, write, bar)
+                except ClutchlabError as exc:
+                    msg = str(exc)
+                    raise type(exc)(msg if msg.startswith(str(spec.path)) else f"{spec.path}: {msg}") from None
+        finally:
+            bar.close()
+        results, summary = _finish(spec, output, plot)
+    n_ids = results[VARIANT_ID].to_numpy()
+    if not np.array_equal(n_ids, np.arange(spec.n_variants)):
+        raise DataError(f"{output}: chunks do not hold every variant exactly once")
+    return SweepResult(output, spec, todo, done, results, summary)
