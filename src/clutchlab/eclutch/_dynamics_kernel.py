@@ -715,12 +715,13 @@ def outputs(T, Y, MODES, nz, imode, tin, vin, interp, par, mass, GA, Gb, d0, cx,
 @numba.njit(cache=True, parallel=True)
 def integrate_batch(Y0, MODES0, t_end, nz, imode, tin, vin, interp, breaks, PAR, MASS, mvec, typ,
                     GA_b, Gb_b, d0_b, cx, cf, cd, offsets, kinds, extraps, SCALE, unilateral,
-                    fr_on, fr_c0, FR_MUN, fr_nidx, fr_mup, fr_pidx, fr_rs, fr_c,
-                    rtol, atol, h0, h_max, max_steps, t_grid):
+                    fr_on, FR_C0, FR_MUN, fr_nidx, FR_MUP, fr_pidx, FR_RS, FR_C,
+                    rtol, atol, h0, h_max, max_steps, t_grid, t_event_tol, jac_every):
     """Integrate many variants in parallel (``prange``), one solver per variant, recorded on ``t_grid``.
 
-    Per-variant arrays carry a leading variant axis: ``Y0``, ``MODES0``, ``PAR``, ``MASS``, ``GA_b``,
-    ``Gb_b``, ``d0_b``, ``SCALE``, ``FR_MUN``.
+    Per-variant arrays carry a leading variant axis (``Y0``, ``MODES0``, ``PAR``, ``MASS``, ``GA_b``,
+    ``Gb_b``, ``d0_b``, ``SCALE``, ``FR_*``); the structure (curves, friction placement) is shared.
+    Returns states, outputs and element forces on the grid, statistics and event counts per variant.
     """
     nv = Y0.shape[0]
     n = Y0.shape[1]
@@ -734,11 +735,11 @@ def integrate_batch(Y0, MODES0, t_end, nz, imode, tin, vin, interp, breaks, PAR,
         T, Yv, _A, Mv, evt, _k, _i, st, _yf, _mf = integrate(
             Y0[v], MODES0[v], 0.0, t_end, nz, imode, tin, vin, interp, breaks, PAR[v], MASS[v], mvec, typ,
             GA_b[v], Gb_b[v], d0_b[v], cx, cf, cd, offsets, kinds, extraps, SCALE[v], unilateral,
-            fr_on, fr_c0, FR_MUN[v], fr_nidx, fr_mup, fr_pidx, fr_rs, fr_c, rtol, atol, h0, h_max, max_steps,
-            t_grid, 1e-9, 1)
+            fr_on, FR_C0[v], FR_MUN[v], fr_nidx, FR_MUP[v], fr_pidx, FR_RS[v], FR_C[v], rtol, atol, h0, h_max,
+            max_steps, t_grid, t_event_tol, jac_every)
         A, Fv = outputs(T, Yv, Mv, nz, imode, tin, vin, interp, PAR[v], MASS[v], GA_b[v], Gb_b[v], d0_b[v], cx, cf,
-                        cd, offsets, kinds, extraps, SCALE[v], unilateral, fr_on, fr_c0, FR_MUN[v], fr_nidx, fr_mup,
-                        fr_pidx, fr_rs, fr_c)
+                        cd, offsets, kinds, extraps, SCALE[v], unilateral, fr_on, FR_C0[v], FR_MUN[v], fr_nidx,
+                        FR_MUP[v], fr_pidx, FR_RS[v], FR_C[v])
         OUT[v] = Yv
         AUXB[v] = A
         FB[v] = Fv

@@ -55,7 +55,8 @@ from .network import GROUND, AxialNetwork, Lever, Spring, solve_static
 
 __all__ = [
     "FrictionParameters", "FrictionElement", "ClutchDynamics", "EClutch", "DynamicsResult",
-    "apply_wear_and_expansion", "pedal_reference", "actuator_test_rig", "EVENT_KINDS",
+    "apply_wear_and_expansion", "pedal_reference", "actuator_test_rig", "EVENT_KINDS", "simulate_batch",
+    "BatchResult",
 ]
 
 EVENT_KINDS = {K.EV_STICK: "stick", K.EV_BREAKAWAY: "breakaway", K.EV_REVERSAL: "slip reversal",
@@ -889,15 +890,7 @@ class EClutch:
             position, ``bearing_force_N = p A_sl``, clutch forces, torque),
             events and statistics.
         """
-        if not isinstance(inputs, Mapping) or len(inputs) != 1:
-            raise ParameterError("inputs must be a mapping with exactly one of 'voltage' or 'bearing_reference'")
-        (key, value), = inputs.items()
-        if key == "voltage":
-            imode, interp = K.VOLTAGE, 1
-        elif key == "bearing_reference":
-            imode, interp = K.POSITION, 0
-        else:
-            raise ParameterError(f"unknown input {key!r}; use 'voltage' [V] or 'bearing_reference' [m]")
+        imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
         t_end = float(t_end)
         _check_run(t_end, rtol, max_steps)
@@ -908,3 +901,124 @@ class EClutch:
         res = self.system.result(imode, tin, vin, interp, T, Y, MODES, evt, evk, evi, stats)
         _raise_status(res)
         return res
+
+
+def _input_mode(inputs):
+    if not isinstance(inputs, Mapping) or len(inputs) != 1:
+        raise ParameterError("inputs must be a mapping with exactly one of 'voltage' or 'bearing_reference'")
+    (key, value), = inputs.items()
+    if key == "voltage":
+        return K.VOLTAGE, 1, key, value
+    if key == "bearing_reference":
+        return K.POSITION, 0, key, value
+    raise ParameterError(f"unknown input {key!r}; use 'voltage' [V] or 'bearing_reference' [m]")
+
+
+@dataclasses.dataclass
+class BatchResult:
+    """Results of :func:`simulate_batch` on a common time grid.
+
+    Attributes
+    ----------
+    time : ndarray
+        Output grid [s].
+    outputs : dict of str to ndarray
+        ``(n_variants, n_times)`` arrays: ``bearing_position_m``, ``bearing_force_N`` (``p A_sl``),
+        ``pressure_Pa``, ``master_pressure_Pa``, ``motor_current_A``, ``motor_voltage_V``,
+        ``master_position_m``, ``normal_force_N``, ``torque_Nm``, ``input_work_J``, ``dissipated_J``,
+        ``friction_dissipated_J`` (and ``reference_m`` under position control).
+    stats : pandas.DataFrame
+        Accepted/rejected steps, right-hand sides, Jacobians, status and event count per variant.
+    """
+
+    time: np.ndarray
+    outputs: dict
+    stats: pd.DataFrame
+
+    def to_dataframe(self, variant: int) -> pd.DataFrame:
+        """The outputs of one variant as a table."""
+        data = {"time_s": self.time}
+        data.update({k: v[variant] for k, v in self.outputs.items()})
+        return pd.DataFrame(data)
+
+
+def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3, rtol: float = 1e-4,
+                   h_max: float = 0.01, max_steps: int = 500_000, event_tol: float = 1e-8,
+                   jac_every: int = 4) -> BatchResult:
+    """Simulate many E-clutch variants in parallel, one Rodas3 solver per variant (numba ``prange``).
+
+    Parameters
+    ----------
+    eclutches : sequence of EClutch
+        The variants, e.g. a sweep of lever ratio and stiffness scales.  They
+        must share the model structure (same nodes, elements and component
+        curves, same friction placement); scalar parameters, masses, lever
+        ratios, pre-strains, stiffness scales and actuator parameters may differ.
+    inputs : dict
+        As in :meth:`EClutch.simulate` (one input for every variant).
+    t_end, output_step : float
+        End time and output grid step [s].
+    rtol, h_max, max_steps, event_tol, jac_every
+        As in :meth:`EClutch.simulate`.
+
+    Returns
+    -------
+    BatchResult
+    """
+    ecs = list(eclutches)
+    if not ecs:
+        raise ParameterError("simulate_batch: no variants given")
+    for k, ec in enumerate(ecs):
+        if not isinstance(ec, EClutch):
+            raise ParameterError(f"simulate_batch: variant {k} is a {type(ec).__name__}, not an EClutch")
+    imode, interp, key, value = _input_mode(inputs)
+    tin, vin = _as_table(value, key)
+    t_end = float(t_end)
+    _check_run(t_end, rtol, max_steps)
+    grid = _grid(output_step, t_end)
+    s0 = ecs[0].system
+    shared = ("cx", "cf", "cd", "offsets", "kinds", "extraps", "unilateral", "fr_on", "fr_nidx", "fr_pidx", "mvec")
+    for k, ec in enumerate(ecs[1:], start=1):
+        s = ec.system
+        if s.nz != s0.nz or len(s.element_names) != len(s0.element_names):
+            raise ParameterError(f"simulate_batch: variant {k} has another model structure than variant 0")
+        for name in shared:
+            a, b = getattr(s, name), getattr(s0, name)
+            if a.shape != b.shape or not np.array_equal(a, b):
+                raise ParameterError(f"simulate_batch: variant {k} differs from variant 0 in {name!r} "
+                                     "(component curves and friction placement must be shared)")
+    Y0 = np.empty((len(ecs), s0.n))
+    M0 = np.empty((len(ecs), s0.nz), dtype=np.int64)
+    for k, ec in enumerate(ecs):
+        y, m = ec.system.initial_state(ec.rest_position)
+        Y0[k], M0[k] = y, m
+    st = [ec.system for ec in ecs]
+    stack = lambda name: np.ascontiguousarray(np.stack([getattr(s, name) for s in st]))  # noqa: E731
+    asm = lambda name: np.ascontiguousarray(np.stack([s.asm[name] for s in st]))  # noqa: E731
+    breaks = np.unique(tin[(tin > 0) & (tin < t_end)])
+    OUT, AUX, F, STATS, NEV = K.integrate_batch(
+        Y0, M0, t_end, s0.nz, imode, tin, vin, interp, breaks, stack("par"), stack("mass"), s0.mvec, s0.typ,
+        asm("GA"), asm("Gb"), asm("d0"), s0.cx, s0.cf, s0.cd, s0.offsets, s0.kinds, s0.extraps, stack("scale"),
+        s0.unilateral, s0.fr_on, stack("fr_c0"), stack("fr_mun"), s0.fr_nidx, stack("fr_mup"), s0.fr_pidx,
+        stack("fr_rs"), stack("fr_c"), float(rtol), s0.atol, 1e-5, float(h_max), int(max_steps), grid,
+        float(event_tol), int(jac_every))
+    nz = s0.nz
+    b0 = 2 * nz
+    a_sl = np.array([ec.actuator.slave_area for ec in ecs])[:, None]
+    r_eff = np.array([ec.clutch.r_eff * ec.clutch.mu for ec in ecs])[:, None]
+    nf = s0.element_names.index(ecs[0].clutch.network.normal_force)
+    out = {
+        "bearing_position_m": OUT[:, :, 1], "bearing_velocity_m_s": OUT[:, :, nz + 1],
+        "pressure_Pa": OUT[:, :, b0 + 2], "master_pressure_Pa": OUT[:, :, b0],
+        "bearing_force_N": OUT[:, :, b0 + 2] * a_sl, "bearing_force_clutch_N": AUX[:, :, 1],
+        "motor_current_A": OUT[:, :, b0 + 3], "motor_voltage_V": AUX[:, :, 0],
+        "master_position_m": OUT[:, :, 0], "normal_force_N": F[:, :, nf], "torque_Nm": 2.0 * F[:, :, nf] * r_eff,
+        "input_work_J": OUT[:, :, b0 + 5], "dissipated_J": OUT[:, :, b0 + 6],
+        "friction_dissipated_J": OUT[:, :, b0 + 7],
+    }
+    if imode == K.POSITION:
+        out["reference_m"] = AUX[:, :, 2]
+    stats = pd.DataFrame(STATS, columns=["accepted_steps", "rejected_steps", "rhs_evaluations", "jacobians",
+                                         "status"])
+    stats["events"] = NEV
+    return BatchResult(grid, out, stats)

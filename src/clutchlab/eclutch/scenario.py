@@ -43,7 +43,7 @@ from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionParamete
                        pedal_reference)
 from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
 
-__all__ = ["Scenario", "load_scenario", "run_scenario", "INPUT_KINDS"]
+__all__ = ["Scenario", "load_scenario", "scenario_from_dict", "run_scenario", "INPUT_KINDS"]
 
 INPUT_KINDS = {"voltage": "V", "bearing_reference": "m", "pedal": "1", "bearing_position": "m"}
 _TABLES = ("scenario", "input", "eclutch", "eclutch_actuator", "eclutch_friction", "offsets")
@@ -113,8 +113,13 @@ def _number_list(raw, unit, where):
 
 def load_scenario(path) -> Scenario:
     """Read a scenario TOML file (see the module documentation for the format)."""
-    data = load_toml(path)
-    src = str(path)
+    return scenario_from_dict(load_toml(path), source=str(path))
+
+
+def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
+    """A :class:`Scenario` from the tables of a scenario file (``source`` names it in errors)."""
+    src = source
+    data = {k: v for k, v in data.items() if not k.startswith("_")}
     unknown = [k for k in data if k not in _TABLES]
     if unknown:
         raise ParameterError(f"{src}: unknown table [{unknown[0]}] (known: {', '.join(_TABLES)})")
