@@ -123,6 +123,9 @@ class EClutchCoSimulation(CoSimulation):
         """Advance from ``t`` to ``t + dt`` with the inputs held; return the outputs at ``t + dt``."""
         if not (np.isfinite(dt) and dt > 0):
             raise ParameterError(f"communication step dt = {dt!r} s must be finite and > 0")
+        if abs(t - self.t) > 1e-9 * max(1.0, abs(t)):
+            raise SimulationError(f"do_step at t = {t!r} s but the E-clutch is at t = {self.t!r} s "
+                                  "(steps must be contiguous; call reset() to start again)")
         s = self.eclutch.system
         tin, vin = self._table(t, inputs)
         interp = 0 if self.imode == K.POSITION else 1

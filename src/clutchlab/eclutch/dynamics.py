@@ -362,6 +362,10 @@ class DynamicsResult:
         Located events: ``time_s``, ``event``, ``where``.
     stats : dict
         Accepted and rejected steps, right-hand-side evaluations, Jacobians.
+    energy : pandas.DataFrame or None
+        Energy bookkeeping per recorded point [J]: ``input_work_J``,
+        ``dissipated_J``, ``friction_dissipated_J`` (integrated with the
+        states) and ``stored_J`` (computed from the states).
     """
 
     time: np.ndarray

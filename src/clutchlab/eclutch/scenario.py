@@ -112,12 +112,26 @@ def _number_list(raw, unit, where):
 
 
 def load_scenario(path) -> Scenario:
-    """Read a scenario TOML file (see the module documentation for the format)."""
+    """Read a scenario TOML file (see the module documentation for the format).
+
+    Parameters
+    ----------
+    path : str or Path
+        Scenario TOML file; errors name it with the table, key and value at fault.
+    """
     return scenario_from_dict(load_toml(path), source=str(path))
 
 
 def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
-    """A :class:`Scenario` from the tables of a scenario file (``source`` names it in errors)."""
+    """A :class:`Scenario` from the tables of a scenario file.
+
+    Parameters
+    ----------
+    data : dict
+        Tables as read from TOML (keys starting with ``_`` are ignored).
+    source : str
+        Name of the file, used in error messages.
+    """
     src = source
     data = {k: v for k, v in data.items() if not k.startswith("_")}
     unknown = [k for k in data if k not in _TABLES]
@@ -189,7 +203,15 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
 
 
 def run_scenario(scenario: Scenario, progress=None) -> DynamicsResult:
-    """Simulate a scenario: the E-clutch (actuator + clutch), or the clutch alone for ``bearing_position``."""
+    """Simulate a scenario: the E-clutch (actuator + clutch), or the clutch alone for ``bearing_position``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to simulate (:func:`load_scenario`).
+    progress : callable, optional
+        Called with a message string as the run proceeds.
+    """
     if progress:
         progress(f"building Model {scenario.model} and the actuator ...")
     model = scenario.clutch_model()

@@ -224,6 +224,13 @@ def _events(y, aux, imode, pv, pa, gv):
         gv[5] = pv[17] * aux[AUX_CAP] - abs(aux[AUX_TC])  # 1.02 T_cap < |T_lock|
 
 
+#: layout of the ``carry`` vector of :func:`bench_advance` (what survives between two calls)
+CARRY_T, CARRY_H, CARRY_PLEN, CARRY_PU, CARRY_CLEN, CARRY_CU, CARRY_FRESH = range(7)
+CARRY_K1 = 7
+CARRY_AUX = CARRY_K1 + NY
+N_CARRY = CARRY_AUX + N_AUX
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
                  thr_t, thr_v, vf_t, vf_v, vr_t, vr_v, tm_thr, tm_v, tm_t, t_ref_override,
@@ -235,15 +242,53 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
     ``out[k]`` holds the state and outputs at each controller sample; ``ev[k]``
     = (time, kind, arm mode after, coupling mode after).  status 0: done,
     1: hysteresis memory full, 2: step size underflow, 3: more than ``max_steps`` steps.
+    A fresh run of :func:`bench_advance` from t = 0 (empty hysteresis memories).
+    """
+    y = y0.copy()
+    imode = imode0.copy()
+    carry = np.zeros(N_CARRY)
+    carry[CARRY_H] = min(1e-4, pv[18])
+    carry[CARRY_PU] = pgrid[0]
+    carry[CARRY_CU] = cgrid[0]
+    carry[CARRY_FRESH] = 1.0
+    return bench_advance(y, imode, carry, 0, True, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
+                         thr_t, thr_v, vf_t, vf_v, vr_t, vr_v, tm_thr, tm_v, tm_t, t_ref_override,
+                         ptab, pgrid, pgaps, pstack, ppref, ctab, cgrid, cgaps, cstack, cpref,
+                         rtol, atol, out, ev, max_steps)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
+                  thr_t, thr_v, vf_t, vf_v, vr_t, vr_v, tm_thr, tm_v, tm_t, t_ref_override,
+                  ptab, pgrid, pgaps, pstack, ppref,
+                  ctab, cgrid, cgaps, cstack, cpref,
+                  rtol, atol, out, ev, max_steps):
+    """Advance the bench model over ``out.shape[0]`` controller samples from sample ``k0`` (resumable).
+
+    ``y`` (states) and ``imode`` (armature mode, coupling mode, slip
+    direction) are updated in place, ``carry`` (see ``CARRY_*``: time, step
+    size, hysteresis-memory lengths and last inputs, derivative and outputs
+    at the current point) too; ``pv[21:23]`` and ``pv[30:32]`` (command,
+    torque reference, LuGre memory) and the memory stacks persist in their
+    arrays.  Row ``k`` of ``out`` is sample ``k0 + k`` at ``(k0 + k) *
+    sample_time``.  With ``control_last`` false the controller does not run
+    at the last sample (it is left to the next call, whose inputs may
+    differ), so a chain of calls with ``control_last=False`` reproduces one
+    uninterrupted call exactly.  ``carry[CARRY_FRESH]`` = 1 evaluates the
+    derivative at the first sample (a fresh start).  Returns ``(n_out,
+    n_events, n_steps, status)`` as :func:`bench_kernel`.
     """
     ts = pv[18]
     n_samples = out.shape[0]
-    y = y0.copy()
-    imode = imode0.copy()
     dy = np.zeros(NY)
     aux = np.zeros(N_AUX)
     tmp3 = np.zeros(6)
     k1 = np.zeros(NY)
+    for q in range(NY):
+        k1[q] = carry[CARRY_K1 + q]
+    for q in range(N_AUX):
+        aux[q] = carry[CARRY_AUX + q]
+    fresh = carry[CARRY_FRESH] > 0.5
     k2 = np.zeros(NY)
     k3 = np.zeros(NY)
     k4 = np.zeros(NY)
@@ -265,19 +310,19 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
     pw = np.zeros(4)
     pw[3] = np.nan
     pcomb = np.zeros((1, ptab.shape[1], ptab.shape[2], 4))
-    plen = 0
-    pu = pgrid[0]
-    clen = 0
-    cu = cgrid[0]
+    plen = int(carry[CARRY_PLEN])
+    pu = carry[CARRY_PU]
+    clen = int(carry[CARRY_CLEN])
+    cu = carry[CARRY_CU]
     n_ev = 0
     n_steps = 0
-    t = 0.0
-    h = min(1e-4, ts)
+    t = carry[CARRY_T]
+    h = carry[CARRY_H]
     gain = 1.0 + (2.0 * geo[11] * geo[1] * geo[7] * geo[10] + 2.0 * geo[11] * geo[2] * geo[8]) / (
         3.0 * geo[12] - 2.0 * geo[11] * geo[2] * geo[8])  # T_c / T_k1 by Eq. 15
     gap_c = pa[5] - pa[4]
     for ks in range(n_samples):
-        t_s = ks * ts
+        t_s = (k0 + ks) * ts
         # ---- controller sample: torque reference (Eq. 31) -> F_n1 -> magnet force -> inverse Preisach (Eqs. 6-7)
         vx = y[0] / pv[1] * pv[5]
         thr = _interp(thr_t, thr_v, t_s)
@@ -288,17 +333,22 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
         tk1 = max(t_ref, 0.0) / gain
         fn1_req = tk1 / (2.0 / 3.0 * geo[0] * geo[6] * geo[9])  # [1], Eq. 13
         fm_req = fn1_req + pa[2] + pa[1] * pa[4] if t_ref > 0.0 else 0.0  # [1], Eq. 11 solved for F_m
-        gap_weights(cgaps, min(max(gap_c, cgaps[0]), cgaps[cgaps.shape[0] - 1]), idx, w)
-        if clen + 2 > cstack.shape[0] or plen + 2 > pstack.shape[0]:
-            return ks, n_ev, n_steps, 1
-        i_new, ok = invert_one(ctab, cgrid, cstack, cpref, clen, cu, fm_req, idx, w, 1e-9)
-        clen = commit(ctab, cgrid, cstack, cpref, clen, cu, i_new)
-        cu = i_new
-        pv[21] = i_new
-        pv[22] = t_ref
+        if ks < n_samples - 1 or control_last:
+            gap_weights(cgaps, min(max(gap_c, cgaps[0]), cgaps[cgaps.shape[0] - 1]), idx, w)
+            if clen + 2 > cstack.shape[0] or plen + 2 > pstack.shape[0]:
+                return ks, n_ev, n_steps, 1
+            i_new, ok = invert_one(ctab, cgrid, cstack, cpref, clen, cu, fm_req, idx, w, 1e-9)
+            clen = commit(ctab, cgrid, cstack, cpref, clen, cu, i_new)
+            cu = i_new
+            pv[21] = i_new
+            pv[22] = t_ref
+        else:  # the next call runs the controller at this sample with its own inputs
+            i_new = pv[21]
+            t_ref = pv[22]
+            ok = True
         # ---- record the sample.  After the first sample, k1 and aux already hold the derivative and the
         # outputs at (t, y) from the last stage of the previous step; only dy[5] depends on the new command
-        if ks == 0:
+        if ks == 0 and fresh:
             _rhs(t, y, dy, aux, imode, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
                  thr_t, thr_v, vf_t, vf_v, vr_t, vr_v, ptab, pgrid, pgaps, pstack, ppref, plen, pu, tmp3, pidx, pw, pcomb)
         else:
@@ -319,7 +369,7 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
         row[25] = 1.0 if ok else 0.0
         if ks == n_samples - 1:
             break
-        t_next = (ks + 1) * ts
+        t_next = (k0 + ks + 1) * ts
         # ---- integrate to the next sample (the recorded evaluation is the first stage)
         for q in range(NY):
             k1[q] = dy[q]
@@ -482,4 +532,15 @@ def bench_kernel(y0, t_end, pv, pa, geo, fmap_v, fmap_t, fmap_mu, fric_mode,
                     gv0[q] = gv1[q]
                 for q in range(N_AUX):
                     aux[q] = auxm[q]
+    carry[CARRY_T] = t
+    carry[CARRY_H] = h
+    carry[CARRY_PLEN] = plen
+    carry[CARRY_PU] = pu
+    carry[CARRY_CLEN] = clen
+    carry[CARRY_CU] = cu
+    carry[CARRY_FRESH] = 0.0
+    for q in range(NY):
+        carry[CARRY_K1 + q] = dy[q]
+    for q in range(N_AUX):
+        carry[CARRY_AUX + q] = aux[q]
     return n_samples, n_ev, n_steps, 0

@@ -124,6 +124,10 @@ class VehicleParameters(ParameterSet):
                 f"differs from wheelbase = {self.wheelbase:.4f} m")
         if not self.plate_inner_radius < self.plate_outer_radius:
             raise ParameterError("VehicleParameters: plate_inner_radius must be < plate_outer_radius")
+        ratios = self.gear_ratios
+        if any(not a > b for a, b in zip(ratios, ratios[1:])):
+            raise ParameterError(
+                f"VehicleParameters: gear_ratios = {list(ratios)!r}: must fall strictly from 1st to top gear")
 
     def axle_loads(self) -> tuple[float, float]:
         """Static front and rear axle loads [N]."""

@@ -310,17 +310,44 @@ def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
     the final state), writes states (and outputs if ``want_aux``) at ``ts``
     and the located events into ``ev_t``/``ev_k``.  Returns (number of events,
     accepted steps, status, peak pack temperature, first lock-up time or NaN);
-    status 0 ok, 1 step limit, 2 step-size underflow.
+    status 0 ok, 1 step limit, 2 step-size underflow.  The starting mode
+    follows the sign of the initial slip speed; see :func:`_integrate_from`.
+    """
+    nev, steps, status, peak, t_lock, mode, hstep = _integrate_from(
+        p, y0, 0.0, -1, 0.0, t_end, ts, rtol, atol, hmax, max_steps,
+        fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
+        out_y, out_aux, out_mode, ev_t, ev_k, want_aux)
+    return nev, steps, status, peak, t_lock
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _integrate_from(p, y0, t0, mode0, h0, t_end, ts, rtol, atol, hmax, max_steps,
+                    fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
+                    out_y, out_aux, out_mode, ev_t, ev_k, want_aux):
+    """Dormand-Prince 5(4) from ``(t0, y0, mode0)`` to ``t_end`` (resumable form of :func:`_integrate`).
+
+    ``mode0`` < 0 derives the starting mode from the sign of the slip speed
+    (the fresh start of :func:`_integrate`); ``mode0`` in {SLIP, STICK,
+    SLIP_NEG} resumes a run stopped earlier in that mode (co-simulation,
+    :mod:`clutchlab.fmu`).  On a resume in *stick* the break-away condition
+    is checked at ``t0`` itself, because a step of the slip reference at the
+    communication point can raise the drive torque above the static capacity
+    at once.  ``h0`` > 0 is the first trial step (the step size proposed at
+    the end of the previous call), else it is estimated.  Returns (number of
+    events, accepted steps, status, peak pack temperature, first lock-up
+    time or NaN, mode at ``t_end``, proposed next step).
     """
     n = N_STATE
     y = y0.copy()
-    if y[S_W] > 0.0:
+    if mode0 >= 0:
+        mode = mode0
+    elif y[S_W] > 0.0:
         mode = SLIP
     elif y[S_W] < 0.0:
         mode = SLIP_NEG
     else:
         mode = STICK
-    t = 0.0
+    t = t0
     kk = np.zeros((7, n))
     k1 = kk[0]
     k3 = kk[2]
@@ -359,7 +386,19 @@ def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
     aux1 = np.empty(N_AUX)
     auxn = np.empty(N_AUX)
     _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, k1, aux)
-    hstep = initial_step(y, k1, rtol, atol, t_end, 5)
+    nev = 0
+    if mode0 == STICK and abs(aux[A_TD]) > aux[A_CAP]:
+        # resumed in stick with the drive torque already above the capacity: break away at t0
+        mode = SLIP if aux[A_TD] > 0.0 else SLIP_NEG
+        if nev < ev_t.shape[0]:
+            ev_t[nev] = t
+            ev_k[nev] = EV_BREAKAWAY
+            nev += 1
+        _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, k1, aux)
+    if h0 > 0.0:
+        hstep = h0
+    else:
+        hstep = initial_step(y, k1, rtol, atol, t_end - t, 5)
     if hstep > hmax:
         hstep = hmax
     ns = ts.shape[0]
@@ -370,7 +409,6 @@ def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
             out_aux[isamp, :] = aux
         out_mode[isamp] = mode
         isamp += 1
-    nev = 0
     steps = 0
     status = 0
     prev_rej = False
@@ -380,7 +418,9 @@ def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
         if steps >= max_steps:
             status = 1
             break
-        if hstep > t_end - t:
+        if hstep > (t_end - t) * (1.0 - 1e-9):
+            # last step: also stretched by up to 1e-9 relative so that no rounding remainder is left
+            # (a resumed run whose end time is one ulp past t + max_step would otherwise underflow)
             hstep = t_end - t
         if hstep < 1e-14 * max(1.0, t):
             status = 2
@@ -511,7 +551,7 @@ def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
             peak = y[S_T]
     for i in range(n):
         y0[i] = y[i]
-    return nev, steps, status, peak, t_lock
+    return nev, steps, status, peak, t_lock, mode, hstep
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")

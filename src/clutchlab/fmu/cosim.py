@@ -1,0 +1,784 @@
+"""Co-simulation wrappers: the models as step-by-step slaves (FMI 2.0 co-simulation semantics).
+
+A :class:`CoSimulation` is what :mod:`clutchlab.fmu.export` wraps into an
+FMU: named real inputs, outputs and parameters (:class:`Variable`), and
+``do_step(t, dt, inputs)`` that advances the compiled model from ``t`` to
+``t + dt`` with the inputs held constant (zero-order hold) and returns the
+outputs at ``t + dt``.  Each step *continues* the compiled integration from
+the stored state (states, mode, step size, hysteresis memories) -- nothing is
+re-simulated from t = 0.
+
+* :class:`WetCoSimulation` -- the wet-clutch bench of Shin, Kim and Choi
+  ([1], Eqs. 1-8) with the engagement dynamics of
+  :mod:`clutchlab.wet.engagement`; resumed with
+  ``engagement._integrate_from``.
+* :class:`EmtcCoSimulation` -- the AWD vehicle with the EMTC on the drum
+  bench ([2], Eqs. 8-31) of :mod:`clutchlab.emtc.bench`; resumed with
+  ``_bench_kernel.bench_advance``.
+* ``EClutchCoSimulation`` (``clutchlab.eclutch.cosim``) -- the E-clutch
+  dynamics, written against the same protocol.
+
+:data:`COSIMULATIONS` maps the model names to ``"module:Class"`` strings,
+imported lazily by :func:`load_cosimulation`.
+
+References
+----------
+.. [1] S. Shin, D.-H. Kim, S. B. Choi, "Apparatus for identification of
+   frictional and thermal characteristics of a wet clutch" (KAIST).
+.. [2] Electromagnetic hysteresis based dynamics model of an electromagnetic
+   torque controlled coupling (EMTC), Processes 7 (2019) 557,
+   doi:10.3390/pr7090557
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import importlib
+import math
+
+import numpy as np
+
+from ..errors import ParameterError, SimulationError
+from . import COSIMULATIONS
+
+__all__ = [
+    "Variable",
+    "CoSimulation",
+    "WetCoSimulation",
+    "EmtcCoSimulation",
+    "COSIMULATIONS",
+    "load_cosimulation",
+    "parameter_set_variables",
+    "build_parameter_set",
+    "fmi_unit",
+]
+
+def load_cosimulation(name: str) -> type:
+    """The co-simulation class registered under ``name`` in :data:`COSIMULATIONS`.
+
+    Raises
+    ------
+    ParameterError
+        Unknown name, or the class cannot be imported.
+    """
+    if name not in COSIMULATIONS:
+        raise ParameterError(f"model = {name!r}: unknown (known: {', '.join(COSIMULATIONS)})")
+    module_name, _, class_name = COSIMULATIONS[name].partition(":")
+    try:
+        cls = getattr(importlib.import_module(module_name), class_name)
+    except (ImportError, AttributeError) as exc:
+        raise ParameterError(f"model = {name!r}: cannot import {COSIMULATIONS[name]} ({exc})") from None
+    return cls
+
+
+def fmi_unit(unit: str) -> str:
+    """Unit string in the Modelica/FMI notation (``"N*m"`` -> ``"N.m"``, ``"kg*m^2"`` -> ``"kg.m2"``).
+
+    Parameters
+    ----------
+    unit : str
+        Unit in pint notation, as in the parameter-set field metadata.
+    """
+    return unit.replace("*", ".").replace("^", "").replace(" ", "")
+
+
+@dataclasses.dataclass(frozen=True)
+class Variable:
+    """A real, scalar variable of a co-simulation.
+
+    Parameters
+    ----------
+    name : str
+        FMI name (structured naming: ``clutch.k1``, ``vehicle.gear_ratios[2]``).
+    unit : str
+        Unit in Modelica notation (``"N.m"``, ``"rad/s"``, ``"degC"``, ``"1"``);
+        values are SI except temperatures in degC, as everywhere in clutchlab.
+    start : float
+        Start (default) value in ``unit``.
+    description : str
+        One line for the modelDescription.
+    """
+
+    name: str
+    unit: str
+    start: float
+    description: str = ""
+
+    def __post_init__(self):
+        if not self.name or not isinstance(self.name, str):
+            raise ParameterError(f"Variable.name = {self.name!r}: expected a non-empty string")
+        if not math.isfinite(float(self.start)):
+            raise ParameterError(f"Variable {self.name!r}: start = {self.start!r} is not finite")
+        object.__setattr__(self, "start", float(self.start))
+
+
+class CoSimulation(abc.ABC):
+    """Protocol of a model run step by step by a co-simulation master (an FMU).
+
+    Class attributes
+    ----------------
+    name : str
+        Model name (``"wet"``, ``"emtc"``, ``"eclutch"``).
+    inputs, outputs, parameters : tuple of Variable
+        Real, continuous inputs; outputs; parameters (tunable before
+        initialisation, values in SI).
+
+    Construction ``Cls(**parameter_values)`` takes parameter values by
+    :class:`Variable` name; missing ones take their ``start`` (the model's
+    paper / bundled preset).  :meth:`reset` returns to the initial state at
+    t = 0; :meth:`do_step` advances with the inputs held constant.
+    """
+
+    name: str = ""
+    inputs: tuple = ()
+    outputs: tuple = ()
+    parameters: tuple = ()
+
+    @abc.abstractmethod
+    def __init__(self, **parameter_values):
+        ...
+
+    @abc.abstractmethod
+    def reset(self) -> None:
+        """Back to the initial state at t = 0 (same parameters)."""
+
+    @abc.abstractmethod
+    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
+        """Advance from t to t+dt with the inputs held constant (zero-order hold); return outputs at t+dt."""
+
+    # ------------------------------------------------------------- optional hooks and helpers
+    def initial_outputs(self, inputs: dict) -> dict:
+        """Outputs at t = 0 for the given inputs (optional; default: the outputs' start values).
+
+        The FMU reports these after initialisation, before the first step.
+        """
+        return {v.name: v.start for v in self.outputs}
+
+    @classmethod
+    def resolve_parameters(cls, values: dict) -> dict:
+        """All parameter values by name: ``values`` checked (known, finite) over the start values.
+
+        Raises
+        ------
+        ParameterError
+            Unknown parameter name or non-finite value.
+        """
+        known = {v.name: v.start for v in cls.parameters}
+        for key, val in values.items():
+            if key not in known:
+                raise ParameterError(f"{cls.__name__}: unknown parameter {key!r}")
+            try:
+                fv = float(val)
+            except (TypeError, ValueError):
+                raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is not a number") from None
+            if not math.isfinite(fv):
+                raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is not finite")
+            known[key] = fv
+        return known
+
+    @classmethod
+    def resolve_inputs(cls, inputs: dict) -> dict:
+        """Input values by name: ``inputs`` checked (known, finite); missing inputs take their start value.
+
+        Raises
+        ------
+        ParameterError
+            Unknown input name or non-finite value.
+        """
+        out = {v.name: v.start for v in cls.inputs}
+        for key, val in inputs.items():
+            if key not in out:
+                raise ParameterError(f"{cls.__name__}: unknown input {key!r} (known: {', '.join(out)})")
+            fv = float(val)
+            if not math.isfinite(fv):
+                raise ParameterError(f"{cls.__name__}: input {key!r} = {val!r} is not finite")
+            out[key] = fv
+        return out
+
+
+def parameter_set_variables(prefix: str, cls, skip=()) -> tuple:
+    """Variables for the numeric fields of a :class:`~clutchlab.params.ParameterSet` class.
+
+    Parameters
+    ----------
+    prefix : str
+        Name prefix (``"clutch"`` gives ``clutch.k1``).
+    cls : type
+        ParameterSet subclass; its default instance gives the start values.
+    skip : iterable of str
+        Field names left out (e.g. sensor noise that the model does not use).
+
+    Returns
+    -------
+    tuple of Variable
+        Scalars as ``prefix.field``, tuples as ``prefix.field[i]`` (1-based,
+        FMI structured naming); units and descriptions from the field metadata.
+    """
+    out = []
+    default = cls()
+    for f in dataclasses.fields(cls):
+        if f.name in skip or "unit" not in f.metadata:
+            continue
+        value = getattr(default, f.name)
+        unit = fmi_unit(f.metadata["unit"])
+        doc = f.metadata.get("doc", "")
+        if isinstance(value, tuple):
+            for i, v in enumerate(value):
+                out.append(Variable(f"{prefix}.{f.name}[{i + 1}]", unit, float(v), f"{doc} (element {i + 1})"))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            out.append(Variable(f"{prefix}.{f.name}", unit, float(value), doc))
+    return tuple(out)
+
+
+def build_parameter_set(prefix: str, cls, values: dict, skip=()):
+    """A ``cls`` instance from the ``prefix.*`` entries of ``values`` (inverse of :func:`parameter_set_variables`).
+
+    Parameters
+    ----------
+    prefix : str
+        Name prefix used by :func:`parameter_set_variables`.
+    cls : type
+        ParameterSet subclass to build (validated on construction).
+    values : dict
+        All parameter values by name (e.g. from :meth:`CoSimulation.resolve_parameters`).
+    skip : iterable of str
+        Field names left out (they keep their defaults).
+
+    Returns
+    -------
+    ParameterSet
+        The default instance itself when no value differs from it.
+
+    Raises
+    ------
+    ParameterError
+        A whole-number field given a fractional value, or the set's own validation.
+    """
+    default = cls()
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name in skip or "unit" not in f.metadata:
+            continue
+        dv = getattr(default, f.name)
+        if isinstance(dv, tuple):
+            kwargs[f.name] = tuple(values[f"{prefix}.{f.name}[{i + 1}]"] for i in range(len(dv)))
+        elif isinstance(dv, (int, float)) and not isinstance(dv, bool):
+            v = values[f"{prefix}.{f.name}"]
+            if isinstance(dv, int):
+                if v != round(v):
+                    raise ParameterError(f"parameter {prefix}.{f.name} = {v!r}: must be a whole number")
+                v = int(round(v))
+            kwargs[f.name] = v
+    if all(kwargs[k] == getattr(default, k) for k in kwargs):
+        return default
+    return cls(**kwargs)
+
+
+def _flag(name: str, value: float) -> bool:
+    if value not in (0.0, 1.0):
+        raise ParameterError(f"parameter {name} = {value!r}: expected 0 or 1")
+    return value == 1.0
+
+
+def _check_time(owner: str, t_model: float, t: float, dt: float):
+    if not (math.isfinite(t) and math.isfinite(dt)) or dt <= 0:
+        raise SimulationError(f"{owner}.do_step: step size dt = {dt!r} must be > 0 [s]")
+    if abs(t - t_model) > 1e-9 * max(1.0, abs(t)):
+        raise SimulationError(
+            f"{owner}.do_step: called at t = {t!r} s but the model is at t = {t_model!r} s "
+            "(steps must be contiguous; call reset() to start again)")
+
+
+# ===================================================================== wet clutch
+def _wet_variables():
+    from ..wet.bench import _pack_equilibrium
+    from ..wet.params import Bench, WetClutch
+
+    clutch = parameter_set_variables("clutch", WetClutch)
+    bench = parameter_set_variables("bench", Bench, skip=(
+        "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
+        "noise_fluid_temperature", "seed"))
+    scenario = (
+        Variable("scenario.free_inertia", "1", 0.0,
+                 "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)"),
+        Variable("scenario.initial_slip_speed", "rad/s", 1500 * math.pi / 30, "slip speed at t = 0"),
+        Variable("scenario.initial_temperature", "degC", _pack_equilibrium(WetClutch(), 80.0, 70.0),
+                 "pack temperature at t = 0 (default: Eq. 8 equilibrium of fluid and housing)"),
+        Variable("scenario.fluid_temperature", "degC", 80.0, "oil reservoir temperature at t = 0"),
+        Variable("scenario.housing_temperature", "degC", 70.0, "housing temperature at t = 0"),
+        Variable("scenario.heater_setpoint", "degC", 80.0, "reservoir thermostat set point"),
+        Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f"),
+        Variable("solver.rtol", "1", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
+        Variable("solver.max_step", "s", 0.01, "largest integration step"),
+    )
+    return clutch + bench + scenario
+
+
+#: (output name, unit, description, source) -- source: ("aux", index) or ("state", index) or ("stick",)
+def _wet_output_table():
+    from ..wet import engagement as E
+
+    return (
+        ("clutch_torque", "N.m", "clutch torque tau = T_c + T_v (Eq. 3)", ("aux", E.A_TAU)),
+        ("contact_torque", "N.m", "asperity contact torque T_c (Eq. 4)", ("aux", E.A_TC)),
+        ("viscous_torque", "N.m", "viscous torque T_v (Eq. 5)", ("aux", E.A_TV)),
+        ("slip_speed", "rad/s", "slip speed = clutch shaft speed", ("state", E.S_W)),
+        ("drive_torque", "N.m", "motor torque at the clutch shaft", ("aux", E.A_TD)),
+        ("sensor_torque", "N.m", "torque at the shaft torque sensor", ("aux", E.A_TS)),
+        ("static_capacity", "N.m", "static torque capacity r_eff N_c mu_f F_c", ("aux", E.A_CAP)),
+        ("contact_force", "N", "asperity contact force F_c (Greenwood-Williamson)", ("aux", E.A_FC)),
+        ("squeeze_force", "N", "hydrodynamic squeeze-film force", ("aux", E.A_FH)),
+        ("load_cell_force", "N", "force at the actuator load cell", ("aux", E.A_FLC)),
+        ("actuator_force", "N", "actuator force (first-order lag of the reference)", ("state", E.S_FA)),
+        ("piston_position", "m", "piston position x_p", ("state", E.S_X)),
+        ("nominal_separation", "m", "nominal film thickness h per interface (Eq. 1)", ("aux", E.A_H)),
+        ("mean_film", "m", "Patir-Cheng mean film thickness h_bar (Eq. 2)", ("aux", E.A_HBAR)),
+        ("mu_f", "1", "asperity friction coefficient", ("aux", E.A_MUF)),
+        ("viscosity", "Pa.s", "oil viscosity mu_v (Eq. 7)", ("aux", E.A_MUV)),
+        ("friction_power", "W", "friction power tau * omega", ("aux", E.A_PF)),
+        ("heater_power", "W", "reservoir heater power", ("aux", E.A_QH)),
+        ("temperature", "degC", "pack temperature T (Eq. 8)", ("state", E.S_T)),
+        ("fluid_temperature", "degC", "oil reservoir temperature", ("state", E.S_TF)),
+        ("housing_temperature", "degC", "housing temperature", ("state", E.S_TH)),
+        ("thermistor_temperature", "degC", "thermistor reading (first-order lag of T)", ("state", E.S_TM)),
+        ("friction_work", "J", "friction work since t = 0", ("state", E.S_EF)),
+        ("stick", "1", "1 while the clutch is locked (stick mode), 0 while slipping", ("stick",)),
+    )
+
+
+class WetCoSimulation(CoSimulation):
+    """The wet-clutch bench of Shin, Kim and Choi [1] as a co-simulation slave.
+
+    Inputs are the two references of the bench (Fig. 4): the actuator force
+    reference [N] (the bench presses the piston with a force-controlled
+    linear actuator; a piston pressure command is ``p * A_piston``) and the
+    slip-speed reference [rad/s] of the speed-controlled drive motor
+    (ignored with ``scenario.free_inertia = 1``).  Parameters are every
+    numeric field of :class:`~clutchlab.wet.params.WetClutch` (``clutch.*``,
+    Table 1 of [1] plus documented choices) and of
+    :class:`~clutchlab.wet.params.Bench` (``bench.*``, without the sensor
+    noise), the initial conditions (``scenario.*``, defaults of
+    :class:`~clutchlab.wet.bench.EngagementProtocol`) and the step control
+    (``solver.*``).  Outputs: torques (Eqs. 3-6), forces, film thickness
+    (Eqs. 1-2), viscosity (Eq. 7), temperatures (Eq. 8), friction work and
+    the stick flag.
+
+    Each :meth:`do_step` resumes the compiled DOPRI 5(4) integration of
+    :mod:`clutchlab.wet.engagement` (``_integrate_from``) at the stored state,
+    mode (slip / stick / reverse slip) and step size, with both references
+    constant over the step; lock-up, break-away and contact inside the step
+    are located as in the native run and kept in :attr:`events`.
+
+    Notes
+    -----
+    The friction law is the bench's true law
+    (:meth:`~clutchlab.wet.friction.ParametricFriction.bench_truth`).  The
+    integrator stops at every communication point, so the results differ
+    from one uninterrupted :func:`~clutchlab.wet.engagement.simulate_engagement`
+    run by the integration error (of order ``solver.rtol``), not more.
+    """
+
+    name = "wet"
+    inputs = (
+        Variable("force_reference", "N", 0.0, "actuator force reference (piston apply force)"),
+        Variable("slip_speed_reference", "rad/s", 1500 * math.pi / 30,
+                 "slip-speed reference of the speed-controlled drive motor"),
+    )
+    outputs = tuple(Variable(n, u, 0.0, d) for n, u, d, _ in _wet_output_table())
+    parameters = _wet_variables()
+
+    def __init__(self, **parameter_values):
+        from ..wet import engagement as E
+        from ..wet.params import Bench, WetClutch
+
+        values = self.resolve_parameters(parameter_values)
+        self.parameter_values = values
+        self.clutch = build_parameter_set("clutch", WetClutch, values)
+        self.bench = build_parameter_set("bench", Bench, values, skip=(
+            "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
+            "noise_fluid_temperature", "seed"))
+        free = _flag("scenario.free_inertia", values["scenario.free_inertia"])
+        self.rtol = values["solver.rtol"]
+        self.max_step = values["solver.max_step"]
+        if not (0 < self.rtol < 1):
+            raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
+        if not self.max_step > 0:
+            raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
+        self.scenario = E.Scenario(
+            force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
+            motor="free" if free else "speed", initial_slip_speed=values["scenario.initial_slip_speed"],
+            initial_temperature_c=values["scenario.initial_temperature"],
+            fluid_temperature_c=values["scenario.fluid_temperature"],
+            housing_temperature_c=values["scenario.housing_temperature"],
+            heater_setpoint_c=values["scenario.heater_setpoint"])
+        self._p = E.parameter_vector(self.clutch, self.bench, self.scenario)
+        self._p[E.P_MUSCALE] = values["scenario.mu_scale"]
+        self._atol = E._atol(self.clutch)
+        self._fdata = E._friction_data(None)
+        self._gw = E.gw_table()
+        self._table = _wet_output_table()
+        self.reset()
+
+    def reset(self) -> None:
+        self.time = 0.0
+        self.state = None  # set at the first step / initial_outputs (the actuator force starts at its reference)
+        self.mode = -1
+        self._h = 0.0
+        self.events = []
+        self.n_steps = 0
+
+    def _profiles(self, u):
+        fmax = self.bench.actuator_force_max
+        f = u["force_reference"]
+        w = u["slip_speed_reference"]
+        if f < 0 or f > fmax * (1 + 1e-12):
+            raise ParameterError(f"input force_reference = {f!r} N: must be within [0, {fmax:g}] N (actuator limit)")
+        if self.scenario.motor == "speed" and abs(w) > self.bench.drive_speed_max:
+            raise ParameterError(f"input slip_speed_reference = {w!r} rad/s exceeds the bench's speed limit "
+                                 f"{self.bench.drive_speed_max:.6g} rad/s")
+        zero = np.zeros(1)
+        return zero, np.array([f]), zero, np.array([w])
+
+    def _start(self, u):
+        from ..wet import engagement as E
+
+        y = E.initial_state(self.scenario)
+        y[E.S_FA] = u["force_reference"]  # the actuator force starts at its reference, as in the native run
+        self.state = y
+        self.mode = -1
+
+    def _outputs(self, u):
+        from ..wet import engagement as E
+
+        ft, fv, st, sv = self._profiles(u)
+        mode = self.mode
+        if mode < 0:
+            w = self.state[E.S_W]
+            mode = E.SLIP if w > 0 else (E.SLIP_NEG if w < 0 else E.STICK)
+        dy = np.empty(E.N_STATE)
+        aux = np.empty(E.N_AUX)
+        fk, fc, fgv, fgt, fgf, ftab = self._fdata
+        g0, gdt, gv, gd = self._gw
+        E._rhs(self.time, self.state, mode, self._p, int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
+               ft, fv, st, sv, dy, aux)
+        out = {}
+        for name, _, _, src in self._table:
+            if src[0] == "aux":
+                out[name] = float(aux[src[1]])
+            elif src[0] == "state":
+                out[name] = float(self.state[src[1]])
+            else:
+                out[name] = 1.0 if mode == E.STICK else 0.0
+        return out
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        u = self.resolve_inputs(inputs)
+        if self.state is None or self.time != 0.0:
+            self.reset()
+            self._start(u)
+        return self._outputs(u)
+
+    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
+        """Advance from ``t`` to ``t + dt`` with the references held; return the outputs at ``t + dt``.
+
+        Raises
+        ------
+        SimulationError
+            Non-contiguous step, step limit or step-size underflow.
+        ParameterError
+            Unknown or out-of-range input.
+        """
+        from ..wet import engagement as E
+
+        _check_time("WetCoSimulation", self.time, t, dt)
+        u = self.resolve_inputs(inputs)
+        if self.state is None:
+            self._start(u)
+        ft, fv, st, sv = self._profiles(u)
+        fk, fc, fgv, fgt, fgf, ftab = self._fdata
+        g0, gdt, gv, gd = self._gw
+        t_end = t + dt
+        y = self.state.copy()
+        ts = np.zeros(0)
+        et = np.zeros(E.MAX_EVENTS)
+        ek = np.zeros(E.MAX_EVENTS, dtype=np.int64)
+        nev, steps, status, _peak, _tl, mode, h = E._integrate_from(
+            self._p, y, float(t), int(self.mode), float(self._h), float(t_end), ts, float(self.rtol),
+            self._atol, float(self.max_step), 2_000_000, int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
+            ft, fv, st, sv, np.zeros((0, E.N_STATE)), np.zeros((1, E.N_AUX)), np.zeros(0, dtype=np.int64),
+            et, ek, False)
+        if status == 1:
+            raise SimulationError(f"WetCoSimulation: step limit reached between t = {t} and {t_end} s")
+        if status == 2:
+            raise SimulationError(f"WetCoSimulation: step size underflow between t = {t} and {t_end} s")
+        self.state = y
+        self.mode = int(mode)
+        self._h = float(h)
+        self.time = t_end
+        self.n_steps += int(steps)
+        order = np.argsort(et[:nev], kind="stable")
+        self.events.extend(E.Event(float(et[i]), E.EVENT_KINDS[int(ek[i])]) for i in order)
+        return self._outputs(u)
+
+
+# ===================================================================== EMTC
+_EMTC_OUTPUTS = (
+    # name, unit, description, column of the kernel's output row
+    ("coupling_torque", "N.m", "torque transferred by the EMTC T_c (Eqs. 17, 25, 30)", 8 + 5),
+    ("front_shaft_speed", "rad/s", "coupling input shaft speed omega_f (Eq. 27)", 1),
+    ("rear_shaft_speed", "rad/s", "coupling output shaft speed omega_r (Eq. 27)", 2),
+    ("slip_speed", "rad/s", "omega_f - omega_r", -1),
+    ("magnet_force", "N", "magnet force F_m from the plant Preisach model (Eq. 1)", 8 + 0),
+    ("primary_clamp_force", "N", "primary clutch normal force F_n1 (Eq. 11)", 8 + 1),
+    ("main_clamp_force", "N", "main clutch normal force F_n2 from the ball cam (Eq. 14)", 8 + 10),
+    ("torque_capacity", "N.m", "locked-mode torque capacity (Eq. 21)", 8 + 8),
+    ("lock_torque", "N.m", "torque needed to keep the coupling locked (Eq. 29)", 8 + 6),
+    ("engine_torque", "N.m", "engine torque", 8 + 11),
+    ("armature_position", "m", "armature displacement x (Eqs. 8-12)", 4),
+    ("armature_speed", "m/s", "armature speed", 5),
+    ("airgap", "m", "magnetic airgap d (Eq. 12)", -2),
+    ("coil_current", "A", "coil current (second lag of Fig. 15)", 7),
+    ("current_command", "A", "coil current command applied over the last controller sample (Eqs. 6-7)", 22),
+    ("torsen_twist", "rad", "Torsen twist angle since lock-up (Eq. 30)", 3),
+    ("armature_mode", "1", "0 at the rest stop, 1 free, 2 pressing the primary clutch", 20),
+    ("coupling_mode", "1", "0 open, 1 slipping, 2 locked", 21),
+)
+
+
+def _emtc_variables():
+    from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
+    from ..emtc.torque import CouplingGeometry
+
+    scen = BenchScenario()
+    return (parameter_set_variables("vehicle", VehicleParameters)
+            + parameter_set_variables("actuator", ActuatorParameters)
+            + parameter_set_variables("coupling", CouplingGeometry)
+            + (Variable("scenario.gear", "1", float(scen.gear), "engaged gear (1-6)"),
+               Variable("scenario.drum_load_front", "N.m", scen.drum_load_front, "extra drum resistance, front axle"),
+               Variable("scenario.drum_load_rear", "N.m", scen.drum_load_rear, "extra drum resistance, rear axle"),
+               Variable("scenario.sample_time", "s", scen.sample_time,
+                        "EMTC controller sample time; the communication step must be a multiple of it"),
+               Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control")))
+
+
+class EmtcCoSimulation(CoSimulation):
+    """The AWD vehicle with the EMTC on the drum bench [2] as a co-simulation slave.
+
+    Inputs: the coupling torque request ``T_cal`` [N*m] of the AWD controller
+    (replaces the map of Eq. 31, as ``simulate_bench(torque_reference=...)``),
+    the throttle [-] and the front and rear drum surface speeds [m/s].  The
+    EMTC controller samples the torque request every
+    ``scenario.sample_time``, converts it to a primary-clutch force (Eqs. 13,
+    15), a magnet force (Eq. 11) and a coil current through the inverse
+    Preisach model (Eqs. 6-7); the current follows the two lags of Fig. 15.
+    Parameters: every numeric field of
+    :class:`~clutchlab.emtc.bench.VehicleParameters` (``vehicle.*``, Table 1
+    of [2]), :class:`~clutchlab.emtc.bench.ActuatorParameters`
+    (``actuator.*``) and :class:`~clutchlab.emtc.torque.CouplingGeometry`
+    (``coupling.*``), gear, drum loads, sample time, tolerance.  The friction
+    coefficients are the constant ones of the coupling geometry (no friction
+    map, no LuGre).
+    The magnet is the Preisach family identified from the bundled synthetic
+    FORC records (:func:`clutchlab.emtc.magnet.bundled_magnet`).
+
+    Each :meth:`do_step` continues the compiled model
+    (``_bench_kernel.bench_advance``) with its states, modes, step size and
+    both hysteresis memories (plant magnet and controller model); the
+    controller runs at the first sample of the step with the new inputs.  A
+    chain of steps therefore reproduces one uninterrupted
+    :func:`~clutchlab.emtc.bench.simulate_bench` run exactly when the inputs
+    change only at communication points (see ``docs/fmu.md``).
+
+    Notes
+    -----
+    ``dt`` must be a whole multiple of ``scenario.sample_time`` and ``t`` a
+    sample instant (the controller is sampled).  The shaft speeds start at
+    the free-rolling speeds of the drum-speed inputs at t = 0.
+    """
+
+    name = "emtc"
+    inputs = (
+        Variable("torque_request", "N.m", 0.0, "coupling torque request T_cal of the AWD controller"),
+        Variable("throttle", "1", 0.1, "engine throttle (0-1)"),
+        Variable("drum_speed_front", "m/s", 8.0, "front drum surface speed"),
+        Variable("drum_speed_rear", "m/s", 7.7, "rear drum surface speed"),
+    )
+    outputs = tuple(Variable(n, u, 0.0, d) for n, u, d, _ in _EMTC_OUTPUTS)
+    parameters = _emtc_variables()
+
+    def __init__(self, **parameter_values):
+        from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
+        from ..emtc.magnet import bundled_magnet
+        from ..emtc.torque import UNLOCK_MARGIN, CouplingGeometry
+
+        values = self.resolve_parameters(parameter_values)
+        self.parameter_values = values
+        self.vehicle = build_parameter_set("vehicle", VehicleParameters, values)
+        self.actuator = build_parameter_set("actuator", ActuatorParameters, values)
+        self.coupling = build_parameter_set("coupling", CouplingGeometry, values)
+        gear = values["scenario.gear"]
+        if gear not in (1.0, 2.0, 3.0, 4.0, 5.0, 6.0):
+            raise ParameterError(f"parameter scenario.gear = {gear!r}: expected 1-6")
+        self.sample_time = values["scenario.sample_time"]
+        if not self.sample_time > 0:
+            raise ParameterError(f"parameter scenario.sample_time = {self.sample_time!r}: must be > 0 [s]")
+        self.rtol = values["solver.rtol"]
+        if not (0 < self.rtol < 1):
+            raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
+        self.magnet = bundled_magnet()
+        m = self.magnet
+        a = self.actuator
+        if m.n_airgaps > 1 and (a.airgap_open - a.free_travel < m.airgaps[0] - 1e-12
+                                or a.airgap_open > m.airgaps[-1] + 1e-12):
+            raise ParameterError(
+                f"actuator airgap range [{a.airgap_open - a.free_travel:g}, {a.airgap_open:g}] m is outside the "
+                f"magnet's calibration airgaps [{m.airgaps[0]:g}, {m.airgaps[-1]:g}] m")
+        v = self.vehicle
+        ic = v.rear_final_drive
+        jf = v.inertia_input_shaft + v.inertia_front_axle / ic**2  # [2], Eq. 29, J_f (as simulate_bench)
+        jr = v.inertia_output_shaft + v.inertia_rear_axle / ic**2  # [2], Eq. 29, J_r
+        fzf, fzr = v.axle_loads()
+        pv = np.zeros(32)
+        pv[:23] = [v.front_final_drive, ic, v.gear_ratios[int(gear) - 1], jf, jr, v.tyre_radius, fzf, fzr,
+                   v.rolling_resistance, v.tyre_slip_stiffness, v.slip_speed_floor, v.engine_torque_max,
+                   v.engine_power, v.torsen_stiffness, v.torsen_damping, BenchScenario().temperature_c,
+                   v.drag_coefficient(), UNLOCK_MARGIN, self.sample_time, values["scenario.drum_load_front"],
+                   values["scenario.drum_load_rear"], 0.0, 0.0]
+        self._pv0 = pv
+        self._pa = a.kernel_data()
+        self._geo = self.coupling.kernel_data()
+        self._atol = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
+        self._fmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)), 0)
+        self._tmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.zeros((2, 2)))  # unused: torque_request
+        self.reset()
+
+    def reset(self) -> None:
+        from ..emtc import _bench_kernel as BK
+
+        self.time = 0.0
+        self._k = 0  # controller sample index at self.time
+        self._pv = self._pv0.copy()
+        self._y = None
+        self._imode = np.array([0, 0, 1], dtype=np.int64)
+        self._carry = np.zeros(BK.N_CARRY)
+        self._carry[BK.CARRY_H] = min(1e-4, self.sample_time)
+        self._carry[BK.CARRY_PU] = self.magnet.grid[0]
+        self._carry[BK.CARRY_CU] = self.magnet.grid[0]
+        self._carry[BK.CARRY_FRESH] = 1.0
+        self._alloc(64)
+        self.events = []
+        self.n_steps = 0
+        self._last_row = None
+
+    def _alloc(self, cap):
+        m = self.magnet
+        self._pstack = np.zeros(cap)
+        self._ppref = np.zeros((m.n_airgaps, cap // 2 + 2))
+        self._cstack = np.zeros(cap)
+        self._cpref = np.zeros((m.n_airgaps, cap // 2 + 2))
+
+    def _grow(self):
+        old = (self._pstack, self._ppref, self._cstack, self._cpref)
+        self._alloc(4 * old[0].shape[0])
+        self._pstack[:old[0].shape[0]] = old[0]
+        self._ppref[:, :old[1].shape[1]] = old[1]
+        self._cstack[:old[2].shape[0]] = old[2]
+        self._cpref[:, :old[3].shape[1]] = old[3]
+
+    def _start(self, u):
+        r = self.vehicle.tyre_radius
+        ic = self.vehicle.rear_final_drive
+        y = np.zeros(7)
+        y[0] = u["drum_speed_front"] / r * ic  # free rolling at t = 0, as simulate_bench
+        y[1] = u["drum_speed_rear"] / r * ic
+        y[5] = y[6] = self.magnet.grid[0]
+        self._y = y
+
+    def _advance(self, u, n_rows, k0):
+        """Run ``n_rows`` samples from sample ``k0`` (the last one without the controller); row array."""
+        from ..emtc import _bench_kernel as BK
+
+        thr = u["throttle"]
+        if not 0.0 <= thr <= 1.0:
+            raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
+        prof = np.array([0.0, 1.0])
+        tref = np.array([[0.0, 1.0], [u["torque_request"], u["torque_request"]]])
+        m = self.magnet
+        fmv, fmt, fmm, fmode = self._fmap
+        while True:
+            snapshot = (self._y.copy(), self._imode.copy(), self._carry.copy(), self._pv.copy(),
+                        self._pstack.copy(), self._ppref.copy(), self._cstack.copy(), self._cpref.copy())
+            out = np.zeros((n_rows, BK.N_OUT))
+            ev = np.zeros((max(1000, 20 * n_rows), 4))
+            n_out, n_ev, n_steps, status = BK.bench_advance(
+                self._y, self._imode, self._carry, int(k0), False, self._pv, self._pa, self._geo,
+                fmv, fmt, fmm, fmode, prof, np.array([thr, thr]),
+                prof, np.array([u["drum_speed_front"]] * 2), prof, np.array([u["drum_speed_rear"]] * 2),
+                *self._tmap, tref, m.kernel_tables, m.grid, m.airgaps, self._pstack, self._ppref,
+                m.kernel_tables, m.grid, m.airgaps, self._cstack, self._cpref,
+                float(self.rtol), self._atol, out, ev, 2_000_000)
+            if status == 1:  # hysteresis memory full: restore, enlarge, repeat
+                (self._y, self._imode, self._carry, self._pv, self._pstack, self._ppref, self._cstack,
+                 self._cpref) = snapshot
+                self._grow()
+                continue
+            if status == 2:
+                raise SimulationError(f"EmtcCoSimulation: step size underflow after t = {self.time} s")
+            if status == 3:
+                raise SimulationError(f"EmtcCoSimulation: step limit after t = {self.time} s")
+            break
+        from ..emtc.bench import EVENT_NAMES
+
+        self.n_steps += int(n_steps)
+        self.events.extend((float(e[0]), EVENT_NAMES.get(int(e[1]), "?")) for e in ev[:n_ev])
+        return out[n_out - 1]
+
+    def _row_outputs(self, row) -> dict:
+        out = {}
+        for name, _, _, col in _EMTC_OUTPUTS:
+            if col == -1:
+                out[name] = float(row[1] - row[2])
+            elif col == -2:
+                out[name] = float(self.actuator.airgap_open - row[4])
+            else:
+                out[name] = float(row[col])
+        return out
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        u = self.resolve_inputs(inputs)
+        if self.time != 0.0 or self._y is None:
+            self.reset()
+            self._start(u)
+        if self._last_row is None:
+            # one sample without the controller: evaluates the model at t = 0 (the derivative is kept
+            # for the first step, which replaces the current-command term once the controller has run)
+            self._last_row = self._advance(u, 1, 0)
+        return self._row_outputs(self._last_row)
+
+    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
+        """Advance from ``t`` to ``t + dt`` (a multiple of the controller sample time); outputs at ``t + dt``.
+
+        Raises
+        ------
+        SimulationError
+            Non-contiguous step, ``dt`` not a multiple of the sample time,
+            step limit or step-size underflow.
+        ParameterError
+            Unknown or out-of-range input.
+        """
+        _check_time("EmtcCoSimulation", self.time, t, dt)
+        ts = self.sample_time
+        m = round(dt / ts)
+        if m < 1 or abs(m * ts - dt) > 1e-9 * ts:
+            raise SimulationError(
+                f"EmtcCoSimulation.do_step: dt = {dt!r} s is not a whole multiple of the controller sample time "
+                f"scenario.sample_time = {ts!r} s")
+        u = self.resolve_inputs(inputs)
+        if self._y is None:
+            self._start(u)
+        row = self._advance(u, m + 1, self._k)
+        self._k += m
+        self.time = t + dt
+        self._last_row = row
+        return self._row_outputs(row)
