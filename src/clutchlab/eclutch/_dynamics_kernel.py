@@ -40,6 +40,8 @@ N_PAR = 33
 VOLTAGE, POSITION, PRESCRIBED = 0, 1, 2
 # event kinds recorded
 EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_CONTACT_CLOSE, EV_CONTACT_OPEN, EV_STOP_HIT, EV_STOP_LEAVE = range(7)
+EV_CAVITATION_START, EV_CAVITATION_END = 7, 8
+N_OTHER_EVENTS = 9  # end stops (4), cavitation (2), current limit (1), snifting port edges (2)
 N_AUX_FIXED = 4  # V_drive, bearing force of the clutch, reference, bearing position used
 
 
@@ -215,11 +217,16 @@ def rhs(t, y, modes, out, g, aux, nz, imode, tin, vin, interp, par, mass,
         g[ne + 1] = par[P_XMAX] - x_mc
         g[ne + 2] = u - par[P_UMIN]
         g[ne + 3] = par[P_UMAX] - u
+        # kinks located so that no step straddles them: cavitation in either chamber, the drive's
+        # current limit, the two edges of the snifting port
+        g[ne + 4] = p_m - par[P_PCAV]
+        g[ne + 5] = p_s - par[P_PCAV]
+        g[ne + 6] = par[P_IMAX] - abs(cur)
+        g[ne + 7] = x_mc - par[P_XSN]
+        g[ne + 8] = x_mc - (par[P_XSN] - par[P_WSN])
     else:
-        g[ne] = 1.0
-        g[ne + 1] = 1.0
-        g[ne + 2] = 1.0
-        g[ne + 3] = 1.0
+        for k in range(N_OTHER_EVENTS):
+            g[ne + k] = 1.0
     aux[0] = v_drive
     aux[1] = bearing_force
     aux[2] = ref
@@ -368,6 +375,14 @@ def _new_modes(t, y, modes, g_old, g_new, nz, n_el, imode, fr_on, Fz_at, fn_at, 
                 ev_kind[n_ev] = EV_STOP_HIT if g_new[k] < 0.0 else EV_STOP_LEAVE
                 ev_idx[n_ev] = s
                 n_ev += 1
+    for s in range(2):
+        k = ne + 4 + s
+        if g_old[k] * g_new[k] < 0.0:
+            if n_ev < max_ev:
+                ev_t[n_ev] = t
+                ev_kind[n_ev] = EV_CAVITATION_START if g_new[k] < 0.0 else EV_CAVITATION_END
+                ev_idx[n_ev] = s
+                n_ev += 1
     return n_ev
 
 
@@ -410,7 +425,7 @@ def integrate(y0, modes0, t0, t_end, nz, imode, tin, vin, interp, breaks, par, m
     """
     n = y0.shape[0]
     n_el = GA.shape[0]
-    n_g = nz + n_el + 4
+    n_g = nz + n_el + N_OTHER_EVENTS
     n_aux = N_AUX_FIXED + nz
     n_jac = 2 * nz + 5
     use_grid = t_grid.shape[0] > 0
@@ -694,7 +709,7 @@ def outputs(T, Y, MODES, nz, imode, tin, vin, interp, par, mass, GA, Gb, d0, cx,
     """Outputs (aux) and element forces at recorded points, evaluated exactly from the states."""
     n = Y.shape[1]
     n_el = GA.shape[0]
-    n_g = nz + n_el + 4
+    n_g = nz + n_el + N_OTHER_EVENTS
     AUX = np.empty((T.shape[0], N_AUX_FIXED + nz))
     F = np.empty((T.shape[0], n_el))
     out = np.empty(n)

@@ -56,7 +56,7 @@ class EClutchCoSimulation(CoSimulation):
         Variable("model", "1", 4.0, "axial model of Haramina et al. (2024), 0-4"),
         Variable("control_mode", "1", 1.0, "1: bearing position control, 0: motor voltage"),
         Variable("friction_on", "1", 1.0, "1: clutch friction elements R_f.ds, R_f.pp on"),
-        Variable("rtol", "1", 1e-4, "relative tolerance of the Rodas3 integrator"),
+        Variable("rtol", "1", 1e-3, "relative tolerance of the Rodas3 integrator"),
         *parameter_set_variables("clutch", EClutchParameters, skip=_CLUTCH_SKIP),
         *parameter_set_variables("actuator", ActuatorParameters),
         *parameter_set_variables("friction", FrictionParameters),
@@ -132,7 +132,7 @@ class EClutchCoSimulation(CoSimulation):
         *_, stats, yf, mf = K.integrate(
             self.y, self.modes, float(t), float(t + dt), s.nz, self.imode, tin, vin, interp, np.empty(0), s.par,
             s.mass, s.mvec, s.typ, *s.kernel_network(), *s.kernel_friction(), float(self.rtol), s.atol,
-            min(1e-5, dt), 0.01, 200_000, np.array([t + dt]), 1e-8, 4)
+            min(1e-5, dt), 0.01, 200_000, np.array([t + dt]), 1e-8, 10)
         if stats[4] != 0:
             raise SimulationError(f"E-clutch step from t = {t!r} s failed (status {int(stats[4])})")
         self.y = yf.copy()

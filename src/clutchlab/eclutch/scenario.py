@@ -8,7 +8,7 @@ alone), the run length and any parameter overrides::
     model = 4                     # axial Model 0-4 of Haramina et al. (2024)
     t_end = "1.2 s"
     output_step = "1 ms"          # optional: uniform output grid
-    rtol = 1e-4                   # optional
+    rtol = 1e-3                   # optional
     friction = true               # clutch friction elements R_f.ds, R_f.pp (default true)
 
     [input]
@@ -88,7 +88,7 @@ class Scenario:
     wear_m: float = 0.0
     temperature_rise_k: float = 0.0
     output_step: float | None = None
-    rtol: float = 1e-4
+    rtol: float = 1e-3
     source: str = "defaults"
 
     def clutch_model(self) -> ClutchModel:
@@ -153,7 +153,7 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
         output_step = to_si(sc["output_step"], "s", name="[scenario] output_step", source=src)
         if not 0 < output_step <= t_end:
             raise ParameterError(f"{src}: [scenario] output_step = {sc['output_step']!r} must be in (0, t_end]")
-    rtol = to_si(sc.get("rtol", 1e-4), "1", name="[scenario] rtol", source=src)
+    rtol = to_si(sc.get("rtol", 1e-3), "1", name="[scenario] rtol", source=src)
     use_friction = sc.get("friction", True)
     if not isinstance(use_friction, bool):
         raise ParameterError(f"{src}: [scenario] friction = {use_friction!r}: expected true or false")

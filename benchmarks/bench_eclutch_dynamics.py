@@ -1,0 +1,347 @@
+"""Benchmark: 1 s of E-clutch dynamics (actuator + Model 4 with stick-slip friction).
+
+Measured in one run:
+
+1. clutchlab's compiled Rodas3 kernel (``EClutch.simulate`` and the kernel alone), after compilation;
+2. the **same equations** integrated by ``scipy.integrate.solve_ivp`` with a plain-Python right-hand side:
+   the massless finger-tip node is solved by Newton inside the right-hand side (solve_ivp has no mass
+   matrix), the friction state machine runs on terminal events with a restart after each, and the
+   integration restarts at every input breakpoint -- what one would write with SciPy;
+3. the accuracy of both against a tight-tolerance clutchlab run (rtol 1e-8), to show the tolerances match;
+4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale) with ``prange`` on all threads
+   against one thread.
+
+Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from clutchlab.eclutch import ClutchModel, EClutch, EClutchParameters, FrictionParameters
+from clutchlab.eclutch import _dynamics_kernel as K
+from clutchlab.eclutch.dynamics import _as_table, simulate_batch
+
+T_END = 1.0
+INPUT = {"bearing_reference": ([0.0, 0.1, 0.3, 0.6, 0.8], [0.0, 0.0, 7e-3, 7e-3, 0.0])}
+RTOL = 1e-4
+
+
+# ---------------------------------------------------------------------------------------------
+# plain-Python reference of the same equations
+# ---------------------------------------------------------------------------------------------
+class PythonEClutch:
+    """The E-clutch right-hand side in plain Python (position control), for solve_ivp."""
+
+    def __init__(self, ec: EClutch, tin, vin):
+        s = ec.system
+        self.s = s
+        self.nz = s.nz
+        self.GA = s.asm["GA"].tolist()
+        self.Gb = s.asm["Gb"].tolist()
+        self.d0 = s.asm["d0"].tolist()
+        self.curves = []
+        for e in range(len(s.element_names)):
+            lo, hi = s.offsets[e], s.offsets[e + 1]
+            self.curves.append((s.cx[lo:hi].tolist(), s.cf[lo:hi].tolist(), s.cd[lo:hi].tolist(), int(s.kinds[e]),
+                                float(s.scale[e]), bool(s.unilateral[e])))
+        self.par = s.par.tolist()
+        self.mass = s.mass.tolist()
+        self.massless = [j for j in range(2, s.nz) if s.mass[j] == 0.0]
+        self.massive = [j for j in range(s.nz) if s.mass[j] > 0.0]
+        self.fr = (s.fr_on.tolist(), s.fr_c0.tolist(), s.fr_mun.tolist(), s.fr_nidx.tolist(), s.fr_mup.tolist(),
+                   s.fr_pidx.tolist(), s.fr_rs.tolist(), s.fr_c.tolist())
+        self.tin = list(tin)
+        self.vin = list(vin)
+        self.q_alg = None
+
+    @staticmethod
+    def curve(c, x):
+        xs, fs, ds, kind, scale, _ = c
+        n = len(xs)
+        if x <= xs[0]:
+            s = ds[0] if kind else (fs[1] - fs[0]) / (xs[1] - xs[0])
+            return scale * (fs[0] + s * (x - xs[0])), scale * s
+        if x >= xs[-1]:
+            s = ds[-1] if kind else (fs[-1] - fs[-2]) / (xs[-1] - xs[-2])
+            return scale * (fs[-1] + s * (x - xs[-1])), scale * s
+        lo, hi = 0, n - 1
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if xs[mid] <= x:
+                lo = mid
+            else:
+                hi = mid
+        h = xs[hi] - xs[lo]
+        if not kind:
+            s = (fs[hi] - fs[lo]) / h
+            return scale * (fs[lo] + s * (x - xs[lo])), scale * s
+        t = (x - xs[lo]) / h
+        t2, t3 = t * t, t * t * t
+        val = ((2 * t3 - 3 * t2 + 1) * fs[lo] + (t3 - 2 * t2 + t) * h * ds[lo] + (-2 * t3 + 3 * t2) * fs[hi]
+               + (t3 - t2) * h * ds[hi])
+        der = ((6 * t2 - 6 * t) / h * fs[lo] + (3 * t2 - 4 * t + 1) * ds[lo] + (-6 * t2 + 6 * t) / h * fs[hi]
+               + (3 * t2 - 2 * t) * ds[hi])
+        return scale * val, scale * der
+
+    def ref(self, t):
+        tin, vin = self.tin, self.vin
+        if t <= tin[0]:
+            return vin[0]
+        for k in range(len(tin) - 1):
+            if t <= tin[k + 1]:
+                return vin[k] + (vin[k + 1] - vin[k]) * (t - tin[k]) / (tin[k + 1] - tin[k])
+        return vin[-1]
+
+    def element_forces(self, u, q):
+        f, k = [], []
+        for e, c in enumerate(self.curves):
+            d = self.d0[e] + self.Gb[e] * u + sum(g * qq for g, qq in zip(self.GA[e], q))
+            fe, ke = self.curve(c, d)
+            if c[5] and fe < 0.0:
+                fe, ke = 0.0, 0.0
+            f.append(fe)
+            k.append(ke)
+        return f, k
+
+    def solve_tip(self, u, q):
+        """Newton on the massless coordinates: 0 = -(GA^T f)_j."""
+        for _ in range(50):
+            f, k = self.element_forces(u, q)
+            worst = 0.0
+            for j in self.massless:
+                jj = j - 2
+                r = -sum(self.GA[e][jj] * f[e] for e in range(len(f)))
+                dr = -sum(self.GA[e][jj] ** 2 * k[e] for e in range(len(f)))
+                if dr == 0.0:
+                    dr = -1.0
+                q[jj] -= r / dr
+                worst = max(worst, abs(r))
+            if worst < 1e-9:
+                break
+        return q
+
+    def unpack(self, y):
+        """Full coordinate/velocity lists from the ODE state (massless coordinates solved)."""
+        nz = self.nz
+        z = [0.0] * nz
+        v = [0.0] * nz
+        m = len(self.massive)
+        for i, j in enumerate(self.massive):
+            z[j] = y[i]
+            v[j] = y[m + i]
+        q = [z[j] for j in range(2, nz)]
+        for j in self.massless:
+            q[j - 2] = self.q_alg[j - 2]
+        q = self.solve_tip(z[1], q)
+        for j in self.massless:
+            z[j] = q[j - 2]
+        return z, v, q, list(y[2 * m:])
+
+    def forces(self, t, y, modes):
+        nz, p = self.nz, self.par
+        z, v, q, (p_m, Q, p_s, cur, e_int) = self.unpack(y)
+        u, v_u = z[1], v[1]
+        f, _k = self.element_forces(u, q)
+        Fz = [0.0] * nz
+        fb = sum(self.Gb[e] * f[e] for e in range(len(f)))
+        for j in range(2, nz):
+            Fz[j] = -sum(self.GA[e][j - 2] * f[e] for e in range(len(f)))
+        Fz[1] -= fb
+        r = min(max(self.ref(t), p[K.P_REFMIN]), p[K.P_REFMAX])
+        v_pid = p[K.P_KP] * (r - u) + p[K.P_KI] * e_int - p[K.P_KD] * v_u
+        v_drive = min(max(v_pid, -p[K.P_VSUP]), p[K.P_VSUP])
+        exc = abs(cur) - p[K.P_IMAX]
+        if exc > 0.0:
+            v_drive -= p[K.P_KIL] * exc * (1.0 if cur > 0 else -1.0)
+            v_drive = min(max(v_drive, -p[K.P_VSUP]), p[K.P_VSUP])
+        x_mc, v_mc = z[0], v[0]
+        di = (v_drive - p[K.P_R] * cur - p[K.P_KT] * v_mc / p[K.P_NS]) / p[K.P_L]
+        de = (r - u) + p[K.P_KAW] * (v_drive - v_pid)
+        Fz[0] += p[K.P_KT] * cur / p[K.P_NS] - p_m * p[K.P_AMC]
+        opening = min(max((p[K.P_XSN] - x_mc) / p[K.P_WSN], 0.0), 1.0)
+        q_vent = p[K.P_GV] * opening * p_m
+        cm = p[K.P_CM] * (p[K.P_CAVF] if p_m < p[K.P_PCAV] else 1.0)
+        cs = p[K.P_CS] * (p[K.P_CAVF] if p_s < p[K.P_PCAV] else 1.0)
+        dpm = (p[K.P_AMC] * v_mc - Q - q_vent) / cm
+        dQ = (p_m - p_s - p[K.P_RH] * Q) / p[K.P_LH]
+        dps = (Q - p[K.P_ASL] * v_u) / cs
+        Fz[1] += p_s * p[K.P_ASL] + p[K.P_FPRE] - p[K.P_KPRE] * u
+        ks, cst = p[K.P_KSTOP], p[K.P_CSTOP]
+        for j, lo, hi in ((0, 0.0, p[K.P_XMAX]), (1, p[K.P_UMIN], p[K.P_UMAX])):
+            dl = lo - z[j]
+            if dl > 0.0:
+                Fz[j] += max(ks * dl - cst * dl * v[j], 0.0)
+            dh = z[j] - hi
+            if dh > 0.0:
+                Fz[j] -= max(ks * dh + cst * dh * v[j], 0.0)
+        fn = []
+        on, c0, mun, nidx, mup, pidx, rs, cv = self.fr
+        for j in range(nz):
+            val = c0[j]
+            if nidx[j] >= 0:
+                val += mun[j] * abs(f[nidx[j]])
+            if pidx[j] == 1:
+                val += mup[j] * abs(p_m)
+            elif pidx[j] == 2:
+                val += mup[j] * abs(p_s)
+            fn.append(val)
+        return z, v, Fz, fn, (di, de, dpm, dQ, dps)
+
+    def rhs(self, t, y, modes):
+        z, v, Fz, fn, (di, de, dpm, dQ, dps) = self.forces(t, y, modes)
+        on, _c0, _mun, _nidx, _mup, _pidx, _rs, cv = self.fr
+        m = len(self.massive)
+        dy = [0.0] * len(y)
+        for i, j in enumerate(self.massive):
+            if on[j] and modes[j] == 2:
+                continue
+            frc = -cv[j] * v[j]
+            if on[j]:
+                frc -= (1.0 if modes[j] > 0 else -1.0) * fn[j]
+            dy[i] = v[j]
+            dy[m + i] = (Fz[j] + frc) / self.mass[j]
+        dy[2 * m:] = [dpm, dQ, dps, di, de]
+        return dy
+
+    def event_values(self, t, y, modes):
+        z, v, Fz, fn, _ = self.forces(t, y, modes)
+        on, rs = self.fr[0], self.fr[6]
+        return [(rs[j] * fn[j] - abs(Fz[j])) if modes[j] == 2 else v[j] for j in range(self.nz) if on[j]]
+
+
+def run_reference(ec: EClutch, method: str, rtol: float):
+    """Integrate with solve_ivp; restarts at breakpoints and friction events.  Returns (t, bearing force)."""
+    imode, interp, key, value = K.POSITION, 0, "bearing_reference", INPUT["bearing_reference"]
+    tin, vin = _as_table(value, key)
+    py = PythonEClutch(ec, tin, vin)
+    s = ec.system
+    y_full, modes = s.initial_state(ec.rest_position)
+    modes = modes.tolist()
+    nz = s.nz
+    py.q_alg = [y_full[2 + j] for j in range(nz - 2)]
+    massive = py.massive
+    y = [y_full[j] for j in massive] + [y_full[nz + j] for j in massive] + list(y_full[2 * nz: 2 * nz + 5])
+    atol = np.array([s.atol[j] for j in massive] + [s.atol[nz + j] for j in massive]
+                    + list(s.atol[2 * nz: 2 * nz + 5]))
+    fr_idx = [j for j in range(nz) if s.fr_on[j]]
+    m = len(massive)
+    breaks = [b for b in tin if 0.0 < b < T_END] + [T_END]
+    t0 = 0.0
+    T, FB = [0.0], [y[2 * m + 2] * ec.actuator.slave_area]
+    n_rhs = 0
+
+    def fun(t, yy):
+        nonlocal n_rhs
+        n_rhs += 1
+        return py.rhs(t, yy, modes)
+
+    for t_stop in breaks:
+        while t0 < t_stop - 1e-12:
+            evs = []
+            for k in range(len(fr_idx)):
+                def ev(t, yy, k=k):
+                    return py.event_values(t, yy, modes)[k]
+                ev.terminal = True
+                evs.append(ev)
+            # consistency of the modes at the start (as the kernel does)
+            z, v, Fz, fn, _ = py.forces(t0, y, modes)
+            for j in fr_idx:
+                if modes[j] == 2 and abs(Fz[j]) > py.fr[6][j] * fn[j]:
+                    modes[j] = 1 if Fz[j] > 0 else -1
+            sol = solve_ivp(fun, (t0, t_stop), y, method=method, rtol=rtol, atol=atol, events=evs)
+            T.extend(sol.t[1:].tolist())
+            FB.extend((sol.y[2 * m + 2, 1:] * ec.actuator.slave_area).tolist())
+            y = sol.y[:, -1].tolist()
+            t0 = float(sol.t[-1])
+            if sol.status == 1:
+                z, v, Fz, fn, _ = py.forces(t0, y, modes)
+                for k, j in enumerate(fr_idx):
+                    if len(sol.t_events[k]):
+                        i = massive.index(j)
+                        if modes[j] == 2:
+                            modes[j] = 1 if Fz[j] > 0 else -1
+                            y[m + i] = 0.0
+                        elif abs(Fz[j]) <= py.fr[6][j] * fn[j]:
+                            modes[j] = 2
+                            y[m + i] = 0.0
+                        else:
+                            modes[j] = 1 if Fz[j] > 0 else -1
+                # step just past the event so it does not fire again at once
+            elif sol.status < 0:
+                raise RuntimeError(sol.message)
+            py.q_alg = py.unpack(y)[2]
+    return np.array(T), np.array(FB), n_rhs
+
+
+def best_of(fn, n):
+    best = math.inf
+    for _ in range(n):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def main(quick: bool = False):
+    ec = EClutch(clutch=ClutchModel.preset(4), friction=FrictionParameters())
+    print("E-clutch dynamics benchmark: 1 s, position control (release 7 mm and re-engage), Model 4, friction on")
+    ec.simulate(INPUT, T_END, rtol=RTOL)  # compile / load cache
+    s = ec.system
+    tin, vin = _as_table(INPUT["bearing_reference"], "bearing_reference")
+    t_kernel, out = best_of(lambda: s.run(K.POSITION, tin, vin, 0, T_END, rtol=RTOL, h_max=0.01, max_steps=500_000,
+                                          t_grid=np.empty(0), event_tol=1e-8, jac_every=4,
+                                          u0=ec.rest_position), 10)
+    stats = out[7]
+    t_sim, res = best_of(lambda: ec.simulate(INPUT, T_END, rtol=RTOL), 5)
+    print(f"clutchlab kernel (Rodas3, rtol {RTOL:g}): {t_kernel * 1e3:.2f} ms -> {T_END / t_kernel:,.0f}x real time "
+          f"({stats[0]} steps, {stats[1]} rejected, {stats[2]} RHS, {stats[3]} Jacobians, {len(out[4])} events)")
+    print(f"clutchlab EClutch.simulate incl. outputs: {t_sim * 1e3:.2f} ms -> {T_END / t_sim:,.0f}x real time")
+
+    tight = ec.simulate(INPUT, T_END, rtol=1e-8, atol_scale=1e-2)
+    grid = np.linspace(0.0, T_END, 2001)
+    fb_tight = np.interp(grid, tight.outputs.time_s, tight.outputs.bearing_force_N)
+    peak = np.abs(fb_tight).max()
+    err_cl = np.abs(np.interp(grid, res.outputs.time_s, res.outputs.bearing_force_N) - fb_tight).max() / peak
+    print(f"clutchlab error vs rtol 1e-8 run: max |dF_b| = {err_cl * 100:.3f} % of peak")
+
+    for method in ("Radau", "BDF", "LSODA"):
+        try:
+            t_ref, (T, FB, n_rhs) = best_of(lambda: run_reference(ec, method, RTOL), 1 if quick else 2)
+        except Exception as exc:  # report, do not hide
+            print(f"solve_ivp {method}: failed ({exc})")
+            continue
+        err_ref = np.abs(np.interp(grid, T, FB) - fb_tight).max() / peak
+        print(f"solve_ivp {method} (Python RHS, rtol {RTOL:g}, same atol): {t_ref:.2f} s, {n_rhs} RHS; "
+              f"error {err_ref * 100:.3f} % of peak; clutchlab is {t_ref / t_sim:,.0f}x faster "
+              f"({t_ref / t_kernel:,.0f}x kernel alone)")
+
+    # batch of 1,000 variants
+    import numba
+
+    n_r, n_s = (10, 10) if quick else (40, 25)
+    ratios = np.linspace(-4.4, -3.6, n_r)
+    scales = np.linspace(1.0, 1.5, n_s)
+    t0 = time.perf_counter()
+    ecs = [EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r, diaphragm_scale=d)),
+                   friction=FrictionParameters()) for r in ratios for d in scales]
+    t_build = time.perf_counter() - t0
+    simulate_batch(ecs[:2], INPUT, T_END, output_step=1e-3)  # compile / load cache
+    threads = numba.get_num_threads()
+    t_all, b = best_of(lambda: simulate_batch(ecs, INPUT, T_END, output_step=1e-3), 1)
+    numba.set_num_threads(1)
+    t_one, _ = best_of(lambda: simulate_batch(ecs, INPUT, T_END, output_step=1e-3), 1)
+    numba.set_num_threads(threads)
+    print(f"batch of {len(ecs)} variants (lever ratio x diaphragm scale; building the models {t_build:.1f} s): "
+          f"{t_all:.2f} s on {threads} threads vs {t_one:.2f} s on 1 ({t_one / t_all:.2f}x); "
+          f"{(b.stats.status == 0).sum()} of {len(ecs)} finished; {len(ecs) * T_END / t_all:,.0f} simulated "
+          "seconds per second")
+
+
+if __name__ == "__main__":
+    main(quick="--quick" in sys.argv)
