@@ -26,9 +26,10 @@ import numba
 import numpy as np
 
 from ..curves import curve_eval
+from ..numerics.dopri import error_norm
 from ..numerics.interp import bracket
 from ..numerics.rosenbrock import (A31, A41, A43, C21, C31, C32, C41, C42, C43, GAMMA, GAMMA1, GAMMA2, lu_factor,
-                                   lu_solve, rodas_error_norm, rodas_next_step)
+                                   lu_solve, rodas_next_step)
 
 # parameter vector layout
 P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF = range(13)
@@ -59,6 +60,19 @@ def _table(tin, vin, interp, t):
     if t < tin[0] or t > tin[tin.shape[0] - 1] or dt <= 0.0:
         return vin[lo] + w * (vin[lo + 1] - vin[lo]), 0.0
     return vin[lo] + w * (vin[lo + 1] - vin[lo]), (vin[lo + 1] - vin[lo]) / dt
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _stop(pen, rate, ks, cs):
+    """Hunt-Crossley end stop: force ``max(k d + c d d', 0)`` [N] and dissipated power ``(F - k d) d'`` [W].
+
+    ``pen`` is the penetration d [m] (no contact if <= 0), ``rate`` its rate d' [m/s].  The force pushes
+    out of the stop; the stored energy is k d^2 / 2.
+    """
+    if pen <= 0.0:
+        return 0.0, 0.0
+    f = max(ks * pen + cs * pen * rate, 0.0)
+    return f, (f - ks * pen) * rate
 
 
 @numba.njit(cache=True, nogil=True)
@@ -142,26 +156,18 @@ def rhs(t, y, modes, out, g, aux, nz, imode, tin, vin, interp, par, mass,
         # end stops (Hunt-Crossley contact): master at 0 and its stroke, CSC at its travel limits
         ks = par[P_KSTOP]
         cs_ = par[P_CSTOP]
-        dl = -x_mc
-        if dl > 0.0:
-            fs = max(ks * dl - cs_ * dl * v_mc, 0.0)
-            Fz[0] += fs
-            dissip += max(-(fs - ks * dl) * v_mc, 0.0) if fs > 0.0 else 0.0
-        dh = x_mc - par[P_XMAX]
-        if dh > 0.0:
-            fs = max(ks * dh + cs_ * dh * v_mc, 0.0)
-            Fz[0] -= fs
-            dissip += max((fs - ks * dh) * v_mc, 0.0) if fs > 0.0 else 0.0
-        dl = par[P_UMIN] - u
-        if dl > 0.0:
-            fs = max(ks * dl - cs_ * dl * v_u, 0.0)
-            Fz[1] += fs
-            dissip += max(-(fs - ks * dl) * v_u, 0.0) if fs > 0.0 else 0.0
-        dh = u - par[P_UMAX]
-        if dh > 0.0:
-            fs = max(ks * dh + cs_ * dh * v_u, 0.0)
-            Fz[1] -= fs
-            dissip += max((fs - ks * dh) * v_u, 0.0) if fs > 0.0 else 0.0
+        fs, ds = _stop(-x_mc, -v_mc, ks, cs_)
+        Fz[0] += fs
+        dissip += ds
+        fs, ds = _stop(x_mc - par[P_XMAX], v_mc, ks, cs_)
+        Fz[0] -= fs
+        dissip += ds
+        fs, ds = _stop(par[P_UMIN] - u, -v_u, ks, cs_)
+        Fz[1] += fs
+        dissip += ds
+        fs, ds = _stop(u - par[P_UMAX], v_u, ks, cs_)
+        Fz[1] -= fs
+        dissip += ds
         out[b0 + 5] = v_drive * cur
     else:
         for k in range(5):
@@ -576,7 +582,7 @@ def integrate(y0, modes0, t0, t_end, nz, imode, tin, vin, interp, breaks, par, m
                    atmp, nz, imode, tin, vin, interp, par, mass, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps,
                    scale, unilateral, fr_on, fr_c0, fr_mun, fr_nidx, fr_mup, fr_pidx, fr_rs, fr_c, f, fraw, Fz)
         n_rhs += 2
-        en = rodas_error_norm(err, y, y1, rtol, atol) if ok else np.inf
+        en = error_norm(err, y, y1, rtol, atol) if ok else np.inf
         if en > 1.0:
             stats[1] += 1
             h = rodas_next_step(h, en, rejected_before)

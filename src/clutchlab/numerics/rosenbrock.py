@@ -17,7 +17,8 @@ Wanner [2], Sec. VI.4::
                             + M sum_j (c_ij / h) K_j + h gamma_i df/dt
     y_new = y + sum_i m_i K_i,       error = K_4
 
-Subsystem kernels call the cached helpers here (numba cannot cache a kernel
+Subsystem kernels call the cached helpers here (and the error norm of
+:mod:`clutchlab.numerics.dopri`) (numba cannot cache a kernel
 that receives another compiled function, so each subsystem writes its own
 loop around its own right-hand side).
 
@@ -36,7 +37,7 @@ import math
 
 import numba
 
-__all__ = ["GAMMA", "lu_factor", "lu_solve", "rodas_error_norm", "rodas_next_step"]
+__all__ = ["GAMMA", "lu_factor", "lu_solve", "rodas_next_step"]
 
 #: diagonal coefficient gamma of Rodas3
 GAMMA = 0.5
@@ -108,18 +109,6 @@ def lu_solve(lu, piv, b):
         for j in range(i + 1, n):
             s -= lu[i, j] * b[j]
         b[i] = s / lu[i, i]
-
-
-@numba.njit(cache=True, nogil=True)
-def rodas_error_norm(err, y_old, y_new, rtol, atol):
-    """RMS norm of the local error scaled by ``atol + rtol*max(|y_old|, |y_new|)`` (atol per state)."""
-    s = 0.0
-    n = err.shape[0]
-    for i in range(n):
-        sc = atol[i] + rtol * max(abs(y_old[i]), abs(y_new[i]))
-        r = err[i] / sc
-        s += r * r
-    return math.sqrt(s / n)
 
 
 @numba.njit(cache=True, nogil=True)
