@@ -148,3 +148,15 @@ def test_sweep_target_outputs():
         run_batch(variants, None, ["lap_time"])
     with pytest.raises(ParameterError, match="variant 1"):
         run_batch(variants.assign(**{"actuator.slave_mass": [0.2, -1.0]}), None, ["input_work"])
+
+
+@pytest.mark.parametrize("name", ["eclutch_launch.toml", "eclutch_hysteresis.toml"])
+def test_example_scenarios_run(name):
+    import pathlib
+
+    sc = load_scenario(pathlib.Path(__file__).parents[2] / "examples" / name)
+    res = run_scenario(sc)
+    o = res.outputs
+    assert o.time_s.iloc[-1] == pytest.approx(sc.t_end)
+    assert o.bearing_position_m.max() > 6e-3  # both release the clutch
+    assert o.torque_Nm.iloc[-1] > 0.9 * o.torque_Nm.iloc[0]  # and engage it again
