@@ -12,10 +12,7 @@ from .interp import bracket
 
 __all__ = ["error_norm", "next_step", "dense_hermite", "initial_step", "bracket", "FASTMATH"]
 
-#: LLVM fast-math flags for the hot kernels: contraction (FMA), reciprocal and approximate functions,
-#: no signed zeros -- but *not* 'nnan'/'ninf', so NaN and infinity checks (infeasible targets, NaN
-#: lock-up times) keep their meaning, and *not* 'reassoc': with reassociation LLVM vectorises sums
-#: (error norms) with a loop peeled to the arrays' alignment, so the last bits -- and through the step
-#: size control whole trajectories at the 1e-12 level -- depend on where numpy happened to allocate.
-#: A sweep must give identical results in any process (local, worker, Dask), so sums stay in order.
-FASTMATH = {"contract", "arcp", "afn", "nsz"}
+#: LLVM fast-math flags for the hot kernels: reassociation, contraction (FMA), reciprocal and
+#: approximate functions, no signed zeros -- but *not* 'nnan'/'ninf', so NaN and infinity checks
+#: (infeasible targets, NaN lock-up times) keep their meaning.
+FASTMATH = {"reassoc", "contract", "arcp", "afn", "nsz"}
