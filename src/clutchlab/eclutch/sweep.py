@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ParameterError
+from ..sweep.targets import check_outputs
 from .actuator import ActuatorParameters
 from .dynamics import EClutch, FrictionParameters, simulate_batch
 from .models import ClutchModel, EClutchParameters
@@ -147,9 +148,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     outputs : list of str
         Names from :data:`OUTPUTS`.
     """
-    unknown = [o for o in outputs if o not in OUTPUTS]
-    if unknown:
-        raise ParameterError(f"eclutch: unknown output {unknown[0]!r} (known: {', '.join(OUTPUTS)})")
+    check_outputs("eclutch", outputs, OUTPUTS)
     sc = _scenario(scenario)
     ecs = [_variant(sc, row, vid) for vid, row in zip(variants.index, variants.to_dict("records"))]
     t, v = sc.input_table()

@@ -44,7 +44,7 @@ import pandas as pd
 from ..eclutch.models import MODEL_NUMBERS, ClutchModel, ComponentCurves, EClutchParameters
 from ..errors import ParameterError
 from ..units import to_si
-from .targets import nan_frame, rows, sweepable_fields, vary_parameter_set
+from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
 
 __all__ = ["run_batch", "describe", "check_variants", "OUTPUTS", "lift_off_position"]
 
@@ -161,9 +161,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     pandas.DataFrame
         Same index, one column per output.
     """
-    unknown = [o for o in outputs if o not in OUTPUTS]
-    if unknown:
-        raise ParameterError(f"eclutch-static: unknown output {unknown[0]!r} (known: {', '.join(OUTPUTS)})")
+    check_outputs("eclutch-static", outputs, OUTPUTS)
     params, curves, number, travel = _base(scenario)
     out = nan_frame(variants.index, outputs)
     values = np.full((len(variants), len(outputs)), np.nan)

@@ -37,7 +37,7 @@ from ..errors import ParameterError
 from ..emtc import _bench_kernel as BK
 from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters, simulate_bench
 from ..emtc.torque import CouplingGeometry
-from .targets import nan_frame, rows, sweepable_fields, vary_parameter_set
+from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
 
 __all__ = ["run_batch", "describe", "check_variants", "OUTPUTS"]
 
@@ -130,9 +130,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     pandas.DataFrame
         Same index, one column per output.
     """
-    unknown = [o for o in outputs if o not in OUTPUTS]
-    if unknown:
-        raise ParameterError(f"emtc: unknown output {unknown[0]!r} (known: {', '.join(OUTPUTS)})")
+    check_outputs("emtc", outputs, OUTPUTS)
     out = nan_frame(variants.index, outputs)
     values = np.full((len(variants), len(outputs)), np.nan)
     for k, (vid, sets, magnet) in enumerate(_variants(variants, scenario)):

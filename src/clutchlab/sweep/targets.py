@@ -237,6 +237,23 @@ def rows(variants: pd.DataFrame):
         yield vid, dict(zip(cols, vals))
 
 
+def check_outputs(model: str, outputs, known) -> None:
+    """Raise ParameterError naming the first of ``outputs`` that ``model`` does not know.
+
+    Parameters
+    ----------
+    model : str
+        Target name used in the message.
+    outputs : iterable of str
+        Requested outputs.
+    known : mapping or iterable of str
+        The target's outputs.
+    """
+    unknown = [o for o in outputs if o not in known]
+    if unknown:
+        raise ParameterError(f"{model}: unknown output {unknown[0]!r} (known: {', '.join(known)})")
+
+
 def nan_frame(index, outputs) -> pd.DataFrame:
     """All-NaN output table."""
     return pd.DataFrame(np.full((len(index), len(outputs)), np.nan), index=index, columns=list(outputs))

@@ -70,7 +70,7 @@ from ..wet.engagement import (
 from ..wet.film import gw_table
 from ..wet.friction import ParametricFriction
 from ..wet.params import Bench, WetClutch
-from .targets import nan_frame, rows, sweepable_fields, vary_parameter_set
+from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
 
 __all__ = ["run_batch", "describe", "check_variants", "OUTPUTS", "RTOL", "MAX_STEP", "MAX_STEPS"]
 
@@ -213,9 +213,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     pandas.DataFrame
         Same index, one column per output.
     """
-    unknown = [o for o in outputs if o not in OUTPUTS]
-    if unknown:
-        raise ParameterError(f"wet: unknown output {unknown[0]!r} (known: {', '.join(OUTPUTS)})")
+    check_outputs("wet", outputs, OUTPUTS)
     built = _build(variants, scenario)
     m = len(built)
     summary = np.full((m, 8), np.nan)
