@@ -282,11 +282,7 @@ def _enforce_modes(t, y, modes, Fz, f, nz, mass, fr_on, fr_c0, fr_mun, fr_nidx, 
                     kind = EV_REVERSAL
         if kind >= 0:
             changed = True
-            if n_ev < max_ev:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = kind
-                ev_idx[n_ev] = j
-                n_ev += 1
+            n_ev = _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, j)
     return changed, n_ev
 
 
@@ -338,6 +334,17 @@ def _step(t, y, h, J, mvec, f0, ft, nonauto, modes, ynew, err, G, piv, K1, K2, K
     return ok
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, idx):
+    """Append an event (time [s], kind, index) if there is room; returns the new count."""
+    if n_ev < ev_t.shape[0]:
+        ev_t[n_ev] = t
+        ev_kind[n_ev] = kind
+        ev_idx[n_ev] = idx
+        n_ev += 1
+    return n_ev
+
+
 @numba.njit(cache=True, nogil=True)
 def _new_modes(t, y, modes, g_old, g_new, nz, n_el, imode, fr_on, Fz_at, fn_at, fr_rs, ev_t, ev_kind, ev_idx,
                n_ev, max_ev):
@@ -359,36 +366,23 @@ def _new_modes(t, y, modes, g_old, g_new, nz, n_el, imode, fr_on, Fz_at, fn_at, 
                 else:
                     modes[j] = 1 if Fz_at[j] > 0.0 else -1
                     kind = EV_REVERSAL
-            if n_ev < max_ev:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = kind
-                ev_idx[n_ev] = j
-                n_ev += 1
+            n_ev = _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, j)
     for e in range(n_el):
         k = nz + e
         if g_old[k] * g_new[k] < 0.0:
-            if n_ev < max_ev:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = EV_CONTACT_OPEN if g_new[k] < 0.0 else EV_CONTACT_CLOSE
-                ev_idx[n_ev] = e
-                n_ev += 1
+            kind = EV_CONTACT_OPEN if g_new[k] < 0.0 else EV_CONTACT_CLOSE
+            n_ev = _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, e)
     ne = nz + n_el
     for s in range(4):
         k = ne + s
         if g_old[k] * g_new[k] < 0.0:
-            if n_ev < max_ev:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = EV_STOP_HIT if g_new[k] < 0.0 else EV_STOP_LEAVE
-                ev_idx[n_ev] = s
-                n_ev += 1
+            kind = EV_STOP_HIT if g_new[k] < 0.0 else EV_STOP_LEAVE
+            n_ev = _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, s)
     for s in range(2):
         k = ne + 4 + s
         if g_old[k] * g_new[k] < 0.0:
-            if n_ev < max_ev:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = EV_CAVITATION_START if g_new[k] < 0.0 else EV_CAVITATION_END
-                ev_idx[n_ev] = s
-                n_ev += 1
+            kind = EV_CAVITATION_START if g_new[k] < 0.0 else EV_CAVITATION_END
+            n_ev = _record(ev_t, ev_kind, ev_idx, n_ev, t, kind, s)
     return n_ev
 
 
@@ -694,7 +688,8 @@ def integrate(y0, modes0, t0, t_end, nz, imode, tin, vin, interp, breaks, par, m
             MODES[i_rec, :] = modes
             i_rec += 1
         if not event:
-            h = rodas_next_step(h, en, rejected_before) if not hit_stop else max(h, rodas_next_step(h, en, rejected_before))
+            h_new = rodas_next_step(h, en, rejected_before)
+            h = h_new if not hit_stop else max(h, h_new)
         rejected_before = False
     stats[2] = n_rhs
     stats[4] = status
