@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab import units
 from clutchlab.errors import ParameterError
@@ -17,7 +18,7 @@ def test_closed_form_conversions():
     np.testing.assert_allclose(units.rad_s_to_rpm(np.array([math.pi])), [30.0])
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.floats(-1e6, 1e6, allow_nan=False))
 def test_round_trips(x):
     assert units.rad_s_to_rpm(units.rpm_to_rad_s(x)) == pytest.approx(x, abs=1e-9)

@@ -14,6 +14,9 @@ __version__ = "0.1.0"
 from .errors import ClutchlabError, DataError, IdentificationError, ParameterError, SimulationError  # noqa: E402
 from .curves import Curve  # noqa: E402
 from . import curves  # noqa: E402
+from . import _compile_notice  # noqa: E402
+
+_compile_notice.install()  # one stderr line when kernels are compiled (never at import)
 
 __all__ = [
     "__version__",

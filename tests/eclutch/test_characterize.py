@@ -4,6 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 import clutchlab
 from clutchlab.curves import Curve, series
@@ -281,7 +282,7 @@ def test_operator_pause_mid_stroke_does_not_split_a_branch():
 
 
 # ---------------------------------------------------------------- property tests
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=examples(15), deadline=None)
 @given(a=st.floats(5e4, 5e6), b_rel=st.floats(0.0, 3.0), travel=st.floats(0.5e-3, 10e-3),
        friction=st.floats(0.0, 60.0))
 def test_noise_free_quadratic_law_is_recovered(a, b_rel, travel, friction):
@@ -296,7 +297,7 @@ def test_noise_free_quadratic_law_is_recovered(a, b_rel, travel, friction):
     np.testing.assert_allclose(curve.hysteresis_half_width[inner], friction, atol=2e-4 * span + 1e-6)
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=examples(10), deadline=None)
 @given(f1=st.floats(0.0, 80.0), f2=st.floats(0.0, 80.0), seed=st.integers(0, 2**16))
 def test_averaged_curve_does_not_depend_on_the_friction(f1, f2, seed):
     """The friction is symmetric on both branches, so the average is friction-free (Section 4)."""

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab import Curve
 from clutchlab.eclutch import (ClutchModel, ComponentCurves, EClutchParameters, Lever, Node, Spring,
@@ -102,7 +103,7 @@ def test_static_curve_frame_and_torque(true_curves):
     assert clutch_torque(5000.0, 0.1, 0.3) == pytest.approx(300.0)
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=examples(12), deadline=None)
 @given(n=st.sampled_from([0, 1, 2, 3, 4]), ratio=st.floats(-5.0, -3.2), cushion=st.floats(0.55e-3, 0.8e-3),
        k_fl=st.floats(6e5, 3e6))
 def test_torque_non_increasing_with_release_and_zero_after_liftoff(true_curves, n, ratio, cushion, k_fl):

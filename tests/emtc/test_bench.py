@@ -180,9 +180,10 @@ def test_load_scenario(tmp_path):
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=examples(12), deadline=None)
 @given(thr_end=st.floats(0.0, 1.0), ref=st.floats(20.0, 400.0), dv=st.floats(-0.2, 0.2))
 def test_no_chattering_property(thr_end, ref, dv):
     """Whatever the load and reference, lock/unlock events never alternate rapidly (Fig. 11 logic)."""

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.emtc import FrictionMap, LuGreParameters, coupling_torque, drag_torque, lugre_simulate, lugre_steady_state, stribeck
 from clutchlab.errors import DataError, ParameterError
@@ -42,7 +43,7 @@ def test_lugre_exact_step_is_independent_of_sampling():
     assert coarse.z[-1] == pytest.approx(expect, rel=1e-12)
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(speeds=st.lists(st.floats(-50, 50), min_size=2, max_size=80), dt=st.floats(1e-6, 1.0))
 def test_lugre_bristle_state_bounded(speeds, dt):
     t = np.arange(len(speeds)) * dt

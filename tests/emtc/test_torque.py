@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.emtc import (
     CouplingGeometry,
@@ -108,7 +109,7 @@ def test_locked_beyond_capacity_and_margin():
     assert locked_torques(0.0, 0.0, G) == (0.0, 0.0, 0.0)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(fn1=st.floats(1.0, 3000.0), frac=st.floats(-1.0, 1.0), cam=st.floats(1.0, 5.5))
 def test_locked_sum_and_capacities_never_exceeded(fn1, frac, cam):
     g = CouplingGeometry(cam_ratio=cam)

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import ParameterError, SimulationError
 from clutchlab.fmu import COSIMULATIONS
@@ -297,7 +298,7 @@ def test_public_api_is_documented():
 
 
 # ----------------------------------------------------------------- properties
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=examples(8), deadline=None)
 @given(levels=st.lists(st.floats(0.0, 450.0), min_size=2, max_size=4), m=st.integers(2, 5))
 def test_emtc_splitting_a_step_changes_nothing(levels, m):
     """Held inputs: one step of m controller samples equals m steps of one sample, bit for bit."""
@@ -314,7 +315,7 @@ def test_emtc_splitting_a_step_changes_nothing(levels, m):
     assert coarse.n_steps == fine.n_steps
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=examples(8), deadline=None)
 @given(levels=st.lists(st.floats(0.0, 5000.0), min_size=3, max_size=6))
 def test_wet_dissipation_and_actuator_closed_form(levels):
     """Any held force sequence: friction work never decreases (dissipation >= 0), the actuator force

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.hysteresis import Preisach, PreisachState, forc_table_from_masses
@@ -99,7 +100,7 @@ def test_interpolation_triangular_cell_linear_eq5():
 inputs = st.lists(st.floats(0.0, 4.5, allow_nan=False), min_size=1, max_size=25)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(seed=st.integers(0, 50), history=inputs, top=st.floats(0.0, 4.5), tail=inputs)
 def test_wiping_out(seed, history, top, tail):
     """An input above every past value erases the memory: the history no longer matters."""
@@ -110,7 +111,7 @@ def test_wiping_out(seed, history, top, tail):
     np.testing.assert_allclose(a, b, atol=1e-9)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(seed=st.integers(0, 50), history=inputs, excursion=inputs, tail=inputs)
 def test_return_point_memory(seed, history, excursion, tail):
     """A closed excursion from the last reversal point leaves no trace (return-point memory).
@@ -133,7 +134,7 @@ def test_return_point_memory(seed, history, excursion, tail):
     np.testing.assert_allclose(a[-len(tail):], b[-len(tail):], atol=1e-9)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(seed=st.integers(0, 50), h1=inputs, h2=inputs, ua=st.floats(0.0, 4.0), width=st.floats(0.05, 2.0),
        n=st.integers(2, 12))
 def test_congruency_of_minor_loops(seed, h1, h2, ua, width, n):
@@ -150,7 +151,7 @@ def test_congruency_of_minor_loops(seed, h1, h2, ua, width, n):
     np.testing.assert_allclose(out[0], out[1], atol=1e-9)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(seed=st.integers(0, 50), u=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=60))
 def test_output_within_major_loop(seed, u):
     m = model(seed)
@@ -161,7 +162,7 @@ def test_output_within_major_loop(seed, u):
     assert np.all(y <= high + 1e-9)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(seed=st.integers(0, 50), u=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=60))
 def test_invert_simulate_identity(seed, u):
     m = model(seed)
@@ -298,7 +299,7 @@ def test_json_roundtrip(tmp_path):
         Preisach.from_json(tmp_path / "bad.json")
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(history=st.lists(st.floats(0.0, 4.5), min_size=1, max_size=30), v=st.floats(0.0, 4.5),
        gap=st.floats(0.2e-3, 1.0e-3))
 def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):

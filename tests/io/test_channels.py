@@ -4,6 +4,7 @@ import math
 
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.io import ChannelMap, ChannelSpec, canonical_unit, unit_conversion
@@ -49,7 +50,7 @@ def test_unit_conversion_errors_name_channel_and_unit():
 UNITS = ["rpm", "rad/s", "deg/s", "degC", "degF", "K", "bar", "kPa", "Pa", "psi"]
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.sampled_from(UNITS), st.sampled_from(UNITS), st.floats(-1e4, 1e4))
 def test_conversion_round_trip_is_identity(u, v, x):
     try:

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.io import read_measurement, read_table, resample, write_measurement
@@ -142,7 +143,7 @@ def test_table_without_time(tmp_path):
     assert read_measurement(out, time=None).units == {"airgap": "m", "current": "A", "force": "N"}
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.lists(st.floats(1e-3, 1.0), min_size=2, max_size=30), st.floats(-5, 5), st.floats(-5, 5),
        st.lists(st.floats(0, 1), min_size=1, max_size=20))
 def test_resample_properties(steps, slope, intercept, where):

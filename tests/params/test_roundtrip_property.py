@@ -5,6 +5,7 @@ import math
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import ParameterError
 from clutchlab.params.registry import MODELS, load_model_file, model_sets, model_toml
@@ -46,7 +47,7 @@ def perturbed_set(draw):
         assume(False)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(perturbed_set())
 def test_documented_toml_round_trip_is_exact(tmp_path_factory, drawn):
     entry, pset = drawn
@@ -56,7 +57,7 @@ def test_documented_toml_round_trip_is_exact(tmp_path_factory, drawn):
     assert model == entry.model and sets == {entry.table: pset}  # floats bit for bit (repr), ints as ints
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(perturbed_set())
 def test_to_toml_from_toml_round_trip(tmp_path_factory, drawn):
     _, pset = drawn
@@ -83,7 +84,7 @@ CONVERSIONS = [
 
 
 @pytest.mark.parametrize("table, name, values, write", CONVERSIONS, ids=[f"{c[1]}-{c[3](1.0).split()[-1]}" for c in CONVERSIONS])
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 @given(data=st.data())
 def test_unit_strings_convert_to_si(tmp_path_factory, table, name, values, write, data):
     value = data.draw(values)

@@ -4,6 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import assume, given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.eclutch import ClutchModel, EClutchParameters
 from clutchlab.sweep import eclutch_static as target
@@ -43,7 +44,7 @@ def test_outputs_match_the_static_curve():
         assert xs[j - 1] < lift <= xs[j] + 1e-15                             # between the last clamped and first open sample
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(x0=st.floats(0.5e-3, 8.5e-3), slope=st.floats(1e5, 1e7), n=st.integers(5, 200))
 def test_lift_off_interpolation_is_exact_for_a_linear_clamp_force(x0, slope, n):
     x = np.linspace(0, 9e-3, n)

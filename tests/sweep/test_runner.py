@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab import __version__
 from clutchlab.errors import ClutchlabError, SimulationError
@@ -232,7 +233,7 @@ def small_run(tmp_path_factory):
     return path, run_sweep(path, tmp / "full", progress=False, plot=False).results
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(lost=st.sets(st.integers(0, 4)), stale=st.booleans())
 def test_any_set_of_missing_chunks_is_redone_exactly(tmp_path_factory, small_run, lost, stale):
     """Whatever chunks an interruption lost, the resume computes exactly those and the results are unchanged."""

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import ParameterError
 from clutchlab.sweep import load_spec, spec_from_dict
@@ -168,7 +169,7 @@ def test_hash_follows_what_changes_the_results(tmp_path):
 values = st.lists(st.floats(0.5, 2.0, allow_nan=False), min_size=1, max_size=4, unique=True)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(a=values, b=values, c=values, chunk=st.integers(1, 20))
 def test_grid_covers_every_combination_once_and_chunks_partition_the_ids(a, b, c, chunk):
     data = {"sweep": {"model": "wet", "outputs": ["energy"], "chunk_size": chunk},

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import ParameterError
 from clutchlab.wet import (
@@ -124,7 +125,7 @@ def test_break_away_event_when_drive_exceeds_capacity():
     assert np.all(np.abs(res.output("drive_torque_Nm")[before]) <= res.output("static_capacity_Nm")[before] + 1e-9)
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=examples(8), deadline=None)
 @given(st.floats(800.0, 8000.0), st.floats(30.0, 300.0))
 def test_energy_conservation_property(force, w0):
     res = dyno(force=force, w0=w0, duration=2.0)

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 from scipy import integrate, special
 
 from clutchlab.errors import ParameterError
@@ -79,7 +80,7 @@ def test_patir_cheng_is_the_gaussian_mean_of_the_gap():
         assert mean_film_thickness(t * SIGMA, SIGMA) == pytest.approx(val * SIGMA, rel=1e-9)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(st.floats(-40, 40), st.floats(-40, 40))
 def test_patir_cheng_monotone_and_bounded(a, b):
     lo, hi = sorted((a, b))

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import DataError
 from clutchlab.wet import FrictionMap, ParametricFriction
@@ -37,7 +38,7 @@ def test_map_reproduces_bilinear_function_and_clamps():
     assert m.mu(-1.0, 90.0) == pytest.approx(bilinear(1.0, 90.0))    # |v|
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(st.floats(0, 4), st.floats(40, 140), st.floats(0, 5000))
 def test_kernel_lookup_equals_python(v, t, f):
     gv = np.array([0.0, 0.5, 1.5, 3.0])

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.wet import asperity_torque, clutch_torque, viscous_torque
 
@@ -24,7 +25,7 @@ def test_clutch_torque_eq6_is_sum():
     assert tau == pytest.approx(asperity_torque(R, N, 0.12, 1665.0) + viscous_torque(R, N, 0.01, A, 2.44, 2e-4))
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.floats(-30, 30).filter(lambda v: abs(v) > 1e-6), st.floats(0, 0.3), st.floats(0, 2e4),
        st.floats(1e-3, 0.2), st.floats(1e-7, 1e-2))
 def test_torque_opposes_slip(v, mu, force, visc, film):

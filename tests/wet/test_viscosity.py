@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.errors import DataError
 from clutchlab.wet import WetClutch, atf_viscosity, fit_viscosity
@@ -19,7 +20,7 @@ def test_clutch_viscosity_property_is_table1():
     assert WetClutch.paper().viscosity == pytest.approx(TABLE1)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.floats(-20, 180), st.floats(0.1, 50))
 def test_viscosity_falls_with_temperature(t, dt):
     assert atf_viscosity(t + dt, *TABLE1) < atf_viscosity(t, *TABLE1)

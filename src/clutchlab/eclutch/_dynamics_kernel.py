@@ -519,6 +519,7 @@ def integrate(y0, modes0, t0, t_end, nz, imode, tin, vin, interp, breaks, par, m
                     fr_c, f, fraw, Fz)
                 n_rhs += 1
         if need_jac and (jac_age >= jac_every or jac_stale):
+            n_extra = 0
             for c in range(n_jac):
                 yp[:] = y
                 dl = 1.5e-8 * max(abs(y[c]), typ[c])
@@ -526,9 +527,19 @@ def integrate(y0, modes0, t0, t_end, nz, imode, tin, vin, interp, breaks, par, m
                 rhs(t, yp, modes, fp, gtmp, atmp, nz, imode, tin, vin, interp, par, mass, GA, Gb, d0, cx, cf, cd,
                     offsets, kinds, extraps, scale, unilateral, fr_on, fr_c0, fr_mun, fr_nidx, fr_mup, fr_pidx, fr_rs,
                     fr_c, f, fraw, Fz)
+                if _crossed(g0, gtmp, n_g):
+                    # the forward difference straddles a kink (cavitation, a contact, an end stop, the current
+                    # limit, ...): difference on the side the state is on, or the Jacobian mixes two regimes
+                    # (a x1000 compliance change gave entries ~1e14 that froze the chamber pressure)
+                    dl = -dl
+                    yp[c] = y[c] + dl
+                    rhs(t, yp, modes, fp, gtmp, atmp, nz, imode, tin, vin, interp, par, mass, GA, Gb, d0, cx, cf,
+                        cd, offsets, kinds, extraps, scale, unilateral, fr_on, fr_c0, fr_mun, fr_nidx, fr_mup,
+                        fr_pidx, fr_rs, fr_c, f, fraw, Fz)
+                    n_extra += 1
                 for r in range(n):
                     J[r, c] = (fp[r] - f0[r]) / dl
-            n_rhs += n_jac
+            n_rhs += n_jac + n_extra
             jac_age = 0
             jac_stale = False
             stats[3] += 1
