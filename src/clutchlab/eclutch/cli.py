@@ -41,14 +41,22 @@ def _characterize(args) -> int:
     from ..plotting import press_characterization
     from .characterize import characterize
 
-    check_writable(args.output, args.force)
-    curve = characterize(args.record, channel=args.channel, n_grid=args.points)
-    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
-                  header_comment=f"characterised from {args.record} by clutchlab eclutch characterize")
-    if args.plot:
-        from ..io import read_measurement
+    from pathlib import Path
 
-        rec = read_measurement(args.record, required=["time_s", "force_N", args.channel]).frame
+    from ..io import read_measurement
+
+    check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
+    # one read: the channel map (if any) renames the logger's channels, units in the file become SI
+    meas = read_measurement(args.record, args.channel_map, required=["time_s", "force_N", args.channel],
+                            name=str(args.record))
+    curve = characterize(meas, channel=args.channel, n_grid=args.points, name=Path(args.record).stem)
+    mapped = f" with channel map {args.channel_map}" if args.channel_map else ""
+    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
+                  header_comment=f"characterised from {args.record}{mapped} by clutchlab eclutch characterize")
+    if args.plot:
+        rec = meas.frame
         fig = press_characterization([dict(title=str(args.record), record=rec, curve=curve, channel=args.channel)],
                                      ncols=1)
         _save_figure(fig, args.plot, args.force)
@@ -59,9 +67,11 @@ def _characterize(args) -> int:
 
 
 def _static(args) -> int:
-    from ..plotting import static_curves_vs_record
+    from ..plotting import static_curves_panels
 
     check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
     travel = to_si(args.travel, "m", name="--travel")
     if not travel > 0:
         raise ParameterError(f"--travel = {args.travel!r}: must be > 0")
@@ -75,7 +85,7 @@ def _static(args) -> int:
         from .validation import read_full_clutch_record
 
         record = read_full_clutch_record(args.record) if args.record else None
-        fig = static_curves_vs_record({model.name: df}, record, title=f"{model.name}: release bearing force")
+        fig = static_curves_panels({model.name: df}, record, title=f"{model.name}: static curves (friction off)")
         _save_figure(fig, args.plot, args.force)
     peak = df["bearing_force_N"].max()
     print(f"{args.output}: {model.name}, {len(df)} points, peak bearing force {peak:.1f} N, "
@@ -159,6 +169,9 @@ def register(subparsers) -> None:
     c.add_argument("record", help="CSV with time_s, force_N, displacement_m (lines starting with # are comments)")
     c.add_argument("-o", "--output", required=True, help="curve CSV to write")
     c.add_argument("--channel", default="displacement_m", help="displacement column (default: %(default)s)")
+    c.add_argument("--channel-map", metavar="MAP.toml",
+                   help="TOML map from the logger's channel names and units to time_s, force_N and the "
+                        "displacement channel (docs/measurements.md)")
     c.add_argument("--points", type=int, default=60, help="samples of the returned curve (default: %(default)s)")
     c.add_argument("--plot", help="also write a PNG figure of raw record and curve")
     c.add_argument("--force", action="store_true", help="overwrite existing output files")
@@ -172,7 +185,7 @@ def register(subparsers) -> None:
     s.add_argument("--travel", default="9 mm", help="release travel, with unit (default: %(default)s)")
     s.add_argument("--points", type=int, default=200, help="number of bearing positions (default: %(default)s)")
     s.add_argument("-o", "--output", required=True, help="CSV to write")
-    s.add_argument("--plot", help="also write a PNG figure")
+    s.add_argument("--plot", help="also write a PNG figure: bearing force, normal force and torque over the travel")
     s.add_argument("--record", help="full-clutch record CSV to draw in the figure")
     s.add_argument("--force", action="store_true", help="overwrite existing output files")
     s.set_defaults(func=_static)

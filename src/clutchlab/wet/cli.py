@@ -1,6 +1,6 @@
 """``clutchlab wet`` sub-commands: a thin layer over :mod:`clutchlab.wet`.
 
-``clutchlab wet simulate PROTOCOL.toml -o record.csv [--force]``
+``clutchlab wet simulate PROTOCOL.toml -o record.csv [--plot record.png] [--force]``
     run a protocol on the virtual bench and write the measured record;
 ``clutchlab wet identify RECORDS... -o map.json [--plot map.png] [--force]``
     identify the friction map and k1, k2 from bench records;
@@ -26,7 +26,8 @@ def register(subparsers) -> None:
     sim = sub.add_parser("simulate", help="run a protocol TOML on the virtual bench and write a bench record CSV")
     sim.add_argument("protocol", help="protocol file ([protocol] type = friction_map | engagement | inertia_dynamometer)")
     sim.add_argument("-o", "--output", required=True, help="record CSV to write")
-    sim.add_argument("--force", action="store_true", help="overwrite the output")
+    sim.add_argument("--plot", help="also write a PNG figure of the record (slip, torque, force, temperatures)")
+    sim.add_argument("--force", action="store_true", help="overwrite the outputs")
     sim.set_defaults(func=_simulate)
     ident = sub.add_parser("identify", help="identify the friction map and k1, k2 from bench records")
     ident.add_argument("records", nargs="+", help="bench record CSV files")
@@ -48,9 +49,22 @@ def _simulate(args) -> int:
     from .bench import load_protocol, run_protocol, write_bench_record
 
     check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
     run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype)
     write_bench_record(run, args.output, overwrite=args.force)
+    if args.plot:
+        from ..io import atomic_write_bytes
+        from .plots import map_traces_figure
+
+        fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
     print(f"{args.output}: {len(run.record)} samples of protocol {ptype}; events: {events}")
     return 0
