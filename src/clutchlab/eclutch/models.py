@@ -42,7 +42,8 @@ from ..params import ParameterSet, load_toml, quantity
 from ..units import to_si
 from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
 
-__all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve", "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
+__all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve",
+           "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
 
 MODEL_NUMBERS = (0, 1, 2, 3, 4)
 _BUNDLED = "bundled synthetic press-rig data, characterised (src/clutchlab/eclutch/data)"
@@ -235,7 +236,10 @@ def _curves_from_table(spec, path: Path) -> ComponentCurves:
         close = difflib.get_close_matches(unknown[0], COMPONENTS, n=1)
         hint = f"; did you mean {close[0]!r}?" if close else ""
         raise ParameterError(f"{where}: unknown key {unknown[0]!r}{hint} (allowed: folder, {', '.join(COMPONENTS)})")
-    curves = ComponentCurves.from_folder(path.parent / str(spec["folder"])) if "folder" in spec else ComponentCurves.bundled()
+    if "folder" in spec:
+        curves = ComponentCurves.from_folder(path.parent / str(spec["folder"]))
+    else:
+        curves = ComponentCurves.bundled()
     for name in COMPONENTS:
         if name not in spec:
             continue
