@@ -6,6 +6,7 @@ import io
 import json
 import os
 import pathlib
+import re
 import runpy
 import shlex
 import zipfile
@@ -63,8 +64,8 @@ def test_every_readme_line_is_a_clutchlab_command_with_existing_inputs():
                 continue
             if a.startswith("examples/"):
                 assert (ROOT / a).is_file(), f"README names {a}, which is not in examples/"
-            elif "." in a and not a.replace(".", "").isdigit():  # a file or folder argument
-                assert a.rstrip("/") in produced or a == ".", f"{a}: neither in examples/ nor written by an earlier line"
+            elif a.endswith("/") or re.search(r"\.[a-z0-9]+$", a):  # a file or folder argument
+                assert a.rstrip("/") in produced, f"{a}: neither in examples/ nor written by an earlier line"
         produced.update(o.rstrip("/") for o in outputs)
 
 
@@ -79,6 +80,8 @@ def test_every_readme_command_is_run_and_checked():
 @pytest.fixture(scope="module")
 def readme_run(tmp_path_factory):
     """Run every README command in order in one scratch folder; return {key: (exit code, stdout)}."""
+    import matplotlib.pyplot as plt
+
     work = tmp_path_factory.mktemp("readme")
     results = {}
     old = os.getcwd()
@@ -91,6 +94,7 @@ def readme_run(tmp_path_factory):
             out = io.StringIO()
             with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
                 code = main(argv)
+            plt.close("all")
             results[_key(args)] = (code, out.getvalue())
     finally:
         os.chdir(old)
@@ -260,9 +264,9 @@ def check_record(work, out):
 
 
 def check_report(work, out):
-    html = (work / "report" / "index.html").read_text()
-    assert "run.csv" in html and "curves.csv" in html
-    assert "data:image/png;base64," in html
+    html = (work / "results" / "report" / "index.html").read_text()
+    assert "results.parquet" in html and "peak_bearing_force" in html   # the sweep's table and outputs
+    assert "data:image/png;base64," in html and "synthetic" in html
 
 
 def check_fmu(work, out):
@@ -296,7 +300,7 @@ CHECKS = {
     "my_params.toml": check_my_params,
     "params check my_params.toml": check_params_check,
     "record.csv": check_record,
-    "report/": check_report,
+    "report results/": check_report,
     "eclutch.fmu": check_fmu,
     "results/": check_results,
 }
