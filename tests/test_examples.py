@@ -1,14 +1,329 @@
-"""Every script in examples/ runs (the README tour among them)."""
+"""The examples: every script in examples/ runs, and every command of README.md's command list runs on
+the example inputs (in order, in a scratch folder) and gives a physically sensible output."""
 
+import contextlib
+import io
+import json
+import os
 import pathlib
+import re
 import runpy
+import shlex
+import zipfile
 
+import numpy as np
+import pandas as pd
 import pytest
 
-EXAMPLES = sorted((pathlib.Path(__file__).parents[1] / "examples").glob("*.py"))
+from clutchlab.cli import main
+
+ROOT = pathlib.Path(__file__).parents[1]
+EXAMPLE_DIR = ROOT / "examples"
+EXAMPLES = sorted(EXAMPLE_DIR.glob("*.py"))
+#: README commands run by another test (expensive, and tested there in depth): command -> test file
+RUN_ELSEWHERE = {"demo": "tests/test_demo.py"}
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
 def test_example_runs(path, capsys):
     runpy.run_path(str(path), run_name="__main__")
     assert capsys.readouterr().out.strip()
+
+
+# ---------------------------------------------------------------------------------------- README commands
+def readme_commands() -> list[list[str]]:
+    """The ``clutchlab ...`` lines of README.md's command-line block, as argument lists."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    start = text.index("```bash", text.index("Command line"))
+    block = text[start + len("```bash"):text.index("```", start + 7)]
+    lines = [shlex.split(line, comments=True) for line in block.splitlines() if line.strip()]
+    return [line for line in lines if line]
+
+
+def _key(args: list[str]) -> str:
+    """How a README line is identified in CHECKS: its output, else the command itself."""
+    for flag in ("-o", "--output"):
+        if flag in args:
+            return args[args.index(flag) + 1]
+    return " ".join(args[1:])
+
+
+def _outputs(args):
+    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot")]
+
+
+def test_every_readme_line_is_a_clutchlab_command_with_existing_inputs():
+    commands = readme_commands()
+    assert len(commands) >= 15
+    produced = set()
+    for args in commands:
+        assert args[0] == "clutchlab", args
+        outputs = _outputs(args)
+        for a in args[2:]:
+            if a.startswith("-") or a in outputs:
+                continue
+            if a.startswith("examples/"):
+                assert (ROOT / a).is_file(), f"README names {a}, which is not in examples/"
+            elif a.endswith("/") or re.search(r"\.[a-z0-9]+$", a):  # a file or folder argument
+                assert a.rstrip("/") in produced, f"{a}: neither in examples/ nor written by an earlier line"
+        produced.update(o.rstrip("/") for o in outputs)
+
+
+def test_every_readme_command_is_run_and_checked():
+    keys = [_key(a) for a in readme_commands() if a[1] not in RUN_ELSEWHERE]
+    assert len(keys) == len(set(keys)), "two README lines write the same output"
+    assert sorted(keys) == sorted(CHECKS)
+    for command, test_file in RUN_ELSEWHERE.items():
+        assert f'main(["{command}"' in (ROOT / test_file).read_text()
+
+
+@pytest.fixture(scope="module")
+def readme_run(tmp_path_factory):
+    """Run every README command in order in one scratch folder; return {key: (exit code, stdout)}."""
+    import matplotlib.pyplot as plt
+
+    work = tmp_path_factory.mktemp("readme")
+    results = {}
+    old = os.getcwd()
+    os.chdir(work)
+    try:
+        for args in readme_commands():
+            if args[1] in RUN_ELSEWHERE:
+                continue
+            argv = [str(ROOT / a) if a.startswith("examples/") else a for a in args[1:]]
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+                code = main(argv)
+            plt.close("all")
+            results[_key(args)] = (code, out.getvalue())
+    finally:
+        os.chdir(old)
+    return work, results
+
+
+def _csv(path):
+    return pd.read_csv(path, comment="#")
+
+
+def _is_png(path, min_height_over_width=0.0):
+    import matplotlib.image
+
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    h, w = matplotlib.image.imread(path).shape[:2]
+    return h / w >= min_height_over_width
+
+
+def check_curve(work, out):
+    from clutchlab.eclutch import VirtualClutch
+
+    curve = _csv(work / "curve.csv")
+    truth = VirtualClutch()
+    law = truth.diaphragm_at_tip()
+    # the LVDT reads deflection + rig compliance * force ([1] Sec. 5.3): undo it to compare with the truth
+    x_true = curve["deflection_m"] - truth.press_compliance * curve["force_N"]
+    scale = curve["force_N"].abs().max()
+    assert np.max(np.abs(law(x_true.to_numpy()) - curve["force_N"])) < 0.03 * scale
+    assert "3 cycles" in out
+    assert _is_png(work / "curve.png")
+
+
+def check_logger_curve(work, out):
+    # same test, logged in kN and mm with other names: after the map and unit conversion it is the same curve
+    a, b = _csv(work / "curve.csv"), _csv(work / "logger_curve.csv")
+    x = np.linspace(max(a.deflection_m.min(), b.deflection_m.min()), min(a.deflection_m.max(), b.deflection_m.max()), 30)
+    fa, fb = np.interp(x, a.deflection_m, a.force_N), np.interp(x, b.deflection_m, b.force_N)
+    assert np.max(np.abs(fa - fb)) < 0.02 * np.max(np.abs(fa))
+    assert "channel map" in (work / "logger_curve.csv").read_text().split("deflection_m")[0]
+
+
+def check_curves(work, out):
+    from clutchlab.eclutch import ClutchModel, ComponentCurves
+
+    df = _csv(work / "curves.csv")
+    api = ClutchModel.preset(4, curves=ComponentCurves.bundled().replace(
+        "diaphragm", EXAMPLE_DIR / "my_diaphragm.csv")).static_curve(df["bearing_position_m"].to_numpy())
+    np.testing.assert_allclose(df["bearing_force_N"], api["bearing_force_N"], rtol=1e-7, atol=1e-5)
+    assert df["bearing_force_N"].iloc[0] == pytest.approx(80.0, abs=1e-4)   # zeroed at the CSC preload
+    assert df["torque_Nm"].iloc[0] > 200 and df["torque_Nm"].iloc[-1] == pytest.approx(0.0, abs=1e-9)
+    assert _is_png(work / "curves.png", min_height_over_width=1.0)            # three stacked panels
+
+
+def check_variant(work, out):
+    var, own = _csv(work / "variant.csv"), _csv(work / "curves.csv")
+    assert var["bearing_force_N"].iloc[0] == pytest.approx(80.0, abs=1e-4)
+    assert var["bearing_force_N"].max() == pytest.approx(own["bearing_force_N"].max(), rel=0.02)
+    assert "Model 4 with my diaphragm" in out
+
+
+def check_validate(work, out):
+    rows = {int(line.split()[0]): [float(v) for v in line.split()[1:]] for line in out.splitlines()[1:]}
+    assert sorted(rows) == [0, 1, 2, 3, 4]
+    assert rows[2][0] < 0.7 * rows[0][0]     # the lever compliance of Models 1-2 halves the force RMSE (docs)
+
+
+def _slip_rpm(record):
+    return record["slip_speed_rad_s"] * 30 / np.pi
+
+
+def check_record1(work, out):
+    rec = _csv(work / "record1.csv")
+    hold = rec[(rec.time_s > 2.0) & (rec.time_s < 5.0)]
+    assert _slip_rpm(hold).median() == pytest.approx(300, rel=0.02)
+    assert hold["force_N"].median() == pytest.approx(1665, rel=0.02)
+    assert _is_png(work / "record1.png")
+
+
+def check_record2(work, out):
+    rec = _csv(work / "record2.csv")
+    hold = rec[(rec.time_s > 2.0) & (rec.time_s < 5.0)]
+    assert _slip_rpm(hold).median() == pytest.approx(450, rel=0.02)
+
+
+def check_engagement(work, out):
+    rec = _csv(work / "engagement.csv")
+    assert _slip_rpm(rec).iloc[:5].mean() == pytest.approx(1500, rel=0.02)
+    assert abs(_slip_rpm(rec).iloc[-10:].mean()) < 20          # engaged at the end
+    assert "lock-up" in out
+    assert _is_png(work / "engagement.png")
+
+
+def check_map(work, out):
+    from clutchlab.wet import FrictionMap
+    from clutchlab.wet.friction import ParametricFriction
+
+    fmap = FrictionMap.from_json(work / "map.json")
+    truth = ParametricFriction.bench_truth()
+    cov = fmap.covered if fmap.covered.ndim == 2 else fmap.covered[0]
+    vv, tt = np.meshgrid(fmap.speed_grid, fmap.temperature_grid)
+    assert cov.sum() >= 4
+    err = fmap.mu(vv[cov], tt[cov]) - truth.mu(vv[cov], tt[cov])
+    assert np.max(np.abs(err)) < 0.006                          # the bench's true map, recovered
+    assert _is_png(work / "map.png")
+
+
+def _truth_magnet():
+    from clutchlab.emtc.magnet import synthetic_magnet
+
+    return synthetic_magnet([0.6e-3])
+
+
+def check_model(work, out):
+    from clutchlab.hysteresis import Preisach
+
+    forc = _csv(EXAMPLE_DIR / "forc.csv")
+    model = Preisach.from_json(work / "model.json")
+    f = model.simulate(forc["current"].to_numpy())
+    assert np.sqrt(np.mean((f - forc["force"]) ** 2)) < 0.02 * forc["force"].max()
+
+
+def check_out(work, out):
+    res = _csv(work / "out.csv")
+    truth = _truth_magnet().simulate(res["current"].to_numpy())
+    assert np.max(np.abs(res["force_model"] - truth)) < 0.03 * np.max(truth)
+
+
+def check_run(work, out):
+    run = _csv(work / "run.csv")
+    assert run["time"].iloc[-1] == pytest.approx(1.5, abs=0.01)
+    assert "armature contacts primary clutch" in out
+    assert (run["t_coupling"].iloc[len(run) // 2:] > 0).all()   # the coupling transmits torque once engaged
+    assert _is_png(work / "run.png")
+
+
+def check_launch(work, out):
+    run = _csv(work / "launch.csv")
+    assert run["reference_m"].max() == pytest.approx(8e-3, rel=1e-9)           # release_travel of the scenario
+    assert run["bearing_position_m"].max() == pytest.approx(8e-3, rel=0.1)     # ... which the bearing follows
+    assert run["torque_Nm"].iloc[0] > 200 and run["torque_Nm"].min() < 5          # engaged, released
+    assert _is_png(work / "launch.png")
+
+
+def check_params_show(work, out):
+    rows = {line.split()[0]: line.split()[1] for line in out.splitlines() if line.startswith("  ") and line.split()}
+    assert rows["seed"] == "20240601" and rows["n_c"] == "8"    # integers print as integers
+    assert rows["r_outer"] == "0.08315"
+
+
+def check_my_params(work, out):
+    text = (work / "my_params.toml").read_text()
+    assert "[eclutch]" in text and "bearing_preload" in text
+
+
+def check_params_check(work, out):
+    assert "valid eclutch parameters" in out
+
+
+def check_record(work, out):
+    from clutchlab.io import read_measurement
+
+    rec = read_measurement(work / "record.csv")
+    raw = read_measurement(EXAMPLE_DIR / "press_logger.mf4", time="t")
+    assert rec.units["force_N"] == "N" and rec.units["displacement_m"] == "m"
+    np.testing.assert_allclose(rec.frame["force_N"], raw.frame["F_Press"] * 1e3, rtol=1e-9)
+    np.testing.assert_allclose(rec.frame["displacement_m"], raw.frame["LVDT1"] * 1e-3, rtol=1e-9)
+
+
+def check_report(work, out):
+    html = (work / "results" / "report" / "index.html").read_text()
+    assert "results.parquet" in html and "peak_bearing_force" in html   # the sweep's table and outputs
+    assert "data:image/png;base64," in html and "synthetic" in html
+
+
+def check_fmu(work, out):
+    with zipfile.ZipFile(work / "eclutch.fmu") as z:
+        xml = z.read("modelDescription.xml").decode()
+    assert 'fmiVersion="2.0"' in xml and "bearing_force" in xml
+
+
+def check_results(work, out):
+    frame = pd.read_parquet(work / "results" / "results.parquet")
+    assert len(frame) == 12                                     # the 4 x 3 grid of the spec
+    peak = frame.filter(like="peak_bearing_force").iloc[:, 0]
+    assert np.isfinite(peak).all() and peak.max() > peak.min()  # the stiffer diaphragm needs more force
+
+
+CHECKS = {
+    "curve.csv": check_curve,
+    "logger_curve.csv": check_logger_curve,
+    "curves.csv": check_curves,
+    "variant.csv": check_variant,
+    "eclutch validate examples/full_clutch.csv": check_validate,
+    "record1.csv": check_record1,
+    "record2.csv": check_record2,
+    "engagement.csv": check_engagement,
+    "map.json": check_map,
+    "model.json": check_model,
+    "out.csv": check_out,
+    "run.csv": check_run,
+    "launch.csv": check_launch,
+    "params show wet --paper": check_params_show,
+    "my_params.toml": check_my_params,
+    "params check my_params.toml": check_params_check,
+    "record.csv": check_record,
+    "report results/": check_report,
+    "eclutch.fmu": check_fmu,
+    "results/": check_results,
+}
+
+
+@pytest.mark.parametrize("key", list(CHECKS))
+def test_readme_command(readme_run, key):
+    work, results = readme_run
+    code, out = results[key]
+    assert code == 0, f"clutchlab ... {key}: exit {code}"
+    CHECKS[key](work, out)
+
+
+def test_example_generator_reproduces_the_committed_files(tmp_path):
+    from clutchlab.io import read_measurement
+
+    mod = runpy.run_path(str(EXAMPLE_DIR / "_tools" / "make_examples.py"))
+    for path in mod["generate"](tmp_path):
+        committed = EXAMPLE_DIR / path.name
+        if path.suffix == ".mf4":   # MDF headers carry a time stamp: compare the channels
+            a, b = read_measurement(path, time="t"), read_measurement(committed, time="t")
+            pd.testing.assert_frame_equal(a.frame, b.frame)
+            assert a.units == b.units
+        else:
+            assert path.read_text() == committed.read_text(), path.name
+        assert "synthetic" in committed.read_bytes()[:4096].decode("latin-1")

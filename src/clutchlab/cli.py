@@ -68,10 +68,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="clutchlab",
         description="Model, simulate and identify automotive clutches (E-clutch, wet multi-plate, EMTC).",
+        epilog="Documentation: README.md and docs/index.md (one page per subsystem). "
+               "'clutchlab COMMAND --help' describes each command.",
     )
     parser.add_argument("--version", action="version", version=f"clutchlab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    demo = sub.add_parser("demo", help="run every subsystem's demo on bundled synthetic data and write an HTML report")
+    demo = sub.add_parser("demo", help="run every subsystem's demo on bundled synthetic data and write an HTML report",
+                          description="Run the E-clutch, wet-clutch and EMTC demos on the bundled synthetic data "
+                                      "(characterisation, identification, simulation against the virtual rigs) and "
+                                      "write one self-contained HTML report with figures and tables.",
+                          epilog="Documentation: docs/report.md")
     demo.add_argument("-o", "--output", default="clutchlab-demo", help="report folder to write (default: %(default)s)")
     demo.add_argument("--force", action="store_true", help="replace the report folder if it exists")
     demo.set_defaults(func=_demo)

@@ -90,6 +90,46 @@ def static_curves_vs_record(curves: dict, record=None, *, quantity: str = "beari
     return fig
 
 
+def static_curves_panels(curves: dict, record=None, *, title: str = ""):
+    """Static curves in three panels over the bearing position: bearing force, normal force, torque.
+
+    Parameters
+    ----------
+    curves : dict
+        Label -> DataFrame of :meth:`~clutchlab.eclutch.ClutchModel.static_curve`
+        (``bearing_position_m`` [m], ``bearing_force_N`` [N], ``normal_force_N``
+        [N], ``torque_Nm`` [N·m]).
+    record : DataFrame, optional
+        A full-clutch record (``bearing_position_m`` and whichever of the three
+        quantities it has), drawn in grey.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three axes sharing the x axis, labelled with units.
+    """
+    panels = (("bearing_force_N", "bearing force [N]", 1.0), ("normal_force_N", "normal (clamp) force [kN]", 1e-3),
+              ("torque_Nm", "clutch torque [N·m]", 1.0))
+    fig, axes = new_figure(3, 1, width=7.0, height=8.0, sharex=True)
+    for ax, (col, ylabel, factor) in zip(axes, panels):
+        if record is not None and col in record:
+            ax.plot(record["bearing_position_m"] * 1e3, record[col] * factor, color="0.55", lw=0.8,
+                    label="full-clutch record (synthetic)")
+        for k, (label, df) in enumerate(curves.items()):
+            ax.plot(df["bearing_position_m"] * 1e3, df[col] * factor, color=MODEL_COLORS[k % len(MODEL_COLORS)],
+                    lw=1.4, label=label)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    axes[-1].set_xlabel("release bearing position [mm]")
+    if title:
+        axes[0].set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
 def eclutch_response(frame, *, title: str = ""):
     """E-clutch time response: bearing position (and reference), pressure and bearing force, motor current, torque.
 

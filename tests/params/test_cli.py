@@ -1,6 +1,8 @@
 """``clutchlab params show|check``."""
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from clutchlab.cli import main
 from clutchlab.params.registry import load_model_file, preset
@@ -51,3 +53,27 @@ def test_check_reports_file_table_key_and_value(tmp_path, capsys):
     assert "unknown table [actuator] for model 'wet'" in capsys.readouterr().err
     assert main(["params", "check", str(tmp_path / "missing.toml")]) == 2
     assert "no such parameter file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value, text", [
+    (20240601, "20240601"), (8, "8"), (0.08315, "0.08315"), (2.3e6, "2.3e6"), (3e-11, "3e-11"),
+    (1.5e-5, "1.5e-5"), (628.3185307, "628.319"), (-95000.0, "-95000"), (12.0, "12"), (0.0, "0"),
+])
+def test_numbers_print_as_a_person_reads_them(value, text):
+    from clutchlab.params.registry import format_number
+
+    assert format_number(value) == text
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e30, max_value=1e30))
+def test_formatted_numbers_read_back_to_six_digits(value):
+    from clutchlab.params.registry import format_number
+
+    assert float(format_number(value)) == pytest.approx(value, rel=5e-6, abs=1e-300)
+
+
+def test_params_show_prints_the_seed_as_an_integer_and_readable_units(capsys):
+    assert main(["params", "show", "wet"]) == 0
+    rows = {ln.split()[0]: ln.split()[1:3] for ln in capsys.readouterr().out.splitlines() if ln.startswith("  ")}
+    assert rows["seed"] == ["20240601", "1"]
+    assert rows["contact_modulus"] == ["2.3e6", "Pa"] and rows["friction_area"][1] == "m^2"

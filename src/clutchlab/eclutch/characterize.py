@@ -41,7 +41,7 @@ import pandas as pd
 
 from ..curves import Curve, series
 from ..errors import DataError, IdentificationError, ParameterError
-from ..io import read_measurement
+from ..io import Measurement, read_measurement
 
 __all__ = [
     "CharacterizedCurve",
@@ -207,15 +207,16 @@ class _Cycles:
     label: str
 
 
-def _load_record(record, channels, name):
+def _load_record(record, channels, name, channel_map=None):
     if isinstance(record, (str, Path)):
         label = name or str(record)
-    elif isinstance(record, pd.DataFrame):
+    elif isinstance(record, (pd.DataFrame, Measurement)):
         label = name or "record"
     else:
         raise DataError(f"record must be a pandas.DataFrame or a file path, got {type(record).__name__}")
-    # CSV, Parquet or MDF 4; units in the file converted to the ones the column names state
-    frame = read_measurement(record, required=["time_s", "force_N", *channels], name=label).frame
+    # CSV, Parquet or MDF 4; units in the file converted to the ones the column names state; a channel
+    # map renames a logger's channels to time_s, force_N, displacement_m (docs/measurements.md)
+    frame = read_measurement(record, channel_map, required=["time_s", "force_N", *channels], name=label).frame
     t = frame["time_s"].to_numpy(dtype=float)
     if t.size < MIN_SAMPLES:
         raise DataError(f"{label}: record too short ({t.size} samples, need at least {MIN_SAMPLES})")
@@ -336,7 +337,7 @@ def _correct_turning_points(load: np.ndarray, unload: np.ndarray, mean: np.ndarr
 # ------------------------------------------------------------------------ characterize
 def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, kind: str = "pchip",
                  min_cycles: int = 1, turning_point_correction: bool = True,
-                 name: str | None = None) -> CharacterizedCurve:
+                 name: str | None = None, channel_map=None) -> CharacterizedCurve:
     """Component characteristic from a press-rig record ([1], Section 4, Fig. 9).
 
     The procedure of [1], Section 4: "raw experimental results exhibit a
@@ -366,6 +367,13 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         average.
     name : str, optional
         Name of the curve (default: the file name or ``"characterized"``).
+    channel_map : ChannelMap, mapping, str or Path, optional
+        Map from the logger's channel names (and units) to ``time_s``,
+        ``force_N`` and ``channel`` (a TOML file or a mapping, see
+        :class:`~clutchlab.io.channels.ChannelMap` and docs/measurements.md).
+        Without a map the record must use those names; units stated in the
+        file (a CSV ``# units:`` line, Parquet metadata, MDF channel units) are
+        converted to SI either way.
 
     Returns
     -------
@@ -430,7 +438,7 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         raise ParameterError(f"kind = {kind!r}, expected 'pchip' or 'linear'")
     if isinstance(min_cycles, bool) or not isinstance(min_cycles, (int, np.integer)) or min_cycles < 1:
         raise ParameterError(f"min_cycles = {min_cycles!r} must be an integer >= 1")
-    frame, label = _load_record(record, [channel], None)
+    frame, label = _load_record(record, [channel], None, channel_map)
     cyc = _cycles(frame, label, channel, ["force_N"], int(n_grid))
     n_cycles = cyc.loading.shape[0]
     if n_cycles < min_cycles:

@@ -6,7 +6,7 @@ import io
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
 from ..units import to_si
 
@@ -41,14 +41,28 @@ def _characterize(args) -> int:
     from ..plotting import press_characterization
     from .characterize import characterize
 
-    check_writable(args.output, args.force)
-    curve = characterize(args.record, channel=args.channel, n_grid=args.points)
-    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
-                  header_comment=f"characterised from {args.record} by clutchlab eclutch characterize")
-    if args.plot:
-        from ..io import read_measurement
+    from pathlib import Path
 
-        rec = read_measurement(args.record, required=["time_s", "force_N", args.channel]).frame
+    from ..io import read_measurement
+
+    check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
+    # one read: the channel map (if any) renames the logger's channels, units in the file become SI
+    try:
+        meas = read_measurement(args.record, args.channel_map, required=["time_s", "force_N", args.channel],
+                                name=str(args.record))
+    except DataError as exc:
+        if args.channel_map or "missing column" not in str(exc):
+            raise
+        raise DataError(f"{exc}; map the logger's channel names with --channel-map MAP.toml "
+                        "(docs/measurements.md)") from None
+    curve = characterize(meas, channel=args.channel, n_grid=args.points, name=Path(args.record).stem)
+    mapped = f" with channel map {args.channel_map}" if args.channel_map else ""
+    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
+                  header_comment=f"characterised from {args.record}{mapped} by clutchlab eclutch characterize")
+    if args.plot:
+        rec = meas.frame
         fig = press_characterization([dict(title=str(args.record), record=rec, curve=curve, channel=args.channel)],
                                      ncols=1)
         _save_figure(fig, args.plot, args.force)
@@ -59,9 +73,11 @@ def _characterize(args) -> int:
 
 
 def _static(args) -> int:
-    from ..plotting import static_curves_vs_record
+    from ..plotting import static_curves_panels
 
     check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
     travel = to_si(args.travel, "m", name="--travel")
     if not travel > 0:
         raise ParameterError(f"--travel = {args.travel!r}: must be > 0")
@@ -75,7 +91,7 @@ def _static(args) -> int:
         from .validation import read_full_clutch_record
 
         record = read_full_clutch_record(args.record) if args.record else None
-        fig = static_curves_vs_record({model.name: df}, record, title=f"{model.name}: release bearing force")
+        fig = static_curves_panels({model.name: df}, record, title=f"{model.name}: static curves (friction off)")
         _save_figure(fig, args.plot, args.force)
     peak = df["bearing_force_N"].max()
     print(f"{args.output}: {model.name}, {len(df)} points, peak bearing force {peak:.1f} N, "
@@ -151,40 +167,68 @@ def _describe(args) -> int:
 def register(subparsers) -> None:
     """Add ``clutchlab eclutch`` with its sub-commands."""
     p = subparsers.add_parser("eclutch", help="dry clutch-by-wire (E-clutch): press-rig characterisation, Models 0-4",
-                              description="E-clutch after Haramina et al., Trans. FAMENA 48 (2024) 21-35.")
+                              description="E-clutch (dry clutch-by-wire) after Haramina et al., Trans. FAMENA 48 "
+                                          "(2024) 21-35: characterise component curves from press-rig records, "
+                                          "build the axial Models 0-4 from them, compute static curves, validate "
+                                          "against a full-clutch record and simulate actuator and clutch dynamics.",
+                              epilog="Documentation: docs/eclutch.md, docs/pressrig.md, docs/eclutch_dynamics.md")
     sub = p.add_subparsers(dest="eclutch_command", metavar="COMMAND", required=True)
 
-    c = sub.add_parser("characterize", help="characteristic curve from a raw press-rig record (CSV)",
-                       description="Find load cycles, average loading/unloading branches and cycles (Sec. 4).")
-    c.add_argument("record", help="CSV with time_s, force_N, displacement_m (lines starting with # are comments)")
+    c = sub.add_parser("characterize", help="characteristic curve from a raw press-rig record (CSV, Parquet, MDF 4)",
+                       description="Turn a raw press-rig record (force and displacement over several load "
+                                   "cycles) into a component characteristic: find the cycles, average the "
+                                   "loading and unloading branches (removing the friction hysteresis) and the "
+                                   "cycles (Haramina et al. 2024, Sec. 4). A channel map reads a logger's "
+                                   "own channel names and units. The output curve can replace a component "
+                                   "of the models ([eclutch.curves] in a parameter file).",
+                       epilog="Documentation: docs/pressrig.md (characterisation), docs/measurements.md "
+                              "(channel maps), docs/eclutch.md (using your own component curve)")
+    c.add_argument("record", help="record (.csv, .parquet, .mf4) with time_s, force_N, displacement_m, or the "
+                                  "logger's channels named in --channel-map; units in the file are converted")
     c.add_argument("-o", "--output", required=True, help="curve CSV to write")
     c.add_argument("--channel", default="displacement_m", help="displacement column (default: %(default)s)")
+    c.add_argument("--channel-map", metavar="MAP.toml",
+                   help="TOML map from the logger's channel names and units to time_s, force_N and the "
+                        "displacement channel (docs/measurements.md)")
     c.add_argument("--points", type=int, default=60, help="samples of the returned curve (default: %(default)s)")
     c.add_argument("--plot", help="also write a PNG figure of raw record and curve")
     c.add_argument("--force", action="store_true", help="overwrite existing output files")
     c.set_defaults(func=_characterize)
 
     s = sub.add_parser("static", help="static curves (bearing force, normal force, torque) of Model N",
-                       description="Static equilibrium by Newton continuation along the bearing travel.")
+                       description="Static curves of an E-clutch model with friction off: bearing force, normal "
+                                   "(clamp) force and clutch torque over the release bearing travel, by Newton "
+                                   "continuation of the static equilibrium. Give a paper model (--model, "
+                                   "optionally with a --params file that may replace component curves) or a "
+                                   "model variant (--network).",
+                       epilog="Documentation: docs/eclutch.md")
     s.add_argument("--model", type=int, help="model number 0-4 (Haramina et al. 2024)")
-    s.add_argument("--network", help="TOML description of a model variant (see clutchlab.eclutch.variants)")
+    s.add_argument("--network", help="TOML description of a model variant (docs/eclutch.md)")
     s.add_argument("--params", help="TOML parameter file ([eclutch] table; values may carry units)")
     s.add_argument("--travel", default="9 mm", help="release travel, with unit (default: %(default)s)")
     s.add_argument("--points", type=int, default=200, help="number of bearing positions (default: %(default)s)")
     s.add_argument("-o", "--output", required=True, help="CSV to write")
-    s.add_argument("--plot", help="also write a PNG figure")
+    s.add_argument("--plot", help="also write a PNG figure: bearing force, normal force and torque over the travel")
     s.add_argument("--record", help="full-clutch record CSV to draw in the figure")
     s.add_argument("--force", action="store_true", help="overwrite existing output files")
     s.set_defaults(func=_static)
 
-    v = sub.add_parser("validate", help="errors of Models 0-4 against a full-clutch record (Fig. 12)")
+    v = sub.add_parser("validate", help="errors of Models 0-4 against a full-clutch record (Fig. 12)",
+                       description="Compare the static curves of Models 0-4 with a full-clutch release and "
+                                   "re-engagement record (Haramina et al. 2024, Fig. 12): RMSE of bearing "
+                                   "force and torque, peak force and its error, printed as a table.",
+                       epilog="Documentation: docs/eclutch.md")
     v.add_argument("record", help="CSV with time_s, bearing_position_m, bearing_force_N, torque_Nm")
     v.add_argument("--params", help="TOML parameter file")
     v.add_argument("-o", "--output", help="CSV of the metrics")
     v.add_argument("--force", action="store_true", help="overwrite the output file")
     v.set_defaults(func=_validate)
 
-    lv = sub.add_parser("lever", help="finger (lever) stiffness k_fl from the two multi-LVDT records (Eq. 1)")
+    lv = sub.add_parser("lever", help="finger (lever) stiffness k_fl from the two multi-LVDT records (Eq. 1)",
+                        description="Identify the diaphragm finger (lever) stiffness k_fl with Eq. (1) of "
+                                    "Haramina et al. 2024 from the two press tests with LVDTs at the tips, the support and the "
+                                    "pressure-plate edge (tests 8b and 8c).",
+                        epilog="Documentation: docs/pressrig.md")
     lv.add_argument("record_b", help="test 8b: displacement_m at the tips, displacement2_m at the support")
     lv.add_argument("record_c", help="test 8c: displacement_m at the tips, displacement2_m at the pressure-plate edge")
     lv.add_argument("--ratio", type=float, required=True, help="lever ratio i_ds (< 0)")
@@ -195,15 +239,20 @@ def register(subparsers) -> None:
     lv.set_defaults(func=_lever)
 
     sm = sub.add_parser("simulate", help="simulate actuator and clutch dynamics from a scenario TOML",
-                        description="E-clutch dynamics (actuator + axial Model 0-4 with stick-slip friction), "
-                                    "see clutchlab.eclutch.scenario for the scenario format.")
+                        description="Simulate the E-clutch actuator (motor, spindle, hydraulics) with an axial "
+                                    "Model 0-4 and stick-slip friction for a scenario: pedal, position "
+                                    "reference or prescribed bearing cycle, with optional parameter tables.",
+                        epilog="Documentation: docs/eclutch_dynamics.md (scenario format)")
     sm.add_argument("scenario", help="scenario TOML ([scenario], [input], optional parameter tables)")
     sm.add_argument("-o", "--output", required=True, help="results to write: .csv, .parquet or .mf4")
     sm.add_argument("--plot", help="also write a PNG figure (time response, or hysteresis loop)")
     sm.add_argument("--force", action="store_true", help="overwrite existing output files")
     sm.set_defaults(func=_simulate)
 
-    d = sub.add_parser("describe", help="print the nodes and elements of Model N")
+    d = sub.add_parser("describe", help="print the nodes and elements of Model N",
+                       description="Print the nodes (with masses) and elements (springs, contacts, levers with "
+                                   "pre-strains and scales) of a paper model or a model variant.",
+                       epilog="Documentation: docs/eclutch.md")
     d.add_argument("--model", type=int, help="model number 0-4")
     d.add_argument("--network", help="TOML description of a model variant")
     d.add_argument("--params", help="TOML parameter file")

@@ -28,6 +28,7 @@ References
 from __future__ import annotations
 
 import dataclasses
+import difflib
 from importlib import resources
 from pathlib import Path
 
@@ -38,9 +39,11 @@ from ..curves import Curve
 from ..errors import ParameterError
 from ..io import read_table
 from ..params import ParameterSet, load_toml, quantity
+from ..units import to_si
 from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
 
-__all__ = ["EClutchParameters", "ComponentCurves", "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
+__all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve",
+           "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
 
 MODEL_NUMBERS = (0, 1, 2, 3, 4)
 _BUNDLED = "bundled synthetic press-rig data, characterised (src/clutchlab/eclutch/data)"
@@ -105,6 +108,17 @@ class EClutchParameters(ParameterSet):
 COMPONENTS = ("diaphragm", "cushion", "return_springs", "pp_spring", "support_ring", "yoke_spring")
 
 
+def read_component_curve(path, name: str | None = None) -> Curve:
+    """Read one component characteristic from a CSV file (columns ``deflection_m`` [m], ``force_N`` [N]).
+
+    The output of ``clutchlab eclutch characterize`` (extra columns are
+    ignored); interpolated with PCHIP like the bundled curves.
+    """
+    path = Path(path)
+    frame = read_table(path, ["deflection_m", "force_N"])
+    return Curve(frame["deflection_m"].to_numpy(), frame["force_N"].to_numpy(), kind="pchip", name=name or path.stem)
+
+
 @dataclasses.dataclass(frozen=True)
 class ComponentCurves:
     """The measured component characteristics the models are built from ([1] Fig. 9).
@@ -151,18 +165,96 @@ class ComponentCurves:
     def from_folder(cls, folder) -> "ComponentCurves":
         """Read ``<component>.csv`` files (columns ``deflection_m``, ``force_N``) from a folder."""
         folder = Path(folder)
-        curves = {}
-        for name in COMPONENTS:
-            path = folder / f"{name}.csv"
-            frame = read_table(path, ["deflection_m", "force_N"])
-            curves[name] = Curve(frame["deflection_m"].to_numpy(), frame["force_N"].to_numpy(), kind="pchip", name=name)
-        return cls(**curves)
+        return cls(**{name: read_component_curve(folder / f"{name}.csv", name) for name in COMPONENTS})
+
+    def replace(self, component: str, curve, *, scale: float = 1.0) -> "ComponentCurves":
+        """A copy with one component's characteristic replaced (e.g. by your own press-rig curve).
+
+        Build the model from the result with :meth:`ClutchModel.preset`: every
+        model is assembled again around the new curve and its bearing is zeroed
+        at ``EClutchParameters.bearing_preload`` (80 N by default), so the
+        bearing force at bearing position 0 stays the CSC preload.  Model 4's
+        own stiffness factors (``diaphragm_scale``, ``support_scale``) still
+        apply on top of ``scale``.
+
+        Parameters
+        ----------
+        component : str
+            One of :data:`COMPONENTS` (``"diaphragm"``, ``"cushion"``,
+            ``"return_springs"``, ``"pp_spring"``, ``"support_ring"``,
+            ``"yoke_spring"``).
+        curve : Curve, str or Path
+            The new characteristic: a :class:`~clutchlab.Curve` (e.g. from
+            :func:`~clutchlab.eclutch.characterize`) or a CSV file with columns
+            ``deflection_m`` [m] and ``force_N`` [N] (the output of
+            ``clutchlab eclutch characterize``).  Deflection is measured the way
+            the bundled press-rig curves are (docs/pressrig.md).
+        scale : float
+            Stiffness factor [-] applied to the curve (force at equal
+            deflection, :meth:`Curve.scale`); default 1.
+
+        Returns
+        -------
+        ComponentCurves
+            A new set; ``self`` is unchanged.
+
+        Raises
+        ------
+        ParameterError
+            Unknown component, a curve that is neither a Curve nor a file, or a
+            scale that is not finite and > 0.
+        """
+        if component not in COMPONENTS:
+            close = difflib.get_close_matches(str(component), COMPONENTS, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(f"unknown component {component!r}{hint} (known: {', '.join(COMPONENTS)})")
+        if isinstance(curve, (str, Path)):
+            curve = read_component_curve(curve, component)
+        elif not isinstance(curve, Curve):
+            raise ParameterError(f"component {component!r}: expected a clutchlab.Curve or a CSV path, "
+                                 f"got {type(curve).__name__}")
+        if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating)) or not (np.isfinite(scale) and scale > 0):
+            raise ParameterError(f"component {component!r}: scale = {scale!r} must be finite and > 0")
+        if scale != 1.0:
+            curve = curve.scale(float(scale))
+        return dataclasses.replace(self, **{component: curve})
 
     @classmethod
     def bundled(cls) -> "ComponentCurves":
         """The characterised curves shipped with clutchlab (synthetic, from the virtual press rig)."""
         with resources.as_file(resources.files("clutchlab.eclutch") / "data" / "curves") as folder:
             return cls.from_folder(folder)
+
+
+def _curves_from_table(spec, path: Path) -> ComponentCurves:
+    """Component curves of an ``[eclutch.curves]`` table (see :meth:`ClutchModel.from_toml`)."""
+    where = f"{path}: [eclutch.curves]"
+    if not isinstance(spec, dict) or not spec:
+        raise ParameterError(f"{where} must be a table with 'folder' and/or component entries")
+    unknown = sorted(set(spec) - {"folder", *COMPONENTS})
+    if unknown:
+        close = difflib.get_close_matches(unknown[0], COMPONENTS, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise ParameterError(f"{where}: unknown key {unknown[0]!r}{hint} (allowed: folder, {', '.join(COMPONENTS)})")
+    if "folder" in spec:
+        curves = ComponentCurves.from_folder(path.parent / str(spec["folder"]))
+    else:
+        curves = ComponentCurves.bundled()
+    for name in COMPONENTS:
+        if name not in spec:
+            continue
+        entry = spec[name]
+        if isinstance(entry, str):
+            entry = {"file": entry}
+        if not isinstance(entry, dict) or "file" not in entry or set(entry) - {"file", "scale"}:
+            raise ParameterError(f"{where} {name} = {entry!r}: expected a CSV file name or "
+                                 "{file = \"curve.csv\", scale = 1.0}")
+        scale = to_si(entry.get("scale", 1.0), "1", name=f"[eclutch.curves] {name}.scale", source=str(path))
+        try:
+            curves = curves.replace(name, path.parent / str(entry["file"]), scale=scale)
+        except ParameterError as exc:
+            raise ParameterError(f"{where} {name}: {exc}") from None
+    return curves
 
 
 def _model0(p: EClutchParameters, c: ComponentCurves) -> AxialNetwork:
@@ -304,17 +396,19 @@ class ClutchModel:
         The file has an ``[eclutch]`` table of :class:`EClutchParameters`
         (values may carry units, e.g. ``lever_ratio = -3.8``,
         ``k_fl_model1 = "1.2 MN/m"``) and optionally an ``[eclutch.curves]``
-        table naming a folder of component CSV files (``folder = "curves/"``,
-        relative to the parameter file).
+        table of component curves, paths relative to the parameter file:
+        ``folder = "curves/"`` (a folder with all six ``<component>.csv``
+        files) and/or one entry per component to replace, a CSV file
+        (``diaphragm = "my_diaphragm.csv"``) or a table with a stiffness
+        factor (``diaphragm = {file = "my_diaphragm.csv", scale = 1.3}``),
+        see :meth:`ComponentCurves.replace`.  The bearing is zeroed at
+        ``bearing_preload`` with the new curves.
         """
         data = load_toml(path)
         table = dict(data.get("eclutch", data))
         curves = None
         if "curves" in table:
-            spec = table.pop("curves")
-            if not isinstance(spec, dict) or set(spec) != {"folder"}:
-                raise ParameterError(f"{path}: [eclutch.curves] must contain exactly one key 'folder'")
-            curves = ComponentCurves.from_folder(Path(path).parent / spec["folder"])
+            curves = _curves_from_table(table.pop("curves"), Path(path))
         params = EClutchParameters.from_dict(table, source=str(path))
         return cls.preset(n, params, curves)
 

@@ -2,8 +2,13 @@
 
 A variant either starts from one of the paper's Models 0-4 (``base = N``) and
 replaces or adds nodes and elements by name (a replaced element keeps the
-pre-strain of the one it replaces unless ``prestrain`` is given), or lists a
-whole network.
+pre-strain, and a replaced spring its ``b`` node, ``scale``, ``unilateral``
+and ``gain``, of the one it replaces unless given; the bearing is then zeroed
+again at ``bearing_preload``, default the parameters' 80 N, unless the
+variant gives the bearing's ``prestrain``), or lists a whole network.
+To replace a component's characteristic and keep every model assembled
+around it, prefer ``[eclutch.curves]`` in a parameter file
+(:meth:`~clutchlab.eclutch.ComponentCurves.replace`, docs/eclutch.md).
 Quantities may carry units; curves come from CSV files (columns
 ``deflection_m``, ``force_N``) relative to the TOML file, or are linear
 (``stiffness``)::
@@ -44,14 +49,14 @@ from ..io import read_table
 from ..params import load_toml
 from ..units import to_si
 from .models import ClutchModel, EClutchParameters, build_model
-from .network import AxialNetwork, Lever, Node, Spring
+from .network import AxialNetwork, Lever, Node, Spring, zero_input
 
 __all__ = ["load_variant"]
 
 _NODE_KEYS = {"name", "mass"}
 _SPRING_KEYS = {"name", "a", "b", "curve", "stiffness", "prestrain", "scale", "unilateral", "gain"}
 _LEVER_KEYS = {"name", "tip", "edge", "pivot", "ratio", "stiffness", "prestrain"}
-_TOP_KEYS = {"name", "base", "input", "normal_force", "r_eff", "mu", "nodes", "springs", "levers"}
+_TOP_KEYS = {"name", "base", "bearing_preload", "input", "normal_force", "r_eff", "mu", "nodes", "springs", "levers"}
 
 
 def _check_keys(where: str, table: dict, allowed: set, required: set):
@@ -103,6 +108,7 @@ def load_variant(path, params: EClutchParameters | None = None) -> ClutchModel:
     src = str(path)
     _check_keys(f"{src}: [network]", top, _TOP_KEYS, set())
     params = params or EClutchParameters()
+    preload = to_si(top.get("bearing_preload", params.bearing_preload), "N", name="network.bearing_preload", source=src)
     if "base" in top:
         base = build_model(top["base"], params)
     else:
@@ -112,24 +118,35 @@ def load_variant(path, params: EClutchParameters | None = None) -> ClutchModel:
         where = f"{src}: network.nodes[{k}]"
         _check_keys(where, entry, _NODE_KEYS, {"name"})
         nodes.append(Node(str(entry["name"]), to_si(entry.get("mass", 0.0), "kg", name=f"{where}.mass")))
+    def replaced(entry):
+        """The element of the base model that ``entry`` replaces (None if it adds one)."""
+        if base is not None and entry["name"] in {e.name for e in base.elements}:
+            return base.element(entry["name"])
+        return None
+
     def prestrain(where, entry):
         # a replaced element keeps the pre-strain of the element it replaces unless one is given
         if "prestrain" in entry:
             return to_si(entry["prestrain"], "m", name=f"{where}.prestrain")
-        if base is not None and entry["name"] in {e.name for e in base.elements}:
-            return base.element(entry["name"]).prestrain
-        return 0.0
+        old = replaced(entry)
+        return old.prestrain if old is not None else 0.0
+
+    def inherited(entry, key, default):
+        # ... and its other settings: Model 4's diaphragm keeps b = "support" and its x1.3 scale
+        old = replaced(entry)
+        return getattr(old, key) if isinstance(old, Spring) and key not in entry else entry.get(key, default)
 
     elements = []
     for k, entry in enumerate(top.get("springs", [])):
         where = f"{src}: network.springs[{k}]"
         _check_keys(where, entry, _SPRING_KEYS, {"name", "a"})
         elements.append(Spring(
-            str(entry["name"]), str(entry["a"]), _curve(where, entry, path.parent), b=str(entry.get("b", "ground")),
+            str(entry["name"]), str(entry["a"]), _curve(where, entry, path.parent),
+            b=str(inherited(entry, "b", "ground")),
             prestrain=prestrain(where, entry),
-            scale=to_si(entry.get("scale", 1.0), "1", name=f"{where}.scale"),
-            unilateral=bool(entry.get("unilateral", False)),
-            gain=to_si(entry.get("gain", 1.0), "1", name=f"{where}.gain")))
+            scale=to_si(inherited(entry, "scale", 1.0), "1", name=f"{where}.scale"),
+            unilateral=bool(inherited(entry, "unilateral", False)),
+            gain=to_si(inherited(entry, "gain", 1.0), "1", name=f"{where}.gain")))
     for k, entry in enumerate(top.get("levers", [])):
         where = f"{src}: network.levers[{k}]"
         _check_keys(where, entry, _LEVER_KEYS, {"name", "tip", "edge", "ratio"})
@@ -150,6 +167,11 @@ def load_variant(path, params: EClutchParameters | None = None) -> ClutchModel:
             if dup:
                 raise ParameterError(f"node {dup[0]!r} already exists in Model {top['base']}")
             network = base.modified(nodes=tuple(nodes), replace=replace, add=added, name=name)
+            explicit = {str(e["name"]) for e in top.get("springs", []) if "prestrain" in e}
+            if "bearing" not in explicit:
+                # the replaced elements change the engaged state: zero the bearing contact again at the
+                # CSC preload, as build_model does (bearing position 0 = engaged clutch, bearing at preload)
+                network = zero_input(network, "bearing", preload)
         else:
             network = AxialNetwork(tuple(nodes), tuple(elements), input=str(top.get("input", "bearing")),
                                    normal_force=str(top.get("normal_force", "cushion")), name=name)

@@ -93,26 +93,45 @@ def _simulate(args) -> int:
 
 def register(subparsers) -> None:
     """Add ``emtc`` with ``preisach identify``, ``preisach run`` and ``simulate``."""
-    p = subparsers.add_parser("emtc", help="electromagnetic torque-controlled coupling (Processes 2019)")
+    p = subparsers.add_parser("emtc", help="electromagnetic torque-controlled coupling (Processes 2019)",
+                              description="Electromagnetic torque-controlled coupling (Processes 7 (2019) 557): "
+                                          "identify and run the Preisach hysteresis model of the magnet force, "
+                                          "and simulate the vehicle with its EMTC on the drum bench.",
+                              epilog="Documentation: docs/emtc.md")
     sub = p.add_subparsers(dest="emtc_command", metavar="COMMAND")
     sub.required = True
-    pre = sub.add_parser("preisach", help="Preisach hysteresis model of the magnet force")
+    pre = sub.add_parser("preisach", help="Preisach hysteresis model of the magnet force",
+                         description="Identify a Preisach hysteresis model from first-order reversal curve "
+                                     "(FORC) records, or run one forward (current to force) or inverse.",
+                         epilog="Documentation: docs/emtc.md")
     psub = pre.add_subparsers(dest="preisach_command", metavar="COMMAND")
     psub.required = True
-    ident = psub.add_parser("identify", help="identify the FORC table(s) from recorded current/force traces")
+    ident = psub.add_parser("identify", help="identify the FORC table(s) from recorded current/force traces",
+                            description="Identify the FORC table of a Preisach model (one per airgap if the "
+                                        "record has an airgap column) from recorded current and force traces, "
+                                        "print the fit report and write the model as JSON.",
+                            epilog="Documentation: docs/emtc.md")
     ident.add_argument("forc", type=Path, help="CSV with columns current [A], force [N] (and airgap [m])")
     ident.add_argument("-o", "--output", type=Path, required=True, help="model JSON to write")
     ident.add_argument("--grid", help="comma-separated current grid [A] (default: from the reversal points)")
     ident.add_argument("--force", action="store_true", help="overwrite the output")
     ident.set_defaults(func=_identify)
-    run = psub.add_parser("run", help="run a model on an input CSV (current -> force, or --inverse force -> current)")
+    run = psub.add_parser("run", help="run a model on an input CSV (current -> force, or --inverse force -> current)",
+                          description="Run an identified Preisach model on an input record: the magnet force "
+                                      "for a current trace, or with --inverse the current that produces a "
+                                      "wanted force.",
+                          epilog="Documentation: docs/emtc.md")
     run.add_argument("model", type=Path, help="model JSON from 'identify'")
     run.add_argument("input", type=Path, help="CSV with current [A] (or force [N] with --inverse), airgap [m] for a family")
     run.add_argument("-o", "--output", type=Path, required=True, help="CSV to write")
     run.add_argument("--inverse", action="store_true", help="compute the current that produces the force column")
     run.add_argument("--force", action="store_true", help="overwrite the output")
     run.set_defaults(func=_run)
-    sim = sub.add_parser("simulate", help="simulate the vehicle with EMTC on the drum bench")
+    sim = sub.add_parser("simulate", help="simulate the vehicle with EMTC on the drum bench",
+                         description="Simulate the vehicle with its EMTC on the drum bench for a scenario "
+                                     "(drum speeds, throttle ramp, gear; optional vehicle, actuator, coupling "
+                                     "and magnet tables) and write the run with its mode events.",
+                         epilog="Documentation: docs/emtc.md (scenario format)")
     sim.add_argument("scenario", type=Path, help="TOML with [scenario], [vehicle], [actuator], [coupling], [magnet]")
     sim.add_argument("-o", "--output", type=Path, required=True, help="CSV of the run")
     sim.add_argument("--plot", type=Path, help="PNG figure of the run")

@@ -23,7 +23,8 @@ def register(subparsers) -> None:
         help="build an FMI 2.0 co-simulation FMU of a model (needs pythonfmu; runs with clutchlab installed)",
         description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
                     "units). The FMU runs the model through pythonfmu: the importing tool needs a Python with "
-                    "clutchlab installed.")
+                    "clutchlab installed.",
+        epilog="Documentation: docs/fmu.md")
     p.add_argument("model", choices=sorted(COSIMULATIONS), help="model to export")
     p.add_argument("-o", "--output", type=Path, default=None, help="FMU file to write (default: MODEL.fmu)")
     p.add_argument("--force", action="store_true", help="replace the FMU if it exists")

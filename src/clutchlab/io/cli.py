@@ -30,7 +30,8 @@ def register(subparsers) -> None:
         "convert", help="convert a measurement file (CSV, Parquet, MDF 4) to clutchlab names and SI units",
         description="Read a record (.csv, .parquet, .mf4), map the logger's channels to clutchlab names with "
                     "--channel-map, convert units to those the names state, put channels logged at different "
-                    "rates onto one time base, and write .csv, .parquet or .mf4 with the units in the file.")
+                    "rates onto one time base, and write .csv, .parquet or .mf4 with the units in the file.",
+        epilog="Documentation: docs/measurements.md")
     p.add_argument("input", help="record to read (.csv, .parquet, .mf4/.mdf)")
     p.add_argument("-o", "--output", required=True, help="file to write (.csv, .parquet, .mf4)")
     p.add_argument("--channel-map", metavar="MAP.toml",

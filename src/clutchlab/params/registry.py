@@ -22,6 +22,8 @@ import importlib
 import re
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ParameterError
 from .base import ParameterSet, load_toml, registered_sets
 
@@ -231,6 +233,32 @@ def load_model_file(path, model: str | None = None) -> tuple[str, dict[str, Para
     return model, out
 
 
+def format_number(value) -> str:
+    """A parameter value as a person reads it: integers as integers, floats to 6 significant digits.
+
+    Plain decimals between 1e-4 and 1e6 (``0.08315``, ``32000``), otherwise
+    scientific notation without padding (``2.3e6``, ``3e-11``); ``20240601``
+    (a seed) stays an integer.
+    """
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    v = float(value)
+    if v == 0.0 or not np.isfinite(v):
+        return f"{v:g}"
+    if 1e-4 <= abs(v) < 1e6:
+        text = f"{v:.6g}"
+        return text if "e" not in text else f"{v:.6f}".rstrip("0").rstrip(".")
+    mantissa, exponent = f"{v:.6e}".split("e")
+    return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+
+
+def format_unit(unit: str) -> str:
+    """A pint unit string for reading: ``kg*m**2`` -> ``kg*m^2``; dimensionless ``1`` stays ``1``."""
+    return unit.replace("**", "^")
+
+
 def show_table(model: str, sets: dict[str, ParameterSet] | None = None, *, paper: bool = False) -> str:
     """Plain-text table of every set of ``model``: name, value, unit, source and description.
 
@@ -255,8 +283,8 @@ def show_table(model: str, sets: dict[str, ParameterSet] | None = None, *, paper
         rows = [("name", "value", "unit", "source", "description")]
         for name, meta in pset.field_info().items():
             value = getattr(pset, name)
-            val = ", ".join(f"{v:.6g}" for v in value) if isinstance(value, tuple) else f"{value:.6g}"
-            rows.append((name, val, meta["unit"], meta.get("source") or "-", meta["doc"]))
+            val = ", ".join(format_number(v) for v in value) if isinstance(value, tuple) else format_number(value)
+            rows.append((name, val, format_unit(meta["unit"]), meta.get("source") or "-", meta["doc"]))
         widths = [max(len(r[i]) for r in rows) for i in range(4)]
         for r in rows:
             out.append("  " + "  ".join(r[i].ljust(widths[i]) if i != 1 else r[i].rjust(widths[i]) for i in range(4))

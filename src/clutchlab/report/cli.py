@@ -12,7 +12,10 @@ __all__ = ["register"]
 def register(subparsers) -> None:
     """Add the ``report`` command."""
     rep = subparsers.add_parser(
-        "report", help="write a self-contained HTML report (figures, metrics, parameters, provenance) of a results folder")
+        "report", help="write a self-contained HTML report (figures, metrics, parameters, provenance) of a results folder",
+        description="Write a self-contained HTML page (readable offline) of a results folder: figures, metrics "
+                    "tables, parameters and the provenance of every file (synthetic data labelled so).",
+        epilog="Documentation: docs/report.md")
     rep.add_argument("run_dir", metavar="RUN_DIR",
                      help="folder of results: CSV (with # comment headers), Parquet chunks, MDF4, *.toml, manifest.json")
     rep.add_argument("-o", "--output", help="report folder to write (default: RUN_DIR/report)")

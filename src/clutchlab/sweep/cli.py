@@ -44,7 +44,10 @@ def register(subparsers) -> None:
     """Add the ``sweep`` command."""
     p = subparsers.add_parser(
         "sweep", help="grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores or Dask)",
-        description="Run the variants of SPEC.toml in chunks; an interrupted sweep resumes where it stopped.")
+        description="Run the variants of SPEC.toml (a grid or a Monte Carlo sample of a model's parameters) "
+                    "as compiled batches in Parquet chunks, on local cores or a Dask cluster; an interrupted "
+                    "sweep resumes where it stopped.",
+        epilog="Documentation: docs/sweeps.md (spec format)")
     p.add_argument("spec", help="sweep spec TOML ([sweep] model/outputs/chunk_size, [grid] or [monte_carlo])")
     p.add_argument("-o", "--output", help="results folder (manifest.json, chunks/, results.parquet, summary.csv/png)")
     p.add_argument("--workers", type=int, default=None,

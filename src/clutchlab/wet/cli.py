@@ -1,6 +1,6 @@
 """``clutchlab wet`` sub-commands: a thin layer over :mod:`clutchlab.wet`.
 
-``clutchlab wet simulate PROTOCOL.toml -o record.csv [--force]``
+``clutchlab wet simulate PROTOCOL.toml -o record.csv [--plot record.png] [--force]``
     run a protocol on the virtual bench and write the measured record;
 ``clutchlab wet identify RECORDS... -o map.json [--plot map.png] [--force]``
     identify the friction map and k1, k2 from bench records;
@@ -21,14 +21,27 @@ __all__ = ["register"]
 
 def register(subparsers) -> None:
     """Add the ``wet`` command and its sub-commands."""
-    wet = subparsers.add_parser("wet", help="wet multi-plate clutch: virtual bench and friction/thermal identification")
+    wet = subparsers.add_parser("wet", help="wet multi-plate clutch: virtual bench and friction/thermal identification",
+                                description="Wet multi-plate clutch after Shin, Kim and Choi: run test protocols "
+                                            "on the virtual bench, identify the friction map and the thermal "
+                                            "conductances from bench records, print the Table 1 parameters.",
+                                epilog="Documentation: docs/wet.md")
     sub = wet.add_subparsers(dest="wet_command", metavar="SUBCOMMAND")
-    sim = sub.add_parser("simulate", help="run a protocol TOML on the virtual bench and write a bench record CSV")
+    sim = sub.add_parser("simulate", help="run a protocol TOML on the virtual bench and write a bench record CSV",
+                         description="Run a test protocol (friction map, engagement or inertia dynamometer) on "
+                                     "the virtual wet-clutch bench and write the record its sensors measure "
+                                     "(with noise, labelled synthetic), optionally with a figure.",
+                         epilog="Documentation: docs/wet.md (protocol format)")
     sim.add_argument("protocol", help="protocol file ([protocol] type = friction_map | engagement | inertia_dynamometer)")
     sim.add_argument("-o", "--output", required=True, help="record CSV to write")
-    sim.add_argument("--force", action="store_true", help="overwrite the output")
+    sim.add_argument("--plot", help="also write a PNG figure of the record (slip, torque, force, temperatures)")
+    sim.add_argument("--force", action="store_true", help="overwrite the outputs")
     sim.set_defaults(func=_simulate)
-    ident = sub.add_parser("identify", help="identify the friction map and k1, k2 from bench records")
+    ident = sub.add_parser("identify", help="identify the friction map and k1, k2 from bench records",
+                           description="Identify the friction coefficient map mu(v, T) and the thermal "
+                                       "conductances k1, k2 from one or more bench records; writes the map as "
+                                       "JSON with its statistics.",
+                           epilog="Documentation: docs/wet.md")
     ident.add_argument("records", nargs="+", help="bench record CSV files")
     ident.add_argument("-o", "--output", required=True, help="friction map JSON to write")
     ident.add_argument("--plot", help="also write the map surface as PNG")
@@ -36,7 +49,10 @@ def register(subparsers) -> None:
     ident.add_argument("--sensor-lag", type=float, default=0.0, help="thermistor time constant to compensate [s]")
     ident.add_argument("--force", action="store_true", help="overwrite the outputs")
     ident.set_defaults(func=_identify)
-    par = sub.add_parser("params", help="print the Table 1 parameter set, or write it as TOML")
+    par = sub.add_parser("params", help="print the Table 1 parameter set, or write it as TOML",
+                         description="Print the wet-clutch parameter set of Table 1 with units, or write it as "
+                                     "a TOML file that loads back identically.",
+                         epilog="Documentation: docs/wet.md, docs/parameters.md")
     par.add_argument("-o", "--output", help="TOML file to write")
     par.add_argument("--force", action="store_true", help="overwrite the output")
     par.set_defaults(func=_params)
@@ -48,9 +64,22 @@ def _simulate(args) -> int:
     from .bench import load_protocol, run_protocol, write_bench_record
 
     check_writable(args.output, args.force)
+    if args.plot:
+        check_writable(args.plot, args.force)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
     run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype)
     write_bench_record(run, args.output, overwrite=args.force)
+    if args.plot:
+        from ..io import atomic_write_bytes
+        from .plots import map_traces_figure
+
+        fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
     print(f"{args.output}: {len(run.record)} samples of protocol {ptype}; events: {events}")
     return 0
