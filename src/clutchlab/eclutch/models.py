@@ -8,10 +8,10 @@ Figs. 10-11 add compliances and masses:
 Model 0   bearing stiffness k_b; diaphragm spring k_ds (tip to surroundings); rigid
           lever 1/i_ds to the pressure plate m_pp; return springs k_rs; friction
           plate (cushion) contact k_fp ([1] Sec. 3.2, Fig. 5b)
-Model 1   + lever (finger) compliance k_fl of Eq. (1) from tests 8b-c ([1] Sec. 5.1)
-Model 2   + pressure-plate spring k_pp (wear compensation) between the diaphragm
+Model 1   adds the lever (finger) compliance k_fl of Eq. (1) from tests 8b-c ([1] Sec. 5.1)
+Model 2   adds the pressure-plate spring k_pp (wear compensation) between the diaphragm
           edge (new mass m_pps) and the pressure plate; k_fl from tests 8a/8c ([1] Sec. 5.2)
-Model 3   + equivalent yoke support k_ys.eq (support ring and yoke support spring in
+Model 3   adds the equivalent yoke support k_ys.eq (support ring and yoke support spring in
           series, extrapolated) carrying the lever pivot (new mass m_ds) ([1] Sec. 5.3)
 Model 4   diaphragm spring attached to the yoke support instead of the surroundings;
           k_ys.eq scaled by 20, diaphragm spring by 1.3 ([1] Sec. 5.4)

@@ -34,7 +34,7 @@ __all__ = [
     "UNLOCK_MARGIN",
 ]
 
-#: locked -> slipping when |T_lock| > UNLOCK_MARGIN * T_cap_L ([1], Sec. 3.2, Fig. 11)
+#: locked -> slipping when ``abs(T_lock) > UNLOCK_MARGIN * T_cap_L`` ([1], Sec. 3.2, Fig. 11)
 UNLOCK_MARGIN = 1.02
 
 

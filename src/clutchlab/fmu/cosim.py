@@ -116,18 +116,18 @@ class Variable:
 class CoSimulation(abc.ABC):
     """Protocol of a model run step by step by a co-simulation master (an FMU).
 
-    Class attributes
-    ----------------
-    name : str
-        Model name (``"wet"``, ``"emtc"``, ``"eclutch"``).
-    inputs, outputs, parameters : tuple of Variable
-        Real, continuous inputs; outputs; parameters (tunable before
-        initialisation, values in SI).
-
     Construction ``Cls(**parameter_values)`` takes parameter values by
     :class:`Variable` name; missing ones take their ``start`` (the model's
     paper / bundled preset).  :meth:`reset` returns to the initial state at
     t = 0; :meth:`do_step` advances with the inputs held constant.
+
+    Attributes
+    ----------
+    name : str
+        Model name (``"wet"``, ``"emtc"``, ``"eclutch"``); a class attribute.
+    inputs, outputs, parameters : tuple of Variable
+        Real, continuous inputs; outputs; parameters (tunable before
+        initialisation, values in SI); class attributes.
     """
 
     name: str = ""
