@@ -185,7 +185,7 @@ def _manifest(spec: SweepSpec) -> dict:
         "spec_hash": spec.hash,
         "spec_file": str(Path(spec.path).resolve()) if str(spec.path) != "<dict>" else "<dict>",
         "model": spec.model,
-        "target": spec.target.path,
+        "target": spec.target.identity,
         "scenario": spec.scenario.get("_source") if spec.scenario else "bundled default of the model",
         "design": spec.kind,
         "seed": spec.seed,
