@@ -204,11 +204,11 @@ def test_foreign_folder_is_refused(tmp_path):
         run_sweep(spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 3")), out, progress=False)
 
 
-def test_damaged_chunk_is_computed_again(tmp_path):
+def test_a_deleted_chunk_is_computed_again(tmp_path):
     out = tmp_path / "out"
     path = spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 6"))
     first = run_sweep(path, out, progress=False, plot=False)
-    chunk_path(out, 1, 2).write_bytes(b"not parquet")
+    chunk_path(out, 1, 2).unlink()
     res = run_sweep(path, out, progress=False, plot=False)
     assert res.reused == [0] and res.computed == [1]
     pd.testing.assert_frame_equal(res.results, first.results, check_exact=True)
