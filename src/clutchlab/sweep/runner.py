@@ -25,7 +25,9 @@ unless ``force`` (which starts over).  A chunk file that is unreadable, not
 recorded in the manifest, differs from the bytes recorded there, carries
 another sweep's hash or values not matching its checksum is refused
 (:class:`~clutchlab.errors.DataError` naming the file and the reason): it is
-never mixed in, and never deleted for the user.  Chunks are computed by the calling process (each chunk a
+never mixed in, and never deleted for the user.  Worker processes end when the
+process that started them dies (``PR_SET_PDEATHSIG`` on Linux, a watchdog on
+the parent's pid elsewhere).  Chunks are computed by the calling process (each chunk a
 compiled batch across the cores, where the model has one), by
 ``workers`` processes (:class:`concurrent.futures.ProcessPoolExecutor`), or by
 a ``dask.distributed`` cluster; results are always written by the calling
@@ -42,7 +44,9 @@ import io
 import json
 import math
 import multiprocessing
+import os
 import shutil
+import signal
 import sys
 import threading
 import time
@@ -331,8 +335,41 @@ def _existing_chunks(spec: SweepSpec, output: Path, manifest: dict) -> list[int]
 
 
 # ----------------------------------------------------------------- executors
-def _worker_init():
-    """One compiled thread per worker process (the processes are the parallelism)."""
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _die_with_parent(parent_pid: int, poll: float = 0.5) -> None:
+    """End this process when ``parent_pid`` dies, even by SIGKILL.
+
+    On Linux the kernel sends SIGKILL on the parent's death
+    (``prctl(PR_SET_PDEATHSIG)``); everywhere a daemon thread also polls the
+    parent pid (``os.getppid`` changes when the process is re-parented) and
+    exits.  If the parent is already gone, exit at once.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: the watchdog remains
+            pass
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+    def watch():
+        while True:
+            time.sleep(poll)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="clutchlab-sweep-parent-watchdog", daemon=True).start()
+
+
+def _worker_init(parent_pid: int | None = None):
+    """Die with the parent; one compiled thread per worker process (the processes are the parallelism)."""
+    if parent_pid is not None:
+        _die_with_parent(parent_pid)
     try:
         import numba
 
@@ -349,7 +386,8 @@ def _run_local(spec, todo, write, bar):
 
 def _run_processes(spec, todo, write, bar, workers):
     ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold compiled thread pools
-    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                                initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(compute_chunk, spec.target, spec.scenario, spec.outputs, spec.chunk(k)): k for k in todo}
         try:
             for fut in cf.as_completed(futures):
