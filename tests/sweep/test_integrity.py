@@ -245,3 +245,17 @@ def test_the_hash_follows_file_contents_not_the_folder_they_are_in(tmp_path, reg
     assert load_spec(moved / "spec.toml").hash == load_spec(spec).hash
     (moved / "table.csv").write_text("t,v\n0,1\n1,1\n")
     assert load_spec(moved / "spec.toml").hash != load_spec(spec).hash
+
+
+def test_the_run_report_shows_the_chunk_records_as_one_manifest_row(finished):
+    from clutchlab.report.html import Table
+    from clutchlab.report.run import run_sections
+
+    _, out, _ = finished
+    tables = [item for sec in run_sections(out) for item in sec.items
+              if isinstance(item, Table) and item.name == "manifest"]
+    assert len(tables) == 1
+    rows = tables[0].frame
+    chunk_rows = rows[rows["field"].str.startswith("chunks")]
+    assert chunk_rows["value"].tolist() == ["3 chunk files recorded (SHA-256 and content checksum)"]
+    assert "inputs.table.csv" in rows["field"].tolist()

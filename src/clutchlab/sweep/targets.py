@@ -228,7 +228,10 @@ def unregister_target(name: str) -> None:
 
 
 def _untrusted_dirs(source) -> set:
-    dirs = {Path.cwd().resolve()}
+    try:
+        dirs = {Path.cwd().resolve()}
+    except OSError:  # the working directory was removed: nothing is found there either
+        dirs = set()
     if source is not None and str(source) not in ("<spec>", "<dict>"):
         dirs.add(Path(source).resolve().parent)
     return dirs
