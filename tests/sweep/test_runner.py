@@ -36,12 +36,9 @@ n = 24
 
 
 @pytest.fixture
-def test_target(monkeypatch):
-    """Make the test-only target module importable in this process."""
-    monkeypatch.syspath_prepend(str(HERE))
-    monkeypatch.delenv("CLUTCHLAB_SWEEP_TEST_FAIL_ID", raising=False)
-    monkeypatch.delenv("CLUTCHLAB_SWEEP_TEST_DELAY", raising=False)
-    return "sweep_test_target:run_batch"
+def test_target(registered_targets):
+    """The test-only target (``wet``, failing on request), registered in this process."""
+    return registered_targets["wet"]
 
 
 def spec_file(tmp_path, model="wet", name="spec.toml", text=SPEC):
@@ -131,12 +128,16 @@ def test_resume_after_a_crash_runs_only_the_missing_chunks(tmp_path, test_target
     pd.testing.assert_frame_equal(res.results, reference.results, check_exact=True)
 
 
-def test_sigkill_mid_sweep_then_resume(tmp_path, test_target, reference):
-    """Kill the process computing the chunks (SIGKILL), rerun: every variant once, values of the uninterrupted run."""
-    path = spec_file(tmp_path, model=test_target)
+def test_sigkill_mid_sweep_then_resume(tmp_path, plugins, reference):
+    """Kill the process computing the chunks (SIGKILL), rerun: every variant once, values of the uninterrupted run.
+
+    The target is the installed test plugin (entry point ``plugin-wet``), found the same way by the CLI
+    subprocess and by this process.
+    """
+    path = spec_file(tmp_path, model="plugin-wet")
     out = tmp_path / "out"
     env = dict(os.environ, CLUTCHLAB_SWEEP_TEST_DELAY="0.4",
-               PYTHONPATH=os.pathsep.join([str(HERE), str(SRC), os.environ.get("PYTHONPATH", "")]))
+               PYTHONPATH=os.pathsep.join([str(plugins), str(SRC), os.environ.get("PYTHONPATH", "")]))
     env.pop("CLUTCHLAB_SWEEP_TEST_FAIL_ID", None)
     proc = subprocess.Popen([sys.executable, "-m", "clutchlab.cli", "sweep", str(path), "-o", str(out), "--no-progress"],
                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -204,11 +205,11 @@ def test_foreign_folder_is_refused(tmp_path):
         run_sweep(spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 3")), out, progress=False)
 
 
-def test_damaged_chunk_is_computed_again(tmp_path):
+def test_a_deleted_chunk_is_computed_again(tmp_path):
     out = tmp_path / "out"
     path = spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 6"))
     first = run_sweep(path, out, progress=False, plot=False)
-    chunk_path(out, 1, 2).write_bytes(b"not parquet")
+    chunk_path(out, 1, 2).unlink()
     res = run_sweep(path, out, progress=False, plot=False)
     assert res.reused == [0] and res.computed == [1]
     pd.testing.assert_frame_equal(res.results, first.results, check_exact=True)

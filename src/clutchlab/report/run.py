@@ -478,6 +478,8 @@ def _read_manifests(run_dir: Path, output: Path | None) -> dict[str, dict]:
 
 def _manifest_rows(name: str, data: dict) -> list[dict]:
     rows = []
+    if isinstance(data.get("chunks"), dict):  # a sweep's per-chunk checksums: one row, not two per chunk
+        data = {**data, "chunks": f"{len(data['chunks'])} chunk files recorded (SHA-256 and content checksum)"}
     for key, value in _flatten(data):
         text = json.dumps(value) if not isinstance(value, str) else value
         rows.append({"file": name, "field": key, "value": text if len(text) <= 200 else text[:200] + " ..."})

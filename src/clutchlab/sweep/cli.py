@@ -24,7 +24,7 @@ def _sweep(args) -> int:
     spec = load_spec(args.spec)
     if args.list_parameters:
         info = spec.target.describe(spec.scenario)
-        print(f"model {spec.model!r} ({spec.target.path})")
+        print(f"model {spec.model!r} ({spec.target.origin})")
         for title, table in (("parameters", info.parameters), ("outputs", info.outputs)):
             print(f"{title}:")
             for name, unit in (table or {}).items():

@@ -41,12 +41,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..eclutch.models import MODEL_NUMBERS, ClutchModel, ComponentCurves, EClutchParameters
+from ..eclutch.models import COMPONENTS, MODEL_NUMBERS, ClutchModel, ComponentCurves, EClutchParameters
 from ..errors import ParameterError
 from ..units import to_si
-from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
+from .targets import check_outputs, file_digest, nan_frame, rows, sweepable_fields, vary_parameter_set
 
-__all__ = ["run_batch", "describe", "check_variants", "OUTPUTS", "lift_off_position"]
+__all__ = ["run_batch", "describe", "check_variants", "referenced_files", "OUTPUTS", "lift_off_position"]
 
 OUTPUTS = {
     "engaged_normal_force": "N",
@@ -60,8 +60,29 @@ _STATIC_KEYS = ("model", "travel", "points")
 
 
 @functools.lru_cache(maxsize=4)
-def _curves(folder: str | None):
+def _curves(folder: str | None, digests: tuple = ()):  # keyed by content too: edited curves are read again
     return ComponentCurves.bundled() if folder is None else ComponentCurves.from_folder(folder)
+
+
+def _curve_files(folder) -> list:
+    return [Path(folder) / f"{name}.csv" for name in COMPONENTS]
+
+
+def _curves_folder(data):
+    """Absolute curves folder named by ``[eclutch.curves] folder`` (None: the bundled curves)."""
+    spec = (data.get("eclutch") or {}).get("curves") if isinstance(data.get("eclutch"), dict) else None
+    if spec is None:
+        return None
+    src = str(data.get("_source", "bundled defaults"))
+    if not isinstance(spec, dict) or set(spec) != {"folder"} or not isinstance(spec["folder"], str):
+        raise ParameterError(f"{src}: [eclutch.curves] must contain exactly one key 'folder' (a folder name)")
+    return (Path(src).parent / spec["folder"]).resolve()
+
+
+def referenced_files(scenario) -> list:
+    """Files the scenario makes this target read: the component curves of ``[eclutch.curves] folder``, if any."""
+    folder = _curves_folder(scenario or {})
+    return [] if folder is None else _curve_files(folder)
 
 
 def _base(scenario):
@@ -72,12 +93,15 @@ def _base(scenario):
     if unknown:
         raise ParameterError(f"{src}: unknown table [{unknown[0]}] (known: eclutch, static)")
     table = dict(tables.get("eclutch", {}))
-    folder = None
-    if "curves" in table:
-        spec = table.pop("curves")
-        if not isinstance(spec, dict) or set(spec) != {"folder"}:
-            raise ParameterError(f"{src}: [eclutch.curves] must contain exactly one key 'folder'")
-        folder = str((Path(src).parent / spec["folder"]).resolve())
+    folder = _curves_folder(data)
+    table.pop("curves", None)
+    digests = ()
+    if folder is not None:
+        missing = [p for p in _curve_files(folder) if not p.is_file()]
+        if missing:
+            raise ParameterError(f"{src}: [eclutch.curves] folder = {str(folder)!r}: no file {missing[0].name}")
+        digests = tuple(file_digest(p) for p in _curve_files(folder))
+        folder = str(folder)
     params = EClutchParameters.from_dict(table, source=src)
     static = dict(tables.get("static", {}))
     bad = [k for k in static if k not in _STATIC_KEYS]
@@ -92,7 +116,7 @@ def _base(scenario):
     points = static.get("points", 181)
     if isinstance(points, bool) or not isinstance(points, int) or points < 3:
         raise ParameterError(f"{src}: [static] points = {points!r}: expected a whole number >= 3")
-    return params, _curves(folder), int(model), np.linspace(0.0, travel, points)
+    return params, _curves(folder, digests), int(model), np.linspace(0.0, travel, points)
 
 
 def describe(scenario) -> dict:

@@ -37,9 +37,9 @@ from ..errors import ParameterError
 from ..emtc import _bench_kernel as BK
 from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters, simulate_bench
 from ..emtc.torque import CouplingGeometry
-from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
+from .targets import check_outputs, file_digest, nan_frame, rows, sweepable_fields, vary_parameter_set
 
-__all__ = ["run_batch", "describe", "check_variants", "OUTPUTS"]
+__all__ = ["run_batch", "describe", "check_variants", "referenced_files", "OUTPUTS"]
 
 OUTPUTS = {
     "peak_coupling_torque": "N*m",
@@ -63,7 +63,7 @@ def _bundled_magnet():
 
 
 @functools.lru_cache(maxsize=4)
-def _magnet_from(path: str):
+def _magnet_from(path: str, digest: str):  # keyed by content too: an edited file is read again
     from ..hysteresis import Preisach
 
     return Preisach.from_json(path)
@@ -82,10 +82,25 @@ def _base(scenario):
     if mag:
         if not isinstance(mag, dict) or set(mag) != {"model"}:
             raise ParameterError(f"{src}: [magnet] takes only model = 'path/to/model.json'")
-        sets["magnet"] = _magnet_from(str((Path(src).parent / mag["model"]).resolve()))
+        if not isinstance(mag["model"], str):
+            raise ParameterError(f"{src}: [magnet] model = {mag['model']!r}: expected a file name")
+        path = _magnet_path(data)
+        if not path.is_file():
+            raise ParameterError(f"{src}: [magnet] model = {mag['model']!r}: no such file {path}")
+        sets["magnet"] = _magnet_from(str(path), file_digest(path))
     else:
         sets["magnet"] = _bundled_magnet()
     return sets
+
+
+def _magnet_path(data) -> Path:
+    return (Path(str(data.get("_source", "."))).parent / data["magnet"]["model"]).resolve()
+
+
+def referenced_files(scenario) -> list:
+    """Files the scenario makes this target read: the Preisach model of ``[magnet] model``, if any."""
+    mag = (scenario or {}).get("magnet")
+    return [_magnet_path(scenario)] if isinstance(mag, dict) and isinstance(mag.get("model"), str) else []
 
 
 def describe(scenario) -> dict:

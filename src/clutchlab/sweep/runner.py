@@ -3,8 +3,11 @@
 Layout of a results folder::
 
     results/
-      manifest.json            spec hash, n variants, chunk size, clutchlab version, provenance
-      chunks/chunk-00000.parquet   variant_id, parameter columns [SI], outputs -- one file per chunk
+      manifest.json            spec hash, input files, n variants, chunk size, clutchlab version, provenance,
+                               and per chunk file its SHA-256 and content checksum
+      chunks/chunk-00000.parquet   variant_id, parameter columns [SI], outputs -- one file per chunk,
+                               its Parquet key-value metadata "clutchlab.sweep" holding the spec hash,
+                               the chunk number and the content checksum
       chunks/chunk-00001.parquet
       ...
       results.parquet          all chunks, sorted by variant_id (written when every chunk is done)
@@ -12,11 +15,19 @@ Layout of a results folder::
       summary.png              outputs against the swept parameters
 
 Every file is written to a temporary sibling and moved into place
-(``os.replace``), so a chunk file either exists complete or not at all.  On
-start, a folder holding the same spec (same hash) is resumed: finished chunks
-are kept and only the missing ones run; temporary files left by a killed run
-are removed.  A folder holding a different spec is refused unless ``force``
-(which starts over).  Chunks are computed by the calling process (each chunk a
+(``os.replace``), so a chunk file either exists complete or not at all; the
+manifest records a chunk before the chunk file appears.  On start, a folder
+holding the same spec (same hash: the same spec, referenced files, target and
+clutchlab version) is resumed: finished chunks are kept and only the missing
+ones run; temporary files left by a killed run are removed.  A folder holding
+a different spec (or the same spec after a referenced file changed) is refused
+unless ``force`` (which starts over).  A chunk file that is unreadable, not
+recorded in the manifest, differs from the bytes recorded there, carries
+another sweep's hash or values not matching its checksum is refused
+(:class:`~clutchlab.errors.DataError` naming the file and the reason): it is
+never mixed in, and never deleted for the user.  Worker processes end when the
+process that started them dies (``PR_SET_PDEATHSIG`` on Linux, a watchdog on
+the parent's pid elsewhere).  Chunks are computed by the calling process (each chunk a
 compiled batch across the cores, where the model has one), by
 ``workers`` processes (:class:`concurrent.futures.ProcessPoolExecutor`), or by
 a ``dask.distributed`` cluster; results are always written by the calling
@@ -28,11 +39,14 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import datetime
+import hashlib
 import io
 import json
 import math
 import multiprocessing
+import os
 import shutil
+import signal
 import sys
 import threading
 import time
@@ -55,7 +69,9 @@ CHUNK_DIR = "chunks"
 RESULTS = "results.parquet"
 SUMMARY_CSV = "summary.csv"
 SUMMARY_PNG = "summary.png"
-FORMAT = "clutchlab-sweep/1"
+FORMAT = "clutchlab-sweep/2"
+#: Parquet key-value metadata key of a chunk file
+CHUNK_METADATA = b"clutchlab.sweep"
 PROVENANCE = "synthetic: outputs of clutchlab model simulations (virtual rigs and bundled synthetic data, no measurement)"
 QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 
@@ -89,20 +105,61 @@ def compute_chunk(target, scenario, outputs, variants: pd.DataFrame) -> pd.DataF
     return frame
 
 
-def _write_chunk(frame: pd.DataFrame, path: Path) -> None:
+def content_checksum(frame: pd.DataFrame) -> str:
+    """SHA-256 over the column names, dtypes and values of a chunk table (independent of the file encoding)."""
+    h = hashlib.sha256()
+    for name in frame.columns:
+        values = np.ascontiguousarray(frame[name].to_numpy())
+        h.update(json.dumps([str(name), values.dtype.str, int(values.size)]).encode("utf-8"))
+        h.update(values.tobytes())
+    return h.hexdigest()
+
+
+def _chunk_bytes(frame: pd.DataFrame, spec_hash: str, index: int, n_chunks: int) -> tuple[bytes, str]:
+    """Parquet bytes of a chunk with its metadata, and the content checksum."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    checksum = content_checksum(frame)
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    meta = {"format": FORMAT, "spec_hash": spec_hash, "chunk": int(index), "n_chunks": int(n_chunks),
+            "checksum": checksum}
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), CHUNK_METADATA: json.dumps(meta).encode()})
     buf = io.BytesIO()
-    frame.to_parquet(buf, index=False, engine="pyarrow")
-    atomic_write_bytes(path, buf.getvalue(), overwrite=True)
+    pq.write_table(table, buf)
+    return buf.getvalue(), checksum
 
 
-def _chunk_ok(path: Path, expected_ids: np.ndarray, columns) -> bool:
+def _refuse(path: Path, reason: str):
+    raise DataError(f"{path}: {reason}; not used (delete this file to compute the chunk again, "
+                    "or pass force=True / --force to start the sweep over)")
+
+
+def _verified_chunk(path: Path, manifest: dict) -> tuple[pd.DataFrame, dict]:
+    """Read a chunk file and check it against the manifest: (table, its metadata) or :class:`DataError`."""
+    import pyarrow.parquet as pq
+
     try:
-        frame = pd.read_parquet(path, engine="pyarrow")
-    except Exception:  # a file that does not parse is redone
-        return False
-    if list(frame.columns) != list(columns):
-        return False
-    return np.array_equal(frame[VARIANT_ID].to_numpy(), expected_ids)
+        data = path.read_bytes()
+        table = pq.read_table(io.BytesIO(data))
+    except Exception as exc:  # any parse failure: the file is not a chunk
+        _refuse(path, f"not a readable Parquet file ({type(exc).__name__})")
+    try:
+        meta = json.loads(table.schema.metadata[CHUNK_METADATA])
+        spec_hash, index, checksum = str(meta["spec_hash"]), int(meta["chunk"]), str(meta["checksum"])
+    except (TypeError, KeyError, ValueError):
+        _refuse(path, "no clutchlab sweep metadata (not written by clutchlab sweep)")
+    if spec_hash != manifest.get("spec_hash"):
+        _refuse(path, f"written by another sweep (spec hash {spec_hash[:12]}, this sweep {str(manifest.get('spec_hash'))[:12]})")
+    entry = (manifest.get("chunks") or {}).get(path.name)
+    if not isinstance(entry, dict):
+        _refuse(path, f"not recorded in {MANIFEST} (copied here, or from another run)")
+    if hashlib.sha256(data).hexdigest() != entry.get("sha256"):
+        _refuse(path, f"its bytes differ from those recorded in {MANIFEST} (changed after it was written)")
+    frame = table.to_pandas()
+    if content_checksum(frame) != checksum or checksum != entry.get("checksum"):
+        _refuse(path, "its values do not match its checksum")
+    return frame, {**meta, "chunk": index}
 
 
 # ----------------------------------------------------------------- progress
@@ -184,8 +241,9 @@ def _manifest(spec: SweepSpec) -> dict:
         "format": FORMAT,
         "spec_hash": spec.hash,
         "spec_file": str(Path(spec.path).resolve()) if str(spec.path) != "<dict>" else "<dict>",
+        "inputs": {label: digest for label, _, digest in spec.inputs},
         "model": spec.model,
-        "target": spec.target.path,
+        "target": spec.target.identity,
         "scenario": spec.scenario.get("_source") if spec.scenario else "bundled default of the model",
         "design": spec.kind,
         "seed": spec.seed,
@@ -197,26 +255,50 @@ def _manifest(spec: SweepSpec) -> dict:
         "clutchlab_version": __version__,
         "provenance": PROVENANCE,
         "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "chunks": {},
     }
 
 
-def _prepare(spec: SweepSpec, output: Path, force: bool) -> None:
-    """Create, resume or (with ``force``) reset the results folder."""
+def _load_manifest(output: Path) -> dict | None:
+    """The manifest of ``output`` if it is a readable manifest of this format, else None."""
+    try:
+        old = json.loads((output / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(old, dict) or old.get("format") != FORMAT or not isinstance(old.get("chunks"), dict) \
+            or not isinstance(old.get("spec_hash"), str):
+        return None
+    return old
+
+
+def _difference(old: dict | None, spec: SweepSpec) -> str:
+    """Why the sweep in a folder is not ``spec``, in a few words."""
+    if old is None:
+        return "written by another clutchlab version or damaged"
+    inputs = old.get("inputs") if isinstance(old.get("inputs"), dict) else {}
+    now = {label: digest for label, _, digest in spec.inputs}
+    changed = sorted(k for k in set(inputs) | set(now) if inputs.get(k) != now.get(k))
+    if changed:
+        return f"{', '.join(changed)} changed since it started"
+    if old.get("target") != spec.target.identity:
+        return f"target {old.get('target')!r} != {spec.target.identity!r}"
+    return f"spec hash {old['spec_hash'][:12]} != {spec.hash[:12]}"
+
+
+def _prepare(spec: SweepSpec, output: Path, force: bool) -> dict:
+    """Create, resume or (with ``force``) reset the results folder; return its manifest."""
     mpath = output / MANIFEST
     if output.exists() and not output.is_dir():
         raise FileExistsError(f"{output} exists and is not a folder")
     if mpath.exists():
-        try:
-            old = json.loads(mpath.read_text())
-            old_hash = old["spec_hash"]
-        except (ValueError, KeyError, TypeError):
-            old_hash = None
-        if old_hash == spec.hash and not force:
+        old = _load_manifest(output)
+        same = old is not None and old["spec_hash"] == spec.hash
+        if same and not force:
             (output / CHUNK_DIR).mkdir(exist_ok=True)
-            return
-        if old_hash != spec.hash and not force:
-            raise FileExistsError(f"{output} holds a different sweep (spec hash {str(old_hash)[:12]} != "
-                                  f"{spec.hash[:12]}); pass force=True (CLI: --force) to start over")
+            return old
+        if not same and not force:
+            raise FileExistsError(f"{output} holds a different sweep ({_difference(old, spec)}); "
+                                  "pass force=True (CLI: --force) to start over")
     elif output.exists() and any(p.name != ".lock" for p in output.iterdir()) and not force:
         raise FileExistsError(f"{output} exists and is not a sweep folder (no {MANIFEST}); "
                               "pass force=True (CLI: --force) to use it")
@@ -226,12 +308,68 @@ def _prepare(spec: SweepSpec, output: Path, force: bool) -> None:
     for name in (RESULTS, SUMMARY_CSV, SUMMARY_PNG, MANIFEST):
         (output / name).unlink(missing_ok=True)
     (output / CHUNK_DIR).mkdir(parents=True, exist_ok=True)
-    atomic_write_text(mpath, json.dumps(_manifest(spec), indent=2) + "\n", overwrite=True)
+    manifest = _manifest(spec)
+    _save_manifest(output, manifest)
+    return manifest
+
+
+def _save_manifest(output: Path, manifest: dict) -> None:
+    atomic_write_text(output / MANIFEST, json.dumps(manifest, indent=2) + "\n", overwrite=True)
+
+
+def _existing_chunks(spec: SweepSpec, output: Path, manifest: dict) -> list[int]:
+    """Chunks already done, each checked against the manifest and the design; anything else is refused."""
+    expected = {chunk_path(output, k, spec.n_chunks).name: k for k in range(spec.n_chunks)}
+    columns = [VARIANT_ID, *spec.parameters, *spec.outputs]
+    done = []
+    for path in sorted((output / CHUNK_DIR).glob("chunk-*.parquet")):
+        if path.name not in expected:
+            _refuse(path, f"not a chunk of this sweep ({spec.n_chunks} chunks)")
+        k = expected[path.name]
+        frame, meta = _verified_chunk(path, manifest)
+        if meta["chunk"] != k or list(frame.columns) != columns \
+                or not np.array_equal(frame[VARIANT_ID].to_numpy(), spec.chunk(k).index.to_numpy()):
+            _refuse(path, f"does not hold the variants and columns of chunk {k} of this sweep")
+        done.append(k)
+    return sorted(done)
 
 
 # ----------------------------------------------------------------- executors
-def _worker_init():
-    """One compiled thread per worker process (the processes are the parallelism)."""
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _die_with_parent(parent_pid: int, poll: float = 0.5) -> None:
+    """End this process when ``parent_pid`` dies, even by SIGKILL.
+
+    On Linux the kernel sends SIGKILL on the parent's death
+    (``prctl(PR_SET_PDEATHSIG)``); everywhere a daemon thread also polls the
+    parent pid (``os.getppid`` changes when the process is re-parented) and
+    exits.  If the parent is already gone, exit at once.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: the watchdog remains
+            pass
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+    def watch():
+        while True:
+            time.sleep(poll)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="clutchlab-sweep-parent-watchdog", daemon=True).start()
+
+
+def _worker_init(parent_pid: int | None = None):
+    """Die with the parent; one compiled thread per worker process (the processes are the parallelism)."""
+    if parent_pid is not None:
+        _die_with_parent(parent_pid)
     try:
         import numba
 
@@ -248,7 +386,8 @@ def _run_local(spec, todo, write, bar):
 
 def _run_processes(spec, todo, write, bar, workers):
     ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold compiled thread pools
-    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                                initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(compute_chunk, spec.target, spec.scenario, spec.outputs, spec.chunk(k)): k for k in todo}
         try:
             for fut in cf.as_completed(futures):
@@ -322,12 +461,23 @@ class SweepResult:
 
 
 def read_results(output) -> pd.DataFrame:
-    """Read every chunk of the results folder ``output``, sorted by ``variant_id`` (finished or interrupted sweep)."""
-    folder = Path(output) / CHUNK_DIR
+    """Read every chunk of the results folder ``output``, sorted by ``variant_id`` (finished or interrupted sweep).
+
+    Every chunk file is checked against ``manifest.json`` first (recorded
+    there, same bytes, this sweep's hash, values matching the checksum);
+    :class:`~clutchlab.errors.DataError` names the first that is not.
+    """
+    output = Path(output)
+    folder = output / CHUNK_DIR
+    manifest = _load_manifest(output)
+    if manifest is None:
+        raise DataError(f"{output}: no readable {MANIFEST} of a clutchlab sweep ({FORMAT})")
     files = sorted(folder.glob("chunk-*.parquet"))
     if not files:
         raise DataError(f"{output}: no chunk files in {folder}")
-    frame = pd.concat([pd.read_parquet(f, engine="pyarrow") for f in files], ignore_index=True)
+    frame = pd.concat([_verified_chunk(f, manifest)[0] for f in files], ignore_index=True)
+    if frame[VARIANT_ID].duplicated().any():
+        raise DataError(f"{output}: chunks hold variant {int(frame[VARIANT_ID][frame[VARIANT_ID].duplicated()].iloc[0])} twice")
     return frame.sort_values(VARIANT_ID, kind="stable").reset_index(drop=True)
 
 
@@ -465,26 +615,28 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
     with _exclusive(output):
-        _prepare(spec, output, force)
+        changed = spec.changed_inputs()
+        if changed:
+            raise DataError(f"{spec.path}: {', '.join(changed)} changed after the spec was loaded; load it again")
+        manifest = _prepare(spec, output, force)
         removed = _clean_temporaries(output)
         if removed:
             log(f"removed {len(removed)} partial file(s) left by an interrupted run")
-        columns = [VARIANT_ID, *spec.parameters, *spec.outputs]
-        done, todo = [], []
-        for k in range(spec.n_chunks):
-            path = chunk_path(output, k, spec.n_chunks)
-            if path.exists():
-                if _chunk_ok(path, spec.chunk(k).index.to_numpy(), columns):
-                    done.append(k)
-                    continue
-                log(f"{path.name} is damaged or foreign: computing it again")
-                path.unlink()
-            todo.append(k)
+        done = _existing_chunks(spec, output, manifest)
+        todo = [k for k in range(spec.n_chunks) if k not in set(done)]
         if done:
             log(f"resuming: {len(done)} of {spec.n_chunks} chunks already done")
 
         def write(k, frame):
-            _write_chunk(frame, chunk_path(output, k, spec.n_chunks))
+            changed = spec.changed_inputs()
+            if changed:  # never record a chunk that may have read the new contents under the old hash
+                raise DataError(f"{spec.path}: {', '.join(changed)} changed while the sweep ran; chunk {k} and "
+                                "later ones were not kept (the folder now holds a different sweep: --force to start over)")
+            path = chunk_path(output, k, spec.n_chunks)
+            data, checksum = _chunk_bytes(frame, spec.hash, k, spec.n_chunks)
+            manifest["chunks"][path.name] = {"sha256": hashlib.sha256(data).hexdigest(), "checksum": checksum}
+            _save_manifest(output, manifest)  # recorded first: a kill between the two leaves a missing chunk, redone
+            atomic_write_bytes(path, data, overwrite=True)
 
         bar = _Bar(spec.n_chunks, len(done), progress)
         try:

@@ -9,6 +9,11 @@ value) and builds the design: one row per variant, the row number being the
 variant's stable id.  Monte Carlo samples are drawn from ``numpy.random``'s
 PCG64 generator seeded with ``seed``, parameter after parameter in file order,
 so the same spec always yields the same design.
+
+The spec's hash (:attr:`SweepSpec.hash`), which a resumed sweep must match,
+covers the normalised spec and design, the target's identity, the clutchlab
+version and the bytes of every file the spec references: the scenario file
+and every file the scenario makes the target read (:attr:`SweepSpec.inputs`).
 """
 
 from __future__ import annotations
@@ -19,16 +24,18 @@ import hashlib
 import itertools
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..errors import ParameterError
+from .. import __version__
+from ..errors import DataError, ParameterError
 from ..params import load_toml
 from ..units import to_si
-from .targets import Target, resolve_target
+from .targets import Target, file_digest, files_in, resolve_target
 
 __all__ = ["SweepSpec", "load_spec", "DISTRIBUTIONS", "VARIANT_ID"]
 
@@ -55,7 +62,7 @@ class SweepSpec:
     path : Path
         The spec file (``"<dict>"`` when built from a mapping).
     model : str
-        Target name or import path as written in the spec.
+        Target name as written in the spec.
     target : Target
         The resolved target.
     scenario : dict or None
@@ -77,6 +84,9 @@ class SweepSpec:
         One row per variant (index ``variant_id`` = row number), SI values.
     definition : dict
         Normalised design definition (SI values), part of the hash.
+    inputs : tuple of (str, str, str)
+        ``(label, absolute path, SHA-256 of the bytes)`` of every file the
+        spec references (the label is the path relative to the spec's folder).
     """
 
     path: Path
@@ -91,6 +101,7 @@ class SweepSpec:
     units: dict
     design: pd.DataFrame
     definition: dict = field(repr=False)
+    inputs: tuple = ()
 
     @property
     def n_variants(self) -> int:
@@ -110,10 +121,12 @@ class SweepSpec:
 
     @functools.cached_property
     def hash(self) -> str:
-        """SHA-256 over the normalised spec, the scenario contents and the design values."""
+        """SHA-256 over the normalised spec, the design values, the target, the clutchlab version and the input files."""
         scen = None if self.scenario is None else {k: v for k, v in self.scenario.items() if not k.startswith("_")}
         body = {
-            "target": self.target.path,
+            "target": self.target.identity,
+            "clutchlab": __version__,
+            "inputs": {label: digest for label, _, digest in self.inputs},
             "scenario": scen,
             "outputs": list(self.outputs),
             "chunk_size": self.chunk_size,
@@ -123,6 +136,43 @@ class SweepSpec:
         }
         text = json.dumps(body, sort_keys=True, default=str)
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+    def changed_inputs(self) -> list[str]:
+        """Labels of the referenced files whose bytes differ now from when the spec was loaded (or that are gone)."""
+        changed = []
+        for label, path, digest in self.inputs:
+            try:
+                now = file_digest(path)
+            except OSError:
+                now = None
+            if now != digest:
+                changed.append(label)
+        return changed
+
+
+def _inputs(target, scenario, scen_path, base_dir, where) -> tuple:
+    """``(label, path, sha256)`` of the scenario file and of every file it makes the target read."""
+    paths = []
+    if scen_path is not None:
+        paths.append(scen_path)
+        try:
+            declared = target.referenced_files(scenario)
+        except ParameterError as exc:
+            raise ParameterError(f"{where}: {exc}") from None
+        paths += [p if p.is_absolute() else (scen_path.parent / p) for p in declared]
+        paths += files_in(scenario)
+    out, seen = [], set()
+    for p in paths:
+        p = Path(p).resolve()
+        if p in seen:
+            continue
+        seen.add(p)
+        try:
+            digest = file_digest(p)
+        except OSError as exc:
+            raise DataError(f"{where}: cannot read {p}, referenced by the spec ({exc.strerror or exc})") from None
+        out.append((Path(os.path.relpath(p, base_dir)).as_posix(), str(p), digest))
+    return tuple(sorted(out))
 
 
 def _suggest(name, known):
@@ -262,12 +312,13 @@ def spec_from_dict(data: dict, *, source=None) -> SweepSpec:
     if bad:
         raise ParameterError(f"{where}: [sweep] unknown key {bad[0]!r} = {sweep[bad[0]]!r} (known: {', '.join(_SWEEP_KEYS)})")
     if "model" not in sweep:
-        raise ParameterError(f"{where}: [sweep] needs model = \"wet\" | \"emtc\" | \"eclutch-static\" | \"module:function\"")
+        raise ParameterError(f"{where}: [sweep] needs model = \"wet\" | \"emtc\" | \"eclutch-static\" | \"eclutch\" "
+                             "(or a registered or plugin target name)")
     model = sweep["model"]
     if not isinstance(model, str):
         raise ParameterError(f"{where}: [sweep] model = {model!r}: expected a string")
     target = resolve_target(model, source=where)
-    scenario = None
+    scenario = scen_path = None
     if "scenario" in sweep:
         scen_raw = sweep["scenario"]
         if not isinstance(scen_raw, str) or not scen_raw:
@@ -278,6 +329,7 @@ def spec_from_dict(data: dict, *, source=None) -> SweepSpec:
         scenario = dict(load_toml(scen_path))
         scenario["_source"] = str(scen_path)
     info = target.describe(scenario)
+    inputs = _inputs(target, scenario, scen_path, base_dir, where)
     outputs = sweep.get("outputs")
     if not isinstance(outputs, list) or not outputs or not all(isinstance(o, str) for o in outputs):
         raise ParameterError(f"{where}: [sweep] outputs = {outputs!r}: expected a non-empty list of output names")
@@ -309,7 +361,8 @@ def spec_from_dict(data: dict, *, source=None) -> SweepSpec:
     target.check(design, scenario, source=where)
     return SweepSpec(path=Path(source) if source is not None else Path("<dict>"), model=model, target=target,
                      scenario=scenario, outputs=tuple(outputs), chunk_size=chunk_size, seed=seed, kind=kind,
-                     parameters=tuple(design.columns), units=units, design=design, definition=definition)
+                     parameters=tuple(design.columns), units=units, design=design, definition=definition,
+                     inputs=inputs)
 
 
 class _PlainNumbers(dict):

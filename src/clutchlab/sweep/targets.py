@@ -1,6 +1,6 @@
-"""Sweep targets: what a model has to provide to be swept, and the registry of models.
+"""Sweep targets: what a model has to provide to be swept, and where targets come from.
 
-A target is a function, named by an import path ``"package.module:function"``,
+A target is a ``run_batch`` function,
 
 .. code-block:: python
 
@@ -15,8 +15,8 @@ paths) or ``None`` for the model's bundled default.  The function returns a
 DataFrame with the same index and one float column per name in ``outputs``
 (NaN where a variant has no value, e.g. no lock-up).
 
-Two optional functions in the same module let the spec be checked before
-anything runs:
+Three optional functions beside it (attributes of the same module or object)
+let the spec be checked before anything runs and a resumed sweep be trusted:
 
 * ``describe(scenario) -> {"parameters": {name: si_unit}, "outputs": {name: unit}}``
   -- the parameters that may be swept (values in the spec may carry units and
@@ -26,52 +26,58 @@ anything runs:
 * ``check_variants(variants, scenario)`` -- raise
   :class:`~clutchlab.errors.ParameterError` naming the variant id, parameter
   and value if a variant cannot be built (``r_inner >= r_outer``, a gear
-  that does not exist).
+  that does not exist);
+* ``referenced_files(scenario) -> list of paths`` -- every file the scenario
+  makes the target read (curves, a Preisach model, an input signal).  Their
+  bytes are part of the sweep's hash, so a resumed sweep never mixes results
+  of old and new files.  (Strings in the scenario naming an existing file
+  beside it are hashed as well, declared or not.)
 
-Built-in targets are listed in :data:`TARGETS`; :func:`register_target` adds
-more (the spec may also name an import path directly as ``model``).
+**A spec names a target, never code.**  Targets come from three places only:
+clutchlab's built-in targets (:data:`BUILTIN`), targets registered in this
+process with :func:`register_target` (a module or a function object, not an
+import path), and installed plugins declaring an entry point in the group
+``clutchlab.sweep_targets`` (``name = "package.module"`` or
+``"package.module:object"``), which is imported only when a spec names it.
+Entry points of distributions found in the working directory or the spec's
+folder are ignored (``python -m clutchlab`` puts the working directory on
+``sys.path``).  :func:`available_targets` lists the names.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import importlib
+import importlib.metadata
+import os
 import threading
+import types
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..errors import ClutchlabError, ParameterError
 
-__all__ = ["TARGETS", "Target", "TargetInfo", "register_target", "resolve_target", "sweepable_fields",
-           "vary_parameter_set"]
+__all__ = ["BUILTIN", "ENTRY_POINT_GROUP", "Target", "TargetInfo", "available_targets", "register_target",
+           "unregister_target", "resolve_target", "file_digest", "files_in", "sweepable_fields", "vary_parameter_set"]
 
-#: model name -> import path of its ``run_batch``
-TARGETS: dict[str, str] = {
-    "wet": "clutchlab.sweep.wet:run_batch",
-    "emtc": "clutchlab.sweep.emtc:run_batch",
-    "eclutch-static": "clutchlab.sweep.eclutch_static:run_batch",
-    "eclutch": "clutchlab.eclutch.sweep:run_batch",  # E-clutch dynamics (issue #5), available once that module exists
-}
+#: built-in model name -> clutchlab module holding its ``run_batch`` (a constant of this package, never read from a file)
+BUILTIN: types.MappingProxyType = types.MappingProxyType({
+    "wet": "clutchlab.sweep.wet",
+    "emtc": "clutchlab.sweep.emtc",
+    "eclutch-static": "clutchlab.sweep.eclutch_static",
+    "eclutch": "clutchlab.eclutch.sweep",
+})
 
-_LOADED: dict = {}
-_LOAD_LOCK = threading.Lock()
+#: entry-point group of plugin targets
+ENTRY_POINT_GROUP = "clutchlab.sweep_targets"
 
-
-def register_target(name: str, path: str) -> None:
-    """Make ``name`` usable as ``model`` in a spec, running the function at import path ``path``.
-
-    Parameters
-    ----------
-    name : str
-        Model name used in specs.
-    path : str
-        ``"package.module:function"`` of a ``run_batch`` function (see the module docstring).
-    """
-    if not isinstance(path, str) or path.count(":") != 1:
-        raise ParameterError(f"register_target({name!r}, {path!r}): expected 'package.module:function'")
-    TARGETS[name] = path
+_HOOKS = ("run_batch", "describe", "check_variants", "referenced_files")
+_REGISTERED: dict = {}
+_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -84,46 +90,59 @@ class TargetInfo:
 
 @dataclass(frozen=True)
 class Target:
-    """A resolved target: model name and import path (picklable; the function is imported on first use)."""
+    """A resolved target: its name, where it came from and its functions.
+
+    Picklable (the functions are pickled by reference), so it can be shipped
+    to worker processes and Dask workers, where the defining module must be
+    importable.
+
+    Attributes
+    ----------
+    name : str
+        Model name as written in the spec.
+    origin : str
+        ``"built-in"``, ``"registered"`` or ``"entry point NAME = VALUE (DIST VERSION)"``.
+    identity : str
+        What the sweep's hash records about the target (module, function, plugin version).
+    run_batch : callable
+        The batch function (see the module docstring).
+    describe, check_variants, referenced_files : callable or None
+        The optional functions.
+    """
 
     name: str
-    path: str
-
-    def _module_and_function(self):
-        with _LOAD_LOCK:
-            if self.path not in _LOADED:
-                mod_name, _, func_name = self.path.partition(":")
-                try:
-                    mod = importlib.import_module(mod_name)
-                except ModuleNotFoundError as exc:
-                    raise ParameterError(f"model {self.name!r}: cannot import {mod_name!r} ({exc})") from None
-                func = getattr(mod, func_name, None)
-                if not callable(func):
-                    raise ParameterError(f"model {self.name!r}: {mod_name!r} has no function {func_name!r}")
-                _LOADED[self.path] = (mod, func)
-            return _LOADED[self.path]
+    origin: str
+    identity: str
+    run_batch: object = dataclasses.field(repr=False)
+    describe_fn: object = dataclasses.field(default=None, repr=False)
+    check_fn: object = dataclasses.field(default=None, repr=False)
+    files_fn: object = dataclasses.field(default=None, repr=False)
 
     @property
     def function(self):
         """The ``run_batch`` function."""
-        return self._module_and_function()[1]
+        return self.run_batch
 
     def describe(self, scenario) -> TargetInfo:
         """Declared parameters and outputs for ``scenario`` (``None`` entries where the target declares none)."""
-        mod, _ = self._module_and_function()
-        if not hasattr(mod, "describe"):
+        if self.describe_fn is None:
             return TargetInfo(None, None)
-        info = mod.describe(scenario)
+        info = self.describe_fn(scenario)
         return TargetInfo(dict(info.get("parameters", {})), dict(info.get("outputs", {})))
 
     def check(self, variants: pd.DataFrame, scenario, source: str | None = None) -> None:
         """Run the target's ``check_variants`` if it has one; errors name ``source``."""
-        mod, _ = self._module_and_function()
-        if hasattr(mod, "check_variants"):
+        if self.check_fn is not None:
             try:
-                mod.check_variants(variants, scenario)
+                self.check_fn(variants, scenario)
             except ParameterError as exc:
                 raise ParameterError(f"{source}: {exc}" if source else str(exc)) from None
+
+    def referenced_files(self, scenario) -> list[Path]:
+        """Files the target reads for ``scenario`` (its ``referenced_files``; empty without one)."""
+        if self.files_fn is None or scenario is None:
+            return []
+        return [Path(p) for p in self.files_fn(scenario)]
 
     def run(self, variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
         """Call ``run_batch`` and check its answer (same index, every output, numeric)."""
@@ -139,35 +158,212 @@ class Target:
         return out.loc[:, list(outputs)].astype(float)
 
 
+def _hooks(obj, what: str) -> dict:
+    """``{hook: callable or None}`` of a module / object with ``run_batch``, or of a bare ``run_batch`` function."""
+    if isinstance(obj, str):
+        raise ParameterError(f"{what}: got the string {obj!r}; pass the module or function object "
+                             "(targets are never imported from a name)")
+    if callable(getattr(obj, "run_batch", None)):
+        hooks = {h: getattr(obj, h, None) for h in _HOOKS}
+        for h, fn in hooks.items():
+            if fn is not None and not callable(fn):
+                raise ParameterError(f"{what}: {h} is not callable")
+        return hooks
+    if callable(obj) and not isinstance(obj, type):
+        return {"run_batch": obj, "describe": None, "check_variants": None, "referenced_files": None}
+    raise ParameterError(f"{what}: expected a module or object with a run_batch function, or the function itself")
+
+
+def _qualname(fn) -> str:
+    return f"{getattr(fn, '__module__', '?')}.{getattr(fn, '__qualname__', type(fn).__name__)}"
+
+
+def _make(name, origin, identity, hooks) -> Target:
+    return Target(name, origin, identity, hooks["run_batch"], hooks["describe"], hooks["check_variants"],
+                  hooks["referenced_files"])
+
+
+def register_target(name: str, target, *, replace: bool = False) -> None:
+    """Make ``name`` usable as ``model`` in a spec (in this process).
+
+    Parameters
+    ----------
+    name : str
+        Model name used in specs (no ``:``; not one of :data:`BUILTIN`).
+    target : module, object or callable
+        A module or object with a ``run_batch`` function (and optionally
+        ``describe``, ``check_variants``, ``referenced_files``; see the module
+        docstring), or the ``run_batch`` function itself.  For worker
+        processes and Dask the functions must be importable module-level
+        functions.
+    replace : bool
+        Replace an existing registration of ``name``.
+
+    Raises
+    ------
+    ParameterError
+        A bad name, an import path given as a string, or a name already taken.
+    """
+    if not isinstance(name, str) or not name or ":" in name or name != name.strip():
+        raise ParameterError(f"register_target({name!r}): expected a plain name without ':'")
+    if name in BUILTIN:
+        raise ParameterError(f"register_target({name!r}): {name!r} is a built-in target")
+    hooks = _hooks(target, f"register_target({name!r})")
+    with _LOCK:
+        if name in _REGISTERED and not replace:
+            raise ParameterError(f"register_target({name!r}): already registered (pass replace=True)")
+        _REGISTERED[name] = hooks
+
+
+def unregister_target(name: str) -> None:
+    """Forget a target registered with :func:`register_target`.
+
+    Parameters
+    ----------
+    name : str
+        The registered name (nothing happens if it is not registered).
+    """
+    with _LOCK:
+        _REGISTERED.pop(name, None)
+
+
+def _untrusted_dirs(source) -> set:
+    try:
+        dirs = {Path.cwd().resolve()}
+    except OSError:  # the working directory was removed: nothing is found there either
+        dirs = set()
+    if source is not None and str(source) not in ("<spec>", "<dict>"):
+        dirs.add(Path(source).resolve().parent)
+    return dirs
+
+
+def _entry_points(source=None) -> dict:
+    """``{name: [entry points]}`` of installed plugins, leaving out distributions in untrusted folders."""
+    untrusted = _untrusted_dirs(source)
+    found: dict = {}
+    for dist in importlib.metadata.distributions():
+        try:
+            eps = [ep for ep in dist.entry_points if ep.group == ENTRY_POINT_GROUP]
+        except Exception:  # pragma: no cover - a broken dist-info: not a plugin
+            continue
+        if not eps:
+            continue
+        try:
+            home = Path(str(dist.locate_file(""))).resolve()
+        except Exception:  # pragma: no cover
+            continue
+        if home in untrusted:
+            continue
+        for ep in eps:
+            found.setdefault(ep.name, []).append((ep, dist))
+    return found
+
+
+def available_targets(source=None) -> list[str]:
+    """Names a spec may give as ``model``: built-in, registered, then installed plugins (sorted each).
+
+    Parameters
+    ----------
+    source : str or Path, optional
+        The spec file; plugins installed in its folder are not offered.
+
+    Notes
+    -----
+    Lists entry points from the installed metadata without importing any of them.
+    """
+    with _LOCK:
+        registered = sorted(_REGISTERED)
+    plugins = sorted(n for n in _entry_points(source) if n not in BUILTIN and n not in registered)
+    return [*sorted(BUILTIN), *registered, *plugins]
+
+
 def resolve_target(model: str, source: str | None = None) -> Target:
-    """The :class:`Target` for a model name in :data:`TARGETS` or an import path ``"module:function"``.
+    """The :class:`Target` named ``model``: built-in, registered, or an installed plugin's entry point.
 
     Parameters
     ----------
     model : str
-        Model name (``"wet"``, ``"emtc"``, ``"eclutch-static"``, ...) or ``"package.module:function"``.
+        Model name (``"wet"``, ``"emtc"``, ``"eclutch-static"``, ``"eclutch"``, a registered or plugin name).
     source : str, optional
         Spec file, named in error messages.
 
     Raises
     ------
     ParameterError
-        Unknown name, or the module or function cannot be imported.
+        Unknown name (the message lists the available ones; an import path
+        such as ``"module:function"`` is an unknown name), or a plugin that
+        cannot be loaded.
     """
+    from .. import __version__
+
     where = f"{source}: " if source else ""
-    if model in TARGETS:
-        path = TARGETS[model]
-    elif isinstance(model, str) and model.count(":") == 1 and all(model.split(":")):
-        path = model
-    else:
-        raise ParameterError(f"{where}[sweep] model = {model!r}: unknown model (known: {', '.join(TARGETS)}, "
-                             f"or 'package.module:function')")
-    target = Target(model, path)
+    if not isinstance(model, str):
+        raise ParameterError(f"{where}[sweep] model = {model!r}: expected a target name")
+    if model in BUILTIN:
+        module = importlib.import_module(BUILTIN[model])
+        return _make(model, "built-in", f"clutchlab {__version__} built-in {model} ({BUILTIN[model]})",
+                     _hooks(module, f"built-in target {model!r}"))
+    with _LOCK:
+        hooks = _REGISTERED.get(model)
+    if hooks is not None:
+        return _make(model, "registered", f"registered {model} ({_qualname(hooks['run_batch'])})", hooks)
+    plugins = _entry_points(source).get(model, []) if ":" not in model else []
+    if not plugins:
+        hint = ("; a spec names a target, never code: register it with clutchlab.sweep.register_target or "
+                f"install it as an entry point in the group {ENTRY_POINT_GROUP!r}") if ":" in model or "." in model else ""
+        raise ParameterError(f"{where}[sweep] model = {model!r}: unknown model "
+                             f"(available: {', '.join(available_targets(source))}){hint}")
+    if len(plugins) > 1:
+        dists = ", ".join(f"{d.metadata['Name']} {d.version}" for _, d in plugins)
+        raise ParameterError(f"{where}[sweep] model = {model!r}: provided by more than one installed plugin ({dists})")
+    ep, dist = plugins[0]
+    label = f"entry point {ep.name} = {ep.value} ({dist.metadata['Name']} {dist.version})"
     try:
-        target.function
-    except ParameterError as exc:
-        raise ParameterError(f"{where}[sweep] model = {model!r}: {exc}") from None
-    return target
+        obj = ep.load()
+    except Exception as exc:  # a plugin that does not import is the plugin's error, reported in one line
+        raise ParameterError(f"{where}[sweep] model = {model!r}: cannot load the {label}: "
+                             f"{type(exc).__name__}: {exc}") from None
+    return _make(model, label, label, _hooks(obj, f"{where}[sweep] model = {model!r}: {label}"))
+
+
+def file_digest(path) -> str:
+    """SHA-256 (hex) of the bytes of the file ``path``."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def files_in(scenario) -> list[Path]:
+    """Existing files named by string values anywhere in ``scenario``, relative to its ``_source`` folder.
+
+    The catch-all behind a target's ``referenced_files``: a plugin that does
+    not declare its files still has those it names in the scenario hashed.
+    """
+    if not scenario or "_source" not in scenario:
+        return []
+    base = Path(scenario["_source"]).parent
+    found = []
+
+    def walk(value):
+        if isinstance(value, dict):
+            for k, v in value.items():
+                if not str(k).startswith("_"):
+                    walk(v)
+        elif isinstance(value, list):
+            for v in value:
+                walk(v)
+        elif isinstance(value, str) and value and len(value) < 4096 and "\0" not in value:
+            try:
+                p = (base / value).resolve()
+                if p.is_file():
+                    found.append(p)
+            except (OSError, ValueError):
+                pass
+
+    walk(scenario)
+    return found
 
 
 # ----------------------------------------------------------------- helpers for built-in targets
