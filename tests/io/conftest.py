@@ -112,13 +112,14 @@ def unfinalise(path, *, std_flags=0x05, custom_flags=0x01):
     return bytes(data)
 
 
-def write_can_logger_file(path, *, version="4.11"):
+def write_can_logger_file(path, *, version="4.11", bus_groups=1):
     """A CAN-logger-like MF4: a decoded signal group, duplicate names in one group, and a raw CAN frame group.
 
     Group 0 (100 Hz): ``EngineSpeed`` in ``U/  min`` (as a German logger
     writes it), ``TQ`` twice (index 2: N*m, index 3: kN*m, both as "Nm"
-    spellings), ``Label`` text.  Group 1: raw ``CAN_DataFrame`` frames (bus
-    event group with a CAN source).
+    spellings), ``Label`` text.  Groups 1 .. ``bus_groups``: raw
+    ``CAN_DataFrame`` frames (bus event groups with a CAN source, as CANedge
+    writes one per frame type).
     """
     from asammdf import Source
     from asammdf.blocks import v4_constants as v4c
@@ -137,7 +138,8 @@ def write_can_logger_file(path, *, version="4.11"):
     frames["CAN_DataFrame.DLC"] = frames["CAN_DataFrame.DataLength"] = 8
     frames["CAN_DataFrame.DataBytes"] = np.arange(t.size * 8).reshape(t.size, 8) % 256
     bus = Source(name="CAN1", path="CAN1", comment="", source_type=v4c.SOURCE_BUS, bus_type=v4c.BUS_TYPE_CAN)
-    mdf.append([Signal(frames, t, name="CAN_DataFrame", source=bus)], acq_name="CAN1", acq_source=bus)
+    for _ in range(bus_groups):
+        mdf.append([Signal(frames, t, name="CAN_DataFrame", source=bus)], acq_name="CAN1", acq_source=bus)
     out = mdf.save(path, overwrite=True)
     mdf.close()
     return out

@@ -182,11 +182,12 @@ def test_truncated_and_foreign_files_fail_cleanly(tmp_path, logger_file):
             read_measurement(bad, LOGGER_MAP)
     text = tmp_path / "notes.mf4"
     text.write_text("time,torque\n0,1\n")
-    with pytest.raises(DataError, match=r"notes\.mf4: not a readable MDF file.*magic"):
+    with pytest.raises(DataError, match=r"notes\.mf4: not a readable MDF file "
+                                        r"\(it starts with b'time,tor', not b'MDF     '\)"):
         read_measurement(text)
     empty = tmp_path / "empty.mf4"
     empty.write_bytes(b"")
-    with pytest.raises(DataError, match=r"empty\.mf4: not a readable MDF file"):
+    with pytest.raises(DataError, match=r"empty\.mf4: not a readable MDF file \(it is empty\)"):
         read_measurement(empty)
     with pytest.raises(DataError, match="no such file"):
         read_measurement(tmp_path / "absent.mf4")

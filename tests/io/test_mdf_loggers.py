@@ -235,6 +235,14 @@ def test_many_skipped_channels_end_in_one_summary_line(tmp_path, capfd):
     assert lines[10] == f"clutchlab: warning: {path}: ... and 3 more skipped (all listed in the provenance above)"
 
 
+def test_raw_bus_frame_groups_are_reported_once(tmp_path):
+    path = write_can_logger_file(tmp_path / "frames.mf4", bus_groups=3)
+    m = read_measurement(path)
+    assert m.channels == ("EngineSpeed",)
+    bus = [k for k in m.source.skipped if k.startswith("group")]
+    assert bus == ["groups 1-3"] and m.source.skipped["groups 1-3"].startswith("raw bus frames (CAN1.CAN_DataFrame")
+
+
 def test_raw_bus_frames_can_be_mapped_field_by_field(can_file):
     m = read_measurement(can_file, {"frame_id": {"source": "CAN_DataFrame.ID", "unit": "1"},
                                     "dlc": {"source": "CAN_DataFrame.DLC", "unit": "1"}})

@@ -126,7 +126,10 @@ def _one_line(exc: BaseException, limit: int = 160) -> str:
     text = " ".join(str(exc).split())
     if len(text) > limit:
         text = text[:limit - 3] + "..."
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+    kind = type(exc).__name__
+    if kind == "error":  # struct.error, zlib.error: say whose
+        kind = f"{type(exc).__module__.lstrip('_')}.{kind}"
+    return f"{kind}: {text}" if text else kind
 
 
 def _defuse(exc: BaseException) -> None:
@@ -241,8 +244,13 @@ class MdfReader:
             self._fh = open(self.path, "rb")
         except OSError as exc:
             raise DataError(f"{label}: cannot open ({exc.strerror or type(exc).__name__})") from None
-        self.unfinalised_flags = _unfinalised_flags(self._fh.read(64))
+        head = self._fh.read(64)
         self._fh.seek(0)
+        if not head.startswith((b"MDF", UNFINALISED_ID)):
+            self._fh.close()
+            shown = "it is empty" if not head else f"it starts with {head[:8]!r}, not b'MDF     '"
+            raise DataError(f"{label}: not a readable MDF file ({shown})")
+        self.unfinalised_flags = _unfinalised_flags(head)
         if self.unfinalised_flags:
             # asammdf finalises in place: give it a writable copy, never the user's file
             copy = tempfile.TemporaryFile(prefix="clutchlab-unfinalised-", suffix=".mf4")

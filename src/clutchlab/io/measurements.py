@@ -478,13 +478,26 @@ def _table_time(reader, time: str, time_spec: ChannelSpec | None) -> np.ndarray:
     return t
 
 
+def _group_list(groups: list[int]) -> str:
+    """``group 3`` or ``groups 0-60, 64`` (runs of consecutive numbers joined)."""
+    runs: list[list[int]] = []
+    for g in groups:
+        if runs and g == runs[-1][1] + 1:
+            runs[-1][1] = g
+        else:
+            runs.append([g, g])
+    text = ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
+    return f"group{'s' if len(groups) > 1 else ''} {text}"
+
+
 def _mdf_identity(reader: MdfReader, required, time, skipped: dict[str, str]) -> list[ChannelSpec]:
     """Channels of an identity read of an MDF file; raw bus frames and ambiguous names go to ``skipped``."""
-    for g in sorted(reader.bus_groups):
-        names = sorted({n for n in reader.channel_names() if g in reader.groups_of(n)})
+    if reader.bus_groups:
+        bus = sorted(reader.bus_groups)
+        names = sorted({n for n in reader.channel_names() if set(reader.groups_of(n)) & reader.bus_groups})
         shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-        skipped[f"group {g}"] = (f"raw bus frames ({shown}), not signals; decode them with a DBC file "
-                                 "(asammdf extract_bus_logging) or map their fields explicitly")
+        skipped[_group_list(bus)] = (f"raw bus frames ({shown}), not signals; decode them with a DBC file "
+                                     "(asammdf extract_bus_logging) or map their fields explicitly")
     specs = []
     for n in reader.channel_names():
         if n == time:
