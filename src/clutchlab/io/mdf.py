@@ -265,7 +265,7 @@ class MdfReader:
             self._fh.close()
             self._fh = copy
         try:
-            with _quiet_asammdf() as said:
+            with _quiet_asammdf():
                 self._mdf = MDF(self._fh)
         except Exception as exc:  # asammdf raises MdfException, ValueError, struct.error ... on damaged files
             _defuse(exc)
@@ -274,7 +274,6 @@ class MdfReader:
                 raise DataError(f"{label}: unfinalised MDF file (flags 0x{self.unfinalised_flags:02x}) that asammdf "
                                 f"cannot finalise ({_one_line(exc)})") from None
             raise DataError(f"{label}: not a readable MDF file ({_one_line(exc)})") from None
-        self.messages = tuple(said.lines)  # what asammdf said while opening (not shown)
         groups = self._mdf.groups
         self._masters = {(g, i) for g, i in self._mdf.masters_db.items()}
         self.bus_groups = {g for g, grp in enumerate(groups)
