@@ -112,14 +112,16 @@ def unfinalise(path, *, std_flags=0x05, custom_flags=0x01):
     return bytes(data)
 
 
-def write_can_logger_file(path, *, version="4.11", bus_groups=1):
+def write_can_logger_file(path, *, version="4.11", bus_groups=1, bus_source=True):
     """A CAN-logger-like MF4: a decoded signal group, duplicate names in one group, and a raw CAN frame group.
 
     Group 0 (100 Hz): ``EngineSpeed`` in ``U/  min`` (as a German logger
     writes it), ``TQ`` twice (index 2: N*m, index 3: kN*m, both as "Nm"
     spellings), ``Label`` text.  Groups 1 .. ``bus_groups``: raw
     ``CAN_DataFrame`` frames (bus event groups with a CAN source, as CANedge
-    writes one per frame type).
+    writes one per frame type); with ``bus_source=False`` written without
+    the CAN source, so the group lacks the bus-event flag as in some
+    converted files.
     """
     from asammdf import Source
     from asammdf.blocks import v4_constants as v4c
@@ -139,7 +141,10 @@ def write_can_logger_file(path, *, version="4.11", bus_groups=1):
     frames["CAN_DataFrame.DataBytes"] = np.arange(t.size * 8).reshape(t.size, 8) % 256
     bus = Source(name="CAN1", path="CAN1", comment="", source_type=v4c.SOURCE_BUS, bus_type=v4c.BUS_TYPE_CAN)
     for _ in range(bus_groups):
-        mdf.append([Signal(frames, t, name="CAN_DataFrame", source=bus)], acq_name="CAN1", acq_source=bus)
+        if bus_source:
+            mdf.append([Signal(frames, t, name="CAN_DataFrame", source=bus)], acq_name="CAN1", acq_source=bus)
+        else:
+            mdf.append([Signal(frames, t, name="CAN_DataFrame")], acq_name="CAN1")
     out = mdf.save(path, overwrite=True)
     mdf.close()
     return out

@@ -235,12 +235,16 @@ def test_many_skipped_channels_end_in_one_summary_line(tmp_path, capfd):
     assert lines[10] == f"clutchlab: warning: {path}: ... and 3 more skipped (all listed in the provenance above)"
 
 
-def test_raw_bus_frame_groups_are_reported_once(tmp_path):
-    path = write_can_logger_file(tmp_path / "frames.mf4", bus_groups=3)
+@pytest.mark.parametrize("bus_source", [True, False])
+def test_raw_bus_frame_groups_are_reported_once(tmp_path, bus_source):
+    path = write_can_logger_file(tmp_path / "frames.mf4", bus_groups=3, bus_source=bus_source)
+    with MDF(path) as mdf:  # the fixture is what it claims: CG flag bit 1 (bus event) set or not
+        assert all(bool(mdf.groups[g].channel_group.flags & 2) == bus_source for g in (1, 2, 3))
     m = read_measurement(path)
     assert m.channels == ("EngineSpeed",)
     bus = [k for k in m.source.skipped if k.startswith("group")]
-    assert bus == ["groups 1-3"] and m.source.skipped["groups 1-3"].startswith("raw bus frames (CAN1.CAN_DataFrame")
+    assert bus == ["groups 1-3"] and m.source.skipped["groups 1-3"].startswith("raw bus frames (")
+    assert "CAN_DataFrame.BusChannel" in m.source.skipped["groups 1-3"]
 
 
 def test_raw_bus_frames_can_be_mapped_field_by_field(can_file):

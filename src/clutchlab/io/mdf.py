@@ -61,10 +61,11 @@ class RawChannel:
 UNFINALISED_ID = b"UnFinMF "
 #: MDF 4.1 channel-group flag of bus-event groups (raw CAN/LIN/FlexRay/Ethernet frames), cg_flags bit 1
 _CG_BUS_EVENT = 1 << 1
-#: channel names of raw bus frames (ASAM MDF bus logging), for groups written without the bus-event flag
-_BUS_FRAME_PREFIXES = ("CAN_DataFrame", "CAN_RemoteFrame", "CAN_ErrorFrame", "CAN_OverloadFrame",
-                       "LIN_Frame", "LIN_ChecksumError", "LIN_ReceiveError", "LIN_SyncError", "LIN_TransmissionError",
-                       "FLX_Frame", "FLX_NullFrame", "FLX_StartCycle", "ETH_Frame", "MOST_")
+#: structure channels of raw bus frames (ASAM MDF bus logging; fields follow as ``CAN_DataFrame.ID`` ...),
+#: for groups written without the bus-event flag
+_BUS_FRAMES = frozenset({"CAN_DataFrame", "CAN_RemoteFrame", "CAN_ErrorFrame", "CAN_OverloadFrame",
+                         "LIN_Frame", "LIN_ChecksumError", "LIN_ReceiveError", "LIN_SyncError",
+                         "LIN_TransmissionError", "FLX_Frame", "FLX_NullFrame", "FLX_StartCycle", "ETH_Frame"})
 
 
 class _Captured:
@@ -278,7 +279,7 @@ class MdfReader:
         self._masters = {(g, i) for g, i in self._mdf.masters_db.items()}
         self.bus_groups = {g for g, grp in enumerate(groups)
                            if getattr(grp.channel_group, "flags", 0) & _CG_BUS_EVENT
-                           or any(ch.name.startswith(_BUS_FRAME_PREFIXES) for ch in grp.channels)}
+                           or any(ch.name.split(".", 1)[0] in _BUS_FRAMES for ch in grp.channels)}
         self._occurrences: dict[str, list[tuple[int, int]]] = {}
         for name, entries in self._mdf.channels_db.items():
             for g, i in entries:

@@ -450,13 +450,12 @@ def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), 
 
 
 def _has(reader, spec_or_name) -> bool:
-    if isinstance(spec_or_name, ChannelSpec):
-        if isinstance(reader, MdfReader):
-            return reader.has(spec_or_name.source, spec_or_name.group, spec_or_name.index)
-        return reader.has(spec_or_name.source)
-    if isinstance(reader, MdfReader):
+    """True if the reader has the channel (an MDF spec: at its group and index, if given)."""
+    if not isinstance(spec_or_name, ChannelSpec):
         return reader.has(spec_or_name)
-    return reader.has(spec_or_name)
+    if isinstance(reader, MdfReader):
+        return reader.has(spec_or_name.source, spec_or_name.group, spec_or_name.index)
+    return reader.has(spec_or_name.source)
 
 
 def _dimensionless(unit: str) -> bool:
