@@ -26,6 +26,8 @@ __all__ = [
     "pa_to_bar",
     "to_si",
     "format_quantity",
+    "UNIT_ALIASES",
+    "normalise_unit",
 ]
 
 _RPM = 2.0 * math.pi / 60.0
@@ -126,6 +128,72 @@ def pa_to_bar(pressure_pa):
         Value(s) in bar.
     """
     return np.asarray(pressure_pa, dtype=float) / 1e5 if np.ndim(pressure_pa) else float(pressure_pa) / 1e5
+
+
+#: logger spellings of units, translated before pint parses them (after whitespace and Unicode are
+#: normalised by :func:`normalise_unit`); pint alone would read ``Nm`` as nanometre, ``U/min`` as
+#: enzyme units per minute, ``1/min`` as 1/60 Hz (not 2 pi/60 rad/s) and ``mNm`` as "millinumber metre"
+UNIT_ALIASES = {
+    # torque
+    "Nm": "N*m", "N.m": "N*m", "N m": "N*m", "N-m": "N*m", "NM": "N*m", "Nmm": "N*mm",
+    "kNm": "kN*m", "mNm": "mN*m", "kN.m": "kN*m", "kN m": "kN*m",
+    # temperature
+    "°C": "degC", "° C": "degC", "deg C": "degC", "Grad C": "degC", "°F": "degF", "° F": "degF",
+    "deg F": "degF", "°K": "K", "°": "deg",
+    # rotational speed: revolutions per minute, never enzyme units (U) or cycles per minute (1/min)
+    "rpm": "rpm", "U/min": "rpm", "UpM": "rpm", "Upm": "rpm", "1/min": "rpm", "min-1": "rpm", "min^-1": "rpm",
+    "min**-1": "rpm", "r/min": "rpm", "rev/min": "rpm", "revs/min": "rpm", "tr/min": "rpm", "r/mn": "rpm",
+    "U/s": "rps", "1/s": "1/s", "r/s": "rps", "rev/s": "rps", "rps": "rps",
+    # speed, pressure
+    "kmh": "km/h", "kph": "km/h", "barg": "bar", "bar(g)": "bar", "mbarg": "mbar",
+    # dimensionless
+    "-": "", "[-]": "", "--": "", "1": "", "none": "", "%": "percent", "‰": "permille",
+}
+# spellings looked up without regard to case (RPM, Rpm, u/min, NM, DEGC ...)
+_CASELESS = {k.lower(): v for k, v in UNIT_ALIASES.items()
+             if v in ("rpm", "rps", "degC", "degF", "km/h")} | {"degc": "degC", "degf": "degF"}
+_UNICODE = {"µ": "u", "μ": "u", "²": "**2", "³": "**3", "⁻¹": "**-1", "·": "*", "⋅": "*", "×": "*",
+            "Ω": "ohm", "℃": "degC", "℉": "degF", "\u00a0": " "}
+_SPACES_AROUND_OPERATORS = re.compile(r"\s*([/*^])\s*")
+
+
+def normalise_unit(unit: str | None) -> str:
+    """Translate a unit as data loggers spell it into pint syntax.
+
+    Whitespace is collapsed (``"U/  min"`` -> ``"U/min"``), surrounding square
+    brackets are dropped (``"[Nm]"``), Unicode signs are spelled out
+    (``µ``, ``²``, ``·``, ``℃``), and the logger spellings of
+    :data:`UNIT_ALIASES` are translated (``Nm`` -> ``N*m``, ``U/min`` and
+    ``1/min`` -> ``rpm``, ``°C`` -> ``degC``, ``-`` -> dimensionless).  Unknown
+    spellings are returned (normalised) for pint to judge.
+
+    Parameters
+    ----------
+    unit : str or None
+        Unit string as stored in a file or written in a channel map.
+
+    Returns
+    -------
+    str
+        Unit string for pint; ``""`` means dimensionless (or no unit).
+    """
+    if unit is None:
+        return ""
+    text = str(unit)
+    for sign, spelled in _UNICODE.items():
+        text = text.replace(sign, spelled)
+    text = " ".join(text.split())
+    if len(text) >= 2 and text[0] == "[" and text[-1] == "]":
+        text = " ".join(text[1:-1].split())
+    if text in UNIT_ALIASES:
+        return UNIT_ALIASES[text]
+    compact = _SPACES_AROUND_OPERATORS.sub(r"\1", text)
+    for candidate in (compact, compact.replace(" ", "")):
+        if candidate in UNIT_ALIASES:
+            return UNIT_ALIASES[candidate]
+        if candidate.lower() in _CASELESS:
+            return _CASELESS[candidate.lower()]
+    return compact
 
 
 @lru_cache(maxsize=1)

@@ -8,6 +8,7 @@ from hypothesis_budget import examples
 
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.io import ChannelMap, ChannelSpec, canonical_unit, unit_conversion
+from clutchlab.units import normalise_unit
 
 
 @pytest.mark.parametrize("name, unit", [
@@ -103,3 +104,54 @@ def test_channel_map_file_errors(tmp_path):
         ChannelMap([ChannelSpec("torque_Nm", "A"), ChannelSpec("torque_Nm", "B")])
     with pytest.raises(ParameterError, match="channel_map"):
         ChannelMap.coerce(42)
+
+
+# ---------------------------------------------------------------- logger spellings of units
+
+@pytest.mark.parametrize("spelling, unit", [
+    ("U/  min", "rpm"), ("U / min", "rpm"), ("u/min", "rpm"), ("UpM", "rpm"), ("1/min", "rpm"), ("1 / min", "rpm"),
+    ("min-1", "rpm"), ("min^-1", "rpm"), ("min⁻¹", "rpm"), ("r/min", "rpm"), ("rev/min", "rpm"), ("RPM", "rpm"),
+    (" rpm ", "rpm"), ("[rpm]", "rpm"),
+    ("Nm", "N*m"), ("N m", "N*m"), ("N.m", "N*m"), ("N·m", "N*m"), ("NM", "N*m"), ("[Nm]", "N*m"),
+    ("kNm", "kN*m"), ("mNm", "mN*m"),
+    ("°C", "degC"), ("° C", "degC"), ("℃", "degC"), ("degC", "degC"), ("deg C", "degC"), ("°F", "degF"),
+    ("bar", "bar"), ("mbar", "mbar"), ("µs", "us"), ("m/s²", "m/s**2"),
+    ("-", ""), ("[-]", ""), ("1", ""), ("", ""), ("%", "percent"),
+])
+def test_logger_unit_spellings(spelling, unit):
+    assert normalise_unit(spelling) == unit
+
+
+@pytest.mark.parametrize("source, target, scale, offset", [
+    ("U/  min", "rad/s", 2 * math.pi / 60, 0.0),  # pint alone: enzyme units per minute
+    ("1/min", "rad/s", 2 * math.pi / 60, 0.0),    # pint alone: 1/60 Hz, i.e. 1/60 rad/s
+    ("mNm", "N*m", 1e-3, 0.0),                    # pint alone: "millinumber metre"
+    ("° C", "K", 1.0, 273.15),
+    ("bar", "Pa", 1e5, 0.0),
+    ("[Nm]", "N*m", 1.0, 0.0),
+])
+def test_logger_spellings_convert_correctly(source, target, scale, offset):
+    s, o = unit_conversion(source, target)
+    assert s == pytest.approx(scale, rel=1e-12) and o == pytest.approx(offset, rel=1e-12, abs=1e-12)
+
+
+_BLANKS = st.text(alphabet=" \t\u00a0", max_size=3)
+
+
+@settings(deadline=None)
+@given(_BLANKS, st.sampled_from(["U", "u", "1", "r", "rev"]), _BLANKS, _BLANKS)
+def test_whitespace_never_turns_revolutions_into_enzyme_units(lead, numerator, around, trail):
+    spelled = f"{lead}{numerator}{around}/{around}min{trail}"
+    assert normalise_unit(spelled) == "rpm"
+    assert unit_conversion(spelled, "rad/s") == pytest.approx((2 * math.pi / 60, 0.0))
+
+
+@settings(deadline=None)
+@given(st.text(max_size=12))
+def test_any_unit_text_converts_or_raises_data_error(text):
+    try:
+        scale, offset = unit_conversion(text, text, name="X", where="f.mf4")
+    except DataError as exc:
+        assert str(exc).startswith("f.mf4: channel 'X': ")
+    else:
+        assert math.isfinite(scale) and math.isfinite(offset)

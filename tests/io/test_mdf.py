@@ -89,23 +89,35 @@ def test_uniform_rate_and_given_time_base(logger_file):
 
 
 def test_identity_read_keeps_file_names_and_units(logger_file):
-    with pytest.raises(DataError, match="'TQ_Clutch'.*several groups"):
-        read_measurement(write_logger_file(logger_file.parent / "dup.mf4", duplicate=True))
     m = read_measurement(logger_file, rate=100.0)
     assert set(m.channels) == {"TQ_Clutch", "P_Piston", "N_Slip", "T_Oil", "Status", "Gear"}
-    assert m.units["TQ_Clutch"] == "Nm" and m.units["T_Oil"] == "°F"  # no name suffix: the file's unit is kept
+    # no name suffix: the file's unit is kept, in pint spelling (pint alone would read "Nm" as nanometre)
+    assert m.units["TQ_Clutch"] == "N*m" and m.units["T_Oil"] == "degF" and m.units["N_Slip"] == "rpm"
+    assert m.source.channels["T_Oil"].source_unit == "°F"  # the provenance keeps the file's spelling
     np.testing.assert_allclose(m["T_Oil"], oil_degf(m.time), rtol=1e-12)
+    assert m.source.skipped == {}
+
+
+def test_identity_read_skips_a_name_in_several_groups(tmp_path):
+    m = read_measurement(write_logger_file(tmp_path / "dup.mf4", duplicate=True), rate=100.0)
+    assert "TQ_Clutch" not in m.channels and {"P_Piston", "N_Slip", "T_Oil"} <= set(m.channels)
+    assert m.source.skipped["TQ_Clutch"] == ("occurs 2 times (group 0 index 1 [Nm] 'clutch torque'; "
+                                             "group 1 index 4 [Nm]); map it with group and index")
+    with pytest.raises(DataError, match=r"dup\.mf4: channel 'TQ_Clutch' occurs 2 times"):
+        read_measurement(tmp_path / "dup.mf4", required=["TQ_Clutch"])  # asked for: an error, not a skip
 
 
 def test_duplicate_names_need_a_group(tmp_path):
     path = write_logger_file(tmp_path / "dup.mf4", duplicate=True)
-    with pytest.raises(DataError, match=r"dup\.mf4.*'TQ_Clutch'.*several groups \(0, 1\).*group"):
+    with pytest.raises(DataError, match=r"dup\.mf4: channel 'TQ_Clutch' \(for 'torque_Nm'\) occurs 2 times "
+                                        r"\(group 0 index 1 \[Nm\] 'clutch torque'; group 1 index 4 \[Nm\]\); "
+                                        r"give `group` \(and `index`\) in the channel map"):
         read_measurement(path, {"torque_Nm": "TQ_Clutch"})
     fast = read_measurement(path, {"torque_Nm": {"source": "TQ_Clutch", "group": 0}})
     slow = read_measurement(path, {"torque_Nm": {"source": "TQ_Clutch", "group": 1}})
     np.testing.assert_allclose(fast["torque_Nm"], torque_nm(FAST_T), rtol=1e-12)
     np.testing.assert_allclose(slow["torque_Nm"], torque_nm(SLOW_T) + 1.0, rtol=1e-12)
-    with pytest.raises(DataError, match="not in group 2"):
+    with pytest.raises(DataError, match=r"'TQ_Clutch' \(for 'torque_Nm'\) is not at group 2 \(it is at group 0 "):
         read_measurement(path, {"torque_Nm": {"source": "TQ_Clutch", "group": 2}})
 
 
@@ -170,11 +182,12 @@ def test_truncated_and_foreign_files_fail_cleanly(tmp_path, logger_file):
             read_measurement(bad, LOGGER_MAP)
     text = tmp_path / "notes.mf4"
     text.write_text("time,torque\n0,1\n")
-    with pytest.raises(DataError, match=r"notes\.mf4: not a readable MDF file.*magic"):
+    with pytest.raises(DataError, match=r"notes\.mf4: not a readable MDF file "
+                                        r"\(it starts with b'time,tor', not b'MDF     '\)"):
         read_measurement(text)
     empty = tmp_path / "empty.mf4"
     empty.write_bytes(b"")
-    with pytest.raises(DataError, match=r"empty\.mf4: not a readable MDF file"):
+    with pytest.raises(DataError, match=r"empty\.mf4: not a readable MDF file \(it is empty\)"):
         read_measurement(empty)
     with pytest.raises(DataError, match="no such file"):
         read_measurement(tmp_path / "absent.mf4")

@@ -93,10 +93,17 @@ def test_csv_errors_name_file_column_and_row(tmp_path):
         read_measurement(tmp_path / "back.csv")
     (tmp_path / "units.csv").write_text("# units: time_s=s, force_N=furlong\ntime_s,force_N\n0,1\n1,2\n")
     with pytest.raises(DataError, match=r"units\.csv: channel 'force_N': unit 'furlong' cannot be converted to 'N'"):
+        read_measurement(tmp_path / "units.csv", required=["force_N"])
+    # not asked for: skipped with the reason; nothing else to read is still an error
+    with pytest.raises(DataError, match=r"units\.csv: no channel could be read \(1 skipped; force_N: unit 'furlong' "
+                                        r"cannot be converted to 'N'"):
         read_measurement(tmp_path / "units.csv")
-    (tmp_path / "units2.csv").write_text("# units: time_s=s, force_N=zorch\ntime_s,force_N\n0,1\n1,2\n")
+    (tmp_path / "units2.csv").write_text("# units: time_s=s, force_N=zorch, x_m=mm\ntime_s,force_N,x_m\n0,1,1\n1,2,2\n")
     with pytest.raises(DataError, match=r"units2\.csv: channel 'force_N': unknown unit 'zorch'"):
-        read_measurement(tmp_path / "units2.csv")
+        read_measurement(tmp_path / "units2.csv", required=["force_N"])
+    m = read_measurement(tmp_path / "units2.csv")
+    assert m.channels == ("x_m",) and m.source.skipped == {"force_N": "unknown unit 'zorch'"}
+    np.testing.assert_allclose(m["x_m"], [1e-3, 2e-3])
     (tmp_path / "bin.csv").write_bytes(b"\xff\xfe\x00garbage\x00\x81")
     with pytest.raises(DataError, match=r"bin\.csv: cannot read as CSV"):
         read_measurement(tmp_path / "bin.csv")

@@ -10,8 +10,9 @@ mapping::
     source_unit = "kN*m"          # optional: overrides the unit stored in the file
 
     [channels.slip_speed_rad_s]
-    source = "N_Slip"             # recorded in rpm: converted to rad/s
-    group = 2                     # optional: MDF data group, if the name occurs twice
+    source = "N_Slip"             # recorded in rpm (or "U/min", "1/min"): converted to rad/s
+    group = 2                     # optional: MDF data group, if the name occurs in several groups
+    index = 4                     # optional: channel index in the group, if it occurs twice there
 
     [channels.gear]
     source = "Gear_Act"
@@ -23,8 +24,10 @@ The target unit of an entry is the one its clutchlab name states (``_Nm`` ->
 N·m, ``_rad_s`` -> rad/s, ``_C`` -> °C, see :func:`canonical_unit`); names
 without a unit suffix need ``unit``.  Unit strings are parsed with pint
 (through :mod:`clutchlab.units`), after the logger spellings in
-:data:`UNIT_ALIASES` (``Nm``, ``°C``, ``1/min``, ``-``) are translated, so
-``"Nm"`` is a newton metre and not a nanometre.
+:data:`~clutchlab.units.UNIT_ALIASES` (``Nm``, ``°C``, ``U/  min``, ``1/min``,
+``-``) are translated by :func:`~clutchlab.units.normalise_unit`, so ``"Nm"``
+is a newton metre and not a nanometre, and ``"U/min"`` revolutions per minute,
+not enzyme units.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from pathlib import Path
 from typing import Iterable, Iterator, Mapping
 
 from ..errors import ClutchlabError, DataError, ParameterError
+from ..units import UNIT_ALIASES, normalise_unit
 
 __all__ = [
     "UNIT_ALIASES",
@@ -46,14 +50,6 @@ __all__ = [
     "ChannelSpec",
     "ChannelMap",
 ]
-
-#: logger spellings of units translated before pint parses them (pint would read ``Nm`` as nanometre)
-UNIT_ALIASES = {
-    "Nm": "N*m", "N.m": "N*m", "N m": "N*m", "N·m": "N*m", "kNm": "kN*m",
-    "°C": "degC", "℃": "degC", "deg C": "degC", "°F": "degF", "°": "deg",
-    "1/min": "rpm", "U/min": "rpm", "min-1": "rpm", "min^-1": "rpm", "rev/min": "rpm", "RPM": "rpm",
-    "-": "", "[-]": "", "1": "", "%": "percent",
-}
 
 #: how a channel recorded at its own timestamps is carried onto another time base
 INTERPOLATIONS = ("linear", "previous")
@@ -94,18 +90,13 @@ def canonical_unit(name: str) -> str | None:
     return None
 
 
-def _normalise(unit: str) -> str:
-    text = unit.strip()
-    return UNIT_ALIASES.get(text, text)
-
-
 @lru_cache(maxsize=512)
 def _conversion(source: str, target: str) -> tuple[float, float]:
     from ..units import _registry
 
     ureg = _registry()
-    src = _normalise(source) or "dimensionless"
-    tgt = _normalise(target) or "dimensionless"
+    src = normalise_unit(source) or "dimensionless"
+    tgt = normalise_unit(target) or "dimensionless"
     zero = ureg.Quantity(0.0, src).to(tgt).magnitude
     one = ureg.Quantity(1.0, src).to(tgt).magnitude
     return float(one - zero), float(zero)
@@ -181,6 +172,11 @@ class ChannelSpec:
     group : int, optional
         MDF data group holding the channel, needed when the name occurs in
         several groups.
+    index : int, optional
+        Index of the channel within ``group`` (as asammdf numbers them; the
+        error for an ambiguous name lists the candidates), needed when the
+        name occurs twice in one group.  The channel found there must be
+        called ``source``.  Requires ``group``.
     interpolation : {"linear", "previous"}, optional
         How the channel is carried onto another time base (default: the
         reader's ``interpolation``); ``"previous"`` holds the last sample (for
@@ -194,6 +190,7 @@ class ChannelSpec:
     unit: str | None = None
     source_unit: str | None = None
     group: int | None = None
+    index: int | None = None
     interpolation: str | None = None
     optional: bool = False
 
@@ -229,6 +226,11 @@ class ChannelSpec:
         if self.group is not None and (isinstance(self.group, bool) or not isinstance(self.group, int)
                                        or self.group < 0):
             raise ParameterError(f"{where}: group = {self.group!r} must be a non-negative whole number")
+        if self.index is not None:
+            if isinstance(self.index, bool) or not isinstance(self.index, int) or self.index < 0:
+                raise ParameterError(f"{where}: index = {self.index!r} must be a non-negative whole number")
+            if self.group is None:
+                raise ParameterError(f"{where}: index = {self.index} needs group (the index counts within a group)")
         if self.interpolation is not None and self.interpolation not in INTERPOLATIONS:
             raise ParameterError(f"{where}: interpolation = {self.interpolation!r}; expected one of "
                                  f"{', '.join(INTERPOLATIONS)}")
@@ -278,7 +280,7 @@ class ChannelMap:
         mapping : mapping
             clutchlab name -> logger name, or clutchlab name -> table with the
             keys of :class:`ChannelSpec` (``source``, ``unit``,
-            ``source_unit``, ``group``, ``interpolation``, ``optional``).  A
+            ``source_unit``, ``group``, ``index``, ``interpolation``, ``optional``).  A
             mapping with the single key ``"channels"`` (the TOML layout) is
             accepted too.
         name : str

@@ -14,8 +14,25 @@ def _convert(args) -> int:
     out = write_measurement(meas, args.output, overwrite=args.force,
                             comment=f"converted from {args.input} by clutchlab convert; {meas.source.time_base}")
     print(meas.source.describe())
+    _warn_skipped(args.input, meas.source.skipped)
     print(f"{out}: {len(meas)} samples, {len(meas.channels)} channels")
     return 0
+
+
+#: at most this many "skipped" warning lines, then one summary line
+MAX_SKIP_WARNINGS = 10
+
+
+def _warn_skipped(source, skipped) -> None:
+    """One stderr line per channel a read without map left out (the provenance lists them all)."""
+    import sys
+
+    items = list(skipped.items())
+    for what, reason in items[:MAX_SKIP_WARNINGS]:
+        print(f"clutchlab: warning: {source}: skipped {what}: {reason}", file=sys.stderr)
+    if len(items) > MAX_SKIP_WARNINGS:
+        print(f"clutchlab: warning: {source}: ... and {len(items) - MAX_SKIP_WARNINGS} more skipped "
+              "(all listed in the provenance above)", file=sys.stderr)
 
 
 def register(subparsers) -> None:
@@ -35,7 +52,9 @@ def register(subparsers) -> None:
     p.add_argument("input", help="record to read (.csv, .parquet, .mf4/.mdf)")
     p.add_argument("-o", "--output", required=True, help="file to write (.csv, .parquet, .mf4)")
     p.add_argument("--channel-map", metavar="MAP.toml",
-                   help="TOML file with [channels.<name>] tables: source, unit, source_unit, group, interpolation")
+                   help="TOML file with [channels.<name>] tables: source, unit, source_unit, group, index, "
+                        "interpolation (without a map: every channel that can be converted; the others are "
+                        "skipped with a warning)")
     p.add_argument("--rate", type=float, metavar="HZ", help="resample onto a uniform time base at this rate")
     p.add_argument("--interpolation", choices=("linear", "previous"), default="linear",
                    help="resampling between samples (default: %(default)s)")

@@ -7,10 +7,14 @@ write MDF files with :func:`~clutchlab.io.read_measurement` and
 
 from __future__ import annotations
 
+import io
 import logging
 import os
+import re
+import shutil
 import tempfile
-from contextlib import contextmanager
+import warnings
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +23,7 @@ import numpy as np
 from ..errors import DataError
 from .files import check_writable
 
-__all__ = ["MDF_SUFFIXES", "RawChannel", "MdfReader", "write_mdf"]
+__all__ = ["MDF_SUFFIXES", "UNFINALISED_ID", "RawChannel", "ChannelPlace", "MdfReader", "write_mdf"]
 
 #: file name endings read and written as MDF
 MDF_SUFFIXES = (".mf4", ".mdf")
@@ -41,6 +45,8 @@ class RawChannel:
         Unit stored in the file (``None`` if the file stores none).
     group : int or None
         MDF data group (``None`` for tables).
+    index : int or None
+        Channel index within the MDF group (``None`` for tables).
     """
 
     name: str
@@ -48,18 +54,83 @@ class RawChannel:
     timestamps: np.ndarray | None
     unit: str | None
     group: int | None = None
+    index: int | None = None
+
+
+#: first bytes of an MDF 4 file a logger has not finalised (ASAM MDF 4.1, IDBLOCK id_file)
+UNFINALISED_ID = b"UnFinMF "
+#: MDF 4.1 channel-group flag of bus-event groups (raw CAN/LIN/FlexRay/Ethernet frames), cg_flags bit 1
+_CG_BUS_EVENT = 1 << 1
+#: structure channels of raw bus frames (ASAM MDF bus logging; fields follow as ``CAN_DataFrame.ID`` ...),
+#: for groups written without the bus-event flag
+_BUS_FRAMES = frozenset({"CAN_DataFrame", "CAN_RemoteFrame", "CAN_ErrorFrame", "CAN_OverloadFrame",
+                         "LIN_Frame", "LIN_ChecksumError", "LIN_ReceiveError", "LIN_SyncError",
+                         "LIN_TransmissionError", "FLX_Frame", "FLX_NullFrame", "FLX_StartCycle", "ETH_Frame"})
+
+
+class _Captured:
+    """What asammdf logged, printed or warned while a block of code ran (kept, never shown)."""
+
+    def __init__(self):
+        self.lines: list[str] = []
+
+    def last(self) -> str:
+        """The last captured line that says something (empty if none)."""
+        for line in reversed(self.lines):
+            if line.strip() and not line.startswith(("Traceback", "  ")):
+                return " ".join(line.split())
+        return ""
+
+
+class _ListHandler(logging.Handler):
+    def __init__(self, sink: _Captured):
+        super().__init__(logging.DEBUG)
+        self.sink = sink
+
+    def emit(self, record):
+        try:
+            self.sink.lines.append(record.getMessage())
+        except Exception:  # a record that cannot be formatted is not worth a second failure
+            pass
 
 
 @contextmanager
 def _quiet_asammdf():
-    # asammdf logs an ERROR before raising for ambiguous names; we raise our own error instead
+    """Keep asammdf's logging, prints and warnings away from the user's terminal.
+
+    asammdf logs an ERROR before raising for ambiguous names and prints a
+    traceback to stdout when it fails to finalise a file; clutchlab raises its
+    own one-line :class:`~clutchlab.errors.DataError` instead.  The captured
+    lines are yielded, for the message of that error.
+    """
+    sink = _Captured()
     log = logging.getLogger("asammdf")
-    level = log.level
-    log.setLevel(logging.CRITICAL)
+    handler = _ListHandler(sink)
+    saved = (log.level, log.propagate, log.handlers[:])
+    log.handlers[:] = [handler]
+    log.setLevel(logging.DEBUG)
+    log.propagate = False
+    out, err = io.StringIO(), io.StringIO()
     try:
-        yield
+        with warnings.catch_warnings(record=True) as caught, redirect_stdout(out), redirect_stderr(err):
+            warnings.simplefilter("always")
+            yield sink
     finally:
-        log.setLevel(level)
+        log.setLevel(saved[0])
+        log.propagate = saved[1]
+        log.handlers[:] = saved[2]
+        sink.lines.extend(out.getvalue().splitlines() + err.getvalue().splitlines())
+        sink.lines.extend(str(w.message) for w in caught)
+
+
+def _one_line(exc: BaseException, limit: int = 160) -> str:
+    text = " ".join(str(exc).split())
+    if len(text) > limit:
+        text = text[:limit - 3] + "..."
+    kind = type(exc).__name__
+    if kind == "error":  # struct.error, zlib.error: say whose
+        kind = f"{type(exc).__module__.lstrip('_')}.{kind}"
+    return f"{kind}: {text}" if text else kind
 
 
 def _defuse(exc: BaseException) -> None:
@@ -81,8 +152,72 @@ def _defuse(exc: BaseException) -> None:
         tb = tb.tb_next
 
 
+def _unfinalised_flags(head: bytes) -> int | None:
+    """Standard "unfinalised" flags of an MDF >= 4.10 identification block, ``None`` if finalised.
+
+    Parameters
+    ----------
+    head : bytes
+        The first 64 bytes of the file (the IDBLOCK: ``id_file`` char[8],
+        ``id_vers`` char[8], ``id_prog`` char[8], reserved, ``id_ver`` uint16,
+        reserved, ``id_unfin_flags`` uint16 at byte 60, ``id_custom_unfin_flags``
+        uint16 at byte 62; ASAM MDF 4.1, IDBLOCK).
+    """
+    if len(head) < 64:
+        return None
+    version = head[8:16].decode("ascii", "replace").strip(" \0\t\r\n")
+    flags = int.from_bytes(head[60:62], "little")
+    if version >= "4.10" and (flags or head[:8] == UNFINALISED_ID):
+        return flags
+    return None
+
+
+def _plain_comment(text, limit: int = 40) -> str:
+    """First line of a channel comment, the text of an XML ``<CNcomment><TX>`` block if it is one."""
+    text = str(text or "").strip()
+    if text.startswith("<"):
+        tx = re.search(r"<TX>(.*?)</TX>", text, re.S)
+        text = tx.group(1) if tx else re.sub(r"<[^>]*>", " ", text)
+    lines = [" ".join(line.split()) for line in text.splitlines() if line.strip()]
+    return lines[0][:limit] if lines else ""
+
+
+@dataclass(frozen=True)
+class ChannelPlace:
+    """Where a channel name occurs in an MDF file.
+
+    Attributes
+    ----------
+    group : int
+        Data group.
+    index : int
+        Channel index within the group (asammdf's numbering; the master is
+        usually 0).
+    unit : str
+        Unit field (``""`` if none).
+    comment : str
+        Channel comment (first line, shortened).
+    """
+
+    group: int
+    index: int
+    unit: str
+    comment: str
+
+    def describe(self) -> str:
+        """``group 1 index 3 [Nm] 'clutch torque'``."""
+        text = f"group {self.group} index {self.index} [{self.unit or '-'}]"
+        return text + (f" {self.comment!r}" if self.comment else "")
+
+
 class MdfReader:
     """An open MDF file: its channel names, groups, header comment, and channel access.
+
+    Unfinalised MDF 4.1x files (as CAN loggers leave them: identification
+    ``UnFinMF``, cycle counters or the last data block's length not yet
+    written) are copied to an anonymous temporary file that asammdf finalises;
+    the user's file is only ever read.  asammdf's logging, prints and warnings
+    are captured; every failure is one :class:`~clutchlab.errors.DataError`.
 
     Parameters
     ----------
@@ -94,7 +229,8 @@ class MdfReader:
     Raises
     ------
     DataError
-        Missing file, not an MDF file, truncated or otherwise unreadable.
+        Missing file, not an MDF file, truncated, unfinalised beyond repair or
+        otherwise unreadable.
     """
 
     def __init__(self, path, label: str):
@@ -105,25 +241,58 @@ class MdfReader:
         if not self.path.exists():
             raise DataError(f"{label}: no such file")
         # open through a file object: asammdf then never leaves a half-built object that complains when collected
-        self._fh = open(self.path, "rb")
+        try:
+            self._fh = open(self.path, "rb")
+        except OSError as exc:
+            raise DataError(f"{label}: cannot open ({exc.strerror or type(exc).__name__})") from None
+        head = self._fh.read(64)
+        self._fh.seek(0)
+        if not head.startswith((b"MDF", UNFINALISED_ID)):
+            self._fh.close()
+            shown = "it is empty" if not head else f"it starts with {head[:8]!r}, not b'MDF     '"
+            raise DataError(f"{label}: not a readable MDF file ({shown})")
+        self.unfinalised_flags = _unfinalised_flags(head)
+        if self.unfinalised_flags:
+            # asammdf finalises in place: give it a writable copy, never the user's file
+            copy = tempfile.TemporaryFile(prefix="clutchlab-unfinalised-", suffix=".mf4")
+            try:
+                shutil.copyfileobj(self._fh, copy, 1 << 20)
+                copy.seek(0)
+            except OSError as exc:
+                copy.close()
+                self._fh.close()
+                raise DataError(f"{label}: unfinalised MDF file, and no room to finalise a temporary copy "
+                                f"({exc.strerror or type(exc).__name__})") from None
+            self._fh.close()
+            self._fh = copy
         try:
             with _quiet_asammdf():
                 self._mdf = MDF(self._fh)
         except Exception as exc:  # asammdf raises MdfException, ValueError, struct.error ... on damaged files
             _defuse(exc)
             self._fh.close()
-            raise DataError(f"{label}: not a readable MDF file ({type(exc).__name__}: {exc})") from None
+            if self.unfinalised_flags:
+                raise DataError(f"{label}: unfinalised MDF file (flags 0x{self.unfinalised_flags:02x}) that asammdf "
+                                f"cannot finalise ({_one_line(exc)})") from None
+            raise DataError(f"{label}: not a readable MDF file ({_one_line(exc)})") from None
+        groups = self._mdf.groups
         self._masters = {(g, i) for g, i in self._mdf.masters_db.items()}
+        self.bus_groups = {g for g, grp in enumerate(groups)
+                           if getattr(grp.channel_group, "flags", 0) & _CG_BUS_EVENT
+                           or any(ch.name.split(".", 1)[0] in _BUS_FRAMES for ch in grp.channels)}
         self._occurrences: dict[str, list[tuple[int, int]]] = {}
         for name, entries in self._mdf.channels_db.items():
             for g, i in entries:
-                if (g, i) not in self._masters:
+                if (g, i) not in self._masters and (g, i) not in self._occurrences.get(name, []):
                     self._occurrences.setdefault(name, []).append((g, i))
+        for places in self._occurrences.values():
+            places.sort()
 
     def close(self) -> None:
-        """Close the file."""
+        """Close the file (and delete a temporary finalised copy)."""
         try:
-            self._mdf.close()
+            with _quiet_asammdf():
+                self._mdf.close()
         finally:
             self._fh.close()
 
@@ -137,7 +306,8 @@ class MdfReader:
     def comment(self) -> str:
         """The header comment (plain text)."""
         try:
-            return str(self._mdf.header.description or "")
+            with _quiet_asammdf():
+                return str(self._mdf.header.description or "")
         except Exception:  # an odd XML comment is not worth failing a read
             return ""
 
@@ -149,26 +319,41 @@ class MdfReader:
         """Data groups in which the channel ``name`` occurs."""
         return sorted({g for g, _ in self._occurrences.get(name, [])})
 
-    def load(self, name: str, group: int | None = None, *, target: str | None = None,
-             skip_nonnumeric: bool = False) -> RawChannel | None:
-        """Read one channel with its conversion applied.
+    def places(self, name: str) -> list[ChannelPlace]:
+        """Every (group, index) at which the non-master channel ``name`` occurs, with unit and comment."""
+        out = []
+        for g, i in self._occurrences.get(name, []):
+            ch = self._mdf.groups[g].channels[i]
+            comment = _plain_comment(getattr(ch, "comment", ""))
+            out.append(ChannelPlace(g, i, str(getattr(ch, "unit", "") or "").strip(), comment))
+        return out
+
+    def has(self, name: str, group: int | None = None, index: int | None = None) -> bool:
+        """True if ``name`` occurs (in ``group``, at ``index`` if given)."""
+        return any((group is None or g == group) and (index is None or i == index)
+                   for g, i in self._occurrences.get(name, []))
+
+    def locate(self, name: str, group: int | None = None, index: int | None = None, *,
+               target: str | None = None) -> tuple[int, int]:
+        """The (group, index) of the channel ``name``, unambiguous or an error listing the candidates.
 
         Parameters
         ----------
         name : str
             Channel name in the file.
         group : int, optional
-            Data group; required if ``name`` occurs in several groups.
+            Data group; needed if ``name`` occurs in several groups.
+        index : int, optional
+            Channel index within ``group``; needed if ``name`` occurs twice in
+            that group.
         target : str, optional
             clutchlab name the channel is read for (for error messages).
-        skip_nonnumeric : bool
-            Return ``None`` for a channel of text or structured samples
-            instead of raising.
 
         Raises
         ------
         DataError
-            Channel missing (or not in ``group``), ambiguous, empty or not numeric.
+            Missing, not at the given place, or ambiguous (the message lists
+            group, index, unit and comment of every candidate).
         """
         what = f"channel {name!r}" + (f" (for {target!r})" if target and target != name else "")
         places = self._occurrences.get(name)
@@ -178,31 +363,63 @@ class MdfReader:
             close = difflib.get_close_matches(name, list(self._occurrences), n=3)
             hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
             raise DataError(f"{self.label}: missing {what}{hint} (the file has {len(self._occurrences)} channels)")
-        if group is not None:
-            places = [p for p in places if p[0] == group]
-            if not places:
-                raise DataError(f"{self.label}: {what} is not in group {group} "
-                                f"(it is in group {', '.join(map(str, self.groups_of(name)))})")
-        if len(places) > 1:
-            groups = ", ".join(str(g) for g, _ in places)
-            raise DataError(f"{self.label}: {what} occurs in several groups ({groups}); "
-                            f"give `group` in the channel map")
-        g, i = places[0]
+        found = [p for p in places if (group is None or p[0] == group) and (index is None or p[1] == index)]
+        if not found:
+            where = f"group {group}" + (f" index {index}" if index is not None else "")
+            there = "; ".join(p.describe() for p in self.places(name))
+            raise DataError(f"{self.label}: {what} is not at {where} (it is at {there})")
+        if len(found) > 1:
+            candidates = "; ".join(p.describe() for p in self.places(name) if (p.group, p.index) in found)
+            need = "`group` and `index`" if len({g for g, _ in found}) == 1 else "`group` (and `index`)"
+            inside = f" in group {group}" if group is not None else ""
+            raise DataError(f"{self.label}: {what} occurs {len(found)} times{inside} ({candidates}); "
+                            f"give {need} in the channel map")
+        return found[0]
+
+    def load(self, name: str, group: int | None = None, index: int | None = None, *, target: str | None = None,
+             skip_nonnumeric: bool = False) -> RawChannel | None:
+        """Read one channel with its conversion applied.
+
+        Parameters
+        ----------
+        name : str
+            Channel name in the file.
+        group : int, optional
+            Data group; required if ``name`` occurs in several groups.
+        index : int, optional
+            Channel index within ``group``; required if ``name`` occurs twice
+            in that group.
+        target : str, optional
+            clutchlab name the channel is read for (for error messages).
+        skip_nonnumeric : bool
+            Return ``None`` for a channel of text or structured samples
+            instead of raising.
+
+        Raises
+        ------
+        DataError
+            Channel missing (or not at ``group``/``index``), ambiguous, empty,
+            not numeric or unreadable.
+        """
+        what = f"channel {name!r}" + (f" (for {target!r})" if target and target != name else "")
+        g, i = self.locate(name, group, index, target=target)
         try:
             with _quiet_asammdf():
                 sig = self._mdf.get(name, group=g, index=i)
         except Exception as exc:
-            raise DataError(f"{self.label}: cannot read {what} in group {g} ({type(exc).__name__}: {exc})") from None
+            raise DataError(f"{self.label}: cannot read {what} in group {g} ({_one_line(exc)})") from None
         samples = np.asarray(sig.samples)
         if samples.dtype.kind not in "biuf" or samples.ndim != 1:
             if skip_nonnumeric:
                 return None
-            raise DataError(f"{self.label}: {what} in group {g} has non-numeric samples (dtype {samples.dtype}); "
+            kind = f"dtype {samples.dtype}" if samples.ndim == 1 else f"{samples.ndim}-D samples"
+            frames = " (raw bus frames: decode them with a DBC file first)" if g in self.bus_groups else ""
+            raise DataError(f"{self.label}: {what} in group {g} has non-numeric samples ({kind}){frames}; "
                             "only numeric channels can be read")
         if samples.size == 0:
             raise DataError(f"{self.label}: {what} in group {g} has no samples")
         unit = sig.unit.strip() if isinstance(sig.unit, str) and sig.unit.strip() else None
-        return RawChannel(name, samples.astype(float), np.asarray(sig.timestamps, dtype=float), unit, g)
+        return RawChannel(name, samples.astype(float), np.asarray(sig.timestamps, dtype=float), unit, g, i)
 
 
 def write_mdf(path, time: np.ndarray, channels: dict[str, np.ndarray], units: dict[str, str], *,

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError, ParameterError
+from ..units import normalise_unit
 from .channels import INTERPOLATIONS, ChannelMap, ChannelSpec, canonical_unit, unit_conversion
 from .files import atomic_to_csv, atomic_write_bytes, check_writable
 from .mdf import MDF_SUFFIXES, MdfReader, RawChannel, write_mdf
@@ -103,6 +104,10 @@ class MeasurementSource:
         Column name -> :class:`ChannelOrigin`.
     time_base : str
         How the time base was chosen (``"as recorded"``, ``"resampled ..."``).
+    skipped : mapping of str to str
+        Channels (or MDF groups) of the file that a read without channel map
+        left out, with the reason (unknown unit, non-numeric samples, raw bus
+        frames, a name occurring several times); empty when reading with a map.
     """
 
     path: str | None
@@ -110,6 +115,7 @@ class MeasurementSource:
     comments: tuple[str, ...] = ()
     channels: Mapping[str, ChannelOrigin] = field(default_factory=dict)
     time_base: str = "as recorded"
+    skipped: Mapping[str, str] = field(default_factory=dict)
 
     @property
     def synthetic(self) -> bool:
@@ -127,6 +133,8 @@ class MeasurementSource:
             conv = f" [{o.source_unit or '-'} -> {o.unit or '-'}]" if (o.source_unit or "") != (o.unit or "") else \
                 f" [{o.unit or '-'}]"
             lines.append(f"{name} <- {o.source}{grp}{rate}{conv}")
+        for what, reason in self.skipped.items():
+            lines.append(f"skipped {what}: {reason}")
         return "\n".join(lines)
 
 
@@ -441,10 +449,13 @@ def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), 
         reader.close()
 
 
-def _has(reader, name: str) -> bool:
+def _has(reader, spec_or_name) -> bool:
+    """True if the reader has the channel (an MDF spec: at its group and index, if given)."""
+    if not isinstance(spec_or_name, ChannelSpec):
+        return reader.has(spec_or_name)
     if isinstance(reader, MdfReader):
-        return bool(reader.groups_of(name))
-    return reader.has(name)
+        return reader.has(spec_or_name.source, spec_or_name.group, spec_or_name.index)
+    return reader.has(spec_or_name.source)
 
 
 def _dimensionless(unit: str) -> bool:
@@ -466,54 +477,134 @@ def _table_time(reader, time: str, time_spec: ChannelSpec | None) -> np.ndarray:
     return t
 
 
+def _group_list(groups: list[int]) -> str:
+    """``group 3`` or ``groups 0-60, 64`` (runs of consecutive numbers joined)."""
+    runs: list[list[int]] = []
+    for g in groups:
+        if runs and g == runs[-1][1] + 1:
+            runs[-1][1] = g
+        else:
+            runs.append([g, g])
+    text = ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
+    return f"group{'s' if len(groups) > 1 else ''} {text}"
+
+
+def _mdf_identity(reader: MdfReader, required, time, skipped: dict[str, str]) -> list[ChannelSpec]:
+    """Channels of an identity read of an MDF file; raw bus frames and ambiguous names go to ``skipped``."""
+    if reader.bus_groups:
+        bus = sorted(reader.bus_groups)
+        names = sorted({n for n in reader.channel_names() if set(reader.groups_of(n)) & reader.bus_groups})
+        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+        skipped[_group_list(bus)] = (f"raw bus frames ({shown}), not signals; decode them with a DBC file "
+                                     "(asammdf extract_bus_logging) or map their fields explicitly")
+    specs = []
+    for n in reader.channel_names():
+        if n == time:
+            continue
+        places = reader.places(n)
+        if n not in required:
+            if not n.strip():
+                skipped[repr(n)] = "a channel without name"
+                continue
+            if all(p.group in reader.bus_groups for p in places):
+                continue  # reported per group above
+            if len(places) > 1:
+                skipped[n] = (f"occurs {len(places)} times ({'; '.join(p.describe() for p in places)}); "
+                              "map it with group and index")
+                continue
+        specs.append(ChannelSpec(n, unit=canonical_unit(n) or "", optional=n not in required))
+    return specs
+
+
+def _source_units(spec: ChannelSpec, raw: RawChannel, label: str, identity: bool) -> tuple[str, str, float, float]:
+    """(source unit, target unit, scale, offset) of one channel, or a DataError."""
+    src_unit = spec.source_unit or raw.unit or canonical_unit(spec.source)
+    target_unit = spec.unit
+    if identity and not target_unit:
+        # a name without unit suffix: keep the file's unit, in pint spelling ("-", "[-]" -> "1")
+        target_unit = normalise_unit(raw.unit) or ("1" if raw.unit else "")
+    if src_unit is None:
+        if spec.source == spec.name or _dimensionless(target_unit):
+            src_unit = target_unit  # no unit in the file: the clutchlab name's (or a pure number) taken as is
+        else:
+            raise DataError(f"{label}: channel {spec.source!r} (for {spec.name!r}) carries no unit; "
+                            f"give source_unit in the channel map")
+    scale, offset = unit_conversion(src_unit, target_unit, name=spec.source, where=label)
+    return src_unit, target_unit, scale, offset
+
+
 def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_nan) -> Measurement:
     label = reader.label
     is_mdf = isinstance(reader, MdfReader)
     if is_mdf and time is None:
         time = "time_s"  # an MDF file always has a time base
+    skipped: dict[str, str] = {}
     if cmap is None:
         for r in required:
             if r != time and not _has(reader, r):
                 reader.load(r, target=r)  # raises the reader's "missing channel/column" error
-        specs = [ChannelSpec(n, unit=canonical_unit(n) or "", optional=n not in required)
-                 for n in reader.channel_names() if n != time]
-        lenient = {s.name for s in specs if s.optional}  # passed through if not numeric, NaN allowed
+        if is_mdf:
+            specs = _mdf_identity(reader, required, time, skipped)
+        else:
+            specs = [ChannelSpec(n, unit=canonical_unit(n) or "", optional=n not in required)
+                     for n in reader.channel_names() if n != time]
+        # channels nobody asked for: skipped (with the reason in the provenance) if they cannot be converted
+        lenient = {s.name for s in specs if s.optional}
     else:
         specs = list(cmap)
         lenient = set()
     time_spec = next((s for s in specs if s.name == time), None)
     specs = [s for s in specs if s.name != time]
-    if not is_mdf and time_spec is not None and time_spec.group is not None:
-        raise ParameterError(f"channel map entry {time!r}: group only applies to MDF files")
+    if not is_mdf and time_spec is not None and (time_spec.group is not None or time_spec.index is not None):
+        raise ParameterError(f"channel map entry {time!r}: group and index only apply to MDF files")
 
-    # ---- channels as stored, checked
+    # ---- channels as stored, checked, with their unit conversion
     table_t = _table_time(reader, time, time_spec) if (not is_mdf and time is not None) else None
     raws: dict[str, RawChannel] = {}
+    conversions: dict[str, tuple[str, str, float, float]] = {}
     used: list[ChannelSpec] = []
     for spec in specs:
-        if spec.optional and not _has(reader, spec.source):
+        if spec.optional and not _has(reader, spec):
             continue
         nan_ok = spec.name in allow_nan or spec.name in lenient
-        if is_mdf:
-            raw = reader.load(spec.source, spec.group, target=spec.name, skip_nonnumeric=spec.name in lenient)
-            if raw is None:
-                continue
-            bad = ~np.isfinite(raw.samples)
-            if bad.any() and not nan_ok:
-                k = int(np.flatnonzero(bad)[0])
-                raise DataError(f"{label}: channel {spec.source!r} (group {raw.group}) has a non-finite value "
-                                f"{float(raw.samples[k])!r} at sample {k} (t = {float(raw.timestamps[k])!r} s)")
-            _check_time(raw.timestamps, label, f"timestamps of channel {spec.source!r} (group {raw.group})", "sample")
-        else:
-            if spec.group is not None:
-                raise ParameterError(f"channel map entry {spec.name!r}: group = {spec.group} only applies to MDF "
-                                     f"files, but {label} is a {reader.format} table")
-            raw = reader.load(spec.source, target=spec.name, allow_nan=nan_ok, skip_nonnumeric=spec.name in lenient)
-            if raw is None:
-                continue
-            raw.timestamps = table_t
+        try:
+            if is_mdf:
+                raw = reader.load(spec.source, spec.group, spec.index, target=spec.name,
+                                  skip_nonnumeric=spec.name in lenient)
+                if raw is None:
+                    skipped[spec.source] = "non-numeric samples (text, structures or arrays)"
+                    continue
+                bad = ~np.isfinite(raw.samples)
+                if bad.any() and not nan_ok:
+                    k = int(np.flatnonzero(bad)[0])
+                    raise DataError(f"{label}: channel {spec.source!r} (group {raw.group}) has a non-finite value "
+                                    f"{float(raw.samples[k])!r} at sample {k} (t = {float(raw.timestamps[k])!r} s)")
+                _check_time(raw.timestamps, label, f"timestamps of channel {spec.source!r} (group {raw.group})",
+                            "sample")
+            else:
+                if spec.group is not None or spec.index is not None:
+                    raise ParameterError(f"channel map entry {spec.name!r}: group and index only apply to MDF "
+                                         f"files, but {label} is a {reader.format} table")
+                raw = reader.load(spec.source, target=spec.name, allow_nan=nan_ok,
+                                  skip_nonnumeric=spec.name in lenient)
+                if raw is None:
+                    continue  # a text column of an identity read: passed through below
+                raw.timestamps = table_t
+            conversions[spec.name] = _source_units(spec, raw, label, cmap is None)
+        except DataError as exc:
+            if spec.name not in lenient:
+                raise
+            reason = str(exc)
+            for prefix in (f"{label}: ", f"channel {spec.source!r}: "):
+                reason = reason[len(prefix):] if reason.startswith(prefix) else reason
+            skipped[spec.source] = reason
+            continue
         raws[spec.name] = raw
         used.append(spec)
+
+    if not used and skipped:
+        what, reason = next(iter(skipped.items()))
+        raise DataError(f"{label}: no channel could be read ({len(skipped)} skipped; {what}: {reason})")
 
     # ---- one time base
     resampled = False
@@ -573,17 +664,7 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
         units[time] = "s"
     for spec in used:
         raw = raws[spec.name]
-        src_unit = spec.source_unit or raw.unit or canonical_unit(spec.source)
-        target_unit = spec.unit
-        if cmap is None and not target_unit:
-            target_unit = raw.unit or ""  # a name without unit suffix: keep the file's unit
-        if src_unit is None:
-            if spec.source == spec.name or _dimensionless(target_unit):
-                src_unit = target_unit  # no unit in the file: the clutchlab name's (or a pure number) taken as is
-            else:
-                raise DataError(f"{label}: channel {spec.source!r} (for {spec.name!r}) carries no unit; "
-                                f"give source_unit in the channel map")
-        scale, offset = unit_conversion(src_unit, target_unit, name=spec.source, where=label)
+        src_unit, target_unit, scale, offset = conversions[spec.name]
         values = raw.samples
         method = None
         if resampled:
@@ -597,7 +678,7 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
     if isinstance(reader, _TableReader) and cmap is None:
         # identity read of a table: other (non-numeric) columns pass through untouched, in the file's order
         for c in reader.frame.columns:
-            if c not in frame.columns:
+            if c not in frame.columns and c not in skipped:
                 frame[c] = reader.frame[c].to_numpy()
         order = [c for c in reader.frame.columns if c in frame.columns]
         if time is not None:
@@ -609,7 +690,7 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
     else:
         comments = reader.comments
         path = None if reader.path is None else str(reader.path)
-    src = MeasurementSource(path, "mdf" if is_mdf else reader.format, comments, origins, how)
+    src = MeasurementSource(path, "mdf" if is_mdf else reader.format, comments, origins, how, skipped)
     return Measurement(frame.reset_index(drop=True), units, src, time if timeline is not None else None)
 
 
