@@ -1,13 +1,36 @@
 """``clutchlab demo``: the main job runs on the bundled data and writes a complete report."""
 
+import importlib.util
 import re
+from pathlib import Path
 
+import clutchlab.report.html as report_html
 from clutchlab.cli import DEMO_SECTIONS, _optional_module, main
+from clutchlab.plotting import is_marked_synthetic
+
+_spec = importlib.util.spec_from_file_location("figure_checks", Path(__file__).with_name("figure_checks.py"))
+figure_checks = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(figure_checks)
+figure_problems = figure_checks.figure_problems
 
 
-def test_demo_writes_report_with_every_section(tmp_path, capsys):
+def test_demo_writes_report_with_every_section(tmp_path, capsys, monkeypatch):
+    """The whole demo runs once here; every figure is checked as a reviewer would as it is rendered."""
+    problems, rendered = [], []
+    render = report_html._figure_png
+
+    def checked_render(fig):
+        name = fig.axes[0].get_title() or (fig._suptitle.get_text() if fig._suptitle else f"figure {len(rendered)}")
+        rendered.append(name)
+        problems.extend(figure_problems(fig, name))
+        assert is_marked_synthetic(fig), f"{name}: not stamped synthetic"
+        return render(fig)
+
+    monkeypatch.setattr(report_html, "_figure_png", checked_render)
     out = tmp_path / "report"
     assert main(["demo", "-o", str(out)]) == 0
+    assert len(rendered) >= 10
+    assert problems == []
     html = (out / "index.html").read_text()
     sections = [m for m in DEMO_SECTIONS if _optional_module(m) is not None]
     assert "clutchlab.eclutch.demo" in sections
@@ -17,6 +40,12 @@ def test_demo_writes_report_with_every_section(tmp_path, capsys):
     pngs = list((out / "figures").glob("*.png"))
     assert len(re.findall(r"data:image/png;base64,", html)) == len(pngs) >= 3
     assert "Model 4" in html and "RMSE" in html
+    # run times are measured with compiled kernels; the compilation is reported on its own
+    timing = re.search(r"With the kernels compiled, the 1 s step response took (\d+) ms.*?The first call, which runs "
+                       r"the same step, took ([\d.]+) s: about ([\d.]+) s of it went into compiling", html)
+    assert timing, "the step-response timing sentence is missing"
+    run_ms, first_s, compile_s = int(timing.group(1)), float(timing.group(2)), float(timing.group(3))
+    assert run_ms / 1e3 <= first_s + 1e-3 and abs(first_s - run_ms / 1e3 - compile_s) <= 0.11  # each rounded to 0.1 s
     # a second run refuses to overwrite without --force
     assert main(["demo", "-o", str(out)]) == 2
     assert "exists" in capsys.readouterr().err

@@ -51,6 +51,7 @@ def _demo(args) -> int:
 
     sections = []
     t0 = time.perf_counter()
+    progress("the first run compiles numba kernels (several minutes on a fresh machine; cached afterwards)")
     for name in DEMO_SECTIONS:
         mod = _optional_module(name)
         if mod is None:

@@ -28,6 +28,10 @@ __all__ = [
     "format_quantity",
     "UNIT_ALIASES",
     "normalise_unit",
+    "COLUMN_UNITS",
+    "column_unit",
+    "unit_label",
+    "column_label",
 ]
 
 _RPM = 2.0 * math.pi / 60.0
@@ -266,3 +270,103 @@ def format_quantity(value: float, unit: str) -> str:
     if unit in ("", "1"):
         return repr(float(value))
     return f"{float(value)!r} {unit}"
+
+
+# ---------------------------------------------------------------- units of column names
+#: unit suffixes of clutchlab column names (docs/nomenclature.md, "Unit suffixes"):
+#: suffix -> (unit for files and pint, unit for people).  The longest matching suffix of a name wins.
+COLUMN_UNITS: dict[str, tuple[str, str]] = {
+    "s": ("s", "s"), "ms": ("ms", "ms"),
+    "m": ("m", "m"), "mm": ("mm", "mm"), "m2": ("m**2", "m²"), "m3": ("m**3", "m³"),
+    "m_s": ("m/s", "m/s"), "m_s2": ("m/s**2", "m/s²"), "m3_s": ("m**3/s", "m³/s"), "m_per_N": ("m/N", "m/N"),
+    "rad": ("rad", "rad"), "rad_s": ("rad/s", "rad/s"), "rad_s2": ("rad/s**2", "rad/s²"), "rpm": ("rpm", "rpm"),
+    "N": ("N", "N"), "kN": ("kN", "kN"), "N_m": ("N/m", "N/m"), "Nm": ("N*m", "N·m"),
+    "Pa": ("Pa", "Pa"), "kPa": ("kPa", "kPa"), "MPa": ("MPa", "MPa"), "bar": ("bar", "bar"), "Pa_s": ("Pa*s", "Pa·s"),
+    "C": ("degC", "°C"), "c": ("degC", "°C"), "degC": ("degC", "°C"), "K": ("K", "K"), "deg": ("deg", "°"),
+    "kg": ("kg", "kg"), "kg_m2": ("kg*m**2", "kg·m²"),
+    "A": ("A", "A"), "V": ("V", "V"), "W": ("W", "W"), "kW": ("kW", "kW"), "J": ("J", "J"), "Hz": ("Hz", "Hz"),
+    "W_K": ("W/K", "W/K"), "J_K": ("J/K", "J/K"), "ohm": ("ohm", "Ω"), "H": ("H", "H"), "T": ("T", "T"),
+    "Wb": ("Wb", "Wb"), "pct": ("percent", "%"), "1": ("1", "dimensionless"),
+}
+#: bare column names with a fixed unit (EMTC FORC tables, generic time)
+NAME_UNITS: dict[str, str] = {"time": "s", "current": "A", "force": "N", "airgap": "m", "torque": "N*m"}
+_HUMAN = {file_unit: human for file_unit, human in COLUMN_UNITS.values()}
+_HUMAN.update({"N*m": "N·m", "degC": "°C", "": "dimensionless"})
+
+
+def _suffix(name: str) -> str | None:
+    parts = str(name).split("_")
+    for k in range(1, len(parts)):  # longest suffix first: "line_flow_m3_s" -> "m3_s", not "s"
+        suffix = "_".join(parts[k:])
+        if suffix in COLUMN_UNITS:
+            return suffix
+    return None
+
+
+def column_unit(name: str) -> str | None:
+    """The unit a column name states, as written in a file's units line (``"N*m"``, ``"m**3/s"``).
+
+    Parameters
+    ----------
+    name : str
+        Column name following docs/nomenclature.md (``torque_Nm``,
+        ``line_flow_m3_s``, ``temperature_C``, ``throttle_1``) or one of the
+        bare names ``time``, ``current``, ``force``, ``airgap``, ``torque``.
+
+    Returns
+    -------
+    str or None
+        A unit string pint understands (``"1"`` for dimensionless), or
+        ``None`` if the name states no unit.
+    """
+    name = str(name)
+    if name in NAME_UNITS:
+        return NAME_UNITS[name]
+    suffix = _suffix(name)
+    return None if suffix is None else COLUMN_UNITS[suffix][0]
+
+
+def unit_label(unit: str) -> str:
+    """A unit for people: a column suffix or a file unit written as in print (``rad_s`` -> ``rad/s``).
+
+    Parameters
+    ----------
+    unit : str
+        A suffix of :data:`COLUMN_UNITS` (``"rad_s"``, ``"C"``, ``"m3_s"``,
+        ``"Nm"``, ``"1"``) or a unit string as :func:`column_unit` returns it
+        (``"rad/s"``, ``"degC"``, ``"N*m"``).
+
+    Returns
+    -------
+    str
+        ``"rad/s"``, ``"°C"``, ``"m³/s"``, ``"N·m"``, ``"dimensionless"``;
+        anything unknown comes back as given.
+    """
+    unit = str(unit)
+    if unit in COLUMN_UNITS:
+        return COLUMN_UNITS[unit][1]
+    return _HUMAN.get(unit, unit)
+
+
+def column_label(name: str) -> str:
+    """Axis or table label of a column: its name in words and its unit (``slip_speed_rad_s`` -> ``slip speed [rad/s]``).
+
+    Parameters
+    ----------
+    name : str
+        Column name following docs/nomenclature.md.
+
+    Returns
+    -------
+    str
+        ``"<words> [<unit>]"``; a name without a unit suffix is only put into
+        words (``coupling_mode`` -> ``coupling mode``).
+    """
+    name = str(name)
+    if name in NAME_UNITS:
+        return f"{name} [{unit_label(NAME_UNITS[name])}]"
+    suffix = _suffix(name)
+    if suffix is None:
+        return name.replace("_", " ")
+    stem = name[: -len(suffix) - 1].replace("_", " ")
+    return f"{stem} [{COLUMN_UNITS[suffix][1]}]"

@@ -45,7 +45,7 @@ def test_current_follows_two_first_order_lags(magnet):
     ref = ([0.0, 0.1, 0.1001, 0.3], [50.0, 50.0, 250.0, 100.0])
     res = simulate_bench(magnet, sc, torque_reference=ref)
     df = res.to_dataframe()
-    u, i1, i2 = df["current_command"].to_numpy(), df["i1"].to_numpy(), df["i2"].to_numpy()
+    u, i1, i2 = df["current_command_A"].to_numpy(), df["i1_A"].to_numpy(), df["i2_A"].to_numpy()
     h, t1, t2 = sc.sample_time, act.tau1, act.tau2
     e1, e2 = math.exp(-h / t1), math.exp(-h / t2)
     p1 = u[:-1] + (i1[:-1] - u[:-1]) * e1
@@ -57,34 +57,34 @@ def test_current_follows_two_first_order_lags(magnet):
 def test_armature_clamp_force_eq11_and_airgap_eq12(slipping_run):
     act = ActuatorParameters()
     df = slipping_run.to_dataframe()
-    at_clutch = df["armature_mode"] == 2
+    at_clutch = df["armature_mode"] == "contact"
     assert at_clutch.mean() > 0.9
     d = df[at_clutch]
-    np.testing.assert_allclose(d["fn1"], d["magnet_force"] - act.preload - act.stiffness * act.free_travel, atol=1e-9)
-    np.testing.assert_allclose(d["airgap"], act.airgap_open - act.free_travel, atol=1e-12)
-    before = df[df["armature_mode"] == 0]
-    assert (before["fn1"] == 0).all() and (before["magnet_force"] <= act.preload + 1e-9).all()
+    np.testing.assert_allclose(d["fn1_N"], d["magnet_force_N"] - act.preload - act.stiffness * act.free_travel, atol=1e-9)
+    np.testing.assert_allclose(d["airgap_m"], act.airgap_open - act.free_travel, atol=1e-12)
+    before = df[df["armature_mode"] == "rest"]
+    assert (before["fn1_N"] == 0).all() and (before["magnet_force_N"] <= act.preload + 1e-9).all()
 
 
 def test_slipping_torques_follow_eq15(slipping_run):
     g = CouplingGeometry()
     df = slipping_run.to_dataframe()
-    slip = df[df["coupling_mode"] == 1]
+    slip = df[df["coupling_mode"] == "slipping"]
     assert len(slip) > 0.9 * len(df)
-    assert (slip["slip_speed"] > 0).all()  # the drums hold the speed difference: no lock-up
-    expect = np.array([slipping_torques(f, 1.0, g) for f in slip["fn1"]])
-    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), expect, rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(slip["t_coupling"], expect.sum(axis=1), rtol=1e-12)
+    assert (slip["slip_speed_rad_s"] > 0).all()  # the drums hold the speed difference: no lock-up
+    expect = np.array([slipping_torques(f, 1.0, g) for f in slip["fn1_N"]])
+    np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), expect, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(slip["coupling_torque_Nm"], expect.sum(axis=1), rtol=1e-12)
     assert slipping_run.events["name"].str.contains("lock").sum() == 0
 
 
 def test_torque_reference_tracking_through_inverse_preisach(slipping_run):
     """In slipping mode the transferred torque follows T_cal through the inverse magnet model (Eqs. 6-7, 31)."""
     df = slipping_run.to_dataframe()
-    late = df[(df["time"] > 0.3) & df["command_feasible"]]
+    late = df[(df["time_s"] > 0.3) & df["command_feasible"]]
     # the plant is the model itself: only the two current lags delay the torque
-    err = (late["t_coupling"] - late["torque_reference"]).abs()
-    assert err.median() < 0.02 * late["torque_reference"].abs().median()
+    err = (late["coupling_torque_Nm"] - late["torque_reference_Nm"]).abs()
+    assert err.median() < 0.02 * late["torque_reference_Nm"].abs().median()
 
 
 def test_locked_mode_logic_fig11(locked_run):
@@ -93,33 +93,33 @@ def test_locked_mode_logic_fig11(locked_run):
     lock = [i for i, n in enumerate(names) if n.startswith("lock-up")]
     unlock = [i for i, n in enumerate(names) if n.startswith("unlock")]
     assert len(lock) == 1 and len(unlock) == 1  # no chattering
-    t_lock, t_unlock = ev["time"][lock[0]], ev["time"][unlock[0]]
+    t_lock, t_unlock = ev["time_s"][lock[0]], ev["time_s"][unlock[0]]
     assert t_unlock - t_lock > 1.0
     df = locked_run.to_dataframe()
-    locked = df[(df["time"] > t_lock) & (df["time"] < t_unlock)]
-    assert (locked["coupling_mode"] == 2).all()
-    assert locked["slip_speed"].abs().max() < 1e-6 * df["omega_f"].mean()
-    np.testing.assert_allclose(locked[["t1", "t2", "t3"]].sum(axis=1), locked["t_coupling"], rtol=1e-10, atol=1e-9)
+    locked = df[(df["time_s"] > t_lock) & (df["time_s"] < t_unlock)]
+    assert (locked["coupling_mode"] == "locked").all()
+    assert locked["slip_speed_rad_s"].abs().max() < 1e-6 * df["omega_f_rad_s"].mean()
+    np.testing.assert_allclose(locked[["t1_Nm", "t2_Nm", "t3_Nm"]].sum(axis=1), locked["coupling_torque_Nm"], rtol=1e-10, atol=1e-9)
     # the locked split is the one of Eqs. 18-21 for the lock torque
     g = CouplingGeometry()
     for _, row in locked.iloc[::50].iterrows():
-        assert locked_torques(row["fn1"], row["t_coupling"], g, margin=1.02) == pytest.approx(
-            (row["t1"], row["t2"], row["t3"]), rel=1e-9, abs=1e-9)
+        assert locked_torques(row["fn1_N"], row["coupling_torque_Nm"], g, margin=1.02) == pytest.approx(
+            (row["t1_Nm"], row["t2_Nm"], row["t3_Nm"]), rel=1e-9, abs=1e-9)
     # the split passes through several cases of Fig. 12
     assert len(set(locked["locked_case"])) >= 3
     # unlock exactly where |T_lock| reaches 1.02 T_cap
     last = locked.iloc[-1]
-    assert abs(last["t_coupling"]) == pytest.approx(1.02 * last["capacity_locked"], rel=2e-2)
-    after = df[df["time"] > t_unlock]
-    assert (after["coupling_mode"] == 1).all()  # stays slipping: no relock
-    assert (after["slip_speed"] > 0).all()
+    assert abs(last["coupling_torque_Nm"]) == pytest.approx(1.02 * last["capacity_locked_Nm"], rel=2e-2)
+    after = df[df["time_s"] > t_unlock]
+    assert (after["coupling_mode"] == "slipping").all()  # stays slipping: no relock
+    assert (after["slip_speed_rad_s"] > 0).all()
 
 
 def test_results_converge_with_tolerance(magnet):
     sc = BenchScenario(duration=1.0, speed_difference=0.3, throttle_end=0.5, ramp_start=0.1, ramp_end=0.9)
     a = simulate_bench(magnet, sc, rtol=1e-6).to_dataframe()
     b = simulate_bench(magnet, sc, rtol=1e-9).to_dataframe()
-    for col in ("omega_f", "omega_r", "t_coupling", "i2", "x"):
+    for col in ("omega_f_rad_s", "omega_r_rad_s", "coupling_torque_Nm", "i2_A", "x_armature_m"):
         np.testing.assert_allclose(a[col], b[col], rtol=1e-4, atol=1e-4 * b[col].abs().max())
 
 
@@ -132,16 +132,16 @@ def test_open_coupling_transfers_drag_torque_eq25_26(magnet):
     veh = VehicleParameters()
     res = simulate_bench(magnet, BenchScenario(duration=0.2, speed_difference=0.5), torque_reference=([0, 1], [0, 0]))
     df = res.to_dataframe()
-    assert (df["coupling_mode"] == 0).all()
-    np.testing.assert_allclose(df["t_coupling"], veh.drag_coefficient() * df["slip_speed"], rtol=1e-12)
+    assert (df["coupling_mode"] == "open").all()
+    np.testing.assert_allclose(df["coupling_torque_Nm"], veh.drag_coefficient() * df["slip_speed_rad_s"], rtol=1e-12)
 
 
 def test_plant_model_mismatch_runs_with_separate_controller_model(magnet):
     truth = synthetic_magnet()
     res = simulate_bench(truth, BenchScenario(duration=1.0), controller_model=magnet)
     df = res.to_dataframe()
-    late = df[df["time"] > 0.5]
-    rel = (late["t_coupling"] - late["torque_reference"]).abs().median() / late["torque_reference"].median()
+    late = df[df["time_s"] > 0.5]
+    rel = (late["coupling_torque_Nm"] - late["torque_reference_Nm"]).abs().median() / late["torque_reference_Nm"].median()
     assert rel < 0.05  # identification error of the model only
 
 
@@ -194,12 +194,12 @@ def test_no_chattering_property(thr_end, ref, dv):
     mode_ev = ev[ev["name"].str.startswith(("lock-up", "unlock", "slip reversal"))]
     assert len(mode_ev) <= 6
     if len(mode_ev) > 1:
-        assert np.diff(mode_ev["time"].to_numpy()).min() > 0.01
+        assert np.diff(mode_ev["time_s"].to_numpy()).min() > 0.01
     df = res.to_dataframe()
     # locked samples have zero slip; slipping samples never carry more than the kinetic capacity
-    locked = df[df["coupling_mode"] == 2]
-    assert (locked["slip_speed"].abs() < 1e-6 * df["omega_f"].abs().max()).all()
-    assert (locked["t_coupling"].abs() <= 1.02 * locked["capacity_locked"] * (1 + 1e-9) + 1e-9).all()
+    locked = df[df["coupling_mode"] == "locked"]
+    assert (locked["slip_speed_rad_s"].abs() < 1e-6 * df["omega_f_rad_s"].abs().max()).all()
+    assert (locked["coupling_torque_Nm"].abs() <= 1.02 * locked["capacity_locked_Nm"] * (1 + 1e-9) + 1e-9).all()
 
 
 _MAGNET = bundled_magnet()
@@ -220,9 +220,9 @@ def test_friction_map_in_bench(magnet):
     fm = FrictionMap([0.0, 5.0, 50.0], [0.0, 100.0], [[0.10, 0.09], [0.08, 0.07], [0.06, 0.05]])
     sc = BenchScenario(duration=0.6, speed_difference=0.3, temperature_c=50.0)
     df = simulate_bench(magnet, sc, friction_map=fm).to_dataframe()
-    slip = df[(df["coupling_mode"] == 1) & (df["time"] > 0.1)]
-    mu = np.array([fm(v, 50.0) for v in slip["slip_speed"]])
-    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), _eq15(slip["fn1"].to_numpy(), mu, g), rtol=1e-9)
+    slip = df[(df["coupling_mode"] == "slipping") & (df["time_s"] > 0.1)]
+    mu = np.array([fm(v, 50.0) for v in slip["slip_speed_rad_s"]])
+    np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), _eq15(slip["fn1_N"].to_numpy(), mu, g), rtol=1e-9)
 
 
 def test_lugre_in_bench_reaches_stribeck_steady_state(magnet):
@@ -233,13 +233,13 @@ def test_lugre_in_bench_reaches_stribeck_steady_state(magnet):
     sc = BenchScenario(duration=0.6, speed_difference=0.3)
     res = simulate_bench(magnet, sc, lugre=lp)
     df = res.to_dataframe()
-    slip = df[(df["coupling_mode"] == 1) & (df["time"] > 0.1)]
-    mu_ss, _ = lugre_steady_state(slip["slip_speed"].to_numpy(), lp)
-    fn1 = slip["fn1"].to_numpy()
-    mu_eff = slip["t1"].to_numpy() / (2 / 3 * g.radius1 * fn1 * g.pairs1)
+    slip = df[(df["coupling_mode"] == "slipping") & (df["time_s"] > 0.1)]
+    mu_ss, _ = lugre_steady_state(slip["slip_speed_rad_s"].to_numpy(), lp)
+    fn1 = slip["fn1_N"].to_numpy()
+    mu_eff = slip["t1_Nm"].to_numpy() / (2 / 3 * g.radius1 * fn1 * g.pairs1)
     # quasi-steady slip: the LuGre coefficient sits on the Stribeck curve (bristle lag ~ g/(sigma0 |v|) = 30 us)
     np.testing.assert_allclose(mu_eff, mu_ss, rtol=5e-3)
-    np.testing.assert_allclose(slip[["t1", "t2", "t3"]].to_numpy(), _eq15(fn1, mu_eff, g), rtol=1e-9)
+    np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), _eq15(fn1, mu_eff, g), rtol=1e-9)
     with pytest.raises(ParameterError, match="either"):
         from clutchlab.emtc import FrictionMap
 
@@ -257,8 +257,8 @@ def test_lugre_lock_and_unlock_without_chattering(magnet):
     assert sum(n.startswith("unlock") for n in names) == 1
     assert not any(n.startswith("slip reversal") for n in names)
     df = res.to_dataframe()
-    after = df[df["time"] > res.events["time"].iloc[-1]]
-    assert (after["slip_speed"] > 0).all() and (after["coupling_mode"] == 1).all()
+    after = df[df["time_s"] > res.events["time_s"].iloc[-1]]
+    assert (after["slip_speed_rad_s"] > 0).all() and (after["coupling_mode"] == "slipping").all()
 
 
 def test_magnet_force_is_the_preisach_output_at_coil_current_and_airgap(magnet):
@@ -267,10 +267,10 @@ def test_magnet_force_is_the_preisach_output_at_coil_current_and_airgap(magnet):
     res = simulate_bench(magnet, BenchScenario(duration=0.5, speed_difference=0.3),
                          torque_reference=([0.0, 0.5], [20.0, 300.0]))
     df = res.to_dataframe()
-    assert np.all(np.diff(df["i2"]) >= -1e-12)  # monotone coil current
-    at = df[df["armature_mode"] == 2]
+    assert np.all(np.diff(df["i2_A"]) >= -1e-12)  # monotone coil current
+    at = df[df["armature_mode"] == "contact"]
     gap = act.airgap_open - act.free_travel
-    np.testing.assert_allclose(at["magnet_force"], magnet.forc(at["i2"], at["i2"], airgap=gap), rtol=1e-10, atol=1e-9)
-    rest = df[df["armature_mode"] == 0]
-    np.testing.assert_allclose(rest["magnet_force"], magnet.forc(rest["i2"], rest["i2"], airgap=act.airgap_open),
+    np.testing.assert_allclose(at["magnet_force_N"], magnet.forc(at["i2_A"], at["i2_A"], airgap=gap), rtol=1e-10, atol=1e-9)
+    rest = df[df["armature_mode"] == "rest"]
+    np.testing.assert_allclose(rest["magnet_force_N"], magnet.forc(rest["i2_A"], rest["i2_A"], airgap=act.airgap_open),
                                rtol=1e-10, atol=1e-9)

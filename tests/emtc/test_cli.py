@@ -67,7 +67,7 @@ def test_simulate_scenario_with_plot(tmp_path, capsys):
     code, text, _ = run(capsys, "emtc", "simulate", sc, "-o", out, "--plot", tmp_path / "run.png")
     assert code == 0 and "lock-up" in text
     df = pd.read_csv(out, comment="#")
-    assert len(df) == 251 and {"t1", "t2", "t3", "slip_speed", "coupling_mode"} <= set(df.columns)
+    assert len(df) == 251 and {"t1_Nm", "t2_Nm", "t3_Nm", "slip_speed_rad_s", "coupling_mode"} <= set(df.columns)
     assert (tmp_path / "run.png").read_bytes()[:4] == b"\x89PNG"
     code, _, err = run(capsys, "emtc", "simulate", sc, "-o", out)
     assert code == 2 and "exists" in err

@@ -168,8 +168,8 @@ def test_errors_and_overwrite(tmp_path, capsys):
 
 def test_channels_grouped_by_unit_suffix():
     groups = _groups(["torque_Nm", "speed_rad_s", "drag_Nm", "x_m", "count", "y_m", "temperature_C"])
-    assert groups == [("Nm", ["torque_Nm", "drag_Nm"]), ("rad_s", ["speed_rad_s"]), ("m", ["x_m", "y_m"]),
-                      ("", ["count"]), ("C", ["temperature_C"])]
+    assert groups == [("N*m", ["torque_Nm", "drag_Nm"]), ("rad/s", ["speed_rad_s"]), ("m", ["x_m", "y_m"]),
+                      ("", ["count"]), ("degC", ["temperature_C"])]
     # names without a unit: grouped by stem (EMTC run: omega_f/omega_r, i1/i2, t1..t3)
     groups = _groups(["omega_f", "omega_r", "theta", "i1", "i2", "t1", "t2", "t3", "t_coupling", "x", "xdot"])
     assert groups == [("", ["omega_f", "omega_r"]), ("", ["theta"]), ("", ["i1", "i2"]), ("", ["t1", "t2", "t3"]),

@@ -16,7 +16,7 @@ def _save_figure(fig, path, overwrite):
 
     check_writable(path, overwrite)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")
     plt.close(fig)
     atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
 
@@ -38,12 +38,11 @@ def _model(args):
 
 
 def _characterize(args) -> int:
-    from ..plotting import press_characterization
+    from ..io import read_measurement
+    from ..plotting import mark_synthetic, press_characterization
     from .characterize import characterize
 
     from pathlib import Path
-
-    from ..io import read_measurement
 
     check_writable(args.output, args.force)
     if args.plot:
@@ -59,13 +58,14 @@ def _characterize(args) -> int:
                         "(docs/measurements.md)") from None
     curve = characterize(meas, channel=args.channel, n_grid=args.points, name=Path(args.record).stem)
     mapped = f" with channel map {args.channel_map}" if args.channel_map else ""
-    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force,
-                  header_comment=f"characterised from {args.record}{mapped} by clutchlab eclutch characterize")
+    comment = f"characterised from {args.record}{mapped} by clutchlab eclutch characterize"
+    if meas.source.synthetic:  # the record's own "synthetic: ..." lines travel with the curve
+        comment = "\n".join([c for c in meas.source.comments if c.lower().startswith("synthetic")] + [comment])
+    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force, header_comment=comment)
     if args.plot:
-        rec = meas.frame
-        fig = press_characterization([dict(title=str(args.record), record=rec, curve=curve, channel=args.channel)],
-                                     ncols=1)
-        _save_figure(fig, args.plot, args.force)
+        fig = press_characterization([dict(title=str(args.record), record=meas.frame, curve=curve,
+                                           channel=args.channel)], ncols=1)
+        _save_figure(mark_synthetic(fig) if meas.source.synthetic else fig, args.plot, args.force)
     print(f"{args.output}: {curve.deflection.size} samples, {curve.n_cycles} cycles, "
           f"hysteresis half-width {np.median(curve.hysteresis_half_width):.3g} N, "
           f"cycle scatter <= {np.max(curve.cycle_scatter):.3g} N")
@@ -129,7 +129,7 @@ def _lever(args) -> int:
 def _simulate(args) -> int:
     from .. import __version__
     from ..io import write_measurement
-    from ..plotting import eclutch_response, hysteresis_loop
+    from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
     from .scenario import load_scenario, run_scenario
 
     check_writable(args.output, args.force)
@@ -140,8 +140,8 @@ def _simulate(args) -> int:
 
     res = run_scenario(scenario, progress=progress)
     frame = res.to_dataframe()
-    comment = (f"simulated by clutchlab {__version__} (E-clutch Model {scenario.model}, scenario {args.scenario}); "
-               "model output, not a measurement")
+    comment = (f"synthetic: simulated by clutchlab {__version__} (E-clutch Model {scenario.model}, scenario "
+               f"{args.scenario}); model output, not a measurement")
     write_measurement(frame, args.output, comment=comment, overwrite=args.force)
     if args.plot:
         if scenario.input_kind == "bearing_position":
@@ -151,7 +151,7 @@ def _simulate(args) -> int:
                                   title=f"Model {scenario.model}: bearing force over the prescribed cycle")
         else:
             fig = eclutch_response(res.outputs, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
-        _save_figure(fig, args.plot, args.force)
+        _save_figure(mark_synthetic(fig), args.plot, args.force)
     st = res.stats
     print(f"{args.output}: {len(frame)} points over {scenario.t_end:g} s, {st['accepted_steps']} steps "
           f"({st['rejected_steps']} rejected), {len(res.events)} events; "

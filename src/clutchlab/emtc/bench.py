@@ -29,7 +29,7 @@ from ..errors import ParameterError, SimulationError
 from ..params import ParameterSet, quantity
 from ..params.base import load_toml
 from . import _bench_kernel as BK
-from .torque import UNLOCK_MARGIN, CouplingGeometry
+from .torque import LOCKED_CASE_NAMES, UNLOCK_MARGIN, CouplingGeometry
 
 __all__ = [
     "ActuatorParameters",
@@ -40,6 +40,10 @@ __all__ = [
     "simulate_bench",
     "load_scenario",
     "EVENT_NAMES",
+    "EVENT_KEYS",
+    "MODE_NAMES",
+    "ARMATURE_MODE_NAMES",
+    "COLUMN_NAMES",
 ]
 
 EVENT_NAMES = {
@@ -51,7 +55,33 @@ EVENT_NAMES = {
     BK.EV_SLIP_REVERSAL: "slip reversal (capacity below T_lock)",
     BK.EV_UNLOCK: "unlock (|T_lock| > 1.02 T_cap)",
 }
+#: short name of each event kind, as in the ``event`` column of :attr:`BenchResult.events`
+EVENT_KEYS = {
+    BK.EV_ARM_REST: "armature_rest",
+    BK.EV_ARM_CONTACT: "armature_contact",
+    BK.EV_ARM_LEAVE_REST: "armature_leave_rest",
+    BK.EV_ARM_LEAVE_CONTACT: "armature_leave_contact",
+    BK.EV_LOCK: "lockup",
+    BK.EV_SLIP_REVERSAL: "slip_reversal",
+    BK.EV_UNLOCK: "unlock",
+}
 MODE_NAMES = {0: "open", 1: "slipping", 2: "locked"}
+#: armature modes of the kernel: at the rest stop, free, pressing the primary clutch
+ARMATURE_MODE_NAMES = {0: "rest", 1: "free", 2: "contact"}
+
+#: kernel names of :attr:`BenchResult.states` / :attr:`BenchResult.outputs` -> columns of
+#: :meth:`BenchResult.to_dataframe` (docs/nomenclature.md, "EMTC drum-bench results")
+COLUMN_NAMES = {
+    "time": "time_s",
+    "omega_f": "omega_f_rad_s", "omega_r": "omega_r_rad_s", "theta": "theta_rad",
+    "x": "x_armature_m", "xdot": "v_armature_m_s", "i1": "i1_A", "i2": "i2_A",
+    "magnet_force": "magnet_force_N", "fn1": "fn1_N", "t1": "t1_Nm", "t2": "t2_Nm", "t3": "t3_Nm",
+    "t_coupling": "coupling_torque_Nm", "t_lock_eq29": "lock_torque_Nm", "t_trans": "transmission_torque_Nm",
+    "capacity_locked": "capacity_locked_Nm", "locked_case": "locked_case", "fn2": "fn2_N",
+    "engine_torque": "engine_torque_Nm", "armature_mode": "armature_mode", "coupling_mode": "coupling_mode",
+    "current_command": "current_command_A", "torque_reference": "torque_reference_Nm", "throttle": "throttle_1",
+    "command_feasible": "command_feasible", "slip_speed": "slip_speed_rad_s", "airgap": "airgap_m",
+}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -201,16 +231,24 @@ class BenchResult:
     time : numpy.ndarray
         Sample times [s].
     states : pandas.DataFrame
-        ``omega_f, omega_r`` [rad/s], ``theta`` [rad], ``x`` [m], ``xdot`` [m/s], ``i1, i2`` [A].
+        Kernel names, kept for existing code: ``omega_f, omega_r`` [rad/s],
+        ``theta`` [rad], ``x`` [m], ``xdot`` [m/s], ``i1, i2`` [A].
     outputs : pandas.DataFrame
-        Magnet force, clamp forces, element torques, lock torque, capacity, modes, commands.
+        Kernel names, kept for existing code: magnet force, clamp forces,
+        element torques, lock torque, capacity, integer mode codes
+        (:data:`MODE_NAMES`, :data:`ARMATURE_MODE_NAMES`), commands.
     events : pandas.DataFrame
-        ``time, kind, name, armature_mode, coupling_mode``.
+        ``time_s``, ``event`` (:data:`EVENT_KEYS`: ``lockup``, ``unlock``,
+        ...), ``description``, ``armature_mode`` and ``coupling_mode`` after
+        the event (names); the former ``time``, ``kind`` (integer code) and
+        ``name`` (= ``description``) columns are kept for existing code.
     n_steps : int
         Accepted integration steps.
 
     Notes
     -----
+    :meth:`to_dataframe` is the table to keep and to write: every column
+    named with its unit suffix and modes as names (docs/nomenclature.md).
     The tables are assembled from the kernel's arrays on first access:
     ``raw`` (samples x columns) and ``raw_events`` are the kernel's output
     arrays, ``airgap_open`` [m] the airgap at the rest stop, used to report
@@ -254,10 +292,13 @@ class BenchResult:
     def events(self) -> pd.DataFrame:
         if "events" not in self._cache:
             e = self._raw_events
+            kinds = e[:, 1].astype(int)
+            names = [EVENT_NAMES.get(int(k), "?") for k in kinds]
             self._cache["events"] = pd.DataFrame({
-                "time": e[:, 0], "kind": e[:, 1].astype(int),
-                "name": [EVENT_NAMES.get(int(k), "?") for k in e[:, 1]],
-                "armature_mode": e[:, 2].astype(int), "coupling_mode": e[:, 3].astype(int)})
+                "time_s": e[:, 0], "event": [EVENT_KEYS.get(int(k), "?") for k in kinds], "description": names,
+                "armature_mode": [ARMATURE_MODE_NAMES.get(int(m), "?") for m in e[:, 2]],
+                "coupling_mode": [MODE_NAMES.get(int(m), "?") for m in e[:, 3]],
+                "time": e[:, 0], "kind": kinds, "name": names})
         return self._cache["events"]
 
     @property
@@ -266,8 +307,22 @@ class BenchResult:
         return self.outputs["coupling_mode"].map(MODE_NAMES)
 
     def to_dataframe(self) -> pd.DataFrame:
-        """One table with time, states and outputs."""
-        return pd.concat([pd.DataFrame({"time": self.time}), self.states, self.outputs], axis=1)
+        """One table with time, states and outputs, in the names and units of docs/nomenclature.md.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns :data:`COLUMN_NAMES` (``time_s``, ``omega_f_rad_s``,
+            ``coupling_torque_Nm``, ``slip_speed_rad_s``, ...), all SI;
+            ``armature_mode`` (``rest``/``free``/``contact``),
+            ``coupling_mode`` (``open``/``slipping``/``locked``) and
+            ``locked_case`` (the case of Fig. 12, ``""`` unless locked) as names.
+        """
+        frame = pd.concat([pd.DataFrame({"time": self.time}), self.states, self.outputs], axis=1)
+        frame["armature_mode"] = frame["armature_mode"].map(ARMATURE_MODE_NAMES)
+        frame["coupling_mode"] = frame["coupling_mode"].map(MODE_NAMES)
+        frame["locked_case"] = frame["locked_case"].map(lambda c: LOCKED_CASE_NAMES.get(int(c), ""))
+        return frame.rename(columns=COLUMN_NAMES)
 
 
 _STATE_COLS = ["omega_f", "omega_r", "theta", "x", "xdot", "i1", "i2"]

@@ -72,19 +72,25 @@ def _simulate(args) -> int:
     magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
     res = simulate_bench(magnet, sc["scenario"], vehicle=sc["vehicle"], actuator=sc["actuator"], coupling=sc["coupling"])
     frame = res.to_dataframe()
-    atomic_to_csv(frame, args.output, overwrite=args.force,
-                  header_comment=f"clutchlab emtc simulate {args.scenario}; magnet: "
-                                 f"{sc['magnet'] or 'bundled synthetic FORC data (synthetic)'}")
+    from .. import __version__
+    from ..io import write_measurement
+
+    magnet_src = sc["magnet"] or "bundled synthetic FORC data"
+    comment = (f"synthetic: simulated by clutchlab {__version__} (emtc simulate {args.scenario}; magnet: "
+               f"{magnet_src}); model output, not a measurement")
+    write_measurement(frame, args.output, comment=comment, overwrite=args.force)
     if len(res.events):
-        print(res.events.to_string(index=False))
+        print(res.events[["time_s", "event", "description", "coupling_mode"]].to_string(index=False))
     if args.plot:
         from ..io import atomic_write_bytes
+        from ..plotting import mark_synthetic
+        from ..report.html import DPI
         from .demo import bench_figure
         import io
 
-        fig = bench_figure(res, "EMTC drum-bench simulation")
+        fig = mark_synthetic(bench_figure(res, "EMTC drum-bench simulation"))
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
         print(args.plot)
     print(args.output)

@@ -24,28 +24,32 @@ def _loop_input():
 
 
 def bench_figure(res, title):
-    """Speeds, current and magnet force, and element torques of a bench run."""
+    """Speeds, current and magnet force, and element torques of a bench run (:class:`BenchResult`)."""
     import matplotlib.pyplot as plt
 
     df = res.to_dataframe()
+    t = df["time_s"]
     fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    ax[0].plot(df["time"], df["omega_f"], label="coupling input (front)")
-    ax[0].plot(df["time"], df["omega_r"], label="coupling output (rear)")
-    ax[0].set_ylabel("speed [rad/s]")
-    ax[0].legend(loc="best")
-    ax[1].plot(df["time"], df["current_command"], label="current command")
-    ax[1].plot(df["time"], df["i2"], label="coil current")
+    ax[0].plot(t, df["omega_f_rad_s"], label="coupling input (front)")
+    ax[0].plot(t, df["omega_r_rad_s"], "--", label="coupling output (rear)")
+    ax[0].set_ylabel("shaft speed [rad/s]")
+    ax[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax[1].plot(t, df["current_command_A"], label="current command")
+    ax[1].plot(t, df["i2_A"], label="coil current")
     ax[1].set_ylabel("current [A]")
     a2 = ax[1].twinx()
-    a2.plot(df["time"], df["magnet_force"], "k:", label="magnet force")
-    a2.set_ylabel("force [N]")
-    ax[1].legend(loc="upper left")
-    for col, lab in (("t_coupling", "total"), ("t1", "primary T1"), ("t2", "secondary T2"), ("t3", "third T3"),
-                     ("torque_reference", "reference T_cal")):
-        ax[2].plot(df["time"], df[col], label=lab)
-    ax[2].set_ylabel("torque [N m]")
+    a2.plot(t, df["magnet_force_N"], "k:", label="magnet force (right axis)")
+    a2.set_ylabel("magnet force [N]")
+    lines = ax[1].get_lines() + a2.get_lines()
+    ax[1].legend(lines, [ln.get_label() for ln in lines], loc="upper left", bbox_to_anchor=(1.12, 1.0), fontsize=8)
+    for col, lab in (("coupling_torque_Nm", "total"), ("t1_Nm", "primary T1"), ("t2_Nm", "secondary T2"),
+                     ("t3_Nm", "third T3"), ("torque_reference_Nm", "reference T_cal")):
+        ax[2].plot(t, df[col], label=lab)
+    ax[2].set_ylabel("torque [N·m]")
     ax[2].set_xlabel("time [s]")
-    ax[2].legend(loc="best", fontsize=8)
+    ax[2].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    for a in ax:
+        a.grid(alpha=0.3)
     fig.suptitle(title)
     fig.tight_layout()
     return fig
@@ -55,14 +59,15 @@ def _element_figure(res, title):
     import matplotlib.pyplot as plt
 
     df = res.to_dataframe()
-    engaged = df["coupling_mode"] > 0
+    engaged = df["coupling_mode"] != "open"
     fig, ax = plt.subplots(figsize=(6, 4))
-    for col, lab in (("t1", "primary T1"), ("t2", "secondary T2"), ("t3", "third T3")):
-        ax.plot(df.loc[engaged, "t_coupling"], df.loc[engaged, col], ".", ms=2, label=lab)
-    ax.set_xlabel("total transferred torque [N m]")
-    ax.set_ylabel("element torque [N m]")
+    for col, lab in (("t1_Nm", "primary T1"), ("t2_Nm", "secondary T2"), ("t3_Nm", "third T3")):
+        ax.plot(df.loc[engaged, "coupling_torque_Nm"], df.loc[engaged, col], ".", ms=2, label=lab)
+    ax.set_xlabel("total transferred torque [N·m]")
+    ax.set_ylabel("element torque [N·m]")
     ax.set_title(title)
-    ax.legend()
+    ax.legend(loc="upper left", markerscale=4)
+    ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
 
@@ -124,11 +129,14 @@ def demo_section(progress=print) -> Section:
     ax[0].plot(t, target, "k", lw=2, label="target force")
     ax[0].plot(t, achieved, "C3", label="with inverse Preisach (Eqs. 6-7)")
     ax[0].plot(t, naive, "C0--", lw=1, label="ascending-branch inverse only")
-    ax[0].set_ylabel("force [N]")
-    ax[0].legend(loc="best", fontsize=8)
-    ax[1].plot(t, inv.input, "C3")
-    ax[1].set_ylabel("current [A]")
+    ax[0].set_ylabel("magnet force [N]")
+    ax[0].set_title("open-loop compensation at 0.7 mm airgap", fontsize=10)
+    ax[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax[1].plot(t, inv.input, "C3", label="current from the inverse model")
+    ax[1].set_ylabel("coil current [A]")
     ax[1].set_xlabel("time [s]")
+    for a in ax:
+        a.grid(alpha=0.3)
     fig.tight_layout()
     items.append(Figure("emtc_compensation", fig, "Open-loop hysteresis compensation (Figs. 7-8) at 0.7 mm"))
     items.append(Table("emtc_compensation_error", pd.DataFrame({
@@ -156,7 +164,9 @@ def demo_section(progress=print) -> Section:
     items.append(Figure("emtc_elements_locked", _element_figure(r2, "locked: element vs total torque"),
                         "Per-element torque against the total in locked mode (cases a, b', c of Eqs. 18-20)"))
     ev = pd.concat([r1.events.assign(run="slipping"), r2.events.assign(run="locked")], ignore_index=True)
-    items.append(Table("emtc_bench_events", ev[["run", "time", "name"]], "Mode events located inside the steps"))
+    ev = ev[["run", "time_s", "event", "description", "coupling_mode"]].rename(
+        columns={"time_s": "time [s]", "coupling_mode": "coupling mode after"})
+    items.append(Table("emtc_bench_events", ev, "Mode events located inside the steps"))
     plt.close("all")
     params = {"magnet": "identified from bundled synthetic FORC data (7 airgaps, 0-4.5 A)",
               "vehicle": "Table 1 of the paper (2162 kg, i0 = 3.75, i_r = 2.533, 225/65R17)",

@@ -374,7 +374,8 @@ def locked_torques(fn1, t_lock, geometry: CouplingGeometry, *, margin: float = 1
     return float(out[0]), float(out[1]), float(out[2])
 
 
-_CASE_NAMES = {
+#: distribution cases of the locked coupling ([1], Fig. 12) by kernel code
+LOCKED_CASE_NAMES = _CASE_NAMES = {
     0: "a: equal split (Eq. 18)",
     4: "b: third element saturated (Eq. 19)",
     1: "b': primary clutch saturated (mirrored Eq. 19)",

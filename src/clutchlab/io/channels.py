@@ -54,17 +54,6 @@ __all__ = [
 #: how a channel recorded at its own timestamps is carried onto another time base
 INTERPOLATIONS = ("linear", "previous")
 
-# unit suffixes of clutchlab column names (nomenclature.md); the longest matching suffix wins
-_SUFFIX_UNITS = {
-    "s": "s", "ms": "ms", "m": "m", "mm": "mm", "N": "N", "kN": "kN", "Nm": "N*m", "Pa": "Pa", "Pa_s": "Pa*s",
-    "bar": "bar", "C": "degC", "c": "degC", "K": "K", "rad_s": "rad/s", "rpm": "rpm", "rad": "rad",
-    "m_s": "m/s", "m_s2": "m/s**2", "rad_s2": "rad/s**2", "A": "A", "V": "V", "W": "W", "J": "J", "kg": "kg",
-    "kg_m2": "kg*m**2", "Hz": "Hz", "W_K": "W/K", "J_K": "J/K", "ohm": "ohm", "H": "H", "T": "T", "Wb": "Wb",
-}
-# bare names with a fixed meaning (EMTC FORC tables, generic time)
-_NAME_UNITS = {"time": "s", "current": "A", "force": "N", "airgap": "m", "torque": "N*m"}
-
-
 def canonical_unit(name: str) -> str | None:
     """The unit a clutchlab column name states, or ``None`` if it states none.
 
@@ -73,21 +62,17 @@ def canonical_unit(name: str) -> str | None:
     name : str
         Column name following the nomenclature (``torque_Nm``,
         ``slip_speed_rad_s``, ``temperature_C``, ``time_s``) or one of the bare
-        names ``time``, ``current``, ``force``, ``airgap``, ``torque``.
+        names ``time``, ``current``, ``force``, ``airgap``, ``torque``; the
+        suffixes are those of :data:`clutchlab.units.COLUMN_UNITS`.
 
     Returns
     -------
     str or None
         Unit string for pint (``"N*m"``, ``"rad/s"``, ``"degC"``, ``"s"``).
     """
-    if name in _NAME_UNITS:
-        return _NAME_UNITS[name]
-    parts = name.split("_")
-    for k in range(1, len(parts)):  # longest suffix first: "slip_speed_rad_s" -> "rad_s", not "s"
-        suffix = "_".join(parts[k:])
-        if suffix in _SUFFIX_UNITS:
-            return _SUFFIX_UNITS[suffix]
-    return None
+    from ..units import column_unit
+
+    return column_unit(name)  # one suffix table for files, axis labels and reports: clutchlab.units.COLUMN_UNITS
 
 
 @lru_cache(maxsize=512)

@@ -80,9 +80,13 @@ caption{caption-side:top;text-align:left;font-weight:600;padding:.3em 0}
 """
 
 
+#: resolution of the embedded figures [dots per inch]: print quality at the figure's size
+DPI = 150
+
+
 def _figure_png(fig) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
     return buf.getvalue()
 
 
@@ -110,7 +114,10 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
     ``sections`` are the report's chapters, ``title`` its heading; ``progress``
     (a callable taking a message) is told about every figure rendered.
     The page is self-contained: figures are embedded as base64 PNG ``data:``
-    URIs and the style sheet is inline, so it loads nothing from elsewhere.
+    URIs (:data:`DPI` dots per inch) and the style sheet is inline, so it
+    loads nothing from elsewhere.  Every figure of a synthetic section is
+    stamped "synthetic data" (:func:`clutchlab.plotting.mark_synthetic`), so
+    it stays marked when copied out of the page.
 
     The folder is assembled in a temporary sibling and moved into place, so an
     interrupted run never leaves half a report.  An existing ``outdir`` is
@@ -158,6 +165,10 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
                     done += 1
                     if progress is not None:
                         progress(f"rendering figure {done}/{n_figures}: {item.name}")
+                    if synthetic:
+                        from ..plotting import mark_synthetic
+
+                        mark_synthetic(item.figure)
                     png = _figure_png(item.figure)
                     plt.close(item.figure)
                     (tmp / "figures" / f"{_unique(used, 'figures', item.name)}.png").write_bytes(png)

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import DataError
+from ..units import NAME_UNITS, column_label, column_unit, unit_label
 from .html import Figure, Section, Table, Text, write_report
 
 __all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "DEFAULT_OUTPUT"]
@@ -40,9 +41,6 @@ DEFAULT_OUTPUT = "report"
 
 TABLE_SUFFIXES = {".csv": "CSV", ".parquet": "Parquet", ".mf4": "MDF4", ".mdf": "MDF4"}
 _TIME_NAMES = ("time_s", "time", "t_s", "t", "timestamp_s", "timestamps")
-#: unit suffixes of canonical channel names (longest first), used to group channels into axes
-_UNIT_SUFFIXES = ("rad_s2", "rad_s", "m_s2", "m_s", "kg_m2", "Nm", "N_m", "rpm", "bar", "kPa", "MPa", "Pa", "degC",
-                  "mm", "deg", "rad", "kW", "W", "J", "A", "V", "T", "Hz", "kg", "N", "C", "K", "m", "s", "pct")
 MAX_LINES_PER_AXES = 6
 MAX_AXES_PER_FIGURE = 4
 MAX_PLOT_POINTS = 4000
@@ -255,16 +253,32 @@ def find_datasets(run_dir, *, output=None, progress: Callable[[str], None] | Non
 
 # ---------------------------------------------------------------------- figures
 def _unit_of(column: str) -> str:
+    """The unit a channel name states: a ``[unit]`` at its end, else its suffix (``N*m``, ``rad/s``); ``""`` if none."""
     name = str(column)
-    for suffix in _UNIT_SUFFIXES:
-        if name.endswith("_" + suffix) or name.endswith("[" + suffix + "]"):
-            return suffix
-    return ""
+    m = re.search(r"\[([^\]]+)\]\s*$", name)
+    if m:
+        return m.group(1).strip()
+    unit = column_unit(name)
+    return "" if unit is None or name in NAME_UNITS else unit
 
 
 def _stem_of(column: str) -> str:
     """Name without a trailing index (``i1`` -> ``i``, ``fn2`` -> ``fn``, ``omega_f`` -> ``omega``)."""
     return re.sub(r"(?:_?\d+|_[A-Za-z])$", "", str(column)) or str(column)
+
+
+def _words(column) -> str:
+    """A channel name in words, without its unit (``slip_speed_rad_s`` -> ``slip speed``)."""
+    return re.sub(r"\s*\[[^\]]*\]\s*$", "", column_label(column)) or str(column)
+
+
+def _axis_label(unit: str, cols: list[str]) -> str:
+    """y label of an axes of channels ``cols``: their common name in words and the unit for people."""
+    if not unit:
+        return _stem_of(cols[0]).replace("_", " ")
+    if len(cols) == 1:
+        return f"{_words(cols[0])} [{unit_label(unit)}]"
+    return f"[{unit_label(unit)}]"
 
 
 def _groups(columns: list[str]) -> list[tuple[str, list[str]]]:
@@ -322,12 +336,13 @@ def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
         fig, axes = new_figure(len(part), 1, width=8.0, height=1.9 * len(part) + 0.6, sharex=True, squeeze=False)
         for ax, (unit, cols) in zip(axes[:, 0], part):
             for c in cols:
-                ax.plot(t, frame[c].to_numpy(dtype=float)[::stride], lw=0.9, label=str(c))
-            ax.set_ylabel(f"[{unit}]" if unit else _stem_of(cols[0]), fontsize=8)
-            ax.legend(fontsize=7, loc="best")
+                ax.plot(t, frame[c].to_numpy(dtype=float)[::stride], lw=0.9, label=_words(c) if unit else str(c))
+            ax.set_ylabel(_axis_label(unit, cols), fontsize=8)
+            if len(cols) > 1:  # one line: the axis label names it
+                ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=7)
-        axes[-1, 0].set_xlabel(f"{tcol}", fontsize=8)
+        axes[-1, 0].set_xlabel(column_label(tcol) if _unit_of(tcol) else f"{tcol} [s]", fontsize=8)
         n = k // MAX_AXES_PER_FIGURE + 1
         total = math.ceil(len(groups) / MAX_AXES_PER_FIGURE)
         names = ", ".join(str(c) for _, cols in part for c in cols)
@@ -375,9 +390,9 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=7)
             if i == len(outputs) - 1:
-                ax.set_xlabel(str(inp), fontsize=8)
+                ax.set_xlabel(column_label(inp), fontsize=8)
             if j == 0:
-                ax.set_ylabel(str(out), fontsize=8)
+                ax.set_ylabel(column_label(out), fontsize=8)
     fig.tight_layout()
     cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
     if len(frame) < len(ds.frame):
@@ -399,17 +414,20 @@ def metrics_table(ds: Dataset) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        One row per channel: ``channel, finite, non-finite, min, max, mean, final``.
+        One row per channel: ``channel, unit`` (for people: rad/s, °C, N·m), ``finite, non-finite, min, max,
+        mean, final``.
     """
     rows = []
     for c in ds.numeric_columns():
         v = ds.frame[c].to_numpy(dtype=float)
         ok = np.isfinite(v)
         fin = v[ok]
-        rows.append({"channel": str(c), "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
+        unit = _unit_of(c)
+        rows.append({"channel": str(c), "unit": unit_label(unit) if unit else "",
+                     "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
                      "min": float(fin.min()), "max": float(fin.max()), "mean": float(fin.mean()),
                      "final": float(fin[-1])})
-    return pd.DataFrame(rows, columns=["channel", "finite", "non-finite", "min", "max", "mean", "final"])
+    return pd.DataFrame(rows, columns=["channel", "unit", "finite", "non-finite", "min", "max", "mean", "final"])
 
 
 def _flatten(data, prefix=""):

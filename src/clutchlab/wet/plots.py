@@ -65,8 +65,10 @@ def map_traces_figure(record, title="friction-map experiment"):
     axs[2].plot(t, record["force_N"], lw=0.8, label="load cell")
     axs[2].set_ylabel("force [N]")
     ax2b = axs[2].twinx()
-    ax2b.plot(t, record["piston_position_m"] * 1e3, lw=0.8, color="tab:orange")
+    ax2b.plot(t, record["piston_position_m"] * 1e3, lw=0.8, color="tab:orange", label="piston (right axis)")
     ax2b.set_ylabel("piston [mm]", color="tab:orange")
+    lines = axs[2].get_lines() + ax2b.get_lines()
+    axs[2].legend(lines, [ln.get_label() for ln in lines], fontsize=7, loc="lower right")
     axs[3].plot(t, record["temperature_C"], lw=0.8, label="clutch (thermistor)")
     axs[3].plot(t, record["fluid_temperature_C"], lw=0.8, label="fluid")
     axs[3].plot(t, record["housing_temperature_C"], lw=0.8, label="housing")
@@ -92,7 +94,7 @@ def engagement_figure(bench_result, dyno_result):
         axs[2].plot(t, res.output("squeeze_force_N"), ls, label=f"squeeze film, {name.split(' ')[0]}")
         for ev in res.events:
             if ev.kind == "lock-up":
-                axs[0].axvline(ev.time, color="0.5", lw=0.8, ls=ls)
+                axs[0].axvline(ev.time, color="0.5", lw=0.8, ls=ls, label=f"lock-up, {name.split(' ')[0]}")
     axs[0].plot(bench_result.time, bench_result.output("slip_reference_rad_s") * 30 / np.pi, ":", color="k",
                 label="slip reference")
     axs[2].plot(bench_result.time, bench_result.output("force_reference_N"), ":", color="k", label="force reference")
