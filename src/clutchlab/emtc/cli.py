@@ -8,6 +8,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
+from ..io.files import check_outputs
 
 
 def _identify(args) -> int:
@@ -65,9 +66,7 @@ def _simulate(args) -> int:
     from .bench import load_scenario, simulate_bench
     from .magnet import bundled_magnet
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     sc = load_scenario(args.scenario)
     magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
     res = simulate_bench(magnet, sc["scenario"], vehicle=sc["vehicle"], actuator=sc["actuator"], coupling=sc["coupling"])

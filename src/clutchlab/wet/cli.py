@@ -58,13 +58,12 @@ def _simulate(args) -> int:
 
 def _identify(args) -> int:
     from ..errors import IdentificationError
-    from ..io import atomic_write_bytes, atomic_write_text, check_writable
+    from ..io import atomic_write_bytes, atomic_write_text
+    from ..io.files import check_outputs
     from .identify import friction_samples, identify_friction_map, identify_thermal
     from .params import WetClutch
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     if args.sensor_lag < 0:
         raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
