@@ -209,6 +209,16 @@ def test_huge_rate(work, capsys, monkeypatch):
             "rec.csv", "rate = 1e+09 Hz", "memory budget")
 
 
+def test_non_finite_or_degenerate_arguments(work, capsys):
+    _record(work / "rec.csv")
+    refused(["convert", "rec.csv", "-o", "out.csv", "--rate", "1e-9"], work, capsys, "rec.csv", "rate = 1e-09 Hz",
+            "single sample")
+    refused(["wet", "identify", "rec.csv", "-o", "map.json", "--sensor-lag", "nan"], work, capsys,
+            "--sensor-lag = nan")
+    refused(["emtc", "preisach", "identify", "rec.csv", "-o", "m.json", "--grid", "0,1,nan"], work, capsys,
+            "--grid '0,1,nan'", "finite")
+
+
 def test_huge_duration_emtc(work, capsys, monkeypatch):
     from clutchlab.emtc import _bench_kernel
 

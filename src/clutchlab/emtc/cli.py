@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._limits import short_repr
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
 from ..io.files import check_outputs
@@ -15,15 +16,17 @@ def _identify(args) -> int:
     from ..hysteresis import identify_forc_family
 
     check_writable(args.output, args.force)
-    frame = read_measurement(args.forc, required=["current", "force"], time=None, name=str(args.forc)).frame
-    if "airgap" in frame.columns:
-        frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
     grid = None
     if args.grid:
         try:
             grid = np.array([float(v) for v in args.grid.split(",")])
         except ValueError:
-            raise DataError(f"--grid {args.grid!r}: expected comma-separated currents in A") from None
+            grid = None
+        if grid is None or not np.all(np.isfinite(grid)):
+            raise DataError(f"--grid {short_repr(args.grid)}: expected comma-separated finite currents in A")
+    frame = read_measurement(args.forc, required=["current", "force"], time=None, name=str(args.forc)).frame
+    if "airgap" in frame.columns:
+        frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
     model, results = identify_forc_family(frame, grid=grid, name=str(args.forc))
     model.to_json(args.output, overwrite=args.force)
     for gap, res in results:

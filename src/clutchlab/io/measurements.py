@@ -590,6 +590,9 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
                 check_allocation((t_hi - t_lo) * rate + 1, len(used) + 1,
                                  f"{label}: rate = {rate:g} Hz over {t_hi - t_lo:g} s")
                 n = int(np.floor((t_hi - t_lo) * rate * (1 + 1e-12))) + 1
+                if n < 2:
+                    raise ParameterError(f"{label}: rate = {rate:g} Hz gives a single sample over the "
+                                         f"{t_hi - t_lo:g} s of the record; need at least 2")
                 timeline = t_lo + np.arange(n) / rate
                 how = f"resampled at {rate:g} Hz over [{t_lo:g}, {t_hi:g}] s"
             else:

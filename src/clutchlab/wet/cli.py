@@ -64,8 +64,8 @@ def _identify(args) -> int:
     from .params import WetClutch
 
     check_outputs([args.output, args.plot], args.force)
-    if args.sensor_lag < 0:
-        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be >= 0 [s]")
+    if not args.sensor_lag >= 0 or args.sensor_lag == float("inf"):  # NaN fails the first test
+        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be a finite number >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
     fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
     data = fmap.to_dict()
