@@ -156,9 +156,6 @@ def short_repr(value, limit: int = 60) -> str:
         return f"{type(value).__name__} of {len(value)} items"
     if isinstance(value, dict) and len(value) > 3:
         return f"{{... {len(value)} keys}}"
-    if isinstance(value, (str, bytes)) and len(value) > limit:
-        keep = max(limit // 2 - 2, 4)
-        return repr(value[:keep])[:-1] + "..." + repr(value[-keep:])[1:]
     try:
         text = repr(value)
     except Exception:
