@@ -3,12 +3,16 @@
 Each subsystem registers its own sub-command from ``clutchlab.<subsystem>.cli``
 (a ``register(subparsers)`` function that adds a parser whose handler is set
 with ``set_defaults(func=...)``).  Every :class:`~clutchlab.errors.ClutchlabError`,
-missing file or refused overwrite becomes one line on stderr and exit code 2.
+missing, unreadable or unwritable file (any ``OSError``), refused overwrite,
+undecodable or too deeply nested input, and as a last resort a
+``MemoryError``, becomes one line of at most about 300 characters on stderr
+and exit code 2 -- never a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import sys
 import time
@@ -47,7 +51,10 @@ def progress(message: str) -> None:
 
 
 def _demo(args) -> int:
+    from .io.files import check_writable
     from .report import write_report
+
+    check_writable(args.output, args.force, what="folder")  # before minutes of simulation
 
     sections = []
     t0 = time.perf_counter()
@@ -89,6 +96,45 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: library wording for "replace it" -> the command line's
+_API_HINTS = (("pass overwrite=True (CLI: --force)", "use --force"), ("pass force=True (CLI: --force)", "use --force"),
+              ("pass overwrite=True", "use --force"), ("overwrite=True", "--force"), ("force=True", "--force"))
+
+
+def error_message(exc: BaseException) -> str:
+    """The one line (at most about 300 characters) the command line prints for ``exc``.
+
+    :class:`~clutchlab.errors.ClutchlabError` messages are printed as they
+    are (they name file, field and value); operating-system errors name the
+    path and the reason; the library's ``overwrite=True`` becomes ``--force``.
+    """
+    from ._limits import one_line
+
+    if isinstance(exc, FileExistsError) and hasattr(exc, "cli_message"):
+        msg = exc.cli_message
+    elif isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        reason = exc.strerror
+        if exc.errno == errno.ENOSPC:
+            reason = "no space left on the device"
+        elif exc.errno == errno.EROFS:
+            reason = "read-only file system"
+        elif isinstance(exc, FileExistsError):
+            reason = "exists; use --force to replace it"
+        msg = f"{exc.filename}: {reason}"
+    elif isinstance(exc, UnicodeDecodeError):
+        msg = f"input is not UTF-8 text (byte {exc.object[exc.start:exc.start + 1]!r} at offset {exc.start})"
+    elif isinstance(exc, RecursionError):
+        msg = "input nested too deeply to read"
+    elif isinstance(exc, MemoryError):
+        msg = ("out of memory: the requested size is too large for this machine "
+               "(reduce the number of points, the duration or the rate)")
+    else:
+        msg = str(exc) or type(exc).__name__
+    for api, cli in _API_HINTS:
+        msg = msg.replace(api, cli)
+    return one_line(msg, 300)
+
+
 def main(argv=None) -> int:
     """Entry point of the ``clutchlab`` command."""
     parser = build_parser()
@@ -98,9 +144,9 @@ def main(argv=None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except (ClutchlabError, FileExistsError, FileNotFoundError, PermissionError, IsADirectoryError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"clutchlab: error: {msg}", file=sys.stderr)
+    except (ClutchlabError, OSError, UnicodeDecodeError, RecursionError, MemoryError) as exc:
+        # OSError: read-only or full disk, a parent that is a file, a refused overwrite (FileExistsError)
+        print(f"clutchlab: error: {error_message(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("clutchlab: interrupted", file=sys.stderr)

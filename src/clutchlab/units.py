@@ -15,6 +15,7 @@ from numbers import Real
 
 import numpy as np
 
+from ._limits import short_repr
 from .errors import ParameterError
 
 __all__ = [
@@ -236,7 +237,7 @@ def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -
     """
     where = f"{source}: " if source else ""
     if isinstance(value, bool):
-        raise ParameterError(f"{where}{name} = {value!r}: expected a number or a quantity string")
+        raise ParameterError(f"{where}{name} = {short_repr(value)}: expected a number or a quantity string")
     if isinstance(value, Real):
         out = float(value)
     elif isinstance(value, str):
@@ -249,19 +250,19 @@ def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -
                 raise ValueError("expected '<number> <unit>'")
             q = ureg.Quantity(float(m.group(1)), m.group(2).strip() or "dimensionless")
         except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError, TypeError, AttributeError) as exc:
-            raise ParameterError(f"{where}{name} = {value!r}: cannot parse quantity ({exc})") from None
+            raise ParameterError(f"{where}{name} = {short_repr(value)}: cannot parse quantity ({exc})") from None
         except Exception as exc:  # pint raises assorted tokenizer errors
-            raise ParameterError(f"{where}{name} = {value!r}: cannot parse quantity ({exc})") from None
+            raise ParameterError(f"{where}{name} = {short_repr(value)}: cannot parse quantity ({exc})") from None
         try:
             out = float(q.to(unit).magnitude)
         except pint.errors.DimensionalityError:
             raise ParameterError(
-                f"{where}{name} = {value!r}: wrong unit, expected a quantity convertible to {unit!r}"
+                f"{where}{name} = {short_repr(value)}: wrong unit, expected a quantity convertible to {unit!r}"
             ) from None
     else:
-        raise ParameterError(f"{where}{name} = {value!r}: expected a number or a quantity string")
+        raise ParameterError(f"{where}{name} = {short_repr(value)}: expected a number or a quantity string")
     if not math.isfinite(out):
-        raise ParameterError(f"{where}{name} = {value!r}: not a finite number")
+        raise ParameterError(f"{where}{name} = {short_repr(value)}: not a finite number")
     return out
 
 

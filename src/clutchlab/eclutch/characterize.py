@@ -40,6 +40,7 @@ import numpy as np
 import pandas as pd
 
 from ..curves import Curve, series
+from .._limits import check_allocation
 from ..errors import DataError, IdentificationError, ParameterError
 from ..io import Measurement, read_measurement
 
@@ -439,6 +440,8 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
     if isinstance(min_cycles, bool) or not isinstance(min_cycles, (int, np.integer)) or min_cycles < 1:
         raise ParameterError(f"min_cycles = {min_cycles!r} must be an integer >= 1")
     frame, label = _load_record(record, [channel], None, channel_map)
+    # kernel weights of the local linear regression: n_grid x samples of a branch, a few temporaries
+    check_allocation(n_grid, 6 * len(frame), f"n_grid = {n_grid} points for {label} ({len(frame)} samples)")
     cyc = _cycles(frame, label, channel, ["force_N"], int(n_grid))
     n_cycles = cyc.loading.shape[0]
     if n_cycles < min_cycles:

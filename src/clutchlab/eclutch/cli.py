@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import numpy as np
 
+from .._limits import check_allocation
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
+from ..io.files import check_outputs
 from ..units import to_si
 
 
@@ -42,11 +45,7 @@ def _characterize(args) -> int:
     from ..plotting import mark_synthetic, press_characterization
     from .characterize import characterize
 
-    from pathlib import Path
-
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     # one read: the channel map (if any) renames the logger's channels, units in the file become SI
     try:
         meas = read_measurement(args.record, args.channel_map, required=["time_s", "force_N", args.channel],
@@ -75,15 +74,15 @@ def _characterize(args) -> int:
 def _static(args) -> int:
     from ..plotting import static_curves_panels
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     travel = to_si(args.travel, "m", name="--travel")
     if not travel > 0:
         raise ParameterError(f"--travel = {args.travel!r}: must be > 0")
     if args.points < 2:
         raise ParameterError(f"--points = {args.points}: need at least 2")
     model = _model(args)
+    # node positions, element forces and deflections at every point
+    check_allocation(args.points, 3 * len(model.network.elements) + 8, f"--points {args.points}")
     df = model.static_curve(np.linspace(0.0, travel, args.points))
     atomic_to_csv(df, args.output, overwrite=args.force,
                   header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static")
@@ -105,6 +104,7 @@ def _validate(args) -> int:
     from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
     from .validation import compare, read_full_clutch_record
 
+    check_outputs([args.output], args.force)
     record = read_full_clutch_record(args.record, name=str(args.record))
     params = EClutchParameters.from_toml(args.params) if args.params else EClutchParameters()
     rows = [{"model": n, **compare(ClutchModel.preset(n, params), record)} for n in MODEL_NUMBERS]
@@ -118,6 +118,7 @@ def _validate(args) -> int:
 def _lever(args) -> int:
     from .characterize import lever_stiffness
 
+    check_outputs([args.output], args.force)
     result = lever_stiffness(args.record_b, args.record_c, args.ratio, reference=args.reference)
     print(result.report())
     if args.output:
@@ -132,9 +133,7 @@ def _simulate(args) -> int:
     from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
     from .scenario import load_scenario, run_scenario
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     scenario = load_scenario(args.scenario)
     from ..cli import progress
 

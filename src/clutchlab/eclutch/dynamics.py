@@ -46,6 +46,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from .._limits import check_allocation
 from ..errors import ParameterError, SimulationError
 from ..params import ParameterSet, quantity
 from . import _dynamics_kernel as K
@@ -612,6 +613,10 @@ class _System:
             u0=0.0, jac_every=1, atol_scale=1.0):
         if not (np.isfinite(atol_scale) and atol_scale > 0):
             raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
+        rows, what = ((t_grid.shape[0], f"t_end = {t_end!r} s at output_step = {t_grid[1] - t_grid[0]!r} s")
+                      if t_grid.shape[0] > 1 else (int(max_steps) + 1, f"max_steps = {max_steps!r} recorded steps"))
+        # the kernel's records (time, states, auxiliaries, modes), then the outputs computed from them
+        check_allocation(rows, 2 * (1 + self.n + K.N_AUX_FIXED + 2 * self.nz), what)
         if y0 is None:
             y0, modes0 = self.initial_state(u0)
         breaks = np.unique(tin[(tin > 0) & (tin < t_end)])
@@ -781,6 +786,7 @@ def _grid(output_step, t_end):
         return np.empty(0)
     if not (np.isfinite(output_step) and 0 < output_step <= t_end):
         raise ParameterError(f"output_step = {output_step!r} s must be in (0, t_end]")
+    check_allocation(t_end / output_step + 1, 1, f"output_step = {output_step!r} s over t_end = {t_end!r} s")
     n = int(np.floor(t_end / output_step + 1e-9)) + 1
     return np.arange(n) * output_step
 

@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..params import load_toml
 from ..units import to_si
@@ -107,7 +108,7 @@ class Scenario:
 
 def _number_list(raw, unit, where):
     if not isinstance(raw, list) or not raw:
-        raise ParameterError(f"{where} = {raw!r}: expected a non-empty list")
+        raise ParameterError(f"{where} = {short_repr(raw)}: expected a non-empty list")
     return np.array([to_si(v, unit, name=f"{where}[{i}]") for i, v in enumerate(raw)], dtype=float)
 
 
@@ -136,15 +137,18 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
     data = {k: v for k, v in data.items() if not k.startswith("_")}
     unknown = [k for k in data if k not in _TABLES]
     if unknown:
-        raise ParameterError(f"{src}: unknown table [{unknown[0]}] (known: {', '.join(_TABLES)})")
+        raise ParameterError(f"{src}: unknown table [{short_repr(unknown[0])}] (known: {', '.join(_TABLES)})")
+    for name, table in data.items():
+        if not isinstance(table, dict):
+            raise ParameterError(f"{src}: {name} = {short_repr(table)}: expected a table [{name}]")
     sc = dict(data.get("scenario", {}))
     known = {"model", "t_end", "output_step", "rtol", "friction"}
     for k in sc:
         if k not in known:
-            raise ParameterError(f"{src}: [scenario] unknown key {k!r} (known: {', '.join(sorted(known))})")
+            raise ParameterError(f"{src}: [scenario] unknown key {short_repr(k)} (known: {', '.join(sorted(known))})")
     model = sc.get("model", 4)
     if isinstance(model, bool) or not isinstance(model, int) or model not in MODEL_NUMBERS:
-        raise ParameterError(f"{src}: [scenario] model = {model!r}: expected one of 0, 1, 2, 3, 4")
+        raise ParameterError(f"{src}: [scenario] model = {short_repr(model)}: expected one of 0, 1, 2, 3, 4")
     t_end = to_si(sc.get("t_end", 1.0), "s", name="[scenario] t_end", source=src)
     if t_end <= 0:
         raise ParameterError(f"{src}: [scenario] t_end = {sc.get('t_end')!r} must be > 0")
@@ -153,20 +157,25 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
         output_step = to_si(sc["output_step"], "s", name="[scenario] output_step", source=src)
         if not 0 < output_step <= t_end:
             raise ParameterError(f"{src}: [scenario] output_step = {sc['output_step']!r} must be in (0, t_end]")
+        check_allocation(t_end / output_step + 1, 1, f"{src}: [scenario] t_end = {short_repr(sc.get('t_end'))} "
+                                                     f"at output_step = {short_repr(sc['output_step'])}")
     rtol = to_si(sc.get("rtol", 1e-3), "1", name="[scenario] rtol", source=src)
     use_friction = sc.get("friction", True)
     if not isinstance(use_friction, bool):
-        raise ParameterError(f"{src}: [scenario] friction = {use_friction!r}: expected true or false")
+        raise ParameterError(f"{src}: [scenario] friction = {short_repr(use_friction)}: expected true or false")
     inp = dict(data.get("input", {}))
     kind = inp.pop("kind", "pedal")
-    if kind not in INPUT_KINDS:
-        raise ParameterError(f"{src}: [input] kind = {kind!r}: expected one of {', '.join(INPUT_KINDS)}")
+    if not isinstance(kind, str) or kind not in INPUT_KINDS:
+        raise ParameterError(f"{src}: [input] kind = {short_repr(kind)}: expected one of {', '.join(INPUT_KINDS)}")
     release_travel = to_si(inp.pop("release_travel", 8e-3), "m", name="[input] release_travel", source=src)
     if "file" in inp:
         from ..io import read_table
 
-        f = Path(src).parent / inp.pop("file")
-        frame = read_table(f, ["time_s", "value"])
+        name = inp.pop("file")
+        if not isinstance(name, str) or not name.strip():
+            raise ParameterError(f"{src}: [input] file = {short_repr(name)}: expected the path of a CSV file")
+        f = Path(src).parent / name
+        frame = read_table(f, ["time_s", "value"], name=f"{src}: [input] file {str(f)!r}")
         t = frame["time_s"].to_numpy(float)
         v = frame["value"].to_numpy(float)
     else:
@@ -178,7 +187,7 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
         except ParameterError as exc:
             raise ParameterError(f"{src}: {exc}") from None
     if inp:
-        raise ParameterError(f"{src}: [input] unknown key {next(iter(inp))!r}")
+        raise ParameterError(f"{src}: [input] unknown key {short_repr(next(iter(inp)))}")
     if t.size != v.size:
         raise ParameterError(f"{src}: [input] time_s has {t.size} values but value has {v.size}")
     if t.size > 1 and np.any(np.diff(t) <= 0):
@@ -188,7 +197,8 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
     wear = to_si(offsets.pop("wear", 0.0), "m", name="[offsets] wear", source=src)
     rise = to_si(offsets.pop("temperature_rise", 0.0), "K", name="[offsets] temperature_rise", source=src)
     if offsets:
-        raise ParameterError(f"{src}: [offsets] unknown key {next(iter(offsets))!r} (known: wear, temperature_rise)")
+        raise ParameterError(f"{src}: [offsets] unknown key {short_repr(next(iter(offsets)))} "
+                             "(known: wear, temperature_rise)")
     if wear < 0:
         raise ParameterError(f"{src}: [offsets] wear = {wear!r} m must be >= 0")
     clutch = EClutchParameters.from_dict(data.get("eclutch", {}), source=src)

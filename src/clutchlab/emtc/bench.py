@@ -25,6 +25,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from .._limits import check_allocation, short_repr
 from ..errors import ParameterError, SimulationError
 from ..params import ParameterSet, quantity
 from ..params.base import load_toml
@@ -450,6 +451,9 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
         atol = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
     else:
         atol = np.broadcast_to(np.asarray(atol, float), (7,)).copy()
+    # output rows plus the event buffer (20 events of 4 values per output row)
+    check_allocation(scenario.duration / scenario.sample_time + 1, BK.N_OUT + 80,
+                     f"duration = {scenario.duration!r} s at sample_time = {scenario.sample_time!r} s")
     n = int(round(scenario.duration / scenario.sample_time)) + 1
     cap = 64
     while True:
@@ -493,7 +497,7 @@ def load_scenario(path):
     known = {"scenario", "vehicle", "actuator", "coupling", "magnet"}
     unknown = set(data) - known
     if unknown:
-        raise ParameterError(f"{path}: unknown table(s) {sorted(unknown)} (known: {sorted(known)})")
+        raise ParameterError(f"{path}: unknown table(s) {short_repr(sorted(unknown))} (known: {sorted(known)})")
     out = {
         "scenario": BenchScenario.from_dict(data.get("scenario", {}), source=str(path)),
         "vehicle": VehicleParameters.from_dict(data.get("vehicle", {}), source=str(path)),
@@ -504,6 +508,9 @@ def load_scenario(path):
     mag = data.get("magnet", {})
     if mag:
         if not isinstance(mag, dict) or set(mag) - {"model"}:
-            raise ParameterError(f"{path}: [magnet] takes only model = 'path/to/model.json'")
+            raise ParameterError(f"{path}: [magnet] takes only model = 'path/to/model.json', got {short_repr(mag)}")
+        if not isinstance(mag.get("model"), str) or not mag["model"].strip():
+            raise ParameterError(f"{path}: [magnet] model = {short_repr(mag.get('model'))}: expected the path of "
+                                 "a Preisach model JSON file")
         out["magnet"] = (Path(path).parent / mag["model"]).resolve()
     return out

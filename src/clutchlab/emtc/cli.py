@@ -6,23 +6,27 @@ from pathlib import Path
 
 import numpy as np
 
+from .._limits import short_repr
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
+from ..io.files import check_outputs
 
 
 def _identify(args) -> int:
     from ..hysteresis import identify_forc_family
 
     check_writable(args.output, args.force)
-    frame = read_measurement(args.forc, required=["current", "force"], time=None, name=str(args.forc)).frame
-    if "airgap" in frame.columns:
-        frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
     grid = None
     if args.grid:
         try:
             grid = np.array([float(v) for v in args.grid.split(",")])
         except ValueError:
-            raise DataError(f"--grid {args.grid!r}: expected comma-separated currents in A") from None
+            grid = None
+        if grid is None or not np.all(np.isfinite(grid)):
+            raise DataError(f"--grid {short_repr(args.grid)}: expected comma-separated finite currents in A")
+    frame = read_measurement(args.forc, required=["current", "force"], time=None, name=str(args.forc)).frame
+    if "airgap" in frame.columns:
+        frame = read_table(frame, ["current", "force", "airgap"], name=str(args.forc))
     model, results = identify_forc_family(frame, grid=grid, name=str(args.forc))
     model.to_json(args.output, overwrite=args.force)
     for gap, res in results:
@@ -65,9 +69,7 @@ def _simulate(args) -> int:
     from .bench import load_scenario, simulate_bench
     from .magnet import bundled_magnet
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     sc = load_scenario(args.scenario)
     magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
     res = simulate_bench(magnet, sc["scenario"], vehicle=sc["vehicle"], actuator=sc["actuator"], coupling=sc["coupling"])

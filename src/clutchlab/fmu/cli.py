@@ -10,7 +10,10 @@ from . import COSIMULATIONS
 def _export(args) -> int:
     from .export import export_fmu
 
+    from ..io.files import check_writable
+
     output = args.output if args.output is not None else Path(f"{args.model}.fmu")
+    check_writable(output, args.force)  # before the build
     path = export_fmu(args.model, output, overwrite=args.force)
     print(path)
     return 0

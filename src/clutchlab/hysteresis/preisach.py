@@ -519,18 +519,17 @@ class Preisach:
     @classmethod
     def from_json(cls, path) -> "Preisach":
         """Load a model written by :meth:`to_json`."""
+        from .._limits import check_allocation
+        from ..io.files import read_json
+
         path = Path(path)
-        if not path.exists():
-            raise DataError(f"{path}: no such model file")
-        try:
-            body = json.loads(path.read_text())
-        except json.JSONDecodeError as exc:
-            raise DataError(f"{path}: not valid JSON ({exc})") from None
+        body = read_json(path, DataError)
         if not isinstance(body, dict) or body.get("kind") != "clutchlab.preisach":
             raise DataError(f"{path}: not a clutchlab Preisach model (missing kind='clutchlab.preisach')")
         try:
             grid = np.asarray(body["grid_A"], dtype=float)
             n = grid.size
+            check_allocation(n, n * (1 + len(body["tables_N"])), f"{path}: grid_A of {n} currents")
             i, j = np.tril_indices(n)
             tabs = []
             for vals in body["tables_N"]:

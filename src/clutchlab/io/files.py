@@ -1,33 +1,174 @@
-"""Atomic writes and validated table reading.
+"""Atomic writes, output checks and validated reading of tables, TOML and JSON.
 
-Nothing a user wrote is overwritten unless ``overwrite=True`` is given; every
-file is written to a temporary sibling and moved into place, so a crash never
-leaves half a file behind.
+Nothing a user wrote is overwritten unless ``overwrite=True`` is given (the
+CLI's ``--force``); every file is written to a hidden temporary sibling
+(``.NAME.PID.XXXXXXXX.tmp``) and moved into place, so a crash never leaves
+half a file behind, and the temporary file of a writer that was killed is
+removed by the next write of the same output.
 """
 
 from __future__ import annotations
 
+import errno
+import json
 import os
 import tempfile
+import tomllib
 from pathlib import Path
 from typing import Iterable
 
 import numpy as np
 import pandas as pd
 
-from ..errors import DataError
+from .._limits import check_allocation, format_bytes, short_repr
+from ..errors import DataError, ParameterError
 
-__all__ = ["check_writable", "atomic_write_text", "atomic_write_bytes", "atomic_to_csv", "read_table"]
+__all__ = ["OutputExistsError", "check_writable", "check_outputs", "atomic_write_text", "atomic_write_bytes",
+           "atomic_to_csv", "read_table", "read_toml", "read_json", "temporary_sibling", "remove_stale_temporaries"]
+
+#: a text document (TOML, JSON) larger than this many times the memory budget is refused unread
+_DOCUMENT_EXPANSION = 20
 
 
-def check_writable(path, overwrite: bool = False) -> Path:
-    """Return ``Path(path)`` or raise if it exists and ``overwrite`` is false."""
+class OutputExistsError(FileExistsError):
+    """An output exists and replacing it was not asked for (``overwrite=True``, CLI ``--force``).
+
+    ``str()`` gives the library wording (``pass overwrite=True``); the command
+    line prints :attr:`cli_message` (``use --force``).
+    """
+
+    def __init__(self, path, what: str = "file"):
+        super().__init__(errno.EEXIST, f"{what} exists", str(path))
+        self.what = what
+
+    def __str__(self) -> str:
+        return f"{self.filename}: {self.what} exists; pass overwrite=True to replace it"
+
+    @property
+    def cli_message(self) -> str:
+        """The message for the command line: ``PATH: file exists; use --force to replace it``."""
+        return f"{self.filename}: {self.what} exists; use --force to replace it"
+
+
+def _check_parent(path: Path) -> None:
+    """Raise if the folder of ``path`` cannot be created or written to (no side effects)."""
+    parent = path.parent
+    probe = parent
+    while not probe.exists():
+        if probe.is_symlink():  # a dangling link
+            raise NotADirectoryError(errno.ENOTDIR, "is a broken link, not a folder", str(probe))
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "is a file, not a folder; cannot write inside it", str(probe))
+    if probe.exists() and not os.access(probe, os.W_OK | os.X_OK):
+        raise PermissionError(errno.EACCES, "folder is not writable", str(probe))
+
+
+def check_writable(path, overwrite: bool = False, *, what: str = "file") -> Path:
+    """Check that ``path`` can be written, without creating anything.
+
+    Parameters
+    ----------
+    path : str or Path
+        Output to write.
+    overwrite : bool
+        Whether an existing output may be replaced.
+    what : str
+        What the output is, for messages (``"file"``, ``"folder"``).
+
+    Returns
+    -------
+    Path
+        ``Path(path)``.
+
+    Raises
+    ------
+    OutputExistsError
+        ``path`` exists and ``overwrite`` is false.
+    IsADirectoryError
+        ``path`` is a folder but a file is to be written.
+    NotADirectoryError, PermissionError
+        A parent of ``path`` is a file, or its folder is not writable.
+    """
     path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+    if what == "file" and path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a folder; give a file name", str(path))
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise OutputExistsError(path, what)
+    _check_parent(path)
     return path
+
+
+def check_outputs(paths, overwrite: bool = False) -> list[Path]:
+    """:func:`check_writable` for every output of a command (``None`` entries skipped), before any work."""
+    checked = [check_writable(p, overwrite) for p in paths if p is not None]
+    seen = {}
+    for p in checked:
+        key = os.path.abspath(p)
+        if key in seen:
+            raise ParameterError(f"{p}: given twice as an output")
+        seen[key] = p
+    return checked
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    except (OverflowError, ValueError, OSError):  # not a valid process id
+        return False
+    return True
+
+
+def remove_stale_temporaries(path) -> list[Path]:
+    """Remove hidden temporary siblings of ``path`` left by a writer that no longer runs.
+
+    A writer's temporary file is ``.NAME.PID.XXXXXXXX.tmp`` (or ``.mf4``); it
+    is stale if process ``PID`` is gone (killed before it could rename or
+    remove the file).  Temporary files of running writers are left alone.
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    path = Path(path)
+    removed = []
+    prefix = f".{path.name}."
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        name = entry.name
+        if not (name.startswith(prefix) and name.endswith((".tmp", ".mf4"))):
+            continue
+        pid_text = name[len(prefix):].split(".", 1)[0]
+        if pid_text.isdigit() and _pid_alive(int(pid_text)):
+            continue
+        try:
+            if entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:
+            pass
+    return removed
+
+
+def temporary_sibling(path: Path, suffix: str = ".tmp") -> tuple[int, str]:
+    """Create a hidden temporary file beside ``path`` (``.NAME.PID.XXXXXXXX<suffix>``).
+
+    Stale temporary files of ``path`` are removed first and the folder is
+    created if missing.  Returns ``(fd, name)`` like :func:`tempfile.mkstemp`.
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
+    return tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=suffix, dir=path.parent)
 
 
 def atomic_write_bytes(path, data: bytes, overwrite: bool = False) -> Path:
@@ -36,19 +177,21 @@ def atomic_write_bytes(path, data: bytes, overwrite: bool = False) -> Path:
     Refuses to replace an existing file unless ``overwrite`` is true.
     """
     path = check_writable(path, overwrite)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
+    fd, tmp = temporary_sibling(path)
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename != str(path):  # disk full, read-only: name the output
+            raise type(exc)(exc.errno, exc.strerror or str(exc), str(path)) from None
         raise
     return path
 
@@ -113,3 +256,56 @@ def read_table(source, required: Iterable[str], *, name: str | None = None, allo
             raise DataError(f"{label}: column {col!r} has a non-finite or non-numeric value {frame[col].iloc[row]!r} at row {row}")
         frame[col] = values.astype(float)
     return frame
+
+
+def _read_document(path, kind: str, parse, error) -> object:
+    """Read a UTF-8 text document and parse it; every way it can be bad becomes ``error`` naming the file."""
+    path = Path(path)
+    if not path.exists():
+        raise error(f"{path}: no such {kind} file")
+    if path.is_dir():
+        raise error(f"{path}: is a folder, not a {kind} file")
+    try:
+        size = path.stat().st_size
+        check_allocation(size, _DOCUMENT_EXPANSION / 8, f"{path}: {kind} file of {format_bytes(size)}")
+        raw = path.read_bytes()
+    except PermissionError:
+        raise error(f"{path}: cannot read the {kind} file (permission denied)") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {kind} file ({exc.strerror or type(exc).__name__})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not a UTF-8 text file (byte {raw[exc.start:exc.start + 1]!r} at offset {exc.start}); "
+                    f"save it as UTF-8") from None
+    try:
+        return parse(text)
+    except RecursionError:
+        raise error(f"{path}: {kind} nested too deeply to read") from None
+    except (ValueError, TypeError) as exc:  # TOMLDecodeError and JSONDecodeError are ValueErrors
+        msg = " ".join(str(exc).split())
+        raise error(f"{path}: not valid {kind} ({short_repr(msg, 160)})") from None
+
+
+def read_toml(path, error=ParameterError) -> dict:
+    """Read the TOML file at ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        TOML file (UTF-8).
+    error : type
+        Exception class to raise (a :class:`~clutchlab.errors.ClutchlabError`).
+
+    Raises
+    ------
+    ParameterError (or ``error``)
+        Missing or unreadable file, not UTF-8, not valid TOML, nested too
+        deeply, or larger than the memory budget allows -- naming the file.
+    """
+    return _read_document(path, "TOML", tomllib.loads, error)
+
+
+def read_json(path, error=DataError):
+    """Read the JSON file at ``path`` (see :func:`read_toml` for the errors; default :class:`DataError`)."""
+    return _read_document(path, "JSON", json.loads, error)

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from .files import check_writable
+from .files import check_writable, temporary_sibling
 
 __all__ = ["MDF_SUFFIXES", "UNFINALISED_ID", "RawChannel", "ChannelPlace", "MdfReader", "write_mdf"]
 
@@ -450,7 +450,7 @@ def write_mdf(path, time: np.ndarray, channels: dict[str, np.ndarray], units: di
     if signals:
         mdf.append(signals, comment="clutchlab")
     mdf.header.comment = comment
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".mf4", dir=path.parent)
+    fd, tmp = temporary_sibling(path, ".mf4")
     os.close(fd)
     try:
         written = Path(mdf.save(tmp, overwrite=True))
@@ -459,8 +459,10 @@ def write_mdf(path, time: np.ndarray, channels: dict[str, np.ndarray], units: di
         os.umask(umask)
         os.chmod(written, 0o666 & ~umask)
         os.replace(written, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename != str(path):  # disk full, read-only: name the output
+            raise type(exc)(exc.errno, exc.strerror or str(exc), str(path)) from None
         raise
     return path

@@ -33,6 +33,7 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from .._limits import check_allocation, short_repr
 from ..errors import DataError, ParameterError
 from ..units import normalise_unit
 from .channels import INTERPOLATIONS, ChannelMap, ChannelSpec, canonical_unit, unit_conversion
@@ -54,6 +55,8 @@ CSV_SUFFIXES = (".csv", ".txt")
 PARQUET_SUFFIXES = (".parquet", ".pq")
 _UNITS_PREFIX = "units:"
 _PARQUET_KEY = b"clutchlab"
+#: largest magnitude a channel may have in its unit; beyond it the file is taken to be corrupted
+PLAUSIBLE_MAGNITUDE = 1e15
 
 
 @dataclass(frozen=True)
@@ -245,6 +248,8 @@ def _parse_units_line(text: str, label: str) -> dict[str, str]:
 
 def _read_csv(path: Path, label: str) -> _TableReader:
     comments, units = [], {}
+    size = path.stat().st_size
+    check_allocation(size, 2 / 8, f"{label}: CSV file of {size} bytes")  # parsed floats ~ twice the text
     try:
         with open(path, encoding="utf-8") as fh:
             for line in fh:
@@ -269,9 +274,18 @@ def _read_parquet(path: Path, label: str) -> _TableReader:
     import pyarrow.parquet as pq
 
     try:
-        table = pq.read_table(path)
-    except Exception as exc:  # ArrowInvalid, OSError on truncated files
-        raise DataError(f"{label}: not a readable Parquet file ({type(exc).__name__}: {exc})") from None
+        meta = pq.read_metadata(path)
+        check_allocation(meta.num_rows, max(meta.num_columns, 1), f"{label}: Parquet file of {meta.num_rows} rows")
+        # page checksums (written by write_measurement) catch corrupted data pages that still decode
+        table = pq.read_table(path, page_checksum_verification=True)
+    except ParameterError as exc:
+        raise DataError(str(exc)) from None
+    except Exception as exc:  # ArrowInvalid, OSError on truncated or corrupted files
+        text = " ".join(str(exc).split())
+        if "checksum" in text.lower():
+            raise DataError(f"{label}: corrupted Parquet file (a data page fails its checksum)") from None
+        raise DataError(f"{label}: not a readable Parquet file ({type(exc).__name__}: {short_repr(text, 160)})") \
+            from None
     meta = table.schema.metadata or {}
     units, comments = {}, []
     if _PARQUET_KEY in meta:
@@ -315,6 +329,25 @@ def _open(source, name: str | None):
 
 
 # ---------------------------------------------------------------- checks and resampling
+
+def _check_plausible(values: np.ndarray, unit: str, label: str, what: str, sample_word: str = "sample") -> None:
+    """Reject values no sensor produces: magnitude above :data:`PLAUSIBLE_MAGNITUDE`, temperature below 0 K."""
+    big = np.abs(values) > PLAUSIBLE_MAGNITUDE
+    if big.any():
+        k = int(np.flatnonzero(big)[0])
+        raise DataError(f"{label}: {what} has an implausible value {float(values[k])!r} {unit} at {sample_word} {k} "
+                        f"(magnitude above {PLAUSIBLE_MAGNITUDE:g}; corrupted file?)")
+    if values.size and unit:
+        try:
+            scale, offset = unit_conversion(unit, "K", name=what, where=label)
+        except DataError:
+            return  # not a temperature
+        cold = values * scale + offset < -1e-9
+        if cold.any():
+            k = int(np.flatnonzero(cold)[0])
+            raise DataError(f"{label}: {what} has a temperature below absolute zero, {float(values[k])!r} {unit} "
+                            f"at {sample_word} {k}")
+
 
 def _check_time(t: np.ndarray, label: str, what: str, sample_word: str) -> None:
     bad = ~np.isfinite(t)
@@ -474,6 +507,7 @@ def _table_time(reader, time: str, time_spec: ChannelSpec | None) -> np.ndarray:
     scale, offset = unit_conversion(tunit, "s", name=tsrc, where=reader.label)
     t = traw.samples * scale + offset
     _check_time(t, reader.label, time if tsrc == time else f"{tsrc} (time)", "row")
+    _check_plausible(t, "s", reader.label, f"time column {tsrc!r}", "row")
     return t
 
 
@@ -538,6 +572,8 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
     is_mdf = isinstance(reader, MdfReader)
     if is_mdf and time is None:
         time = "time_s"  # an MDF file always has a time base
+    if isinstance(reader, _TableReader) and reader.path is not None and len(reader.frame) == 0:
+        raise DataError(f"{label}: no samples (the file has column names but no data rows)")
     skipped: dict[str, str] = {}
     if cmap is None:
         for r in required:
@@ -642,7 +678,12 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
                                   for s in used)
                 raise DataError(f"{label}: the channels share no common time span ({spans})")
             if rate is not None:
+                check_allocation((t_hi - t_lo) * rate + 1, len(used) + 1,
+                                 f"{label}: rate = {rate:g} Hz over {t_hi - t_lo:g} s")
                 n = int(np.floor((t_hi - t_lo) * rate * (1 + 1e-12))) + 1
+                if n < 2:
+                    raise ParameterError(f"{label}: rate = {rate:g} Hz gives a single sample over the "
+                                         f"{t_hi - t_lo:g} s of the record; need at least 2")
                 timeline = t_lo + np.arange(n) / rate
                 how = f"resampled at {rate:g} Hz over [{t_lo:g}, {t_hi:g}] s"
             else:
@@ -665,6 +706,9 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
     for spec in used:
         raw = raws[spec.name]
         src_unit, target_unit, scale, offset = conversions[spec.name]
+        grp = f" (group {raw.group})" if raw.group is not None else ""
+        _check_plausible(raw.samples * scale + offset if (scale != 1.0 or offset != 0.0) else raw.samples,
+                         target_unit, label, f"channel {spec.source!r}{grp}", "row" if raw.group is None else "sample")
         values = raw.samples
         method = None
         if resampled:
@@ -777,7 +821,7 @@ def write_measurement(data, path, *, units: Mapping[str, str] | None = None, com
         meta[_PARQUET_KEY] = json.dumps({"units": col_units, "comments": comments}).encode("utf-8")
         table = table.cast(pa.schema(fields, metadata=meta))
         buf = io.BytesIO()
-        pq.write_table(table, buf)
+        pq.write_table(table, buf, write_page_checksum=True)
         return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
     if suffix in MDF_SUFFIXES:
         if time is None or time not in frame.columns:

@@ -12,10 +12,10 @@ import dataclasses
 import difflib
 import math
 import re
-import tomllib
 from pathlib import Path
 from typing import Any, ClassVar
 
+from .._limits import short_repr
 from ..errors import ParameterError
 from ..units import format_quantity, to_si
 
@@ -76,7 +76,9 @@ def _check_number(cls_name, fname, value, meta, source):
 
 
 def show_value(raw) -> str:
-    """Format a value as it is written in a TOML file (``"83.15 mm"``, ``4``, ``[1, 2]``)."""
+    """Format a value as it is written in a TOML file (``"83.15 mm"``, ``4``, ``[1, 2]``), long ones shortened."""
+    if isinstance(raw, (list, tuple)) and len(raw) > 8 or isinstance(raw, str) and len(raw) > 80:
+        return short_repr(raw, 80)
     if isinstance(raw, str):
         return repr(raw)  # a TOML literal string when it has no quote inside
     if isinstance(raw, bool):
@@ -290,15 +292,13 @@ class ParameterSet:
 
 
 def load_toml(path) -> dict[str, Any]:
-    """Read the TOML file at ``path``, turning a missing file and syntax errors into :class:`ParameterError`."""
-    path = Path(path)
-    if not path.exists():
+    """Read the TOML file at ``path``; a missing, unreadable, non-UTF-8, invalid or too deeply nested file
+    raises :class:`ParameterError` naming it (:func:`clutchlab.io.files.read_toml`)."""
+    from ..io.files import read_toml
+
+    if not Path(path).exists():
         raise ParameterError(f"{path}: no such parameter file")
-    try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{path}: not valid TOML ({exc})") from None
+    return read_toml(path, ParameterError)
 
 
 def registered_sets() -> tuple[type, ...]:

@@ -19,8 +19,9 @@ def _log(message: str) -> None:
 
 def _sweep(args) -> int:
     from .runner import run_sweep
-    from .spec import load_spec
+    from .spec import check_scheduler, load_spec
 
+    check_scheduler(args.scheduler)
     spec = load_spec(args.spec)
     if args.list_parameters:
         info = spec.target.describe(spec.scenario)

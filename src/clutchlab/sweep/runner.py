@@ -59,7 +59,7 @@ import pandas as pd
 from .. import __version__
 from ..errors import ClutchlabError, DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, atomic_write_text
-from .spec import VARIANT_ID, SweepSpec, load_spec
+from .spec import VARIANT_ID, SweepSpec, check_scheduler, load_spec
 
 __all__ = ["run_sweep", "SweepResult", "compute_chunk", "chunk_path", "read_results", "summarize",
            "MANIFEST", "CHUNK_DIR", "PROVENANCE"]
@@ -215,14 +215,22 @@ def _exclusive(output: Path):
     except ImportError:  # pragma: no cover - not on POSIX: no lock
         yield
         return
-    fh = open(output / ".lock", "a+")
+    lock = output / ".lock"
+    fh = open(lock, "a+")
+    held = False
     try:
         try:
             fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            # a lock file removed by the previous holder after we opened it locks nothing: same inode?
+            held = lock.exists() and os.path.samestat(os.fstat(fh.fileno()), os.stat(lock))
         except OSError:
-            raise ClutchlabError(f"{output}: another sweep is running in this folder") from None
+            pass
+        if not held:
+            raise ClutchlabError(f"{output}: another sweep is running in this folder")
         yield
     finally:
+        if held:
+            lock.unlink(missing_ok=True)  # while still holding it: no .lock stays behind
         fh.close()
 
 
@@ -611,6 +619,7 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
         raise ParameterError(f"workers = {workers!r}: expected a whole number >= 1")
     if workers is not None and scheduler is not None:
         raise ParameterError("give either workers or scheduler, not both")
+    check_scheduler(scheduler)
     log = log or (lambda msg: None)
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)

@@ -25,6 +25,7 @@ import itertools
 import json
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,12 +33,13 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from .._limits import short_repr
 from ..errors import DataError, ParameterError
 from ..params import load_toml
 from ..units import to_si
 from .targets import Target, file_digest, files_in, resolve_target
 
-__all__ = ["SweepSpec", "load_spec", "DISTRIBUTIONS", "VARIANT_ID"]
+__all__ = ["SweepSpec", "load_spec", "check_scheduler", "DISTRIBUTIONS", "VARIANT_ID"]
 
 #: name of the variant-id column (and of the design's index)
 VARIANT_ID = "variant_id"
@@ -262,6 +264,37 @@ def _monte_carlo(table, params, seed, where):
         definition[key] = {"dist": dist, DISTRIBUTIONS[dist][0]: a, DISTRIBUTIONS[dist][1]: b}
     design = pd.DataFrame(columns)
     return design, units, {"monte_carlo": {"n": n, **definition}}
+
+
+#: Dask scheduler address: [protocol://]host:port
+_SCHEDULER = re.compile(r"^(?:(?:tcp|tls|ucx|ws|wss)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})/?$")
+
+
+def check_scheduler(scheduler):
+    """Check a Dask scheduler address before anything is written.
+
+    Parameters
+    ----------
+    scheduler : str, dask.distributed.Client or None
+        ``tcp://HOST:PORT`` (also ``tls://``, ``ucx://``, ``ws://``, ``wss://``
+        or a bare ``HOST:PORT``; port 1-65535), or a client (passed through).
+
+    Returns
+    -------
+    The argument, unchanged.
+
+    Raises
+    ------
+    ParameterError
+        Anything else, naming the value.
+    """
+    if scheduler is None or hasattr(scheduler, "submit"):
+        return scheduler
+    m = _SCHEDULER.match(scheduler) if isinstance(scheduler, str) else None
+    if m is None or not 0 < int(m.group(2)) < 65536:
+        raise ParameterError(f"--scheduler {short_repr(scheduler)}: expected a Dask scheduler address "
+                             "tcp://HOST:PORT (port 1-65535)")
+    return scheduler
 
 
 def load_spec(path) -> SweepSpec:

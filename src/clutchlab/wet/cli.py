@@ -87,15 +87,14 @@ def _simulate(args) -> int:
 
 def _identify(args) -> int:
     from ..errors import IdentificationError
-    from ..io import atomic_write_bytes, atomic_write_text, check_writable
+    from ..io import atomic_write_bytes, atomic_write_text
+    from ..io.files import check_outputs
     from .identify import friction_samples, identify_friction_map, identify_thermal
     from .params import WetClutch
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
-    if args.sensor_lag < 0:
-        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be >= 0 [s]")
+    check_outputs([args.output, args.plot], args.force)
+    if not args.sensor_lag >= 0 or args.sensor_lag == float("inf"):  # NaN fails the first test
+        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be a finite number >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
     fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
     data = fmap.to_dict()

@@ -52,6 +52,7 @@ import numba
 import numpy as np
 import pandas as pd
 
+from .._limits import check_allocation
 from ..errors import ParameterError, SimulationError
 from ..numerics.interp import bracket
 from ..numerics.dopri import (
@@ -808,6 +809,9 @@ def _sample_times(duration, sample_rate, sample_times):
         return ts
     if not (sample_rate > 0):
         raise ParameterError(f"sample_rate = {sample_rate!r}: must be > 0 [Hz]")
+    # the record: states, auxiliaries and the noisy bench channels, each about N_STATE + N_AUX values a sample
+    check_allocation(duration * sample_rate + 1, 2 * (N_STATE + N_AUX),
+                     f"duration = {duration!r} s at sample_rate = {sample_rate!r} Hz")
     n = int(math.floor(duration * sample_rate + 1e-9)) + 1
     return np.arange(n) / sample_rate
 

@@ -202,6 +202,8 @@ class FrictionMap:
     @classmethod
     def from_dict(cls, data: dict, source: str = "map") -> "FrictionMap":
         """Rebuild a map from :meth:`to_dict` output."""
+        if not isinstance(data, dict):
+            raise DataError(f"{source}: expected a friction map (a JSON object), got {type(data).__name__}")
         try:
             law = ParametricFriction.from_dict(data["law"], source=source) if data.get("law") else None
             return cls(data["speed_grid"], data["temperature_grid"], data["values"], data.get("force_grid"),
@@ -212,14 +214,9 @@ class FrictionMap:
     @classmethod
     def from_json(cls, path) -> "FrictionMap":
         """Read a map written by :meth:`to_json`."""
-        try:
-            with open(path, encoding="utf-8") as fh:
-                data = json.load(fh)
-        except FileNotFoundError:
-            raise DataError(f"{path}: no such file") from None
-        except json.JSONDecodeError as exc:
-            raise DataError(f"{path}: not valid JSON ({exc})") from None
-        return cls.from_dict(data, source=str(path))
+        from ..io.files import read_json
+
+        return cls.from_dict(read_json(path, DataError), source=str(path))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
