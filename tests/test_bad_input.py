@@ -3,7 +3,7 @@
 Every case runs the ``clutchlab`` command (in-process through
 :func:`clutchlab.cli.main`, a few in a subprocess to prove that no traceback
 reaches the terminal) and checks: exit code 2, exactly one stderr line
-``clutchlab: error: ...`` of at most ~300 characters naming the file, field
+``clutchlab: error: ...`` of at most 400 characters naming the file, field
 and value at fault, and no new file in the working folder (a refused command
 leaves nothing behind: no output, no hidden temporary file, no ``.lock``).
 """
@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 
 import clutchlab
 from clutchlab._limits import MEMORY_ENV, check_allocation, memory_budget, one_line, short_repr
-from clutchlab.cli import error_message, main
+from clutchlab.cli import MESSAGE_LIMIT, error_message, main
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.io import write_measurement
 from clutchlab.io.files import atomic_write_text, check_writable, read_json, read_toml, remove_stale_temporaries
@@ -354,7 +354,7 @@ def test_short_repr_is_short(value):
 
 
 def test_error_message_truncates():
-    assert len(error_message(DataError("x" * 10_000_000))) <= 300
+    assert len(error_message(DataError("x" * 10_000_000))) <= MESSAGE_LIMIT <= 400
 
 
 # ----------------------------------------------------------------------------- corrupted or absurd records

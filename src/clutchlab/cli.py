@@ -5,7 +5,7 @@ Each subsystem registers its own sub-command from ``clutchlab.<subsystem>.cli``
 with ``set_defaults(func=...)``).  Every :class:`~clutchlab.errors.ClutchlabError`,
 missing, unreadable or unwritable file (any ``OSError``), refused overwrite,
 undecodable or too deeply nested input, and as a last resort a
-``MemoryError``, becomes one line of at most about 300 characters on stderr
+``MemoryError``, becomes one line of at most 400 characters (``MESSAGE_LIMIT``) on stderr
 and exit code 2 -- never a traceback.
 """
 
@@ -33,6 +33,9 @@ SUBSYSTEM_CLIS = (
 )
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
 DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo")
+#: longest error line the CLI prints [characters]; longer messages lose their middle (file names stay whole
+#: at the start, the reason at the end)
+MESSAGE_LIMIT = 400
 
 
 def _optional_module(name: str):
@@ -102,7 +105,7 @@ _API_HINTS = (("pass overwrite=True (CLI: --force)", "use --force"), ("pass forc
 
 
 def error_message(exc: BaseException) -> str:
-    """The one line (at most about 300 characters) the command line prints for ``exc``.
+    """The one line (at most ``MESSAGE_LIMIT`` characters) the command line prints for ``exc``.
 
     :class:`~clutchlab.errors.ClutchlabError` messages are printed as they
     are (they name file, field and value); operating-system errors name the
@@ -132,7 +135,7 @@ def error_message(exc: BaseException) -> str:
         msg = str(exc) or type(exc).__name__
     for api, cli in _API_HINTS:
         msg = msg.replace(api, cli)
-    return one_line(msg, 300)
+    return one_line(msg, MESSAGE_LIMIT)
 
 
 def main(argv=None) -> int:

@@ -27,6 +27,7 @@ def test_plot_shows_the_record_with_units(tmp_path, monkeypatch):
         seen["labels"] = [ax.get_ylabel() for ax in fig.axes]
         seen["torque"] = fig.axes[1].lines[0].get_ydata()
         seen["record"] = record
+        seen["fig"] = fig
         return fig
 
     monkeypatch.setattr(plots, "map_traces_figure", spy)
@@ -34,3 +35,8 @@ def test_plot_shows_the_record_with_units(tmp_path, monkeypatch):
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
     assert "torque [N·m]" in seen["labels"] and "slip [rpm]" in seen["labels"] and "T [°C]" in seen["labels"]
     assert (seen["torque"] == seen["record"]["torque_Nm"].to_numpy()).all()
+    # the virtual bench is synthetic: the figure carries the stamp and the record its header lines
+    from clutchlab.plotting import is_marked_synthetic
+
+    assert is_marked_synthetic(seen["fig"])
+    assert (tmp_path / "r.csv").read_text().startswith("# synthetic:")

@@ -309,8 +309,8 @@ def resolve_target(model: str, source: str | None = None) -> Target:
         return _make(model, "registered", f"registered {model} ({_qualname(hooks['run_batch'])})", hooks)
     plugins = _entry_points(source).get(model, []) if ":" not in model else []
     if not plugins:
-        hint = ("; a spec names a target, never code: register it with clutchlab.sweep.register_target or "
-                f"install it as an entry point in the group {ENTRY_POINT_GROUP!r}") if ":" in model or "." in model else ""
+        hint = (f"; a spec names a target, never code (plugins: entry-point group {ENTRY_POINT_GROUP!r}, "
+                "docs/sweeps.md)") if ":" in model or "." in model else ""
         raise ParameterError(f"{where}[sweep] model = {model!r}: unknown model "
                              f"(available: {', '.join(available_targets(source))}){hint}")
     if len(plugins) > 1:

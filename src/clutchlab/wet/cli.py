@@ -60,22 +60,22 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
-    from ..io import check_writable
+    from ..io.files import check_outputs
     from .bench import load_protocol, run_protocol, write_bench_record
 
-    check_writable(args.output, args.force)
-    if args.plot:
-        check_writable(args.plot, args.force)
+    check_outputs([args.output, args.plot], args.force)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
     run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype)
     write_bench_record(run, args.output, overwrite=args.force)
     if args.plot:
         from ..io import atomic_write_bytes
+        from ..plotting import mark_synthetic
         from .plots import map_traces_figure
 
         fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
+        mark_synthetic(fig)  # the virtual bench's data are synthetic: the stamp travels with the image
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")
         import matplotlib.pyplot as plt
 
         plt.close(fig)
