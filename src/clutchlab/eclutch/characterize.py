@@ -62,6 +62,11 @@ REVERSAL_FRACTION = 0.05
 REVERSAL_SIGMAS = 8.0
 #: Smallest Savitzky-Golay window of a branch, as a fraction of the branch's samples.
 BRANCH_SMOOTHING = 0.05
+#: Radius of the tricube kernel of the local regression, in bandwidths (same standard deviation as a
+#: Gaussian of 0.95 bandwidth, hence the same smoothing and curvature bias as before).
+KERNEL_RADIUS = 2.5
+#: ... widened where needed to reach this many nearest samples.
+KERNEL_NEIGHBOURS = 5
 
 
 # ----------------------------------------------------------------------------- result
@@ -160,9 +165,22 @@ def _noise_sigma(x: np.ndarray) -> float:
 
 
 def _local_linear(x: np.ndarray, y: np.ndarray, grid: np.ndarray, bandwidth: float) -> np.ndarray:
-    """Local linear regression [2] of ``y(x)`` at ``grid`` with a Gaussian kernel; ``y`` may be 2-D (rows)."""
+    """Local linear regression [2] of ``y(x)`` at ``grid``; ``y`` may be 2-D (rows).
+
+    Tricube weights ``(1 - |d/h|^3)^3`` as in [2]: compact support, so a sample
+    farther than ``h`` from a grid point has no influence on it.  ``h`` is
+    ``KERNEL_RADIUS * bandwidth``, widened where needed to reach the
+    :data:`KERNEL_NEIGHBOURS` nearest samples (the nearest-neighbour span of [2]).
+    A Gaussian kernel, used before, let the sticking samples crowded at a
+    turning point leak into grid points several bandwidths away (about 1e-4 of
+    the friction force two grid steps inside the turning point).
+    """
     d = x[None, :] - grid[:, None]
-    w = np.exp(-0.5 * (d / bandwidth) ** 2)
+    ad = np.abs(d)
+    k = min(KERNEL_NEIGHBOURS, x.size) - 1
+    h = np.maximum(KERNEL_RADIUS * bandwidth, np.partition(ad, k, axis=1)[:, k] * (1.0 + 1e-9))
+    u = np.minimum(ad / h[:, None], 1.0)
+    w = (1.0 - u ** 3) ** 3
     s0 = w.sum(axis=1)
     s1 = (w * d).sum(axis=1)
     s2 = (w * d * d).sum(axis=1)
@@ -170,7 +188,7 @@ def _local_linear(x: np.ndarray, y: np.ndarray, grid: np.ndarray, bandwidth: flo
     t0 = w @ y.T  # (n_grid, n_quantities)
     t1 = (w * d) @ y.T
     den = s0 * s2 - s1 * s1
-    ok = den > 1e-12 * s0 * s0 * bandwidth * bandwidth
+    ok = den > 1e-12 * s0 * s0 * h * h
     with np.errstate(divide="ignore", invalid="ignore"):
         ll = (s2[:, None] * t0 - s1[:, None] * t1) / den[:, None]
         nw = t0 / s0[:, None]
@@ -400,8 +418,10 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
        the branch; a nearly noise-free displacement avoids the
        errors-in-variables flattening where the samples crowd at the turning
        points, and a common window keeps a linear law exactly linear), then
-       regressed locally linearly on the displacement grid (Gaussian kernel,
-       bandwidth half a grid step).  The grid ends are the smoothed
+       regressed locally linearly on the displacement grid (tricube kernel
+       of [2] with compact support, radius 2.5 bandwidths, bandwidth half a
+       grid step or more: a sticking zone at a turning point cannot leak
+       beyond it).  The grid ends are the smoothed
        displacements at the turning points.
     3. Per cycle, loading and unloading are averaged at equal displacement:
        the mean removes a friction force that is symmetric on both branches;
