@@ -65,8 +65,8 @@ def _identify(args) -> int:
     check_writable(args.output, args.force)
     if args.plot:
         check_writable(args.plot, args.force)
-    if args.sensor_lag < 0:
-        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be >= 0 [s]")
+    if not 0.0 <= args.sensor_lag < float("inf"):  # NaN fails too
+        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be finite and >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
     fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
     data = fmap.to_dict()
