@@ -351,6 +351,38 @@ def _correct_turning_points(load: np.ndarray, unload: np.ndarray, mean: np.ndarr
     return out
 
 
+def _check_sign_convention(load: np.ndarray, unload: np.ndarray, frame: pd.DataFrame, label: str,
+                           channel: str) -> None:
+    """Refuse a record whose force or displacement has the reversed sign.
+
+    Friction opposes the motion, so at equal deflection the loading force lies
+    above the unloading force: the hysteresis half-width is >= 0 for any
+    component.  A force that is negative over most of the record is negated
+    (the press pushes); with a positive force, a half-width clearly below zero
+    over the central part of the travel (median below minus twice its robust
+    scatter and 0.1 % of the force span) means the displacement is negated.
+    Refused, not corrected:
+    which channel to negate is the user's call, and a silently mirrored
+    characteristic would be worse than an error.
+    """
+    force = frame["force_N"].to_numpy(dtype=float)
+    if np.median(force) < 0:
+        raise DataError(
+            f"{label}: force_N is negative over most of the record (median {np.median(force):.4g} N): the press "
+            "pushes, so a press record has the compression force positive; negate the column and run again")
+    n_g = load.shape[1]
+    hw = 0.5 * (load - unload)[:, int(0.2 * n_g):int(np.ceil(0.8 * n_g))].mean(axis=0)
+    med = float(np.median(hw))
+    scatter = 1.4826 * float(np.median(np.abs(hw - med)))
+    span = float(np.ptp(0.5 * (load + unload)))
+    if not med < -max(2.0 * scatter, 1e-3 * span):
+        return
+    raise DataError(
+        f"{label}: the unloading force lies above the loading force (hysteresis half-width {med:.3g} N), "
+        f"which friction cannot do: the sign of {channel!r} looks reversed (a press record has compression "
+        f"force and deflection positive); negate that column and run again")
+
+
 # ------------------------------------------------------------------------ characterize
 def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, kind: str = "pchip",
                  min_cycles: int = 1, turning_point_correction: bool = True,
@@ -397,7 +429,9 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
     ------
     DataError
         Missing column, NaN, time not strictly increasing (naming the row),
-        fewer than :data:`MIN_SAMPLES` samples.
+        fewer than :data:`MIN_SAMPLES` samples; force or displacement of
+        reversed sign (the unloading branch above the loading branch, which
+        friction cannot produce; refused, not corrected).
     IdentificationError
         No loading or no unloading branch, fewer than ``min_cycles`` cycles.
 
@@ -457,6 +491,7 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         raise IdentificationError(f"{label}: {n_cycles} complete load cycle(s), min_cycles = {min_cycles}")
     load = cyc.loading[:, 0, :]
     unload = cyc.unloading[:, 0, :]
+    _check_sign_convention(load, unload, frame, label, channel)
     per_cycle = 0.5 * (load + unload)        # friction removed by averaging, [1] Section 4
     if turning_point_correction:
         per_cycle = _correct_turning_points(load, unload, per_cycle)
