@@ -3,7 +3,7 @@
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 from hypothesis_budget import examples
 
 import clutchlab
@@ -285,6 +285,7 @@ def test_operator_pause_mid_stroke_does_not_split_a_branch():
 @settings(max_examples=examples(15), deadline=None)
 @given(a=st.floats(5e4, 5e6), b_rel=st.floats(0.0, 3.0), travel=st.floats(0.5e-3, 10e-3),
        friction=st.floats(0.0, 60.0))
+@example(a=50000.0, b_rel=0.0, travel=0.0005, friction=50.0)  # sticking samples leaked through a Gaussian kernel
 def test_noise_free_quadratic_law_is_recovered(a, b_rel, travel, friction):
     b = b_rel * a / travel   # force = a s + b s^2, monotone
     law = lambda s: a * s + b * s * s  # noqa: E731

@@ -63,6 +63,11 @@ REVERSAL_FRACTION = 0.05
 REVERSAL_SIGMAS = 8.0
 #: Smallest Savitzky-Golay window of a branch, as a fraction of the branch's samples.
 BRANCH_SMOOTHING = 0.05
+#: Radius of the tricube kernel of the local regression, in bandwidths (same standard deviation as a
+#: Gaussian of 0.95 bandwidth, hence the same smoothing and curvature bias as before).
+KERNEL_RADIUS = 2.5
+#: ... widened where needed to reach this many nearest samples.
+KERNEL_NEIGHBOURS = 5
 
 
 # ----------------------------------------------------------------------------- result
@@ -161,9 +166,22 @@ def _noise_sigma(x: np.ndarray) -> float:
 
 
 def _local_linear(x: np.ndarray, y: np.ndarray, grid: np.ndarray, bandwidth: float) -> np.ndarray:
-    """Local linear regression [2] of ``y(x)`` at ``grid`` with a Gaussian kernel; ``y`` may be 2-D (rows)."""
+    """Local linear regression [2] of ``y(x)`` at ``grid``; ``y`` may be 2-D (rows).
+
+    Tricube weights ``(1 - |d/h|^3)^3`` as in [2]: compact support, so a sample
+    farther than ``h`` from a grid point has no influence on it.  ``h`` is
+    ``KERNEL_RADIUS * bandwidth``, widened where needed to reach the
+    :data:`KERNEL_NEIGHBOURS` nearest samples (the nearest-neighbour span of [2]).
+    A Gaussian kernel, used before, let the sticking samples crowded at a
+    turning point leak into grid points several bandwidths away (about 1e-4 of
+    the friction force two grid steps inside the turning point).
+    """
     d = x[None, :] - grid[:, None]
-    w = np.exp(-0.5 * (d / bandwidth) ** 2)
+    ad = np.abs(d)
+    k = min(KERNEL_NEIGHBOURS, x.size) - 1
+    h = np.maximum(KERNEL_RADIUS * bandwidth, np.partition(ad, k, axis=1)[:, k] * (1.0 + 1e-9))
+    u = np.minimum(ad / h[:, None], 1.0)
+    w = (1.0 - u ** 3) ** 3
     s0 = w.sum(axis=1)
     s1 = (w * d).sum(axis=1)
     s2 = (w * d * d).sum(axis=1)
@@ -171,7 +189,7 @@ def _local_linear(x: np.ndarray, y: np.ndarray, grid: np.ndarray, bandwidth: flo
     t0 = w @ y.T  # (n_grid, n_quantities)
     t1 = (w * d) @ y.T
     den = s0 * s2 - s1 * s1
-    ok = den > 1e-12 * s0 * s0 * bandwidth * bandwidth
+    ok = den > 1e-12 * s0 * s0 * h * h
     with np.errstate(divide="ignore", invalid="ignore"):
         ll = (s2[:, None] * t0 - s1[:, None] * t1) / den[:, None]
         nw = t0 / s0[:, None]
@@ -335,6 +353,38 @@ def _correct_turning_points(load: np.ndarray, unload: np.ndarray, mean: np.ndarr
     return out
 
 
+def _check_sign_convention(load: np.ndarray, unload: np.ndarray, frame: pd.DataFrame, label: str,
+                           channel: str) -> None:
+    """Refuse a record whose force or displacement has the reversed sign.
+
+    Friction opposes the motion, so at equal deflection the loading force lies
+    above the unloading force: the hysteresis half-width is >= 0 for any
+    component.  A force that is negative over most of the record is negated
+    (the press pushes); with a positive force, a half-width clearly below zero
+    over the central part of the travel (median below minus twice its robust
+    scatter and 0.1 % of the force span) means the displacement is negated.
+    Refused, not corrected:
+    which channel to negate is the user's call, and a silently mirrored
+    characteristic would be worse than an error.
+    """
+    force = frame["force_N"].to_numpy(dtype=float)
+    if np.median(force) < 0:
+        raise DataError(
+            f"{label}: force_N is negative over most of the record (median {np.median(force):.4g} N): the press "
+            "pushes, so a press record has the compression force positive; negate the column and run again")
+    n_g = load.shape[1]
+    hw = 0.5 * (load - unload)[:, int(0.2 * n_g):int(np.ceil(0.8 * n_g))].mean(axis=0)
+    med = float(np.median(hw))
+    scatter = 1.4826 * float(np.median(np.abs(hw - med)))
+    span = float(np.ptp(0.5 * (load + unload)))
+    if not med < -max(2.0 * scatter, 1e-3 * span):
+        return
+    raise DataError(
+        f"{label}: the unloading force lies above the loading force (hysteresis half-width {med:.3g} N), "
+        f"which friction cannot do: the sign of {channel!r} looks reversed (a press record has compression "
+        f"force and deflection positive); negate that column and run again")
+
+
 # ------------------------------------------------------------------------ characterize
 def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, kind: str = "pchip",
                  min_cycles: int = 1, turning_point_correction: bool = True,
@@ -388,7 +438,9 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
     ------
     DataError
         Missing column, NaN, time not strictly increasing (naming the row),
-        fewer than :data:`MIN_SAMPLES` samples.
+        fewer than :data:`MIN_SAMPLES` samples; force or displacement of
+        reversed sign (the unloading branch above the loading branch, which
+        friction cannot produce; refused, not corrected).
     IdentificationError
         No loading or no unloading branch, fewer than ``min_cycles`` cycles.
 
@@ -409,8 +461,10 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
        the branch; a nearly noise-free displacement avoids the
        errors-in-variables flattening where the samples crowd at the turning
        points, and a common window keeps a linear law exactly linear), then
-       regressed locally linearly on the displacement grid (Gaussian kernel,
-       bandwidth half a grid step).  The grid ends are the smoothed
+       regressed locally linearly on the displacement grid (tricube kernel
+       of [2] with compact support, radius 2.5 bandwidths, bandwidth half a
+       grid step or more: a sticking zone at a turning point cannot leak
+       beyond it).  The grid ends are the smoothed
        displacements at the turning points.
     3. Per cycle, loading and unloading are averaged at equal displacement:
        the mean removes a friction force that is symmetric on both branches;
@@ -448,6 +502,7 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         raise IdentificationError(f"{label}: {n_cycles} complete load cycle(s), min_cycles = {min_cycles}")
     load = cyc.loading[:, 0, :]
     unload = cyc.unloading[:, 0, :]
+    _check_sign_convention(load, unload, frame, label, channel)
     per_cycle = 0.5 * (load + unload)        # friction removed by averaging, [1] Section 4
     if turning_point_correction:
         per_cycle = _correct_turning_points(load, unload, per_cycle)

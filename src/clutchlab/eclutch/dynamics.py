@@ -195,6 +195,11 @@ def pedal_reference(pedal, release_travel: float = 8e-3):
     release_travel : float
         Bearing travel that fully releases the clutch [m].
 
+    Raises
+    ------
+    ParameterError
+        A pedal value that is not finite or lies outside 0..1.
+
     Notes
     -----
     A linear map, the simplest of the pedal-to-bearing maps an E-clutch
@@ -203,7 +208,10 @@ def pedal_reference(pedal, release_travel: float = 8e-3):
     p = np.asarray(pedal, dtype=float)
     if np.any(~np.isfinite(p)):
         raise ParameterError("pedal signal contains NaN or infinite values")
-    return np.clip(p, 0.0, 1.0) * release_travel
+    bad = np.flatnonzero((p < 0.0) | (p > 1.0))
+    if bad.size:  # a pedal beyond its stops is a unit or scaling slip (percent?), never clipped silently
+        raise ParameterError(f"pedal[{int(bad[0])}] = {float(p.ravel()[bad[0]])!r}: a pedal position must lie in 0..1")
+    return p * release_travel
 
 
 def apply_wear_and_expansion(model: ClutchModel, *, wear_m: float = 0.0, temperature_rise_k: float = 0.0,

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from ..curves import Curve
-from ..errors import ParameterError
+from ..errors import ParameterError, SimulationError
 from ..io import read_table
 from ..params import ParameterSet, load_toml, quantity
 from ..units import to_si
@@ -46,6 +46,9 @@ __all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component
            "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
 
 MODEL_NUMBERS = (0, 1, 2, 3, 4)
+#: A measured characteristic may be continued beyond its characterised deflection range by this
+#: fraction of the range (the curve ends are noisy and fixtures shift them a little); farther is refused.
+EXTRAPOLATION_TOLERANCE = 0.05
 _BUNDLED = "bundled synthetic press-rig data, characterised (src/clutchlab/eclutch/data)"
 _INSPECT = "inspection of the (virtual) assembled clutch, clutchlab.eclutch.virtual"
 _PAPER = "Haramina et al. 2024, Sec. 5.4"
@@ -417,7 +420,7 @@ class ClutchModel:
         """Display name."""
         return self.network.name
 
-    def static_curve(self, bearing_position_m) -> pd.DataFrame:
+    def static_curve(self, bearing_position_m, *, extrapolate: bool = False) -> pd.DataFrame:
         """Static curves (friction off): bearing force, normal force and torque vs bearing position.
 
         Solves the static equilibrium directly by Newton continuation along
@@ -428,6 +431,14 @@ class ClutchModel:
         bearing_position_m : array_like
             Release bearing positions [m], from the engaged clutch (0) in the
             release direction.
+        extrapolate : bool
+            Accept equilibria in which a measured characteristic (a curve of
+            more than two samples) is deflected beyond its characterised range
+            by more than :data:`EXTRAPOLATION_TOLERANCE` of the range (its
+            linear continuation is then an assumption, not a measurement).
+            Default ``False``: such positions raise.  Straight-line
+            characteristics, the lever and a unilateral contact that has
+            opened are never extrapolations.
 
         Returns
         -------
@@ -437,6 +448,8 @@ class ClutchModel:
             ``x_<node>_m``.
         """
         st = solve_static(self.network, bearing_position_m)
+        if not extrapolate:
+            self._refuse_extrapolation(st)
         fn = st["forces"][:, st["element_names"].index(self.network.normal_force)]
         out = pd.DataFrame({
             "bearing_position_m": st["input"],
@@ -448,3 +461,25 @@ class ClutchModel:
             if node != self.network.input:
                 out[f"x_{node}_m"] = st["node_positions"][:, j]
         return out
+
+    def _refuse_extrapolation(self, st: dict) -> None:
+        """Raise if an equilibrium deflects a measured characteristic beyond its characterised range."""
+        elements = {e.name: e for e in self.network.elements}
+        for j, name in enumerate(st["element_names"]):
+            e = elements[name]
+            if isinstance(e, Lever) or e.curve.deflection.size <= 2:
+                continue  # linear by construction: valid at any deflection
+            x = e.curve.deflection
+            lo, hi = float(x[0]), float(x[-1])
+            tol = EXTRAPOLATION_TOLERANCE * (hi - lo)
+            d = st["deflections"][:, j]
+            beyond = (d > hi + tol) | (d < lo - tol)
+            if e.unilateral:
+                beyond &= st["forces"][:, j] > 0.0  # an open contact carries nothing
+            if beyond.any():
+                i = int(np.flatnonzero(beyond)[0])
+                raise SimulationError(
+                    f"{self.name}: bearing position {st['input'][i] * 1e3:.4g} mm deflects the {name!r} spring "
+                    f"by {d[i] * 1e3:.4g} mm, outside its characterised range {lo * 1e3:.4g}..{hi * 1e3:.4g} mm "
+                    f"(curve {e.curve.name!r}): the result would be an extrapolation; shorten the travel "
+                    "(or pass extrapolate=True)")

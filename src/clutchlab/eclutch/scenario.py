@@ -168,7 +168,8 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
     if not isinstance(kind, str) or kind not in INPUT_KINDS:
         raise ParameterError(f"{src}: [input] kind = {short_repr(kind)}: expected one of {', '.join(INPUT_KINDS)}")
     release_travel = to_si(inp.pop("release_travel", 8e-3), "m", name="[input] release_travel", source=src)
-    if "file" in inp:
+    file_input = "file" in inp
+    if file_input:
         from ..io import read_table
 
         name = inp.pop("file")
@@ -188,6 +189,14 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
             raise ParameterError(f"{src}: {exc}") from None
     if inp:
         raise ParameterError(f"{src}: [input] unknown key {short_repr(next(iter(inp)))}")
+    if kind == "pedal":
+        bad = np.flatnonzero(~((v >= 0.0) & (v <= 1.0)))  # NaN too
+        if bad.size:
+            where = f"{f}: row {int(bad[0])} value" if file_input else f"[input] value[{int(bad[0])}]"
+            raise ParameterError(f"{src}: {where} = {float(v[bad[0]])!r}: a pedal position must lie in 0..1 "
+                                 "(0 released, 1 pressed down)")
+        if not 0.0 < release_travel < float("inf"):
+            raise ParameterError(f"{src}: [input] release_travel = {release_travel!r} m: must be finite and > 0")
     if t.size != v.size:
         raise ParameterError(f"{src}: [input] time_s has {t.size} values but value has {v.size}")
     if t.size > 1 and np.any(np.diff(t) <= 0):

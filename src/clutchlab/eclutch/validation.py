@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
-from ..errors import IdentificationError, SimulationError
+from ..errors import DataError, IdentificationError, SimulationError
 from ..io import read_measurement
 from .models import ClutchModel, ComponentCurves, EClutchParameters
 
@@ -48,7 +48,10 @@ def read_full_clutch_record(source, name: str | None = None, channel_map=None, *
     rate : float, optional
         Resample onto a uniform time base [Hz].
     """
-    return read_measurement(source, channel_map, required=FULL_CLUTCH_COLUMNS, rate=rate, name=name).frame
+    frame = read_measurement(source, channel_map, required=FULL_CLUTCH_COLUMNS, rate=rate, name=name).frame
+    frame.attrs["name"] = name if name is not None else (str(source) if not isinstance(source, pd.DataFrame)
+                                                         else "record")
+    return frame
 
 
 def compare(model: ClutchModel, record: pd.DataFrame) -> dict[str, float]:
@@ -64,13 +67,28 @@ def compare(model: ClutchModel, record: pd.DataFrame) -> dict[str, float]:
         ``rmse_force_N``, ``rmse_torque_Nm``, ``peak_force_N`` (model),
         ``peak_force_error_N`` (model peak minus recorded peak of the release
         branch), ``peak_force_error_pct``, ``max_torque_Nm``.
+
+    Raises
+    ------
+    DataError
+        If the record has no excitation: a constant bearing position, or no
+        positive bearing force on the release branch (an all-zero record, or
+        a force of reversed sign).
     """
+    name = record.attrs.get("name", "record")
     u = record["bearing_position_m"].to_numpy()
+    if not np.ptp(u) > 0:
+        raise DataError(f"{name}: bearing_position_m is constant ({float(u[0]):g} m): the record has no release travel "
+                        "to validate the models on")
+    f_rec = record["bearing_force_N"].to_numpy()
+    release = np.arange(u.size) <= int(np.argmax(u))
+    if not f_rec[release].max() > 0:
+        raise DataError(f"{name}: bearing_force_N is never > 0 on the release branch (max "
+                        f"{float(f_rec[release].max()):g} N): no force was recorded, or its sign is reversed")
     sim = model.static_curve(u)
     e_f = sim["bearing_force_N"].to_numpy() - record["bearing_force_N"].to_numpy()
     e_t = sim["torque_Nm"].to_numpy() - record["torque_Nm"].to_numpy()
-    release = np.arange(u.size) <= int(np.argmax(u))
-    measured_peak = float(record["bearing_force_N"].to_numpy()[release].max())
+    measured_peak = float(f_rec[release].max())
     model_peak = float(sim["bearing_force_N"].max())
     return {
         "rmse_force_N": float(np.sqrt(np.mean(e_f**2))),
@@ -166,7 +184,7 @@ def fit_model4_scales(record: pd.DataFrame, params: EClutchParameters | None = N
     def residual(logs):
         p = params.replace(support_scale=float(np.exp(logs[0])), diaphragm_scale=float(np.exp(logs[1])))
         try:
-            sim = ClutchModel.preset(4, p, curves).static_curve(u)
+            sim = ClutchModel.preset(4, p, curves).static_curve(u, extrapolate=True)
         except SimulationError:
             return np.full(2 * u.size, 1e6)
         return np.concatenate([sim["bearing_force_N"].to_numpy() - f_meas, w * (sim["torque_Nm"].to_numpy() - t_meas)])

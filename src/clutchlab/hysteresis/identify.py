@@ -217,6 +217,8 @@ def identify_forc(current, force, grid=None, *, window=None, name="FORC record")
                 clusters.append([p])
         grid = np.array([u_low] + [float(np.mean(c)) for c in clusters])
     grid = np.asarray(grid, dtype=float)
+    if grid.ndim != 1:
+        raise DataError(f"{name}: grid must be a 1-D list of currents [A], got an array of shape {grid.shape}")
     if grid.size < 2 or np.any(np.diff(grid) <= 0):
         raise DataError(f"{name}: grid must be strictly increasing with at least two values")
     h = float(np.min(np.diff(grid)))

@@ -108,7 +108,10 @@ class InverseResult:
 
 
 def _as_1d(name, values):
-    arr = np.asarray(values, dtype=float).ravel()
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim > 1:  # never flattened silently: a table passed as a grid is a mistake
+        raise DataError(f"{name}: expected a 1-D list of values, got an array of shape {arr.shape}")
+    arr = arr.ravel()
     if arr.size == 0:
         raise DataError(f"{name}: empty")
     bad = ~np.isfinite(arr)
@@ -528,6 +531,9 @@ class Preisach:
             raise DataError(f"{path}: not a clutchlab Preisach model (missing kind='clutchlab.preisach')")
         try:
             grid = np.asarray(body["grid_A"], dtype=float)
+            if grid.ndim != 1:
+                raise DataError(f"{path}: grid_A must be a 1-D list of currents [A], got an array of shape "
+                                f"{grid.shape}")
             n = grid.size
             check_allocation(n, n * (1 + len(body["tables_N"])), f"{path}: grid_A of {n} currents")
             i, j = np.tril_indices(n)
@@ -537,9 +543,14 @@ class Preisach:
                 t[i, j] = np.asarray(vals, dtype=float)
                 tabs.append(t)
             gaps = body.get("airgaps_m")
+        except DataError:
+            raise
         except (KeyError, TypeError, ValueError) as exc:
             raise DataError(f"{path}: malformed Preisach model ({exc})") from None
-        return cls(grid, np.array(tabs), gaps)
+        try:
+            return cls(grid, np.array(tabs), gaps)
+        except (DataError, ParameterError) as exc:  # name the file
+            raise type(exc)(f"{path}: {exc}") from None
 
     def __repr__(self) -> str:
         g = f", {self.n_airgaps} airgaps {self.airgaps[0]:g}..{self.airgaps[-1]:g} m" if self._has_gap else ""

@@ -42,12 +42,48 @@ def quantity(default, unit: str, doc: str, *, source: str = "", positive: bool =
     positive, nonnegative : bool
         Sign constraints checked on construction.
     bounds : (low, high)
-        Optional inclusive bounds checked on construction.
+        Optional inclusive bounds checked on construction.  Without them the
+        magnitude must not exceed the plausibility limit of the unit
+        (:data:`PLAUSIBLE_LIMITS`, else :data:`MAGNITUDE_LIMIT`).
     """
     meta = dict(unit=unit, doc=doc, source=source, positive=positive, nonnegative=nonnegative, bounds=bounds)
     if isinstance(default, (list, tuple)):
         default = tuple(float(v) for v in default)
     return dataclasses.field(default=default, metadata=meta)
+
+
+#: Largest magnitude [SI] a parameter of each unit may have: generous limits for the clutches and
+#: drivelines of road vehicles (a factor of 10-1000 above the largest value any model uses), so a
+#: slip of the unit or the exponent (``r_outer = 1e300``, ``"83 km"``) is refused on construction
+#: instead of overflowing or giving a silently absurd result.  A field's own ``bounds`` replace the
+#: limit; units not listed get :data:`MAGNITUDE_LIMIT`.
+PLAUSIBLE_LIMITS = {
+    "m": (100.0, "a length"),                      # largest used: a wheelbase, 2.7 m
+    "m^2": (100.0, "an area"),
+    "m**2": (100.0, "an area"),
+    "m**3": (10.0, "a volume"),
+    "kg": (1e5, "a mass"),                         # a 100 t vehicle
+    "kg*m^2": (1e4, "a moment of inertia"),
+    "kg*m**2": (1e4, "a moment of inertia"),
+    "s": (1e6, "a time"),                          # 11 days
+    "N": (1e7, "a force"),
+    "N*m": (1e6, "a torque"),
+    "W": (1e8, "a power"),
+    "rad/s": (1e5, "an angular speed"),            # ~1e6 rpm
+    "m/s": (1e3, "a speed"),
+    "Pa": (1e12, "a pressure or modulus"),         # above the modulus of diamond
+    "Pa*s": (1e3, "a dynamic viscosity"),
+    "N/m": (1e15, "a stiffness"),                 # a rigid link is modelled as 1e13 N/m
+    "degC": (1e4, "a temperature"),
+    "K": (1e4, "a temperature difference"),
+    "W/K": (1e7, "a thermal conductance"),
+    "J/(kg*K)": (1e5, "a specific heat capacity"),
+}
+#: Limit of the units not in :data:`PLAUSIBLE_LIMITS` (and of dimensionless numbers): products of a
+#: few such values stay far from float overflow.
+MAGNITUDE_LIMIT = 1e15
+#: No temperature [degC] lies below the absolute zero.
+ABSOLUTE_ZERO_C = -273.15
 
 
 def _number_problem(value, meta) -> str | None:
@@ -56,11 +92,18 @@ def _number_problem(value, meta) -> str | None:
         return "expected a number"
     if not math.isfinite(value):
         return "not finite"
+    lo, hi = meta.get("bounds", (None, None))
+    if lo is None and hi is None:
+        unit = meta.get("unit", "1")
+        limit, what = PLAUSIBLE_LIMITS.get(unit, (MAGNITUDE_LIMIT, "a value"))
+        if abs(value) > limit:
+            return f"implausible for {what} (magnitude above {limit:g} {unit}); check the unit and the exponent"
+        if unit == "degC" and value < ABSOLUTE_ZERO_C:
+            return f"below the absolute zero ({ABSOLUTE_ZERO_C} degC)"
     if meta.get("positive") and not value > 0:
         return f"must be > 0 [{meta['unit']}]"
     if meta.get("nonnegative") and value < 0:
         return f"must be >= 0 [{meta['unit']}]"
-    lo, hi = meta.get("bounds", (None, None))
     if lo is not None and value < lo:
         return f"below the lower bound {lo} [{meta['unit']}]"
     if hi is not None and value > hi:

@@ -78,6 +78,21 @@ def _lag_corrected_temperature(frame, sensor_time_constant, window_s, label):
     return temp, dtemp, sg, n
 
 
+#: Plausible range of a friction coefficient of a wet clutch (paper-based linings: about 0.1).
+MU_RANGE = (0.0, 1.0)
+
+
+def _check_time_constant(value) -> float:
+    """The thermistor lag [s] as a float: finite and >= 0, else :class:`ParameterError`."""
+    try:
+        tau = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"sensor_time_constant = {value!r}: expected a number [s]") from None
+    if not (math.isfinite(tau) and tau >= 0):
+        raise ParameterError(f"sensor_time_constant = {value!r}: must be finite and >= 0 [s]")
+    return tau
+
+
 def friction_samples(records, clutch: WetClutch, *, min_slip_velocity: float = 0.05, min_force: float = 100.0,
                      sensor_time_constant: float = 0.0, window: float = 0.2) -> pd.DataFrame:
     """Asperity friction coefficient per sample, as the paper computes it (Sec. 4).
@@ -107,8 +122,7 @@ def friction_samples(records, clutch: WetClutch, *, min_slip_velocity: float = 0
     pandas.DataFrame
         Columns ``slip_velocity_m_s, temperature_C, force_N, mu_f, viscous_torque_Nm, record``.
     """
-    if sensor_time_constant < 0:
-        raise ParameterError(f"sensor_time_constant = {sensor_time_constant!r}: must be >= 0 [s]")
+    sensor_time_constant = _check_time_constant(sensor_time_constant)
     parts = []
     r_eff = clutch.r_eff
     for label, fr in _records(records):
@@ -205,6 +219,24 @@ def fit_parametric_friction(v, temp, mu, t_ref: float | None = None):
     return law, stats
 
 
+def _check_friction_law(law: ParametricFriction, stats: dict, v: np.ndarray) -> None:
+    """Refuse a fitted law that the samples do not determine or that is not physical."""
+    v_max = float(np.max(v))
+    if law.v_s > v_max:
+        corr = stats["correlation"][0][2]
+        raise IdentificationError(
+            f"friction law: v_s = {law.v_s:.3g} m/s lies beyond the fastest recorded slip velocity "
+            f"{v_max:.3g} m/s, so the records do not show the decay of the exponential term and do not "
+            f"determine mu0 = {law.mu0:.3g} and mu_e = {law.mu_e:.3g} (correlation {corr:.4f}); add "
+            "friction-map records (protocol friction_map) over a wider slip-speed range")
+    lo, hi = MU_RANGE
+    for what, value in (("mu0 (high slip)", law.mu0), ("mu0 + mu_e (zero slip)", law.mu0 + law.mu_e)):
+        if not lo < value <= hi:
+            raise IdentificationError(
+                f"friction law: {what} = {value:.4g} is not a friction coefficient ({lo:g} < mu <= {hi:g}); "
+                "the records do not determine the law")
+
+
 def identify_friction_map(records, clutch: WetClutch, *, speed_bins: int = 12, temperature_bins: int = 8,
                           min_count: int = 20, min_slip_velocity: float = 0.05, min_force: float = 100.0,
                           sensor_time_constant: float = 0.0) -> FrictionMap:
@@ -234,8 +266,14 @@ def identify_friction_map(records, clutch: WetClutch, *, speed_bins: int = 12, t
 
     Raises
     ------
+    ParameterError
+        ``sensor_time_constant`` negative, NaN or infinite.
     IdentificationError
-        Too few usable samples, or fewer than 2 covered cells.
+        Too few usable samples, fewer than 2 covered cells, or a fitted law
+        the records do not determine: ``v_s`` beyond the fastest recorded
+        slip velocity (the exponential term is then indistinguishable from
+        a linear one), or a friction coefficient outside 0..1 at zero or
+        high slip.
     """
     if speed_bins < 2 or temperature_bins < 1 or min_count < 1:
         raise ParameterError("speed_bins >= 2, temperature_bins >= 1 and min_count >= 1 are required")
@@ -245,6 +283,7 @@ def identify_friction_map(records, clutch: WetClutch, *, speed_bins: int = 12, t
     temp = s["temperature_C"].to_numpy()
     mu = s["mu_f"].to_numpy()
     law, stats = fit_parametric_friction(v, temp, mu)
+    _check_friction_law(law, stats, v)
     ve = np.linspace(v.min(), v.max(), speed_bins + 1)
     te = np.linspace(temp.min(), temp.max(), temperature_bins + 1)
     iv = np.clip(np.searchsorted(ve, v, side="right") - 1, 0, speed_bins - 1)
@@ -351,14 +390,19 @@ def identify_thermal(records, clutch: WetClutch, *, sensor_time_constant: float 
 
     Raises
     ------
+    ParameterError
+        ``sensor_time_constant`` negative, NaN or infinite; ``window`` not > 0.
     IdentificationError
         If fluid and housing temperatures do not differ enough to separate
-        k1 from k2 (the regressors are collinear).
+        k1 from k2 (the regressors are collinear), if a conductance comes out
+        negative (non-physical) or its standard error is not smaller than
+        its value (the records do not determine it).
     """
     from scipy import stats as sstats
 
-    if window <= 0:
-        raise ParameterError(f"window = {window!r}: must be > 0 [s]")
+    if not (math.isfinite(window) and window > 0):
+        raise ParameterError(f"window = {window!r}: must be finite and > 0 [s]")
+    sensor_time_constant = _check_time_constant(sensor_time_constant)
     cap = clutch.heat_capacity
     rows_a, rows_b = [], []
     nwin = 1
@@ -387,6 +431,17 @@ def identify_thermal(records, clutch: WetClutch, *, sensor_time_constant: float 
     se = np.sqrt(np.diag(cov))
     q = sstats.t.ppf(0.975, max(n // nwin - 2, 1))
     corr = float(cov[0, 1] / math.sqrt(cov[0, 0] * cov[1, 1]))
+    for name, value, err in (("k1", x[0], se[0]), ("k2", x[1], se[1])):
+        if value < 0 and not err > abs(value):
+            raise IdentificationError(
+                f"{name} = {value:.4g} +/- {err:.2g} W/K is negative, which a conductance cannot be: the heat "
+                "balance (Eq. 8) does not describe the records (an engagement without a cooling phase, a wrong "
+                "heat capacity or sensor lag?)")
+        if not err < abs(value):
+            raise IdentificationError(
+                f"{name} = {value:.4g} +/- {err:.2g} W/K: the standard error is not smaller than the value, so "
+                "the records do not determine it (record the pack heating and cooling well away from the "
+                "fluid and housing temperatures)")
     return ThermalFit(float(x[0]), float(x[1]), {"k1": float(se[0]), "k2": float(se[1])},
                       {"k1": (float(x[0] - q * se[0]), float(x[0] + q * se[0])),
                        "k2": (float(x[1] - q * se[1]), float(x[1] + q * se[1]))},
