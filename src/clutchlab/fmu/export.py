@@ -107,6 +107,30 @@ def keep_namespace(namespace: dict) -> None:
     _KEPT_NAMESPACES.append(namespace)
 
 
+#: the one Python thread that runs the model work of every FMU instance in this process (created on first use)
+_MODEL_THREAD = None
+
+
+def _on_model_thread(fn, *args):
+    """``fn(*args)`` run on the FMUs' model thread; its result, or its exception re-raised here.
+
+    pythonfmu calls the slave from inside the host's ``fmi2*`` call (a ctypes
+    foreign call in FMPy) with the GIL taken by ``PyGILState_Ensure``.  With
+    the compiled kernels first loaded and run in that context, 5 of 24 FMPy
+    host processes (wet FMU, 30 steps with an input table) aborted at exit with
+    "corrupted double-linked list"; run on an ordinary Python thread, none of
+    40 (and none of 8 EMTC runs, of which 3 in 14 aborted before) -- see
+    ``docs/fmu.md``, "Exit".  The thread is a (non-daemon) pool worker that
+    :mod:`concurrent.futures` joins at interpreter exit.
+    """
+    global _MODEL_THREAD
+    if _MODEL_THREAD is None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        _MODEL_THREAD = ThreadPoolExecutor(max_workers=1, thread_name_prefix="clutchlab-fmu")
+    return _MODEL_THREAD.submit(fn, *args).result()
+
+
 def _slave_base():
     """The pythonfmu base class, defined on first use (pythonfmu is needed only to build and run FMUs)."""
     from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
@@ -154,6 +178,9 @@ def _slave_base():
             return False
 
         def exit_initialization_mode(self):
+            _on_model_thread(self._initialise)
+
+        def _initialise(self):
             try:
                 if self.built_with and self.built_with != __version__:
                     raise ClutchlabError(f"FMU built with clutchlab {self.built_with}, installed is {__version__}")
@@ -167,6 +194,9 @@ def _slave_base():
                 raise
 
         def do_step(self, current_time: float, step_size: float) -> bool:
+            return _on_model_thread(self._step, current_time, step_size)
+
+        def _step(self, current_time: float, step_size: float) -> bool:
             try:
                 self.values.update(self.cosim.do_step(float(current_time), float(step_size), self._inputs()))
             except Exception as exc:  # reported to the master through the FMI logger
