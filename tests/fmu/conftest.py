@@ -40,18 +40,14 @@ if names:
 res = fmpy.simulate_fmu(spec["path"], start_time=0.0, stop_time=n * dt, step_size=dt, output_interval=dt,
                         input=table, output=spec["outputs"], start_values=spec["start_values"])
 np.savez(spec["result"], time=res["time"], **{k: res[k] for k in spec["outputs"]})
-sys.stdout.flush()
-import os
-os._exit(0)  # skip interpreter finalisation: pythonfmu 0.7 can corrupt the heap on teardown (issue #228)
 """
 
 
 def _run_fmu(path, inputs, dt, n, outputs, start_values=None):
-    """Simulate ``path`` with FMPy over ``n`` communication steps of ``dt``, in a fresh Python process.
+    """Simulate ``path`` with FMPy over ``n`` communication steps of ``dt``, as a host does.
 
-    A pythonfmu FMU cannot be instantiated twice in one process (pythonfmu
-    issue #228: the second ``fmi2Instantiate`` fails and the process may
-    crash on exit), so every simulation runs in its own interpreter.
+    A plain script file run by a fresh Python, which exits normally (interpreter
+    finalisation included); its return code must be 0 -- a crash at exit fails.
     ``inputs`` maps input names to arrays of length ``n + 1`` (value held over
     ``[k dt, (k+1) dt]``; FMPy samples the table at the communication points).
     Returns a dict of output arrays at ``0, dt, ..., n dt``.
@@ -67,9 +63,10 @@ def _run_fmu(path, inputs, dt, n, outputs, start_values=None):
                 "inputs": {k: [float(x) for x in v] for k, v in inputs.items()},
                 "start_values": dict(start_values or {}), "result": str(Path(tmp) / "result.npz")}
         (Path(tmp) / "spec.json").write_text(json.dumps(spec))
-        proc = subprocess.run([sys.executable, "-c", _RUNNER, str(Path(tmp) / "spec.json")], capture_output=True,
-                              text=True, timeout=300)
-        assert proc.returncode == 0, proc.stderr[-3000:]
+        (Path(tmp) / "host.py").write_text(_RUNNER)
+        proc = subprocess.run([sys.executable, str(Path(tmp) / "host.py"), str(Path(tmp) / "spec.json")],
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, f"return code {proc.returncode}: {proc.stderr[-3000:]}"
         with np.load(spec["result"]) as data:
             res = {k: np.asarray(data[k], float) for k in data.files}
     tk = np.arange(n + 1) * dt

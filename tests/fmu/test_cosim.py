@@ -67,8 +67,13 @@ def test_bad_parameters_inputs_and_steps_raise():
     with pytest.raises(SimulationError, match="dt"):
         c.do_step(0.01, 0.0, {})
     e = EmtcCoSimulation()
-    with pytest.raises(SimulationError, match="multiple"):
-        e.do_step(0.0, 0.003, {})
+    for dt in (0.0, -0.002, math.nan, math.inf):
+        with pytest.raises(SimulationError, match="dt"):
+            e.do_step(0.0, dt, {})
+    with pytest.raises(SimulationError, match="contiguous"):
+        e.do_step(0.001, 0.002, {})
+    with pytest.raises(ParameterError, match="throttle"):
+        e.do_step(0.0, 0.002, {"throttle": math.nan})
     with pytest.raises(ParameterError, match="gear"):
         EmtcCoSimulation(**{"scenario.gear": 7.0})
 
@@ -267,6 +272,78 @@ def test_emtc_input_step_that_unlocks_agrees_within_solver_tolerance():
     slip = nat.outputs["slip_speed"].to_numpy()[idx]
     assert np.max(np.abs(out["slip_speed"] - slip)) < 1e-4 * np.max(np.abs(slip))
     assert np.max(np.abs(out["coupling_torque"] - nat.outputs["t_coupling"].to_numpy()[idx])) < 1e-4 * 300.0
+
+
+def _emtc_master(cosim, dt, duration, torque_at, throttle_at):
+    """A fixed-step master: steps of ``dt`` (the last one shorter) up to ``duration``; inputs sampled at each
+    step start.  Returns the communication points and the outputs there."""
+    n = math.ceil(duration / dt - 1e-9)
+    tk = np.minimum(np.arange(n + 1) * dt, duration)
+    rows = [cosim.initial_outputs({"torque_request": torque_at(0.0), "throttle": throttle_at(0.0)})]
+    for k in range(n):
+        u = {"torque_request": torque_at(tk[k]), "throttle": throttle_at(tk[k])}
+        rows.append(cosim.do_step(tk[k], tk[k + 1] - tk[k], u))
+    return tk, {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+
+@pytest.mark.parametrize("dt", [0.001, 0.0003, 0.0007])
+def test_emtc_accepts_any_communication_step_and_follows_the_native_run(dt):
+    """A 1 ms (0.3 ms, 0.7 ms) master with the 2 ms controller: the controller samples at its own instants
+    inside and across steps.  Inputs change at t = 0.042 s and 0.084 s (communication points of every master
+    and controller samples), so the native run sees the same inputs; only the integration steps, broken at
+    the extra communication points, differ.  Tolerances: the DOPRI 5(4) control (rtol 1e-6, atol 1e-5 A on
+    the coil currents); the slip speed (a difference of two shaft speeds near 56 rad/s) carries the error of
+    the speeds: the native run itself differs from an rtol = 1e-10 run by 0.024 rad/s in this scenario."""
+    c = EmtcCoSimulation()
+    torque_at = lambda t: 0.0 if t < 0.042 - 1e-9 else 300.0  # noqa: E731
+    throttle_at = lambda t: 0.1 if t < 0.084 - 1e-9 else 0.6  # noqa: E731
+    tk, out = _emtc_master(c, dt, 0.1, torque_at, throttle_at)
+    ts = c.sample_time
+    grid = np.arange(round(0.1 / ts) + 1) * ts
+    nat = _emtc_native(c, grid, [torque_at(t) for t in grid], 0.084)
+    common = np.flatnonzero(np.abs(tk / ts - np.round(tk / ts)) < 1e-6)[1:]
+    assert len(common) >= 7
+    idx = np.round(tk[common] / ts).astype(int)
+    o, s = nat.outputs, nat.states
+    np.testing.assert_allclose(out["coupling_torque"][common], o["t_coupling"].to_numpy()[idx], rtol=0, atol=3e-3)
+    np.testing.assert_allclose(out["coil_current"][common], s["i2"].to_numpy()[idx], rtol=0, atol=2e-5)
+    np.testing.assert_allclose(out["magnet_force"][common], o["magnet_force"].to_numpy()[idx], rtol=0, atol=0.1)
+    np.testing.assert_allclose(out["slip_speed"][common], o["slip_speed"].to_numpy()[idx], rtol=0, atol=0.05)
+    np.testing.assert_array_equal(out["coupling_mode"][common], o["coupling_mode"].to_numpy()[idx])
+    # the command is sampled exactly as natively: the one applied over the last sample before each point
+    np.testing.assert_array_equal(out["current_command"][common], o["current_command"].to_numpy()[idx - 1])
+    assert [name for _, name in c.events] == list(nat.events.name)
+    np.testing.assert_allclose([t for t, _ in c.events], nat.events.time, rtol=0, atol=1e-6)
+    assert np.max(out["coupling_torque"]) > 250.0  # the coupling did engage
+
+
+@settings(max_examples=10, deadline=None)
+@given(steps=st.lists(st.tuples(st.floats(1e-4, 5e-3), st.floats(0.0, 450.0)), min_size=1, max_size=12))
+def test_emtc_controller_samples_at_its_own_instants_for_any_steps(steps):
+    """Any sequence of communication steps: the command reported at t + dt is the one the controller
+    computed at the last sample instant k ts <= t + dt (held in between) from the torque request of the
+    step containing that instant -- the command depends on the sampled requests only (Eqs. 6-7, 11, 13, 15),
+    so it must equal that of a 2 ms chain fed with those requests, bit for bit."""
+    c = EmtcCoSimulation()
+    ts = c.sample_time
+    c.initial_outputs({})
+    t = 0.0
+    bounds = []
+    for dt, level in steps:
+        out = c.do_step(t, dt, {"torque_request": level})
+        bounds.append((t, t + dt, level))
+        t += dt
+        k_last = math.floor(t / ts + 1e-9)  # last sample instant at or before t
+        on_sample = abs(k_last * ts - t) <= 1e-9 * ts
+        # the controller ran at samples 0 .. k_last (not at k_last if the step ends on it: next step's input)
+        n_run = k_last if on_sample else k_last + 1
+        ref = EmtcCoSimulation()
+        cmd = ref.initial_outputs({})["current_command"]
+        for k in range(n_run):
+            sample = k * ts
+            level_k = next(lv for t0, t1, lv in bounds if t0 - 1e-9 * ts <= sample < t1 - 1e-9 * ts)
+            cmd = ref.do_step(sample, ts, {"torque_request": level_k})["current_command"]
+        assert out["current_command"] == cmd
 
 
 def test_reset_returns_to_the_initial_state():

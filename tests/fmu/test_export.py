@@ -27,7 +27,7 @@ def test_model_description_lists_every_variable_with_causality_and_unit(build_fm
     assert fmpy.validation.validate_fmu(str(path)) == []
     md = fmpy.read_model_description(str(path), validate=True)
     assert md.fmiVersion == "2.0" and md.coSimulation.modelIdentifier == model_identifier(model)
-    assert md.coSimulation.canBeInstantiatedOnlyOncePerProcess and md.coSimulation.needsExecutionTool
+    assert not md.coSimulation.canBeInstantiatedOnlyOncePerProcess and md.coSimulation.needsExecutionTool
     got = {v.name: v for v in md.modelVariables}
     expected = ([(v, "parameter", "fixed") for v in cls.parameters] + [(v, "input", "continuous") for v in cls.inputs]
                 + [(v, "output", "continuous") for v in cls.outputs])
@@ -57,6 +57,7 @@ def test_fmu_needs_installed_clutchlab_and_bundles_only_the_slave(build_fmu):
     assert "binaries/linux64/ClutchlabWet.so" in names
     assert not any(n.startswith("resources/clutchlab/") for n in names)
     assert "from clutchlab.fmu.export import CoSimulationSlave" in script and 'model_key = "wet"' in script
+    assert "\nkeep_namespace(globals())" in script  # balances pythonfmu's release at every instantiation
     assert root.find("DefaultExperiment") is not None
 
 

@@ -228,7 +228,12 @@ def _events(y, aux, imode, pv, pa, gv):
 CARRY_T, CARRY_H, CARRY_PLEN, CARRY_PU, CARRY_CLEN, CARRY_CU, CARRY_FRESH = range(7)
 CARRY_K1 = 7
 CARRY_AUX = CARRY_K1 + NY
-N_CARRY = CARRY_AUX + N_AUX
+#: co-simulation steps that do not end on a sample (zero in a plain run): CARRY_HOLD = 1 -- the call starts
+#: between two samples, so the first row keeps the held command (no controller); CARRY_STOP > 0 -- the last
+#: row is at this time (between samples k0 + n - 2 and k0 + n - 1) instead of at sample k0 + n - 1
+CARRY_HOLD = CARRY_AUX + N_AUX
+CARRY_STOP = CARRY_HOLD + 1
+N_CARRY = CARRY_STOP + 1
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -275,8 +280,11 @@ def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t
     at the last sample (it is left to the next call, whose inputs may
     differ), so a chain of calls with ``control_last=False`` reproduces one
     uninterrupted call exactly.  ``carry[CARRY_FRESH]`` = 1 evaluates the
-    derivative at the first sample (a fresh start).  Returns ``(n_out,
-    n_events, n_steps, status)`` as :func:`bench_kernel`.
+    derivative at the first sample (a fresh start).  ``carry[CARRY_HOLD]``
+    and ``carry[CARRY_STOP]`` let a call start and end between samples (a
+    co-simulation step that is not a multiple of the sample time); both are
+    cleared on return.  Returns ``(n_out, n_events, n_steps, status)`` as
+    :func:`bench_kernel`.
     """
     ts = pv[18]
     n_samples = out.shape[0]
@@ -333,7 +341,7 @@ def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t
         tk1 = max(t_ref, 0.0) / gain
         fn1_req = tk1 / (2.0 / 3.0 * geo[0] * geo[6] * geo[9])  # [1], Eq. 13
         fm_req = fn1_req + pa[2] + pa[1] * pa[4] if t_ref > 0.0 else 0.0  # [1], Eq. 11 solved for F_m
-        if ks < n_samples - 1 or control_last:
+        if (ks < n_samples - 1 or control_last) and not (ks == 0 and carry[CARRY_HOLD] > 0.5):
             gap_weights(cgaps, min(max(gap_c, cgaps[0]), cgaps[cgaps.shape[0] - 1]), idx, w)
             if clen + 2 > cstack.shape[0] or plen + 2 > pstack.shape[0]:
                 return ks, n_ev, n_steps, 1
@@ -342,7 +350,7 @@ def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t
             cu = i_new
             pv[21] = i_new
             pv[22] = t_ref
-        else:  # the next call runs the controller at this sample with its own inputs
+        else:  # the next call runs the controller at this sample with its own inputs (or: between samples, held)
             i_new = pv[21]
             t_ref = pv[22]
             ok = True
@@ -370,6 +378,8 @@ def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t
         if ks == n_samples - 1:
             break
         t_next = (k0 + ks + 1) * ts
+        if ks == n_samples - 2 and carry[CARRY_STOP] > 0.0:
+            t_next = carry[CARRY_STOP]
         # ---- integrate to the next sample (the recorded evaluation is the first stage)
         for q in range(NY):
             k1[q] = dy[q]
@@ -539,6 +549,8 @@ def bench_advance(y, imode, carry, k0, control_last, pv, pa, geo, fmap_v, fmap_t
     carry[CARRY_CLEN] = clen
     carry[CARRY_CU] = cu
     carry[CARRY_FRESH] = 0.0
+    carry[CARRY_HOLD] = 0.0
+    carry[CARRY_STOP] = 0.0
     for q in range(NY):
         carry[CARRY_K1 + q] = dy[q]
     for q in range(N_AUX):

@@ -558,7 +558,7 @@ def _emtc_variables():
                Variable("scenario.drum_load_front", "N.m", scen.drum_load_front, "extra drum resistance, front axle"),
                Variable("scenario.drum_load_rear", "N.m", scen.drum_load_rear, "extra drum resistance, rear axle"),
                Variable("scenario.sample_time", "s", scen.sample_time,
-                        "EMTC controller sample time; the communication step must be a multiple of it"),
+                        "EMTC controller sample time (any communication step: the controller samples at its own instants)"),
                Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control")))
 
 
@@ -592,9 +592,11 @@ class EmtcCoSimulation(CoSimulation):
 
     Notes
     -----
-    ``dt`` must be a whole multiple of ``scenario.sample_time`` and ``t`` a
-    sample instant (the controller is sampled).  The shaft speeds start at
-    the free-rolling speeds of the drum-speed inputs at t = 0.
+    Any communication step is accepted: the controller samples at its own
+    instants ``k * scenario.sample_time`` inside or across steps and holds
+    its command in between.  A step that is a whole multiple of the sample
+    time, starting on a sample, is the case reproduced exactly.  The shaft
+    speeds start at the free-rolling speeds of the drum-speed inputs at t = 0.
     """
 
     name = "emtc"
@@ -757,28 +759,43 @@ class EmtcCoSimulation(CoSimulation):
         return self._row_outputs(self._last_row)
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
-        """Advance from ``t`` to ``t + dt`` (a multiple of the controller sample time); outputs at ``t + dt``.
+        """Advance from ``t`` to ``t + dt`` (any step > 0); outputs at ``t + dt``.
+
+        The controller runs at its own sample instants ``k * scenario.sample_time``
+        that fall in ``[t, t + dt)``, with this step's inputs; between them the
+        coil-current command is held, also across communication points.  A
+        communication point within ``1e-9 * sample_time`` of a sample instant
+        counts as that instant.
 
         Raises
         ------
         SimulationError
-            Non-contiguous step, ``dt`` not a multiple of the sample time,
-            step limit or step-size underflow.
+            Non-contiguous or non-positive step, step limit or step-size underflow.
         ParameterError
             Unknown or out-of-range input.
         """
+        from ..emtc import _bench_kernel as BK
+
         _check_time("EmtcCoSimulation", self.time, t, dt)
-        ts = self.sample_time
-        m = round(dt / ts)
-        if m < 1 or abs(m * ts - dt) > 1e-9 * ts:
-            raise SimulationError(
-                f"EmtcCoSimulation.do_step: dt = {dt!r} s is not a whole multiple of the controller sample time "
-                f"scenario.sample_time = {ts!r} s")
         u = self.resolve_inputs(inputs)
         if self._y is None:
             self._start(u)
-        row = self._advance(u, m + 1, self._k)
-        self._k += m
-        self.time = t + dt
+        ts = self.sample_time
+        tol = 1e-9 * ts
+        t_end = t + dt
+        # self._k: the first sample whose controller has not run; the call starts on it or just before it
+        on_sample = abs(self._k * ts - t) <= tol
+        k0 = self._k if on_sample else self._k - 1
+        k_end = round(t_end / ts)
+        if abs(k_end * ts - t_end) <= tol:  # the step ends on a sample: its controller runs in the next step
+            n_rows, stop, k_next = k_end - k0 + 1, 0.0, k_end
+        else:  # rows at the samples inside the step, then one at t + dt
+            k_last = math.floor(t_end / ts)
+            n_rows, stop, k_next = k_last - k0 + 2, t_end, k_last + 1
+        self._carry[BK.CARRY_HOLD] = 0.0 if on_sample else 1.0
+        self._carry[BK.CARRY_STOP] = stop
+        row = self._advance(u, n_rows, k0)
+        self._k = k_next
+        self.time = t_end
         self._last_row = row
         return self._row_outputs(row)

@@ -1,0 +1,184 @@
+"""The exported FMUs in a real host: FMPy from a plain script file, normal interpreter exit.
+
+Each test starts a fresh Python on a script file, as a user's host program
+runs, and requires return code 0 -- a crash at interpreter finalisation
+(SIGABRT "corrupted double-linked list", SIGSEGV) fails the test; nothing
+skips finalisation.
+"""
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clutchlab.fmu.cosim import EmtcCoSimulation, WetCoSimulation
+
+fmpy = pytest.importorskip("fmpy")
+
+FMI2_DISCARD = 2
+
+
+def _host(tmp_path, script, *args):
+    """Run ``script`` as a file with a fresh Python; its stdout (return code 0 required)."""
+    path = tmp_path / "host.py"
+    path.write_text(script)
+    proc = subprocess.run([sys.executable, str(path), *map(str, args)], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path)
+    assert proc.returncode == 0, f"return code {proc.returncode}: {proc.stderr[-3000:]}"
+    return proc.stdout
+
+
+def _inputs(cls, n):
+    k = np.arange(n + 1)
+    return {v.name: np.where(k < n // 2, v.start, 0.5 * v.start + 100.0 * (v.unit == "N.m")) for v in cls.inputs}
+
+
+@pytest.mark.parametrize("model", ["wet", "emtc", "eclutch"])
+def test_host_exits_normally_with_correct_results_every_time(build_fmu, run_fmu, run_cosim, model):
+    """Five host processes per model, each exiting normally (return code 0) with the in-process results."""
+    from clutchlab.fmu.cosim import load_cosimulation
+    from clutchlab.fmu.export import DEFAULT_EXPERIMENT
+
+    cls = load_cosimulation(model)
+    _, dt = DEFAULT_EXPERIMENT[model]
+    n = 30
+    inputs = _inputs(cls, n)
+    names = [v.name for v in cls.outputs][:6]
+    ref = run_cosim(cls(), inputs, dt, n)
+    for _ in range(5):
+        got = run_fmu(build_fmu(model), inputs, dt, n, names)
+        for name in names:
+            scale = max(np.max(np.abs(ref[name])), 1e-300)
+            np.testing.assert_allclose(got[name][1:], ref[name][1:], rtol=1e-12, atol=1e-12 * scale, err_msg=name)
+
+
+_TWICE = """
+import json, sys
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+
+path = sys.argv[1]
+first = fmpy.simulate_fmu(path, stop_time=0.05, step_size=0.01, output_interval=0.01, output=["clutch_torque"])
+second = fmpy.simulate_fmu(path, stop_time=0.05, step_size=0.01, output_interval=0.01, output=["clutch_torque"])
+md = fmpy.read_model_description(path)
+vr = next(v.valueReference for v in md.modelVariables if v.name == "clutch_torque")
+slaves = [FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path), modelIdentifier="ClutchlabWet",
+                    instanceName=f"wet{i}") for i in range(2)]
+for s in slaves:
+    s.instantiate()
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+together = []
+for s in slaves:
+    for k in range(5):
+        s.doStep(k * 0.01, 0.01)
+    together.append(s.getReal([vr])[0])
+for s in slaves:
+    s.terminate()
+    s.freeInstance()  # FMPy's freeInstance also unloads the library
+print(json.dumps({"first": list(first["clutch_torque"]), "second": list(second["clutch_torque"]),
+                  "together": together}))
+"""
+
+
+def test_second_instance_in_one_process(tmp_path, build_fmu, run_cosim):
+    """Re-instantiation within one process (as Simulink does), one after the other and side by side."""
+    out = json.loads(_host(tmp_path, _TWICE, build_fmu("wet")).strip().splitlines()[-1])
+    ref = run_cosim(WetCoSimulation(), {}, 0.01, 5)["clutch_torque"]
+    assert out["second"] == out["first"]  # a fresh instance of the same model: the same run, bit for bit
+    assert out["together"][0] == out["together"][1]
+    # the adaptive solver sees the step sizes as each master rounds them (k dt vs. a running sum): 1e-9 apart
+    np.testing.assert_allclose(out["first"], ref, rtol=1e-8)
+    np.testing.assert_allclose(out["together"], [ref[-1]] * 2, rtol=1e-8)
+    assert ref[-1] > 0.0
+
+
+_INVALID = """
+import json, math, sys
+import fmpy
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+
+path = sys.argv[1]
+md = fmpy.read_model_description(path)
+vr = {v.name: v.valueReference for v in md.modelVariables}
+s = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path), modelIdentifier="ClutchlabEmtc", instanceName="e")
+s.instantiate()
+s.setupExperiment(startTime=0.0)
+s.enterInitializationMode()
+s.exitInitializationMode()
+status = {}
+def step(case, t, dt):
+    try:
+        s.doStep(t, dt)
+        status[case] = 0
+    except FMICallException as exc:
+        status[case] = exc.status
+step("zero", 0.0, 0.0)
+step("negative", 0.0, -0.001)
+step("nan", 0.0, math.nan)
+step("not at the current time", 0.5, 0.001)
+step("valid", 0.0, 0.001)
+s.setReal([vr["torque_request"]], [math.nan])
+step("nan input", 0.001, 0.001)
+s.setReal([vr["torque_request"]], [100.0])
+step("valid again", 0.001, 0.001)
+s.terminate()
+s.freeInstance()
+print(json.dumps(status))
+"""
+
+
+def test_invalid_steps_and_inputs_fail_the_step_and_leave_the_instance_usable(tmp_path, build_fmu):
+    """Through FMPy's FMU2Slave: every invalid step or input fails that step with the status documented in
+    docs/fmu.md (pythonfmu 0.7 maps a failed step to fmi2Discard) and the model stays where it was."""
+    out = _host(tmp_path, _INVALID, build_fmu("emtc"))
+    status = json.loads(out.strip().splitlines()[-1])
+    assert status == {"zero": FMI2_DISCARD, "negative": FMI2_DISCARD, "nan": FMI2_DISCARD,
+                      "not at the current time": FMI2_DISCARD, "valid": 0, "nan input": FMI2_DISCARD,
+                      "valid again": 0}
+
+
+def _docs_example():
+    text = (Path(__file__).parents[2] / "docs" / "fmu.md").read_text()
+    match = re.search(r"<!-- fmpy-example -->\s*```python\n(.*?)```", text, re.S)
+    assert match, "docs/fmu.md: FMPy example block missing"
+    return match.group(1)
+
+
+def test_docs_fmpy_example_runs_as_written(tmp_path, build_fmu):
+    """The copy-paste example of docs/fmu.md, run as a script next to emtc.fmu, prints the in-process result."""
+    (tmp_path / "emtc.fmu").write_bytes(Path(build_fmu("emtc")).read_bytes())
+    out = _host(tmp_path, _docs_example())
+    got = float(re.search(r"coupling torque at 0\.100 s: (\S+) N\.m", out).group(1))
+    c = EmtcCoSimulation(**{"actuator.tau1": 0.012})
+    c.initial_outputs({})
+    for k in range(100):
+        t = k * 0.001
+        res = c.do_step(t, (k + 1) * 0.001 - t, {"torque_request": 0.0 if t < 0.04 - 1e-9 else 300.0})
+    # FMPy forms its communication points its own way (last-bit differences in dt); the adaptive solver
+    # (rtol 1e-6) turns them into differences of the integration error: measured 1e-8 relative
+    assert got == pytest.approx(res["coupling_torque"], rel=1e-6)
+    assert got > 200.0
+
+
+_BAD_PARAMETER = """
+import fmpy
+from fmpy.fmi1 import FMICallException
+try:
+    fmpy.simulate_fmu("emtc.fmu", stop_time=0.01, step_size=0.002, start_values={"scenario.gear": 7.0})
+except FMICallException as exc:
+    print("status", exc.status)
+"""
+
+
+def test_invalid_parameter_stops_at_initialisation_and_the_host_exits_normally(tmp_path, build_fmu):
+    """A refused parameter: pythonfmu reports the raised ParameterError as fmi2Fatal (4) when the master
+    leaves initialisation mode; the host process still exits normally (return code 0, checked by _host)."""
+    (tmp_path / "emtc.fmu").write_bytes(Path(build_fmu("emtc")).read_bytes())
+    assert _host(tmp_path, _BAD_PARAMETER).split() == ["status", "4"]
