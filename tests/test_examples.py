@@ -224,9 +224,9 @@ def check_out(work, out):
 
 def check_run(work, out):
     run = _csv(work / "run.csv")
-    assert run["time"].iloc[-1] == pytest.approx(1.5, abs=0.01)
+    assert run["time_s"].iloc[-1] == pytest.approx(1.5, abs=0.01)
     assert "armature contacts primary clutch" in out
-    assert (run["t_coupling"].iloc[len(run) // 2:] > 0).all()   # the coupling transmits torque once engaged
+    assert (run["coupling_torque_Nm"].iloc[len(run) // 2:] > 0).all()   # the coupling transmits torque once engaged
     assert _is_png(work / "run.png")
 
 
