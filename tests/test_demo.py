@@ -42,10 +42,11 @@ def test_demo_writes_report_with_every_section(tmp_path, capsys, monkeypatch):
     assert "Model 4" in html and "RMSE" in html
     # run times are measured with compiled kernels; the compilation is reported on its own
     timing = re.search(r"With the kernels compiled, the 1 s step response took (\d+) ms.*?The first call, which runs "
-                       r"the same step, took ([\d.]+) s: about ([\d.]+) s of it went into compiling", html)
+                       r"the same step, took (\d+) ms, of which ([\d.]+) s went into compiling", html)
     assert timing, "the step-response timing sentence is missing"
-    run_ms, first_s, compile_s = int(timing.group(1)), float(timing.group(2)), float(timing.group(3))
-    assert run_ms / 1e3 <= first_s + 1e-3 and abs(first_s - run_ms / 1e3 - compile_s) <= 0.11  # each rounded to 0.1 s
+    run_ms, first_ms, compile_s = int(timing.group(1)), int(timing.group(2)), float(timing.group(3))
+    # the compile time is measured (numba's compile events), a part of the first call; each figure is rounded
+    assert run_ms > 0 and compile_s * 1e3 <= first_ms + 50
     # a second run refuses to overwrite without --force
     assert main(["demo", "-o", str(out)]) == 2
     assert "exists" in capsys.readouterr().err

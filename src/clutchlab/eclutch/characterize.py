@@ -229,7 +229,9 @@ class _Cycles:
 def _load_record(record, channels, name, channel_map=None):
     if isinstance(record, (str, Path)):
         label = name or str(record)
-    elif isinstance(record, (pd.DataFrame, Measurement)):
+    elif isinstance(record, Measurement):
+        label = record.source.path or name or "record"  # errors name the file the measurement came from
+    elif isinstance(record, pd.DataFrame):
         label = name or "record"
     else:
         raise DataError(f"record must be a pandas.DataFrame or a file path, got {type(record).__name__}")

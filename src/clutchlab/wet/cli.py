@@ -94,7 +94,7 @@ def _identify(args) -> int:
 
     check_outputs([args.output, args.plot], args.force)
     if not args.sensor_lag >= 0 or args.sensor_lag == float("inf"):  # NaN fails the first test
-        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be a finite number >= 0 [s]")
+        raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be finite and >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
     fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
     data = fmap.to_dict()
