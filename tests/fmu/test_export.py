@@ -29,6 +29,8 @@ def test_model_description_lists_every_variable_with_causality_and_unit(build_fm
     assert md.fmiVersion == "2.0" and md.coSimulation.modelIdentifier == model_identifier(model)
     assert not md.coSimulation.canBeInstantiatedOnlyOncePerProcess and md.coSimulation.needsExecutionTool
     got = {v.name: v for v in md.modelVariables}
+    flag = got.pop("step_error")  # local Boolean read by the shim library after a refused step
+    assert (flag.causality, flag.variability, flag.type) == ("local", "discrete", "Boolean")
     expected = ([(v, "parameter", "fixed") for v in cls.parameters] + [(v, "input", "continuous") for v in cls.inputs]
                 + [(v, "output", "continuous") for v in cls.outputs])
     assert len(got) == len(expected)

@@ -10,6 +10,7 @@ import json
 import re
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from clutchlab.fmu.cosim import EmtcCoSimulation, WetCoSimulation
 fmpy = pytest.importorskip("fmpy")
 
 FMI2_DISCARD = 2
+FMI2_ERROR = 3
 
 
 def _host(tmp_path, script, *args):
@@ -128,20 +130,60 @@ s.setReal([vr["torque_request"]], [math.nan])
 step("nan input", 0.001, 0.001)
 s.setReal([vr["torque_request"]], [100.0])
 step("valid again", 0.001, 0.001)
+torque = s.getReal([vr["coupling_torque"]])[0]
+step("zero again", 0.002, 0.0)
+status["torque kept"] = s.getReal([vr["coupling_torque"]])[0] == torque
+# FMI 2.0 after fmi2Error: fmi2Reset (or fmi2FreeInstance); the reset instance starts afresh
+s.reset()
+s.setupExperiment(startTime=0.0)
+s.enterInitializationMode()
+s.exitInitializationMode()
+step("valid after reset", 0.0, 0.001)
 s.terminate()
 s.freeInstance()
 print(json.dumps(status))
 """
 
 
-def test_invalid_steps_and_inputs_fail_the_step_and_leave_the_instance_usable(tmp_path, build_fmu):
-    """Through FMPy's FMU2Slave: every invalid step or input fails that step with the status documented in
-    docs/fmu.md (pythonfmu 0.7 maps a failed step to fmi2Discard) and the model stays where it was."""
+def _invalid_statuses(code):
+    return {"zero": code, "negative": code, "nan": code, "not at the current time": code, "valid": 0,
+            "nan input": code, "valid again": 0, "zero again": code, "torque kept": True, "valid after reset": 0}
+
+
+def test_invalid_steps_and_inputs_return_fmi2error_and_leave_the_instance_usable(tmp_path, build_fmu):
+    """Through FMPy's FMU2Slave: every invalid step or input returns fmi2Error (3), as docs/fmu.md says (the
+    shim library turns pythonfmu's fmi2Discard into fmi2Error); the model stays where it was, valid steps
+    continue, and fmi2Reset after the error starts afresh."""
+    with zipfile.ZipFile(build_fmu("emtc")) as z:
+        assert {"binaries/linux64/ClutchlabEmtc.so", "binaries/linux64/ClutchlabEmtc_pythonfmu.so"} <= set(z.namelist())
     out = _host(tmp_path, _INVALID, build_fmu("emtc"))
-    status = json.loads(out.strip().splitlines()[-1])
-    assert status == {"zero": FMI2_DISCARD, "negative": FMI2_DISCARD, "nan": FMI2_DISCARD,
-                      "not at the current time": FMI2_DISCARD, "valid": 0, "nan input": FMI2_DISCARD,
-                      "valid again": 0}
+    assert json.loads(out.strip().splitlines()[-1]) == _invalid_statuses(FMI2_ERROR)
+
+
+def test_without_a_c_compiler_the_fmu_works_and_returns_fmi2discard(tmp_path, build_fmu, run_fmu, monkeypatch,
+                                                                     capsys):
+    """No ``cc`` on the PATH: the export still succeeds with pythonfmu's library alone, says so in one warning
+    line, and the FMU gives the same results, failing invalid steps with fmi2Discard (2)."""
+    from clutchlab.cli import main
+
+    path = tmp_path / "emtc.fmu"
+    with monkeypatch.context() as m:
+        m.setenv("PATH", str(tmp_path / "no-bin"))
+        assert main(["export-fmu", "emtc", "-o", str(path)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("clutchlab: warning:") and "fmi2Discard" in err[0], err
+    with zipfile.ZipFile(path) as z:
+        names = z.namelist()
+    assert "binaries/linux64/ClutchlabEmtc.so" in names and not any("_pythonfmu" in n for n in names)
+    out = _host(tmp_path, _INVALID, path)
+    assert json.loads(out.strip().splitlines()[-1]) == _invalid_statuses(FMI2_DISCARD)
+    # valid steps: the same results through either binary
+    n, dt = 10, 0.01
+    inputs = {"torque_request": np.full(n + 1, 200.0)}
+    names = ["coupling_torque", "coil_current"]
+    plain, shimmed = run_fmu(path, inputs, dt, n, names), run_fmu(build_fmu("emtc"), inputs, dt, n, names)
+    for name in names:
+        np.testing.assert_array_equal(plain[name], shimmed[name], err_msg=name)
 
 
 def _docs_example():

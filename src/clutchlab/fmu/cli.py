@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+import warnings
 from pathlib import Path
 
 from . import COSIMULATIONS
@@ -14,7 +16,11 @@ def _export(args) -> int:
 
     output = args.output if args.output is not None else Path(f"{args.model}.fmu")
     check_writable(output, args.force)  # before the build
-    path = export_fmu(args.model, output, overwrite=args.force)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UserWarning)
+        path = export_fmu(args.model, output, overwrite=args.force)
+    for w in caught:  # e.g. no C compiler for the fmi2Error shim: one line each
+        print(f"clutchlab: warning: {w.message}", file=sys.stderr)
     print(path)
     return 0
 

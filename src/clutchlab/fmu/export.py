@@ -26,9 +26,13 @@ References
 from __future__ import annotations
 
 import io
+import platform
 import re
+import shutil
+import subprocess
 import sys
 import tempfile
+import warnings
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -39,7 +43,10 @@ from ..io import atomic_write_bytes, check_writable
 from . import COSIMULATIONS
 from .cosim import load_cosimulation
 
-__all__ = ["export_fmu", "keep_namespace", "model_identifier", "slave_script", "unit_definition"]
+__all__ = ["compile_shim", "export_fmu", "keep_namespace", "model_identifier", "slave_script", "unit_definition"]
+
+#: name of the slave's local Boolean that flags a refused step (read by the shim library, ``shim/fmi2_shim.c``)
+STEP_ERROR = "step_error"
 
 #: default experiment written into the modelDescription (stop time [s], communication step [s])
 DEFAULT_EXPERIMENT = {"wet": (1.0, 1e-3), "emtc": (2.0, 0.01), "eclutch": (1.0, 1e-3)}
@@ -133,7 +140,7 @@ def _on_model_thread(fn, *args):
 
 def _slave_base():
     """The pythonfmu base class, defined on first use (pythonfmu is needed only to build and run FMUs)."""
-    from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+    from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
     from pythonfmu.enums import Fmi2Status
     from pythonfmu.default_experiment import DefaultExperiment
 
@@ -143,7 +150,10 @@ def _slave_base():
         Parameters are applied when the master leaves initialisation mode
         (they are ``fixed``); inputs are read and outputs written at every
         ``fmi2DoStep``.  Errors of the model are logged with status
-        ``fmi2Error`` and make the step fail.
+        ``fmi2Error`` and make the step fail: ``do_step`` returns ``False``
+        (pythonfmu's ``fmi2Discard``) and raises the local Boolean
+        :data:`STEP_ERROR` variable, from which the FMU's shim library
+        returns ``fmi2Error`` (see :func:`export_fmu`).
         """
 
         model_key: str = ""
@@ -169,6 +179,13 @@ def _slave_base():
                         var.name, causality=causality, variability=variability, description=var.description or None,
                         getter=(lambda n=var.name: self.values[n]),
                         setter=(lambda x, n=var.name: self.values.__setitem__(n, float(x)))), nested=False)
+            # read by the shim after a discarded step (fmi2_shim.c): True if this slave refused the last step
+            self.step_error = False
+            self.register_variable(Boolean(
+                STEP_ERROR, causality=Fmi2Causality.local, variability=Fmi2Variability.discrete,
+                description="true if the last fmi2DoStep was refused (invalid step or input, model failure): "
+                            "the FMU then returns fmi2Error",
+                getter=lambda: self.step_error), nested=False)
 
         def _inputs(self):
             return {v.name: self.values[v.name] for v in self.cosim_class.inputs}
@@ -197,9 +214,11 @@ def _slave_base():
             return _on_model_thread(self._step, current_time, step_size)
 
         def _step(self, current_time: float, step_size: float) -> bool:
+            self.step_error = False
             try:
                 self.values.update(self.cosim.do_step(float(current_time), float(step_size), self._inputs()))
             except Exception as exc:  # reported to the master through the FMI logger
+                self.step_error = True
                 return self._fail(exc)
             return True
 
@@ -283,6 +302,68 @@ def _add_units(xml_bytes: bytes, units: dict) -> bytes:
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
 
 
+# ----------------------------------------------------------------- fmi2Error shim
+#: folder of the shim's C source and the FMI 2.0 headers it is compiled against
+SHIM_SOURCE = Path(__file__).with_name("shim")
+
+
+def _step_error_reference(xml_bytes: bytes) -> int:
+    """Value reference of the slave's :data:`STEP_ERROR` Boolean in a modelDescription.xml."""
+    root = ET.fromstring(xml_bytes)
+    for sv in root.iter("ScalarVariable"):
+        if sv.get("name") == STEP_ERROR:
+            return int(sv.get("valueReference"))
+    raise ClutchlabError(f"modelDescription.xml has no {STEP_ERROR!r} variable")  # pragma: no cover
+
+
+def compile_shim(ident: str, step_error_vr: int, workdir) -> bytes:
+    """Compile the FMI 2.0 shim library (``shim/fmi2_shim.c``) for the FMU ``ident`` on this Linux machine.
+
+    The shim becomes ``binaries/linux64/<ident>.so`` and forwards every
+    ``fmi2*`` function to pythonfmu's library, renamed ``<ident>_pythonfmu.so``
+    beside it; from a step that library reports as ``fmi2Discard`` it returns
+    ``fmi2Error`` when the slave's ``step_error`` Boolean (value reference
+    ``step_error_vr``) is set.  Built with the system C compiler, ``cc``.
+
+    Parameters
+    ----------
+    ident : str
+        FMI model identifier (:func:`model_identifier`).
+    step_error_vr : int
+        Value reference of the slave's :data:`STEP_ERROR` variable.
+    workdir : path-like
+        Existing folder for the compiler's output.
+
+    Returns
+    -------
+    bytes
+        The shared library.
+
+    Raises
+    ------
+    OSError
+        Not a 64-bit x86 Linux, no ``cc`` on the ``PATH``, or the compilation
+        failed (the message says which).
+    """
+    if not sys.platform.startswith("linux") or platform.machine() not in ("x86_64", "AMD64"):
+        raise OSError(f"the shim is built for linux64 only (exporting on {sys.platform} {platform.machine()})")
+    cc = shutil.which("cc")
+    if cc is None:
+        raise OSError("no C compiler ('cc') found on the PATH")
+    out = Path(workdir) / f"{ident}.so"
+    cmd = [cc, "-shared", "-fPIC", "-O2", f"-I{SHIM_SOURCE}", f'-DCLUTCHLAB_INNER_LIBRARY="{ident}_pythonfmu.so"',
+           f"-DCLUTCHLAB_STEP_ERROR_VR={int(step_error_vr)}u", str(SHIM_SOURCE / "fmi2_shim.c"), "-o", str(out),
+           "-ldl", "-lpthread"]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise OSError(f"C compiler {cc} failed to run: {exc}") from None
+    if proc.returncode != 0 or not out.is_file():
+        last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
+        raise OSError(f"C compiler {cc} failed (return code {proc.returncode}): {last}")
+    return out.read_bytes()
+
+
 def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
     """Build an FMI 2.0 co-simulation FMU of a registered model.
 
@@ -307,12 +388,22 @@ def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
     FileExistsError
         ``path`` exists and ``overwrite`` is false.
 
+    Warns
+    -----
+    UserWarning
+        One line, when the shim library cannot be compiled (no ``cc``, not
+        Linux x86-64): the FMU then keeps pythonfmu's library alone, and an
+        invalid step returns ``fmi2Discard`` instead of ``fmi2Error``.
+
     Notes
     -----
     The FMU lists the model's inputs (causality ``input``), outputs
     (``output``) and parameters (``parameter``, variability ``fixed``: set
     before initialisation) with units; the importing tool needs a Python
-    with clutchlab installed (module docstring).
+    with clutchlab installed (module docstring).  On Linux x86-64, pythonfmu's
+    library becomes ``binaries/linux64/<id>_pythonfmu.so`` behind a shim
+    compiled here (:func:`compile_shim`) that returns ``fmi2Error`` for a
+    refused step; the Windows binary is pythonfmu's, unchanged.
     """
     ident = model_identifier(model)
     path = Path(path)
@@ -335,11 +426,22 @@ def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
                                      canBeInstantiatedOnlyOncePerProcess=False)
         # pythonfmu leaves the script module imported; drop it so a later build starts clean
         sys.modules.pop(script.stem, None)
+        linux_lib = f"binaries/linux64/{ident}.so"
+        with zipfile.ZipFile(built) as src:
+            try:
+                shim = compile_shim(ident, _step_error_reference(src.read("modelDescription.xml")), tmp)
+            except OSError as exc:
+                shim = None
+                warnings.warn(f"{exc}: {path.name} keeps pythonfmu's library alone, so invalid steps return "
+                              f"fmi2Discard (2), not fmi2Error (3)", UserWarning, stacklevel=2)
         buf = io.BytesIO()
         with zipfile.ZipFile(built) as src, zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as dst:
             for info in src.infolist():
                 data = src.read(info.filename)
                 if info.filename == "modelDescription.xml":
                     data = _add_units(data, units)
+                if info.filename == linux_lib and shim is not None:
+                    dst.writestr(f"binaries/linux64/{ident}_pythonfmu.so", data)  # pythonfmu's, unmodified
+                    data = shim
                 dst.writestr(info.filename, data)
     return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
