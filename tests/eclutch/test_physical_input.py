@@ -4,22 +4,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from clutchlab.cli import main
 from clutchlab.eclutch import ClutchModel, pedal_reference
 from clutchlab.eclutch.characterize import characterize
 from clutchlab.eclutch.pressrig import simulate_press_test
 from clutchlab.eclutch.scenario import scenario_from_dict
 from clutchlab.eclutch.validation import compare
 from clutchlab.errors import DataError, ParameterError, SimulationError
+from cli_checks import one_line_error
 
 
-def one_line_error(capsys, argv):
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("clutchlab: error: "), err
-    return lines[0]
 
 
 def leaf(s):

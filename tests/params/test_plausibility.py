@@ -4,22 +4,15 @@ import dataclasses
 
 import pytest
 
-from clutchlab.cli import main
 from clutchlab.errors import ParameterError
 from clutchlab.params.base import MAGNITUDE_LIMIT, PLAUSIBLE_LIMITS
 from clutchlab.params.registry import MODELS, model_sets
 from clutchlab.wet import WetClutch
+from cli_checks import one_line_error
 
 ENTRIES = [e for m in MODELS for e in model_sets(m)]
 
 
-def one_line_error(capsys, argv):
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("clutchlab: error: "), err
-    return lines[0]
 
 
 def test_huge_radius_is_refused_not_overflowed():

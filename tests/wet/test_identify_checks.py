@@ -4,11 +4,11 @@ import math
 
 import pytest
 
-from clutchlab.cli import main
 from clutchlab.errors import IdentificationError, ParameterError
 from clutchlab.wet import Bench, WetClutch
 from clutchlab.wet.bench import EngagementProtocol, MapProtocol, run_protocol
 from clutchlab.wet.identify import friction_samples, identify_friction_map, identify_thermal
+from cli_checks import one_line_error
 
 
 @pytest.fixture(scope="module")
@@ -18,13 +18,6 @@ def engagement():
                         protocol_type="engagement").record
 
 
-def one_line_error(capsys, argv):
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("clutchlab: error: "), err
-    return lines[0]
 
 
 @pytest.mark.parametrize("lag", [math.nan, math.inf, -0.1])
