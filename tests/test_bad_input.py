@@ -461,3 +461,14 @@ def test_subprocess_no_traceback(tmp_path, files, argv, fragment):
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("clutchlab: error: ") and fragment in lines[0], proc.stderr
     assert _listing(tmp_path) == before
+
+
+def test_short_repr_shows_numpy_scalars_as_plain_numbers():
+    import numpy as np
+
+    assert short_repr(np.float64(1.5)) == "1.5"
+    assert short_repr(np.int64(3)) == "3"
+    assert short_repr(np.bool_(True)) == "True"
+    assert short_repr(np.array(2.25)) == "2.25"
+    assert short_repr("abc") == "'abc'"
+    assert short_repr(np.arange(10.0)).startswith("ndarray(shape=(10,)")

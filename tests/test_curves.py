@@ -180,3 +180,14 @@ def test_stiffness_matches_finite_difference():
 def test_public_names():
     assert clutchlab.Curve is Curve
     assert clutchlab.curves.series is series and clutchlab.curves.parallel is parallel
+
+
+def test_curve_errors_show_plain_numbers():
+    """Array elements in messages read 0.002, not np.float64(0.002) (NumPy 2 repr)."""
+    with pytest.raises(DataError) as info:
+        Curve([0.0, 0.002, 0.002], [0.0, 1.0, 2.0], name="c")
+    assert "deflection[2] = 0.002 <= deflection[1] = 0.002" in str(info.value)
+    assert "np." not in str(info.value)
+    with pytest.raises(ParameterError) as info:
+        Curve([0.0, 1e-3], [0.0, 1.0], extrapolation="error", name="c")(np.array([0.5]))
+    assert "deflection 0.5 m outside the measured range [0.0, 0.001]" in str(info.value)

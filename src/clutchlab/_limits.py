@@ -127,7 +127,8 @@ def short_repr(value, limit: int = 60) -> str:
 
     Arrays and long sequences are summarised by their type, length and first
     elements (``array(shape=(10000000,), [0.0, 1.0, 2.0, ...])``); long strings
-    and other long representations are cut in the middle with ``...``.
+    and other long representations are cut in the middle with ``...``.  A NumPy
+    scalar shows as the plain number (``1.5``, not ``np.float64(1.5)``).
 
     Parameters
     ----------
@@ -141,6 +142,11 @@ def short_repr(value, limit: int = 60) -> str:
     str
     """
     shape = getattr(value, "shape", None)
+    if shape == () and hasattr(value, "item"):  # a NumPy scalar or 0-d array: 1.5, not np.float64(1.5)
+        try:
+            value, shape = value.item(), None
+        except Exception:  # pragma: no cover - an exotic scalar type: keep it as it is
+            pass
     if shape is not None and hasattr(value, "ravel") and getattr(value, "size", 0) > 3:
         try:
             head = ", ".join(short_repr(v.item() if hasattr(v, "item") else v, 12) for v in value.ravel()[:3])

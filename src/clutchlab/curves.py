@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from ._limits import short_repr
 from .errors import DataError, ParameterError
 from .numerics.interp import bracket
 
@@ -190,13 +191,13 @@ class Curve:
             bad = ~np.isfinite(arr)
             if bad.any():
                 k = int(np.flatnonzero(bad)[0])
-                raise DataError(f"curve {self.name!r}: {label}[{k}] = {arr[k]!r} is not finite")
+                raise DataError(f"curve {self.name!r}: {label}[{k}] = {short_repr(arr[k])} is not finite")
         dx = np.diff(x)
         if (dx <= 0).any():
             k = int(np.flatnonzero(dx <= 0)[0])
             raise DataError(
                 f"curve {self.name!r}: deflection must be strictly increasing, but "
-                f"deflection[{k + 1}] = {x[k + 1]!r} <= deflection[{k}] = {x[k]!r}"
+                f"deflection[{k + 1}] = {short_repr(x[k + 1])} <= deflection[{k}] = {short_repr(x[k])}"
             )
         if self.kind not in KIND_CODES:
             raise ParameterError(f"curve {self.name!r}: kind = {self.kind!r}, expected one of {sorted(KIND_CODES)}")
@@ -224,7 +225,7 @@ class Curve:
         """A linear spring ``F = force_at_zero + stiffness * x`` [N/m, N], extrapolated linearly."""
         lo, hi = span
         if not np.isfinite(stiffness):
-            raise ParameterError(f"curve {name!r}: stiffness = {stiffness!r} is not finite")
+            raise ParameterError(f"curve {name!r}: stiffness = {short_repr(stiffness)} is not finite")
         return cls([lo, hi], [force_at_zero + stiffness * lo, force_at_zero + stiffness * hi], name=name)
 
     @classmethod
@@ -247,7 +248,7 @@ class Curve:
             if np.any(bad):
                 v = np.asarray(x)[bad].ravel()[0]
                 raise ParameterError(
-                    f"curve {self.name!r}: deflection {v!r} m outside the measured range [{lo!r}, {hi!r}] "
+                    f"curve {self.name!r}: deflection {short_repr(v)} m outside the measured range [{short_repr(lo)}, {short_repr(hi)}] "
                     "and extrapolation='error'"
                 )
 
@@ -282,7 +283,7 @@ class Curve:
         diaphragm spring by 1.3 (Section 5.4).
         """
         if not (np.isfinite(factor) and factor > 0):
-            raise ParameterError(f"curve {self.name!r}: scale factor = {factor!r} must be finite and > 0")
+            raise ParameterError(f"curve {self.name!r}: scale factor = {short_repr(factor)} must be finite and > 0")
         return self._replace(force=self.force * factor, name=f"{self.name}*{factor:g}")
 
     def shift(self, prestrain: float) -> "Curve":
@@ -292,7 +293,7 @@ class Curve:
         in the assembled clutch) has force ``g(0) = f(prestrain)`` there.
         """
         if not np.isfinite(prestrain):
-            raise ParameterError(f"curve {self.name!r}: prestrain = {prestrain!r} is not finite")
+            raise ParameterError(f"curve {self.name!r}: prestrain = {short_repr(prestrain)} is not finite")
         return self._replace(deflection=self.deflection - prestrain)
 
     def is_monotone(self) -> bool:
@@ -308,7 +309,7 @@ class Curve:
             return -1
         k = int(np.flatnonzero(np.diff(np.sign(df)) != 0)[0]) + 1 if np.any(np.diff(np.sign(df)) != 0) else int(np.flatnonzero(df == 0)[0])
         raise ParameterError(
-            f"curve {self.name!r} is not monotone (force turns near deflection {self.deflection[k]!r} m); "
+            f"curve {self.name!r} is not monotone (force turns near deflection {short_repr(self.deflection[k])} m); "
             "it has no inverse"
         )
 
@@ -330,8 +331,8 @@ class Curve:
             bad = (g < fz[0] - 1e-9 * max(1.0, abs(fz[0]))) | (g > fz[-1] + 1e-9 * max(1.0, abs(fz[-1])))
             if np.any(bad):
                 raise ParameterError(
-                    f"curve {self.name!r}: force {np.atleast_1d(f)[np.atleast_1d(bad)][0]!r} N outside the measured "
-                    f"range [{min(fs[0], fs[-1])!r}, {max(fs[0], fs[-1])!r}] and extrapolation='error'"
+                    f"curve {self.name!r}: force {short_repr(np.atleast_1d(f)[np.atleast_1d(bad)][0])} N outside the measured "
+                    f"range [{short_repr(min(fs[0], fs[-1]))}, {short_repr(max(fs[0], fs[-1]))}] and extrapolation='error'"
                 )
         i = np.clip(np.searchsorted(fz, g, side="right") - 1, 0, xs.size - 2)
         if self.kind == "linear":
@@ -374,7 +375,7 @@ class Curve:
         ``result.stiffness(0.0)``.
         """
         if not (np.isfinite(lower) and np.isfinite(upper) and upper > lower):
-            raise ParameterError(f"curve {self.name!r}: linearize range [{lower!r}, {upper!r}] is empty or not finite")
+            raise ParameterError(f"curve {self.name!r}: linearize range [{short_repr(lower)}, {short_repr(upper)}] is empty or not finite")
         x = np.linspace(lower, upper, npoints)
         k, c = np.polyfit(x, self(x), 1)
         return Curve([lower, upper], [c + k * lower, c + k * upper], name=f"{self.name} (linearised)")

@@ -134,3 +134,25 @@ def test_bad_networks_raise_clear_errors(build, match):
 def test_bad_input_positions():
     with pytest.raises(ParameterError, match="finite"):
         solve_static(linear_model0(), [0.0, np.nan])
+
+
+@pytest.mark.parametrize(
+    "build, shown",
+    [
+        (lambda: Node("m", mass=np.float64(-1.5)), "mass = -1.5 kg"),
+        (lambda: Lever("l", "a", "b", np.float64(2.5)), "i_ds = 2.5 must"),
+        (lambda: Lever("l", "a", "b", -2.0, stiffness=np.float64(-5.0)), "k_fl = -5.0 N/m"),
+        (lambda: Spring("s", "a", Curve.linear(1.0), scale=np.float64(0.0)), "scale = 0.0 must"),
+        (lambda: Spring("s", "a", Curve.linear(1.0), gain=np.float32(0.0)), "gain = 0.0 must"),
+        (lambda: zero_input(linear_model0(), "bearing", np.float64(-3.0)), "force = -3.0 N"),
+        (lambda: zero_input(linear_model0(), "bearing", 80.0, bracket=np.array([0.01, 0.02])),
+         "within [0.01, 0.02] m"),
+    ],
+)
+def test_network_errors_show_numpy_scalars_as_plain_numbers(build, shown):
+    """NumPy 2 reprs (``np.float64(1.5)``) must not leak into the messages."""
+    with pytest.raises(ParameterError) as info:
+        build()
+    msg = str(info.value)
+    assert shown in msg
+    assert "np." not in msg and "float64" not in msg and "float32" not in msg

@@ -40,7 +40,7 @@ import numpy as np
 import pandas as pd
 
 from ..curves import Curve, series
-from .._limits import check_allocation
+from .._limits import check_allocation, short_repr
 from ..errors import DataError, IdentificationError, ParameterError
 from ..io import Measurement, read_measurement
 
@@ -689,7 +689,7 @@ def lever_stiffness(record_b, record_c, lever_ratio: float, *, force_range=None,
     sxx = float(((d - d.mean()) ** 2).sum())
     se = float(np.sqrt((resid ** 2).sum() / dof / sxx)) if sxx > 0 else float("inf")
     if not (np.isfinite(k_fl) and k_fl > 0):
-        raise IdentificationError(f"Eq. 1 gives a non-positive finger stiffness {k_fl!r} N/m; check lever_ratio and channels")
+        raise IdentificationError(f"Eq. 1 gives a non-positive finger stiffness {short_repr(k_fl)} N/m; check lever_ratio and channels")
 
     # finger characteristic: isotonic in force (noise can make the deflection jitter), strictly increasing
     from scipy.optimize import isotonic_regression

@@ -46,7 +46,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from .._limits import check_allocation
+from .._limits import check_allocation, short_repr
 from ..errors import ParameterError, SimulationError
 from ..params import ParameterSet, quantity
 from . import _dynamics_kernel as K
@@ -621,7 +621,7 @@ class _System:
             u0=0.0, jac_every=1, atol_scale=1.0):
         if not (np.isfinite(atol_scale) and atol_scale > 0):
             raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
-        rows, what = ((t_grid.shape[0], f"t_end = {t_end!r} s at output_step = {t_grid[1] - t_grid[0]!r} s")
+        rows, what = ((t_grid.shape[0], f"t_end = {short_repr(t_end)} s at output_step = {short_repr(t_grid[1] - t_grid[0])} s")
                       if t_grid.shape[0] > 1 else (int(max_steps) + 1, f"max_steps = {max_steps!r} recorded steps"))
         # the kernel's records (time, states, auxiliaries, modes), then the outputs computed from them
         check_allocation(rows, 2 * (1 + self.n + K.N_AUX_FIXED + 2 * self.nz), what)
@@ -770,10 +770,10 @@ def _as_table(value, name: str):
     bad = ~(np.isfinite(t) & np.isfinite(v))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ParameterError(f"input {name!r}: row {i} (time {t[i]!r} s, value {v[i]!r}) is not finite")
+        raise ParameterError(f"input {name!r}: row {i} (time {short_repr(t[i])} s, value {short_repr(v[i])}) is not finite")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
-        raise ParameterError(f"input {name!r}: times must increase strictly (row {i}: {t[i]!r} s after {t[i - 1]!r} s)")
+        raise ParameterError(f"input {name!r}: times must increase strictly (row {i}: {short_repr(t[i])} s after {short_repr(t[i - 1])} s)")
     if t[0] > 0:
         t = np.concatenate([[0.0], t])
         v = np.concatenate([[v[0]], v])

@@ -41,6 +41,7 @@ import numba
 import numpy as np
 
 from ..curves import Curve, curve_eval
+from .._limits import short_repr
 from ..errors import ParameterError, SimulationError
 
 __all__ = ["Node", "Spring", "Lever", "AxialNetwork", "solve_static", "zero_input", "GROUND"]
@@ -68,7 +69,7 @@ class Node:
         if not isinstance(self.name, str) or not self.name or self.name == GROUND:
             raise ParameterError(f"node name {self.name!r} is empty or reserved")
         if not (np.isfinite(self.mass) and self.mass >= 0):
-            raise ParameterError(f"node {self.name!r}: mass = {self.mass!r} kg must be finite and >= 0")
+            raise ParameterError(f"node {self.name!r}: mass = {short_repr(self.mass)} kg must be finite and >= 0")
 
 
 @dataclass(frozen=True)
@@ -115,11 +116,11 @@ class Spring:
         if not isinstance(self.curve, Curve):
             raise ParameterError(f"spring {self.name!r}: curve must be a clutchlab.Curve, got {type(self.curve).__name__}")
         if not np.isfinite(self.prestrain):
-            raise ParameterError(f"spring {self.name!r}: prestrain = {self.prestrain!r} m is not finite")
+            raise ParameterError(f"spring {self.name!r}: prestrain = {short_repr(self.prestrain)} m is not finite")
         if not (np.isfinite(self.scale) and self.scale > 0):
-            raise ParameterError(f"spring {self.name!r}: scale = {self.scale!r} must be finite and > 0")
+            raise ParameterError(f"spring {self.name!r}: scale = {short_repr(self.scale)} must be finite and > 0")
         if not (np.isfinite(self.gain) and self.gain != 0):
-            raise ParameterError(f"spring {self.name!r}: gain = {self.gain!r} must be finite and non-zero")
+            raise ParameterError(f"spring {self.name!r}: gain = {short_repr(self.gain)} must be finite and non-zero")
         if self.a == self.b:
             raise ParameterError(f"spring {self.name!r}: both ends on node {self.a!r}")
 
@@ -169,15 +170,15 @@ class Lever:
 
     def __post_init__(self):
         if not (np.isfinite(self.ratio) and self.ratio < 0):
-            raise ParameterError(f"lever {self.name!r}: ratio i_ds = {self.ratio!r} must be finite and < 0")
+            raise ParameterError(f"lever {self.name!r}: ratio i_ds = {short_repr(self.ratio)} must be finite and < 0")
         if len({self.tip, self.edge, self.pivot}) != 3:
             raise ParameterError(f"lever {self.name!r}: tip, edge and pivot must be three different nodes")
         if not np.isfinite(self.prestrain):
-            raise ParameterError(f"lever {self.name!r}: prestrain = {self.prestrain!r} m is not finite")
+            raise ParameterError(f"lever {self.name!r}: prestrain = {short_repr(self.prestrain)} m is not finite")
         s = self.stiffness
         if s is not None and not isinstance(s, Curve):
             if isinstance(s, bool) or not isinstance(s, (int, float)) or not (np.isfinite(s) and s > 0):
-                raise ParameterError(f"lever {self.name!r}: stiffness k_fl = {s!r} N/m must be finite and > 0 (or None: rigid)")
+                raise ParameterError(f"lever {self.name!r}: stiffness k_fl = {short_repr(s)} N/m must be finite and > 0 (or None: rigid)")
 
     @property
     def rigid(self) -> bool:
@@ -575,7 +576,7 @@ def solve_static(network: AxialNetwork, input_positions, *, q0=None, force_tol: 
     Q, F, D, status = _static_path(u, q, *network.kernel_data(), force_tol, x_tol)
     if status:
         raise SimulationError(
-            f"{network.name}: static equilibrium not found at input position {u[status - 1]!r} m "
+            f"{network.name}: static equilibrium not found at input position {short_repr(u[status - 1])} m "
             "(snap-through or an element without stiffness)"
         )
     X = Q @ a["A"].T + np.outer(u, a["b"]) + a["c"]
@@ -613,7 +614,7 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
     if not isinstance(el, Spring):
         raise ParameterError(f"zero_input: element {element!r} must be a spring")
     if not (np.isfinite(force) and force >= 0):
-        raise ParameterError(f"zero_input: force = {force!r} N must be finite and >= 0")
+        raise ParameterError(f"zero_input: force = {short_repr(force)} N must be finite and >= 0")
 
     def residual(p):
         net = network.replace_element(element, _replace_spring(el, prestrain=p))
@@ -625,7 +626,7 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
     lo, hi = bracket
     r_lo, r_hi = residual(lo), residual(hi)
     if not (np.isfinite(r_lo) and np.isfinite(r_hi)) or r_lo * r_hi > 0:
-        raise ParameterError(f"zero_input: cannot reach an input force of {force!r} N by shifting {element!r} within {bracket} m")
+        raise ParameterError(f"zero_input: cannot reach an input force of {short_repr(force)} N by shifting {element!r} within [{short_repr(lo)}, {short_repr(hi)}] m")
     p = brentq(residual, lo, hi, xtol=1e-13, rtol=1e-12)
     return network.replace_element(element, _replace_spring(el, prestrain=p))
 

@@ -40,6 +40,7 @@ import numba
 import numpy as np
 import pandas as pd
 
+from .._limits import short_repr
 from ..errors import ParameterError, SimulationError
 
 __all__ = ["simulate_press_test", "simulate_lever_tests", "spindle_stroke", "stop_operator"]
@@ -92,7 +93,7 @@ def _call_law(law: Callable, x: np.ndarray, what: str) -> np.ndarray:
     bad = ~np.isfinite(out)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise SimulationError(f"{what} returned {out[k]!r} at input {x[k]!r}")
+        raise SimulationError(f"{what} returned {short_repr(out[k])} at input {short_repr(x[k])}")
     return out
 
 

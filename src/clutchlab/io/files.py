@@ -253,7 +253,7 @@ def read_table(source, required: Iterable[str], *, name: str | None = None, allo
         bad = ~np.isfinite(values.to_numpy(dtype=float))
         if col not in allow_nan and bad.any():
             row = int(np.flatnonzero(bad)[0])
-            raise DataError(f"{label}: column {col!r} has a non-finite or non-numeric value {frame[col].iloc[row]!r} at row {row}")
+            raise DataError(f"{label}: column {col!r} has a non-finite or non-numeric value {short_repr(frame[col].iloc[row])} at row {row}")
         frame[col] = values.astype(float)
     return frame
 

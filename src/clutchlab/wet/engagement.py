@@ -52,7 +52,7 @@ import numba
 import numpy as np
 import pandas as pd
 
-from .._limits import check_allocation
+from .._limits import check_allocation, short_repr
 from ..errors import ParameterError, SimulationError
 from ..numerics.interp import bracket
 from ..numerics.dopri import (
@@ -165,7 +165,7 @@ class Scenario:
         ft, fv = _profile("force", self.force_time, self.force_value)
         st, sv = _profile("speed", self.speed_time, self.speed_value)
         if np.any(fv < 0):
-            raise ParameterError(f"Scenario.force_value: negative force {fv[fv < 0][0]!r} [N]")
+            raise ParameterError(f"Scenario.force_value: negative force {short_repr(fv[fv < 0][0])} [N]")
         object.__setattr__(self, "force_time", ft)
         object.__setattr__(self, "force_value", fv)
         object.__setattr__(self, "speed_time", st)

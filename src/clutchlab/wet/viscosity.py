@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from .._limits import short_repr
 from ..errors import DataError, IdentificationError
 
 __all__ = ["atf_viscosity", "fit_viscosity", "ViscosityFit"]
@@ -125,7 +126,7 @@ def fit_viscosity(temperature_c, viscosity) -> ViscosityFit:
     if not np.all(np.isfinite(t)) or not np.all(np.isfinite(mu)):
         raise DataError("temperature_c/viscosity: non-finite sample")
     if np.any(mu <= 0):
-        raise DataError(f"viscosity: non-positive value {mu[mu <= 0][0]!r} [Pa*s]")
+        raise DataError(f"viscosity: non-positive value {short_repr(mu[mu <= 0][0])} [Pa*s]")
     if np.unique(t).size < 5:
         raise DataError(f"fit_viscosity needs at least 5 distinct temperatures, got {np.unique(t).size}")
     order = np.argsort(t)
