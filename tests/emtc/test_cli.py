@@ -88,3 +88,17 @@ def test_demo_section_is_synthetic_and_complete():
     # compensation with the inverse model beats the anhysteretic inverse by a wide margin (Fig. 8)
     assert comp["RMS error [N]"].iloc[0] < 0.3 * comp["RMS error [N]"].iloc[1]
     assert len(msgs) >= 3
+
+
+def test_simulate_plot_closes_its_figure(tmp_path, capsys):
+    """``emtc simulate --plot`` saves the figure and closes it: nothing stays open in the process."""
+    import matplotlib.pyplot as plt
+    from pathlib import Path
+
+    plt.close("all")
+    scenario = Path(__file__).resolve().parents[2] / "examples" / "emtc_scenario.toml"
+    png = tmp_path / "run.png"
+    code, _, err = run(capsys, "emtc", "simulate", scenario, "-o", tmp_path / "run.csv", "--plot", png)
+    assert code == 0, err
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert plt.get_fignums() == []

@@ -90,9 +90,14 @@ def _simulate(args) -> int:
         from .demo import bench_figure
         import io
 
+        import matplotlib.pyplot as plt
+
         fig = mark_synthetic(bench_figure(res, "EMTC drum-bench simulation"))
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+        try:
+            fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+        finally:
+            plt.close(fig)  # a CLI run (or many in one process) must not leave figures open
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
         print(args.plot)
     print(args.output)
