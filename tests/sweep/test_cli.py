@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from clutchlab.cli import main
+from cli_checks import one_line_error
 
 SPEC = """
 [sweep]
@@ -54,6 +55,26 @@ def test_sweep_command_errors_are_one_line(tmp_path, capsys):
     assert main(["sweep", str(other), "-o", str(tmp_path / "res2")]) == 2
     assert "different sweep" in capsys.readouterr().err
     assert main(["sweep", str(other), "-o", str(tmp_path / "res2"), "--force", "--no-progress", "--no-plot"]) == 0
+
+
+def test_refused_sweep_prints_only_its_error(tmp_path, capsys):
+    """Every refusal comes before the "N variants ..." start line: the user sees one stderr line."""
+    path = write(tmp_path)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("not a sweep\n")
+    assert "not a sweep folder" in one_line_error(capsys, ["sweep", str(path), "-o", str(foreign), "--no-progress"])
+    assert (foreign / "notes.txt").read_text() == "not a sweep\n" and not (foreign / "manifest.json").exists()
+    assert "workers = 0" in one_line_error(capsys, ["sweep", str(path), "-o", str(tmp_path / "w"), "--workers", "0"])
+    res = tmp_path / "res"
+    assert main(["sweep", str(path), "-o", str(res), "--no-progress", "--no-plot"]) == 0
+    assert "4 variants of" in capsys.readouterr().err  # the start line is still there for a sweep that runs
+    other = tmp_path / "other.toml"
+    other.write_text(SPEC.replace("0.3]", "0.35]"))
+    assert "different sweep" in one_line_error(capsys, ["sweep", str(other), "-o", str(res), "--no-progress"])
+    stray = res / "chunks" / "chunk-9-of-9.parquet"
+    stray.write_bytes(b"not parquet")
+    assert "not a chunk of this sweep" in one_line_error(capsys, ["sweep", str(path), "-o", str(res), "--no-progress"])
 
 
 def test_list_parameters(tmp_path, capsys):

@@ -33,7 +33,7 @@ def _sweep(args) -> int:
         return 0
     if args.output is None:
         raise FileNotFoundError("no results folder given: use -o/--output DIR")
-    _log(f"{spec.n_variants} variants of {spec.model!r} in {spec.n_chunks} chunks of {spec.chunk_size} -> {args.output}")
+    # run_sweep logs the start line itself, after every check that can refuse the sweep: a refusal is one line
     result = run_sweep(spec, args.output, workers=args.workers, scheduler=args.scheduler, force=args.force,
                        progress=not args.no_progress, plot=not args.no_plot, log=_log)
     _log(f"done: {len(result.computed)} chunks computed, {len(result.reused)} reused")

@@ -600,7 +600,8 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
     plot : bool
         Write ``summary.png``.
     log : callable, optional
-        Called with one-line messages (resume, cleanup).
+        Called with one-line messages (start, cleanup, resume); the first comes only after every
+        check that can refuse the sweep (arguments, lock, folder, existing chunks) has passed.
 
     Returns
     -------
@@ -629,10 +630,13 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
             raise DataError(f"{spec.path}: {', '.join(changed)} changed after the spec was loaded; load it again")
         manifest = _prepare(spec, output, force)
         removed = _clean_temporaries(output)
-        if removed:
-            log(f"removed {len(removed)} partial file(s) left by an interrupted run")
         done = _existing_chunks(spec, output, manifest)
         todo = [k for k in range(spec.n_chunks) if k not in set(done)]
+        # every refusal (arguments, lock, changed inputs, foreign folder, bad chunk files) came before this
+        # first message: a refused sweep prints its error alone
+        log(f"{spec.n_variants} variants of {spec.model!r} in {spec.n_chunks} chunks of {spec.chunk_size} -> {output}")
+        if removed:
+            log(f"removed {len(removed)} partial file(s) left by an interrupted run")
         if done:
             log(f"resuming: {len(done)} of {spec.n_chunks} chunks already done")
 
