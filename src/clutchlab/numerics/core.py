@@ -1,0 +1,869 @@
+"""The integrator core: one compiled hybrid integrator for every clutchlab model.
+
+Two methods, each written once:
+
+* :func:`advance_dopri` -- explicit Dormand-Prince 5(4) (SciPy's ``RK45``
+  tableau, FSAL) with cubic Hermite dense output, for non-stiff models
+  (wet clutch, EMTC bench);
+* :func:`advance_rodas` -- Rodas3, a linearly implicit, stiffly accurate,
+  L-stable Rosenbrock method (Sandu et al. 1997) with a diagonal mass matrix
+  (zero rows are algebraic equations of index 1), for stiff models
+  (E-clutch actuator + clutch).  Jacobian from the model (analytic) or by
+  forward differences over the columns named in ``Options.jac_cols``, each
+  column differenced backwards when the forward perturbation crosses a
+  switching function (a kink).
+
+Both share the hybrid logic:
+
+* every switching function ``g_k`` returned by the model's ``rhs`` is
+  watched; a crossing in the direction ``Options.gdir[k]`` (+1 rising
+  through zero, -1 falling, 0 either; a start exactly on zero does not
+  count) is located by root finding (Illinois) on the step's dense output,
+  the step is cut at the earliest root, and the model's ``update`` is called
+  for every function that crossed there, which changes the modes and records
+  named events (:func:`record`);
+* ``next_break`` times (input table corners, controller samples) end a step
+  exactly and call the model's ``restart``;
+* after every accepted step the model's ``accept`` runs (hysteresis memory
+  commit, projection of stuck velocities);
+* stepping is resumable: :func:`advance_dopri` / :func:`advance_rodas`
+  continue from the solver state ``(sf, si)`` to ``t_end`` (co-simulation,
+  controller sampling, chunked recording).
+
+One step-size controller per method, one NaN-safe error norm
+(:func:`clutchlab.numerics.dopri.error_norm`, a non-finite norm rejects the
+step with the smallest factor), one status enumeration
+(:mod:`clutchlab.numerics.status`).
+
+The model is never passed as a function: the core calls the stubs of
+:mod:`clutchlab.numerics.dispatch`, resolved at compile time from the type of
+the parameter structure ``p`` (see docs/architecture.md).
+
+References
+----------
+.. [1] J. R. Dormand, P. J. Prince, J. Comput. Appl. Math. 6 (1980) 19-26.
+.. [2] A. Sandu et al., Atmos. Environ. 31 (1997) 3459-3472 (Rodas3).
+.. [3] E. Hairer, G. Wanner, Solving Ordinary Differential Equations I/II,
+   Springer 1993/1996 (step control II.4, Rosenbrock methods VI.4).
+.. [4] SciPy ``integrate._ivp`` (RK45 tableau, event handling).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from . import dispatch as model
+from .dopri import (
+    A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
+    B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
+    dense_hermite, error_norm, initial_step, next_step,
+)
+from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
+                         C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
+                         GAMMA2 as R_GAMMA2, lu_factor, lu_solve, rodas_next_step)
+from .status import MODEL_ERROR, RECORD_FULL, SINGULAR, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
+
+__all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
+           "batch_dopri", "batch_rodas",
+           "SF_T", "SF_H", "SI_ACCEPTED", "SI_REJECTED", "SI_NRHS", "SI_NJAC", "SI_STATUS", "SI_IREC",
+           "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI", "evaluate", "evaluate_outputs", "outputs_at"]
+
+# ---- solver state (resumable): float and int vectors
+SF_T, SF_H = 0, 1
+N_SF = 2
+SI_ACCEPTED, SI_REJECTED, SI_NRHS, SI_NJAC, SI_STATUS, SI_IREC, SI_STARTED, SI_MODEL_CODE = range(8)
+N_SI = 8
+
+
+class Options(NamedTuple):
+    """Step control and event options of one run (all SI).
+
+    Attributes
+    ----------
+    rtol : float
+        Relative tolerance [1].
+    atol : ndarray
+        Absolute tolerance per state, in the state's unit.
+    max_step : float
+        Largest step [s].
+    first_step : float
+        First trial step [s]; 0 estimates it (Hairer & Wanner II.4).
+    max_steps : int
+        Accepted-step limit of the whole run (status ``STEP_LIMIT``).
+    event_tol : float
+        Width [s] to which an event time is bracketed.
+    gdir : ndarray of int64
+        Direction of each switching function's crossing that is an event:
+        +1 rising through zero, -1 falling, 0 either.
+    mass : ndarray
+        Diagonal of the mass matrix (Rosenbrock only; 0 marks an algebraic row).
+    jac_cols : ndarray of int64
+        Columns of the finite-difference Jacobian (Rosenbrock; the others are zero).
+    fd_scale : ndarray
+        Typical magnitude of each state for the difference increment.
+    jac_every : int
+        Accepted steps a Jacobian is reused for (refreshed at once after a
+        rejection or a mode change).
+    nonautonomous : bool
+        Difference df/dt for the Rosenbrock stages (inputs that vary within a step).
+    """
+
+    rtol: float
+    atol: np.ndarray
+    max_step: float
+    first_step: float
+    max_steps: int
+    event_tol: float
+    gdir: np.ndarray
+    mass: np.ndarray
+    jac_cols: np.ndarray
+    fd_scale: np.ndarray
+    jac_every: int
+    nonautonomous: bool
+
+
+class EventLog(NamedTuple):
+    """Events recorded by the models' ``update``/``restart`` hooks.
+
+    ``time`` [s], ``code`` (index into the model's event names), ``element``
+    (index of the element concerned, -1 for none); ``count[0]`` events held,
+    ``count[1]`` events dropped because the log was full.
+    """
+
+    time: np.ndarray
+    code: np.ndarray
+    element: np.ndarray
+    count: np.ndarray
+
+
+def new_log(capacity: int) -> EventLog:
+    """An empty event log holding up to ``capacity`` events."""
+    return EventLog(np.zeros(capacity), np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+                    np.zeros(2, dtype=np.int64))
+
+
+def new_solver_state(t0: float):
+    """Solver state ``(sf, si)`` of a run that starts at ``t0``."""
+    sf = np.zeros(N_SF)
+    sf[SF_T] = t0
+    return sf, np.zeros(N_SI, dtype=np.int64)
+
+
+@numba.njit(cache=True, nogil=True)
+def record(log, t, code, element):
+    """Append a named event (model hooks call this)."""
+    n = log.count[0]
+    if n < log.time.shape[0]:
+        log.time[n] = t
+        log.code[n] = code
+        log.element[n] = element
+        log.count[0] = n + 1
+    else:
+        log.count[1] += 1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _crossed(a, b, d):
+    """True if a switching value went from ``a`` to ``b`` through zero in direction ``d``."""
+    if d >= 0 and a < 0.0 and b >= 0.0:
+        return True
+    if d <= 0 and a > 0.0 and b <= 0.0:
+        return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _store(rec_t, rec_x, rec_m, i, t, x, m):
+    rec_t[i] = t
+    for q in range(x.shape[0]):
+        rec_x[i, q] = x[q]
+    for q in range(m.shape[0]):
+        rec_m[i, q] = m[q]
+
+
+@numba.njit(cache=True, nogil=True)
+def _dense(theta, h, x0, f0, x1, f1, mass, out):
+    """Cubic Hermite dense output; linear in the algebraic rows (``mass`` = 0)."""
+    dense_hermite(theta, h, x0, f0, x1, f1, out)
+    for i in range(x0.shape[0]):
+        if mass[i] == 0.0:
+            out[i] = x0[i] + theta * (x1[i] - x0[i])
+
+
+@numba.njit(cache=True, nogil=True)
+def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga):
+    """Earliest root of the crossed switching functions on the dense output of the step.
+
+    Illinois iteration per crossed function on the step fraction; returns
+    ``(theta, n_rhs)`` with ``theta`` the bracket end just past the earliest
+    root (so that the crossing shows at the returned point), or 2.0 if none
+    crossed.  ``ga`` receives the value each function starts the step with:
+    ``g0``, except that a function starting exactly on zero (after the event
+    that put it there: a ball on the ground, a clutch that just broke away)
+    takes its sign from a probe just after the start (``theta`` = 1e-6), so a
+    return through zero later in the same step is still seen.
+    """
+    best = 2.0
+    n_rhs = 0
+    ng = g0.shape[0]
+    probed = False
+    th0 = 1e-6
+    for k in range(ng):
+        ga[k] = g0[k]
+        if g0[k] == 0.0 and g1[k] != 0.0:
+            if not probed:
+                _dense(th0, h, x0, f0, x1, f1, mass, xe)
+                model.rhs(t + th0 * h, xe, u, m, p, fe, ge)
+                n_rhs += 1
+                probed = True
+            ga[k] = ge[k]
+    for k in range(ng):
+        if not _crossed(ga[k], g1[k], gdir[k]):
+            continue
+        lo = th0 if g0[k] == 0.0 else 0.0
+        hi = min(1.0, best)
+        glo = ga[k]
+        if hi < 1.0:
+            # an earlier root is known: only look before it
+            _dense(hi, h, x0, f0, x1, f1, mass, xe)
+            model.rhs(t + hi * h, xe, u, m, p, fe, ge)
+            n_rhs += 1
+            if not _crossed(glo, ge[k], gdir[k]):
+                continue
+            ghi = ge[k]
+        else:
+            ghi = g1[k]
+        side = 0
+        for _it in range(100):
+            if (hi - lo) * h <= event_tol:
+                break
+            if glo != ghi:
+                th = lo + (hi - lo) * glo / (glo - ghi)
+            else:
+                th = 0.5 * (lo + hi)
+            span = hi - lo
+            th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
+            _dense(th, h, x0, f0, x1, f1, mass, xe)
+            model.rhs(t + th * h, xe, u, m, p, fe, ge)
+            n_rhs += 1
+            if _crossed(ga[k], ge[k], gdir[k]):
+                hi = th
+                ghi = ge[k]
+                if side == 1:
+                    glo *= 0.5
+                side = 1
+            else:
+                lo = th
+                glo = ge[k]
+                if side == -1:
+                    ghi *= 0.5
+                side = -1
+        if hi < best:
+            best = hi
+    return best, n_rhs
+
+
+@numba.njit(cache=True, nogil=True)
+def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
+    """Call the model's ``update`` for every switching function that crossed; returns the worst flag."""
+    flag = 0
+    for k in range(g0.shape[0]):
+        if _crossed(g0[k], g1[k], gdir[k]):
+            r = model.update(t, x, u, m, p, k, log)
+            if r < 0:
+                return r
+            if r > flag:
+                flag = r
+    return flag
+
+
+@numba.njit(cache=True, nogil=True)
+def _outputs_row(p, t, x, u, m, rec_y, i, yb):
+    model.outputs(t, x, u, m, p, yb)
+    for q in range(yb.shape[0]):
+        rec_y[i, q] = yb[q]
+
+
+# ============================================================ Dormand-Prince 5(4)
+@numba.njit(cache=True, nogil=True)
+def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+    """Advance a model with Dormand-Prince 5(4) from the solver state to ``t_end`` (resumable).
+
+    Parameters
+    ----------
+    p : NamedTuple
+        The model's packed parameters (selects the model at compile time).
+    x, m, u : ndarray
+        State [SI], mode vector (int64) and held inputs; ``x`` and ``m`` are
+        updated in place.
+    t_end : float
+        End of this call [s].
+    sf, si : ndarray
+        Solver state from :func:`new_solver_state` (time, step, counters, status).
+    opt : Options
+    log : EventLog
+    ts : ndarray
+        Sample times [s]; empty records every accepted step into the record
+        buffers until they are full (status ``RECORD_FULL``: resume with
+        ``si[SI_IREC] = 0``).
+    rec_t, rec_x, rec_m, rec_y : ndarray
+        Record buffers (time, states, modes, outputs); ``rec_y`` is written
+        only if ``want_y``.
+    want_y : bool
+
+    Returns
+    -------
+    int
+        Status (:mod:`clutchlab.numerics.status`), also in ``si[SI_STATUS]``.
+    """
+    n = x.shape[0]
+    ng = opt.gdir.shape[0]
+    grid = ts.shape[0] > 0
+    cap = rec_t.shape[0]
+    K = np.empty((7, n))
+    xt = np.empty(n)
+    xn = np.empty(n)
+    xe = np.empty(n)
+    fe = np.empty(n)
+    err = np.empty(n)
+    g0 = np.empty(ng)
+    g1 = np.empty(ng)
+    ge = np.empty(ng)
+    ga = np.empty(ng)
+    yb = np.empty(rec_y.shape[1])
+    tab_a = np.zeros((7, 6))
+    tab_a[1, 0] = A21
+    tab_a[2, 0] = A31
+    tab_a[2, 1] = A32
+    tab_a[3, 0] = A41
+    tab_a[3, 1] = A42
+    tab_a[3, 2] = A43
+    tab_a[4, 0] = A51
+    tab_a[4, 1] = A52
+    tab_a[4, 2] = A53
+    tab_a[4, 3] = A54
+    tab_a[5, 0] = A61
+    tab_a[5, 1] = A62
+    tab_a[5, 2] = A63
+    tab_a[5, 3] = A64
+    tab_a[5, 4] = A65
+    tab_a[6, 0] = B1
+    tab_a[6, 2] = B3
+    tab_a[6, 3] = B4
+    tab_a[6, 4] = B5
+    tab_a[6, 5] = B6
+    tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
+    k1 = K[0]
+    k7 = K[6]
+    t = sf[SF_T]
+    h = sf[SF_H]
+    rtol = opt.rtol
+    atol = opt.atol
+    mass = opt.mass
+    status = SUCCESS
+    model.restart(t, x, u, m, p, log)
+    model.rhs(t, x, u, m, p, k1, g0)
+    si[SI_NRHS] += 1
+    i_rec = si[SI_IREC]
+    if si[SI_STARTED] == 0:
+        si[SI_STARTED] = 1
+        if grid:
+            while i_rec < ts.shape[0] and ts[i_rec] <= t:
+                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
+                if want_y:
+                    _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+                i_rec += 1
+        elif i_rec < cap:
+            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+        if opt.first_step > 0.0:
+            h = opt.first_step
+        else:
+            h = initial_step(x, k1, rtol, atol, t_end - t, 5)
+    if h <= 0.0:
+        h = initial_step(x, k1, rtol, atol, t_end - t, 5)
+    tb = model.next_break(t, m, p)
+    prev_rej = False
+    while t < t_end:
+        if si[SI_ACCEPTED] >= opt.max_steps:
+            status = STEP_LIMIT
+            break
+        if not grid and cap > 0 and i_rec >= cap:
+            status = RECORD_FULL
+            break
+        t_stop = t_end if t_end < tb else tb
+        if t_stop - t <= 1e-13 * max(1.0, abs(t_stop)):
+            # at a break time: let the model react (input corner, controller sample)
+            t = t_stop
+            if t >= t_end:
+                break
+            if model.restart(t, x, u, m, p, log):
+                pass
+            model.rhs(t, x, u, m, p, k1, g0)
+            si[SI_NRHS] += 1
+            tb = model.next_break(t, m, p)
+            continue
+        if h > opt.max_step:
+            h = opt.max_step
+        last = False
+        if h >= (t_stop - t) * (1.0 - 1e-9):
+            h = t_stop - t
+            last = True
+        if h < 1e-14 * max(1.0, abs(t)):
+            status = STEP_UNDERFLOW
+            break
+        for stg in range(1, 7):
+            for i in range(n):
+                acc = 0.0
+                for j in range(stg):
+                    acc += tab_a[stg, j] * K[j, i]
+                xt[i] = x[i] + h * acc
+            if stg == 6:
+                for i in range(n):
+                    xn[i] = xt[i]
+            model.rhs(t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
+        si[SI_NRHS] += 6
+        for i in range(n):
+            err[i] = h * (E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i] + E7 * K[6, i])
+        en = error_norm(err, x, xn, rtol, atol)
+        if not (en <= 1.0):
+            si[SI_REJECTED] += 1
+            if en != en or not math.isfinite(en):
+                h = 0.2 * h
+            else:
+                h = next_step(h, en, False)
+            prev_rej = True
+            continue
+        # ---- events on the dense output
+        theta, nr = _locate(p, t, h, x, k1, xn, k7, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge, ga)
+        si[SI_NRHS] += nr
+        if theta <= 1.0:
+            t_new = t + theta * h
+        elif last:
+            t_new = t_stop
+        else:
+            t_new = t + h
+        # ---- samples in (t, t_new] on the dense output (modes of the step)
+        if grid:
+            while i_rec < ts.shape[0] and ts[i_rec] <= t_new:
+                th = (ts[i_rec] - t) / h
+                _dense(th, h, x, k1, xn, k7, mass, xe)
+                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
+                if want_y:
+                    _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
+                i_rec += 1
+        si[SI_ACCEPTED] += 1
+        if theta <= 1.0:
+            _dense(theta, h, x, k1, xn, k7, mass, xe)
+            for i in range(n):
+                x[i] = xe[i]
+            t = t_new
+            model.rhs(t, x, u, m, p, fe, g1)
+            si[SI_NRHS] += 1
+            flag = _apply_updates(p, t, x, u, m, ga, g1, opt.gdir, log)
+            r = model.accept(t, x, u, m, p)
+            if flag < 0 or r < 0:
+                si[SI_MODEL_CODE] = flag if flag < 0 else r
+                status = MODEL_ERROR
+                break
+            model.rhs(t, x, u, m, p, k1, g0)
+            si[SI_NRHS] += 1
+            if flag == 1:
+                status = TERMINATED
+                if not grid and i_rec < cap:
+                    _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+                    if want_y:
+                        _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+                    i_rec += 1
+                break
+        else:
+            for i in range(n):
+                x[i] = xn[i]
+                k1[i] = k7[i]
+            for k in range(ng):
+                g0[k] = g1[k]
+            t = t_new
+            r = model.accept(t, x, u, m, p)
+            if r < 0:
+                si[SI_MODEL_CODE] = r
+                status = MODEL_ERROR
+                break
+            if r > 0:
+                model.rhs(t, x, u, m, p, k1, g0)
+                si[SI_NRHS] += 1
+            h = next_step(h, en, prev_rej)
+        prev_rej = False
+        if not grid and i_rec < cap:
+            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+    if grid and status == SUCCESS:
+        # samples at the end time itself (rounding) hold the final state
+        while i_rec < ts.shape[0] and ts[i_rec] <= t_end * (1.0 + 1e-12) and ts[i_rec] <= t + 1e-9:
+            _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+    sf[SF_T] = t
+    sf[SF_H] = h
+    si[SI_IREC] = i_rec
+    si[SI_STATUS] = status
+    return status
+
+
+# ============================================================ Rosenbrock (Rodas3)
+@numba.njit(cache=True, nogil=True)
+def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K1, K2, K3, K4, xtmp, ftmp,
+                gtmp):
+    """One Rodas3 step of size ``h`` from ``(t, x)``; False if the matrix is singular or NaN appears."""
+    n = x.shape[0]
+    hg = 1.0 / (h * R_GAMMA)
+    for i in range(n):
+        for j in range(n):
+            G[i, j] = -J[i, j]
+        G[i, i] += mass[i] * hg
+    if not lu_factor(G, piv):
+        return False
+    for i in range(n):
+        K1[i] = f0[i] + (h * R_GAMMA1 * ft[i] if nonauto else 0.0)
+    lu_solve(G, piv, K1)
+    for i in range(n):
+        K2[i] = f0[i] + mass[i] * (R_C21 / h) * K1[i] + (h * R_GAMMA2 * ft[i] if nonauto else 0.0)
+    lu_solve(G, piv, K2)
+    for i in range(n):
+        xtmp[i] = x[i] + R_A31 * K1[i]
+    model.rhs(t + h, xtmp, u, m, p, ftmp, gtmp)
+    for i in range(n):
+        K3[i] = ftmp[i] + mass[i] * (R_C31 * K1[i] + R_C32 * K2[i]) / h
+    lu_solve(G, piv, K3)
+    for i in range(n):
+        xtmp[i] = x[i] + R_A41 * K1[i] + R_A43 * K3[i]
+    model.rhs(t + h, xtmp, u, m, p, ftmp, gtmp)
+    for i in range(n):
+        K4[i] = ftmp[i] + mass[i] * (R_C41 * K1[i] + R_C42 * K2[i] + R_C43 * K3[i]) / h
+    lu_solve(G, piv, K4)
+    ok = True
+    for i in range(n):
+        xnew[i] = xtmp[i] + K4[i]
+        err[i] = K4[i]
+        if not math.isfinite(xnew[i]):
+            ok = False
+    return ok
+
+
+@numba.njit(cache=True, nogil=True)
+def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp):
+    """Forward-difference Jacobian over ``opt.jac_cols``; backward where the forward step crosses a kink.
+
+    A forward perturbation that changes the sign of a switching function
+    differences across the kink (cavitation, a contact, an end stop): such a
+    column is differenced backwards.  Returns the number of ``rhs`` calls.
+    """
+    n = x.shape[0]
+    ng = g0.shape[0]
+    nr = 0
+    for c in opt.jac_cols:
+        for i in range(n):
+            xp[i] = x[i]
+        dl = 1.5e-8 * max(abs(x[c]), opt.fd_scale[c])
+        xp[c] = x[c] + dl
+        model.rhs(t, xp, u, m, p, fp, gp)
+        nr += 1
+        kink = False
+        for k in range(ng):
+            if g0[k] * gp[k] < 0.0 or (gp[k] == 0.0 and g0[k] != 0.0):
+                kink = True
+                break
+        if kink:
+            dl = -dl
+            xp[c] = x[c] + dl
+            model.rhs(t, xp, u, m, p, fp, gp)
+            nr += 1
+        for r in range(n):
+            J[r, c] = (fp[r] - f0[r]) / dl
+    return nr
+
+
+@numba.njit(cache=True, nogil=True)
+def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+    """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
+
+    Arguments and return value as :func:`advance_dopri`.  The Jacobian is the
+    model's analytic one where its ``jacobian`` hook returns True, else a
+    finite-difference one (:func:`_fd_jacobian`), reused for
+    ``opt.jac_every`` accepted steps and refreshed after a rejection or a
+    mode change.  The state at a located event comes from one Rodas3 step
+    of the located length from the step start, so that the algebraic rows
+    stay consistent.
+    """
+    n = x.shape[0]
+    ng = opt.gdir.shape[0]
+    grid = ts.shape[0] > 0
+    cap = rec_t.shape[0]
+    mass = opt.mass
+    rtol = opt.rtol
+    atol = opt.atol
+    f0 = np.empty(n)
+    f1 = np.empty(n)
+    ft = np.zeros(n)
+    fp = np.empty(n)
+    g0 = np.empty(ng)
+    g1 = np.empty(ng)
+    gp = np.empty(ng)
+    ga = np.empty(ng)
+    J = np.zeros((n, n))
+    G = np.empty((n, n))
+    piv = np.empty(n, dtype=np.int64)
+    K1 = np.empty(n)
+    K2 = np.empty(n)
+    K3 = np.empty(n)
+    K4 = np.empty(n)
+    xtmp = np.empty(n)
+    ftmp = np.empty(n)
+    x1 = np.empty(n)
+    xe = np.empty(n)
+    xp = np.empty(n)
+    err = np.empty(n)
+    yb = np.empty(rec_y.shape[1])
+    t = sf[SF_T]
+    h = sf[SF_H]
+    status = SUCCESS
+    model.restart(t, x, u, m, p, log)
+    model.rhs(t, x, u, m, p, f0, g0)
+    si[SI_NRHS] += 1
+    i_rec = si[SI_IREC]
+    if si[SI_STARTED] == 0:
+        si[SI_STARTED] = 1
+        if grid:
+            while i_rec < ts.shape[0] and ts[i_rec] <= t:
+                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
+                if want_y:
+                    _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+                i_rec += 1
+        elif i_rec < cap:
+            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+        h = opt.first_step if opt.first_step > 0.0 else 1e-5
+    if h <= 0.0:
+        h = 1e-5
+    tb = model.next_break(t, m, p)
+    need_jac = True
+    jac_stale = True
+    jac_age = opt.jac_every
+    rejected_before = False
+    en = 0.0
+    while t < t_end:
+        if si[SI_ACCEPTED] >= opt.max_steps:
+            status = STEP_LIMIT
+            break
+        if not grid and cap > 0 and i_rec >= cap:
+            status = RECORD_FULL
+            break
+        t_stop = t_end if t_end < tb else tb
+        if t_stop - t <= 1e-12 * max(1.0, abs(t_stop)):
+            t = t_stop
+            if t >= t_end:
+                break
+            if model.restart(t, x, u, m, p, log):
+                jac_stale = True
+            model.rhs(t, x, u, m, p, f0, g0)
+            si[SI_NRHS] += 1
+            tb = model.next_break(t, m, p)
+            need_jac = True
+            jac_stale = True
+            continue
+        if need_jac:
+            if jac_age >= opt.jac_every or jac_stale:
+                if not model.jacobian(t, x, u, m, p, J):
+                    si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp)
+                jac_age = 0
+                jac_stale = False
+                si[SI_NJAC] += 1
+            if opt.nonautonomous:
+                dt = 1e-7 * max(1e-3, abs(t))
+                if t + dt < tb:
+                    model.rhs(t + dt, x, u, m, p, fp, gp)
+                    for r in range(n):
+                        ft[r] = (fp[r] - f0[r]) / dt
+                else:
+                    model.rhs(t - dt, x, u, m, p, fp, gp)
+                    for r in range(n):
+                        ft[r] = (f0[r] - fp[r]) / dt
+                si[SI_NRHS] += 1
+            need_jac = False
+        if h > opt.max_step:
+            h = opt.max_step
+        hit_stop = False
+        if t + h >= t_stop - 1e-14 * max(1.0, abs(t_stop)):
+            h = t_stop - t
+            hit_stop = True
+        if h < 1e-14 * max(1.0, abs(t)):
+            status = STEP_UNDERFLOW
+            break
+        ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, K1, K2, K3, K4,
+                         xtmp, ftmp, gp)
+        si[SI_NRHS] += 2
+        en = error_norm(err, x, x1, rtol, atol) if ok else np.inf
+        if not (en <= 1.0):
+            si[SI_REJECTED] += 1
+            h = rodas_next_step(h, en, rejected_before)
+            rejected_before = True
+            if jac_age > 0:
+                jac_stale = True
+                need_jac = True
+            continue
+        # step end: derivative (dense output, next step's f0) and switching functions
+        model.rhs(t + h, x1, u, m, p, f1, g1)
+        si[SI_NRHS] += 1
+        theta, nr = _locate(p, t, h, x, f0, x1, f1, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp, ga)
+        si[SI_NRHS] += nr
+        event = False
+        if theta <= 1.0:
+            # land on the located instant with one step of that length (consistent algebraic rows)
+            hs = theta * h
+            ok2 = _rodas_step(p, t, x, hs, u, m, J, mass, f0, ft, opt.nonautonomous, xe, err, G, piv, K1, K2, K3,
+                              K4, xtmp, ftmp, gp)
+            si[SI_NRHS] += 2
+            if ok2:
+                model.rhs(t + hs, xe, u, m, p, ftmp, gp)
+                si[SI_NRHS] += 1
+                for i in range(n):
+                    x1[i] = xe[i]
+                    f1[i] = ftmp[i]
+                for k in range(ng):
+                    g1[k] = gp[k]
+                h_acc = hs
+                event = True
+            else:
+                h_acc = h
+        else:
+            h_acc = h
+        t_new = t + h_acc
+        if hit_stop and not event:
+            t_new = t_stop
+        if grid:
+            while i_rec < ts.shape[0] and ts[i_rec] <= t_new:
+                th = (ts[i_rec] - t) / h_acc if h_acc > 0.0 else 1.0
+                _dense(th, h_acc, x, f0, x1, f1, mass, xe)
+                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
+                if want_y:
+                    _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
+                i_rec += 1
+        si[SI_ACCEPTED] += 1
+        for i in range(n):
+            x[i] = x1[i]
+            f0[i] = f1[i]
+        t = t_new
+        flag = 0
+        if event:
+            flag = _apply_updates(p, t, x, u, m, ga, g1, opt.gdir, log)
+            jac_stale = True
+        r = model.accept(t, x, u, m, p)
+        if flag < 0 or r < 0:
+            si[SI_MODEL_CODE] = flag if flag < 0 else r
+            status = MODEL_ERROR
+            break
+        if event or r > 0:
+            model.rhs(t, x, u, m, p, f0, g0)
+            si[SI_NRHS] += 1
+        else:
+            for k in range(ng):
+                g0[k] = g1[k]
+        need_jac = True
+        jac_age += 1
+        if not grid and i_rec < cap:
+            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+        if flag == 1:
+            status = TERMINATED
+            break
+        if not event:
+            h_new = rodas_next_step(h, en, rejected_before)
+            h = h_new if not hit_stop else max(h, h_new)
+        rejected_before = False
+    if grid and status == SUCCESS:
+        while i_rec < ts.shape[0] and ts[i_rec] <= t_end * (1.0 + 1e-12) and ts[i_rec] <= t + 1e-9:
+            _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
+            if want_y:
+                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            i_rec += 1
+    sf[SF_T] = t
+    sf[SF_H] = h
+    si[SI_IREC] = i_rec
+    si[SI_STATUS] = status
+    return status
+
+
+# ============================================================ batch runners
+@numba.njit(cache=True, parallel=True)
+def batch_dopri(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
+    """One Dormand-Prince solver per variant, in parallel (``prange``), recorded on ``ts``.
+
+    ``plist`` holds one parameter structure per variant (their mutable
+    memories are their own); ``X0``, ``M0``, ``U`` have one row per variant.
+    ``STATS[v]`` receives the solver counters (``SI_*``); events go to
+    ``EV_*[v]`` (time, code, element) and ``EV_N[v]`` (held, dropped).
+    """
+    nv = X0.shape[0]
+    ns = ts.shape[0]
+    for v in numba.prange(nv):
+        x = X0[v].copy()
+        m = M0[v].copy()
+        sf = np.zeros(N_SF)
+        si = np.zeros(N_SI, dtype=np.int64)
+        log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
+        rt = np.empty(ns)
+        advance_dopri(plist[v], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
+        for q in range(N_SI):
+            STATS[v, q] = si[q]
+
+
+@numba.njit(cache=True, parallel=True)
+def batch_rodas(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
+    """One Rodas3 solver per variant, in parallel (``prange``); arguments as :func:`batch_dopri`."""
+    nv = X0.shape[0]
+    ns = ts.shape[0]
+    for v in numba.prange(nv):
+        x = X0[v].copy()
+        m = M0[v].copy()
+        sf = np.zeros(N_SF)
+        si = np.zeros(N_SI, dtype=np.int64)
+        log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
+        rt = np.empty(ns)
+        advance_rodas(plist[v], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
+        for q in range(N_SI):
+            STATS[v, q] = si[q]
+
+
+# ============================================================ evaluation through the contract
+@numba.njit(cache=True, nogil=True)
+def evaluate(p, t, x, u, m, dx, g):
+    """The model's right-hand side and switching functions at one point (linearisation, tests)."""
+    model.rhs(t, x, u, m, p, dx, g)
+
+
+@numba.njit(cache=True, nogil=True)
+def evaluate_outputs(p, t, x, u, m, y):
+    """The model's outputs at one point."""
+    model.outputs(t, x, u, m, p, y)
+
+
+@numba.njit(cache=True, nogil=True)
+def outputs_at(p, T, X, u, M, Y):
+    """Outputs at recorded points ``(T[i], X[i], M[i])`` into ``Y[i]``."""
+    y = np.empty(Y.shape[1])
+    for i in range(T.shape[0]):
+        model.outputs(T[i], X[i], u, M[i], p, y)
+        for q in range(y.shape[0]):
+            Y[i, q] = y[q]

@@ -1,0 +1,534 @@
+"""The system contract: how a compiled model describes itself, and the one way to run it.
+
+A model (wet clutch, EMTC bench, E-clutch, a driveline) implements the
+contract once, in its own package:
+
+1. its parameters packed once into its own ``NamedTuple`` class of floats
+   and arrays (numba caches code specialised on it across processes);
+2. compiled hooks -- ``rhs``, ``outputs``, ``update``, ``restart``,
+   ``accept``, ``next_break``, ``jacobian`` (see
+   :mod:`clutchlab.numerics.dispatch`) -- registered for that class with
+   :func:`clutchlab.numerics.dispatch.register`;
+3. a :class:`System`: the named states, outputs, inputs, switching
+   functions, events and modes with their units, the packed parameters, the
+   initial state and the integration method.
+
+Everything else is written once against the :class:`System`:
+:func:`simulate` (returns a :class:`clutchlab.SimulationResult`),
+:class:`Simulation` (resumable stepping for co-simulation and controllers in
+the loop), :func:`simulate_batch` (one solver per variant in ``prange``),
+:func:`evaluate` (right-hand side, switching functions and outputs at one
+point, for linearisation and tests).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from ._limits import check_allocation, short_repr
+from .errors import ParameterError, SimulationError
+from .numerics import status as st
+from .result import SimulationResult
+
+__all__ = ["Variable", "System", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
+           "MODELS", "register_model"]
+
+#: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
+CHUNK_ROWS = 4096
+#: events a run keeps (more are counted as dropped)
+EVENT_CAPACITY = 100_000
+
+
+@dataclasses.dataclass(frozen=True)
+class Variable:
+    """A named quantity of a system with its unit.
+
+    Parameters
+    ----------
+    name : str
+        Canonical name (docs/nomenclature.md), without unit: ``"piston_position"``.
+    unit : str
+        Unit suffix of :data:`clutchlab.units.COLUMN_UNITS` (``"m"``, ``"rad_s"``, ``"Nm"``, ``"C"``,
+        ``"1"`` for dimensionless).
+    description : str
+        One line for people.
+    """
+
+    name: str
+    unit: str
+    description: str = ""
+
+    @property
+    def column(self) -> str:
+        """Column name with the unit suffix (``piston_position_m``)."""
+        return f"{self.name}_{self.unit}"
+
+
+def variables(spec) -> tuple:
+    """``Variable`` tuple from ``(name, unit[, description])`` tuples (model packages use this)."""
+    return tuple(v if isinstance(v, Variable) else Variable(*v) for v in spec)
+
+
+@dataclasses.dataclass(frozen=True)
+class System:
+    """A compiled model described once: what the integrator core and every tool built on it need.
+
+    Attributes
+    ----------
+    name : str
+        Model name (``"wet"``, ``"emtc_bench"``, ``"eclutch"``).
+    params : NamedTuple
+        Packed parameters; its class selects the model's compiled hooks.
+    states, outputs, inputs : tuple of Variable
+        Named, unit-carrying state, output and held-input vectors.
+    switching : tuple of (str, int)
+        Name and crossing direction (+1, -1, 0) of each switching function.
+    events : tuple of str
+        Event names by code (what the hooks record).
+    mode_names : tuple of str
+        Names of the mode variables (entries of the mode vector).
+    mode_values : tuple of tuple of str
+        Names of the values of each mode variable.
+    x0, m0, u0 : ndarray
+        Initial state, initial modes (int), initial held inputs.
+    atol : ndarray
+        Absolute tolerance per state (default of :func:`simulate`).
+    method : {"dopri", "rodas"}
+        Dormand-Prince 5(4) or Rodas3 (stiff, with the mass matrix ``mass``).
+    mass, jac_cols, fd_scale : ndarray, optional
+        Diagonal mass matrix (0: algebraic row), the Jacobian's difference
+        columns and their typical magnitudes (Rosenbrock).
+    nonautonomous : bool
+        Inputs vary inside a step (Rosenbrock: difference df/dt).
+    jac_every : int
+        Accepted steps a Jacobian is kept.
+    rtol, max_step, first_step, event_tol : float
+        Defaults of :func:`simulate` for this model.
+    element_name : callable, optional
+        ``element_name(event_code, element_index) -> str``: which element an event concerns.
+    error_messages : dict
+        Messages of the model's negative error codes.
+    """
+
+    name: str
+    params: tuple
+    states: tuple
+    outputs: tuple
+    x0: np.ndarray
+    m0: np.ndarray
+    atol: np.ndarray
+    switching: tuple = ()
+    events: tuple = ()
+    mode_names: tuple = ()
+    mode_values: tuple = ()
+    inputs: tuple = ()
+    u0: np.ndarray | None = None
+    method: str = "dopri"
+    mass: np.ndarray | None = None
+    jac_cols: np.ndarray | None = None
+    fd_scale: np.ndarray | None = None
+    nonautonomous: bool = False
+    jac_every: int = 1
+    rtol: float = 1e-6
+    max_step: float = math.inf
+    first_step: float = 0.0
+    event_tol: float = 1e-12
+    element_name: Callable | None = None
+    error_messages: dict = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self):
+        n = len(self.states)
+        for field, arr, dtype in (("x0", self.x0, float), ("m0", self.m0, np.int64), ("atol", self.atol, float)):
+            object.__setattr__(self, field, np.ascontiguousarray(arr, dtype=dtype))
+        if self.x0.shape != (n,) or self.atol.shape != (n,):
+            raise ParameterError(f"System {self.name!r}: x0 and atol need {n} entries (one per state)")
+        if self.m0.shape != (len(self.mode_names),):
+            raise ParameterError(f"System {self.name!r}: m0 needs {len(self.mode_names)} entries (one per mode)")
+        u0 = np.zeros(len(self.inputs)) if self.u0 is None else np.ascontiguousarray(self.u0, dtype=float)
+        if u0.shape != (len(self.inputs),):
+            raise ParameterError(f"System {self.name!r}: u0 needs {len(self.inputs)} entries (one per input)")
+        object.__setattr__(self, "u0", u0)
+        if self.method not in ("dopri", "rodas"):
+            raise ParameterError(f"System {self.name!r}: method = {self.method!r}: expected 'dopri' or 'rodas'")
+        mass = np.ones(n) if self.mass is None else np.ascontiguousarray(self.mass, dtype=float)
+        object.__setattr__(self, "mass", mass)
+        cols = np.arange(n) if self.jac_cols is None else np.ascontiguousarray(self.jac_cols, dtype=np.int64)
+        object.__setattr__(self, "jac_cols", cols)
+        scale = np.maximum(self.atol, 1e-12) if self.fd_scale is None else np.asarray(self.fd_scale, dtype=float)
+        object.__setattr__(self, "fd_scale", np.ascontiguousarray(scale))
+        object.__setattr__(self, "states", variables(self.states))
+        object.__setattr__(self, "outputs", variables(self.outputs))
+        object.__setattr__(self, "inputs", variables(self.inputs))
+
+    # ---- names
+    @property
+    def state_columns(self) -> tuple:
+        return tuple(v.column for v in self.states)
+
+    @property
+    def output_columns(self) -> tuple:
+        return tuple(v.column for v in self.outputs)
+
+    @property
+    def input_columns(self) -> tuple:
+        return tuple(v.column for v in self.inputs)
+
+    def state_index(self, name: str) -> int:
+        return _index(self.states, name, "state", self.name)
+
+    def output_index(self, name: str) -> int:
+        return _index(self.outputs, name, "output", self.name)
+
+    def input_index(self, name: str) -> int:
+        return _index(self.inputs, name, "input", self.name)
+
+    def replace(self, **changes) -> "System":
+        """A copy with some fields replaced (``params``, ``x0``, ...)."""
+        return dataclasses.replace(self, **changes)
+
+    # ---- options of the core
+    def options(self, *, rtol=None, atol=None, max_step=None, max_steps=1_000_000, first_step=None,
+                event_tol=None):
+        """The core's :class:`~clutchlab.numerics.core.Options` from this system's defaults and overrides."""
+        from .numerics.core import Options
+
+        rtol = self.rtol if rtol is None else rtol
+        if not (isinstance(rtol, (int, float, np.floating)) and 0.0 < float(rtol) < 1.0):
+            raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
+        if atol is None:
+            atol_v = self.atol
+        else:
+            atol_v = np.broadcast_to(np.asarray(atol, dtype=float), self.atol.shape).copy()
+            if not np.all(np.isfinite(atol_v)) or np.any(atol_v <= 0):
+                raise ParameterError(f"atol = {short_repr(atol)}: must be > 0")
+        max_step = self.max_step if max_step is None else max_step
+        if not (max_step > 0):
+            raise ParameterError(f"max_step = {short_repr(max_step)}: must be > 0 [s]")
+        if int(max_steps) < 1:
+            raise ParameterError(f"max_steps = {short_repr(max_steps)}: must be >= 1")
+        first_step = self.first_step if first_step is None else first_step
+        event_tol = self.event_tol if event_tol is None else event_tol
+        gdir = np.array([d for _, d in self.switching], dtype=np.int64)
+        return Options(float(rtol), np.ascontiguousarray(atol_v), float(min(max_step, 1e300)), float(first_step),
+                       int(max_steps), float(event_tol), gdir, self.mass, self.jac_cols, self.fd_scale,
+                       int(self.jac_every), bool(self.nonautonomous))
+
+    # ---- events
+    def events_frame(self, times, codes, elements, variant=None) -> pd.DataFrame:
+        """Named events as a DataFrame (``time_s``, ``event``, ``element``)."""
+        names = [self.events[int(c)] if 0 <= int(c) < len(self.events) else f"event {int(c)}" for c in codes]
+        if self.element_name is not None:
+            elems = [self.element_name(int(c), int(e)) for c, e in zip(codes, elements)]
+        else:
+            elems = ["" if int(e) < 0 else str(int(e)) for e in elements]
+        frame = pd.DataFrame({"time_s": np.asarray(times, dtype=float), "event": names, "element": elems})
+        if variant is not None:
+            frame.insert(0, "variant", variant)
+        return frame
+
+
+def _index(vars_, name, kind, model):
+    for i, v in enumerate(vars_):
+        if name in (v.name, v.column):
+            return i
+    known = ", ".join(v.column for v in vars_) or "none"
+    raise ParameterError(f"{model}: unknown {kind} {name!r} (known: {known})")
+
+
+def sample_grid(t0: float, t_end: float, output_step: float | None, sample_times=None):
+    """Sample times of a run: ``sample_times`` as given, an ``output_step`` grid, or ``None`` (every step)."""
+    if sample_times is not None:
+        ts = np.ascontiguousarray(sample_times, dtype=float).ravel()
+        if ts.size and (not np.all(np.isfinite(ts)) or np.any(np.diff(ts) < 0) or ts[0] < t0
+                        or ts[-1] > t_end * (1 + 1e-12) + 1e-300):
+            raise ParameterError(f"sample_times: must be finite, increasing and within [{t0:g}, {t_end:g}] s")
+        return ts
+    if output_step is None:
+        return None
+    if not (isinstance(output_step, (int, float, np.floating)) and math.isfinite(output_step) and output_step > 0):
+        raise ParameterError(f"output_step = {short_repr(output_step)}: must be > 0 [s]")
+    n = int(math.floor((t_end - t0) / output_step + 1e-9)) + 1
+    check_allocation(n, 1, f"output_step = {output_step!r} s over {t_end - t0:g} s")
+    ts = t0 + np.arange(n) * output_step
+    if ts[-1] < t_end - 1e-9 * output_step:
+        ts = np.append(ts, t_end)
+    return ts
+
+
+def _check_status(system: System, code: int, si, t, check: bool):
+    if not check or code in (st.SUCCESS, st.TERMINATED):
+        return
+    msg = st.message(code)
+    if code == st.MODEL_ERROR:
+        msg = system.error_messages.get(int(si[7]), msg)
+    raise SimulationError(f"{system.name}: {msg} (at t = {t:.6g} s)")
+
+
+def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=None, max_step: float | None = None,
+             output_step: float | None = None, sample_times=None, max_steps: int = 1_000_000,
+             first_step: float | None = None, event_tol: float | None = None, outputs: bool = True,
+             t0: float = 0.0, check: bool = True) -> SimulationResult:
+    """Simulate a system from ``t0`` to ``t_end`` with the integrator core.
+
+    Parameters
+    ----------
+    system : System
+    t_end : float
+        End time [s].
+    rtol : float, optional
+        Relative tolerance (default: the model's).
+    atol : float or array_like, optional
+        Absolute tolerance, per state in the state's unit (default: the model's).
+    max_step : float, optional
+        Largest step [s] (default: the model's).
+    output_step : float, optional
+        Sample interval [s] of the result (dense output); without it every accepted step is kept.
+    sample_times : array_like, optional
+        Explicit sample times [s] instead of ``output_step``.
+    max_steps : int
+        Accepted-step limit.
+    first_step, event_tol : float, optional
+        First trial step [s] and event bracket width [s] (defaults: the model's).
+    outputs : bool
+        Evaluate the outputs at the samples (otherwise NaN).
+    t0 : float
+        Start time [s].
+    check : bool
+        Raise :class:`~clutchlab.errors.SimulationError` for a failed run (otherwise the
+        result carries the status).
+
+    Returns
+    -------
+    SimulationResult
+    """
+    from .numerics import _cache, core
+
+    if not (isinstance(t_end, (int, float, np.floating)) and math.isfinite(t_end) and t_end > t0):
+        raise ParameterError(f"t_end = {short_repr(t_end)}: must be finite and > t0 = {t0:g} s")
+    opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, first_step=first_step,
+                         event_tol=event_tol)
+    ts = sample_grid(t0, float(t_end), output_step, sample_times)
+    _cache.ensure_fresh()
+    nx, ny, nm = len(system.states), len(system.outputs), len(system.mode_names)
+    x = system.x0.copy()
+    m = system.m0.copy()
+    u = system.u0.copy()
+    sf, si = core.new_solver_state(float(t0))
+    log = core.new_log(EVENT_CAPACITY)
+    advance = core.advance_rodas if system.method == "rodas" else core.advance_dopri
+    if ts is not None:
+        check_allocation(ts.size, nx + ny + nm + 1, f"{ts.size} samples of {system.name}")
+        rt = np.empty(ts.size)
+        rx = np.empty((ts.size, nx))
+        rm = np.zeros((ts.size, nm), dtype=np.int64)
+        ry = np.full((ts.size, ny), np.nan) if outputs else np.empty((1, ny))
+        code = advance(system.params, x, m, u, float(t_end), sf, si, opt, log, ts, rt, rx, rm, ry, bool(outputs))
+        n = int(si[core.SI_IREC])
+        rt, rx, rm = rt[:n], rx[:n], rm[:n]
+        ry = ry[:n] if outputs else np.full((n, ny), np.nan)
+    else:
+        empty = np.empty(0)
+        chunks = []
+        while True:
+            rt = np.empty(CHUNK_ROWS)
+            rx = np.empty((CHUNK_ROWS, nx))
+            rm = np.zeros((CHUNK_ROWS, nm), dtype=np.int64)
+            ry = np.full((CHUNK_ROWS, ny), np.nan) if outputs else np.empty((1, ny))
+            si[core.SI_IREC] = 0
+            code = advance(system.params, x, m, u, float(t_end), sf, si, opt, log, empty, rt, rx, rm, ry,
+                           bool(outputs))
+            n = int(si[core.SI_IREC])
+            chunks.append((rt[:n], rx[:n], rm[:n], ry[:n] if outputs else np.full((n, ny), np.nan)))
+            if code != st.RECORD_FULL:
+                break
+            check_allocation(CHUNK_ROWS * (len(chunks) + 1), nx + ny + nm + 1, f"the steps of {system.name}")
+        rt = np.concatenate([c[0] for c in chunks])
+        rx = np.concatenate([c[1] for c in chunks])
+        rm = np.concatenate([c[2] for c in chunks])
+        ry = np.concatenate([c[3] for c in chunks])
+    _check_status(system, int(code), si, float(sf[0]), check)
+    ne = int(log.count[0])
+    events = system.events_frame(log.time[:ne], log.code[:ne], log.element[:ne])
+    stats = {"accepted_steps": int(si[core.SI_ACCEPTED]), "rejected_steps": int(si[core.SI_REJECTED]),
+             "rhs_evaluations": int(si[core.SI_NRHS]), "jacobians": int(si[core.SI_NJAC]),
+             "events_dropped": int(log.count[1]), "final_state": x.copy(), "final_modes": m.copy(),
+             "final_time": float(sf[0])}
+    return SimulationResult(rt, rx, ry, rm, events, st.Status(int(code)), system.state_columns,
+                            system.output_columns, tuple(system.mode_names), tuple(system.mode_values), stats,
+                            system.name)
+
+
+class Simulation:
+    """Resumable run of a system (co-simulation, controllers in the loop): ``advance(t_end, u)`` step by step.
+
+    Parameters
+    ----------
+    system : System
+    rtol, atol, max_step, max_steps, first_step, event_tol
+        As :func:`simulate`; ``max_steps`` counts over the whole session.
+    t0 : float
+        Start time [s].
+    """
+
+    def __init__(self, system: System, *, rtol=None, atol=None, max_step=None, max_steps: int = 100_000_000,
+                 first_step=None, event_tol=None, t0: float = 0.0):
+        from .numerics import _cache, core
+
+        _cache.ensure_fresh()
+        self.system = system
+        self._core = core
+        self._opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,
+                                   first_step=first_step, event_tol=event_tol)
+        self._advance = core.advance_rodas if system.method == "rodas" else core.advance_dopri
+        self.x = system.x0.copy()
+        self.m = system.m0.copy()
+        self.u = system.u0.copy()
+        self._sf, self._si = core.new_solver_state(float(t0))
+        self.log = core.new_log(EVENT_CAPACITY)
+        self._empty = np.empty(0)
+        self._rt = np.empty(0)
+        self._rx = np.empty((0, len(system.states)))
+        self._rm = np.empty((0, len(system.mode_names)), dtype=np.int64)
+        self._ry = np.empty((1, len(system.outputs)))
+        self._y = np.empty(len(system.outputs))
+
+    @property
+    def time(self) -> float:
+        """Current time [s]."""
+        return float(self._sf[0])
+
+    def set_inputs(self, u) -> None:
+        """Hold new input values (``u`` in the order of ``system.inputs``, SI)."""
+        u = np.asarray(u, dtype=float).ravel()
+        if u.shape != self.u.shape:
+            raise ParameterError(f"{self.system.name}: {u.size} inputs given, {self.u.size} expected")
+        self.u[:] = u
+
+    def advance(self, t_end: float, u=None) -> int:
+        """Integrate to ``t_end`` [s] holding the inputs ``u``; returns the status code (raises on failure)."""
+        if u is not None:
+            self.set_inputs(u)
+        code = self._advance(self.system.params, self.x, self.m, self.u, float(t_end), self._sf, self._si,
+                             self._opt, self.log, self._empty, self._rt, self._rx, self._rm, self._ry, False)
+        _check_status(self.system, int(code), self._si, self.time, True)
+        return int(code)
+
+    def outputs(self) -> np.ndarray:
+        """Output vector at the current point (order of ``system.outputs``)."""
+        self._core.evaluate_outputs(self.system.params, self.time, self.x, self.u, self.m, self._y)
+        return self._y.copy()
+
+    def events(self) -> pd.DataFrame:
+        """Events recorded so far."""
+        n = int(self.log.count[0])
+        return self.system.events_frame(self.log.time[:n], self.log.code[:n], self.log.element[:n])
+
+
+def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
+                   rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
+                   event_capacity: int = 256, check: bool = False) -> SimulationResult:
+    """Simulate variants of one model in parallel: one solver per variant (``numba.prange``).
+
+    Parameters
+    ----------
+    systems : sequence of System
+        Variants of one model (same parameter structure and sizes; each its own parameter memory).
+    t_end : float
+        End time [s].
+    sample_times, output_step
+        Common sample times [s] (default: the end time only).
+    rtol, atol, max_step, max_steps
+        As :func:`simulate`, shared by all variants (defaults: the first variant's).
+    outputs : bool
+        Evaluate the outputs at the samples.
+    event_capacity : int
+        Events kept per variant.
+    check : bool
+        Raise if any variant failed (otherwise see ``status``).
+
+    Returns
+    -------
+    SimulationResult
+        Stacked: ``states[v, i, :]``; ``status`` one code per variant; events with a ``variant`` column.
+    """
+    import numba
+
+    from .numerics import _cache, core
+
+    systems = list(systems)
+    if not systems:
+        raise ParameterError("simulate_batch: no variants")
+    first = systems[0]
+    for s in systems[1:]:
+        if type(s.params) is not type(first.params) or s.x0.shape != first.x0.shape:
+            raise ParameterError("simulate_batch: all variants must be the same model with the same structure")
+    ts = sample_grid(0.0, float(t_end), output_step, sample_times)
+    if ts is None:
+        ts = np.array([float(t_end)])
+    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps)
+    _cache.ensure_fresh()
+    nv, ns = len(systems), ts.size
+    nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
+    check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
+    plist = numba.typed.List([s.params for s in systems])
+    X0 = np.stack([s.x0 for s in systems])
+    M0 = np.stack([s.m0 for s in systems])
+    U = np.stack([s.u0 for s in systems]) if ny >= 0 else None
+    OX = np.full((nv, ns, nx), np.nan)
+    OM = np.zeros((nv, ns, nm), dtype=np.int64)
+    OY = np.full((nv, ns, ny) if outputs else (nv, 1, ny), np.nan)
+    STATS = np.zeros((nv, core.N_SI), dtype=np.int64)
+    EVT = np.zeros((nv, event_capacity))
+    EVC = np.zeros((nv, event_capacity), dtype=np.int64)
+    EVE = np.zeros((nv, event_capacity), dtype=np.int64)
+    EVN = np.zeros((nv, 2), dtype=np.int64)
+    runner = core.batch_rodas if first.method == "rodas" else core.batch_dopri
+    runner(plist, X0, M0, U, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE, EVN)
+    status = STATS[:, core.SI_STATUS].copy()
+    if check:
+        bad = np.flatnonzero(~np.isin(status, [st.SUCCESS, st.TERMINATED]))
+        if bad.size:
+            raise SimulationError(f"{first.name}: variant {bad[0]}: {st.message(status[bad[0]])}")
+    frames = [first.events_frame(EVT[v, :EVN[v, 0]], EVC[v, :EVN[v, 0]], EVE[v, :EVN[v, 0]], variant=v)
+              for v in range(nv)]
+    events = pd.concat(frames, ignore_index=True) if frames else first.events_frame([], [], [])
+    if not outputs:
+        OY = np.full((nv, ns, ny), np.nan)
+    stats = {"accepted_steps": STATS[:, core.SI_ACCEPTED].copy(), "rejected_steps": STATS[:, core.SI_REJECTED].copy(),
+             "rhs_evaluations": STATS[:, core.SI_NRHS].copy(), "events_dropped": EVN[:, 1].copy()}
+    return SimulationResult(ts, OX, OY, OM, events, status, first.state_columns, first.output_columns,
+                            tuple(first.mode_names), tuple(first.mode_values), stats, first.name)
+
+
+def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):
+    """Right-hand side, switching functions and outputs of a system at one point (through the contract).
+
+    Returns ``(dx, g, y)`` [SI].  Defaults: the initial state, inputs and modes.
+    """
+    from .numerics import _cache, core
+
+    _cache.ensure_fresh()
+    x = system.x0.copy() if x is None else np.ascontiguousarray(x, dtype=float)
+    u = system.u0.copy() if u is None else np.ascontiguousarray(u, dtype=float)
+    m = system.m0.copy() if m is None else np.ascontiguousarray(m, dtype=np.int64)
+    dx = np.empty(len(system.states))
+    g = np.empty(len(system.switching))
+    y = np.empty(len(system.outputs))
+    core.evaluate(system.params, float(t), x, u, m, dx, g)
+    core.evaluate_outputs(system.params, float(t), x, u, m, y)
+    return dx, g, y
+
+
+# ---------------------------------------------------------------- the model registry
+#: model name -> factory ``f(**kwargs) -> System`` (registered once by each model package)
+MODELS: dict = {}
+
+
+def register_model(name: str, factory: Callable) -> None:
+    """Register a model's :class:`System` factory under ``name`` (the one registry of models)."""
+    MODELS[name] = factory

@@ -1,0 +1,193 @@
+"""Toy systems for testing the integrator core on its own (closed-form solutions).
+
+Each toy implements the system contract (:mod:`clutchlab.system`) the way a
+clutch model does: a parameter NamedTuple, compiled hooks registered for it,
+and a :class:`~clutchlab.system.System` factory.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from clutchlab.numerics import dispatch
+from clutchlab.numerics.core import record
+from clutchlab.system import System
+
+
+# ------------------------------------------------------------------ linear test equation / oscillator
+class LinearParams(NamedTuple):
+    """x' = A x + B u."""
+
+    a: np.ndarray
+    b: np.ndarray
+
+
+@numba.njit(cache=True)
+def _lin_rhs(t, x, u, m, p, dx, g):
+    n = x.shape[0]
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += p.a[i, j] * x[j]
+        for j in range(u.shape[0]):
+            s += p.b[i, j] * u[j]
+        dx[i] = s
+
+
+@numba.njit(cache=True)
+def _lin_outputs(t, x, u, m, p, y):
+    for i in range(y.shape[0]):
+        y[i] = x[i]
+
+
+@numba.njit(cache=True)
+def _no_update(t, x, u, m, p, k, log):
+    return 0
+
+
+@numba.njit(cache=True)
+def _no_restart(t, x, u, m, p, log):
+    return False
+
+
+@numba.njit(cache=True)
+def _no_accept(t, x, u, m, p):
+    return 0
+
+
+@numba.njit(cache=True)
+def _no_break(t, m, p):
+    return np.inf
+
+
+@numba.njit(cache=True)
+def _lin_jac(t, x, u, m, p, J):
+    for i in range(x.shape[0]):
+        for j in range(x.shape[0]):
+            J[i, j] = p.a[i, j]
+    return True
+
+
+dispatch.register(LinearParams, rhs=_lin_rhs, outputs=_lin_outputs, update=_no_update, restart=_no_restart,
+                  accept=_no_accept, next_break=_no_break, jacobian=_lin_jac)
+
+
+def linear_system(a, x0, b=None, method="dopri", mass=None):
+    a = np.atleast_2d(np.asarray(a, dtype=float))
+    n = a.shape[0]
+    b = np.zeros((n, 0)) if b is None else np.atleast_2d(np.asarray(b, dtype=float))
+    states = tuple((f"x{i}", "1") for i in range(n))
+    return System("linear", LinearParams(a, b), states, states, np.asarray(x0, float), np.zeros(0, np.int64),
+                  np.full(n, 1e-12), inputs=tuple((f"u{i}", "1") for i in range(b.shape[1])), method=method,
+                  mass=mass, rtol=1e-8)
+
+
+# ------------------------------------------------------------------ bouncing ball
+class BallParams(NamedTuple):
+    """Ball under gravity bouncing on the ground with restitution e."""
+
+    gravity: float
+    restitution: float
+
+
+@numba.njit(cache=True)
+def _ball_rhs(t, x, u, m, p, dx, g):
+    dx[0] = x[1]
+    dx[1] = -p.gravity
+    g[0] = x[0]  # height: an event when it falls through zero
+
+
+@numba.njit(cache=True)
+def _ball_update(t, x, u, m, p, k, log):
+    x[0] = 0.0
+    x[1] = -p.restitution * x[1]
+    m[0] += 1
+    record(log, t, 0, -1)
+    return 1 if m[0] >= 4 else 0  # the fourth bounce is terminal
+
+
+@numba.njit(cache=True)
+def _no_jac(t, x, u, m, p, J):
+    return False
+
+
+dispatch.register(BallParams, rhs=_ball_rhs, outputs=_lin_outputs, update=_ball_update, restart=_no_restart,
+                  accept=_no_accept, next_break=_no_break, jacobian=_no_jac)
+
+
+def ball_system(h0=1.0, e=0.5, method="dopri"):
+    return System("ball", BallParams(9.81, e), (("height", "m"), ("velocity", "m_s")),
+                  (("height", "m"), ("velocity", "m_s")), np.array([h0, 0.0]), np.zeros(1, np.int64),
+                  np.full(2, 1e-12), switching=(("height", -1),), events=("bounce",), mode_names=("bounces",),
+                  mode_values=(tuple(str(i) for i in range(5)),), method=method, rtol=1e-10)
+
+
+# ------------------------------------------------------------------ Coulomb stick-slip: mass on a moving belt
+class BeltParams(NamedTuple):
+    """Mass m on spring k to ground, Coulomb friction to a belt at speed v_b (static mu_s, kinetic mu_k)."""
+
+    mass: float
+    stiffness: float
+    belt_speed: float
+    normal_force: float
+    mu_s: float
+    mu_k: float
+
+
+SLIP_FWD, STUCK, SLIP_BWD = 0, 1, 2  # relative to the belt: mass slower than the belt = forward friction
+
+
+@numba.njit(cache=True)
+def _belt_rhs(t, x, u, m, p, dx, g):
+    spring = -p.stiffness * x[0]
+    if m[0] == STUCK:
+        dx[0] = p.belt_speed
+        dx[1] = 0.0
+        g[0] = abs(spring) - p.mu_s * p.normal_force  # break-away when the spring exceeds static friction
+        g[1] = -1.0
+    else:
+        sgn = 1.0 if m[0] == SLIP_FWD else -1.0
+        dx[0] = x[1]
+        dx[1] = (spring + sgn * p.mu_k * p.normal_force) / p.mass
+        g[0] = -1.0
+        g[1] = sgn * (x[1] - p.belt_speed)  # relative speed reaches zero: rises through 0
+    
+
+@numba.njit(cache=True)
+def _belt_update(t, x, u, m, p, k, log):
+    if k == 0:
+        m[0] = SLIP_FWD if -p.stiffness * x[0] > 0.0 else SLIP_BWD
+        record(log, t, 0, 0)
+    else:
+        x[1] = p.belt_speed
+        if abs(p.stiffness * x[0]) <= p.mu_s * p.normal_force:
+            m[0] = STUCK
+            record(log, t, 1, 0)
+        else:
+            m[0] = SLIP_BWD if m[0] == SLIP_FWD else SLIP_FWD
+            record(log, t, 2, 0)
+    return 0
+
+
+@numba.njit(cache=True)
+def _belt_accept(t, x, u, m, p):
+    if m[0] == STUCK:
+        x[1] = p.belt_speed
+    return 0
+
+
+dispatch.register(BeltParams, rhs=_belt_rhs, outputs=_lin_outputs, update=_belt_update, restart=_no_restart,
+                  accept=_belt_accept, next_break=_no_break, jacobian=_no_jac)
+
+
+def belt_system(method="dopri", mass=1.0, k=100.0, vb=0.1, fn=10.0, mu_s=0.5, mu_k=0.3):
+    return System("belt", BeltParams(mass, k, vb, fn, mu_s, mu_k), (("position", "m"), ("velocity", "m_s")),
+                  (("position", "m"), ("velocity", "m_s")), np.array([0.0, vb]), np.array([STUCK], np.int64),
+                  np.full(2, 1e-12), switching=(("breakaway", 1), ("stick", 1)),
+                  events=("breakaway", "stick", "reversal"), mode_names=("friction",),
+                  mode_values=(("forward", "stick", "backward"),), method=method, rtol=1e-10,
+                  fd_scale=np.array([1e-3, 1e-2]))
