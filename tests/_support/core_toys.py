@@ -126,6 +126,48 @@ def ball_system(h0=1.0, e=0.5, method="dopri"):
                   mode_values=(tuple(str(i) for i in range(5)),), method=method, rtol=1e-10)
 
 
+# ------------------------------------------------------------------ sine with a directional event and a break
+class SineParams(NamedTuple):
+    """x' = cos(t): x = sin(t); switching function x (direction per the System); breaks every ``period``."""
+
+    period: float
+
+
+@numba.njit(cache=True)
+def _sine_rhs(t, x, u, m, p, dx, g):
+    dx[0] = math.cos(t)
+    g[0] = x[0]
+
+
+@numba.njit(cache=True)
+def _sine_update(t, x, u, m, p, k, log):
+    record(log, t, 0, k)
+    return 0
+
+
+@numba.njit(cache=True)
+def _sine_restart(t, x, u, m, p, log):
+    m[0] += 1  # counts the break times seen
+    return False
+
+
+@numba.njit(cache=True)
+def _sine_break(t, m, p):
+    if p.period <= 0.0:
+        return np.inf
+    return (math.floor(t / p.period + 1e-9) + 1.0) * p.period
+
+
+dispatch.register(SineParams, rhs=_sine_rhs, outputs=_lin_outputs, update=_sine_update, restart=_sine_restart,
+                  accept=_no_accept, next_break=_sine_break, jacobian=_no_jac)
+
+
+def sine_system(direction=0, period=0.0, method="dopri"):
+    return System("sine", SineParams(period), (("x", "1"),), (("x", "1"),), np.zeros(1), np.zeros(1, np.int64),
+                  np.full(1, 1e-12), switching=(("x", direction),), events=("zero",), mode_names=("restarts",),
+                  mode_values=(tuple(str(i) for i in range(1000)),), method=method, rtol=1e-10)
+
+
 # ------------------------------------------------------------------ Coulomb stick-slip: mass on a moving belt
 class BeltParams(NamedTuple):
     """Mass m on spring k to ground, Coulomb friction to a belt at speed v_b (static mu_s, kinetic mu_k)."""
@@ -160,7 +202,7 @@ def _belt_rhs(t, x, u, m, p, dx, g):
 @numba.njit(cache=True)
 def _belt_update(t, x, u, m, p, k, log):
     if k == 0:
-        m[0] = SLIP_FWD if -p.stiffness * x[0] > 0.0 else SLIP_BWD
+        m[0] = SLIP_BWD if -p.stiffness * x[0] > 0.0 else SLIP_FWD  # spring pushes the mass ahead of the belt: backward friction
         record(log, t, 0, 0)
     else:
         x[1] = p.belt_speed

@@ -46,15 +46,18 @@ and the parameters ``p``):
 
 from __future__ import annotations
 
+import inspect
+
 from numba.core import types
 from numba.extending import overload
 
-__all__ = ["register", "registered", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
+__all__ = ["register", "registered", "model_sources", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 
 # parameter NamedTuple class -> {hook name: compiled function}
 _MODELS: dict = {}
+_SOURCES: set = set()
 
 
 def register(params_cls, **functions) -> None:
@@ -68,6 +71,16 @@ def register(params_cls, **functions) -> None:
     if missing or extra:
         raise TypeError(f"register({params_cls.__name__}): missing hooks {missing}, unknown hooks {extra}")
     _MODELS[params_cls] = dict(functions)
+    for fn in functions.values():
+        try:
+            _SOURCES.add(inspect.getsourcefile(getattr(fn, "py_func", fn)))
+        except TypeError:
+            pass
+
+
+def model_sources() -> list:
+    """Source files of every registered hook (the core's cache guard watches them)."""
+    return sorted(f for f in _SOURCES if f)
 
 
 def registered(params_cls) -> bool:

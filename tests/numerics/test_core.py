@@ -1,0 +1,286 @@
+"""The integrator core on its own, as SciPy's test_ivp tests solve_ivp.
+
+Toy systems (tests/_support/core_toys.py) implement the system contract like
+the clutch models do; every expected value here is a closed form or computed
+independently of the core (SciPy's brentq on a closed-form trajectory).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import brentq
+
+import core_toys as toys
+from hypothesis_budget import examples
+from clutchlab import SimulationError
+from clutchlab.numerics import core
+from clutchlab.numerics.status import Status
+from clutchlab.system import Simulation, evaluate, simulate, simulate_batch
+
+METHODS = ("dopri", "rodas")
+OSC = [[0.0, 1.0], [-1.0, 0.0]]  # x'' = -x
+
+
+def _osc_error(method, rtol):
+    res = simulate(toys.linear_system(OSC, [1.0, 0.0], method=method), 10.0, rtol=rtol, atol=rtol * 1e-2,
+                   output_step=0.25)
+    return np.max(np.abs(res.states[:, 0] - np.cos(res.time)) + np.abs(res.states[:, 1] + np.sin(res.time)))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_error_follows_the_tolerance(method):
+    """Error against the analytic solution shrinks with rtol and stays within a modest multiple of it."""
+    tols = [1e-4, 1e-6, 1e-8] if method == "dopri" else [1e-3, 1e-5, 1e-7]
+    errs = [_osc_error(method, r) for r in tols]
+    for r, e in zip(tols, errs):
+        assert e < 200 * r, (r, e)
+    assert errs[0] > 10 * errs[1] > 100 * errs[2] * 0.1
+    assert errs[2] < errs[1] < errs[0]
+
+
+def _fixed_step_error(method, h):
+    # huge tolerances accept every step; max_step == first_step fixes the step size
+    res = simulate(toys.linear_system(OSC, [1.0, 0.0], method=method), 2.0, rtol=0.5, atol=1e3, max_step=h,
+                   first_step=h, output_step=2.0)
+    return abs(res.states[-1, 0] - math.cos(2.0))
+
+
+@pytest.mark.parametrize("method, order", [("dopri", 5), ("rodas", 3)])
+def test_observed_order_of_convergence(method, order):
+    hs = [0.1, 0.05, 0.025]
+    errs = [_fixed_step_error(method, h) for h in hs]
+    slopes = [math.log(errs[i] / errs[i + 1]) / math.log(2.0) for i in range(2)]
+    for s in slopes:
+        assert order - 0.4 < s < order + 0.8, slopes
+
+
+def test_rodas_is_stable_on_a_stiff_system_with_large_steps():
+    """x0' = -1e6 x0, x1' = -x1: Rodas3 takes steps far beyond the explicit stability limit (2.8e-6 s)."""
+    a = [[-1e6, 0.0], [0.0, -1.0]]
+    res = simulate(toys.linear_system(a, [1.0, 1.0], method="rodas"), 5.0, rtol=1e-6, atol=1e-9, output_step=0.5)
+    assert res.stats["accepted_steps"] < 2000
+    assert np.allclose(res.states[1:, 0], 0.0, atol=1e-9)
+    assert np.allclose(res.states[:, 1], np.exp(-res.time), rtol=1e-4)
+
+
+def test_rodas_index1_algebraic_row_with_the_mass_matrix():
+    """x' = -x + y, 0 = y - x/2 (mass row 0): x = exp(-t/2), y = x/2 on the whole trajectory."""
+    a = [[-1.0, 1.0], [-0.5, 1.0]]
+    res = simulate(toys.linear_system(a, [1.0, 0.5], method="rodas", mass=[1.0, 0.0]), 4.0, rtol=1e-7, atol=1e-10,
+                   output_step=0.5)
+    assert np.allclose(res.states[:, 0], np.exp(-res.time / 2), rtol=1e-5)
+    # the algebraic row is interpolated linearly between steps (the step points themselves are exact)
+    assert np.allclose(res.states[:, 1], res.states[:, 0] / 2, rtol=1e-4)
+    steps = simulate(toys.linear_system(a, [1.0, 0.5], method="rodas", mass=[1.0, 0.0]), 4.0, rtol=1e-7, atol=1e-10)
+    assert np.allclose(steps.states[:, 1], steps.states[:, 0] / 2, rtol=1e-9)
+
+
+def _bounce_times(h0, e, n, g=9.81):
+    t = math.sqrt(2 * h0 / g)
+    v = g * t
+    out = [t]
+    for _ in range(n - 1):
+        v *= e
+        out.append(out[-1] + 2 * v / g)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_bouncing_ball_event_times_and_terminal_event(method):
+    res = simulate(toys.ball_system(method=method), 10.0)
+    assert res.status == Status.TERMINATED and res.ok
+    assert list(res.events.event) == ["bounce"] * 4
+    assert np.allclose(res.events.time_s, _bounce_times(1.0, 0.5, 4), rtol=0, atol=1e-9)
+    assert res.stats["final_time"] == pytest.approx(_bounce_times(1.0, 0.5, 4)[-1], abs=1e-9)
+
+
+@settings(max_examples=examples(15), deadline=None)
+@given(h0=st.floats(0.05, 5.0), e=st.floats(0.2, 0.9))
+def test_bouncing_ball_any_height_and_restitution(h0, e):
+    res = simulate(toys.ball_system(h0, e), 60.0)
+    assert np.allclose(res.events.time_s, _bounce_times(h0, e, 4), rtol=0, atol=1e-8)
+
+
+def _belt_closed_form(m=1.0, k=100.0, vb=0.1, fn=10.0, mu_s=0.5, mu_k=0.3):
+    """Break-away, stick and next break-away times of the belt oscillator, from its closed-form trajectory."""
+    w = math.sqrt(k / m)
+    t_b = mu_s * fn / (k * vb)
+    xb = mu_s * fn / k
+    xeq = mu_k * fn / k
+    a = xb - xeq
+
+    def v(tau):  # slipping: x = xeq + a cos(w tau) + vb/w sin(w tau)
+        return -a * w * math.sin(w * tau) + vb * math.cos(w * tau)
+
+    # first return of the speed to the belt speed: bracket on a fine grid, then brentq
+    taus = np.linspace(1e-6, 2 * math.pi / w, 20001)
+    vals = np.array([v(t) - vb for t in taus])
+    i = np.flatnonzero((vals[:-1] < 0) & (vals[1:] >= 0))[0]
+    tau = brentq(lambda t: v(t) - vb, taus[i], taus[i + 1], xtol=1e-15)
+    x_stick = xeq + a * math.cos(w * tau) + vb / w * math.sin(w * tau)
+    t_stick = t_b + tau
+    t_b2 = t_stick + (xb - x_stick) / vb
+    return t_b, t_stick, t_b2, x_stick
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_coulomb_stick_slip_against_the_closed_form(method):
+    t_b, t_s, t_b2, x_s = _belt_closed_form()
+    res = simulate(toys.belt_system(method=method), t_b2 + 0.1, output_step=1e-3, rtol=1e-10 if method == "dopri"
+                   else 1e-8)
+    ev = res.events
+    assert list(ev.event[:3]) == ["breakaway", "stick", "breakaway"]
+    tol = 1e-8 if method == "dopri" else 1e-6
+    assert ev.time_s.iloc[0] == pytest.approx(t_b, abs=tol)
+    assert ev.time_s.iloc[1] == pytest.approx(t_s, abs=tol)
+    assert ev.time_s.iloc[2] == pytest.approx(t_b2, abs=tol)
+    # stuck: the mass moves with the belt, exactly
+    stuck = (res.time > t_s + 1e-6) & (res.time < t_b2 - 1e-6)
+    assert np.all(res.mode("friction")[stuck] == "stick")
+    assert np.allclose(res.states[stuck, 1], 0.1, atol=1e-12)
+    assert np.allclose(res.states[stuck, 0], x_s + 0.1 * (res.time[stuck] - t_s), atol=1e-7)
+
+
+@pytest.mark.parametrize("direction, expected", [(0, [math.pi, 2 * math.pi, 3 * math.pi]),
+                                                 (1, [2 * math.pi]), (-1, [math.pi, 3 * math.pi])])
+def test_event_direction_flags(direction, expected):
+    res = simulate(toys.sine_system(direction), 10.0)
+    assert np.allclose(res.events.time_s, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_break_times_end_steps_and_restart_the_model(method):
+    res = simulate(toys.sine_system(0, period=0.25, method=method), 2.0, output_step=0.5)
+    # restart runs at t0 and at each of the 7 break times before the end (0.25 ... 1.75)
+    assert res.stats["final_modes"][0] == 8
+    assert np.allclose(res.states[:, 0], np.sin(res.time), atol=1e-8)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_resumed_advance_matches_one_run(method):
+    system = toys.belt_system(method=method)
+    one = simulate(system, 1.5, rtol=1e-9, output_step=0.5)
+    sim = Simulation(system, rtol=1e-9)
+    for t in np.linspace(0.01, 1.5, 150):
+        sim.advance(t)
+    assert sim.time == pytest.approx(1.5)
+    assert np.allclose(sim.x, one.states[-1], atol=1e-6)
+    ev = sim.events()
+    assert list(ev.event) == list(one.events.event)
+    assert np.allclose(ev.time_s, one.events.time_s, atol=1e-8)
+    y = sim.outputs()
+    assert np.allclose(y, sim.x)
+
+
+def test_inputs_are_held_over_an_advance():
+    """x' = u with u switched per call: a ramp of the held values."""
+    system = toys.linear_system([[0.0]], [0.0], b=[[1.0]])
+    sim = Simulation(system)
+    sim.advance(1.0, [2.0])
+    sim.advance(3.0, [-1.0])
+    assert sim.x[0] == pytest.approx(2.0 * 1.0 - 1.0 * 2.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_batch_equals_single_runs(method):
+    systems = [toys.ball_system(h0, e, method=method) for h0, e in [(1.0, 0.5), (2.0, 0.7), (0.3, 0.4)]]
+    batch = simulate_batch(systems, 3.0, output_step=0.1, event_capacity=16)
+    assert batch.batch and batch.states.shape == (3, 31, 2)
+    for v, s in enumerate(systems):
+        single = simulate(s, 3.0, output_step=0.1)
+        n = single.time.size
+        assert np.array_equal(batch.states[v, :n], single.states)
+        ev = batch.events[batch.events.variant == v]
+        assert np.array_equal(ev.time_s.to_numpy(), single.events.time_s.to_numpy())
+    assert list(batch.status) == [Status.TERMINATED] * 3
+
+
+def test_every_step_recording_grows_in_chunks():
+    """Without output_step every accepted step is kept, across several record chunks."""
+    res = simulate(toys.linear_system(OSC, [1.0, 0.0]), 200.0, rtol=1e-10, atol=1e-12)
+    assert res.time.size == res.stats["accepted_steps"] + 1 > 4096
+    assert np.all(np.diff(res.time) > 0)
+    assert np.allclose(res.states[:, 0], np.cos(res.time), atol=1e-7)
+
+
+def test_step_limit_is_a_status_and_an_error():
+    system = toys.linear_system(OSC, [1.0, 0.0])
+    with pytest.raises(SimulationError, match="step limit"):
+        simulate(system, 10.0, max_steps=5)
+    res = simulate(system, 10.0, max_steps=5, check=False)
+    assert res.status == Status.STEP_LIMIT and not res.ok
+
+
+def test_result_columns_carry_units_and_events_have_names():
+    res = simulate(toys.ball_system(), 2.0, output_step=0.1)
+    frame = res.to_dataframe()
+    assert list(frame.columns) == ["time_s", "height_m", "velocity_m_s", "bounces"]
+    assert res["height_m"].shape == res.time.shape
+    assert set(res.events.columns) == {"time_s", "event", "element"}
+    with pytest.raises(KeyError, match="not a state or output"):
+        res["nothing_m"]
+
+
+def test_evaluate_through_the_contract():
+    dx, g, y = evaluate(toys.ball_system(), 0.0, [0.5, -1.0])
+    assert np.allclose(dx, [-1.0, -9.81]) and np.allclose(g, [0.5]) and np.allclose(y, [0.5, -1.0])
+
+
+def test_nan_error_norm_rejects_the_step():
+    """x' = -sqrt(x) style blow-up: a NaN trial step is rejected and the run still ends correctly."""
+    # x' = -50 x on [0, 1] started with a huge first step: the trial overflows to inf/NaN and must be rejected
+    res = simulate(toys.linear_system([[-50.0]], [1.0]), 1.0, first_step=1e3, rtol=1e-8, output_step=0.5)
+    assert res.ok
+    assert res.states[-1, 0] == pytest.approx(math.exp(-50.0), abs=1e-11)
+
+
+def test_cache_guard_drops_stale_core_code(tmp_path):
+    """A changed clutchlab source (stamp differs) deletes the core's cached code before the next run."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), CLUTCHLAB_COMPILE_NOTICE="0",
+               PYTHONPATH=os.pathsep.join([str(Path(__file__).parents[1] / "_support")] + sys.path))
+    script = ("import core_toys as T; from clutchlab.system import simulate; from clutchlab.numerics import core;"
+              "simulate(T.ball_system(), 1.0); print(core.advance_dopri._cache._cache_path)")
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    path = Path(out.stdout.strip().splitlines()[-1])
+    index = sorted(path.glob("core.advance_dopri*.nbi"))
+    assert index, "the core was not cached"
+    stamp = path / "clutchlab-core-sources.json"
+    assert stamp.exists()
+    # unchanged sources: the cache survives the next run
+    subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    assert sorted(path.glob("core.advance_dopri*.nbi")) == index
+    # a source changed since (simulated by a different stamp): the next run drops and rebuilds the core's code
+    import json
+
+    recorded = json.loads(stamp.read_text())
+    recorded[next(iter(recorded))] = "stale"
+    stamp.write_text(json.dumps(recorded))
+    before = {p: p.stat().st_mtime_ns for p in path.glob("core.advance_dopri*.nbc")}
+    subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    after = {p: p.stat().st_mtime_ns for p in path.glob("core.advance_dopri*.nbc")}
+    assert "stale" not in stamp.read_text()
+    assert after and all(after.get(p) != t for p, t in before.items())
+
+
+def test_source_stamp_follows_edits(tmp_path, monkeypatch):
+    from clutchlab.numerics import _cache
+
+    a = _cache.source_stamp()
+    assert a == _cache.source_stamp()
+    target = Path(core.__file__)
+    st_ = target.stat()
+    try:
+        os.utime(target, ns=(st_.st_atime_ns, st_.st_mtime_ns + 1_000_000_000))
+        assert _cache.source_stamp() != a
+    finally:
+        os.utime(target, ns=(st_.st_atime_ns, st_.st_mtime_ns))
+    assert _cache.source_stamp() == a
