@@ -241,7 +241,17 @@ def _index(vars_, name, kind, model):
 
 
 def sample_grid(t0: float, t_end: float, output_step: float | None, sample_times=None):
-    """Sample times of a run: ``sample_times`` as given, an ``output_step`` grid, or ``None`` (every step)."""
+    """Sample times of a run: ``sample_times`` as given, an ``output_step`` grid, or ``None`` (every step).
+
+    Parameters
+    ----------
+    t0, t_end : float
+        Start and end of the run [s].
+    output_step : float or None
+        Grid interval [s]; the end time is always a sample.
+    sample_times : array_like, optional
+        Explicit, increasing sample times within ``[t0, t_end]`` [s] (takes precedence).
+    """
     if sample_times is not None:
         ts = np.ascontiguousarray(sample_times, dtype=float).ravel()
         if ts.size and (not np.all(np.isfinite(ts)) or np.any(np.diff(ts) < 0) or ts[0] < t0
