@@ -288,6 +288,42 @@ def _outputs_row(p, t, x, u, m, rec_y, i, yb):
         rec_y[i, q] = yb[q]
 
 
+@numba.njit(cache=True, nogil=True)
+def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
+    """Record the samples ``ts[i_rec:] <= t_limit`` holding the state at ``t``; returns the next sample index."""
+    while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
+        _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
+        if want_y:
+            _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+        i_rec += 1
+    return i_rec
+
+
+@numba.njit(cache=True, nogil=True)
+def _record_dense(p, t, h, x0, f0, x1, f1, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, xe,
+                  i_rec):
+    """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index."""
+    while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
+        th = (ts[i_rec] - t) / h if h > 0.0 else 1.0
+        _dense(th, h, x0, f0, x1, f1, mass, xe)
+        _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
+        if want_y:
+            _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
+        i_rec += 1
+    return i_rec
+
+
+@numba.njit(cache=True, nogil=True)
+def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
+    """Record the point ``(t, x, m)`` in the step record if it has room; returns the next row."""
+    if i_rec < rec_t.shape[0]:
+        _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
+        if want_y:
+            _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+        i_rec += 1
+    return i_rec
+
+
 # ============================================================ Dormand-Prince 5(4)
 @numba.njit(cache=True, nogil=True)
 def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
@@ -372,16 +408,9 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     if si[SI_STARTED] == 0:
         si[SI_STARTED] = 1
         if grid:
-            while i_rec < ts.shape[0] and ts[i_rec] <= t:
-                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
-                if want_y:
-                    _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-                i_rec += 1
-        elif i_rec < cap:
-            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+        else:
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
         if opt.first_step > 0.0:
             h = opt.first_step
         else:
@@ -451,13 +480,8 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
             t_new = t + h
         # ---- samples in (t, t_new] on the dense output (modes of the step)
         if grid:
-            while i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-                th = (ts[i_rec] - t) / h
-                _dense(th, h, x, k1, xn, k7, mass, xe)
-                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
-                if want_y:
-                    _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
-                i_rec += 1
+            i_rec = _record_dense(p, t, h, x, k1, xn, k7, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
+                                  yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
         if theta <= 1.0:
             _dense(theta, h, x, k1, xn, k7, mass, xe)
@@ -476,11 +500,8 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
             si[SI_NRHS] += 1
             if flag == 1:
                 status = TERMINATED
-                if not grid and i_rec < cap:
-                    _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
-                    if want_y:
-                        _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-                    i_rec += 1
+                if not grid:
+                    i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
                 break
         else:
             for i in range(n):
@@ -499,18 +520,12 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
                 si[SI_NRHS] += 1
             h = next_step(h, en, prev_rej)
         prev_rej = False
-        if not grid and i_rec < cap:
-            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+        if not grid:
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
     if grid and status == SUCCESS:
         # samples at the end time itself (rounding) hold the final state
-        while i_rec < ts.shape[0] and ts[i_rec] <= t_end * (1.0 + 1e-12) and ts[i_rec] <= t + 1e-9:
-            _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                             want_y, yb, i_rec)
     sf[SF_T] = t
     sf[SF_H] = h
     si[SI_IREC] = i_rec
@@ -642,16 +657,9 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     if si[SI_STARTED] == 0:
         si[SI_STARTED] = 1
         if grid:
-            while i_rec < ts.shape[0] and ts[i_rec] <= t:
-                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
-                if want_y:
-                    _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-                i_rec += 1
-        elif i_rec < cap:
-            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+        else:
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
         h = opt.first_step if opt.first_step > 0.0 else 1e-5
     if h <= 0.0:
         h = 1e-5
@@ -751,13 +759,8 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
         if hit_stop and not event:
             t_new = t_stop
         if grid:
-            while i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-                th = (ts[i_rec] - t) / h_acc if h_acc > 0.0 else 1.0
-                _dense(th, h_acc, x, f0, x1, f1, mass, xe)
-                _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
-                if want_y:
-                    _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
-                i_rec += 1
+            i_rec = _record_dense(p, t, h_acc, x, f0, x1, f1, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                                  want_y, yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
         for i in range(n):
             x[i] = x1[i]
@@ -780,11 +783,8 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
                 g0[k] = g1[k]
         need_jac = True
         jac_age += 1
-        if not grid and i_rec < cap:
-            _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+        if not grid:
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
         if flag == 1:
             status = TERMINATED
             break
@@ -793,11 +793,9 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
             h = h_new if not hit_stop else max(h, h_new)
         rejected_before = False
     if grid and status == SUCCESS:
-        while i_rec < ts.shape[0] and ts[i_rec] <= t_end * (1.0 + 1e-12) and ts[i_rec] <= t + 1e-9:
-            _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
-            if want_y:
-                _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
-            i_rec += 1
+        # samples at the end time itself (rounding) hold the final state
+        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                             want_y, yb, i_rec)
     sf[SF_T] = t
     sf[SF_H] = h
     si[SI_IREC] = i_rec
