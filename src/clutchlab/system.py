@@ -103,6 +103,10 @@ class System:
     mass, jac_cols, fd_scale : ndarray, optional
         Diagonal mass matrix (0: algebraic row), the Jacobian's difference
         columns and their typical magnitudes (Rosenbrock).
+    jac_pattern : ndarray of bool, optional
+        Structural non-zeros of ``df/dx`` (``[row, column]``, valid in every mode); with it the
+        difference columns are grouped so that columns sharing no row are perturbed together
+        (greedy colouring, Curtis-Powell-Reid), one right-hand side per group.
     nonautonomous : bool
         Inputs vary inside a step (Rosenbrock: difference df/dt).
     jac_every : int
@@ -131,6 +135,7 @@ class System:
     method: str = "dopri"
     mass: np.ndarray | None = None
     jac_cols: np.ndarray | None = None
+    jac_pattern: np.ndarray | None = None
     fd_scale: np.ndarray | None = None
     nonautonomous: bool = False
     jac_every: int = 1
@@ -159,6 +164,14 @@ class System:
         object.__setattr__(self, "mass", mass)
         cols = np.arange(n) if self.jac_cols is None else np.ascontiguousarray(self.jac_cols, dtype=np.int64)
         object.__setattr__(self, "jac_cols", cols)
+        if self.jac_pattern is None:
+            pattern = np.ones((n, n), dtype=np.bool_)
+        else:
+            pattern = np.ascontiguousarray(self.jac_pattern, dtype=np.bool_)
+            if pattern.shape != (n, n):
+                raise ParameterError(f"System {self.name!r}: jac_pattern must be {n} x {n}")
+        object.__setattr__(self, "jac_pattern", pattern)
+        object.__setattr__(self, "_jac_groups", _colour_columns(pattern, cols))
         scale = np.maximum(self.atol, 1e-12) if self.fd_scale is None else np.asarray(self.fd_scale, dtype=float)
         object.__setattr__(self, "fd_scale", np.ascontiguousarray(scale))
         object.__setattr__(self, "states", variables(self.states))
@@ -215,7 +228,8 @@ class System:
         event_tol = self.event_tol if event_tol is None else event_tol
         gdir = np.array([d for _, d in self.switching], dtype=np.int64)
         return Options(float(rtol), np.ascontiguousarray(atol_v), float(min(max_step, 1e300)), float(first_step),
-                       int(max_steps), float(event_tol), gdir, self.mass, self.jac_cols, self.fd_scale,
+                       int(max_steps), float(event_tol), gdir, self.mass, self._jac_groups, self.jac_pattern,
+                       self.fd_scale,
                        int(self.jac_every), bool(self.nonautonomous))
 
     # ---- events
@@ -230,6 +244,26 @@ class System:
         if variant is not None:
             frame.insert(0, "variant", variant)
         return frame
+
+
+def _colour_columns(pattern: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Groups of columns that share no structural row (greedy colouring), padded with -1."""
+    groups: list[list[int]] = []
+    rows: list[np.ndarray] = []
+    for c in cols:
+        for g, used in zip(groups, rows):
+            if not np.any(used & pattern[:, c]):
+                g.append(int(c))
+                used |= pattern[:, c]
+                break
+        else:
+            groups.append([int(c)])
+            rows.append(pattern[:, c].copy())
+    width = max((len(g) for g in groups), default=1)
+    out = np.full((max(len(groups), 1), width), -1, dtype=np.int64)
+    for i, g in enumerate(groups):
+        out[i, :len(g)] = g
+    return out
 
 
 def _index(vars_, name, kind, model):

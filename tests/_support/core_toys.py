@@ -233,3 +233,43 @@ def belt_system(method="dopri", mass=1.0, k=100.0, vb=0.1, fn=10.0, mu_s=0.5, mu
                   events=("breakaway", "stick", "reversal"), mode_names=("friction",),
                   mode_values=(("forward", "stick", "backward"),), method=method, rtol=1e-10,
                   fd_scale=np.array([1e-3, 1e-2]))
+
+
+# ------------------------------------------------------------------ chain of masses (sparse Jacobian, no analytic one)
+class ChainParams(NamedTuple):
+    """n unit masses in a chain of springs k (fixed ends) with dampers c, a cubic spring at each node."""
+
+    stiffness: float
+    damping: float
+    cubic: float
+
+
+@numba.njit(cache=True)
+def _chain_rhs(t, x, u, m, p, dx, g):
+    n = x.shape[0] // 2
+    for i in range(n):
+        left = x[i - 1] if i > 0 else 0.0
+        right = x[i + 1] if i < n - 1 else 0.0
+        dx[i] = x[n + i]
+        dx[n + i] = (p.stiffness * (left - 2.0 * x[i] + right) - p.damping * x[n + i] - p.cubic * x[i] ** 3)
+
+
+dispatch.register(ChainParams, rhs=_chain_rhs, outputs=_lin_outputs, update=_no_update, restart=_no_restart,
+                  accept=_no_accept, next_break=_no_break, jacobian=_no_jac)
+
+
+def chain_system(n=8, pattern=True):
+    pat = None
+    if pattern:
+        pat = np.zeros((2 * n, 2 * n), dtype=bool)
+        for i in range(n):
+            pat[i, n + i] = True
+            for j in (i - 1, i, i + 1):
+                if 0 <= j < n:
+                    pat[n + i, j] = True
+            pat[n + i, n + i] = True
+    x0 = np.zeros(2 * n)
+    x0[0] = 0.1
+    states = tuple((f"x{i}", "m") for i in range(n)) + tuple((f"v{i}", "m_s") for i in range(n))
+    return System("chain", ChainParams(1e4, 5.0, 1e5), states, states, x0, np.zeros(0, np.int64), np.full(2 * n, 1e-9),
+                  method="rodas", jac_pattern=pat, fd_scale=np.full(2 * n, 1e-3), rtol=1e-6)

@@ -9,8 +9,9 @@ Two methods, each written once:
   L-stable Rosenbrock method (Sandu et al. 1997) with a diagonal mass matrix
   (zero rows are algebraic equations of index 1), for stiff models
   (E-clutch actuator + clutch).  Jacobian from the model (analytic) or by
-  forward differences over the columns named in ``Options.jac_cols``, each
-  column differenced backwards when the forward perturbation crosses a
+  forward differences over the columns named in ``Options.jac_groups``
+  (columns that share no row of the sparsity pattern are perturbed
+  together, one right-hand side per group), each group differenced backwards when the forward perturbation crosses a
   switching function (a kink).
 
 Both share the hybrid logic:
@@ -101,8 +102,12 @@ class Options(NamedTuple):
         +1 rising through zero, -1 falling, 0 either.
     mass : ndarray
         Diagonal of the mass matrix (Rosenbrock only; 0 marks an algebraic row).
-    jac_cols : ndarray of int64
-        Columns of the finite-difference Jacobian (Rosenbrock; the others are zero).
+    jac_groups : ndarray of int64, shape (n_groups, width)
+        Columns of the finite-difference Jacobian (Rosenbrock; the others are
+        zero), in groups perturbed together (padding -1); columns in a group
+        share no row of ``jac_pattern``.
+    jac_pattern : ndarray of bool, shape (n, n)
+        Structural non-zeros of the Jacobian (all True without a pattern).
     fd_scale : ndarray
         Typical magnitude of each state for the difference increment.
     jac_every : int
@@ -120,7 +125,8 @@ class Options(NamedTuple):
     event_tol: float
     gdir: np.ndarray
     mass: np.ndarray
-    jac_cols: np.ndarray
+    jac_groups: np.ndarray
+    jac_pattern: np.ndarray
     fd_scale: np.ndarray
     jac_every: int
     nonautonomous: bool
@@ -574,21 +580,30 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K
 
 
 @numba.njit(cache=True, nogil=True)
-def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp):
-    """Forward-difference Jacobian over ``opt.jac_cols``; backward where the forward step crosses a kink.
+def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
+    """Forward-difference Jacobian by column groups; backward where the forward step crosses a kink.
 
-    A forward perturbation that changes the sign of a switching function
-    differences across the kink (cavitation, a contact, an end stop): such a
-    column is differenced backwards.  Returns the number of ``rhs`` calls.
+    The columns of one group of ``opt.jac_groups`` share no row of
+    ``opt.jac_pattern`` and are perturbed together (one ``rhs`` call per
+    group; column ``c`` fills only its pattern rows).  A forward perturbation
+    that changes the sign of a switching function differences across a kink
+    (cavitation, a contact, an end stop): that group is differenced
+    backwards.  Returns the number of ``rhs`` calls.
     """
     n = x.shape[0]
     ng = g0.shape[0]
+    groups = opt.jac_groups
+    pattern = opt.jac_pattern
     nr = 0
-    for c in opt.jac_cols:
+    for gi in range(groups.shape[0]):
         for i in range(n):
             xp[i] = x[i]
-        dl = 1.5e-8 * max(abs(x[c]), opt.fd_scale[c])
-        xp[c] = x[c] + dl
+        for q in range(groups.shape[1]):
+            c = groups[gi, q]
+            if c < 0:
+                break
+            dls[c] = 1.5e-8 * max(abs(x[c]), opt.fd_scale[c])
+            xp[c] = x[c] + dls[c]
         model.rhs(t, xp, u, m, p, fp, gp)
         nr += 1
         kink = False
@@ -597,12 +612,20 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp):
                 kink = True
                 break
         if kink:
-            dl = -dl
-            xp[c] = x[c] + dl
+            for q in range(groups.shape[1]):
+                c = groups[gi, q]
+                if c < 0:
+                    break
+                dls[c] = -dls[c]
+                xp[c] = x[c] + dls[c]
             model.rhs(t, xp, u, m, p, fp, gp)
             nr += 1
-        for r in range(n):
-            J[r, c] = (fp[r] - f0[r]) / dl
+        for q in range(groups.shape[1]):
+            c = groups[gi, q]
+            if c < 0:
+                break
+            for r in range(n):
+                J[r, c] = (fp[r] - f0[r]) / dls[c] if pattern[r, c] else 0.0
     return nr
 
 
@@ -646,6 +669,7 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     xe = np.empty(n)
     xp = np.empty(n)
     err = np.empty(n)
+    dls = np.empty(n)
     yb = np.empty(rec_y.shape[1])
     t = sf[SF_T]
     h = sf[SF_H]
@@ -692,7 +716,7 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
         if need_jac:
             if jac_age >= opt.jac_every or jac_stale:
                 if not model.jacobian(t, x, u, m, p, J):
-                    si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp)
+                    si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls)
                 jac_age = 0
                 jac_stale = False
                 si[SI_NJAC] += 1
