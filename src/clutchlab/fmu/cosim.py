@@ -45,6 +45,7 @@ from . import COSIMULATIONS
 __all__ = [
     "Variable",
     "CoSimulation",
+    "ContractCoSimulation",
     "WetCoSimulation",
     "EmtcCoSimulation",
     "COSIMULATIONS",
@@ -288,6 +289,60 @@ def _check_time(owner: str, t_model: float, t: float, dt: float):
         raise SimulationError(
             f"{owner}.do_step: called at t = {t!r} s but the model is at t = {t_model!r} s "
             "(steps must be contiguous; call reset() to start again)")
+
+
+class ContractCoSimulation(CoSimulation):
+    """A co-simulation written once against the system contract (:mod:`clutchlab.system`).
+
+    A model's co-simulation subclasses this and supplies only :meth:`build_system` (its
+    :class:`~clutchlab.system.System` from the parameter values), :meth:`input_vector` (the held
+    inputs ``u`` from the FMI inputs) and :meth:`output_values` (FMI outputs from the model's output
+    vector).  Stepping is the core's resumable ``advance``
+    (:class:`clutchlab.system.Simulation`): each ``do_step`` continues the integration from the
+    stored state, modes, step size and memories, with the inputs held (zero-order hold).
+
+    Attributes
+    ----------
+    simulation_options : dict
+        Keyword arguments of :class:`~clutchlab.system.Simulation` (``rtol``, ``max_step``, ...);
+        a class attribute.
+    """
+
+    simulation_options: dict = {}
+
+    def __init__(self, **parameter_values):
+        self._values = self.resolve_parameters(parameter_values)
+        self.reset()
+
+    @abc.abstractmethod
+    def build_system(self, values: dict):
+        """The model's System for the parameter values ``values`` (by :class:`Variable` name, SI)."""
+
+    @abc.abstractmethod
+    def input_vector(self, inputs: dict) -> np.ndarray:
+        """Held inputs ``u`` of the System from the FMI input values ``inputs`` (all present, checked)."""
+
+    @abc.abstractmethod
+    def output_values(self, y: np.ndarray) -> dict:
+        """FMI outputs by name from the System's output vector ``y`` at the current point."""
+
+    def reset(self) -> None:
+        """Back to the initial state at t = 0 (same parameters)."""
+        from ..system import Simulation
+
+        self.system = self.build_system(self._values)
+        self.simulation = Simulation(self.system, **self.simulation_options)
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        """Outputs at t = 0 with the given inputs held."""
+        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
+        return self.output_values(self.simulation.outputs())
+
+    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
+        """Advance from ``t`` to ``t + dt`` [s] with ``inputs`` held; outputs at ``t + dt``."""
+        _check_time(type(self).__name__, self.simulation.time, t, dt)
+        self.simulation.advance(t + dt, self.input_vector(self.resolve_inputs(inputs)))
+        return self.output_values(self.simulation.outputs())
 
 
 # ===================================================================== wet clutch
