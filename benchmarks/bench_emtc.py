@@ -179,8 +179,8 @@ def measure(magnet, sc, reps=30):
     ref, n_ref_steps = reference(magnet, sc)
     t_ref = _best(lambda: reference(magnet, sc), 3)
     df = res.to_dataframe()
-    err_w = max(np.max(np.abs(df["omega_f"] - ref[:, 1])), np.max(np.abs(df["omega_r"] - ref[:, 2])))
-    err_i = np.max(np.abs(df["i2"] - ref[:, 7]))
+    err_w = max(np.max(np.abs(df["omega_f_rad_s"] - ref[:, 1])), np.max(np.abs(df["omega_r_rad_s"] - ref[:, 2])))
+    err_i = np.max(np.abs(df["i2_A"] - ref[:, 7]))
     print(f"--- {sc.duration:g} s simulated, controller/output every {sc.sample_time * 1e3:g} ms, rtol 1e-6")
     print(f"clutchlab simulate_bench (result object): {t_cl * 1e3:.2f} ms ({1.0 / t_cl:.0f}x faster than real time); "
           f"with to_dataframe(): {t_df * 1e3:.2f} ms ({1.0 / t_df:.0f}x); "
