@@ -40,6 +40,7 @@ from .bench import (
     simulate_bench,
 )
 from .magnet import bundled_magnet, synthetic_magnet
+from .system import BenchOptions, bench_system, simulate
 
 __all__ = [
     "UNLOCK_MARGIN",
@@ -66,4 +67,7 @@ __all__ = [
     "load_scenario",
     "bundled_magnet",
     "synthetic_magnet",
+    "BenchOptions",
+    "bench_system",
+    "simulate",
 ]

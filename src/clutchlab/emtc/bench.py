@@ -1,8 +1,9 @@
 """AWD vehicle with the EMTC on a drum test bench ([1], Secs. 3.1 and 4).
 
 Parameter sets (frozen, unit-annotated, TOML load/save), the torque reference
-map of Eq. 31, and :func:`simulate_bench`, which runs the compiled model of
-:mod:`clutchlab.emtc._bench_kernel` and returns a :class:`BenchResult`.
+map of Eq. 31, and :func:`simulate_bench`, a thin layer over the model of
+:mod:`clutchlab.emtc.system` (run by the integrator core) that returns the
+per-sample view :class:`BenchResult` of a :class:`clutchlab.SimulationResult`.
 
 Schematic (coupling shaft side, speeds at the coupling)::
 
@@ -26,11 +27,12 @@ import numpy as np
 import pandas as pd
 
 from .._limits import check_allocation, short_repr
-from ..errors import ParameterError, SimulationError
+from ..errors import ParameterError
 from ..params import ParameterSet, quantity
 from ..params.base import load_toml
-from . import _bench_kernel as BK
-from .torque import LOCKED_CASE_NAMES, UNLOCK_MARGIN, CouplingGeometry
+from ._lookup import bilinear
+from .friction import drag_torque
+from .torque import LOCKED_CASE_NAMES, CouplingGeometry
 
 __all__ = [
     "ActuatorParameters",
@@ -47,25 +49,15 @@ __all__ = [
     "COLUMN_NAMES",
 ]
 
-EVENT_NAMES = {
-    BK.EV_ARM_REST: "armature at rest stop",
-    BK.EV_ARM_CONTACT: "armature contacts primary clutch (engaged)",
-    BK.EV_ARM_LEAVE_REST: "armature leaves rest stop",
-    BK.EV_ARM_LEAVE_CONTACT: "armature leaves primary clutch (open)",
-    BK.EV_LOCK: "lock-up (slip speed zero, capacity covers T_lock)",
-    BK.EV_SLIP_REVERSAL: "slip reversal (capacity below T_lock)",
-    BK.EV_UNLOCK: "unlock (|T_lock| > 1.02 T_cap)",
-}
+#: event codes (``kind``) of :attr:`BenchResult.events`: the index of the event in :data:`EVENT_KEYS`
+_EVENTS = ("armature_rest", "armature_contact", "armature_leave_rest", "armature_leave_contact", "lockup",
+           "slip_reversal", "unlock")
+_DESCRIPTIONS = ("armature at rest stop", "armature contacts primary clutch (engaged)", "armature leaves rest stop",
+                 "armature leaves primary clutch (open)", "lock-up (slip speed zero, capacity covers T_lock)",
+                 "slip reversal (capacity below T_lock)", "unlock (|T_lock| > 1.02 T_cap)")
+EVENT_NAMES = dict(enumerate(_DESCRIPTIONS))
 #: short name of each event kind, as in the ``event`` column of :attr:`BenchResult.events`
-EVENT_KEYS = {
-    BK.EV_ARM_REST: "armature_rest",
-    BK.EV_ARM_CONTACT: "armature_contact",
-    BK.EV_ARM_LEAVE_REST: "armature_leave_rest",
-    BK.EV_ARM_LEAVE_CONTACT: "armature_leave_contact",
-    BK.EV_LOCK: "lockup",
-    BK.EV_SLIP_REVERSAL: "slip_reversal",
-    BK.EV_UNLOCK: "unlock",
-}
+EVENT_KEYS = dict(enumerate(_EVENTS))
 MODE_NAMES = {0: "open", 1: "slipping", 2: "locked"}
 #: armature modes of the kernel: at the rest stop, free, pressing the primary clutch
 ARMATURE_MODE_NAMES = {0: "rest", 1: "free", 2: "contact"}
@@ -110,6 +102,7 @@ class ActuatorParameters(ParameterSet):
                 f"{self.free_travel!r} m (Eq. 12: d > sigma)")
 
     def kernel_data(self) -> np.ndarray:
+        """Array ``[mass, stiffness, preload, damping, free_travel, airgap_open, tau1, tau2]`` (SI)."""
         return np.array([self.mass, self.stiffness, self.preload, self.damping, self.free_travel,
                          self.airgap_open, self.tau1, self.tau2])
 
@@ -167,8 +160,8 @@ class VehicleParameters(ParameterSet):
 
     def drag_coefficient(self) -> float:
         """``T_drag / omega`` of Eq. 25 [N*m*s/rad]."""
-        return (self.drag_pairs * math.pi * self.oil_viscosity / (2.0 * self.plate_clearance)
-                * (self.plate_outer_radius**4 - self.plate_inner_radius**4))
+        return drag_torque(self.drag_pairs, self.oil_viscosity, 1.0, self.plate_clearance, self.plate_outer_radius,
+                           self.plate_inner_radius)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -221,16 +214,18 @@ class TorqueMap:
 
     def __call__(self, throttle, speed):
         """``T_cal`` [N*m] at throttle [-] and vehicle speed [m/s]."""
-        return float(BK._bilinear(self.throttle, self.speed, self.torque, float(throttle), float(speed)))
+        return float(bilinear(self.throttle, self.speed, self.torque, float(throttle), float(speed)))
 
 
 class BenchResult:
-    """Result of :func:`simulate_bench`.
+    """Result of :func:`simulate_bench`: a per-sample view of a :class:`clutchlab.SimulationResult`.
 
     Attributes
     ----------
+    result : clutchlab.SimulationResult
+        The run as every model returns it: unit-suffixed states and outputs, modes and named events.
     time : numpy.ndarray
-        Sample times [s].
+        Sample times [s] (the controller samples).
     states : pandas.DataFrame
         Kernel names, kept for existing code: ``omega_f, omega_r`` [rad/s],
         ``theta`` [rad], ``x`` [m], ``xdot`` [m/s], ``i1, i2`` [A].
@@ -250,41 +245,64 @@ class BenchResult:
     -----
     :meth:`to_dataframe` is the table to keep and to write: every column
     named with its unit suffix and modes as names (docs/nomenclature.md).
-    The tables are assembled from the kernel's arrays on first access:
-    ``raw`` (samples x columns) and ``raw_events`` are the kernel's output
-    arrays, ``airgap_open`` [m] the airgap at the rest stop, used to report
-    the airgap.
+    The controller columns (``current_command``, ``torque_reference``,
+    ``throttle``, ``command_feasible``) of row ``k`` are those the controller
+    computed at sample ``k`` (the command applied from there on); the
+    :attr:`result` reports at each sample the command held up to it.
     """
 
-    def __init__(self, raw: np.ndarray, raw_events: np.ndarray, n_steps: int, airgap_open: float):
-        self._raw = raw
-        self._raw_events = raw_events
-        self.n_steps = int(n_steps)
-        self._airgap_open = airgap_open
-        self.time = raw[:, 0].copy()
+    def __init__(self, result, controller_log=None):
+        self.result = result
+        self._log = controller_log
+        self.n_steps = int(result.stats.get("accepted_steps", 0))
+        self.time = np.asarray(result.time, dtype=float).copy()
         self._cache = {}
+
+    @classmethod
+    def from_result(cls, result, controller_log=None) -> "BenchResult":
+        """The per-sample view of a drum-bench :class:`clutchlab.SimulationResult`.
+
+        Parameters
+        ----------
+        result : clutchlab.SimulationResult
+            A run of the ``emtc_bench`` model (:func:`clutchlab.emtc.simulate`).
+        controller_log : numpy.ndarray, optional
+            ``(samples, 4)``: command [A], reference [N*m], throttle [-], feasible (1/0) computed at each
+            sample (``params.ctl_log``); without it the held values the result reports are used.
+        """
+        return cls(result, controller_log)
+
+    def _out(self, name):
+        return self.result[name]
 
     @property
     def states(self) -> pd.DataFrame:
         if "states" not in self._cache:
-            self._cache["states"] = pd.DataFrame({c: self._raw[:, 1 + q] for q, c in enumerate(_STATE_COLS)})
+            x = self.result.states
+            self._cache["states"] = pd.DataFrame({c: x[:, q] for q, c in enumerate(_STATE_COLS)})
         return self._cache["states"]
 
     @property
     def outputs(self) -> pd.DataFrame:
         if "outputs" not in self._cache:
-            out = self._raw
-            cols = {c: out[:, 8 + q] for q, c in enumerate(_AUX_COLS)}
-            cols["locked_case"] = out[:, 17].astype(int)
+            r = self.result
+            cols = {c: np.asarray(r[name], float) for c, name in _AUX_COLS}
+            cols["locked_case"] = cols["locked_case"].astype(int)
+            log = self._log
+            if log is not None and log.shape[0] == self.time.size:
+                cmd, tref, thr, ok = log[:, 0], log[:, 1], log[:, 2], log[:, 3] > 0.5
+            else:
+                cmd, tref = r["current_command_A"], r["torque_reference_Nm"]
+                thr, ok = r["throttle_1"], r["command_feasible_1"] > 0.5
             cols.update({
-                "armature_mode": out[:, 20].astype(int),
-                "coupling_mode": out[:, 21].astype(int),
-                "current_command": out[:, 22],
-                "torque_reference": out[:, 23],
-                "throttle": out[:, 24],
-                "command_feasible": out[:, 25] > 0.5,
-                "slip_speed": out[:, 1] - out[:, 2],
-                "airgap": self._airgap_open - out[:, 4],
+                "armature_mode": r.modes[:, 0].astype(int),
+                "coupling_mode": r.modes[:, 1].astype(int),
+                "current_command": np.asarray(cmd, float),
+                "torque_reference": np.asarray(tref, float),
+                "throttle": np.asarray(thr, float),
+                "command_feasible": np.asarray(ok, bool),
+                "slip_speed": np.asarray(r["slip_speed_rad_s"], float),
+                "airgap": np.asarray(r["airgap_m"], float),
             })
             self._cache["outputs"] = pd.DataFrame(cols)
         return self._cache["outputs"]
@@ -292,14 +310,21 @@ class BenchResult:
     @property
     def events(self) -> pd.DataFrame:
         if "events" not in self._cache:
-            e = self._raw_events
-            kinds = e[:, 1].astype(int)
-            names = [EVENT_NAMES.get(int(k), "?") for k in kinds]
+            e = self.result.events
+            keys = [str(k) for k in e["event"]]
+            kinds = np.array([_EVENTS.index(k) for k in keys], dtype=int)
+            names = [_DESCRIPTIONS[k] for k in kinds]
+            # the modes after each event follow from the event alone (Fig. 11; the armature stops)
+            arm, cpl = (int(v) for v in self.result.modes[0, :2]) if len(self.time) else (0, 0)
+            arm_after, cpl_after = [], []
+            for k in keys:
+                arm, cpl = _AFTER[k](arm, cpl)
+                arm_after.append(ARMATURE_MODE_NAMES[arm])
+                cpl_after.append(MODE_NAMES[cpl])
+            t = e["time_s"].to_numpy(dtype=float)
             self._cache["events"] = pd.DataFrame({
-                "time_s": e[:, 0], "event": [EVENT_KEYS.get(int(k), "?") for k in kinds], "description": names,
-                "armature_mode": [ARMATURE_MODE_NAMES.get(int(m), "?") for m in e[:, 2]],
-                "coupling_mode": [MODE_NAMES.get(int(m), "?") for m in e[:, 3]],
-                "time": e[:, 0], "kind": kinds, "name": names})
+                "time_s": t, "event": keys, "description": names, "armature_mode": arm_after,
+                "coupling_mode": cpl_after, "time": t, "kind": kinds, "name": names})
         return self._cache["events"]
 
     @property
@@ -327,8 +352,21 @@ class BenchResult:
 
 
 _STATE_COLS = ["omega_f", "omega_r", "theta", "x", "xdot", "i1", "i2"]
-_AUX_COLS = ["magnet_force", "fn1", "t1", "t2", "t3", "t_coupling", "t_lock_eq29", "t_trans", "capacity_locked",
-             "locked_case", "fn2", "engine_torque"]
+#: kernel names of the outputs and the SimulationResult columns they come from
+_AUX_COLS = [("magnet_force", "magnet_force_N"), ("fn1", "fn1_N"), ("t1", "t1_Nm"), ("t2", "t2_Nm"),
+             ("t3", "t3_Nm"), ("t_coupling", "coupling_torque_Nm"), ("t_lock_eq29", "lock_torque_Nm"),
+             ("t_trans", "transmission_torque_Nm"), ("capacity_locked", "capacity_locked_Nm"),
+             ("locked_case", "locked_case_1"), ("fn2", "fn2_N"), ("engine_torque", "engine_torque_Nm")]
+#: (armature mode, coupling mode) after each event
+_AFTER = {
+    "armature_rest": lambda a, c: (0, c),
+    "armature_contact": lambda a, c: (2, 1),
+    "armature_leave_rest": lambda a, c: (1, c),
+    "armature_leave_contact": lambda a, c: (1, 0),
+    "lockup": lambda a, c: (a, 2),
+    "slip_reversal": lambda a, c: (a, 1),
+    "unlock": lambda a, c: (a, 1),
+}
 
 
 _DEFAULTS: dict = {}
@@ -341,17 +379,15 @@ def _default(cls):
     return _DEFAULTS[cls]
 
 
-def _ramp(s: BenchScenario):
-    t = np.array([0.0, s.ramp_start, max(s.ramp_end, s.ramp_start + 1e-9), max(s.duration, s.ramp_end) + 1.0])
-    v = np.array([s.throttle_start, s.throttle_start, s.throttle_end, s.throttle_end])
-    return t, v
-
-
 def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: VehicleParameters | None = None,
                    actuator: ActuatorParameters | None = None, coupling: CouplingGeometry | None = None,
                    torque_map: TorqueMap | None = None, controller_model=None, friction_map=None, lugre=None,
                    torque_reference=None, rtol=1e-6, atol=None, max_steps=2_000_000) -> BenchResult:
     """Simulate the vehicle with EMTC on the drum bench ([1], Eqs. 8-31, Figs. 11, 15-17).
+
+    A thin layer over :func:`clutchlab.emtc.simulate` (the ``emtc_bench`` model run by the integrator
+    core), kept for existing code: the result is recorded at every controller sample up to the last one
+    at or before ``scenario.duration`` and viewed as a :class:`BenchResult`.
 
     Parameters
     ----------
@@ -394,92 +430,29 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     from the inverse Preisach model at the engaged airgap ``d - sigma``
     (Eqs. 6-7).  The current follows through the two lags of Fig. 15.
     """
+    import dataclasses as _dc
+
+    from . import system as S
+
     scenario = scenario or _default(BenchScenario)
-    vehicle = vehicle or _default(VehicleParameters)
-    actuator = actuator or _default(ActuatorParameters)
-    coupling = coupling or _default(CouplingGeometry)
-    torque_map = torque_map or _default(TorqueMap)
-    controller_model = controller_model or magnet
-    for name, model in (("magnet", magnet), ("controller_model", controller_model)):
-        lo_gap = actuator.airgap_open - actuator.free_travel
-        if model.n_airgaps > 1 and (lo_gap < model.airgaps[0] - 1e-12 or actuator.airgap_open > model.airgaps[-1] + 1e-12):
-            raise ParameterError(
-                f"{name}: airgap range [{lo_gap:g}, {actuator.airgap_open:g}] m of the actuator is outside the "
-                f"calibration airgaps [{model.airgaps[0]:g}, {model.airgaps[-1]:g}] m")
-    ic = vehicle.rear_final_drive
-    jf = vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2  # [1], Eq. 29, J_f
-    jr = vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2  # [1], Eq. 29, J_r
-    fzf, fzr = vehicle.axle_loads()
-    pv = np.zeros(32)
-    pv[:23] = [vehicle.front_final_drive, ic, vehicle.gear_ratios[scenario.gear - 1], jf, jr, vehicle.tyre_radius,
-               fzf, fzr, vehicle.rolling_resistance, vehicle.tyre_slip_stiffness, vehicle.slip_speed_floor,
-               vehicle.engine_torque_max, vehicle.engine_power, vehicle.torsen_stiffness, vehicle.torsen_damping,
-               scenario.temperature_c, vehicle.drag_coefficient(), UNLOCK_MARGIN, scenario.sample_time,
-               scenario.drum_load_front, scenario.drum_load_rear, 0.0, 0.0]
-    pa = actuator.kernel_data()
-    geo = coupling.kernel_data()
-    thr_t, thr_v = _ramp(scenario)
-    t_far = np.array([0.0, scenario.duration + 1.0])
-    vf = scenario.drum_speed
-    vr = scenario.drum_speed - scenario.speed_difference
-    vf_t, vf_v = t_far, np.array([vf, vf])
-    vr_t, vr_v = t_far, np.array([vr, vr])
-    if friction_map is not None and lugre is not None:
-        raise ParameterError("give either friction_map or lugre, not both")
-    if friction_map is not None:
-        fmv, fmt, fmm, fmode = friction_map.slip_speed, friction_map.temperature_c, friction_map.mu, 1
-    elif lugre is not None:
-        pv[24:30] = lugre.kernel_data()
-        # the locked capacity must use LuGre's own breakaway coefficient, else the friction just after
-        # an unlock could exceed the lock capacity and the slip would reverse at once (chattering)
-        geo = geo.copy()
-        geo[3:6] = lugre.mu_p
-        fmv, fmt, fmm, fmode = np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)), 2
-    else:
-        fmv, fmt, fmm, fmode = np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)), 0
-    if torque_reference is not None:
-        tr = np.asarray(torque_reference, float)
-        if tr.ndim != 2 or tr.shape[0] != 2 or tr.shape[1] < 2 or not np.all(np.isfinite(tr)) or np.any(np.diff(tr[0]) <= 0):
-            raise ParameterError("torque_reference: expected (times, torques) with strictly increasing finite times")
-    else:
-        tr = np.zeros((0, 2))
-    w_f0 = vf / vehicle.tyre_radius * ic
-    w_r0 = vr / vehicle.tyre_radius * ic
-    y0 = np.array([w_f0, w_r0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    y0[5] = y0[6] = magnet.grid[0]
-    if atol is None:
-        atol = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
-    else:
-        atol = np.broadcast_to(np.asarray(atol, float), (7,)).copy()
-    # output rows plus the event buffer (20 events of 4 values per output row)
-    check_allocation(scenario.duration / scenario.sample_time + 1, BK.N_OUT + 80,
+    options = S.BenchOptions(actuator=actuator, coupling=coupling, torque_map=torque_map,
+                             controller_model=controller_model, friction_map=friction_map, lugre=lugre,
+                             torque_reference=torque_reference)
+    # output rows plus the event buffer (20 events of 4 values per output row, as before)
+    check_allocation(scenario.duration / scenario.sample_time + 1, 26 + 80,
                      f"duration = {scenario.duration!r} s at sample_time = {scenario.sample_time!r} s")
     n = int(round(scenario.duration / scenario.sample_time)) + 1
-    cap = 64
-    while True:
-        out = np.zeros((n, BK.N_OUT))
-        ev = np.zeros((max(1000, 20 * n), 4))
-        pstack = np.zeros(cap)
-        ppref = np.zeros((magnet.n_airgaps, cap // 2 + 2))
-        cstack = np.zeros(cap)
-        cpref = np.zeros((controller_model.n_airgaps, cap // 2 + 2))
-        n_out, n_ev, n_steps, status = BK.bench_kernel(
-            y0, scenario.duration, pv.copy(), pa, geo, fmv, fmt, fmm, fmode, thr_t, thr_v, vf_t, vf_v, vr_t, vr_v,
-            torque_map.throttle, torque_map.speed, torque_map.torque, tr,
-            magnet.kernel_tables, magnet.grid, magnet.airgaps, pstack, ppref,
-            controller_model.kernel_tables, controller_model.grid, controller_model.airgaps, cstack, cpref,
-            float(rtol), atol, out, ev, np.array([0, 0, 1], dtype=np.int64), int(max_steps))
-        if status == 1:
-            cap *= 4
-            continue
-        if status == 2:
-            raise SimulationError(f"EMTC bench: step size underflow at t = {out[max(n_out - 1, 0), 0]:.6g} s")
-        if status == 3:
-            raise SimulationError(
-                f"EMTC bench: more than max_steps = {max_steps} steps before t = {out[max(n_out - 1, 0), 0]:.6g} s "
-                "(tolerances too tight for the piecewise-linear magnet characteristic?)")
-        break
-    return BenchResult(out[:n_out].copy(), ev[:n_ev].copy(), n_steps, actuator.airgap_open)
+    samples = np.arange(n) * scenario.sample_time
+
+    def build(cap):
+        opts = options if cap is None else _dc.replace(options, memory_capacity=cap)
+        return S.bench_system(magnet, scenario, vehicle, opts, n_samples=n)
+
+    system, res = S.run(build, float(samples[-1]), rtol=float(rtol), atol=atol, sample_times=samples,
+                        max_steps=int(max_steps))
+    # the controller also runs at the last sample (its break never comes: the run ends there)
+    S.run_controller(system.params, float(samples[-1]), res.stats["final_state"], system.u0)
+    return BenchResult(res, system.params.ctl_log.copy())
 
 
 def load_scenario(path):

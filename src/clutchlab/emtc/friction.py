@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import DataError, ParameterError
 from ..params import ParameterSet, quantity
+from ._lookup import bilinear_many
 
 __all__ = [
     "LuGreParameters",
@@ -67,29 +68,75 @@ class LuGreParameters(ParameterSet):
 
 
 @numba.njit(cache=True, nogil=True)
-def _g(v, p):
+def stribeck_g(v, p):
+    """Stribeck curve ``g(v) = mu_cl + (mu_p - mu_cl) exp(-(v/v_s)^2)`` at one slip speed ([1], Eq. 24).
+
+    Parameters
+    ----------
+    v : float
+        Slip speed [rad/s].
+    p : ndarray
+        :meth:`LuGreParameters.kernel_data` ``[sigma0, sigma1, sigma2, mu_c, mu_p, v_s]``.
+
+    Returns
+    -------
+    float
+        ``g(v)`` [-], between ``mu_c`` and ``mu_p``.
+    """
     return p[3] + (p[4] - p[3]) * math.exp(-((v / p[5]) ** 2))  # [1], Eq. 24
 
 
 @numba.njit(cache=True, nogil=True)
+def _stribeck_many(v, p, out):
+    for k in range(v.shape[0]):
+        out[k] = stribeck_g(v[k], p)
+
+
+@numba.njit(cache=True, nogil=True)
 def lugre_advance(z, v, h, p):
-    """Bristle state after ``h`` seconds at constant slip speed ``v`` (exact solution of Eq. 23).
+    """Bristle state after ``h`` seconds at constant slip speed ``v`` (exact solution of [1], Eq. 23).
 
     ``dz/dt = v - sigma0 |v| / g(v) z`` is linear in ``z`` for constant ``v``:
     ``z(h) = z_ss + (z - z_ss) exp(-sigma0 |v| h / g(v))`` with
     ``z_ss = g(v) sgn(v) / sigma0``; unconditionally stable and bounded.
+
+    Parameters
+    ----------
+    z : float
+        Bristle deflection at the start [rad].
+    v : float
+        Slip speed held over the interval [rad/s].
+    h : float
+        Interval [s]; ``h <= 0`` (or ``v = 0``) returns ``z`` unchanged.
+    p : ndarray
+        :meth:`LuGreParameters.kernel_data`.
     """
-    if v == 0.0:
+    if v == 0.0 or h <= 0.0:
         return z
-    g = _g(v, p)
+    g = stribeck_g(v, p)
     zss = g / p[0] * (1.0 if v > 0.0 else -1.0)
     return zss + (z - zss) * math.exp(-p[0] * abs(v) * h / g)
 
 
 @numba.njit(cache=True, nogil=True)
 def lugre_mu(z, v, p):
-    """Friction coefficient ``sigma0 z + sigma1 dz/dt + sigma2 v`` ([1], Eqs. 22-23)."""
-    zdot = v - p[0] * abs(v) / _g(v, p) * z  # [1], Eq. 23
+    """Friction coefficient ``sigma0 z + sigma1 dz/dt + sigma2 v`` ([1], Eqs. 22-23).
+
+    Parameters
+    ----------
+    z : float
+        Bristle deflection [rad].
+    v : float
+        Slip speed [rad/s].
+    p : ndarray
+        :meth:`LuGreParameters.kernel_data`.
+
+    Returns
+    -------
+    float
+        Friction coefficient [-] (signed like the slip).
+    """
+    zdot = v - p[0] * abs(v) / stribeck_g(v, p) * z  # [1], Eq. 23
     return p[0] * z + p[1] * zdot + p[2] * v  # [1], Eq. 22
 
 
@@ -120,7 +167,9 @@ def stribeck(slip_speed, params: LuGreParameters):
         ``g(v)`` [-].
     """
     v = np.asarray(slip_speed, dtype=float)
-    return params.mu_c + (params.mu_p - params.mu_c) * np.exp(-((v / params.v_s) ** 2))  # [1], Eq. 24
+    out = np.empty(v.shape)
+    _stribeck_many(np.ascontiguousarray(v).ravel(), params.kernel_data(), out.reshape(-1))  # [1], Eq. 24
+    return float(out) if out.ndim == 0 else out
 
 
 def lugre_steady_state(slip_speed, params: LuGreParameters):
@@ -225,24 +274,10 @@ class FrictionMap:
     def __call__(self, slip_speed, temperature_c):
         """Coefficient at the given slip speed [rad/s] and temperature [degC] (broadcasting)."""
         v, tc = np.broadcast_arrays(np.abs(np.asarray(slip_speed, float)), np.asarray(temperature_c, float))
-        out = np.array([_map_eval(self.slip_speed, self.temperature_c, self.mu, a, b) for a, b in zip(v.ravel(), tc.ravel())])
+        out = np.empty(v.size)
+        bilinear_many(self.slip_speed, self.temperature_c, self.mu, np.ascontiguousarray(v).ravel(),
+                      np.ascontiguousarray(tc).ravel(), out)  # the table look-up of the bench model's hooks
         return out.reshape(v.shape) if v.ndim else float(out[0])
-
-
-@numba.njit(cache=True, nogil=True)
-def _map_eval(vg, tg, m, v, tc):
-    v = abs(v)
-    v = min(max(v, vg[0]), vg[-1])
-    tc = min(max(tc, tg[0]), tg[-1])
-    i = 0
-    while i < vg.shape[0] - 2 and vg[i + 1] < v:
-        i += 1
-    j = 0
-    while j < tg.shape[0] - 2 and tg[j + 1] < tc:
-        j += 1
-    s = (v - vg[i]) / (vg[i + 1] - vg[i])
-    r = (tc - tg[j]) / (tg[j + 1] - tg[j])
-    return (m[i, j] * (1 - s) * (1 - r) + m[i + 1, j] * s * (1 - r) + m[i, j + 1] * (1 - s) * r + m[i + 1, j + 1] * s * r)
 
 
 def drag_torque(n_pairs, viscosity, slip_speed, clearance, r_outer, r_inner):
@@ -279,8 +314,64 @@ def drag_torque(n_pairs, viscosity, slip_speed, clearance, r_outer, r_inner):
     w = np.asarray(slip_speed, dtype=float)
     if not np.all(np.isfinite(w)):
         raise ParameterError("slip_speed: not finite")
-    t = n_pairs * np.pi * w * viscosity / (2.0 * clearance) * (r_outer**4 - r_inner**4)  # [1], Eq. 25
-    return float(t) if t.ndim == 0 else t
+    out = np.empty(w.shape)
+    _drag_many(float(n_pairs), float(viscosity), np.ascontiguousarray(w).ravel(), float(clearance), float(r_outer),
+               float(r_inner), out.reshape(-1))  # [1], Eq. 25
+    return float(out) if out.ndim == 0 else out
+
+
+@numba.njit(cache=True, nogil=True)
+def drag_torque_scalar(n_pairs, viscosity, slip_speed, clearance, r_outer, r_inner):
+    """Viscous drag torque of the open coupling at one slip speed ([1], Eq. 25).
+
+    ``T_drag = N pi omega mu / (2 h) (R_o^4 - R_i^4)``: laminar Couette shear of the fluid film in each
+    of the ``N`` gaps.  Used by :func:`drag_torque` and by the bench model's hooks.
+
+    Parameters
+    ----------
+    n_pairs : float
+        Fluid gaps N [-].
+    viscosity : float
+        Dynamic viscosity of the fluid [Pa*s].
+    slip_speed : float
+        Relative speed of the discs [rad/s] (the torque has its sign).
+    clearance : float
+        Axial clearance h between consecutive discs [m].
+    r_outer, r_inner : float
+        Outer and inner radius of the wetted annulus [m].
+
+    Returns
+    -------
+    float
+        Drag torque [N*m].
+    """
+    return n_pairs * math.pi * slip_speed * viscosity / (2.0 * clearance) * (r_outer**4 - r_inner**4)  # [1], Eq. 25
+
+
+@numba.njit(cache=True, nogil=True)
+def _drag_many(n_pairs, viscosity, w, clearance, r_outer, r_inner, out):
+    for k in range(w.shape[0]):
+        out[k] = drag_torque_scalar(n_pairs, viscosity, w[k], clearance, r_outer, r_inner)
+
+
+@numba.njit(cache=True, nogil=True)
+def coupling_torque_scalar(engaged, t_drag, t_friction):
+    """Torque the EMTC transfers at one instant: drag when open, friction when engaged ([1], Eq. 26).
+
+    Parameters
+    ----------
+    engaged : bool
+        ``eta``: True when the primary clutch is pressed.
+    t_drag, t_friction : float
+        Drag torque (Eq. 25) and friction torque (Eqs. 15/17 slipping, Eqs. 21/30 locked) [N*m].
+    """
+    return t_friction if engaged else t_drag  # [1], Eq. 26
+
+
+@numba.njit(cache=True, nogil=True)
+def _coupling_many(engaged, t_drag, t_friction, out):
+    for k in range(out.shape[0]):
+        out[k] = coupling_torque_scalar(engaged[k], t_drag[k], t_friction[k])
 
 
 def coupling_torque(engaged, t_drag, t_friction):
@@ -292,5 +383,15 @@ def coupling_torque(engaged, t_drag, t_friction):
         ``eta``: True when the primary clutch is pressed (``F_n1 > 0``).
     t_drag, t_friction : array_like
         Drag torque (Eq. 25) and friction torque (Eqs. 15/21) [N*m].
+
+    Returns
+    -------
+    numpy.ndarray
+        Transferred torque [N*m], broadcast over the three arguments.
     """
-    return np.where(np.asarray(engaged, dtype=bool), t_friction, t_drag)  # [1], Eq. 26
+    e, d, f = np.broadcast_arrays(np.asarray(engaged, dtype=bool), np.asarray(t_drag, dtype=float),
+                                  np.asarray(t_friction, dtype=float))
+    out = np.empty(e.shape)
+    _coupling_many(np.ascontiguousarray(e).ravel(), np.ascontiguousarray(d).ravel(), np.ascontiguousarray(f).ravel(),
+                   out.reshape(-1))  # [1], Eq. 26
+    return out

@@ -126,7 +126,13 @@ class CouplingGeometry(ParameterSet):
 # ----------------------------------------------------------------- compiled core
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _slipping(fn1, dw, g, mu1, mu2, mu3, out):
-    """Eqs. 13-15 with given kinetic coefficients; out = (T1, T2, T3)."""
+    """Torques of the three elements in slipping mode with given kinetic coefficients ([1], Eqs. 13-15).
+
+    ``fn1``: primary-clutch normal force [N]; ``dw``: slip speed [rad/s] (only its sign is used);
+    ``g``: :meth:`CouplingGeometry.kernel_data`; ``mu1..mu3``: kinetic coefficients [-];
+    ``out[0:3]`` receives ``(T1, T2, T3)`` [N*m].  Used by :func:`slipping_torques`, by the bench
+    model's right-hand side and, with ``fn1 = dw = 1``, by its controller (the gain ``T_c/F_n1``).
+    """
     lam, rc = g[11], g[12]
     sgn = 1.0 if dw > 0.0 else (-1.0 if dw < 0.0 else 0.0)
     t1 = 2.0 / 3.0 * mu1 * g[6] * fn1 * g[9] * sgn  # [1], Eq. 15 (first line)
@@ -147,6 +153,27 @@ def _locked_coefficients(fn1, g):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def _locked_capacity(fn1, g):
+    """Locked-mode capacity ``T_cap_L = c1 (1 + a2) / (1 - a3)`` with every element saturated ([1], Eq. 21).
+
+    ``fn1`` is the primary-clutch normal force [N], ``g`` :meth:`CouplingGeometry.kernel_data` (the static
+    coefficients ``mu_s``); returns [N*m].  Used by the locked split and by the bench model's hooks.
+    """
+    c1, a2, a3 = _locked_coefficients(fn1, g)
+    return c1 * (1.0 + a2) / (1.0 - a3)  # [1], Eq. 21
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _cam_force(t1, t3, g):
+    """Ball-cam axial force ``F_n2 = lambda/R (T1 + T3)`` on the secondary clutch and third element ([1], Eq. 14).
+
+    ``t1``, ``t3``: torques of the primary clutch and the third element [N*m]; ``g``:
+    :meth:`CouplingGeometry.kernel_data`; returns the force magnitude [N].
+    """
+    return g[11] / g[12] * abs(t1 + t3)  # [1], Eq. 14
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _locked(fn1, t_lock, g, margin, out):
     """Locked-mode split (Eqs. 18-21) by equal sharing with saturation.
 
@@ -157,7 +184,7 @@ def _locked(fn1, t_lock, g, margin, out):
     c1, a2, a3 = _locked_coefficients(fn1, g)
     sgn = 1.0 if t_lock >= 0.0 else -1.0
     t = abs(t_lock)
-    total_cap = c1 * (1.0 + a2) / (1.0 - a3)  # [1], Eq. 21 with every element saturated
+    total_cap = _locked_capacity(fn1, g)  # [1], Eq. 21 with every element saturated
     if t > total_cap * (1.0 + 1e-12):
         if t > margin * total_cap * (1.0 + 1e-12) or total_cap <= 0.0:
             return -1

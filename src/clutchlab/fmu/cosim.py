@@ -13,8 +13,9 @@ re-simulated from t = 0.
   :mod:`clutchlab.wet.engagement`; resumed with
   ``engagement._integrate_from``.
 * :class:`EmtcCoSimulation` -- the AWD vehicle with the EMTC on the drum
-  bench ([2], Eqs. 8-31) of :mod:`clutchlab.emtc.bench`; resumed with
-  ``_bench_kernel.bench_advance``.
+  bench ([2], Eqs. 8-31), the ``emtc_bench`` system of
+  :mod:`clutchlab.emtc.system` resumed step by step by a
+  :class:`clutchlab.system.Simulation`.
 * ``EClutchCoSimulation`` (``clutchlab.eclutch.cosim``) -- the E-clutch
   dynamics, written against the same protocol.
 
@@ -579,25 +580,26 @@ class WetCoSimulation(CoSimulation):
 
 # ===================================================================== EMTC
 _EMTC_OUTPUTS = (
-    # name, unit, description, column of the kernel's output row
-    ("coupling_torque", "N.m", "torque transferred by the EMTC T_c (Eqs. 17, 25, 30)", 8 + 5),
-    ("front_shaft_speed", "rad/s", "coupling input shaft speed omega_f (Eq. 27)", 1),
-    ("rear_shaft_speed", "rad/s", "coupling output shaft speed omega_r (Eq. 27)", 2),
-    ("slip_speed", "rad/s", "omega_f - omega_r", -1),
-    ("magnet_force", "N", "magnet force F_m from the plant Preisach model (Eq. 1)", 8 + 0),
-    ("primary_clamp_force", "N", "primary clutch normal force F_n1 (Eq. 11)", 8 + 1),
-    ("main_clamp_force", "N", "main clutch normal force F_n2 from the ball cam (Eq. 14)", 8 + 10),
-    ("torque_capacity", "N.m", "locked-mode torque capacity (Eq. 21)", 8 + 8),
-    ("lock_torque", "N.m", "torque needed to keep the coupling locked (Eq. 29)", 8 + 6),
-    ("engine_torque", "N.m", "engine torque", 8 + 11),
-    ("armature_position", "m", "armature displacement x (Eqs. 8-12)", 4),
-    ("armature_speed", "m/s", "armature speed", 5),
-    ("airgap", "m", "magnetic airgap d (Eq. 12)", -2),
-    ("coil_current", "A", "coil current (second lag of Fig. 15)", 7),
-    ("current_command", "A", "coil current command applied over the last controller sample (Eqs. 6-7)", 22),
-    ("torsen_twist", "rad", "Torsen twist angle since lock-up (Eq. 30)", 3),
-    ("armature_mode", "1", "0 at the rest stop, 1 free, 2 pressing the primary clutch", 20),
-    ("coupling_mode", "1", "0 open, 1 slipping, 2 locked", 21),
+    # name, unit, description, source in the emtc_bench system: ("state" | "output", column) or ("mode", index)
+    ("coupling_torque", "N.m", "torque transferred by the EMTC T_c (Eqs. 17, 25, 30)", ("output", "coupling_torque_Nm")),
+    ("front_shaft_speed", "rad/s", "coupling input shaft speed omega_f (Eq. 27)", ("state", "omega_f_rad_s")),
+    ("rear_shaft_speed", "rad/s", "coupling output shaft speed omega_r (Eq. 27)", ("state", "omega_r_rad_s")),
+    ("slip_speed", "rad/s", "omega_f - omega_r", ("output", "slip_speed_rad_s")),
+    ("magnet_force", "N", "magnet force F_m from the plant Preisach model (Eq. 1)", ("output", "magnet_force_N")),
+    ("primary_clamp_force", "N", "primary clutch normal force F_n1 (Eq. 11)", ("output", "fn1_N")),
+    ("main_clamp_force", "N", "main clutch normal force F_n2 from the ball cam (Eq. 14)", ("output", "fn2_N")),
+    ("torque_capacity", "N.m", "locked-mode torque capacity (Eq. 21)", ("output", "capacity_locked_Nm")),
+    ("lock_torque", "N.m", "torque needed to keep the coupling locked (Eq. 29)", ("output", "lock_torque_Nm")),
+    ("engine_torque", "N.m", "engine torque", ("output", "engine_torque_Nm")),
+    ("armature_position", "m", "armature displacement x (Eqs. 8-12)", ("state", "x_armature_m")),
+    ("armature_speed", "m/s", "armature speed", ("state", "v_armature_m_s")),
+    ("airgap", "m", "magnetic airgap d (Eq. 12)", ("output", "airgap_m")),
+    ("coil_current", "A", "coil current (second lag of Fig. 15)", ("state", "i2_A")),
+    ("current_command", "A", "coil current command applied over the last controller sample (Eqs. 6-7)",
+     ("output", "current_command_A")),
+    ("torsen_twist", "rad", "Torsen twist angle since lock-up (Eq. 30)", ("state", "theta_rad")),
+    ("armature_mode", "1", "0 at the rest stop, 1 free, 2 pressing the primary clutch", ("mode", 0)),
+    ("coupling_mode", "1", "0 open, 1 slipping, 2 locked", ("mode", 1)),
 )
 
 
@@ -637,13 +639,15 @@ class EmtcCoSimulation(CoSimulation):
     The magnet is the Preisach family identified from the bundled synthetic
     FORC records (:func:`clutchlab.emtc.magnet.bundled_magnet`).
 
-    Each :meth:`do_step` continues the compiled model
-    (``_bench_kernel.bench_advance``) with its states, modes, step size and
-    both hysteresis memories (plant magnet and controller model); the
-    controller runs at the first sample of the step with the new inputs.  A
-    chain of steps therefore reproduces one uninterrupted
-    :func:`~clutchlab.emtc.bench.simulate_bench` run exactly when the inputs
-    change only at communication points (see ``docs/fmu.md``).
+    Written against the system contract: the ``emtc_bench`` model
+    (:func:`clutchlab.emtc.system.bench_system` with the inputs held by the
+    master) run by a :class:`clutchlab.system.Simulation`; each
+    :meth:`do_step` is one ``advance`` of the integrator core, which
+    continues with the states, modes, step size and both hysteresis
+    memories (plant magnet and controller model).  The controller samples
+    are break times of the model, so a chain of steps reproduces one
+    uninterrupted :func:`~clutchlab.emtc.bench.simulate_bench` run exactly
+    when the inputs change only at communication points (see ``docs/fmu.md``).
 
     Notes
     -----
@@ -667,7 +671,8 @@ class EmtcCoSimulation(CoSimulation):
     def __init__(self, **parameter_values):
         from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
         from ..emtc.magnet import bundled_magnet
-        from ..emtc.torque import UNLOCK_MARGIN, CouplingGeometry
+        from ..emtc.system import BenchOptions
+        from ..emtc.torque import CouplingGeometry
 
         values = self.resolve_parameters(parameter_values)
         self.parameter_values = values
@@ -684,134 +689,96 @@ class EmtcCoSimulation(CoSimulation):
         if not (0 < self.rtol < 1):
             raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
         self.magnet = bundled_magnet()
-        m = self.magnet
-        a = self.actuator
-        if m.n_airgaps > 1 and (a.airgap_open - a.free_travel < m.airgaps[0] - 1e-12
-                                or a.airgap_open > m.airgaps[-1] + 1e-12):
-            raise ParameterError(
-                f"actuator airgap range [{a.airgap_open - a.free_travel:g}, {a.airgap_open:g}] m is outside the "
-                f"magnet's calibration airgaps [{m.airgaps[0]:g}, {m.airgaps[-1]:g}] m")
-        v = self.vehicle
-        ic = v.rear_final_drive
-        jf = v.inertia_input_shaft + v.inertia_front_axle / ic**2  # [2], Eq. 29, J_f (as simulate_bench)
-        jr = v.inertia_output_shaft + v.inertia_rear_axle / ic**2  # [2], Eq. 29, J_r
-        fzf, fzr = v.axle_loads()
-        pv = np.zeros(32)
-        pv[:23] = [v.front_final_drive, ic, v.gear_ratios[int(gear) - 1], jf, jr, v.tyre_radius, fzf, fzr,
-                   v.rolling_resistance, v.tyre_slip_stiffness, v.slip_speed_floor, v.engine_torque_max,
-                   v.engine_power, v.torsen_stiffness, v.torsen_damping, BenchScenario().temperature_c,
-                   v.drag_coefficient(), UNLOCK_MARGIN, self.sample_time, values["scenario.drum_load_front"],
-                   values["scenario.drum_load_rear"], 0.0, 0.0]
-        self._pv0 = pv
-        self._pa = a.kernel_data()
-        self._geo = self.coupling.kernel_data()
-        self._atol = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
-        self._fmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)), 0)
-        self._tmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.zeros((2, 2)))  # unused: torque_request
+        self._scenario = BenchScenario(gear=int(gear), drum_load_front=values["scenario.drum_load_front"],
+                                       drum_load_rear=values["scenario.drum_load_rear"],
+                                       sample_time=self.sample_time, duration=max(4.0, self.sample_time))
+        self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling, memory_capacity=64)
+        self._build(self._options.memory_capacity)  # checks the parameters once (airgap range of the magnet)
         self.reset()
 
+    def _build(self, capacity):
+        from ..emtc.system import bench_system
+
+        self._options = dataclasses.replace(self._options, memory_capacity=capacity)
+        self._system = bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
+        cols = {("state", c): i for i, c in enumerate(self._system.state_columns)}
+        cols.update({("output", c): i for i, c in enumerate(self._system.output_columns)})
+        self._sources = [(src[0], src[1] if src[0] == "mode" else cols[src]) for _, _, _, src in _EMTC_OUTPUTS]
+
     def reset(self) -> None:
-        from ..emtc import _bench_kernel as BK
-
         self.time = 0.0
-        self._k = 0  # controller sample index at self.time
-        self._pv = self._pv0.copy()
-        self._y = None
-        self._imode = np.array([0, 0, 1], dtype=np.int64)
-        self._carry = np.zeros(BK.N_CARRY)
-        self._carry[BK.CARRY_H] = min(1e-4, self.sample_time)
-        self._carry[BK.CARRY_PU] = self.magnet.grid[0]
-        self._carry[BK.CARRY_CU] = self.magnet.grid[0]
-        self._carry[BK.CARRY_FRESH] = 1.0
-        self._alloc(64)
+        self._history = []  # (model time reached, inputs): replayed if a hysteresis memory must grow
+        self._restart_session()
         self.events = []
-        self.n_steps = 0
-        self._last_row = None
 
-    def _alloc(self, cap):
-        m = self.magnet
-        self._pstack = np.zeros(cap)
-        self._ppref = np.zeros((m.n_airgaps, cap // 2 + 2))
-        self._cstack = np.zeros(cap)
-        self._cpref = np.zeros((m.n_airgaps, cap // 2 + 2))
+    def _restart_session(self):
+        from ..system import Simulation
 
-    def _grow(self):
-        old = (self._pstack, self._ppref, self._cstack, self._cpref)
-        self._alloc(4 * old[0].shape[0])
-        self._pstack[:old[0].shape[0]] = old[0]
-        self._ppref[:, :old[1].shape[1]] = old[1]
-        self._cstack[:old[2].shape[0]] = old[2]
-        self._cpref[:, :old[3].shape[1]] = old[3]
+        self._build(self._options.memory_capacity)
+        self._sim = Simulation(self._system, rtol=self.rtol, max_steps=2_000_000)
+        self._started = False
+        self._n_logged = 0
+
+    @property
+    def n_steps(self) -> int:
+        """Accepted integration steps since the start."""
+        return self._sim.stats["accepted_steps"]
 
     def _start(self, u):
         r = self.vehicle.tyre_radius
         ic = self.vehicle.rear_final_drive
-        y = np.zeros(7)
-        y[0] = u["drum_speed_front"] / r * ic  # free rolling at t = 0, as simulate_bench
-        y[1] = u["drum_speed_rear"] / r * ic
-        y[5] = y[6] = self.magnet.grid[0]
-        self._y = y
+        x = self._sim.x  # free rolling at t = 0, as simulate_bench
+        x[0] = u[2] / r * ic
+        x[1] = u[3] / r * ic
+        self._started = True
 
-    def _advance(self, u, n_rows, k0):
-        """Run ``n_rows`` samples from sample ``k0`` (the last one without the controller); row array."""
-        from ..emtc import _bench_kernel as BK
-
+    def _vector(self, u: dict) -> np.ndarray:
         thr = u["throttle"]
         if not 0.0 <= thr <= 1.0:
             raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
-        prof = np.array([0.0, 1.0])
-        tref = np.array([[0.0, 1.0], [u["torque_request"], u["torque_request"]]])
-        m = self.magnet
-        fmv, fmt, fmm, fmode = self._fmap
+        return np.array([u["torque_request"], thr, u["drum_speed_front"], u["drum_speed_rear"]])
+
+    def _advance(self, target, uv):
+        """Advance the session to ``target`` with the inputs ``uv``; a full memory replays the steps larger."""
+        from ..emtc.system import EVENT_DESCRIPTIONS, EVENTS, memory_full
+
         while True:
-            snapshot = (self._y.copy(), self._imode.copy(), self._carry.copy(), self._pv.copy(),
-                        self._pstack.copy(), self._ppref.copy(), self._cstack.copy(), self._cpref.copy())
-            out = np.zeros((n_rows, BK.N_OUT))
-            ev = np.zeros((max(1000, 20 * n_rows), 4))
-            n_out, n_ev, n_steps, status = BK.bench_advance(
-                self._y, self._imode, self._carry, int(k0), False, self._pv, self._pa, self._geo,
-                fmv, fmt, fmm, fmode, prof, np.array([thr, thr]),
-                prof, np.array([u["drum_speed_front"]] * 2), prof, np.array([u["drum_speed_rear"]] * 2),
-                *self._tmap, tref, m.kernel_tables, m.grid, m.airgaps, self._pstack, self._ppref,
-                m.kernel_tables, m.grid, m.airgaps, self._cstack, self._cpref,
-                float(self.rtol), self._atol, out, ev, 2_000_000)
-            if status == 1:  # hysteresis memory full: restore, enlarge, repeat
-                (self._y, self._imode, self._carry, self._pv, self._pstack, self._ppref, self._cstack,
-                 self._cpref) = snapshot
-                self._grow()
-                continue
-            if status == 2:
-                raise SimulationError(f"EmtcCoSimulation: step size underflow after t = {self.time} s")
-            if status == 3:
-                raise SimulationError(f"EmtcCoSimulation: step limit after t = {self.time} s")
-            break
-        from ..emtc.bench import EVENT_NAMES
+            try:
+                self._sim.advance(target, uv)
+                break
+            except SimulationError as exc:
+                if not memory_full(self._system):
+                    raise SimulationError(f"EmtcCoSimulation: {exc}") from None
+                # a hysteresis memory is full: the same steps again with four times the memory (deterministic)
+                self._options = dataclasses.replace(self._options, memory_capacity=4 * self._options.memory_capacity)
+                self._restart_session()
+                self._start(self._history[0][1] if self._history else uv)
+                for t_done, u_done in self._history:
+                    self._sim.advance(t_done, u_done)
+                self._n_logged = int(self._sim.log.count[0])
+        self._history.append((target, uv))
+        log = self._sim.log
+        n = int(log.count[0])
+        self.events.extend((float(log.time[i]), EVENT_DESCRIPTIONS[EVENTS[int(log.code[i])]])
+                           for i in range(self._n_logged, n))
+        self._n_logged = n
 
-        self.n_steps += int(n_steps)
-        self.events.extend((float(e[0]), EVENT_NAMES.get(int(e[1]), "?")) for e in ev[:n_ev])
-        return out[n_out - 1]
-
-    def _row_outputs(self, row) -> dict:
+    def _outputs(self) -> dict:
+        y = self._sim.outputs()
+        x = self._sim.x
+        m = self._sim.m
         out = {}
-        for name, _, _, col in _EMTC_OUTPUTS:
-            if col == -1:
-                out[name] = float(row[1] - row[2])
-            elif col == -2:
-                out[name] = float(self.actuator.airgap_open - row[4])
-            else:
-                out[name] = float(row[col])
+        for (name, _, _, _), (kind, i) in zip(_EMTC_OUTPUTS, self._sources):
+            out[name] = float(x[i] if kind == "state" else (y[i] if kind == "output" else m[i]))
         return out
 
     def initial_outputs(self, inputs: dict) -> dict:
-        u = self.resolve_inputs(inputs)
-        if self.time != 0.0 or self._y is None:
+        uv = self._vector(self.resolve_inputs(inputs))
+        if self.time != 0.0 or not self._started:
             self.reset()
-            self._start(u)
-        if self._last_row is None:
-            # one sample without the controller: evaluates the model at t = 0 (the derivative is kept
-            # for the first step, which replaces the current-command term once the controller has run)
-            self._last_row = self._advance(u, 1, 0)
-        return self._row_outputs(self._last_row)
+            self._start(uv)
+        self._sim.set_inputs(uv)
+        return self._outputs()
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` (any step > 0); outputs at ``t + dt``.
@@ -829,28 +796,15 @@ class EmtcCoSimulation(CoSimulation):
         ParameterError
             Unknown or out-of-range input.
         """
-        from ..emtc import _bench_kernel as BK
-
         _check_time("EmtcCoSimulation", self.time, t, dt)
-        u = self.resolve_inputs(inputs)
-        if self._y is None:
-            self._start(u)
+        uv = self._vector(self.resolve_inputs(inputs))
+        if not self._started:
+            self._start(uv)
         ts = self.sample_time
-        tol = 1e-9 * ts
         t_end = t + dt
-        # self._k: the first sample whose controller has not run; the call starts on it or just before it
-        on_sample = abs(self._k * ts - t) <= tol
-        k0 = self._k if on_sample else self._k - 1
-        k_end = round(t_end / ts)
-        if abs(k_end * ts - t_end) <= tol:  # the step ends on a sample: its controller runs in the next step
-            n_rows, stop, k_next = k_end - k0 + 1, 0.0, k_end
-        else:  # rows at the samples inside the step, then one at t + dt
-            k_last = math.floor(t_end / ts)
-            n_rows, stop, k_next = k_last - k0 + 2, t_end, k_last + 1
-        self._carry[BK.CARRY_HOLD] = 0.0 if on_sample else 1.0
-        self._carry[BK.CARRY_STOP] = stop
-        row = self._advance(u, n_rows, k0)
-        self._k = k_next
+        k = round(t_end / ts)
+        target = k * ts if abs(k * ts - t_end) <= 1e-9 * ts else t_end  # a sample instant counts as itself
+        if target > self._sim.time:
+            self._advance(target, uv)
         self.time = t_end
-        self._last_row = row
-        return self._row_outputs(row)
+        return self._outputs()
