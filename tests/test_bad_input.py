@@ -220,10 +220,10 @@ def test_non_finite_or_degenerate_arguments(work, capsys):
 
 
 def test_huge_duration_emtc(work, capsys, monkeypatch):
-    from clutchlab.emtc import _bench_kernel
+    from clutchlab.emtc import system as emtc_system
 
     monkeypatch.setenv(MEMORY_ENV, "256M")
-    monkeypatch.setattr(_bench_kernel, "bench_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
+    monkeypatch.setattr(emtc_system, "run", lambda *a, **k: (_ for _ in ()).throw(AssertionError("ran")))
     (work / "scen.toml").write_text('[scenario]\nduration = "1e6 s"\nramp_end = "1 s"\n')
     refused(["emtc", "simulate", "scen.toml", "-o", "out.csv"], work, capsys,
             "duration = 1000000.0 s", "sample_time = 0.002 s", "memory budget")

@@ -1,10 +1,9 @@
-"""Sweep target "emtc": a loop of drum-bench runs equal to simulate_bench."""
+"""Sweep target "emtc": batches of drum-bench runs equal to simulate_bench."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from clutchlab.emtc import _bench_kernel as BK
 from clutchlab.emtc.bench import BenchScenario, simulate_bench
 from clutchlab.emtc.magnet import bundled_magnet
 from clutchlab.errors import ParameterError
@@ -25,7 +24,7 @@ def test_variants_match_simulate_bench():
         assert got.loc[vid, "mean_coupling_torque"] == np.mean(tc)
         assert got.loc[vid, "final_slip_speed"] == slip[-1]
         assert got.loc[vid, "n_steps"] == res.n_steps
-        locks = res.events["time"].to_numpy()[res.events["kind"].to_numpy() == BK.EV_LOCK]
+        locks = res.events["time_s"].to_numpy()[res.events["event"].to_numpy() == "lockup"]
         assert (np.isnan(got.loc[vid, "lock_time"]) and locks.size == 0) or got.loc[vid, "lock_time"] == locks[0]
 
 

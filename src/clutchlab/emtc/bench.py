@@ -220,6 +220,14 @@ class TorqueMap:
 class BenchResult:
     """Result of :func:`simulate_bench`: a per-sample view of a :class:`clutchlab.SimulationResult`.
 
+    Parameters
+    ----------
+    result : clutchlab.SimulationResult
+        A run of the ``emtc_bench`` model recorded at the controller samples.
+    controller_log : numpy.ndarray, optional
+        ``(samples, 4)``: command [A], reference [N*m], throttle [-] and feasible (1/0) computed by the
+        controller at each sample (see :meth:`from_result`).
+
     Attributes
     ----------
     result : clutchlab.SimulationResult
