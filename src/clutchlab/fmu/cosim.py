@@ -619,7 +619,7 @@ def _emtc_variables():
                Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control")))
 
 
-class EmtcCoSimulation(CoSimulation):
+class EmtcCoSimulation(ContractCoSimulation):
     """The AWD vehicle with the EMTC on the drum bench [2] as a co-simulation slave.
 
     Inputs: the coupling torque request ``T_cal`` [N*m] of the AWD controller
@@ -639,22 +639,24 @@ class EmtcCoSimulation(CoSimulation):
     The magnet is the Preisach family identified from the bundled synthetic
     FORC records (:func:`clutchlab.emtc.magnet.bundled_magnet`).
 
-    Written against the system contract: the ``emtc_bench`` model
+    A :class:`ContractCoSimulation` of the ``emtc_bench`` system
     (:func:`clutchlab.emtc.system.bench_system` with the inputs held by the
-    master) run by a :class:`clutchlab.system.Simulation`; each
-    :meth:`do_step` is one ``advance`` of the integrator core, which
-    continues with the states, modes, step size and both hysteresis
-    memories (plant magnet and controller model).  The controller samples
-    are break times of the model, so a chain of steps reproduces one
+    master): each :meth:`do_step` is one ``advance`` of the integrator core,
+    which continues with the states, modes, step size and both hysteresis
+    memories (plant magnet and controller model).  The controller samples are
+    break times of the model, so a chain of steps reproduces one
     uninterrupted :func:`~clutchlab.emtc.bench.simulate_bench` run exactly
-    when the inputs change only at communication points (see ``docs/fmu.md``).
+    when the communication points are controller samples and the plant
+    inputs (throttle, drum speeds) are held (see ``docs/fmu.md``).
 
     Notes
     -----
     Any communication step is accepted: the controller samples at its own
     instants ``k * scenario.sample_time`` inside or across steps and holds
     its command in between.  A step that is a whole multiple of the sample
-    time, starting on a sample, is the case reproduced exactly.  The shaft
+    time, starting on a sample, is the case reproduced exactly.  Inputs that
+    change at a communication point apply from that point on (the model's
+    restart makes the modes consistent with them, e.g. an unlock).  The shaft
     speeds start at the free-rolling speeds of the drum-speed inputs at t = 0.
     """
 
@@ -692,93 +694,93 @@ class EmtcCoSimulation(CoSimulation):
         self._scenario = BenchScenario(gear=int(gear), drum_load_front=values["scenario.drum_load_front"],
                                        drum_load_rear=values["scenario.drum_load_rear"],
                                        sample_time=self.sample_time, duration=max(4.0, self.sample_time))
-        self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling, memory_capacity=64)
-        self._build(self._options.memory_capacity)  # checks the parameters once (airgap range of the magnet)
-        self.reset()
+        self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling)
+        self.simulation_options = {"rtol": self.rtol, "max_steps": 2_000_000}
+        super().__init__(**parameter_values)
 
-    def _build(self, capacity):
+    # ---- the contract
+    def build_system(self, values: dict):
+        """The ``emtc_bench`` system with the inputs held by the master (``values``: the parameters, by name)."""
         from ..emtc.system import bench_system
 
-        self._options = dataclasses.replace(self._options, memory_capacity=capacity)
-        self._system = bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
-        cols = {("state", c): i for i, c in enumerate(self._system.state_columns)}
-        cols.update({("output", c): i for i, c in enumerate(self._system.output_columns)})
+        system = bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
+        cols = {("state", c): i for i, c in enumerate(system.state_columns)}
+        cols.update({("output", c): i for i, c in enumerate(system.output_columns)})
         self._sources = [(src[0], src[1] if src[0] == "mode" else cols[src]) for _, _, _, src in _EMTC_OUTPUTS]
+        return system
 
-    def reset(self) -> None:
-        self.time = 0.0
-        self._history = []  # (model time reached, inputs): replayed if a hysteresis memory must grow
-        self._restart_session()
-        self.events = []
-
-    def _restart_session(self):
-        from ..system import Simulation
-
-        self._build(self._options.memory_capacity)
-        self._sim = Simulation(self._system, rtol=self.rtol, max_steps=2_000_000)
-        self._started = False
-        self._n_logged = 0
-
-    @property
-    def n_steps(self) -> int:
-        """Accepted integration steps since the start."""
-        return self._sim.stats["accepted_steps"]
-
-    def _start(self, u):
-        r = self.vehicle.tyre_radius
-        ic = self.vehicle.rear_final_drive
-        x = self._sim.x  # free rolling at t = 0, as simulate_bench
-        x[0] = u[2] / r * ic
-        x[1] = u[3] / r * ic
-        self._started = True
-
-    def _vector(self, u: dict) -> np.ndarray:
-        thr = u["throttle"]
+    def input_vector(self, inputs: dict) -> np.ndarray:
+        """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear]`` from the FMI ``inputs``."""
+        thr = inputs["throttle"]
         if not 0.0 <= thr <= 1.0:
             raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
-        return np.array([u["torque_request"], thr, u["drum_speed_front"], u["drum_speed_rear"]])
+        return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"]])
 
-    def _advance(self, target, uv):
-        """Advance the session to ``target`` with the inputs ``uv``; a full memory replays the steps larger."""
-        from ..emtc.system import EVENT_DESCRIPTIONS, EVENTS, memory_full
-
-        while True:
-            try:
-                self._sim.advance(target, uv)
-                break
-            except SimulationError as exc:
-                if not memory_full(self._system):
-                    raise SimulationError(f"EmtcCoSimulation: {exc}") from None
-                # a hysteresis memory is full: the same steps again with four times the memory (deterministic)
-                self._options = dataclasses.replace(self._options, memory_capacity=4 * self._options.memory_capacity)
-                self._restart_session()
-                self._start(self._history[0][1] if self._history else uv)
-                for t_done, u_done in self._history:
-                    self._sim.advance(t_done, u_done)
-                self._n_logged = int(self._sim.log.count[0])
-        self._history.append((target, uv))
-        log = self._sim.log
-        n = int(log.count[0])
-        self.events.extend((float(log.time[i]), EVENT_DESCRIPTIONS[EVENTS[int(log.code[i])]])
-                           for i in range(self._n_logged, n))
-        self._n_logged = n
-
-    def _outputs(self) -> dict:
-        y = self._sim.outputs()
-        x = self._sim.x
-        m = self._sim.m
+    def output_values(self, y: np.ndarray) -> dict:
+        """FMI outputs from the output vector ``y`` and the current states and modes."""
+        x = self.simulation.x
+        m = self.simulation.m
         out = {}
         for (name, _, _, _), (kind, i) in zip(_EMTC_OUTPUTS, self._sources):
             out[name] = float(x[i] if kind == "state" else (y[i] if kind == "output" else m[i]))
         return out
 
+    # ---- what the EMTC adds: the initial speeds, sample instants, named events, memories that grow
+    def reset(self) -> None:
+        """Back to the initial state at t = 0 (same parameters)."""
+        super().reset()
+        self.time = 0.0
+        self.events = []
+        self._history = []  # (model time reached, inputs): replayed if a hysteresis memory must grow
+        self._n_logged = 0
+        self._started = False
+
+    @property
+    def n_steps(self) -> int:
+        """Accepted integration steps since the start."""
+        return self.simulation.stats["accepted_steps"]
+
+    def _start(self, u):
+        r = self.vehicle.tyre_radius
+        ic = self.vehicle.rear_final_drive
+        x = self.simulation.x  # free rolling at t = 0, as simulate_bench
+        x[0] = u[2] / r * ic
+        x[1] = u[3] / r * ic
+        self._started = True
+
+    def _advance(self, target, uv):
+        """Advance to ``target`` with the inputs ``uv``; a full memory replays the steps with a larger one."""
+        from ..emtc.system import EVENT_DESCRIPTIONS, EVENTS, memory_full
+
+        while True:
+            try:
+                self.simulation.advance(target, uv)
+                break
+            except SimulationError as exc:
+                if not memory_full(self.system):
+                    raise SimulationError(f"EmtcCoSimulation: {exc}") from None
+                # the same steps again with four times the memory (the run does not depend on its size)
+                self._options = dataclasses.replace(self._options, memory_capacity=4 * self._options.memory_capacity)
+                history = self._history
+                super().reset()
+                self._start(history[0][1] if history else uv)
+                for t_done, u_done in history:
+                    self.simulation.advance(t_done, u_done)
+                self._n_logged = int(self.simulation.log.count[0])
+        self._history.append((target, uv))
+        log = self.simulation.log
+        n = int(log.count[0])
+        self.events.extend((float(log.time[i]), EVENT_DESCRIPTIONS[EVENTS[int(log.code[i])]])
+                           for i in range(self._n_logged, n))
+        self._n_logged = n
+
     def initial_outputs(self, inputs: dict) -> dict:
-        uv = self._vector(self.resolve_inputs(inputs))
+        """Outputs at t = 0 with the given inputs held (the shaft speeds start free rolling on the drums)."""
+        uv = self.input_vector(self.resolve_inputs(inputs))
         if self.time != 0.0 or not self._started:
             self.reset()
             self._start(uv)
-        self._sim.set_inputs(uv)
-        return self._outputs()
+        return super().initial_outputs(inputs)
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` (any step > 0); outputs at ``t + dt``.
@@ -797,14 +799,14 @@ class EmtcCoSimulation(CoSimulation):
             Unknown or out-of-range input.
         """
         _check_time("EmtcCoSimulation", self.time, t, dt)
-        uv = self._vector(self.resolve_inputs(inputs))
+        uv = self.input_vector(self.resolve_inputs(inputs))
         if not self._started:
             self._start(uv)
         ts = self.sample_time
         t_end = t + dt
         k = round(t_end / ts)
         target = k * ts if abs(k * ts - t_end) <= 1e-9 * ts else t_end  # a sample instant counts as itself
-        if target > self._sim.time:
+        if target > self.simulation.time:
             self._advance(target, uv)
         self.time = t_end
-        return self._outputs()
+        return self.output_values(self.simulation.outputs())
