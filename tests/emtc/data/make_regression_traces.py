@@ -1,6 +1,6 @@
 """Write ``regression_traces.npz``: reference traces of the EMTC drum-bench model before the port to the core.
 
-Provenance: run on commit 45cc909 (the last commit with the model's own Dormand-Prince loop,
+Provenance: run on the model code of commit 45cc909 (the last one with the model's own Dormand-Prince loop,
 ``emtc/_bench_kernel.py``), ``python tests/emtc/data/make_regression_traces.py``.  Rerunning it on a
 later commit would overwrite the pre-port reference with the ported model's answer: don't, unless the
 physics changed on purpose (then say so in the README).
