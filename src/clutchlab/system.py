@@ -350,14 +350,13 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     -------
     SimulationResult
     """
-    from .numerics import _cache, core
+    from .numerics import core
 
     if not (isinstance(t_end, (int, float, np.floating)) and math.isfinite(t_end) and t_end > t0):
         raise ParameterError(f"t_end = {short_repr(t_end)}: must be finite and > t0 = {t0:g} s")
     opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, first_step=first_step,
                          event_tol=event_tol)
     ts = sample_grid(t0, float(t_end), output_step, sample_times)
-    _cache.ensure_fresh()
     nx, ny, nm = len(system.states), len(system.outputs), len(system.mode_names)
     x = system.x0.copy()
     m = system.m0.copy()
@@ -421,9 +420,8 @@ class Simulation:
 
     def __init__(self, system: System, *, rtol=None, atol=None, max_step=None, max_steps: int = 100_000_000,
                  first_step=None, event_tol=None, t0: float = 0.0):
-        from .numerics import _cache, core
+        from .numerics import core
 
-        _cache.ensure_fresh()
         self.system = system
         self._core = core
         self._opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,
@@ -510,7 +508,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     """
     import numba
 
-    from .numerics import _cache, core
+    from .numerics import core
 
     systems = list(systems)
     if not systems:
@@ -523,7 +521,6 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     if ts is None:
         ts = np.array([float(t_end)])
     opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps)
-    _cache.ensure_fresh()
     nv, ns = len(systems), ts.size
     nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
     check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
@@ -539,8 +536,8 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     EVC = np.zeros((nv, event_capacity), dtype=np.int64)
     EVE = np.zeros((nv, event_capacity), dtype=np.int64)
     EVN = np.zeros((nv, 2), dtype=np.int64)
-    runner = core.batch_rodas if first.method == "rodas" else core.batch_dopri
-    runner(plist, X0, M0, U, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE, EVN)
+    core.batch(first.method, plist, X0, M0, U, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE,
+               EVN)
     status = STATS[:, core.SI_STATUS].copy()
     if check:
         bad = np.flatnonzero(~np.isin(status, [st.SUCCESS, st.TERMINATED]))
@@ -562,9 +559,8 @@ def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):
 
     Returns ``(dx, g, y)`` [SI].  Defaults: the initial state, inputs and modes.
     """
-    from .numerics import _cache, core
+    from .numerics import core
 
-    _cache.ensure_fresh()
     x = system.x0.copy() if x is None else np.ascontiguousarray(x, dtype=float)
     u = system.u0.copy() if u is None else np.ascontiguousarray(u, dtype=float)
     m = system.m0.copy() if m is None else np.ascontiguousarray(m, dtype=np.int64)

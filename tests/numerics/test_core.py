@@ -11,6 +11,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -243,47 +244,82 @@ def test_nan_error_norm_rejects_the_step():
     assert res.states[-1, 0] == pytest.approx(math.exp(-50.0), abs=1e-11)
 
 
-def test_cache_guard_drops_stale_core_code(tmp_path):
-    """A changed clutchlab source (stamp differs) deletes the core's cached code before the next run."""
+_TOY_MODULE = """
+import numba, numpy as np
+from typing import NamedTuple
+from clutchlab.numerics import dispatch
+from clutchlab.system import System, simulate
+
+class DecayParams(NamedTuple):
+    rate: float
+
+@numba.njit(cache=True)
+def rhs(t, x, u, m, p, dx, g):
+    dx[0] = -RATE * p.rate * x[0]
+
+@numba.njit(cache=True)
+def out(t, x, u, m, p, y):
+    y[0] = x[0]
+
+@numba.njit(cache=True)
+def upd(t, x, u, m, p, k, log):
+    return 0
+
+@numba.njit(cache=True)
+def rst(t, x, u, m, p, log):
+    return False
+
+@numba.njit(cache=True)
+def acc(t, x, u, m, p):
+    return 0
+
+@numba.njit(cache=True)
+def brk(t, m, p):
+    return np.inf
+
+@numba.njit(cache=True)
+def jac(t, x, u, m, p, J):
+    return False
+
+dispatch.register(DecayParams, rhs=rhs, outputs=out, update=upd, restart=rst, accept=acc, next_break=brk, jacobian=jac)
+res = simulate(System("decay", DecayParams(1.0), (("x", "1"),), (("x", "1"),), np.ones(1), np.zeros(0, np.int64),
+                      np.full(1, 1e-12), rtol=1e-10), 1.0)
+print("decay", res.states[-1, 0])
+"""
+
+_BALL = ("import core_toys as T; from clutchlab.system import simulate; "
+         "print('ball', simulate(T.ball_system(), 1.0).events.time_s.iloc[0])")
+
+
+def _run(code, env, cwd=None):
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, cwd=cwd)
+    assert out.returncode == 0, out.stderr[-3000:]
+    seconds = [float(x) for x in __import__("re").findall(r"compile seconds ([0-9.]+)", out.stderr)]
+    return out.stdout, seconds[-1] if seconds else None
+
+
+def test_compiled_entry_points_are_per_model_and_follow_edits(tmp_path):
+    """A model defined outside clutchlab neither poisons the cache for others nor runs stale code after an edit."""
+    support = str(Path(__file__).parents[1] / "_support")
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), CLUTCHLAB_COMPILE_NOTICE="0",
-               PYTHONPATH=os.pathsep.join([str(Path(__file__).parents[1] / "_support")] + sys.path))
-    script = ("import core_toys as T; from clutchlab.system import simulate; from clutchlab.numerics import core;"
-              "simulate(T.ball_system(), 1.0); print(core.advance_dopri._cache._cache_path)")
-    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
-    path = Path(out.stdout.strip().splitlines()[-1])
-    index = sorted(path.glob("core.advance_dopri*.nbi"))
-    assert index, "the core was not cached"
-    stamp = path / "clutchlab-core-sources.json"
-    assert stamp.exists()
-    # unchanged sources: the cache survives the next run
-    subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
-    assert sorted(path.glob("core.advance_dopri*.nbi")) == index
-    # a source changed since (simulated by a different stamp): the next run drops and rebuilds the core's code
-    import json
-
-    recorded = json.loads(stamp.read_text())
-    recorded[next(iter(recorded))] = "stale"
-    stamp.write_text(json.dumps(recorded))
-    before = {p: p.stat().st_mtime_ns for p in path.glob("core.advance_dopri*.nbc")}
-    subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
-    after = {p: p.stat().st_mtime_ns for p in path.glob("core.advance_dopri*.nbc")}
-    assert "stale" not in stamp.read_text()
-    assert after and all(after.get(p) != t for p, t in before.items())
-
-
-def test_source_stamp_follows_edits(tmp_path, monkeypatch):
-    from clutchlab.numerics import _cache
-
-    a = _cache.source_stamp()
-    assert a == _cache.source_stamp()
-    target = Path(core.__file__)
-    st_ = target.stat()
-    try:
-        os.utime(target, ns=(st_.st_atime_ns, st_.st_mtime_ns + 1_000_000_000))
-        assert _cache.source_stamp() != a
-    finally:
-        os.utime(target, ns=(st_.st_atime_ns, st_.st_mtime_ns))
-    assert _cache.source_stamp() == a
+               CLUTCHLAB_COMPILE_REPORT="1", PYTHONPATH=os.pathsep.join([support, str(tmp_path)] + sys.path))
+    (tmp_path / "toy_decay.py").write_text(_TOY_MODULE.replace("RATE", "1.0"))
+    out, _ = _run("import toy_decay; " + _BALL.split("; ", 1)[1].replace("T.", "__import__('core_toys')."),
+                  env)
+    assert "decay 0.3678794" in out and "ball 0.4515" in out
+    # another process that cannot import toy_decay still loads its own cached code
+    env_b = dict(env, PYTHONPATH=os.pathsep.join([support] + sys.path))
+    out, seconds = _run(_BALL, env_b)
+    assert "ball 0.4515" in out
+    assert seconds == 0.0, "the ball's cached entry points were not reused"
+    # unchanged toy: reused from the cache
+    out, seconds = _run("import toy_decay", env)
+    assert "decay 0.3678794" in out and seconds == 0.0
+    # edited toy (twice the rate): the new code runs
+    time.sleep(0.01)
+    (tmp_path / "toy_decay.py").write_text(_TOY_MODULE.replace("RATE", "2.0"))
+    out, seconds = _run("import toy_decay", env)
+    assert "decay 0.1353352" in out and seconds > 0.0
 
 
 def test_grouped_finite_difference_jacobian_matches_the_dense_one():

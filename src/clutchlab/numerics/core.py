@@ -56,6 +56,7 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.extending import register_jitable
 
 from . import dispatch as model
 from .dopri import (
@@ -69,9 +70,9 @@ from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21,
 from .status import MODEL_ERROR, RECORD_FULL, SINGULAR, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
 
 __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
-           "batch_dopri", "batch_rodas",
+           "batch", "evaluate", "evaluate_outputs", "outputs_at",
            "SF_T", "SF_H", "SI_ACCEPTED", "SI_REJECTED", "SI_NRHS", "SI_NJAC", "SI_STATUS", "SI_IREC",
-           "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI", "evaluate", "evaluate_outputs", "outputs_at"]
+           "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI"]
 
 # ---- solver state (resumable): float and int vectors
 SF_T, SF_H = 0, 1
@@ -200,7 +201,7 @@ def _dense(theta, h, x0, f0, x1, f1, mass, out):
             out[i] = x0[i] + theta * (x1[i] - x0[i])
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga):
     """Earliest root of the crossed switching functions on the dense output of the step.
 
@@ -273,7 +274,7 @@ def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe
     return best, n_rhs
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
     """Call the model's ``update`` for every switching function that crossed; returns the worst flag."""
     flag = 0
@@ -287,14 +288,14 @@ def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
     return flag
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _outputs_row(p, t, x, u, m, rec_y, i, yb):
     model.outputs(t, x, u, m, p, yb)
     for q in range(yb.shape[0]):
         rec_y[i, q] = yb[q]
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
     """Record the samples ``ts[i_rec:] <= t_limit`` holding the state at ``t``; returns the next sample index."""
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
@@ -305,7 +306,7 @@ def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
     return i_rec
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _record_dense(p, t, h, x0, f0, x1, f1, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, xe,
                   i_rec):
     """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index."""
@@ -319,7 +320,7 @@ def _record_dense(p, t, h, x0, f0, x1, f1, mass, t_limit, u, m, ts, rec_t, rec_x
     return i_rec
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
     """Record the point ``(t, x, m)`` in the step record if it has room; returns the next row."""
     if i_rec < rec_t.shape[0]:
@@ -331,8 +332,8 @@ def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
 
 
 # ============================================================ Dormand-Prince 5(4)
-@numba.njit(cache=True, nogil=True)
-def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+@register_jitable
+def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Dormand-Prince 5(4) from the solver state to ``t_end`` (resumable).
 
     Parameters
@@ -540,7 +541,7 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
 
 
 # ============================================================ Rosenbrock (Rodas3)
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K1, K2, K3, K4, xtmp, ftmp,
                 gtmp):
     """One Rodas3 step of size ``h`` from ``(t, x)``; False if the matrix is singular or NaN appears."""
@@ -579,7 +580,7 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K
     return ok
 
 
-@numba.njit(cache=True, nogil=True)
+@register_jitable
 def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
     """Forward-difference Jacobian by column groups; backward where the forward step crosses a kink.
 
@@ -629,8 +630,8 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
     return nr
 
 
-@numba.njit(cache=True, nogil=True)
-def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+@register_jitable
+def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
 
     Arguments and return value as :func:`advance_dopri`.  The Jacobian is the
@@ -827,65 +828,101 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     return status
 
 
-# ============================================================ batch runners
-@numba.njit(cache=True, parallel=True)
-def batch_dopri(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
-    """One Dormand-Prince solver per variant, in parallel (``prange``), recorded on ``ts``.
-
-    ``plist`` holds one parameter structure per variant (their mutable
-    memories are their own); ``X0``, ``M0``, ``U`` have one row per variant.
-    ``STATS[v]`` receives the solver counters (``SI_*``); events go to
-    ``EV_*[v]`` (time, code, element) and ``EV_N[v]`` (held, dropped).
-    """
-    nv = X0.shape[0]
-    ns = ts.shape[0]
-    for v in numba.prange(nv):
-        x = X0[v].copy()
-        m = M0[v].copy()
-        sf = np.zeros(N_SF)
-        si = np.zeros(N_SI, dtype=np.int64)
-        log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
-        rt = np.empty(ns)
-        advance_dopri(plist[np.int64(v)], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
-        for q in range(N_SI):
-            STATS[v, q] = si[q]
-
-
-@numba.njit(cache=True, parallel=True)
-def batch_rodas(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
-    """One Rodas3 solver per variant, in parallel (``prange``); arguments as :func:`batch_dopri`."""
-    nv = X0.shape[0]
-    ns = ts.shape[0]
-    for v in numba.prange(nv):
-        x = X0[v].copy()
-        m = M0[v].copy()
-        sf = np.zeros(N_SF)
-        si = np.zeros(N_SI, dtype=np.int64)
-        log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
-        rt = np.empty(ns)
-        advance_rodas(plist[np.int64(v)], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
-        for q in range(N_SI):
-            STATS[v, q] = si[q]
-
-
 # ============================================================ evaluation through the contract
-@numba.njit(cache=True, nogil=True)
-def evaluate(p, t, x, u, m, dx, g):
-    """The model's right-hand side and switching functions at one point (linearisation, tests)."""
+@register_jitable
+def _evaluate(p, t, x, u, m, dx, g):
     model.rhs(t, x, u, m, p, dx, g)
 
 
-@numba.njit(cache=True, nogil=True)
-def evaluate_outputs(p, t, x, u, m, y):
-    """The model's outputs at one point."""
+@register_jitable
+def _evaluate_outputs(p, t, x, u, m, y):
     model.outputs(t, x, u, m, p, y)
 
 
-@numba.njit(cache=True, nogil=True)
-def outputs_at(p, T, X, u, M, Y):
-    """Outputs at recorded points ``(T[i], X[i], M[i])`` into ``Y[i]``."""
+@register_jitable
+def _outputs_at(p, T, X, u, M, Y):
     y = np.empty(Y.shape[1])
     for i in range(T.shape[0]):
         model.outputs(T[i], X[i], u, M[i], p, y)
         for q in range(y.shape[0]):
             Y[i, q] = y[q]
+
+
+# ============================================================ Python entry points (compiled per model)
+def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+    """Advance a model with Dormand-Prince 5(4) from the solver state to ``t_end`` (resumable).
+
+    Parameters
+    ----------
+    p : NamedTuple
+        The model's packed parameters (selects the model).
+    x, m, u : ndarray
+        State [SI], mode vector (int64) and held inputs; ``x`` and ``m`` are
+        updated in place.
+    t_end : float
+        End of this call [s].
+    sf, si : ndarray
+        Solver state from :func:`new_solver_state` (time, step, counters, status).
+    opt : Options
+    log : EventLog
+    ts : ndarray
+        Sample times [s]; empty records every accepted step into the record
+        buffers until they are full (status ``RECORD_FULL``: resume with
+        ``si[SI_IREC] = 0``); record buffers of length 0 record nothing.
+    rec_t, rec_x, rec_m, rec_y : ndarray
+        Record buffers (time, states, modes, outputs); ``rec_y`` is written
+        only if ``want_y``.
+    want_y : bool
+
+    Returns
+    -------
+    int
+        Status (:mod:`clutchlab.numerics.status`), also in ``si[SI_STATUS]``.
+    """
+    return entry_points(type(p), "dopri").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
+                                                  rec_y, want_y)
+
+
+def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
+    """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
+
+    Arguments and return value as :func:`advance_dopri`.  The Jacobian is the
+    model's analytic one where its ``jacobian`` hook returns True, else a
+    finite-difference one grouped by the sparsity pattern, reused for
+    ``opt.jac_every`` accepted steps and refreshed after a rejection or a
+    mode change.  The state at a located event comes from one Rodas3 step of
+    the located length from the step start, so the algebraic rows stay
+    consistent.
+    """
+    return entry_points(type(p), "rodas").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
+                                                  rec_y, want_y)
+
+
+def batch(method, plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
+    """One solver per variant, in parallel (``prange``), recorded on ``ts``.
+
+    ``method`` is ``"dopri"`` or ``"rodas"``; ``plist`` is a ``numba.typed.List`` with one
+    parameter structure per variant (their mutable memories are their own); ``X0``, ``M0``, ``U``
+    have one row per variant.  ``STATS[v]`` receives the solver counters (``SI_*``); events go to
+    ``EV_*[v]`` (time, code, element) and ``EV_N[v]`` (held, dropped).
+    """
+    entry_points(type(plist[0]), method).batch(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS,
+                                               EV_T, EV_C, EV_E, EV_N)
+
+
+def evaluate(p, t, x, u, m, dx, g):
+    """The model's right-hand side ``dx`` and switching functions ``g`` at one point (linearisation, tests)."""
+    entry_points(type(p), "dopri").evaluate(p, t, x, u, m, dx, g)
+
+
+def evaluate_outputs(p, t, x, u, m, y):
+    """The model's outputs ``y`` at one point."""
+    entry_points(type(p), "dopri").evaluate_outputs(p, t, x, u, m, y)
+
+
+def outputs_at(p, T, X, u, M, Y):
+    """Outputs at recorded points ``(T[i], X[i], M[i])`` into ``Y[i]``."""
+    entry_points(type(p), "dopri").outputs_at(p, T, X, u, M, Y)
+
+
+from .entry import entry_points  # noqa: E402  (entry imports this module's names lazily)

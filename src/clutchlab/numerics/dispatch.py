@@ -3,7 +3,8 @@
 numba cannot cache a kernel that receives a jitted function as an argument
 (numba issue 6251): the dispatcher type is new in every process, so the
 kernel would silently recompile in each one.  The core therefore never takes
-functions as arguments.  It calls the stubs below with the model's parameter
+functions as arguments (and is compiled into per-model entry points, see
+:mod:`clutchlab.numerics.entry`).  It calls the stubs below with the model's parameter
 structure ``p``; each model packs its parameters in its own ``NamedTuple``
 class and registers its compiled functions for that class once
 (:func:`register`).  At compile time the ``@overload`` of each stub looks at
@@ -51,13 +52,13 @@ import inspect
 from numba.core import types
 from numba.extending import overload
 
-__all__ = ["register", "registered", "model_sources", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
+__all__ = ["register", "registered", "hook_sources", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 
 # parameter NamedTuple class -> {hook name: compiled function}
 _MODELS: dict = {}
-_SOURCES: set = set()
+_SOURCES: dict = {}
 
 
 def register(params_cls, **functions) -> None:
@@ -71,16 +72,18 @@ def register(params_cls, **functions) -> None:
     if missing or extra:
         raise TypeError(f"register({params_cls.__name__}): missing hooks {missing}, unknown hooks {extra}")
     _MODELS[params_cls] = dict(functions)
+    files = set()
     for fn in functions.values():
         try:
-            _SOURCES.add(inspect.getsourcefile(getattr(fn, "py_func", fn)))
+            files.add(inspect.getsourcefile(getattr(fn, "py_func", fn)))
         except TypeError:
             pass
+    _SOURCES[params_cls] = sorted(f for f in files if f)
 
 
-def model_sources() -> list:
-    """Source files of every registered hook (the core's cache guard watches them)."""
-    return sorted(f for f in _SOURCES if f)
+def hook_sources(params_cls) -> list:
+    """Source files of a model's registered hooks (part of the name of its compiled entry points)."""
+    return list(_SOURCES.get(params_cls, ()))
 
 
 def registered(params_cls) -> bool:
