@@ -90,13 +90,24 @@ N_OTHER = len(OTHER_SWITCHING)
 N_AUX = 4
 
 
+# rows of the packed per-coordinate, per-element and scratch arrays of EClutchParams
+CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = range(6)  # coord [float]
+CI_FRICTION, CI_NORMAL, CI_PRESSURE = range(3)  # coord_int: Coulomb friction on, pressing element, chamber
+NE_D0, NE_GB, NE_SCALE = range(3)  # net [float]: pre-deflection, input gain, stiffness scale
+NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = range(4)  # net_int: curve offsets, kind, extrapolation, contact
+W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X = range(7)  # work rows
+
+
 class EClutchParams(NamedTuple):
     """Packed parameters of one E-clutch run (:meth:`Assembly.params`; SI units).
 
-    Scalars and contiguous arrays only: numba specialises the core on this
-    class and caches it across processes.  ``work_*`` are scratch arrays of
-    the right-hand side (one set per run, so a fresh structure per run or
-    batch variant).
+    Scalars and C-contiguous arrays only: numba specialises the core on this
+    class and caches it across processes.  Per-coordinate and per-element
+    quantities are rows of a few 2-D arrays (``CO_*``, ``CI_*``, ``NE_*``,
+    ``NI_*``): every compiled function that receives the structure unpacks
+    it, so few fields keep compile time and call overhead low.  ``work`` holds
+    the right-hand side's scratch rows (``W_*``): one structure per run or
+    batch variant.
     """
 
     nz: int                  # generalised coordinates (master, bearing, free nodes)
@@ -105,37 +116,18 @@ class EClutchParams(NamedTuple):
     tin: np.ndarray          # input table times [s] (empty: the held input u[0] is the input)
     vin: np.ndarray          # input table values [V] or [m]
     par: np.ndarray          # actuator parameters (P_* layout)
-    mass: np.ndarray         # mass of each coordinate [kg] (0: massless node, algebraic)
-    GA: np.ndarray           # network assembly (AxialNetwork.kernel_data, node-aligned)
-    Gb: np.ndarray
-    d0: np.ndarray
-    cx: np.ndarray
-    cf: np.ndarray
-    cd: np.ndarray
-    offsets: np.ndarray
-    kinds: np.ndarray
-    extraps: np.ndarray
-    scale: np.ndarray
-    unilateral: np.ndarray
-    fr_on: np.ndarray        # coordinate has Coulomb friction
-    fr_c0: np.ndarray        # constant Coulomb force [N]
-    fr_mun: np.ndarray       # friction per unit normal force [-]
-    fr_nidx: np.ndarray      # element pressing the contact (-1: none)
-    fr_mup: np.ndarray       # friction per unit pressure [N/Pa]
-    fr_pidx: np.ndarray      # chamber pressing the seal (0 none, 1 master, 2 CSC)
-    fr_rs: np.ndarray        # static over kinetic ratio [-]
-    fr_c: np.ndarray         # viscous coefficient [N s/m]
+    coord: np.ndarray        # (6, nz): mass [kg] (0: massless node), Coulomb [N], per normal force [-],
+    #                          per pressure [N/Pa], static ratio [-], viscous [N s/m]
+    coord_int: np.ndarray    # (3, nz): friction on (0/1), pressing element (-1 none), chamber (0 none, 1, 2)
     friction_outputs: np.ndarray  # coordinates whose friction force is an output
+    GA: np.ndarray           # (n_el, n_q) network assembly (node-aligned coordinates)
+    net: np.ndarray          # (3, n_el): d0 [m], Gb [-], stiffness scale [-]
+    net_int: np.ndarray      # (4, n_el + 1): curve offsets, kinds, extrapolation, unilateral (0/1)
+    curve: np.ndarray        # (3, n_samples): deflections [m], forces [N], slopes [N/m] of all curves
     normal_element: int      # element carrying the clamp (normal) force
     r_eff: float             # effective friction radius [m]
     mu: float                # friction coefficient of the facings [-]
-    work_f: np.ndarray       # scratch: element forces after the contact law [N]
-    work_free: np.ndarray    # scratch: element forces before it [N]
-    work_fz: np.ndarray      # scratch: force on each coordinate except friction [N]
-    work_aux: np.ndarray     # scratch: auxiliary values (N_AUX + nz)
-    work_dx: np.ndarray      # scratch: right-hand side for outputs/update/restart
-    work_g: np.ndarray       # scratch: switching functions for outputs/update/restart
-    work_x: np.ndarray       # scratch: state with the massless nodes in equilibrium (outputs)
+    work: np.ndarray         # (7, n): scratch rows W_*
 
 
 # ---------------------------------------------------------------- compiled hooks
@@ -158,15 +150,16 @@ def reference(t, u, tin, vin, interp):
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _friction_level(j, x, nz, f, fr_c0, fr_mun, fr_nidx, fr_mup, fr_pidx):
+def _friction_level(j, x, nz, f, coord, coord_int):
     """Kinetic friction force F_c of coordinate ``j`` [N] (``f``: element forces of the current point)."""
-    fnorm = f[fr_nidx[j]] if fr_nidx[j] >= 0 else 0.0
+    k = coord_int[CI_NORMAL, j]
+    fnorm = f[k] if k >= 0 else 0.0
     pres = 0.0
-    if fr_pidx[j] == 1:
+    if coord_int[CI_PRESSURE, j] == 1:
         pres = x[2 * nz]
-    elif fr_pidx[j] == 2:
+    elif coord_int[CI_PRESSURE, j] == 2:
         pres = x[2 * nz + 2]
-    return kinetic_level(fr_c0[j], fr_mun[j], fnorm, fr_mup[j], pres)
+    return kinetic_level(coord[CO_COULOMB, j], coord[CO_MU_NORMAL, j], fnorm, coord[CO_MU_PRESSURE, j], pres)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -174,33 +167,30 @@ def rhs(t, x, u, m, p, dx, g):
     """Right-hand side (residual on the algebraic rows) and switching functions of the E-clutch."""
     nz = p.nz
     GA = p.GA
-    Gb = p.Gb
-    d0 = p.d0
-    cx = p.cx
-    cf = p.cf
-    cd = p.cd
-    offsets = p.offsets
-    kinds = p.kinds
-    extraps = p.extraps
-    scale = p.scale
-    unilateral = p.unilateral
-    fr_on = p.fr_on
-    fr_c0 = p.fr_c0
-    fr_mun = p.fr_mun
-    fr_nidx = p.fr_nidx
-    fr_mup = p.fr_mup
-    fr_pidx = p.fr_pidx
-    fr_rs = p.fr_rs
-    fr_c = p.fr_c
-    mass = p.mass
+    net = p.net
+    net_int = p.net_int
+    curve = p.curve
+    coord = p.coord
+    coord_int = p.coord_int
+    par = p.par
+    work = p.work
+    d0 = net[NE_D0]
+    Gb = net[NE_GB]
+    scale = net[NE_SCALE]
+    offsets = net_int[NI_OFFSETS]
+    kinds = net_int[NI_KINDS]
+    extraps = net_int[NI_EXTRAPS]
+    unilateral = net_int[NI_UNILATERAL]
+    cx = curve[0]
+    cf = curve[1]
+    cd = curve[2]
+    f = work[W_F]
+    free = work[W_FREE]
+    Fz = work[W_FZ]
+    aux = work[W_AUX]
     nq = nz - 2
     n_el = GA.shape[0]
     b0 = 2 * nz
-    par = p.par
-    f = p.work_f
-    free = p.work_free
-    Fz = p.work_fz
-    aux = p.work_aux
     prescribed = p.imode == PRESCRIBED
     x_mc = x[0]
     v_mc = x[nz]
@@ -221,8 +211,7 @@ def rhs(t, x, u, m, p, dx, g):
     for j in range(nz):
         Fz[j] = 0.0
     for e in range(n_el):
-        _d, fe, _k, fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
-                                       unilateral)
+        _d, fe, _k, fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
         free[e] = fr
         f[e] = fe
         bearing_force += Gb[e] * fe
@@ -278,29 +267,30 @@ def rhs(t, x, u, m, p, dx, g):
     fric_dissip = 0.0
     for j in range(nz):
         vj = x[nz + j]
-        if fr_on[j]:
-            level = _friction_level(j, x, nz, f, fr_c0, fr_mun, fr_nidx, fr_mup, fr_pidx)
+        if coord_int[CI_FRICTION, j]:
+            level = _friction_level(j, x, nz, f, coord, coord_int)
             if m[j] == STUCK:
-                g[j] = static_margin(fr_rs[j], level, Fz[j])
+                g[j] = static_margin(coord[CO_STATIC_RATIO, j], level, Fz[j])
                 frc = -Fz[j]
             else:
                 g[j] = vj
-                frc = slip_force(1.0 if m[j] == SLIP_FORWARD else -1.0, level, fr_c[j], vj)
+                frc = slip_force(1.0 if m[j] == SLIP_FORWARD else -1.0, level, coord[CO_VISCOUS, j], vj)
         else:
             g[j] = 1.0
-            frc = slip_force(0.0, 0.0, fr_c[j], vj)
+            frc = slip_force(0.0, 0.0, coord[CO_VISCOUS, j], vj)
         aux[N_AUX + j] = frc
+        mass = coord[CO_MASS, j]
         if prescribed and j < 2:
             # the actuator is not simulated; the bearing follows the prescribed motion
             dx[j] = v_u if j == 1 else 0.0
             dx[nz + j] = 0.0
-        elif mass[j] > 0.0:
-            if fr_on[j] and m[j] == STUCK:
+        elif mass > 0.0:
+            if coord_int[CI_FRICTION, j] and m[j] == STUCK:
                 dx[j] = 0.0
                 dx[nz + j] = 0.0
             else:
                 dx[j] = vj
-                dx[nz + j] = (Fz[j] + frc) / mass[j]
+                dx[nz + j] = (Fz[j] + frc) / mass
                 fric_dissip -= frc * vj
         else:
             dx[j] = Fz[j]  # algebraic: massless node in equilibrium
@@ -340,19 +330,33 @@ def _equilibrate(x, ub, p):
     """
     nz = p.nz
     GA = p.GA
+    net = p.net
+    net_int = p.net_int
+    curve = p.curve
+    coord = p.coord
+    Gb = net[NE_GB]
+    d0 = net[NE_D0]
+    scale = net[NE_SCALE]
+    offsets = net_int[NI_OFFSETS]
+    kinds = net_int[NI_KINDS]
+    extraps = net_int[NI_EXTRAPS]
+    unilateral = net_int[NI_UNILATERAL]
+    cx = curve[0]
+    cf = curve[1]
+    cd = curve[2]
     q = x[2:nz]
     for _it in range(8):
         worst = 0.0
         for j in range(2, nz):
-            if p.mass[j] > 0.0:
+            if coord[CO_MASS, j] > 0.0:
                 continue
             r = 0.0
             dr = 0.0
             for e in range(GA.shape[0]):
                 if GA[e, j - 2] == 0.0:
                     continue
-                _d, fe, ke, _fr = element_force(e, q, ub, GA, p.Gb, p.d0, p.cx, p.cf, p.cd, p.offsets, p.kinds,
-                                                p.extraps, p.scale, p.unilateral)
+                _d, fe, ke, _fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
+                                                unilateral)
                 r -= GA[e, j - 2] * fe
                 dr -= GA[e, j - 2] * GA[e, j - 2] * ke
             if dr != 0.0:
@@ -367,7 +371,8 @@ def _equilibrate(x, ub, p):
 def outputs(t, x, u, m, p, y):
     """Outputs (see :meth:`Assembly.output_variables`) at one point (massless nodes in equilibrium)."""
     nz = p.nz
-    xs = p.work_x
+    work = p.work
+    xs = work[W_X]
     for i in range(x.shape[0]):
         xs[i] = x[i]
     if p.imode == PRESCRIBED:
@@ -375,10 +380,10 @@ def outputs(t, x, u, m, p, y):
     else:
         ub = x[1]
     _equilibrate(xs, ub, p)
-    rhs(t, xs, u, m, p, p.work_dx, p.work_g)
-    aux = p.work_aux
-    f = p.work_f
-    n_el = f.shape[0]
+    dispatch.rhs(t, xs, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
+    aux = work[W_AUX]
+    f = work[W_F]
+    n_el = p.GA.shape[0]
     fn = f[p.normal_element]
     y[0] = aux[0]
     y[1] = xs[2 * nz + 2] * p.par[P_ASL]  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
@@ -389,11 +394,12 @@ def outputs(t, x, u, m, p, y):
     y[6] = aux[2]
     for e in range(n_el):
         y[7 + e] = f[e]
-    for k in range(p.friction_outputs.shape[0]):
-        y[7 + n_el + k] = aux[N_AUX + p.friction_outputs[k]]
+    fo = p.friction_outputs
+    for k in range(fo.shape[0]):
+        y[7 + n_el + k] = aux[N_AUX + fo[k]]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _slip_mode(force):
     return SLIP_FORWARD if force > 0.0 else SLIP_BACKWARD
 
@@ -403,19 +409,20 @@ def update(t, x, u, m, p, k, log):
     """The friction state machine and the named events when switching function ``k`` crossed zero."""
     nz = p.nz
     n_el = p.GA.shape[0]
-    rhs(t, x, u, m, p, p.work_dx, p.work_g)
+    work = p.work
+    dispatch.rhs(t, x, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
     if k < nz:
         j = k
-        if not p.fr_on[j]:
+        if not p.coord_int[CI_FRICTION, j]:
             return 0
-        force = p.work_fz[j]
+        force = work[W_FZ, j]
         if m[j] == STUCK:
             # break-away: slip in the direction of the applied force, exactly at rest (no spurious reversal)
             m[j] = _slip_mode(force)
             x[nz + j] = 0.0
             kind = EV_BREAKAWAY
-        elif static_margin(p.fr_rs[j], _friction_level(j, x, nz, p.work_f, p.fr_c0, p.fr_mun, p.fr_nidx, p.fr_mup,
-                                                       p.fr_pidx), force) >= 0.0:
+        elif static_margin(p.coord[CO_STATIC_RATIO, j],
+                           _friction_level(j, x, nz, work[W_F], p.coord, p.coord_int), force) >= 0.0:
             m[j] = STUCK
             x[nz + j] = 0.0
             kind = EV_STICK
@@ -424,7 +431,7 @@ def update(t, x, u, m, p, k, log):
             kind = EV_REVERSAL
         record(log, t, kind, j)
         return 0
-    gk = p.work_g[k]
+    gk = work[W_G, k]
     if k < nz + n_el:
         record(log, t, EV_CONTACT_OPEN if gk <= 0.0 else EV_CONTACT_CLOSE, k - nz)
         return 0
@@ -445,6 +452,9 @@ def restart(t, x, u, m, p, log):
     motion the bearing position and velocity are set to the table's.
     """
     nz = p.nz
+    work = p.work
+    coord = p.coord
+    coord_int = p.coord_int
     changed = False
     if p.imode == PRESCRIBED:
         ref, slope = reference(t, u, p.tin, p.vin, p.interp)
@@ -452,22 +462,22 @@ def restart(t, x, u, m, p, log):
             x[1] = ref
             x[nz + 1] = slope
             changed = True
-    rhs(t, x, u, m, p, p.work_dx, p.work_g)
+    dispatch.rhs(t, x, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
     for j in range(nz):
-        if not p.fr_on[j] or p.mass[j] <= 0.0:
+        if not coord_int[CI_FRICTION, j] or coord[CO_MASS, j] <= 0.0:
             continue
-        force = p.work_fz[j]
-        level = _friction_level(j, x, nz, p.work_f, p.fr_c0, p.fr_mun, p.fr_nidx, p.fr_mup, p.fr_pidx)
+        force = work[W_FZ, j]
+        level = _friction_level(j, x, nz, work[W_F], coord, coord_int)
         kind = -1
         if m[j] == STUCK:
-            if static_margin(p.fr_rs[j], level, force) < 0.0:
+            if static_margin(coord[CO_STATIC_RATIO, j], level, force) < 0.0:
                 m[j] = _slip_mode(force)
                 x[nz + j] = 0.0
                 kind = EV_BREAKAWAY
         elif x[nz + j] == 0.0:
             s = 1.0 if m[j] == SLIP_FORWARD else -1.0
             if (force - s * level) * s < 0.0:  # would accelerate against its slip direction
-                if static_margin(p.fr_rs[j], level, force) >= 0.0:
+                if static_margin(coord[CO_STATIC_RATIO, j], level, force) >= 0.0:
                     m[j] = STUCK
                     kind = EV_STICK
                 else:
@@ -858,16 +868,21 @@ class Assembly:
         a = self.asm
         n_el = len(self.element_names)
         f64 = lambda v: np.ascontiguousarray(v, dtype=np.float64)  # noqa: E731
-        i64 = lambda v: np.ascontiguousarray(v, dtype=np.int64)  # noqa: E731
+        coord = f64(np.stack([self.mass, self.fr_c0, self.fr_mun, self.fr_mup, self.fr_rs, self.fr_c]))
+        coord_int = np.ascontiguousarray(np.stack([self.fr_on.astype(np.int64), self.fr_nidx, self.fr_pidx]),
+                                         dtype=np.int64)
+        net = f64(np.stack([a["d0"], a["Gb"], self.scale]))
+        net_int = np.zeros((4, n_el + 1), dtype=np.int64)
+        net_int[NI_OFFSETS] = self.offsets
+        net_int[NI_KINDS, :n_el] = self.kinds
+        net_int[NI_EXTRAPS, :n_el] = self.extraps
+        net_int[NI_UNILATERAL, :n_el] = self.unilateral
+        curve = f64(np.stack([self.cx, self.cf, self.cd]))
+        width = max(self.n, len(self.switching()), N_AUX + self.nz)
         return EClutchParams(
-            int(self.nz), int(imode), int(interp), f64(tin), f64(vin), f64(self.par), f64(self.mass),
-            f64(a["GA"]), f64(a["Gb"]), f64(a["d0"]), f64(self.cx), f64(self.cf), f64(self.cd), i64(self.offsets),
-            i64(self.kinds), i64(self.extraps), f64(self.scale), np.ascontiguousarray(self.unilateral, dtype=np.bool_),
-            np.ascontiguousarray(self.fr_on, dtype=np.bool_), f64(self.fr_c0), f64(self.fr_mun), i64(self.fr_nidx),
-            f64(self.fr_mup), i64(self.fr_pidx), f64(self.fr_rs), f64(self.fr_c), i64(self.friction_outputs),
-            int(self.normal_element), float(self.model.r_eff), float(self.model.mu),
-            np.zeros(n_el), np.zeros(n_el), np.zeros(self.nz), np.zeros(N_AUX + self.nz), np.zeros(self.n),
-            np.zeros(len(self.switching())), np.zeros(self.n))
+            int(self.nz), int(imode), int(interp), f64(tin), f64(vin), f64(self.par), coord, coord_int,
+            np.ascontiguousarray(self.friction_outputs, dtype=np.int64), f64(a["GA"]), net, net_int, curve,
+            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((7, width)))
 
     def system(self, imode: int, tin, vin, interp: int, u0: float, *, held_input: bool = False,
                rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8, jac_every: int = 10,
