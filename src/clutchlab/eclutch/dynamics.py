@@ -371,51 +371,47 @@ class DynamicsResult:
         prescribed = asm.prescribed
         nz = asm.nz
         b0 = 2 * nz
-        states = pd.DataFrame(Y, columns=list(result.state_columns))
-        states.insert(0, "time_s", T)
+        # one float block per table (fast to build), bool flags appended
+        states = pd.DataFrame(np.column_stack([T, Y]), columns=["time_s", *result.state_columns])
         col = result.__getitem__
         u = Y[:, 1]
         v_u = Y[:, nz + 1]
-        out = {
-            "time_s": T,
-            "bearing_position_m": u,
-            "bearing_velocity_m_s": v_u,
-            "bearing_force_clutch_N": col("bearing_force_clutch_N"),
-            "normal_force_N": col("normal_force_N"),
-            "torque_Nm": col("torque_Nm"),
-        }
+        names = ["time_s", "bearing_position_m", "bearing_velocity_m_s", "bearing_force_clutch_N", "normal_force_N",
+                 "torque_Nm"]
+        cols = [T, u, v_u, col("bearing_force_clutch_N"), col("normal_force_N"), col("torque_Nm")]
         if not prescribed:
-            out.update({
-                "motor_voltage_V": col("motor_voltage_V"),
-                "motor_current_A": Y[:, b0 + 3],
-                "motor_speed_rpm": col("motor_speed_rpm"),
-                "master_position_m": Y[:, 0],
-                "master_pressure_Pa": Y[:, b0],
-                "line_flow_m3_s": Y[:, b0 + 1],
-                "pressure_Pa": Y[:, b0 + 2],
-                "bearing_force_N": col("bearing_force_N"),  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
-            })
+            names += ["motor_voltage_V", "motor_current_A", "motor_speed_rpm", "master_position_m",
+                      "master_pressure_Pa", "line_flow_m3_s", "pressure_Pa", "bearing_force_N"]
+            # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
+            cols += [col("motor_voltage_V"), Y[:, b0 + 3], col("motor_speed_rpm"), Y[:, 0], Y[:, b0], Y[:, b0 + 1],
+                     Y[:, b0 + 2], col("bearing_force_N")]
             if "reference_m" in result.output_columns:
-                out["reference_m"] = col("reference_m")
+                names.append("reference_m")
+                cols.append(col("reference_m"))
         for k, node in enumerate(asm.asm["independent"]):
-            out[f"x_{node}_m"] = Y[:, 2 + k]
+            names.append(f"x_{node}_m")
+            cols.append(Y[:, 2 + k])
         M = np.asarray(result.modes)
+        flags = {}
         for j in asm.friction_outputs:
             c = asm.coord_names[j]
-            out[f"friction_{c}_N"] = col(f"friction_{c}_N")
-            out[f"stuck_{c}"] = M[:, j] == S.STUCK
-        outputs = pd.DataFrame(out)
+            names.append(f"friction_{c}_N")
+            cols.append(col(f"friction_{c}_N"))
+            flags[f"stuck_{c}"] = M[:, j] == S.STUCK
+        outputs = pd.DataFrame(np.column_stack(cols), columns=names)
+        if flags:
+            outputs = pd.concat([outputs, pd.DataFrame(flags)], axis=1)
         ev = result.events
+        kinds = ev["event"].tolist()
+        elements = ev["element"].tolist()
         where = []
-        for name, element in zip(ev["event"], ev["element"]):
+        for name, element in zip(kinds, elements):
             if name in ("stick", "breakaway", "slip_reversal"):
-                j = asm.coord_names.index(element)
-                where.append(f"{element} ({asm.friction_names[j]})")
+                where.append(f"{element} ({asm.friction_names[asm.coord_names.index(element)]})")
             else:
                 where.append(_STOPS.get(element, _CHAMBERS.get(element, element)))
-        events = pd.DataFrame({"time_s": ev["time_s"].to_numpy(float),
-                               "event": [_LABELS.get(n, n) for n in ev["event"]], "where": where,
-                               "element": list(ev["element"])})
+        events = pd.DataFrame({"time_s": ev["time_s"].to_numpy(float), "event": [_LABELS.get(n, n) for n in kinds],
+                               "where": where, "element": elements})
         rs = result.stats
         stats = {"accepted_steps": int(rs.get("accepted_steps", 0)), "rejected_steps": int(rs.get("rejected_steps", 0)),
                  "rhs_evaluations": int(rs.get("rhs_evaluations", 0)), "jacobians": int(rs.get("jacobians", 0)),
@@ -833,7 +829,7 @@ def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3
     stats = pd.DataFrame({
         "accepted_steps": res.stats["accepted_steps"], "rejected_steps": res.stats["rejected_steps"],
         "rhs_evaluations": res.stats["rhs_evaluations"],
-        "jacobians": res.stats.get("jacobians", np.zeros(nv, dtype=np.int64)),
+        "jacobians": res.stats["jacobians"],
         "status": np.asarray(res.status, dtype=np.int64),
         "events": [int(counts.get(v, 0)) for v in range(nv)]})
     return BatchResult(grid, out, stats, res)

@@ -643,6 +643,7 @@ class Assembly:
         self.model = model
         self.actuator = actuator
         self.prescribed = prescribed
+        self._initial = {}  # bearing position -> static initial state and modes
         net = model.network
         asm = _node_aligned(net)
         self.asm = asm
@@ -798,6 +799,9 @@ class Assembly:
     # ------------------------------------------------------------ initial state
     def initial_state(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
         """Static equilibrium at bearing position ``u0`` with the actuator at rest; initial friction modes."""
+        cached = self._initial.get(float(u0))
+        if cached is not None:
+            return cached[0].copy(), cached[1].copy()
         st = solve_static(self.model.network, np.array([u0]))
         X = st["node_positions"][0]
         names = st["node_names"]
@@ -807,7 +811,8 @@ class Assembly:
             y[2 + k] = X[names.index(node)]
         modes = np.zeros(self.nz, dtype=np.int64)
         modes[self.fr_on] = STUCK  # at rest: stuck; the state machine breaks away if the force exceeds the limit
-        return y, modes
+        self._initial[float(u0)] = (y, modes)
+        return y.copy(), modes.copy()
 
     def rest_position(self) -> float:
         """Bearing position at rest [m]: the CSC preload spring balances the clutch's bearing force.
