@@ -11,8 +11,11 @@ peak of each trace:
 * friction (stick-slip of the seals and of the pressure plate and diaphragm): which of two nearly equal
   states sticks first depends on the step sequence, so two correct integrators differ by more than their
   tolerance.  The former kernel itself moved by 8e-4 (voltage steps) and 4e-3 (position control) between
-  rtol 1e-8 and 1e-10; the bounds below are twice to three times the differences observed, an error in the
-  friction law or the state machine changes the traces by tens of percent.
+  rtol 1e-8 and 1e-10, the ported model by 2.5e-3 in the line flow of the voltage steps between rtol 1e-10
+  and 2e-12; and the port evaluates the Rodas3 stages of a step that ends on an input corner with the row
+  that step integrates (the former kernel took the next row's voltage there).  The bounds below are about
+  twice the differences observed; an error in the friction law or the state machine changes the traces by
+  tens of percent.
 """
 
 from pathlib import Path
@@ -69,7 +72,7 @@ def test_voltage_steps_through_cavitation_follow_the_former_kernel():
     res = EClutch().simulate({"voltage": volts}, 0.35, rtol=1e-10, atol_scale=1e-2, output_step=1e-3,
                              max_steps=2_000_000)
     out = res.outputs.assign(input_work_J=res.energy["input_work_J"].to_numpy())
-    check("voltage", out, 2e-3)
+    check("voltage", out, 5e-3)
 
 
 def test_prescribed_hysteresis_cycle_follows_the_former_kernel():

@@ -22,9 +22,10 @@ CSC/bearing, then the network's free node coordinates)::
     x[2nz + 5..7]  input work [J], dissipated energy [J], friction dissipation [J]
 
 Mass-matrix rows are 1 except the position rows of massless network nodes
-(0: algebraic force balance).  Friction mode per coordinate (the Modelica
-Standard Library's friction state machine [2]): ``free`` (no Coulomb
-friction), ``slip_forward``, ``stuck``, ``slip_backward``.  When the bearing
+(0: algebraic force balance).  Modes: the friction mode per coordinate (the
+Modelica Standard Library's friction state machine [2]): ``free`` (no Coulomb
+friction), ``slip_forward``, ``stuck``, ``slip_backward``; then the active row
+of the input table (``input_segment``, switched at each table corner).  When the bearing
 motion is prescribed (:class:`~clutchlab.eclutch.dynamics.ClutchDynamics`),
 the actuator is not simulated: the bearing position follows the input table
 (its slope is integrated exactly and reset at every table corner) and the
@@ -132,21 +133,40 @@ class EClutchParams(NamedTuple):
 
 # ---------------------------------------------------------------- compiled hooks
 @numba.njit(cache=True, nogil=True, inline="always")
-def reference(t, u, tin, vin, interp):
-    """Input value and its slope at ``t``: the table (linear or held) or, without a table, the held input."""
-    if tin.shape[0] == 0:
+def reference(t, u, tin, vin, interp, segment):
+    """Input value and its slope at ``t`` on the table row ``segment - 1`` (or the held input ``u[0]``).
+
+    The active row is a mode (``input_segment``, set by :func:`restart` at each corner), not looked up from
+    ``t``: the Rodas3 stages of a step that ends on a corner are evaluated at the corner itself and must see
+    the row the step integrates (a voltage step or a change of slope starts with the next step).
+    ``segment`` 0 is before the table, ``k`` the row ``k - 1`` up to the next corner; beyond the last row the
+    last value is held.
+    """
+    n = tin.shape[0]
+    if n == 0:
         return u[0], 0.0
-    if tin.shape[0] == 1:
+    k = segment - 1
+    if k < 0:
         return vin[0], 0.0
-    lo, w = bracket(tin, t)
+    if k >= n - 1:
+        return vin[n - 1], 0.0
     if interp == 1:
-        if w >= 1.0 and t >= tin[lo + 1]:
-            return vin[lo + 1], 0.0
-        return vin[lo], 0.0
-    dt = tin[lo + 1] - tin[lo]
-    if t < tin[0] or t > tin[tin.shape[0] - 1] or dt <= 0.0:
-        return vin[lo] + w * (vin[lo + 1] - vin[lo]), 0.0
-    return vin[lo] + w * (vin[lo + 1] - vin[lo]), (vin[lo + 1] - vin[lo]) / dt
+        return vin[k], 0.0
+    slope = (vin[k + 1] - vin[k]) / (tin[k + 1] - tin[k])
+    return vin[k] + slope * (t - tin[k]), slope
+
+
+@numba.njit(cache=True, nogil=True)
+def _segment(t, tin):
+    """Mode ``input_segment`` at ``t``: 0 before the table, ``k + 1`` from row ``k`` on (right-continuous)."""
+    n = tin.shape[0]
+    if n == 0 or t < tin[0]:
+        return 0
+    lo, _w = bracket(tin, t) if n > 1 else (0, 0.0)
+    k = lo
+    while k + 1 < n and tin[k + 1] <= t:
+        k += 1
+    return k + 1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -198,7 +218,7 @@ def rhs(t, x, u, m, p, dx, g):
     Q = x[b0 + 1]
     p_s = x[b0 + 2]
     cur = x[b0 + 3]
-    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp)
+    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
     if prescribed:
         ub = ref
         v_u = ref_slope
@@ -376,7 +396,7 @@ def outputs(t, x, u, m, p, y):
     for i in range(x.shape[0]):
         xs[i] = x[i]
     if p.imode == PRESCRIBED:
-        ub, _slope = reference(t, u, p.tin, p.vin, p.interp)
+        ub, _slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
     else:
         ub = x[1]
     _equilibrate(xs, ub, p)
@@ -456,8 +476,12 @@ def restart(t, x, u, m, p, log):
     coord = p.coord
     coord_int = p.coord_int
     changed = False
+    seg = _segment(t, p.tin)
+    if m[nz] != seg:
+        m[nz] = seg
+        changed = True
     if p.imode == PRESCRIBED:
-        ref, slope = reference(t, u, p.tin, p.vin, p.interp)
+        ref, slope = reference(t, u, p.tin, p.vin, p.interp, seg)
         if x[1] != ref or x[nz + 1] != slope:
             x[1] = ref
             x[nz + 1] = slope
@@ -505,16 +529,10 @@ def accept(t, x, u, m, p):
 def next_break(t, m, p):
     """Next corner of the input table after ``t`` (the integrator never steps across one) [s]."""
     tin = p.tin
-    n = tin.shape[0]
-    if n < 2 or t >= tin[n - 1]:
-        return np.inf
-    if t < tin[0]:
-        return tin[0]
-    lo, _w = bracket(tin, t)
-    for k in range(lo, n):
-        if tin[k] > t:
-            return tin[k]
-    return np.inf
+    k = m[p.nz]  # the next corner is row k (the active one is k - 1)
+    while k < tin.shape[0] and tin[k] <= t:
+        k += 1
+    return tin[k] if k < tin.shape[0] else np.inf
 
 
 @numba.njit(cache=True, nogil=True)
@@ -925,18 +943,22 @@ class Assembly:
             inputs, u_start = (name,), np.array([float(vin[0])])
             params = self.params(imode, np.empty(0), np.empty(0), interp)
             nonauto = False
+            segments = ("held input",)
         else:
             inputs, u_start = (), None
             params = self.params(imode, tin, vin, interp)
             # inputs that vary inside a step: a linear table (position reference, prescribed motion)
             nonauto = tin.size > 1 and (imode != VOLTAGE or interp == 0)
+            segments = ("before the table",) + tuple(f"row {k} ({t:g} s)" for k, t in enumerate(tin))
+        # the active row of the input table is a mode (see reference()); restart() sets it at t0
+        m0 = np.append(m0, 0 if held_input else int(np.searchsorted(tin, 0.0, side="right")))
         n_jac = 2 * self.nz + 5  # the energy states enter no equation
         return System(
             name="eclutch" if not self.prescribed else "eclutch_clutch", params=params,
             states=self.state_variables(), outputs=self.output_variables(imode), x0=x0, m0=m0,
             atol=self.atol * atol_scale, switching=self.switching(), events=EVENTS,
-            mode_names=tuple(f"friction_mode_{c}" for c in self.coord_names),
-            mode_values=tuple(MODE_VALUES for _ in self.coord_names), inputs=inputs, u0=u_start, method="rodas",
+            mode_names=tuple(f"friction_mode_{c}" for c in self.coord_names) + ("input_segment",),
+            mode_values=tuple(MODE_VALUES for _ in self.coord_names) + (segments,), inputs=inputs, u0=u_start, method="rodas",
             mass=self.mvec, jac_cols=np.arange(n_jac), fd_scale=self.typ, nonautonomous=bool(nonauto),
             jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
             event_tol=float(event_tol), element_name=self.element_name,
