@@ -2,7 +2,8 @@
 
 Measured in one run:
 
-1. clutchlab's compiled Rodas3 kernel (``EClutch.simulate`` and the kernel alone), after compilation;
+1. clutchlab's Rodas3 integrator core on the E-clutch system (``clutchlab.system.simulate`` of
+   ``EClutch.as_system``, without outputs) and ``EClutch.simulate`` (outputs and tables), after compilation;
 2. the **same equations** integrated by ``scipy.integrate.solve_ivp`` with a plain-Python right-hand side:
    the massless finger-tip node is solved by Newton inside the right-hand side (solve_ivp has no mass
    matrix), the friction state machine runs on terminal events with a restart after each, and the
@@ -23,8 +24,9 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from clutchlab import system as contract
 from clutchlab.eclutch import ActuatorParameters, ClutchModel, EClutch, EClutchParameters, FrictionParameters
-from clutchlab.eclutch import _dynamics_kernel as K
+from clutchlab.eclutch import system as S
 from clutchlab.eclutch.dynamics import _as_table, simulate_batch
 
 T_END = 1.0
@@ -39,7 +41,7 @@ class PythonEClutch:
     """The E-clutch right-hand side in plain Python (position control), for solve_ivp."""
 
     def __init__(self, ec: EClutch, tin, vin):
-        s = ec.system
+        s = ec.assembly
         self.s = s
         self.nz = s.nz
         self.GA = s.asm["GA"].tolist()
@@ -153,27 +155,27 @@ class PythonEClutch:
         for j in range(2, nz):
             Fz[j] = -sum(self.GA[e][j - 2] * f[e] for e in range(len(f)))
         Fz[1] -= fb
-        r = min(max(self.ref(t), p[K.P_REFMIN]), p[K.P_REFMAX])
-        v_pid = p[K.P_KP] * (r - u) + p[K.P_KI] * e_int - p[K.P_KD] * v_u
-        v_drive = min(max(v_pid, -p[K.P_VSUP]), p[K.P_VSUP])
-        exc = abs(cur) - p[K.P_IMAX]
+        r = min(max(self.ref(t), p[S.P_REFMIN]), p[S.P_REFMAX])
+        v_pid = p[S.P_KP] * (r - u) + e_int - p[S.P_KD] * v_u  # e_int: the integral action [V]
+        v_drive = min(max(v_pid, -p[S.P_VSUP]), p[S.P_VSUP])
+        exc = abs(cur) - p[S.P_IMAX]
         if exc > 0.0:
-            v_drive -= p[K.P_KIL] * exc * (1.0 if cur > 0 else -1.0)
-            v_drive = min(max(v_drive, -p[K.P_VSUP]), p[K.P_VSUP])
+            v_drive -= p[S.P_KIL] * exc * (1.0 if cur > 0 else -1.0)
+            v_drive = min(max(v_drive, -p[S.P_VSUP]), p[S.P_VSUP])
         x_mc, v_mc = z[0], v[0]
-        di = (v_drive - p[K.P_R] * cur - p[K.P_KT] * v_mc / p[K.P_NS]) / p[K.P_L]
-        de = (r - u) + p[K.P_KAW] * (v_drive - v_pid)
-        Fz[0] += p[K.P_KT] * cur / p[K.P_NS] - p_m * p[K.P_AMC]
-        opening = min(max((p[K.P_XSN] - x_mc) / p[K.P_WSN], 0.0), 1.0)
-        q_vent = p[K.P_GV] * opening * p_m
-        cm = p[K.P_CM] * (p[K.P_CAVF] if p_m < p[K.P_PCAV] else 1.0)
-        cs = p[K.P_CS] * (p[K.P_CAVF] if p_s < p[K.P_PCAV] else 1.0)
-        dpm = (p[K.P_AMC] * v_mc - Q - q_vent) / cm
-        dQ = (p_m - p_s - p[K.P_RH] * Q) / p[K.P_LH]
-        dps = (Q - p[K.P_ASL] * v_u) / cs
-        Fz[1] += p_s * p[K.P_ASL] + p[K.P_FPRE] - p[K.P_KPRE] * u
-        ks, cst = p[K.P_KSTOP], p[K.P_CSTOP]
-        for j, lo, hi in ((0, 0.0, p[K.P_XMAX]), (1, p[K.P_UMIN], p[K.P_UMAX])):
+        di = (v_drive - p[S.P_R] * cur - p[S.P_KT] * v_mc / p[S.P_NS]) / p[S.P_L]
+        de = p[S.P_KI] * ((r - u) + p[S.P_KAW] * (v_drive - v_pid))
+        Fz[0] += p[S.P_KT] * cur / p[S.P_NS] - p_m * p[S.P_AMC]
+        opening = min(max((p[S.P_XSN] - x_mc) / p[S.P_WSN], 0.0), 1.0)
+        q_vent = p[S.P_GV] * opening * p_m
+        cm = p[S.P_CM] * (p[S.P_CAVF] if p_m < p[S.P_PCAV] else 1.0)
+        cs = p[S.P_CS] * (p[S.P_CAVF] if p_s < p[S.P_PCAV] else 1.0)
+        dpm = (p[S.P_AMC] * v_mc - Q - q_vent) / cm
+        dQ = (p_m - p_s - p[S.P_RH] * Q) / p[S.P_LH]
+        dps = (Q - p[S.P_ASL] * v_u) / cs
+        Fz[1] += p_s * p[S.P_ASL] + p[S.P_FPRE] - p[S.P_KPRE] * u
+        ks, cst = p[S.P_KSTOP], p[S.P_CSTOP]
+        for j, lo, hi in ((0, 0.0, p[S.P_XMAX]), (1, p[S.P_UMIN], p[S.P_UMAX])):
             dl = lo - z[j]
             if dl > 0.0:
                 Fz[j] += max(ks * dl - cst * dl * v[j], 0.0)
@@ -222,7 +224,7 @@ def run_reference(ec: EClutch, method: str, rtol: float):
     """Integrate with solve_ivp; restarts at breakpoints and friction events.  Returns (t, bearing force)."""
     tin, vin = _as_table(INPUT["bearing_reference"], "bearing_reference")
     py = PythonEClutch(ec, tin, vin)
-    s = ec.system
+    s = ec.assembly
     y_full, modes = s.initial_state(ec.rest_position)
     modes = modes.tolist()
     nz = s.nz
@@ -314,16 +316,14 @@ def frictionless_actuator():
 def compare(ec: EClutch, label: str, methods, repeats: int):
     """Time clutchlab and the solve_ivp reference on one configuration; print the ratios."""
     ec.simulate(INPUT, T_END)  # compile / load cache
-    s = ec.system
-    tin, vin = _as_table(INPUT["bearing_reference"], "bearing_reference")
-    t_kernel, out = best_of(lambda: s.run(K.POSITION, tin, vin, 0, T_END, rtol=RTOL, h_max=0.01, max_steps=500_000,
-                                          t_grid=np.empty(0), event_tol=1e-8, jac_every=10,
-                                          u0=ec.rest_position), 20)
-    stats = out[7]
-    t_sim, res = best_of(lambda: ec.simulate(INPUT, T_END, rtol=RTOL), 10)
+    system = ec.as_system(INPUT, rtol=RTOL)
+    t_kernel, out = best_of(lambda: contract.simulate(system, T_END, outputs=False, max_steps=500_000), 20)
+    stats = out.stats
     print(f"[{label}]")
-    print(f"  clutchlab kernel (Rodas3, rtol {RTOL:g}): {t_kernel * 1e3:.2f} ms -> {T_END / t_kernel:,.0f}x real time "
-          f"({stats[0]} steps, {stats[1]} rejected, {stats[2]} RHS, {stats[3]} Jacobians, {len(out[4])} events)")
+    print(f"  clutchlab core (Rodas3, rtol {RTOL:g}): {t_kernel * 1e3:.2f} ms -> {T_END / t_kernel:,.0f}x real time "
+          f"({stats['accepted_steps']} steps, {stats['rejected_steps']} rejected, {stats['rhs_evaluations']} RHS, "
+          f"{stats['jacobians']} Jacobians, {len(out.events)} events)")
+    t_sim, res = best_of(lambda: ec.simulate(INPUT, T_END, rtol=RTOL), 10)
     print(f"  clutchlab EClutch.simulate incl. outputs: {t_sim * 1e3:.2f} ms -> {T_END / t_sim:,.0f}x real time")
     tight = ec.simulate(INPUT, T_END, rtol=1e-8, atol_scale=1e-2)
     grid = np.linspace(0.0, T_END, 2001)

@@ -549,7 +549,8 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     if not outputs:
         OY = np.full((nv, ns, ny), np.nan)
     stats = {"accepted_steps": STATS[:, core.SI_ACCEPTED].copy(), "rejected_steps": STATS[:, core.SI_REJECTED].copy(),
-             "rhs_evaluations": STATS[:, core.SI_NRHS].copy(), "events_dropped": EVN[:, 1].copy()}
+             "rhs_evaluations": STATS[:, core.SI_NRHS].copy(), "jacobians": STATS[:, core.SI_NJAC].copy(),
+             "events_dropped": EVN[:, 1].copy()}
     return SimulationResult(ts, OX, OY, OM, events, status, first.state_columns, first.output_columns,
                             tuple(first.mode_names), tuple(first.mode_values), stats, first.name)
 

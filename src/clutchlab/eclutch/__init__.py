@@ -8,6 +8,8 @@
 - :class:`EClutch`, :class:`ClutchDynamics` -- dynamics: actuator + clutch with stick-slip friction
 - :class:`ActuatorParameters`, :class:`FrictionParameters` -- actuator and friction parameters
 - :func:`load_scenario`, :func:`run_scenario` -- simulation scenarios from TOML
+- :func:`simulate` -- the uniform entry point: a scenario in, a :class:`clutchlab.SimulationResult` out
+  (the model implements the system contract once, :mod:`clutchlab.eclutch.system`, registered as ``"eclutch"``)
 """
 
 from .actuator import ActuatorParameters
@@ -16,7 +18,7 @@ from .models import ClutchModel, ComponentCurves, EClutchParameters, build_model
 from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionElement, FrictionParameters,
                        actuator_test_rig, apply_wear_and_expansion, pedal_reference)
 from .network import AxialNetwork, Lever, Node, Spring, solve_static, zero_input
-from .scenario import Scenario, load_scenario, run_scenario
+from .scenario import Scenario, load_scenario, run_scenario, simulate
 from .variants import load_variant
 from .virtual import VirtualClutch
 
@@ -51,4 +53,5 @@ __all__ = [
     "Scenario",
     "load_scenario",
     "run_scenario",
+    "simulate",
 ]

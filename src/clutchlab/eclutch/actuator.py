@@ -37,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numba
 import numpy as np
 
 from ..errors import ParameterError
@@ -45,6 +46,9 @@ from ..params import ParameterSet, quantity
 __all__ = [
     "ActuatorParameters", "spindle_ratio", "reflected_mass", "chamber_compliance", "line_inertance",
     "line_resistance", "snifting_opening", "motor_current_derivative", "static_pressure",
+    # scalar compiled equations (the dynamics' right-hand side and the vectorised functions above call them)
+    "current_rate", "spindle_force", "drive_voltage", "controller_voltage", "controller_integral_rate",
+    "vent_opening", "cavitating_compliance", "chamber_pressure_rate", "line_flow_rate", "stop_contact",
 ]
 
 _REP = "representative passenger-car E-clutch actuator (docs/eclutch_dynamics.md)"
@@ -247,8 +251,12 @@ def snifting_opening(x_mc, port, width):
         Position at which the port is fully covered by the seal [m].
     width : float
         Travel over which it closes [m] (linear area law).
+
+    Notes
+    -----
+    Vectorised :func:`vent_opening` (the one implementation of the law).
     """
-    return np.clip((port - np.asarray(x_mc, dtype=float)) / width, 0.0, 1.0)
+    return _apply(_vent_opening_array, x_mc, port, width)
 
 
 def motor_current_derivative(voltage, current, speed, resistance, inductance, torque_constant):
@@ -269,8 +277,161 @@ def motor_current_derivative(voltage, current, speed, resistance, inductance, to
     -----
     The electronically commutated motor is represented by its DC-equivalent
     circuit (commutation ripple neglected), as in the actuator model of [2].
+    Vectorised :func:`current_rate` (the one implementation of the equation,
+    also used by the dynamics); array arguments broadcast.
+    """
+    return _apply(_current_rate_array, voltage, current, speed, resistance, inductance, torque_constant)
+
+
+def _apply(loop, *args):
+    """Broadcast the arguments, run a compiled element-wise loop, return a float for scalar input."""
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in args))
+    shape = arrays[0].shape
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    out = np.empty(flat[0].size)
+    loop(*flat, out)
+    return float(out[0]) if shape == () else out.reshape(shape)
+
+
+# ---------------------------------------------------------------------------
+# scalar compiled equations of the actuator ([1] Sec. 2.1, Fig. 5a; [2]; docs/eclutch_dynamics.md Sec. 2).
+# One function per equation: the E-clutch right-hand side (clutchlab.eclutch.system) and the vectorised
+# public functions above call these, so every equation is written once.
+# ---------------------------------------------------------------------------
+
+@numba.njit(cache=True, nogil=True)
+def current_rate(voltage, current, speed, resistance, inductance, torque_constant):
+    """Motor current derivative ``di/dt = (V - R i - k_t omega_m) / L`` [A/s].
+
+    [1] Sec. 2.1, Fig. 5a ([2]): the brushless DC servomotor as its DC-equivalent circuit (commutation ripple
+    neglected, k_e = k_t).  Arguments: voltage V [V], current i [A], rotor speed omega_m [rad/s], R [ohm],
+    L [H], k_t [V s/rad].
     """
     return (voltage - resistance * current - torque_constant * speed) / inductance
+
+
+@numba.njit(cache=True, nogil=True)
+def spindle_force(current, torque_constant, ratio):
+    """Axial force of the motor on the master piston through the spindle, ``F_m = k_t i / n_s`` [N].
+
+    [1] Sec. 2.1 (planetary spindle, rigid, losses as load-dependent friction on the piston, see
+    :func:`clutchlab.eclutch.dynamics.actuator_friction_elements`).  Arguments: current i [A], k_t [N m/A],
+    spindle ratio n_s [m/rad].
+    """
+    return torque_constant * current / ratio
+
+
+@numba.njit(cache=True, nogil=True)
+def drive_voltage(command, current, supply, current_limit, limit_gain):
+    """Voltage the drive applies [V]: the command saturated at the supply, pulled back above the current limit.
+
+    ``V = clip(V_cmd, +-V_sup)``; above ``i_max`` the drive's current limiter subtracts
+    ``K_il (|i| - i_max) sign(i)`` and the result is clipped again (docs/eclutch_dynamics.md Sec. 2, "drive").
+    Arguments: command V_cmd [V], current i [A], supply V_sup [V], i_max [A], K_il [V/A].
+
+    Notes
+    -----
+    A representative drive, not printed in [1] or [2]: a proportional current limiter, no PWM ripple.
+    """
+    v = min(max(command, -supply), supply)
+    excess = abs(current) - current_limit
+    if excess > 0.0:
+        v -= limit_gain * excess * (1.0 if current > 0.0 else -1.0)
+        v = min(max(v, -supply), supply)
+    return v
+
+
+@numba.njit(cache=True, nogil=True)
+def controller_voltage(reference, position, integral, velocity, kp, kd):
+    """Voltage command of the bearing position controller, ``V_cmd = K_p (r - x) + V_I - K_d v`` [V].
+
+    The E-clutch's own PI(D) loop (docs/eclutch_dynamics.md, "Position controller"): ``V_I`` is the
+    integral action (state ``controller_integral_V``), the derivative acts on the measured CSC velocity.
+    Arguments: reference r [m] (already clipped to the CSC travel), position x [m], V_I [V], velocity v [m/s],
+    K_p [V/m], K_d [V s/m].
+    """
+    return kp * (reference - position) + integral - kd * velocity
+
+
+@numba.njit(cache=True, nogil=True)
+def controller_integral_rate(reference, position, applied, command, ki, anti_windup):
+    """Rate of the controller's integral action, ``dV_I/dt = K_i [(r - x) + K_aw (V - V_cmd)]`` [V/s].
+
+    Integral action with back-calculation anti-windup (docs/eclutch_dynamics.md, "Position controller"):
+    the difference between the applied (saturated, current-limited) voltage V and the command V_cmd
+    bleeds the integrator.  Arguments: reference r [m], position x [m], V [V], V_cmd [V], K_i [V/(m s)],
+    K_aw [m/V].
+    """
+    return ki * ((reference - position) + anti_windup * (applied - command))
+
+
+@numba.njit(cache=True, nogil=True)
+def vent_opening(x_mc, port, width):
+    """Open fraction of the snifting port, ``clip((x_port - x_mc) / w, 0, 1)`` [-].
+
+    Linear area law over the seal width w; 1 at rest (vented to the reservoir), 0 once the seal covers the
+    port at ``x_port`` [m].  Arguments: master piston position x_mc [m], x_port [m], w [m].
+    """
+    return min(max((port - x_mc) / width, 0.0), 1.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def cavitating_compliance(pressure, compliance, vapour_pressure, factor):
+    """Chamber compliance [m^3/Pa], ``factor`` times larger below the vapour pressure (cavitation).
+
+    docs/eclutch_dynamics.md Sec. 2: when the motor pulls a piston back faster than the line refills the
+    chamber, the fluid cavitates and the pressure stays bounded; modelled as a compliance 1000x larger
+    (``factor``) below ``p_v``.  Arguments: gauge pressure p [Pa], compliance C [m^3/Pa], p_v [Pa], factor [-].
+    """
+    return compliance * (factor if pressure < vapour_pressure else 1.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def chamber_pressure_rate(inflow, outflow, compliance):
+    """Pressure derivative of a hydraulic chamber, ``dp/dt = (Q_in - Q_out) / C`` [Pa/s].
+
+    [1] Fig. 5a ([2]): master chamber ``C_m dp_m/dt = A_mc v_mc - Q - G_v s(x_mc) p_m`` and CSC chamber
+    ``C_s dp_s/dt = Q - A_sl v_sl`` (constant volume, small-signal compliance).  Arguments: inflow and
+    outflow [m^3/s], compliance C [m^3/Pa] (:func:`cavitating_compliance`).
+    """
+    return (inflow - outflow) / compliance
+
+
+@numba.njit(cache=True, nogil=True)
+def line_flow_rate(upstream, downstream, flow, inertance, resistance):
+    """Flow derivative of the hydraulic line, ``L_h dQ/dt = p_m - p_s - R_h Q`` [m^3/s^2].
+
+    [1] Fig. 5a ([2]): one-dimensional plug flow with fluid inertia ``L_h = rho l / A``
+    (:func:`line_inertance`) and laminar Hagen-Poiseuille resistance (:func:`line_resistance`).
+    Arguments: p_m, p_s [Pa], Q [m^3/s], L_h [kg/m^4], R_h [Pa s/m^3].
+    """
+    return (upstream - downstream - resistance * flow) / inertance
+
+
+@numba.njit(cache=True, nogil=True)
+def stop_contact(penetration, rate, stiffness, damping):
+    """Hunt-Crossley end stop: force ``max(k d + c d d', 0)`` [N] and dissipated power ``(F - k d) d'`` [W].
+
+    ``penetration`` is the penetration d [m] (no contact if <= 0), ``rate`` its rate d' [m/s], k [N/m],
+    c [N s/m^2].  The force pushes out of the stop; the stored energy is k d^2 / 2.  Representative end stops of
+    the master piston and the CSC (docs/eclutch_dynamics.md Sec. 2).
+    """
+    if penetration <= 0.0:
+        return 0.0, 0.0
+    f = max(stiffness * penetration + damping * penetration * rate, 0.0)
+    return f, (f - stiffness * penetration) * rate
+
+
+@numba.njit(cache=True, nogil=True)
+def _current_rate_array(voltage, current, speed, resistance, inductance, torque_constant, out):
+    for i in range(out.shape[0]):
+        out[i] = current_rate(voltage[i], current[i], speed[i], resistance[i], inductance[i], torque_constant[i])
+
+
+@numba.njit(cache=True, nogil=True)
+def _vent_opening_array(x_mc, port, width, out):
+    for i in range(out.shape[0]):
+        out[i] = vent_opening(x_mc[i], port[i], width[i])
 
 
 def static_pressure(bearing_force, bearing_position, params: ActuatorParameters):

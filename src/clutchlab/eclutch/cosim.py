@@ -1,11 +1,13 @@
 """The E-clutch as a co-simulation slave (FMI 2.0 co-simulation semantics, :mod:`clutchlab.fmu`).
 
-``do_step`` continues the compiled Rodas3 integration of
-:mod:`clutchlab.eclutch.dynamics` from the stored state (positions,
-velocities, pressures, current, controller integral, friction modes) over one
-communication interval with the inputs held constant -- the E-clutch as a
-controller-design or HIL plant inside Simulink, Dymola/OpenModelica or any
-FMI master.
+Written against the system contract: ``do_step`` advances a resumable
+:class:`clutchlab.system.Simulation` of the E-clutch system
+(:meth:`clutchlab.eclutch.dynamics.EClutch.as_system` with a held input) over
+one communication interval with the inputs held constant; the integrator's
+state (positions, velocities, pressures, current, controller integral,
+friction modes, step size) carries over from one interval to the next --
+the E-clutch as a controller-design or HIL plant inside Simulink,
+Dymola/OpenModelica or any FMI master.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..fmu.cosim import CoSimulation, Variable, build_parameter_set, parameter_set_variables
-from . import _dynamics_kernel as K
+from ..system import Simulation
 from .actuator import ActuatorParameters
 from .dynamics import EClutch, FrictionParameters
 from .models import ClutchModel, EClutchParameters
@@ -79,45 +81,40 @@ class EClutchCoSimulation(CoSimulation):
         self.rtol = values["rtol"]
         if not 1e-10 < self.rtol < 0.1:
             raise ParameterError(f"parameter rtol = {self.rtol!r}: expected a value in (1e-10, 0.1)")
-        self.imode = K.POSITION if mode == 1.0 else K.VOLTAGE
+        self.input_name = "bearing_reference" if mode == 1.0 else "motor_voltage"
         self.eclutch = EClutch(actuator, ClutchModel.preset(int(model), clutch), friction)
         self.reset()
 
     def reset(self) -> None:
         """Back to rest at t = 0: clutch engaged, actuator at its rest stop."""
-        self.y, self.modes = self.eclutch.system.initial_state(self.eclutch.rest_position)
+        key = "bearing_reference" if self.input_name == "bearing_reference" else "voltage"
+        start = next(v.start for v in self.inputs if v.name == self.input_name)
+        system = self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
+        self.simulation = Simulation(system)
+        self._nz = self.eclutch.assembly.nz
         self.t = 0.0
 
-    def _outputs(self, t, inputs) -> dict:
-        s = self.eclutch.system
-        tin, vin = self._table(t, inputs)
-        interp = 0 if self.imode == K.POSITION else 1
-        aux, f = K.outputs(np.array([t]), self.y[None, :], self.modes[None, :], s.nz, self.imode, tin, vin, interp,
-                           s.par, s.mass, *s.kernel_network(), *s.kernel_friction())
-        nz = s.nz
-        b0 = 2 * nz
-        act = self.eclutch.actuator
-        fn = float(f[0, s.element_names.index(self.eclutch.clutch.network.normal_force)])
+    def _outputs(self, inputs) -> dict:
+        sim = self.simulation
+        sim.set_inputs([self.resolve_inputs(inputs)[self.input_name]])
+        y = sim.outputs()
+        x = sim.x
+        b0 = 2 * self._nz
         return {
-            "bearing_position": float(self.y[1]),
-            "bearing_force": float(self.y[b0 + 2] * act.slave_area),
-            "pressure": float(self.y[b0 + 2]),
-            "master_pressure": float(self.y[b0]),
-            "master_position": float(self.y[0]),
-            "motor_current": float(self.y[b0 + 3]),
-            "motor_voltage_applied": float(aux[0, 0]),
-            "normal_force": fn,
-            "clutch_torque": 2.0 * fn * self.eclutch.clutch.r_eff * self.eclutch.clutch.mu,
+            "bearing_position": float(x[1]),
+            "bearing_force": float(y[1]),
+            "pressure": float(x[b0 + 2]),
+            "master_pressure": float(x[b0]),
+            "master_position": float(x[0]),
+            "motor_current": float(x[b0 + 3]),
+            "motor_voltage_applied": float(y[0]),
+            "normal_force": float(y[3]),
+            "clutch_torque": float(y[4]),
         }
-
-    def _table(self, t, inputs):
-        u = self.resolve_inputs(inputs)
-        value = u["bearing_reference"] if self.imode == K.POSITION else u["motor_voltage"]
-        return np.array([t]), np.array([value])
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 (the rest state)."""
-        return self._outputs(0.0, inputs)
+        return self._outputs(inputs)
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` with the inputs held; return the outputs at ``t + dt``."""
@@ -126,16 +123,7 @@ class EClutchCoSimulation(CoSimulation):
         if abs(t - self.t) > 1e-9 * max(1.0, abs(t)):
             raise SimulationError(f"do_step at t = {t!r} s but the E-clutch is at t = {self.t!r} s "
                                   "(steps must be contiguous; call reset() to start again)")
-        s = self.eclutch.system
-        tin, vin = self._table(t, inputs)
-        interp = 0 if self.imode == K.POSITION else 1
-        *_, stats, yf, mf = K.integrate(
-            self.y, self.modes, float(t), float(t + dt), s.nz, self.imode, tin, vin, interp, np.empty(0), s.par,
-            s.mass, s.mvec, s.typ, *s.kernel_network(), *s.kernel_friction(), float(self.rtol), s.atol,
-            min(1e-5, dt), 0.01, 200_000, np.array([t + dt]), 1e-8, 10)
-        if stats[4] != 0:
-            raise SimulationError(f"E-clutch step from t = {t!r} s failed (status {int(stats[4])})")
-        self.y = yf.copy()
-        self.modes = mf.copy()
+        u = self.resolve_inputs(inputs)[self.input_name]
+        self.simulation.advance(float(t + dt), [u])
         self.t = t + dt
-        return self._outputs(t + dt, inputs)
+        return self._outputs(inputs)

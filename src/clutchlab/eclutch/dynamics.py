@@ -24,10 +24,16 @@ nodes of the network; ``d = d0 + GA q + Gb u`` are the element deflections)::
     0           = F_j(z)                    (massless nodes: algebraic)
     F_q = -GA^T f(d),   F_u = -Gb^T f(d) + p_s A_sl + F_pre - k_pre u
 
-integrated by Rodas3 (:mod:`clutchlab.numerics.rosenbrock`), stiffly accurate
-so the algebraic rows of massless nodes are solved with the dynamics, with
-stick/slip, contact and end-stop events located by re-stepping to within
-``event_tol`` seconds.
+integrated by the Rodas3 method of the integrator core
+(:func:`clutchlab.numerics.core.advance_rodas`), stiffly accurate so the
+algebraic rows of massless nodes are solved with the dynamics, with
+stick/slip, contact and end-stop events located by root finding on the dense
+output to within ``event_tol`` seconds.  The model implements the system
+contract once, in :mod:`clutchlab.eclutch.system`; the classes here are thin
+wrappers that build its :class:`~clutchlab.system.System` and run it with
+:func:`clutchlab.system.simulate` (:meth:`EClutch.simulate`,
+:meth:`ClutchDynamics.simulate` return a :class:`DynamicsResult` view of the
+:class:`~clutchlab.SimulationResult`, kept in its ``result`` attribute).
 
 References
 ----------
@@ -46,13 +52,15 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from .. import system as contract
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError, SimulationError
 from ..params import ParameterSet, quantity
-from . import _dynamics_kernel as K
+from ..result import SimulationResult
+from . import system as S
 from .actuator import ActuatorParameters
 from .models import ClutchModel
-from .network import GROUND, AxialNetwork, Lever, Spring, solve_static
+from .network import AxialNetwork, Lever, Spring
 
 __all__ = [
     "FrictionParameters", "FrictionElement", "ClutchDynamics", "EClutch", "DynamicsResult",
@@ -60,12 +68,17 @@ __all__ = [
     "BatchResult",
 ]
 
-EVENT_KINDS = {K.EV_STICK: "stick", K.EV_BREAKAWAY: "breakaway", K.EV_REVERSAL: "slip reversal",
-               K.EV_CONTACT_CLOSE: "contact closes", K.EV_CONTACT_OPEN: "contact opens",
-               K.EV_STOP_HIT: "end stop hit", K.EV_STOP_LEAVE: "end stop left",
-               K.EV_CAVITATION_START: "cavitation starts", K.EV_CAVITATION_END: "cavitation ends"}
-_STOPS = ("master rest stop", "master stroke end", "CSC engaged stop", "CSC travel end")
-_CHAMBERS = ("master chamber", "CSC chamber")
+#: labels of the events in :attr:`DynamicsResult.events` by event code (the :class:`~clutchlab.SimulationResult`
+#: of :attr:`DynamicsResult.result` names them as :data:`clutchlab.eclutch.system.EVENTS`: ``stick``,
+#: ``breakaway``, ``slip_reversal``, ``contact_close``, ``contact_open``, ``stop_hit``, ``stop_leave``,
+#: ``cavitation_start``, ``cavitation_end``)
+EVENT_KINDS = {S.EV_STICK: "stick", S.EV_BREAKAWAY: "breakaway", S.EV_REVERSAL: "slip reversal",
+               S.EV_CONTACT_CLOSE: "contact closes", S.EV_CONTACT_OPEN: "contact opens",
+               S.EV_STOP_HIT: "end stop hit", S.EV_STOP_LEAVE: "end stop left",
+               S.EV_CAVITATION_START: "cavitation starts", S.EV_CAVITATION_END: "cavitation ends"}
+_LABELS = {S.EVENTS[code]: label for code, label in EVENT_KINDS.items()}
+_STOPS = dict(zip(S.STOPS, ("master rest stop", "master stroke end", "CSC engaged stop", "CSC travel end")))
+_CHAMBERS = dict(zip(S.CHAMBERS, ("master chamber", "CSC chamber")))
 _REP = "representative (docs/eclutch_dynamics.md)"
 
 
@@ -285,62 +298,10 @@ def actuator_test_rig(stiffness: float = 3.0e5, preload: float = 80.0, travel: f
     return ClutchModel(net, r_eff=0.1, mu=0.27)
 
 
+
 # ---------------------------------------------------------------------------
-# assembly of the dynamic system
+# results
 # ---------------------------------------------------------------------------
-
-def _node_aligned(network: AxialNetwork) -> dict:
-    """Coordinates aligned with nodes: ``x = A q + b u + c`` with ``q`` = positions of the independent nodes.
-
-    The input node and, for every rigid lever, one massless node are the
-    dependent ones, so each mass (and each friction element) sits on one
-    coordinate of its own and the mass matrix is diagonal.
-    """
-    a = network._assembly
-    names = list(a["node_names"])
-    idx = {n: i for i, n in enumerate(names)}
-    mass = np.array([n.mass for n in network.nodes])
-    G = a["G"]
-    prestrain = a["d0"] - G @ a["c"]
-    N = len(names)
-    rows, ru, rc, dep = [], [], [], []
-    r = np.zeros(N)
-    r[idx[network.input]] = 1.0
-    rows.append(r), ru.append(1.0), rc.append(0.0), dep.append(idx[network.input])
-    for e in network.elements:
-        if isinstance(e, Lever) and e.rigid:
-            g = np.zeros(N)
-            for node, coef in e.coefficients().items():
-                if node != GROUND:
-                    g[idx[node]] += coef
-            cands = [i for i in np.flatnonzero(g) if i not in dep]
-            cands.sort(key=lambda i: (mass[i] > 0, -abs(g[i])))
-            if not cands:
-                raise ParameterError(f"{network.name}: rigid lever {e.name!r} over-constrains the nodes")
-            if mass[cands[0]] > 0:
-                raise ParameterError(
-                    f"{network.name}: rigid lever {e.name!r} ties two masses together; give one of its nodes zero mass")
-            rows.append(g), ru.append(0.0), rc.append(-e.prestrain), dep.append(cands[0])
-    C = np.array(rows)
-    ind = [i for i in range(N) if i not in dep]
-    CD = C[:, dep]
-    CI = C[:, ind]
-    inv = np.linalg.inv(CD)
-    A = np.zeros((N, len(ind)))
-    b = np.zeros(N)
-    c = np.zeros(N)
-    for k, i in enumerate(ind):
-        A[i, k] = 1.0
-    A[dep, :] = -inv @ CI
-    b[dep] = inv @ np.array(ru)
-    c[dep] = inv @ np.array(rc)
-    GA = G @ A
-    return dict(
-        names=names, independent=[names[i] for i in ind], A=A, b=b, c=c,
-        GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), d0=np.ascontiguousarray(prestrain + G @ c),
-        mass=mass[ind].astype(float), elements=list(a["element_names"]),
-    )
-
 
 def _curve_energy(curve, scale, unilateral, d_values, d_ref):
     """Elastic energy ``int_{d_ref}^{d} max?(scale*curve)`` [J] (fine trapezoid on the interpolant)."""
@@ -359,24 +320,30 @@ def _curve_energy(curve, scale, unilateral, d_values, d_ref):
 
 @dataclasses.dataclass
 class DynamicsResult:
-    """Result of an E-clutch simulation.
+    """Result of an E-clutch simulation: a table view of a :class:`~clutchlab.SimulationResult`.
 
     Attributes
     ----------
     time : ndarray
         Time [s] of the recorded points.
     states : pandas.DataFrame
-        Raw state vector (positions, velocities, pressures, current, energies).
+        State vector (positions, velocities, pressures, current, controller integral, energies), unit-suffixed
+        columns.
     outputs : pandas.DataFrame
         Measured and derived quantities (see :meth:`to_dataframe`).
     events : pandas.DataFrame
-        Located events: ``time_s``, ``event``, ``where``.
+        Located events: ``time_s``, ``event`` (a label of :data:`EVENT_KINDS`), ``where`` (coordinate and
+        friction element, network element, end stop or chamber) and ``element`` (the element's name as in
+        ``result.events``).
     stats : dict
-        Accepted and rejected steps, right-hand-side evaluations, Jacobians.
+        Accepted and rejected steps, right-hand-side evaluations, Jacobians, status (0: the end time was
+        reached).
     energy_source : callable or DataFrame, optional
         What :attr:`energy` returns: energy bookkeeping per recorded point [J]: ``input_work_J``,
         ``dissipated_J``, ``friction_dissipated_J`` (integrated with the
         states) and ``stored_J`` (computed from the states).
+    result : SimulationResult, optional
+        The run as the integrator core returned it (named events ``stick``, ``breakaway``, ...).
     """
 
     time: np.ndarray
@@ -385,6 +352,71 @@ class DynamicsResult:
     events: pd.DataFrame
     stats: dict
     energy_source: object = dataclasses.field(default=None, repr=False)
+    result: object = dataclasses.field(default=None, repr=False)
+
+    @classmethod
+    def from_result(cls, result: SimulationResult, source) -> "DynamicsResult":
+        """The table view of a run of ``source`` (an :class:`EClutch` or a :class:`ClutchDynamics`).
+
+        Parameters
+        ----------
+        result : SimulationResult
+            What :func:`clutchlab.system.simulate` returned for ``source.as_system(...)``.
+        source : EClutch or ClutchDynamics
+            The model that was simulated (names, masses and curves for the energy bookkeeping).
+        """
+        asm = source.assembly
+        T = np.asarray(result.time)
+        Y = np.asarray(result.states)
+        prescribed = asm.prescribed
+        nz = asm.nz
+        b0 = 2 * nz
+        # one float block per table (fast to build), bool flags appended
+        states = pd.DataFrame(np.column_stack([T, Y]), columns=["time_s", *result.state_columns])
+        col = result.__getitem__
+        u = Y[:, 1]
+        v_u = Y[:, nz + 1]
+        names = ["time_s", "bearing_position_m", "bearing_velocity_m_s", "bearing_force_clutch_N", "normal_force_N",
+                 "torque_Nm"]
+        cols = [T, u, v_u, col("bearing_force_clutch_N"), col("normal_force_N"), col("torque_Nm")]
+        if not prescribed:
+            names += ["motor_voltage_V", "motor_current_A", "motor_speed_rpm", "master_position_m",
+                      "master_pressure_Pa", "line_flow_m3_s", "pressure_Pa", "bearing_force_N"]
+            # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
+            cols += [col("motor_voltage_V"), Y[:, b0 + 3], col("motor_speed_rpm"), Y[:, 0], Y[:, b0], Y[:, b0 + 1],
+                     Y[:, b0 + 2], col("bearing_force_N")]
+            if "reference_m" in result.output_columns:
+                names.append("reference_m")
+                cols.append(col("reference_m"))
+        for k, node in enumerate(asm.asm["independent"]):
+            names.append(f"x_{node}_m")
+            cols.append(Y[:, 2 + k])
+        M = np.asarray(result.modes)
+        flags = {}
+        for j in asm.friction_outputs:
+            c = asm.coord_names[j]
+            names.append(f"friction_{c}_N")
+            cols.append(col(f"friction_{c}_N"))
+            flags[f"stuck_{c}"] = M[:, j] == S.STUCK
+        outputs = pd.DataFrame(np.column_stack(cols), columns=names)
+        if flags:
+            outputs = pd.concat([outputs, pd.DataFrame(flags)], axis=1)
+        ev = result.events
+        kinds = ev["event"].tolist()
+        elements = ev["element"].tolist()
+        where = []
+        for name, element in zip(kinds, elements):
+            if name in ("stick", "breakaway", "slip_reversal"):
+                where.append(f"{element} ({asm.friction_names[asm.coord_names.index(element)]})")
+            else:
+                where.append(_STOPS.get(element, _CHAMBERS.get(element, element)))
+        events = pd.DataFrame({"time_s": ev["time_s"].to_numpy(float), "event": [_LABELS.get(n, n) for n in kinds],
+                               "where": where, "element": elements})
+        rs = result.stats
+        stats = {"accepted_steps": int(rs.get("accepted_steps", 0)), "rejected_steps": int(rs.get("rejected_steps", 0)),
+                 "rhs_evaluations": int(rs.get("rhs_evaluations", 0)), "jacobians": int(rs.get("jacobians", 0)),
+                 "status": int(result.status)}
+        return cls(T, states, outputs, events, stats, lambda: _energy(asm, Y, u, v_u), result)
 
     @property
     def energy(self) -> pd.DataFrame | None:
@@ -417,331 +449,45 @@ class DynamicsResult:
                 "friction_dissipated_J": float(e["friction_dissipated_J"].iloc[-1] - e["friction_dissipated_J"].iloc[0])}
 
 
-class _System:
-    """Arrays of one dynamic system (clutch network + optional actuator) for the kernel."""
-
-    def __init__(self, model: ClutchModel, actuator: ActuatorParameters | None, friction: list[FrictionElement],
-                 prescribed: bool):
-        if not isinstance(model, ClutchModel):
-            raise ParameterError(f"expected a ClutchModel, got {type(model).__name__}")
-        self.model = model
-        self.actuator = actuator
-        self.prescribed = prescribed
-        net = model.network
-        asm = _node_aligned(net)
-        self.asm = asm
-        self.nq = len(asm["independent"])
-        self.nz = 2 + self.nq
-        self.coord_names = ["master", "bearing"] + asm["independent"]
-        kd = net.kernel_data()
-        # curve data come from the network's own assembly (same element order)
-        self.cx, self.cf, self.cd, self.offsets, self.kinds, self.extraps = kd[3], kd[4], kd[5], kd[6], kd[7], kd[8]
-        self.scale = np.ascontiguousarray(kd[9], dtype=float)
-        self.unilateral = kd[10]
-        self.element_names = asm["elements"]
-        act = actuator or ActuatorParameters()
-        mass = np.zeros(self.nz)
-        mass[0] = act.master_equivalent_mass
-        mass[1] = act.slave_mass
-        mass[2:] = asm["mass"]
-        self.mass = mass
-        n = 2 * self.nz + 8
-        self.n = n
-        mvec = np.ones(n)
-        for j in range(2, self.nz):
-            if mass[j] == 0.0:
-                mvec[j] = 0.0
-        self.mvec = mvec
-        self.par = self._par(act)
-        self._friction(friction)
-        typ = np.empty(n)
-        typ[: self.nz] = 1e-3
-        typ[self.nz: 2 * self.nz] = 1e-2
-        b0 = 2 * self.nz
-        typ[b0: b0 + 8] = [1e5, 1e-6, 1e5, 1.0, 1e-4, 1.0, 1.0, 1.0]
-        self.typ = typ
-        atol = np.empty(n)
-        atol[: self.nz] = 1e-8
-        atol[self.nz: 2 * self.nz] = 1e-5
-        atol[b0: b0 + 8] = [10.0, 1e-10, 10.0, 1e-4, 1e-9, 1e-6, 1e-6, 1e-6]
-        if not prescribed:
-            # with the actuator: 0.1 um, 0.1 mm/s, 100 Pa, 1 mA, ... (far below what a rig resolves; tighter
-            # values only resolve stick-slip micro-motions of the seals, see docs/eclutch_dynamics.md)
-            atol[: b0 + 5] *= 10.0
-        self.atol = atol
-
-    def _par(self, a: ActuatorParameters) -> np.ndarray:
-        par = np.zeros(K.N_PAR)
-        par[K.P_AMC] = a.master_area
-        par[K.P_ASL] = a.slave_area
-        par[K.P_MMC] = a.master_equivalent_mass
-        par[K.P_MSL] = a.slave_mass
-        par[K.P_CM] = a.master_compliance
-        par[K.P_CS] = a.slave_compliance
-        par[K.P_LH] = a.line_inertance
-        par[K.P_RH] = a.line_resistance
-        par[K.P_GV] = a.snifting_conductance
-        par[K.P_XSN] = a.snifting_port + a.snifting_width
-        par[K.P_WSN] = a.snifting_width
-        par[K.P_PCAV] = a.vapour_pressure
-        par[K.P_CAVF] = 1e3
-        par[K.P_R] = a.resistance
-        par[K.P_L] = a.inductance
-        par[K.P_KT] = a.torque_constant
-        par[K.P_VSUP] = a.supply_voltage
-        par[K.P_IMAX] = a.current_limit
-        par[K.P_KIL] = a.current_limit_gain
-        par[K.P_NS] = a.spindle_ratio
-        par[K.P_FPRE] = a.csc_preload
-        par[K.P_KPRE] = a.csc_spring_rate
-        par[K.P_UMIN] = a.slave_min
-        par[K.P_UMAX] = a.slave_max
-        par[K.P_XMAX] = a.master_stroke
-        par[K.P_KSTOP] = a.stop_stiffness
-        par[K.P_CSTOP] = a.stop_damping
-        par[K.P_KP] = a.kp
-        par[K.P_KI] = a.ki
-        par[K.P_KD] = a.kd
-        par[K.P_KAW] = a.anti_windup
-        par[K.P_REFMIN] = a.slave_min
-        par[K.P_REFMAX] = a.slave_max
-        return par
-
-    def _friction(self, elements):
-        nz = self.nz
-        self.fr_on = np.zeros(nz, dtype=np.bool_)
-        self.fr_c0 = np.zeros(nz)
-        self.fr_mun = np.zeros(nz)
-        self.fr_nidx = -np.ones(nz, dtype=np.int64)
-        self.fr_mup = np.zeros(nz)
-        self.fr_pidx = np.zeros(nz, dtype=np.int64)
-        self.fr_rs = np.ones(nz)
-        self.fr_c = np.zeros(nz)
-        self.friction_names = [""] * nz
-        for el in elements:
-            if not isinstance(el, FrictionElement):
-                raise ParameterError(f"friction elements must be FrictionElement, got {type(el).__name__}")
-            if el.node not in self.coord_names:
-                raise ParameterError(
-                    f"friction element {el.name!r}: node {el.node!r} is not a free coordinate "
-                    f"(free: {self.coord_names})")
-            j = self.coord_names.index(el.node)
-            if self.prescribed and j < 2:
-                continue  # the actuator is not simulated
-            if self.mass[j] <= 0.0:
-                raise ParameterError(f"friction element {el.name!r} acts on massless node {el.node!r}; give it a mass")
-            self.fr_c[j] += el.viscous
-            if not el.active:
-                continue
-            if self.fr_on[j]:
-                # several elements on one coordinate: they stick and slip together
-                if el.normal is not None and self.fr_nidx[j] >= 0:
-                    raise ParameterError(f"node {el.node!r}: only one normal-force element per node is supported")
-            self.fr_on[j] = True
-            self.fr_c0[j] += el.coulomb
-            if el.normal is not None:
-                if el.normal not in self.element_names:
-                    raise ParameterError(f"friction element {el.name!r}: normal = {el.normal!r} is not an elastic element "
-                                         f"of {self.model.name} ({self.element_names})")
-                self.fr_nidx[j] = self.element_names.index(el.normal)
-                self.fr_mun[j] = el.coefficient
-            if el.pressure is not None:
-                self.fr_pidx[j] = 1 if el.pressure == "master" else 2
-                self.fr_mup[j] = el.pressure_coefficient
-            self.fr_rs[j] = max(self.fr_rs[j], el.static_ratio)
-            self.friction_names[j] = (self.friction_names[j] + "+" if self.friction_names[j] else "") + el.name
-
-    def kernel_network(self):
-        a = self.asm
-        return (a["GA"], a["Gb"], a["d0"], self.cx, self.cf, self.cd, self.offsets, self.kinds, self.extraps,
-                self.scale, self.unilateral)
-
-    def kernel_friction(self):
-        return (self.fr_on, self.fr_c0, self.fr_mun, self.fr_nidx, self.fr_mup, self.fr_pidx, self.fr_rs, self.fr_c)
-
-    # ------------------------------------------------------------- initial state
-    def initial_state(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
-        """Static equilibrium at bearing position ``u0`` with the actuator at rest; initial friction modes."""
-        st = solve_static(self.model.network, np.array([u0]))
-        X = st["node_positions"][0]
-        names = st["node_names"]
-        y = np.zeros(self.n)
-        y[1] = u0
-        for k, node in enumerate(self.asm["independent"]):
-            y[2 + k] = X[names.index(node)]
-        modes = np.zeros(self.nz, dtype=np.int64)
-        modes[self.fr_on] = 2  # at rest: stuck; the state machine breaks away if the force exceeds the limit
-        return y, modes
-
-    def rest_position(self) -> float:
-        """Bearing position at rest [m]: the CSC preload spring balances the clutch's bearing force.
-
-        With the bundled parameters this is 0 (the bearing origin is set at the
-        CSC preload); wear and thermal offsets or another preload move it.
-
-        Raises
-        ------
-        ParameterError
-            If no stable rest position lies within the CSC travel (e.g. a CSC
-            preload above the clutch's bearing force everywhere: the clutch
-            could not stay engaged).
-        """
-        a = self.actuator
-        lo, hi = a.slave_min, a.slave_max
-
-        def g(u):
-            return a.csc_preload - a.csc_spring_rate * u - float(solve_static(self.model.network, [u])["input_force"][0])
-
-        if abs(g(0.0)) < 1e-9:
-            return 0.0
-        grid = np.concatenate([np.linspace(0.0, hi, 201), np.linspace(0.0, lo, 41)[1:]])
-        up = solve_static(self.model.network, grid[:201])["input_force"]
-        down = solve_static(self.model.network, grid[201:])["input_force"] if lo < 0 else np.empty(0)
-        gu = a.csc_preload - a.csc_spring_rate * grid[:201] - up
-        gd = a.csc_preload - a.csc_spring_rate * grid[201:] - down
-        from scipy.optimize import brentq
-
-        if gu[0] > 0:  # pushed towards release: first stable root (g from + to -) going up
-            k = np.flatnonzero((gu[:-1] > 0) & (gu[1:] <= 0))
-            if k.size:
-                return float(brentq(g, grid[k[0]], grid[k[0] + 1], xtol=1e-13))
-        else:  # pulled towards the engaged side
-            uu = np.concatenate([[0.0], grid[201:]])
-            gg = np.concatenate([[gu[0]], gd])
-            k = np.flatnonzero((gg[:-1] <= 0) & (gg[1:] > 0))
-            if k.size:
-                return float(brentq(g, uu[k[0] + 1], uu[k[0]], xtol=1e-13))
-        raise ParameterError(
-            f"inconsistent parameters: with csc_preload = {a.csc_preload!r} N the CSC finds no rest position within "
-            f"its travel [{lo:g}, {hi:g}] m (the clutch's bearing force at position 0 is {a.csc_preload - g(0.0):.4g} N; "
-            "EClutchParameters.bearing_preload and ActuatorParameters.csc_preload should match)")
-
-    # --------------------------------------------------------------------- run
-    def run(self, imode, tin, vin, interp, t_end, *, rtol, h_max, max_steps, t_grid, event_tol, y0=None, modes0=None,
-            u0=0.0, jac_every=1, atol_scale=1.0):
-        if not (np.isfinite(atol_scale) and atol_scale > 0):
-            raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
-        rows, what = ((t_grid.shape[0], f"t_end = {short_repr(t_end)} s at output_step = {short_repr(t_grid[1] - t_grid[0])} s")
-                      if t_grid.shape[0] > 1 else (int(max_steps) + 1, f"max_steps = {max_steps!r} recorded steps"))
-        # the kernel's records (time, states, auxiliaries, modes), then the outputs computed from them
-        check_allocation(rows, 2 * (1 + self.n + K.N_AUX_FIXED + 2 * self.nz), what)
-        if y0 is None:
-            y0, modes0 = self.initial_state(u0)
-        breaks = np.unique(tin[(tin > 0) & (tin < t_end)])
-        T, Y, AUX, MODES, evt, evk, evi, stats, yf, mf = K.integrate(
-            y0, modes0, 0.0, float(t_end), self.nz, imode, tin, vin, interp, breaks, self.par, self.mass, self.mvec,
-            self.typ, *self.kernel_network(), *self.kernel_friction(), float(rtol), self.atol * atol_scale, 1e-5, float(h_max),
-            int(max_steps), t_grid, float(event_tol), int(jac_every))
-        return T, Y, AUX, MODES, evt, evk, evi, stats, yf, mf
-
-    # ------------------------------------------------------------------ result
-    def result(self, imode, tin, vin, interp, T, Y, MODES, evt, evk, evi, stats) -> DynamicsResult:
-        AUX, F = K.outputs(T, Y, MODES, self.nz, imode, tin, vin, interp, self.par, self.mass,
-                           *self.kernel_network(), *self.kernel_friction())
-        nz = self.nz
-        b0 = 2 * nz
-        cols = [f"z_{c}_m" for c in self.coord_names] + [f"v_{c}_m_s" for c in self.coord_names] + [
-            "master_pressure_Pa", "line_flow_m3_s", "pressure_Pa", "motor_current_A", "controller_integral_m_s",
-            "input_work_J", "dissipated_J", "friction_dissipated_J"]
-        states = pd.DataFrame(Y, columns=cols)
-        states.insert(0, "time_s", T)
-        a = self.actuator or ActuatorParameters()
-        if imode == K.PRESCRIBED:
-            u = AUX[:, 3]
-            # the prescribed input's slope, right-continuous at the table's breakpoints
-            seg = np.clip(np.searchsorted(tin, T, side="right") - 1, 0, max(len(tin) - 2, 0))
-            v_u = np.zeros_like(u) if len(tin) < 2 else (vin[seg + 1] - vin[seg]) / (tin[seg + 1] - tin[seg])
-            v_u = np.where((T < tin[0]) | (T >= tin[-1]), 0.0, v_u)
+def _energy(asm: "S.Assembly", Y, u, v_u) -> pd.DataFrame:
+    """Stored energy from the states (independent of the integrator's bookkeeping)."""
+    nz = asm.nz
+    b0 = 2 * nz
+    a = asm.actuator or ActuatorParameters()
+    kin = 0.5 * (Y[:, nz: 2 * nz] ** 2 * asm.mass[None, :])
+    if asm.prescribed:
+        kin[:, :2] = 0.0
+    stored = kin.sum(axis=1)
+    # elastic energy of the network elements
+    q = Y[:, 2: nz]
+    D = asm.asm["d0"][None, :] + q @ asm.asm["GA"].T + np.outer(u, asm.asm["Gb"])
+    net = asm.model.network
+    for e, name in enumerate(asm.element_names):
+        elm = net.element(name)
+        if isinstance(elm, Lever):
+            curve, scl, uni = elm.curve(), 1.0, False
         else:
-            u = Y[:, 1]
-            v_u = Y[:, nz + 1]
-        net = self.model.network
-        el = self.element_names
-        fn = F[:, el.index(net.normal_force)]
-        out = {
-            "time_s": T,
-            "bearing_position_m": u,
-            "bearing_velocity_m_s": v_u,
-            "bearing_force_clutch_N": AUX[:, 1],
-            "normal_force_N": fn,
-            "torque_Nm": 2.0 * fn * self.model.r_eff * self.model.mu,
-        }
-        if imode != K.PRESCRIBED:
-            out.update({
-                "motor_voltage_V": AUX[:, 0],
-                "motor_current_A": Y[:, b0 + 3],
-                "motor_speed_rpm": Y[:, nz] / a.spindle_ratio * 60.0 / (2.0 * np.pi),
-                "master_position_m": Y[:, 0],
-                "master_pressure_Pa": Y[:, b0],
-                "line_flow_m3_s": Y[:, b0 + 1],
-                "pressure_Pa": Y[:, b0 + 2],
-                "bearing_force_N": Y[:, b0 + 2] * a.slave_area,  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
-            })
-            if imode == K.POSITION:
-                out["reference_m"] = AUX[:, 2]
-        for k, node in enumerate(self.asm["independent"]):
-            out[f"x_{node}_m"] = Y[:, 2 + k]
-        for j in range(nz):
-            if self.fr_on[j] or self.fr_c[j] > 0:
-                out[f"friction_{self.coord_names[j]}_N"] = AUX[:, K.N_AUX_FIXED + j]
-                out[f"stuck_{self.coord_names[j]}"] = MODES[:, j] == 2
-        outputs = pd.DataFrame(out)
-        rows = []
-        for t_, k_, i_ in zip(evt, evk, evi):
-            if k_ in (K.EV_STICK, K.EV_BREAKAWAY, K.EV_REVERSAL):
-                where = f"{self.coord_names[i_]} ({self.friction_names[i_]})"
-            elif k_ in (K.EV_CONTACT_OPEN, K.EV_CONTACT_CLOSE):
-                where = el[i_]
-            elif k_ in (K.EV_CAVITATION_START, K.EV_CAVITATION_END):
-                where = _CHAMBERS[i_]
-            else:
-                where = _STOPS[i_]
-            rows.append((t_, EVENT_KINDS[int(k_)], where))
-        events = pd.DataFrame(rows, columns=["time_s", "event", "where"])
-        st = {"accepted_steps": int(stats[0]), "rejected_steps": int(stats[1]), "rhs_evaluations": int(stats[2]),
-              "jacobians": int(stats[3]), "status": int(stats[4])}
-        return DynamicsResult(T, states, outputs, events, st, lambda: self._energy(Y, F, u, v_u, imode))
-
-    def _energy(self, Y, F, u, v_u, imode) -> pd.DataFrame:
-        """Stored energy from the states (independent of the integrator's bookkeeping)."""
-        nz = self.nz
-        b0 = 2 * nz
-        a = self.actuator or ActuatorParameters()
-        kin = 0.5 * (Y[:, nz: 2 * nz] ** 2 * self.mass[None, :])
-        if imode == K.PRESCRIBED:
-            kin[:, :2] = 0.0
-        stored = kin.sum(axis=1)
-        # elastic energy of the network elements
-        asm = self.asm
-        q = Y[:, 2: nz]
-        D = asm["d0"][None, :] + q @ asm["GA"].T + np.outer(u, asm["Gb"])
-        net = self.model.network
-        for e, name in enumerate(self.element_names):
-            elm = net.element(name)
-            if isinstance(elm, Lever):
-                curve, scl, uni = elm.curve(), 1.0, False
-            else:
-                curve, scl, uni = elm.curve, elm.scale, elm.unilateral
-            stored = stored + _curve_energy(curve, scl, uni, D[:, e], D[0, e])
-        if imode != K.PRESCRIBED:
-            def cap(p, c):
-                pc = a.vapour_pressure
-                below = p < pc
-                e = 0.5 * p ** 2 * c
-                # below the vapour pressure the compliance is 1000 x larger (kernel P_CAVF)
-                e_b = 0.5 * pc ** 2 * c + 0.5 * (p ** 2 - pc ** 2) * c * 1e3
-                return np.where(below, e_b, e)
-            stored = stored + 0.5 * a.inductance * Y[:, b0 + 3] ** 2
-            stored = stored + cap(Y[:, b0], a.master_compliance) + cap(Y[:, b0 + 2], a.slave_compliance)
-            stored = stored + 0.5 * a.line_inertance * Y[:, b0 + 1] ** 2
-            # CSC preload spring: force F_pre - k_pre u on the piston
-            stored = stored - (a.csc_preload * u - 0.5 * a.csc_spring_rate * u ** 2)
-            # end stops
-            ks = a.stop_stiffness
-            for pen in (-Y[:, 0], Y[:, 0] - a.master_stroke, a.slave_min - u, u - a.slave_max):
-                stored = stored + 0.5 * ks * np.maximum(pen, 0.0) ** 2
-        return pd.DataFrame({"input_work_J": Y[:, b0 + 5], "dissipated_J": Y[:, b0 + 6],
-                             "friction_dissipated_J": Y[:, b0 + 7], "stored_J": stored})
+            curve, scl, uni = elm.curve, elm.scale, elm.unilateral
+        stored = stored + _curve_energy(curve, scl, uni, D[:, e], D[0, e])
+    if not asm.prescribed:
+        def cap(p, c):
+            pc = a.vapour_pressure
+            below = p < pc
+            e = 0.5 * p ** 2 * c
+            # below the vapour pressure the compliance is 1000 x larger (actuator.cavitating_compliance)
+            e_b = 0.5 * pc ** 2 * c + 0.5 * (p ** 2 - pc ** 2) * c * 1e3
+            return np.where(below, e_b, e)
+        stored = stored + 0.5 * a.inductance * Y[:, b0 + 3] ** 2
+        stored = stored + cap(Y[:, b0], a.master_compliance) + cap(Y[:, b0 + 2], a.slave_compliance)
+        stored = stored + 0.5 * a.line_inertance * Y[:, b0 + 1] ** 2
+        # CSC preload spring: force F_pre - k_pre u on the piston
+        stored = stored - (a.csc_preload * u - 0.5 * a.csc_spring_rate * u ** 2)
+        # end stops
+        ks = a.stop_stiffness
+        for pen in (-Y[:, 0], Y[:, 0] - a.master_stroke, a.slave_min - u, u - a.slave_max):
+            stored = stored + 0.5 * ks * np.maximum(pen, 0.0) ** 2
+    return pd.DataFrame({"input_work_J": Y[:, b0 + 5], "dissipated_J": Y[:, b0 + 6],
+                         "friction_dissipated_J": Y[:, b0 + 7], "stored_J": stored})
 
 
 def _as_table(value, name: str):
@@ -799,6 +545,24 @@ def _grid(output_step, t_end):
     return np.arange(n) * output_step
 
 
+def _max_step(max_step, h_max):
+    """The largest step [s]: ``max_step`` (the uniform name) or its alias ``h_max``."""
+    if max_step is not None and h_max is not None and float(max_step) != float(h_max):
+        raise ParameterError(f"max_step = {max_step!r} and h_max = {h_max!r}: give one (h_max is the old name)")
+    value = max_step if max_step is not None else h_max
+    value = 0.01 if value is None else float(value)
+    if not (np.isfinite(value) and value > 0):
+        raise ParameterError(f"max_step = {value!r} s must be finite and > 0")
+    return value
+
+
+def _run(source, system: contract.System, t_end: float, max_steps: int, output_step) -> DynamicsResult:
+    grid = _grid(output_step, t_end)
+    # without a grid every accepted step is kept, in chunks that grow with the run (not max_steps rows up front)
+    res = contract.simulate(system, t_end, max_steps=int(max_steps), sample_times=grid if grid.size else None)
+    return DynamicsResult.from_result(res, source)
+
+
 class ClutchDynamics:
     """Clutch axial dynamics driven by a prescribed bearing motion.
 
@@ -824,35 +588,40 @@ class ClutchDynamics:
         if isinstance(friction, FrictionParameters):
             friction = clutch_friction_elements(model.network, friction)
         self.model = model
-        self.system = _System(model, None, list(friction), prescribed=True)
+        #: the packed structure (:class:`clutchlab.eclutch.system.Assembly`)
+        self.assembly = S.Assembly(model, None, list(friction), prescribed=True)
 
-    def simulate(self, bearing_position, t_end: float | None = None, *, rtol: float = 1e-5, h_max: float = 0.01,
-                 max_steps: int = 500_000, output_step: float | None = None, event_tol: float = 1e-9,
-                 jac_every: int = 4, atol_scale: float = 1.0) -> DynamicsResult:
+    def as_system(self, bearing_position, *, rtol: float = 1e-5, max_step: float = 0.01, event_tol: float = 1e-9,
+                  jac_every: int = 4, atol_scale: float = 1.0) -> contract.System:
+        """The :class:`~clutchlab.system.System` of a run with the bearing position prescribed.
+
+        Parameters
+        ----------
+        bearing_position : table
+            ``(times [s], positions [m])``, linear in between (see :meth:`simulate`).
+        rtol, max_step, event_tol, jac_every, atol_scale
+            Defaults of the run, as in :meth:`simulate`.
+        """
+        tin, vin = _as_table(bearing_position, "bearing_position")
+        return self.assembly.system(S.PRESCRIBED, tin, vin, 0, float(vin[0]), rtol=rtol, max_step=max_step,
+                                    event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
+
+    def simulate(self, bearing_position, t_end: float | None = None, *, rtol: float = 1e-5,
+                 max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
+                 output_step: float | None = None, event_tol: float = 1e-9, jac_every: int = 4,
+                 atol_scale: float = 1.0) -> DynamicsResult:
         """Simulate with the bearing position prescribed as ``(times [s], positions [m])`` (linear in between).
 
         Tolerances: ``rtol`` and the default absolute tolerances (10 nm, 10 um/s, 10 Pa, ...) times
-        ``atol_scale``; other arguments as in :meth:`EClutch.simulate`.
+        ``atol_scale``; ``bearing_position``, ``t_end``, ``max_step`` (alias ``h_max``), ``max_steps``,
+        ``output_step``, ``event_tol`` and ``jac_every`` as in :meth:`EClutch.simulate`.
         """
-        tin, vin = _as_table(bearing_position, "bearing_position")
+        tin, _vin = _as_table(bearing_position, "bearing_position")
         t_end = float(tin[-1]) if t_end is None else float(t_end)
         _check_run(t_end, rtol, max_steps)
-        grid = _grid(output_step, t_end)
-        T, Y, AUX, MODES, evt, evk, evi, stats, _yf, _mf = self.system.run(
-            K.PRESCRIBED, tin, vin, 0, t_end, rtol=rtol, h_max=h_max, max_steps=max_steps, t_grid=grid,
-            event_tol=event_tol, u0=float(vin[0]), jac_every=jac_every, atol_scale=atol_scale)
-        res = self.system.result(K.PRESCRIBED, tin, vin, 0, T, Y, MODES, evt, evk, evi, stats)
-        _raise_status(res)
-        return res
-
-
-def _raise_status(res: DynamicsResult):
-    if res.stats["status"] == 1:
-        raise SimulationError(f"simulation stopped at t = {res.time[-1]:.6g} s: max_steps reached "
-                              "(raise max_steps or loosen rtol)")
-    if res.stats["status"] == 2:
-        raise SimulationError(f"simulation stopped at t = {res.time[-1]:.6g} s: step size underflow "
-                              "(inconsistent parameters or an input the model cannot follow)")
+        system = self.as_system(bearing_position, rtol=rtol, max_step=_max_step(max_step, h_max),
+                                event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
+        return _run(self, system, t_end, max_steps, output_step)
 
 
 class EClutch:
@@ -880,13 +649,38 @@ class EClutch:
         if isinstance(friction, FrictionParameters):
             friction = clutch_friction_elements(self.clutch.network, friction)
         self.friction = list(friction) + actuator_friction_elements(self.actuator)
-        self.system = _System(self.clutch, self.actuator, self.friction, prescribed=False)
+        #: the packed structure (:class:`clutchlab.eclutch.system.Assembly`)
+        self.assembly = S.Assembly(self.clutch, self.actuator, self.friction, prescribed=False)
         #: bearing position at rest [m] (0 unless offsets or the preload move it)
-        self.rest_position = self.system.rest_position()
+        self.rest_position = self.assembly.rest_position()
 
-    def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, h_max: float = 0.01, max_steps: int = 500_000,
-                 output_step: float | None = None, event_tol: float = 1e-8, jac_every: int = 10,
-                 atol_scale: float = 1.0) -> DynamicsResult:
+    def as_system(self, inputs, *, rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8,
+                  jac_every: int = 10, atol_scale: float = 1.0, held_input: bool = False,
+                  first_step: float = 1e-5) -> contract.System:
+        """The :class:`~clutchlab.system.System` of a run from rest (for :func:`clutchlab.system.simulate`).
+
+        Parameters
+        ----------
+        inputs : dict
+            As in :meth:`simulate`.
+        rtol, max_step, event_tol, jac_every, atol_scale
+            Defaults of the run, as in :meth:`simulate`.
+        held_input : bool
+            The input is the system's held input (``motor_voltage`` [V] or ``bearing_reference`` [m],
+            set by :meth:`clutchlab.system.Simulation.advance`) instead of the table; it starts at the
+            table's first value (co-simulation).
+        first_step : float
+            First trial step [s].
+        """
+        imode, interp, key, value = _input_mode(inputs)
+        tin, vin = _as_table(value, key)
+        return self.assembly.system(imode, tin, vin, interp, self.rest_position, held_input=held_input, rtol=rtol,
+                                    max_step=max_step, event_tol=event_tol, jac_every=jac_every,
+                                    atol_scale=atol_scale, first_step=first_step)
+
+    def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, max_step: float | None = None,
+                 h_max: float | None = None, max_steps: int = 500_000, output_step: float | None = None,
+                 event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float = 1.0) -> DynamicsResult:
         """Simulate from rest (clutch engaged, actuator at its rest stop).
 
         Parameters
@@ -901,13 +695,15 @@ class EClutch:
             End time [s].
         rtol : float
             Relative tolerance of the Rodas3 integrator.
+        max_step : float
+            Largest step [s] (default 0.01).
         h_max : float
-            Largest step [s].
+            Old name of ``max_step`` (either may be given).
         max_steps : int
             Accepted-step budget.
         output_step : float, optional
-            Record on a uniform grid (linear interpolation between steps);
-            default: every accepted step.
+            Record on a uniform grid (dense output of the steps); default:
+            every accepted step.
         event_tol : float
             Time tolerance of event location [s].
         jac_every : int
@@ -922,19 +718,13 @@ class EClutch:
         DynamicsResult
             States, outputs (motor current, piston position, pressure, bearing
             position, ``bearing_force_N = p A_sl``, clutch forces, torque),
-            events and statistics.
+            events and statistics; ``.result`` is the :class:`~clutchlab.SimulationResult`.
         """
-        imode, interp, key, value = _input_mode(inputs)
-        tin, vin = _as_table(value, key)
         t_end = float(t_end)
         _check_run(t_end, rtol, max_steps)
-        grid = _grid(output_step, t_end)
-        T, Y, AUX, MODES, evt, evk, evi, stats, _yf, _mf = self.system.run(
-            imode, tin, vin, interp, t_end, rtol=rtol, h_max=h_max, max_steps=max_steps, t_grid=grid,
-            event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale, u0=self.rest_position)
-        res = self.system.result(imode, tin, vin, interp, T, Y, MODES, evt, evk, evi, stats)
-        _raise_status(res)
-        return res
+        system = self.as_system(inputs, rtol=rtol, max_step=_max_step(max_step, h_max), event_tol=event_tol,
+                                jac_every=jac_every, atol_scale=atol_scale)
+        return _run(self, system, t_end, max_steps, output_step)
 
 
 def _input_mode(inputs):
@@ -942,9 +732,9 @@ def _input_mode(inputs):
         raise ParameterError("inputs must be a mapping with exactly one of 'voltage' or 'bearing_reference'")
     (key, value), = inputs.items()
     if key == "voltage":
-        return K.VOLTAGE, 1, key, value
+        return S.VOLTAGE, 1, key, value
     if key == "bearing_reference":
-        return K.POSITION, 0, key, value
+        return S.POSITION, 0, key, value
     raise ParameterError(f"unknown input {key!r}; use 'voltage' [V] or 'bearing_reference' [m]")
 
 
@@ -963,36 +753,48 @@ class BatchResult:
         ``friction_dissipated_J`` (and ``reference_m`` under position control).
     stats : pandas.DataFrame
         Accepted/rejected steps, right-hand sides, Jacobians, status and event count per variant.
+    result : SimulationResult, optional
+        The stacked batch as the integrator core returned it.
     """
 
     time: np.ndarray
     outputs: dict
     stats: pd.DataFrame
+    result: object = dataclasses.field(default=None, repr=False)
 
     def to_dataframe(self, variant: int) -> pd.DataFrame:
-        """The outputs of one variant as a table."""
+        """The outputs of one variant as a table.
+
+        Parameters
+        ----------
+        variant : int
+            Index of the variant (order of the ``eclutches`` given to :func:`simulate_batch`).
+        """
         data = {"time_s": self.time}
         data.update({k: v[variant] for k, v in self.outputs.items()})
         return pd.DataFrame(data)
 
 
 def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3, rtol: float = 1e-3,
-                   h_max: float = 0.01, max_steps: int = 500_000, event_tol: float = 1e-8,
-                   jac_every: int = 10) -> BatchResult:
+                   max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
+                   event_tol: float = 1e-8, jac_every: int = 10) -> BatchResult:
     """Simulate many E-clutch variants in parallel, one Rodas3 solver per variant (numba ``prange``).
+
+    A thin wrapper of :func:`clutchlab.system.simulate_batch` over the variants' systems
+    (:meth:`EClutch.as_system`).
 
     Parameters
     ----------
     eclutches : sequence of EClutch
         The variants, e.g. a sweep of lever ratio and stiffness scales.  They
-        must share the model structure (same nodes, elements and component
-        curves, same friction placement); scalar parameters, masses, lever
-        ratios, pre-strains, stiffness scales and actuator parameters may differ.
+        must share the model structure (same coordinates, elements and friction
+        placement); parameters, masses, lever ratios, pre-strains, stiffness
+        scales, component curves and actuator parameters may differ.
     inputs : dict
         As in :meth:`EClutch.simulate` (one input for every variant).
     t_end, output_step : float
         End time and output grid step [s].
-    rtol, h_max, max_steps, event_tol, jac_every
+    rtol, max_step, h_max, max_steps, event_tol, jac_every
         As in :meth:`EClutch.simulate`.
 
     Returns
@@ -1005,54 +807,29 @@ def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3
     for k, ec in enumerate(ecs):
         if not isinstance(ec, EClutch):
             raise ParameterError(f"simulate_batch: variant {k} is a {type(ec).__name__}, not an EClutch")
-    imode, interp, key, value = _input_mode(inputs)
-    tin, vin = _as_table(value, key)
     t_end = float(t_end)
     _check_run(t_end, rtol, max_steps)
     grid = _grid(output_step, t_end)
-    s0 = ecs[0].system
-    shared = ("cx", "cf", "cd", "offsets", "kinds", "extraps", "unilateral", "fr_on", "fr_nidx", "fr_pidx", "mvec")
+    h = _max_step(max_step, h_max)
+    sig = ecs[0].assembly.signature()
     for k, ec in enumerate(ecs[1:], start=1):
-        s = ec.system
-        if s.nz != s0.nz or len(s.element_names) != len(s0.element_names):
-            raise ParameterError(f"simulate_batch: variant {k} has another model structure than variant 0")
-        for name in shared:
-            a, b = getattr(s, name), getattr(s0, name)
-            if a.shape != b.shape or not np.array_equal(a, b):
-                raise ParameterError(f"simulate_batch: variant {k} differs from variant 0 in {name!r} "
-                                     "(component curves and friction placement must be shared)")
-    Y0 = np.empty((len(ecs), s0.n))
-    M0 = np.empty((len(ecs), s0.nz), dtype=np.int64)
-    for k, ec in enumerate(ecs):
-        y, m = ec.system.initial_state(ec.rest_position)
-        Y0[k], M0[k] = y, m
-    st = [ec.system for ec in ecs]
-    stack = lambda name: np.ascontiguousarray(np.stack([getattr(s, name) for s in st]))  # noqa: E731
-    asm = lambda name: np.ascontiguousarray(np.stack([s.asm[name] for s in st]))  # noqa: E731
-    breaks = np.unique(tin[(tin > 0) & (tin < t_end)])
-    OUT, AUX, F, STATS, NEV = K.integrate_batch(
-        Y0, M0, t_end, s0.nz, imode, tin, vin, interp, breaks, stack("par"), stack("mass"), s0.mvec, s0.typ,
-        asm("GA"), asm("Gb"), asm("d0"), s0.cx, s0.cf, s0.cd, s0.offsets, s0.kinds, s0.extraps, stack("scale"),
-        s0.unilateral, s0.fr_on, stack("fr_c0"), stack("fr_mun"), s0.fr_nidx, stack("fr_mup"), s0.fr_pidx,
-        stack("fr_rs"), stack("fr_c"), float(rtol), s0.atol, 1e-5, float(h_max), int(max_steps), grid,
-        float(event_tol), int(jac_every))
-    nz = s0.nz
-    b0 = 2 * nz
-    a_sl = np.array([ec.actuator.slave_area for ec in ecs])[:, None]
-    r_eff = np.array([ec.clutch.r_eff * ec.clutch.mu for ec in ecs])[:, None]
-    nf = s0.element_names.index(ecs[0].clutch.network.normal_force)
-    out = {
-        "bearing_position_m": OUT[:, :, 1], "bearing_velocity_m_s": OUT[:, :, nz + 1],
-        "pressure_Pa": OUT[:, :, b0 + 2], "master_pressure_Pa": OUT[:, :, b0],
-        "bearing_force_N": OUT[:, :, b0 + 2] * a_sl, "bearing_force_clutch_N": AUX[:, :, 1],
-        "motor_current_A": OUT[:, :, b0 + 3], "motor_voltage_V": AUX[:, :, 0],
-        "master_position_m": OUT[:, :, 0], "normal_force_N": F[:, :, nf], "torque_Nm": 2.0 * F[:, :, nf] * r_eff,
-        "input_work_J": OUT[:, :, b0 + 5], "dissipated_J": OUT[:, :, b0 + 6],
-        "friction_dissipated_J": OUT[:, :, b0 + 7],
-    }
-    if imode == K.POSITION:
-        out["reference_m"] = AUX[:, :, 2]
-    stats = pd.DataFrame(STATS, columns=["accepted_steps", "rejected_steps", "rhs_evaluations", "jacobians",
-                                         "status"])
-    stats["events"] = NEV
-    return BatchResult(grid, out, stats)
+        if ec.assembly.signature() != sig:
+            raise ParameterError(f"simulate_batch: variant {k} has another model structure than variant 0 "
+                                 "(coordinates, elements and friction placement must be shared)")
+    systems = [ec.as_system(inputs, rtol=rtol, max_step=h, event_tol=event_tol, jac_every=jac_every) for ec in ecs]
+    res = contract.simulate_batch(systems, t_end, sample_times=grid, max_steps=int(max_steps), check=False)
+    keys = ["bearing_position_m", "bearing_velocity_m_s", "pressure_Pa", "master_pressure_Pa", "bearing_force_N",
+            "bearing_force_clutch_N", "motor_current_A", "motor_voltage_V", "master_position_m", "normal_force_N",
+            "torque_Nm", "input_work_J", "dissipated_J", "friction_dissipated_J"]
+    if "reference_m" in res.output_columns:
+        keys.append("reference_m")
+    out = {k: res[k] for k in keys}
+    nv = len(ecs)
+    counts = res.events["variant"].value_counts() if len(res.events) else pd.Series(dtype=int)
+    stats = pd.DataFrame({
+        "accepted_steps": res.stats["accepted_steps"], "rejected_steps": res.stats["rejected_steps"],
+        "rhs_evaluations": res.stats["rhs_evaluations"],
+        "jacobians": res.stats["jacobians"],
+        "status": np.asarray(res.status, dtype=np.int64),
+        "events": [int(counts.get(v, 0)) for v in range(nv)]})
+    return BatchResult(grid, out, stats, res)

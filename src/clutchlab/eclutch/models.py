@@ -32,6 +32,7 @@ import difflib
 from importlib import resources
 from pathlib import Path
 
+import numba
 import numpy as np
 import pandas as pd
 
@@ -43,7 +44,7 @@ from ..units import to_si
 from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
 
 __all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve",
-           "ClutchModel", "build_model", "clutch_torque", "MODEL_NUMBERS"]
+           "ClutchModel", "build_model", "clutch_torque", "torque_of_clamp_force", "MODEL_NUMBERS"]
 
 MODEL_NUMBERS = (0, 1, 2, 3, 4)
 #: A measured characteristic may be continued beyond its characterised deflection range by this
@@ -72,8 +73,33 @@ def clutch_torque(normal_force, r_eff, mu):
     torque : ndarray or float
         Transmissible torque [N·m]; the factor 2 counts the two friction
         surfaces of the single friction plate.
+
+    Notes
+    -----
+    Vectorised :func:`torque_of_clamp_force`, the one implementation of the
+    equation (the dynamics' outputs call it too); arguments broadcast.
     """
-    return 2.0 * np.asarray(normal_force, dtype=float) * r_eff * mu
+    fn, r, m = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (normal_force, r_eff, mu)))
+    out = np.empty(fn.size)
+    _torque_array(np.ascontiguousarray(fn).ravel(), np.ascontiguousarray(r).ravel(), np.ascontiguousarray(m).ravel(),
+                  out)
+    return out[0] if fn.shape == () else out.reshape(fn.shape)
+
+
+@numba.njit(cache=True, nogil=True)
+def torque_of_clamp_force(normal_force, r_eff, mu):
+    """Transmissible torque of the dry single-plate clutch, ``M_cl = 2 F_n r_eff mu`` [N m] ([1], Sec. 3.2).
+
+    Scalar compiled form: normal (clamp) force F_n [N], effective radius r_eff [m], friction coefficient
+    mu [-] (constant, as in [1]); the factor 2 counts the two friction faces of the plate.
+    """
+    return 2.0 * normal_force * r_eff * mu
+
+
+@numba.njit(cache=True, nogil=True)
+def _torque_array(normal_force, r_eff, mu, out):
+    for i in range(out.shape[0]):
+        out[i] = torque_of_clamp_force(normal_force[i], r_eff[i], mu[i])
 
 
 @dataclasses.dataclass(frozen=True)

@@ -375,26 +375,61 @@ class AxialNetwork:
 # compiled static solver
 # ---------------------------------------------------------------------------
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def element_force(e, q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral):
+    """Deflection, force and tangent stiffness of elastic element ``e`` of an axial network ([1] Figs. 5b, 10-11).
+
+    The element's deflection is linear in the free coordinates and the input,
+    ``d_e = d0_e + Gb_e u + sum_j GA_ej q_j`` [m] (node-aligned coordinates of
+    the network, rigid levers eliminated); its force is its characteristic
+    curve times its stiffness scale, ``f_e = scale_e F_e(d_e)`` [N], and a
+    unilateral element (a contact: the cushion, the release bearing) carries
+    no tension, ``f_e = max(f_e, 0)``.  The one implementation of the
+    element law: the static solver (:func:`element_forces`) and the dynamics
+    (:mod:`clutchlab.eclutch.system`) both call it.
+
+    Parameters
+    ----------
+    e : int
+        Element index (assembly order).
+    q : ndarray
+        Free coordinates [m].
+    u : float
+        Input (bearing) position [m].
+    GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral
+        Assembly arrays of :meth:`AxialNetwork.kernel_data`.
+
+    Returns
+    -------
+    (d, f, k, f_free) : tuple of float
+        Deflection [m], force [N] and tangent stiffness [N/m] after the
+        contact law, and the force before it [N] (its sign says whether a
+        unilateral element is in contact: the contact's switching function).
+    """
+    de = d0[e] + Gb[e] * u
+    for j in range(GA.shape[1]):
+        de += GA[e, j] * q[j]
+    lo = offsets[e]
+    hi = offsets[e + 1]
+    fe, ke = curve_eval(cx[lo:hi], cf[lo:hi], cd[lo:hi], kinds[e], extraps[e], de)
+    fe *= scale[e]
+    ke *= scale[e]
+    free = fe
+    if unilateral[e] and fe <= 0.0:
+        fe = 0.0
+        ke = 0.0
+    return de, fe, ke, free
+
+
 @numba.njit(cache=True, nogil=True)
 def element_forces(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d):
-    """Deflections ``d`` [m], forces ``f`` [N] and tangent stiffnesses ``k`` [N/m] of the elastic elements."""
-    n_el = GA.shape[0]
-    n_q = GA.shape[1]
-    for e in range(n_el):
-        de = d0[e] + Gb[e] * u
-        for j in range(n_q):
-            de += GA[e, j] * q[j]
-        d[e] = de
-        lo = offsets[e]
-        hi = offsets[e + 1]
-        fe, ke = curve_eval(cx[lo:hi], cf[lo:hi], cd[lo:hi], kinds[e], extraps[e], de)
-        fe *= scale[e]
-        ke *= scale[e]
-        if unilateral[e] and fe <= 0.0:
-            fe = 0.0
-            ke = 0.0
-        f[e] = fe
-        k[e] = ke
+    """Deflections ``d`` [m], forces ``f`` [N] and tangent stiffnesses ``k`` [N/m] of all elastic elements.
+
+    Fills the output arrays with :func:`element_force` of every element.
+    """
+    for e in range(GA.shape[0]):
+        d[e], f[e], k[e], _free = element_force(e, q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
+                                                unilateral)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -31,6 +31,8 @@ key, and the value.
 from __future__ import annotations
 
 import dataclasses
+import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -44,7 +46,8 @@ from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionParamete
                        pedal_reference)
 from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
 
-__all__ = ["Scenario", "load_scenario", "scenario_from_dict", "run_scenario", "INPUT_KINDS"]
+__all__ = ["Scenario", "load_scenario", "scenario_from_dict", "run_scenario", "scenario_system", "simulate",
+           "INPUT_KINDS"]
 
 INPUT_KINDS = {"voltage": "V", "bearing_reference": "m", "pedal": "1", "bearing_position": "m"}
 _TABLES = ("scenario", "input", "eclutch", "eclutch_actuator", "eclutch_friction", "offsets")
@@ -243,3 +246,87 @@ def run_scenario(scenario: Scenario, progress=None) -> DynamicsResult:
     key = "voltage" if scenario.input_kind == "voltage" else "bearing_reference"
     ec = EClutch(scenario.actuator, model, scenario.friction)
     return ec.simulate({key: (t, v)}, scenario.t_end, rtol=scenario.rtol, output_step=scenario.output_step)
+
+
+def _as_scenario(scenario) -> Scenario:
+    if scenario is None:
+        return Scenario()
+    if isinstance(scenario, Scenario):
+        return scenario
+    if isinstance(scenario, (str, Path)):
+        return load_scenario(scenario)
+    if isinstance(scenario, Mapping):
+        keys = set(scenario)
+        if len(keys) == 1 and keys <= {"voltage", "bearing_reference", "bearing_position"}:
+            # an input table: the default E-clutch (Model 4, friction on) driven by it
+            from .dynamics import _as_table
+
+            (kind, value), = scenario.items()
+            t, v = _as_table(value, kind)
+            return Scenario(input_kind=kind, time_s=t, value=v, t_end=float(t[-1]) if t[-1] > 0 else 1.0,
+                            source=f"{kind} input")
+        return scenario_from_dict(dict(scenario), source=str(scenario.get("_source", "scenario")))
+    raise ParameterError(f"scenario: expected a Scenario, a scenario file or an input mapping, "
+                         f"got {type(scenario).__name__}")
+
+
+def scenario_system(scenario=None, **options):
+    """The :class:`~clutchlab.system.System` of a scenario (what :func:`simulate` runs).
+
+    Parameters
+    ----------
+    scenario : Scenario, str, Path, dict or None
+        A :class:`Scenario`, a scenario TOML file, its parsed tables, an input mapping
+        (``{"voltage": table}``, ``{"bearing_reference": table}``, ``{"bearing_position": table}``: the
+        default E-clutch, Model 4 with friction) or None for the default scenario.
+    **options
+        Run defaults for the system (``max_step``, ``event_tol``, ``jac_every``, ``atol_scale``).
+    """
+    sc = _as_scenario(scenario)
+    model = sc.clutch_model()
+    t, v = sc.input_table()
+    options.setdefault("rtol", sc.rtol)
+    if sc.input_kind == "bearing_position":
+        return ClutchDynamics(model, sc.friction).as_system((t, v), **options)
+    key = "voltage" if sc.input_kind == "voltage" else "bearing_reference"
+    return EClutch(sc.actuator, model, sc.friction).as_system({key: (t, v)}, **options)
+
+
+def simulate(scenario=None, t_end: float | None = None, *, rtol: float | None = None, atol=None,
+             max_step: float | None = None, output_step: float | None = None):
+    """Simulate an E-clutch scenario with the integrator core: the uniform entry point.
+
+    Parameters
+    ----------
+    scenario : Scenario, str, Path, dict or None
+        What to simulate: a :class:`Scenario`, a scenario TOML file (:func:`load_scenario`), its parsed
+        tables, an input mapping (``{"voltage": (times, volts)}``, ``{"bearing_reference": (times, m)}`` or
+        ``{"bearing_position": (times, m)}`` for the clutch alone; the default E-clutch, Model 4 with
+        friction), or None for the default scenario (pedal press and release).
+    t_end : float, optional
+        End time [s] (default: the scenario's).
+    rtol : float, optional
+        Relative tolerance (default: the scenario's, 1e-3).
+    atol : float or array_like, optional
+        Absolute tolerance per state in the state's unit (default: 0.1 um, 0.1 mm/s, 100 Pa, 1 mA, ...).
+    max_step : float, optional
+        Largest step [s] (default 0.01).
+    output_step : float, optional
+        Sample interval of the result [s] (dense output; default: the scenario's, else every accepted step).
+
+    Returns
+    -------
+    SimulationResult
+        States, outputs (``bearing_force_N``, ``torque_Nm``, ``motor_current_A``, ...), friction modes and
+        named events (``stick``, ``breakaway``, ``slip_reversal``, ``contact_open``, ``stop_hit``,
+        ``cavitation_start``, ...) with the element they concern.
+    """
+    from ..system import simulate as run
+
+    sc = _as_scenario(scenario)
+    t_end = sc.t_end if t_end is None else float(t_end)
+    if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):
+        raise ParameterError(f"t_end = {t_end!r} s must be finite and > 0")
+    system = scenario_system(sc)
+    step = sc.output_step if output_step is None else output_step
+    return run(system, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=step, max_steps=500_000)

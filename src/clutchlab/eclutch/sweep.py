@@ -7,8 +7,9 @@ scenario of :mod:`clutchlab.eclutch.scenario` with some parameters changed --
 (:class:`~clutchlab.eclutch.ActuatorParameters`, e.g. ``actuator.kp``,
 ``actuator.bulk_modulus``) and ``friction.<field>``
 (:class:`~clutchlab.eclutch.FrictionParameters`).  Variants that share the
-model structure run as one compiled ``prange`` batch
-(:func:`~clutchlab.eclutch.dynamics.simulate_batch`), one solver per variant.
+model structure run as one compiled ``prange`` batch of the system contract
+(:func:`clutchlab.system.simulate_batch` over
+:meth:`~clutchlab.eclutch.dynamics.EClutch.as_system`), one solver per variant.
 
 Outputs per variant:
 
@@ -35,9 +36,11 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ParameterError
+from ..numerics.status import Status
 from ..sweep.targets import check_outputs
+from ..system import simulate_batch
 from .actuator import ActuatorParameters
-from .dynamics import EClutch, FrictionParameters, simulate_batch
+from .dynamics import EClutch, FrictionParameters
 from .models import ClutchModel, EClutchParameters
 from .scenario import Scenario, scenario_from_dict
 
@@ -110,7 +113,13 @@ def check_variants(variants: pd.DataFrame, scenario) -> None:
         _variant(sc, row, vid)
 
 
-def _reduce(t, out: dict, k: int, position_mode: bool) -> dict:
+def _reduce(res, k: int, position_mode: bool) -> dict:
+    """The sweep outputs of variant ``k`` of a stacked :class:`~clutchlab.SimulationResult`."""
+    t = res.time
+    out = {name: res[name] for name in ("torque_Nm", "bearing_position_m", "bearing_force_N", "pressure_Pa",
+                                         "motor_current_A", "friction_dissipated_J", "input_work_J")}
+    if position_mode:
+        out["reference_m"] = res["reference_m"]
     tq = out["torque_Nm"][k]
     t0 = tq[0]
     rel = np.flatnonzero(tq < 0.05 * t0)
@@ -154,18 +163,16 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     t, v = sc.input_table()
     key = "voltage" if sc.input_kind == "voltage" else "bearing_reference"
     values = np.full((len(ecs), len(outputs)), np.nan)
-    # variants with the same structure run together (component curves may differ, e.g. support_max_force)
+    # variants with the same structure (state, output and mode layout) run together as one compiled batch
     groups: dict = {}
     for k, ec in enumerate(ecs):
-        s = ec.system
-        sig = (s.nz, s.cx.tobytes(), s.cf.tobytes(), s.fr_on.tobytes(), s.fr_nidx.tobytes(), s.fr_pidx.tobytes())
-        groups.setdefault(sig, []).append(k)
+        groups.setdefault(ec.assembly.signature(), []).append(k)
     for idx in groups.values():
-        res = simulate_batch([ecs[k] for k in idx], {key: (t, v)}, sc.t_end, output_step=sc.output_step,
-                             rtol=sc.rtol)
+        systems = [ecs[k].as_system({key: (t, v)}, rtol=sc.rtol) for k in idx]
+        res = simulate_batch(systems, sc.t_end, output_step=sc.output_step, max_steps=500_000)
         for j, k in enumerate(idx):
-            if res.stats["status"].iloc[j] != 0:
+            if not Status(int(res.status[j])).ok:
                 continue
-            got = _reduce(res.time, res.outputs, j, key == "bearing_reference")
+            got = _reduce(res, j, key == "bearing_reference")
             values[k] = [got[o] for o in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))

@@ -1,0 +1,985 @@
+"""The E-clutch dynamics as a system of the contract (:mod:`clutchlab.system`), implemented once.
+
+Actuator ([1] Sec. 2.1, Fig. 5a) plus clutch axial Model 0-4 ([1] Figs. 5b,
+10-11) with stick-slip friction: the parameters packed once into
+:class:`EClutchParams` (:meth:`Assembly.params`), the compiled hooks of
+:mod:`clutchlab.numerics.dispatch` registered for that class, and the
+:class:`~clutchlab.system.System` factory :meth:`Assembly.system`
+(registered as model ``"eclutch"``).  The integrator is the core's Rodas3
+(:func:`clutchlab.numerics.core.advance_rodas`) with the diagonal mass
+matrix of the massless network nodes (index-1 algebraic rows).  The
+equations are the scalar compiled functions of
+:mod:`clutchlab.eclutch.actuator`, :mod:`clutchlab.eclutch.network`,
+:mod:`clutchlab.eclutch.friction` and :mod:`clutchlab.eclutch.models`; the
+hooks here only assemble them and run the friction state machine.
+
+State vector (``nz = 2 + n_q`` generalised coordinates: master piston,
+CSC/bearing, then the network's free node coordinates)::
+
+    x[0:nz]        positions z [m]
+    x[nz:2nz]      velocities v [m/s]
+    x[2nz + 0..4]  p_m [Pa], Q [m^3/s], p_s [Pa], i [A], controller integral action V_I [V]
+    x[2nz + 5..7]  input work [J], dissipated energy [J], friction dissipation [J]
+
+Mass-matrix rows are 1 except the position rows of massless network nodes
+(0: algebraic force balance).  Modes: the friction mode per coordinate (the
+Modelica Standard Library's friction state machine [2]): ``free`` (no Coulomb
+friction), ``slip_forward``, ``stuck``, ``slip_backward``; then the active row
+of the input table (``input_segment``, switched at each table corner).  When the bearing
+motion is prescribed (:class:`~clutchlab.eclutch.dynamics.ClutchDynamics`),
+the actuator is not simulated: the bearing position follows the input table
+(its slope is integrated exactly and reset at every table corner) and the
+actuator states stay at rest.
+
+References
+----------
+.. [1] K. Haramina, N. Kranjčević, M. Hoić, J. Deur, A. Tissot, Trans. FAMENA
+   48 (2024) 21-35, doi:10.21278/TOF.483057923
+.. [2] M. Otter, H. Elmqvist, S. E. Mattsson, "Hybrid modeling in Modelica
+   based on the synchronous data flow principle", CACSD 1999.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..errors import ParameterError
+from ..numerics import dispatch
+from ..numerics.core import record
+from ..numerics.interp import bracket
+from ..system import System, register_model
+from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
+                       controller_voltage, current_rate, drive_voltage, line_flow_rate, spindle_force, stop_contact,
+                       vent_opening)
+from .friction import kinetic_level, slip_force, static_margin
+from .models import ClutchModel, torque_of_clamp_force
+from .network import GROUND, Lever, element_force, solve_static
+
+__all__ = ["EClutchParams", "Assembly", "eclutch_system", "rhs", "outputs", "update", "restart", "accept",
+           "next_break", "jacobian", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
+
+# actuator parameter vector layout (EClutchParams.par)
+P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF = range(13)
+P_R, P_L, P_KT, P_VSUP, P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX = range(13, 25)
+P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN, P_REFMAX = range(25, 33)
+N_PAR = 33
+
+#: input modes: motor voltage (held between table rows), bearing reference (position control), prescribed bearing
+VOLTAGE, POSITION, PRESCRIBED = 0, 1, 2
+#: friction modes of a coordinate
+FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = 0, 1, 2, 3
+MODE_VALUES = ("free", "slip_forward", "stuck", "slip_backward")
+#: event names by code (what the hooks record)
+EVENTS = ("stick", "breakaway", "slip_reversal", "contact_close", "contact_open", "stop_hit", "stop_leave",
+          "cavitation_start", "cavitation_end")
+EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_CONTACT_CLOSE, EV_CONTACT_OPEN, EV_STOP_HIT, EV_STOP_LEAVE = range(7)
+EV_CAVITATION_START, EV_CAVITATION_END = 7, 8
+#: the four end stops and the two chambers (elements of stop and cavitation events)
+STOPS = ("master_rest_stop", "master_stroke_end", "csc_engaged_stop", "csc_travel_end")
+CHAMBERS = ("master_chamber", "csc_chamber")
+#: switching functions after the friction coordinates and the network elements: end stops (4), cavitation (2),
+#: current limit (1), snifting-port edges (2) -- the last three are kinks located so no step straddles them
+OTHER_SWITCHING = STOPS + ("master_cavitation", "csc_cavitation", "current_limit", "snifting_port_closed",
+                           "snifting_port_open")
+N_OTHER = len(OTHER_SWITCHING)
+#: auxiliary values of the right-hand side: drive voltage, clutch bearing force, reference, bearing position,
+#: then the friction force of every coordinate
+N_AUX = 4
+
+
+# rows of the packed per-coordinate, per-element and scratch arrays of EClutchParams
+CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = range(6)  # coord [float]
+CI_FRICTION, CI_NORMAL, CI_PRESSURE = range(3)  # coord_int: Coulomb friction on, pressing element, chamber
+NE_D0, NE_GB, NE_SCALE = range(3)  # net [float]: pre-deflection, input gain, stiffness scale
+NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = range(4)  # net_int: curve offsets, kind, extrapolation, contact
+W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X = range(7)  # work rows
+
+
+class EClutchParams(NamedTuple):
+    """Packed parameters of one E-clutch run (:meth:`Assembly.params`; SI units).
+
+    Scalars and C-contiguous arrays only: numba specialises the core on this
+    class and caches it across processes.  Per-coordinate and per-element
+    quantities are rows of a few 2-D arrays (``CO_*``, ``CI_*``, ``NE_*``,
+    ``NI_*``): every compiled function that receives the structure unpacks
+    it, so few fields keep compile time and call overhead low.  ``work`` holds
+    the right-hand side's scratch rows (``W_*``): one structure per run or
+    batch variant.
+    """
+
+    nz: int                  # generalised coordinates (master, bearing, free nodes)
+    imode: int               # VOLTAGE, POSITION or PRESCRIBED
+    interp: int              # input table: 0 linear, 1 held between rows
+    tin: np.ndarray          # input table times [s] (empty: the held input u[0] is the input)
+    vin: np.ndarray          # input table values [V] or [m]
+    par: np.ndarray          # actuator parameters (P_* layout)
+    coord: np.ndarray        # (6, nz): mass [kg] (0: massless node), Coulomb [N], per normal force [-],
+    #                          per pressure [N/Pa], static ratio [-], viscous [N s/m]
+    coord_int: np.ndarray    # (3, nz): friction on (0/1), pressing element (-1 none), chamber (0 none, 1, 2)
+    friction_outputs: np.ndarray  # coordinates whose friction force is an output
+    GA: np.ndarray           # (n_el, n_q) network assembly (node-aligned coordinates)
+    net: np.ndarray          # (3, n_el): d0 [m], Gb [-], stiffness scale [-]
+    net_int: np.ndarray      # (4, n_el + 1): curve offsets, kinds, extrapolation, unilateral (0/1)
+    curve: np.ndarray        # (3, n_samples): deflections [m], forces [N], slopes [N/m] of all curves
+    normal_element: int      # element carrying the clamp (normal) force
+    r_eff: float             # effective friction radius [m]
+    mu: float                # friction coefficient of the facings [-]
+    work: np.ndarray         # (7, n): scratch rows W_*
+
+
+# ---------------------------------------------------------------- compiled hooks
+@numba.njit(cache=True, nogil=True, inline="always")
+def reference(t, u, tin, vin, interp, segment):
+    """Input value and its slope at ``t`` on the table row ``segment - 1`` (or the held input ``u[0]``).
+
+    The active row is a mode (``input_segment``, set by :func:`restart` at each corner), not looked up from
+    ``t``: the Rodas3 stages of a step that ends on a corner are evaluated at the corner itself and must see
+    the row the step integrates (a voltage step or a change of slope starts with the next step).
+    ``segment`` 0 is before the table, ``k`` the row ``k - 1`` up to the next corner; beyond the last row the
+    last value is held.
+    """
+    n = tin.shape[0]
+    if n == 0:
+        return u[0], 0.0
+    k = segment - 1
+    if k < 0:
+        return vin[0], 0.0
+    if k >= n - 1:
+        return vin[n - 1], 0.0
+    if interp == 1:
+        return vin[k], 0.0
+    slope = (vin[k + 1] - vin[k]) / (tin[k + 1] - tin[k])
+    return vin[k] + slope * (t - tin[k]), slope
+
+
+@numba.njit(cache=True, nogil=True)
+def _segment(t, tin):
+    """Mode ``input_segment`` at ``t``: 0 before the table, ``k + 1`` from row ``k`` on (right-continuous)."""
+    n = tin.shape[0]
+    if n == 0 or t < tin[0]:
+        return 0
+    lo, _w = bracket(tin, t) if n > 1 else (0, 0.0)
+    k = lo
+    while k + 1 < n and tin[k + 1] <= t:
+        k += 1
+    return k + 1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _friction_level(j, x, nz, f, coord, coord_int):
+    """Kinetic friction force F_c of coordinate ``j`` [N] (``f``: element forces of the current point)."""
+    k = coord_int[CI_NORMAL, j]
+    fnorm = f[k] if k >= 0 else 0.0
+    pres = 0.0
+    if coord_int[CI_PRESSURE, j] == 1:
+        pres = x[2 * nz]
+    elif coord_int[CI_PRESSURE, j] == 2:
+        pres = x[2 * nz + 2]
+    return kinetic_level(coord[CO_COULOMB, j], coord[CO_MU_NORMAL, j], fnorm, coord[CO_MU_PRESSURE, j], pres)
+
+
+@numba.njit(cache=True, nogil=True)
+def rhs(t, x, u, m, p, dx, g):
+    """Right-hand side (residual on the algebraic rows) and switching functions of the E-clutch."""
+    nz = p.nz
+    GA = p.GA
+    net = p.net
+    net_int = p.net_int
+    curve = p.curve
+    coord = p.coord
+    coord_int = p.coord_int
+    par = p.par
+    work = p.work
+    d0 = net[NE_D0]
+    Gb = net[NE_GB]
+    scale = net[NE_SCALE]
+    offsets = net_int[NI_OFFSETS]
+    kinds = net_int[NI_KINDS]
+    extraps = net_int[NI_EXTRAPS]
+    unilateral = net_int[NI_UNILATERAL]
+    cx = curve[0]
+    cf = curve[1]
+    cd = curve[2]
+    f = work[W_F]
+    free = work[W_FREE]
+    Fz = work[W_FZ]
+    aux = work[W_AUX]
+    nq = nz - 2
+    n_el = GA.shape[0]
+    b0 = 2 * nz
+    prescribed = p.imode == PRESCRIBED
+    x_mc = x[0]
+    v_mc = x[nz]
+    p_m = x[b0]
+    Q = x[b0 + 1]
+    p_s = x[b0 + 2]
+    cur = x[b0 + 3]
+    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
+    if prescribed:
+        ub = ref
+        v_u = ref_slope
+    else:
+        ub = x[1]
+        v_u = x[nz + 1]
+    # --- clutch network: element forces on the coordinates ([1] Figs. 5b, 10-11)
+    q = x[2:nz]
+    bearing_force = 0.0
+    for j in range(nz):
+        Fz[j] = 0.0
+    for e in range(n_el):
+        _d, fe, _k, fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
+        free[e] = fr
+        f[e] = fe
+        bearing_force += Gb[e] * fe
+        for j in range(nq):
+            Fz[2 + j] -= GA[e, j] * fe
+    Fz[1] -= bearing_force
+    # --- actuator ([1] Sec. 2.1, Fig. 5a; equations in clutchlab.eclutch.actuator)
+    v_drive = 0.0
+    dissip = 0.0
+    if not prescribed:
+        if p.imode == VOLTAGE:
+            r = ref
+            v_cmd = ref
+        else:
+            r = min(max(ref, par[P_REFMIN]), par[P_REFMAX])
+            v_cmd = controller_voltage(r, ub, x[b0 + 4], v_u, par[P_KP], par[P_KD])
+        v_drive = drive_voltage(v_cmd, cur, par[P_VSUP], par[P_IMAX], par[P_KIL])
+        dx[b0 + 3] = current_rate(v_drive, cur, v_mc / par[P_NS], par[P_R], par[P_L], par[P_KT])
+        if p.imode == POSITION:
+            dx[b0 + 4] = controller_integral_rate(r, ub, v_drive, v_cmd, par[P_KI], par[P_KAW])
+        else:
+            dx[b0 + 4] = 0.0
+        Fz[0] += spindle_force(cur, par[P_KT], par[P_NS]) - p_m * par[P_AMC]
+        q_vent = par[P_GV] * vent_opening(x_mc, par[P_XSN], par[P_WSN]) * p_m
+        cm = cavitating_compliance(p_m, par[P_CM], par[P_PCAV], par[P_CAVF])
+        cs = cavitating_compliance(p_s, par[P_CS], par[P_PCAV], par[P_CAVF])
+        dx[b0] = chamber_pressure_rate(par[P_AMC] * v_mc, Q + q_vent, cm)
+        dx[b0 + 1] = line_flow_rate(p_m, p_s, Q, par[P_LH], par[P_RH])
+        dx[b0 + 2] = chamber_pressure_rate(Q, par[P_ASL] * v_u, cs)
+        Fz[1] += p_s * par[P_ASL] + par[P_FPRE] - par[P_KPRE] * ub
+        dissip += par[P_R] * cur * cur + par[P_RH] * Q * Q + q_vent * p_m
+        # end stops: master at 0 and its stroke, CSC at its travel limits
+        ks = par[P_KSTOP]
+        cst = par[P_CSTOP]
+        fs, ds = stop_contact(-x_mc, -v_mc, ks, cst)
+        Fz[0] += fs
+        dissip += ds
+        fs, ds = stop_contact(x_mc - par[P_XMAX], v_mc, ks, cst)
+        Fz[0] -= fs
+        dissip += ds
+        fs, ds = stop_contact(par[P_UMIN] - ub, -v_u, ks, cst)
+        Fz[1] += fs
+        dissip += ds
+        fs, ds = stop_contact(ub - par[P_UMAX], v_u, ks, cst)
+        Fz[1] -= fs
+        dissip += ds
+        dx[b0 + 5] = v_drive * cur
+    else:
+        for k in range(5):
+            dx[b0 + k] = 0.0
+        dx[b0 + 5] = bearing_force * v_u  # mechanical work done on the clutch at the bearing
+    # --- coordinates: kinematics, friction state machine, force balance
+    fric_dissip = 0.0
+    for j in range(nz):
+        vj = x[nz + j]
+        if coord_int[CI_FRICTION, j]:
+            level = _friction_level(j, x, nz, f, coord, coord_int)
+            if m[j] == STUCK:
+                g[j] = static_margin(coord[CO_STATIC_RATIO, j], level, Fz[j])
+                frc = -Fz[j]
+            else:
+                g[j] = vj
+                frc = slip_force(1.0 if m[j] == SLIP_FORWARD else -1.0, level, coord[CO_VISCOUS, j], vj)
+        else:
+            g[j] = 1.0
+            frc = slip_force(0.0, 0.0, coord[CO_VISCOUS, j], vj)
+        aux[N_AUX + j] = frc
+        mass = coord[CO_MASS, j]
+        if prescribed and j < 2:
+            # the actuator is not simulated; the bearing follows the prescribed motion
+            dx[j] = v_u if j == 1 else 0.0
+            dx[nz + j] = 0.0
+        elif mass > 0.0:
+            if coord_int[CI_FRICTION, j] and m[j] == STUCK:
+                dx[j] = 0.0
+                dx[nz + j] = 0.0
+            else:
+                dx[j] = vj
+                dx[nz + j] = (Fz[j] + frc) / mass
+                fric_dissip -= frc * vj
+        else:
+            dx[j] = Fz[j]  # algebraic: massless node in equilibrium
+            dx[nz + j] = -vj
+    dx[b0 + 6] = dissip + fric_dissip
+    dx[b0 + 7] = fric_dissip
+    # --- other switching functions: contacts of unilateral elements, end stops, kinks
+    for e in range(n_el):
+        g[nz + e] = free[e] if unilateral[e] else 1.0
+    ne = nz + n_el
+    if not prescribed:
+        g[ne] = x_mc
+        g[ne + 1] = par[P_XMAX] - x_mc
+        g[ne + 2] = ub - par[P_UMIN]
+        g[ne + 3] = par[P_UMAX] - ub
+        g[ne + 4] = p_m - par[P_PCAV]
+        g[ne + 5] = p_s - par[P_PCAV]
+        g[ne + 6] = par[P_IMAX] - abs(cur)
+        g[ne + 7] = x_mc - par[P_XSN]
+        g[ne + 8] = x_mc - (par[P_XSN] - par[P_WSN])
+    else:
+        for k in range(N_OTHER):
+            g[ne + k] = 1.0
+    aux[0] = v_drive
+    aux[1] = bearing_force
+    aux[2] = ref
+    aux[3] = ub
+
+
+@numba.njit(cache=True, nogil=True)
+def _equilibrate(x, ub, p):
+    """Massless nodes of ``x`` moved into equilibrium (Newton on their force balance, in place).
+
+    The state at a sample comes from the dense output of a step, which is linear in the algebraic rows and
+    cubic in the others; the stiff release bearing turns that small mismatch into a force error.  The
+    outputs are therefore evaluated with the massless nodes re-solved for the interpolated positions.
+    """
+    nz = p.nz
+    GA = p.GA
+    net = p.net
+    net_int = p.net_int
+    curve = p.curve
+    coord = p.coord
+    Gb = net[NE_GB]
+    d0 = net[NE_D0]
+    scale = net[NE_SCALE]
+    offsets = net_int[NI_OFFSETS]
+    kinds = net_int[NI_KINDS]
+    extraps = net_int[NI_EXTRAPS]
+    unilateral = net_int[NI_UNILATERAL]
+    cx = curve[0]
+    cf = curve[1]
+    cd = curve[2]
+    q = x[2:nz]
+    for _it in range(8):
+        worst = 0.0
+        for j in range(2, nz):
+            if coord[CO_MASS, j] > 0.0:
+                continue
+            r = 0.0
+            dr = 0.0
+            for e in range(GA.shape[0]):
+                if GA[e, j - 2] == 0.0:
+                    continue
+                _d, fe, ke, _fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
+                                                unilateral)
+                r -= GA[e, j - 2] * fe
+                dr -= GA[e, j - 2] * GA[e, j - 2] * ke
+            if dr != 0.0:
+                dq = r / dr
+                x[j] -= dq
+                worst = max(worst, abs(dq))
+        if worst <= 1e-14:  # [m]
+            break
+
+
+@numba.njit(cache=True, nogil=True)
+def outputs(t, x, u, m, p, y):
+    """Outputs (see :meth:`Assembly.output_variables`) at one point (massless nodes in equilibrium)."""
+    nz = p.nz
+    work = p.work
+    xs = work[W_X]
+    for i in range(x.shape[0]):
+        xs[i] = x[i]
+    if p.imode == PRESCRIBED:
+        ub, _slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
+    else:
+        ub = x[1]
+    _equilibrate(xs, ub, p)
+    dispatch.rhs(t, xs, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
+    aux = work[W_AUX]
+    f = work[W_F]
+    n_el = p.GA.shape[0]
+    fn = f[p.normal_element]
+    y[0] = aux[0]
+    y[1] = xs[2 * nz + 2] * p.par[P_ASL]  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
+    y[2] = aux[1]
+    y[3] = fn
+    y[4] = torque_of_clamp_force(fn, p.r_eff, p.mu)
+    y[5] = xs[nz] / p.par[P_NS] * 60.0 / (2.0 * math.pi)
+    y[6] = aux[2]
+    for e in range(n_el):
+        y[7 + e] = f[e]
+    fo = p.friction_outputs
+    for k in range(fo.shape[0]):
+        y[7 + n_el + k] = aux[N_AUX + fo[k]]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _slip_mode(force):
+    return SLIP_FORWARD if force > 0.0 else SLIP_BACKWARD
+
+
+@numba.njit(cache=True, nogil=True)
+def update(t, x, u, m, p, k, log):
+    """The friction state machine and the named events when switching function ``k`` crossed zero."""
+    nz = p.nz
+    n_el = p.GA.shape[0]
+    work = p.work
+    dispatch.rhs(t, x, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
+    if k < nz:
+        j = k
+        if not p.coord_int[CI_FRICTION, j]:
+            return 0
+        force = work[W_FZ, j]
+        if m[j] == STUCK:
+            # break-away: slip in the direction of the applied force, exactly at rest (no spurious reversal)
+            m[j] = _slip_mode(force)
+            x[nz + j] = 0.0
+            kind = EV_BREAKAWAY
+        elif static_margin(p.coord[CO_STATIC_RATIO, j],
+                           _friction_level(j, x, nz, work[W_F], p.coord, p.coord_int), force) >= 0.0:
+            m[j] = STUCK
+            x[nz + j] = 0.0
+            kind = EV_STICK
+        else:
+            m[j] = _slip_mode(force)
+            kind = EV_REVERSAL
+        record(log, t, kind, j)
+        return 0
+    gk = work[W_G, k]
+    if k < nz + n_el:
+        record(log, t, EV_CONTACT_OPEN if gk <= 0.0 else EV_CONTACT_CLOSE, k - nz)
+        return 0
+    s = k - nz - n_el
+    if s < 4:
+        record(log, t, EV_STOP_HIT if gk <= 0.0 else EV_STOP_LEAVE, s)
+    elif s < 6:
+        record(log, t, EV_CAVITATION_START if gk <= 0.0 else EV_CAVITATION_END, s - 4)
+    return 0  # current limit and snifting-port edges: kinks, no event
+
+
+@numba.njit(cache=True, nogil=True)
+def restart(t, x, u, m, p, log):
+    """Make the friction modes consistent with the forces at a (re)start or an input corner.
+
+    A stuck coordinate whose needed force exceeds the static limit breaks away; a coordinate slipping
+    from exactly zero velocity against its force sticks or turns round.  With a prescribed bearing
+    motion the bearing position and velocity are set to the table's.
+    """
+    nz = p.nz
+    work = p.work
+    coord = p.coord
+    coord_int = p.coord_int
+    changed = False
+    seg = _segment(t, p.tin)
+    if m[nz] != seg:
+        m[nz] = seg
+        changed = True
+    if p.imode == PRESCRIBED:
+        ref, slope = reference(t, u, p.tin, p.vin, p.interp, seg)
+        if x[1] != ref or x[nz + 1] != slope:
+            x[1] = ref
+            x[nz + 1] = slope
+            changed = True
+    dispatch.rhs(t, x, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
+    for j in range(nz):
+        if not coord_int[CI_FRICTION, j] or coord[CO_MASS, j] <= 0.0:
+            continue
+        force = work[W_FZ, j]
+        level = _friction_level(j, x, nz, work[W_F], coord, coord_int)
+        kind = -1
+        if m[j] == STUCK:
+            if static_margin(coord[CO_STATIC_RATIO, j], level, force) < 0.0:
+                m[j] = _slip_mode(force)
+                x[nz + j] = 0.0
+                kind = EV_BREAKAWAY
+        elif x[nz + j] == 0.0:
+            s = 1.0 if m[j] == SLIP_FORWARD else -1.0
+            if (force - s * level) * s < 0.0:  # would accelerate against its slip direction
+                if static_margin(coord[CO_STATIC_RATIO, j], level, force) >= 0.0:
+                    m[j] = STUCK
+                    kind = EV_STICK
+                else:
+                    m[j] = _slip_mode(force)
+                    kind = EV_REVERSAL
+        if kind >= 0:
+            changed = True
+            record(log, t, kind, j)
+    return changed
+
+
+@numba.njit(cache=True, nogil=True)
+def accept(t, x, u, m, p):
+    """After an accepted step: stuck coordinates have exactly zero velocity; 1 if a velocity was reset."""
+    nz = p.nz
+    changed = 0
+    for j in range(nz):
+        if m[j] == STUCK and x[nz + j] != 0.0:
+            x[nz + j] = 0.0
+            changed = 1
+    return changed
+
+
+@numba.njit(cache=True, nogil=True)
+def next_break(t, m, p):
+    """Next corner of the input table after ``t`` (the integrator never steps across one) [s]."""
+    tin = p.tin
+    k = m[p.nz]  # the next corner is row k (the active one is k - 1)
+    while k < tin.shape[0] and tin[k] <= t:
+        k += 1
+    return tin[k] if k < tin.shape[0] else np.inf
+
+
+@numba.njit(cache=True, nogil=True)
+def jacobian(t, x, u, m, p, J):
+    """No analytic Jacobian: the core differences the right-hand side (kink-aware)."""
+    return False
+
+
+dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restart=restart, accept=accept,
+                  next_break=next_break, jacobian=jacobian)
+
+
+# ---------------------------------------------------------------- packing and the System
+def _node_aligned(network) -> dict:
+    """Coordinates aligned with nodes: ``x = A q + b u + c`` with ``q`` = positions of the independent nodes.
+
+    The input node and, for every rigid lever, one massless node are the
+    dependent ones, so each mass (and each friction element) sits on one
+    coordinate of its own and the mass matrix is diagonal.
+    """
+    a = network._assembly
+    names = list(a["node_names"])
+    idx = {n: i for i, n in enumerate(names)}
+    mass = np.array([n.mass for n in network.nodes])
+    G = a["G"]
+    prestrain = a["d0"] - G @ a["c"]
+    N = len(names)
+    rows, ru, rc, dep = [], [], [], []
+    r = np.zeros(N)
+    r[idx[network.input]] = 1.0
+    rows.append(r), ru.append(1.0), rc.append(0.0), dep.append(idx[network.input])
+    for e in network.elements:
+        if isinstance(e, Lever) and e.rigid:
+            g = np.zeros(N)
+            for node, coef in e.coefficients().items():
+                if node != GROUND:
+                    g[idx[node]] += coef
+            cands = [i for i in np.flatnonzero(g) if i not in dep]
+            cands.sort(key=lambda i: (mass[i] > 0, -abs(g[i])))
+            if not cands:
+                raise ParameterError(f"{network.name}: rigid lever {e.name!r} over-constrains the nodes")
+            if mass[cands[0]] > 0:
+                raise ParameterError(
+                    f"{network.name}: rigid lever {e.name!r} ties two masses together; give one of its nodes zero mass")
+            rows.append(g), ru.append(0.0), rc.append(-e.prestrain), dep.append(cands[0])
+    C = np.array(rows)
+    ind = [i for i in range(N) if i not in dep]
+    CD = C[:, dep]
+    CI = C[:, ind]
+    inv = np.linalg.inv(CD)
+    A = np.zeros((N, len(ind)))
+    b = np.zeros(N)
+    c = np.zeros(N)
+    for k, i in enumerate(ind):
+        A[i, k] = 1.0
+    A[dep, :] = -inv @ CI
+    b[dep] = inv @ np.array(ru)
+    c[dep] = inv @ np.array(rc)
+    GA = G @ A
+    return dict(
+        names=names, independent=[names[i] for i in ind], A=A, b=b, c=c,
+        GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), d0=np.ascontiguousarray(prestrain + G @ c),
+        mass=mass[ind].astype(float), elements=list(a["element_names"]),
+    )
+
+
+def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
+    par = np.zeros(N_PAR)
+    par[P_AMC] = a.master_area
+    par[P_ASL] = a.slave_area
+    par[P_MMC] = a.master_equivalent_mass
+    par[P_MSL] = a.slave_mass
+    par[P_CM] = a.master_compliance
+    par[P_CS] = a.slave_compliance
+    par[P_LH] = a.line_inertance
+    par[P_RH] = a.line_resistance
+    par[P_GV] = a.snifting_conductance
+    par[P_XSN] = a.snifting_port + a.snifting_width
+    par[P_WSN] = a.snifting_width
+    par[P_PCAV] = a.vapour_pressure
+    par[P_CAVF] = 1e3
+    par[P_R] = a.resistance
+    par[P_L] = a.inductance
+    par[P_KT] = a.torque_constant
+    par[P_VSUP] = a.supply_voltage
+    par[P_IMAX] = a.current_limit
+    par[P_KIL] = a.current_limit_gain
+    par[P_NS] = a.spindle_ratio
+    par[P_FPRE] = a.csc_preload
+    par[P_KPRE] = a.csc_spring_rate
+    par[P_UMIN] = a.slave_min
+    par[P_UMAX] = a.slave_max
+    par[P_XMAX] = a.master_stroke
+    par[P_KSTOP] = a.stop_stiffness
+    par[P_CSTOP] = a.stop_damping
+    par[P_KP] = a.kp
+    par[P_KI] = a.ki
+    par[P_KD] = a.kd
+    par[P_KAW] = a.anti_windup
+    par[P_REFMIN] = a.slave_min
+    par[P_REFMAX] = a.slave_max
+    return par
+
+
+class Assembly:
+    """One E-clutch structure (clutch network + actuator + friction placement), packed for the compiled hooks.
+
+    The only place the E-clutch's parameters are packed: :meth:`params` builds the
+    :class:`EClutchParams` of a run, :meth:`system` the :class:`~clutchlab.system.System`.
+
+    Parameters
+    ----------
+    model : ClutchModel
+        Axial Model 0-4 or a variant.
+    actuator : ActuatorParameters or None
+        The actuator (None with a prescribed bearing: the defaults fill the unused fields).
+    friction : list of FrictionElement
+        Friction elements (clutch and actuator).
+    prescribed : bool
+        Bearing motion prescribed (the actuator is not simulated).
+    """
+
+    def __init__(self, model: ClutchModel, actuator: ActuatorParameters | None, friction, prescribed: bool):
+        if not isinstance(model, ClutchModel):
+            raise ParameterError(f"expected a ClutchModel, got {type(model).__name__}")
+        self.model = model
+        self.actuator = actuator
+        self.prescribed = prescribed
+        self._initial = {}  # bearing position -> static initial state and modes
+        net = model.network
+        asm = _node_aligned(net)
+        self.asm = asm
+        self.nq = len(asm["independent"])
+        self.nz = 2 + self.nq
+        self.coord_names = ["master", "bearing"] + asm["independent"]
+        kd = net.kernel_data()
+        # curve data come from the network's own assembly (same element order)
+        self.cx, self.cf, self.cd, self.offsets, self.kinds, self.extraps = kd[3], kd[4], kd[5], kd[6], kd[7], kd[8]
+        self.scale = np.ascontiguousarray(kd[9], dtype=float)
+        self.unilateral = np.ascontiguousarray(kd[10], dtype=np.bool_)
+        self.element_names = asm["elements"]
+        act = actuator or ActuatorParameters()
+        mass = np.zeros(self.nz)
+        mass[0] = act.master_equivalent_mass
+        mass[1] = act.slave_mass
+        mass[2:] = asm["mass"]
+        self.mass = mass
+        n = 2 * self.nz + 8
+        self.n = n
+        mvec = np.ones(n)
+        for j in range(2, self.nz):
+            if mass[j] == 0.0:
+                mvec[j] = 0.0
+        self.mvec = mvec
+        self.par = _actuator_vector(act)
+        self._friction(list(friction))
+        ki = act.ki if act.ki > 0 else 1.0  # the integral state is the integral action K_i * int(e) [V]
+        b0 = 2 * self.nz
+        typ = np.empty(n)
+        typ[: self.nz] = 1e-3
+        typ[self.nz: b0] = 1e-2
+        typ[b0: b0 + 8] = [1e5, 1e-6, 1e5, 1.0, 1e-4 * ki, 1.0, 1.0, 1.0]
+        self.typ = typ
+        atol = np.empty(n)
+        atol[: self.nz] = 1e-8
+        atol[self.nz: b0] = 1e-5
+        atol[b0: b0 + 8] = [10.0, 1e-10, 10.0, 1e-4, 1e-9 * ki, 1e-6, 1e-6, 1e-6]
+        if not prescribed:
+            # with the actuator: 0.1 um, 0.1 mm/s, 100 Pa, 1 mA, ... (far below what a rig resolves; tighter
+            # values only resolve stick-slip micro-motions of the seals, see docs/eclutch_dynamics.md)
+            atol[: b0 + 5] *= 10.0
+        self.atol = atol
+        nf = net.normal_force
+        self.normal_element = self.element_names.index(nf)
+        self.friction_outputs = np.array([j for j in range(self.nz) if self.fr_on[j] or self.fr_c[j] > 0],
+                                         dtype=np.int64)
+
+    def _friction(self, elements):
+        from .dynamics import FrictionElement
+
+        nz = self.nz
+        self.fr_on = np.zeros(nz, dtype=np.bool_)
+        self.fr_c0 = np.zeros(nz)
+        self.fr_mun = np.zeros(nz)
+        self.fr_nidx = -np.ones(nz, dtype=np.int64)
+        self.fr_mup = np.zeros(nz)
+        self.fr_pidx = np.zeros(nz, dtype=np.int64)
+        self.fr_rs = np.ones(nz)
+        self.fr_c = np.zeros(nz)
+        self.friction_names = [""] * nz
+        for el in elements:
+            if not isinstance(el, FrictionElement):
+                raise ParameterError(f"friction elements must be FrictionElement, got {type(el).__name__}")
+            if el.node not in self.coord_names:
+                raise ParameterError(
+                    f"friction element {el.name!r}: node {el.node!r} is not a free coordinate "
+                    f"(free: {self.coord_names})")
+            j = self.coord_names.index(el.node)
+            if self.prescribed and j < 2:
+                continue  # the actuator is not simulated
+            if self.mass[j] <= 0.0:
+                raise ParameterError(f"friction element {el.name!r} acts on massless node {el.node!r}; give it a mass")
+            self.fr_c[j] += el.viscous
+            if not el.active:
+                continue
+            if self.fr_on[j]:
+                # several elements on one coordinate: they stick and slip together
+                if el.normal is not None and self.fr_nidx[j] >= 0:
+                    raise ParameterError(f"node {el.node!r}: only one normal-force element per node is supported")
+            self.fr_on[j] = True
+            self.fr_c0[j] += el.coulomb
+            if el.normal is not None:
+                if el.normal not in self.element_names:
+                    raise ParameterError(f"friction element {el.name!r}: normal = {el.normal!r} is not an elastic "
+                                         f"element of {self.model.name} ({self.element_names})")
+                self.fr_nidx[j] = self.element_names.index(el.normal)
+                self.fr_mun[j] = el.coefficient
+            if el.pressure is not None:
+                self.fr_pidx[j] = 1 if el.pressure == "master" else 2
+                self.fr_mup[j] = el.pressure_coefficient
+            self.fr_rs[j] = max(self.fr_rs[j], el.static_ratio)
+            self.friction_names[j] = (self.friction_names[j] + "+" if self.friction_names[j] else "") + el.name
+
+    # ------------------------------------------------------------ names
+    def state_variables(self) -> tuple:
+        """Named states with units (order of the state vector)."""
+        pos = [("master_position", "m", "master piston position"),
+               ("bearing_position", "m", "release bearing (CSC piston) position")]
+        vel = [("master_velocity", "m_s", "master piston velocity"),
+               ("bearing_velocity", "m_s", "release bearing velocity")]
+        for node in self.asm["independent"]:
+            pos.append((f"x_{node}", "m", f"position of network node {node}"))
+            vel.append((f"v_{node}", "m_s", f"velocity of network node {node}"))
+        return tuple(pos + vel + [
+            ("master_pressure", "Pa", "master chamber pressure p_m (gauge)"),
+            ("line_flow", "m3_s", "flow Q in the hydraulic line"),
+            ("pressure", "Pa", "CSC chamber pressure p_s (gauge)"),
+            ("motor_current", "A", "motor current i"),
+            ("controller_integral", "V", "integral action of the position controller"),
+            ("input_work", "J", "electrical energy into the motor (mechanical at the bearing if prescribed)"),
+            ("dissipated", "J", "energy dissipated (resistances, vent, end stops, friction)"),
+            ("friction_dissipated", "J", "energy dissipated by the friction elements"),
+        ])
+
+    def output_variables(self, imode: int) -> tuple:
+        """Named outputs with units (order of the output vector)."""
+        ref = {VOLTAGE: ("voltage_command", "V", "motor voltage commanded (input)"),
+               POSITION: ("reference", "m", "bearing position reference (input)"),
+               PRESCRIBED: ("prescribed_position", "m", "prescribed bearing position (input)")}[imode]
+        out = [("motor_voltage", "V", "voltage the drive applies (after saturation and current limit)"),
+               ("bearing_force", "N", "bearing force from the CSC pressure, p A_sl"),
+               ("bearing_force_clutch", "N", "force the clutch exerts on the release bearing"),
+               ("normal_force", "N", "clamp force on the friction plate F_n"),
+               ("torque", "Nm", "transmissible clutch torque 2 F_n r_eff mu"),
+               ("motor_speed", "rpm", "motor speed"),
+               ref]
+        out += [(f"force_{e}", "N", f"force of network element {e}") for e in self.element_names]
+        out += [(f"friction_{self.coord_names[j]}", "N", f"friction force on {self.coord_names[j]}")
+                for j in self.friction_outputs]
+        return tuple(out)
+
+    def switching(self) -> tuple:
+        """Switching functions (name, direction) in the order of the right-hand side."""
+        return (tuple((f"friction_{c}", 0) for c in self.coord_names)
+                + tuple((f"contact_{e}", 0) for e in self.element_names)
+                + tuple((s, 0) for s in OTHER_SWITCHING))
+
+    def element_name(self, code: int, index: int) -> str:
+        """Which element an event concerns: the friction coordinate, network element, end stop or chamber."""
+        if code in (EV_STICK, EV_BREAKAWAY, EV_REVERSAL):
+            return self.coord_names[index]
+        if code in (EV_CONTACT_OPEN, EV_CONTACT_CLOSE):
+            return self.element_names[index]
+        if code in (EV_CAVITATION_START, EV_CAVITATION_END):
+            return CHAMBERS[index]
+        return STOPS[index]
+
+    def signature(self) -> tuple:
+        """What variants of one batch must share: the state, output and mode layout."""
+        return (self.nz, tuple(self.coord_names), tuple(self.element_names), self.friction_outputs.tobytes())
+
+    # ------------------------------------------------------------ initial state
+    def initial_state(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
+        """Static equilibrium at bearing position ``u0`` with the actuator at rest; initial friction modes."""
+        cached = self._initial.get(float(u0))
+        if cached is not None:
+            return cached[0].copy(), cached[1].copy()
+        st = solve_static(self.model.network, np.array([u0]))
+        X = st["node_positions"][0]
+        names = st["node_names"]
+        y = np.zeros(self.n)
+        y[1] = u0
+        for k, node in enumerate(self.asm["independent"]):
+            y[2 + k] = X[names.index(node)]
+        modes = np.zeros(self.nz, dtype=np.int64)
+        modes[self.fr_on] = STUCK  # at rest: stuck; the state machine breaks away if the force exceeds the limit
+        self._initial[float(u0)] = (y, modes)
+        return y.copy(), modes.copy()
+
+    def rest_position(self) -> float:
+        """Bearing position at rest [m]: the CSC preload spring balances the clutch's bearing force.
+
+        With the bundled parameters this is 0 (the bearing origin is set at the
+        CSC preload); wear and thermal offsets or another preload move it.
+
+        Raises
+        ------
+        ParameterError
+            If no stable rest position lies within the CSC travel (e.g. a CSC
+            preload above the clutch's bearing force everywhere: the clutch
+            could not stay engaged).
+        """
+        a = self.actuator
+        lo, hi = a.slave_min, a.slave_max
+
+        def g(u):
+            return a.csc_preload - a.csc_spring_rate * u - float(solve_static(self.model.network, [u])["input_force"][0])
+
+        if abs(g(0.0)) < 1e-9:
+            return 0.0
+        grid = np.concatenate([np.linspace(0.0, hi, 201), np.linspace(0.0, lo, 41)[1:]])
+        up = solve_static(self.model.network, grid[:201])["input_force"]
+        down = solve_static(self.model.network, grid[201:])["input_force"] if lo < 0 else np.empty(0)
+        gu = a.csc_preload - a.csc_spring_rate * grid[:201] - up
+        gd = a.csc_preload - a.csc_spring_rate * grid[201:] - down
+        from scipy.optimize import brentq
+
+        if gu[0] > 0:  # pushed towards release: first stable root (g from + to -) going up
+            k = np.flatnonzero((gu[:-1] > 0) & (gu[1:] <= 0))
+            if k.size:
+                return float(brentq(g, grid[k[0]], grid[k[0] + 1], xtol=1e-13))
+        else:  # pulled towards the engaged side
+            uu = np.concatenate([[0.0], grid[201:]])
+            gg = np.concatenate([[gu[0]], gd])
+            k = np.flatnonzero((gg[:-1] <= 0) & (gg[1:] > 0))
+            if k.size:
+                return float(brentq(g, uu[k[0] + 1], uu[k[0]], xtol=1e-13))
+        raise ParameterError(
+            f"inconsistent parameters: with csc_preload = {a.csc_preload!r} N the CSC finds no rest position within "
+            f"its travel [{lo:g}, {hi:g}] m (the clutch's bearing force at position 0 is {a.csc_preload - g(0.0):.4g} N; "
+            "EClutchParameters.bearing_preload and ActuatorParameters.csc_preload should match)")
+
+    # ------------------------------------------------------------ packing
+    def params(self, imode: int, tin, vin, interp: int) -> EClutchParams:
+        """The packed parameters of one run (fresh scratch arrays: one per run or batch variant).
+
+        Parameters
+        ----------
+        imode : int
+            :data:`VOLTAGE`, :data:`POSITION` or :data:`PRESCRIBED`.
+        tin, vin : array_like
+            Input table: times [s] and values [V or m]; empty: the held input ``u[0]`` is the input.
+        interp : int
+            0 linear between rows, 1 held.
+        """
+        a = self.asm
+        n_el = len(self.element_names)
+        f64 = lambda v: np.ascontiguousarray(v, dtype=np.float64)  # noqa: E731
+        coord = f64(np.stack([self.mass, self.fr_c0, self.fr_mun, self.fr_mup, self.fr_rs, self.fr_c]))
+        coord_int = np.ascontiguousarray(np.stack([self.fr_on.astype(np.int64), self.fr_nidx, self.fr_pidx]),
+                                         dtype=np.int64)
+        net = f64(np.stack([a["d0"], a["Gb"], self.scale]))
+        net_int = np.zeros((4, n_el + 1), dtype=np.int64)
+        net_int[NI_OFFSETS] = self.offsets
+        net_int[NI_KINDS, :n_el] = self.kinds
+        net_int[NI_EXTRAPS, :n_el] = self.extraps
+        net_int[NI_UNILATERAL, :n_el] = self.unilateral
+        curve = f64(np.stack([self.cx, self.cf, self.cd]))
+        width = max(self.n, len(self.switching()), N_AUX + self.nz)
+        return EClutchParams(
+            int(self.nz), int(imode), int(interp), f64(tin), f64(vin), f64(self.par), coord, coord_int,
+            np.ascontiguousarray(self.friction_outputs, dtype=np.int64), f64(a["GA"]), net, net_int, curve,
+            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((7, width)))
+
+    def system(self, imode: int, tin, vin, interp: int, u0: float, *, held_input: bool = False,
+               rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8, jac_every: int = 10,
+               atol_scale: float = 1.0, first_step: float = 1e-5) -> System:
+        """The :class:`~clutchlab.system.System` of one run.
+
+        Parameters
+        ----------
+        imode : int
+            :data:`VOLTAGE`, :data:`POSITION` or :data:`PRESCRIBED`.
+        tin, vin : ndarray
+            Input table (times [s], values [V or m]); ignored with ``held_input``.
+        interp : int
+            0 linear between rows, 1 held.
+        u0 : float
+            Bearing position at the start [m] (static equilibrium of the clutch there).
+        held_input : bool
+            The input is the system's held input ``u[0]`` (co-simulation), not a table; its start value is
+            ``vin[0]``.
+        rtol, max_step, event_tol, first_step : float
+            Defaults of the run: relative tolerance, largest step [s], event bracket [s], first step [s].
+        jac_every : int
+            Accepted steps a finite-difference Jacobian is kept.
+        atol_scale : float
+            Factor on the default absolute tolerances.
+        """
+        if not (np.isfinite(atol_scale) and atol_scale > 0):
+            raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
+        tin = np.asarray(tin, dtype=float)
+        vin = np.asarray(vin, dtype=float)
+        x0, m0 = self.initial_state(u0)
+        name = {VOLTAGE: ("motor_voltage", "V"), POSITION: ("bearing_reference", "m"),
+                PRESCRIBED: ("bearing_position", "m")}[imode]
+        if held_input:
+            inputs, u_start = (name,), np.array([float(vin[0])])
+            params = self.params(imode, np.empty(0), np.empty(0), interp)
+            nonauto = False
+            segments = ("held input",)
+        else:
+            inputs, u_start = (), None
+            params = self.params(imode, tin, vin, interp)
+            # inputs that vary inside a step: a linear table (position reference, prescribed motion)
+            nonauto = tin.size > 1 and (imode != VOLTAGE or interp == 0)
+            segments = ("before the table",) + tuple(f"row {k} ({t:g} s)" for k, t in enumerate(tin))
+        # the active row of the input table is a mode (see reference()); restart() sets it at t0
+        m0 = np.append(m0, 0 if held_input else int(np.searchsorted(tin, 0.0, side="right")))
+        n_jac = 2 * self.nz + 5  # the energy states enter no equation
+        return System(
+            name="eclutch" if not self.prescribed else "eclutch_clutch", params=params,
+            states=self.state_variables(), outputs=self.output_variables(imode), x0=x0, m0=m0,
+            atol=self.atol * atol_scale, switching=self.switching(), events=EVENTS,
+            mode_names=tuple(f"friction_mode_{c}" for c in self.coord_names) + ("input_segment",),
+            mode_values=tuple(MODE_VALUES for _ in self.coord_names) + (segments,), inputs=inputs, u0=u_start, method="rodas",
+            mass=self.mvec, jac_cols=np.arange(n_jac), fd_scale=self.typ, nonautonomous=bool(nonauto),
+            jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
+            event_tol=float(event_tol), element_name=self.element_name,
+        )
+
+
+def eclutch_system(scenario=None, **options) -> System:
+    """The :class:`~clutchlab.system.System` of an E-clutch scenario (the factory registered as ``"eclutch"``).
+
+    Parameters
+    ----------
+    scenario : Scenario, str, Path or None
+        A :class:`~clutchlab.eclutch.scenario.Scenario`, a scenario TOML file, or None for the default
+        scenario (pedal press and release, Model 4, friction on).
+    **options
+        Run defaults passed to :meth:`Assembly.system` (``max_step``, ``event_tol``, ``jac_every``,
+        ``atol_scale``).
+    """
+    from .scenario import scenario_system
+
+    return scenario_system(scenario, **options)
+
+
+register_model("eclutch", eclutch_system)

@@ -1,0 +1,123 @@
+"""The E-clutch on the system contract: one entry point, one result, named events, equations written once."""
+
+import numpy as np
+import pytest
+
+from clutchlab.result import SimulationResult
+from clutchlab import system as contract
+from clutchlab.eclutch import ClutchDynamics, ClutchModel, EClutch, FrictionParameters, Scenario, simulate
+from clutchlab.eclutch.actuator import current_rate, motor_current_derivative, snifting_opening, vent_opening
+from clutchlab.eclutch.models import clutch_torque, torque_of_clamp_force
+from clutchlab.eclutch.system import EVENTS, MODE_VALUES
+from clutchlab.errors import ParameterError
+from clutchlab.units import column_unit
+
+PEDAL = {"bearing_reference": ([0.0, 0.1, 0.3, 0.6, 0.8], [0.0, 0.0, 7e-3, 7e-3, 0.0])}
+
+
+def test_simulate_returns_a_simulation_result_with_units_and_named_events():
+    res = simulate(Scenario(t_end=1.0), output_step=1e-3)
+    assert isinstance(res, SimulationResult) and res.ok and res.model == "eclutch"
+    assert res.time.size == 1001 and res.time[-1] == pytest.approx(1.0)
+    frame = res.to_dataframe()
+    for col in ("time_s", "bearing_position_m", "pressure_Pa", "motor_current_A", "controller_integral_V",
+                "line_flow_m3_s", "bearing_force_N", "torque_Nm", "motor_speed_rpm", "force_cushion_N",
+                "friction_pp_N"):
+        assert col in frame.columns, col
+    for col in res.state_columns + res.output_columns:
+        assert column_unit(col) is not None, col  # every column states its unit
+    assert set(frame["friction_mode_pp"]) <= set(MODE_VALUES)
+    ev = res.events
+    assert list(ev.columns) == ["time_s", "event", "element"]
+    assert set(ev.event) <= set(EVENTS) and {"breakaway", "stick", "contact_open", "contact_close"} <= set(ev.event)
+    assert set(ev[ev.event == "contact_open"].element) == {"cushion"}
+    assert {"master", "bearing", "pp", "edge"} <= set(ev[ev.event == "breakaway"].element)
+    # the clutch opens during the pedal press and closes again
+    assert res["torque_Nm"][500] < 1.0 < res["torque_Nm"][0]
+
+
+def test_the_table_view_keeps_its_labels_and_holds_the_result():
+    dyn = EClutch(friction=FrictionParameters()).simulate(PEDAL, 1.0)
+    assert isinstance(dyn.result, SimulationResult)
+    assert len(dyn.events) == len(dyn.result.events)
+    assert "contact opens" in set(dyn.events.event) and "pp (R_f.pp)" in set(dyn.events["where"])
+    np.testing.assert_array_equal(dyn.outputs.torque_Nm.to_numpy(), dyn.result["torque_Nm"])
+
+
+def test_every_step_without_output_step_in_growing_chunks():
+    res = simulate(PEDAL, 1.0)
+    assert res.time.size == res.stats["accepted_steps"] + 1  # no 500,001-row reservation: what was stepped
+    assert np.all(np.diff(res.time) > 0)
+
+
+def test_same_options_everywhere_and_h_max_is_max_step():
+    ec = EClutch()
+    a = ec.simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, max_step=2e-3)
+    b = ec.simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, h_max=2e-3)
+    np.testing.assert_array_equal(a.time, b.time)
+    assert np.diff(a.time).max() <= 2e-3 * (1 + 1e-9)
+    with pytest.raises(ParameterError, match="h_max"):
+        ec.simulate({"voltage": 1.0}, 0.1, max_step=1e-3, h_max=2e-3)
+    # the uniform entry point with an input mapping: the default E-clutch (Model 4, friction on)
+    c = simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, max_step=2e-3, rtol=1e-3)
+    d = EClutch(friction=FrictionParameters()).simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, max_step=2e-3)
+    np.testing.assert_array_equal(c.time, d.time)
+    np.testing.assert_array_equal(c["pressure_Pa"], d.outputs.pressure_Pa.to_numpy())
+
+
+def test_registered_model_and_evaluation_through_the_contract():
+    system = contract.MODELS["eclutch"]()
+    assert system.method == "rodas" and system.mass.min() == 0.0  # massless finger tip: an algebraic row
+    dx, g, y = contract.evaluate(system)
+    assert np.all(np.isfinite(dx)) and np.all(np.isfinite(g)) and np.all(np.isfinite(y))
+    # at rest: no flow, no motion, the clutch's bearing force balances the CSC preload (80 N)
+    assert abs(dx[system.state_index("pressure")]) < 1e-6
+    assert y[system.output_index("bearing_force_clutch")] == pytest.approx(80.0, abs=1e-6)
+
+
+def test_cosimulation_session_equals_one_run_at_its_communication_points():
+    """A resumed Simulation restarts at each point but integrates the same equations (co-simulation, FMU)."""
+    ec = EClutch(friction=FrictionParameters())
+    sim = contract.Simulation(ec.as_system({"bearing_reference": 0.0}, held_input=True, rtol=1e-6))
+    xs = []
+    for k in range(1, 101):
+        sim.advance(k * 2e-3, [5e-3 if k > 10 else 0.0])
+        xs.append(sim.x[1])
+    one = ec.simulate({"bearing_reference": ([0.0, 0.02, 0.02 + 1e-12], [0.0, 0.0, 5e-3])}, 0.2, rtol=1e-6,
+                      output_step=2e-3)
+    assert np.abs(np.array(xs) - one.outputs.bearing_position_m.to_numpy()[1:]).max() < 2e-6
+    assert set(sim.events().event) <= set(EVENTS)
+
+
+def test_batch_is_the_contracts_batch():
+    from clutchlab.eclutch.dynamics import simulate_batch
+
+    from clutchlab.eclutch import EClutchParameters
+
+    ecs = [EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r)), friction=FrictionParameters())
+           for r in (-4.2, -3.8)]
+    batch = simulate_batch(ecs, PEDAL, 0.4, output_step=2e-3)
+    assert isinstance(batch.result, SimulationResult) and batch.result.batch
+    assert (batch.stats.jacobians > 0).all() and (batch.stats.events > 0).all()
+    assert "variant" in batch.result.events.columns
+
+
+def test_each_equation_is_one_compiled_function():
+    v = np.array([12.0, -3.0, 0.0])
+    i = np.array([1.0, 40.0, -2.0])
+    w = np.array([0.0, 100.0, -50.0])
+    expect = [current_rate(a, b, c, 0.2, 2.5e-4, 0.025) for a, b, c in zip(v, i, w)]
+    np.testing.assert_array_equal(motor_current_derivative(v, i, w, 0.2, 2.5e-4, 0.025), expect)
+    assert motor_current_derivative(12.0, 1.0, 0.0, 0.2, 2.5e-4, 0.025) == pytest.approx((12.0 - 0.2) / 2.5e-4)
+    x = np.linspace(-1e-3, 2e-3, 7)
+    np.testing.assert_array_equal(snifting_opening(x, 1e-3, 3e-4), [vent_opening(xx, 1e-3, 3e-4) for xx in x])
+    fn = np.array([0.0, 5000.0])
+    np.testing.assert_array_equal(clutch_torque(fn, 0.1, 0.3), [torque_of_clamp_force(f, 0.1, 0.3) for f in fn])
+
+
+def test_prescribed_motion_is_followed_exactly():
+    t = np.array([0.0, 0.2, 0.5])
+    x = np.array([0.0, 3e-3, 1e-3])
+    res = ClutchDynamics(ClutchModel.preset(4)).simulate((t, x), output_step=0.01).result
+    np.testing.assert_allclose(res["bearing_position_m"], np.interp(res.time, t, x), atol=1e-15)
+    np.testing.assert_allclose(res["prescribed_position_m"], np.interp(res.time, t, x), atol=1e-15)
