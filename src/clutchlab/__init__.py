@@ -29,9 +29,9 @@ def __getattr__(name):
 
         return SimulationResult
     if name == "system":
-        from . import system
+        import importlib
 
-        return system
+        return importlib.import_module(".system", __name__)
     raise AttributeError(f"module 'clutchlab' has no attribute {name!r}")
 
 
