@@ -428,6 +428,14 @@ class Simulation:
         n = int(self.log.count[0])
         return self.system.events_frame(self.log.time[:n], self.log.code[:n], self.log.element[:n])
 
+    @property
+    def stats(self) -> dict:
+        """Solver counters of the session so far (as ``SimulationResult.stats``)."""
+        si = self._si
+        return {"accepted_steps": int(si[self._core.SI_ACCEPTED]), "rejected_steps": int(si[self._core.SI_REJECTED]),
+                "rhs_evaluations": int(si[self._core.SI_NRHS]), "jacobians": int(si[self._core.SI_NJAC]),
+                "events_dropped": int(self.log.count[1])}
+
 
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
