@@ -141,8 +141,8 @@ class EventLog(NamedTuple):
 
 
 def new_log(capacity: int) -> EventLog:
-    """An empty event log holding up to ``capacity`` events."""
-    return EventLog(np.zeros(capacity), np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+    """An empty event log holding up to ``capacity`` events (only the first ``count[0]`` entries are ever read)."""
+    return EventLog(np.empty(capacity), np.empty(capacity, dtype=np.int64), np.empty(capacity, dtype=np.int64),
                     np.zeros(2, dtype=np.int64))
 
 
@@ -824,7 +824,7 @@ def batch_dopri(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, S
         si = np.zeros(N_SI, dtype=np.int64)
         log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
         rt = np.empty(ns)
-        advance_dopri(plist[v], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
+        advance_dopri(plist[np.int64(v)], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
         for q in range(N_SI):
             STATS[v, q] = si[q]
 
@@ -841,7 +841,7 @@ def batch_rodas(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, S
         si = np.zeros(N_SI, dtype=np.int64)
         log = EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
         rt = np.empty(ns)
-        advance_rodas(plist[v], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
+        advance_rodas(plist[np.int64(v)], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v], OUT_M[v], OUT_Y[v], want_y)
         for q in range(N_SI):
             STATS[v, q] = si[q]
 
