@@ -50,6 +50,7 @@ References
 
 from __future__ import annotations
 
+import collections
 import functools
 import math
 from dataclasses import dataclass
@@ -95,8 +96,8 @@ BATCH_VARIABLES = ("force_scale", "mu_scale", "speed_scale", "initial_slip_speed
 
 # ----------------------------------------------------------------- scenario
 def _profile(name, t, v):
-    t = np.asarray(t, dtype=float).ravel()
-    v = np.asarray(v, dtype=float).ravel()
+    t = np.array(t, dtype=float).ravel()  # copies: the scenario owns its profiles
+    v = np.array(v, dtype=float).ravel()
     if t.size < 1 or t.size != v.size:
         raise ParameterError(f"Scenario.{name}: time and value need the same, non-zero length ({t.size} vs {v.size})")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
@@ -146,6 +147,8 @@ class Scenario:
     def __post_init__(self):
         ft, fv = _profile("force", self.force_time, self.force_value)
         st, sv = _profile("speed", self.speed_time, self.speed_value)
+        for arr in (ft, fv, st, sv):
+            arr.setflags(write=False)  # a frozen scenario: its profiles cannot change under a cached model
         if np.any(fv < 0):
             raise ParameterError(f"Scenario.force_value: negative force {short_repr(fv[fv < 0][0])} [N]")
         object.__setattr__(self, "force_time", ft)
@@ -208,6 +211,40 @@ class Event:
     kind: str
 
 
+class _ListOnFirstAccess:
+    """Descriptor of a dataclass field that may be given as a zero-argument callable (called on first read).
+
+    A benchmark loop or a batch of engagements that never reads the mode names or the events does
+    not pay for building them (pandas).
+    """
+
+    def __set_name__(self, owner, name):
+        self.slot = "_built_" + name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            raise AttributeError(self.slot)  # no class-level default: the field stays required
+        value = obj.__dict__[self.slot]
+        if callable(value):
+            value = value()
+            obj.__dict__[self.slot] = value
+        return value
+
+    def __set__(self, obj, value):
+        obj.__dict__[self.slot] = value
+
+
+def _mode_names(result: SimulationResult) -> np.ndarray:
+    return _MODE_NAMES[result.modes[:, W.M_FRICTION]] if result.modes.shape[0] else np.array([], dtype="<U5")
+
+
+def _event_list(result: SimulationResult) -> list:
+    ev = result.events
+    events = [Event(float(t), EVENT_KINDS[name]) for t, name in zip(ev["time_s"], ev["event"]) if name in EVENT_KINDS]
+    events.sort(key=lambda e: e.time)
+    return events
+
+
 @dataclass
 class EngagementResult:
     """Result of :func:`simulate_engagement`: a view of the :class:`~clutchlab.SimulationResult`.
@@ -245,8 +282,8 @@ class EngagementResult:
     time: np.ndarray
     states: np.ndarray
     outputs: np.ndarray
-    modes: np.ndarray
-    events: list
+    modes: np.ndarray = _ListOnFirstAccess()   # from_result passes callables for these two: built when first read
+    events: list = _ListOnFirstAccess()
     n_steps: int
     final_state: np.ndarray
     heat_capacity: float
@@ -270,11 +307,8 @@ class EngagementResult:
         peak_temperature_c, lockup_time : float
             The run's peak pack temperature [degC] and first lock-up time [s].
         """
-        ev = result.events
-        events = [Event(float(t), EVENT_KINDS[name]) for t, name in zip(ev["time_s"], ev["event"])
-                  if name in EVENT_KINDS]
-        events.sort(key=lambda e: e.time)
-        modes = _MODE_NAMES[result.modes[:, W.M_FRICTION]] if result.modes.shape[0] else np.array([], dtype="<U5")
+        modes = functools.partial(_mode_names, result)
+        events = functools.partial(_event_list, result)
         return cls(result.time, result.states, result.outputs, modes, events, int(result.stats["accepted_steps"]),
                    np.array(result.stats["final_state"]), float(heat_capacity),
                    peak_temperature_c=float(peak_temperature_c), lockup_time=float(lockup_time), result=result)
@@ -371,6 +405,34 @@ def _sample_times(duration, sample_rate, sample_times):
     return np.arange(n) / sample_rate
 
 
+#: recently built systems by the identity of their (immutable) inputs: repeated runs skip the packing
+_RECENT: "collections.OrderedDict" = collections.OrderedDict()
+_RECENT_SIZE = 8
+
+
+def _run_system(clutch, scenario, bench, friction, rtol):
+    """The system of one run with its own per-run buffers; the packing is reused for the same inputs.
+
+    Clutch, bench, scenario and a parametric friction law are frozen, so the
+    system built for the same objects is still right; a friction map is
+    mutable, so a run with one always packs afresh.
+    """
+    inputs = (clutch, scenario, bench, friction)
+    cacheable = friction is None or isinstance(friction, ParametricFriction)
+    key = (*map(id, inputs), float(rtol))
+    hit = _RECENT.get(key) if cacheable else None
+    if hit is not None and all(a is b for a, b in zip(hit[0], inputs)):
+        _RECENT.move_to_end(key)
+        system = hit[1]
+    else:
+        system = _system(clutch, scenario, bench, friction, rtol)
+        if cacheable:
+            _RECENT[key] = (inputs, system)
+            while len(_RECENT) > _RECENT_SIZE:
+                _RECENT.popitem(last=False)
+    return system.variant(params=W.fresh_buffers(system.params, scenario.initial_temperature_c))
+
+
 def _system(clutch, scenario, bench, friction, rtol):
     bench = _default_bench() if bench is None else bench
     check_scenario(bench, scenario)
@@ -426,7 +488,7 @@ def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutc
 
     clutch = WetClutch.paper() if clutch is None else clutch
     t_end = scenario.duration if t_end is None else t_end
-    return run(_system(clutch, scenario, bench, friction, rtol), t_end, atol=atol, max_step=max_step,
+    return run(_run_system(clutch, scenario, bench, friction, rtol), t_end, atol=atol, max_step=max_step,
                output_step=output_step)
 
 
@@ -479,7 +541,7 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     """
     from ..system import simulate as run
 
-    sysm = _system(clutch, scenario, bench, friction, rtol)
+    sysm = _run_system(clutch, scenario, bench, friction, rtol)
     ts = _sample_times(scenario.duration, sample_rate, sample_times)
     res = run(sysm, float(scenario.duration), max_step=max_step, max_steps=max_steps, sample_times=ts,
               outputs=outputs)
@@ -542,7 +604,7 @@ def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, ben
     systems = _variant_systems(base, vals, m)
     res = run_batch(systems, duration, sample_times=grid, max_step=max_step, max_steps=max_steps, outputs=False)
     final = res.states[:, -1, :]
-    work = np.array([s.params.work[:2] for s in systems]).reshape(m, 2)
+    work = np.array([s.params.work[:2] for s in systems]).reshape(m, 2)  # each variant's memories
     status = np.asarray(res.status, dtype=int)
     return BatchResult(vals, ts, res.states[:, :ts.size, :], work[:, W.W_LOCKUP], final[:, W.S_EF],
                        work[:, W.W_PEAK], final[:, W.S_T], final[:, W.S_W],
@@ -555,7 +617,7 @@ _PARAM_FIELDS = {"force_scale": "force_scale", "mu_scale": "mu_scale", "speed_sc
 
 
 def _variant_systems(base, vals: dict, m: int) -> list:
-    """One :class:`~clutchlab.system.System` per variant: its own parameters (fresh memories) and initial state."""
+    """One :class:`~clutchlab.system.System` per variant: its own constants, initial state and per-run buffer."""
     x0 = np.tile(base.x0, (m, 1))
     for k, v in vals.items():
         if k == "initial_slip_speed":
@@ -567,10 +629,13 @@ def _variant_systems(base, vals: dict, m: int) -> list:
             x0[:, W.S_TF] = v
     if "force_scale" in vals:
         x0[:, W.S_FA] *= vals["force_scale"]  # the actuator starts at the scaled reference
-    fields = {_PARAM_FIELDS[k]: v for k, v in vals.items() if k in _PARAM_FIELDS}
-    piston_h0 = float(base.params.constants["piston_h0"][0])
-    systems = []
-    for i in range(m):
-        params = W.fresh_buffers(base.params, x0[i, W.S_T], **{f: float(v[i]) for f, v in fields.items()})
-        systems.append(base.replace(params=params, x0=x0[i], m0=W.initial_modes(x0[i], piston_h0)))
-    return systems
+    constants = np.repeat(base.params.constants, m)
+    for k, v in vals.items():
+        if k in _PARAM_FIELDS:
+            constants[_PARAM_FIELDS[k]] = v
+    work = W.new_work(x0[:, W.S_T])
+    piston_h0 = float(constants["piston_h0"][0])
+    m0 = np.stack([W.initial_modes(x, piston_h0) for x in x0]) if m else np.zeros((0, 3), np.int64)
+    params = base.params
+    return [base.variant(params=W.variant_parameters(params, constants[i], work[i]), x0=x0[i], m0=m0[i])
+            for i in range(m)]

@@ -339,6 +339,12 @@ def gw_table(t_min: float = -12.0, t_max: float = 8.0, n: int = 2001):
     return float(t[0]), float(t[1] - t[0]), values, ders
 
 
+#: the table the compiled model uses (:func:`asperity_force_scalar`): module constants, which numba
+#: compiles into the code -- a fixed approximation of a special function, not a parameter of the model
+GW_T0, GW_DT, GW_VALUES, GW_DERS = gw_table()
+GW_N = GW_VALUES.shape[0]
+
+
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def gw_scalar(t, t0, dt, values, ders):
     """Compiled cubic-Hermite lookup of ``F_{3/2}(t)`` in a :func:`gw_table`.
@@ -356,27 +362,46 @@ def gw_scalar(t, t0, dt, values, ders):
     -----
     Zero beyond the last node, linear extrapolation before the first.
     """
-    n = values.shape[0]
+    return gw_lookup(t, t0, dt, values, 0, ders, 0, values.shape[0])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def gw_lookup(t, t0, dt, values, vstart, ders, dstart, n):
+    """:func:`gw_scalar` on a table stored inside larger arrays: nodes at ``values[vstart:vstart + n]``
+    and derivatives at ``ders[dstart:dstart + n]`` (the engagement model keeps its tables in one array).
+
+    Parameters
+    ----------
+    t, t0, dt
+        As :func:`gw_scalar`.
+    values, ders : ndarray
+        Arrays holding the node values and derivatives.
+    vstart, dstart : int
+        Index of the first node in each.
+    n : int
+        Number of nodes.
+    """
     x = (t - t0) / dt
     if x >= n - 1:
         return 0.0
     if x < 0.0:
-        return values[0] + ders[0] * (t - t0)
+        return values[vstart] + ders[dstart] * (t - t0)
     i = int(x)
     th = x - i
     t2 = th * th
     t3 = t2 * th
-    return ((2.0 * t3 - 3.0 * t2 + 1.0) * values[i] + (t3 - 2.0 * t2 + th) * dt * ders[i]
-            + (-2.0 * t3 + 3.0 * t2) * values[i + 1] + (t3 - t2) * dt * ders[i + 1])
+    return ((2.0 * t3 - 3.0 * t2 + 1.0) * values[vstart + i] + (t3 - 2.0 * t2 + th) * dt * ders[dstart + i]
+            + (-2.0 * t3 + 3.0 * t2) * values[vstart + i + 1] + (t3 - t2) * dt * ders[dstart + i + 1])
 
 
 @numba.njit(cache=True, nogil=True)
-def asperity_force_scalar(h, sigma, area, pressure_scale, t0, dt, values, ders):
+def asperity_force_scalar(h, sigma, area, pressure_scale):
     """Greenwood-Williamson asperity contact force ``F_c = A_f p_c(h)`` [N], compiled scalar form.
 
     Greenwood and Williamson [3], Eq. 11, as used by Deur et al. [4]:
     ``p_c = 4/3 E' eta sqrt(beta) sigma^{3/2} F_{3/2}(h/sigma)``, with
-    ``F_{3/2}`` from the cubic-Hermite table of :func:`gw_table`.
+    ``F_{3/2}`` from the cubic-Hermite table of :func:`gw_table` (``GW_VALUES``,
+    ``GW_DERS``: constants of the compiled code).
 
     Parameters
     ----------
@@ -388,8 +413,6 @@ def asperity_force_scalar(h, sigma, area, pressure_scale, t0, dt, values, ders):
         Nominal friction area of one face A_f [m^2].
     pressure_scale : float
         ``4/3 E' eta sqrt(beta) sigma^{3/2}`` [Pa] (:func:`gw_pressure_scale`).
-    t0, dt, values, ders
-        The table of :func:`gw_table`.
 
     Returns
     -------
@@ -400,7 +423,7 @@ def asperity_force_scalar(h, sigma, area, pressure_scale, t0, dt, values, ders):
     -----
     Assumptions as :func:`asperity_contact_pressure`.
     """
-    return area * pressure_scale * gw_scalar(h / sigma, t0, dt, values, ders)  # [3], Eq. 11
+    return area * pressure_scale * gw_lookup(h / sigma, GW_T0, GW_DT, GW_VALUES, 0, GW_DERS, 0, GW_N)  # [3], Eq. 11
 
 
 @numba.njit(cache=True, nogil=True)

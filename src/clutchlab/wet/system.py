@@ -71,18 +71,18 @@ import numpy as np
 
 from ..numerics import dispatch
 from ..numerics.core import record
-from ..system import System, register_model
-from .film import (asperity_force_scalar, film_scalar, gw_table, separation_scalar, slip_velocity_scalar,
+from ..system import System, register_model, variables
+from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
                    squeeze_film_force_scalar)
-from .friction import ParametricFriction, mu_kernel
+from .friction import KIND_PARAMETRIC, ParametricFriction, mu_kernel, parametric_mu_scalar
 from .thermal import heat_balance_scalar
 from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque_scalar
 from .viscosity import viscosity_scalar
 
 __all__ = [
-    "WetParams", "pack_parameters", "engagement_system", "initial_state", "initial_modes", "absolute_tolerance",
-    "fresh_buffers", "peak_temperature", "lockup_time", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS",
-    "MODE_NAMES", "MODE_VALUES", "CONSTANTS", "piston_speed", "drive_torque",
+    "WetParams", "pack_parameters", "fresh_buffers", "variant_parameters", "new_work", "engagement_system", "initial_state",
+    "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque",
+    "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
 ]
 
 # ----------------------------------------------------------------- layout
@@ -198,14 +198,18 @@ CONSTANTS = (
     ("force_scale", "1", "factor on the force profile (batch variants)"),
     ("mu_scale", "1", "factor on mu_f (batch variants)"),
     ("speed_scale", "1", "factor on the slip-speed profile (batch variants)"),
-    ("gw_t0", "1", "first node of the F_3/2 table (h/sigma)"),
-    ("gw_dt", "1", "node spacing of the F_3/2 table"),
     ("free_inertia", "1", "no motor torque (inertia dynamometer), a bool"),
     ("friction_kind", "1", "friction law: 0 parametric, 1 table (an int)"),
+    ("force_start", "1", "force profile in tables: times from here, then values (an int)"),
+    ("force_n", "1", "breakpoints of the force profile (an int)"),
+    ("speed_start", "1", "slip-speed profile in tables (an int)"),
+    ("speed_n", "1", "breakpoints of the slip-speed profile (an int)"),
+    ("friction_start", "1", "coefficients of the friction law in tables (an int)"),
 )
-#: the record type of ``WetParams.constants`` (floats, then one bool and one int)
-CONSTANTS_DTYPE = np.dtype([(n, np.float64) for n, _, _ in CONSTANTS[:-2]]
-                           + [("free_inertia", np.bool_), ("friction_kind", np.int64)], align=True)
+_INT_CONSTANTS = ("friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start")
+#: the record type of ``WetParams.constants`` (floats, one bool, ints)
+CONSTANTS_DTYPE = np.dtype([(n, np.float64) for n, _, _ in CONSTANTS if n not in _INT_CONSTANTS + ("free_inertia",)]
+                           + [("free_inertia", np.bool_)] + [(n, np.int64) for n in _INT_CONSTANTS], align=True)
 
 #: layout of the per-run ``WetParams.work`` buffer: memories, then scratch for outputs, derivative, switching
 W_PEAK, W_LOCKUP = 0, 1          # peak pack temperature [degC], first lock-up time [s] (NaN: none yet)
@@ -221,23 +225,28 @@ class WetParams(NamedTuple):
     Built by :func:`pack_parameters` only; its class selects the wet model's
     compiled hooks in the integrator core.  The scalars are the named fields
     of a one-element structured array (``constants``, fields
-    :data:`CONSTANTS`), so the whole structure stays a handful of arrays
-    (cheap to pass between compiled functions) while every value keeps its
-    name.  ``work`` holds per-run memories and scratch space: build a fresh
-    structure per run and per batch variant (:func:`fresh_buffers`).
+    :data:`CONSTANTS`); the reference profiles and the friction law's
+    coefficients share one array (``tables``), located by the ``*_start`` /
+    ``*_n`` constants; ``work`` holds per-run memories and scratch space:
+    build a fresh structure per run and per batch variant
+    (:func:`fresh_buffers`).  The Greenwood-Williamson table is a constant of
+    the compiled code (:data:`clutchlab.wet.film.GW_VALUES`).
+
+    Few, small arrays on purpose: numba counts a reference for every array
+    read from the structure (an atomic increment and decrement), which on
+    this model's right-hand side cost as much as the physics, and in a
+    parallel batch arrays shared between variants make those counters
+    contended; each variant gets its own (small) arrays.  The four
+    friction-map arrays are read only for a tabulated law.
     """
 
-    constants: np.ndarray            # one record, fields CONSTANTS [SI]
-    force_profile: np.ndarray        # (2, n): breakpoint times [s], actuator force reference [N]
-    speed_profile: np.ndarray        # (2, n): breakpoint times [s], slip-speed reference [rad/s]
-    friction_coef: np.ndarray        # asperity friction law: ``kernel_data()`` of the law
-    friction_speed_grid: np.ndarray
+    constants: np.ndarray               # one record, fields CONSTANTS [SI]
+    tables: np.ndarray                  # force profile | speed profile | friction coefficients
+    work: np.ndarray                    # per run: W_PEAK, W_LOCKUP, then scratch (N_WORK)
+    friction_speed_grid: np.ndarray     # friction map (``kernel_data()`` of a FrictionMap), else 1-element
     friction_temperature_grid: np.ndarray
     friction_force_grid: np.ndarray
     friction_table: np.ndarray
-    gw_values: np.ndarray            # F_3/2 at the table nodes (gw_table)
-    gw_ders: np.ndarray              # its derivative at the nodes
-    work: np.ndarray                 # per run: W_PEAK, W_LOCKUP, then scratch (N_WORK)
 
 
 # ----------------------------------------------------------------- model pieces (compiled, scalar)
@@ -293,23 +302,24 @@ def drive_torque(slip_speed, reference, integral, torque_max, power_max, kp, ki)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _pwl(t, profile):
-    """Piecewise-linear reference ``profile`` (rows: breakpoint times, values) at ``t``, constant beyond the ends."""
-    n = profile.shape[1]
-    if t <= profile[0, 0]:
-        return profile[1, 0]
-    if t >= profile[0, n - 1]:
-        return profile[1, n - 1]
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:  # bisection: profile[0, lo] <= t < profile[0, hi]
+def _pwl(t, tables, start, n):
+    """Piecewise-linear reference profile at ``t`` (times ``tables[start:start+n]``, values after them),
+    constant beyond the ends."""
+    v0 = start + n
+    if t <= tables[start]:
+        return tables[v0]
+    if t >= tables[start + n - 1]:
+        return tables[v0 + n - 1]
+    lo = start
+    hi = start + n - 1
+    while hi - lo > 1:  # bisection: tables[lo] <= t < tables[hi]
         mid = (lo + hi) // 2
-        if profile[0, mid] <= t:
+        if tables[mid] <= t:
             lo = mid
         else:
             hi = mid
-    w = (t - profile[0, lo]) / (profile[0, lo + 1] - profile[0, lo])
-    return profile[1, lo] + w * (profile[1, lo + 1] - profile[1, lo])
+    w = (t - tables[lo]) / (tables[lo + 1] - tables[lo])
+    return tables[lo + n] + w * (tables[lo + n + 1] - tables[lo + n])
 
 
 # ----------------------------------------------------------------- hooks
@@ -317,6 +327,7 @@ def _pwl(t, profile):
 def wet_rhs(t, x, u, m, p, dx, g):
     """Right-hand side, switching functions and (into ``p.work``) the outputs of the engagement model."""
     c = p.constants[0]
+    tb = p.tables
     wk = p.work
     nc = c.n_c
     xp = x[S_X]
@@ -330,15 +341,18 @@ def wet_rhs(t, x, u, m, p, dx, g):
     h = separation_scalar(xp, c.piston_h0, nc)                                     # [1], Eq. 1
     hbar = film_scalar(h, c.sigma)                                                  # [1], Eq. 2
     muv = viscosity_scalar(temp, c.mu_v1, c.mu_v2, c.mu_v3, c.mu_v4)                # [1], Eq. 7
-    fc = asperity_force_scalar(h, c.sigma, c.friction_area, c.gw_scale, c.gw_t0, c.gw_dt, p.gw_values,
-                               p.gw_ders)                                           # [3], Eq. 11
+    fc = asperity_force_scalar(h, c.sigma, c.friction_area, c.gw_scale)              # [3], Eq. 11
     v = slip_velocity_scalar(w, c.r_eff)                                            # [1], Eq. (2')
-    muf = c.mu_scale * mu_kernel(abs(v), temp, fc, c.friction_kind, p.friction_coef, p.friction_speed_grid,
-                                 p.friction_temperature_grid, p.friction_force_grid, p.friction_table)
+    k = c.friction_start
+    if c.friction_kind == KIND_PARAMETRIC:
+        muf = c.mu_scale * parametric_mu_scalar(abs(v), temp, tb[k], tb[k + 1], tb[k + 2], tb[k + 3], tb[k + 4])
+    else:  # a friction map (its arrays are read only here)
+        muf = c.mu_scale * mu_kernel(abs(v), temp, fc, c.friction_kind, tb[k:k + 5], p.friction_speed_grid,
+                                     p.friction_temperature_grid, p.friction_force_grid, p.friction_table)
     cap = asperity_torque_scalar(c.r_eff, nc, muf, fc)                              # [1], Eq. 4 (static)
     # references: scenario profiles plus the held inputs
-    wref = c.speed_scale * _pwl(t, p.speed_profile) + u[U_SPEED]
-    fref = min(c.force_scale * _pwl(t, p.force_profile) + u[U_FORCE], c.actuator_force_max)
+    wref = c.speed_scale * _pwl(t, tb, c.speed_start, c.speed_n) + u[U_SPEED]
+    fref = min(c.force_scale * _pwl(t, tb, c.force_start, c.force_n) + u[U_FORCE], c.actuator_force_max)
     # drive: speed-controlled motor or free inertia
     if c.free_inertia:
         td = 0.0
@@ -426,8 +440,10 @@ def _evaluate(t, x, u, m, p):
 @numba.njit(cache=True, nogil=True)
 def wet_outputs(t, x, u, m, p, y):
     """Outputs at one point (:data:`OUTPUTS` order)."""
+    # y (18 entries) takes the derivative and the switching values first (scratch, overwritten), then the
+    # outputs the right-hand side left in p.work: no scratch array is sliced or allocated per sample
+    wet_rhs(t, x, u, m, p, y, y)
     wk = p.work
-    wet_rhs(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH])
     for i in range(N_OUT):
         y[i] = wk[W_OUT + i]
 
@@ -521,19 +537,20 @@ def wet_accept(t, x, u, m, p):
 
 
 @numba.njit(cache=True, nogil=True)
-def _next_corner(profile, t):
-    for i in range(profile.shape[1]):
-        if profile[0, i] > t:
-            return profile[0, i]
+def _next_corner(tables, start, n, t):
+    for i in range(start, start + n):
+        if tables[i] > t:
+            return tables[i]
     return np.inf
 
 
 @numba.njit(cache=True, nogil=True)
 def wet_next_break(t, m, p):
     """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
-    tb = _next_corner(p.force_profile, t)
-    if not p.constants[0].free_inertia:
-        ts = _next_corner(p.speed_profile, t)
+    c = p.constants[0]
+    tb = _next_corner(p.tables, c.force_start, c.force_n, t)
+    if not c.free_inertia:
+        ts = _next_corner(p.tables, c.speed_start, c.speed_n, t)
         if ts < tb:
             tb = ts
     return tb
@@ -551,13 +568,7 @@ dispatch.register(WetParams, rhs=wet_rhs, outputs=wet_outputs, update=wet_update
 
 # ----------------------------------------------------------------- packing
 def _array(values) -> np.ndarray:
-    return np.array(values, dtype=np.float64, order="C")
-
-
-def _profile(times, values) -> np.ndarray:
-    return np.ascontiguousarray(np.vstack([np.asarray(times, dtype=float), np.asarray(values, dtype=float)]))
-
-
+    return np.array(values, dtype=np.float64, order="C").ravel()
 
 
 def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetParams:
@@ -586,7 +597,9 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
     """
     law = ParametricFriction.bench_truth() if friction is None else friction
     kind, coef, gv, gt, gf, table = law.kernel_data()
-    t0, dt, gw_values, gw_ders = gw_table()
+    parts = [_array(scenario.force_time), _array(scenario.force_value), _array(scenario.speed_time),
+             _array(scenario.speed_value), _array(coef)]
+    starts = np.concatenate([[0], np.cumsum([a.size for a in parts])])
     values = dict(
         n_c=clutch.n_c, r_eff=clutch.r_eff, sigma=clutch.sigma, friction_area=clutch.friction_area,
         piston_h0=clutch.piston_h0, mu_v1=clutch.mu_v1, mu_v2=clutch.mu_v2, mu_v3=clutch.mu_v3, mu_v4=clutch.mu_v4,
@@ -601,23 +614,32 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
         heater_gain=bench.heater_gain, heater_setpoint=scenario.setpoint_c, reservoir_cooling=bench.reservoir_cooling,
         housing_heat_capacity=bench.housing_heat_capacity, housing_cooling=bench.housing_cooling,
         fluid_housing_conductance=bench.fluid_housing_conductance, ambient_temperature=bench.ambient_temperature,
-        force_scale=1.0, mu_scale=1.0, speed_scale=1.0, gw_t0=t0, gw_dt=dt,
+        force_scale=1.0, mu_scale=1.0, speed_scale=1.0,
         free_inertia=scenario.motor == "free", friction_kind=int(kind),
+        force_start=int(starts[0]), force_n=parts[0].size, speed_start=int(starts[2]), speed_n=parts[2].size,
+        friction_start=int(starts[4]),
     )
     unknown = [k for k in overrides if k not in values]
     if unknown:
         raise TypeError(f"pack_parameters: unknown field {unknown[0]!r} (known: {', '.join(values)})")
     values.update(overrides)
     constants = np.array([tuple(values[n] for n in CONSTANTS_DTYPE.names)], dtype=CONSTANTS_DTYPE)
-    return WetParams(constants, _profile(scenario.force_time, scenario.force_value),
-                     _profile(scenario.speed_time, scenario.speed_value), _array(coef), _array(gv), _array(gt),
-                     _array(gf), _array(table), gw_values, gw_ders, _new_work(scenario.initial_temperature_c))
+    return WetParams(constants, np.concatenate(parts), new_work(scenario.initial_temperature_c), _array(gv),
+                     _array(gt), _array(gf), _array(table))
 
 
-def _new_work(initial_temperature_c: float) -> np.ndarray:
-    work = np.zeros(N_WORK)
-    work[W_PEAK] = initial_temperature_c
-    work[W_LOCKUP] = math.nan
+def new_work(initial_temperature_c):
+    """Fresh per-run buffer(s): the peak memory starts at the initial pack temperature, no lock-up yet.
+
+    Parameters
+    ----------
+    initial_temperature_c : float or array_like
+        Pack temperature at the start [degC]; an array gives one buffer (row) per value.
+    """
+    temp = np.asarray(initial_temperature_c, dtype=float)
+    work = np.zeros(temp.shape + (N_WORK,))
+    work[..., W_PEAK] = temp
+    work[..., W_LOCKUP] = math.nan
     return work
 
 
@@ -638,7 +660,30 @@ def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) 
         constants = constants.copy()
         for name, value in overrides.items():
             constants[name] = value
-    return params._replace(constants=constants, work=_new_work(initial_temperature_c))
+    return params._replace(constants=constants, work=new_work(initial_temperature_c))
+
+
+def variant_parameters(params: WetParams, constants, work) -> WetParams:
+    """Parameters of one batch variant: its own constants record, work buffer and copy of the tables.
+
+    Parameters
+    ----------
+    params : WetParams
+        The base case (its friction-map arrays are shared: read only for a tabulated law).
+    constants : numpy.void or ndarray
+        The variant's constants (one record of :data:`CONSTANTS`).
+    work : ndarray
+        Its per-run buffer (:func:`new_work`).
+
+    Notes
+    -----
+    Every array a variant's right-hand side reads is its own, so the
+    reference counts numba keeps on them are not contended between the
+    threads of a parallel batch.
+    """
+    own = np.empty(1, dtype=CONSTANTS_DTYPE)
+    own[0] = constants
+    return params._replace(constants=own, tables=params.tables.copy(), work=np.array(work, dtype=float))
 
 
 def peak_temperature(params: WetParams) -> float:
@@ -729,6 +774,9 @@ def absolute_tolerance(clutch, rtol: float = 1e-7) -> np.ndarray:
     return min(float(rtol), 1e-7) * scale
 
 
+_STATE_VARIABLES, _OUTPUT_VARIABLES, _INPUT_VARIABLES = variables(STATES), variables(OUTPUTS), variables(INPUTS)
+
+
 def _element_name(code: int, element: int) -> str:
     return ELEMENTS[element] if 0 <= element < len(ELEMENTS) else ""
 
@@ -774,7 +822,7 @@ def engagement_system(scenario=None, *, clutch=None, bench=None, friction=None, 
         params = pack_parameters(clutch, bench, scenario, friction)
     x0 = initial_state(scenario) if x0 is None else np.asarray(x0, dtype=float)
     return System(
-        name="wet", params=params, states=STATES, outputs=OUTPUTS, inputs=INPUTS, x0=x0,
+        name="wet", params=params, states=_STATE_VARIABLES, outputs=_OUTPUT_VARIABLES, inputs=_INPUT_VARIABLES, x0=x0,
         m0=initial_modes(x0, clutch.piston_h0), atol=absolute_tolerance(clutch, rtol), switching=SWITCHING,
         events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES, method="dopri", rtol=float(rtol), event_tol=1e-12,
         element_name=_element_name)
