@@ -23,7 +23,6 @@ point, for linearisation and tests).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import functools
 import math
@@ -207,7 +206,8 @@ class System:
         x0, m0, u0 : array_like, optional
             Initial state, modes and held inputs, of this system's sizes.
         """
-        new = copy.copy(self)
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)  # a shallow copy (copy.copy of a dataclass is slower)
         if params is not None:
             if type(params) is not type(self.params):
                 raise ParameterError(f"System {self.name!r}: variant params must be a {type(self.params).__name__}")
