@@ -604,7 +604,7 @@ def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, ben
     systems = _variant_systems(base, vals, m)
     res = run_batch(systems, duration, sample_times=grid, max_step=max_step, max_steps=max_steps, outputs=False)
     final = res.states[:, -1, :]
-    work = np.array([s.params.work[:2] for s in systems]).reshape(m, 2)  # each variant's memories
+    work = np.array([s.params.data[:2] for s in systems]).reshape(m, 2)  # each variant's memories
     status = np.asarray(res.status, dtype=int)
     return BatchResult(vals, ts, res.states[:, :ts.size, :], work[:, W.W_LOCKUP], final[:, W.S_EF],
                        work[:, W.W_PEAK], final[:, W.S_T], final[:, W.S_W],
@@ -636,6 +636,5 @@ def _variant_systems(base, vals: dict, m: int) -> list:
     work = W.new_work(x0[:, W.S_T])
     piston_h0 = float(constants["piston_h0"][0])
     m0 = np.stack([W.initial_modes(x, piston_h0) for x in x0]) if m else np.zeros((0, 3), np.int64)
-    params = base.params
-    return [base.variant(params=W.variant_parameters(params, constants[i], work[i]), x0=x0[i], m0=m0[i])
-            for i in range(m)]
+    return [base.variant(params=params, x0=x0[i], m0=m0[i])
+            for i, params in enumerate(W.batch_parameters(base.params, constants, work))]

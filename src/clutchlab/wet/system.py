@@ -80,7 +80,7 @@ from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque
 from .viscosity import viscosity_scalar
 
 __all__ = [
-    "WetParams", "pack_parameters", "fresh_buffers", "variant_parameters", "new_work", "engagement_system", "initial_state",
+    "WetParams", "pack_parameters", "fresh_buffers", "batch_parameters", "new_work", "engagement_system", "initial_state",
     "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque",
     "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
 ]
@@ -200,18 +200,29 @@ CONSTANTS = (
     ("speed_scale", "1", "factor on the slip-speed profile (batch variants)"),
     ("free_inertia", "1", "no motor torque (inertia dynamometer), a bool"),
     ("friction_kind", "1", "friction law: 0 parametric, 1 table (an int)"),
-    ("force_start", "1", "force profile in tables: times from here, then values (an int)"),
+    ("force_start", "1", "force profile in data: times from here, then values (an int)"),
     ("force_n", "1", "breakpoints of the force profile (an int)"),
-    ("speed_start", "1", "slip-speed profile in tables (an int)"),
+    ("speed_start", "1", "slip-speed profile in data (an int)"),
     ("speed_n", "1", "breakpoints of the slip-speed profile (an int)"),
-    ("friction_start", "1", "coefficients of the friction law in tables (an int)"),
+    ("friction_start", "1", "coefficients of the friction law in data (an int)"),
+    ("map_speed_start", "1", "friction map: slip-velocity grid in data (an int)"),
+    ("map_speed_n", "1", "friction map: its length (an int)"),
+    ("map_temperature_start", "1", "friction map: temperature grid in data (an int)"),
+    ("map_temperature_n", "1", "friction map: its length (an int)"),
+    ("map_force_start", "1", "friction map: force grid in data (an int)"),
+    ("map_force_n", "1", "friction map: its length (an int)"),
+    ("map_table_start", "1", "friction map: values in data (an int)"),
+    ("map_table_n", "1", "friction map: their number (an int)"),
 )
-_INT_CONSTANTS = ("friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start")
+_INT_CONSTANTS = ("friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start",
+                  "map_speed_start", "map_speed_n", "map_temperature_start", "map_temperature_n", "map_force_start",
+                  "map_force_n", "map_table_start", "map_table_n")
 #: the record type of ``WetParams.constants`` (floats, one bool, ints)
 CONSTANTS_DTYPE = np.dtype([(n, np.float64) for n, _, _ in CONSTANTS if n not in _INT_CONSTANTS + ("free_inertia",)]
                            + [("free_inertia", np.bool_)] + [(n, np.int64) for n in _INT_CONSTANTS], align=True)
 
-#: layout of the per-run ``WetParams.work`` buffer: memories, then scratch for outputs, derivative, switching
+#: layout of the per-run buffer at the head of ``WetParams.data``: memories, then scratch for outputs,
+#: derivative, switching values
 W_PEAK, W_LOCKUP = 0, 1          # peak pack temperature [degC], first lock-up time [s] (NaN: none yet)
 W_OUT = 2
 W_DX = W_OUT + N_OUT
@@ -225,28 +236,24 @@ class WetParams(NamedTuple):
     Built by :func:`pack_parameters` only; its class selects the wet model's
     compiled hooks in the integrator core.  The scalars are the named fields
     of a one-element structured array (``constants``, fields
-    :data:`CONSTANTS`); the reference profiles and the friction law's
-    coefficients share one array (``tables``), located by the ``*_start`` /
-    ``*_n`` constants; ``work`` holds per-run memories and scratch space:
-    build a fresh structure per run and per batch variant
-    (:func:`fresh_buffers`).  The Greenwood-Williamson table is a constant of
-    the compiled code (:data:`clutchlab.wet.film.GW_VALUES`).
+    :data:`CONSTANTS`); everything else is one float array (``data``): first
+    the per-run buffer (memories and scratch, layout ``W_*``), then the
+    reference profiles and the friction law (coefficients, or grids and
+    values of a map), located by the ``*_start`` / ``*_n`` constants.  Build
+    a fresh structure per run and per batch variant (:func:`fresh_buffers`,
+    :func:`variant_parameters`).  The Greenwood-Williamson table is a
+    constant of the compiled code (:data:`clutchlab.wet.film.GW_VALUES`).
 
-    Few, small arrays on purpose: numba counts a reference for every array
-    read from the structure (an atomic increment and decrement), which on
-    this model's right-hand side cost as much as the physics, and in a
-    parallel batch arrays shared between variants make those counters
-    contended; each variant gets its own (small) arrays.  The four
-    friction-map arrays are read only for a tabulated law.
+    Two arrays on purpose (measured): numba passes the structure by value,
+    field by field, to every hook call (six per step), and keeps an atomic
+    reference count for every array read from it; with the thirteen arrays
+    of a first layout that cost as much as the physics, and in a parallel
+    batch arrays shared between variants make those counters contended.
+    Each variant gets its own (small) arrays.
     """
 
     constants: np.ndarray               # one record, fields CONSTANTS [SI]
-    tables: np.ndarray                  # force profile | speed profile | friction coefficients
-    work: np.ndarray                    # per run: W_PEAK, W_LOCKUP, then scratch (N_WORK)
-    friction_speed_grid: np.ndarray     # friction map (``kernel_data()`` of a FrictionMap), else 1-element
-    friction_temperature_grid: np.ndarray
-    friction_force_grid: np.ndarray
-    friction_table: np.ndarray
+    data: np.ndarray                    # per-run buffer (N_WORK) | force profile | speed profile | friction law
 
 
 # ----------------------------------------------------------------- model pieces (compiled, scalar)
@@ -325,10 +332,10 @@ def _pwl(t, tables, start, n):
 # ----------------------------------------------------------------- hooks
 @numba.njit(cache=True, nogil=True)
 def wet_rhs(t, x, u, m, p, dx, g):
-    """Right-hand side, switching functions and (into ``p.work``) the outputs of the engagement model."""
+    """Right-hand side, switching functions and (into the scratch of ``p.data``) the outputs of the model."""
     c = p.constants[0]
-    tb = p.tables
-    wk = p.work
+    tb = p.data
+    wk = tb
     nc = c.n_c
     xp = x[S_X]
     fa = x[S_FA]
@@ -346,9 +353,13 @@ def wet_rhs(t, x, u, m, p, dx, g):
     k = c.friction_start
     if c.friction_kind == KIND_PARAMETRIC:
         muf = c.mu_scale * parametric_mu_scalar(abs(v), temp, tb[k], tb[k + 1], tb[k + 2], tb[k + 3], tb[k + 4])
-    else:  # a friction map (its arrays are read only here)
-        muf = c.mu_scale * mu_kernel(abs(v), temp, fc, c.friction_kind, tb[k:k + 5], p.friction_speed_grid,
-                                     p.friction_temperature_grid, p.friction_force_grid, p.friction_table)
+    else:  # a friction map: its grids and values are sliced out of the tables only here
+        muf = c.mu_scale * mu_kernel(
+            abs(v), temp, fc, c.friction_kind, tb[k:k + 5],
+            tb[c.map_speed_start:c.map_speed_start + c.map_speed_n],
+            tb[c.map_temperature_start:c.map_temperature_start + c.map_temperature_n],
+            tb[c.map_force_start:c.map_force_start + c.map_force_n],
+            tb[c.map_table_start:c.map_table_start + c.map_table_n])
     cap = asperity_torque_scalar(c.r_eff, nc, muf, fc)                              # [1], Eq. 4 (static)
     # references: scenario profiles plus the held inputs
     wref = c.speed_scale * _pwl(t, tb, c.speed_start, c.speed_n) + u[U_SPEED]
@@ -432,8 +443,8 @@ def wet_rhs(t, x, u, m, p, dx, g):
 
 @numba.njit(cache=True, nogil=True)
 def _evaluate(t, x, u, m, p):
-    """The model at one point into the scratch space of ``p.work`` (hooks other than ``rhs``)."""
-    wk = p.work
+    """The model at one point into the scratch space of ``p.data`` (hooks other than ``rhs``)."""
+    wk = p.data
     wet_rhs(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH])
 
 
@@ -441,9 +452,9 @@ def _evaluate(t, x, u, m, p):
 def wet_outputs(t, x, u, m, p, y):
     """Outputs at one point (:data:`OUTPUTS` order)."""
     # y (18 entries) takes the derivative and the switching values first (scratch, overwritten), then the
-    # outputs the right-hand side left in p.work: no scratch array is sliced or allocated per sample
+    # outputs the right-hand side left in p.data: no scratch array is sliced or allocated per sample
     wet_rhs(t, x, u, m, p, y, y)
-    wk = p.work
+    wk = p.data
     for i in range(N_OUT):
         y[i] = wk[W_OUT + i]
 
@@ -451,7 +462,7 @@ def wet_outputs(t, x, u, m, p, y):
 @numba.njit(cache=True, nogil=True)
 def wet_update(t, x, u, m, p, k, log):
     """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name)."""
-    wk = p.work
+    wk = p.data
     if k == G_LOCKUP:
         old = m[M_FRICTION]
         x[S_W] = 0.0
@@ -500,7 +511,7 @@ def wet_restart(t, x, u, m, p, log):
     change a mode evaluate the model.
     """
     c = p.constants[0]
-    wk = p.work
+    wk = p.data
     changed = False
     film = CONTACT if separation_scalar(x[S_X], c.piston_h0, c.n_c) <= 0.0 else OPEN
     if m[M_FILM] != film:
@@ -530,7 +541,7 @@ def wet_restart(t, x, u, m, p, log):
 @numba.njit(cache=True, nogil=True)
 def wet_accept(t, x, u, m, p):
     """After each accepted step: track the peak pack temperature."""
-    wk = p.work
+    wk = p.data
     if x[S_T] > wk[W_PEAK]:
         wk[W_PEAK] = x[S_T]
     return 0
@@ -548,9 +559,9 @@ def _next_corner(tables, start, n, t):
 def wet_next_break(t, m, p):
     """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
     c = p.constants[0]
-    tb = _next_corner(p.tables, c.force_start, c.force_n, t)
+    tb = _next_corner(p.data, c.force_start, c.force_n, t)
     if not c.free_inertia:
-        ts = _next_corner(p.tables, c.speed_start, c.speed_n, t)
+        ts = _next_corner(p.data, c.speed_start, c.speed_n, t)
         if ts < tb:
             tb = ts
     return tb
@@ -598,8 +609,8 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
     law = ParametricFriction.bench_truth() if friction is None else friction
     kind, coef, gv, gt, gf, table = law.kernel_data()
     parts = [_array(scenario.force_time), _array(scenario.force_value), _array(scenario.speed_time),
-             _array(scenario.speed_value), _array(coef)]
-    starts = np.concatenate([[0], np.cumsum([a.size for a in parts])])
+             _array(scenario.speed_value), _array(coef), _array(gv), _array(gt), _array(gf), _array(table)]
+    starts = N_WORK + np.concatenate([[0], np.cumsum([a.size for a in parts])])  # after the per-run buffer
     values = dict(
         n_c=clutch.n_c, r_eff=clutch.r_eff, sigma=clutch.sigma, friction_area=clutch.friction_area,
         piston_h0=clutch.piston_h0, mu_v1=clutch.mu_v1, mu_v2=clutch.mu_v2, mu_v3=clutch.mu_v3, mu_v4=clutch.mu_v4,
@@ -617,15 +628,16 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
         force_scale=1.0, mu_scale=1.0, speed_scale=1.0,
         free_inertia=scenario.motor == "free", friction_kind=int(kind),
         force_start=int(starts[0]), force_n=parts[0].size, speed_start=int(starts[2]), speed_n=parts[2].size,
-        friction_start=int(starts[4]),
+        friction_start=int(starts[4]), map_speed_start=int(starts[5]), map_speed_n=parts[5].size,
+        map_temperature_start=int(starts[6]), map_temperature_n=parts[6].size, map_force_start=int(starts[7]),
+        map_force_n=parts[7].size, map_table_start=int(starts[8]), map_table_n=parts[8].size,
     )
     unknown = [k for k in overrides if k not in values]
     if unknown:
         raise TypeError(f"pack_parameters: unknown field {unknown[0]!r} (known: {', '.join(values)})")
     values.update(overrides)
     constants = np.array([tuple(values[n] for n in CONSTANTS_DTYPE.names)], dtype=CONSTANTS_DTYPE)
-    return WetParams(constants, np.concatenate(parts), new_work(scenario.initial_temperature_c), _array(gv),
-                     _array(gt), _array(gf), _array(table))
+    return WetParams(constants, np.concatenate([new_work(scenario.initial_temperature_c)] + parts))
 
 
 def new_work(initial_temperature_c):
@@ -644,7 +656,7 @@ def new_work(initial_temperature_c):
 
 
 def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) -> WetParams:
-    """A copy of packed parameters with a new per-run buffer and some constants replaced (batch variants).
+    """A copy of packed parameters with a new per-run buffer and some constants replaced.
 
     Parameters
     ----------
@@ -660,30 +672,38 @@ def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) 
         constants = constants.copy()
         for name, value in overrides.items():
             constants[name] = value
-    return params._replace(constants=constants, work=new_work(initial_temperature_c))
+    data = params.data.copy()
+    data[:N_WORK] = new_work(initial_temperature_c)
+    return params._replace(constants=constants, data=data)
 
 
-def variant_parameters(params: WetParams, constants, work) -> WetParams:
-    """Parameters of one batch variant: its own constants record, work buffer and copy of the tables.
+def batch_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray) -> list:
+    """Parameters of the variants of a batch: each its own constants record, per-run buffer and tables.
 
     Parameters
     ----------
     params : WetParams
-        The base case (its friction-map arrays are shared: read only for a tabulated law).
-    constants : numpy.void or ndarray
-        The variant's constants (one record of :data:`CONSTANTS`).
+        The base case.
+    constants : ndarray
+        The variants' constants, an array of ``m`` records of :data:`CONSTANTS`.
     work : ndarray
-        Its per-run buffer (:func:`new_work`).
+        Their per-run buffers, ``(m, N_WORK)`` (:func:`new_work`).
+
+    Returns
+    -------
+    list of WetParams
 
     Notes
     -----
-    Every array a variant's right-hand side reads is its own, so the
-    reference counts numba keeps on them are not contended between the
-    threads of a parallel batch.
+    Every array a variant's hooks read is its own, so the reference counts
+    numba keeps on them are not contended between the threads of a parallel
+    batch.  (A record array is copied as raw bytes: NumPy copies structured
+    arrays field by field, five times slower.)
     """
-    own = np.empty(1, dtype=CONSTANTS_DTYPE)
-    own[0] = constants
-    return params._replace(constants=own, tables=params.tables.copy(), work=np.array(work, dtype=float))
+    raw = np.ascontiguousarray(constants, dtype=CONSTANTS_DTYPE).view(np.uint8).reshape(len(constants), -1)
+    data = np.tile(params.data, (len(constants), 1))
+    data[:, :N_WORK] = work
+    return [WetParams(raw[i].copy().view(CONSTANTS_DTYPE), data[i].copy()) for i in range(len(constants))]
 
 
 def peak_temperature(params: WetParams) -> float:
@@ -694,7 +714,7 @@ def peak_temperature(params: WetParams) -> float:
     params : WetParams
         After the run.
     """
-    return float(params.work[W_PEAK])
+    return float(params.data[W_PEAK])
 
 
 def lockup_time(params: WetParams) -> float:
@@ -705,7 +725,7 @@ def lockup_time(params: WetParams) -> float:
     params : WetParams
         After the run.
     """
-    return float(params.work[W_LOCKUP])
+    return float(params.data[W_LOCKUP])
 
 
 def initial_state(scenario) -> np.ndarray:
