@@ -30,7 +30,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from clutchlab.fmu.cosim import WetCoSimulation
+from clutchlab.numerics import core
 from clutchlab.wet import engagement as E
+from clutchlab.wet import system as W
 
 T_END = 0.45
 FORCE = 3000.0
@@ -52,7 +54,7 @@ def cosim(dt, n):
     c = WetCoSimulation(**START)
     u = {"force_reference": FORCE, "slip_speed_reference": 0.0}
     c.initial_outputs(u)
-    w = [c.state[E.S_W]]
+    w = [c.state[W.S_W]]
     for k in range(n):
         w.append(c.do_step(k * dt, dt, u)["slip_speed"])
     return np.array(w)
@@ -62,23 +64,25 @@ def scipy_cosim(dt, n):
     c = WetCoSimulation(**START)
     u = {"force_reference": FORCE, "slip_speed_reference": 0.0}
     c.initial_outputs(u)
-    y = c.state.copy()
-    ft, fv, st, sv = c._profiles(u)
-    fk, fc, fgv, fgt, fgf, ftab = c._fdata
-    g0, gdt, gv, gd = c._gw
-    aux = np.empty(E.N_AUX)
-    p = c._p
+    sim = c.simulation
+    system = sim.system
+    y = sim.x.copy()
+    uu = sim.u.copy()
+    m = sim.m.copy()
+    m[W.M_PISTON] = W.FREE  # the force is far above the preload: the piston leaves its stop at once
+    g = np.empty(len(system.switching))
+    p = system.params
 
     def rhs(t, yy):
-        dy = np.empty(E.N_STATE)
-        E._rhs(t, yy, E.SLIP, p, int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, dy, aux)
+        dy = np.empty(len(system.states))
+        core.evaluate(p, t, np.ascontiguousarray(yy), uu, m, dy, g)  # the model's compiled rhs, through the contract
         return dy
 
-    w = [y[E.S_W]]
+    w = [y[W.S_W]]
     for k in range(n):
-        sol = solve_ivp(rhs, (k * dt, (k + 1) * dt), y, method="RK45", rtol=1e-7, atol=c._atol, max_step=0.01)
+        sol = solve_ivp(rhs, (k * dt, (k + 1) * dt), y, method="RK45", rtol=1e-7, atol=system.atol, max_step=0.01)
         y = sol.y[:, -1].copy()
-        w.append(y[E.S_W])
+        w.append(y[W.S_W])
     return np.array(w)
 
 

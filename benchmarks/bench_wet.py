@@ -1,7 +1,8 @@
 """Wet-clutch performance, measured in one run.
 
 1. A 1 s engagement (protocol (b): force rise, speed-controlled slip ramp-down,
-   lock-up event, stick mode) with the compiled DOPRI kernel, against real
+   lock-up event, stick mode) with the integrator core (compiled Dormand-Prince
+   5(4), events located on the dense output), against real
    time and against ``scipy.integrate.solve_ivp`` (RK45, the same Dormand-Prince
    pair) integrating the same equations with a Python right-hand side at the
    same tolerances, with the same lock-up / break-away events.
@@ -24,7 +25,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from clutchlab.wet import Bench, ParametricFriction, WetClutch, simulate_batch, simulate_engagement
-from clutchlab.wet import engagement as E
+from clutchlab.wet import system as W
 from clutchlab.wet.bench import EngagementProtocol, MapProtocol, run_protocol
 from clutchlab.wet.film import gw_table
 from clutchlab.wet.identify import identify_friction_map, identify_thermal
@@ -44,8 +45,9 @@ def best_of(fn, repeat):
 
 # ---------------------------------------------------------------- Python reference
 def make_python_model(clutch, bench, scen, friction):
-    """The engagement equations of clutchlab.wet.engagement._rhs, transcribed to plain Python."""
-    p = E.parameter_vector(clutch, bench, scen)
+    """The engagement equations of clutchlab.wet.system (the model's rhs), transcribed to plain Python."""
+    c = W.pack_parameters(clutch, bench, scen, friction).constants[0]
+    p = {name: c[name].item() for name in c.dtype.names}
     g0, gdt, gv, gd = gw_table()
     gv = gv.tolist()
     gd = gd.tolist()
@@ -82,44 +84,44 @@ def make_python_model(clutch, bench, scen, friction):
         return s * math.exp(-0.5 * t * t) / math.sqrt(2 * math.pi) * u * (1 - 3 * u + 15 * u * u - 105 * u**3 + 945 * u**4)
 
     def terms(t, y, mode):
-        nc = p[E.P_NC]
+        nc = p["n_c"]
         x, fa, w, integ, temp, tf, th = y[0], y[1], y[2], y[3], y[4], y[5], y[6]
-        h = (p[E.P_XH0] - x) / nc
-        hbar = film(h, p[E.P_SIGMA])
-        muv = p[E.P_MU1] * math.exp(p[E.P_MU2] * temp) + p[E.P_MU3] * math.exp(p[E.P_MU4] * temp)
-        fc = p[E.P_AREA] * p[E.P_GW] * gw(h / p[E.P_SIGMA])
-        v = p[E.P_REFF] * w
+        h = (p["piston_h0"] - x) / nc
+        hbar = film(h, p["sigma"])
+        muv = p["mu_v1"] * math.exp(p["mu_v2"] * temp) + p["mu_v3"] * math.exp(p["mu_v4"] * temp)
+        fc = p["friction_area"] * p["gw_scale"] * gw(h / p["sigma"])
+        v = p["r_eff"] * w
         muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-abs(v) / law.v_s), 0.0)
-        cap = p[E.P_REFF] * nc * muf * fc
+        cap = p["r_eff"] * nc * muf * fc
         wref = pwl(t, st, sv)
-        fref = min(pwl(t, ft, fv), p[E.P_FMAX])
+        fref = min(pwl(t, ft, fv), p["actuator_force_max"])
         e = wref - w
-        tcmd = p[E.P_KP] * e + integ
-        tlim = p[E.P_TMAX]
-        if abs(w) * tlim > p[E.P_PMAX]:
-            tlim = p[E.P_PMAX] / abs(w)
+        tcmd = p["speed_kp"] * e + integ
+        tlim = p["drive_torque_max"]
+        if abs(w) * tlim > p["motor_power_max"]:
+            tlim = p["motor_power_max"] / abs(w)
         td = min(max(tcmd, -tlim), tlim)
-        dint = p[E.P_KI] * e + p[E.P_KI] / p[E.P_KP] * (td - tcmd)
+        dint = p["speed_ki"] * e + p["speed_ki"] / p["speed_kp"] * (td - tcmd)
         if mode == "stick":
             tau, wdot, pf = td, 0.0, 0.0
         else:
             sgn = 1.0 if mode == "slip+" else -1.0
-            tau = sgn * cap + p[E.P_REFF] * nc * muv * p[E.P_AREA] * v / hbar
-            wdot = (td - tau) / p[E.P_J]
+            tau = sgn * cap + p["r_eff"] * nc * muv * p["friction_area"] * v / hbar
+            wdot = (td - tau) / p["total_inertia"]
             pf = tau * w
-        fnet = fa - p[E.P_F0] - p[E.P_KS] * x - fc
-        csq = p[E.P_KSQ] * muv / (nc * hbar**3)
-        xdot = p[E.P_VMAX] * math.tanh(fnet / (csq * p[E.P_VMAX]))
+        fnet = fa - p["spring_preload"] - p["spring_stiffness"] * x - fc
+        csq = p["squeeze_coefficient"] * muv / (nc * hbar**3)
+        xdot = p["actuator_speed_max"] * math.tanh(fnet / (csq * p["actuator_speed_max"]))
         if x <= 0 and xdot < 0:
             xdot = 0.0
-        qk1 = p[E.P_K1] * (temp - tf)
-        qk2 = p[E.P_K2] * (temp - th)
-        qh = min(max(p[E.P_GHEAT] * (p[E.P_TSET] - tf), 0.0), p[E.P_QMAX])
-        qfh = p[E.P_KFH] * (tf - th)
-        dy = [xdot, (fref - fa) / p[E.P_TAUA], wdot, dint, (pf - qk1 - qk2) / p[E.P_CPACK],
-              (qk1 + qh - p[E.P_KRA] * (tf - p[E.P_TAMB]) - qfh) / p[E.P_CRES],
-              (qk2 + qfh - p[E.P_KHA] * (th - p[E.P_TAMB])) / p[E.P_CH], (temp - y[7]) / p[E.P_TAUTH],
-              pf, qk1, qk2, td * w]
+        qk1 = p["k1"] * (temp - tf)
+        qk2 = p["k2"] * (temp - th)
+        qh = min(max(p["heater_gain"] * (p["heater_setpoint"] - tf), 0.0), p["heater_power_max"])
+        qfh = p["fluid_housing_conductance"] * (tf - th)
+        dy = [xdot, (fref - fa) / p["actuator_time_constant"], wdot, dint, (pf - qk1 - qk2) / p["heat_capacity"],
+              (qk1 + qh - p["reservoir_cooling"] * (tf - p["ambient_temperature"]) - qfh) / p["reservoir_heat_capacity"],
+              (qk2 + qfh - p["housing_cooling"] * (th - p["ambient_temperature"])) / p["housing_heat_capacity"],
+              (temp - y[7]) / p["thermistor_time_constant"], pf, qk1, qk2, td * w]
         return dy, td, cap
 
     return terms
@@ -127,8 +129,8 @@ def make_python_model(clutch, bench, scen, friction):
 
 def solve_reference(clutch, bench, scen, friction, t_eval):
     terms = make_python_model(clutch, bench, scen, friction)
-    atol = E._atol(clutch)
-    y = E.initial_state(scen)
+    atol = W.absolute_tolerance(clutch, RTOL)
+    y = W.initial_state(scen)
     t = 0.0
     mode = "slip+" if y[2] > 0 else ("slip-" if y[2] < 0 else "stick")
     ts, ys, events = [], [], []

@@ -29,6 +29,8 @@ MEMORY_ENV = "CLUTCHLAB_MEMORY_LIMIT"
 MEMORY_FRACTION = 0.5
 #: budget when the available memory cannot be determined [bytes]
 _FALLBACK_BUDGET = 2 * 1024**3
+#: tables this small pass without reading the available memory (unless CLUTCHLAB_MEMORY_LIMIT is set) [bytes]
+_SMALL = 1024**2
 _SUFFIXES = {"": 1, "B": 1, "K": 1024, "KB": 1024, "KIB": 1024, "M": 1024**2, "MB": 1024**2, "MIB": 1024**2,
              "G": 1024**3, "GB": 1024**3, "GIB": 1024**3, "T": 1024**4, "TB": 1024**4, "TIB": 1024**4}
 _SIZE = re.compile(r"^\s*(\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
@@ -114,6 +116,8 @@ def check_allocation(rows, columns, what: str, *, itemsize: int = 8) -> int:
     need = rows * max(columns, 1.0) * itemsize
     if not math.isfinite(need):
         raise ParameterError(f"{what}: the number of values is not finite ({short_repr(rows)} rows)")
+    if need <= _SMALL and not os.environ.get(MEMORY_ENV, "").strip():
+        return int(need)  # far below any default budget: no need to ask the system (a file read per call)
     budget = memory_budget()
     if need > budget:
         raise ParameterError(

@@ -75,13 +75,13 @@ def test_friction_and_protocol_variants_split_into_batches_with_the_same_numbers
 def test_force_and_speed_levels_share_one_batch(monkeypatch):
     """Protocol force / initial slip levels become per-variant scale factors: one kernel call for the chunk."""
     calls = []
-    real = target._integrate_batch
+    real = target.simulate_batch
 
-    def spy(pmat, *args):
-        calls.append(pmat.shape[0])
-        return real(pmat, *args)
+    def spy(systems, *args, **kwargs):
+        calls.append(len(systems))
+        return real(systems, *args, **kwargs)
 
-    monkeypatch.setattr(target, "_integrate_batch", spy)
+    monkeypatch.setattr(target, "simulate_batch", spy)
     variants = frame(**{"protocol.force": [2500.0, 3000.0, 3500.0],
                         "protocol.initial_slip_speed": [150.0, 160.0, 170.0]})
     out = target.run_batch(variants, None, ["energy", "engagement_time"])

@@ -10,8 +10,8 @@ re-simulated from t = 0.
 
 * :class:`WetCoSimulation` -- the wet-clutch bench of Shin, Kim and Choi
   ([1], Eqs. 1-8) with the engagement dynamics of
-  :mod:`clutchlab.wet.engagement`; resumed with
-  ``engagement._integrate_from``.
+  :mod:`clutchlab.wet.engagement`; written against the system contract
+  (a :class:`clutchlab.system.Simulation` of the ``"wet"`` system).
 * :class:`EmtcCoSimulation` -- the AWD vehicle with the EMTC on the drum
   bench ([2], Eqs. 8-31), the ``emtc_bench`` system of
   :mod:`clutchlab.emtc.system` resumed step by step by a
@@ -371,34 +371,33 @@ def _wet_variables():
     return clutch + bench + scenario
 
 
-#: (output name, unit, description, source) -- source: ("aux", index) or ("state", index) or ("stick",)
+#: (output name, unit, description, source) -- source: ("output", system output) or ("state", system state)
+#: or ("stick",)
 def _wet_output_table():
-    from ..wet import engagement as E
-
     return (
-        ("clutch_torque", "N.m", "clutch torque tau = T_c + T_v (Eq. 3)", ("aux", E.A_TAU)),
-        ("contact_torque", "N.m", "asperity contact torque T_c (Eq. 4)", ("aux", E.A_TC)),
-        ("viscous_torque", "N.m", "viscous torque T_v (Eq. 5)", ("aux", E.A_TV)),
-        ("slip_speed", "rad/s", "slip speed = clutch shaft speed", ("state", E.S_W)),
-        ("drive_torque", "N.m", "motor torque at the clutch shaft", ("aux", E.A_TD)),
-        ("sensor_torque", "N.m", "torque at the shaft torque sensor", ("aux", E.A_TS)),
-        ("static_capacity", "N.m", "static torque capacity r_eff N_c mu_f F_c", ("aux", E.A_CAP)),
-        ("contact_force", "N", "asperity contact force F_c (Greenwood-Williamson)", ("aux", E.A_FC)),
-        ("squeeze_force", "N", "hydrodynamic squeeze-film force", ("aux", E.A_FH)),
-        ("load_cell_force", "N", "force at the actuator load cell", ("aux", E.A_FLC)),
-        ("actuator_force", "N", "actuator force (first-order lag of the reference)", ("state", E.S_FA)),
-        ("piston_position", "m", "piston position x_p", ("state", E.S_X)),
-        ("nominal_separation", "m", "nominal film thickness h per interface (Eq. 1)", ("aux", E.A_H)),
-        ("mean_film", "m", "Patir-Cheng mean film thickness h_bar (Eq. 2)", ("aux", E.A_HBAR)),
-        ("mu_f", "1", "asperity friction coefficient", ("aux", E.A_MUF)),
-        ("viscosity", "Pa.s", "oil viscosity mu_v (Eq. 7)", ("aux", E.A_MUV)),
-        ("friction_power", "W", "friction power tau * omega", ("aux", E.A_PF)),
-        ("heater_power", "W", "reservoir heater power", ("aux", E.A_QH)),
-        ("temperature", "degC", "pack temperature T (Eq. 8)", ("state", E.S_T)),
-        ("fluid_temperature", "degC", "oil reservoir temperature", ("state", E.S_TF)),
-        ("housing_temperature", "degC", "housing temperature", ("state", E.S_TH)),
-        ("thermistor_temperature", "degC", "thermistor reading (first-order lag of T)", ("state", E.S_TM)),
-        ("friction_work", "J", "friction work since t = 0", ("state", E.S_EF)),
+        ("clutch_torque", "N.m", "clutch torque tau = T_c + T_v (Eq. 3)", ("output", "clutch_torque")),
+        ("contact_torque", "N.m", "asperity contact torque T_c (Eq. 4)", ("output", "contact_torque")),
+        ("viscous_torque", "N.m", "viscous torque T_v (Eq. 5)", ("output", "viscous_torque")),
+        ("slip_speed", "rad/s", "slip speed = clutch shaft speed", ("state", "slip_speed")),
+        ("drive_torque", "N.m", "motor torque at the clutch shaft", ("output", "drive_torque")),
+        ("sensor_torque", "N.m", "torque at the shaft torque sensor", ("output", "sensor_torque")),
+        ("static_capacity", "N.m", "static torque capacity r_eff N_c mu_f F_c", ("output", "static_capacity")),
+        ("contact_force", "N", "asperity contact force F_c (Greenwood-Williamson)", ("output", "contact_force")),
+        ("squeeze_force", "N", "hydrodynamic squeeze-film force", ("output", "squeeze_force")),
+        ("load_cell_force", "N", "force at the actuator load cell", ("output", "load_cell_force")),
+        ("actuator_force", "N", "actuator force (first-order lag of the reference)", ("state", "actuator_force")),
+        ("piston_position", "m", "piston position x_p", ("state", "piston_position")),
+        ("nominal_separation", "m", "nominal film thickness h per interface (Eq. 1)", ("output", "nominal_separation")),
+        ("mean_film", "m", "Patir-Cheng mean film thickness h_bar (Eq. 2)", ("output", "mean_film")),
+        ("mu_f", "1", "asperity friction coefficient", ("output", "friction_coefficient")),
+        ("viscosity", "Pa.s", "oil viscosity mu_v (Eq. 7)", ("output", "viscosity")),
+        ("friction_power", "W", "friction power tau * omega", ("output", "friction_power")),
+        ("heater_power", "W", "reservoir heater power", ("output", "heater_power")),
+        ("temperature", "degC", "pack temperature T (Eq. 8)", ("state", "temperature")),
+        ("fluid_temperature", "degC", "oil reservoir temperature", ("state", "fluid_temperature")),
+        ("housing_temperature", "degC", "housing temperature", ("state", "housing_temperature")),
+        ("thermistor_temperature", "degC", "thermistor reading (first-order lag of T)", ("state", "thermistor_temperature")),
+        ("friction_work", "J", "friction work since t = 0", ("state", "friction_work")),
         ("stick", "1", "1 while the clutch is locked (stick mode), 0 while slipping", ("stick",)),
     )
 
@@ -420,11 +419,15 @@ class WetCoSimulation(CoSimulation):
     (Eqs. 1-2), viscosity (Eq. 7), temperatures (Eq. 8), friction work and
     the stick flag.
 
-    Each :meth:`do_step` resumes the compiled DOPRI 5(4) integration of
-    :mod:`clutchlab.wet.engagement` (``_integrate_from``) at the stored state,
-    mode (slip / stick / reverse slip) and step size, with both references
-    constant over the step; lock-up, break-away and contact inside the step
-    are located as in the native run and kept in :attr:`events`.
+    Written against the system contract: the model is the ``"wet"``
+    :class:`~clutchlab.system.System` (:func:`clutchlab.wet.system.engagement_system`)
+    with flat reference profiles, run by a :class:`clutchlab.system.Simulation`
+    whose held inputs are the two references.  Each :meth:`do_step`
+    continues the integration (``Simulation.advance``) from the stored
+    state, modes and step size; lock-up, break-away, contact and the piston
+    stop inside the step are located as in the native run and kept in
+    :attr:`events` (``result.events`` names of :func:`clutchlab.wet.simulate`
+    are in :attr:`simulation` ``.events()``).
 
     Notes
     -----
@@ -461,6 +464,7 @@ class WetCoSimulation(CoSimulation):
             raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
         if not self.max_step > 0:
             raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
+        # flat (zero) profiles: the references are the held inputs of the system
         self.scenario = E.Scenario(
             force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
             motor="free" if free else "speed", initial_slip_speed=values["scenario.initial_slip_speed"],
@@ -468,23 +472,34 @@ class WetCoSimulation(CoSimulation):
             fluid_temperature_c=values["scenario.fluid_temperature"],
             housing_temperature_c=values["scenario.housing_temperature"],
             heater_setpoint_c=values["scenario.heater_setpoint"])
-        self._p = E.parameter_vector(self.clutch, self.bench, self.scenario)
-        self._p[E.P_MUSCALE] = values["scenario.mu_scale"]
-        self._atol = E._atol(self.clutch)
-        self._fdata = E._friction_data(None)
-        self._gw = E.gw_table()
+        self._mu_scale = values["scenario.mu_scale"]
         self._table = _wet_output_table()
         self.reset()
 
     def reset(self) -> None:
         self.time = 0.0
-        self.state = None  # set at the first step / initial_outputs (the actuator force starts at its reference)
-        self.mode = -1
-        self._h = 0.0
+        self.simulation = None  # created at the first step / initial_outputs (the actuator starts at its reference)
         self.events = []
-        self.n_steps = 0
+        self._n_events = 0
 
-    def _profiles(self, u):
+    @property
+    def state(self):
+        """State vector of the wet system (order of ``clutchlab.wet.system.STATES``), None before the start."""
+        return None if self.simulation is None else self.simulation.x
+
+    @property
+    def mode(self) -> int:
+        """Friction mode: 0 slip (positive), 1 stick, 2 slip (negative); -1 before the start."""
+        from ..wet import system as W
+
+        return -1 if self.simulation is None else int(self.simulation.m[W.M_FRICTION])
+
+    @property
+    def n_steps(self) -> int:
+        """Accepted integration steps since the start."""
+        return 0 if self.simulation is None else self.simulation.stats["accepted_steps"]
+
+    def _inputs(self, u):
         fmax = self.bench.actuator_force_max
         f = u["force_reference"]
         w = u["slip_speed_reference"]
@@ -493,47 +508,41 @@ class WetCoSimulation(CoSimulation):
         if self.scenario.motor == "speed" and abs(w) > self.bench.drive_speed_max:
             raise ParameterError(f"input slip_speed_reference = {w!r} rad/s exceeds the bench's speed limit "
                                  f"{self.bench.drive_speed_max:.6g} rad/s")
-        zero = np.zeros(1)
-        return zero, np.array([f]), zero, np.array([w])
+        return np.array([f, w])
 
     def _start(self, u):
-        from ..wet import engagement as E
+        from ..system import Simulation
+        from ..wet import system as W
 
-        y = E.initial_state(self.scenario)
-        y[E.S_FA] = u["force_reference"]  # the actuator force starts at its reference, as in the native run
-        self.state = y
-        self.mode = -1
+        x0 = W.initial_state(self.scenario)
+        x0[W.S_FA] = u["force_reference"]  # the actuator force starts at its reference, as in the native run
+        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
+        system = W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params, x0=x0,
+                                     rtol=self.rtol)
+        self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000)
+        self.simulation.set_inputs(self._inputs(u))
 
-    def _outputs(self, u):
-        from ..wet import engagement as E
-
-        ft, fv, st, sv = self._profiles(u)
-        mode = self.mode
-        if mode < 0:
-            w = self.state[E.S_W]
-            mode = E.SLIP if w > 0 else (E.SLIP_NEG if w < 0 else E.STICK)
-        dy = np.empty(E.N_STATE)
-        aux = np.empty(E.N_AUX)
-        fk, fc, fgv, fgt, fgf, ftab = self._fdata
-        g0, gdt, gv, gd = self._gw
-        E._rhs(self.time, self.state, mode, self._p, int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
-               ft, fv, st, sv, dy, aux)
+    def _outputs(self):
+        sim = self.simulation
+        system = sim.system
+        y = sim.outputs()
         out = {}
         for name, _, _, src in self._table:
-            if src[0] == "aux":
-                out[name] = float(aux[src[1]])
+            if src[0] == "output":
+                out[name] = float(y[system.output_index(src[1])])
             elif src[0] == "state":
-                out[name] = float(self.state[src[1]])
+                out[name] = float(sim.x[system.state_index(src[1])])
             else:
-                out[name] = 1.0 if mode == E.STICK else 0.0
+                out[name] = 1.0 if self.mode == 1 else 0.0
         return out
 
     def initial_outputs(self, inputs: dict) -> dict:
         u = self.resolve_inputs(inputs)
-        if self.state is None or self.time != 0.0:
+        if self.simulation is None or self.time != 0.0:
             self.reset()
             self._start(u)
-        return self._outputs(u)
+        self.simulation.set_inputs(self._inputs(u))
+        return self._outputs()
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` with the references held; return the outputs at ``t + dt``.
@@ -549,33 +558,20 @@ class WetCoSimulation(CoSimulation):
 
         _check_time("WetCoSimulation", self.time, t, dt)
         u = self.resolve_inputs(inputs)
-        if self.state is None:
+        if self.simulation is None:
             self._start(u)
-        ft, fv, st, sv = self._profiles(u)
-        fk, fc, fgv, fgt, fgf, ftab = self._fdata
-        g0, gdt, gv, gd = self._gw
         t_end = t + dt
-        y = self.state.copy()
-        ts = np.zeros(0)
-        et = np.zeros(E.MAX_EVENTS)
-        ek = np.zeros(E.MAX_EVENTS, dtype=np.int64)
-        nev, steps, status, _peak, _tl, mode, h = E._integrate_from(
-            self._p, y, float(t), int(self.mode), float(self._h), float(t_end), ts, float(self.rtol),
-            self._atol, float(self.max_step), 2_000_000, int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
-            ft, fv, st, sv, np.zeros((0, E.N_STATE)), np.zeros((1, E.N_AUX)), np.zeros(0, dtype=np.int64),
-            et, ek, False)
-        if status == 1:
-            raise SimulationError(f"WetCoSimulation: step limit reached between t = {t} and {t_end} s")
-        if status == 2:
-            raise SimulationError(f"WetCoSimulation: step size underflow between t = {t} and {t_end} s")
-        self.state = y
-        self.mode = int(mode)
-        self._h = float(h)
+        try:
+            self.simulation.advance(t_end, self._inputs(u))
+        except SimulationError as exc:
+            raise SimulationError(f"WetCoSimulation: between t = {t} and {t_end} s: {exc}") from None
         self.time = t_end
-        self.n_steps += int(steps)
-        order = np.argsort(et[:nev], kind="stable")
-        self.events.extend(E.Event(float(et[i]), E.EVENT_KINDS[int(ek[i])]) for i in order)
-        return self._outputs(u)
+        ev = self.simulation.events()
+        new = ev.iloc[self._n_events:]
+        self._n_events = len(ev)
+        self.events.extend(E.Event(float(tt), E.EVENT_KINDS[name]) for tt, name in zip(new["time_s"], new["event"])
+                           if name in E.EVENT_KINDS)
+        return self._outputs()
 
 
 # ===================================================================== EMTC

@@ -148,8 +148,8 @@ class EventLog(NamedTuple):
 
 
 def new_log(capacity: int) -> EventLog:
-    """An empty event log holding up to ``capacity`` events."""
-    return EventLog(np.zeros(capacity), np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+    """An empty event log holding up to ``capacity`` events (only the first ``count[0]`` entries are ever read)."""
+    return EventLog(np.empty(capacity), np.empty(capacity, dtype=np.int64), np.empty(capacity, dtype=np.int64),
                     np.zeros(2, dtype=np.int64))
 
 

@@ -19,24 +19,18 @@ engagement protocol, Fig. 14 of Shin et al.) with some parameters changed:
 * ``batch.force_scale``, ``batch.mu_scale``, ``batch.speed_scale`` -- the
   per-variant multipliers of :func:`clutchlab.wet.simulate_batch`.
 
-All variants of a chunk that share the reference profiles, the friction law
-and the absolute tolerances (which scale with ``clutch.sigma``) run in one call
-of the compiled batch kernel of :mod:`clutchlab.wet.engagement` (one DOPRI 5(4)
-solver per variant, ``numba.prange``), with their own parameter vector
-(``parameter_vector``) and initial state each -- so sweeping any clutch or
-bench field keeps the whole chunk in one parallel batch.  The force and
-slip-speed reference profiles are normalised to a peak of one and their
-levels moved into the kernel's per-variant scale factors whenever a
-``protocol.*`` parameter is swept, so sweeping ``protocol.force``,
-``protocol.initial_slip_speed`` or the temperatures also keeps one batch.  Sweeping the timing of the protocol (rise, ramp,
-duration), the friction law or ``clutch.sigma`` (the absolute tolerance of
-the piston position scales with it) splits a chunk into one batch per
-distinct value (a Monte Carlo over ``friction.mu0`` runs one variant per
-batch call).  A variant's result does not depend on which other variants
-share its batch.  It equals :func:`clutchlab.wet.simulate_batch` of the same
-variant bit for bit when no ``protocol.*`` parameter is swept; otherwise the
-normalised profiles (rounded to 1e-13 of the peak) change the step sequence
-and the results agree within the integration tolerance (``rtol`` = 1e-6).
+Written against the system contract: every variant is the ``"wet"``
+:class:`~clutchlab.system.System` (:func:`clutchlab.wet.system.engagement_system`)
+with its own packed parameters -- clutch, bench, friction law, reference
+profiles, scale factors -- and initial state, and all variants of a chunk
+that share the duration and the absolute tolerances (which scale with
+``clutch.piston_h0``) run in one call of :func:`clutchlab.system.simulate_batch`
+(one Dormand-Prince 5(4) solver per variant, ``numba.prange``).  Sweeping
+any field, the protocol and the friction law included, therefore keeps a
+chunk in one parallel batch; only ``protocol.duration`` or
+``clutch.piston_h0`` split it.  A variant's result does not depend on which
+other variants share its batch, and equals :func:`clutchlab.wet.simulate_batch`
+of the same variant bit for bit.
 
 Outputs (per variant): ``engagement_time`` [s] (lock-up time, NaN if the
 clutch did not lock), ``energy`` [J] (friction work, the integral of
@@ -63,11 +57,10 @@ import pandas as pd
 
 from ..errors import ParameterError
 from ..params import load_toml
+from ..system import simulate_batch
+from ..wet import system as W
 from ..wet.bench import PROTOCOL_TYPES, EngagementProtocol, MapProtocol
-from ..wet.engagement import (
-    P_FSCALE, P_MUSCALE, P_WSCALE, S_FA, _atol, _check_scenario, _integrate_batch, initial_state, parameter_vector,
-)
-from ..wet.film import gw_table
+from ..wet.engagement import check_scenario
 from ..wet.friction import ParametricFriction
 from ..wet.params import Bench, WetClutch
 from .targets import check_outputs, nan_frame, rows, sweepable_fields, vary_parameter_set
@@ -86,7 +79,8 @@ OUTPUTS = {
 }
 _SUMMARY_COLUMN = {"engagement_time": 0, "energy": 1, "peak_temperature_c": 2, "final_temperature_c": 3,
                    "final_slip_speed": 4, "n_steps": 5, "status": 6}
-_BATCH = {"batch.force_scale": P_FSCALE, "batch.mu_scale": P_MUSCALE, "batch.speed_scale": P_WSCALE}
+#: per-variant multipliers -> the constants of the packed parameters they set
+_BATCH = {"batch.force_scale": "force_scale", "batch.mu_scale": "mu_scale", "batch.speed_scale": "speed_scale"}
 
 #: step control of every variant (the defaults of :func:`clutchlab.wet.simulate_batch`)
 RTOL = 1e-6
@@ -138,14 +132,12 @@ def describe(scenario) -> dict:
 
 
 def _build(variants: pd.DataFrame, scenario):
-    """Per variant: parameter vector, initial state, and the batch key (profiles, friction, tolerances)."""
+    """Per variant: (batch key, System) -- the key groups variants that can share one batch call."""
     protocol, ptype, clutch, bench, friction = _base(scenario)
     motor = "free" if ptype == "inertia_dynamometer" else "speed"
     built = []
     geometry = "clutch.r_outer" in variants.columns or "clutch.r_inner" in variants.columns
     follow_area = geometry and "clutch.friction_area" not in variants.columns
-    # only when the protocol is swept do the profiles differ between variants (decided per spec, not per chunk)
-    normalise = any(str(col).startswith("protocol.") for col in variants.columns)
     area_ratio = clutch.friction_area / (math.pi * (clutch.r_outer**2 - clutch.r_inner**2))
     for vid, row in rows(variants):
         if follow_area:  # the friction area follows the annulus (same land fraction as the base clutch)
@@ -158,33 +150,20 @@ def _build(variants: pd.DataFrame, scenario):
         pr = vary_parameter_set(protocol, "protocol", row, vid)
         try:
             scen = pr.scenario(c) if ptype == "friction_map" else pr.scenario(c, motor=motor)
-            _check_scenario(b, scen)
+            check_scenario(b, scen)
         except ParameterError as exc:
             raise ParameterError(f"variant {vid}: {exc}") from None
-        p = parameter_vector(c, b, scen)
-        for key, col in _BATCH.items():
+        scales = {}
+        for key, field in _BATCH.items():
             if key in row:
                 if not row[key] > 0:
                     raise ParameterError(f"variant {vid}: {key} = {row[key]!r}: must be > 0")
-                p[col] = row[key]
-        y = initial_state(scen)
-        y[S_FA] *= p[P_FSCALE]  # as simulate_batch: the actuator starts at the scaled reference
-        # reference profiles normalised to a peak of 1, their amplitudes carried by the per-variant scale
-        # factors of the kernel: variants differing only in force or speed level share one batch
-        fv, sv = scen.force_value, scen.speed_value
-        f_amp = float(np.max(np.abs(fv))) if normalise else 0.0
-        s_amp = float(np.max(np.abs(sv))) if normalise else 0.0
-        if f_amp > 0:
-            fv = np.round(fv / f_amp, 13)  # rounded so that levels of one shape give identical arrays
-            p[P_FSCALE] *= f_amp
-        if s_amp > 0:
-            sv = np.round(sv / s_amp, 13)
-            p[P_WSCALE] *= s_amp
-        fdata = f.kernel_data()
-        atol = _atol(c)
-        key = (scen.duration, scen.force_time.tobytes(), fv.tobytes(), scen.speed_time.tobytes(), sv.tobytes(),
-               fdata[1].tobytes(), atol.tobytes())
-        built.append((key, p, y, (scen.duration, scen.force_time, fv, scen.speed_time, sv), fdata, atol))
+                scales[field] = float(row[key])
+        params = W.pack_parameters(c, b, scen, f, **scales)
+        x0 = W.initial_state(scen)
+        x0[W.S_FA] *= scales.get("force_scale", 1.0)  # as simulate_batch: the actuator starts at the scaled reference
+        system = W.engagement_system(scen, clutch=c, bench=b, friction=f, params=params, x0=x0, rtol=RTOL)
+        built.append(((scen.duration, system.atol.tobytes()), system))
     return built
 
 
@@ -197,7 +176,7 @@ def check_variants(variants: pd.DataFrame, scenario) -> None:
 
 
 def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
-    """Simulate every variant's engagement; one compiled ``prange`` batch per group of shared profiles.
+    """Simulate every variant's engagement; one compiled ``prange`` batch per duration and tolerance.
 
     Parameters
     ----------
@@ -218,19 +197,21 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     m = len(built)
     summary = np.full((m, 8), np.nan)
     groups: dict = {}
-    for i, item in enumerate(built):
-        groups.setdefault(item[0], []).append(i)
-    g0, gdt, gv, gd = gw_table()
-    for members in groups.values():
-        _, _, _, (duration, ft, fv, st, sv), fdata, atol = built[members[0]]
-        pmat = np.ascontiguousarray(np.array([built[i][1] for i in members]))
-        ymat = np.ascontiguousarray(np.array([built[i][2] for i in members]))
-        ts = np.array([duration])
-        out_y = np.zeros((len(members), 1, ymat.shape[1]))
-        part = np.zeros((len(members), 8))
-        fk, fc, fgv, fgt, fgf, ftab = fdata
-        _integrate_batch(pmat, ymat, float(duration), ts, RTOL, atol, MAX_STEP, MAX_STEPS,
-                         int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, out_y, part)
+    for i, (key, _) in enumerate(built):
+        groups.setdefault(key, []).append(i)
+    for (duration, _), members in groups.items():
+        systems = [built[i][1] for i in members]
+        res = simulate_batch(systems, float(duration), sample_times=[duration], max_step=MAX_STEP,
+                             max_steps=MAX_STEPS, outputs=False)
+        final = res.states[:, -1, :]
+        part = summary[members]
+        part[:, 0] = [W.lockup_time(s.params) for s in systems]
+        part[:, 1] = final[:, W.S_EF]
+        part[:, 2] = [W.peak_temperature(s.params) for s in systems]
+        part[:, 3] = final[:, W.S_T]
+        part[:, 4] = final[:, W.S_W]
+        part[:, 5] = res.stats["accepted_steps"]
+        part[:, 6] = res.status
         summary[members] = part
     out = nan_frame(variants.index, outputs)
     failed = summary[:, 6] != 0

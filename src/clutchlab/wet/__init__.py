@@ -27,11 +27,12 @@ from .thermal import (
 )
 from .friction import FrictionMap, ParametricFriction
 from .params import Bench, WetClutch
-from .engagement import (
+from .engagement import (  # also registers the model "wet" (clutchlab.wet.system)
     BatchResult,
     EngagementResult,
     Event,
     Scenario,
+    simulate,
     simulate_batch,
     simulate_engagement,
 )
@@ -56,7 +57,7 @@ __all__ = [
     "temperature_step_response",
     "ParametricFriction", "FrictionMap",
     "WetClutch", "Bench",
-    "Scenario", "Event", "EngagementResult", "BatchResult", "simulate_engagement", "simulate_batch",
+    "Scenario", "Event", "EngagementResult", "BatchResult", "simulate", "simulate_engagement", "simulate_batch",
     "MapProtocol", "EngagementProtocol", "BenchRun", "run_protocol", "measure", "read_bench_record",
     "write_bench_record", "load_protocol",
     "friction_samples", "fit_parametric_friction", "identify_friction_map", "identify_thermal", "ThermalFit",

@@ -9,7 +9,8 @@ extended to the transient engagement the way Deur et al. [4] do:
   Patir-Cheng mean film h_bar, Eq. 2 [2]) and the Greenwood-Williamson
   asperity contact force [3].  The piston mass is neglected (quasi-static
   force balance), the actuator has a first-order force lag and a no-load
-  speed limit (smooth ``tanh`` saturation);
+  speed limit (smooth ``tanh`` saturation); the piston rests on its stop
+  while the force balance pushes it there;
 * the clutch torque is Eq. 6 with the asperity force ``F_c = A_f p_c(h)``;
 * one rotating inertia (motor, flywheel, gear, shaft referred to the clutch
   shaft) is driven by the speed-controlled motor (PI with back-calculation
@@ -22,14 +23,19 @@ extended to the transient engagement the way Deur et al. [4] do:
 * the energy terms (friction work, heat to oil, heat to housing, drive work)
   are integrated as states, so the energy balance can be audited.
 
-Lock-up (slip speed reaching zero while the static capacity holds the drive
-torque) and break-away are events located inside the step on the dense
-output and switch the mode between *slip* and *stick*; the contact event
-(nominal separation crossing zero, Fig. 3 (b) -> (c)) is recorded.
-
-The integrator is a compiled Dormand-Prince 5(4) loop
-(:mod:`clutchlab.numerics.dopri`); :func:`simulate_batch` runs one solver
-per variant in parallel with ``numba.prange``.
+The model is written once against the system contract, in
+:mod:`clutchlab.wet.system` (parameters, compiled hooks, modes and events),
+and integrated by the one integrator core (:mod:`clutchlab.numerics.core`,
+Dormand-Prince 5(4) with events located on the dense output): lock-up,
+break-away, slip reversal, contact, separation and the piston reaching and
+leaving its stop are located events that switch the modes; the corners of
+the reference profiles are stepped on exactly.  This module holds the
+scenario and the public entry points: :func:`simulate` (returns a
+:class:`clutchlab.SimulationResult`), and the thin wrappers
+:func:`simulate_engagement` (:class:`EngagementResult`) and
+:func:`simulate_batch` (:class:`BatchResult`, on
+:func:`clutchlab.system.simulate_batch`: one solver per variant in
+``numba.prange``).
 
 References
 ----------
@@ -44,24 +50,19 @@ References
 
 from __future__ import annotations
 
+import collections
 import functools
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import pandas as pd
 
 from .._limits import check_allocation, short_repr
-from ..errors import ParameterError, SimulationError
-from ..numerics.interp import bracket
-from ..numerics.dopri import (
-    A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
-    B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
-    dense_hermite, error_norm, initial_step, next_step,
-)
-from .film import film_scalar, gw_scalar, gw_table
-from .friction import ParametricFriction, mu_kernel
+from ..errors import ParameterError
+from ..result import SimulationResult
+from . import system as W
+from .friction import ParametricFriction
 from .params import Bench, WetClutch
 
 __all__ = [
@@ -69,42 +70,24 @@ __all__ = [
     "Event",
     "EngagementResult",
     "BatchResult",
+    "simulate",
     "simulate_engagement",
     "simulate_batch",
+    "check_scenario",
     "STATE_NAMES",
     "OUTPUT_NAMES",
     "BATCH_VARIABLES",
+    "EVENT_KINDS",
 ]
 
-# ----------------------------------------------------------------- layout
-(P_NC, P_REFF, P_SIGMA, P_AREA, P_XH0, P_MU1, P_MU2, P_MU3, P_MU4, P_CPACK, P_K1, P_K2, P_GW, P_KSQ,
- P_KS, P_F0, P_J, P_JSHAFT, P_TMAX, P_PMAX, P_KP, P_KI, P_MOTOR, P_TAUA, P_FMAX, P_VMAX, P_TAUTH,
- P_CRES, P_QMAX, P_GHEAT, P_TSET, P_KRA, P_CH, P_KHA, P_KFH, P_TAMB, P_FSCALE, P_MUSCALE, P_WSCALE,
- N_PAR) = range(40)
-
-STATE_NAMES = (
-    "piston_position_m", "actuator_force_N", "slip_speed_rad_s", "controller_integral_Nm", "temperature_C",
-    "fluid_temperature_C", "housing_temperature_C", "thermistor_temperature_C", "friction_work_J",
-    "heat_to_fluid_J", "heat_to_housing_J", "drive_work_J",
-)
-(S_X, S_FA, S_W, S_I, S_T, S_TF, S_TH, S_TM, S_EF, S_EK1, S_EK2, S_ED) = range(12)
-N_STATE = 12
-
-OUTPUT_NAMES = (
-    "clutch_torque_Nm", "contact_torque_Nm", "viscous_torque_Nm", "contact_force_N", "squeeze_force_N",
-    "load_cell_force_N", "nominal_separation_m", "mean_film_m", "mu_f", "viscosity_Pa_s", "drive_torque_Nm",
-    "slip_reference_rad_s", "force_reference_N", "slip_acceleration_rad_s2", "sensor_torque_Nm",
-    "friction_power_W", "heater_power_W", "static_capacity_Nm",
-)
-(A_TAU, A_TC, A_TV, A_FC, A_FH, A_FLC, A_H, A_HBAR, A_MUF, A_MUV, A_TD, A_WREF, A_FREF, A_WDOT, A_TS,
- A_PF, A_QH, A_CAP) = range(18)
-N_AUX = 18
-
-SLIP, STICK, SLIP_NEG = 0, 1, 2  # SLIP: positive slip direction; SLIP_NEG: negative
-EV_CONTACT, EV_SEPARATION, EV_LOCKUP, EV_BREAKAWAY, EV_REVERSAL = range(5)
+#: column names of :attr:`EngagementResult.states` (those of the system's states)
+STATE_NAMES = tuple(f"{n}_{u}" for n, u, _ in W.STATES)
+#: column names of :attr:`EngagementResult.outputs` (the system's, ``mu_f`` for ``friction_coefficient_1``)
+OUTPUT_NAMES = tuple("mu_f" if n == "friction_coefficient" else f"{n}_{u}" for n, u, _ in W.OUTPUTS)
+#: the event kinds of :attr:`EngagementResult.events`, by the system's event name
+EVENT_KINDS = {"contact": "contact", "separation": "separation", "lockup": "lock-up", "breakaway": "break-away",
+               "slip_reversal": "slip reversal"}
 _MODE_NAMES = np.array(["slip", "stick", "slip"])
-EVENT_KINDS = ("contact", "separation", "lock-up", "break-away", "slip reversal")
-MAX_EVENTS = 64
 
 #: scenario/parameter names that :func:`simulate_batch` can vary per variant
 BATCH_VARIABLES = ("force_scale", "mu_scale", "speed_scale", "initial_slip_speed", "initial_temperature_c",
@@ -113,8 +96,8 @@ BATCH_VARIABLES = ("force_scale", "mu_scale", "speed_scale", "initial_slip_speed
 
 # ----------------------------------------------------------------- scenario
 def _profile(name, t, v):
-    t = np.asarray(t, dtype=float).ravel()
-    v = np.asarray(v, dtype=float).ravel()
+    t = np.array(t, dtype=float).ravel()  # copies: the scenario owns its profiles
+    v = np.array(v, dtype=float).ravel()
     if t.size < 1 or t.size != v.size:
         raise ParameterError(f"Scenario.{name}: time and value need the same, non-zero length ({t.size} vs {v.size})")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
@@ -164,6 +147,8 @@ class Scenario:
     def __post_init__(self):
         ft, fv = _profile("force", self.force_time, self.force_value)
         st, sv = _profile("speed", self.speed_time, self.speed_value)
+        for arr in (ft, fv, st, sv):
+            arr.setflags(write=False)  # a frozen scenario: its profiles cannot change under a cached model
         if np.any(fv < 0):
             raise ParameterError(f"Scenario.force_value: negative force {short_repr(fv[fv < 0][0])} [N]")
         object.__setattr__(self, "force_time", ft)
@@ -183,473 +168,22 @@ class Scenario:
         return self.fluid_temperature_c if self.heater_setpoint_c is None else float(self.heater_setpoint_c)
 
 
-# ----------------------------------------------------------------- compiled model
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _pwl(t, tt, vv):
-    n = tt.shape[0]
-    if t <= tt[0]:
-        return vv[0]
-    if t >= tt[n - 1]:
-        return vv[n - 1]
-    lo, w = bracket(tt, t)
-    return vv[lo] + w * (vv[lo + 1] - vv[lo])
+def check_scenario(bench: Bench, scenario: Scenario) -> None:
+    """Refuse references outside the bench's limits (drive speed, actuator force).
 
+    Parameters
+    ----------
+    bench : Bench
+        The bench whose limits apply.
+    scenario : Scenario
+        The run's references.
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _model(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, dy, aux):
-    """Right-hand side and outputs of the engagement model (see module docstring).
-
-    Inlined into the stage loop of the integrator (the hot call site);
-    :func:`_rhs` is the out-of-line copy used everywhere else.
+    Raises
+    ------
+    ParameterError
+        A slip-speed reference above the drive's speed limit (motor ``"speed"``)
+        or a force reference above the actuator's.
     """
-    nc = p[P_NC]
-    x = y[S_X]
-    fa = y[S_FA]
-    w = y[S_W]
-    temp = y[S_T]
-    h = (p[P_XH0] - x) / nc                                            # [1], Eq. 1
-    hbar = film_scalar(h, p[P_SIGMA])                                   # [1], Eq. 2 (Patir-Cheng)
-    muv = p[P_MU1] * math.exp(p[P_MU2] * temp) + p[P_MU3] * math.exp(p[P_MU4] * temp)  # [1], Eq. 7
-    fc_ = p[P_AREA] * p[P_GW] * gw_scalar(h / p[P_SIGMA], g0, gdt, gv, gd)  # GW [3], Eq. 11
-    v = p[P_REFF] * w                                                  # [1], Eq. (2')
-    muf = p[P_MUSCALE] * mu_kernel(abs(v), temp, fc_, fk, fc, fgv, fgt, fgf, ftab)
-    cap = p[P_REFF] * nc * muf * fc_                                   # [1], Eq. 4 (static capacity)
-    # drive: speed-controlled motor or free inertia
-    wref = p[P_WSCALE] * _pwl(t, st, sv)
-    fref = p[P_FSCALE] * _pwl(t, ft, fv)
-    if fref > p[P_FMAX]:
-        fref = p[P_FMAX]
-    if p[P_MOTOR] == 0.0:
-        e = wref - w
-        tcmd = p[P_KP] * e + y[S_I]
-        aw = abs(w)
-        tlim = p[P_TMAX]
-        if aw * tlim > p[P_PMAX]:
-            tlim = p[P_PMAX] / aw
-        td = min(max(tcmd, -tlim), tlim)
-        kaw = p[P_KI] / p[P_KP] if p[P_KP] > 0.0 else 0.0
-        dy[S_I] = p[P_KI] * e + kaw * (td - tcmd)
-    else:
-        td = 0.0
-        dy[S_I] = 0.0
-    # clutch torque, [1], Eqs. 3-6
-    if mode != STICK:
-        # the sliding direction is part of the mode (changes only at located events),
-        # so the right-hand side stays smooth across dw = 0 within a step
-        sgn = 1.0 if mode == SLIP else -1.0
-        tc = sgn * cap                                                 # [1], Eq. 4
-        tv = p[P_REFF] * nc * muv * p[P_AREA] * v / hbar               # [1], Eq. 5
-        tau = tc + tv                                                  # [1], Eq. 3
-        wdot = (td - tau) / p[P_J]
-        pf = tau * w
-    else:
-        tc = td
-        tv = 0.0
-        tau = td
-        wdot = 0.0
-        pf = 0.0
-    dy[S_W] = wdot
-    # piston: quasi-static balance of actuator, spring, squeeze film and asperities
-    fsp = p[P_F0] + p[P_KS] * x
-    fnet = fa - fsp - fc_
-    csq = p[P_KSQ] * muv / (nc * hbar * hbar * hbar)                  # squeeze film, per piston velocity
-    vmax = p[P_VMAX]
-    xdot = vmax * math.tanh(fnet / (csq * vmax))
-    at_stop = x <= 0.0 and xdot < 0.0
-    if at_stop:
-        xdot = 0.0
-    dy[S_X] = xdot
-    dy[S_FA] = (fref - fa) / p[P_TAUA]
-    # thermal network
-    qk1 = p[P_K1] * (temp - y[S_TF])
-    qk2 = p[P_K2] * (temp - y[S_TH])
-    dy[S_T] = (pf - qk1 - qk2) / p[P_CPACK]                            # [1], Eq. 8
-    qh = p[P_GHEAT] * (p[P_TSET] - y[S_TF])
-    qh = min(max(qh, 0.0), p[P_QMAX])
-    qfh = p[P_KFH] * (y[S_TF] - y[S_TH])
-    dy[S_TF] = (qk1 + qh - p[P_KRA] * (y[S_TF] - p[P_TAMB]) - qfh) / p[P_CRES]
-    dy[S_TH] = (qk2 + qfh - p[P_KHA] * (y[S_TH] - p[P_TAMB])) / p[P_CH]
-    dy[S_TM] = (temp - y[S_TM]) / p[P_TAUTH]
-    dy[S_EF] = pf
-    dy[S_EK1] = qk1
-    dy[S_EK2] = qk2
-    dy[S_ED] = td * w
-    aux[A_TAU] = tau
-    aux[A_TC] = tc
-    aux[A_TV] = tv
-    aux[A_FC] = fc_
-    fh = csq * xdot
-    aux[A_FH] = fh
-    aux[A_FLC] = fa if at_stop else fsp + fc_ + fh
-    aux[A_H] = h
-    aux[A_HBAR] = hbar
-    aux[A_MUF] = muf
-    aux[A_MUV] = muv
-    aux[A_TD] = td
-    aux[A_WREF] = wref
-    aux[A_FREF] = fref
-    aux[A_WDOT] = wdot
-    aux[A_TS] = tau + p[P_JSHAFT] * wdot
-    aux[A_PF] = pf
-    aux[A_QH] = qh
-    aux[A_CAP] = cap
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, dy, aux):
-    """Out-of-line right-hand side (samples, events, step restarts)."""
-    _model(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, dy, aux)
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _integrate(p, y0, t_end, ts, rtol, atol, hmax, max_steps,
-               fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-               out_y, out_aux, out_mode, ev_t, ev_k, want_aux):
-    """Dormand-Prince 5(4) with event location on the dense output.
-
-    Integrates from t = 0 to ``t_end`` starting from ``y0`` (overwritten with
-    the final state), writes states (and outputs if ``want_aux``) at ``ts``
-    and the located events into ``ev_t``/``ev_k``.  Returns (number of events,
-    accepted steps, status, peak pack temperature, first lock-up time or NaN);
-    status 0 ok, 1 step limit, 2 step-size underflow.  The starting mode
-    follows the sign of the initial slip speed; see :func:`_integrate_from`.
-    """
-    nev, steps, status, peak, t_lock, mode, hstep = _integrate_from(
-        p, y0, 0.0, -1, 0.0, t_end, ts, rtol, atol, hmax, max_steps,
-        fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-        out_y, out_aux, out_mode, ev_t, ev_k, want_aux)
-    return nev, steps, status, peak, t_lock
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _integrate_from(p, y0, t0, mode0, h0, t_end, ts, rtol, atol, hmax, max_steps,
-                    fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-                    out_y, out_aux, out_mode, ev_t, ev_k, want_aux):
-    """Dormand-Prince 5(4) from ``(t0, y0, mode0)`` to ``t_end`` (resumable form of :func:`_integrate`).
-
-    ``mode0`` < 0 derives the starting mode from the sign of the slip speed
-    (the fresh start of :func:`_integrate`); ``mode0`` in {SLIP, STICK,
-    SLIP_NEG} resumes a run stopped earlier in that mode (co-simulation,
-    :mod:`clutchlab.fmu`).  On a resume in *stick* the break-away condition
-    is checked at ``t0`` itself, because a step of the slip reference at the
-    communication point can raise the drive torque above the static capacity
-    at once.  ``h0`` > 0 is the first trial step (the step size proposed at
-    the end of the previous call), else it is estimated.  Returns (number of
-    events, accepted steps, status, peak pack temperature, first lock-up
-    time or NaN, mode at ``t_end``, proposed next step).
-    """
-    n = N_STATE
-    y = y0.copy()
-    if mode0 >= 0:
-        mode = mode0
-    elif y[S_W] > 0.0:
-        mode = SLIP
-    elif y[S_W] < 0.0:
-        mode = SLIP_NEG
-    else:
-        mode = STICK
-    t = t0
-    kk = np.zeros((7, n))
-    k1 = kk[0]
-    k3 = kk[2]
-    k4 = kk[3]
-    k5 = kk[4]
-    k6 = kk[5]
-    k7 = kk[6]
-    tab_a = np.zeros((7, 6))
-    tab_a[1, 0] = A21
-    tab_a[2, 0] = A31
-    tab_a[2, 1] = A32
-    tab_a[3, 0] = A41
-    tab_a[3, 1] = A42
-    tab_a[3, 2] = A43
-    tab_a[4, 0] = A51
-    tab_a[4, 1] = A52
-    tab_a[4, 2] = A53
-    tab_a[4, 3] = A54
-    tab_a[5, 0] = A61
-    tab_a[5, 1] = A62
-    tab_a[5, 2] = A63
-    tab_a[5, 3] = A64
-    tab_a[5, 4] = A65
-    tab_a[6, 0] = B1
-    tab_a[6, 2] = B3
-    tab_a[6, 3] = B4
-    tab_a[6, 4] = B5
-    tab_a[6, 5] = B6
-    tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
-    yt = np.empty(n)
-    yn = np.empty(n)
-    err = np.empty(n)
-    ye = np.empty(n)
-    de = np.empty(n)
-    aux = np.empty(N_AUX)
-    aux1 = np.empty(N_AUX)
-    auxn = np.empty(N_AUX)
-    _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, k1, aux)
-    nev = 0
-    if mode0 == STICK and abs(aux[A_TD]) > aux[A_CAP]:
-        # resumed in stick with the drive torque already above the capacity: break away at t0
-        mode = SLIP if aux[A_TD] > 0.0 else SLIP_NEG
-        if nev < ev_t.shape[0]:
-            ev_t[nev] = t
-            ev_k[nev] = EV_BREAKAWAY
-            nev += 1
-        _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, k1, aux)
-    if h0 > 0.0:
-        hstep = h0
-    else:
-        hstep = initial_step(y, k1, rtol, atol, t_end - t, 5)
-    if hstep > hmax:
-        hstep = hmax
-    ns = ts.shape[0]
-    isamp = 0
-    while isamp < ns and ts[isamp] <= t:
-        out_y[isamp, :] = y
-        if want_aux:
-            out_aux[isamp, :] = aux
-        out_mode[isamp] = mode
-        isamp += 1
-    steps = 0
-    status = 0
-    prev_rej = False
-    peak = y[S_T]
-    t_lock = np.nan
-    while t < t_end:
-        if steps >= max_steps:
-            status = 1
-            break
-        if hstep > (t_end - t) * (1.0 - 1e-9):
-            # last step: also stretched by up to 1e-9 relative so that no rounding remainder is left
-            # (a resumed run whose end time is one ulp past t + max_step would otherwise underflow)
-            hstep = t_end - t
-        if hstep < 1e-14 * max(1.0, t):
-            status = 2
-            break
-        hh = hstep
-        # stages 2..7 (k7 at the new point, FSAL) with one inlined call site
-        for stg in range(1, 7):
-            for i in range(n):
-                acc = 0.0
-                for j in range(stg):
-                    acc += tab_a[stg, j] * kk[j, i]
-                yt[i] = y[i] + hh * acc
-            if stg == 6:
-                for i in range(n):
-                    yn[i] = yt[i]
-            _model(t + tab_c[stg] * hh, yt, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-                   kk[stg], auxn)
-        for i in range(n):
-            err[i] = hh * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
-        en = error_norm(err, y, yn, rtol, atol)
-        if not (en <= 1.0):
-            if en != en:
-                hstep = 0.2 * hh
-            else:
-                hstep = next_step(hh, en, False)
-            prev_rej = True
-            continue
-        steps += 1
-        # ---- terminal events: lock-up (slip) / break-away (stick)
-        theta_e = 2.0
-        kind_e = -1
-        if mode != STICK:
-            sd = 1.0 if mode == SLIP else -1.0
-            w0 = sd * y[S_W]
-            w1 = sd * yn[S_W]
-            if w0 >= 0.0 and w1 < 0.0:
-                lo = 0.0
-                hi = 1.0
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    dense_hermite(mid, hh, y, k1, yn, k7, ye)
-                    if sd * ye[S_W] > 0.0:
-                        lo = mid
-                    else:
-                        hi = mid
-                theta_e = hi
-                kind_e = EV_LOCKUP
-        else:
-            g0_ = abs(aux[A_TD]) - aux[A_CAP]
-            g1_ = abs(auxn[A_TD]) - auxn[A_CAP]
-            if g0_ <= 0.0 and g1_ > 0.0:
-                lo = 0.0
-                hi = 1.0
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    dense_hermite(mid, hh, y, k1, yn, k7, ye)
-                    _rhs(t + mid * hh, ye, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, de, aux1)
-                    if abs(aux1[A_TD]) - aux1[A_CAP] <= 0.0:
-                        lo = mid
-                    else:
-                        hi = mid
-                theta_e = hi
-                kind_e = EV_BREAKAWAY
-        # ---- non-terminal: contact / separation (h crosses 0)
-        h0 = p[P_XH0] - y[S_X]
-        h1 = p[P_XH0] - yn[S_X]
-        if (h0 > 0.0) != (h1 > 0.0):
-            lo = 0.0
-            hi = 1.0
-            for _ in range(60):
-                mid = 0.5 * (lo + hi)
-                dense_hermite(mid, hh, y, k1, yn, k7, ye)
-                if ((p[P_XH0] - ye[S_X]) > 0.0) == (h0 > 0.0):
-                    lo = mid
-                else:
-                    hi = mid
-            if hi <= theta_e and nev < ev_t.shape[0]:
-                ev_t[nev] = t + hi * hh
-                ev_k[nev] = EV_CONTACT if h0 > 0.0 else EV_SEPARATION
-                nev += 1
-        t_new = t + hh if kind_e < 0 else t + theta_e * hh
-        # ---- samples in (t, t_new]
-        while isamp < ns and ts[isamp] <= t_new:
-            th = (ts[isamp] - t) / hh
-            dense_hermite(th, hh, y, k1, yn, k7, ye)
-            out_y[isamp, :] = ye
-            if want_aux:
-                _rhs(ts[isamp], ye, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, de, aux1)
-                out_aux[isamp, :] = aux1
-            out_mode[isamp] = mode
-            isamp += 1
-        if kind_e >= 0:
-            dense_hermite(theta_e, hh, y, k1, yn, k7, ye)
-            for i in range(n):
-                y[i] = ye[i]
-            t = t_new
-            if kind_e == EV_LOCKUP:
-                y[S_W] = 0.0
-                _rhs(t, y, STICK, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, de, aux1)
-                if abs(aux1[A_TD]) <= aux1[A_CAP]:
-                    mode = STICK
-                    if t_lock != t_lock:
-                        t_lock = t
-                else:
-                    kind_e = EV_REVERSAL
-                    mode = SLIP_NEG if mode == SLIP else SLIP
-            else:
-                _rhs(t, y, STICK, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, de, aux1)
-                mode = SLIP if aux1[A_TD] > 0.0 else SLIP_NEG
-            if nev < ev_t.shape[0]:
-                ev_t[nev] = t
-                ev_k[nev] = kind_e
-                nev += 1
-            _rhs(t, y, mode, p, fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv, k1, aux)
-            prev_rej = False
-        else:
-            for i in range(n):
-                y[i] = yn[i]
-                k1[i] = k7[i]
-            for i in range(N_AUX):
-                aux[i] = auxn[i]
-            t = t + hh
-            hstep = next_step(hh, en, prev_rej)
-            if hstep > hmax:
-                hstep = hmax
-            prev_rej = False
-        if y[S_T] > peak:
-            peak = y[S_T]
-    for i in range(n):
-        y0[i] = y[i]
-    return nev, steps, status, peak, t_lock, mode, hstep
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def _integrate_batch(pmat, y0mat, t_end, ts, rtol, atol, hmax, max_steps,
-                     fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-                     out_y, summary):
-    """One DOPRI solver per variant (rows of ``pmat``/``y0mat``), in parallel."""
-    m = pmat.shape[0]
-    ns = ts.shape[0]
-    for j in numba.prange(m):
-        oy = np.empty((ns, N_STATE))
-        oa = np.empty((1, N_AUX))
-        om = np.empty(ns, dtype=np.int64)
-        et = np.empty(MAX_EVENTS)
-        ek = np.empty(MAX_EVENTS, dtype=np.int64)
-        y = y0mat[j].copy()
-        nev, steps, status, peak, tl = _integrate(pmat[j], y, t_end, ts, rtol, atol, hmax, max_steps,
-                                                   fk, fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd, ft, fv, st, sv,
-                                                   oy, oa, om, et, ek, False)
-        out_y[j] = oy
-        summary[j, 0] = tl
-        summary[j, 1] = y[S_EF]
-        summary[j, 2] = peak
-        summary[j, 3] = y[S_T]
-        summary[j, 4] = y[S_W]
-        summary[j, 5] = steps
-        summary[j, 6] = status
-        summary[j, 7] = nev
-
-
-# ----------------------------------------------------------------- Python layer
-def parameter_vector(clutch: WetClutch, bench: Bench, scenario: Scenario) -> np.ndarray:
-    """Flat parameter vector of the compiled kernel (SI units)."""
-    p = np.zeros(N_PAR)
-    p[P_NC] = clutch.n_c
-    p[P_REFF] = clutch.r_eff
-    p[P_SIGMA] = clutch.sigma
-    p[P_AREA] = clutch.friction_area
-    p[P_XH0] = clutch.piston_h0
-    p[P_MU1], p[P_MU2], p[P_MU3], p[P_MU4] = clutch.viscosity
-    p[P_CPACK] = clutch.heat_capacity
-    p[P_K1] = clutch.k1
-    p[P_K2] = clutch.k2
-    p[P_GW] = clutch.gw_scale
-    p[P_KSQ] = clutch.squeeze_coefficient
-    p[P_KS] = clutch.spring_stiffness
-    p[P_F0] = clutch.spring_preload
-    p[P_J] = bench.total_inertia
-    p[P_JSHAFT] = bench.shaft_inertia
-    p[P_TMAX] = bench.drive_torque_max
-    p[P_PMAX] = bench.motor_power_max
-    p[P_KP] = bench.speed_kp
-    p[P_KI] = bench.speed_ki
-    p[P_MOTOR] = 0.0 if scenario.motor == "speed" else 1.0
-    p[P_TAUA] = bench.actuator_time_constant
-    p[P_FMAX] = bench.actuator_force_max
-    p[P_VMAX] = bench.actuator_speed_max
-    p[P_TAUTH] = bench.thermistor_time_constant
-    p[P_CRES] = bench.reservoir_heat_capacity
-    p[P_QMAX] = bench.heater_power_max
-    p[P_GHEAT] = bench.heater_gain
-    p[P_TSET] = scenario.setpoint_c
-    p[P_KRA] = bench.reservoir_cooling
-    p[P_CH] = bench.housing_heat_capacity
-    p[P_KHA] = bench.housing_cooling
-    p[P_KFH] = bench.fluid_housing_conductance
-    p[P_TAMB] = bench.ambient_temperature
-    p[P_FSCALE] = 1.0
-    p[P_MUSCALE] = 1.0
-    p[P_WSCALE] = 1.0
-    return p
-
-
-def initial_state(scenario: Scenario) -> np.ndarray:
-    """State at t = 0: piston at its stop, actuator force at the reference, no energy yet."""
-    y = np.zeros(N_STATE)
-    y[S_FA] = np.interp(0.0, scenario.force_time, scenario.force_value)
-    y[S_W] = scenario.initial_slip_speed
-    y[S_T] = scenario.initial_temperature_c
-    y[S_TF] = scenario.fluid_temperature_c
-    y[S_TH] = scenario.housing_temperature_c
-    y[S_TM] = scenario.initial_temperature_c
-    return y
-
-
-def _atol(clutch: WetClutch) -> np.ndarray:
-    a = np.empty(N_STATE)
-    a[S_X] = 1e-4 * clutch.sigma
-    a[S_FA] = 1e-3
-    a[S_W] = 1e-5
-    a[S_I] = 1e-5
-    a[S_T:S_TM + 1] = 1e-6
-    a[S_EF:] = 1e-4
-    return a
-
-
-def _check_scenario(bench: Bench, scenario: Scenario):
     if scenario.motor == "speed":
         top = float(np.max(np.abs(scenario.speed_value)))
         if top > bench.drive_speed_max:
@@ -677,9 +211,43 @@ class Event:
     kind: str
 
 
+class _ListOnFirstAccess:
+    """Descriptor of a dataclass field that may be given as a zero-argument callable (called on first read).
+
+    A benchmark loop or a batch of engagements that never reads the mode names or the events does
+    not pay for building them (pandas).
+    """
+
+    def __set_name__(self, owner, name):
+        self.slot = "_built_" + name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            raise AttributeError(self.slot)  # no class-level default: the field stays required
+        value = obj.__dict__[self.slot]
+        if callable(value):
+            value = value()
+            obj.__dict__[self.slot] = value
+        return value
+
+    def __set__(self, obj, value):
+        obj.__dict__[self.slot] = value
+
+
+def _mode_names(result: SimulationResult) -> np.ndarray:
+    return _MODE_NAMES[result.modes[:, W.M_FRICTION]] if result.modes.shape[0] else np.array([], dtype="<U5")
+
+
+def _event_list(result: SimulationResult) -> list:
+    ev = result.events
+    events = [Event(float(t), EVENT_KINDS[name]) for t, name in zip(ev["time_s"], ev["event"]) if name in EVENT_KINDS]
+    events.sort(key=lambda e: e.time)
+    return events
+
+
 @dataclass
 class EngagementResult:
-    """Result of :func:`simulate_engagement`.
+    """Result of :func:`simulate_engagement`: a view of the :class:`~clutchlab.SimulationResult`.
 
     Attributes
     ----------
@@ -692,7 +260,8 @@ class EngagementResult:
     modes : numpy.ndarray
         Mode per sample: ``"slip"`` or ``"stick"``.
     events : list of Event
-        Contact, separation, lock-up, break-away in time order.
+        Contact, separation, lock-up, break-away, slip reversal in time order
+        (the piston-stop events are in ``result.events``).
     n_steps : int
         Accepted integration steps.
     final_state : numpy.ndarray
@@ -702,16 +271,19 @@ class EngagementResult:
     state_names, output_names : tuple of str
         Column names of ``states`` and ``outputs``.
     peak_temperature_c : float
-        Highest pack temperature [degC].
+        Highest pack temperature [degC] over the accepted steps.
     lockup_time : float
-        Time of lock-up [s] (NaN if the clutch did not lock).
+        Time of the first lock-up [s] (NaN if the clutch did not lock).
+    result : SimulationResult, optional
+        The run through the system contract (named events ``lockup``,
+        ``piston_leaves_stop``, ..., modes, unit-suffixed columns).
     """
 
     time: np.ndarray
     states: np.ndarray
     outputs: np.ndarray
-    modes: np.ndarray
-    events: list
+    modes: np.ndarray = _ListOnFirstAccess()   # from_result passes callables for these two: built when first read
+    events: list = _ListOnFirstAccess()
     n_steps: int
     final_state: np.ndarray
     heat_capacity: float
@@ -719,6 +291,27 @@ class EngagementResult:
     output_names: tuple = OUTPUT_NAMES
     peak_temperature_c: float = float("nan")
     lockup_time: float = float("nan")
+    result: SimulationResult | None = None
+
+    @classmethod
+    def from_result(cls, result: SimulationResult, heat_capacity: float, peak_temperature_c: float,
+                    lockup_time: float) -> "EngagementResult":
+        """The view of a :class:`~clutchlab.SimulationResult` of the ``"wet"`` model.
+
+        Parameters
+        ----------
+        result : SimulationResult
+            A single run of :func:`simulate`.
+        heat_capacity : float
+            Pack heat capacity [J/K].
+        peak_temperature_c, lockup_time : float
+            The run's peak pack temperature [degC] and first lock-up time [s].
+        """
+        modes = functools.partial(_mode_names, result)
+        events = functools.partial(_event_list, result)
+        return cls(result.time, result.states, result.outputs, modes, events, int(result.stats["accepted_steps"]),
+                   np.array(result.stats["final_state"]), float(heat_capacity),
+                   peak_temperature_c=float(peak_temperature_c), lockup_time=float(lockup_time), result=result)
 
     def state(self, name: str) -> np.ndarray:
         """One state trace by name."""
@@ -743,9 +336,9 @@ class EngagementResult:
         ``residual`` is the relative integration error.
         """
         y = self.final_state
-        wf = y[S_EF]
-        stored = self.heat_capacity * (y[S_T] - self.states[0, S_T])
-        out = y[S_EK1] + y[S_EK2]
+        wf = y[W.S_EF]
+        stored = self.heat_capacity * (y[W.S_T] - self.states[0, W.S_T])
+        out = y[W.S_EK1] + y[W.S_EK2]
         return {"friction_work": wf, "heat_into_pack": stored, "heat_out": out,
                 "residual": (wf - stored - out) / max(abs(wf), 1e-300)}
 
@@ -759,8 +352,11 @@ class BatchResult:
     (``(m, n, 12)``).  Per variant: ``lockup_time`` [s] (NaN where the clutch
     did not lock), ``friction_work`` [J], ``peak_temperature_c`` and
     ``final_temperature_c`` [degC], ``final_slip_speed`` [rad/s], ``n_steps``
-    (accepted steps) and ``status`` (0 success, 1 step limit, 2 step-size
-    underflow).
+    (accepted steps) and ``status`` (:class:`clutchlab.numerics.status.Status`
+    codes: 0 success, 1 step limit, 2 step-size underflow).  ``result`` is the
+    stacked :class:`~clutchlab.SimulationResult` of
+    :func:`clutchlab.system.simulate_batch` (sampled at ``time`` and at the
+    end time).
     """
 
     variants: dict
@@ -773,6 +369,7 @@ class BatchResult:
     final_slip_speed: np.ndarray
     n_steps: np.ndarray
     status: np.ndarray
+    result: SimulationResult | None = None
 
     def to_dataframe(self) -> pd.DataFrame:
         """Summary per variant with the varied inputs."""
@@ -788,17 +385,9 @@ def _default_bench() -> Bench:
     return Bench()
 
 
-@functools.lru_cache(maxsize=1)
-def _truth_data():
-    return ParametricFriction.bench_truth().kernel_data()
-
-
-def _friction_data(friction):
-    if friction is None:
-        return _truth_data()
-    if not hasattr(friction, "kernel_data"):
+def _check_friction(friction):
+    if friction is not None and not hasattr(friction, "kernel_data"):
         raise ParameterError(f"friction = {friction!r}: expected a ParametricFriction or a FrictionMap")
-    return friction.kernel_data()
 
 
 def _sample_times(duration, sample_rate, sample_times):
@@ -809,17 +398,108 @@ def _sample_times(duration, sample_rate, sample_times):
         return ts
     if not (sample_rate > 0):
         raise ParameterError(f"sample_rate = {sample_rate!r}: must be > 0 [Hz]")
-    # the record: states, auxiliaries and the noisy bench channels, each about N_STATE + N_AUX values a sample
-    check_allocation(duration * sample_rate + 1, 2 * (N_STATE + N_AUX),
+    # the record: states, auxiliaries and the noisy bench channels, each about N_STATE + N_OUT values a sample
+    check_allocation(duration * sample_rate + 1, 2 * (W.N_STATE + W.N_OUT),
                      f"duration = {duration!r} s at sample_rate = {sample_rate!r} Hz")
     n = int(math.floor(duration * sample_rate + 1e-9)) + 1
     return np.arange(n) / sample_rate
+
+
+#: recently built systems by the identity of their (immutable) inputs: repeated runs skip the packing
+_RECENT: "collections.OrderedDict" = collections.OrderedDict()
+_RECENT_SIZE = 8
+
+
+def _run_system(clutch, scenario, bench, friction, rtol):
+    """The system of one run with its own per-run buffers; the packing is reused for the same inputs.
+
+    Clutch, bench, scenario and a parametric friction law are frozen, so the
+    system built for the same objects is still right; a friction map is
+    mutable, so a run with one always packs afresh.
+    """
+    inputs = (clutch, scenario, bench, friction)
+    cacheable = friction is None or isinstance(friction, ParametricFriction)
+    key = (*map(id, inputs), float(rtol))
+    hit = _RECENT.get(key) if cacheable else None
+    if hit is not None and all(a is b for a, b in zip(hit[0], inputs)):
+        _RECENT.move_to_end(key)
+        system = hit[1]
+    else:
+        system = _system(clutch, scenario, bench, friction, rtol)
+        if cacheable:
+            _RECENT[key] = (inputs, system)
+            while len(_RECENT) > _RECENT_SIZE:
+                _RECENT.popitem(last=False)
+    return system.variant(params=W.fresh_buffers(system.params, scenario.initial_temperature_c))
+
+
+def _system(clutch, scenario, bench, friction, rtol):
+    bench = _default_bench() if bench is None else bench
+    check_scenario(bench, scenario)
+    _check_friction(friction)
+    if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
+        raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
+    return W.engagement_system(scenario, clutch=clutch, bench=bench, friction=friction, rtol=rtol)
+
+
+def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutch | None = None,
+             bench: Bench | None = None, friction=None, rtol: float = 1e-7, atol=None,
+             max_step: float = math.inf, output_step: float | None = None) -> SimulationResult:
+    """Simulate one wet-clutch run: the uniform entry point, returning a :class:`~clutchlab.SimulationResult`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Force and slip references, drive mode, initial temperatures.
+    t_end : float, optional
+        End time [s] (default ``scenario.duration``).
+    clutch : WetClutch, optional
+        Clutch parameters (default :meth:`WetClutch.paper`, Table 1 of [1]).
+    bench : Bench, optional
+        Drive, actuator, sensors and oil loop (default ``Bench()``).
+    friction : ParametricFriction or FrictionMap, optional
+        Asperity friction law (default :meth:`ParametricFriction.bench_truth`).
+    rtol : float
+        Relative tolerance of the Dormand-Prince 5(4) step control.
+    atol : float or array_like, optional
+        Absolute tolerance per state in its unit (default: ``rtol`` times the
+        states' typical magnitudes, :func:`clutchlab.wet.system.absolute_tolerance`).
+    max_step : float
+        Largest step [s] (the reference corners are break times, so no limit is needed).
+    output_step : float, optional
+        Sample interval [s]; without it every accepted step (and event) is kept.
+
+    Returns
+    -------
+    SimulationResult
+        States and outputs with unit-suffixed columns, modes ``friction``,
+        ``piston``, ``film``, named events (``contact``, ``separation``,
+        ``lockup``, ``breakaway``, ``slip_reversal``, ``piston_reaches_stop``,
+        ``piston_leaves_stop``).
+
+    Raises
+    ------
+    ParameterError
+        References outside the bench's limits, bad tolerances.
+    SimulationError
+        Step limit reached or step-size underflow.
+    """
+    from ..system import simulate as run
+
+    clutch = WetClutch.paper() if clutch is None else clutch
+    t_end = scenario.duration if t_end is None else t_end
+    return run(_run_system(clutch, scenario, bench, friction, rtol), t_end, atol=atol, max_step=max_step,
+               output_step=output_step)
 
 
 def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench | None = None, friction=None,
                         sample_rate: float = 1000.0, sample_times=None, rtol: float = 1e-7,
                         max_step: float = 0.01, max_steps: int = 2_000_000, outputs: bool = True) -> EngagementResult:
     """Simulate one engagement (or any bench run) of the wet clutch.
+
+    A thin wrapper of :func:`clutchlab.system.simulate` on
+    :func:`clutchlab.wet.system.engagement_system`; ``result.result`` holds
+    the :class:`~clutchlab.SimulationResult`.
 
     Parameters
     ----------
@@ -837,9 +517,11 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     sample_times : array_like, optional
         Explicit output times [s].
     rtol : float
-        Relative tolerance of the DOPRI 5(4) step control.
+        Relative tolerance of the DOPRI 5(4) step control; the absolute
+        tolerances follow it (``rtol`` times the states' typical magnitudes,
+        :func:`clutchlab.wet.system.absolute_tolerance`).
     max_step : float
-        Largest step [s] (keeps reference-profile corners resolved).
+        Largest step [s].
     max_steps : int
         Accepted-step limit (a :class:`SimulationError` beyond it).
     outputs : bool
@@ -857,46 +539,23 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     SimulationError
         Step limit reached or step size underflow.
     """
-    bench = _default_bench() if bench is None else bench
-    _check_scenario(bench, scenario)
-    if not (0 < rtol < 1):
-        raise ParameterError(f"rtol = {rtol!r}: must be in (0, 1)")
+    from ..system import simulate as run
+
+    sysm = _run_system(clutch, scenario, bench, friction, rtol)
     ts = _sample_times(scenario.duration, sample_rate, sample_times)
-    p = parameter_vector(clutch, bench, scenario)
-    y = initial_state(scenario)
-    y0 = y.copy()
-    fk, fc, fgv, fgt, fgf, ftab = _friction_data(friction)
-    g0, gdt, gv, gd = gw_table()
-    ns = ts.size
-    oy = np.zeros((ns, N_STATE))
-    oa = np.full((ns, N_AUX) if outputs else (1, N_AUX), np.nan)
-    om = np.zeros(ns, dtype=np.int64)
-    et = np.zeros(MAX_EVENTS)
-    ek = np.zeros(MAX_EVENTS, dtype=np.int64)
-    nev, steps, status, peak, tl = _integrate(
-        p, y, float(scenario.duration), ts, float(rtol), _atol(clutch), float(max_step), int(max_steps),
-        int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
-        scenario.force_time, scenario.force_value, scenario.speed_time, scenario.speed_value,
-        oy, oa, om, et, ek, bool(outputs))
-    if not outputs:
-        oa = np.full((ns, N_AUX), np.nan)
-    if status == 1:
-        raise SimulationError(f"simulate_engagement: step limit {max_steps} reached before t = {scenario.duration} s")
-    if status == 2:
-        raise SimulationError("simulate_engagement: step size underflow (stiff or discontinuous input?)")
-    events = [Event(float(et[i]), EVENT_KINDS[int(ek[i])]) for i in range(nev)]
-    events.sort(key=lambda e: e.time)
-    if ns and oy[0, S_T] != y0[S_T]:
-        oy[0] = y0
-    modes = _MODE_NAMES[om]
-    return EngagementResult(ts, oy, oa, modes, events, int(steps), y, clutch.heat_capacity,
-                            peak_temperature_c=float(peak), lockup_time=float(tl))
+    res = run(sysm, float(scenario.duration), max_step=max_step, max_steps=max_steps, sample_times=ts,
+              outputs=outputs)
+    return EngagementResult.from_result(res, clutch.heat_capacity, W.peak_temperature(sysm.params),
+                                        W.lockup_time(sysm.params))
 
 
 def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, bench: Bench | None = None,
                    friction=None, sample_times=None, rtol: float = 1e-6, max_step: float = 0.01,
                    max_steps: int = 1_000_000) -> BatchResult:
     """Simulate many variants of one scenario in parallel (``numba.prange``, one solver each).
+
+    Runs on :func:`clutchlab.system.simulate_batch`; each variant has its own
+    packed parameters and initial state.
 
     Parameters
     ----------
@@ -918,8 +577,9 @@ def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, ben
     -------
     BatchResult
     """
-    bench = _default_bench() if bench is None else bench
-    _check_scenario(bench, scenario)
+    from ..system import simulate_batch as run_batch
+
+    base = _system(clutch, scenario, bench, friction, rtol)
     if not variants:
         raise ParameterError("simulate_batch: variants is empty")
     unknown = [k for k in variants if k not in BATCH_VARIABLES]
@@ -937,32 +597,44 @@ def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, ben
             raise ParameterError(f"simulate_batch: variant {k!r} must be > 0")
         if k in ("k1", "k2") and np.any(v < 0):
             raise ParameterError(f"simulate_batch: variant {k!r} must be >= 0")
-    ts = np.array([scenario.duration]) if sample_times is None else _sample_times(scenario.duration, 1.0, sample_times)
-    p = parameter_vector(clutch, bench, scenario)
-    y = initial_state(scenario)
-    pmat = np.tile(p, (m, 1))
-    ymat = np.tile(y, (m, 1))
-    col = {"force_scale": P_FSCALE, "mu_scale": P_MUSCALE, "speed_scale": P_WSCALE, "total_inertia": P_J,
-           "k1": P_K1, "k2": P_K2}
+    duration = float(scenario.duration)
+    ts = np.array([duration]) if sample_times is None else _sample_times(duration, 1.0, sample_times)
+    # the end time is always sampled (final state of each variant), then dropped if not asked for
+    grid = ts if ts.size and ts[-1] >= duration else np.append(ts, duration)
+    systems = _variant_systems(base, vals, m)
+    res = run_batch(systems, duration, sample_times=grid, max_step=max_step, max_steps=max_steps, outputs=False)
+    final = res.states[:, -1, :]
+    work = np.array([s.params.data[:2] for s in systems]).reshape(m, 2)  # each variant's memories
+    status = np.asarray(res.status, dtype=int)
+    return BatchResult(vals, ts, res.states[:, :ts.size, :], work[:, W.W_LOCKUP], final[:, W.S_EF],
+                       work[:, W.W_PEAK], final[:, W.S_T], final[:, W.S_W],
+                       np.asarray(res.stats["accepted_steps"], dtype=int), status, result=res)
+
+
+#: batch variable -> WetParams field it overrides
+_PARAM_FIELDS = {"force_scale": "force_scale", "mu_scale": "mu_scale", "speed_scale": "speed_scale",
+                 "total_inertia": "total_inertia", "k1": "k1", "k2": "k2", "fluid_temperature_c": "heater_setpoint"}
+
+
+def _variant_systems(base, vals: dict, m: int) -> list:
+    """One :class:`~clutchlab.system.System` per variant: its own constants, initial state and per-run buffer."""
+    x0 = np.tile(base.x0, (m, 1))
     for k, v in vals.items():
-        if k in col:
-            pmat[:, col[k]] = v
-        elif k == "initial_slip_speed":
-            ymat[:, S_W] = v
+        if k == "initial_slip_speed":
+            x0[:, W.S_W] = v
         elif k == "initial_temperature_c":
-            ymat[:, S_T] = v
-            ymat[:, S_TM] = v
+            x0[:, W.S_T] = v
+            x0[:, W.S_TM] = v
         elif k == "fluid_temperature_c":
-            ymat[:, S_TF] = v
-            pmat[:, P_TSET] = v
-    ymat[:, S_FA] *= pmat[:, P_FSCALE]
-    fk, fc, fgv, fgt, fgf, ftab = _friction_data(friction)
-    g0, gdt, gv, gd = gw_table()
-    out_y = np.zeros((m, ts.size, N_STATE))
-    summary = np.zeros((m, 8))
-    _integrate_batch(pmat, ymat, float(scenario.duration), ts, float(rtol), _atol(clutch), float(max_step),
-                     int(max_steps), int(fk), fc, fgv, fgt, fgf, ftab, g0, gdt, gv, gd,
-                     scenario.force_time, scenario.force_value, scenario.speed_time, scenario.speed_value,
-                     out_y, summary)
-    return BatchResult(vals, ts, out_y, summary[:, 0], summary[:, 1], summary[:, 2], summary[:, 3], summary[:, 4],
-                       summary[:, 5].astype(int), summary[:, 6].astype(int))
+            x0[:, W.S_TF] = v
+    if "force_scale" in vals:
+        x0[:, W.S_FA] *= vals["force_scale"]  # the actuator starts at the scaled reference
+    constants = np.repeat(base.params.constants, m)
+    for k, v in vals.items():
+        if k in _PARAM_FIELDS:
+            constants[_PARAM_FIELDS[k]] = v
+    work = W.new_work(x0[:, W.S_T])
+    piston_h0 = float(constants["piston_h0"][0])
+    m0 = np.stack([W.initial_modes(x, piston_h0) for x in x0]) if m else np.zeros((0, 3), np.int64)
+    return [base.variant(params=params, x0=x0[i], m0=m0[i])
+            for i, params in enumerate(W.batch_parameters(base.params, constants, work))]

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from typing import ClassVar
 
 import numba
@@ -65,8 +64,8 @@ class ParametricFriction(ParameterSet):
         """Friction coefficient [-] at slip velocity [m/s] and temperature [degC] (force ignored)."""
         v = np.abs(np.asarray(slip_velocity, dtype=float))
         t = np.asarray(temperature_c, dtype=float)
-        out = self.mu0 + self.mu_t * (t - self.t_ref) + self.mu_e * np.exp(-v / self.v_s)  # [1], Sec. 4
-        out = np.maximum(out, 0.0)
+        # the compiled law of the engagement model, evaluated on arrays
+        out = np.asarray(parametric_mu_scalar.py_func(v, t, self.mu0, self.mu_t, self.mu_e, self.v_s, self.t_ref))
         return float(out) if out.ndim == 0 else out
 
     def kernel_data(self):
@@ -219,7 +218,7 @@ class FrictionMap:
         return cls.from_dict(read_json(path, DataError), source=str(path))
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _lin_index(grid, x):
     n = grid.shape[0]
     if n == 1:
@@ -227,12 +226,43 @@ def _lin_index(grid, x):
     return bracket(grid, x)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, nogil=True, inline="always")
+def parametric_mu_scalar(v_abs, temperature_c, mu0, mu_t, mu_e, v_s, t_ref):
+    """Parametric asperity friction ``mu_f = mu0 + mu_t (T - t_ref) + mu_e exp(-|v|/v_s)``, clipped at 0 ([1], Sec. 4).
+
+    Compiled scalar form used by :func:`mu_kernel`;
+    :meth:`ParametricFriction.mu` evaluates the same function body on arrays.
+
+    Parameters
+    ----------
+    v_abs : float
+        Slip velocity magnitude |v| [m/s].
+    temperature_c : float
+        Friction-surface temperature [degC].
+    mu0, mu_t, mu_e, v_s, t_ref : float
+        The law's parameters ([-], [1/K], [-], [m/s], [degC]).
+    """
+    mu = mu0 + mu_t * (temperature_c - t_ref) + mu_e * np.exp(-v_abs / v_s)  # [1], Sec. 4
+    return np.maximum(mu, 0.0)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def mu_kernel(v_abs, temperature_c, force, kind, coef, gv, gt, gf, table):
-    """Compiled friction law: parametric (kind 0) or (tri)linear table (kind 1) ([1], Eq. 4 input)."""
+    """Compiled friction law: parametric (kind 0) or (tri)linear table (kind 1) ([1], Eq. 4 input).
+
+    Parameters
+    ----------
+    v_abs : float
+        Slip velocity magnitude [m/s].
+    temperature_c : float
+        Friction-surface temperature [degC].
+    force : float
+        Pressing force [N] (3-D maps only).
+    kind, coef, gv, gt, gf, table
+        The arrays of ``kernel_data()`` of a :class:`ParametricFriction` or :class:`FrictionMap`.
+    """
     if kind == 0:
-        mu = coef[0] + coef[1] * (temperature_c - coef[4]) + coef[2] * math.exp(-v_abs / coef[3])
-        return mu if mu > 0.0 else 0.0
+        return parametric_mu_scalar(v_abs, temperature_c, coef[0], coef[1], coef[2], coef[3], coef[4])
     nv = gv.shape[0]
     nt = gt.shape[0]
     iv, wv = _lin_index(gv, v_abs)

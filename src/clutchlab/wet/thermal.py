@@ -15,6 +15,7 @@ References
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from ..errors import ParameterError
@@ -79,10 +80,36 @@ def heat_balance(temperature_c, friction_power, fluid_temperature_c, housing_tem
     Uniform pack temperature (thin steel cores, single-sided linings, after
     Yang et al. [2]); all friction heat enters the pack.
     """
-    t = np.asarray(temperature_c, dtype=float)
-    q = (np.asarray(friction_power, dtype=float) - k1 * (t - np.asarray(fluid_temperature_c, dtype=float))
-         - k2 * (t - np.asarray(housing_temperature_c, dtype=float)))  # [1], Eq. 8
-    return _out(q / float(heat_capacity))
+    return _out(heat_balance_scalar.py_func(
+        np.asarray(temperature_c, dtype=float), np.asarray(friction_power, dtype=float),
+        np.asarray(fluid_temperature_c, dtype=float), np.asarray(housing_temperature_c, dtype=float),
+        float(heat_capacity), k1, k2))  # [1], Eq. 8
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def heat_balance_scalar(temperature_c, friction_power, fluid_temperature_c, housing_temperature_c, heat_capacity,
+                        k1, k2):
+    """Pack temperature rate ``dT/dt`` [K/s] of Eq. 8 (Shin et al. [1]), compiled scalar form.
+
+    ``C dT/dt = tau dw - k1 (T - T_fluid) - k2 (T - T_housing)``; the
+    engagement model calls it, :func:`heat_balance` evaluates the same
+    function body on arrays.
+
+    Parameters
+    ----------
+    temperature_c : float
+        Pack temperature T [degC].
+    friction_power : float
+        Friction power ``tau * dw`` [W].
+    fluid_temperature_c, housing_temperature_c : float
+        Oil and housing temperatures [degC].
+    heat_capacity : float
+        Pack heat capacity C [J/K].
+    k1, k2 : float
+        Conductances to the oil and to the housing [W/K].
+    """
+    q = friction_power - k1 * (temperature_c - fluid_temperature_c) - k2 * (temperature_c - housing_temperature_c)
+    return q / heat_capacity  # [1], Eq. 8
 
 
 def thermal_time_constant(heat_capacity, k1, k2):

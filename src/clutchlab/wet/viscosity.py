@@ -49,14 +49,33 @@ def atf_viscosity(temperature_c, mu1, mu2, mu3, mu4):
     100 degC, the range of an ATF (in kelvin the exponentials would vanish).
     """
     t = np.asarray(temperature_c, dtype=float)
-    out = mu1 * np.exp(mu2 * t) + mu3 * np.exp(mu4 * t)  # [1], Eq. 7
+    # the one implementation of Eq. 7 (the compiled model calls the same function), on arrays
+    out = np.asarray(viscosity_scalar.py_func(t, mu1, mu2, mu3, mu4))
     return float(out) if out.ndim == 0 else out
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def viscosity_scalar(temperature_c, mu1, mu2, mu3, mu4):
-    """Compiled scalar form of :func:`atf_viscosity` ([1], Eq. 7)."""
-    return mu1 * math.exp(mu2 * temperature_c) + mu3 * math.exp(mu4 * temperature_c)
+    """ATF dynamic viscosity ``mu1 exp(mu2 T) + mu3 exp(mu4 T)`` [Pa*s] (Shin et al. [1], Eq. 7).
+
+    The compiled scalar form used by the engagement model; :func:`atf_viscosity`
+    evaluates the same function body on arrays.
+
+    Parameters
+    ----------
+    temperature_c : float
+        Fluid temperature T [degC].
+    mu1, mu3 : float
+        Viscosity parameters [Pa*s].
+    mu2, mu4 : float
+        Exponents [1/K].
+
+    Returns
+    -------
+    float
+        Dynamic viscosity [Pa*s].
+    """
+    return mu1 * np.exp(mu2 * temperature_c) + mu3 * np.exp(mu4 * temperature_c)  # [1], Eq. 7
 
 
 @dataclass(frozen=True)
@@ -144,9 +163,8 @@ def fit_viscosity(temperature_c, viscosity) -> ViscosityFit:
         b2, a2 = 3.0 * b4, math.log(max(mu[0] * 0.5, 1e-12)) - 3.0 * b4 * t[0]
     x0 = np.array([a2, b2, a4, b4])
 
-    def resid(p):
-        model = np.exp(p[0] + p[1] * t) + np.exp(p[2] + p[3] * t)
-        return np.log(model) - np.log(mu)
+    def resid(p):  # log residuals of Eq. 7 with log-amplitudes as unknowns
+        return np.log(atf_viscosity(t, np.exp(p[0]), p[1], np.exp(p[2]), p[3])) - np.log(mu)
 
     sol = least_squares(resid, x0, method="lm", x_scale="jac")
     if not sol.success:

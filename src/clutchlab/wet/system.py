@@ -1,0 +1,851 @@
+"""The wet-clutch engagement model on the system contract (:mod:`clutchlab.system`).
+
+The model of :mod:`clutchlab.wet.engagement` (Shin, Kim and Choi [1],
+Eqs. 1-8, with the squeeze-film / asperity engagement dynamics of Deur et al.
+[4]) written once against the contract:
+
+* :class:`WetParams` -- every parameter, reference profile, table and per-run
+  memory in one ``NamedTuple``, packed by :func:`pack_parameters` (the only
+  place they are packed);
+* the compiled hooks (``rhs``, ``outputs``, ``update``, ``restart``,
+  ``accept``, ``next_break``, ``jacobian``) registered for :class:`WetParams`
+  with :func:`clutchlab.numerics.dispatch.register`; the integrator core
+  (:mod:`clutchlab.numerics.core`) compiles them in;
+* :func:`engagement_system` -- the :class:`~clutchlab.system.System` of one
+  engagement, registered as model ``"wet"``.
+
+States, outputs and events
+--------------------------
+States (SI, temperatures in degC): piston position, actuator force, slip
+speed, speed-controller integral, pack / reservoir / housing / thermistor
+temperatures, and the energy integrals (friction work, heat to the oil, heat
+to the housing, drive work).  Outputs: the 18 quantities of
+:data:`OUTPUTS` (torques, forces, film, viscosity, references, powers).
+
+Modes and their switching functions (located by the core on the dense
+output, so nothing in the right-hand side has a kink inside a step):
+
+* ``friction``: ``slip_positive`` / ``stick`` / ``slip_negative`` -- the
+  sliding direction is part of the mode.  ``lockup``: the slip speed falls
+  through zero while slipping; the clutch sticks if the static capacity
+  ``R_eff N_c mu_f F_c`` holds the drive torque, otherwise the slip reverses
+  (``slip_reversal``).  ``breakaway``: ``|T_drive| - capacity`` rises through
+  zero while stuck.
+* ``piston``: ``free`` / ``at_stop``.  The piston rests on its stop at
+  ``x_p = 0`` while the force balance pushes it against the stop.
+  ``piston_reaches_stop``: ``x_p`` falls through zero; ``piston_leaves_stop``:
+  the free piston speed (the speed the force balance would give) rises
+  through zero.  (The former kernel clipped ``dx_p/dt`` at the stop inside
+  the right-hand side, an unlocated kink.)
+* ``film``: ``open`` / ``contact`` -- the nominal separation ``h`` (Eq. 1)
+  crosses zero (Fig. 3 (b) -> (c)): ``contact`` / ``separation``.
+
+The corners of the force and slip-speed reference profiles are break times
+(``next_break``): steps end on them exactly.
+
+Inputs
+------
+Two held inputs are added to the scenario's reference profiles:
+``force_reference`` [N] and ``slip_speed_reference`` [rad/s].  They are
+zero for a scenario run; the co-simulation (:mod:`clutchlab.fmu.cosim`)
+sets them at every communication point with flat profiles.
+
+References
+----------
+.. [1] S. Shin, D.-H. Kim, S. B. Choi, "Apparatus for identification of
+   frictional and thermal characteristics of a wet clutch" (KAIST).
+.. [2] N. Patir, H. S. Cheng, J. Lubrication Technol. 101 (1979) 220-229.
+.. [3] J. A. Greenwood, J. B. P. Williamson, Proc. R. Soc. Lond. A 295 (1966) 300-319.
+.. [4] J. Deur, J. Petric, J. Asgari, D. Hrovat, "Modeling of wet clutch
+   engagement including a thorough experimental validation", SAE Trans.
+   (2005) 1013-1028, doi:10.4271/2005-01-0877
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..numerics import dispatch
+from ..numerics.core import record
+from ..system import System, register_model, variables
+from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
+                   squeeze_film_force_scalar)
+from .friction import KIND_PARAMETRIC, ParametricFriction, mu_kernel, parametric_mu_scalar
+from .thermal import heat_balance_scalar
+from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque_scalar
+from .viscosity import viscosity_scalar
+
+__all__ = [
+    "WetParams", "pack_parameters", "fresh_buffers", "batch_parameters", "new_work", "engagement_system", "initial_state",
+    "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque",
+    "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
+]
+
+# ----------------------------------------------------------------- layout
+#: states: (name, unit, description)
+STATES = (
+    ("piston_position", "m", "piston position x_p, positive towards the pack (0: on its stop)"),
+    ("actuator_force", "N", "actuator force (first-order lag of the reference)"),
+    ("slip_speed", "rad_s", "slip speed = clutch shaft speed (outer plates held)"),
+    ("controller_integral", "Nm", "integral term of the speed controller"),
+    ("temperature", "C", "pack temperature T (Eq. 8)"),
+    ("fluid_temperature", "C", "oil reservoir temperature"),
+    ("housing_temperature", "C", "housing temperature"),
+    ("thermistor_temperature", "C", "thermistor reading (first-order lag of T)"),
+    ("friction_work", "J", "friction work, integral of tau * dw"),
+    ("heat_to_fluid", "J", "heat from the pack to the oil, integral of k1 (T - T_fluid)"),
+    ("heat_to_housing", "J", "heat from the pack to the housing, integral of k2 (T - T_housing)"),
+    ("drive_work", "J", "work of the drive motor, integral of T_drive * dw"),
+)
+(S_X, S_FA, S_W, S_I, S_T, S_TF, S_TH, S_TM, S_EF, S_EK1, S_EK2, S_ED) = range(12)
+N_STATE = 12
+
+#: outputs: (name, unit, description)
+OUTPUTS = (
+    ("clutch_torque", "Nm", "clutch torque tau = tau_c + tau_v (Eq. 3)"),
+    ("contact_torque", "Nm", "asperity contact torque tau_c (Eq. 4); the drive torque while stuck"),
+    ("viscous_torque", "Nm", "viscous torque tau_v (Eq. 5)"),
+    ("contact_force", "N", "asperity contact force F_c (Greenwood-Williamson)"),
+    ("squeeze_force", "N", "hydrodynamic squeeze-film force"),
+    ("load_cell_force", "N", "force at the actuator load cell"),
+    ("nominal_separation", "m", "nominal separation h per interface (Eq. 1)"),
+    ("mean_film", "m", "Patir-Cheng mean film thickness h_bar (Eq. 2)"),
+    ("friction_coefficient", "1", "asperity friction coefficient mu_f"),
+    ("viscosity", "Pa_s", "oil viscosity mu_v (Eq. 7)"),
+    ("drive_torque", "Nm", "drive motor torque at the clutch shaft"),
+    ("slip_reference", "rad_s", "slip-speed reference of the speed controller"),
+    ("force_reference", "N", "actuator force reference"),
+    ("slip_acceleration", "rad_s2", "rate of change of the slip speed"),
+    ("sensor_torque", "Nm", "torque at the shaft torque sensor"),
+    ("friction_power", "W", "friction power tau * dw"),
+    ("heater_power", "W", "reservoir heater power"),
+    ("static_capacity", "Nm", "static torque capacity R_eff N_c mu_f F_c (Eq. 4)"),
+)
+(O_TAU, O_TC, O_TV, O_FC, O_FH, O_FLC, O_H, O_HBAR, O_MUF, O_MUV, O_TD, O_WREF, O_FREF, O_WDOT, O_TS,
+ O_PF, O_QH, O_CAP) = range(18)
+N_OUT = 18
+
+#: held inputs, added to the scenario's reference profiles (zero in a scenario run)
+INPUTS = (
+    ("force_reference", "N", "actuator force reference, added to the scenario's force profile"),
+    ("slip_speed_reference", "rad_s", "slip-speed reference, added to the scenario's speed profile"),
+)
+U_FORCE, U_SPEED = 0, 1
+
+#: modes: friction, piston, film
+MODE_NAMES = ("friction", "piston", "film")
+MODE_VALUES = (("slip_positive", "stick", "slip_negative"), ("free", "at_stop"), ("open", "contact"))
+M_FRICTION, M_PISTON, M_FILM = 0, 1, 2
+SLIP, STICK, SLIP_NEG = 0, 1, 2
+FREE, AT_STOP = 0, 1
+OPEN, CONTACT = 0, 1
+
+#: switching functions: (name, crossing direction)
+SWITCHING = (("lockup", -1), ("breakaway", 1), ("contact", 0), ("piston_leaves_stop", 1),
+             ("piston_reaches_stop", -1))
+G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES = range(5)
+N_SWITCH = 5
+
+#: event names by code
+EVENTS = ("contact", "separation", "lockup", "breakaway", "slip_reversal", "piston_reaches_stop",
+          "piston_leaves_stop")
+EV_CONTACT, EV_SEPARATION, EV_LOCKUP, EV_BREAKAWAY, EV_REVERSAL, EV_REACHES, EV_LEAVES = range(7)
+#: elements an event concerns
+ELEMENTS = ("clutch", "piston")
+EL_CLUTCH, EL_PISTON = 0, 1
+
+#: scalar parameters: (field, unit, description) -- the named fields of ``WetParams.constants``
+CONSTANTS = (
+    ("n_c", "1", "number of clutches N_c (Table 1)"),
+    ("r_eff", "m", "torque effective radius (Eq. (1'))"),
+    ("sigma", "m", "RMS roughness (Table 1)"),
+    ("friction_area", "m^2", "friction area of one face A_f"),
+    ("piston_h0", "m", "piston position at zero separation"),
+    ("mu_v1", "Pa*s", "viscosity parameter (Eq. 7)"),
+    ("mu_v2", "1/K", "viscosity exponent (Eq. 7)"),
+    ("mu_v3", "Pa*s", "viscosity parameter (Eq. 7)"),
+    ("mu_v4", "1/K", "viscosity exponent (Eq. 7)"),
+    ("heat_capacity", "J/K", "pack heat capacity (Eq. 8)"),
+    ("k1", "W/K", "conductance pack -> oil (Eq. 8)"),
+    ("k2", "W/K", "conductance pack -> housing (Eq. 8)"),
+    ("gw_scale", "Pa", "Greenwood-Williamson pressure scale"),
+    ("squeeze_coefficient", "m^4", "squeeze-film factor (groove factor x K)"),
+    ("spring_stiffness", "N/m", "piston return spring"),
+    ("spring_preload", "N", "return spring preload at x_p = 0"),
+    ("total_inertia", "kg*m^2", "rotating inertia at the clutch shaft"),
+    ("shaft_inertia", "kg*m^2", "inertia between torque sensor and clutch"),
+    ("drive_torque_max", "N*m", "motor torque limit at the clutch shaft"),
+    ("motor_power_max", "W", "motor power limit"),
+    ("speed_kp", "N*m*s/rad", "speed controller gain"),
+    ("speed_ki", "N*m/rad", "speed controller integral gain"),
+    ("actuator_time_constant", "s", "actuator force lag"),
+    ("actuator_force_max", "N", "actuator force limit"),
+    ("actuator_speed_max", "m/s", "actuator no-load speed"),
+    ("thermistor_time_constant", "s", "thermistor lag"),
+    ("reservoir_heat_capacity", "J/K", "oil reservoir"),
+    ("heater_power_max", "W", "reservoir heater"),
+    ("heater_gain", "W/K", "reservoir thermostat gain"),
+    ("heater_setpoint", "degC", "reservoir thermostat set point"),
+    ("reservoir_cooling", "W/K", "natural cooling of the reservoir"),
+    ("housing_heat_capacity", "J/K", "housing"),
+    ("housing_cooling", "W/K", "natural cooling of the housing"),
+    ("fluid_housing_conductance", "W/K", "oil -> housing"),
+    ("ambient_temperature", "degC", "laboratory"),
+    ("force_scale", "1", "factor on the force profile (batch variants)"),
+    ("mu_scale", "1", "factor on mu_f (batch variants)"),
+    ("speed_scale", "1", "factor on the slip-speed profile (batch variants)"),
+    ("free_inertia", "1", "no motor torque (inertia dynamometer), a bool"),
+    ("friction_kind", "1", "friction law: 0 parametric, 1 table (an int)"),
+    ("force_start", "1", "force profile in data: times from here, then values (an int)"),
+    ("force_n", "1", "breakpoints of the force profile (an int)"),
+    ("speed_start", "1", "slip-speed profile in data (an int)"),
+    ("speed_n", "1", "breakpoints of the slip-speed profile (an int)"),
+    ("friction_start", "1", "coefficients of the friction law in data (an int)"),
+    ("map_speed_start", "1", "friction map: slip-velocity grid in data (an int)"),
+    ("map_speed_n", "1", "friction map: its length (an int)"),
+    ("map_temperature_start", "1", "friction map: temperature grid in data (an int)"),
+    ("map_temperature_n", "1", "friction map: its length (an int)"),
+    ("map_force_start", "1", "friction map: force grid in data (an int)"),
+    ("map_force_n", "1", "friction map: its length (an int)"),
+    ("map_table_start", "1", "friction map: values in data (an int)"),
+    ("map_table_n", "1", "friction map: their number (an int)"),
+)
+_INT_CONSTANTS = ("friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start",
+                  "map_speed_start", "map_speed_n", "map_temperature_start", "map_temperature_n", "map_force_start",
+                  "map_force_n", "map_table_start", "map_table_n")
+#: the record type of ``WetParams.constants`` (floats, one bool, ints)
+CONSTANTS_DTYPE = np.dtype([(n, np.float64) for n, _, _ in CONSTANTS if n not in _INT_CONSTANTS + ("free_inertia",)]
+                           + [("free_inertia", np.bool_)] + [(n, np.int64) for n in _INT_CONSTANTS], align=True)
+
+#: layout of the per-run buffer at the head of ``WetParams.data``: memories, then scratch for outputs,
+#: derivative, switching values
+W_PEAK, W_LOCKUP = 0, 1          # peak pack temperature [degC], first lock-up time [s] (NaN: none yet)
+W_OUT = 2
+W_DX = W_OUT + N_OUT
+W_G = W_DX + N_STATE
+N_WORK = W_G + N_SWITCH
+
+
+class WetParams(NamedTuple):
+    """Packed parameters of one wet-clutch engagement (SI, temperatures in degC).
+
+    Built by :func:`pack_parameters` only; its class selects the wet model's
+    compiled hooks in the integrator core.  The scalars are the named fields
+    of a one-element structured array (``constants``, fields
+    :data:`CONSTANTS`); everything else is one float array (``data``): first
+    the per-run buffer (memories and scratch, layout ``W_*``), then the
+    reference profiles and the friction law (coefficients, or grids and
+    values of a map), located by the ``*_start`` / ``*_n`` constants.  Build
+    a fresh structure per run and per batch variant (:func:`fresh_buffers`,
+    :func:`variant_parameters`).  The Greenwood-Williamson table is a
+    constant of the compiled code (:data:`clutchlab.wet.film.GW_VALUES`).
+
+    Two arrays on purpose (measured): numba passes the structure by value,
+    field by field, to every hook call (six per step), and keeps an atomic
+    reference count for every array read from it; with the thirteen arrays
+    of a first layout that cost as much as the physics, and in a parallel
+    batch arrays shared between variants make those counters contended.
+    Each variant gets its own (small) arrays.
+    """
+
+    constants: np.ndarray               # one record, fields CONSTANTS [SI]
+    data: np.ndarray                    # per-run buffer (N_WORK) | force profile | speed profile | friction law
+
+
+# ----------------------------------------------------------------- model pieces (compiled, scalar)
+@numba.njit(cache=True, nogil=True, inline="always")
+def piston_speed(net_force, film_resistance, speed_max):
+    """Piston speed from the quasi-static force balance with the actuator's speed limit [m/s].
+
+    The massless piston moves at the speed at which the squeeze film carries
+    the net force, ``F_net = c x_p'`` (Deur et al. [4]), saturated smoothly
+    at the actuator's no-load speed: ``x_p' = v_max tanh(F_net / (c v_max))``.
+
+    Parameters
+    ----------
+    net_force : float
+        Actuator force minus return spring and asperity force [N].
+    film_resistance : float
+        Squeeze-film force per unit piston speed c [N*s/m].
+    speed_max : float
+        Actuator no-load speed v_max [m/s].
+    """
+    return speed_max * math.tanh(net_force / (film_resistance * speed_max))
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def drive_torque(slip_speed, reference, integral, torque_max, power_max, kp, ki):
+    """Speed-controlled bench motor: PI with back-calculation anti-windup, torque and power limits.
+
+    Parameters
+    ----------
+    slip_speed, reference : float
+        Clutch shaft speed and its reference [rad/s].
+    integral : float
+        Controller integral state [N*m].
+    torque_max, power_max : float
+        Torque limit at the clutch shaft [N*m] and power limit [W].
+    kp, ki : float
+        Gains [N*m*s/rad], [N*m/rad].
+
+    Returns
+    -------
+    (float, float)
+        Drive torque at the clutch shaft [N*m] and the rate of the integral [N*m/s].
+    """
+    e = reference - slip_speed
+    command = kp * e + integral
+    limit = torque_max
+    aw = abs(slip_speed)
+    if aw * limit > power_max:
+        limit = power_max / aw
+    td = min(max(command, -limit), limit)
+    kaw = ki / kp if kp > 0.0 else 0.0
+    return td, ki * e + kaw * (td - command)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _pwl(t, tables, start, n):
+    """Piecewise-linear reference profile at ``t`` (times ``tables[start:start+n]``, values after them),
+    constant beyond the ends."""
+    v0 = start + n
+    if t <= tables[start]:
+        return tables[v0]
+    if t >= tables[start + n - 1]:
+        return tables[v0 + n - 1]
+    lo = start
+    hi = start + n - 1
+    while hi - lo > 1:  # bisection: tables[lo] <= t < tables[hi]
+        mid = (lo + hi) // 2
+        if tables[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    w = (t - tables[lo]) / (tables[lo + 1] - tables[lo])
+    return tables[lo + n] + w * (tables[lo + n + 1] - tables[lo + n])
+
+
+# ----------------------------------------------------------------- hooks
+@numba.njit(cache=True, nogil=True)
+def wet_rhs(t, x, u, m, p, dx, g):
+    """Right-hand side, switching functions and (into the scratch of ``p.data``) the outputs of the model."""
+    c = p.constants[0]
+    tb = p.data
+    wk = tb
+    nc = c.n_c
+    xp = x[S_X]
+    fa = x[S_FA]
+    w = x[S_W]
+    temp = x[S_T]
+    tf = x[S_TF]
+    th = x[S_TH]
+    fmode = m[M_FRICTION]
+    at_stop = m[M_PISTON] == AT_STOP
+    h = separation_scalar(xp, c.piston_h0, nc)                                     # [1], Eq. 1
+    hbar = film_scalar(h, c.sigma)                                                  # [1], Eq. 2
+    muv = viscosity_scalar(temp, c.mu_v1, c.mu_v2, c.mu_v3, c.mu_v4)                # [1], Eq. 7
+    fc = asperity_force_scalar(h, c.sigma, c.friction_area, c.gw_scale)              # [3], Eq. 11
+    v = slip_velocity_scalar(w, c.r_eff)                                            # [1], Eq. (2')
+    k = c.friction_start
+    if c.friction_kind == KIND_PARAMETRIC:
+        muf = c.mu_scale * parametric_mu_scalar(abs(v), temp, tb[k], tb[k + 1], tb[k + 2], tb[k + 3], tb[k + 4])
+    else:  # a friction map: its grids and values are sliced out of the tables only here
+        muf = c.mu_scale * mu_kernel(
+            abs(v), temp, fc, c.friction_kind, tb[k:k + 5],
+            tb[c.map_speed_start:c.map_speed_start + c.map_speed_n],
+            tb[c.map_temperature_start:c.map_temperature_start + c.map_temperature_n],
+            tb[c.map_force_start:c.map_force_start + c.map_force_n],
+            tb[c.map_table_start:c.map_table_start + c.map_table_n])
+    cap = asperity_torque_scalar(c.r_eff, nc, muf, fc)                              # [1], Eq. 4 (static)
+    # references: scenario profiles plus the held inputs
+    wref = c.speed_scale * _pwl(t, tb, c.speed_start, c.speed_n) + u[U_SPEED]
+    fref = min(c.force_scale * _pwl(t, tb, c.force_start, c.force_n) + u[U_FORCE], c.actuator_force_max)
+    # drive: speed-controlled motor or free inertia
+    if c.free_inertia:
+        td = 0.0
+        dx[S_I] = 0.0
+    else:
+        td, dx[S_I] = drive_torque(w, wref, x[S_I], c.drive_torque_max, c.motor_power_max, c.speed_kp,
+                                   c.speed_ki)
+    # clutch torque, [1] Eqs. 3-6; the sliding direction is the mode's (smooth within a step)
+    if fmode == STICK:
+        tc = td
+        tv = 0.0
+        tau = td
+        wdot = 0.0
+        pf = 0.0
+        g[G_LOCKUP] = 1.0
+        g[G_BREAKAWAY] = abs(td) - cap
+    else:
+        sgn = 1.0 if fmode == SLIP else -1.0
+        tau = clutch_torque_scalar(c.r_eff, nc, muf, fc, muv, c.friction_area, v, hbar, sgn)  # [1], Eqs. 3, 6
+        tc = sgn * cap                                                                       # [1], Eq. 4
+        tv = viscous_torque_scalar(c.r_eff, nc, muv, c.friction_area, v, hbar)               # [1], Eq. 5
+        wdot = (td - tau) / c.total_inertia
+        pf = tau * w
+        g[G_LOCKUP] = sgn * w
+        g[G_BREAKAWAY] = -1.0
+    dx[S_W] = wdot
+    # piston: quasi-static balance of actuator, spring, squeeze film and asperities
+    fsp = c.spring_preload + c.spring_stiffness * xp
+    # squeeze-film force per unit piston speed (dh/dt = -x_p'/N_c), the N_c films in series
+    csq = squeeze_film_force_scalar(c.squeeze_coefficient, muv, -1.0 / nc, hbar)
+    vfree = piston_speed(fa - fsp - fc, csq, c.actuator_speed_max)
+    if at_stop:
+        xdot = 0.0
+        g[G_LEAVES] = vfree
+        g[G_REACHES] = 1.0
+    else:
+        xdot = vfree
+        g[G_LEAVES] = -1.0
+        g[G_REACHES] = xp
+    g[G_CONTACT] = h
+    dx[S_X] = xdot
+    dx[S_FA] = (fref - fa) / c.actuator_time_constant
+    # thermal network
+    qk1 = c.k1 * (temp - tf)
+    qk2 = c.k2 * (temp - th)
+    dx[S_T] = heat_balance_scalar(temp, pf, tf, th, c.heat_capacity, c.k1, c.k2)    # [1], Eq. 8
+    qh = min(max(c.heater_gain * (c.heater_setpoint - tf), 0.0), c.heater_power_max)
+    qfh = c.fluid_housing_conductance * (tf - th)
+    dx[S_TF] = (qk1 + qh - c.reservoir_cooling * (tf - c.ambient_temperature) - qfh) / c.reservoir_heat_capacity
+    dx[S_TH] = (qk2 + qfh - c.housing_cooling * (th - c.ambient_temperature)) / c.housing_heat_capacity
+    dx[S_TM] = (temp - x[S_TM]) / c.thermistor_time_constant
+    dx[S_EF] = pf
+    dx[S_EK1] = qk1
+    dx[S_EK2] = qk2
+    dx[S_ED] = td * w
+    # outputs
+    fh = csq * xdot
+    wk[W_OUT + O_TAU] = tau
+    wk[W_OUT + O_TC] = tc
+    wk[W_OUT + O_TV] = tv
+    wk[W_OUT + O_FC] = fc
+    wk[W_OUT + O_FH] = fh
+    wk[W_OUT + O_FLC] = fa if at_stop else fsp + fc + fh
+    wk[W_OUT + O_H] = h
+    wk[W_OUT + O_HBAR] = hbar
+    wk[W_OUT + O_MUF] = muf
+    wk[W_OUT + O_MUV] = muv
+    wk[W_OUT + O_TD] = td
+    wk[W_OUT + O_WREF] = wref
+    wk[W_OUT + O_FREF] = fref
+    wk[W_OUT + O_WDOT] = wdot
+    wk[W_OUT + O_TS] = tau + c.shaft_inertia * wdot
+    wk[W_OUT + O_PF] = pf
+    wk[W_OUT + O_QH] = qh
+    wk[W_OUT + O_CAP] = cap
+
+
+@numba.njit(cache=True, nogil=True)
+def _evaluate(t, x, u, m, p):
+    """The model at one point into the scratch space of ``p.data`` (hooks other than ``rhs``)."""
+    wk = p.data
+    wet_rhs(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH])
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_outputs(t, x, u, m, p, y):
+    """Outputs at one point (:data:`OUTPUTS` order)."""
+    # y (18 entries) takes the derivative and the switching values first (scratch, overwritten), then the
+    # outputs the right-hand side left in p.data: no scratch array is sliced or allocated per sample
+    wet_rhs(t, x, u, m, p, y, y)
+    wk = p.data
+    for i in range(N_OUT):
+        y[i] = wk[W_OUT + i]
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_update(t, x, u, m, p, k, log):
+    """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name)."""
+    wk = p.data
+    if k == G_LOCKUP:
+        old = m[M_FRICTION]
+        x[S_W] = 0.0
+        m[M_FRICTION] = STICK
+        _evaluate(t, x, u, m, p)
+        if abs(wk[W_OUT + O_TD]) <= wk[W_OUT + O_CAP]:
+            record(log, t, EV_LOCKUP, EL_CLUTCH)
+            if wk[W_LOCKUP] != wk[W_LOCKUP]:
+                wk[W_LOCKUP] = t
+        else:
+            # the static capacity cannot hold the drive torque: the slip changes direction
+            m[M_FRICTION] = SLIP_NEG if old == SLIP else SLIP
+            record(log, t, EV_REVERSAL, EL_CLUTCH)
+    elif k == G_BREAKAWAY:
+        _evaluate(t, x, u, m, p)
+        m[M_FRICTION] = SLIP if wk[W_OUT + O_TD] > 0.0 else SLIP_NEG
+        record(log, t, EV_BREAKAWAY, EL_CLUTCH)
+    elif k == G_CONTACT:
+        if m[M_FILM] == OPEN:
+            m[M_FILM] = CONTACT
+            record(log, t, EV_CONTACT, EL_CLUTCH)
+        else:
+            m[M_FILM] = OPEN
+            record(log, t, EV_SEPARATION, EL_CLUTCH)
+    elif k == G_LEAVES:
+        m[M_PISTON] = FREE
+        record(log, t, EV_LEAVES, EL_PISTON)
+    elif k == G_REACHES:
+        x[S_X] = 0.0
+        m[M_PISTON] = AT_STOP
+        _evaluate(t, x, u, m, p)
+        if wk[W_G + G_LEAVES] > 0.0:
+            # the force balance pushes it off the stop again at once (a touch): stays free
+            m[M_PISTON] = FREE
+        else:
+            record(log, t, EV_REACHES, EL_PISTON)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_restart(t, x, u, m, p, log):
+    """Modes consistent with the forces at a (re)start: break-away, piston on or off its stop, film contact.
+
+    Called at t0, on every resumed ``advance`` (inputs may have jumped) and
+    at every corner of the reference profiles; only the checks that can
+    change a mode evaluate the model.
+    """
+    c = p.constants[0]
+    wk = p.data
+    changed = False
+    film = CONTACT if separation_scalar(x[S_X], c.piston_h0, c.n_c) <= 0.0 else OPEN
+    if m[M_FILM] != film:
+        m[M_FILM] = film
+        changed = True
+    if m[M_FRICTION] != STICK and m[M_PISTON] == FREE and x[S_X] > 0.0:
+        return changed
+    _evaluate(t, x, u, m, p)
+    if m[M_FRICTION] == STICK and abs(wk[W_OUT + O_TD]) > wk[W_OUT + O_CAP]:
+        # stuck with the drive torque above the capacity (a jump of an input at a resume)
+        m[M_FRICTION] = SLIP if wk[W_OUT + O_TD] > 0.0 else SLIP_NEG
+        record(log, t, EV_BREAKAWAY, EL_CLUTCH)
+        changed = True
+    if m[M_PISTON] == AT_STOP:
+        if wk[W_G + G_LEAVES] > 0.0:
+            m[M_PISTON] = FREE
+            record(log, t, EV_LEAVES, EL_PISTON)
+            changed = True
+    elif x[S_X] <= 0.0 and wk[W_DX + S_X] <= 0.0:
+        x[S_X] = 0.0
+        m[M_PISTON] = AT_STOP
+        record(log, t, EV_REACHES, EL_PISTON)
+        changed = True
+    return changed
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_accept(t, x, u, m, p):
+    """After each accepted step: track the peak pack temperature."""
+    wk = p.data
+    if x[S_T] > wk[W_PEAK]:
+        wk[W_PEAK] = x[S_T]
+    return 0
+
+
+@numba.njit(cache=True, nogil=True)
+def _next_corner(tables, start, n, t):
+    for i in range(start, start + n):
+        if tables[i] > t:
+            return tables[i]
+    return np.inf
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_next_break(t, m, p):
+    """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
+    c = p.constants[0]
+    tb = _next_corner(p.data, c.force_start, c.force_n, t)
+    if not c.free_inertia:
+        ts = _next_corner(p.data, c.speed_start, c.speed_n, t)
+        if ts < tb:
+            tb = ts
+    return tb
+
+
+@numba.njit(cache=True, nogil=True)
+def wet_jacobian(t, x, u, m, p, J):
+    """No analytic Jacobian (Dormand-Prince does not need one)."""
+    return False
+
+
+dispatch.register(WetParams, rhs=wet_rhs, outputs=wet_outputs, update=wet_update, restart=wet_restart,
+                  accept=wet_accept, next_break=wet_next_break, jacobian=wet_jacobian)
+
+
+# ----------------------------------------------------------------- packing
+def _array(values) -> np.ndarray:
+    return np.array(values, dtype=np.float64, order="C").ravel()
+
+
+def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetParams:
+    """Pack clutch, bench, scenario and friction law into a :class:`WetParams` (the one packing function).
+
+    Parameters
+    ----------
+    clutch : WetClutch
+        Clutch parameters.
+    bench : Bench
+        Drive, actuator and oil loop.
+    scenario : Scenario
+        Reference profiles, drive mode, heater set point.
+    friction : ParametricFriction or FrictionMap, optional
+        Asperity friction law (default: :meth:`ParametricFriction.bench_truth`).
+    **overrides
+        Values of fields of :data:`CONSTANTS` that replace the packed ones
+        (batch variants: ``force_scale``, ``mu_scale``, ``speed_scale``,
+        ``total_inertia``, ``k1``, ``k2``, ``heater_setpoint``).
+
+    Returns
+    -------
+    WetParams
+        With a fresh per-run ``work`` buffer (peak temperature from the
+        scenario's initial pack temperature, no lock-up yet).
+    """
+    law = ParametricFriction.bench_truth() if friction is None else friction
+    kind, coef, gv, gt, gf, table = law.kernel_data()
+    parts = [_array(scenario.force_time), _array(scenario.force_value), _array(scenario.speed_time),
+             _array(scenario.speed_value), _array(coef), _array(gv), _array(gt), _array(gf), _array(table)]
+    starts = N_WORK + np.concatenate([[0], np.cumsum([a.size for a in parts])])  # after the per-run buffer
+    values = dict(
+        n_c=clutch.n_c, r_eff=clutch.r_eff, sigma=clutch.sigma, friction_area=clutch.friction_area,
+        piston_h0=clutch.piston_h0, mu_v1=clutch.mu_v1, mu_v2=clutch.mu_v2, mu_v3=clutch.mu_v3, mu_v4=clutch.mu_v4,
+        heat_capacity=clutch.heat_capacity, k1=clutch.k1, k2=clutch.k2, gw_scale=clutch.gw_scale,
+        squeeze_coefficient=clutch.squeeze_coefficient, spring_stiffness=clutch.spring_stiffness,
+        spring_preload=clutch.spring_preload, total_inertia=bench.total_inertia, shaft_inertia=bench.shaft_inertia,
+        drive_torque_max=bench.drive_torque_max, motor_power_max=bench.motor_power_max, speed_kp=bench.speed_kp,
+        speed_ki=bench.speed_ki, actuator_time_constant=bench.actuator_time_constant,
+        actuator_force_max=bench.actuator_force_max, actuator_speed_max=bench.actuator_speed_max,
+        thermistor_time_constant=bench.thermistor_time_constant,
+        reservoir_heat_capacity=bench.reservoir_heat_capacity, heater_power_max=bench.heater_power_max,
+        heater_gain=bench.heater_gain, heater_setpoint=scenario.setpoint_c, reservoir_cooling=bench.reservoir_cooling,
+        housing_heat_capacity=bench.housing_heat_capacity, housing_cooling=bench.housing_cooling,
+        fluid_housing_conductance=bench.fluid_housing_conductance, ambient_temperature=bench.ambient_temperature,
+        force_scale=1.0, mu_scale=1.0, speed_scale=1.0,
+        free_inertia=scenario.motor == "free", friction_kind=int(kind),
+        force_start=int(starts[0]), force_n=parts[0].size, speed_start=int(starts[2]), speed_n=parts[2].size,
+        friction_start=int(starts[4]), map_speed_start=int(starts[5]), map_speed_n=parts[5].size,
+        map_temperature_start=int(starts[6]), map_temperature_n=parts[6].size, map_force_start=int(starts[7]),
+        map_force_n=parts[7].size, map_table_start=int(starts[8]), map_table_n=parts[8].size,
+    )
+    unknown = [k for k in overrides if k not in values]
+    if unknown:
+        raise TypeError(f"pack_parameters: unknown field {unknown[0]!r} (known: {', '.join(values)})")
+    values.update(overrides)
+    constants = np.array([tuple(values[n] for n in CONSTANTS_DTYPE.names)], dtype=CONSTANTS_DTYPE)
+    return WetParams(constants, np.concatenate([new_work(scenario.initial_temperature_c)] + parts))
+
+
+def new_work(initial_temperature_c):
+    """Fresh per-run buffer(s): the peak memory starts at the initial pack temperature, no lock-up yet.
+
+    Parameters
+    ----------
+    initial_temperature_c : float or array_like
+        Pack temperature at the start [degC]; an array gives one buffer (row) per value.
+    """
+    temp = np.asarray(initial_temperature_c, dtype=float)
+    work = np.zeros(temp.shape + (N_WORK,))
+    work[..., W_PEAK] = temp
+    work[..., W_LOCKUP] = math.nan
+    return work
+
+
+def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) -> WetParams:
+    """A copy of packed parameters with a new per-run buffer and some constants replaced.
+
+    Parameters
+    ----------
+    params : WetParams
+        Packed by :func:`pack_parameters`.
+    initial_temperature_c : float
+        Pack temperature at the start [degC] (starts the peak memory).
+    **overrides
+        Values of fields of :data:`CONSTANTS` to replace.
+    """
+    constants = params.constants
+    if overrides:
+        constants = constants.copy()
+        for name, value in overrides.items():
+            constants[name] = value
+    data = params.data.copy()
+    data[:N_WORK] = new_work(initial_temperature_c)
+    return params._replace(constants=constants, data=data)
+
+
+def batch_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray) -> list:
+    """Parameters of the variants of a batch: each its own constants record, per-run buffer and tables.
+
+    Parameters
+    ----------
+    params : WetParams
+        The base case.
+    constants : ndarray
+        The variants' constants, an array of ``m`` records of :data:`CONSTANTS`.
+    work : ndarray
+        Their per-run buffers, ``(m, N_WORK)`` (:func:`new_work`).
+
+    Returns
+    -------
+    list of WetParams
+
+    Notes
+    -----
+    Every array a variant's hooks read is its own, so the reference counts
+    numba keeps on them are not contended between the threads of a parallel
+    batch.  (A record array is copied as raw bytes: NumPy copies structured
+    arrays field by field, five times slower.)
+    """
+    raw = np.ascontiguousarray(constants, dtype=CONSTANTS_DTYPE).view(np.uint8).reshape(len(constants), -1)
+    data = np.tile(params.data, (len(constants), 1))
+    data[:, :N_WORK] = work
+    return [WetParams(raw[i].copy().view(CONSTANTS_DTYPE), data[i].copy()) for i in range(len(constants))]
+
+
+def peak_temperature(params: WetParams) -> float:
+    """Highest pack temperature [degC] over the accepted steps of the run that used ``params``.
+
+    Parameters
+    ----------
+    params : WetParams
+        After the run.
+    """
+    return float(params.data[W_PEAK])
+
+
+def lockup_time(params: WetParams) -> float:
+    """First lock-up time [s] of the run that used ``params`` (NaN if the clutch did not lock).
+
+    Parameters
+    ----------
+    params : WetParams
+        After the run.
+    """
+    return float(params.data[W_LOCKUP])
+
+
+def initial_state(scenario) -> np.ndarray:
+    """State at t = 0: piston on its stop, actuator force at the reference, no energy yet.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Initial slip speed and temperatures, force profile.
+    """
+    x = np.zeros(N_STATE)
+    x[S_FA] = np.interp(0.0, scenario.force_time, scenario.force_value)
+    x[S_W] = scenario.initial_slip_speed
+    x[S_T] = scenario.initial_temperature_c
+    x[S_TF] = scenario.fluid_temperature_c
+    x[S_TH] = scenario.housing_temperature_c
+    x[S_TM] = scenario.initial_temperature_c
+    return x
+
+
+def initial_modes(x0, piston_h0: float) -> np.ndarray:
+    """Modes at t = 0 from the initial state: slip direction, piston on its stop, film contact.
+
+    Parameters
+    ----------
+    x0 : ndarray
+        Initial state.
+    piston_h0 : float
+        Piston position at zero separation [m] (Eq. 1).
+    """
+    m = np.zeros(3, dtype=np.int64)
+    w = x0[S_W]
+    m[M_FRICTION] = SLIP if w > 0.0 else (SLIP_NEG if w < 0.0 else STICK)
+    m[M_PISTON] = AT_STOP if x0[S_X] <= 0.0 else FREE
+    m[M_FILM] = CONTACT if piston_h0 - x0[S_X] <= 0.0 else OPEN
+    return m
+
+
+#: typical magnitude of each state except the piston position (whose scale is the piston travel to contact)
+STATE_SCALES = np.array([np.nan, 1e4, 100.0, 100.0, 10.0, 10.0, 10.0, 10.0, 1e3, 1e3, 1e3, 1e3])
+
+
+def absolute_tolerance(clutch, rtol: float = 1e-7) -> np.ndarray:
+    """Absolute tolerance per state: ``min(rtol, 1e-7)`` times the state's typical magnitude.
+
+    The magnitudes are the piston travel to contact ``x_{p,h0}`` [m], 1e4 N,
+    100 rad/s, 100 N*m, 10 K and 1e3 J (:data:`STATE_SCALES`).  For
+    ``rtol >= 1e-7`` (the default) these are the former kernel's fixed
+    absolute tolerances (1e-3 N, 1e-5 rad/s, 1e-6 K, 1e-4 J), except the
+    piston position's (1.2e-9 m instead of 6e-8 m: with the stop located, the
+    first step off the stop, where the piston reaches the actuator's speed
+    limit within a microsecond, set the error of the whole stroke).  Below
+    1e-7 they shrink with ``rtol``, so that the whole error control follows
+    the tolerance: with fixed absolute tolerances an ``rtol`` below about
+    1e-8 changed nothing.
+
+    Parameters
+    ----------
+    clutch : WetClutch
+        For the piston travel ``piston_h0``.
+    rtol : float
+        Relative tolerance of the run.
+    """
+    scale = STATE_SCALES.copy()
+    scale[S_X] = clutch.piston_h0
+    return min(float(rtol), 1e-7) * scale
+
+
+_STATE_VARIABLES, _OUTPUT_VARIABLES, _INPUT_VARIABLES = variables(STATES), variables(OUTPUTS), variables(INPUTS)
+
+
+def _element_name(code: int, element: int) -> str:
+    return ELEMENTS[element] if 0 <= element < len(ELEMENTS) else ""
+
+
+def engagement_system(scenario=None, *, clutch=None, bench=None, friction=None, params=None, x0=None,
+                      rtol: float = 1e-7) -> System:
+    """The :class:`~clutchlab.system.System` of one wet-clutch engagement (registered as model ``"wet"``).
+
+    Parameters
+    ----------
+    scenario : Scenario, optional
+        Inputs of the run (default: the bench engagement of
+        :class:`~clutchlab.wet.bench.EngagementProtocol`, protocol (b)).
+    clutch : WetClutch, optional
+        Default :meth:`WetClutch.paper`.
+    bench : Bench, optional
+        Default ``Bench()``.
+    friction : ParametricFriction or FrictionMap, optional
+        Default :meth:`ParametricFriction.bench_truth`.
+    params : WetParams, optional
+        Already packed parameters (they must come from the same clutch,
+        bench and scenario); default: :func:`pack_parameters`.
+    x0 : array_like, optional
+        Initial state (default :func:`initial_state`).
+    rtol : float
+        The system's default relative tolerance; its absolute tolerances are
+        :func:`absolute_tolerance` at this ``rtol``.
+
+    Returns
+    -------
+    System
+        Dormand-Prince 5(4), event bracket 1e-12 s.
+    """
+    from .params import Bench, WetClutch
+
+    clutch = WetClutch.paper() if clutch is None else clutch
+    bench = Bench() if bench is None else bench
+    if scenario is None:
+        from .bench import EngagementProtocol
+
+        scenario = EngagementProtocol().scenario(clutch, "speed")
+    if params is None:
+        params = pack_parameters(clutch, bench, scenario, friction)
+    x0 = initial_state(scenario) if x0 is None else np.asarray(x0, dtype=float)
+    return System(
+        name="wet", params=params, states=_STATE_VARIABLES, outputs=_OUTPUT_VARIABLES, inputs=_INPUT_VARIABLES, x0=x0,
+        m0=initial_modes(x0, clutch.piston_h0), atol=absolute_tolerance(clutch, rtol), switching=SWITCHING,
+        events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES, method="dopri", rtol=float(rtol), event_tol=1e-12,
+        element_name=_element_name)
+
+
+register_model("wet", engagement_system)

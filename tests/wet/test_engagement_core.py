@@ -1,0 +1,254 @@
+"""The wet clutch on the integrator core: located piston stop, convergence, regression against the old kernel.
+
+Tolerances
+----------
+* Convergence (``test_lockup_time_converges_to_an_independent_solution``): the
+  reference is computed here, independently of clutchlab's integrator and of
+  its compiled model: the engagement equations written out again in Python,
+  the Greenwood-Williamson integral evaluated exactly (parabolic cylinder
+  function, where the model uses a cubic-Hermite table, 1e-7 relative),
+  integrated by SciPy's ``DOP853`` at ``rtol`` 1e-12 with SciPy events for the
+  piston leaving its stop, the contact and the lock-up.  The model's lock-up
+  time must approach it as ``rtol`` shrinks and be within 1e-6 s at
+  ``rtol = 1e-10`` (the issue's acceptance; the former kernel, which clipped
+  the piston speed at the stop inside the right-hand side, was 1.3e-5 s off
+  there).  Measured: 4.1e-6, 2.5e-7, 2.6e-9 s at ``rtol`` 1e-6, 1e-8, 1e-10.
+* Regression (``test_reproduces_the_traces_of_the_former_kernel``): the stored
+  traces (``data/README.md``) come from the former kernel at ``rtol`` 1e-10,
+  where its integration error is negligible but its modelling of the stop is
+  not: its stroke, hence contact and lock-up, is 1.3e-5 s late.  That lag is
+  the whole difference: event times within 3e-5 s, every trace within 5e-4 of
+  its largest magnitude (measured at most 2.3e-4: the drive torque, 1.3e-5 s
+  times its slope during the engagement).  A wrong equation would show as a
+  difference of percents.
+"""
+
+import math
+import pathlib
+
+import numpy as np
+import pytest
+from scipy import special
+from scipy.integrate import solve_ivp
+
+from clutchlab.result import SimulationResult
+from clutchlab.system import MODELS, System
+from clutchlab.wet import Bench, ParametricFriction, Scenario, WetClutch, simulate, simulate_engagement
+from clutchlab.wet import system as W
+from clutchlab.wet.bench import EngagementProtocol
+
+CLUTCH = WetClutch.paper()
+BENCH = Bench()
+TRUTH = ParametricFriction.bench_truth()
+DATA = pathlib.Path(__file__).with_name("data")
+
+
+# ----------------------------------------------------------------- independent reference (SciPy, exact GW)
+def reference_events(scen, clutch=CLUTCH, bench=BENCH, law=TRUTH, rtol=1e-12):
+    """Leave-stop, contact and lock-up times of a free-inertia engagement, solved by SciPy from the equations."""
+    nc, sig, area, reff = clutch.n_c, clutch.sigma, clutch.friction_area, clutch.r_eff
+    mu1, mu2, mu3, mu4 = clutch.viscosity
+    coef = 4.0 / 3.0 * clutch.contact_modulus * clutch.asperity_density * math.sqrt(clutch.asperity_radius) * sig**1.5
+    ksq = clutch.squeeze_flow_factor * 1.5 * math.pi * (
+        clutch.r_outer**4 - clutch.r_inner**4 - (clutch.r_outer**2 - clutch.r_inner**2) ** 2
+        / math.log(clutch.r_outer / clutch.r_inner))
+    vmax = bench.actuator_speed_max
+    assert scen.motor == "free"
+
+    def f32(t):  # Greenwood-Williamson integral F_3/2, exactly
+        return special.gamma(2.5) / math.sqrt(2 * math.pi) * math.exp(-0.25 * t * t) * special.pbdv(-2.5, t)[0]
+
+    def rhs(t, y, free, slipping):
+        x, fa, w, temp, tf, th = y
+        h = (clutch.piston_h0 - x) / nc
+        s = h / sig
+        hbar = sig * (0.5 * s * math.erfc(-s / math.sqrt(2)) + math.exp(-0.5 * s * s) / math.sqrt(2 * math.pi))
+        muv = mu1 * math.exp(mu2 * temp) + mu3 * math.exp(mu4 * temp)
+        fc = area * coef * f32(s)
+        mu = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-abs(reff * w) / law.v_s), 0.0)
+        tau = reff * nc * (mu * fc + muv * area * reff * w / hbar) if slipping else 0.0
+        c_film = ksq * muv / (nc * hbar**3)
+        v_free = vmax * math.tanh((fa - clutch.spring_preload - clutch.spring_stiffness * x - fc) / (c_film * vmax))
+        q1, q2 = clutch.k1 * (temp - tf), clutch.k2 * (temp - th)
+        qh = min(max(bench.heater_gain * (scen.setpoint_c - tf), 0.0), bench.heater_power_max)
+        qfh = bench.fluid_housing_conductance * (tf - th)
+        fref = float(np.interp(t, scen.force_time, scen.force_value))
+        return ([v_free if free else 0.0, (fref - fa) / bench.actuator_time_constant,
+                 -tau / bench.total_inertia, (tau * w - q1 - q2) / clutch.heat_capacity,
+                 (q1 + qh - bench.reservoir_cooling * (tf - bench.ambient_temperature) - qfh)
+                 / bench.reservoir_heat_capacity,
+                 (q2 + qfh - bench.housing_cooling * (th - bench.ambient_temperature)) / bench.housing_heat_capacity],
+                v_free)
+
+    y = np.array([0.0, float(scen.force_value[0]), scen.initial_slip_speed, scen.initial_temperature_c,
+                  scen.fluid_temperature_c, scen.housing_temperature_c])
+    atol = np.array([1e-12, 1e-7, 1e-9, 1e-10, 1e-10, 1e-10])
+    free, slipping, open_film = False, True, True
+    events = {}
+    t = 0.0
+    corners = [tc for tc in scen.force_time if tc > 0.0] + [scen.duration]
+    for t_seg in corners:  # integrate piecewise between the corners of the force reference
+        while t < t_seg and slipping:
+            def leave(tt, yy):
+                return rhs(tt, yy, False, slipping)[1]
+
+            def contact(tt, yy):
+                return clutch.piston_h0 - yy[0]
+
+            def lock(tt, yy):
+                return yy[2]
+
+            for ev in (leave, contact, lock):
+                ev.terminal = True
+            leave.direction, contact.direction, lock.direction = 1, -1, -1
+            watched = [e for e, on in ((leave, not free), (contact, open_film), (lock, slipping)) if on]
+            sol = solve_ivp(lambda tt, yy: rhs(tt, yy, free, slipping)[0], (t, t_seg), y, method="DOP853",
+                            rtol=rtol, atol=atol, events=watched)
+            t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+            if sol.status != 1:
+                t = t_seg
+                continue
+            for ev, times in zip(watched, sol.t_events):
+                if len(times):
+                    events[ev.__name__] = float(times[0])
+                    if ev is leave:
+                        free = True
+                    elif ev is contact:
+                        open_film = False
+                    else:
+                        slipping = False
+    return events
+
+
+@pytest.fixture(scope="module")
+def dyno_reference():
+    scen = EngagementProtocol().scenario(CLUTCH, "free")
+    return scen, reference_events(scen)
+
+
+def test_lockup_time_converges_to_an_independent_solution(dyno_reference):
+    scen, ref = dyno_reference
+    assert set(ref) == {"leave", "contact", "lock"}
+    errors = {}
+    for rtol in (1e-6, 1e-8, 1e-10):
+        res = simulate(scen, 0.7, clutch=CLUTCH, bench=BENCH, friction=TRUTH, rtol=rtol)
+        ev = res.events
+        t = {name: float(ev.time_s[ev.event == name].iloc[0])
+             for name in ("piston_leaves_stop", "contact", "lockup")}
+        errors[rtol] = abs(t["lockup"] - ref["lock"])
+        if rtol == 1e-10:
+            assert abs(t["piston_leaves_stop"] - ref["leave"]) < 1e-7
+            assert abs(t["contact"] - ref["contact"]) < 1e-6
+    assert errors[1e-8] < errors[1e-6] / 10 and errors[1e-10] < errors[1e-8]
+    assert errors[1e-10] < 1e-6
+
+
+def test_simulate_engagement_lockup_time_follows_the_tolerance(dyno_reference):
+    """The wrapper gives the same converged answer (its absolute tolerances follow rtol below 1e-7)."""
+    scen, ref = dyno_reference
+    res = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, rtol=1e-10, sample_rate=100.0)
+    assert abs(res.lockup_time - ref["lock"]) < 1e-6
+    assert abs(simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH).lockup_time - ref["lock"]) < 5e-6
+
+
+# ----------------------------------------------------------------- regression against the former kernel
+@pytest.mark.parametrize("name", ["bench", "dyno", "breakaway"])
+def test_reproduces_the_traces_of_the_former_kernel(name):
+    import sys
+
+    sys.path.insert(0, str(DATA))
+    try:
+        from generate_traces import OUTPUTS, RTOL, STATES, scenarios
+    finally:
+        sys.path.remove(str(DATA))
+    data = np.load(DATA / "engagement_traces.npz")
+    scen, ts = scenarios()[name]
+    res = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, sample_times=ts, rtol=RTOL)
+    np.testing.assert_array_equal(res.time, data[f"{name}/time_s"])
+    assert [e.kind for e in res.events] == list(data[f"{name}/event"])
+    np.testing.assert_allclose([e.time for e in res.events], data[f"{name}/event_time_s"], rtol=0, atol=3e-5)
+    for col in STATES + OUTPUTS:
+        ref = data[f"{name}/{col}"]
+        new = res.state(col) if col in STATES else res.output(col)
+        np.testing.assert_allclose(new, ref, rtol=0, atol=5e-4 * max(np.max(np.abs(ref)), 1e-300), err_msg=col)
+
+
+# ----------------------------------------------------------------- the contract
+def test_uniform_simulate_returns_a_named_simulation_result():
+    scen = EngagementProtocol().scenario(CLUTCH, "speed")
+    res = simulate(scen, clutch=CLUTCH, friction=TRUTH, output_step=1e-3)
+    assert isinstance(res, SimulationResult) and res.model == "wet" and res.ok
+    assert res.time[-1] == pytest.approx(scen.duration)  # t_end defaults to the scenario's duration
+    frame = res.to_dataframe()
+    for col in ("time_s", "piston_position_m", "slip_speed_rad_s", "temperature_C", "clutch_torque_Nm",
+                "friction_coefficient_1", "viscosity_Pa_s", "slip_acceleration_rad_s2", "friction", "piston", "film"):
+        assert col in frame.columns, col
+    assert list(res.events.columns) == ["time_s", "event", "element"]
+    assert list(res.events.event) == ["piston_leaves_stop", "contact", "lockup"]
+    assert list(res.events.element) == ["piston", "clutch", "clutch"]
+    assert set(frame["friction"]) == {"slip_positive", "stick"}
+    # the same run through the wrapper: EngagementResult is a view of it
+    old = simulate_engagement(CLUTCH, scen, friction=TRUTH, sample_times=res.time, max_step=math.inf)
+    np.testing.assert_array_equal(old.states, res.states)
+    assert old.result.events.equals(res.events)
+
+
+def test_model_is_registered_and_describes_itself():
+    system = MODELS["wet"]()
+    assert isinstance(system, System) and system.name == "wet" and isinstance(system.params, W.WetParams)
+    assert system.state_columns[:3] == ("piston_position_m", "actuator_force_N", "slip_speed_rad_s")
+    assert [name for name, _ in system.switching] == ["lockup", "breakaway", "contact", "piston_leaves_stop",
+                                                      "piston_reaches_stop"]
+    assert set(system.events) == {"contact", "separation", "lockup", "breakaway", "slip_reversal",
+                                  "piston_reaches_stop", "piston_leaves_stop"}
+    assert set(W.CONSTANTS_DTYPE.names) == {name for name, _, _ in W.CONSTANTS}
+
+
+def test_piston_returns_to_its_stop_as_a_located_event():
+    """Force applied and released: separation, then the piston reaches its stop and stays exactly there."""
+    scen = Scenario([0.0, 0.1, 0.6, 0.7], [0.0, 2000.0, 2000.0, 0.0], [0.0], [0.0], duration=1.5, motor="free",
+                    initial_slip_speed=50.0)
+    res = simulate(scen, clutch=CLUTCH, friction=TRUTH)
+    ev = list(res.events.event)
+    assert ev[0] == "piston_leaves_stop" and "contact" in ev and "separation" in ev
+    assert ev[-1] == "piston_reaches_stop"
+    t_stop = float(res.events.time_s.iloc[-1])
+    after = res.time >= t_stop
+    assert np.all(res["piston_position_m"][after] == 0.0)
+    t_leave = float(res.events.time_s.iloc[0])
+    assert np.all(res.mode("piston")[after] == "at_stop") and np.all(res.mode("piston")[res.time < t_leave] == "at_stop")
+    # while on the stop the load cell reads the actuator force
+    np.testing.assert_allclose(res["load_cell_force_N"][after], res["actuator_force_N"][after], rtol=1e-12)
+
+
+def test_reference_corners_are_steps_ends():
+    """Every corner of the force and slip-speed references is the end of an accepted step (next_break)."""
+    scen = EngagementProtocol().scenario(CLUTCH, "speed")
+    res = simulate(scen, clutch=CLUTCH, friction=TRUTH)  # every accepted step is kept
+    corners = np.concatenate([scen.force_time, scen.speed_time])
+    corners = corners[(corners > 0) & (corners < scen.duration)]
+    for tc in corners:
+        assert np.min(np.abs(res.time - tc)) <= 1e-13 * max(1.0, tc), tc
+
+
+def test_batch_is_the_single_runs():
+    """simulate_batch (on clutchlab.system.simulate_batch) equals simulate_engagement variant by variant, exactly."""
+    from clutchlab.wet import simulate_batch
+
+    scen = EngagementProtocol(duration=0.8).scenario(CLUTCH, "speed")
+    batch = simulate_batch(CLUTCH, scen, {"k1": [100.0, 140.0], "initial_temperature_c": [60.0, 90.0]},
+                           bench=BENCH, friction=TRUTH, sample_times=[0.2, 0.5])
+    assert np.all(batch.status == 0)
+    for v, (k1, temp) in enumerate([(100.0, 60.0), (140.0, 90.0)]):
+        single_scen = Scenario(scen.force_time, scen.force_value, scen.speed_time, scen.speed_value, scen.duration,
+                               initial_slip_speed=scen.initial_slip_speed, initial_temperature_c=temp,
+                               fluid_temperature_c=scen.fluid_temperature_c,
+                               housing_temperature_c=scen.housing_temperature_c)
+        single = simulate_engagement(CLUTCH.replace(k1=k1), single_scen, bench=BENCH, friction=TRUTH, rtol=1e-6,
+                                     sample_times=[0.2, 0.5, 0.8])
+        np.testing.assert_array_equal(batch.samples[v], single.states[:2])
+        assert batch.final_temperature_c[v] == single.final_state[W.S_T]
+        assert batch.peak_temperature_c[v] == single.peak_temperature_c
+        np.testing.assert_equal(batch.lockup_time[v], single.lockup_time)  # NaN: no lock-up within 0.8 s
+        assert batch.n_steps[v] == single.n_steps
+    assert batch.result.states.shape == (2, 3, 12)  # the stacked SimulationResult also holds the end time
