@@ -722,6 +722,7 @@ class EClutch:
         """
         t_end = float(t_end)
         _check_run(t_end, rtol, max_steps)
+        _grid(output_step, t_end)  # refuse an output grid beyond the memory budget before any work
         system = self.as_system(inputs, rtol=rtol, max_step=_max_step(max_step, h_max), event_tol=event_tol,
                                 jac_every=jac_every, atol_scale=atol_scale)
         return _run(self, system, t_end, max_steps, output_step)

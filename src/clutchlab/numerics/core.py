@@ -634,7 +634,8 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
 def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
 
-    Arguments and return value as :func:`advance_dopri`.  The Jacobian is the
+    Arguments (``p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x,
+    rec_m, rec_y, want_y``) and return value as :func:`advance_dopri`.  The Jacobian is the
     model's analytic one where its ``jacobian`` hook returns True, else a
     finite-difference one (:func:`_fd_jacobian`), reused for
     ``opt.jac_every`` accepted steps and refreshed after a rejection or a
@@ -901,10 +902,26 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
 def batch(method, plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
     """One solver per variant, in parallel (``prange``), recorded on ``ts``.
 
-    ``method`` is ``"dopri"`` or ``"rodas"``; ``plist`` is a ``numba.typed.List`` with one
-    parameter structure per variant (their mutable memories are their own); ``X0``, ``M0``, ``U``
-    have one row per variant.  ``STATS[v]`` receives the solver counters (``SI_*``); events go to
-    ``EV_*[v]`` (time, code, element) and ``EV_N[v]`` (held, dropped).
+    Parameters
+    ----------
+    method : {"dopri", "rodas"}
+    plist : numba.typed.List
+        One parameter structure per variant (their mutable memories are their own).
+    X0, M0, U : ndarray
+        Initial states, modes and held inputs, one row per variant.
+    t_end : float
+        End time [s].
+    ts : ndarray
+        Sample times [s].
+    opt : Options
+        Step control shared by all variants.
+    OUT_X, OUT_M, OUT_Y : ndarray
+        Records ``(variant, sample, column)``; ``OUT_Y`` written only if ``want_y``.
+    want_y : bool
+    STATS : ndarray
+        Solver counters per variant (``SI_*``).
+    EV_T, EV_C, EV_E, EV_N : ndarray
+        Events per variant: time, code, element; ``EV_N[v]`` = (held, dropped).
     """
     entry_points(type(plist[0]), method).batch(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS,
                                                EV_T, EV_C, EV_E, EV_N)
@@ -916,7 +933,7 @@ def evaluate(p, t, x, u, m, dx, g):
 
 
 def evaluate_outputs(p, t, x, u, m, y):
-    """The model's outputs ``y`` at one point."""
+    """The model's outputs ``y`` at one point ``(t, x, u, m)``."""
     entry_points(type(p), "dopri").evaluate_outputs(p, t, x, u, m, y)
 
 
