@@ -887,13 +887,36 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
 def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
 
-    Arguments and return value as :func:`advance_dopri`.  The Jacobian is the
-    model's analytic one where its ``jacobian`` hook returns True, else a
-    finite-difference one grouped by the sparsity pattern, reused for
-    ``opt.jac_every`` accepted steps and refreshed after a rejection or a
-    mode change.  The state at a located event comes from one Rodas3 step of
-    the located length from the step start, so the algebraic rows stay
-    consistent.
+    The Jacobian is the model's analytic one where its ``jacobian`` hook
+    returns True, else a finite-difference one grouped by the sparsity
+    pattern, reused for ``opt.jac_every`` accepted steps and refreshed after
+    a rejection or a mode change.  The state at a located event comes from
+    one Rodas3 step of the located length from the step start, so the
+    algebraic rows stay consistent.
+
+    Parameters
+    ----------
+    p : NamedTuple
+        The model's packed parameters (selects the model).
+    x, m, u : ndarray
+        State [SI], mode vector (int64) and held inputs; ``x`` and ``m`` are updated in place.
+    t_end : float
+        End of this call [s].
+    sf, si : ndarray
+        Solver state from :func:`new_solver_state`.
+    opt : Options
+    log : EventLog
+    ts : ndarray
+        Sample times [s] (empty: every accepted step, see :func:`advance_dopri`).
+    rec_t, rec_x, rec_m, rec_y : ndarray
+        Record buffers (time, states, modes, outputs).
+    want_y : bool
+        Evaluate the outputs into ``rec_y``.
+
+    Returns
+    -------
+    int
+        Status (:mod:`clutchlab.numerics.status`).
     """
     return entry_points(type(p), "rodas").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                                                   rec_y, want_y)
