@@ -494,9 +494,9 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         bad = np.flatnonzero(~np.isin(status, [st.SUCCESS, st.TERMINATED]))
         if bad.size:
             raise SimulationError(f"{first.name}: variant {bad[0]}: {st.message(status[bad[0]])}")
-    frames = [first.events_frame(EVT[v, :EVN[v, 0]], EVC[v, :EVN[v, 0]], EVE[v, :EVN[v, 0]], variant=v)
-              for v in range(nv)]
-    events = pd.concat(frames, ignore_index=True) if frames else first.events_frame([], [], [])
+    # one frame for all variants (one per variant cost ~0.5 ms each: as much as a run for large batches)
+    held = np.arange(EVT.shape[1])[None, :] < EVN[:, :1]
+    events = first.events_frame(EVT[held], EVC[held], EVE[held], variant=np.repeat(np.arange(nv), EVN[:, 0]))
     if not outputs:
         OY = np.full((nv, ns, ny), np.nan)
     stats = {"accepted_steps": STATS[:, core.SI_ACCEPTED].copy(), "rejected_steps": STATS[:, core.SI_REJECTED].copy(),
