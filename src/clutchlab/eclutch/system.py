@@ -383,7 +383,7 @@ def _equilibrate(x, ub, p):
                 dq = r / dr
                 x[j] -= dq
                 worst = max(worst, abs(dq))
-        if worst <= 1e-11:  # [m]: Newton converges quadratically, what is left after such a step is ~1e-20 m
+        if worst <= 1e-9:  # [m]: Newton converges quadratically: after a step this small ~1e-17 m are left
             break
 
 
