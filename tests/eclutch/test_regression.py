@@ -5,9 +5,10 @@ tolerances, with a knot of the input table at every recorded time so that they h
 interpolations.  The ported model runs the same inputs at the same tolerances.  Tolerances, relative to the
 peak of each trace:
 
-* no friction (a smooth solution between five events): 1e-6.  Both integrators converge to one solution; at
-  rtol 2e-12 they agree to 1e-7, while either one at rtol 1e-10 (atol_scale 1e-2) is 2e-4 away from it, so a
-  changed equation or parameter shows at once.
+* no friction (a smooth solution between five events): 5e-6.  Both integrators converge to one solution; at
+  rtol 2e-12 they agree to 1.5e-6 (1e-7 with the same absolute tolerances: the port's energy states have a
+  100x smaller one), while either one at rtol 1e-10 (atol_scale 1e-2) is 2e-4 away from it, so a changed
+  equation or parameter shows at once.
 * friction (stick-slip of the seals and of the pressure plate and diaphragm): which of two nearly equal
   states sticks first depends on the step sequence, so two correct integrators differ by more than their
   tolerance.  The former kernel itself moved by 8e-4 (voltage steps) and 4e-3 (position control) between
@@ -58,7 +59,7 @@ def test_without_friction_the_trajectory_is_the_former_kernels():
                              spindle_efficiency=1.0)
     res = EClutch(act, ClutchModel.preset(4), FrictionParameters.off()).simulate(
         bench_input(), 1.0, rtol=2e-12, atol_scale=1e-4, output_step=2.5e-3, max_steps=2_000_000)
-    check("smooth", res.outputs, 1e-6)
+    check("smooth", res.outputs, 5e-6)
 
 
 def test_position_control_with_friction_follows_the_former_kernel():
