@@ -162,9 +162,17 @@ def _build(variants: pd.DataFrame, scenario):
         params = W.pack_parameters(c, b, scen, f, **scales)
         x0 = W.initial_state(scen)
         x0[W.S_FA] *= scales.get("force_scale", 1.0)  # as simulate_batch: the actuator starts at the scaled reference
-        system = W.engagement_system(scen, clutch=c, bench=b, friction=f, params=params, x0=x0, rtol=RTOL)
-        built.append(((scen.duration, system.atol.tobytes()), system))
+        atol = W.absolute_tolerance(c, RTOL)
+        built.append(((scen.duration, atol.tobytes()), (scen, c, b, f, params, x0)))
     return built
+
+
+def _systems(items) -> list:
+    """The systems of one batch: the first built in full, the others variants of it (same tolerances)."""
+    scen, c, b, f, params, x0 = items[0]
+    first = W.engagement_system(scen, clutch=c, bench=b, friction=f, params=params, x0=x0, rtol=RTOL)
+    return [first] + [first.variant(params=params, x0=x0, m0=W.initial_modes(x0, c.piston_h0))
+                      for scen, c, b, f, params, x0 in items[1:]]
 
 
 def check_variants(variants: pd.DataFrame, scenario) -> None:
@@ -200,7 +208,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     for i, (key, _) in enumerate(built):
         groups.setdefault(key, []).append(i)
     for (duration, _), members in groups.items():
-        systems = [built[i][1] for i in members]
+        systems = _systems([built[i][1] for i in members])
         res = simulate_batch(systems, float(duration), sample_times=[duration], max_step=MAX_STEP,
                              max_steps=MAX_STEPS, outputs=False)
         final = res.states[:, -1, :]

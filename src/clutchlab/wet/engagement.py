@@ -60,7 +60,7 @@ import pandas as pd
 
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
-from ..result import SimulationResult
+from ..result import BuiltOnFirstAccess, SimulationResult
 from . import system as W
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
@@ -211,29 +211,6 @@ class Event:
     kind: str
 
 
-class _ListOnFirstAccess:
-    """Descriptor of a dataclass field that may be given as a zero-argument callable (called on first read).
-
-    A benchmark loop or a batch of engagements that never reads the mode names or the events does
-    not pay for building them (pandas).
-    """
-
-    def __set_name__(self, owner, name):
-        self.slot = "_built_" + name
-
-    def __get__(self, obj, owner=None):
-        if obj is None:
-            raise AttributeError(self.slot)  # no class-level default: the field stays required
-        value = obj.__dict__[self.slot]
-        if callable(value):
-            value = value()
-            obj.__dict__[self.slot] = value
-        return value
-
-    def __set__(self, obj, value):
-        obj.__dict__[self.slot] = value
-
-
 def _mode_names(result: SimulationResult) -> np.ndarray:
     return _MODE_NAMES[result.modes[:, W.M_FRICTION]] if result.modes.shape[0] else np.array([], dtype="<U5")
 
@@ -282,8 +259,10 @@ class EngagementResult:
     time: np.ndarray
     states: np.ndarray
     outputs: np.ndarray
-    modes: np.ndarray = _ListOnFirstAccess()   # from_result passes callables for these two: built when first read
-    events: list = _ListOnFirstAccess()
+    # from_result passes callables for these two, built when first read (a loop of runs that does not read
+    # the mode names or the events does not pay for them)
+    modes: np.ndarray = BuiltOnFirstAccess()
+    events: list = BuiltOnFirstAccess()
     n_steps: int
     final_state: np.ndarray
     heat_capacity: float

@@ -154,9 +154,10 @@ N_SWITCH = 5
 EVENTS = ("contact", "separation", "lockup", "breakaway", "slip_reversal", "piston_reaches_stop",
           "piston_leaves_stop")
 EV_CONTACT, EV_SEPARATION, EV_LOCKUP, EV_BREAKAWAY, EV_REVERSAL, EV_REACHES, EV_LEAVES = range(7)
-#: elements an event concerns
+#: elements an event concerns, and the element of each event
 ELEMENTS = ("clutch", "piston")
 EL_CLUTCH, EL_PISTON = 0, 1
+EVENT_ELEMENT = np.array([EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_PISTON, EL_PISTON])
 
 #: scalar parameters: (field, unit, description) -- the named fields of ``WetParams.constants``
 CONSTANTS = (
@@ -463,33 +464,34 @@ def wet_outputs(t, x, u, m, p, y):
 def wet_update(t, x, u, m, p, k, log):
     """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name)."""
     wk = p.data
+    code = -1  # the event to record (one call site: numba compiles ``record`` once, not per literal code)
     if k == G_LOCKUP:
         old = m[M_FRICTION]
         x[S_W] = 0.0
         m[M_FRICTION] = STICK
         _evaluate(t, x, u, m, p)
         if abs(wk[W_OUT + O_TD]) <= wk[W_OUT + O_CAP]:
-            record(log, t, EV_LOCKUP, EL_CLUTCH)
+            code = EV_LOCKUP
             if wk[W_LOCKUP] != wk[W_LOCKUP]:
                 wk[W_LOCKUP] = t
         else:
             # the static capacity cannot hold the drive torque: the slip changes direction
             m[M_FRICTION] = SLIP_NEG if old == SLIP else SLIP
-            record(log, t, EV_REVERSAL, EL_CLUTCH)
+            code = EV_REVERSAL
     elif k == G_BREAKAWAY:
         _evaluate(t, x, u, m, p)
         m[M_FRICTION] = SLIP if wk[W_OUT + O_TD] > 0.0 else SLIP_NEG
-        record(log, t, EV_BREAKAWAY, EL_CLUTCH)
+        code = EV_BREAKAWAY
     elif k == G_CONTACT:
         if m[M_FILM] == OPEN:
             m[M_FILM] = CONTACT
-            record(log, t, EV_CONTACT, EL_CLUTCH)
+            code = EV_CONTACT
         else:
             m[M_FILM] = OPEN
-            record(log, t, EV_SEPARATION, EL_CLUTCH)
+            code = EV_SEPARATION
     elif k == G_LEAVES:
         m[M_PISTON] = FREE
-        record(log, t, EV_LEAVES, EL_PISTON)
+        code = EV_LEAVES
     elif k == G_REACHES:
         x[S_X] = 0.0
         m[M_PISTON] = AT_STOP
@@ -498,7 +500,9 @@ def wet_update(t, x, u, m, p, k, log):
             # the force balance pushes it off the stop again at once (a touch): stays free
             m[M_PISTON] = FREE
         else:
-            record(log, t, EV_REACHES, EL_PISTON)
+            code = EV_REACHES
+    if code >= 0:
+        record(log, t, code, EVENT_ELEMENT[code])
     return 0
 
 
@@ -520,21 +524,22 @@ def wet_restart(t, x, u, m, p, log):
     if m[M_FRICTION] != STICK and m[M_PISTON] == FREE and x[S_X] > 0.0:
         return changed
     _evaluate(t, x, u, m, p)
-    if m[M_FRICTION] == STICK and abs(wk[W_OUT + O_TD]) > wk[W_OUT + O_CAP]:
-        # stuck with the drive torque above the capacity (a jump of an input at a resume)
-        m[M_FRICTION] = SLIP if wk[W_OUT + O_TD] > 0.0 else SLIP_NEG
-        record(log, t, EV_BREAKAWAY, EL_CLUTCH)
-        changed = True
-    if m[M_PISTON] == AT_STOP:
-        if wk[W_G + G_LEAVES] > 0.0:
+    for check in range(2):  # the friction, then the piston; one call site of ``record``
+        code = -1
+        if check == 0 and m[M_FRICTION] == STICK and abs(wk[W_OUT + O_TD]) > wk[W_OUT + O_CAP]:
+            # stuck with the drive torque above the capacity (a jump of an input at a resume)
+            m[M_FRICTION] = SLIP if wk[W_OUT + O_TD] > 0.0 else SLIP_NEG
+            code = EV_BREAKAWAY
+        elif check == 1 and m[M_PISTON] == AT_STOP and wk[W_G + G_LEAVES] > 0.0:
             m[M_PISTON] = FREE
-            record(log, t, EV_LEAVES, EL_PISTON)
+            code = EV_LEAVES
+        elif check == 1 and m[M_PISTON] == FREE and x[S_X] <= 0.0 and wk[W_DX + S_X] <= 0.0:
+            x[S_X] = 0.0
+            m[M_PISTON] = AT_STOP
+            code = EV_REACHES
+        if code >= 0:
+            record(log, t, code, EVENT_ELEMENT[code])
             changed = True
-    elif x[S_X] <= 0.0 and wk[W_DX + S_X] <= 0.0:
-        x[S_X] = 0.0
-        m[M_PISTON] = AT_STOP
-        record(log, t, EV_REACHES, EL_PISTON)
-        changed = True
     return changed
 
 
