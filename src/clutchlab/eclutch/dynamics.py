@@ -556,8 +556,7 @@ def _max_step(max_step, h_max):
     return value
 
 
-def _run(source, system: contract.System, t_end: float, max_steps: int, output_step) -> DynamicsResult:
-    grid = _grid(output_step, t_end)
+def _run(source, system: contract.System, t_end: float, max_steps: int, grid) -> DynamicsResult:
     # without a grid every accepted step is kept, in chunks that grow with the run (not max_steps rows up front)
     res = contract.simulate(system, t_end, max_steps=int(max_steps), sample_times=grid if grid.size else None)
     return DynamicsResult.from_result(res, source)
@@ -619,9 +618,10 @@ class ClutchDynamics:
         tin, _vin = _as_table(bearing_position, "bearing_position")
         t_end = float(tin[-1]) if t_end is None else float(t_end)
         _check_run(t_end, rtol, max_steps)
+        grid = _grid(output_step, t_end)  # refused before anything is built
         system = self.as_system(bearing_position, rtol=rtol, max_step=_max_step(max_step, h_max),
                                 event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, output_step)
+        return _run(self, system, t_end, max_steps, grid)
 
 
 class EClutch:
@@ -721,11 +721,13 @@ class EClutch:
             events and statistics; ``.result`` is the :class:`~clutchlab.SimulationResult`.
         """
         t_end = float(t_end)
+        _imode, _interp, key, value = _input_mode(inputs)
+        _as_table(value, key)
         _check_run(t_end, rtol, max_steps)
-        _grid(output_step, t_end)  # refuse an output grid beyond the memory budget before any work
+        grid = _grid(output_step, t_end)  # refused before anything is built
         system = self.as_system(inputs, rtol=rtol, max_step=_max_step(max_step, h_max), event_tol=event_tol,
                                 jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, output_step)
+        return _run(self, system, t_end, max_steps, grid)
 
 
 def _input_mode(inputs):
