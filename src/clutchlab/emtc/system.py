@@ -327,132 +327,10 @@ def commanded_magnet_force(t_ref, g, a, split):
 
 # ------------------------------------------------------------------ the model
 @numba.njit(cache=True, nogil=True)
-def _cold(p, k):
-    """Table ``k`` (``L_*``) of ``p.cold`` as a 1-D view."""
-    o = p.layout[2 * k]
-    return p.cold[o:o + p.layout[2 * k + 1]]
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _model(t, x, u, m, p, dx, aux):
-    """Right-hand side ``dx`` and intermediates ``aux`` ([1], Eqs. 8-30, Fig. 15) in the modes ``m``.
-
-    The one place the model is written; every hook evaluates it through the core's ``rhs`` hook.
-    """
-    a = p.actuator
-    v = p.vehicle
-    c = p.coupling
-    g = p.geometry
-    fmem = p.fmem
-    arm = m[0]
-    cpl = m[1]
-    wf = x[0]
-    wr = x[1]
-    xa = x[3]
-    xd = x[4]
-    # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
-    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12; the weighted cell
-    # table is rebuilt only when the airgap changes, i.e. while the armature moves)
-    grid = p.plant_grid
-    icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
-    gap = a.airgap_open - xa
-    gw = fmem[FM_GW:FM_GW + 4]
-    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
-    if gap != gw[3]:
-        gaps = _cold(p, L_PLANT_GAPS)
-        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
-        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
-        gw[3] = gap
-    fm = peek_combined(p.plant_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil,
-                       gidx, gw)
-    fn1 = 0.0
-    if arm == ARM_FREE:
-        dx[3] = xd
-        dx[4] = armature_acceleration(fm, xa, xd, a)
-    else:
-        dx[3] = 0.0
-        dx[4] = 0.0
-        if arm == ARM_CONTACT:
-            fn1 = max(primary_clamp_force(fm, a), 0.0)
-    # current control: two first-order lags in series ([1], Fig. 15)
-    dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
-    dx[6] = (x[5] - x[6]) / a.tau2
-    thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
-    a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
-    tlock = lock_torque(a_f, a_r, v)
-    dw = wf - wr
-    s = fmem[FM_SPLIT:FM_SPLIT + 6]
-    t1 = 0.0
-    t2 = 0.0
-    t3 = 0.0
-    case = -1.0
-    fn2 = 0.0
-    t_drag = 0.0
-    if cpl == OPEN:
-        t_drag = drag_torque_scalar(c.drag_pairs, c.oil_viscosity, dw, c.plate_clearance, c.plate_outer_radius,
-                                    c.plate_inner_radius)  # [1], Eq. 25
-        t_fric = 0.0
-        dx[2] = 0.0
-    elif cpl == SLIPPING:
-        # kinetic friction in the slip direction of the mode: the slip crossing zero is an event (lock-up or
-        # reversal, Fig. 11) located by the core, not a sign change inside the mode (that would make the slip
-        # slide along zero until a step happened to end past it; see docs/emtc.md)
-        sl = 1.0 if m[2] == POSITIVE else -1.0
-        if p.friction_mode == FRICTION_MAP:
-            m1 = bilinear(_cold(p, L_FMAP_SPEED), _cold(p, L_FMAP_TEMP),
-                          _cold(p, L_FMAP_MU).reshape((p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
-            m2 = m1
-            m3 = m1
-        elif p.friction_mode == FRICTION_LUGRE:
-            # [1], Eqs. 22-23: bristles advanced exactly from their committed value at the step start
-            tlast = fmem[FM_TLAST]
-            zb = lugre_advance(fmem[FM_Z], dw, t - tlast if tlast == tlast else 0.0, p.lugre)
-            mu = lugre_mu(zb, dw, p.lugre)
-            if mu != 0.0:
-                sl = mu
-            m1 = abs(mu)
-            m2 = m1
-            m3 = m1
-        else:
-            m1 = g[0]
-            m2 = g[1]
-            m3 = g[2]
-        _slipping(fn1, sl, g, m1, m2, m3, s)  # [1], Eqs. 13-15
-        t1 = s[0]
-        t2 = s[1]
-        t3 = s[2]
-        t_fric = t1 + t2 + t3  # [1], Eq. 17
-        fn2 = _cam_force(t1, t3, g)  # [1], Eq. 14
-        dx[2] = 0.0
-    else:
-        tl = tlock + v.torsen_stiffness * x[2] + v.torsen_damping * dw  # [1], Eq. 30
-        code = _locked(fn1, tl, g, c.unlock_margin, s)  # [1], Eqs. 18-21
-        if code >= 0:
-            t1 = s[0]
-            t2 = s[1]
-            t3 = s[2]
-            case = code
-        else:  # beyond the margin (only inside a step before the unlock event is located)
-            t1 = tl
-        t_fric = tl
-        fn2 = _cam_force(t1, t3, g)
-        dx[2] = dw
-    tc = coupling_torque_scalar(cpl != OPEN, t_drag, t_fric)  # [1], Eq. 26
-    aux[AUX_FM] = fm
-    aux[AUX_FN1] = fn1
-    aux[AUX_T1] = t1
-    aux[AUX_T2] = t2
-    aux[AUX_T3] = t3
-    aux[AUX_TC] = tc
-    aux[AUX_TLOCK] = tlock
-    aux[AUX_TTRANS] = ttrans
-    aux[AUX_CAP] = _locked_capacity(fn1, g)  # [1], Eq. 21
-    aux[AUX_CASE] = case
-    aux[AUX_FN2] = fn2
-    aux[AUX_TE] = te
-    aux[AUX_THR] = thr
-    dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
-    dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+def _cold(cold, layout, k):
+    """Table ``k`` (``L_*``) of ``EmtcParams.cold`` as a 1-D view (``layout``: ``EmtcParams.layout``)."""
+    o = layout[2 * k]
+    return cold[o:o + layout[2 * k + 1]]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -582,25 +460,23 @@ def _controller(t, x, u, p):
     if p.reference_source == REFERENCE_INPUT:
         t_ref = u[U_TORQUE]
     elif p.reference_source == REFERENCE_TABLE:
-        t_ref = interp1(_cold(p, L_REF_TIME), _cold(p, L_REF_VALUE), t)
+        t_ref = interp1(_cold(p.cold, p.layout, L_REF_TIME), _cold(p.cold, p.layout, L_REF_VALUE), t)
     else:
         vx = x[0] / p.vehicle.axle_ratio * p.vehicle.tyre_radius
-        t_ref = bilinear(_cold(p, L_MAP_THROTTLE), _cold(p, L_MAP_SPEED),
-                         _cold(p, L_MAP_TORQUE).reshape((p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
+        t_ref = bilinear(_cold(p.cold, p.layout, L_MAP_THROTTLE), _cold(p.cold, p.layout, L_MAP_SPEED),
+                         _cold(p.cold, p.layout, L_MAP_TORQUE).reshape((p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
     fm_req = commanded_magnet_force(t_ref, p.geometry, a, fmem[FM_SPLIT:FM_SPLIT + 3])
     clen = imem[IM_CLEN]
-    stack = _cold(p, L_CTL_STACK)
+    stack = _cold(p.cold, p.layout, L_CTL_STACK)
     if clen + 2 > stack.shape[0]:
         imem[IM_ERROR] = ERR_CONTROLLER_MEMORY  # reported by the next accepted step
         return
     n = p.n_ctl_cells
-    tables = _cold(p, L_CTL_TABLES).reshape((p.n_ctl_airgaps, n, n, 4))
-    grid = _cold(p, L_CTL_GRID)
-    prefix = _cold(p, L_CTL_PREFIX).reshape((p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
-    cg = _cold(p, L_CTL_GAPS)
-    cidx = imem[IM_CIDX:IM_CIDX + 3]
+    tables = _cold(p.cold, p.layout, L_CTL_TABLES).reshape((p.n_ctl_airgaps, n, n, 4))
+    grid = _cold(p.cold, p.layout, L_CTL_GRID)
+    prefix = _cold(p.cold, p.layout, L_CTL_PREFIX).reshape((p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
+    cidx = imem[IM_CIDX:IM_CIDX + 3]  # airgap weights at the engaged airgap d - sigma (set by pack_parameters)
     cw = fmem[FM_CW:FM_CW + 3]
-    gap_weights(cg, min(max(a.airgap_open - a.free_travel, cg[0]), cg[cg.shape[0] - 1]), cidx, cw)
     cu = fmem[FM_CU]
     i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7 at d - sigma
     imem[IM_CLEN] = commit(tables, grid, stack, prefix, clen, cu, i_new)
@@ -609,7 +485,7 @@ def _controller(t, x, u, p):
     fmem[FM_TREF] = t_ref
     fmem[FM_FEASIBLE] = 1.0 if ok else 0.0
     k = imem[IM_KNEXT]
-    log = _cold(p, L_LOG)
+    log = _cold(p.cold, p.layout, L_LOG)
     if 4 * k + 3 < log.shape[0]:
         log[4 * k + LOG_CMD] = i_new
         log[4 * k + LOG_TREF] = t_ref
@@ -620,9 +496,130 @@ def _controller(t, x, u, p):
 # ------------------------------------------------------------------ the hooks of the contract
 @numba.njit(cache=True, nogil=True)
 def _rhs(t, x, u, m, p, dx, g):
+    """Right-hand side ``dx`` ([1], Eqs. 8-30, Fig. 15) and switching functions ``g`` in the modes ``m``.
+
+    The one place the model is written (every other hook evaluates it through the core's ``rhs`` hook);
+    the intermediates go to ``fmem[FM_AUX:]``.  Written out in the hook itself rather than in a function it
+    calls: each call that takes the parameter structure costs the reference counting of all its arrays.
+    """
     aux = p.fmem[FM_AUX:FM_AUX + N_AUX]
-    _model(t, x, u, m, p, dx, aux)
-    _switching(x, m, p.actuator, p.coupling.unlock_margin, aux, g)
+    a = p.actuator
+    v = p.vehicle
+    c = p.coupling
+    geo = p.geometry
+    fmem = p.fmem
+    arm = m[0]
+    cpl = m[1]
+    wf = x[0]
+    wr = x[1]
+    xa = x[3]
+    xd = x[4]
+    # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
+    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12; the weighted cell
+    # table is rebuilt only when the airgap changes, i.e. while the armature moves)
+    grid = p.plant_grid
+    icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
+    gap = a.airgap_open - xa
+    gw = fmem[FM_GW:FM_GW + 4]
+    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
+    if gap != gw[3]:
+        gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
+        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
+        gw[3] = gap
+    fm = peek_combined(p.plant_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil,
+                       gidx, gw)
+    fn1 = 0.0
+    if arm == ARM_FREE:
+        dx[3] = xd
+        dx[4] = armature_acceleration(fm, xa, xd, a)
+    else:
+        dx[3] = 0.0
+        dx[4] = 0.0
+        if arm == ARM_CONTACT:
+            fn1 = max(primary_clamp_force(fm, a), 0.0)
+    # current control: two first-order lags in series ([1], Fig. 15)
+    dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
+    dx[6] = (x[5] - x[6]) / a.tau2
+    thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
+    a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
+    tlock = lock_torque(a_f, a_r, v)
+    dw = wf - wr
+    s = fmem[FM_SPLIT:FM_SPLIT + 6]
+    t1 = 0.0
+    t2 = 0.0
+    t3 = 0.0
+    case = -1.0
+    fn2 = 0.0
+    t_drag = 0.0
+    if cpl == OPEN:
+        t_drag = drag_torque_scalar(c.drag_pairs, c.oil_viscosity, dw, c.plate_clearance, c.plate_outer_radius,
+                                    c.plate_inner_radius)  # [1], Eq. 25
+        t_fric = 0.0
+        dx[2] = 0.0
+    elif cpl == SLIPPING:
+        # kinetic friction in the slip direction of the mode: the slip crossing zero is an event (lock-up or
+        # reversal, Fig. 11) located by the core, not a sign change inside the mode (that would make the slip
+        # slide along zero until a step happened to end past it; see docs/emtc.md)
+        sl = 1.0 if m[2] == POSITIVE else -1.0
+        if p.friction_mode == FRICTION_MAP:
+            m1 = bilinear(_cold(p.cold, p.layout, L_FMAP_SPEED), _cold(p.cold, p.layout, L_FMAP_TEMP),
+                          _cold(p.cold, p.layout, L_FMAP_MU).reshape((p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
+            m2 = m1
+            m3 = m1
+        elif p.friction_mode == FRICTION_LUGRE:
+            # [1], Eqs. 22-23: bristles advanced exactly from their committed value at the step start
+            tlast = fmem[FM_TLAST]
+            zb = lugre_advance(fmem[FM_Z], dw, t - tlast if tlast == tlast else 0.0, p.lugre)
+            mu = lugre_mu(zb, dw, p.lugre)
+            if mu != 0.0:
+                sl = mu
+            m1 = abs(mu)
+            m2 = m1
+            m3 = m1
+        else:
+            m1 = geo[0]
+            m2 = geo[1]
+            m3 = geo[2]
+        _slipping(fn1, sl, geo, m1, m2, m3, s)  # [1], Eqs. 13-15
+        t1 = s[0]
+        t2 = s[1]
+        t3 = s[2]
+        t_fric = t1 + t2 + t3  # [1], Eq. 17
+        fn2 = _cam_force(t1, t3, geo)  # [1], Eq. 14
+        dx[2] = 0.0
+    else:
+        tl = tlock + v.torsen_stiffness * x[2] + v.torsen_damping * dw  # [1], Eq. 30
+        code = _locked(fn1, tl, geo, c.unlock_margin, s)  # [1], Eqs. 18-21
+        if code >= 0:
+            t1 = s[0]
+            t2 = s[1]
+            t3 = s[2]
+            case = code
+        else:  # beyond the margin (only inside a step before the unlock event is located)
+            t1 = tl
+        t_fric = tl
+        fn2 = _cam_force(t1, t3, geo)
+        dx[2] = dw
+    tc = coupling_torque_scalar(cpl != OPEN, t_drag, t_fric)  # [1], Eq. 26
+    aux[AUX_FM] = fm
+    aux[AUX_FN1] = fn1
+    aux[AUX_T1] = t1
+    aux[AUX_T2] = t2
+    aux[AUX_T3] = t3
+    aux[AUX_TC] = tc
+    aux[AUX_TLOCK] = tlock
+    aux[AUX_TTRANS] = ttrans
+    aux[AUX_CAP] = _locked_capacity(fn1, geo)  # [1], Eq. 21
+    aux[AUX_CASE] = case
+    aux[AUX_FN2] = fn2
+    aux[AUX_TE] = te
+    aux[AUX_THR] = thr
+    dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
+    dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+    _switching(x, m, a, c.unlock_margin, aux, g)
+
+
 
 
 @numba.njit(cache=True, nogil=True)
@@ -895,6 +892,8 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
     cold.add(L_LOG, np.zeros(4 * int(n_samples)))
     imem = np.zeros(N_IMEM, dtype=np.int64)
     fmem = np.zeros(N_FMEM)
+    cg = _f(ctl.airgaps)
+    gap_weights(cg, float(min(max(lo_gap, cg[0]), cg[-1])), imem[IM_CIDX:IM_CIDX + 3], fmem[FM_CW:FM_CW + 3])
     fmem[FM_PU] = magnet.grid[0]
     fmem[FM_CU] = ctl.grid[0]
     fmem[FM_TLAST] = np.nan
