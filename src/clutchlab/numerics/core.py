@@ -147,8 +147,12 @@ class EventLog(NamedTuple):
 
 
 def new_log(capacity: int) -> EventLog:
-    """An empty event log holding up to ``capacity`` events."""
-    return EventLog(np.zeros(capacity), np.zeros(capacity, dtype=np.int64), np.zeros(capacity, dtype=np.int64),
+    """An empty event log holding up to ``capacity`` events.
+
+    The entries are left uninitialised (only ``count`` is zeroed; nothing beyond ``count[0]`` is ever
+    read): a large log then costs no page faults and no zeroing until events are recorded.
+    """
+    return EventLog(np.empty(capacity), np.empty(capacity, dtype=np.int64), np.empty(capacity, dtype=np.int64),
                     np.zeros(2, dtype=np.int64))
 
 
