@@ -21,7 +21,6 @@ References
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pandas as pd
@@ -276,7 +275,7 @@ class BenchResult:
             A run of the ``emtc_bench`` model (:func:`clutchlab.emtc.simulate`).
         controller_log : numpy.ndarray, optional
             ``(samples, 4)``: command [A], reference [N*m], throttle [-], feasible (1/0) computed at each
-            sample (``params.ctl_log``); without it the held values the result reports are used.
+            sample (:func:`clutchlab.emtc.system.controller_log`); without it the held values the result reports are used.
         """
         return cls(result, controller_log)
 
@@ -460,7 +459,7 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
                         max_steps=int(max_steps))
     # the controller also runs at the last sample (its break never comes: the run ends there)
     S.run_controller(system.params, float(samples[-1]), res.stats["final_state"], system.u0)
-    return BenchResult(res, system.params.ctl_log.copy())
+    return BenchResult(res, S.controller_log(system.params))
 
 
 def load_scenario(path):

@@ -56,9 +56,8 @@ from .torque import UNLOCK_MARGIN, _cam_force, _locked, _locked_capacity, _slipp
 
 __all__ = ["EmtcParams", "BenchOptions", "pack_parameters", "bench_system", "simulate", "STATES", "OUTPUTS",
            "INPUTS", "SWITCHING", "EVENTS", "EVENT_DESCRIPTIONS", "MODE_NAMES", "MODE_VALUES", "ERROR_MESSAGES",
-           "memory_full", "run", "run_controller",
-           "armature_acceleration", "primary_clamp_force", "bench_loads", "lock_torque", "commanded_magnet_force",
-           "plant_magnet_force"]
+           "memory_full", "run", "run_controller", "controller_log", "VehicleData", "CouplingData", "ActuatorData",
+           "armature_acceleration", "primary_clamp_force", "bench_loads", "lock_torque", "commanded_magnet_force"]
 
 # ------------------------------------------------------------------ the self-description
 STATES = (
@@ -137,31 +136,34 @@ ERROR_MESSAGES = {
     ERR_CONTROLLER_MEMORY: "the controller model's hysteresis memory is full (BenchOptions.memory_capacity)",
 }
 
-# per-run memories: integers and floats (see EmtcParams.imem / fmem)
-IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR = range(4)
-N_IMEM = 4
+# per-run integer memories (EmtcParams.imem)
+IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX = 0, 1, 2, 3, 4, 7
+N_IMEM = 10
+# per-run float memories and scratch (EmtcParams.fmem)
 FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
-N_FMEM = 8
-# model intermediates (EmtcParams.aux)
+FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
+FM_CW = 12  # 3: airgap weights of the controller model
+FM_ULAST = 15  # 4: inputs seen at the last restart
+FM_AUX = 19  # N_AUX model intermediates of the last evaluation
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
  AUX_THR) = range(13)
 N_AUX = 13
+FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque split
+FM_DX = FM_SPLIT + 6  # 7: scratch derivative
+FM_G = FM_DX + 7  # 6: scratch switching functions
+N_FMEM = FM_G + 6
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
+# the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
+(L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_GAPS, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
+ L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(16)
+N_LAYOUT = 16
 
 ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
 
 
-class EmtcParams(NamedTuple):
-    """Packed parameters and per-run memories of the EMTC drum-bench model (SI; built by :func:`pack_parameters`).
-
-    Scalars are the vehicle (Table 1 of [1] and representative values), bench, actuator and controller
-    data; arrays are the coupling geometry (:meth:`CouplingGeometry.kernel_data`), friction data, input
-    profiles (an empty profile takes the held input), the torque map (Eq. 31), the plant and controller
-    Preisach tables, and the mutable memories of one run: hysteresis stacks and prefix sums, ``imem``
-    (memory lengths, next controller sample, error), ``fmem`` (last memory inputs, held command, bristle
-    state), the airgap-weight cache and scratch arrays.  One instance per run (or batch variant).
-    """
+class VehicleData(NamedTuple):
+    """Vehicle and drum-bench scalars of the model (SI; [1] Table 1, Eqs. 27-30 and clutchlab's bench)."""
 
     front_final_drive: float
     axle_ratio: float
@@ -178,293 +180,196 @@ class EmtcParams(NamedTuple):
     engine_power: float
     torsen_stiffness: float
     torsen_damping: float
-    temperature_c: float
+    drum_load_front: float
+    drum_load_rear: float
+
+
+class CouplingData(NamedTuple):
+    """Coupling scalars: drag of the open coupling (Eq. 25), unlock margin, temperature of the friction map."""
+
     drag_pairs: float
     oil_viscosity: float
     plate_clearance: float
     plate_outer_radius: float
     plate_inner_radius: float
     unlock_margin: float
-    sample_time: float
-    drum_load_front: float
-    drum_load_rear: float
-    armature_mass: float
-    spring_stiffness: float
-    spring_preload: float
-    spring_damping: float
+    temperature_c: float
+
+
+class ActuatorData(NamedTuple):
+    """Armature, return spring and current lags ([1], Eqs. 8-12, Fig. 15), SI."""
+
+    mass: float
+    stiffness: float
+    preload: float
+    damping: float
     free_travel: float
     airgap_open: float
     tau1: float
     tau2: float
+
+
+class EmtcParams(NamedTuple):
+    """Packed parameters and per-run memories of the EMTC drum-bench model (built by :func:`pack_parameters`).
+
+    Scalars are grouped in NamedTuples of floats (:class:`VehicleData`, :class:`CouplingData`,
+    :class:`ActuatorData`), the coupling geometry (:meth:`CouplingGeometry.kernel_data`) and the LuGre data
+    are tuples: values that cost nothing to pass.  The arrays are few, because the integrator core hands this
+    structure to every hook call and numba reference-counts each array in it on each call (measured: with 40
+    arrays that traffic was two thirds of the run time): the throttle profile and the plant magnet's memory
+    (read on every evaluation), the integer and float memories of the run (``imem``, ``fmem``, offsets
+    ``IM_*``, ``FM_*``), and one array ``cold`` with everything read only at controller samples, airgap
+    changes or in the friction-map mode (offsets and sizes in ``layout``, indices ``L_*``).  One instance per
+    run (or batch variant).
+    """
+
+    vehicle: VehicleData
+    coupling: CouplingData
+    actuator: ActuatorData
+    geometry: tuple
+    lugre: tuple
+    sample_time: float
     friction_mode: int
     reference_source: int
-    geometry: np.ndarray
-    lugre: np.ndarray
-    fmap_speed: np.ndarray
-    fmap_temperature: np.ndarray
-    fmap_mu: np.ndarray
-    throttle_time: np.ndarray
-    throttle_value: np.ndarray
-    drum_front_time: np.ndarray
-    drum_front_value: np.ndarray
-    drum_rear_time: np.ndarray
-    drum_rear_value: np.ndarray
-    map_throttle: np.ndarray
-    map_speed: np.ndarray
-    map_torque: np.ndarray
-    reference_time: np.ndarray
-    reference_value: np.ndarray
+    n_airgaps: int
+    n_cells: int
+    n_ctl_airgaps: int
+    n_ctl_cells: int
+    n_fmap_speed: int
+    n_fmap_temp: int
+    n_map_throttle: int
+    n_map_speed: int
+    layout: tuple
+    throttle: np.ndarray
     plant_tables: np.ndarray
     plant_grid: np.ndarray
-    plant_airgaps: np.ndarray
     plant_stack: np.ndarray
     plant_prefix: np.ndarray
-    ctl_tables: np.ndarray
-    ctl_grid: np.ndarray
-    ctl_airgaps: np.ndarray
-    ctl_stack: np.ndarray
-    ctl_prefix: np.ndarray
+    plant_comb: np.ndarray
     imem: np.ndarray
     fmem: np.ndarray
-    u_last: np.ndarray
-    gap_idx: np.ndarray
-    gap_w: np.ndarray
-    gap_comb: np.ndarray
-    ctl_idx: np.ndarray
-    ctl_w: np.ndarray
-    aux: np.ndarray
-    dxw: np.ndarray
-    gw: np.ndarray
-    split: np.ndarray
-    ctl_log: np.ndarray
+    cold: np.ndarray
 
 
 # ------------------------------------------------------------------ equations (one scalar function each)
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def plant_magnet_force(current, gap, p):
-    """Magnet force of the plant at a coil current and airgap, memory not committed ([1], Eqs. 1-5, Sec. 2.1).
-
-    The Preisach output of the plant's memory for the next input ``current`` [A] (clamped to the grid),
-    interpolated over the calibration airgaps at ``gap`` [m] (clamped to their range).  While the airgap
-    does not change (armature at a stop) the airgap-weighted cell table is reused (``gap_w[3]`` holds the
-    airgap it was built for).  Returns [N].
-    """
-    grid = p.plant_grid
-    i = min(max(current, grid[0]), grid[grid.shape[0] - 1])
-    w = p.gap_w
-    if gap != w[3]:
-        gaps = p.plant_airgaps
-        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), p.gap_idx, w)
-        combine_tables(p.plant_tables, p.gap_idx, w, p.gap_comb)
-        w[3] = gap
-    return peek_combined(p.gap_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], p.fmem[FM_PU], i,
-                         p.gap_idx, w)
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def armature_acceleration(fm, x, v, p):
+def armature_acceleration(fm, x, v, a):
     """Acceleration of the free armature ([1], Eq. 9 with ``F_n0 = F_n1 = 0``) [m/s^2].
 
-    ``m0 a = F_m - F_k0 - K x - c v`` with the magnet force ``fm`` [N], displacement ``x`` [m] and speed
-    ``v`` [m/s]; mass, spring and damping from ``p``.
+    ``m0 a = F_m - F_k0 - K x - c v`` with the magnet force ``fm`` [N], displacement ``x`` [m], speed
+    ``v`` [m/s] and the armature data ``a`` (:class:`ActuatorData`).
     """
-    return (fm - p.spring_preload - p.spring_stiffness * x - p.spring_damping * v) / p.armature_mass  # [1], Eq. 9
+    return (fm - a.preload - a.stiffness * x - a.damping * v) / a.mass  # [1], Eq. 9
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def primary_clamp_force(fm, p):
+def primary_clamp_force(fm, a):
     """Force of the armature on the primary clutch at ``x = sigma``: ``F_m - F_k0 - K sigma`` ([1], Eq. 11) [N].
 
-    Negative values mean the armature leaves the clutch (the clamp force itself is ``max(., 0)``).
+    ``fm``: magnet force [N]; ``a``: :class:`ActuatorData`.  Negative values mean the armature leaves the
+    clutch (the clamp force itself is ``max(., 0)``).
     """
-    return fm - p.spring_preload - p.spring_stiffness * p.free_travel  # [1], Eq. 11
+    return fm - a.preload - a.stiffness * a.free_travel  # [1], Eq. 11
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def bench_loads(wf, wr, throttle, v_front, v_rear, p):
+def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     """Loads on the two coupling shafts of the vehicle on the drum bench ([1], Eq. 27, rows 1+3 and 2+4).
 
     ``J_F dw_f/dt = A_f - T_c``, ``J_R dw_r/dt = T_c - A_r`` with ``A_f = (T_trans i0 - F_xf r - T_ff)/i``,
     ``A_r = (F_xr r + T_fr)/i`` at the shaft speeds ``wf``, ``wr`` [rad/s], throttle [-] and drum surface
-    speeds [m/s].  Tyre force on a drum ``F_x = 2 C_x r (w_w r - v_d)/max(|v_d|, v_floor)`` per axle,
-    rolling resistance ``f_rr F_z r tanh(w_w / 0.5 rad/s)`` plus the drum load, engine torque
-    ``throttle min(T_max, P/w_e)`` (clutchlab's assumptions: the paper does not model the tyre-drum
-    contact or the engine).  Returns ``(A_f, A_r, T_e, T_trans)`` [N*m].
+    speeds [m/s]; ``v``: :class:`VehicleData`.  Tyre force on a drum
+    ``F_x = 2 C_x r (w_w r - v_d)/max(|v_d|, v_floor)`` per axle, rolling resistance
+    ``f_rr F_z r tanh(w_w / 0.5 rad/s)`` plus the drum load, engine torque ``throttle min(T_max, P/w_e)``
+    (clutchlab's assumptions: the paper does not model the tyre-drum contact or the engine).
+    Returns ``(A_f, A_r, T_e, T_trans)`` [N*m].
     """
-    ic = p.axle_ratio
-    rw = p.tyre_radius
+    ic = v.axle_ratio
+    rw = v.tyre_radius
     wwf = wf / ic
     wwr = wr / ic
-    kf = 2.0 * p.tyre_slip_stiffness * rw / max(abs(v_front), p.slip_speed_floor)
-    kr = 2.0 * p.tyre_slip_stiffness * rw / max(abs(v_rear), p.slip_speed_floor)
+    kf = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_front), v.slip_speed_floor)
+    kr = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_rear), v.slip_speed_floor)
     fxf = kf * (wwf * rw - v_front)  # tyre-drum longitudinal force, both wheels
     fxr = kr * (wwr * rw - v_rear)
-    rrf = p.rolling_resistance * p.axle_load_front * rw * math.tanh(wwf / 0.5) + p.drum_load_front
-    rrr = p.rolling_resistance * p.axle_load_rear * rw * math.tanh(wwr / 0.5) + p.drum_load_rear
-    we = abs(wwf) * p.front_final_drive * p.gear_ratio
-    te = throttle * min(p.engine_torque_max, p.engine_power / max(we, 1.0))
-    ttrans = te * p.gear_ratio
-    a_f = (ttrans * p.front_final_drive - fxf * rw - rrf) / ic  # [1], Eq. 27: front loads at the coupling shaft
+    rrf = v.rolling_resistance * v.axle_load_front * rw * math.tanh(wwf / 0.5) + v.drum_load_front
+    rrr = v.rolling_resistance * v.axle_load_rear * rw * math.tanh(wwr / 0.5) + v.drum_load_rear
+    we = abs(wwf) * v.front_final_drive * v.gear_ratio
+    te = throttle * min(v.engine_torque_max, v.engine_power / max(we, 1.0))
+    ttrans = te * v.gear_ratio
+    a_f = (ttrans * v.front_final_drive - fxf * rw - rrf) / ic  # [1], Eq. 27: front loads at the coupling shaft
     a_r = (fxr * rw + rrr) / ic
     return a_f, a_r, te, ttrans
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def lock_torque(a_f, a_r, p):
-    """Torque that keeps both shafts at the same acceleration, ``(J_R A_f + J_F A_r)/(J_F + J_R)`` ([1], Eq. 29) [N*m]."""
-    return (p.inertia_rear * a_f + p.inertia_front * a_r) / (p.inertia_front + p.inertia_rear)  # [1], Eq. 29
+def lock_torque(a_f, a_r, v):
+    """Torque that keeps both shafts at the same acceleration, ``(J_R A_f + J_F A_r)/(J_F + J_R)`` ([1], Eq. 29) [N*m].
+
+    ``a_f``, ``a_r``: the loads of Eq. 27 [N*m]; ``v``: :class:`VehicleData`.
+    """
+    return (v.inertia_rear * a_f + v.inertia_front * a_r) / (v.inertia_front + v.inertia_rear)  # [1], Eq. 29
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def commanded_magnet_force(t_ref, p):
+def commanded_magnet_force(t_ref, g, a, split):
     """Magnet force the controller asks for to transfer ``t_ref`` [N*m] in slipping mode ([1], Eqs. 13, 15, 11).
 
     ``F_n1 = T_ref / (T_c/F_n1)`` with the slipping-mode torque per newton of Eqs. 13-15 at the kinetic
-    coefficients, then ``F_m = F_n1 + F_k0 + K sigma`` (Eq. 11 solved for ``F_m``); 0 for ``t_ref <= 0``.
-    Returns [N].
+    coefficients of the geometry ``g``, then ``F_m = F_n1 + F_k0 + K sigma`` (Eq. 11 solved for ``F_m``;
+    ``a``: :class:`ActuatorData`); 0 for ``t_ref <= 0``.  ``split`` is scratch (3 values).  Returns [N].
     """
     if not t_ref > 0.0:
         return 0.0
-    g = p.geometry
-    s = p.split
-    _slipping(1.0, 1.0, g, g[0], g[1], g[2], s)  # [1], Eqs. 13-15 per newton of F_n1
-    return t_ref / (s[0] + s[1] + s[2]) + p.spring_preload + p.spring_stiffness * p.free_travel  # [1], Eq. 11
+    _slipping(1.0, 1.0, g, g[0], g[1], g[2], split)  # [1], Eqs. 13-15 per newton of F_n1
+    return t_ref / (split[0] + split[1] + split[2]) + a.preload + a.stiffness * a.free_travel  # [1], Eq. 11
 
 
 # ------------------------------------------------------------------ the model
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _profile(tx, ty, u, k, t):
-    """Input profile at ``t``, or the held input ``u[k]`` where the profile is empty."""
-    if tx.shape[0] == 0:
-        return u[k]
-    return interp1(tx, ty, t)
+@numba.njit(cache=True, nogil=True)
+def _cold(cold, layout, k):
+    """Table ``k`` (``L_*``) of ``EmtcParams.cold`` as a 1-D view (``layout``: ``EmtcParams.layout``)."""
+    o = layout[2 * k]
+    return cold[o:o + layout[2 * k + 1]]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _model(t, x, u, m, p, dx, aux):
-    """Right-hand side ``dx`` and intermediates ``aux`` ([1], Eqs. 8-30, Fig. 15) in the modes ``m``."""
-    arm = m[0]
-    cpl = m[1]
-    wf = x[0]
-    wr = x[1]
-    xa = x[3]
-    xd = x[4]
-    fm = plant_magnet_force(x[6], p.airgap_open - xa, p)  # [1], Eq. 12: airgap d - x
-    fn1 = 0.0
-    if arm == ARM_FREE:
-        dx[3] = xd
-        dx[4] = armature_acceleration(fm, xa, xd, p)
-    else:
-        dx[3] = 0.0
-        dx[4] = 0.0
-        if arm == ARM_CONTACT:
-            fn1 = max(primary_clamp_force(fm, p), 0.0)
-    # current control: two first-order lags in series ([1], Fig. 15)
-    dx[5] = (p.fmem[FM_CMD] - x[5]) / p.tau1
-    dx[6] = (x[5] - x[6]) / p.tau2
-    thr = _profile(p.throttle_time, p.throttle_value, u, U_THROTTLE, t)
-    vdf = _profile(p.drum_front_time, p.drum_front_value, u, U_DRUM_FRONT, t)
-    vdr = _profile(p.drum_rear_time, p.drum_rear_value, u, U_DRUM_REAR, t)
-    a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, vdf, vdr, p)
-    tlock = lock_torque(a_f, a_r, p)
-    dw = wf - wr
-    g = p.geometry
-    s = p.split
-    t1 = 0.0
-    t2 = 0.0
-    t3 = 0.0
-    case = -1.0
-    fn2 = 0.0
-    t_drag = 0.0
-    if cpl == OPEN:
-        t_drag = drag_torque_scalar(p.drag_pairs, p.oil_viscosity, dw, p.plate_clearance, p.plate_outer_radius,
-                                    p.plate_inner_radius)  # [1], Eq. 25
-        t_fric = 0.0
-        dx[2] = 0.0
-    elif cpl == SLIPPING:
-        # kinetic friction in the slip direction of the mode: the slip crossing zero is an event (lock-up or
-        # reversal, Fig. 11) located by the core, not a sign change inside the mode (that would make the slip
-        # slide along zero until a step happened to end past it; see docs/emtc.md)
-        sl = 1.0 if m[2] == POSITIVE else -1.0
-        if p.friction_mode == FRICTION_MAP:
-            m1 = bilinear(p.fmap_speed, p.fmap_temperature, p.fmap_mu, abs(dw), p.temperature_c)
-            m2 = m1
-            m3 = m1
-        elif p.friction_mode == FRICTION_LUGRE:
-            # [1], Eqs. 22-23: bristles advanced exactly from their committed value at the step start
-            tlast = p.fmem[FM_TLAST]
-            zb = lugre_advance(p.fmem[FM_Z], dw, t - tlast if tlast == tlast else 0.0, p.lugre)
-            mu = lugre_mu(zb, dw, p.lugre)
-            if mu != 0.0:
-                sl = mu
-            m1 = abs(mu)
-            m2 = m1
-            m3 = m1
-        else:
-            m1 = g[0]
-            m2 = g[1]
-            m3 = g[2]
-        _slipping(fn1, sl, g, m1, m2, m3, s)  # [1], Eqs. 13-15
-        t1 = s[0]
-        t2 = s[1]
-        t3 = s[2]
-        t_fric = t1 + t2 + t3  # [1], Eq. 17
-        fn2 = _cam_force(t1, t3, g)  # [1], Eq. 14
-        dx[2] = 0.0
-    else:
-        tl = tlock + p.torsen_stiffness * x[2] + p.torsen_damping * dw  # [1], Eq. 30
-        code = _locked(fn1, tl, g, p.unlock_margin, s)  # [1], Eqs. 18-21
-        if code >= 0:
-            t1 = s[0]
-            t2 = s[1]
-            t3 = s[2]
-            case = code
-        else:  # beyond the margin (only inside a step before the unlock event is located)
-            t1 = tl
-        t_fric = tl
-        fn2 = _cam_force(t1, t3, g)
-        dx[2] = dw
-    tc = coupling_torque_scalar(cpl != OPEN, t_drag, t_fric)  # [1], Eq. 26
-    aux[AUX_FM] = fm
-    aux[AUX_FN1] = fn1
-    aux[AUX_T1] = t1
-    aux[AUX_T2] = t2
-    aux[AUX_T3] = t3
-    aux[AUX_TC] = tc
-    aux[AUX_TLOCK] = tlock
-    aux[AUX_TTRANS] = ttrans
-    aux[AUX_CAP] = _locked_capacity(fn1, g)  # [1], Eq. 21
-    aux[AUX_CASE] = case
-    aux[AUX_FN2] = fn2
-    aux[AUX_TE] = te
-    aux[AUX_THR] = thr
-    dx[0] = (a_f - tc) / p.inertia_front  # [1], Eq. 27 (rows 1 and 3)
-    dx[1] = (tc - a_r) / p.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+def _switching(x, m, a, margin, aux, g):
+    """Switching functions (:data:`SWITCHING`) from the state and the intermediates; inactive ones are +1.
 
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _switching(x, m, p, aux, g):
-    """Switching functions (:data:`SWITCHING`); inactive ones are +1."""
+    ``a``: :class:`ActuatorData`; ``margin``: unlock margin of Fig. 11.
+    """
     for k in range(6):
         g[k] = 1.0
     arm = m[0]
     if arm == ARM_FREE:
         g[0] = x[3]  # reaches the rest stop
-        g[1] = p.free_travel - x[3]  # reaches the primary clutch (x = sigma)
+        g[1] = a.free_travel - x[3]  # reaches the primary clutch (x = sigma)
     elif arm == ARM_REST:
-        g[2] = p.spring_preload - aux[AUX_FM]  # the magnet overcomes the preload
+        g[2] = a.preload - aux[AUX_FM]  # the magnet overcomes the preload
     else:
-        g[3] = primary_clamp_force(aux[AUX_FM], p)  # F_n1 of Eq. 11 drops to zero
+        g[3] = primary_clamp_force(aux[AUX_FM], a)  # F_n1 of Eq. 11 drops to zero
     if m[1] == SLIPPING:
         g[4] = (1.0 if m[2] == POSITIVE else -1.0) * (x[0] - x[1])  # slip speed reaches zero
     elif m[1] == LOCKED:
-        g[5] = p.unlock_margin * aux[AUX_CAP] - abs(aux[AUX_TC])  # |T'_lock| > 1.02 T_cap_L
+        g[5] = margin * aux[AUX_CAP] - abs(aux[AUX_TC])  # |T'_lock| > 1.02 T_cap_L
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+@numba.njit(cache=True, nogil=True)
+def _evaluate(t, x, u, m, p):
+    """The model at one point into the scratch of ``p.fmem`` (derivative, switching functions, ``aux``)."""
+    fmem = p.fmem
+    aux = fmem[FM_AUX:FM_AUX + N_AUX]
+    dispatch.rhs(t, x, u, m, p, fmem[FM_DX:FM_DX + 7], fmem[FM_G:FM_G + 6])
+    return aux
+
+
+@numba.njit(cache=True, nogil=True)
 def _switch(k, t, x, u, m, p, log):
     """Mode change when switching function ``k`` crossed at ``t`` ([1], Eqs. 8-11, Fig. 11); records the event."""
     fmem = p.fmem
+    a = p.actuator
+    v = p.vehicle
     if k == 0:
         if m[0] != ARM_FREE:
             return
@@ -475,7 +380,7 @@ def _switch(k, t, x, u, m, p, log):
     elif k == 1:
         if m[0] != ARM_FREE:
             return
-        x[3] = p.free_travel  # plastic impact on the primary clutch: engaged
+        x[3] = a.free_travel  # plastic impact on the primary clutch: engaged
         x[4] = 0.0
         m[0] = ARM_CONTACT
         m[1] = SLIPPING
@@ -499,10 +404,9 @@ def _switch(k, t, x, u, m, p, log):
     elif k == 4:  # slip speed zero: lock if the static capacity covers the lock torque (Fig. 11)
         if m[1] != SLIPPING:
             return
-        aux = p.aux
-        _model(t, x, u, m, p, p.dxw, aux)
+        aux = _evaluate(t, x, u, m, p)
         if abs(aux[AUX_TLOCK]) <= aux[AUX_CAP]:
-            wm = (x[0] * p.inertia_front + x[1] * p.inertia_rear) / (p.inertia_front + p.inertia_rear)
+            wm = (x[0] * v.inertia_front + x[1] * v.inertia_rear) / (v.inertia_front + v.inertia_rear)
             x[0] = wm
             x[1] = wm
             x[2] = 0.0
@@ -514,8 +418,7 @@ def _switch(k, t, x, u, m, p, log):
     elif k == 5:  # |T'_lock| > 1.02 T_cap: slipping in the direction of the lock torque
         if m[1] != LOCKED:
             return
-        aux = p.aux
-        _model(t, x, u, m, p, p.dxw, aux)
+        aux = _evaluate(t, x, u, m, p)
         m[1] = SLIPPING
         m[2] = POSITIVE if aux[AUX_TC] >= 0.0 else NEGATIVE
         x[2] = 0.0
@@ -524,77 +427,207 @@ def _switch(k, t, x, u, m, p, log):
         record(log, t, EV_UNLOCK, EL_COUPLING)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _commit(t, x, p):
-    """Commit the plant magnet memory and the LuGre bristle state at the end of an accepted step (once per ``t``)."""
-    fmem = p.fmem
+@numba.njit(cache=True, nogil=True)
+def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode):
+    """Commit the plant magnet memory and the LuGre bristle state at the end of an accepted step (once per ``t``).
+
+    ``tables``, ``grid``, ``stack``, ``prefix``: the plant's Preisach tables and memory; ``imem``, ``fmem``:
+    the run's memories; ``lugre``: the LuGre data; returns 0 or :data:`ERR_PLANT_MEMORY`.
+    """
     if t == fmem[FM_TLAST]:
         return 0
-    grid = p.plant_grid
     inew = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
-    plen = p.imem[IM_PLEN]
-    if plen + 2 > p.plant_stack.shape[0]:
+    plen = imem[IM_PLEN]
+    if plen + 2 > stack.shape[0]:
         return ERR_PLANT_MEMORY
-    p.imem[IM_PLEN] = commit(p.plant_tables, grid, p.plant_stack, p.plant_prefix, plen, fmem[FM_PU], inew)
+    imem[IM_PLEN] = commit(tables, grid, stack, prefix, plen, fmem[FM_PU], inew)
     fmem[FM_PU] = inew
     tlast = fmem[FM_TLAST]
-    if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
+    if friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
         dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
-        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, p.lugre)
+        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, lugre)
     fmem[FM_TLAST] = t
     return 0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+@numba.njit(cache=True, nogil=True)
 def _controller(t, x, u, p):
     """One controller sample at ``t``: reference (Eq. 31, table or input), force (Eqs. 13, 15, 11), current (Eqs. 6-7)."""
-    thr = _profile(p.throttle_time, p.throttle_value, u, U_THROTTLE, t)
+    fmem = p.fmem
+    imem = p.imem
+    a = p.actuator
+    thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
     if p.reference_source == REFERENCE_INPUT:
         t_ref = u[U_TORQUE]
     elif p.reference_source == REFERENCE_TABLE:
-        t_ref = interp1(p.reference_time, p.reference_value, t)
+        t_ref = interp1(_cold(p.cold, p.layout, L_REF_TIME), _cold(p.cold, p.layout, L_REF_VALUE), t)
     else:
-        vx = x[0] / p.axle_ratio * p.tyre_radius
-        t_ref = bilinear(p.map_throttle, p.map_speed, p.map_torque, thr, vx)  # [1], Eq. 31
-    fm_req = commanded_magnet_force(t_ref, p)
-    imem = p.imem
-    fmem = p.fmem
+        vx = x[0] / p.vehicle.axle_ratio * p.vehicle.tyre_radius
+        t_ref = bilinear(_cold(p.cold, p.layout, L_MAP_THROTTLE), _cold(p.cold, p.layout, L_MAP_SPEED),
+                         _cold(p.cold, p.layout, L_MAP_TORQUE).reshape((p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
+    fm_req = commanded_magnet_force(t_ref, p.geometry, a, fmem[FM_SPLIT:FM_SPLIT + 3])
     clen = imem[IM_CLEN]
-    if clen + 2 > p.ctl_stack.shape[0]:
+    stack = _cold(p.cold, p.layout, L_CTL_STACK)
+    if clen + 2 > stack.shape[0]:
         imem[IM_ERROR] = ERR_CONTROLLER_MEMORY  # reported by the next accepted step
         return
-    cg = p.ctl_airgaps
-    gap_weights(cg, min(max(p.airgap_open - p.free_travel, cg[0]), cg[cg.shape[0] - 1]), p.ctl_idx, p.ctl_w)
+    n = p.n_ctl_cells
+    tables = _cold(p.cold, p.layout, L_CTL_TABLES).reshape((p.n_ctl_airgaps, n, n, 4))
+    grid = _cold(p.cold, p.layout, L_CTL_GRID)
+    prefix = _cold(p.cold, p.layout, L_CTL_PREFIX).reshape((p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
+    cidx = imem[IM_CIDX:IM_CIDX + 3]  # airgap weights at the engaged airgap d - sigma (set by pack_parameters)
+    cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
-    i_new, ok = invert_one(p.ctl_tables, p.ctl_grid, p.ctl_stack, p.ctl_prefix, clen, cu, fm_req, p.ctl_idx,
-                           p.ctl_w, 1e-9)  # [1], Eqs. 6-7 at the engaged airgap d - sigma
-    imem[IM_CLEN] = commit(p.ctl_tables, p.ctl_grid, p.ctl_stack, p.ctl_prefix, clen, cu, i_new)
+    i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7 at d - sigma
+    imem[IM_CLEN] = commit(tables, grid, stack, prefix, clen, cu, i_new)
     fmem[FM_CU] = i_new
     fmem[FM_CMD] = i_new
     fmem[FM_TREF] = t_ref
     fmem[FM_FEASIBLE] = 1.0 if ok else 0.0
     k = imem[IM_KNEXT]
-    if k < p.ctl_log.shape[0]:
-        p.ctl_log[k, LOG_CMD] = i_new
-        p.ctl_log[k, LOG_TREF] = t_ref
-        p.ctl_log[k, LOG_THR] = thr
-        p.ctl_log[k, LOG_FEASIBLE] = 1.0 if ok else 0.0
+    log = _cold(p.cold, p.layout, L_LOG)
+    if 4 * k + 3 < log.shape[0]:
+        log[4 * k + LOG_CMD] = i_new
+        log[4 * k + LOG_TREF] = t_ref
+        log[4 * k + LOG_THR] = thr
+        log[4 * k + LOG_FEASIBLE] = 1.0 if ok else 0.0
 
 
 # ------------------------------------------------------------------ the hooks of the contract
 @numba.njit(cache=True, nogil=True)
 def _rhs(t, x, u, m, p, dx, g):
-    _model(t, x, u, m, p, dx, p.aux)
-    _switching(x, m, p, p.aux, g)
+    """Right-hand side ``dx`` ([1], Eqs. 8-30, Fig. 15) and switching functions ``g`` in the modes ``m``.
+
+    The one place the model is written (every other hook evaluates it through the core's ``rhs`` hook);
+    the intermediates go to ``fmem[FM_AUX:]``.  Written out in the hook itself rather than in a function it
+    calls: each call that takes the parameter structure costs the reference counting of all its arrays.
+    """
+    aux = p.fmem[FM_AUX:FM_AUX + N_AUX]
+    a = p.actuator
+    v = p.vehicle
+    c = p.coupling
+    geo = p.geometry
+    fmem = p.fmem
+    arm = m[0]
+    cpl = m[1]
+    wf = x[0]
+    wr = x[1]
+    xa = x[3]
+    xd = x[4]
+    # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
+    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12; the weighted cell
+    # table is rebuilt only when the airgap changes, i.e. while the armature moves)
+    grid = p.plant_grid
+    icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
+    gap = a.airgap_open - xa
+    gw = fmem[FM_GW:FM_GW + 4]
+    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
+    if gap != gw[3]:
+        gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
+        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
+        gw[3] = gap
+    fm = peek_combined(p.plant_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil,
+                       gidx, gw)
+    fn1 = 0.0
+    if arm == ARM_FREE:
+        dx[3] = xd
+        dx[4] = armature_acceleration(fm, xa, xd, a)
+    else:
+        dx[3] = 0.0
+        dx[4] = 0.0
+        if arm == ARM_CONTACT:
+            fn1 = max(primary_clamp_force(fm, a), 0.0)
+    # current control: two first-order lags in series ([1], Fig. 15)
+    dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
+    dx[6] = (x[5] - x[6]) / a.tau2
+    thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
+    a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
+    tlock = lock_torque(a_f, a_r, v)
+    dw = wf - wr
+    s = fmem[FM_SPLIT:FM_SPLIT + 6]
+    t1 = 0.0
+    t2 = 0.0
+    t3 = 0.0
+    case = -1.0
+    fn2 = 0.0
+    t_drag = 0.0
+    if cpl == OPEN:
+        t_drag = drag_torque_scalar(c.drag_pairs, c.oil_viscosity, dw, c.plate_clearance, c.plate_outer_radius,
+                                    c.plate_inner_radius)  # [1], Eq. 25
+        t_fric = 0.0
+        dx[2] = 0.0
+    elif cpl == SLIPPING:
+        # kinetic friction in the slip direction of the mode: the slip crossing zero is an event (lock-up or
+        # reversal, Fig. 11) located by the core, not a sign change inside the mode (that would make the slip
+        # slide along zero until a step happened to end past it; see docs/emtc.md)
+        sl = 1.0 if m[2] == POSITIVE else -1.0
+        if p.friction_mode == FRICTION_MAP:
+            m1 = bilinear(_cold(p.cold, p.layout, L_FMAP_SPEED), _cold(p.cold, p.layout, L_FMAP_TEMP),
+                          _cold(p.cold, p.layout, L_FMAP_MU).reshape((p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
+            m2 = m1
+            m3 = m1
+        elif p.friction_mode == FRICTION_LUGRE:
+            # [1], Eqs. 22-23: bristles advanced exactly from their committed value at the step start
+            tlast = fmem[FM_TLAST]
+            zb = lugre_advance(fmem[FM_Z], dw, t - tlast if tlast == tlast else 0.0, p.lugre)
+            mu = lugre_mu(zb, dw, p.lugre)
+            if mu != 0.0:
+                sl = mu
+            m1 = abs(mu)
+            m2 = m1
+            m3 = m1
+        else:
+            m1 = geo[0]
+            m2 = geo[1]
+            m3 = geo[2]
+        _slipping(fn1, sl, geo, m1, m2, m3, s)  # [1], Eqs. 13-15
+        t1 = s[0]
+        t2 = s[1]
+        t3 = s[2]
+        t_fric = t1 + t2 + t3  # [1], Eq. 17
+        fn2 = _cam_force(t1, t3, geo)  # [1], Eq. 14
+        dx[2] = 0.0
+    else:
+        tl = tlock + v.torsen_stiffness * x[2] + v.torsen_damping * dw  # [1], Eq. 30
+        code = _locked(fn1, tl, geo, c.unlock_margin, s)  # [1], Eqs. 18-21
+        if code >= 0:
+            t1 = s[0]
+            t2 = s[1]
+            t3 = s[2]
+            case = code
+        else:  # beyond the margin (only inside a step before the unlock event is located)
+            t1 = tl
+        t_fric = tl
+        fn2 = _cam_force(t1, t3, geo)
+        dx[2] = dw
+    tc = coupling_torque_scalar(cpl != OPEN, t_drag, t_fric)  # [1], Eq. 26
+    aux[AUX_FM] = fm
+    aux[AUX_FN1] = fn1
+    aux[AUX_T1] = t1
+    aux[AUX_T2] = t2
+    aux[AUX_T3] = t3
+    aux[AUX_TC] = tc
+    aux[AUX_TLOCK] = tlock
+    aux[AUX_TTRANS] = ttrans
+    aux[AUX_CAP] = _locked_capacity(fn1, geo)  # [1], Eq. 21
+    aux[AUX_CASE] = case
+    aux[AUX_FN2] = fn2
+    aux[AUX_TE] = te
+    aux[AUX_THR] = thr
+    dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
+    dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+    _switching(x, m, a, c.unlock_margin, aux, g)
+
+
 
 
 @numba.njit(cache=True, nogil=True)
 def _outputs(t, x, u, m, p, y):
-    aux = p.aux
-    _model(t, x, u, m, p, p.dxw, aux)
     fmem = p.fmem
+    aux = _evaluate(t, x, u, m, p)
     y[0] = x[0] - x[1]
-    y[1] = p.airgap_open - x[3]
+    y[1] = p.actuator.airgap_open - x[3]
     y[2] = aux[AUX_FM]
     y[3] = aux[AUX_FN1]
     y[4] = aux[AUX_FN2]
@@ -615,7 +648,8 @@ def _outputs(t, x, u, m, p, y):
 
 @numba.njit(cache=True, nogil=True)
 def _update(t, x, u, m, p, k, log):
-    r = _commit(t, x, p)  # the memories see the state at the event, before the mode change
+    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
+                p.friction_mode)  # the memories see the state at the event, before the mode change
     if r < 0:
         return r
     _switch(k, t, x, u, m, p, log)
@@ -641,22 +675,20 @@ def _restart(t, x, u, m, p, log):
         changed = True
     # held inputs that jumped (a resumed co-simulation step, or the start) may leave a mode inconsistent
     jumped = False
-    ul = p.u_last
     for q in range(u.shape[0]):
-        if u[q] != ul[q]:
+        if u[q] != fmem[FM_ULAST + q]:
             jumped = True
-            ul[q] = u[q]
+            fmem[FM_ULAST + q] = u[q]
     if jumped:
         for _ in range(3):
-            _model(t, x, u, m, p, p.dxw, p.aux)
-            _switching(x, m, p, p.aux, p.gw)
-            gw = p.gw
+            _evaluate(t, x, u, m, p)
+            gv = fmem[FM_G:FM_G + 6]
             kk = -1
-            if m[0] == ARM_REST and gw[2] < 0.0:
+            if m[0] == ARM_REST and gv[2] < 0.0:
                 kk = 2
-            elif m[0] == ARM_CONTACT and gw[3] < 0.0:
+            elif m[0] == ARM_CONTACT and gv[3] < 0.0:
                 kk = 3
-            elif m[1] == LOCKED and gw[5] < 0.0:
+            elif m[1] == LOCKED and gv[5] < 0.0:
                 kk = 5
             if kk < 0:
                 break
@@ -670,7 +702,8 @@ def _accept(t, x, u, m, p):
     e = p.imem[IM_ERROR]
     if e != 0:
         return e
-    r = _commit(t, x, p)
+    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
+                p.friction_mode)
     if r < 0:
         p.imem[IM_ERROR] = r
         return r
@@ -748,7 +781,23 @@ def _f(a):
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
-_EMPTY = np.zeros(0)
+class _Cold:
+    """Builds ``EmtcParams.cold`` and its ``layout``: tables appended one after the other (C order)."""
+
+    def __init__(self):
+        self.parts = []
+        self.layout = [0] * (2 * N_LAYOUT)
+        self.size = 0
+
+    def add(self, k, array):
+        a = _f(array).ravel()
+        self.layout[2 * k] = self.size
+        self.layout[2 * k + 1] = a.size
+        self.parts.append(a)
+        self.size += a.size
+
+    def array(self):
+        return np.concatenate(self.parts) if self.parts else np.zeros(0)
 
 
 def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions | None = None, *,
@@ -760,16 +809,16 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
     magnet : clutchlab.hysteresis.Preisach
         Plant magnet force [N] vs coil current [A] (and airgap [m]).
     scenario : BenchScenario, optional
-        Gear, drum speeds and loads, throttle ramp, temperature, sample time (default: the defaults).
+        Gear, drum loads, throttle ramp, temperature, sample time (default: the defaults).
     vehicle : VehicleParameters, optional
         Default: Table 1 of [1] and representative values.
     options : BenchOptions, optional
         Actuator, coupling, torque map, controller model, friction, reference, memory capacity.
     cosimulation : bool
-        Throttle, drum speeds and torque request from the held inputs instead of the scenario's
-        ramp and map (co-simulation).
+        Throttle and torque request from the held inputs instead of the scenario's ramp and map
+        (co-simulation).
     n_samples : int
-        Rows of the per-sample controller log (0: none).
+        Rows of the per-sample controller log (0: none; see :func:`controller_log`).
 
     Returns
     -------
@@ -794,43 +843,63 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
                 f"calibration airgaps [{model.airgaps[0]:g}, {model.airgaps[-1]:g}] m")
     ic = vehicle.rear_final_drive
     fzf, fzr = vehicle.axle_loads()
-    geo = _f(coupling.kernel_data())
-    lugre = np.zeros(6)
+    geo = [float(g) for g in coupling.kernel_data()]
+    lugre = (0.0,) * 6
     fmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)))
     fmode = FRICTION_CONSTANT
     if options.friction_map is not None:
         fm = options.friction_map
         fmap, fmode = (fm.slip_speed, fm.temperature_c, fm.mu), FRICTION_MAP
     elif options.lugre is not None:
-        lugre = _f(options.lugre.kernel_data())
+        lugre = tuple(float(q) for q in options.lugre.kernel_data())
         # the locked capacity must use LuGre's own breakaway coefficient, else the friction just after
         # an unlock could exceed the lock capacity and the slip would reverse at once (chattering)
-        geo = geo.copy()
-        geo[3:6] = options.lugre.mu_p
+        geo[3:6] = [float(options.lugre.mu_p)] * 3
         fmode = FRICTION_LUGRE
     if options.torque_reference is not None:
         tr = np.asarray(options.torque_reference, float)
         if (tr.ndim != 2 or tr.shape[0] != 2 or tr.shape[1] < 2 or not np.all(np.isfinite(tr))
                 or np.any(np.diff(tr[0]) <= 0)):
             raise ParameterError("torque_reference: expected (times, torques) with strictly increasing finite times")
-        ref_t, ref_v, ref_src = _f(tr[0]), _f(tr[1]), REFERENCE_TABLE
+        ref, ref_src = tr, REFERENCE_TABLE
     else:
-        ref_t, ref_v, ref_src = _EMPTY, _EMPTY, REFERENCE_MAP
+        ref, ref_src = np.zeros((2, 1)), REFERENCE_MAP
     if cosimulation:
-        thr_t, thr_v, ref_src = _EMPTY, _EMPTY, REFERENCE_INPUT
+        throttle, ref_src = np.zeros((2, 0)), REFERENCE_INPUT
     else:
         s = scenario
-        thr_t = np.array([0.0, s.ramp_start, max(s.ramp_end, s.ramp_start + 1e-9), max(s.duration, s.ramp_end) + 1.0])
-        thr_v = np.array([s.throttle_start, s.throttle_start, s.throttle_end, s.throttle_end])
+        throttle = np.array([[0.0, s.ramp_start, max(s.ramp_end, s.ramp_start + 1e-9), max(s.duration, s.ramp_end) + 1.0],
+                             [s.throttle_start, s.throttle_start, s.throttle_end, s.throttle_end]])
     cap = int(options.memory_capacity)
-    ntab = magnet.kernel_tables.shape[1]
+    n = magnet.kernel_tables.shape[1]
+    nc = ctl.kernel_tables.shape[1]
+    cold = _Cold()
+    cold.add(L_PLANT_TABLES, np.zeros(0))  # a field of its own (every accepted step reads it)
+    cold.add(L_PLANT_GAPS, magnet.airgaps)
+    cold.add(L_CTL_TABLES, ctl.kernel_tables)
+    cold.add(L_CTL_GRID, ctl.grid)
+    cold.add(L_CTL_GAPS, ctl.airgaps)
+    cold.add(L_CTL_STACK, np.zeros(cap))
+    cold.add(L_CTL_PREFIX, np.zeros((ctl.n_airgaps, cap // 2 + 2)))
+    cold.add(L_MAP_THROTTLE, torque_map.throttle)
+    cold.add(L_MAP_SPEED, torque_map.speed)
+    cold.add(L_MAP_TORQUE, torque_map.torque)
+    cold.add(L_REF_TIME, ref[0])
+    cold.add(L_REF_VALUE, ref[1])
+    cold.add(L_FMAP_SPEED, fmap[0])
+    cold.add(L_FMAP_TEMP, fmap[1])
+    cold.add(L_FMAP_MU, fmap[2])
+    cold.add(L_LOG, np.zeros(4 * int(n_samples)))
+    imem = np.zeros(N_IMEM, dtype=np.int64)
     fmem = np.zeros(N_FMEM)
+    cg = _f(ctl.airgaps)
+    gap_weights(cg, float(min(max(lo_gap, cg[0]), cg[-1])), imem[IM_CIDX:IM_CIDX + 3], fmem[FM_CW:FM_CW + 3])
     fmem[FM_PU] = magnet.grid[0]
     fmem[FM_CU] = ctl.grid[0]
     fmem[FM_TLAST] = np.nan
-    gap_w = np.zeros(4)
-    gap_w[3] = np.nan
-    return EmtcParams(
+    fmem[FM_GW + 3] = np.nan
+    fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
+    veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
         gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),
         inertia_front=float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2),  # [1], Eq. 29, J_F
@@ -839,30 +908,36 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
         rolling_resistance=float(vehicle.rolling_resistance), tyre_slip_stiffness=float(vehicle.tyre_slip_stiffness),
         slip_speed_floor=float(vehicle.slip_speed_floor), engine_torque_max=float(vehicle.engine_torque_max),
         engine_power=float(vehicle.engine_power), torsen_stiffness=float(vehicle.torsen_stiffness),
-        torsen_damping=float(vehicle.torsen_damping), temperature_c=float(scenario.temperature_c),
+        torsen_damping=float(vehicle.torsen_damping), drum_load_front=float(scenario.drum_load_front),
+        drum_load_rear=float(scenario.drum_load_rear))
+    cpl = CouplingData(
         drag_pairs=float(vehicle.drag_pairs), oil_viscosity=float(vehicle.oil_viscosity),
         plate_clearance=float(vehicle.plate_clearance), plate_outer_radius=float(vehicle.plate_outer_radius),
         plate_inner_radius=float(vehicle.plate_inner_radius), unlock_margin=float(UNLOCK_MARGIN),
-        sample_time=float(scenario.sample_time), drum_load_front=float(scenario.drum_load_front),
-        drum_load_rear=float(scenario.drum_load_rear),
-        armature_mass=float(actuator.mass), spring_stiffness=float(actuator.stiffness),
-        spring_preload=float(actuator.preload), spring_damping=float(actuator.damping),
-        free_travel=float(actuator.free_travel), airgap_open=float(actuator.airgap_open),
-        tau1=float(actuator.tau1), tau2=float(actuator.tau2),
-        friction_mode=int(fmode), reference_source=int(ref_src),
-        geometry=geo, lugre=_f(lugre), fmap_speed=_f(fmap[0]), fmap_temperature=_f(fmap[1]), fmap_mu=_f(fmap[2]),
-        throttle_time=_f(thr_t), throttle_value=_f(thr_v),
-        drum_front_time=_EMPTY, drum_front_value=_EMPTY, drum_rear_time=_EMPTY, drum_rear_value=_EMPTY,
-        map_throttle=_f(torque_map.throttle), map_speed=_f(torque_map.speed), map_torque=_f(torque_map.torque),
-        reference_time=ref_t, reference_value=ref_v,
-        plant_tables=_f(magnet.kernel_tables), plant_grid=_f(magnet.grid), plant_airgaps=_f(magnet.airgaps),
+        temperature_c=float(scenario.temperature_c))
+    act = ActuatorData(
+        mass=float(actuator.mass), stiffness=float(actuator.stiffness), preload=float(actuator.preload),
+        damping=float(actuator.damping), free_travel=float(actuator.free_travel),
+        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2))
+    return EmtcParams(
+        vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
+        sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
+        n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_airgaps=int(ctl.n_airgaps), n_ctl_cells=int(nc),
+        n_fmap_speed=int(np.shape(fmap[2])[0]), n_fmap_temp=int(np.shape(fmap[2])[1]),
+        n_map_throttle=int(torque_map.torque.shape[0]), n_map_speed=int(torque_map.torque.shape[1]),
+        layout=tuple(int(q) for q in cold.layout), throttle=_f(throttle), plant_tables=_f(magnet.kernel_tables),
+        plant_grid=_f(magnet.grid),
         plant_stack=np.zeros(cap), plant_prefix=np.zeros((magnet.n_airgaps, cap // 2 + 2)),
-        ctl_tables=_f(ctl.kernel_tables), ctl_grid=_f(ctl.grid), ctl_airgaps=_f(ctl.airgaps),
-        ctl_stack=np.zeros(cap), ctl_prefix=np.zeros((ctl.n_airgaps, cap // 2 + 2)),
-        imem=np.zeros(N_IMEM, dtype=np.int64), fmem=fmem, u_last=np.full(len(INPUTS), np.nan),
-        gap_idx=np.zeros(3, dtype=np.int64), gap_w=gap_w, gap_comb=np.zeros((1, ntab, ntab, 4)),
-        ctl_idx=np.zeros(3, dtype=np.int64), ctl_w=np.zeros(3), aux=np.zeros(N_AUX), dxw=np.zeros(len(STATES)),
-        gw=np.zeros(len(SWITCHING)), split=np.zeros(6), ctl_log=np.zeros((int(n_samples), 4)))
+        plant_comb=np.zeros((1, n, n, 4)), imem=imem, fmem=fmem, cold=cold.array())
+
+
+def controller_log(params: EmtcParams) -> np.ndarray:
+    """The per-sample controller log of a run: ``(samples, 4)`` command [A], reference [N*m], throttle [-], feasible.
+
+    ``params`` is the :class:`EmtcParams` of the run (``system.params``), packed with ``n_samples`` rows.
+    """
+    o, size = params.layout[2 * L_LOG], params.layout[2 * L_LOG + 1]
+    return params.cold[o:o + size].reshape(-1, 4).copy()
 
 
 def _element_name(code: int, element: int) -> str:
@@ -882,7 +957,7 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     cosimulation : bool
         Throttle, drum speeds and torque request from the held inputs (see :func:`pack_parameters`).
     n_samples : int
-        Rows of the per-sample controller log (``params.ctl_log``).
+        Rows of the per-sample controller log (:func:`controller_log`).
 
     Returns
     -------
