@@ -142,8 +142,8 @@ class EventLog(NamedTuple):
 
 def new_log(capacity: int) -> EventLog:
     """An empty event log holding up to ``capacity`` events (only the first ``count[0]`` entries are ever read)."""
-    return EventLog(np.empty(capacity), np.empty(capacity, dtype=np.int64), np.empty(capacity, dtype=np.int64),
-                    np.zeros(2, dtype=np.int64))
+    ints = np.empty(2 * capacity, dtype=np.int64)  # codes and elements: one allocation
+    return EventLog(np.empty(capacity), ints[:capacity], ints[capacity:], np.zeros(2, dtype=np.int64))
 
 
 def new_solver_state(t0: float):
