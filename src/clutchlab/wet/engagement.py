@@ -53,6 +53,7 @@ from __future__ import annotations
 import collections
 import functools
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -385,6 +386,7 @@ def _sample_times(duration, sample_rate, sample_times):
 #: recently built systems by the identity of their (immutable) inputs: repeated runs skip the packing
 _RECENT: "collections.OrderedDict" = collections.OrderedDict()
 _RECENT_SIZE = 8
+_RECENT_LOCK = threading.Lock()
 
 
 def _run_system(clutch, scenario, bench, friction, rtol):
@@ -397,16 +399,21 @@ def _run_system(clutch, scenario, bench, friction, rtol):
     inputs = (clutch, scenario, bench, friction)
     cacheable = friction is None or isinstance(friction, ParametricFriction)
     key = (*map(id, inputs), float(rtol))
-    hit = _RECENT.get(key) if cacheable else None
-    if hit is not None and all(a is b for a, b in zip(hit[0], inputs)):
-        _RECENT.move_to_end(key)
+    with _RECENT_LOCK:
+        hit = _RECENT.get(key) if cacheable else None
+        if hit is not None and not all(a is b for a, b in zip(hit[0], inputs)):
+            hit = None
+        if hit is not None:
+            _RECENT.move_to_end(key)
+    if hit is not None:
         system = hit[1]
     else:
         system = _system(clutch, scenario, bench, friction, rtol)
         if cacheable:
-            _RECENT[key] = (inputs, system)
-            while len(_RECENT) > _RECENT_SIZE:
-                _RECENT.popitem(last=False)
+            with _RECENT_LOCK:
+                _RECENT[key] = (inputs, system)
+                while len(_RECENT) > _RECENT_SIZE:
+                    _RECENT.popitem(last=False)
     return system.variant(params=W.fresh_buffers(system.params, scenario.initial_temperature_c))
 
 
