@@ -178,7 +178,7 @@ class System:
         object.__setattr__(self, "states", variables(self.states))
         object.__setattr__(self, "outputs", variables(self.outputs))
         object.__setattr__(self, "inputs", variables(self.inputs))
-        self.state_columns, self.output_columns, self.input_columns  # noqa: B018  (cached now, shared by variants)
+        self.state_columns, self.output_columns, self.input_columns, self._directions  # noqa: B018  (cached now)
 
     # ---- names (computed once: read by every run)
     @functools.cached_property
@@ -255,11 +255,17 @@ class System:
             raise ParameterError(f"max_steps = {short_repr(max_steps)}: must be >= 1")
         first_step = self.first_step if first_step is None else first_step
         event_tol = self.event_tol if event_tol is None else event_tol
-        gdir = np.array([d for _, d in self.switching], dtype=np.int64)
         return Options(float(rtol), np.ascontiguousarray(atol_v), float(min(max_step, 1e300)), float(first_step),
-                       int(max_steps), float(event_tol), gdir, self.mass, self._jac_groups, self.jac_pattern,
-                       self.fd_scale,
+                       int(max_steps), float(event_tol), self._directions, self.mass, self._jac_groups,
+                       self.jac_pattern, self.fd_scale,
                        int(self.jac_every), bool(self.nonautonomous))
+
+    @functools.cached_property
+    def _directions(self) -> np.ndarray:
+        """Crossing direction of each switching function (``Options.gdir``)."""
+        gdir = np.array([d for _, d in self.switching], dtype=np.int64)
+        gdir.setflags(write=False)
+        return gdir
 
     # ---- events
     def events_frame(self, times, codes, elements, variant=None) -> pd.DataFrame:
@@ -317,8 +323,9 @@ def sample_grid(t0: float, t_end: float, output_step: float | None, sample_times
     """
     if sample_times is not None:
         ts = np.ascontiguousarray(sample_times, dtype=float).ravel()
-        if ts.size and (not np.all(np.isfinite(ts)) or np.any(np.diff(ts) < 0) or ts[0] < t0
-                        or ts[-1] > t_end * (1 + 1e-12) + 1e-300):
+        # one comparison pass (NaN and infinities fail it as well)
+        if ts.size and not (ts[0] >= t0 and ts[-1] <= t_end * (1 + 1e-12) + 1e-300
+                            and (ts.size == 1 or bool((ts[1:] >= ts[:-1]).all()))):
             raise ParameterError(f"sample_times: must be finite, increasing and within [{t0:g}, {t_end:g}] s")
         return ts
     if output_step is None:

@@ -149,8 +149,8 @@ class EventLog(NamedTuple):
 
 def new_log(capacity: int) -> EventLog:
     """An empty event log holding up to ``capacity`` events (only the first ``count[0]`` entries are ever read)."""
-    return EventLog(np.empty(capacity), np.empty(capacity, dtype=np.int64), np.empty(capacity, dtype=np.int64),
-                    np.zeros(2, dtype=np.int64))
+    ints = np.empty(2 * capacity, dtype=np.int64)  # codes and elements: one allocation
+    return EventLog(np.empty(capacity), ints[:capacity], ints[capacity:], np.zeros(2, dtype=np.int64))
 
 
 def new_solver_state(t0: float):
@@ -199,6 +199,19 @@ def _dense(theta, h, x0, f0, x1, f1, mass, out):
     for i in range(x0.shape[0]):
         if mass[i] == 0.0:
             out[i] = x0[i] + theta * (x1[i] - x0[i])
+
+
+@register_jitable(inline="always")
+def _may_cross(g0, g1, gdir):
+    """False if no switching function can have crossed in the step (then :func:`_locate` is skipped).
+
+    A function that starts exactly on zero may return through zero within the step: that needs
+    :func:`_locate`'s probe.
+    """
+    for k in range(g0.shape[0]):
+        if _crossed(g0[k], g1[k], gdir[k]) or (g0[k] == 0.0 and g1[k] != 0.0):
+            return True
+    return False
 
 
 @register_jitable
@@ -477,7 +490,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             prev_rej = True
             continue
         # ---- events on the dense output
-        theta, nr = _locate(p, t, h, x, k1, xn, k7, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge, ga)
+        if _may_cross(g0, g1, opt.gdir):
+            theta, nr = _locate(p, t, h, x, k1, xn, k7, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge, ga)
+        else:
+            theta, nr = 2.0, 0
         si[SI_NRHS] += nr
         if theta <= 1.0:
             t_new = t + theta * h
@@ -758,7 +774,10 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         # step end: derivative (dense output, next step's f0) and switching functions
         model.rhs(t + h, x1, u, m, p, f1, g1)
         si[SI_NRHS] += 1
-        theta, nr = _locate(p, t, h, x, f0, x1, f1, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp, ga)
+        if _may_cross(g0, g1, opt.gdir):
+            theta, nr = _locate(p, t, h, x, f0, x1, f1, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp, ga)
+        else:
+            theta, nr = 2.0, 0
         si[SI_NRHS] += nr
         event = False
         if theta <= 1.0:
