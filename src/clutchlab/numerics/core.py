@@ -59,6 +59,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from . import dispatch as model
+from .borrow import borrow, byref, keep_alive
 from .dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
@@ -376,6 +377,9 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     int
         Status (:mod:`clutchlab.numerics.status`), also in ``si[SI_STATUS]``.
     """
+    p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
+    p = byref(p)
+    ts, rec_t, rec_x, rec_m, rec_y = borrow((ts, rec_t, rec_x, rec_m, rec_y))
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0
@@ -659,6 +663,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     of the located length from the step start, so that the algebraic rows
     stay consistent.
     """
+    p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
+    p = byref(p)
+    ts, rec_t, rec_x, rec_m, rec_y = borrow((ts, rec_t, rec_x, rec_m, rec_y))
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0

@@ -52,6 +52,8 @@ import inspect
 from numba.core import types
 from numba.extending import overload
 
+from .borrow import ByRef
+
 __all__ = ["register", "registered", "hook_sources", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
@@ -92,6 +94,8 @@ def registered(params_cls) -> bool:
 
 
 def _hook(p, name):
+    if isinstance(p, ByRef):
+        p = p.pointee
     if isinstance(p, types.BaseNamedTuple) and p.instance_class in _MODELS:
         return _MODELS[p.instance_class][name].py_func
     return None
