@@ -172,13 +172,19 @@ class System:
             if pattern.shape != (n, n):
                 raise ParameterError(f"System {self.name!r}: jac_pattern must be {n} x {n}")
         object.__setattr__(self, "jac_pattern", pattern)
-        object.__setattr__(self, "_jac_groups", _colour_columns(pattern, cols))
         scale = np.maximum(self.atol, 1e-12) if self.fd_scale is None else np.asarray(self.fd_scale, dtype=float)
         object.__setattr__(self, "fd_scale", np.ascontiguousarray(scale))
         object.__setattr__(self, "states", variables(self.states))
         object.__setattr__(self, "outputs", variables(self.outputs))
         object.__setattr__(self, "inputs", variables(self.inputs))
         self.state_columns, self.output_columns, self.input_columns, self._directions  # noqa: B018  (cached now)
+
+    @functools.cached_property
+    def _jac_groups(self) -> np.ndarray:
+        """Column groups of the finite-difference Jacobian (Rosenbrock only; one empty group for Dormand-Prince)."""
+        if self.method != "rodas":
+            return _NO_GROUPS
+        return _colour_columns(self.jac_pattern, self.jac_cols)
 
     # ---- names (computed once: read by every run)
     @functools.cached_property
@@ -281,8 +287,27 @@ class System:
         return frame
 
 
+_NO_GROUPS = np.full((1, 1), -1, dtype=np.int64)
+_NO_GROUPS.setflags(write=False)
+_COLOURINGS: dict = {}
+
+
 def _colour_columns(pattern: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """Groups of columns that share no structural row (greedy colouring), padded with -1."""
+    """Groups of columns that share no structural row (greedy colouring), padded with -1.
+
+    Remembered per (pattern, columns): the variants of a model share their structure.
+    """
+    key = (pattern.shape, pattern.tobytes(), cols.tobytes())
+    hit = _COLOURINGS.get(key)
+    if hit is None:
+        if len(_COLOURINGS) > 256:
+            _COLOURINGS.clear()
+        hit = _COLOURINGS[key] = _colour(pattern, cols)
+        hit.setflags(write=False)
+    return hit
+
+
+def _colour(pattern: np.ndarray, cols: np.ndarray) -> np.ndarray:
     groups: list[list[int]] = []
     rows: list[np.ndarray] = []
     for c in cols:

@@ -151,7 +151,8 @@ N_AUX = 13
 FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque split
 FM_DX = FM_SPLIT + 6  # 7: scratch derivative
 FM_G = FM_DX + 7  # 6: scratch switching functions
-N_FMEM = FM_G + 6
+FM_KEY = FM_G + 6  # 11: point (t, x, modes) of the last evaluation; NaN once a memory or mode may have changed
+N_FMEM = FM_KEY + 11
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
 # the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
@@ -618,14 +619,32 @@ def _rhs(t, x, u, m, p, dx, g):
     dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
     dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
     _switching(x, m, a, c.unlock_margin, aux, g)
+    fmem[FM_KEY] = t
+    for i in range(7):
+        fmem[FM_KEY + 1 + i] = x[i]
+    for i in range(3):
+        fmem[FM_KEY + 8 + i] = m[i]
 
 
+@numba.njit(cache=True, nogil=True)
+def _same_point(t, x, m, fmem):
+    """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, m)`` with the memories as they are now."""
+    if fmem[FM_KEY] != t:
+        return False
+    for i in range(7):
+        if fmem[FM_KEY + 1 + i] != x[i]:
+            return False
+    for i in range(3):
+        if fmem[FM_KEY + 8 + i] != m[i]:
+            return False
+    return True
 
 
 @numba.njit(cache=True, nogil=True)
 def _outputs(t, x, u, m, p, y):
     fmem = p.fmem
-    aux = _evaluate(t, x, u, m, p)
+    # a sample at the end of a step reuses the step's last evaluation (same point, memories not yet committed)
+    aux = fmem[FM_AUX:FM_AUX + N_AUX] if _same_point(t, x, m, fmem) else _evaluate(t, x, u, m, p)
     y[0] = x[0] - x[1]
     y[1] = p.actuator.airgap_open - x[3]
     y[2] = aux[AUX_FM]
@@ -648,6 +667,7 @@ def _outputs(t, x, u, m, p, y):
 
 @numba.njit(cache=True, nogil=True)
 def _update(t, x, u, m, p, k, log):
+    p.fmem[FM_KEY] = np.nan
     r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
                 p.friction_mode)  # the memories see the state at the event, before the mode change
     if r < 0:
@@ -659,6 +679,7 @@ def _update(t, x, u, m, p, k, log):
 @numba.njit(cache=True, nogil=True)
 def _restart(t, x, u, m, p, log):
     fmem = p.fmem
+    fmem[FM_KEY] = np.nan
     imem = p.imem
     changed = False
     if fmem[FM_TLAST] != fmem[FM_TLAST]:  # first start: the memories begin here
@@ -699,6 +720,7 @@ def _restart(t, x, u, m, p, log):
 
 @numba.njit(cache=True, nogil=True)
 def _accept(t, x, u, m, p):
+    p.fmem[FM_KEY] = np.nan
     e = p.imem[IM_ERROR]
     if e != 0:
         return e
@@ -899,6 +921,7 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
     fmem[FM_TLAST] = np.nan
     fmem[FM_GW + 3] = np.nan
     fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
+    fmem[FM_KEY] = np.nan
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
         gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),

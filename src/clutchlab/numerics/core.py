@@ -195,7 +195,11 @@ def _store(rec_t, rec_x, rec_m, i, t, x, m):
 
 @numba.njit(cache=True, nogil=True)
 def _dense(theta, h, x0, f0, x1, f1, mass, out):
-    """Cubic Hermite dense output; linear in the algebraic rows (``mass`` = 0)."""
+    """Cubic Hermite dense output; linear in the algebraic rows (``mass`` = 0); the step end itself at ``theta`` = 1."""
+    if theta == 1.0:
+        for i in range(x0.shape[0]):
+            out[i] = x1[i]
+        return
     dense_hermite(theta, h, x0, f0, x1, f1, out)
     for i in range(x0.shape[0]):
         if mass[i] == 0.0:
@@ -417,6 +421,9 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     tab_a[6, 4] = B5
     tab_a[6, 5] = B6
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
+    # work arrays without reference counting (their owners are kept alive to the end of the run)
+    owners = (K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_a, tab_c)
+    K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_a, tab_c = borrow(owners)
     k1 = K[0]
     k7 = K[6]
     t = sf[SF_T]
@@ -557,6 +564,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     sf[SF_H] = h
     si[SI_IREC] = i_rec
     si[SI_STATUS] = status
+    keep_alive(owners)
     return status
 
 
@@ -696,6 +704,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     err = np.empty(n)
     dls = np.empty(n)
     yb = np.empty(rec_y.shape[1])
+    # work arrays without reference counting (their owners are kept alive to the end of the run)
+    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb)
+    f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb = borrow(owners)
     t = sf[SF_T]
     h = sf[SF_H]
     status = SUCCESS
@@ -852,6 +863,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     sf[SF_H] = h
     si[SI_IREC] = i_rec
     si[SI_STATUS] = status
+    keep_alive(owners)
     return status
 
 
