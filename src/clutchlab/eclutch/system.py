@@ -183,27 +183,25 @@ def _friction_level(j, x, nz, f, coord, coord_int):
 
 
 @numba.njit(cache=True, nogil=True)
+def _network(p):
+    """Views of the axial network in ``p``: ``(d0, Gb, scale, offsets, kinds, extraps, unilateral, cx, cf, cd)``."""
+    net = p.net
+    net_int = p.net_int
+    curve = p.curve
+    return (net[NE_D0], net[NE_GB], net[NE_SCALE], net_int[NI_OFFSETS], net_int[NI_KINDS], net_int[NI_EXTRAPS],
+            net_int[NI_UNILATERAL], curve[0], curve[1], curve[2])
+
+
+@numba.njit(cache=True, nogil=True)
 def rhs(t, x, u, m, p, dx, g):
     """Right-hand side (residual on the algebraic rows) and switching functions of the E-clutch."""
     nz = p.nz
     GA = p.GA
-    net = p.net
-    net_int = p.net_int
-    curve = p.curve
     coord = p.coord
     coord_int = p.coord_int
     par = p.par
     work = p.work
-    d0 = net[NE_D0]
-    Gb = net[NE_GB]
-    scale = net[NE_SCALE]
-    offsets = net_int[NI_OFFSETS]
-    kinds = net_int[NI_KINDS]
-    extraps = net_int[NI_EXTRAPS]
-    unilateral = net_int[NI_UNILATERAL]
-    cx = curve[0]
-    cf = curve[1]
-    cd = curve[2]
+    d0, Gb, scale, offsets, kinds, extraps, unilateral, cx, cf, cd = _network(p)
     f = work[W_F]
     free = work[W_FREE]
     Fz = work[W_FZ]
@@ -350,20 +348,8 @@ def _equilibrate(x, ub, p):
     """
     nz = p.nz
     GA = p.GA
-    net = p.net
-    net_int = p.net_int
-    curve = p.curve
     coord = p.coord
-    Gb = net[NE_GB]
-    d0 = net[NE_D0]
-    scale = net[NE_SCALE]
-    offsets = net_int[NI_OFFSETS]
-    kinds = net_int[NI_KINDS]
-    extraps = net_int[NI_EXTRAPS]
-    unilateral = net_int[NI_UNILATERAL]
-    cx = curve[0]
-    cf = curve[1]
-    cd = curve[2]
+    d0, Gb, scale, offsets, kinds, extraps, unilateral, cx, cf, cd = _network(p)
     q = x[2:nz]
     for _it in range(6):
         worst = 0.0

@@ -327,7 +327,7 @@ def commanded_magnet_force(t_ref, g, a, split):
 
 
 # ------------------------------------------------------------------ the model
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _cold(cold, layout, k):
     """Table ``k`` (``L_*``) of ``EmtcParams.cold`` as a 1-D view (``layout``: ``EmtcParams.layout``)."""
     o = layout[2 * k]
@@ -356,7 +356,7 @@ def _switching(x, m, a, margin, aux, g):
         g[5] = margin * aux[AUX_CAP] - abs(aux[AUX_TC])  # |T'_lock| > 1.02 T_cap_L
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _evaluate(t, x, u, m, p):
     """The model at one point into the scratch of ``p.fmem`` (derivative, switching functions, ``aux``)."""
     fmem = p.fmem
@@ -365,7 +365,7 @@ def _evaluate(t, x, u, m, p):
     return aux
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _switch(k, t, x, u, m, p, log):
     """Mode change when switching function ``k`` crossed at ``t`` ([1], Eqs. 8-11, Fig. 11); records the event."""
     fmem = p.fmem
@@ -428,7 +428,7 @@ def _switch(k, t, x, u, m, p, log):
         record(log, t, EV_UNLOCK, EL_COUPLING)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode):
     """Commit the plant magnet memory and the LuGre bristle state at the end of an accepted step (once per ``t``).
 
@@ -451,7 +451,7 @@ def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode)
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _controller(t, x, u, p):
     """One controller sample at ``t``: reference (Eq. 31, table or input), force (Eqs. 13, 15, 11), current (Eqs. 6-7)."""
     fmem = p.fmem
@@ -495,7 +495,7 @@ def _controller(t, x, u, p):
 
 
 # ------------------------------------------------------------------ the hooks of the contract
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _rhs(t, x, u, m, p, dx, g):
     """Right-hand side ``dx`` ([1], Eqs. 8-30, Fig. 15) and switching functions ``g`` in the modes ``m``.
 
@@ -626,7 +626,7 @@ def _rhs(t, x, u, m, p, dx, g):
         fmem[FM_KEY + 8 + i] = m[i]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _same_point(t, x, m, fmem):
     """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, m)`` with the memories as they are now."""
     if fmem[FM_KEY] != t:
@@ -640,7 +640,7 @@ def _same_point(t, x, m, fmem):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _outputs(t, x, u, m, p, y):
     fmem = p.fmem
     # a sample at the end of a step reuses the step's last evaluation (same point, memories not yet committed)
@@ -665,7 +665,7 @@ def _outputs(t, x, u, m, p, y):
     y[17] = fmem[FM_FEASIBLE]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _update(t, x, u, m, p, k, log):
     p.fmem[FM_KEY] = np.nan
     r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
@@ -676,7 +676,7 @@ def _update(t, x, u, m, p, k, log):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _restart(t, x, u, m, p, log):
     fmem = p.fmem
     fmem[FM_KEY] = np.nan
@@ -718,7 +718,7 @@ def _restart(t, x, u, m, p, log):
     return changed
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _accept(t, x, u, m, p):
     p.fmem[FM_KEY] = np.nan
     e = p.imem[IM_ERROR]
@@ -734,17 +734,17 @@ def _accept(t, x, u, m, p):
     return 1 if p.friction_mode == FRICTION_LUGRE else 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _next_break(t, m, p):
     return p.imem[IM_KNEXT] * p.sample_time
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _jacobian(t, x, u, m, p, J):
     return False
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def run_controller(p, t, x, u):
     """Run the controller sample that is due at ``t`` (the last sample of a run, whose break never comes)."""
     k = p.imem[IM_KNEXT]

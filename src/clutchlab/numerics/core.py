@@ -349,37 +349,55 @@ def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
     return i_rec
 
 
+# ============================================================ shared by both methods
+@register_jitable
+def _run_limit(si, opt, grid, cap, i_rec):
+    """Status that ends a run before its next step (step limit, every-step record full), else ``SUCCESS``."""
+    if si[SI_ACCEPTED] >= opt.max_steps:
+        return STEP_LIMIT
+    if not grid and cap > 0 and i_rec >= cap:
+        return RECORD_FULL
+    return SUCCESS
+
+
+@register_jitable
+def _at_break(p, t, x, u, m, log, f, g, si):
+    """At a break time ``t`` (input corner, controller sample): the model's ``restart``, then ``f`` and ``g``
+    at ``t``; returns the next break time."""
+    model.restart(t, x, u, m, p, log)
+    model.rhs(t, x, u, m, p, f, g)
+    si[SI_NRHS] += 1
+    return model.next_break(t, m, p)
+
+
+@register_jitable
+def _clip_step(h, t, t_stop, max_step):
+    """Step size within ``max_step`` that ends exactly on ``t_stop`` if it would reach it; ``(h, last)``."""
+    if h > max_step:
+        h = max_step
+    if h >= (t_stop - t) * (1.0 - 1e-9):
+        return t_stop - t, True
+    return h, False
+
+
+@register_jitable
+def _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
+    """End of an ``advance``: samples at the end time itself (rounding) hold the final state; solver state saved."""
+    if grid and status == SUCCESS:
+        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                             want_y, yb, i_rec)
+    sf[SF_T] = t
+    sf[SF_H] = h
+    si[SI_IREC] = i_rec
+    si[SI_STATUS] = status
+
+
 # ============================================================ Dormand-Prince 5(4)
 @register_jitable
 def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Dormand-Prince 5(4) from the solver state to ``t_end`` (resumable).
 
-    Parameters
-    ----------
-    p : NamedTuple
-        The model's packed parameters (selects the model at compile time).
-    x, m, u : ndarray
-        State [SI], mode vector (int64) and held inputs; ``x`` and ``m`` are
-        updated in place.
-    t_end : float
-        End of this call [s].
-    sf, si : ndarray
-        Solver state from :func:`new_solver_state` (time, step, counters, status).
-    opt : Options
-    log : EventLog
-    ts : ndarray
-        Sample times [s]; empty records every accepted step into the record
-        buffers until they are full (status ``RECORD_FULL``: resume with
-        ``si[SI_IREC] = 0``).
-    rec_t, rec_x, rec_m, rec_y : ndarray
-        Record buffers (time, states, modes, outputs); ``rec_y`` is written
-        only if ``want_y``.
-    want_y : bool
-
-    Returns
-    -------
-    int
-        Status (:mod:`clutchlab.numerics.status`), also in ``si[SI_STATUS]``.
+    Compiled into each model's entry points; arguments and result as in :func:`advance_dopri`.
     """
     p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
     p = byref(p)
@@ -451,30 +469,17 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     tb = model.next_break(t, m, p)
     prev_rej = False
     while t < t_end:
-        if si[SI_ACCEPTED] >= opt.max_steps:
-            status = STEP_LIMIT
-            break
-        if not grid and cap > 0 and i_rec >= cap:
-            status = RECORD_FULL
+        status = _run_limit(si, opt, grid, cap, i_rec)
+        if status != SUCCESS:
             break
         t_stop = t_end if t_end < tb else tb
-        if t_stop - t <= 1e-13 * max(1.0, abs(t_stop)):
-            # at a break time: let the model react (input corner, controller sample)
+        if t_stop - t <= 1e-12 * max(1.0, abs(t_stop)):
             t = t_stop
             if t >= t_end:
                 break
-            if model.restart(t, x, u, m, p, log):
-                pass
-            model.rhs(t, x, u, m, p, k1, g0)
-            si[SI_NRHS] += 1
-            tb = model.next_break(t, m, p)
+            tb = _at_break(p, t, x, u, m, log, k1, g0, si)
             continue
-        if h > opt.max_step:
-            h = opt.max_step
-        last = False
-        if h >= (t_stop - t) * (1.0 - 1e-9):
-            h = t_stop - t
-            last = True
+        h, last = _clip_step(h, t, t_stop, opt.max_step)
         if h < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
@@ -556,14 +561,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         prev_rej = False
         if not grid:
             i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
-    if grid and status == SUCCESS:
-        # samples at the end time itself (rounding) hold the final state
-        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                             want_y, yb, i_rec)
-    sf[SF_T] = t
-    sf[SF_H] = h
-    si[SI_IREC] = i_rec
-    si[SI_STATUS] = status
+    _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
     keep_alive(owners)
     return status
 
@@ -662,14 +660,7 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
 def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Rodas3 from the solver state to ``t_end`` (resumable).
 
-    Arguments (``p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x,
-    rec_m, rec_y, want_y``) and return value as :func:`advance_dopri`.  The Jacobian is the
-    model's analytic one where its ``jacobian`` hook returns True, else a
-    finite-difference one (:func:`_fd_jacobian`), reused for
-    ``opt.jac_every`` accepted steps and refreshed after a rejection or a
-    mode change.  The state at a located event comes from one Rodas3 step
-    of the located length from the step start, so that the algebraic rows
-    stay consistent.
+    Compiled into each model's entry points; arguments and result as in :func:`advance_rodas`.
     """
     p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
     p = byref(p)
@@ -730,22 +721,15 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     rejected_before = False
     en = 0.0
     while t < t_end:
-        if si[SI_ACCEPTED] >= opt.max_steps:
-            status = STEP_LIMIT
-            break
-        if not grid and cap > 0 and i_rec >= cap:
-            status = RECORD_FULL
+        status = _run_limit(si, opt, grid, cap, i_rec)
+        if status != SUCCESS:
             break
         t_stop = t_end if t_end < tb else tb
         if t_stop - t <= 1e-12 * max(1.0, abs(t_stop)):
             t = t_stop
             if t >= t_end:
                 break
-            if model.restart(t, x, u, m, p, log):
-                jac_stale = True
-            model.rhs(t, x, u, m, p, f0, g0)
-            si[SI_NRHS] += 1
-            tb = model.next_break(t, m, p)
+            tb = _at_break(p, t, x, u, m, log, f0, g0, si)
             need_jac = True
             jac_stale = True
             continue
@@ -768,12 +752,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                         ft[r] = (f0[r] - fp[r]) / dt
                 si[SI_NRHS] += 1
             need_jac = False
-        if h > opt.max_step:
-            h = opt.max_step
-        hit_stop = False
-        if t + h >= t_stop - 1e-14 * max(1.0, abs(t_stop)):
-            h = t_stop - t
-            hit_stop = True
+        h, hit_stop = _clip_step(h, t, t_stop, opt.max_step)
         if h < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
@@ -855,14 +834,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             h_new = rodas_next_step(h, en, rejected_before)
             h = h_new if not hit_stop else max(h, h_new)
         rejected_before = False
-    if grid and status == SUCCESS:
-        # samples at the end time itself (rounding) hold the final state
-        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                             want_y, yb, i_rec)
-    sf[SF_T] = t
-    sf[SF_H] = h
-    si[SI_IREC] = i_rec
-    si[SI_STATUS] = status
+    _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
     keep_alive(owners)
     return status
 
