@@ -2,9 +2,10 @@
 
 Runs ``clutchlab demo`` twice in subprocesses sharing one empty numba cache folder
 (``NUMBA_CACHE_DIR``): the first run compiles every kernel the demo uses (what a user sees on a fresh
-machine), the second loads them from the cache.  Prints the wall time of each run and the compile time
-measured inside the first one (numba's ``numba:compile`` events for clutchlab functions, outermost
-compilations only; see clutchlab/_compile_notice.py).
+machine), the second loads them from the cache.  The time the first run spends compiling is the
+difference of the two wall times (the demo compiles its last section's kernels in a background process
+while the first sections run, see clutchlab/warmup.py, so the compile time inside the main process alone,
+also printed, undercounts the work).
 
 Usage: ``python benchmarks/bench_compile.py``  (takes a few minutes on a 2-core machine).
 Goal (issue #12): at most 45 s of compiling on the project's 2-core machine.
@@ -40,9 +41,11 @@ def main() -> None:
         cache = os.path.join(tmp, "numba-cache")
         cold_wall, cold_compile = run_demo(cache, os.path.join(tmp, "demo1"))
         warm_wall, warm_compile = run_demo(cache, os.path.join(tmp, "demo2"))
-    print(f"first run (empty numba cache): {cold_wall:6.1f} s wall, {cold_compile:6.1f} s compiling")
-    print(f"second run (cache warm):       {warm_wall:6.1f} s wall, {warm_compile:6.1f} s compiling")
-    print(f"goal: <= 45 s compiling on the first run -> {'met' if cold_compile <= 45 else 'NOT met'}")
+    spent = cold_wall - warm_wall
+    print(f"first run (empty numba cache): {cold_wall:6.1f} s wall ({cold_compile:5.1f} s compiling in the main process)")
+    print(f"second run (cache warm):       {warm_wall:6.1f} s wall ({warm_compile:5.1f} s compiling)")
+    print(f"time the first run spends compiling (wall difference): {spent:6.1f} s")
+    print(f"goal: <= 45 s compiling on the first run -> {'met' if spent <= 45 else 'NOT met'}")
 
 
 if __name__ == "__main__":

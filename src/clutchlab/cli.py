@@ -14,11 +14,12 @@ from __future__ import annotations
 import argparse
 import errno
 import importlib
+import os
 import sys
 import time
 
 from . import __version__
-from .errors import ClutchlabError
+from .errors import ClutchlabError, ParameterError
 
 #: modules that contribute a sub-command (``register(subparsers)``)
 SUBSYSTEM_CLIS = (
@@ -61,16 +62,43 @@ def _demo(args) -> int:
 
     sections = []
     t0 = time.perf_counter()
-    progress("the first run compiles numba kernels (several minutes on a fresh machine; cached afterwards)")
-    for name in DEMO_SECTIONS:
-        mod = _optional_module(name)
-        if mod is None:
-            continue
-        progress(f"running {name.split('.')[1]} demo ...")
-        sections.append(mod.demo_section(progress=progress))
+    progress("the first run compiles numba kernels (about a minute on a fresh machine; cached afterwards)")
+    # the kernels of the last section compile in a second process while the first sections run
+    # (numba compiles one function at a time per process; clutchlab.warmup)
+    background = {}
+    if (os.cpu_count() or 1) >= 2:
+        from . import warmup
+
+        background["emtc"] = warmup.start(["emtc"])
+    try:
+        for name in DEMO_SECTIONS:
+            mod = _optional_module(name)
+            if mod is None:
+                continue
+            short = name.split('.')[1]
+            if short in background:
+                background.pop(short).wait()
+            progress(f"running {short} demo ...")
+            sections.append(mod.demo_section(progress=progress))
+    finally:
+        for proc in background.values():
+            proc.kill()
+            proc.wait()
     index = write_report(sections, args.output, title="clutchlab demo report (synthetic data)", overwrite=args.force)
     progress(f"done in {time.perf_counter() - t0:.1f} s")
     print(index)
+    return 0
+
+
+def _warmup(args) -> int:
+    from . import warmup
+
+    unknown = [g for g in args.groups if g not in warmup.GROUPS]
+    if unknown:
+        raise ParameterError(f"warmup: unknown group {unknown[0]!r} (known: {', '.join(warmup.GROUPS)})")
+    if args.jobs is not None and args.jobs < 1:
+        raise ParameterError(f"warmup: --jobs = {args.jobs}: must be >= 1")
+    warmup.run_parallel(args.groups or None, args.jobs, progress=progress)
     return 0
 
 
@@ -92,6 +120,13 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("-o", "--output", default="clutchlab-demo", help="report folder to write (default: %(default)s)")
     demo.add_argument("--force", action="store_true", help="replace the report folder if it exists")
     demo.set_defaults(func=_demo)
+    warm = sub.add_parser("warmup", help="compile every numba kernel ahead of use, in parallel processes",
+                          description="Compile (or load from the cache) the numerical kernels of every model, one "
+                                      "group per process, so that later runs start at once.",
+                          epilog="Documentation: docs/architecture.md")
+    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc (default: all)")
+    warm.add_argument("-j", "--jobs", type=int, default=None, help="processes (default: the number of cores)")
+    warm.set_defaults(func=_warmup)
     for name in SUBSYSTEM_CLIS:
         mod = _optional_module(name)
         if mod is not None:

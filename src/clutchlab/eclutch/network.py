@@ -43,6 +43,7 @@ import numpy as np
 from ..curves import Curve, curve_eval
 from .._limits import short_repr
 from ..errors import ParameterError, SimulationError
+from ..numerics.rosenbrock import lu_factor, lu_solve
 
 __all__ = ["Node", "Spring", "Lever", "AxialNetwork", "solve_static", "zero_input", "GROUND"]
 
@@ -447,6 +448,19 @@ def _residual(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unil
 
 
 @numba.njit(cache=True, nogil=True)
+def _solve_in_place(J, b):
+    """``b <- J^-1 b`` by LU with partial pivoting (``J`` is overwritten); False if ``J`` is singular.
+
+    The small dense solve of the core (numba's ``np.linalg.solve`` costs seconds of compilation).
+    """
+    piv = np.empty(J.shape[0], dtype=np.int64)
+    if not lu_factor(J, piv):
+        return False
+    lu_solve(J, piv, b)
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
 def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f_tol, x_tol, max_iter):
     """Damped Newton on ``(GA)^T f(d) = 0``; returns (converged, iterations)."""
     n_el = GA.shape[0]
@@ -473,7 +487,9 @@ def _newton(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilat
         # regularise a singular tangent (e.g. all contacts open on one node)
         for i in range(n_q):
             J[i, i] += 1e-9 * (abs(J[i, i]) + 1.0)
-        dq = np.linalg.solve(J, r)
+        dq = r.copy()
+        if not _solve_in_place(J, dq):
+            return False, it
         step = 1.0
         for _ls in range(30):
             for j in range(n_q):
@@ -515,7 +531,9 @@ def _tangent(q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unila
                 s += GA[e, i] * k[e] * GA[e, j]
             J[i, j] = s
         J[i, i] += 1e-9 * (abs(J[i, i]) + 1.0)
-    return np.linalg.solve(J, rhs)
+    if not _solve_in_place(J, rhs):
+        rhs[:] = np.nan
+    return rhs
 
 
 @numba.njit(cache=True, nogil=True)

@@ -48,6 +48,7 @@ import numpy as np
 from ..errors import ParameterError, SimulationError
 from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek_combined
 from ..numerics import FASTMATH, dispatch
+from ..numerics.borrow import borrow, byref
 from ..numerics.core import record
 from ..system import System, register_model
 from ._lookup import bilinear, interp1
@@ -215,9 +216,8 @@ class EmtcParams(NamedTuple):
 
     Scalars are grouped in NamedTuples of floats (:class:`VehicleData`, :class:`CouplingData`,
     :class:`ActuatorData`), the coupling geometry (:meth:`CouplingGeometry.kernel_data`) and the LuGre data
-    are tuples: values that cost nothing to pass.  The arrays are few, because the integrator core hands this
-    structure to every hook call and numba reference-counts each array in it on each call (measured: with 40
-    arrays that traffic was two thirds of the run time): the throttle profile and the plant magnet's memory
+    are tuples.  The core passes the structure to the hooks by reference with its arrays borrowed (no
+    reference counting; see docs/architecture.md).  The arrays: the throttle profile and the plant magnet's memory
     (read on every evaluation), the integer and float memories of the run (``imem``, ``fmem``, offsets
     ``IM_*``, ``FM_*``), and one array ``cold`` with everything read only at controller samples, airgap
     changes or in the friction-map mode (offsets and sizes in ``layout``, indices ``L_*``).  One instance per
@@ -327,7 +327,7 @@ def commanded_magnet_force(t_ref, g, a, split):
 
 
 # ------------------------------------------------------------------ the model
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _cold(cold, layout, k):
     """Table ``k`` (``L_*``) of ``EmtcParams.cold`` as a 1-D view (``layout``: ``EmtcParams.layout``)."""
     o = layout[2 * k]
@@ -500,8 +500,8 @@ def _rhs(t, x, u, m, p, dx, g):
     """Right-hand side ``dx`` ([1], Eqs. 8-30, Fig. 15) and switching functions ``g`` in the modes ``m``.
 
     The one place the model is written (every other hook evaluates it through the core's ``rhs`` hook);
-    the intermediates go to ``fmem[FM_AUX:]``.  Written out in the hook itself rather than in a function it
-    calls: each call that takes the parameter structure costs the reference counting of all its arrays.
+    the intermediates go to ``fmem[FM_AUX:]`` and the point of the evaluation to ``fmem[FM_KEY:]`` (an
+    output sample at the end of a step reuses it).
     """
     aux = p.fmem[FM_AUX:FM_AUX + N_AUX]
     a = p.actuator
@@ -747,6 +747,7 @@ def _jacobian(t, x, u, m, p, J):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def run_controller(p, t, x, u):
     """Run the controller sample that is due at ``t`` (the last sample of a run, whose break never comes)."""
+    p = byref(borrow(p))  # the hooks' own specialisation (compiled once, with the core's)
     k = p.imem[IM_KNEXT]
     if t >= k * p.sample_time - 1e-9 * p.sample_time:
         _controller(t, x, u, p)

@@ -161,7 +161,7 @@ def new_solver_state(t0: float):
     return sf, np.zeros(N_SI, dtype=np.int64)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def record(log, t, code, element):
     """Append a named event (model hooks call this)."""
     n = log.count[0]
@@ -842,16 +842,19 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 # ============================================================ evaluation through the contract
 @register_jitable
 def _evaluate(p, t, x, u, m, dx, g):
+    p = byref(borrow(p))  # the same specialisation of the hooks as the loops'
     model.rhs(t, x, u, m, p, dx, g)
 
 
 @register_jitable
 def _evaluate_outputs(p, t, x, u, m, y):
+    p = byref(borrow(p))
     model.outputs(t, x, u, m, p, y)
 
 
 @register_jitable
 def _outputs_at(p, T, X, u, M, Y):
+    p = byref(borrow(p))
     y = np.empty(Y.shape[1])
     for i in range(T.shape[0]):
         model.outputs(T[i], X[i], u, M[i], p, y)

@@ -1,0 +1,122 @@
+"""Compile clutchlab's numba kernels ahead of use, in parallel processes.
+
+clutchlab's kernels are compiled on first use and cached on disk (numba's
+``cache=True``; the integrator core's per-model entry points in
+:func:`clutchlab.numerics.entry.kernel_dir`).  numba compiles one function at a
+time in a process (a global compiler lock), so on a fresh machine the first run
+of the demo spends most of its time compiling, on one core.  The kernels of the
+three models are independent: compiling each group in its own process uses every
+core, and the processes share the cache on disk (numba writes its files
+atomically), so the process that runs the model later loads them.
+
+``clutchlab warmup`` compiles every group (``--jobs`` processes); ``clutchlab
+demo`` compiles the groups of its later sections in a background process while
+its first section runs (:func:`start`).  Each group exercises the same compiled
+functions as its model's demo section, on tiny problems.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+from .errors import ParameterError, SimulationError
+
+__all__ = ["GROUPS", "warm", "start", "run_parallel", "main"]
+
+
+def _warm_eclutch() -> None:
+    import numpy as np
+
+    from .eclutch import ClutchModel, EClutch, EClutchParameters, FrictionParameters
+
+    model = ClutchModel.preset(4, EClutchParameters())
+    model.static_curve(np.linspace(0.0, 8e-3, 5))
+    inputs = {"bearing_reference": ([0.0, 0.005, 0.01], [0.0, 1e-3, 1e-3])}
+    EClutch(clutch=model, friction=FrictionParameters()).simulate(inputs, 0.01, output_step=1e-3)
+
+
+def _warm_wet() -> None:
+    from .wet import Bench, EngagementProtocol, ParametricFriction, WetClutch, simulate_engagement
+
+    clutch = WetClutch.paper()
+    scenario = EngagementProtocol(duration=0.05).scenario(clutch, "speed")
+    simulate_engagement(clutch, scenario, bench=Bench(), friction=ParametricFriction.bench_truth())
+
+
+def _warm_emtc() -> None:
+    import numpy as np
+
+    from .emtc.bench import BenchScenario, simulate_bench
+    from .emtc.magnet import bundled_magnet
+
+    model = bundled_magnet()
+    u = np.linspace(0.0, 2.0, 20)
+    model.simulate(u, airgap=0.8e-3)
+    model.invert(np.linspace(100.0, 300.0, 20), airgap=0.8e-3)
+    simulate_bench(model, BenchScenario(duration=0.01), controller_model=model)
+
+
+#: compile groups: name -> function that runs the group's kernels once on a tiny problem
+GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc}
+
+
+def _check(names) -> None:
+    unknown = [g for g in names if g not in GROUPS]
+    if unknown:
+        raise ParameterError(f"unknown kernel group(s) {unknown}; known: {', '.join(GROUPS)}")
+
+
+def warm(groups=None) -> dict:
+    """Compile (or load) the kernels of ``groups`` (default: all) in this process; seconds per group."""
+    names = list(GROUPS) if groups is None else list(groups)
+    _check(names)
+    seconds = {}
+    for name in names:
+        t0 = time.perf_counter()
+        GROUPS[name]()
+        seconds[name] = time.perf_counter() - t0
+    return seconds
+
+
+def start(groups) -> subprocess.Popen:
+    """Compile ``groups`` in a background process (same interpreter and environment); returns the process.
+
+    Its output is discarded: a failure only means that the process that uses the kernels compiles them
+    itself.  Call ``.wait()`` before running those groups, so that they are not compiled twice.
+    """
+    env = dict(os.environ, CLUTCHLAB_COMPILE_NOTICE="0", MPLBACKEND="Agg")
+    return subprocess.Popen([sys.executable, "-m", "clutchlab.warmup", *groups], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+
+
+def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
+    """Compile ``groups`` (default: all) in up to ``jobs`` processes (default: the cores); wall seconds."""
+    names = list(GROUPS) if groups is None else list(groups)
+    _check(names)
+    jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
+    t0 = time.perf_counter()
+    # deal the groups round-robin to the processes, the costliest first (measured: emtc, eclutch, wet)
+    order = [g for g in ("emtc", "eclutch", "wet") if g in names]
+    order += [g for g in names if g not in order]
+    lots = [order[i::jobs] for i in range(jobs)]
+    procs = [start(lot) for lot in lots if lot]
+    failed = [lot for lot, p in zip(lots, procs) if p.wait() != 0]
+    if failed:
+        raise SimulationError(f"compiling kernel group(s) {failed} failed; run 'python -m clutchlab.warmup "
+                           f"{' '.join(failed[0])}' to see why")
+    if progress is not None:
+        progress(f"kernels of {', '.join(names)} ready in {time.perf_counter() - t0:.1f} s")
+    return time.perf_counter() - t0
+
+
+def main(argv=None) -> int:
+    names = sys.argv[1:] if argv is None else list(argv)
+    warm(names or None)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
