@@ -59,7 +59,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from . import dispatch as model
-from .borrow import borrow, byref, keep_alive
+from .borrow import borrow, byref
 from .dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
@@ -306,9 +306,8 @@ def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
     return flag
 
 
-@register_jitable
-def _outputs_row(p, t, x, u, m, rec_y, i, yb):
-    model.outputs(t, x, u, m, p, yb)
+@numba.njit(cache=True, nogil=True)
+def _copy_row(rec_y, i, yb):
     for q in range(yb.shape[0]):
         rec_y[i, q] = yb[q]
 
@@ -319,7 +318,8 @@ def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
         if want_y:
-            _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            model.outputs(t, x, u, m, p, yb)
+            _copy_row(rec_y, i_rec, yb)
         i_rec += 1
     return i_rec
 
@@ -333,7 +333,8 @@ def _record_dense(p, t, h, x0, f0, x1, f1, mass, t_limit, u, m, ts, rec_t, rec_x
         _dense(th, h, x0, f0, x1, f1, mass, xe)
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
         if want_y:
-            _outputs_row(p, ts[i_rec], xe, u, m, rec_y, i_rec, yb)
+            model.outputs(ts[i_rec], xe, u, m, p, yb)
+            _copy_row(rec_y, i_rec, yb)
         i_rec += 1
     return i_rec
 
@@ -344,13 +345,15 @@ def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
     if i_rec < rec_t.shape[0]:
         _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
         if want_y:
-            _outputs_row(p, t, x, u, m, rec_y, i_rec, yb)
+            model.outputs(t, x, u, m, p, yb)
+            _copy_row(rec_y, i_rec, yb)
         i_rec += 1
     return i_rec
 
 
 # ============================================================ shared by both methods
-@register_jitable
+# (helpers that do not call the model are ordinary cached functions: compiled once, not once per model)
+@numba.njit(cache=True, nogil=True)
 def _run_limit(si, opt, grid, cap, i_rec):
     """Status that ends a run before its next step (step limit, every-step record full), else ``SUCCESS``."""
     if si[SI_ACCEPTED] >= opt.max_steps:
@@ -370,7 +373,7 @@ def _at_break(p, t, x, u, m, log, f, g, si):
     return model.next_break(t, m, p)
 
 
-@register_jitable
+@numba.njit(cache=True, nogil=True)
 def _clip_step(h, t, t_stop, max_step):
     """Step size within ``max_step`` that ends exactly on ``t_stop`` if it would reach it; ``(h, last)``."""
     if h > max_step:
@@ -380,16 +383,14 @@ def _clip_step(h, t, t_stop, max_step):
     return h, False
 
 
-@register_jitable
-def _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
-    """End of an ``advance``: samples at the end time itself (rounding) hold the final state; solver state saved."""
-    if grid and status == SUCCESS:
-        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                             want_y, yb, i_rec)
+@numba.njit(cache=True, nogil=True)
+def _save_state(sf, si, t, h, i_rec, status, owners):
+    """End of an ``advance``: the solver state saved; ``owners`` (the loop's work arrays) live until here."""
     sf[SF_T] = t
     sf[SF_H] = h
     si[SI_IREC] = i_rec
     si[SI_STATUS] = status
+    return status
 
 
 # ============================================================ Dormand-Prince 5(4)
@@ -561,9 +562,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         prev_rej = False
         if not grid:
             i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
-    _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
-    keep_alive(owners)
-    return status
+    if grid and status == SUCCESS:  # samples at the end time itself (rounding) hold the final state
+        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                             want_y, yb, i_rec)
+    return _save_state(sf, si, t, h, i_rec, status, owners)
 
 
 # ============================================================ Rosenbrock (Rodas3)
@@ -834,9 +836,10 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             h_new = rodas_next_step(h, en, rejected_before)
             h = h_new if not hit_stop else max(h, h_new)
         rejected_before = False
-    _finish(p, t, h, t_end, x, u, m, status, grid, sf, si, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
-    keep_alive(owners)
-    return status
+    if grid and status == SUCCESS:  # samples at the end time itself (rounding) hold the final state
+        i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                             want_y, yb, i_rec)
+    return _save_state(sf, si, t, h, i_rec, status, owners)
 
 
 # ============================================================ evaluation through the contract
