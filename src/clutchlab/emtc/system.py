@@ -153,7 +153,9 @@ FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque spl
 FM_DX = FM_SPLIT + 6  # 7: scratch derivative
 FM_G = FM_DX + 7  # 6: scratch switching functions
 FM_KEY = FM_G + 6  # 11: point (t, x, modes) of the last evaluation; NaN once a memory or mode may have changed
-N_FMEM = FM_KEY + 11
+FM_DXM = FM_KEY + 11  # 7: derivative of the last evaluation
+FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
+N_FMEM = FM_GM + 6
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
 # the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
@@ -503,12 +505,21 @@ def _rhs(t, x, u, m, p, dx, g):
     the intermediates go to ``fmem[FM_AUX:]`` and the point of the evaluation to ``fmem[FM_KEY:]`` (an
     output sample at the end of a step reuses it).
     """
-    aux = p.fmem[FM_AUX:FM_AUX + N_AUX]
     a = p.actuator
+    fmem = p.fmem
+    if _same_point(t, x, m, fmem):
+        # the point of the last evaluation again (a controller sample at the end of a step): only the
+        # current command may have changed since, and only the first current lag depends on it
+        for i in range(7):
+            dx[i] = fmem[FM_DXM + i]
+        for k in range(6):
+            g[k] = fmem[FM_GM + k]
+        dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
+        return
+    aux = fmem[FM_AUX:FM_AUX + N_AUX]
     v = p.vehicle
     c = p.coupling
     geo = p.geometry
-    fmem = p.fmem
     arm = m[0]
     cpl = m[1]
     wf = x[0]
@@ -622,8 +633,11 @@ def _rhs(t, x, u, m, p, dx, g):
     fmem[FM_KEY] = t
     for i in range(7):
         fmem[FM_KEY + 1 + i] = x[i]
+        fmem[FM_DXM + i] = dx[i]
     for i in range(3):
         fmem[FM_KEY + 8 + i] = m[i]
+    for k in range(6):
+        fmem[FM_GM + k] = g[k]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -679,7 +693,6 @@ def _update(t, x, u, m, p, k, log):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _restart(t, x, u, m, p, log):
     fmem = p.fmem
-    fmem[FM_KEY] = np.nan
     imem = p.imem
     changed = False
     if fmem[FM_TLAST] != fmem[FM_TLAST]:  # first start: the memories begin here
@@ -701,6 +714,7 @@ def _restart(t, x, u, m, p, log):
             jumped = True
             fmem[FM_ULAST + q] = u[q]
     if jumped:
+        fmem[FM_KEY] = np.nan  # the last evaluation was for other inputs
         for _ in range(3):
             _evaluate(t, x, u, m, p)
             gv = fmem[FM_G:FM_G + 6]
@@ -720,7 +734,9 @@ def _restart(t, x, u, m, p, log):
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _accept(t, x, u, m, p):
-    p.fmem[FM_KEY] = np.nan
+    if p.friction_mode == FRICTION_LUGRE:
+        p.fmem[FM_KEY] = np.nan  # the committed bristle state changes the friction at the same point
+    # (committing the magnet memory at the current coil current leaves the magnet force there unchanged)
     e = p.imem[IM_ERROR]
     if e != 0:
         return e

@@ -484,6 +484,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if h < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
+        t1 = t_stop if last else t + h  # the step end, exactly as the step will end (stages with c = 1)
         for stg in range(1, 7):
             for i in range(n):
                 acc = 0.0
@@ -493,7 +494,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if stg == 6:
                 for i in range(n):
                     xn[i] = xt[i]
-            model.rhs(t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
+            model.rhs(t1 if tab_c[stg] == 1.0 else t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
         si[SI_NRHS] += 6
         for i in range(n):
             err[i] = h * (E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i] + E7 * K[6, i])
