@@ -400,9 +400,9 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 
     Compiled into each model's entry points; arguments and result as in :func:`advance_dopri`.
     """
-    p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
-    p = byref(p)
-    ts, rec_t, rec_x, rec_m, rec_y = borrow((ts, rec_t, rec_x, rec_m, rec_y))
+    p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y = borrow(
+        (p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y))
+    p = byref(p)  # (after borrow: the members read through the reference are not reference-counted)
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0
@@ -665,9 +665,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 
     Compiled into each model's entry points; arguments and result as in :func:`advance_rodas`.
     """
-    p, x, m, u, sf, si, opt, log = borrow((p, x, m, u, sf, si, opt, log))
-    p = byref(p)
-    ts, rec_t, rec_x, rec_m, rec_y = borrow((ts, rec_t, rec_x, rec_m, rec_y))
+    p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y = borrow(
+        (p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y))
+    p = byref(p)  # (after borrow: the members read through the reference are not reference-counted)
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0
