@@ -11,8 +11,8 @@ parameters), these atomic operations were a fifth of the run time.
 owner (``meminfo``) of every array in it set to NULL, so numba's reference
 counting of the copies is a null test.  The caller must keep the original
 alive while the borrowed value is used: the core borrows only its own
-arguments (held by its caller for the whole call) and work arrays it keeps
-alive to its end with :func:`keep_alive`.  A borrowed array must never be
+arguments (held by its caller for the whole call) and work arrays whose
+owners it passes to its last call (so numba keeps them to the end).  A borrowed array must never be
 returned to Python or stored beyond the call.
 """
 
@@ -23,7 +23,7 @@ from numba.core.imputils import impl_ret_borrowed, lower_getattr_generic
 from numba.core.typing.templates import AttributeTemplate, infer_getattr
 from numba.extending import intrinsic, models, register_model
 
-__all__ = ["borrow", "keep_alive", "byref", "ByRef"]
+__all__ = ["borrow", "byref", "ByRef"]
 
 
 def _has_arrays(ty) -> bool:
@@ -56,17 +56,6 @@ def borrow(typingctx, value):
 
     def codegen(context, builder, signature, args):
         return _strip(context, builder, signature.args[0], args[0])
-
-    return sig, codegen
-
-
-@intrinsic
-def keep_alive(typingctx, value):
-    """A use of ``value`` that keeps numba from releasing it before this point (no code)."""
-    sig = types.none(value)
-
-    def codegen(context, builder, signature, args):
-        return context.get_dummy_value()
 
     return sig, codegen
 
