@@ -258,7 +258,7 @@ class WetParams(NamedTuple):
 
 
 # ----------------------------------------------------------------- model pieces (compiled, scalar)
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def piston_speed(net_force, film_resistance, speed_max):
     """Piston speed from the quasi-static force balance with the actuator's speed limit [m/s].
 
@@ -278,7 +278,7 @@ def piston_speed(net_force, film_resistance, speed_max):
     return speed_max * math.tanh(net_force / (film_resistance * speed_max))
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def drive_torque(slip_speed, reference, integral, torque_max, power_max, kp, ki):
     """Speed-controlled bench motor: PI with back-calculation anti-windup, torque and power limits.
 
@@ -309,7 +309,7 @@ def drive_torque(slip_speed, reference, integral, torque_max, power_max, kp, ki)
     return td, ki * e + kaw * (td - command)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _pwl(t, tables, start, n):
     """Piecewise-linear reference profile at ``t`` (times ``tables[start:start+n]``, values after them),
     constant beyond the ends."""
@@ -331,7 +331,7 @@ def _pwl(t, tables, start, n):
 
 
 # ----------------------------------------------------------------- hooks
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_rhs(t, x, u, m, p, dx, g):
     """Right-hand side, switching functions and (into the scratch of ``p.data``) the outputs of the model."""
     c = p.constants[0]
@@ -442,14 +442,14 @@ def wet_rhs(t, x, u, m, p, dx, g):
     wk[W_OUT + O_CAP] = cap
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _evaluate(t, x, u, m, p):
     """The model at one point into the scratch space of ``p.data`` (hooks other than ``rhs``)."""
     wk = p.data
     wet_rhs(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_outputs(t, x, u, m, p, y):
     """Outputs at one point (:data:`OUTPUTS` order)."""
     # y (18 entries) takes the derivative and the switching values first (scratch, overwritten), then the
@@ -460,7 +460,7 @@ def wet_outputs(t, x, u, m, p, y):
         y[i] = wk[W_OUT + i]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_update(t, x, u, m, p, k, log):
     """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name)."""
     wk = p.data
@@ -506,7 +506,7 @@ def wet_update(t, x, u, m, p, k, log):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a (re)start: break-away, piston on or off its stop, film contact.
 
@@ -543,7 +543,7 @@ def wet_restart(t, x, u, m, p, log):
     return changed
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_accept(t, x, u, m, p):
     """After each accepted step: track the peak pack temperature."""
     wk = p.data
@@ -552,7 +552,7 @@ def wet_accept(t, x, u, m, p):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _next_corner(tables, start, n, t):
     for i in range(start, start + n):
         if tables[i] > t:
@@ -560,7 +560,7 @@ def _next_corner(tables, start, n, t):
     return np.inf
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_next_break(t, m, p):
     """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
     c = p.constants[0]
@@ -572,7 +572,7 @@ def wet_next_break(t, m, p):
     return tb
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_jacobian(t, x, u, m, p, J):
     """No analytic Jacobian (Dormand-Prince does not need one)."""
     return False
