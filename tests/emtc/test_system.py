@@ -22,6 +22,7 @@ equality is not expected.  Two documented departures from the pre-port answers:
   (bristle update first order in the step near zero slip) is compared to 3e-5 s.
 """
 
+import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +30,7 @@ import pandas as pd
 import pytest
 
 from clutchlab import SimulationResult
-from clutchlab.emtc import (BenchOptions, BenchScenario, LuGreParameters, bench_system, bundled_magnet, simulate,
+from clutchlab.emtc import (BenchOptions, BenchScenario, bench_system, bundled_magnet, simulate,
                             simulate_bench)
 from clutchlab.emtc import system as S
 from clutchlab.errors import SimulationError
@@ -47,13 +48,11 @@ def magnet():
 
 
 def _scenarios():
-    yield "slipping", BenchScenario(duration=2.0, speed_difference=0.3, throttle_start=0.1, throttle_end=0.6,
-                                    ramp_start=0.2, ramp_end=1.8), {}
-    yield "lock_unlock", BenchScenario(duration=3.0, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9,
-                                       ramp_start=0.3, ramp_end=2.8), {"torque_reference": ([0.0, 10.0], [250.0, 250.0])}
-    yield "lugre", BenchScenario(duration=3.0, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9,
-                                 ramp_start=0.3, ramp_end=2.8), {"torque_reference": ([0.0, 10.0], [150.0, 150.0]),
-                                                                 "lugre": LuGreParameters()}
+    """The scenarios of the regression traces, from the script that wrote them (one definition)."""
+    spec = importlib.util.spec_from_file_location("make_regression_traces", DATA.with_name("make_regression_traces.py"))
+    maker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(maker)
+    return maker.scenarios()
 
 
 @pytest.mark.parametrize("name, scenario, kwargs", list(_scenarios()), ids=lambda v: v if isinstance(v, str) else "")
