@@ -16,7 +16,8 @@ contract once, in its own package:
 Everything else is written once against the :class:`System`:
 :func:`simulate` (returns a :class:`clutchlab.SimulationResult`),
 :class:`Simulation` (resumable stepping for co-simulation and controllers in
-the loop), :func:`simulate_batch` (one solver per variant in ``prange``),
+the loop), :func:`simulate_batch` (one solver per variant in ``prange``, over
+:class:`Variants`: the variants' parameters stacked along a first axis),
 :func:`evaluate` (right-hand side, switching functions and outputs at one
 point, for linearisation and tests).
 """
@@ -36,7 +37,7 @@ from .errors import ParameterError, SimulationError
 from .numerics import status as st
 from .result import SimulationResult
 
-__all__ = ["Variable", "System", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
+__all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
            "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
@@ -72,7 +73,21 @@ class Variable:
 
 def variables(spec) -> tuple:
     """``Variable`` tuple from ``(name, unit[, description])`` tuples (model packages use this)."""
+    try:
+        return _variables(tuple(spec))
+    except TypeError:  # an unhashable entry (a list): not remembered
+        return tuple(v if isinstance(v, Variable) else Variable(*v) for v in spec)
+
+
+@functools.lru_cache(maxsize=256)
+def _variables(spec: tuple) -> tuple:
+    # a model's specs are module constants: converted once, not at every System (a run builds one)
     return tuple(v if isinstance(v, Variable) else Variable(*v) for v in spec)
+
+
+@functools.lru_cache(maxsize=256)
+def _columns(vars_: tuple) -> tuple:
+    return tuple(v.column for v in vars_)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -189,15 +204,15 @@ class System:
     # ---- names (computed once: read by every run)
     @functools.cached_property
     def state_columns(self) -> tuple:
-        return tuple(v.column for v in self.states)
+        return _columns(self.states)
 
     @functools.cached_property
     def output_columns(self) -> tuple:
-        return tuple(v.column for v in self.outputs)
+        return _columns(self.outputs)
 
     @functools.cached_property
     def input_columns(self) -> tuple:
-        return tuple(v.column for v in self.inputs)
+        return _columns(self.inputs)
 
     def state_index(self, name: str) -> int:
         return _index(self.states, name, "state", self.name)
@@ -550,6 +565,150 @@ class Simulation:
                 "events_dropped": int(self.log.count[1])}
 
 
+@dataclasses.dataclass(frozen=True, eq=False)
+class Variants:
+    """Variants of one system for :func:`simulate_batch`, their parameters stacked along a first axis.
+
+    Every array of the parameter structure gets a leading variant axis (``params.data[v]`` is variant
+    ``v``'s ``data``), so a model can build thousands of variants with a few vectorised NumPy operations
+    instead of one :class:`System` and one parameter structure each.  The compiled batch takes variant
+    ``v``'s structure as views of these arrays (:func:`clutchlab.numerics.borrow.take`); memories a model
+    keeps in its parameters (a lock-up time, a peak temperature) are therefore written into ``params``.
+
+    Parameters
+    ----------
+    system : System
+        The base system: names, units, method, tolerances and the structure of the parameters.
+    params : NamedTuple
+        Of the class of ``system.params``; each array field ``f`` an array of shape
+        ``(n,) + system.params.f.shape`` and the same dtype, a number field an array of shape ``(n,)``
+        (float64, int64 or bool), a tuple field the same tuple of such stacked members.
+    x0, m0, u0 : ndarray
+        Initial states ``(n, n_x)``, modes ``(n, n_m)`` and held inputs ``(n, n_u)``.
+    """
+
+    system: System
+    params: tuple
+    x0: np.ndarray
+    m0: np.ndarray
+    u0: np.ndarray
+
+    def __post_init__(self):
+        base = self.system
+        if type(self.params) is not type(base.params):
+            raise ParameterError(f"Variants of {base.name!r}: params must be a stacked {type(base.params).__name__}")
+        n = None
+        for name, ref, arr in zip(base.params._fields, base.params, self.params):
+            layout = _field_layout(ref)
+            if layout is None:
+                raise ParameterError(f"Variants of {base.name!r}: parameter field {name!r} is neither a number, an "
+                                     "array of at least one dimension nor a tuple of those")
+            first = arr
+            while isinstance(first, tuple) and len(first):
+                first = first[0]
+            if n is None:
+                n = getattr(first, "shape", (0,))[0] if getattr(first, "ndim", 0) >= 1 else 0
+            if not _stacked_matches(arr, layout, n):
+                raise ParameterError(f"Variants of {base.name!r}: stacked field {name!r} is not {n} variants of "
+                                     f"the base system's field (each array with a leading variant axis of "
+                                     f"length {n}, C-contiguous, of the same dtype)")
+        for field, arr, dtype, width in (("x0", self.x0, float, base.x0.size), ("m0", self.m0, np.int64,
+                                                                                 base.m0.size),
+                                         ("u0", self.u0, float, base.u0.size)):
+            arr = np.ascontiguousarray(arr, dtype=dtype)
+            if arr.shape != (n, width):
+                raise ParameterError(f"Variants of {base.name!r}: {field} needs shape ({n}, {width}), "
+                                     f"got {arr.shape}")
+            object.__setattr__(self, field, arr)
+
+    def __len__(self) -> int:
+        return self.x0.shape[0]
+
+    @classmethod
+    def stack(cls, systems) -> "Variants":
+        """Stack a sequence of :class:`System` variants of one model (same parameter sizes)."""
+        systems = list(systems)
+        if not systems:
+            raise ParameterError("simulate_batch: no variants")
+        first = systems[0]
+        for i, s in enumerate(systems[1:], start=1):
+            if type(s.params) is not type(first.params) or s.x0.shape != first.x0.shape:
+                raise ParameterError("simulate_batch: all variants must be the same model with the same structure "
+                                     f"(variant {i} differs from variant 0)")
+        fields = []
+        for k, name in enumerate(first.params._fields):
+            layout = _field_layout(first.params[k])
+            if layout is None:
+                raise ParameterError(f"simulate_batch: parameter field {name!r} of {first.name!r} is neither a "
+                                     "number, an array of at least one dimension nor a tuple of those")
+            for i, s in enumerate(systems):
+                if _field_layout(s.params[k]) != layout:
+                    raise ParameterError(f"simulate_batch: variant {i} of {first.name!r}: parameter {name!r} has "
+                                         "other sizes than in variant 0 (variants of a batch need equal sizes)")
+            fields.append(_stack_field([s.params[k] for s in systems], layout))
+        return cls(first, type(first.params)(*fields), np.stack([s.x0 for s in systems]),
+                   np.stack([s.m0 for s in systems]), np.stack([s.u0 for s in systems]))
+
+    def params_of(self, v: int):
+        """Variant ``v``'s parameter structure (views of the stacked arrays; numbers for number fields)."""
+        return _row(self.params, v)
+
+
+def _row(stacked, v):
+    if isinstance(stacked, np.ndarray):
+        return stacked[v] if stacked.ndim > 1 else stacked[v].item()
+    members = [_row(s_, v) for s_ in stacked]
+    return type(stacked)(*members) if hasattr(stacked, "_fields") else tuple(members)
+
+
+def _field_layout(value):
+    """Layout of a parameter field as :class:`Variants` stacks it, or None if it cannot be stacked.
+
+    ``("array", shape, dtype)`` for an array of at least one dimension, ``("number", dtype)`` for a number,
+    ``("tuple", class, (member layouts))`` for a tuple or NamedTuple of such fields.
+    """
+    if isinstance(value, np.ndarray):
+        return ("array", value.shape, value.dtype) if value.ndim >= 1 else None
+    if isinstance(value, (bool, np.bool_)):
+        return ("number", np.dtype(np.bool_))
+    if isinstance(value, (int, np.integer)):
+        return ("number", np.dtype(np.int64))
+    if isinstance(value, (float, np.floating)):
+        return ("number", np.dtype(np.float64))
+    if isinstance(value, tuple) and len(value):
+        members = tuple(_field_layout(v) for v in value)
+        return None if any(m is None for m in members) else ("tuple", type(value), members)
+    return None
+
+
+def _stack_field(values, layout):
+    """The values of one field over the variants, stacked (arrays with a leading variant axis)."""
+    if layout[0] == "tuple":
+        members = [_stack_field([v[k] for v in values], sub) for k, sub in enumerate(layout[2])]
+        return layout[1](*members) if hasattr(layout[1], "_fields") else tuple(members)
+    return np.stack([np.asarray(v, dtype=layout[-1]) for v in values])
+
+
+def _stacked_matches(stacked, layout, n) -> bool:
+    """True if ``stacked`` is ``n`` variants of a field of ``layout``."""
+    if layout[0] == "tuple":
+        return (type(stacked) is layout[1] and len(stacked) == len(layout[2])
+                and all(_stacked_matches(s, sub, n) for s, sub in zip(stacked, layout[2])))
+    shape = layout[1] if layout[0] == "array" else ()
+    return (isinstance(stacked, np.ndarray) and stacked.shape == (n,) + shape and stacked.dtype == layout[-1]
+            and stacked.flags.c_contiguous)
+
+
+def _write_back(dst, src, v) -> None:
+    """Copy variant ``v`` of the stacked ``src`` into the arrays of one variant's field ``dst``."""
+    if isinstance(dst, np.ndarray):
+        if dst.flags.writeable:
+            dst[...] = src[v]
+    elif isinstance(dst, tuple):
+        for d, s_ in zip(dst, src):
+            _write_back(d, s_, v)
+
+
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
                    event_capacity: int = 256, check: bool = False) -> SimulationResult:
@@ -557,14 +716,16 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
 
     Parameters
     ----------
-    systems : sequence of System
-        Variants of one model (same parameter structure and sizes; each its own parameter memory).
+    systems : Variants or sequence of System
+        Variants of one model with equal parameter sizes: a :class:`Variants` (parameters already
+        stacked; memories the model keeps in them are written there), or systems, stacked here (their
+        parameter arrays get the memories back after the run).
     t_end : float
         End time [s].
     sample_times, output_step
         Common sample times [s] (default: the end time only).
     rtol, atol, max_step, max_steps
-        As :func:`simulate`, shared by all variants (defaults: the first variant's).
+        As :func:`simulate`, shared by all variants (defaults: the base system's).
     outputs : bool
         Evaluate the outputs at the samples.
     event_capacity : int
@@ -577,28 +738,26 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     SimulationResult
         Stacked: ``states[v, i, :]``; ``status`` one code per variant; events with a ``variant`` column.
     """
-    import numba
-
     from .numerics import core
 
-    systems = list(systems)
-    if not systems:
-        raise ParameterError("simulate_batch: no variants")
-    first = systems[0]
-    for s in systems[1:]:
-        if type(s.params) is not type(first.params) or s.x0.shape != first.x0.shape:
-            raise ParameterError("simulate_batch: all variants must be the same model with the same structure")
+    given = None
+    if isinstance(systems, Variants):
+        batch = systems
+    else:
+        given = list(systems)
+        batch = Variants.stack(given)
+    first = batch.system
     ts = sample_grid(0.0, float(t_end), output_step, sample_times)
     if ts is None:
         ts = np.array([float(t_end)])
     opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps)
-    nv, ns = len(systems), ts.size
+    nv, ns = len(batch), ts.size
+    if nv == 0:
+        raise ParameterError("simulate_batch: no variants")
     nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
     check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
-    plist = numba.typed.List([s.params for s in systems])
-    X0 = np.stack([s.x0 for s in systems])
-    M0 = np.stack([s.m0 for s in systems])
-    U = np.stack([s.u0 for s in systems]) if ny >= 0 else None
+    X0 = batch.x0.copy()
+    M0 = batch.m0.copy()
     OX = np.full((nv, ns, nx), np.nan)
     OM = np.zeros((nv, ns, nm), dtype=np.int64)
     OY = np.full((nv, ns, ny) if outputs else (nv, 1, ny), np.nan)
@@ -607,8 +766,12 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     EVC = np.zeros((nv, event_capacity), dtype=np.int64)
     EVE = np.zeros((nv, event_capacity), dtype=np.int64)
     EVN = np.zeros((nv, 2), dtype=np.int64)
-    core.batch(first.method, plist, X0, M0, U, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE,
-               EVN)
+    core.batch(first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
+               EVT, EVC, EVE, EVN)
+    if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
+        for v, s in enumerate(given):
+            for dst, src in zip(s.params, batch.params):
+                _write_back(dst, src, v)
     status = STATS[:, core.SI_STATUS].copy()
     if check:
         bad = np.flatnonzero(~np.isin(status, [st.SUCCESS, st.TERMINATED]))

@@ -19,24 +19,28 @@ peak of each trace:
   tens of percent.
 """
 
+import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from clutchlab.eclutch import ActuatorParameters, ClutchDynamics, ClutchModel, EClutch, FrictionParameters
+from clutchlab.eclutch import ClutchDynamics, ClutchModel, EClutch, FrictionParameters
 
-REF = np.load(Path(__file__).parent / "data" / "dynamics_reference.npz")
-BENCH = ([0.0, 0.1, 0.3, 0.6, 0.8], [0.0, 0.0, 7e-3, 7e-3, 0.0])
+DATA = Path(__file__).parent / "data"
+REF = np.load(DATA / "dynamics_reference.npz")
 
 
-def knotted(times, values, grid, hold=False):
-    """The same input with a knot at every output time (linear, or held for a voltage)."""
-    t = np.union1d(times, grid)
-    if hold:
-        idx = np.searchsorted(times, t, side="right") - 1
-        return t, np.asarray(values, float)[np.clip(idx, 0, len(values) - 1)]
-    return t, np.interp(t, times, values)
+def _scenarios():
+    """The scenario definitions of the script that wrote the traces (one definition for both)."""
+    spec = importlib.util.spec_from_file_location("eclutch_make_reference", DATA / "make_reference.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+SC = _scenarios()
+BENCH = SC.BENCH
 
 
 def check(name, outputs, tol):
@@ -50,38 +54,28 @@ def check(name, outputs, tol):
     assert worst and max(worst.values()) < tol, worst
 
 
-def bench_input():
-    return {"bearing_reference": knotted(*BENCH, np.arange(401) * 2.5e-3)}
-
-
 def test_without_friction_the_trajectory_is_the_former_kernels():
-    act = ActuatorParameters(master_seal_friction=0.0, slave_seal_friction=0.0, seal_pressure_friction=0.0,
-                             spindle_efficiency=1.0)
-    res = EClutch(act, ClutchModel.preset(4), FrictionParameters.off()).simulate(
-        bench_input(), 1.0, rtol=2e-12, atol_scale=1e-4, output_step=2.5e-3, max_steps=2_000_000)
+    res = EClutch(SC.frictionless_actuator(), ClutchModel.preset(4), FrictionParameters.off()).simulate(
+        SC.bench_input(), 1.0, rtol=2e-12, atol_scale=1e-4, output_step=2.5e-3, max_steps=2_000_000)
     check("smooth", res.outputs, 5e-6)
 
 
 def test_position_control_with_friction_follows_the_former_kernel():
     res = EClutch(clutch=ClutchModel.preset(4), friction=FrictionParameters()).simulate(
-        bench_input(), 1.0, rtol=1e-10, atol_scale=1e-2, output_step=2.5e-3, max_steps=2_000_000)
+        SC.bench_input(), 1.0, rtol=1e-10, atol_scale=1e-2, output_step=2.5e-3, max_steps=2_000_000)
     check("position", res.outputs, 1e-2)
 
 
 def test_voltage_steps_through_cavitation_follow_the_former_kernel():
-    volts = knotted(np.linspace(0.0, 0.3, 4), [0.0, -12.0, 6.0, 0.0], np.arange(351) * 1e-3, hold=True)
-    res = EClutch().simulate({"voltage": volts}, 0.35, rtol=1e-10, atol_scale=1e-2, output_step=1e-3,
+    res = EClutch().simulate(SC.voltage_input(), 0.35, rtol=1e-10, atol_scale=1e-2, output_step=1e-3,
                              max_steps=2_000_000)
     out = res.outputs.assign(input_work_J=res.energy["input_work_J"].to_numpy())
     check("voltage", out, 5e-3)
 
 
 def test_prescribed_hysteresis_cycle_follows_the_former_kernel():
-    t = np.linspace(0.0, 2.0, 801)
-    s = np.where(t <= 1.0, t, 2.0 - t)
-    x = 7.5e-3 * (3 * s ** 2 - 2 * s ** 3)
     res = ClutchDynamics(ClutchModel.preset(4), FrictionParameters()).simulate(
-        (t, x), rtol=1e-9, atol_scale=1e-2, output_step=5e-3, max_steps=5_000_000)
+        SC.prescribed_cycle(), rtol=1e-9, atol_scale=1e-2, output_step=5e-3, max_steps=5_000_000)
     out = res.outputs.assign(friction_dissipated_J=res.energy["friction_dissipated_J"].to_numpy())
     check("prescribed", out, 6e-3)
 

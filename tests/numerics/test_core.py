@@ -25,7 +25,8 @@ from hypothesis_budget import examples
 from clutchlab import SimulationError
 from clutchlab.numerics import core
 from clutchlab.numerics.status import Status
-from clutchlab.system import Simulation, evaluate, simulate, simulate_batch
+from clutchlab.errors import ParameterError
+from clutchlab.system import Simulation, Variants, evaluate, simulate, simulate_batch
 
 METHODS = ("dopri", "rodas")
 OSC = [[0.0, 1.0], [-1.0, 0.0]]  # x'' = -x
@@ -205,6 +206,38 @@ def test_batch_equals_single_runs(method):
     assert list(batch.status) == [Status.TERMINATED] * 3
 
 
+def test_stacked_variants_equal_single_runs_and_the_list_of_systems():
+    """A batch given as :class:`Variants` (parameters stacked along a first axis) runs each variant on its row.
+
+    x' = -k x with k per variant: each variant's end state is exp(-k t_end), the same as its own run and as
+    the batch of the same systems given as a list.
+    """
+    rates = np.array([0.5, 1.0, 2.0, 4.0])
+    base = toys.linear_system([[-1.0]], [1.0])
+    stacked = toys.LinearParams(-rates.reshape(4, 1, 1).copy(), np.zeros((4, 1, 0)))
+    batch = Variants(base, stacked, np.ones((4, 1)), np.zeros((4, 0), np.int64), np.zeros((4, 0)))
+    assert len(batch) == 4 and np.array_equal(batch.params_of(2).a, [[-2.0]])
+    res = simulate_batch(batch, 1.5, output_step=0.5)
+    assert res.states.shape == (4, 4, 1)
+    np.testing.assert_allclose(res.states[:, -1, 0], np.exp(-1.5 * rates), rtol=1e-7)
+    systems = [toys.linear_system([[-k]], [1.0]) for k in rates]
+    listed = simulate_batch(systems, 1.5, output_step=0.5)
+    assert np.array_equal(listed.states, res.states)
+    for v, s in enumerate(systems):
+        assert np.array_equal(simulate(s, 1.5, output_step=0.5).states, res.states[v])
+
+
+def test_batch_refuses_variants_it_cannot_stack():
+    """Parameters of other sizes, or stacked arrays of the wrong shape, are refused with the field named."""
+    a = toys.linear_system(OSC, [1.0, 0.0])
+    b = toys.linear_system(OSC, [1.0, 0.0], b=[[0.0], [1.0]])  # an input more: b is (2, 1), not (2, 0)
+    with pytest.raises(ParameterError, match="parameter 'b'"):
+        simulate_batch([a, b], 1.0)
+    stacked = toys.LinearParams(np.zeros((3, 2, 2)), np.zeros((2, 2, 0)))  # b stacked for 2 variants, a for 3
+    with pytest.raises(ParameterError, match="stacked field 'b'"):
+        Variants(a, stacked, np.zeros((3, 2)), np.zeros((3, 0), np.int64), np.zeros((3, 0)))
+
+
 def test_every_step_recording_grows_in_chunks():
     """Without output_step every accepted step is kept, across several record chunks."""
     res = simulate(toys.linear_system(OSC, [1.0, 0.0]), 200.0, rtol=1e-10, atol=1e-12)
@@ -333,3 +366,79 @@ def test_grouped_finite_difference_jacobian_matches_the_dense_one():
     assert per_jac_grouped <= 6
     saved = dense.stats["rhs_evaluations"] - grouped.stats["rhs_evaluations"]
     assert saved >= (per_jac_dense - per_jac_grouped) * grouped.stats["jacobians"]
+
+
+# ---- a hook's njit options (error model) hold inside the core too
+_DIVISION_MODULE = """
+import numba, numpy as np
+from typing import NamedTuple
+from clutchlab.numerics import dispatch
+from clutchlab.system import System, evaluate
+
+class NumpyErr(NamedTuple):
+    scale: float
+
+class PythonErr(NamedTuple):
+    scale: float
+
+def hooks(**options):
+    @numba.njit(cache=True, **options)
+    def rhs(t, x, u, m, p, dx, g):
+        dx[0] = p.scale / (x[0] - x[0])  # a division by zero: inf under NumPy's error model
+
+    @numba.njit(cache=True, **options)
+    def out(t, x, u, m, p, y):
+        y[0] = p.scale / (x[0] - x[0])
+
+    @numba.njit(cache=True, **options)
+    def upd(t, x, u, m, p, k, log):
+        return 0
+
+    @numba.njit(cache=True, **options)
+    def rst(t, x, u, m, p, log):
+        return False
+
+    @numba.njit(cache=True, **options)
+    def acc(t, x, u, m, p):
+        return 0
+
+    @numba.njit(cache=True, **options)
+    def brk(t, m, p):
+        return np.inf
+
+    @numba.njit(cache=True, **options)
+    def jac(t, x, u, m, p, J):
+        return False
+
+    return dict(rhs=rhs, outputs=out, update=upd, restart=rst, accept=acc, next_break=brk, jacobian=jac)
+
+dispatch.register(NumpyErr, **hooks(error_model="numpy"))
+dispatch.register(PythonErr, **hooks())
+
+def system(params):
+    return System("division", params, (("x", "1"),), (("y", "1"),), np.ones(1), np.zeros(0, np.int64),
+                  np.full(1, 1e-9))
+
+dx, _, y = evaluate(system(NumpyErr(2.0)))
+print("numpy", dx[0], y[0])
+try:
+    evaluate(system(PythonErr(2.0)))
+    print("python no error")
+except ZeroDivisionError:
+    print("python ZeroDivisionError")
+"""
+
+
+def test_hooks_keep_their_error_model_inside_the_core(tmp_path):
+    """A hook declared with ``error_model="numpy"`` divides by zero to inf in the core; the default raises.
+
+    (The core compiles each hook through an ``@overload``, which compiles with its own options: the hooks'
+    were once silently replaced by numba's defaults.)  Run in a fresh process and cache, so that no hook
+    compiled earlier with other options is loaded from the cache.
+    """
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), CLUTCHLAB_COMPILE_NOTICE="0",
+               PYTHONPATH=os.pathsep.join([str(tmp_path)] + sys.path))
+    (tmp_path / "toy_division.py").write_text(_DIVISION_MODULE)
+    out, _ = _run("import toy_division", env)
+    assert "numpy inf inf" in out
+    assert "python ZeroDivisionError" in out

@@ -843,6 +843,11 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
                     cosimulation: bool = False, n_samples: int = 0) -> EmtcParams:
     """Pack the drum-bench model's parameters and fresh per-run memories into :class:`EmtcParams`.
 
+    The packed tables of the last few distinct requests are remembered (keyed on the magnet objects and
+    the frozen parameter sets; a request with an unhashable part, e.g. a torque map, is packed anew):
+    repeated runs of one bench copy only the per-run memories (a Monte-Carlo loop of short runs spent a
+    tenth of its time packing).
+
     Parameters
     ----------
     magnet : clutchlab.hysteresis.Preisach
@@ -863,9 +868,38 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
     -------
     EmtcParams
     """
+    try:
+        key = (id(magnet), scenario, vehicle, options, bool(cosimulation), int(n_samples))
+        hash(key)
+    except TypeError:
+        key = None
+    packed = _PACKED.get(key) if key is not None else None
+    if packed is None:
+        packed = _pack(magnet, scenario, vehicle, options, cosimulation, n_samples)
+        if key is not None:
+            if len(_PACKED) >= 8:
+                _PACKED.pop(next(iter(_PACKED)))
+            _PACKED[key] = packed  # (holds magnet and options: their ids stay theirs while remembered)
+    return _fresh_memories(packed[-1])
+
+
+#: (magnet id, scenario, vehicle, options, cosimulation, n_samples) -> (magnet, options, packed parameters)
+_PACKED: dict = {}
+
+
+def _fresh_memories(params: EmtcParams) -> EmtcParams:
+    """``params`` with its own copy of every array a run writes (memories, stacks, the controller log)."""
+    return params._replace(imem=params.imem.copy(), fmem=params.fmem.copy(), plant_stack=params.plant_stack.copy(),
+                           plant_prefix=params.plant_prefix.copy(), plant_comb=params.plant_comb.copy(),
+                           cold=params.cold.copy())
+
+
+def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
+    """:func:`pack_parameters` without the memory of earlier requests: ``(magnet, options, params)``."""
     from .bench import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
     from .torque import CouplingGeometry
 
+    given_options = options
     scenario = scenario or _default(BenchScenario)
     vehicle = vehicle or _default(VehicleParameters)
     options = options or BenchOptions()
@@ -959,7 +993,7 @@ def pack_parameters(magnet, scenario=None, vehicle=None, options: BenchOptions |
         mass=float(actuator.mass), stiffness=float(actuator.stiffness), preload=float(actuator.preload),
         damping=float(actuator.damping), free_travel=float(actuator.free_travel),
         airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2))
-    return EmtcParams(
+    return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
         n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_airgaps=int(ctl.n_airgaps), n_ctl_cells=int(nc),
@@ -1021,10 +1055,22 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     x0 = np.array([vf / vehicle.tyre_radius * ic, vr / vehicle.tyre_radius * ic, 0.0, 0.0, 0.0,
                    magnet.grid[0], magnet.grid[0]])
     u0 = np.array([0.0, scenario.throttle_start, vf, vr])
-    return System("emtc_bench", params, STATES, OUTPUTS, x0, np.array([ARM_REST, OPEN, POSITIVE], dtype=np.int64),
-                  ATOL.copy(), switching=SWITCHING, events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES,
-                  inputs=INPUTS, u0=u0, method="dopri", rtol=1e-6, first_step=min(1e-4, scenario.sample_time),
-                  event_tol=1e-12, element_name=_element_name, error_messages=dict(ERROR_MESSAGES))
+    first_step = min(1e-4, scenario.sample_time)
+    template = _TEMPLATES.get(first_step)
+    if template is None:
+        template = System("emtc_bench", params, STATES, OUTPUTS, x0, np.array([ARM_REST, OPEN, POSITIVE], dtype=np.int64),
+                          ATOL.copy(), switching=SWITCHING, events=EVENTS, mode_names=MODE_NAMES,
+                          mode_values=MODE_VALUES, inputs=INPUTS, u0=u0, method="dopri", rtol=1e-6,
+                          first_step=first_step, event_tol=1e-12, element_name=_element_name,
+                          error_messages=dict(ERROR_MESSAGES))
+        if len(_TEMPLATES) < 64:
+            _TEMPLATES[first_step] = template
+    # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
+    return template.variant(params=params, x0=x0, u0=u0)
+
+
+#: first trial step -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`
+_TEMPLATES: dict = {}
 
 
 register_model("emtc_bench", bench_system)

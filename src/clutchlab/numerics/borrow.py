@@ -22,8 +22,9 @@ from numba.core import cgutils, types
 from numba.core.imputils import impl_ret_borrowed, lower_getattr_generic
 from numba.core.typing.templates import AttributeTemplate, infer_getattr
 from numba.extending import intrinsic, models, register_model
+from numba.np.arrayobj import load_item
 
-__all__ = ["borrow", "byref", "ByRef"]
+__all__ = ["borrow", "byref", "ByRef", "take"]
 
 
 def _has_arrays(ty) -> bool:
@@ -117,5 +118,76 @@ def byref(typingctx, value):
 
     def codegen(context, builder, signature, args):
         return cgutils.alloca_once_value(builder, args[0])
+
+    return sig, codegen
+
+
+# ---------------------------------------------------------------- one variant of stacked parameters
+def _row_type(ty):
+    """Type of one variant of a stacked structure (None if ``ty`` is not one).
+
+    An array becomes the array of one less dimension (its row), a one-dimensional array the scalar of
+    its dtype (a number field), a tuple/NamedTuple the tuple of its members' rows.
+    """
+    if isinstance(ty, types.Array):
+        if ty.ndim == 1:
+            return ty.dtype
+        return ty.copy(ndim=ty.ndim - 1, layout="C" if ty.layout == "C" else "A")
+    if not isinstance(ty, types.BaseTuple) or not len(ty.types):
+        return None
+    members = [_row_type(t) for t in ty.types]
+    if any(m is None for m in members):
+        return None
+    if isinstance(ty, types.BaseNamedTuple):  # as numba types a NamedTuple object
+        if all(m == members[0] for m in members[1:]):
+            return types.NamedUniTuple(members[0], len(members), ty.instance_class)
+        return types.NamedTuple(members, ty.instance_class)
+    return types.Tuple(members)
+
+
+def _take_row(context, builder, ty, row_ty, value, idx):
+    if isinstance(ty, types.Array):
+        src = context.make_array(ty)(context, builder, value=value)
+        shape = cgutils.unpack_tuple(builder, src.shape)
+        strides = cgutils.unpack_tuple(builder, src.strides)
+        data = cgutils.pointer_add(builder, src.data, builder.mul(idx, strides[0]))
+        if ty.ndim == 1:
+            return load_item(context, builder, ty, data)
+        out = context.make_array(row_ty)(context, builder)
+        context.populate_array(out, data=data, shape=cgutils.pack_array(builder, shape[1:]),
+                               strides=cgutils.pack_array(builder, strides[1:]), itemsize=src.itemsize,
+                               meminfo=None)
+        return out._getvalue()
+    members = [_take_row(context, builder, t, r, builder.extract_value(value, k), idx)
+               for k, (t, r) in enumerate(zip(ty.types, row_ty.types))]
+    return context.make_tuple(builder, row_ty, members)
+
+
+@intrinsic
+def take(typingctx, stacked, v):
+    """Variant ``v`` of stacked parameters: ``stacked`` with every array ``a`` replaced by ``a[v]`` (borrowed).
+
+    ``stacked`` is a tuple/NamedTuple (or a :class:`ByRef` to one) of arrays or of such tuples, each array
+    with a leading variant axis;
+    the result is the structure of one variant: a one-dimensional array gives a scalar (a number field of the
+    structure), an array with more dimensions a view without owner (as :func:`borrow`), valid while
+    ``stacked`` is alive; nested tuples are taken member by member.  ``v`` is not bounds-checked: the caller
+    iterates over the variant axis.
+    """
+    ref = isinstance(stacked, ByRef)
+    sty = stacked.pointee if ref else stacked
+    if not isinstance(sty, types.BaseTuple) or not isinstance(v, types.Integer) or not len(sty.types):
+        return None
+    row = _row_type(sty)
+    if row is None:
+        return None
+    sig = row(stacked, v)
+
+    def codegen(context, builder, signature, args):
+        value, idx = args
+        if ref:  # (a parallel loop takes the structure by reference: its gufunc cannot pass nested tuples)
+            value = builder.load(value)
+        idx = context.cast(builder, idx, signature.args[1], types.intp)
+        return _take_row(context, builder, sty, signature.return_type, value, idx)
 
     return sig, codegen

@@ -418,32 +418,16 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     ge = np.empty(ng)
     ga = np.empty(ng)
     yb = np.empty(rec_y.shape[1])
-    tab_a = np.zeros((7, 6))
-    tab_a[1, 0] = A21
-    tab_a[2, 0] = A31
-    tab_a[2, 1] = A32
-    tab_a[3, 0] = A41
-    tab_a[3, 1] = A42
-    tab_a[3, 2] = A43
-    tab_a[4, 0] = A51
-    tab_a[4, 1] = A52
-    tab_a[4, 2] = A53
-    tab_a[4, 3] = A54
-    tab_a[5, 0] = A61
-    tab_a[5, 1] = A62
-    tab_a[5, 2] = A63
-    tab_a[5, 3] = A64
-    tab_a[5, 4] = A65
-    tab_a[6, 0] = B1
-    tab_a[6, 2] = B3
-    tab_a[6, 3] = B4
-    tab_a[6, 4] = B5
-    tab_a[6, 5] = B6
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_a, tab_c)
-    K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_a, tab_c = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_c)
+    K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_c = borrow(owners)
     k1 = K[0]
+    k2 = K[1]
+    k3 = K[2]
+    k4 = K[3]
+    k5 = K[4]
+    k6 = K[5]
     k7 = K[6]
     t = sf[SF_T]
     h = sf[SF_H]
@@ -486,18 +470,34 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             break
         t1 = t_stop if last else t + h  # the step end, exactly as the step will end (stages with c = 1)
         for stg in range(1, 7):
-            for i in range(n):
-                acc = 0.0
-                for j in range(stg):
-                    acc += tab_a[stg, j] * K[j, i]
-                xt[i] = x[i] + h * acc
+            # the stage points written out (a loop over a coefficient table makes each state's sum one chain
+            # of dependent additions through memory: measured as most of the loop's own time); the sums run
+            # in the tableau's order, as the table loop did, so results are the same to the last bit
+            if stg == 1:
+                for i in range(n):
+                    xt[i] = x[i] + h * (A21 * k1[i])
+            elif stg == 2:
+                for i in range(n):
+                    xt[i] = x[i] + h * (A31 * k1[i] + A32 * k2[i])
+            elif stg == 3:
+                for i in range(n):
+                    xt[i] = x[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+            elif stg == 4:
+                for i in range(n):
+                    xt[i] = x[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+            elif stg == 5:
+                for i in range(n):
+                    xt[i] = x[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+            else:
+                for i in range(n):
+                    xt[i] = x[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             if stg == 6:
                 for i in range(n):
                     xn[i] = xt[i]
-            model.rhs(t1 if tab_c[stg] == 1.0 else t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
+            model.rhs_stage(t1 if tab_c[stg] == 1.0 else t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
         si[SI_NRHS] += 6
         for i in range(n):
-            err[i] = h * (E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i] + E7 * K[6, i])
+            err[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
         en = error_norm(err, x, xn, rtol, atol)
         if not (en <= 1.0):
             si[SI_REJECTED] += 1
@@ -519,8 +519,8 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             t_new = t_stop
         else:
             t_new = t + h
-        # ---- samples in (t, t_new] on the dense output (modes of the step)
-        if grid:
+        # ---- samples in (t, t_new] on the dense output (modes of the step; the test here saves a call per step)
+        if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
             i_rec = _record_dense(p, t, h, x, k1, xn, k7, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
                                   yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
@@ -803,7 +803,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         t_new = t + h_acc
         if hit_stop and not event:
             t_new = t_stop
-        if grid:
+        if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
             i_rec = _record_dense(p, t, h_acc, x, f0, x1, f1, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
                                   want_y, yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
@@ -939,14 +939,15 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
                                                   rec_y, want_y)
 
 
-def batch(method, plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
+def batch(method, P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
     """One solver per variant, in parallel (``prange``), recorded on ``ts``.
 
     Parameters
     ----------
     method : {"dopri", "rodas"}
-    plist : numba.typed.List
-        One parameter structure per variant (their mutable memories are their own).
+    P : NamedTuple
+        The variants' parameter structures stacked: every array with a leading variant axis
+        (:class:`clutchlab.system.Variants`); variant ``v`` runs on views of row ``v``.
     X0, M0, U : ndarray
         Initial states, modes and held inputs, one row per variant.
     t_end : float
@@ -963,8 +964,8 @@ def batch(method, plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y,
     EV_T, EV_C, EV_E, EV_N : ndarray
         Events per variant: time, code, element; ``EV_N[v]`` = (held, dropped).
     """
-    entry_points(type(plist[0]), method).batch(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS,
-                                               EV_T, EV_C, EV_E, EV_N)
+    entry_points(type(P), method).batch(P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C,
+                                        EV_E, EV_N)
 
 
 def evaluate(p, t, x, u, m, dx, g):

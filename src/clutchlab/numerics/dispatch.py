@@ -23,6 +23,7 @@ and the parameters ``p``):
 
 ``rhs(t, x, u, m, p, dx, g)``
     Right-hand side into ``dx`` and the switching functions into ``g``.
+    (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the same hook, inlined.)
 ``outputs(t, x, u, m, p, y)``
     Output vector into ``y``.
 ``update(t, x, u, m, p, k, log)``
@@ -47,6 +48,7 @@ and the parameters ``p``):
 
 from __future__ import annotations
 
+import functools
 import inspect
 
 from numba.core import types
@@ -54,7 +56,8 @@ from numba.extending import overload
 
 from .borrow import ByRef
 
-__all__ = ["register", "registered", "hook_sources", "rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian"]
+__all__ = ["register", "registered", "hook_sources", "rhs", "rhs_stage", "outputs", "update", "restart", "accept",
+           "next_break", "jacobian"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 
@@ -68,11 +71,15 @@ def register(params_cls, **functions) -> None:
 
     Every hook of :data:`HOOKS` must be given, as a ``numba.njit`` function.
     Registering the same class again replaces the hooks (a reloaded module).
+    Each hook is compiled into the core with its own ``error_model`` and
+    ``fastmath`` options (:func:`_declare`).
     """
     missing = [h for h in HOOKS if h not in functions]
     extra = [h for h in functions if h not in HOOKS]
     if missing or extra:
         raise TypeError(f"register({params_cls.__name__}): missing hooks {missing}, unknown hooks {extra}")
+    for fn in functions.values():
+        _declare(_options_key(fn))
     _MODELS[params_cls] = dict(functions)
     files = set()
     for fn in functions.values():
@@ -93,16 +100,35 @@ def registered(params_cls) -> bool:
     return params_cls in _MODELS
 
 
-def _hook(p, name):
+def _options_key(fn) -> tuple:
+    """``(error_model, fastmath)`` a hook was declared with (``njit`` options; defaults for a plain function)."""
+    opts = getattr(fn, "targetoptions", {}) or {}
+    fastmath = opts.get("fastmath", False)
+    if isinstance(fastmath, (set, frozenset, list, tuple)):
+        fastmath = frozenset(fastmath)
+    elif isinstance(fastmath, dict):
+        fastmath = frozenset(k for k, v in fastmath.items() if v)
+    else:
+        fastmath = bool(fastmath)
+    return str(opts.get("error_model", "python")), fastmath
+
+
+def _hook(p, name, key):
     if isinstance(p, ByRef):
         p = p.pointee
     if isinstance(p, types.BaseNamedTuple) and p.instance_class in _MODELS:
-        return _MODELS[p.instance_class][name].py_func
+        fn = _MODELS[p.instance_class][name]
+        if _options_key(fn) == key:
+            return fn.py_func
     return None
 
 
 # ---- stubs: the core calls these; numba resolves them per parameter type at compile time
 def rhs(t, x, u, m, p, dx, g):  # pragma: no cover - replaced by the overload
+    raise NotImplementedError
+
+
+def rhs_stage(t, x, u, m, p, dx, g):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
 
@@ -130,36 +156,42 @@ def jacobian(t, x, u, m, p, J):  # pragma: no cover
     raise NotImplementedError
 
 
-@overload(rhs, jit_options={"cache": True})
-def _ov_rhs(t, x, u, m, p, dx, g):
-    return _hook(p, "rhs")
+# ---- the overloads: one set per option key, each returning only the hooks declared with its options
+# (an overload compiles the function it returns with its own jit options, not with the options of the
+# ``njit`` the hook was declared with; without this a hook's error_model and fastmath were silently dropped)
+_DECLARED: set = set()
 
 
-@overload(outputs, jit_options={"cache": True})
-def _ov_outputs(t, x, u, m, p, y):
-    return _hook(p, "outputs")
+def _declare(key) -> None:
+    """Declare the stubs' overloads for hooks with options ``key`` = ``(error_model, fastmath)`` (once)."""
+    if key in _DECLARED:
+        return
+    _DECLARED.add(key)
+    error_model, fastmath = key
+    opts = {"cache": True, "error_model": error_model}
+    if fastmath:
+        opts["fastmath"] = set(fastmath) if isinstance(fastmath, frozenset) else True
+    for stub, hook in _STUBS:
+        # the stage call of Dormand-Prince: the right-hand side inlined by LLVM (docs/architecture.md).  Not
+        # cached on its own: numba's cache index keys a function by its source and signature, not by its
+        # options, so it would load the plain ``rhs`` compiled from the same source (or give it this one);
+        # the code is cached inside the entry points that inline it.
+        jit_options = dict(opts, forceinline=True, cache=False) if stub is rhs_stage else opts
+        overload(stub, jit_options=jit_options)(_typing(stub, hook, key))
 
 
-@overload(update, jit_options={"cache": True})
-def _ov_update(t, x, u, m, p, k, log):
-    return _hook(p, "update")
+def _typing(stub, hook, key):
+    """The overload's typing function for ``stub``: the hook ``hook`` of the model of ``p`` if declared with
+    options ``key`` (it carries the stub's signature, which numba compares with the hook's)."""
+    i_p = list(inspect.signature(stub).parameters).index("p")
+
+    @functools.wraps(stub)
+    def typing(*args):
+        return _hook(args[i_p], hook, key)
+
+    return typing
 
 
-@overload(restart, jit_options={"cache": True})
-def _ov_restart(t, x, u, m, p, log):
-    return _hook(p, "restart")
-
-
-@overload(accept, jit_options={"cache": True})
-def _ov_accept(t, x, u, m, p):
-    return _hook(p, "accept")
-
-
-@overload(next_break, jit_options={"cache": True})
-def _ov_next_break(t, m, p):
-    return _hook(p, "next_break")
-
-
-@overload(jacobian, jit_options={"cache": True})
-def _ov_jacobian(t, x, u, m, p, J):
-    return _hook(p, "jacobian")
+#: (stub, hook it resolves to)
+_STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
+          (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"))

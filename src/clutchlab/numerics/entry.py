@@ -4,7 +4,8 @@ The core's loops (:mod:`clutchlab.numerics.core`) are ``register_jitable``
 functions: they compile into whichever cached function calls them.  Each model
 (each parameter ``NamedTuple`` class and method) gets its own small module of
 cached entry points -- ``advance``, ``batch`` (``prange``, one solver per
-variant), ``evaluate``, ``evaluate_outputs``, ``outputs_at`` -- generated from
+variant, over parameters stacked along a variant axis), ``evaluate``,
+``evaluate_outputs``, ``outputs_at`` -- generated from
 one template (:data:`TEMPLATE`) into clutchlab's kernel folder and imported
 from there.  Why generated, per model:
 
@@ -48,6 +49,7 @@ import numba
 import numpy as np
 
 from clutchlab.numerics import core as _core
+from clutchlab.numerics.borrow import borrow as _borrow, byref as _byref, take as _take
 
 
 @numba.njit(cache=True, nogil=True)
@@ -56,9 +58,10 @@ def advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y,
 
 
 @numba.njit(cache=True, parallel=True)
-def batch(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
+def batch(P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
     nv = X0.shape[0]
     ns = ts.shape[0]
+    Pr = _byref(_borrow(P))  # (the parallel loop's gufunc cannot take nested tuples of arrays as arguments)
     for v in numba.prange(nv):
         x = X0[v].copy()
         m = M0[v].copy()
@@ -66,7 +69,7 @@ def batch(plist, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, 
         si = np.zeros(_core.N_SI, dtype=np.int64)
         log = _core.EventLog(EV_T[v], EV_C[v], EV_E[v], EV_N[v])
         rt = np.empty(ns)
-        _core._advance_{method}(plist[np.int64(v)], x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v],
+        _core._advance_{method}(_take(Pr, v), x, m, U[v], t_end, sf, si, opt, log, ts, rt, OUT_X[v],
                                 OUT_M[v], OUT_Y[v], want_y)
         for q in range(_core.N_SI):
             STATS[v, q] = si[q]

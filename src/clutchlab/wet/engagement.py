@@ -585,13 +585,13 @@ def simulate_batch(clutch: WetClutch, scenario: Scenario, variants: dict, *, ben
     ts = np.array([duration]) if sample_times is None else sample_grid(0.0, duration, None, sample_times)
     # the end time is always sampled (final state of each variant), then dropped if not asked for
     grid = ts if ts.size and ts[-1] >= duration else np.append(ts, duration)
-    systems = _variant_systems(base, vals, m)
-    res = run_batch(systems, duration, sample_times=grid, max_step=max_step, max_steps=max_steps, outputs=False)
+    batch = _variants(base, vals, m)
+    res = run_batch(batch, duration, sample_times=grid, max_step=max_step, max_steps=max_steps, outputs=False)
     final = res.states[:, -1, :]
-    work = np.array([s.params.data[:2] for s in systems]).reshape(m, 2)  # each variant's memories
+    work = batch.params.data[:, :W.N_WORK]  # each variant's memories
     status = np.asarray(res.status, dtype=int)
-    return BatchResult(vals, ts, res.states[:, :ts.size, :], work[:, W.W_LOCKUP], final[:, W.S_EF],
-                       work[:, W.W_PEAK], final[:, W.S_T], final[:, W.S_W],
+    return BatchResult(vals, ts, res.states[:, :ts.size, :], work[:, W.W_LOCKUP].copy(), final[:, W.S_EF],
+                       work[:, W.W_PEAK].copy(), final[:, W.S_T], final[:, W.S_W],
                        np.asarray(res.stats["accepted_steps"], dtype=int), status, result=res)
 
 
@@ -600,8 +600,10 @@ _PARAM_FIELDS = {"force_scale": "force_scale", "mu_scale": "mu_scale", "speed_sc
                  "total_inertia": "total_inertia", "k1": "k1", "k2": "k2", "fluid_temperature_c": "heater_setpoint"}
 
 
-def _variant_systems(base, vals: dict, m: int) -> list:
-    """One :class:`~clutchlab.system.System` per variant: its own constants, initial state and per-run buffer."""
+def _variants(base, vals: dict, m: int):
+    """The variants of a batch, stacked (:class:`~clutchlab.system.Variants`): constants, initial states, buffers."""
+    from ..system import Variants
+
     x0 = np.tile(base.x0, (m, 1))
     for k, v in vals.items():
         if k == "initial_slip_speed":
@@ -619,6 +621,7 @@ def _variant_systems(base, vals: dict, m: int) -> list:
             constants[_PARAM_FIELDS[k]] = v
     work = W.new_work(x0[:, W.S_T])
     piston_h0 = float(constants["piston_h0"][0])
-    m0 = np.stack([W.initial_modes(x, piston_h0) for x in x0]) if m else np.zeros((0, 3), np.int64)
-    return [base.variant(params=params, x0=x0[i], m0=m0[i])
-            for i, params in enumerate(W.batch_parameters(base.params, constants, work))]
+    m0 = W.initial_modes(x0, piston_h0)
+    return Variants(base, W.stacked_parameters(base.params, constants, work), x0, m0, np.tile(base.u0, (m, 1)))
+
+

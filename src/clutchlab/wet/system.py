@@ -80,7 +80,7 @@ from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque
 from .viscosity import viscosity_scalar
 
 __all__ = [
-    "WetParams", "pack_parameters", "fresh_buffers", "batch_parameters", "new_work", "engagement_system", "initial_state",
+    "WetParams", "pack_parameters", "fresh_buffers", "stacked_parameters", "new_work", "engagement_system", "initial_state",
     "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque",
     "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
 ]
@@ -682,8 +682,8 @@ def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) 
     return params._replace(constants=constants, data=data)
 
 
-def batch_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray) -> list:
-    """Parameters of the variants of a batch: each its own constants record, per-run buffer and tables.
+def stacked_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray) -> WetParams:
+    """Parameters of the variants of a batch, stacked (:class:`clutchlab.system.Variants`).
 
     Parameters
     ----------
@@ -696,19 +696,14 @@ def batch_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray)
 
     Returns
     -------
-    list of WetParams
-
-    Notes
-    -----
-    Every array a variant's hooks read is its own, so the reference counts
-    numba keeps on them are not contended between the threads of a parallel
-    batch.  (A record array is copied as raw bytes: NumPy copies structured
-    arrays field by field, five times slower.)
+    WetParams
+        ``constants`` of shape ``(m, 1)``, ``data`` ``(m, n)``: row ``v`` is variant ``v``'s, its
+        per-run buffer (lock-up time, peak temperature) written by the run.
     """
-    raw = np.ascontiguousarray(constants, dtype=CONSTANTS_DTYPE).view(np.uint8).reshape(len(constants), -1)
-    data = np.tile(params.data, (len(constants), 1))
+    m = len(constants)
+    data = np.tile(params.data, (m, 1))
     data[:, :N_WORK] = work
-    return [WetParams(raw[i].copy().view(CONSTANTS_DTYPE), data[i].copy()) for i in range(len(constants))]
+    return WetParams(np.ascontiguousarray(constants, dtype=CONSTANTS_DTYPE).reshape(m, 1), data)
 
 
 def peak_temperature(params: WetParams) -> float:
@@ -757,15 +752,16 @@ def initial_modes(x0, piston_h0: float) -> np.ndarray:
     Parameters
     ----------
     x0 : ndarray
-        Initial state.
+        Initial state, or initial states ``(m, n)`` (one row per variant: modes ``(m, 3)``).
     piston_h0 : float
         Piston position at zero separation [m] (Eq. 1).
     """
-    m = np.zeros(3, dtype=np.int64)
-    w = x0[S_W]
-    m[M_FRICTION] = SLIP if w > 0.0 else (SLIP_NEG if w < 0.0 else STICK)
-    m[M_PISTON] = AT_STOP if x0[S_X] <= 0.0 else FREE
-    m[M_FILM] = CONTACT if piston_h0 - x0[S_X] <= 0.0 else OPEN
+    x0 = np.asarray(x0, dtype=float)
+    m = np.zeros(x0.shape[:-1] + (3,), dtype=np.int64)
+    w = x0[..., S_W]
+    m[..., M_FRICTION] = np.where(w > 0.0, SLIP, np.where(w < 0.0, SLIP_NEG, STICK))
+    m[..., M_PISTON] = np.where(x0[..., S_X] <= 0.0, AT_STOP, FREE)
+    m[..., M_FILM] = np.where(piston_h0 - x0[..., S_X] <= 0.0, CONTACT, OPEN)
     return m
 
 
