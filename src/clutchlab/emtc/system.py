@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import ParameterError, SimulationError
 from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek_combined
 from ..numerics import FASTMATH, dispatch
-from ..numerics.borrow import borrow, byref
+from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
 from ..system import System, register_model
 from ._lookup import bilinear, interp1
@@ -467,7 +467,7 @@ def _controller(t, x, u, p):
     else:
         vx = x[0] / p.vehicle.axle_ratio * p.vehicle.tyre_radius
         t_ref = bilinear(_cold(p.cold, p.layout, L_MAP_THROTTLE), _cold(p.cold, p.layout, L_MAP_SPEED),
-                         _cold(p.cold, p.layout, L_MAP_TORQUE).reshape((p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
+                         shaped(_cold(p.cold, p.layout, L_MAP_TORQUE), (p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
     fm_req = commanded_magnet_force(t_ref, p.geometry, a, fmem[FM_SPLIT:FM_SPLIT + 3])
     clen = imem[IM_CLEN]
     stack = _cold(p.cold, p.layout, L_CTL_STACK)
@@ -475,9 +475,9 @@ def _controller(t, x, u, p):
         imem[IM_ERROR] = ERR_CONTROLLER_MEMORY  # reported by the next accepted step
         return
     n = p.n_ctl_cells
-    tables = _cold(p.cold, p.layout, L_CTL_TABLES).reshape((p.n_ctl_airgaps, n, n, 4))
+    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (p.n_ctl_airgaps, n, n, 4))
     grid = _cold(p.cold, p.layout, L_CTL_GRID)
-    prefix = _cold(p.cold, p.layout, L_CTL_PREFIX).reshape((p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
+    prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
     cidx = imem[IM_CIDX:IM_CIDX + 3]  # airgap weights at the engaged airgap d - sigma (set by pack_parameters)
     cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
@@ -576,7 +576,7 @@ def _rhs(t, x, u, m, p, dx, g):
         sl = 1.0 if m[2] == POSITIVE else -1.0
         if p.friction_mode == FRICTION_MAP:
             m1 = bilinear(_cold(p.cold, p.layout, L_FMAP_SPEED), _cold(p.cold, p.layout, L_FMAP_TEMP),
-                          _cold(p.cold, p.layout, L_FMAP_MU).reshape((p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
+                          shaped(_cold(p.cold, p.layout, L_FMAP_MU), (p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
             m2 = m1
             m3 = m1
         elif p.friction_mode == FRICTION_LUGRE:
