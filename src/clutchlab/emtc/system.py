@@ -770,7 +770,7 @@ def run_controller(p, t, x, u):
         p.imem[IM_KNEXT] = k + 1
 
 
-dispatch.register(EmtcParams, rhs=_rhs, outputs=_outputs, update=_update, restart=_restart, accept=_accept,
+dispatch.register(EmtcParams, inline_stages=True, rhs=_rhs, outputs=_outputs, update=_update, restart=_restart, accept=_accept,
                   next_break=_next_break, jacobian=_jacobian)
 
 

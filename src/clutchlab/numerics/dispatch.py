@@ -23,7 +23,8 @@ and the parameters ``p``):
 
 ``rhs(t, x, u, m, p, dx, g)``
     Right-hand side into ``dx`` and the switching functions into ``g``.
-    (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the same hook, inlined.)
+    (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the same hook, inlined
+    there for a model registered with ``inline_stages=True``.)
 ``outputs(t, x, u, m, p, y)``
     Output vector into ``y``.
 ``update(t, x, u, m, p, k, log)``
@@ -63,16 +64,23 @@ HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobia
 
 # parameter NamedTuple class -> {hook name: compiled function}
 _MODELS: dict = {}
+# parameter classes whose right-hand side is inlined into the Dormand-Prince stages
+_INLINE_STAGES: set = set()
 _SOURCES: dict = {}
 
 
-def register(params_cls, **functions) -> None:
+def register(params_cls, inline_stages: bool = False, **functions) -> None:
     """Register a model's compiled hooks for its parameter ``NamedTuple`` class.
 
     Every hook of :data:`HOOKS` must be given, as a ``numba.njit`` function.
     Registering the same class again replaces the hooks (a reloaded module).
     Each hook is compiled into the core with its own ``error_model`` and
-    ``fastmath`` options (:func:`_declare`).
+    ``fastmath`` options (:func:`_declare`).  ``inline_stages``: the
+    right-hand side is inlined (LLVM ``alwaysinline``) into the six stage
+    calls of a Dormand-Prince step: faster where the model's evaluation is
+    cheap against a call (the EMTC bench: 10 %), at the price of compiling
+    the right-hand side a second time (measured: several seconds for the
+    EMTC bench), so off by default.
     """
     missing = [h for h in HOOKS if h not in functions]
     extra = [h for h in functions if h not in HOOKS]
@@ -81,6 +89,10 @@ def register(params_cls, **functions) -> None:
     for fn in functions.values():
         _declare(_options_key(fn))
     _MODELS[params_cls] = dict(functions)
+    if inline_stages:
+        _INLINE_STAGES.add(params_cls)
+    else:
+        _INLINE_STAGES.discard(params_cls)
     files = set()
     for fn in functions.values():
         try:
@@ -172,21 +184,27 @@ def _declare(key) -> None:
     if fastmath:
         opts["fastmath"] = set(fastmath) if isinstance(fastmath, frozenset) else True
     for stub, hook in _STUBS:
-        # the stage call of Dormand-Prince: the right-hand side inlined by LLVM (docs/architecture.md).  Not
-        # cached on its own: numba's cache index keys a function by its source and signature, not by its
-        # options, so it would load the plain ``rhs`` compiled from the same source (or give it this one);
-        # the code is cached inside the entry points that inline it.
-        jit_options = dict(opts, forceinline=True, cache=False) if stub is rhs_stage else opts
-        overload(stub, jit_options=jit_options)(_typing(stub, hook, key))
+        overload(stub, jit_options=opts)(_typing(stub, hook, key, inline=False if stub is rhs_stage else None))
+    # the stage call of Dormand-Prince for the models registered with ``inline_stages``: the right-hand side
+    # inlined by LLVM (docs/architecture.md).  Not cached on its own: numba's cache index keys a function by
+    # its source and signature, not by its options, so it would load the plain ``rhs`` compiled from the same
+    # source (or give it this one); the code is cached inside the entry points that inline it.
+    overload(rhs_stage, jit_options=dict(opts, forceinline=True, cache=False))(
+        _typing(rhs_stage, "rhs", key, inline=True))
 
 
-def _typing(stub, hook, key):
+def _typing(stub, hook, key, inline=None):
     """The overload's typing function for ``stub``: the hook ``hook`` of the model of ``p`` if declared with
-    options ``key`` (it carries the stub's signature, which numba compares with the hook's)."""
+    options ``key`` (and, for ``inline`` True/False, if the model is/is not registered with
+    ``inline_stages``); it carries the stub's signature, which numba compares with the hook's."""
     i_p = list(inspect.signature(stub).parameters).index("p")
 
     @functools.wraps(stub)
     def typing(*args):
+        if inline is not None:
+            p = args[i_p].pointee if isinstance(args[i_p], ByRef) else args[i_p]
+            if (getattr(p, "instance_class", None) in _INLINE_STAGES) != inline:
+                return None
         return _hook(args[i_p], hook, key)
 
     return typing
