@@ -635,6 +635,8 @@ class Variants:
             if type(s.params) is not type(first.params) or s.x0.shape != first.x0.shape:
                 raise ParameterError("simulate_batch: all variants must be the same model with the same structure "
                                      f"(variant {i} differs from variant 0)")
+        check_allocation(len(systems), _nbytes(first.params) / 8, f"the parameters of {len(systems)} variants of "
+                         f"{first.name!r}, stacked")
         fields = []
         for k, name in enumerate(first.params._fields):
             layout = _field_layout(first.params[k])
@@ -652,6 +654,15 @@ class Variants:
     def params_of(self, v: int):
         """Variant ``v``'s parameter structure (views of the stacked arrays; numbers for number fields)."""
         return _row(self.params, v)
+
+
+def _nbytes(value) -> int:
+    """Bytes of the arrays and numbers of a parameter structure."""
+    if isinstance(value, np.ndarray):
+        return value.nbytes
+    if isinstance(value, tuple):
+        return sum(_nbytes(v) for v in value)
+    return 8
 
 
 def _row(stacked, v):
