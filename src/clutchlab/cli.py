@@ -63,12 +63,15 @@ def _demo(args) -> int:
     sections = []
     t0 = time.perf_counter()
     progress("the first run compiles numba kernels (about a minute on a fresh machine; cached afterwards)")
-    # the kernels of the last section compile in a second process while the first sections run
-    # (numba compiles one function at a time per process; clutchlab.warmup)
+    # the kernels of the later sections compile in background processes while the first section runs
+    # (numba compiles one function at a time per process; clutchlab.warmup).  One process per section even
+    # on two cores: the operating system shares the cores among the three compilations, which balances them
+    # better than any fixed split (measured on the 2-core machine, benchmarks/README.md)
     background = {}
     if (os.cpu_count() or 1) >= 2:
         from . import warmup
 
+        background["wet"] = warmup.start(["wet"])
         background["emtc"] = warmup.start(["emtc"])
     try:
         for name in DEMO_SECTIONS:

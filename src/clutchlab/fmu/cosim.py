@@ -519,21 +519,27 @@ class WetCoSimulation(CoSimulation):
         params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
         system = W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params, x0=x0,
                                      rtol=self.rtol)
+        # where each FMI output comes from, resolved once (a name lookup per output and step cost more
+        # than the integration of a 1 ms step)
+        self._sources = [(name, src[0], system.output_index(src[1]) if src[0] == "output"
+                          else system.state_index(src[1]) if src[0] == "state" else W.M_FRICTION)
+                         for name, _, _, src in self._table]
         self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000)
         self.simulation.set_inputs(self._inputs(u))
 
     def _outputs(self):
         sim = self.simulation
-        system = sim.system
         y = sim.outputs()
+        x = sim.x
+        m = sim.m
         out = {}
-        for name, _, _, src in self._table:
-            if src[0] == "output":
-                out[name] = float(y[system.output_index(src[1])])
-            elif src[0] == "state":
-                out[name] = float(sim.x[system.state_index(src[1])])
+        for name, kind, i in self._sources:
+            if kind == "output":
+                out[name] = float(y[i])
+            elif kind == "state":
+                out[name] = float(x[i])
             else:
-                out[name] = 1.0 if self.mode == 1 else 0.0
+                out[name] = 1.0 if m[i] == 1 else 0.0
         return out
 
     def initial_outputs(self, inputs: dict) -> dict:
@@ -566,11 +572,15 @@ class WetCoSimulation(CoSimulation):
         except SimulationError as exc:
             raise SimulationError(f"WetCoSimulation: between t = {t} and {t_end} s: {exc}") from None
         self.time = t_end
-        ev = self.simulation.events()
-        new = ev.iloc[self._n_events:]
-        self._n_events = len(ev)
-        self.events.extend(E.Event(float(tt), E.EVENT_KINDS[name]) for tt, name in zip(new["time_s"], new["event"])
-                           if name in E.EVENT_KINDS)
+        log = self.simulation.log
+        n = int(log.count[0])
+        if n > self._n_events:  # new events only (a DataFrame per step cost more than the step itself)
+            names = self.simulation.system.events
+            for i in range(self._n_events, n):
+                name = names[int(log.code[i])]
+                if name in E.EVENT_KINDS:
+                    self.events.append(E.Event(float(log.time[i]), E.EVENT_KINDS[name]))
+            self._n_events = n
         return self._outputs()
 
 

@@ -57,7 +57,7 @@ from numba.extending import overload
 
 from .borrow import ByRef
 
-__all__ = ["register", "registered", "hook_sources", "rhs", "rhs_stage", "outputs", "update", "restart", "accept",
+__all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "outputs", "update", "restart", "accept",
            "next_break", "jacobian"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
@@ -105,6 +105,11 @@ def register(params_cls, inline_stages: bool = False, **functions) -> None:
 def hook_sources(params_cls) -> list:
     """Source files of a model's registered hooks (part of the name of its compiled entry points)."""
     return list(_SOURCES.get(params_cls, ()))
+
+
+def inlines_stages(params_cls) -> bool:
+    """True if a model was registered with ``inline_stages`` (its right-hand side inlined into the stages)."""
+    return params_cls in _INLINE_STAGES
 
 
 def registered(params_cls) -> bool:

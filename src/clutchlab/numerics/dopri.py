@@ -35,7 +35,7 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, forceinline=True)
 def error_norm(err, y_old, y_new, rtol, atol):
     """RMS norm of the local error scaled by ``atol + rtol*max(|y_old|, |y_new|)`` (atol per state)."""
     s = 0.0
@@ -47,7 +47,7 @@ def error_norm(err, y_old, y_new, rtol, atol):
     return math.sqrt(s / n)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, forceinline=True)
 def next_step(h, err_norm, accepted_previous_rejected):
     """New step size from the error norm (order-5 controller, Hairer & Wanner II.4)."""
     if err_norm == 0.0:
