@@ -252,3 +252,43 @@ def test_batch_is_the_single_runs():
         np.testing.assert_equal(batch.lockup_time[v], single.lockup_time)  # NaN: no lock-up within 0.8 s
         assert batch.n_steps[v] == single.n_steps
     assert batch.result.states.shape == (2, 3, 12)  # the stacked SimulationResult also holds the end time
+
+
+def test_a_new_scenario_for_the_same_clutch_gives_the_run_built_from_scratch():
+    """Runs reuse the system of an earlier scenario for the same clutch, bench and friction law (a faster
+    build); the result must be the one of a system built from nothing, whatever the scenario changes
+    (drive mode, slip direction, profiles, temperatures)."""
+    from clutchlab.wet import engagement as E
+
+    clutch, bench, law = WetClutch.paper(), Bench(), ParametricFriction.bench_truth()
+    first = Scenario([0.0, 0.05], [0.0, 2500.0], [0.0], [0.0], duration=0.3, motor="free",
+                     initial_slip_speed=120.0)
+    others = [
+        Scenario([0.0, 0.02, 0.2], [0.0, 3000.0, 3000.0], [0.0], [0.0], duration=0.3, motor="free",
+                 initial_slip_speed=-90.0, initial_temperature_c=95.0, fluid_temperature_c=85.0),
+        EngagementProtocol(duration=0.3).scenario(clutch, "speed"),
+    ]
+    simulate(first, clutch=clutch, bench=bench, friction=law)
+    for sc in others:
+        reused = simulate(sc, clutch=clutch, bench=bench, friction=law)
+        E._RECENT.clear()
+        fresh = simulate(sc, clutch=clutch, bench=bench, friction=law)
+        assert reused.states.shape == fresh.states.shape
+        np.testing.assert_array_equal(reused.states, fresh.states)
+        np.testing.assert_array_equal(reused.outputs, fresh.outputs)
+        np.testing.assert_array_equal(reused.modes, fresh.modes)
+        assert list(reused.events.event) == list(fresh.events.event)
+        simulate(first, clutch=clutch, bench=bench, friction=law)  # the template again for the next case
+
+
+@pytest.mark.parametrize("w", [-3.0, 0.0, 2.0])
+@pytest.mark.parametrize("xp", [-1e-6, 0.0, 1e-4, CLUTCH.piston_h0, 2 * CLUTCH.piston_h0])
+def test_initial_modes_of_one_run_are_those_of_a_batch_row(w, xp):
+    x0 = np.zeros(len(W.STATES))
+    x0[W.S_W] = w
+    x0[W.S_X] = xp
+    one = W.initial_modes(x0, CLUTCH.piston_h0)
+    rows = W.initial_modes(np.vstack([x0, x0]), CLUTCH.piston_h0)
+    assert one.dtype == np.int64 and one.shape == (3,)
+    np.testing.assert_array_equal(one, rows[0])
+    assert one[W.M_FRICTION] == (W.SLIP if w > 0 else W.SLIP_NEG if w < 0 else W.STICK)

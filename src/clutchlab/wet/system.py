@@ -757,6 +757,10 @@ def initial_modes(x0, piston_h0: float) -> np.ndarray:
         Piston position at zero separation [m] (Eq. 1).
     """
     x0 = np.asarray(x0, dtype=float)
+    if x0.ndim == 1:  # one run (the same rules as below, without the array machinery)
+        w, xp = float(x0[S_W]), float(x0[S_X])
+        return np.array([SLIP if w > 0.0 else SLIP_NEG if w < 0.0 else STICK, AT_STOP if xp <= 0.0 else FREE,
+                         CONTACT if piston_h0 - xp <= 0.0 else OPEN], dtype=np.int64)
     m = np.zeros(x0.shape[:-1] + (3,), dtype=np.int64)
     w = x0[..., S_W]
     m[..., M_FRICTION] = np.where(w > 0.0, SLIP, np.where(w < 0.0, SLIP_NEG, STICK))
