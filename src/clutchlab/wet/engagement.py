@@ -411,7 +411,7 @@ def _run_system(clutch, scenario, bench, friction, rtol):
         system = hit
     else:
         if template is not None:
-            check_scenario(_default_bench() if bench is None else bench, scenario)
+            check_scenario(template.bench, scenario)
             params = W.pack_parameters(clutch, template.bench, scenario, friction)
             x0 = W.initial_state(scenario)
             system = template.system.variant(params=params, x0=x0, m0=W.initial_modes(x0, clutch.piston_h0))
