@@ -257,6 +257,11 @@ def test_memory_budget_setting(monkeypatch):
         monkeypatch.setenv(MEMORY_ENV, bad)
         with pytest.raises(ParameterError, match=MEMORY_ENV):
             memory_budget()
+    # a budget below 64 KiB is not meaningful: tables up to that size pass, larger ones are refused
+    monkeypatch.setenv(MEMORY_ENV, "1K")
+    assert check_allocation(100, 80, "x") == 64_000
+    with pytest.raises(ParameterError, match="memory budget of 1 KB"):
+        check_allocation(100, 82, "x")
     monkeypatch.delenv(MEMORY_ENV)
     assert memory_budget() > 0
     with pytest.raises(ParameterError, match="what: would need"):

@@ -192,7 +192,7 @@ class System:
         object.__setattr__(self, "states", variables(self.states))
         object.__setattr__(self, "outputs", variables(self.outputs))
         object.__setattr__(self, "inputs", variables(self.inputs))
-        self.state_columns, self.output_columns, self.input_columns, self._directions  # noqa: B018  (cached now)
+        self.state_columns, self.output_columns, self.input_columns, self._directions, self._option_memo  # noqa: B018
 
     @functools.cached_property
     def _jac_groups(self) -> np.ndarray:
@@ -255,11 +255,35 @@ class System:
         return new
 
     # ---- options of the core
+    @functools.cached_property
+    def _option_memo(self) -> dict:
+        """Options already built, by their arguments (shared with :meth:`variant` copies, which keep the tolerances)."""
+        return {}
+
     def options(self, *, rtol=None, atol=None, max_step=None, max_steps=1_000_000, first_step=None,
                 event_tol=None):
-        """The core's :class:`~clutchlab.numerics.core.Options` from this system's defaults and overrides."""
+        """The core's :class:`~clutchlab.numerics.core.Options` from this system's defaults and overrides.
+
+        Built once per set of arguments (without an ``atol`` array) and remembered: checking and
+        converting them was a tenth of a short run's time.
+        """
+        key = None
+        if atol is None:
+            key = (rtol, max_step, max_steps, first_step, event_tol)
+            try:
+                hit = self._option_memo.get(key)
+            except TypeError:  # an unhashable argument: checked (and refused) below
+                key = hit = None
+            if hit is not None:
+                return hit
         from .numerics.core import Options
 
+        opt = self._build_options(Options, rtol, atol, max_step, max_steps, first_step, event_tol)
+        if key is not None and len(self._option_memo) < 32:
+            self._option_memo[key] = opt
+        return opt
+
+    def _build_options(self, Options, rtol, atol, max_step, max_steps, first_step, event_tol):
         rtol = self.rtol if rtol is None else rtol
         if not (isinstance(rtol, (int, float, np.floating)) and 0.0 < float(rtol) < 1.0):
             raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
@@ -349,6 +373,26 @@ def _index(vars_, name, kind, model):
     raise ParameterError(f"{model}: unknown {kind} {name!r} (known: {known})")
 
 
+_CORE = None
+#: the statuses by code (calling the enum class costs a microsecond a run)
+_STATUS = {int(s): s for s in st.Status}
+#: the event log of a run without events (read-only, shared)
+_NO_EVENTS = (np.empty(0), np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64))
+for _a in _NO_EVENTS:
+    _a.setflags(write=False)
+
+
+def _numerics_core():
+    """The integrator core, imported on first use (``import clutchlab`` stays light; an import
+    statement in a function costs about 1.5 us a call, measured)."""
+    global _CORE
+    if _CORE is None:
+        from .numerics import core
+
+        _CORE = core
+    return _CORE
+
+
 def sample_grid(t0: float, t_end: float, output_step: float | None, sample_times=None):
     """Sample times of a run: ``sample_times`` as given, an ``output_step`` grid, or ``None`` (every step).
 
@@ -426,7 +470,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     -------
     SimulationResult
     """
-    from .numerics import core
+    core = _numerics_core()
 
     if not (isinstance(t_end, (int, float, np.floating)) and math.isfinite(t_end) and t_end > t0):
         raise ParameterError(f"t_end = {short_repr(t_end)}: must be finite and > t0 = {t0:g} s")
@@ -442,10 +486,11 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     advance = core.advance_rodas if system.method == "rodas" else core.advance_dopri
     if ts is not None:
         check_allocation(ts.size, nx + ny + nm + 1, f"{ts.size} samples of {system.name}")
+        # every recorded row is written whole (time, states, modes and, if asked, outputs)
         rt = np.empty(ts.size)
         rx = np.empty((ts.size, nx))
-        rm = np.zeros((ts.size, nm), dtype=np.int64)
-        ry = np.full((ts.size, ny), np.nan) if outputs else np.empty((1, ny))
+        rm = np.empty((ts.size, nm), dtype=np.int64)
+        ry = np.empty((ts.size if outputs else 1, ny))
         code = advance(system.params, x, m, u, float(t_end), sf, si, opt, log, ts, rt, rx, rm, ry, bool(outputs))
         n = int(si[core.SI_IREC])
         rt, rx, rm = rt[:n], rx[:n], rm[:n]
@@ -470,16 +515,19 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
         rx = np.concatenate([c[1] for c in chunks])
         rm = np.concatenate([c[2] for c in chunks])
         ry = np.concatenate([c[3] for c in chunks])
-    _check_status(system, int(code), si, float(sf[0]), check)
-    ne = int(log.count[0])
+    code = int(code)
+    t_final = float(sf[0])
+    _check_status(system, code, si, t_final, check)
+    counts = si.tolist()  # Python ints at once (an int() per NumPy element costs more)
+    ne, dropped = log.count.tolist()
     # the events DataFrame is built when it is first read (SimulationResult takes a callable)
-    events = functools.partial(system.events_frame, log.time[:ne].copy(), log.code[:ne].copy(),
-                               log.element[:ne].copy())
-    stats = {"accepted_steps": int(si[core.SI_ACCEPTED]), "rejected_steps": int(si[core.SI_REJECTED]),
-             "rhs_evaluations": int(si[core.SI_NRHS]), "jacobians": int(si[core.SI_NJAC]),
-             "events_dropped": int(log.count[1]), "final_state": x.copy(), "final_modes": m.copy(),
-             "final_time": float(sf[0])}
-    return SimulationResult(rt, rx, ry, rm, events, st.Status(int(code)), system.state_columns,
+    events = functools.partial(system.events_frame, *((log.time[:ne].copy(), log.code[:ne].copy(),
+                                                       log.element[:ne].copy()) if ne else _NO_EVENTS))
+    stats = {"accepted_steps": counts[core.SI_ACCEPTED], "rejected_steps": counts[core.SI_REJECTED],
+             "rhs_evaluations": counts[core.SI_NRHS], "jacobians": counts[core.SI_NJAC],
+             "events_dropped": dropped, "final_state": x, "final_modes": m,  # this run's own copies
+             "final_time": t_final}
+    return SimulationResult(rt, rx, ry, rm, events, _STATUS.get(code) or st.Status(code), system.state_columns,
                             system.output_columns, tuple(system.mode_names), tuple(system.mode_values), stats,
                             system.name)
 
@@ -498,7 +546,7 @@ class Simulation:
 
     def __init__(self, system: System, *, rtol=None, atol=None, max_step=None, max_steps: int = 100_000_000,
                  first_step=None, event_tol=None, t0: float = 0.0):
-        from .numerics import core
+        core = _numerics_core()
 
         self.system = system
         self._core = core
@@ -749,7 +797,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     SimulationResult
         Stacked: ``states[v, i, :]``; ``status`` one code per variant; events with a ``variant`` column.
     """
-    from .numerics import core
+    core = _numerics_core()
 
     given = None
     if isinstance(systems, Variants):
@@ -806,7 +854,7 @@ def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):
 
     Returns ``(dx, g, y)`` [SI].  Defaults: the initial state, inputs and modes.
     """
-    from .numerics import core
+    core = _numerics_core()
 
     x = system.x0.copy() if x is None else np.ascontiguousarray(x, dtype=float)
     u = system.u0.copy() if u is None else np.ascontiguousarray(u, dtype=float)

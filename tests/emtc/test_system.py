@@ -40,6 +40,12 @@ from clutchlab.system import simulate as core_simulate
 
 DATA = Path(__file__).with_name("data") / "regression_traces.npz"
 RTOL = 1e-6
+#: columns whose pre-port trace is itself this far off the converged solution (rtol 1e-10, steps of at most
+#: 20 us, measured 2026-11-25), as a fraction of the range: x_armature 1.8e-6 in ``slipping`` (a sample inside
+#: a 5 ms step, read off the dense output), i2 7.6e-7 and the magnet force 9.2e-7 in ``lock_unlock``.  The port
+#: at rtol 1e-6 is off the converged solution by 2.9e-6, 4.4e-7 and 5.4e-7 there; the two errors add.
+TRACE_TOL = {("slipping", "x_armature_m"): 6e-6, ("lock_unlock", "i2_A"): 2e-6, ("lock_unlock", "magnet_force_N"): 2e-6,
+             ("lock_unlock", "omega_f_rad_s"): 1e-5, ("lock_unlock", "omega_r_rad_s"): 1e-5}
 
 
 @pytest.fixture(scope="module")
@@ -77,9 +83,7 @@ def test_reproduces_the_pre_port_traces(magnet, name, scenario, kwargs):
     t_unlock = data[f"{name}_event_time"][-1]
     for q, col in enumerate(cols[1:], start=1):
         scale = np.max(np.abs(ref[:, q]))
-        tol = RTOL
-        if name == "lock_unlock" and col.startswith("omega"):
-            tol = 1e-5
+        tol = TRACE_TOL.get((name, col), RTOL)
         rows = slice(None)
         if name == "lugre" and col == "coupling_torque_Nm":
             rows = ref[:, 0] < t_unlock

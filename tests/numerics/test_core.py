@@ -65,6 +65,34 @@ def test_observed_order_of_convergence(method, order):
         assert order - 0.4 < s < order + 0.8, slopes
 
 
+def _dense_errors(hs):
+    """Largest error of samples half-way between fixed steps h (dense output), and of the located root of
+    sin(t) at pi (an event on the dense output), against the closed forms."""
+    dense, event = [], []
+    for h in hs:
+        ts = (np.arange(int(round(2.0 / h))) + 0.5) * h
+        res = simulate(toys.linear_system(OSC, [1.0, 0.0]), 2.0, rtol=0.5, atol=1e3, max_step=h, first_step=h,
+                       sample_times=ts)
+        dense.append(np.max(np.abs(res.states[:, 0] - np.cos(res.time))))
+        res = simulate(toys.sine_system(), 4.0, rtol=0.5, atol=1e3, max_step=2 * h, first_step=2 * h,
+                       output_step=4.0)
+        event.append(abs(res.events.time_s.iloc[0] - math.pi))
+    return dense, event
+
+
+def test_dense_output_and_events_have_the_order_of_the_steps():
+    """Dormand-Prince's continuous extension is of order 4 (local error h^5, as the step's global error):
+    samples between steps and event times converge at order 5 together with the steps.  The cubic Hermite
+    interpolant alone converges at order 4 (measured 4.00 here) and put sampled wet-clutch results 1e-7
+    off at rtol 1e-11."""
+    hs = [0.1, 0.05, 0.025]
+    dense, event = _dense_errors(hs)
+    for errs in (dense, event):
+        slopes = [math.log(errs[i] / errs[i + 1]) / math.log(2.0) for i in range(len(hs) - 1)]
+        assert all(4.6 < s < 5.8 for s in slopes), (errs, slopes)
+    assert dense[0] < 1e-8 and event[0] < 1e-7
+
+
 def test_rodas_is_stable_on_a_stiff_system_with_large_steps():
     """x0' = -1e6 x0, x1' = -x1: Rodas3 takes steps far beyond the explicit stability limit (2.8e-6 s)."""
     a = [[-1e6, 0.0], [0.0, -1.0]]

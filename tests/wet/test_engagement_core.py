@@ -127,10 +127,12 @@ def dyno_reference():
 
 
 def test_lockup_time_converges_to_an_independent_solution(dyno_reference):
+    """The lock-up error shrinks with the tolerance.  Between neighbouring tolerances it need not (measured:
+    1.2e-6 s at rtol 1e-6, 5.4e-6 s at 1e-7), so the worst error of each pair of decades is compared."""
     scen, ref = dyno_reference
     assert set(ref) == {"leave", "contact", "lock"}
     errors = {}
-    for rtol in (1e-6, 1e-8, 1e-10):
+    for rtol in (1e-6, 1e-7, 1e-8, 1e-9, 1e-10):
         res = simulate(scen, 0.7, clutch=CLUTCH, bench=BENCH, friction=TRUTH, rtol=rtol)
         ev = res.events
         t = {name: float(ev.time_s[ev.event == name].iloc[0])
@@ -139,7 +141,8 @@ def test_lockup_time_converges_to_an_independent_solution(dyno_reference):
         if rtol == 1e-10:
             assert abs(t["piston_leaves_stop"] - ref["leave"]) < 1e-7
             assert abs(t["contact"] - ref["contact"]) < 1e-6
-    assert errors[1e-8] < errors[1e-6] / 10 and errors[1e-10] < errors[1e-8]
+    loose, mid = max(errors[1e-6], errors[1e-7]), max(errors[1e-8], errors[1e-9])
+    assert mid < loose / 10 and errors[1e-10] < mid
     assert errors[1e-10] < 1e-6
 
 
@@ -292,3 +295,105 @@ def test_initial_modes_of_one_run_are_those_of_a_batch_row(w, xp):
     assert one.dtype == np.int64 and one.shape == (3,)
     np.testing.assert_array_equal(one, rows[0])
     assert one[W.M_FRICTION] == (W.SLIP if w > 0 else W.SLIP_NEG if w < 0 else W.STICK)
+
+
+# ----------------------------------------------------------------- a new scenario on a packed clutch/bench/law
+def _profile_strategy(draw, st, low, high):
+    n = draw(st.integers(1, 24))  # both sides of the short-profile path of Scenario (16 points)
+    steps = draw(st.lists(st.floats(1e-3, 0.05), min_size=n, max_size=n))
+    times = np.cumsum([0.0] + steps[:-1]) - draw(st.floats(0.0, 0.01))
+    values = draw(st.lists(st.floats(low, high), min_size=n, max_size=n))
+    return times, np.array(values)
+
+
+def _scenario_strategy():
+    from hypothesis import strategies as st
+
+    @st.composite
+    def scenarios(draw):
+        ft, fv = _profile_strategy(draw, st, 0.0, 3000.0)
+        stt, sv = _profile_strategy(draw, st, -150.0, 150.0)
+        return Scenario(ft, fv, stt, sv, duration=draw(st.floats(0.05, 1.0)),
+                        motor=draw(st.sampled_from(["speed", "free"])),
+                        initial_slip_speed=draw(st.floats(-100.0, 100.0)),
+                        initial_temperature_c=draw(st.floats(20.0, 120.0)),
+                        fluid_temperature_c=draw(st.floats(20.0, 120.0)),
+                        heater_setpoint_c=draw(st.one_of(st.none(), st.floats(20.0, 120.0))))
+
+    return scenarios()
+
+
+def _map_law():
+    from clutchlab.wet.friction import FrictionMap
+
+    speeds, temps, forces = np.array([0.0, 0.5, 2.0]), np.array([40.0, 80.0]), np.array([500.0, 2000.0, 4000.0])
+    shape = (forces.size, temps.size, speeds.size)
+    values = 0.1 + 0.01 * np.arange(np.prod(shape)).reshape(shape)
+    return FrictionMap(speeds, temps, values, force_grid=forces)
+
+
+def _assert_same_params(a, b):
+    assert a.constants.dtype == b.constants.dtype and a.constants.shape == b.constants.shape
+    for name in W.CONSTANTS_DTYPE.names:
+        assert a.constants[name][0] == b.constants[name][0] or (
+            np.isnan(a.constants[name][0]) and np.isnan(b.constants[name][0])), name
+    np.testing.assert_array_equal(a.data, b.data)
+
+
+def test_with_scenario_packs_what_pack_parameters_packs():
+    """The fast repacking for a new scenario must give exactly the full packing of that scenario, for profiles
+    of any length (the friction law moves in ``data``) and both kinds of friction law."""
+    from hypothesis import given, settings
+
+    from hypothesis_budget import examples
+
+    bench = Bench()
+
+    @settings(max_examples=examples(60), deadline=None)
+    @given(_scenario_strategy(), _scenario_strategy())
+    def check(first, second):
+        for law in (ParametricFriction.bench_truth(), _map_law()):
+            packed = W.pack_parameters(CLUTCH, bench, first, law)
+            packed.data[W.W_PEAK] = 999.0  # the buffer of a finished run: must not carry over
+            packed.data[W.W_LOCKUP] = 0.1
+            _assert_same_params(W.with_scenario(packed, second), W.pack_parameters(CLUTCH, bench, second, law))
+
+    check()
+
+
+def test_the_same_scenario_twice_starts_from_fresh_buffers():
+    """The second run of one scenario object reuses its system; its peak temperature and lock-up time must be
+    its own, equal to the first run's (the first run wrote them into the shared packing)."""
+    clutch, bench, law = WetClutch.paper(), Bench(), ParametricFriction.bench_truth()
+    sc = Scenario([0.0, 0.05], [0.0, 3000.0], [0.0], [0.0], duration=0.5, motor="free", initial_slip_speed=60.0)
+    other = Scenario([0.0, 0.05], [0.0, 1500.0], [0.0], [0.0], duration=0.5, motor="free", initial_slip_speed=90.0)
+    a = simulate_engagement(clutch, sc, bench=bench, friction=law)
+    b = simulate_engagement(clutch, sc, bench=bench, friction=law)
+    simulate_engagement(clutch, other, bench=bench, friction=law)
+    c = simulate_engagement(clutch, sc, bench=bench, friction=law)  # rebuilt from the other's
+    assert 0.2 < a.lockup_time < 0.5 and a.peak_temperature_c > 81.0
+    for r in (b, c):
+        assert r.lockup_time == a.lockup_time and r.peak_temperature_c == a.peak_temperature_c
+        np.testing.assert_array_equal(r.states, a.states)
+    from clutchlab.wet import engagement as E
+
+    again = E._run_system(clutch, sc, bench, law, 1e-7)  # what the next run of ``sc`` starts from
+    assert math.isnan(W.lockup_time(again.params)) and W.peak_temperature(again.params) == sc.initial_temperature_c
+
+
+@pytest.mark.parametrize("n", [2, 16, 17, 40])
+def test_scenario_refuses_bad_profiles_on_both_paths(n):
+    """Short profiles are checked with Python floats, long ones with NumPy: the same refusals either way."""
+    from clutchlab.errors import ParameterError
+
+    t = np.linspace(0.0, 1.0, n)
+    v = np.full(n, 100.0)
+    Scenario(t, v, t, v, duration=1.0)  # valid
+    for bad_t, bad_v, match in ((np.where(np.arange(n) == n - 1, np.nan, t), v, "non-finite"),
+                                (t, np.where(np.arange(n) == 1, np.inf, v), "non-finite"),
+                                (np.where(np.arange(n) == n - 1, t[0], t), v, "strictly increasing"),
+                                (np.where(np.arange(n) == 1, t[0], t), v, "strictly increasing")):
+        with pytest.raises(ParameterError, match=match):
+            Scenario(bad_t, bad_v, t, v, duration=1.0)
+        with pytest.raises(ParameterError, match=match):
+            Scenario(t, v, bad_t, bad_v, duration=1.0)

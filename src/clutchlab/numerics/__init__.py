@@ -1,16 +1,18 @@
-"""Compiled numerical building blocks shared by the subsystem kernels.
+"""The integrator core and its compiled building blocks.
 
-numba cannot cache a kernel that receives another compiled function as an
-argument (the dispatcher type is new in every process), so each subsystem
-writes its own integration loop around its own right-hand side and uses the
-cached pieces here: the Dormand-Prince 5(4) tableau, the error norm, the step
-controller and the dense-output interpolant used to locate events.
+:mod:`clutchlab.numerics.core` holds the one hybrid integrator every model runs on
+(Dormand-Prince 5(4) and Rodas3 with events, resumable stepping and the batch
+runner, ``docs/architecture.md``); :mod:`~clutchlab.numerics.dispatch` registers
+a model's compiled hooks and :mod:`~clutchlab.numerics.entry` generates its cached
+entry points.  The pieces exported here: the Dormand-Prince tableau's error norm,
+step controller, dense output (cubic Hermite and its order-4 term) and the
+first step; a grid bracketing helper.
 """
 
-from .dopri import dense_hermite, error_norm, initial_step, next_step
+from .dopri import dense_correction, dense_hermite, error_norm, initial_step, next_step
 from .interp import bracket
 
-__all__ = ["error_norm", "next_step", "dense_hermite", "initial_step", "bracket", "FASTMATH"]
+__all__ = ["error_norm", "next_step", "dense_hermite", "dense_correction", "initial_step", "bracket", "FASTMATH"]
 
 #: LLVM fast-math flags for the hot kernels: reassociation, contraction (FMA), reciprocal and
 #: approximate functions, no signed zeros -- but *not* 'nnan'/'ninf', so NaN and infinity checks

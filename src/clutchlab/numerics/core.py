@@ -63,7 +63,7 @@ from .borrow import borrow, byref
 from .dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
-    dense_hermite, error_norm, initial_step, next_step,
+    dense_correction, dense_hermite, error_norm, initial_step, next_step,
 )
 from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
                          C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
@@ -194,16 +194,22 @@ def _store(rec_t, rec_x, rec_m, i, t, x, m):
 
 
 @numba.njit(cache=True, nogil=True, forceinline=True)
-def _dense(theta, h, x0, f0, x1, f1, mass, out):
-    """Cubic Hermite dense output; linear in the algebraic rows (``mass`` = 0); the step end itself at ``theta`` = 1."""
+def _dense(theta, h, x0, f0, x1, f1, rc, mass, out):
+    """Dense output: cubic Hermite plus ``theta^2 (1 - theta)^2 rc`` (Dormand-Prince's order-4 term,
+    :func:`~clutchlab.numerics.dopri.dense_correction`; zeros for Rodas3, whose order is 3); linear in the
+    algebraic rows (``mass`` = 0); the step end itself at ``theta`` = 1."""
     if theta == 1.0:
         for i in range(x0.shape[0]):
             out[i] = x1[i]
         return
     dense_hermite(theta, h, x0, f0, x1, f1, out)
+    w = theta * (1.0 - theta)
+    w = w * w
     for i in range(x0.shape[0]):
         if mass[i] == 0.0:
             out[i] = x0[i] + theta * (x1[i] - x0[i])
+        else:
+            out[i] += w * rc[i]
 
 
 @register_jitable(inline="always")
@@ -220,7 +226,7 @@ def _may_cross(g0, g1, gdir):
 
 
 @register_jitable
-def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga):
+def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga):
     """Earliest root of the crossed switching functions on the dense output of the step.
 
     Illinois iteration per crossed function on the step fraction; returns
@@ -241,7 +247,7 @@ def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe
         ga[k] = g0[k]
         if g0[k] == 0.0 and g1[k] != 0.0:
             if not probed:
-                _dense(th0, h, x0, f0, x1, f1, mass, xe)
+                _dense(th0, h, x0, f0, x1, f1, rc, mass, xe)
                 model.rhs(t + th0 * h, xe, u, m, p, fe, ge)
                 n_rhs += 1
                 probed = True
@@ -254,7 +260,7 @@ def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe
         glo = ga[k]
         if hi < 1.0:
             # an earlier root is known: only look before it
-            _dense(hi, h, x0, f0, x1, f1, mass, xe)
+            _dense(hi, h, x0, f0, x1, f1, rc, mass, xe)
             model.rhs(t + hi * h, xe, u, m, p, fe, ge)
             n_rhs += 1
             if not _crossed(glo, ge[k], gdir[k]):
@@ -272,7 +278,7 @@ def _locate(p, t, h, x0, f0, x1, f1, u, m, g0, g1, gdir, mass, event_tol, xe, fe
                 th = 0.5 * (lo + hi)
             span = hi - lo
             th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
-            _dense(th, h, x0, f0, x1, f1, mass, xe)
+            _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
             model.rhs(t + th * h, xe, u, m, p, fe, ge)
             n_rhs += 1
             if _crossed(ga[k], ge[k], gdir[k]):
@@ -325,12 +331,12 @@ def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
 
 
 @register_jitable(forceinline=True)
-def _record_dense(p, t, h, x0, f0, x1, f1, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, xe,
-                  i_rec):
+def _record_dense(p, t, h, x0, f0, x1, f1, rc, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb,
+                  xe, i_rec):
     """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index."""
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
         th = (ts[i_rec] - t) / h if h > 0.0 else 1.0
-        _dense(th, h, x0, f0, x1, f1, mass, xe)
+        _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
         if want_y:
             model.outputs(ts[i_rec], xe, u, m, p, yb)
@@ -418,6 +424,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     xe = np.empty(n)
     fe = np.empty(n)
     err = np.empty(n)
+    rc = np.empty(n)
     g0 = np.empty(ng)
     g1 = np.empty(ng)
     ge = np.empty(ng)
@@ -425,8 +432,8 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     yb = np.empty(rec_y.shape[1])
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_c)
-    K, xt, xn, xe, fe, err, g0, g1, ge, ga, yb, tab_c = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, yb, tab_c)
+    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, yb, tab_c = borrow(owners)
     k1 = K[0]
     k2 = K[1]
     k3 = K[2]
@@ -512,11 +519,17 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 h = next_step(h, en, False)
             prev_rej = True
             continue
-        # ---- events on the dense output
+        # ---- events on the dense output (its order-4 term only where it is read)
+        samples = grid and i_rec < ts.shape[0] and ts[i_rec] <= t1
         if _may_cross(g0, g1, opt.gdir):
-            theta, nr = _locate(p, t, h, x, k1, xn, k7, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge, ga)
+            dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
+            samples = grid
+            theta, nr = _locate(p, t, h, x, k1, xn, k7, rc, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge,
+                                ga)
         else:
             theta, nr = 2.0, 0
+            if samples:
+                dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
         si[SI_NRHS] += nr
         if theta <= 1.0:
             t_new = t + theta * h
@@ -525,12 +538,12 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         else:
             t_new = t + h
         # ---- samples in (t, t_new] on the dense output (modes of the step; the test here saves a call per step)
-        if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-            i_rec = _record_dense(p, t, h, x, k1, xn, k7, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
-                                  yb, xe, i_rec)
+        if samples and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
+            i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                                  want_y, yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
         if theta <= 1.0:
-            _dense(theta, h, x, k1, xn, k7, mass, xe)
+            _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
             for i in range(n):
                 x[i] = xe[i]
             t = t_new
@@ -703,9 +716,11 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     err = np.empty(n)
     dls = np.empty(n)
     yb = np.empty(rec_y.shape[1])
+    rc0 = np.zeros(n)  # no order-4 term in the dense output: Rodas3 is of order 3
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb)
-    f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb = borrow(owners)
+    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb, rc0)
+    (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
+     rc0) = borrow(owners)
     t = sf[SF_T]
     h = sf[SF_H]
     status = SUCCESS
@@ -780,7 +795,8 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         model.rhs(t + h, x1, u, m, p, f1, g1)
         si[SI_NRHS] += 1
         if _may_cross(g0, g1, opt.gdir):
-            theta, nr = _locate(p, t, h, x, f0, x1, f1, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp, ga)
+            theta, nr = _locate(p, t, h, x, f0, x1, f1, rc0, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp,
+                                ga)
         else:
             theta, nr = 2.0, 0
         si[SI_NRHS] += nr
@@ -809,7 +825,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if hit_stop and not event:
             t_new = t_stop
         if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-            i_rec = _record_dense(p, t, h_acc, x, f0, x1, f1, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+            i_rec = _record_dense(p, t, h_acc, x, f0, x1, f1, rc0, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
                                   want_y, yb, xe, i_rec)
         si[SI_ACCEPTED] += 1
         for i in range(n):

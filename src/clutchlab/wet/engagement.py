@@ -63,6 +63,7 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..result import BuiltOnFirstAccess, SimulationResult
+from ..system import simulate as run
 from . import system as W
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
@@ -102,9 +103,16 @@ def _profile(name, t, v):
     v = np.array(v, dtype=float).ravel()
     if t.size < 1 or t.size != v.size:
         raise ParameterError(f"Scenario.{name}: time and value need the same, non-zero length ({t.size} vs {v.size})")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+    if t.size <= 16:  # short profiles (most): Python floats beat NumPy's reductions (measured 5 -> 2 us)
+        tl = t.tolist()
+        finite = all(map(math.isfinite, tl)) and all(map(math.isfinite, v.tolist()))
+        increasing = all(a < b for a, b in zip(tl, tl[1:]))
+    else:
+        finite = np.isfinite(t).all() and np.isfinite(v).all()
+        increasing = (t[1:] > t[:-1]).all()
+    if not finite:
         raise ParameterError(f"Scenario.{name}: non-finite breakpoint")
-    if t.size > 1 and np.any(np.diff(t) <= 0):
+    if not increasing:
         raise ParameterError(f"Scenario.{name}: breakpoint times must be strictly increasing")
     return t, v
 
@@ -151,7 +159,7 @@ class Scenario:
         st, sv = _profile("speed", self.speed_time, self.speed_value)
         for arr in (ft, fv, st, sv):
             arr.setflags(write=False)  # a frozen scenario: its profiles cannot change under a cached model
-        if np.any(fv < 0):
+        if fv.min() < 0:
             raise ParameterError(f"Scenario.force_value: negative force {short_repr(fv[fv < 0][0])} [N]")
         object.__setattr__(self, "force_time", ft)
         object.__setattr__(self, "force_value", fv)
@@ -187,12 +195,12 @@ def check_scenario(bench: Bench, scenario: Scenario) -> None:
         or a force reference above the actuator's.
     """
     if scenario.motor == "speed":
-        top = float(np.max(np.abs(scenario.speed_value)))
+        top = float(np.abs(scenario.speed_value).max())
         if top > bench.drive_speed_max:
             raise ParameterError(
                 f"Scenario.speed_value: {top:.6g} rad/s exceeds the bench's speed limit {bench.drive_speed_max:.6g} rad/s "
                 f"(motor 6000 rpm through the 1:{bench.gear_ratio:g} gear)")
-    if float(np.max(scenario.force_value)) > bench.actuator_force_max * (1 + 1e-12):
+    if float(scenario.force_value.max()) > bench.actuator_force_max * (1 + 1e-12):
         raise ParameterError(f"Scenario.force_value: {np.max(scenario.force_value):.6g} N exceeds the actuator's "
                              f"{bench.actuator_force_max:.6g} N")
 
@@ -384,62 +392,61 @@ def _sample_times(duration, sample_rate, sample_times):
     return np.arange(n) / sample_rate
 
 
-#: recently built systems by the identity of their (immutable) inputs: repeated runs skip the packing
+#: systems built recently, one entry per (clutch, bench, friction law, rtol) by identity: later runs skip the packing
 _RECENT: "collections.OrderedDict" = collections.OrderedDict()
 _RECENT_SIZE = 16
 _RECENT_LOCK = threading.Lock()
 
 
+class _Recent:
+    """The system built for one clutch, bench and law (``base``) and the one of the last scenario run with them."""
+
+    __slots__ = ("clutch", "bench_given", "friction", "bench", "base", "last")
+
+    def __init__(self, clutch, bench_given, friction, bench, system, scenario):
+        self.clutch, self.bench_given, self.friction, self.bench = clutch, bench_given, friction, bench
+        self.base = system
+        self.last = (scenario, system)  # replaced whole (one assignment: threads read a consistent pair)
+
+
 def _run_system(clutch, scenario, bench, friction, rtol):
     """The system of one run with its own per-run buffers; the packing is reused for the same inputs.
 
-    Clutch, bench, scenario and a parametric friction law are frozen, so the
+    Clutch, bench, scenario and a parametric friction law are frozen, so a
     system built for the same objects is still right; a friction map is
-    mutable, so a run with one always packs afresh.
+    mutable, so a run with one always packs afresh.  A new scenario for a
+    known clutch, bench and law takes the known system with this scenario's
+    parameters and initial values (:func:`~clutchlab.wet.system.with_scenario`):
+    names, tolerances and checks stay.  Measured: building the system again
+    was a third of a short run's time (benchmarks/README.md, "fresh scenario").
     """
-    inputs = (clutch, scenario, bench, friction)
-    cacheable = friction is None or isinstance(friction, ParametricFriction)
-    key = (*map(id, inputs), float(rtol))
-    # a new scenario for the same clutch, bench and friction law: the system of an earlier one with this
-    # scenario's parameters and initial values (names, tolerances and checks stay; measured: building the
-    # System again was a third of a short run's time, benchmarks/README.md)
-    base = ("base", id(clutch), id(bench), id(friction), float(rtol))
+    if not (friction is None or isinstance(friction, ParametricFriction)) \
+            or not isinstance(rtol, (int, float, np.floating)):
+        return _system(clutch, scenario, bench, friction, rtol)  # (a bad rtol is refused there)
+    key = (id(clutch), id(bench), id(friction), float(rtol))
     with _RECENT_LOCK:
-        hit = _recent(key, inputs) if cacheable else None
-        template = _recent(base, (clutch, bench, friction)) if cacheable and hit is None else None
-    if hit is not None:
-        system = hit
-    else:
-        if template is not None:
-            check_scenario(template.bench, scenario)
-            params = W.pack_parameters(clutch, template.bench, scenario, friction)
-            x0 = W.initial_state(scenario)
-            system = template.system.variant(params=params, x0=x0, m0=W.initial_modes(x0, clutch.piston_h0))
+        entry = _RECENT.get(key)
+        if entry is not None and entry.clutch is clutch and entry.bench_given is bench and entry.friction is friction:
+            _RECENT.move_to_end(key)
         else:
-            system = _system(clutch, scenario, bench, friction, rtol)
-        if cacheable:
-            with _RECENT_LOCK:
-                _RECENT[key] = (inputs, system)
-                if template is None:
-                    _RECENT[base] = ((clutch, bench, friction),
-                                     _Template(system, _default_bench() if bench is None else bench))
-                while len(_RECENT) > _RECENT_SIZE:
-                    _RECENT.popitem(last=False)
-    return system.variant(params=W.fresh_buffers(system.params, scenario.initial_temperature_c))
-
-
-class _Template(NamedTuple):
-    system: object
-    bench: Bench
-
-
-def _recent(key, inputs):
-    """The remembered entry for ``key`` if it was built for these very objects (call with the lock held)."""
-    hit = _RECENT.get(key)
-    if hit is None or not all(a is b for a, b in zip(hit[0], inputs)):
-        return None
-    _RECENT.move_to_end(key)
-    return hit[1]
+            entry = None
+    if entry is None:
+        system = _system(clutch, scenario, bench, friction, rtol)
+        with _RECENT_LOCK:
+            _RECENT[key] = _Recent(clutch, bench, friction, _default_bench() if bench is None else bench, system,
+                                   scenario)
+            while len(_RECENT) > _RECENT_SIZE:
+                _RECENT.popitem(last=False)
+        return system
+    last_scenario, last = entry.last
+    if last_scenario is scenario:  # the system's buffers were written by that run: fresh ones
+        return last.variant(params=W.fresh_buffers(last.params, scenario.initial_temperature_c))
+    check_scenario(entry.bench, scenario)
+    x0 = W.initial_state(scenario)
+    system = entry.base.variant(params=W.with_scenario(entry.base.params, scenario), x0=x0,
+                                m0=W.initial_modes(x0, clutch.piston_h0))
+    entry.last = (scenario, system)
+    return system
 
 
 def _system(clutch, scenario, bench, friction, rtol):
@@ -493,8 +500,6 @@ def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutc
     SimulationError
         Step limit reached or step-size underflow.
     """
-    from ..system import simulate as run
-
     clutch = WetClutch.paper() if clutch is None else clutch
     t_end = scenario.duration if t_end is None else t_end
     return run(_run_system(clutch, scenario, bench, friction, rtol), t_end, atol=atol, max_step=max_step,
@@ -548,8 +553,6 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     SimulationError
         Step limit reached or step size underflow.
     """
-    from ..system import simulate as run
-
     sysm = _run_system(clutch, scenario, bench, friction, rtol)
     ts = _sample_times(scenario.duration, sample_rate, sample_times)
     res = run(sysm, float(scenario.duration), max_step=max_step, max_steps=max_steps, sample_times=ts,
