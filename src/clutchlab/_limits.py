@@ -132,6 +132,31 @@ def check_allocation(rows, columns, what: str, *, itemsize: int = 8) -> int:
     return int(need)
 
 
+def check_number(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
+    """``value`` as a finite float, or a :class:`ParameterError` naming ``name`` and the value.
+
+    Parameters
+    ----------
+    name : str
+        What the value is, as the message should say it (``"clutch1: fn_max"``).
+    value : object
+        The value given.
+    positive, nonnegative : bool
+        Also require ``> 0`` or ``>= 0``.
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} = {value!r} is not a number") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{name} = {value!r} is not finite")
+    if positive and not v > 0:
+        raise ParameterError(f"{name} = {value!r} must be > 0")
+    if nonnegative and v < 0:
+        raise ParameterError(f"{name} = {value!r} must be >= 0")
+    return v
+
+
 def short_repr(value, limit: int = 60) -> str:
     """A representation of ``value`` of at most about ``limit`` characters.
 

@@ -26,6 +26,7 @@ SUBSYSTEM_CLIS = (
     "clutchlab.eclutch.cli",
     "clutchlab.wet.cli",
     "clutchlab.emtc.cli",
+    "clutchlab.driveline.cli",  # clutchlab driveline simulate|describe
     "clutchlab.params.cli",  # clutchlab params show|check
     "clutchlab.fmu.cli",  # clutchlab export-fmu
     "clutchlab.sweep.cli",  # clutchlab sweep

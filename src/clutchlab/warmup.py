@@ -5,7 +5,7 @@ clutchlab's kernels are compiled on first use and cached on disk (numba's
 :func:`clutchlab.numerics.entry.kernel_dir`).  numba compiles one function at a
 time in a process (a global compiler lock), so on a fresh machine the first run
 of the demo spends most of its time compiling, on one core.  The kernels of the
-three models are independent: compiling each group in its own process uses every
+models are independent: compiling each group in its own process uses every
 core, and the processes share the cache on disk (numba writes its files
 atomically), so the process that runs the model later loads them.
 
@@ -59,8 +59,19 @@ def _warm_emtc() -> None:
     simulate_bench(model, BenchScenario(duration=0.01), controller_model=model)
 
 
+def _warm_driveline() -> None:
+    from .driveline import Driveline, Signal
+
+    d = Driveline("warmup")
+    d.inertia("J1", J=1.0, w0=1.0).inertia("J2", J=1.0)
+    d.torque("T", "J1", Signal.sine(1.0, 5.0))
+    d.clutch("c", "J1", "J2", fn_max=1.0, normal=Signal.step(1.0, 0.01))
+    d.spring_damper("k", "J2", None, c=1.0, d=0.1)
+    d.simulate(0.02, output_step=0.01)
+
+
 #: compile groups: name -> function that runs the group's kernels once on a tiny problem
-GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc}
+GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "driveline": _warm_driveline}
 
 
 def _check(names) -> None:

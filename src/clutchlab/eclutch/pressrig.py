@@ -40,7 +40,7 @@ import numba
 import numpy as np
 import pandas as pd
 
-from .._limits import short_repr
+from .._limits import check_number, short_repr
 from ..errors import ParameterError, SimulationError
 
 __all__ = ["simulate_press_test", "simulate_lever_tests", "spindle_stroke", "stop_operator"]
@@ -54,18 +54,7 @@ _CORE_COLUMNS = ("time_s", "force_N", "displacement_m")
 
 
 # --------------------------------------------------------------------------- helpers
-def _check_number(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} = {value!r} is not a number") from None
-    if not math.isfinite(v):
-        raise ParameterError(f"{name} = {value!r} is not finite")
-    if positive and not v > 0:
-        raise ParameterError(f"{name} = {value!r} must be > 0")
-    if nonnegative and v < 0:
-        raise ParameterError(f"{name} = {value!r} must be >= 0")
-    return v
+_check_number = check_number  # (the shared check of clutchlab._limits)
 
 
 def _check_int(name: str, value, minimum: int) -> int:

@@ -1,0 +1,91 @@
+"""``clutchlab driveline`` sub-commands: a thin layer over :mod:`clutchlab.driveline`.
+
+``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--events EVENTS.csv] [--plot fig.png] [--force]``
+    run a driveline network and write its states and outputs (and its events);
+``clutchlab driveline describe FILE.toml``
+    print a text schematic of the network.
+"""
+
+from __future__ import annotations
+
+import io
+
+from ..errors import ParameterError
+
+__all__ = ["register"]
+
+
+def register(subparsers) -> None:
+    """Add the ``driveline`` command and its sub-commands."""
+    dl = subparsers.add_parser("driveline", help="driveline networks: inertias, springs, sources and clutches with "
+                                                 "exact stick/slip",
+                               description="One-dimensional driveline networks (inertias, spring-dampers, torque "
+                                           "sources, clutches, brakes and bearing friction between two flanges) "
+                                           "with the friction semantics of the Modelica Standard Library.",
+                               epilog="Documentation: docs/driveline.md")
+    sub = dl.add_subparsers(dest="driveline_command", metavar="SUBCOMMAND")
+    sim = sub.add_parser("simulate", help="run a driveline TOML and write its states and outputs as CSV",
+                         description="Run a driveline network described in a TOML file from its initial state "
+                                     "and write every state and output with unit-suffixed columns "
+                                     "(<component>.<quantity>_<unit>), optionally the events and a figure.",
+                         epilog="Documentation: docs/driveline.md (file format)")
+    sim.add_argument("file", help="driveline description (TOML with units)")
+    sim.add_argument("-o", "--output", required=True, help="CSV of the states and outputs to write")
+    sim.add_argument("--t-end", help="end time, e.g. '1.5 s' (default: [simulation] t_end)")
+    sim.add_argument("--output-step", help="sample interval, e.g. '1 ms' (default: [simulation] output_step, "
+                                           "else every accepted step)")
+    sim.add_argument("--events", help="CSV of the events to write (time_s, component, event)")
+    sim.add_argument("--plot", help="also write a PNG figure (speeds, friction torques, modes, energy)")
+    sim.add_argument("--force", action="store_true", help="overwrite the outputs")
+    sim.set_defaults(func=_simulate)
+    des = sub.add_parser("describe", help="print a text schematic of a driveline TOML",
+                         description="Read a driveline description, check it and print its inertias and every "
+                                     "element between its two flanges with its parameters.",
+                         epilog="Documentation: docs/driveline.md")
+    des.add_argument("file", help="driveline description (TOML with units)")
+    des.set_defaults(func=_describe)
+    dl.set_defaults(func=lambda args: (dl.print_help(), 2)[1])
+
+
+def _simulate(args) -> int:
+    from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
+    from ..units import to_si
+    from .description import load_driveline
+
+    check_outputs([args.output, args.events, args.plot], args.force)
+    spec = load_driveline(args.file)
+    t_end = to_si(args.t_end, "s", name="--t-end") if args.t_end is not None else spec.t_end
+    if t_end is None:
+        raise ParameterError(f"{args.file}: no end time: give --t-end or [simulation] t_end")
+    step = to_si(args.output_step, "s", name="--output-step") if args.output_step is not None else spec.output_step
+    if step is not None and not step > 0:
+        raise ParameterError(f"--output-step = {args.output_step!r}: must be > 0")
+    if not t_end > 0:
+        raise ParameterError(f"end time = {t_end!r} s: must be > 0")
+    res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step)
+    frame = res.to_dataframe()
+    events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
+    atomic_to_csv(frame, args.output, overwrite=args.force)
+    if args.events:
+        atomic_to_csv(events, args.events, overwrite=args.force)
+    if args.plot:
+        from .plots import driveline_figure
+
+        fig = driveline_figure(frame, events, title=f"{spec.driveline.name}: {args.file}")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=130, bbox_inches="tight")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+    err = float(frame["energy_error_J"].abs().max())
+    print(f"{args.output}: {len(frame)} samples to {t_end:g} s; {len(events)} events; "
+          f"energy balance within {err:.2g} J of {float(frame['input_work_J'].abs().max()):.4g} J input work")
+    return 0
+
+
+def _describe(args) -> int:
+    from .description import load_driveline
+
+    print(load_driveline(args.file).driveline.describe())
+    return 0
