@@ -49,7 +49,7 @@ def _key(args: list[str]) -> str:
 
 
 def _outputs(args):
-    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot")]
+    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot", "--events")]
 
 
 def test_every_readme_line_is_a_clutchlab_command_with_existing_inputs():
@@ -282,7 +282,20 @@ def check_results(work, out):
     assert np.isfinite(peak).all() and peak.max() > peak.min()  # the stiffer diaphragm needs more force
 
 
+def check_coupled_clutches(work, out):
+    frame = _csv(work / "cc.csv")
+    events = _csv(work / "cc_events.csv")
+    assert len(frame) == 1501 and frame.time_s.iloc[-1] == 1.5          # [simulation] output_step 1 ms
+    assert list(events.columns) == ["time_s", "component", "event"] and len(events) == 9
+    assert list(events.event) == ["backward", "stick", "stick", "backward", "backward", "stick", "backward",
+                                  "stick", "free"]
+    assert abs(frame["J1.w_rad_s"].iloc[-1] - 3.24705827) < 1e-6       # the independent SciPy solution
+    assert (work / "cc.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "9 events" in out
+
+
 CHECKS = {
+    "cc.csv": check_coupled_clutches,
     "curve.csv": check_curve,
     "logger_curve.csv": check_logger_curve,
     "curves.csv": check_curves,

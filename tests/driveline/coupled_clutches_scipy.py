@@ -273,7 +273,7 @@ def snap_stuck(y, modes):
 
 # ----------------------------------------------------------------------------- driver
 def reference(t_end=1.5, snap=False, rtol=1e-12, atol=1e-12, max_step=0.01,
-              return_trajectory=False):
+              return_trajectory=False, method="DOP853"):
     """Simulate CoupledClutches and return
     {"events": [(t, element, mode), ...],   # every mode change after t=0
      "final": {"J1.w": ..., "J2.w": ..., "J3.w": ..., "J4.w": ...,
@@ -303,7 +303,7 @@ def reference(t_end=1.5, snap=False, rtol=1e-12, atol=1e-12, max_step=0.01,
         if snap:
             y = snap_stuck(y, modes)
         evs = [e for e in make_events(modes) if e[1] not in disabled]
-        sol = solve_ivp(make_rhs(modes), (t, t_stop), y, method="DOP853",
+        sol = solve_ivp(make_rhs(modes), (t, t_stop), y, method=method,
                         rtol=rtol, atol=atol, max_step=max_step,
                         events=[e[0] for e in evs])
         nseg += 1

@@ -253,3 +253,41 @@ def test_bad_descriptions_give_one_clear_error(build, match):
     d.inertia("J1", J=1.0).inertia("J2", J=1.0)
     with pytest.raises(ParameterError, match=match):
         build(d)
+
+
+def test_a_locked_loop_is_resolved():
+    """J1 and J2 each braked to the ground and clutched to each other: stuck together the three
+    constraints are dependent (a loop).  The torques still balance every inertia (brake 1 + clutch =
+    drive on J1, brake 2 = clutch on J2), follow the split by the static limits (the minimiser of
+    sum(tau^2 / limit) along the loop, in closed form below), and the first element to reach its limit
+    breaks away at that instant."""
+    lim_b1, lim_c, lim_b2 = 2.0, 3.0, 4.0
+    k = 10.0
+    d = Driveline("loop")
+    d.inertia("J1", J=1.0).inertia("J2", J=2.0)
+    d.torque("drive", "J1", Signal.ramp(k * 10.0, 10.0))
+    d.brake("b1", "J1", fn_max=2 * lim_b1, mu=0.5)
+    d.brake("b2", "J2", fn_max=2 * lim_b2, mu=0.5)
+    d.clutch("c", "J1", "J2", fn_max=2 * lim_c, mu=0.5)
+    res = d.simulate(1.0, output_step=1e-3, rtol=1e-10)
+    df = res.to_dataframe()
+    t = df.time_s.to_numpy()
+    t_first = res.events.time_s.iloc[0]
+    stuck = (t > 0.0) & (t < t_first - 1e-3)
+    T = k * t[stuck]
+    b1, c, b2 = (df[f"{n}.tau_Nm"].to_numpy()[stuck] for n in ("b1", "c", "b2"))
+    # balance: J1 gets drive - b1 + c (b1: -tau on flange b = J1; c: +tau on flange a = J1); J2 gets -c - b2
+    np.testing.assert_allclose(T - b1 + c, 0.0, atol=1e-7)
+    np.testing.assert_allclose(-c - b2, 0.0, atol=1e-7)
+    assert np.max(np.abs(df["J1.w_rad_s"].to_numpy()[stuck])) < 1e-9
+    # the split along the loop: b1 = x, and the path clutch + brake 2 carries T - x; minimise
+    # x^2/lim_b1 + (T - x)^2 (1/lim_c + 1/lim_b2)  ->  x = T s / (1/lim_b1 + s), s = 1/lim_c + 1/lim_b2
+    s = 1.0 / lim_c + 1.0 / lim_b2
+    np.testing.assert_allclose(b1, T * s / (1.0 / lim_b1 + s), rtol=1e-6, atol=1e-9)
+    # the first break-away: the element whose share reaches its limit first
+    share = {"b1": s / (1.0 / lim_b1 + s), "c": (1.0 / lim_b1) / (1.0 / lim_b1 + s),
+             "b2": (1.0 / lim_b1) / (1.0 / lim_b1 + s)}
+    limits = {"b1": lim_b1, "c": lim_c, "b2": lim_b2}
+    first = min(share, key=lambda n: limits[n] / share[n])
+    assert res.events.element.iloc[0] == first
+    assert abs(t_first - limits[first] / (share[first] * k)) < 1e-8
