@@ -291,3 +291,20 @@ def test_a_locked_loop_is_resolved():
     first = min(share, key=lambda n: limits[n] / share[n])
     assert res.events.element.iloc[0] == first
     assert abs(t_first - limits[first] / (share[first] * k)) < 1e-8
+
+
+def test_signals_drive_as_their_closed_forms():
+    """A table torque 0 -> 4 N m over 1 s then held, on J = 2: w = t^2 for t < 1, then 1 + 2 (t - 1);
+    a sine from 0.5 s with an offset on a second inertia: w = offset t + the integral of the sine."""
+    d = Driveline("signals")
+    d.inertia("J1", J=2.0).inertia("J2", J=1.0)
+    d.torque("T1", "J1", Signal.table([0.0, 1.0, 2.0], [0.0, 4.0, 4.0]))
+    d.torque("T2", "J2", Signal.sine(3.0, 2.0, phase=0.3, offset=0.5, start=0.5))
+    df = d.simulate(2.0, output_step=0.01, rtol=1e-10).to_dataframe()
+    t = df.time_s.to_numpy()
+    np.testing.assert_allclose(df["J1.w_rad_s"], np.where(t < 1.0, t ** 2, 1.0 + 2.0 * (t - 1.0)), atol=1e-8)
+    w = 2 * math.pi * 2.0
+    after = np.clip(t - 0.5, 0.0, None)
+    expect = 0.5 * t + np.where(t > 0.5, 3.0 / w * (math.cos(0.3) - np.cos(w * after + 0.3)), 0.0)
+    np.testing.assert_allclose(df["J2.w_rad_s"], expect, atol=1e-8)
+    assert Signal.table([0.0, 1.0], [0.0, 4.0]).describe() == "table of 2 points from 0 to 1 s"

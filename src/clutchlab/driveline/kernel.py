@@ -36,6 +36,7 @@ import numpy as np
 from ..numerics import dispatch
 from ..numerics.core import record
 from ..numerics.interp import bracket
+from ..numerics.rosenbrock import lu_factor, lu_solve
 
 # element kinds (DrivelineParams.elem[:, E_KIND])
 K_SPRING, K_FRICTION, K_SOURCE = 0, 1, 2
@@ -67,7 +68,8 @@ class DrivelineParams(NamedTuple):
     ``elem`` (int64, one row per element, columns ``E_*``) and ``coef`` (float, ``C_*``): the
     elements; ``signals`` (one row per signal: kind, then up to 6 parameters) and ``data`` (tables:
     friction characteristics and signal tables); ``fric`` (int64): the element row of each friction
-    element; ``work``: scratch of the hooks (per run).
+    element; ``work`` and ``iwork`` (int64, the pivots of the stuck set's factorisation): scratch of
+    the hooks (per run).
     """
 
     inertia: np.ndarray
@@ -77,6 +79,7 @@ class DrivelineParams(NamedTuple):
     data: np.ndarray
     fric: np.ndarray
     work: np.ndarray
+    iwork: np.ndarray
 
 
 # ----------------------------------------------------------------- signals
@@ -184,32 +187,6 @@ def _is_free(p, r, t):
 @numba.njit(cache=True, nogil=True)
 def _speed(x, n, i):
     return 0.0 if i < 0 else x[n + i]
-
-
-@numba.njit(cache=True, nogil=True)
-def _solve(A, b, k):
-    """Solve ``A[:k, :k] y = b[:k]`` in place (Gaussian elimination, partial pivoting); ``b`` becomes ``y``."""
-    for c in range(k):
-        piv = c
-        for r in range(c + 1, k):
-            if abs(A[r, c]) > abs(A[piv, c]):
-                piv = r
-        if piv != c:
-            for j in range(k):
-                A[c, j], A[piv, j] = A[piv, j], A[c, j]
-            b[c], b[piv] = b[piv], b[c]
-        d = A[c, c]
-        for r in range(c + 1, k):
-            f = A[r, c] / d
-            if f != 0.0:
-                for j in range(c, k):
-                    A[r, j] -= f * A[c, j]
-                b[r] -= f * b[c]
-    for c in range(k - 1, -1, -1):
-        s = b[c]
-        for j in range(c + 1, k):
-            s -= A[c, j] * b[j]
-        b[c] = s / A[c, c]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -325,7 +302,6 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
     wk = p.work
     o_a, o_m, o_b, o_l, o_c, o_r, _, _ = _layout(n, nf, ne)
     A = wk[o_a:o_a + nf * nf].reshape((nf, nf))
-    M = wk[o_m:o_m + nf * nf].reshape((nf, nf))
     b = wk[o_b:o_b + nf]
     lam = wk[o_l:o_l + nf]
     cap = wk[o_c:o_c + nf]
@@ -360,16 +336,20 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
         scale = max(scale, A[k, k])
         cap[k] = static_limit(p, rk, t)
         cmax = max(cmax, cap[k])
+    M = wk[o_m:o_m + ns * ns].reshape((ns, ns))
+    for k in range(ns):
+        for j in range(ns):
+            M[k, j] = A[k, j]
+        c = max(cap[k], 1e-6 * cmax, 1e-300)
+        M[k, k] += 1e-8 * scale * (cmax / c if cmax > 0.0 else 1.0)
+    lu_factor(M, p.iwork)
     for _it in range(3):  # the regularised solution, then two refinements on the residual
         for k in range(ns):
             r = b[k]
             for j in range(ns):
                 r -= A[k, j] * lam[j]
-                M[k, j] = A[k, j]
-            c = max(cap[k], 1e-6 * cmax, 1e-300)
-            M[k, k] += 1e-8 * scale * (cmax / c if cmax > 0.0 else 1.0)
             res[k] = r
-        _solve(M, res, ns)
+        lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
     for k in range(ns):
@@ -404,7 +384,6 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
-    wk = p.work
     acc, tau = _acc_tau(p)
     evaluate_network(t, x, m, p, acc, tau)
     for i in range(n):
@@ -441,7 +420,6 @@ def driveline_outputs(t, x, u, m, p, y):
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
-    wk = p.work
     acc, tau = _acc_tau(p)
     evaluate_network(t, x, m, p, acc, tau)
     q = 0
@@ -477,7 +455,7 @@ def driveline_outputs(t, x, u, m, p, y):
     y[q + 1] = spring
     y[q + 2] = work
     y[q + 3] = lost
-    y[q + 4] = work - lost - (kinetic + spring - p.work[wk.shape[0] - 1])
+    y[q + 4] = work - lost - (kinetic + spring - p.work[p.work.shape[0] - 1])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -487,9 +465,7 @@ def settle(t, x, m, p, log, old):
     acceleration, to a fixed point.  An event per element whose mode now differs from ``old`` (the modes
     before the event), named for the mode entered.  Returns True if a mode changed."""
     n = p.inertia.shape[0]
-    ne = p.elem.shape[0]
     nf = p.fric.shape[0]
-    wk = p.work
     acc, tau = _acc_tau(p)
     wscale = 1.0
     for i in range(n):

@@ -47,12 +47,12 @@ class Signal:
     ----------
     row : tuple
         The kind (``kernel.SIG_*``) and its parameters.
-    table : tuple
+    points : tuple
         The breakpoints of a table signal: times, then values.
     """
 
     row: tuple
-    table: tuple = ()
+    points: tuple = ()
 
     @classmethod
     def constant(cls, value: float) -> "Signal":
@@ -103,8 +103,8 @@ class Signal:
         if k == K.SIG_SINE:
             off = f"{a[3]:g} + " if a[3] else ""
             return f"{off}{a[0]:g}{u} sine at {a[1]:g} Hz, phase {a[2]:g} rad" + (f", from {a[4]:g} s" if a[4] else "")
-        n = len(self.table) // 2
-        return f"table of {n} points from {self.table[0]:g} to {self.table[n - 1]:g} s"
+        n = len(self.points) // 2
+        return f"table of {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
 
     @classmethod
     def of(cls, value, what: str) -> "Signal":
@@ -283,9 +283,9 @@ class Driveline:
         def add_signal(sig):
             row = list(sig.row)
             if row[0] == K.SIG_TABLE:
-                n = len(sig.table) // 2
+                n = len(sig.points) // 2
                 row = [K.SIG_TABLE, float(len(data)), float(n)]
-                data.extend(sig.table)
+                data.extend(sig.points)
             signals.append(row + [0.0] * (7 - len(row)))
             return len(signals) - 1
 
@@ -307,7 +307,7 @@ class Driveline:
         x0 = self.initial_state()
         work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(x0, index)
         return K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
-                                 np.array(data, dtype=float), fric, work)
+                                 np.array(data, dtype=float), fric, work, np.zeros(max(nf, 1), dtype=np.int64))
 
     def _spring_energy(self, x0, index):
         e_sum = 0.0
