@@ -527,7 +527,8 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
              "rhs_evaluations": counts[core.SI_NRHS], "jacobians": counts[core.SI_NJAC],
              "events_dropped": dropped, "final_state": x, "final_modes": m,  # this run's own copies
              "final_time": t_final}
-    return SimulationResult(rt, rx, ry, rm, events, _STATUS.get(code) or st.Status(code), system.state_columns,
+    status = _STATUS[code] if code in _STATUS else st.Status(code)  # (SUCCESS is 0: falsy, so no `or` here)
+    return SimulationResult(rt, rx, ry, rm, events, status, system.state_columns,
                             system.output_columns, tuple(system.mode_names), tuple(system.mode_values), stats,
                             system.name)
 
