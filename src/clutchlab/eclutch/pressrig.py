@@ -33,7 +33,6 @@ References
 
 from __future__ import annotations
 
-import math
 from typing import Callable, Mapping
 
 import numba

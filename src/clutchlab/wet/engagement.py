@@ -54,7 +54,6 @@ import collections
 import functools
 import math
 import threading
-from typing import NamedTuple
 from dataclasses import dataclass
 
 import numpy as np
