@@ -102,3 +102,119 @@ def test_bad_descriptions_name_file_key_and_value(tmp_path, capsys, body, fragme
     line = one_line_error(capsys, ["driveline", "simulate", str(path), "-o", str(tmp_path / "out.csv"),
                                    "--t-end", "1 s"])
     assert fragments[-1] in line and not (tmp_path / "out.csv").exists()
+
+
+@pytest.mark.parametrize("body, fragments", [
+    ('[gear.g]\na = "J1"\nb = "J2"\nratio = 0\n', ["gear.g", "ratio = 0"]),
+    ('[speed.s]\nflange = "J1"\nspeed = { step = { height = "1 rad/s", start = "1 s" } }\n',
+     ["speed.s", "speed step would need an infinite torque"]),
+    ('[speed.s]\nflange = "J1"\nspeed = "3 N m"\n', ["speed.s.speed", "wrong unit"]),
+    ('[spring.k]\na = "J1"\nb = "J2"\ncurve = 5\n', ["spring.k.curve", "expected rows"]),
+    ('[spring.k]\na = "J1"\nb = "J2"\ncurve = [["0 rad", "0 N m"]]\n', ["spring.k", "at least 2 rows"]),
+    ('[spring.k]\na = "J1"\nb = "J2"\ncurve = [[0, 0], [1, 2]]\ninterpolation = "spline"\n',
+     ["spring.k.interpolation", "expected \"linear\" or \"pchip\""]),
+    ('[backlash.l]\na = "J1"\nb = "J2"\nc = "1 N m/rad"\nb_gap = "0 deg"\n', ["backlash.l", "b_gap = 0.0 must be > 0"]),
+    ('[mass.m]\nm = "1 kg"\n', ["[mass] belongs to a translational driveline"]),
+    ('[driveline]\ndomain = "hydraulic"\n', ["driveline.domain = 'hydraulic'"]),
+])
+def test_bad_element_descriptions_name_file_key_and_value(tmp_path, body, fragments):
+    path = tmp_path / "bad.toml"
+    path.write_text(BASE + body)
+    with pytest.raises(ParameterError) as exc:
+        load_driveline(path)
+    for fragment in fragments + [str(path)]:
+        assert fragment in str(exc.value), str(exc.value)
+
+
+def test_every_element_reads_with_units_as_the_python_network(tmp_path):
+    """A file with one component of each new kind, quantities in other units than SI, gives the network
+    built in Python with SI numbers: the same columns and trajectories."""
+    from clutchlab.driveline import Driveline, Signal
+
+    path = tmp_path / "all.toml"
+    path.write_text("""
+[driveline]
+name = "all"
+[inertia.engine]
+J = "2000 kg cm^2"
+[inertia.input]
+J = "0.05 kg m^2"
+[inertia.output]
+J = "1 kg m^2"
+[inertia.wheel]
+J = "3 kg m^2"
+[speed.drive]
+flange = "engine"
+speed = { ramp = { height = "1000 rpm", duration = "0.5 s", offset = "600 rpm" } }
+[spring.damper_spring]
+a = "engine"
+b = "input"
+curve = [["-10 deg", "-300 N m"], ["0 deg", "0 N m"], ["10 deg", "200 N m"]]
+interpolation = "pchip"
+d = "0.5 N m s/rad"
+[gear.gearbox]
+a = "input"
+b = "output"
+ratio = 3.5
+[backlash.lash]
+a = "output"
+b = "wheel"
+c = "5 kN m/rad"
+b_gap = "2 deg"
+d = "2 N m s/rad"
+[one_way_clutch.freewheel]
+a = "ground"
+b = "wheel"
+""")
+    spec = load_driveline(path)
+    d = Driveline("all")
+    d.inertia("engine", J=0.2).inertia("input", J=0.05).inertia("output", J=1.0).inertia("wheel", J=3.0)
+    rpm = math.pi / 30.0
+    d.speed("drive", "engine", Signal.ramp(1000 * rpm, 0.5, offset=600 * rpm))
+    deg = math.pi / 180.0
+    from clutchlab.curves import Curve
+    d.spring("damper_spring", "engine", "input", Curve([-10 * deg, 0.0, 10 * deg], [-300.0, 0.0, 200.0], kind="pchip"),
+             d=0.5)
+    d.gear("gearbox", "input", "output", 3.5)
+    d.backlash("lash", "output", "wheel", c=5000.0, b_gap=2 * deg, d=2.0)
+    d.one_way_clutch("freewheel", "ground", "wheel")
+    a = spec.driveline.simulate(1.0, output_step=0.01).to_dataframe()
+    b = d.simulate(1.0, output_step=0.01).to_dataframe()
+    assert list(a.columns) == list(b.columns)
+    for col in b.columns:
+        if pd.api.types.is_numeric_dtype(b[col]):
+            np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12, err_msg=col)
+    assert abs(a["energy_error_J"]).max() < 1e-6 * a["input_work_J"].abs().max()
+    assert "[input] --(gearbox: gear, w_a = 3.5 w_b)-- [output]" in spec.driveline.describe()
+
+
+def test_a_translational_file_has_masses_forces_and_metre_columns(tmp_path):
+    """A sled (10 kg at 2 m/s) on a block (5 kg) held by dry friction (0.3 x 100 N): the sled slides
+    forward over the block and both decelerate/accelerate by 30 N until they move together at the
+    momentum-conserving speed 2 x 10 / 15 m/s: the sled at -3 m/s^2, the block at +6, the slip of 2 m/s
+    closes at 9 m/s^2, after ``t = 2 / 9`` s."""
+    path = tmp_path / "sled.toml"
+    path.write_text("""
+[driveline]
+name = "sled"
+domain = "translational"
+[mass.sled]
+m = "10 kg"
+v0 = "2 m/s"
+[mass.block]
+m = "5000 g"
+[clutch.contact]
+a = "sled"
+b = "block"
+fn_max = "100 N"
+mu = 0.3
+""")
+    spec = load_driveline(path)
+    res = spec.driveline.simulate(0.5, output_step=0.1)
+    df = res.to_dataframe()
+    for col in ("sled.s_m", "sled.v_m_s", "contact.f_N", "contact.v_rel_m_s", "contact.mode_1"):
+        assert col in df, col
+    (t, name), = zip(res.events.time_s, res.events.event)
+    assert name == "stick" and t == pytest.approx(2.0 / 9.0, abs=1e-9)
+    assert df["block.v_m_s"].iloc[-1] == pytest.approx(4.0 / 3.0, rel=1e-10)
+    assert "sled: 2 masses, 1 elements" in spec.driveline.describe()

@@ -26,10 +26,15 @@
     peak = 1.1
     normal = { sine = { amplitude = 1, frequency = "0.2 Hz", phase = "90 deg" } }
 
-Component tables: ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0), ``torque``
-(flange, torque, support), ``clutch`` (a, b, fn_max, mu, peak, cgeo, normal), ``brake`` (flange,
-fn_max, mu, peak, cgeo, normal, support) and ``bearing_friction`` (flange, torque, peak, support).
-Quantities are numbers in SI or strings with units, converted once here.  A signal is a number or
+Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
+``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
+``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio), ``torque`` (flange, torque,
+support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
+peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
+(flange, torque, peak, support) and ``one_way_clutch`` (a, b).  With ``[driveline] domain =
+"translational"`` the bodies are ``mass`` (m, v0, s0) and the sources ``force`` (flange, force,
+support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities are numbers in SI or
+strings with units, converted once here.  A signal is a number or
 quantity (a constant) or one of ``{ constant = v }``, ``{ step = { height, start, offset } }``,
 ``{ ramp = { height, duration, start, offset } }``, ``{ sine = { amplitude, frequency, phase, offset,
 start } }``, ``{ table = { times = [...], values = [...] } }`` (times in s, values in the signal's unit).
@@ -41,7 +46,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import ParameterError
+from ..errors import DataError, ParameterError
 from ..io.files import read_toml
 from ..units import to_si
 from .network import Driveline, Signal
@@ -53,14 +58,32 @@ FIELDS = {
     "inertia": {"J": ("kg*m**2", True), "w0": ("rad/s", False), "phi0": ("rad", False)},
     "spring_damper": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", False), "d": ("N*m*s/rad", False),
                       "phi_rel0": ("rad", False)},
+    "spring": {"a": (None, True), "b": (None, True), "curve": ("N*m", True), "interpolation": ("text", False),
+               "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
+    "backlash": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", True), "b_gap": ("rad", True),
+                 "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
+    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True)},
     "torque": {"flange": (None, True), "torque": ("N*m", True), "support": (None, False)},
+    "speed": {"flange": (None, True), "speed": ("rad/s", True)},
+    "position": {"flange": (None, True), "position": ("rad", True)},
     "clutch": {"a": (None, True), "b": (None, True), "fn_max": ("N", True), "mu": ("1", False),
                "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False)},
     "brake": {"flange": (None, True), "fn_max": ("N", True), "mu": ("1", False), "peak": ("1", False),
               "cgeo": ("1", False), "normal": ("1", False), "support": (None, False)},
     "bearing_friction": {"flange": (None, True), "torque": ("N*m", False), "peak": ("1", False),
                          "support": (None, False)},
+    "one_way_clutch": {"a": (None, True), "b": (None, True)},
 }
+#: a translational driveline: masses and forces, the units of its domain
+_TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
+_RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
+TRANSLATIONAL_FIELDS = {
+    _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
+                                       for f, (u, req) in fields.items()}
+    for kind, fields in FIELDS.items()}
+#: signal fields carrying the signal's own unit, per component table
+_SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
+            "brake": "normal"}
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -68,6 +91,10 @@ SIGNAL_FIELDS = {
     "sine": {"amplitude": "value", "frequency": "Hz", "phase": "rad", "offset": "value", "start": "s"},
     "table": {"times": "s", "values": "value"},
 }
+_ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
+        "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
+        "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
+        "one_way_clutch": "one_way_clutch"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -138,15 +165,36 @@ def _signal(value, unit, key, src) -> Signal:
         raise ParameterError(f"{src}: {key}: {exc}") from None
 
 
-def _characteristic(value, unit, key, src):
+def _characteristic(value, unit, key, src, x_unit="rad/s", table_only=False):
     if isinstance(value, list):
         rows = []
         for i, row in enumerate(value):
             if not (isinstance(row, list) and len(row) == 2):
-                raise ParameterError(f"{src}: {key}[{i}] = {row!r}: expected a row [w_rad_s, value]")
-            rows.append([_quantity(row[0], "rad/s", f"{key}[{i}][0]", src), _quantity(row[1], unit, f"{key}[{i}][1]", src)])
+                raise ParameterError(f"{src}: {key}[{i}] = {row!r}: expected a row [{x_unit}, {unit}]")
+            rows.append([_quantity(row[0], x_unit, f"{key}[{i}][0]", src), _quantity(row[1], unit, f"{key}[{i}][1]", src)])
         return rows
+    if table_only:
+        raise ParameterError(f"{src}: {key} = {value!r}: expected rows [[{x_unit}, {unit}], ...]")
     return _quantity(value, unit, key, src)
+
+
+def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
+    """Add one component read from a file (``args`` converted to SI) through the Python API."""
+    if kind == "spring":
+        from ..curves import Curve
+
+        rows = args.pop("curve")
+        if len(rows) < 2:
+            raise ParameterError(f"curve needs at least 2 rows, got {len(rows)}")
+        args["curve"] = Curve([r[0] for r in rows], [r[1] for r in rows], kind=args.pop("interpolation", "linear"),
+                              name=name)
+    elif kind in ("torque", "force", "speed", "position"):
+        args = dict(args)
+        flange = args.pop("flange")
+        signal = args.pop(kind)
+        getattr(d, kind)(name, flange, signal, **args)
+        return
+    getattr(d, _ADD[kind])(name, **args)
 
 
 def load_driveline(path) -> DrivelineFile:
@@ -169,14 +217,20 @@ def load_driveline(path) -> DrivelineFile:
     """
     src = str(path)
     doc = read_toml(path)
-    known = {"driveline", "simulation", *FIELDS}
+    known = {"driveline", "simulation", *FIELDS, *TRANSLATIONAL_FIELDS}
     for top in doc:
         if top not in known:
             raise ParameterError(f"{src}: unknown table [{top}] (known: {', '.join(sorted(known))})")
     head = doc.get("driveline", {})
-    if not isinstance(head, dict) or any(k != "name" for k in head):
-        raise ParameterError(f"{src}: [driveline] takes only name = \"...\"")
-    d = Driveline(str(head.get("name", "driveline")))
+    if not isinstance(head, dict) or any(k not in ("name", "domain") for k in head):
+        raise ParameterError(f"{src}: [driveline] takes only name = \"...\" and domain = \"rotational\" or \"translational\"")
+    domain = head.get("domain", "rotational")
+    if domain not in ("rotational", "translational"):
+        raise ParameterError(f"{src}: driveline.domain = {domain!r}: expected \"rotational\" or \"translational\"")
+    d = Driveline(str(head.get("name", "driveline")), domain=domain)
+    table_fields = FIELDS if domain == "rotational" else TRANSLATIONAL_FIELDS
+    speed_unit = "rad/s" if domain == "rotational" else "m/s"
+    angle_unit = "rad" if domain == "rotational" else "m"
     sim = doc.get("simulation", {})
     if not isinstance(sim, dict):
         raise ParameterError(f"{src}: [simulation] must be a table")
@@ -184,8 +238,14 @@ def load_driveline(path) -> DrivelineFile:
         if k not in SIMULATION_FIELDS:
             raise ParameterError(f"{src}: [simulation] {k}: unknown field (known: {', '.join(SIMULATION_FIELDS)})")
     settings = {k: _quantity(v, SIMULATION_FIELDS[k], f"simulation.{k}", src) for k, v in sim.items()}
-    # inertias first: the elements name them
-    order = ["inertia"] + [k for k in doc if k in FIELDS and k != "inertia"]
+    for top in doc:
+        if top in known and top not in table_fields and top not in ("driveline", "simulation"):
+            other = "translational" if domain == "rotational" else "rotational"
+            raise ParameterError(f"{src}: [{top}] belongs to a {other} driveline (this one is {domain}; set "
+                                 f"[driveline] domain)")
+    # bodies first: the elements name them
+    body = "inertia" if domain == "rotational" else "mass"
+    order = [body] + [k for k in doc if k in table_fields and k != body]
     for kind in order:
         table = doc.get(kind, {})
         if not isinstance(table, dict):
@@ -194,7 +254,7 @@ def load_driveline(path) -> DrivelineFile:
             key = f"{kind}.{name}"
             if not isinstance(comp, dict):
                 raise ParameterError(f"{src}: {key} = {comp!r}: expected a table [{key}]")
-            fields = FIELDS[kind]
+            fields = table_fields[kind]
             for f in comp:
                 if f not in fields:
                     raise ParameterError(f"{src}: {key}.{f}: unknown field (known: {', '.join(fields)})")
@@ -209,28 +269,23 @@ def load_driveline(path) -> DrivelineFile:
                     if not isinstance(v, str):
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
                     args[f] = v
-                elif f in ("torque", "normal") and kind != "bearing_friction":
+                elif _SIGNALS.get(kind) == f:
                     args[f] = _signal(v, unit, fkey, src)
-                elif f in ("mu",) or (kind == "bearing_friction" and f == "torque"):
-                    args[f] = _characteristic(v, unit, fkey, src)
+                elif f == "mu" or (kind == "bearing_friction" and f == "torque"):
+                    args[f] = _characteristic(v, unit, fkey, src, x_unit=speed_unit)
+                elif f == "curve":
+                    args[f] = _characteristic(v, unit, fkey, src, x_unit=angle_unit, table_only=True)
+                elif unit == "text":
+                    if v not in ("linear", "pchip"):
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected \"linear\" or \"pchip\"")
+                    args[f] = v
                 else:
                     args[f] = _quantity(v, unit, fkey, src)
             try:
-                if kind == "inertia":
-                    d.inertia(name, **args)
-                elif kind == "spring_damper":
-                    d.spring_damper(name, **args)
-                elif kind == "torque":
-                    d.torque(name, args.pop("flange"), args.pop("torque"), **args)
-                elif kind == "clutch":
-                    d.clutch(name, **args)
-                elif kind == "brake":
-                    d.brake(name, **args)
-                else:
-                    d.bearing_friction(name, **args)
-            except ParameterError as exc:
+                _add(d, kind, name, args)
+            except (ParameterError, DataError) as exc:
                 raise ParameterError(f"{src}: [{key}] {exc}") from None
     if not d._inertias:
-        raise ParameterError(f"{src}: no [inertia.NAME] table (a driveline needs at least one inertia)")
+        raise ParameterError(f"{src}: no [{body}.NAME] table (a driveline needs at least one {body})")
     return DrivelineFile(d, settings.get("t_end"), settings.get("output_step"), settings.get("rtol", 1e-8),
                          settings.get("max_step"))

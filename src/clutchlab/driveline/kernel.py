@@ -39,24 +39,36 @@ from ..numerics.interp import bracket
 from ..numerics.rosenbrock import lu_factor, lu_solve
 
 # element kinds (DrivelineParams.elem[:, E_KIND])
-K_SPRING, K_FRICTION, K_SOURCE = 0, 1, 2
+K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = 0, 1, 2, 3, 4
 # friction laws
-LAW_CLUTCH, LAW_TABLE = 0, 1          # torque = cgeo * fn * mu(|w|);  torque = table(|w|) (bearing friction)
+LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY = 0, 1, 2  # cgeo * fn * mu(|w|); table(|w|) (bearing friction); freewheel
+# spring laws
+SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = 0, 1, 2
+# motion sources (K_MOTION): prescribed speed or position of flange b
+MOTION_SPEED, MOTION_POSITION = 0, 1
+# modes of a switched spring (after the friction elements' in the mode vector): a backlash in its gap, or in
+# contact beyond either side; a curve spring: the segment of its curve it is on (0 below the first point, i
+# between points i-1 and i, m above the last of m points)
+LASH_GAP, LASH_UPPER, LASH_LOWER = 0, 1, 2
+LASH_VALUES = ("gap", "upper", "lower")
 # modes of a friction element (index into MODE_VALUES); MSL's codes are MODE_CODES
 STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
 MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Forward 1, Backward -1, Free 2
-# events: named for the mode entered
-EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE = 0, 1, 2, 3
-EVENTS = ("stick", "forward", "backward", "free")
+# events: named for the mode entered (friction), or for a backlash closing or opening its gap
+EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE = 0, 1, 2, 3, 4, 5
+EVENTS = ("stick", "forward", "backward", "free", "contact", "separate")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 # signals
 SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE = 0, 1, 2, 3, 4
 # columns of ``elem`` (ints) and ``coef`` (floats)
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_INDEX = range(8)
-C_STIFF, C_DAMP, C_PHI0 = 0, 1, 2                  # spring-damper
+E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE = range(9)  # E_AUX: a curve's kind (0 linear,
+N_ELEM = 9                                                                        # 1 pchip); E_MODE: index in m
+C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
 C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
-# switching functions per friction element
+C_RATIO = 0                                        # gear: w_a = ratio * w_b
+N_COEF = 4
+# switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves)
 G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
 N_G = 3
 
@@ -67,9 +79,11 @@ class DrivelineParams(NamedTuple):
     Built by :func:`clutchlab.driveline.network.pack`.  ``inertia``: the inertias [kg m^2];
     ``elem`` (int64, one row per element, columns ``E_*``) and ``coef`` (float, ``C_*``): the
     elements; ``signals`` (one row per signal: kind, then up to 6 parameters) and ``data`` (tables:
-    friction characteristics and signal tables); ``fric`` (int64): the element row of each friction
-    element; ``work`` and ``iwork`` (int64, the pivots of the stuck set's factorisation): scratch of
-    the hooks (per run).
+    friction characteristics, spring curves and signal tables); ``fric`` (int64): the element row of
+    each friction element; ``cons``: of each constraint (gears and motion sources, always held);
+    ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
+    ``elem[r, E_MODE]``); ``work`` and ``iwork`` (int64, the pivots of the constraint set's
+    factorisation): scratch of the hooks (per run).
     """
 
     inertia: np.ndarray
@@ -78,6 +92,8 @@ class DrivelineParams(NamedTuple):
     signals: np.ndarray
     data: np.ndarray
     fric: np.ndarray
+    cons: np.ndarray
+    swit: np.ndarray
     work: np.ndarray
     iwork: np.ndarray
 
@@ -138,6 +154,35 @@ def signal_break(sig, data, t):
     return np.inf
 
 
+@numba.njit(cache=True, nogil=True)
+def signal_rates(sig, data, t):
+    """First and second time derivatives of one signal row at ``t``.
+
+    One-sided from the right at a corner (the slope of the segment that follows), so a ramp's or a
+    table's rate is piecewise constant between the breaks of :func:`signal_break`.  A step's jump has
+    no rate here (motion sources refuse steps).
+    """
+    kind = int(sig[0])
+    if kind == SIG_RAMP:
+        if sig[3] <= t < sig[3] + sig[2]:
+            return sig[1] / sig[2], 0.0
+        return 0.0, 0.0
+    if kind == SIG_SINE:
+        if t < sig[5]:
+            return 0.0, 0.0
+        om = 2.0 * math.pi * sig[2]
+        arg = om * (t - sig[5]) + sig[3]
+        return sig[1] * om * math.cos(arg), -sig[1] * om * om * math.sin(arg)
+    if kind == SIG_TABLE:
+        s = int(sig[1])
+        n = int(sig[2])
+        if n < 2 or t < data[s] or t >= data[s + n - 1]:
+            return 0.0, 0.0
+        lo, _w = bracket(data[s:s + n], t)
+        return (data[s + n + lo + 1] - data[s + n + lo]) / (data[s + lo + 1] - data[s + lo]), 0.0
+    return 0.0, 0.0
+
+
 # ----------------------------------------------------------------- friction characteristic
 @numba.njit(cache=True, nogil=True, inline="always")
 def _characteristic(data, start, n, w):
@@ -156,13 +201,16 @@ def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
     Clutch and brake (MSL ``Clutch``/``Brake``): ``cgeo * fn * mu(|w|)`` with ``fn = fn_max * f(t)``;
-    bearing friction (``BearingFriction``): the table itself.  At ``w = 0`` this is ``tau0``; the static
-    limit is ``peak * tau0``.
+    bearing friction (``BearingFriction``): the table itself; a one-way clutch (freewheel): none while it
+    overruns.  At ``w = 0`` this is ``tau0``; the static limit is ``peak * tau0``.
     """
     e = p.elem[r]
+    law = e[E_LAW]
+    if law == LAW_ONEWAY:
+        return 0.0
     c = p.coef[r]
     val = _characteristic(p.data, e[E_TABLE], e[E_TABLE_N], w_abs)
-    if e[E_LAW] == LAW_TABLE:
+    if law == LAW_TABLE:
         return val
     return c[C_CGEO] * normal_force(p, r, t) * val
 
@@ -177,10 +225,150 @@ def normal_force(p, r, t):
 
 @numba.njit(cache=True, nogil=True)
 def _is_free(p, r, t):
+    """A clutch or brake is free when its normal force is negative, or zero and not rising (a force that
+    leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing)."""
     e = p.elem[r]
-    if e[E_LAW] == LAW_TABLE:
+    if e[E_LAW] != LAW_CLUTCH:
         return False
-    return normal_force(p, r, t) <= 0.0
+    fn = normal_force(p, r, t)
+    if fn != 0.0:
+        return fn < 0.0
+    if e[E_SIGNAL] < 0:
+        return True
+    rate, _d2 = signal_rates(p.signals[e[E_SIGNAL]], p.data, t)
+    return p.coef[r][C_FN_MAX] * rate <= 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def static_limit(p, r, t):
+    """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: inf)."""
+    if p.elem[r][E_LAW] == LAW_ONEWAY:
+        return np.inf
+    return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def holding_limit(p, r, t, tau):
+    """Largest ``|tau|`` [N m] a stuck friction element row ``r`` holds in the direction of ``tau``: its static
+    limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and none for it (``tau > 0``)."""
+    if p.elem[r][E_LAW] == LAW_ONEWAY:
+        return 0.0 if tau > 0.0 else np.inf
+    return static_limit(p, r, t)
+
+
+# ----------------------------------------------------------------- springs
+@numba.njit(cache=True, nogil=True)
+def _segment_value(data, s, m, kind, seg, phi):
+    """Elastic torque [N m] of a curve spring on segment ``seg`` (0 below the first point, ``i`` between
+    points ``i-1`` and ``i``, ``m`` above the last), the segment's polynomial continued beyond its points:
+    the torque is smooth within a step and the kink at a point falls on a located event."""
+    xs = data[s:s + m]
+    fs = data[s + m:s + 2 * m]
+    ds = data[s + 2 * m:s + 3 * m]
+    if seg == 0 or seg == m:
+        end = 0 if seg == 0 else m - 1
+        if kind == 0:
+            sl = (fs[1] - fs[0]) / (xs[1] - xs[0]) if seg == 0 else (fs[m - 1] - fs[m - 2]) / (xs[m - 1] - xs[m - 2])
+        else:
+            sl = ds[end]
+        return fs[end] + sl * (phi - xs[end])
+    lo = seg - 1
+    h = xs[lo + 1] - xs[lo]
+    u = (phi - xs[lo]) / h
+    if kind == 0:
+        return fs[lo] + (fs[lo + 1] - fs[lo]) * u
+    u2 = u * u
+    u3 = u2 * u
+    return ((2.0 * u3 - 3.0 * u2 + 1.0) * fs[lo] + (u3 - 2.0 * u2 + u) * h * ds[lo] + (-2.0 * u3 + 3.0 * u2) * fs[lo + 1]
+            + (u3 - u2) * h * ds[lo + 1])
+
+
+@numba.njit(cache=True, nogil=True)
+def _segment_energy(data, s, m, kind, seg, phi):
+    """Integral of the curve from the first point to ``phi`` along segment ``seg``'s polynomial (as
+    :func:`_segment_value`; the curve's own integral where ``phi`` lies on the segment) [J]."""
+    xs = data[s:s + m]
+    fs = data[s + m:s + 2 * m]
+    ds = data[s + 2 * m:s + 3 * m]
+    cs = data[s + 3 * m:s + 4 * m]
+    if seg == 0 or seg == m:
+        end = 0 if seg == 0 else m - 1
+        if kind == 0:
+            sl = (fs[1] - fs[0]) / (xs[1] - xs[0]) if seg == 0 else (fs[m - 1] - fs[m - 2]) / (xs[m - 1] - xs[m - 2])
+        else:
+            sl = ds[end]
+        dx = phi - xs[end]
+        return cs[end] + fs[end] * dx + 0.5 * sl * dx * dx
+    lo = seg - 1
+    h = xs[lo + 1] - xs[lo]
+    u = (phi - xs[lo]) / h
+    if kind == 0:
+        return cs[lo] + h * (fs[lo] * u + 0.5 * (fs[lo + 1] - fs[lo]) * u * u)
+    u2 = u * u
+    u3 = u2 * u
+    u4 = u3 * u
+    return cs[lo] + h * (fs[lo] * (u - u3 + 0.5 * u4) + h * ds[lo] * (0.5 * u2 - 2.0 * u3 / 3.0 + 0.25 * u4)
+                         + fs[lo + 1] * (u3 - 0.5 * u4) + h * ds[lo + 1] * (0.25 * u4 - u3 / 3.0))
+
+
+@numba.njit(cache=True, nogil=True)
+def _spring_deflection(p, r, x, n):
+    e = p.elem[r]
+    pa = 0.0 if e[E_A] < 0 else x[e[E_A]]
+    pb = 0.0 if e[E_B] < 0 else x[e[E_B]]
+    return pb - pa - p.coef[r][C_PHI0]
+
+
+
+
+@numba.njit(cache=True, nogil=True)
+def spring_torque(p, r, x, n, m):
+    """Torque [N m] of spring-damper row ``r`` and its elastic part, ``(tau, tau_c)``.
+
+    Deflection ``phi = phi_b - phi_a - phi_rel0``, damping ``tau_d = d (w_b - w_a)``.  Linear:
+    ``tau_c = c phi``; a curve: ``tau_c = curve(phi)`` (as :func:`clutchlab.curves.curve_eval`) on the
+    segment of its mode (:func:`_segment_value`); backlash
+    (total gap ``b``), by its contact mode (``m``): in contact above the gap ``tau_c = c (phi - b/2)``,
+    below it ``c (phi + b/2)``, nothing in the gap.  The contact is a mode, entered at the gap's edge and
+    left when the torque would pull (located events, :func:`driveline_update`), so the torque is smooth
+    within a step.  ``tau = tau_c + tau_d``.
+    """
+    e = p.elem[r]
+    c = p.coef[r]
+    phi = _spring_deflection(p, r, x, n)
+    tau_d = c[C_DAMP] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+    law = e[E_LAW]
+    if law == SPRING_CURVE:
+        tc = _segment_value(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], m[e[E_MODE]], phi)
+        return tc + tau_d, tc
+    if law == SPRING_BACKLASH:
+        b2 = 0.5 * c[C_GAP]
+        mode = m[e[E_MODE]]
+        if mode == LASH_GAP:
+            return 0.0, 0.0
+        tc = c[C_STIFF] * (phi - b2 if mode == LASH_UPPER else phi + b2)
+        return tc + tau_d, tc
+    tc = c[C_STIFF] * phi
+    return tc + tau_d, tc
+
+
+@numba.njit(cache=True, nogil=True)
+def spring_energy(p, r, x, n, m):
+    """Energy [J] stored in spring-damper row ``r`` (the integral of its elastic torque over the deflection;
+    a backlash's in its contact mode ``m``)."""
+    e = p.elem[r]
+    c = p.coef[r]
+    phi = _spring_deflection(p, r, x, n)
+    law = e[E_LAW]
+    if law == SPRING_CURVE:
+        return _segment_energy(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], m[e[E_MODE]], phi)
+    if law == SPRING_BACKLASH:
+        mode = m[e[E_MODE]]
+        if mode == LASH_GAP:
+            return 0.0
+        q = phi - 0.5 * c[C_GAP] if mode == LASH_UPPER else phi + 0.5 * c[C_GAP]
+        return 0.5 * c[C_STIFF] * q * q
+    return 0.5 * c[C_STIFF] * phi * phi
 
 
 # ----------------------------------------------------------------- network evaluation
@@ -190,17 +378,47 @@ def _speed(x, n, i):
 
 
 @numba.njit(cache=True, nogil=True)
+def _coefficients(p, r):
+    """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a``, its torque ``tau`` acts
+    ``+ca tau`` on flange a and ``-cb tau`` on flange b.  A gear (MSL ``IdealGear``, ``w_a = ratio w_b``):
+    ``ca = 1, cb = ratio``; a motion source: ``ca = 0`` (ground); others 1, 1."""
+    e = p.elem[r]
+    if e[E_KIND] == K_GEAR:
+        return 1.0, p.coef[r][C_RATIO]
+    if e[E_KIND] == K_MOTION:
+        return 0.0, 1.0
+    return 1.0, 1.0
+
+
+@numba.njit(cache=True, nogil=True)
+def relative_speed(p, r, x, n):
+    """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears)."""
+    e = p.elem[r]
+    ca, cb = _coefficients(p, r)
+    return cb * _speed(x, n, e[E_B]) - ca * _speed(x, n, e[E_A])
+
+
+@numba.njit(cache=True, nogil=True)
+def _apply(F, e, ca, cb, tq):
+    if e[E_B] >= 0:
+        F[e[E_B]] -= cb * tq
+    if e[E_A] >= 0:
+        F[e[E_A]] += ca * tq
+
+
+@numba.njit(cache=True, nogil=True)
 def evaluate_network(t, x, m, p, acc, tau):
     """Accelerations ``acc`` [rad/s^2] of the inertias and the torque ``tau`` [N m] of every element.
 
-    Spring-dampers ``tau = c (phi_b - phi_a - phi0) + d (w_b - w_a)``; sources: their signal (acting on
-    flange b, positive accelerating it, so ``tau`` is stored with the element convention as minus the
-    source torque); sliding friction ``+-friction_torque``; free friction 0; stuck friction the
-    solution of the stuck set.  Returns the number of stuck elements.
+    Spring-dampers :func:`spring_torque`; torque sources: their signal (acting on flange b, positive
+    accelerating it, so ``tau`` is stored with the element convention as minus the source torque);
+    sliding friction ``+-friction_torque``; free friction 0; stuck friction, gears and motion sources:
+    the solution of the constraint set (:func:`_solve_stuck`).  Returns the size of that set.
     """
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
+    nc = p.cons.shape[0]
     wk = p.work
     F = wk[0:n]
     for i in range(n):
@@ -208,25 +426,17 @@ def evaluate_network(t, x, m, p, acc, tau):
     for r in range(ne):
         e = p.elem[r]
         kind = e[E_KIND]
-        a = e[E_A]
-        b = e[E_B]
         if kind == K_SPRING:
-            c = p.coef[r]
-            pa = 0.0 if a < 0 else x[a]
-            pb = 0.0 if b < 0 else x[b]
-            tq = c[C_STIFF] * (pb - pa - c[C_PHI0]) + c[C_DAMP] * (_speed(x, n, b) - _speed(x, n, a))
+            tq, _tc = spring_torque(p, r, x, n, m)
         elif kind == K_SOURCE:
             tq = -signal_value(p.signals[e[E_SIGNAL]], p.data, t)
         else:
             continue
         tau[r] = tq
-        if b >= 0:
-            F[b] -= tq
-        if a >= 0:
-            F[a] += tq
-    # sliding and free friction; the stuck set
+        _apply(F, e, 1.0, 1.0, tq)
+    # sliding and free friction; the constraint set: stuck friction, gears, motion sources
     ns = 0
-    stuck = wk[n:n + nf]  # element rows of the stuck set (as floats)
+    stuck = wk[n:n + nf + nc]  # element rows of the set (as floats)
     for k in range(nf):
         r = p.fric[k]
         e = p.elem[r]
@@ -243,10 +453,10 @@ def evaluate_network(t, x, m, p, acc, tau):
             if mk == BACKWARD:
                 tq = -tq
         tau[r] = tq
-        if e[E_B] >= 0:
-            F[e[E_B]] -= tq
-        if e[E_A] >= 0:
-            F[e[E_A]] += tq
+        _apply(F, e, 1.0, 1.0, tq)
+    for k in range(nc):
+        stuck[ns] = p.cons[k]
+        ns += 1
     if ns > 0:
         _solve_stuck(t, p, stuck, ns, F, tau)
     for i in range(n):
@@ -255,86 +465,119 @@ def evaluate_network(t, x, m, p, acc, tau):
 
 
 @numba.njit(cache=True, nogil=True)
-def _layout(n, nf, ne):
-    """Offsets in ``DrivelineParams.work``: net torques F (n) | stuck set (nf) | A (nf^2) | A + eps D (nf^2)
-    | right-hand side (nf) | torques of the stuck set (nf) | static limits (nf) | residual (nf) |
-    accelerations (n) | element torques (ne) | initial stored energy (1)."""
-    o_a = n + nf
-    o_m = o_a + nf * nf
-    o_b = o_m + nf * nf
-    o_l = o_b + nf
-    o_c = o_l + nf
-    o_r = o_c + nf
-    o_acc = o_r + nf
+def _layout(n, nk, ne):
+    """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
+    (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
+    (nk) | flange a, ca, flange b, cb of each member (4 nk) | accelerations (n) | element torques (ne) |
+    slack of each friction element's stick function (nf, :func:`settle`) | initial stored energy (1)."""
+    o_a = n + nk
+    o_m = o_a + nk * nk
+    o_b = o_m + nk * nk
+    o_l = o_b + nk
+    o_c = o_l + nk
+    o_r = o_c + nk
+    o_g = o_r + nk
+    o_acc = o_g + 4 * nk
     o_tau = o_acc + n
-    return o_a, o_m, o_b, o_l, o_c, o_r, o_acc, o_tau
+    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_acc, o_tau
 
 
-def work_size(n, nf, ne):
-    """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nf`` friction elements, ``ne`` elements."""
-    return 2 * n + 5 * nf + 2 * nf * nf + ne + 1
+def work_size(n, nk, ne, nf):
+    """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` friction elements and constraints, ``ne``
+    elements, ``nf`` friction elements."""
+    return 2 * n + 10 * nk + 2 * nk * nk + ne + nf + 1
 
 
 @numba.njit(cache=True, nogil=True)
 def _acc_tau(p):
     n = p.inertia.shape[0]
+    nk = p.fric.shape[0] + p.cons.shape[0]
+    ne = p.elem.shape[0]
+    o = _layout(n, nk, ne)
+    return p.work[o[7]:o[7] + n], p.work[o[8]:o[8] + ne]
+
+
+@numba.njit(cache=True, nogil=True)
+def _slack(p):
+    n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     ne = p.elem.shape[0]
-    o = _layout(n, nf, ne)
-    return p.work[o[6]:o[6] + n], p.work[o[7]:o[7] + ne]
+    o = _layout(n, nf + p.cons.shape[0], ne)
+    return p.work[o[8] + ne:o[8] + ne + nf]
 
 
 @numba.njit(cache=True, nogil=True)
 def _solve_stuck(t, p, stuck, ns, F, tau):
-    """Torques of the stuck elements: zero relative acceleration for each, solved together.
+    """Torques of the constraint set -- stuck friction elements, gears, motion sources -- solved together.
 
-    ``A lam = g^T M^-1 F`` with ``A[k, j] = g_k^T M^-1 g_j`` (``g = e_b - e_a``).  Where stuck elements
-    lock the same relative motion (two clutches in parallel) ``A`` is singular: the torque is then split
-    in proportion to the static limits, the solution minimising ``sum(lam_k^2 / limit_k)``.  It comes
-    from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s
-    diagonal (whose solution has ``D lam`` in the range of ``A``: the proportional split), refined twice
-    on the residual of ``A lam = b`` (the constraints hold to rounding; the split to about 1e-8).
-    ``F`` is updated with the stuck torques.
+    Each member ``k`` holds its relative acceleration ``g_k^T a`` (``g_k = cb e_b - ca e_a``) at its
+    target: zero, or the prescribed acceleration of a motion source.  ``A lam = g^T M^-1 F - target``
+    with ``A[k, j] = g_k^T M^-1 g_j``.  Where stuck elements lock the same relative motion (two clutches
+    in parallel) ``A`` is singular: the torque is then split in proportion to the static limits, the
+    solution minimising ``sum(lam_k^2 / limit_k)`` (one-way clutches, gears and motion sources weigh as
+    the strongest friction element).  It comes from ``(A + eps D) lam = b`` with ``D = diag(max limit /
+    limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal (whose solution has ``D lam`` in the range of ``A``:
+    the proportional split), refined twice on the residual of ``A lam = b`` (the constraints hold to
+    rounding; the split to about 1e-8).  ``F`` is updated with the torques.
     """
     n = p.inertia.shape[0]
-    nf = p.fric.shape[0]
+    nk = p.fric.shape[0] + p.cons.shape[0]
     ne = p.elem.shape[0]
     wk = p.work
-    o_a, o_m, o_b, o_l, o_c, o_r, _, _ = _layout(n, nf, ne)
-    A = wk[o_a:o_a + nf * nf].reshape((nf, nf))
-    b = wk[o_b:o_b + nf]
-    lam = wk[o_l:o_l + nf]
-    cap = wk[o_c:o_c + nf]
-    res = wk[o_r:o_r + nf]
-    scale = 0.0
+    o_a, o_m, o_b, o_l, o_c, o_r, o_g, _, _ = _layout(n, nk, ne)
+    A = wk[o_a:o_a + nk * nk].reshape((nk, nk))
+    b = wk[o_b:o_b + nk]
+    lam = wk[o_l:o_l + nk]
+    cap = wk[o_c:o_c + nk]
+    res = wk[o_r:o_r + nk]
+    fa = wk[o_g:o_g + nk]
+    ga = wk[o_g + nk:o_g + 2 * nk]
+    fb = wk[o_g + 2 * nk:o_g + 3 * nk]
+    gb = wk[o_g + 3 * nk:o_g + 4 * nk]
     cmax = 0.0
     for k in range(ns):
         rk = int(stuck[k])
         ek = p.elem[rk]
-        ak, bk = ek[E_A], ek[E_B]
-        s = 0.0
-        if bk >= 0:
-            s += F[bk] / p.inertia[bk]
-        if ak >= 0:
-            s -= F[ak] / p.inertia[ak]
+        ca, cb = _coefficients(p, rk)
+        fa[k] = ek[E_A]
+        fb[k] = ek[E_B]
+        ga[k] = ca
+        gb[k] = cb
+        target = 0.0
+        if ek[E_KIND] == K_MOTION:
+            d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
+            target = d1 if ek[E_LAW] == MOTION_SPEED else d2
+        s = -target
+        if ek[E_B] >= 0:
+            s += cb * F[ek[E_B]] / p.inertia[ek[E_B]]
+        if ek[E_A] >= 0:
+            s -= ca * F[ek[E_A]] / p.inertia[ek[E_A]]
         b[k] = s
         lam[k] = 0.0
+        cap[k] = -1.0
+        if ek[E_KIND] == K_FRICTION and ek[E_LAW] != LAW_ONEWAY:
+            cap[k] = static_limit(p, rk, t)
+            cmax = max(cmax, cap[k])
+    scale = 0.0
+    for k in range(ns):
+        if cap[k] < 0.0:
+            cap[k] = cmax if cmax > 0.0 else 1.0
+        ak, bk = int(fa[k]), int(fb[k])
         for j in range(ns):
-            rj = int(stuck[j])
-            ej = p.elem[rj]
-            aj, bj = ej[E_A], ej[E_B]
+            aj, bj = int(fa[j]), int(fb[j])
             v = 0.0
             if bk >= 0 and bk == bj:
-                v += 1.0 / p.inertia[bk]
+                v += gb[k] * gb[j] / p.inertia[bk]
             if bk >= 0 and bk == aj:
-                v -= 1.0 / p.inertia[bk]
+                v -= gb[k] * ga[j] / p.inertia[bk]
             if ak >= 0 and ak == bj:
-                v -= 1.0 / p.inertia[ak]
+                v -= ga[k] * gb[j] / p.inertia[ak]
             if ak >= 0 and ak == aj:
-                v += 1.0 / p.inertia[ak]
+                v += ga[k] * ga[j] / p.inertia[ak]
             A[k, j] = v
         scale = max(scale, A[k, k])
-        cap[k] = static_limit(p, rk, t)
+    cmax = 0.0
+    for k in range(ns):
         cmax = max(cmax, cap[k])
     M = wk[o_m:o_m + ns * ns].reshape((ns, ns))
     for k in range(ns):
@@ -354,19 +597,8 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
             lam[k] += res[k]
     for k in range(ns):
         rk = int(stuck[k])
-        ek = p.elem[rk]
-        tq = lam[k]
-        tau[rk] = tq
-        if ek[E_B] >= 0:
-            F[ek[E_B]] -= tq
-        if ek[E_A] >= 0:
-            F[ek[E_A]] += tq
-
-
-@numba.njit(cache=True, nogil=True)
-def static_limit(p, r, t):
-    """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t``."""
-    return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
+        tau[rk] = lam[k]
+        _apply(F, p.elem[rk], ga[k], gb[k], lam[k])
 
 
 # ----------------------------------------------------------------- hooks
@@ -375,27 +607,34 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     """Angles and speeds of the inertias, work of the sources, energy dissipated by each element.
 
     States: ``phi`` (n), ``w`` (n), then one energy per element in element order [J]: a source's work
-    ``tau_src * w_b``, a spring-damper's dissipation ``d w_rel^2``, a friction element's
-    ``tau * w_rel``.  Switching functions, three per friction element: the relative speed of a
-    sliding element in its direction (falls through zero: it sticks or reverses), the static limit
-    minus the torque of a stuck one (falls through zero: break-away), the normalised normal force
-    (either way: free or engaged).
+    ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
+    the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift).
+    Switching functions, three per friction element: the relative speed of a sliding element in its
+    direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
+    one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
+    (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
+    side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
+    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull).  A
+    curve spring: the deflection above the segment's lower point and below its upper one (either falling
+    through zero moves it to the next segment).
     """
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
     acc, tau = _acc_tau(p)
+    slack = _slack(p)
     evaluate_network(t, x, m, p, acc, tau)
     for i in range(n):
         dx[i] = x[n + i]
         dx[n + i] = acc[i]
     for r in range(ne):
         e = p.elem[r]
-        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-        if e[E_KIND] == K_SPRING:
-            d = p.coef[r][C_DAMP]
-            dx[2 * n + r] = d * w_rel * w_rel
-        elif e[E_KIND] == K_SOURCE:
+        kind = e[E_KIND]
+        w_rel = relative_speed(p, r, x, n)
+        if kind == K_SPRING:
+            _tq, tc = spring_torque(p, r, x, n, m)
+            dx[2 * n + r] = (tau[r] - tc) * w_rel
+        elif kind == K_SOURCE or kind == K_MOTION:
             dx[2 * n + r] = -tau[r] * w_rel
         else:
             dx[2 * n + r] = tau[r] * w_rel
@@ -404,19 +643,41 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         e = p.elem[r]
         w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
         mk = m[k]
-        g[N_G * k + G_STICK] = w_rel if mk == FORWARD else -w_rel if mk == BACKWARD else 1.0
-        g[N_G * k + G_BREAK] = static_limit(p, r, t) - abs(tau[r]) if mk == STUCK else 1.0
-        if e[E_LAW] == LAW_TABLE or e[E_SIGNAL] < 0:
+        g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
+        if mk != STUCK:
+            g[N_G * k + G_BREAK] = 1.0
+        elif e[E_LAW] == LAW_ONEWAY:
+            g[N_G * k + G_BREAK] = -tau[r]
+        else:
+            g[N_G * k + G_BREAK] = static_limit(p, r, t) - abs(tau[r])
+        if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         else:
             g[N_G * k + G_NORMAL] = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+    for j in range(p.swit.shape[0]):
+        r = p.swit[j]
+        c = p.coef[r]
+        e = p.elem[r]
+        phi = _spring_deflection(p, r, x, n)
+        mode = m[nf + j]
+        if e[E_LAW] == SPRING_CURVE:   # the points bounding the segment: below (falls through) and above
+            s0, mp = e[E_TABLE], e[E_TABLE_N]
+            g[N_G * nf + 2 * j] = phi - p.data[s0 + mode - 1] if mode > 0 else 1.0
+            g[N_G * nf + 2 * j + 1] = p.data[s0 + mode] - phi if mode < mp else 1.0
+            continue
+        b2 = 0.5 * c[C_GAP]
+        # in the gap: the edges; in contact: the torque over c (it falls through zero: it would pull)
+        lag = c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+        g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
+        g[N_G * nf + 2 * j + 1] = phi + b2 + (lag if mode == LASH_LOWER else 0.0)
 
 
 @numba.njit(cache=True, nogil=True)
 def driveline_outputs(t, x, u, m, p, y):
-    """Per element: torque [N m] (a source: its torque on flange b), relative speed [rad/s]; per
-    friction element also its MSL mode code [-] and normal force [N]; then kinetic and spring
-    energy, the sources' work, the dissipated energy and the energy balance error [J]."""
+    """Per element: torque [N m] (a source: its torque on flange b; a gear: ``tau``, on flange a) and, for
+    springs and friction, the relative speed [rad/s]; per friction element also its MSL mode code [-] and
+    normal force [N]; then kinetic and spring energy, the sources' work, the dissipated energy and the
+    energy balance error [J]."""
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
@@ -431,25 +692,25 @@ def driveline_outputs(t, x, u, m, p, y):
     lost = 0.0
     for r in range(ne):
         e = p.elem[r]
-        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-        if e[E_KIND] == K_SOURCE:
+        kind = e[E_KIND]
+        if kind == K_SOURCE or kind == K_MOTION:
             y[q] = -tau[r]
             q += 1
             work += x[2 * n + r]
             continue
-        y[q] = tau[r]
-        y[q + 1] = w_rel
-        q += 2
-        if e[E_KIND] == K_SPRING:
-            c = p.coef[r]
-            pa = 0.0 if e[E_A] < 0 else x[e[E_A]]
-            pb = 0.0 if e[E_B] < 0 else x[e[E_B]]
-            spring += 0.5 * c[C_STIFF] * (pb - pa - c[C_PHI0]) ** 2
         lost += x[2 * n + r]
+        y[q] = tau[r]
+        q += 1
+        if kind == K_GEAR:
+            continue
+        y[q] = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        q += 1
+        if kind == K_SPRING:
+            spring += spring_energy(p, r, x, n, m)
     for k in range(nf):
         r = p.fric[k]
         y[q] = MODE_CODES[m[k]]
-        y[q + 1] = 0.0 if p.elem[r][E_LAW] == LAW_TABLE else normal_force(p, r, t)
+        y[q + 1] = normal_force(p, r, t) if p.elem[r][E_LAW] == LAW_CLUTCH else 0.0
         q += 2
     y[q] = kinetic
     y[q + 1] = spring
@@ -476,21 +737,28 @@ def settle(t, x, m, p, log, old):
         e = p.elem[r]
         if _is_free(p, r, t):
             m[k] = FREE
-        elif m[k] == FREE:
+        elif m[k] == FREE:   # engaged: slides the way it moves, or sticks (then breaks away if it must)
             w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-            m[k] = FORWARD if w_rel > 0.0 else BACKWARD if w_rel < 0.0 else STUCK
+            m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
+    ne = p.elem.shape[0]
     for _it in range(4 * nf + 4):
         evaluate_network(t, x, m, p, acc, tau)
+        # torques below 1e-12 of the largest in the network are rounding (a stuck element that carries
+        # nothing while its normal force rises from zero must not break away on them)
+        t_noise = 0.0
+        for r in range(ne):
+            t_noise = max(t_noise, abs(tau[r]))
+        t_noise *= 1e-12
         worst = -1
         ratio = 0.0
         for k in range(nf):
             if m[k] != STUCK:
                 continue
             r = p.fric[k]
-            lim = static_limit(p, r, t)
+            lim = holding_limit(p, r, t, tau[r])
             # the same test as the break-away function, which has crossed when it reaches zero (the core's
             # convention): |tau| >= limit, a torque to carry (a ratio may round to exactly 1)
-            if abs(tau[r]) >= lim and abs(tau[r]) > 0.0:
+            if abs(tau[r]) >= lim and abs(tau[r]) > t_noise:
                 q = abs(tau[r]) / lim if lim > 0.0 else np.inf
                 if q >= ratio:
                     ratio = q
@@ -515,18 +783,47 @@ def settle(t, x, m, p, log, old):
                 break
         if not changed:
             break
+    # an element that starts to slide from (about) rest may start a rounding's width on the wrong side of zero:
+    # its stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at
+    # once, the crossing would be missed); one that slides clearly watches 0
+    slack = _slack(p)
     any_change = False
     for k in range(nf):
         if m[k] != old[k]:
             record(log, t, _EVENT_OF_MODE[m[k]], k)
             any_change = True
+            e = p.elem[p.fric[k]]
+            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+            slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
     return any_change
 
 
 @numba.njit(cache=True, nogil=True)
 def driveline_update(t, x, u, m, p, k, log):
     """Switching function ``k`` crossed: a sliding element reached zero relative speed (it sticks, or
-    reverses if it cannot hold), a stuck one reached its static limit, or a normal force changed sign."""
+    reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
+    backlash closed (``contact``) or opened (``separate``) its gap."""
+    nf = p.fric.shape[0]
+    if k >= N_G * nf:
+        j = (k - N_G * nf) // 2
+        r = p.swit[j]
+        n = p.inertia.shape[0]
+        e = p.elem[r]
+        if e[E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
+            m[nf + j] += -1 if (k - N_G * nf) % 2 == 0 else 1
+            return 0
+        side = LASH_UPPER if (k - N_G * nf) % 2 == 0 else LASH_LOWER   # phi - b/2: the gap's upper side
+        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        if m[nf + j] == LASH_GAP and ((side == LASH_UPPER and w_rel > 0.0) or (side == LASH_LOWER and w_rel < 0.0)):
+            m[nf + j] = side
+            record(log, t, EV_CONTACT, nf + j)
+        elif m[nf + j] == side:
+            # the energy left in the spring (a damped contact separates before the edge) is lost: the
+            # massless spring relaxes through its damper
+            x[2 * n + r] += spring_energy(p, r, x, n, m)
+            m[nf + j] = LASH_GAP
+            record(log, t, EV_SEPARATE, nf + j)
+        return 0
     old = m.copy()
     kf = k // N_G
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):

@@ -32,6 +32,17 @@ __all__ = ["Driveline", "Signal", "GROUND"]
 
 GROUND = "ground"
 
+#: per domain: the quantity names and units (column unit, unit for people) of an inertia's angle and speed,
+#: of an element's torque and relative speed, and the units of inertia, stiffness and damping
+DOMAINS = {
+    "rotational": {"angle": ("phi", "rad", "rad"), "speed": ("w", "rad_s", "rad/s"), "torque": ("tau", "Nm", "N m"),
+                   "relative": ("w_rel", "rad_s", "rad/s"), "inertia": ("J", "kg m^2"), "stiffness": "N m/rad",
+                   "damping": "N m s/rad", "words": ("inertia", "angle", "torque")},
+    "translational": {"angle": ("s", "m", "m"), "speed": ("v", "m_s", "m/s"), "torque": ("f", "N", "N"),
+                      "relative": ("v_rel", "m_s", "m/s"), "inertia": ("m", "kg"), "stiffness": "N/m",
+                      "damping": "N s/m", "words": ("mass", "position", "force")},
+}
+
 
 def _finite(component, name, value, *, positive=False, nonneg=False):
     return check_number(f"{component}: {name}", value, positive=positive, nonnegative=nonneg)
@@ -106,6 +117,36 @@ class Signal:
         n = len(self.points) // 2
         return f"table of {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
 
+    def value_and_rate(self, t: float) -> tuple:
+        """Value and time derivative (from the right) at ``t`` [s], in Python (as the kernel's
+        :func:`~clutchlab.driveline.kernel.signal_value` and :func:`~clutchlab.driveline.kernel.signal_rates`)."""
+        k, *a = self.row
+        if k == K.SIG_CONST:
+            return a[0], 0.0
+        if k == K.SIG_STEP:
+            return a[2] + (a[0] if t >= a[1] else 0.0), 0.0
+        if k == K.SIG_RAMP:
+            height, duration, start, offset = a
+            if t < start:
+                return offset, 0.0
+            if t >= start + duration:
+                return offset + height, 0.0
+            return offset + height * (t - start) / duration, height / duration
+        if k == K.SIG_SINE:
+            amp, freq, phase, offset, start = a
+            if t < start:
+                return offset, 0.0
+            om = 2.0 * math.pi * freq
+            arg = om * (t - start) + phase
+            return offset + amp * math.sin(arg), amp * om * math.cos(arg)
+        n = len(self.points) // 2
+        ts, vs = np.array(self.points[:n]), np.array(self.points[n:])
+        value = float(np.interp(t, ts, vs))
+        if n < 2 or t < ts[0] or t >= ts[-1]:
+            return value, 0.0
+        lo = int(np.searchsorted(ts, t, side="right")) - 1
+        return value, float((vs[lo + 1] - vs[lo]) / (ts[lo + 1] - ts[lo]))
+
     @classmethod
     def of(cls, value, what: str) -> "Signal":
         """``value`` as a signal: a :class:`Signal` as it is, a number as a constant."""
@@ -116,31 +157,114 @@ class Signal:
         raise ParameterError(f"{what} = {value!r}: expected a number or a Signal")
 
 
+def _curve_integrals(xs, fs, ds, kind):
+    """Integral of a spring curve from its first point to each point (exact for linear and cubic Hermite).
+
+    :meth:`Driveline.spring` shifts them so the stored energy is the integral from zero deflection."""
+    h = np.diff(xs)
+    if kind == 0:
+        seg = 0.5 * h * (fs[:-1] + fs[1:])
+    else:
+        seg = h * (0.5 * (fs[:-1] + fs[1:]) + h * (ds[:-1] - ds[1:]) / 12.0)
+    return np.concatenate([[0.0], np.cumsum(seg)])
+
+
+def _curve_energy_py(table, m, kind, phi):
+    """Python twin of :func:`clutchlab.driveline.kernel._curve_energy` (the initial stored energy)."""
+    xs, fs, ds, cs = table[:m], table[m:2 * m], table[2 * m:3 * m], table[3 * m:4 * m]
+    if phi <= xs[0] or phi >= xs[-1]:
+        end = 0 if phi <= xs[0] else m - 1
+        if kind == 0:
+            sl = (fs[1] - fs[0]) / (xs[1] - xs[0]) if end == 0 else (fs[-1] - fs[-2]) / (xs[-1] - xs[-2])
+        else:
+            sl = ds[end]
+        dx = phi - xs[end]
+        return float(cs[end] + fs[end] * dx + 0.5 * sl * dx * dx)
+    lo = int(np.searchsorted(xs, phi, side="right")) - 1
+    h = xs[lo + 1] - xs[lo]
+    u = (phi - xs[lo]) / h
+    if kind == 0:
+        return float(cs[lo] + h * (fs[lo] * u + 0.5 * (fs[lo + 1] - fs[lo]) * u * u))
+    return float(cs[lo] + h * (fs[lo] * (u - u ** 3 + 0.5 * u ** 4) + h * ds[lo] * (0.5 * u ** 2 - 2 * u ** 3 / 3 + 0.25 * u ** 4)
+                               + fs[lo + 1] * (u ** 3 - 0.5 * u ** 4) + h * ds[lo + 1] * (0.25 * u ** 4 - u ** 3 / 3)))
+
+
+def _check_motion_signal(name, what, sig):
+    """A motion source's signal may not jump (an infinite torque) nor, for a position, have a speed jump."""
+    kind, *a = sig.row
+    if what == "speed":
+        if kind == K.SIG_STEP:
+            raise ParameterError(f"{name}: a speed step would need an infinite torque; use a ramp or a table")
+        if kind == K.SIG_SINE and a[4] > 0.0 and abs(a[0] * math.sin(a[2])) > 0.0:
+            raise ParameterError(f"{name}: the sine jumps at its start ({a[4]:g} s); start it at 0 or with phase 0")
+        return
+    if kind not in (K.SIG_CONST, K.SIG_SINE):
+        raise ParameterError(f"{name}: a position source needs a signal with a continuous speed (a constant or a "
+                             f"sine); for a ramp or a table of positions, prescribe the speed with a speed source")
+    if kind == K.SIG_SINE and a[4] != 0.0 and a[0] != 0.0:
+        raise ParameterError(f"{name}: a position sine must start at t = 0 (start = {a[4]:g} s makes its speed jump)")
+
+
+class _Groups:
+    """Union-find over the inertias and the ground (-1), for the loops of gears and motion sources."""
+
+    def __init__(self, n):
+        self.parent = list(range(n + 1))
+
+    def find(self, i):
+        i += 1
+        while self.parent[i] != i:
+            self.parent[i] = self.parent[self.parent[i]]
+            i = self.parent[i]
+        return i
+
+    def union(self, a, b):
+        ra, rb = self.find(a), self.find(b)
+        if ra == rb:
+            return False
+        self.parent[ra] = rb
+        return True
+
+
 @dataclass
 class _Element:
     kind: int
     name: str
     a: str | None
     b: str | None
-    coef: tuple = (0.0, 0.0, 0.0)
+    coef: tuple = (0.0, 0.0, 0.0, 0.0)
     law: int = 0
     signal: Signal | None = None
-    table: tuple = ()   # friction characteristic: speeds [rad/s], then values
+    table: tuple = ()   # friction characteristic: speeds [rad/s], then values; a spring curve: its kernel data
+    aux: int = 0        # a spring curve's kind (0 linear, 1 pchip)
 
 
 class Driveline:
-    """A driveline network: inertias, spring-dampers, torque sources and friction elements.
+    """A driveline network: inertias, springs, dampers, backlash, gears, torque, speed and position sources,
+    and friction elements (clutches, brakes, bearing friction, one-way clutches).
 
     Parameters
     ----------
     name : str
         Name of the model (shown in results and errors).
+    domain : {"rotational", "translational"}
+        Rotational (kg m^2, rad, rad/s, N m; columns ``phi_rad``, ``w_rad_s``, ``tau_Nm``) or translational
+        (kg, m, m/s, N; columns ``s_m``, ``v_m_s``, ``f_N``; build with :meth:`mass` and :meth:`force`).  The
+        elements and their equations are the same; a translational clutch's ``cgeo`` is 1 by default
+        (force = fn * mu) and a gear is a lever.
     """
 
-    def __init__(self, name: str = "driveline"):
+    def __init__(self, name: str = "driveline", domain: str = "rotational"):
         self.name = str(name)
+        if domain not in DOMAINS:
+            raise ParameterError(f"{self.name}: domain = {domain!r} (known: {', '.join(DOMAINS)})")
+        self.domain = domain
         self._inertias: dict = {}
         self._elements: list = []
+
+    @property
+    def _units(self):
+        return DOMAINS[self.domain]
 
     # ---- components
     def _new_name(self, name):
@@ -166,12 +290,36 @@ class Driveline:
             raise ParameterError(f"{name}: both flanges are {a or GROUND!r} (an element needs two different flanges)")
         return a, b
 
-    def inertia(self, name: str, J: float, w0: float = 0.0, phi0: float = 0.0) -> "Driveline":
-        """A rigid inertia ``J`` [kg m^2] starting at angle ``phi0`` [rad] and speed ``w0`` [rad/s]."""
+    def inertia(self, name: str, J: float, w0: float | None = None, phi0: float | None = None) -> "Driveline":
+        """A rigid inertia ``J`` [kg m^2] starting at angle ``phi0`` [rad] and speed ``w0`` [rad/s].
+
+        Left out, ``w0`` follows from the gears and motion sources that bind this inertia to another one
+        (0 without any), ``phi0`` from a position source (0 without one); given, they must agree with them.
+        """
+        if self.domain != "rotational":
+            raise ParameterError(f"{name}: a translational driveline has masses (mass(name, m, v0, s0)), not inertias")
+        return self._body(name, (J, w0, phi0), ("J", "w0", "phi0"))
+
+    def mass(self, name: str, m: float, v0: float | None = None, s0: float | None = None) -> "Driveline":
+        """A rigid mass ``m`` [kg] starting at position ``s0`` [m] and speed ``v0`` [m/s] (translational
+        drivelines; as :meth:`inertia`)."""
+        if self.domain != "translational":
+            raise ParameterError(f"{name}: a rotational driveline has inertias (inertia(name, J, w0, phi0)), not masses")
+        return self._body(name, (m, v0, s0), ("m", "v0", "s0"))
+
+    def _body(self, name, values, labels):
         name = self._new_name(name)
-        self._inertias[name] = (_finite(name, "J", J, positive=True), _finite(name, "w0", w0),
-                                _finite(name, "phi0", phi0))
+        J, w0, phi0 = values
+        self._inertias[name] = (_finite(name, labels[0], J, positive=True),
+                                None if w0 is None else _finite(name, labels[1], w0),
+                                None if phi0 is None else _finite(name, labels[2], phi0))
         return self
+
+    def force(self, name: str, flange, signal, support=None) -> "Driveline":
+        """A force source [N] pushing ``flange`` (translational drivelines; as :meth:`torque`)."""
+        if self.domain != "translational":
+            raise ParameterError(f"{name}: a rotational driveline has torque sources (torque(...)), not forces")
+        return self.torque(name, flange, signal, support)
 
     def spring_damper(self, name: str, a, b, c: float = 0.0, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
         """Spring ``c`` [N m/rad] and damper ``d`` [N m s/rad] in parallel between flanges a and b
@@ -180,8 +328,92 @@ class Driveline:
         a, b = self._two(name, a, b)
         self._elements.append(_Element(K.K_SPRING, name, a, b, (_finite(name, "c", c, nonneg=True),
                                                                  _finite(name, "d", d, nonneg=True),
-                                                                 _finite(name, "phi_rel0", phi_rel0))))
+                                                                 _finite(name, "phi_rel0", phi_rel0), 0.0)))
         return self
+
+    def spring(self, name: str, a, b, curve, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
+        """A nonlinear spring and a damper ``d`` [N m s/rad] in parallel between flanges a and b:
+        ``tau = curve(phi_b - phi_a - phi_rel0) + d (w_b - w_a)``.
+
+        ``curve``: a :class:`~clutchlab.curves.Curve` (deflection [rad], torque [N m]; piecewise linear or
+        monotone cubic, extrapolated with its end slopes -- an ``extrapolation="error"`` curve is refused)
+        or rows ``[[phi_rad, tau_Nm], ...]`` (piecewise linear).  The stored energy is the exact integral
+        of the curve, so the energy balance holds for any curve.
+        """
+        from ..curves import Curve
+
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        if not isinstance(curve, Curve):
+            arr = np.asarray(curve, dtype=float) if not isinstance(curve, (str, bytes)) else np.empty(0)
+            if arr.ndim != 2 or arr.shape[1] != 2:
+                raise ParameterError(f"{name}: curve must be a Curve or rows [[phi_rad, tau_Nm], ...]")
+            curve = Curve(arr[:, 0], arr[:, 1], name=name)
+        if curve.extrapolation != "linear":
+            raise ParameterError(f"{name}: curve {curve.name!r} has extrapolation={curve.extrapolation!r}; a "
+                                 "driveline spring needs 'linear' (it may be deflected beyond its points)")
+        xs, fs, ds, kind, _ext = curve.kernel_data()
+        cs = _curve_integrals(xs, fs, ds, kind)
+        m = xs.size
+        cs = cs - _curve_energy_py(np.concatenate([xs, fs, ds, cs]), m, kind, 0.0)   # stored energy 0 at phi = 0
+        table = tuple(xs) + tuple(fs) + tuple(ds) + tuple(cs)
+        self._elements.append(_Element(K.K_SPRING, name, a, b, (0.0, _finite(name, "d", d, nonneg=True),
+                                                                 _finite(name, "phi_rel0", phi_rel0), 0.0),
+                                       law=K.SPRING_CURVE, table=table, aux=int(kind)))
+        return self
+
+    def backlash(self, name: str, a, b, c: float, b_gap: float, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
+        """A spring-damper behind a gap between flanges a and b (as MSL ``ElastoBacklash``): no torque in the
+        gap ``|phi_b - phi_a - phi_rel0| < b_gap / 2``; in contact ``c`` [N m/rad] on the deflection past the
+        gap's edge plus ``d`` [N m s/rad] on the relative speed.  Contact begins at the edge (the damping
+        torque steps in with the impact speed) and ends when the torque would pull; both are located events,
+        ``contact`` and ``separate``.  The energy still in the spring at a damped separation is counted as
+        dissipated (the massless spring relaxes through its damper, taken as instantaneous).  ``c`` > 0,
+        ``b_gap`` [rad] > 0 (without a gap, use :meth:`spring_damper`)."""
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        gap = _finite(name, "b_gap", b_gap, positive=True)
+        self._elements.append(_Element(K.K_SPRING, name, a, b, (_finite(name, "c", c, positive=True),
+                                                                 _finite(name, "d", d, nonneg=True),
+                                                                 _finite(name, "phi_rel0", phi_rel0), gap),
+                                       law=K.SPRING_BACKLASH))
+        return self
+
+    def gear(self, name: str, a, b, ratio: float) -> "Driveline":
+        """An ideal gear between flanges a and b (MSL ``IdealGear``): ``w_a = ratio * w_b``, the torque on
+        flange b ``ratio`` times the torque on flange a and of opposite sign, lossless.  ``ratio`` != 0
+        (negative reverses).  Gears and motion sources may not close a loop (the network would be
+        over-constrained); the initial speeds of the inertias they bind follow from one of them."""
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        ratio = _finite(name, "ratio", ratio)
+        if ratio == 0.0:
+            raise ParameterError(f"{name}: ratio = 0 (a gear needs a ratio != 0)")
+        self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio, 0.0, 0.0, 0.0)))
+        return self
+
+    def _motion(self, name, flange, signal, law, what):
+        name = self._new_name(name)
+        b = self._flange(name, "flange", flange)
+        if b is None:
+            raise ParameterError(f"{name}: a {what} source needs an inertia as its flange, not the ground")
+        sig = Signal.of(signal, f"{name}: {what}")
+        _check_motion_signal(name, what, sig)
+        self._elements.append(_Element(K.K_MOTION, name, None, b, law=law, signal=sig))
+        return self
+
+    def speed(self, name: str, flange, signal) -> "Driveline":
+        """A speed source (MSL ``Speed`` with ``exact = true``): ``flange`` turns at ``signal(t)`` [rad/s]
+        against the ground, whatever torque it takes (reported as the source's torque).  The signal must
+        be continuous (a constant, ramp, table, or a sine starting at zero); its initial value is the
+        flange's initial speed."""
+        return self._motion(name, flange, signal, K.MOTION_SPEED, "speed")
+
+    def position(self, name: str, flange, signal) -> "Driveline":
+        """A position source (MSL ``Position`` with ``exact = true``): ``flange`` follows ``signal(t)`` [rad].
+        The signal must have a continuous speed: a constant or a sine starting at t = 0; its value and
+        rate at 0 are the flange's initial angle and speed.  (For a ramp or table, prescribe the speed.)"""
+        return self._motion(name, flange, signal, K.MOTION_POSITION, "position")
 
     def torque(self, name: str, flange, signal, support=None) -> "Driveline":
         """A torque source [N m] accelerating ``flange`` (its reaction on ``support``, default the ground)."""
@@ -199,7 +431,7 @@ class Driveline:
         peak = _finite(name, "peak", peak)
         if peak < 1.0:
             raise ParameterError(f"{name}: peak = {peak!r} must be >= 1 (static limit = peak x sliding torque at rest)")
-        coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak)
+        coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak, 0.0)
         sig = None if normal is None else Signal.of(normal, f"{name}: normal")
         self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, table))
         return self
@@ -241,31 +473,64 @@ class Driveline:
         a, b = self._two(name, support, flange)
         return self._friction(name, a, b, K.LAW_TABLE, self._characteristic(name, "torque", torque), peak)
 
+    def one_way_clutch(self, name: str, a, b) -> "Driveline":
+        """A one-way clutch (freewheel) between flanges a and b: flange b may overrun flange a freely
+        (``w_b > w_a``, no torque) and locks to it, holding any torque, when it would turn slower.  A
+        located ``stick`` event when it locks, ``forward`` when it overruns; it never slides backward,
+        so it may not start with ``w_b < w_a``."""
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        return self._friction(name, a, b, K.LAW_ONEWAY, (0.0, 0.0), 1.0)
+
     # ---- the system
     def describe(self) -> str:
         """A text schematic: the inertias, then every element between its flanges (``ground`` for none)."""
         fric = self.friction_names
-        lines = [f"{self.name}: {len(self._inertias)} inertias, {len(self._elements)} elements "
+        bodies = "masses" if self.domain == "translational" else "inertias"
+        lines = [f"{self.name}: {len(self._inertias)} {bodies}, {len(self._elements)} elements "
                  f"({len(fric)} friction)"]
-        for name, (J, w0, phi0) in self._inertias.items():
-            lines.append(f"  [{name}]  J = {J:g} kg m^2, w0 = {w0:g} rad/s, phi0 = {phi0:g} rad")
+        x0 = self.initial_state()
+        n = len(self._inertias)
+        u = self._units
+        (jn, ju), (an, _, au), (wn, _, wu), (_, _, tu) = u["inertia"], u["angle"], u["speed"], u["torque"]
+        st, dm = u["stiffness"], u["damping"]
+        for i, (name, (J, _w0, _phi0)) in enumerate(self._inertias.items()):
+            lines.append(f"  [{name}]  {jn} = {J:g} {ju}, {wn}0 = {x0[n + i]:g} {wu}, {an}0 = {x0[i]:g} {au}")
         for e in self._elements:
             a, b = e.a or GROUND, e.b or GROUND
             if e.kind == K.K_SOURCE:
-                lines.append(f"  {a} --({e.name}: torque {e.signal.describe('N m')})--> [{b}]")
+                lines.append(f"  {a} --({e.name}: {u['words'][2]} {e.signal.describe(tu)})--> [{b}]")
                 continue
-            if e.kind == K.K_SPRING:
-                what = f"spring-damper c = {e.coef[0]:g} N m/rad, d = {e.coef[1]:g} N m s/rad"
+            if e.kind == K.K_MOTION:
+                what, unit = ("speed", wu) if e.law == K.MOTION_SPEED else (u["words"][1], au)
+                lines.append(f"  {a} --({e.name}: {what} {e.signal.describe(unit)})--> [{b}]")
+                continue
+            if e.kind == K.K_GEAR:
+                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
+            elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
+                what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
+            elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
+                what = f"backlash gap {e.coef[3]:g} {au}, c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+            elif e.kind == K.K_SPRING:
+                what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+            elif e.law == K.LAW_ONEWAY:
+                what = "one-way clutch (b overruns a freely)"
             else:
                 n = len(e.table) // 2
                 char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
                 if e.law == K.LAW_TABLE:
-                    what = f"bearing friction {char} N m, peak {e.coef[2]:g}"
+                    what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
                 else:
                     normal = "" if e.signal is None else f", normal {e.signal.describe()}"
                     what = f"friction fn_max = {e.coef[0]:g} N, mu {char}, peak {e.coef[2]:g}{normal}"
             lines.append(f"  [{a}] --({e.name}: {what})-- [{b}]")
         return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        try:
+            return f"<Driveline {self.describe()}>"
+        except ParameterError as exc:   # an inconsistent network still shows
+            return f"<Driveline {self.name!r}: {exc}>"
 
     @property
     def friction_names(self) -> tuple:
@@ -277,8 +542,8 @@ class Driveline:
             raise ParameterError(f"{self.name}: no inertia")
         index = {n: i for i, n in enumerate(self._inertias)}
         signals, data = [], []
-        elem = np.zeros((len(self._elements), 8), dtype=np.int64)
-        coef = np.zeros((len(self._elements), 3))
+        elem = np.zeros((len(self._elements), K.N_ELEM), dtype=np.int64)
+        coef = np.zeros((len(self._elements), K.N_COEF))
 
         def add_signal(sig):
             row = list(sig.row)
@@ -297,59 +562,168 @@ class Driveline:
             elem[r, K.E_SIGNAL] = -1 if e.signal is None else add_signal(e.signal)
             if e.table:
                 elem[r, K.E_TABLE] = len(data)
-                elem[r, K.E_TABLE_N] = len(e.table) // 2
+                elem[r, K.E_TABLE_N] = len(e.table) // (4 if e.kind == K.K_SPRING else 2)
                 data.extend(e.table)
+            elem[r, K.E_AUX] = e.aux
+            elem[r, K.E_MODE] = -1
             coef[r] = e.coef
         fric = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_FRICTION], dtype=np.int64)
-        n, ne, nf = len(index), len(self._elements), fric.size
-        work = np.zeros(K.work_size(n, nf, ne))
+        cons = np.array([r for r, e in enumerate(self._elements) if e.kind in (K.K_GEAR, K.K_MOTION)], dtype=np.int64)
+        swit = np.array([r for r, e in enumerate(self._elements)
+                         if e.kind == K.K_SPRING and e.law in (K.SPRING_BACKLASH, K.SPRING_CURVE)], dtype=np.int64)
+        elem[swit, K.E_MODE] = fric.size + np.arange(swit.size)
+        n, ne, nk = len(index), len(self._elements), fric.size + cons.size
+        work = np.zeros(K.work_size(n, nk, ne, fric.size))
         inertia = np.array([v[0] for v in self._inertias.values()])
+        p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
+                              np.array(data, dtype=float), fric, cons, swit, work,
+                              np.zeros(max(nk, 1), dtype=np.int64))
         x0 = self.initial_state()
-        work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(x0, index)
-        return K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
-                                 np.array(data, dtype=float), fric, work, np.zeros(max(nf, 1), dtype=np.int64))
+        work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
+        return p
 
-    def _spring_energy(self, x0, index):
-        e_sum = 0.0
-        for e in self._elements:
-            if e.kind == K.K_SPRING:
-                pa = 0.0 if e.a is None else x0[index[e.a]]
-                pb = 0.0 if e.b is None else x0[index[e.b]]
-                e_sum += 0.5 * e.coef[0] * (pb - pa - e.coef[2]) ** 2
-        return e_sum
+    def _spring_energy(self, p, x0):
+        """Energy stored in the springs at ``x0`` [J] (as :func:`~clutchlab.driveline.kernel.spring_energy`)."""
+        total = 0.0
+        for r, e in enumerate(self._elements):
+            if e.kind != K.K_SPRING:
+                continue
+            pa = 0.0 if e.a is None else x0[list(self._inertias).index(e.a)]
+            pb = 0.0 if e.b is None else x0[list(self._inertias).index(e.b)]
+            phi = pb - pa - e.coef[2]
+            if e.law == K.SPRING_CURVE:
+                m = len(e.table) // 4
+                total += _curve_energy_py(np.asarray(e.table), m, e.aux, phi)
+            elif e.law == K.SPRING_BACKLASH:   # in the initial contact mode, from the deflection
+                q = abs(phi) - 0.5 * e.coef[3]
+                total += 0.5 * e.coef[0] * q * q if q > 0 else 0.0
+            else:
+                total += 0.5 * e.coef[0] * phi * phi
+        return total
 
     def initial_state(self) -> np.ndarray:
-        """Angles, speeds, then the energy states (zero)."""
-        n = len(self._inertias)
+        """Angles, speeds, then the energy states (zero).
+
+        Speeds left out follow from the motion sources and gears (a source sets its flange, a gear
+        ``w_a = ratio w_b`` carries it on); speeds given must agree with them, to 1e-9 relative.  Raises
+        :class:`~clutchlab.errors.ParameterError` on a disagreement or a loop of gears and motion sources.
+        """
+        names = list(self._inertias)
+        index = {nm: i for i, nm in enumerate(names)}
+        n = len(names)
         x = np.zeros(2 * n + len(self._elements))
-        for i, (J, w0, phi0) in enumerate(self._inertias.values()):
-            x[i] = phi0
-            x[n + i] = w0
+        w = [v[1] for v in self._inertias.values()]
+        phi = [v[2] for v in self._inertias.values()]
+        groups = _Groups(n)
+        links = {i: [] for i in range(n)}
+        fixed = {}
+        for e in self._elements:
+            if e.kind not in (K.K_GEAR, K.K_MOTION):
+                continue
+            ia = -1 if e.a is None else index[e.a]
+            ib = -1 if e.b is None else index[e.b]
+            if not groups.union(ia, ib):
+                raise ParameterError(f"{self.name}: {e.name} closes a loop of gears and motion sources "
+                                     "(the network is over-constrained)")
+            if e.kind == K.K_MOTION:
+                v, rate = e.signal.value_and_rate(0.0)
+                fixed[ib] = (v if e.law == K.MOTION_SPEED else rate, e.name)
+                if e.law == K.MOTION_POSITION:
+                    if phi[ib] is not None and not math.isclose(phi[ib], v, rel_tol=1e-9, abs_tol=1e-12):
+                        raise ParameterError(f"{names[ib]}: phi0 = {phi[ib]:g} rad but {e.name} starts it at {v:g} rad")
+                    phi[ib] = v
+            elif ia >= 0 and ib >= 0:
+                links[ia].append((ib, 1.0 / e.coef[0], e.name))   # w_b = w_a / ratio
+                links[ib].append((ia, e.coef[0], e.name))         # w_a = ratio w_b
+            else:   # a gear to the ground holds its flange at rest
+                fixed[ia if ia >= 0 else ib] = (0.0, e.name)
+        value = [None] * n
+
+        def assign(i, v, why):
+            if w[i] is not None and not math.isclose(w[i], v, rel_tol=1e-9, abs_tol=1e-12):
+                raise ParameterError(f"{names[i]}: w0 = {w[i]:g} rad/s but {why} gives {v:g} rad/s")
+            value[i] = v
+
+        def spread(start):
+            todo = [start]
+            while todo:
+                i = todo.pop()
+                for j, factor, gname in links[i]:
+                    if value[j] is None:
+                        assign(j, factor * value[i], f"{gname} from {names[i]}")
+                        todo.append(j)
+
+        for i, (v, why) in fixed.items():
+            assign(i, v, why)
+            spread(i)
+        for i in range(n):   # the first speed given in each remaining group, else rest
+            if value[i] is None and w[i] is not None:
+                value[i] = w[i]
+                spread(i)
+        for i in range(n):
+            if value[i] is None:
+                value[i] = 0.0
+                spread(i)
+        for i in range(n):
+            x[i] = 0.0 if phi[i] is None else phi[i]
+            x[n + i] = value[i]
         return x
 
     def _initial_modes(self, p, x0):
+        """Friction modes from the initial relative speeds and normal forces, then the backlash contacts
+        from the deflections (at the edge of the gap, in contact if moving into it) and the segments of the
+        curve springs (at a point, the segment it moves onto)."""
         n = len(self._inertias)
-        m = np.empty(p.fric.size, dtype=np.int64)
+        m = np.empty(p.fric.size + p.swit.size, dtype=np.int64)
+        for j, r in enumerate(p.swit):
+            e = self._elements[r]
+            pa = 0.0 if e.a is None else x0[p.elem[r][K.E_A]]
+            pb = 0.0 if e.b is None else x0[p.elem[r][K.E_B]]
+            w_rel = (0.0 if e.b is None else x0[n + p.elem[r][K.E_B]]) - (0.0 if e.a is None else x0[n + p.elem[r][K.E_A]])
+            phi = pb - pa - e.coef[2]
+            if e.law == K.SPRING_CURVE:
+                xs = np.asarray(e.table[:len(e.table) // 4])
+                m[p.fric.size + j] = int(np.searchsorted(xs, phi, side="left" if w_rel < 0 else "right"))
+                continue
+            b2 = 0.5 * e.coef[3]
+            upper = phi > b2 or (phi == b2 and w_rel > 0)
+            lower = phi < -b2 or (phi == -b2 and w_rel < 0)
+            m[p.fric.size + j] = K.LASH_UPPER if upper else K.LASH_LOWER if lower else K.LASH_GAP
         for k, r in enumerate(p.fric):
             e = p.elem[r]
             w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
-            free = e[K.E_LAW] != K.LAW_TABLE and K.normal_force(p, r, 0.0) <= 0.0
+            el = self._elements[r]
+            if el.law == K.LAW_CLUTCH:   # as kernel._is_free: negative, or zero and not rising
+                value, rate = (1.0, 0.0) if el.signal is None else el.signal.value_and_rate(0.0)
+                fn, dfn = el.coef[0] * value, el.coef[0] * rate
+                free = fn < 0.0 or (fn == 0.0 and dfn <= 0.0)
+            else:
+                free = False
+            if e[K.E_LAW] == K.LAW_ONEWAY and w_rel < 0:
+                raise ParameterError(f"{self._elements[r].name}: a one-way clutch cannot start with flange b slower "
+                                     f"than flange a (w_b - w_a = {w_rel:g} rad/s)")
             m[k] = K.FREE if free else K.FORWARD if w_rel > 0 else K.BACKWARD if w_rel < 0 else K.STUCK
         return m
 
     def variables(self):
         """States and outputs as ``(name, unit, description)`` (column ``<component>.<quantity>_<unit>``)."""
-        states = [(f"{i}.phi", "rad", f"angle of {i}") for i in self._inertias]
-        states += [(f"{i}.w", "rad_s", f"speed of {i}") for i in self._inertias]
+        u = self._units
+        (an, au, _), (wn, wu, _), (tn, tu, _), (rn, ru, _) = u["angle"], u["speed"], u["torque"], u["relative"]
+        word = u["words"][2]
+        states = [(f"{i}.{an}", au, f"{u['words'][1]} of {i}") for i in self._inertias]
+        states += [(f"{i}.{wn}", wu, f"speed of {i}") for i in self._inertias]
         outputs = []
         for e in self._elements:
-            if e.kind == K.K_SOURCE:
+            if e.kind in (K.K_SOURCE, K.K_MOTION):
                 states.append((f"{e.name}.work", "J", f"work of the source {e.name}"))
-                outputs.append((f"{e.name}.tau", "Nm", f"torque of the source {e.name} on its flange"))
+                outputs.append((f"{e.name}.{tn}", tu, f"{word} of the source {e.name} on its flange"))
+            elif e.kind == K.K_GEAR:
+                states.append((f"{e.name}.dissipated", "J", f"energy lost in {e.name} (zero but for drift)"))
+                outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} on flange a (on flange b: -ratio {tn})"))
             else:
                 states.append((f"{e.name}.dissipated", "J", f"energy dissipated in {e.name}"))
-                outputs.append((f"{e.name}.tau", "Nm", f"torque of {e.name} (on flange b: -tau)"))
-                outputs.append((f"{e.name}.w_rel", "rad_s", f"relative speed of {e.name}, flange b minus flange a"))
+                outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} (on flange b: -{tn})"))
+                outputs.append((f"{e.name}.{rn}", ru, f"relative speed of {e.name}, flange b minus flange a"))
         for name in self.friction_names:
             outputs.append((f"{name}.mode", "1", f"mode of {name}: 1 forward, 0 stuck, -1 backward, 2 free (MSL)"))
             outputs.append((f"{name}.fn", "N", f"normal force of {name}"))
@@ -368,10 +742,17 @@ class Driveline:
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric
                           for what, d in (("stick", -1), ("breakaway", -1), ("normal", 0)))
+        swit = [self._elements[r] for r in p.swit]
+        switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH else -1) for e in swit
+                           for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
+                                        else ("segment_below", "segment_above")))
+        named = fric + tuple(e.name for e in swit)
+        swit_values = tuple(K.LASH_VALUES if e.law == K.SPRING_BACKLASH else
+                            tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
         n = len(self._inertias)
         scale = np.concatenate([np.full(n, 1.0), np.full(n, 1.0), np.full(len(self._elements), 1.0)])
 
-        def element_name(code, element, _names=fric):
+        def element_name(code, element, _names=named):
             return _names[element] if 0 <= element < len(_names) else ""
 
         # the switching functions follow the sources: a step holds at most an eighth of a sine's period, so a
@@ -380,7 +761,8 @@ class Driveline:
         max_step = min((0.125 / f for f in freqs if f > 0), default=math.inf)
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
                       m0=self._initial_modes(p, x0), atol=float(rtol) * scale, switching=switching,
-                      events=K.EVENTS, mode_names=fric, mode_values=tuple(K.MODE_VALUES for _ in fric),
+                      events=K.EVENTS, mode_names=named,
+                      mode_values=tuple(K.MODE_VALUES for _ in fric) + swit_values,
                       method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name)
 

@@ -465,6 +465,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         h = initial_step(x, k1, rtol, atol, t_end - t, 5)
     tb = model.next_break(t, m, p)
     prev_rej = False
+    n_dips = 0
     while t < t_end:
         status = _run_limit(si, opt, grid, cap, i_rec)
         if status != SUCCESS:
@@ -477,10 +478,15 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             tb = _at_break(p, t, x, u, m, log, k1, g0, si)
             continue
         h, last = _clip_step(h, t, t_stop, opt.max_step)
+        c_dip = 2.0
+        k_dip = -1
         if h < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
         t1 = t_stop if last else t + h  # the step end, exactly as the step will end (stages with c = 1)
+        # a step cut at a break evaluates its c = 1 stages at the inputs' left limits: a jump there (a step of a
+        # torque, the corner of a prescribed speed's ramp) belongs to the next step, which restarts at the break
+        t1s = t1 - 1e-15 * max(1.0, abs(t1)) if last else t1
         for stg in range(1, 7):
             # the stage points written out (a loop over a coefficient table makes each state's sum one chain
             # of dependent additions through memory: measured as most of the loop's own time); the sums run
@@ -506,7 +512,13 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if stg == 6:
                 for i in range(n):
                     xn[i] = xt[i]
-            model.rhs_stage(t1 if tab_c[stg] == 1.0 else t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
+            model.rhs_stage(t1s if tab_c[stg] == 1.0 else t + tab_c[stg] * h, xt, u, m, p, K[stg], g1)
+            if stg <= 4 and c_dip > 1.0:
+                for k in range(ng):
+                    if (g0[k] > 0.0 and g1[k] < 0.0) or (g0[k] < 0.0 and g1[k] > 0.0):
+                        c_dip = tab_c[stg]
+                        k_dip = k
+                        break
         si[SI_NRHS] += 6
         for i in range(n):
             err[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
@@ -519,6 +531,23 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 h = next_step(h, en, False)
             prev_rej = True
             continue
+        # a switching function that changed sign at an inner stage but not by the step's end may have crossed
+        # zero and come back within the step (a stuck clutch's slip dipping through zero): the step is retried
+        # shorter, at most 4 times in a row, so that its end falls in the dip and the crossing is located
+        retry = False
+        if c_dip <= 1.0 and n_dips < 4 and h > 64.0 * opt.event_tol:
+            if g0[k_dip] * g1[k_dip] > 0.0:
+                retry = True
+                for k in range(ng):   # (the test of _may_cross, written out: inlined twice it trips numba's SSA check)
+                    if _crossed(g0[k], g1[k], opt.gdir[k]) or (g0[k] == 0.0 and g1[k] != 0.0):
+                        retry = False
+                        break
+        if retry:
+            n_dips += 1
+            si[SI_REJECTED] += 1
+            h = 0.9 * c_dip * h
+            continue
+        n_dips = 0
         # ---- events on the dense output (its order-4 term only where it is read)
         samples = grid and i_rec < ts.shape[0] and ts[i_rec] <= t1
         if _may_cross(g0, g1, opt.gdir):

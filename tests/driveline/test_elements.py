@@ -1,0 +1,339 @@
+"""Gears, motion sources, one-way clutches, backlash and nonlinear springs against closed forms.
+
+Every expected value here is derived by hand in the test's docstring (constant accelerations, harmonic
+arcs, energy integrals computed by SciPy's adaptive quadrature), not from the package's own integrator.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import integrate
+
+from clutchlab.curves import Curve
+from clutchlab.driveline import Driveline, Signal
+from clutchlab.errors import DataError, ParameterError
+from hypothesis_budget import examples
+
+
+def _events(result, component=None):
+    ev = result.events
+    if component is not None:
+        ev = ev[ev["element"] == component]
+    return list(zip(ev["time_s"], ev["event"]))
+
+
+# ----------------------------------------------------------------- gears
+def test_gear_reflects_inertia_and_scales_torque():
+    """Torque T on J1, gear ``w1 = i w2`` to J2: ``a1 = T / (J1 + J2 / i^2)``, ``a2 = a1 / i``; the gear's
+    torque on flange b is ``J2 a2 = -i tau``.  Lossless: input work = kinetic energy."""
+    T, J1, J2, i = 3.0, 0.2, 5.0, 4.0
+    d = Driveline("gear")
+    d.inertia("J1", J=J1, w0=8.0).inertia("J2", J=J2)
+    d.torque("T", "J1", T)
+    d.gear("g", "J1", "J2", ratio=i)
+    df = d.simulate(2.0, output_step=0.5).to_dataframe()
+    a1 = T / (J1 + J2 / i ** 2)
+    t = df["time_s"].to_numpy()
+    assert np.allclose(df["J1.w_rad_s"], 8.0 + a1 * t, rtol=1e-10, atol=1e-10)
+    assert np.allclose(df["J2.w_rad_s"], (8.0 + a1 * t) / i, rtol=1e-10, atol=1e-10)
+    assert np.allclose(df["g.tau_Nm"], -J2 * a1 / i / i, rtol=1e-9)
+    assert abs(df["energy_error_J"]).max() < 1e-9 * df["input_work_J"].max()
+    assert abs(df["g.dissipated_J"]).max() < 1e-9 * df["input_work_J"].max()
+
+
+def test_gear_clutch_launch_locks_at_the_closed_form_time():
+    """An engine J1 (torque T, starting at W) slips a clutch (sliding torque Tc = mu fn) onto J2, geared
+    ``w2 = i w3`` to a vehicle J3: ``a1 = (T - Tc) / J1``, ``a2 = Tc / (J2 + J3 / i^2)``; it locks when
+    ``W + a1 t = a2 t`` and then all three turn together: ``a = T / (J1 + J2 + J3 / i^2)``."""
+    T, Tc, J1, J2, J3, i, W = 20.0, 60.0, 0.25, 0.05, 120.0, 10.0, 100.0
+    d = Driveline("launch")
+    d.inertia("engine", J=J1, w0=W).inertia("input", J=J2).inertia("vehicle", J=J3)
+    d.torque("T", "engine", T)
+    d.clutch("clutch", "engine", "input", fn_max=Tc / 0.4, mu=0.4)
+    d.gear("gearbox", "input", "vehicle", ratio=i)
+    res = d.simulate(1.0, output_step=0.25)
+    a1 = (T - Tc) / J1
+    a2 = Tc / (J2 + J3 / i ** 2)
+    t_lock = W / (a2 - a1)
+    (t_ev, name), = _events(res, "clutch")
+    assert name == "stick" and t_ev == pytest.approx(t_lock, abs=1e-9)
+    df = res.to_dataframe()
+    a = T / (J1 + J2 + J3 / i ** 2)
+    w_end = a2 * t_lock + a * (1.0 - t_lock)
+    assert df["engine.w_rad_s"].iloc[-1] == pytest.approx(w_end, rel=1e-9)
+    assert df["vehicle.w_rad_s"].iloc[-1] == pytest.approx(w_end / i, rel=1e-9)
+    # the lost energy is the slip work: Tc times the integral of the slip speed W + (a1 - a2) t
+    lost = Tc * (W * t_lock + 0.5 * (a1 - a2) * t_lock ** 2)
+    assert df["clutch.dissipated_J"].iloc[-1] == pytest.approx(lost, rel=1e-9)
+
+
+# ----------------------------------------------------------------- motion sources
+def test_speed_source_ramp_drives_inertia_damper_and_a_slipping_clutch():
+    """A speed source ramps J1 from 0 to 50 rad/s in 1 s (the ramp's corner at 1 s is a jump of the
+    acceleration: exact only if the step before it does not see the next one), J1 has a damper d to ground and a clutch
+    (sliding torque Tc) to a free J2.  Source torque = J1 a + d w + Tc while J2 slips; J2 gains Tc/J2
+    per second and sticks when ``Tc/J2 t = 50`` (after the ramp: ``t = 50 J2 / Tc``); then the source
+    carries ``d w`` alone.  Work of the source = kinetic energy + damper and clutch losses."""
+    J1, J2, dmp, Tc = 0.5, 2.0, 0.1, 40.0
+    d = Driveline("speed")
+    d.inertia("J1", J=J1).inertia("J2", J=J2)
+    d.speed("drive", "J1", Signal.ramp(50.0, 1.0))
+    d.spring_damper("damper", "ground", "J1", d=dmp)
+    d.clutch("clutch", "J1", "J2", fn_max=Tc, mu=1.0)
+    res = d.simulate(3.0, sample_times=[0.5, 1.5, 2.9])
+    df = res.to_dataframe()
+    assert np.allclose(df["J1.w_rad_s"], [25.0, 50.0, 50.0], rtol=1e-10)
+    assert df["drive.tau_Nm"].iloc[0] == pytest.approx(J1 * 50.0 + dmp * 25.0 + Tc, rel=1e-9)
+    assert df["drive.tau_Nm"].iloc[1] == pytest.approx(dmp * 50.0 + Tc, rel=1e-9)
+    assert df["drive.tau_Nm"].iloc[2] == pytest.approx(dmp * 50.0, rel=1e-9)
+    # at rest together, the clutch cannot carry J2's share (J2 * 50 > Tc): it slides (J2 behind J1) at once
+    (t0, e0), (t1, e1) = _events(res, "clutch")
+    assert (t0, e0) == (0.0, "backward")
+    assert e1 == "stick" and t1 == pytest.approx(50.0 * J2 / Tc, abs=1e-9)
+    assert abs(df["energy_error_J"]).max() < 1e-9 * df["input_work_J"].max()
+
+
+def test_position_source_sine_needs_the_torque_of_the_closed_form():
+    """Position ``A sin(w t)`` on J with a spring c to ground: torque ``(c - J w^2) A sin(w t)``; the
+    source starts J at ``phi = 0``, ``w = A w``."""
+    J, c, A, f = 0.3, 50.0, 0.2, 2.0
+    om = 2.0 * math.pi * f
+    d = Driveline("position")
+    d.inertia("J", J=J)
+    d.position("servo", "J", Signal.sine(A, f))
+    d.spring_damper("spring", "ground", "J", c=c)
+    ts = np.linspace(0.01, 1.0, 17)
+    df = d.simulate(1.0, sample_times=ts).to_dataframe()
+    assert np.allclose(df["J.phi_rad"], A * np.sin(om * ts), atol=1e-8)
+    assert np.allclose(df["J.w_rad_s"], A * om * np.cos(om * ts), atol=1e-7)
+    assert np.allclose(df["servo.tau_Nm"], (c - J * om ** 2) * A * np.sin(om * ts), atol=1e-7)
+
+
+# ----------------------------------------------------------------- one-way clutch
+def test_one_way_clutch_overruns_and_locks_at_closed_form_times():
+    """J1 (flange a) driven by +2 N m, -2 N m from 1 s, +2 N m from 2 s; J2 (flange b) behind a freewheel.
+    Locked they share ``a = 1``; at 1 s the torque turns and J2 overruns at 1 rad/s while J1 decelerates
+    at 2, to -1 rad/s at 2 s, and catches J2 up at 3 s: ``forward`` at 1 s, ``stick`` at 3 s; J2 ends at
+    1 + (4 - 3) = 2 rad/s."""
+    d = Driveline("freewheel")
+    d.inertia("J1", J=1.0).inertia("J2", J=1.0)
+    d.torque("T1", "J1", Signal.step(-4.0, start=1.0, offset=2.0))
+    d.torque("T2", "J1", Signal.step(4.0, start=2.0))
+    d.one_way_clutch("freewheel", "J1", "J2")
+    res = d.simulate(4.0, sample_times=[0.5, 1.5, 2.5, 4.0])
+    got = _events(res, "freewheel")
+    assert [e for _, e in got] == ["forward", "stick"]
+    assert got[0][0] == pytest.approx(1.0, abs=1e-9) and got[1][0] == pytest.approx(3.0, abs=1e-9)
+    df = res.to_dataframe()
+    assert np.allclose(df["J2.w_rad_s"], [0.5, 1.0, 1.0, 2.0], atol=1e-9)
+    assert np.allclose(df["J1.w_rad_s"], [0.5, 0.0, 0.0, 2.0], atol=1e-9)
+    assert df["freewheel.tau_Nm"].iloc[0] == pytest.approx(-1.0, rel=1e-9)   # holds J2 against overrun
+    assert df["freewheel.tau_Nm"].iloc[1] == 0.0                              # overrunning: no torque
+
+
+# ----------------------------------------------------------------- backlash
+def test_backlash_contacts_and_separations_at_closed_form_times():
+    """J at v0 in the middle of a gap b (spring c beyond it, no damping): contact after ``b/2 / v0``, half a
+    period ``pi sqrt(J/c)`` in contact, leaving at -v0, crossing the gap ``b`` in ``b / v0``, and so on.
+    No damping: the energy stays ``J v0^2 / 2``."""
+    J, c, b, v0 = 0.5, 200.0, 0.2, 2.0
+    d = Driveline("lash")
+    d.inertia("J", J=J, w0=v0)
+    d.backlash("lash", "ground", "J", c=c, b_gap=b)
+    res = d.simulate(1.0, output_step=1e-3, rtol=1e-10)   # measured energy drift: 2e-7 at rtol 1e-8, 2e-9 at 1e-10
+    half = math.pi * math.sqrt(J / c)
+    expected, t, kinds = [], 0.5 * b / v0, []
+    while t < 1.0:
+        expected += [t, t + half]
+        kinds += ["contact", "separate"]
+        t += half + b / v0
+    got = _events(res, "lash")
+    n = min(len(expected), len(got))
+    assert n >= 6
+    assert [e for _, e in got[:n]] == kinds[:n]
+    assert np.allclose([tt for tt, _ in got[:n]], expected[:n], atol=1e-9)
+    df = res.to_dataframe()
+    total = df["kinetic_energy_J"] + df["spring_energy_J"]
+    assert np.allclose(total, 0.5 * J * v0 ** 2, rtol=1e-8)
+
+
+def test_backlash_damping_never_pulls_and_the_balance_closes():
+    """With damping, contact ends when the torque would pull: the contact torque never changes sign, the
+    gap carries none, dissipation grows and the balance closes (the spring's energy at a separation before
+    the edge counted as dissipated).  The first contact has the closed form of a damped oscillator:
+    ``phi - b/2 = v0 / wd exp(-z wn t) sin(wd t)``, ``tau = c (phi - b/2) + d w``, which falls to zero
+    before half a damped period; the test finds that root with SciPy's brentq."""
+    from scipy.optimize import brentq
+
+    J, c, gap, dmp, v0 = 0.1, 500.0, 0.05, 2.0, 3.0
+    d = Driveline("lash")
+    d.inertia("J", J=J, w0=v0)
+    d.backlash("lash", "ground", "J", c=c, b_gap=gap, d=dmp)
+    res = d.simulate(1.0, output_step=1e-4, rtol=1e-10)   # measured balance: 3.6e-8 J at rtol 1e-8, 3.3e-10 at 1e-10
+    df = res.to_dataframe()
+    phi = df["J.phi_rad"].to_numpy()
+    tau = df["lash.tau_Nm"].to_numpy()
+    assert np.all(tau[phi > 0.5 * gap] >= -1e-9) and np.all(tau[phi < -0.5 * gap] <= 1e-9)
+    assert np.all(tau[np.abs(phi) < 0.5 * gap - 1e-9] == 0.0)
+    assert np.all(np.diff(df["lash.dissipated_J"]) >= -1e-12)
+    assert abs(df["energy_error_J"]).max() < 1e-9
+    wn, z = math.sqrt(c / J), dmp / (2.0 * math.sqrt(c * J))
+    wd = wn * math.sqrt(1.0 - z * z)
+    t0 = 0.5 * gap / v0
+
+    def torque(s):
+        x = v0 / wd * math.exp(-z * wn * s) * math.sin(wd * s)
+        v = v0 * math.exp(-z * wn * s) * (math.cos(wd * s) - z * wn / wd * math.sin(wd * s))
+        return c * x + dmp * v
+
+    t_sep = t0 + brentq(torque, 1e-6, math.pi / wd)
+    got = _events(res, "lash")
+    assert got[0][1] == "contact" and got[0][0] == pytest.approx(t0, abs=1e-9)
+    assert got[1][1] == "separate" and got[1][0] == pytest.approx(t_sep, abs=1e-8)
+
+
+# ----------------------------------------------------------------- nonlinear springs
+@pytest.mark.parametrize("kind", ["linear", "pchip"])
+def test_curve_spring_stores_the_integral_of_its_curve(kind):
+    """A stiffening curve spring oscillating without damping keeps kinetic + stored energy at its initial
+    value; the stored energy at each sample equals SciPy's adaptive quadrature of the curve."""
+    curve = Curve([-0.3, -0.1, 0.0, 0.1, 0.3], [-90.0, -12.0, 0.0, 12.0, 90.0], kind=kind)
+    d = Driveline("curve")
+    d.inertia("J", J=0.05, w0=25.0)
+    d.spring("k", "ground", "J", curve)
+    # the curve's slope (linear) or curvature (pchip) jumps at its points, located as the spring moves from
+    # segment to segment: the energy error is proportional to the tolerance (measured 3e-7 and 1e-6 relative at
+    # rtol 1e-8, 3e-9 and 1e-9 at 1e-10; 5e-6 and 1e-5 at 1e-8 when the points were stepped over)
+    df = d.simulate(0.5, output_step=0.01, rtol=1e-10).to_dataframe()
+    stored = [integrate.quad(lambda s: float(curve(s)), 0.0, p, epsabs=1e-13, limit=200)[0] for p in df["J.phi_rad"]]
+    assert np.allclose(df["spring_energy_J"], stored, atol=1e-10)
+    assert np.allclose(df["kinetic_energy_J"] + df["spring_energy_J"], 0.5 * 0.05 * 625.0, rtol=1e-8)
+    assert df["J.phi_rad"].max() > 0.3   # beyond the points: the extrapolation is integrated too
+    assert set(df["k"]) == {f"segment {i}" for i in range(6)}   # every segment visited, each a mode
+
+
+def test_linear_curve_spring_equals_the_spring_damper():
+    a = Driveline("a").inertia("J", J=0.2, w0=4.0, phi0=0.05)
+    a.spring_damper("k", "ground", "J", c=30.0, d=0.4)
+    b = Driveline("b").inertia("J", J=0.2, w0=4.0, phi0=0.05)
+    b.spring("k", "ground", "J", [[-1.0, -30.0], [1.0, 30.0]], d=0.4)
+    ya = a.simulate(1.0, output_step=0.05).to_dataframe()
+    yb = b.simulate(1.0, output_step=0.05).to_dataframe()
+    for col in ("J.phi_rad", "J.w_rad_s", "k.tau_Nm", "spring_energy_J", "k.dissipated_J"):
+        assert np.allclose(ya[col], yb[col], rtol=1e-9, atol=1e-11), col
+
+
+# ----------------------------------------------------------------- errors
+@pytest.mark.parametrize("build, match", [
+    (lambda d: d.gear("g", "J1", "J2", ratio=0.0), "ratio = 0"),
+    (lambda d: d.gear("g", "J1", "J2", 2.0).gear("h", "J2", "J1", 0.5).initial_state(), "closes a loop"),
+    (lambda d: d.speed("s", "J1", 1.0).speed("s2", "J1", 2.0).initial_state(), "closes a loop"),
+    (lambda d: d.speed("s", "J1", Signal.step(1.0, 0.5)), "speed step would need an infinite torque"),
+    (lambda d: d.position("s", "J1", Signal.ramp(1.0, 1.0)), "position source needs a signal with a continuous"),
+    (lambda d: d.speed("s", "ground", 1.0), "needs an inertia as its flange"),
+    (lambda d: d.backlash("l", "J1", "J2", c=1.0, b_gap=0.0), "b_gap = 0.0 must be > 0"),
+    (lambda d: d.spring("k", "J1", "J2", [[0.0, 1.0]]), "needs at least 2 samples"),
+    (lambda d: d.spring("k", "J1", "J2", Curve([0, 1], [0, 1], extrapolation="error")), "needs 'linear'"),
+])
+def test_bad_elements_give_one_clear_error(build, match):
+    d = Driveline("bad")
+    d.inertia("J1", J=1.0).inertia("J2", J=1.0)
+    with pytest.raises((ParameterError, DataError), match=match):
+        build(d)
+
+
+def test_initial_speeds_follow_gears_and_sources_and_conflicts_are_named():
+    d = Driveline("ok")
+    d.inertia("J1", J=1.0).inertia("J2", J=1.0).inertia("J3", J=1.0)
+    d.speed("s", "J1", Signal.ramp(10.0, 1.0, offset=6.0))
+    d.gear("g1", "J1", "J2", 3.0).gear("g2", "J3", "J2", 0.5)
+    x0 = d.initial_state()
+    assert list(x0[3:6]) == pytest.approx([6.0, 2.0, 1.0])
+    bad = Driveline("bad")
+    bad.inertia("J1", J=1.0, w0=10.0).inertia("J2", J=1.0, w0=4.0)
+    bad.gear("g", "J1", "J2", 2.0)
+    with pytest.raises(ParameterError, match=r"J2: w0 = 4 rad/s but g from J1 gives 5 rad/s"):
+        bad.initial_state()
+    ow = Driveline("ow").inertia("J1", J=1.0, w0=3.0).inertia("J2", J=1.0, w0=1.0)
+    ow.one_way_clutch("fw", "J1", "J2")
+    with pytest.raises(ParameterError, match="fw: a one-way clutch cannot start"):
+        ow.system()
+
+
+# ----------------------------------------------------------------- energy as a property
+@st.composite
+def networks(draw):
+    """A random chain of 2-4 inertias, each link a spring-damper, backlash, curve spring, gear, one-way
+    clutch or clutch; sine torques or a speed source on some."""
+    n = draw(st.integers(2, 4))
+    d = Driveline("random")
+    driven = draw(st.integers(-1, n - 1))   # the inertia on a speed source (-1: none)
+    for i in range(n):
+        d.inertia(f"J{i}", J=draw(st.floats(0.05, 2.0)))
+    kinds = [draw(st.sampled_from(["spring", "backlash", "curve", "gear", "oneway", "clutch"])) for _ in range(n - 1)]
+    for i, kind in enumerate(kinds):
+        a, b = f"J{i}", f"J{i + 1}"
+        if kind == "spring":
+            d.spring_damper(f"k{i}", a, b, c=draw(st.floats(0.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
+        elif kind == "backlash":
+            d.backlash(f"k{i}", a, b, c=draw(st.floats(1.0, 500.0)), b_gap=draw(st.floats(0.01, 0.5)),
+                       d=draw(st.floats(0.0, 2.0)), phi_rel0=draw(st.floats(-0.2, 0.2)))
+        elif kind == "curve":
+            k1, k3 = draw(st.floats(1.0, 100.0)), draw(st.floats(0.0, 500.0))
+            d.spring(f"k{i}", a, b, Curve.from_function(lambda x: k1 * x + k3 * x ** 3, np.linspace(-0.5, 0.5, 9),
+                                                        kind=draw(st.sampled_from(["linear", "pchip"]))),
+                     d=draw(st.floats(0.0, 1.0)))
+        elif kind == "gear":
+            d.gear(f"g{i}", a, b, ratio=draw(st.floats(0.2, 5.0)) * draw(st.sampled_from([-1.0, 1.0])))
+        elif kind == "oneway":
+            d.one_way_clutch(f"f{i}", a, b)
+        else:
+            d.clutch(f"c{i}", a, b, fn_max=draw(st.floats(0.0, 100.0)), mu=draw(st.floats(0.05, 0.6)),
+                     peak=draw(st.floats(1.0, 1.5)),
+                     normal=Signal.sine(1.0, draw(st.floats(0.1, 3.0)), phase=draw(st.floats(0.0, 6.0))))
+    if driven >= 0:
+        d.speed("drive", f"J{driven}", Signal.sine(draw(st.floats(0.0, 20.0)), draw(st.floats(0.1, 4.0))))
+    for i in range(n):
+        if i != driven and draw(st.booleans()):
+            d.torque(f"T{i}", f"J{i}", Signal.sine(draw(st.floats(0.0, 30.0)), draw(st.floats(0.1, 8.0)),
+                                                  phase=draw(st.floats(0.0, 6.0))))
+    return d
+
+
+@settings(max_examples=examples(15), deadline=None)
+@given(networks())
+def test_energy_balance_on_random_networks_with_every_element(d):
+    """Whatever the network: input work = dissipated + stored change, every dissipation grows (a gear's
+    stays ~0), every one-way clutch never slides backward."""
+    df = d.simulate(1.0, output_step=5e-3, rtol=1e-9).to_dataframe()
+    scale = max(1.0, np.max(np.abs(df["input_work_J"])), df["kinetic_energy_J"].iloc[0] + df["spring_energy_J"].iloc[0],
+                df["kinetic_energy_J"].max())
+    assert np.max(np.abs(df["energy_error_J"].to_numpy())) < 1e-6 * scale
+    for col in df.columns:
+        if col.endswith(".dissipated_J"):
+            assert np.all(np.diff(df[col].to_numpy()) >= -1e-8 * scale), col
+        if col.startswith("f") and col.endswith(".w_rel_rad_s"):
+            assert df[col].min() >= -1e-6 * max(1.0, df.filter(like=".w_rad_s").abs().max().max()), col
+
+
+@pytest.mark.parametrize("normal", [Signal.ramp(1.0, 0.5, start=0.2), Signal.sine(1.0, 0.5)])
+def test_a_normal_force_rising_from_zero_engages_at_once(normal):
+    """A clutch whose normal force leaves zero upward (a ramp from its start, a sine from t = 0) engages
+    there, though its switching function starts on zero: J1 (w0 = 10) slides on J2 from that time on.
+    With the ramp the sliding torque is ``20 (t - 0.2) / 0.5`` (mu 0.5, fn_max 40 N), so J2 gains
+    ``20 (t - 0.2)^2`` rad/s until it sticks."""
+    d = Driveline("engage")
+    d.inertia("J1", J=1.0, w0=10.0).inertia("J2", J=1.0)
+    d.clutch("c", "J1", "J2", fn_max=40.0, mu=0.5, normal=normal)
+    df = d.simulate(0.4, sample_times=[0.1, 0.3]).to_dataframe()
+    assert df["c.mode_1"].iloc[1] == -1.0      # sliding backward (J2 behind J1)
+    if normal.row[0] == 2:   # the ramp
+        assert df["J2.w_rad_s"].iloc[0] == 0.0
+        assert df["J2.w_rad_s"].iloc[1] == pytest.approx(20.0 * 0.1 ** 2, rel=1e-9)
+    else:
+        assert df["J2.w_rad_s"].iloc[0] > 0.0
