@@ -9,8 +9,12 @@ Model: ``Modelica.Mechanics.Rotational.Examples.CoupledClutches`` (MSL 4.x), 1.5
   on the order-4 dense output), sampled at the end only; the system is built once.
 * SciPy: the independent solution of ``tests/driveline/coupled_clutches_scipy.py`` -- the same
   equations with a Python right-hand side, ``solve_ivp`` restarted at every event, event functions for
-  every switching condition -- with RK45 (the same Dormand-Prince pair) and DOP853, with the same
+  every switching condition -- with RK45 (the same Dormand-Prince pair), DOP853 and LSODA, with the same
   largest step as clutchlab (an eighth of the drive's period).
+* Compiled peer: the same SciPy drivers with the right-hand side and the torque of the switching
+  functions compiled by numba (``_cc_compiled.py``): LSODA (ODEPACK's Fortran, Adams/BDF switching) and
+  RK45 calling compiled code through a thin Python wrapper -- what a SciPy user gets by compiling their
+  model.
 * Accuracy: the largest error of the final speeds and of the nine event times against the SciPy
   solution at rtol = atol = 1e-12 (DOP853), which agrees with a closed-form check to 1e-13.
 
@@ -30,6 +34,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "driveline"))
 import coupled_clutches_scipy as ref_cc  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import _cc_compiled as compiled_cc  # noqa: E402
 
 from clutchlab.driveline.description import load_driveline  # noqa: E402
 from clutchlab.system import simulate  # noqa: E402
@@ -77,11 +84,16 @@ def main(quick: bool = False):
         final = {n: res.states[-1, system.state_index(f"{n}.w")] for n in NAMES}
         events = list(res.events.time_s)
         _row(f"{res.stats['accepted_steps']} steps", rtol, _error(events, final, ref), times)
-    for method in ("RK45", "DOP853"):
-        print(f"SciPy solve_ivp {method}, restarted at every event (Python right-hand side)")
+    runs = [("RK45", "Python", {}), ("DOP853", "Python", {}), ("LSODA", "Python", {}),
+            ("RK45", "compiled", dict(rhs_factory=compiled_cc.make_rhs, events_factory=compiled_cc.make_events)),
+            ("LSODA", "compiled", dict(rhs_factory=compiled_cc.make_rhs, events_factory=compiled_cc.make_events))]
+    ref_cc.reference(0.1, rtol=1e-6, atol=1e-6, max_step=MAX_STEP, **runs[-1][2])   # compile the peer once
+    for method, kind, factories in runs:
+        print(f"SciPy solve_ivp {method}, restarted at every event ({kind} right-hand side)")
         for rtol in tols:
             def run():
-                return ref_cc.reference(T_END, rtol=rtol, atol=rtol, method=method, max_step=MAX_STEP)
+                return ref_cc.reference(T_END, rtol=rtol, atol=rtol, method=method, max_step=MAX_STEP,
+                                        **factories)
 
             times, r = _timed(run, 1 if quick else 3)
             final = {n: r["final"][f"{n}.w"] for n in NAMES}

@@ -273,7 +273,7 @@ def snap_stuck(y, modes):
 
 # ----------------------------------------------------------------------------- driver
 def reference(t_end=1.5, snap=False, rtol=1e-12, atol=1e-12, max_step=0.01,
-              return_trajectory=False, method="DOP853"):
+              return_trajectory=False, method="DOP853", rhs_factory=None, events_factory=None):
     """Simulate CoupledClutches and return
     {"events": [(t, element, mode), ...],   # every mode change after t=0
      "final": {"J1.w": ..., "J2.w": ..., "J3.w": ..., "J4.w": ...,
@@ -283,7 +283,9 @@ def reference(t_end=1.5, snap=False, rtol=1e-12, atol=1e-12, max_step=0.01,
      "energy": {...}, "initial_modes": [...], "final_modes": {...},
      "n_segments": ..., "nfev": ...}
     snap=True: before every segment, put inertias joined by stuck clutches on their
-    momentum-weighted mean speed (stuck w_rel exactly 0)."""
+    momentum-weighted mean speed (stuck w_rel exactly 0).
+    rhs_factory / events_factory: replacements of make_rhs / make_events (the same equations, e.g.
+    compiled: benchmarks/_cc_compiled.py)."""
     y = np.zeros(NY)
     y[IW] = W0
     t = 0.0
@@ -302,8 +304,8 @@ def reference(t_end=1.5, snap=False, rtol=1e-12, atol=1e-12, max_step=0.01,
         t_stop = min(tb for tb in breaks if tb > t)
         if snap:
             y = snap_stuck(y, modes)
-        evs = [e for e in make_events(modes) if e[1] not in disabled]
-        sol = solve_ivp(make_rhs(modes), (t, t_stop), y, method=method,
+        evs = [e for e in (events_factory or make_events)(modes) if e[1] not in disabled]
+        sol = solve_ivp((rhs_factory or make_rhs)(modes), (t, t_stop), y, method=method,
                         rtol=rtol, atol=atol, max_step=max_step,
                         events=[e[0] for e in evs])
         nseg += 1
