@@ -1,0 +1,191 @@
+"""A driveline description file whose numeric component parameters can be changed by name.
+
+The FMU of a driveline (:mod:`clutchlab.driveline.cosim`) and the sweep target ``driveline``
+(:mod:`clutchlab.driveline.sweep`) both start from a description file (the format of
+:mod:`clutchlab.driveline.description`) and change some of its numbers: ``J1.J``, ``J1.w0``,
+``clutch1.fn_max``, ``clutch1.mu``.  A parameter is named ``<component>.<field>`` after the file's
+``[<kind>.<component>]`` table; its unit is the field's SI unit
+(:data:`clutchlab.driveline.description.FIELDS`).  Every scalar field is one: a number or a quantity
+string given in the file, or a field the file leaves out whose default is a number (``w0 = 0``,
+``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) and signals (a sine torque, a step
+of the normal force) are not parameters.
+
+::
+
+    doc = DrivelineDocument.read("examples/driveline_coupled_clutches.toml")
+    doc.parameters["clutch1.fn_max"]          # Parameter(name, unit "N", value 20.0, description)
+    spec = doc.load({"clutch1.fn_max": 30.0, "J2.J": 2.0})   # a DrivelineFile, checked by the loader
+
+Every variant is read by the one loader, :func:`~clutchlab.driveline.description.load_driveline`,
+so it is checked as the file itself would be; the changed values go in as SI numbers.
+"""
+
+from __future__ import annotations
+
+import difflib
+import inspect
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ParameterError
+from ..io.files import read_toml
+from ..units import to_si
+from .description import FIELDS, DrivelineFile, load_driveline
+from .network import Driveline
+
+__all__ = ["Parameter", "DrivelineDocument"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A numeric parameter of a driveline description.
+
+    Parameters
+    ----------
+    name : str
+        ``<component>.<field>`` (``"clutch1.fn_max"``).
+    unit : str
+        SI unit in pint notation (``"N"``, ``"kg*m**2"``, ``"rad/s"``, ``"1"``).
+    value : float
+        Value in the file (or the field's default) [unit].
+    description : str
+        One line for people (``"fn_max of clutch clutch1"``).
+    """
+
+    name: str
+    unit: str
+    value: float
+    description: str
+
+
+def _is_scalar(value) -> bool:
+    return isinstance(value, (int, float, str)) and not isinstance(value, bool)
+
+
+def _defaults(kind: str) -> dict:
+    """Number defaults of the fields of ``kind`` (the keyword defaults of the ``Driveline`` method of that name)."""
+    method = getattr(Driveline, kind, None)
+    if method is None:
+        return {}
+    return {p.name: p.default for p in inspect.signature(method).parameters.values()
+            if isinstance(p.default, (int, float)) and not isinstance(p.default, bool)}
+
+
+class DrivelineDocument:
+    """A parsed driveline description file: its numeric parameters by name, and variants of it.
+
+    Parameters
+    ----------
+    document : dict
+        The parsed TOML (keys starting with ``_`` are ignored, e.g. a sweep scenario's ``_source``).
+    source : str
+        The file it came from, named in error messages.
+
+    Raises
+    ------
+    ParameterError
+        A component table that is not a table, or a scalar field whose value cannot be converted to its
+        unit (naming the file, the key and the value).  The rest is checked by :meth:`load`.
+    """
+
+    def __init__(self, document: dict, source: str):
+        self.source = str(source)
+        self.document = {k: v for k, v in document.items() if not str(k).startswith("_")}
+        params = {}
+        for kind, fields in FIELDS.items():
+            table = self.document.get(kind, {})
+            if not isinstance(table, dict):
+                continue  # the loader names the error
+            defaults = _defaults(kind)
+            for component, comp in table.items():
+                if not isinstance(comp, dict):
+                    continue
+                for field, (unit, _) in fields.items():
+                    if unit is None:
+                        continue
+                    value = comp.get(field, defaults.get(field))
+                    if not _is_scalar(value):
+                        continue
+                    name = f"{component}.{field}"
+                    si = to_si(value, unit, name=f"{kind}.{name}", source=self.source)
+                    params[name] = Parameter(name, unit, si, f"{field} of {kind.replace('_', ' ')} {component}")
+        self.parameters = params
+
+    @classmethod
+    def read(cls, path) -> "DrivelineDocument":
+        """The description file at ``path`` (TOML; errors name the file).
+
+        Parameters
+        ----------
+        path : str or Path
+            The driveline description.
+        """
+        return cls(read_toml(path), str(path))
+
+    def check_names(self, names) -> None:
+        """Raise :class:`ParameterError` for the first of ``names`` that is not a parameter of this file.
+
+        Parameters
+        ----------
+        names : iterable of str
+            Parameter names (``"clutch1.fn_max"``).
+        """
+        for name in names:
+            if name not in self.parameters:
+                close = difflib.get_close_matches(str(name), list(self.parameters), n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise ParameterError(
+                    f"{self.source}: {name!r} is not a numeric parameter of this driveline (parameters are "
+                    f"<component>.<field> with a number, e.g. {', '.join(list(self.parameters)[:4])}){hint}")
+
+    def load(self, changes: dict | None = None) -> DrivelineFile:
+        """The driveline of this file with some parameters changed, read by ``load_driveline``.
+
+        Parameters
+        ----------
+        changes : dict, optional
+            ``{parameter name: value in its SI unit}``.
+
+        Returns
+        -------
+        DrivelineFile
+
+        Raises
+        ------
+        ParameterError
+            An unknown parameter name, or a value the loader refuses (a negative inertia): the message
+            names the file, the changed values and the key.
+        """
+        changes = dict(changes or {})
+        self.check_names(changes)
+        doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in self.document.items()}
+        for name, value in changes.items():
+            component, field = name.rsplit(".", 1)
+            kind = next(k for k, table in doc.items() if k in FIELDS and isinstance(table, dict)
+                        and component in table)
+            doc[kind] = {**doc[kind], component: {**doc[kind][component], field: float(value)}}
+        return _load_document(doc, self.source, changes)
+
+
+def _load_document(doc: dict, source: str, changes: dict) -> DrivelineFile:
+    """``load_driveline`` of a parsed document.
+
+    ``load_driveline`` reads a path, so the document is written to a temporary file; error messages
+    name ``source`` and the changes instead of it.
+    """
+    import tomli_w
+
+    fd, tmp = tempfile.mkstemp(prefix="clutchlab_driveline_", suffix=".toml")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            tomli_w.dump(doc, fh)
+        try:
+            return load_driveline(tmp)
+        except ParameterError as exc:
+            what = ", ".join(f"{k} = {float(v)!r}" for k, v in changes.items())
+            where = f"{source} with {what}" if what else source
+            raise ParameterError(str(exc).replace(tmp, where).replace(Path(tmp).name, where)) from None
+    finally:
+        os.unlink(tmp)
