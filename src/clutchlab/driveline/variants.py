@@ -16,7 +16,7 @@ of the normal force) are not parameters.
     doc.parameters["clutch1.fn_max"]          # Parameter(name, unit "N", value 20.0, description)
     spec = doc.load({"clutch1.fn_max": 30.0, "J2.J": 2.0})   # a DrivelineFile, checked by the loader
 
-Every variant is read by the one loader, :func:`~clutchlab.driveline.description.load_driveline`,
+Every variant is read by the one loader, :func:`~clutchlab.driveline.description.parse_driveline`,
 so it is checked as the file itself would be; the changed values go in as SI numbers.
 """
 
@@ -24,15 +24,12 @@ from __future__ import annotations
 
 import difflib
 import inspect
-import os
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import FIELDS, DrivelineFile, load_driveline
+from .description import FIELDS, TRANSLATIONAL_FIELDS, DrivelineFile, parse_driveline
 from .network import Driveline
 
 __all__ = ["Parameter", "DrivelineDocument"]
@@ -69,8 +66,12 @@ def _defaults(kind: str) -> dict:
     method = getattr(Driveline, kind, None)
     if method is None:
         return {}
-    return {p.name: p.default for p in inspect.signature(method).parameters.values()
-            if isinstance(p.default, (int, float)) and not isinstance(p.default, bool)}
+    out = {p.name: p.default for p in inspect.signature(method).parameters.values()
+           if isinstance(p.default, (int, float)) and not isinstance(p.default, bool)}
+    # a body's initial speed and angle left out follow from its gears and sources, else rest: 0 to vary from
+    out.update({p.name: 0.0 for p in inspect.signature(method).parameters.values()
+                if p.default is None and p.name in ("w0", "phi0", "v0", "s0")})
+    return out
 
 
 class DrivelineDocument:
@@ -94,7 +95,10 @@ class DrivelineDocument:
         self.source = str(source)
         self.document = {k: v for k, v in document.items() if not str(k).startswith("_")}
         params = {}
-        for kind, fields in FIELDS.items():
+        head = self.document.get("driveline", {})
+        translational = isinstance(head, dict) and head.get("domain") == "translational"
+        self._fields = TRANSLATIONAL_FIELDS if translational else FIELDS
+        for kind, fields in self._fields.items():
             table = self.document.get(kind, {})
             if not isinstance(table, dict):
                 continue  # the loader names the error
@@ -163,29 +167,14 @@ class DrivelineDocument:
         doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in self.document.items()}
         for name, value in changes.items():
             component, field = name.rsplit(".", 1)
-            kind = next(k for k, table in doc.items() if k in FIELDS and isinstance(table, dict)
+            kind = next(k for k, table in doc.items() if k in self._fields and isinstance(table, dict)
                         and component in table)
             doc[kind] = {**doc[kind], component: {**doc[kind][component], field: float(value)}}
         return _load_document(doc, self.source, changes)
 
 
 def _load_document(doc: dict, source: str, changes: dict) -> DrivelineFile:
-    """``load_driveline`` of a parsed document.
-
-    ``load_driveline`` reads a path, so the document is written to a temporary file; error messages
-    name ``source`` and the changes instead of it.
-    """
-    import tomli_w
-
-    fd, tmp = tempfile.mkstemp(prefix="clutchlab_driveline_", suffix=".toml")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            tomli_w.dump(doc, fh)
-        try:
-            return load_driveline(tmp)
-        except ParameterError as exc:
-            what = ", ".join(f"{k} = {float(v)!r}" for k, v in changes.items())
-            where = f"{source} with {what}" if what else source
-            raise ParameterError(str(exc).replace(tmp, where).replace(Path(tmp).name, where)) from None
-    finally:
-        os.unlink(tmp)
+    """:func:`~clutchlab.driveline.description.parse_driveline` of a changed document; its errors name
+    ``source`` and the changes."""
+    what = ", ".join(f"{k} = {float(v)!r}" for k, v in changes.items())
+    return parse_driveline(doc, f"{source} with {what}" if what else source)
