@@ -91,6 +91,7 @@ def test_header_only_csv(work, capsys):
     ["wet", "simulate", "bad.toml", "-o", "out.csv"],
     ["emtc", "simulate", "bad.toml", "-o", "out.csv"],
     ["sweep", "bad.toml", "-o", "results"],
+    ["export-fmu", "driveline", "bad.toml", "-o", "bad.fmu"],
 ])
 def test_toml_not_utf8(work, capsys, argv):
     (work / "bad.toml").write_bytes(b"[scenario]\nmodel = 4\n# caf\xe9 in Latin-1\n")

@@ -27,6 +27,13 @@ def test_demo_writes_report_with_every_section(tmp_path, capsys, monkeypatch):
         return render(fig)
 
     monkeypatch.setattr(report_html, "_figure_png", checked_render)
+    # the kernels of every later section compile in a background process of their own (clutchlab.warmup)
+    import os
+
+    from clutchlab import warmup
+
+    started, start = [], warmup.start
+    monkeypatch.setattr(warmup, "start", lambda groups: started.append(list(groups)) or start(groups))
     out = tmp_path / "report"
     assert main(["demo", "-o", str(out)]) == 0
     assert len(rendered) >= 10
@@ -40,6 +47,15 @@ def test_demo_writes_report_with_every_section(tmp_path, capsys, monkeypatch):
     pngs = list((out / "figures").glob("*.png"))
     assert len(re.findall(r"data:image/png;base64,", html)) == len(pngs) >= 3
     assert "Model 4" in html and "RMSE" in html
+    if (os.cpu_count() or 1) >= 2:
+        later = [m.split(".")[1] for m in sections[1:] if m.split(".")[1] in warmup.GROUPS]
+        assert sorted(started) == sorted([g] for g in later) and "driveline" in later
+    # the driveline section: CoupledClutches from the bundled file, its figures and its tables
+    assert "clutchlab.driveline.demo" in sections and "Drivelines" in html and "CoupledClutches" in html
+    for what in ("speeds", "torques", "modes", "energy"):
+        assert (out / "figures" / f"driveline_coupled_clutches_{what}.png").is_file()
+    for what in ("events", "metrics"):
+        assert (out / "tables" / f"driveline_coupled_clutches_{what}.csv").is_file()
     # run times are measured with compiled kernels; the compilation is reported on its own
     timing = re.search(r"With the kernels compiled, the 1 s step response took (\d+) ms.*?The first call, which runs "
                        r"the same step, took (\d+) ms, of which ([\d.]+) s went into compiling", html)

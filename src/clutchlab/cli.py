@@ -34,7 +34,7 @@ SUBSYSTEM_CLIS = (
     "clutchlab.io.cli",  # clutchlab convert (measurement files)
 )
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
-DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo")
+DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo", "clutchlab.driveline.demo")
 #: longest error line the CLI prints [characters]; longer messages lose their middle (file names stay whole
 #: at the start, the reason at the end)
 MESSAGE_LIMIT = 400
@@ -66,14 +66,16 @@ def _demo(args) -> int:
     progress("the first run compiles numba kernels (about a minute on a fresh machine; cached afterwards)")
     # the kernels of the later sections compile in background processes while the first section runs
     # (numba compiles one function at a time per process; clutchlab.warmup).  One process per section even
-    # on two cores: the operating system shares the cores among the three compilations, which balances them
+    # on two cores: the operating system shares the cores among the compilations, which balances them
     # better than any fixed split (measured on the 2-core machine, benchmarks/README.md)
     background = {}
     if (os.cpu_count() or 1) >= 2:
         from . import warmup
 
-        background["wet"] = warmup.start(["wet"])
-        background["emtc"] = warmup.start(["emtc"])
+        for name in DEMO_SECTIONS[1:]:
+            short = name.split(".")[1]
+            if short in warmup.GROUPS and _optional_module(name) is not None:
+                background[short] = warmup.start([short])
     try:
         for name in DEMO_SECTIONS:
             mod = _optional_module(name)
@@ -117,9 +119,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"clutchlab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     demo = sub.add_parser("demo", help="run every subsystem's demo on bundled synthetic data and write an HTML report",
-                          description="Run the E-clutch, wet-clutch and EMTC demos on the bundled synthetic data "
-                                      "(characterisation, identification, simulation against the virtual rigs) and "
-                                      "write one self-contained HTML report with figures and tables.",
+                          description="Run the E-clutch, wet-clutch, EMTC and driveline demos on the bundled synthetic "
+                                      "data (characterisation, identification, simulation against the virtual rigs, "
+                                      "driveline examples with stick/slip events) and write one self-contained "
+                                      "HTML report with figures and tables.",
                           epilog="Documentation: docs/report.md")
     demo.add_argument("-o", "--output", default="clutchlab-demo", help="report folder to write (default: %(default)s)")
     demo.add_argument("--force", action="store_true", help="replace the report folder if it exists")
@@ -128,7 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
                           description="Compile (or load from the cache) the numerical kernels of every model, one "
                                       "group per process, so that later runs start at once.",
                           epilog="Documentation: docs/architecture.md")
-    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc (default: all)")
+    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc, driveline (default: all)")
     warm.add_argument("-j", "--jobs", type=int, default=None, help="processes (default: the number of cores)")
     warm.set_defaults(func=_warmup)
     for name in SUBSYSTEM_CLIS:

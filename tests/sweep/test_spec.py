@@ -67,7 +67,7 @@ def test_unknown_output_is_named(tmp_path):
 
 @pytest.mark.parametrize("text, match", [
     (GRID.replace('model = "wet"', 'model = "nosuch"'), "unknown model"),
-    (GRID.replace('model = "wet"', 'model = "no_such_module_xyz:run"'), r"unknown model \(available: eclutch, "),
+    (GRID.replace('model = "wet"', 'model = "no_such_module_xyz:run"'), r"unknown model \(available: driveline, eclutch, "),
     (GRID + "\n[monte_carlo]\nn = 3\n", "exactly one of"),
     (GRID.replace("chunk_size = 4", "chunk_size = 0"), "chunk_size"),
     (GRID.replace("chunk_size = 4", "chunk_size = 4\nchunks = 3"), "unknown key 'chunks'"),

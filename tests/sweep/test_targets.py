@@ -41,12 +41,13 @@ def run_batch(variants, scenario, outputs):
 
 
 def test_builtin_names_resolve_to_clutchlab_modules():
-    assert sorted(BUILTIN) == ["eclutch", "eclutch-static", "emtc", "wet"]
+    assert sorted(BUILTIN) == ["driveline", "eclutch", "eclutch-static", "emtc", "wet"]
     wet = resolve_target("wet")
     assert wet.origin == "built-in" and wet.run_batch.__module__ == "clutchlab.sweep.wet"
     assert wet.describe_fn is not None and wet.check_fn is not None
     assert resolve_target("eclutch").run_batch.__module__ == "clutchlab.eclutch.sweep"
-    with pytest.raises(ParameterError, match=r"unknown model.*available: eclutch, eclutch-static, emtc, wet"):
+    assert resolve_target("driveline").run_batch.__module__ == "clutchlab.driveline.sweep"
+    with pytest.raises(ParameterError, match=r"unknown model.*available: driveline, eclutch, eclutch-static, emtc, wet"):
         resolve_target("hydraulic")
 
 
@@ -171,7 +172,7 @@ def test_a_spec_naming_a_module_runs_none_of_its_code(tmp_path, monkeypatch, cap
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("clutchlab: error:") and "\n" not in err
-    assert f"model = {model!r}: unknown model (available: eclutch, eclutch-static, emtc, wet" in err
+    assert f"model = {model!r}: unknown model (available: driveline, eclutch, eclutch-static, emtc, wet" in err
     assert not (folder / "MARKER").exists() and "evil" not in sys.modules
     assert not (tmp_path / "out").exists()
 
@@ -187,5 +188,5 @@ def test_python_m_clutchlab_in_the_spec_folder_runs_none_of_its_code(tmp_path):
         assert proc.returncode == 2, proc.stderr
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("clutchlab: error: spec.toml: [sweep] model = ")
-        assert "unknown model (available: eclutch, eclutch-static, emtc, wet" in lines[0]
+        assert "unknown model (available: driveline, eclutch, eclutch-static, emtc, wet" in lines[0]
         assert not (folder / "MARKER").exists()

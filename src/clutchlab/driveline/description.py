@@ -51,7 +51,7 @@ from ..io.files import read_toml
 from ..units import to_si
 from .network import Driveline, Signal
 
-__all__ = ["load_driveline", "DrivelineFile"]
+__all__ = ["load_driveline", "parse_driveline", "DrivelineFile"]
 
 #: component tables and their fields: field -> (unit, required); "flange"/"a"/"b"/"support" are names
 FIELDS = {
@@ -215,8 +215,24 @@ def load_driveline(path) -> DrivelineFile:
         Unknown tables, components or fields, missing fields, wrong units, bad values, unknown flanges
         -- naming the file, the key and the value.
     """
-    src = str(path)
-    doc = read_toml(path)
+    return parse_driveline(read_toml(path), str(path))
+
+
+def parse_driveline(doc: dict, source: str) -> DrivelineFile:
+    """A driveline from a parsed TOML document (the format of :func:`load_driveline`).
+
+    Parameters
+    ----------
+    doc : dict
+        The document, as ``tomllib`` reads it.
+    source : str
+        What to name in error messages (the file, or the file and the changes of a variant).
+
+    Returns
+    -------
+    DrivelineFile
+    """
+    src = str(source)
     known = {"driveline", "simulation", *FIELDS, *TRANSLATIONAL_FIELDS}
     for top in doc:
         if top not in known:

@@ -4,7 +4,8 @@
 (:class:`~clutchlab.fmu.cosim.CoSimulation`, :class:`~clutchlab.fmu.cosim.Variable`)
 and the wet-clutch and EMTC slaves; :func:`export_fmu` wraps any model of
 :data:`COSIMULATIONS` into an FMU with pythonfmu (``clutchlab export-fmu
-{eclutch,wet,emtc} -o NAME.fmu``).  See ``docs/fmu.md``.  The model modules
+{eclutch,wet,emtc} -o NAME.fmu``; a driveline from its description file,
+``clutchlab export-fmu driveline FILE.toml``).  See ``docs/fmu.md``.  The model modules
 are imported on first use, so ``import clutchlab.fmu`` stays light.
 """
 
@@ -15,6 +16,7 @@ COSIMULATIONS = {
     "wet": "clutchlab.fmu.cosim:WetCoSimulation",
     "emtc": "clutchlab.fmu.cosim:EmtcCoSimulation",
     "eclutch": "clutchlab.eclutch.cosim:EClutchCoSimulation",
+    "driveline": "clutchlab.driveline.cosim:DrivelineCoSimulation",
 }
 
 

@@ -1,4 +1,8 @@
-"""``clutchlab export-fmu {eclutch,wet,emtc} -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.export.export_fmu`."""
+"""``clutchlab export-fmu MODEL [FILE] -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.export.export_fmu`.
+
+``clutchlab export-fmu {eclutch,wet,emtc} -o NAME.fmu`` exports a model with its bundled parameters;
+``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes.
+"""
 
 from __future__ import annotations
 
@@ -6,19 +10,30 @@ import sys
 import warnings
 from pathlib import Path
 
+from ..errors import ParameterError
 from . import COSIMULATIONS
 
 
 def _export(args) -> int:
+    from .cosim import load_cosimulation
     from .export import export_fmu
 
     from ..io.files import check_writable
 
-    output = args.output if args.output is not None else Path(f"{args.model}.fmu")
+    cls = load_cosimulation(args.model)
+    if cls.description_file and args.file is None:
+        raise ParameterError(f"export-fmu {args.model} needs a description file, {cls.description_file}: "
+                             f"clutchlab export-fmu {args.model} FILE.toml")
+    if args.file is not None and not cls.description_file:
+        raise ParameterError(f"export-fmu {args.model} takes no description file (got {args.file!r}); "
+                             f"only {', '.join(m for m in COSIMULATIONS if load_cosimulation(m).description_file)}"
+                             " does")
+    default = Path(args.file).stem if args.file is not None else args.model
+    output = args.output if args.output is not None else Path(f"{default}.fmu")
     check_writable(output, args.force)  # before the build
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
-        path = export_fmu(args.model, output, overwrite=args.force)
+        path = export_fmu(args.model, output, overwrite=args.force, description=args.file)
     for w in caught:  # e.g. no C compiler for the fmi2Error shim: one line each
         print(f"clutchlab: warning: {w.message}", file=sys.stderr)
     print(path)
@@ -29,12 +44,17 @@ def register(subparsers) -> None:
     """Add the ``export-fmu`` sub-command."""
     p = subparsers.add_parser(
         "export-fmu",
-        help="build an FMI 2.0 co-simulation FMU of a model (needs pythonfmu; runs with clutchlab installed)",
+        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs pythonfmu; runs with "
+             "clutchlab installed)",
         description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
                     "units). The FMU runs the model through pythonfmu: the importing tool needs a Python with "
-                    "clutchlab installed.",
-        epilog="Documentation: docs/fmu.md")
+                    "clutchlab installed. A driveline is exported from its description file, which the FMU "
+                    "carries: 'export-fmu driveline FILE.toml'.",
+        epilog="Documentation: docs/fmu.md (drivelines: docs/driveline.md)")
     p.add_argument("model", choices=sorted(COSIMULATIONS), help="model to export")
-    p.add_argument("-o", "--output", type=Path, default=None, help="FMU file to write (default: MODEL.fmu)")
+    p.add_argument("file", nargs="?", default=None,
+                   help="description file of a model built from one (driveline: its TOML); the others take none")
+    p.add_argument("-o", "--output", type=Path, default=None,
+                   help="FMU file to write (default: MODEL.fmu, for a driveline FILE's name with .fmu)")
     p.add_argument("--force", action="store_true", help="replace the FMU if it exists")
     p.set_defaults(func=_export)

@@ -82,7 +82,7 @@ def fmi_unit(unit: str) -> str:
     unit : str
         Unit in pint notation, as in the parameter-set field metadata.
     """
-    return unit.replace("*", ".").replace("^", "").replace(" ", "")
+    return unit.replace("**", "").replace("*", ".").replace("^", "").replace(" ", "")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,19 +123,32 @@ class CoSimulation(abc.ABC):
     paper / bundled preset).  :meth:`reset` returns to the initial state at
     t = 0; :meth:`do_step` advances with the inputs held constant.
 
+    A model built from a description file (the driveline) names that file
+    in :attr:`description_file` and returns, from :meth:`for_description`,
+    its class for one file, whose variables are those of the described
+    model.
+
     Attributes
     ----------
     name : str
-        Model name (``"wet"``, ``"emtc"``, ``"eclutch"``); a class attribute.
+        Model name (``"wet"``, ``"emtc"``, ``"eclutch"``, ``"driveline"``); a class attribute.
     inputs, outputs, parameters : tuple of Variable
         Real, continuous inputs; outputs; parameters (tunable before
         initialisation, values in SI); class attributes.
+    description_file : str
+        What the model is built from (``"a driveline description (TOML)"``),
+        ``""`` for a model that takes no file; a class attribute.
+    experiment : tuple of float or None
+        Default experiment ``(stop time, communication step)`` [s] written
+        into the FMU (None: the exporter's default for the model).
     """
 
     name: str = ""
     inputs: tuple = ()
     outputs: tuple = ()
     parameters: tuple = ()
+    description_file: str = ""
+    experiment: tuple | None = None
 
     @abc.abstractmethod
     def __init__(self, **parameter_values):
@@ -150,6 +163,25 @@ class CoSimulation(abc.ABC):
         """Advance from t to t+dt with the inputs held constant (zero-order hold); return outputs at t+dt."""
 
     # ------------------------------------------------------------- optional hooks and helpers
+    @classmethod
+    def for_description(cls, path) -> type:
+        """The co-simulation class of the model described by the file at ``path``.
+
+        Only for a model with a :attr:`description_file`; the class returned
+        has the variables of the described model.
+
+        Parameters
+        ----------
+        path : str or Path
+            The description file.
+
+        Raises
+        ------
+        ParameterError
+            The model takes no description file (or the file is invalid).
+        """
+        raise ParameterError(f"model {cls.name!r} takes no description file (got {str(path)!r})")
+
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 for the given inputs (optional; default: the outputs' start values).
 

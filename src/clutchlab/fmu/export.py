@@ -4,7 +4,9 @@ The FMU is built with pythonfmu [1]: its binary (``binaries/linux64``,
 ``binaries/win64``) embeds a Python interpreter link and runs the slave
 script in ``resources/``.  The script is three lines -- a subclass of
 :class:`CoSimulationSlave` naming the model -- and imports clutchlab at run
-time, so **the importing tool must run a Python in which clutchlab is
+time.  A model built from a description file (the driveline) carries that
+file in the FMU, ``resources/description.toml``, read when the FMU is
+instantiated; so **the importing tool must run a Python in which clutchlab is
 installed** (with numpy, numba, scipy, pandas, pint).  clutchlab's source is
 deliberately not bundled: the compiled kernels cache their machine code next
 to the installed package (a bundled copy, unpacked to a fresh temporary
@@ -48,8 +50,12 @@ __all__ = ["compile_shim", "export_fmu", "keep_namespace", "model_identifier", "
 #: name of the slave's local Boolean that flags a refused step (read by the shim library, ``shim/fmi2_shim.c``)
 STEP_ERROR = "step_error"
 
-#: default experiment written into the modelDescription (stop time [s], communication step [s])
+#: default experiment written into the modelDescription (stop time [s], communication step [s]); a
+#: co-simulation class's own ``experiment`` (the driveline's, from its file) comes first
 DEFAULT_EXPERIMENT = {"wet": (1.0, 1e-3), "emtc": (2.0, 0.01), "eclutch": (1.0, 1e-3)}
+
+#: name of a model's description file inside the FMU's ``resources/`` folder
+DESCRIPTION_RESOURCE = "description.toml"
 
 
 def model_identifier(model: str) -> str:
@@ -65,13 +71,15 @@ def model_identifier(model: str) -> str:
     return "Clutchlab" + model[:1].upper() + model[1:]
 
 
-def slave_script(model: str) -> str:
+def slave_script(model: str, description: bool = False) -> str:
     """Source of the slave script placed in the FMU's resources.
 
     Parameters
     ----------
     model : str
         Name in :data:`~clutchlab.fmu.COSIMULATIONS`.
+    description : bool
+        The FMU carries the model's description file (:data:`DESCRIPTION_RESOURCE`).
     """
     ident = model_identifier(model)
     return (
@@ -82,6 +90,7 @@ def slave_script(model: str) -> str:
         f"class {ident}(CoSimulationSlave):\n"
         f'    model_key = "{model}"\n'
         f'    built_with = "{__version__}"\n'
+        + (f'    description_file = "{DESCRIPTION_RESOURCE}"\n' if description else "")
     )
 
 
@@ -158,14 +167,18 @@ def _slave_base():
 
         model_key: str = ""
         built_with: str = ""
+        description_file: str = ""
         author = "clutchlab"
 
         def __init__(self, **kwargs):
             super().__init__(**kwargs)
             cls = load_cosimulation(self.model_key)
+            if self.description_file:  # the model of the description carried in the FMU's resources
+                # on the model thread: reading it builds the model, which may load compiled kernels
+                cls = _on_model_thread(cls.for_description, Path(self.resources) / self.description_file)
             self.description = (f"clutchlab {self.model_key} model ({cls.__name__}); inputs held constant over "
                                 f"each communication step; needs a Python with clutchlab installed")
-            stop, step = DEFAULT_EXPERIMENT.get(self.model_key, (1.0, 1e-3))
+            stop, step = cls.experiment or DEFAULT_EXPERIMENT.get(self.model_key, (1.0, 1e-3))
             self.default_experiment = DefaultExperiment(start_time=0.0, stop_time=stop, step_size=step)
             self.cosim_class = cls
             self.values = {}
@@ -364,17 +377,21 @@ def compile_shim(ident: str, step_error_vr: int, workdir) -> bytes:
     return out.read_bytes()
 
 
-def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
+def export_fmu(model: str, path, *, overwrite: bool = False, description=None) -> Path:
     """Build an FMI 2.0 co-simulation FMU of a registered model.
 
     Parameters
     ----------
-    model : {"eclutch", "wet", "emtc"}
+    model : {"eclutch", "wet", "emtc", "driveline"}
         Name in :data:`~clutchlab.fmu.cosim.COSIMULATIONS`.
     path : path-like
         FMU file to write (``.fmu``).
     overwrite : bool
         Replace an existing file (the CLI's ``--force``).
+    description : path-like, optional
+        The description file of a model built from one (the driveline's TOML); copied into the FMU
+        (``resources/description.toml``), so the FMU runs wherever clutchlab is installed.  Required
+        for such a model, refused for the others.
 
     Returns
     -------
@@ -384,7 +401,8 @@ def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
     Raises
     ------
     ParameterError
-        Unknown model, wrong suffix, or the model class cannot be imported.
+        Unknown model, wrong suffix, the model class cannot be imported, a description file missing,
+        given to a model that takes none, or invalid.
     FileExistsError
         ``path`` exists and ``overwrite`` is false.
 
@@ -411,6 +429,14 @@ def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
         raise ParameterError(f"output {str(path)!r}: the file name must end in .fmu")
     check_writable(path, overwrite)
     cls = load_cosimulation(model)
+    if description is None and cls.description_file:
+        raise ParameterError(f"model {model!r} is built from a description file: give {cls.description_file}")
+    if description is not None:
+        if not cls.description_file:
+            takes = ", ".join(m for m in COSIMULATIONS if load_cosimulation(m).description_file)
+            raise ParameterError(f"model {model!r} takes no description file (got {str(description)!r}; "
+                                 f"only {takes} does)")
+        cls = cls.for_description(description)  # checks the file before anything is built
     try:
         from pythonfmu import FmuBuilder
     except ImportError as exc:  # pragma: no cover - pythonfmu is in the test extras
@@ -420,9 +446,14 @@ def export_fmu(model: str, path, *, overwrite: bool = False) -> Path:
         tmp = Path(tmp)
         script = tmp / "src" / f"{ident.lower()}_slave.py"
         script.parent.mkdir()
-        script.write_text(slave_script(model))
+        script.write_text(slave_script(model, description is not None))
+        files = []
+        if description is not None:  # the description travels in the FMU's resources
+            (tmp / "files").mkdir()
+            files.append(tmp / "files" / DESCRIPTION_RESOURCE)
+            files[0].write_bytes(Path(description).read_bytes())
         # several instances per process work once keep_namespace balances pythonfmu's release (issue #228)
-        built = FmuBuilder.build_FMU(script, dest=tmp / "build" / f"{ident}.fmu",
+        built = FmuBuilder.build_FMU(script, dest=tmp / "build" / f"{ident}.fmu", project_files=files,
                                      canBeInstantiatedOnlyOncePerProcess=False)
         # pythonfmu leaves the script module imported; drop it so a later build starts clean
         sys.modules.pop(script.stem, None)

@@ -345,7 +345,8 @@ def spec_from_dict(data: dict, *, source=None) -> SweepSpec:
     if bad:
         raise ParameterError(f"{where}: [sweep] unknown key {bad[0]!r} = {sweep[bad[0]]!r} (known: {', '.join(_SWEEP_KEYS)})")
     if "model" not in sweep:
-        raise ParameterError(f"{where}: [sweep] needs model = \"wet\" | \"emtc\" | \"eclutch-static\" | \"eclutch\" "
+        raise ParameterError(f"{where}: [sweep] needs model = \"wet\" | \"emtc\" | \"eclutch-static\" | \"eclutch\" | "
+                             "\"driveline\" "
                              "(or a registered or plugin target name)")
     model = sweep["model"]
     if not isinstance(model, str):

@@ -70,6 +70,7 @@ BUILTIN: types.MappingProxyType = types.MappingProxyType({
     "emtc": "clutchlab.sweep.emtc",
     "eclutch-static": "clutchlab.sweep.eclutch_static",
     "eclutch": "clutchlab.eclutch.sweep",
+    "driveline": "clutchlab.driveline.sweep",
 })
 
 #: entry-point group of plugin targets
@@ -283,7 +284,8 @@ def resolve_target(model: str, source: str | None = None) -> Target:
     Parameters
     ----------
     model : str
-        Model name (``"wet"``, ``"emtc"``, ``"eclutch-static"``, ``"eclutch"``, a registered or plugin name).
+        Model name (``"wet"``, ``"emtc"``, ``"eclutch-static"``, ``"eclutch"``, ``"driveline"``, a registered
+        or plugin name).
     source : str, optional
         Spec file, named in error messages.
 

@@ -1,0 +1,136 @@
+"""A driveline network as a co-simulation slave (FMI 2.0 co-simulation semantics, :mod:`clutchlab.fmu`).
+
+``clutchlab export-fmu driveline FILE.toml`` builds an FMU of the network that a driveline description
+(:mod:`clutchlab.driveline.description`) describes.  The co-simulation is a
+:class:`~clutchlab.fmu.cosim.ContractCoSimulation` of the :class:`~clutchlab.system.System` that
+:meth:`Driveline.system <clutchlab.driveline.network.Driveline.system>` returns: each ``do_step``
+continues the integrator core's run (``clutchlab.system.Simulation.advance``) from the stored angles,
+speeds, energies, friction modes and step size.  The network has no inputs (its sources are the
+signals of the file); its outputs are every state and output column of the driveline; its parameters
+are ``rtol`` and the numeric fields of its components, ``<component>.<field>``
+(:class:`~clutchlab.driveline.variants.DrivelineDocument`).
+
+::
+
+    Cls = DrivelineCoSimulation.for_description("examples/driveline_coupled_clutches.toml")
+    sim = Cls(**{"clutch1.fn_max": 25.0})
+    y = sim.do_step(0.0, 1e-3, {})      # {"J1.w": ..., "clutch1.tau": ..., "clutch1.mode": ..., ...}
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..fmu.cosim import ContractCoSimulation, Variable, fmi_unit
+from ..units import COLUMN_UNITS
+from .variants import DrivelineDocument
+
+__all__ = ["DrivelineCoSimulation"]
+
+
+def _fmi_unit(suffix: str) -> str:
+    """FMI unit of a column suffix (``"rad_s"`` -> ``"rad/s"``, ``"Nm"`` -> ``"N.m"``)."""
+    return fmi_unit(COLUMN_UNITS[suffix][0])
+
+
+class DrivelineCoSimulation(ContractCoSimulation):
+    """A driveline network described in a TOML file, stepped by a co-simulation master.
+
+    Build the class of one file with :meth:`for_description`; this base class has no variables.
+    Outputs: every column of the driveline -- the angle ``<inertia>.phi`` [rad] and speed
+    ``<inertia>.w`` [rad/s] of each inertia, the work ``<source>.work`` of each source and the energy
+    ``<element>.dissipated`` [J] dissipated in each other element, the torque ``<element>.tau`` [N.m]
+    of each element and the relative speed ``<element>.w_rel`` [rad/s] of each non-source, the mode
+    ``<friction>.mode`` (MSL codes: 1 forward, 0 stuck, -1 backward, 2 free) and normal force
+    ``<friction>.fn`` [N] of each friction element, and the network's ``kinetic_energy``,
+    ``spring_energy``, ``input_work``, ``dissipated_energy`` and ``energy_error`` [J].  Parameters:
+    ``rtol`` (start: the file's ``[simulation] rtol``) and every numeric component field,
+    ``<component>.<field>`` in SI (``J1.J`` [kg.m2], ``J1.w0`` [rad/s], ``clutch1.fn_max`` [N],
+    ``clutch1.mu`` [1], ...).  No inputs.
+
+    Parameters
+    ----------
+    **parameter_values
+        Parameter values by name (SI); the others keep the file's values.
+
+    Notes
+    -----
+    The integration stops at every communication point, so a chain of steps differs from one
+    :meth:`Driveline.simulate <clutchlab.driveline.network.Driveline.simulate>` run of the same
+    file by the integration error (of order ``rtol``), not more; events inside a step are located as
+    in that run (``events()`` of :attr:`simulation`).
+    """
+
+    name = "driveline"
+    description_file = "a driveline description (TOML, docs/driveline.md)"
+    #: the description of the class built by :meth:`for_description` (None on this base class)
+    document: DrivelineDocument | None = None
+    #: the file's :class:`~clutchlab.driveline.description.DrivelineFile` (None on this base class)
+    base = None
+
+    @classmethod
+    def for_description(cls, path) -> type:
+        """The co-simulation class of the driveline described in the file at ``path``.
+
+        Parameters
+        ----------
+        path : str or Path
+            A driveline description (TOML).
+
+        Returns
+        -------
+        type
+            A subclass whose ``outputs`` and ``parameters`` are those of that driveline and whose
+            ``experiment`` is the file's ``[simulation]`` ``t_end`` and ``output_step`` (default
+            1 s and 1 ms).
+
+        Raises
+        ------
+        ParameterError
+            The file is not a valid driveline description (naming the file, key and value).
+        """
+        doc = DrivelineDocument.read(path)
+        base = doc.load()
+        system = base.driveline.system(base.rtol)
+        outputs = tuple(Variable(v.name, _fmi_unit(v.unit), 0.0, v.description)
+                        for v in (*system.states, *system.outputs))
+        parameters = (Variable("rtol", "1", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step "
+                                                       "control ([simulation] rtol)"),
+                      *(Variable(p.name, fmi_unit(p.unit), p.value, p.description) for p in doc.parameters.values()))
+        names = [v.name for v in (*outputs, *parameters)]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ParameterError(f"{path}: {twice[0]!r} would name two FMU variables (rename that component)")
+        experiment = (base.t_end if base.t_end is not None else 1.0,
+                      base.output_step if base.output_step is not None else 1e-3)
+        return type(f"{cls.__name__}[{base.driveline.name}]", (cls,),
+                    {"document": doc, "base": base, "outputs": outputs, "parameters": parameters,
+                     "experiment": experiment, "__module__": cls.__module__, "__doc__": cls.__doc__})
+
+    def __init__(self, **parameter_values):
+        if self.document is None:
+            raise ParameterError("DrivelineCoSimulation: build the class of a file first, "
+                                 "DrivelineCoSimulation.for_description(path)")
+        values = self.resolve_parameters(parameter_values)
+        if not 0.0 < values["rtol"] < 1.0:
+            raise ParameterError(f"parameter rtol = {values['rtol']!r}: must be in (0, 1)")
+        self.simulation_options = {} if self.base.max_step is None else {"max_step": self.base.max_step}
+        super().__init__(**parameter_values)
+
+    # ---- the contract
+    def build_system(self, values: dict):
+        """The driveline's System with the parameter ``values`` (by name, SI) in place of the file's."""
+        changes = {p.name: values[p.name] for p in self.document.parameters.values() if values[p.name] != p.value}
+        spec = self.document.load(changes) if changes else self.base
+        system = spec.driveline.system(values["rtol"])
+        return system
+
+    def input_vector(self, inputs: dict) -> np.ndarray:
+        """No inputs: an empty vector (``inputs`` is empty)."""
+        return np.empty(0)
+
+    def output_values(self, y: np.ndarray) -> dict:
+        """Every state and output of the driveline, by name, from the current state and ``y``."""
+        values = np.concatenate((self.simulation.x, y))
+        return {v.name: float(x) for v, x in zip(self.outputs, values)}

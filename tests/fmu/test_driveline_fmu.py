@@ -1,0 +1,174 @@
+"""The driveline as a co-simulation slave and an FMU (``export-fmu driveline FILE.toml``) against
+``Driveline.simulate`` of the same file.
+
+Tolerance: the co-simulation stops the adaptive Dormand-Prince 5(4) at every communication point
+(1 ms) while ``Driveline.simulate`` steps across them, so the two differ by the integration error.
+CoupledClutches over 1.5 s, measured: at rtol 1e-8 the speeds differ by 5e-8 of their range and the
+source's work by 4.5e-7 of its range; at rtol 1e-10 by 5e-10 and 6e-9 -- a hundred times less for a
+hundred times tighter tolerance, which a model mismatch would not give.  The FMU runs the very same
+co-simulation behind pythonfmu: equal to 1e-12.
+"""
+
+import math
+import shutil
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cli_checks import one_line_error
+from clutchlab.cli import main
+from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline.cosim import DrivelineCoSimulation
+from clutchlab.driveline.description import load_driveline
+from clutchlab.errors import ParameterError
+from clutchlab.fmu.cosim import load_cosimulation
+from clutchlab.fmu.export import export_fmu
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "driveline_coupled_clutches.toml"
+DT, N = 1e-3, 1500  # 1 ms communication steps through 1.5 s
+
+
+def _native(network, rtol):
+    res = network.simulate(N * DT, rtol=rtol, output_step=DT)
+    system = network.system(rtol)
+    names = [v.name for v in (*system.states, *system.outputs)]
+    values = np.concatenate((res.states, res.outputs), axis=1)
+    return {n: values[:, i] for i, n in enumerate(names)}, res.events
+
+
+def _scale(ref, name):
+    """The range a column's difference is measured against (the energy balance error: the input work's)."""
+    return max(np.max(np.abs(ref["input_work" if name == "energy_error" else name])), 1e-12)
+
+
+def _largest_difference(out, ref, names):
+    return max(np.max(np.abs(out[n] - ref[n])) / _scale(ref, n) for n in names)
+
+
+@pytest.fixture(scope="module")
+def chains():
+    """Co-simulation and native run of the example file at two tolerances."""
+    cls = DrivelineCoSimulation.for_description(EXAMPLE)
+    runs = {}
+    for rtol in (1e-8, 1e-10):
+        sim = cls(rtol=rtol)
+        rows = [sim.initial_outputs({})]
+        for k in range(N):
+            t = k * DT
+            rows.append(sim.do_step(t, (k + 1) * DT - t, {}))
+        out = {v.name: np.array([r[v.name] for r in rows]) for v in cls.outputs}
+        runs[rtol] = (sim, out, *_native(load_driveline(EXAMPLE).driveline, rtol))
+    return cls, runs
+
+
+def test_the_class_of_a_file_has_its_columns_and_parameters(chains):
+    cls, _ = chains
+    assert load_cosimulation("driveline") is DrivelineCoSimulation and cls.__name__.endswith("[coupled_clutches]")
+    system = load_driveline(EXAMPLE).driveline.system()
+    assert [v.name for v in cls.outputs] == [v.name for v in (*system.states, *system.outputs)]
+    units = {v.name: v.unit for v in cls.outputs}
+    assert (units["J1.phi"], units["J1.w"], units["clutch1.tau"], units["clutch1.mode"], units["clutch1.fn"],
+            units["clutch1.dissipated"], units["kinetic_energy"]) == ("rad", "rad/s", "N.m", "1", "N", "J", "J")
+    params = {v.name: v for v in cls.parameters}
+    assert (params["rtol"].start, params["clutch1.fn_max"].unit, params["clutch1.fn_max"].start) == (1e-8, "N", 20.0)
+    assert (params["J1.J"].unit, params["J1.w0"].start, params["clutch2.peak"].start) == ("kg.m2", 10.0, 1.1)
+    assert "torque.torque" not in params and "clutch1.normal" not in params  # signals are not parameters
+    assert cls.inputs == () and cls.experiment == (1.5, 1e-3)
+    with pytest.raises(ParameterError, match="for_description"):
+        DrivelineCoSimulation()
+    with pytest.raises(ParameterError, match="clutch1.fn_maxx"):
+        cls(**{"clutch1.fn_maxx": 1.0})
+    with pytest.raises(ParameterError, match="rtol"):
+        cls(rtol=2.0)
+
+
+@pytest.mark.parametrize("rtol,bound", [(1e-8, 2e-6), (1e-10, 2e-8)])
+def test_chain_of_steps_follows_simulate_within_solver_tolerance(chains, rtol, bound):
+    _, runs = chains
+    sim, out, ref, events = runs[rtol]
+    assert _largest_difference(out, ref, list(ref)) < bound
+    for name in ref:
+        if name.endswith(".mode"):
+            np.testing.assert_array_equal(out[name], ref[name], err_msg=name)
+    got = sim.simulation.events()
+    assert list(zip(got.element, got.event)) == list(zip(events.element, events.event)) and len(got) == 9
+    np.testing.assert_allclose(got.time_s, events.time_s, rtol=0, atol=1e-7)
+
+
+def test_the_difference_is_integration_error(chains):
+    _, runs = chains
+    speeds = [n for n in runs[1e-8][2] if n.endswith(".w") or n.endswith("work")]
+    coarse = _largest_difference(runs[1e-8][1], runs[1e-8][2], speeds)
+    fine = _largest_difference(runs[1e-10][1], runs[1e-10][2], speeds)
+    assert fine < coarse / 20
+
+
+def _network(J2, fn_max1, w0):
+    """CoupledClutches written in Python with three of its numbers changed (independent of the file)."""
+    d = Driveline("coupled_clutches")
+    for name, J, w in (("J1", 1.0, w0), ("J2", J2, 0.0), ("J3", 1.0, 0.0), ("J4", 1.0, 0.0)):
+        d.inertia(name, J=J, w0=w)
+    d.torque("torque", "J1", Signal.sine(10.0, 5.0))
+    d.clutch("clutch1", "J1", "J2", fn_max=fn_max1, mu=0.5, peak=1.1, normal=Signal.sine(1.0, 0.2, phase=math.pi / 2))
+    d.clutch("clutch2", "J2", "J3", fn_max=20.0, mu=0.5, peak=1.1, normal=Signal.step(1.0, 0.4))
+    d.clutch("clutch3", "J3", "J4", fn_max=20.0, mu=0.5, peak=1.1, normal=Signal.step(1.0, 0.9))
+    return d
+
+
+def test_parameters_change_the_run_as_the_python_network(chains, run_cosim):
+    cls, _ = chains
+    params = {"J2.J": 2.0, "clutch1.fn_max": 25.0, "J1.w0": 12.0}
+    out = run_cosim(cls(**params), {}, DT, N)
+    ref, _ = _native(_network(2.0, 25.0, 12.0), 1e-8)
+    assert _largest_difference(out, ref, list(ref)) < 2e-6
+    default, _ = _native(load_driveline(EXAMPLE).driveline, 1e-8)
+    assert _largest_difference(ref, default, list(ref)) > 1e-2  # the change matters (5000 times the bound)
+
+
+def test_the_fmu_carries_its_description_and_runs_it(tmp_path, chains, run_fmu, run_cosim):
+    import fmpy
+    import fmpy.validation
+
+    cls, _ = chains
+    copy = tmp_path / "src" / "my_driveline.toml"
+    copy.parent.mkdir()
+    shutil.copy(EXAMPLE, copy)
+    path = export_fmu("driveline", tmp_path / "dl.fmu", description=copy)
+    shutil.rmtree(copy.parent)  # the FMU needs only itself
+    assert fmpy.validation.validate_fmu(str(path)) == []
+    md = fmpy.read_model_description(str(path), validate=True)
+    assert md.coSimulation.modelIdentifier == "ClutchlabDriveline" and "coupled_clutches" in md.description
+    assert (float(md.defaultExperiment.stopTime), float(md.defaultExperiment.stepSize)) == (1.5, 1e-3)
+    got = {v.name: v for v in md.modelVariables}
+    for var, causality in [*((v, "output") for v in cls.outputs), *((v, "parameter") for v in cls.parameters)]:
+        assert (got[var.name].causality, got[var.name].unit) == (causality, var.unit), var.name
+    with zipfile.ZipFile(path) as z:
+        assert z.read("resources/description.toml") == EXAMPLE.read_bytes()
+        assert 'description_file = "description.toml"' in z.read("resources/clutchlabdriveline_slave.py").decode()
+    names = ["J1.w", "J4.w", "clutch1.tau", "clutch1.mode", "clutch3.dissipated", "energy_error"]
+    start = {"clutch1.fn_max": 25.0, "J2.J": 2.0}
+    fmu = run_fmu(path, {}, DT, N, names, start)
+    ref = run_cosim(cls(**start), {}, DT, N)
+    for name in names:
+        np.testing.assert_allclose(fmu[name], ref[name], rtol=1e-12, atol=1e-12 * np.max(np.abs(ref[name])),
+                                   err_msg=name)
+
+
+def test_export_fmu_command_for_a_driveline(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["export-fmu", "driveline", str(EXAMPLE)]) == 0
+    assert capsys.readouterr().out.strip() == "driveline_coupled_clutches.fmu"  # named after the file
+    assert "exists" in one_line_error(capsys, ["export-fmu", "driveline", str(EXAMPLE)])
+    assert "needs a description file" in one_line_error(capsys, ["export-fmu", "driveline", "-o", "x.fmu"])
+    assert "takes no description file" in one_line_error(capsys, ["export-fmu", "wet", str(EXAMPLE)])
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[inertia.J1]\nJ = "-1 kg m^2"\n')
+    err = one_line_error(capsys, ["export-fmu", "driveline", str(bad), "-o", "bad.fmu"])
+    assert "bad.toml" in err and "J" in err
+    with pytest.raises(ParameterError, match="takes no description file"):
+        export_fmu("wet", tmp_path / "w.fmu", description=EXAMPLE)
+    with pytest.raises(ParameterError, match="description file"):
+        export_fmu("driveline", tmp_path / "d.fmu")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "driveline_coupled_clutches.fmu"]
