@@ -571,14 +571,6 @@ class Simulation:
         """Current time [s]."""
         return float(self._sf[0])
 
-    @property
-    def stats(self) -> dict:
-        """Solver counters of the session so far (as ``SimulationResult.stats``)."""
-        core = self._core
-        return {"accepted_steps": int(self._si[core.SI_ACCEPTED]), "rejected_steps": int(self._si[core.SI_REJECTED]),
-                "rhs_evaluations": int(self._si[core.SI_NRHS]), "jacobians": int(self._si[core.SI_NJAC]),
-                "events_dropped": int(self.log.count[1])}
-
     def set_inputs(self, u) -> None:
         """Hold new input values (``u`` in the order of ``system.inputs``, SI)."""
         u = np.asarray(u, dtype=float).ravel()

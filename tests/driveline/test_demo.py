@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from clutchlab.driveline import data
-from clutchlab.driveline.demo import EXAMPLES, demo_section, mode_intervals, run_example
+from clutchlab.driveline.demo import EXAMPLES, demo_section, mode_intervals
 from clutchlab.driveline.description import load_driveline
 from clutchlab.report import Figure, Section, Table
 

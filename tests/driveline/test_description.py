@@ -218,3 +218,41 @@ mu = 0.3
     assert name == "stick" and t == pytest.approx(2.0 / 9.0, abs=1e-9)
     assert df["block.v_m_s"].iloc[-1] == pytest.approx(4.0 / 3.0, rel=1e-10)
     assert "sled: 2 masses, 1 elements" in spec.driveline.describe()
+
+
+def test_an_eclutch_file_is_the_python_network(tmp_path):
+    """``[eclutch.NAME]`` with a position signal in mm, the axial model and its travel: the same network
+    as the Python API's ``eclutch``; a missing parameter file and a wrong model are one clear error."""
+    from clutchlab.driveline import Driveline, Signal
+
+    path = tmp_path / "ec.toml"
+    path.write_text("""
+[inertia.engine]
+J = "0.2 kg m^2"
+w0 = "2000 rpm"
+[inertia.input]
+J = "0.05 kg m^2"
+[eclutch.clutch]
+a = "engine"
+b = "input"
+position = { ramp = { height = "-7 mm", duration = "0.5 s", offset = "7 mm" } }
+model = 2
+travel = "7 mm"
+points = 71
+""")
+    spec = load_driveline(path)
+    d = Driveline("driveline")
+    d.inertia("engine", J=0.2, w0=2000 * math.pi / 30).inertia("input", J=0.05)
+    d.eclutch("clutch", "engine", "input", position=Signal.ramp(-7e-3, 0.5, offset=7e-3), model=2, travel=7e-3,
+              points=71)
+    a = spec.driveline.simulate(0.6, output_step=0.05).to_dataframe()
+    b = d.simulate(0.6, output_step=0.05).to_dataframe()
+    for col in ("engine.w_rad_s", "input.w_rad_s", "clutch.tau_Nm", "clutch.fn_N"):
+        np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12, err_msg=col)
+    assert a["clutch.fn_N"].max() > 1000.0
+    for body, fragment in (('parameters = "nowhere.toml"\n', "clutch.parameters = 'nowhere.toml': no such file"),
+                           ('model = 7\n', "model = 7 must be one of the axial models 0-4")):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(path.read_text().replace("model = 2\n", body))
+        with pytest.raises(ParameterError, match=fragment):
+            load_driveline(bad)

@@ -337,3 +337,51 @@ def test_a_normal_force_rising_from_zero_engages_at_once(normal):
         assert df["J2.w_rad_s"].iloc[1] == pytest.approx(20.0 * 0.1 ** 2, rel=1e-9)
     else:
         assert df["J2.w_rad_s"].iloc[0] > 0.0
+
+
+# ----------------------------------------------------------------- the E-clutch as an element
+def test_eclutch_element_follows_its_static_curve():
+    """The dry E-clutch (Model 4 of seed 000) between a spinning J and the ground, engaged by a release
+    bearing ramp from 8 mm to 0 over 1 s: free until the bearing passes the lift-off position (an
+    event at ``(8 mm - u_lift) / 8 mm/s``), then sliding with the torque ``2 F_n r_eff mu`` that
+    ``ClutchModel.static_curve`` gives at the same bearing position (at the curve's points exactly)."""
+    from clutchlab.eclutch.models import ClutchModel
+
+    travel, points = 8e-3, 81
+    d = Driveline("eclutch")
+    d.inertia("J", J=0.5, w0=300.0)
+    d.eclutch("clutch", "ground", "J", position=Signal.ramp(-travel, 1.0, offset=travel), model=4,
+              travel=travel, points=points)
+    u_nodes = np.linspace(0.0, travel, points)
+    cm = ClutchModel.preset(4)
+    static = cm.static_curve(u_nodes)
+    fn = static["normal_force_N"].to_numpy()
+    u_lift = u_nodes[np.flatnonzero(fn <= 0.0)[0]]
+    ts = 1.0 - u_nodes[(u_nodes < u_lift) & (u_nodes > 0.0)] / travel     # times the ramp is on a point
+    res = d.simulate(1.0, sample_times=np.sort(ts), rtol=1e-10)
+    df = res.to_dataframe()
+    (t_on, name), = _events(res, "clutch")
+    assert name == "forward" and t_on == pytest.approx(1.0 - u_lift / travel, abs=1e-9)
+    u = travel * (1.0 - df["time_s"].to_numpy())
+    expect = cm.static_curve(u)["torque_Nm"].to_numpy()
+    assert np.allclose(df["clutch.tau_Nm"], expect, rtol=1e-9, atol=1e-9)
+    assert np.allclose(df["clutch.fn_N"], cm.static_curve(u)["normal_force_N"], rtol=1e-9, atol=1e-9)
+    assert abs(df["energy_error_J"]).max() < 1e-6 * 0.5 * 0.5 * 300.0 ** 2
+    assert "E-clutch Model 4" in d.describe()
+
+
+def test_a_user_function_drives_as_its_sampled_table():
+    """A torque from a Python function, sampled every 1 ms: the speed of a free inertia is the integral
+    of the piecewise-linear interpolant, which for ``t^2`` sampled at ``h`` is ``t^3/3 + h^2 t / 6`` at
+    the sample times (the trapezoid rule's error on a parabola)."""
+    h = 1e-3
+    d = Driveline("user")
+    d.inertia("J", J=1.0)
+    d.torque("T", "J", Signal.function(lambda t: t * t, t_end=1.0, step=h))
+    df = d.simulate(1.0, sample_times=[0.25, 0.5, 1.0], rtol=1e-10).to_dataframe()
+    t = df["time_s"].to_numpy()
+    assert np.allclose(df["J.w_rad_s"], t ** 3 / 3 + h * h * t / 6, rtol=1e-9, atol=1e-12)
+    with pytest.raises(ParameterError, match="'bad'"):
+        def bad(t):
+            return 1.0 / (t - 0.5)
+        Signal.function(bad, 1.0, 0.25)

@@ -31,7 +31,8 @@ Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, 
 ``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio), ``torque`` (flange, torque,
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
 peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
-(flange, torque, peak, support) and ``one_way_clutch`` (a, b).  With ``[driveline] domain =
+(flange, torque, peak, support), ``one_way_clutch`` (a, b) and ``eclutch`` (a, b, position [m], model
+0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak).  With ``[driveline] domain =
 "translational"`` the bodies are ``mass`` (m, v0, s0) and the sources ``force`` (flange, force,
 support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities are numbers in SI or
 strings with units, converted once here.  A signal is a number or
@@ -45,6 +46,7 @@ A friction characteristic (``mu``, a bearing's ``torque``) is a number or a tabl
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 from ..errors import DataError, ParameterError
 from ..io.files import read_toml
@@ -73,17 +75,22 @@ FIELDS = {
     "bearing_friction": {"flange": (None, True), "torque": ("N*m", False), "peak": ("1", False),
                          "support": (None, False)},
     "one_way_clutch": {"a": (None, True), "b": (None, True)},
+    "eclutch": {"a": (None, True), "b": (None, True), "position": ("m", True), "model": ("int", False),
+                "parameters": ("path", False), "travel": ("m", False), "points": ("int", False),
+                "peak": ("1", False)},
 }
+#: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
+NOT_QUANTITIES = ("text", "int", "path")
 #: a translational driveline: masses and forces, the units of its domain
 _TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
 _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
 TRANSLATIONAL_FIELDS = {
     _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
                                        for f, (u, req) in fields.items()}
-    for kind, fields in FIELDS.items()}
+    for kind, fields in FIELDS.items() if kind != "eclutch"}
 #: signal fields carrying the signal's own unit, per component table
 _SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
-            "brake": "normal"}
+            "brake": "normal", "eclutch": "position"}
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -94,7 +101,7 @@ SIGNAL_FIELDS = {
 _ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
         "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
         "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
-        "one_way_clutch": "one_way_clutch"}
+        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -215,10 +222,10 @@ def load_driveline(path) -> DrivelineFile:
         Unknown tables, components or fields, missing fields, wrong units, bad values, unknown flanges
         -- naming the file, the key and the value.
     """
-    return parse_driveline(read_toml(path), str(path))
+    return parse_driveline(read_toml(path), str(path), Path(path).parent)
 
 
-def parse_driveline(doc: dict, source: str) -> DrivelineFile:
+def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
     """A driveline from a parsed TOML document (the format of :func:`load_driveline`).
 
     Parameters
@@ -227,12 +234,15 @@ def parse_driveline(doc: dict, source: str) -> DrivelineFile:
         The document, as ``tomllib`` reads it.
     source : str
         What to name in error messages (the file, or the file and the changes of a variant).
+    base : str or Path, optional
+        Folder that files named in the document are relative to (default: the folder of ``source``).
 
     Returns
     -------
     DrivelineFile
     """
     src = str(source)
+    base = Path(base) if base is not None else Path(src).parent
     known = {"driveline", "simulation", *FIELDS, *TRANSLATIONAL_FIELDS}
     for top in doc:
         if top not in known:
@@ -295,6 +305,17 @@ def parse_driveline(doc: dict, source: str) -> DrivelineFile:
                     if v not in ("linear", "pchip"):
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected \"linear\" or \"pchip\"")
                     args[f] = v
+                elif unit == "int":
+                    if not isinstance(v, int) or isinstance(v, bool):
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")
+                    args[f] = v
+                elif unit == "path":
+                    if not isinstance(v, str) or not v:
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected a file name")
+                    target = (base / v).resolve()
+                    if not target.is_file():
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: no such file ({target})")
+                    args[f] = target
                 else:
                     args[f] = _quantity(v, unit, fkey, src)
             try:

@@ -66,8 +66,9 @@ E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE = range(9) 
 N_ELEM = 9                                                                        # 1 pchip); E_MODE: index in m
 C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
 C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
-C_RATIO = 0                                        # gear: w_a = ratio * w_b
-N_COEF = 4
+C_NCURVE, C_LIFTOFF = 3, 4                         # friction with a normal-force curve (E_AUX points): its
+C_RATIO = 0                                        # data offset and lift-off input; gear: w_a = ratio * w_b
+N_COEF = 5
 # switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves)
 G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
 N_G = 3
@@ -217,9 +218,13 @@ def friction_torque(p, r, t, w_abs):
 
 @numba.njit(cache=True, nogil=True)
 def normal_force(p, r, t):
-    """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal)."""
+    """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal);
+    with a normal-force curve (``E_AUX`` points, an E-clutch's static curve), ``fn_max * curve(f(t))``:
+    the signal is then the actuator input (the release bearing position [m])."""
     e = p.elem[r]
     f = 1.0 if e[E_SIGNAL] < 0 else signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+    if e[E_AUX] > 0:
+        f = _table(p.data, int(p.coef[r][C_NCURVE]), e[E_AUX], f)
     return p.coef[r][C_FN_MAX] * f
 
 
@@ -230,6 +235,13 @@ def _is_free(p, r, t):
     e = p.elem[r]
     if e[E_LAW] != LAW_CLUTCH:
         return False
+    if e[E_AUX] > 0:   # a normal-force curve: free beyond its lift-off input, or at it and not coming back
+        u = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+        lift = p.coef[r][C_LIFTOFF]
+        if u != lift:
+            return u > lift
+        rate, _d2 = signal_rates(p.signals[e[E_SIGNAL]], p.data, t)
+        return rate >= 0.0
     fn = normal_force(p, r, t)
     if fn != 0.0:
         return fn < 0.0
@@ -652,6 +664,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_BREAK] = static_limit(p, r, t) - abs(tau[r])
         if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
+        elif e[E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
+            g[N_G * k + G_NORMAL] = p.coef[r][C_LIFTOFF] - signal_value(p.signals[e[E_SIGNAL]], p.data, t)
         else:
             g[N_G * k + G_NORMAL] = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
     for j in range(p.swit.shape[0]):

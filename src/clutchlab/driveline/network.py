@@ -101,6 +101,34 @@ class Signal:
             raise ParameterError("table signal: times must be strictly increasing")
         return cls((K.SIG_TABLE,), tuple(t) + tuple(v))
 
+    @classmethod
+    def function(cls, fn, t_end: float, step: float, start: float = 0.0) -> "Signal":
+        """A user function ``fn(t)`` of time [s], sampled every ``step`` from ``start`` to ``t_end`` into a
+        :meth:`table` (piecewise linear between the samples, held beyond).
+
+        The compiled network cannot call Python, so the function is read once here; its values must be
+        finite numbers.  A jump of ``fn`` shows as a ramp over one ``step``; pass its corners in a
+        :meth:`table` to keep them exact.
+        """
+        t_end = _finite("function signal", "t_end", t_end)
+        step = _finite("function signal", "step", step, positive=True)
+        start = _finite("function signal", "start", start)
+        if t_end <= start:
+            raise ParameterError(f"function signal: t_end = {t_end!r} must be after start = {start!r}")
+        n = int(math.ceil((t_end - start) / step - 1e-9)) + 1
+        if n > 1_000_000:
+            raise ParameterError(f"function signal: {n} samples (t_end - start) / step; at most 1,000,000")
+        times = np.minimum(start + step * np.arange(n), t_end)
+        try:
+            values = np.array([float(fn(float(t))) for t in times])
+        except Exception as exc:   # the user's function: name it and its failure
+            raise ParameterError(f"function signal: {getattr(fn, '__name__', fn)!r} failed at a sample: {exc}") from None
+        if not np.all(np.isfinite(values)):
+            k = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise ParameterError(f"function signal: {getattr(fn, '__name__', fn)!r}({times[k]:g}) = {values[k]!r} "
+                                 "is not finite")
+        return cls.table(times, values)
+
     def describe(self, unit: str = "") -> str:
         """One line for people: ``sine 10 N m at 5 Hz``, ``step to 1 at 0.4 s`` (``unit``: of the values)."""
         k, *a = self.row
@@ -237,6 +265,9 @@ class _Element:
     signal: Signal | None = None
     table: tuple = ()   # friction characteristic: speeds [rad/s], then values; a spring curve: its kernel data
     aux: int = 0        # a spring curve's kind (0 linear, 1 pchip)
+    ncurve: tuple = ()  # a friction element's normal-force curve: inputs, then forces [N]
+    liftoff: float = math.inf   # the input beyond which that force is 0
+    model: str = ""     # what built it (for describe)
 
 
 class Driveline:
@@ -473,6 +504,44 @@ class Driveline:
         a, b = self._two(name, support, flange)
         return self._friction(name, a, b, K.LAW_TABLE, self._characteristic(name, "torque", torque), peak)
 
+    def eclutch(self, name: str, a, b, position, model: int = 4, parameters=None, travel: float = 8e-3,
+                points: int = 161, peak: float = 1.0) -> "Driveline":
+        """The dry E-clutch of seed 000 between flanges a and b, its normal force from the static curve of
+        its axial model: sliding torque ``2 F_n r_eff mu`` ([1] Sec. 3.2, :func:`clutchlab.eclutch.models.
+        clutch_torque`) with ``F_n = F_n(position(t))``.
+
+        ``position`` [m] is the release bearing position (0 engaged, increasing to release; a signal);
+        ``model`` (0-4) and ``parameters`` (an :class:`~clutchlab.eclutch.models.EClutchParameters`, or a
+        path to an E-clutch parameter file) choose the axial model (:meth:`ClutchModel.preset`); its
+        static curve is solved once at ``points`` positions over ``[0, travel]`` and read linearly between
+        them (held beyond).  ``r_eff`` and ``mu`` are the model's.  The clutch is free beyond its lift-off
+        position (the first point whose normal force is 0); ``peak`` scales the static limit.
+        """
+        from ..eclutch.models import ClutchModel, EClutchParameters
+
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        travel = _finite(name, "travel", travel, positive=True)
+        if not isinstance(points, (int, np.integer)) or isinstance(points, bool) or not 3 <= points <= 10_000:
+            raise ParameterError(f"{name}: points = {points!r} must be an integer from 3 to 10000")
+        if model not in (0, 1, 2, 3, 4) or isinstance(model, bool):
+            raise ParameterError(f"{name}: model = {model!r} must be one of the axial models 0-4")
+        if parameters is None or isinstance(parameters, EClutchParameters):
+            cm = ClutchModel.preset(int(model), parameters)
+        else:
+            cm = ClutchModel.from_toml(int(model), parameters)
+        u = np.linspace(0.0, travel, int(points))
+        fn = np.maximum(cm.static_curve(u)["normal_force_N"].to_numpy(), 0.0)
+        zero = np.flatnonzero(fn <= 0.0)
+        liftoff = float(u[zero[0]]) if zero.size else math.inf
+        sig = Signal.of(position, f"{name}: position")
+        self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, 2.0 * float(cm.r_eff), sig)
+        el = self._elements[-1]
+        el.ncurve = tuple(u) + tuple(fn)
+        el.liftoff = liftoff
+        el.model = f"E-clutch Model {int(model)} (r_eff = {cm.r_eff:g} m, mu = {cm.mu:g})"
+        return self
+
     def one_way_clutch(self, name: str, a, b) -> "Driveline":
         """A one-way clutch (freewheel) between flanges a and b: flange b may overrun flange a freely
         (``w_b > w_a``, no torque) and locks to it, holding any torque, when it would turn slower.  A
@@ -520,6 +589,9 @@ class Driveline:
                 char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
                 if e.law == K.LAW_TABLE:
                     what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
+                elif e.ncurve:
+                    what = (f"{e.model}, static curve of {len(e.ncurve) // 2} points, lift-off at "
+                            f"{e.liftoff * 1e3:g} mm, position {e.signal.describe('m')}")
                 else:
                     normal = "" if e.signal is None else f", normal {e.signal.describe()}"
                     what = f"friction fn_max = {e.coef[0]:g} N, mu {char}, peak {e.coef[2]:g}{normal}"
@@ -566,7 +638,12 @@ class Driveline:
                 data.extend(e.table)
             elem[r, K.E_AUX] = e.aux
             elem[r, K.E_MODE] = -1
-            coef[r] = e.coef
+            coef[r, :len(e.coef)] = e.coef
+            if e.ncurve:
+                coef[r, K.C_NCURVE] = len(data)
+                coef[r, K.C_LIFTOFF] = e.liftoff
+                elem[r, K.E_AUX] = len(e.ncurve) // 2
+                data.extend(e.ncurve)
         fric = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_FRICTION], dtype=np.int64)
         cons = np.array([r for r, e in enumerate(self._elements) if e.kind in (K.K_GEAR, K.K_MOTION)], dtype=np.int64)
         swit = np.array([r for r, e in enumerate(self._elements)
@@ -693,7 +770,10 @@ class Driveline:
             e = p.elem[r]
             w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
             el = self._elements[r]
-            if el.law == K.LAW_CLUTCH:   # as kernel._is_free: negative, or zero and not rising
+            if el.law == K.LAW_CLUTCH and el.ncurve:   # as kernel._is_free: beyond lift-off, or at it and not coming back
+                value, rate = el.signal.value_and_rate(0.0)
+                free = value > el.liftoff or (value == el.liftoff and rate >= 0.0)
+            elif el.law == K.LAW_CLUTCH:   # as kernel._is_free: negative, or zero and not rising
                 value, rate = (1.0, 0.0) if el.signal is None else el.signal.value_and_rate(0.0)
                 fn, dfn = el.coef[0] * value, el.coef[0] * rate
                 free = fn < 0.0 or (fn == 0.0 and dfn <= 0.0)

@@ -25,11 +25,12 @@ from __future__ import annotations
 import difflib
 import inspect
 from dataclasses import dataclass
+from pathlib import Path
 
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import FIELDS, TRANSLATIONAL_FIELDS, DrivelineFile, parse_driveline
+from .description import FIELDS, NOT_QUANTITIES, TRANSLATIONAL_FIELDS, DrivelineFile, parse_driveline
 from .network import Driveline
 
 __all__ = ["Parameter", "DrivelineDocument"]
@@ -107,7 +108,7 @@ class DrivelineDocument:
                 if not isinstance(comp, dict):
                     continue
                 for field, (unit, _) in fields.items():
-                    if unit is None:
+                    if unit is None or unit in NOT_QUANTITIES:
                         continue
                     value = comp.get(field, defaults.get(field))
                     if not _is_scalar(value):
@@ -177,4 +178,4 @@ def _load_document(doc: dict, source: str, changes: dict) -> DrivelineFile:
     """:func:`~clutchlab.driveline.description.parse_driveline` of a changed document; its errors name
     ``source`` and the changes."""
     what = ", ".join(f"{k} = {float(v)!r}" for k, v in changes.items())
-    return parse_driveline(doc, f"{source} with {what}" if what else source)
+    return parse_driveline(doc, f"{source} with {what}" if what else source, Path(source).parent)

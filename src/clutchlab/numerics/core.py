@@ -68,7 +68,7 @@ from .dopri import (
 from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
                          C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
                          GAMMA2 as R_GAMMA2, lu_factor, lu_solve, rodas_next_step)
-from .status import MODEL_ERROR, RECORD_FULL, SINGULAR, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
+from .status import MODEL_ERROR, RECORD_FULL, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
 
 __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
            "batch", "evaluate", "evaluate_outputs", "outputs_at",

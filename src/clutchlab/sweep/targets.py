@@ -50,7 +50,6 @@ import dataclasses
 import hashlib
 import importlib
 import importlib.metadata
-import os
 import threading
 import types
 from dataclasses import dataclass
