@@ -385,3 +385,19 @@ def test_a_user_function_drives_as_its_sampled_table():
         def bad(t):
             return 1.0 / (t - 0.5)
         Signal.function(bad, 1.0, 0.25)
+
+
+def test_a_backlash_impact_breaks_a_stuck_bearing_away_at_once():
+    """J1 (w0 = 2) closes a damped backlash onto J2, held by bearing friction of 1 N m: at contact the
+    damping torque steps to ``d * 2 = 20 N m``, beyond the bearing's limit, so it breaks away at the
+    contact instant itself (its break-away function starts the next step below zero, no crossing)."""
+    d = Driveline("impact")
+    d.inertia("J1", J=1.0, w0=2.0).inertia("J2", J=1.0)
+    d.backlash("lash", "J1", "J2", c=1000.0, b_gap=0.2, d=10.0)
+    d.bearing_friction("bearing", "J2", torque=1.0)
+    res = d.simulate(0.3, output_step=0.01)
+    ev = res.events
+    t_contact = float(ev[(ev.element == "lash") & (ev.event == "contact")].time_s.iloc[0])
+    assert t_contact == pytest.approx(0.1 / 2.0, abs=1e-9)
+    brk = ev[ev.element == "bearing"]
+    assert list(brk.event)[:1] == ["forward"] and float(brk.time_s.iloc[0]) == pytest.approx(t_contact, abs=1e-12)

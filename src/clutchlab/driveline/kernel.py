@@ -837,6 +837,11 @@ def driveline_update(t, x, u, m, p, k, log):
             x[2 * n + r] += spring_energy(p, r, x, n, m)
             m[nf + j] = LASH_GAP
             record(log, t, EV_SEPARATE, nf + j)
+        else:
+            return 0
+        # the torque of a damped contact steps at impact: a stuck element may have to break away now (its
+        # break-away function starts the next step beyond zero, which is no crossing)
+        settle(t, x, m, p, log, m.copy())
         return 0
     old = m.copy()
     kf = k // N_G
