@@ -31,8 +31,11 @@ Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, 
 ``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio), ``torque`` (flange, torque,
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
 peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
-(flange, torque, peak, support), ``one_way_clutch`` (a, b) and ``eclutch`` (a, b, position [m], model
-0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak).  With ``[driveline] domain =
+(flange, torque, peak, support), ``one_way_clutch`` (a, b), ``eclutch`` (a, b, position [m], model
+0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak) and ``wet_clutch``
+(a, b, force [N] = a constant, ramp or table; clutch, bench = wet-clutch parameter files, friction = a
+friction law file or an identified map ``.json``; temperature0, fluid_temperature0, housing_temperature0
+[degC]).  With ``[driveline] domain =
 "translational"`` the bodies are ``mass`` (m, v0, s0) and the sources ``force`` (flange, force,
 support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities are numbers in SI or
 strings with units, converted once here.  A signal is a number or
@@ -78,6 +81,9 @@ FIELDS = {
     "eclutch": {"a": (None, True), "b": (None, True), "position": ("m", True), "model": ("int", False),
                 "parameters": ("path", False), "travel": ("m", False), "points": ("int", False),
                 "peak": ("1", False)},
+    "wet_clutch": {"a": (None, True), "b": (None, True), "force": ("N", True), "clutch": ("path", False),
+                   "bench": ("path", False), "friction": ("path", False), "temperature0": ("degC", False),
+                   "fluid_temperature0": ("degC", False), "housing_temperature0": ("degC", False)},
 }
 #: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
 NOT_QUANTITIES = ("text", "int", "path")
@@ -87,10 +93,10 @@ _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": 
 TRANSLATIONAL_FIELDS = {
     _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
                                        for f, (u, req) in fields.items()}
-    for kind, fields in FIELDS.items() if kind != "eclutch"}
+    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch")}
 #: signal fields carrying the signal's own unit, per component table
 _SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
-            "brake": "normal", "eclutch": "position"}
+            "brake": "normal", "eclutch": "position", "wet_clutch": "force"}
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -101,7 +107,7 @@ SIGNAL_FIELDS = {
 _ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
         "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
         "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
-        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch"}
+        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch", "wet_clutch": "wet_clutch"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -195,6 +201,18 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
             raise ParameterError(f"curve needs at least 2 rows, got {len(rows)}")
         args["curve"] = Curve([r[0] for r in rows], [r[1] for r in rows], kind=args.pop("interpolation", "linear"),
                               name=name)
+    elif kind == "wet_clutch":
+        from ..wet.friction import FrictionMap, ParametricFriction
+        from ..wet.params import Bench, WetClutch
+
+        if "clutch" in args:
+            args["clutch"] = WetClutch.from_toml(args["clutch"])
+        if "bench" in args:
+            args["bench"] = Bench.from_toml(args["bench"])
+        if "friction" in args:
+            path = args["friction"]
+            args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
+                                else ParametricFriction.from_toml(path))
     elif kind in ("torque", "force", "speed", "position"):
         args = dict(args)
         flange = args.pop("flange")

@@ -41,7 +41,9 @@ from ..numerics.rosenbrock import lu_factor, lu_solve
 # element kinds (DrivelineParams.elem[:, E_KIND])
 K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = 0, 1, 2, 3, 4
 # friction laws
-LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY = 0, 1, 2  # cgeo * fn * mu(|w|); table(|w|) (bearing friction); freewheel
+LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = 0, 1, 2, 3  # cgeo * fn * mu(|w|); table(|w|) (bearing friction);
+# freewheel; a clutch model with states of its own (its sliding torque and static limit set by the model's hooks
+# before each evaluation of the network: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
 # spring laws
 SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = 0, 1, 2
 # motion sources (K_MOTION): prescribed speed or position of flange b
@@ -209,6 +211,8 @@ def friction_torque(p, r, t, w_abs):
     law = e[E_LAW]
     if law == LAW_ONEWAY:
         return 0.0
+    if law == LAW_EXTERNAL:
+        return _external(p)[2 * e[E_AUX]]
     c = p.coef[r]
     val = _characteristic(p.data, e[E_TABLE], e[E_TABLE_N], w_abs)
     if law == LAW_TABLE:
@@ -256,6 +260,8 @@ def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: inf)."""
     if p.elem[r][E_LAW] == LAW_ONEWAY:
         return np.inf
+    if p.elem[r][E_LAW] == LAW_EXTERNAL:
+        return _external(p)[2 * p.elem[r][E_AUX] + 1]
     return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
@@ -481,7 +487,8 @@ def _layout(n, nk, ne):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | flange a, ca, flange b, cb of each member (4 nk) | accelerations (n) | element torques (ne) |
-    slack of each friction element's stick function (nf, :func:`settle`) | initial stored energy (1)."""
+    slack of each friction element's stick function (nf, :func:`settle`) | sliding torque and static limit of
+    each clutch model (2 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored energy (1)."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -494,10 +501,10 @@ def _layout(n, nk, ne):
     return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_acc, o_tau
 
 
-def work_size(n, nk, ne, nf):
+def work_size(n, nk, ne, nf, nx=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` friction elements and constraints, ``ne``
-    elements, ``nf`` friction elements."""
-    return 2 * n + 10 * nk + 2 * nk * nk + ne + nf + 1
+    elements, ``nf`` friction elements, ``nx`` clutch models with states of their own."""
+    return 2 * n + 10 * nk + 2 * nk * nk + ne + nf + 2 * nx + 1
 
 
 @numba.njit(cache=True, nogil=True)
@@ -516,6 +523,26 @@ def _slack(p):
     ne = p.elem.shape[0]
     o = _layout(n, nf + p.cons.shape[0], ne)
     return p.work[o[8] + ne:o[8] + ne + nf]
+
+
+@numba.njit(cache=True, nogil=True)
+def _external(p):
+    """The sliding torques and static limits of the clutch models (``LAW_EXTERNAL``), two per model."""
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    ne = p.elem.shape[0]
+    o = _layout(n, nf + p.cons.shape[0], ne)
+    return p.work[o[8] + ne + nf:p.work.shape[0] - 1]
+
+
+@numba.njit(cache=True, nogil=True)
+def set_external(p, j, slide, limit):
+    """Set clutch model ``j``'s (``elem[r, E_AUX] = j``) sliding torque magnitude ``slide`` [N m] at the present
+    relative speed and its static limit ``limit`` [N m] (the torque it holds while stuck), for the network's
+    evaluations at the present state.  Its model's hooks call this before every hook of the network."""
+    ext = _external(p)
+    ext[2 * j] = slide
+    ext[2 * j + 1] = limit
 
 
 @numba.njit(cache=True, nogil=True)

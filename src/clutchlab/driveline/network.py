@@ -268,6 +268,7 @@ class _Element:
     ncurve: tuple = ()  # a friction element's normal-force curve: inputs, then forces [N]
     liftoff: float = math.inf   # the input beyond which that force is 0
     model: str = ""     # what built it (for describe)
+    wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
 
 
 class Driveline:
@@ -542,6 +543,73 @@ class Driveline:
         el.model = f"E-clutch Model {int(model)} (r_eff = {cm.r_eff:g} m, mu = {cm.mu:g})"
         return self
 
+    def wet_clutch(self, name: str, a, b, force, clutch=None, bench=None, friction=None,
+                   temperature0: float = 80.0, fluid_temperature0: float = 80.0,
+                   housing_temperature0: float = 80.0) -> "Driveline":
+        """The wet clutch of seed 001 between flanges a (outer plates) and b (inner plates), with states of its
+        own: actuator force, piston, squeeze film, pack, oil and housing temperatures (the engagement model of
+        :mod:`clutchlab.wet.system`, Shin et al. Eqs. 1-8; :mod:`clutchlab.driveline.wet`).
+
+        Its torque is the asperity torque ``R_eff N_c mu_f F_c`` (Eq. 4) plus the viscous torque (Eq. 5)
+        while it slides, and at most ``R_eff N_c mu_f F_c`` while stuck; the network's friction state machine
+        decides which.  ``force`` [N]: the actuator force reference (a constant, ramp or table signal: the
+        model's piecewise-linear profile; the actuator follows it with its lag).  ``clutch``
+        (:class:`~clutchlab.wet.params.WetClutch`, default ``WetClutch.paper()``), ``bench``
+        (:class:`~clutchlab.wet.params.Bench`: actuator, oil loop and housing; default ``Bench()``; its drive
+        is not used) and ``friction`` (a friction law or map of :mod:`clutchlab.wet.friction`, default the
+        bench's): as :func:`clutchlab.wet.system.pack_parameters`.  ``temperature0``, ``fluid_temperature0``,
+        ``housing_temperature0``: the temperatures [degC] at the start of the pack, the oil reservoir (also the
+        heater's set point) and the housing.  One wet clutch per network.
+        """
+        from ..wet.params import Bench, WetClutch
+
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        if any(e.wet is not None for e in self._elements):
+            raise ParameterError(f"{name}: a network takes one wet clutch (it has one already)")
+        sig = Signal.of(force, f"{name}: force")
+        kind = sig.row[0]
+        if kind == K.SIG_CONST:
+            times, values = (0.0,), (sig.row[1],)
+        elif kind == K.SIG_RAMP:
+            height, duration, start, offset = sig.row[1:5]
+            times, values = (start, start + duration), (offset, offset + height)
+        elif kind == K.SIG_TABLE:
+            half = len(sig.points) // 2
+            times, values = tuple(sig.points[:half]), tuple(sig.points[half:])
+        else:
+            raise ParameterError(f"{name}: force must be a constant, a ramp or a table (the actuator's "
+                                 f"piecewise-linear force reference), not {sig.describe('N')}")
+        if min(values) < 0.0:
+            raise ParameterError(f"{name}: force reference {min(values):g} N is negative")
+        temps = {}
+        for what, value in (("temperature0", temperature0), ("fluid_temperature0", fluid_temperature0),
+                            ("housing_temperature0", housing_temperature0)):
+            temps[what] = _finite(name, what, value)
+        clutch = WetClutch.paper() if clutch is None else clutch
+        bench = Bench() if bench is None else bench
+        self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
+        el = self._elements[-1]
+        el.wet = dict(clutch=clutch, bench=bench, friction=friction, times=times, values=values, **temps)
+        el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
+        return self
+
+    def _wet_parameters(self):
+        """The wet clutch's element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
+        shaft) and initial state, or None without one."""
+        from ..wet import system as W
+        from ..wet.engagement import Scenario
+
+        el = next((e for e in self._elements if e.wet is not None), None)
+        if el is None:
+            return None
+        w = el.wet
+        scenario = Scenario(force_time=w["times"], force_value=w["values"], speed_time=[0.0], speed_value=[0.0],
+                            duration=1.0, motor="free", initial_temperature_c=w["temperature0"],
+                            fluid_temperature_c=w["fluid_temperature0"], housing_temperature_c=w["housing_temperature0"])
+        params = W.pack_parameters(w["clutch"], w["bench"], scenario, w["friction"])
+        return el, params, W.initial_state(scenario), w["clutch"]
+
     def one_way_clutch(self, name: str, a, b) -> "Driveline":
         """A one-way clutch (freewheel) between flanges a and b: flange b may overrun flange a freely
         (``w_b > w_a``, no torque) and locks to it, holding any torque, when it would turn slower.  A
@@ -584,6 +652,8 @@ class Driveline:
                 what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
             elif e.law == K.LAW_ONEWAY:
                 what = "one-way clutch (b overruns a freely)"
+            elif e.law == K.LAW_EXTERNAL:
+                what = f"{e.model}, force reference {e.signal.describe('N')}"
             else:
                 n = len(e.table) // 2
                 char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
@@ -650,7 +720,9 @@ class Driveline:
                          if e.kind == K.K_SPRING and e.law in (K.SPRING_BACKLASH, K.SPRING_CURVE)], dtype=np.int64)
         elem[swit, K.E_MODE] = fric.size + np.arange(swit.size)
         n, ne, nk = len(index), len(self._elements), fric.size + cons.size
-        work = np.zeros(K.work_size(n, nk, ne, fric.size))
+        ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
+        elem[ext, K.E_AUX] = np.arange(len(ext))
+        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext)))
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
                               np.array(data, dtype=float), fric, cons, swit, work,
@@ -815,7 +887,11 @@ class Driveline:
         return tuple(states), tuple(outputs)
 
     def system(self, rtol: float = 1e-8) -> System:
-        """The :class:`~clutchlab.system.System` of this network (Dormand-Prince 5(4), events to 1e-12 s)."""
+        """The :class:`~clutchlab.system.System` of this network (Dormand-Prince 5(4), events to 1e-12 s).
+
+        With a wet clutch (:meth:`wet_clutch`) its parameters are a
+        :class:`~clutchlab.driveline.wet.WetDrivelineParams` and its states, outputs, switching functions,
+        modes and events follow the network's (named ``<clutch>.<quantity>``)."""
         p = self.pack()
         x0 = self.initial_state()
         states, outputs = self.variables()
@@ -827,10 +903,27 @@ class Driveline:
                            for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
                                         else ("segment_below", "segment_above")))
         named = fric + tuple(e.name for e in swit)
+        mode_names = named
         swit_values = tuple(K.LASH_VALUES if e.law == K.SPRING_BACKLASH else
                             tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
+        mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values
+        m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
-        scale = np.concatenate([np.full(n, 1.0), np.full(n, 1.0), np.full(len(self._elements), 1.0)])
+        atol = float(rtol) * np.ones(2 * n + len(self._elements))
+        events = K.EVENTS
+        wet = self._wet_parameters()
+        if wet is not None:
+            p, x0, m0, atol = self._with_wet(p, x0, m0, atol, wet, rtol, len(switching), len(named))
+            from ..wet import system as W
+
+            el = wet[0]
+            states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.STATES)
+            outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.OUTPUTS)
+            switching += tuple((f"{el.name}.{q}", d) for q, d in W.SWITCHING)
+            named += (el.name, f"{el.name}.piston")
+            mode_names += tuple(f"{el.name}.{q}" for q in W.MODE_NAMES)
+            mode_values += W.MODE_VALUES
+            events = K.EVENTS + W.EVENTS
 
         def element_name(code, element, _names=named):
             return _names[element] if 0 <= element < len(_names) else ""
@@ -840,11 +933,29 @@ class Driveline:
         freqs = [e.signal.row[2] for e in self._elements if e.signal is not None and e.signal.row[0] == K.SIG_SINE]
         max_step = min((0.125 / f for f in freqs if f > 0), default=math.inf)
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
-                      m0=self._initial_modes(p, x0), atol=float(rtol) * scale, switching=switching,
-                      events=K.EVENTS, mode_names=named,
-                      mode_values=tuple(K.MODE_VALUES for _ in fric) + swit_values,
-                      method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
+                      m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
+                      mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name)
+
+    def _with_wet(self, p, x0, m0, atol, wet, rtol, ng, nel):
+        """The network's parameters, initial state and modes and absolute tolerances joined with the wet
+        clutch's (:class:`~clutchlab.driveline.wet.WetDrivelineParams`)."""
+        from ..wet import system as W
+        from . import wet as DW
+
+        el, wp, xw, clutch = wet
+        r = self._elements.index(el)
+        k = int(np.flatnonzero(p.fric == r)[0])
+        n = len(self._inertias)
+        w_rel = (x0[n + p.elem[r][K.E_B]] if p.elem[r][K.E_B] >= 0 else 0.0) - (
+            x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
+        xw = xw.copy()
+        xw[W.S_W] = w_rel
+        mw = W.initial_modes(xw, clutch.piston_h0)
+        conf = np.array([k, r, x0.size, ng, m0.size, len(K.EVENTS), nel], dtype=np.int64)
+        params = DW.WetDrivelineParams(p, wp, conf, np.zeros(DW.N_BUF), np.zeros(DW.N_MODE, dtype=np.int64))
+        return (params, np.concatenate([x0, xw]), np.concatenate([m0, mw]),
+                np.concatenate([atol, W.absolute_tolerance(clutch, rtol)]))
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
                  output_step: float | None = None, sample_times=None):

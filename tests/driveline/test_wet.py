@@ -1,0 +1,178 @@
+"""The wet clutch as a driveline element (:meth:`Driveline.wet_clutch`, :mod:`clutchlab.driveline.wet`).
+
+The dedicated model (:mod:`clutchlab.wet`, its own shaft and stick/slip logic) is the independent
+reference: the driveline replaces its shaft by a network inertia and its lock-up by the network's friction
+state machine, so the two must agree to the solver's tolerance.  Energy is checked between two integrals
+that share no code: the network's dissipation ``tau * w_rel`` and the wet model's friction work state.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline.description import load_driveline, parse_driveline
+from clutchlab.errors import ParameterError
+from clutchlab.wet.bench import EngagementProtocol
+from clutchlab.wet.engagement import simulate_engagement
+from clutchlab.wet.params import Bench, WetClutch
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.fixture(scope="module")
+def bench_run():
+    """The wet bench's own inertia-dynamometer run (protocol (c), SAE No. 2) at a tight tolerance."""
+    clutch, bench = WetClutch.paper(), Bench()
+    scenario = EngagementProtocol().scenario(clutch, "free")
+    times = np.linspace(0.0, scenario.duration, 1201)
+    ref = simulate_engagement(clutch, scenario, bench=bench, sample_times=times, rtol=1e-9)
+    return clutch, bench, scenario, times, ref.result.to_dataframe(), ref.lockup_time
+
+
+def test_sae2_example_equals_the_wet_bench(bench_run):
+    """``examples/driveline_wet_sae2.toml`` reproduces the bench's inertia dynamometer: the same events
+    (piston off its stop, film contact, lock-up) to 1e-7 s, speed, torque and pack temperature to the
+    solver's tolerance, and the example's parameters are the bench's (inertia, speed, force, temperatures)."""
+    clutch, bench, scenario, times, ref, lockup = bench_run
+    f = load_driveline(EXAMPLES / "driveline_wet_sae2.toml")
+    d = f.driveline
+    assert d._inertias["dyno"][0] == bench.total_inertia
+    assert math.isclose(d._inertias["dyno"][1], scenario.initial_slip_speed, rel_tol=1e-14)
+    r = d.simulate(f.t_end, rtol=1e-9, sample_times=times)
+    df = r.to_dataframe()
+    ev = r.events
+    stick = ev[ev["event"] == "stick"]["time_s"].to_numpy()
+    assert stick.size == 1 and abs(stick[0] - lockup) < 1e-7
+    bev = simulate_engagement(clutch, scenario, bench=bench, sample_times=times, rtol=1e-9).result.events
+    for name in ("piston_leaves_stop", "contact"):
+        mine = ev[ev["event"] == name]["time_s"].to_numpy()
+        theirs = bev[bev["event"] == name]["time_s"].to_numpy()
+        assert mine.size == theirs.size == 1 and abs(mine[0] - theirs[0]) < 1e-7
+    w_scale = scenario.initial_slip_speed
+    assert np.max(np.abs(df["dyno.w_rad_s"] - ref["slip_speed_rad_s"])) < 1e-6 * w_scale
+    tau_scale = np.max(np.abs(ref["clutch_torque_Nm"]))
+    assert np.max(np.abs(df["clutch.tau_Nm"] - ref["clutch_torque_Nm"])) < 1e-6 * tau_scale
+    assert np.max(np.abs(df["clutch.temperature_C"] - ref["temperature_C"])) < 1e-6
+    # the torque is the paper's: asperity + viscous while slipping (Eq. 3)
+    slip = df["time_s"] < lockup - 1e-3
+    np.testing.assert_allclose(df["clutch.tau_Nm"][slip], (df["clutch.contact_torque_Nm"]
+                                                          + df["clutch.viscous_torque_Nm"])[slip], rtol=1e-9, atol=1e-9)
+    # energy: the kinetic energy all went into the clutch
+    assert abs(df["dissipated_energy_J"].iloc[-1] - 0.5 * bench.total_inertia * w_scale ** 2) < 1e-6 * 0.5 * bench.total_inertia * w_scale ** 2
+
+
+def _launch(force=None, **kw):
+    """An engine (constant torque, inertia) driving a vehicle inertia with a road load through a wet clutch."""
+    d = Driveline("wet_launch")
+    d.inertia("engine", J=0.2, w0=150.0).inertia("vehicle", J=4.0)
+    d.torque("engine_torque", "engine", 40.0)
+    d.bearing_friction("road", "vehicle", torque=10.0)
+    d.wet_clutch("clutch", "vehicle", "engine",
+                 force=Signal.ramp(4000.0, 0.3, start=0.05) if force is None else force, **kw)
+    return d
+
+
+def test_wet_clutch_between_two_inertias_locks_and_conserves_energy():
+    """Engine and vehicle are brought to one speed by the clutch, which then stays locked (its capacity at
+    4 kN is far above the 30 N m it has to carry); the network's energy balance closes, and the clutch's
+    dissipated energy (the network's ``tau * w_rel``) equals the wet model's friction work (its own state,
+    ``tau * slip``) and the heat that went into the pack, oil and housing."""
+    d = _launch()
+    r = d.simulate(1.5, rtol=1e-9, output_step=1e-3)
+    df = r.to_dataframe()
+    ev = r.events
+    stick = ev[(ev["element"] == "clutch") & (ev["event"] == "stick")]["time_s"].to_numpy()
+    assert stick.size == 1 and 0.1 < stick[0] < 1.5
+    after = df["time_s"] > stick[0] + 1e-3
+    np.testing.assert_allclose(df["engine.w_rad_s"][after], df["vehicle.w_rad_s"][after], rtol=0, atol=1e-6)
+    # stuck: the clutch carries the vehicle's share, tau = (J_v T_e + J_e T_road) / (J_e + J_v) (on flange b, the
+    # engine: -tau)
+    np.testing.assert_allclose(df["clutch.tau_Nm"][after], (4.0 * 40.0 + 0.2 * 10.0) / 4.2, rtol=1e-7)
+    work = df["input_work_J"].iloc[-1]
+    assert abs(df["energy_error_J"]).max() < 1e-7 * work
+    diss = df["clutch.dissipated_J"].iloc[-1]
+    assert diss > 100.0
+    assert abs(diss - df["clutch.friction_work_J"].iloc[-1]) < 1e-6 * diss
+    # Eq. 8: friction work = heat stored in the pack + heat to the oil + heat to the housing
+    cp = WetClutch.paper().heat_capacity
+    stored = cp * (df["clutch.temperature_C"].iloc[-1] - df["clutch.temperature_C"].iloc[0])
+    heat = stored + df["clutch.heat_to_fluid_J"].iloc[-1] + df["clutch.heat_to_housing_J"].iloc[-1]
+    assert abs(heat - diss) < 1e-6 * diss
+
+
+def test_wet_clutch_slides_backward_and_stays_open_without_force():
+    """With the flanges swapped the slip is negative: the torque changes sign with it (the viscous drag of
+    the open film and the asperity tail of the piston at its stop, Greenwood-Williamson), and the clutch never
+    locks."""
+    d = Driveline("drag")
+    d.inertia("a", J=0.1, w0=100.0).inertia("b", J=0.1)
+    d.wet_clutch("clutch", "a", "b", force=0.0)
+    df = d.simulate(0.5, output_step=0.05).to_dataframe()
+    assert (df["clutch.w_rel_rad_s"] < 0).all()
+    assert (df["clutch.contact_force_N"] < 2.0).all()   # the piston stays on its stop
+    assert (df["clutch.tau_Nm"] < 0).all()          # opposes the negative slip
+    assert (df["clutch.mode_1"] == -1).all()        # backward (MSL code)
+    np.testing.assert_allclose(df["clutch.tau_Nm"], df["clutch.contact_torque_Nm"] + df["clutch.viscous_torque_Nm"],
+                               rtol=1e-12)
+    # momentum: no external torque, so J_a w_a + J_b w_b stays 10 N m s
+    np.testing.assert_allclose(0.1 * df["a.w_rad_s"] + 0.1 * df["b.w_rad_s"], 10.0, rtol=1e-9)
+
+
+def test_wet_clutch_errors():
+    d = _launch()
+    with pytest.raises(ParameterError, match="one wet clutch"):
+        d.wet_clutch("clutch2", "engine", "vehicle", force=100.0)
+    with pytest.raises(ParameterError, match="constant, a ramp or a table"):
+        _launch(force=Signal.sine(100.0, 1.0))
+    with pytest.raises(ParameterError, match="negative"):
+        _launch(force=Signal.table([0.0, 1.0], [0.0, -5.0]))
+    with pytest.raises(ParameterError, match="temperature0"):
+        _launch(temperature0=math.nan)
+    assert "wet clutch (seed 001" in repr(_launch())
+
+
+def test_wet_clutch_file_errors(tmp_path):
+    doc = {"inertia": {"J": {"J": "1 kg m^2", "w0": "100 rad/s"}},
+           "wet_clutch": {"c": {"a": "ground", "b": "J", "force": "2 kN", "temperature0": "80 N"}}}
+    with pytest.raises(ParameterError, match=r"wet_clutch\.c\.temperature0"):
+        parse_driveline(doc, "x.toml", tmp_path)
+    doc["wet_clutch"]["c"]["temperature0"] = "60 degC"
+    doc["wet_clutch"]["c"]["clutch"] = "missing.toml"
+    with pytest.raises(ParameterError, match=r"wet_clutch\.c\.clutch = 'missing.toml': no such file"):
+        parse_driveline(doc, "x.toml", tmp_path)
+    (tmp_path / "c.toml").write_text('[wet]\nn_c = "-3"\n')
+    doc["wet_clutch"]["c"]["clutch"] = "c.toml"
+    with pytest.raises(ParameterError, match="n_c"):
+        parse_driveline(doc, "x.toml", tmp_path)
+    del doc["wet_clutch"]["c"]["clutch"]
+    f = parse_driveline(doc, "x.toml", tmp_path)
+    assert f.driveline._elements[0].wet["temperature0"] == 60.0
+
+
+def test_wet_clutch_in_the_co_simulation_and_the_sweep_variants():
+    """The FMU's co-simulation class of the SAE No. 2 file steps the wet clutch's states through the contract
+    (a chain of 10 ms steps ends on the one-run result to the solver's tolerance), and its parameters include
+    the clutch's initial temperatures (a changed pack temperature changes the run as the Python network)."""
+    from clutchlab.driveline.cosim import DrivelineCoSimulation
+
+    path = EXAMPLES / "driveline_wet_sae2.toml"
+    cls = DrivelineCoSimulation.for_description(path)
+    names = {v.name for v in cls.parameters}
+    assert {"clutch.temperature0", "clutch.fluid_temperature0", "dyno.J"} <= names
+    sim = cls(**{"clutch.temperature0": 90.0})
+    t, y = 0.0, None
+    for _ in range(80):
+        y = sim.do_step(t, 0.01, {})
+        t += 0.01
+    f = load_driveline(path)
+    d = f.driveline
+    d._elements[0].wet["temperature0"] = 90.0
+    ref = d.simulate(0.8, rtol=f.rtol, sample_times=[0.8]).to_dataframe().iloc[-1]
+    assert abs(y["dyno.w"] - ref["dyno.w_rad_s"]) < 1e-5
+    assert abs(y["clutch.temperature"] - ref["clutch.temperature_C"]) < 1e-5
+    assert y["clutch.mode"] == 0.0    # locked by 0.8 s
