@@ -20,6 +20,15 @@ Model: ``Modelica.Mechanics.Rotational.Examples.CoupledClutches`` (MSL 4.x), 1.5
 
 Each row: the tolerance, the error, the time (median and min-max of the repeats) and the speed against
 real time.  Compare rows of matched error, not of matched tolerance.
+
+Then the E-clutch launch (``examples/driveline_eclutch_launch.toml``, 5 s: engine map and idle controller,
+dual-mass flywheel, E-clutch with its actuator dynamics, gearbox, final drive, driveshaft lash, vehicle):
+the network's run at several tolerances, its error (final engine and vehicle speeds, lock-up time) against
+the same network at rtol 1e-11, and separately the solve of the E-clutch's actuator dynamics (Rodas3, done
+once when the element is built, :meth:`Driveline.eclutch`) -- the run of a built model is the network; a
+new pedal profile costs both.  No SciPy row: the launch has no independent implementation here (the
+network's equations are checked against SciPy on CoupledClutches above and against closed forms in
+``tests/driveline``).  ``--launch`` runs only this part.
 """
 
 from __future__ import annotations
@@ -101,5 +110,46 @@ def main(quick: bool = False):
             _row(f"{r['nfev']} rhs", rtol, _error([e[0] for e in r["events"]], final, ref), times)
 
 
+LAUNCH_T_END = 5.0
+
+
+def launch(quick: bool = False):
+    """The E-clutch launch: network run time and error at several tolerances, and the actuator's solve."""
+    spec = load_driveline(ROOT / "examples" / "driveline_eclutch_launch.toml")
+    d = spec.driveline
+    print(f"E-clutch launch, {LAUNCH_T_END} s; {platform.processor() or platform.machine()}, "
+          f"Python {platform.python_version()}")
+
+    def summary(res, system):
+        ev = res.events
+        lock = ev[(ev["element"] == "clutch") & (ev["event"] == "stick")]["time_s"].to_numpy()
+        return (res.states[-1, system.state_index("engine.w")], res.states[-1, system.state_index("vehicle.w")],
+                lock[0] if lock.size else float("nan"))
+
+    tight = d.system(1e-11)
+    ref = summary(simulate(tight, LAUNCH_T_END, sample_times=[LAUNCH_T_END]), tight)
+    print("clutchlab network (compiled core), error = worst of final engine and vehicle speed [rad/s] and lock-up "
+          "time [s] against rtol 1e-11")
+    for rtol in ((1e-6, 1e-8) if quick else (1e-5, 1e-6, 1e-7, 1e-8)):
+        system = d.system(rtol)
+        res = simulate(system, LAUNCH_T_END, sample_times=[LAUNCH_T_END])
+        times, res = _timed(lambda: simulate(system, LAUNCH_T_END, sample_times=[LAUNCH_T_END]), 5 if quick else 21)
+        err = max(abs(a - b) for a, b in zip(summary(res, system), ref))
+        med = statistics.median(times)
+        print(f"  {res.stats['accepted_steps']:5d} steps          rtol {rtol:7.0e}   error {err:8.1e}   "
+              f"{med * 1e3:9.3f} ms ({min(times) * 1e3:.3f}-{max(times) * 1e3:.3f})   "
+              f"{LAUNCH_T_END / med:9.0f}x real time")
+    el = next(e for e in d._elements if e.name == "clutch")
+    from clutchlab.eclutch.models import ClutchModel
+
+    cm = ClutchModel.preset(4)
+    times, _ = _timed(lambda: d._eclutch_dynamics("clutch", cm, el.reference, True, 1e-3, 1.0, 0.5), 3 if quick else 11)
+    med = statistics.median(times)
+    print(f"  actuator dynamics (E-clutch, Rodas3 rtol 1e-3, 1 s pre-roll + 3 s + 0.5 s, 1 ms samples): "
+          f"{med * 1e3:.2f} ms ({min(times) * 1e3:.2f}-{max(times) * 1e3:.2f})")
+
+
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    if "--launch" not in sys.argv:
+        main(quick="--quick" in sys.argv)
+    launch(quick="--quick" in sys.argv)

@@ -294,8 +294,28 @@ def check_coupled_clutches(work, out):
     assert "9 events" in out
 
 
+def check_drive_off(work, out):
+    frame = _csv(work / "drive_off.csv")
+    events = _csv(work / "drive_off_events.csv")
+    assert len(frame) == 501 and frame.time_s.iloc[-1] == 5.0          # [simulation] output_step 10 ms
+    clutch = events[events.component == "clutch"]
+    assert list(clutch.event) == ["backward", "stick"]                 # engages slipping, locks up once
+    assert 2.0 < clutch.time_s.iloc[1] < 2.5
+    assert frame["engine.w_rad_s"].min() > 0.95 * 800 * 3.141592653589793 / 30   # no stall
+    assert "energy balance" in out
+
+
+def check_sae2(work, out):
+    frame = _csv(work / "sae2.csv")
+    assert abs(frame["dyno.w_rad_s"].iloc[-1]) < 1e-6 and frame["dyno.w_rad_s"].iloc[0] > 157.0   # locked
+    assert frame["clutch.temperature_C"].max() > frame["clutch.temperature_C"].iloc[0] + 1.0
+    assert "3 events" in out
+
+
 CHECKS = {
     "cc.csv": check_coupled_clutches,
+    "drive_off.csv": check_drive_off,
+    "sae2.csv": check_sae2,
     "curve.csv": check_curve,
     "logger_curve.csv": check_logger_curve,
     "curves.csv": check_curves,

@@ -80,7 +80,8 @@ def _simulate(args) -> int:
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     err = float(frame["energy_error_J"].abs().max())
     print(f"{args.output}: {len(frame)} samples to {t_end:g} s; {len(events)} events; "
-          f"energy balance within {err:.2g} J of {float(frame['input_work_J'].abs().max()):.4g} J input work")
+          f"energy balance within {err:.2g} J of {float(frame['input_work_J'].abs().max()):.4g} J input work "
+          f"and {float(frame['dissipated_energy_J'].abs().max()):.4g} J dissipated")
     return 0
 
 

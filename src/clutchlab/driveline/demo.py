@@ -24,7 +24,7 @@ __all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_examp
            "header_comment"]
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
-EXAMPLES = ("coupled_clutches.toml",)
+EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml")
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "

@@ -32,7 +32,10 @@ Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, 
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
 peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b), ``eclutch`` (a, b, position [m], model
-0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak) and ``wet_clutch``
+0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak; actuator = true: the
+position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
+(flange, torque_map = ``{ speeds, throttles, torques }`` or full-load rows ``[[w, T], ...]``, throttle,
+idle_speed, idle_kp, idle_ki, idle_torque_max, support) and ``wet_clutch``
 (a, b, force [N] = a constant, ramp or table; clutch, bench = wet-clutch parameter files, friction = a
 friction law file or an identified map ``.json``; temperature0, fluid_temperature0, housing_temperature0
 [degC]).  With ``[driveline] domain =
@@ -80,23 +83,27 @@ FIELDS = {
     "one_way_clutch": {"a": (None, True), "b": (None, True)},
     "eclutch": {"a": (None, True), "b": (None, True), "position": ("m", True), "model": ("int", False),
                 "parameters": ("path", False), "travel": ("m", False), "points": ("int", False),
-                "peak": ("1", False)},
+                "peak": ("1", False), "actuator": ("bool", False), "actuator_step": ("s", False),
+                "pre_roll": ("s", False), "settle": ("s", False)},
+    "engine": {"flange": (None, True), "torque_map": ("map", True), "throttle": ("1", False),
+               "idle_speed": ("rad/s", False), "idle_kp": ("N*m*s/rad", False), "idle_ki": ("N*m/rad", False),
+               "idle_torque_max": ("N*m", False), "support": (None, False)},
     "wet_clutch": {"a": (None, True), "b": (None, True), "force": ("N", True), "clutch": ("path", False),
                    "bench": ("path", False), "friction": ("path", False), "temperature0": ("degC", False),
                    "fluid_temperature0": ("degC", False), "housing_temperature0": ("degC", False)},
 }
 #: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("text", "int", "path")
+NOT_QUANTITIES = ("text", "int", "path", "bool", "map")
 #: a translational driveline: masses and forces, the units of its domain
 _TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
 _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
 TRANSLATIONAL_FIELDS = {
     _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
                                        for f, (u, req) in fields.items()}
-    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch")}
+    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch", "engine")}
 #: signal fields carrying the signal's own unit, per component table
 _SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
-            "brake": "normal", "eclutch": "position", "wet_clutch": "force"}
+            "brake": "normal", "eclutch": "position", "wet_clutch": "force", "engine": "throttle"}
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -107,7 +114,8 @@ SIGNAL_FIELDS = {
 _ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
         "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
         "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
-        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch", "wet_clutch": "wet_clutch"}
+        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch", "wet_clutch": "wet_clutch",
+        "engine": "engine"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -191,6 +199,28 @@ def _characteristic(value, unit, key, src, x_unit="rad/s", table_only=False):
     return _quantity(value, unit, key, src)
 
 
+def _engine_map(value, key, src):
+    """An engine's torque map: ``{ speeds = [...], throttles = [...], torques = [[...], ...] }`` (a row of
+    torques per speed) or the full-load rows ``[[w, T], ...]``, converted to SI."""
+    if isinstance(value, list):
+        return _characteristic(value, "N*m", key, src, table_only=True)
+    if not isinstance(value, dict) or set(value) != {"speeds", "throttles", "torques"}:
+        raise ParameterError(f"{src}: {key}: expected {{ speeds = [...], throttles = [...], torques = [[...], ...] }} "
+                             "or rows [[speed, torque], ...]")
+    for f in ("speeds", "throttles", "torques"):
+        if not isinstance(value[f], list) or not value[f]:
+            raise ParameterError(f"{src}: {key}.{f} = {value[f]!r}: expected a non-empty list")
+    speeds = [_quantity(v, "rad/s", f"{key}.speeds[{i}]", src) for i, v in enumerate(value["speeds"])]
+    throttles = [_quantity(v, "1", f"{key}.throttles[{i}]", src) for i, v in enumerate(value["throttles"])]
+    rows = []
+    for i, row in enumerate(value["torques"]):
+        if not isinstance(row, list) or len(row) != len(throttles):
+            raise ParameterError(f"{src}: {key}.torques[{i}] = {row!r}: expected a row of {len(throttles)} torques "
+                                 "(one per throttle)")
+        rows.append([_quantity(v, "N*m", f"{key}.torques[{i}][{j}]", src) for j, v in enumerate(row)])
+    return (speeds, throttles, rows)
+
+
 def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
     """Add one component read from a file (``args`` converted to SI) through the Python API."""
     if kind == "spring":
@@ -213,6 +243,11 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
             path = args["friction"]
             args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
                                 else ParametricFriction.from_toml(path))
+    elif kind == "engine":
+        args = dict(args)
+        flange = args.pop("flange")
+        d.engine(name, flange, **args)
+        return
     elif kind in ("torque", "force", "speed", "position"):
         args = dict(args)
         flange = args.pop("flange")
@@ -323,6 +358,12 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                     if v not in ("linear", "pchip"):
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected \"linear\" or \"pchip\"")
                     args[f] = v
+                elif unit == "bool":
+                    if not isinstance(v, bool):
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected true or false")
+                    args[f] = v
+                elif unit == "map":
+                    args[f] = _engine_map(v, fkey, src)
                 elif unit == "int":
                     if not isinstance(v, int) or isinstance(v, bool):
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")

@@ -46,6 +46,9 @@ LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = 0, 1, 2, 3  # cgeo * fn * mu(|
 # before each evaluation of the network: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
 # spring laws
 SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = 0, 1, 2
+# torque sources (K_SOURCE): a signal, or an engine (a torque map over speed and throttle plus an idle-speed PI
+# controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``)
+SOURCE_SIGNAL, SOURCE_ENGINE = 0, 1
 # motion sources (K_MOTION): prescribed speed or position of flange b
 MOTION_SPEED, MOTION_POSITION = 0, 1
 # modes of a switched spring (after the friction elements' in the mode vector): a backlash in its gap, or in
@@ -62,14 +65,16 @@ EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE = 0, 1, 2, 3
 EVENTS = ("stick", "forward", "backward", "free", "contact", "separate")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 # signals
-SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE = 0, 1, 2, 3, 4
+SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
 # columns of ``elem`` (ints) and ``coef`` (floats)
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE = range(9)  # E_AUX: a curve's kind (0 linear,
-N_ELEM = 9                                                                        # 1 pchip); E_MODE: index in m
+E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE = range(10)  # E_AUX: a curve's kind
+N_ELEM = 10      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE: index in m; E_STATE: of a controller state
 C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
 C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
 C_NCURVE, C_LIFTOFF = 3, 4                         # friction with a normal-force curve (E_AUX points): its
 C_RATIO = 0                                        # data offset and lift-off input; gear: w_a = ratio * w_b
+C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = 0, 1, 2, 3   # an engine's idle controller: set speed [rad/s], gains
+                                                   # [N m s/rad], [N m/rad], torque limit [N m]
 N_COEF = 5
 # switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves)
 G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
@@ -117,7 +122,8 @@ def signal_value(sig, data, t):
 
     Rows: ``[kind, p0 .. p5]``; constant ``[k, value]``; step ``[k, height, start, offset]``; ramp
     ``[k, height, duration, start, offset]``; sine ``[k, amplitude, frequency, phase, offset, start]``
-    (zero plus offset before the start, as MSL's ``Sine``); table ``[k, start index, n]`` in ``data``.
+    (zero plus offset before the start, as MSL's ``Sine``); table ``[k, start index, n]`` in ``data``; a
+    sampled signal as a table, then ``[start, number]`` of its corners in ``data``.
     """
     kind = int(sig[0])
     if kind == SIG_CONST:
@@ -149,9 +155,9 @@ def signal_break(sig, data, t):
         return sig[3] + sig[2] if sig[3] + sig[2] > t else np.inf
     if kind == SIG_SINE:
         return sig[5] if sig[5] > t else np.inf
-    if kind == SIG_TABLE:
-        s = int(sig[1])
-        for i in range(s, s + int(sig[2])):
+    if kind == SIG_TABLE or kind == SIG_SAMPLED:   # every point of a table; a sampled signal's corners
+        s = int(sig[1]) if kind == SIG_TABLE else int(sig[3])
+        for i in range(s, s + int(sig[2] if kind == SIG_TABLE else sig[4])):
             if data[i] > t:
                 return data[i]
     return np.inf
@@ -176,7 +182,7 @@ def signal_rates(sig, data, t):
         om = 2.0 * math.pi * sig[2]
         arg = om * (t - sig[5]) + sig[3]
         return sig[1] * om * math.cos(arg), -sig[1] * om * om * math.sin(arg)
-    if kind == SIG_TABLE:
+    if kind == SIG_TABLE or kind == SIG_SAMPLED:
         s = int(sig[1])
         n = int(sig[2])
         if n < 2 or t < data[s] or t >= data[s + n - 1]:
@@ -272,6 +278,67 @@ def holding_limit(p, r, t, tau):
     if p.elem[r][E_LAW] == LAW_ONEWAY:
         return 0.0 if tau > 0.0 else np.inf
     return static_limit(p, r, t)
+
+
+# ----------------------------------------------------------------- engines
+@numba.njit(cache=True, nogil=True)
+def engine_map(data, start, ns, nt, w, throttle):
+    """Full-load/part-load torque [N m] of an engine map at speed ``w`` [rad/s] and throttle [-]: bilinear in
+    the speed grid ``data[start:start+ns]`` and the throttle grid (``nt`` points after it), the values row by
+    speed (``ns x nt`` after the grids), held beyond the grids."""
+    ws = data[start:start + ns]
+    th = data[start + ns:start + ns + nt]
+    v0 = start + ns + nt
+    i, a = 0, 0.0
+    if ns > 1:
+        i, a = bracket(ws, min(max(w, ws[0]), ws[ns - 1]))
+    j, b = 0, 0.0
+    if nt > 1:
+        j, b = bracket(th, min(max(throttle, th[0]), th[nt - 1]))
+    i1 = min(i + 1, ns - 1)
+    j1 = min(j + 1, nt - 1)
+    f00 = data[v0 + i * nt + j]
+    f01 = data[v0 + i * nt + j1]
+    f10 = data[v0 + i1 * nt + j]
+    f11 = data[v0 + i1 * nt + j1]
+    return (1.0 - a) * ((1.0 - b) * f00 + b * f01) + a * ((1.0 - b) * f10 + b * f11)
+
+
+@numba.njit(cache=True, nogil=True)
+def engine_torque(p, r, t, x, n):
+    """Torque [N m] of engine row ``r`` on its flange, and the rate of its idle controller's integral [N m/s].
+
+    ``T = map(w, throttle(t)) + T_idle`` with ``w = w_b - w_a`` (crankshaft against its support) and the
+    idle-speed PI controller ``T_idle = clip(kp (w_idle - w) + I, 0, T_idle_max)``, ``dI/dt = ki (w_idle - w) +
+    (ki / kp) (T_idle - kp (w_idle - w) - I)`` (back-calculation anti-windup: the integral tracks the clipped
+    output, so the right-hand side is continuous).  The controller only adds torque (it cannot brake the
+    engine)."""
+    e = p.elem[r]
+    c = p.coef[r]
+    w = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+    thr = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+    tq = engine_map(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], w, thr)
+    if c[C_IDLE_MAX] <= 0.0:
+        return tq, 0.0
+    err = c[C_IDLE_W] - w
+    integral = x[2 * n + p.elem.shape[0] + e[E_STATE]]
+    cmd = c[C_IDLE_KP] * err + integral
+    out = min(max(cmd, 0.0), c[C_IDLE_MAX])
+    # back-calculation anti-windup with the tracking gain ki/kp: the right-hand side stays continuous (a
+    # conditional integration would switch on the clip's edge and chatter there: a sliding mode)
+    kaw = c[C_IDLE_KI] / c[C_IDLE_KP] if c[C_IDLE_KP] > 0.0 else c[C_IDLE_KI]
+    return tq + out, c[C_IDLE_KI] * err + kaw * (out - cmd)
+
+
+@numba.njit(cache=True, nogil=True)
+def source_torque(p, r, t, x, n):
+    """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, or an
+    engine's (:func:`engine_torque`)."""
+    e = p.elem[r]
+    if e[E_LAW] == SOURCE_ENGINE:
+        tq, _rate = engine_torque(p, r, t, x, n)
+        return tq
+    return signal_value(p.signals[e[E_SIGNAL]], p.data, t)
 
 
 # ----------------------------------------------------------------- springs
@@ -447,7 +514,7 @@ def evaluate_network(t, x, m, p, acc, tau):
         if kind == K_SPRING:
             tq, _tc = spring_torque(p, r, x, n, m)
         elif kind == K_SOURCE:
-            tq = -signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+            tq = -source_torque(p, r, t, x, n)
         else:
             continue
         tau[r] = tq
@@ -647,8 +714,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
 
     States: ``phi`` (n), ``w`` (n), then one energy per element in element order [J]: a source's work
     ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
-    the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift).
-    Switching functions, three per friction element: the relative speed of a sliding element in its
+    the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift); then
+    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, three per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
@@ -675,6 +742,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             dx[2 * n + r] = (tau[r] - tc) * w_rel
         elif kind == K_SOURCE or kind == K_MOTION:
             dx[2 * n + r] = -tau[r] * w_rel
+            if kind == K_SOURCE and e[E_LAW] == SOURCE_ENGINE and e[E_STATE] >= 0:
+                _tq, rate = engine_torque(p, r, t, x, n)
+                dx[2 * n + ne + e[E_STATE]] = rate
         else:
             dx[2 * n + r] = tau[r] * w_rel
     for k in range(nf):

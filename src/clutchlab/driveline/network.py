@@ -60,10 +60,13 @@ class Signal:
         The kind (``kernel.SIG_*``) and its parameters.
     points : tuple
         The breakpoints of a table signal: times, then values.
+    breaks : tuple
+        A sampled signal's corners (times [s]), the only points at which a step must end.
     """
 
     row: tuple
     points: tuple = ()
+    breaks: tuple = ()
 
     @classmethod
     def constant(cls, value: float) -> "Signal":
@@ -100,6 +103,17 @@ class Signal:
         if t.size > 1 and np.any(np.diff(t) <= 0):
             raise ParameterError("table signal: times must be strictly increasing")
         return cls((K.SIG_TABLE,), tuple(t) + tuple(v))
+
+    @classmethod
+    def sampled(cls, times, values, breaks=()) -> "Signal":
+        """Samples of a smooth signal, read linearly between them as :meth:`table`, but whose sample times are
+        not corners of the signal: a step ends only at ``breaks`` [s] (its real corners) and at its ends, so a
+        densely sampled trajectory does not cut the integrator's steps to the sampling interval."""
+        sig = cls.table(times, values)
+        b = np.asarray(breaks, dtype=float).ravel()
+        if not np.all(np.isfinite(b)):
+            raise ParameterError("sampled signal: breaks must be finite times")
+        return cls((K.SIG_SAMPLED,), sig.points, tuple(np.unique(b)))
 
     @classmethod
     def function(cls, fn, t_end: float, step: float, start: float = 0.0) -> "Signal":
@@ -143,7 +157,8 @@ class Signal:
             off = f"{a[3]:g} + " if a[3] else ""
             return f"{off}{a[0]:g}{u} sine at {a[1]:g} Hz, phase {a[2]:g} rad" + (f", from {a[4]:g} s" if a[4] else "")
         n = len(self.points) // 2
-        return f"table of {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
+        what = "samples" if k == K.SIG_SAMPLED else "table of"
+        return f"{what} {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
 
     def value_and_rate(self, t: float) -> tuple:
         """Value and time derivative (from the right) at ``t`` [s], in Python (as the kernel's
@@ -269,6 +284,7 @@ class _Element:
     liftoff: float = math.inf   # the input beyond which that force is 0
     model: str = ""     # what built it (for describe)
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
+    reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
 
 
 class Driveline:
@@ -459,6 +475,55 @@ class Driveline:
         self._elements.append(_Element(K.K_SOURCE, name, a, b, signal=Signal.of(signal, f"{name}: torque")))
         return self
 
+    def engine(self, name: str, flange, torque_map, throttle=1.0, idle_speed: float | None = None,
+               idle_kp: float = 2.0, idle_ki: float = 20.0, idle_torque_max: float = 50.0, support=None) -> "Driveline":
+        """A combustion engine driving ``flange`` (its crankshaft inertia; reaction on ``support``, default ground).
+
+        Torque ``T = map(w, throttle(t)) + T_idle`` [N m], ``w`` the crankshaft speed against the support.
+        ``torque_map``: ``(speeds [rad/s], throttles [-], torques [N m] of shape (speeds, throttles))``, bilinear,
+        held beyond the grids (full load at throttle 1, the drag torque, negative, at throttle 0); or a table
+        ``[[w_rad_s, N m], ...]`` of the full-load curve, scaled by the throttle.  ``throttle``: a signal (0-1).
+        ``idle_speed`` [rad/s]: the set speed of an idle-speed PI controller, ``T_idle = clip(idle_kp (w_idle -
+        w) + I, 0, idle_torque_max)`` with ``dI/dt = idle_ki (w_idle - w)`` and back-calculation anti-windup (its
+        integral ``I`` is a state, ``<name>.idle_integral_Nm``); None: no controller.  Gains in N m s/rad and N m/rad.
+        """
+        name = self._new_name(name)
+        a, b = self._two(name, support, flange)
+        if isinstance(torque_map, tuple) and len(torque_map) == 3:
+            ws, th, tq = (np.asarray(v, dtype=float) for v in torque_map)
+        else:
+            rows = np.asarray(torque_map, dtype=float)
+            if rows.ndim != 2 or rows.shape[1] != 2:
+                raise ParameterError(f"{name}: torque_map must be (speeds, throttles, torques) or rows [w_rad_s, N m]")
+            ws, th = rows[:, 0], np.array([0.0, 1.0])
+            tq = np.column_stack([np.zeros(len(rows)), rows[:, 1]])
+        ws, th, tq = np.atleast_1d(ws), np.atleast_1d(th), np.atleast_2d(tq)
+        if tq.shape != (ws.size, th.size):
+            raise ParameterError(f"{name}: torque_map torques have shape {tq.shape}, expected (speeds, throttles) = "
+                                 f"({ws.size}, {th.size})")
+        for what, grid in (("speeds", ws), ("throttles", th)):
+            if grid.size < 1 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
+                raise ParameterError(f"{name}: torque_map {what} must be finite and strictly increasing")
+        if not np.all(np.isfinite(tq)):
+            raise ParameterError(f"{name}: torque_map torques must be finite")
+        if idle_speed is None:
+            coef = (0.0, 0.0, 0.0, 0.0)
+        else:
+            coef = (_finite(name, "idle_speed", idle_speed, positive=True), _finite(name, "idle_kp", idle_kp, nonneg=True),
+                    _finite(name, "idle_ki", idle_ki, nonneg=True),
+                    _finite(name, "idle_torque_max", idle_torque_max, positive=True))
+        el = _Element(K.K_SOURCE, name, a, b, coef, K.SOURCE_ENGINE, Signal.of(throttle, f"{name}: throttle"),
+                      tuple(ws) + tuple(th) + tuple(tq.ravel()), th.size)
+        el.model = (f"engine map {ws.size} x {th.size} (speed x throttle)"
+                    + ("" if idle_speed is None else f", idle controller at {idle_speed:g} rad/s"))
+        self._elements.append(el)
+        return self
+
+    @property
+    def _controllers(self) -> list:
+        """The elements with a controller state (engines with an idle controller), in state order."""
+        return [e for e in self._elements if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE and e.coef[3] > 0]
+
     def _friction(self, name, a, b, law, table, peak, fn_max=1.0, cgeo=1.0, normal=None):
         peak = _finite(name, "peak", peak)
         if peak < 1.0:
@@ -506,17 +571,27 @@ class Driveline:
         return self._friction(name, a, b, K.LAW_TABLE, self._characteristic(name, "torque", torque), peak)
 
     def eclutch(self, name: str, a, b, position, model: int = 4, parameters=None, travel: float = 8e-3,
-                points: int = 161, peak: float = 1.0) -> "Driveline":
-        """The dry E-clutch of seed 000 between flanges a and b, its normal force from the static curve of
-        its axial model: sliding torque ``2 F_n r_eff mu`` ([1] Sec. 3.2, :func:`clutchlab.eclutch.models.
-        clutch_torque`) with ``F_n = F_n(position(t))``.
+                points: int = 161, peak: float = 1.0, actuator=None, actuator_step: float = 1e-3,
+                pre_roll: float = 1.0, settle: float = 0.5) -> "Driveline":
+        """The dry E-clutch of seed 000 between flanges a and b: sliding torque ``2 F_n r_eff mu`` ([1] Sec. 3.2,
+        :func:`clutchlab.eclutch.models.torque_of_clamp_force`), ``r_eff`` and ``mu`` its axial model's.
 
-        ``position`` [m] is the release bearing position (0 engaged, increasing to release; a signal);
         ``model`` (0-4) and ``parameters`` (an :class:`~clutchlab.eclutch.models.EClutchParameters`, or a
-        path to an E-clutch parameter file) choose the axial model (:meth:`ClutchModel.preset`); its
-        static curve is solved once at ``points`` positions over ``[0, travel]`` and read linearly between
-        them (held beyond).  ``r_eff`` and ``mu`` are the model's.  The clutch is free beyond its lift-off
-        position (the first point whose normal force is 0); ``peak`` scales the static limit.
+        path to an E-clutch parameter file) choose the axial model (:meth:`ClutchModel.preset`).  ``peak``
+        scales the static limit.  The normal force ``F_n``:
+
+        * without ``actuator``: from the model's static curve at the release bearing position ``position(t)``
+          [m] (0 engaged, increasing to release; a signal), solved once at ``points`` positions over ``[0,
+          travel]`` and read linearly between them (held beyond); free beyond the lift-off position (the first
+          point whose force is 0);
+        * with ``actuator`` (``True`` for the default :class:`~clutchlab.eclutch.actuator.ActuatorParameters`, or
+          one): from the E-clutch dynamics ([1] Sec. 2-3: the electro-hydrostatic actuator under its position
+          controller, the hydraulic line, the CSC and the axial model, :class:`~clutchlab.eclutch.dynamics.
+          EClutch`), ``position`` being the bearing position *reference* (a constant, ramp or table).  The axial
+          dynamics do not depend on the rotation (one-way coupling), so they are solved once, before the network,
+          from rest through a ``pre_roll`` [s] holding the reference's first value (the actuator settles there
+          before t = 0) to ``settle`` [s] past its last corner; ``F_n(t)`` is read linearly between samples
+          ``actuator_step`` [s] apart (held after the run: the reference is constant there).
         """
         from ..eclutch.models import ClutchModel, EClutchParameters
 
@@ -531,17 +606,75 @@ class Driveline:
             cm = ClutchModel.preset(int(model), parameters)
         else:
             cm = ClutchModel.from_toml(int(model), parameters)
-        u = np.linspace(0.0, travel, int(points))
-        fn = np.maximum(cm.static_curve(u)["normal_force_N"].to_numpy(), 0.0)
-        zero = np.flatnonzero(fn <= 0.0)
-        liftoff = float(u[zero[0]]) if zero.size else math.inf
         sig = Signal.of(position, f"{name}: position")
-        self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, 2.0 * float(cm.r_eff), sig)
+        cgeo = 2.0 * float(cm.r_eff)
+        label = f"E-clutch Model {int(model)} (r_eff = {cm.r_eff:g} m, mu = {cm.mu:g})"
+        if actuator is None or actuator is False:
+            u = np.linspace(0.0, travel, int(points))
+            fn = np.maximum(cm.static_curve(u)["normal_force_N"].to_numpy(), 0.0)
+            zero = np.flatnonzero(fn <= 0.0)
+            liftoff = float(u[zero[0]]) if zero.size else math.inf
+            self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo, sig)
+            el = self._elements[-1]
+            el.ncurve = tuple(u) + tuple(fn)
+            el.liftoff = liftoff
+            el.model = label
+            return self
+        times, fn, corners, info = self._eclutch_dynamics(name, cm, sig, actuator, actuator_step, pre_roll, settle)
+        self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo,
+                       Signal.sampled(times, fn, corners))
         el = self._elements[-1]
-        el.ncurve = tuple(u) + tuple(fn)
-        el.liftoff = liftoff
-        el.model = f"E-clutch Model {int(model)} (r_eff = {cm.r_eff:g} m, mu = {cm.mu:g})"
+        el.model = f"{label} with its actuator ({info})"
+        el.reference = sig
         return self
+
+    @staticmethod
+    def _eclutch_dynamics(name, cm, sig, actuator, step, pre_roll, settle):
+        """Normal force samples ``(times, F_n)`` of the E-clutch dynamics under the bearing reference ``sig``."""
+        from ..eclutch.actuator import ActuatorParameters
+        from ..eclutch.dynamics import EClutch
+
+        step = _finite(name, "actuator_step", step, positive=True)
+        pre_roll = _finite(name, "pre_roll", pre_roll, nonneg=True)
+        settle = _finite(name, "settle", settle, positive=True)
+        if actuator is True:
+            actuator = ActuatorParameters()
+        if not isinstance(actuator, ActuatorParameters):
+            raise ParameterError(f"{name}: actuator must be True or ActuatorParameters, not {type(actuator).__name__}")
+        kind = sig.row[0]
+        if kind == K.SIG_CONST:
+            t_ref, v_ref = [0.0], [sig.row[1]]
+        elif kind == K.SIG_RAMP:
+            height, duration, start, offset = sig.row[1:5]
+            t_ref, v_ref = [start, start + duration], [offset, offset + height]
+        elif kind in (K.SIG_TABLE, K.SIG_SAMPLED):
+            half = len(sig.points) // 2
+            t_ref, v_ref = list(sig.points[:half]), list(sig.points[half:])
+        else:
+            raise ParameterError(f"{name}: with an actuator, position (the bearing reference) must be a constant, a "
+                                 f"ramp or a table, not {sig.describe('m')}")
+        if min(t_ref) < 0.0:
+            raise ParameterError(f"{name}: the bearing reference starts at {min(t_ref):g} s (before t = 0)")
+        times = np.array([0.0] + [t + pre_roll for t in t_ref]) if pre_roll > 0 else np.array(t_ref, dtype=float)
+        values = np.array([v_ref[0]] + list(v_ref), dtype=float) if pre_roll > 0 else np.array(v_ref, dtype=float)
+        keep = np.concatenate([[True], np.diff(times) > 0])
+        times, values = times[keep], values[keep]
+        t_end = pre_roll + max(t_ref[-1], 0.0) + settle
+        n = int(math.ceil(t_end / step))
+        if n > 5_000_000:
+            raise ParameterError(f"{name}: {n} actuator samples ({t_end:g} s every {step:g} s): choose a larger "
+                                 "actuator_step")
+        run = EClutch(actuator, cm).simulate({"bearing_reference": (times, values)}, n * step, output_step=step)
+        df = run.to_dataframe()
+        t = df["time_s"].to_numpy() - pre_roll
+        fn = np.maximum(df["normal_force_N"].to_numpy(), 0.0)
+        keep = t >= -1e-12
+        t, fn = np.maximum(t[keep], 0.0), fn[keep]
+        # the corners of F_n(t): where it leaves zero or falls to it (engagement, lift-off); elsewhere it is smooth
+        on = fn > 0.0
+        change = np.flatnonzero(on[1:] != on[:-1])
+        corners = np.concatenate([t[change], t[change + 1]])
+        return t, fn, corners, f"{len(t)} samples every {step * 1e3:g} ms, pre-roll {pre_roll:g} s"
 
     def wet_clutch(self, name: str, a, b, force, clutch=None, bench=None, friction=None,
                    temperature0: float = 80.0, fluid_temperature0: float = 80.0,
@@ -574,7 +707,7 @@ class Driveline:
         elif kind == K.SIG_RAMP:
             height, duration, start, offset = sig.row[1:5]
             times, values = (start, start + duration), (offset, offset + height)
-        elif kind == K.SIG_TABLE:
+        elif kind in (K.SIG_TABLE, K.SIG_SAMPLED):
             half = len(sig.points) // 2
             times, values = tuple(sig.points[:half]), tuple(sig.points[half:])
         else:
@@ -635,6 +768,9 @@ class Driveline:
             lines.append(f"  [{name}]  {jn} = {J:g} {ju}, {wn}0 = {x0[n + i]:g} {wu}, {an}0 = {x0[i]:g} {au}")
         for e in self._elements:
             a, b = e.a or GROUND, e.b or GROUND
+            if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
+                lines.append(f"  {a} --({e.name}: {e.model}, throttle {e.signal.describe()})--> [{b}]")
+                continue
             if e.kind == K.K_SOURCE:
                 lines.append(f"  {a} --({e.name}: {u['words'][2]} {e.signal.describe(tu)})--> [{b}]")
                 continue
@@ -659,6 +795,8 @@ class Driveline:
                 char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
                 if e.law == K.LAW_TABLE:
                     what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
+                elif e.reference is not None:
+                    what = f"{e.model}, bearing reference {e.reference.describe('m')}"
                 elif e.ncurve:
                     what = (f"{e.model}, static curve of {len(e.ncurve) // 2} points, lift-off at "
                             f"{e.liftoff * 1e3:g} mm, position {e.signal.describe('m')}")
@@ -689,10 +827,14 @@ class Driveline:
 
         def add_signal(sig):
             row = list(sig.row)
-            if row[0] == K.SIG_TABLE:
+            if row[0] in (K.SIG_TABLE, K.SIG_SAMPLED):
                 n = len(sig.points) // 2
-                row = [K.SIG_TABLE, float(len(data)), float(n)]
+                row = [row[0], float(len(data)), float(n)]
                 data.extend(sig.points)
+                if row[0] == K.SIG_SAMPLED:   # its corners: the ends, then the breaks
+                    corners = sorted({sig.points[0], sig.points[n - 1], *sig.breaks})
+                    row += [float(len(data)), float(len(corners))]
+                    data.extend(corners)
             signals.append(row + [0.0] * (7 - len(row)))
             return len(signals) - 1
 
@@ -704,10 +846,12 @@ class Driveline:
             elem[r, K.E_SIGNAL] = -1 if e.signal is None else add_signal(e.signal)
             if e.table:
                 elem[r, K.E_TABLE] = len(data)
-                elem[r, K.E_TABLE_N] = len(e.table) // (4 if e.kind == K.K_SPRING else 2)
+                elem[r, K.E_TABLE_N] = (len(e.table) // (4 if e.kind == K.K_SPRING else 2) if e.law != K.SOURCE_ENGINE
+                                        or e.kind != K.K_SOURCE else (len(e.table) - e.aux) // (1 + e.aux))
                 data.extend(e.table)
             elem[r, K.E_AUX] = e.aux
             elem[r, K.E_MODE] = -1
+            elem[r, K.E_STATE] = self._controllers.index(e) if e in self._controllers else -1
             coef[r, :len(e.coef)] = e.coef
             if e.ncurve:
                 coef[r, K.C_NCURVE] = len(data)
@@ -760,7 +904,7 @@ class Driveline:
         names = list(self._inertias)
         index = {nm: i for i, nm in enumerate(names)}
         n = len(names)
-        x = np.zeros(2 * n + len(self._elements))
+        x = np.zeros(2 * n + len(self._elements) + len(self._controllers))
         w = [v[1] for v in self._inertias.values()]
         phi = [v[2] for v in self._inertias.values()]
         groups = _Groups(n)
@@ -876,6 +1020,8 @@ class Driveline:
                 states.append((f"{e.name}.dissipated", "J", f"energy dissipated in {e.name}"))
                 outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} (on flange b: -{tn})"))
                 outputs.append((f"{e.name}.{rn}", ru, f"relative speed of {e.name}, flange b minus flange a"))
+        states += [(f"{e.name}.idle_integral", tu, f"integral of the idle-speed controller of {e.name}")
+                   for e in self._controllers]
         for name in self.friction_names:
             outputs.append((f"{name}.mode", "1", f"mode of {name}: 1 forward, 0 stuck, -1 backward, 2 free (MSL)"))
             outputs.append((f"{name}.fn", "N", f"normal force of {name}"))
@@ -909,7 +1055,7 @@ class Driveline:
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values
         m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
-        atol = float(rtol) * np.ones(2 * n + len(self._elements))
+        atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
         events = K.EVENTS
         wet = self._wet_parameters()
         if wet is not None:
