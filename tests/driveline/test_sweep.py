@@ -208,3 +208,65 @@ def test_sweep_command_runs_the_example_and_an_edit_of_the_driveline_is_a_new_sw
     scen.write_text(scen.read_text().replace('J = "1 kg m^2"', 'J = "1.0 kg m^2"', 1))
     err = one_line_error(capsys, ["sweep", str(spec), "-o", str(out), "--no-progress"])
     assert "different sweep" in err and "driveline_test_friction.toml" in err
+
+
+ECLUTCH = """
+[driveline]
+name = "eclutch"
+
+[simulation]
+t_end = "0.3 s"
+output_step = "1 ms"
+
+[inertia.J2]
+J = "0.1 kg m^2"
+w0 = "100 rad/s"
+
+[eclutch.e]
+a = "ground"
+b = "J2"
+position = { ramp = { height = "-8 mm", duration = "0.2 s", offset = "8 mm" } }
+parameters = "eclutch/my_clutch.toml"   # relative to this file
+"""
+
+
+def test_the_files_a_description_names_are_read_beside_it_and_hashed(tmp_path, monkeypatch, capsys):
+    """A spec in one folder, its driveline description in another, run from a third that holds a decoy of the same
+    name: the E-clutch parameter file the description names is read relative to the description (the sweep equals
+    ``Driveline.simulate`` of the file), and an edit of the curve file that parameter file names in turn is another
+    sweep (the resume is refused)."""
+    from clutchlab.driveline.description import load_driveline
+
+    model, specs, work = tmp_path / "model", tmp_path / "specs", tmp_path / "work"
+    for folder in (model, specs, work):
+        (folder / "eclutch").mkdir(parents=True)
+        for name in ("my_clutch.toml", "my_diaphragm.csv"):
+            (folder / "eclutch" / name).write_bytes((EXAMPLES / name).read_bytes())
+    for decoy in (specs, work):  # same names, another clutch: read from here, the sweep would differ
+        path = decoy / "eclutch" / "my_clutch.toml"
+        path.write_text(path.read_text().replace('r_eff = "102.6 mm"', 'r_eff = "80 mm"'))
+    (model / "dl.toml").write_text(ECLUTCH)
+    (work / "dl.toml").write_text(ECLUTCH)
+    (specs / "sweep.toml").write_text(
+        '[sweep]\nmodel = "driveline"\nscenario = "../model/dl.toml"\n'
+        'outputs = ["e.last_stick_s", "e.dissipated_J", "J2.w_final_rad_s"]\n'
+        '[grid]\n"J2.J" = ["0.1 kg m^2", "0.2 kg m^2"]\n')
+    monkeypatch.chdir(work)
+    assert main(["sweep", "../specs/sweep.toml", "-o", "res", "--no-progress", "--no-plot"]) == 0
+    got = pd.read_parquet(work / "res" / "results.parquet").sort_values("J2.J").iloc[0]
+    assert got["J2.J"] == 0.1
+
+    def native(path):
+        res = load_driveline(path).driveline.simulate(0.3, rtol=1e-8, output_step=1e-3)
+        return res.events[res.events.event == "stick"].time_s.max(), res.to_dataframe()["e.dissipated_J"].iloc[-1]
+
+    stick, dissipated = native(model / "dl.toml")
+    assert abs(got["e.last_stick_s"] - stick) < 1e-9 and got["e.dissipated_J"] == pytest.approx(dissipated, rel=1e-9)
+    assert abs(native(work / "dl.toml")[0] - stick) > 1e-3  # the decoy is another clutch
+    capsys.readouterr()
+    assert main(["sweep", "../specs/sweep.toml", "-o", "res", "--no-progress", "--no-plot"]) == 0
+    assert "0 chunks computed" in capsys.readouterr().err
+    curve = model / "eclutch" / "my_diaphragm.csv"
+    curve.write_text(curve.read_text() + "\n")  # the same curve, other bytes: the sweep's inputs changed
+    err = one_line_error(capsys, ["sweep", "../specs/sweep.toml", "-o", "res", "--no-progress"])
+    assert "different sweep" in err and "my_diaphragm.csv" in err

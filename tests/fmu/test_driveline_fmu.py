@@ -172,3 +172,166 @@ def test_export_fmu_command_for_a_driveline(tmp_path, monkeypatch, capsys):
     with pytest.raises(ParameterError, match="description file"):
         export_fmu("driveline", tmp_path / "d.fmu")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "driveline_coupled_clutches.fmu"]
+
+
+# ----------------------------------------------------------------- the files a description names
+EXAMPLES = EXAMPLE.parent
+#: the wet example's wet clutch with a parameter file of its own clutch and of its bench (both named wet.toml,
+#: one outside the description's folder) and an E-clutch with examples/my_clutch.toml, which names its curve
+WET_FILES = {"clutch": 'clutch = "wet/wet.toml"   # N_c = 6, not the paper\'s 8\n',
+             "bench": "bench = '../shared/wet.toml'\n"}
+ECLUTCH = """
+[inertia.J2]
+J = "0.1 kg m^2"
+w0 = "100 rad/s"
+
+[eclutch.e]
+a = "ground"
+b = "J2"
+position = { ramp = { height = "-8 mm", duration = "0.2 s", offset = "8 mm" } }
+parameters = "eclutch/my_clutch.toml"   # with its own diaphragm curve
+"""
+SHORT = 300  # 0.3 s of 1 ms steps
+
+
+def _files_description(folder: Path, without=()) -> Path:
+    """``folder/model/dl.toml``: the wet example over 0.3 s with the files of WET_FILES and ECLUTCH (less those
+    named in ``without``)."""
+    from clutchlab.wet.params import Bench, WetClutch
+
+    model = folder / "model"
+    for sub in (model / "wet", model / "eclutch", folder / "shared"):
+        sub.mkdir(parents=True, exist_ok=True)
+    if not (model / "wet" / "wet.toml").exists():
+        WetClutch.paper(n_c=6).to_toml(model / "wet" / "wet.toml")
+        Bench(actuator_time_constant=0.03).to_toml(folder / "shared" / "wet.toml")
+        for name in ("my_clutch.toml", "my_diaphragm.csv"):
+            shutil.copy(EXAMPLES / name, model / "eclutch" / name)
+    text = (EXAMPLES / "driveline_wet_sae2.toml").read_text().replace('t_end = "1.2 s"', 't_end = "0.3 s"')
+    last = 'housing_temperature0 = "70 degC"\n'
+    text = text.replace(last, last + "".join(line for key, line in WET_FILES.items() if key not in without))
+    text += ECLUTCH.replace('parameters = "eclutch/my_clutch.toml"', "#") if "parameters" in without else ECLUTCH
+    path = model / ("dl.toml" if not without else f"dl_without_{'_'.join(without)}.toml")
+    path.write_text(text)
+    return path
+
+
+def test_the_fmu_carries_the_files_its_description_names(tmp_path, run_fmu):
+    """An FMU of a description that names parameter files (a wet clutch's clutch and bench, two files both named
+    wet.toml, one in a folder beside the description's; an E-clutch's, which names its own curve file) runs them
+    from its resources: with the originals deleted it equals ``Driveline.simulate`` of the original description
+    to the solver's tolerance, and every one of those files changes the run."""
+    path = _files_description(tmp_path)
+    originals = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    names = [v.name for v in DrivelineCoSimulation.for_description(path).outputs]
+
+    def native(description):
+        res = load_driveline(description).driveline.simulate(SHORT * DT, rtol=1e-8, output_step=DT)
+        return dict(zip(names, np.concatenate((res.states, res.outputs), axis=1).T))
+
+    ref = native(path)
+    fmu_path = export_fmu("driveline", tmp_path / "dl.fmu", description=path)
+    assert {p: p.read_bytes() for p in originals} == originals  # nothing the user wrote is touched
+    with zipfile.ZipFile(fmu_path) as z:
+        copies = sorted(n for n in z.namelist() if n.startswith("resources/description"))
+        assert copies == ["resources/description.toml", "resources/description_files/my_clutch.toml",
+                          "resources/description_files/my_diaphragm.csv", "resources/description_files/wet.toml",
+                          "resources/description_files/wet_2.toml"]
+        carried = z.read("resources/description.toml").decode()
+        files = {n.rsplit("/", 1)[1]: z.read(n) for n in copies[1:]}
+    # the description's text is kept: only the three file names change, to the copies (comments kept)
+    changed = [(a, b) for a, b in zip(path.read_text().splitlines(), carried.splitlines(), strict=True) if a != b]
+    assert changed == [('clutch = "wet/wet.toml"   # N_c = 6, not the paper\'s 8',
+                        'clutch = "description_files/wet.toml"   # N_c = 6, not the paper\'s 8'),
+                       ("bench = '../shared/wet.toml'", 'bench = "description_files/wet_2.toml"'),
+                       ('parameters = "eclutch/my_clutch.toml"   # with its own diaphragm curve',
+                        'parameters = "description_files/my_clutch.toml"   # with its own diaphragm curve')]
+    assert files["wet.toml"] == originals[tmp_path / "model" / "wet" / "wet.toml"]
+    assert files["wet_2.toml"] == originals[tmp_path / "shared" / "wet.toml"]
+    assert files["my_diaphragm.csv"] == (EXAMPLES / "my_diaphragm.csv").read_bytes()
+    assert files["my_clutch.toml"] == (EXAMPLES / "my_clutch.toml").read_bytes()  # names its curve beside it
+    for p in tmp_path.iterdir():  # the FMU needs only itself
+        if p != fmu_path:
+            shutil.rmtree(p)
+    out = run_fmu(fmu_path, {}, DT, SHORT, names)
+    # the integration error at rtol 1e-8 (measured: 2.6e-6 of its range in the squeeze force, below 1e-6 elsewhere;
+    # no source: the energy balance is measured against the initial kinetic energy, 2e-8)
+    assert _largest_difference(out, ref, [n for n in names if n != "energy_error"]) < 1e-5
+    assert np.max(np.abs(out["energy_error"] - ref["energy_error"])) < 1e-7 * ref["kinetic_energy"][0]
+    for name in names:
+        if name.endswith(".mode"):
+            np.testing.assert_array_equal(out[name], ref[name], err_msg=name)
+    # every file changes the run: without it (the defaults) the columns move by far more than the bound
+    for without, columns in ((("clutch",), ["dyno.w", "clutch.tau"]), (("bench",), ["dyno.w", "clutch.tau"]),
+                             (("parameters",), ["J2.w", "e.fn", "e.tau"])):
+        other = native(_files_description(tmp_path / "again", without))
+        assert _largest_difference(other, ref, columns) > 1e-2, without
+
+
+def test_a_missing_file_or_one_outside_the_resources_is_refused(tmp_path, capsys):
+    """Export refuses a description (or an E-clutch parameter file) naming a file that does not exist, naming
+    the file, the key and the value, and writes nothing; the FMU's class refuses a name leading out of its
+    resources folder."""
+    last = 'housing_temperature0 = "70 degC"\n'
+    wet = (EXAMPLES / "driveline_wet_sae2.toml").read_text()
+    desc = tmp_path / "dl.toml"
+    desc.write_text(wet.replace(last, last + 'friction = "laws/law.toml"\n'))
+    with pytest.raises(ParameterError,
+                       match=r"dl\.toml: wet_clutch\.clutch\.friction = 'laws/law\.toml': no such file"):
+        export_fmu("driveline", tmp_path / "dl.fmu", description=desc)
+    err = one_line_error(capsys, ["export-fmu", "driveline", str(desc), "-o", str(tmp_path / "dl.fmu")])
+    assert "dl.toml" in err and "wet_clutch.clutch.friction = 'laws/law.toml'" in err
+    (tmp_path / "ec.toml").write_text('[eclutch]\nr_eff = "0.1 m"\n\n[eclutch.curves]\n'
+                                      'diaphragm = { file = "gone.csv" }\n')
+    desc.write_text(ECLUTCH.replace("eclutch/my_clutch.toml", "ec.toml"))
+    with pytest.raises(ParameterError, match=r"dl\.toml: eclutch\.e\.parameters = 'ec\.toml': .*ec\.toml: "
+                                             r"eclutch\.curves\.diaphragm\.file = 'gone\.csv': no such file"):
+        export_fmu("driveline", tmp_path / "dl.fmu", description=desc)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dl.toml", "ec.toml"]
+    resources = tmp_path / "resources"
+    resources.mkdir()
+    (resources / "description.toml").write_text(ECLUTCH.replace("eclutch/my_clutch.toml", "../ec.toml"))
+    with pytest.raises(ParameterError, match=r"eclutch\.e\.parameters = '\.\./ec\.toml': names .*ec\.toml, outside "
+                                             r"the folder .*resources"):
+        DrivelineCoSimulation.for_description(resources / "description.toml", within=resources)
+
+
+def test_bundle_names_every_copy_apart_and_the_copy_loads_as_the_original(tmp_path):
+    """``bundle_description``: two E-clutch parameter files both named clutch.toml (one with a curve folder, one
+    with a curve file) and a path also used as another string value (the copy is then written anew from its
+    values): the bundle holds every file under a name of its own and, with the originals gone, reads as the
+    same network."""
+    from importlib import resources
+
+    from clutchlab.fmu.export import bundle_description
+
+    src = tmp_path / "src"
+    for sub in ("a/curves", "b"):
+        (src / sub).mkdir(parents=True)
+    with resources.as_file(resources.files("clutchlab.eclutch") / "data" / "curves") as bundled:
+        for csv in Path(bundled).glob("*.csv"):
+            shutil.copy(csv, src / "a" / "curves" / csv.name)
+    (src / "a" / "clutch.toml").write_text('[eclutch]\nr_eff = "95 mm"\n\n[eclutch.curves]\nfolder = "curves"\n')
+    (src / "b" / "clutch.toml").write_text('[eclutch]\n\n[eclutch.curves]\ndiaphragm = "my_diaphragm.csv"\n')
+    shutil.copy(EXAMPLES / "my_diaphragm.csv", src / "b" / "my_diaphragm.csv")
+    text = ECLUTCH.replace("eclutch/my_clutch.toml", "a/clutch.toml") + ECLUTCH.replace(
+        "J2", "J3").replace("[eclutch.e]", '[eclutch.e2]').replace("eclutch/my_clutch.toml", "b/clutch.toml")
+    desc = src / "dl.toml"
+    desc.write_text('[driveline]\nname = "a/clutch.toml"\n' + text)
+    out = bundle_description(desc, tmp_path / "bundle")
+    files = sorted(str(p.relative_to(tmp_path / "bundle")) for p in (tmp_path / "bundle").rglob("*") if p.is_file())
+    assert files == ["description.toml", "description_files/clutch.toml", "description_files/clutch_2.toml",
+                     *(f"description_files/curves/{c}.csv" for c in sorted(
+                         ("cushion", "diaphragm", "pp_spring", "return_springs", "support_ring", "yoke_spring"))),
+                     "description_files/my_diaphragm.csv"]
+    assert out.read_text().startswith("# driveline description dl.toml, written anew")  # the name is a path too
+    with pytest.raises(FileExistsError, match="description.toml"):
+        bundle_description(desc, tmp_path / "bundle")  # replaces nothing
+    original = load_driveline(desc).driveline
+    shutil.rmtree(src)
+    copy = load_driveline(out).driveline
+    assert copy.name == "a/clutch.toml"
+    assert [(e.name, e.ncurve, e.model) for e in copy._elements] == [(e.name, e.ncurve, e.model)
+                                                                      for e in original._elements]
+    assert original._elements[0].ncurve != original._elements[1].ncurve  # the two parameter files differ

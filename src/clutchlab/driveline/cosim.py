@@ -70,13 +70,17 @@ class DrivelineCoSimulation(ContractCoSimulation):
     base = None
 
     @classmethod
-    def for_description(cls, path) -> type:
+    def for_description(cls, path, *, within=None) -> type:
         """The co-simulation class of the driveline described in the file at ``path``.
 
         Parameters
         ----------
         path : str or Path
-            A driveline description (TOML).
+            A driveline description (TOML).  The files it names (an E-clutch's or a wet clutch's
+            parameter files) are read relative to its folder.
+        within : str or Path, optional
+            A folder that every file the description names must be in: the FMU passes its
+            ``resources`` folder, so an FMU reads only the copies it carries.
 
         Returns
         -------
@@ -88,9 +92,11 @@ class DrivelineCoSimulation(ContractCoSimulation):
         Raises
         ------
         ParameterError
-            The file is not a valid driveline description (naming the file, key and value).
+            The file is not a valid driveline description, or names a file that does not exist (or lies
+            outside ``within``) -- naming the file, key and value.
         """
         doc = DrivelineDocument.read(path)
+        doc.referenced_files(within=within)  # every file it names is there (and inside within), before any is read
         base = doc.load()
         system = base.driveline.system(base.rtol)
         outputs = tuple(Variable(v.name, _fmi_unit(v.unit), 0.0, v.description)

@@ -13,6 +13,11 @@ Used by ``clutchlab sweep`` (:mod:`clutchlab.sweep`).  The spec's scenario is a 
     "clutch.fn_max" = ["0.8 N", "1 N", "1.2 N"]
     "inertia3.J" = ["1 kg m^2", "2 kg m^2"]
 
+The files the description names (an E-clutch's or a wet clutch's parameter files) are read relative to
+the description's folder, as ``clutchlab driveline simulate`` reads them -- not the spec's folder nor
+the working directory; their bytes, and those of the curve files an E-clutch parameter file names, are
+part of the sweep's hash (:func:`referenced_files`).
+
 The parameters are the numeric fields of the file's components, ``<component>.<field>``
 (:class:`~clutchlab.driveline.variants.DrivelineDocument`): ``J1.J``, ``J1.w0``, ``clutch1.fn_max``,
 ``clutch1.mu``, ``clutch1.peak``, a spring's ``c``, ...  Written against the system contract: every
@@ -100,14 +105,21 @@ def describe(scenario) -> dict:
 
 
 def referenced_files(scenario) -> list:
-    """The driveline description itself (its bytes are part of the sweep's hash).
+    """The driveline description and every file it names (their bytes are part of the sweep's hash).
+
+    The files are those the loader reads, relative to the description's folder
+    (:meth:`~clutchlab.driveline.variants.DrivelineDocument.referenced_files`): E-clutch and wet-clutch
+    parameter files, a friction law or map, and the curve files an E-clutch parameter file names in turn.
 
     Parameters
     ----------
     scenario : dict
         The parsed driveline description (``_source`` = its path).
     """
-    return [] if not scenario or "_source" not in scenario else [scenario["_source"]]
+    if not scenario or "_source" not in scenario:
+        return []
+    doc = DrivelineDocument(scenario, str(scenario["_source"]))
+    return [scenario["_source"], *(f for ref in doc.referenced_files() for f in ref.files())]
 
 
 def _system(doc, vid, row):

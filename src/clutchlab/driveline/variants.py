@@ -18,6 +18,12 @@ of the normal force) are not parameters.
 
 Every variant is read by the one loader, :func:`~clutchlab.driveline.description.parse_driveline`,
 so it is checked as the file itself would be; the changed values go in as SI numbers.
+
+A description can name other files, relative to its folder (the fields whose unit is ``"path"``: an
+E-clutch's ``parameters``, a wet clutch's ``clutch``, ``bench`` and ``friction``), and an E-clutch
+parameter file can name curve files relative to itself (``[eclutch.curves]``, ``folder`` and one entry
+per component).  :meth:`DrivelineDocument.referenced_files` lists them all; the FMU copies them into its
+resources, the sweep hashes them.
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ from ..units import to_si
 from .description import FIELDS, NOT_QUANTITIES, TRANSLATIONAL_FIELDS, DrivelineFile, parse_driveline
 from .network import Driveline
 
-__all__ = ["Parameter", "DrivelineDocument"]
+__all__ = ["Parameter", "DrivelineDocument", "ReferencedFile"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +62,83 @@ class Parameter:
     unit: str
     value: float
     description: str
+
+
+@dataclass(frozen=True)
+class ReferencedFile:
+    """A file (or a folder of curve files) that a driveline description makes the loader read.
+
+    Parameters
+    ----------
+    source : pathlib.Path
+        The file that names it: the description, or an E-clutch parameter file.
+    key : str
+        Where that file names it (``"wet_clutch.clutch.clutch"``, ``"eclutch.curves.diaphragm.file"``).
+    value : str
+        The name as written, relative to the folder of ``source``.
+    path : pathlib.Path
+        The file (or folder) it names, resolved.
+    role : str
+        ``"file"`` (read as it is), ``"eclutch_parameters"`` (an E-clutch parameter file; its own
+        references are in ``children``) or ``"curve_folder"`` (a folder of the component curves
+        ``<component>.csv``, listed in ``children``).
+    children : tuple of ReferencedFile
+        The files this one names in turn.
+    """
+
+    source: Path
+    key: str
+    value: str
+    path: Path
+    role: str = "file"
+    children: tuple = ()
+
+    def files(self) -> list:
+        """Every file this reference makes the loader read: itself (a folder: its curve files) and its children's."""
+        own = [] if self.role == "curve_folder" else [self.path]
+        return own + [f for child in self.children for f in child.files()]
+
+
+def _resolve(base: Path, value, source, key: str, within, folder: bool = False, what: str = "file") -> Path:
+    """``base / value`` resolved; a missing file (or folder), or one outside ``within``, raises ParameterError."""
+    if not isinstance(value, str) or not value:
+        raise ParameterError(f"{source}: {key} = {value!r}: expected a {what} name")
+    target = (base / value).resolve()
+    root = None if within is None else Path(within).resolve()
+    if root is not None and not target.is_relative_to(root):
+        raise ParameterError(f"{source}: {key} = {value!r}: names {target}, outside the folder {root} that the "
+                             f"description's files must be in")
+    if not (target.is_dir() if folder else target.is_file()):
+        raise ParameterError(f"{source}: {key} = {value!r}: no such {what} ({target})")
+    return target
+
+
+def _curve_files(path: Path, within) -> tuple:
+    """The curve files an E-clutch parameter file names (``[eclutch.curves]``, read as ``ClutchModel.from_toml``
+    reads them)."""
+    from ..eclutch.models import COMPONENTS
+
+    data = read_toml(path)
+    table = data.get("eclutch", data)
+    curves = table.get("curves") if isinstance(table, dict) else None
+    if not isinstance(curves, dict):
+        return ()  # none (the loader names a malformed table)
+    out = []
+    if "folder" in curves:
+        key = "eclutch.curves.folder"
+        folder = _resolve(path.parent, curves["folder"], path, key, within, folder=True, what="folder")
+        out.append(ReferencedFile(path, key, curves["folder"], folder, "curve_folder", tuple(
+            ReferencedFile(path, f"{key} {name}.csv", f"{name}.csv",
+                           _resolve(folder, f"{name}.csv", path, f"{key} ({curves['folder']!r}) {name}.csv", within))
+            for name in COMPONENTS)))
+    for name in COMPONENTS:
+        entry = curves.get(name)
+        key = f"eclutch.curves.{name}"
+        if isinstance(entry, dict) and "file" in entry:
+            entry, key = entry["file"], f"{key}.file"
+        if entry is not None:
+            out.append(ReferencedFile(path, key, entry, _resolve(path.parent, entry, path, key, within)))
+    return tuple(out)
 
 
 def _is_scalar(value) -> bool:
@@ -128,6 +211,54 @@ class DrivelineDocument:
             The driveline description.
         """
         return cls(read_toml(path), str(path))
+
+    def referenced_files(self, within=None) -> list:
+        """Every file the description names, relative to its folder, and the files those name in turn.
+
+        The fields whose unit is ``"path"`` (:data:`~clutchlab.driveline.description.FIELDS`): an
+        E-clutch's ``parameters`` (with the curve files of its ``[eclutch.curves]`` table, relative to
+        the parameter file) and a wet clutch's ``clutch``, ``bench`` and ``friction``.
+
+        Parameters
+        ----------
+        within : str or Path, optional
+            A folder every named file must be in (the FMU's ``resources``): a name that leads out of it
+            (``..``, an absolute path, a link) is refused.
+
+        Returns
+        -------
+        list of ReferencedFile
+            In the order of the description; the description's own references at the top level.
+
+        Raises
+        ------
+        ParameterError
+            A named file that does not exist (or lies outside ``within``), naming the file that names
+            it, the key and the value.
+        """
+        base = Path(self.source).parent
+        out = []
+        for kind, fields in self._fields.items():
+            table = self.document.get(kind, {})
+            if not isinstance(table, dict):
+                continue
+            for component, comp in table.items():
+                if not isinstance(comp, dict):
+                    continue
+                for field, (unit, _) in fields.items():
+                    if unit != "path" or field not in comp:
+                        continue
+                    key, value = f"{kind}.{component}.{field}", comp[field]
+                    path = _resolve(base, value, self.source, key, within)
+                    if kind == "eclutch":
+                        try:
+                            children = _curve_files(path, within)
+                        except ParameterError as exc:
+                            raise ParameterError(f"{self.source}: {key} = {value!r}: {exc}") from None
+                        out.append(ReferencedFile(Path(self.source), key, value, path, "eclutch_parameters", children))
+                    else:
+                        out.append(ReferencedFile(Path(self.source), key, value, path))
+        return out
 
     def check_names(self, names) -> None:
         """Raise :class:`ParameterError` for the first of ``names`` that is not a parameter of this file.

@@ -1,7 +1,8 @@
 """``clutchlab export-fmu MODEL [FILE] -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.export.export_fmu`.
 
 ``clutchlab export-fmu {eclutch,wet,emtc} -o NAME.fmu`` exports a model with its bundled parameters;
-``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes.
+``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes
+(the FMU carries the file and every file it names, :func:`clutchlab.fmu.export.bundle_description`).
 """
 
 from __future__ import annotations
@@ -49,7 +50,8 @@ def register(subparsers) -> None:
         description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
                     "units). The FMU runs the model through pythonfmu: the importing tool needs a Python with "
                     "clutchlab installed. A driveline is exported from its description file, which the FMU "
-                    "carries: 'export-fmu driveline FILE.toml'.",
+                    "carries with a copy of every file it names (parameter files, a friction map, curves): "
+                    "'export-fmu driveline FILE.toml'.",
         epilog="Documentation: docs/fmu.md (drivelines: docs/driveline.md)")
     p.add_argument("model", choices=sorted(COSIMULATIONS), help="model to export")
     p.add_argument("file", nargs="?", default=None,

@@ -6,13 +6,16 @@ script in ``resources/``.  The script is three lines -- a subclass of
 :class:`CoSimulationSlave` naming the model -- and imports clutchlab at run
 time.  A model built from a description file (the driveline) carries that
 file in the FMU, ``resources/description.toml``, read when the FMU is
-instantiated; so **the importing tool must run a Python in which clutchlab is
-installed** (with numpy, numba, scipy, pandas, pint).  clutchlab's source is
-deliberately not bundled: the compiled kernels cache their machine code next
-to the installed package (a bundled copy, unpacked to a fresh temporary
-folder by each importer, would compile for tens of seconds at every
-instantiation), and one installed version keeps the FMU and the Python API in
-step.  The slave refuses to start if the installed clutchlab version differs
+instantiated, with a copy of every file it names (parameter files, a
+friction map, curves) in ``resources/description_files/``: the copy of the
+description names those copies, and the slave reads no file outside its
+resources (:func:`bundle_description`).  So **the importing tool must run a
+Python in which clutchlab is installed** (with numpy, numba, scipy, pandas,
+pint).  clutchlab's source is deliberately not bundled: the compiled kernels
+cache their machine code next to the installed package (a bundled copy,
+unpacked to a fresh temporary folder by each importer, would compile for tens
+of seconds at every instantiation), and one installed version keeps the FMU
+and the Python API in step.  The slave refuses to start if the installed clutchlab version differs
 from the one that built the FMU.
 
 pythonfmu writes no units; :func:`export_fmu` adds them afterwards: a
@@ -27,13 +30,16 @@ References
 
 from __future__ import annotations
 
+import functools
 import io
+import json
 import platform
 import re
 import shutil
 import subprocess
 import sys
 import tempfile
+import tomllib
 import warnings
 import zipfile
 from pathlib import Path
@@ -45,7 +51,8 @@ from ..io import atomic_write_bytes, check_writable
 from . import COSIMULATIONS
 from .cosim import load_cosimulation
 
-__all__ = ["compile_shim", "export_fmu", "keep_namespace", "model_identifier", "slave_script", "unit_definition"]
+__all__ = ["bundle_description", "compile_shim", "export_fmu", "keep_namespace", "model_identifier", "slave_script",
+           "unit_definition"]
 
 #: name of the slave's local Boolean that flags a refused step (read by the shim library, ``shim/fmi2_shim.c``)
 STEP_ERROR = "step_error"
@@ -56,6 +63,8 @@ DEFAULT_EXPERIMENT = {"wet": (1.0, 1e-3), "emtc": (2.0, 0.01), "eclutch": (1.0, 
 
 #: name of a model's description file inside the FMU's ``resources/`` folder
 DESCRIPTION_RESOURCE = "description.toml"
+#: folder, beside :data:`DESCRIPTION_RESOURCE`, of the copies of the files that the description names
+FILES_RESOURCE = "description_files"
 
 
 def model_identifier(model: str) -> str:
@@ -175,7 +184,10 @@ def _slave_base():
             cls = load_cosimulation(self.model_key)
             if self.description_file:  # the model of the description carried in the FMU's resources
                 # on the model thread: reading it builds the model, which may load compiled kernels
-                cls = _on_model_thread(cls.for_description, Path(self.resources) / self.description_file)
+                # (only the files of its own resources: the copies the description names, never the originals)
+                resources = Path(self.resources)
+                cls = _on_model_thread(functools.partial(cls.for_description, resources / self.description_file,
+                                                         within=resources))
             self.description = (f"clutchlab {self.model_key} model ({cls.__name__}); inputs held constant over "
                                 f"each communication step; needs a Python with clutchlab installed")
             stop, step = cls.experiment or DEFAULT_EXPERIMENT.get(self.model_key, (1.0, 1e-3))
@@ -244,6 +256,173 @@ def __getattr__(name):  # CoSimulationSlave is created lazily so importing this 
         globals()["CoSimulationSlave"] = cls
         return cls
     raise AttributeError(name)
+
+
+# ----------------------------------------------------------------- the files of a description
+#: a string in a TOML text (or a comment, skipped): multi-line and one-line, basic and literal
+_TOML_TOKEN = re.compile(r'#[^\r\n]*'                  # a comment
+                         r'|"""(?:\\[\s\S]|[^\\])*?"""'  # multi-line basic string
+                         r"|'''[\s\S]*?'''"              # multi-line literal string
+                         r'|"(?:\\.|[^"\\\r\n])*"'       # basic string
+                         r"|'[^'\r\n]*'")                # literal string
+#: file names Windows refuses whatever their suffix
+_WINDOWS_RESERVED = {"CON", "PRN", "AUX", "NUL", *(f"COM{i}" for i in range(1, 10)),
+                     *(f"LPT{i}" for i in range(1, 10))}
+
+
+def _unique_name(name: str, taken: set) -> str:
+    """A safe file name like ``name`` (letters, digits, ``_.-``; its suffix kept) not in ``taken`` (case-blind)."""
+    original = Path(name)
+    suffix = re.sub(r"[^A-Za-z0-9]+", "_", original.suffix[1:])[:16]
+    suffix = f".{suffix}" if suffix else ""
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", original.stem).strip("._-")[:60] or "file"
+    if stem.split(".")[0].upper() in _WINDOWS_RESERVED:
+        stem += "_"
+    candidate, k = stem + suffix, 2
+    while candidate.lower() in taken:
+        candidate, k = f"{stem}_{k}{suffix}", k + 1
+    taken.add(candidate.lower())
+    return candidate
+
+
+def _rewrite_strings(raw: bytes, replace: dict, expected: dict, what: str) -> bytes:
+    """The TOML text ``raw`` with the string values in ``replace`` replaced, everything else kept as written.
+
+    Only strings in a value position (after ``=``) are replaced; the result must parse to ``expected``
+    (the parsed document with the new values).  Where it does not (the same string elsewhere in a
+    value), the document is written anew from ``expected``, without its comments.
+    """
+    if not replace:
+        return raw
+    text = raw.decode("utf-8")
+    out, pos = [], 0
+    for m in _TOML_TOKEN.finditer(text):
+        token = m.group()
+        if token.startswith("#") or not text[max(0, m.start() - 256):m.start()].rstrip(" \t").endswith("="):
+            continue
+        try:
+            value = tomllib.loads(f"v = {token}")["v"]
+        except tomllib.TOMLDecodeError:
+            continue
+        if value in replace:
+            out += [text[pos:m.start()], json.dumps(replace[value])]
+            pos = m.end()
+    new = "".join(out) + text[pos:]
+    try:
+        if tomllib.loads(new) == expected:
+            return new.encode("utf-8")
+    except tomllib.TOMLDecodeError:
+        pass
+    import tomli_w
+
+    head = (f"# {what}, written anew by clutchlab {__version__} from its values (its comments are not kept),\n"
+            f"# naming the copies of the files it names\n")
+    return (head + tomli_w.dumps(expected)).encode("utf-8")
+
+
+def _curves_replaced(data: dict, mapping: dict) -> dict:
+    """An E-clutch parameter document with the curve file names of its ``[eclutch.curves]`` replaced."""
+    from ..eclutch.models import COMPONENTS
+
+    data = _copy(data)
+    table = data.get("eclutch", data)
+    curves = table.get("curves") if isinstance(table, dict) else None
+    for key in ("folder", *COMPONENTS) if isinstance(curves, dict) else ():
+        entry = curves.get(key)
+        if isinstance(entry, dict) and isinstance(entry.get("file"), str) and entry["file"] in mapping:
+            entry["file"] = mapping[entry["file"]]
+        elif isinstance(entry, str) and entry in mapping:
+            curves[key] = mapping[entry]
+    return data
+
+
+def _copy(value):
+    """A copy of a parsed TOML document (its tables and arrays; the values themselves are immutable)."""
+    if isinstance(value, dict):
+        return {k: _copy(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_copy(v) for v in value]
+    return value
+
+
+def bundle_description(description, folder) -> Path:
+    """Copy a driveline description and every file it names into ``folder``, the copy naming the copies.
+
+    Writes ``folder/description.toml`` (:data:`DESCRIPTION_RESOURCE`) and, if the description names
+    files (:meth:`~clutchlab.driveline.variants.DrivelineDocument.referenced_files`: E-clutch and
+    wet-clutch parameter files, a friction law or map, an E-clutch parameter file's curve files or
+    curve folder), a copy of each in ``folder/description_files/`` (:data:`FILES_RESOURCE`) under a
+    name of its own: the file's name made safe (letters, digits, ``_.-``, its suffix kept) and, where
+    two files share a name, numbered (``wet.toml``, ``wet_2.toml``; case-blind).  A file named twice is
+    copied once.  The copy of the description (and of an E-clutch parameter file) is its text with the
+    names of those files replaced by the names of the copies, relative to it; nothing else changes (if
+    a replacement cannot be made in the text alone, the file is written anew from its parsed values).
+    The folder is then self-contained: every file the copy names is inside it (checked).
+
+    Parameters
+    ----------
+    description : str or Path
+        The driveline description (TOML).
+    folder : str or Path
+        The folder to write into (the FMU's resources under construction); created if missing.
+
+    Returns
+    -------
+    pathlib.Path
+        The copy of the description.
+
+    Raises
+    ------
+    ParameterError
+        The description (or an E-clutch parameter file) names a file that does not exist: the message
+        names the file, the key and the value.
+    FileExistsError
+        ``folder`` holds a ``description.toml`` or ``description_files`` already (nothing is replaced).
+    """
+    from ..driveline.variants import DrivelineDocument
+    from ..io.files import read_toml
+
+    description, folder = Path(description), Path(folder)
+    doc = DrivelineDocument.read(description)
+    refs = doc.referenced_files()
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in (DESCRIPTION_RESOURCE, FILES_RESOURCE):
+        if (folder / name).exists():
+            raise FileExistsError(f"{folder / name} exists: bundle_description writes into a folder without it")
+    files = folder / FILES_RESOURCE
+    taken, placed = set(), {}
+
+    def place(ref) -> str:
+        """Name of the copy of ``ref`` in ``files`` (copied on first use)."""
+        if (ref.path, ref.role) in placed:
+            return placed[(ref.path, ref.role)]
+        name = placed[(ref.path, ref.role)] = _unique_name(ref.path.name, taken)
+        files.mkdir(exist_ok=True)
+        if ref.role == "curve_folder":  # the folder's curve files under their own names (the loader's)
+            (files / name).mkdir()
+            for child in ref.children:
+                shutil.copyfile(child.path, files / name / child.value)
+        elif ref.role == "eclutch_parameters":  # its curve files beside it
+            mapping = {child.value: place(child) for child in ref.children}
+            raw = ref.path.read_bytes()
+            (files / name).write_bytes(_rewrite_strings(raw, mapping, _curves_replaced(read_toml(ref.path), mapping),
+                                                        f"E-clutch parameter file {ref.path.name}"))
+        else:
+            shutil.copyfile(ref.path, files / name)
+        return name
+
+    raw = description.read_bytes()
+    expected = _copy(read_toml(description))
+    mapping = {}
+    for ref in refs:
+        mapping[ref.value] = f"{FILES_RESOURCE}/{place(ref)}"
+        kind, rest = ref.key.split(".", 1)  # "<kind>.<component>.<field>"; a component's name may hold dots
+        component, field = rest.rsplit(".", 1)
+        expected[kind][component][field] = mapping[ref.value]
+    out = folder / DESCRIPTION_RESOURCE
+    out.write_bytes(_rewrite_strings(raw, mapping, expected, f"driveline description {description.name}"))
+    DrivelineDocument.read(out).referenced_files(within=folder)  # self-contained
+    return out
 
 
 # ----------------------------------------------------------------- units
@@ -448,10 +627,10 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None) -
         script.parent.mkdir()
         script.write_text(slave_script(model, description is not None))
         files = []
-        if description is not None:  # the description travels in the FMU's resources
+        if description is not None:  # the description and the files it names travel in the FMU's resources
             (tmp / "files").mkdir()
-            files.append(tmp / "files" / DESCRIPTION_RESOURCE)
-            files[0].write_bytes(Path(description).read_bytes())
+            bundle_description(description, tmp / "files")
+            files = sorted((tmp / "files").iterdir())
         # several instances per process work once keep_namespace balances pythonfmu's release (issue #228)
         built = FmuBuilder.build_FMU(script, dest=tmp / "build" / f"{ident}.fmu", project_files=files,
                                      canBeInstantiatedOnlyOncePerProcess=False)
