@@ -124,9 +124,6 @@ def test_wet_clutch_slides_backward_and_stays_open_without_force():
 
 
 def test_wet_clutch_errors():
-    d = _launch()
-    with pytest.raises(ParameterError, match="one wet clutch"):
-        d.wet_clutch("clutch2", "engine", "vehicle", force=100.0)
     with pytest.raises(ParameterError, match="constant, a ramp or a table"):
         _launch(force=Signal.sine(100.0, 1.0))
     with pytest.raises(ParameterError, match="negative"):
@@ -176,3 +173,38 @@ def test_wet_clutch_in_the_co_simulation_and_the_sweep_variants():
     assert abs(y["dyno.w"] - ref["dyno.w_rad_s"]) < 1e-5
     assert abs(y["clutch.temperature"] - ref["clutch.temperature_C"]) < 1e-5
     assert y["clutch.mode"] == 0.0    # locked by 0.8 s
+
+
+def test_two_wet_clutches_each_equal_their_own_bench(bench_run):
+    """Two SAE No. 2 dynamometers in one network (different speeds, forces, temperatures and clutches: the
+    second has 6 plates): each gives its own bench run's lock-up, speed and temperature, and the events and
+    columns are named per clutch."""
+    clutch, bench, scenario, times, ref, lockup = bench_run
+    clutch6 = WetClutch.paper(n_c=6)
+    d = Driveline("two_dynos")
+    d.inertia("dyno1", J=bench.total_inertia, w0=scenario.initial_slip_speed)
+    d.inertia("dyno2", J=bench.total_inertia, w0=120.0)
+    d.wet_clutch("c1", "ground", "dyno1", force=Signal.table(scenario.force_time, scenario.force_value), clutch=clutch,
+                 bench=bench, temperature0=scenario.initial_temperature_c, fluid_temperature0=scenario.fluid_temperature_c,
+                 housing_temperature0=scenario.housing_temperature_c)
+    d.wet_clutch("c2", "ground", "dyno2", force=Signal.ramp(2500.0, 0.3, start=0.1), clutch=clutch6,
+                 temperature0=60.0, fluid_temperature0=60.0, housing_temperature0=60.0)
+    r = d.simulate(1.2, rtol=1e-9, sample_times=times)
+    df = r.to_dataframe()
+    np.testing.assert_allclose(df["dyno1.w_rad_s"], ref["slip_speed_rad_s"], rtol=0, atol=1e-6 * scenario.initial_slip_speed)
+    np.testing.assert_allclose(df["c1.temperature_C"], ref["temperature_C"], rtol=0, atol=1e-6)
+    ev = r.events
+    assert abs(ev[(ev.element == "c1") & (ev.event == "stick")].time_s.iloc[0] - lockup) < 1e-7
+    # the second against its own single-clutch network and its own bench run (6 plates, 60 degC)
+    from clutchlab.wet.engagement import Scenario
+
+    sc2 = Scenario(force_time=[0.1, 0.4], force_value=[0.0, 2500.0], speed_time=[0.0], speed_value=[0.0],
+                   duration=1.2, motor="free", initial_slip_speed=120.0, initial_temperature_c=60.0,
+                   fluid_temperature_c=60.0, housing_temperature_c=60.0)
+    ref2 = simulate_engagement(clutch6, sc2, bench=bench, sample_times=times, rtol=1e-9)
+    r2 = ref2.result.to_dataframe()
+    np.testing.assert_allclose(df["dyno2.w_rad_s"], r2["slip_speed_rad_s"], rtol=0, atol=1e-6 * 120.0)
+    np.testing.assert_allclose(df["c2.clutch_torque_Nm"], r2["clutch_torque_Nm"], rtol=0,
+                               atol=1e-6 * np.abs(r2["clutch_torque_Nm"]).max())
+    assert abs(ev[(ev.element == "c2") & (ev.event == "stick")].time_s.iloc[0] - ref2.lockup_time) < 1e-7
+    assert {"c1.piston", "c2.piston"} <= set(ev.element)

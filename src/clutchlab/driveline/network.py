@@ -692,14 +692,12 @@ class Driveline:
         is not used) and ``friction`` (a friction law or map of :mod:`clutchlab.wet.friction`, default the
         bench's): as :func:`clutchlab.wet.system.pack_parameters`.  ``temperature0``, ``fluid_temperature0``,
         ``housing_temperature0``: the temperatures [degC] at the start of the pack, the oil reservoir (also the
-        heater's set point) and the housing.  One wet clutch per network.
+        heater's set point) and the housing.  Any number of wet clutches per network.
         """
         from ..wet.params import Bench, WetClutch
 
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        if any(e.wet is not None for e in self._elements):
-            raise ParameterError(f"{name}: a network takes one wet clutch (it has one already)")
         sig = Signal.of(force, f"{name}: force")
         kind = sig.row[0]
         if kind == K.SIG_CONST:
@@ -727,21 +725,24 @@ class Driveline:
         el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
         return self
 
-    def _wet_parameters(self):
-        """The wet clutch's element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
-        shaft) and initial state, or None without one."""
+    def _wet_parameters(self) -> list:
+        """Per wet clutch: its element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
+        shaft), initial state and clutch parameters (an empty list without one)."""
         from ..wet import system as W
         from ..wet.engagement import Scenario
 
-        el = next((e for e in self._elements if e.wet is not None), None)
-        if el is None:
-            return None
-        w = el.wet
-        scenario = Scenario(force_time=w["times"], force_value=w["values"], speed_time=[0.0], speed_value=[0.0],
-                            duration=1.0, motor="free", initial_temperature_c=w["temperature0"],
-                            fluid_temperature_c=w["fluid_temperature0"], housing_temperature_c=w["housing_temperature0"])
-        params = W.pack_parameters(w["clutch"], w["bench"], scenario, w["friction"])
-        return el, params, W.initial_state(scenario), w["clutch"]
+        out = []
+        for el in self._elements:
+            if el.wet is None:
+                continue
+            w = el.wet
+            scenario = Scenario(force_time=w["times"], force_value=w["values"], speed_time=[0.0], speed_value=[0.0],
+                                duration=1.0, motor="free", initial_temperature_c=w["temperature0"],
+                                fluid_temperature_c=w["fluid_temperature0"],
+                                housing_temperature_c=w["housing_temperature0"])
+            params = W.pack_parameters(w["clutch"], w["bench"], scenario, w["friction"])
+            out.append((el, params, W.initial_state(scenario), w["clutch"]))
+        return out
 
     def one_way_clutch(self, name: str, a, b) -> "Driveline":
         """A one-way clutch (freewheel) between flanges a and b: flange b may overrun flange a freely
@@ -1058,17 +1059,18 @@ class Driveline:
         atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
         events = K.EVENTS
         wet = self._wet_parameters()
-        if wet is not None:
+        if wet:
             p, x0, m0, atol = self._with_wet(p, x0, m0, atol, wet, rtol, len(switching), len(named))
             from ..wet import system as W
 
-            el = wet[0]
-            states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.STATES)
-            outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.OUTPUTS)
-            switching += tuple((f"{el.name}.{q}", d) for q, d in W.SWITCHING)
-            named += (el.name, f"{el.name}.piston")
-            mode_names += tuple(f"{el.name}.{q}" for q in W.MODE_NAMES)
-            mode_values += W.MODE_VALUES
+            for el, *_ in wet:
+                states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.STATES)
+                switching += tuple((f"{el.name}.{q}", d) for q, d in W.SWITCHING)
+                named += (el.name, f"{el.name}.piston")
+                mode_names += tuple(f"{el.name}.{q}" for q in W.MODE_NAMES)
+                mode_values += W.MODE_VALUES
+            for el, *_ in wet:
+                outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.OUTPUTS)
             events = K.EVENTS + W.EVENTS
 
         def element_name(code, element, _names=named):
@@ -1085,23 +1087,36 @@ class Driveline:
 
     def _with_wet(self, p, x0, m0, atol, wet, rtol, ng, nel):
         """The network's parameters, initial state and modes and absolute tolerances joined with the wet
-        clutch's (:class:`~clutchlab.driveline.wet.WetDrivelineParams`)."""
+        clutches' (:class:`~clutchlab.driveline.wet.WetDrivelineParams`)."""
         from ..wet import system as W
         from . import wet as DW
 
-        el, wp, xw, clutch = wet
-        r = self._elements.index(el)
-        k = int(np.flatnonzero(p.fric == r)[0])
         n = len(self._inertias)
-        w_rel = (x0[n + p.elem[r][K.E_B]] if p.elem[r][K.E_B] >= 0 else 0.0) - (
-            x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
-        xw = xw.copy()
-        xw[W.S_W] = w_rel
-        mw = W.initial_modes(xw, clutch.piston_h0)
-        conf = np.array([k, r, x0.size, ng, m0.size, len(K.EVENTS), nel], dtype=np.int64)
-        params = DW.WetDrivelineParams(p, wp, conf, np.zeros(DW.N_BUF), np.zeros(DW.N_MODE, dtype=np.int64))
-        return (params, np.concatenate([x0, xw]), np.concatenate([m0, mw]),
-                np.concatenate([atol, W.absolute_tolerance(clutch, rtol)]))
+        conf, xs, ms, tols, consts, datas = [], [x0], [m0], [atol], [], []
+        nx, nm = x0.size, m0.size
+        for j, (el, wp, xw, clutch) in enumerate(wet):
+            r = self._elements.index(el)
+            k = int(np.flatnonzero(p.fric == r)[0])
+            w_rel = (x0[n + p.elem[r][K.E_B]] if p.elem[r][K.E_B] >= 0 else 0.0) - (
+                x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
+            xw = xw.copy()
+            xw[W.S_W] = w_rel
+            conf.append([k, r, nx + j * W.N_STATE, ng + j * W.N_SWITCH, nm + j * DW.N_MODE, len(K.EVENTS),
+                         nel + 2 * j])
+            xs.append(xw)
+            ms.append(W.initial_modes(xw, clutch.piston_h0))
+            tols.append(W.absolute_tolerance(clutch, rtol))
+            consts.append(wp.constants)
+            datas.append(wp.data)
+        width = max(d.size for d in datas)
+        data = np.zeros((len(datas), width))
+        for j, d in enumerate(datas):
+            data[j, :d.size] = d
+        nw = len(wet)
+        params = DW.WetDrivelineParams(p, np.ascontiguousarray(np.stack(consts)), data,
+                                       np.array(conf, dtype=np.int64), np.zeros((nw, DW.N_BUF)),
+                                       np.zeros((nw, DW.N_MODE), dtype=np.int64))
+        return params, np.concatenate(xs), np.concatenate(ms), np.concatenate(tols)
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
                  output_step: float | None = None, sample_times=None):

@@ -1,5 +1,5 @@
-"""The wet clutch as a driveline element: the network of :mod:`clutchlab.driveline.kernel` with one wet clutch
-whose torque comes from its own states (piston, actuator force, film, pack and oil temperatures).
+"""The wet clutch as a driveline element: the network of :mod:`clutchlab.driveline.kernel` with wet clutches
+whose torque comes from their own states (piston, actuator force, film, pack and oil temperatures).
 
 The clutch is the engagement model of :mod:`clutchlab.wet.system` (Shin, Kim and Choi, seed 001, Eqs. 1-8;
 squeeze film and piston of Deur et al.), unchanged: its hooks are called here on its own states with the
@@ -18,9 +18,10 @@ network's mode is passed to the wet model, so its friction heat ``tau * w`` is z
 model's piston and film switching functions and events (``contact``, ``separation``, ``piston_reaches_stop``,
 ``piston_leaves_stop``) are kept, named for the element (``<name>`` and ``<name>.piston``).
 
-States: the network's, then the wet model's twelve (its ``slip_speed`` follows the element's relative speed,
-integrated from the relative acceleration and reset to it at every event; its drive states stay zero).
-Outputs: the network's, then the wet model's eighteen.  One wet clutch per network (a second is refused).
+States: the network's, then per clutch the wet model's twelve (its ``slip_speed`` follows the element's
+relative speed, integrated from the relative acceleration and reset to it at every event; its drive states
+stay zero).  Outputs: the network's, then per clutch the wet model's eighteen.  Any number of wet clutches:
+each is packed on its own and evaluated with its own hooks (its parameters one row of the stacked arrays).
 """
 
 from __future__ import annotations
@@ -38,8 +39,9 @@ from .kernel import DrivelineParams
 __all__ = ["WetDrivelineParams", "N_STATE", "N_SWITCH", "N_MODE"]
 
 N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
-# conf (int64): the friction index of the wet clutch, its element row, then the offsets of its states, switching
-# functions and modes in the whole system's, the number of the network's events and of its named elements
+# conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
+# states, switching functions and modes in the whole system's, the number of the network's events and the index of
+# its first named element (``<name>``, then ``<name>.piston``)
 F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
 # buf (float): its states with the slip replaced | their derivative | switching values | inputs (zero) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
@@ -47,40 +49,50 @@ N_BUF = B_Y + W.N_OUT
 
 
 class WetDrivelineParams(NamedTuple):
-    """Packed parameters of a driveline with a wet clutch: the network, the clutch (packed by
-    :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft), ``conf`` (int64,
-    the layout ``F_*``), ``buf`` (float, scratch ``B_*``) and ``mbuf`` (int64, the clutch's modes)."""
+    """Packed parameters of a driveline with wet clutches: the network, then per clutch ``j`` (rows): its
+    parameters packed by :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft
+    (``constants[j]``, ``data[j]``: the rows of the clutches' :class:`~clutchlab.wet.system.WetParams`, the data
+    padded to one length), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch ``B_*``) and
+    ``mbuf[j]`` (int64, its modes)."""
 
     net: DrivelineParams
-    wet: W.WetParams
+    constants: np.ndarray
+    data: np.ndarray
     conf: np.ndarray
     buf: np.ndarray
     mbuf: np.ndarray
 
 
 @numba.njit(cache=True, nogil=True)
-def _clutch(t, x, m, p):
-    """Evaluate the wet clutch at the network's state: its derivative, switching values and outputs into
-    ``p.buf``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
+def _wet(p, j):
+    """Clutch ``j``'s :class:`~clutchlab.wet.system.WetParams` (views of its rows)."""
+    return W.WetParams(p.constants[j], p.data[j])
+
+
+@numba.njit(cache=True, nogil=True)
+def _clutch(t, x, m, p, j):
+    """Evaluate wet clutch ``j`` at the network's state: its derivative, switching values and outputs into
+    ``p.buf[j]``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
     Returns the element's relative speed [rad/s]."""
-    cf = p.conf
+    cf = p.conf[j]
     net = p.net
     n = net.inertia.shape[0]
     r = cf[F_ROW]
     w_rel = K.relative_speed(net, r, x, n)
-    b = p.buf
+    b = p.buf[j]
     xs = b[B_X:B_X + N_STATE]
     for i in range(N_STATE):
         xs[i] = x[cf[F_X] + i]
     xs[W.S_W] = w_rel
-    ms = p.mbuf
+    ms = p.mbuf[j]
     for i in range(N_MODE):
         ms[i] = m[cf[F_M] + i]
     mk = m[cf[F_K]]
     ms[W.M_FRICTION] = W.STICK if mk == K.STUCK else (W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0)
                                                     else W.SLIP)
-    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, p.wet, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
-    wk = p.wet.data
+    wp = _wet(p, j)
+    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, wp, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
     K.set_external(net, net.elem[r][K.E_AUX], cap + abs(wk[W.W_OUT + W.O_TV]), cap)
     for i in range(W.N_OUT):
@@ -89,72 +101,86 @@ def _clutch(t, x, m, p):
 
 
 @numba.njit(cache=True, nogil=True)
+def _clutches(t, x, m, p):
+    """Evaluate every wet clutch (:func:`_clutch`)."""
+    for j in range(p.conf.shape[0]):
+        _clutch(t, x, m, p, j)
+
+
+@numba.njit(cache=True, nogil=True)
 def wet_driveline_rhs(t, x, u, m, p, dx, g):
-    """The network's right-hand side and switching functions, then the wet clutch's (its slip speed follows the
-    element's relative acceleration; its lock-up and break-away functions are held off)."""
-    _clutch(t, x, m, p)
+    """The network's right-hand side and switching functions, then each wet clutch's (its slip speed follows
+    the element's relative acceleration; its lock-up and break-away functions are held off)."""
+    _clutches(t, x, m, p)
     K.driveline_rhs(t, x, u, m, p.net, dx, g)
-    cf = p.conf
-    b = p.buf
     net = p.net
-    n = net.inertia.shape[0]
-    e = net.elem[cf[F_ROW]]
     acc, _tau = K._acc_tau(net)
-    for i in range(N_STATE):
-        dx[cf[F_X] + i] = b[B_DX + i]
-    dx[cf[F_X] + W.S_W] = (0.0 if e[K.E_B] < 0 else acc[e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else acc[e[K.E_A]])
-    dx[cf[F_X] + W.S_I] = 0.0
-    dx[cf[F_X] + W.S_ED] = 0.0
-    for i in range(N_SWITCH):
-        g[cf[F_G] + i] = b[B_G + i]
-    g[cf[F_G] + W.G_LOCKUP] = 1.0
-    g[cf[F_G] + W.G_BREAKAWAY] = -1.0
+    for j in range(p.conf.shape[0]):
+        cf = p.conf[j]
+        b = p.buf[j]
+        e = net.elem[cf[F_ROW]]
+        for i in range(N_STATE):
+            dx[cf[F_X] + i] = b[B_DX + i]
+        dx[cf[F_X] + W.S_W] = (0.0 if e[K.E_B] < 0 else acc[e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else acc[e[K.E_A]])
+        dx[cf[F_X] + W.S_I] = 0.0
+        dx[cf[F_X] + W.S_ED] = 0.0
+        for i in range(N_SWITCH):
+            g[cf[F_G] + i] = b[B_G + i]
+        g[cf[F_G] + W.G_LOCKUP] = 1.0
+        g[cf[F_G] + W.G_BREAKAWAY] = -1.0
     return None
 
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_outputs(t, x, u, m, p, y):
-    """The network's outputs, then the wet clutch's eighteen (:data:`clutchlab.wet.system.OUTPUTS`)."""
-    _clutch(t, x, m, p)
+    """The network's outputs, then each wet clutch's eighteen (:data:`clutchlab.wet.system.OUTPUTS`)."""
+    _clutches(t, x, m, p)
     K.driveline_outputs(t, x, u, m, p.net, y)
-    q = y.shape[0] - W.N_OUT
-    for i in range(W.N_OUT):
-        y[q + i] = p.buf[B_Y + i]
+    nw = p.conf.shape[0]
+    q = y.shape[0] - nw * W.N_OUT
+    for j in range(nw):
+        for i in range(W.N_OUT):
+            y[q + j * W.N_OUT + i] = p.buf[j][B_Y + i]
 
 
 @numba.njit(cache=True, nogil=True)
-def _rename(log, start, p):
-    """The wet model's events recorded from ``start`` on: codes after the network's, elements after its names."""
+def _rename(log, start, p, j):
+    """Clutch ``j``'s events recorded from ``start`` on: codes after the network's, elements after its names."""
     for i in range(start, min(log.count[0], log.time.shape[0])):
-        log.code[i] += p.conf[F_EV]
-        log.element[i] += p.conf[F_EL]
+        log.code[i] += p.conf[j][F_EV]
+        log.element[i] += p.conf[j][F_EL]
 
 
 @numba.njit(cache=True, nogil=True)
-def _sync(x, m, p, w_rel):
-    """The clutch's slip-speed state reset to the element's relative speed, and its friction mode to the
+def _sync(x, m, p):
+    """Each clutch's slip-speed state reset to its element's relative speed, and its friction mode to the
     network's (at an event or a restart)."""
-    x[p.conf[F_X] + W.S_W] = w_rel
-    mk = m[p.conf[F_K]]
-    m[p.conf[F_M] + W.M_FRICTION] = W.STICK if mk == K.STUCK else (
-        W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0) else W.SLIP)
+    net = p.net
+    n = net.inertia.shape[0]
+    for j in range(p.conf.shape[0]):
+        cf = p.conf[j]
+        w_rel = K.relative_speed(net, cf[F_ROW], x, n)
+        x[cf[F_X] + W.S_W] = w_rel
+        mk = m[cf[F_K]]
+        m[cf[F_M] + W.M_FRICTION] = W.STICK if mk == K.STUCK else (
+            W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0) else W.SLIP)
 
 
 @numba.njit(cache=True, nogil=True)
-def _wet_call(t, x, m, p, k, log):
-    """Wet model hook on its own states and modes (``k >= 0``: its update for switching function ``k``; ``k < 0``:
-    its restart), its events renamed; the states and the piston and film modes written back."""
-    cf = p.conf
-    b = p.buf
+def _wet_call(t, x, m, p, j, k, log):
+    """Clutch ``j``'s model hook on its own states and modes (``k >= 0``: its update for switching function
+    ``k``; ``k < 0``: its restart), its events renamed; the states and the piston and film modes written back."""
+    cf = p.conf[j]
+    b = p.buf[j]
     xs = b[B_X:B_X + N_STATE]
-    ms = p.mbuf
+    ms = p.mbuf[j]
     start = log.count[0]
     res = 0
     if k >= 0:
-        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, p.wet, k, log)
-    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, p.wet, log):
+        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, _wet(p, j), k, log)
+    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, _wet(p, j), log):
         res = 1
-    _rename(log, start, p)
+    _rename(log, start, p, j)
     for i in range(N_STATE):
         if i != W.S_W:
             x[cf[F_X] + i] = xs[i]
@@ -165,45 +191,55 @@ def _wet_call(t, x, m, p, k, log):
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_update(t, x, u, m, p, k, log):
-    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or the wet clutch's
+    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or a wet clutch's
     piston and film functions (:func:`clutchlab.wet.system.wet_update`)."""
-    w_rel = _clutch(t, x, m, p)
-    _sync(x, m, p, w_rel)
-    ng = p.conf[F_G]
+    _sync(x, m, p)
+    _clutches(t, x, m, p)
+    ng = p.conf[0][F_G]
     if k < ng:
         res = K.driveline_update(t, x, u, m, p.net, k, log)
-        _sync(x, m, p, w_rel)
+        _sync(x, m, p)
         return res
-    res = _wet_call(t, x, m, p, k - ng, log)
-    _clutch(t, x, m, p)   # the network's modes at the clutch's new state (a piston on its stop, a film opening)
+    j = (k - ng) // N_SWITCH
+    res = _wet_call(t, x, m, p, j, (k - ng) % N_SWITCH, log)
+    _clutches(t, x, m, p)   # the network's modes at the clutch's new state (a piston on its stop, a film opening)
     K.settle(t, x, m, p.net, log, m.copy())
-    _sync(x, m, p, w_rel)
+    _sync(x, m, p)
     return res
 
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_restart(t, x, u, m, p, log):
-    """The wet clutch's restart (piston on or off its stop, film contact), then the network's."""
-    w_rel = _clutch(t, x, m, p)
-    _sync(x, m, p, w_rel)
-    changed = _wet_call(t, x, m, p, -1, log) != 0
-    _clutch(t, x, m, p)
+    """Each wet clutch's restart (piston on or off its stop, film contact), then the network's."""
+    _sync(x, m, p)
+    _clutches(t, x, m, p)
+    changed = False
+    for j in range(p.conf.shape[0]):
+        if _wet_call(t, x, m, p, j, -1, log) != 0:
+            changed = True
+    _clutches(t, x, m, p)
     if K.driveline_restart(t, x, u, m, p.net, log):
         changed = True
-    _sync(x, m, p, w_rel)
+    _sync(x, m, p)
     return changed
 
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_accept(t, x, u, m, p):
-    """The wet clutch's peak-temperature memory."""
-    return W.wet_accept(t, x[p.conf[F_X]:p.conf[F_X] + N_STATE], u, m, p.wet)
+    """Each wet clutch's peak-temperature memory."""
+    for j in range(p.conf.shape[0]):
+        o = p.conf[j][F_X]
+        W.wet_accept(t, x[o:o + N_STATE], u, m, _wet(p, j))
+    return 0
 
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_next_break(t, m, p):
-    """The next corner of the network's signals or of the clutch's force profile."""
-    return min(K.driveline_next_break(t, m, p.net), W.wet_next_break(t, m, p.wet))
+    """The next corner of the network's signals or of a clutch's force profile."""
+    tb = K.driveline_next_break(t, m, p.net)
+    for j in range(p.conf.shape[0]):
+        tb = min(tb, W.wet_next_break(t, m, _wet(p, j)))
+    return tb
 
 
 @numba.njit(cache=True, nogil=True)
