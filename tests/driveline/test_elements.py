@@ -268,8 +268,8 @@ def test_initial_speeds_follow_gears_and_sources_and_conflicts_are_named():
 # ----------------------------------------------------------------- energy as a property
 @st.composite
 def networks(draw):
-    """A random chain of 2-4 inertias, each link a spring-damper, backlash, curve spring, gear, one-way
-    clutch or clutch; sine torques or a speed source on some."""
+    """A random chain of 2-4 inertias, each link a spring-damper, backlash, curve spring, gear (ideal or
+    lossy), one-way clutch or clutch; sine torques or a speed source on some."""
     n = draw(st.integers(2, 4))
     d = Driveline("random")
     driven = draw(st.integers(-1, n - 1))   # the inertia on a speed source (-1: none)
@@ -289,7 +289,8 @@ def networks(draw):
                                                         kind=draw(st.sampled_from(["linear", "pchip"]))),
                      d=draw(st.floats(0.0, 1.0)))
         elif kind == "gear":
-            d.gear(f"g{i}", a, b, ratio=draw(st.floats(0.2, 5.0)) * draw(st.sampled_from([-1.0, 1.0])))
+            d.gear(f"g{i}", a, b, ratio=draw(st.floats(0.2, 5.0)) * draw(st.sampled_from([-1.0, 1.0])),
+                   efficiency=draw(st.sampled_from([1.0, 0.95, 0.7])))
         elif kind == "oneway":
             d.one_way_clutch(f"f{i}", a, b)
         else:
@@ -308,8 +309,9 @@ def networks(draw):
 @settings(max_examples=examples(15), deadline=None)
 @given(networks())
 def test_energy_balance_on_random_networks_with_every_element(d):
-    """Whatever the network: input work = dissipated + stored change, every dissipation grows (a gear's
-    stays ~0), every one-way clutch never slides backward."""
+    """Whatever the network: input work = dissipated + stored change, every dissipation grows (an ideal
+    gear's stays ~0; a lossy gear's grows: its mode always has the driving flange right), every one-way
+    clutch never slides backward."""
     df = d.simulate(1.0, output_step=5e-3, rtol=1e-9).to_dataframe()
     scale = max(1.0, np.max(np.abs(df["input_work_J"])), df["kinetic_energy_J"].iloc[0] + df["spring_energy_J"].iloc[0],
                 df["kinetic_energy_J"].max())
@@ -401,3 +403,66 @@ def test_a_backlash_impact_breaks_a_stuck_bearing_away_at_once():
     assert t_contact == pytest.approx(0.1 / 2.0, abs=1e-9)
     brk = ev[ev.element == "bearing"]
     assert list(brk.event)[:1] == ["forward"] and float(brk.time_s.iloc[0]) == pytest.approx(t_contact, abs=1e-12)
+
+
+# ----------------------------------------------------------------- lossy gears
+def test_lossy_gear_takes_the_loss_from_the_driving_side():
+    """Torque ``T`` on J1 (flange a), gear ``w1 = i w2`` with efficiency ``eta`` to J2.  While J1 drives, J2 is
+    reflected as ``J2 / (i^2 eta)``: ``a1 = T / (J1 + J2 / (i^2 eta))``; when the torque reverses (a step to
+    ``-T`` at 1 s) the load drives the gear (it decelerates through it): ``a1 = -T / (J1 + eta J2 / i^2)``,
+    until the speeds pass zero (at ``t_0``), after which J1 drives again.  Each power reversal is a located
+    event; the loss is ``(1 - eta)`` of the driving side's power, so the energy balance closes and the
+    dissipation only grows."""
+    T, J1, J2, i, eta, w0 = 2.0, 0.3, 4.0, 3.0, 0.8, 5.0
+    d = Driveline("lossy")
+    d.inertia("J1", J=J1, w0=w0).inertia("J2", J=J2)
+    d.torque("T", "J1", Signal.step(-2 * T, 1.0, offset=T))
+    d.gear("g", "J1", "J2", ratio=i, efficiency=eta)
+    a_drive = T / (J1 + J2 / (i ** 2 * eta))
+    b_drive = -T / (J1 + eta * J2 / i ** 2)
+    w1 = w0 + a_drive * 1.0
+    t0 = 1.0 - w1 / b_drive                     # the speed reaches zero
+    r = d.simulate(t0 + 1.0, rtol=1e-10, sample_times=[0.5, 1.0, 0.5 * (1.0 + t0), t0 + 0.5])
+    df = r.to_dataframe()
+    expected = [w0 + 0.5 * a_drive, w1, w1 + b_drive * 0.5 * (t0 - 1.0), -a_drive * 0.5]
+    np.testing.assert_allclose(df["J1.w_rad_s"], expected, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(df["J1.w_rad_s"], i * df["J2.w_rad_s"], rtol=1e-10, atol=1e-10)
+    assert [e for _, e in _events(r, "g")] == ["b_drives", "a_drives"]
+    times = [tt for tt, _ in _events(r, "g")]
+    assert times == pytest.approx([1.0, t0], abs=1e-9)
+    assert abs(df["energy_error_J"]).max() < 1e-8 * df["input_work_J"].abs().max()
+    diss = df["g.dissipated_J"].to_numpy()
+    assert np.all(np.diff(diss) > 0) and diss[0] > 0
+    # the mode columns name the driving flange
+    assert list(r.mode("g")) == ["a_drives", "a_drives", "b_drives", "a_drives"]
+
+
+def test_gear_efficiency_bounds():
+    d = Driveline("x").inertia("a", J=1).inertia("b", J=1)
+    for bad in (0.5, 0.2, 1.2, math.nan):
+        with pytest.raises(ParameterError, match="efficiency"):
+            d.gear(f"g{str(bad).replace('.', '')}", "a", "b", ratio=2.0, efficiency=bad)
+
+
+def test_lossy_gear_holds_within_its_loss_band_and_releases_at_its_edge():
+    """At rest, torques ``T_a`` on flange a and ``T_b`` on flange b of a lossy gear (ratio ``i``, efficiency
+    ``eta``) that oppose each other hold it while neither side can drive the other through the loss: a drives only
+    if ``i eta T_a > |T_b|``, b only if ``|T_b| eta / i > T_a``.  With ``T_b = -1.8``, ``i = 2``, ``eta = 0.8``
+    and ``T_a = 1 + t`` the gear is held (``locked``) until ``i eta T_a = 1.8``, at ``t = 0.125 s``, then a
+    drives: ``(J1 + J2 / (i^2 eta)) a1 = T_a - 1.8 / (i eta)``, integrated in closed form."""
+    J1, J2, i, eta = 0.5, 2.0, 2.0, 0.8
+    d = Driveline("band")
+    d.inertia("J1", J=J1).inertia("J2", J=J2)
+    d.torque("Ta", "J1", Signal.ramp(1.0, 1.0, offset=1.0))
+    d.torque("Tb", "J2", -1.8)
+    d.gear("g", "J1", "J2", ratio=i, efficiency=eta)
+    r = d.simulate(0.6, rtol=1e-10, sample_times=[0.1, 0.6])
+    ev = _events(r, "g")
+    assert [e for _, e in ev] == ["locked", "a_drives"]
+    assert ev[0][0] == 0.0 and ev[1][0] == pytest.approx(0.125, abs=1e-9)
+    df = r.to_dataframe()
+    assert df["J1.w_rad_s"].iloc[0] == pytest.approx(0.0, abs=1e-12)
+    # after release: J_eff a1 = (1 + t) - 1.8 / (i eta) = t - 0.125
+    j_eff = J1 + J2 / (i ** 2 * eta)
+    assert df["J1.w_rad_s"].iloc[1] == pytest.approx(0.5 * (0.6 - 0.125) ** 2 / j_eff, rel=1e-8)
+    assert abs(df["energy_error_J"]).max() < 1e-9

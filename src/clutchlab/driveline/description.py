@@ -28,7 +28,7 @@
 
 Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
-``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio), ``torque`` (flange, torque,
+``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio, efficiency), ``torque`` (flange, torque,
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
 peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b), ``eclutch`` (a, b, position [m], model
@@ -70,7 +70,7 @@ FIELDS = {
                "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
     "backlash": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", True), "b_gap": ("rad", True),
                  "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
-    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True)},
+    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True), "efficiency": ("1", False)},
     "torque": {"flange": (None, True), "torque": ("N*m", True), "support": (None, False)},
     "speed": {"flange": (None, True), "speed": ("rad/s", True)},
     "position": {"flange": (None, True), "position": ("rad", True)},

@@ -61,8 +61,8 @@ STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
 MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Forward 1, Backward -1, Free 2
 # events: named for the mode entered (friction), or for a backlash closing or opening its gap
-EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE = 0, 1, 2, 3, 4, 5
-EVENTS = ("stick", "forward", "backward", "free", "contact", "separate")
+EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B, EV_LOCKED = range(9)
+EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives", "locked")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 # signals
 SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
@@ -72,11 +72,16 @@ N_ELEM = 10      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE:
 C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
 C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
 C_NCURVE, C_LIFTOFF = 3, 4                         # friction with a normal-force curve (E_AUX points): its
-C_RATIO = 0                                        # data offset and lift-off input; gear: w_a = ratio * w_b
+C_RATIO, C_ETA = 0, 1                              # data offset and lift-off input; gear: w_a = ratio * w_b, efficiency
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = 0, 1, 2, 3   # an engine's idle controller: set speed [rad/s], gains
                                                    # [N m s/rad], [N m/rad], torque limit [N m]
 N_COEF = 5
-# switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves)
+# modes of a lossy gear (after the switched springs' in the mode vector): the flange that drives (power flows
+# from it into the gear)
+DRIVE_A, DRIVE_B, DRIVE_LOCKED = 0, 1, 2
+DRIVE_VALUES = ("a_drives", "b_drives", "locked")
+# switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves),
+# then one per lossy gear (``lossy``: the power it takes from its driving flange)
 G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
 N_G = 3
 
@@ -90,8 +95,9 @@ class DrivelineParams(NamedTuple):
     friction characteristics, spring curves and signal tables); ``fric`` (int64): the element row of
     each friction element; ``cons``: of each constraint (gears and motion sources, always held);
     ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
-    ``elem[r, E_MODE]``); ``work`` and ``iwork`` (int64, the pivots of the constraint set's
-    factorisation): scratch of the hooks (per run).
+    ``elem[r, E_MODE]``); ``lossy``: of each gear with an efficiency below 1 (its mode, the driving flange, at
+    ``elem[r, E_MODE]``); ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
+    scratch of the hooks (per run).
     """
 
     inertia: np.ndarray
@@ -102,6 +108,7 @@ class DrivelineParams(NamedTuple):
     fric: np.ndarray
     cons: np.ndarray
     swit: np.ndarray
+    lossy: np.ndarray
     work: np.ndarray
     iwork: np.ndarray
 
@@ -476,6 +483,26 @@ def _coefficients(p, r):
 
 
 @numba.njit(cache=True, nogil=True)
+def _force_factor(p, r, m):
+    """Factor on the torque a gear row ``r`` puts on flange b: its efficiency ``eta`` while flange a drives, ``1 /
+    eta`` while b drives (a lossy gear's mode in ``m``); 1 for everything else."""
+    e = p.elem[r]
+    if e[E_KIND] != K_GEAR or e[E_MODE] < 0:
+        return 1.0
+    eta = p.coef[r][C_ETA]
+    mode = m[e[E_MODE]]
+    return eta if mode == DRIVE_A else (1.0 / eta if mode == DRIVE_B else 1.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def gear_loss(p, r, m, w_a, tau):
+    """Power [W] lost in a gear row ``r`` carrying ``tau`` (its torque on flange a) at flange a's speed ``w_a``:
+    ``(1 - f) P_a`` with ``P_a = -tau w_a`` the power flange a delivers and ``f`` :func:`_force_factor` (zero for
+    an ideal gear; non-negative in a consistent mode)."""
+    return (1.0 - _force_factor(p, r, m)) * (-tau * w_a)
+
+
+@numba.njit(cache=True, nogil=True)
 def relative_speed(p, r, x, n):
     """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears)."""
     e = p.elem[r]
@@ -521,7 +548,7 @@ def evaluate_network(t, x, m, p, acc, tau):
         _apply(F, e, 1.0, 1.0, tq)
     # sliding and free friction; the constraint set: stuck friction, gears, motion sources
     ns = 0
-    stuck = wk[n:n + nf + nc]  # element rows of the set (as floats)
+    stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a locked gear's hold)
     for k in range(nf):
         r = p.fric[k]
         e = p.elem[r]
@@ -542,8 +569,13 @@ def evaluate_network(t, x, m, p, acc, tau):
     for k in range(nc):
         stuck[ns] = p.cons[k]
         ns += 1
+    for j in range(p.lossy.shape[0]):   # a locked lossy gear holds flange a at rest (member -(row + 1))
+        r = p.lossy[j]
+        if m[p.elem[r][E_MODE]] == DRIVE_LOCKED:
+            stuck[ns] = -(r + 1)
+            ns += 1
     if ns > 0:
-        _solve_stuck(t, p, stuck, ns, F, tau)
+        _solve_stuck(t, p, m, stuck, ns, F, tau)
     for i in range(n):
         acc[i] = F[i] / p.inertia[i]
     return ns
@@ -553,7 +585,7 @@ def evaluate_network(t, x, m, p, acc, tau):
 def _layout(n, nk, ne):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
-    (nk) | flange a, ca, flange b, cb of each member (4 nk) | accelerations (n) | element torques (ne) |
+    (nk) | flange a, ca, flange b, cb, force factor of each member (5 nk) | accelerations (n) | element torques (ne) |
     slack of each friction element's stick function (nf, :func:`settle`) | sliding torque and static limit of
     each clutch model (2 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored energy (1)."""
     o_a = n + nk
@@ -563,7 +595,7 @@ def _layout(n, nk, ne):
     o_c = o_l + nk
     o_r = o_c + nk
     o_g = o_r + nk
-    o_acc = o_g + 4 * nk
+    o_acc = o_g + 5 * nk
     o_tau = o_acc + n
     return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_acc, o_tau
 
@@ -571,13 +603,20 @@ def _layout(n, nk, ne):
 def work_size(n, nk, ne, nf, nx=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` friction elements and constraints, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own."""
-    return 2 * n + 10 * nk + 2 * nk * nk + ne + nf + 2 * nx + 1
+    return 2 * n + 11 * nk + 2 * nk * nk + ne + nf + 2 * nx + 1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _nk(p):
+    """Largest constraint set: every friction element, every gear and motion source, and the hold of every lossy
+    gear (``DRIVE_LOCKED``)."""
+    return p.fric.shape[0] + p.cons.shape[0] + p.lossy.shape[0]
 
 
 @numba.njit(cache=True, nogil=True)
 def _acc_tau(p):
     n = p.inertia.shape[0]
-    nk = p.fric.shape[0] + p.cons.shape[0]
+    nk = _nk(p)
     ne = p.elem.shape[0]
     o = _layout(n, nk, ne)
     return p.work[o[7]:o[7] + n], p.work[o[8]:o[8] + ne]
@@ -588,7 +627,7 @@ def _slack(p):
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     ne = p.elem.shape[0]
-    o = _layout(n, nf + p.cons.shape[0], ne)
+    o = _layout(n, _nk(p), ne)
     return p.work[o[8] + ne:o[8] + ne + nf]
 
 
@@ -598,7 +637,7 @@ def _external(p):
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     ne = p.elem.shape[0]
-    o = _layout(n, nf + p.cons.shape[0], ne)
+    o = _layout(n, _nk(p), ne)
     return p.work[o[8] + ne + nf:p.work.shape[0] - 1]
 
 
@@ -613,12 +652,15 @@ def set_external(p, j, slide, limit):
 
 
 @numba.njit(cache=True, nogil=True)
-def _solve_stuck(t, p, stuck, ns, F, tau):
+def _solve_stuck(t, p, m, stuck, ns, F, tau):
     """Torques of the constraint set -- stuck friction elements, gears, motion sources -- solved together.
 
     Each member ``k`` holds its relative acceleration ``g_k^T a`` (``g_k = cb e_b - ca e_a``) at its
     target: zero, or the prescribed acceleration of a motion source.  ``A lam = g^T M^-1 F - target``
-    with ``A[k, j] = g_k^T M^-1 g_j``.  Where stuck elements lock the same relative motion (two clutches
+    with ``A[k, j] = g_k^T M^-1 h_j``, ``h_j`` the flange weights of member ``j``'s torque: ``g_j``, but for
+    a lossy gear (efficiency ``eta``, MSL ``LossyGear`` without bearing friction), whose torque on flange b
+    is ``-ratio f lam`` with ``f = eta`` while flange a drives (mode ``DRIVE_A``) and ``1 / eta`` while b
+    drives: the loss is taken from the driving side.  Where stuck elements lock the same relative motion (two clutches
     in parallel) ``A`` is singular: the torque is then split in proportion to the static limits, the
     solution minimising ``sum(lam_k^2 / limit_k)`` (one-way clutches, gears and motion sources weigh as
     the strongest friction element).  It comes from ``(A + eps D) lam = b`` with ``D = diag(max limit /
@@ -627,7 +669,7 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
     rounding; the split to about 1e-8).  ``F`` is updated with the torques.
     """
     n = p.inertia.shape[0]
-    nk = p.fric.shape[0] + p.cons.shape[0]
+    nk = _nk(p)
     ne = p.elem.shape[0]
     wk = p.work
     o_a, o_m, o_b, o_l, o_c, o_r, o_g, _, _ = _layout(n, nk, ne)
@@ -640,15 +682,28 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
     ga = wk[o_g + nk:o_g + 2 * nk]
     fb = wk[o_g + 2 * nk:o_g + 3 * nk]
     gb = wk[o_g + 3 * nk:o_g + 4 * nk]
+    hf = wk[o_g + 4 * nk:o_g + 5 * nk]
     cmax = 0.0
     for k in range(ns):
         rk = int(stuck[k])
+        if rk < 0:   # a locked lossy gear's hold: flange a against the ground, at rest
+            ek = p.elem[-rk - 1]
+            fa[k] = -1
+            fb[k] = ek[E_A]
+            ga[k] = 0.0
+            gb[k] = 1.0
+            hf[k] = 1.0
+            b[k] = F[ek[E_A]] / p.inertia[ek[E_A]] if ek[E_A] >= 0 else 0.0
+            lam[k] = 0.0
+            cap[k] = -1.0
+            continue
         ek = p.elem[rk]
         ca, cb = _coefficients(p, rk)
         fa[k] = ek[E_A]
         fb[k] = ek[E_B]
         ga[k] = ca
         gb[k] = cb
+        hf[k] = _force_factor(p, rk, m)
         target = 0.0
         if ek[E_KIND] == K_MOTION:
             d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
@@ -672,12 +727,13 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
         for j in range(ns):
             aj, bj = int(fa[j]), int(fb[j])
             v = 0.0
+            hb = gb[j] * hf[j]
             if bk >= 0 and bk == bj:
-                v += gb[k] * gb[j] / p.inertia[bk]
+                v += gb[k] * hb / p.inertia[bk]
             if bk >= 0 and bk == aj:
                 v -= gb[k] * ga[j] / p.inertia[bk]
             if ak >= 0 and ak == bj:
-                v -= ga[k] * gb[j] / p.inertia[ak]
+                v -= ga[k] * hb / p.inertia[ak]
             if ak >= 0 and ak == aj:
                 v += ga[k] * ga[j] / p.inertia[ak]
             A[k, j] = v
@@ -703,8 +759,13 @@ def _solve_stuck(t, p, stuck, ns, F, tau):
             lam[k] += res[k]
     for k in range(ns):
         rk = int(stuck[k])
+        if rk < 0:   # the hold's torque acts on flange a (from the housing); it is not an element's torque
+            ea = p.elem[-rk - 1][E_A]
+            if ea >= 0:
+                F[ea] -= lam[k]
+            continue
         tau[rk] = lam[k]
-        _apply(F, p.elem[rk], ga[k], gb[k], lam[k])
+        _apply(F, p.elem[rk], ga[k], gb[k] * hf[k], lam[k])
 
 
 # ----------------------------------------------------------------- hooks
@@ -722,7 +783,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
     into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull).  A
     curve spring: the deflection above the segment's lower point and below its upper one (either falling
-    through zero moves it to the next segment).
+    through zero moves it to the next segment).  Then one per lossy gear: the power its driving flange delivers
+    plus a floor of 1e-12 of the largest torque times the largest speed (at least 1e-12 W) (falls through zero:
+    the power flow reverses).
     """
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
@@ -745,6 +808,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             if kind == K_SOURCE and e[E_LAW] == SOURCE_ENGINE and e[E_STATE] >= 0:
                 _tq, rate = engine_torque(p, r, t, x, n)
                 dx[2 * n + ne + e[E_STATE]] = rate
+        elif kind == K_GEAR:   # the power lost, and the (drift) work of the constraint
+            dx[2 * n + r] = gear_loss(p, r, m, _speed(x, n, e[E_A]), tau[r]) + _force_factor(p, r, m) * tau[r] * w_rel
         else:
             dx[2 * n + r] = tau[r] * w_rel
     for k in range(nf):
@@ -781,6 +846,30 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         lag = c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
         g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
         g[N_G * nf + 2 * j + 1] = phi + b2 + (lag if mode == LASH_LOWER else 0.0)
+    nsw = p.swit.shape[0]
+    nl = p.lossy.shape[0]
+    if nl > 0:
+        # the power the driving flange delivers, plus a rounding floor: it falls through zero when the power
+        # reverses -- also when it grows from exactly zero (a network starting at rest) the wrong way, which a
+        # function starting on zero would not show as a crossing
+        tmax = 0.0
+        for r in range(ne):
+            tmax = max(tmax, abs(tau[r]))
+        wmax = 0.0
+        for i in range(n):
+            wmax = max(wmax, abs(x[n + i]))
+        floor = 1e-12 * max(1.0, tmax * wmax)
+        for j in range(nl):
+            r = p.lossy[j]
+            e = p.elem[r]
+            if m[e[E_MODE]] != DRIVE_LOCKED:
+                pa = -tau[r] * _speed(x, n, e[E_A])
+                g[N_G * nf + 2 * nsw + j] = (pa if m[e[E_MODE]] == DRIVE_A else -pa) + floor
+        for j in range(nl):   # a locked gear: negative while it holds, rising through zero when released
+            r = p.lossy[j]
+            if m[p.elem[r][E_MODE]] == DRIVE_LOCKED:
+                c_a, c_b = _drive_rates(t, x, m, p, j)   # (overwrites the scratch: after everything else)
+                g[N_G * nf + 2 * nsw + j] = max(c_a, c_b) - 1e-12 * max(1.0, tmax * tmax)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -831,6 +920,101 @@ def driveline_outputs(t, x, u, m, p, y):
 
 
 @numba.njit(cache=True, nogil=True)
+def _drive_rates(t, x, m, p, j):
+    """Rates of the power flange a of lossy gear ``j`` would deliver, were it released from rest into either
+    driving mode: ``(c_a, c_b)`` with ``c_a = -lam_A acc_a`` (positive: flange a would drive) and ``c_b = lam_B
+    acc_a`` (positive: flange b would drive), each from the network evaluated in that mode.  At most one is
+    positive (the gear's torque has the same sign in both modes); neither is while the torques on its sides are
+    within its loss band (a ratio in [eta, 1/eta]): it holds.  Overwrites the network's scratch."""
+    n = p.inertia.shape[0]
+    r = p.lossy[j]
+    e = p.elem[r]
+    mi = e[E_MODE]
+    acc, tau = _acc_tau(p)
+    keep = m[mi]
+    m[mi] = DRIVE_A
+    evaluate_network(t, x, m, p, acc, tau)
+    c_a = -tau[r] * (acc[e[E_A]] if e[E_A] >= 0 else 0.0)
+    m[mi] = DRIVE_B
+    evaluate_network(t, x, m, p, acc, tau)
+    c_b = tau[r] * (acc[e[E_A]] if e[E_A] >= 0 else 0.0)
+    m[mi] = keep
+    return c_a, c_b
+
+
+@numba.njit(cache=True, nogil=True)
+def _scales(x, p, tau):
+    """Largest speed (at least 1) and torque of the network at its last evaluation."""
+    n = p.inertia.shape[0]
+    wmax = 1.0
+    for i in range(n):
+        wmax = max(wmax, abs(x[n + i]))
+    tmax = 0.0
+    for r in range(p.elem.shape[0]):
+        tmax = max(tmax, abs(tau[r]))
+    return wmax, tmax
+
+
+@numba.njit(cache=True, nogil=True)
+def _gear_mode_at(t, x, m, p, j):
+    """The consistent mode of lossy gear ``j``: moving (``|w_a|`` above 1e-9 of the largest speed), the mode
+    whose power flows the right way (its own, unless the power it carries has the wrong sign beyond rounding);
+    at rest, the mode it would be released into (:func:`_drive_rates`), or ``DRIVE_LOCKED``."""
+    n = p.inertia.shape[0]
+    r = p.lossy[j]
+    e = p.elem[r]
+    mode = m[e[E_MODE]]
+    acc, tau = _acc_tau(p)
+    evaluate_network(t, x, m, p, acc, tau)
+    wmax, tmax = _scales(x, p, tau)
+    w_a = _speed(x, n, e[E_A])
+    if abs(w_a) > 1e-9 * wmax:
+        pa = -tau[r] * w_a
+        noise = 1e-12 * max(1.0, tmax * wmax)
+        if mode == DRIVE_LOCKED:
+            return DRIVE_A if pa > 0.0 else DRIVE_B
+        if mode == DRIVE_A and pa < -noise:
+            return DRIVE_B
+        if mode == DRIVE_B and pa > noise:
+            return DRIVE_A
+        return mode
+    c_a, c_b = _drive_rates(t, x, m, p, j)
+    floor = 1e-12 * max(1.0, tmax * tmax)
+    if c_a > floor:
+        return DRIVE_A
+    if c_b > floor:
+        return DRIVE_B
+    return DRIVE_LOCKED
+
+
+@numba.njit(cache=True, nogil=True)
+def _gear_modes(t, x, m, p, log):
+    """Every lossy gear in its consistent mode (:func:`_gear_mode_at`), one change at a time to a fixed point;
+    an event (``a_drives``, ``b_drives``, ``locked``) per change.  Returns True if a mode changed."""
+    nl = p.lossy.shape[0]
+    if nl == 0:
+        return False
+    changed = False
+    nf = p.fric.shape[0]
+    nsw = p.swit.shape[0]
+    for _it in range(3 * nl):
+        flip = -1
+        new = 0
+        for j in range(nl):
+            mode = _gear_mode_at(t, x, m, p, j)
+            if mode != m[p.elem[p.lossy[j]][E_MODE]]:
+                flip = j
+                new = mode
+                break
+        if flip < 0:
+            break
+        m[p.elem[p.lossy[flip]][E_MODE]] = new
+        record(log, t, EV_DRIVE_A + new, nf + nsw + flip)
+        changed = True
+    return changed
+
+
+@numba.njit(cache=True, nogil=True)
 def settle(t, x, m, p, log, old):
     """Modes consistent with the forces at ``t``: free or engaged by the normal force, then break-away of
     stuck elements (the worst violation first) and re-sticking of an element released against its
@@ -852,6 +1036,7 @@ def settle(t, x, m, p, log, old):
             w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
             m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
     ne = p.elem.shape[0]
+    gears = _gear_modes(t, x, m, p, log)
     for _it in range(4 * nf + 4):
         evaluate_network(t, x, m, p, acc, tau)
         # torques below 1e-12 of the largest in the network are rounding (a stuck element that carries
@@ -894,6 +1079,8 @@ def settle(t, x, m, p, log, old):
                 break
         if not changed:
             break
+    if _gear_modes(t, x, m, p, log):   # the friction modes changed the torques the gears carry
+        gears = True
     # an element that starts to slide from (about) rest may start a rounding's width on the wrong side of zero:
     # its stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at
     # once, the crossing would be missed); one that slides clearly watches 0
@@ -906,7 +1093,7 @@ def settle(t, x, m, p, log, old):
             e = p.elem[p.fric[k]]
             w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
             slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
-    return any_change
+    return any_change or gears
 
 
 @numba.njit(cache=True, nogil=True)
@@ -915,6 +1102,23 @@ def driveline_update(t, x, u, m, p, k, log):
     reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
     backlash closed (``contact``) or opened (``separate``) its gap."""
     nf = p.fric.shape[0]
+    nsw = p.swit.shape[0]
+    if k >= N_G * nf + 2 * nsw:   # a lossy gear's power reached zero: the other flange drives now
+        j = k - N_G * nf - 2 * nsw
+        mi = p.elem[p.lossy[j]][E_MODE]
+        n = p.inertia.shape[0]
+        acc, tau = _acc_tau(p)
+        evaluate_network(t, x, m, p, acc, tau)
+        wmax, _tmax = _scales(x, p, tau)
+        if m[mi] != DRIVE_LOCKED and abs(_speed(x, n, p.elem[p.lossy[j]][E_A])) > 1e-9 * wmax:
+            new = DRIVE_B if m[mi] == DRIVE_A else DRIVE_A   # its torque reversed while moving: the other side drives
+        else:
+            new = _gear_mode_at(t, x, m, p, j)                # at rest: released one way, or held
+        if new != m[mi]:
+            m[mi] = new
+            record(log, t, EV_DRIVE_A + new, nf + nsw + j)
+        settle(t, x, m, p, log, m.copy())
+        return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // 2
         r = p.swit[j]

@@ -427,18 +427,31 @@ class Driveline:
                                        law=K.SPRING_BACKLASH))
         return self
 
-    def gear(self, name: str, a, b, ratio: float) -> "Driveline":
-        """An ideal gear between flanges a and b (MSL ``IdealGear``): ``w_a = ratio * w_b``, the torque on
-        flange b ``ratio`` times the torque on flange a and of opposite sign, lossless.  ``ratio`` != 0
-        (negative reverses).  Gears and motion sources may not close a loop (the network would be
-        over-constrained); the initial speeds of the inertias they bind follow from one of them."""
+    def gear(self, name: str, a, b, ratio: float, efficiency: float = 1.0) -> "Driveline":
+        """A gear between flanges a and b: ``w_a = ratio * w_b``.  Ideal (``efficiency`` 1, MSL ``IdealGear``):
+        the torque on flange b is ``-ratio`` times the torque on flange a.  Lossy (``efficiency`` ``eta`` in
+        (0.5, 1), MSL ``LossyGear`` with a constant efficiency and no bearing friction): the loss is taken from
+        the driving side, ``-ratio eta`` times while flange a drives (delivers power) and ``-ratio / eta`` while
+        b drives; at rest with the torques on its sides opposing within its loss band it is ``locked`` (holds
+        flange a at rest).  Its mode changes at located events (``a_drives``, ``b_drives``, ``locked``).
+        ``ratio`` != 0 (negative reverses).  Gears and motion sources may not close a loop (the network would
+        be over-constrained); the initial speeds of the inertias they bind follow from one of them."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         ratio = _finite(name, "ratio", ratio)
         if ratio == 0.0:
             raise ParameterError(f"{name}: ratio = 0 (a gear needs a ratio != 0)")
-        self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio, 0.0, 0.0, 0.0)))
+        eta = _finite(name, "efficiency", efficiency, positive=True)
+        if not 0.5 < eta <= 1.0:
+            raise ParameterError(f"{name}: efficiency = {eta!r} must be in (0.5, 1] (at 0.5 or below a gear "
+                                 "self-locks, which is not modelled)")
+        self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio, eta, 0.0, 0.0)))
         return self
+
+    @property
+    def _lossy(self) -> list:
+        """The gears with an efficiency below 1, in mode order."""
+        return [e for e in self._elements if e.kind == K.K_GEAR and e.coef[1] < 1.0]
 
     def _motion(self, name, flange, signal, law, what):
         name = self._new_name(name)
@@ -780,7 +793,7 @@ class Driveline:
                 lines.append(f"  {a} --({e.name}: {what} {e.signal.describe(unit)})--> [{b}]")
                 continue
             if e.kind == K.K_GEAR:
-                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
+                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b" + (f", efficiency {e.coef[1]:g}" if e.coef[1] < 1 else "")
             elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
                 what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
             elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
@@ -864,13 +877,17 @@ class Driveline:
         swit = np.array([r for r, e in enumerate(self._elements)
                          if e.kind == K.K_SPRING and e.law in (K.SPRING_BACKLASH, K.SPRING_CURVE)], dtype=np.int64)
         elem[swit, K.E_MODE] = fric.size + np.arange(swit.size)
-        n, ne, nk = len(index), len(self._elements), fric.size + cons.size
+        lossy = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_GEAR and e.coef[1] < 1.0],
+                         dtype=np.int64)
+        elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
+        n, ne = len(index), len(self._elements)
+        nk = fric.size + cons.size + sum(1 for e in self._elements if e.kind == K.K_GEAR and e.coef[1] < 1.0)
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
         elem[ext, K.E_AUX] = np.arange(len(ext))
         work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext)))
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
-                              np.array(data, dtype=float), fric, cons, swit, work,
+                              np.array(data, dtype=float), fric, cons, swit, lossy, work,
                               np.zeros(max(nk, 1), dtype=np.int64))
         x0 = self.initial_state()
         work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
@@ -966,9 +983,11 @@ class Driveline:
     def _initial_modes(self, p, x0):
         """Friction modes from the initial relative speeds and normal forces, then the backlash contacts
         from the deflections (at the edge of the gap, in contact if moving into it) and the segments of the
-        curve springs (at a point, the segment it moves onto)."""
+        curve springs (at a point, the segment it moves onto); lossy gears start with flange a driving (the
+        restart at t0 sets them by the power they carry)."""
         n = len(self._inertias)
-        m = np.empty(p.fric.size + p.swit.size, dtype=np.int64)
+        m = np.empty(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
+        m[p.fric.size + p.swit.size:] = K.DRIVE_A
         for j, r in enumerate(p.swit):
             e = self._elements[r]
             pa = 0.0 if e.a is None else x0[p.elem[r][K.E_A]]
@@ -1049,11 +1068,12 @@ class Driveline:
         switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH else -1) for e in swit
                            for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
                                         else ("segment_below", "segment_above")))
-        named = fric + tuple(e.name for e in swit)
+        named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
+        switching += tuple((f"{e.name}.power", 0) for e in self._lossy)
         mode_names = named
         swit_values = tuple(K.LASH_VALUES if e.law == K.SPRING_BACKLASH else
                             tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
-        mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values
+        mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.DRIVE_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
         atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
