@@ -190,6 +190,22 @@ class Signal:
         lo = int(np.searchsorted(ts, t, side="right")) - 1
         return value, float((vs[lo + 1] - vs[lo]) / (ts[lo + 1] - ts[lo]))
 
+    def breakpoints(self, what: str, unit: str = "") -> tuple:
+        """The corners ``(times [s], values)`` of a piecewise-linear signal (constant, ramp, table or sampled),
+        as a model with its own piecewise-linear profile takes them; ``what`` names the signal in the error a
+        step or sine raises (:class:`~clutchlab.errors.ParameterError`)."""
+        kind = self.row[0]
+        if kind == K.SIG_CONST:
+            return (0.0,), (self.row[1],)
+        if kind == K.SIG_RAMP:
+            height, duration, start, offset = self.row[1:5]
+            return (start, start + duration), (offset, offset + height)
+        if kind in (K.SIG_TABLE, K.SIG_SAMPLED):
+            half = len(self.points) // 2
+            return tuple(self.points[:half]), tuple(self.points[half:])
+        raise ParameterError(f"{what} must be a constant, a ramp or a table (a piecewise-linear profile), not "
+                             f"{self.describe(unit)}")
+
     @classmethod
     def of(cls, value, what: str) -> "Signal":
         """``value`` as a signal: a :class:`Signal` as it is, a number as a constant."""
@@ -654,18 +670,8 @@ class Driveline:
             actuator = ActuatorParameters()
         if not isinstance(actuator, ActuatorParameters):
             raise ParameterError(f"{name}: actuator must be True or ActuatorParameters, not {type(actuator).__name__}")
-        kind = sig.row[0]
-        if kind == K.SIG_CONST:
-            t_ref, v_ref = [0.0], [sig.row[1]]
-        elif kind == K.SIG_RAMP:
-            height, duration, start, offset = sig.row[1:5]
-            t_ref, v_ref = [start, start + duration], [offset, offset + height]
-        elif kind in (K.SIG_TABLE, K.SIG_SAMPLED):
-            half = len(sig.points) // 2
-            t_ref, v_ref = list(sig.points[:half]), list(sig.points[half:])
-        else:
-            raise ParameterError(f"{name}: with an actuator, position (the bearing reference) must be a constant, a "
-                                 f"ramp or a table, not {sig.describe('m')}")
+        t_ref, v_ref = (list(v) for v in sig.breakpoints(f"{name}: with an actuator, position (the bearing "
+                                                         "reference)", "m"))
         if min(t_ref) < 0.0:
             raise ParameterError(f"{name}: the bearing reference starts at {min(t_ref):g} s (before t = 0)")
         times = np.array([0.0] + [t + pre_roll for t in t_ref]) if pre_roll > 0 else np.array(t_ref, dtype=float)
@@ -712,18 +718,7 @@ class Driveline:
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         sig = Signal.of(force, f"{name}: force")
-        kind = sig.row[0]
-        if kind == K.SIG_CONST:
-            times, values = (0.0,), (sig.row[1],)
-        elif kind == K.SIG_RAMP:
-            height, duration, start, offset = sig.row[1:5]
-            times, values = (start, start + duration), (offset, offset + height)
-        elif kind in (K.SIG_TABLE, K.SIG_SAMPLED):
-            half = len(sig.points) // 2
-            times, values = tuple(sig.points[:half]), tuple(sig.points[half:])
-        else:
-            raise ParameterError(f"{name}: force must be a constant, a ramp or a table (the actuator's "
-                                 f"piecewise-linear force reference), not {sig.describe('N')}")
+        times, values = sig.breakpoints(f"{name}: force (the actuator's force reference)", "N")
         if min(values) < 0.0:
             raise ParameterError(f"{name}: force reference {min(values):g} N is negative")
         temps = {}
