@@ -541,7 +541,8 @@ def evaluate_network(t, x, m, p, acc, tau):
         if kind == K_SPRING:
             tq, _tc = spring_torque(p, r, x, n, m)
         elif kind == K_SOURCE:
-            tq = -source_torque(p, r, t, x, n)
+            tq = -(signal_value(p.signals[e[E_SIGNAL]], p.data, t) if e[E_LAW] == SOURCE_SIGNAL
+                   else source_torque(p, r, t, x, n))
         else:
             continue
         tau[r] = tq
@@ -703,7 +704,7 @@ def _solve_stuck(t, p, m, stuck, ns, F, tau):
         fb[k] = ek[E_B]
         ga[k] = ca
         gb[k] = cb
-        hf[k] = _force_factor(p, rk, m)
+        hf[k] = _force_factor(p, rk, m) if p.lossy.shape[0] > 0 else 1.0
         target = 0.0
         if ek[E_KIND] == K_MOTION:
             d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
