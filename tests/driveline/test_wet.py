@@ -130,6 +130,10 @@ def test_wet_clutch_errors():
         _launch(force=Signal.table([0.0, 1.0], [0.0, -5.0]))
     with pytest.raises(ParameterError, match="temperature0"):
         _launch(temperature0=math.nan)
+    with pytest.raises(ParameterError, match="clutch: clutch must be a WetClutch, not Bench"):
+        _launch(clutch=Bench())
+    with pytest.raises(ParameterError, match="friction must be a ParametricFriction or FrictionMap, not float"):
+        _launch(friction=0.3)
     assert "wet clutch (seed 001" in repr(_launch())
 
 

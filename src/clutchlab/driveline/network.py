@@ -725,8 +725,15 @@ class Driveline:
         for what, value in (("temperature0", temperature0), ("fluid_temperature0", fluid_temperature0),
                             ("housing_temperature0", housing_temperature0)):
             temps[what] = _finite(name, what, value)
+        from ..wet.friction import FrictionMap, ParametricFriction
+
         clutch = WetClutch.paper() if clutch is None else clutch
         bench = Bench() if bench is None else bench
+        for what, value, cls, label in (("clutch", clutch, WetClutch, "WetClutch"), ("bench", bench, Bench, "Bench"),
+                                        ("friction", friction, (ParametricFriction, FrictionMap, type(None)),
+                                         "ParametricFriction or FrictionMap")):
+            if not isinstance(value, cls):
+                raise ParameterError(f"{name}: {what} must be a {label}, not {type(value).__name__}")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
         el = self._elements[-1]
         el.wet = dict(clutch=clutch, bench=bench, friction=friction, times=times, values=values, **temps)
