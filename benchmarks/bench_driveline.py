@@ -139,11 +139,16 @@ def launch(quick: bool = False):
         print(f"  {res.stats['accepted_steps']:5d} steps          rtol {rtol:7.0e}   error {err:8.1e}   "
               f"{med * 1e3:9.3f} ms ({min(times) * 1e3:.3f}-{max(times) * 1e3:.3f})   "
               f"{LAUNCH_T_END / med:9.0f}x real time")
-    el = next(e for e in d._elements if e.name == "clutch")
+    # the actuator's solve as the element does it (Driveline.eclutch with actuator=True): the E-clutch dynamics
+    # from rest under the file's bearing reference, held at its first value through the 1 s pre-roll, to 0.5 s
+    # past its last corner, sampled every 1 ms
+    from clutchlab.eclutch.dynamics import EClutch
     from clutchlab.eclutch.models import ClutchModel
 
-    cm = ClutchModel.preset(4)
-    times, _ = _timed(lambda: d._eclutch_dynamics("clutch", cm, el.reference, True, 1e-3, 1.0, 0.5), 3 if quick else 11)
+    ecl = EClutch(clutch=ClutchModel.preset(4))
+    reference = ([0.0, 1.0, 1.5, 1.7, 3.0, 4.0], [8e-3, 8e-3, 8e-3, 5.5e-3, 3e-3, 0.0])
+    times, _ = _timed(lambda: ecl.simulate({"bearing_reference": reference}, 4.5, output_step=1e-3).to_dataframe(),
+                      3 if quick else 11)
     med = statistics.median(times)
     print(f"  actuator dynamics (E-clutch, Rodas3 rtol 1e-3, 1 s pre-roll + 3 s + 0.5 s, 1 ms samples): "
           f"{med * 1e3:.2f} ms ({min(times) * 1e3:.2f}-{max(times) * 1e3:.2f})")
