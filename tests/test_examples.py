@@ -312,7 +312,18 @@ def check_sae2(work, out):
     assert "3 events" in out
 
 
+def check_awd(work, out):
+    frame = _csv(work / "awd.csv")
+    events = _csv(work / "awd_events.csv")
+    assert len(frame) == 301 and frame.time_s.iloc[-1] == 1.5          # [simulation] output_step 5 ms
+    assert list(events.event) == ["armature_leave_rest", "armature_contact"]
+    assert (frame["emtc.w_rel_rad_s"] < 0).all()                       # the rear shaft slower: slipping
+    assert frame["emtc.tau_Nm"].iloc[-1] < -100.0                      # torque to the rear axle
+    assert "energy balance" in out
+
+
 CHECKS = {
+    "awd.csv": check_awd,
     "cc.csv": check_coupled_clutches,
     "drive_off.csv": check_drive_off,
     "sae2.csv": check_sae2,

@@ -38,7 +38,10 @@ position is the reference of its actuator's position controller, actuator_step, 
 idle_speed, idle_kp, idle_ki, idle_torque_max, support) and ``wet_clutch``
 (a, b, force [N] = a constant, ramp or table; clutch, bench = wet-clutch parameter files, friction = a
 friction law file or an identified map ``.json``; temperature0, fluid_temperature0, housing_temperature0
-[degC]).  With ``[driveline] domain =
+[degC]) and ``emtc`` (a = its input shaft, b = its output shaft; bench = an EMTC scenario file of
+``clutchlab emtc simulate`` (its ``[scenario]``, ``[vehicle]``, ``[actuator]``, ``[coupling]`` tables: the
+controller's throttle ramp, gear and sample time, the coupling's data; no ``[magnet]`` table), magnet = a
+Preisach model ``.json`` (default the bundled synthetic one)).  With ``[driveline] domain =
 "translational"`` the bodies are ``mass`` (m, v0, s0) and the sources ``force`` (flange, force,
 support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities are numbers in SI or
 strings with units, converted once here.  A signal is a number or
@@ -91,6 +94,7 @@ FIELDS = {
     "wet_clutch": {"a": (None, True), "b": (None, True), "force": ("N", True), "clutch": ("path", False),
                    "bench": ("path", False), "friction": ("path", False), "temperature0": ("degC", False),
                    "fluid_temperature0": ("degC", False), "housing_temperature0": ("degC", False)},
+    "emtc": {"a": (None, True), "b": (None, True), "bench": ("path", False), "magnet": ("path", False)},
 }
 #: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
 NOT_QUANTITIES = ("text", "int", "path", "bool", "map")
@@ -100,7 +104,7 @@ _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": 
 TRANSLATIONAL_FIELDS = {
     _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
                                        for f, (u, req) in fields.items()}
-    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch", "engine")}
+    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch", "engine", "emtc")}
 #: signal fields carrying the signal's own unit, per component table
 _SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
             "brake": "normal", "eclutch": "position", "wet_clutch": "force", "engine": "throttle"}
@@ -115,7 +119,7 @@ _ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", 
         "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
         "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
         "one_way_clutch": "one_way_clutch", "eclutch": "eclutch", "wet_clutch": "wet_clutch",
-        "engine": "engine"}
+        "engine": "engine", "emtc": "emtc"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -243,6 +247,22 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
             path = args["friction"]
             args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
                                 else ParametricFriction.from_toml(path))
+    elif kind == "emtc":
+        from ..hysteresis import Preisach
+
+        if "bench" in args:
+            from ..emtc.bench import load_scenario
+            from ..emtc.system import BenchOptions
+
+            path = args.pop("bench")
+            bench = load_scenario(path)
+            if bench["magnet"] is not None:
+                raise ParameterError(f"bench = {path.name!r} names a magnet in its [magnet] table: give the model "
+                                     "as this component's magnet field instead")
+            args.update(scenario=bench["scenario"], vehicle=bench["vehicle"],
+                        options=BenchOptions(actuator=bench["actuator"], coupling=bench["coupling"]))
+        if "magnet" in args:
+            args["magnet"] = Preisach.from_json(args["magnet"])
     elif kind == "engine":
         args = dict(args)
         flange = args.pop("flange")

@@ -225,7 +225,7 @@ def friction_torque(p, r, t, w_abs):
     if law == LAW_ONEWAY:
         return 0.0
     if law == LAW_EXTERNAL:
-        return _external(p)[2 * e[E_AUX]]
+        return _external(p)[3 * e[E_AUX]]
     c = p.coef[r]
     val = _characteristic(p.data, e[E_TABLE], e[E_TABLE_N], w_abs)
     if law == LAW_TABLE:
@@ -274,7 +274,7 @@ def static_limit(p, r, t):
     if p.elem[r][E_LAW] == LAW_ONEWAY:
         return np.inf
     if p.elem[r][E_LAW] == LAW_EXTERNAL:
-        return _external(p)[2 * p.elem[r][E_AUX] + 1]
+        return _external(p)[3 * p.elem[r][E_AUX] + 1]
     return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
@@ -588,7 +588,7 @@ def _layout(n, nk, ne):
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | flange a, ca, flange b, cb, force factor of each member (5 nk) | accelerations (n) | element torques (ne) |
     slack of each friction element's stick function (nf, :func:`settle`) | sliding torque and static limit of
-    each clutch model (2 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored energy (1)."""
+    each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored energy (1)."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -604,7 +604,7 @@ def _layout(n, nk, ne):
 def work_size(n, nk, ne, nf, nx=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` friction elements and constraints, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own."""
-    return 2 * n + 11 * nk + 2 * nk * nk + ne + nf + 2 * nx + 1
+    return 2 * n + 11 * nk + 2 * nk * nk + ne + nf + 3 * nx + 1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -634,7 +634,8 @@ def _slack(p):
 
 @numba.njit(cache=True, nogil=True)
 def _external(p):
-    """The sliding torques and static limits of the clutch models (``LAW_EXTERNAL``), two per model."""
+    """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
+    model."""
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     ne = p.elem.shape[0]
@@ -643,13 +644,16 @@ def _external(p):
 
 
 @numba.njit(cache=True, nogil=True)
-def set_external(p, j, slide, limit):
+def set_external(p, j, slide, limit, lock):
     """Set clutch model ``j``'s (``elem[r, E_AUX] = j``) sliding torque magnitude ``slide`` [N m] at the present
-    relative speed and its static limit ``limit`` [N m] (the torque it holds while stuck), for the network's
-    evaluations at the present state.  Its model's hooks call this before every hook of the network."""
+    relative speed, its static limit ``limit`` [N m] (the torque it holds while stuck: beyond it, it breaks
+    away) and its lock-up limit ``lock`` [N m] (the torque it must cover to stick when its relative speed
+    reaches zero; MSL's friction elements use their static limit for both), for the network's evaluations at
+    the present state.  Its model's hooks call this before every hook of the network."""
     ext = _external(p)
-    ext[2 * j] = slide
-    ext[2 * j + 1] = limit
+    ext[3 * j] = slide
+    ext[3 * j + 1] = limit
+    ext[3 * j + 2] = lock
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1053,6 +1057,8 @@ def settle(t, x, m, p, log, old):
                 continue
             r = p.fric[k]
             lim = holding_limit(p, r, t, tau[r])
+            if old[k] != STUCK and p.elem[r][E_LAW] == LAW_EXTERNAL:   # sticking now: its lock-up limit
+                lim = _external(p)[3 * p.elem[r][E_AUX] + 2]
             # the same test as the break-away function, which has crossed when it reaches zero (the core's
             # convention): |tau| >= limit, a torque to carry (a ratio may round to exactly 1)
             if abs(tau[r]) >= lim and abs(tau[r]) > t_noise:

@@ -301,6 +301,7 @@ class _Element:
     model: str = ""     # what built it (for describe)
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
+    emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
 
 
 class Driveline:
@@ -734,11 +735,78 @@ class Driveline:
                                          "ParametricFriction or FrictionMap")):
             if not isinstance(value, cls):
                 raise ParameterError(f"{name}: {what} must be a {label}, not {type(value).__name__}")
+        if any(e.emtc is not None for e in self._elements):
+            raise ParameterError(f"{name}: a wet clutch and an EMTC coupling cannot share a network")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
         el = self._elements[-1]
         el.wet = dict(clutch=clutch, bench=bench, friction=friction, times=times, values=values, **temps)
         el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
         return self
+
+    def emtc(self, name: str, a, b, magnet=None, scenario=None, vehicle=None, options=None) -> "Driveline":
+        """The electromagnetic torque-controlled coupling of seed 002 between flanges a (its input, front shaft)
+        and b (its output, rear shaft), with states of its own: coil current lags, armature, Preisach magnet
+        memory, and its controller (:mod:`clutchlab.emtc.system`, Processes 7 (2019) 557, Eqs. 1-26 and 31;
+        :mod:`clutchlab.driveline.emtc`).
+
+        Its torque is the slipping-mode torque of the three friction elements and the ball-cam (Eqs. 13-17)
+        while its armature presses the primary clutch, the drag of Eq. 25 while it does not; stuck, it holds
+        up to ``1.02 T_cap_L`` (Eq. 21 and the unlock margin of Fig. 11); the network's friction state machine
+        decides which.  Its controller samples every ``scenario.sample_time`` the torque reference (the map of
+        Eq. 31 at ``scenario``'s throttle ramp and the vehicle speed of flange a, or
+        ``options.torque_reference``) and commands the coil current through the inverse Preisach model
+        (Eqs. 6-7).  ``magnet`` (:class:`~clutchlab.hysteresis.Preisach`, default the bundled synthetic
+        model), ``scenario`` (:class:`~clutchlab.emtc.bench.BenchScenario`: its throttle ramp, gear,
+        temperature and sample time; its drum speeds are not used), ``vehicle``
+        (:class:`~clutchlab.emtc.bench.VehicleParameters`: the map's vehicle speed and the drag of Eq. 25)
+        and ``options`` (:class:`~clutchlab.emtc.system.BenchOptions`: actuator, coupling geometry, torque map,
+        controller model, friction map, reference, memory capacity; LuGre friction is refused): as
+        :func:`clutchlab.emtc.system.pack_parameters`.  One EMTC per network, and not with a wet clutch.
+        """
+        from ..emtc.bench import BenchScenario, VehicleParameters
+        from ..emtc.system import BenchOptions
+        from ..hysteresis import Preisach
+
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        for what, value, cls, label in (("magnet", magnet, (Preisach, type(None)), "Preisach"),
+                                        ("scenario", scenario, (BenchScenario, type(None)), "BenchScenario"),
+                                        ("vehicle", vehicle, (VehicleParameters, type(None)), "VehicleParameters"),
+                                        ("options", options, (BenchOptions, type(None)), "BenchOptions")):
+            if not isinstance(value, cls):
+                raise ParameterError(f"{name}: {what} must be a {label}, not {type(value).__name__}")
+        if options is not None and options.lugre is not None:
+            raise ParameterError(f"{name}: LuGre friction is not available in a driveline (its bristle state "
+                                 "follows the drum bench's own lock-up logic); give a friction map or none")
+        for e in self._elements:
+            if e.emtc is not None:
+                raise ParameterError(f"{name}: a network holds one EMTC coupling ({e.name} is one)")
+            if e.wet is not None:
+                raise ParameterError(f"{name}: an EMTC coupling and a wet clutch ({e.name}) cannot share a network")
+        if a is None or b is None:
+            raise ParameterError(f"{name}: an EMTC coupling sits between two inertias (its shafts), not on the ground")
+        self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0)
+        el = self._elements[-1]
+        el.emtc = dict(magnet=magnet, scenario=scenario or BenchScenario(), vehicle=vehicle or VehicleParameters(),
+                       options=options or BenchOptions())
+        el.model = "EMTC coupling (seed 002: three friction elements, ball-cam, Preisach magnet, controller)"
+        return self
+
+    def _emtc_parameters(self):
+        """The EMTC coupling's element and packed parameters (:func:`clutchlab.emtc.system.pack_parameters`),
+        or None."""
+        from ..emtc import system as S
+
+        for el in self._elements:
+            if el.emtc is not None:
+                w = el.emtc
+                magnet = w["magnet"]
+                if magnet is None:
+                    from ..emtc.magnet import bundled_magnet
+
+                    magnet = bundled_magnet()
+                return el, S.pack_parameters(magnet, w["scenario"], w["vehicle"], w["options"]), magnet
+        return None
 
     def _wet_parameters(self) -> list:
         """Per wet clutch: its element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
@@ -804,6 +872,10 @@ class Driveline:
                 what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
             elif e.law == K.LAW_ONEWAY:
                 what = "one-way clutch (b overruns a freely)"
+            elif e.law == K.LAW_EXTERNAL and e.emtc is not None:
+                sc = e.emtc["scenario"]
+                what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
+                        f"{sc.ramp_start:g}-{sc.ramp_end:g} s, controller every {sc.sample_time * 1e3:g} ms")
             elif e.law == K.LAW_EXTERNAL:
                 what = f"{e.model}, force reference {e.signal.describe('N')}"
             else:
@@ -1059,7 +1131,9 @@ class Driveline:
 
         With a wet clutch (:meth:`wet_clutch`) its parameters are a
         :class:`~clutchlab.driveline.wet.WetDrivelineParams` and its states, outputs, switching functions,
-        modes and events follow the network's (named ``<clutch>.<quantity>``)."""
+        modes and events follow the network's (named ``<clutch>.<quantity>``); with an EMTC coupling
+        (:meth:`emtc`), a :class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`, the same way (a full
+        hysteresis memory of its magnet is a model error naming the coupling)."""
         p = self.pack()
         x0 = self.initial_state()
         states, outputs = self.variables()
@@ -1095,6 +1169,23 @@ class Driveline:
                 outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.OUTPUTS)
             events = K.EVENTS + W.EVENTS
 
+        emtc = self._emtc_parameters()
+        error_messages = None
+        if emtc is not None:
+            from ..emtc import system as S
+            from . import emtc as DE
+
+            el, ep, magnet = emtc
+            p, x0, m0, atol = self._with_emtc(p, x0, m0, atol, el, ep, magnet, rtol, len(switching), len(named))
+            states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in S.STATES)
+            switching += tuple((f"{el.name}.{q}", d) for q, d in S.SWITCHING)
+            named += tuple(f"{el.name}.{q}" for q in S.ELEMENTS)
+            mode_names += tuple(f"{el.name}.{q}" for q in S.MODE_NAMES)
+            mode_values += S.MODE_VALUES
+            outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in DE.OUTPUTS)
+            events = K.EVENTS + S.EVENTS
+            error_messages = {code: f"{el.name}: {text}" for code, text in S.ERROR_MESSAGES.items()}
+
         def element_name(code, element, _names=named):
             return _names[element] if 0 <= element < len(_names) else ""
 
@@ -1105,7 +1196,7 @@ class Driveline:
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
                       m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
-                      element_name=element_name)
+                      element_name=element_name, error_messages=error_messages or {})
 
     def _with_wet(self, p, x0, m0, atol, wet, rtol, ng, nel):
         """The network's parameters, initial state and modes and absolute tolerances joined with the wet
@@ -1139,6 +1230,27 @@ class Driveline:
                                        np.array(conf, dtype=np.int64), np.zeros((nw, DW.N_BUF)),
                                        np.zeros((nw, DW.N_MODE), dtype=np.int64))
         return params, np.concatenate(xs), np.concatenate(ms), np.concatenate(tols)
+
+    def _with_emtc(self, p, x0, m0, atol, el, ep, magnet, rtol, ng, nel):
+        """The network's parameters, initial state and modes and absolute tolerances joined with the EMTC
+        coupling's (:class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`): armature at rest, coil current at
+        the magnet's lowest grid current, shaft speeds the flanges'."""
+        from ..emtc import system as S
+        from . import emtc as DE
+
+        n = len(self._inertias)
+        r = self._elements.index(el)
+        k = int(np.flatnonzero(p.fric == r)[0])
+        i0 = float(magnet.grid[0])
+        xe = np.array([x0[n + p.elem[r][K.E_A]], x0[n + p.elem[r][K.E_B]], 0.0, 0.0, 0.0, i0, i0])
+        conf = np.array([k, r, x0.size, ng, m0.size, len(K.EVENTS), nel], dtype=np.int64)
+        params = DE.EmtcDrivelineParams(p, ep, conf, np.zeros(DE.N_BUF), np.zeros(DE.N_MODE, dtype=np.int64),
+                                        DE.OUTPUT_INDEX.copy())
+        me = np.array([S.ARM_REST, S.OPEN, S.POSITIVE], dtype=np.int64)
+        # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
+        ae = S.ATOL * (float(rtol) / 1e-6)
+        ae[:3] = float(rtol)
+        return params, np.concatenate([x0, xe]), np.concatenate([m0, me]), np.concatenate([atol, ae])
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
                  output_step: float | None = None, sample_times=None):

@@ -10,7 +10,8 @@ per evaluation (:func:`clutchlab.driveline.kernel.set_external`):
 * the **sliding torque** ``|tau| = R_eff N_c mu_f F_c + |tau_v|`` (Eqs. 3-6 at the present slip), used by the
   network while the element slides;
 * the **static limit** ``R_eff N_c mu_f F_c`` (Eq. 4 at the present slip; at lock-up the slip is zero), the
-  torque the element holds while stuck.
+  torque the element holds while stuck, and also the torque it must cover to lock up (the lock-up limit of
+  :func:`~clutchlab.driveline.kernel.set_external` equals it).
 
 The network's friction state machine decides stick and slip (the wet model's own ``lockup``/``breakaway``
 switching functions are held off: they watch the bench's shaft, which is now a body of the network); the
@@ -94,7 +95,7 @@ def _clutch(t, x, m, p, j):
     W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, wp, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
-    K.set_external(net, net.elem[r][K.E_AUX], cap + abs(wk[W.W_OUT + W.O_TV]), cap)
+    K.set_external(net, net.elem[r][K.E_AUX], cap + abs(wk[W.W_OUT + W.O_TV]), cap, cap)
     for i in range(W.N_OUT):
         b[B_Y + i] = wk[W.W_OUT + i]
     return w_rel

@@ -1,0 +1,322 @@
+"""The EMTC coupling as a driveline element: the network of :mod:`clutchlab.driveline.kernel` with the
+electromagnetic torque-controlled coupling of seed 002 between two of its flanges.
+
+The coupling is the model of :mod:`clutchlab.emtc.system` (Processes 7 (2019) 557, Eqs. 1-26 and 31),
+unchanged and called through the system contract (:mod:`clutchlab.numerics.dispatch`): its coil current
+lags, the Preisach magnet (Eqs. 1-5) at the airgap of its armature (Eqs. 8-12), the ball-cam and the three
+friction elements (Eqs. 13-21), the drag of the open coupling (Eq. 25) and its controller (the torque
+reference of Eq. 31 or a table, the commanded force of Eqs. 13, 15 and 11, the inverse Preisach model of
+Eqs. 6-7, sampled every ``sample_time``).  Flange a is the coupling's input (front) shaft, flange b its
+output (rear) shaft: the coupling's slip speed is ``w_a - w_b`` (``omega_f - omega_r``), minus the
+element's relative speed ``w_b - w_a``.
+
+What the drum bench's own model does with its two shafts (the vehicle loads of Eq. 27, the lock torque
+of Eq. 29, the Torsen twist of Eq. 30, the lock-up and unlock decisions of Fig. 11) is the network's
+here.  The two parts meet through three numbers per evaluation (:func:`clutchlab.driveline.kernel.set_external`):
+
+* the **sliding torque**: while the armature presses the primary clutch, ``|T1 + T2 + T3|`` of the
+  slipping mode (Eqs. 13-15, 17, with the coupling's kinetic coefficients or friction map); while it
+  does not, the drag ``|T_drag|`` of Eq. 25 at the present slip (Eq. 26);
+* the **static limit**: ``1.02 T_cap_L`` (Eq. 21 with the unlock margin of Fig. 11) while the armature
+  presses, 0 while it does not (an open coupling holds nothing: at zero slip it passes through): a stuck
+  coupling breaks away beyond it;
+* the **lock-up limit** ``T_cap_L``: the torque the coupling must cover to lock when its slip reaches zero
+  (below it the slip reverses, Fig. 11).
+
+The network's friction state machine decides stick and slip (the bench model's ``slip_speed_zero`` and
+``lock_capacity_exceeded`` switching functions are held off).  A stuck coupling carries the torque the
+network's constraint solve gives it: for the two shafts of the bench, that is Eq. 29's ``T_lock``, and
+the Torsen twist of Eq. 30 stays zero (its terms vanish identically while both shafts turn together).
+
+The armature events (``armature_rest``, ``armature_contact``, ``armature_leave_rest``,
+``armature_leave_contact``) are kept and named for the element (``<name>.armature``).
+
+States: the network's, then the coupling's seven (:data:`clutchlab.emtc.system.STATES`; its two shaft
+speeds follow the flanges, integrated from their accelerations and reset to them at every event, its
+Torsen twist stays zero).  Outputs: the network's, then the coupling's :data:`OUTPUTS`.  One EMTC per
+network (its parameters are one :class:`~clutchlab.emtc.system.EmtcParams`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..emtc import system as S
+from ..numerics import dispatch
+from .kernel import DrivelineParams
+from . import kernel as K
+
+__all__ = ["EmtcDrivelineParams", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "drum_bench"]
+
+N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
+# conf (int64): the friction index of the coupling, its element row, then the offsets of its states, switching
+# functions and modes in the whole system's, the number of the network's events and the index of its first named
+# element (``<name>.armature``, then ``<name>.coupling``)
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
+# buf (float): its states with the shaft speeds replaced | their derivative | switching values | inputs (zero) |
+# outputs
+B_X, B_DX, B_G, B_U = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH
+B_Y = B_U + N_IN
+N_BUF = B_Y + len(S.OUTPUTS)
+#: the coupling's outputs in a network (the bench model's others describe its vehicle: here the network's)
+OUTPUTS = tuple(o for o in S.OUTPUTS if o[0] in ("airgap", "magnet_force", "fn1", "capacity_locked",
+                                                 "current_command", "torque_reference", "throttle",
+                                                 "command_feasible"))
+OUTPUT_INDEX = np.array([[o[0] for o in S.OUTPUTS].index(q[0]) for q in OUTPUTS], dtype=np.int64)
+_ARM, _CPL, _DIR = 0, 1, 2
+_SLIP_ZERO, _UNLOCK = 4, 5   # the bench's switching functions the network takes over
+
+
+class EmtcDrivelineParams(NamedTuple):
+    """Packed parameters of a driveline with an EMTC coupling: the network, the coupling's parameters packed
+    by :func:`clutchlab.emtc.system.pack_parameters` (its vehicle data used only by its controller's map and
+    its drag data), ``conf`` (int64, the layout ``F_*``), ``buf`` (float, scratch ``B_*``), ``mbuf`` (int64,
+    its modes) and ``index`` (int64, :data:`OUTPUT_INDEX`)."""
+
+    net: DrivelineParams
+    emtc: S.EmtcParams
+    conf: np.ndarray
+    buf: np.ndarray
+    mbuf: np.ndarray
+    index: np.ndarray
+
+
+@numba.njit(cache=True, nogil=True)
+def _load(x, m, p):
+    """The coupling's own states and modes from the network's into ``p.buf``/``p.mbuf``: its shaft speeds
+    are the flanges', its coupling mode ``slipping`` while the armature presses (else ``open``), its slip
+    direction the network's (stuck: ``positive``; the torque magnitudes do not depend on it)."""
+    cf = p.conf
+    net = p.net
+    n = net.inertia.shape[0]
+    e = net.elem[cf[F_ROW]]
+    b = p.buf
+    for i in range(N_STATE):
+        b[B_X + i] = x[cf[F_X] + i]
+    b[B_X] = K._speed(x, n, e[K.E_A])
+    b[B_X + 1] = K._speed(x, n, e[K.E_B])
+    b[B_X + 2] = 0.0
+    ms = p.mbuf
+    ms[_ARM] = m[cf[F_M] + _ARM]
+    ms[_CPL] = S.SLIPPING if ms[_ARM] == S.ARM_CONTACT else S.OPEN
+    ms[_DIR] = S.NEGATIVE if m[cf[F_K]] == K.FORWARD else S.POSITIVE
+
+
+@numba.njit(cache=True, nogil=True)
+def _coupling(t, x, m, p):
+    """Evaluate the coupling at the network's state (:func:`_load`): its derivative and switching values into
+    ``p.buf``, its sliding torque and static limit into the network (:func:`kernel.set_external`)."""
+    _load(x, m, p)
+    b = p.buf
+    dispatch.rhs(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, b[B_DX:B_DX + N_STATE],
+                 b[B_G:B_G + N_SWITCH])
+    aux = p.emtc.fmem[S.FM_AUX:S.FM_AUX + S.N_AUX]
+    net = p.net
+    cap = aux[S.AUX_CAP] if p.mbuf[_ARM] == S.ARM_CONTACT else 0.0
+    K.set_external(net, net.elem[p.conf[F_ROW]][K.E_AUX], abs(aux[S.AUX_TC]), p.emtc.coupling.unlock_margin * cap,
+                   cap)
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_rhs(t, x, u, m, p, dx, g):
+    """The network's right-hand side and switching functions, then the coupling's (its shaft speeds follow
+    the flanges' accelerations; its lock-up and unlock functions are held off)."""
+    _coupling(t, x, m, p)
+    net = p.net
+    K.driveline_rhs(t, x, u, m, net, dx, g)
+    acc, _tau = K._acc_tau(net)
+    cf = p.conf
+    b = p.buf
+    e = net.elem[cf[F_ROW]]
+    for i in range(N_STATE):
+        dx[cf[F_X] + i] = b[B_DX + i]
+    dx[cf[F_X]] = 0.0 if e[K.E_A] < 0 else acc[e[K.E_A]]
+    dx[cf[F_X] + 1] = 0.0 if e[K.E_B] < 0 else acc[e[K.E_B]]
+    dx[cf[F_X] + 2] = 0.0
+    for i in range(N_SWITCH):
+        g[cf[F_G] + i] = b[B_G + i]
+    g[cf[F_G] + _SLIP_ZERO] = 1.0
+    g[cf[F_G] + _UNLOCK] = 1.0
+    return None
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_outputs(t, x, u, m, p, y):
+    """The network's outputs, then the coupling's (:data:`OUTPUTS`)."""
+    _coupling(t, x, m, p)
+    K.driveline_outputs(t, x, u, m, p.net, y)
+    b = p.buf
+    dispatch.outputs(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, b[B_Y:N_BUF])
+    q = y.shape[0] - p.index.shape[0]
+    for i in range(p.index.shape[0]):
+        y[q + i] = b[B_Y + p.index[i]]
+
+
+@numba.njit(cache=True, nogil=True)
+def _sync(x, m, p):
+    """The coupling's shaft-speed states reset to its flanges' speeds, its twist to zero (an event, a restart)."""
+    net = p.net
+    n = net.inertia.shape[0]
+    cf = p.conf
+    e = net.elem[cf[F_ROW]]
+    x[cf[F_X]] = K._speed(x, n, e[K.E_A])
+    x[cf[F_X] + 1] = K._speed(x, n, e[K.E_B])
+    x[cf[F_X] + 2] = 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def _write_back(x, m, p, start, log):
+    """The coupling's armature and current states and its armature mode from ``p.buf``/``p.mbuf`` into the
+    network's, its events from ``start`` on renamed (codes after the network's, elements after its names)."""
+    cf = p.conf
+    for i in range(3, N_STATE):
+        x[cf[F_X] + i] = p.buf[B_X + i]
+    m[cf[F_M] + _ARM] = p.mbuf[_ARM]
+    for i in range(start, min(log.count[0], log.time.shape[0])):
+        log.code[i] += cf[F_EV]
+        log.element[i] += cf[F_EL]
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_update(t, x, u, m, p, k, log):
+    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or one of the
+    coupling's armature functions (its own update: rest stop, contact, leaving them); then the network's
+    modes at the coupling's new torque."""
+    _sync(x, m, p)
+    _coupling(t, x, m, p)
+    ng = p.conf[F_G]
+    if k < ng:
+        res = K.driveline_update(t, x, u, m, p.net, k, log)
+        _sync(x, m, p)
+        return res
+    _load(x, m, p)
+    b = p.buf
+    start = log.count[0]
+    res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, k - ng, log)
+    _write_back(x, m, p, start, log)
+    if res < 0:
+        return res
+    _coupling(t, x, m, p)
+    K.settle(t, x, m, p.net, log, m.copy())
+    _sync(x, m, p)
+    return res
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_restart(t, x, u, m, p, log):
+    """The coupling's restart (its controller sample when one is due; the armature's modes at a start), then
+    the network's modes at its torque."""
+    _sync(x, m, p)
+    _load(x, m, p)
+    b = p.buf
+    start = log.count[0]
+    changed = dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, log)
+    _write_back(x, m, p, start, log)
+    _coupling(t, x, m, p)
+    if K.driveline_restart(t, x, u, m, p.net, log):
+        changed = True
+    _sync(x, m, p)
+    return changed
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_accept(t, x, u, m, p):
+    """The coupling's commit of its plant magnet's memory (or its model error: a full memory)."""
+    _load(x, m, p)
+    b = p.buf
+    return dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc)
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_next_break(t, m, p):
+    """The next corner of the network's signals or the coupling's next controller sample."""
+    return min(K.driveline_next_break(t, m, p.net), dispatch.next_break(t, p.mbuf, p.emtc))
+
+
+@numba.njit(cache=True, nogil=True)
+def emtc_driveline_jacobian(t, x, u, m, p, J):
+    """No analytic Jacobian (Dormand-Prince)."""
+    return False
+
+
+dispatch.register(EmtcDrivelineParams, rhs=emtc_driveline_rhs, outputs=emtc_driveline_outputs,
+                  update=emtc_driveline_update, restart=emtc_driveline_restart, accept=emtc_driveline_accept,
+                  next_break=emtc_driveline_next_break, jacobian=emtc_driveline_jacobian)
+
+
+# ------------------------------------------------------------------ the drum bench as a network
+def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: str = "emtc_awd"):
+    """The AWD vehicle with its EMTC on the drum bench of seed 002 (Sec. 4, Eq. 27) as a
+    :class:`~clutchlab.driveline.Driveline`: the same equations as :func:`clutchlab.emtc.system.simulate`,
+    written as a network.
+
+    Components (SI): ``front_shaft`` and ``rear_shaft`` (the coupling's shafts, ``J_sf``, ``J_sr``),
+    ``front_axle`` and ``rear_axle`` (axles and wheels, ``J_wf``, ``J_wr``) joined to them by the gears
+    ``front_drive`` and ``rear_drive`` (ratio ``i_r``: the shaft turns ``i_r`` times the wheel, so the
+    shafts see ``J_F``, ``J_R`` of Eq. 29); ``engine`` on the front axle (the transmission's output torque
+    at the wheels, ``i_g i_0 throttle min(T_max, P / w_e)``, tabulated over the axle speed: exact below the
+    power corner, linear between 400 points of the hyperbola above it); the tyres on the drums
+    (``tyres_front``, ``tyres_rear``: dampers ``2 C_x r^3 / max(|v_d|, v_floor)`` to the drums
+    ``drum_front``, ``drum_rear``, held at ``v_d / r`` by the speed sources ``drum_front_drive``,
+    ``drum_rear_drive``), rolling resistance ``f_rr F_z r tanh(w / 0.5 rad/s)`` plus the drum load
+    (``rolling_front``, ``rolling_rear``: bearing friction, tabulated, exact above 10 rad/s), and the
+    coupling ``emtc`` (:meth:`~clutchlab.driveline.Driveline.emtc`) between the shafts.  Initial speeds:
+    free rolling on the drums, as the bench's.  ``scenario``
+    (:class:`~clutchlab.emtc.bench.BenchScenario`), ``vehicle``
+    (:class:`~clutchlab.emtc.bench.VehicleParameters`), ``magnet`` and ``options`` as
+    :func:`clutchlab.emtc.system.simulate`; ``name``: the network's name.
+    """
+    from ..emtc.bench import BenchScenario, VehicleParameters
+    from .network import Driveline, Signal
+
+    sc = scenario or BenchScenario()
+    veh = vehicle or VehicleParameters()
+    ic, r = float(veh.rear_final_drive), float(veh.tyre_radius)
+    i_tr = float(veh.gear_ratios[sc.gear - 1]) * float(veh.front_final_drive)
+    vf, vr = float(sc.drum_speed), float(sc.drum_speed - sc.speed_difference)
+    fzf, fzr = veh.axle_loads()
+    d = Driveline(name)
+    d.inertia("front_shaft", J=veh.inertia_input_shaft, w0=vf / r * ic)
+    d.inertia("rear_shaft", J=veh.inertia_output_shaft, w0=vr / r * ic)
+    d.inertia("front_axle", J=veh.inertia_front_axle, w0=vf / r)
+    d.inertia("rear_axle", J=veh.inertia_rear_axle, w0=vr / r)
+    d.inertia("drum_front", J=1.0, w0=vf / r)
+    d.inertia("drum_rear", J=1.0, w0=vr / r)
+    d.speed("drum_front_drive", "drum_front", vf / r)
+    d.speed("drum_rear_drive", "drum_rear", vr / r)
+    d.gear("front_drive", "front_shaft", "front_axle", ratio=ic)
+    d.gear("rear_drive", "rear_shaft", "rear_axle", ratio=ic)
+    speeds, torques = engine_curve(veh, i_tr)
+    d.engine("engine", "front_axle", torque_map=np.column_stack([speeds, torques]),
+             throttle=Signal.table([0.0, sc.ramp_start, max(sc.ramp_end, sc.ramp_start + 1e-9)],
+                                   [sc.throttle_start, sc.throttle_start, sc.throttle_end]))
+    for side, v, fz, load in (("front", vf, fzf, sc.drum_load_front), ("rear", vr, fzr, sc.drum_load_rear)):
+        k = 2.0 * veh.tyre_slip_stiffness * r / max(abs(v), veh.slip_speed_floor)
+        d.spring_damper(f"tyres_{side}", f"{side}_axle", f"drum_{side}", d=k * r * r)
+        d.bearing_friction(f"rolling_{side}", f"{side}_axle", torque=rolling_curve(veh.rolling_resistance * fz * r,
+                                                                                   load))
+    d.emtc("emtc", "front_shaft", "rear_shaft", magnet=magnet, scenario=sc, vehicle=veh, options=options)
+    return d
+
+
+def engine_curve(vehicle, ratio, points: int = 400):
+    """Full-load torque at the wheels ``ratio * min(T_max, P / max(w ratio, 1))`` [N m] over the axle speed ``w``
+    [rad/s] (the bench's engine, :func:`clutchlab.emtc.system.bench_loads`): flat up to the power corner, then
+    ``points`` points of the hyperbola up to 20 times the corner speed (linear between them)."""
+    tmax, power = float(vehicle.engine_torque_max), float(vehicle.engine_power)
+    corner = max(power / tmax, 1.0) / ratio
+    hyper = np.geomspace(corner, 20.0 * corner, points)
+    speeds = np.concatenate([[0.0], hyper])
+    torques = ratio * np.minimum(tmax, power / np.maximum(speeds * ratio, 1.0))
+    return speeds, torques
+
+
+def rolling_curve(scale, load, width: float = 0.5):
+    """Rolling resistance ``scale tanh(w / width) + load`` [N m] as rows ``[w_rad_s, N m]`` (the bench's,
+    :func:`clutchlab.emtc.system.bench_loads`): 81 points up to ``4 width``, then to ``40 width``, where the
+    tanh is 1 to machine precision."""
+    w = np.concatenate([np.linspace(0.0, 4.0 * width, 81), width * np.array([5.0, 6.0, 8.0, 10.0, 20.0, 40.0])])
+    return np.column_stack([w, scale * np.tanh(w / width) + load])
