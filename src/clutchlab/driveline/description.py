@@ -30,7 +30,9 @@ Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, 
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
 ``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio, efficiency), ``torque`` (flange, torque,
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
-peak, cgeo, normal), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support), ``bearing_friction``
+peak, cgeo, normal; or mu_map = a friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
+temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support; mu_map, radius, temperature),
+``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b), ``eclutch`` (a, b, position [m], model
 0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak; actuator = true: the
 position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
@@ -78,9 +80,11 @@ FIELDS = {
     "speed": {"flange": (None, True), "speed": ("rad/s", True)},
     "position": {"flange": (None, True), "position": ("rad", True)},
     "clutch": {"a": (None, True), "b": (None, True), "fn_max": ("N", True), "mu": ("1", False),
-               "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False)},
+               "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False), "mu_map": ("path", False),
+               "radius": ("m", False), "temperature": ("degC", False)},
     "brake": {"flange": (None, True), "fn_max": ("N", True), "mu": ("1", False), "peak": ("1", False),
-              "cgeo": ("1", False), "normal": ("1", False), "support": (None, False)},
+              "cgeo": ("1", False), "normal": ("1", False), "support": (None, False), "mu_map": ("path", False),
+              "radius": ("m", False), "temperature": ("degC", False)},
     "bearing_friction": {"flange": (None, True), "torque": ("N*m", False), "peak": ("1", False),
                          "support": (None, False)},
     "one_way_clutch": {"a": (None, True), "b": (None, True)},
@@ -247,6 +251,12 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
             path = args["friction"]
             args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
                                 else ParametricFriction.from_toml(path))
+    elif kind in ("clutch", "brake") and "mu_map" in args:
+        from ..wet.friction import FrictionMap
+
+        if "mu" in args:
+            raise ParameterError("give mu or mu_map, not both")
+        args["mu"] = FrictionMap.from_json(args.pop("mu_map"))
     elif kind == "emtc":
         from ..hysteresis import Preisach
 

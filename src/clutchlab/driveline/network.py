@@ -576,22 +576,65 @@ class Driveline:
         return tuple(arr[:, 0]) + tuple(arr[:, 1])
 
     def clutch(self, name: str, a, b, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
-               normal=1.0) -> "Driveline":
+               normal=1.0, radius: float | None = None, temperature: float | None = None) -> "Driveline":
         """A clutch between flanges a and b (MSL ``Clutch``): sliding torque ``cgeo fn mu(|w_rel|)``,
         ``fn = fn_max * normal(t)`` [N] (free when ``<= 0``), static limit ``peak`` times the sliding
-        torque at rest.  ``mu``: a number or a table ``[[w_rad_s, mu], ...]``."""
+        torque at rest.  ``mu``: a number, a table ``[[w_rad_s, mu], ...]``, or a friction map
+        ``mu(v, T)`` identified by :mod:`clutchlab.wet` (:class:`clutchlab.wet.friction.FrictionMap`) read
+        at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
+        [degC] (both required with a map, refused without one; :meth:`_map_characteristic`)."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
-                              normal)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak, fn_max,
+                              cgeo, normal)
 
     def brake(self, name: str, flange, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
-              normal=1.0, support=None) -> "Driveline":
+              normal=1.0, support=None, radius: float | None = None,
+              temperature: float | None = None) -> "Driveline":
         """A brake between ``flange`` and ``support`` (default the ground), as :meth:`clutch` (MSL ``Brake``)."""
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
-                              normal)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak, fn_max,
+                              cgeo, normal)
+
+    @classmethod
+    def _mu(cls, name, mu, radius, temperature):
+        """A clutch's or brake's friction characteristic: a number or table, or a map with its radius and
+        temperature."""
+        from ..wet.friction import FrictionMap
+
+        if isinstance(mu, FrictionMap):
+            return cls._map_characteristic(name, mu, radius, temperature)
+        for what, value in (("radius", radius), ("temperature", temperature)):
+            if value is not None:
+                raise ParameterError(f"{name}: {what} = {value!r} is for a friction map mu(v, T); mu is "
+                                     f"{type(mu).__name__}")
+        return cls._characteristic(name, "mu", mu)
+
+    @staticmethod
+    def _map_characteristic(name, fmap, radius, temperature):
+        """The characteristic ``mu(|w|)`` of a friction map ``mu(v, T)`` (:class:`clutchlab.wet.friction.FrictionMap`,
+        bilinear, constant beyond its grids) at ``v = radius |w|`` and a constant ``temperature`` [degC]: its
+        speed nodes divided by ``radius`` [m], the map's value there at that temperature, held at the first
+        node's value down to ``w = 0`` and beyond the last node (exact: at a fixed temperature the map is
+        piecewise linear in ``v`` between its nodes).  A map over the pressing force too (3-D) is refused."""
+        if radius is None or temperature is None:
+            raise ParameterError(f"{name}: a friction map mu(v, T) needs radius [m] (v = radius |w_rel|) and "
+                                 "temperature [degC]")
+        radius = _finite(name, "radius", radius, positive=True)
+        temperature = _finite(name, "temperature", temperature)
+        if fmap.force_grid is not None:
+            raise ParameterError(f"{name}: the friction map depends on the pressing force too "
+                                 f"({fmap.force_grid.size} forces); a clutch takes a map mu(v, T) (the wet clutch "
+                                 "element takes any)")
+        v = np.asarray(fmap.speed_grid, dtype=float)
+        values = np.asarray(fmap.mu(v, np.full(v.shape, temperature)), dtype=float)
+        w = v / radius
+        if w[0] > 0.0:
+            w, values = np.concatenate([[0.0], w]), np.concatenate([[values[0]], values])
+        w = np.concatenate([w, [w[-1] + max(w[-1], 1.0)]])   # the last two equal: held beyond the grid
+        values = np.concatenate([values, [values[-1]]])
+        return tuple(float(q) for q in w) + tuple(float(q) for q in values)
 
     def bearing_friction(self, name: str, flange, torque=1.0, peak: float = 1.0, support=None) -> "Driveline":
         """Bearing friction of ``flange`` against ``support`` (default the ground; MSL ``BearingFriction``):
