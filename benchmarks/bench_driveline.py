@@ -29,6 +29,9 @@ once when the element is built, :meth:`Driveline.eclutch`) -- the run of a built
 new pedal profile costs both.  No SciPy row: the launch has no independent implementation here (the
 network's equations are checked against SciPy on CoupledClutches above and against closed forms in
 ``tests/driveline``).  ``--launch`` runs only this part.
+
+``--emtc`` runs only the EMTC drum bench as a network (``examples/driveline_emtc_awd.toml``) against the
+EMTC package's own model of the same bench (:func:`emtc`).
 """
 
 from __future__ import annotations
@@ -154,7 +157,49 @@ def launch(quick: bool = False):
           f"{med * 1e3:.2f} ms ({min(times) * 1e3:.2f}-{max(times) * 1e3:.2f})")
 
 
+def emtc(quick: bool = False):
+    """The EMTC in the AWD vehicle on the drum bench (``examples/driveline_emtc_awd.toml``, 1.5 s) as a network,
+    against the EMTC package's own drum-bench model of the same scenario: run time and error (worst final shaft
+    speed [rad/s]) against that model at rtol 1e-11 with tight absolute tolerances.  A system holds the
+    coupling's memories (magnet, controller), so each timed run gets a system built beforehand (its build is
+    timed apart)."""
+    from clutchlab.emtc import system as S
+    from clutchlab.emtc.bench import load_scenario
+
+    spec = load_driveline(ROOT / "examples" / "driveline_emtc_awd.toml")
+    bench = load_scenario(ROOT / "examples" / "emtc_scenario.toml")
+    sc, veh, t_end = bench["scenario"], bench["vehicle"], spec.t_end
+    print(f"EMTC AWD vehicle on the drum bench, {t_end} s; {platform.processor() or platform.machine()}, "
+          f"Python {platform.python_version()}")
+    tight = S.simulate(sc, vehicle=veh, rtol=1e-11, atol=S.ATOL * 1e-10, output_step=t_end).to_dataframe()
+    ref = (tight["omega_f_rad_s"].iloc[-1], tight["omega_r_rad_s"].iloc[-1])
+    repeat = 5 if quick else 21
+    for label, build, names in (
+            ("network", lambda rtol: spec.driveline.system(rtol), ("front_shaft.w", "rear_shaft.w")),
+            ("EMTC bench model", lambda rtol: S.bench_system(None, sc, veh), ("omega_f", "omega_r"))):
+        print(f"clutchlab {label} (compiled core)")
+        for rtol in ((1e-6, 1e-8) if quick else (1e-6, 1e-7, 1e-8)):
+            kw = dict(rtol=rtol, sample_times=[t_end])
+            if label != "network":
+                kw["atol"] = S.ATOL * rtol * 10   # its default absolute tolerances would cap its accuracy
+            simulate(build(rtol), t_end, **kw)
+            builds, systems = _timed(lambda: [build(rtol) for _ in range(repeat)], 1)
+            times = []
+            for system in systems:
+                t0 = time.perf_counter()
+                res = simulate(system, t_end, **kw)
+                times.append(time.perf_counter() - t0)
+            err = max(abs(res.states[-1, system.state_index(n)] - r) for n, r in zip(names, ref))
+            med = statistics.median(times)
+            print(f"  {res.stats['accepted_steps']:5d} steps          rtol {rtol:7.0e}   error {err:8.1e}   "
+                  f"{med * 1e3:9.3f} ms ({min(times) * 1e3:.3f}-{max(times) * 1e3:.3f})   "
+                  f"{t_end / med:9.0f}x real time   (build {builds[0] / repeat * 1e3:.2f} ms)")
+
+
 if __name__ == "__main__":
+    if "--emtc" in sys.argv:
+        emtc(quick="--quick" in sys.argv)
+        sys.exit(0)
     if "--launch" not in sys.argv:
         main(quick="--quick" in sys.argv)
     launch(quick="--quick" in sys.argv)

@@ -1176,7 +1176,9 @@ class Driveline:
         :class:`~clutchlab.driveline.wet.WetDrivelineParams` and its states, outputs, switching functions,
         modes and events follow the network's (named ``<clutch>.<quantity>``); with an EMTC coupling
         (:meth:`emtc`), a :class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`, the same way (a full
-        hysteresis memory of its magnet is a model error naming the coupling)."""
+        hysteresis memory of its magnet is a model error naming the coupling).  That system holds the
+        coupling's memories (magnet, controller) as the EMTC bench's does: one run per system
+        (:meth:`simulate` builds one per call)."""
         p = self.pack()
         x0 = self.initial_state()
         states, outputs = self.variables()
