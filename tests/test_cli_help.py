@@ -53,3 +53,66 @@ def test_help_output_names_the_page(capsys, argv, page):
         main(argv)
     assert exc.value.code == 0
     assert page in capsys.readouterr().out
+
+
+def test_the_top_level_lines_are_the_commands_own():
+    """``clutchlab --help`` lists each subsystem command with a line of its own (its module is not imported);
+    that line is the one the command's module registers."""
+    from clutchlab.cli import COMMANDS
+
+    full = {a.dest: a.help for action in build_parser()._actions if isinstance(action, argparse._SubParsersAction)
+            for a in action._choices_actions}
+    light = {a.dest: a.help for action in build_parser("")._actions
+             if isinstance(action, argparse._SubParsersAction) for a in action._choices_actions}
+    assert list(full) == list(light)
+    assert full == light
+    assert set(COMMANDS) == set(full) - {"demo", "warmup"}
+
+
+HEAVY = ("numba", "pandas", "scipy", "matplotlib", "pyarrow", "clutchlab.eclutch", "clutchlab.wet", "clutchlab.emtc",
+         "clutchlab.driveline", "clutchlab.numerics", "clutchlab.curves", "clutchlab.system")
+
+
+def test_top_level_help_imports_no_model():
+    """``clutchlab --help`` (and ``--version``) import no model, numba, pandas or SciPy: the CLI starts in the time
+    of Python's own start (benchmarks/README.md); a command imports only its own subsystem."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom clutchlab.cli import main\n"
+            "try:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+            "print('MODULES', ' '.join(sorted(sys.modules)), file=sys.stderr)\n")
+    for args in (["--help"], ["--version"], ["driveline", "--help"]):
+        out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=120)
+        mods = out.stderr.split("MODULES", 1)[1].split()
+        loaded = {h for h in HEAVY if any(m == h or m.startswith(h + ".") for m in mods)}
+        if args[0] == "driveline":
+            assert "clutchlab.driveline" in loaded and not loaded & {"clutchlab.eclutch", "clutchlab.wet"}, loaded
+        else:
+            assert not loaded, (args, loaded)
+            assert "usage: clutchlab" in out.stdout or "clutchlab 0" in out.stdout
+
+
+def _compiling_packages():
+    """The top-level modules and packages of clutchlab whose source defines compiled functions."""
+    root = pathlib.Path(__file__).parents[1] / "src" / "clutchlab"
+    marks = ("njit", "numba.jit", "@overload", "@intrinsic")
+    found = set()
+    for path in root.rglob("*.py"):
+        if any(m in path.read_text(encoding="utf-8") for m in marks):
+            rel = path.relative_to(root)
+            found.add("clutchlab." + (rel.parts[0] if len(rel.parts) > 1 else rel.stem))
+    return sorted(found)
+
+
+@pytest.mark.parametrize("package", _compiling_packages())
+def test_every_compiling_package_installs_the_compile_notice(package):
+    """The one-line compile notice is installed by clutchlab.numerics, not at ``import clutchlab``: each package
+    with compiled functions imports it, so the notice is in place before its first compilation."""
+    import subprocess
+    import sys
+
+    code = (f"import importlib, sys\nimportlib.import_module({package!r})\n"
+            "from clutchlab import _compile_notice\nprint(_compile_notice._state['installed'])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.stdout.strip() == "True", out.stderr

@@ -14,24 +14,24 @@ Public API (curated):
 __version__ = "0.1.0"
 
 from .errors import ClutchlabError, DataError, IdentificationError, ParameterError, SimulationError  # noqa: E402
-from .curves import Curve  # noqa: E402
-from . import curves  # noqa: E402
-from . import _compile_notice  # noqa: E402
 
-_compile_notice.install()  # one stderr line when kernels are compiled (never at import)
-
+# numba is imported by the first module that compiles (clutchlab.numerics installs the one-line compile notice
+# then), not here: `clutchlab --help` imports neither numba nor a model (tests/test_cli_help.py)
 
 
 def __getattr__(name):
-    # imported on first use: the result type needs pandas, which `clutchlab --help` should not pay for
+    # imported on first use: the curves need numba and the result type pandas, which `clutchlab --help` should
+    # not pay for
+    import importlib
+
     if name == "SimulationResult":
         from .result import SimulationResult
 
         return SimulationResult
-    if name == "system":
-        import importlib
-
-        return importlib.import_module(".system", __name__)
+    if name == "Curve":
+        return importlib.import_module(".curves", __name__).Curve
+    if name in ("system", "curves"):
+        return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module 'clutchlab' has no attribute {name!r}")
 
 

@@ -21,18 +21,28 @@ import time
 from . import __version__
 from .errors import ClutchlabError, ParameterError
 
-#: modules that contribute a sub-command (``register(subparsers)``)
-SUBSYSTEM_CLIS = (
-    "clutchlab.eclutch.cli",
-    "clutchlab.wet.cli",
-    "clutchlab.emtc.cli",
-    "clutchlab.driveline.cli",  # clutchlab driveline simulate|describe
-    "clutchlab.params.cli",  # clutchlab params show|check
-    "clutchlab.fmu.cli",  # clutchlab export-fmu
-    "clutchlab.sweep.cli",  # clutchlab sweep
-    "clutchlab.report.cli",  # clutchlab report RUN_DIR
-    "clutchlab.io.cli",  # clutchlab convert (measurement files)
-)
+#: the sub-commands of the subsystems: command -> (module that registers it with ``register(subparsers)``, the
+#: one line ``clutchlab --help`` lists).  A command's parser is built only when that command runs (its module
+#: imports its models), so ``clutchlab --help`` imports none (tests/test_cli_help.py: the lines equal the
+#: modules' own).
+COMMANDS = {
+    "eclutch": ("clutchlab.eclutch.cli", "dry clutch-by-wire (E-clutch): press-rig characterisation, Models 0-4"),
+    "wet": ("clutchlab.wet.cli", "wet multi-plate clutch: virtual bench and friction/thermal identification"),
+    "emtc": ("clutchlab.emtc.cli", "electromagnetic torque-controlled coupling (Processes 2019)"),
+    "driveline": ("clutchlab.driveline.cli",
+                  "driveline networks: inertias, springs, sources and clutches with exact stick/slip"),
+    "params": ("clutchlab.params.cli", "show the parameter sets of a model, write or check parameter files"),
+    "export-fmu": ("clutchlab.fmu.cli", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs "
+                                        "pythonfmu; runs with clutchlab installed)"),
+    "sweep": ("clutchlab.sweep.cli", "grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores "
+                                     "or Dask)"),
+    "report": ("clutchlab.report.cli", "write a self-contained HTML report (figures, metrics, parameters, "
+                                       "provenance) of a results folder"),
+    "convert": ("clutchlab.io.cli", "convert a measurement file (CSV, Parquet, MDF 4) to clutchlab names and SI "
+                                    "units"),
+}
+#: modules that contribute a sub-command (``register(subparsers)``), in the order of ``clutchlab --help``
+SUBSYSTEM_CLIS = tuple(dict.fromkeys(module for module, _ in COMMANDS.values()))
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
 DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo", "clutchlab.driveline.demo")
 #: longest error line the CLI prints [characters]; longer messages lose their middle (file names stay whole
@@ -108,8 +118,13 @@ def _warmup(args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Return the argument parser with every available sub-command."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """Return the argument parser.
+
+    ``command``: None, every sub-command's whole parser (every subsystem imported); the name of a subsystem's
+    command (:data:`COMMANDS`), that command's whole parser and one line for each other; ``""``, one line for
+    each (what ``clutchlab --help`` shows, importing no model).
+    """
     parser = argparse.ArgumentParser(
         prog="clutchlab",
         description="Model, simulate and identify automotive clutches (E-clutch, wet multi-plate, EMTC).",
@@ -134,10 +149,15 @@ def build_parser() -> argparse.ArgumentParser:
     warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc, driveline (default: all)")
     warm.add_argument("-j", "--jobs", type=int, default=None, help="processes (default: the number of cores)")
     warm.set_defaults(func=_warmup)
-    for name in SUBSYSTEM_CLIS:
-        mod = _optional_module(name)
-        if mod is not None:
-            mod.register(sub)
+    registered = set()
+    for cmd, (name, summary) in COMMANDS.items():
+        if command is not None and cmd != command:
+            sub.add_parser(cmd, help=summary)   # its whole parser when it is the command given
+        elif name not in registered:
+            registered.add(name)
+            mod = _optional_module(name)
+            if mod is not None:
+                mod.register(sub)
     return parser
 
 
@@ -182,7 +202,10 @@ def error_message(exc: BaseException) -> str:
 
 def main(argv=None) -> int:
     """Entry point of the ``clutchlab`` command."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    # the command is the first word that is not an option (the top level takes no option with a value)
+    command = next((a for a in argv if not a.startswith("-")), "")
+    parser = build_parser(command if command in COMMANDS else "")
     args = parser.parse_args(argv)
     if not hasattr(args, "func"):
         parser.print_help()

@@ -9,8 +9,13 @@ step controller, dense output (cubic Hermite and its order-4 term) and the
 first step; a grid bracketing helper.
 """
 
-from .dopri import dense_correction, dense_hermite, error_norm, initial_step, next_step
-from .interp import bracket
+from .. import _compile_notice
+
+_compile_notice.install()  # one stderr line when kernels are compiled (never at import); every compiled module
+# imports this package (its interpolation and step helpers), so the notice is in place before any compilation
+
+from .dopri import dense_correction, dense_hermite, error_norm, initial_step, next_step  # noqa: E402
+from .interp import bracket  # noqa: E402
 
 __all__ = ["error_norm", "next_step", "dense_hermite", "dense_correction", "initial_step", "bracket", "FASTMATH"]
 
