@@ -587,8 +587,9 @@ def _layout(n, nk, ne):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | flange a, ca, flange b, cb, force factor of each member (5 nk) | accelerations (n) | element torques (ne) |
-    slack of each friction element's stick function (nf, :func:`settle`) | sliding torque and static limit of
-    each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored energy (1)."""
+    slack of each friction element's stick function (nf, :func:`settle`) | sliding torque, static limit and
+    lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored
+    energy (1)."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
