@@ -461,3 +461,33 @@ def test_characterized_curve_validates_its_statistics():
     np.testing.assert_array_equal(plain.cycle_scatter, [0.0, 0.0])
     with pytest.raises(ValueError):
         plain.hysteresis_half_width[0] = 1.0   # read-only, like the samples
+
+
+def test_yoke_support_is_computed_once_per_content():
+    """Building model variants reuses the series sum: the same curves (by content: the bundled curves are read
+    anew by every preset) give the same object, other contents or arguments a new result, and a result from
+    memory equals a fresh computation."""
+    import importlib
+
+    ch = importlib.import_module("clutchlab.eclutch.characterize")   # (the package exports a function of that name)
+    ring = Curve.linear(5e7, span=(0.0, 40e-6))
+    spring = Curve.linear(4e6, span=(0.0, 0.5e-3))
+    first = yoke_support_equivalent(ring, spring, max_force_N=12e3)
+    again = yoke_support_equivalent(Curve.linear(5e7, span=(0.0, 40e-6)), Curve.linear(4e6, span=(0.0, 0.5e-3)),
+                                    max_force_N=12e3)
+    assert again is first
+    fresh = ch._yoke_support_equivalent(ring, spring, 12e3, 0.2, "yoke support (eq.)")
+    np.testing.assert_array_equal(fresh.deflection, first.deflection)
+    np.testing.assert_array_equal(fresh.force, first.force)
+    stiffer = yoke_support_equivalent(ring.scale(2.0), spring, max_force_N=12e3)
+    assert stiffer is not first and stiffer.inverse(5e3) < first.inverse(5e3)
+    higher = yoke_support_equivalent(ring, spring, max_force_N=20e3)
+    assert higher.force[-1] == pytest.approx(20e3) and first.force[-1] == pytest.approx(12e3)
+    # Model 4 variants of the bundled curves: one series sum for all
+    from clutchlab.eclutch import ClutchModel, EClutchParameters
+
+    ch._SUPPORT_EQUIVALENTS.clear()
+    a = ClutchModel.preset(4, EClutchParameters(lever_ratio=-4.0))
+    b = ClutchModel.preset(4, EClutchParameters(lever_ratio=-3.9))
+    assert len(ch._SUPPORT_EQUIVALENTS) == 1
+    assert a.network.element("support").curve is b.network.element("support").curve

@@ -778,9 +778,35 @@ def yoke_support_equivalent(ring: Curve, spring: Curve, *, max_force_N: float | 
     for label, c in (("ring", ring), ("spring", spring)):
         if not isinstance(c, Curve):
             raise ParameterError(f"{label} must be a clutchlab.Curve, got {type(c).__name__}")
-        parts.append(_increasing(c, label))
     if not (0.0 < end_fraction <= 1.0):
         raise ParameterError(f"end_fraction = {end_fraction!r} must be in (0, 1]")
+    # the series sum does not depend on a model variant's scalars: building many variants (Monte Carlo, a
+    # sweep) computes it once.  Keyed on the curves' contents (curves are immutable; the bundled ones are read
+    # anew by every preset) and the arguments
+    key = (_curve_key(ring), _curve_key(spring), None if max_force_N is None else float(max_force_N),
+           float(end_fraction), str(name))
+    cached = _SUPPORT_EQUIVALENTS.get(key)
+    if cached is not None:
+        return cached
+    out = _yoke_support_equivalent(ring, spring, max_force_N, end_fraction, name)
+    if len(_SUPPORT_EQUIVALENTS) >= 16:
+        _SUPPORT_EQUIVALENTS.pop(next(iter(_SUPPORT_EQUIVALENTS)))
+    _SUPPORT_EQUIVALENTS[key] = out
+    return out
+
+
+#: (ring, spring, max_force_N, end_fraction, name) -> the equivalent curve (:func:`yoke_support_equivalent`)
+_SUPPORT_EQUIVALENTS: dict = {}
+
+
+def _curve_key(c: Curve) -> tuple:
+    """What a curve's behaviour depends on, as a hashable key (its samples, interpolation, extrapolation)."""
+    return (c.deflection.tobytes(), c.force.tobytes(), c.kind, c.extrapolation)
+
+
+def _yoke_support_equivalent(ring, spring, max_force_N, end_fraction, name):
+    """:func:`yoke_support_equivalent` without its memory of earlier requests."""
+    parts = [_increasing(c, label) for label, c in (("ring", ring), ("spring", spring))]
     eq = series(*parts, name=name)  # [1], Section 5.3: springs in series
     if max_force_N is None:
         return eq
