@@ -209,6 +209,11 @@ def test_describe_and_outputs():
 
 
 def test_refusals(tmp_path):
+    t = Driveline("t", domain="translational")
+    t.mass("a", m=1.0)
+    t.mass("b", m=1.0)
+    with pytest.raises(ParameterError, match="rotational driveline"):
+        t.emtc("c", "a", "b")
     d = Driveline("x")
     d.inertia("a", J=1.0)
     d.inertia("b", J=1.0)

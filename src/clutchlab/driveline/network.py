@@ -810,6 +810,8 @@ class Driveline:
         from ..emtc.system import BenchOptions
         from ..hysteresis import Preisach
 
+        if self.domain != "rotational":
+            raise ParameterError(f"{name}: an EMTC coupling turns: it belongs to a rotational driveline")
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         for what, value, cls, label in (("magnet", magnet, (Preisach, type(None)), "Preisach"),
