@@ -156,3 +156,26 @@ def test_network_errors_show_numpy_scalars_as_plain_numbers(build, shown):
     msg = str(info.value)
     assert shown in msg
     assert "np." not in msg and "float64" not in msg and "float32" not in msg
+
+
+def test_the_zeroing_shortcut_equals_a_rebuilt_network():
+    """The zeroing's root search moves one pre-strain without assembling the network again: the shortcut's
+    arrays equal those of the network rebuilt with that pre-strain bit for bit (so the zeroed models are
+    unchanged), on Model 4 with its lever, pivot and unilateral contacts."""
+    import dataclasses
+
+    from clutchlab.eclutch import ClutchModel
+
+    net = ClutchModel.preset(4).network
+    for name in ("bearing", "diaphragm"):
+        el = net.element(name)
+        for p in (-1.3e-3, 0.0, el.prestrain, 2.7e-3):
+            fast = net._with_prestrain(name, p)
+            slow = net.replace_element(name, dataclasses.replace(el, prestrain=p))
+            for a, b in zip(fast.kernel_data(), slow.kernel_data(), strict=True):
+                np.testing.assert_array_equal(a, b)
+            assert fast.elements == slow.elements
+            u = np.array([0.0, 2e-3])
+            np.testing.assert_array_equal(solve_static(fast, u)["input_force"], solve_static(slow, u)["input_force"])
+    with pytest.raises(ParameterError, match="not a spring"):
+        net._with_prestrain("lever", 0.0)

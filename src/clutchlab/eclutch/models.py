@@ -250,9 +250,20 @@ class ComponentCurves:
 
     @classmethod
     def bundled(cls) -> "ComponentCurves":
-        """The characterised curves shipped with clutchlab (synthetic, from the virtual press rig)."""
+        """The characterised curves shipped with clutchlab (synthetic, from the virtual press rig).
+
+        Read once per process (the curves are immutable): every preset and variant shares them."""
+        if cls is ComponentCurves and _BUNDLED:
+            return _BUNDLED[0]
         with resources.as_file(resources.files("clutchlab.eclutch") / "data" / "curves") as folder:
-            return cls.from_folder(folder)
+            out = cls.from_folder(folder)
+        if cls is ComponentCurves:
+            _BUNDLED.append(out)
+        return out
+
+
+#: the bundled component curves, once read (:meth:`ComponentCurves.bundled`)
+_BUNDLED: list = []
 
 
 def _curves_from_table(spec, path: Path) -> ComponentCurves:

@@ -35,6 +35,7 @@ References
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numba
@@ -284,6 +285,27 @@ class AxialNetwork:
         return AxialNetwork(self.nodes + tuple(nodes), elements, input=self.input, normal_force=self.normal_force,
                             name=name or self.name)
 
+    def _with_prestrain(self, name: str, prestrain: float) -> "AxialNetwork":
+        """A copy with spring ``name``'s pre-strain set to ``prestrain`` [m], its assembly reused: the
+        topology, the curves and every check are unchanged, only the spring's rest deflection ``d0`` moves
+        (computed as :meth:`_assemble` does, so the copy equals ``replace_element`` bit for bit).  For the
+        zeroing's root search, which changes one pre-strain dozens of times per model."""
+        old = self.element(name)
+        if not isinstance(old, Spring):
+            raise ParameterError(f"network {self.name!r}: {name!r} is not a spring")
+        a = dict(self._assembly)
+        k = a["element_names"].index(name)
+        d0 = a["d0"].copy()
+        d0[k] = float(prestrain) + a["Gc"][k]
+        a["d0"] = d0
+        net = object.__new__(AxialNetwork)
+        for f in ("nodes", "input", "normal_force", "name"):
+            object.__setattr__(net, f, getattr(self, f))
+        object.__setattr__(net, "elements", tuple(dataclasses.replace(e, prestrain=float(prestrain))
+                                                  if e.name == name else e for e in self.elements))
+        object.__setattr__(net, "_assembly", a)
+        return net
+
     def replace_element(self, name: str, new) -> "AxialNetwork":
         """Return a copy with element ``name`` replaced by ``new`` (``None`` removes it)."""
         return self.modified(replace={name: new})
@@ -355,7 +377,8 @@ class AxialNetwork:
         extraps = np.array([cv.kernel_data()[4] for cv in curves], dtype=np.int64)
         return dict(
             node_names=names, element_names=[e.name for e, _ in elastic], A=A, b=b, c=c, G=G,
-            GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), d0=np.ascontiguousarray(np.array(prestrain) + G @ c),
+            GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), Gc=G @ c,
+            d0=np.ascontiguousarray(np.array(prestrain) + G @ c),
             cx=cx, cf=cf, cd=cd, offsets=offsets, kinds=kinds, extraps=extraps,
             scale=np.array(scale), unilateral=np.array(unilateral, dtype=np.bool_),
         )
@@ -670,7 +693,7 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
         raise ParameterError(f"zero_input: force = {short_repr(force)} N must be finite and >= 0")
 
     def residual(p):
-        net = network.replace_element(element, _replace_spring(el, prestrain=p))
+        net = network._with_prestrain(element, p)
         try:
             return float(solve_static(net, np.array([0.0]))["input_force"][0]) - force
         except SimulationError:
