@@ -66,8 +66,16 @@ OUTPUTS = tuple(o for o in S.OUTPUTS if o[0] in ("airgap", "magnet_force", "fn1"
                                                  "current_command", "torque_reference", "throttle",
                                                  "command_feasible"))
 OUTPUT_INDEX = np.array([[o[0] for o in S.OUTPUTS].index(q[0]) for q in OUTPUTS], dtype=np.int64)
-_ARM, _CPL, _DIR = 0, 1, 2
-_SLIP_ZERO, _UNLOCK = 4, 5   # the bench's switching functions the network takes over
+# what the network reads of the coupling: its published outputs, modes and switching functions (by name)
+_Y_TC = [o[0] for o in S.OUTPUTS].index("coupling_torque")
+_Y_CAP = [o[0] for o in S.OUTPUTS].index("capacity_locked")
+_ARM, _CPL, _DIR = (S.MODE_NAMES.index(q) for q in ("armature_mode", "coupling_mode", "slip_direction"))
+_CONTACT = S.MODE_VALUES[_ARM].index("contact")
+_OPEN, _SLIPPING = (S.MODE_VALUES[_CPL].index(q) for q in ("open", "slipping"))
+_NEGATIVE, _POSITIVE = (S.MODE_VALUES[_DIR].index(q) for q in ("negative", "positive"))
+_REST = S.MODE_VALUES[_ARM].index("rest")
+# the bench's switching functions the network takes over
+_SLIP_ZERO, _UNLOCK = ([q[0] for q in S.SWITCHING].index(q) for q in ("slip_speed_zero", "lock_capacity_exceeded"))
 
 
 class EmtcDrivelineParams(NamedTuple):
@@ -101,22 +109,24 @@ def _load(x, m, p):
     b[B_X + 2] = 0.0
     ms = p.mbuf
     ms[_ARM] = m[cf[F_M] + _ARM]
-    ms[_CPL] = S.SLIPPING if ms[_ARM] == S.ARM_CONTACT else S.OPEN
-    ms[_DIR] = S.NEGATIVE if m[cf[F_K]] == K.FORWARD else S.POSITIVE
+    ms[_CPL] = _SLIPPING if ms[_ARM] == _CONTACT else _OPEN
+    ms[_DIR] = _NEGATIVE if m[cf[F_K]] == K.FORWARD else _POSITIVE
 
 
 @numba.njit(cache=True, nogil=True)
 def _coupling(t, x, m, p):
-    """Evaluate the coupling at the network's state (:func:`_load`): its derivative and switching values into
-    ``p.buf``, its sliding torque and static limit into the network (:func:`kernel.set_external`)."""
+    """Evaluate the coupling at the network's state (:func:`_load`) through its hooks: its derivative,
+    switching values and outputs into ``p.buf``, its sliding torque (its output ``coupling_torque``) and
+    static and lock-up limits (from ``capacity_locked``) into the network (:func:`kernel.set_external`)."""
     _load(x, m, p)
     b = p.buf
-    dispatch.rhs(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, b[B_DX:B_DX + N_STATE],
-                 b[B_G:B_G + N_SWITCH])
-    aux = p.emtc.fmem[S.FM_AUX:S.FM_AUX + S.N_AUX]
+    xs = b[B_X:B_X + N_STATE]
+    us = b[B_U:B_U + N_IN]
+    dispatch.rhs(t, xs, us, p.mbuf, p.emtc, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    dispatch.outputs(t, xs, us, p.mbuf, p.emtc, b[B_Y:N_BUF])   # (the same point: the model reuses it)
     net = p.net
-    cap = aux[S.AUX_CAP] if p.mbuf[_ARM] == S.ARM_CONTACT else 0.0
-    K.set_external(net, net.elem[p.conf[F_ROW]][K.E_AUX], abs(aux[S.AUX_TC]), p.emtc.coupling.unlock_margin * cap,
+    cap = b[B_Y + _Y_CAP] if p.mbuf[_ARM] == _CONTACT else 0.0
+    K.set_external(net, net.elem[p.conf[F_ROW]][K.E_AUX], abs(b[B_Y + _Y_TC]), p.emtc.coupling.unlock_margin * cap,
                    cap)
 
 
@@ -149,7 +159,6 @@ def emtc_driveline_outputs(t, x, u, m, p, y):
     _coupling(t, x, m, p)
     K.driveline_outputs(t, x, u, m, p.net, y)
     b = p.buf
-    dispatch.outputs(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, b[B_Y:N_BUF])
     q = y.shape[0] - p.index.shape[0]
     for i in range(p.index.shape[0]):
         y[q + i] = b[B_Y + p.index[i]]

@@ -1293,7 +1293,7 @@ class Driveline:
         conf = np.array([k, r, x0.size, ng, m0.size, len(K.EVENTS), nel], dtype=np.int64)
         params = DE.EmtcDrivelineParams(p, ep, conf, np.zeros(DE.N_BUF), np.zeros(DE.N_MODE, dtype=np.int64),
                                         DE.OUTPUT_INDEX.copy())
-        me = np.array([S.ARM_REST, S.OPEN, S.POSITIVE], dtype=np.int64)
+        me = np.array([DE._REST, DE._OPEN, DE._POSITIVE], dtype=np.int64)   # armature at rest, open
         # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
         ae = S.ATOL * (float(rtol) / 1e-6)
         ae[:3] = float(rtol)
