@@ -35,7 +35,6 @@ References
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 
 import numba
@@ -301,7 +300,7 @@ class AxialNetwork:
         net = object.__new__(AxialNetwork)
         for f in ("nodes", "input", "normal_force", "name"):
             object.__setattr__(net, f, getattr(self, f))
-        object.__setattr__(net, "elements", tuple(dataclasses.replace(e, prestrain=float(prestrain))
+        object.__setattr__(net, "elements", tuple(_replace_spring(e, prestrain=float(prestrain))
                                                   if e.name == name else e for e in self.elements))
         object.__setattr__(net, "_assembly", a)
         return net
@@ -367,6 +366,7 @@ class AxialNetwork:
                 curves.append(e.curve()), prestrain.append(e.prestrain), scale.append(1.0), unilateral.append(False)
             else:
                 curves.append(e.curve), prestrain.append(e.prestrain), scale.append(e.scale), unilateral.append(e.unilateral)
+        Gc = G @ c
         offsets = np.zeros(len(curves) + 1, dtype=np.int64)
         for k, cv in enumerate(curves):
             offsets[k + 1] = offsets[k] + cv.deflection.size
@@ -377,8 +377,8 @@ class AxialNetwork:
         extraps = np.array([cv.kernel_data()[4] for cv in curves], dtype=np.int64)
         return dict(
             node_names=names, element_names=[e.name for e, _ in elastic], A=A, b=b, c=c, G=G,
-            GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), Gc=G @ c,
-            d0=np.ascontiguousarray(np.array(prestrain) + G @ c),
+            GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), Gc=Gc,
+            d0=np.ascontiguousarray(np.array(prestrain) + Gc),
             cx=cx, cf=cf, cd=cd, offsets=offsets, kinds=kinds, extraps=extraps,
             scale=np.array(scale), unilateral=np.array(unilateral, dtype=np.bool_),
         )
