@@ -31,6 +31,8 @@ COMMANDS = {
     "emtc": ("clutchlab.emtc.cli", "electromagnetic torque-controlled coupling (Processes 2019)"),
     "driveline": ("clutchlab.driveline.cli",
                   "driveline networks: inertias, springs, sources and clutches with exact stick/slip"),
+    "control": ("clutchlab.control.cli", "operating points, linear models and Bode diagrams of any model "
+                                         "(python-control)"),
     "params": ("clutchlab.params.cli", "show the parameter sets of a model, write or check parameter files"),
     "export-fmu": ("clutchlab.fmu.cli", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs "
                                         "pythonfmu; runs with clutchlab installed)"),

@@ -133,6 +133,10 @@ class System:
         ``element_name(event_code, element_index) -> str``: which element an event concerns.
     error_messages : dict
         Messages of the model's negative error codes.
+    limits : dict
+        Physical range ``name -> (low, high)`` [SI] of states, inputs or outputs (an actuator's travel,
+        a drive's supply voltage): operating points outside it are refused
+        (:func:`clutchlab.control.operating_point`).
     """
 
     name: str
@@ -161,6 +165,7 @@ class System:
     event_tol: float = 1e-12
     element_name: Callable | None = None
     error_messages: dict = dataclasses.field(default_factory=dict)
+    limits: dict = dataclasses.field(default_factory=dict)
 
     def __post_init__(self):
         n = len(self.states)

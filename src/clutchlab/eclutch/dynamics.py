@@ -678,6 +678,63 @@ class EClutch:
                                     max_step=max_step, event_tol=event_tol, jac_every=jac_every,
                                     atol_scale=atol_scale, first_step=first_step)
 
+    def operating_point(self, bearing_position: float, *, input: str = "voltage", friction: str = "slip_forward",
+                        settle: float = 0.5):
+        """Steady state holding the release bearing at ``bearing_position`` (for linear models and control design).
+
+        The actuator is first run under its own position controller (``settle`` seconds towards the
+        position, the start of Newton's method), then trimmed by
+        :func:`clutchlab.control.operating_point` within one friction mode.
+
+        Parameters
+        ----------
+        bearing_position : float
+            Bearing position [m], inside the CSC travel (``ActuatorParameters.slave_min`` ... ``slave_max``).
+        input : {"voltage", "bearing_reference"}
+            The held input of the system trimmed: the motor voltage (open loop; the voltage is solved for)
+            or the position controller's reference (closed loop; all states steady, the integral action
+            included).
+        friction : {"slip_forward", "slip_backward"}
+            Mode of every coordinate with a friction element (seals, spindle, clutch friction): the
+            direction the bearing last moved in. Coulomb friction is then a constant force and only its
+            viscous part enters the linear model (a stuck element leaves the steady state undetermined).
+        settle : float
+            Time [s] of the position-controlled run that gives Newton's method its start.
+
+        Returns
+        -------
+        clutchlab.control.OperatingPoint
+            ``op.system`` is the system with the held input (``motor_voltage`` [V] or ``bearing_reference``
+            [m]).
+
+        Raises
+        ------
+        clutchlab.control.OperatingPointError
+            A position outside the travel; a voltage beyond the supply; no convergence.
+        """
+        from ..control.trim import OperatingPointError, operating_point
+
+        if input not in ("voltage", "bearing_reference"):
+            raise ParameterError(f"input = {input!r}: expected 'voltage' or 'bearing_reference'")
+        if friction not in ("slip_forward", "slip_backward"):
+            raise ParameterError(f"friction = {friction!r}: expected 'slip_forward' or 'slip_backward'")
+        pos = float(bearing_position)
+        lo, hi = self.actuator.slave_min, self.actuator.slave_max
+        if not lo <= pos <= hi:
+            raise OperatingPointError(f"eclutch: bearing_position = {pos:.6g} m is outside the CSC travel "
+                                      f"[{lo:.6g}, {hi:.6g}] m")
+        closed = self.as_system({"bearing_reference": pos}, held_input=True)
+        run = contract.Simulation(closed)
+        run.advance(float(settle))
+        modes = {name: friction for name, value in zip(closed.mode_names, closed.m0)
+                 if name.startswith("friction_mode_") and value != S.MODE_VALUES.index("free")}
+        if input == "bearing_reference":
+            return operating_point(closed, inputs={"bearing_reference": pos}, modes=modes, guess=run.x)
+        voltage = float(run.outputs()[closed.output_index("motor_voltage")])
+        system = self.as_system({"voltage": voltage}, held_input=True)
+        return operating_point(system, inputs={"motor_voltage": voltage}, targets={"bearing_position": pos},
+                               free_inputs=["motor_voltage"], modes=modes, guess=run.x)
+
     def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, max_step: float | None = None,
                  h_max: float | None = None, max_steps: int = 500_000, output_step: float | None = None,
                  event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float = 1.0) -> DynamicsResult:

@@ -974,8 +974,16 @@ class Assembly:
             mode_values=tuple(MODE_VALUES for _ in self.coord_names) + (segments,), inputs=inputs, u0=u_start, method="rodas",
             mass=self.mvec, jac_cols=np.arange(n_jac), fd_scale=self.typ, nonautonomous=bool(nonauto),
             jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
-            event_tol=float(event_tol), element_name=self.element_name,
+            event_tol=float(event_tol), element_name=self.element_name, limits=self.limits(),
         )
+
+    def limits(self) -> dict:
+        """Physical range of the actuator [SI]: CSC travel, master stroke, supply voltage, current limit."""
+        a = self.actuator
+        travel = (float(a.slave_min), float(a.slave_max))
+        return {"bearing_position": travel, "bearing_reference": travel, "master_position": (0.0, float(a.master_stroke)),
+                "motor_voltage": (-float(a.supply_voltage), float(a.supply_voltage)),
+                "motor_current": (-float(a.current_limit), float(a.current_limit))}
 
 
 def eclutch_system(scenario=None, **options) -> System:

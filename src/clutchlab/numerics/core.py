@@ -71,7 +71,7 @@ from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21,
 from .status import MODEL_ERROR, RECORD_FULL, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
 
 __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
-           "batch", "evaluate", "evaluate_outputs", "outputs_at",
+           "batch", "evaluate", "evaluate_jacobian", "evaluate_outputs", "outputs_at",
            "SF_T", "SF_H", "SI_ACCEPTED", "SI_REJECTED", "SI_NRHS", "SI_NJAC", "SI_STATUS", "SI_IREC",
            "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI"]
 
@@ -901,6 +901,12 @@ def _evaluate(p, t, x, u, m, dx, g):
 
 
 @register_jitable
+def _evaluate_jacobian(p, t, x, u, m, J):
+    p = byref(borrow(p))
+    return model.jacobian(t, x, u, m, p, J)
+
+
+@register_jitable
 def _evaluate_outputs(p, t, x, u, m, y):
     p = byref(borrow(p))
     model.outputs(t, x, u, m, p, y)
@@ -1021,6 +1027,14 @@ def batch(method, P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STA
 def evaluate(p, t, x, u, m, dx, g):
     """The model's right-hand side ``dx`` and switching functions ``g`` at one point (linearisation, tests)."""
     entry_points(type(p), "dopri").evaluate(p, t, x, u, m, dx, g)
+
+
+def evaluate_jacobian(p, t, x, u, m, J):
+    """The model's analytic Jacobian ``df/dx`` at one point ``(t, x, u, m)`` of parameters ``p``, into ``J``.
+
+    Returns ``False`` (``J`` untouched) if the model has none (the core then differences ``rhs``).
+    """
+    return bool(entry_points(type(p), "dopri").evaluate_jacobian(p, t, x, u, m, J))
 
 
 def evaluate_outputs(p, t, x, u, m, y):

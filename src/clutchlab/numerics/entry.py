@@ -81,6 +81,11 @@ def evaluate(p, t, x, u, m, dx, g):
 
 
 @numba.njit(cache=True, nogil=True)
+def evaluate_jacobian(p, t, x, u, m, J):
+    return _core._evaluate_jacobian(p, t, x, u, m, J)
+
+
+@numba.njit(cache=True, nogil=True)
 def evaluate_outputs(p, t, x, u, m, y):
     _core._evaluate_outputs(p, t, x, u, m, y)
 

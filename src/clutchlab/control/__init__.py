@@ -1,0 +1,42 @@
+"""Control design: operating points, linear models, fixed-step runs, controllers in the loop.
+
+Everything here is written against the system contract (:mod:`clutchlab.system`): it works for every
+model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's own.
+
+* :func:`operating_point` -- steady state of a system for given inputs, or the inputs that hold given
+  outputs (trim), within the system's physical limits;
+* :func:`linearize` -- a python-control ``StateSpace`` with named states, inputs and outputs (their
+  unit in the name, ``bearing_position_m``), within the active mode of a hybrid model;
+* :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range.
+
+python-control (``control`` on PyPI) is imported when a linear model is built, not with this package.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__all__ = ["OperatingPoint", "operating_point", "linearize", "jacobians", "frequency_table", "pole_sweep",
+           "write_linear_model", "OperatingPointError"]
+
+_WHERE = {
+    "OperatingPoint": "clutchlab.control.trim",
+    "operating_point": "clutchlab.control.trim",
+    "OperatingPointError": "clutchlab.control.trim",
+    "linearize": "clutchlab.control.linear",
+    "jacobians": "clutchlab.control.linear",
+    "frequency_table": "clutchlab.control.linear",
+    "pole_sweep": "clutchlab.control.linear",
+    "write_linear_model": "clutchlab.control.linear",
+}
+
+
+def __getattr__(name):
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'clutchlab.control' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_WHERE))

@@ -1,0 +1,238 @@
+"""``clutchlab control trim|linearize|bode MODEL ...``: a thin layer over :mod:`clutchlab.control`.
+
+``clutchlab control trim eclutch --at "4 mm" -o op.json``
+    the steady state holding the release bearing at 4 mm (motor voltage solved for);
+``clutchlab control linearize eclutch --at "4 mm" -u motor_voltage -y bearing_position -o lin.json``
+    the linear model there, matrices with their names and units (JSON or CSV);
+``clutchlab control bode eclutch --at "0.5 mm" --at "4 mm" --at "8 mm" -u motor_voltage -y bearing_position -o bode.png``
+    Bode diagram at several operating points (and ``--table`` its magnitude and phase as CSV, ``--poles``
+    the poles at each point).
+
+Other models: ``wet``, ``emtc`` (their held inputs) and ``driveline FILE.toml``, with the generic trim
+options (``--set``, ``--hold``, ``--target``, ``--free``, ``--mode``, ``--time``, ``--settle``).
+"""
+
+from __future__ import annotations
+
+import io
+
+from ..errors import ParameterError
+
+__all__ = ["register"]
+
+MODELS = ("eclutch", "wet", "emtc", "driveline")
+
+
+def register(subparsers) -> None:
+    """Add the ``control`` command and its sub-commands."""
+    top = subparsers.add_parser(
+        "control", help="operating points, linear models and Bode diagrams of any model (python-control)",
+        description="Control design on the models: steady states (trim), linear state-space models within "
+                    "the active mode, and frequency responses and poles over operating points.",
+        epilog="Documentation: docs/control.md")
+    sub = top.add_subparsers(dest="control_command", metavar="SUBCOMMAND")
+    trim = sub.add_parser("trim", help="find a steady state and write it (JSON)",
+                          description="Steady state of a model for given inputs, or the inputs that hold given "
+                                      "outputs; written as JSON with every state, input and output and its unit.",
+                          epilog="Documentation: docs/control.md")
+    _common(trim)
+    trim.add_argument("-o", "--output", required=True, help="JSON file of the operating point")
+    trim.set_defaults(func=_trim)
+    lin = sub.add_parser("linearize", help="linear state-space model at an operating point (JSON or CSV)",
+                         description="Linearise a model at a steady state within its active mode and write A, B, "
+                                     "C, D with the names and units of states, inputs and outputs.",
+                         epilog="Documentation: docs/control.md")
+    _common(lin)
+    _signals(lin)
+    lin.add_argument("-o", "--output", required=True, help="file to write: .json or .csv")
+    lin.set_defaults(func=_linearize)
+    bode = sub.add_parser("bode", help="Bode diagram (PNG) at one or more operating points",
+                          description="Frequency response of the linear model at each operating point (each "
+                                      "--at of the E-clutch), as a figure; optionally the table and the poles.",
+                          epilog="Documentation: docs/control.md")
+    _common(bode)
+    _signals(bode)
+    bode.add_argument("-o", "--output", required=True, help="PNG figure to write")
+    bode.add_argument("--table", help="also write magnitude and phase as CSV")
+    bode.add_argument("--poles", help="also write the poles at each operating point as CSV")
+    bode.add_argument("--fmin", default="0.1 Hz", help="lowest frequency (default 0.1 Hz)")
+    bode.add_argument("--fmax", default="2 kHz", help="highest frequency (default 2 kHz)")
+    bode.set_defaults(func=_bode)
+    top.set_defaults(func=lambda args: (top.print_help(), 2)[1])
+
+
+def _common(p) -> None:
+    p.add_argument("model", choices=MODELS, help="model (its bundled parameters; a driveline from its FILE)")
+    p.add_argument("file", nargs="?", default=None, help="driveline description (TOML); the others take none")
+    p.add_argument("--at", action="append", default=[],
+                   help="E-clutch: bearing position of the operating point, e.g. '4 mm' (bode: repeat for "
+                        "several)")
+    p.add_argument("--input", dest="eclutch_input", choices=("voltage", "bearing_reference"), default="voltage",
+                   help="E-clutch: held input, motor voltage (open loop, default) or the position controller's "
+                        "reference (closed loop)")
+    p.add_argument("--direction", choices=("slip_forward", "slip_backward"), default="slip_forward",
+                   help="E-clutch: friction mode, the direction the bearing last moved in (default slip_forward)")
+    p.add_argument("--set", action="append", default=[], metavar="INPUT=VALUE",
+                   help="hold an input, e.g. 'force_reference=300 N'")
+    p.add_argument("--hold", action="append", default=[], metavar="STATE=VALUE",
+                   help="keep a state at a value instead of requiring it steady, e.g. 'temperature=80 degC'")
+    p.add_argument("--target", action="append", default=[], metavar="NAME=VALUE",
+                   help="require a state or output value (one --free input each)")
+    p.add_argument("--free", action="append", default=[], metavar="INPUT", help="an input solved for")
+    p.add_argument("--mode", action="append", default=[], metavar="MODE=VALUE",
+                   help="mode of a hybrid model, e.g. 'piston=free'")
+    p.add_argument("--time", default="0 s", help="time of the operating point (models with profiles)")
+    p.add_argument("--settle", default="0 s", help="simulate this long with the inputs held before Newton's method")
+    p.add_argument("--force", action="store_true", help="overwrite the outputs")
+
+
+def _signals(p) -> None:
+    p.add_argument("-u", "--u", dest="inputs", action="append", default=None, metavar="INPUT",
+                   help="input of the linear model (repeat; default: all held inputs)")
+    p.add_argument("-y", "--y", dest="outputs", action="append", default=None, metavar="NAME",
+                   help="state or output of the linear model (repeat; default: all outputs)")
+
+
+def _system(args):
+    from ..system import MODELS as REGISTRY
+
+    if args.model != "driveline" and args.file is not None:
+        raise ParameterError(f"control {args.model} takes no file (got {args.file!r}); only driveline does")
+    if args.model != "eclutch" and args.at:
+        raise ParameterError(f"--at is the E-clutch's bearing position; for {args.model} use --target/--set")
+    if args.model == "eclutch":
+        from ..eclutch import EClutch
+
+        ec = EClutch()
+        key = "voltage" if args.eclutch_input == "voltage" else "bearing_reference"
+        return ec, ec.as_system({key: 0.0}, held_input=True)
+    if args.model == "wet":
+        import clutchlab.wet  # noqa: F401  (registers the model)
+
+        return None, REGISTRY["wet"]()
+    if args.model == "emtc":
+        from ..emtc.system import bench_system
+
+        return None, bench_system(cosimulation=True)
+    if args.file is None:
+        raise ParameterError("control ... driveline needs its description: clutchlab control trim driveline FILE.toml")
+    from ..driveline.description import load_driveline
+
+    return None, load_driveline(args.file).driveline.system()
+
+
+def _pairs(system, items, kinds, flag):
+    from ..units import COLUMN_UNITS, to_si
+    from .trim import resolve
+
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise ParameterError(f"{flag} {item!r}: expected NAME=VALUE")
+        name = name.strip()
+        kind, i = resolve(system, name, kinds)
+        var = {"state": system.states, "output": system.outputs, "input": system.inputs}[kind][i]
+        out[var.name] = to_si(value.strip(), COLUMN_UNITS.get(var.unit, (var.unit,))[0], name=f"{flag} {name}")
+    return out
+
+
+def _points(args):
+    """The operating points the arguments ask for: ``[(label, value, OperatingPoint)]``."""
+    from ..units import to_si
+    from .trim import operating_point
+
+    ec, system = _system(args)
+    if ec is not None and args.at:
+        if any((args.set, args.hold, args.target, args.free, args.mode)):
+            raise ParameterError("--at trims the E-clutch by itself; drop --set/--hold/--target/--free/--mode")
+        out = []
+        for at in args.at:
+            pos = to_si(at, "m", name="--at")
+            out.append((f"bearing at {pos * 1e3:g} mm", pos,
+                        ec.operating_point(pos, input=args.eclutch_input, friction=args.direction)))
+        return out
+    modes = {}
+    for item in args.mode:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--mode {item!r}: expected MODE=VALUE")
+        modes[name.strip()] = value.strip()
+    op = operating_point(system, inputs=_pairs(system, args.set, ("input",), "--set"),
+                         states=_pairs(system, args.hold, ("state",), "--hold"),
+                         targets=_pairs(system, args.target, ("state", "output"), "--target"),
+                         free_inputs=args.free, modes=modes, t=to_si(args.time, "s", name="--time"),
+                         settle=to_si(args.settle, "s", name="--settle"))
+    return [(system.name, 0.0, op)]
+
+
+def _trim(args) -> int:
+    import json
+
+    from ..io.files import atomic_write_text, check_writable
+
+    check_writable(args.output, args.force)
+    points = _points(args)
+    if len(points) != 1:
+        raise ParameterError("trim writes one operating point: give one --at")
+    op = points[0][2]
+    atomic_write_text(args.output, json.dumps(op.to_dict(), indent=1), overwrite=args.force)
+    print(f"{op.system.name}: steady in mode {op.modes} after {op.iterations} Newton iterations -> {args.output}")
+    return 0
+
+
+def _linearize(args) -> int:
+    from ..io.files import check_writable
+    from .linear import linearize, write_linear_model
+
+    check_writable(args.output, args.force)
+    points = _points(args)
+    if len(points) != 1:
+        raise ParameterError("linearize writes one model: give one --at")
+    sys = linearize(points[0][2], inputs=args.inputs, outputs=args.outputs)
+    write_linear_model(sys, args.output, force=args.force)
+    print(f"{sys.nstates} states, {sys.ninputs} inputs, {sys.noutputs} outputs -> {args.output}")
+    return 0
+
+
+def _bode(args) -> int:
+    import numpy as np
+
+    from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
+    from ..units import to_si
+    from .linear import frequency_table, linearize, pole_sweep
+
+    check_outputs([args.output, args.table, args.poles], args.force)
+    fmin, fmax = to_si(args.fmin, "Hz", name="--fmin"), to_si(args.fmax, "Hz", name="--fmax")
+    if not 0 < fmin < fmax:
+        raise ParameterError(f"--fmin {args.fmin!r} and --fmax {args.fmax!r}: need 0 < fmin < fmax")
+    points = _points(args)
+    f = np.logspace(np.log10(fmin), np.log10(fmax), 400)
+    models = [(label, value, op, linearize(op, inputs=args.inputs, outputs=args.outputs)) for label, value, op in points]
+    if models[0][3].ninputs == 0:
+        raise ParameterError(f"{points[0][2].system.name} has no held inputs: no frequency response")
+    tables = []
+    for label, value, _, sys in models:
+        t = frequency_table(sys, f)
+        t.insert(0, "operating_point", label)
+        tables.append(t)
+    import pandas as pd
+
+    from .plots import bode_figure
+
+    fig = bode_figure([(label, sys) for label, _, _, sys in models], f)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    atomic_write_bytes(args.output, buf.getvalue(), overwrite=args.force)
+    if args.table:
+        atomic_to_csv(pd.concat(tables, ignore_index=True), args.table, overwrite=args.force)
+    if args.poles:
+        name = "bearing_position_m" if args.model == "eclutch" and args.at else "operating_point_1"
+        poles = pole_sweep([(value, op) for _, value, op, _ in models], inputs=args.inputs, outputs=args.outputs,
+                           name=name)
+        atomic_to_csv(poles, args.poles, overwrite=args.force)
+    print(args.output)
+    return 0

@@ -1,0 +1,300 @@
+"""Linear models of any system at an operating point (python-control ``StateSpace``).
+
+For a system ``M x' = f(t, x, u, m)``, ``y = h(t, x, u, m)`` (:mod:`clutchlab.system`; ``M`` diagonal, 0 on
+algebraic rows such as the E-clutch's massless finger tip) at an operating point ``(t, x0, u0, m)``:
+
+* ``A_full = df/dx`` from the model's analytic Jacobian hook where it has one, else central differences
+  (step ``6e-6`` times the state's typical magnitude, :func:`clutchlab.control.trim.state_scale`);
+  ``B = df/du``, ``C = dh/dx``, ``D = dh/du`` by central differences; the modes stay fixed, so a hybrid model
+  is linearised within its active mode (stuck or sliding, in contact or not), and that mode is part of the
+  result;
+* differential rows are divided by their mass, algebraic rows ``a`` are eliminated
+  (``A = A_dd - A_da A_aa^-1 A_ad``, likewise ``B``, ``C``, ``D``): index-1 DAEs only;
+* states that no other kept state and no requested output reads are dropped, repeatedly (energy
+  integrals, see :mod:`clutchlab.control.trim`; the E-clutch's massless-tip velocity): they are
+  unobservable, so the input-output behaviour is unchanged (``keep_monitors=True`` keeps them).
+
+The result is a ``control.StateSpace`` whose signal names carry their unit (``bearing_position_m``,
+``motor_voltage_V``); its ``operating_point`` attribute holds the :class:`OperatingPoint` and ``mode`` the
+active mode by name.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..system import System, evaluate
+from .trim import OperatingPoint, input_scale, resolve, state_scale
+
+__all__ = ["jacobians", "linearize", "frequency_table", "pole_sweep", "write_linear_model"]
+
+#: relative step of the central differences (about the cube root of the machine epsilon)
+FD_STEP = 6e-6
+
+
+def _signals(system: System, names, kinds, default):
+    if names is None:
+        names = default
+    if isinstance(names, str):
+        names = [names]
+    return [resolve(system, n, kinds) for n in names]
+
+
+def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
+    """The full Jacobians of a system at an operating point (before eliminating algebraic rows).
+
+    Parameters
+    ----------
+    system : System
+        The system (normally ``op.system``).
+    op : OperatingPoint
+        Where: time, state, inputs and modes.
+    inputs : sequence of str, optional
+        Held inputs (default: all).
+    outputs : sequence of str, optional
+        States or outputs (default: all outputs).
+
+    Returns
+    -------
+    dict
+        ``A`` (n x n), ``B`` (n x p), ``C`` (q x n), ``D`` (q x p) [SI per SI], ``analytic`` (bool: the
+        model's own ``df/dx``), and the resolved ``inputs``/``outputs`` as ``(kind, index)`` lists.
+    """
+    from ..numerics.core import evaluate_jacobian
+
+    ins = _signals(system, inputs, ("input",), [v.name for v in system.inputs])
+    outs = _signals(system, outputs, ("state", "output"), [v.name for v in system.outputs])
+    t, x, u, m = op.t, op.x.copy(), op.u.copy(), op.m.copy()
+    n, q = x.size, len(outs)
+    xs = state_scale(system, x)
+    us = input_scale(system, u)
+
+    def pick(xx, y):
+        return np.array([xx[i] if kind == "state" else y[i] for kind, i in outs])
+
+    A = np.zeros((n, n))
+    C = np.zeros((q, n))
+    analytic = bool(evaluate_jacobian(system.params, float(t), x, u, m, A))
+    for j in range(n):
+        h = FD_STEP * xs[j]
+        xp, xm = x.copy(), x.copy()
+        xp[j] += h
+        xm[j] -= h
+        fp, _, yp = evaluate(system, t, xp, u, m)
+        fm, _, ym = evaluate(system, t, xm, u, m)
+        if not analytic:
+            A[:, j] = (fp - fm) / (2 * h)
+        C[:, j] = (pick(xp, yp) - pick(xm, ym)) / (2 * h)
+    B = np.zeros((n, len(ins)))
+    D = np.zeros((q, len(ins)))
+    for k, (_, j) in enumerate(ins):
+        h = FD_STEP * us[j]
+        up, um = u.copy(), u.copy()
+        up[j] += h
+        um[j] -= h
+        fp, _, yp = evaluate(system, t, x, up, m)
+        fm, _, ym = evaluate(system, t, x, um, m)
+        B[:, k] = (fp - fm) / (2 * h)
+        D[:, k] = (pick(x, yp) - pick(x, ym)) / (2 * h)
+    for name, M in (("A", A), ("B", B), ("C", C), ("D", D)):
+        if not np.all(np.isfinite(M)):
+            raise ParameterError(f"{system.name}: the Jacobian {name} is not finite at this operating point "
+                                 f"(mode {op.modes})")
+    return {"A": A, "B": B, "C": C, "D": D, "analytic": analytic, "inputs": ins, "outputs": outs}
+
+
+def linearize(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
+              keep_monitors: bool = False, name: str | None = None):
+    """Linear model of ``system`` at ``op`` within its active mode, as a python-control ``StateSpace``.
+
+    Parameters
+    ----------
+    system : System or OperatingPoint
+        The system; an :class:`OperatingPoint` alone stands for its system and itself.
+    op : OperatingPoint, optional
+        Where to linearise (default: the system's initial state, inputs and modes at t = 0).
+    inputs : sequence of str, optional
+        Held inputs of the model (default: all), names with or without unit.
+    outputs : sequence of str, optional
+        States or outputs (default: all outputs).
+    keep_monitors : bool
+        Keep states that no other state and no requested output reads (unobservable poles).
+    name : str, optional
+        Name of the ``StateSpace`` (default: the system's name and the mode).
+
+    Returns
+    -------
+    control.StateSpace
+        Signals named by column (``bearing_position_m``); attributes ``operating_point`` and ``mode``
+        (``{mode variable: value}``) and ``units`` (``{signal: unit}``).
+
+    Raises
+    ------
+    ParameterError
+        Unknown names, a system without the requested inputs, an algebraic block that is singular.
+    """
+    import control
+
+    if isinstance(system, OperatingPoint):
+        system, op = system.system, system
+    if op is None:
+        op = OperatingPoint(system, 0.0, system.x0.copy(), system.u0.copy(), system.m0.copy())
+    if op.system is not system and op.x.shape != system.x0.shape:
+        raise ParameterError(f"{system.name}: the operating point belongs to another system ({op.system.name})")
+    jac = jacobians(system, op, inputs, outputs)
+    A, B, C, D = jac["A"], jac["B"], jac["C"], jac["D"]
+    mass = system.mass
+    alg = np.flatnonzero(mass == 0.0)
+    dif = np.flatnonzero(mass != 0.0)
+    if alg.size:
+        Aaa = A[np.ix_(alg, alg)]
+        try:
+            lu_a = np.linalg.solve(Aaa, np.hstack([A[np.ix_(alg, dif)], B[alg]]))
+        except np.linalg.LinAlgError:
+            raise ParameterError(f"{system.name}: the algebraic equations ({', '.join(system.states[i].name for i in alg)}) "
+                                 "are singular at this operating point: not an index-1 system") from None
+        Xa, Ba = lu_a[:, :dif.size], lu_a[:, dif.size:]
+        A_ = A[np.ix_(dif, dif)] - A[np.ix_(dif, alg)] @ Xa
+        B_ = B[dif] - A[np.ix_(dif, alg)] @ Ba
+        C_ = C[:, dif] - C[:, alg] @ Xa
+        D_ = D - C[:, alg] @ Ba
+    else:
+        A_, B_, C_, D_ = A, B, C, D
+    md = mass[dif]
+    A_ = A_ / md[:, None]
+    B_ = B_ / md[:, None]
+    keep = np.ones(dif.size, dtype=bool)
+    changed = not keep_monitors
+    while changed:  # a state no kept state and no output reads: unobservable, dropped (then look again)
+        changed = False
+        for k in np.flatnonzero(keep):
+            others = keep & (np.arange(dif.size) != k)
+            if np.all(A_[others, k] == 0.0) and np.all(C_[:, k] == 0.0):
+                keep[k] = False
+                changed = True
+    A_, B_, C_ = A_[np.ix_(keep, keep)], B_[keep], C_[:, keep]
+    state_vars = [system.states[i] for i in dif[keep]]
+    in_vars = [system.inputs[j] for _, j in jac["inputs"]]
+    out_vars = [(system.states if kind == "state" else system.outputs)[i] for kind, i in jac["outputs"]]
+    mode = op.modes
+    label = name or system.name
+    sys = control.ss(A_, B_, C_, D_, states=[v.column for v in state_vars], inputs=[v.column for v in in_vars],
+                     outputs=[v.column for v in out_vars], name=label)
+    sys.operating_point = op
+    sys.mode = mode
+    sys.units = {v.column: v.unit for v in (*state_vars, *in_vars, *out_vars)}
+    sys.analytic_jacobian = jac["analytic"]
+    return sys
+
+
+def frequency_table(sys, frequencies_hz) -> "pandas.DataFrame":  # noqa: F821
+    """Magnitude and phase of every input-output pair of a linear model (a Bode table).
+
+    Parameters
+    ----------
+    sys : control.StateSpace or control.TransferFunction
+        The linear model (e.g. from :func:`linearize`).
+    frequencies_hz : array_like
+        Frequencies [Hz].
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``frequency_Hz``, then per pair ``gain_<out>__<in>`` (output unit per input unit),
+        ``gain_dB_<out>__<in>`` and ``phase_deg_<out>__<in>`` (unwrapped).
+    """
+    import pandas as pd
+
+    f = np.asarray(frequencies_hz, dtype=float)
+    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise ParameterError("frequencies_hz must be a non-empty vector of positive frequencies [Hz]")
+    w = 2 * np.pi * f
+    resp = sys(1j * w) if sys.ninputs * sys.noutputs > 1 else np.reshape(sys(1j * w), (1, 1, -1))
+    resp = np.reshape(resp, (sys.noutputs, sys.ninputs, -1))
+    cols = {"frequency_Hz": f}
+    for i, o in enumerate(sys.output_labels):
+        for j, n in enumerate(sys.input_labels):
+            g = resp[i, j]
+            cols[f"gain_{o}__{n}"] = np.abs(g)
+            cols[f"gain_dB_{o}__{n}"] = 20 * np.log10(np.maximum(np.abs(g), 1e-300))
+            cols[f"phase_deg_{o}__{n}"] = np.degrees(np.unwrap(np.angle(g)))
+    return pd.DataFrame(cols)
+
+
+def pole_sweep(points, inputs=None, outputs=None, *, name: str = "value") -> "pandas.DataFrame":  # noqa: F821
+    """Poles of the linear models at a series of operating points (a pole map over an operating range).
+
+    Parameters
+    ----------
+    points : sequence of (float, OperatingPoint)
+        The swept value (e.g. the bearing position [m]) and the operating point there.
+    inputs, outputs : sequence of str, optional
+        As :func:`linearize`.
+    name : str
+        Column name of the swept value (with its unit, ``bearing_position_m``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per pole: ``name``, ``pole_real_1_s``, ``pole_imag_1_s`` [1/s], ``natural_frequency_Hz``,
+        ``damping_1``.
+    """
+    import pandas as pd
+
+    rows = []
+    for value, op in points:
+        sys = linearize(op, inputs=inputs, outputs=outputs)
+        for p in np.linalg.eigvals(sys.A) if sys.nstates else []:
+            wn = abs(p)
+            rows.append({name: float(value), "pole_real_1_s": float(p.real), "pole_imag_1_s": float(p.imag),
+                         "natural_frequency_Hz": wn / (2 * np.pi),
+                         "damping_1": float(-p.real / wn) if wn > 0 else 1.0})
+    return pd.DataFrame(rows)
+
+
+def write_linear_model(sys, path, *, force: bool = False) -> Path:
+    """Write a linear model's matrices with their names and units: JSON (``.json``) or CSV (``.csv``).
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        From :func:`linearize` (its operating point and mode are written too).
+    path : str or Path
+        ``*.json``: one document (matrices, names, units, operating point, mode); ``*.csv``: one table,
+        rows ``A``/``B``/``C``/``D`` with their row and column names.
+    force : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    Path
+    """
+    from ..io.files import atomic_write_text, check_writable
+
+    path = Path(path)
+    check_writable(path, force)
+    units = getattr(sys, "units", {})
+    states, ins, outs = list(sys.state_labels), list(sys.input_labels), list(sys.output_labels)
+    if path.suffix.lower() == ".json":
+        op = getattr(sys, "operating_point", None)
+        doc = {"name": sys.name, "states": states, "inputs": ins, "outputs": outs, "units": units,
+               "mode": getattr(sys, "mode", {}), "A": np.asarray(sys.A).tolist(), "B": np.asarray(sys.B).tolist(),
+               "C": np.asarray(sys.C).tolist(), "D": np.asarray(sys.D).tolist(),
+               "operating_point": op.to_dict() if op is not None else None}
+        atomic_write_text(path, json.dumps(doc, indent=1), overwrite=force)
+    elif path.suffix.lower() == ".csv":
+        lines = ["matrix,row,column,value"]
+        for mname, M, rows, cols in (("A", sys.A, states, states), ("B", sys.B, states, ins),
+                                     ("C", sys.C, outs, states), ("D", sys.D, outs, ins)):
+            M = np.asarray(M)
+            for i, r in enumerate(rows):
+                for j, c in enumerate(cols):
+                    lines.append(f"{mname},{r},{c},{float(M[i, j])!r}")
+        atomic_write_text(path, "\n".join(lines) + "\n", overwrite=force)
+    else:
+        raise ParameterError(f"{path}: write a linear model as .json or .csv, not {path.suffix!r}")
+    return path

@@ -1,0 +1,86 @@
+"""Figures of linear models: Bode diagrams over operating points and pole maps."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..plotting import legend_outside, new_figure
+
+__all__ = ["bode_figure", "pole_map_figure"]
+
+
+def bode_figure(models, frequencies_hz, *, title: str = ""):
+    """Bode diagram (magnitude in dB, phase in degrees) of linear models, one line per model and pair.
+
+    Parameters
+    ----------
+    models : sequence of (str, control.StateSpace)
+        Label (the operating point) and linear model (:func:`clutchlab.control.linearize`).
+    frequencies_hz : array_like
+        Frequencies [Hz].
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .linear import frequency_table
+
+    f = np.asarray(frequencies_hz, dtype=float)
+    fig, (ax_m, ax_p) = new_figure(2, 1, width=7.5, height=6.0, sharex=True)
+    for label, sys in models:
+        table = frequency_table(sys, f)
+        for o in sys.output_labels:
+            for i in sys.input_labels:
+                name = label if sys.ninputs * sys.noutputs == 1 else f"{label}: {o} / {i}"
+                (line,) = ax_m.semilogx(f, table[f"gain_dB_{o}__{i}"], label=name)
+                ax_p.semilogx(f, table[f"phase_deg_{o}__{i}"], color=line.get_color())
+    first = models[0][1]
+    if first.ninputs * first.noutputs == 1:
+        ax_m.set_ylabel(f"|{first.output_labels[0]} / {first.input_labels[0]}| [dB]")
+    else:
+        ax_m.set_ylabel("magnitude [dB]")
+    ax_p.set_ylabel("phase [deg]")
+    ax_p.set_xlabel("frequency [Hz]")
+    for ax in (ax_m, ax_p):
+        ax.grid(True, which="both", alpha=0.3)
+    legend_outside(ax_m)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def pole_map_figure(poles, value: str, *, title: str = "", scale: float = 1.0, unit: str = ""):
+    """Poles over an operating range, coloured by the swept value.
+
+    Parameters
+    ----------
+    poles : pandas.DataFrame
+        From :func:`clutchlab.control.pole_sweep`.
+    value : str
+        Column of the swept value.
+    title : str
+        Figure title.
+    scale : float
+        Factor for the colour bar's values (1e3 for mm).
+    unit : str
+        Unit label of the colour bar.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = new_figure(1, 1, width=7.0, height=4.5)
+    sc = ax.scatter(poles["pole_real_1_s"], poles["pole_imag_1_s"] / (2 * np.pi), c=poles[value] * scale, s=14,
+                    cmap="viridis")
+    cb = fig.colorbar(sc, ax=ax)
+    cb.set_label(f"{value} [{unit}]" if unit else value)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xscale("symlog", linthresh=10.0)
+    ax.set_xlabel("real part [1/s]")
+    ax.set_ylabel("imaginary part / 2π [Hz]")
+    ax.grid(True, alpha=0.3)
+    if title:
+        ax.set_title(title)
+    return fig

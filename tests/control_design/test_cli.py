@@ -1,0 +1,72 @@
+"""``clutchlab control trim|linearize|bode``: outputs, refusals, nothing left behind."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+pytest.importorskip("control")
+
+from cli_checks import one_line_error  # noqa: E402
+from clutchlab.cli import main  # noqa: E402
+
+
+def test_trim_linearize_and_bode_of_the_eclutch(tmp_path, capsys):
+    op = tmp_path / "op.json"
+    assert main(["control", "trim", "eclutch", "--at", "4 mm", "-o", str(op)]) == 0
+    doc = json.loads(op.read_text())
+    assert doc["state.bearing_position_m"] == pytest.approx(4e-3, rel=1e-9)
+    assert doc["modes"]["friction_mode_bearing"] == "slip_forward"
+    assert -12.0 < doc["input.motor_voltage_V"] < 12.0
+    lin = tmp_path / "lin.json"
+    assert main(["control", "linearize", "eclutch", "--at", "4 mm", "-u", "motor_voltage", "-y", "bearing_position",
+                 "-y", "pressure", "-o", str(lin)]) == 0
+    m = json.loads(lin.read_text())
+    assert m["inputs"] == ["motor_voltage_V"] and m["outputs"] == ["bearing_position_m", "pressure_Pa"]
+    assert m["units"]["pressure_Pa"] == "Pa" and np.shape(m["A"]) == (len(m["states"]),) * 2
+    # the JSON's matrices give the same DC gain as the Python API
+    A, B, C = (np.array(m[k]) for k in "ABC")
+    assert (-C @ np.linalg.solve(A, B))[0, 0] == pytest.approx(2.77e-3, rel=0.02)
+    png, table, poles = tmp_path / "bode.png", tmp_path / "bode.csv", tmp_path / "poles.csv"
+    assert main(["control", "bode", "eclutch", "--at", "1 mm", "--at", "7 mm", "-u", "motor_voltage", "-y",
+                 "bearing_position", "-o", str(png), "--table", str(table), "--poles", str(poles),
+                 "--fmin", "1 Hz", "--fmax", "200 Hz"]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    t = pd.read_csv(table)
+    assert set(t.operating_point) == {"bearing at 1 mm", "bearing at 7 mm"}
+    assert t.frequency_Hz.min() == pytest.approx(1.0) and t.frequency_Hz.max() == pytest.approx(200.0)
+    p = pd.read_csv(poles)
+    assert (p[p.bearing_position_m == 7e-3].pole_real_1_s > 0).any()  # beyond the diaphragm's peak
+    capsys.readouterr()
+
+
+def test_refusals_are_one_line_and_leave_nothing(tmp_path, capsys):
+    out = tmp_path / "op.json"
+    line = one_line_error(capsys, ["control", "trim", "eclutch", "--at", "40 mm", "-o", str(out)])
+    assert "outside the CSC travel" in line and not out.exists()
+    line = one_line_error(capsys, ["control", "linearize", "eclutch", "--at", "4 mm", "-u", "volts", "-o",
+                                   str(tmp_path / "l.json")])
+    assert "unknown input 'volts'" in line
+    line = one_line_error(capsys, ["control", "trim", "eclutch", "--target", "bearing_position=4 mm", "-o", str(out)])
+    assert "conditions" in line and not out.exists()
+    line = one_line_error(capsys, ["control", "trim", "wet", "--at", "4 mm", "-o", str(out)])
+    assert "--at is the E-clutch's" in line
+    out.write_text("mine")
+    line = one_line_error(capsys, ["control", "trim", "eclutch", "--at", "4 mm", "-o", str(out)])
+    assert "exists" in line and out.read_text() == "mine"
+    line = one_line_error(capsys, ["control", "bode", "eclutch", "--at", "4 mm", "-o", str(tmp_path / "b.png"),
+                                   "--fmin", "10 Hz", "--fmax", "1 Hz"])
+    assert "fmin" in line and not (tmp_path / "b.png").exists()
+
+
+def test_generic_trim_of_the_linear_parts_of_a_model(tmp_path, capsys):
+    """The generic options on the E-clutch's closed loop: reference held, all states steady."""
+    out = tmp_path / "op.json"
+    assert main(["control", "trim", "eclutch", "--input", "bearing_reference", "--at", "2 mm", "-o", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["state.bearing_position_m"] == pytest.approx(2e-3, rel=1e-8)
+    assert doc["input.bearing_reference_m"] == 2e-3
+    capsys.readouterr()

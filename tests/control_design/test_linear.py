@@ -1,0 +1,187 @@
+"""Operating points and linear models (clutchlab.control) against closed forms and nonlinear simulation."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+control = pytest.importorskip("control")
+
+from clutchlab import eclutch as E  # noqa: E402
+from clutchlab.control import (OperatingPointError, frequency_table, linearize, operating_point,  # noqa: E402
+                               pole_sweep, write_linear_model)
+from clutchlab.errors import ParameterError  # noqa: E402
+from clutchlab.system import Simulation  # noqa: E402
+from core_toys import linear_system  # noqa: E402
+
+finite = st.floats(-3.0, 3.0, allow_nan=False)
+
+
+def _stable(m):
+    """A well-conditioned Hurwitz matrix from any square matrix: -(M M^T + I)."""
+    return -(m @ m.T + np.eye(m.shape[0]))
+
+
+@settings(deadline=None, max_examples=25)
+@given(arrays(float, (3, 3), elements=finite), arrays(float, (3, 2), elements=finite),
+       arrays(float, 2, elements=finite))
+def test_linear_model_gives_its_own_matrices_and_steady_state(m, b, u):
+    a = _stable(m)
+    s = linear_system(a, np.zeros(3), b)
+    op = operating_point(s, inputs={"u0": u[0], "u1": u[1]})
+    x_exact = -np.linalg.solve(a, b @ u)  # x' = A x + B u = 0
+    np.testing.assert_allclose(op.x, x_exact, rtol=1e-9, atol=1e-9 * (1 + np.abs(x_exact).max()))
+    lin = linearize(op)
+    assert lin.analytic_jacobian
+    assert np.array_equal(lin.A, a)  # the model's analytic Jacobian, exactly
+    np.testing.assert_allclose(lin.B, b, rtol=1e-9, atol=1e-9 * (1 + np.abs(b).max()))
+    np.testing.assert_allclose(lin.C, np.eye(3), atol=1e-9)
+    np.testing.assert_allclose(lin.D, 0.0, atol=1e-9)
+    assert lin.state_labels == ["x0_1", "x1_1", "x2_1"] and lin.input_labels == ["u0_1", "u1_1"]
+
+
+@settings(deadline=None, max_examples=25)
+@given(arrays(float, (3, 3), elements=finite), arrays(float, (3, 1), elements=finite))
+def test_algebraic_rows_are_eliminated(m, b):
+    a = _stable(m)  # the algebraic block a[2, 2] < 0 is non-singular
+    s = linear_system(a, np.zeros(3), b, method="rodas", mass=np.array([1.0, 1.0, 0.0]))
+    lin = linearize(s, outputs=["x0", "x1", "x2"])
+    d, g = [0, 1], [2]
+    aaa = a[np.ix_(g, g)]
+    a_red = a[np.ix_(d, d)] - a[np.ix_(d, g)] @ np.linalg.solve(aaa, a[np.ix_(g, d)])
+    b_red = b[d] - a[np.ix_(d, g)] @ np.linalg.solve(aaa, b[g])
+    np.testing.assert_allclose(lin.A, a_red, rtol=1e-9, atol=1e-9 * (1 + np.abs(a_red).max()))
+    np.testing.assert_allclose(lin.B, b_red, rtol=1e-7, atol=1e-7 * (1 + np.abs(b_red).max()))
+    # the algebraic state as an output: x2 = -aaa^-1 (a[2, d] x_d + b[2] u)
+    c_alg = -np.linalg.solve(aaa, a[np.ix_(g, d)])
+    np.testing.assert_allclose(lin.C[2], c_alg[0], rtol=1e-7, atol=1e-7 * (1 + np.abs(c_alg).max()))
+    assert lin.nstates == 2
+
+
+def test_trim_solves_for_an_input_holding_a_target():
+    a = np.array([[-2.0, 1.0], [0.5, -3.0]])
+    b = np.array([[1.0], [0.0]])
+    s = linear_system(a, np.zeros(2), b)
+    op = operating_point(s, targets={"x1": 0.25}, free_inputs=["u0"])
+    # steady: x = -A^-1 B u, and x1 = 0.25 fixes u
+    g = -np.linalg.solve(a, b)[:, 0]
+    np.testing.assert_allclose(op.u[0], 0.25 / g[1], rtol=1e-10)
+    np.testing.assert_allclose(op.x, g * op.u[0], rtol=1e-10)
+
+
+def test_bad_requests_say_what_is_wrong():
+    s = linear_system(np.array([[-1.0]]), np.zeros(1), np.array([[1.0]]))
+    with pytest.raises(ParameterError, match="unknown input 'volts'"):
+        operating_point(s, inputs={"volts": 1.0})
+    with pytest.raises(ParameterError, match="conditions"):
+        operating_point(s, targets={"x0": 1.0})  # a target without a free input
+    with pytest.raises(ParameterError, match="unknown state/output 'bearing'"):
+        linearize(s, outputs=["bearing"])
+
+
+# ------------------------------------------------------------------ the E-clutch actuator
+@pytest.fixture(scope="module")
+def frictionless():
+    """The E-clutch with the actuator's Coulomb friction off: one mode for small signals either way."""
+    return E.EClutch(E.ActuatorParameters(master_seal_friction=0.0, slave_seal_friction=0.0,
+                                          seal_pressure_friction=0.0, spindle_efficiency=1.0))
+
+
+def test_eclutch_operating_point_refuses_beyond_the_travel():
+    ec = E.EClutch()
+    with pytest.raises(OperatingPointError, match=r"bearing_position = 0.02 m is outside the CSC travel"):
+        ec.operating_point(0.02)
+    s = ec.as_system({"voltage": 0.0}, held_input=True)
+    with pytest.raises(OperatingPointError, match=r"target bearing_position = 0.012 is outside its physical range"):
+        operating_point(s, targets={"bearing_position": 0.012}, free_inputs=["motor_voltage"])
+    with pytest.raises(OperatingPointError, match=r"input motor_voltage = 20 is outside its physical range"):
+        operating_point(s, inputs={"motor_voltage": 20.0})
+
+
+def test_eclutch_steady_state_is_a_force_balance(frictionless):
+    op = frictionless.operating_point(4e-3)  # voltage input
+    assert op.value("bearing_position") == pytest.approx(4e-3, rel=1e-9)
+    assert op.value("bearing_velocity") == 0.0 or abs(op.value("bearing_velocity")) < 1e-12
+    a = frictionless.actuator
+    # the motor stands still: i = V / R
+    assert op.value("motor_current") == pytest.approx(op.u[0] / a.resistance, rel=1e-9)
+    # the CSC piston: p A_sl + preload spring (F_0 - k x) = clutch force on the bearing
+    spring = a.csc_preload - a.csc_spring_rate * 4e-3
+    assert op.value("bearing_force") + spring == pytest.approx(op.value("bearing_force_clutch"), rel=1e-9)
+    # no flow in the line, equal pressures at both ends
+    assert op.value("pressure") == pytest.approx(op.value("master_pressure"), rel=1e-9)
+    assert {"input_work", "dissipated", "friction_dissipated"} <= set(op.monitors)
+
+
+def test_closed_loop_step_matches_the_nonlinear_model(frictionless):
+    op = frictionless.operating_point(4e-3, input="bearing_reference")
+    lin = linearize(op, outputs=["bearing_position"])
+    assert lin.mode["friction_mode_bearing"] == "free"  # no friction element left on the CSC
+    assert lin.dcgain() == pytest.approx(1.0, rel=1e-6)  # integral action
+    d = 2e-5  # 0.5 % of the position
+    T = np.linspace(0.0, 0.3, 301)
+    sim = Simulation(op.start(), rtol=1e-8)
+    y = [0.0]
+    for t in T[1:]:
+        sim.advance(t, [op.u[0] + d])
+        y.append(sim.x[1] - op.x[1])
+    y_lin = control.forced_response(lin, T, np.full(T.size, d)).outputs
+    assert np.max(np.abs(np.array(y) - y_lin)) < 0.01 * d
+
+
+@pytest.mark.parametrize("f", [3.0, 20.0, 60.0])
+def test_bode_matches_simulated_sines(frictionless, f):
+    op = frictionless.operating_point(4e-3, input="bearing_reference")
+    lin = linearize(op, outputs=["bearing_position"])
+    Ts, amp, w = 5e-5, 1e-5, 2 * np.pi * f
+    n = int(round(2.0 / Ts))
+    tt = np.arange(1, n + 1) * Ts
+    yy = np.empty(n)
+    sim = Simulation(op.start(), rtol=1e-8)
+    for k in range(n):  # the input held over each Ts (zero-order hold of the sine)
+        sim.advance(tt[k], [op.u[0] + amp * np.sin(w * (tt[k] - Ts))])
+        yy[k] = sim.x[1] - op.x[1]
+    sel = tt > 1.5  # after the transient (slowest pole about -4.6 1/s)
+    M = np.column_stack([np.sin(w * tt[sel]), np.cos(w * tt[sel]), np.ones(sel.sum())])
+    a, b, _ = np.linalg.lstsq(M, yy[sel], rcond=None)[0]
+    g_sim = (a + 1j * b) / amp
+    g_lin = complex(np.squeeze(lin(1j * w))) * np.exp(-1j * w * Ts / 2)  # the hold delays by Ts / 2
+    table = frequency_table(lin, [f])
+    assert table[f"gain_bearing_position_m__bearing_reference_m"].iloc[0] == pytest.approx(abs(g_lin), rel=1e-12)
+    assert abs(g_sim) == pytest.approx(abs(g_lin), rel=1e-3)
+    assert abs(np.degrees(np.angle(g_sim / g_lin))) < 0.1
+
+
+def test_pole_map_over_the_travel_moves_the_line_resonance():
+    ec = E.EClutch()
+    pts = [(x, ec.operating_point(x)) for x in (1e-3, 4e-3, 7e-3)]
+    assert pts[0][1].modes["friction_mode_bearing"] == "slip_forward"  # linearised while sliding
+    poles = pole_sweep(pts, inputs=["motor_voltage"], outputs=["bearing_position"], name="bearing_position_m")
+    # the hydraulic line's resonance (lightly damped, 60-80 Hz) falls as the clutch gets softer
+    line = poles[(poles.pole_imag_1_s > 0) & poles.natural_frequency_Hz.between(50, 90)]
+    f = line.groupby("bearing_position_m").natural_frequency_Hz.first()
+    assert list(f.index) == [1e-3, 4e-3, 7e-3] and f.is_monotonic_decreasing
+    # beyond the diaphragm spring's force peak the open-loop actuator is unstable (negative stiffness)
+    assert (poles[poles.bearing_position_m == 7e-3].pole_real_1_s > 0).any()
+    assert not (poles[poles.bearing_position_m == 1e-3].pole_real_1_s > 0).any()
+
+
+def test_linear_model_files(tmp_path):
+    s = linear_system(np.array([[-1.0, 0.5], [0.0, -2.0]]), np.zeros(2), np.array([[1.0], [2.0]]))
+    lin = linearize(operating_point(s, inputs={"u0": 1.0}))
+    p = write_linear_model(lin, tmp_path / "lin.json")
+    doc = json.loads(p.read_text())
+    assert doc["states"] == ["x0_1", "x1_1"] and doc["A"] == [[-1.0, 0.5], [0.0, -2.0]]
+    assert doc["operating_point"]["input.u0_1"] == 1.0
+    with pytest.raises(Exception, match="exists"):
+        write_linear_model(lin, p)
+    q = write_linear_model(lin, tmp_path / "lin.csv")
+    rows = q.read_text().splitlines()
+    assert rows[0] == "matrix,row,column,value" and "A,x0_1,x1_1,0.5" in rows
+    with pytest.raises(ParameterError, match="json or .csv"):
+        write_linear_model(lin, tmp_path / "lin.txt")
