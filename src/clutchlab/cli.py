@@ -46,7 +46,8 @@ COMMANDS = {
 #: modules that contribute a sub-command (``register(subparsers)``), in the order of ``clutchlab --help``
 SUBSYSTEM_CLIS = tuple(dict.fromkeys(module for module, _ in COMMANDS.values()))
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
-DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo", "clutchlab.driveline.demo")
+DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo", "clutchlab.driveline.demo",
+                 "clutchlab.control.demo")
 #: longest error line the CLI prints [characters]; longer messages lose their middle (file names stay whole
 #: at the start, the reason at the end)
 MESSAGE_LIMIT = 400

@@ -7,7 +7,9 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   outputs (trim), within the system's physical limits;
 * :func:`linearize` -- a python-control ``StateSpace`` with named states, inputs and outputs (their
   unit in the name, ``bearing_position_m``), within the active mode of a hybrid model;
-* :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range.
+* :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range;
+* :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
+* :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling.
 
 python-control (``control`` on PyPI) is imported when a linear model is built, not with this package.
 """
@@ -17,7 +19,8 @@ from __future__ import annotations
 import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "jacobians", "frequency_table", "pole_sweep",
-           "write_linear_model", "OperatingPointError"]
+           "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
+           "pi_for_phase_margin", "ScheduledPI"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.control.trim",
@@ -28,6 +31,11 @@ _WHERE = {
     "frequency_table": "clutchlab.control.linear",
     "pole_sweep": "clutchlab.control.linear",
     "write_linear_model": "clutchlab.control.linear",
+    "closed_loop": "clutchlab.control.loop",
+    "ClosedLoopResult": "clutchlab.control.loop",
+    "PI": "clutchlab.control.design",
+    "pi_for_phase_margin": "clutchlab.control.design",
+    "ScheduledPI": "clutchlab.control.design",
 }
 
 

@@ -5,6 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..plotting import legend_outside, new_figure
+from ..units import column_label
+
+
+def _name(column: str) -> str:
+    """``bearing_position_m`` -> ``bearing position`` (the label without its unit)."""
+    return column_label(column).split(" [")[0]
+
+
+def _unit(column: str) -> str:
+    label = column_label(column)
+    return label[label.index("[") + 1:-1] if "[" in label else "1"
 
 __all__ = ["bode_figure", "pole_map_figure"]
 
@@ -33,12 +44,13 @@ def bode_figure(models, frequencies_hz, *, title: str = ""):
         table = frequency_table(sys, f)
         for o in sys.output_labels:
             for i in sys.input_labels:
-                name = label if sys.ninputs * sys.noutputs == 1 else f"{label}: {o} / {i}"
+                name = label if sys.ninputs * sys.noutputs == 1 else f"{label}: {_name(o)} / {_name(i)}"
                 (line,) = ax_m.semilogx(f, table[f"gain_dB_{o}__{i}"], label=name)
-                ax_p.semilogx(f, table[f"phase_deg_{o}__{i}"], color=line.get_color())
+                ax_p.semilogx(f, table[f"phase_deg_{o}__{i}"], color=line.get_color(), label=name)
     first = models[0][1]
     if first.ninputs * first.noutputs == 1:
-        ax_m.set_ylabel(f"|{first.output_labels[0]} / {first.input_labels[0]}| [dB]")
+        o, i = first.output_labels[0], first.input_labels[0]
+        ax_m.set_ylabel(f"|{_name(o)} / {_name(i)}| [dB re 1 {_unit(o)}/{_unit(i)}]")
     else:
         ax_m.set_ylabel("magnitude [dB]")
     ax_p.set_ylabel("phase [deg]")
@@ -46,6 +58,7 @@ def bode_figure(models, frequencies_hz, *, title: str = ""):
     for ax in (ax_m, ax_p):
         ax.grid(True, which="both", alpha=0.3)
     legend_outside(ax_m)
+    legend_outside(ax_p)
     if title:
         fig.suptitle(title)
     return fig
@@ -73,10 +86,11 @@ def pole_map_figure(poles, value: str, *, title: str = "", scale: float = 1.0, u
     """
     fig, ax = new_figure(1, 1, width=7.0, height=4.5)
     sc = ax.scatter(poles["pole_real_1_s"], poles["pole_imag_1_s"] / (2 * np.pi), c=poles[value] * scale, s=14,
-                    cmap="viridis")
+                    cmap="viridis", label="poles")
     cb = fig.colorbar(sc, ax=ax)
     cb.set_label(f"{value} [{unit}]" if unit else value)
-    ax.axvline(0.0, color="k", lw=0.8)
+    ax.axvline(0.0, color="k", lw=0.8, label="stability boundary")
+    ax.legend(loc="upper left", fontsize=8)
     ax.set_xscale("symlog", linthresh=10.0)
     ax.set_xlabel("real part [1/s]")
     ax.set_ylabel("imaginary part / 2π [Hz]")

@@ -980,6 +980,8 @@ class Assembly:
     def limits(self) -> dict:
         """Physical range of the actuator [SI]: CSC travel, master stroke, supply voltage, current limit."""
         a = self.actuator
+        if a is None:  # the clutch alone, its bearing moved by a prescribed input
+            return {}
         travel = (float(a.slave_min), float(a.slave_max))
         return {"bearing_position": travel, "bearing_reference": travel, "master_position": (0.0, float(a.master_stroke)),
                 "motor_voltage": (-float(a.supply_voltage), float(a.supply_voltage)),

@@ -1,0 +1,128 @@
+"""Controllers in the loop and PI design against python-control's own closed loops."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+control = pytest.importorskip("control")
+
+from clutchlab.control.design import PI, ScheduledPI, pi_for_phase_margin  # noqa: E402
+from clutchlab.control.loop import closed_loop  # noqa: E402
+from clutchlab.errors import ParameterError  # noqa: E402
+from core_toys import linear_system  # noqa: E402
+
+A = np.array([[0.0, 1.0], [-40.0, -3.0]])  # a lightly damped mass-spring, y = x0
+B = np.array([[0.0], [40.0]])
+
+
+def _plant():
+    return control.ss(A, B, [[1.0, 0.0]], [[0.0]])
+
+
+@settings(deadline=None, max_examples=20)
+@given(st.floats(0.3, 3.0), st.floats(20.0, 80.0))
+def test_pi_reaches_the_phase_margin_at_the_crossover(fc, pm):
+    G = _plant()
+    try:
+        pi = pi_for_phase_margin(G, fc, pm)
+    except ParameterError as exc:  # only where a PI cannot do it: the phase needed is outside (-90, 0) deg
+        assert "cannot give" in str(exc) or "unstable" in str(exc)
+        return
+    L = pi.tf() * control.tf(G)
+    w = 2 * np.pi * fc
+    assert abs(complex(np.squeeze(L(1j * w)))) == pytest.approx(1.0, rel=1e-9)
+    phase = np.degrees(np.angle(complex(np.squeeze(L(1j * w)))))
+    assert (phase + 180.0 - pm + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-7)
+    assert np.all(control.feedback(L, 1).poles().real < 0)
+
+
+def test_pi_refuses_what_it_cannot_do():
+    with pytest.raises(ParameterError, match="cannot give"):
+        pi_for_phase_margin(_plant(), 50.0, 60.0)  # far above the resonance the plant has -180 deg
+    with pytest.raises(ParameterError, match="in \\(0, 90\\)"):
+        pi_for_phase_margin(_plant(), 1.0, 120.0)
+
+
+@pytest.mark.parametrize("delay", [0, 1])
+def test_discrete_loop_equals_the_sampled_data_closed_loop(delay):
+    """The loop (model between samples, controller at samples, zero-order hold) against python-control:
+    the plant discretised exactly (ZOH) in feedback with the same discrete controller."""
+    Ts = 0.01
+    s = linear_system(A, np.zeros(2), B)
+    C = PI(0.3, 0.1).discrete(Ts)
+    r = 0.1
+    res = closed_loop(s, C, Ts, 3.0, measure=["x0"], actuate=["u0"], reference=r, rtol=1e-11, delay=delay)
+    Gd = control.c2d(_plant(), Ts, "zoh")
+    Cs = control.ss(C)
+    n = res.frame.shape[0]
+    xg, xc, pending = np.zeros(2), np.zeros(Cs.nstates), 0.0
+    y_ref, u_ref = np.empty(n), np.empty(n)
+    for k in range(n):
+        y = float((Gd.C @ xg)[0])
+        e = r - y
+        out = float((Cs.C @ xc + Cs.D @ [e])[0])
+        xc = Cs.A @ xc + Cs.B @ [e]
+        applied, pending = (out, out) if delay == 0 else (pending, out)
+        y_ref[k], u_ref[k] = y, applied
+        xg = Gd.A @ xg + Gd.B[:, 0] * applied
+    np.testing.assert_allclose(res.frame["x0_1"], y_ref, atol=1e-8)
+    np.testing.assert_allclose(res.frame["u0_1"], u_ref, atol=1e-8)
+    assert abs(res.frame["x0_1"].iloc[-100:].mean() - r) < 0.05 * r  # integral action: no offset left
+    assert res.frame["reference_x0_1"].eq(r).all()
+
+
+def test_function_controller_memory_and_saturation():
+    Ts = 0.01
+    s = linear_system(A, np.zeros(2), B).replace(limits={"u0": (-0.05, 0.05)})
+    calls = []
+
+    def bang(t, y, memory):
+        memory[0] += 1.0  # counts the samples
+        calls.append(memory[0])
+        return np.array([1.0 if y[0] < 0.5 else -1.0])
+
+    res = closed_loop(s, bang, Ts, 0.5, measure=["x0"], actuate=["u0"], memory=[0.0])
+    assert calls == list(np.arange(1.0, 52.0))
+    assert set(np.round(res.frame["u0_1"], 12)) <= {0.05, -0.05} and res.frame["saturated_1"].all()
+    # without saturation the output is applied as returned
+    free = closed_loop(s, bang, Ts, 0.5, measure=["x0"], actuate=["u0"], saturate=False)
+    assert set(free.frame["u0_1"]) <= {1.0, -1.0} and not free.frame["saturated_1"].any()
+
+
+def test_loop_refuses_bad_requests():
+    s = linear_system(A, np.zeros(2), B)
+    with pytest.raises(ParameterError, match="c2d"):
+        closed_loop(s, PI(1.0, 1.0).tf(), 0.01, 1.0, measure=["x0"], actuate=["u0"])
+    with pytest.raises(ParameterError, match="differs from sample_time"):
+        closed_loop(s, PI(1.0, 1.0).discrete(0.02), 0.01, 1.0, measure=["x0"], actuate=["u0"])
+    with pytest.raises(ParameterError, match="unknown input 'volts'"):
+        closed_loop(s, PI(1.0, 1.0).discrete(0.01), 0.01, 1.0, measure=["x0"], actuate=["volts"])
+    with pytest.raises(ParameterError, match="sample_time"):
+        closed_loop(s, PI(1.0, 1.0).discrete(0.01), 0.0, 1.0, measure=["x0"], actuate=["u0"])
+
+
+def test_scheduled_pi_interpolates_its_gains():
+    pi = ScheduledPI(np.array([0.0, 1.0]), np.array([1.0, 3.0]), np.array([1.0, 1.0]), None, 0.1,
+                     lambda t: 1.0)
+    mem = np.array([0.0])
+    u = pi(0.0, np.array([0.5]), mem)  # kp = 2 at 0.5, e = 0.5
+    assert u[0] == pytest.approx(2 * 0.5 + 2 * 0.1 / 1.0 * 0.5)
+    assert mem[0] == pytest.approx(0.1)
+
+
+def test_eclutch_worked_design_linear_prediction_holds_on_the_nonlinear_model():
+    """Worked design (1): PI for 60 deg at 5 Hz, scheduled over the travel, at 1 kHz on the nonlinear model."""
+    from clutchlab.control import demo
+
+    d = demo.design()
+    assert d["ops"][d["touch"]].value("normal_force") == pytest.approx(0.0, abs=80.0)  # near the touch point
+    runs = demo.step_runs(d, t_end=0.3)
+    for r in runs:
+        # the overshoot the linear closed loop predicts, within 2 percentage points
+        assert abs(r["overshoot_nonlinear"] - r["overshoot_linear"]) < 2.0, r["position"]
+        # and the rise the same: within 3 % of the step over the first 60 ms
+        first = r["time_s"] <= 0.06
+        assert np.max(np.abs(r["nonlinear"][first] - r["linear"][first])) < 0.03
