@@ -285,6 +285,28 @@ class Preisach:
                 raise ParameterError(f"family: model {k} has a different current grid")
         return cls(grid, np.concatenate([m.tables for m in models]), airgaps)
 
+    def anhysteretic(self) -> "Preisach":
+        """The same characteristic without hysteresis: ``F(alpha, beta) = g(beta)`` on every table.
+
+        ``g(u) = (F(u, u) + F(u_max, u)) / 2`` is the mean of the limiting ascending and descending
+        branches of the major loop ([1], Sec. 2.1) at each grid current (and airgap table). The model it
+        gives is single-valued: its output depends on the present input only, and its inverse
+        (:meth:`invert`) is the static inverse characteristic a compensator without a hysteresis model
+        uses -- the "without inverse Preisach compensation" case of [1], Fig. 7.
+
+        Returns
+        -------
+        Preisach
+            Same grid and airgaps.
+        """
+        n = self.grid.size
+        tables = np.empty_like(self.tables)
+        for k in range(self.tables.shape[0]):
+            t = self.tables[k]
+            g = 0.5 * (np.diag(t) + t[n - 1, :])  # ascending F(u, u), descending F(u_max, u)
+            tables[k] = np.tril(np.broadcast_to(g, (n, n))) + np.triu(np.full((n, n), np.nan), 1)
+        return Preisach(self.grid, tables, self.airgaps if self._has_gap else None)
+
     # ------------------------------------------------------------- state
     def reset(self) -> None:
         """Return to the initial memory: input at the lowest grid value, all relays off."""
