@@ -7,6 +7,7 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   outputs (trim), within the system's physical limits;
 * :func:`linearize` -- a python-control ``StateSpace`` with named states, inputs and outputs (their
   unit in the name, ``bearing_position_m``), within the active mode of a hybrid model;
+  :func:`nonlinear_iosystem` -- the model as a python-control ``NonlinearIOSystem`` (one mode);
 * :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
 * :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling.
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import importlib
 
-__all__ = ["OperatingPoint", "operating_point", "linearize", "jacobians", "frequency_table", "pole_sweep",
+__all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
            "pi_for_phase_margin", "ScheduledPI"]
 
@@ -28,6 +29,7 @@ _WHERE = {
     "OperatingPointError": "clutchlab.control.trim",
     "linearize": "clutchlab.control.linear",
     "jacobians": "clutchlab.control.linear",
+    "nonlinear_iosystem": "clutchlab.control.linear",
     "frequency_table": "clutchlab.control.linear",
     "pole_sweep": "clutchlab.control.linear",
     "write_linear_model": "clutchlab.control.linear",

@@ -30,7 +30,7 @@ from ..errors import ParameterError
 from ..system import System, evaluate
 from .trim import OperatingPoint, input_scale, resolve, state_scale
 
-__all__ = ["jacobians", "linearize", "frequency_table", "pole_sweep", "write_linear_model"]
+__all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "write_linear_model"]
 
 #: relative step of the central differences (about the cube root of the machine epsilon)
 FD_STEP = 6e-6
@@ -189,6 +189,56 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     sys.units = {v.column: v.unit for v in (*state_vars, *in_vars, *out_vars)}
     sys.analytic_jacobian = jac["analytic"]
     return sys
+
+
+def nonlinear_iosystem(system: System, op: OperatingPoint | None = None, outputs=None, *, name: str | None = None):
+    """The model as a python-control ``NonlinearIOSystem`` (for python-control's own tools).
+
+    The update and output functions evaluate the model's right-hand side and outputs through the
+    contract at fixed modes (those of ``op``, else the system's initial modes): python-control's
+    ``input_output_response``, ``find_operating_point`` and ``linearize`` then see one mode of the hybrid
+    model, without its events. For simulation use :func:`clutchlab.system.simulate` (events, compiled).
+
+    Parameters
+    ----------
+    system : System
+        A model with a unit mass matrix (no algebraic rows: python-control integrates ODEs only).
+    op : OperatingPoint, optional
+        Gives the modes (default: ``system.m0``).
+    outputs : sequence of str, optional
+        States or outputs (default: all outputs).
+    name : str, optional
+        Name of the I/O system.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States, inputs and outputs named by column (``bearing_position_m``).
+
+    Raises
+    ------
+    ParameterError
+        A system with algebraic rows (mass 0).
+    """
+    import control
+
+    if np.any(system.mass != 1.0):
+        raise ParameterError(f"{system.name}: a mass matrix other than the identity (algebraic rows) cannot be "
+                             "a python-control NonlinearIOSystem; use linearize() for its linear model")
+    m = (op.m if op is not None else system.m0).copy()
+    outs = _signals(system, outputs, ("state", "output"), [v.name for v in system.outputs])
+
+    def update(t, x, u, params):
+        return evaluate(system, t, np.asarray(x, float), np.atleast_1d(np.asarray(u, float)), m)[0]
+
+    def output(t, x, u, params):
+        x = np.asarray(x, float)
+        y = evaluate(system, t, x, np.atleast_1d(np.asarray(u, float)), m)[2]
+        return np.array([x[i] if kind == "state" else y[i] for kind, i in outs])
+
+    return control.nlsys(update, output, states=list(system.state_columns), inputs=list(system.input_columns),
+                         outputs=[(system.states if k == "state" else system.outputs)[i].column for k, i in outs],
+                         name=name or system.name)
 
 
 def frequency_table(sys, frequencies_hz) -> "pandas.DataFrame":  # noqa: F821
