@@ -149,7 +149,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                           description="Compile (or load from the cache) the numerical kernels of every model, one "
                                       "group per process, so that later runs start at once.",
                           epilog="Documentation: docs/architecture.md")
-    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc, driveline (default: all)")
+    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc, driveline, control (default: all)")
     warm.add_argument("-j", "--jobs", type=int, default=None, help="processes (default: the number of cores)")
     warm.set_defaults(func=_warmup)
     registered = set()

@@ -70,8 +70,23 @@ def _warm_driveline() -> None:
     d.simulate(0.02, output_step=0.01)
 
 
+def _warm_control() -> None:
+    # what control design adds to the E-clutch's and the EMTC's kernels: the point evaluations of the
+    # contract (right-hand side, outputs, analytic Jacobian) that trim and linearisation call
+    import numpy as np
+
+    from .eclutch import EClutch
+    from .numerics.core import evaluate_jacobian
+    from .system import evaluate
+
+    system = EClutch().as_system({"voltage": 0.0}, held_input=True)
+    evaluate(system)
+    evaluate_jacobian(system.params, 0.0, system.x0, system.u0, system.m0, np.zeros((system.x0.size,) * 2))
+
+
 #: compile groups: name -> function that runs the group's kernels once on a tiny problem
-GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "driveline": _warm_driveline}
+GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "driveline": _warm_driveline,
+          "control": _warm_control}
 
 
 def _check(names) -> None:

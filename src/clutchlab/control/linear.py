@@ -76,30 +76,33 @@ def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
     def pick(xx, y):
         return np.array([xx[i] if kind == "state" else y[i] for kind, i in outs])
 
+    def moved(vec, j, h):
+        """Right-hand side and picked outputs with component ``j`` of ``vec`` (x or u) moved by +h and -h."""
+        out = []
+        for sign in (1.0, -1.0):
+            v = vec.copy()
+            v[j] += sign * h
+            xx, uu = (v, u) if vec is x else (x, v)
+            f, _, y = evaluate(system, t, xx, uu, m)
+            out.append((f, pick(xx, y)))
+        return out
+
     A = np.zeros((n, n))
     C = np.zeros((q, n))
     analytic = bool(evaluate_jacobian(system.params, float(t), x, u, m, A))
     for j in range(n):
         h = FD_STEP * xs[j]
-        xp, xm = x.copy(), x.copy()
-        xp[j] += h
-        xm[j] -= h
-        fp, _, yp = evaluate(system, t, xp, u, m)
-        fm, _, ym = evaluate(system, t, xm, u, m)
+        (fp, yp), (fm, ym) = moved(x, j, h)
         if not analytic:
             A[:, j] = (fp - fm) / (2 * h)
-        C[:, j] = (pick(xp, yp) - pick(xm, ym)) / (2 * h)
+        C[:, j] = (yp - ym) / (2 * h)
     B = np.zeros((n, len(ins)))
     D = np.zeros((q, len(ins)))
     for k, (_, j) in enumerate(ins):
         h = FD_STEP * us[j]
-        up, um = u.copy(), u.copy()
-        up[j] += h
-        um[j] -= h
-        fp, _, yp = evaluate(system, t, x, up, m)
-        fm, _, ym = evaluate(system, t, x, um, m)
+        (fp, yp), (fm, ym) = moved(u, j, h)
         B[:, k] = (fp - fm) / (2 * h)
-        D[:, k] = (pick(x, yp) - pick(x, ym)) / (2 * h)
+        D[:, k] = (yp - ym) / (2 * h)
     for name, M in (("A", A), ("B", B), ("C", C), ("D", D)):
         if not np.all(np.isfinite(M)):
             raise ParameterError(f"{system.name}: the Jacobian {name} is not finite at this operating point "
