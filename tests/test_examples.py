@@ -49,7 +49,7 @@ def _key(args: list[str]) -> str:
 
 
 def _outputs(args):
-    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot", "--events")]
+    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot", "--events", "--poles", "--table")]
 
 
 def test_every_readme_line_is_a_clutchlab_command_with_existing_inputs():
@@ -322,8 +322,28 @@ def check_awd(work, out):
     assert "energy balance" in out
 
 
+def check_lin(work, out):
+    import json
+
+    m = json.loads((work / "lin.json").read_text())
+    assert m["inputs"] == ["motor_voltage_V"] and m["outputs"] == ["bearing_position_m", "pressure_Pa"]
+    A, B, C = (np.array(m[k]) for k in "ABC")
+    assert np.all(np.linalg.eigvals(A).real < 0)                       # stable at 4 mm, before the force peak
+    assert (-C @ np.linalg.solve(A, B))[0, 0] > 0                      # more voltage, further out
+    assert m["mode"]["friction_mode_bearing"] == "slip_forward" and "13 states" in out
+
+
+def check_bode(work, out):
+    assert _is_png(work / "bode.png")
+    poles = _csv(work / "poles.csv")
+    assert set(poles.bearing_position_m) == {1e-3, 4e-3, 7e-3}
+    assert (poles[poles.bearing_position_m == 7e-3].pole_real_1_s > 0).any()   # beyond the force peak
+
+
 CHECKS = {
     "awd.csv": check_awd,
+    "lin.json": check_lin,
+    "bode.png": check_bode,
     "cc.csv": check_coupled_clutches,
     "drive_off.csv": check_drive_off,
     "sae2.csv": check_sae2,
