@@ -38,6 +38,7 @@ from .numerics import status as st
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
+           "check_fixed_step",
            "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
