@@ -27,6 +27,9 @@ Both share the hybrid logic:
   exactly and call the model's ``restart``;
 * after every accepted step the model's ``accept`` runs (hysteresis memory
   commit, projection of stuck velocities);
+* a fixed-step mode of :func:`advance_rodas` (``Options.fixed_step`` > 0,
+  a HIL frame: the same work every step, events and breaks at the step end;
+  docs/architecture.md);
 * stepping is resumable: :func:`advance_dopri` / :func:`advance_rodas`
   continue from the solver state ``(sf, si)`` to ``t_end`` (co-simulation,
   controller sampling, chunked recording).
@@ -1029,6 +1032,15 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     a rejection or a mode change.  The state at a located event comes from
     one Rodas3 step of the located length from the step start, so the
     algebraic rows stay consistent.
+
+    With ``opt.fixed_step`` > 0 (the fixed-step mode, a HIL frame) the loop
+    takes steps of exactly that length on the grid ``t0 + k * fixed_step``
+    (``t0`` the run's start, ``sf[SF_T0]``; an end off the grid ends with a
+    shorter step), without error control, with the Jacobian every step
+    (forward differences only) and the same number of right-hand sides every
+    step; switching functions are looked at the step end (``update`` there,
+    no root finding) and break times inside a step call ``restart`` at its
+    end.  Any model can run so, also one registered for Dormand-Prince.
 
     Parameters
     ----------
