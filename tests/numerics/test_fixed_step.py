@@ -154,3 +154,27 @@ def test_ball_bounces_at_step_ends():
     assert len(t_fix) == 4 and res.status.name == "TERMINATED"
     assert t_fix[0] == pytest.approx(math.ceil(t_ref[0] / 1e-3) * 1e-3, abs=1e-12)
     assert np.all(t_fix >= t_ref - 1e-12)
+
+
+def test_driveline_clutch_modes_change_at_the_first_step_end_after_the_located_time():
+    """Modelica's CoupledClutches as a driveline network (a Dormand-Prince model): every stick, reversal and
+    release of the three clutches is recorded at the first 1 ms frame end at or after the adaptive run's instant."""
+    from pathlib import Path
+
+    from clutchlab.driveline.description import load_driveline
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "driveline_coupled_clutches.toml"
+    system = load_driveline(example).driveline.system()
+    ref = simulate(system, 1.5, rtol=1e-10)
+    h = 1e-3
+    res = simulate(system, 1.5, fixed_step=h, output_step=0.01)
+    assert list(res.events["event"]) == list(ref.events["event"]) and len(res.events) >= 8
+    assert list(res.events["element"]) == list(ref.events["element"])
+    firsts = [math.ceil(t_ref / h - 1e-9) * h for t_ref in ref.events["time_s"]]
+    # the first located stick (0.7096 s, before any mode change came late): at the next frame end
+    assert res.events["time_s"][1] == pytest.approx(firsts[1], abs=1e-12) and ref.events["time_s"][1] < firsts[1]
+    # all: at the first frame end at or after the adaptive instant, or one frame later (the fixed-step trajectory
+    # carries the earlier delays; a switching function that reaches zero exactly on a frame end, at the break
+    # time 1.25 s, crosses in the next frame)
+    for t_fix, first in zip(res.events["time_s"], firsts):
+        assert first - 1e-12 <= t_fix <= first + h + 1e-12
