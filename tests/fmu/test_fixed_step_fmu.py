@@ -52,3 +52,19 @@ def test_emtc_cosimulation_runs_fixed_step(run_cosim):
 def test_bad_fixed_step_parameter_is_refused(bad):
     with pytest.raises(ParameterError, match="solver.fixed_step"):
         WetCoSimulation(**{"solver.fixed_step": bad})
+
+
+def test_eclutch_cosimulation_runs_fixed_step(run_cosim):
+    """The E-clutch (stiff, Rodas3 anyway) in 1 ms frames inside 5 ms communication steps follows its adaptive run."""
+    from clutchlab.eclutch.cosim import EClutchCoSimulation
+
+    dt, n = 5e-3, 60
+    k = np.arange(n + 1)
+    inputs = {"bearing_reference": np.where(k < 10, 0.0, 5e-3), "motor_voltage": np.zeros(n + 1)}
+    fixed_c = EClutchCoSimulation(**{"solver.fixed_step": 1e-3})
+    fixed = run_cosim(fixed_c, inputs, dt, n)
+    adaptive = run_cosim(EClutchCoSimulation(), inputs, dt, n)
+    assert fixed_c.simulation.stats["accepted_steps"] == 5 * n
+    assert np.all(np.isfinite(fixed["bearing_position"]))
+    assert np.max(fixed["bearing_position"]) > 3e-3
+    assert np.max(np.abs(fixed["bearing_position"] - adaptive["bearing_position"])) < 2e-5

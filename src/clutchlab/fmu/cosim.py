@@ -54,6 +54,8 @@ __all__ = [
     "parameter_set_variables",
     "build_parameter_set",
     "fmi_unit",
+    "fixed_step_parameter",
+    "FIXED_STEP_DOC",
 ]
 
 def load_cosimulation(name: str) -> type:
@@ -316,12 +318,23 @@ def _flag(name: str, value: float) -> bool:
 
 
 #: description of the ``solver.fixed_step`` parameter of the co-simulations
-_FIXED_STEP_DOC = ("fixed-step (real-time) mode: Rodas3 steps of this length [s] on the grid k * fixed_step, "
+FIXED_STEP_DOC = ("fixed-step (real-time) mode: Rodas3 steps of this length [s] on the grid k * fixed_step, "
                    "events at step ends; 0 = step-size control")
 
 
-def _fixed_step(values: dict):
-    """``solver.fixed_step`` of the parameter values: None for 0 (step-size control), else the checked step."""
+def fixed_step_parameter(values: dict):
+    """The ``solver.fixed_step`` parameter of a co-simulation: None for 0 (step-size control), else the step [s].
+
+    Parameters
+    ----------
+    values : dict
+        Parameter values by name (:meth:`CoSimulation.resolve_parameters`), with ``solver.fixed_step`` [s].
+
+    Raises
+    ------
+    ParameterError
+        A negative or non-finite value.
+    """
     from ..system import check_fixed_step
 
     h = values["solver.fixed_step"]
@@ -418,7 +431,7 @@ def _wet_variables():
         Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f"),
         Variable("solver.rtol", "1", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
         Variable("solver.max_step", "s", 0.01, "largest integration step"),
-        Variable("solver.fixed_step", "s", 0.0, _FIXED_STEP_DOC),
+        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
     )
     return clutch + bench + scenario
 
@@ -516,7 +529,7 @@ class WetCoSimulation(CoSimulation):
             raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
         if not self.max_step > 0:
             raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
-        self.fixed_step = _fixed_step(values)
+        self.fixed_step = fixed_step_parameter(values)
         # flat (zero) profiles: the references are the held inputs of the system
         self.scenario = E.Scenario(
             force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
@@ -677,7 +690,7 @@ def _emtc_variables():
                Variable("scenario.sample_time", "s", scen.sample_time,
                         "EMTC controller sample time (any communication step: the controller samples at its own instants)"),
                Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control"),
-               Variable("solver.fixed_step", "s", 0.0, _FIXED_STEP_DOC)))
+               Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC)))
 
 
 class EmtcCoSimulation(ContractCoSimulation):
@@ -756,7 +769,7 @@ class EmtcCoSimulation(ContractCoSimulation):
                                        drum_load_rear=values["scenario.drum_load_rear"],
                                        sample_time=self.sample_time, duration=max(4.0, self.sample_time))
         self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling)
-        self.fixed_step = _fixed_step(values)
+        self.fixed_step = fixed_step_parameter(values)
         self.simulation_options = {"rtol": self.rtol, "max_steps": 2_000_000, "fixed_step": self.fixed_step}
         super().__init__(**parameter_values)
 
