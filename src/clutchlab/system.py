@@ -652,7 +652,7 @@ class Simulation:
         si = self._si
         return {"accepted_steps": int(si[self._core.SI_ACCEPTED]), "rejected_steps": int(si[self._core.SI_REJECTED]),
                 "rhs_evaluations": int(si[self._core.SI_NRHS]), "jacobians": int(si[self._core.SI_NJAC]),
-                "events_dropped": int(self.log.count[1])}
+                "events_dropped": int(self.log.count[1]), "fixed_step": self.fixed_step}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -812,7 +812,7 @@ def _write_back(dst, src, v) -> None:
 
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
-                   event_capacity: int = 256, check: bool = False) -> SimulationResult:
+                   event_capacity: int = 256, check: bool = False, fixed_step: float | None = None) -> SimulationResult:
     """Simulate variants of one model in parallel: one solver per variant (``numba.prange``).
 
     Parameters
@@ -833,6 +833,8 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         Events kept per variant.
     check : bool
         Raise if any variant failed (otherwise see ``status``).
+    fixed_step : float, optional
+        Fixed-step mode with this step [s] for every variant, as :func:`simulate`.
 
     Returns
     -------
@@ -851,7 +853,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     ts = sample_grid(0.0, float(t_end), output_step, sample_times)
     if ts is None:
         ts = np.array([float(t_end)])
-    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps)
+    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
     nv, ns = len(batch), ts.size
     if nv == 0:
         raise ParameterError("simulate_batch: no variants")
@@ -867,7 +869,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     EVC = np.zeros((nv, event_capacity), dtype=np.int64)
     EVE = np.zeros((nv, event_capacity), dtype=np.int64)
     EVN = np.zeros((nv, 2), dtype=np.int64)
-    core.batch(first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
+    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
                EVT, EVC, EVE, EVN)
     if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
         for v, s in enumerate(given):

@@ -178,3 +178,14 @@ def test_driveline_clutch_modes_change_at_the_first_step_end_after_the_located_t
     # time 1.25 s, crosses in the next frame)
     for t_fix, first in zip(res.events["time_s"], firsts):
         assert first - 1e-12 <= t_fix <= first + h + 1e-12
+
+
+def test_batch_runs_fixed_step_like_simulate():
+    from clutchlab.system import simulate_batch
+
+    systems = [toys.linear_system(A_OSC * s, X0, method="dopri") for s in (0.5, 1.0, 2.0)]
+    batch = simulate_batch(systems, 0.2, output_step=0.01, fixed_step=1e-3, check=True)
+    for v, system in enumerate(systems):
+        one = simulate(system, 0.2, output_step=0.01, fixed_step=1e-3)
+        np.testing.assert_array_equal(batch.states[v], one.states)
+    assert np.all(batch.stats["accepted_steps"] == 200)
