@@ -38,6 +38,7 @@ from .numerics import status as st
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
+           "check_fixed_step",
            "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
@@ -266,15 +267,22 @@ class System:
         return {}
 
     def options(self, *, rtol=None, atol=None, max_step=None, max_steps=1_000_000, first_step=None,
-                event_tol=None):
+                event_tol=None, fixed_step=None):
         """The core's :class:`~clutchlab.numerics.core.Options` from this system's defaults and overrides.
 
         Built once per set of arguments (without an ``atol`` array) and remembered: checking and
         converting them was a tenth of a short run's time.
+
+        Parameters
+        ----------
+        rtol, atol, max_step, max_steps, first_step, event_tol
+            As :func:`simulate` (defaults: this system's).
+        fixed_step : float, optional
+            Fixed-step mode's step [s] (:func:`simulate`); None for step-size control.
         """
         key = None
         if atol is None:
-            key = (rtol, max_step, max_steps, first_step, event_tol)
+            key = (rtol, max_step, max_steps, first_step, event_tol, fixed_step)
             try:
                 hit = self._option_memo.get(key)
             except TypeError:  # an unhashable argument: checked (and refused) below
@@ -283,12 +291,13 @@ class System:
                 return hit
         from .numerics.core import Options
 
-        opt = self._build_options(Options, rtol, atol, max_step, max_steps, first_step, event_tol)
+        opt = self._build_options(Options, rtol, atol, max_step, max_steps, first_step, event_tol, fixed_step)
         if key is not None and len(self._option_memo) < 32:
             self._option_memo[key] = opt
         return opt
 
-    def _build_options(self, Options, rtol, atol, max_step, max_steps, first_step, event_tol):
+    def _build_options(self, Options, rtol, atol, max_step, max_steps, first_step, event_tol, fixed_step=None):
+        fixed = check_fixed_step(fixed_step)
         rtol = self.rtol if rtol is None else rtol
         if not (isinstance(rtol, (int, float, np.floating)) and 0.0 < float(rtol) < 1.0):
             raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
@@ -305,10 +314,18 @@ class System:
             raise ParameterError(f"max_steps = {short_repr(max_steps)}: must be >= 1")
         first_step = self.first_step if first_step is None else first_step
         event_tol = self.event_tol if event_tol is None else event_tol
+        if fixed == 0.0:
+            return Options(float(rtol), np.ascontiguousarray(atol_v), float(min(max_step, 1e300)),
+                           float(first_step), int(max_steps), float(event_tol), self._directions, self.mass,
+                           self._jac_groups, self.jac_pattern, self.fd_scale,
+                           int(self.jac_every), bool(self.nonautonomous))
+        # fixed-step mode: the Rosenbrock loop for every model; a Dormand-Prince model gets difference columns
+        # (all of them, grouped by its pattern) and df/dt (its inputs may vary inside a frame)
+        groups = _colour_columns(self.jac_pattern, self.jac_cols) if self.method != "rodas" else self._jac_groups
         return Options(float(rtol), np.ascontiguousarray(atol_v), float(min(max_step, 1e300)), float(first_step),
-                       int(max_steps), float(event_tol), self._directions, self.mass, self._jac_groups,
-                       self.jac_pattern, self.fd_scale,
-                       int(self.jac_every), bool(self.nonautonomous))
+                       int(max_steps), float(event_tol), self._directions, self.mass, groups,
+                       self.jac_pattern, self.fd_scale, 1, bool(self.nonautonomous or self.method != "rodas"),
+                       fixed)
 
     @functools.cached_property
     def _directions(self) -> np.ndarray:
@@ -368,6 +385,23 @@ def _colour(pattern: np.ndarray, cols: np.ndarray) -> np.ndarray:
     for i, g in enumerate(groups):
         out[i, :len(g)] = g
     return out
+
+
+def check_fixed_step(fixed_step) -> float:
+    """The fixed step [s] of a run (0.0 for None: step-size control); :class:`ParameterError` unless finite and > 0.
+
+    Parameters
+    ----------
+    fixed_step : float or None
+        Step [s] of the fixed-step mode, or None.
+    """
+    if fixed_step is None:
+        return 0.0
+    if isinstance(fixed_step, (bool, np.bool_)) or not isinstance(fixed_step, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(fixed_step) and fixed_step > 0):
+        raise ParameterError(f"fixed_step = {short_repr(fixed_step)}: must be a finite step > 0 [s] (or None for "
+                             "step-size control)")
+    return float(fixed_step)
 
 
 def _index(vars_, name, kind, model):
@@ -441,7 +475,7 @@ def _check_status(system: System, code: int, si, t, check: bool):
 def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=None, max_step: float | None = None,
              output_step: float | None = None, sample_times=None, max_steps: int = 1_000_000,
              first_step: float | None = None, event_tol: float | None = None, outputs: bool = True,
-             t0: float = 0.0, check: bool = True) -> SimulationResult:
+             t0: float = 0.0, check: bool = True, fixed_step: float | None = None) -> SimulationResult:
     """Simulate a system from ``t0`` to ``t_end`` with the integrator core.
 
     Parameters
@@ -470,17 +504,26 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     check : bool
         Raise :class:`~clutchlab.errors.SimulationError` for a failed run (otherwise the
         result carries the status).
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3 (linearly implicit, L-stable,
+        order 3) for every model, steps on the grid ``t0 + k * fixed_step`` (the last one shorter if
+        ``t_end`` is not on it), no error control, the Jacobian every step, mode changes and break times
+        inside a step handled at its end (docs/architecture.md, "Fixed-step mode").  ``rtol``, ``atol``,
+        ``max_step``, ``first_step`` and ``event_tol`` are accepted and unused.  None (default): step-size
+        control.
 
     Returns
     -------
     SimulationResult
+        ``stats`` holds the solver counters (``accepted_steps``, ``rhs_evaluations``, ...) and
+        ``fixed_step`` (0.0 for step-size control).
     """
     core = _numerics_core()
 
     if not (isinstance(t_end, (int, float, np.floating)) and math.isfinite(t_end) and t_end > t0):
         raise ParameterError(f"t_end = {short_repr(t_end)}: must be finite and > t0 = {t0:g} s")
     opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, first_step=first_step,
-                         event_tol=event_tol)
+                         event_tol=event_tol, fixed_step=fixed_step)
     ts = sample_grid(t0, float(t_end), output_step, sample_times)
     nx, ny, nm = len(system.states), len(system.outputs), len(system.mode_names)
     x = system.x0.copy()
@@ -488,7 +531,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     u = system.u0.copy()
     sf, si = core.new_solver_state(float(t0))
     log = core.new_log(EVENT_CAPACITY)
-    advance = core.advance_rodas if system.method == "rodas" else core.advance_dopri
+    advance = core.advance_rodas if system.method == "rodas" or opt.fixed_step > 0.0 else core.advance_dopri
     if ts is not None:
         check_allocation(ts.size, nx + ny + nm + 1, f"{ts.size} samples of {system.name}")
         # every recorded row is written whole (time, states, modes and, if asked, outputs)
@@ -531,7 +574,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     stats = {"accepted_steps": counts[core.SI_ACCEPTED], "rejected_steps": counts[core.SI_REJECTED],
              "rhs_evaluations": counts[core.SI_NRHS], "jacobians": counts[core.SI_NJAC],
              "events_dropped": dropped, "final_state": x, "final_modes": m,  # this run's own copies
-             "final_time": t_final}
+             "final_time": t_final, "fixed_step": opt.fixed_step}
     status = _STATUS[code] if code in _STATUS else st.Status(code)  # (SUCCESS is 0: falsy, so no `or` here)
     return SimulationResult(rt, rx, ry, rm, events, status, system.state_columns,
                             system.output_columns, tuple(system.mode_names), tuple(system.mode_values), stats,
@@ -548,17 +591,23 @@ class Simulation:
         As :func:`simulate`; ``max_steps`` counts over the whole session.
     t0 : float
         Start time [s].
+    fixed_step : float, optional
+        Fixed-step mode (a HIL frame) with this step [s], as :func:`simulate`; the steps lie on the grid
+        ``t0 + k * fixed_step`` whatever the times ``advance`` is called with (an advance to a time off the
+        grid ends with a shorter step).  None: step-size control.
     """
 
     def __init__(self, system: System, *, rtol=None, atol=None, max_step=None, max_steps: int = 100_000_000,
-                 first_step=None, event_tol=None, t0: float = 0.0):
+                 first_step=None, event_tol=None, t0: float = 0.0, fixed_step=None):
         core = _numerics_core()
 
         self.system = system
         self._core = core
         self._opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,
-                                   first_step=first_step, event_tol=event_tol)
-        self._advance = core.advance_rodas if system.method == "rodas" else core.advance_dopri
+                                   first_step=first_step, event_tol=event_tol, fixed_step=fixed_step)
+        self.fixed_step = self._opt.fixed_step
+        self._advance = (core.advance_rodas if system.method == "rodas" or self.fixed_step > 0.0
+                         else core.advance_dopri)
         self.x = system.x0.copy()
         self.m = system.m0.copy()
         self.u = system.u0.copy()
@@ -608,7 +657,7 @@ class Simulation:
         si = self._si
         return {"accepted_steps": int(si[self._core.SI_ACCEPTED]), "rejected_steps": int(si[self._core.SI_REJECTED]),
                 "rhs_evaluations": int(si[self._core.SI_NRHS]), "jacobians": int(si[self._core.SI_NJAC]),
-                "events_dropped": int(self.log.count[1])}
+                "events_dropped": int(self.log.count[1]), "fixed_step": self.fixed_step}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -768,7 +817,7 @@ def _write_back(dst, src, v) -> None:
 
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
-                   event_capacity: int = 256, check: bool = False) -> SimulationResult:
+                   event_capacity: int = 256, check: bool = False, fixed_step: float | None = None) -> SimulationResult:
     """Simulate variants of one model in parallel: one solver per variant (``numba.prange``).
 
     Parameters
@@ -789,6 +838,8 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         Events kept per variant.
     check : bool
         Raise if any variant failed (otherwise see ``status``).
+    fixed_step : float, optional
+        Fixed-step mode with this step [s] for every variant, as :func:`simulate`.
 
     Returns
     -------
@@ -807,7 +858,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     ts = sample_grid(0.0, float(t_end), output_step, sample_times)
     if ts is None:
         ts = np.array([float(t_end)])
-    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps)
+    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
     nv, ns = len(batch), ts.size
     if nv == 0:
         raise ParameterError("simulate_batch: no variants")
@@ -823,7 +874,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     EVC = np.zeros((nv, event_capacity), dtype=np.int64)
     EVE = np.zeros((nv, event_capacity), dtype=np.int64)
     EVN = np.zeros((nv, 2), dtype=np.int64)
-    core.batch(first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
+    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
                EVT, EVC, EVE, EVN)
     if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
         for v, s in enumerate(given):

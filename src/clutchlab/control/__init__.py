@@ -10,7 +10,10 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   :func:`nonlinear_iosystem` -- the model as a python-control ``NonlinearIOSystem`` (one mode);
 * :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
-* :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling.
+* :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling;
+* :func:`time_steps`, :func:`fixed_step_error` -- fixed-step (HIL frame) runs: wall time per frame and
+  the error against the adaptive solution (``simulate(..., fixed_step=1e-3)`` runs the core's fixed-step
+  mode).
 
 python-control (``control`` on PyPI) is imported when a linear model is built, not with this package.
 """
@@ -21,7 +24,7 @@ import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
-           "pi_for_phase_margin", "ScheduledPI"]
+           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.control.trim",
@@ -38,6 +41,8 @@ _WHERE = {
     "PI": "clutchlab.control.design",
     "pi_for_phase_margin": "clutchlab.control.design",
     "ScheduledPI": "clutchlab.control.design",
+    "time_steps": "clutchlab.control.realtime",
+    "fixed_step_error": "clutchlab.control.realtime",
 }
 
 

@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..fmu.cosim import CoSimulation, Variable, build_parameter_set, parameter_set_variables
+from ..fmu.cosim import (FIXED_STEP_DOC, CoSimulation, Variable, build_parameter_set, fixed_step_parameter,
+                         parameter_set_variables)
 from ..system import Simulation
 from .actuator import ActuatorParameters
 from .dynamics import EClutch, FrictionParameters
@@ -35,7 +36,8 @@ class EClutchCoSimulation(CoSimulation):
     clutch torque.  Parameters: ``model`` (0-4), ``control_mode``,
     ``friction_on`` and every field of :class:`EClutchParameters`
     (``clutch.*``), :class:`ActuatorParameters` (``actuator.*``) and
-    :class:`FrictionParameters` (``friction.*``).
+    :class:`FrictionParameters` (``friction.*``); ``solver.fixed_step`` > 0 runs the fixed-step mode of
+    the core (a HIL frame).
     """
 
     name = "eclutch"
@@ -59,6 +61,7 @@ class EClutchCoSimulation(CoSimulation):
         Variable("control_mode", "1", 1.0, "1: bearing position control, 0: motor voltage"),
         Variable("friction_on", "1", 1.0, "1: clutch friction elements R_f.ds, R_f.pp on"),
         Variable("rtol", "1", 1e-3, "relative tolerance of the Rodas3 integrator"),
+        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
         *parameter_set_variables("clutch", EClutchParameters, skip=_CLUTCH_SKIP),
         *parameter_set_variables("actuator", ActuatorParameters),
         *parameter_set_variables("friction", FrictionParameters),
@@ -81,6 +84,7 @@ class EClutchCoSimulation(CoSimulation):
         self.rtol = values["rtol"]
         if not 1e-10 < self.rtol < 0.1:
             raise ParameterError(f"parameter rtol = {self.rtol!r}: expected a value in (1e-10, 0.1)")
+        self.fixed_step = fixed_step_parameter(values)
         self.input_name = "bearing_reference" if mode == 1.0 else "motor_voltage"
         self.eclutch = EClutch(actuator, ClutchModel.preset(int(model), clutch), friction)
         self.reset()
@@ -90,7 +94,7 @@ class EClutchCoSimulation(CoSimulation):
         key = "bearing_reference" if self.input_name == "bearing_reference" else "voltage"
         start = next(v.start for v in self.inputs if v.name == self.input_name)
         system = self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
-        self.simulation = Simulation(system)
+        self.simulation = Simulation(system, fixed_step=self.fixed_step)
         self._nz = self.eclutch.assembly.nz
         self.t = 0.0
 

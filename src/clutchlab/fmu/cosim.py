@@ -54,6 +54,8 @@ __all__ = [
     "parameter_set_variables",
     "build_parameter_set",
     "fmi_unit",
+    "fixed_step_parameter",
+    "FIXED_STEP_DOC",
 ]
 
 def load_cosimulation(name: str) -> type:
@@ -315,6 +317,36 @@ def _flag(name: str, value: float) -> bool:
     return value == 1.0
 
 
+#: description of the ``solver.fixed_step`` parameter of the co-simulations
+FIXED_STEP_DOC = ("fixed-step (real-time) mode: Rodas3 steps of this length [s] on the grid k * fixed_step, "
+                   "events at step ends; 0 = step-size control")
+
+
+def fixed_step_parameter(values: dict):
+    """The ``solver.fixed_step`` parameter of a co-simulation: None for 0 (step-size control), else the step [s].
+
+    Parameters
+    ----------
+    values : dict
+        Parameter values by name (:meth:`CoSimulation.resolve_parameters`), with ``solver.fixed_step`` [s].
+
+    Raises
+    ------
+    ParameterError
+        A negative or non-finite value.
+    """
+    from ..system import check_fixed_step
+
+    h = values["solver.fixed_step"]
+    if h == 0.0:
+        return None
+    try:
+        return check_fixed_step(h)
+    except ParameterError:
+        raise ParameterError(f"parameter solver.fixed_step = {h!r}: must be 0 (step-size control) or a step > 0 "
+                             "[s]") from None
+
+
 def _check_time(owner: str, t_model: float, t: float, dt: float):
     if not (math.isfinite(t) and math.isfinite(dt)) or dt <= 0:
         raise SimulationError(f"{owner}.do_step: step size dt = {dt!r} must be > 0 [s]")
@@ -399,6 +431,7 @@ def _wet_variables():
         Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f"),
         Variable("solver.rtol", "1", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
         Variable("solver.max_step", "s", 0.01, "largest integration step"),
+        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
     )
     return clutch + bench + scenario
 
@@ -447,7 +480,7 @@ class WetCoSimulation(CoSimulation):
     :class:`~clutchlab.wet.params.Bench` (``bench.*``, without the sensor
     noise), the initial conditions (``scenario.*``, defaults of
     :class:`~clutchlab.wet.bench.EngagementProtocol`) and the step control
-    (``solver.*``).  Outputs: torques (Eqs. 3-6), forces, film thickness
+    (``solver.*``; ``solver.fixed_step`` > 0 runs the fixed-step mode of the core, a HIL frame).  Outputs: torques (Eqs. 3-6), forces, film thickness
     (Eqs. 1-2), viscosity (Eq. 7), temperatures (Eq. 8), friction work and
     the stick flag.
 
@@ -496,6 +529,7 @@ class WetCoSimulation(CoSimulation):
             raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
         if not self.max_step > 0:
             raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
+        self.fixed_step = fixed_step_parameter(values)
         # flat (zero) profiles: the references are the held inputs of the system
         self.scenario = E.Scenario(
             force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
@@ -556,7 +590,8 @@ class WetCoSimulation(CoSimulation):
         self._sources = [(name, src[0], system.output_index(src[1]) if src[0] == "output"
                           else system.state_index(src[1]) if src[0] == "state" else W.M_FRICTION)
                          for name, _, _, src in self._table]
-        self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000)
+        self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000,
+                                     fixed_step=self.fixed_step)
         self.simulation.set_inputs(self._inputs(u))
 
     def _outputs(self):
@@ -654,7 +689,8 @@ def _emtc_variables():
                Variable("scenario.drum_load_rear", "N.m", scen.drum_load_rear, "extra drum resistance, rear axle"),
                Variable("scenario.sample_time", "s", scen.sample_time,
                         "EMTC controller sample time (any communication step: the controller samples at its own instants)"),
-               Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control")))
+               Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control"),
+               Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC)))
 
 
 class EmtcCoSimulation(ContractCoSimulation):
@@ -733,7 +769,8 @@ class EmtcCoSimulation(ContractCoSimulation):
                                        drum_load_rear=values["scenario.drum_load_rear"],
                                        sample_time=self.sample_time, duration=max(4.0, self.sample_time))
         self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling)
-        self.simulation_options = {"rtol": self.rtol, "max_steps": 2_000_000}
+        self.fixed_step = fixed_step_parameter(values)
+        self.simulation_options = {"rtol": self.rtol, "max_steps": 2_000_000, "fixed_step": self.fixed_step}
         super().__init__(**parameter_values)
 
     # ---- the contract

@@ -27,6 +27,9 @@ Both share the hybrid logic:
   exactly and call the model's ``restart``;
 * after every accepted step the model's ``accept`` runs (hysteresis memory
   commit, projection of stuck velocities);
+* a fixed-step mode of :func:`advance_rodas` (``Options.fixed_step`` > 0,
+  a HIL frame: the same work every step, events and breaks at the step end;
+  docs/architecture.md);
 * stepping is resumable: :func:`advance_dopri` / :func:`advance_rodas`
   continue from the solver state ``(sf, si)`` to ``t_end`` (co-simulation,
   controller sampling, chunked recording).
@@ -68,16 +71,16 @@ from .dopri import (
 from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
                          C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
                          GAMMA2 as R_GAMMA2, lu_factor, lu_solve, rodas_next_step)
-from .status import MODEL_ERROR, RECORD_FULL, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
+from .status import MODEL_ERROR, RECORD_FULL, SINGULAR, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
 
 __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
            "batch", "evaluate", "evaluate_jacobian", "evaluate_outputs", "outputs_at",
-           "SF_T", "SF_H", "SI_ACCEPTED", "SI_REJECTED", "SI_NRHS", "SI_NJAC", "SI_STATUS", "SI_IREC",
+           "SF_T", "SF_H", "SF_T0", "SI_ACCEPTED", "SI_REJECTED", "SI_NRHS", "SI_NJAC", "SI_STATUS", "SI_IREC",
            "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI"]
 
 # ---- solver state (resumable): float and int vectors
-SF_T, SF_H = 0, 1
-N_SF = 2
+SF_T, SF_H, SF_T0 = 0, 1, 2  # time, step size, start of the run (origin of a fixed-step grid)
+N_SF = 3
 SI_ACCEPTED, SI_REJECTED, SI_NRHS, SI_NJAC, SI_STATUS, SI_IREC, SI_STARTED, SI_MODEL_CODE = range(8)
 N_SI = 8
 
@@ -117,6 +120,9 @@ class Options(NamedTuple):
         rejection or a mode change).
     nonautonomous : bool
         Difference df/dt for the Rosenbrock stages (inputs that vary within a step).
+    fixed_step : float
+        0 for step-size control; > 0 [s]: the Rosenbrock loop takes steps of exactly this length on the
+        grid ``t0 + k * fixed_step`` (a HIL frame; see :func:`advance_rodas`).
     """
 
     rtol: float
@@ -132,6 +138,7 @@ class Options(NamedTuple):
     fd_scale: np.ndarray
     jac_every: int
     nonautonomous: bool
+    fixed_step: float = 0.0
 
 
 class EventLog(NamedTuple):
@@ -657,7 +664,7 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K
 
 
 @register_jitable
-def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
+def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, kinks):
     """Forward-difference Jacobian by column groups; backward where the forward step crosses a kink.
 
     The columns of one group of ``opt.jac_groups`` share no row of
@@ -665,7 +672,8 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
     group; column ``c`` fills only its pattern rows).  A forward perturbation
     that changes the sign of a switching function differences across a kink
     (cavitation, a contact, an end stop): that group is differenced
-    backwards.  Returns the number of ``rhs`` calls.
+    backwards (only with ``kinks``: the fixed-step mode differences forwards always, so that every
+    Jacobian costs the same).  Returns the number of ``rhs`` calls.
     """
     n = x.shape[0]
     ng = g0.shape[0]
@@ -684,7 +692,7 @@ def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls):
         model.rhs(t, xp, u, m, p, fp, gp)
         nr += 1
         kink = False
-        for k in range(ng):
+        for k in range(ng if kinks else 0):
             if g0[k] * gp[k] < 0.0 or (gp[k] == 0.0 and g0[k] != 0.0):
                 kink = True
                 break
@@ -764,6 +772,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         else:
             i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
         h = opt.first_step if opt.first_step > 0.0 else 1e-5
+        sf[SF_T0] = t
     if h <= 0.0:
         h = 1e-5
     tb = model.next_break(t, m, p)
@@ -772,10 +781,73 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     jac_age = opt.jac_every
     rejected_before = False
     en = 0.0
+    hf = opt.fixed_step
+    fixed = hf > 0.0
     while t < t_end:
         status = _run_limit(si, opt, grid, cap, i_rec)
         if status != SUCCESS:
             break
+        if fixed:
+            # ---- fixed-step mode (a HIL frame): one step to the next point of the grid t0 + k hf (t_end if it
+            # comes first), the same work every step: Jacobian, df/dt, two stages and two right-hand sides;
+            # no error control; switching functions and break times are looked at the step end only
+            kf = math.floor((t - sf[SF_T0]) / hf + 1e-6) + 1.0
+            t_new = sf[SF_T0] + kf * hf
+            if t_new >= t_end - 1e-6 * hf:
+                t_new = t_end
+            h = t_new - t
+            if h <= 1e-9 * hf:  # t_end within rounding of t: the run is there
+                t = t_end
+                break
+            if not model.jacobian(t, x, u, m, p, J):
+                si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, False)
+            si[SI_NJAC] += 1
+            if opt.nonautonomous:
+                dt = 1e-7 * max(1e-3, abs(t))
+                if t + dt < tb:
+                    model.rhs(t + dt, x, u, m, p, fp, gp)
+                    for r in range(n):
+                        ft[r] = (fp[r] - f0[r]) / dt
+                else:
+                    model.rhs(t - dt, x, u, m, p, fp, gp)
+                    for r in range(n):
+                        ft[r] = (f0[r] - fp[r]) / dt
+                si[SI_NRHS] += 1
+            ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, K1, K2, K3,
+                             K4, xtmp, ftmp, gp)
+            si[SI_NRHS] += 2
+            if not ok:
+                status = SINGULAR
+                break
+            model.rhs(t_new, x1, u, m, p, f1, g1)
+            si[SI_NRHS] += 1
+            if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
+                i_rec = _record_dense(p, t, h, x, f0, x1, f1, rc0, mass, t_new, u, m, ts, rec_t, rec_x, rec_m,
+                                      rec_y, want_y, yb, xe, i_rec)
+            si[SI_ACCEPTED] += 1
+            for i in range(n):
+                x[i] = x1[i]
+            t = t_new
+            # mode changes at the step end, as a HIL target sees them: no root finding
+            flag = _apply_updates(p, t, x, u, m, g0, g1, opt.gdir, log)
+            r = model.accept(t, x, u, m, p)
+            if flag < 0 or r < 0:
+                si[SI_MODEL_CODE] = flag if flag < 0 else r
+                status = MODEL_ERROR
+                break
+            if tb <= t + 1e-6 * hf:  # a break time inside the step or on its end: restart at the step end
+                model.restart(t, x, u, m, p, log)
+                tb = model.next_break(t, m, p)
+            # the derivative at the step end again, always (modes, restart or accept may have changed it):
+            # every step evaluates the same number of right-hand sides
+            model.rhs(t, x, u, m, p, f0, g0)
+            si[SI_NRHS] += 1
+            if not grid:
+                i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            if flag == 1:
+                status = TERMINATED
+                break
+            continue
         t_stop = t_end if t_end < tb else tb
         if t_stop - t <= 1e-12 * max(1.0, abs(t_stop)):
             t = t_stop
@@ -788,7 +860,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if need_jac:
             if jac_age >= opt.jac_every or jac_stale:
                 if not model.jacobian(t, x, u, m, p, J):
-                    si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls)
+                    si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, True)
                 jac_age = 0
                 jac_stale = False
                 si[SI_NJAC] += 1
@@ -966,6 +1038,15 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     a rejection or a mode change.  The state at a located event comes from
     one Rodas3 step of the located length from the step start, so the
     algebraic rows stay consistent.
+
+    With ``opt.fixed_step`` > 0 (the fixed-step mode, a HIL frame) the loop
+    takes steps of exactly that length on the grid ``t0 + k * fixed_step``
+    (``t0`` the run's start, ``sf[SF_T0]``; an end off the grid ends with a
+    shorter step), without error control, with the Jacobian every step
+    (forward differences only) and the same number of right-hand sides every
+    step; switching functions are looked at the step end (``update`` there,
+    no root finding) and break times inside a step call ``restart`` at its
+    end.  Any model can run so, also one registered for Dormand-Prince.
 
     Parameters
     ----------
