@@ -162,3 +162,18 @@ def test_emtc_worked_design_inverse_preisach_removes_the_hysteresis_error():
     falling = plain.reference_Nm.diff().fillna(1.0).to_numpy() < 0  # holds after a falling reference
     assert (plain.torque_error_Nm.to_numpy()[falling] > 10.0).all()  # the descending branch holds more force
     assert (plain.torque_error_Nm.to_numpy()[~falling] < -5.0).all()
+
+
+def test_loop_on_a_fixed_step_model_converges_to_the_sampled_data_loop():
+    """The model in the core's fixed-step mode (Rodas3, order 3) inside the loop: at a tenth of the sample
+    time the loop equals the exact sampled-data loop closely, and the error falls as the step does."""
+    Ts = 0.01
+    s = linear_system(A, np.zeros(2), B)
+    C = PI(0.3, 0.1).discrete(Ts)
+    exact = closed_loop(s, C, Ts, 1.0, measure=["x0"], actuate=["u0"], reference=0.1, rtol=1e-11).frame["x0_1"]
+    errs = []
+    for h in (Ts / 2, Ts / 4, Ts / 8):
+        run = closed_loop(s, C, Ts, 1.0, measure=["x0"], actuate=["u0"], reference=0.1, fixed_step=h)
+        errs.append(float(np.max(np.abs(run.frame["x0_1"] - exact))))
+    assert errs[-1] < 1e-4 * 0.1
+    assert errs[0] / errs[1] > 5 and errs[1] / errs[2] > 5  # order 3: a factor 8 per halving

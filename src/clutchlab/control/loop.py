@@ -85,7 +85,7 @@ def discrete_matrices(controller, sample_time: float):
 
 def closed_loop(system: System | OperatingPoint, controller, sample_time: float, t_end: float, *, measure,
                 actuate, reference=None, memory=None, saturate: bool = True, delay: int = 0, rtol=None,
-                max_step=None) -> ClosedLoopResult:
+                max_step=None, fixed_step=None) -> ClosedLoopResult:
     """Run ``system`` with a discrete ``controller`` in the loop from ``t = 0`` to ``t_end``.
 
     Parameters
@@ -115,6 +115,9 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
         Samples between reading ``y_k`` and applying ``u_k``.
     rtol, max_step : float, optional
         Integrator options (the system's defaults otherwise).
+    fixed_step : float, optional
+        Run the model in the core's fixed-step mode with this step [s] (a HIL target's frame; see
+        :func:`clutchlab.system.simulate`), normally ``sample_time`` or an integer fraction of it.
 
     Returns
     -------
@@ -133,7 +136,7 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
     n = int(np.floor(t_end / sample_time + 1e-9))
     check_allocation(n + 1, 2 * len(meas) + len(act) + 2,
                      what=f"closed loop of t_end = {t_end:g} s at sample_time = {sample_time:g} s")
-    sim = Simulation(base, rtol=rtol, max_step=max_step)
+    sim = Simulation(base, rtol=rtol, max_step=max_step, fixed_step=fixed_step)
     u_op = base.u0.copy()
     lo = np.array([base.limits.get(base.inputs[j].name, (-np.inf, np.inf))[0] for j in act])
     hi = np.array([base.limits.get(base.inputs[j].name, (-np.inf, np.inf))[1] for j in act])

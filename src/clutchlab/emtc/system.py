@@ -152,8 +152,8 @@ N_AUX = 13
 FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque split
 FM_DX = FM_SPLIT + 6  # 7: scratch derivative
 FM_G = FM_DX + 7  # 6: scratch switching functions
-FM_KEY = FM_G + 6  # 11: point (t, x, modes) of the last evaluation; NaN once a memory or mode may have changed
-FM_DXM = FM_KEY + 11  # 7: derivative of the last evaluation
+FM_KEY = FM_G + 6  # 15: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
+FM_DXM = FM_KEY + 15  # 7: derivative of the last evaluation
 FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
 N_FMEM = FM_GM + 6
 # controller log (one row per sample, for the per-sample view of simulate_bench)
@@ -507,7 +507,7 @@ def _rhs(t, x, u, m, p, dx, g):
     """
     a = p.actuator
     fmem = p.fmem
-    if _same_point(t, x, m, fmem):
+    if _same_point(t, x, u, m, fmem):
         # the point of the last evaluation again (a controller sample at the end of a step): only the
         # current command may have changed since, and only the first current lag depends on it
         for i in range(7):
@@ -636,13 +636,20 @@ def _rhs(t, x, u, m, p, dx, g):
         fmem[FM_DXM + i] = dx[i]
     for i in range(3):
         fmem[FM_KEY + 8 + i] = m[i]
+    for i in range(4):
+        fmem[FM_KEY + 11 + i] = u[i]
     for k in range(6):
         fmem[FM_GM + k] = g[k]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _same_point(t, x, m, fmem):
-    """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, m)`` with the memories as they are now."""
+def _same_point(t, x, u, m, fmem):
+    """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, u, m)`` with the memories as they are now.
+
+    The inputs are part of the point: a run changes them only at a restart (which clears the key), but an
+    evaluation through the contract (:func:`clutchlab.system.evaluate`: linearisation, trim) may ask for
+    the same state with other inputs.
+    """
     if fmem[FM_KEY] != t:
         return False
     for i in range(7):
@@ -651,6 +658,9 @@ def _same_point(t, x, m, fmem):
     for i in range(3):
         if fmem[FM_KEY + 8 + i] != m[i]:
             return False
+    for i in range(4):
+        if fmem[FM_KEY + 11 + i] != u[i]:
+            return False
     return True
 
 
@@ -658,7 +668,7 @@ def _same_point(t, x, m, fmem):
 def _outputs(t, x, u, m, p, y):
     fmem = p.fmem
     # a sample at the end of a step reuses the step's last evaluation (same point, memories not yet committed)
-    aux = fmem[FM_AUX:FM_AUX + N_AUX] if _same_point(t, x, m, fmem) else _evaluate(t, x, u, m, p)
+    aux = fmem[FM_AUX:FM_AUX + N_AUX] if _same_point(t, x, u, m, fmem) else _evaluate(t, x, u, m, p)
     y[0] = x[0] - x[1]
     y[1] = p.actuator.airgap_open - x[3]
     y[2] = aux[AUX_FM]
