@@ -177,3 +177,28 @@ def test_loop_on_a_fixed_step_model_converges_to_the_sampled_data_loop():
         errs.append(float(np.max(np.abs(run.frame["x0_1"] - exact))))
     assert errs[-1] < 1e-4 * 0.1
     assert errs[0] / errs[1] > 5 and errs[1] / errs[2] > 5  # order 3: a factor 8 per halving
+
+
+def test_wet_worked_design_pi_holds_the_torque_the_feedforward_loses():
+    """Worked design (3): the wet engagement's torque, feedforward from trimmed points, PI on the linear model."""
+    from clutchlab.control import demo
+
+    wet = demo.wet_torque_control()
+    m = wet["metrics"].set_index("controller")
+    torques, forces = wet["feedforward"]
+    assert np.all(np.diff(forces) > 0)  # more torque needs more force at the design slip speed
+    ff, pi, windup = (m.loc[k, "rms_error_Nm"] for k in ("feedforward", "feedforward + PI",
+                                                           "feedforward + PI, integrating always"))
+    assert pi < 0.4 * ff and pi < 5.0
+    assert windup > ff  # integrating through the fill and the ramp winds up: why the band is there
+    assert m["lockup_s"].between(0.75, 0.9).all()  # every run locks up as the drive's ramp ends
+
+
+def test_scheduled_pi_conditional_integration():
+    pi = ScheduledPI(np.array([0.0, 1.0]), np.array([1.0, 1.0]), np.array([1.0, 1.0]), None, 0.1,
+                     lambda t: 1.0, integrate_band=0.1)
+    mem = np.array([0.0])
+    pi(0.0, np.array([0.5]), mem)  # 50 % off: no integration
+    assert mem[0] == 0.0
+    pi(0.0, np.array([0.95]), mem)  # 5 % off: integrates
+    assert mem[0] == pytest.approx(0.1 * 0.05)

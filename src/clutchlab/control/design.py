@@ -122,6 +122,9 @@ class ScheduledPI:
         ``r(t)`` [SI].
     limits : tuple of float
         Output range (anti-windup: the integral stops while the output is limited).
+    integrate_band : float
+        Conditional integration: the integral runs only while ``|r - y| <= integrate_band * |r|`` (a
+        reference ramp or a fill phase the plant cannot follow does not wind it up); default: always.
     """
 
     points: np.ndarray
@@ -131,6 +134,7 @@ class ScheduledPI:
     sample_time: float
     reference: object
     limits: tuple = (-np.inf, np.inf)
+    integrate_band: float = np.inf
 
     def __call__(self, t, y, memory):
         """One sample: ``t`` [s], measured ``y``, ``memory`` (the integral term, changed in place)."""
@@ -143,6 +147,6 @@ class ScheduledPI:
         integral = memory[0] + kp * self.sample_time / ti * e
         u = u_ff + kp * e + integral
         lo, hi = self.limits
-        if lo <= u <= hi:
-            memory[0] = integral  # anti-windup: integrate only while the output is not limited
+        if lo <= u <= hi and abs(e) <= self.integrate_band * abs(r):
+            memory[0] = integral  # anti-windup: integrate only while the output is not limited (and near r)
         return np.array([min(max(u, lo), hi)])
