@@ -208,22 +208,28 @@ def test_nonlinear_iosystem_agrees_with_python_control_linearize():
         nonlinear_iosystem(linear_system(a, np.zeros(2), b, method="rodas", mass=np.array([1.0, 0.0])))
 
 
-def test_wet_clutch_small_signal_step_matches_the_nonlinear_model():
-    """The wet pack slipping at 100 rad/s (the bench's speed controller), 100 N*m: trim the force, then a
-    2 N force step of the nonlinear model minus the unperturbed run against the linear model."""
+@pytest.mark.parametrize("slip, torque, tol", [(10.0, 20.0, 0.01), (100.0, 100.0, 0.02)])
+def test_wet_clutch_small_signal_step_matches_the_nonlinear_model(slip, torque, tol):
+    """The wet pack slipping (the bench's speed controller holds the slip): trim the force for the torque,
+    then a 2 N force step of the nonlinear model minus the unperturbed run against the linear model.
+
+    At 10 rad/s and 20 N*m the pack heats by 0.6 K/s: 1 % of the response (measured 0.25 %). At 100 rad/s
+    and 100 N*m it heats by 29 K/s: the temperatures are held in the trim, not steady, so the model is a
+    linearisation along a drifting trajectory: 2 % (measured 0.9 %).
+    """
     from clutchlab.wet.engagement import Scenario
     from clutchlab.wet.system import engagement_system
 
-    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[100.0, 100.0],
-                  duration=5.0, motor="speed", initial_slip_speed=100.0)
+    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[slip, slip],
+                  duration=5.0, motor="speed", initial_slip_speed=slip)
     s = engagement_system(sc)
     temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
                                                         "thermistor_temperature")}
-    op = operating_point(s, states=temps, targets={"clutch_torque": 100.0}, free_inputs=["force_reference"],
+    op = operating_point(s, states=temps, targets={"clutch_torque": torque}, free_inputs=["force_reference"],
                          inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
     assert op.modes == {"friction": "slip_positive", "piston": "free", "film": "contact"}
-    assert op.value("clutch_torque") == pytest.approx(100.0, rel=1e-8)
-    assert op.value("slip_speed") == pytest.approx(100.0, rel=1e-8)  # the drive holds the speed
+    assert op.value("clutch_torque") == pytest.approx(torque, rel=1e-8)
+    assert op.value("slip_speed") == pytest.approx(slip, rel=1e-8)  # the drive holds the speed
     G = linearize(op, inputs=["force_reference"], outputs=["clutch_torque"])
     assert np.all(G.poles().real < 0)
     T = np.linspace(0.0, 0.15, 151)
@@ -240,8 +246,7 @@ def test_wet_clutch_small_signal_step_matches_the_nonlinear_model():
     d = 2.0
     response = run(d) - run(0.0)  # the temperatures are held in the trim, not steady: subtract their drift
     linear = np.ravel(control.forced_response(G, T, np.full(T.size, d)).outputs)
-    # linearised about a point that is not an equilibrium (the pack heats at 29 K/s): 2 % of the response
-    assert np.max(np.abs(response - linear)) < 0.02 * abs(linear[-1])
+    assert np.max(np.abs(response - linear)) < tol * abs(linear[-1])
 
 
 def _sine_gain(op, inp, read, f, amp, *, Ts=5e-5, t_total=0.5, t_fit=0.2):
@@ -332,3 +337,20 @@ def test_wet_bode_matches_simulated_sines(f):
     g_lin = complex(np.squeeze(G(2j * np.pi * f)))
     assert abs(g_sim) == pytest.approx(abs(g_lin), rel=1e-2)
     assert abs(np.degrees(np.angle(g_sim / g_lin))) < 0.5
+
+
+def test_pressure_per_motor_current_is_the_spindle_at_low_frequency(frictionless):
+    """Bode of pressure over motor current (voltage-driven actuator): at low frequency the motor stands and
+    its torque is all on the spindle, p A_mc = k_t (2 pi / lead) i (efficiency 1 here)."""
+    op = frictionless.operating_point(4e-3)
+    G = linearize(op, inputs=["motor_voltage"], outputs=["pressure", "motor_current"])
+    table = frequency_table(G, [0.01, 1.0, 70.0], over="motor_current_A")
+    a = frictionless.actuator
+    area = np.pi * a.master_diameter ** 2 / 4
+    expected = a.torque_constant * 2 * np.pi / a.lead / area  # Pa per A
+    assert table["gain_pressure_Pa__motor_current_A"].iloc[0] == pytest.approx(expected, rel=1e-3)
+    # at the line's resonance the pressure at the CSC no longer follows the current
+    assert abs(table["gain_dB_pressure_Pa__motor_current_A"].iloc[2]
+               - table["gain_dB_pressure_Pa__motor_current_A"].iloc[0]) > 3.0
+    with pytest.raises(ParameterError, match="not an output"):
+        frequency_table(G, [1.0], over="torque_Nm")

@@ -55,6 +55,9 @@ def register(subparsers) -> None:
     bode.add_argument("-o", "--output", required=True, help="PNG figure to write")
     bode.add_argument("--table", help="also write magnitude and phase as CSV")
     bode.add_argument("--poles", help="also write the poles at each operating point as CSV")
+    bode.add_argument("--over", default=None, metavar="NAME",
+                      help="plot the other outputs over this one (one input), e.g. -y pressure -y motor_current "
+                           "--over motor_current: pressure per motor current")
     bode.add_argument("--fmin", default="0.1 Hz", help="lowest frequency (default 0.1 Hz)")
     bode.add_argument("--fmax", default="2 kHz", help="highest frequency (default 2 kHz)")
     bode.set_defaults(func=_bode)
@@ -211,16 +214,22 @@ def _bode(args) -> int:
     models = [(label, value, op, linearize(op, inputs=args.inputs, outputs=args.outputs)) for label, value, op in points]
     if models[0][3].ninputs == 0:
         raise ParameterError(f"{points[0][2].system.name} has no held inputs: no frequency response")
+    over = None
+    if args.over is not None:
+        from .trim import resolve
+
+        kind, i = resolve(points[0][2].system, args.over, ("state", "output"))
+        over = (points[0][2].system.states if kind == "state" else points[0][2].system.outputs)[i].column
     tables = []
     for label, value, _, sys in models:
-        t = frequency_table(sys, f)
+        t = frequency_table(sys, f, over=over)
         t.insert(0, "operating_point", label)
         tables.append(t)
     import pandas as pd
 
     from .plots import bode_figure
 
-    fig = bode_figure([(label, sys) for label, _, _, sys in models], f)
+    fig = bode_figure([(label, sys) for label, _, _, sys in models], f, over=over)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
     import matplotlib.pyplot as plt

@@ -244,7 +244,7 @@ def nonlinear_iosystem(system: System, op: OperatingPoint | None = None, outputs
                          name=name or system.name)
 
 
-def frequency_table(sys, frequencies_hz) -> "pandas.DataFrame":  # noqa: F821
+def frequency_table(sys, frequencies_hz, *, over: str | None = None) -> "pandas.DataFrame":  # noqa: F821
     """Magnitude and phase of every input-output pair of a linear model (a Bode table).
 
     Parameters
@@ -253,12 +253,16 @@ def frequency_table(sys, frequencies_hz) -> "pandas.DataFrame":  # noqa: F821
         The linear model (e.g. from :func:`linearize`).
     frequencies_hz : array_like
         Frequencies [Hz].
+    over : str, optional
+        An output of ``sys`` (e.g. ``"motor_current_A"``): every other output's response is divided by
+        this one's, for the model's single input (pressure per motor current from the voltage-driven
+        actuator: how the pressure follows the current, with the line and the clutch in between).
 
     Returns
     -------
     pandas.DataFrame
-        ``frequency_Hz``, then per pair ``gain_<out>__<in>`` (output unit per input unit),
-        ``gain_dB_<out>__<in>`` and ``phase_deg_<out>__<in>`` (unwrapped).
+        ``frequency_Hz``, then per pair ``gain_<out>__<in>`` (output unit per input unit; with ``over``
+        the pairs are ``<out>__<over>``), ``gain_dB_<out>__<in>`` and ``phase_deg_<out>__<in>`` (unwrapped).
     """
     import pandas as pd
 
@@ -268,9 +272,19 @@ def frequency_table(sys, frequencies_hz) -> "pandas.DataFrame":  # noqa: F821
     w = 2 * np.pi * f
     resp = sys(1j * w) if sys.ninputs * sys.noutputs > 1 else np.reshape(sys(1j * w), (1, 1, -1))
     resp = np.reshape(resp, (sys.noutputs, sys.ninputs, -1))
+    outs, ins = list(sys.output_labels), list(sys.input_labels)
+    if over is not None:
+        if over not in outs:
+            raise ParameterError(f"over = {over!r} is not an output of the model ({', '.join(outs)})")
+        if sys.ninputs != 1:
+            raise ParameterError(f"over = {over!r} needs a model with one input, not {sys.ninputs}")
+        k = outs.index(over)
+        keep = [i for i in range(len(outs)) if i != k]
+        resp = resp[keep] / resp[k][None]
+        outs, ins = [outs[i] for i in keep], [over]
     cols = {"frequency_Hz": f}
-    for i, o in enumerate(sys.output_labels):
-        for j, n in enumerate(sys.input_labels):
+    for i, o in enumerate(outs):
+        for j, n in enumerate(ins):
             g = resp[i, j]
             cols[f"gain_{o}__{n}"] = np.abs(g)
             cols[f"gain_dB_{o}__{n}"] = 20 * np.log10(np.maximum(np.abs(g), 1e-300))

@@ -20,7 +20,7 @@ def _unit(column: str) -> str:
 __all__ = ["bode_figure", "pole_map_figure"]
 
 
-def bode_figure(models, frequencies_hz, *, title: str = ""):
+def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = None):
     """Bode diagram (magnitude in dB, phase in degrees) of linear models, one line per model and pair.
 
     Parameters
@@ -31,6 +31,8 @@ def bode_figure(models, frequencies_hz, *, title: str = ""):
         Frequencies [Hz].
     title : str
         Figure title.
+    over : str, optional
+        Plot every other output over this output (:func:`clutchlab.control.frequency_table`).
 
     Returns
     -------
@@ -40,16 +42,20 @@ def bode_figure(models, frequencies_hz, *, title: str = ""):
 
     f = np.asarray(frequencies_hz, dtype=float)
     fig, (ax_m, ax_p) = new_figure(2, 1, width=7.5, height=6.0, sharex=True)
+    def pairs(sys):
+        if over is None:
+            return [(o, i) for o in sys.output_labels for i in sys.input_labels]
+        return [(o, over) for o in sys.output_labels if o != over]
+
     for label, sys in models:
-        table = frequency_table(sys, f)
-        for o in sys.output_labels:
-            for i in sys.input_labels:
-                name = label if sys.ninputs * sys.noutputs == 1 else f"{label}: {_name(o)} / {_name(i)}"
-                (line,) = ax_m.semilogx(f, table[f"gain_dB_{o}__{i}"], label=name)
-                ax_p.semilogx(f, table[f"phase_deg_{o}__{i}"], color=line.get_color(), label=name)
-    first = models[0][1]
-    if first.ninputs * first.noutputs == 1:
-        o, i = first.output_labels[0], first.input_labels[0]
+        table = frequency_table(sys, f, over=over)
+        for o, i in pairs(sys):
+            name = label if len(pairs(sys)) == 1 else f"{label}: {_name(o)} / {_name(i)}"
+            (line,) = ax_m.semilogx(f, table[f"gain_dB_{o}__{i}"], label=name)
+            ax_p.semilogx(f, table[f"phase_deg_{o}__{i}"], color=line.get_color(), label=name)
+    first = pairs(models[0][1])
+    if len(first) == 1:
+        o, i = first[0]
         ax_m.set_ylabel(f"|{_name(o)} / {_name(i)}| [dB re 1 {_unit(o)}/{_unit(i)}]")
     else:
         ax_m.set_ylabel("magnitude [dB]")
