@@ -228,46 +228,46 @@ def wet_torque_control() -> dict:
     return {"frames": frames, "metrics": pd.DataFrame(rows), "pi": pi, "feedforward": (torques, forces)}
 
 
-def _wet_figure(wet):
+def _tracking_figure(frames, reference, tracked, lower, labels, title, ylim=None, lower_ylim=None):
+    """Two panels: the tracked signal of each run with the reference, and a second signal of each run.
+
+    ``reference``, ``tracked``: column names; ``lower(frame)`` gives the lower panel's values; ``labels``: the
+    two y labels; ``ylim``/``lower_ylim``: optional limits.
+    """
     from ..plotting import legend_outside, mark_synthetic, new_figure
 
-    fig, (ax, ax_f) = new_figure(2, 1, width=7.5, height=5.5, sharex=True)
-    first = next(iter(wet["frames"].values()))
-    ax.plot(first["time_s"], first["reference_sensor_torque_Nm"], "k--", label="reference")
-    for name, frame in wet["frames"].items():
-        ax.plot(frame["time_s"], frame["sensor_torque_Nm"], label=name)
-        ax_f.plot(frame["time_s"], frame["force_reference_N"] * 1e-3, label=name)
-    ax.set_ylabel("measured torque [N·m]")
-    ax.set_ylim(0.0, 170.0)
-    ax_f.set_ylabel("force command [kN]")
-    ax_f.set_xlabel("time [s]")
-    for a in (ax, ax_f):
+    fig, (ax, ax_l) = new_figure(2, 1, width=7.5, height=5.5, sharex=True)
+    first = next(iter(frames.values()))
+    ax.plot(first["time_s"], first[reference], "k--", label="reference")
+    for name, frame in frames.items():
+        ax.plot(frame["time_s"], frame[tracked], label=name)
+        ax_l.plot(frame["time_s"], lower(frame), label=name)
+    ax.set_ylabel(labels[0])
+    ax_l.set_ylabel(labels[1])
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    if lower_ylim is not None:
+        ax_l.set_ylim(*lower_ylim)
+    ax_l.set_xlabel("time [s]")
+    for a in (ax, ax_l):
         a.grid(True, alpha=0.3)
         legend_outside(a)
-    fig.suptitle("Wet clutch: torque control during an engagement")
+    fig.suptitle(title)
     mark_synthetic(fig)
     return fig
+
+
+def _wet_figure(wet):
+    return _tracking_figure(wet["frames"], "reference_sensor_torque_Nm", "sensor_torque_Nm",
+                            lambda f: f["force_reference_N"] * 1e-3, ("measured torque [N·m]", "force command [kN]"),
+                            "Wet clutch: torque control during an engagement", ylim=(0.0, 170.0))
 
 
 def _emtc_figure(track):
-    from ..plotting import legend_outside, mark_synthetic, new_figure
-
-    fig, (ax, ax_e) = new_figure(2, 1, width=7.5, height=5.5, sharex=True)
-    first = next(iter(track["frames"].values()))
-    ax.plot(first["time_s"], first["torque_reference_Nm"], "k--", label="reference")
-    for name, frame in track["frames"].items():
-        ax.plot(frame["time_s"], frame["coupling_torque_Nm"], label=name)
-        ax_e.plot(frame["time_s"], frame["coupling_torque_Nm"] - frame["torque_reference_Nm"], label=name)
-    ax.set_ylabel("coupling torque [N·m]")
-    ax_e.set_ylabel("torque error [N·m]")
-    ax_e.set_ylim(-60.0, 60.0)
-    ax_e.set_xlabel("time [s]")
-    for a in (ax, ax_e):
-        a.grid(True, alpha=0.3)
-        legend_outside(a)
-    fig.suptitle("EMTC: torque tracking with and without hysteresis compensation")
-    mark_synthetic(fig)
-    return fig
+    return _tracking_figure(track["frames"], "torque_reference_Nm", "coupling_torque_Nm",
+                            lambda f: f["coupling_torque_Nm"] - f["torque_reference_Nm"],
+                            ("coupling torque [N·m]", "torque error [N·m]"),
+                            "EMTC: torque tracking with and without hysteresis compensation", lower_ylim=(-60.0, 60.0))
 
 
 def _settling(T, y, band: float = 0.05) -> float:

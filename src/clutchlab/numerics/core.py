@@ -663,6 +663,20 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K
     return ok
 
 
+@register_jitable(forceinline=True)
+def _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft):
+    """Forward difference of df/dt at ``t`` into ``ft`` (backward if a break time is within the difference)."""
+    dt = 1e-7 * max(1e-3, abs(t))
+    if t + dt < tb:
+        model.rhs(t + dt, x, u, m, p, fp, gp)
+        for r in range(x.shape[0]):
+            ft[r] = (fp[r] - f0[r]) / dt
+    else:
+        model.rhs(t - dt, x, u, m, p, fp, gp)
+        for r in range(x.shape[0]):
+            ft[r] = (f0[r] - fp[r]) / dt
+
+
 @register_jitable
 def _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, kinks):
     """Forward-difference Jacobian by column groups; backward where the forward step crosses a kink.
@@ -803,15 +817,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, False)
             si[SI_NJAC] += 1
             if opt.nonautonomous:
-                dt = 1e-7 * max(1e-3, abs(t))
-                if t + dt < tb:
-                    model.rhs(t + dt, x, u, m, p, fp, gp)
-                    for r in range(n):
-                        ft[r] = (fp[r] - f0[r]) / dt
-                else:
-                    model.rhs(t - dt, x, u, m, p, fp, gp)
-                    for r in range(n):
-                        ft[r] = (f0[r] - fp[r]) / dt
+                _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
                 si[SI_NRHS] += 1
             ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, K1, K2, K3,
                              K4, xtmp, ftmp, gp)
@@ -865,15 +871,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 jac_stale = False
                 si[SI_NJAC] += 1
             if opt.nonautonomous:
-                dt = 1e-7 * max(1e-3, abs(t))
-                if t + dt < tb:
-                    model.rhs(t + dt, x, u, m, p, fp, gp)
-                    for r in range(n):
-                        ft[r] = (fp[r] - f0[r]) / dt
-                else:
-                    model.rhs(t - dt, x, u, m, p, fp, gp)
-                    for r in range(n):
-                        ft[r] = (f0[r] - fp[r]) / dt
+                _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
                 si[SI_NRHS] += 1
             need_jac = False
         h, hit_stop = _clip_step(h, t, t_stop, opt.max_step)
