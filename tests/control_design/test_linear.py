@@ -354,3 +354,26 @@ def test_pressure_per_motor_current_is_the_spindle_at_low_frequency(frictionless
                - table["gain_dB_pressure_Pa__motor_current_A"].iloc[0]) > 3.0
     with pytest.raises(ParameterError, match="not an output"):
         frequency_table(G, [1.0], over="torque_Nm")
+
+
+def test_trim_continues_to_a_far_target():
+    """From the wet pack's 20 N*m point to 80 N*m with few Newton iterations allowed per solve: the direct
+    solve stops, the continuation over the target reaches it, and the point is the one a direct solve with
+    many iterations finds."""
+    from clutchlab.wet.engagement import Scenario
+    from clutchlab.wet.system import engagement_system
+
+    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[10.0, 10.0],
+                  duration=5.0, motor="speed", initial_slip_speed=10.0)
+    s = engagement_system(sc)
+    temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
+                                                        "thermistor_temperature")}
+    op20 = operating_point(s, states=temps, targets={"clutch_torque": 20.0}, free_inputs=["force_reference"],
+                           inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
+    start = dict(states=temps, targets={"clutch_torque": 80.0}, free_inputs=["force_reference"],
+                 inputs={"force_reference": op20.u[0]}, guess=op20.x, modes=op20.modes, t=0.5)
+    far = operating_point(s, max_iterations=8, **start)
+    assert far.iterations > 8  # the continuation's iterations, summed
+    direct = operating_point(s, max_iterations=200, **start)
+    assert far.value("clutch_torque") == pytest.approx(80.0, rel=1e-8)
+    assert far.u[0] == pytest.approx(direct.u[0], rel=1e-7)

@@ -367,15 +367,14 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
 
     z1, r, res, it = newton(z, goal, max_iterations)
     if not res <= tol and tgt:
-        # continuation: move the targets from their values at the start towards the goal, each step
-        # started from the last solution (a steady state at the start needs no more than the rest state)
+        # continuation: solve with the targets at their values at the start (the start's own steady state),
+        # then move them towards the goal in steps, each started from the last solution
         start = np.array([(x[i] if kind == "state" else evaluate(system, t, x, u, m)[2][i]) for kind, i, _ in tgt])
-        zc, zs_, _, _ = z, None, None, None
-        zc, rc, resc, itc = newton(z, start, max_iterations)
-        lam, step, total = 0.0, 0.1, itc
+        zc, _, resc, total = newton(z, start, max_iterations)
+        lam, step = 0.0, 0.1
         while resc <= tol and lam < 1.0 and step > 1e-4 and total < 20 * max_iterations:
             trial = min(1.0, lam + step)
-            zt, rt, rest, itt = newton(zc, start + trial * (goal - start), 12)
+            zt, _, rest, itt = newton(zc, start + trial * (goal - start), 12)
             total += itt
             if rest <= tol:
                 zc, lam, step = zt, trial, min(2 * step, 0.5)
