@@ -202,3 +202,12 @@ def test_scheduled_pi_conditional_integration():
     assert mem[0] == 0.0
     pi(0.0, np.array([0.95]), mem)  # 5 % off: integrates
     assert mem[0] == pytest.approx(0.1 * 0.05)
+
+
+def test_function_controller_reference_is_recorded_only_when_given():
+    s = linear_system(A, np.zeros(2), B)
+    hold = lambda t, y, memory: np.array([0.0])  # noqa: E731
+    plain = closed_loop(s, hold, 0.01, 0.1, measure=["x0"], actuate=["u0"])
+    assert "reference_x0_1" not in plain.frame
+    given = closed_loop(s, hold, 0.01, 0.1, measure=["x0"], actuate=["u0"], reference=lambda t: 2.0 * t)
+    np.testing.assert_allclose(given.frame["reference_x0_1"], 2.0 * given.frame["time_s"])

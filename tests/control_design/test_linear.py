@@ -208,6 +208,20 @@ def test_nonlinear_iosystem_agrees_with_python_control_linearize():
         nonlinear_iosystem(linear_system(a, np.zeros(2), b, method="rodas", mass=np.array([1.0, 0.0])))
 
 
+def _wet_slipping(slip):
+    """The wet bench with its slip speed held at ``slip`` [rad/s] by the drive and no force profile, and its
+    four temperatures at the start (held in the trims: they are not steady while the pack slips)."""
+    from clutchlab.wet.engagement import Scenario
+    from clutchlab.wet.system import engagement_system
+
+    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[slip, slip],
+                  duration=5.0, motor="speed", initial_slip_speed=slip)
+    s = engagement_system(sc)
+    temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
+                                                        "thermistor_temperature")}
+    return s, temps
+
+
 @pytest.mark.parametrize("slip, torque, tol", [(10.0, 20.0, 0.01), (100.0, 100.0, 0.02)])
 def test_wet_clutch_small_signal_step_matches_the_nonlinear_model(slip, torque, tol):
     """The wet pack slipping (the bench's speed controller holds the slip): trim the force for the torque,
@@ -217,14 +231,7 @@ def test_wet_clutch_small_signal_step_matches_the_nonlinear_model(slip, torque, 
     and 100 N*m it heats by 29 K/s: the temperatures are held in the trim, not steady, so the model is a
     linearisation along a drifting trajectory: 2 % (measured 0.9 %).
     """
-    from clutchlab.wet.engagement import Scenario
-    from clutchlab.wet.system import engagement_system
-
-    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[slip, slip],
-                  duration=5.0, motor="speed", initial_slip_speed=slip)
-    s = engagement_system(sc)
-    temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
-                                                        "thermistor_temperature")}
+    s, temps = _wet_slipping(slip)
     op = operating_point(s, states=temps, targets={"clutch_torque": torque}, free_inputs=["force_reference"],
                          inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
     assert op.modes == {"friction": "slip_positive", "piston": "free", "film": "contact"}
@@ -321,14 +328,7 @@ def test_emtc_bode_matches_simulated_sines(emtc_point, f):
 @pytest.mark.parametrize("f", [2.0, 10.0, 40.0])
 def test_wet_bode_matches_simulated_sines(f):
     """The wet pack slipping slowly (10 rad/s, 20 N*m: it heats at about 0.6 K/s, so the point stays put)."""
-    from clutchlab.wet.engagement import Scenario
-    from clutchlab.wet.system import engagement_system
-
-    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[10.0, 10.0],
-                  duration=5.0, motor="speed", initial_slip_speed=10.0)
-    s = engagement_system(sc)
-    temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
-                                                        "thermistor_temperature")}
+    s, temps = _wet_slipping(10.0)
     op = operating_point(s, states=temps, targets={"clutch_torque": 20.0}, free_inputs=["force_reference"],
                          inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
     G = linearize(op, inputs=["force_reference"], outputs=["clutch_torque"])
@@ -360,14 +360,7 @@ def test_trim_continues_to_a_far_target():
     """From the wet pack's 20 N*m point to 80 N*m with few Newton iterations allowed per solve: the direct
     solve stops, the continuation over the target reaches it, and the point is the one a direct solve with
     many iterations finds."""
-    from clutchlab.wet.engagement import Scenario
-    from clutchlab.wet.system import engagement_system
-
-    sc = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0], speed_value=[10.0, 10.0],
-                  duration=5.0, motor="speed", initial_slip_speed=10.0)
-    s = engagement_system(sc)
-    temps = {n: float(s.x0[s.state_index(n)]) for n in ("temperature", "fluid_temperature", "housing_temperature",
-                                                        "thermistor_temperature")}
+    s, temps = _wet_slipping(10.0)
     op20 = operating_point(s, states=temps, targets={"clutch_torque": 20.0}, free_inputs=["force_reference"],
                            inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
     start = dict(states=temps, targets={"clutch_torque": 80.0}, free_inputs=["force_reference"],

@@ -40,9 +40,9 @@ class ClosedLoopResult:
     Attributes
     ----------
     frame : pandas.DataFrame
-        ``time_s``, each measured signal (its column name), ``reference_<column>``, each actuated input
-        (its column name, the value applied from that sample on) and ``saturated_1`` (1 where the output
-        was limited).
+        ``time_s``, each measured signal (its column name), ``reference_<column>`` (for a function
+        controller only if a reference was given), each actuated input (its column name, the value applied
+        from that sample on) and ``saturated_1`` (1 where the output was limited).
     events : pandas.DataFrame
         The model's events (time, element, event name).
     stats : dict
@@ -105,8 +105,10 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
         Held inputs the controller sets.
     reference : float, array_like or callable, optional
         Reference of each measured signal: a constant (per signal), ``r(t)`` returning one value per
-        signal, or an array of shape ``(samples, signals)`` at ``t_k = k sample_time``. Default: the
-        measured values at the start (LTI controllers only need it; a function controller gets ``y``).
+        signal, or an array of shape ``(samples, signals)`` at ``t_k = k sample_time``. An LTI controller
+        acts on ``reference - y`` (default: the measured values at the start); a function controller gets
+        ``y`` and keeps its own reference: given here, it is only recorded (``reference_<signal>``
+        columns, absent otherwise).
     memory : array_like, optional
         Initial memory of a function controller (default: 16 zeros).
     saturate : bool
@@ -197,7 +199,8 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
     for q, (kind, i) in enumerate(meas):
         c = (base.states if kind == "state" else base.outputs)[i].column
         cols[c] = Y[:, q]
-        cols[f"reference_{c}"] = ref[:, q]
+        if lti or reference is not None:  # a function controller keeps its reference to itself unless given
+            cols[f"reference_{c}"] = ref[:, q]
     for q, j in enumerate(act):
         cols[base.inputs[j].column] = U[:, q]
     cols["saturated_1"] = S
