@@ -641,6 +641,26 @@ class Simulation:
         _check_status(self.system, int(code), self._si, self.time, True)
         return int(code)
 
+    def run_sampled(self, T, R, meas_kind, meas_idx, act, lo, hi, delay, kind, f, A, B, C, D, xc, sched, par, memory,
+                    u_op, Y, U, S) -> int:
+        """Run a sampled controller in the compiled loop from sample ``T[0]`` (the current time) to ``T[-1]``.
+
+        The arguments are those of :func:`clutchlab.numerics.core.closed_loop` after the model's own (its
+        parameters, state, modes, inputs, solver state and event log are this session's and carry on);
+        :func:`clutchlab.control.closed_loop` prepares them.  Returns the number of samples done; raises
+        :class:`~clutchlab.errors.SimulationError` on a failed step, as :meth:`advance`.
+        """
+        method = "rodas" if self.system.method == "rodas" or self.fixed_step > 0.0 else "dopri"
+        code, done = self._core.closed_loop(method, self.system.params, self.x, self.m, self.u, self._sf, self._si,
+                                            self._opt, self.log, self._y, T, R, meas_kind, meas_idx, act, lo, hi,
+                                            int(delay), int(kind), f, A, B, C, D, xc, sched, par, memory, u_op, Y, U,
+                                            S)
+        if int(code) == -1:
+            raise ParameterError(f"the controller returned another number of values than the {act.size} actuated "
+                                 f"inputs (at t = {T[done]:.6g} s)")
+        _check_status(self.system, int(code), self._si, self.time, True)
+        return int(done)
+
     def outputs(self) -> np.ndarray:
         """Output vector at the current point (order of ``system.outputs``)."""
         self._core.evaluate_outputs(self.system.params, self.time, self.x, self.u, self.m, self._y)

@@ -94,7 +94,7 @@ def step_runs(d: dict, t_end: float = 1.0) -> list[dict]:
     list of dict
         Per start: ``position``, ``time_s``, ``nonlinear`` and ``linear`` (normalised responses, 1 = the
         step), overshoots [%], ``settling_s`` (±5 % band; nan if not settled), ``seconds`` (wall time of
-        the closed-loop run).
+        the closed-loop run, in the Python loop).
     """
     import control
 
@@ -110,8 +110,10 @@ def step_runs(d: dict, t_end: float = 1.0) -> list[dict]:
         lo, hi = op.system.limits["motor_voltage"]
         ctrl = ScheduledPI(d["points"], kp, ti, None, SAMPLE_TIME, lambda t, r=x0 + STEP: r, (lo, hi))
         t = time.perf_counter()
+        # compiled=False: the report runs each loop once, and the Python loop's few ms beat the compiled loop's
+        # first-use compilation (about 10 s per model; clutchlab.control.loop)
         res = closed_loop(op, ctrl, SAMPLE_TIME, t_end, measure=["bearing_position"], actuate=["motor_voltage"],
-                          memory=[op.u[0]])
+                          memory=[op.u[0]], compiled=False)
         seconds = time.perf_counter() - t
         T = res.frame["time_s"].to_numpy()
         y = (res.frame["bearing_position_m"].to_numpy() - x0) / STEP
@@ -216,7 +218,7 @@ def wet_torque_control() -> dict:
                            ("feedforward + PI, integrating always", pi.kp, np.inf)):
         ctrl = ScheduledPI(torques, kp * ones, pi.ti * ones, forces, SAMPLE_TIME, _wet_reference, (0.0, 8000.0), band)
         res = closed_loop(engagement, ctrl, SAMPLE_TIME, float(protocol.duration), measure=["sensor_torque"],
-                          actuate=["force_reference"], memory=[0.0], reference=_wet_reference)
+                          actuate=["force_reference"], memory=[0.0], reference=_wet_reference, compiled=False)
         frame = res.frame
         lock = res.events.loc[res.events["event"] == "lockup", "time_s"]
         t_lock = float(lock.iloc[0]) if len(lock) else float("nan")

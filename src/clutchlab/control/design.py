@@ -104,7 +104,9 @@ class ScheduledPI:
     """A discrete PI whose gains follow the measured value (gain scheduling) with a feedforward.
 
     Call it as the controller of :func:`clutchlab.control.loop.closed_loop`: ``u = f(t, y, memory)`` with
-    ``y[0]`` the measured value (and scheduling variable), ``memory[0]`` the integral term.
+    ``y[0]`` the measured value (and scheduling variable), ``memory[0]`` the integral term.  There it runs in
+    the model's compiled loop (:func:`clutchlab.numerics.sampled.scheduled_pi_update`, the same arithmetic
+    as :meth:`__call__`).
 
     Attributes
     ----------
@@ -147,6 +149,6 @@ class ScheduledPI:
         integral = memory[0] + kp * self.sample_time / ti * e
         u = u_ff + kp * e + integral
         lo, hi = self.limits
-        if lo <= u <= hi and abs(e) <= self.integrate_band * abs(r):
+        if lo <= u <= hi and (self.integrate_band == np.inf or abs(e) <= self.integrate_band * abs(r)):
             memory[0] = integral  # anti-windup: integrate only while the output is not limited (and near r)
         return np.array([min(max(u, lo), hi)])

@@ -10,8 +10,15 @@ modes and hysteresis memories carry over); the controller is
   the error ``e = r - y`` and adding its output to the operating point's inputs:
   ``u_k = u_op + C x_k + D e_k``, ``x_{k+1} = A x_k + B e_k``;
 * or a function ``u = f(t, y, memory)`` of the time [s], the measured vector ``y`` [SI] and a float
-  array ``memory`` it may change in place (integrator states, the last output); a function compiled
-  with numba is called as it is.
+  array ``memory`` it may change in place (integrator states, the last output).
+
+For an LTI controller, a :class:`~clutchlab.control.design.ScheduledPI` and a function compiled with
+numba in nopython mode (called through a C entry, :func:`clutchlab.numerics.sampled.function_pointer`;
+it must not raise) the whole loop -- measuring, the controller's update, the hold and the model -- runs
+in the model's compiled entry
+(:mod:`clutchlab.numerics.sampled`, cached per model; its first use compiles the integrator into it, as
+:func:`clutchlab.system.simulate_batch` does); another function is called from a Python loop around
+:meth:`clutchlab.system.Simulation.advance`, with the same arithmetic.
 
 The output is limited to the model's physical range (:attr:`clutchlab.system.System.limits`, e.g. the
 drive's supply voltage) when ``saturate=True``, as the drive would.  ``delay=1`` applies each output one
@@ -85,7 +92,7 @@ def discrete_matrices(controller, sample_time: float):
 
 def closed_loop(system: System | OperatingPoint, controller, sample_time: float, t_end: float, *, measure,
                 actuate, reference=None, memory=None, saturate: bool = True, delay: int = 0, rtol=None,
-                max_step=None, fixed_step=None) -> ClosedLoopResult:
+                max_step=None, fixed_step=None, compiled=None) -> ClosedLoopResult:
     """Run ``system`` with a discrete ``controller`` in the loop from ``t = 0`` to ``t_end``.
 
     Parameters
@@ -120,6 +127,14 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
     fixed_step : float, optional
         Run the model in the core's fixed-step mode with this step [s] (a HIL target's frame; see
         :func:`clutchlab.system.simulate`), normally ``sample_time`` or an integer fraction of it.
+    compiled : bool, optional
+        Run the whole loop -- measurement, controller, hold and the model -- in the model's compiled entry
+        (:mod:`clutchlab.numerics.sampled`): the default for a python-control discrete system, a
+        :class:`~clutchlab.control.design.ScheduledPI` and a function compiled with numba; any other
+        function runs in the Python loop (``compiled=True`` then raises).  The compiled loop's first use
+        per model compiles the integrator into it (about 10 s on the 2-core machine; cached after that).
+        ``False`` forces the Python loop
+        (the same arithmetic; for debugging a controller).
 
     Returns
     -------
@@ -169,32 +184,48 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
                                  f"measures {len(meas)} and actuates {len(act)}")
         xc = np.zeros(Ad.shape[0])
     else:
-        mem = np.zeros(16) if memory is None else np.array(memory, dtype=float)
+        mem = np.zeros(16) if memory is None else np.array(memory, dtype=float).ravel()
     T = np.arange(n + 1) * sample_time
     Y = np.empty((n + 1, len(meas)))
     U = np.empty((n + 1, len(act)))
     S = np.zeros(n + 1)
-    pending = u_op[act].copy()
-    u = u_op.copy()
-    for k in range(n + 1):
-        y = measured()
-        Y[k] = y
-        if lti:
-            e = ref[k] - y
-            out = u_op[act] + Cd @ xc + Dd @ e
-            xc = Ad @ xc + Bd @ e
-        else:
-            out = np.asarray(controller(T[k], y, mem), dtype=float).ravel()
-            if out.shape != (len(act),):
-                raise ParameterError(f"the controller returned {out.size} values for {len(act)} actuated inputs")
-        clipped = np.minimum(np.maximum(out, lo), hi)
-        S[k] = float(np.any(clipped != out))
-        applied = clipped if delay == 0 else pending
-        pending = clipped
-        u[act] = applied
-        U[k] = applied
-        if k < n:
-            sim.advance(T[k + 1], u)
+    scheduled = _is_scheduled_pi(controller)
+    jitted = hasattr(controller, "py_func") and hasattr(controller, "signatures")  # a numba-compiled function
+    if compiled is None:
+        compiled = lti or scheduled or jitted
+    if compiled and not (lti or scheduled or jitted):
+        raise ParameterError(f"compiled=True: a {type(controller).__name__} runs in the Python loop; the compiled "
+                             "loop takes a python-control discrete system, a ScheduledPI or a numba-compiled "
+                             "function")
+    if compiled and scheduled and (len(meas) != 1 or len(act) != 1):
+        raise ParameterError(f"a ScheduledPI measures one signal and actuates one input; the loop has {len(meas)} "
+                             f"and {len(act)}")
+    if compiled:
+        _run_compiled(sim, controller, lti, T, ref, meas, act, lo, hi, delay, u_op, Ad if lti else None,
+                      Bd if lti else None, Cd if lti else None, Dd if lti else None, None if lti else mem, Y, U, S)
+    else:
+        pending = u_op[act].copy()
+        u = u_op.copy()
+        for k in range(n + 1):
+            y = measured()
+            Y[k] = y
+            if lti:
+                e = ref[k] - y
+                out = u_op[act] + Cd @ xc + Dd @ e
+                xc = Ad @ xc + Bd @ e
+            else:
+                out = np.asarray(controller(T[k], y, mem), dtype=float).ravel()
+                if out.shape != (len(act),):
+                    raise ParameterError(f"the controller returned {out.size} values for {len(act)} actuated "
+                                         "inputs")
+            clipped = np.minimum(np.maximum(out, lo), hi)
+            S[k] = float(np.any(clipped != out))
+            applied = clipped if delay == 0 else pending
+            pending = clipped
+            u[act] = applied
+            U[k] = applied
+            if k < n:
+                sim.advance(T[k + 1], u)
     cols = {"time_s": T}
     for q, (kind, i) in enumerate(meas):
         c = (base.states if kind == "state" else base.outputs)[i].column
@@ -205,6 +236,42 @@ def closed_loop(system: System | OperatingPoint, controller, sample_time: float,
         cols[base.inputs[j].column] = U[:, q]
     cols["saturated_1"] = S
     return ClosedLoopResult(pd.DataFrame(cols), sim.events(), sim.stats)
+
+
+def _is_scheduled_pi(controller) -> bool:
+    from .design import ScheduledPI
+
+    return isinstance(controller, ScheduledPI) and type(controller).__call__ is ScheduledPI.__call__
+
+
+def _run_compiled(sim, controller, lti, T, ref, meas, act, lo, hi, delay, u_op, Ad, Bd, Cd, Dd, mem, Y, U, S):
+    """The loop of :func:`closed_loop` in the model's compiled entry (``clutchlab.numerics.sampled``)."""
+    from ..numerics.sampled import FUNCTION, LTI, SCHEDULED_PI, function_pointer, placeholder
+
+    f64 = lambda a: np.ascontiguousarray(a, dtype=float)  # noqa: E731
+    kind = np.array([0 if k == "state" else 1 for k, _ in meas], dtype=np.int64)
+    idx = np.array([i for _, i in meas], dtype=np.int64)
+    act = np.asarray(act, dtype=np.int64)
+    f, sched, par, R, memory = placeholder(), np.zeros((4, 1)), np.zeros(5), ref, mem  # (unused parts: empty)
+    if lti:
+        xc, memory, code = np.zeros(Ad.shape[0]), np.zeros(1), LTI
+    else:
+        Ad, Bd, Cd, Dd, xc = np.zeros((0, 0)), np.zeros((0, len(meas))), np.zeros((len(act), 0)), \
+            np.zeros((len(act), len(meas))), np.zeros(0)
+    if not lti and not _is_scheduled_pi(controller):
+        f, code = function_pointer(controller), FUNCTION
+    elif not lti:
+        ff = controller.feedforward
+        pts = f64(controller.points).ravel()
+        sched = np.vstack([pts, f64(controller.kp).ravel(), f64(controller.ti).ravel(),
+                           np.zeros(pts.size) if ff is None else f64(ff).ravel()])
+        lo_c, hi_c = controller.limits
+        par = np.array([controller.sample_time, 0.0 if ff is None else 1.0, controller.integrate_band, lo_c, hi_c],
+                       dtype=float)
+        R = np.array([[float(controller.reference(t))] for t in T])
+        code = SCHEDULED_PI
+    sim.run_sampled(T, f64(R), kind, idx, act, f64(lo), f64(hi), delay, code, f, f64(Ad), f64(Bd), f64(Cd), f64(Dd), xc,
+                    f64(sched), f64(par), memory, f64(u_op[act]), Y, U, S)
 
 
 def _reference(reference, y0, n, sample_time):

@@ -1103,6 +1103,55 @@ def batch(method, P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STA
                                         EV_E, EV_N)
 
 
+def closed_loop(method, p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx, act, lo, hi, delay, kind, f, A,
+                B, C, D, xc, sched, par, memory, u_op, Y, U, S):
+    """Run a model with a sampled controller in the compiled loop (:mod:`clutchlab.numerics.sampled`).
+
+    Parameters
+    ----------
+    method : {"dopri", "rodas"}
+        The loop advancing the model between samples ("rodas" for the fixed-step mode).
+    p, x, m, u, sf, si, opt, log
+        As :func:`advance_rodas` (``x``, ``m``, ``u``, ``sf``, ``si``, ``log`` updated in place).
+    ybuf : ndarray
+        Work array of the model's outputs.
+    T : ndarray
+        Sample instants [s], ``T[0]`` the solver state's time.
+    R : ndarray
+        References ``(samples, measured)``.
+    meas_kind, meas_idx : ndarray
+        Measured signals: 0 a state, 1 an output, and its index.
+    act : ndarray
+        Indices of the actuated inputs.
+    lo, hi : ndarray
+        Limits of the actuated inputs.
+    delay : int
+        0 or 1 samples between reading and applying.
+    kind : int
+        ``sampled.LTI``, ``sampled.SCHEDULED_PI`` or ``sampled.FUNCTION``.
+    f : numba.core.ccallback.CFunc
+        The compiled function controller's C entry (:func:`clutchlab.numerics.sampled.function_pointer`;
+        a placeholder for the other kinds).
+    A, B, C, D, xc : ndarray
+        The LTI controller's matrices and state (``xc`` updated).
+    sched, par, memory : ndarray
+        The scheduled PI's tables, parameters and memory (``memory`` updated).
+    u_op : ndarray
+        Operating-point values of the actuated inputs (LTI) or the held values before the first sample.
+    Y, U, S : ndarray
+        Records per sample: measured values, applied inputs, saturation flag.
+
+    Returns
+    -------
+    tuple of int
+        Status of the last advance (-1: the function controller returned the wrong number of values) and
+        the number of samples done.
+    """
+    return entry_points(type(p), method).closed_loop(p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx, act,
+                                                     lo, hi, delay, kind, f, A, B, C, D, xc, sched, par, memory, u_op,
+                                                     Y, U, S)
+
+
 def evaluate(p, t, x, u, m, dx, g):
     """The model's right-hand side ``dx`` and switching functions ``g`` at one point (linearisation, tests)."""
     entry_points(type(p), "dopri").evaluate(p, t, x, u, m, dx, g)

@@ -3,7 +3,8 @@
 The core's loops (:mod:`clutchlab.numerics.core`) are ``register_jitable``
 functions: they compile into whichever cached function calls them.  Each model
 (each parameter ``NamedTuple`` class and method) gets its own small module of
-cached entry points -- ``advance``, ``batch`` (``prange``, one solver per
+cached entry points -- ``advance``, ``closed_loop`` (a sampled controller in
+the loop, :mod:`~clutchlab.numerics.sampled`), ``batch`` (``prange``, one solver per
 variant, over parameters stacked along a variant axis), ``evaluate``,
 ``evaluate_outputs``, ``outputs_at`` -- generated from
 one template (:data:`TEMPLATE`) into clutchlab's kernel folder and imported
@@ -50,6 +51,7 @@ import numba
 import numpy as np
 
 from clutchlab.numerics import core as _core
+from clutchlab.numerics import sampled as _sampled
 from clutchlab.numerics.borrow import borrow as _borrow, byref as _byref, take as _take
 from clutchlab.numerics.entry import rehome as _rehome
 
@@ -73,6 +75,49 @@ def batch(P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T
                                 OUT_M[v], OUT_Y[v], want_y)
         for q in range(_core.N_SI):
             STATS[v, q] = si[q]
+
+
+@numba.njit(cache=True, nogil=True)
+def closed_loop(p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx, act, lo, hi, delay, kind, f, A, B, C,
+                D, xc, sched, par, memory, u_op, Y, U, S):
+    # a sampled controller in the loop (clutchlab.numerics.sampled); returns (status, samples done)
+    n = T.shape[0] - 1
+    na = act.shape[0]
+    ny = meas_kind.shape[0]
+    ts = np.empty(0)
+    rt = np.empty(0)
+    rx = np.empty((0, x.shape[0]))
+    rm = np.empty((0, m.shape[0]), dtype=np.int64)
+    ry = np.empty((1, ybuf.shape[0]))
+    y = np.empty(ny)
+    e = np.empty(ny)
+    xn = np.empty(xc.shape[0])
+    out = np.empty(na)
+    clipped = np.empty(na)
+    pending = u_op.copy()
+    code = 0
+    for k in range(n + 1):
+        _sampled.measure(p, T[k], x, u, m, meas_kind, meas_idx, ybuf, y)
+        for q in range(ny):
+            Y[k, q] = y[q]
+        if kind == _sampled.LTI:
+            _sampled.lti_update(A, B, C, D, xc, R[k], y, u_op, out, e, xn)
+        elif kind == _sampled.SCHEDULED_PI:
+            out[0] = _sampled.scheduled_pi_update(sched, par, R[k, 0], y[0], memory)
+        else:  # a compiled function through its C pointer (clutchlab.numerics.sampled.function_pointer)
+            if f(T[k], y.ctypes.data, ny, memory.ctypes.data, memory.shape[0], out.ctypes.data, na) != 0:
+                return -1, k
+        S[k] = _sampled.hold(out, lo, hi, clipped)
+        for i in range(na):
+            a = clipped[i] if delay == 0 else pending[i]
+            pending[i] = clipped[i]
+            u[act[i]] = a
+            U[k, i] = a
+        if k < n:
+            code = advance(p, x, m, u, T[k + 1], sf, si, opt, log, ts, rt, rx, rm, ry, False)
+            if code != 0 and code != 3:
+                return code, k + 1
+    return code, n + 1
 
 
 @numba.njit(cache=True, nogil=True)
