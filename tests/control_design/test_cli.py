@@ -70,3 +70,35 @@ def test_generic_trim_of_the_linear_parts_of_a_model(tmp_path, capsys):
     assert doc["state.bearing_position_m"] == pytest.approx(2e-3, rel=1e-8)
     assert doc["input.bearing_reference_m"] == 2e-3
     capsys.readouterr()
+
+
+def test_emtc_coil_at_a_current_from_the_command_line(tmp_path, capsys):
+    """``--coil-drive current``: the EMTC's coil trimmed at a current and linearised along the rising branch
+    of its magnet (the same model as the Python API's); refusals are one line and write nothing."""
+    from clutchlab.control import linearize, operating_point
+    from clutchlab.emtc.system import BenchOptions, bench_system
+
+    common = ["emtc", "--coil-drive", "current", "--set", "throttle=0.2", "--set", "coil_current_command=1.5 A",
+              "--settle", "1 s"]
+    op = tmp_path / "op.json"
+    assert main(["control", "trim", *common, "-o", str(op)]) == 0, capsys.readouterr()
+    doc = json.loads(op.read_text())
+    assert doc["state.i2_A"] == pytest.approx(1.5, rel=1e-9) and doc["modes"]["armature_mode"] == "contact"
+    lin = tmp_path / "lin.json"
+    assert main(["control", "linearize", *common, "-u", "coil_current_command", "-y", "coupling_torque",
+                 "--branch", "i2=rising", "-o", str(lin)]) == 0, capsys.readouterr()
+    m = json.loads(lin.read_text())
+    assert m["directions"] == {"i2": "rising"} and m["states"] == ["i1_A", "i2_A"]
+    A, B, C = (np.array(m[k]) for k in "ABC")
+    s = bench_system(cosimulation=True, options=BenchOptions(coil_drive="current"))
+    point = operating_point(s, inputs={"throttle": 0.2, "coil_current_command": 1.5}, settle=1.0)
+    G = linearize(point, inputs=["coil_current_command"], outputs=["coupling_torque"], directions={"i2": "rising"})
+    assert (-C @ np.linalg.solve(A, B))[0, 0] == pytest.approx(float(np.squeeze(G.dcgain())), rel=1e-9)
+    bad = tmp_path / "bad.json"
+    line = one_line_error(capsys, ["control", "trim", "emtc", "--coil-drive", "current", "--set",
+                                   "coil_current_command=6 A", "-o", str(bad)])
+    assert "coil_current_command = 6 is outside its physical range" in line and not bad.exists()
+    line = one_line_error(capsys, ["control", "trim", "wet", "--coil-drive", "current", "-o", str(bad)])
+    assert "--coil-drive is the EMTC's" in line
+    line = one_line_error(capsys, ["control", "linearize", *common, "--branch", "i2", "-o", str(bad)])
+    assert "--branch 'i2'" in line and not bad.exists()

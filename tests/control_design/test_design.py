@@ -211,3 +211,48 @@ def test_function_controller_reference_is_recorded_only_when_given():
     assert "reference_x0_1" not in plain.frame
     given = closed_loop(s, hold, 0.01, 0.1, measure=["x0"], actuate=["u0"], reference=lambda t: 2.0 * t)
     np.testing.assert_allclose(given.frame["reference_x0_1"], 2.0 * given.frame["time_s"])
+
+
+@settings(deadline=None, max_examples=25)
+@given(st.floats(0.5, 30.0))
+def test_loop_margins_of_a_triple_lag_against_closed_forms(k):
+    """L = k / (s + 1)^3: the phase is -180 deg at w = sqrt(3), where |L| = k / 8, so the gain margin is
+    8 / k; |L| = 1 at w = sqrt(k^(2/3) - 1) (k > 1), phase margin 180 - 3 atan(w). The closed loop
+    (s + 1)^3 + k has two right-half-plane poles for k > 8, which the Nyquist count must give."""
+    from clutchlab.control import loop_margins
+
+    row = loop_margins([("lag", control.tf([k], [1.0, 3.0, 3.0, 1.0]))]).iloc[0]
+    assert row.gain_margin_dB == pytest.approx(20 * np.log10(8.0 / k), abs=1e-6)
+    assert row.phase_crossover_Hz == pytest.approx(np.sqrt(3.0) / (2 * np.pi), rel=1e-6)
+    if k > 1.01:
+        w = np.sqrt(k ** (2.0 / 3.0) - 1.0)
+        assert row.crossover_Hz == pytest.approx(w / (2 * np.pi), rel=1e-6)
+        assert row.phase_margin_deg == pytest.approx(180.0 - 3 * np.degrees(np.arctan(w)), abs=1e-5)
+    unstable = k > 8.0 + 1e-6
+    assert row.closed_loop_rhp_poles_1 == (2 if unstable else 0) or abs(k - 8.0) < 1e-6
+    assert row.encirclements_1 == row.closed_loop_rhp_poles_1 and row.open_loop_rhp_poles_1 == 0
+    assert row.nyquist_consistent_1 == 1
+
+
+def test_eclutch_loops_satisfy_the_nyquist_criterion():
+    """The E-clutch position loops of worked design 1: the designed phase margin at the designed crossover,
+    stable closed loops, and where the actuator is open-loop unstable (beyond the force peak) one
+    counter-clockwise encirclement of -1 (N = -1), as Z = N + P = 0 requires."""
+    from clutchlab.control import demo, loop_margins
+    from clutchlab.control.plots import nyquist_figure
+
+    d = demo.design()
+    loops = [(f"{x * 1e3:g} mm", control.ss(p.tf()) * G) for x, p, G in zip(demo.POSITIONS, d["pis"], d["models"])]
+    m = loop_margins(loops)
+    np.testing.assert_allclose(m.phase_margin_deg, demo.PHASE_MARGIN_DEG, atol=1e-6)
+    np.testing.assert_allclose(m.crossover_Hz, demo.CROSSOVER_HZ, rtol=1e-6)
+    assert (m.closed_loop_rhp_poles_1 == 0).all() and (m.nyquist_consistent_1 == 1).all()
+    unstable = m.open_loop_rhp_poles_1 > 0
+    assert unstable.any() and not unstable.all()  # the open loop is unstable beyond the force peak only
+    assert (m.encirclements_1[unstable] == -m.open_loop_rhp_poles_1[unstable]).all()
+    fig = nyquist_figure(loops[:2])
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "Re L(jω) [1]" and ax.get_legend() is not None
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -9,6 +9,7 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   unit in the name, ``bearing_position_m``), within the active mode of a hybrid model;
   :func:`nonlinear_iosystem` -- the model as a python-control ``NonlinearIOSystem`` (one mode);
 * :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range;
+  :func:`loop_margins` -- gain, phase and stability margins of loops, checked by the Nyquist criterion;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
 * :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling;
 * :func:`time_steps`, :func:`fixed_step_error` -- fixed-step (HIL frame) runs: wall time per frame and
@@ -23,7 +24,7 @@ from __future__ import annotations
 import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
-           "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
+           "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
            "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error"]
 
 _WHERE = {
@@ -35,6 +36,7 @@ _WHERE = {
     "nonlinear_iosystem": "clutchlab.control.linear",
     "frequency_table": "clutchlab.control.linear",
     "pole_sweep": "clutchlab.control.linear",
+    "loop_margins": "clutchlab.control.linear",
     "write_linear_model": "clutchlab.control.linear",
     "closed_loop": "clutchlab.control.loop",
     "ClosedLoopResult": "clutchlab.control.loop",

@@ -8,8 +8,10 @@
     Bode diagram at several operating points (and ``--table`` its magnitude and phase as CSV, ``--poles``
     the poles at each point).
 
-Other models: ``wet``, ``emtc`` (their held inputs) and ``driveline FILE.toml``, with the generic trim
-options (``--set``, ``--hold``, ``--target``, ``--free``, ``--mode``, ``--time``, ``--settle``).
+Other models: ``wet``, ``emtc`` (their held inputs; ``--coil-drive current`` drives the EMTC's coil at
+the input ``coil_current_command``) and ``driveline FILE.toml``, with the generic trim options
+(``--set``, ``--hold``, ``--target``, ``--free``, ``--mode``, ``--time``, ``--settle``); ``--branch
+i2=rising`` linearises a hysteretic element along one branch.
 """
 
 from __future__ import annotations
@@ -84,6 +86,9 @@ def _common(p) -> None:
     p.add_argument("--free", action="append", default=[], metavar="INPUT", help="an input solved for")
     p.add_argument("--mode", action="append", default=[], metavar="MODE=VALUE",
                    help="mode of a hybrid model, e.g. 'piston=free'")
+    p.add_argument("--coil-drive", choices=("controller", "current"), default=None,
+                   help="EMTC: the coil driven by its torque controller (default) or at the held input "
+                        "coil_current_command (current drive: --set coil_current_command='1.5 A')")
     p.add_argument("--time", default="0 s", help="time of the operating point (models with profiles)")
     p.add_argument("--settle", default="0 s", help="simulate this long with the inputs held before Newton's method")
     p.add_argument("--force", action="store_true", help="overwrite the outputs")
@@ -94,6 +99,9 @@ def _signals(p) -> None:
                    help="input of the linear model (repeat; default: all held inputs)")
     p.add_argument("-y", "--y", dest="outputs", action="append", default=None, metavar="NAME",
                    help="state or output of the linear model (repeat; default: all outputs)")
+    p.add_argument("--branch", action="append", default=[], metavar="NAME=rising|falling",
+                   help="linearise a hysteretic element along one branch, e.g. 'i2=rising' (the EMTC magnet "
+                        "driven up); default: the mean of both slopes")
 
 
 def _system(args):
@@ -103,6 +111,8 @@ def _system(args):
         raise ParameterError(f"control {args.model} takes no file (got {args.file!r}); only driveline does")
     if args.model != "eclutch" and args.at:
         raise ParameterError(f"--at is the E-clutch's bearing position; for {args.model} use --target/--set")
+    if args.model != "emtc" and args.coil_drive is not None:
+        raise ParameterError(f"--coil-drive is the EMTC's; {args.model} has no coil")
     if args.model == "eclutch":
         from ..eclutch import EClutch
 
@@ -114,14 +124,24 @@ def _system(args):
 
         return None, REGISTRY["wet"]()
     if args.model == "emtc":
-        from ..emtc.system import bench_system
+        from ..emtc.system import BenchOptions, bench_system
 
-        return None, bench_system(cosimulation=True)
+        return None, bench_system(cosimulation=True, options=BenchOptions(coil_drive=args.coil_drive or "controller"))
     if args.file is None:
         raise ParameterError("control ... driveline needs its description: clutchlab control trim driveline FILE.toml")
     from ..driveline.description import load_driveline
 
     return None, load_driveline(args.file).driveline.system()
+
+
+def _branches(args) -> dict:
+    out = {}
+    for item in args.branch:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--branch {item!r}: expected NAME=rising or NAME=falling")
+        out[name.strip()] = value.strip()
+    return out
 
 
 def _pairs(system, items, kinds, flag):
@@ -189,10 +209,11 @@ def _linearize(args) -> int:
     from .linear import linearize, write_linear_model
 
     check_writable(args.output, args.force)
+    branches = _branches(args)
     points = _points(args)
     if len(points) != 1:
         raise ParameterError("linearize writes one model: give one --at")
-    sys = linearize(points[0][2], inputs=args.inputs, outputs=args.outputs)
+    sys = linearize(points[0][2], inputs=args.inputs, outputs=args.outputs, directions=branches)
     write_linear_model(sys, args.output, force=args.force)
     print(f"{sys.nstates} states, {sys.ninputs} inputs, {sys.noutputs} outputs -> {args.output}")
     return 0
@@ -209,9 +230,11 @@ def _bode(args) -> int:
     fmin, fmax = to_si(args.fmin, "Hz", name="--fmin"), to_si(args.fmax, "Hz", name="--fmax")
     if not 0 < fmin < fmax:
         raise ParameterError(f"--fmin {args.fmin!r} and --fmax {args.fmax!r}: need 0 < fmin < fmax")
+    branches = _branches(args)
     points = _points(args)
     f = np.logspace(np.log10(fmin), np.log10(fmax), 400)
-    models = [(label, value, op, linearize(op, inputs=args.inputs, outputs=args.outputs)) for label, value, op in points]
+    models = [(label, value, op, linearize(op, inputs=args.inputs, outputs=args.outputs, directions=branches))
+              for label, value, op in points]
     if models[0][3].ninputs == 0:
         raise ParameterError(f"{points[0][2].system.name} has no held inputs: no frequency response")
     over = None
@@ -241,7 +264,7 @@ def _bode(args) -> int:
     if args.poles:
         name = "bearing_position_m" if args.model == "eclutch" and args.at else "operating_point_1"
         poles = pole_sweep([(value, op) for _, value, op, _ in models], inputs=args.inputs, outputs=args.outputs,
-                           name=name)
+                           directions=branches, name=name)
         atomic_to_csv(poles, args.poles, overwrite=args.force)
     print(args.output)
     return 0

@@ -282,7 +282,7 @@ def _settling(T, y, band: float = 0.05) -> float:
 def _figures(d, runs):
     from ..plotting import legend_outside, mark_synthetic, new_figure
     from .linear import pole_sweep
-    from .plots import bode_figure, pole_map_figure
+    from .plots import bode_figure, nyquist_figure, pole_map_figure
 
     f = np.logspace(-1, np.log10(2000.0), 400)
     chosen = [0, 3, d["touch"], len(POSITIONS) - 1]
@@ -311,9 +311,18 @@ def _figures(d, runs):
     for ax in np.atleast_1d(axes):
         legend_outside(ax)
     steps.suptitle(f"E-clutch: {STEP * 1e3:g} mm reference steps, scheduled PI")
-    for fig in (bode, current, pmap, steps):
+    import control
+
+    from .linear import loop_margins
+
+    loops = [(f"bearing at {POSITIONS[k] * 1e3:g} mm", control.ss(d["pis"][k].tf()) * d["models"][k])
+             for k in chosen]
+    nyq = nyquist_figure(loops, np.logspace(-2, np.log10(2000.0), 800),
+                         title="E-clutch: open loops L = PI G near the critical point")
+    margins = loop_margins(loops)
+    for fig in (bode, current, pmap, steps, nyq):
         mark_synthetic(fig)
-    return bode, current, pmap, steps, poles
+    return bode, current, pmap, steps, poles, nyq, margins
 
 
 def demo_section(progress=None) -> Section:
@@ -328,7 +337,7 @@ def demo_section(progress=None) -> Section:
         progress("control: E-clutch operating points, linear models and PI design ...")
     d = design()
     runs = step_runs(d)
-    bode, current, pmap, steps, poles = _figures(d, runs)
+    bode, current, pmap, steps, poles, nyq, margins = _figures(d, runs)
     line = poles[(poles["pole_imag_1_s"] > 0) & poles["natural_frequency_Hz"].between(50, 90)]
     res_f = line.groupby("bearing_position_m")["natural_frequency_Hz"].first()
     unstable = sorted(set(poles.loc[poles["pole_real_1_s"] > 0, "bearing_position_m"]))
@@ -366,6 +375,14 @@ def demo_section(progress=None) -> Section:
                "and the PI stabilises it."),
         Table("control_eclutch_schedule", gains, "Operating points and the scheduled PI (Kp in V/mm, Ti in s) "
               "with the line resonance there", float_format="{:.4g}"),
+        Figure("control_eclutch_nyquist", nyq, "Nyquist diagram of the open loops (PI times actuator) at four "
+               "positions, near the critical point -1 (negative and positive frequencies). Every loop passes -1 at "
+               f"the designed {PHASE_MARGIN_DEG:g} deg; where the actuator is open-loop unstable the curve "
+               "encircles -1 once counter-clockwise, which the Nyquist criterion requires for a stable closed "
+               "loop."),
+        Table("control_eclutch_margins", margins, "Margins of the loops and the Nyquist criterion: P open-loop "
+              "right-half-plane poles, N clockwise encirclements of -1, Z closed-loop right-half-plane poles "
+              "counted from the closed loop's poles; consistent where Z = N + P", float_format="{:.4g}"),
         Figure("control_eclutch_steps", steps, f"{STEP * 1e3:g} mm reference steps of the nonlinear model with "
                "the gain-scheduled PI sampled at 1 kHz (zero-order hold on the motor voltage), against the "
                "linear closed loop at the start position."),

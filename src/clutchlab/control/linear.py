@@ -12,7 +12,9 @@ algebraic rows such as the E-clutch's massless finger tip) at an operating point
   (``A = A_dd - A_da A_aa^-1 A_ad``, likewise ``B``, ``C``, ``D``): index-1 DAEs only;
 * states that no other kept state and no requested output reads are dropped, repeatedly (energy
   integrals, see :mod:`clutchlab.control.trim`; the E-clutch's massless-tip velocity): they are
-  unobservable, so the input-output behaviour is unchanged (``keep_monitors=True`` keeps them).
+  unobservable, so the input-output behaviour is unchanged (``keep_monitors=True`` keeps them); so are
+  states the active mode holds still (a zero row in ``A`` and ``B``: the EMTC's armature at its stop),
+  which stay at their operating values whatever the inputs do.
 
 The result is a ``control.StateSpace`` whose signal names carry their unit (``bearing_position_m``,
 ``motor_voltage_V``); its ``operating_point`` attribute holds the :class:`OperatingPoint` and ``mode`` the
@@ -30,7 +32,8 @@ from ..errors import ParameterError
 from ..system import System, evaluate
 from .trim import OperatingPoint, input_scale, resolve, state_scale
 
-__all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "write_linear_model"]
+__all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
+           "write_linear_model"]
 
 #: relative step of the central differences (about the cube root of the machine epsilon)
 FD_STEP = 6e-6
@@ -44,7 +47,17 @@ def _signals(system: System, names, kinds, default):
     return [resolve(system, n, kinds) for n in names]
 
 
-def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
+def _directions(system: System, directions) -> dict:
+    """``{("state"|"input", index): +1.0 | -1.0}`` from ``{name: "rising" | "falling"}``."""
+    out = {}
+    for name, d in (directions or {}).items():
+        if d not in ("rising", "falling"):
+            raise ParameterError(f"{system.name}: direction of {name!r} = {d!r}: expected 'rising' or 'falling'")
+        out[resolve(system, name, ("state", "input"))] = 1.0 if d == "rising" else -1.0
+    return out
+
+
+def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None, directions=None):
     """The full Jacobians of a system at an operating point (before eliminating algebraic rows).
 
     Parameters
@@ -57,6 +70,10 @@ def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
         Held inputs (default: all).
     outputs : sequence of str, optional
         States or outputs (default: all outputs).
+    directions : dict, optional
+        ``{state or input: "rising" | "falling"}``: one-sided differences in that direction for those
+        columns (a hysteretic element's branch: the EMTC magnet's force rises along its ascending branch
+        and falls along a descending one, with other slopes); central differences otherwise.
 
     Returns
     -------
@@ -76,33 +93,38 @@ def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
     def pick(xx, y):
         return np.array([xx[i] if kind == "state" else y[i] for kind, i in outs])
 
-    def moved(vec, j, h):
-        """Right-hand side and picked outputs with component ``j`` of ``vec`` (x or u) moved by +h and -h."""
+    sides = _directions(system, directions)
+    f0, _, y0 = evaluate(system, t, x, u, m)
+    y0 = pick(x, y0)
+
+    def slopes(vec, kind, j, h):
+        """d(rhs)/d and d(outputs)/d component ``j`` of ``vec`` (x or u): central, or one-sided (directions)."""
+        side = sides.get((kind, j))
         out = []
-        for sign in (1.0, -1.0):
+        for sign in ((1.0, -1.0) if side is None else (side,)):
             v = vec.copy()
             v[j] += sign * h
             xx, uu = (v, u) if vec is x else (x, v)
             f, _, y = evaluate(system, t, xx, uu, m)
             out.append((f, pick(xx, y)))
-        return out
+        if side is None:
+            (fp, yp), (fm, ym) = out
+            return (fp - fm) / (2 * h), (yp - ym) / (2 * h), False
+        (f1, y1), = out
+        return (f1 - f0) / (side * h), (y1 - y0) / (side * h), True
 
     A = np.zeros((n, n))
     C = np.zeros((q, n))
     analytic = bool(evaluate_jacobian(system.params, float(t), x, u, m, A))
     for j in range(n):
-        h = FD_STEP * xs[j]
-        (fp, yp), (fm, ym) = moved(x, j, h)
-        if not analytic:
-            A[:, j] = (fp - fm) / (2 * h)
-        C[:, j] = (yp - ym) / (2 * h)
+        a, c, one_sided = slopes(x, "state", j, FD_STEP * xs[j])
+        if not analytic or one_sided:
+            A[:, j] = a
+        C[:, j] = c
     B = np.zeros((n, len(ins)))
     D = np.zeros((q, len(ins)))
     for k, (_, j) in enumerate(ins):
-        h = FD_STEP * us[j]
-        (fp, yp), (fm, ym) = moved(u, j, h)
-        B[:, k] = (fp - fm) / (2 * h)
-        D[:, k] = (yp - ym) / (2 * h)
+        B[:, k], D[:, k], _ = slopes(u, "input", j, FD_STEP * us[j])
     for name, M in (("A", A), ("B", B), ("C", C), ("D", D)):
         if not np.all(np.isfinite(M)):
             raise ParameterError(f"{system.name}: the Jacobian {name} is not finite at this operating point "
@@ -111,7 +133,7 @@ def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None):
 
 
 def linearize(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
-              keep_monitors: bool = False, name: str | None = None):
+              directions: dict | None = None, keep_monitors: bool = False, name: str | None = None):
     """Linear model of ``system`` at ``op`` within its active mode, as a python-control ``StateSpace``.
 
     Parameters
@@ -124,16 +146,23 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
         Held inputs of the model (default: all), names with or without unit.
     outputs : sequence of str, optional
         States or outputs (default: all outputs).
+    directions : dict, optional
+        ``{state or input: "rising" | "falling"}``: linearise a hysteretic element along one branch
+        (:func:`jacobians`), e.g. ``{"i2": "rising"}`` for the EMTC magnet driven up.  Without it the
+        slopes are central differences: on a hysteresis branch point, the mean of the rising and falling
+        slopes.
     keep_monitors : bool
-        Keep states that no other state and no requested output reads (unobservable poles).
+        Keep states that no other state and no requested output reads (unobservable poles) and states the
+        mode holds still (poles at zero that no input reaches).
     name : str, optional
         Name of the ``StateSpace`` (default: the system's name and the mode).
 
     Returns
     -------
     control.StateSpace
-        Signals named by column (``bearing_position_m``); attributes ``operating_point`` and ``mode``
-        (``{mode variable: value}``) and ``units`` (``{signal: unit}``).
+        Signals named by column (``bearing_position_m``); attributes ``operating_point``, ``mode``
+        (``{mode variable: value}``), ``directions`` (the branches asked for) and ``units``
+        (``{signal: unit}``).
 
     Raises
     ------
@@ -148,7 +177,7 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
         op = OperatingPoint(system, 0.0, system.x0.copy(), system.u0.copy(), system.m0.copy())
     if op.system is not system and op.x.shape != system.x0.shape:
         raise ParameterError(f"{system.name}: the operating point belongs to another system ({op.system.name})")
-    jac = jacobians(system, op, inputs, outputs)
+    jac = jacobians(system, op, inputs, outputs, directions)
     A, B, C, D = jac["A"], jac["B"], jac["C"], jac["D"]
     mass = system.mass
     alg = np.flatnonzero(mass == 0.0)
@@ -172,11 +201,13 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     B_ = B_ / md[:, None]
     keep = np.ones(dif.size, dtype=bool)
     changed = not keep_monitors
-    while changed:  # a state no kept state and no output reads: unobservable, dropped (then look again)
-        changed = False
+    while changed:  # a state no kept state and no output reads: unobservable, dropped (then look again);
+        changed = False  # a state the mode holds still (zero row, no input): constant, dropped as well
         for k in np.flatnonzero(keep):
             others = keep & (np.arange(dif.size) != k)
-            if np.all(A_[others, k] == 0.0) and np.all(C_[:, k] == 0.0):
+            unread = np.all(A_[others, k] == 0.0) and np.all(C_[:, k] == 0.0)
+            frozen = np.all(A_[k, keep] == 0.0) and np.all(B_[k] == 0.0)
+            if unread or frozen:
                 keep[k] = False
                 changed = True
     A_, B_, C_ = A_[np.ix_(keep, keep)], B_[keep], C_[:, keep]
@@ -189,6 +220,7 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
                      outputs=[v.column for v in out_vars], name=label)
     sys.operating_point = op
     sys.mode = mode
+    sys.directions = dict(directions or {})
     sys.units = {v.column: v.unit for v in (*state_vars, *in_vars, *out_vars)}
     sys.analytic_jacobian = jac["analytic"]
     return sys
@@ -292,7 +324,8 @@ def frequency_table(sys, frequencies_hz, *, over: str | None = None) -> "pandas.
     return pd.DataFrame(cols)
 
 
-def pole_sweep(points, inputs=None, outputs=None, *, name: str = "value") -> "pandas.DataFrame":  # noqa: F821
+def pole_sweep(points, inputs=None, outputs=None, *, directions: dict | None = None,
+               name: str = "value") -> "pandas.DataFrame":  # noqa: F821
     """Poles of the linear models at a series of operating points (a pole map over an operating range).
 
     Parameters
@@ -301,6 +334,8 @@ def pole_sweep(points, inputs=None, outputs=None, *, name: str = "value") -> "pa
         The swept value (e.g. the bearing position [m]) and the operating point there.
     inputs, outputs : sequence of str, optional
         As :func:`linearize`.
+    directions : dict, optional
+        Hysteresis branches, as :func:`linearize`.
     name : str
         Column name of the swept value (with its unit, ``bearing_position_m``).
 
@@ -314,12 +349,50 @@ def pole_sweep(points, inputs=None, outputs=None, *, name: str = "value") -> "pa
 
     rows = []
     for value, op in points:
-        sys = linearize(op, inputs=inputs, outputs=outputs)
+        sys = linearize(op, inputs=inputs, outputs=outputs, directions=directions)
         for p in np.linalg.eigvals(sys.A) if sys.nstates else []:
             wn = abs(p)
             rows.append({name: float(value), "pole_real_1_s": float(p.real), "pole_imag_1_s": float(p.imag),
                          "natural_frequency_Hz": wn / (2 * np.pi),
                          "damping_1": float(-p.real / wn) if wn > 0 else 1.0})
+    return pd.DataFrame(rows)
+
+
+def loop_margins(loops) -> "pandas.DataFrame":  # noqa: F821
+    """Stability margins and the Nyquist criterion of open loops ``L = C G`` (SISO), one row per loop.
+
+    Parameters
+    ----------
+    loops : sequence of (str, control.LTI)
+        Label and open-loop transfer (e.g. ``control.ss(pi.tf()) * G``; negative feedback around it).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``loop``; ``gain_margin_dB`` (inf: none), ``phase_crossover_Hz`` (where the phase is -180°);
+        ``phase_margin_deg``, ``crossover_Hz`` (where ``|L| = 1``); ``stability_margin_1`` (the least
+        ``|1 + L(jw)|``, the distance of the Nyquist curve from -1); ``open_loop_rhp_poles_1`` (P);
+        ``encirclements_1`` (N, clockwise encirclements of -1 by the Nyquist curve, python-control's
+        ``nyquist_response``); ``closed_loop_rhp_poles_1`` (Z, counted from the closed loop's poles) and
+        ``nyquist_consistent_1`` (1 if Z = N + P: the two counts agree).
+    """
+    import control
+    import pandas as pd
+
+    rows = []
+    for label, L in loops:
+        if L.ninputs != 1 or L.noutputs != 1:
+            raise ParameterError(f"loop {label!r}: {L.ninputs} inputs and {L.noutputs} outputs; a loop has one each")
+        gm, pm, sm, w_pc, w_gc, _ = control.stability_margins(L)
+        # (a pole on the imaginary axis, an integrator, is passed on the right by the Nyquist contour: not counted)
+        poles, cl = L.poles(), control.feedback(L, 1).poles()
+        p = int(np.sum(np.real(poles) > 1e-9 * np.maximum(1.0, np.abs(poles))))
+        z = int(np.sum(np.real(cl) > 1e-9 * np.maximum(1.0, np.abs(cl))))
+        n = int(control.nyquist_response(L, warn_encirclements=False, warn_nyquist=False).count)
+        rows.append({"loop": label, "gain_margin_dB": 20 * np.log10(gm) if np.isfinite(gm) and gm > 0 else np.inf,
+                     "phase_crossover_Hz": w_pc / (2 * np.pi), "phase_margin_deg": pm,
+                     "crossover_Hz": w_gc / (2 * np.pi), "stability_margin_1": sm, "open_loop_rhp_poles_1": p,
+                     "encirclements_1": n, "closed_loop_rhp_poles_1": z, "nyquist_consistent_1": int(z == n + p)})
     return pd.DataFrame(rows)
 
 
@@ -349,7 +422,7 @@ def write_linear_model(sys, path, *, force: bool = False) -> Path:
     if path.suffix.lower() == ".json":
         op = getattr(sys, "operating_point", None)
         doc = {"name": sys.name, "states": states, "inputs": ins, "outputs": outs, "units": units,
-               "mode": getattr(sys, "mode", {}), "A": np.asarray(sys.A).tolist(), "B": np.asarray(sys.B).tolist(),
+               "mode": getattr(sys, "mode", {}), "directions": getattr(sys, "directions", {}), "A": np.asarray(sys.A).tolist(), "B": np.asarray(sys.B).tolist(),
                "C": np.asarray(sys.C).tolist(), "D": np.asarray(sys.D).tolist(),
                "operating_point": op.to_dict() if op is not None else None}
         atomic_write_text(path, json.dumps(doc, indent=1), overwrite=force)

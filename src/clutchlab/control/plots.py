@@ -1,4 +1,4 @@
-"""Figures of linear models: Bode diagrams over operating points and pole maps."""
+"""Figures of linear models: Bode diagrams over operating points, Nyquist diagrams of loops and pole maps."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def _unit(column: str) -> str:
     label = column_label(column)
     return label[label.index("[") + 1:-1] if "[" in label else "1"
 
-__all__ = ["bode_figure", "pole_map_figure"]
+__all__ = ["bode_figure", "nyquist_figure", "pole_map_figure"]
 
 
 def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = None):
@@ -101,6 +101,47 @@ def pole_map_figure(poles, value: str, *, title: str = "", scale: float = 1.0, u
     ax.set_xlabel("real part [1/s]")
     ax.set_ylabel("imaginary part / 2π [Hz]")
     ax.grid(True, alpha=0.3)
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def nyquist_figure(loops, frequencies_hz=None, *, title: str = "", radius: float = 3.0):
+    """Nyquist diagram of SISO open loops ``L(jw)`` around the critical point -1.
+
+    Parameters
+    ----------
+    loops : sequence of (str, control.LTI)
+        Label and open loop (e.g. ``control.ss(pi.tf()) * G``).
+    frequencies_hz : array_like, optional
+        Frequencies [Hz] (default: 400 from 0.01 Hz to 10 kHz); the curve runs through the negative
+        frequencies (the mirror image) and then the positive ones.
+    title : str
+        Figure title.
+    radius : float
+        Half-width of the view around the origin (a loop with an integrator goes to infinity at low
+        frequency; what matters is near -1).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    f = np.logspace(-2, 4, 400) if frequencies_hz is None else np.asarray(frequencies_hz, dtype=float)
+    fig, ax = new_figure(1, 1, width=6.5, height=5.5)
+    for label, L in loops:
+        g = np.asarray(L(2j * np.pi * f)).reshape(-1)
+        g = np.concatenate([np.conj(g[::-1]), g])  # negative frequencies (the mirror image), then positive
+        ax.plot(g.real, g.imag, label=label)
+    circle = np.exp(1j * np.linspace(0.0, 2 * np.pi, 361))
+    ax.plot(circle.real, circle.imag, ":", color="0.5", lw=0.8, label="|L| = 1")
+    ax.plot([-1.0], [0.0], "rx", ms=9, mew=2, label="critical point -1")
+    ax.set_xlim(-radius, radius)
+    ax.set_ylim(-radius, radius)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re L(jω) [1]")
+    ax.set_ylabel("Im L(jω) [1]")
+    ax.grid(True, alpha=0.3)
+    legend_outside(ax)
     if title:
         ax.set_title(title)
     return fig

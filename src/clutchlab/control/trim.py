@@ -6,7 +6,9 @@ or not).  The conditions are
 
 * ``f_i(t, x, u, m) = 0`` for every state ``i`` that must be steady: all states but the *held* ones
   (``states=``, kept at their given values: a slow temperature, a shaft speed set by a bench) and the
-  *monitors* (states nothing depends on: energy integrals, a free shaft angle), which keep their values;
+  *monitors* (states nothing depends on: energy integrals, a free shaft angle; and states the active mode
+  holds still, whose derivative is zero whatever the state: an armature at its stop), which keep their
+  values;
   algebraic rows (mass 0) are part of the conditions;
 * ``y_k(t, x, u, m) = r_k`` for every target (``targets=``: a state or an output), each paid for by one
   unknown input (``free_inputs=``) or by one held state left free.
@@ -82,7 +84,9 @@ class OperatingPoint:
     held : tuple of str
         States kept at given values (not required steady).
     monitors : tuple of str
-        States nothing depends on (energy integrals): not required steady, kept at their values.
+        States nothing depends on (energy integrals), and states the active mode holds still (derivative
+        zero whatever the state: the EMTC's armature at its stop): not required steady, kept at their
+        values.
     residual : float
         Largest scaled steady-state condition at the solution (see the module docstring).
     iterations : int
@@ -129,8 +133,13 @@ class OperatingPoint:
         return float(evaluate(self.system, self.t, self.x, self.u, self.m)[2][i])
 
     def start(self) -> System:
-        """The system started at this point (initial state, held inputs and modes replaced)."""
-        return self.system.variant(x0=self.x, m0=self.m, u0=self.u)
+        """The system started at this point (initial state, held inputs and modes replaced).
+
+        Each call gives the system its own copy of the point's parameter arrays: memories a model keeps
+        there (the EMTC magnet's hysteresis memory, a lock-up time) start as they were at the point, and a
+        run from one start does not change the next.
+        """
+        return self.system.variant(params=own_memories(self.system.params), x0=self.x, m0=self.m, u0=self.u)
 
     def to_dict(self) -> dict:
         """Plain description (JSON): time, modes, every state, input and output with its unit."""
@@ -183,9 +192,25 @@ def _check_limits(system: System, what: dict, where: str) -> None:
                                       f"[{lo:.6g}, {hi:.6g}] (System.limits)")
 
 
-def _zero_columns(system, t, x, u, m, h) -> np.ndarray:
-    """States nothing depends on: perturbing them changes no derivative (bit for bit)."""
+def own_memories(params):
+    """A copy of ``params`` with its own copy of every C-contiguous array (NamedTuples and tuples rebuilt,
+    numbers and other arrays shared): the memories a model keeps in its parameters, as they are."""
+    if isinstance(params, np.ndarray):
+        return params.copy() if params.flags.c_contiguous else params
+    if isinstance(params, tuple):
+        parts = [own_memories(q) for q in params]
+        return type(params)(*parts) if hasattr(params, "_fields") else tuple(parts)
+    return params
+
+
+def _zero_columns(system, t, x, u, m, h):
+    """``(monitors, frozen)`` as boolean masks over the states, bit for bit.
+
+    Monitors: states nothing depends on (perturbing them changes no derivative).  Frozen: states the
+    active mode holds still -- their derivative is exactly zero at the point and stays so whichever state
+    is perturbed (an armature at its stop)."""
     out = np.zeros(x.size, dtype=bool)
+    still = evaluate(system, t, x, u, m)[0] == 0.0
     for j in range(x.size):
         xp, xm = x.copy(), x.copy()
         xp[j] += h[j]
@@ -195,7 +220,8 @@ def _zero_columns(system, t, x, u, m, h) -> np.ndarray:
         # its own row may depend on itself only through a rate it does not feed back (none here)
         others = np.arange(x.size) != j
         out[j] = bool(np.all(fp[others] == fm[others]) and fp[j] == fm[j])
-    return out
+        still &= (fp == 0.0) & (fm == 0.0)
+    return out, still
 
 
 def operating_point(system: System, *, inputs: dict | None = None, states: dict | None = None,
@@ -252,6 +278,9 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
     for name, value in inputs.items():
         _, i = resolve(system, name, ("input",))
         u[i] = float(value)
+    # work on an own copy of the memories a model keeps in its parameters: the settle and Newton's method
+    # change them there, not in the caller's system
+    system = system.variant(params=own_memories(system.params))
     x = system.x0.copy() if guess is None else np.array(guess, dtype=float).ravel()
     if x.shape != system.x0.shape:
         raise ParameterError(f"{system.name}: guess has {x.size} entries, the system {system.x0.size} states")
@@ -280,8 +309,10 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
     xs = state_scale(system, x)
     us = input_scale(system, u)
     target_states = {i for k, i, _ in tgt if k == "state"}
-    zero = _zero_columns(system, t, x, u, m, 1e-6 * xs)
+    zero, still = _zero_columns(system, t, x, u, m, 1e-6 * xs)
     monitors = [j for j in range(x.size) if zero[j] and j not in held and j not in target_states]
+    frozen = [j for j in range(x.size) if still[j] and not zero[j] and j not in held and j not in target_states]
+    monitors += frozen
     freed = [resolve(system, name, ("state",))[1] for name in free_states]
     for j in freed:
         if j not in held:
@@ -329,7 +360,8 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
     goal = np.array([v for _, _, v in tgt])
     z = np.concatenate([x[ix] / scale[:ix.size], u[iu] / scale[ix.size:]])
     if n_cond == 0:
-        return OperatingPoint(system, t, x, u, m, tuple(system.states[i].name for i in held),
+        return OperatingPoint(system.variant(params=own_memories(system.params)), t, x, u, m,
+                              tuple(system.states[i].name for i in held),
                               tuple(system.states[i].name for i in monitors), 0.0, 0)
     J0 = jac(z, goal)
     weight = np.sum(np.abs(J0), axis=1)
@@ -403,7 +435,9 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
     _check_limits(system, {v.name: xx[i] for i, v in enumerate(system.states)}, "steady state")
     _check_limits(system, {v.name: uu[i] for i, v in enumerate(system.inputs)}, "input")
     _check_limits(system, {v.name: y[i] for i, v in enumerate(system.outputs)}, "output")
-    return OperatingPoint(system, t, xx, uu, m.copy(), tuple(system.states[i].name for i in held),
+    # the point keeps the memories as they are now (its own copy: later runs of `system` leave them)
+    return OperatingPoint(system.variant(params=own_memories(system.params)), t, xx, uu, m.copy(),
+                          tuple(system.states[i].name for i in held),
                           tuple(system.states[i].name for i in monitors), res, it)
 
 

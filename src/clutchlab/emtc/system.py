@@ -95,6 +95,8 @@ INPUTS = (
     ("throttle", "1", "throttle (co-simulation; a scenario gives its ramp)"),
     ("drum_speed_front", "m_s", "front drum surface speed"),
     ("drum_speed_rear", "m_s", "rear drum surface speed"),
+    ("coil_current_command", "A", "coil current set point of the current drive (BenchOptions(coil_drive='current'): "
+                                  "replaces the torque controller of Eqs. 6-7 and 31)"),
 )
 #: switching functions and their crossing direction (all: falling through zero, [1] Fig. 11)
 SWITCHING = (
@@ -126,9 +128,9 @@ EL_ARMATURE, EL_COUPLING = 0, 1
 ARM_REST, ARM_FREE, ARM_CONTACT = 0, 1, 2
 OPEN, SLIPPING, LOCKED = 0, 1, 2
 NEGATIVE, POSITIVE = 0, 1
-U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR = range(4)
+U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR, U_COIL = range(5)
 FRICTION_CONSTANT, FRICTION_MAP, FRICTION_LUGRE = 0, 1, 2
-REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT = 0, 1, 2
+REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT, REFERENCE_CURRENT = 0, 1, 2, 3  # CURRENT: coil current from u
 
 # model errors (negative codes of the hooks)
 ERR_PLANT_MEMORY, ERR_CONTROLLER_MEMORY = -1, -2
@@ -144,16 +146,16 @@ N_IMEM = 10
 FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
 FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
 FM_CW = 12  # 3: airgap weights of the controller model
-FM_ULAST = 15  # 4: inputs seen at the last restart
-FM_AUX = 19  # N_AUX model intermediates of the last evaluation
+FM_ULAST = 15  # 5: inputs seen at the last restart
+FM_AUX = 20  # N_AUX model intermediates of the last evaluation
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
  AUX_THR) = range(13)
 N_AUX = 13
 FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque split
 FM_DX = FM_SPLIT + 6  # 7: scratch derivative
 FM_G = FM_DX + 7  # 6: scratch switching functions
-FM_KEY = FM_G + 6  # 15: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
-FM_DXM = FM_KEY + 15  # 7: derivative of the last evaluation
+FM_KEY = FM_G + 6  # 16: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
+FM_DXM = FM_KEY + 16  # 7: derivative of the last evaluation
 FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
 N_FMEM = FM_GM + 6
 # controller log (one row per sample, for the per-sample view of simulate_bench)
@@ -460,6 +462,18 @@ def _controller(t, x, u, p):
     imem = p.imem
     a = p.actuator
     thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
+    if p.reference_source == REFERENCE_CURRENT:  # current drive: the coil's set point is an input, no controller
+        fmem[FM_CMD] = u[U_COIL]
+        fmem[FM_TREF] = np.nan
+        fmem[FM_FEASIBLE] = 1.0
+        k = imem[IM_KNEXT]
+        log = _cold(p.cold, p.layout, L_LOG)
+        if 4 * k + 3 < log.shape[0]:
+            log[4 * k + LOG_CMD] = u[U_COIL]
+            log[4 * k + LOG_TREF] = np.nan
+            log[4 * k + LOG_THR] = thr
+            log[4 * k + LOG_FEASIBLE] = 1.0
+        return
     if p.reference_source == REFERENCE_INPUT:
         t_ref = u[U_TORQUE]
     elif p.reference_source == REFERENCE_TABLE:
@@ -496,6 +510,14 @@ def _controller(t, x, u, p):
         log[4 * k + LOG_FEASIBLE] = 1.0 if ok else 0.0
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _command(u, p):
+    """Coil current command [A] of the current lags (Fig. 15): the held input ``coil_current_command`` in
+    current drive (its changes act at once: a linear model has it as an input), else the controller's
+    command held since its last sample (Eqs. 6-7)."""
+    return u[U_COIL] if p.reference_source == REFERENCE_CURRENT else p.fmem[FM_CMD]
+
+
 # ------------------------------------------------------------------ the hooks of the contract
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _rhs(t, x, u, m, p, dx, g):
@@ -514,7 +536,7 @@ def _rhs(t, x, u, m, p, dx, g):
             dx[i] = fmem[FM_DXM + i]
         for k in range(6):
             g[k] = fmem[FM_GM + k]
-        dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
+        dx[5] = (_command(u, p) - x[5]) / a.tau1
         return
     aux = fmem[FM_AUX:FM_AUX + N_AUX]
     v = p.vehicle
@@ -551,7 +573,7 @@ def _rhs(t, x, u, m, p, dx, g):
         if arm == ARM_CONTACT:
             fn1 = max(primary_clamp_force(fm, a), 0.0)
     # current control: two first-order lags in series ([1], Fig. 15)
-    dx[5] = (fmem[FM_CMD] - x[5]) / a.tau1
+    dx[5] = (_command(u, p) - x[5]) / a.tau1
     dx[6] = (x[5] - x[6]) / a.tau2
     thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
     a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
@@ -636,7 +658,7 @@ def _rhs(t, x, u, m, p, dx, g):
         fmem[FM_DXM + i] = dx[i]
     for i in range(3):
         fmem[FM_KEY + 8 + i] = m[i]
-    for i in range(4):
+    for i in range(5):
         fmem[FM_KEY + 11 + i] = u[i]
     for k in range(6):
         fmem[FM_GM + k] = g[k]
@@ -658,7 +680,7 @@ def _same_point(t, x, u, m, fmem):
     for i in range(3):
         if fmem[FM_KEY + 8 + i] != m[i]:
             return False
-    for i in range(4):
+    for i in range(5):
         if fmem[FM_KEY + 11 + i] != u[i]:
             return False
     return True
@@ -683,7 +705,7 @@ def _outputs(t, x, u, m, p, y):
     y[11] = aux[AUX_CAP]
     y[12] = aux[AUX_TE]
     y[13] = aux[AUX_CASE]
-    y[14] = fmem[FM_CMD]
+    y[14] = _command(u, p)
     y[15] = fmem[FM_TREF]
     y[16] = aux[AUX_THR]
     y[17] = fmem[FM_FEASIBLE]
@@ -805,6 +827,10 @@ class BenchOptions:
         LuGre friction (Eqs. 22-24) in slipping mode instead of the constant kinetic coefficients.
     torque_reference : (times, torques), optional
         Prescribed reference [s], [N*m] instead of the map of Eq. 31.
+    coil_drive : {"controller", "current"}
+        ``"controller"``: the torque controller sets the coil current command at every sample (Eqs. 6-7,
+        31); ``"current"``: the coil is driven at the held input ``coil_current_command`` [A] (a current
+        amplifier on a test bench; trimming the coil at a current, a linear model from the command).
     memory_capacity : int
         Entries of each hysteresis memory stack (a run whose memory fills up is repeated with four
         times the capacity by :func:`simulate` and :func:`~clutchlab.emtc.simulate_bench`).
@@ -817,9 +843,12 @@ class BenchOptions:
     friction_map: object = None
     lugre: object = None
     torque_reference: object = None
+    coil_drive: str = "controller"
     memory_capacity: int = 64
 
     def __post_init__(self):
+        if self.coil_drive not in ("controller", "current"):
+            raise ParameterError(f"coil_drive = {self.coil_drive!r}: expected 'controller' or 'current'")
         if self.friction_map is not None and self.lugre is not None:
             raise ParameterError("give either friction_map or lugre, not both")
         if not (isinstance(self.memory_capacity, (int, np.integer)) and self.memory_capacity >= 4):
@@ -949,7 +978,9 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
         ref, ref_src = np.zeros((2, 1)), REFERENCE_MAP
     if cosimulation:
         throttle, ref_src = np.zeros((2, 0)), REFERENCE_INPUT
-    else:
+    if options.coil_drive == "current":
+        ref_src = REFERENCE_CURRENT
+    if not cosimulation:
         s = scenario
         throttle = np.array([[0.0, s.ramp_start, max(s.ramp_end, s.ramp_start + 1e-9), max(s.duration, s.ramp_end) + 1.0],
                              [s.throttle_start, s.throttle_start, s.throttle_end, s.throttle_end]])
@@ -1064,22 +1095,24 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     ic = vehicle.rear_final_drive
     x0 = np.array([vf / vehicle.tyre_radius * ic, vr / vehicle.tyre_radius * ic, 0.0, 0.0, 0.0,
                    magnet.grid[0], magnet.grid[0]])
-    u0 = np.array([0.0, scenario.throttle_start, vf, vr])
+    u0 = np.array([0.0, scenario.throttle_start, vf, vr, magnet.grid[0]])
     first_step = min(1e-4, scenario.sample_time)
-    template = _TEMPLATES.get(first_step)
+    # the coil current command within the magnet's calibrated currents (the drive's current limit)
+    current_range = (float(magnet.grid[0]), float(magnet.grid[-1]))
+    template = _TEMPLATES.get((first_step, current_range))
     if template is None:
         template = System("emtc_bench", params, STATES, OUTPUTS, x0, np.array([ARM_REST, OPEN, POSITIVE], dtype=np.int64),
                           ATOL.copy(), switching=SWITCHING, events=EVENTS, mode_names=MODE_NAMES,
                           mode_values=MODE_VALUES, inputs=INPUTS, u0=u0, method="dopri", rtol=1e-6,
                           first_step=first_step, event_tol=1e-12, element_name=_element_name,
-                          error_messages=dict(ERROR_MESSAGES))
+                          error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range})
         if len(_TEMPLATES) < 64:
-            _TEMPLATES[first_step] = template
+            _TEMPLATES[(first_step, current_range)] = template
     # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
     return template.variant(params=params, x0=x0, u0=u0)
 
 
-#: first trial step -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`
+#: (first trial step, coil current range) -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`
 _TEMPLATES: dict = {}
 
 

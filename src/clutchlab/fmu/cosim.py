@@ -785,11 +785,12 @@ class EmtcCoSimulation(ContractCoSimulation):
         return system
 
     def input_vector(self, inputs: dict) -> np.ndarray:
-        """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear]`` from the FMI ``inputs``."""
+        """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear, coil_current_command]`` from the
+        FMI ``inputs`` (the coil current command is unused: the FMU's coupling runs its torque controller)."""
         thr = inputs["throttle"]
         if not 0.0 <= thr <= 1.0:
             raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
-        return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"]])
+        return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"], 0.0])
 
     def output_values(self, y: np.ndarray) -> dict:
         """FMI outputs from the output vector ``y`` and the current states and modes."""
