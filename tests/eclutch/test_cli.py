@@ -1,5 +1,7 @@
 """``clutchlab eclutch`` commands: outputs, plots, one-line errors, no silent overwrite."""
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -75,6 +77,45 @@ def test_validate_and_describe(tmp_path, capsys):
     assert len(pd.read_csv(tmp_path / "m.csv")) == 5
     code, text, _ = run(capsys, "eclutch", "describe", "--model", "3")
     assert code == 0 and "pivot support" in text
+
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
+    """``eclutch simulate --fixed-step "1 ms"`` on the launch example (pedal press, hold, slow release; 1.6 s):
+    1600 Rodas3 steps on the 1 ms grid, said in the file's header, and the adaptive run's result.
+
+    Tolerances, measured: bearing position within 4.8 um of the adaptive run (8.6 mm travel; bound 20 um, as the
+    fixed-step FMU test: the adaptive runs themselves differ by 2 um between tolerances through the seals'
+    stick-slip, tests/numerics/test_fixed_step.py), bearing force within 0.42 % of its peak and clutch torque
+    within 0.1 % of its peak (bound 1 % each)."""
+    example = str(EXAMPLES / "eclutch_launch.toml")
+    adaptive, fixed = tmp_path / "adaptive.csv", tmp_path / "fixed.csv"
+    code, _, _ = run(capsys, "eclutch", "simulate", example, "-o", str(adaptive))
+    assert code == 0
+    code, text, _ = run(capsys, "eclutch", "simulate", example, "-o", str(fixed), "--fixed-step", "1 ms")
+    assert code == 0 and "1600 steps (fixed steps of 0.001 s)" in text
+    header = [line for line in fixed.read_text().splitlines() if line.startswith("#")]
+    assert header[0].startswith("# synthetic:") and any(
+        line.startswith("# solver: fixed-step (real-time) mode, step 0.001 s") for line in header)
+    assert "fixed-step" not in adaptive.read_text().split("\ntime_s", 1)[0]
+    a, f = pd.read_csv(adaptive, comment="#"), pd.read_csv(fixed, comment="#")
+    assert len(a) == len(f) == 1601
+    np.testing.assert_array_equal(f.time_s, a.time_s)
+    assert np.all(np.isfinite(f.select_dtypes("number").to_numpy()))
+    assert np.max(np.abs(f.bearing_position_m - a.bearing_position_m)) < 2e-5
+    for column in ("bearing_force_N", "torque_Nm"):
+        assert np.max(np.abs(f[column] - a[column])) < 0.01 * np.max(np.abs(a[column])), column
+
+
+@pytest.mark.parametrize("value, message", [("-1ms", "must be a time > 0"), ("abc", "cannot parse quantity")])
+def test_simulate_refuses_a_bad_fixed_step(tmp_path, capsys, value, message):
+    out = tmp_path / "out.csv"
+    code, _, err = run(capsys, "eclutch", "simulate", str(EXAMPLES / "eclutch_launch.toml"), "-o", str(out),
+                       "--fixed-step", value)
+    assert code == 2 and err.startswith("clutchlab: error: --fixed-step = ") and message in err
+    assert err.count("\n") == 1 and "Traceback" not in err and not out.exists()
 
 
 def test_help_everywhere(capsys):

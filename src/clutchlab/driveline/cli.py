@@ -1,6 +1,6 @@
 """``clutchlab driveline`` sub-commands: a thin layer over :mod:`clutchlab.driveline`.
 
-``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--events EVENTS.csv] [--plot fig.png] [--force]``
+``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--fixed-step STEP] [--events EVENTS.csv] [--plot fig.png] [--force]``
     run a driveline network and write its states and outputs (and its events);
 ``clutchlab driveline describe FILE.toml``
     print a text schematic of the network.
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 
+from ..cli import add_fixed_step_option
 from ..errors import ParameterError
 
 __all__ = ["register"]
@@ -34,6 +35,7 @@ def register(subparsers) -> None:
     sim.add_argument("--t-end", help="end time, e.g. '1.5 s' (default: [simulation] t_end)")
     sim.add_argument("--output-step", help="sample interval, e.g. '1 ms' (default: [simulation] output_step, "
                                            "else every accepted step)")
+    add_fixed_step_option(sim)
     sim.add_argument("--events", help="CSV of the events to write (time_s, component, event)")
     sim.add_argument("--plot", help="also write a PNG figure (speeds, friction torques, modes, energy)")
     sim.add_argument("--force", action="store_true", help="overwrite the outputs")
@@ -48,11 +50,13 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
+    from ..cli import fixed_step_note, fixed_step_option
     from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
     from ..units import to_si
     from .description import load_driveline
 
     check_outputs([args.output, args.events, args.plot], args.force)
+    fixed_step = fixed_step_option(args.fixed_step)
     spec = load_driveline(args.file)
     t_end = to_si(args.t_end, "s", name="--t-end") if args.t_end is not None else spec.t_end
     if t_end is None:
@@ -62,10 +66,13 @@ def _simulate(args) -> int:
         raise ParameterError(f"--output-step = {args.output_step!r}: must be > 0")
     if not t_end > 0:
         raise ParameterError(f"end time = {t_end!r} s: must be > 0")
-    res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step)
+    res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step,
+                                  fixed_step=fixed_step)
     frame = res.to_dataframe()
     events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
-    atomic_to_csv(frame, args.output, overwrite=args.force)
+    # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
+    atomic_to_csv(frame, args.output, overwrite=args.force,
+                  header_comment=None if fixed_step is None else fixed_step_note(fixed_step))
     if args.events:
         atomic_to_csv(events, args.events, overwrite=args.force)
     if args.plot:
@@ -79,7 +86,8 @@ def _simulate(args) -> int:
         plt.close(fig)
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     err = float(frame["energy_error_J"].abs().max())
-    print(f"{args.output}: {len(frame)} samples to {t_end:g} s; {len(events)} events; "
+    mode = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
+    print(f"{args.output}: {len(frame)} samples to {t_end:g} s{mode}; {len(events)} events; "
           f"energy balance within {err:.2g} J of {float(frame['input_work_J'].abs().max()):.4g} J input work "
           f"and {float(frame['dissipated_energy_J'].abs().max()):.4g} J dissipated")
     return 0

@@ -7,7 +7,8 @@
 continues the integrator core's run (``clutchlab.system.Simulation.advance``) from the stored angles,
 speeds, energies, friction modes and step size.  The network has no inputs (its sources are the
 signals of the file); its outputs are every state and output column of the driveline; its parameters
-are ``rtol`` and the numeric fields of its components, ``<component>.<field>``
+are ``rtol``, ``solver.fixed_step`` (> 0: the core's fixed-step mode, a HIL frame; 0: step-size
+control) and the numeric fields of its components, ``<component>.<field>``
 (:class:`~clutchlab.driveline.variants.DrivelineDocument`).
 
 ::
@@ -22,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
-from ..fmu.cosim import ContractCoSimulation, Variable, fmi_unit
+from ..fmu.cosim import FIXED_STEP_DOC, ContractCoSimulation, Variable, fixed_step_parameter, fmi_unit
 from ..units import COLUMN_UNITS
 from .variants import DrivelineDocument
 
@@ -45,7 +46,9 @@ class DrivelineCoSimulation(ContractCoSimulation):
     ``<friction>.mode`` (MSL codes: 1 forward, 0 stuck, -1 backward, 2 free) and normal force
     ``<friction>.fn`` [N] of each friction element, and the network's ``kinetic_energy``,
     ``spring_energy``, ``input_work``, ``dissipated_energy`` and ``energy_error`` [J].  Parameters:
-    ``rtol`` (start: the file's ``[simulation] rtol``) and every numeric component field,
+    ``rtol`` (start: the file's ``[simulation] rtol``), ``solver.fixed_step`` [s] (start 0: step-size
+    control; a step > 0 runs the core's fixed-step mode, Rodas3 steps on the grid ``k * fixed_step`` with
+    the mode changes at step ends, a HIL frame) and every numeric component field,
     ``<component>.<field>`` in SI (``J1.J`` [kg.m2], ``J1.w0`` [rad/s], ``clutch1.fn_max`` [N],
     ``clutch1.mu`` [1], ...).  No inputs.
 
@@ -59,7 +62,9 @@ class DrivelineCoSimulation(ContractCoSimulation):
     The integration stops at every communication point, so a chain of steps differs from one
     :meth:`Driveline.simulate <clutchlab.driveline.network.Driveline.simulate>` run of the same
     file by the integration error (of order ``rtol``), not more; events inside a step are located as
-    in that run (``events()`` of :attr:`simulation`).
+    in that run (``events()`` of :attr:`simulation`).  In fixed-step mode the steps lie on the grid
+    ``k * solver.fixed_step`` whatever the communication step (a communication point off the grid ends
+    with a shorter step) and a mode change inside a step is taken at its end.
     """
 
     name = "driveline"
@@ -103,6 +108,7 @@ class DrivelineCoSimulation(ContractCoSimulation):
                         for v in (*system.states, *system.outputs))
         parameters = (Variable("rtol", "1", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step "
                                                        "control ([simulation] rtol)"),
+                      Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
                       *(Variable(p.name, fmi_unit(p.unit), p.value, p.description) for p in doc.parameters.values()))
         names = [v.name for v in (*outputs, *parameters)]
         twice = sorted({n for n in names if names.count(n) > 1})
@@ -121,7 +127,10 @@ class DrivelineCoSimulation(ContractCoSimulation):
         values = self.resolve_parameters(parameter_values)
         if not 0.0 < values["rtol"] < 1.0:
             raise ParameterError(f"parameter rtol = {values['rtol']!r}: must be in (0, 1)")
-        self.simulation_options = {} if self.base.max_step is None else {"max_step": self.base.max_step}
+        self.fixed_step = fixed_step_parameter(values)
+        self.simulation_options = {"fixed_step": self.fixed_step}
+        if self.base.max_step is not None:
+            self.simulation_options["max_step"] = self.base.max_step
         super().__init__(**parameter_values)
 
     # ---- the contract

@@ -1300,10 +1300,31 @@ class Driveline:
         return params, np.concatenate([x0, xe]), np.concatenate([m0, me]), np.concatenate([atol, ae])
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
-                 output_step: float | None = None, sample_times=None):
-        """Run the network from its initial state to ``t_end`` [s]; a :class:`~clutchlab.SimulationResult`."""
+                 output_step: float | None = None, sample_times=None, fixed_step: float | None = None):
+        """Run the network from its initial state to ``t_end`` [s]; a :class:`~clutchlab.SimulationResult`.
+
+        Parameters
+        ----------
+        t_end : float
+            End time [s].
+        rtol : float
+            Relative tolerance of the Dormand-Prince 5(4) step control (:meth:`system`).
+        atol : float or array_like, optional
+            Absolute tolerance per state (default: the network's, from ``rtol``).
+        max_step : float, optional
+            Largest step [s] (default: an eighth of the period of the fastest sine source, none without one).
+        output_step : float, optional
+            Sample interval [s] of the result (default: every accepted step).
+        sample_times : array_like, optional
+            Explicit sample times [s] instead of ``output_step``.
+        fixed_step : float, optional
+            Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3 steps on the grid
+            ``k * fixed_step``, the mode changes (stick, slip, reversal) at the first step end after them
+            (:func:`clutchlab.system.simulate`); ``rtol``, ``atol`` and ``max_step`` are then unused.  None
+            (default): step-size control.
+        """
         return _simulate(self.system(rtol), t_end, atol=atol, max_step=max_step, output_step=output_step,
-                         sample_times=sample_times)
+                         sample_times=sample_times, fixed_step=fixed_step)
 
 
 def _example_system(rtol: float = 1e-8) -> System:

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .._limits import check_allocation
+from ..cli import add_fixed_step_option
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
 from ..io.files import check_outputs
@@ -129,18 +130,20 @@ def _lever(args) -> int:
 
 def _simulate(args) -> int:
     from .. import __version__
+    from ..cli import fixed_step_note, fixed_step_option, progress
     from ..io import write_measurement
     from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
     from .scenario import load_scenario, run_scenario
 
     check_outputs([args.output, args.plot], args.force)
+    fixed_step = fixed_step_option(args.fixed_step)
     scenario = load_scenario(args.scenario)
-    from ..cli import progress
-
-    res = run_scenario(scenario, progress=progress)
+    res = run_scenario(scenario, progress=progress, fixed_step=fixed_step)
     frame = res.to_dataframe()
     comment = (f"synthetic: simulated by clutchlab {__version__} (E-clutch Model {scenario.model}, scenario "
                f"{args.scenario}); model output, not a measurement")
+    if fixed_step is not None:
+        comment += "\n" + fixed_step_note(fixed_step)
     write_measurement(frame, args.output, comment=comment, overwrite=args.force)
     if args.plot:
         if scenario.input_kind == "bearing_position":
@@ -152,8 +155,10 @@ def _simulate(args) -> int:
             fig = eclutch_response(res.outputs, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
         _save_figure(mark_synthetic(fig), args.plot, args.force)
     st = res.stats
+    steps = (f"({st['rejected_steps']} rejected)" if fixed_step is None else
+             f"(fixed steps of {fixed_step:g} s)")
     print(f"{args.output}: {len(frame)} points over {scenario.t_end:g} s, {st['accepted_steps']} steps "
-          f"({st['rejected_steps']} rejected), {len(res.events)} events; "
+          f"{steps}, {len(res.events)} events; "
           f"peak bearing force {frame.get('bearing_force_N', frame['bearing_force_clutch_N']).max():.1f} N")
     return 0
 
@@ -244,6 +249,7 @@ def register(subparsers) -> None:
                         epilog="Documentation: docs/eclutch_dynamics.md (scenario format)")
     sm.add_argument("scenario", help="scenario TOML ([scenario], [input], optional parameter tables)")
     sm.add_argument("-o", "--output", required=True, help="results to write: .csv, .parquet or .mf4")
+    add_fixed_step_option(sm)
     sm.add_argument("--plot", help="also write a PNG figure (time response, or hysteresis loop)")
     sm.add_argument("--force", action="store_true", help="overwrite existing output files")
     sm.set_defaults(func=_simulate)

@@ -556,9 +556,10 @@ def _max_step(max_step, h_max):
     return value
 
 
-def _run(source, system: contract.System, t_end: float, max_steps: int, grid) -> DynamicsResult:
+def _run(source, system: contract.System, t_end: float, max_steps: int, grid, fixed_step=None) -> DynamicsResult:
     # without a grid every accepted step is kept, in chunks that grow with the run (not max_steps rows up front)
-    res = contract.simulate(system, t_end, max_steps=int(max_steps), sample_times=grid if grid.size else None)
+    res = contract.simulate(system, t_end, max_steps=int(max_steps), sample_times=grid if grid.size else None,
+                            fixed_step=fixed_step)
     return DynamicsResult.from_result(res, source)
 
 
@@ -608,12 +609,12 @@ class ClutchDynamics:
     def simulate(self, bearing_position, t_end: float | None = None, *, rtol: float = 1e-5,
                  max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
                  output_step: float | None = None, event_tol: float = 1e-9, jac_every: int = 4,
-                 atol_scale: float = 1.0) -> DynamicsResult:
+                 atol_scale: float = 1.0, fixed_step: float | None = None) -> DynamicsResult:
         """Simulate with the bearing position prescribed as ``(times [s], positions [m])`` (linear in between).
 
         Tolerances: ``rtol`` and the default absolute tolerances (10 nm, 10 um/s, 10 Pa, ...) times
         ``atol_scale``; ``bearing_position``, ``t_end``, ``max_step`` (alias ``h_max``), ``max_steps``,
-        ``output_step``, ``event_tol`` and ``jac_every`` as in :meth:`EClutch.simulate`.
+        ``output_step``, ``event_tol``, ``jac_every`` and ``fixed_step`` as in :meth:`EClutch.simulate`.
         """
         tin, _vin = _as_table(bearing_position, "bearing_position")
         t_end = float(tin[-1]) if t_end is None else float(t_end)
@@ -621,7 +622,7 @@ class ClutchDynamics:
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self.as_system(bearing_position, rtol=rtol, max_step=_max_step(max_step, h_max),
                                 event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, grid)
+        return _run(self, system, t_end, max_steps, grid, fixed_step)
 
 
 class EClutch:
@@ -737,7 +738,8 @@ class EClutch:
 
     def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, max_step: float | None = None,
                  h_max: float | None = None, max_steps: int = 500_000, output_step: float | None = None,
-                 event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float = 1.0) -> DynamicsResult:
+                 event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float = 1.0,
+                 fixed_step: float | None = None) -> DynamicsResult:
         """Simulate from rest (clutch engaged, actuator at its rest stop).
 
         Parameters
@@ -769,6 +771,13 @@ class EClutch:
         atol_scale : float
             Factor on the default absolute tolerances (0.1 um, 0.1 mm/s,
             100 Pa, 1 mA, ...).
+        fixed_step : float, optional
+            Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3
+            steps on the grid ``k * fixed_step``, no error control, the
+            Jacobian every step, mode changes (stick, slip, stops) at the
+            first step end after them (:func:`clutchlab.system.simulate`;
+            ``rtol``, ``max_step``, ``event_tol`` and ``jac_every`` are then
+            unused).  None (default): step-size control.
 
         Returns
         -------
@@ -784,7 +793,7 @@ class EClutch:
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self.as_system(inputs, rtol=rtol, max_step=_max_step(max_step, h_max), event_tol=event_tol,
                                 jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, grid)
+        return _run(self, system, t_end, max_steps, grid, fixed_step)
 
 
 def _input_mode(inputs):

@@ -224,7 +224,7 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
                     output_step=output_step, rtol=rtol, source=src)
 
 
-def run_scenario(scenario: Scenario, progress=None) -> DynamicsResult:
+def run_scenario(scenario: Scenario, progress=None, *, fixed_step: float | None = None) -> DynamicsResult:
     """Simulate a scenario: the E-clutch (actuator + clutch), or the clutch alone for ``bearing_position``.
 
     Parameters
@@ -233,19 +233,25 @@ def run_scenario(scenario: Scenario, progress=None) -> DynamicsResult:
         What to simulate (:func:`load_scenario`).
     progress : callable, optional
         Called with a message string as the run proceeds.
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s] (:meth:`EClutch.simulate`); the
+        scenario's ``rtol`` is then unused.  None (default): step-size control.
     """
     if progress:
         progress(f"building Model {scenario.model} and the actuator ...")
     model = scenario.clutch_model()
     t, v = scenario.input_table()
     if progress:
-        progress(f"simulating {scenario.t_end:g} s ({scenario.input_kind} input) ...")
+        frames = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
+        progress(f"simulating {scenario.t_end:g} s ({scenario.input_kind} input){frames} ...")
     if scenario.input_kind == "bearing_position":
         return ClutchDynamics(model, scenario.friction).simulate((t, v), scenario.t_end, rtol=scenario.rtol,
-                                                                 output_step=scenario.output_step)
+                                                                 output_step=scenario.output_step,
+                                                                 fixed_step=fixed_step)
     key = "voltage" if scenario.input_kind == "voltage" else "bearing_reference"
     ec = EClutch(scenario.actuator, model, scenario.friction)
-    return ec.simulate({key: (t, v)}, scenario.t_end, rtol=scenario.rtol, output_step=scenario.output_step)
+    return ec.simulate({key: (t, v)}, scenario.t_end, rtol=scenario.rtol, output_step=scenario.output_step,
+                       fixed_step=fixed_step)
 
 
 def _as_scenario(scenario) -> Scenario:

@@ -389,7 +389,8 @@ def _default(cls):
 def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: VehicleParameters | None = None,
                    actuator: ActuatorParameters | None = None, coupling: CouplingGeometry | None = None,
                    torque_map: TorqueMap | None = None, controller_model=None, friction_map=None, lugre=None,
-                   torque_reference=None, rtol=1e-6, atol=None, max_steps=2_000_000) -> BenchResult:
+                   torque_reference=None, rtol=1e-6, atol=None, max_steps=2_000_000,
+                   fixed_step: float | None = None) -> BenchResult:
     """Simulate the vehicle with EMTC on the drum bench ([1], Eqs. 8-31, Figs. 11, 15-17).
 
     A thin layer over :func:`clutchlab.emtc.simulate` (the ``emtc_bench`` model run by the integrator
@@ -424,6 +425,11 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
         Integrator tolerances (atol per state; default scaled to each state).
     max_steps : int
         Accepted steps after which the run stops with :class:`SimulationError`.
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3 steps on the grid
+        ``k * fixed_step``, the controller samples and mode changes inside a step at its end
+        (:func:`clutchlab.system.simulate`; ``rtol`` and ``atol`` are then unused).  None (default):
+        step-size control.
 
     Returns
     -------
@@ -456,7 +462,7 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
         return S.bench_system(magnet, scenario, vehicle, opts, n_samples=n)
 
     system, res = S.run(build, float(samples[-1]), rtol=float(rtol), atol=atol, sample_times=samples,
-                        max_steps=int(max_steps))
+                        max_steps=int(max_steps), fixed_step=fixed_step)
     # the controller also runs at the last sample (its break never comes: the run ends there)
     S.run_controller(system.params, float(samples[-1]), res.stats["final_state"], system.u0)
     return BenchResult(res, S.controller_log(system.params))

@@ -231,7 +231,8 @@ PROTOCOL_TYPES = ("friction_map", "engagement", "inertia_dynamometer")
 
 
 def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None = None, friction=None, *,
-                 protocol_type: str | None = None, seed: int | None = None) -> BenchRun:
+                 protocol_type: str | None = None, seed: int | None = None,
+                 fixed_step: float | None = None) -> BenchRun:
     """Run a protocol on the virtual bench and return truth and noisy record.
 
     Parameters
@@ -249,6 +250,10 @@ def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None 
         Needed for an :class:`EngagementProtocol` (default "engagement").
     seed : int, optional
         Noise seed (default ``bench.seed``).
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s]
+        (:func:`~clutchlab.wet.engagement.simulate_engagement`).  None
+        (default): step-size control.
     """
     clutch = WetClutch.paper() if clutch is None else clutch
     bench = Bench() if bench is None else bench
@@ -263,7 +268,8 @@ def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None 
         scen = protocol.scenario(clutch, motor="speed" if ptype == "engagement" else "free")
     else:
         raise ParameterError(f"protocol = {protocol!r}: expected a MapProtocol or an EngagementProtocol")
-    res = simulate_engagement(clutch, scen, bench=bench, friction=friction, sample_rate=bench.sample_rate)
+    res = simulate_engagement(clutch, scen, bench=bench, friction=friction, sample_rate=bench.sample_rate,
+                              fixed_step=fixed_step)
     seed = bench.seed if seed is None else int(seed)
     return BenchRun(protocol, ptype, res, measure(res, bench, seed), clutch, bench, friction, seed)
 

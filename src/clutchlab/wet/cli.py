@@ -1,6 +1,6 @@
 """``clutchlab wet`` sub-commands: a thin layer over :mod:`clutchlab.wet`.
 
-``clutchlab wet simulate PROTOCOL.toml -o record.csv [--plot record.png] [--force]``
+``clutchlab wet simulate PROTOCOL.toml -o record.csv [--fixed-step STEP] [--plot record.png] [--force]``
     run a protocol on the virtual bench and write the measured record;
 ``clutchlab wet identify RECORDS... -o map.json [--plot map.png] [--force]``
     identify the friction map and k1, k2 from bench records;
@@ -14,6 +14,7 @@ import io
 import json
 import sys
 
+from ..cli import add_fixed_step_option
 from ..errors import ParameterError
 
 __all__ = ["register"]
@@ -34,6 +35,7 @@ def register(subparsers) -> None:
                          epilog="Documentation: docs/wet.md (protocol format)")
     sim.add_argument("protocol", help="protocol file ([protocol] type = friction_map | engagement | inertia_dynamometer)")
     sim.add_argument("-o", "--output", required=True, help="record CSV to write")
+    add_fixed_step_option(sim)
     sim.add_argument("--plot", help="also write a PNG figure of the record (slip, torque, force, temperatures)")
     sim.add_argument("--force", action="store_true", help="overwrite the outputs")
     sim.set_defaults(func=_simulate)
@@ -60,13 +62,16 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
+    from ..cli import fixed_step_note, fixed_step_option
     from ..io.files import check_outputs
     from .bench import load_protocol, run_protocol, write_bench_record
 
     check_outputs([args.output, args.plot], args.force)
+    fixed_step = fixed_step_option(args.fixed_step)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
-    run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype)
-    write_bench_record(run, args.output, overwrite=args.force)
+    run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype, fixed_step=fixed_step)
+    header = None if fixed_step is None else run.header() + "\n" + fixed_step_note(fixed_step)
+    write_bench_record(run, args.output, overwrite=args.force, header=header)
     if args.plot:
         from ..io import atomic_write_bytes
         from ..plotting import mark_synthetic
@@ -81,7 +86,8 @@ def _simulate(args) -> int:
         plt.close(fig)
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
-    print(f"{args.output}: {len(run.record)} samples of protocol {ptype}; events: {events}")
+    frames = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
+    print(f"{args.output}: {len(run.record)} samples of protocol {ptype}{frames}; events: {events}")
     return 0
 
 

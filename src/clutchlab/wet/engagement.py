@@ -507,7 +507,8 @@ def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutc
 
 def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench | None = None, friction=None,
                         sample_rate: float = 1000.0, sample_times=None, rtol: float = 1e-7,
-                        max_step: float = 0.01, max_steps: int = 2_000_000, outputs: bool = True) -> EngagementResult:
+                        max_step: float = 0.01, max_steps: int = 2_000_000, outputs: bool = True,
+                        fixed_step: float | None = None) -> EngagementResult:
     """Simulate one engagement (or any bench run) of the wet clutch.
 
     A thin wrapper of :func:`clutchlab.system.simulate` on
@@ -540,6 +541,12 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     outputs : bool
         Evaluate the outputs (torques, forces, film, ...) at the samples; with
         ``False`` only the states are kept and ``outputs`` is all NaN.
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3
+        steps on the grid ``k * fixed_step``, the events (piston stop,
+        contact, lock-up, break-away) at the first step end after them
+        (:func:`clutchlab.system.simulate`; ``rtol`` and ``max_step`` are then
+        unused).  None (default): step-size control.
 
     Returns
     -------
@@ -555,7 +562,7 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     sysm = _run_system(clutch, scenario, bench, friction, rtol)
     ts = _sample_times(scenario.duration, sample_rate, sample_times)
     res = run(sysm, float(scenario.duration), max_step=max_step, max_steps=max_steps, sample_times=ts,
-              outputs=outputs)
+              outputs=outputs, fixed_step=fixed_step)
     return EngagementResult.from_result(res, clutch.heat_capacity, W.peak_temperature(sysm.params),
                                         W.lockup_time(sysm.params))
 
