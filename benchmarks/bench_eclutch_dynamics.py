@@ -12,7 +12,7 @@ Measured in one run:
 4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale) with ``prange`` on all threads
    against one thread.
 
-Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]
+Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--build``: only the time to build one variant)
 """
 
 from __future__ import annotations
@@ -377,8 +377,33 @@ def main(quick: bool = False, friction_reference: bool = False):
           "seconds per second")
 
 
+def build_timing(repeat: int = 21) -> None:
+    """Building one variant (``ClutchModel.preset(4, ...)`` + ``EClutch``, friction on), lever ratio and
+    diaphragm scale varied at every build (nothing reused from an identical request): medians of
+    ``repeat`` rounds of 20 builds each, per build, with min-max."""
+    import statistics
+
+    def build(r, d):
+        return EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r, diaphragm_scale=d)),
+                       friction=FrictionParameters())
+
+    build(-4.0, 1.0)  # the bundled curves read and the kernels loaded
+    out = []
+    for k in range(repeat):
+        ratios = np.linspace(-4.4, -3.6, 20) + 1e-4 * k
+        scales = np.linspace(1.0, 1.5, 20)
+        t0 = time.perf_counter()
+        for r, d in zip(ratios, scales):
+            build(r, d)
+        out.append((time.perf_counter() - t0) / 20)
+    print(f"building one variant: {1e3 * statistics.median(out):.2f} ms ({1e3 * min(out):.2f}-{1e3 * max(out):.2f}), "
+          f"medians of {repeat} rounds of 20")
+
+
 if __name__ == "__main__":
-    if "--reference-only" in sys.argv:
+    if "--build" in sys.argv:
+        build_timing()
+    elif "--reference-only" in sys.argv:
         reference_only()
     else:
         main(quick="--quick" in sys.argv, friction_reference="--friction-reference" in sys.argv)

@@ -606,8 +606,6 @@ class Simulation:
         self._opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,
                                    first_step=first_step, event_tol=event_tol, fixed_step=fixed_step)
         self.fixed_step = self._opt.fixed_step
-        self._advance = (core.advance_rodas if system.method == "rodas" or self.fixed_step > 0.0
-                         else core.advance_dopri)
         self.x = system.x0.copy()
         self.m = system.m0.copy()
         self.u = system.u0.copy()
@@ -619,6 +617,30 @@ class Simulation:
         self._rm = np.empty((0, len(system.mode_names)), dtype=np.int64)
         self._ry = np.empty((1, len(system.outputs)))
         self._y = np.empty(len(system.outputs))
+        self._direct = {}  # entry name -> (compiled overload's entry, the arrays it was found for)
+
+    def _call(self, name: str, method: str, args):
+        """Call the compiled entry ``name`` of this model's entry module for ``method`` with ``args``.
+
+        The first call goes through numba's dispatch (compiling or loading the code); later calls go to the
+        compiled overload for these argument types directly (``overloads[signature].entry_point``), which
+        skips the dispatcher's type resolution of every argument -- about half of the per-call cost of a
+        session's ``advance`` (its parameter structure alone has tens of arrays).  The types cannot change
+        while the session's own arrays, parameters and options are the ones the entry was found for; if
+        any was replaced, the dispatcher is used again.
+        """
+        held = (self.system.params, self.x, self.m, self.u, self._opt)
+        entry = self._direct.get(name)
+        if entry is not None and all(a is b for a, b in zip(entry[1], held)):
+            return entry[0](*args)
+        dispatcher = getattr(self._core.entry_points(type(self.system.params), method), name)
+        out = dispatcher(*args)
+        try:
+            sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+            self._direct[name] = (dispatcher.overloads[sig].entry_point, held)
+        except (KeyError, AttributeError, TypeError):  # (no such overload: keep dispatching)
+            self._direct.pop(name, None)
+        return out
 
     @property
     def time(self) -> float:
@@ -636,8 +658,10 @@ class Simulation:
         """Integrate to ``t_end`` [s] holding the inputs ``u``; returns the status code (raises on failure)."""
         if u is not None:
             self.set_inputs(u)
-        code = self._advance(self.system.params, self.x, self.m, self.u, float(t_end), self._sf, self._si,
-                             self._opt, self.log, self._empty, self._rt, self._rx, self._rm, self._ry, False)
+        method = "rodas" if self.system.method == "rodas" or self.fixed_step > 0.0 else "dopri"
+        code = self._call("advance", method, (self.system.params, self.x, self.m, self.u, float(t_end), self._sf,
+                                              self._si, self._opt, self.log, self._empty, self._rt, self._rx,
+                                              self._rm, self._ry, False))
         _check_status(self.system, int(code), self._si, self.time, True)
         return int(code)
 
@@ -663,7 +687,7 @@ class Simulation:
 
     def outputs(self) -> np.ndarray:
         """Output vector at the current point (order of ``system.outputs``)."""
-        self._core.evaluate_outputs(self.system.params, self.time, self.x, self.u, self.m, self._y)
+        self._call("evaluate_outputs", "dopri", (self.system.params, self.time, self.x, self.u, self.m, self._y))
         return self._y.copy()
 
     def events(self) -> pd.DataFrame:

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from clutchlab import Curve
 from clutchlab.eclutch.network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
@@ -109,6 +111,38 @@ def test_bearing_force_is_the_derivative_of_stored_energy():
 def test_zero_input_sets_the_engaged_bearing_force():
     net = zero_input(linear_model0(), "bearing", 80.0)
     assert solve_static(net, [0.0])["input_force"][0] == pytest.approx(80.0, rel=1e-8)
+
+
+@settings(deadline=None, max_examples=30)
+@given(force=st.floats(1.0, 2000.0), k_b=st.floats(1e6, 2e7), p_b=st.floats(-2e-3, 2e-3))
+def test_zero_input_root_equals_brents_from_the_bracket(force, k_b, p_b):
+    """The zeroing's secant steps (from the spring's own pre-strain) find the pre-strain Brent's method
+    finds from the wide bracket, to its tolerance, and the input force is the one asked for; its network is
+    the one replace_element gives (the assembly reused, bit for bit)."""
+    from scipy.optimize import brentq
+
+    base = linear_model0(k_b=k_b, p_b=p_b)
+    net = zero_input(base, "bearing", force)
+    p = net.element("bearing").prestrain
+
+    def residual(x):
+        return float(solve_static(base._with_prestrain("bearing", x), [0.0])["input_force"][0]) - force
+
+    assert p == pytest.approx(brentq(residual, -0.05, 0.05, xtol=1e-13, rtol=1e-12), abs=3e-13)
+    assert solve_static(net, [0.0])["input_force"][0] == pytest.approx(force, rel=1e-8)
+    again = base.replace_element("bearing", Spring("bearing", "bearing", base.element("bearing").curve, b="tip",
+                                                   prestrain=p, unilateral=True))
+    for key in ("GA", "Gb", "d0", "cx", "cf"):
+        assert np.array_equal(net._assembly[key], again._assembly[key])
+
+
+def test_secant_root_hands_a_flat_function_to_the_bracket():
+    from clutchlab.eclutch.network import _secant_root
+
+    assert _secant_root(lambda x: -80.0, 0.0, 1e-6, -1.0, 1.0, xtol=1e-13, rtol=1e-12) is None  # flat: no root
+    assert _secant_root(lambda x: x - 2.0, 0.0, 1e-6, -1.0, 1.0, xtol=1e-13, rtol=1e-12) is None  # outside
+    assert _secant_root(lambda x: x ** 3 - 0.125, 0.3, 0.31, -1.0, 1.0, xtol=1e-14, rtol=1e-14) == \
+        pytest.approx(0.5, abs=1e-13)
 
 
 @pytest.mark.parametrize(

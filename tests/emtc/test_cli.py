@@ -4,6 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from cli_checks import fixed_step_frames
 from clutchlab.cli import main
 from clutchlab.emtc.magnet import bundled_forc
 from clutchlab.hysteresis import Preisach
@@ -123,13 +124,7 @@ def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
     assert code == 0
     for word in ("armature_leave_rest", "armature_contact", "lockup"):
         assert word in text_a and word in text_f
-    header = [line for line in fixed.read_text().splitlines() if line.startswith("#")]
-    assert header[0].startswith("# synthetic:")
-    assert "# solver: fixed-step (real-time) mode, step 0.001 s (Rodas3 on the grid k * step)" in header
-    assert "fixed-step" not in adaptive.read_text()
-    a, f = pd.read_csv(adaptive, comment="#"), pd.read_csv(fixed, comment="#")
-    assert len(a) == len(f) == 251
-    np.testing.assert_array_equal(f.time_s, a.time_s)
+    a, f = fixed_step_frames(fixed, adaptive, 251)
     for column in ("omega_f_rad_s", "omega_r_rad_s"):
         assert np.all(np.isfinite(f[column])) and np.max(np.abs(f[column] - a[column])) < 0.1, column
     assert np.max(np.abs(f.magnet_force_N - a.magnet_force_N)) < 0.03 * np.max(np.abs(a.magnet_force_N))

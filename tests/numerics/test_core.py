@@ -211,6 +211,28 @@ def test_resumed_advance_matches_one_run(method):
     assert np.allclose(y, sim.x)
 
 
+@pytest.mark.parametrize("method", METHODS)
+def test_direct_entry_calls_equal_dispatched_ones(method):
+    """After its first call a session calls the compiled overload directly (no numba dispatch): the same
+    steps, events and outputs as a session whose calls all go through the dispatcher, and a replaced state
+    array sends the next call through the dispatcher again."""
+    system = toys.belt_system(method=method)
+    direct, plain = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
+    for k, t in enumerate(np.linspace(0.01, 1.5, 150)):
+        direct.advance(t)
+        plain._direct.clear()  # (every call of this one dispatches)
+        plain.advance(t)
+        y_direct, y_plain = direct.outputs(), plain.outputs()
+        plain._direct.clear()
+        assert np.array_equal(direct.x, plain.x) and np.array_equal(y_direct, y_plain)
+        if k == 70:
+            direct.x = direct.x.copy()  # a new array of the same type: found again by the dispatcher
+    assert set(direct._direct) == {"advance", "evaluate_outputs"} and direct._direct["advance"][1][1] is direct.x
+    assert direct.stats == plain.stats
+    pd_direct, pd_plain = direct.events(), plain.events()
+    assert list(pd_direct.event) == list(pd_plain.event) and np.array_equal(pd_direct.time_s, pd_plain.time_s)
+
+
 def test_inputs_are_held_over_an_advance():
     """x' = u with u switched per call: a ramp of the held values."""
     system = toys.linear_system([[0.0]], [0.0], b=[[1.0]])

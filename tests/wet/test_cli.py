@@ -2,6 +2,7 @@ import json
 
 import pytest
 
+from cli_checks import fixed_step_frames
 from clutchlab.cli import main
 from clutchlab.wet import FrictionMap
 from clutchlab.wet.data import DATA_DIR, MAP_RECORDS
@@ -50,7 +51,6 @@ def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
     adaptive run (of 157 rad/s; bound 0.1 rad/s), thermistor temperature within 0.043 K (bound 0.1 K); the events
     are the same, each at the first frame end after the adaptive instant (tests/numerics/test_fixed_step.py)."""
     import numpy as np
-    import pandas as pd
 
     protocol = str(DATA_DIR / "engagement_protocol.toml")
     adaptive, fixed = tmp_path / "adaptive.csv", tmp_path / "fixed.csv"
@@ -59,13 +59,7 @@ def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
     assert main(["wet", "simulate", protocol, "-o", str(fixed), "--fixed-step", "1 ms"]) == 0
     out = capsys.readouterr().out
     assert "in fixed steps of 0.001 s" in out and "contact at 0.193 s" in out and "lock-up at 0.83 s" in out
-    header = [line for line in fixed.read_text().splitlines() if line.startswith("#")]
-    assert header[0].startswith("# synthetic:")
-    assert "# solver: fixed-step (real-time) mode, step 0.001 s (Rodas3 on the grid k * step)" in header
-    assert "fixed-step" not in adaptive.read_text()
-    a, f = pd.read_csv(adaptive, comment="#"), pd.read_csv(fixed, comment="#")
-    assert len(a) == len(f) == 1201
-    np.testing.assert_array_equal(f.time_s, a.time_s)
+    a, f = fixed_step_frames(fixed, adaptive, 1201)
     assert np.max(np.abs(f.slip_speed_rad_s - a.slip_speed_rad_s)) < 0.1
     assert np.max(np.abs(f.temperature_C - a.temperature_C)) < 0.1
 

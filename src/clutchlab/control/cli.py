@@ -134,14 +134,19 @@ def _system(args):
     return None, load_driveline(args.file).driveline.system()
 
 
-def _branches(args) -> dict:
+def _name_values(items, flag: str, form: str) -> dict:
+    """``{NAME: VALUE}`` from ``NAME=VALUE`` arguments of ``flag`` (strings; ``form`` names the form in errors)."""
     out = {}
-    for item in args.branch:
+    for item in items:
         name, sep, value = item.partition("=")
         if not sep:
-            raise ParameterError(f"--branch {item!r}: expected NAME=rising or NAME=falling")
+            raise ParameterError(f"{flag} {item!r}: expected {form}")
         out[name.strip()] = value.strip()
     return out
+
+
+def _branches(args) -> dict:
+    return _name_values(args.branch, "--branch", "NAME=rising or NAME=falling")
 
 
 def _pairs(system, items, kinds, flag):
@@ -149,14 +154,10 @@ def _pairs(system, items, kinds, flag):
     from .trim import resolve
 
     out = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep:
-            raise ParameterError(f"{flag} {item!r}: expected NAME=VALUE")
-        name = name.strip()
+    for name, value in _name_values(items, flag, "NAME=VALUE").items():
         kind, i = resolve(system, name, kinds)
         var = {"state": system.states, "output": system.outputs, "input": system.inputs}[kind][i]
-        out[var.name] = to_si(value.strip(), COLUMN_UNITS.get(var.unit, (var.unit,))[0], name=f"{flag} {name}")
+        out[var.name] = to_si(value, COLUMN_UNITS.get(var.unit, (var.unit,))[0], name=f"{flag} {name}")
     return out
 
 
@@ -175,12 +176,7 @@ def _points(args):
             out.append((f"bearing at {pos * 1e3:g} mm", pos,
                         ec.operating_point(pos, input=args.eclutch_input, friction=args.direction)))
         return out
-    modes = {}
-    for item in args.mode:
-        name, sep, value = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--mode {item!r}: expected MODE=VALUE")
-        modes[name.strip()] = value.strip()
+    modes = _name_values(args.mode, "--mode", "MODE=VALUE")
     op = operating_point(system, inputs=_pairs(system, args.set, ("input",), "--set"),
                          states=_pairs(system, args.hold, ("state",), "--hold"),
                          targets=_pairs(system, args.target, ("state", "output"), "--target"),

@@ -347,9 +347,13 @@ class AxialNetwork:
             else:
                 elastic.append((e, g))
         C = np.array(rows)
-        if np.linalg.matrix_rank(C) < C.shape[0]:
+        # one SVD for the rank and the pseudo-inverse (what numpy's matrix_rank and pinv each compute)
+        u_c, s_c, vt_c = np.linalg.svd(C, full_matrices=False)
+        if np.count_nonzero(s_c > s_c.max(initial=0.0) * max(C.shape) * np.finfo(float).eps) < C.shape[0]:
             raise ParameterError(f"network {self.name!r}: rigid levers over-constrain the nodes")
-        pinv = np.linalg.pinv(C)
+        large = s_c > 1e-15 * s_c.max(initial=0.0)
+        inv_s = np.divide(1.0, s_c, where=large, out=np.zeros_like(s_c))
+        pinv = np.matmul(vt_c.T, np.multiply(inv_s[:, None], u_c.T))
         b = pinv @ np.array(rhs_u)
         c = pinv @ np.array(rhs_c)
         A = null_space(C)
@@ -370,11 +374,12 @@ class AxialNetwork:
         offsets = np.zeros(len(curves) + 1, dtype=np.int64)
         for k, cv in enumerate(curves):
             offsets[k + 1] = offsets[k] + cv.deflection.size
-        cx = np.concatenate([cv.kernel_data()[0] for cv in curves])
-        cf = np.concatenate([cv.kernel_data()[1] for cv in curves])
-        cd = np.concatenate([cv.kernel_data()[2] for cv in curves])
-        kinds = np.array([cv.kernel_data()[3] for cv in curves], dtype=np.int64)
-        extraps = np.array([cv.kernel_data()[4] for cv in curves], dtype=np.int64)
+        data = [cv.kernel_data() for cv in curves]
+        cx = np.concatenate([k[0] for k in data])
+        cf = np.concatenate([k[1] for k in data])
+        cd = np.concatenate([k[2] for k in data])
+        kinds = np.array([k[3] for k in data], dtype=np.int64)
+        extraps = np.array([k[4] for k in data], dtype=np.int64)
         return dict(
             node_names=names, element_names=[e.name for e, _ in elastic], A=A, b=b, c=c, G=G,
             GA=np.ascontiguousarray(GA), Gb=np.ascontiguousarray(G @ b), Gc=Gc,
@@ -700,11 +705,40 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
             return np.nan
 
     lo, hi = bracket
-    r_lo, r_hi = residual(lo), residual(hi)
-    if not (np.isfinite(r_lo) and np.isfinite(r_hi)) or r_lo * r_hi > 0:
-        raise ParameterError(f"zero_input: cannot reach an input force of {short_repr(force)} N by shifting {element!r} within [{short_repr(lo)}, {short_repr(hi)}] m")
-    p = brentq(residual, lo, hi, xtol=1e-13, rtol=1e-12)
-    return network.replace_element(element, _replace_spring(el, prestrain=p))
+    # the input force is linear in the pre-strain while the contact is closed: secant steps from the
+    # element's own pre-strain find the root in a few solves (Brent's method from the wide bracket took
+    # 17-18, most of them where the contact is open and the force is flat); Brent's method remains the
+    # fallback and gives the refusal
+    p = _secant_root(residual, float(el.prestrain), float(el.prestrain) + 1e-6, lo, hi, xtol=1e-13, rtol=1e-12)
+    if p is None:
+        r_lo, r_hi = residual(lo), residual(hi)
+        if not (np.isfinite(r_lo) and np.isfinite(r_hi)) or r_lo * r_hi > 0:
+            raise ParameterError(f"zero_input: cannot reach an input force of {short_repr(force)} N by shifting {element!r} within [{short_repr(lo)}, {short_repr(hi)}] m")
+        p = brentq(residual, lo, hi, xtol=1e-13, rtol=1e-12)
+    return network._with_prestrain(element, p)  # (equals replace_element bit for bit, without assembling again)
+
+
+def _secant_root(fun, x0: float, x1: float, lo: float, hi: float, *, xtol: float, rtol: float, max_iter: int = 12):
+    """A root of ``fun`` by secant steps from ``x0``, ``x1`` within ``[lo, hi]``, or None (no convergence, a flat
+    or non-finite function, a step out of the interval): the caller then brackets.
+
+    Converged when a step is below ``xtol + rtol |x|`` (Brent's criterion) and the function changes sign
+    across the last step or vanishes at its end, so the root is that of ``fun``, not of a flat stretch.
+    """
+    f0, f1 = fun(x0), fun(x1)
+    for _ in range(max_iter):
+        if not (np.isfinite(f0) and np.isfinite(f1)) or f1 == f0:
+            return None
+        x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
+        if not (lo <= x2 <= hi):
+            return None
+        if abs(x2 - x1) <= xtol + rtol * abs(x2):
+            f2 = fun(x2)
+            if f2 == 0.0 or np.sign(f2) != np.sign(f1) or abs(f2) <= abs(f1):
+                return x2
+            return None
+        x0, f0, x1, f1 = x1, f1, x2, fun(x2)
+    return None
 
 
 def _replace_spring(spring: Spring, **changes) -> Spring:

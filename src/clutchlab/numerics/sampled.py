@@ -113,26 +113,28 @@ def measure(p, t, x, u, m, kind, idx, ybuf, y):
         y[q] = x[idx[q]] if kind[q] == 0 else ybuf[idx[q]]
 
 
+@register_jitable(inline="always")
+def _row_products(M, v, N, w, i):
+    """``(M[i] . v, N[i] . w)``, each summed in index order (as numpy's matrix-vector product of these sizes)."""
+    s = 0.0
+    for j in range(v.shape[0]):
+        s += M[i, j] * v[j]
+    s2 = 0.0
+    for j in range(w.shape[0]):
+        s2 += N[i, j] * w[j]
+    return s, s2
+
+
 @register_jitable
 def lti_update(A, B, C, D, xc, r, y, u_op, out, e, xn):
     """One sample of a discrete LTI controller on ``e = r - y``: ``out = u_op + C xc + D e``; ``xc`` advanced."""
     for q in range(y.shape[0]):
         e[q] = r[q] - y[q]
     for i in range(out.shape[0]):
-        s = 0.0
-        for j in range(xc.shape[0]):
-            s += C[i, j] * xc[j]
-        s2 = 0.0
-        for j in range(e.shape[0]):
-            s2 += D[i, j] * e[j]
+        s, s2 = _row_products(C, xc, D, e, i)
         out[i] = (u_op[i] + s) + s2
     for i in range(xc.shape[0]):
-        s = 0.0
-        for j in range(xc.shape[0]):
-            s += A[i, j] * xc[j]
-        s2 = 0.0
-        for j in range(e.shape[0]):
-            s2 += B[i, j] * e[j]
+        s, s2 = _row_products(A, xc, B, e, i)
         xn[i] = s + s2
     for i in range(xc.shape[0]):
         xc[i] = xn[i]
