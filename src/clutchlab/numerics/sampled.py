@@ -113,7 +113,7 @@ def measure(p, t, x, u, m, kind, idx, ybuf, y):
         y[q] = x[idx[q]] if kind[q] == 0 else ybuf[idx[q]]
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _row_products(M, v, N, w, i):
     """``(M[i] . v, N[i] . w)``, each summed in index order (as numpy's matrix-vector product of these sizes)."""
     s = 0.0
