@@ -412,8 +412,8 @@ class ContractCoSimulation(CoSimulation):
 
 # ===================================================================== wet clutch
 def _wet_variables():
-    from ..wet.bench import _pack_equilibrium
     from ..wet.params import Bench, WetClutch
+    from ..wet.thermal import steady_state_temperature
 
     clutch = parameter_set_variables("clutch", WetClutch)
     bench = parameter_set_variables("bench", Bench, skip=(
@@ -423,7 +423,8 @@ def _wet_variables():
         Variable("scenario.free_inertia", "1", 0.0,
                  "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)"),
         Variable("scenario.initial_slip_speed", "rad/s", 1500 * math.pi / 30, "slip speed at t = 0"),
-        Variable("scenario.initial_temperature", "degC", _pack_equilibrium(WetClutch(), 80.0, 70.0),
+        Variable("scenario.initial_temperature", "degC",
+                 steady_state_temperature(0.0, 80.0, 70.0, WetClutch().k1, WetClutch().k2),
                  "pack temperature at t = 0 (default: Eq. 8 equilibrium of fluid and housing)"),
         Variable("scenario.fluid_temperature", "degC", 80.0, "oil reservoir temperature at t = 0"),
         Variable("scenario.housing_temperature", "degC", 70.0, "housing temperature at t = 0"),

@@ -42,6 +42,7 @@ from ..params import ParameterSet, load_toml, quantity
 from .engagement import EngagementResult, Scenario, simulate_engagement
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
+from .thermal import steady_state_temperature
 
 __all__ = [
     "MapProtocol",
@@ -64,8 +65,10 @@ _P300 = 300e3 * WetClutch().friction_area  # 300 kPa on the friction area, Sec. 
 
 
 def _pack_equilibrium(clutch: WetClutch, fluid_c: float, housing_c: float) -> float:
-    k = clutch.k1 + clutch.k2
-    return (clutch.k1 * fluid_c + clutch.k2 * housing_c) / k if k > 0 else fluid_c  # Eq. 8 with no friction
+    # Eq. 8 with no friction power (thermal.steady_state_temperature); the oil's temperature without conductances
+    if not clutch.k1 + clutch.k2 > 0:
+        return fluid_c
+    return float(steady_state_temperature(0.0, fluid_c, housing_c, clutch.k1, clutch.k2))
 
 
 @dataclasses.dataclass(frozen=True)
