@@ -41,7 +41,7 @@ from ..errors import ParameterError, SimulationError
 from ..io import read_table
 from ..params import ParameterSet, load_toml, quantity
 from ..units import to_si
-from .network import GROUND, AxialNetwork, Lever, Node, Spring, solve_static, zero_input
+from .network import GROUND, AxialNetwork, Lever, Node, Spring, modified_parts, solve_static, zero_input
 
 __all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve",
            "ClutchModel", "build_model", "clutch_torque", "torque_of_clamp_force", "MODEL_NUMBERS"]
@@ -327,40 +327,45 @@ def _engaged_loads(p: EClutchParameters, c: ComponentCurves) -> dict[str, float]
 
 def _model1(p, c, loads):
     # + lever compliance k_fl (Eq. 1): the tip becomes a free, massless node
-    return loads["net"].modified(
-        replace={"lever": Lever("lever", "tip", "pp", p.lever_ratio, stiffness=p.k_fl_model1,
-                                prestrain=loads["lever"] / p.k_fl_model1)}, name="Model 1")
+    net = loads["net"]
+    return _parts(net.nodes, net.elements, "Model 1",
+                  replace={"lever": Lever("lever", "tip", "pp", p.lever_ratio, stiffness=p.k_fl_model1,
+                                          prestrain=loads["lever"] / p.k_fl_model1)})
 
 
 def _model2(p, c, loads):
     # + pressure-plate spring k_pp between the diaphragm edge (mass m_pps) and the pressure plate
-    return _model1(p, c, loads).modified(
-        nodes=(Node("edge", p.m_pps),),
-        replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, stiffness=p.k_fl_model2,
-                                prestrain=loads["lever"] / p.k_fl_model2)},
-        add=(Spring("pp_spring", "edge", c.pp_spring, b="pp", unilateral=True,
-                    prestrain=float(c.pp_spring.inverse(loads["pp_spring"]))),),
-        name="Model 2")
+    nodes, elements, _ = _model1(p, c, loads)
+    return _parts(nodes, elements, "Model 2", extra_nodes=(Node("edge", p.m_pps),),
+                  replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, stiffness=p.k_fl_model2,
+                                          prestrain=loads["lever"] / p.k_fl_model2)},
+                  add=(Spring("pp_spring", "edge", c.pp_spring, b="pp", unilateral=True,
+                              prestrain=float(c.pp_spring.inverse(loads["pp_spring"]))),))
 
 
 def _model3(p, c, loads, support_scale=1.0):
     # + equivalent yoke support k_ys.eq carrying the lever pivot (mass m_ds)
     k_ys = c.support_equivalent(p.support_max_force)
-    return _model2(p, c, loads).modified(
-        nodes=(Node("support", p.m_ds),),
-        replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, pivot="support", stiffness=p.k_fl_model2,
-                                prestrain=loads["lever"] / p.k_fl_model2)},
-        add=(Spring("support", GROUND, k_ys, b="support", scale=support_scale,
-                    prestrain=float(k_ys.inverse(loads["support"] / support_scale))),),
-        name="Model 3")
+    nodes, elements, _ = _model2(p, c, loads)
+    return _parts(nodes, elements, "Model 3", extra_nodes=(Node("support", p.m_ds),),
+                  replace={"lever": Lever("lever", "tip", "edge", p.lever_ratio, pivot="support",
+                                          stiffness=p.k_fl_model2, prestrain=loads["lever"] / p.k_fl_model2)},
+                  add=(Spring("support", GROUND, k_ys, b="support", scale=support_scale,
+                              prestrain=float(k_ys.inverse(loads["support"] / support_scale))),))
 
 
 def _model4(p, c, loads):
     # diaphragm spring towards the yoke support; k_ys.eq x20, diaphragm x1.3 (Sec. 5.4)
-    return _model3(p, c, loads, support_scale=p.support_scale).modified(
-        replace={"diaphragm": Spring("diaphragm", "tip", c.diaphragm, b="support",
-                                     prestrain=p.diaphragm_prestrain, scale=p.diaphragm_scale)},
-        name="Model 4")
+    nodes, elements, _ = _model3(p, c, loads, support_scale=p.support_scale)
+    return _parts(nodes, elements, "Model 4",
+                  replace={"diaphragm": Spring("diaphragm", "tip", c.diaphragm, b="support",
+                                               prestrain=p.diaphragm_prestrain, scale=p.diaphragm_scale)})
+
+
+def _parts(nodes, elements, name, **changes):
+    """(nodes, elements, name) of a model derived from another's; Models 1-4 chain these and only the
+    last is assembled into a network (:func:`.network.modified_parts`)."""
+    return (*modified_parts(nodes, elements, where=name, **changes), name)
 
 
 _BUILDERS = {1: _model1, 2: _model2, 3: _model3, 4: _model4}
@@ -385,7 +390,8 @@ def build_model(number: int, params: EClutchParameters | None = None, curves: Co
     loads = _engaged_loads(params, curves)
     if int(number) == 0:
         return loads["net"]
-    net = _BUILDERS[int(number)](params, curves, loads)
+    nodes, elements, name = _BUILDERS[int(number)](params, curves, loads)
+    net = AxialNetwork(nodes, elements, input="bearing", normal_force="cushion", name=name)
     if int(number) == 4:  # the scaled diaphragm changes the engaged state: zero the bearing again
         net = zero_input(net, "bearing", params.bearing_preload)
     return net

@@ -276,13 +276,9 @@ class AxialNetwork:
         compliances or moves an element to another node.  Replacing with
         ``None`` removes the element.
         """
-        replace = dict(replace or {})
-        for key in replace:
-            self.element(key)
-        elements = tuple(replace.get(e.name, e) for e in self.elements)
-        elements = tuple(e for e in elements if e is not None) + tuple(add)
-        return AxialNetwork(self.nodes + tuple(nodes), elements, input=self.input, normal_force=self.normal_force,
-                            name=name or self.name)
+        nodes, elements = modified_parts(self.nodes, self.elements, extra_nodes=nodes, replace=replace, add=add,
+                                         where=f"network {self.name!r}")
+        return AxialNetwork(nodes, elements, input=self.input, normal_force=self.normal_force, name=name or self.name)
 
     def _with_prestrain(self, name: str, prestrain: float) -> "AxialNetwork":
         """A copy with spring ``name``'s pre-strain set to ``prestrain`` [m], its assembly reused: the
@@ -697,12 +693,20 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
     if not (np.isfinite(force) and force >= 0):
         raise ParameterError(f"zero_input: force = {short_repr(force)} N must be finite and >= 0")
 
+    # the residual is solve_static(network with pre-strain p, [0.0])["input_force"][0] - force, computed
+    # without building that network: only the element's rest deflection d0 moves (as _with_prestrain
+    # sets it, so the root is the same to the last bit)
+    a = network._assembly
+    k = a["element_names"].index(element)
+    kernel = list(network.kernel_data())
+    d0 = kernel[2] = kernel[2].copy()
+    gc, gb = a["Gc"][k], a["Gb"]
+    u0, q0 = np.zeros(1), np.zeros(network.n_free)
+
     def residual(p):
-        net = network._with_prestrain(element, p)
-        try:
-            return float(solve_static(net, np.array([0.0]))["input_force"][0]) - force
-        except SimulationError:
-            return np.nan
+        d0[k] = float(p) + gc
+        _, F, _, status = _static_path(u0, q0, *kernel, 1e-7, 1e-14)
+        return np.nan if status else float((F @ gb)[0]) - force
 
     lo, hi = bracket
     # the input force is linear in the pre-strain while the contact is closed: secant steps from the
@@ -739,6 +743,23 @@ def _secant_root(fun, x0: float, x1: float, lo: float, hi: float, *, xtol: float
             return None
         x0, f0, x1, f1 = x1, f1, x2, fun(x2)
     return None
+
+
+def modified_parts(nodes: tuple, elements: tuple, *, extra_nodes=(), replace=None, add=(),
+                   where: str = "network") -> tuple:
+    """The nodes and elements of :meth:`AxialNetwork.modified`, without assembling a network.
+
+    ``extra_nodes`` are appended, elements are replaced (``{name: new}``; ``None`` removes one) and
+    ``add`` is appended.  Models 1-4 chain three or four such changes; only the last result is
+    assembled (each assembly costs two SVDs and a null space).  ``where`` names the network in errors.
+    """
+    replace = dict(replace or {})
+    known = {e.name for e in elements}
+    for key in replace:
+        if key not in known:
+            raise ParameterError(f"{where}: no element {key!r} (has: {[e.name for e in elements]})")
+    out = tuple(replace.get(e.name, e) for e in elements)
+    return tuple(nodes) + tuple(extra_nodes), tuple(e for e in out if e is not None) + tuple(add)
 
 
 def _replace_spring(spring: Spring, **changes) -> Spring:
