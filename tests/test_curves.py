@@ -191,3 +191,19 @@ def test_curve_errors_show_plain_numbers():
     with pytest.raises(ParameterError) as info:
         Curve([0.0, 1e-3], [0.0, 1.0], extrapolation="error", name="c")(np.array([0.5]))
     assert "deflection 0.5 m outside the measured range [0.0, 0.001]" in str(info.value)
+
+
+def test_inverse_exact_at_a_sample_and_on_a_steep_segment():
+    """Two cases hypothesis found: a force equal to the first sample's (the residual is zero at the first
+    guess, which must be kept, not bisected away), and a 1e8 N/m segment, where a step bound of 1e-15 m
+    left a 1e-7 N error."""
+    c = Curve(np.array([0.0, 0.00079615, 0.00080615]), np.array([0.0, 1.0, 2.0]), kind="pchip")
+    assert c.inverse(0.0) == 0.0
+    xs = np.array([0.00064704, 0.00065704, 0.00066704, 0.00067704, 0.00068704, 0.00069704, 0.00070704,
+                   0.00071704, 0.00072704, 0.00073704, 0.00074704, 0.00075704])
+    fs = np.array([0.0, 940.0, 1338.0, 1339.0, 1340.0, 1341.0, 1342.0, 1343.0, 1344.0, 1345.0, 1873.0, 2873.0])
+    steep = Curve(xs, fs, kind="pchip")
+    force = 1.5e-5 * 2873.0
+    assert abs(steep(steep.inverse(force)) - force) < 1e-9
+    forces = np.linspace(1.0, 2872.0, 101)
+    assert np.max(np.abs(steep(steep.inverse(forces)) - forces)) < 1e-9 * 2873.0
