@@ -43,3 +43,24 @@ def test_notice_can_be_silenced(tmp_path):
     assert out.returncode == 0, out.stderr
     assert NOTICE not in out.stderr
     assert _seconds(out) > 0.0
+
+
+def test_a_function_without_a_module_does_not_break_the_listener(tmp_path):
+    """numbalsoda compiles functions made by ``exec``, whose ``__module__`` is None: the listener must
+    let them compile (it raised AttributeError) and stay silent about them."""
+    script = """
+import numba
+from clutchlab import _compile_notice
+_compile_notice.install()
+ns = {"__name__": None}
+exec("def f(x):\\n    return x + 1", ns)
+ns["f"].__module__ = None
+print("value", numba.njit(ns["f"])(1))
+print("compile_seconds", _compile_notice.compile_seconds())
+"""
+    full = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=full, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert "value 2" in out.stdout
+    assert NOTICE not in out.stderr
+    assert _seconds(out) == 0.0

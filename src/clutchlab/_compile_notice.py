@@ -42,7 +42,8 @@ def compile_seconds() -> float:
 def _is_clutchlab(event) -> bool:
     disp = (event.data or {}).get("dispatcher")
     func = getattr(disp, "py_func", None)
-    return getattr(func, "__module__", "").startswith("clutchlab.")
+    # a function made by exec (numbalsoda's, for one) has __module__ None
+    return (getattr(func, "__module__", None) or "").startswith("clutchlab.")
 
 
 def install() -> None:
