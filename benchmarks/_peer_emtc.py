@@ -68,7 +68,7 @@ try:  # numbalsoda is the benchmark's extra; the equations (and their test) do n
 except ImportError:  # pragma: no cover - depends on the environment
     lsoda = None
     lsoda_sig = types.void(types.double, types.CPointer(types.double), types.CPointer(types.double),
-                           types.voidptr)
+                           types.CPointer(types.double))  # numbalsoda's
     HAVE_NUMBALSODA = False
 
 NX = 7
@@ -445,7 +445,7 @@ def _first_crossing(ga, gb):
     return best
 
 
-@numba.njit(cache=True)
+@numba.njit  # not cache=True: numbalsoda's lsoda is a ctypes pointer, which numba cannot cache (compiles in ~5 s)
 def run(funcptr, d, z0, ts, n_samples, nsub, rtol, atol, ctl_tab, ctl_grid, ctl_gaps, map_thr, map_v, map_t,
         out, event_tol=1e-12):
     """The whole run: ``n_samples`` controller samples every ``ts`` from t = 0; writes the unscaled states at the
