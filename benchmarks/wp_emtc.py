@@ -229,7 +229,7 @@ def main(argv=None):
         rtols = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
         rtols_compiled = rtols + [1e-9, 1e-10]
         methods = ["RK45", "DOP853", "LSODA", "Radau"]
-        budget_fast, budget_slow = 1.0, 2.5
+        budget_fast, budget_slow = 2.0, 4.0
     print(f"scenario: {sc.duration:g} s, controller every {sc.sample_time * 1e3:g} ms, {n} samples; "
           f"atol = ATOL * rtol / 1e-6 for every solver")
 
