@@ -104,3 +104,16 @@ def plot(series, path, title: str, error_label: str) -> None:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     print(f"\nwrote {path}")
+
+
+def cheapest_at(series, error: float):
+    """The cheapest point (lowest median time) of ``series`` (a :class:`Series` or a list of them) whose error
+    is at most ``error``, as ``(label, point)``; ``None`` where no point got that accurate."""
+    if isinstance(series, Series):
+        series = [series]
+    best = None
+    for s in series:
+        for p in s.points:
+            if p.error <= error and (best is None or p.median < best[1].median):
+                best = (s.label, p)
+    return best
