@@ -164,6 +164,22 @@ def test_position_control_tracks_the_pedal_reference():
     assert abs(e := res.energy_balance()["relative"]) < 0.005, e
 
 
+
+def test_result_tables_survive_pickling_before_they_are_read():
+    """The tables of a run are built when first read; a result pickled before that (a sweep worker
+    returning it) carries the same tables, events and energy as one read in place."""
+    import pickle
+
+    ec = EClutch(friction=FrictionParameters())
+    inp = {"bearing_reference": ([0.0, 0.1, 0.3], [0.0, 0.0, 6e-3])}
+    read = ec.simulate(inp, 0.4)
+    shipped = pickle.loads(pickle.dumps(ec.simulate(inp, 0.4)))
+    for name in ("states", "outputs", "events"):
+        assert getattr(shipped, name).equals(getattr(read, name)), name
+    assert len(read.events) > 0 and read.outputs.shape[0] == read.time.size
+    assert shipped.energy.equals(read.energy)
+    assert shipped.stats == read.stats
+
 # ----------------------------------------------------------------- actuator steady states
 def frictionless_actuator(**kw):
     return ActuatorParameters(master_seal_friction=0.0, slave_seal_friction=0.0, seal_pressure_friction=0.0,
