@@ -104,3 +104,10 @@ def plot(series, path, title: str, error_label: str) -> None:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     print(f"\nwrote {path}")
+
+
+def cheapest_at_error(series: Series, error: float):
+    """The point of ``series`` with the lowest median time among those whose error is at most ``error``
+    (``None`` if no point is that accurate): a solver's cost at a fixed error level."""
+    cands = [p for p in series.points if p.error <= error]
+    return min(cands, key=lambda p: p.median) if cands else None
