@@ -38,6 +38,7 @@ the physical state and the switching values, and the two reference profiles (tim
 from __future__ import annotations
 
 import math
+import warnings
 
 import numba
 import numpy as np
@@ -232,6 +233,10 @@ def rhs(t, u, du, p):
 
 
 # ----------------------------------------------------------------- the driver (needs numbalsoda)
+# numbalsoda's ``lsoda`` calls its C library through a ctypes function, whose address numba bakes into the
+# caller: the driver cannot be cached and compiles in every process (numba says so once per process)
+warnings.filterwarnings("ignore", message='Cannot cache compiled function "_integrate"',
+                        category=numba.NumbaWarning)
 lsoda = None  # numbalsoda.lsoda, bound by _load() before the driver is first compiled
 
 
