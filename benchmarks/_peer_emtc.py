@@ -45,20 +45,9 @@ from clutchlab.hysteresis import _kernels as K
 
 
 def _import_numbalsoda():
-    """``(lsoda, lsoda_sig)``.  numbalsoda compiles functions at import whose ``py_func.__module__`` is None,
-    and clutchlab's compile-notice listener (``clutchlab._compile_notice._is_clutchlab``) fails on those
-    with AttributeError; the listener is set aside while numbalsoda is imported."""
-    from numba.core import event as ev
+    """``(lsoda, lsoda_sig)`` from numbalsoda (the ``bench`` extra)."""
+    from numbalsoda import lsoda as _lsoda, lsoda_sig as _sig
 
-    listeners = ev._registered["numba:compile"]
-    ours = [x for x in listeners if type(x).__module__.startswith("clutchlab.")]
-    for x in ours:
-        ev.unregister("numba:compile", x)
-    try:
-        from numbalsoda import lsoda as _lsoda, lsoda_sig as _sig
-    finally:
-        for x in ours:
-            ev.register("numba:compile", x)
     return _lsoda, _sig
 
 
