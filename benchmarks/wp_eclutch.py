@@ -9,7 +9,7 @@ Solvers, each over rtol = 1e-3 ... 1e-7 (clutchlab also 1e-8):
   ``bench_eclutch_dynamics.py`` (massless tip by Newton inside the right-hand side, friction on terminal
   events with restarts, restarts at the input corners), driven by :func:`run_scipy` (the state machine of
   clutchlab's ``update``/``restart``; see there why not ``bench_eclutch_dynamics.run_reference``).  Each run
-  is capped at ``--scipy-cap`` seconds of wall time (default 60 s, ``--quick`` 20 s); a capped run is
+  is capped at ``--scipy-cap`` seconds of wall time (default 60 s, ``--quick`` 10 s); a capped run is
   reported as such and has no point.
 * the compiled peer (``_peer_eclutch.py``): LSODA of ``numbalsoda`` (ODEPACK, switches to BDF when stiff)
   with a numba ``cfunc`` right-hand side and an ``njit`` driver that locates the friction events.
@@ -20,9 +20,11 @@ the seals' stick-slip micro-motions: clutchlab at rtol 1e-6, atol x 1e-3 takes 1
 The peer integrates the state scaled by those atol (``w = y / atol``) with LSODA's scalar atol 1.
 
 Error: max |F_b - F_b,ref| over 2001 points of [0, 1] s, relative to the peak of F_b,ref (F_b = p_s A_sl, the
-bearing force as the rig measures it).  Reference: the compiled peer at rtol 1e-10, atol x 1e-2 (LSODA,
-independent of clutchlab's integrator and event handling; its equations are tested against clutchlab's in
-tests/eclutch/test_peer_equations.py).  clutchlab's and the peer's F_b are read at the grid points (clutchlab:
+bearing force as the rig measures it).  Reference: SciPy Radau on the plain-Python equations at rtol 1e-9
+(default atol; about 8 s), independent of clutchlab's integrator, event handling and code; the peer at rtol
+1e-10 is printed as a cross-check.  The seals' stick-slip (tens to hundreds of located events, more the tighter
+the tolerance) makes F_b depend on the event sequence: independent solutions agree to about 1e-3 of peak, not
+better, so errors below that measure the disagreement with the reference, not accuracy.  clutchlab's and the peer's F_b are read at the grid points (clutchlab:
 ``output_step`` 0.5 ms; the peer: its sub-grid), SciPy's from its dense output.
 
 Run:  python benchmarks/wp_eclutch.py [--quick] [--scipy-cap SECONDS] [--no-scipy]
@@ -49,6 +51,7 @@ from clutchlab.eclutch import ClutchModel, EClutch, FrictionParameters  # noqa: 
 from clutchlab.eclutch.dynamics import _as_table  # noqa: E402
 
 GRID = np.linspace(0.0, T_END, 2001)
+REF_RTOL = 1e-9
 
 
 class _Capped(Exception):
@@ -152,19 +155,21 @@ def main(quick: bool = False, scipy_cap: float | None = None, with_scipy: bool =
     cl_rtols = rtols + [1e-8]
     rep_cl = 5 if quick else 11
     rep_peer = 1 if quick else 3
-    cap = scipy_cap if scipy_cap is not None else (20.0 if quick else 60.0)
+    cap = scipy_cap if scipy_cap is not None else (10.0 if quick else 60.0)
 
-    # reference: the peer at rtol 1e-10
+    # reference: SciPy Radau on the Python equations at rtol 1e-9 (atol the defaults)
+    t0 = time.perf_counter()
+    fb_ref, n_rhs, n_ev = run_scipy(ec, "Radau", REF_RTOL)
+    peak = np.abs(fb_ref).max()
+    print(f"reference: SciPy Radau (Python RHS) rtol {REF_RTOL:g}, default atol: {time.perf_counter() - t0:.1f} s, "
+          f"{n_rhs} RHS, {n_ev} events; peak F_b {peak:.1f} N")
     t0 = time.perf_counter()
     data = peer.pack(ec, tin, vin)
     peer.simulate(ec, tin, vin, T_END, 1e-3, data=data)  # compile the driver
     print(f"peer compiled/loaded in {time.perf_counter() - t0:.1f} s")
-    t0 = time.perf_counter()
-    T, FB, n_ev, ok = peer.simulate(ec, tin, vin, T_END, 1e-10, atol_scale=1e-2, data=data)
-    fb_ref = np.interp(GRID, T, FB)
-    peak = np.abs(fb_ref).max()
-    print(f"reference: peer LSODA rtol 1e-10, atol x 1e-2: {time.perf_counter() - t0:.1f} s, {n_ev} events, "
-          f"ok {ok}; peak F_b {peak:.1f} N")
+    T, FB, n_ev, ok = peer.simulate(ec, tin, vin, T_END, 1e-10, data=data)
+    print(f"cross-check: peer at rtol 1e-10 differs from the reference by "
+          f"{np.abs(np.interp(GRID, T, FB) - fb_ref).max() / peak:.1e} of peak ({n_ev} events)")
 
     def err(fb):
         return float(np.abs(fb - fb_ref).max() / peak)
@@ -220,7 +225,7 @@ def main(quick: bool = False, scipy_cap: float | None = None, with_scipy: bool =
             txt = ", ".join(f"{e:.1e}: " + (f"{q:.0f}x" if q is not None else "never as accurate") for e, q in rs)
             print(f"  vs {label:10s} ({cl.label}): {txt}")
     plot([core, sim, pe] + sci, os.path.join(os.path.dirname(os.path.abspath(__file__)), "wp_eclutch.png"),
-         "E-clutch dynamics 1 s, Model 4, friction on", "max |F_b error| / peak F_b (ref: peer rtol 1e-10)")
+         "E-clutch dynamics 1 s, Model 4, friction on", "max |F_b error| / peak F_b (ref: SciPy Radau rtol 1e-9)")
 
 
 if __name__ == "__main__":
