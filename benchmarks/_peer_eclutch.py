@@ -25,8 +25,6 @@ turns round.
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 from numba import types
