@@ -426,20 +426,9 @@ _DRIVER = {}
 
 
 def import_lsoda():
-    """``numbalsoda.lsoda``.  numbalsoda compiles functions whose ``__module__`` is None when it is imported;
-    clutchlab's compile-notice listener (``clutchlab._compile_notice._is_clutchlab``) calls ``.startswith``
-    on it and raises, so the listener is unregistered for the import (a bug of clutchlab, reported)."""
-    from numba.core import event as ev
+    """``numbalsoda.lsoda`` (the ``bench`` extra)."""
+    from numbalsoda import lsoda
 
-    mine = [lst for lst in list(ev._registered["numba:compile"])
-            if (type(lst).__module__ or "").startswith("clutchlab")]
-    for lst in mine:
-        ev.unregister("numba:compile", lst)
-    try:
-        from numbalsoda import lsoda
-    finally:
-        for lst in mine:
-            ev.register("numba:compile", lst)
     return lsoda
 
 
