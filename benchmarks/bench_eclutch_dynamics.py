@@ -12,7 +12,8 @@ Measured in one run:
 4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale) with ``prange`` on all threads
    against one thread.
 
-Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--build``: only the time to build one variant)
+Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--build``: only the time to build one variant;
+``--batch [--quick]``: only the batch, building included)
 """
 
 from __future__ import annotations
@@ -356,25 +357,45 @@ def main(quick: bool = False, friction_reference: bool = False):
               "pass --friction-reference to measure it)")
 
     # batch of 1,000 variants
+    batch_timing(quick)
+
+
+def batch_timing(quick: bool = False, rounds: int = 3) -> None:
+    """A batch of variants (lever ratio x diaphragm scale), friction on, **building included**: one thread
+    (build them all, then run them on one numba thread) against two (a list built, then run on two
+    threads; and a generator, each chunk of 64 run on two threads while the next is built).  Alternating
+    rounds, medians (min-max)."""
+    import statistics
+
     import numba
 
     n_r, n_s = (10, 10) if quick else (40, 25)
     ratios = np.linspace(-4.4, -3.6, n_r)
     scales = np.linspace(1.0, 1.5, n_s)
-    t0 = time.perf_counter()
-    ecs = [EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r, diaphragm_scale=d)),
-                   friction=FrictionParameters()) for r in ratios for d in scales]
-    t_build = time.perf_counter() - t0
-    simulate_batch(ecs[:2], INPUT, T_END, output_step=1e-3)  # compile / load cache
+
+    def variants():
+        return (EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r, diaphragm_scale=d)),
+                        friction=FrictionParameters()) for r in ratios for d in scales)
+
+    simulate_batch(list(variants())[:2], INPUT, T_END, output_step=1e-3)  # compile / load cache
     threads = numba.get_num_threads()
-    t_all, b = best_of(lambda: simulate_batch(ecs, INPUT, T_END, output_step=1e-3), 1)
-    numba.set_num_threads(1)
-    t_one, _ = best_of(lambda: simulate_batch(ecs, INPUT, T_END, output_step=1e-3), 1)
+    times = {"1 thread (build, then run)": [], f"{threads} threads (build, then run)": [],
+             f"{threads} threads (built while running)": []}
+    for _ in range(rounds):
+        for label in times:
+            numba.set_num_threads(1 if label.startswith("1 ") else threads)
+            t0 = time.perf_counter()
+            b = simulate_batch(variants() if "while" in label else list(variants()), INPUT, T_END, output_step=1e-3)
+            times[label].append(time.perf_counter() - t0)
     numba.set_num_threads(threads)
-    print(f"batch of {len(ecs)} variants with friction (lever ratio x diaphragm scale; building the models "
-          f"{t_build:.1f} s): {t_all:.2f} s on {threads} threads vs {t_one:.2f} s on 1 ({t_one / t_all:.2f}x); "
-          f"{(b.stats.status == 0).sum()} of {len(ecs)} finished; {len(ecs) * T_END / t_all:,.0f} simulated "
-          "seconds per second")
+    n = n_r * n_s
+    print(f"batch of {n} variants with friction, building included, medians of {rounds} alternating rounds:")
+    base = statistics.median(times["1 thread (build, then run)"])
+    for label, ts in times.items():
+        med = statistics.median(ts)
+        print(f"  {label:40s} {med:6.2f} s ({min(ts):.2f}-{max(ts):.2f})  {base / med:4.2f}x the one thread; "
+              f"{n * T_END / med:,.0f} simulated seconds per second")
+    print(f"  {(b.stats.status == 0).sum()} of {n} finished")
 
 
 def build_timing(repeat: int = 21) -> None:
@@ -403,6 +424,8 @@ def build_timing(repeat: int = 21) -> None:
 if __name__ == "__main__":
     if "--build" in sys.argv:
         build_timing()
+    elif "--batch" in sys.argv:
+        batch_timing(quick="--quick" in sys.argv)
     elif "--reference-only" in sys.argv:
         reference_only()
     else:

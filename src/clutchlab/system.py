@@ -861,15 +861,19 @@ def _write_back(dst, src, v) -> None:
 
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
-                   event_capacity: int = 256, check: bool = False, fixed_step: float | None = None) -> SimulationResult:
+                   event_capacity: int = 256, check: bool = False, fixed_step: float | None = None,
+                   chunk: int = 64) -> SimulationResult:
     """Simulate variants of one model in parallel: one solver per variant (``numba.prange``).
 
     Parameters
     ----------
-    systems : Variants or sequence of System
+    systems : Variants, sequence of System or iterator of System
         Variants of one model with equal parameter sizes: a :class:`Variants` (parameters already
         stacked; memories the model keeps in them are written there), or systems, stacked here (their
-        parameter arrays get the memories back after the run).
+        parameter arrays get the memories back after the run).  An **iterator** (a generator that builds
+        each variant) is drawn in chunks of ``chunk``: each chunk runs on all cores in a background thread
+        while the next is being built, so building the variants (Python) and simulating them (compiled,
+        without the interpreter lock) overlap.
     t_end : float
         End time [s].
     sample_times, output_step
@@ -884,6 +888,8 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         Raise if any variant failed (otherwise see ``status``).
     fixed_step : float, optional
         Fixed-step mode with this step [s] for every variant, as :func:`simulate`.
+    chunk : int
+        Variants per chunk when ``systems`` is an iterator (default 64).
 
     Returns
     -------
@@ -891,39 +897,48 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         Stacked: ``states[v, i, :]``; ``status`` one code per variant; events with a ``variant`` column.
     """
     core = _numerics_core()
-
-    given = None
-    if isinstance(systems, Variants):
-        batch = systems
+    if isinstance(systems, Variants) or hasattr(systems, "__len__"):
+        batch, given = (systems, None) if isinstance(systems, Variants) else (None, list(systems))
+        batch = batch if batch is not None else Variants.stack(given)
+        if len(batch) == 0:
+            raise ParameterError("simulate_batch: no variants")
+        first = batch.system
+        ts, opt = _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, max_steps, fixed_step)
+        parts = [_run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity)]
     else:
-        given = list(systems)
-        batch = Variants.stack(given)
-    first = batch.system
-    ts = sample_grid(0.0, float(t_end), output_step, sample_times)
-    if ts is None:
-        ts = np.array([float(t_end)])
-    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
-    nv, ns = len(batch), ts.size
-    if nv == 0:
-        raise ParameterError("simulate_batch: no variants")
-    nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
-    check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
-    X0 = batch.x0.copy()
-    M0 = batch.m0.copy()
-    OX = np.full((nv, ns, nx), np.nan)
-    OM = np.zeros((nv, ns, nm), dtype=np.int64)
-    OY = np.full((nv, ns, ny) if outputs else (nv, 1, ny), np.nan)
-    STATS = np.zeros((nv, core.N_SI), dtype=np.int64)
-    EVT = np.zeros((nv, event_capacity))
-    EVC = np.zeros((nv, event_capacity), dtype=np.int64)
-    EVE = np.zeros((nv, event_capacity), dtype=np.int64)
-    EVN = np.zeros((nv, 2), dtype=np.int64)
-    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, X0, M0, batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS,
-               EVT, EVC, EVE, EVN)
-    if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
-        for v, s in enumerate(given):
-            for dst, src in zip(s.params, batch.params):
-                _write_back(dst, src, v)
+        if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+            raise ParameterError(f"simulate_batch: chunk = {chunk!r} must be a positive integer")
+        first, ts, opt, parts = None, None, None, []
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="clutchlab-batch") as pool:
+            running = []
+            it = iter(systems)
+            while True:
+                given = []
+                for s in it:
+                    given.append(s)
+                    if len(given) == chunk:
+                        break
+                if not given:
+                    break
+                batch = Variants.stack(given)
+                if first is None:
+                    first = batch.system
+                    ts, opt = _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step,
+                                           max_steps, fixed_step)
+                elif (batch.system.state_columns, batch.system.output_columns, batch.system.mode_names) != (
+                        first.state_columns, first.output_columns, first.mode_names):
+                    raise ParameterError(f"simulate_batch: variant {sum(len(r[1]) for r in running)} has other "
+                                         f"states, outputs or modes than variant 0 ({first.name!r})")
+                running.append((pool.submit(_run_stacked, core, batch, given, ts, opt, t_end, outputs,
+                                            event_capacity), given))
+            parts = [f.result() for f, _ in running]
+        if first is None:
+            raise ParameterError("simulate_batch: no variants")
+    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = (np.concatenate([p[k] for p in parts]) if len(parts) > 1 else parts[0][k]
+                                            for k in range(8))
+    nv, ns, ny = OX.shape[0], ts.size, len(first.outputs)
     status = STATS[:, core.SI_STATUS].copy()
     if check:
         bad = np.flatnonzero(~np.isin(status, [st.SUCCESS, st.TERMINATED]))
@@ -940,6 +955,41 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
              "events_dropped": EVN[:, 1].copy()}
     return SimulationResult(ts, OX, OY, OM, events, status, first.state_columns, first.output_columns,
                             tuple(first.mode_names), tuple(first.mode_values), stats, first.name)
+
+
+def _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, max_steps, fixed_step):
+    """Sample times and solver options of a batch, from its first variant."""
+    ts = sample_grid(0.0, float(t_end), output_step, sample_times)
+    if ts is None:
+        ts = np.array([float(t_end)])
+    return ts, first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
+
+
+def _run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity):
+    """Run one stacked batch on all cores (the compiled loop releases the interpreter lock); returns
+    (states, modes, outputs, counters, event times, codes, elements, counts).  The memories each variant's
+    model kept go back into its own parameter arrays (``given``: the systems stacked, or None)."""
+    first = batch.system
+    nv, ns = len(batch), ts.size
+    nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
+    check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
+    X0 = batch.x0.copy()
+    M0 = batch.m0.copy()
+    OX = np.full((nv, ns, nx), np.nan)
+    OM = np.zeros((nv, ns, nm), dtype=np.int64)
+    OY = np.full((nv, ns, ny) if outputs else (nv, 1, ny), np.nan)
+    STATS = np.zeros((nv, core.N_SI), dtype=np.int64)
+    EVT = np.zeros((nv, event_capacity))
+    EVC = np.zeros((nv, event_capacity), dtype=np.int64)
+    EVE = np.zeros((nv, event_capacity), dtype=np.int64)
+    EVN = np.zeros((nv, 2), dtype=np.int64)
+    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, X0, M0, batch.u0, float(t_end), ts,
+               opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE, EVN)
+    if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
+        for v, s in enumerate(given):
+            for dst, src in zip(s.params, batch.params):
+                _write_back(dst, src, v)
+    return OX, OM, OY, STATS, EVT, EVC, EVE, EVN
 
 
 def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):

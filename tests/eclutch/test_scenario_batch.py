@@ -107,6 +107,22 @@ def test_batch_equals_single_runs():
     assert peaks[0] < peaks[1] < peaks[2]
 
 
+def test_batch_of_variants_built_while_earlier_ones_run_equals_the_list():
+    """A generator of variants is built chunk by chunk while the chunks before it run: the same outputs
+    and counters as the list; a variant of another structure is refused by its number."""
+    ratios = (-4.2, -3.9, -3.6, -4.0, -3.7)
+    make = lambda: (EClutch(clutch=ClutchModel.preset(4, EClutchParameters(lever_ratio=r)),  # noqa: E731
+                            friction=FrictionParameters()) for r in ratios)
+    inp = {"bearing_reference": ([0.0, 0.05, 0.2, 0.4, 0.5], [0.0, 0.0, 7e-3, 7e-3, 0.0])}
+    listed = simulate_batch(list(make()), inp, 0.6, output_step=2e-3)
+    drawn = simulate_batch(make(), inp, 0.6, output_step=2e-3, chunk=2)
+    for key, value in listed.outputs.items():
+        np.testing.assert_array_equal(drawn.outputs[key], value, err_msg=key)
+    assert drawn.stats.equals(listed.stats) and len(drawn.stats) == len(ratios)
+    mixed = iter([EClutch(clutch=ClutchModel.preset(4)), EClutch(clutch=ClutchModel.preset(1))])
+    with pytest.raises(ParameterError, match="variant 1 has another model structure"):
+        simulate_batch(mixed, {"voltage": 0.0}, 0.1, chunk=1)
+
 def test_batch_rejects_different_structures():
     with pytest.raises(ParameterError, match="structure"):
         simulate_batch([EClutch(clutch=ClutchModel.preset(4)), EClutch(clutch=ClutchModel.preset(1))],

@@ -256,6 +256,37 @@ def test_batch_equals_single_runs(method):
     assert list(batch.status) == [Status.TERMINATED] * 3
 
 
+@pytest.mark.parametrize("chunk", [1, 2, 64])
+def test_batch_from_a_generator_equals_the_list(chunk):
+    """Variants drawn from a generator run chunk by chunk while the next chunk is built: the same states,
+    events (numbered across the chunks), counters and memories as the list of the same systems."""
+    cases = [(1.0, 0.5), (2.0, 0.7), (0.3, 0.4), (1.5, 0.6), (0.8, 0.3)]
+    listed = simulate_batch([toys.ball_system(h0, e) for h0, e in cases], 3.0, output_step=0.1, event_capacity=16)
+    built = []
+
+    def make():
+        for h0, e in cases:
+            built.append((h0, e))
+            yield toys.ball_system(h0, e)
+
+    drawn = simulate_batch(make(), 3.0, output_step=0.1, event_capacity=16, chunk=chunk)
+    assert built == cases
+    assert np.array_equal(drawn.states, listed.states, equal_nan=True) and np.array_equal(drawn.modes, listed.modes)
+    assert drawn.events.equals(listed.events) and set(drawn.events.variant) == set(range(len(cases)))
+    for key in listed.stats:
+        assert np.array_equal(drawn.stats[key], listed.stats[key]), key
+    assert list(drawn.status) == list(listed.status)
+
+
+def test_batch_from_a_generator_refuses_bad_requests():
+    with pytest.raises(ParameterError, match="no variants"):
+        simulate_batch(iter(()), 1.0)
+    with pytest.raises(ParameterError, match="chunk = 0"):
+        simulate_batch(iter([toys.linear_system([[-1.0]], [1.0])]), 1.0, chunk=0)
+    mixed = iter([toys.linear_system([[-1.0]], [1.0]), toys.linear_system(OSC, [1.0, 0.0])])
+    with pytest.raises(ParameterError, match="variant 1 has other states"):
+        simulate_batch(mixed, 1.0, chunk=1)
+
 def test_stacked_variants_equal_single_runs_and_the_list_of_systems():
     """A batch given as :class:`Variants` (parameters stacked along a first axis) runs each variant on its row.
 

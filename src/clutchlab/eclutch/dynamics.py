@@ -876,7 +876,7 @@ class BatchResult:
 
 def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3, rtol: float = 1e-3,
                    max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
-                   event_tol: float = 1e-8, jac_every: int = 10) -> BatchResult:
+                   event_tol: float = 1e-8, jac_every: int = 10, chunk: int = 64) -> BatchResult:
     """Simulate many E-clutch variants in parallel, one Rodas3 solver per variant (numba ``prange``).
 
     A thin wrapper of :func:`clutchlab.system.simulate_batch` over the variants' systems
@@ -884,46 +884,56 @@ def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3
 
     Parameters
     ----------
-    eclutches : sequence of EClutch
+    eclutches : sequence or iterator of EClutch
         The variants, e.g. a sweep of lever ratio and stiffness scales.  They
         must share the model structure (same coordinates, elements and friction
         placement); parameters, masses, lever ratios, pre-strains, stiffness
-        scales, component curves and actuator parameters may differ.
+        scales, component curves and actuator parameters may differ.  Pass a
+        generator that builds them (``(EClutch(...) for r in ratios)``) and the
+        building overlaps the runs: each chunk of ``chunk`` variants runs on all
+        cores while the next is built.
     inputs : dict
         As in :meth:`EClutch.simulate` (one input for every variant).
     t_end, output_step : float
         End time and output grid step [s].
     rtol, max_step, h_max, max_steps, event_tol, jac_every
         As in :meth:`EClutch.simulate`.
+    chunk : int
+        Variants per chunk when ``eclutches`` is an iterator (default 64).
 
     Returns
     -------
     BatchResult
     """
-    ecs = list(eclutches)
-    if not ecs:
-        raise ParameterError("simulate_batch: no variants given")
-    for k, ec in enumerate(ecs):
-        if not isinstance(ec, EClutch):
-            raise ParameterError(f"simulate_batch: variant {k} is a {type(ec).__name__}, not an EClutch")
     t_end = float(t_end)
     _check_run(t_end, rtol, max_steps)
     grid = _grid(output_step, t_end)
     h = _max_step(max_step, h_max)
-    sig = ecs[0].assembly.signature()
-    for k, ec in enumerate(ecs[1:], start=1):
-        if ec.assembly.signature() != sig:
-            raise ParameterError(f"simulate_batch: variant {k} has another model structure than variant 0 "
-                                 "(coordinates, elements and friction placement must be shared)")
-    systems = [ec.as_system(inputs, rtol=rtol, max_step=h, event_tol=event_tol, jac_every=jac_every) for ec in ecs]
-    res = contract.simulate_batch(systems, t_end, sample_times=grid, max_steps=int(max_steps), check=False)
+    sig = []
+
+    def systems():
+        for k, ec in enumerate(eclutches):
+            if not isinstance(ec, EClutch):
+                raise ParameterError(f"simulate_batch: variant {k} is a {type(ec).__name__}, not an EClutch")
+            if not sig:
+                sig.append(ec.assembly.signature())
+            elif ec.assembly.signature() != sig[0]:
+                raise ParameterError(f"simulate_batch: variant {k} has another model structure than variant 0 "
+                                     "(coordinates, elements and friction placement must be shared)")
+            yield ec.as_system(inputs, rtol=rtol, max_step=h, event_tol=event_tol, jac_every=jac_every)
+
+    # a sequence is checked and stacked at once; an iterator is built chunk by chunk while the chunks
+    # before it run (clutchlab.system.simulate_batch)
+    source = list(systems()) if hasattr(eclutches, "__len__") else systems()
+    res = contract.simulate_batch(source, t_end, sample_times=grid, max_steps=int(max_steps), check=False,
+                                  chunk=chunk)
     keys = ["bearing_position_m", "bearing_velocity_m_s", "pressure_Pa", "master_pressure_Pa", "bearing_force_N",
             "bearing_force_clutch_N", "motor_current_A", "motor_voltage_V", "master_position_m", "normal_force_N",
             "torque_Nm", "input_work_J", "dissipated_J", "friction_dissipated_J"]
     if "reference_m" in res.output_columns:
         keys.append("reference_m")
     out = {k: res[k] for k in keys}
-    nv = len(ecs)
+    nv = res.states.shape[0]
     counts = res.events["variant"].value_counts() if len(res.events) else pd.Series(dtype=int)
     stats = pd.DataFrame({
         "accepted_steps": res.stats["accepted_steps"], "rejected_steps": res.stats["rejected_steps"],

@@ -59,7 +59,7 @@ from clutchlab.numerics.entry import rehome as _rehome
 {advance}
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, nogil=True)
 def batch(P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
     nv = X0.shape[0]
     ns = ts.shape[0]
