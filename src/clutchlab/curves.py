@@ -26,12 +26,14 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+from numba import uintp as _u
 
 from ._limits import short_repr
 from .errors import DataError, ParameterError
-from .numerics.interp import bracket
+from .numerics.interp import bracket_range
 
-__all__ = ["Curve", "series", "parallel", "curve_eval", "KIND_CODES", "EXTRAPOLATION_CODES"]
+__all__ = ["Curve", "series", "parallel", "curve_eval", "curve_eval_range", "curve_eval_segment", "KIND_CODES",
+           "EXTRAPOLATION_CODES"]
 
 KIND_CODES = {"linear": 0, "pchip": 1}
 EXTRAPOLATION_CODES = {"linear": 0, "error": 1}
@@ -74,28 +76,65 @@ def curve_eval(xs, fs, ds, kind, extrap, x):
     (force, stiffness) : (float, float)
         Force [N] and slope dF/dx [N/m].
     """
-    n = xs.shape[0]
-    if x <= xs[0] or x >= xs[n - 1]:
-        if x < xs[0] or x > xs[n - 1]:
+    return curve_eval_range(xs, fs, ds, 0, xs.shape[0], kind, extrap, x)
+
+
+@numba.njit(cache=True, nogil=True, forceinline=True)
+def curve_eval_range(xs, fs, ds, start, stop, kind, extrap, x):
+    """:func:`curve_eval` of the curve held in ``xs[start:stop]`` (``fs``, ``ds`` alike) of packed arrays.
+
+    Indexing into the packed arrays of a network's curves instead of slicing them saves building an array
+    structure per look-up.  Arguments and result as :func:`curve_eval`; ``start``, ``stop``: the curve's
+    samples (non-negative: they are read as unsigned indices, without numba's wrap-around test).
+    """
+    val, der, _seg = curve_eval_segment(xs, fs, ds, start, stop, kind, extrap, x, -1)
+    return val, der
+
+
+@numba.njit(cache=True, nogil=True, forceinline=True)
+def curve_eval_segment(xs, fs, ds, start, stop, kind, extrap, x, hint):
+    """:func:`curve_eval_range` starting the search at segment ``hint``; also returns the segment used.
+
+    The one implementation of the curve law (:func:`curve_eval` and :func:`curve_eval_range` call it).  A
+    right-hand side evaluates each curve close to where it did last time: checking the segment of the
+    previous look-up first (``hint``, an index into ``xs``; -1: none) spares the binary search and its
+    unpredictable branches.  The segment is the one the binary search finds (``xs[lo] <= x < xs[lo + 1]``),
+    so the result does not depend on the hint.
+
+    Returns
+    -------
+    (force, stiffness, segment) : (float, float, int)
+        Force [N], slope dF/dx [N/m] and the segment's first sample (-1 outside the samples).
+    """
+    first = _u(start)
+    last = _u(stop - 1)
+    if x <= xs[first] or x >= xs[last]:
+        if x < xs[first] or x > xs[last]:
             if extrap == 1:
-                return np.nan, np.nan
-        if x <= xs[0]:
+                return np.nan, np.nan, -1
+        if x <= xs[first]:
             if kind == 0:
-                s = (fs[1] - fs[0]) / (xs[1] - xs[0])
+                s = (fs[first + _u(1)] - fs[first]) / (xs[first + _u(1)] - xs[first])
             else:
-                s = ds[0]
-            return fs[0] + s * (x - xs[0]), s
+                s = ds[first]
+            return fs[first] + s * (x - xs[first]), s, -1
         if kind == 0:
-            s = (fs[n - 1] - fs[n - 2]) / (xs[n - 1] - xs[n - 2])
+            s = (fs[last] - fs[last - _u(1)]) / (xs[last] - xs[last - _u(1)])
         else:
-            s = ds[n - 1]
-        return fs[n - 1] + s * (x - xs[n - 1]), s
-    lo, t = bracket(xs, x)  # segment xs[lo] <= x <= xs[lo+1], binary search
-    hi = lo + 1
+            s = ds[last]
+        return fs[last] + s * (x - xs[last]), s, -1
+    if start <= hint < stop - 1 and xs[_u(hint)] <= x < xs[_u(hint + 1)]:
+        k = hint
+        lo = _u(k)
+        t = (x - xs[lo]) / (xs[lo + _u(1)] - xs[lo])
+    else:
+        k, t = bracket_range(xs, start, stop, x)  # segment xs[lo] <= x <= xs[lo+1], binary search
+        lo = _u(k)
+    hi = lo + _u(1)
     h = xs[hi] - xs[lo]
     if kind == 0:
         s = (fs[hi] - fs[lo]) / h
-        return fs[lo] + s * (x - xs[lo]), s
+        return fs[lo] + s * (x - xs[lo]), s, k
     t2 = t * t
     t3 = t2 * t
     h00 = 2.0 * t3 - 3.0 * t2 + 1.0
@@ -108,7 +147,7 @@ def curve_eval(xs, fs, ds, kind, extrap, x):
     dh01 = (-6.0 * t2 + 6.0 * t) / h
     dh11 = 3.0 * t2 - 2.0 * t
     der = dh00 * fs[lo] + dh10 * ds[lo] + dh01 * fs[hi] + dh11 * ds[hi]
-    return val, der
+    return val, der, k
 
 
 @numba.njit(cache=True, nogil=True)

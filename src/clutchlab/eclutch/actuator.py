@@ -49,6 +49,8 @@ __all__ = [
     # scalar compiled equations (the dynamics' right-hand side and the vectorised functions above call them)
     "current_rate", "spindle_force", "drive_voltage", "controller_voltage", "controller_integral_rate",
     "vent_opening", "cavitating_compliance", "chamber_pressure_rate", "line_flow_rate", "stop_contact",
+    # their slopes (the analytic Jacobian of the dynamics)
+    "drive_voltage_slopes", "vent_opening_slope", "stop_contact_slopes",
 ]
 
 _REP = "representative passenger-car E-clutch actuator (docs/eclutch_dynamics.md)"
@@ -420,6 +422,58 @@ def stop_contact(penetration, rate, stiffness, damping):
         return 0.0, 0.0
     f = max(stiffness * penetration + damping * penetration * rate, 0.0)
     return f, (f - stiffness * penetration) * rate
+
+
+# ---------------------------------------------------------------------------
+# slopes of the piecewise equations above, for the analytic Jacobian of the dynamics
+# (clutchlab.eclutch.system.jacobian); each is the derivative of the function it names, on the branch the
+# point lies on (at a kink the branch of the function's own comparison, as a one-sided difference would see it)
+# ---------------------------------------------------------------------------
+
+@numba.njit(cache=True, nogil=True)
+def drive_voltage_slopes(command, current, supply, current_limit, limit_gain):
+    """Partial derivatives of :func:`drive_voltage`: ``(dV/dV_cmd [-], dV/di [V/A])``.
+
+    Inside the supply range the voltage follows the command (slope 1) and, above the current limit,
+    falls with ``K_il`` per ampere of excess; once clipped at ``+-V_sup`` it depends on neither.
+    Arguments as :func:`drive_voltage`.
+    """
+    v = command
+    d_cmd = 1.0
+    if v < -supply or v > supply:
+        v = min(max(v, -supply), supply)
+        d_cmd = 0.0
+    d_i = 0.0
+    excess = abs(current) - current_limit
+    if excess > 0.0:
+        v -= limit_gain * excess * (1.0 if current > 0.0 else -1.0)
+        d_i = -limit_gain
+        if v < -supply or v > supply:
+            d_cmd = 0.0
+            d_i = 0.0
+    return d_cmd, d_i
+
+
+@numba.njit(cache=True, nogil=True)
+def vent_opening_slope(x_mc, port, width):
+    """Derivative of :func:`vent_opening` with respect to the master position, ``-1/w`` inside the port [1/m]."""
+    s = (port - x_mc) / width
+    return -1.0 / width if 0.0 < s < 1.0 else 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def stop_contact_slopes(penetration, rate, stiffness, damping):
+    """Partial derivatives of :func:`stop_contact`: ``(dF/dd, dF/dd', dP/dd, dP/dd')``.
+
+    Units: N/m, N s/m, W/m, W s/m.  In contact with a pushing force, ``F = k d + c d d'`` and
+    ``P = c d d'^2``; when the damping would pull (``F`` clipped at 0), ``F = 0`` and ``P = -k d d'``.
+    """
+    if penetration <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    if stiffness * penetration + damping * penetration * rate > 0.0:
+        return (stiffness + damping * rate, damping * penetration, damping * rate * rate,
+                2.0 * damping * penetration * rate)
+    return 0.0, 0.0, -stiffness * rate, -stiffness * penetration
 
 
 @numba.njit(cache=True, nogil=True)

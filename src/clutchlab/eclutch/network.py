@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from ..curves import Curve, curve_eval
+from ..curves import Curve, curve_eval_segment
 from .._limits import short_repr
 from ..errors import ParameterError, SimulationError
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -431,19 +431,30 @@ def element_force(e, q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scal
         contact law, and the force before it [N] (its sign says whether a
         unilateral element is in contact: the contact's switching function).
     """
+    de, fe, ke, free, _seg = element_force_segment(e, q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
+                                                   unilateral, -1)
+    return de, fe, ke, free
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def element_force_segment(e, q, u, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, hint):
+    """:func:`element_force` with the curve's segment of a previous look-up as a hint, and the segment used.
+
+    The one implementation of the element law (:func:`element_force` calls it without a hint); the hint
+    (:func:`clutchlab.curves.curve_eval_segment`) only spares the search, the result is the same.  Returns
+    ``(d, f, k, f_free, segment)``.
+    """
     de = d0[e] + Gb[e] * u
     for j in range(GA.shape[1]):
         de += GA[e, j] * q[j]
-    lo = offsets[e]
-    hi = offsets[e + 1]
-    fe, ke = curve_eval(cx[lo:hi], cf[lo:hi], cd[lo:hi], kinds[e], extraps[e], de)
+    fe, ke, seg = curve_eval_segment(cx, cf, cd, offsets[e], offsets[e + 1], kinds[e], extraps[e], de, hint)
     fe *= scale[e]
     ke *= scale[e]
     free = fe
     if unilateral[e] and fe <= 0.0:
         fe = 0.0
         ke = 0.0
-    return de, fe, ke, free
+    return de, fe, ke, free, seg
 
 
 @numba.njit(cache=True, nogil=True)

@@ -53,14 +53,14 @@ from ..numerics.core import record
 from ..numerics.interp import bracket
 from ..system import System, register_model, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
-                       controller_voltage, current_rate, drive_voltage, line_flow_rate, spindle_force, stop_contact,
-                       vent_opening)
+                       controller_voltage, current_rate, drive_voltage, drive_voltage_slopes, line_flow_rate,
+                       spindle_force, stop_contact, stop_contact_slopes, vent_opening, vent_opening_slope)
 from .friction import kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
-from .network import GROUND, Lever, element_force, solve_static
+from .network import GROUND, Lever, element_force, element_force_segment, solve_static
 
 __all__ = ["EClutchParams", "Assembly", "eclutch_system", "rhs", "outputs", "update", "restart", "accept",
-           "next_break", "jacobian", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
+           "next_break", "jacobian", "time_derivative", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
 
 # actuator parameter vector layout (EClutchParams.par)
 P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF = range(13)
@@ -96,7 +96,10 @@ CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS =
 CI_FRICTION, CI_NORMAL, CI_PRESSURE = range(3)  # coord_int: Coulomb friction on, pressing element, chamber
 NE_D0, NE_GB, NE_SCALE = range(3)  # net [float]: pre-deflection, input gain, stiffness scale
 NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = range(4)  # net_int: curve offsets, kind, extrapolation, contact
-W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X = range(7)  # work rows
+# work rows; W_K: element stiffnesses (rhs, jacobian); W_KEY: the point (t, x, m) of the last rhs evaluation;
+# W_SEG: each element curve's segment at the last look-up (a search hint; integers held as floats)
+W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = range(10)
+N_WORK = 10
 
 
 class EClutchParams(NamedTuple):
@@ -128,7 +131,7 @@ class EClutchParams(NamedTuple):
     normal_element: int      # element carrying the clamp (normal) force
     r_eff: float             # effective friction radius [m]
     mu: float                # friction coefficient of the facings [-]
-    work: np.ndarray         # (7, n): scratch rows W_*
+    work: np.ndarray         # (N_WORK, n): scratch rows W_*
 
 
 # ---------------------------------------------------------------- compiled hooks
@@ -228,10 +231,15 @@ def rhs(t, x, u, m, p, dx, g):
     bearing_force = 0.0
     for j in range(nz):
         Fz[j] = 0.0
+    kel = work[W_K]
+    seg = work[W_SEG]
     for e in range(n_el):
-        _d, fe, _k, fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
+        _d, fe, ke, fr, sg = element_force_segment(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
+                                                   unilateral, int(seg[e]))
+        seg[e] = sg
         free[e] = fr
         f[e] = fe
+        kel[e] = ke
         bearing_force += Gb[e] * fe
         for j in range(nq):
             Fz[2 + j] -= GA[e, j] * fe
@@ -336,10 +344,38 @@ def rhs(t, x, u, m, p, dx, g):
     aux[1] = bearing_force
     aux[2] = ref
     aux[3] = ub
+    _store_key(work[W_KEY], t, x, m)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _store_key(key, t, x, m):
+    """Remember the point ``(t, x, m)`` of an evaluation (in a work row)."""
+    n = x.shape[0]
+    key[0] = t
+    for i in range(n):
+        key[1 + i] = x[i]
+    for i in range(m.shape[0]):
+        key[1 + n + i] = m[i]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _is_key(key, t, x, m):
+    """True if the last evaluation was at exactly ``(t, x, m)`` (its element forces and stiffnesses hold)."""
+    n = x.shape[0]
+    if key[0] != t:
+        return False
+    for i in range(n):
+        if key[1 + i] != x[i]:
+            return False
+    for i in range(m.shape[0]):
+        if key[1 + n + i] != m[i]:
+            return False
+    return True
 
 
 @numba.njit(cache=True, nogil=True)
-def _equilibrate(x, ub, p):
+def _equilibrate(x, ub, p, known):
+
     """Massless nodes of ``x`` moved into equilibrium (Newton on their force balance, in place).
 
     The state at a sample comes from the dense output of a step, which is linear in the algebraic rows and
@@ -349,6 +385,7 @@ def _equilibrate(x, ub, p):
     nz = p.nz
     GA = p.GA
     coord = p.coord
+    work = p.work
     d0, Gb, scale, offsets, kinds, extraps, unilateral, cx, cf, cd = _network(p)
     q = x[2:nz]
     for _it in range(6):
@@ -361,14 +398,20 @@ def _equilibrate(x, ub, p):
             for e in range(GA.shape[0]):
                 if GA[e, j - 2] == 0.0:
                     continue
-                _d, fe, ke, _fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale,
-                                                unilateral)
+                if known:
+                    # the point of the last evaluation (a step end): its element forces and stiffnesses
+                    fe = work[W_F, e]
+                    ke = work[W_K, e]
+                else:
+                    _d, fe, ke, _fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps,
+                                                    scale, unilateral)
                 r -= GA[e, j - 2] * fe
                 dr -= GA[e, j - 2] * GA[e, j - 2] * ke
             if dr != 0.0:
                 dq = r / dr
                 x[j] -= dq
                 worst = max(worst, abs(dq))
+                known = False  # the point moved
         if worst <= 1e-9:  # [m]: Newton converges quadratically: after a step this small ~1e-17 m are left
             break
 
@@ -385,7 +428,7 @@ def outputs(t, x, u, m, p, y):
         ub, _slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
     else:
         ub = x[1]
-    _equilibrate(xs, ub, p)
+    _equilibrate(xs, ub, p, _is_key(work[W_KEY], t, x, m))
     dispatch.rhs(t, xs, u, m, p, work[W_DX], work[W_G])  # the compiled rhs the core uses (one compilation)
     aux = work[W_AUX]
     f = work[W_F]
@@ -521,14 +564,281 @@ def next_break(t, m, p):
     return tin[k] if k < tin.shape[0] else np.inf
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _force_row(j, nz, coord):
+    """Row of the Jacobian that holds coordinate ``j``'s force balance: its velocity row, or its position row
+    for a massless node (algebraic row)."""
+    return nz + j if coord[CO_MASS, j] > 0.0 else j
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _stop_rows(J, fr, e_row, c_pos, c_vel, sign, pen, rate, ks, cst):
+    """Add an end stop's force (``sign`` +1 pushes the coordinate forward) and dissipation to the Jacobian.
+
+    ``pen``/``rate`` are the penetration and its rate as :func:`rhs` passes them; their derivatives with
+    respect to the coordinate's position and velocity are ``-sign`` (a stop pushing forward is penetrated by
+    moving backward).
+    """
+    dfd, dfr, dpd, dpr = stop_contact_slopes(pen, rate, ks, cst)
+    J[fr, c_pos] -= dfd  # d(sign * F)/dz = sign * dF/dd * (-sign)
+    J[fr, c_vel] -= dfr
+    J[e_row, c_pos] -= sign * dpd
+    J[e_row, c_vel] -= sign * dpr
+
+
 @numba.njit(cache=True, nogil=True)
 def jacobian(t, x, u, m, p, J):
-    """No analytic Jacobian: the core differences the right-hand side (kink-aware)."""
-    return False
+    """Analytic Jacobian ``J = df/dx`` of :func:`rhs` in the modes ``m`` (mass-matrix form, residual rows).
+
+    The derivative of every term of the right-hand side, assembled from the slopes of the same scalar
+    equations: the elements' tangent stiffnesses from their curves ([1] Figs. 5b, 10-11;
+    :func:`~clutchlab.eclutch.network.element_force`), the actuator's linear laws ([1] Sec. 2.1, Fig. 5a)
+    and the slopes of its piecewise ones (:func:`~clutchlab.eclutch.actuator.drive_voltage_slopes`,
+    :func:`~clutchlab.eclutch.actuator.vent_opening_slope`,
+    :func:`~clutchlab.eclutch.actuator.stop_contact_slopes`), the kinetic friction's dependence on the
+    normal force and the chamber pressure.  Inside a mode the right-hand side is smooth except at the kinks
+    that are switching functions (contacts, stops, cavitation, the current limit, the snifting port); there
+    the slope of the branch the point lies on is taken.  The compliance switch at the vapour pressure is
+    piecewise constant (no slope).  The energy states enter no equation (zero columns).  Tested against
+    central differences of :func:`rhs` at random states and modes (tests/eclutch/test_jacobian.py).
+    Replaces the core's 17 finite-difference evaluations of the right-hand side per Jacobian.
+    """
+    nz = p.nz
+    GA = p.GA
+    coord = p.coord
+    coord_int = p.coord_int
+    par = p.par
+    work = p.work
+    d0, Gb, scale, offsets, kinds, extraps, unilateral, cx, cf, cd = _network(p)
+    f = work[W_F]
+    kel = work[W_K]
+    work[W_KEY, 0] = np.nan  # the element rows are overwritten here: no longer those of the last rhs point
+    n = x.shape[0]
+    nq = nz - 2
+    n_el = GA.shape[0]
+    b0 = 2 * nz
+    prescribed = p.imode == PRESCRIBED
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+    x_mc = x[0]
+    v_mc = x[nz]
+    p_m = x[b0]
+    Q = x[b0 + 1]
+    p_s = x[b0 + 2]
+    cur = x[b0 + 3]
+    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
+    if prescribed:
+        ub = ref
+        v_u = ref_slope
+        cu = -1  # the bearing position is no state: no column
+    else:
+        ub = x[1]
+        v_u = x[nz + 1]
+        cu = 1
+    e_in = b0 + 5
+    e_dis = b0 + 6
+    e_fr = b0 + 7
+    # --- network: dFz_j/dq_i = -sum_e GA_ej k_e GA_ei, dFz_1/dq_i = -sum_e Gb_e k_e GA_ei ([1] Figs. 5b, 10-11)
+    q = x[2:nz]
+    bearing_force = 0.0
+    for e in range(n_el):
+        _d, fe, ke, _fr = element_force(e, q, ub, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
+        f[e] = fe
+        kel[e] = ke
+        bearing_force += Gb[e] * fe
+        if ke == 0.0:
+            continue
+        for j in range(nq):
+            gj = GA[e, j] * ke
+            if gj == 0.0:
+                continue
+            fr = _force_row(2 + j, nz, coord)
+            for i in range(nq):
+                J[fr, 2 + i] -= gj * GA[e, i]
+            if cu >= 0:
+                J[fr, cu] -= gj * Gb[e]
+        gb = Gb[e] * ke
+        if gb != 0.0:
+            fr = _force_row(1, nz, coord)
+            for i in range(nq):
+                J[fr, 2 + i] -= gb * GA[e, i]
+            if cu >= 0:
+                J[fr, cu] -= gb * Gb[e]
+            if prescribed:  # input work F_b v_u
+                for i in range(nq):
+                    J[e_in, 2 + i] += v_u * gb * GA[e, i]
+    # --- actuator ([1] Sec. 2.1, Fig. 5a)
+    if not prescribed:
+        fm = _force_row(0, nz, coord)  # master piston
+        fb = _force_row(1, nz, coord)  # CSC piston and bearing
+        dvc_u = 0.0  # d V_cmd / d(x_sl, v_sl, V_I)
+        dvc_v = 0.0
+        dvc_i = 0.0
+        if p.imode == VOLTAGE:
+            v_cmd = ref
+        else:
+            r = min(max(ref, par[P_REFMIN]), par[P_REFMAX])
+            v_cmd = controller_voltage(r, ub, x[b0 + 4], v_u, par[P_KP], par[P_KD])
+            dvc_u = -par[P_KP]
+            dvc_v = -par[P_KD]
+            dvc_i = 1.0
+        v_drive = drive_voltage(v_cmd, cur, par[P_VSUP], par[P_IMAX], par[P_KIL])
+        dv_cmd, dv_i = drive_voltage_slopes(v_cmd, cur, par[P_VSUP], par[P_IMAX], par[P_KIL])
+        inv_l = 1.0 / par[P_L]
+        # di/dt = (V - R i - k_t v_mc / n_s) / L
+        J[b0 + 3, 1] += dv_cmd * dvc_u * inv_l
+        J[b0 + 3, nz + 1] += dv_cmd * dvc_v * inv_l
+        J[b0 + 3, b0 + 4] += dv_cmd * dvc_i * inv_l
+        J[b0 + 3, b0 + 3] += (dv_i - par[P_R]) * inv_l
+        J[b0 + 3, nz] -= par[P_KT] / par[P_NS] * inv_l
+        if p.imode == POSITION:  # dV_I/dt = K_i [(r - x) + K_aw (V - V_cmd)]
+            ki = par[P_KI]
+            kaw = par[P_KAW]
+            J[b0 + 4, 1] += ki * (-1.0 + kaw * (dv_cmd - 1.0) * dvc_u)
+            J[b0 + 4, nz + 1] += ki * kaw * (dv_cmd - 1.0) * dvc_v
+            J[b0 + 4, b0 + 4] += ki * kaw * (dv_cmd - 1.0) * dvc_i
+            J[b0 + 4, b0 + 3] += ki * kaw * dv_i
+        # input work V i
+        J[e_in, 1] += cur * dv_cmd * dvc_u
+        J[e_in, nz + 1] += cur * dv_cmd * dvc_v
+        J[e_in, b0 + 4] += cur * dv_cmd * dvc_i
+        J[e_in, b0 + 3] += cur * dv_i + v_drive
+        # master piston: spindle force k_t i / n_s - p_m A_mc
+        J[fm, b0 + 3] += par[P_KT] / par[P_NS]
+        J[fm, b0] -= par[P_AMC]
+        # snifting port flow G_v s(x_mc) p_m, chamber compliances (piecewise constant)
+        vent = vent_opening(x_mc, par[P_XSN], par[P_WSN])
+        dq_dx = par[P_GV] * vent_opening_slope(x_mc, par[P_XSN], par[P_WSN]) * p_m
+        dq_dp = par[P_GV] * vent
+        q_vent = dq_dp * p_m
+        cm = cavitating_compliance(p_m, par[P_CM], par[P_PCAV], par[P_CAVF])
+        cs = cavitating_compliance(p_s, par[P_CS], par[P_PCAV], par[P_CAVF])
+        J[b0, nz] += par[P_AMC] / cm
+        J[b0, b0 + 1] -= 1.0 / cm
+        J[b0, 0] -= dq_dx / cm
+        J[b0, b0] -= dq_dp / cm
+        J[b0 + 1, b0] += 1.0 / par[P_LH]
+        J[b0 + 1, b0 + 2] -= 1.0 / par[P_LH]
+        J[b0 + 1, b0 + 1] -= par[P_RH] / par[P_LH]
+        J[b0 + 2, b0 + 1] += 1.0 / cs
+        J[b0 + 2, nz + 1] -= par[P_ASL] / cs
+        # CSC: p_s A_sl + F_pre - k_pre x_sl
+        J[fb, b0 + 2] += par[P_ASL]
+        J[fb, 1] -= par[P_KPRE]
+        # dissipation R i^2 + R_h Q^2 + q_vent p_m
+        J[e_dis, b0 + 3] += 2.0 * par[P_R] * cur
+        J[e_dis, b0 + 1] += 2.0 * par[P_RH] * Q
+        J[e_dis, 0] += dq_dx * p_m
+        J[e_dis, b0] += dq_dp * p_m + q_vent
+        # end stops: master at 0 (pushes forward) and at its stroke (backward), CSC at its travel limits
+        ks = par[P_KSTOP]
+        cst = par[P_CSTOP]
+        _stop_rows(J, fm, e_dis, 0, nz, 1.0, -x_mc, -v_mc, ks, cst)
+        _stop_rows(J, fm, e_dis, 0, nz, -1.0, x_mc - par[P_XMAX], v_mc, ks, cst)
+        _stop_rows(J, fb, e_dis, 1, nz + 1, 1.0, par[P_UMIN] - ub, -v_u, ks, cst)
+        _stop_rows(J, fb, e_dis, 1, nz + 1, -1.0, ub - par[P_UMAX], v_u, ks, cst)
+    # --- coordinates: friction, kinematics, mass or equilibrium rows
+    for j in range(nz):
+        vj = x[nz + j]
+        mass = coord[CO_MASS, j]
+        if prescribed and j < 2:
+            for c in range(n):
+                J[j, c] = 0.0
+                J[nz + j, c] = 0.0
+            continue
+        if mass <= 0.0:
+            J[nz + j, nz + j] = -1.0  # massless node: dv/dt = -v (the velocity is not used)
+            continue  # its position row holds the force balance already
+        stuck = coord_int[CI_FRICTION, j] and m[j] == STUCK
+        if stuck:
+            for c in range(n):
+                J[j, c] = 0.0
+                J[nz + j, c] = 0.0
+            continue
+        fr = nz + j
+        # friction force -s F_c - c v (kinetic level F_c0 + mu_n |f_n| + mu_p |p|) and its dissipation -F_f v
+        J[fr, nz + j] -= coord[CO_VISCOUS, j]
+        J[e_dis, nz + j] += coord[CO_VISCOUS, j] * vj
+        J[e_fr, nz + j] += coord[CO_VISCOUS, j] * vj
+        if coord_int[CI_FRICTION, j]:
+            s = 1.0 if m[j] == SLIP_FORWARD else -1.0
+            level = _friction_level(j, x, nz, f, coord, coord_int)
+            frc = -s * level - coord[CO_VISCOUS, j] * vj
+            k = coord_int[CI_NORMAL, j]
+            if k >= 0 and kel[k] != 0.0 and f[k] != 0.0:
+                dl = coord[CO_MU_NORMAL, j] * (1.0 if f[k] > 0.0 else -1.0) * kel[k]
+                for i in range(nq):
+                    a = dl * GA[k, i]
+                    J[fr, 2 + i] -= s * a
+                    J[e_dis, 2 + i] += s * a * vj
+                    J[e_fr, 2 + i] += s * a * vj
+                if cu >= 0:
+                    a = dl * Gb[k]
+                    J[fr, cu] -= s * a
+                    J[e_dis, cu] += s * a * vj
+                    J[e_fr, cu] += s * a * vj
+            pc = coord_int[CI_PRESSURE, j]
+            if pc != 0:
+                col = b0 if pc == 1 else b0 + 2
+                pres = x[col]
+                if pres != 0.0:
+                    a = coord[CO_MU_PRESSURE, j] * (1.0 if pres > 0.0 else -1.0)
+                    J[fr, col] -= s * a
+                    J[e_dis, col] += s * a * vj
+                    J[e_fr, col] += s * a * vj
+        else:
+            frc = -coord[CO_VISCOUS, j] * vj
+        J[e_dis, nz + j] -= frc
+        J[e_fr, nz + j] -= frc
+        inv_m = 1.0 / mass
+        for c in range(n):
+            J[fr, c] *= inv_m
+        J[j, nz + j] = 1.0
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def time_derivative(t, x, u, m, p, ft):
+    """Analytic ``df/dt`` of :func:`rhs` at fixed state, with the actuator simulated (False otherwise).
+
+    Time enters only through the input table's active row (a mode): the voltage command follows a linear
+    voltage table, or the position controller follows a linear bearing reference (its proportional term,
+    ``K_p dr/dt``, and its integral action, docs/eclutch_dynamics.md "Position controller"); both reach the
+    motor current ([1] Sec. 2.1), the controller's integral and the input work through the drive's slope
+    (:func:`~clutchlab.eclutch.actuator.drive_voltage_slopes`).  With a prescribed bearing motion the
+    network moves with time: the core differences that case.
+    """
+    n = x.shape[0]
+    for i in range(n):
+        ft[i] = 0.0
+    if p.imode == PRESCRIBED:
+        return False
+    nz = p.nz
+    par = p.par
+    b0 = 2 * nz
+    ref, slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
+    if slope == 0.0:
+        return True
+    cur = x[b0 + 3]
+    if p.imode == VOLTAGE:
+        v_cmd = ref
+        dvc = slope
+    else:
+        if ref < par[P_REFMIN] or ref > par[P_REFMAX]:
+            return True  # the clipped reference does not move
+        v_cmd = controller_voltage(ref, x[1], x[b0 + 4], x[nz + 1], par[P_KP], par[P_KD])
+        dvc = par[P_KP] * slope
+    d_cmd, _d_i = drive_voltage_slopes(v_cmd, cur, par[P_VSUP], par[P_IMAX], par[P_KIL])
+    ft[b0 + 3] = d_cmd * dvc / par[P_L]
+    if p.imode == POSITION:
+        ft[b0 + 4] = par[P_KI] * (slope + par[P_KAW] * (d_cmd - 1.0) * dvc)
+    ft[b0 + 5] = cur * d_cmd * dvc
+    return True
 
 
 dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restart=restart, accept=accept,
-                  next_break=next_break, jacobian=jacobian)
+                  next_break=next_break, jacobian=jacobian, time_derivative=time_derivative)
 
 
 # ---------------------------------------------------------------- packing and the System
@@ -650,6 +960,7 @@ class Assembly:
         self._initial = {}  # bearing position -> static initial state and modes
         self._constant = None  # constant arrays of EClutchParams (_packed)
         self._names = {}  # cached Variable tuples and switching functions
+        self._systems = {}  # the last systems built (system()), by their arguments
         net = model.network
         asm = _node_aligned(net)
         self.asm = asm
@@ -914,11 +1225,11 @@ class Assembly:
             0 linear between rows, 1 held.
         """
         par, coord, coord_int, fo, GA, net, net_int, curve = self._packed()
-        width = max(self.n, len(self.switching()), N_AUX + self.nz)
+        width = max(self.n, len(self.switching()), N_AUX + self.nz, 2 + self.n + self.nz)
         return EClutchParams(
             int(self.nz), int(imode), int(interp), np.ascontiguousarray(tin, dtype=np.float64),
             np.ascontiguousarray(vin, dtype=np.float64), par, coord, coord_int, fo, GA, net, net_int, curve,
-            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((7, width)))
+            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((N_WORK, width)))
 
     def system(self, imode: int, tin, vin, interp: int, u0: float, *, held_input: bool = False,
                rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8, jac_every: int = 10,
@@ -949,6 +1260,24 @@ class Assembly:
             raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
         tin = np.asarray(tin, dtype=float)
         vin = np.asarray(vin, dtype=float)
+        # a run asked for again (controller design, Monte Carlo by hand, benchmarks): the same System with a
+        # fresh parameter structure (its scratch rows belong to one run), without building and checking the
+        # System again (tens of microseconds against a run of about a millisecond)
+        key = (int(imode), tin.tobytes(), vin.tobytes(), int(interp), float(u0), bool(held_input), float(rtol),
+               float(max_step), float(event_tol), int(jac_every), float(atol_scale), float(first_step))
+        known = self._systems.get(key)
+        if known is not None:
+            params = known.params
+            return known.variant(params=params._replace(work=np.zeros_like(params.work)))
+        system = self._build_system(imode, tin, vin, interp, u0, held_input, rtol, max_step, event_tol, jac_every,
+                                    atol_scale, first_step)
+        if len(self._systems) >= 16:
+            self._systems.pop(next(iter(self._systems)))
+        self._systems[key] = system
+        return system
+
+    def _build_system(self, imode, tin, vin, interp, u0, held_input, rtol, max_step, event_tol, jac_every,
+                      atol_scale, first_step) -> System:
         x0, m0 = self.initial_state(u0)
         name = {VOLTAGE: ("motor_voltage", "V"), POSITION: ("bearing_reference", "m"),
                 PRESCRIBED: ("bearing_position", "m")}[imode]

@@ -70,7 +70,8 @@ from .dopri import (
 )
 from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
                          C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
-                         GAMMA2 as R_GAMMA2, lu_factor, lu_solve, rodas_next_step)
+                         GAMMA2 as R_GAMMA2, plan_reduction, reduced_factor, reduced_solve, reduction_sizes,
+                         rodas_next_step)
 from .status import MODEL_ERROR, RECORD_FULL, SINGULAR, STEP_LIMIT, STEP_UNDERFLOW, SUCCESS, TERMINATED
 
 __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "advance_dopri", "advance_rodas",
@@ -625,35 +626,43 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 
 # ============================================================ Rosenbrock (Rodas3)
 @register_jitable
-def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K1, K2, K3, K4, xtmp, ftmp,
-                gtmp):
-    """One Rodas3 step of size ``h`` from ``(t, x)``; False if the matrix is singular or NaN appears."""
+def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp,
+                gtmp, refactor):
+    """One Rodas3 step of size ``h`` from ``(t, x)``; False if the matrix is singular or NaN appears.
+
+    The linear systems are solved along the reduction planned for ``J`` (``iw``, ``fw``:
+    :func:`~clutchlab.numerics.rosenbrock.plan_reduction`): kinematic rows eliminated first, trailing states
+    solved last, a partial-pivoting LU of the rest.  ``refactor`` False: the iteration matrix of the previous
+    step is still the one for ``h`` and ``J`` (the same step size, the Jacobian kept), and its factors are
+    used again.
+    """
     n = x.shape[0]
-    hg = 1.0 / (h * R_GAMMA)
-    for i in range(n):
-        for j in range(n):
-            G[i, j] = -J[i, j]
-        G[i, i] += mass[i] * hg
-    if not lu_factor(G, piv):
-        return False
+    if refactor:
+        hg = 1.0 / (h * R_GAMMA)
+        for i in range(n):
+            for j in range(n):
+                G[i, j] = -J[i, j]
+            G[i, i] += mass[i] * hg
+        if not reduced_factor(G, iw, fw, piv):
+            return False
     for i in range(n):
         K1[i] = f0[i] + (h * R_GAMMA1 * ft[i] if nonauto else 0.0)
-    lu_solve(G, piv, K1)
+    reduced_solve(G, iw, fw, piv, K1)
     for i in range(n):
         K2[i] = f0[i] + mass[i] * (R_C21 / h) * K1[i] + (h * R_GAMMA2 * ft[i] if nonauto else 0.0)
-    lu_solve(G, piv, K2)
+    reduced_solve(G, iw, fw, piv, K2)
     for i in range(n):
         xtmp[i] = x[i] + R_A31 * K1[i]
     model.rhs(t + h, xtmp, u, m, p, ftmp, gtmp)
     for i in range(n):
         K3[i] = ftmp[i] + mass[i] * (R_C31 * K1[i] + R_C32 * K2[i]) / h
-    lu_solve(G, piv, K3)
+    reduced_solve(G, iw, fw, piv, K3)
     for i in range(n):
         xtmp[i] = x[i] + R_A41 * K1[i] + R_A43 * K3[i]
     model.rhs(t + h, xtmp, u, m, p, ftmp, gtmp)
     for i in range(n):
         K4[i] = ftmp[i] + mass[i] * (R_C41 * K1[i] + R_C42 * K2[i] + R_C43 * K3[i]) / h
-    lu_solve(G, piv, K4)
+    reduced_solve(G, iw, fw, piv, K4)
     ok = True
     for i in range(n):
         xnew[i] = xtmp[i] + K4[i]
@@ -665,7 +674,10 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, K
 
 @register_jitable(forceinline=True)
 def _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft):
-    """Forward difference of df/dt at ``t`` into ``ft`` (backward if a break time is within the difference)."""
+    """df/dt at ``t`` into ``ft``: the model's own (``time_derivative`` hook), else a forward difference
+    (backward if a break time is within the difference); returns the number of ``rhs`` calls."""
+    if model.time_derivative(t, x, u, m, p, ft):
+        return 0
     dt = 1e-7 * max(1e-3, abs(t))
     if t + dt < tb:
         model.rhs(t + dt, x, u, m, p, fp, gp)
@@ -675,6 +687,7 @@ def _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft):
         model.rhs(t - dt, x, u, m, p, fp, gp)
         for r in range(x.shape[0]):
             ft[r] = (f0[r] - fp[r]) / dt
+    return 1
 
 
 @register_jitable
@@ -755,6 +768,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     J = np.zeros((n, n))
     G = np.empty((n, n))
     piv = np.empty(n, dtype=np.int64)
+    n_iw, n_fw = reduction_sizes(n)
+    iw = np.zeros(n_iw, dtype=np.int64)
+    fw = np.empty(n_fw)
     K1 = np.empty(n)
     K2 = np.empty(n)
     K3 = np.empty(n)
@@ -769,8 +785,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     yb = np.empty(rec_y.shape[1])
     rc0 = np.zeros(n)  # no order-4 term in the dense output: Rodas3 is of order 3
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb, rc0)
-    (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
+    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
+              rc0)
+    (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
      rc0) = borrow(owners)
     t = sf[SF_T]
     h = sf[SF_H]
@@ -795,6 +812,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     jac_age = opt.jac_every
     rejected_before = False
     en = 0.0
+    h_fact = 0.0  # the step size of the factored iteration matrix (0: none)
     hf = opt.fixed_step
     fixed = hf > 0.0
     while t < t_end:
@@ -815,12 +833,12 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 break
             if not model.jacobian(t, x, u, m, p, J):
                 si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, False)
+            plan_reduction(J, mass, iw)
             si[SI_NJAC] += 1
             if opt.nonautonomous:
-                _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
-                si[SI_NRHS] += 1
-            ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, K1, K2, K3,
-                             K4, xtmp, ftmp, gp)
+                si[SI_NRHS] += _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
+            ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, iw, fw, K1, K2,
+                             K3, K4, xtmp, ftmp, gp, True)
             si[SI_NRHS] += 2
             if not ok:
                 status = SINGULAR
@@ -867,19 +885,21 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if jac_age >= opt.jac_every or jac_stale:
                 if not model.jacobian(t, x, u, m, p, J):
                     si[SI_NRHS] += _fd_jacobian(p, t, x, u, m, f0, g0, opt, J, xp, fp, gp, dls, True)
+                plan_reduction(J, mass, iw)
+                h_fact = 0.0  # a new Jacobian: factor again
                 jac_age = 0
                 jac_stale = False
                 si[SI_NJAC] += 1
             if opt.nonautonomous:
-                _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
-                si[SI_NRHS] += 1
+                si[SI_NRHS] += _time_derivative(p, t, x, u, m, f0, tb, fp, gp, ft)
             need_jac = False
         h, hit_stop = _clip_step(h, t, t_stop, opt.max_step)
         if h < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
-        ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, K1, K2, K3, K4,
-                         xtmp, ftmp, gp)
+        ok = _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, opt.nonautonomous, x1, err, G, piv, iw, fw, K1, K2, K3,
+                         K4, xtmp, ftmp, gp, h != h_fact)
+        h_fact = h
         si[SI_NRHS] += 2
         en = error_norm(err, x, x1, rtol, atol) if ok else np.inf
         if not (en <= 1.0):
@@ -903,8 +923,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if theta <= 1.0:
             # land on the located instant with one step of that length (consistent algebraic rows)
             hs = theta * h
-            ok2 = _rodas_step(p, t, x, hs, u, m, J, mass, f0, ft, opt.nonautonomous, xe, err, G, piv, K1, K2, K3,
-                              K4, xtmp, ftmp, gp)
+            ok2 = _rodas_step(p, t, x, hs, u, m, J, mass, f0, ft, opt.nonautonomous, xe, err, G, piv, iw, fw, K1, K2,
+                              K3, K4, xtmp, ftmp, gp, True)
+            h_fact = hs
             si[SI_NRHS] += 2
             if ok2:
                 model.rhs(t + hs, xe, u, m, p, ftmp, gp)

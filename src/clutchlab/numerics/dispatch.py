@@ -45,6 +45,10 @@ and the parameters ``p``):
 ``jacobian(t, x, u, m, p, J)``
     Fills ``J = df/dx`` and returns True where the model has an analytic
     Jacobian; returns False to let the core difference ``rhs``.
+``time_derivative(t, x, u, m, p, ft)`` (optional)
+    Fills ``ft = df/dt`` at fixed state (inputs that vary within a step,
+    for the Rosenbrock stages) and returns True; False (the default for a
+    model that does not give it) lets the core difference ``rhs`` in time.
 """
 
 from __future__ import annotations
@@ -58,9 +62,20 @@ from numba.extending import overload
 from .borrow import ByRef
 
 __all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "outputs", "update", "restart", "accept",
-           "next_break", "jacobian"]
+           "next_break", "jacobian", "time_derivative", "no_time_derivative"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
+#: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time)
+OPTIONAL_HOOKS = ("time_derivative",)
+
+
+def no_time_derivative(t, x, u, m, p, ft):
+    """What the ``time_derivative`` stub compiles to for a model without the hook: ``False`` (none analytic).
+
+    Compiled into the caller, never cached on its own: a cached default would keep one index of every model
+    that used it, and a process that cannot import one of them (a test's toy model) could not load it.
+    """
+    return False
 
 # parameter NamedTuple class -> {hook name: compiled function}
 _MODELS: dict = {}
@@ -72,7 +87,9 @@ _SOURCES: dict = {}
 def register(params_cls, inline_stages: bool = False, **functions) -> None:
     """Register a model's compiled hooks for its parameter ``NamedTuple`` class.
 
-    Every hook of :data:`HOOKS` must be given, as a ``numba.njit`` function.
+    Every hook of :data:`HOOKS` must be given, as a ``numba.njit`` function; those of
+    :data:`OPTIONAL_HOOKS` may be (without ``time_derivative`` the stub compiles to
+    :func:`no_time_derivative`).
     Registering the same class again replaces the hooks (a reloaded module).
     Each hook is compiled into the core with its own ``error_model`` and
     ``fastmath`` options (:func:`_declare`).  ``inline_stages``: the
@@ -83,9 +100,10 @@ def register(params_cls, inline_stages: bool = False, **functions) -> None:
     EMTC bench), so off by default.
     """
     missing = [h for h in HOOKS if h not in functions]
-    extra = [h for h in functions if h not in HOOKS]
+    extra = [h for h in functions if h not in HOOKS + OPTIONAL_HOOKS]
     if missing or extra:
         raise TypeError(f"register({params_cls.__name__}): missing hooks {missing}, unknown hooks {extra}")
+    functions = dict(functions)
     for fn in functions.values():
         _declare(_options_key(fn))
     _MODELS[params_cls] = dict(functions)
@@ -134,9 +152,18 @@ def _hook(p, name, key):
     if isinstance(p, ByRef):
         p = p.pointee
     if isinstance(p, types.BaseNamedTuple) and p.instance_class in _MODELS:
-        fn = _MODELS[p.instance_class][name]
-        if _options_key(fn) == key:
+        fn = _MODELS[p.instance_class].get(name)
+        if fn is not None and _options_key(fn) == key:
             return fn.py_func
+    return None
+
+
+def _default_time_derivative(t, x, u, m, p, ft):
+    """Typing of the ``time_derivative`` stub for a registered model that does not give the hook."""
+    q = p.pointee if isinstance(p, ByRef) else p
+    if isinstance(q, types.BaseNamedTuple) and q.instance_class in _MODELS \
+            and "time_derivative" not in _MODELS[q.instance_class]:
+        return no_time_derivative
     return None
 
 
@@ -170,6 +197,10 @@ def next_break(t, m, p):  # pragma: no cover
 
 
 def jacobian(t, x, u, m, p, J):  # pragma: no cover
+    raise NotImplementedError
+
+
+def time_derivative(t, x, u, m, p, ft):  # pragma: no cover
     raise NotImplementedError
 
 
@@ -215,6 +246,11 @@ def _typing(stub, hook, key, inline=None):
     return typing
 
 
+# models without a ``time_derivative`` hook: the stub compiles to ``return False`` inside the caller
+overload(time_derivative, jit_options={"cache": False})(
+    functools.wraps(time_derivative)(_default_time_derivative))
+
 #: (stub, hook it resolves to)
 _STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
-          (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"))
+          (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"),
+          (time_derivative, "time_derivative"))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numba
+from numba import uintp as _u
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -14,17 +15,27 @@ def bracket(grid, x):
     end segment is returned with ``w`` clamped to 0 or 1.  Binary search,
     O(log n).
     """
-    n = grid.shape[0]
-    if x <= grid[0]:
-        return 0, 0.0
-    if x >= grid[n - 1]:
-        return n - 2, 1.0
-    lo = 0
-    hi = n - 1
+    return bracket_range(grid, 0, grid.shape[0], x)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def bracket_range(grid, start, stop, x):
+    """:func:`bracket` on the part ``grid[start:stop]`` of a packed array (at least 2 points), without a slice.
+
+    Returns ``(lo, w)`` with ``lo`` an index into ``grid`` itself (``start <= lo < stop - 1``).  A slice
+    builds a new array structure at every call (the E-clutch's curve look-ups, several per right-hand side).
+    ``start`` and ``stop`` must be non-negative (indices are read as unsigned: no wrap-around test).
+    """
+    if x <= grid[_u(start)]:
+        return start, 0.0
+    if x >= grid[_u(stop - 1)]:
+        return stop - 2, 1.0
+    lo = start
+    hi = stop - 1
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if grid[mid] <= x:
+        if grid[_u(mid)] <= x:
             lo = mid
         else:
             hi = mid
-    return lo, (x - grid[lo]) / (grid[lo + 1] - grid[lo])
+    return lo, (x - grid[_u(lo)]) / (grid[_u(lo + 1)] - grid[_u(lo)])

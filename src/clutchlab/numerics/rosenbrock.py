@@ -36,8 +36,12 @@ from __future__ import annotations
 import math
 
 import numba
+from numba import uintp as _u
 
-__all__ = ["GAMMA", "lu_factor", "lu_solve", "rodas_next_step"]
+from .borrow import shaped
+
+__all__ = ["GAMMA", "lu_factor", "lu_solve", "plan_reduction", "reduced_factor", "reduced_solve", "reduction_sizes",
+           "rodas_next_step"]
 
 #: diagonal coefficient gamma of Rodas3
 GAMMA = 0.5
@@ -56,6 +60,10 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 6.0
 
 
+# Indices below are cast to unsigned (``_u``): numba wraps a negative signed index around (``a[-1]``), and
+# LLVM cannot prove that indices such as ``range(k + 1, n)`` are non-negative, so every element access carried a
+# test and an addition; unsigned indices are never wrapped.  Measured on an 11 x 11 factorisation and four
+# solves: 24 % fewer instructions, bit-identical results.
 @numba.njit(cache=True, nogil=True)
 def lu_factor(a, piv):
     """In-place LU factorisation with partial pivoting of a small dense matrix.
@@ -64,28 +72,33 @@ def lu_factor(a, piv):
     """
     n = a.shape[0]
     for k in range(n):
+        uk = _u(k)
         p = k
-        amax = abs(a[k, k])
+        amax = abs(a[uk, uk])
         for i in range(k + 1, n):
-            v = abs(a[i, k])
+            v = abs(a[_u(i), uk])
             if v > amax:
                 amax = v
                 p = i
-        piv[k] = p
+        piv[uk] = p
         if amax == 0.0 or not math.isfinite(amax):
             return False
         if p != k:
+            up = _u(p)
             for j in range(n):
-                tmp = a[k, j]
-                a[k, j] = a[p, j]
-                a[p, j] = tmp
-        inv = 1.0 / a[k, k]
+                uj = _u(j)
+                tmp = a[uk, uj]
+                a[uk, uj] = a[up, uj]
+                a[up, uj] = tmp
+        inv = 1.0 / a[uk, uk]
         for i in range(k + 1, n):
-            a[i, k] *= inv
-            lik = a[i, k]
+            ui = _u(i)
+            lik = a[ui, uk] * inv
+            a[ui, uk] = lik
             if lik != 0.0:
                 for j in range(k + 1, n):
-                    a[i, j] -= lik * a[k, j]
+                    uj = _u(j)
+                    a[ui, uj] -= lik * a[uk, uj]
     return True
 
 
@@ -94,21 +107,223 @@ def lu_solve(lu, piv, b):
     """Solve ``A x = b`` in place (``b`` becomes ``x``) from :func:`lu_factor` output."""
     n = lu.shape[0]
     for k in range(n):
-        p = piv[k]
+        uk = _u(k)
+        p = piv[uk]
         if p != k:
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
+            up = _u(p)
+            tmp = b[uk]
+            b[uk] = b[up]
+            b[up] = tmp
     for i in range(n):
-        s = b[i]
+        ui = _u(i)
+        s = b[ui]
         for j in range(i):
-            s -= lu[i, j] * b[j]
-        b[i] = s
-    for i in range(n - 1, -1, -1):
-        s = b[i]
+            uj = _u(j)
+            s -= lu[ui, uj] * b[uj]
+        b[ui] = s
+    for ii in range(n):
+        i = n - 1 - ii
+        ui = _u(i)
+        s = b[ui]
         for j in range(i + 1, n):
-            s -= lu[i, j] * b[j]
-        b[i] = s / lu[i, i]
+            uj = _u(j)
+            s -= lu[ui, uj] * b[uj]
+        b[ui] = s / lu[ui, ui]
+
+
+# ---------------------------------------------------------------- the linear systems of a step, reduced
+# The iteration matrix G = M/(h gamma) - J of a mechanical model has two kinds of rows that need no
+# pivoting: *kinematic* rows (dz/dt = v: one entry off the diagonal) and *trailing* states (integrals of
+# energies, a massless node's unused velocity: nothing depends on them, their columns are zero off the
+# diagonal).  Eliminating the kinematic rows first (each changes one column of the rows that use the
+# position: the usual effective stiffness k h gamma / m of an implicit mass-spring step) and solving the
+# trailing rows last leaves a smaller dense system for the partial-pivoting LU.  On the E-clutch (20 states):
+# 5 kinematic, 4 trailing, 11 kept; an LU of 20 x 20 and four solves were most of a step's cost.
+KEEP, KINEMATIC, TRAILING = 0, 1, 2
+_NK, _NKIN, _NTR, _MODE, _DENSE_NOW = 0, 1, 2, 3, 4
+_HEAD = 8
+
+
+@numba.njit(cache=True, nogil=True)
+def reduction_sizes(n):
+    """Lengths ``(int work, float work)`` of the arrays :func:`plan_reduction` and :func:`reduced_factor` use."""
+    return _HEAD + 6 * n + 2 + 2 * n * n, 2 * n * n + n
+
+
+@numba.njit(cache=True, nogil=True)
+def plan_reduction(J, mass, iw):
+    """Classify the states from the non-zeros of the Jacobian ``J`` (once per Jacobian) into ``iw``.
+
+    *Trailing*: column zero off the diagonal (nothing depends on the state).  *Kinematic*: a row with a
+    positive mass and at most one non-zero off the diagonal, at a column that is kept (a position whose
+    derivative is a velocity; a stuck coordinate's rows, zero).  *Kept*: the rest, factored densely.
+    ``iw`` (int64, :func:`reduction_sizes`) receives the counts, the kind and partner column of every state,
+    the order kept - kinematic - trailing and the position of each kept state in the reduced matrix.
+    """
+    n = J.shape[0]
+    kind = iw[_HEAD:_HEAD + n]
+    partner = iw[_HEAD + n:_HEAD + 2 * n]
+    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
+    posk = iw[_HEAD + 3 * n:_HEAD + 4 * n]
+    for c in range(n):
+        trailing = True
+        for r in range(n):
+            if r != c and J[r, c] != 0.0:
+                trailing = False
+                break
+        kind[c] = TRAILING if trailing else KEEP
+        partner[c] = -1
+    for r in range(n):
+        if kind[r] == TRAILING or not mass[r] > 0.0:
+            continue
+        s = -1
+        cnt = 0
+        for c in range(n):
+            if c != r and J[r, c] != 0.0:
+                cnt += 1
+                s = c
+                if cnt > 1:
+                    break
+        if cnt <= 1 and (s < 0 or kind[s] != TRAILING):
+            kind[r] = KINEMATIC
+            partner[r] = s
+    for r in range(n):  # a kinematic row's partner must be kept (no chains)
+        if kind[r] == KINEMATIC and partner[r] >= 0 and kind[partner[r]] == KINEMATIC:
+            kind[r] = KEEP
+            partner[r] = -1
+    nk = 0
+    for want in (KEEP, KINEMATIC, TRAILING):
+        for i in range(n):
+            if kind[i] == want:
+                if want == KEEP:
+                    posk[i] = nk
+                order[nk] = i
+                nk += 1
+    n_keep = 0
+    n_kin = 0
+    for i in range(n):
+        if kind[i] == KEEP:
+            n_keep += 1
+        elif kind[i] == KINEMATIC:
+            n_kin += 1
+    iw[_NK] = n_keep
+    iw[_NKIN] = n_kin
+    iw[_NTR] = n - n_keep - n_kin
+    iw[_MODE] = 1 if n_keep < n else 0
+    # the trailing rows' non-zero columns off the diagonal (their back-substitution)
+    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
+    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
+    e = 0
+    for q in range(n - n_keep - n_kin):
+        c = order[n_keep + n_kin + q]
+        tptr[q] = e
+        for j in range(n):
+            if j != c and J[c, j] != 0.0:
+                tcol[e] = j
+                e += 1
+    tptr[n - n_keep - n_kin] = e
+
+
+@numba.njit(cache=True, nogil=True)
+def reduced_factor(G, iw, fw, piv):
+    """Factor ``G`` along the plan of :func:`plan_reduction`; False if singular.
+
+    With a reduction: the kept rows and columns of ``G`` are copied into ``fw`` with the kinematic rows
+    eliminated (their multipliers kept for the solves) and factored by :func:`lu_factor`; ``G`` itself is
+    left unchanged (the solves read its kinematic and trailing rows).  Without one, or when a kinematic
+    row's diagonal is not the larger entry of its row at this step size (it would need pivoting),
+    ``G`` is factored in place as a whole.
+    """
+    n = G.shape[0]
+    iw[_DENSE_NOW] = 1
+    if iw[_MODE] == 0:
+        return lu_factor(G, piv)
+    nk = iw[_NK]
+    nkin = iw[_NKIN]
+    partner = iw[_HEAD + n:_HEAD + 2 * n]
+    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
+    posk = iw[_HEAD + 3 * n:_HEAD + 4 * n]
+    mptr = iw[_HEAD + 4 * n:_HEAD + 5 * n + 1]
+    mrow = iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n]
+    mval = fw[n * n:2 * n * n]
+    for q in range(nkin):
+        r = _u(order[_u(nk + q)])
+        s = partner[r]
+        grr = G[r, r]
+        if grr == 0.0 or not math.isfinite(grr) or (s >= 0 and abs(grr) < abs(G[r, _u(s)])):
+            return lu_factor(G, piv)
+    gr = shaped(fw[:nk * nk], (nk, nk))
+    for a in range(nk):
+        i = _u(order[a])
+        for b in range(nk):
+            gr[a, b] = G[i, _u(order[b])]
+    cnt = 0
+    for q in range(nkin):
+        r = _u(order[_u(nk + q)])
+        s = partner[r]
+        grr = G[r, r]
+        mptr[q] = cnt
+        for a in range(nk):
+            gir = G[_u(order[a]), r]
+            if gir != 0.0:
+                lir = gir / grr
+                mrow[_u(cnt)] = a
+                mval[_u(cnt)] = lir
+                cnt += 1
+                if s >= 0:
+                    gr[a, _u(posk[_u(s)])] -= lir * G[r, _u(s)]
+    mptr[nkin] = cnt
+    for q in range(iw[_NTR]):
+        c = _u(order[_u(nk + nkin + q)])
+        if G[c, c] == 0.0 or not math.isfinite(G[c, c]):
+            return False
+    iw[_DENSE_NOW] = 0
+    return lu_factor(gr, piv)
+
+
+@numba.njit(cache=True, nogil=True)
+def reduced_solve(G, iw, fw, piv, b):
+    """Solve ``G y = b`` in place from :func:`reduced_factor` (kept block, then kinematic and trailing rows)."""
+    n = G.shape[0]
+    if iw[_DENSE_NOW] == 1:
+        lu_solve(G, piv, b)
+        return
+    nk = iw[_NK]
+    nkin = iw[_NKIN]
+    partner = iw[_HEAD + n:_HEAD + 2 * n]
+    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
+    mptr = iw[_HEAD + 4 * n:_HEAD + 5 * n + 1]
+    mrow = iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n]
+    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
+    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
+    mval = fw[n * n:2 * n * n]
+    gr = shaped(fw[:nk * nk], (nk, nk))
+    bk = fw[2 * n * n:2 * n * n + nk]
+    for a in range(nk):
+        bk[a] = b[_u(order[a])]
+    for q in range(nkin):
+        br = b[_u(order[_u(nk + q)])]
+        if br != 0.0:
+            for c in range(mptr[q], mptr[q + 1]):
+                uc = _u(c)
+                bk[_u(mrow[uc])] -= mval[uc] * br
+    lu_solve(gr, piv, bk)
+    for a in range(nk):
+        b[_u(order[a])] = bk[a]
+    for q in range(nkin):
+        r = _u(order[_u(nk + q)])
+        s = partner[r]
+        v = b[r]
+        if s >= 0:
+            v -= G[r, _u(s)] * b[_u(s)]
+        b[r] = v / G[r, r]
+    for q in range(iw[_NTR]):
+        c = _u(order[_u(nk + nkin + q)])
+        v = b[c]
+        for e in range(tptr[q], tptr[q + 1]):
+            j = _u(tcol[_u(e)])
+            v -= G[c, j] * b[j]
+        b[c] = v / G[c, c]
 
 
 @numba.njit(cache=True, nogil=True)
