@@ -6,14 +6,15 @@ modes, inputs, solver state, options, event log and buffers -- and only the end 
 from Python, every array among them is unboxed at every call (a reference to the Python object, an
 owner record allocated and freed, the shape and strides read): about thirty arrays, 5 us per call.
 
-Here they are unboxed once per session.  :func:`pack` stores them, borrowed (the owners set to NULL as
-:func:`~clutchlab.numerics.borrow.borrow` does; the session keeps the originals alive), in one table
-together with the addresses of the two compiled functions; :class:`Handle` is the Python object that
-carries the table's address, and numba unboxes it as one pointer (:class:`SessionType`, which also
-carries the arguments' types).  :func:`call` (compiled into each model's entry module as ``session``)
-loads the arguments from the table and calls the model's ``advance`` and ``evaluate_outputs`` through
-their addresses, then copies the values the session reports (outputs, states, modes) into its report
-array.
+Here they are unboxed once per session.  :func:`open_session` writes them, borrowed (the owners set to
+NULL as :func:`~clutchlab.numerics.borrow.borrow` does; the session keeps the originals alive), into one
+table together with the addresses of the two compiled functions -- from Python, in the layout of numba's
+data model, or for a type that this does not know with the compiled :func:`pack`; :class:`Handle` is the
+Python object that carries the table's address, and numba unboxes it as one pointer
+(:class:`SessionType`, which also carries the arguments' types).  :func:`call` (compiled into each
+model's entry module as ``session``) loads the arguments from the table and calls the model's
+``advance`` and ``evaluate_outputs`` through their addresses, then copies the values the session reports
+(outputs, states, modes) into its report array.
 
 Why addresses, not calls: a compiled function that calls ``advance`` links the whole loop into itself
 and numba optimises and emits it once more (2-3.5 s per model, docs/architecture.md); called through
@@ -32,8 +33,8 @@ from numba.extending import NativeValue, intrinsic, models, register_jitable, re
 from .borrow import _strip
 from .status import SUCCESS, TERMINATED
 
-__all__ = ["SessionType", "Handle", "pack", "call", "ADVANCE", "OUTPUTS", "REPORT_OUTPUT", "REPORT_STATE",
-           "REPORT_MODE", "REPORT_MODE_IS"]
+__all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "FIELDS",
+           "ADVANCE", "OUTPUTS", "REPORT_OUTPUT", "REPORT_STATE", "REPORT_MODE", "REPORT_MODE_IS"]
 
 #: bits of ``what`` in :func:`call`: advance to the end time; evaluate the outputs and fill the report
 ADVANCE = 1
