@@ -4,7 +4,7 @@ What is measured (medians of 15 rounds, min-max in brackets, microseconds per ca
 
 * **co-simulation step** of each model's co-simulation (:mod:`clutchlab.fmu.cosim`: wet bench with a free
   inertia and 3 kN held; EMTC drum bench, 300 N.m requested; E-clutch at a 4 mm bearing reference; the
-  CoupledClutches driveline of ``examples/``), 1 ms communication steps after the first one:
+  CoupledClutches driveline of ``examples/``), 1 ms communication steps after the first two:
 
   - ``do_step_array``: what the FMU slave calls at every ``fmi2DoStep`` (inputs and outputs as sequences);
   - ``do_step``: the Python API, inputs and outputs as dicts;
@@ -95,14 +95,20 @@ class Case:
     dt = 1e-3
     n = 450
 
+    first = 2  # steps before the timed ones (with initial_outputs, the session packs at its third call)
+
     def make(self):
         c = self.build()
         c.initial_outputs(dict(zip((v.name for v in c.inputs), self.u)))
-        c.do_step(0.0, self.dt, dict(zip((v.name for v in c.inputs), self.u)))
+        for k in range(self.first):
+            c.do_step(k * self.dt, self.dt, dict(zip((v.name for v in c.inputs), self.u)))
         return c
 
+    def steps(self):
+        return range(self.first, self.first + self.n)
+
     def ends(self):
-        return [k * self.dt + self.dt for k in range(1, self.n + 1)]
+        return [k * self.dt + self.dt for k in self.steps()]
 
     def sim(self, c):
         return c.simulation
@@ -164,13 +170,13 @@ def _steps(case, c, array: bool) -> float:
     if array:
         step = c.do_step_array
         t0 = time.perf_counter()
-        for k in range(1, case.n + 1):
+        for k in case.steps():
             step(k * dt, dt, u)
     else:
         step = c.do_step
         inputs = dict(zip(names, u))
         t0 = time.perf_counter()
-        for k in range(1, case.n + 1):
+        for k in case.steps():
             step(k * dt, dt, inputs)
     return (time.perf_counter() - t0) / case.n
 
@@ -253,8 +259,9 @@ def bench_slave() -> None:
         outs = [vr for vr, v in s.vars.items() if v.causality.name == "output"]
         step = s.do_step if on_thread else s._step
         step(0.0, 1e-3)
+        step(1e-3, 1e-3)  # (the session packs at its third call)
         t0 = time.perf_counter()
-        for k in range(1, 451):
+        for k in range(2, 452):
             if not step(k * 1e-3, 1e-3):
                 raise AssertionError("the slave refused a step")
             s.get_real(outs)

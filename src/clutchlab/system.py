@@ -622,7 +622,8 @@ class Simulation:
     Notes
     -----
     The session's objects -- the parameters, ``x``, ``m``, ``u``, the solver state, options, event log and
-    buffers -- are packed once, at the first call, into a table that the model's compiled ``session`` entry
+    buffers -- are packed once, at the third call (the first two go through numba's dispatcher, so that a
+    session advanced once or twice compiles nothing more), into a table that the model's compiled ``session`` entry
     reads (:mod:`clutchlab.numerics.session`): a call passes one pointer and the end time instead of some
     thirty arrays that numba would unbox at every call.  Their contents may change between calls (``x[0] =
     ...``, ``u[:] = ...``); replacing one of ``system``, ``x``, ``m``, ``u`` or ``log`` by another object packs
@@ -665,7 +666,11 @@ class Simulation:
         self._report_spec[:, 1] = np.arange(ny)
         self._r = np.empty(ny)
         self._pack = True
-        self._fast = None  # (callable, handle): the packed call, or (self._general, None); None until the first call
+        #: calls that go through numba's dispatcher before the session packs its objects: a session advanced once
+        #: or twice (a settling run, a trim) neither packs nor compiles the model's ``session`` entry
+        self._pack_after = 2
+        self._dispatched = 0
+        self._fast = None  # (callable, handle): the packed call, or (self._general, None); None: not decided
 
     # ---- the compiled calls
     def _call(self, t: float, what: int) -> int:
@@ -674,7 +679,13 @@ class Simulation:
         advance's status."""
         fast = self._fast
         if fast is None:
-            fast = self._fast = self._open() if self._pack else (self._general, None)
+            if not self._pack:
+                fast = self._fast = (self._general, None)
+            elif self._dispatched < self._pack_after:
+                self._dispatched += 1
+                return self._general(None, t, what)
+            else:
+                fast = self._fast = self._open()
         return fast[0](fast[1], t, what)
 
     def _method(self) -> str:

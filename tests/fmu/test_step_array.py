@@ -52,6 +52,7 @@ def _pair(factory, u0):
     for c in (fast, plain):
         c.initial_outputs(dict(zip(_names(c), u0)))
     plain.simulation._pack = False  # (unpacked: every call dispatches)
+    fast.simulation._pack_after = 0  # (packed from the next call)
     return fast, plain
 
 

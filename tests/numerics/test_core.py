@@ -221,6 +221,8 @@ def test_packed_session_calls_equal_dispatched_ones(method):
     system = toys.belt_system(method=method)
     packed, plain = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
     plain._pack = False  # (every call of this one dispatches)
+    assert packed._pack_after == 2
+    packed._pack_after = 0  # (packed from the first call)
     for sim in (packed, plain):
         sim.report([("state", 1), ("output", 0), ("mode", 0), ("mode_is", 0, 1), ("state", "position")])
     for k, t in enumerate(np.linspace(0.01, 1.5, 150)):
@@ -256,11 +258,32 @@ def test_a_session_packed_by_the_compiled_packing_runs_the_same(monkeypatch):
 
     system = toys.belt_system()
     python, compiled = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
+    python._pack_after = compiled._pack_after = 0
     python.advance(0.5)
     monkeypatch.setattr(S, "_plan", lambda args_ty: None)
     compiled.advance(0.5)
     assert compiled._fast[1] is not None
     assert np.array_equal(python.x, compiled.x) and np.array_equal(python.outputs(), compiled.outputs())
+
+
+def test_the_session_codes_of_system_and_numerics_agree():
+    from clutchlab import system as contract
+    from clutchlab.numerics import session as S
+
+    assert (contract._ADVANCE, contract._OUTPUTS) == (S.ADVANCE, S.OUTPUTS)
+    assert contract._REPORT_KINDS == {"output": S.REPORT_OUTPUT, "state": S.REPORT_STATE, "mode": S.REPORT_MODE,
+                                      "mode_is": S.REPORT_MODE_IS}
+
+
+def test_a_session_packs_at_its_third_call():
+    """A session advanced once or twice (a settling run, a trim) goes through numba's dispatcher and compiles
+    nothing more; the third call packs it."""
+    sim = Simulation(toys.belt_system())
+    sim.advance(0.1)
+    sim.outputs()
+    assert sim._fast is None
+    sim.advance(0.2)
+    assert sim._fast[1] is not None
 
 
 def test_report_chooses_values_by_name_or_index():
@@ -580,6 +603,7 @@ from clutchlab.system import Simulation
 for pack in (True, False):
     sim = Simulation(system(PythonErr(2.0)))
     sim._pack = pack
+    sim._pack_after = 0  # (packed from the first call)
     for call in (lambda: sim.advance(1.0), sim.outputs, lambda: sim.step(1.0)):
         try:
             call()
