@@ -593,6 +593,29 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
                             system.name)
 
 
+#: bits of a session call (``clutchlab.numerics.session.ADVANCE`` and ``OUTPUTS``): advance to the end time;
+#: evaluate the outputs and the report at the time reached
+_ADVANCE = 1
+_OUTPUTS = 2
+#: kinds of reported values (``clutchlab.numerics.session.REPORT_*``) by the names :meth:`Simulation.report` takes
+_REPORT_KINDS = {"output": 0, "state": 1, "mode": 2, "mode_is": 3}
+
+
+def _held(name: str, doc: str) -> property:
+    """An attribute of :class:`Simulation` packed into its compiled call: replacing it unpacks the call (the next
+    call packs the objects again, through numba's dispatcher)."""
+    key = "_held_" + name
+
+    def get(self):
+        return self.__dict__[key]
+
+    def set_(self, value):
+        self.__dict__[key] = value
+        self.__dict__["_fast"] = None
+
+    return property(get, set_, doc=doc)
+
+
 class Simulation:
     """Resumable run of a system (co-simulation, controllers in the loop): ``advance(t_end, u)`` step by step.
 
@@ -607,7 +630,28 @@ class Simulation:
         Fixed-step mode (a HIL frame) with this step [s], as :func:`simulate`; the steps lie on the grid
         ``t0 + k * fixed_step`` whatever the times ``advance`` is called with (an advance to a time off the
         grid ends with a shorter step).  None: step-size control.
+
+    Notes
+    -----
+    The session's objects -- the parameters, ``x``, ``m``, ``u``, the solver state, options, event log and
+    buffers -- are packed once, at the third call (the first two go through numba's dispatcher, so that a
+    session advanced once or twice compiles nothing more), into a table that the model's compiled ``session`` entry
+    reads (:mod:`clutchlab.numerics.session`): a call passes one pointer and the end time instead of some
+    thirty arrays that numba would unbox at every call.  Their contents may change between calls (``x[0] =
+    ...``, ``u[:] = ...``); replacing one of ``system``, ``x``, ``m``, ``u`` or ``log`` by another object packs
+    them again at the next call.
     """
+
+    system = _held("system", "The simulated :class:`System`.")
+    x = _held("x", "State vector [SI] (changed in place by every call).")
+    m = _held("m", "Mode vector (int64, changed in place).")
+    u = _held("u", "Held inputs (order of ``system.inputs``, SI).")
+    log = _held("log", "Event log (:class:`clutchlab.numerics.core.EventLog`) of the session.")
+    fixed_step = _held("fixed_step", "Step [s] of the fixed-step mode (0.0: step-size control).")
+    _opt = _held("opt", "Options of the core.")
+    #: pack the session's objects for the compiled ``session`` entry (False: every call goes through numba's
+    #: dispatcher with all its arguments -- the general path, kept for comparison)
+    _pack = _held("pack", "Pack the session's objects (False: the general path).")
 
     def __init__(self, system: System, *, rtol=None, atol=None, max_step=None, max_steps: int = 100_000_000,
                  first_step=None, event_tol=None, t0: float = 0.0, fixed_step=None):
@@ -629,30 +673,73 @@ class Simulation:
         self._rm = np.empty((0, len(system.mode_names)), dtype=np.int64)
         self._ry = np.empty((1, len(system.outputs)))
         self._y = np.empty(len(system.outputs))
-        self._direct = {}  # entry name -> (compiled overload's entry, the arrays it was found for)
+        ny = len(system.outputs)
+        self._report_spec = np.zeros((ny, 3), dtype=np.int64)  # (kind, index, value) per reported value
+        self._report_spec[:, 1] = np.arange(ny)
+        self._r = np.empty(ny)
+        self._pack = True
+        #: calls that go through numba's dispatcher before the session packs its objects: a session advanced once
+        #: or twice (a settling run, a trim) neither packs nor compiles the model's ``session`` entry
+        self._pack_after = 2
+        self._dispatched = 0
+        self._fast = None  # (callable, handle): the packed call, or (self._general, None); None: not decided
 
-    def _call(self, name: str, method: str, args):
-        """Call the compiled entry ``name`` of this model's entry module for ``method`` with ``args``.
+    # ---- the compiled calls
+    def _call(self, t: float, what: int) -> int:
+        """One call of the session: ``what & _ADVANCE`` advances to ``t``; ``what & _OUTPUTS`` then evaluates
+        the outputs and the report (if the advance succeeded or ended at a terminal event).  Returns the
+        advance's status."""
+        fast = self._fast
+        if fast is None:
+            if not self._pack:
+                fast = self._fast = (self._general, None)
+            elif self._dispatched < self._pack_after:
+                self._dispatched += 1
+                return self._general(None, t, what)
+            else:
+                fast = self._fast = self._open()
+        return fast[0](fast[1], t, what)
 
-        The first call goes through numba's dispatch (compiling or loading the code); later calls go to the
-        compiled overload for these argument types directly (``overloads[signature].entry_point``), which
-        skips the dispatcher's type resolution of every argument -- about half of the per-call cost of a
-        session's ``advance`` (its parameter structure alone has tens of arrays).  The types cannot change
-        while the session's own arrays, parameters and options are the ones the entry was found for; if
-        any was replaced, the dispatcher is used again.
+    def _method(self) -> str:
+        return "rodas" if self.system.method == "rodas" or self.fixed_step > 0.0 else "dopri"
+
+    def _open(self):
+        """Pack the session's objects for the model's compiled ``session`` entry; ``(entry, handle)``.
+
+        The model's ``advance`` and ``evaluate_outputs`` are compiled (or loaded from numba's cache) for
+        these objects' types by their dispatchers, exactly as a dispatched call would, and the session
+        entry calls those overloads through their addresses.  Falls back to the general path if an
+        overload does not have the expected form.
         """
-        held = (self.system.params, self.x, self.m, self.u, self._opt)
-        entry = self._direct.get(name)
-        if entry is not None and all(a is b for a, b in zip(entry[1], held)):
-            return entry[0](*args)
-        dispatcher = getattr(self._core.entry_points(type(self.system.params), method), name)
-        out = dispatcher(*args)
-        try:
-            sig = tuple(dispatcher.typeof_pyval(a) for a in args)
-            self._direct[name] = (dispatcher.overloads[sig].entry_point, held)
-        except (KeyError, AttributeError, TypeError):  # (no such overload: keep dispatching)
-            self._direct.pop(name, None)
-        return out
+        from .numerics import session as S
+
+        params = self.system.params
+        opened = S.open_session(self._core.entry_points(type(params), self._method()),
+                                self._core.entry_points(type(params), "dopri"),
+                                (params, self.x, self.m, self.u, self._sf, self._si, self._opt, self.log, self._empty,
+                                 self._rt, self._rx, self._rm, self._ry, False, self._y, self._report_spec, self._r))
+        return opened if opened is not None else (self._general, None)
+
+    def _dispatch(self, name: str, method: str, args):
+        """The compiled entry ``name`` of the model's entry module for ``method``, called through numba's dispatcher."""
+        return getattr(self._core.entry_points(type(self.system.params), method), name)(*args)
+
+    def _general(self, _handle, t: float, what: int) -> int:
+        """:meth:`_call` through numba's dispatcher with all the arguments (no packed table)."""
+        code = st.SUCCESS
+        if what & _ADVANCE:
+            code = int(self._dispatch("advance", self._method(), (
+                self.system.params, self.x, self.m, self.u, t, self._sf, self._si, self._opt, self.log, self._empty,
+                self._rt, self._rx, self._rm, self._ry, False)))
+            if code != st.SUCCESS and code != st.TERMINATED:
+                return code
+        if what & _OUTPUTS:
+            self._dispatch("evaluate_outputs", "dopri", (self.system.params, self.time, self.x, self.u, self.m,
+                                                         self._y))
+            for k, (kind, i, value) in enumerate(self._report_spec.tolist()):
+                self._r[k] = (self._y[i] if kind == 0 else self.x[i] if kind == 1 else self.m[i] if kind == 2
+                              else float(self.m[i] == value))
+        return code
 
     @property
     def time(self) -> float:
@@ -670,12 +757,63 @@ class Simulation:
         """Integrate to ``t_end`` [s] holding the inputs ``u``; returns the status code (raises on failure)."""
         if u is not None:
             self.set_inputs(u)
-        method = "rodas" if self.system.method == "rodas" or self.fixed_step > 0.0 else "dopri"
-        code = self._call("advance", method, (self.system.params, self.x, self.m, self.u, float(t_end), self._sf,
-                                              self._si, self._opt, self.log, self._empty, self._rt, self._rx,
-                                              self._rm, self._ry, False))
-        _check_status(self.system, int(code), self._si, self.time, True)
-        return int(code)
+        code = self._call(float(t_end), _ADVANCE)
+        if code:  # (SUCCESS is 0)
+            _check_status(self.system, code, self._si, self.time, True)
+        return code
+
+    def step(self, t_end: float) -> np.ndarray:
+        """Integrate to ``t_end`` [s] with the held inputs and return the reported values there (:meth:`report`).
+
+        One compiled call: :meth:`advance` and the outputs at the time reached, for a co-simulation step.
+        The array returned is the session's own, rewritten by the next :meth:`step` or :meth:`outputs`
+        (copy it to keep it); it is written only by a step that succeeded.
+
+        Raises
+        ------
+        SimulationError
+            As :meth:`advance`.
+        """
+        code = self._call(float(t_end), _ADVANCE | _OUTPUTS)
+        if code:
+            _check_status(self.system, code, self._si, self.time, True)
+        return self._r
+
+    def reported(self) -> np.ndarray:
+        """The reported values (:meth:`report`) at the current point, without advancing; the array of :meth:`step`."""
+        self._call(0.0, _OUTPUTS)
+        return self._r
+
+    def report(self, sources) -> None:
+        """Choose the values :meth:`step` returns: outputs, states or modes of the system, in a given order.
+
+        Parameters
+        ----------
+        sources : sequence of tuple
+            ``("output", i)``, ``("state", i)``, ``("mode", i)`` (the mode's value as a float) or
+            ``("mode_is", i, value)`` (1.0 if mode ``i`` equals ``value``, else 0.0); ``i`` an index or a
+            name (``"clutch_torque"``, ``"slip_speed_rad_s"``, a mode name).  By default the outputs, in order.
+        """
+        spec = []
+        for src in sources:
+            kind, key = src[0], src[1]
+            if kind not in _REPORT_KINDS or len(src) != (3 if kind == "mode_is" else 2):
+                raise ParameterError(f"report: {src!r}: expected (kind, index) with kind one of 'output', 'state', "
+                                     "'mode', or ('mode_is', index, value)")
+            if kind == "output":
+                n, find = len(self.system.outputs), self.system.output_index
+            elif kind == "state":
+                n, find = len(self.system.states), self.system.state_index
+            else:
+                names = tuple(self.system.mode_names)
+                n, find = len(names), (lambda name: names.index(name) if name in names else -1)
+            i = find(key) if isinstance(key, str) else key
+            if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 0 <= i < n:
+                raise ParameterError(f"report: {src!r}: no {kind} {key!r} (the system has {n})")
+            spec.append((_REPORT_KINDS[kind], int(i), int(src[2]) if kind == "mode_is" else 0))
+        self._report_spec = np.array(spec, dtype=np.int64).reshape(len(spec), 3)
+        self._r = np.empty(len(spec))
+        self._fast = None  # (packed again at the next call)
 
     def run_sampled(self, T, R, meas_kind, meas_idx, act, lo, hi, delay, kind, f, A, B, C, D, xc, sched, par, memory,
                     u_op, Y, U, S) -> int:
@@ -699,7 +837,7 @@ class Simulation:
 
     def outputs(self) -> np.ndarray:
         """Output vector at the current point (order of ``system.outputs``)."""
-        self._call("evaluate_outputs", "dopri", (self.system.params, self.time, self.x, self.u, self.m, self._y))
+        self._call(0.0, _OUTPUTS)
         return self._y.copy()
 
     def events(self) -> pd.DataFrame:

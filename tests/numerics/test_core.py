@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 import core_toys as toys
+from session_check import assert_packed_as_compiled
 from hypothesis_budget import examples
 from clutchlab import SimulationError
 from clutchlab.numerics import core
@@ -212,25 +213,96 @@ def test_resumed_advance_matches_one_run(method):
 
 
 @pytest.mark.parametrize("method", METHODS)
-def test_direct_entry_calls_equal_dispatched_ones(method):
-    """After its first call a session calls the compiled overload directly (no numba dispatch): the same
-    steps, events and outputs as a session whose calls all go through the dispatcher, and a replaced state
-    array sends the next call through the dispatcher again."""
+def test_packed_session_calls_equal_dispatched_ones(method):
+    """A session packs its objects once and calls the model through one compiled entry
+    (clutchlab.numerics.session): the same steps, events, outputs and reports, bit for bit, as a session whose
+    calls all go through numba's dispatcher with every argument; replaced arrays, inputs and reports are
+    packed again at the next call."""
     system = toys.belt_system(method=method)
-    direct, plain = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
+    packed, plain = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
+    plain._pack = False  # (every call of this one dispatches)
+    assert packed._pack_after == 2
+    packed._pack_after = 0  # (packed from the first call)
+    for sim in (packed, plain):
+        sim.report([("state", 1), ("output", 0), ("mode", 0), ("mode_is", 0, 1), ("state", "position")])
     for k, t in enumerate(np.linspace(0.01, 1.5, 150)):
-        direct.advance(t)
-        plain._direct.clear()  # (every call of this one dispatches)
-        plain.advance(t)
-        y_direct, y_plain = direct.outputs(), plain.outputs()
-        plain._direct.clear()
-        assert np.array_equal(direct.x, plain.x) and np.array_equal(y_direct, y_plain)
+        if k % 3:
+            packed.advance(t)
+            plain.advance(t)
+            r_packed, r_plain = packed.outputs(), plain.outputs()
+        else:
+            r_packed, r_plain = packed.step(t).copy(), plain.step(t).copy()
+            assert np.array_equal(r_packed, [packed.x[1], packed.outputs()[0], packed.m[0], packed.m[0] == 1,
+                                             packed.x[0]])
+        assert np.array_equal(packed.x, plain.x) and np.array_equal(packed.m, plain.m)
+        assert np.array_equal(r_packed, r_plain) and packed.time == plain.time
         if k == 70:
-            direct.x = direct.x.copy()  # a new array of the same type: found again by the dispatcher
-    assert set(direct._direct) == {"advance", "evaluate_outputs"} and direct._direct["advance"][1][1] is direct.x
-    assert direct.stats == plain.stats
-    pd_direct, pd_plain = direct.events(), plain.events()
-    assert list(pd_direct.event) == list(pd_plain.event) and np.array_equal(pd_direct.time_s, pd_plain.time_s)
+            packed.x = packed.x.copy()  # a new array of the same type: packed again, and then used
+            assert packed._fast is None
+    assert packed._fast[1].owners[1] is packed.x and plain._fast[1] is None
+    assert packed.stats == plain.stats
+    pd_packed, pd_plain = packed.events(), plain.events()
+    assert list(pd_packed.event) == list(pd_plain.event) and np.array_equal(pd_packed.time_s, pd_plain.time_s)
+
+
+@pytest.mark.parametrize("system", [toys.belt_system(), toys.ball_system(1.0, 0.5, method="rodas"),
+                                    toys.linear_system(OSC, [1.0, 0.0]), toys.chain_system(pattern=True)],
+                         ids=["belt", "ball", "linear", "chain"])
+def test_a_session_table_written_from_python_equals_the_compiled_one(system):
+    assert_packed_as_compiled(Simulation(system))
+
+
+def test_a_session_packed_by_the_compiled_packing_runs_the_same(monkeypatch):
+    """A structure the Python packing does not know is packed by the model's compiled session_pack."""
+    from clutchlab.numerics import session as S
+
+    system = toys.belt_system()
+    python, compiled = Simulation(system, rtol=1e-9), Simulation(system, rtol=1e-9)
+    python._pack_after = compiled._pack_after = 0
+    python.advance(0.5)
+    monkeypatch.setattr(S, "_plan", lambda args_ty: None)
+    compiled.advance(0.5)
+    assert compiled._fast[1] is not None
+    assert np.array_equal(python.x, compiled.x) and np.array_equal(python.outputs(), compiled.outputs())
+
+
+def test_the_session_codes_of_system_and_numerics_agree():
+    from clutchlab import system as contract
+    from clutchlab.numerics import session as S
+
+    assert (contract._ADVANCE, contract._OUTPUTS) == (S.ADVANCE, S.OUTPUTS)
+    assert contract._REPORT_KINDS == {"output": S.REPORT_OUTPUT, "state": S.REPORT_STATE, "mode": S.REPORT_MODE,
+                                      "mode_is": S.REPORT_MODE_IS}
+
+
+def test_a_session_packs_at_its_third_call():
+    """A session advanced once or twice (a settling run, a trim) goes through numba's dispatcher and compiles
+    nothing more; the third call packs it."""
+    sim = Simulation(toys.belt_system())
+    sim.advance(0.1)
+    sim.outputs()
+    assert sim._fast is None
+    sim.advance(0.2)
+    assert sim._fast[1] is not None
+
+
+def test_report_chooses_values_by_name_or_index():
+    sim = Simulation(toys.belt_system())
+    sim.report([("state", "velocity_m_s"), ("mode", "friction"), ("output", 0)])
+    r = sim.step(0.2)
+    assert np.array_equal(r, [sim.x[1], sim.m[0], sim.outputs()[0]]) and sim.reported() is r
+    for bad in ([("state", 2)], [("output", "nope")], [("mode", "nope")], [("modes", 0)], [("mode_is", 0)],
+                [("state", True)]):
+        with pytest.raises(ParameterError, match="report|unknown"):
+            sim.report(bad)
+
+
+def test_a_failed_step_leaves_the_report_of_the_last_good_one():
+    sim = Simulation(toys.belt_system(), max_steps=40)
+    r = sim.step(0.01).copy()
+    with pytest.raises(SimulationError, match="step limit|steps"):
+        sim.step(10.0)
+    assert np.array_equal(sim._r, r)
 
 
 def test_inputs_are_held_over_an_advance():
@@ -436,6 +508,25 @@ def test_compiled_entry_points_are_per_model_and_follow_edits(tmp_path):
     assert "decay 0.1353352" in out and seconds > 0.0
 
 
+_SESSION = ("import core_toys as T; from clutchlab.system import Simulation; "
+            "s = Simulation(T.belt_system({method!r})); s.advance(0.5); y = s.outputs(); r = s.step(1.0); "
+            "print('belt', repr(float(y[1])), repr(float(r[0])), s.stats['accepted_steps'])")
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_packed_session_entries_are_reused_by_a_second_process(tmp_path, method):
+    """The compiled session entries (clutchlab.numerics.session: packing, the call through the overloads'
+    addresses) are cached like the rest: a second process loads them and compiles nothing."""
+    support = str(Path(__file__).parents[1] / "_support")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), CLUTCHLAB_COMPILE_NOTICE="0",
+               CLUTCHLAB_COMPILE_REPORT="1", PYTHONPATH=os.pathsep.join([support] + sys.path))
+    first, seconds = _run(_SESSION.format(method=method), env)
+    assert first.startswith("belt") and seconds > 0.0
+    again, seconds = _run(_SESSION.format(method=method), env)
+    assert again == first
+    assert seconds == 0.0, "the session's cached entries were not reused"
+
+
 def test_grouped_finite_difference_jacobian_matches_the_dense_one():
     """A declared sparsity pattern groups the difference columns: same solution, fewer right-hand sides."""
     dense = simulate(toys.chain_system(pattern=False), 0.2, output_step=0.01)
@@ -507,6 +598,18 @@ try:
     print("python no error")
 except ZeroDivisionError:
     print("python ZeroDivisionError")
+# the same error out of a session, packed or through the dispatcher
+from clutchlab.system import Simulation
+for pack in (True, False):
+    sim = Simulation(system(PythonErr(2.0)))
+    sim._pack = pack
+    sim._pack_after = 0  # (packed from the first call)
+    for call in (lambda: sim.advance(1.0), sim.outputs, lambda: sim.step(1.0)):
+        try:
+            call()
+            print("session no error")
+        except ZeroDivisionError as exc:
+            print("session", type(exc).__name__, exc)
 """
 
 
@@ -523,3 +626,6 @@ def test_hooks_keep_their_error_model_inside_the_core(tmp_path):
     out, _ = _run("import toy_division", env)
     assert "numpy inf inf" in out
     assert "python ZeroDivisionError" in out
+    # an exception raised by a hook leaves a session as it leaves numba's dispatcher
+    session = [line for line in out.splitlines() if line.startswith("session")]
+    assert len(session) == 6 and session[:3] == session[3:] and "ZeroDivisionError" in session[0], out

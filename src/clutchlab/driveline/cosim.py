@@ -145,7 +145,7 @@ class DrivelineCoSimulation(ContractCoSimulation):
         """No inputs: an empty vector (``inputs`` is empty)."""
         return np.empty(0)
 
-    def output_values(self, y: np.ndarray) -> dict:
-        """Every state and output of the driveline, by name, from the current state and ``y``."""
-        values = np.concatenate((self.simulation.x, y))
-        return {v.name: float(x) for v, x in zip(self.outputs, values)}
+    def output_sources(self) -> list:
+        """Every state and then every output of the driveline (the order of :attr:`outputs`)."""
+        return ([("state", i) for i in range(len(self.system.states))]
+                + [("output", i) for i in range(len(self.system.outputs))])

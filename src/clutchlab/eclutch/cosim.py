@@ -25,6 +25,7 @@ from .models import ClutchModel, EClutchParameters
 __all__ = ["EClutchCoSimulation"]
 
 _CLUTCH_SKIP = ("k_fl_model1",)
+_INF = float("inf")
 
 
 class EClutchCoSimulation(CoSimulation):
@@ -96,25 +97,19 @@ class EClutchCoSimulation(CoSimulation):
         system = self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
         self.simulation = Simulation(system, fixed_step=self.fixed_step)
         self._nz = self.eclutch.assembly.nz
+        b0 = 2 * self._nz
+        # the outputs (in the order of `outputs`), gathered by the compiled step from the states and outputs
+        self.simulation.report([("state", 1), ("output", 1), ("state", b0 + 2), ("state", b0), ("state", 0),
+                                ("state", b0 + 3), ("output", 0), ("output", 3), ("output", 4)])
+        self._held = self.simulation.u
+        self._names = tuple(v.name for v in self.outputs)
+        self._by_reference = self.input_name == "bearing_reference"
         self.t = 0.0
 
     def _outputs(self, inputs) -> dict:
         sim = self.simulation
         sim.set_inputs([self.resolve_inputs(inputs)[self.input_name]])
-        y = sim.outputs()
-        x = sim.x
-        b0 = 2 * self._nz
-        return {
-            "bearing_position": float(x[1]),
-            "bearing_force": float(y[1]),
-            "pressure": float(x[b0 + 2]),
-            "master_pressure": float(x[b0]),
-            "master_position": float(x[0]),
-            "motor_current": float(x[b0 + 3]),
-            "motor_voltage_applied": float(y[0]),
-            "normal_force": float(y[3]),
-            "clutch_torque": float(y[4]),
-        }
+        return dict(zip(self._names, sim.reported().tolist()))
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 (the rest state)."""
@@ -128,6 +123,20 @@ class EClutchCoSimulation(CoSimulation):
             raise SimulationError(f"do_step at t = {t!r} s but the E-clutch is at t = {self.t!r} s "
                                   "(steps must be contiguous; call reset() to start again)")
         u = self.resolve_inputs(inputs)[self.input_name]
-        self.simulation.advance(float(t + dt), [u])
+        self.simulation.set_inputs([u])
+        y = self.simulation.step(float(t + dt))
         self.t = t + dt
-        return self._outputs(inputs)
+        return dict(zip(self._names, y.tolist()))
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
+        reference, voltage = u
+        d = abs(t - self.t)
+        if not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))
+                and -_INF < reference < _INF and -_INF < voltage < _INF):  # every check of do_step, in its order
+            out = self.do_step(t, dt, {"bearing_reference": reference, "motor_voltage": voltage})
+            return np.array([out[name] for name in self._names])
+        self._held[0] = reference if self._by_reference else voltage
+        y = self.simulation.step(t + dt)
+        self.t = t + dt
+        return y

@@ -37,6 +37,7 @@ import abc
 import dataclasses
 import importlib
 import math
+import sys
 
 import numpy as np
 
@@ -163,6 +164,35 @@ class CoSimulation(abc.ABC):
     @abc.abstractmethod
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from t to t+dt with the inputs held constant (zero-order hold); return outputs at t+dt."""
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` as the FMU calls it at every communication step: values in order, no names.
+
+        The models override it with their fast path -- the checks of :meth:`do_step`, the inputs written
+        into the held input vector, and one compiled call that advances and gathers the outputs
+        (:meth:`clutchlab.system.Simulation.step`), with no dictionary built per step; this default goes
+        through :meth:`do_step`.
+
+        Parameters
+        ----------
+        t, dt : float
+            Communication point and step [s].
+        u : sequence of float
+            Input values in the order of :attr:`inputs`.
+
+        Returns
+        -------
+        ndarray
+            Output values at ``t + dt`` in the order of :attr:`outputs`: the model's own array, rewritten by
+            its next successful step (copy it to keep it).
+
+        Raises
+        ------
+        SimulationError, ParameterError
+            As :meth:`do_step`.
+        """
+        out = self.do_step(t, dt, {v.name: x for v, x in zip(self.inputs, u)})
+        return np.array([out[v.name] for v in self.outputs], dtype=float)
 
     # ------------------------------------------------------------- optional hooks and helpers
     @classmethod
@@ -347,6 +377,9 @@ def fixed_step_parameter(values: dict):
                              "[s]") from None
 
 
+_INF = math.inf
+
+
 def _check_time(owner: str, t_model: float, t: float, dt: float):
     if not (math.isfinite(t) and math.isfinite(dt)) or dt <= 0:
         raise SimulationError(f"{owner}.do_step: step size dt = {dt!r} must be > 0 [s]")
@@ -361,10 +394,11 @@ class ContractCoSimulation(CoSimulation):
 
     A model's co-simulation subclasses this and supplies only :meth:`build_system` (its
     :class:`~clutchlab.system.System` from the parameter values), :meth:`input_vector` (the held
-    inputs ``u`` from the FMI inputs) and :meth:`output_values` (FMI outputs from the model's output
-    vector).  Stepping is the core's resumable ``advance``
+    inputs ``u`` from the FMI inputs) and :meth:`output_sources` (where each FMI output comes from: an
+    output, state or mode of the system).  Stepping is the core's resumable ``advance``
     (:class:`clutchlab.system.Simulation`): each ``do_step`` continues the integration from the
-    stored state, modes, step size and memories, with the inputs held (zero-order hold).
+    stored state, modes, step size and memories, with the inputs held (zero-order hold); the FMI
+    outputs are gathered in the same compiled call (:meth:`~clutchlab.system.Simulation.step`).
 
     Attributes
     ----------
@@ -388,8 +422,15 @@ class ContractCoSimulation(CoSimulation):
         """Held inputs ``u`` of the System from the FMI input values ``inputs`` (all present, checked)."""
 
     @abc.abstractmethod
-    def output_values(self, y: np.ndarray) -> dict:
-        """FMI outputs by name from the System's output vector ``y`` at the current point."""
+    def output_sources(self) -> list:
+        """Where each FMI output comes from, in the order of :attr:`outputs`: ``("output", name)``,
+        ``("state", name)`` or ``("mode", index)`` of the System (:meth:`clutchlab.system.Simulation.report`)."""
+
+    def write_inputs(self, u) -> None:
+        """Hold the FMI input values ``u`` (in the order of :attr:`inputs`), checked as :meth:`do_step` checks
+        them: this default goes through :meth:`resolve_inputs` and :meth:`input_vector`."""
+        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(
+            {v.name: x for v, x in zip(self.inputs, u)})))
 
     def reset(self) -> None:
         """Back to the initial state at t = 0 (same parameters)."""
@@ -397,17 +438,33 @@ class ContractCoSimulation(CoSimulation):
 
         self.system = self.build_system(self._values)
         self.simulation = Simulation(self.system, **self.simulation_options)
+        self.simulation.report(self.output_sources())
+        self._output_names = tuple(v.name for v in self.outputs)
+
+    def _output_dict(self, values) -> dict:
+        return dict(zip(self._output_names, values.tolist()))
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 with the given inputs held."""
         self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
-        return self.output_values(self.simulation.outputs())
+        return self._output_dict(self.simulation.reported())
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` [s] with ``inputs`` held; outputs at ``t + dt``."""
         _check_time(type(self).__name__, self.simulation.time, t, dt)
-        self.simulation.advance(t + dt, self.input_vector(self.resolve_inputs(inputs)))
-        return self.output_values(self.simulation.outputs())
+        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
+        return self._output_dict(self.simulation.step(t + dt))
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
+        sim = self.simulation
+        t_model = sim.time
+        d = abs(t - t_model)
+        if not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))):
+            _check_time(type(self).__name__, t_model, t, dt)
+        if len(u) or self.inputs:
+            self.write_inputs(u)
+        return sim.step(t + dt)
 
 
 # ===================================================================== wet clutch
@@ -541,6 +598,10 @@ class WetCoSimulation(CoSimulation):
             heater_setpoint_c=values["scenario.heater_setpoint"])
         self._mu_scale = values["scenario.mu_scale"]
         self._table = _wet_output_table()
+        self._output_names = tuple(v.name for v in self.outputs)
+        # the input checks of _inputs as two comparisons (NaN and infinities fail them as well)
+        self._force_max = self.bench.actuator_force_max * (1 + 1e-12)
+        self._speed_max = self.bench.drive_speed_max if self.scenario.motor == "speed" else sys.float_info.max
         self.reset()
 
     def reset(self) -> None:
@@ -586,29 +647,18 @@ class WetCoSimulation(CoSimulation):
         params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
         system = W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params, x0=x0,
                                      rtol=self.rtol)
-        # where each FMI output comes from, resolved once (a name lookup per output and step cost more
-        # than the integration of a 1 ms step)
-        self._sources = [(name, src[0], system.output_index(src[1]) if src[0] == "output"
-                          else system.state_index(src[1]) if src[0] == "state" else W.M_FRICTION)
-                         for name, _, _, src in self._table]
         self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000,
                                      fixed_step=self.fixed_step)
+        # the FMI outputs, gathered by the compiled step (a name lookup per output and step cost more than the
+        # integration of a 1 ms step, and a dict of them as much again)
+        self.simulation.report([src if src[0] != "stick" else ("mode_is", W.M_FRICTION, 1)
+                                for _, _, _, src in self._table])
+        self._held = self.simulation.u  # the held references, written in place by every step
+        self._event_count = self.simulation.log.count
         self.simulation.set_inputs(self._inputs(u))
 
     def _outputs(self):
-        sim = self.simulation
-        y = sim.outputs()
-        x = sim.x
-        m = sim.m
-        out = {}
-        for name, kind, i in self._sources:
-            if kind == "output":
-                out[name] = float(y[i])
-            elif kind == "state":
-                out[name] = float(x[i])
-            else:
-                out[name] = 1.0 if m[i] == 1 else 0.0
-        return out
+        return dict(zip(self._output_names, self.simulation.reported().tolist()))
 
     def initial_outputs(self, inputs: dict) -> dict:
         u = self.resolve_inputs(inputs)
@@ -628,28 +678,51 @@ class WetCoSimulation(CoSimulation):
         ParameterError
             Unknown or out-of-range input.
         """
-        from ..wet import engagement as E
-
         _check_time("WetCoSimulation", self.time, t, dt)
         u = self.resolve_inputs(inputs)
+        y = self.do_step_array(t, dt, (u["force_reference"], u["slip_speed_reference"]))
+        return dict(zip(self._output_names, y.tolist()))
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
+        f, w = u
+        d = abs(t - self.time)
+        if (self.simulation is None
+                or not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))
+                        and 0.0 <= f <= self._force_max and abs(w) <= self._speed_max)):
+            return self._step_checked(t, dt, f, w)
+        held = self._held
+        held[0] = f
+        held[1] = w
+        return self._step(t, t + dt)
+
+    def _step_checked(self, t, dt, f, w):
+        # a step with every check of do_step, in its order (the first step, or one that fails a check)
+        _check_time("WetCoSimulation", self.time, t, dt)
+        u = self.resolve_inputs({"force_reference": f, "slip_speed_reference": w})
         if self.simulation is None:
             self._start(u)
-        t_end = t + dt
+        self.simulation.set_inputs(self._inputs(u))
+        return self._step(t, t + dt)
+
+    def _step(self, t, t_end):
         try:
-            self.simulation.advance(t_end, self._inputs(u))
+            y = self.simulation.step(t_end)
         except SimulationError as exc:
             raise SimulationError(f"WetCoSimulation: between t = {t} and {t_end} s: {exc}") from None
         self.time = t_end
-        log = self.simulation.log
-        n = int(log.count[0])
-        if n > self._n_events:  # new events only (a DataFrame per step cost more than the step itself)
+        if self._event_count[0] > self._n_events:  # new events only (a DataFrame per step cost more than the step)
+            from ..wet import engagement as E
+
+            log = self.simulation.log
+            n = int(log.count[0])
             names = self.simulation.system.events
             for i in range(self._n_events, n):
                 name = names[int(log.code[i])]
                 if name in E.EVENT_KINDS:
                     self.events.append(E.Event(float(log.time[i]), E.EVENT_KINDS[name]))
             self._n_events = n
-        return self._outputs()
+        return y
 
 
 # ===================================================================== EMTC
@@ -779,11 +852,7 @@ class EmtcCoSimulation(ContractCoSimulation):
         """The ``emtc_bench`` system with the inputs held by the master (``values``: the parameters, by name)."""
         from ..emtc.system import bench_system
 
-        system = bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
-        cols = {("state", c): i for i, c in enumerate(system.state_columns)}
-        cols.update({("output", c): i for i, c in enumerate(system.output_columns)})
-        self._sources = [(src[0], src[1] if src[0] == "mode" else cols[src]) for _, _, _, src in _EMTC_OUTPUTS]
-        return system
+        return bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
 
     def input_vector(self, inputs: dict) -> np.ndarray:
         """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear, coil_current_command]`` from the
@@ -793,14 +862,9 @@ class EmtcCoSimulation(ContractCoSimulation):
             raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
         return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"], 0.0])
 
-    def output_values(self, y: np.ndarray) -> dict:
-        """FMI outputs from the output vector ``y`` and the current states and modes."""
-        x = self.simulation.x
-        m = self.simulation.m
-        out = {}
-        for (name, _, _, _), (kind, i) in zip(_EMTC_OUTPUTS, self._sources):
-            out[name] = float(x[i] if kind == "state" else (y[i] if kind == "output" else m[i]))
-        return out
+    def output_sources(self) -> list:
+        """The FMI outputs: outputs, states (by column) and modes of the ``emtc_bench`` system."""
+        return [src for _, _, _, src in _EMTC_OUTPUTS]
 
     # ---- what the EMTC adds: the initial speeds, sample instants, named events, memories that grow
     def reset(self) -> None:
@@ -826,14 +890,18 @@ class EmtcCoSimulation(ContractCoSimulation):
         self._started = True
 
     def _advance(self, target, uv):
-        """Advance to ``target`` with the inputs ``uv``; a full memory replays the steps with a larger one."""
-        from ..emtc.system import EVENT_DESCRIPTIONS, EVENTS, memory_full
+        """Advance to ``target`` with the inputs ``uv`` (a tuple); the outputs there (:meth:`Simulation.step`).
 
+        A full memory replays the steps with a larger one."""
         while True:
+            held = self.simulation.u
+            held[0], held[1], held[2], held[3], held[4] = uv
             try:
-                self.simulation.advance(target, uv)
+                y = self.simulation.step(target)
                 break
             except SimulationError as exc:
+                from ..emtc.system import memory_full
+
                 if not memory_full(self.system):
                     raise SimulationError(f"EmtcCoSimulation: {exc}") from None
                 # the same steps again with four times the memory (the run does not depend on its size)
@@ -846,10 +914,14 @@ class EmtcCoSimulation(ContractCoSimulation):
                 self._n_logged = int(self.simulation.log.count[0])
         self._history.append((target, uv))
         log = self.simulation.log
-        n = int(log.count[0])
-        self.events.extend((float(log.time[i]), EVENT_DESCRIPTIONS[EVENTS[int(log.code[i])]])
-                           for i in range(self._n_logged, n))
-        self._n_logged = n
+        if log.count[0] > self._n_logged:
+            from ..emtc.system import EVENT_DESCRIPTIONS, EVENTS
+
+            n = int(log.count[0])
+            self.events.extend((float(log.time[i]), EVENT_DESCRIPTIONS[EVENTS[int(log.code[i])]])
+                               for i in range(self._n_logged, n))
+            self._n_logged = n
+        return y
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 with the given inputs held (the shaft speeds start free rolling on the drums)."""
@@ -876,7 +948,21 @@ class EmtcCoSimulation(ContractCoSimulation):
             Unknown or out-of-range input.
         """
         _check_time("EmtcCoSimulation", self.time, t, dt)
-        uv = self.input_vector(self.resolve_inputs(inputs))
+        return self._output_dict(self._step(t, dt, tuple(self.input_vector(self.resolve_inputs(inputs)).tolist())))
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
+        torque, throttle, front, rear = u
+        d = abs(t - self.time)
+        if (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t)) and -_INF < torque < _INF
+                and 0.0 <= throttle <= 1.0 and -_INF < front < _INF and -_INF < rear < _INF):
+            uv = (torque, throttle, front, rear, 0.0)  # (as input_vector)
+        else:  # every check of do_step, in its order
+            _check_time("EmtcCoSimulation", self.time, t, dt)
+            uv = tuple(self.input_vector(self.resolve_inputs({v.name: x for v, x in zip(self.inputs, u)})).tolist())
+        return self._step(t, dt, uv)
+
+    def _step(self, t, dt, uv):
         if not self._started:
             self._start(uv)
         ts = self.sample_time
@@ -884,6 +970,8 @@ class EmtcCoSimulation(ContractCoSimulation):
         k = round(t_end / ts)
         target = k * ts if abs(k * ts - t_end) <= 1e-9 * ts else t_end  # a sample instant counts as itself
         if target > self.simulation.time:
-            self._advance(target, uv)
+            y = self._advance(target, uv)
+        else:  # (nothing to integrate: the outputs with the inputs held so far)
+            y = self.simulation.reported()
         self.time = t_end
-        return self.output_values(self.simulation.outputs())
+        return y

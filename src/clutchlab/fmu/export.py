@@ -193,17 +193,27 @@ def _slave_base():
             stop, step = cls.experiment or DEFAULT_EXPERIMENT.get(self.model_key, (1.0, 1e-3))
             self.default_experiment = DefaultExperiment(start_time=0.0, stop_time=stop, step_size=step)
             self.cosim_class = cls
-            self.values = {}
+            self.values = {}  # the parameters, by name
             self.cosim = None
-            for group, causality, variability in ((cls.parameters, Fmi2Causality.parameter, Fmi2Variability.fixed),
-                                                  (cls.inputs, Fmi2Causality.input, Fmi2Variability.continuous),
-                                                  (cls.outputs, Fmi2Causality.output, Fmi2Variability.continuous)):
-                for var in group:
-                    self.values[var.name] = var.start
-                    self.register_variable(Real(
-                        var.name, causality=causality, variability=variability, description=var.description or None,
-                        getter=(lambda n=var.name: self.values[n]),
-                        setter=(lambda x, n=var.name: self.values.__setitem__(n, float(x)))), nested=False)
+            # the inputs and outputs in order: the co-simulation steps on these (do_step_array), no dict per step
+            self.input_values = [var.start for var in cls.inputs]
+            self.output_values = [var.start for var in cls.outputs]
+            for var in cls.parameters:
+                self.values[var.name] = var.start
+                self.register_variable(Real(
+                    var.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                    description=var.description or None, getter=(lambda n=var.name: self.values[n]),
+                    setter=(lambda x, n=var.name: self.values.__setitem__(n, float(x)))), nested=False)
+            for i, var in enumerate(cls.inputs):
+                self.register_variable(Real(
+                    var.name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+                    description=var.description or None, getter=(lambda i=i: self.input_values[i]),
+                    setter=(lambda x, i=i: self.input_values.__setitem__(i, float(x)))), nested=False)
+            for i, var in enumerate(cls.outputs):
+                self.register_variable(Real(
+                    var.name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                    description=var.description or None, getter=(lambda i=i: float(self.output_values[i]))),
+                    nested=False)
             # read by the shim after a discarded step (fmi2_shim.c): True if this slave refused the last step
             self.step_error = False
             self.register_variable(Boolean(
@@ -213,7 +223,7 @@ def _slave_base():
                 getter=lambda: self.step_error), nested=False)
 
         def _inputs(self):
-            return {v.name: self.values[v.name] for v in self.cosim_class.inputs}
+            return dict(zip((v.name for v in self.cosim_class.inputs), self.input_values))
 
         def _fail(self, exc) -> bool:
             self.log(f"{type(exc).__name__}: {exc}", status=Fmi2Status.error)
@@ -228,7 +238,8 @@ def _slave_base():
                     raise ClutchlabError(f"FMU built with clutchlab {self.built_with}, installed is {__version__}")
                 params = {v.name: self.values[v.name] for v in self.cosim_class.parameters}
                 self.cosim = self.cosim_class(**params)
-                self.values.update(self.cosim.initial_outputs(self._inputs()))
+                initial = self.cosim.initial_outputs(self._inputs())
+                self.output_values = [initial[v.name] for v in self.cosim_class.outputs]
             except Exception:
                 # pythonfmu reports a raised exception as fmi2Fatal and releases the instance, its class and
                 # its log queue once when it fails and once more in fmi2FreeInstance: hold what it over-releases
@@ -241,7 +252,8 @@ def _slave_base():
         def _step(self, current_time: float, step_size: float) -> bool:
             self.step_error = False
             try:
-                self.values.update(self.cosim.do_step(float(current_time), float(step_size), self._inputs()))
+                # the co-simulation's own array of outputs, written only by a step that succeeds
+                self.output_values = self.cosim.do_step_array(float(current_time), float(step_size), self.input_values)
             except Exception as exc:  # reported to the master through the FMI logger
                 self.step_error = True
                 return self._fail(exc)

@@ -52,6 +52,7 @@ import numpy as np
 
 from clutchlab.numerics import core as _core
 from clutchlab.numerics import sampled as _sampled
+from clutchlab.numerics import session as _session
 from clutchlab.numerics.borrow import borrow as _borrow, byref as _byref, take as _take
 from clutchlab.numerics.entry import rehome as _rehome
 
@@ -118,6 +119,17 @@ def closed_loop(p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx, a
             if code != 0 and code != 3:
                 return code, k + 1
     return code, n + 1
+
+
+@numba.njit(cache=True, nogil=True)
+def session_pack(address, args, advance_at, outputs_at):
+    # a Simulation's arguments packed once (clutchlab.numerics.session)
+    _session.pack(address, args, advance_at, outputs_at)
+
+
+# one call of a Simulation: advance and outputs through their addresses (clutchlab.numerics.session.call,
+# compiled as this module's function)
+session = numba.njit(cache=True, nogil=True)(_rehome(_session.call, __file__, __name__, "session"))
 
 
 @numba.njit(cache=True, nogil=True)
