@@ -30,7 +30,7 @@ from numba import uintp as _u
 
 from ._limits import short_repr
 from .errors import DataError, ParameterError
-from .numerics.interp import bracket_range
+from .numerics.interp import segment_range
 
 __all__ = ["Curve", "series", "parallel", "curve_eval", "curve_eval_range", "curve_eval_segment", "KIND_CODES",
            "EXTRAPOLATION_CODES"]
@@ -125,16 +125,16 @@ def curve_eval_segment(xs, fs, ds, start, stop, kind, extrap, x, hint):
         return fs[last] + s * (x - xs[last]), s, -1
     if start <= hint < stop - 1 and xs[_u(hint)] <= x < xs[_u(hint + 1)]:
         k = hint
-        lo = _u(k)
-        t = (x - xs[lo]) / (xs[lo + _u(1)] - xs[lo])
     else:
-        k, t = bracket_range(xs, start, stop, x)  # segment xs[lo] <= x <= xs[lo+1], binary search
-        lo = _u(k)
+        k = segment_range(xs, start, stop, x)  # segment xs[lo] <= x < xs[lo+1], binary search
+    lo = _u(k)
     hi = lo + _u(1)
     h = xs[hi] - xs[lo]
     if kind == 0:
         s = (fs[hi] - fs[lo]) / h
         return fs[lo] + s * (x - xs[lo]), s, k
+    inv_h = 1.0 / h  # (one division: the position in the segment and the derivative's two 1/h terms)
+    t = (x - xs[lo]) * inv_h
     t2 = t * t
     t3 = t2 * t
     h00 = 2.0 * t3 - 3.0 * t2 + 1.0
@@ -142,11 +142,10 @@ def curve_eval_segment(xs, fs, ds, start, stop, kind, extrap, x, hint):
     h01 = -2.0 * t3 + 3.0 * t2
     h11 = t3 - t2
     val = h00 * fs[lo] + h10 * h * ds[lo] + h01 * fs[hi] + h11 * h * ds[hi]
-    dh00 = (6.0 * t2 - 6.0 * t) / h
+    dh00 = (6.0 * t2 - 6.0 * t) * inv_h  # (dh01 = -dh00)
     dh10 = 3.0 * t2 - 4.0 * t + 1.0
-    dh01 = (-6.0 * t2 + 6.0 * t) / h
     dh11 = 3.0 * t2 - 2.0 * t
-    der = dh00 * fs[lo] + dh10 * ds[lo] + dh01 * fs[hi] + dh11 * ds[hi]
+    der = dh00 * (fs[lo] - fs[hi]) + dh10 * ds[lo] + dh11 * ds[hi]
     return val, der, k
 
 

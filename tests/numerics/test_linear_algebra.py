@@ -34,10 +34,10 @@ def _solve(J, mass, h, b):
     """``(M/(h gamma) - J) y = b`` through the plan; (ok, y, dense fallback used)."""
     n = J.shape[0]
     iw, fw = _plan(J, mass)
-    G = -J.copy()
-    G[np.diag_indices(n)] += mass / (h * GAMMA)
+    G = np.full((n, n), np.nan)  # only the entries the solves read are written
     piv = np.zeros(n, dtype=np.int64)
-    ok = reduced_factor(G, iw, fw, piv)
+    ok = reduced_factor(np.ascontiguousarray(J), np.ascontiguousarray(mass, dtype=float), 1.0 / (h * GAMMA), G, iw,
+                        fw, piv)
     y = b.copy()
     if ok:
         reduced_solve(G, iw, fw, piv, y)

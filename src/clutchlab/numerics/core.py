@@ -637,14 +637,8 @@ def _rodas_step(p, t, x, h, u, m, J, mass, f0, ft, nonauto, xnew, err, G, piv, i
     used again.
     """
     n = x.shape[0]
-    if refactor:
-        hg = 1.0 / (h * R_GAMMA)
-        for i in range(n):
-            for j in range(n):
-                G[i, j] = -J[i, j]
-            G[i, i] += mass[i] * hg
-        if not reduced_factor(G, iw, fw, piv):
-            return False
+    if refactor and not reduced_factor(J, mass, 1.0 / (h * R_GAMMA), G, iw, fw, piv):
+        return False
     for i in range(n):
         K1[i] = f0[i] + (h * R_GAMMA1 * ft[i] if nonauto else 0.0)
     reduced_solve(G, iw, fw, piv, K1)

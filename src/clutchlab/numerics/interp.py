@@ -39,3 +39,21 @@ def bracket_range(grid, start, stop, x):
         else:
             hi = mid
     return lo, (x - grid[_u(lo)]) / (grid[_u(lo + 1)] - grid[_u(lo)])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def segment_range(grid, start, stop, x):
+    """Segment of ``grid[start:stop]`` holding ``x`` inside it: ``lo`` with ``grid[lo] <= x < grid[lo + 1]``.
+
+    The binary search of :func:`bracket_range` without the fraction (the caller computes it with its own
+    reciprocal of the segment length); ``grid[start] < x < grid[stop - 1]`` is the caller's to check.
+    """
+    lo = start
+    hi = stop - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if grid[_u(mid)] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return lo

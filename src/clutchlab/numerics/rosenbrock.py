@@ -68,7 +68,10 @@ MAX_FACTOR = 6.0
 def lu_factor(a, piv):
     """In-place LU factorisation with partial pivoting of a small dense matrix.
 
-    Returns False if the matrix is singular to working precision.
+    ``a`` receives the unit lower factor below the diagonal, U above it and the *reciprocals* of U's
+    diagonal on it (:func:`lu_solve` multiplies by them: a division on the critical path of each row of a
+    back substitution costs several multiplications).  Returns False if the matrix is singular to working
+    precision.
     """
     n = a.shape[0]
     for k in range(n):
@@ -91,6 +94,7 @@ def lu_factor(a, piv):
                 a[uk, uj] = a[up, uj]
                 a[up, uj] = tmp
         inv = 1.0 / a[uk, uk]
+        a[uk, uk] = inv
         for i in range(k + 1, n):
             ui = _u(i)
             lik = a[ui, uk] * inv
@@ -128,7 +132,7 @@ def lu_solve(lu, piv, b):
         for j in range(i + 1, n):
             uj = _u(j)
             s -= lu[ui, uj] * b[uj]
-        b[ui] = s / lu[ui, ui]
+        b[ui] = s * lu[ui, ui]  # (the reciprocal of U's diagonal: lu_factor)
 
 
 # ---------------------------------------------------------------- the linear systems of a step, reduced
@@ -147,7 +151,7 @@ _HEAD = 8
 @numba.njit(cache=True, nogil=True)
 def reduction_sizes(n):
     """Lengths ``(int work, float work)`` of the arrays :func:`plan_reduction` and :func:`reduced_factor` use."""
-    return _HEAD + 6 * n + 2 + 2 * n * n, 2 * n * n + n
+    return _HEAD + 6 * n + 2 + 2 * n * n, 2 * n * n + 2 * n
 
 
 @numba.njit(cache=True, nogil=True)
@@ -225,65 +229,92 @@ def plan_reduction(J, mass, iw):
 
 
 @numba.njit(cache=True, nogil=True)
-def reduced_factor(G, iw, fw, piv):
-    """Factor ``G`` along the plan of :func:`plan_reduction`; False if singular.
+def _whole(J, mass, hg, G, piv):
+    """``G = diag(mass) hg - J`` built whole and factored by :func:`lu_factor`."""
+    n = J.shape[0]
+    for i in range(n):
+        for j in range(n):
+            G[i, j] = -J[i, j]
+        G[i, i] += mass[i] * hg
+    return lu_factor(G, piv)
 
-    With a reduction: the kept rows and columns of ``G`` are copied into ``fw`` with the kinematic rows
-    eliminated (their multipliers kept for the solves) and factored by :func:`lu_factor`; ``G`` itself is
-    left unchanged (the solves read its kinematic and trailing rows).  Without one, or when a kinematic
-    row's diagonal is not the larger entry of its row at this step size (it would need pivoting),
-    ``G`` is factored in place as a whole.
+
+@numba.njit(cache=True, nogil=True)
+def reduced_factor(J, mass, hg, G, iw, fw, piv):
+    """Factor ``G = diag(mass) hg - J`` (``hg = 1/(h gamma)``) along the plan of :func:`plan_reduction`.
+
+    With a reduction: the kept rows and columns are taken from ``J`` into ``fw`` with the kinematic rows
+    eliminated (their multipliers kept for the solves) and factored by :func:`lu_factor`; of ``G`` only the
+    entries the solves read are written (the kinematic rows' diagonal and partner, the trailing rows'
+    non-zeros), so the whole matrix is never built.  Without a reduction, or when a kinematic row's diagonal
+    is not the larger entry of its row at this step size (it would need pivoting), ``G`` is built whole and
+    factored in place.  Returns False if the matrix is singular.
     """
-    n = G.shape[0]
+    n = J.shape[0]
     iw[_DENSE_NOW] = 1
     if iw[_MODE] == 0:
-        return lu_factor(G, piv)
+        return _whole(J, mass, hg, G, piv)
     nk = iw[_NK]
     nkin = iw[_NKIN]
+    ntr = iw[_NTR]
     partner = iw[_HEAD + n:_HEAD + 2 * n]
     order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
     posk = iw[_HEAD + 3 * n:_HEAD + 4 * n]
     mptr = iw[_HEAD + 4 * n:_HEAD + 5 * n + 1]
     mrow = iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n]
+    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
+    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
     mval = fw[n * n:2 * n * n]
+    rdiag = fw[2 * n * n + n:2 * n * n + 2 * n]  # reciprocals of the kinematic and trailing rows' diagonals
     for q in range(nkin):
         r = _u(order[_u(nk + q)])
         s = partner[r]
-        grr = G[r, r]
+        grr = mass[r] * hg - J[r, r]
+        G[r, r] = grr
+        if s >= 0:
+            G[r, _u(s)] = -J[r, _u(s)]
         if grr == 0.0 or not math.isfinite(grr) or (s >= 0 and abs(grr) < abs(G[r, _u(s)])):
-            return lu_factor(G, piv)
+            return _whole(J, mass, hg, G, piv)
+        rdiag[r] = 1.0 / grr
+    for q in range(ntr):
+        c = _u(order[_u(nk + nkin + q)])
+        gcc = mass[c] * hg - J[c, c]
+        if gcc == 0.0 or not math.isfinite(gcc):
+            return False
+        G[c, c] = gcc
+        rdiag[c] = 1.0 / gcc
+        for e in range(tptr[q], tptr[q + 1]):
+            j = _u(tcol[_u(e)])
+            G[c, j] = -J[c, j]
     gr = shaped(fw[:nk * nk], (nk, nk))
     for a in range(nk):
         i = _u(order[a])
         for b in range(nk):
-            gr[a, b] = G[i, _u(order[b])]
+            gr[a, b] = -J[i, _u(order[b])]
+        gr[a, a] += mass[i] * hg
     cnt = 0
     for q in range(nkin):
         r = _u(order[_u(nk + q)])
         s = partner[r]
-        grr = G[r, r]
         mptr[q] = cnt
         for a in range(nk):
-            gir = G[_u(order[a]), r]
-            if gir != 0.0:
-                lir = gir / grr
+            jir = J[_u(order[a]), r]
+            if jir != 0.0:
+                lir = -jir * rdiag[r]
                 mrow[_u(cnt)] = a
                 mval[_u(cnt)] = lir
                 cnt += 1
                 if s >= 0:
                     gr[a, _u(posk[_u(s)])] -= lir * G[r, _u(s)]
     mptr[nkin] = cnt
-    for q in range(iw[_NTR]):
-        c = _u(order[_u(nk + nkin + q)])
-        if G[c, c] == 0.0 or not math.isfinite(G[c, c]):
-            return False
     iw[_DENSE_NOW] = 0
     return lu_factor(gr, piv)
 
 
 @numba.njit(cache=True, nogil=True)
 def reduced_solve(G, iw, fw, piv, b):
-    """Solve ``G y = b`` in place from :func:`reduced_factor` (kept block, then kinematic and trailing rows)."""
+    """Solve ``G y = b`` in place from :func:`reduced_factor` (kept block, then kinematic and trailing rows;
+    ``G``: as :func:`reduced_factor` left it)."""
     n = G.shape[0]
     if iw[_DENSE_NOW] == 1:
         lu_solve(G, piv, b)
@@ -299,6 +330,7 @@ def reduced_solve(G, iw, fw, piv, b):
     mval = fw[n * n:2 * n * n]
     gr = shaped(fw[:nk * nk], (nk, nk))
     bk = fw[2 * n * n:2 * n * n + nk]
+    rdiag = fw[2 * n * n + n:2 * n * n + 2 * n]
     for a in range(nk):
         bk[a] = b[_u(order[a])]
     for q in range(nkin):
@@ -316,14 +348,14 @@ def reduced_solve(G, iw, fw, piv, b):
         v = b[r]
         if s >= 0:
             v -= G[r, _u(s)] * b[_u(s)]
-        b[r] = v / G[r, r]
+        b[r] = v * rdiag[r]
     for q in range(iw[_NTR]):
         c = _u(order[_u(nk + nkin + q)])
         v = b[c]
         for e in range(tptr[q], tptr[q + 1]):
             j = _u(tcol[_u(e)])
             v -= G[c, j] * b[j]
-        b[c] = v / G[c, c]
+        b[c] = v * rdiag[c]
 
 
 @numba.njit(cache=True, nogil=True)
