@@ -12,13 +12,16 @@ Measured in one run:
 4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale) with ``prange`` on all threads
    against one thread.
 
-Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--build``: only the time to build one variant;
+Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--clutchlab``: only clutchlab's two figures and their
+error, no SciPy references and no batch)  (``--build``: only the time to build one variant;
 ``--batch [--quick]``: only the batch, building included)
 """
 
 from __future__ import annotations
 
 import math
+import os
+import platform
 import sys
 import time
 
@@ -314,18 +317,33 @@ def frictionless_actuator():
                               spindle_efficiency=1.0)
 
 
-def compare(ec: EClutch, label: str, methods, repeats: int):
-    """Time clutchlab and the solve_ivp reference on one configuration; print the ratios."""
+def timed(fn, n):
+    """Median, min and max wall time of ``n`` calls [s], and the last result."""
+    import statistics
+
+    ts = []
+    out = None
+    for _ in range(n):
+        t0 = time.perf_counter()
+        out = fn()
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts), min(ts), max(ts), out
+
+
+def compare(ec: EClutch, label: str, methods, repeats: int, n: int = 201):
+    """Time clutchlab and the solve_ivp reference on one configuration; print the ratios (clutchlab: medians of
+    ``n`` runs with min-max; the references: best of ``repeats``)."""
     ec.simulate(INPUT, T_END)  # compile / load cache
     system = ec.as_system(INPUT, rtol=RTOL)
-    t_kernel, out = best_of(lambda: contract.simulate(system, T_END, outputs=False, max_steps=500_000), 20)
+    t_kernel, k_lo, k_hi, out = timed(lambda: contract.simulate(system, T_END, outputs=False, max_steps=500_000), n)
     stats = out.stats
     print(f"[{label}]")
-    print(f"  clutchlab core (Rodas3, rtol {RTOL:g}): {t_kernel * 1e3:.2f} ms -> {T_END / t_kernel:,.0f}x real time "
-          f"({stats['accepted_steps']} steps, {stats['rejected_steps']} rejected, {stats['rhs_evaluations']} RHS, "
-          f"{stats['jacobians']} Jacobians, {len(out.events)} events)")
-    t_sim, res = best_of(lambda: ec.simulate(INPUT, T_END, rtol=RTOL), 10)
-    print(f"  clutchlab EClutch.simulate incl. outputs: {t_sim * 1e3:.2f} ms -> {T_END / t_sim:,.0f}x real time")
+    print(f"  clutchlab core (Rodas3, rtol {RTOL:g}): {t_kernel * 1e3:.3f} ms ({k_lo * 1e3:.3f}-{k_hi * 1e3:.3f}) -> "
+          f"{T_END / t_kernel:,.0f}x real time ({stats['accepted_steps']} steps, {stats['rejected_steps']} rejected, "
+          f"{stats['rhs_evaluations']} RHS, {stats['jacobians']} Jacobians, {len(out.events)} events)")
+    t_sim, s_lo, s_hi, res = timed(lambda: ec.simulate(INPUT, T_END, rtol=RTOL), n)
+    print(f"  clutchlab EClutch.simulate incl. outputs: {t_sim * 1e3:.3f} ms ({s_lo * 1e3:.3f}-{s_hi * 1e3:.3f}) -> "
+          f"{T_END / t_sim:,.0f}x real time (medians of {n} runs, min-max)")
     tight = ec.simulate(INPUT, T_END, rtol=1e-8, atol_scale=1e-2)
     grid = np.linspace(0.0, T_END, 2001)
     fb_tight = np.interp(grid, tight.outputs.time_s, tight.outputs.bearing_force_N)
@@ -422,7 +440,11 @@ def build_timing(repeat: int = 21) -> None:
 
 
 if __name__ == "__main__":
-    if "--build" in sys.argv:
+    if "--clutchlab" in sys.argv:
+        print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}")
+        compare(EClutch(clutch=ClutchModel.preset(4), friction=FrictionParameters()),
+                "friction on (seals, spindle, R_f.ds, R_f.pp)", (), 1)
+    elif "--build" in sys.argv:
         build_timing()
     elif "--batch" in sys.argv:
         batch_timing(quick="--quick" in sys.argv)
