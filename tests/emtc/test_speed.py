@@ -6,7 +6,8 @@ every armature event, lock-up and unlock with constant and LuGre friction, a fri
 other than the controller's model), at the default tolerances.  The faster model must give:
 
 * the same trajectories: every state and the recorded outputs at about 60 samples, each column to 1e-9 of its
-  largest magnitude (the integration error at rtol 1e-6 is about 1e-7 of it: a changed equation or a
+  largest magnitude (for a state at least its absolute tolerance: the Torsen twist stays near 1e-16 rad in
+  these runs) (the integration error at rtol 1e-6 is about 1e-7 of it: a changed equation or a
   changed step would show; the evaluation order of a few sums may change the last bits);
 * the same modes at every sample, the same events in the same order at the same instants (to 1e-10 s; the
   core locates them to 1e-12 s) and the same number of accepted steps.
@@ -47,11 +48,11 @@ def test_same_trajectories_events_and_steps_as_before(name, magnet, scenario, kw
     np.testing.assert_array_equal(r.time[rows], data[f"{name}_time"])
     np.testing.assert_array_equal(r.modes[rows], data[f"{name}_modes"])
     names = [o[0] for o in S.OUTPUTS]
-    for label, got, ref in (("state", r.states[rows], data[f"{name}_states"]),
-                            ("output", r.outputs[rows][:, [names.index(o) for o in MAKER.OUTPUTS]],
-                             data[f"{name}_outputs"])):
+    for label, got, ref, floor in (("state", r.states[rows], data[f"{name}_states"], S.ATOL),
+                                   ("output", r.outputs[rows][:, [names.index(o) for o in MAKER.OUTPUTS]],
+                                    data[f"{name}_outputs"], np.full(len(MAKER.OUTPUTS), 1e-300))):
         for q in range(ref.shape[1]):
-            scale = max(np.max(np.abs(ref[:, q])), 1e-300)
+            scale = max(np.max(np.abs(ref[:, q])), floor[q])
             err = np.max(np.abs(got[:, q] - ref[:, q])) / scale
             assert err <= 1e-9, f"{name}: {label} {q} differs by {err:.2e} of its range"
     assert list(r.events["event"]) == [str(e) for e in data[f"{name}_event_name"]]
