@@ -319,3 +319,41 @@ def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):
     assert b == pytest.approx(a, rel=1e-12, abs=1e-9)
     # and peek equals committing the step
     assert a == pytest.approx(fam.step(v, airgap=gap), rel=1e-12, abs=1e-9)
+
+
+@settings(max_examples=examples(200), deadline=None)
+@given(history=st.lists(st.floats(0.0, 4.5), min_size=0, max_size=30), v=st.floats(0.0, 4.5),
+       gap=st.floats(0.2e-3, 1.0e-3), inside=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=5))
+def test_peek_segment_is_the_combined_peek_on_its_whole_stretch(history, v, gap, inside):
+    """:func:`peek_segment` (the drum bench's stage evaluations while the armature rests on a stop): the
+    quadratic it returns for the stretch around ``v`` equals the combined-table peek at ``v`` and at any input
+    strictly inside that stretch, for any memory."""
+    from clutchlab.hysteresis import _kernels as K
+
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
+    fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
+    if history:
+        fam.simulate(history, airgap=gap)
+    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    K.gap_weights(fam.airgaps, gap, idx, w)
+    comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
+    K.combine_tables(fam.kernel_tables, idx, w, comb)
+    args = (fam._stack, fam._pref, fam._length, fam._u)
+    seg = np.zeros(5)
+    scale = np.max(np.abs(fam.kernel_tables)) + 1.0
+    f = K.peek_segment(comb, fam.grid, *args, v, idx, w, seg)
+    assert f == pytest.approx(K.peek_combined(comb, fam.grid, *args, v, idx, w), rel=1e-12, abs=1e-12 * scale)
+    lo, hi, a0, a1, a2 = seg
+    if v == fam._u:
+        assert lo == hi == v
+        return
+    assert lo <= v <= hi and (lo < v or v < hi or lo == hi)
+    for s in inside:
+        x = lo + s * (hi - lo)
+        if not lo < x < hi:
+            continue
+        ref = K.peek_combined(comb, fam.grid, *args, x, idx, w)
+        assert a0 + x * (a1 + x * a2) == pytest.approx(ref, rel=1e-12, abs=1e-12 * scale)
+        seg2 = np.zeros(5)
+        K.peek_segment(comb, fam.grid, *args, x, idx, w, seg2)
+        np.testing.assert_array_equal(seg2, seg)  # one polynomial for the whole stretch

@@ -510,3 +510,112 @@ def peek_combined(comb, grid, stack, pref, length, u, v, idx, w):
     # memory after wiping, output of Eqs. 2-3 with the combined table
     base = _wpref(pref, L // 2, idx, w)
     return base + table_output(comb, 0, grid, stack, L, pref, v) - pref[0, L // 2]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _cell(comb, i, j):
+    """Coefficients ``(C0, C1, C2, C3)`` of cell ``(i, min(j, i))`` of the combined table ([1], Eqs. 4-5)."""
+    if j > i:
+        j = i
+    return comb[0, i, j, 0], comb[0, i, j, 1], comb[0, i, j, 2], comb[0, i, j, 3]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
+    """:func:`peek_combined` as a quadratic in the next input on the stretch of inputs around ``v``.
+
+    For a given memory ``stack[:length]`` (last input ``u``) the output for the next input ``v`` is, on each
+    stretch of inputs where the same branch of Eqs. 2-3 holds (no further wiping, the input in the same grid
+    cell), a quadratic ``a0 + a1 v + a2 v**2``: the interpolation of Eqs. 4-5 is bilinear in a cell and the
+    input enters one or both of its arguments.  Writes ``seg[0:5] = (lo, hi, a0, a1, a2)`` for the stretch
+    whose open interior ``lo < v < hi`` holds ``v`` and returns the quadratic at ``v``: any input strictly
+    inside the same stretch gets the same polynomial, so a caller may keep ``seg`` for later inputs while
+    the memory and the table stay (inputs on a stretch's ends, and ``v == u``, are evaluated afresh:
+    ``seg`` is then made empty, ``lo = hi = v``).  Equal to :func:`peek_combined` to rounding.
+    """
+    n = grid.shape[0]
+    L = length
+    iv = locate(grid, v)
+    lo = grid[iv]
+    hi = grid[iv + 1]
+    if v > u:
+        a = u  # the second argument of the first-order reversal value subtracted: u (a new minimum) or m_last
+        const = 0.0
+        if L % 2 == 1 and v < stack[L - 1]:
+            # u becomes a minimum that is not wiped ([1], Eq. 3 with the pair (M_last, u) completed)
+            mx = stack[L - 1]
+            im = locate(grid, mx)
+            iu = locate(grid, u)
+            const = _wpref(pref, (L - 1) // 2, idx, w) + forc_value_ij(comb, 0, grid, mx, im, u, iu)
+            if L >= 3:
+                prev = stack[L - 2]
+                const -= forc_value_ij(comb, 0, grid, mx, im, prev, locate(grid, prev))
+            hi = min(hi, mx)
+            lo = max(lo, u)
+            ib = iu
+            sub = True
+        else:
+            if L % 2 == 1:
+                L -= 1
+            while L >= 2 and v >= stack[L - 2]:  # wiping-out of (M, m)
+                L -= 2
+            if L < length:
+                lo = max(lo, stack[L])  # the largest maximum wiped (or the maximum the input rose past)
+            lo = max(lo, u)
+            if L >= 2:
+                hi = min(hi, stack[L - 2])  # the next maximum to wipe
+            const = _wpref(pref, L // 2, idx, w)  # [1], Eq. 3
+            ib = 0
+            sub = L > 0
+            if sub:
+                a = stack[L - 1]
+                ib = locate(grid, a)
+        # F(v, v) on the diagonal cell of v, minus F(v, a) (none with the virtual minimum: L == 0, rising)
+        c0, c1, c2, c3 = _cell(comb, iv, iv)
+        a0 = const + c0
+        a1 = c1 + c2
+        a2 = c3
+        if sub:
+            d0, d1, d2, d3 = _cell(comb, iv, ib)
+            a0 -= d0 + d2 * a
+            a1 -= d1 + d3 * a
+    elif v < u:
+        if L % 2 == 0 and (L < 2 or v > stack[L - 1]):
+            # u becomes a maximum that is not wiped ([1], Eq. 2 with M_n = u)
+            top = u
+            const = _wpref(pref, L // 2, idx, w)
+            if L >= 1:
+                prev = stack[L - 1]
+                const -= forc_value_ij(comb, 0, grid, u, locate(grid, u), prev, locate(grid, prev))
+                lo = max(lo, prev)
+            hi = min(hi, u)
+        else:
+            if L % 2 == 0:
+                L -= 1
+            while L >= 3 and v <= stack[L - 2]:  # wiping-out of (m, M)
+                L -= 2
+            if L < length:
+                hi = min(hi, stack[L])  # the smallest minimum wiped (or the minimum the input fell past)
+            hi = min(hi, u)
+            if L >= 3:
+                lo = max(lo, stack[L - 2])  # the next minimum to wipe
+            top = stack[L - 1]
+            const = _wpref(pref, L // 2, idx, w)  # [1], Eq. 2
+            if L > 1:
+                m = stack[L - 2]
+                const -= forc_value_ij(comb, 0, grid, top, locate(grid, top), m, locate(grid, m))
+        # F(top, v) on the cell (top, v): linear in v
+        c0, c1, c2, c3 = _cell(comb, locate(grid, top), iv)
+        a0 = const + c0 + c1 * top
+        a1 = c2 + c3 * top
+        a2 = 0.0
+    else:
+        seg[0] = v
+        seg[1] = v
+        return peek_combined(comb, grid, stack, pref, length, u, v, idx, w)
+    seg[0] = lo
+    seg[1] = hi
+    seg[2] = a0
+    seg[3] = a1
+    seg[4] = a2
+    return a0 + v * (a1 + v * a2)
