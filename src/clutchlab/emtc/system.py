@@ -25,8 +25,8 @@ Hybrid structure:
   the same instants;
 * the plant magnet's hysteresis memory and the LuGre bristle state are committed once per accepted step
   (:func:`_accept`, or at an event before the mode changes), never inside the stages: stages evaluate the
-  magnet with :func:`~clutchlab.hysteresis._kernels.peek_combined` and advance the bristles from their
-  committed value;
+  magnet with :func:`~clutchlab.hysteresis._kernels.peek_segment` (:func:`~clutchlab.hysteresis._kernels.peek`
+  while the armature moves) and advance the bristles from their committed value;
 * a full hysteresis memory is a model error (codes in :data:`ERROR_MESSAGES`), not a solver status.
 
 References
@@ -46,7 +46,7 @@ import numba
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek_combined
+from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek, peek_segment
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
@@ -140,12 +140,12 @@ ERROR_MESSAGES = {
 }
 
 # per-run integer memories (EmtcParams.imem)
-IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX = 0, 1, 2, 3, 4, 7
-N_IMEM = 10
+IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX = 0, 1, 2, 3, 4, 7, 10
+N_IMEM = 13
 # per-run float memories and scratch (EmtcParams.fmem)
 FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
 FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
-FM_CW = 12  # 3: airgap weights of the controller model
+FM_CW = 12  # 3: weights of the controller model's table (one table at the engaged airgap: 1, 0, 0)
 FM_ULAST = 15  # 5: inputs seen at the last restart
 FM_AUX = 20  # N_AUX model intermediates of the last evaluation
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
@@ -157,13 +157,17 @@ FM_G = FM_DX + 7  # 6: scratch switching functions
 FM_KEY = FM_G + 6  # 16: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
 FM_DXM = FM_KEY + 16  # 7: derivative of the last evaluation
 FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
-N_FMEM = FM_GM + 6
+FM_FW = FM_GM + 6  # 3: airgap weights of the plant tables at the last evaluation with the armature moving
+FM_SEG = FM_FW + 3  # 8: the plant magnet's force as a quadratic in the coil current on the stretch of the last
+#                          evaluation (lo, hi, a0, a1, a2; hysteresis._kernels.peek_segment) and the memory length,
+#                          last input and airgap it is for; lo = NaN once the memory changed
+N_FMEM = FM_SEG + 8
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
 # the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
-(L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_GAPS, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
- L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(16)
-N_LAYOUT = 16
+(L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
+ L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(15)
+N_LAYOUT = 15
 
 ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
 
@@ -238,7 +242,6 @@ class EmtcParams(NamedTuple):
     reference_source: int
     n_airgaps: int
     n_cells: int
-    n_ctl_airgaps: int
     n_ctl_cells: int
     n_fmap_speed: int
     n_fmap_temp: int
@@ -447,6 +450,7 @@ def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode)
         return ERR_PLANT_MEMORY
     imem[IM_PLEN] = commit(tables, grid, stack, prefix, plen, fmem[FM_PU], inew)
     fmem[FM_PU] = inew
+    fmem[FM_SEG] = np.nan  # the force's stretch was for the memory before
     tlast = fmem[FM_TLAST]
     if friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
         dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
@@ -488,11 +492,13 @@ def _controller(t, x, u, p):
     if clen + 2 > stack.shape[0]:
         imem[IM_ERROR] = ERR_CONTROLLER_MEMORY  # reported by the next accepted step
         return
+    # the controller's model at its one airgap, the engaged d - sigma: the airgap interpolation (Eqs. 2-5 are
+    # linear in the table) applied to the cell coefficients once by pack_parameters, one table of weight 1
     n = p.n_ctl_cells
-    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (p.n_ctl_airgaps, n, n, 4))
+    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (1, n, n, 4))
     grid = _cold(p.cold, p.layout, L_CTL_GRID)
-    prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
-    cidx = imem[IM_CIDX:IM_CIDX + 3]  # airgap weights at the engaged airgap d - sigma (set by pack_parameters)
+    prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (1, stack.shape[0] // 2 + 2))
+    cidx = imem[IM_CIDX:IM_CIDX + 3]
     cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
     i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7 at d - sigma
@@ -549,20 +555,40 @@ def _rhs(t, x, u, m, p, dx, g):
     xa = x[3]
     xd = x[4]
     # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
-    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12; the weighted cell
-    # table is rebuilt only when the airgap changes, i.e. while the armature moves)
+    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12)
     grid = p.plant_grid
     icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
     gap = a.airgap_open - xa
-    gw = fmem[FM_GW:FM_GW + 4]
-    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
-    if gap != gw[3]:
+    if arm == ARM_FREE:
+        # the armature moves: another airgap at every stage; the weighted output of the nearest calibration
+        # tables (building the weighted cell table would cost more than the evaluation)
         gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
-        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
-        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
-        gw[3] = gap
-    fm = peek_combined(p.plant_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil,
-                       gidx, gw)
+        fidx = p.imem[IM_FIDX:IM_FIDX + 3]
+        fw = fmem[FM_FW:FM_FW + 3]
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), fidx, fw)
+        fm = peek(p.plant_tables, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil, fidx,
+                  fw)
+    else:
+        # at a stop the airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in
+        # it), and while the memory stays (within a step) the force is one quadratic in the coil current on the
+        # stretch where the same branch of Eqs. 2-3 and the same cells hold: kept for the next stages
+        seg = fmem[FM_SEG:FM_SEG + 8]
+        plen = p.imem[IM_PLEN]
+        pu = fmem[FM_PU]
+        if seg[0] < icoil < seg[1] and seg[5] == plen and seg[6] == pu and seg[7] == gap:
+            fm = seg[2] + icoil * (seg[3] + icoil * seg[4])
+        else:
+            gw = fmem[FM_GW:FM_GW + 4]
+            gidx = p.imem[IM_GIDX:IM_GIDX + 3]
+            if gap != gw[3]:
+                gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
+                gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
+                combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
+                gw[3] = gap
+            fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
+            seg[5] = plen
+            seg[6] = pu
+            seg[7] = gap
     fn1 = 0.0
     if arm == ARM_FREE:
         dx[3] = xd
@@ -671,8 +697,14 @@ def _same_point(t, x, u, m, fmem):
     The inputs are part of the point: a run changes them only at a restart (which clears the key), but an
     evaluation through the contract (:func:`clutchlab.system.evaluate`: linearisation, trim) may ask for
     the same state with other inputs.
+
+    The time is the same to rounding (4e-15 of it): the core evaluates the last stage of a step that ends on
+    a break time at the inputs' left limit ``t1 - 1e-15 max(1, |t1|)`` (:mod:`clutchlab.numerics.core`), and
+    the sample and the controller's restart at ``t1`` that follow read that evaluation (one evaluation per
+    step less).  The right-hand side is continuous in ``t`` (its only time dependence is the throttle ramp,
+    piecewise linear; the torque reference is read by the controller), so the two differ by a rounding error.
     """
-    if fmem[FM_KEY] != t:
+    if not abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)):
         return False
     for i in range(7):
         if fmem[FM_KEY + 1 + i] != x[i]:
@@ -990,11 +1022,10 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     cold = _Cold()
     cold.add(L_PLANT_TABLES, np.zeros(0))  # a field of its own (every accepted step reads it)
     cold.add(L_PLANT_GAPS, magnet.airgaps)
-    cold.add(L_CTL_TABLES, ctl.kernel_tables)
+    cold.add(L_CTL_TABLES, _table_at(ctl, lo_gap))
     cold.add(L_CTL_GRID, ctl.grid)
-    cold.add(L_CTL_GAPS, ctl.airgaps)
     cold.add(L_CTL_STACK, np.zeros(cap))
-    cold.add(L_CTL_PREFIX, np.zeros((ctl.n_airgaps, cap // 2 + 2)))
+    cold.add(L_CTL_PREFIX, np.zeros((1, cap // 2 + 2)))
     cold.add(L_MAP_THROTTLE, torque_map.throttle)
     cold.add(L_MAP_SPEED, torque_map.speed)
     cold.add(L_MAP_TORQUE, torque_map.torque)
@@ -1006,14 +1037,14 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     cold.add(L_LOG, np.zeros(4 * int(n_samples)))
     imem = np.zeros(N_IMEM, dtype=np.int64)
     fmem = np.zeros(N_FMEM)
-    cg = _f(ctl.airgaps)
-    gap_weights(cg, float(min(max(lo_gap, cg[0]), cg[-1])), imem[IM_CIDX:IM_CIDX + 3], fmem[FM_CW:FM_CW + 3])
+    fmem[FM_CW] = 1.0  # (imem[IM_CIDX:] = 0: the controller's one table)
     fmem[FM_PU] = magnet.grid[0]
     fmem[FM_CU] = ctl.grid[0]
     fmem[FM_TLAST] = np.nan
     fmem[FM_GW + 3] = np.nan
     fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
     fmem[FM_KEY] = np.nan
+    fmem[FM_SEG] = np.nan
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
         gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),
@@ -1037,13 +1068,27 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
-        n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_airgaps=int(ctl.n_airgaps), n_ctl_cells=int(nc),
+        n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_cells=int(nc),
         n_fmap_speed=int(np.shape(fmap[2])[0]), n_fmap_temp=int(np.shape(fmap[2])[1]),
         n_map_throttle=int(torque_map.torque.shape[0]), n_map_speed=int(torque_map.torque.shape[1]),
         layout=tuple(int(q) for q in cold.layout), throttle=_f(throttle), plant_tables=_f(magnet.kernel_tables),
         plant_grid=_f(magnet.grid),
         plant_stack=np.zeros(cap), plant_prefix=np.zeros((magnet.n_airgaps, cap // 2 + 2)),
         plant_comb=np.zeros((1, n, n, 4)), imem=imem, fmem=fmem, cold=cold.array())
+
+
+def _table_at(model, gap):
+    """``model``'s cell coefficients at the airgap ``gap`` [m] (clamped to its calibration airgaps): one table,
+    shape ``(1, N, N, 4)``, the weights of its airgap interpolation applied to the coefficients ([1], Eqs. 2-5
+    are linear in the table; :func:`~clutchlab.hysteresis._kernels.combine_tables`)."""
+    gaps = _f(model.airgaps)
+    tables = _f(model.kernel_tables)
+    idx = np.zeros(3, dtype=np.int64)
+    w = np.zeros(3)
+    gap_weights(gaps, float(min(max(gap, gaps[0]), gaps[-1])), idx, w)
+    out = np.zeros((1,) + tables.shape[1:])
+    combine_tables(tables, idx, w, out)
+    return out
 
 
 def controller_log(params: EmtcParams) -> np.ndarray:
