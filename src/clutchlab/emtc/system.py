@@ -192,6 +192,11 @@ class VehicleData(NamedTuple):
     torsen_damping: float
     drum_load_front: float
     drum_load_rear: float
+    inv_axle_ratio: float  # 1 / axle_ratio, and below: the divisions of every evaluation done once when packing
+    inv_inertia_front: float
+    inv_inertia_rear: float
+    lock_share_front: float  # J_R / (J_F + J_R): the weight of A_f in T_lock (Eq. 29)
+    lock_share_rear: float  # J_F / (J_F + J_R)
 
 
 class CouplingData(NamedTuple):
@@ -217,6 +222,8 @@ class ActuatorData(NamedTuple):
     airgap_open: float
     tau1: float
     tau2: float
+    inv_tau1: float  # 1 / tau1, 1 / tau2: the divisions of every evaluation done once when packing
+    inv_tau2: float
 
 
 class EmtcParams(NamedTuple):
@@ -292,22 +299,34 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     (clutchlab's assumptions: the paper does not model the tyre-drum contact or the engine).
     Returns ``(A_f, A_r, T_e, T_trans)`` [N*m].
     """
-    ic = v.axle_ratio
+    inv_ic = v.inv_axle_ratio  # 1 / i
     rw = v.tyre_radius
-    wwf = wf / ic
-    wwr = wr / ic
+    wwf = wf * inv_ic
+    wwr = wr * inv_ic
     kf = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_front), v.slip_speed_floor)
     kr = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_rear), v.slip_speed_floor)
     fxf = kf * (wwf * rw - v_front)  # tyre-drum longitudinal force, both wheels
     fxr = kr * (wwr * rw - v_rear)
-    rrf = v.rolling_resistance * v.axle_load_front * rw * math.tanh(wwf / 0.5) + v.drum_load_front
-    rrr = v.rolling_resistance * v.axle_load_rear * rw * math.tanh(wwr / 0.5) + v.drum_load_rear
-    we = abs(wwf) * v.front_final_drive * v.gear_ratio
-    te = throttle * min(v.engine_torque_max, v.engine_power / max(we, 1.0))
+    rrf = v.rolling_resistance * v.axle_load_front * rw * _tanh(wwf * 2.0) + v.drum_load_front  # tanh(w / 0.5 rad/s)
+    rrr = v.rolling_resistance * v.axle_load_rear * rw * _tanh(wwr * 2.0) + v.drum_load_rear
+    we = max(abs(wwf) * v.front_final_drive * v.gear_ratio, 1.0)
+    tmax = v.engine_torque_max
+    te = throttle * (tmax if we * tmax <= v.engine_power else v.engine_power / we)  # min(T_max, P / w_e)
     ttrans = te * v.gear_ratio
-    a_f = (ttrans * v.front_final_drive - fxf * rw - rrf) / ic  # [1], Eq. 27: front loads at the coupling shaft
-    a_r = (fxr * rw + rrr) / ic
+    a_f = (ttrans * v.front_final_drive - fxf * rw - rrf) * inv_ic  # [1], Eq. 27: front loads at the coupling shaft
+    a_r = (fxr * rw + rrr) * inv_ic
     return a_f, a_r, te, ttrans
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _tanh(z):
+    """``math.tanh(z)``, without the call where it is +-1 in double precision (``|z| >= 20``: 1 - tanh(z) is
+    below 1e-17, half an ulp of 1 is 5.5e-17; the same value as the library's)."""
+    if z >= 20.0:
+        return 1.0
+    if z <= -20.0:
+        return -1.0
+    return math.tanh(z)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -316,7 +335,7 @@ def lock_torque(a_f, a_r, v):
 
     ``a_f``, ``a_r``: the loads of Eq. 27 [N*m]; ``v``: :class:`VehicleData`.
     """
-    return (v.inertia_rear * a_f + v.inertia_front * a_r) / (v.inertia_front + v.inertia_rear)  # [1], Eq. 29
+    return v.lock_share_front * a_f + v.lock_share_rear * a_r  # [1], Eq. 29 (the shares J_R, J_F / (J_F + J_R))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -542,7 +561,7 @@ def _rhs(t, x, u, m, p, dx, g):
             dx[i] = fmem[FM_DXM + i]
         for k in range(6):
             g[k] = fmem[FM_GM + k]
-        dx[5] = (_command(u, p) - x[5]) / a.tau1
+        dx[5] = (_command(u, p) - x[5]) * a.inv_tau1
         return
     aux = fmem[FM_AUX:FM_AUX + N_AUX]
     v = p.vehicle
@@ -599,8 +618,8 @@ def _rhs(t, x, u, m, p, dx, g):
         if arm == ARM_CONTACT:
             fn1 = max(primary_clamp_force(fm, a), 0.0)
     # current control: two first-order lags in series ([1], Fig. 15)
-    dx[5] = (_command(u, p) - x[5]) / a.tau1
-    dx[6] = (x[5] - x[6]) / a.tau2
+    dx[5] = (_command(u, p) - x[5]) * a.inv_tau1
+    dx[6] = (x[5] - x[6]) * a.inv_tau2
     thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
     a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
     tlock = lock_torque(a_f, a_r, v)
@@ -675,8 +694,8 @@ def _rhs(t, x, u, m, p, dx, g):
     aux[AUX_FN2] = fn2
     aux[AUX_TE] = te
     aux[AUX_THR] = thr
-    dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
-    dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+    dx[0] = (a_f - tc) * v.inv_inertia_front  # [1], Eq. 27 (rows 1 and 3)
+    dx[1] = (tc - a_r) * v.inv_inertia_rear  # [1], Eq. 27 (rows 2 and 4)
     _switching(x, m, a, c.unlock_margin, aux, g)
     fmem[FM_KEY] = t
     for i in range(7):
@@ -690,7 +709,7 @@ def _rhs(t, x, u, m, p, dx, g):
         fmem[FM_GM + k] = g[k]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _same_point(t, x, u, m, fmem):
     """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, u, m)`` with the memories as they are now.
 
@@ -1055,7 +1074,11 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
         slip_speed_floor=float(vehicle.slip_speed_floor), engine_torque_max=float(vehicle.engine_torque_max),
         engine_power=float(vehicle.engine_power), torsen_stiffness=float(vehicle.torsen_stiffness),
         torsen_damping=float(vehicle.torsen_damping), drum_load_front=float(scenario.drum_load_front),
-        drum_load_rear=float(scenario.drum_load_rear))
+        drum_load_rear=float(scenario.drum_load_rear), inv_axle_ratio=0.0, inv_inertia_front=0.0,
+        inv_inertia_rear=0.0, lock_share_front=0.0, lock_share_rear=0.0)
+    jf, jr = veh.inertia_front, veh.inertia_rear
+    veh = veh._replace(inv_axle_ratio=1.0 / veh.axle_ratio, inv_inertia_front=1.0 / jf, inv_inertia_rear=1.0 / jr,
+                       lock_share_front=jr / (jf + jr), lock_share_rear=jf / (jf + jr))
     cpl = CouplingData(
         drag_pairs=float(vehicle.drag_pairs), oil_viscosity=float(vehicle.oil_viscosity),
         plate_clearance=float(vehicle.plate_clearance), plate_outer_radius=float(vehicle.plate_outer_radius),
@@ -1064,7 +1087,8 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     act = ActuatorData(
         mass=float(actuator.mass), stiffness=float(actuator.stiffness), preload=float(actuator.preload),
         damping=float(actuator.damping), free_travel=float(actuator.free_travel),
-        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2))
+        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2),
+        inv_tau1=1.0 / float(actuator.tau1), inv_tau2=1.0 / float(actuator.tau2))
     return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
