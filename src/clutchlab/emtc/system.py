@@ -1150,14 +1150,13 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
         lowest grid current; modes ``rest``, ``open``, ``positive``; first trial step ``min(0.1 ms,
         sample_time)`` (a resumed run and an uninterrupted one take the same steps).
     """
-    from .bench import BenchScenario, VehicleParameters, _default
-
+    B = _bench_module()
     if magnet is None:
         from .magnet import bundled_magnet
 
         magnet = bundled_magnet()
-    scenario = scenario or _default(BenchScenario)
-    vehicle = vehicle or _default(VehicleParameters)
+    scenario = scenario or B._default(B.BenchScenario)
+    vehicle = vehicle or B._default(B.VehicleParameters)
     params = pack_parameters(magnet, scenario, vehicle, options, cosimulation=cosimulation, n_samples=n_samples)
     vf = scenario.drum_speed
     vr = scenario.drum_speed - scenario.speed_difference
@@ -1179,6 +1178,20 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
             _TEMPLATES[(first_step, current_range)] = template
     # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
     return template.variant(params=params, x0=x0, u0=u0)
+
+
+_BENCH = None
+
+
+def _bench_module():
+    """:mod:`clutchlab.emtc.bench` (imported on first use: it imports this module; an import statement in a
+    function costs about 1.5 us a call)."""
+    global _BENCH
+    if _BENCH is None:
+        from . import bench
+
+        _BENCH = bench
+    return _BENCH
 
 
 #: (first trial step, coil current range) -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`
