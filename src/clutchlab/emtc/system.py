@@ -46,7 +46,7 @@ import numba
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek, peek_segment
+from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_combined, peek, peek_segment
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
@@ -141,7 +141,8 @@ ERROR_MESSAGES = {
 
 # per-run integer memories (EmtcParams.imem)
 IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX = 0, 1, 2, 3, 4, 7, 10
-N_IMEM = 13
+IM_PVER, IM_CVER = 13, 14  # changes of the plant's and the controller's hysteresis stacks so far (their lengths)
+N_IMEM = 15
 # per-run float memories and scratch (EmtcParams.fmem)
 FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
 FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
@@ -158,10 +159,11 @@ FM_KEY = FM_G + 6  # 16: point (t, x, modes, inputs) of the last evaluation; NaN
 FM_DXM = FM_KEY + 16  # 7: derivative of the last evaluation
 FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
 FM_FW = FM_GM + 6  # 3: airgap weights of the plant tables at the last evaluation with the armature moving
-FM_SEG = FM_FW + 3  # 8: the plant magnet's force as a quadratic in the coil current on the stretch of the last
-#                          evaluation (lo, hi, a0, a1, a2; hysteresis._kernels.peek_segment) and the memory length,
-#                          last input and airgap it is for; lo = NaN once the memory changed
-N_FMEM = FM_SEG + 8
+FM_SEG = FM_FW + 3  # 9: the plant magnet's force as a quadratic in the coil current on the stretch of the last
+#                          evaluation (lo, hi, a0, a1, a2, kind: hysteresis._kernels.peek_segment) and the stack
+#                          version (IM_PVER), last input and airgap it is for
+FM_CSEG = FM_SEG + 9  # 8: the controller model's rising stretch (hysteresis._kernels.invert_combined)
+N_FMEM = FM_CSEG + 8
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
 # the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
@@ -467,9 +469,16 @@ def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode)
     plen = imem[IM_PLEN]
     if plen + 2 > stack.shape[0]:
         return ERR_PLANT_MEMORY
-    imem[IM_PLEN] = commit(tables, grid, stack, prefix, plen, fmem[FM_PU], inew)
+    pu = fmem[FM_PU]
+    if (inew > pu and plen % 2 == 0 and (plen < 2 or inew < stack[plen - 2])) or (
+            inew < pu and plen % 2 == 1 and (plen < 3 or inew > stack[plen - 2])):
+        pass  # no turning point, nothing wiped: the stack stays, only the last input moves (all commit would do)
+    elif inew != pu:
+        new = commit(tables, grid, stack, prefix, plen, pu, inew)
+        if new != plen:  # the stack changes only with its length
+            imem[IM_PLEN] = new
+            imem[IM_PVER] += 1
     fmem[FM_PU] = inew
-    fmem[FM_SEG] = np.nan  # the force's stretch was for the memory before
     tlast = fmem[FM_TLAST]
     if friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
         dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
@@ -520,8 +529,12 @@ def _controller(t, x, u, p):
     cidx = imem[IM_CIDX:IM_CIDX + 3]
     cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
-    i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7 at d - sigma
-    imem[IM_CLEN] = commit(tables, grid, stack, prefix, clen, cu, i_new)
+    i_new, ok = invert_combined(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9,
+                                fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eqs. 6-7 at d - sigma
+    new = commit(tables, grid, stack, prefix, clen, cu, i_new)
+    if new != clen:  # the stack changes only with its length
+        imem[IM_CLEN] = new
+        imem[IM_CVER] += 1
     fmem[FM_CU] = i_new
     fmem[FM_CMD] = i_new
     fmem[FM_TREF] = t_ref
@@ -589,14 +602,17 @@ def _rhs(t, x, u, m, p, dx, g):
                   fw)
     else:
         # at a stop the airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in
-        # it), and while the memory stays (within a step) the force is one quadratic in the coil current on the
-        # stretch where the same branch of Eqs. 2-3 and the same cells hold: kept for the next stages
-        seg = fmem[FM_SEG:FM_SEG + 8]
-        plen = p.imem[IM_PLEN]
+        # it), and while the stack stays the force is one quadratic in the coil current on the stretch where
+        # the same branch of Eqs. 2-3 and the same cells hold: kept for the next stages and, while the current
+        # keeps its direction (the stretch does not depend on the last input then), for the next steps
+        seg = fmem[FM_SEG:FM_SEG + 9]
         pu = fmem[FM_PU]
-        if seg[0] < icoil < seg[1] and seg[5] == plen and seg[6] == pu and seg[7] == gap:
+        kind = seg[5]
+        if seg[6] == p.imem[IM_PVER] and seg[8] == gap and seg[0] < icoil < seg[1] and (
+                (kind == 1.0 and icoil > pu) or (kind == -1.0 and icoil < pu) or (kind == 0.0 and seg[7] == pu)):
             fm = seg[2] + icoil * (seg[3] + icoil * seg[4])
         else:
+            plen = p.imem[IM_PLEN]
             gw = fmem[FM_GW:FM_GW + 4]
             gidx = p.imem[IM_GIDX:IM_GIDX + 3]
             if gap != gw[3]:
@@ -605,9 +621,9 @@ def _rhs(t, x, u, m, p, dx, g):
                 combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
                 gw[3] = gap
             fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
-            seg[5] = plen
-            seg[6] = pu
-            seg[7] = gap
+            seg[6] = p.imem[IM_PVER]
+            seg[7] = pu
+            seg[8] = gap
     fn1 = 0.0
     if arm == ARM_FREE:
         dx[3] = xd
@@ -1063,7 +1079,8 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_GW + 3] = np.nan
     fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
     fmem[FM_KEY] = np.nan
-    fmem[FM_SEG] = np.nan
+    fmem[FM_SEG:FM_SEG + 9] = np.nan
+    fmem[FM_CSEG:FM_CSEG + 8] = np.nan
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
         gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),
