@@ -548,7 +548,7 @@ def _controller(t, x, u, p):
         log[4 * k + LOG_FEASIBLE] = 1.0 if ok else 0.0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
 def _command(u, p):
     """Coil current command [A] of the current lags (Fig. 15): the held input ``coil_current_command`` in
     current drive (its changes act at once: a linear model has it as an input), else the controller's
