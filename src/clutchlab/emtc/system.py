@@ -46,7 +46,8 @@ import numba
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_combined, peek, peek_segment
+from ..hysteresis._kernels import (combine_tables, commit, gap_weights, invert_combined, invert_one, peek,
+                                   peek_segment)
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
@@ -309,8 +310,14 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     kr = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_rear), v.slip_speed_floor)
     fxf = kf * (wwf * rw - v_front)  # tyre-drum longitudinal force, both wheels
     fxr = kr * (wwr * rw - v_rear)
-    rrf = v.rolling_resistance * v.axle_load_front * rw * _tanh(wwf * 2.0) + v.drum_load_front  # tanh(w / 0.5 rad/s)
-    rrr = v.rolling_resistance * v.axle_load_rear * rw * _tanh(wwr * 2.0) + v.drum_load_rear
+    # tanh(w_w / 0.5 rad/s), without the call where it is +-1 in double precision (|z| >= 20: 1 - tanh is below
+    # 1e-17, half an ulp of 1 is 5.5e-17: the library's value)
+    zf = wwf * 2.0
+    zr = wwr * 2.0
+    tf = 1.0 if zf >= 20.0 else (-1.0 if zf <= -20.0 else math.tanh(zf))
+    tr = 1.0 if zr >= 20.0 else (-1.0 if zr <= -20.0 else math.tanh(zr))
+    rrf = v.rolling_resistance * v.axle_load_front * rw * tf + v.drum_load_front
+    rrr = v.rolling_resistance * v.axle_load_rear * rw * tr + v.drum_load_rear
     we = max(abs(wwf) * v.front_final_drive * v.gear_ratio, 1.0)
     tmax = v.engine_torque_max
     te = throttle * (tmax if we * tmax <= v.engine_power else v.engine_power / we)  # min(T_max, P / w_e)
@@ -319,16 +326,6 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     a_r = (fxr * rw + rrr) * inv_ic
     return a_f, a_r, te, ttrans
 
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _tanh(z):
-    """``math.tanh(z)``, without the call where it is +-1 in double precision (``|z| >= 20``: 1 - tanh(z) is
-    below 1e-17, half an ulp of 1 is 5.5e-17; the same value as the library's)."""
-    if z >= 20.0:
-        return 1.0
-    if z <= -20.0:
-        return -1.0
-    return math.tanh(z)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -530,7 +527,9 @@ def _controller(t, x, u, p):
     cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
     i_new, ok = invert_combined(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9,
-                                fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eqs. 6-7 at d - sigma
+                                fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eq. 7 on the kept stretch
+    if i_new != i_new:
+        i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7
     new = commit(tables, grid, stack, prefix, clen, cu, i_new)
     if new != clen:  # the stack changes only with its length
         imem[IM_CLEN] = new
@@ -548,12 +547,48 @@ def _controller(t, x, u, p):
         log[4 * k + LOG_FEASIBLE] = 1.0 if ok else 0.0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _command(u, p):
     """Coil current command [A] of the current lags (Fig. 15): the held input ``coil_current_command`` in
     current drive (its changes act at once: a linear model has it as an input), else the controller's
     command held since its last sample (Eqs. 6-7)."""
     return u[U_COIL] if p.reference_source == REFERENCE_CURRENT else p.fmem[FM_CMD]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _magnet_force(p, moving, gap, icoil):
+    """The plant magnet's force [N] at the coil current ``icoil`` [A] and the airgap ``gap`` [m] where the stretch
+    kept in ``fmem[FM_SEG:]`` does not hold: Preisach output for the next input, memory not committed ([1],
+    Eqs. 1-5), interpolated over the calibration airgaps (Eq. 12).
+
+    ``moving``: the armature is free, another airgap at every stage: the weighted output of the nearest
+    calibration tables (building the weighted cell table would cost more than the evaluation).  At a stop the
+    airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in it) and the stretch
+    of :func:`~clutchlab.hysteresis._kernels.peek_segment` around ``icoil`` is kept with the stack version,
+    last input and airgap it is for.
+    """
+    fmem = p.fmem
+    grid = p.plant_grid
+    pu = fmem[FM_PU]
+    plen = p.imem[IM_PLEN]
+    gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
+    if moving:
+        fidx = p.imem[IM_FIDX:IM_FIDX + 3]
+        fw = fmem[FM_FW:FM_FW + 3]
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), fidx, fw)
+        return peek(p.plant_tables, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, fidx, fw)
+    gw = fmem[FM_GW:FM_GW + 4]
+    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
+    if gap != gw[3]:
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
+        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
+        gw[3] = gap
+    seg = fmem[FM_SEG:FM_SEG + 9]
+    fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
+    seg[6] = p.imem[IM_PVER]
+    seg[7] = pu
+    seg[8] = gap
+    return fm
 
 
 # ------------------------------------------------------------------ the hooks of the contract
@@ -567,7 +602,7 @@ def _rhs(t, x, u, m, p, dx, g):
     """
     a = p.actuator
     fmem = p.fmem
-    if _same_point(t, x, u, m, fmem):
+    if abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)) and _same_point(t, x, u, m, fmem):  # (the time first)
         # the point of the last evaluation again (a controller sample at the end of a step): only the
         # current command may have changed since, and only the first current lag depends on it
         for i in range(7):
@@ -587,43 +622,21 @@ def _rhs(t, x, u, m, p, dx, g):
     xa = x[3]
     xd = x[4]
     # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
-    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12)
+    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12).  At a stop, while the
+    # stack stays, the force is one quadratic in the coil current on the stretch where the same branch of
+    # Eqs. 2-3 and the same cells hold: kept for the next stages and, while the current keeps its direction
+    # (the stretch does not depend on the last input then), for the next steps (_magnet_force builds it)
     grid = p.plant_grid
     icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
     gap = a.airgap_open - xa
-    if arm == ARM_FREE:
-        # the armature moves: another airgap at every stage; the weighted output of the nearest calibration
-        # tables (building the weighted cell table would cost more than the evaluation)
-        gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
-        fidx = p.imem[IM_FIDX:IM_FIDX + 3]
-        fw = fmem[FM_FW:FM_FW + 3]
-        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), fidx, fw)
-        fm = peek(p.plant_tables, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil, fidx,
-                  fw)
+    seg = fmem[FM_SEG:FM_SEG + 9]
+    pu = fmem[FM_PU]
+    kind = seg[5]
+    if arm != ARM_FREE and seg[6] == p.imem[IM_PVER] and seg[8] == gap and seg[0] < icoil < seg[1] and (
+            (kind == 1.0 and icoil > pu) or (kind == -1.0 and icoil < pu) or (kind == 0.0 and seg[7] == pu)):
+        fm = seg[2] + icoil * (seg[3] + icoil * seg[4])
     else:
-        # at a stop the airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in
-        # it), and while the stack stays the force is one quadratic in the coil current on the stretch where
-        # the same branch of Eqs. 2-3 and the same cells hold: kept for the next stages and, while the current
-        # keeps its direction (the stretch does not depend on the last input then), for the next steps
-        seg = fmem[FM_SEG:FM_SEG + 9]
-        pu = fmem[FM_PU]
-        kind = seg[5]
-        if seg[6] == p.imem[IM_PVER] and seg[8] == gap and seg[0] < icoil < seg[1] and (
-                (kind == 1.0 and icoil > pu) or (kind == -1.0 and icoil < pu) or (kind == 0.0 and seg[7] == pu)):
-            fm = seg[2] + icoil * (seg[3] + icoil * seg[4])
-        else:
-            plen = p.imem[IM_PLEN]
-            gw = fmem[FM_GW:FM_GW + 4]
-            gidx = p.imem[IM_GIDX:IM_GIDX + 3]
-            if gap != gw[3]:
-                gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
-                gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
-                combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
-                gw[3] = gap
-            fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
-            seg[6] = p.imem[IM_PVER]
-            seg[7] = pu
-            seg[8] = gap
+        fm = _magnet_force(p, arm == ARM_FREE, gap, icoil)
     fn1 = 0.0
     if arm == ARM_FREE:
         dx[3] = xd
@@ -725,7 +738,7 @@ def _rhs(t, x, u, m, p, dx, g):
         fmem[FM_GM + k] = g[k]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _same_point(t, x, u, m, fmem):
     """True if ``aux`` in ``fmem`` comes from an evaluation at ``(t, x, u, m)`` with the memories as they are now.
 

@@ -512,14 +512,6 @@ def peek_combined(comb, grid, stack, pref, length, u, v, idx, w):
     return base + table_output(comb, 0, grid, stack, L, pref, v) - pref[0, L // 2]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
-def _cell(comb, i, j):
-    """Coefficients ``(C0, C1, C2, C3)`` of cell ``(i, min(j, i))`` of the combined table ([1], Eqs. 4-5)."""
-    if j > i:
-        j = i
-    return comb[0, i, j, 0], comb[0, i, j, 1], comb[0, i, j, 2], comb[0, i, j, 3]
-
-
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
     """:func:`peek_combined` as a quadratic in the next input on the stretch of inputs around ``v``.
@@ -531,7 +523,8 @@ def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
     stretch whose open interior ``lo < v < hi`` holds ``v`` and returns the quadratic at ``v``: any input
     strictly inside the same stretch gets the same polynomial, so a caller may keep ``seg`` for later inputs
     while the memory and the table stay (inputs on a stretch's ends, and ``v == u``, are evaluated afresh:
-    ``seg`` is then made empty, ``lo = hi = v``).  Equal to :func:`peek_combined` to rounding.
+    ``v == u`` gives the output of the memory as it is, Eq. 3 for an even length, Eq. 2 for an odd one, and
+    an empty ``seg``, ``lo = hi = v``).  Equal to :func:`peek_combined` to rounding.
 
     ``kind`` says whether the polynomial depends on the last input ``u``: +1 for a rising stretch that does
     not (the output of Eq. 3 with the stored extrema after wiping: ``u`` only bounds it, so it holds for
@@ -539,12 +532,11 @@ def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
     falling one that does not (Eq. 2: ``lo < v < min(hi, u')``), 0 where ``u`` becomes a new extremum
     (the polynomial holds for this ``u`` only).
     """
-    n = grid.shape[0]
     L = length
     iv = locate(grid, v)
     lo = grid[iv]
     hi = grid[iv + 1]
-    if v > u:
+    if v > u or (v == u and L % 2 == 0):
         a = u  # the second argument of the first-order reversal value subtracted: u (a new minimum) or m_last
         const = 0.0
         if L % 2 == 1 and v < stack[L - 1]:
@@ -578,16 +570,16 @@ def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
             if sub:
                 a = stack[L - 1]
                 ib = locate(grid, a)
-        # F(v, v) on the diagonal cell of v, minus F(v, a) (none with the virtual minimum: L == 0, rising)
-        c0, c1, c2, c3 = _cell(comb, iv, iv)
-        a0 = const + c0
-        a1 = c1 + c2
-        a2 = c3
+        # F(v, v) on the diagonal cell of v ([1], Eqs. 4-5: C0 + (C1 + C2) v + C3 v^2), minus F(v, a) on the
+        # cell (v, a) (none with the virtual minimum: L == 0, rising)
+        a0 = const + comb[0, iv, iv, 0]
+        a1 = comb[0, iv, iv, 1] + comb[0, iv, iv, 2]
+        a2 = comb[0, iv, iv, 3]
         if sub:
-            d0, d1, d2, d3 = _cell(comb, iv, ib)
-            a0 -= d0 + d2 * a
-            a1 -= d1 + d3 * a
-    elif v < u:
+            jb = min(ib, iv)
+            a0 -= comb[0, iv, jb, 0] + comb[0, iv, jb, 2] * a
+            a1 -= comb[0, iv, jb, 1] + comb[0, iv, jb, 3] * a
+    else:
         if L % 2 == 0 and (L < 2 or v > stack[L - 1]):
             # u becomes a maximum that is not wiped ([1], Eq. 2 with M_n = u)
             top = u
@@ -615,15 +607,15 @@ def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
                 m = stack[L - 2]
                 const -= forc_value_ij(comb, 0, grid, top, locate(grid, top), m, locate(grid, m))
         # F(top, v) on the cell (top, v): linear in v
-        c0, c1, c2, c3 = _cell(comb, locate(grid, top), iv)
-        a0 = const + c0 + c1 * top
-        a1 = c2 + c3 * top
+        it = locate(grid, top)
+        jv = min(iv, it)
+        a0 = const + comb[0, it, jv, 0] + comb[0, it, jv, 1] * top
+        a1 = comb[0, it, jv, 2] + comb[0, it, jv, 3] * top
         a2 = 0.0
-    else:
-        seg[0] = v
-        seg[1] = v
-        seg[5] = 0.0
-        return peek_combined(comb, grid, stack, pref, length, u, v, idx, w)
+    if v == u:  # the memory as it is: evaluated afresh every time (no stretch)
+        lo = v
+        hi = v
+        kind = 0.0
     seg[0] = lo
     seg[1] = hi
     seg[2] = a0
@@ -643,8 +635,9 @@ def invert_combined(comb, grid, stack, pref, length, u, target, idx, w, tol, seg
     ``kind`` +1), so the inverse of Eq. 7 is solved on it without locating anything.  ``seg`` (8 values:
     :func:`peek_segment`'s six, then ``version``, the count of the memory's changes it was built for) is kept
     by the caller between calls; the caller counts a change whenever :func:`commit` changes the length (the
-    stack changes only then).  Any other case (falling, a target beyond the stretch) is :func:`invert_one`.
-    Returns ``(v, feasible)`` as :func:`invert_one`, to rounding.
+    stack changes only then).  Returns ``(v, feasible)`` as :func:`invert_one`, to rounding, or ``(NaN,
+    False)`` in any other case (falling, a target beyond the stretch): the caller then calls
+    :func:`invert_one` (not called from here: every compiled function's code is linked with its callees).
     """
     n = grid.shape[0]
     if u < grid[n - 1]:
@@ -669,4 +662,4 @@ def invert_combined(comb, grid, stack, pref, length, u, target, idx, w, tol, seg
                 v = (target - a0) / a1  # [1], Eq. 7 on the stretch
                 if v < seg[1]:
                     return max(v, u), True
-    return invert_one(comb, grid, stack, pref, length, u, target, idx, w, tol)
+    return np.nan, False
