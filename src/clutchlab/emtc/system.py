@@ -327,7 +327,6 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     return a_f, a_r, te, ttrans
 
 
-
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def lock_torque(a_f, a_r, v):
     """Torque that keeps both shafts at the same acceleration, ``(J_R A_f + J_F A_r)/(J_F + J_R)`` ([1], Eq. 29) [N*m].
@@ -1094,21 +1093,18 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_KEY] = np.nan
     fmem[FM_SEG:FM_SEG + 9] = np.nan
     fmem[FM_CSEG:FM_CSEG + 8] = np.nan
+    jf = float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2)  # [1], Eq. 29, J_F
+    jr = float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2)  # [1], Eq. 29, J_R
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
-        gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),
-        inertia_front=float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2),  # [1], Eq. 29, J_F
-        inertia_rear=float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2),  # [1], Eq. 29, J_R
+        gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]), inertia_front=jf, inertia_rear=jr,
         tyre_radius=float(vehicle.tyre_radius), axle_load_front=float(fzf), axle_load_rear=float(fzr),
         rolling_resistance=float(vehicle.rolling_resistance), tyre_slip_stiffness=float(vehicle.tyre_slip_stiffness),
         slip_speed_floor=float(vehicle.slip_speed_floor), engine_torque_max=float(vehicle.engine_torque_max),
         engine_power=float(vehicle.engine_power), torsen_stiffness=float(vehicle.torsen_stiffness),
         torsen_damping=float(vehicle.torsen_damping), drum_load_front=float(scenario.drum_load_front),
-        drum_load_rear=float(scenario.drum_load_rear), inv_axle_ratio=0.0, inv_inertia_front=0.0,
-        inv_inertia_rear=0.0, lock_share_front=0.0, lock_share_rear=0.0)
-    jf, jr = veh.inertia_front, veh.inertia_rear
-    veh = veh._replace(inv_axle_ratio=1.0 / veh.axle_ratio, inv_inertia_front=1.0 / jf, inv_inertia_rear=1.0 / jr,
-                       lock_share_front=jr / (jf + jr), lock_share_rear=jf / (jf + jr))
+        drum_load_rear=float(scenario.drum_load_rear), inv_axle_ratio=1.0 / float(ic), inv_inertia_front=1.0 / jf,
+        inv_inertia_rear=1.0 / jr, lock_share_front=jr / (jf + jr), lock_share_rear=jf / (jf + jr))
     cpl = CouplingData(
         drag_pairs=float(vehicle.drag_pairs), oil_viscosity=float(vehicle.oil_viscosity),
         plate_clearance=float(vehicle.plate_clearance), plate_outer_radius=float(vehicle.plate_outer_radius),
