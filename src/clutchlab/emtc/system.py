@@ -453,34 +453,46 @@ def _switch(k, t, x, u, m, p, log):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode):
+def _commit(t, x, p):
     """Commit the plant magnet memory and the LuGre bristle state at the end of an accepted step (once per ``t``).
 
-    ``tables``, ``grid``, ``stack``, ``prefix``: the plant's Preisach tables and memory; ``imem``, ``fmem``:
-    the run's memories; ``lugre``: the LuGre data; returns 0 or :data:`ERR_PLANT_MEMORY`.
+    ``p``: the parameters (the plant's Preisach tables and memory, the run's memories, the LuGre data); returns
+    0 or :data:`ERR_PLANT_MEMORY`.
     """
+    imem = p.imem
+    fmem = p.fmem
     if t == fmem[FM_TLAST]:
         return 0
+    grid = p.plant_grid
+    stack = p.plant_stack
     inew = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
     plen = imem[IM_PLEN]
     if plen + 2 > stack.shape[0]:
         return ERR_PLANT_MEMORY
     pu = fmem[FM_PU]
-    if (inew > pu and plen % 2 == 0 and (plen < 2 or inew < stack[plen - 2])) or (
-            inew < pu and plen % 2 == 1 and (plen < 3 or inew > stack[plen - 2])):
-        pass  # no turning point, nothing wiped: the stack stays, only the last input moves (all commit would do)
-    elif inew != pu:
-        new = commit(tables, grid, stack, prefix, plen, pu, inew)
+    if not _stack_stays(stack, plen, pu, inew):
+        new = commit(p.plant_tables, grid, stack, p.plant_prefix, plen, pu, inew)
         if new != plen:  # the stack changes only with its length
             imem[IM_PLEN] = new
             imem[IM_PVER] += 1
     fmem[FM_PU] = inew
     tlast = fmem[FM_TLAST]
-    if friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
+    if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
         dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
-        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, lugre)
+        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, p.lugre)
     fmem[FM_TLAST] = t
     return 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _stack_stays(stack, length, u, v):
+    """True if moving a hysteresis memory from input ``u`` to ``v`` leaves its stack as it is (no turning point
+    pushed, nothing wiped: :func:`~clutchlab.hysteresis._kernels.commit` would only move the last input)."""
+    if v > u:
+        return length % 2 == 0 and (length < 2 or v < stack[length - 2])
+    if v < u:
+        return length % 2 == 1 and (length < 3 or v > stack[length - 2])
+    return True
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -529,10 +541,11 @@ def _controller(t, x, u, p):
                                 fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eq. 7 on the kept stretch
     if i_new != i_new:
         i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7
-    new = commit(tables, grid, stack, prefix, clen, cu, i_new)
-    if new != clen:  # the stack changes only with its length
-        imem[IM_CLEN] = new
-        imem[IM_CVER] += 1
+    if not _stack_stays(stack, clen, cu, i_new):
+        new = commit(tables, grid, stack, prefix, clen, cu, i_new)
+        if new != clen:  # the stack changes only with its length
+            imem[IM_CLEN] = new
+            imem[IM_CVER] += 1
     fmem[FM_CU] = i_new
     fmem[FM_CMD] = i_new
     fmem[FM_TREF] = t_ref
@@ -793,8 +806,7 @@ def _outputs(t, x, u, m, p, y):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _update(t, x, u, m, p, k, log):
     p.fmem[FM_KEY] = np.nan
-    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
-                p.friction_mode)  # the memories see the state at the event, before the mode change
+    r = _commit(t, x, p)  # the memories see the state at the event, before the mode change
     if r < 0:
         return r
     _switch(k, t, x, u, m, p, log)
@@ -851,8 +863,7 @@ def _accept(t, x, u, m, p):
     e = p.imem[IM_ERROR]
     if e != 0:
         return e
-    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
-                p.friction_mode)
+    r = _commit(t, x, p)
     if r < 0:
         p.imem[IM_ERROR] = r
         return r
