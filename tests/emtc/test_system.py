@@ -153,6 +153,28 @@ def test_controller_log_is_the_command_computed_at_each_sample(magnet):
     assert isinstance(res.events, pd.DataFrame)
 
 
+def test_controller_log_of_the_last_sample_is_built_when_read_and_before_pickling(magnet):
+    """simulate_bench runs the controller's last sample (its break never comes) when the controller columns are
+    first read: the same columns as running it at once, from the run's own memories (a later run does not
+    disturb them), and a pickled result carries them."""
+    import pickle
+
+    sc = BenchScenario(duration=0.2)
+    kw = {"torque_reference": ([0.0, 0.1, 0.2], [50.0, 300.0, 100.0])}
+    first = simulate_bench(magnet, sc, **kw)
+    simulate_bench(magnet, sc, torque_reference=([0.0, 0.2], [10.0, 20.0]))  # another run in between
+    back = pickle.loads(pickle.dumps(simulate_bench(magnet, sc, **kw)))
+    system = bench_system(magnet, sc, options=BenchOptions(**kw), n_samples=101)
+    run = core_simulate(system, 0.2, sample_times=np.arange(101) * 0.002)
+    S.run_controller(system.params, 0.2, run.stats["final_state"], system.u0)
+    log = S.controller_log(system.params)
+    for res in (first, back):
+        out = res.outputs
+        np.testing.assert_array_equal(out["current_command"], log[:, 0])
+        np.testing.assert_array_equal(out["torque_reference"], log[:, 1])
+    assert log[-1, 1] == pytest.approx(100.0)  # the last sample's reference: the table's end
+
+
 def test_repeated_runs_get_fresh_memories_from_the_remembered_packing(magnet):
     """pack_parameters remembers the packed tables of a bench: a second run starts from fresh memories
     (same trajectory bit for bit), never from the first run's hysteresis stacks or controller log."""

@@ -319,3 +319,102 @@ def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):
     assert b == pytest.approx(a, rel=1e-12, abs=1e-9)
     # and peek equals committing the step
     assert a == pytest.approx(fam.step(v, airgap=gap), rel=1e-12, abs=1e-9)
+
+
+@settings(max_examples=examples(200), deadline=None)
+@given(history=st.lists(st.floats(0.0, 4.5), min_size=0, max_size=30), v=st.floats(0.0, 4.5),
+       gap=st.floats(0.2e-3, 1.0e-3), inside=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=5))
+def test_peek_segment_is_the_combined_peek_on_its_whole_stretch(history, v, gap, inside):
+    """:func:`peek_segment` (the drum bench's stage evaluations while the armature rests on a stop): the
+    quadratic it returns for the stretch around ``v`` equals the combined-table peek at ``v`` and at any input
+    strictly inside that stretch, for any memory."""
+    from clutchlab.hysteresis import _kernels as K
+
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
+    fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
+    if history:
+        fam.simulate(history, airgap=gap)
+    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    K.gap_weights(fam.airgaps, gap, idx, w)
+    comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
+    K.combine_tables(fam.kernel_tables, idx, w, comb)
+    args = (fam._stack, fam._pref, fam._length, fam._u)
+    seg = np.zeros(6)
+    scale = np.max(np.abs(fam.kernel_tables)) + 1.0
+    f = K.peek_segment(comb, fam.grid, *args, v, idx, w, seg)
+    assert f == pytest.approx(K.peek_combined(comb, fam.grid, *args, v, idx, w), rel=1e-12, abs=1e-12 * scale)
+    lo, hi, a0, a1, a2, kind = seg
+    if v == fam._u:
+        assert lo == hi == v
+        return
+    assert lo <= v <= hi and (lo < v or v < hi or lo == hi)
+    stack, length, u = fam._stack, fam._length, fam._u
+    # the last inputs the same memory may have: rising from the last minimum below the last maximum (even
+    # length), or falling from the last maximum above the last minimum (odd)
+    if length == 0:
+        lo_u, hi_u = fam.grid[0], fam.grid[-1]
+    elif length % 2 == 0:
+        lo_u, hi_u = stack[length - 1], stack[length - 2]
+    else:
+        lo_u, hi_u = (stack[length - 2] if length >= 3 else fam.grid[0]), stack[length - 1]
+    for s in inside:
+        x = lo + s * (hi - lo)
+        if not lo < x < hi:
+            continue
+        ref = K.peek_combined(comb, fam.grid, *args, x, idx, w)
+        assert a0 + x * (a1 + x * a2) == pytest.approx(ref, rel=1e-12, abs=1e-12 * scale)
+        seg2 = np.zeros(6)
+        K.peek_segment(comb, fam.grid, *args, x, idx, w, seg2)
+        np.testing.assert_array_equal(seg2, seg)  # one polynomial for the whole stretch
+        # kind +1 / -1: the same polynomial for another last input below / above x with the same memory
+        for uo in (lo_u + s * (hi_u - lo_u), lo_u, hi_u):
+            if (kind == 1.0 and uo < x) or (kind == -1.0 and uo > x):
+                ref = K.peek_combined(comb, fam.grid, stack, fam._pref, length, uo, x, idx, w)
+                assert a0 + x * (a1 + x * a2) == pytest.approx(ref, rel=1e-12, abs=1e-12 * scale)
+                K.peek_segment(comb, fam.grid, stack, fam._pref, length, uo, x, idx, w, seg2)
+                np.testing.assert_array_equal(seg2[2:], seg[2:])
+
+
+@settings(max_examples=examples(100), deadline=None)
+@given(history=st.lists(st.floats(0.0, 4.5), min_size=0, max_size=12),
+       targets=st.lists(st.floats(-0.2, 1.2), min_size=1, max_size=25), gap=st.floats(0.2e-3, 1.0e-3),
+       rising=st.booleans())
+def test_invert_combined_is_invert_one_along_a_command_sequence(history, targets, gap, rising):
+    """:func:`invert_combined` (the drum bench's controller, one combined table, its rising stretch kept between
+    samples) gives the inverse of :func:`invert_one` at every sample of a sequence of targets committed one
+    after the other (mostly rising ones with ``rising``: the stretch is reused), to rounding."""
+    from clutchlab.hysteresis import _kernels as K
+
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
+    fam = Preisach(GRID, np.array([np.maximum.accumulate(np.maximum.accumulate(random_table(s), 0), 1) * (1 + s)
+                                   for s in range(5)]), gaps)
+    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    K.gap_weights(fam.airgaps, gap, idx, w)
+    comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
+    K.combine_tables(fam.kernel_tables, idx, w, comb)
+    one, ow = np.zeros(3, dtype=np.int64), np.array([1.0, 0.0, 0.0])
+    cap = 64
+    stack, pref = np.zeros(cap), np.zeros((1, cap // 2 + 2))
+    length, u = 0, float(fam.grid[0])
+    for v in history:
+        length = K.commit(comb, fam.grid, stack, pref, length, u, v)
+        u = v
+    lo = K.peek(comb, fam.grid, stack, pref, length, u, fam.grid[0], one, ow)
+    hi = K.peek(comb, fam.grid, stack, pref, length, u, fam.grid[-1], one, ow)
+    seg = np.full(8, np.nan)
+    version = 0
+    ts = np.sort(targets) if rising else np.asarray(targets)
+    for q in ts:
+        if length + 2 > cap:
+            break
+        target = lo + q * (hi - lo)
+        v1, ok1 = K.invert_one(comb, fam.grid, stack, pref, length, u, target, one, ow, 1e-9)
+        v2, ok2 = K.invert_combined(comb, fam.grid, stack, pref, length, u, target, one, ow, 1e-9, seg, version)
+        if np.isnan(v2):  # not on the kept stretch: the caller's invert_one
+            assert not ok2
+            v2, ok2 = K.invert_one(comb, fam.grid, stack, pref, length, u, target, one, ow, 1e-9)
+        assert ok1 == ok2
+        assert v2 == pytest.approx(v1, rel=1e-11, abs=1e-11)
+        new = K.commit(comb, fam.grid, stack, pref, length, u, v2)
+        version += new != length
+        length, u = new, v2

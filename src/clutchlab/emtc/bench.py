@@ -223,9 +223,11 @@ class BenchResult:
     ----------
     result : clutchlab.SimulationResult
         A run of the ``emtc_bench`` model recorded at the controller samples.
-    controller_log : numpy.ndarray, optional
+    controller_log : numpy.ndarray or callable, optional
         ``(samples, 4)``: command [A], reference [N*m], throttle [-] and feasible (1/0) computed by the
-        controller at each sample (see :meth:`from_result`).
+        controller at each sample (see :meth:`from_result`), or a zero-argument callable returning it, called
+        when the controller columns are first read (:func:`simulate_bench` runs the controller's last sample
+        only then).
 
     Attributes
     ----------
@@ -260,7 +262,7 @@ class BenchResult:
 
     def __init__(self, result, controller_log=None):
         self.result = result
-        self._log = controller_log
+        self._log_source = controller_log
         self.n_steps = int(result.stats.get("accepted_steps", 0))
         self.time = np.asarray(result.time, dtype=float).copy()
         self._cache = {}
@@ -278,6 +280,18 @@ class BenchResult:
             sample (:func:`clutchlab.emtc.system.controller_log`); without it the held values the result reports are used.
         """
         return cls(result, controller_log)
+
+    @property
+    def _log(self):
+        """The controller log (built from its callable on first read)."""
+        if callable(self._log_source):
+            self._log_source = self._log_source()
+        return self._log_source
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["_log_source"] = self._log  # (no callable in the state)
+        return state
 
     def _out(self, name):
         return self.result[name]
@@ -377,6 +391,19 @@ _AFTER = {
 
 
 _DEFAULTS: dict = {}
+_NONE7 = (None,) * 7
+_SYSTEM = None
+
+
+def _system_module():
+    """:mod:`clutchlab.emtc.system` (imported on first use: it imports this module; an import statement in a
+    function costs about 1.5 us a call)."""
+    global _SYSTEM
+    if _SYSTEM is None:
+        from . import system
+
+        _SYSTEM = system
+    return _SYSTEM
 
 
 def _default(cls):
@@ -443,14 +470,15 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     from the inverse Preisach model at the engaged airgap ``d - sigma``
     (Eqs. 6-7).  The current follows through the two lags of Fig. 15.
     """
-    import dataclasses as _dc
-
-    from . import system as S
-
+    S = _system_module()
     scenario = scenario or _default(BenchScenario)
-    options = S.BenchOptions(actuator=actuator, coupling=coupling, torque_map=torque_map,
-                             controller_model=controller_model, friction_map=friction_map, lugre=lugre,
-                             torque_reference=torque_reference)
+    given = (actuator, coupling, torque_map, controller_model, friction_map, lugre, torque_reference)
+    if given == _NONE7:
+        options = _default(S.BenchOptions)
+    else:
+        options = S.BenchOptions(actuator=actuator, coupling=coupling, torque_map=torque_map,
+                                 controller_model=controller_model, friction_map=friction_map, lugre=lugre,
+                                 torque_reference=torque_reference)
     # output rows plus the event buffer (20 events of 4 values per output row, as before)
     check_allocation(scenario.duration / scenario.sample_time + 1, 26 + 80,
                      f"duration = {scenario.duration!r} s at sample_time = {scenario.sample_time!r} s")
@@ -458,14 +486,20 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     samples = np.arange(n) * scenario.sample_time
 
     def build(cap):
-        opts = options if cap is None else _dc.replace(options, memory_capacity=cap)
+        opts = options if cap is None else dataclasses.replace(options, memory_capacity=cap)
         return S.bench_system(magnet, scenario, vehicle, opts, n_samples=n)
 
     system, res = S.run(build, float(samples[-1]), rtol=float(rtol), atol=atol, sample_times=samples,
                         max_steps=int(max_steps), fixed_step=fixed_step)
-    # the controller also runs at the last sample (its break never comes: the run ends there)
-    S.run_controller(system.params, float(samples[-1]), res.stats["final_state"], system.u0)
-    return BenchResult(res, S.controller_log(system.params))
+    params, t_last, x_last, u0 = system.params, float(samples[-1]), res.stats["final_state"].copy(), system.u0
+
+    def controller_log():
+        # the controller also runs at the last sample (its break never comes: the run ends there); done when
+        # the controller columns are first read (the run's own memories wait for it)
+        S.run_controller(params, t_last, x_last, u0)
+        return S.controller_log(params)
+
+    return BenchResult(res, controller_log)
 
 
 def load_scenario(path):

@@ -25,8 +25,8 @@ Hybrid structure:
   the same instants;
 * the plant magnet's hysteresis memory and the LuGre bristle state are committed once per accepted step
   (:func:`_accept`, or at an event before the mode changes), never inside the stages: stages evaluate the
-  magnet with :func:`~clutchlab.hysteresis._kernels.peek_combined` and advance the bristles from their
-  committed value;
+  magnet with :func:`~clutchlab.hysteresis._kernels.peek_segment` (:func:`~clutchlab.hysteresis._kernels.peek`
+  while the armature moves) and advance the bristles from their committed value;
 * a full hysteresis memory is a model error (codes in :data:`ERROR_MESSAGES`), not a solver status.
 
 References
@@ -46,7 +46,8 @@ import numba
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import combine_tables, commit, gap_weights, invert_one, peek_combined
+from ..hysteresis._kernels import (combine_tables, commit, gap_weights, invert_combined, invert_one, peek,
+                                   peek_segment)
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
@@ -140,12 +141,13 @@ ERROR_MESSAGES = {
 }
 
 # per-run integer memories (EmtcParams.imem)
-IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX = 0, 1, 2, 3, 4, 7
-N_IMEM = 10
+IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX = 0, 1, 2, 3, 4, 7, 10
+IM_PVER, IM_CVER = 13, 14  # changes of the plant's and the controller's hysteresis stacks so far (their lengths)
+N_IMEM = 15
 # per-run float memories and scratch (EmtcParams.fmem)
 FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
 FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
-FM_CW = 12  # 3: airgap weights of the controller model
+FM_CW = 12  # 3: weights of the controller model's table (one table at the engaged airgap: 1, 0, 0)
 FM_ULAST = 15  # 5: inputs seen at the last restart
 FM_AUX = 20  # N_AUX model intermediates of the last evaluation
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
@@ -157,13 +159,18 @@ FM_G = FM_DX + 7  # 6: scratch switching functions
 FM_KEY = FM_G + 6  # 16: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
 FM_DXM = FM_KEY + 16  # 7: derivative of the last evaluation
 FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
-N_FMEM = FM_GM + 6
+FM_FW = FM_GM + 6  # 3: airgap weights of the plant tables at the last evaluation with the armature moving
+FM_SEG = FM_FW + 3  # 9: the plant magnet's force as a quadratic in the coil current on the stretch of the last
+#                          evaluation (lo, hi, a0, a1, a2, kind: hysteresis._kernels.peek_segment) and the stack
+#                          version (IM_PVER), last input and airgap it is for
+FM_CSEG = FM_SEG + 9  # 8: the controller model's rising stretch (hysteresis._kernels.invert_combined)
+N_FMEM = FM_CSEG + 8
 # controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
 # the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
-(L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_GAPS, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
- L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(16)
-N_LAYOUT = 16
+(L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
+ L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(15)
+N_LAYOUT = 15
 
 ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
 
@@ -188,6 +195,11 @@ class VehicleData(NamedTuple):
     torsen_damping: float
     drum_load_front: float
     drum_load_rear: float
+    inv_axle_ratio: float  # 1 / axle_ratio, and below: the divisions of every evaluation done once when packing
+    inv_inertia_front: float
+    inv_inertia_rear: float
+    lock_share_front: float  # J_R / (J_F + J_R): the weight of A_f in T_lock (Eq. 29)
+    lock_share_rear: float  # J_F / (J_F + J_R)
 
 
 class CouplingData(NamedTuple):
@@ -213,6 +225,8 @@ class ActuatorData(NamedTuple):
     airgap_open: float
     tau1: float
     tau2: float
+    inv_tau1: float  # 1 / tau1, 1 / tau2: the divisions of every evaluation done once when packing
+    inv_tau2: float
 
 
 class EmtcParams(NamedTuple):
@@ -238,7 +252,6 @@ class EmtcParams(NamedTuple):
     reference_source: int
     n_airgaps: int
     n_cells: int
-    n_ctl_airgaps: int
     n_ctl_cells: int
     n_fmap_speed: int
     n_fmap_temp: int
@@ -289,21 +302,28 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
     (clutchlab's assumptions: the paper does not model the tyre-drum contact or the engine).
     Returns ``(A_f, A_r, T_e, T_trans)`` [N*m].
     """
-    ic = v.axle_ratio
+    inv_ic = v.inv_axle_ratio  # 1 / i
     rw = v.tyre_radius
-    wwf = wf / ic
-    wwr = wr / ic
+    wwf = wf * inv_ic
+    wwr = wr * inv_ic
     kf = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_front), v.slip_speed_floor)
     kr = 2.0 * v.tyre_slip_stiffness * rw / max(abs(v_rear), v.slip_speed_floor)
     fxf = kf * (wwf * rw - v_front)  # tyre-drum longitudinal force, both wheels
     fxr = kr * (wwr * rw - v_rear)
-    rrf = v.rolling_resistance * v.axle_load_front * rw * math.tanh(wwf / 0.5) + v.drum_load_front
-    rrr = v.rolling_resistance * v.axle_load_rear * rw * math.tanh(wwr / 0.5) + v.drum_load_rear
-    we = abs(wwf) * v.front_final_drive * v.gear_ratio
-    te = throttle * min(v.engine_torque_max, v.engine_power / max(we, 1.0))
+    # tanh(w_w / 0.5 rad/s), without the call where it is +-1 in double precision (|z| >= 20: 1 - tanh is below
+    # 1e-17, half an ulp of 1 is 5.5e-17: the library's value)
+    zf = wwf * 2.0
+    zr = wwr * 2.0
+    tf = 1.0 if zf >= 20.0 else (-1.0 if zf <= -20.0 else math.tanh(zf))
+    tr = 1.0 if zr >= 20.0 else (-1.0 if zr <= -20.0 else math.tanh(zr))
+    rrf = v.rolling_resistance * v.axle_load_front * rw * tf + v.drum_load_front
+    rrr = v.rolling_resistance * v.axle_load_rear * rw * tr + v.drum_load_rear
+    we = max(abs(wwf) * v.front_final_drive * v.gear_ratio, 1.0)
+    tmax = v.engine_torque_max
+    te = throttle * (tmax if we * tmax <= v.engine_power else v.engine_power / we)  # min(T_max, P / w_e)
     ttrans = te * v.gear_ratio
-    a_f = (ttrans * v.front_final_drive - fxf * rw - rrf) / ic  # [1], Eq. 27: front loads at the coupling shaft
-    a_r = (fxr * rw + rrr) / ic
+    a_f = (ttrans * v.front_final_drive - fxf * rw - rrf) * inv_ic  # [1], Eq. 27: front loads at the coupling shaft
+    a_r = (fxr * rw + rrr) * inv_ic
     return a_f, a_r, te, ttrans
 
 
@@ -313,7 +333,7 @@ def lock_torque(a_f, a_r, v):
 
     ``a_f``, ``a_r``: the loads of Eq. 27 [N*m]; ``v``: :class:`VehicleData`.
     """
-    return (v.inertia_rear * a_f + v.inertia_front * a_r) / (v.inertia_front + v.inertia_rear)  # [1], Eq. 29
+    return v.lock_share_front * a_f + v.lock_share_rear * a_r  # [1], Eq. 29 (the shares J_R, J_F / (J_F + J_R))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -433,26 +453,46 @@ def _switch(k, t, x, u, m, p, log):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _commit(t, x, tables, grid, stack, prefix, imem, fmem, lugre, friction_mode):
+def _commit(t, x, p):
     """Commit the plant magnet memory and the LuGre bristle state at the end of an accepted step (once per ``t``).
 
-    ``tables``, ``grid``, ``stack``, ``prefix``: the plant's Preisach tables and memory; ``imem``, ``fmem``:
-    the run's memories; ``lugre``: the LuGre data; returns 0 or :data:`ERR_PLANT_MEMORY`.
+    ``p``: the parameters (the plant's Preisach tables and memory, the run's memories, the LuGre data); returns
+    0 or :data:`ERR_PLANT_MEMORY`.
     """
+    imem = p.imem
+    fmem = p.fmem
     if t == fmem[FM_TLAST]:
         return 0
+    grid = p.plant_grid
+    stack = p.plant_stack
     inew = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
     plen = imem[IM_PLEN]
     if plen + 2 > stack.shape[0]:
         return ERR_PLANT_MEMORY
-    imem[IM_PLEN] = commit(tables, grid, stack, prefix, plen, fmem[FM_PU], inew)
+    pu = fmem[FM_PU]
+    if not _stack_stays(stack, plen, pu, inew):
+        new = commit(p.plant_tables, grid, stack, p.plant_prefix, plen, pu, inew)
+        if new != plen:  # the stack changes only with its length
+            imem[IM_PLEN] = new
+            imem[IM_PVER] += 1
     fmem[FM_PU] = inew
     tlast = fmem[FM_TLAST]
-    if friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
+    if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
         dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
-        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, lugre)
+        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, p.lugre)
     fmem[FM_TLAST] = t
     return 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _stack_stays(stack, length, u, v):
+    """True if moving a hysteresis memory from input ``u`` to ``v`` leaves its stack as it is (no turning point
+    pushed, nothing wiped: :func:`~clutchlab.hysteresis._kernels.commit` would only move the last input)."""
+    if v > u:
+        return length % 2 == 0 and (length < 2 or v < stack[length - 2])
+    if v < u:
+        return length % 2 == 1 and (length < 3 or v > stack[length - 2])
+    return True
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -488,15 +528,24 @@ def _controller(t, x, u, p):
     if clen + 2 > stack.shape[0]:
         imem[IM_ERROR] = ERR_CONTROLLER_MEMORY  # reported by the next accepted step
         return
+    # the controller's model at its one airgap, the engaged d - sigma: the airgap interpolation (Eqs. 2-5 are
+    # linear in the table) applied to the cell coefficients once by pack_parameters, one table of weight 1
     n = p.n_ctl_cells
-    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (p.n_ctl_airgaps, n, n, 4))
+    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (1, n, n, 4))
     grid = _cold(p.cold, p.layout, L_CTL_GRID)
-    prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (p.n_ctl_airgaps, stack.shape[0] // 2 + 2))
-    cidx = imem[IM_CIDX:IM_CIDX + 3]  # airgap weights at the engaged airgap d - sigma (set by pack_parameters)
+    prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (1, stack.shape[0] // 2 + 2))
+    cidx = imem[IM_CIDX:IM_CIDX + 3]
     cw = fmem[FM_CW:FM_CW + 3]
     cu = fmem[FM_CU]
-    i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7 at d - sigma
-    imem[IM_CLEN] = commit(tables, grid, stack, prefix, clen, cu, i_new)
+    i_new, ok = invert_combined(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9,
+                                fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eq. 7 on the kept stretch
+    if i_new != i_new:
+        i_new, ok = invert_one(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9)  # [1], Eqs. 6-7
+    if not _stack_stays(stack, clen, cu, i_new):
+        new = commit(tables, grid, stack, prefix, clen, cu, i_new)
+        if new != clen:  # the stack changes only with its length
+            imem[IM_CLEN] = new
+            imem[IM_CVER] += 1
     fmem[FM_CU] = i_new
     fmem[FM_CMD] = i_new
     fmem[FM_TREF] = t_ref
@@ -518,6 +567,42 @@ def _command(u, p):
     return u[U_COIL] if p.reference_source == REFERENCE_CURRENT else p.fmem[FM_CMD]
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _magnet_force(p, moving, gap, icoil):
+    """The plant magnet's force [N] at the coil current ``icoil`` [A] and the airgap ``gap`` [m] where the stretch
+    kept in ``fmem[FM_SEG:]`` does not hold: Preisach output for the next input, memory not committed ([1],
+    Eqs. 1-5), interpolated over the calibration airgaps (Eq. 12).
+
+    ``moving``: the armature is free, another airgap at every stage: the weighted output of the nearest
+    calibration tables (building the weighted cell table would cost more than the evaluation).  At a stop the
+    airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in it) and the stretch
+    of :func:`~clutchlab.hysteresis._kernels.peek_segment` around ``icoil`` is kept with the stack version,
+    last input and airgap it is for.
+    """
+    fmem = p.fmem
+    grid = p.plant_grid
+    pu = fmem[FM_PU]
+    plen = p.imem[IM_PLEN]
+    gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
+    if moving:
+        fidx = p.imem[IM_FIDX:IM_FIDX + 3]
+        fw = fmem[FM_FW:FM_FW + 3]
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), fidx, fw)
+        return peek(p.plant_tables, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, fidx, fw)
+    gw = fmem[FM_GW:FM_GW + 4]
+    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
+    if gap != gw[3]:
+        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
+        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
+        gw[3] = gap
+    seg = fmem[FM_SEG:FM_SEG + 9]
+    fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
+    seg[6] = p.imem[IM_PVER]
+    seg[7] = pu
+    seg[8] = gap
+    return fm
+
+
 # ------------------------------------------------------------------ the hooks of the contract
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _rhs(t, x, u, m, p, dx, g):
@@ -529,14 +614,14 @@ def _rhs(t, x, u, m, p, dx, g):
     """
     a = p.actuator
     fmem = p.fmem
-    if _same_point(t, x, u, m, fmem):
+    if abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)) and _same_point(t, x, u, m, fmem):  # (the time first)
         # the point of the last evaluation again (a controller sample at the end of a step): only the
         # current command may have changed since, and only the first current lag depends on it
         for i in range(7):
             dx[i] = fmem[FM_DXM + i]
         for k in range(6):
             g[k] = fmem[FM_GM + k]
-        dx[5] = (_command(u, p) - x[5]) / a.tau1
+        dx[5] = (_command(u, p) - x[5]) * a.inv_tau1
         return
     aux = fmem[FM_AUX:FM_AUX + N_AUX]
     v = p.vehicle
@@ -549,20 +634,21 @@ def _rhs(t, x, u, m, p, dx, g):
     xa = x[3]
     xd = x[4]
     # magnet force of the plant: Preisach output for the next coil current, memory not committed ([1],
-    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12; the weighted cell
-    # table is rebuilt only when the airgap changes, i.e. while the armature moves)
+    # Eqs. 1-5), interpolated over the calibration airgaps at the airgap d - x (Eq. 12).  At a stop, while the
+    # stack stays, the force is one quadratic in the coil current on the stretch where the same branch of
+    # Eqs. 2-3 and the same cells hold: kept for the next stages and, while the current keeps its direction
+    # (the stretch does not depend on the last input then), for the next steps (_magnet_force builds it)
     grid = p.plant_grid
     icoil = min(max(x[6], grid[0]), grid[grid.shape[0] - 1])
     gap = a.airgap_open - xa
-    gw = fmem[FM_GW:FM_GW + 4]
-    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
-    if gap != gw[3]:
-        gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
-        gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
-        combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
-        gw[3] = gap
-    fm = peek_combined(p.plant_comb, grid, p.plant_stack, p.plant_prefix, p.imem[IM_PLEN], fmem[FM_PU], icoil,
-                       gidx, gw)
+    seg = fmem[FM_SEG:FM_SEG + 9]
+    pu = fmem[FM_PU]
+    kind = seg[5]
+    if arm != ARM_FREE and seg[6] == p.imem[IM_PVER] and seg[8] == gap and seg[0] < icoil < seg[1] and (
+            (kind == 1.0 and icoil > pu) or (kind == -1.0 and icoil < pu) or (kind == 0.0 and seg[7] == pu)):
+        fm = seg[2] + icoil * (seg[3] + icoil * seg[4])
+    else:
+        fm = _magnet_force(p, arm == ARM_FREE, gap, icoil)
     fn1 = 0.0
     if arm == ARM_FREE:
         dx[3] = xd
@@ -573,8 +659,8 @@ def _rhs(t, x, u, m, p, dx, g):
         if arm == ARM_CONTACT:
             fn1 = max(primary_clamp_force(fm, a), 0.0)
     # current control: two first-order lags in series ([1], Fig. 15)
-    dx[5] = (_command(u, p) - x[5]) / a.tau1
-    dx[6] = (x[5] - x[6]) / a.tau2
+    dx[5] = (_command(u, p) - x[5]) * a.inv_tau1
+    dx[6] = (x[5] - x[6]) * a.inv_tau2
     thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
     a_f, a_r, te, ttrans = bench_loads(wf, wr, thr, u[U_DRUM_FRONT], u[U_DRUM_REAR], v)
     tlock = lock_torque(a_f, a_r, v)
@@ -649,8 +735,8 @@ def _rhs(t, x, u, m, p, dx, g):
     aux[AUX_FN2] = fn2
     aux[AUX_TE] = te
     aux[AUX_THR] = thr
-    dx[0] = (a_f - tc) / v.inertia_front  # [1], Eq. 27 (rows 1 and 3)
-    dx[1] = (tc - a_r) / v.inertia_rear  # [1], Eq. 27 (rows 2 and 4)
+    dx[0] = (a_f - tc) * v.inv_inertia_front  # [1], Eq. 27 (rows 1 and 3)
+    dx[1] = (tc - a_r) * v.inv_inertia_rear  # [1], Eq. 27 (rows 2 and 4)
     _switching(x, m, a, c.unlock_margin, aux, g)
     fmem[FM_KEY] = t
     for i in range(7):
@@ -671,8 +757,14 @@ def _same_point(t, x, u, m, fmem):
     The inputs are part of the point: a run changes them only at a restart (which clears the key), but an
     evaluation through the contract (:func:`clutchlab.system.evaluate`: linearisation, trim) may ask for
     the same state with other inputs.
+
+    The time is the same to rounding (4e-15 of it): the core evaluates the last stage of a step that ends on
+    a break time at the inputs' left limit ``t1 - 1e-15 max(1, |t1|)`` (:mod:`clutchlab.numerics.core`), and
+    the sample and the controller's restart at ``t1`` that follow read that evaluation (one evaluation per
+    step less).  The right-hand side is continuous in ``t`` (its only time dependence is the throttle ramp,
+    piecewise linear; the torque reference is read by the controller), so the two differ by a rounding error.
     """
-    if fmem[FM_KEY] != t:
+    if not abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)):
         return False
     for i in range(7):
         if fmem[FM_KEY + 1 + i] != x[i]:
@@ -714,8 +806,7 @@ def _outputs(t, x, u, m, p, y):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _update(t, x, u, m, p, k, log):
     p.fmem[FM_KEY] = np.nan
-    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
-                p.friction_mode)  # the memories see the state at the event, before the mode change
+    r = _commit(t, x, p)  # the memories see the state at the event, before the mode change
     if r < 0:
         return r
     _switch(k, t, x, u, m, p, log)
@@ -772,8 +863,7 @@ def _accept(t, x, u, m, p):
     e = p.imem[IM_ERROR]
     if e != 0:
         return e
-    r = _commit(t, x, p.plant_tables, p.plant_grid, p.plant_stack, p.plant_prefix, p.imem, p.fmem, p.lugre,
-                p.friction_mode)
+    r = _commit(t, x, p)
     if r < 0:
         p.imem[IM_ERROR] = r
         return r
@@ -990,11 +1080,10 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     cold = _Cold()
     cold.add(L_PLANT_TABLES, np.zeros(0))  # a field of its own (every accepted step reads it)
     cold.add(L_PLANT_GAPS, magnet.airgaps)
-    cold.add(L_CTL_TABLES, ctl.kernel_tables)
+    cold.add(L_CTL_TABLES, _table_at(ctl, lo_gap))
     cold.add(L_CTL_GRID, ctl.grid)
-    cold.add(L_CTL_GAPS, ctl.airgaps)
     cold.add(L_CTL_STACK, np.zeros(cap))
-    cold.add(L_CTL_PREFIX, np.zeros((ctl.n_airgaps, cap // 2 + 2)))
+    cold.add(L_CTL_PREFIX, np.zeros((1, cap // 2 + 2)))
     cold.add(L_MAP_THROTTLE, torque_map.throttle)
     cold.add(L_MAP_SPEED, torque_map.speed)
     cold.add(L_MAP_TORQUE, torque_map.torque)
@@ -1006,25 +1095,27 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     cold.add(L_LOG, np.zeros(4 * int(n_samples)))
     imem = np.zeros(N_IMEM, dtype=np.int64)
     fmem = np.zeros(N_FMEM)
-    cg = _f(ctl.airgaps)
-    gap_weights(cg, float(min(max(lo_gap, cg[0]), cg[-1])), imem[IM_CIDX:IM_CIDX + 3], fmem[FM_CW:FM_CW + 3])
+    fmem[FM_CW] = 1.0  # (imem[IM_CIDX:] = 0: the controller's one table)
     fmem[FM_PU] = magnet.grid[0]
     fmem[FM_CU] = ctl.grid[0]
     fmem[FM_TLAST] = np.nan
     fmem[FM_GW + 3] = np.nan
     fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
     fmem[FM_KEY] = np.nan
+    fmem[FM_SEG:FM_SEG + 9] = np.nan
+    fmem[FM_CSEG:FM_CSEG + 8] = np.nan
+    jf = float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2)  # [1], Eq. 29, J_F
+    jr = float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2)  # [1], Eq. 29, J_R
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
-        gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]),
-        inertia_front=float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2),  # [1], Eq. 29, J_F
-        inertia_rear=float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2),  # [1], Eq. 29, J_R
+        gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]), inertia_front=jf, inertia_rear=jr,
         tyre_radius=float(vehicle.tyre_radius), axle_load_front=float(fzf), axle_load_rear=float(fzr),
         rolling_resistance=float(vehicle.rolling_resistance), tyre_slip_stiffness=float(vehicle.tyre_slip_stiffness),
         slip_speed_floor=float(vehicle.slip_speed_floor), engine_torque_max=float(vehicle.engine_torque_max),
         engine_power=float(vehicle.engine_power), torsen_stiffness=float(vehicle.torsen_stiffness),
         torsen_damping=float(vehicle.torsen_damping), drum_load_front=float(scenario.drum_load_front),
-        drum_load_rear=float(scenario.drum_load_rear))
+        drum_load_rear=float(scenario.drum_load_rear), inv_axle_ratio=1.0 / float(ic), inv_inertia_front=1.0 / jf,
+        inv_inertia_rear=1.0 / jr, lock_share_front=jr / (jf + jr), lock_share_rear=jf / (jf + jr))
     cpl = CouplingData(
         drag_pairs=float(vehicle.drag_pairs), oil_viscosity=float(vehicle.oil_viscosity),
         plate_clearance=float(vehicle.plate_clearance), plate_outer_radius=float(vehicle.plate_outer_radius),
@@ -1033,17 +1124,32 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     act = ActuatorData(
         mass=float(actuator.mass), stiffness=float(actuator.stiffness), preload=float(actuator.preload),
         damping=float(actuator.damping), free_travel=float(actuator.free_travel),
-        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2))
+        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2),
+        inv_tau1=1.0 / float(actuator.tau1), inv_tau2=1.0 / float(actuator.tau2))
     return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
-        n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_airgaps=int(ctl.n_airgaps), n_ctl_cells=int(nc),
+        n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_cells=int(nc),
         n_fmap_speed=int(np.shape(fmap[2])[0]), n_fmap_temp=int(np.shape(fmap[2])[1]),
         n_map_throttle=int(torque_map.torque.shape[0]), n_map_speed=int(torque_map.torque.shape[1]),
         layout=tuple(int(q) for q in cold.layout), throttle=_f(throttle), plant_tables=_f(magnet.kernel_tables),
         plant_grid=_f(magnet.grid),
         plant_stack=np.zeros(cap), plant_prefix=np.zeros((magnet.n_airgaps, cap // 2 + 2)),
         plant_comb=np.zeros((1, n, n, 4)), imem=imem, fmem=fmem, cold=cold.array())
+
+
+def _table_at(model, gap):
+    """``model``'s cell coefficients at the airgap ``gap`` [m] (clamped to its calibration airgaps): one table,
+    shape ``(1, N, N, 4)``, the weights of its airgap interpolation applied to the coefficients ([1], Eqs. 2-5
+    are linear in the table; :func:`~clutchlab.hysteresis._kernels.combine_tables`)."""
+    gaps = _f(model.airgaps)
+    tables = _f(model.kernel_tables)
+    idx = np.zeros(3, dtype=np.int64)
+    w = np.zeros(3)
+    gap_weights(gaps, float(min(max(gap, gaps[0]), gaps[-1])), idx, w)
+    out = np.zeros((1,) + tables.shape[1:])
+    combine_tables(tables, idx, w, out)
+    return out
 
 
 def controller_log(params: EmtcParams) -> np.ndarray:
@@ -1081,14 +1187,13 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
         lowest grid current; modes ``rest``, ``open``, ``positive``; first trial step ``min(0.1 ms,
         sample_time)`` (a resumed run and an uninterrupted one take the same steps).
     """
-    from .bench import BenchScenario, VehicleParameters, _default
-
+    B = _bench_module()
     if magnet is None:
         from .magnet import bundled_magnet
 
         magnet = bundled_magnet()
-    scenario = scenario or _default(BenchScenario)
-    vehicle = vehicle or _default(VehicleParameters)
+    scenario = scenario or B._default(B.BenchScenario)
+    vehicle = vehicle or B._default(B.VehicleParameters)
     params = pack_parameters(magnet, scenario, vehicle, options, cosimulation=cosimulation, n_samples=n_samples)
     vf = scenario.drum_speed
     vr = scenario.drum_speed - scenario.speed_difference
@@ -1110,6 +1215,20 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
             _TEMPLATES[(first_step, current_range)] = template
     # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
     return template.variant(params=params, x0=x0, u0=u0)
+
+
+_BENCH = None
+
+
+def _bench_module():
+    """:mod:`clutchlab.emtc.bench` (imported on first use: it imports this module; an import statement in a
+    function costs about 1.5 us a call)."""
+    global _BENCH
+    if _BENCH is None:
+        from . import bench
+
+        _BENCH = bench
+    return _BENCH
 
 
 #: (first trial step, coil current range) -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`

@@ -510,3 +510,156 @@ def peek_combined(comb, grid, stack, pref, length, u, v, idx, w):
     # memory after wiping, output of Eqs. 2-3 with the combined table
     base = _wpref(pref, L // 2, idx, w)
     return base + table_output(comb, 0, grid, stack, L, pref, v) - pref[0, L // 2]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def peek_segment(comb, grid, stack, pref, length, u, v, idx, w, seg):
+    """:func:`peek_combined` as a quadratic in the next input on the stretch of inputs around ``v``.
+
+    For a given memory ``stack[:length]`` (last input ``u``) the output for the next input ``v`` is, on each
+    stretch of inputs where the same branch of Eqs. 2-3 holds (no further wiping, the input in the same grid
+    cell), a quadratic ``a0 + a1 v + a2 v**2``: the interpolation of Eqs. 4-5 is bilinear in a cell and the
+    input enters one or both of its arguments.  Writes ``seg[0:6] = (lo, hi, a0, a1, a2, kind)`` for the
+    stretch whose open interior ``lo < v < hi`` holds ``v`` and returns the quadratic at ``v``: any input
+    strictly inside the same stretch gets the same polynomial, so a caller may keep ``seg`` for later inputs
+    while the memory and the table stay (inputs on a stretch's ends, and ``v == u``, are evaluated afresh:
+    ``v == u`` gives the output of the memory as it is, Eq. 3 for an even length, Eq. 2 for an odd one, and
+    an empty ``seg``, ``lo = hi = v``).  Equal to :func:`peek_combined` to rounding.
+
+    ``kind`` says whether the polynomial depends on the last input ``u``: +1 for a rising stretch that does
+    not (the output of Eq. 3 with the stored extrema after wiping: ``u`` only bounds it, so it holds for
+    ``max(lo, u') < v < hi`` for any later last input ``u'`` reached without changing the stack), -1 for a
+    falling one that does not (Eq. 2: ``lo < v < min(hi, u')``), 0 where ``u`` becomes a new extremum
+    (the polynomial holds for this ``u`` only).
+    """
+    L = length
+    iv = locate(grid, v)
+    lo = grid[iv]
+    hi = grid[iv + 1]
+    if v > u or (v == u and L % 2 == 0):
+        a = u  # the second argument of the first-order reversal value subtracted: u (a new minimum) or m_last
+        const = 0.0
+        if L % 2 == 1 and v < stack[L - 1]:
+            # u becomes a minimum that is not wiped ([1], Eq. 3 with the pair (M_last, u) completed)
+            mx = stack[L - 1]
+            im = locate(grid, mx)
+            iu = locate(grid, u)
+            const = _wpref(pref, (L - 1) // 2, idx, w) + forc_value_ij(comb, 0, grid, mx, im, u, iu)
+            if L >= 3:
+                prev = stack[L - 2]
+                const -= forc_value_ij(comb, 0, grid, mx, im, prev, locate(grid, prev))
+            hi = min(hi, mx)
+            lo = max(lo, u)
+            ib = iu
+            sub = True
+            kind = 0.0
+        else:
+            if L % 2 == 1:
+                L -= 1
+            while L >= 2 and v >= stack[L - 2]:  # wiping-out of (M, m)
+                L -= 2
+            if L < length:
+                lo = max(lo, stack[L])  # the largest maximum wiped (or the maximum the input rose past)
+            lo = max(lo, u)
+            if L >= 2:
+                hi = min(hi, stack[L - 2])  # the next maximum to wipe
+            const = _wpref(pref, L // 2, idx, w)  # [1], Eq. 3
+            ib = 0
+            kind = 1.0
+            sub = L > 0
+            if sub:
+                a = stack[L - 1]
+                ib = locate(grid, a)
+        # F(v, v) on the diagonal cell of v ([1], Eqs. 4-5: C0 + (C1 + C2) v + C3 v^2), minus F(v, a) on the
+        # cell (v, a) (none with the virtual minimum: L == 0, rising)
+        a0 = const + comb[0, iv, iv, 0]
+        a1 = comb[0, iv, iv, 1] + comb[0, iv, iv, 2]
+        a2 = comb[0, iv, iv, 3]
+        if sub:
+            jb = min(ib, iv)
+            a0 -= comb[0, iv, jb, 0] + comb[0, iv, jb, 2] * a
+            a1 -= comb[0, iv, jb, 1] + comb[0, iv, jb, 3] * a
+    else:
+        if L % 2 == 0 and (L < 2 or v > stack[L - 1]):
+            # u becomes a maximum that is not wiped ([1], Eq. 2 with M_n = u)
+            top = u
+            const = _wpref(pref, L // 2, idx, w)
+            if L >= 1:
+                prev = stack[L - 1]
+                const -= forc_value_ij(comb, 0, grid, u, locate(grid, u), prev, locate(grid, prev))
+                lo = max(lo, prev)
+            hi = min(hi, u)
+            kind = 0.0
+        else:
+            if L % 2 == 0:
+                L -= 1
+            while L >= 3 and v <= stack[L - 2]:  # wiping-out of (m, M)
+                L -= 2
+            if L < length:
+                hi = min(hi, stack[L])  # the smallest minimum wiped (or the minimum the input fell past)
+            hi = min(hi, u)
+            if L >= 3:
+                lo = max(lo, stack[L - 2])  # the next minimum to wipe
+            top = stack[L - 1]
+            const = _wpref(pref, L // 2, idx, w)  # [1], Eq. 2
+            kind = -1.0
+            if L > 1:
+                m = stack[L - 2]
+                const -= forc_value_ij(comb, 0, grid, top, locate(grid, top), m, locate(grid, m))
+        # F(top, v) on the cell (top, v): linear in v
+        it = locate(grid, top)
+        jv = min(iv, it)
+        a0 = const + comb[0, it, jv, 0] + comb[0, it, jv, 1] * top
+        a1 = comb[0, it, jv, 2] + comb[0, it, jv, 3] * top
+        a2 = 0.0
+    if v == u:  # the memory as it is: evaluated afresh every time (no stretch)
+        lo = v
+        hi = v
+        kind = 0.0
+    seg[0] = lo
+    seg[1] = hi
+    seg[2] = a0
+    seg[3] = a1
+    seg[4] = a2
+    seg[5] = kind
+    return a0 + v * (a1 + v * a2)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def invert_combined(comb, grid, stack, pref, length, u, target, idx, w, tol, seg, version):
+    """:func:`invert_one` for an airgap-combined table (:func:`combine_tables`), keeping the rising stretch.
+
+    While the memory only rises from an even-length stack (no turning point pushed, none wiped: the usual
+    course of a slowly growing command), the output for inputs above ``u`` is one line on a stretch of
+    :func:`peek_segment` that does not depend on ``u`` itself ([1], Eq. 3 with the stored extrema fixed,
+    ``kind`` +1), so the inverse of Eq. 7 is solved on it without locating anything.  ``seg`` (8 values:
+    :func:`peek_segment`'s six, then ``version``, the count of the memory's changes it was built for) is kept
+    by the caller between calls; the caller counts a change whenever :func:`commit` changes the length (the
+    stack changes only then).  Returns ``(v, feasible)`` as :func:`invert_one`, to rounding, or ``(NaN,
+    False)`` in any other case (falling, a target beyond the stretch): the caller then calls
+    :func:`invert_one` (not called from here: every compiled function's code is linked with its callees).
+    """
+    n = grid.shape[0]
+    if u < grid[n - 1]:
+        if not (seg[6] == version and seg[5] == 1.0 and seg[0] <= u < seg[1]):
+            iu = locate(grid, u)
+            top = grid[iu + 1]
+            if length % 2 == 1:
+                top = -1.0  # (falling from the last maximum: u would become a new minimum, kind 0)
+            elif length >= 2 and stack[length - 2] < top:
+                top = stack[length - 2]  # the next maximum to wipe
+            seg[6] = -1.0
+            if top > u:
+                peek_segment(comb, grid, stack, pref, length, u, 0.5 * (u + top), idx, w, seg)
+                seg[6] = version
+        if seg[6] == version and seg[5] == 1.0 and seg[0] <= u < seg[1] and seg[4] == 0.0 and seg[3] > 0.0:
+            a0 = seg[2]
+            a1 = seg[3]
+            f0 = a0 + a1 * u  # the output now ([1], Eq. 3 at v = u)
+            if abs(target - f0) <= tol:
+                return u, True
+            if target > f0:
+                v = (target - a0) / a1  # [1], Eq. 7 on the stretch
+                if v < seg[1]:
+                    return max(v, u), True
+    return np.nan, False

@@ -1,0 +1,85 @@
+"""The speed work of issue #14 leaves the drum-bench model's answers where they were.
+
+``data/speed_traces.npz`` holds the model's answers before that work (commit 5eb22d8, written by
+``data/make_speed_traces.py``: the figure scenario of the issue with 2 ms and 10 ms controllers, a release with
+every armature event, lock-up and unlock with constant and LuGre friction, a friction map and a plant magnet
+other than the controller's model), at the default tolerances.  The faster model must give:
+
+* the same trajectories: every state and the recorded outputs at about 60 samples, each column to 1e-9 of its
+  largest magnitude, plus 1e-6 of a state's absolute tolerance (the Torsen twist stays near 1e-16 rad in
+  these runs); the integration error at rtol 1e-6 is about 1e-7 of the range: a changed equation or a
+  changed step would show; the evaluation order of a few sums may change the last bits;
+* the same modes at every sample, the same events in the same order at the same instants (to 1e-10 s; the
+  core locates them to 1e-12 s) and the same number of accepted steps.
+
+Nothing here is timed.
+"""
+
+from pathlib import Path
+
+import importlib.util
+
+import numpy as np
+import pytest
+
+DATA = Path(__file__).with_name("data") / "speed_traces.npz"
+
+
+def _maker():
+    spec = importlib.util.spec_from_file_location("make_speed_traces", DATA.with_name("make_speed_traces.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+MAKER = _maker()
+SCENARIOS = list(MAKER.scenarios())
+
+
+@pytest.mark.parametrize("name, magnet, scenario, kwargs", SCENARIOS, ids=[s[0] for s in SCENARIOS])
+def test_same_trajectories_events_and_steps_as_before(name, magnet, scenario, kwargs):
+    from clutchlab.emtc import simulate_bench
+    from clutchlab.emtc import system as S
+
+    data = np.load(DATA)
+    res = simulate_bench(magnet, scenario, **kwargs)
+    r = res.result
+    rows = slice(None, None, max(1, r.time.size // 60))
+    np.testing.assert_array_equal(r.time[rows], data[f"{name}_time"])
+    np.testing.assert_array_equal(r.modes[rows], data[f"{name}_modes"])
+    names = [o[0] for o in S.OUTPUTS]
+    for label, got, ref, floor in (("state", r.states[rows], data[f"{name}_states"], S.ATOL),
+                                   ("output", r.outputs[rows][:, [names.index(o) for o in MAKER.OUTPUTS]],
+                                    data[f"{name}_outputs"], np.zeros(len(MAKER.OUTPUTS)))):
+        for q in range(ref.shape[1]):
+            scale = np.max(np.abs(ref[:, q]))
+            err = np.max(np.abs(got[:, q] - ref[:, q])) / max(scale, 1e-300)
+            assert err * scale <= 1e-9 * scale + 1e-6 * floor[q], f"{name}: {label} {q} differs by {err:.2e} of its range"
+    assert list(r.events["event"]) == [str(e) for e in data[f"{name}_event_name"]]
+    np.testing.assert_allclose(r.events["time_s"].to_numpy(), data[f"{name}_event_time"], rtol=0, atol=1e-10)
+    assert res.n_steps == int(data[f"{name}_steps"][0])
+
+
+def test_figure_error_against_the_tight_reference_is_no_worse_than_before():
+    """The figure of issue #14 at the default tolerances against an independent tight solution: SciPy's DOP853
+    at rtol 1e-12 on the Python equations of ``benchmarks/wp_emtc.py`` (the error its work-precision table
+    quotes: the worst front/rear shaft speed at the 501 samples).  Before the speed work: 4.71e-6 rad/s (the
+    transient of the first 10 ms); it may not grow."""
+    import sys
+
+    from clutchlab.emtc import simulate_bench
+    from clutchlab.emtc.system import ATOL
+
+    bench = Path(__file__).resolve().parents[2] / "benchmarks"
+    sys.path.insert(0, str(bench))
+    try:
+        spec = importlib.util.spec_from_file_location("wp_emtc_for_test", bench / "wp_emtc.py")
+        wp = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(wp)
+    finally:
+        sys.path.remove(str(bench))
+    name, magnet, scenario, kwargs = SCENARIOS[0]
+    assert name == "figure"
+    ref, _ = wp.reference(magnet, scenario, rtol=1e-12, atol=ATOL * 1e-6, method="DOP853")
+    r = simulate_bench(magnet, scenario, **kwargs).result
+    assert wp.error(r.states[:, :2], ref) <= 4.75e-6
