@@ -319,20 +319,17 @@ def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
     return flag
 
 
-@numba.njit(cache=True, nogil=True, forceinline=True)
-def _copy_row(rec_y, i, yb):
-    for q in range(yb.shape[0]):
-        rec_y[i, q] = yb[q]
-
-
 @register_jitable(forceinline=True)
 def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
-    """Record the samples ``ts[i_rec:] <= t_limit`` holding the state at ``t``; returns the next sample index."""
+    """Record the samples ``ts[i_rec:] <= t_limit`` holding the state at ``t``; returns the next sample index.
+
+    The outputs are written by the model straight into their row of ``rec_y`` (``yb`` is not used: a copy
+    through it read the model's scalar stores back as vectors, a store-forwarding stall per sample).
+    """
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
         if want_y:
-            model.outputs(t, x, u, m, p, yb)
-            _copy_row(rec_y, i_rec, yb)
+            model.outputs(t, x, u, m, p, rec_y[i_rec])
         i_rec += 1
     return i_rec
 
@@ -340,26 +337,31 @@ def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
 @register_jitable(forceinline=True)
 def _record_dense(p, t, h, x0, f0, x1, f1, rc, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb,
                   xe, i_rec):
-    """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index."""
+    """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index.
+
+    The model's outputs are written straight into their row of ``rec_y`` (``yb`` is not used: see
+    :func:`_record_held`).  They are evaluated at the work copy ``xe`` of the recorded state, not at its row
+    of ``rec_x``: with the row the recorded states of the EMTC AWD driveline example changed (by 4e-11), so a
+    hook may not leave the state it is given untouched.
+    """
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
         th = (ts[i_rec] - t) / h if h > 0.0 else 1.0
         _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], xe, m)
         if want_y:
-            model.outputs(ts[i_rec], xe, u, m, p, yb)
-            _copy_row(rec_y, i_rec, yb)
+            model.outputs(ts[i_rec], xe, u, m, p, rec_y[i_rec])
         i_rec += 1
     return i_rec
 
 
 @register_jitable(forceinline=True)
 def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
-    """Record the point ``(t, x, m)`` in the step record if it has room; returns the next row."""
+    """Record the point ``(t, x, m)`` in the step record if it has room; returns the next row (outputs
+    written straight into their row of ``rec_y``, ``yb`` unused: see :func:`_record_held`)."""
     if i_rec < rec_t.shape[0]:
         _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
         if want_y:
-            model.outputs(t, x, u, m, p, yb)
-            _copy_row(rec_y, i_rec, yb)
+            model.outputs(t, x, u, m, p, rec_y[i_rec])
         i_rec += 1
     return i_rec
 
