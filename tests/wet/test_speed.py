@@ -40,3 +40,22 @@ def test_profile_segment_memo_gives_the_bisection_value(speed_system):
         y_fresh = evaluate(fresh, float(t), x)[2]
         assert y_memo[W.O_WREF] == y_fresh[W.O_WREF] and y_memo[W.O_FREF] == y_fresh[W.O_FREF], t
     assert sysm.params.data[W.W_SSEG] >= sysm.params.constants[0]["speed_start"]  # the memo was used
+
+
+def _event_times(res):
+    return dict(zip(res.result.events.event, res.result.events.time_s))
+
+
+def test_piston_stroke_follows_the_tolerance():
+    """Off its stop the piston reaches the actuator's speed limit within about a microsecond; the core now
+    restarts the step size there (``wet_update`` returns ``RESTART``).  The stroke from leaving the stop to
+    the film contact then follows the tolerance; with the step of before the event it was 2.6e-6 s too long
+    at every rtol from 1e-5 to 1e-7 (9.1e-4 s at 1e-3), and the whole engagement lagged behind."""
+    from clutchlab.wet import simulate_engagement
+
+    scen = EngagementProtocol(duration=0.3).scenario(CLUTCH, "speed")
+    ref = _event_times(simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, rtol=1e-12, sample_rate=100))
+    stroke_ref = ref["contact"] - ref["piston_leaves_stop"]
+    for rtol, bound in ((1e-3, 1e-7), (1e-5, 1e-8), (1e-6, 1e-8), (1e-7, 1e-8)):
+        ev = _event_times(simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, rtol=rtol, sample_rate=100))
+        assert abs(ev["contact"] - ev["piston_leaves_stop"] - stroke_ref) < bound, rtol

@@ -31,7 +31,9 @@ and the parameters ``p``):
     Discrete update when switching function ``k`` crossed zero at ``t``:
     may change ``m`` and ``x`` and record named events with
     :func:`clutchlab.numerics.core.record`; returns 0 to continue, 1 to stop
-    the run (terminal event) or a negative model error code.
+    the run (terminal event), 2 to continue with the step size started afresh
+    from a short step (the dynamics changed abruptly: a speed that jumps to a
+    limit within microseconds; Dormand-Prince) or a negative model error code.
 ``restart(t, x, u, m, p, log)``
     Makes the modes consistent with the forces at a (re)start: at t0, on
     every resumed ``advance`` (inputs may have jumped) and at every break

@@ -72,7 +72,7 @@ import numba
 import numpy as np
 
 from ..numerics import dispatch
-from ..numerics.core import record
+from ..numerics.core import RESTART, record
 from ..system import System, register_model, variables
 from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
                    squeeze_film_force_scalar)
@@ -477,7 +477,11 @@ def wet_outputs(t, x, u, m, p, y):
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_update(t, x, u, m, p, k, log):
-    """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name)."""
+    """Mode change when switching function ``k`` crossed zero at ``t`` (events recorded by name).
+
+    Returns :data:`~clutchlab.numerics.core.RESTART` when the piston leaves its stop (the core starts the
+    step size afresh there), else 0.
+    """
     wk = p.data
     code = -1  # the event to record (one call site: numba compiles ``record`` once, not per literal code)
     if k == G_LOCKUP:
@@ -518,7 +522,9 @@ def wet_update(t, x, u, m, p, k, log):
             code = EV_REACHES
     if code >= 0:
         record(log, t, code, EVENT_ELEMENT[code])
-    return 0
+    # off its stop the piston reaches the actuator's speed limit within about a microsecond (the squeeze film
+    # of the open pack resists little): the core restarts the step size there (RESTART)
+    return RESTART if code == EV_LEAVES else 0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
