@@ -91,7 +91,10 @@ def make_python_model(clutch, bench, scen, friction):
         muv = p["mu_v1"] * math.exp(p["mu_v2"] * temp) + p["mu_v3"] * math.exp(p["mu_v4"] * temp)
         fc = p["friction_area"] * p["gw_scale"] * gw(h / p["sigma"])
         v = p["r_eff"] * w
-        muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-abs(v) / law.v_s), 0.0)
+        # |v| as the sliding direction of the mode gives it (clutchlab's model): smooth through v = 0 in a
+        # slip mode, so that a step ending past a lock-up sees no kink
+        v_abs = v if mode == "slip+" else (-v if mode == "slip-" else abs(v))
+        muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-v_abs / law.v_s), 0.0)
         cap = p["r_eff"] * nc * muf * fc
         wref = pwl(t, st, sv)
         fref = min(pwl(t, ft, fv), p["actuator_force_max"])

@@ -366,12 +366,16 @@ def wet_rhs(t, x, u, m, p, dx, g):
     muv = viscosity_scalar(temp, c.mu_v1, c.mu_v2, c.mu_v3, c.mu_v4)                # [1], Eq. 7
     fc = asperity_force_scalar(h, c.sigma, c.friction_area, c.gw_scale)              # [3], Eq. 11
     v = slip_velocity_scalar(w, c.r_eff)                                            # [1], Eq. (2')
+    # |v| as the sliding direction of the mode gives it (v itself in slip_positive, -v in slip_negative, and
+    # v = 0 while stuck): equal to |v| wherever the mode is the physical one, and smooth through v = 0, so
+    # that the stages of a step that ends past a lock-up (located on the dense output) see no kink
+    v_abs = -v if fmode == SLIP_NEG else (v if fmode == SLIP else abs(v))
     k = c.friction_start
     if c.friction_kind == KIND_PARAMETRIC:
-        muf = c.mu_scale * parametric_mu_scalar(abs(v), temp, tb[k], tb[k + 1], tb[k + 2], tb[k + 3], tb[k + 4])
+        muf = c.mu_scale * parametric_mu_scalar(v_abs, temp, tb[k], tb[k + 1], tb[k + 2], tb[k + 3], tb[k + 4])
     else:  # a friction map: its grids and values are sliced out of the tables only here
         muf = c.mu_scale * mu_kernel(
-            abs(v), temp, fc, c.friction_kind, tb[k:k + 5],
+            v_abs, temp, fc, c.friction_kind, tb[k:k + 5],
             tb[c.map_speed_start:c.map_speed_start + c.map_speed_n],
             tb[c.map_temperature_start:c.map_temperature_start + c.map_temperature_n],
             tb[c.map_force_start:c.map_force_start + c.map_force_n],
