@@ -558,3 +558,21 @@ def test_a_terminal_update_wins_over_a_restart_at_the_same_event():
         res = simulate(toys.ramp_system(codes=codes), 0.2, check=False)
         assert res.status == Status.TERMINATED, codes
         assert res.time[-1] == pytest.approx(0.0723, abs=1e-9)
+
+
+def test_a_checked_grid_is_checked_once_and_runs_like_any_grid():
+    """``checked_grid``: refused if not finite and increasing; a run on it is the run on a copy of it (which
+    ``sample_grid`` checks again), and ``sample_grid`` hands the very array on."""
+    from clutchlab.system import checked_grid, sample_grid
+
+    for bad in ([0.0, 0.2, 0.1], [0.0, float("nan"), 0.3], [0.0, float("inf")]):
+        with pytest.raises(ParameterError, match="finite and increasing"):
+            checked_grid(bad)
+    ts = checked_grid(np.arange(41) / 20.0)
+    assert sample_grid(0.0, 2.0, None, ts) is ts
+    with pytest.raises(ParameterError, match="within"):   # the bounds of the run are still checked
+        sample_grid(0.0, 1.0, None, ts)
+    a = simulate(toys.ball_system(), 2.0, sample_times=ts)
+    b = simulate(toys.ball_system(), 2.0, sample_times=ts.copy())
+    assert np.array_equal(a.time, b.time) and np.array_equal(a.states, b.states)
+    assert a.time is not ts

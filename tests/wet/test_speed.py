@@ -92,3 +92,15 @@ def test_lockup_time_follows_the_tolerance_on_the_bench():
     errors = [abs(run(rtol) - ref) for rtol in (1e-6, 1e-7, 1e-8, 1e-9)]
     assert all(a > b for a, b in zip(errors, errors[1:])), errors
     assert errors[0] < 1e-6 and errors[2] < 1e-8, errors
+
+
+def test_the_default_sample_grid_is_shared_but_never_handed_out():
+    """``simulate_engagement`` builds its 1 kHz grid once per (duration, rate); the result's times are its own."""
+    from clutchlab.wet import simulate_engagement
+
+    scen = EngagementProtocol(duration=0.2).scenario(CLUTCH, "speed")
+    a = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH)
+    a.time[:] = -1.0
+    b = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH)
+    assert b.time[0] == 0.0 and b.time[-1] == pytest.approx(0.2) and b.time.size == 201
+    assert np.all(np.diff(b.time) > 0)

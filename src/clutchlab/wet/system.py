@@ -767,8 +767,9 @@ def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) 
         for name, value in overrides.items():
             constants[name] = value
     data = params.data.copy()
-    data[:N_WORK] = new_work(initial_temperature_c)
-    return params._replace(constants=constants, data=data)
+    data[:N_WORK] = _FRESH_WORK                   # (what new_work gives, without building it: every run does this)
+    data[W_PEAK] = initial_temperature_c
+    return WetParams(constants, data)
 
 
 def stacked_parameters(params: WetParams, constants: np.ndarray, work: np.ndarray) -> WetParams:
