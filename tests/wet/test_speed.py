@@ -104,3 +104,35 @@ def test_the_default_sample_grid_is_shared_but_never_handed_out():
     b = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH)
     assert b.time[0] == 0.0 and b.time[-1] == pytest.approx(0.2) and b.time.size == 201
     assert np.all(np.diff(b.time) > 0)
+
+
+def test_outputs_hook_gives_what_the_right_hand_side_leaves_in_its_scratch(speed_system):
+    """``wet_outputs`` writes the outputs straight into the row it is given; ``wet_rhs`` (the driveline's wet
+    clutch reads them there) into the scratch of ``p.data``: the same numbers from the same body."""
+    scen, sysm = speed_system
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        x = sysm.x0.copy()
+        x[W.S_X] = rng.uniform(-1e-3, 0.03)
+        x[W.S_FA] = rng.uniform(0.0, 5000.0)
+        x[W.S_W] = rng.uniform(-150.0, 150.0)
+        x[W.S_T] = rng.uniform(30.0, 120.0)
+        m = np.array([rng.integers(0, 3), rng.integers(0, 2), rng.integers(0, 2)], dtype=np.int64)
+        t = float(rng.uniform(0.0, 1.0))
+        dx, g, y = evaluate(sysm, t, x, m=m)      # rhs first (scratch), then the outputs hook
+        assert np.array_equal(y, sysm.params.data[W.W_OUT:W.W_OUT + W.N_OUT])
+
+
+def test_next_break_from_the_memo_is_the_full_search(speed_system):
+    """``wet_next_break`` starts its search at the profile segment read last; from any memo it returns the
+    first corner after ``t``."""
+    scen, sysm = speed_system
+    corners = np.union1d(scen.force_time, scen.speed_time)
+    m = sysm.m0.copy()
+    rng = np.random.default_rng(7)
+    for t in np.concatenate([corners, rng.uniform(-0.1, 1.1, 100), np.nextafter(corners, -np.inf)]):
+        p = W.fresh_buffers(sysm.params, scen.initial_temperature_c)
+        expected = corners[corners > t][0] if np.any(corners > t) else np.inf
+        for memo in (0.0, float(p.constants[0]["speed_start"]), float(p.constants[0]["speed_start"] + 30)):
+            p.data[W.W_SSEG] = memo
+            assert W.wet_next_break(float(t), m, p) == expected, (t, memo)

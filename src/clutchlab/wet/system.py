@@ -349,9 +349,20 @@ def _pwl(t, tables, start, n, memo):
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_rhs(t, x, u, m, p, dx, g):
     """Right-hand side, switching functions and (into the scratch of ``p.data``) the outputs of the model."""
+    wk = p.data
+    _model(t, x, u, m, p, dx, g, wk, W_OUT)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", forceinline=True)
+def _model(t, x, u, m, p, dx, g, y, yo):
+    """The model at one point: derivative ``dx``, switching values ``g``, outputs ``y[yo:yo + N_OUT]`` (:data:`OUTPUTS`).
+
+    One body for :func:`wet_rhs` (outputs into the scratch of ``p.data``, which the driveline's wet clutch
+    and :func:`_evaluate` read) and :func:`wet_outputs` (outputs straight into the record's row; going
+    through the scratch and a copy made an output row cost 15 ns more than a right-hand side).
+    """
     c = p.constants[0]
     tb = p.data
-    wk = tb
     nc = c.n_c
     xp = x[S_X]
     fa = x[S_FA]
@@ -441,24 +452,24 @@ def wet_rhs(t, x, u, m, p, dx, g):
     dx[S_ED] = td * w
     # outputs
     fh = csq * xdot
-    wk[W_OUT + O_TAU] = tau
-    wk[W_OUT + O_TC] = tc
-    wk[W_OUT + O_TV] = tv
-    wk[W_OUT + O_FC] = fc
-    wk[W_OUT + O_FH] = fh
-    wk[W_OUT + O_FLC] = fa if at_stop else fsp + fc + fh
-    wk[W_OUT + O_H] = h
-    wk[W_OUT + O_HBAR] = hbar
-    wk[W_OUT + O_MUF] = muf
-    wk[W_OUT + O_MUV] = muv
-    wk[W_OUT + O_TD] = td
-    wk[W_OUT + O_WREF] = wref
-    wk[W_OUT + O_FREF] = fref
-    wk[W_OUT + O_WDOT] = wdot
-    wk[W_OUT + O_TS] = tau + c.shaft_inertia * wdot
-    wk[W_OUT + O_PF] = pf
-    wk[W_OUT + O_QH] = qh
-    wk[W_OUT + O_CAP] = cap
+    y[yo + O_TAU] = tau
+    y[yo + O_TC] = tc
+    y[yo + O_TV] = tv
+    y[yo + O_FC] = fc
+    y[yo + O_FH] = fh
+    y[yo + O_FLC] = fa if at_stop else fsp + fc + fh
+    y[yo + O_H] = h
+    y[yo + O_HBAR] = hbar
+    y[yo + O_MUF] = muf
+    y[yo + O_MUV] = muv
+    y[yo + O_TD] = td
+    y[yo + O_WREF] = wref
+    y[yo + O_FREF] = fref
+    y[yo + O_WDOT] = wdot
+    y[yo + O_TS] = tau + c.shaft_inertia * wdot
+    y[yo + O_PF] = pf
+    y[yo + O_QH] = qh
+    y[yo + O_CAP] = cap
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -470,13 +481,9 @@ def _evaluate(t, x, u, m, p):
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def wet_outputs(t, x, u, m, p, y):
-    """Outputs at one point (:data:`OUTPUTS` order)."""
-    # y (18 entries) takes the derivative and the switching values first (scratch, overwritten), then the
-    # outputs the right-hand side left in p.data: no scratch array is sliced or allocated per sample
-    wet_rhs(t, x, u, m, p, y, y)
+    """Outputs at one point (:data:`OUTPUTS` order); the derivative and switching values into the scratch."""
     wk = p.data
-    for i in range(N_OUT):
-        y[i] = wk[W_OUT + i]
+    _model(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH], y, 0)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -578,8 +585,13 @@ def wet_accept(t, x, u, m, p):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _next_corner(tables, start, n, t):
-    for i in range(start, start + n):
+def _next_corner(tables, start, n, t, memo):
+    """First time of a profile after ``t``; the search starts at the segment read last (``tables[memo]``,
+    see :func:`_pwl`) when that segment does not begin after ``t`` (no earlier time can then be after it)."""
+    i0 = int(tables[memo])
+    if not (start <= i0 < start + n and tables[i0] <= t):
+        i0 = start
+    for i in range(i0, start + n):
         if tables[i] > t:
             return tables[i]
     return np.inf
@@ -589,9 +601,9 @@ def _next_corner(tables, start, n, t):
 def wet_next_break(t, m, p):
     """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
     c = p.constants[0]
-    tb = _next_corner(p.data, c.force_start, c.force_n, t)
+    tb = _next_corner(p.data, c.force_start, c.force_n, t, W_FSEG)
     if not c.free_inertia:
-        ts = _next_corner(p.data, c.speed_start, c.speed_n, t)
+        ts = _next_corner(p.data, c.speed_start, c.speed_n, t, W_SSEG)
         if ts < tb:
             tb = ts
     return tb
