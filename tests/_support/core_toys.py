@@ -311,3 +311,22 @@ def ramp_system(codes=(0, 0), t_event=0.0723, tau=1e-6, v_max=0.1, atol=1e-8):
                   (("x", "m"),), np.zeros(1), np.zeros(1, np.int64), np.full(1, atol),
                   switching=(("start", 1), ("start_too", 1)), events=("start", "start_too"), mode_names=("moving",),
                   mode_values=(("no", "yes"),), rtol=1e-8, max_step=0.01)
+
+
+# ------------------------------------------------------------------ the oscillator with hooks compiled without reference counting
+class LinearNoRefcountParams(NamedTuple):
+    """:class:`LinearParams` again, its hooks declared with ``numba.njit(_nrt=False)``."""
+
+    a: np.ndarray
+    b: np.ndarray
+
+
+_lin_rhs_no_nrt = numba.njit(_nrt=False)(_lin_rhs.py_func)
+_lin_outputs_no_nrt = numba.njit(_nrt=False)(_lin_outputs.py_func)
+dispatch.register(LinearNoRefcountParams, rhs=_lin_rhs_no_nrt, outputs=_lin_outputs_no_nrt, update=_no_update,
+                  restart=_no_restart, accept=_no_accept, next_break=_no_break, jacobian=_lin_jac)
+
+
+def linear_system_no_refcount(a, x0, method="dopri"):
+    base = linear_system(a, x0, method=method)
+    return base.replace(params=LinearNoRefcountParams(*base.params))

@@ -576,3 +576,17 @@ def test_a_checked_grid_is_checked_once_and_runs_like_any_grid():
     b = simulate(toys.ball_system(), 2.0, sample_times=ts.copy())
     assert np.array_equal(a.time, b.time) and np.array_equal(a.states, b.states)
     assert a.time is not ts
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_hooks_without_reference_counting_run_like_the_others(method):
+    """Hooks declared with ``numba.njit(_nrt=False)`` are compiled into the core so (the options key of
+    ``dispatch``) and give the same run, bit for bit, as the same hooks with numba's reference counting."""
+    from clutchlab.numerics import dispatch
+
+    sysm = toys.linear_system_no_refcount(OSC, [1.0, 0.0], method=method)
+    assert dispatch._options_key(dispatch._MODELS[type(sysm.params)]["rhs"])[2] is False
+    a = simulate(sysm, 10.0, output_step=0.25)
+    b = simulate(toys.linear_system(OSC, [1.0, 0.0], method=method), 10.0, output_step=0.25)
+    assert np.array_equal(a.states, b.states) and np.array_equal(a.outputs, b.outputs)
+    assert a.stats["rhs_evaluations"] == b.stats["rhs_evaluations"]

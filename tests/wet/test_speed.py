@@ -136,3 +136,15 @@ def test_next_break_from_the_memo_is_the_full_search(speed_system):
         for memo in (0.0, float(p.constants[0]["speed_start"]), float(p.constants[0]["speed_start"] + 30)):
             p.data[W.W_SSEG] = memo
             assert W.wet_next_break(float(t), m, p) == expected, (t, memo)
+
+
+def test_wet_hooks_are_compiled_without_reference_counting():
+    """The wet clutch's hooks (and what they call on their own) are declared ``_nrt=False``
+    (``clutchlab.wet.system._HOOK``): they allocate no array and keep none, and the reference-count calls
+    were a quarter of a right-hand side's time.  Guard against a hook losing the option."""
+    from clutchlab.numerics import dispatch
+
+    hooks = dispatch._MODELS[W.WetParams]
+    assert set(hooks) == set(dispatch.HOOKS)
+    for name, fn in hooks.items():
+        assert dispatch._options_key(fn) == ("numpy", False, False), name
