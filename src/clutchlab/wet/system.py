@@ -84,7 +84,7 @@ from .viscosity import viscosity_scalar
 __all__ = [
     "WetParams", "pack_parameters", "with_scenario", "fresh_buffers", "stacked_parameters", "new_work",
     "engagement_system", "initial_state",
-    "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque",
+    "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque", "tanh",
     "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
 ]
 
@@ -271,6 +271,42 @@ _HOOK = dict(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 
 # ----------------------------------------------------------------- model pieces (compiled, scalar)
+#: tanh(x) = x + x^3 P(x^2) / Q(x^2) for |x| < 0.625 (Cephes ``tanh.c``, S. L. Moshier; Q's leading 1 implied)
+_TANH_P = (-9.64399179425052238628e-1, -9.92877231001918586564e1, -1.61468768441708447952e3)
+_TANH_Q = (1.12811678491632931402e2, 2.23548839060100448583e3, 4.84406305325125486048e3)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def tanh(x):
+    """Hyperbolic tangent, as accurate as ``math.tanh`` (at most 2 ulp from the exact value) and about half
+    its cost where the wet piston needs it.
+
+    glibc evaluates ``tanh`` through ``expm1`` (about 25 ns); the piston speed of every right-hand side and
+    output row needs one, a tenth of a 1 s engagement's time.  Here: for ``|x| < 0.625`` the rational
+    approximation of Cephes (``x + x^3 P(x^2)/Q(x^2)``, relative error 2.5e-16), else
+    ``1 - 2 / (exp(2|x|) + 1)`` (no cancellation: the result is above 0.55), and +-1 beyond 22 (where
+    ``1 - tanh`` is below half an ulp).  Tested against a 40-digit evaluation (``tests/wet/test_speed.py``).
+
+    Parameters
+    ----------
+    x : float
+
+    Returns
+    -------
+    float
+    """
+    z = abs(x)
+    if z < 0.625:
+        s = x * x
+        num = (_TANH_P[0] * s + _TANH_P[1]) * s + _TANH_P[2]
+        den = ((s + _TANH_Q[0]) * s + _TANH_Q[1]) * s + _TANH_Q[2]
+        return x + x * s * (num / den)
+    if z > 22.0:
+        return 1.0 if x > 0.0 else -1.0
+    r = 1.0 - 2.0 / (math.exp(2.0 * z) + 1.0)
+    return r if x > 0.0 else -r
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def piston_speed(net_force, film_resistance, speed_max):
     """Piston speed from the quasi-static force balance with the actuator's speed limit [m/s].
@@ -288,7 +324,7 @@ def piston_speed(net_force, film_resistance, speed_max):
     speed_max : float
         Actuator no-load speed v_max [m/s].
     """
-    return speed_max * math.tanh(net_force / (film_resistance * speed_max))
+    return speed_max * tanh(net_force / (film_resistance * speed_max))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
