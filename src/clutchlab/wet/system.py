@@ -394,16 +394,18 @@ def _pwl(t, tables, start, n, memo):
 def wet_rhs(t, x, u, m, p, dx, g):
     """Right-hand side, switching functions and (into the scratch of ``p.data``) the outputs of the model."""
     wk = p.data
-    _model(t, x, u, m, p, dx, g, wk, W_OUT)
+    _model(t, x, u, m, p, dx, g, wk[W_OUT:W_OUT + N_OUT])
 
 
-@numba.njit(**_HOOK, forceinline=True)
-def _model(t, x, u, m, p, dx, g, y, yo):
-    """The model at one point: derivative ``dx``, switching values ``g``, outputs ``y[yo:yo + N_OUT]`` (:data:`OUTPUTS`).
+@numba.njit(**_HOOK)
+def _model(t, x, u, m, p, dx, g, y):
+    """The model at one point: derivative ``dx``, switching values ``g``, outputs ``y`` (:data:`OUTPUTS`).
 
     One body for :func:`wet_rhs` (outputs into the scratch of ``p.data``, which the driveline's wet clutch
     and :func:`_evaluate` read) and :func:`wet_outputs` (outputs straight into the record's row; going
-    through the scratch and a copy made an output row cost 15 ns more than a right-hand side).
+    through the scratch and a copy made an output row cost 15 ns more than a right-hand side).  Both pass
+    arrays only, so that numba compiles it once (an integer offset passed as a module constant is a
+    literal, and each literal a compilation of the whole body: 2.4 s more for the first run).
     """
     c = p.constants[0]
     tb = p.data
@@ -496,24 +498,24 @@ def _model(t, x, u, m, p, dx, g, y, yo):
     dx[S_ED] = td * w
     # outputs
     fh = csq * xdot
-    y[yo + O_TAU] = tau
-    y[yo + O_TC] = tc
-    y[yo + O_TV] = tv
-    y[yo + O_FC] = fc
-    y[yo + O_FH] = fh
-    y[yo + O_FLC] = fa if at_stop else fsp + fc + fh
-    y[yo + O_H] = h
-    y[yo + O_HBAR] = hbar
-    y[yo + O_MUF] = muf
-    y[yo + O_MUV] = muv
-    y[yo + O_TD] = td
-    y[yo + O_WREF] = wref
-    y[yo + O_FREF] = fref
-    y[yo + O_WDOT] = wdot
-    y[yo + O_TS] = tau + c.shaft_inertia * wdot
-    y[yo + O_PF] = pf
-    y[yo + O_QH] = qh
-    y[yo + O_CAP] = cap
+    y[O_TAU] = tau
+    y[O_TC] = tc
+    y[O_TV] = tv
+    y[O_FC] = fc
+    y[O_FH] = fh
+    y[O_FLC] = fa if at_stop else fsp + fc + fh
+    y[O_H] = h
+    y[O_HBAR] = hbar
+    y[O_MUF] = muf
+    y[O_MUV] = muv
+    y[O_TD] = td
+    y[O_WREF] = wref
+    y[O_FREF] = fref
+    y[O_WDOT] = wdot
+    y[O_TS] = tau + c.shaft_inertia * wdot
+    y[O_PF] = pf
+    y[O_QH] = qh
+    y[O_CAP] = cap
 
 
 @numba.njit(**_HOOK)
@@ -527,7 +529,7 @@ def _evaluate(t, x, u, m, p):
 def wet_outputs(t, x, u, m, p, y):
     """Outputs at one point (:data:`OUTPUTS` order); the derivative and switching values into the scratch."""
     wk = p.data
-    _model(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH], y, 0)
+    _model(t, x, u, m, p, wk[W_DX:W_DX + N_STATE], wk[W_G:W_G + N_SWITCH], y)
 
 
 @numba.njit(**_HOOK)
@@ -629,10 +631,11 @@ def wet_accept(t, x, u, m, p):
 
 
 @numba.njit(**_HOOK)
-def _next_corner(tables, start, n, t, memo):
-    """First time of a profile after ``t``; the search starts at the segment read last (``tables[memo]``,
-    see :func:`_pwl`) when that segment does not begin after ``t`` (no earlier time can then be after it)."""
-    i0 = int(tables[memo])
+def _next_corner(tables, start, n, t, i0):
+    """First time of a profile after ``t``; the search starts at ``i0``, the segment read last (see
+    :func:`_pwl`), when that segment does not begin after ``t`` (no earlier time can then be after it).
+    (``i0`` is read by the caller: an index of the buffer passed here would be a literal, and numba would
+    compile this once per literal.)"""
     if not (start <= i0 < start + n and tables[i0] <= t):
         i0 = start
     for i in range(i0, start + n):
@@ -645,9 +648,9 @@ def _next_corner(tables, start, n, t, memo):
 def wet_next_break(t, m, p):
     """Next corner of the force (and, with the motor, the slip-speed) reference profile after ``t``."""
     c = p.constants[0]
-    tb = _next_corner(p.data, c.force_start, c.force_n, t, W_FSEG)
+    tb = _next_corner(p.data, c.force_start, c.force_n, t, int(p.data[W_FSEG]))
     if not c.free_inertia:
-        ts = _next_corner(p.data, c.speed_start, c.speed_n, t, W_SSEG)
+        ts = _next_corner(p.data, c.speed_start, c.speed_n, t, int(p.data[W_SSEG]))
         if ts < tb:
             tb = ts
     return tb
