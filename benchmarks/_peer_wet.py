@@ -167,7 +167,8 @@ def model(t, x, p, dx, g):
     muv = viscosity_scalar(temp, p[C_MUV1], p[C_MUV2], p[C_MUV3], p[C_MUV4])  # Eq. 7
     fc = asperity_force_scalar(h, sigma, area, p[C_GW])                      # Greenwood-Williamson
     v = slip_velocity_scalar(w, r_eff)
-    muf = p[C_MUSCALE] * parametric_mu_scalar(abs(v), temp, p[P_MU], p[P_MU + 1], p[P_MU + 2], p[P_MU + 3],
+    v_abs = -v if fmode == SLIP_NEG else (v if fmode == SLIP else abs(v))  # |v| signed by the mode (clutchlab's)
+    muf = p[C_MUSCALE] * parametric_mu_scalar(v_abs, temp, p[P_MU], p[P_MU + 1], p[P_MU + 2], p[P_MU + 3],
                                               p[P_MU + 4])
     cap = asperity_torque_scalar(r_eff, nc, muf, fc)                         # Eq. 4, static
     wref = p[C_WSCALE] * _pwl(t, p, int(p[P_SSTART]), int(p[P_SN])) + p[P_USPEED]

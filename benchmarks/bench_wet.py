@@ -1,24 +1,35 @@
 """Wet-clutch performance, measured in one run.
 
 1. A 1 s engagement (protocol (b): force rise, speed-controlled slip ramp-down,
-   lock-up event, stick mode) with the integrator core (compiled Dormand-Prince
-   5(4), events located on the dense output), against real
-   time and against ``scipy.integrate.solve_ivp`` (RK45, the same Dormand-Prince
-   pair) integrating the same equations with a Python right-hand side at the
-   same tolerances, with the same lock-up / break-away events.
+   the piston leaving its stop, film contact, lock-up, stick) through the public
+   call ``simulate_engagement`` at rtol 1e-7 (compiled Dormand-Prince 5(4),
+   events located on the dense output), with all 18 outputs at 1 kHz and with
+   the states only; its error against a tight run of an independent solver
+   (SciPy DOP853 at rtol 1e-11 on the Python right-hand side, the reference of
+   ``wp_wet.py``, whose error measure it uses); and ``scipy.integrate.solve_ivp``
+   RK45 (the same Dormand-Prince pair) on that Python right-hand side at the same
+   tolerances and events, with its error.  Comparisons at matched accuracy over
+   several tolerances, with the compiled peer: ``wp_wet.py``.
 2. A batch of 10,000 engagements with varied parameters (``numba.prange``, one
    solver per variant), on all cores and on one thread.
 3. Identification (friction map + k1, k2) of a 30 s friction-map record at 1 kHz.
 
-Run: ``python benchmarks/bench_wet.py``.  Prints the measured ratios.
+Every time is the median of repeated runs with its min-max; the machine and its
+load are printed (the load is that of the whole machine: other processes share it).
+
+Run: ``python benchmarks/bench_wet.py [--quick]``.
 """
 
 from __future__ import annotations
 
+import argparse
 import bisect
 import math
 import os
+import statistics
+import sys
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -33,14 +44,20 @@ from clutchlab.wet.identify import identify_friction_map, identify_thermal
 RTOL = 1e-7
 
 
-def best_of(fn, repeat):
-    best = math.inf
-    out = None
+def timed(fn, repeat):
+    """Wall times [s] of ``repeat`` calls and the last result."""
+    times, out = [], None
     for _ in range(repeat):
         t0 = time.perf_counter()
         out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+        times.append(time.perf_counter() - t0)
+    return times, out
+
+
+def fmt(times, unit=1e3, digits=3):
+    """``median (min-max)`` of ``times`` [s] in ms (``unit`` 1e3) or s (1)."""
+    return (f"{statistics.median(times) * unit:.{digits}f} ({min(times) * unit:.{digits}f}-"
+            f"{max(times) * unit:.{digits}f})")
 
 
 # ---------------------------------------------------------------- Python reference
@@ -91,7 +108,10 @@ def make_python_model(clutch, bench, scen, friction):
         muv = p["mu_v1"] * math.exp(p["mu_v2"] * temp) + p["mu_v3"] * math.exp(p["mu_v4"] * temp)
         fc = p["friction_area"] * p["gw_scale"] * gw(h / p["sigma"])
         v = p["r_eff"] * w
-        muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-abs(v) / law.v_s), 0.0)
+        # |v| as the sliding direction of the mode gives it (clutchlab's model): smooth through v = 0 in a
+        # slip mode, so that a step ending past a lock-up sees no kink
+        v_abs = v if mode == "slip+" else (-v if mode == "slip-" else abs(v))
+        muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-v_abs / law.v_s), 0.0)
         cap = p["r_eff"] * nc * muf * fc
         wref = pwl(t, st, sv)
         fref = min(pwl(t, ft, fv), p["actuator_force_max"])
@@ -175,36 +195,56 @@ def solve_reference(clutch, bench, scen, friction, t_eval):
 
 
 # ---------------------------------------------------------------- benchmarks
-def main():
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer repeats, no batch on one thread")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import _wp  # noqa: PLC0415 (the shared pieces of the work-precision scripts)
+    import wp_wet  # noqa: PLC0415 (its reference and error measure; it imports this module's Python model)
+
     clutch = WetClutch.paper()
     bench = Bench()
     truth = ParametricFriction.bench_truth()
     proto = EngagementProtocol(duration=1.0)
     scen = proto.scenario(clutch, "speed")
+    print(f"machine: {_wp.machine()}")
     print(f"cores available: {os.cpu_count()}, numba threads: {numba.get_num_threads()}")
+    n_fast = 200 if args.quick else 1000
 
     # ---- 1. single engagement
     t0 = time.perf_counter()
     simulate_engagement(clutch, scen, bench=bench, friction=truth, rtol=RTOL)
     print(f"first call (incl. compilation or cache load): {time.perf_counter() - t0:.2f} s")
-    t_kernel, res = best_of(lambda: simulate_engagement(clutch, scen, bench=bench, friction=truth, rtol=RTOL), 50)
-    t_states, _ = best_of(lambda: simulate_engagement(clutch, scen, bench=bench, friction=truth, rtol=RTOL,
-                                                      outputs=False), 50)
-    print(f"[1] 1 s engagement, compiled: {t_kernel * 1e3:.3f} ms ({res.n_steps} steps, 1 kHz output, "
-          f"events: {', '.join(f'{e.kind} {e.time:.4f} s' for e in res.events)})")
-    print(f"    states only (no output evaluation, like solve_ivp's t_eval): {t_states * 1e3:.3f} ms")
-    print(f"    faster than real time: {1.0 / t_kernel:,.0f}x with outputs, {1.0 / t_states:,.0f}x states only")
-    t_eval = res.time
-    t_ref, (tr, yr, ev_ref, y_end) = best_of(lambda: solve_reference(clutch, bench, scen, truth, t_eval), 3)
-    lock_ref = [t for k, t in ev_ref if k == "lock-up"]
-    print(f"    solve_ivp RK45 + Python RHS, same rtol={RTOL:g}/atol, same events: {t_ref * 1e3:.1f} ms")
-    dev_w = np.max(np.abs(np.interp(t_eval, tr, yr[:, 2]) - res.state("slip_speed_rad_s")))
-    dev_t = np.max(np.abs(np.interp(t_eval, tr, yr[:, 4]) - res.state("temperature_C")))
-    print(f"    agreement: lock-up {res.lockup_time:.6f} s vs {lock_ref[0] if lock_ref else float('nan'):.6f} s, "
-          f"max |slip diff| {dev_w:.2e} rad/s, max |T diff| {dev_t:.2e} K, friction work "
-          f"{res.final_state[8]:.3f} vs {y_end[8]:.3f} J")
-    print(f"    speed-up over solve_ivp (both states at 1 kHz): {t_ref / t_states:,.0f}x; "
-          f"with the 18 outputs also evaluated at 1 kHz: {t_ref / t_kernel:,.0f}x")
+
+    def run(outputs=True):
+        return simulate_engagement(clutch, scen, bench=bench, friction=truth, rtol=RTOL, outputs=outputs)
+
+    t_all, res = timed(run, n_fast)
+    t_states, _ = timed(lambda: run(False), n_fast)
+    med_all, med_states = statistics.median(t_all), statistics.median(t_states)
+    stats = res.result.stats
+    print(f"[1] 1 s engagement through simulate_engagement, rtol {RTOL:g}, medians (min-max) of {n_fast} calls:")
+    print(f"    all 18 outputs at 1 kHz: {fmt(t_all)} ms = {1.0 / med_all:,.0f}x real time; states only "
+          f"(like solve_ivp's t_eval): {fmt(t_states)} ms = {1.0 / med_states:,.0f}x")
+    print(f"    {stats['accepted_steps']} steps ({stats['rejected_steps']} rejected), "
+          f"{stats['rhs_evaluations']} right-hand sides + {res.time.size} output rows; events: "
+          f"{', '.join(f'{e.kind} {e.time:.6f} s' for e in res.events)}")
+    terms = make_python_model(clutch, bench, scen, truth)
+    x0 = W.initial_state(scen)
+    ref = wp_wet.reference(terms, x0, scen, res.time, clutch, bench, truth, check=False)
+    e, ew, et = wp_wet.error_of(res.state("slip_speed_rad_s"), res.lockup_time, ref)
+    print(f"    error against the reference: {e:.1e} (slip speed {ew:.1e} of {ref['w_range']:.0f} rad/s, "
+          f"lock-up time {et:.1e} of 1 s; the measure of wp_wet.py)")
+    atol = W.absolute_tolerance(clutch, RTOL)
+    t_ivp, (ys, lock, nfev) = timed(
+        lambda: wp_wet.solve_scipy(terms, x0, scen.duration, res.time, "RK45", RTOL, atol), 1 if args.quick else 5)
+    e_ivp, _, _ = wp_wet.error_of(ys[:, W.S_W], lock, ref)
+    print(f"    solve_ivp RK45 + Python RHS, same rtol/atol and events: {fmt(t_ivp, digits=1)} ms, "
+          f"{nfev} evaluations, error {e_ivp:.1e}")
+    print(f"    at the same tolerance solve_ivp takes {statistics.median(t_ivp) / med_states:,.0f}x the states-only "
+          f"time, {statistics.median(t_ivp) / med_all:,.0f}x the time with all outputs (at matched error, "
+          f"against every SciPy method and the compiled peer: wp_wet.py)")
 
     # ---- 2. batch of 10,000 engagements
     m = 10_000
@@ -220,13 +260,19 @@ def main():
     dyn_scen = proto.scenario(clutch, "free")
     simulate_batch(clutch, dyn_scen, {k: v[:4] for k, v in variants.items()}, bench=bench, friction=truth)
     nthreads = numba.get_num_threads()
-    t_par, batch = best_of(lambda: simulate_batch(clutch, dyn_scen, variants, bench=bench, friction=truth), 2)
-    numba.set_num_threads(1)
-    t_ser, _ = best_of(lambda: simulate_batch(clutch, dyn_scen, variants, bench=bench, friction=truth), 1)
-    numba.set_num_threads(nthreads)
-    print(f"[2] batch of {m} 1 s engagements (inertia dynamometer, 6 parameters varied): "
-          f"{t_par:.3f} s on {nthreads} threads, {t_ser:.3f} s on 1 thread -> parallel speed-up {t_ser / t_par:.2f}x; "
-          f"{m / t_par:,.0f} engagements/s, all ok: {bool(np.all(batch.status == 0))}, "
+    def batch_run():
+        return simulate_batch(clutch, dyn_scen, variants, bench=bench, friction=truth)
+
+    t_par, batch = timed(batch_run, 3)
+    line = (f"[2] batch of {m} 1 s engagements (inertia dynamometer, 6 parameters varied), medians (min-max) of "
+            f"3 runs: {fmt(t_par, 1)} s on {nthreads} threads")
+    if not args.quick:
+        numba.set_num_threads(1)
+        t_ser, _ = timed(batch_run, 3)
+        numba.set_num_threads(nthreads)
+        line += (f", {fmt(t_ser, 1)} s on 1 thread -> parallel speed-up "
+                 f"{statistics.median(t_ser) / statistics.median(t_par):.2f}x")
+    print(line + f"; {m / statistics.median(t_par):,.0f} engagements/s, all ok: {bool(np.all(batch.status == 0))}, "
           f"locked up: {int(np.sum(np.isfinite(batch.lockup_time)))}")
 
     # ---- 3. identification of a 30 s record at 1 kHz
@@ -234,11 +280,13 @@ def main():
     rec = run.record
     identify_friction_map(rec, clutch)  # imports scipy.optimize etc.
     identify_thermal(rec, clutch)
-    t_id, (fmap, th) = best_of(lambda: (identify_friction_map(rec, clutch, sensor_time_constant=0.2),
-                                        identify_thermal(rec, clutch, sensor_time_constant=0.2)), 5)
-    print(f"[3] identification of a {rec['time_s'].iloc[-1]:.0f} s record at 1 kHz ({len(rec)} samples): "
-          f"friction map + k1, k2 in {t_id:.3f} s (target < 1 s); mu_t = {fmap.law.mu_t:.3e} (true {truth.mu_t:.1e}), "
-          f"k1 = {th.k1:.1f}, k2 = {th.k2:.2f} W/K (true {clutch.k1}, {clutch.k2})")
+    t_id, (fmap, th) = timed(lambda: (identify_friction_map(rec, clutch, sensor_time_constant=0.2),
+                                      identify_thermal(rec, clutch, sensor_time_constant=0.2)), 5)
+    print(f"[3] identification of a {rec['time_s'].iloc[-1]:.0f} s record at 1 kHz ({len(rec)} samples), median "
+          f"(min-max) of 5: friction map + k1, k2 in {fmt(t_id, 1)} s (target < 1 s); mu_t = {fmap.law.mu_t:.3e} "
+          f"(true {truth.mu_t:.1e}), k1 = {th.k1:.1f}, k2 = {th.k2:.2f} W/K (true {clutch.k1}, {clutch.k2})")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"load at the end: {load:.2f}")
 
 
 if __name__ == "__main__":

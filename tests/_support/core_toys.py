@@ -273,3 +273,60 @@ def chain_system(n=8, pattern=True):
     states = tuple((f"x{i}", "m") for i in range(n)) + tuple((f"v{i}", "m_s") for i in range(n))
     return System("chain", ChainParams(1e4, 5.0, 1e5), states, states, x0, np.zeros(0, np.int64), np.full(2 * n, 1e-9),
                   method="rodas", jac_pattern=pat, fd_scale=np.full(2 * n, 1e-3), rtol=1e-6)
+
+
+# ------------------------------------------------------------------ a speed that jumps to its limit after an event
+class RampParams(NamedTuple):
+    """x' = 0 until t = ``t_event`` (an event), then x' = v_max tanh((t - t_event) / tau): the speed reaches
+    its limit within a few ``tau`` (the wet clutch's piston leaving its stop).  ``codes``: what ``update``
+    returns for each of the two switching functions (both t - t_event, rising)."""
+
+    t_event: float
+    tau: float
+    v_max: float
+    codes: tuple
+
+
+@numba.njit(cache=True)
+def _ramp_rhs(t, x, u, m, p, dx, g):
+    dx[0] = p.v_max * math.tanh((t - p.t_event) / p.tau) if m[0] == 1 else 0.0
+    g[0] = t - p.t_event
+    g[1] = t - p.t_event
+
+
+@numba.njit(cache=True)
+def _ramp_update(t, x, u, m, p, k, log):
+    m[0] = 1
+    record(log, t, k, -1)
+    return p.codes[k]
+
+
+dispatch.register(RampParams, rhs=_ramp_rhs, outputs=_lin_outputs, update=_ramp_update, restart=_no_restart,
+                  accept=_no_accept, next_break=_no_break, jacobian=_no_jac)
+
+
+def ramp_system(codes=(0, 0), t_event=0.0723, tau=1e-6, v_max=0.1, atol=1e-8):
+    """x(t) = v_max tau ln cosh((t - t_event) / tau) after the event."""
+    return System("ramp", RampParams(t_event, tau, v_max, tuple(int(c) for c in codes)), (("x", "m"),),
+                  (("x", "m"),), np.zeros(1), np.zeros(1, np.int64), np.full(1, atol),
+                  switching=(("start", 1), ("start_too", 1)), events=("start", "start_too"), mode_names=("moving",),
+                  mode_values=(("no", "yes"),), rtol=1e-8, max_step=0.01)
+
+
+# ------------------------------------------------------------------ the oscillator with hooks compiled without reference counting
+class LinearNoRefcountParams(NamedTuple):
+    """:class:`LinearParams` again, its hooks declared with ``numba.njit(_nrt=False)``."""
+
+    a: np.ndarray
+    b: np.ndarray
+
+
+_lin_rhs_no_nrt = numba.njit(_nrt=False)(_lin_rhs.py_func)
+_lin_outputs_no_nrt = numba.njit(_nrt=False)(_lin_outputs.py_func)
+dispatch.register(LinearNoRefcountParams, rhs=_lin_rhs_no_nrt, outputs=_lin_outputs_no_nrt, update=_no_update,
+                  restart=_no_restart, accept=_no_accept, next_break=_no_break, jacobian=_lin_jac)
+
+
+def linear_system_no_refcount(a, x0, method="dopri"):
+    base = linear_system(a, x0, method=method)
+    return base.replace(params=LinearNoRefcountParams(*base.params))

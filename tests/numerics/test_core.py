@@ -629,3 +629,70 @@ def test_hooks_keep_their_error_model_inside_the_core(tmp_path):
     # an exception raised by a hook leaves a session as it leaves numba's dispatcher
     session = [line for line in out.splitlines() if line.startswith("session")]
     assert len(session) == 6 and session[:3] == session[3:] and "ZeroDivisionError" in session[0], out
+
+
+def _ramp_error(res, sysm):
+    p = sysm.params
+    z = (res.time - p.t_event) / p.tau
+    exact = np.where(z > 0, p.v_max * p.tau * (np.abs(z) - math.log(2.0) + np.log1p(np.exp(-2.0 * np.abs(z)))), 0.0)
+    return float(np.max(np.abs(res.states[:, 0] - exact)))
+
+
+def test_update_asks_for_a_restart_of_the_step_size():
+    """An ``update`` that returns ``core.RESTART``: the step after the event starts from ``64 event_tol``, so
+    a speed that reaches its limit within microseconds of the event is resolved.  Without it the step is
+    cut down from its old size only until the error estimate, which cannot see a transient that lies
+    between the first two stages, lets it pass, and x lags behind for good (what the wet clutch's piston
+    did, 2.6e-7 m, at every rtol from 1e-3 to 1e-7)."""
+    kept = toys.ramp_system(codes=(0, 0))
+    restarted = toys.ramp_system(codes=(core.RESTART, 0))
+    res_kept = simulate(kept, 0.2, output_step=0.01)
+    res_restarted = simulate(restarted, 0.2, output_step=0.01)
+    assert list(res_restarted.events.event) == ["start", "start_too"]
+    err_kept, err_restarted = _ramp_error(res_kept, kept), _ramp_error(res_restarted, restarted)
+    # measured: 6.4e-10 m with the restart, 6.2e-7 m without (atol 1e-8 m; v_max tau ln 2 = 6.9e-8 m)
+    assert err_restarted < 1e-9 < 1e-7 < err_kept
+    # and the first step after the event is the short one
+    steps = simulate(restarted, 0.2)
+    after = steps.time[steps.time > restarted.params.t_event]
+    assert after[0] - restarted.params.t_event <= 64.0 * restarted.event_tol * (1.0 + 1e-9)
+
+
+def test_a_terminal_update_wins_over_a_restart_at_the_same_event():
+    """Two switching functions crossing at one instant: one update asks for a restart, the other ends the run."""
+    for codes in ((core.RESTART, core.TERMINAL), (core.TERMINAL, core.RESTART)):
+        res = simulate(toys.ramp_system(codes=codes), 0.2, check=False)
+        assert res.status == Status.TERMINATED, codes
+        assert res.time[-1] == pytest.approx(0.0723, abs=1e-9)
+
+
+def test_a_checked_grid_is_checked_once_and_runs_like_any_grid():
+    """``checked_grid``: refused if not finite and increasing; a run on it is the run on a copy of it (which
+    ``sample_grid`` checks again), and ``sample_grid`` hands the very array on."""
+    from clutchlab.system import checked_grid, sample_grid
+
+    for bad in ([0.0, 0.2, 0.1], [0.0, float("nan"), 0.3], [0.0, float("inf")]):
+        with pytest.raises(ParameterError, match="finite and increasing"):
+            checked_grid(bad)
+    ts = checked_grid(np.arange(41) / 20.0)
+    assert sample_grid(0.0, 2.0, None, ts) is ts
+    with pytest.raises(ParameterError, match="within"):   # the bounds of the run are still checked
+        sample_grid(0.0, 1.0, None, ts)
+    a = simulate(toys.ball_system(), 2.0, sample_times=ts)
+    b = simulate(toys.ball_system(), 2.0, sample_times=ts.copy())
+    assert np.array_equal(a.time, b.time) and np.array_equal(a.states, b.states)
+    assert a.time is not ts
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_hooks_without_reference_counting_run_like_the_others(method):
+    """Hooks declared with ``numba.njit(_nrt=False)`` are compiled into the core so (the options key of
+    ``dispatch``) and give the same run, bit for bit, as the same hooks with numba's reference counting."""
+    from clutchlab.numerics import dispatch
+
+    sysm = toys.linear_system_no_refcount(OSC, [1.0, 0.0], method=method)
+    assert dispatch._options_key(dispatch._MODELS[type(sysm.params)]["rhs"])[2] is False
+    a = simulate(sysm, 10.0, output_step=0.25)
+    b = simulate(toys.linear_system(OSC, [1.0, 0.0], method=method), 10.0, output_step=0.25)
+    assert np.array_equal(a.states, b.states) and np.array_equal(a.outputs, b.outputs)
+    assert a.stats["rhs_evaluations"] == b.stats["rhs_evaluations"]

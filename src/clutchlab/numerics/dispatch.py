@@ -31,7 +31,9 @@ and the parameters ``p``):
     Discrete update when switching function ``k`` crossed zero at ``t``:
     may change ``m`` and ``x`` and record named events with
     :func:`clutchlab.numerics.core.record`; returns 0 to continue, 1 to stop
-    the run (terminal event) or a negative model error code.
+    the run (terminal event), 2 to continue with the step size started afresh
+    from a short step (the dynamics changed abruptly: a speed that jumps to a
+    limit within microseconds; Dormand-Prince) or a negative model error code.
 ``restart(t, x, u, m, p, log)``
     Makes the modes consistent with the forces at a (re)start: at t0, on
     every resumed ``advance`` (inputs may have jumped) and at every break
@@ -91,8 +93,12 @@ def register(params_cls, inline_stages: bool = False, **functions) -> None:
     :data:`OPTIONAL_HOOKS` may be (without ``time_derivative`` the stub compiles to
     :func:`no_time_derivative`).
     Registering the same class again replaces the hooks (a reloaded module).
-    Each hook is compiled into the core with its own ``error_model`` and
-    ``fastmath`` options (:func:`_declare`).  ``inline_stages``: the
+    Each hook is compiled into the core with its own ``error_model``,
+    ``fastmath`` and ``_nrt`` options (:func:`_declare`): a hook declared with
+    ``numba.njit(_nrt=False)`` is compiled without numba's reference counting
+    (for hooks that allocate no array and keep none: the core lends them its
+    arrays; the wet clutch's right-hand side made a dozen reference-count
+    calls per evaluation, a quarter of its time).  ``inline_stages``: the
     right-hand side is inlined (LLVM ``alwaysinline``) into the six stage
     calls of a Dormand-Prince step: faster where the model's evaluation is
     cheap against a call (the EMTC bench: 10 %), at the price of compiling
@@ -136,7 +142,7 @@ def registered(params_cls) -> bool:
 
 
 def _options_key(fn) -> tuple:
-    """``(error_model, fastmath)`` a hook was declared with (``njit`` options; defaults for a plain function)."""
+    """``(error_model, fastmath, nrt)`` a hook was declared with (``njit`` options; defaults for a plain function)."""
     opts = getattr(fn, "targetoptions", {}) or {}
     fastmath = opts.get("fastmath", False)
     if isinstance(fastmath, (set, frozenset, list, tuple)):
@@ -145,7 +151,7 @@ def _options_key(fn) -> tuple:
         fastmath = frozenset(k for k, v in fastmath.items() if v)
     else:
         fastmath = bool(fastmath)
-    return str(opts.get("error_model", "python")), fastmath
+    return str(opts.get("error_model", "python")), fastmath, bool(opts.get("_nrt", True))
 
 
 def _hook(p, name, key):
@@ -211,14 +217,16 @@ _DECLARED: set = set()
 
 
 def _declare(key) -> None:
-    """Declare the stubs' overloads for hooks with options ``key`` = ``(error_model, fastmath)`` (once)."""
+    """Declare the stubs' overloads for hooks with options ``key`` = ``(error_model, fastmath, nrt)`` (once)."""
     if key in _DECLARED:
         return
     _DECLARED.add(key)
-    error_model, fastmath = key
+    error_model, fastmath, nrt = key
     opts = {"cache": True, "error_model": error_model}
     if fastmath:
         opts["fastmath"] = set(fastmath) if isinstance(fastmath, frozenset) else True
+    if not nrt:
+        opts["_nrt"] = False
     for stub, hook in _STUBS:
         overload(stub, jit_options=opts)(_typing(stub, hook, key, inline=False if stub is rhs_stage else None))
     # the stage call of Dormand-Prince for the models registered with ``inline_stages``: the right-hand side

@@ -62,7 +62,7 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..result import BuiltOnFirstAccess, SimulationResult
-from ..system import simulate as run
+from ..system import checked_grid, simulate as run
 from . import system as W
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
@@ -384,11 +384,19 @@ def _sample_times(duration, sample_rate, sample_times):
         return sample_times
     if not (sample_rate > 0):
         raise ParameterError(f"sample_rate = {sample_rate!r}: must be > 0 [Hz]")
+    return _rate_grid(float(duration), float(sample_rate))
+
+
+@functools.lru_cache(maxsize=16)
+def _rate_grid(duration: float, sample_rate: float) -> np.ndarray:
+    """``k / sample_rate`` up to ``duration``, built and checked once per pair (:func:`clutchlab.system.checked_grid`;
+    building and checking it was a fifth of the Python around a 1 s engagement).  Never handed out: the runs
+    read it, the results hold their own copy of the times."""
     # the record: states, auxiliaries and the noisy bench channels, each about N_STATE + N_OUT values a sample
     check_allocation(duration * sample_rate + 1, 2 * (W.N_STATE + W.N_OUT),
                      f"duration = {duration!r} s at sample_rate = {sample_rate!r} Hz")
     n = int(math.floor(duration * sample_rate + 1e-9)) + 1
-    return np.arange(n) / sample_rate
+    return checked_grid(np.arange(n) / sample_rate)
 
 
 #: systems built recently, one entry per (clutch, bench, friction law, rtol) by identity: later runs skip the packing

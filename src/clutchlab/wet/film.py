@@ -394,7 +394,7 @@ def gw_lookup(t, t0, dt, values, vstart, ders, dstart, n):
             + (-2.0 * t3 + 3.0 * t2) * values[vstart + i + 1] + (t3 - t2) * dt * ders[dstart + i + 1])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)  # (no reference counting: see clutchlab.wet.system._HOOK)
 def asperity_force_scalar(h, sigma, area, pressure_scale):
     """Greenwood-Williamson asperity contact force ``F_c = A_f p_c(h)`` [N], compiled scalar form.
 
