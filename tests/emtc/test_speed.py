@@ -34,6 +34,11 @@ def _maker():
 
 MAKER = _maker()
 SCENARIOS = list(MAKER.scenarios())
+#: the release: when the armature leaves the clutch the magnet force jumps by 0.4 % (the engaged airgap lies
+#: halfway between two calibration airgaps, docs/emtc.md), so the last bits of the release instant (1e-13 s
+#: apart after unrelated changes to the core's arithmetic) move the flight by about 2e-8 of its range even at
+#: rtol 1e-9; until then the states agree to 1e-15.  A changed equation or step still shows (>= 1e-6).
+RELATIVE = {"release": 1e-7}
 
 
 @pytest.mark.parametrize("name, magnet, scenario, kwargs", SCENARIOS, ids=[s[0] for s in SCENARIOS])
@@ -54,7 +59,8 @@ def test_same_trajectories_events_and_steps_as_before(name, magnet, scenario, kw
         for q in range(ref.shape[1]):
             scale = np.max(np.abs(ref[:, q]))
             err = np.max(np.abs(got[:, q] - ref[:, q])) / max(scale, 1e-300)
-            assert err * scale <= 1e-9 * scale + 1e-6 * floor[q], f"{name}: {label} {q} differs by {err:.2e} of its range"
+            assert err * scale <= RELATIVE.get(name, 1e-9) * scale + 1e-6 * floor[q], \
+                f"{name}: {label} {q} differs by {err:.2e} of its range"
     assert list(r.events["event"]) == [str(e) for e in data[f"{name}_event_name"]]
     np.testing.assert_allclose(r.events["time_s"].to_numpy(), data[f"{name}_event_time"], rtol=0, atol=1e-10)
     assert res.n_steps == int(data[f"{name}_steps"][0])

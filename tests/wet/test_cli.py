@@ -49,7 +49,9 @@ def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
 
     Tolerances, measured (1.2 s, contact at 0.192 s, lock-up at 0.83 s): slip speed within 0.034 rad/s of the
     adaptive run (of 157 rad/s; bound 0.1 rad/s), thermistor temperature within 0.043 K (bound 0.1 K); the events
-    are the same, each at the first frame end after the adaptive instant (tests/numerics/test_fixed_step.py)."""
+    are the same, each at the first frame end after the adaptive instant, or the next one for the contact: at 1 ms
+    it falls on a frame end in exact arithmetic, where its switching function is +-1e-18 and rounding decides
+    (tests/numerics/test_fixed_step.py)."""
     import numpy as np
 
     protocol = str(DATA_DIR / "engagement_protocol.toml")
@@ -58,7 +60,8 @@ def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
     capsys.readouterr()
     assert main(["wet", "simulate", protocol, "-o", str(fixed), "--fixed-step", "1 ms"]) == 0
     out = capsys.readouterr().out
-    assert "in fixed steps of 0.001 s" in out and "contact at 0.193 s" in out and "lock-up at 0.83 s" in out
+    assert "in fixed steps of 0.001 s" in out and "lock-up at 0.83 s" in out
+    assert "contact at 0.193 s" in out or "contact at 0.194 s" in out
     a, f = fixed_step_frames(fixed, adaptive, 1201)
     assert np.max(np.abs(f.slip_speed_rad_s - a.slip_speed_rad_s)) < 0.1
     assert np.max(np.abs(f.temperature_C - a.temperature_C)) < 0.1
