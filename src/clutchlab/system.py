@@ -1048,7 +1048,7 @@ def _write_back(dst, src, v) -> None:
 def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: float | None = None,
                    rtol=None, atol=None, max_step=None, max_steps: int = 1_000_000, outputs: bool = True,
                    event_capacity: int = 256, check: bool = False, fixed_step: float | None = None,
-                   chunk: int = 64) -> SimulationResult:
+                   chunk: int = 32) -> SimulationResult:
     """Simulate variants of one model in parallel: one solver per variant (``numba.prange``).
 
     Parameters
@@ -1057,9 +1057,10 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
         Variants of one model with equal parameter sizes: a :class:`Variants` (parameters already
         stacked; memories the model keeps in them are written there), or systems, stacked here (their
         parameter arrays get the memories back after the run).  An **iterator** (a generator that builds
-        each variant) is drawn in chunks of ``chunk``: each chunk runs on all cores in a background thread
-        while the next is being built, so building the variants (Python) and simulating them (compiled,
-        without the interpreter lock) overlap.
+        each variant) is drawn in chunks of up to ``chunk``: each chunk runs in a background thread on all
+        cores but one while the next is being built, so building the variants (Python) and simulating them
+        (compiled, without the interpreter lock) overlap; the chunks left when the last variant is built
+        run together on all cores.
     t_end : float
         End time [s].
     sample_times, output_step
@@ -1075,7 +1076,7 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     fixed_step : float, optional
         Fixed-step mode with this step [s] for every variant, as :func:`simulate`.
     chunk : int
-        Variants per chunk when ``systems`` is an iterator (default 64).
+        Variants per chunk when ``systems`` is an iterator (at most: the first chunks are smaller; default 32).
 
     Returns
     -------
@@ -1094,36 +1095,10 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
     else:
         if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
             raise ParameterError(f"simulate_batch: chunk = {chunk!r} must be a positive integer")
-        first, ts, opt, parts = None, None, None, []
-        from concurrent.futures import ThreadPoolExecutor
-
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="clutchlab-batch") as pool:
-            running = []
-            it = iter(systems)
-            while True:
-                given = []
-                for s in it:
-                    given.append(s)
-                    if len(given) == chunk:
-                        break
-                if not given:
-                    break
-                batch = Variants.stack(given)
-                if first is None:
-                    first = batch.system
-                    ts, opt = _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step,
-                                           max_steps, fixed_step)
-                elif (batch.system.state_columns, batch.system.output_columns, batch.system.mode_names) != (
-                        first.state_columns, first.output_columns, first.mode_names):
-                    raise ParameterError(f"simulate_batch: variant {sum(len(r[1]) for r in running)} has other "
-                                         f"states, outputs or modes than variant 0 ({first.name!r})")
-                running.append((pool.submit(_run_stacked, core, batch, given, ts, opt, t_end, outputs,
-                                            event_capacity), given))
-            parts = [f.result() for f, _ in running]
-        if first is None:
-            raise ParameterError("simulate_batch: no variants")
-    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = (np.concatenate([p[k] for p in parts]) if len(parts) > 1 else parts[0][k]
-                                            for k in range(8))
+        first, ts, opt, records = _run_pipelined(core, iter(systems), int(chunk), t_end, sample_times, output_step,
+                                                 rtol, atol, max_step, max_steps, fixed_step, outputs, event_capacity)
+        parts = [records]
+    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = parts[0]
     nv, ns, ny = OX.shape[0], ts.size, len(first.outputs)
     status = STATS[:, core.SI_STATUS].copy()
     if check:
@@ -1143,6 +1118,129 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
                             tuple(first.mode_names), tuple(first.mode_values), stats, first.name)
 
 
+#: variants the records of a batch drawn from an iterator first reserve (memory is mapped only where the
+#: runs write; the records double when more come)
+_PIPELINE_RESERVE = 1024
+
+
+def _run_pipelined(core, it, chunk, t_end, sample_times, output_step, rtol, atol, max_step, max_steps, fixed_step,
+                   outputs, event_capacity):
+    """Build the variants (this thread, Python) while the ones built run (a second thread, compiled code that
+    releases the interpreter lock).
+
+    While variants are still being built, each chunk runs on one thread fewer than the caller's numba
+    threads (one core builds, the others simulate: no core is shared, so no thread of a parallel loop waits
+    for a descheduled one); once the last variant is built, all the chunks still waiting are stacked into
+    one run on all the threads.  The chunks grow from 8 variants to ``chunk`` (the first starts early).
+    Every run writes into views of one set of records that grows by doubling (no concatenation at the
+    end).  Returns ``(first system, sample times, options, records)``.
+    """
+    import queue
+    import threading
+
+    import numba
+
+    threads = numba.get_num_threads()
+    todo: queue.Queue = queue.Queue()
+    failed: list = []
+    building = threading.Event()
+    building.set()
+    cancel = threading.Event()  # the building failed: the chunks still waiting are dropped
+    setup: list = []
+    rec: list = []  # the records [capacity rows], grown by the worker
+    ended: list = []  # the worker has taken the end mark
+
+    def records(first, need):
+        if rec and rec[0].shape[0] >= need:
+            return rec
+        cap = max(need, 2 * rec[0].shape[0] if rec else max(_PIPELINE_RESERVE, 16 * chunk))
+        try:
+            new = _records(first, cap, setup[0].size, outputs, event_capacity, "")
+        except ParameterError:  # the reserve does not fit in the budget: what is needed only
+            new = _records(first, need, setup[0].size, outputs, event_capacity,
+                           f"{need} variants x {setup[0].size} samples")
+        if rec:
+            for dst, src in zip(new, rec):
+                dst[:src.shape[0]] = src
+        rec[:] = new
+        return rec
+
+    def run(first, start, given, batch, nthreads):
+        stop = start + len(given)
+        out = tuple(a[start:stop] for a in records(first, stop))
+        numba.set_num_threads(nthreads)
+        _run_stacked(core, batch, given, *setup, t_end, outputs, event_capacity, out=out)
+
+    def consume():
+        try:
+            while True:
+                item = todo.get()
+                if item is None:
+                    ended.append(True)
+                    return
+                if cancel.is_set():
+                    continue
+                start, given, batch = item
+                if not building.is_set():  # everything is built: the chunks still waiting run at once
+                    pooled, last = list(given), False
+                    while True:
+                        nxt = todo.get()
+                        if nxt is None:
+                            last = True
+                            ended.append(True)
+                            break
+                        pooled.extend(nxt[1])
+                    if len(pooled) > len(given):
+                        given, batch = pooled, Variants.stack(pooled)
+                    run(batch.system, start, given, batch, threads)
+                    if last:
+                        return
+                    continue
+                run(batch.system, start, given, batch, max(1, threads - 1))
+        except BaseException as exc:  # reported by the caller's thread
+            failed.append(exc)
+            while not ended and todo.get() is not None:  # let the producer finish
+                pass
+
+    worker = threading.Thread(target=consume, name="clutchlab-batch", daemon=True)
+    first, n, size = None, 0, min(8, chunk)
+    try:
+        while not failed:
+            given = []
+            for s in it:
+                given.append(s)
+                if len(given) == size:
+                    break
+            if not given:
+                break
+            size = min(2 * size, chunk)
+            batch = Variants.stack(given)
+            if first is None:
+                first = batch.system
+                setup.extend(_batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step,
+                                          max_steps, fixed_step))
+                worker.start()
+            elif (batch.system.state_columns, batch.system.output_columns, batch.system.mode_names) != (
+                    first.state_columns, first.output_columns, first.mode_names):
+                raise ParameterError(f"simulate_batch: variant {n} has other states, outputs or modes than "
+                                     f"variant 0 ({first.name!r})")
+            todo.put((n, given, batch))
+            n += len(given)
+    except BaseException:
+        cancel.set()
+        raise
+    finally:
+        building.clear()
+        todo.put(None)
+        if worker.is_alive():
+            worker.join()
+    if failed:
+        raise failed[0]
+    if first is None:
+        raise ParameterError("simulate_batch: no variants")
+    return first, setup[0], setup[1], tuple(a[:n] for a in rec)
+
+
 def _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, max_steps, fixed_step):
     """Sample times and solver options of a batch, from its first variant."""
     ts = sample_grid(0.0, float(t_end), output_step, sample_times)
@@ -1151,31 +1249,36 @@ def _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, 
     return ts, first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
 
 
-def _run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity):
-    """Run one stacked batch on all cores (the compiled loop releases the interpreter lock); returns
-    (states, modes, outputs, counters, event times, codes, elements, counts).  The memories each variant's
-    model kept go back into its own parameter arrays (``given``: the systems stacked, or None)."""
-    first = batch.system
-    nv, ns = len(batch), ts.size
+def _records(first, nv, ns, outputs, event_capacity, what):
+    """Empty records of ``nv`` variants x ``ns`` samples: (states, modes, outputs, counters, event times,
+    codes, elements, counts); the compiled loop writes every entry of the variants it runs."""
+    core = _numerics_core()
     nx, ny, nm = len(first.states), len(first.outputs), len(first.mode_names)
-    check_allocation(nv * ns, nx + ny + nm, f"{nv} variants x {ns} samples")
-    X0 = batch.x0.copy()
-    M0 = batch.m0.copy()
-    OX = np.full((nv, ns, nx), np.nan)
-    OM = np.zeros((nv, ns, nm), dtype=np.int64)
-    OY = np.full((nv, ns, ny) if outputs else (nv, 1, ny), np.nan)
-    STATS = np.zeros((nv, core.N_SI), dtype=np.int64)
-    EVT = np.zeros((nv, event_capacity))
-    EVC = np.zeros((nv, event_capacity), dtype=np.int64)
-    EVE = np.zeros((nv, event_capacity), dtype=np.int64)
-    EVN = np.zeros((nv, 2), dtype=np.int64)
-    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, X0, M0, batch.u0, float(t_end), ts,
-               opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE, EVN)
+    check_allocation(nv * ns, nx + ny + nm, what)
+    return (np.empty((nv, ns, nx)), np.empty((nv, ns, nm), dtype=np.int64),
+            np.empty((nv, ns, ny) if outputs else (nv, 1, ny)), np.zeros((nv, core.N_SI), dtype=np.int64),
+            np.zeros((nv, event_capacity)), np.zeros((nv, event_capacity), dtype=np.int64),
+            np.zeros((nv, event_capacity), dtype=np.int64), np.zeros((nv, 2), dtype=np.int64))
+
+
+def _run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity, out=None):
+    """Run one stacked batch on all cores (the compiled loop releases the interpreter lock); returns
+    (states, modes, outputs, counters, event times, codes, elements, counts) -- ``out``, views of larger
+    records, if given.  The memories each variant's model kept go back into its own parameter arrays
+    (``given``: the systems stacked, or None)."""
+    first = batch.system
+    if out is None:
+        out = _records(first, len(batch), ts.size, outputs, event_capacity,
+                       f"{len(batch)} variants x {ts.size} samples")
+    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = out
+    # (empty: the compiled loop writes every sample, NaN after the last one a variant reached, in parallel)
+    core.batch("rodas" if opt.fixed_step > 0.0 else first.method, batch.params, batch.x0.copy(), batch.m0.copy(),
+               batch.u0, float(t_end), ts, opt, OX, OM, OY, bool(outputs), STATS, EVT, EVC, EVE, EVN)
     if given is not None:  # the memories each variant's model kept, back into its own parameter arrays
         for v, s in enumerate(given):
             for dst, src in zip(s.params, batch.params):
                 _write_back(dst, src, v)
-    return OX, OM, OY, STATS, EVT, EVC, EVE, EVN
+    return out
 
 
 def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):

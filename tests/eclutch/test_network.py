@@ -136,13 +136,31 @@ def test_zero_input_root_equals_brents_from_the_bracket(force, k_b, p_b):
         assert np.array_equal(net._assembly[key], again._assembly[key])
 
 
-def test_secant_root_hands_a_flat_function_to_the_bracket():
-    from clutchlab.eclutch.network import _secant_root
+def test_zeroing_secant_hands_a_flat_residual_to_the_bracket():
+    """The compiled secant steps give up (NaN) where the input force is flat in the pre-strain (the bearing
+    contact open) or a step leaves the interval, and converge to the root of a closed contact (the force
+    linear in the pre-strain: the hand solution's root); zero_input then brackets and still finds it."""
+    from clutchlab.eclutch.network import _zeroing_root
 
-    assert _secant_root(lambda x: -80.0, 0.0, 1e-6, -1.0, 1.0, xtol=1e-13, rtol=1e-12) is None  # flat: no root
-    assert _secant_root(lambda x: x - 2.0, 0.0, 1e-6, -1.0, 1.0, xtol=1e-13, rtol=1e-12) is None  # outside
-    assert _secant_root(lambda x: x ** 3 - 0.125, 0.3, 0.31, -1.0, 1.0, xtol=1e-14, rtol=1e-14) == \
-        pytest.approx(0.5, abs=1e-13)
+    base = linear_model0()
+    a = base._assembly
+    k = a["element_names"].index("bearing")
+
+    def root(x0, lo=-0.05, hi=0.05, force=80.0):
+        kernel = list(base.kernel_data())
+        kernel[2] = kernel[2].copy()
+        return _zeroing_root(x0, x0 + 1e-6, lo, hi, 1e-13, 1e-12, k, a["Gc"][k], a["Gb"], force, np.zeros(1),
+                             np.zeros(base.n_free), *kernel)
+
+    assert np.isnan(root(-0.02))  # contact open at both starting points: flat, no root
+    assert np.isnan(root(1e-4, lo=-1e-5, hi=1e-5))  # the first step leaves the interval
+    p = root(1e-4)
+    # hand solution: the bearing force k_b (p_b - i q) at u = 0 with the contact closed equals 80 N
+    k_b, k_ds, p_ds, i, k_fp, c0, k_rs, r0 = 5e6, 2e5, 6e-3, -4.0, 8e6, 0.6e-3, 3e4, 8e-3
+    q = (i * k_b * p - i * k_ds * p_ds - k_fp * c0 - k_rs * r0) / (i * i * (k_b + k_ds) + k_fp + k_rs)
+    assert k_b * (p - i * q) == pytest.approx(80.0, rel=1e-9)
+    assert zero_input(base._with_prestrain("bearing", -0.02), "bearing", 80.0).element("bearing").prestrain == \
+        pytest.approx(p, abs=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -350,6 +350,37 @@ def test_batch_from_a_generator_equals_the_list(chunk):
     assert list(drawn.status) == list(listed.status)
 
 
+def test_batch_from_a_generator_grows_its_records(monkeypatch):
+    """Records reserved for fewer variants than come double (the runs before keep their rows); a variant
+    that fails has NaN after the last sample it reached (the records are allocated empty)."""
+    import clutchlab.system as system_module
+
+    monkeypatch.setattr(system_module, "_PIPELINE_RESERVE", 2)
+    cases = [(1.0 + 0.1 * k, 0.3 + 0.05 * k) for k in range(11)]
+    listed = simulate_batch([toys.ball_system(h0, e) for h0, e in cases], 3.0, output_step=0.1, event_capacity=16)
+    drawn = simulate_batch((toys.ball_system(h0, e) for h0, e in cases), 3.0, output_step=0.1, event_capacity=16,
+                           chunk=1)
+    assert drawn.states.shape == listed.states.shape == (11, 31, 2)
+    assert np.array_equal(drawn.states, listed.states, equal_nan=True) and drawn.events.equals(listed.events)
+    short = simulate_batch((toys.ball_system(h0, e) for h0, e in cases[:3]), 3.0, output_step=0.1, max_steps=8,
+                           chunk=1)
+    assert all(s == Status.STEP_LIMIT for s in short.status)
+    reached = ~np.isnan(short.states[:, :, 0])
+    assert reached[:, 0].all() and not reached[:, -1].any()
+    assert np.array_equal(np.isnan(short.outputs).all(axis=2), ~reached)
+
+
+def test_batch_from_a_generator_that_fails_stops_its_runs():
+    """An error raised while building a variant reaches the caller (no run left waiting)."""
+    def make():
+        yield toys.ball_system(1.0, 0.5)
+        yield toys.ball_system(2.0, 0.7)
+        raise ValueError("variant 2 cannot be built")
+
+    with pytest.raises(ValueError, match="variant 2 cannot be built"):
+        simulate_batch(make(), 3.0, output_step=0.1, chunk=1)
+
+
 def test_batch_from_a_generator_refuses_bad_requests():
     with pytest.raises(ParameterError, match="no variants"):
         simulate_batch(iter(()), 1.0)

@@ -888,7 +888,7 @@ class BatchResult:
 
 def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3, rtol: float = 1e-3,
                    max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
-                   event_tol: float = 1e-8, jac_every: int = 10, chunk: int = 64) -> BatchResult:
+                   event_tol: float = 1e-8, jac_every: int = 10, chunk: int = 32) -> BatchResult:
     """Simulate many E-clutch variants in parallel, one Rodas3 solver per variant (numba ``prange``).
 
     A thin wrapper of :func:`clutchlab.system.simulate_batch` over the variants' systems
@@ -902,8 +902,9 @@ def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3
         placement); parameters, masses, lever ratios, pre-strains, stiffness
         scales, component curves and actuator parameters may differ.  Pass a
         generator that builds them (``(EClutch(...) for r in ratios)``) and the
-        building overlaps the runs: each chunk of ``chunk`` variants runs on all
-        cores while the next is built.
+        building overlaps the runs: each chunk of up to ``chunk`` variants runs
+        on all cores but one while the next is built; the rest run together on
+        all cores once the last is built.
     inputs : dict
         As in :meth:`EClutch.simulate` (one input for every variant).
     t_end, output_step : float
@@ -911,7 +912,7 @@ def simulate_batch(eclutches, inputs, t_end: float, *, output_step: float = 1e-3
     rtol, max_step, h_max, max_steps, event_tol, jac_every
         As in :meth:`EClutch.simulate`.
     chunk : int
-        Variants per chunk when ``eclutches`` is an iterator (default 64).
+        Variants per chunk when ``eclutches`` is an iterator (at most; default 32).
 
     Returns
     -------

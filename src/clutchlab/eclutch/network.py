@@ -715,16 +715,16 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
     u0, q0 = np.zeros(1), np.zeros(network.n_free)
 
     def residual(p):
-        d0[k] = float(p) + gc
-        _, F, _, status = _static_path(u0, q0, *kernel, 1e-7, 1e-14)
-        return np.nan if status else float((F @ gb)[0]) - force
+        return _zeroing_residual(float(p), k, gc, gb, float(force), u0, q0, *kernel)
 
     lo, hi = bracket
     # the input force is linear in the pre-strain while the contact is closed: secant steps from the
     # element's own pre-strain find the root in a few solves (Brent's method from the wide bracket took
-    # 17-18, most of them where the contact is open and the force is flat); Brent's method remains the
-    # fallback and gives the refusal
-    p = _secant_root(residual, float(el.prestrain), float(el.prestrain) + 1e-6, lo, hi, xtol=1e-13, rtol=1e-12)
+    # 17-18, most of them where the contact is open and the force is flat), compiled in one call; Brent's
+    # method remains the fallback and gives the refusal
+    p = _zeroing_root(float(el.prestrain), float(el.prestrain) + 1e-6, lo, hi, 1e-13, 1e-12, k, gc, gb,
+                      float(force), u0, q0, *kernel)
+    p = None if np.isnan(p) else p
     if p is None:
         r_lo, r_hi = residual(lo), residual(hi)
         if not (np.isfinite(r_lo) and np.isfinite(r_hi)) or r_lo * r_hi > 0:
@@ -733,27 +733,49 @@ def zero_input(network: AxialNetwork, element: str, force: float, *, bracket=(-0
     return network._with_prestrain(element, p)  # (equals replace_element bit for bit, without assembling again)
 
 
-def _secant_root(fun, x0: float, x1: float, lo: float, hi: float, *, xtol: float, rtol: float, max_iter: int = 12):
-    """A root of ``fun`` by secant steps from ``x0``, ``x1`` within ``[lo, hi]``, or None (no convergence, a flat
-    or non-finite function, a step out of the interval): the caller then brackets.
+@numba.njit(cache=True, nogil=True)
+def _zeroing_residual(p, k, gc, gb, force, u0, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral):
+    """Input force at input position 0 minus ``force`` [N] with element ``k``'s pre-strain ``p`` [m] (its rest
+    deflection ``d0[k] = p + gc``, as :meth:`AxialNetwork._with_prestrain` sets it; ``d0`` is changed);
+    NaN where no equilibrium is found."""
+    d0[k] = p + gc
+    _, F, _, status = _static_path(u0, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral,
+                                   1e-7, 1e-14)
+    if status:
+        return np.nan
+    s = 0.0
+    for e in range(F.shape[1]):
+        s += F[0, e] * gb[e]
+    return s - force
 
-    Converged when a step is below ``xtol + rtol |x|`` (Brent's criterion) and the function changes sign
-    across the last step or vanishes at its end, so the root is that of ``fun``, not of a flat stretch.
+
+@numba.njit(cache=True, nogil=True)
+def _zeroing_root(x0, x1, lo, hi, xtol, rtol, k, gc, gb, force, u0, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds,
+                  extraps, scale, unilateral):
+    """The pre-strain [m] of :func:`zero_input` by secant steps from ``x0``, ``x1`` within ``[lo, hi]``
+    (residual :func:`_zeroing_residual`), or NaN (no convergence in 12 steps, a flat or non-finite residual,
+    a step out of the interval): the caller then brackets.
+
+    Converged when a step is below ``xtol + rtol |x|`` (Brent's criterion) and the residual changes sign
+    across the last step or vanishes at its end, so the root is that of the residual, not of a flat stretch.
     """
-    f0, f1 = fun(x0), fun(x1)
-    for _ in range(max_iter):
+    data = (GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral)
+    f0 = _zeroing_residual(x0, k, gc, gb, force, u0, q0, *data)
+    f1 = _zeroing_residual(x1, k, gc, gb, force, u0, q0, *data)
+    for _ in range(12):
         if not (np.isfinite(f0) and np.isfinite(f1)) or f1 == f0:
-            return None
+            return np.nan
         x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
         if not (lo <= x2 <= hi):
-            return None
+            return np.nan
         if abs(x2 - x1) <= xtol + rtol * abs(x2):
-            f2 = fun(x2)
+            f2 = _zeroing_residual(x2, k, gc, gb, force, u0, q0, *data)
             if f2 == 0.0 or np.sign(f2) != np.sign(f1) or abs(f2) <= abs(f1):
                 return x2
-            return None
-        x0, f0, x1, f1 = x1, f1, x2, fun(x2)
-    return None
+            return np.nan
+        x0, f0, x1 = x1, f1, x2
+        f1 = _zeroing_residual(x2, k, gc, gb, force, u0, q0, *data)
+    return np.nan
 
 
 def modified_parts(nodes: tuple, elements: tuple, *, extra_nodes=(), replace=None, add=(),

@@ -76,6 +76,12 @@ def batch(P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T
                                 OUT_M[v], OUT_Y[v], want_y)
         for q in range(_core.N_SI):
             STATS[v, q] = si[q]
+        # the records are allocated empty (filled here, in parallel): NaN after the last sample reached
+        for i in range(si[_core.SI_IREC], ns):
+            OUT_X[v, i, :] = np.nan
+            OUT_M[v, i, :] = 0
+        for i in range(si[_core.SI_IREC] if want_y else 0, OUT_Y.shape[1]):
+            OUT_Y[v, i, :] = np.nan
 
 
 @numba.njit(cache=True, nogil=True)
