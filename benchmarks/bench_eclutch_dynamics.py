@@ -9,8 +9,8 @@ Measured in one run:
    matrix), the friction state machine runs on terminal events with a restart after each, and the
    integration restarts at every input breakpoint -- what one would write with SciPy;
 3. the accuracy of both against a tight-tolerance clutchlab run (rtol 1e-8), to show the tolerances match;
-4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale) with ``prange`` on all threads
-   against one thread.
+4. a batch of 1,000 variants (lever ratio x diaphragm stiffness scale), building included, with ``prange`` on all threads
+   against one thread, outputs every 1 ms and every 10 ms.
 
 Run:  python benchmarks/bench_eclutch_dynamics.py [--quick]  (``--clutchlab``: only clutchlab's two figures and their
 error, no SciPy references and no batch)  (``--build``: only the time to build one variant;
@@ -376,14 +376,15 @@ def main(quick: bool = False, friction_reference: bool = False):
 
     # batch of 1,000 variants
     batch_timing(quick)
+    batch_timing(quick, output_step=1e-2)
 
 
-def batch_timing(quick: bool = False, rounds: int = 7) -> None:
+def batch_timing(quick: bool = False, rounds: int = 7, output_step: float = 1e-3) -> None:
     """A batch of variants (lever ratio x diaphragm scale), friction on, **building included**: one thread
     (build them all, then run them on one numba thread) against two (a list built, then run on two
     threads; and a generator: chunks of up to 32 run on one thread while the next ones are built on the
     other core, the rest on both once the last is built).  Alternating rounds after one round not counted
-    (it maps the memory of the records, ~0.36 GB a run), medians (min-max)."""
+    (it maps the memory of the records, ~0.36 GB a run at the 1 ms output grid), medians (min-max)."""
     import statistics
 
     import numba
@@ -404,14 +405,16 @@ def batch_timing(quick: bool = False, rounds: int = 7) -> None:
         for label in times:
             numba.set_num_threads(1 if label.startswith("1 ") else threads)
             t0 = time.perf_counter()
-            b = simulate_batch(variants() if "while" in label else list(variants()), INPUT, T_END, output_step=1e-3)
+            b = simulate_batch(variants() if "while" in label else list(variants()), INPUT, T_END,
+                               output_step=output_step)
             if r:
                 times[label].append(time.perf_counter() - t0)
             finished = int((b.stats.status == 0).sum())
             del b
     numba.set_num_threads(threads)
     n = n_r * n_s
-    print(f"batch of {n} variants with friction, building included, medians of {rounds} alternating rounds:")
+    print(f"batch of {n} variants with friction, outputs every {1e3 * output_step:g} ms, building included, "
+          f"medians of {rounds} alternating rounds:")
     base = statistics.median(times["1 thread (build, then run)"])
     for label, ts in times.items():
         med = statistics.median(ts)
@@ -452,6 +455,7 @@ if __name__ == "__main__":
         build_timing()
     elif "--batch" in sys.argv:
         batch_timing(quick="--quick" in sys.argv)
+        batch_timing(quick="--quick" in sys.argv, output_step=1e-2)
     elif "--reference-only" in sys.argv:
         reference_only()
     else:
