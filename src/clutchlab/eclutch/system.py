@@ -197,6 +197,24 @@ def _network(p):
             net_int[NI_UNILATERAL], curve[0], curve[1], curve[2])
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _actuator_point(t, x, u, m, p):
+    """The actuator's states and the bearing's motion at ``(t, x)``: master position [m] and velocity
+    [m/s], master pressure [Pa], line flow [m^3/s], slave pressure [Pa], motor current [A], the input
+    table's value and slope at ``t`` (its active row ``m[nz]``), and the bearing position [m] and velocity
+    [m/s] (the table's, when the bearing motion is prescribed)."""
+    nz = p.nz
+    b0 = 2 * nz
+    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
+    if p.imode == PRESCRIBED:
+        ub = ref
+        v_u = ref_slope
+    else:
+        ub = x[1]
+        v_u = x[nz + 1]
+    return x[0], x[nz], x[b0], x[b0 + 1], x[b0 + 2], x[b0 + 3], ref, ref_slope, ub, v_u
+
+
 @numba.njit(cache=True, nogil=True)
 def rhs(t, x, u, m, p, dx, g):
     """Right-hand side (residual on the algebraic rows) and switching functions of the E-clutch."""
@@ -215,19 +233,7 @@ def rhs(t, x, u, m, p, dx, g):
     n_el = GA.shape[0]
     b0 = 2 * nz
     prescribed = p.imode == PRESCRIBED
-    x_mc = x[0]
-    v_mc = x[nz]
-    p_m = x[b0]
-    Q = x[b0 + 1]
-    p_s = x[b0 + 2]
-    cur = x[b0 + 3]
-    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
-    if prescribed:
-        ub = ref
-        v_u = ref_slope
-    else:
-        ub = x[1]
-        v_u = x[nz + 1]
+    x_mc, v_mc, p_m, Q, p_s, cur, ref, ref_slope, ub, v_u = _actuator_point(t, x, u, m, p)
     # --- clutch network: element forces on the coordinates ([1] Figs. 5b, 10-11)
     q = x[2:nz]
     bearing_force = 0.0
@@ -647,21 +653,8 @@ def jacobian(t, x, u, m, p, J):
     for i in range(n):
         for j in range(n):
             J[i, j] = 0.0
-    x_mc = x[0]
-    v_mc = x[nz]
-    p_m = x[b0]
-    Q = x[b0 + 1]
-    p_s = x[b0 + 2]
-    cur = x[b0 + 3]
-    ref, ref_slope = reference(t, u, p.tin, p.vin, p.interp, m[nz])
-    if prescribed:
-        ub = ref
-        v_u = ref_slope
-        cu = -1  # the bearing position is no state: no column
-    else:
-        ub = x[1]
-        v_u = x[nz + 1]
-        cu = 1
+    x_mc, v_mc, p_m, Q, p_s, cur, ref, ref_slope, ub, v_u = _actuator_point(t, x, u, m, p)
+    cu = -1 if prescribed else 1  # (prescribed: the bearing position is no state, no column)
     e_in = b0 + 5
     e_dis = b0 + 6
     e_fr = b0 + 7

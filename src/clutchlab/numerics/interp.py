@@ -30,14 +30,7 @@ def bracket_range(grid, start, stop, x):
         return start, 0.0
     if x >= grid[_u(stop - 1)]:
         return stop - 2, 1.0
-    lo = start
-    hi = stop - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if grid[_u(mid)] <= x:
-            lo = mid
-        else:
-            hi = mid
+    lo = segment_range(grid, start, stop, x)
     return lo, (x - grid[_u(lo)]) / (grid[_u(lo + 1)] - grid[_u(lo)])
 
 

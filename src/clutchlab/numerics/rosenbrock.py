@@ -154,6 +154,15 @@ def reduction_sizes(n):
     return _HEAD + 6 * n + 2 + 2 * n * n, 2 * n * n + 2 * n
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _plan_views(iw, n):
+    """The plan's index lists in ``iw`` (layout of :func:`plan_reduction`): partner, order, position among
+    the kept rows, the kept rows' sparse pattern (pointers, rows) and the trailing rows' (pointers, columns)."""
+    return (iw[_HEAD + n:_HEAD + 2 * n], iw[_HEAD + 2 * n:_HEAD + 3 * n], iw[_HEAD + 3 * n:_HEAD + 4 * n],
+            iw[_HEAD + 4 * n:_HEAD + 5 * n + 1], iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n],
+            iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n], iw[_HEAD + 6 * n + 2 + n * n:])
+
+
 @numba.njit(cache=True, nogil=True)
 def plan_reduction(J, mass, iw):
     """Classify the states from the non-zeros of the Jacobian ``J`` (once per Jacobian) into ``iw``.
@@ -166,9 +175,7 @@ def plan_reduction(J, mass, iw):
     """
     n = J.shape[0]
     kind = iw[_HEAD:_HEAD + n]
-    partner = iw[_HEAD + n:_HEAD + 2 * n]
-    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
-    posk = iw[_HEAD + 3 * n:_HEAD + 4 * n]
+    partner, order, posk, _mptr, _mrow, tptr, tcol = _plan_views(iw, n)
     for c in range(n):
         trailing = True
         for r in range(n):
@@ -215,8 +222,6 @@ def plan_reduction(J, mass, iw):
     iw[_NTR] = n - n_keep - n_kin
     iw[_MODE] = 1 if n_keep < n else 0
     # the trailing rows' non-zero columns off the diagonal (their back-substitution)
-    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
-    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
     e = 0
     for q in range(n - n_keep - n_kin):
         c = order[n_keep + n_kin + q]
@@ -257,13 +262,7 @@ def reduced_factor(J, mass, hg, G, iw, fw, piv):
     nk = iw[_NK]
     nkin = iw[_NKIN]
     ntr = iw[_NTR]
-    partner = iw[_HEAD + n:_HEAD + 2 * n]
-    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
-    posk = iw[_HEAD + 3 * n:_HEAD + 4 * n]
-    mptr = iw[_HEAD + 4 * n:_HEAD + 5 * n + 1]
-    mrow = iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n]
-    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
-    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
+    partner, order, posk, mptr, mrow, tptr, tcol = _plan_views(iw, n)
     mval = fw[n * n:2 * n * n]
     rdiag = fw[2 * n * n + n:2 * n * n + 2 * n]  # reciprocals of the kinematic and trailing rows' diagonals
     for q in range(nkin):
@@ -321,12 +320,7 @@ def reduced_solve(G, iw, fw, piv, b):
         return
     nk = iw[_NK]
     nkin = iw[_NKIN]
-    partner = iw[_HEAD + n:_HEAD + 2 * n]
-    order = iw[_HEAD + 2 * n:_HEAD + 3 * n]
-    mptr = iw[_HEAD + 4 * n:_HEAD + 5 * n + 1]
-    mrow = iw[_HEAD + 5 * n + 1:_HEAD + 5 * n + 1 + n * n]
-    tptr = iw[_HEAD + 5 * n + 1 + n * n:_HEAD + 6 * n + 2 + n * n]
-    tcol = iw[_HEAD + 6 * n + 2 + n * n:]
+    partner, order, _posk, mptr, mrow, tptr, tcol = _plan_views(iw, n)
     mval = fw[n * n:2 * n * n]
     gr = shaped(fw[:nk * nk], (nk, nk))
     bk = fw[2 * n * n:2 * n * n + nk]
