@@ -29,9 +29,10 @@ def _host(tmp_path, script, *args, known_exit_abort=False):
     """Run ``script`` as a file with a fresh Python; its stdout (return code 0 required).
 
     ``known_exit_abort`` admits exactly one other outcome: SIGABRT with glibc's "corrupted
-    double-linked list" *after* the script printed its results -- the open defect of two
-    instances in one process (docs/fmu.md, "Second instance in one process", about 1 run in
-    20). It is reported as a warning in the test summary, never passed over silently.
+    double-linked list" *after* the script printed its results -- the open defect at interpreter exit
+    (docs/fmu.md, "Second instance in one process": about 1 run in 20 with two instances; "Exit": a
+    single instance in some process layouts). It is reported as a warning in the test summary, never
+    passed over silently.
     """
     path = tmp_path / "host.py"
     path.write_text(script)
@@ -208,7 +209,9 @@ def _docs_example():
 def test_docs_fmpy_example_runs_as_written(tmp_path, build_fmu):
     """The copy-paste example of docs/fmu.md, run as a script next to emtc.fmu, prints the in-process result."""
     (tmp_path / "emtc.fmu").write_bytes(Path(build_fmu("emtc")).read_bytes())
-    out = _host(tmp_path, _docs_example())
+    # (the exit abort of docs/fmu.md "Exit" is admitted after complete results: this host script aborted
+    # at exit in 9 of 10 runs from a fresh venv in one folder and in none of 24 from another, on main too)
+    out = _host(tmp_path, _docs_example(), known_exit_abort=True)
     got = float(re.search(r"coupling torque at 0\.100 s: (\S+) N\.m", out).group(1))
     c = EmtcCoSimulation(**{"actuator.tau1": 0.012})
     c.initial_outputs({})
