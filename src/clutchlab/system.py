@@ -1091,14 +1091,13 @@ def simulate_batch(systems, t_end: float, *, sample_times=None, output_step: flo
             raise ParameterError("simulate_batch: no variants")
         first = batch.system
         ts, opt = _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, max_steps, fixed_step)
-        parts = [_run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity)]
+        records = _run_stacked(core, batch, given, ts, opt, t_end, outputs, event_capacity)
     else:
         if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
             raise ParameterError(f"simulate_batch: chunk = {chunk!r} must be a positive integer")
         first, ts, opt, records = _run_pipelined(core, iter(systems), int(chunk), t_end, sample_times, output_step,
                                                  rtol, atol, max_step, max_steps, fixed_step, outputs, event_capacity)
-        parts = [records]
-    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = parts[0]
+    OX, OM, OY, STATS, EVT, EVC, EVE, EVN = records
     nv, ns, ny = OX.shape[0], ts.size, len(first.outputs)
     status = STATS[:, core.SI_STATUS].copy()
     if check:

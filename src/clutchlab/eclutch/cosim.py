@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..fmu.cosim import (FIXED_STEP_DOC, CoSimulation, Variable, build_parameter_set, fixed_step_parameter,
-                         parameter_set_variables)
+                         parameter_set_variables, step_in_time)
 from ..system import Simulation
 from .actuator import ActuatorParameters
 from .dynamics import EClutch, FrictionParameters
@@ -131,9 +131,8 @@ class EClutchCoSimulation(CoSimulation):
     def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
         reference, voltage = u
-        d = abs(t - self.t)
-        if not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))
-                and -_INF < reference < _INF and -_INF < voltage < _INF):  # every check of do_step, in its order
+        # every check of do_step, in its order, as comparisons
+        if not (step_in_time(self.t, t, dt) and -_INF < reference < _INF and -_INF < voltage < _INF):
             out = self.do_step(t, dt, {"bearing_reference": reference, "motor_voltage": voltage})
             return np.array([out[name] for name in self._names])
         self._held[0] = reference if self._by_reference else voltage

@@ -380,6 +380,13 @@ def fixed_step_parameter(values: dict):
 _INF = math.inf
 
 
+def step_in_time(t_model: float, t: float, dt: float) -> bool:
+    """True if a step of ``dt`` [s] from ``t`` [s] may start from the model at ``t_model`` [s]: the test of
+    :func:`_check_time` as comparisons (NaN and infinities fail them), for the per-step fast paths."""
+    d = abs(t - t_model)
+    return 0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))
+
+
 def _check_time(owner: str, t_model: float, t: float, dt: float):
     if not (math.isfinite(t) and math.isfinite(dt)) or dt <= 0:
         raise SimulationError(f"{owner}.do_step: step size dt = {dt!r} must be > 0 [s]")
@@ -459,8 +466,7 @@ class ContractCoSimulation(CoSimulation):
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
         sim = self.simulation
         t_model = sim.time
-        d = abs(t - t_model)
-        if not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))):
+        if not step_in_time(t_model, t, dt):
             _check_time(type(self).__name__, t_model, t, dt)
         if len(u) or self.inputs:
             self.write_inputs(u)
@@ -686,10 +692,9 @@ class WetCoSimulation(CoSimulation):
     def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
         f, w = u
-        d = abs(t - self.time)
         if (self.simulation is None
-                or not (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t))
-                        and 0.0 <= f <= self._force_max and abs(w) <= self._speed_max)):
+                or not (step_in_time(self.time, t, dt) and 0.0 <= f <= self._force_max
+                        and abs(w) <= self._speed_max)):
             return self._step_checked(t, dt, f, w)
         held = self._held
         held[0] = f
@@ -953,8 +958,7 @@ class EmtcCoSimulation(ContractCoSimulation):
     def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
         torque, throttle, front, rear = u
-        d = abs(t - self.time)
-        if (0.0 < dt < _INF and -_INF < t < _INF and (d <= 1e-9 or d <= 1e-9 * abs(t)) and -_INF < torque < _INF
+        if (step_in_time(self.time, t, dt) and -_INF < torque < _INF
                 and 0.0 <= throttle <= 1.0 and -_INF < front < _INF and -_INF < rear < _INF):
             uv = (torque, throttle, front, rear, 0.0)  # (as input_vector)
         else:  # every check of do_step, in its order

@@ -328,11 +328,11 @@ def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
 
 
 @register_jitable(forceinline=True)
-def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
+def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, i_rec):
     """Record the samples ``ts[i_rec:] <= t_limit`` holding the state at ``t``; returns the next sample index.
 
-    The outputs are written by the model straight into their row of ``rec_y`` (``yb`` is not used: a copy
-    through it read the model's scalar stores back as vectors, a store-forwarding stall per sample).
+    The outputs are written by the model straight into their row of ``rec_y`` (a copy through a work
+    vector read the model's scalar stores back as vectors, a store-forwarding stall per sample).
     """
     while i_rec < ts.shape[0] and ts[i_rec] <= t_limit:
         _store(rec_t, rec_x, rec_m, i_rec, ts[i_rec], x, m)
@@ -343,12 +343,11 @@ def _record_held(p, t, t_limit, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
 
 
 @register_jitable(forceinline=True)
-def _record_dense(p, t, h, x0, f0, x1, f1, rc, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb,
+def _record_dense(p, t, h, x0, f0, x1, f1, rc, mass, t_limit, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y,
                   xe, i_rec):
     """Record the samples in ``(t, t_limit]`` on the dense output of a step of length ``h``; returns the next index.
 
-    The model's outputs are written straight into their row of ``rec_y`` (``yb`` is not used: see
-    :func:`_record_held`).  They are evaluated at the work copy ``xe`` of the recorded state, not at its row
+    The model's outputs are written straight into their row of ``rec_y`` (see :func:`_record_held`).  They are evaluated at the work copy ``xe`` of the recorded state, not at its row
     of ``rec_x``: with the row the recorded states of the EMTC AWD driveline example changed (by 4e-11), so a
     hook may not leave the state it is given untouched.
     """
@@ -363,9 +362,9 @@ def _record_dense(p, t, h, x0, f0, x1, f1, rc, mass, t_limit, u, m, ts, rec_t, r
 
 
 @register_jitable(forceinline=True)
-def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec):
+def _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec):
     """Record the point ``(t, x, m)`` in the step record if it has room; returns the next row (outputs
-    written straight into their row of ``rec_y``, ``yb`` unused: see :func:`_record_held`)."""
+    written straight into their row of ``rec_y``: see :func:`_record_held`)."""
     if i_rec < rec_t.shape[0]:
         _store(rec_t, rec_x, rec_m, i_rec, t, x, m)
         if want_y:
@@ -446,11 +445,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     g1 = np.empty(ng)
     ge = np.empty(ng)
     ga = np.empty(ng)
-    yb = np.empty(rec_y.shape[1])
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, yb, tab_c)
-    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, yb, tab_c = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c)
+    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c = borrow(owners)
     k1 = K[0]
     k2 = K[1]
     k3 = K[2]
@@ -471,9 +469,9 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     if si[SI_STARTED] == 0:
         si[SI_STARTED] = 1
         if grid:
-            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
         else:
-            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
         if opt.first_step > 0.0:
             h = opt.first_step
         else:
@@ -586,7 +584,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         # ---- samples in (t, t_new] on the dense output (modes of the step; the test here saves a call per step)
         if samples and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
             i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                                  want_y, yb, xe, i_rec)
+                                  want_y, xe, i_rec)
         si[SI_ACCEPTED] += 1
         if theta <= 1.0:
             _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
@@ -612,7 +610,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if flag == 1:
                 status = TERMINATED
                 if not grid:
-                    i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+                    i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
                 break
         else:
             for i in range(n):
@@ -632,10 +630,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             h = next_step(h, en, prev_rej)
         prev_rej = False
         if not grid:
-            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
     if grid and status == SUCCESS:  # samples at the end time itself (rounding) hold the final state
         i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                             want_y, yb, i_rec)
+                             want_y, i_rec)
     return _save_state(sf, si, t, h, i_rec, status, owners)
 
 
@@ -791,12 +789,11 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     xp = np.empty(n)
     err = np.empty(n)
     dls = np.empty(n)
-    yb = np.empty(rec_y.shape[1])
     rc0 = np.zeros(n)  # no order-4 term in the dense output: Rodas3 is of order 3
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
+    owners = (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls,
               rc0)
-    (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls, yb,
+    (f0, f1, ft, fp, g0, g1, gp, ga, J, G, piv, iw, fw, K1, K2, K3, K4, xtmp, ftmp, x1, xe, xp, err, dls,
      rc0) = borrow(owners)
     t = sf[SF_T]
     h = sf[SF_H]
@@ -808,9 +805,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     if si[SI_STARTED] == 0:
         si[SI_STARTED] = 1
         if grid:
-            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_held(p, t, t, x, u, m, ts, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
         else:
-            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
         h = opt.first_step if opt.first_step > 0.0 else 1e-5
         sf[SF_T0] = t
     if h <= 0.0:
@@ -856,7 +853,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             si[SI_NRHS] += 1
             if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
                 i_rec = _record_dense(p, t, h, x, f0, x1, f1, rc0, mass, t_new, u, m, ts, rec_t, rec_x, rec_m,
-                                      rec_y, want_y, yb, xe, i_rec)
+                                      rec_y, want_y, xe, i_rec)
             si[SI_ACCEPTED] += 1
             for i in range(n):
                 x[i] = x1[i]
@@ -876,7 +873,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             model.rhs(t, x, u, m, p, f0, g0)
             si[SI_NRHS] += 1
             if not grid:
-                i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+                i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
             if flag == 1:
                 status = TERMINATED
                 break
@@ -955,7 +952,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             t_new = t_stop
         if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
             i_rec = _record_dense(p, t, h_acc, x, f0, x1, f1, rc0, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                                  want_y, yb, xe, i_rec)
+                                  want_y, xe, i_rec)
         si[SI_ACCEPTED] += 1
         for i in range(n):
             x[i] = x1[i]
@@ -979,7 +976,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         need_jac = True
         jac_age += 1
         if not grid:
-            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, yb, i_rec)
+            i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
         if flag == 1:
             status = TERMINATED
             break
@@ -989,7 +986,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         rejected_before = False
     if grid and status == SUCCESS:  # samples at the end time itself (rounding) hold the final state
         i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                             want_y, yb, i_rec)
+                             want_y, i_rec)
     return _save_state(sf, si, t, h, i_rec, status, owners)
 
 
