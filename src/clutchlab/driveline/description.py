@@ -28,12 +28,14 @@
 
 Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
-``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio, efficiency), ``torque`` (flange, torque,
+``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|,
+eta_mf1, eta_mf2, tau_bf1, tau_bf2]`` as MSL's ``lossTable``, support = the housing's inertia), ``torque`` (flange, torque,
 support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
 peak, cgeo, normal; or mu_map = a friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
 temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support; mu_map, radius, temperature),
 ``bearing_friction``
-(flange, torque, peak, support), ``one_way_clutch`` (a, b), ``eclutch`` (a, b, position [m], model
+(flange, torque, peak, support), ``one_way_clutch`` (a, b; fn_max, mu, peak, cgeo, normal: MSL's
+``OneWayClutch``), ``eclutch`` (a, b, position [m], model
 0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak; actuator = true: the
 position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
 (flange, torque_map = ``{ speeds, throttles, torques }`` or full-load rows ``[[w, T], ...]``, throttle,
@@ -75,7 +77,8 @@ FIELDS = {
                "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
     "backlash": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", True), "b_gap": ("rad", True),
                  "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
-    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True), "efficiency": ("1", False)},
+    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True), "efficiency": ("1", False),
+             "loss_table": ("losstable", False), "support": (None, False)},
     "torque": {"flange": (None, True), "torque": ("N*m", True), "support": (None, False)},
     "speed": {"flange": (None, True), "speed": ("rad/s", True)},
     "position": {"flange": (None, True), "position": ("rad", True)},
@@ -87,7 +90,8 @@ FIELDS = {
               "radius": ("m", False), "temperature": ("degC", False)},
     "bearing_friction": {"flange": (None, True), "torque": ("N*m", False), "peak": ("1", False),
                          "support": (None, False)},
-    "one_way_clutch": {"a": (None, True), "b": (None, True)},
+    "one_way_clutch": {"a": (None, True), "b": (None, True), "fn_max": ("N", False), "mu": ("1", False),
+                       "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False)},
     "eclutch": {"a": (None, True), "b": (None, True), "position": ("m", True), "model": ("int", False),
                 "parameters": ("path", False), "travel": ("m", False), "points": ("int", False),
                 "peak": ("1", False), "actuator": ("bool", False), "actuator_step": ("s", False),
@@ -101,7 +105,7 @@ FIELDS = {
     "emtc": {"a": (None, True), "b": (None, True), "bench": ("path", False), "magnet": ("path", False)},
 }
 #: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("text", "int", "path", "bool", "map")
+NOT_QUANTITIES = ("text", "int", "path", "bool", "map", "losstable")
 #: a translational driveline: masses and forces, the units of its domain
 _TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
 _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
@@ -111,7 +115,8 @@ TRANSLATIONAL_FIELDS = {
     for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch", "engine", "emtc")}
 #: signal fields carrying the signal's own unit, per component table
 _SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
-            "brake": "normal", "eclutch": "position", "wet_clutch": "force", "engine": "throttle"}
+            "brake": "normal", "eclutch": "position", "wet_clutch": "force", "engine": "throttle",
+            "one_way_clutch": "normal"}
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -205,6 +210,25 @@ def _characteristic(value, unit, key, src, x_unit="rad/s", table_only=False):
     if table_only:
         raise ParameterError(f"{src}: {key} = {value!r}: expected rows [[{x_unit}, {unit}], ...]")
     return _quantity(value, unit, key, src)
+
+
+#: the columns of a gear's loss table (MSL ``LossyGear.lossTable``) and their units
+LOSS_TABLE_COLUMNS = ("w", "eta_mf1", "eta_mf2", "tau_bf1", "tau_bf2")
+
+
+def _loss_table(value, key, src, speed_unit="rad/s", torque_unit="N*m"):
+    """A gear's loss table: rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]`` (speed, two efficiencies, two
+    bearing friction torques), each entry a number in SI or a quantity with its unit, converted to SI."""
+    if not isinstance(value, list) or not value:
+        raise ParameterError(f"{src}: {key} = {value!r}: expected rows [w, eta_mf1, eta_mf2, tau_bf1, tau_bf2]")
+    units = (speed_unit, "1", "1", torque_unit, torque_unit)
+    rows = []
+    for i, row in enumerate(value):
+        if not (isinstance(row, list) and len(row) == 5):
+            raise ParameterError(f"{src}: {key}[{i}] = {row!r}: expected a row of 5 "
+                                 f"[{', '.join(LOSS_TABLE_COLUMNS)}]")
+        rows.append([_quantity(v, u, f"{key}[{i}][{j}]", src) for j, (v, u) in enumerate(zip(row, units))])
+    return rows
 
 
 def _engine_map(value, key, src):
@@ -394,6 +418,8 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                     args[f] = v
                 elif unit == "map":
                     args[f] = _engine_map(v, fkey, src)
+                elif unit == "losstable":
+                    args[f] = _loss_table(v, fkey, src, speed_unit, "N*m" if domain == "rotational" else "N")
                 elif unit == "int":
                     if not isinstance(v, int) or isinstance(v, bool):
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")

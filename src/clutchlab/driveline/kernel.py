@@ -60,30 +60,40 @@ LASH_VALUES = ("gap", "upper", "lower")
 STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
 MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Forward 1, Backward -1, Free 2
-# events: named for the mode entered (friction), or for a backlash closing or opening its gap
-EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B, EV_LOCKED = range(9)
-EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives", "locked")
+# events: named for the mode entered (friction and lossy gears: stick, forward, backward; a lossy gear's driving
+# flange: a_drives, b_drives), or for a backlash closing or opening its gap
+EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = range(8)
+EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 # signals
 SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
 # columns of ``elem`` (ints) and ``coef`` (floats)
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE = range(10)  # E_AUX: a curve's kind
-N_ELEM = 10      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE: index in m; E_STATE: of a controller state
+E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = range(11)  # E_AUX: a curve's kind
+N_ELEM = 11      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE: index in m; E_STATE: of a controller state;
+#                  E_SUP: a gear's support (housing) inertia, -1 the ground
 C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
 C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
 C_NCURVE, C_LIFTOFF = 3, 4                         # friction with a normal-force curve (E_AUX points): its
-C_RATIO, C_ETA = 0, 1                              # data offset and lift-off input; gear: w_a = ratio * w_b, efficiency
+C_RATIO = 0                                        # data offset and lift-off input; gear: w_a = ratio * w_b (its loss
+#                                                    table, MSL lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2,
+#                                                    tau_bf1, tau_bf2, stored column by column at E_TABLE)
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = 0, 1, 2, 3   # an engine's idle controller: set speed [rad/s], gains
                                                    # [N m s/rad], [N m/rad], torque limit [N m]
 N_COEF = 5
-# modes of a lossy gear (after the switched springs' in the mode vector): the flange that drives (power flows
-# from it into the gear)
-DRIVE_A, DRIVE_B, DRIVE_LOCKED = 0, 1, 2
-DRIVE_VALUES = ("a_drives", "b_drives", "locked")
+# modes of a lossy gear (after the switched springs' in the mode vector; MSL LossyGear): stuck (locked), or rolling
+# forward (w_a > 0) or backward, with the flange that drives (MSL's quadrants: tau_eta >= 0 forward is quadrant 1,
+# flange a drives; < 0 quadrant 2, b drives; backward tau_eta >= 0 quadrant 4, b drives; < 0 quadrant 3, a drives)
+GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = 0, 1, 2, 3, 4
+GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
+GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
 # switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves),
-# then one per lossy gear (``lossy``: the power it takes from its driving flange)
+# then two per lossy gear (``lossy``: its stick or break-away function, and its driving flange's)
 G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
 N_G = 3
+#: relative size of rounding in the torques of the constraint set (the thresholds of the stick/slip decisions
+#: and of the switching functions that watch them, which must agree: after a decision every function watching it
+#: is > 0, so that its next crossing is seen)
+NOISE = 1e-12
 
 
 class DrivelineParams(NamedTuple):
@@ -95,8 +105,8 @@ class DrivelineParams(NamedTuple):
     friction characteristics, spring curves and signal tables); ``fric`` (int64): the element row of
     each friction element; ``cons``: of each constraint (gears and motion sources, always held);
     ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
-    ``elem[r, E_MODE]``); ``lossy``: of each gear with an efficiency below 1 (its mode, the driving flange, at
-    ``elem[r, E_MODE]``); ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
+    ``elem[r, E_MODE]``); ``lossy``: of each gear with losses (MSL ``LossyGear``; its mode at ``elem[r, E_MODE]``);
+    ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
     scratch of the hooks (per run).
     """
 
@@ -217,20 +227,22 @@ def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
     Clutch and brake (MSL ``Clutch``/``Brake``): ``cgeo * fn * mu(|w|)`` with ``fn = fn_max * f(t)``;
-    bearing friction (``BearingFriction``): the table itself; a one-way clutch (freewheel): none while it
-    overruns.  At ``w = 0`` this is ``tau0``; the static limit is ``peak * tau0``.
+    bearing friction (``BearingFriction``): the table itself; a one-way clutch (MSL ``OneWayClutch``: a
+    freewheel in parallel with a clutch): its clutch's ``cgeo * max(fn, 0) * mu(|w|)`` while it overruns (none
+    without a normal force).  At ``w = 0`` this is ``tau0``; the static limit is ``peak * tau0``.
     """
     e = p.elem[r]
     law = e[E_LAW]
-    if law == LAW_ONEWAY:
-        return 0.0
     if law == LAW_EXTERNAL:
         return _external(p)[3 * e[E_AUX]]
     c = p.coef[r]
     val = _characteristic(p.data, e[E_TABLE], e[E_TABLE_N], w_abs)
     if law == LAW_TABLE:
         return val
-    return c[C_CGEO] * normal_force(p, r, t) * val
+    fn = normal_force(p, r, t)
+    if law == LAW_ONEWAY:
+        fn = max(fn, 0.0)
+    return c[C_CGEO] * fn * val
 
 
 @numba.njit(cache=True, nogil=True)
@@ -240,7 +252,7 @@ def normal_force(p, r, t):
     the signal is then the actuator input (the release bearing position [m])."""
     e = p.elem[r]
     f = 1.0 if e[E_SIGNAL] < 0 else signal_value(p.signals[e[E_SIGNAL]], p.data, t)
-    if e[E_AUX] > 0:
+    if e[E_AUX] > 0 and e[E_LAW] == LAW_CLUTCH:
         f = _table(p.data, int(p.coef[r][C_NCURVE]), e[E_AUX], f)
     return p.coef[r][C_FN_MAX] * f
 
@@ -248,7 +260,8 @@ def normal_force(p, r, t):
 @numba.njit(cache=True, nogil=True)
 def _is_free(p, r, t):
     """A clutch or brake is free when its normal force is negative, or zero and not rising (a force that
-    leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing)."""
+    leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing).
+    A one-way clutch is never free (its freewheel locks whatever its clutch's force)."""
     e = p.elem[r]
     if e[E_LAW] != LAW_CLUTCH:
         return False
@@ -270,9 +283,8 @@ def _is_free(p, r, t):
 
 @numba.njit(cache=True, nogil=True)
 def static_limit(p, r, t):
-    """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: inf)."""
-    if p.elem[r][E_LAW] == LAW_ONEWAY:
-        return np.inf
+    """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
+    clutch's, the most it holds against overrunning)."""
     if p.elem[r][E_LAW] == LAW_EXTERNAL:
         return _external(p)[3 * p.elem[r][E_AUX] + 1]
     return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
@@ -281,9 +293,10 @@ def static_limit(p, r, t):
 @numba.njit(cache=True, nogil=True)
 def holding_limit(p, r, t, tau):
     """Largest ``|tau|`` [N m] a stuck friction element row ``r`` holds in the direction of ``tau``: its static
-    limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and none for it (``tau > 0``)."""
-    if p.elem[r][E_LAW] == LAW_ONEWAY:
-        return 0.0 if tau > 0.0 else np.inf
+    limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and its clutch's static limit
+    (zero without a normal force) for it (``tau > 0``)."""
+    if p.elem[r][E_LAW] == LAW_ONEWAY and tau <= 0.0:
+        return np.inf
     return static_limit(p, r, t)
 
 
@@ -471,9 +484,10 @@ def _speed(x, n, i):
 
 @numba.njit(cache=True, nogil=True)
 def _coefficients(p, r):
-    """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a``, its torque ``tau`` acts
-    ``+ca tau`` on flange a and ``-cb tau`` on flange b.  A gear (MSL ``IdealGear``, ``w_a = ratio w_b``):
-    ``ca = 1, cb = ratio``; a motion source: ``ca = 0`` (ground); others 1, 1."""
+    """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a`` (a gear's, against its
+    support: ``ratio (w_b - w_s) - (w_a - w_s)``), its torque ``tau`` acts ``+ca tau`` on flange a and ``-cb tau``
+    on flange b.  A gear (MSL ``IdealGear``, ``w_a = ratio w_b``): ``ca = 1, cb = ratio``; a motion source:
+    ``ca = 0`` (ground); others 1, 1."""
     e = p.elem[r]
     if e[E_KIND] == K_GEAR:
         return 1.0, p.coef[r][C_RATIO]
@@ -482,32 +496,106 @@ def _coefficients(p, r):
     return 1.0, 1.0
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _gear_column(data, start, n, col, w):
+    """Column ``col`` (1 eta_mf1, 2 eta_mf2, 3 tau_bf1, 4 tau_bf2) of a gear's loss table at ``|w_a| = w``: linear
+    between rows, extrapolated from the last two (MSL ``LossyGear``: ``LinearSegments``, ``LastTwoPoints``)."""
+    if n == 1 or w <= data[start]:
+        return data[start + col * n]
+    if w >= data[start + n - 1]:
+        x0, x1 = data[start + n - 2], data[start + n - 1]
+        y0, y1 = data[start + col * n + n - 2], data[start + col * n + n - 1]
+        return y1 + (y1 - y0) * (w - x1) / (x1 - x0)
+    lo, wt = bracket(data[start:start + n], w)
+    return data[start + col * n + lo] + wt * (data[start + col * n + lo + 1] - data[start + col * n + lo])
+
+
 @numba.njit(cache=True, nogil=True)
-def _force_factor(p, r, m):
-    """Factor on the torque a gear row ``r`` puts on flange b: its efficiency ``eta`` while flange a drives, ``1 /
-    eta`` while b drives (a lossy gear's mode in ``m``); 1 for everything else."""
+def gear_losses(p, r, w_abs):
+    """Mesh efficiencies and bearing friction of lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (MSL
+    ``LossyGear``): ``(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a)``: efficiency while flange a drives [-], while
+    b drives [-], the resultant bearing friction with respect to flange a in those two cases [N m] (absolute
+    values), and the bearing friction on flange a's side, ``(tau_bf1 - tau_bf2) / (eta_mf1 - 1/eta_mf2)`` (half of
+    ``tau_bf1`` where both efficiencies are 1: MSL's arbitrary split)."""
     e = p.elem[r]
-    if e[E_KIND] != K_GEAR or e[E_MODE] < 0:
-        return 1.0
-    eta = p.coef[r][C_ETA]
-    mode = m[e[E_MODE]]
-    return eta if mode == DRIVE_A else (1.0 / eta if mode == DRIVE_B else 1.0)
+    s, n = e[E_TABLE], e[E_TABLE_N]
+    eta1 = _gear_column(p.data, s, n, 1, w_abs)
+    eta2 = _gear_column(p.data, s, n, 2, w_abs)
+    bf1 = abs(_gear_column(p.data, s, n, 3, w_abs))
+    bf2 = abs(_gear_column(p.data, s, n, 4, w_abs))
+    if abs(eta1 - 1.0) <= 2.2e-16 and abs(eta2 - 1.0) <= 2.2e-16:
+        bfa = 0.5 * bf1
+    else:
+        bfa = (bf1 - bf2) / (eta1 - 1.0 / eta2)
+    return eta1, eta2, bf1, bf2, bfa
 
 
 @numba.njit(cache=True, nogil=True)
-def gear_loss(p, r, m, w_a, tau):
-    """Power [W] lost in a gear row ``r`` carrying ``tau`` (its torque on flange a) at flange a's speed ``w_a``:
-    ``(1 - f) P_a`` with ``P_a = -tau w_a`` the power flange a delivers and ``f`` :func:`_force_factor` (zero for
-    an ideal gear; non-negative in a consistent mode)."""
-    return (1.0 - _force_factor(p, r, m)) * (-tau * w_a)
+def gear_transfer(p, r, mode, w_abs):
+    """Torque law of a rolling lossy gear row ``r`` in ``mode``: ``(f, c)`` with the torque on flange b's inertia
+    ``ratio (f T_a - c)`` [N m], ``T_a = -tau`` the torque flange a's side applies to the gear (MSL
+    ``flange_a.tau``), from MSL ``LossyGear``'s torque balance ``0 = flange_b.tau + ratio (flange_a.tau -
+    tauLoss)`` with the loss torque of its quadrant: forward, flange a driving (quadrant 1, ``tauLoss = (1 - eta_mf1)
+    T_a + tau_bf1``): ``f = eta_mf1, c = tau_bf1``; forward, b driving (quadrant 2, ``(1 - 1/eta_mf2) T_a +
+    tau_bf2``): ``1/eta_mf2, tau_bf2``; backward, b driving (quadrant 4): ``1/eta_mf2, -tau_bf2``; backward, a
+    driving (quadrant 3): ``eta_mf1, -tau_bf1``.  Stuck or ideal: ``1, 0``."""
+    eta1, eta2, bf1, bf2, _bfa = gear_losses(p, r, w_abs)
+    if mode == GEAR_FWD_A:
+        return eta1, bf1
+    if mode == GEAR_FWD_B:
+        return 1.0 / eta2, bf2
+    if mode == GEAR_BWD_B:
+        return 1.0 / eta2, -bf2
+    if mode == GEAR_BWD_A:
+        return eta1, -bf1
+    return 1.0, 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def gear_band(p, r, t_a):
+    """The loss torques that bound a stuck lossy gear row ``r`` carrying ``T_a`` [N m] on flange a (MSL
+    ``LossyGear``, from the table at ``w_a = 0``): ``(tauLossMin_m, tauLossMax_p)``.  It rolls forward when the
+    loss torque it holds exceeds ``tauLossMax_p`` (``quadrant1_p`` if ``T_a - tau_bf_a0 > 0`` else
+    ``quadrant2_p``) and backward when it falls below ``tauLossMin_m`` (``quadrant4_m`` if ``T_a + tau_bf_a0 > 0``
+    else ``quadrant3_m``)."""
+    eta1, eta2, bf1, bf2, bfa = gear_losses(p, r, 0.0)
+    hi = (1.0 - eta1) * t_a + bf1 if t_a - bfa > 0.0 else (1.0 - 1.0 / eta2) * t_a + bf2
+    lo = (1.0 - 1.0 / eta2) * t_a - bf2 if t_a + bfa > 0.0 else (1.0 - eta1) * t_a - bf1
+    return lo, hi
+
+
+@numba.njit(cache=True, nogil=True)
+def gear_tau_eta(p, r, mode, t_a, w_abs):
+    """MSL ``LossyGear.tau_eta`` [N m] of a rolling gear: ``T_a - tau_bf_a`` forward, ``T_a + tau_bf_a``
+    backward; its sign decides the quadrant (which flange drives)."""
+    _e1, _e2, _b1, _b2, bfa = gear_losses(p, r, w_abs)
+    return t_a - bfa if mode == GEAR_FWD_A or mode == GEAR_FWD_B else t_a + bfa
+
+
+@numba.njit(cache=True, nogil=True)
+def gear_speed(p, r, x, n):
+    """Speed of flange a against the gear's support ``w_a - w_s`` [rad/s] (MSL ``LossyGear.w_a``)."""
+    e = p.elem[r]
+    return _speed(x, n, e[E_A]) - _speed(x, n, e[E_SUP])
+
+
+@numba.njit(cache=True, nogil=True)
+def _gear_mode(p, r, m):
+    """The mode of gear row ``r`` (``GEAR_STUCK`` for an ideal one, which has none)."""
+    mi = p.elem[r][E_MODE]
+    return m[mi] if mi >= 0 else GEAR_STUCK
 
 
 @numba.njit(cache=True, nogil=True)
 def relative_speed(p, r, x, n):
-    """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears)."""
+    """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears, whose
+    constraint speed is ``ratio (w_b - w_s) - (w_a - w_s)``, zero but for drift)."""
     e = p.elem[r]
     ca, cb = _coefficients(p, r)
-    return cb * _speed(x, n, e[E_B]) - ca * _speed(x, n, e[E_A])
+    v = cb * _speed(x, n, e[E_B]) - ca * _speed(x, n, e[E_A])
+    if e[E_KIND] == K_GEAR:
+        v += (ca - cb) * _speed(x, n, e[E_SUP])
+    return v
 
 
 @numba.njit(cache=True, nogil=True)
@@ -519,13 +607,21 @@ def _apply(F, e, ca, cb, tq):
 
 
 @numba.njit(cache=True, nogil=True)
+def _add(F, i, v):
+    if i >= 0:
+        F[i] += v
+
+
+@numba.njit(cache=True, nogil=True)
 def evaluate_network(t, x, m, p, acc, tau):
     """Accelerations ``acc`` [rad/s^2] of the inertias and the torque ``tau`` [N m] of every element.
 
     Spring-dampers :func:`spring_torque`; torque sources: their signal (acting on flange b, positive
     accelerating it, so ``tau`` is stored with the element convention as minus the source torque);
-    sliding friction ``+-friction_torque``; free friction 0; stuck friction, gears and motion sources:
-    the solution of the constraint set (:func:`_solve_stuck`).  Returns the size of that set.
+    sliding friction ``+-friction_torque``; free friction 0; the bearing-friction part of a rolling lossy gear
+    (its constant torques ``-ratio c`` on flange b and ``+ratio c`` on the support, :func:`gear_transfer`);
+    stuck friction, gears, stuck lossy gears' holds and motion sources: the solution of the constraint set
+    (:func:`_solve_stuck`).  Returns the size of that set.
     """
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
@@ -549,7 +645,7 @@ def evaluate_network(t, x, m, p, acc, tau):
         _apply(F, e, 1.0, 1.0, tq)
     # sliding and free friction; the constraint set: stuck friction, gears, motion sources
     ns = 0
-    stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a locked gear's hold)
+    stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a stuck lossy gear's hold)
     for k in range(nf):
         r = p.fric[k]
         e = p.elem[r]
@@ -570,26 +666,38 @@ def evaluate_network(t, x, m, p, acc, tau):
     for k in range(nc):
         stuck[ns] = p.cons[k]
         ns += 1
-    for j in range(p.lossy.shape[0]):   # a locked lossy gear holds flange a at rest (member -(row + 1))
+    for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
-        if m[p.elem[r][E_MODE]] == DRIVE_LOCKED:
+        e = p.elem[r]
+        mode = m[e[E_MODE]]
+        if mode == GEAR_STUCK:   # a stuck gear holds flange a against its support (member -(row + 1))
             stuck[ns] = -(r + 1)
             ns += 1
+        else:                    # the bearing friction of a rolling gear: constant torques on b and the support
+            _f, c = gear_transfer(p, r, mode, abs(gear_speed(p, r, x, n)))
+            ratio = p.coef[r][C_RATIO]
+            _add(F, e[E_B], -ratio * c)
+            _add(F, e[E_SUP], ratio * c)
+    hold = _holds(p)
+    for j in range(hold.shape[0]):
+        hold[j] = 0.0
     if ns > 0:
-        _solve_stuck(t, p, m, stuck, ns, F, tau)
+        _solve_stuck(t, x, p, m, stuck, ns, F, tau)
     for i in range(n):
         acc[i] = F[i] / p.inertia[i]
     return ns
 
 
 @numba.njit(cache=True, nogil=True)
-def _layout(n, nk, ne):
+def _layout(n, nk, ne, nf=0, nl=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
-    (nk) | flange a, ca, flange b, cb, force factor of each member (5 nk) | accelerations (n) | element torques (ne) |
-    slack of each friction element's stick function (nf, :func:`settle`) | sliding torque, static limit and
-    lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | initial stored
-    energy (1)."""
+    (nk) | three flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds,
+    null vector, its scratch, a trial split, breakpoints (11 nk + 2) | accelerations (n) | element torques (ne) | slack of each friction element's
+    and lossy gear's stick function (nf + nl, :func:`settle`) | the loss torque each lossy gear holds or carries
+    (nl) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    :func:`set_external`) | initial stored energy (1).  Returns the offsets of A, A + eps D, right-hand side,
+    torques, weights, residual, member flanges, bounds, accelerations, element torques, slack, holds."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -597,51 +705,59 @@ def _layout(n, nk, ne):
     o_c = o_l + nk
     o_r = o_c + nk
     o_g = o_r + nk
-    o_acc = o_g + 5 * nk
+    o_lim = o_g + 9 * nk
+    o_acc = o_lim + 11 * nk + 2
     o_tau = o_acc + n
-    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_acc, o_tau
+    o_slack = o_tau + ne
+    o_hold = o_slack + nf + nl
+    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_hold
 
 
-def work_size(n, nk, ne, nf, nx=0):
-    """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` friction elements and constraints, ``ne``
-    elements, ``nf`` friction elements, ``nx`` clutch models with states of their own."""
-    return 2 * n + 11 * nk + 2 * nk * nk + ne + nf + 3 * nx + 1
+def work_size(n, nk, ne, nf, nx=0, nl=0):
+    """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
+    elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears (the
+    layout of :func:`_layout`)."""
+    return _layout.py_func(n, nk, ne, nf, nl)[-1] + nl + 3 * nx + 1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _nk(p):
     """Largest constraint set: every friction element, every gear and motion source, and the hold of every lossy
-    gear (``DRIVE_LOCKED``)."""
+    gear (``GEAR_STUCK``)."""
     return p.fric.shape[0] + p.cons.shape[0] + p.lossy.shape[0]
 
 
 @numba.njit(cache=True, nogil=True)
+def _offsets(p):
+    return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0])
+
+
+@numba.njit(cache=True, nogil=True)
 def _acc_tau(p):
-    n = p.inertia.shape[0]
-    nk = _nk(p)
-    ne = p.elem.shape[0]
-    o = _layout(n, nk, ne)
-    return p.work[o[7]:o[7] + n], p.work[o[8]:o[8] + ne]
+    o = _offsets(p)
+    return p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]
 
 
 @numba.njit(cache=True, nogil=True)
 def _slack(p):
-    n = p.inertia.shape[0]
-    nf = p.fric.shape[0]
-    ne = p.elem.shape[0]
-    o = _layout(n, _nk(p), ne)
-    return p.work[o[8] + ne:o[8] + ne + nf]
+    """Slack of the stick functions: the friction elements', then the lossy gears'."""
+    o = _offsets(p)
+    return p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]]
+
+
+@numba.njit(cache=True, nogil=True)
+def _holds(p):
+    """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
+    o = _offsets(p)
+    return p.work[o[11]:o[11] + p.lossy.shape[0]]
 
 
 @numba.njit(cache=True, nogil=True)
 def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
-    n = p.inertia.shape[0]
-    nf = p.fric.shape[0]
-    ne = p.elem.shape[0]
-    o = _layout(n, _nk(p), ne)
-    return p.work[o[8] + ne + nf:p.work.shape[0] - 1]
+    o = _offsets(p)
+    return p.work[o[11] + p.lossy.shape[0]:p.work.shape[0] - 1]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -658,90 +774,278 @@ def set_external(p, j, slide, limit, lock):
 
 
 @numba.njit(cache=True, nogil=True)
-def _solve_stuck(t, p, m, stuck, ns, F, tau):
-    """Torques of the constraint set -- stuck friction elements, gears, motion sources -- solved together.
+def _member(p, m, x, n, rk, fl, gc, hc, k):
+    """Flanges (three, -1 for none or the ground; stored as floats), constraint weights ``g`` and torque weights
+    ``h`` of constraint member ``k`` (element row ``rk``, or ``-(row + 1)`` for a stuck lossy gear's hold): the
+    member holds ``g . alpha`` at its target and its multiplier ``lam`` puts the torques ``-lam h`` on the inertias.
 
-    Each member ``k`` holds its relative acceleration ``g_k^T a`` (``g_k = cb e_b - ca e_a``) at its
-    target: zero, or the prescribed acceleration of a motion source.  ``A lam = g^T M^-1 F - target``
-    with ``A[k, j] = g_k^T M^-1 h_j``, ``h_j`` the flange weights of member ``j``'s torque: ``g_j``, but for
-    a lossy gear (efficiency ``eta``, MSL ``LossyGear`` without bearing friction), whose torque on flange b
-    is ``-ratio f lam`` with ``f = eta`` while flange a drives (mode ``DRIVE_A``) and ``1 / eta`` while b
-    drives: the loss is taken from the driving side.  Where stuck elements lock the same relative motion (two clutches
-    in parallel) ``A`` is singular: the torque is then split in proportion to the static limits, the
-    solution minimising ``sum(lam_k^2 / limit_k)`` (one-way clutches, gears and motion sources weigh as
-    the strongest friction element).  It comes from ``(A + eps D) lam = b`` with ``D = diag(max limit /
-    limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal (whose solution has ``D lam`` in the range of ``A``:
-    the proportional split), refined twice on the residual of ``A lam = b`` (the constraints hold to
-    rounding; the split to about 1e-8).  ``F`` is updated with the torques.
+    Friction, motion sources: ``g = h = cb e_b - ca e_a``.  A gear against its support ``s`` (MSL ``IdealGear``,
+    ``LossyGear`` with ``phi_a - phi_s = ratio (phi_b - phi_s)``): ``g = ratio e_b - e_a + (1 - ratio) e_s``, ``lam =
+    -T_a`` the torque on flange a, ``h = ratio f e_b - e_a + (1 - ratio f) e_s`` with ``f`` of its mode
+    (:func:`gear_transfer`; 1 ideal or stuck).  The hold of a stuck lossy gear: ``g = e_a - e_s`` (flange a at rest
+    on its support), its multiplier the loss torque ``tauLoss`` the gear holds, ``h = ratio (e_b - e_s)`` (MSL:
+    ``flange_b.tau = -ratio (flange_a.tau - tauLoss)``)."""
+    o = 3 * k
+    if rk < 0:
+        r = -rk - 1
+        e = p.elem[r]
+        ratio = p.coef[r][C_RATIO]
+        fl[o], fl[o + 1], fl[o + 2] = e[E_A], e[E_B], e[E_SUP]
+        gc[o], gc[o + 1], gc[o + 2] = 1.0, 0.0, -1.0
+        hc[o], hc[o + 1], hc[o + 2] = 0.0, ratio, -ratio
+        return
+    e = p.elem[rk]
+    ca, cb = _coefficients(p, rk)
+    fl[o], fl[o + 1], fl[o + 2] = e[E_A], e[E_B], -1
+    gc[o], gc[o + 1], gc[o + 2] = -ca, cb, 0.0
+    hc[o], hc[o + 1], hc[o + 2] = -ca, cb, 0.0
+    if e[E_KIND] == K_GEAR:
+        f = 1.0
+        if e[E_MODE] >= 0 and m[e[E_MODE]] != GEAR_STUCK:
+            f, _c = gear_transfer(p, rk, m[e[E_MODE]], abs(gear_speed(p, rk, x, n)))
+        fl[o + 2] = e[E_SUP]
+        gc[o + 2] = ca - cb
+        hc[o + 1] = cb * f
+        hc[o + 2] = ca - cb * f
+
+
+@numba.njit(cache=True, nogil=True)
+def _in_band(p, r, t_a, hold, tol):
+    """True if a stuck lossy gear row ``r`` carrying ``T_a`` holds the loss torque ``hold`` within its band (to
+    ``tol``)."""
+    lo, hi = gear_band(p, r, t_a)
+    return lo - tol <= hold <= hi + tol
+
+
+@numba.njit(cache=True, nogil=True)
+def _feasible(p, stuck, ns, lam, lo, hi, tol):
+    """True if every bounded member of the set is within its bounds (a stuck lossy gear's hold within its band)."""
+    for k in range(ns):
+        rk = int(stuck[k])
+        if rk < 0:
+            r = -rk - 1
+            for q in range(ns):
+                if int(stuck[q]) == r:
+                    if not _in_band(p, r, -lam[q], lam[k], tol):
+                        return False
+                    break
+        elif lam[k] < lo[k] - tol or lam[k] > hi[k] + tol:
+            return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _repair(p, stuck, ns, A, M, iwork, lam, lo, hi, v, tmp, cand, trial, tol):
+    """Move a statically indeterminate split into the stuck members' bounds (one redundant loop).
+
+    Where stuck members lock the same motion (a bearing and a stuck lossy gear on one shaft, two clutches in
+    parallel) ``A`` has a null vector ``v`` and every ``lam + z v`` balances the network.  The members hold as long
+    as some ``z`` keeps each within its bounds (a lossy gear's hold within its band, which depends on the torque
+    it carries); ``z`` is kept at 0 (the split of the regularised solution) unless that leaves the feasible
+    segment of ``z`` nearest to it or comes within 1 % of its width of an edge: it is then clamped there, so every
+    member keeps a margin until the segment closes (the group must slip).  ``v`` comes from two steps of inverse
+    iteration with the regularised factorisation; a set without a null direction (to 1e-7 of ``A``) or with more
+    than one is left as it is.  Returns True if ``lam`` changed."""
+    anorm = 0.0
+    for k in range(ns):
+        s = 0.0
+        for j in range(ns):
+            s += abs(A[k, j])
+        anorm = max(anorm, s)
+    if anorm == 0.0:
+        return False
+    for k in range(ns):
+        v[k] = 1.0 + 0.37 * k
+    for _it in range(3):
+        lu_solve(M, iwork, v)
+        vn = 0.0
+        for k in range(ns):
+            vn = max(vn, abs(v[k]))
+        if vn == 0.0:
+            return False
+        for k in range(ns):
+            v[k] /= vn
+    for k in range(ns):
+        s = 0.0
+        for j in range(ns):
+            s += A[k, j] * v[j]
+        tmp[k] = s
+    res = 0.0
+    for k in range(ns):
+        res = max(res, abs(tmp[k]))
+    if res > 1e-7 * anorm:
+        return False
+    # breakpoints of every bound along z (each bound is piecewise linear in z); the feasible segments lie between
+    nb = 0
+    for k in range(ns):
+        rk = int(stuck[k])
+        if rk < 0:
+            r = -rk - 1
+            q = -1
+            for qq in range(ns):
+                if int(stuck[qq]) == r:
+                    q = qq
+            if q < 0:
+                continue
+            eta1, eta2, bf1, bf2, bfa = gear_losses(p, r, 0.0)
+            # T_a(z) = -(lam_q + z v_q); L(z) = lam_k + z v_k; pieces L - P(T_a) = 0 and the kinks of P
+            for (sl, c0) in ((1.0 - eta1, bf1), (1.0 - 1.0 / eta2, bf2), (1.0 - 1.0 / eta2, -bf2), (1.0 - eta1, -bf1)):
+                den = v[k] + sl * v[q]
+                if den != 0.0:
+                    cand[nb] = -(lam[k] + sl * lam[q] - c0) / den
+                    nb += 1
+            if v[q] != 0.0:
+                cand[nb] = (-bfa - lam[q]) / v[q]
+                cand[nb + 1] = (bfa - lam[q]) / v[q]
+                nb += 2
+        elif v[k] != 0.0:
+            if np.isfinite(lo[k]):
+                cand[nb] = (lo[k] - lam[k]) / v[k]
+                nb += 1
+            if np.isfinite(hi[k]):
+                cand[nb] = (hi[k] - lam[k]) / v[k]
+                nb += 1
+    if nb == 0:
+        return False
+    cs = cand[:nb]
+    cs.sort()
+    # the segment containing z = 0, or the nearest feasible one: scan the gaps between breakpoints
+    best_lo, best_hi, best_d = 0.0, 0.0, np.inf
+    for i in range(nb + 1):
+        a = -np.inf if i == 0 else cs[i - 1]
+        b = np.inf if i == nb else cs[i]
+        if b - a <= 0.0:
+            continue
+        if a == -np.inf:
+            zm = b - max(1.0, abs(b))
+        elif b == np.inf:
+            zm = a + max(1.0, abs(a))
+        else:
+            zm = 0.5 * (a + b)
+        for k in range(ns):
+            trial[k] = lam[k] + zm * v[k]
+        if not _feasible(p, stuck, ns, trial, lo, hi, tol):
+            continue
+        # merge with the neighbouring feasible gaps (a breakpoint that is no edge)
+        d = 0.0 if a <= 0.0 <= b else min(abs(a), abs(b))
+        if d < best_d:
+            best_d, best_lo, best_hi = d, a, b
+    if best_d == np.inf:
+        return False
+    # extend across breakpoints that are not edges of the feasible set
+    for i in range(nb):
+        if cs[i] == best_hi and i + 1 <= nb:
+            nxt = np.inf if i + 1 == nb else cs[i + 1]
+            zm = 0.5 * (cs[i] + nxt) if nxt != np.inf else cs[i] + max(1.0, abs(cs[i]))
+            for k in range(ns):
+                trial[k] = lam[k] + zm * v[k]
+            if _feasible(p, stuck, ns, trial, lo, hi, tol):
+                best_hi = nxt
+    for i in range(nb - 1, -1, -1):
+        if cs[i] == best_lo:
+            prv = -np.inf if i == 0 else cs[i - 1]
+            zm = 0.5 * (cs[i] + prv) if prv != -np.inf else cs[i] - max(1.0, abs(cs[i]))
+            for k in range(ns):
+                trial[k] = lam[k] + zm * v[k]
+            if _feasible(p, stuck, ns, trial, lo, hi, tol):
+                best_lo = prv
+    if best_lo == -np.inf and best_hi == np.inf:
+        return False
+    if best_lo != -np.inf and best_hi != np.inf:
+        margin = 0.01 * (best_hi - best_lo)
+        z = min(max(0.0, best_lo + margin), best_hi - margin)
+    elif best_lo != -np.inf:
+        z = max(0.0, best_lo + 0.01 * abs(best_lo))
+    else:
+        z = min(0.0, best_hi - 0.01 * abs(best_hi))
+    if z == 0.0:
+        return False
+    for k in range(ns):
+        lam[k] += z * v[k]
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
+    """Torques of the constraint set -- stuck friction elements, gears, stuck lossy gears' holds, motion sources
+    -- solved together.
+
+    Each member ``k`` holds its relative acceleration ``g_k . alpha`` at its target (zero, or the prescribed
+    acceleration of a motion source) with a multiplier ``lam_k`` that puts ``-lam_k h_k`` on the inertias
+    (:func:`_member`): ``A lam = g M^-1 F - target`` with ``A[k, j] = g_k . M^-1 h_j``.  Where stuck elements
+    lock the same relative motion (two clutches in parallel) ``A`` is singular: the regularised solution splits
+    the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
+    gears and motion sources weigh as the strongest friction element), from ``(A + eps D) lam = b`` with ``D =
+    diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal, refined twice on the residual of ``A lam =
+    b``; then :func:`_repair` moves that split within the members' bounds where it would leave them while
+    another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
     """
     n = p.inertia.shape[0]
     nk = _nk(p)
-    ne = p.elem.shape[0]
     wk = p.work
-    o_a, o_m, o_b, o_l, o_c, o_r, o_g, _, _ = _layout(n, nk, ne)
+    o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, _, _, _, _ = _offsets(p)
     A = wk[o_a:o_a + nk * nk].reshape((nk, nk))
     b = wk[o_b:o_b + nk]
     lam = wk[o_l:o_l + nk]
     cap = wk[o_c:o_c + nk]
     res = wk[o_r:o_r + nk]
-    fa = wk[o_g:o_g + nk]
-    ga = wk[o_g + nk:o_g + 2 * nk]
-    fb = wk[o_g + 2 * nk:o_g + 3 * nk]
-    gb = wk[o_g + 3 * nk:o_g + 4 * nk]
-    hf = wk[o_g + 4 * nk:o_g + 5 * nk]
+    flf = wk[o_g:o_g + 3 * nk]
+    gc = wk[o_g + 3 * nk:o_g + 6 * nk]
+    hc = wk[o_g + 6 * nk:o_g + 9 * nk]
+    lo = wk[o_lim:o_lim + nk]
+    hi = wk[o_lim + nk:o_lim + 2 * nk]
+    vnull = wk[o_lim + 2 * nk:o_lim + 3 * nk]
+    vtmp = wk[o_lim + 3 * nk:o_lim + 4 * nk]
+    trial = wk[o_lim + 4 * nk:o_lim + 5 * nk]
+    cand = wk[o_lim + 5 * nk:o_lim + 11 * nk + 2]
     cmax = 0.0
+    fscale = 0.0
+    for i in range(n):
+        fscale = max(fscale, abs(F[i]))
+    bounded = False
     for k in range(ns):
         rk = int(stuck[k])
-        if rk < 0:   # a locked lossy gear's hold: flange a against the ground, at rest
-            ek = p.elem[-rk - 1]
-            fa[k] = -1
-            fb[k] = ek[E_A]
-            ga[k] = 0.0
-            gb[k] = 1.0
-            hf[k] = 1.0
-            b[k] = F[ek[E_A]] / p.inertia[ek[E_A]] if ek[E_A] >= 0 else 0.0
-            lam[k] = 0.0
-            cap[k] = -1.0
-            continue
-        ek = p.elem[rk]
-        ca, cb = _coefficients(p, rk)
-        fa[k] = ek[E_A]
-        fb[k] = ek[E_B]
-        ga[k] = ca
-        gb[k] = cb
-        hf[k] = _force_factor(p, rk, m) if p.lossy.shape[0] > 0 else 1.0
+        _member(p, m, x, n, rk, flf, gc, hc, k)
+        s = 0.0
         target = 0.0
-        if ek[E_KIND] == K_MOTION:
-            d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
-            target = d1 if ek[E_LAW] == MOTION_SPEED else d2
+        if rk >= 0:
+            ek = p.elem[rk]
+            if ek[E_KIND] == K_MOTION:
+                d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
+                target = d1 if ek[E_LAW] == MOTION_SPEED else d2
         s = -target
-        if ek[E_B] >= 0:
-            s += cb * F[ek[E_B]] / p.inertia[ek[E_B]]
-        if ek[E_A] >= 0:
-            s -= ca * F[ek[E_A]] / p.inertia[ek[E_A]]
+        for q in range(3):
+            i = int(flf[3 * k + q])
+            if i >= 0:
+                s += gc[3 * k + q] * F[i] / p.inertia[i]
         b[k] = s
         lam[k] = 0.0
         cap[k] = -1.0
-        if ek[E_KIND] == K_FRICTION and ek[E_LAW] != LAW_ONEWAY:
-            cap[k] = static_limit(p, rk, t)
-            cmax = max(cmax, cap[k])
+        lo[k] = -np.inf
+        hi[k] = np.inf
+        if rk >= 0 and p.elem[rk][E_KIND] == K_FRICTION:
+            lim = static_limit(p, rk, t)
+            if p.elem[rk][E_LAW] != LAW_ONEWAY:
+                cap[k] = lim
+                cmax = max(cmax, cap[k])
+                lo[k] = -lim
+            hi[k] = lim
+            bounded = True
+        elif rk < 0:
+            bounded = True
     scale = 0.0
     for k in range(ns):
         if cap[k] < 0.0:
             cap[k] = cmax if cmax > 0.0 else 1.0
-        ak, bk = int(fa[k]), int(fb[k])
         for j in range(ns):
-            aj, bj = int(fa[j]), int(fb[j])
             v = 0.0
-            hb = gb[j] * hf[j]
-            if bk >= 0 and bk == bj:
-                v += gb[k] * hb / p.inertia[bk]
-            if bk >= 0 and bk == aj:
-                v -= gb[k] * ga[j] / p.inertia[bk]
-            if ak >= 0 and ak == bj:
-                v -= ga[k] * hb / p.inertia[ak]
-            if ak >= 0 and ak == aj:
-                v += ga[k] * ga[j] / p.inertia[ak]
+            for q in range(3):
+                i = int(flf[3 * k + q])
+                if i < 0 or gc[3 * k + q] == 0.0:
+                    continue
+                for qq in range(3):
+                    if int(flf[3 * j + qq]) == i:
+                        v += gc[3 * k + q] * hc[3 * j + qq] / p.inertia[i]
             A[k, j] = v
         scale = max(scale, A[k, k])
     cmax = 0.0
@@ -763,15 +1067,334 @@ def _solve_stuck(t, p, m, stuck, ns, F, tau):
         lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
+    if bounded and ns > 1:
+        big = fscale
+        for k in range(ns):
+            big = max(big, abs(lam[k]))
+        tol = NOISE * (1.0 + big)
+        if _repair(p, stuck, ns, A, M, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol):
+            for k in range(ns):   # the constraints again to rounding
+                r = b[k]
+                for j in range(ns):
+                    r -= A[k, j] * lam[j]
+                res[k] = r
+            lu_solve(M, p.iwork, res)
+            for k in range(ns):
+                lam[k] += res[k]
+    hold = _holds(p)
     for k in range(ns):
         rk = int(stuck[k])
-        if rk < 0:   # the hold's torque acts on flange a (from the housing); it is not an element's torque
-            ea = p.elem[-rk - 1][E_A]
-            if ea >= 0:
-                F[ea] -= lam[k]
+        if rk < 0:
+            r = -rk - 1
+            hold[_lossy_index(p, r)] = lam[k]
+        else:
+            tau[rk] = lam[k]
+        for q in range(3):
+            i = int(flf[3 * k + q])
+            if i >= 0:
+                F[i] -= hc[3 * k + q] * lam[k]
+
+
+@numba.njit(cache=True, nogil=True)
+def _lossy_index(p, r):
+    for j in range(p.lossy.shape[0]):
+        if p.lossy[j] == r:
+            return j
+    return -1
+
+
+
+
+# ----------------------------------------------------------------- the stick/slip items: friction elements and lossy gears
+@numba.njit(cache=True, nogil=True)
+def _noise(p, tau):
+    """Rounding floor [N m] of the stick/slip decisions: ``NOISE`` times one plus the largest torque of the network
+    (an element or a lossy gear's hold) at its last evaluation."""
+    tmax = 0.0
+    for r in range(p.elem.shape[0]):
+        tmax = max(tmax, abs(tau[r]))
+    hold = _holds(p)
+    for j in range(hold.shape[0]):
+        tmax = max(tmax, abs(hold[j]))
+    return NOISE * (1.0 + tmax)
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_row(p, i):
+    nf = p.fric.shape[0]
+    return p.fric[i] if i < nf else p.lossy[i - nf]
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_stuck(p, m, i):
+    nf = p.fric.shape[0]
+    if i < nf:
+        return m[i] == STUCK
+    return m[p.elem[p.lossy[i - nf]][E_MODE]] == GEAR_STUCK
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_set(p, m, i, direction):
+    """Put item ``i`` (a friction element, then the lossy gears) in a mode: stuck (``direction`` 0), sliding or
+    rolling forward (+1) or backward (-1; a lossy gear with flange a driving, its quadrant fixed by
+    :func:`_evaluate`)."""
+    nf = p.fric.shape[0]
+    if i < nf:
+        m[i] = STUCK if direction == 0 else (FORWARD if direction > 0 else BACKWARD)
+    else:
+        m[p.elem[p.lossy[i - nf]][E_MODE]] = GEAR_STUCK if direction == 0 else (GEAR_FWD_A if direction > 0
+                                                                                 else GEAR_BWD_A)
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_speed(p, x, n, i):
+    """Relative speed [rad/s] of item ``i``: a friction element's ``w_b - w_a``, a lossy gear's ``w_a - w_s``."""
+    r = _item_row(p, i)
+    if i < p.fric.shape[0]:
+        e = p.elem[r]
+        return _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+    return gear_speed(p, r, x, n)
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_acc(p, acc, i):
+    """Relative acceleration [rad/s^2] of item ``i`` (as :func:`_item_speed`)."""
+    r = _item_row(p, i)
+    e = p.elem[r]
+    if i < p.fric.shape[0]:
+        return (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
+    return (0.0 if e[E_A] < 0 else acc[e[E_A]]) - (0.0 if e[E_SUP] < 0 else acc[e[E_SUP]])
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_excess(t, p, tau, i, noise, sticking):
+    """How far stuck item ``i`` is beyond what it holds at the last evaluation, and the way it would move.
+
+    Returns ``(excess, direction)``: ``excess >= 0`` [-] if it must break away (its torque, or a lossy gear's held
+    loss torque, at or beyond its limit, ``noise`` at least; relative to the limit: the test of the switching
+    function that watches it, which has crossed when it reaches zero), else ``< 0``; ``direction``
+    +1 forward, -1 backward (the sign of its torque; a gear's: the side of its band the held loss is nearer).
+    ``sticking``: the element is sticking now (a clutch model then covers its lock-up limit)."""
+    nf = p.fric.shape[0]
+    r = _item_row(p, i)
+    if i < nf:
+        tq = tau[r]
+        lim = holding_limit(p, r, t, tq)
+        if sticking and p.elem[r][E_LAW] == LAW_EXTERNAL:
+            lim = _external(p)[3 * p.elem[r][E_AUX] + 2]
+        thr = max(lim, noise)
+        d = 1 if tq > 0.0 else -1
+        return (abs(tq) - thr) / thr, d
+    hold = _holds(p)[i - nf]
+    lo, hi = gear_band(p, r, -tau[r])
+    width = hi - lo + noise
+    if hold >= hi + noise:
+        return (hold - hi - noise) / width, 1
+    if hold <= lo - noise:
+        return (lo - noise - hold) / width, -1
+    return -min(hi + noise - hold, hold - lo + noise) / width, 1 if hold > 0.5 * (lo + hi) else -1
+
+
+@numba.njit(cache=True, nogil=True)
+def _evaluate(t, x, m, p, acc, tau):
+    """The network at ``t`` with every rolling lossy gear in the quadrant its torque puts it in (MSL
+    ``LossyGear.tau_eta``'s sign: which flange drives): evaluated, a gear whose quadrant disagrees beyond the noise
+    flipped, evaluated again, to a fixed point (the gear's torque law is continuous and monotone across the flip,
+    so there is one).  Returns the noise floor (:func:`_noise`)."""
+    n = p.inertia.shape[0]
+    nl = p.lossy.shape[0]
+    evaluate_network(t, x, m, p, acc, tau)
+    noise = _noise(p, tau)
+    for _it in range(2 * nl + 2):
+        flipped = False
+        for j in range(nl):
+            r = p.lossy[j]
+            mi = p.elem[r][E_MODE]
+            mode = m[mi]
+            if mode == GEAR_STUCK:
+                continue
+            te = gear_tau_eta(p, r, mode, -tau[r], abs(gear_speed(p, r, x, n)))
+            if (mode == GEAR_FWD_A or mode == GEAR_BWD_B) and te <= -noise:
+                m[mi] = GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_BWD_A
+                flipped = True
+            elif (mode == GEAR_FWD_B or mode == GEAR_BWD_A) and te >= noise:
+                m[mi] = GEAR_FWD_A if mode == GEAR_FWD_B else GEAR_BWD_B
+                flipped = True
+        if not flipped:
+            break
+        evaluate_network(t, x, m, p, acc, tau)
+        noise = _noise(p, tau)
+    return noise
+
+
+@numba.njit(cache=True, nogil=True)
+def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
+    """True if the modes of the candidates (items at rest) agree with the forces of the last evaluation: every
+    stuck one within what it holds, every released one accelerating its way (not against it beyond rounding)."""
+    amax = 0.0
+    for i in range(acc.shape[0]):
+        amax = max(amax, abs(acc[i]))
+    a_noise = 1e-10 * (1.0 + amax)
+    for c in range(nc):
+        i = cand[c]
+        if _item_stuck(p, m, i):
+            ex, _d = _item_excess(t, p, tau, i, noise, not _old_stuck(p, old, i))
+            if ex >= 0.0:
+                return False
+        elif _item_acc(p, acc, i) * dirs[c] < -a_noise:
+            return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _old_stuck(p, old, i):
+    nf = p.fric.shape[0]
+    if i < nf:
+        return old[i] == STUCK
+    return old[p.elem[p.lossy[i - nf]][E_MODE]] == GEAR_STUCK
+
+
+@numba.njit(cache=True, nogil=True)
+def _apply_subset(p, m, cand, nc, dirs, pick, s):
+    for c in range(nc):
+        _item_set(p, m, cand[c], 0)
+    for q in range(s):
+        c = pick[q]
+        _item_set(p, m, cand[c], dirs[c])
+
+
+@numba.njit(cache=True, nogil=True)
+def settle(t, x, m, p, log, old):
+    """Modes consistent with the forces at ``t`` (the event iteration of MSL's friction elements and ``LossyGear``).
+
+    Friction elements are free or engaged by their normal force.  The items at rest -- friction elements and lossy
+    gears that are stuck or whose relative speed is within 1e-9 of the largest speed -- are put stuck; if one of them is then beyond
+    what it holds, the fewest of them that must slide are found: subsets of growing size, the most overloaded
+    first, each released the way its torque pushes it, until every stuck one holds and every released one
+    accelerates its own way (up to ten items at rest; beyond, or if none agrees, the most overloaded is released
+    until the rest hold).  The decision depends only on the forces, not on the order of the elements or on
+    elements elsewhere in the network (beyond rounding, :data:`NOISE`).  An event per item whose mode now differs
+    from ``old`` (the modes before the event), named for the mode entered (a lossy gear's quadrant: ``a_drives``,
+    ``b_drives``).  Returns True if a mode changed."""
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    nl = p.lossy.shape[0]
+    nsw = p.swit.shape[0]
+    acc, tau = _acc_tau(p)
+    wscale = 1.0
+    for i in range(n):
+        wscale = max(wscale, abs(x[n + i]))
+    w_tol = 1e-9 * wscale
+    for k in range(nf):
+        r = p.fric[k]
+        e = p.elem[r]
+        if _is_free(p, r, t):
+            m[k] = FREE
+        elif m[k] == FREE:   # engaged: slides the way it moves, or is at rest (decided below)
+            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+            m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
+    # the items at rest
+    ni = nf + nl
+    cand = np.empty(ni, dtype=np.int64)
+    dirs = np.zeros(ni, dtype=np.int64)
+    exc = np.empty(ni)
+    nc = 0
+    for i in range(ni):
+        if i < nf and m[i] == FREE:
             continue
-        tau[rk] = lam[k]
-        _apply(F, p.elem[rk], ga[k], gb[k] * hf[k], lam[k])
+        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= w_tol:
+            cand[nc] = i
+            nc += 1
+            _item_set(p, m, i, 0)
+    noise = _evaluate(t, x, m, p, acc, tau)
+    worst = -np.inf
+    for c in range(nc):
+        ex, d = _item_excess(t, p, tau, cand[c], noise, not _old_stuck(p, old, cand[c]))
+        exc[c] = ex
+        dirs[c] = d
+        if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
+            dirs[c] = 0          # a one-way clutch never slides backward
+        worst = max(worst, ex)
+    if worst >= 0.0:
+        # the candidates, most overloaded first
+        order = np.argsort(-exc[:nc])
+        cs = cand[:nc][order].copy()
+        ds = dirs[:nc][order].copy()
+        for c in range(nc):
+            cand[c] = cs[c]
+            dirs[c] = ds[c]
+        found = False
+        pick = np.empty(max(nc, 1), dtype=np.int64)
+        smax = nc if nc <= 10 else 2
+        for s in range(1, smax + 1):
+            for q in range(s):
+                pick[q] = q
+            while True:
+                ok = True
+                for q in range(s):
+                    if dirs[pick[q]] == 0:
+                        ok = False
+                if ok:
+                    _apply_subset(p, m, cand, nc, dirs, pick, s)
+                    noise = _evaluate(t, x, m, p, acc, tau)
+                    if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
+                        found = True
+                        break
+                # the next combination of s out of nc
+                q = s - 1
+                while q >= 0 and pick[q] == nc - s + q:
+                    q -= 1
+                if q < 0:
+                    break
+                pick[q] += 1
+                for qq in range(q + 1, s):
+                    pick[qq] = pick[qq - 1] + 1
+            if found:
+                break
+        if not found:   # release the most overloaded until the rest hold
+            for c in range(nc):
+                _item_set(p, m, cand[c], 0)
+            for _it in range(nc):
+                noise = _evaluate(t, x, m, p, acc, tau)
+                best, bi, bd = -np.inf, -1, 0
+                for c in range(nc):
+                    i = cand[c]
+                    if not _item_stuck(p, m, i):
+                        continue
+                    ex, d = _item_excess(t, p, tau, i, noise, not _old_stuck(p, old, i))
+                    if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY and d < 0:
+                        continue
+                    if ex >= 0.0 and ex > best:
+                        best, bi, bd = ex, i, d
+                if bi < 0:
+                    break
+                _item_set(p, m, bi, bd)
+            _evaluate(t, x, m, p, acc, tau)
+    # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
+    # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the
+    # crossing would be missed); one that moves clearly watches 0
+    slack = _slack(p)
+    any_change = False
+    for k in range(nf):
+        if m[k] != old[k]:
+            record(log, t, _EVENT_OF_MODE[m[k]], k)
+            any_change = True
+            w_rel = _item_speed(p, x, n, k)
+            slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
+    for j in range(nl):
+        mi = p.elem[p.lossy[j]][E_MODE]
+        new, was = m[mi], old[mi]
+        if new == was:
+            continue
+        any_change = True
+        if GEAR_CODES[new] != GEAR_CODES[was]:
+            ev = EV_STICK if new == GEAR_STUCK else (EV_FORWARD if GEAR_CODES[new] > 0 else EV_BACKWARD)
+            w_a = _item_speed(p, x, n, nf + j)
+            slack[nf + j] = w_tol if abs(w_a) <= w_tol else 0.0
+        else:
+            ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
+        record(log, t, ev, nf + nsw + j)
+    return any_change
 
 
 # ----------------------------------------------------------------- hooks
@@ -789,9 +1412,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
     into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull).  A
     curve spring: the deflection above the segment's lower point and below its upper one (either falling
-    through zero moves it to the next segment).  Then one per lossy gear: the power its driving flange delivers
-    plus a floor of 1e-12 of the largest torque times the largest speed (at least 1e-12 W) (falls through zero:
-    the power flow reverses).
+    through zero moves it to the next segment).  Then two per lossy gear: stuck, the margin of the loss torque it
+    holds within its band (:func:`gear_band`; falls through zero: it rolls); rolling, its speed in its direction
+    (falls through zero: it sticks or reverses) and ``+-tau_eta`` (falls through zero: the other flange drives).
+    Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0.
     """
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
@@ -799,6 +1423,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     acc, tau = _acc_tau(p)
     slack = _slack(p)
     evaluate_network(t, x, m, p, acc, tau)
+    noise = _noise(p, tau)
     for i in range(n):
         dx[i] = x[n + i]
         dx[n + i] = acc[i]
@@ -814,8 +1439,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             if kind == K_SOURCE and e[E_LAW] == SOURCE_ENGINE and e[E_STATE] >= 0:
                 _tq, rate = engine_torque(p, r, t, x, n)
                 dx[2 * n + ne + e[E_STATE]] = rate
-        elif kind == K_GEAR:   # the power lost, and the (drift) work of the constraint
-            dx[2 * n + r] = gear_loss(p, r, m, _speed(x, n, e[E_A]), tau[r]) + _force_factor(p, r, m) * tau[r] * w_rel
+        elif kind == K_GEAR:   # the power the gear takes from its flanges: its loss (and the constraint's drift)
+            dx[2 * n + r] = gear_power(p, r, x, n, m, tau[r])
         else:
             dx[2 * n + r] = tau[r] * w_rel
     for k in range(nf):
@@ -826,10 +1451,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
         if mk != STUCK:
             g[N_G * k + G_BREAK] = 1.0
-        elif e[E_LAW] == LAW_ONEWAY:
-            g[N_G * k + G_BREAK] = -tau[r]
+        elif e[E_LAW] == LAW_ONEWAY:   # holds any torque against overrunning, its clutch's limit for it
+            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - tau[r]
         else:
-            g[N_G * k + G_BREAK] = static_limit(p, r, t) - abs(tau[r])
+            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - abs(tau[r])
         if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif e[E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
@@ -853,29 +1478,40 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
         g[N_G * nf + 2 * j + 1] = phi + b2 + (lag if mode == LASH_LOWER else 0.0)
     nsw = p.swit.shape[0]
-    nl = p.lossy.shape[0]
-    if nl > 0:
-        # the power the driving flange delivers, plus a rounding floor: it falls through zero when the power
-        # reverses -- also when it grows from exactly zero (a network starting at rest) the wrong way, which a
-        # function starting on zero would not show as a crossing
-        tmax = 0.0
-        for r in range(ne):
-            tmax = max(tmax, abs(tau[r]))
-        wmax = 0.0
-        for i in range(n):
-            wmax = max(wmax, abs(x[n + i]))
-        floor = 1e-12 * max(1.0, tmax * wmax)
-        for j in range(nl):
-            r = p.lossy[j]
-            e = p.elem[r]
-            if m[e[E_MODE]] != DRIVE_LOCKED:
-                pa = -tau[r] * _speed(x, n, e[E_A])
-                g[N_G * nf + 2 * nsw + j] = (pa if m[e[E_MODE]] == DRIVE_A else -pa) + floor
-        for j in range(nl):   # a locked gear: negative while it holds, rising through zero when released
-            r = p.lossy[j]
-            if m[p.elem[r][E_MODE]] == DRIVE_LOCKED:
-                c_a, c_b = _drive_rates(t, x, m, p, j)   # (overwrites the scratch: after everything else)
-                g[N_G * nf + 2 * nsw + j] = max(c_a, c_b) - 1e-12 * max(1.0, tmax * tmax)
+    hold = _holds(p)
+    for j in range(p.lossy.shape[0]):
+        r = p.lossy[j]
+        mode = m[p.elem[r][E_MODE]]
+        q = N_G * nf + 2 * nsw + 2 * j
+        if mode == GEAR_STUCK:
+            lo, hi = gear_band(p, r, -tau[r])
+            g[q] = min(hi + noise - hold[j], hold[j] - lo + noise)
+            g[q + 1] = 1.0
+            continue
+        w_a = gear_speed(p, r, x, n)
+        forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
+        g[q] = (w_a if forward else -w_a) + slack[nf + j]
+        te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
+        g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
+
+
+@numba.njit(cache=True, nogil=True)
+def gear_power(p, r, x, n, m, tau):
+    """Power [W] gear row ``r`` takes from the inertias it joins, ``-(sum of its torques on them times their
+    speeds)``: its loss ``tauLoss (w_a - w_s)`` (MSL ``LossyGear.lossPower``), zero for an ideal or a stuck gear but
+    for the drift of the constraints.  ``tau`` its torque on flange a (``-T_a``)."""
+    e = p.elem[r]
+    ratio = p.coef[r][C_RATIO]
+    mode = _gear_mode(p, r, m)
+    if mode == GEAR_STUCK:
+        tb = -ratio * tau
+        if e[E_MODE] >= 0:
+            tb -= ratio * _holds(p)[_lossy_index(p, r)]
+    else:
+        f, c = gear_transfer(p, r, mode, abs(gear_speed(p, r, x, n)))
+        tb = -ratio * (f * tau + c)
+    ts = -tau - tb
+    return -(tau * _speed(x, n, e[E_A]) + tb * _speed(x, n, e[E_B]) + ts * _speed(x, n, e[E_SUP]))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -916,192 +1552,16 @@ def driveline_outputs(t, x, u, m, p, y):
     for k in range(nf):
         r = p.fric[k]
         y[q] = MODE_CODES[m[k]]
-        y[q + 1] = normal_force(p, r, t) if p.elem[r][E_LAW] == LAW_CLUTCH else 0.0
+        y[q + 1] = normal_force(p, r, t) if p.elem[r][E_LAW] in (LAW_CLUTCH, LAW_ONEWAY) else 0.0
         q += 2
+    for j in range(p.lossy.shape[0]):
+        y[q] = GEAR_CODES[m[p.elem[p.lossy[j]][E_MODE]]]
+        q += 1
     y[q] = kinetic
     y[q + 1] = spring
     y[q + 2] = work
     y[q + 3] = lost
     y[q + 4] = work - lost - (kinetic + spring - p.work[p.work.shape[0] - 1])
-
-
-@numba.njit(cache=True, nogil=True)
-def _drive_rates(t, x, m, p, j):
-    """Rates of the power flange a of lossy gear ``j`` would deliver, were it released from rest into either
-    driving mode: ``(c_a, c_b)`` with ``c_a = -lam_A acc_a`` (positive: flange a would drive) and ``c_b = lam_B
-    acc_a`` (positive: flange b would drive), each from the network evaluated in that mode.  At most one is
-    positive (the gear's torque has the same sign in both modes); neither is while the torques on its sides are
-    within its loss band (a ratio in [eta, 1/eta]): it holds.  Overwrites the network's scratch."""
-    n = p.inertia.shape[0]
-    r = p.lossy[j]
-    e = p.elem[r]
-    mi = e[E_MODE]
-    acc, tau = _acc_tau(p)
-    keep = m[mi]
-    m[mi] = DRIVE_A
-    evaluate_network(t, x, m, p, acc, tau)
-    c_a = -tau[r] * (acc[e[E_A]] if e[E_A] >= 0 else 0.0)
-    m[mi] = DRIVE_B
-    evaluate_network(t, x, m, p, acc, tau)
-    c_b = tau[r] * (acc[e[E_A]] if e[E_A] >= 0 else 0.0)
-    m[mi] = keep
-    return c_a, c_b
-
-
-@numba.njit(cache=True, nogil=True)
-def _scales(x, p, tau):
-    """Largest speed (at least 1) and torque of the network at its last evaluation."""
-    n = p.inertia.shape[0]
-    wmax = 1.0
-    for i in range(n):
-        wmax = max(wmax, abs(x[n + i]))
-    tmax = 0.0
-    for r in range(p.elem.shape[0]):
-        tmax = max(tmax, abs(tau[r]))
-    return wmax, tmax
-
-
-@numba.njit(cache=True, nogil=True)
-def _gear_mode_at(t, x, m, p, j):
-    """The consistent mode of lossy gear ``j``: moving (``|w_a|`` above 1e-9 of the largest speed), the mode
-    whose power flows the right way (its own, unless the power it carries has the wrong sign beyond rounding);
-    at rest, the mode it would be released into (:func:`_drive_rates`), or ``DRIVE_LOCKED``."""
-    n = p.inertia.shape[0]
-    r = p.lossy[j]
-    e = p.elem[r]
-    mode = m[e[E_MODE]]
-    acc, tau = _acc_tau(p)
-    evaluate_network(t, x, m, p, acc, tau)
-    wmax, tmax = _scales(x, p, tau)
-    w_a = _speed(x, n, e[E_A])
-    if abs(w_a) > 1e-9 * wmax:
-        pa = -tau[r] * w_a
-        noise = 1e-12 * max(1.0, tmax * wmax)
-        if mode == DRIVE_LOCKED:
-            return DRIVE_A if pa > 0.0 else DRIVE_B
-        if mode == DRIVE_A and pa < -noise:
-            return DRIVE_B
-        if mode == DRIVE_B and pa > noise:
-            return DRIVE_A
-        return mode
-    c_a, c_b = _drive_rates(t, x, m, p, j)
-    floor = 1e-12 * max(1.0, tmax * tmax)
-    if c_a > floor:
-        return DRIVE_A
-    if c_b > floor:
-        return DRIVE_B
-    return DRIVE_LOCKED
-
-
-@numba.njit(cache=True, nogil=True)
-def _gear_modes(t, x, m, p, log):
-    """Every lossy gear in its consistent mode (:func:`_gear_mode_at`), one change at a time to a fixed point;
-    an event (``a_drives``, ``b_drives``, ``locked``) per change.  Returns True if a mode changed."""
-    nl = p.lossy.shape[0]
-    if nl == 0:
-        return False
-    changed = False
-    nf = p.fric.shape[0]
-    nsw = p.swit.shape[0]
-    for _it in range(3 * nl):
-        flip = -1
-        new = 0
-        for j in range(nl):
-            mode = _gear_mode_at(t, x, m, p, j)
-            if mode != m[p.elem[p.lossy[j]][E_MODE]]:
-                flip = j
-                new = mode
-                break
-        if flip < 0:
-            break
-        m[p.elem[p.lossy[flip]][E_MODE]] = new
-        record(log, t, EV_DRIVE_A + new, nf + nsw + flip)
-        changed = True
-    return changed
-
-
-@numba.njit(cache=True, nogil=True)
-def settle(t, x, m, p, log, old):
-    """Modes consistent with the forces at ``t``: free or engaged by the normal force, then break-away of
-    stuck elements (the worst violation first) and re-sticking of an element released against its
-    acceleration, to a fixed point.  An event per element whose mode now differs from ``old`` (the modes
-    before the event), named for the mode entered.  Returns True if a mode changed."""
-    n = p.inertia.shape[0]
-    nf = p.fric.shape[0]
-    acc, tau = _acc_tau(p)
-    wscale = 1.0
-    for i in range(n):
-        wscale = max(wscale, abs(x[n + i]))
-    w_tol = 1e-9 * wscale
-    for k in range(nf):
-        r = p.fric[k]
-        e = p.elem[r]
-        if _is_free(p, r, t):
-            m[k] = FREE
-        elif m[k] == FREE:   # engaged: slides the way it moves, or sticks (then breaks away if it must)
-            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-            m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
-    ne = p.elem.shape[0]
-    gears = _gear_modes(t, x, m, p, log)
-    for _it in range(4 * nf + 4):
-        evaluate_network(t, x, m, p, acc, tau)
-        # torques below 1e-12 of the largest in the network are rounding (a stuck element that carries
-        # nothing while its normal force rises from zero must not break away on them)
-        t_noise = 0.0
-        for r in range(ne):
-            t_noise = max(t_noise, abs(tau[r]))
-        t_noise *= 1e-12
-        worst = -1
-        ratio = 0.0
-        for k in range(nf):
-            if m[k] != STUCK:
-                continue
-            r = p.fric[k]
-            lim = holding_limit(p, r, t, tau[r])
-            if old[k] != STUCK and p.elem[r][E_LAW] == LAW_EXTERNAL:   # sticking now: its lock-up limit
-                lim = _external(p)[3 * p.elem[r][E_AUX] + 2]
-            # the same test as the break-away function, which has crossed when it reaches zero (the core's
-            # convention): |tau| >= limit, a torque to carry (a ratio may round to exactly 1)
-            if abs(tau[r]) >= lim and abs(tau[r]) > t_noise:
-                q = abs(tau[r]) / lim if lim > 0.0 else np.inf
-                if q >= ratio:
-                    ratio = q
-                    worst = k
-        if worst >= 0:
-            m[worst] = FORWARD if tau[p.fric[worst]] > 0.0 else BACKWARD
-            continue
-        # an element released (relative speed still ~0) must move the way it slides
-        changed = False
-        for k in range(nf):
-            if m[k] != FORWARD and m[k] != BACKWARD:
-                continue
-            r = p.fric[k]
-            e = p.elem[r]
-            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-            if abs(w_rel) > w_tol:
-                continue
-            a_rel = (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
-            if (m[k] == FORWARD and a_rel < 0.0) or (m[k] == BACKWARD and a_rel > 0.0):
-                m[k] = STUCK
-                changed = True
-                break
-        if not changed:
-            break
-    if _gear_modes(t, x, m, p, log):   # the friction modes changed the torques the gears carry
-        gears = True
-    # an element that starts to slide from (about) rest may start a rounding's width on the wrong side of zero:
-    # its stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at
-    # once, the crossing would be missed); one that slides clearly watches 0
-    slack = _slack(p)
-    any_change = False
-    for k in range(nf):
-        if m[k] != old[k]:
-            record(log, t, _EVENT_OF_MODE[m[k]], k)
-            any_change = True
-            e = p.elem[p.fric[k]]
-            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-            slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
-    return any_change or gears
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1111,21 +1571,18 @@ def driveline_update(t, x, u, m, p, k, log):
     backlash closed (``contact``) or opened (``separate``) its gap."""
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
-    if k >= N_G * nf + 2 * nsw:   # a lossy gear's power reached zero: the other flange drives now
-        j = k - N_G * nf - 2 * nsw
+    if k >= N_G * nf + 2 * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
+        j = (k - N_G * nf - 2 * nsw) // 2
         mi = p.elem[p.lossy[j]][E_MODE]
-        n = p.inertia.shape[0]
-        acc, tau = _acc_tau(p)
-        evaluate_network(t, x, m, p, acc, tau)
-        wmax, _tmax = _scales(x, p, tau)
-        if m[mi] != DRIVE_LOCKED and abs(_speed(x, n, p.elem[p.lossy[j]][E_A])) > 1e-9 * wmax:
-            new = DRIVE_B if m[mi] == DRIVE_A else DRIVE_A   # its torque reversed while moving: the other side drives
-        else:
-            new = _gear_mode_at(t, x, m, p, j)                # at rest: released one way, or held
-        if new != m[mi]:
-            m[mi] = new
-            record(log, t, EV_DRIVE_A + new, nf + nsw + j)
-        settle(t, x, m, p, log, m.copy())
+        old = m.copy()
+        mode = m[mi]
+        if mode != GEAR_STUCK:
+            if (k - N_G * nf - 2 * nsw) % 2 == 0:
+                m[mi] = GEAR_STUCK
+            else:   # the other flange drives now
+                m[mi] = (GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_FWD_A if mode == GEAR_FWD_B else
+                         GEAR_BWD_B if mode == GEAR_BWD_A else GEAR_BWD_A)
+        settle(t, x, m, p, log, old)
         return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // 2

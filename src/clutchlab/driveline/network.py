@@ -302,6 +302,7 @@ class _Element:
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
     emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
+    sup: str | None = None    # a gear's support (housing) inertia; None: the ground
 
 
 class Driveline:
@@ -444,31 +445,86 @@ class Driveline:
                                        law=K.SPRING_BACKLASH))
         return self
 
-    def gear(self, name: str, a, b, ratio: float, efficiency: float = 1.0) -> "Driveline":
-        """A gear between flanges a and b: ``w_a = ratio * w_b``.  Ideal (``efficiency`` 1, MSL ``IdealGear``):
-        the torque on flange b is ``-ratio`` times the torque on flange a.  Lossy (``efficiency`` ``eta`` in
-        (0.5, 1), MSL ``LossyGear`` with a constant efficiency and no bearing friction): the loss is taken from
-        the driving side, ``-ratio eta`` times while flange a drives (delivers power) and ``-ratio / eta`` while
-        b drives; at rest with the torques on its sides opposing within its loss band it is ``locked`` (holds
-        flange a at rest).  Its mode changes at located events (``a_drives``, ``b_drives``, ``locked``).
-        ``ratio`` != 0 (negative reverses).  Gears and motion sources may not close a loop (the network would
-        be over-constrained); the initial speeds of the inertias they bind follow from one of them."""
+    def gear(self, name: str, a, b, ratio: float, efficiency: float = 1.0, loss_table=None,
+             support=None) -> "Driveline":
+        """A gear between flanges a and b on a support (MSL ``IdealGear``, ``LossyGear``): ``phi_a - phi_s = ratio
+        (phi_b - phi_s)``.
+
+        Ideal (``efficiency`` 1, no ``loss_table``): the torque on flange b is ``-ratio`` times the torque on flange
+        a.  Lossy: MSL ``LossyGear`` (Pelchen, Otter and Schweiger 2002), a friction element whose relative speed
+        is ``w_a - w_s``: rolling, ``flange_b.tau = -ratio (flange_a.tau - tauLoss)`` with the loss torque of its
+        quadrant (mesh efficiency ``eta_mf1`` while flange a drives, ``eta_mf2`` while b drives, bearing friction
+        ``tau_bf1``, ``tau_bf2``); at rest it is stuck while the loss torque it must hold lies within the band of
+        its quadrants at zero speed, and rolls forward or backward (events ``forward``, ``backward``, ``stick``;
+        ``a_drives``, ``b_drives`` when the driving flange changes) when it leaves it.  Self-locking (a worm gear
+        with a small ``eta_mf2``) follows from those equations: no efficiency is refused.
+
+        Parameters
+        ----------
+        name, a, b : str
+            The gear and its flanges (inertias; "ground" for none).
+        ratio : float
+            ``w_a / w_b`` against the support [-], != 0 (negative reverses).
+        efficiency : float
+            Constant mesh efficiency in (0, 1] for both directions [-] (MSL ``lossTable = [0, eta, eta, 0, 0]``).
+        loss_table : array_like, optional
+            MSL ``lossTable``: rows ``[|w_a| rad/s, eta_mf1, eta_mf2, tau_bf1 N m, tau_bf2 N m]``, ``|w_a|``
+            increasing from 0, linear between rows and extrapolated from the last two; give it or ``efficiency``.
+        support : str, optional
+            The inertia the gear's housing is (MSL ``useSupport``; its reaction torque acts there); default the
+            ground.
+
+        Gears and motion sources may not close a loop (the network would be over-constrained); the initial speeds
+        of the inertias they bind follow from one of them.
+        """
         name = self._new_name(name)
         a, b = self._two(name, a, b)
+        sup = self._flange(name, "support", support)
+        if sup is not None and sup in (a, b):
+            raise ParameterError(f"{name}: support = {sup!r} is also one of its flanges")
         ratio = _finite(name, "ratio", ratio)
         if ratio == 0.0:
             raise ParameterError(f"{name}: ratio = 0 (a gear needs a ratio != 0)")
-        eta = _finite(name, "efficiency", efficiency, positive=True)
-        if not 0.5 < eta <= 1.0:
-            raise ParameterError(f"{name}: efficiency = {eta!r} must be in (0.5, 1] (at 0.5 or below a gear "
-                                 "self-locks, which is not modelled)")
-        self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio, eta, 0.0, 0.0)))
+        if loss_table is not None:
+            if efficiency != 1.0:
+                raise ParameterError(f"{name}: give efficiency or loss_table, not both")
+            try:
+                rows = np.asarray(loss_table, dtype=float)
+            except (TypeError, ValueError):
+                raise ParameterError(f"{name}: loss_table = {loss_table!r} must be rows of 5 numbers "
+                                     "[w_rad_s, eta_mf1, eta_mf2, tau_bf1_Nm, tau_bf2_Nm]") from None
+            if rows.ndim != 2 or rows.shape[1] != 5 or rows.shape[0] < 1 or not np.all(np.isfinite(rows)):
+                raise ParameterError(f"{name}: loss_table must be rows of 5 finite numbers [w_rad_s, eta_mf1, eta_mf2, "
+                                     f"tau_bf1_Nm, tau_bf2_Nm], got shape {rows.shape}")
+            if rows[0, 0] < 0.0 or np.any(np.diff(rows[:, 0]) <= 0):
+                raise ParameterError(f"{name}: loss_table speeds {rows[:, 0].tolist()} must start at >= 0 and increase")
+            bad = rows[(rows[:, 1] <= 0) | (rows[:, 1] > 1) | (rows[:, 2] <= 0) | (rows[:, 2] > 1)]
+            if bad.size:
+                raise ParameterError(f"{name}: loss_table efficiencies must be in (0, 1], got row {bad[0].tolist()}")
+            if np.any(rows[:, 3:] < 0):
+                raise ParameterError(f"{name}: loss_table bearing friction torques must be >= 0")
+        else:
+            eta = _finite(name, "efficiency", efficiency, positive=True)
+            if not 0.0 < eta <= 1.0:
+                raise ParameterError(f"{name}: efficiency = {eta!r} must be in (0, 1]")
+            rows = np.array([[0.0, eta, eta, 0.0, 0.0]])
+        table = tuple(rows.T.ravel())
+        self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio,), table=table, sup=sup))
         return self
+
+    @staticmethod
+    def _is_lossy(e) -> bool:
+        """A gear with losses (its loss table is not MSL's ideal ``[0, 1, 1, 0, 0]``)."""
+        if e.kind != K.K_GEAR:
+            return False
+        n = len(e.table) // 5
+        t = np.asarray(e.table).reshape(5, n)
+        return not (np.all(t[1:3] == 1.0) and np.all(t[3:] == 0.0))
 
     @property
     def _lossy(self) -> list:
-        """The gears with an efficiency below 1, in mode order."""
-        return [e for e in self._elements if e.kind == K.K_GEAR and e.coef[1] < 1.0]
+        """The gears with losses, in mode order."""
+        return [e for e in self._elements if self._is_lossy(e)]
 
     def _motion(self, name, flange, signal, law, what):
         name = self._new_name(name)
@@ -872,14 +928,20 @@ class Driveline:
             out.append((el, params, W.initial_state(scenario), w["clutch"]))
         return out
 
-    def one_way_clutch(self, name: str, a, b) -> "Driveline":
-        """A one-way clutch (freewheel) between flanges a and b: flange b may overrun flange a freely
-        (``w_b > w_a``, no torque) and locks to it, holding any torque, when it would turn slower.  A
-        located ``stick`` event when it locks, ``forward`` when it overruns; it never slides backward,
-        so it may not start with ``w_b < w_a``."""
+    def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
+                       normal=1.0) -> "Driveline":
+        """A one-way clutch between flanges a and b (MSL ``OneWayClutch``: a freewheel in parallel with a clutch).
+
+        Flange b may overrun flange a (``w_b > w_a``); the freewheel locks, holding any torque, when b would turn
+        slower.  Without a normal force (``fn_max`` 0, the default) it overruns freely; with one, its clutch
+        (``fn = fn_max * normal(t)``, ``cgeo``, ``mu`` and ``peak`` as :meth:`clutch`; no torque where ``fn <= 0``)
+        holds up to ``peak * cgeo * fn * mu(0)`` against overrunning and slides with ``cgeo * fn * mu(w_rel)``
+        while b overruns.  Events ``stick`` when it locks or its clutch holds, ``forward`` when b overruns; it
+        never slides backward, so it may not start with ``w_b < w_a``."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_ONEWAY, (0.0, 0.0), 1.0)
+        return self._friction(name, a, b, K.LAW_ONEWAY, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
+                              None if fn_max == 0.0 else normal)
 
     # ---- the system
     def describe(self) -> str:
@@ -908,7 +970,13 @@ class Driveline:
                 lines.append(f"  {a} --({e.name}: {what} {e.signal.describe(unit)})--> [{b}]")
                 continue
             if e.kind == K.K_GEAR:
-                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b" + (f", efficiency {e.coef[1]:g}" if e.coef[1] < 1 else "")
+                nrow = len(e.table) // 5
+                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
+                if self._is_lossy(e):
+                    what += (f", efficiency {e.table[nrow]:g}" if nrow == 1 and e.table[nrow] == e.table[2 * nrow]
+                             and e.table[3 * nrow] == e.table[4 * nrow] == 0.0 else f", loss table of {nrow} rows")
+                if e.sup is not None:
+                    what += f", on support {e.sup}"
             elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
                 what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
             elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
@@ -916,7 +984,8 @@ class Driveline:
             elif e.kind == K.K_SPRING:
                 what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
             elif e.law == K.LAW_ONEWAY:
-                what = "one-way clutch (b overruns a freely)"
+                what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
+                        f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")
             elif e.law == K.LAW_EXTERNAL and e.emtc is not None:
                 sc = e.emtc["scenario"]
                 what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
@@ -977,12 +1046,17 @@ class Driveline:
             elem[r, K.E_B] = -1 if e.b is None else index[e.b]
             elem[r, K.E_LAW] = e.law
             elem[r, K.E_SIGNAL] = -1 if e.signal is None else add_signal(e.signal)
+            elem[r, K.E_SUP] = -1 if e.sup is None else index[e.sup]
             if e.table:
                 elem[r, K.E_TABLE] = len(data)
-                elem[r, K.E_TABLE_N] = (len(e.table) // (4 if e.kind == K.K_SPRING else 2) if e.law != K.SOURCE_ENGINE
-                                        or e.kind != K.K_SOURCE else (len(e.table) - e.aux) // (1 + e.aux))
+                if e.kind == K.K_GEAR:
+                    elem[r, K.E_TABLE_N] = len(e.table) // 5
+                elif e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
+                    elem[r, K.E_TABLE_N] = (len(e.table) - e.aux) // (1 + e.aux)
+                else:
+                    elem[r, K.E_TABLE_N] = len(e.table) // (4 if e.kind == K.K_SPRING else 2)
                 data.extend(e.table)
-            elem[r, K.E_AUX] = e.aux
+            elem[r, K.E_AUX] = 0 if e.kind == K.K_GEAR else e.aux
             elem[r, K.E_MODE] = -1
             elem[r, K.E_STATE] = self._controllers.index(e) if e in self._controllers else -1
             coef[r, :len(e.coef)] = e.coef
@@ -996,14 +1070,13 @@ class Driveline:
         swit = np.array([r for r, e in enumerate(self._elements)
                          if e.kind == K.K_SPRING and e.law in (K.SPRING_BACKLASH, K.SPRING_CURVE)], dtype=np.int64)
         elem[swit, K.E_MODE] = fric.size + np.arange(swit.size)
-        lossy = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_GEAR and e.coef[1] < 1.0],
-                         dtype=np.int64)
+        lossy = np.array([r for r, e in enumerate(self._elements) if self._is_lossy(e)], dtype=np.int64)
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
         n, ne = len(index), len(self._elements)
-        nk = fric.size + cons.size + sum(1 for e in self._elements if e.kind == K.K_GEAR and e.coef[1] < 1.0)
+        nk = fric.size + cons.size + lossy.size
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
         elem[ext, K.E_AUX] = np.arange(len(ext))
-        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext)))
+        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext), lossy.size))
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
@@ -1062,9 +1135,11 @@ class Driveline:
                     if phi[ib] is not None and not math.isclose(phi[ib], v, rel_tol=1e-9, abs_tol=1e-12):
                         raise ParameterError(f"{names[ib]}: phi0 = {phi[ib]:g} rad but {e.name} starts it at {v:g} rad")
                     phi[ib] = v
-            elif ia >= 0 and ib >= 0:
-                links[ia].append((ib, 1.0 / e.coef[0], e.name))   # w_b = w_a / ratio
-                links[ib].append((ia, e.coef[0], e.name))         # w_a = ratio w_b
+            elif ia >= 0 and ib >= 0:   # w_a - w_s = ratio (w_b - w_s), the support at its own initial speed
+                ratio = e.coef[0]
+                ws = 0.0 if e.sup is None or w[index[e.sup]] is None else w[index[e.sup]]
+                links[ia].append((ib, 1.0 / ratio, (1.0 - 1.0 / ratio) * ws, e.name))   # w_b from w_a
+                links[ib].append((ia, ratio, (1.0 - ratio) * ws, e.name))               # w_a from w_b
             else:   # a gear to the ground holds its flange at rest
                 fixed[ia if ia >= 0 else ib] = (0.0, e.name)
         value = [None] * n
@@ -1078,9 +1153,9 @@ class Driveline:
             todo = [start]
             while todo:
                 i = todo.pop()
-                for j, factor, gname in links[i]:
+                for j, factor, offset, gname in links[i]:
                     if value[j] is None:
-                        assign(j, factor * value[i], f"{gname} from {names[i]}")
+                        assign(j, factor * value[i] + offset, f"{gname} from {names[i]}")
                         todo.append(j)
 
         for i, (v, why) in fixed.items():
@@ -1102,11 +1177,14 @@ class Driveline:
     def _initial_modes(self, p, x0):
         """Friction modes from the initial relative speeds and normal forces, then the backlash contacts
         from the deflections (at the edge of the gap, in contact if moving into it) and the segments of the
-        curve springs (at a point, the segment it moves onto); lossy gears start with flange a driving (the
-        restart at t0 sets them by the power they carry)."""
+        curve springs (at a point, the segment it moves onto); lossy gears roll the way their flange a turns on
+        their support, or are stuck (the restart at t0 settles them)."""
         n = len(self._inertias)
         m = np.empty(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
-        m[p.fric.size + p.swit.size:] = K.DRIVE_A
+        for j, r in enumerate(p.lossy):   # rolling the way flange a turns on its support, or stuck (the restart
+            e = p.elem[r]                 # at t0 settles them and the flange that drives)
+            w_a = (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]]) - (0.0 if e[K.E_SUP] < 0 else x0[n + e[K.E_SUP]])
+            m[p.fric.size + p.swit.size + j] = K.GEAR_FWD_A if w_a > 0 else K.GEAR_BWD_A if w_a < 0 else K.GEAR_STUCK
         for j, r in enumerate(p.swit):
             e = self._elements[r]
             pa = 0.0 if e.a is None else x0[p.elem[r][K.E_A]]
@@ -1153,7 +1231,7 @@ class Driveline:
                 states.append((f"{e.name}.work", "J", f"work of the source {e.name}"))
                 outputs.append((f"{e.name}.{tn}", tu, f"{word} of the source {e.name} on its flange"))
             elif e.kind == K.K_GEAR:
-                states.append((f"{e.name}.dissipated", "J", f"energy lost in {e.name} (zero but for drift)"))
+                states.append((f"{e.name}.dissipated", "J", f"energy lost in {e.name} (its mesh and bearing losses)"))
                 outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} on flange a (on flange b: -ratio {tn})"))
             else:
                 states.append((f"{e.name}.dissipated", "J", f"energy dissipated in {e.name}"))
@@ -1164,6 +1242,9 @@ class Driveline:
         for name in self.friction_names:
             outputs.append((f"{name}.mode", "1", f"mode of {name}: 1 forward, 0 stuck, -1 backward, 2 free (MSL)"))
             outputs.append((f"{name}.fn", "N", f"normal force of {name}"))
+        for e in self._lossy:
+            outputs.append((f"{e.name}.mode", "1", f"mode of {e.name}: 1 forward rolling, 0 stuck, -1 backward rolling "
+                                                   "(MSL LossyGear)"))
         outputs += [("kinetic_energy", "J", "kinetic energy of the inertias"),
                     ("spring_energy", "J", "energy stored in the springs"),
                     ("input_work", "J", "work of the sources since the start"),
@@ -1192,11 +1273,11 @@ class Driveline:
                            for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
                                         else ("segment_below", "segment_above")))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
-        switching += tuple((f"{e.name}.power", 0) for e in self._lossy)
+        switching += tuple((f"{e.name}.{what}", -1) for e in self._lossy for what in ("stick", "quadrant"))
         mode_names = named
         swit_values = tuple(K.LASH_VALUES if e.law == K.SPRING_BACKLASH else
                             tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
-        mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.DRIVE_VALUES for _ in self._lossy)
+        mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
         atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
