@@ -192,7 +192,7 @@ def _basic_value(sig, data, t):
     if kind == SIG_PULSE:   # MSL Pulse: amplitude while t < T_start + T_width
         on, tk = _periodic_at(sig, t)
         tw, _c2, _c3 = _corners(sig)
-        return sig[5] + (sig[1] if on and t < tk + tw else 0.0)
+        return sig[5] + (sig[1] if on and (t < tk + tw or sig[2] >= 1.0) else 0.0)   # width 1: on throughout
     if kind == SIG_TRAPEZOID:   # MSL Trapezoid: rising, width, falling, then 0 to the period's end
         on, tk = _periodic_at(sig, t)
         if not on:

@@ -341,7 +341,7 @@ def _periodic_value_and_rate(kind, a, t):
     tk = start + k * period
     c1, c2, c3 = corners
     if kind == K.SIG_PULSE:
-        return offset + (amp if t < tk + c1 else 0.0), 0.0
+        return offset + (amp if t < tk + c1 or width >= 1.0 else 0.0), 0.0
     if t < tk + c1:
         return offset + amp * (t - tk) / rising, amp / rising
     if t < tk + c2:
