@@ -967,7 +967,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
     side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
-    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull).  A
+    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull); with
+    MSL's damping law, the two of its mode that fall through zero at its kinks (:func:`_lash_msl_switching`).  A
     curve spring: the deflection above the segment's lower point and below its upper one (either falling
     through zero moves it to the next segment).  Then one per lossy gear: the power its driving flange delivers
     plus a floor of 1e-12 of the largest torque times the largest speed (at least 1e-12 W) (falls through zero:
@@ -1347,7 +1348,8 @@ def settle(t, x, m, p, log, old):
 def driveline_update(t, x, u, m, p, k, log):
     """Switching function ``k`` crossed: a sliding element reached zero relative speed (it sticks, or
     reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
-    backlash closed (``contact``) or opened (``separate``) its gap."""
+    backlash closed (``contact``) or opened (``separate``) its gap, or (MSL's damping law) reached a kink of
+    its contact law (:func:`_lash_msl_update`, no event)."""
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
     if k >= N_G * nf + 2 * nsw:   # a lossy gear's power reached zero: the other flange drives now
