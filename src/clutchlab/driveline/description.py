@@ -28,10 +28,11 @@
 
 Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
-``backlash`` (a, b, c, b_gap, d, phi_rel0), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|,
-eta_mf1, eta_mf2, tau_bf1, tau_bf2]`` as MSL's ``lossTable``, support = the housing's inertia), ``torque`` (flange, torque,
-support), ``speed`` (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu,
-peak, cgeo, normal; or mu_map = a friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
+``backlash`` (a, b, c, b_gap, d, phi_rel0, damping_law = "kelvin_voigt" (default) or "msl": MSL
+``ElastoBacklash``'s), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1,
+tau_bf2]`` as MSL's ``lossTable``, support = the housing's inertia), ``torque`` (flange, torque, support), ``speed``
+(flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu, peak, cgeo, normal; or mu_map = a
+friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
 temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support; mu_map, radius, temperature),
 ``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b; fn_max, mu, peak, cgeo, normal: MSL's
@@ -51,7 +52,13 @@ support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities a
 strings with units, converted once here.  A signal is a number or
 quantity (a constant) or one of ``{ constant = v }``, ``{ step = { height, start, offset } }``,
 ``{ ramp = { height, duration, start, offset } }``, ``{ sine = { amplitude, frequency, phase, offset,
-start } }``, ``{ table = { times = [...], values = [...] } }`` (times in s, values in the signal's unit).
+start } }``, ``{ pulse = { amplitude, width, period, nperiod, offset, start } }`` (width the fraction of
+the period it is on, in (0, 1]: ``0.5`` or ``"50 %"``; ``nperiod`` a whole number, -1 unlimited),
+``{ trapezoid = { amplitude, rising, width, falling, period, nperiod, offset, start } }`` (times in s,
+rising + width + falling <= period), ``{ exponentials = { out_max, rise_time, rise_time_const,
+fall_time_const, offset, start } }``, ``{ table = { times = [...], values = [...] } }`` (times in s, values
+in the signal's unit) or ``{ product = [S1, S2] }``, S1 a signal in the field's unit (a number, a quantity
+or one of these tables) and S2 a dimensionless one (MSL ``Blocks.Sources`` and ``Blocks.Math.Product``).
 A friction characteristic (``mu``, a bearing's ``torque``) is a number or a table of rows
 ``[w_rad_s, value]``.  Every error names the file, the key and the value.
 """
@@ -76,7 +83,7 @@ FIELDS = {
     "spring": {"a": (None, True), "b": (None, True), "curve": ("N*m", True), "interpolation": ("text", False),
                "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
     "backlash": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", True), "b_gap": ("rad", True),
-                 "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
+                 "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False), "damping_law": ("text", False)},
     "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True), "efficiency": ("1", False),
              "loss_table": ("losstable", False), "support": (None, False)},
     "torque": {"flange": (None, True), "torque": ("N*m", True), "support": (None, False)},
@@ -106,6 +113,8 @@ FIELDS = {
 }
 #: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
 NOT_QUANTITIES = ("text", "int", "path", "bool", "map", "losstable")
+#: the words a text field takes
+CHOICES = {"interpolation": ("linear", "pchip"), "damping_law": ("kelvin_voigt", "msl")}
 #: a translational driveline: masses and forces, the units of its domain
 _TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
 _RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
@@ -122,8 +131,20 @@ SIGNAL_FIELDS = {
     "step": {"height": "value", "start": "s", "offset": "value"},
     "ramp": {"height": "value", "duration": "s", "start": "s", "offset": "value"},
     "sine": {"amplitude": "value", "frequency": "Hz", "phase": "rad", "offset": "value", "start": "s"},
+    "pulse": {"amplitude": "value", "width": "1", "period": "s", "nperiod": "int", "offset": "value", "start": "s"},
+    "trapezoid": {"amplitude": "value", "rising": "s", "width": "s", "falling": "s", "period": "s", "nperiod": "int",
+                  "offset": "value", "start": "s"},
+    "exponentials": {"out_max": "value", "rise_time": "s", "rise_time_const": "s", "fall_time_const": "s",
+                     "offset": "value", "start": "s"},
     "table": {"times": "s", "values": "value"},
+    "product": None,
 }
+#: the parameters a signal needs (the others have defaults)
+SIGNAL_REQUIRED = {"step": (), "ramp": ("height", "duration"), "sine": ("amplitude", "frequency"),
+                   "pulse": ("amplitude", "width", "period"),
+                   "trapezoid": ("amplitude", "rising", "width", "falling", "period"),
+                   "exponentials": ("out_max", "rise_time", "rise_time_const", "fall_time_const"),
+                   "table": ("times", "values")}
 _ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
         "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
         "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
@@ -172,6 +193,12 @@ def _signal(value, unit, key, src) -> Signal:
         raise ParameterError(f"{src}: {key}: unknown signal {kind!r} (known: {', '.join(SIGNAL_FIELDS)})")
     if kind == "constant":
         return Signal.constant(_quantity(spec, unit, f"{key}.constant", src))
+    if kind == "product":   # [a signal in the field's unit, a dimensionless one]
+        if not isinstance(spec, list) or len(spec) != 2:
+            raise ParameterError(f"{src}: {key}.product = {spec!r}: expected two signals [S1, S2] (S1 in the "
+                                 "field's unit, S2 dimensionless)")
+        return Signal.product(_signal(spec[0], unit, f"{key}.product[0]", src),
+                              _signal(spec[1], "1", f"{key}.product[1]", src))
     if not isinstance(spec, dict):
         raise ParameterError(f"{src}: {key}.{kind} = {spec!r}: expected a table of its parameters")
     fields = SIGNAL_FIELDS[kind]
@@ -185,6 +212,10 @@ def _signal(value, unit, key, src) -> Signal:
             if not isinstance(v, list):
                 raise ParameterError(f"{src}: {key}.table.{f} = {v!r}: expected a list")
             args[f] = [_quantity(x, u, f"{key}.table.{f}[{i}]", src) for i, x in enumerate(v)]
+        elif u == "int":
+            if not isinstance(v, int) or isinstance(v, bool):
+                raise ParameterError(f"{src}: {key}.{kind}.{f} = {v!r}: expected a whole number (-1: unlimited)")
+            args[f] = v
         else:
             args[f] = _quantity(v, u, f"{key}.{kind}.{f}", src)
     try:
@@ -194,6 +225,9 @@ def _signal(value, unit, key, src) -> Signal:
             raise ParameterError("ramp needs a duration")
         if kind == "sine" and not {"amplitude", "frequency"} <= set(args):
             raise ParameterError("sine needs an amplitude and a frequency")
+        missing = [f for f in SIGNAL_REQUIRED[kind] if f not in args]
+        if missing:
+            raise ParameterError(f"{kind} needs {', '.join(missing)} (it has {', '.join(args) or 'none'})")
         return getattr(Signal, kind)(**args)
     except ParameterError as exc:
         raise ParameterError(f"{src}: {key}: {exc}") from None
@@ -409,8 +443,9 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                 elif f == "curve":
                     args[f] = _characteristic(v, unit, fkey, src, x_unit=angle_unit, table_only=True)
                 elif unit == "text":
-                    if v not in ("linear", "pchip"):
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected \"linear\" or \"pchip\"")
+                    if v not in CHOICES[f]:
+                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected "
+                                             + " or ".join(f'"{c}"' for c in CHOICES[f]))
                     args[f] = v
                 elif unit == "bool":
                     if not isinstance(v, bool):

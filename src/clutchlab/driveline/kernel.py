@@ -56,6 +56,12 @@ MOTION_SPEED, MOTION_POSITION = 0, 1
 # between points i-1 and i, m above the last of m points)
 LASH_GAP, LASH_UPPER, LASH_LOWER = 0, 1, 2
 LASH_VALUES = ("gap", "upper", "lower")
+# a backlash's damping law (``elem[r, E_AUX]``): Kelvin-Voigt in contact, or MSL ``ElastoBacklash``'s, whose contact
+# has two more modes per side (odd: upper, even: lower): the damping torque limited to the spring torque
+# (tau = 2 tau_c) and the contact unloaded (tau = 0, where tau_c + tau_d would pull)
+LASH_KELVIN_VOIGT, LASH_MSL = 0, 1
+LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED = 3, 4, 5, 6
+LASH_MSL_VALUES = LASH_VALUES + ("upper_limited", "lower_limited", "upper_released", "lower_released")
 # modes of a friction element (index into MODE_VALUES); MSL's codes are MODE_CODES
 STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
@@ -65,8 +71,10 @@ MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Fo
 EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = range(8)
 EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
-# signals
+# signals (rows of ``DrivelineParams.signals``, ``N_SIG`` wide: the kind and up to eight parameters)
 SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
+SIG_PULSE, SIG_TRAPEZOID, SIG_EXPONENTIALS, SIG_PRODUCT = 6, 7, 8, 9
+N_SIG = 9
 # columns of ``elem`` (ints) and ``coef`` (floats)
 E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = range(11)  # E_AUX: a curve's kind
 N_ELEM = 11      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE: index in m; E_STATE: of a controller state;
@@ -101,7 +109,7 @@ class DrivelineParams(NamedTuple):
 
     Built by :func:`clutchlab.driveline.network.pack`.  ``inertia``: the inertias [kg m^2];
     ``elem`` (int64, one row per element, columns ``E_*``) and ``coef`` (float, ``C_*``): the
-    elements; ``signals`` (one row per signal: kind, then up to 6 parameters) and ``data`` (tables:
+    elements; ``signals`` (one row per signal: kind, then up to ``N_SIG - 1`` parameters) and ``data`` (tables:
     friction characteristics, spring curves and signal tables); ``fric`` (int64): the element row of
     each friction element; ``cons``: of each constraint (gears and motion sources, always held);
     ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
@@ -133,15 +141,49 @@ def _table(data, start, n, t):
     return data[start + n + lo] + w * (data[start + n + lo + 1] - data[start + n + lo])
 
 
-@numba.njit(cache=True, nogil=True)
-def signal_value(sig, data, t):
-    """Value of one signal row at ``t`` (MSL ``Modelica.Blocks.Sources``: Constant, Step, Ramp, Sine, table).
+@numba.njit(cache=True, nogil=True, inline="always")
+def _period(start, period, t):
+    """Index ``k`` [-] (a float) of the period holding ``t >= start``: ``start + k period <= t < start + (k + 1)
+    period`` with exactly those sums, the break times of :func:`signal_break` (a floor of the quotient alone
+    may round to the period before a break)."""
+    k = math.floor((t - start) / period)
+    if start + (k + 1.0) * period <= t:
+        k += 1.0
+    elif start + k * period > t:
+        k -= 1.0
+    return k
 
-    Rows: ``[kind, p0 .. p5]``; constant ``[k, value]``; step ``[k, height, start, offset]``; ramp
-    ``[k, height, duration, start, offset]``; sine ``[k, amplitude, frequency, phase, offset, start]``
-    (zero plus offset before the start, as MSL's ``Sine``); table ``[k, start index, n]`` in ``data``; a
-    sampled signal as a table, then ``[start, number]`` of its corners in ``data``.
-    """
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _corners(sig):
+    """Offsets [s] of a periodic signal's corners within its period: a pulse's end of the on-part (the width,
+    a fraction, times the period); a trapezoid's ends of rising, width and falling (MSL ``T_rising``,
+    ``T_width``, ``T_falling``)."""
+    if int(sig[0]) == SIG_PULSE:
+        tw = sig[2] * sig[3]
+        return tw, tw, tw
+    return sig[2], sig[2] + sig[3], sig[2] + sig[3] + sig[4]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _periodic_at(sig, t):
+    """A pulse's or trapezoid's period at ``t``: ``(active, t_k)``, the start ``t_k`` [s] of the period holding
+    ``t`` and whether that period is one of its ``nperiod`` (MSL: 0 before ``startTime``, after ``nperiod``
+    periods, or with ``nperiod = 0``)."""
+    if int(sig[0]) == SIG_PULSE:
+        period, nper, start = sig[3], sig[4], sig[6]
+    else:
+        period, nper, start = sig[5], sig[6], sig[8]
+    if t < start or nper == 0.0:
+        return False, start
+    k = _period(start, period, t)
+    if nper > 0.0 and k >= nper:
+        return False, start
+    return True, start + k * period
+
+
+@numba.njit(cache=True, nogil=True)
+def _basic_value(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_CONST:
         return sig[1]
@@ -157,12 +199,57 @@ def signal_value(sig, data, t):
         if t < sig[5]:
             return sig[4]
         return sig[4] + sig[1] * math.sin(2.0 * math.pi * sig[2] * (t - sig[5]) + sig[3])
+    if kind == SIG_PULSE:   # MSL Pulse: amplitude while t < T_start + T_width
+        on, tk = _periodic_at(sig, t)
+        tw, _c2, _c3 = _corners(sig)
+        return sig[5] + (sig[1] if on and (t < tk + tw or sig[2] >= 1.0) else 0.0)   # width 1: on throughout
+    if kind == SIG_TRAPEZOID:   # MSL Trapezoid: rising, width, falling, then 0 to the period's end
+        on, tk = _periodic_at(sig, t)
+        if not on:
+            return sig[7]
+        c1, c2, c3 = _corners(sig)
+        if t < tk + c1:
+            return sig[7] + sig[1] * (t - tk) / sig[2]
+        if t < tk + c2:
+            return sig[7] + sig[1]
+        if t < tk + c3:
+            return sig[7] + sig[1] * (tk + c3 - t) / sig[4]
+        return sig[7]
+    if kind == SIG_EXPONENTIALS:   # MSL Exponentials: outMax (1 - exp(-t'/riseTimeConst)), then the fall
+        if t < sig[6]:
+            return sig[5]
+        tr = sig[6] + sig[2]
+        if t < tr:
+            return sig[5] - sig[1] * math.expm1(-(t - sig[6]) / sig[3])
+        return sig[5] - sig[1] * math.expm1(-sig[2] / sig[3]) * math.exp(-(t - tr) / sig[4])
     return _table(data, int(sig[1]), int(sig[2]), t)
 
 
 @numba.njit(cache=True, nogil=True)
-def signal_break(sig, data, t):
-    """Next time after ``t`` at which the signal has a jump or a kink (inf if none)."""
+def signal_value(sig, data, t):
+    """Value of one signal row at ``t`` (MSL ``Modelica.Blocks.Sources``: Constant, Step, Ramp, Sine, Pulse,
+    Trapezoid, Exponentials, a table; ``Blocks.Math.Product`` of such signals).
+
+    Rows (``N_SIG`` wide): ``[kind, p0 .. p7]``; constant ``[k, value]``; step ``[k, height, start, offset]``;
+    ramp ``[k, height, duration, start, offset]``; sine ``[k, amplitude, frequency, phase, offset, start]``
+    (zero plus offset before the start, as MSL's ``Sine``); pulse ``[k, amplitude, width (a fraction of the
+    period), period, nperiod (< 0: unlimited), offset, start]``; trapezoid ``[k, amplitude, rising, width,
+    falling, period, nperiod, offset, start]``; exponentials ``[k, outMax, riseTime, riseTimeConst,
+    fallTimeConst, offset, start]``; table ``[k, start index, n]`` in ``data``; a sampled signal as a table,
+    then ``[start, number]`` of its corners in ``data``; a product ``[k, start index, n]``: its ``n`` factors'
+    rows, one after the other in ``data`` (none a product; ``Driveline.pack`` flattens nested ones).
+    """
+    if int(sig[0]) == SIG_PRODUCT:
+        o, nf = int(sig[1]), int(sig[2])
+        v = 1.0
+        for i in range(nf):
+            v *= _basic_value(data[o + i * N_SIG:o + (i + 1) * N_SIG], data, t)
+        return v
+    return _basic_value(sig, data, t)
+
+
+@numba.njit(cache=True, nogil=True)
+def _basic_break(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_STEP:
         return sig[2] if sig[2] > t else np.inf
@@ -172,6 +259,31 @@ def signal_break(sig, data, t):
         return sig[3] + sig[2] if sig[3] + sig[2] > t else np.inf
     if kind == SIG_SINE:
         return sig[5] if sig[5] > t else np.inf
+    if kind == SIG_PULSE or kind == SIG_TRAPEZOID:   # every corner of every period, then each period's start
+        if kind == SIG_PULSE:
+            period, nper, start = sig[3], sig[4], sig[6]
+        else:
+            period, nper, start = sig[5], sig[6], sig[8]
+        if nper == 0.0:
+            return np.inf
+        if t < start:
+            return start
+        k = _period(start, period, t)
+        if nper > 0.0 and k >= nper:
+            return np.inf
+        tk = start + k * period
+        c1, c2, c3 = _corners(sig)
+        if tk + c1 > t:
+            return tk + c1
+        if tk + c2 > t:
+            return tk + c2
+        if tk + c3 > t:
+            return tk + c3
+        return start + (k + 1.0) * period
+    if kind == SIG_EXPONENTIALS:
+        if sig[6] > t:
+            return sig[6]
+        return sig[6] + sig[2] if sig[6] + sig[2] > t else np.inf
     if kind == SIG_TABLE or kind == SIG_SAMPLED:   # every point of a table; a sampled signal's corners
         s = int(sig[1]) if kind == SIG_TABLE else int(sig[3])
         for i in range(s, s + int(sig[2] if kind == SIG_TABLE else sig[4])):
@@ -181,13 +293,20 @@ def signal_break(sig, data, t):
 
 
 @numba.njit(cache=True, nogil=True)
-def signal_rates(sig, data, t):
-    """First and second time derivatives of one signal row at ``t``.
+def signal_break(sig, data, t):
+    """Next time after ``t`` at which the signal has a jump or a kink (inf if none); a product's, the first of
+    its factors'."""
+    if int(sig[0]) == SIG_PRODUCT:
+        o, nf = int(sig[1]), int(sig[2])
+        tb = np.inf
+        for i in range(nf):
+            tb = min(tb, _basic_break(data[o + i * N_SIG:o + (i + 1) * N_SIG], data, t))
+        return tb
+    return _basic_break(sig, data, t)
 
-    One-sided from the right at a corner (the slope of the segment that follows), so a ramp's or a
-    table's rate is piecewise constant between the breaks of :func:`signal_break`.  A step's jump has
-    no rate here (motion sources refuse steps).
-    """
+
+@numba.njit(cache=True, nogil=True)
+def _basic_rates(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_RAMP:
         if sig[3] <= t < sig[3] + sig[2]:
@@ -199,6 +318,27 @@ def signal_rates(sig, data, t):
         om = 2.0 * math.pi * sig[2]
         arg = om * (t - sig[5]) + sig[3]
         return sig[1] * om * math.cos(arg), -sig[1] * om * om * math.sin(arg)
+    if kind == SIG_TRAPEZOID:
+        on, tk = _periodic_at(sig, t)
+        if not on:
+            return 0.0, 0.0
+        c1, c2, c3 = _corners(sig)
+        if t < tk + c1:
+            return sig[1] / sig[2], 0.0
+        if t < tk + c2:
+            return 0.0, 0.0
+        if t < tk + c3:
+            return -sig[1] / sig[4], 0.0
+        return 0.0, 0.0
+    if kind == SIG_EXPONENTIALS:
+        if t < sig[6]:
+            return 0.0, 0.0
+        tr = sig[6] + sig[2]
+        if t < tr:
+            r1 = sig[1] / sig[3] * math.exp(-(t - sig[6]) / sig[3])
+            return r1, -r1 / sig[3]
+        y = -sig[1] * math.expm1(-sig[2] / sig[3]) * math.exp(-(t - tr) / sig[4])
+        return -y / sig[4], y / (sig[4] * sig[4])
     if kind == SIG_TABLE or kind == SIG_SAMPLED:
         s = int(sig[1])
         n = int(sig[2])
@@ -207,6 +347,29 @@ def signal_rates(sig, data, t):
         lo, _w = bracket(data[s:s + n], t)
         return (data[s + n + lo + 1] - data[s + n + lo]) / (data[s + lo + 1] - data[s + lo]), 0.0
     return 0.0, 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def signal_rates(sig, data, t):
+    """First and second time derivatives of one signal row at ``t``.
+
+    One-sided from the right at a corner (the slope of the segment that follows), so a ramp's, a trapezoid's
+    or a table's rate is piecewise constant between the breaks of :func:`signal_break`.  A jump (a step's, a
+    pulse's) has no rate here (speed sources refuse signals that jump).  A product ``y = prod f_i`` by the
+    product rule, one factor at a time: ``(y f)' = y' f + y f'``, ``(y f)'' = y'' f + 2 y' f' + y f''``.
+    """
+    if int(sig[0]) == SIG_PRODUCT:
+        o, nf = int(sig[1]), int(sig[2])
+        y, d1, d2 = 1.0, 0.0, 0.0
+        for i in range(nf):
+            row = data[o + i * N_SIG:o + (i + 1) * N_SIG]
+            f = _basic_value(row, data, t)
+            f1, f2 = _basic_rates(row, data, t)
+            d2 = d2 * f + 2.0 * d1 * f1 + y * f2
+            d1 = d1 * f + y * f1
+            y *= f
+        return d1, d2
+    return _basic_rates(sig, data, t)
 
 
 # ----------------------------------------------------------------- friction characteristic
@@ -426,6 +589,19 @@ def _spring_deflection(p, r, x, n):
 
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _lash_side(mode):
+    """The side of a backlash's contact mode: 1 upper (odd modes), -1 lower (even), 0 in the gap."""
+    return 0.0 if mode == LASH_GAP else (1.0 if mode % 2 == 1 else -1.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def _lash_msl(p, r):
+    """Does backlash row ``r`` follow MSL ``ElastoBacklash``'s damping law (with damping: without, both laws are
+    the same spring)?"""
+    return p.elem[r][E_AUX] == LASH_MSL and p.coef[r][C_DAMP] > 0.0
+
+
 @numba.njit(cache=True, nogil=True)
 def spring_torque(p, r, x, n, m):
     """Torque [N m] of spring-damper row ``r`` and its elastic part, ``(tau, tau_c)``.
@@ -436,7 +612,9 @@ def spring_torque(p, r, x, n, m):
     (total gap ``b``), by its contact mode (``m``): in contact above the gap ``tau_c = c (phi - b/2)``,
     below it ``c (phi + b/2)``, nothing in the gap.  The contact is a mode, entered at the gap's edge and
     left when the torque would pull (located events, :func:`driveline_update`), so the torque is smooth
-    within a step.  ``tau = tau_c + tau_d``.
+    within a step.  ``tau = tau_c + tau_d``.  With MSL's damping law (``ElastoBacklash``, above the gap;
+    mirrored below) ``tau = tau_c + min(tau_c, tau_d)``, and 0 where ``tau_c + tau_d <= 0``: three modes per
+    side (``tau_c + tau_d``; ``2 tau_c`` while ``tau_d >= tau_c``; 0), changed at their kinks, located events.
     """
     e = p.elem[r]
     c = p.coef[r]
@@ -447,12 +625,14 @@ def spring_torque(p, r, x, n, m):
         tc = _segment_value(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], m[e[E_MODE]], phi)
         return tc + tau_d, tc
     if law == SPRING_BACKLASH:
-        b2 = 0.5 * c[C_GAP]
         mode = m[e[E_MODE]]
         if mode == LASH_GAP:
             return 0.0, 0.0
-        tc = c[C_STIFF] * (phi - b2 if mode == LASH_UPPER else phi + b2)
-        return tc + tau_d, tc
+        tc = c[C_STIFF] * (phi - _lash_side(mode) * 0.5 * c[C_GAP])
+        if mode <= LASH_LOWER:
+            return tc + tau_d, tc
+        # MSL ElastoBacklash: tau_c + min(tau_c, tau_d) (upper; max below) -- limited: 2 tau_c; released: 0
+        return (2.0 * tc if mode <= LASH_LOWER_LIMITED else 0.0), tc
     tc = c[C_STIFF] * phi
     return tc + tau_d, tc
 
@@ -471,7 +651,7 @@ def spring_energy(p, r, x, n, m):
         mode = m[e[E_MODE]]
         if mode == LASH_GAP:
             return 0.0
-        q = phi - 0.5 * c[C_GAP] if mode == LASH_UPPER else phi + 0.5 * c[C_GAP]
+        q = phi - _lash_side(mode) * 0.5 * c[C_GAP]
         return 0.5 * c[C_STIFF] * q * q
     return 0.5 * c[C_STIFF] * phi * phi
 
@@ -1410,7 +1590,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
     side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
-    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull).  A
+    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull); with
+    MSL's damping law, the two of its mode that fall through zero at its kinks (:func:`_lash_msl_switching`).  A
     curve spring: the deflection above the segment's lower point and below its upper one (either falling
     through zero moves it to the next segment).  Then two per lossy gear: stuck, the margin of the loss torque it
     holds within its band (:func:`gear_band`; falls through zero: it rolls); rolling, its speed in its direction
@@ -1473,6 +1654,11 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * nf + 2 * j + 1] = p.data[s0 + mode] - phi if mode < mp else 1.0
             continue
         b2 = 0.5 * c[C_GAP]
+        if _lash_msl(p, r):
+            g0, g1 = _lash_msl_switching(p, r, x, n, mode, phi)
+            g[N_G * nf + 2 * j] = g0
+            g[N_G * nf + 2 * j + 1] = g1
+            continue
         # in the gap: the edges; in contact: the torque over c (it falls through zero: it would pull)
         lag = c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
         g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
@@ -1512,6 +1698,60 @@ def gear_power(p, r, x, n, m, tau):
         tb = -ratio * (f * tau + c)
     ts = -tau - tb
     return -(tau * _speed(x, n, e[E_A]) + tb * _speed(x, n, e[E_B]) + ts * _speed(x, n, e[E_SUP]))
+
+
+@numba.njit(cache=True, nogil=True)
+def _lash_msl_switching(p, r, x, n, mode, phi):
+    """The two switching functions of a backlash with MSL's damping law in contact mode ``mode``, each positive
+    within the mode and falling through zero at one of its ends (direction -1), in radians (torques over ``c``);
+    ``s`` the contact's side, ``a = s tau_c``, ``b = s tau_d``:
+
+    * gap: ``b/2 - phi`` (upper contact), ``phi + b/2`` (lower contact);
+    * ``upper``/``lower`` (``tau_c + tau_d``): ``a - b`` (the damping reaches the spring torque: limited), ``a + b``
+      (the torque reaches zero: released);
+    * limited (``2 tau_c``): ``b - a`` (back to ``tau_c + tau_d``); none;
+    * released (0): ``-(a + b)`` (the contact loads again), ``s phi - b/2`` (the gap's edge: separate).
+    """
+    e = p.elem[r]
+    c = p.coef[r]
+    b2 = 0.5 * c[C_GAP]
+    if mode == LASH_GAP:
+        return b2 - phi, phi + b2
+    side = _lash_side(mode)
+    a = side * (phi - side * b2)
+    b = side * c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+    if mode <= LASH_LOWER:
+        return a - b, a + b
+    if mode <= LASH_LOWER_LIMITED:
+        return b - a, 1.0
+    return -(a + b), side * phi - b2
+
+
+@numba.njit(cache=True, nogil=True)
+def _lash_msl_update(p, r, x, n, mode, which):
+    """The mode a backlash with MSL's damping law enters when its switching function ``which`` (0 or 1) of
+    :func:`_lash_msl_switching` falls through zero in ``mode``; from the gap, the contact's mode at the edge
+    (limited while ``s tau_d >= s tau_c``: moving in, the damping torque exceeds the spring's, which is zero)."""
+    if mode == LASH_GAP:
+        side = 1.0 if which == 0 else -1.0
+        e = p.elem[r]
+        c = p.coef[r]
+        a = side * c[C_STIFF] * (_spring_deflection(p, r, x, n) - side * 0.5 * c[C_GAP])
+        b = side * c[C_DAMP] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+        upper = which == 0
+        if b >= a:
+            return LASH_UPPER_LIMITED if upper else LASH_LOWER_LIMITED
+        return LASH_UPPER if upper else LASH_LOWER
+    upper = mode % 2 == 1
+    if mode <= LASH_LOWER:
+        if which == 0:
+            return LASH_UPPER_LIMITED if upper else LASH_LOWER_LIMITED
+        return LASH_UPPER_RELEASED if upper else LASH_LOWER_RELEASED
+    if mode <= LASH_LOWER_LIMITED:
+        return LASH_UPPER if upper else LASH_LOWER
+    if which == 0:
+        return LASH_UPPER if upper else LASH_LOWER
+    return LASH_GAP
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1568,7 +1808,8 @@ def driveline_outputs(t, x, u, m, p, y):
 def driveline_update(t, x, u, m, p, k, log):
     """Switching function ``k`` crossed: a sliding element reached zero relative speed (it sticks, or
     reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
-    backlash closed (``contact``) or opened (``separate``) its gap."""
+    backlash closed (``contact``) or opened (``separate``) its gap, or (MSL's damping law) reached a kink of
+    its contact law (:func:`_lash_msl_update`, no event)."""
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
     if k >= N_G * nf + 2 * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
@@ -1591,6 +1832,15 @@ def driveline_update(t, x, u, m, p, k, log):
         e = p.elem[r]
         if e[E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
             m[nf + j] += -1 if (k - N_G * nf) % 2 == 0 else 1
+            return 0
+        if _lash_msl(p, r):   # MSL's damping law: its kinks change the mode silently; the edges are events
+            old = m[nf + j]
+            new = _lash_msl_update(p, r, x, n, old, (k - N_G * nf) % 2)
+            if new == LASH_GAP:   # at the edge: what the spring holds is ~0 (as below)
+                x[2 * n + r] += spring_energy(p, r, x, n, m)
+            m[nf + j] = new
+            if old == LASH_GAP or new == LASH_GAP:
+                record(log, t, EV_CONTACT if new != LASH_GAP else EV_SEPARATE, nf + j)
             return 0
         side = LASH_UPPER if (k - N_G * nf) % 2 == 0 else LASH_LOWER   # phi - b/2: the gap's upper side
         w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])

@@ -50,7 +50,8 @@ def _finite(component, name, value, *, positive=False, nonneg=False):
 
 @dataclass(frozen=True)
 class Signal:
-    """A time signal as in ``Modelica.Blocks.Sources``: constant, step, ramp, sine or a table.
+    """A time signal as in ``Modelica.Blocks.Sources``: constant, step, ramp, sine, pulse, trapezoid,
+    exponentials or a table, or the product of signals (``Modelica.Blocks.Math.Product``).
 
     Build with the class methods; a plain number is a constant.
 
@@ -62,11 +63,14 @@ class Signal:
         The breakpoints of a table signal: times, then values.
     breaks : tuple
         A sampled signal's corners (times [s]), the only points at which a step must end.
+    factors : tuple
+        A product's factors (signals, none of them a product: nested products are flattened).
     """
 
     row: tuple
     points: tuple = ()
     breaks: tuple = ()
+    factors: tuple = ()
 
     @classmethod
     def constant(cls, value: float) -> "Signal":
@@ -91,6 +95,64 @@ class Signal:
         """``offset + amplitude sin(2 pi f (t - start) + phase)`` from ``start`` [s], ``offset`` before (MSL ``Sine``)."""
         return cls((K.SIG_SINE, _finite("sine", "amplitude", amplitude), _finite("sine", "frequency", frequency, nonneg=True),
                     _finite("sine", "phase", phase), _finite("sine", "offset", offset), _finite("sine", "start", start)))
+
+    @classmethod
+    def pulse(cls, amplitude: float, width: float, period: float, nperiod: int = -1, offset: float = 0.0,
+              start: float = 0.0) -> "Signal":
+        """MSL ``Pulse``: ``offset + amplitude`` for the first ``width`` of each ``period`` [s] from ``start`` [s],
+        ``offset`` otherwise, before ``start`` and after ``nperiod`` periods (< 0: unlimited).
+
+        ``width`` is the fraction of the period the pulse is on, in (0, 1] (MSL's ``width`` is in percent:
+        MSL ``width = 50`` is 0.5 here).  Every on and off instant is a break of the integrator.
+        """
+        w = _finite("pulse", "width", width)
+        if not 0.0 < w <= 1.0:
+            raise ParameterError(f"pulse: width = {width!r} must be in (0, 1] (the fraction of the period the "
+                                 "pulse is on; MSL's width = 50 % is 0.5)")
+        return cls((K.SIG_PULSE, _finite("pulse", "amplitude", amplitude), w,
+                    _finite("pulse", "period", period, positive=True), _count("pulse", nperiod),
+                    _finite("pulse", "offset", offset), _finite("pulse", "start", start)))
+
+    @classmethod
+    def trapezoid(cls, amplitude: float, rising: float, width: float, falling: float, period: float,
+                  nperiod: int = -1, offset: float = 0.0, start: float = 0.0) -> "Signal":
+        """MSL ``Trapezoid``: in each ``period`` [s] from ``start`` [s], linear from ``offset`` to ``offset +
+        amplitude`` over ``rising`` [s], held for ``width`` [s], back to ``offset`` over ``falling`` [s], then
+        ``offset`` to the period's end; ``offset`` before ``start`` and after ``nperiod`` periods (< 0:
+        unlimited).  ``rising + width + falling <= period``; every corner is a break of the integrator."""
+        rising = _finite("trapezoid", "rising", rising, nonneg=True)
+        width = _finite("trapezoid", "width", width, nonneg=True)
+        falling = _finite("trapezoid", "falling", falling, nonneg=True)
+        period = _finite("trapezoid", "period", period, positive=True)
+        if rising + width + falling > period:
+            raise ParameterError(f"trapezoid: rising + width + falling = {rising:g} + {width:g} + {falling:g} s "
+                                 f"must not exceed period = {period:g} s")
+        return cls((K.SIG_TRAPEZOID, _finite("trapezoid", "amplitude", amplitude), rising, width, falling, period,
+                    _count("trapezoid", nperiod), _finite("trapezoid", "offset", offset),
+                    _finite("trapezoid", "start", start)))
+
+    @classmethod
+    def exponentials(cls, out_max: float, rise_time: float, rise_time_const: float, fall_time_const: float,
+                     offset: float = 0.0, start: float = 0.0) -> "Signal":
+        """MSL ``Exponentials``: from ``start`` [s], ``offset + out_max (1 - exp(-(t - start) / rise_time_const))``
+        for ``rise_time`` [s], then that value at ``start + rise_time`` times ``exp(-(t - start - rise_time) /
+        fall_time_const)`` (time constants [s] > 0); ``offset`` before ``start``.  Breaks at ``start`` and
+        ``start + rise_time`` (its kinks)."""
+        return cls((K.SIG_EXPONENTIALS, _finite("exponentials", "out_max", out_max),
+                    _finite("exponentials", "rise_time", rise_time, nonneg=True),
+                    _finite("exponentials", "rise_time_const", rise_time_const, positive=True),
+                    _finite("exponentials", "fall_time_const", fall_time_const, positive=True),
+                    _finite("exponentials", "offset", offset), _finite("exponentials", "start", start)))
+
+    @classmethod
+    def product(cls, a, b) -> "Signal":
+        """The product ``a(t) b(t)`` of two signals (MSL ``Blocks.Math.Product`` of two sources); numbers are
+        constants.  Its breaks are both factors'.  Products of products are flattened into one."""
+        factors = []
+        for what, f in (("a", a), ("b", b)):
+            f = cls.of(f, f"product: {what}")
+            factors.extend(f.factors if f.row[0] == K.SIG_PRODUCT else (f,))
+        return cls((K.SIG_PRODUCT,), factors=tuple(factors))
 
     @classmethod
     def table(cls, times, values) -> "Signal":
@@ -156,6 +218,19 @@ class Signal:
         if k == K.SIG_SINE:
             off = f"{a[3]:g} + " if a[3] else ""
             return f"{off}{a[0]:g}{u} sine at {a[1]:g} Hz, phase {a[2]:g} rad" + (f", from {a[4]:g} s" if a[4] else "")
+        if k == K.SIG_PULSE:
+            count = "" if a[3] < 0 else f", {a[3]:g} periods"
+            return (("" if a[4] == 0 else f"{a[4]:g} + ") + f"{a[0]:g}{u} pulse, {a[1] * 100:g} % of {a[2]:g} s{count}"
+                    + (f", from {a[5]:g} s" if a[5] else ""))
+        if k == K.SIG_TRAPEZOID:
+            count = "" if a[5] < 0 else f", {a[5]:g} periods"
+            return (("" if a[6] == 0 else f"{a[6]:g} + ") + f"{a[0]:g}{u} trapezoid, rising {a[1]:g} s, width {a[2]:g} s, falling {a[3]:g} s, "
+                    f"period {a[4]:g} s{count}" + (f", from {a[7]:g} s" if a[7] else ""))
+        if k == K.SIG_EXPONENTIALS:
+            return (("" if a[4] == 0 else f"{a[4]:g} + ") + f"{a[0]:g}{u} exponentials, rising {a[1]:g} s (time constant {a[2]:g} s), "
+                    f"falling with {a[3]:g} s" + (f", from {a[5]:g} s" if a[5] else ""))
+        if k == K.SIG_PRODUCT:
+            return " * ".join(f"({f.describe(unit if i == 0 else '')})" for i, f in enumerate(self.factors))
         n = len(self.points) // 2
         what = "samples" if k == K.SIG_SAMPLED else "table of"
         return f"{what} {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
@@ -164,10 +239,27 @@ class Signal:
         """Value and time derivative (from the right) at ``t`` [s], in Python (as the kernel's
         :func:`~clutchlab.driveline.kernel.signal_value` and :func:`~clutchlab.driveline.kernel.signal_rates`)."""
         k, *a = self.row
+        if k == K.SIG_PRODUCT:   # the product rule, one factor at a time
+            y, rate = 1.0, 0.0
+            for f in self.factors:
+                v, r = f.value_and_rate(t)
+                y, rate = y * v, rate * v + y * r
+            return y, rate
         if k == K.SIG_CONST:
             return a[0], 0.0
         if k == K.SIG_STEP:
             return a[2] + (a[0] if t >= a[1] else 0.0), 0.0
+        if k in (K.SIG_PULSE, K.SIG_TRAPEZOID):
+            return _periodic_value_and_rate(k, a, t)
+        if k == K.SIG_EXPONENTIALS:
+            out_max, rise, tc_rise, tc_fall, offset, start = a
+            if t < start:
+                return offset, 0.0
+            if t < start + rise:
+                return (offset - out_max * math.expm1(-(t - start) / tc_rise),
+                        out_max / tc_rise * math.exp(-(t - start) / tc_rise))
+            y = -out_max * math.expm1(-rise / tc_rise) * math.exp(-(t - (start + rise)) / tc_fall)
+            return offset + y, -y / tc_fall
         if k == K.SIG_RAMP:
             height, duration, start, offset = a
             if t < start:
@@ -216,6 +308,49 @@ class Signal:
         raise ParameterError(f"{what} = {value!r}: expected a number or a Signal")
 
 
+def _count(component, value):
+    """A number of periods: a whole number (< 0: unlimited, as MSL's ``nperiod = -1``), as a float."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    if isinstance(value, bool) or not math.isfinite(v) or v != math.floor(v):
+        raise ParameterError(f"{component}: nperiod = {value!r} must be a whole number (< 0: unlimited)")
+    return -1.0 if v < 0 else v
+
+
+def _periodic_value_and_rate(kind, a, t):
+    """Python twin of the kernel's pulse and trapezoid (:func:`~clutchlab.driveline.kernel.signal_value`):
+    value and rate (from the right) at ``t`` [s], with the same sums for the period's start and corners."""
+    if kind == K.SIG_PULSE:
+        amp, width, period, nper, offset, start = a
+        tw = width * period
+        corners = (tw, tw, tw)
+    else:
+        amp, rising, width, falling, period, nper, offset, start = a
+        corners = (rising, rising + width, rising + width + falling)
+    if t < start or nper == 0:
+        return offset, 0.0
+    k = math.floor((t - start) / period)
+    if start + (k + 1.0) * period <= t:
+        k += 1.0
+    elif start + k * period > t:
+        k -= 1.0
+    if nper > 0 and k >= nper:
+        return offset, 0.0
+    tk = start + k * period
+    c1, c2, c3 = corners
+    if kind == K.SIG_PULSE:
+        return offset + (amp if t < tk + c1 or width >= 1.0 else 0.0), 0.0
+    if t < tk + c1:
+        return offset + amp * (t - tk) / rising, amp / rising
+    if t < tk + c2:
+        return offset + amp, 0.0
+    if t < tk + c3:
+        return offset + amp * (tk + c3 - t) / falling, -amp / falling
+    return offset, 0.0
+
+
 def _curve_integrals(xs, fs, ds, kind):
     """Integral of a spring curve from its first point to each point (exact for linear and cubic Hermite).
 
@@ -252,8 +387,18 @@ def _check_motion_signal(name, what, sig):
     """A motion source's signal may not jump (an infinite torque) nor, for a position, have a speed jump."""
     kind, *a = sig.row
     if what == "speed":
+        if kind == K.SIG_PRODUCT:   # continuous if every factor is
+            for f in sig.factors:
+                _check_motion_signal(name, what, f)
+            return
         if kind == K.SIG_STEP:
             raise ParameterError(f"{name}: a speed step would need an infinite torque; use a ramp or a table")
+        if kind == K.SIG_PULSE and a[0] != 0.0:
+            raise ParameterError(f"{name}: a speed pulse jumps (an infinite torque); use a trapezoid with rising "
+                                 "and falling > 0")
+        if kind == K.SIG_TRAPEZOID and a[0] != 0.0 and (a[1] == 0.0 or a[3] == 0.0):
+            raise ParameterError(f"{name}: the trapezoid jumps (rising = {a[1]:g} s, falling = {a[3]:g} s): a speed "
+                                 "needs rising and falling > 0")
         if kind == K.SIG_SINE and a[4] > 0.0 and abs(a[0] * math.sin(a[2])) > 0.0:
             raise ParameterError(f"{name}: the sine jumps at its start ({a[4]:g} s); start it at 0 or with phase 0")
         return
@@ -428,21 +573,34 @@ class Driveline:
                                        law=K.SPRING_CURVE, table=table, aux=int(kind)))
         return self
 
-    def backlash(self, name: str, a, b, c: float, b_gap: float, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
+    def backlash(self, name: str, a, b, c: float, b_gap: float, d: float = 0.0, phi_rel0: float = 0.0,
+                 damping_law: str = "kelvin_voigt") -> "Driveline":
         """A spring-damper behind a gap between flanges a and b (as MSL ``ElastoBacklash``): no torque in the
         gap ``|phi_b - phi_a - phi_rel0| < b_gap / 2``; in contact ``c`` [N m/rad] on the deflection past the
-        gap's edge plus ``d`` [N m s/rad] on the relative speed.  Contact begins at the edge (the damping
-        torque steps in with the impact speed) and ends when the torque would pull; both are located events,
-        ``contact`` and ``separate``.  The energy still in the spring at a damped separation is counted as
-        dissipated (the massless spring relaxes through its damper, taken as instantaneous).  ``c`` > 0,
-        ``b_gap`` [rad] > 0 (without a gap, use :meth:`spring_damper`)."""
+        gap's edge, ``tau_c``, and ``d`` [N m s/rad] on the relative speed, ``tau_d``.  ``c`` > 0, ``b_gap``
+        [rad] > 0 (without a gap, use :meth:`spring_damper`).
+
+        ``damping_law``: ``"kelvin_voigt"`` (default): ``tau = tau_c + tau_d``; contact begins at the edge (the
+        damping torque steps in with the impact speed) and ends when the torque would pull; both are located
+        events, ``contact`` and ``separate``.  The energy still in the spring at a damped separation is counted
+        as dissipated (the massless spring relaxes through its damper, taken as instantaneous).  ``"msl"``:
+        MSL ``ElastoBacklash``'s law, ``tau = tau_c + min(tau_c, tau_d)`` beyond the upper edge and 0 where
+        ``tau_c + tau_d <= 0`` (mirrored below), so the torque is continuous at impact and never pulls; its
+        kinks are located events (no names), ``contact`` and ``separate`` are at the edge.  Its dissipation is
+        the damping share ``(tau - tau_c) w_rel`` (MSL's ``lossPower`` is zero where the contact is unloaded;
+        here the spring relaxes through its damper, so the energy balance closes).  Without damping the two
+        laws are the same."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         gap = _finite(name, "b_gap", b_gap, positive=True)
-        self._elements.append(_Element(K.K_SPRING, name, a, b, (_finite(name, "c", c, positive=True),
-                                                                 _finite(name, "d", d, nonneg=True),
+        laws = {"kelvin_voigt": K.LASH_KELVIN_VOIGT, "msl": K.LASH_MSL}
+        if damping_law not in laws:
+            raise ParameterError(f"{name}: damping_law = {damping_law!r} (known: {', '.join(map(repr, laws))})")
+        d = _finite(name, "d", d, nonneg=True)
+        self._elements.append(_Element(K.K_SPRING, name, a, b, (_finite(name, "c", c, positive=True), d,
                                                                  _finite(name, "phi_rel0", phi_rel0), gap),
-                                       law=K.SPRING_BACKLASH))
+                                       law=K.SPRING_BACKLASH,
+                                       aux=laws[damping_law] if d > 0.0 else K.LASH_KELVIN_VOIGT))
         return self
 
     def gear(self, name: str, a, b, ratio: float, efficiency: float = 1.0, loss_table=None,
@@ -980,7 +1138,8 @@ class Driveline:
             elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
                 what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
             elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
-                what = f"backlash gap {e.coef[3]:g} {au}, c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+                what = (f"backlash gap {e.coef[3]:g} {au}, c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+                        + (", MSL damping law" if e.aux == K.LASH_MSL else ""))
             elif e.kind == K.K_SPRING:
                 what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
             elif e.law == K.LAW_ONEWAY:
@@ -1027,7 +1186,9 @@ class Driveline:
         elem = np.zeros((len(self._elements), K.N_ELEM), dtype=np.int64)
         coef = np.zeros((len(self._elements), K.N_COEF))
 
-        def add_signal(sig):
+        def signal_row(sig):
+            """The signal's row (``K.N_SIG`` wide), its tables put in ``data``; a product's factor rows are put
+            in ``data`` one after the other (the row: kind, their start, their number)."""
             row = list(sig.row)
             if row[0] in (K.SIG_TABLE, K.SIG_SAMPLED):
                 n = len(sig.points) // 2
@@ -1037,7 +1198,15 @@ class Driveline:
                     corners = sorted({sig.points[0], sig.points[n - 1], *sig.breaks})
                     row += [float(len(data)), float(len(corners))]
                     data.extend(corners)
-            signals.append(row + [0.0] * (7 - len(row)))
+            elif row[0] == K.SIG_PRODUCT:
+                rows = [signal_row(f) for f in sig.factors]
+                row = [row[0], float(len(data)), float(len(rows))]
+                for f in rows:
+                    data.extend(f)
+            return row + [0.0] * (K.N_SIG - len(row))
+
+        def add_signal(sig):
+            signals.append(signal_row(sig))
             return len(signals) - 1
 
         for r, e in enumerate(self._elements):
@@ -1078,7 +1247,7 @@ class Driveline:
         elem[ext, K.E_AUX] = np.arange(len(ext))
         work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext), lossy.size))
         inertia = np.array([v[0] for v in self._inertias.values()])
-        p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, 7),
+        p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, K.N_SIG),
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
                               np.zeros(max(nk, 1), dtype=np.int64))
         x0 = self.initial_state()
@@ -1199,6 +1368,13 @@ class Driveline:
             upper = phi > b2 or (phi == b2 and w_rel > 0)
             lower = phi < -b2 or (phi == -b2 and w_rel < 0)
             m[p.fric.size + j] = K.LASH_UPPER if upper else K.LASH_LOWER if lower else K.LASH_GAP
+            if e.aux == K.LASH_MSL and (upper or lower):   # which part of MSL's law: s tau_c = a, s tau_d = b
+                s = 1.0 if upper else -1.0
+                a, b = s * e.coef[0] * (phi - s * b2), s * e.coef[1] * w_rel
+                if b >= a:
+                    m[p.fric.size + j] = K.LASH_UPPER_LIMITED if upper else K.LASH_LOWER_LIMITED
+                elif a + b <= 0.0:
+                    m[p.fric.size + j] = K.LASH_UPPER_RELEASED if upper else K.LASH_LOWER_RELEASED
         for k, r in enumerate(p.fric):
             e = p.elem[r]
             w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
@@ -1269,14 +1445,15 @@ class Driveline:
         switching = tuple((f"{f}.{what}", d) for f in fric
                           for what, d in (("stick", -1), ("breakaway", -1), ("normal", 0)))
         swit = [self._elements[r] for r in p.swit]
-        switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH else -1) for e in swit
-                           for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
-                                        else ("segment_below", "segment_above")))
+        # (a backlash's Kelvin-Voigt contact is watched both ways; MSL's law and curves by falling functions)
+        switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH and e.aux != K.LASH_MSL else -1)
+                           for e in swit for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
+                                                      else ("segment_below", "segment_above")))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
         switching += tuple((f"{e.name}.{what}", -1) for e in self._lossy for what in ("stick", "quadrant"))
         mode_names = named
-        swit_values = tuple(K.LASH_VALUES if e.law == K.SPRING_BACKLASH else
-                            tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
+        swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_VALUES)
+                            if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
@@ -1319,7 +1496,8 @@ class Driveline:
 
         # the switching functions follow the sources: a step holds at most an eighth of a sine's period, so a
         # stuck element whose torque swings past its limit and back within one step is not stepped over
-        freqs = [e.signal.row[2] for e in self._elements if e.signal is not None and e.signal.row[0] == K.SIG_SINE]
+        freqs = [f.row[2] for e in self._elements if e.signal is not None
+                 for f in (e.signal.factors or (e.signal,)) if f.row[0] == K.SIG_SINE]
         max_step = min((0.125 / f for f in freqs if f > 0), default=math.inf)
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
                       m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
