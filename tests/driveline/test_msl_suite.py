@@ -1,0 +1,136 @@
+"""The MSL suite: every friction, clutch, brake, one-way clutch, gear and backlash example of
+``Modelica.Mechanics.Rotational.Examples`` and ``ModelicaTest.Rotational`` that a clutchlab network can
+hold, as TOML (``tests/driveline/msl/*.toml``), against an independent solution written from the MSL
+equations (``tests/driveline/msl/reference.py``: SciPy DOP853 at rtol 1e-12, restarted at every event,
+the networks transcribed separately in ``msl/models.py``).
+
+Criteria (issue #30): every stick/slip/roll event within 1e-6 s; every signal (speeds, angles, element
+torques, dissipated energies, source work, a lossy gear's mode) within 2e-3 of its range (MSL's own
+regression tube), torques away from their jumps; the energy balance ``energy_error_J`` within 1e-6 of the
+energy that flowed.  ``msl/README.md`` lists the examples left out and why.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from clutchlab.driveline.description import load_driveline
+
+from .msl.models import MODELS
+from .msl.reference import collapse
+
+HERE = Path(__file__).parent / "msl"
+NAMES = sorted(MODELS)
+EVENT_TOL = 1e-6            # [s]
+SIGNAL_TOL = 2e-3           # of the signal's range
+MODES = ("stick", "forward", "backward", "free")
+#: events not compared: LossyGearDemo2 before 0.2 s (a stuck bearing on the flange of a locked gear: the
+#: split of the holding torque is not unique, MSL's system is singular there; see its TOML header)
+COMPARE_AFTER = {"lossy_gear_demo2": 0.2}
+
+
+def _grid(t_end, dt):
+    return np.linspace(0.0, t_end, int(round(t_end / dt)) + 1)
+
+
+@functools.lru_cache(maxsize=None)
+def reference(name):
+    build, t_end, dt = MODELS[name]
+    return build().simulate(t_end, _grid(t_end, dt))
+
+
+@functools.lru_cache(maxsize=None)
+def clutchlab_run(name):
+    f = load_driveline(HERE / f"{name}.toml")
+    _, t_end, dt = MODELS[name]
+    assert f.t_end == pytest.approx(t_end) and f.output_step == pytest.approx(dt), "TOML and models.py disagree"
+    return f.driveline.simulate(f.t_end, rtol=f.rtol, output_step=f.output_step)
+
+
+def _kinds(name):
+    """Element name -> kind in the reference network."""
+    return {e.name: e.kind for e in MODELS[name][0]().elements}
+
+
+def _events_of(rows, name):
+    """(t, element, mode) of the friction elements, one-way clutches and lossy gears after t = 0 (one-way
+    clutches: stick/forward only; the ideal gears have no events)."""
+    kinds = _kinds(name)
+    after = COMPARE_AFTER.get(name, 1e-9)
+    out = []
+    for t, element, event in rows:
+        kind = kinds.get(element)
+        if t <= after or event not in MODES or kind not in ("friction", "one_way", "lossy_gear"):
+            continue
+        if kind in ("one_way", "lossy_gear") and event == "free":
+            continue
+        out.append((float(t), element, event))
+    return collapse(sorted(out, key=lambda e: e[0]))
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_events_match_the_msl_reference(name):
+    """Every mode change (element, mode entered) in order, at the reference's time within 1e-6 s."""
+    ref = _events_of(reference(name).events, name)
+    ev = clutchlab_run(name).events
+    got = _events_of(zip(ev["time_s"], ev["element"], ev["event"]), name)
+    lines = [f"{'clutchlab':>34} | reference"]
+    for i in range(max(len(got), len(ref))):
+        g = "%.9f %s %s" % got[i] if i < len(got) else ""
+        r = "%.9f %s %s" % ref[i] if i < len(ref) else ""
+        lines.append(f"{g:>34} | {r}")
+    table = "\n".join(lines)
+    assert [e[1:] for e in got] == [e[1:] for e in ref], f"{name}: the events differ\n{table}"
+    dt = max((abs(g[0] - r[0]) for g, r in zip(got, ref)), default=0.0)
+    assert dt <= EVENT_TOL, f"{name}: event times differ by up to {dt:.3g} s\n{table}"
+
+
+def _compared_columns(name, ref):
+    kinds = _kinds(name)
+    cols = []
+    for col in ref.columns:
+        element, quantity = col.split(".", 1)
+        if quantity == "dissipated_J" and kinds.get(element) in ("spring_damper", "backlash"):
+            continue   # a separating backlash's spring energy: counted differently on purpose (docs/driveline.md)
+        cols.append(col)
+    return cols
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_signals_match_the_msl_reference(name):
+    """Speeds, angles, torques, dissipated energies, source work and lossy-gear modes within 2e-3 of each
+    signal's range (torques and modes not within 2e-5 s of a reference event or break, where they jump)."""
+    ref = reference(name)
+    df = clutchlab_run(name).to_dataframe()
+    t = ref.time
+    jumps = np.array(sorted({e[0] for e in ref.log} | set(ref.breaks)))
+    near = np.zeros(len(t), bool)
+    for tj in jumps:
+        near |= np.abs(t - tj) < 2e-5
+    missing = [c for c in _compared_columns(name, ref) if c not in df.columns]
+    assert not missing, f"{name}: clutchlab lacks the columns {missing}"
+    worst = []
+    for col in _compared_columns(name, ref):
+        r = ref.columns[col]
+        g = np.interp(t, df["time_s"].to_numpy(), df[col].to_numpy())
+        mask = ~near if col.endswith(("tau_Nm", "mode_1")) else np.ones(len(t), bool)
+        span = max(np.ptp(r), 1e-3)
+        err = np.max(np.abs(g - r)[mask]) / span
+        worst.append((err, col))
+    worst.sort(reverse=True)
+    bad = [(c, e) for e, c in worst if e > SIGNAL_TOL]
+    assert not bad, f"{name}: signals beyond {SIGNAL_TOL} of their range: " + ", ".join(
+        f"{c} {e:.3g}" for c, e in bad)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_energy_balance_closes(name):
+    """``energy_error_J`` within 1e-6 of the energy that flowed (input work, initial kinetic energy)."""
+    df = clutchlab_run(name).to_dataframe()
+    scale = max(np.abs(df["input_work_J"]).max(), df["kinetic_energy_J"].max(), 1.0)
+    err = np.abs(df["energy_error_J"]).max()
+    assert err <= 1e-6 * scale, f"{name}: energy balance error {err:.3g} J against {scale:.3g} J"
