@@ -31,6 +31,28 @@ MODES = ("stick", "forward", "backward", "free")
 #: events not compared: LossyGearDemo2 before 0.2 s (a stuck bearing on the flange of a locked gear: the
 #: split of the holding torque is not unique, MSL's system is singular there; see its TOML header)
 COMPARE_AFTER = {"lossy_gear_demo2": 0.2}
+#: statically indeterminate groups: elements that hold one shaft together (a stuck bearing on the flange of a stuck
+#: lossy gear).  While the shaft is at rest the split of the holding torque between them, and so which of them
+#: MSL labels "stuck", is not unique (MSL's LossyGearDemo2 documentation: "no unique solution"); clutchlab keeps
+#: every member stuck with a split within all limits, the reference a least-squares split that may leave one
+#: "sliding" at zero speed.  For such a group the events compared are the instants the shaft starts or stops
+#: (the motion, which is unique), and its members' torques and modes are compared only while the shaft moves.
+INDETERMINATE = {"lossy_gear_demo2": ("Inertia1.w_rad_s", ("bearingFriction", "gear"))}
+
+
+def _motion_events(times, speed_t, speed_w, after):
+    """The instants among ``times`` (> ``after``) at which a shaft with speed samples ``(speed_t, speed_w)``
+    starts or stops: at rest (|w| < 1e-7 of its range) just before and moving just after, or the reverse."""
+    span = max(np.ptp(speed_w), 1e-9)
+    out = []
+    for t in sorted(set(times)):
+        if t <= after:
+            continue
+        before = abs(np.interp(t - 2e-3, speed_t, speed_w)) < 1e-7 * span
+        later = abs(np.interp(t + 2e-3, speed_t, speed_w)) < 1e-7 * span
+        if before != later:
+            out.append((t, "start" if before else "stop"))
+    return out
 
 
 def _grid(t_end, dt):
@@ -69,7 +91,8 @@ def _events_of(rows, name):
         if kind in ("one_way", "lossy_gear") and event == "free":
             continue
         out.append((float(t), element, event))
-    return collapse(sorted(out, key=lambda e: e[0]))
+    # several elements changing mode at one instant: in element order (their order in time is not defined)
+    return collapse(sorted(out, key=lambda e: (round(e[0], 7), e[1], e[2])))
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -78,6 +101,18 @@ def test_events_match_the_msl_reference(name):
     ref = _events_of(reference(name).events, name)
     ev = clutchlab_run(name).events
     got = _events_of(zip(ev["time_s"], ev["element"], ev["event"]), name)
+    if name in INDETERMINATE:
+        col, group = INDETERMINATE[name]
+        after = COMPARE_AFTER.get(name, 1e-9)
+        df = clutchlab_run(name).to_dataframe()
+        rr = reference(name)
+        got_m = _motion_events([e[0] for e in got if e[1] in group], df["time_s"].to_numpy(), df[col].to_numpy(),
+                               after)
+        ref_m = _motion_events([e[0] for e in ref if e[1] in group], rr.time, rr.columns[col], after)
+        assert [m for _, m in got_m] == [m for _, m in ref_m] and len(got_m) >= 2, (got_m, ref_m)
+        assert max(abs(a[0] - b[0]) for a, b in zip(got_m, ref_m)) <= EVENT_TOL, (got_m, ref_m)
+        got = [e for e in got if e[1] not in group]
+        ref = [e for e in ref if e[1] not in group]
     lines = [f"{'clutchlab':>34} | reference"]
     for i in range(max(len(got), len(ref))):
         g = "%.9f %s %s" % got[i] if i < len(got) else ""
@@ -118,6 +153,9 @@ def test_signals_match_the_msl_reference(name):
         r = ref.columns[col]
         g = np.interp(t, df["time_s"].to_numpy(), df[col].to_numpy())
         mask = ~near if col.endswith(("tau_Nm", "mode_1")) else np.ones(len(t), bool)
+        if name in INDETERMINATE and col.split(".")[0] in INDETERMINATE[name][1] and col.endswith(("tau_Nm", "mode_1")):
+            w = ref.columns[INDETERMINATE[name][0]]
+            mask &= np.abs(w) > 1e-7 * np.ptp(w)    # the split is not unique while the shaft is at rest
         span = max(np.ptp(r), 1e-3)
         err = np.max(np.abs(g - r)[mask]) / span
         worst.append((err, col))
