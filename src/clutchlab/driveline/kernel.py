@@ -114,6 +114,7 @@ class DrivelineParams(NamedTuple):
     each friction element; ``cons``: of each constraint (gears and motion sources, always held);
     ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
     ``elem[r, E_MODE]``); ``lossy``: of each gear with losses (MSL ``LossyGear``; its mode at ``elem[r, E_MODE]``);
+    ``check``: ``[on, energy tolerance]``, the invariants checked at every accepted step (:func:`check_invariants`);
     ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
     scratch of the hooks (per run).
     """
@@ -129,6 +130,7 @@ class DrivelineParams(NamedTuple):
     lossy: np.ndarray
     work: np.ndarray
     iwork: np.ndarray
+    check: np.ndarray
 
 
 # ----------------------------------------------------------------- signals
@@ -1873,9 +1875,104 @@ def driveline_restart(t, x, u, m, p, log):
     return settle(t, x, m, p, log, m.copy())
 
 
+# invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
+# -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY = 0, 1, 2, 3, 4
+INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
+              "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
+              "energy balance beyond its tolerance")
+INV_BASE, N_INV = 100, 5
+
+
+@numba.njit(cache=True, nogil=True)
+def check_invariants(t, x, m, p):
+    """The invariants of the network at an accepted step: 0, or the model error code of the first violated.
+
+    * a stuck friction element carries at most what it holds (its static limit, a one-way clutch any torque against
+      overrunning), a stuck lossy gear's loss torque within its band, to the decision's rounding floor (:data:`NOISE`)
+      and 1e-9 relative;
+    * modes agree with the relative speeds: forward >= 0, backward <= 0, stuck ~0 (to 1e-6 of the largest speed,
+      what the event location and a stuck element's drift leave);
+    * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
+    * every lossy gear's loss power >= 0 (to rounding);
+    * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
+      that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed).
+    """
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    ne = p.elem.shape[0]
+    for s in range(p.signals.shape[0]):   # a step ending on a signal's jump: the restart there settles the modes
+        if signal_break(p.signals[s], p.data, t - 1e-12 * max(1.0, abs(t))) == t:
+            return 0
+    acc, tau = _acc_tau(p)
+    evaluate_network(t, x, m, p, acc, tau)
+    noise = _noise(p, tau)
+    wmax = 1.0
+    for i in range(n):
+        wmax = max(wmax, abs(x[n + i]))
+    w_tol = 1e-6 * wmax
+    for k in range(nf):
+        r = p.fric[k]
+        e = p.elem[r]
+        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        mk = m[k]
+        tq = tau[r]
+        if mk == STUCK:
+            lim = max(holding_limit(p, r, t, tq), noise)
+            if abs(tq) > lim * (1.0 + 1e-9) + noise:
+                return -(INV_BASE + N_INV * r + (INV_ONEWAY if e[E_LAW] == LAW_ONEWAY else INV_LIMIT))
+            if abs(w_rel) > w_tol:
+                return -(INV_BASE + N_INV * r + INV_MODE)
+        elif (mk == FORWARD and w_rel < -w_tol) or (mk == BACKWARD and w_rel > w_tol):
+            return -(INV_BASE + N_INV * r + INV_MODE)
+        if e[E_LAW] == LAW_ONEWAY:
+            cap = max(static_limit(p, r, t), friction_torque(p, r, t, abs(w_rel)), noise)
+            if mk == BACKWARD or w_rel < -w_tol or tq > cap * (1.0 + 1e-9) + noise:
+                return -(INV_BASE + N_INV * r + INV_ONEWAY)
+    hold = _holds(p)
+    for j in range(p.lossy.shape[0]):
+        r = p.lossy[j]
+        mode = m[p.elem[r][E_MODE]]
+        w_a = gear_speed(p, r, x, n)
+        if mode == GEAR_STUCK:
+            lo, hi = gear_band(p, r, -tau[r])
+            if hold[j] > hi + 2.0 * noise or hold[j] < lo - 2.0 * noise:
+                return -(INV_BASE + N_INV * r + INV_LIMIT)
+            if abs(w_a) > w_tol:
+                return -(INV_BASE + N_INV * r + INV_MODE)
+        else:
+            if GEAR_CODES[mode] * w_a < -w_tol:
+                return -(INV_BASE + N_INV * r + INV_MODE)
+            # rolling: the loss torque of its quadrant times its speed, MSL's lossPower = tauLoss w_a
+            f, c = gear_transfer(p, r, mode, abs(w_a))
+            loss = ((1.0 - f) * (-tau[r]) + c) * w_a
+            if loss < -10.0 * noise * abs(w_a):
+                return -(INV_BASE + N_INV * r + INV_LOSS)
+    if p.check[1] > 0.0:
+        kinetic, spring, work, lost = 0.0, 0.0, 0.0, 0.0
+        for i in range(n):
+            kinetic += 0.5 * p.inertia[i] * x[n + i] ** 2
+        for r in range(ne):
+            kind = p.elem[r][E_KIND]
+            if kind == K_SOURCE or kind == K_MOTION:
+                work += x[2 * n + r]
+            else:
+                lost += x[2 * n + r]
+            if kind == K_SPRING:
+                spring += spring_energy(p, r, x, n, m)
+        e0 = p.work[p.work.shape[0] - 1]
+        flow = abs(work) + abs(lost) + kinetic + spring + e0
+        if abs(work - lost - (kinetic + spring - e0)) > p.check[1] * (flow + 1.0):
+            return -(INV_BASE + N_INV * ne + INV_ENERGY)
+    return 0
+
+
 @numba.njit(cache=True, nogil=True)
 def driveline_accept(t, x, u, m, p):
-    """Nothing to commit (the network has no memories)."""
+    """Nothing to commit (the network has no memories); with ``check[0]`` set, the invariants
+    (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
+    if p.check[0] != 0.0:
+        return check_invariants(t, x, m, p)
     return 0
 
 

@@ -1249,7 +1249,7 @@ class Driveline:
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, K.N_SIG),
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
-                              np.zeros(max(nk, 1), dtype=np.int64))
+                              np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2))
         x0 = self.initial_state()
         work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
         return p
@@ -1428,7 +1428,7 @@ class Driveline:
                     ("energy_error", "J", "input work - dissipated - change of the stored energy")]
         return tuple(states), tuple(outputs)
 
-    def system(self, rtol: float = 1e-8) -> System:
+    def system(self, rtol: float = 1e-8, check_invariants: bool = False) -> System:
         """The :class:`~clutchlab.system.System` of this network (Dormand-Prince 5(4), events to 1e-12 s).
 
         With a wet clutch (:meth:`wet_clutch`) its parameters are a
@@ -1437,8 +1437,14 @@ class Driveline:
         (:meth:`emtc`), a :class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`, the same way (a full
         hysteresis memory of its magnet is a model error naming the coupling).  That system holds the
         coupling's memories (magnet, controller) as the EMTC bench's does: one run per system
-        (:meth:`simulate` builds one per call)."""
+        (:meth:`simulate` builds one per call).  ``check_invariants``: check the invariants of every element at every
+        accepted step (:func:`~clutchlab.driveline.kernel.check_invariants`; the energy balance to ``max(1e-7, 1000
+        rtol)`` of the energy that flowed plus 1 J); a violation ends the run with a
+        :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time."""
         p = self.pack()
+        if check_invariants:
+            p.check[0] = 1.0
+            p.check[1] = _check_tol(rtol)
         x0 = self.initial_state()
         states, outputs = self.variables()
         fric = self.friction_names
@@ -1491,6 +1497,14 @@ class Driveline:
             events = K.EVENTS + S.EVENTS
             error_messages = {code: f"{el.name}: {text}" for code, text in S.ERROR_MESSAGES.items()}
 
+        names_rows = [e.name for e in self._elements]
+        invariant_messages = {-(K.INV_BASE + K.N_INV * r + kind): f"invariant violated: {nm}: {what}"
+                              for r, nm in enumerate(names_rows) for kind, what in enumerate(K.INVARIANTS)}
+        invariant_messages[-(K.INV_BASE + K.N_INV * len(names_rows) + K.INV_ENERGY)] = (
+            f"invariant violated: the network's {K.INVARIANTS[K.INV_ENERGY]} ({_check_tol(rtol):.3g} of the energy "
+            "that flowed)")
+        error_messages = {**invariant_messages, **(error_messages or {})}
+
         def element_name(code, element, _names=named):
             return _names[element] if 0 <= element < len(_names) else ""
 
@@ -1502,7 +1516,7 @@ class Driveline:
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
                       m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
-                      element_name=element_name, error_messages=error_messages or {})
+                      element_name=element_name, error_messages=error_messages)
 
     def _with_wet(self, p, x0, m0, atol, wet, rtol, ng, nel):
         """The network's parameters, initial state and modes and absolute tolerances joined with the wet
@@ -1559,7 +1573,8 @@ class Driveline:
         return params, np.concatenate([x0, xe]), np.concatenate([m0, me]), np.concatenate([atol, ae])
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
-                 output_step: float | None = None, sample_times=None, fixed_step: float | None = None):
+                 output_step: float | None = None, sample_times=None, fixed_step: float | None = None,
+                 check_invariants: bool = False):
         """Run the network from its initial state to ``t_end`` [s]; a :class:`~clutchlab.SimulationResult`.
 
         Parameters
@@ -1581,9 +1596,20 @@ class Driveline:
             ``k * fixed_step``, the mode changes (stick, slip, reversal) at the first step end after them
             (:func:`clutchlab.system.simulate`); ``rtol``, ``atol`` and ``max_step`` are then unused.  None
             (default): step-size control.
+        check_invariants : bool
+            Debug option: check at every accepted step that every stuck element is within its static limit, every
+            mode agrees with the sign of its relative speed, no one-way clutch transmits torque in its free
+            direction, no lossy gear generates power and the energy balance holds (:meth:`system`); a violation
+            raises :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time.
         """
-        return _simulate(self.system(rtol), t_end, atol=atol, max_step=max_step, output_step=output_step,
+        return _simulate(self.system(rtol, check_invariants=check_invariants), t_end, atol=atol, max_step=max_step, output_step=output_step,
                          sample_times=sample_times, fixed_step=fixed_step)
+
+
+def _check_tol(rtol: float) -> float:
+    """The energy-balance tolerance of ``check_invariants`` [-]: ``max(1e-7, 1000 rtol)`` of the energy that flowed
+    plus 1 J."""
+    return max(1e-7, 1e3 * float(rtol))
 
 
 def _example_system(rtol: float = 1e-8) -> System:
