@@ -73,11 +73,12 @@ __all__ = [
 #: labels of the events in :attr:`DynamicsResult.events` by event code (the :class:`~clutchlab.SimulationResult`
 #: of :attr:`DynamicsResult.result` names them as :data:`clutchlab.eclutch.system.EVENTS`: ``stick``,
 #: ``breakaway``, ``slip_reversal``, ``contact_close``, ``contact_open``, ``stop_hit``, ``stop_leave``,
-#: ``cavitation_start``, ``cavitation_end``)
+#: ``cavitation_start``, ``cavitation_end``, ``friction_free``, ``friction_engage``)
 EVENT_KINDS = {S.EV_STICK: "stick", S.EV_BREAKAWAY: "breakaway", S.EV_REVERSAL: "slip reversal",
                S.EV_CONTACT_CLOSE: "contact closes", S.EV_CONTACT_OPEN: "contact opens",
                S.EV_STOP_HIT: "end stop hit", S.EV_STOP_LEAVE: "end stop left",
-               S.EV_CAVITATION_START: "cavitation starts", S.EV_CAVITATION_END: "cavitation ends"}
+               S.EV_CAVITATION_START: "cavitation starts", S.EV_CAVITATION_END: "cavitation ends",
+               S.EV_FREE: "friction free", S.EV_ENGAGE: "friction engages"}
 _LABELS = {S.EVENTS[code]: label for code, label in EVENT_KINDS.items()}
 _STOPS = dict(zip(S.STOPS, ("master rest stop", "master stroke end", "CSC engaged stop", "CSC travel end")))
 _CHAMBERS = dict(zip(S.CHAMBERS, ("master chamber", "CSC chamber")))
@@ -356,7 +357,7 @@ def _events_frame(result, asm) -> pd.DataFrame:
     elements = ev["element"].tolist()
     where = []
     for name, element in zip(kinds, elements):
-        if name in ("stick", "breakaway", "slip_reversal"):
+        if name in ("stick", "breakaway", "slip_reversal", "friction_free", "friction_engage"):
             where.append(f"{element} ({asm.friction_names[asm.coord_names.index(element)]})")
         else:
             where.append(_STOPS.get(element, _CHAMBERS.get(element, element)))

@@ -75,9 +75,11 @@ FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = 0, 1, 2, 3
 MODE_VALUES = ("free", "slip_forward", "stuck", "slip_backward")
 #: event names by code (what the hooks record)
 EVENTS = ("stick", "breakaway", "slip_reversal", "contact_close", "contact_open", "stop_hit", "stop_leave",
-          "cavitation_start", "cavitation_end")
+          "cavitation_start", "cavitation_end", "friction_free", "friction_engage")
 EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_CONTACT_CLOSE, EV_CONTACT_OPEN, EV_STOP_HIT, EV_STOP_LEAVE = range(7)
 EV_CAVITATION_START, EV_CAVITATION_END = 7, 8
+#: a friction coordinate whose kinetic level F_c fell to exactly zero (free), or left zero (engages)
+EV_FREE, EV_ENGAGE = 9, 10
 #: the four end stops and the two chambers (elements of stop and cavitation events)
 STOPS = ("master_rest_stop", "master_stroke_end", "csc_engaged_stop", "csc_travel_end")
 CHAMBERS = ("master_chamber", "csc_chamber")
@@ -306,9 +308,14 @@ def rhs(t, x, u, m, p, dx, g):
             if m[j] == STUCK:
                 g[j] = static_margin(coord[CO_STATIC_RATIO, j], level, Fz[j])
                 frc = -Fz[j]
+            elif m[j] == FREE:
+                # zero normal force: no Coulomb friction; the switching function jumps from +1 to -F_c when
+                # the kinetic level leaves zero (a contact pressing the element closes), located as a root
+                g[j] = 1.0 if level == 0.0 else -level
+                frc = slip_force(0.0, level, coord[CO_VISCOUS, j], vj)
             else:
                 g[j] = vj
-                frc = slip_force(1.0 if m[j] == SLIP_FORWARD else -1.0, level, coord[CO_VISCOUS, j], vj)
+                frc = slip_force(_direction(m[j]), level, coord[CO_VISCOUS, j], vj)
         else:
             g[j] = 1.0
             frc = slip_force(0.0, 0.0, coord[CO_VISCOUS, j], vj)
@@ -485,6 +492,53 @@ def _slip_mode(force):
     return SLIP_FORWARD if force > 0.0 else SLIP_BACKWARD
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _direction(mode):
+    """Slip direction s of a friction mode: +1 forward, -1 backward, 0 stuck or free."""
+    if mode == SLIP_FORWARD:
+        return 1.0
+    if mode == SLIP_BACKWARD:
+        return -1.0
+    return 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _engaged_mode(velocity, level, force, static_ratio):
+    """Mode of a free coordinate whose kinetic level ``level`` [N] just left zero.
+
+    Moving, it slips in the direction of its velocity [m/s]; at rest it sticks if the static limit holds
+    the force ``force`` [N] it must carry, else it breaks away in that force's direction ([2], the friction
+    element's start from rest).
+    """
+    if velocity > 0.0:
+        return SLIP_FORWARD
+    if velocity < 0.0:
+        return SLIP_BACKWARD
+    if static_margin(static_ratio, level, force) >= 0.0:
+        return STUCK
+    return _slip_mode(force)
+
+
+@numba.njit(cache=True, nogil=True)
+def _free_unloaded(t, x, m, p, log):
+    """Friction coordinates whose kinetic level is exactly zero become free (event ``friction_free``).
+
+    A zero normal force (an open contact pressing the element, no Coulomb or pressure part) means no
+    friction: the element neither sticks nor turns, whatever the force on its coordinate.  ``work`` holds
+    the element forces of ``(t, x)``.  Returns True if a mode changed.
+    """
+    nz = p.nz
+    changed = False
+    for j in range(nz):
+        if not p.coord_int[CI_FRICTION, j] or p.coord[CO_MASS, j] <= 0.0 or m[j] == FREE:
+            continue
+        if _friction_level(j, x, nz, p.work[W_F], p.coord, p.coord_int) == 0.0:
+            m[j] = FREE
+            record(log, t, EV_FREE, j)
+            changed = True
+    return changed
+
+
 @numba.njit(cache=True, nogil=True)
 def update(t, x, u, m, p, k, log):
     """The friction state machine and the named events when switching function ``k`` crossed zero."""
@@ -497,13 +551,23 @@ def update(t, x, u, m, p, k, log):
         if not p.coord_int[CI_FRICTION, j]:
             return 0
         force = work[W_FZ, j]
-        if m[j] == STUCK:
+        level = _friction_level(j, x, nz, work[W_F], p.coord, p.coord_int)
+        if m[j] == FREE:
+            if level == 0.0:
+                return 0
+            # the normal force left zero: friction engages at once
+            m[j] = _engaged_mode(x[nz + j], level, force, p.coord[CO_STATIC_RATIO, j])
+            kind = EV_ENGAGE
+        elif level == 0.0:
+            # zero normal force means free (a stuck or slipping element that lost its load)
+            m[j] = FREE
+            kind = EV_FREE
+        elif m[j] == STUCK:
             # break-away: slip in the direction of the applied force, exactly at rest (no spurious reversal)
             m[j] = _slip_mode(force)
             x[nz + j] = 0.0
             kind = EV_BREAKAWAY
-        elif static_margin(p.coord[CO_STATIC_RATIO, j],
-                           _friction_level(j, x, nz, work[W_F], p.coord, p.coord_int), force) >= 0.0:
+        elif static_margin(p.coord[CO_STATIC_RATIO, j], level, force) >= 0.0:
             m[j] = STUCK
             x[nz + j] = 0.0
             kind = EV_STICK
@@ -515,6 +579,8 @@ def update(t, x, u, m, p, k, log):
     gk = work[W_G, k]
     if k < nz + n_el:
         record(log, t, EV_CONTACT_OPEN if gk <= 0.0 else EV_CONTACT_CLOSE, k - nz)
+        if gk <= 0.0:
+            _free_unloaded(t, x, m, p, log)  # the contact may have pressed a friction element
         return 0
     s = k - nz - n_el
     if s < 4:
@@ -529,8 +595,10 @@ def restart(t, x, u, m, p, log):
     """Make the friction modes consistent with the forces at a (re)start or an input corner.
 
     A stuck coordinate whose needed force exceeds the static limit breaks away; a coordinate slipping
-    from exactly zero velocity against its force sticks or turns round.  With a prescribed bearing
-    motion the bearing position and velocity are set to the table's.
+    from exactly zero velocity against its force sticks or turns round; a coordinate whose kinetic level
+    is exactly zero (zero normal force) is free, and a free one whose level is positive engages
+    (:func:`_engaged_mode`).  With a prescribed bearing motion the bearing position and velocity are set
+    to the table's.
     """
     nz = p.nz
     work = p.work
@@ -554,7 +622,14 @@ def restart(t, x, u, m, p, log):
         force = work[W_FZ, j]
         level = _friction_level(j, x, nz, work[W_F], coord, coord_int)
         kind = -1
-        if m[j] == STUCK:
+        if m[j] == FREE:
+            if level > 0.0:
+                m[j] = _engaged_mode(x[nz + j], level, force, coord[CO_STATIC_RATIO, j])
+                kind = EV_ENGAGE
+        elif level == 0.0:
+            m[j] = FREE  # zero normal force means free
+            kind = EV_FREE
+        elif m[j] == STUCK:
             if static_margin(coord[CO_STATIC_RATIO, j], level, force) < 0.0:
                 m[j] = _slip_mode(force)
                 x[nz + j] = 0.0
@@ -781,7 +856,7 @@ def jacobian(t, x, u, m, p, J):
         J[e_dis, nz + j] += coord[CO_VISCOUS, j] * vj
         J[e_fr, nz + j] += coord[CO_VISCOUS, j] * vj
         if coord_int[CI_FRICTION, j]:
-            s = 1.0 if m[j] == SLIP_FORWARD else -1.0
+            s = _direction(m[j])
             level = _friction_level(j, x, nz, f, coord, coord_int)
             frc = -s * level - coord[CO_VISCOUS, j] * vj
             k = coord_int[CI_NORMAL, j]
@@ -1137,7 +1212,7 @@ class Assembly:
 
     def element_name(self, code: int, index: int) -> str:
         """Which element an event concerns: the friction coordinate, network element, end stop or chamber."""
-        if code in (EV_STICK, EV_BREAKAWAY, EV_REVERSAL):
+        if code in (EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_FREE, EV_ENGAGE):
             return self.coord_names[index]
         if code in (EV_CONTACT_OPEN, EV_CONTACT_CLOSE):
             return self.element_names[index]
@@ -1163,7 +1238,13 @@ class Assembly:
         for k, node in enumerate(self.asm["independent"]):
             y[2 + k] = X[names.index(node)]
         modes = np.zeros(self.nz, dtype=np.int64)
-        modes[self.fr_on] = STUCK  # at rest: stuck; the state machine breaks away if the force exceeds the limit
+        # at rest: stuck (the state machine breaks away if the force exceeds the limit), or free where the
+        # kinetic level is zero (no Coulomb part, the pressing element unloaded; the chambers start at 0 Pa)
+        forces = st["forces"][0]
+        for j in np.flatnonzero(self.fr_on):
+            fn = forces[st["element_names"].index(self.element_names[self.fr_nidx[j]])] if self.fr_nidx[j] >= 0 else 0.0
+            level = self.fr_c0[j] + self.fr_mun[j] * abs(fn)
+            modes[j] = STUCK if level > 0.0 else FREE
         self._initial[float(u0)] = (y, modes)
         return y.copy(), modes.copy()
 
