@@ -747,6 +747,18 @@ def gear_band(p, r, t_a):
 
 
 @numba.njit(cache=True, nogil=True)
+def gear_margin(p, r, t_a, hold, noise):
+    """How far the loss torque ``hold`` [N m] a stuck lossy gear row ``r`` carrying ``T_a`` holds is inside its band
+    (:func:`gear_band`, widened by ``noise``): ``(margin, width, direction)``, ``margin <= 0`` where it must roll,
+    forward (``direction`` +1) beyond the upper edge, backward (-1) below the lower one.  The one expression both
+    the switching function and :func:`settle` use, so that their decisions agree to the last bit."""
+    lo, hi = gear_band(p, r, t_a)
+    up = (hi + noise) - hold
+    down = hold - (lo - noise)
+    return min(up, down), hi - lo + noise, 1 if up < down else -1
+
+
+@numba.njit(cache=True, nogil=True)
 def gear_tau_eta(p, r, mode, t_a, w_abs):
     """MSL ``LossyGear.tau_eta`` [N m] of a rolling gear: ``T_a - tau_bf_a`` forward, ``T_a + tau_bf_a``
     backward; its sign decides the quadrant (which flange drives)."""
@@ -1367,14 +1379,8 @@ def _item_excess(t, p, tau, i, noise, sticking):
         thr = max(lim, noise)
         d = 1 if tq > 0.0 else -1
         return (abs(tq) - thr) / thr, d
-    hold = _holds(p)[i - nf]
-    lo, hi = gear_band(p, r, -tau[r])
-    width = hi - lo + noise
-    if hold >= hi + noise:
-        return (hold - hi - noise) / width, 1
-    if hold <= lo - noise:
-        return (lo - noise - hold) / width, -1
-    return -min(hi + noise - hold, hold - lo + noise) / width, 1 if hold > 0.5 * (lo + hi) else -1
+    margin, width, d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
+    return -margin / width, d
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1672,8 +1678,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         mode = m[p.elem[r][E_MODE]]
         q = N_G * nf + 2 * nsw + 2 * j
         if mode == GEAR_STUCK:
-            lo, hi = gear_band(p, r, -tau[r])
-            g[q] = min(hi + noise - hold[j], hold[j] - lo + noise)
+            g[q], _w, _d = gear_margin(p, r, -tau[r], hold[j], noise)
             g[q + 1] = 1.0
             continue
         w_a = gear_speed(p, r, x, n)
@@ -1894,7 +1899,7 @@ def check_invariants(t, x, m, p):
     * modes agree with the relative speeds: forward >= 0, backward <= 0, stuck ~0 (to 1e-6 of the largest speed,
       what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
-    * every lossy gear's loss power >= 0 (to rounding);
+    * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
       that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed).
     """
@@ -1943,10 +1948,10 @@ def check_invariants(t, x, m, p):
         else:
             if GEAR_CODES[mode] * w_a < -w_tol:
                 return -(INV_BASE + N_INV * r + INV_MODE)
-            # rolling: the loss torque of its quadrant times its speed, MSL's lossPower = tauLoss w_a
+            # rolling: MSL's lossPower = tauLoss w_a >= 0, the loss torque of its quadrant opposing the motion
+            # (with the mode agreeing with the speed, checked above; at rest a drift of w_a has either sign)
             f, c = gear_transfer(p, r, mode, abs(w_a))
-            loss = ((1.0 - f) * (-tau[r]) + c) * w_a
-            if loss < -10.0 * noise * abs(w_a):
+            if ((1.0 - f) * (-tau[r]) + c) * GEAR_CODES[mode] < -10.0 * noise:
                 return -(INV_BASE + N_INV * r + INV_LOSS)
     if p.check[1] > 0.0:
         kinetic, spring, work, lost = 0.0, 0.0, 0.0, 0.0
