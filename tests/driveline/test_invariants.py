@@ -198,8 +198,8 @@ def networks(draw, with_unrelated=False):
             elif kind == "lossy":
                 d.gear(f"g{i}", a, b, ratio=ratio, efficiency=draw(st.floats(0.2, 1.0)))
             else:
-                e1, e2 = draw(st.floats(0.3, 1.0)), draw(st.floats(0.3, 1.0))
-                bf1, bf2 = draw(st.floats(0.0, 2.0)), draw(st.floats(0.0, 2.0))
+                e1, e2 = draw(st.floats(0.3, 1.0)), draw(st.floats(0.3, 0.999))
+                bf1, bf2 = draw(st.floats(0.0, 2.0)), draw(st.floats(0.0, 2.0))   # (e2 < 1: a split of bf exists)
                 d.gear(f"g{i}", a, b, ratio=ratio, loss_table=[[0.0, e1, e2, bf1, bf2],
                                                                [20.0, min(1.0, e1 + 0.05), e2, bf1 * 1.5, bf2]])
         elif kind == "clutch":

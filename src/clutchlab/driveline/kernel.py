@@ -94,10 +94,14 @@ N_COEF = 5
 GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = 0, 1, 2, 3, 4
 GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
-# switching functions: three per friction element, then two per switched spring (``swit``: backlash and curves),
-# then two per lossy gear (``lossy``: its stick or break-away function, and its driving flange's)
-G_STICK, G_BREAK, G_NORMAL = 0, 1, 2
-N_G = 3
+# switching functions: four per friction element, then two per switched spring (``swit``: backlash and curves),
+# then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
+G_STICK, G_BREAK, G_NORMAL, G_TURN = 0, 1, 2, 3
+N_G = 4
+N_GEAR_G = 3
+#: a sliding element's relative speed below this share of the largest speed (at least 1) is watched for its turning
+#: point (G_TURN), so that a dip through zero shorter than a step is not stepped over
+TURN_WATCH = 1e-2
 #: relative size of rounding in the torques of the constraint set (the thresholds of the stick/slip decisions
 #: and of the switching functions that watch them, which must agree: after a decision every function watching it
 #: is > 0, so that its next crossing is seen)
@@ -1443,6 +1447,26 @@ def _old_stuck(p, old, i):
 
 
 @numba.njit(cache=True, nogil=True)
+def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+    """Turn every released item of ``pick`` that accelerates against its direction the other way (a one-way clutch
+    cannot); True if one turned.  ``dirs`` follows."""
+    amax = 0.0
+    for i in range(acc.shape[0]):
+        amax = max(amax, abs(acc[i]))
+    turned = False
+    for q in range(s):
+        c = pick[q]
+        i = cand[c]
+        if _item_acc(p, acc, i) * dirs[c] < -1e-10 * (1.0 + amax):
+            if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY:
+                continue
+            dirs[c] = -dirs[c]
+            _item_set(p, m, i, dirs[c])
+            turned = True
+    return turned
+
+
+@numba.njit(cache=True, nogil=True)
 def _apply_subset(p, m, cand, nc, dirs, pick, s):
     for c in range(nc):
         _item_set(p, m, cand[c], 0)
@@ -1525,8 +1549,16 @@ def settle(t, x, m, p, log, old):
                 if ok:
                     _apply_subset(p, m, cand, nc, dirs, pick, s)
                     noise = _evaluate(t, x, m, p, acc, tau)
-                    if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
-                        found = True
+                    # released together, an item may move against the way its own torque pushed it (two gears
+                    # coupled through a reversing ratio): flip those to the way they accelerate, a few times
+                    for _flip in range(s + 1):
+                        if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
+                            found = True
+                            break
+                        if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+                            break
+                        noise = _evaluate(t, x, m, p, acc, tau)
+                    if found:
                         break
                 # the next combination of s out of nc
                 q = s - 1
@@ -1593,7 +1625,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     States: ``phi`` (n), ``w`` (n), then one energy per element in element order [J]: a source's work
     ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
     the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift); then
-    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, three per friction element: the relative speed of a sliding element in its
+    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, four per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
@@ -1613,9 +1645,11 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     slack = _slack(p)
     evaluate_network(t, x, m, p, acc, tau)
     noise = _noise(p, tau)
+    wscale = 1.0
     for i in range(n):
         dx[i] = x[n + i]
         dx[n + i] = acc[i]
+        wscale = max(wscale, abs(x[n + i]))
     for r in range(ne):
         e = p.elem[r]
         kind = e[E_KIND]
@@ -1644,6 +1678,12 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - tau[r]
         else:
             g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - abs(tau[r])
+        # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
+        # the sliding direction), located so that a dip of the speed through zero within a step is seen
+        g[N_G * k + G_TURN] = 1.0
+        if (mk == FORWARD or mk == BACKWARD) and abs(w_rel) < TURN_WATCH * wscale:
+            a_rel = (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
+            g[N_G * k + G_TURN] = a_rel if mk == FORWARD else -a_rel
         if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif e[E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
@@ -1676,7 +1716,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
         mode = m[p.elem[r][E_MODE]]
-        q = N_G * nf + 2 * nsw + 2 * j
+        q = N_G * nf + 2 * nsw + N_GEAR_G * j
+        g[q + 2] = 1.0
         if mode == GEAR_STUCK:
             g[q], _w, _d = gear_margin(p, r, -tau[r], hold[j], noise)
             g[q + 1] = 1.0
@@ -1684,6 +1725,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         w_a = gear_speed(p, r, x, n)
         forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
         g[q] = (w_a if forward else -w_a) + slack[nf + j]
+        if abs(w_a) < TURN_WATCH * wscale:
+            a_a = _item_acc(p, acc, nf + j)
+            g[q + 2] = a_a if forward else -a_a
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
@@ -1820,12 +1864,15 @@ def driveline_update(t, x, u, m, p, k, log):
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
     if k >= N_G * nf + 2 * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
-        j = (k - N_G * nf - 2 * nsw) // 2
+        j = (k - N_G * nf - 2 * nsw) // N_GEAR_G
+        which = (k - N_G * nf - 2 * nsw) % N_GEAR_G
+        if which == 2:   # its speed's turning point: a step ends there, nothing changes
+            return 0
         mi = p.elem[p.lossy[j]][E_MODE]
         old = m.copy()
         mode = m[mi]
         if mode != GEAR_STUCK:
-            if (k - N_G * nf - 2 * nsw) % 2 == 0:
+            if which == 0:
                 m[mi] = GEAR_STUCK
             else:   # the other flange drives now
                 m[mi] = (GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_FWD_A if mode == GEAR_FWD_B else
@@ -1865,6 +1912,8 @@ def driveline_update(t, x, u, m, p, k, log):
         # the torque of a damped contact steps at impact: a stuck element may have to break away now (its
         # break-away function starts the next step beyond zero, which is no crossing)
         settle(t, x, m, p, log, m.copy())
+        return 0
+    if k % N_G == G_TURN:   # a slow sliding speed's turning point: a step ends there, nothing changes
         return 0
     old = m.copy()
     kf = k // N_G

@@ -661,6 +661,12 @@ class Driveline:
                 raise ParameterError(f"{name}: loss_table efficiencies must be in (0, 1], got row {bad[0].tolist()}")
             if np.any(rows[:, 3:] < 0):
                 raise ParameterError(f"{name}: loss_table bearing friction torques must be >= 0")
+            ideal_mesh = (rows[:, 1] == 1.0) & (rows[:, 2] == 1.0) & (rows[:, 3] != rows[:, 4])
+            if np.any(ideal_mesh):
+                raise ParameterError(
+                    f"{name}: loss_table row {rows[ideal_mesh][0].tolist()}: with both efficiencies 1 the bearing "
+                    "friction cannot be split between the sides (MSL halves tau_bf1, which makes the torque jump where "
+                    "the driving side changes): give tau_bf1 = tau_bf2 there, or an efficiency below 1")
         else:
             eta = _finite(name, "efficiency", efficiency, positive=True)
             if not 0.0 < eta <= 1.0:
@@ -1449,14 +1455,15 @@ class Driveline:
         states, outputs = self.variables()
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric
-                          for what, d in (("stick", -1), ("breakaway", -1), ("normal", 0)))
+                          for what, d in (("stick", -1), ("breakaway", -1), ("normal", 0), ("turn", 1)))
         swit = [self._elements[r] for r in p.swit]
         # (a backlash's Kelvin-Voigt contact is watched both ways; MSL's law and curves by falling functions)
         switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH and e.aux != K.LASH_MSL else -1)
                            for e in swit for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
                                                       else ("segment_below", "segment_above")))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
-        switching += tuple((f"{e.name}.{what}", -1) for e in self._lossy for what in ("stick", "quadrant"))
+        switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
+                           for what, d in (("stick", -1), ("quadrant", -1), ("turn", 1)))
         mode_names = named
         swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)

@@ -279,34 +279,68 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
             ghi = ge[k]
         else:
             ghi = g1[k]
-        side = 0
-        for _it in range(100):
-            if (hi - lo) * h <= event_tol:
-                break
-            if glo != ghi:
-                th = lo + (hi - lo) * glo / (glo - ghi)
-            else:
-                th = 0.5 * (lo + hi)
-            span = hi - lo
-            th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
-            _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
-            model.rhs(t + th * h, xe, u, m, p, fe, ge)
-            n_rhs += 1
-            if _crossed(ga[k], ge[k], gdir[k]):
-                hi = th
-                ghi = ge[k]
-                if side == 1:
-                    glo *= 0.5
-                side = 1
-            else:
-                lo = th
-                glo = ge[k]
-                if side == -1:
-                    ghi *= 0.5
-                side = -1
+        hi, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, lo, hi, glo, ghi,
+                           ga[k], gdir[k])
+        n_rhs += nr
         if hi < best:
             best = hi
+    # a function that had not crossed by the step's end may have crossed before the earliest root and come back
+    # (a dip through zero that the root of a turning-point function reveals): look again at the earliest root and
+    # locate any such crossing before it
+    for _round in range(4):
+        if best >= 1.0:
+            break
+        _dense(best, h, x0, f0, x1, f1, rc, mass, xe)
+        model.rhs(t + best * h, xe, u, m, p, fe, ge)
+        n_rhs += 1
+        earliest = best
+        gb = ge.copy()   # (rare: a step with an event; the searches below overwrite ge)
+        for k in range(ng):
+            if _crossed(ga[k], g1[k], gdir[k]) or not _crossed(ga[k], gb[k], gdir[k]):
+                continue
+            lo = th0 if g0[k] == 0.0 else 0.0
+            root, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, lo, best, ga[k],
+                                 gb[k], ga[k], gdir[k])
+            n_rhs += nr
+            earliest = min(earliest, root)
+        if earliest >= best:
+            break
+        best = earliest
     return best, n_rhs
+
+
+@register_jitable
+def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, lo, hi, glo, ghi, gref, gdir_k):
+    """Root of switching function ``k`` within the step fraction ``[lo, hi]`` (``glo``, ``ghi`` its values there,
+    crossed from ``gref`` in direction ``gdir_k``) on the dense output, by the Illinois iteration to ``event_tol``
+    [s]: ``(theta, n_rhs)``, ``theta`` the bracket end just past the root."""
+    n_rhs = 0
+    side = 0
+    for _it in range(100):
+        if (hi - lo) * h <= event_tol:
+            break
+        if glo != ghi:
+            th = lo + (hi - lo) * glo / (glo - ghi)
+        else:
+            th = 0.5 * (lo + hi)
+        span = hi - lo
+        th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
+        _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
+        model.rhs(t + th * h, xe, u, m, p, fe, ge)
+        n_rhs += 1
+        if _crossed(gref, ge[k], gdir_k):
+            hi = th
+            ghi = ge[k]
+            if side == 1:
+                glo *= 0.5
+            side = 1
+        else:
+            lo = th
+            glo = ge[k]
+            if side == -1:
+                ghi *= 0.5
+            side = -1
+    return hi, n_rhs
 
 
 @register_jitable(forceinline=True)
