@@ -265,6 +265,14 @@ def _check_columns(d, df):
         assert np.all(np.abs(w[mode == 0]) <= 1e-6 * wmax), e.name
 
 
+def _mode_events(res):
+    """(time, element, event) of the mode changes, but a lossy gear's driving flange (``a_drives``/``b_drives``): its
+    torque law is continuous across that change, which is located where the torque it carries passes zero to the
+    rounding floor, so near a zero-torque start it may come or go with the step sequence (documented)."""
+    return [(t, el, ev) for t, el, ev in zip(res.events.time_s, res.events.element, res.events.event)
+            if ev not in ("a_drives", "b_drives")]
+
+
 @settings(max_examples=examples(25), deadline=None)
 @given(networks())
 def test_invariants_hold_on_random_networks(d):
@@ -290,9 +298,8 @@ def test_an_unrelated_element_changes_nothing(d):
         if col.endswith(".w_rad_s"):
             span = max(1.0, np.ptp(b[col]))
             assert np.max(np.abs(a[col] - b[col])) <= 1e-6 * span, col
-    ea = [(t, el, ev) for t, el, ev in zip(both.events.time_s, both.events.element, both.events.event)
-          if not str(el).startswith("U")]
-    eb = list(zip(one.events.time_s, one.events.element, one.events.event))
+    ea = [(t, el, ev) for t, el, ev in _mode_events(both) if not str(el).startswith("U")]
+    eb = _mode_events(one)
     assert [e[1:] for e in ea] == [e[1:] for e in eb]
     assert all(abs(x[0] - y[0]) <= 1e-6 for x, y in zip(ea, eb))
 
@@ -310,4 +317,4 @@ def test_the_result_follows_the_tolerance_on_random_networks(d):
         if col.endswith(".w_rad_s"):
             span = max(1.0, np.ptp(b[col]))
             assert np.max(np.abs(a[col] - b[col])) <= 1e-4 * span, col
-    assert list(zip(lo.events.element, lo.events.event)) == list(zip(hi.events.element, hi.events.event))
+    assert [e[1:] for e in _mode_events(lo)] == [e[1:] for e in _mode_events(hi)]

@@ -797,11 +797,15 @@ def relative_speed(p, r, x, n):
 
 
 @numba.njit(cache=True, nogil=True)
-def _apply(F, e, ca, cb, tq):
+def _apply(F, Fa, e, ca, cb, tq):
+    """Torque ``tq`` of an element on its inertias (``+ca tq`` on flange a, ``-cb tq`` on b), and its magnitude into
+    ``Fa``."""
     if e[E_B] >= 0:
         F[e[E_B]] -= cb * tq
+        Fa[e[E_B]] += abs(cb * tq)
     if e[E_A] >= 0:
         F[e[E_A]] += ca * tq
+        Fa[e[E_A]] += abs(ca * tq)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -827,8 +831,10 @@ def evaluate_network(t, x, m, p, acc, tau):
     nc = p.cons.shape[0]
     wk = p.work
     F = wk[0:n]
+    Fa = _torque_magnitudes(p)
     for i in range(n):
         F[i] = 0.0
+        Fa[i] = 0.0
     for r in range(ne):
         e = p.elem[r]
         kind = e[E_KIND]
@@ -840,7 +846,7 @@ def evaluate_network(t, x, m, p, acc, tau):
         else:
             continue
         tau[r] = tq
-        _apply(F, e, 1.0, 1.0, tq)
+        _apply(F, Fa, e, 1.0, 1.0, tq)
     # sliding and free friction; the constraint set: stuck friction, gears, motion sources
     ns = 0
     stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a stuck lossy gear's hold)
@@ -860,7 +866,7 @@ def evaluate_network(t, x, m, p, acc, tau):
             if mk == BACKWARD:
                 tq = -tq
         tau[r] = tq
-        _apply(F, e, 1.0, 1.0, tq)
+        _apply(F, Fa, e, 1.0, 1.0, tq)
     for k in range(nc):
         stuck[ns] = p.cons[k]
         ns += 1
@@ -876,6 +882,8 @@ def evaluate_network(t, x, m, p, acc, tau):
             ratio = p.coef[r][C_RATIO]
             _add(F, e[E_B], -ratio * c)
             _add(F, e[E_SUP], ratio * c)
+            _add(Fa, e[E_B], abs(ratio * c))
+            _add(Fa, e[E_SUP], abs(ratio * c))
     hold = _holds(p)
     for j in range(hold.shape[0]):
         hold[j] = 0.0
@@ -891,11 +899,13 @@ def _layout(n, nk, ne, nf=0, nl=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | three flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds,
-    null vector, its scratch, a trial split, breakpoints (11 nk + 2) | accelerations (n) | element torques (ne) | slack of each friction element's
-    and lossy gear's stick function (nf + nl, :func:`settle`) | the loss torque each lossy gear holds or carries
+    null vector, its scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2) | accelerations (n) | element torques (ne) | slack of each friction element's
+    and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
+    inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
     (nl) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | initial stored energy (1).  Returns the offsets of A, A + eps D, right-hand side,
-    torques, weights, residual, member flanges, bounds, accelerations, element torques, slack, holds."""
+    torques, weights, residual, member flanges, bounds, accelerations, element torques, slack, torque magnitudes,
+    holds."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -904,11 +914,12 @@ def _layout(n, nk, ne, nf=0, nl=0):
     o_r = o_c + nk
     o_g = o_r + nk
     o_lim = o_g + 9 * nk
-    o_acc = o_lim + 11 * nk + 2
+    o_acc = o_lim + 11 * nk + 2 + nk * nk
     o_tau = o_acc + n
     o_slack = o_tau + ne
-    o_hold = o_slack + nf + nl
-    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_hold
+    o_fabs = o_slack + nf + nl
+    o_hold = o_fabs + n
+    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0):
@@ -947,7 +958,14 @@ def _slack(p):
 def _holds(p):
     """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
     o = _offsets(p)
-    return p.work[o[11]:o[11] + p.lossy.shape[0]]
+    return p.work[o[12]:o[12] + p.lossy.shape[0]]
+
+
+@numba.njit(cache=True, nogil=True)
+def _torque_magnitudes(p):
+    """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
+    o = _offsets(p)
+    return p.work[o[11]:o[11] + p.inertia.shape[0]]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -955,7 +973,7 @@ def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
     o = _offsets(p)
-    return p.work[o[11] + p.lossy.shape[0]:p.work.shape[0] - 1]
+    return p.work[o[12] + p.lossy.shape[0]:p.work.shape[0] - 1]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1033,7 +1051,60 @@ def _feasible(p, stuck, ns, lam, lo, hi, tol):
 
 
 @numba.njit(cache=True, nogil=True)
-def _repair(p, stuck, ns, A, M, iwork, lam, lo, hi, v, tmp, cand, trial, tol):
+def _null_vector(A, ns, S, cp, v, y):
+    """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (the last pivot of Gaussian elimination
+    with complete pivoting below 1e-10 of the first, the one before it above): True, ``v`` scaled to a largest
+    entry of 1.  ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
+    if ns < 2:
+        return False
+    for k in range(ns):
+        cp[k] = k
+        for j in range(ns):
+            S[k, j] = A[k, j]
+    first = 0.0
+    for c in range(ns):
+        bi, bj, bv = c, c, -1.0
+        for i in range(c, ns):
+            for j in range(c, ns):
+                if abs(S[i, j]) > bv:
+                    bi, bj, bv = i, j, abs(S[i, j])
+        if c == 0:
+            first = bv
+            if first == 0.0:
+                return False
+        if bv <= 1e-10 * first:
+            if c != ns - 1:
+                return False        # more than one null direction
+            break
+        if c == ns - 1:
+            return False            # full rank
+        for j in range(ns):
+            S[c, j], S[bi, j] = S[bi, j], S[c, j]
+        for i in range(ns):
+            S[i, c], S[i, bj] = S[i, bj], S[i, c]
+        cp[c], cp[bj] = cp[bj], cp[c]
+        for i in range(c + 1, ns):
+            f = S[i, c] / S[c, c]
+            if f != 0.0:
+                for j in range(c, ns):
+                    S[i, j] -= f * S[c, j]
+    # U y = 0 with y[ns-1] = 1, back substitution; v[cp[i]] = y[i]
+    y[ns - 1] = 1.0
+    for i in range(ns - 2, -1, -1):
+        acc_ = 0.0
+        for j in range(i + 1, ns):
+            acc_ += S[i, j] * y[j]
+        y[i] = -acc_ / S[i, i]
+    big = 0.0
+    for i in range(ns):
+        big = max(big, abs(y[i]))
+    for i in range(ns):
+        v[cp[i]] = y[i] / big
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     """Move a statically indeterminate split into the stuck members' bounds (one redundant loop).
 
     Where stuck members lock the same motion (a bearing and a stuck lossy gear on one shaft, two clutches in
@@ -1041,37 +1112,11 @@ def _repair(p, stuck, ns, A, M, iwork, lam, lo, hi, v, tmp, cand, trial, tol):
     as some ``z`` keeps each within its bounds (a lossy gear's hold within its band, which depends on the torque
     it carries); ``z`` is kept at 0 (the split of the regularised solution) unless that leaves the feasible
     segment of ``z`` nearest to it or comes within 1 % of its width of an edge: it is then clamped there, so every
-    member keeps a margin until the segment closes (the group must slip).  ``v`` comes from two steps of inverse
-    iteration with the regularised factorisation; a set without a null direction (to 1e-7 of ``A``) or with more
-    than one is left as it is.  Returns True if ``lam`` changed."""
-    anorm = 0.0
-    for k in range(ns):
-        s = 0.0
-        for j in range(ns):
-            s += abs(A[k, j])
-        anorm = max(anorm, s)
-    if anorm == 0.0:
-        return False
-    for k in range(ns):
-        v[k] = 1.0 + 0.37 * k
-    for _it in range(3):
-        lu_solve(M, iwork, v)
-        vn = 0.0
-        for k in range(ns):
-            vn = max(vn, abs(v[k]))
-        if vn == 0.0:
-            return False
-        for k in range(ns):
-            v[k] /= vn
-    for k in range(ns):
-        s = 0.0
-        for j in range(ns):
-            s += A[k, j] * v[j]
-        tmp[k] = s
-    res = 0.0
-    for k in range(ns):
-        res = max(res, abs(tmp[k]))
-    if res > 1e-7 * anorm:
+    member keeps a margin until the segment closes (the group must slip).  ``v`` is the null vector of ``A`` from
+    Gaussian elimination with complete pivoting (:func:`_null_vector`, exact to rounding, so ``lam + z v`` keeps the
+    constraints); a set without a null direction, or with more than one, is left as it is.  Returns True if ``lam``
+    changed."""
+    if not _null_vector(A, ns, S, cp, v, tmp):
         return False
     # breakpoints of every bound along z (each bound is piecewise linear in z); the feasible segments lie between
     nb = 0
@@ -1129,7 +1174,20 @@ def _repair(p, stuck, ns, A, M, iwork, lam, lo, hi, v, tmp, cand, trial, tol):
         if d < best_d:
             best_d, best_lo, best_hi = d, a, b
     if best_d == np.inf:
-        return False
+        # no segment: the feasible set may be a single point (a lossy gear whose output is free holds only while
+        # it carries nothing); the nearest feasible breakpoint, where the members sit on their bounds (the noise
+        # floor of their switching functions keeps those > 0)
+        zp, dp = 0.0, np.inf
+        for i in range(nb):
+            for k in range(ns):
+                trial[k] = lam[k] + cs[i] * v[k]
+            if _feasible(p, stuck, ns, trial, lo, hi, tol) and abs(cs[i]) < dp:
+                zp, dp = cs[i], abs(cs[i])
+        if dp == np.inf or zp == 0.0:
+            return False
+        for k in range(ns):
+            lam[k] += zp * v[k]
+        return True
     # extend across breakpoints that are not edges of the feasible set
     for i in range(nb):
         if cs[i] == best_hi and i + 1 <= nb:
@@ -1181,7 +1239,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     n = p.inertia.shape[0]
     nk = _nk(p)
     wk = p.work
-    o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, _, _, _, _ = _offsets(p)
+    o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim = _offsets(p)[:8]
     A = wk[o_a:o_a + nk * nk].reshape((nk, nk))
     b = wk[o_b:o_b + nk]
     lam = wk[o_l:o_l + nk]
@@ -1196,6 +1254,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     vtmp = wk[o_lim + 3 * nk:o_lim + 4 * nk]
     trial = wk[o_lim + 4 * nk:o_lim + 5 * nk]
     cand = wk[o_lim + 5 * nk:o_lim + 11 * nk + 2]
+    S = wk[o_lim + 11 * nk + 2:o_lim + 11 * nk + 2 + ns * ns].reshape((ns, ns))
     cmax = 0.0
     fscale = 0.0
     for i in range(n):
@@ -1270,15 +1329,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         for k in range(ns):
             big = max(big, abs(lam[k]))
         tol = NOISE * (1.0 + big)
-        if _repair(p, stuck, ns, A, M, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol):
-            for k in range(ns):   # the constraints again to rounding
-                r = b[k]
-                for j in range(ns):
-                    r -= A[k, j] * lam[j]
-                res[k] = r
-            lu_solve(M, p.iwork, res)
-            for k in range(ns):
-                lam[k] += res[k]
+        # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
+        # v keeps the constraints, v being A's null vector to rounding)
+        _repair(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
     hold = _holds(p)
     for k in range(ns):
         rk = int(stuck[k])
@@ -1287,10 +1340,12 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
             hold[_lossy_index(p, r)] = lam[k]
         else:
             tau[rk] = lam[k]
+        Fa = _torque_magnitudes(p)
         for q in range(3):
             i = int(flf[3 * k + q])
             if i >= 0:
                 F[i] -= hc[3 * k + q] * lam[k]
+                Fa[i] += abs(hc[3 * k + q] * lam[k])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1305,16 +1360,41 @@ def _lossy_index(p, r):
 
 # ----------------------------------------------------------------- the stick/slip items: friction elements and lossy gears
 @numba.njit(cache=True, nogil=True)
-def _noise(p, tau):
-    """Rounding floor [N m] of the stick/slip decisions: ``NOISE`` times one plus the largest torque of the network
-    (an element or a lossy gear's hold) at its last evaluation."""
-    tmax = 0.0
-    for r in range(p.elem.shape[0]):
-        tmax = max(tmax, abs(tau[r]))
-    hold = _holds(p)
-    for j in range(hold.shape[0]):
-        tmax = max(tmax, abs(hold[j]))
-    return NOISE * (1.0 + tmax)
+def _flanges_max(v, e):
+    """The largest of ``|v|`` over an element's flanges (a, b and a gear's support; 0 for the ground)."""
+    out = 0.0
+    if e[E_A] >= 0:
+        out = max(out, abs(v[e[E_A]]))
+    if e[E_B] >= 0:
+        out = max(out, abs(v[e[E_B]]))
+    if e[E_KIND] == K_GEAR and e[E_SUP] >= 0:
+        out = max(out, abs(v[e[E_SUP]]))
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_noise(p, r, tau):
+    """Rounding floor [N m] of the stick/slip decisions of element row ``r``: ``NOISE`` times one plus its torque and
+    the torques on its own inertias at the last evaluation (local: an element elsewhere in the network does not move
+    a decision here)."""
+    e = p.elem[r]
+    scale = max(abs(tau[r]), _flanges_max(_torque_magnitudes(p), e))
+    if e[E_KIND] == K_GEAR and e[E_MODE] >= 0:
+        scale = max(scale, abs(_holds(p)[_lossy_index(p, r)]))
+    return NOISE * (1.0 + scale)
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_wtol(p, r, x, n):
+    """Rounding width [rad/s] of a relative speed of element row ``r``: 1e-9 of the largest speed of its inertias
+    (at least 1 rad/s)."""
+    n_ = p.inertia.shape[0]
+    e = p.elem[r]
+    w = 1.0
+    for i in (e[E_A], e[E_B], e[E_SUP] if e[E_KIND] == K_GEAR else -1):
+        if i >= 0:
+            w = max(w, abs(x[n_ + i]))
+    return 1e-9 * w
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1365,7 +1445,7 @@ def _item_acc(p, acc, i):
 
 
 @numba.njit(cache=True, nogil=True)
-def _item_excess(t, p, tau, i, noise, sticking):
+def _item_excess(t, p, tau, i, sticking):
     """How far stuck item ``i`` is beyond what it holds at the last evaluation, and the way it would move.
 
     Returns ``(excess, direction)``: ``excess >= 0`` [-] if it must break away (its torque, or a lossy gear's held
@@ -1375,6 +1455,7 @@ def _item_excess(t, p, tau, i, noise, sticking):
     ``sticking``: the element is sticking now (a clutch model then covers its lock-up limit)."""
     nf = p.fric.shape[0]
     r = _item_row(p, i)
+    noise = _item_noise(p, r, tau)
     if i < nf:
         tq = tau[r]
         lim = holding_limit(p, r, t, tq)
@@ -1396,7 +1477,6 @@ def _evaluate(t, x, m, p, acc, tau):
     n = p.inertia.shape[0]
     nl = p.lossy.shape[0]
     evaluate_network(t, x, m, p, acc, tau)
-    noise = _noise(p, tau)
     for _it in range(2 * nl + 2):
         flipped = False
         for j in range(nl):
@@ -1406,6 +1486,7 @@ def _evaluate(t, x, m, p, acc, tau):
             if mode == GEAR_STUCK:
                 continue
             te = gear_tau_eta(p, r, mode, -tau[r], abs(gear_speed(p, r, x, n)))
+            noise = _item_noise(p, r, tau)
             if (mode == GEAR_FWD_A or mode == GEAR_BWD_B) and te <= -noise:
                 m[mi] = GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_BWD_A
                 flipped = True
@@ -1415,27 +1496,29 @@ def _evaluate(t, x, m, p, acc, tau):
         if not flipped:
             break
         evaluate_network(t, x, m, p, acc, tau)
-        noise = _noise(p, tau)
-    return noise
+    return 0.0
 
 
 @numba.njit(cache=True, nogil=True)
-def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
+def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
     """True if the modes of the candidates (items at rest) agree with the forces of the last evaluation: every
     stuck one within what it holds, every released one accelerating its way (not against it beyond rounding)."""
-    amax = 0.0
-    for i in range(acc.shape[0]):
-        amax = max(amax, abs(acc[i]))
-    a_noise = 1e-10 * (1.0 + amax)
     for c in range(nc):
         i = cand[c]
         if _item_stuck(p, m, i):
-            ex, _d = _item_excess(t, p, tau, i, noise, not _old_stuck(p, old, i))
+            ex, _d = _item_excess(t, p, tau, i, not _old_stuck(p, old, i))
             if ex >= 0.0:
                 return False
-        elif _item_acc(p, acc, i) * dirs[c] < -a_noise:
+        elif _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             return False
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_anoise(p, r, acc):
+    """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
+    acceleration of its inertias."""
+    return 1e-10 * (1.0 + _flanges_max(acc, p.elem[r]))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1450,14 +1533,11 @@ def _old_stuck(p, old, i):
 def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
     """Turn every released item of ``pick`` that accelerates against its direction the other way (a one-way clutch
     cannot); True if one turned.  ``dirs`` follows."""
-    amax = 0.0
-    for i in range(acc.shape[0]):
-        amax = max(amax, abs(acc[i]))
     turned = False
     for q in range(s):
         c = pick[q]
         i = cand[c]
-        if _item_acc(p, acc, i) * dirs[c] < -1e-10 * (1.0 + amax):
+        if _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY:
                 continue
             dirs[c] = -dirs[c]
@@ -1493,10 +1573,6 @@ def settle(t, x, m, p, log, old):
     nl = p.lossy.shape[0]
     nsw = p.swit.shape[0]
     acc, tau = _acc_tau(p)
-    wscale = 1.0
-    for i in range(n):
-        wscale = max(wscale, abs(x[n + i]))
-    w_tol = 1e-9 * wscale
     for k in range(nf):
         r = p.fric[k]
         e = p.elem[r]
@@ -1504,6 +1580,7 @@ def settle(t, x, m, p, log, old):
             m[k] = FREE
         elif m[k] == FREE:   # engaged: slides the way it moves, or is at rest (decided below)
             w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+            w_tol = _item_wtol(p, r, x, n)
             m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
     # the items at rest
     ni = nf + nl
@@ -1514,14 +1591,14 @@ def settle(t, x, m, p, log, old):
     for i in range(ni):
         if i < nf and m[i] == FREE:
             continue
-        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= w_tol:
+        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n):
             cand[nc] = i
             nc += 1
             _item_set(p, m, i, 0)
-    noise = _evaluate(t, x, m, p, acc, tau)
+    _evaluate(t, x, m, p, acc, tau)
     worst = -np.inf
     for c in range(nc):
-        ex, d = _item_excess(t, p, tau, cand[c], noise, not _old_stuck(p, old, cand[c]))
+        ex, d = _item_excess(t, p, tau, cand[c], not _old_stuck(p, old, cand[c]))
         exc[c] = ex
         dirs[c] = d
         if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
@@ -1548,16 +1625,16 @@ def settle(t, x, m, p, log, old):
                         ok = False
                 if ok:
                     _apply_subset(p, m, cand, nc, dirs, pick, s)
-                    noise = _evaluate(t, x, m, p, acc, tau)
+                    _evaluate(t, x, m, p, acc, tau)
                     # released together, an item may move against the way its own torque pushed it (two gears
                     # coupled through a reversing ratio): flip those to the way they accelerate, a few times
                     for _flip in range(s + 1):
-                        if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, noise):
+                        if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
                             found = True
                             break
                         if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
                             break
-                        noise = _evaluate(t, x, m, p, acc, tau)
+                        _evaluate(t, x, m, p, acc, tau)
                     if found:
                         break
                 # the next combination of s out of nc
@@ -1575,13 +1652,13 @@ def settle(t, x, m, p, log, old):
             for c in range(nc):
                 _item_set(p, m, cand[c], 0)
             for _it in range(nc):
-                noise = _evaluate(t, x, m, p, acc, tau)
+                _evaluate(t, x, m, p, acc, tau)
                 best, bi, bd = -np.inf, -1, 0
                 for c in range(nc):
                     i = cand[c]
                     if not _item_stuck(p, m, i):
                         continue
-                    ex, d = _item_excess(t, p, tau, i, noise, not _old_stuck(p, old, i))
+                    ex, d = _item_excess(t, p, tau, i, not _old_stuck(p, old, i))
                     if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY and d < 0:
                         continue
                     if ex >= 0.0 and ex > best:
@@ -1600,6 +1677,7 @@ def settle(t, x, m, p, log, old):
             record(log, t, _EVENT_OF_MODE[m[k]], k)
             any_change = True
             w_rel = _item_speed(p, x, n, k)
+            w_tol = _item_wtol(p, p.fric[k], x, n)
             slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
     for j in range(nl):
         mi = p.elem[p.lossy[j]][E_MODE]
@@ -1610,6 +1688,7 @@ def settle(t, x, m, p, log, old):
         if GEAR_CODES[new] != GEAR_CODES[was]:
             ev = EV_STICK if new == GEAR_STUCK else (EV_FORWARD if GEAR_CODES[new] > 0 else EV_BACKWARD)
             w_a = _item_speed(p, x, n, nf + j)
+            w_tol = _item_wtol(p, p.lossy[j], x, n)
             slack[nf + j] = w_tol if abs(w_a) <= w_tol else 0.0
         else:
             ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
@@ -1644,12 +1723,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     acc, tau = _acc_tau(p)
     slack = _slack(p)
     evaluate_network(t, x, m, p, acc, tau)
-    noise = _noise(p, tau)
-    wscale = 1.0
     for i in range(n):
         dx[i] = x[n + i]
         dx[n + i] = acc[i]
-        wscale = max(wscale, abs(x[n + i]))
     for r in range(ne):
         e = p.elem[r]
         kind = e[E_KIND]
@@ -1672,6 +1748,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
         mk = m[k]
         g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
+        noise = _item_noise(p, r, tau)
         if mk != STUCK:
             g[N_G * k + G_BREAK] = 1.0
         elif e[E_LAW] == LAW_ONEWAY:   # holds any torque against overrunning, its clutch's limit for it
@@ -1681,9 +1758,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
         # the sliding direction), located so that a dip of the speed through zero within a step is seen
         g[N_G * k + G_TURN] = 1.0
-        if (mk == FORWARD or mk == BACKWARD) and abs(w_rel) < TURN_WATCH * wscale:
+        if (mk == FORWARD or mk == BACKWARD) and abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_rel = (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
-            g[N_G * k + G_TURN] = a_rel if mk == FORWARD else -a_rel
+            # (plus the rounding of an acceleration: a speed held at rest by other elements has no turning point)
+            g[N_G * k + G_TURN] = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
         if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif e[E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
@@ -1717,6 +1795,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         r = p.lossy[j]
         mode = m[p.elem[r][E_MODE]]
         q = N_G * nf + 2 * nsw + N_GEAR_G * j
+        noise = _item_noise(p, r, tau)
         g[q + 2] = 1.0
         if mode == GEAR_STUCK:
             g[q], _w, _d = gear_margin(p, r, -tau[r], hold[j], noise)
@@ -1725,9 +1804,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         w_a = gear_speed(p, r, x, n)
         forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
         g[q] = (w_a if forward else -w_a) + slack[nf + j]
-        if abs(w_a) < TURN_WATCH * wscale:
+        if abs(w_a) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_a = _item_acc(p, acc, nf + j)
-            g[q + 2] = a_a if forward else -a_a
+            g[q + 2] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
@@ -1945,8 +2024,8 @@ def check_invariants(t, x, m, p):
     * a stuck friction element carries at most what it holds (its static limit, a one-way clutch any torque against
       overrunning), a stuck lossy gear's loss torque within its band, to the decision's rounding floor (:data:`NOISE`)
       and 1e-9 relative;
-    * modes agree with the relative speeds: forward >= 0, backward <= 0, stuck ~0 (to 1e-6 of the largest speed,
-      what the event location and a stuck element's drift leave);
+    * modes agree with the relative speeds: forward >= 0, backward <= 0, stuck ~0 (to 1e-6 of the largest speed of
+      the element's inertias, what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
     * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
@@ -1960,14 +2039,11 @@ def check_invariants(t, x, m, p):
             return 0
     acc, tau = _acc_tau(p)
     evaluate_network(t, x, m, p, acc, tau)
-    noise = _noise(p, tau)
-    wmax = 1.0
-    for i in range(n):
-        wmax = max(wmax, abs(x[n + i]))
-    w_tol = 1e-6 * wmax
     for k in range(nf):
         r = p.fric[k]
         e = p.elem[r]
+        noise = _item_noise(p, r, tau)
+        w_tol = 1e3 * _item_wtol(p, r, x, n)
         w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
         mk = m[k]
         tq = tau[r]
@@ -1988,6 +2064,8 @@ def check_invariants(t, x, m, p):
         r = p.lossy[j]
         mode = m[p.elem[r][E_MODE]]
         w_a = gear_speed(p, r, x, n)
+        noise = _item_noise(p, r, tau)
+        w_tol = 1e3 * _item_wtol(p, r, x, n)
         if mode == GEAR_STUCK:
             lo, hi = gear_band(p, r, -tau[r])
             if hold[j] > hi + 2.0 * noise or hold[j] < lo - 2.0 * noise:
