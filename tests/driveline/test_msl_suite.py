@@ -92,7 +92,28 @@ def _events_of(rows, name):
             continue
         out.append((float(t), element, event))
     # several elements changing mode at one instant: in element order (their order in time is not defined)
-    return collapse(sorted(out, key=lambda e: (round(e[0], 7), e[1], e[2])))
+    return _drop_touches(collapse(sorted(out, key=lambda e: (round(e[0], 7), e[1], e[2]))))
+
+
+def _drop_touches(events, width=1e-5):
+    """Drop a stick that the same element undoes within ``width`` [s] (a relative speed that touches zero
+    tangentially, a double root, e.g. OneWayClutch's at 1.5 s where its drive torque and its clutch's pulse end
+    together: whether the integration error puts the touch a few 1e-9 rad/s below zero, a stick of a few
+    microseconds, or above, none, is not a decision of the model)."""
+    out = []
+    skip = set()
+    for i, (t, el, ev) in enumerate(events):
+        if i in skip:
+            continue
+        if ev == "stick":
+            nxt = next((j for j in range(i + 1, len(events)) if events[j][1] == el), None)
+            if nxt is not None and events[nxt][0] - t < width and events[nxt][2] != "stick":
+                prev = next((e[2] for e in reversed(events[:i]) if e[1] == el), None)
+                if prev == events[nxt][2]:
+                    skip.add(nxt)
+                    continue
+        out.append((t, el, ev))
+    return out
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -1758,7 +1758,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
         # the sliding direction), located so that a dip of the speed through zero within a step is seen
         g[N_G * k + G_TURN] = 1.0
-        if (mk == FORWARD or mk == BACKWARD) and abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
+        if (mk == FORWARD or mk == BACKWARD) and e[E_LAW] != LAW_EXTERNAL and \
+                abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_rel = (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
             # (plus the rounding of an acceleration: a speed held at rest by other elements has no turning point)
             g[N_G * k + G_TURN] = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)

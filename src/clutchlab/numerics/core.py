@@ -296,13 +296,16 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         earliest = best
         gb = ge.copy()   # (rare: a step with an event; the searches below overwrite ge)
         for k in range(ng):
-            if _crossed(ga[k], g1[k], gdir[k]) or not _crossed(ga[k], gb[k], gdir[k]):
+            # (a function that watches either way, or one that starts the step at zero, is not looked at again:
+            # only a dip of a directed function that started clear of zero)
+            if (gdir[k] == 0 or g0[k] == 0.0 or _crossed(ga[k], g1[k], gdir[k])
+                    or not _crossed(ga[k], gb[k], gdir[k])):
                 continue
-            lo = th0 if g0[k] == 0.0 else 0.0
-            root, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, lo, best, ga[k],
+            root, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, 0.0, best, ga[k],
                                  gb[k], ga[k], gdir[k])
             n_rhs += nr
-            earliest = min(earliest, root)
+            if root > 1e-3 * best:   # (a root at the very start of the step is the last event's, not a new one)
+                earliest = min(earliest, root)
         if earliest >= best:
             break
         best = earliest
@@ -316,12 +319,12 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
     [s]: ``(theta, n_rhs)``, ``theta`` the bracket end just past the root."""
     n_rhs = 0
     side = 0
-    for _it in range(100):
+    for _it in range(200):
         if (hi - lo) * h <= event_tol:
             break
-        if glo != ghi:
+        if glo != ghi and _it < 40:
             th = lo + (hi - lo) * glo / (glo - ghi)
-        else:
+        else:   # (a function that jumps at its root converges only by 1 % a step: bisect after 40 steps)
             th = 0.5 * (lo + hi)
         span = hi - lo
         th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
