@@ -22,9 +22,10 @@ rtol   speeds [rad/s]   i2 [A]      x [m]       events [s]
 
 At the default rtol the speeds' error is set by their absolute tolerance (1e-4 rad/s); before issue #30 that
 stayed fixed below the default, and the error stopped at 1.3e-4 rad/s from rtol 1e-7 down.  Now the absolute
-tolerances shrink with rtol (``clutchlab.emtc.system.absolute_tolerance``).  The speeds' floor against this
-reference, 3.4e-7 rad/s at one sample (t = 1.14 s, where the coil current crosses the 2.5 A grid line of the
-Preisach table: a kink of the magnet force that neither solver locates), is reached from rtol 1e-9 on.
+tolerances shrink with rtol (``clutchlab.emtc.system.absolute_tolerance``).  Left: around t = 1.14 s, where the
+coil current crosses the 2.5 A grid line of the Preisach table (a kink of the magnet force that clutchlab does
+not locate), the speeds are off by 3.2e-7 to 4.8e-7 rad/s at rtol 1e-8, 1e-9 and 1e-10 alike (the error decays
+within a few milliseconds through the tyres); at rtol 1e-11 clutchlab meets the reference there.
 """
 
 from __future__ import annotations

@@ -188,7 +188,8 @@ def absolute_tolerance(rtol: float = ATOL_RTOL) -> np.ndarray:
     shaft speeds' 1e-4 rad/s set the error of every run from ``rtol`` 1e-7
     down (measured on ``examples/emtc_scenario.toml`` against SciPy's DOP853
     at rtol 1e-12: 1.3e-4 rad/s at rtol 1e-7, 1e-8, 1e-9 and 1e-10 alike;
-    with the scaling 6.4e-6, 4.8e-7, 3.2e-7 rad/s; ``tests/emtc/test_accuracy.py``).
+    with the scaling 6.4e-6, 4.8e-7, 3.2e-7, 3.5e-7 rad/s, the last two set by an unlocated kink of the
+    magnet force, see ``docs/emtc.md``, "Accuracy"; ``tests/emtc/test_accuracy.py``).
 
     Parameters
     ----------
