@@ -449,7 +449,8 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     torque_reference : (times, torques), optional
         Replaces the map of Eq. 31 by a prescribed reference [s], [N*m].
     rtol, atol : float
-        Integrator tolerances (atol per state; default scaled to each state).
+        Integrator tolerances (atol per state; default: ``clutchlab.emtc.system.absolute_tolerance(rtol)``,
+        scaled to each state and shrinking with ``rtol`` below its default 1e-6).
     max_steps : int
         Accepted steps after which the run stops with :class:`SimulationError`.
     fixed_step : float, optional

@@ -172,7 +172,31 @@ LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
  L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(15)
 N_LAYOUT = 15
 
+#: absolute tolerances of the states at rtol 1e-6 and above: omega_f, omega_r [rad/s], theta [rad], x [m],
+#: v [m/s], i1, i2 [A]
 ATOL = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5])
+#: the relative tolerance below which the absolute tolerances shrink with it (the default rtol)
+ATOL_RTOL = 1e-6
+
+
+def absolute_tolerance(rtol: float = ATOL_RTOL) -> np.ndarray:
+    """Absolute tolerance per state for a relative tolerance: :data:`ATOL` times ``min(1, rtol / 1e-6)``.
+
+    At the default ``rtol`` (1e-6) and above these are the fixed tolerances the
+    model has always used; below it they shrink with ``rtol``, so that the
+    error control follows the tolerance.  With :data:`ATOL` fixed, the
+    shaft speeds' 1e-4 rad/s set the error of every run from ``rtol`` 1e-7
+    down (measured on ``examples/emtc_scenario.toml`` against SciPy's DOP853
+    at rtol 1e-12: 1.3e-4 rad/s at rtol 1e-7, 1e-8, 1e-9 and 1e-10 alike;
+    with the scaling 6.4e-6, 4.8e-7, 3.2e-7, 3.5e-7 rad/s, the last two set by an unlocated kink of the
+    magnet force, see ``docs/emtc.md``, "Accuracy"; ``tests/emtc/test_accuracy.py``).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance of the run.
+    """
+    return ATOL * min(1.0, float(rtol) / ATOL_RTOL)
 
 
 class VehicleData(NamedTuple):
@@ -1250,10 +1274,13 @@ def memory_full(system: System) -> bool:
 def run(build, t_end: float, **kwargs):
     """Simulate ``build(capacity)`` with :func:`clutchlab.system.simulate`; a full memory repeats the run larger.
 
-    ``build(memory_capacity) -> System`` makes a fresh system; returns ``(system, result)``.
+    ``build(memory_capacity) -> System`` makes a fresh system; returns ``(system, result)``.  Without an
+    ``atol``, a given ``rtol`` brings its :func:`absolute_tolerance`.
     """
     from ..system import simulate as core_simulate
 
+    if kwargs.get("atol") is None and kwargs.get("rtol") is not None:
+        kwargs["atol"] = absolute_tolerance(kwargs["rtol"])  # the error control follows rtol below its default
     cap = None
     while True:
         system = build(cap)
@@ -1285,7 +1312,8 @@ def simulate(scenario=None, t_end: float | None = None, *, magnet=None, vehicle=
     rtol : float, optional
         Relative tolerance (default 1e-6).
     atol : float or array_like, optional
-        Absolute tolerance per state (default scaled to each state).
+        Absolute tolerance per state (default: :func:`absolute_tolerance` of ``rtol``, scaled to each
+        state and shrinking with ``rtol`` below 1e-6).
     max_step : float, optional
         Largest step [s] (default: none besides the controller samples).
     output_step : float, optional
