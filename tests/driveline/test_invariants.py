@@ -318,3 +318,19 @@ def test_the_result_follows_the_tolerance_on_random_networks(d):
             span = max(1.0, np.ptp(b[col]))
             assert np.max(np.abs(a[col] - b[col])) <= 1e-4 * span, col
     assert [e[1:] for e in _mode_events(lo)] == [e[1:] for e in _mode_events(hi)]
+
+
+def test_the_debug_check_from_the_command_line(tmp_path):
+    """``clutchlab driveline simulate ... --check-invariants`` runs the same check (TestFriction keeps every
+    invariant: exit 0, the CSV written, its events the closed-form ones)."""
+    from clutchlab.cli import main
+
+    out = tmp_path / "run.csv"
+    events = tmp_path / "events.csv"
+    code = main(["driveline", "simulate", "examples/driveline_test_friction.toml", "-o", str(out), "--events",
+                 str(events), "--check-invariants"])
+    assert code == 0 and out.is_file()
+    import pandas as pd
+
+    ev = pd.read_csv(events)
+    assert len(ev) == 6 and abs(ev["time_s"].iloc[0] - 0.0159421) < 1e-6

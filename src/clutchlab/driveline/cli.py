@@ -1,6 +1,6 @@
 """``clutchlab driveline`` sub-commands: a thin layer over :mod:`clutchlab.driveline`.
 
-``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--fixed-step STEP] [--events EVENTS.csv] [--plot fig.png] [--force]``
+``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--fixed-step STEP] [--check-invariants] [--events EVENTS.csv] [--plot fig.png] [--force]``
     run a driveline network and write its states and outputs (and its events);
 ``clutchlab driveline describe FILE.toml``
     print a text schematic of the network.
@@ -36,6 +36,10 @@ def register(subparsers) -> None:
     sim.add_argument("--output-step", help="sample interval, e.g. '1 ms' (default: [simulation] output_step, "
                                            "else every accepted step)")
     add_fixed_step_option(sim)
+    sim.add_argument("--check-invariants", action="store_true",
+                     help="debug: check at every step that stuck elements are within their limits, modes agree "
+                          "with the relative speeds, one-way clutches never drive their free direction, lossy "
+                          "gears never generate and the energy balance holds; a violation names the element")
     sim.add_argument("--events", help="CSV of the events to write (time_s, component, event)")
     sim.add_argument("--plot", help="also write a PNG figure (speeds, friction torques, modes, energy)")
     sim.add_argument("--force", action="store_true", help="overwrite the outputs")
@@ -67,7 +71,7 @@ def _simulate(args) -> int:
     if not t_end > 0:
         raise ParameterError(f"end time = {t_end!r} s: must be > 0")
     res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step,
-                                  fixed_step=fixed_step)
+                                  fixed_step=fixed_step, check_invariants=args.check_invariants)
     frame = res.to_dataframe()
     events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
     # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
