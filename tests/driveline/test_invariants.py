@@ -334,3 +334,34 @@ def test_the_debug_check_from_the_command_line(tmp_path):
 
     ev = pd.read_csv(events)
     assert len(ev) == 6 and abs(ev["time_s"].iloc[0] - 0.0159421) < 1e-6
+
+
+@pytest.mark.parametrize("efficiency", [1.0, 0.8])
+def test_a_gear_on_a_free_housing(efficiency):
+    """A gear on a support (MSL ``useSupport``): its housing an inertia ``Js`` free to turn.  Ideal: the torques on
+    the inertias are ``lam``, ``-i lam``, ``(i - 1) lam`` (flange a, b, housing), so with ``T`` on flange a
+    ``lam = -(T/Ja) / (1/Ja + i^2/Jb + (i - 1)^2/Js)`` and the total angular momentum grows at ``T`` (no reaction
+    on the ground).  Lossy, flange a driving forward (quadrant 1): the torque on b is ``-i eta lam`` and the
+    housing takes ``(i eta - 1) lam``: ``lam = -(T/Ja) / (1/Ja + i^2 eta/Jb + (i - 1)(i eta - 1)/Js)``; the
+    momentum still grows at ``T`` and the loss is ``(1 - eta) T_a (w_a - w_s)``."""
+    Ja, Jb, Js, i, T = 0.5, 2.0, 3.0, 2.5, 4.0
+    d = Driveline("housing")
+    d.inertia("A", J=Ja).inertia("B", J=Jb).inertia("S", J=Js)
+    d.torque("T", "A", T)
+    d.gear("g", "A", "B", ratio=i, efficiency=efficiency, support="S")
+    res = d.simulate(1.0, sample_times=[0.5, 1.0], rtol=1e-10, check_invariants=True)
+    df = res.to_dataframe()
+    eta = efficiency
+    lam = -(T / Ja) / (1 / Ja + i * i * eta / Jb + (i - 1) * (i * eta - 1) / Js)
+    t = df["time_s"].to_numpy()
+    np.testing.assert_allclose(df["A.w_rad_s"], (T + lam) / Ja * t, rtol=1e-9)
+    np.testing.assert_allclose(df["B.w_rad_s"], -i * eta * lam / Jb * t, rtol=1e-9)
+    np.testing.assert_allclose(df["S.w_rad_s"], (i * eta - 1) * lam / Js * t, rtol=1e-9)
+    momentum = Ja * df["A.w_rad_s"] + Jb * df["B.w_rad_s"] + Js * df["S.w_rad_s"]
+    np.testing.assert_allclose(momentum, T * t, rtol=1e-9)
+    # the constraint against the housing
+    np.testing.assert_allclose(df["A.w_rad_s"] - df["S.w_rad_s"], i * (df["B.w_rad_s"] - df["S.w_rad_s"]),
+                               rtol=1e-9, atol=1e-12)
+    w_rel = ((T + lam) / Ja - (i * eta - 1) * lam / Js) * t
+    np.testing.assert_allclose(df["g.dissipated_J"], (1 - eta) * (-lam) * w_rel * t / 2, rtol=1e-8, atol=1e-12)
+    assert "on support S" in d.describe()
