@@ -1405,6 +1405,7 @@ def _item_row(p, i):
 
 @numba.njit(cache=True, nogil=True)
 def _item_stuck(p, m, i):
+    """True if item ``i`` (a friction element, then the lossy gears) is stuck in the modes ``m``."""
     nf = p.fric.shape[0]
     if i < nf:
         return m[i] == STUCK
@@ -1506,7 +1507,7 @@ def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
     for c in range(nc):
         i = cand[c]
         if _item_stuck(p, m, i):
-            ex, _d = _item_excess(t, p, tau, i, not _old_stuck(p, old, i))
+            ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
             if ex >= 0.0:
                 return False
         elif _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
@@ -1519,14 +1520,6 @@ def _item_anoise(p, r, acc):
     """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
     acceleration of its inertias."""
     return 1e-10 * (1.0 + _flanges_max(acc, p.elem[r]))
-
-
-@numba.njit(cache=True, nogil=True)
-def _old_stuck(p, old, i):
-    nf = p.fric.shape[0]
-    if i < nf:
-        return old[i] == STUCK
-    return old[p.elem[p.lossy[i - nf]][E_MODE]] == GEAR_STUCK
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1598,7 +1591,7 @@ def settle(t, x, m, p, log, old):
     _evaluate(t, x, m, p, acc, tau)
     worst = -np.inf
     for c in range(nc):
-        ex, d = _item_excess(t, p, tau, cand[c], not _old_stuck(p, old, cand[c]))
+        ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
         exc[c] = ex
         dirs[c] = d
         if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
@@ -1658,7 +1651,7 @@ def settle(t, x, m, p, log, old):
                     i = cand[c]
                     if not _item_stuck(p, m, i):
                         continue
-                    ex, d = _item_excess(t, p, tau, i, not _old_stuck(p, old, i))
+                    ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
                     if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY and d < 0:
                         continue
                     if ex >= 0.0 and ex > best:
