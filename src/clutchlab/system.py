@@ -107,7 +107,8 @@ class System:
     states, outputs, inputs : tuple of Variable
         Named, unit-carrying state, output and held-input vectors.
     switching : tuple of (str, int)
-        Name and crossing direction (+1, -1, 0) of each switching function.
+        Name and crossing direction (+1, -1, 0) of each switching function; +-2: the same direction, and a function
+        the core looks at again at the earliest root of a step (a dip through zero and back before it is located).
     events : tuple of str
         Event names by code (what the hooks record).
     mode_names : tuple of str

@@ -240,8 +240,11 @@ def networks(draw, with_unrelated=False):
     return d
 
 
-def _check_columns(d, df):
-    """The invariants from the sampled columns, by code independent of the kernel's check."""
+def _check_columns(d, df, events=None):
+    """The invariants from the sampled columns, by code independent of the kernel's check (a sample at an event's
+    instant, a source's jump, holds the modes before they settle there: left out)."""
+    if events is not None and len(events):
+        df = df[~np.isin(df["time_s"].to_numpy(), events["time_s"].to_numpy())]
     wmax = max(1.0, df.filter(like=".w_rad_s").abs().max().max())
     scale = max(1.0, df["input_work_J"].abs().max(), df["kinetic_energy_J"].max(), df["dissipated_energy_J"].max())
     assert np.abs(df["energy_error_J"]).max() < 1e-6 * scale
@@ -279,7 +282,7 @@ def test_invariants_hold_on_random_networks(d):
     """Whatever the network, the invariants hold at every accepted step (the compiled check) and in the samples
     (checked here from the columns)."""
     res = d.simulate(1.0, output_step=2e-3, rtol=1e-9, check_invariants=True)
-    _check_columns(d, res.to_dataframe())
+    _check_columns(d, res.to_dataframe(), res.events)
 
 
 @settings(max_examples=examples(10), deadline=None)

@@ -1455,7 +1455,7 @@ class Driveline:
         states, outputs = self.variables()
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric
-                          for what, d in (("stick", -1), ("breakaway", -1), ("normal", 0), ("turn", 1)))
+                          for what, d in (("stick", -2), ("breakaway", -1), ("normal", 0), ("turn", 1)))
         swit = [self._elements[r] for r in p.swit]
         # (a backlash's Kelvin-Voigt contact is watched both ways; MSL's law and curves by falling functions)
         switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH and e.aux != K.LASH_MSL else -1)
@@ -1463,7 +1463,7 @@ class Driveline:
                                                       else ("segment_below", "segment_above")))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
         switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
-                           for what, d in (("stick", -1), ("quadrant", -1), ("turn", 1)))
+                           for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1)))
         mode_names = named
         swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)

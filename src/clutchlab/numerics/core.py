@@ -296,9 +296,9 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         earliest = best
         gb = ge.copy()   # (rare: a step with an event; the searches below overwrite ge)
         for k in range(ng):
-            # (a function that watches either way, or one that starts the step at zero, is not looked at again:
-            # only a dip of a directed function that started clear of zero)
-            if (gdir[k] == 0 or g0[k] == 0.0 or _crossed(ga[k], g1[k], gdir[k])
+            # (only the functions a model marks for it, direction +-2, that started the step clear of zero: a
+            # driveline element's relative speed, whose dip through zero its turning-point function reveals)
+            if (abs(gdir[k]) != 2 or g0[k] == 0.0 or _crossed(ga[k], g1[k], gdir[k])
                     or not _crossed(ga[k], gb[k], gdir[k])):
                 continue
             root, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, 0.0, best, ga[k],
