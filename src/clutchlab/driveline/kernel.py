@@ -1508,11 +1508,18 @@ def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
         i = cand[c]
         if _item_stuck(p, m, i):
             ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-            if ex >= 0.0:
+            if ex >= 0.0 or _item_slips(p, acc, i):
                 return False
         elif _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             return False
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _item_slips(p, acc, i):
+    """True if stuck item ``i`` does not hold its relative acceleration at zero (a motion source prescribes the
+    motion it would hold: the constraints contradict each other, the stuck set is no solution)."""
+    return abs(_item_acc(p, acc, i)) > 1e3 * _item_anoise(p, _item_row(p, i), acc)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1592,6 +1599,9 @@ def settle(t, x, m, p, log, old):
     worst = -np.inf
     for c in range(nc):
         ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
+        if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
+            a = _item_acc(p, acc, cand[c])
+            ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
         exc[c] = ex
         dirs[c] = d
         if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
