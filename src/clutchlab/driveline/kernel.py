@@ -1474,7 +1474,7 @@ def _evaluate(t, x, m, p, acc, tau):
     """The network at ``t`` with every rolling lossy gear in the quadrant its torque puts it in (MSL
     ``LossyGear.tau_eta``'s sign: which flange drives): evaluated, a gear whose quadrant disagrees beyond the noise
     flipped, evaluated again, to a fixed point (the gear's torque law is continuous and monotone across the flip,
-    so there is one).  Returns the noise floor (:func:`_noise`)."""
+    so there is one).  Returns 0.0 (the rounding floors are per element: :func:`_item_noise`)."""
     n = p.inertia.shape[0]
     nl = p.lossy.shape[0]
     evaluate_network(t, x, m, p, acc, tau)
