@@ -46,6 +46,7 @@ import numpy as np
 
 from ..emtc import system as S
 from ..numerics import dispatch
+from ..numerics.borrow import byref
 from .kernel import DrivelineParams
 from . import kernel as K
 
@@ -98,7 +99,7 @@ def _load(x, m, p):
     are the flanges', its coupling mode ``slipping`` while the armature presses (else ``open``), its slip
     direction the network's (stuck: ``positive``; the torque magnitudes do not depend on it)."""
     cf = p.conf
-    net = p.net
+    net = byref(p.net)
     n = net.inertia.shape[0]
     e = net.elem[cf[F_ROW]]
     b = p.buf
@@ -122,9 +123,9 @@ def _coupling(t, x, m, p):
     b = p.buf
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
-    dispatch.rhs(t, xs, us, p.mbuf, p.emtc, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
-    dispatch.outputs(t, xs, us, p.mbuf, p.emtc, b[B_Y:N_BUF])   # (the same point: the model reuses it)
-    net = p.net
+    dispatch.rhs(t, xs, us, p.mbuf, byref(p.emtc), b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    dispatch.outputs(t, xs, us, p.mbuf, byref(p.emtc), b[B_Y:N_BUF])   # (the same point: the model reuses it)
+    net = byref(p.net)
     cap = b[B_Y + _Y_CAP] if p.mbuf[_ARM] == _CONTACT else 0.0
     K.set_external(net, net.elem[p.conf[F_ROW]][K.E_AUX], abs(b[B_Y + _Y_TC]), p.emtc.coupling.unlock_margin * cap,
                    cap)
@@ -135,7 +136,7 @@ def emtc_driveline_rhs(t, x, u, m, p, dx, g):
     """The network's right-hand side and switching functions, then the coupling's (its shaft speeds follow
     the flanges' accelerations; its lock-up and unlock functions are held off)."""
     _coupling(t, x, m, p)
-    net = p.net
+    net = byref(p.net)
     K.driveline_rhs(t, x, u, m, net, dx, g)
     acc, _tau = K._acc_tau(net)
     cf = p.conf
@@ -157,7 +158,7 @@ def emtc_driveline_rhs(t, x, u, m, p, dx, g):
 def emtc_driveline_outputs(t, x, u, m, p, y):
     """The network's outputs, then the coupling's (:data:`OUTPUTS`)."""
     _coupling(t, x, m, p)
-    K.driveline_outputs(t, x, u, m, p.net, y)
+    K.driveline_outputs(t, x, u, m, byref(p.net), y)
     b = p.buf
     q = y.shape[0] - p.index.shape[0]
     for i in range(p.index.shape[0]):
@@ -167,7 +168,7 @@ def emtc_driveline_outputs(t, x, u, m, p, y):
 @numba.njit(cache=True, nogil=True)
 def _sync(x, m, p):
     """The coupling's shaft-speed states reset to its flanges' speeds, its twist to zero (an event, a restart)."""
-    net = p.net
+    net = byref(p.net)
     n = net.inertia.shape[0]
     cf = p.conf
     e = net.elem[cf[F_ROW]]
@@ -198,18 +199,18 @@ def emtc_driveline_update(t, x, u, m, p, k, log):
     _coupling(t, x, m, p)
     ng = p.conf[F_G]
     if k < ng:
-        res = K.driveline_update(t, x, u, m, p.net, k, log)
+        res = K.driveline_update(t, x, u, m, byref(p.net), k, log)
         _sync(x, m, p)
         return res
     _load(x, m, p)
     b = p.buf
     start = log.count[0]
-    res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, k - ng, log)
+    res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc), k - ng, log)
     _write_back(x, m, p, start, log)
     if res < 0:
         return res
     _coupling(t, x, m, p)
-    K.settle(t, x, m, p.net, log, m.copy())
+    K.settle(t, x, m, byref(p.net), log, m.copy())
     _sync(x, m, p)
     return res
 
@@ -222,10 +223,10 @@ def emtc_driveline_restart(t, x, u, m, p, log):
     _load(x, m, p)
     b = p.buf
     start = log.count[0]
-    changed = dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc, log)
+    changed = dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc), log)
     _write_back(x, m, p, start, log)
     _coupling(t, x, m, p)
-    if K.driveline_restart(t, x, u, m, p.net, log):
+    if K.driveline_restart(t, x, u, m, byref(p.net), log):
         changed = True
     _sync(x, m, p)
     return changed
@@ -236,13 +237,13 @@ def emtc_driveline_accept(t, x, u, m, p):
     """The coupling's commit of its plant magnet's memory (or its model error: a full memory)."""
     _load(x, m, p)
     b = p.buf
-    return dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, p.emtc)
+    return dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc))
 
 
 @numba.njit(cache=True, nogil=True)
 def emtc_driveline_next_break(t, m, p):
     """The next corner of the network's signals or the coupling's next controller sample."""
-    return min(K.driveline_next_break(t, m, p.net), dispatch.next_break(t, p.mbuf, p.emtc))
+    return min(K.driveline_next_break(t, m, byref(p.net)), dispatch.next_break(t, p.mbuf, byref(p.emtc)))
 
 
 @numba.njit(cache=True, nogil=True)

@@ -34,6 +34,7 @@ import numba
 import numpy as np
 
 from ..numerics import dispatch
+from ..numerics.borrow import shaped
 from ..numerics.core import record
 from ..numerics.interp import bracket
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -391,7 +392,7 @@ def _characteristic(data, start, n, w):
     return _table(data, start, n, w)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
@@ -400,71 +401,67 @@ def friction_torque(p, r, t, w_abs):
     freewheel in parallel with a clutch): its clutch's ``cgeo * max(fn, 0) * mu(|w|)`` while it overruns (none
     without a normal force).  At ``w = 0`` this is ``tau0``; the static limit is ``peak * tau0``.
     """
-    e = p.elem[r]
-    law = e[E_LAW]
+    law = p.elem[r, E_LAW]
     if law == LAW_EXTERNAL:
-        return _external(p)[3 * e[E_AUX]]
-    c = p.coef[r]
-    val = _characteristic(p.data, e[E_TABLE], e[E_TABLE_N], w_abs)
+        return _external(p)[3 * p.elem[r, E_AUX]]
+    val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
     if law == LAW_TABLE:
         return val
     fn = normal_force(p, r, t)
     if law == LAW_ONEWAY:
         fn = max(fn, 0.0)
-    return c[C_CGEO] * fn * val
+    return p.coef[r, C_CGEO] * fn * val
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def normal_force(p, r, t):
     """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal);
     with a normal-force curve (``E_AUX`` points, an E-clutch's static curve), ``fn_max * curve(f(t))``:
     the signal is then the actuator input (the release bearing position [m])."""
-    e = p.elem[r]
-    f = 1.0 if e[E_SIGNAL] < 0 else signal_value(p.signals[e[E_SIGNAL]], p.data, t)
-    if e[E_AUX] > 0 and e[E_LAW] == LAW_CLUTCH:
-        f = _table(p.data, int(p.coef[r][C_NCURVE]), e[E_AUX], f)
-    return p.coef[r][C_FN_MAX] * f
+    f = 1.0 if p.elem[r, E_SIGNAL] < 0 else signal_at(p, p.elem[r, E_SIGNAL], t)
+    if p.elem[r, E_AUX] > 0 and p.elem[r, E_LAW] == LAW_CLUTCH:
+        f = _table(p.data, int(p.coef[r, C_NCURVE]), p.elem[r, E_AUX], f)
+    return p.coef[r, C_FN_MAX] * f
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _is_free(p, r, t):
     """A clutch or brake is free when its normal force is negative, or zero and not rising (a force that
     leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing).
     A one-way clutch is never free (its freewheel locks whatever its clutch's force)."""
-    e = p.elem[r]
-    if e[E_LAW] != LAW_CLUTCH:
+    if p.elem[r, E_LAW] != LAW_CLUTCH:
         return False
-    if e[E_AUX] > 0:   # a normal-force curve: free beyond its lift-off input, or at it and not coming back
-        u = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
-        lift = p.coef[r][C_LIFTOFF]
+    if p.elem[r, E_AUX] > 0:   # a normal-force curve: free beyond its lift-off input, or at it and not coming back
+        u = signal_at(p, p.elem[r, E_SIGNAL], t)
+        lift = p.coef[r, C_LIFTOFF]
         if u != lift:
             return u > lift
-        rate, _d2 = signal_rates(p.signals[e[E_SIGNAL]], p.data, t)
+        rate, _d2 = signal_rates(p.signals[p.elem[r, E_SIGNAL]], p.data, t)
         return rate >= 0.0
     fn = normal_force(p, r, t)
     if fn != 0.0:
         return fn < 0.0
-    if e[E_SIGNAL] < 0:
+    if p.elem[r, E_SIGNAL] < 0:
         return True
-    rate, _d2 = signal_rates(p.signals[e[E_SIGNAL]], p.data, t)
-    return p.coef[r][C_FN_MAX] * rate <= 0.0
+    rate, _d2 = signal_rates(p.signals[p.elem[r, E_SIGNAL]], p.data, t)
+    return p.coef[r, C_FN_MAX] * rate <= 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
     clutch's, the most it holds against overrunning)."""
-    if p.elem[r][E_LAW] == LAW_EXTERNAL:
-        return _external(p)[3 * p.elem[r][E_AUX] + 1]
-    return p.coef[r][C_PEAK] * friction_torque(p, r, t, 0.0)
+    if p.elem[r, E_LAW] == LAW_EXTERNAL:
+        return _external(p)[3 * p.elem[r, E_AUX] + 1]
+    return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def holding_limit(p, r, t, tau):
     """Largest ``|tau|`` [N m] a stuck friction element row ``r`` holds in the direction of ``tau``: its static
     limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and its clutch's static limit
     (zero without a normal force) for it (``tau > 0``)."""
-    if p.elem[r][E_LAW] == LAW_ONEWAY and tau <= 0.0:
+    if p.elem[r, E_LAW] == LAW_ONEWAY and tau <= 0.0:
         return np.inf
     return static_limit(p, r, t)
 
@@ -502,32 +499,29 @@ def engine_torque(p, r, t, x, n):
     (ki / kp) (T_idle - kp (w_idle - w) - I)`` (back-calculation anti-windup: the integral tracks the clipped
     output, so the right-hand side is continuous).  The controller only adds torque (it cannot brake the
     engine)."""
-    e = p.elem[r]
-    c = p.coef[r]
-    w = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
-    thr = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
-    tq = engine_map(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], w, thr)
-    if c[C_IDLE_MAX] <= 0.0:
+    w = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+    thr = signal_at(p, p.elem[r, E_SIGNAL], t)
+    tq = engine_map(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX], w, thr)
+    if p.coef[r, C_IDLE_MAX] <= 0.0:
         return tq, 0.0
-    err = c[C_IDLE_W] - w
-    integral = x[2 * n + p.elem.shape[0] + e[E_STATE]]
-    cmd = c[C_IDLE_KP] * err + integral
-    out = min(max(cmd, 0.0), c[C_IDLE_MAX])
+    err = p.coef[r, C_IDLE_W] - w
+    integral = x[2 * n + p.elem.shape[0] + p.elem[r, E_STATE]]
+    cmd = p.coef[r, C_IDLE_KP] * err + integral
+    out = min(max(cmd, 0.0), p.coef[r, C_IDLE_MAX])
     # back-calculation anti-windup with the tracking gain ki/kp: the right-hand side stays continuous (a
     # conditional integration would switch on the clip's edge and chatter there: a sliding mode)
-    kaw = c[C_IDLE_KI] / c[C_IDLE_KP] if c[C_IDLE_KP] > 0.0 else c[C_IDLE_KI]
-    return tq + out, c[C_IDLE_KI] * err + kaw * (out - cmd)
+    kaw = p.coef[r, C_IDLE_KI] / p.coef[r, C_IDLE_KP] if p.coef[r, C_IDLE_KP] > 0.0 else p.coef[r, C_IDLE_KI]
+    return tq + out, p.coef[r, C_IDLE_KI] * err + kaw * (out - cmd)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def source_torque(p, r, t, x, n):
     """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, or an
     engine's (:func:`engine_torque`)."""
-    e = p.elem[r]
-    if e[E_LAW] == SOURCE_ENGINE:
+    if p.elem[r, E_LAW] == SOURCE_ENGINE:
         tq, _rate = engine_torque(p, r, t, x, n)
         return tq
-    return signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+    return signal_at(p, p.elem[r, E_SIGNAL], t)
 
 
 # ----------------------------------------------------------------- springs
@@ -585,12 +579,11 @@ def _segment_energy(data, s, m, kind, seg, phi):
                          + fs[lo + 1] * (u3 - 0.5 * u4) + h * ds[lo + 1] * (0.25 * u4 - u3 / 3.0))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _spring_deflection(p, r, x, n):
-    e = p.elem[r]
-    pa = 0.0 if e[E_A] < 0 else x[e[E_A]]
-    pb = 0.0 if e[E_B] < 0 else x[e[E_B]]
-    return pb - pa - p.coef[r][C_PHI0]
+    pa = 0.0 if p.elem[r, E_A] < 0 else x[p.elem[r, E_A]]
+    pb = 0.0 if p.elem[r, E_B] < 0 else x[p.elem[r, E_B]]
+    return pb - pa - p.coef[r, C_PHI0]
 
 
 
@@ -601,14 +594,14 @@ def _lash_side(mode):
     return 0.0 if mode == LASH_GAP else (1.0 if mode % 2 == 1 else -1.0)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _lash_msl(p, r):
     """Does backlash row ``r`` follow MSL ``ElastoBacklash``'s damping law (with damping: without, both laws are
     the same spring)?"""
-    return p.elem[r][E_AUX] == LASH_MSL and p.coef[r][C_DAMP] > 0.0
+    return p.elem[r, E_AUX] == LASH_MSL and p.coef[r, C_DAMP] > 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def spring_torque(p, r, x, n, m):
     """Torque [N m] of spring-damper row ``r`` and its elastic part, ``(tau, tau_c)``.
 
@@ -622,24 +615,22 @@ def spring_torque(p, r, x, n, m):
     mirrored below) ``tau = tau_c + min(tau_c, tau_d)``, and 0 where ``tau_c + tau_d <= 0``: three modes per
     side (``tau_c + tau_d``; ``2 tau_c`` while ``tau_d >= tau_c``; 0), changed at their kinks, located events.
     """
-    e = p.elem[r]
-    c = p.coef[r]
     phi = _spring_deflection(p, r, x, n)
-    tau_d = c[C_DAMP] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
-    law = e[E_LAW]
+    tau_d = p.coef[r, C_DAMP] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
+    law = p.elem[r, E_LAW]
     if law == SPRING_CURVE:
-        tc = _segment_value(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], m[e[E_MODE]], phi)
+        tc = _segment_value(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX], m[p.elem[r, E_MODE]], phi)
         return tc + tau_d, tc
     if law == SPRING_BACKLASH:
-        mode = m[e[E_MODE]]
+        mode = m[p.elem[r, E_MODE]]
         if mode == LASH_GAP:
             return 0.0, 0.0
-        tc = c[C_STIFF] * (phi - _lash_side(mode) * 0.5 * c[C_GAP])
+        tc = p.coef[r, C_STIFF] * (phi - _lash_side(mode) * 0.5 * p.coef[r, C_GAP])
         if mode <= LASH_LOWER:
             return tc + tau_d, tc
         # MSL ElastoBacklash: tau_c + min(tau_c, tau_d) (upper; max below) -- limited: 2 tau_c; released: 0
         return (2.0 * tc if mode <= LASH_LOWER_LIMITED else 0.0), tc
-    tc = c[C_STIFF] * phi
+    tc = p.coef[r, C_STIFF] * phi
     return tc + tau_d, tc
 
 
@@ -647,37 +638,34 @@ def spring_torque(p, r, x, n, m):
 def spring_energy(p, r, x, n, m):
     """Energy [J] stored in spring-damper row ``r`` (the integral of its elastic torque over the deflection;
     a backlash's in its contact mode ``m``)."""
-    e = p.elem[r]
-    c = p.coef[r]
     phi = _spring_deflection(p, r, x, n)
-    law = e[E_LAW]
+    law = p.elem[r, E_LAW]
     if law == SPRING_CURVE:
-        return _segment_energy(p.data, e[E_TABLE], e[E_TABLE_N], e[E_AUX], m[e[E_MODE]], phi)
+        return _segment_energy(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX], m[p.elem[r, E_MODE]], phi)
     if law == SPRING_BACKLASH:
-        mode = m[e[E_MODE]]
+        mode = m[p.elem[r, E_MODE]]
         if mode == LASH_GAP:
             return 0.0
-        q = phi - _lash_side(mode) * 0.5 * c[C_GAP]
-        return 0.5 * c[C_STIFF] * q * q
-    return 0.5 * c[C_STIFF] * phi * phi
+        q = phi - _lash_side(mode) * 0.5 * p.coef[r, C_GAP]
+        return 0.5 * p.coef[r, C_STIFF] * q * q
+    return 0.5 * p.coef[r, C_STIFF] * phi * phi
 
 
 # ----------------------------------------------------------------- network evaluation
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _speed(x, n, i):
     return 0.0 if i < 0 else x[n + i]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _coefficients(p, r):
     """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a`` (a gear's, against its
     support: ``ratio (w_b - w_s) - (w_a - w_s)``), its torque ``tau`` acts ``+ca tau`` on flange a and ``-cb tau``
     on flange b.  A gear (MSL ``IdealGear``, ``w_a = ratio w_b``): ``ca = 1, cb = ratio``; a motion source:
     ``ca = 0`` (ground); others 1, 1."""
-    e = p.elem[r]
-    if e[E_KIND] == K_GEAR:
-        return 1.0, p.coef[r][C_RATIO]
-    if e[E_KIND] == K_MOTION:
+    if p.elem[r, E_KIND] == K_GEAR:
+        return 1.0, p.coef[r, C_RATIO]
+    if p.elem[r, E_KIND] == K_MOTION:
         return 0.0, 1.0
     return 1.0, 1.0
 
@@ -696,15 +684,14 @@ def _gear_column(data, start, n, col, w):
     return data[start + col * n + lo] + wt * (data[start + col * n + lo + 1] - data[start + col * n + lo])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def gear_losses(p, r, w_abs):
     """Mesh efficiencies and bearing friction of lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (MSL
     ``LossyGear``): ``(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a)``: efficiency while flange a drives [-], while
     b drives [-], the resultant bearing friction with respect to flange a in those two cases [N m] (absolute
     values), and the bearing friction on flange a's side, ``(tau_bf1 - tau_bf2) / (eta_mf1 - 1/eta_mf2)`` (half of
     ``tau_bf1`` where both efficiencies are 1: MSL's arbitrary split)."""
-    e = p.elem[r]
-    s, n = e[E_TABLE], e[E_TABLE_N]
+    s, n = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
     eta1 = _gear_column(p.data, s, n, 1, w_abs)
     eta2 = _gear_column(p.data, s, n, 2, w_abs)
     bf1 = abs(_gear_column(p.data, s, n, 3, w_abs))
@@ -716,7 +703,7 @@ def gear_losses(p, r, w_abs):
     return eta1, eta2, bf1, bf2, bfa
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def gear_transfer(p, r, mode, w_abs):
     """Torque law of a rolling lossy gear row ``r`` in ``mode``: ``(f, c)`` with the torque on flange b's inertia
     ``ratio (f T_a - c)`` [N m], ``T_a = -tau`` the torque flange a's side applies to the gear (MSL
@@ -762,7 +749,7 @@ def gear_margin(p, r, t_a, hold, noise):
     return min(up, down), hi - lo + noise, 1 if up < down else -1
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def gear_tau_eta(p, r, mode, t_a, w_abs):
     """MSL ``LossyGear.tau_eta`` [N m] of a rolling gear: ``T_a - tau_bf_a`` forward, ``T_a + tau_bf_a``
     backward; its sign decides the quadrant (which flange drives)."""
@@ -770,45 +757,45 @@ def gear_tau_eta(p, r, mode, t_a, w_abs):
     return t_a - bfa if mode == GEAR_FWD_A or mode == GEAR_FWD_B else t_a + bfa
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def gear_speed(p, r, x, n):
     """Speed of flange a against the gear's support ``w_a - w_s`` [rad/s] (MSL ``LossyGear.w_a``)."""
-    e = p.elem[r]
-    return _speed(x, n, e[E_A]) - _speed(x, n, e[E_SUP])
+    return _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _gear_mode(p, r, m):
     """The mode of gear row ``r`` (``GEAR_STUCK`` for an ideal one, which has none)."""
-    mi = p.elem[r][E_MODE]
+    mi = p.elem[r, E_MODE]
     return m[mi] if mi >= 0 else GEAR_STUCK
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def relative_speed(p, r, x, n):
     """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears, whose
     constraint speed is ``ratio (w_b - w_s) - (w_a - w_s)``, zero but for drift)."""
-    e = p.elem[r]
     ca, cb = _coefficients(p, r)
-    v = cb * _speed(x, n, e[E_B]) - ca * _speed(x, n, e[E_A])
-    if e[E_KIND] == K_GEAR:
-        v += (ca - cb) * _speed(x, n, e[E_SUP])
+    v = cb * _speed(x, n, p.elem[r, E_B]) - ca * _speed(x, n, p.elem[r, E_A])
+    if p.elem[r, E_KIND] == K_GEAR:
+        v += (ca - cb) * _speed(x, n, p.elem[r, E_SUP])
     return v
 
 
-@numba.njit(cache=True, nogil=True)
-def _apply(F, Fa, e, ca, cb, tq):
-    """Torque ``tq`` of an element on its inertias (``+ca tq`` on flange a, ``-cb tq`` on b), and its magnitude into
-    ``Fa``."""
-    if e[E_B] >= 0:
-        F[e[E_B]] -= cb * tq
-        Fa[e[E_B]] += abs(cb * tq)
-    if e[E_A] >= 0:
-        F[e[E_A]] += ca * tq
-        Fa[e[E_A]] += abs(ca * tq)
+@numba.njit(cache=True, nogil=True, inline="always")
+def _apply(F, Fa, elem, r, ca, cb, tq):
+    """Torque ``tq`` of element row ``r`` on its inertias (``+ca tq`` on flange a, ``-cb tq`` on b), and its magnitude
+    into ``Fa``."""
+    b = elem[r, E_B]
+    a = elem[r, E_A]
+    if b >= 0:
+        F[b] -= cb * tq
+        Fa[b] += abs(cb * tq)
+    if a >= 0:
+        F[a] += ca * tq
+        Fa[a] += abs(ca * tq)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _add(F, i, v):
     if i >= 0:
         F[i] += v
@@ -830,29 +817,28 @@ def evaluate_network(t, x, m, p, acc, tau):
     nf = p.fric.shape[0]
     nc = p.cons.shape[0]
     wk = p.work
+    refresh_signals(p, t)
     F = wk[0:n]
     Fa = _torque_magnitudes(p)
     for i in range(n):
         F[i] = 0.0
         Fa[i] = 0.0
     for r in range(ne):
-        e = p.elem[r]
-        kind = e[E_KIND]
+        kind = p.elem[r, E_KIND]
         if kind == K_SPRING:
             tq, _tc = spring_torque(p, r, x, n, m)
         elif kind == K_SOURCE:
-            tq = -(signal_value(p.signals[e[E_SIGNAL]], p.data, t) if e[E_LAW] == SOURCE_SIGNAL
+            tq = -(signal_at(p, p.elem[r, E_SIGNAL], t) if p.elem[r, E_LAW] == SOURCE_SIGNAL
                    else source_torque(p, r, t, x, n))
         else:
             continue
         tau[r] = tq
-        _apply(F, Fa, e, 1.0, 1.0, tq)
+        _apply(F, Fa, p.elem, r, 1.0, 1.0, tq)
     # sliding and free friction; the constraint set: stuck friction, gears, motion sources
     ns = 0
     stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a stuck lossy gear's hold)
     for k in range(nf):
         r = p.fric[k]
-        e = p.elem[r]
         mk = m[k]
         if mk == STUCK:
             stuck[ns] = r
@@ -861,29 +847,28 @@ def evaluate_network(t, x, m, p, acc, tau):
         if mk == FREE:
             tq = 0.0
         else:
-            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             tq = friction_torque(p, r, t, abs(w_rel))
             if mk == BACKWARD:
                 tq = -tq
         tau[r] = tq
-        _apply(F, Fa, e, 1.0, 1.0, tq)
+        _apply(F, Fa, p.elem, r, 1.0, 1.0, tq)
     for k in range(nc):
         stuck[ns] = p.cons[k]
         ns += 1
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
-        e = p.elem[r]
-        mode = m[e[E_MODE]]
+        mode = m[p.elem[r, E_MODE]]
         if mode == GEAR_STUCK:   # a stuck gear holds flange a against its support (member -(row + 1))
             stuck[ns] = -(r + 1)
             ns += 1
         else:                    # the bearing friction of a rolling gear: constant torques on b and the support
             _f, c = gear_transfer(p, r, mode, abs(gear_speed(p, r, x, n)))
-            ratio = p.coef[r][C_RATIO]
-            _add(F, e[E_B], -ratio * c)
-            _add(F, e[E_SUP], ratio * c)
-            _add(Fa, e[E_B], abs(ratio * c))
-            _add(Fa, e[E_SUP], abs(ratio * c))
+            ratio = p.coef[r, C_RATIO]
+            _add(F, p.elem[r, E_B], -ratio * c)
+            _add(F, p.elem[r, E_SUP], ratio * c)
+            _add(Fa, p.elem[r, E_B], abs(ratio * c))
+            _add(Fa, p.elem[r, E_SUP], abs(ratio * c))
     hold = _holds(p)
     for j in range(hold.shape[0]):
         hold[j] = 0.0
@@ -895,17 +880,18 @@ def evaluate_network(t, x, m, p, acc, tau):
 
 
 @numba.njit(cache=True, nogil=True)
-def _layout(n, nk, ne, nf=0, nl=0):
+def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | three flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds,
     null vector, its scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2) | accelerations (n) | element torques (ne) | slack of each friction element's
     and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
     inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
-    (nl) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
+    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | initial stored energy (1).  Returns the offsets of A, A + eps D, right-hand side,
     torques, weights, residual, member flanges, bounds, accelerations, element torques, slack, torque magnitudes,
-    holds."""
+    holds, signal cache, clutch models, null-vector cache."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -919,14 +905,17 @@ def _layout(n, nk, ne, nf=0, nl=0):
     o_slack = o_tau + ne
     o_fabs = o_slack + nf + nl
     o_hold = o_fabs + n
-    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold
+    o_sig = o_hold + nl
+    o_nv = o_sig + 1 + nsig
+    o_ext = o_nv + 2 + nk * nk + nk
+    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_ext, o_nv
 
 
-def work_size(n, nk, ne, nf, nx=0, nl=0):
+def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
-    elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears (the
-    layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl)[-1] + nl + 3 * nx + 1
+    elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
+    signals (the layout of :func:`_layout`)."""
+    return _layout.py_func(n, nk, ne, nf, nl, nsig)[14] + 3 * nx + 1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -936,44 +925,73 @@ def _nk(p):
     return p.fric.shape[0] + p.cons.shape[0] + p.lossy.shape[0]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _offsets(p):
-    return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0])
+    return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0],
+                   p.signals.shape[0])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _acc_tau(p):
     o = _offsets(p)
     return p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _slack(p):
     """Slack of the stick functions: the friction elements', then the lossy gears'."""
     o = _offsets(p)
     return p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _holds(p):
     """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
     o = _offsets(p)
     return p.work[o[12]:o[12] + p.lossy.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
     return p.work[o[11]:o[11] + p.inertia.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
     o = _offsets(p)
-    return p.work[o[12] + p.lossy.shape[0]:p.work.shape[0] - 1]
+    return p.work[o[14]:p.work.shape[0] - 1]
+
+
+@numba.njit(cache=True, nogil=True)
+def refresh_signals(p, t):
+    """Evaluate every signal of the network at ``t`` once (:func:`signal_value`) into the signal cache; every
+    evaluation of the network starts with this, and :func:`signal_at` reads from it at that time."""
+    o = _offsets(p)[13]
+    w = p.work
+    for s in range(p.signals.shape[0]):
+        w[o + 1 + s] = signal_value(p.signals[s], p.data, t)
+    w[o] = t
+
+
+@numba.njit(cache=True, nogil=True)
+def forget_signals(p):
+    """Empty the signal cache (a run starts, or a signal's parameters change)."""
+    p.work[_offsets(p)[13]] = np.nan
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def signal_at(p, s, t):
+    """Value of signal ``s`` of the network at ``t``: from the cache of the last evaluation if it was at ``t``
+    (:func:`refresh_signals`), else :func:`signal_value` itself.  The same value either way: a signal is a
+    function of time alone."""
+    o = _offsets(p)[13]
+    if p.work[o] == t:
+        return p.work[o + 1 + s]
+    return signal_value(p.signals[s], p.data, t)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -989,7 +1007,7 @@ def set_external(p, j, slide, limit, lock):
     ext[3 * j + 2] = lock
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _member(p, m, x, n, rk, fl, gc, hc, k):
     """Flanges (three, -1 for none or the ground; stored as floats), constraint weights ``g`` and torque weights
     ``h`` of constraint member ``k`` (element row ``rk``, or ``-(row + 1)`` for a stuck lossy gear's hold): the
@@ -1004,22 +1022,20 @@ def _member(p, m, x, n, rk, fl, gc, hc, k):
     o = 3 * k
     if rk < 0:
         r = -rk - 1
-        e = p.elem[r]
-        ratio = p.coef[r][C_RATIO]
-        fl[o], fl[o + 1], fl[o + 2] = e[E_A], e[E_B], e[E_SUP]
+        ratio = p.coef[r, C_RATIO]
+        fl[o], fl[o + 1], fl[o + 2] = p.elem[r, E_A], p.elem[r, E_B], p.elem[r, E_SUP]
         gc[o], gc[o + 1], gc[o + 2] = 1.0, 0.0, -1.0
         hc[o], hc[o + 1], hc[o + 2] = 0.0, ratio, -ratio
         return
-    e = p.elem[rk]
     ca, cb = _coefficients(p, rk)
-    fl[o], fl[o + 1], fl[o + 2] = e[E_A], e[E_B], -1
+    fl[o], fl[o + 1], fl[o + 2] = p.elem[rk, E_A], p.elem[rk, E_B], -1
     gc[o], gc[o + 1], gc[o + 2] = -ca, cb, 0.0
     hc[o], hc[o + 1], hc[o + 2] = -ca, cb, 0.0
-    if e[E_KIND] == K_GEAR:
+    if p.elem[rk, E_KIND] == K_GEAR:
         f = 1.0
-        if e[E_MODE] >= 0 and m[e[E_MODE]] != GEAR_STUCK:
-            f, _c = gear_transfer(p, rk, m[e[E_MODE]], abs(gear_speed(p, rk, x, n)))
-        fl[o + 2] = e[E_SUP]
+        if p.elem[rk, E_MODE] >= 0 and m[p.elem[rk, E_MODE]] != GEAR_STUCK:
+            f, _c = gear_transfer(p, rk, m[p.elem[rk, E_MODE]], abs(gear_speed(p, rk, x, n)))
+        fl[o + 2] = p.elem[rk, E_SUP]
         gc[o + 2] = ca - cb
         hc[o + 1] = cb * f
         hc[o + 2] = ca - cb * f
@@ -1103,6 +1119,56 @@ def _null_vector(A, ns, S, cp, v, y):
     return True
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _full_rank_known(p, A, ns):
+    """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A`` and found it of
+    full rank (nothing to repair)."""
+    o = _offsets(p)[15]
+    nk = _nk(p)
+    w = p.work
+    if w[o] != ns or w[o + 1] != 0.0:
+        return False
+    for k in range(ns):
+        for j in range(ns):
+            if w[o + 2 + k * nk + j] != A[k, j]:
+                return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _null_vector_cached(p, A, ns, S, cp, v, y):
+    """:func:`_null_vector` of ``A[:ns, :ns]``, reusing the last search's result when ``A`` is exactly the matrix it
+    searched (a stuck set evaluated again: the same set, the same ``A`` but for speed-dependent gear losses), so the
+    answer is the same bit for bit."""
+    o = _offsets(p)[15]
+    nk = _nk(p)
+    w = p.work
+    same = w[o] == ns
+    if same:
+        for k in range(ns):
+            for j in range(ns):
+                if w[o + 2 + k * nk + j] != A[k, j]:
+                    same = False
+                    break
+            if not same:
+                break
+    if same:
+        if w[o + 1] == 0.0:
+            return False
+        for k in range(ns):
+            v[k] = w[o + 2 + nk * nk + k]
+        return True
+    found = _null_vector(A, ns, S, cp, v, y)
+    w[o] = ns
+    w[o + 1] = 1.0 if found else 0.0
+    for k in range(ns):
+        for j in range(ns):
+            w[o + 2 + k * nk + j] = A[k, j]
+        if found:
+            w[o + 2 + nk * nk + k] = v[k]
+    return found
+
+
 @numba.njit(cache=True, nogil=True)
 def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     """Move a statically indeterminate split into the stuck members' bounds (one redundant loop).
@@ -1116,7 +1182,7 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     Gaussian elimination with complete pivoting (:func:`_null_vector`, exact to rounding, so ``lam + z v`` keeps the
     constraints); a set without a null direction, or with more than one, is left as it is.  Returns True if ``lam``
     changed."""
-    if not _null_vector(A, ns, S, cp, v, tmp):
+    if not _null_vector_cached(p, A, ns, S, cp, v, tmp):
         return False
     # breakpoints of every bound along z (each bound is piecewise linear in z); the feasible segments lie between
     nb = 0
@@ -1240,7 +1306,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     nk = _nk(p)
     wk = p.work
     o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim = _offsets(p)[:8]
-    A = wk[o_a:o_a + nk * nk].reshape((nk, nk))
+    A = shaped(wk[o_a:o_a + nk * nk], (nk, nk))
     b = wk[o_b:o_b + nk]
     lam = wk[o_l:o_l + nk]
     cap = wk[o_c:o_c + nk]
@@ -1254,7 +1320,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     vtmp = wk[o_lim + 3 * nk:o_lim + 4 * nk]
     trial = wk[o_lim + 4 * nk:o_lim + 5 * nk]
     cand = wk[o_lim + 5 * nk:o_lim + 11 * nk + 2]
-    S = wk[o_lim + 11 * nk + 2:o_lim + 11 * nk + 2 + ns * ns].reshape((ns, ns))
+    S = shaped(wk[o_lim + 11 * nk + 2:o_lim + 11 * nk + 2 + ns * ns], (ns, ns))
     cmax = 0.0
     fscale = 0.0
     for i in range(n):
@@ -1266,10 +1332,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         s = 0.0
         target = 0.0
         if rk >= 0:
-            ek = p.elem[rk]
-            if ek[E_KIND] == K_MOTION:
-                d1, d2 = signal_rates(p.signals[ek[E_SIGNAL]], p.data, t)
-                target = d1 if ek[E_LAW] == MOTION_SPEED else d2
+            if p.elem[rk, E_KIND] == K_MOTION:
+                d1, d2 = signal_rates(p.signals[p.elem[rk, E_SIGNAL]], p.data, t)
+                target = d1 if p.elem[rk, E_LAW] == MOTION_SPEED else d2
         s = -target
         for q in range(3):
             i = int(flf[3 * k + q])
@@ -1280,9 +1345,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         cap[k] = -1.0
         lo[k] = -np.inf
         hi[k] = np.inf
-        if rk >= 0 and p.elem[rk][E_KIND] == K_FRICTION:
+        if rk >= 0 and p.elem[rk, E_KIND] == K_FRICTION:
             lim = static_limit(p, rk, t)
-            if p.elem[rk][E_LAW] != LAW_ONEWAY:
+            if p.elem[rk, E_LAW] != LAW_ONEWAY:
                 cap[k] = lim
                 cmax = max(cmax, cap[k])
                 lo[k] = -lim
@@ -1308,7 +1373,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     cmax = 0.0
     for k in range(ns):
         cmax = max(cmax, cap[k])
-    M = wk[o_m:o_m + ns * ns].reshape((ns, ns))
+    M = shaped(wk[o_m:o_m + ns * ns], (ns, ns))
     for k in range(ns):
         for j in range(ns):
             M[k, j] = A[k, j]
@@ -1324,7 +1389,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
-    if bounded and ns > 1:
+    if bounded and ns > 1 and not _full_rank_known(p, A, ns):
         big = fscale
         for k in range(ns):
             big = max(big, abs(lam[k]))
@@ -1333,6 +1398,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         # v keeps the constraints, v being A's null vector to rounding)
         _repair(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
     hold = _holds(p)
+    Fa = _torque_magnitudes(p)
     for k in range(ns):
         rk = int(stuck[k])
         if rk < 0:
@@ -1340,7 +1406,6 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
             hold[_lossy_index(p, r)] = lam[k]
         else:
             tau[rk] = lam[k]
-        Fa = _torque_magnitudes(p)
         for q in range(3):
             i = int(flf[3 * k + q])
             if i >= 0:
@@ -1348,7 +1413,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
                 Fa[i] += abs(hc[3 * k + q] * lam[k])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _lossy_index(p, r):
     for j in range(p.lossy.shape[0]):
         if p.lossy[j] == r:
@@ -1359,57 +1424,57 @@ def _lossy_index(p, r):
 
 
 # ----------------------------------------------------------------- the stick/slip items: friction elements and lossy gears
-@numba.njit(cache=True, nogil=True)
-def _flanges_max(v, e):
-    """The largest of ``|v|`` over an element's flanges (a, b and a gear's support; 0 for the ground)."""
+@numba.njit(cache=True, nogil=True, inline="always")
+def _flanges_max(v, elem, r):
+    """The largest of ``|v|`` over element row ``r``'s flanges (a, b and a gear's support; 0 for the ground)."""
     out = 0.0
-    if e[E_A] >= 0:
-        out = max(out, abs(v[e[E_A]]))
-    if e[E_B] >= 0:
-        out = max(out, abs(v[e[E_B]]))
-    if e[E_KIND] == K_GEAR and e[E_SUP] >= 0:
-        out = max(out, abs(v[e[E_SUP]]))
+    a = elem[r, E_A]
+    b = elem[r, E_B]
+    if a >= 0:
+        out = max(out, abs(v[a]))
+    if b >= 0:
+        out = max(out, abs(v[b]))
+    if elem[r, E_KIND] == K_GEAR and elem[r, E_SUP] >= 0:
+        out = max(out, abs(v[elem[r, E_SUP]]))
     return out
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_noise(p, r, tau):
     """Rounding floor [N m] of the stick/slip decisions of element row ``r``: ``NOISE`` times one plus its torque and
     the torques on its own inertias at the last evaluation (local: an element elsewhere in the network does not move
     a decision here)."""
-    e = p.elem[r]
-    scale = max(abs(tau[r]), _flanges_max(_torque_magnitudes(p), e))
-    if e[E_KIND] == K_GEAR and e[E_MODE] >= 0:
+    scale = max(abs(tau[r]), _flanges_max(_torque_magnitudes(p), p.elem, r))
+    if p.elem[r, E_KIND] == K_GEAR and p.elem[r, E_MODE] >= 0:
         scale = max(scale, abs(_holds(p)[_lossy_index(p, r)]))
     return NOISE * (1.0 + scale)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_wtol(p, r, x, n):
     """Rounding width [rad/s] of a relative speed of element row ``r``: 1e-9 of the largest speed of its inertias
     (at least 1 rad/s)."""
     n_ = p.inertia.shape[0]
-    e = p.elem[r]
     w = 1.0
-    for i in (e[E_A], e[E_B], e[E_SUP] if e[E_KIND] == K_GEAR else -1):
+    for i in (p.elem[r, E_A], p.elem[r, E_B], p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1):
         if i >= 0:
             w = max(w, abs(x[n_ + i]))
     return 1e-9 * w
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_row(p, i):
     nf = p.fric.shape[0]
     return p.fric[i] if i < nf else p.lossy[i - nf]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_stuck(p, m, i):
     """True if item ``i`` (a friction element, then the lossy gears) is stuck in the modes ``m``."""
     nf = p.fric.shape[0]
     if i < nf:
         return m[i] == STUCK
-    return m[p.elem[p.lossy[i - nf]][E_MODE]] == GEAR_STUCK
+    return m[p.elem[p.lossy[i - nf], E_MODE]] == GEAR_STUCK
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1421,28 +1486,26 @@ def _item_set(p, m, i, direction):
     if i < nf:
         m[i] = STUCK if direction == 0 else (FORWARD if direction > 0 else BACKWARD)
     else:
-        m[p.elem[p.lossy[i - nf]][E_MODE]] = GEAR_STUCK if direction == 0 else (GEAR_FWD_A if direction > 0
+        m[p.elem[p.lossy[i - nf], E_MODE]] = GEAR_STUCK if direction == 0 else (GEAR_FWD_A if direction > 0
                                                                                  else GEAR_BWD_A)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_speed(p, x, n, i):
     """Relative speed [rad/s] of item ``i``: a friction element's ``w_b - w_a``, a lossy gear's ``w_a - w_s``."""
     r = _item_row(p, i)
     if i < p.fric.shape[0]:
-        e = p.elem[r]
-        return _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        return _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
     return gear_speed(p, r, x, n)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_acc(p, acc, i):
     """Relative acceleration [rad/s^2] of item ``i`` (as :func:`_item_speed`)."""
     r = _item_row(p, i)
-    e = p.elem[r]
     if i < p.fric.shape[0]:
-        return (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
-    return (0.0 if e[E_A] < 0 else acc[e[E_A]]) - (0.0 if e[E_SUP] < 0 else acc[e[E_SUP]])
+        return (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
+    return (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]]) - (0.0 if p.elem[r, E_SUP] < 0 else acc[p.elem[r, E_SUP]])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1460,8 +1523,8 @@ def _item_excess(t, p, tau, i, sticking):
     if i < nf:
         tq = tau[r]
         lim = holding_limit(p, r, t, tq)
-        if sticking and p.elem[r][E_LAW] == LAW_EXTERNAL:
-            lim = _external(p)[3 * p.elem[r][E_AUX] + 2]
+        if sticking and p.elem[r, E_LAW] == LAW_EXTERNAL:
+            lim = _external(p)[3 * p.elem[r, E_AUX] + 2]
         thr = max(lim, noise)
         d = 1 if tq > 0.0 else -1
         return (abs(tq) - thr) / thr, d
@@ -1482,7 +1545,7 @@ def _evaluate(t, x, m, p, acc, tau):
         flipped = False
         for j in range(nl):
             r = p.lossy[j]
-            mi = p.elem[r][E_MODE]
+            mi = p.elem[r, E_MODE]
             mode = m[mi]
             if mode == GEAR_STUCK:
                 continue
@@ -1522,11 +1585,11 @@ def _item_slips(p, acc, i):
     return abs(_item_acc(p, acc, i)) > 1e3 * _item_anoise(p, _item_row(p, i), acc)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _item_anoise(p, r, acc):
     """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
     acceleration of its inertias."""
-    return 1e-10 * (1.0 + _flanges_max(acc, p.elem[r]))
+    return 1e-10 * (1.0 + _flanges_max(acc, p.elem, r))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1538,7 +1601,7 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
         c = pick[q]
         i = cand[c]
         if _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
-            if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY:
+            if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY:
                 continue
             dirs[c] = -dirs[c]
             _item_set(p, m, i, dirs[c])
@@ -1575,11 +1638,10 @@ def settle(t, x, m, p, log, old):
     acc, tau = _acc_tau(p)
     for k in range(nf):
         r = p.fric[k]
-        e = p.elem[r]
         if _is_free(p, r, t):
             m[k] = FREE
         elif m[k] == FREE:   # engaged: slides the way it moves, or is at rest (decided below)
-            w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             w_tol = _item_wtol(p, r, x, n)
             m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
     # the items at rest
@@ -1662,7 +1724,7 @@ def settle(t, x, m, p, log, old):
                     if not _item_stuck(p, m, i):
                         continue
                     ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-                    if i < nf and p.elem[p.fric[i]][E_LAW] == LAW_ONEWAY and d < 0:
+                    if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
                         continue
                     if ex >= 0.0 and ex > best:
                         best, bi, bd = ex, i, d
@@ -1683,7 +1745,7 @@ def settle(t, x, m, p, log, old):
             w_tol = _item_wtol(p, p.fric[k], x, n)
             slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
     for j in range(nl):
-        mi = p.elem[p.lossy[j]][E_MODE]
+        mi = p.elem[p.lossy[j], E_MODE]
         new, was = m[mi], old[mi]
         if new == was:
             continue
@@ -1730,74 +1792,69 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         dx[i] = x[n + i]
         dx[n + i] = acc[i]
     for r in range(ne):
-        e = p.elem[r]
-        kind = e[E_KIND]
+        kind = p.elem[r, E_KIND]
         w_rel = relative_speed(p, r, x, n)
         if kind == K_SPRING:
             _tq, tc = spring_torque(p, r, x, n, m)
             dx[2 * n + r] = (tau[r] - tc) * w_rel
         elif kind == K_SOURCE or kind == K_MOTION:
             dx[2 * n + r] = -tau[r] * w_rel
-            if kind == K_SOURCE and e[E_LAW] == SOURCE_ENGINE and e[E_STATE] >= 0:
+            if kind == K_SOURCE and p.elem[r, E_LAW] == SOURCE_ENGINE and p.elem[r, E_STATE] >= 0:
                 _tq, rate = engine_torque(p, r, t, x, n)
-                dx[2 * n + ne + e[E_STATE]] = rate
+                dx[2 * n + ne + p.elem[r, E_STATE]] = rate
         elif kind == K_GEAR:   # the power the gear takes from its flanges: its loss (and the constraint's drift)
             dx[2 * n + r] = gear_power(p, r, x, n, m, tau[r])
         else:
             dx[2 * n + r] = tau[r] * w_rel
     for k in range(nf):
         r = p.fric[k]
-        e = p.elem[r]
-        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         mk = m[k]
         g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
-        noise = _item_noise(p, r, tau)
         if mk != STUCK:
             g[N_G * k + G_BREAK] = 1.0
-        elif e[E_LAW] == LAW_ONEWAY:   # holds any torque against overrunning, its clutch's limit for it
-            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - tau[r]
+        elif p.elem[r, E_LAW] == LAW_ONEWAY:   # holds any torque against overrunning, its clutch's limit for it
+            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), _item_noise(p, r, tau)) - tau[r]
         else:
-            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), noise) - abs(tau[r])
+            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), _item_noise(p, r, tau)) - abs(tau[r])
         # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
         # the sliding direction), located so that a dip of the speed through zero within a step is seen
         g[N_G * k + G_TURN] = 1.0
-        if (mk == FORWARD or mk == BACKWARD) and e[E_LAW] != LAW_EXTERNAL and \
+        if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL and \
                 abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
-            a_rel = (0.0 if e[E_B] < 0 else acc[e[E_B]]) - (0.0 if e[E_A] < 0 else acc[e[E_A]])
+            a_rel = (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
             # (plus the rounding of an acceleration: a speed held at rest by other elements has no turning point)
             g[N_G * k + G_TURN] = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
-        if e[E_LAW] != LAW_CLUTCH or e[E_SIGNAL] < 0:
+        if p.elem[r, E_LAW] != LAW_CLUTCH or p.elem[r, E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
-        elif e[E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
-            g[N_G * k + G_NORMAL] = p.coef[r][C_LIFTOFF] - signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+        elif p.elem[r, E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
+            g[N_G * k + G_NORMAL] = p.coef[r, C_LIFTOFF] - signal_at(p, p.elem[r, E_SIGNAL], t)
         else:
-            g[N_G * k + G_NORMAL] = signal_value(p.signals[e[E_SIGNAL]], p.data, t)
+            g[N_G * k + G_NORMAL] = signal_at(p, p.elem[r, E_SIGNAL], t)
     for j in range(p.swit.shape[0]):
         r = p.swit[j]
-        c = p.coef[r]
-        e = p.elem[r]
         phi = _spring_deflection(p, r, x, n)
         mode = m[nf + j]
-        if e[E_LAW] == SPRING_CURVE:   # the points bounding the segment: below (falls through) and above
-            s0, mp = e[E_TABLE], e[E_TABLE_N]
+        if p.elem[r, E_LAW] == SPRING_CURVE:   # the points bounding the segment: below (falls through) and above
+            s0, mp = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
             g[N_G * nf + 2 * j] = phi - p.data[s0 + mode - 1] if mode > 0 else 1.0
             g[N_G * nf + 2 * j + 1] = p.data[s0 + mode] - phi if mode < mp else 1.0
             continue
-        b2 = 0.5 * c[C_GAP]
+        b2 = 0.5 * p.coef[r, C_GAP]
         if _lash_msl(p, r):
             g0, g1 = _lash_msl_switching(p, r, x, n, mode, phi)
             g[N_G * nf + 2 * j] = g0
             g[N_G * nf + 2 * j + 1] = g1
             continue
         # in the gap: the edges; in contact: the torque over c (it falls through zero: it would pull)
-        lag = c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+        lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
         g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
         g[N_G * nf + 2 * j + 1] = phi + b2 + (lag if mode == LASH_LOWER else 0.0)
     nsw = p.swit.shape[0]
     hold = _holds(p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
-        mode = m[p.elem[r][E_MODE]]
+        mode = m[p.elem[r, E_MODE]]
         q = N_G * nf + 2 * nsw + N_GEAR_G * j
         noise = _item_noise(p, r, tau)
         g[q + 2] = 1.0
@@ -1820,18 +1877,17 @@ def gear_power(p, r, x, n, m, tau):
     """Power [W] gear row ``r`` takes from the inertias it joins, ``-(sum of its torques on them times their
     speeds)``: its loss ``tauLoss (w_a - w_s)`` (MSL ``LossyGear.lossPower``), zero for an ideal or a stuck gear but
     for the drift of the constraints.  ``tau`` its torque on flange a (``-T_a``)."""
-    e = p.elem[r]
-    ratio = p.coef[r][C_RATIO]
+    ratio = p.coef[r, C_RATIO]
     mode = _gear_mode(p, r, m)
     if mode == GEAR_STUCK:
         tb = -ratio * tau
-        if e[E_MODE] >= 0:
+        if p.elem[r, E_MODE] >= 0:
             tb -= ratio * _holds(p)[_lossy_index(p, r)]
     else:
         f, c = gear_transfer(p, r, mode, abs(gear_speed(p, r, x, n)))
         tb = -ratio * (f * tau + c)
     ts = -tau - tb
-    return -(tau * _speed(x, n, e[E_A]) + tb * _speed(x, n, e[E_B]) + ts * _speed(x, n, e[E_SUP]))
+    return -(tau * _speed(x, n, p.elem[r, E_A]) + tb * _speed(x, n, p.elem[r, E_B]) + ts * _speed(x, n, p.elem[r, E_SUP]))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1846,14 +1902,12 @@ def _lash_msl_switching(p, r, x, n, mode, phi):
     * limited (``2 tau_c``): ``b - a`` (back to ``tau_c + tau_d``); none;
     * released (0): ``-(a + b)`` (the contact loads again), ``s phi - b/2`` (the gap's edge: separate).
     """
-    e = p.elem[r]
-    c = p.coef[r]
-    b2 = 0.5 * c[C_GAP]
+    b2 = 0.5 * p.coef[r, C_GAP]
     if mode == LASH_GAP:
         return b2 - phi, phi + b2
     side = _lash_side(mode)
     a = side * (phi - side * b2)
-    b = side * c[C_DAMP] / c[C_STIFF] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+    b = side * p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
     if mode <= LASH_LOWER:
         return a - b, a + b
     if mode <= LASH_LOWER_LIMITED:
@@ -1868,10 +1922,8 @@ def _lash_msl_update(p, r, x, n, mode, which):
     (limited while ``s tau_d >= s tau_c``: moving in, the damping torque exceeds the spring's, which is zero)."""
     if mode == LASH_GAP:
         side = 1.0 if which == 0 else -1.0
-        e = p.elem[r]
-        c = p.coef[r]
-        a = side * c[C_STIFF] * (_spring_deflection(p, r, x, n) - side * 0.5 * c[C_GAP])
-        b = side * c[C_DAMP] * (_speed(x, n, e[E_B]) - _speed(x, n, e[E_A]))
+        a = side * p.coef[r, C_STIFF] * (_spring_deflection(p, r, x, n) - side * 0.5 * p.coef[r, C_GAP])
+        b = side * p.coef[r, C_DAMP] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
         upper = which == 0
         if b >= a:
             return LASH_UPPER_LIMITED if upper else LASH_LOWER_LIMITED
@@ -1907,8 +1959,7 @@ def driveline_outputs(t, x, u, m, p, y):
     work = 0.0
     lost = 0.0
     for r in range(ne):
-        e = p.elem[r]
-        kind = e[E_KIND]
+        kind = p.elem[r, E_KIND]
         if kind == K_SOURCE or kind == K_MOTION:
             y[q] = -tau[r]
             q += 1
@@ -1919,17 +1970,17 @@ def driveline_outputs(t, x, u, m, p, y):
         q += 1
         if kind == K_GEAR:
             continue
-        y[q] = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        y[q] = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         q += 1
         if kind == K_SPRING:
             spring += spring_energy(p, r, x, n, m)
     for k in range(nf):
         r = p.fric[k]
         y[q] = MODE_CODES[m[k]]
-        y[q + 1] = normal_force(p, r, t) if p.elem[r][E_LAW] in (LAW_CLUTCH, LAW_ONEWAY) else 0.0
+        y[q + 1] = normal_force(p, r, t) if p.elem[r, E_LAW] in (LAW_CLUTCH, LAW_ONEWAY) else 0.0
         q += 2
     for j in range(p.lossy.shape[0]):
-        y[q] = GEAR_CODES[m[p.elem[p.lossy[j]][E_MODE]]]
+        y[q] = GEAR_CODES[m[p.elem[p.lossy[j], E_MODE]]]
         q += 1
     y[q] = kinetic
     y[q + 1] = spring
@@ -1951,7 +2002,7 @@ def driveline_update(t, x, u, m, p, k, log):
         which = (k - N_G * nf - 2 * nsw) % N_GEAR_G
         if which == 2:   # its speed's turning point: a step ends there, nothing changes
             return 0
-        mi = p.elem[p.lossy[j]][E_MODE]
+        mi = p.elem[p.lossy[j], E_MODE]
         old = m.copy()
         mode = m[mi]
         if mode != GEAR_STUCK:
@@ -1966,8 +2017,7 @@ def driveline_update(t, x, u, m, p, k, log):
         j = (k - N_G * nf) // 2
         r = p.swit[j]
         n = p.inertia.shape[0]
-        e = p.elem[r]
-        if e[E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
+        if p.elem[r, E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
             m[nf + j] += -1 if (k - N_G * nf) % 2 == 0 else 1
             return 0
         if _lash_msl(p, r):   # MSL's damping law: its kinks change the mode silently; the edges are events
@@ -1980,7 +2030,7 @@ def driveline_update(t, x, u, m, p, k, log):
                 record(log, t, EV_CONTACT if new != LASH_GAP else EV_SEPARATE, nf + j)
             return 0
         side = LASH_UPPER if (k - N_G * nf) % 2 == 0 else LASH_LOWER   # phi - b/2: the gap's upper side
-        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         if m[nf + j] == LASH_GAP and ((side == LASH_UPPER and w_rel > 0.0) or (side == LASH_LOWER and w_rel < 0.0)):
             m[nf + j] = side
             record(log, t, EV_CONTACT, nf + j)
@@ -2008,7 +2058,9 @@ def driveline_update(t, x, u, m, p, k, log):
 
 @numba.njit(cache=True, nogil=True)
 def driveline_restart(t, x, u, m, p, log):
-    """Modes consistent with the forces at a start, a resume or a signal's jump."""
+    """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
+    :func:`forget_signals`)."""
+    forget_signals(p)
     return settle(t, x, m, p, log, m.copy())
 
 
@@ -2045,28 +2097,27 @@ def check_invariants(t, x, m, p):
     evaluate_network(t, x, m, p, acc, tau)
     for k in range(nf):
         r = p.fric[k]
-        e = p.elem[r]
         noise = _item_noise(p, r, tau)
         w_tol = 1e3 * _item_wtol(p, r, x, n)
-        w_rel = _speed(x, n, e[E_B]) - _speed(x, n, e[E_A])
+        w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         mk = m[k]
         tq = tau[r]
         if mk == STUCK:
             lim = max(holding_limit(p, r, t, tq), noise)
             if abs(tq) > lim * (1.0 + 1e-9) + noise:
-                return -(INV_BASE + N_INV * r + (INV_ONEWAY if e[E_LAW] == LAW_ONEWAY else INV_LIMIT))
+                return -(INV_BASE + N_INV * r + (INV_ONEWAY if p.elem[r, E_LAW] == LAW_ONEWAY else INV_LIMIT))
             if abs(w_rel) > w_tol:
                 return -(INV_BASE + N_INV * r + INV_MODE)
         elif (mk == FORWARD and w_rel < -w_tol) or (mk == BACKWARD and w_rel > w_tol):
             return -(INV_BASE + N_INV * r + INV_MODE)
-        if e[E_LAW] == LAW_ONEWAY:
+        if p.elem[r, E_LAW] == LAW_ONEWAY:
             cap = max(static_limit(p, r, t), friction_torque(p, r, t, abs(w_rel)), noise)
             if mk == BACKWARD or w_rel < -w_tol or tq > cap * (1.0 + 1e-9) + noise:
                 return -(INV_BASE + N_INV * r + INV_ONEWAY)
     hold = _holds(p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
-        mode = m[p.elem[r][E_MODE]]
+        mode = m[p.elem[r, E_MODE]]
         w_a = gear_speed(p, r, x, n)
         noise = _item_noise(p, r, tau)
         w_tol = 1e3 * _item_wtol(p, r, x, n)
@@ -2089,7 +2140,7 @@ def check_invariants(t, x, m, p):
         for i in range(n):
             kinetic += 0.5 * p.inertia[i] * x[n + i] ** 2
         for r in range(ne):
-            kind = p.elem[r][E_KIND]
+            kind = p.elem[r, E_KIND]
             if kind == K_SOURCE or kind == K_MOTION:
                 work += x[2 * n + r]
             else:

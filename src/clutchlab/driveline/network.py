@@ -1251,9 +1251,11 @@ class Driveline:
         nk = fric.size + cons.size + lossy.size
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
         elem[ext, K.E_AUX] = np.arange(len(ext))
-        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext), lossy.size))
+        sig = np.array(signals, dtype=float).reshape(-1, K.N_SIG)
+        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0]))
+        work[K._layout.py_func(n, nk, ne, fric.size, lossy.size, sig.shape[0])[13]] = np.nan   # empty signal cache
         inertia = np.array([v[0] for v in self._inertias.values()])
-        p = K.DrivelineParams(inertia, elem, coef, np.array(signals, dtype=float).reshape(-1, K.N_SIG),
+        p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
                               np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2))
         x0 = self.initial_state()

@@ -33,6 +33,7 @@ import numba
 import numpy as np
 
 from ..numerics import dispatch
+from ..numerics.borrow import byref
 from ..wet import system as W
 from . import kernel as K
 from .kernel import DrivelineParams
@@ -76,7 +77,7 @@ def _clutch(t, x, m, p, j):
     ``p.buf[j]``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
     Returns the element's relative speed [rad/s]."""
     cf = p.conf[j]
-    net = p.net
+    net = byref(p.net)
     n = net.inertia.shape[0]
     r = cf[F_ROW]
     w_rel = K.relative_speed(net, r, x, n)
@@ -92,7 +93,7 @@ def _clutch(t, x, m, p, j):
     ms[W.M_FRICTION] = W.STICK if mk == K.STUCK else (W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0)
                                                     else W.SLIP)
     wp = _wet(p, j)
-    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, wp, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, byref(wp), b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
     K.set_external(net, net.elem[r][K.E_AUX], cap + abs(wk[W.W_OUT + W.O_TV]), cap, cap)
@@ -113,8 +114,8 @@ def wet_driveline_rhs(t, x, u, m, p, dx, g):
     """The network's right-hand side and switching functions, then each wet clutch's (its slip speed follows
     the element's relative acceleration; its lock-up and break-away functions are held off)."""
     _clutches(t, x, m, p)
-    K.driveline_rhs(t, x, u, m, p.net, dx, g)
-    net = p.net
+    K.driveline_rhs(t, x, u, m, byref(p.net), dx, g)
+    net = byref(p.net)
     acc, _tau = K._acc_tau(net)
     for j in range(p.conf.shape[0]):
         cf = p.conf[j]
@@ -136,7 +137,7 @@ def wet_driveline_rhs(t, x, u, m, p, dx, g):
 def wet_driveline_outputs(t, x, u, m, p, y):
     """The network's outputs, then each wet clutch's eighteen (:data:`clutchlab.wet.system.OUTPUTS`)."""
     _clutches(t, x, m, p)
-    K.driveline_outputs(t, x, u, m, p.net, y)
+    K.driveline_outputs(t, x, u, m, byref(p.net), y)
     nw = p.conf.shape[0]
     q = y.shape[0] - nw * W.N_OUT
     for j in range(nw):
@@ -156,7 +157,7 @@ def _rename(log, start, p, j):
 def _sync(x, m, p):
     """Each clutch's slip-speed state reset to its element's relative speed, and its friction mode to the
     network's (at an event or a restart)."""
-    net = p.net
+    net = byref(p.net)
     n = net.inertia.shape[0]
     for j in range(p.conf.shape[0]):
         cf = p.conf[j]
@@ -198,13 +199,13 @@ def wet_driveline_update(t, x, u, m, p, k, log):
     _clutches(t, x, m, p)
     ng = p.conf[0][F_G]
     if k < ng:
-        res = K.driveline_update(t, x, u, m, p.net, k, log)
+        res = K.driveline_update(t, x, u, m, byref(p.net), k, log)
         _sync(x, m, p)
         return res
     j = (k - ng) // N_SWITCH
     res = _wet_call(t, x, m, p, j, (k - ng) % N_SWITCH, log)
     _clutches(t, x, m, p)   # the network's modes at the clutch's new state (a piston on its stop, a film opening)
-    K.settle(t, x, m, p.net, log, m.copy())
+    K.settle(t, x, m, byref(p.net), log, m.copy())
     _sync(x, m, p)
     return res
 
@@ -219,7 +220,7 @@ def wet_driveline_restart(t, x, u, m, p, log):
         if _wet_call(t, x, m, p, j, -1, log) != 0:
             changed = True
     _clutches(t, x, m, p)
-    if K.driveline_restart(t, x, u, m, p.net, log):
+    if K.driveline_restart(t, x, u, m, byref(p.net), log):
         changed = True
     _sync(x, m, p)
     return changed
@@ -237,7 +238,7 @@ def wet_driveline_accept(t, x, u, m, p):
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_next_break(t, m, p):
     """The next corner of the network's signals or of a clutch's force profile."""
-    tb = K.driveline_next_break(t, m, p.net)
+    tb = K.driveline_next_break(t, m, byref(p.net))
     for j in range(p.conf.shape[0]):
         tb = min(tb, W.wet_next_break(t, m, _wet(p, j)))
     return tb
