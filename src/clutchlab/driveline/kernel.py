@@ -95,11 +95,15 @@ N_COEF = 5
 GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = 0, 1, 2, 3, 4
 GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
-# switching functions: four per friction element, then two per switched spring (``swit``: backlash and curves),
+# switching functions: four per friction element, then three per switched spring (``swit``: backlash and curves),
 # then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
 G_STICK, G_BREAK, G_NORMAL, G_TURN = 0, 1, 2, 3
 N_G = 4
 N_GEAR_G = 3
+#: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends) and the
+#: turning points of a backlash's deflection in its gap (G_LASH_TURN)
+N_SW = 3
+G_LASH_TURN = 2
 #: a sliding element's relative speed below this share of the largest speed (at least 1) is watched for its turning
 #: point (G_TURN), so that a dip through zero shorter than a step is not stepped over
 TURN_WATCH = 1e-2
@@ -392,7 +396,7 @@ def _characteristic(data, start, n, w):
     return _table(data, start, n, w)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
@@ -413,7 +417,7 @@ def friction_torque(p, r, t, w_abs):
     return p.coef[r, C_CGEO] * fn * val
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def normal_force(p, r, t):
     """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal);
     with a normal-force curve (``E_AUX`` points, an E-clutch's static curve), ``fn_max * curve(f(t))``:
@@ -424,7 +428,7 @@ def normal_force(p, r, t):
     return p.coef[r, C_FN_MAX] * f
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _is_free(p, r, t):
     """A clutch or brake is free when its normal force is negative, or zero and not rising (a force that
     leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing).
@@ -447,7 +451,7 @@ def _is_free(p, r, t):
     return p.coef[r, C_FN_MAX] * rate <= 0.0
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
     clutch's, the most it holds against overrunning)."""
@@ -456,7 +460,7 @@ def static_limit(p, r, t):
     return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def holding_limit(p, r, t, tau):
     """Largest ``|tau|`` [N m] a stuck friction element row ``r`` holds in the direction of ``tau``: its static
     limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and its clutch's static limit
@@ -514,7 +518,7 @@ def engine_torque(p, r, t, x, n):
     return tq + out, p.coef[r, C_IDLE_KI] * err + kaw * (out - cmd)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def source_torque(p, r, t, x, n):
     """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, or an
     engine's (:func:`engine_torque`)."""
@@ -579,7 +583,7 @@ def _segment_energy(data, s, m, kind, seg, phi):
                          + fs[lo + 1] * (u3 - 0.5 * u4) + h * ds[lo + 1] * (0.25 * u4 - u3 / 3.0))
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _spring_deflection(p, r, x, n):
     pa = 0.0 if p.elem[r, E_A] < 0 else x[p.elem[r, E_A]]
     pb = 0.0 if p.elem[r, E_B] < 0 else x[p.elem[r, E_B]]
@@ -594,14 +598,14 @@ def _lash_side(mode):
     return 0.0 if mode == LASH_GAP else (1.0 if mode % 2 == 1 else -1.0)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _lash_msl(p, r):
     """Does backlash row ``r`` follow MSL ``ElastoBacklash``'s damping law (with damping: without, both laws are
     the same spring)?"""
     return p.elem[r, E_AUX] == LASH_MSL and p.coef[r, C_DAMP] > 0.0
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def spring_torque(p, r, x, n, m):
     """Torque [N m] of spring-damper row ``r`` and its elastic part, ``(tau, tau_c)``.
 
@@ -652,12 +656,12 @@ def spring_energy(p, r, x, n, m):
 
 
 # ----------------------------------------------------------------- network evaluation
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _speed(x, n, i):
     return 0.0 if i < 0 else x[n + i]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _coefficients(p, r):
     """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a`` (a gear's, against its
     support: ``ratio (w_b - w_s) - (w_a - w_s)``), its torque ``tau`` acts ``+ca tau`` on flange a and ``-cb tau``
@@ -684,7 +688,7 @@ def _gear_column(data, start, n, col, w):
     return data[start + col * n + lo] + wt * (data[start + col * n + lo + 1] - data[start + col * n + lo])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def gear_losses(p, r, w_abs):
     """Mesh efficiencies and bearing friction of lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (MSL
     ``LossyGear``): ``(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a)``: efficiency while flange a drives [-], while
@@ -703,7 +707,7 @@ def gear_losses(p, r, w_abs):
     return eta1, eta2, bf1, bf2, bfa
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def gear_transfer(p, r, mode, w_abs):
     """Torque law of a rolling lossy gear row ``r`` in ``mode``: ``(f, c)`` with the torque on flange b's inertia
     ``ratio (f T_a - c)`` [N m], ``T_a = -tau`` the torque flange a's side applies to the gear (MSL
@@ -749,7 +753,7 @@ def gear_margin(p, r, t_a, hold, noise):
     return min(up, down), hi - lo + noise, 1 if up < down else -1
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def gear_tau_eta(p, r, mode, t_a, w_abs):
     """MSL ``LossyGear.tau_eta`` [N m] of a rolling gear: ``T_a - tau_bf_a`` forward, ``T_a + tau_bf_a``
     backward; its sign decides the quadrant (which flange drives)."""
@@ -757,20 +761,20 @@ def gear_tau_eta(p, r, mode, t_a, w_abs):
     return t_a - bfa if mode == GEAR_FWD_A or mode == GEAR_FWD_B else t_a + bfa
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def gear_speed(p, r, x, n):
     """Speed of flange a against the gear's support ``w_a - w_s`` [rad/s] (MSL ``LossyGear.w_a``)."""
     return _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _gear_mode(p, r, m):
     """The mode of gear row ``r`` (``GEAR_STUCK`` for an ideal one, which has none)."""
     mi = p.elem[r, E_MODE]
     return m[mi] if mi >= 0 else GEAR_STUCK
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def relative_speed(p, r, x, n):
     """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears, whose
     constraint speed is ``ratio (w_b - w_s) - (w_a - w_s)``, zero but for drift)."""
@@ -781,7 +785,7 @@ def relative_speed(p, r, x, n):
     return v
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _apply(F, Fa, elem, r, ca, cb, tq):
     """Torque ``tq`` of element row ``r`` on its inertias (``+ca tq`` on flange a, ``-cb tq`` on b), and its magnitude
     into ``Fa``."""
@@ -795,7 +799,7 @@ def _apply(F, Fa, elem, r, ca, cb, tq):
         Fa[a] += abs(ca * tq)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _add(F, i, v):
     if i >= 0:
         F[i] += v
@@ -925,40 +929,40 @@ def _nk(p):
     return p.fric.shape[0] + p.cons.shape[0] + p.lossy.shape[0]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _offsets(p):
     return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0],
                    p.signals.shape[0])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _acc_tau(p):
     o = _offsets(p)
     return p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _slack(p):
     """Slack of the stick functions: the friction elements', then the lossy gears'."""
     o = _offsets(p)
     return p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _holds(p):
     """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
     o = _offsets(p)
     return p.work[o[12]:o[12] + p.lossy.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
     return p.work[o[11]:o[11] + p.inertia.shape[0]]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
@@ -983,7 +987,7 @@ def forget_signals(p):
     p.work[_offsets(p)[13]] = np.nan
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def signal_at(p, s, t):
     """Value of signal ``s`` of the network at ``t``: from the cache of the last evaluation if it was at ``t``
     (:func:`refresh_signals`), else :func:`signal_value` itself.  The same value either way: a signal is a
@@ -1007,7 +1011,7 @@ def set_external(p, j, slide, limit, lock):
     ext[3 * j + 2] = lock
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _member(p, m, x, n, rk, fl, gc, hc, k):
     """Flanges (three, -1 for none or the ground; stored as floats), constraint weights ``g`` and torque weights
     ``h`` of constraint member ``k`` (element row ``rk``, or ``-(row + 1)`` for a stuck lossy gear's hold): the
@@ -1119,7 +1123,7 @@ def _null_vector(A, ns, S, cp, v, y):
     return True
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _full_rank_known(p, A, ns):
     """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A`` and found it of
     full rank (nothing to repair)."""
@@ -1413,7 +1417,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
                 Fa[i] += abs(hc[3 * k + q] * lam[k])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _lossy_index(p, r):
     for j in range(p.lossy.shape[0]):
         if p.lossy[j] == r:
@@ -1424,7 +1428,7 @@ def _lossy_index(p, r):
 
 
 # ----------------------------------------------------------------- the stick/slip items: friction elements and lossy gears
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _flanges_max(v, elem, r):
     """The largest of ``|v|`` over element row ``r``'s flanges (a, b and a gear's support; 0 for the ground)."""
     out = 0.0
@@ -1439,7 +1443,7 @@ def _flanges_max(v, elem, r):
     return out
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_noise(p, r, tau):
     """Rounding floor [N m] of the stick/slip decisions of element row ``r``: ``NOISE`` times one plus its torque and
     the torques on its own inertias at the last evaluation (local: an element elsewhere in the network does not move
@@ -1450,7 +1454,7 @@ def _item_noise(p, r, tau):
     return NOISE * (1.0 + scale)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_wtol(p, r, x, n):
     """Rounding width [rad/s] of a relative speed of element row ``r``: 1e-9 of the largest speed of its inertias
     (at least 1 rad/s)."""
@@ -1462,13 +1466,13 @@ def _item_wtol(p, r, x, n):
     return 1e-9 * w
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_row(p, i):
     nf = p.fric.shape[0]
     return p.fric[i] if i < nf else p.lossy[i - nf]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_stuck(p, m, i):
     """True if item ``i`` (a friction element, then the lossy gears) is stuck in the modes ``m``."""
     nf = p.fric.shape[0]
@@ -1490,7 +1494,7 @@ def _item_set(p, m, i, direction):
                                                                                  else GEAR_BWD_A)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_speed(p, x, n, i):
     """Relative speed [rad/s] of item ``i``: a friction element's ``w_b - w_a``, a lossy gear's ``w_a - w_s``."""
     r = _item_row(p, i)
@@ -1499,7 +1503,28 @@ def _item_speed(p, x, n, i):
     return gear_speed(p, r, x, n)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
+def _item_passed_rest(p, m, x, n, i):
+    """True if sliding (rolling) item ``i`` has passed zero relative speed the wrong way for its mode: its stick
+    function (the speed in its direction plus its slack) is at or below zero.  Two items on one relative motion (a
+    bearing and a brake on one inertia) reach zero together; the event is located for the first, and the other's
+    speed at the located instant may lie a hair past zero, beyond the rounding width (the root is bracketed to the
+    event tolerance in time): it is at rest too."""
+    nf = p.fric.shape[0]
+    if i < nf:
+        mode = m[i]
+        if mode != FORWARD and mode != BACKWARD:
+            return False
+        d = 1.0 if mode == FORWARD else -1.0
+    else:
+        mode = m[p.elem[p.lossy[i - nf], E_MODE]]
+        if mode == GEAR_STUCK:
+            return False
+        d = 1.0 if mode == GEAR_FWD_A or mode == GEAR_FWD_B else -1.0
+    return d * _item_speed(p, x, n, i) + _slack(p)[i] <= 0.0
+
+
+@numba.njit(cache=True, nogil=True)
 def _item_acc(p, acc, i):
     """Relative acceleration [rad/s^2] of item ``i`` (as :func:`_item_speed`)."""
     r = _item_row(p, i)
@@ -1585,7 +1610,7 @@ def _item_slips(p, acc, i):
     return abs(_item_acc(p, acc, i)) > 1e3 * _item_anoise(p, _item_row(p, i), acc)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True)
 def _item_anoise(p, r, acc):
     """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
     acceleration of its inertias."""
@@ -1653,7 +1678,8 @@ def settle(t, x, m, p, log, old):
     for i in range(ni):
         if i < nf and m[i] == FREE:
             continue
-        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n):
+        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) or \
+                _item_passed_rest(p, m, x, n, i):
             cand[nc] = i
             nc += 1
             _item_set(p, m, i, 0)
@@ -1772,14 +1798,17 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, four per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
-    (either way: free or engaged); then two per switched spring.  A backlash, for its upper and lower
-    side: in the gap the deflection minus and plus half the gap (contact when the edge is reached moving
-    into it), in contact ``tau / c`` (separation when it falls through zero, as the torque would pull); with
-    MSL's damping law, the two of its mode that fall through zero at its kinks (:func:`_lash_msl_switching`).  A
-    curve spring: the deflection above the segment's lower point and below its upper one (either falling
-    through zero moves it to the next segment).  Then two per lossy gear: stuck, the margin of the loss torque it
-    holds within its band (:func:`gear_band`; falls through zero: it rolls); rolling, its speed in its direction
-    (falls through zero: it sticks or reverses) and ``+-tau_eta`` (falls through zero: the other flange drives).
+    (either way: free or engaged), the turning point of a slow sliding speed; then three per switched spring.  A
+    backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
+    (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
+    pull); with MSL's damping law, the two of its mode that fall through zero at its kinks
+    (:func:`_lash_msl_switching`); third, in the gap, the relative speed plus its rounding width on the nearer
+    edge's side (its turning points, either way: a step ends there, and the edges' functions get the core's second
+    look, so a touch of an edge within a step is found).  A curve spring: the deflection above the segment's lower
+    point and below its upper one (either falling through zero moves it to the next segment), third unused.  Then
+    three per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
+    through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
+    ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed.
     Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0.
     """
     n = p.inertia.shape[0]
@@ -1835,27 +1864,39 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         r = p.swit[j]
         phi = _spring_deflection(p, r, x, n)
         mode = m[nf + j]
+        q = N_G * nf + N_SW * j
+        g[q + G_LASH_TURN] = 1.0
         if p.elem[r, E_LAW] == SPRING_CURVE:   # the points bounding the segment: below (falls through) and above
             s0, mp = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
-            g[N_G * nf + 2 * j] = phi - p.data[s0 + mode - 1] if mode > 0 else 1.0
-            g[N_G * nf + 2 * j + 1] = p.data[s0 + mode] - phi if mode < mp else 1.0
+            g[q] = phi - p.data[s0 + mode - 1] if mode > 0 else 1.0
+            g[q + 1] = p.data[s0 + mode] - phi if mode < mp else 1.0
             continue
         b2 = 0.5 * p.coef[r, C_GAP]
+        if mode == LASH_GAP:
+            # the turning points of the deflection in the gap (the relative speed through zero at its extremes,
+            # either way), located so that a touch of an edge within a step (the deflection crosses it and comes
+            # back: free flight is a parabola the step control does not see) is found: the edges' functions get
+            # the core's second look at the turning point's root.  The rounding width of the speed is added on the
+            # side of the edge the deflection is nearer (the root lies just past the extreme; a gap at rest has none)
+            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+            wt = _item_wtol(p, r, x, n)
+            g[q + G_LASH_TURN] = w_rel + (wt if phi > 0.0 else -wt)
         if _lash_msl(p, r):
             g0, g1 = _lash_msl_switching(p, r, x, n, mode, phi)
-            g[N_G * nf + 2 * j] = g0
-            g[N_G * nf + 2 * j + 1] = g1
+            g[q] = g0
+            g[q + 1] = g1
             continue
-        # in the gap: the edges; in contact: the torque over c (it falls through zero: it would pull)
+        # in the gap: the distances to the edges; in contact: the torque over c, signed to be positive in the
+        # contact (each falls through zero: contact with that edge; separation, as the torque would pull)
         lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
-        g[N_G * nf + 2 * j] = phi - b2 + (lag if mode == LASH_UPPER else 0.0)
-        g[N_G * nf + 2 * j + 1] = phi + b2 + (lag if mode == LASH_LOWER else 0.0)
+        g[q] = phi - b2 + lag if mode == LASH_UPPER else b2 - phi
+        g[q + 1] = -(phi + b2 + lag) if mode == LASH_LOWER else phi + b2
     nsw = p.swit.shape[0]
     hold = _holds(p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
         mode = m[p.elem[r, E_MODE]]
-        q = N_G * nf + 2 * nsw + N_GEAR_G * j
+        q = N_G * nf + N_SW * nsw + N_GEAR_G * j
         noise = _item_noise(p, r, tau)
         g[q + 2] = 1.0
         if mode == GEAR_STUCK:
@@ -1997,9 +2038,9 @@ def driveline_update(t, x, u, m, p, k, log):
     its contact law (:func:`_lash_msl_update`, no event)."""
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
-    if k >= N_G * nf + 2 * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
-        j = (k - N_G * nf - 2 * nsw) // N_GEAR_G
-        which = (k - N_G * nf - 2 * nsw) % N_GEAR_G
+    if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
+        j = (k - N_G * nf - N_SW * nsw) // N_GEAR_G
+        which = (k - N_G * nf - N_SW * nsw) % N_GEAR_G
         if which == 2:   # its speed's turning point: a step ends there, nothing changes
             return 0
         mi = p.elem[p.lossy[j], E_MODE]
@@ -2014,22 +2055,24 @@ def driveline_update(t, x, u, m, p, k, log):
         settle(t, x, m, p, log, old)
         return 0
     if k >= N_G * nf:
-        j = (k - N_G * nf) // 2
+        j = (k - N_G * nf) // N_SW
+        if (k - N_G * nf) % N_SW == G_LASH_TURN:   # a backlash's turning point in its gap: a step ends there
+            return 0
         r = p.swit[j]
         n = p.inertia.shape[0]
         if p.elem[r, E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
-            m[nf + j] += -1 if (k - N_G * nf) % 2 == 0 else 1
+            m[nf + j] += -1 if (k - N_G * nf) % N_SW == 0 else 1
             return 0
         if _lash_msl(p, r):   # MSL's damping law: its kinks change the mode silently; the edges are events
             old = m[nf + j]
-            new = _lash_msl_update(p, r, x, n, old, (k - N_G * nf) % 2)
+            new = _lash_msl_update(p, r, x, n, old, (k - N_G * nf) % N_SW)
             if new == LASH_GAP:   # at the edge: what the spring holds is ~0 (as below)
                 x[2 * n + r] += spring_energy(p, r, x, n, m)
             m[nf + j] = new
             if old == LASH_GAP or new == LASH_GAP:
                 record(log, t, EV_CONTACT if new != LASH_GAP else EV_SEPARATE, nf + j)
             return 0
-        side = LASH_UPPER if (k - N_G * nf) % 2 == 0 else LASH_LOWER   # phi - b/2: the gap's upper side
+        side = LASH_UPPER if (k - N_G * nf) % N_SW == 0 else LASH_LOWER   # b/2 - phi: the gap's upper side
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         if m[nf + j] == LASH_GAP and ((side == LASH_UPPER and w_rel > 0.0) or (side == LASH_LOWER and w_rel < 0.0)):
             m[nf + j] = side
@@ -2066,11 +2109,12 @@ def driveline_restart(t, x, u, m, p, log):
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
-INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY = 0, 1, 2, 3, 4
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = 0, 1, 2, 3, 4, 5
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
-              "energy balance beyond its tolerance")
-INV_BASE, N_INV = 100, 5
+              "energy balance beyond its tolerance",
+              "backlash in its gap beyond an edge, moving outward (a contact missed)")
+INV_BASE, N_INV = 100, 6
 
 
 @numba.njit(cache=True, nogil=True)
@@ -2084,6 +2128,8 @@ def check_invariants(t, x, m, p):
       the element's inertias, what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
     * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding);
+    * a backlash in its gap is not beyond an edge moving on outward (a contact missed; beyond it and moving back is a
+      damped contact that has just separated, as its torque would pull);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
       that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed).
     """
@@ -2135,6 +2181,17 @@ def check_invariants(t, x, m, p):
             f, c = gear_transfer(p, r, mode, abs(w_a))
             if ((1.0 - f) * (-tau[r]) + c) * GEAR_CODES[mode] < -10.0 * noise:
                 return -(INV_BASE + N_INV * r + INV_LOSS)
+    for j in range(p.swit.shape[0]):
+        r = p.swit[j]
+        if p.elem[r, E_LAW] == SPRING_BACKLASH and m[nf + j] == LASH_GAP:
+            b2 = 0.5 * p.coef[r, C_GAP]
+            phi = _spring_deflection(p, r, x, n)
+            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+            w_tol = 1e3 * _item_wtol(p, r, x, n)
+            tol = 1e-8 * max(1.0, b2)
+            # (a damped contact separates beyond its edge, moving back: only moving on outward is a missed contact)
+            if (phi > b2 + tol and w_rel > w_tol) or (phi < -b2 - tol and w_rel < -w_tol):
+                return -(INV_BASE + N_INV * r + INV_GAP)
     if p.check[1] > 0.0:
         kinetic, spring, work, lost = 0.0, 0.0, 0.0, 0.0
         for i in range(n):

@@ -214,7 +214,7 @@ class Signal:
         if k == K.SIG_STEP:
             return f"step from {a[2]:g} to {a[2] + a[0]:g}{u} at {a[1]:g} s"
         if k == K.SIG_RAMP:
-            return f"ramp from {a[3]:g} to {a[3] + a[0]:g}{u} over {a[2]:g} s from {a[1]:g} s"
+            return f"ramp from {a[3]:g} to {a[3] + a[0]:g}{u} over {a[1]:g} s from {a[2]:g} s"
         if k == K.SIG_SINE:
             off = f"{a[3]:g} + " if a[3] else ""
             return f"{off}{a[0]:g}{u} sine at {a[1]:g} Hz, phase {a[2]:g} rad" + (f", from {a[4]:g} s" if a[4] else "")
@@ -1459,10 +1459,12 @@ class Driveline:
         switching = tuple((f"{f}.{what}", d) for f in fric
                           for what, d in (("stick", -2), ("breakaway", -1), ("normal", 0), ("turn", 1)))
         swit = [self._elements[r] for r in p.swit]
-        # (a backlash's Kelvin-Voigt contact is watched both ways; MSL's law and curves by falling functions)
-        switching += tuple((f"{e.name}.{side}", 0 if e.law == K.SPRING_BACKLASH and e.aux != K.LASH_MSL else -1)
-                           for e in swit for side in (("gap_upper", "gap_lower") if e.law == K.SPRING_BACKLASH
-                                                      else ("segment_below", "segment_above")))
+        # (every function of a switched spring falls through zero; a backlash's edges get the core's second look at
+        # the root of its turning point in the gap, direction -2: a touch of an edge within a step is located)
+        switching += tuple((f"{e.name}.{side}", d) for e in swit
+                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 0))
+                                           if e.law == K.SPRING_BACKLASH else
+                                           (("segment_below", -1), ("segment_above", -1), ("turn", -1))))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
         switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
                            for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1)))
