@@ -7,8 +7,8 @@ ramped at the 2 mm/s of the documented release-engage cycle (0 -> 0.2 mm in 0.1 
 (~1.07 ms period for Model 0: 367 located events in the reference) and the reversal.
 
 Measured 2026-11-29 (docs/eclutch_dynamics.md, "Accuracy per model"): at the default rtol 1e-5 and the
-default absolute tolerances (10 nm, 10 um/s) clutchlab finds the reference's micro-cycles (Model 0: 371
-events against 367) and its F_b is within 2.7 % of peak (Model 4: 1.0 %); that is the floor of the absolute
+default absolute tolerances (10 nm, 10 um/s) clutchlab finds the reference's micro-cycles (Model 0: 370
+events against 367) and its F_b is within 2.7 % of peak (Model 4: 0.93 %); that is the floor of the absolute
 tolerance (the micro-cycles are ~0.7 um, ~3 mm/s), the same at rtol 1e-8.  With the absolute tolerances
 scaled with rtol (``atol_scale = rtol / 1e-5``) the error shrinks to 0.005 % (Model 0) / 0.045 % (Model 4)
 at rtol 1e-8 and the event count equals the reference's.
@@ -91,6 +91,26 @@ def test_clutch_with_friction_error_shrinks_with_the_tolerance(number):
     assert errors[1e-8]["Fb"] < 0.1 * errors[1e-6]["Fb"], errors
     assert errors[1e-8]["Fb"] < 1e-3 and errors[1e-8]["Fn"] < 5e-5 and errors[1e-8]["x_pp"] < 5e-8, errors
     assert all(e["events"] == e["ref_events"] for e in (errors[1e-7], errors[1e-8])), errors
+
+
+@pytest.mark.parametrize("number", [0, 4])
+def test_loose_tolerances_keep_the_micro_cycles(number):
+    # the step after a stick or break-away starts afresh (update returns RESTART): before, the first step
+    # after a break-away kept the stuck phase's trial length, longer than a cycle, whose L-stable stages damped
+    # the ringing unseen; the plate then slid smoothly (Model 0: 3 events of 367 at rtol 1e-3, 103 at 1e-4)
+    for rtol in (1e-3, 1e-4):
+        e = _compare(number, rtol=rtol)
+        assert e["events"] > 0.5 * e["ref_events"], (rtol, e)
+        assert e["Fb"] < 2.0 * BOUND_FB[number], (rtol, e)
+
+
+def test_the_full_cycle_has_the_reference_s_micro_cycles_at_the_default_rtol():
+    # the documented cycle (0 -> 8 mm -> 0 in 8 s, Model 0): the reference has 13,953 stick-slip events
+    # (dynamics_friction_scipy.reference, 35 s on the 2-core machine, measured 2026-11-29: too long to run
+    # here); clutchlab had 1,227 at the default rtol before the step restart, 14,064 after
+    res = ClutchDynamics(ClutchModel.preset(0), FrictionParameters()).simulate(([0.0, 4.0, 8.0], [0.0, 8e-3, 0.0]))
+    n = int(res.events.event.isin(STICK_SLIP).sum())
+    assert abs(n - 13_953) < 0.02 * 13_953, n
 
 
 @pytest.mark.parametrize("friction", [
