@@ -1038,6 +1038,12 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if event or r > 0:
             model.rhs(t, x, u, m, p, f0, g0)
             si[SI_NRHS] += 1
+            if flag == RESTART:
+                # the model says the dynamics changed at the event (a mass breaking away from its stuck
+                # phase): the trial step of the mode before says nothing about the next one, and one much
+                # longer than the ringing the new mode starts would damp it unseen (L-stable stages, issue
+                # #30); start afresh as after a break time at which the derivative jumps
+                h = _step_after_break(h, f1, f0, x, mass, rtol, atol, 64.0 * opt.event_tol)
         else:
             for k in range(ng):
                 g0[k] = g1[k]
@@ -1173,6 +1179,14 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     -------
     int
         Status (:mod:`clutchlab.numerics.status`).
+
+    Notes
+    -----
+    After an event the next step is tried with the step size of the step that found it, unless an
+    ``update`` returned :data:`RESTART`: then it starts afresh as after a break time at which the derivative
+    jumps (``_step_after_break``: from ``h / jump``, at least ``64 * event_tol``), grown by the controller.
+    (The E-clutch's clutch alone asks for it at every stick and break-away: a first step of the stuck
+    phase's length damped the pressure plate's stick-slip ringing away unseen, issue #30.)
     """
     return entry_points(type(p), "rodas").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                                                   rec_y, want_y)
