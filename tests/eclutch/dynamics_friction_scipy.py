@@ -104,13 +104,8 @@ class ClutchAlone:
 
     # ------------------------------------------------------------------ equations
     def u(self, t):
-        tin, vin = self.tin, self.vin
-        if t <= tin[0]:
-            return vin[0]
-        for k in range(len(tin) - 1):
-            if t <= tin[k + 1]:
-                return vin[k] + (vin[k + 1] - vin[k]) * (t - tin[k]) / (tin[k + 1] - tin[k])
-        return vin[-1]
+        """The prescribed bearing position [m]: linear between the table's points, held outside."""
+        return float(np.interp(t, self.tin, self.vin))
 
     def element_forces(self, u, q):
         d = self.d0 + self.Gb * u + self.GA @ np.asarray(q)
