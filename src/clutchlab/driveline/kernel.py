@@ -922,6 +922,13 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     return _layout.py_func(n, nk, ne, nf, nl, nsig)[14] + 3 * nx + 1
 
 
+def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
+    """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
+    work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig))
+    work[_layout.py_func(n, nk, ne, nf, nl, nsig)[13]] = np.nan
+    return work
+
+
 @numba.njit(cache=True, nogil=True, inline="always")
 def _nk(p):
     """Largest constraint set: every friction element, every gear and motion source, and the hold of every lossy
@@ -1124,19 +1131,25 @@ def _null_vector(A, ns, S, cp, v, y):
 
 
 @numba.njit(cache=True, nogil=True)
-def _full_rank_known(p, A, ns):
-    """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A`` and found it of
-    full rank (nothing to repair)."""
+def _searched_before(p, A, ns):
+    """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A[:ns, :ns]``."""
     o = _offsets(p)[15]
     nk = _nk(p)
     w = p.work
-    if w[o] != ns or w[o + 1] != 0.0:
+    if w[o] != ns:
         return False
     for k in range(ns):
         for j in range(ns):
             if w[o + 2 + k * nk + j] != A[k, j]:
                 return False
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def _full_rank_known(p, A, ns):
+    """True if the last null-vector search was of exactly this ``A`` and found it of full rank (nothing to
+    repair)."""
+    return _searched_before(p, A, ns) and p.work[_offsets(p)[15] + 1] == 0.0
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1147,16 +1160,7 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
     o = _offsets(p)[15]
     nk = _nk(p)
     w = p.work
-    same = w[o] == ns
-    if same:
-        for k in range(ns):
-            for j in range(ns):
-                if w[o + 2 + k * nk + j] != A[k, j]:
-                    same = False
-                    break
-            if not same:
-                break
-    if same:
+    if _searched_before(p, A, ns):
         if w[o + 1] == 0.0:
             return False
         for k in range(ns):

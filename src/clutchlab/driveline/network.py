@@ -1252,8 +1252,7 @@ class Driveline:
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
         elem[ext, K.E_AUX] = np.arange(len(ext))
         sig = np.array(signals, dtype=float).reshape(-1, K.N_SIG)
-        work = np.zeros(K.work_size(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0]))
-        work[K._layout.py_func(n, nk, ne, fric.size, lossy.size, sig.shape[0])[13]] = np.nan   # empty signal cache
+        work = K.new_work(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0])
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,

@@ -657,8 +657,9 @@ class ClutchDynamics:
         Tolerances: ``rtol`` and the default absolute tolerances (10 nm, 10 um/s, 10 Pa, ...) times
         ``atol_scale`` (default ``min(1, rtol / 1e-5)``: below the default rtol they shrink with it, so the error
         follows the tolerance -- with friction, fixed absolute tolerances held the pressure plate's stick-slip
-        phase, and the bearing force, at 2.6 % of peak from rtol 1e-5 to 1e-8, issue #30); ``bearing_position``, ``t_end``, ``max_step`` (alias ``h_max``), ``max_steps``,
-        ``output_step``, ``event_tol``, ``jac_every`` and ``fixed_step`` as in :meth:`EClutch.simulate`.
+        phase, and the bearing force, at 2.6 % of peak from rtol 1e-5 to 1e-8, issue #30); ``bearing_position``,
+        ``t_end``, ``max_step`` (alias ``h_max``), ``max_steps``, ``output_step``, ``event_tol``, ``jac_every`` and
+        ``fixed_step`` as in :meth:`EClutch.simulate`.
         """
         tin, _vin = _as_table(bearing_position, "bearing_position")
         t_end = float(tin[-1]) if t_end is None else float(t_end)
