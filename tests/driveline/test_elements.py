@@ -197,6 +197,88 @@ def test_backlash_damping_never_pulls_and_the_balance_closes():
     assert got[1][1] == "separate" and got[1][0] == pytest.approx(t_sep, abs=1e-8)
 
 
+def _recontact_reference(t_out, J0, J1, c, dmp, gap, amp, freq):
+    """Two inertias, a sine torque on J0, a backlash from J0 to J1 with the documented law written as a function
+    of the state alone: beyond an edge ``tau = c (phi -+ b/2) + d w`` where it pushes, 0 where it would pull, 0 in
+    the gap (``phi = phi1 - phi0``, ``+tau`` on J0 and ``-tau`` on J1).  DOP853 at rtol 1e-12 restarted at every
+    edge and every zero of the contact's torque beyond one.  Returns the speeds at ``t_out`` and the times at which
+    the torque switches on (contact) and off (separation)."""
+    b2 = 0.5 * gap
+
+    def tau(y):
+        phi, w = y[2] - y[0], y[3] - y[1]
+        if phi > b2:
+            return max(0.0, c * (phi - b2) + dmp * w)
+        if phi < -b2:
+            return min(0.0, c * (phi + b2) + dmp * w)
+        return 0.0
+
+    def rhs(t, y):
+        tq = tau(y)
+        return [y[1], (amp * math.sin(2.0 * math.pi * freq * t) + tq) / J0, y[3], -tq / J1]
+
+    def kink(side):
+        def f(t, y):
+            phi, w = y[2] - y[0], y[3] - y[1]
+            return c * (phi - side * b2) + dmp * w
+        return f
+
+    events = [lambda t, y: y[2] - y[0] - b2, lambda t, y: y[2] - y[0] + b2, kink(1.0), kink(-1.0)]
+    for ev in events:
+        ev.terminal = True
+    y, t, t_end = np.zeros(4), 0.0, t_out[-1]
+    out = np.empty((len(t_out), 2))
+    switches = []
+    active = False
+    while t < t_end:
+        sol = integrate.solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=1e-12, atol=1e-13, events=events,
+                                  dense_output=True)
+        mask = (t_out >= t) & (t_out <= sol.t[-1])
+        out[mask] = sol.sol(t_out[mask])[[1, 3]].T
+        if sol.status != 1:
+            break
+        step = integrate.solve_ivp(rhs, (sol.t[-1], sol.t[-1] + 1e-10), sol.y[:, -1], method="DOP853", rtol=1e-12,
+                                   atol=1e-13)
+        t, y = step.t[-1], step.y[:, -1]
+        if (tau(y) != 0.0) != active:
+            active = not active
+            switches.append((sol.t[-1], "contact" if active else "separate"))
+    return out, switches
+
+
+@pytest.mark.xfail(strict=True, reason="open (issue #30): a damped contact that separated beyond its edge and turns "
+                   "outward again before reaching it is not closed: the contact is watched at the edge only")
+def test_a_damped_contact_that_separated_beyond_its_edge_closes_again_where_it_pushes():
+    """The damper of a contact pulls before the spring has relaxed: the contact separates beyond its edge, moving
+    back.  Turned outward again before reaching the edge (a torque drives it), it closes where its torque would
+    push -- not only at the edge, which it never reaches (hypothesis found that case on a random network: the
+    deflection then went on outward in the gap, beyond the edge, with no torque).  Against an independent
+    solution of the law written as a function of the state: every contact and separation to 1e-7 s, the speeds
+    to 1e-6 of their range; two of the contacts close beyond the edge.  Open: a fix of the switching functions
+    (the larger of the distance to the edge and the contact's torque over c) finds these contacts, but with the
+    spring's energy counted as lost at the separation its return at the re-contact makes a dissipation fall, and
+    counting it as stored beyond the edge put a kink in the energy's rate at the edge that cost the balance its
+    accuracy (3e-6 J at rtol 1e-8); see the closing note of 2026-11-29."""
+    J0, J1, c, dmp, gap, amp, freq = 0.75, 1.0, 10.0, 2.0, 0.01, 1.0, 5.0
+    d = Driveline("recontact")
+    d.inertia("J0", J=J0)
+    d.inertia("J1", J=J1)
+    d.backlash("k0", "J0", "J1", c=c, b_gap=gap, d=dmp)
+    d.torque("T0", "J0", Signal.sine(amp, freq))
+    times = np.linspace(0.0, 1.0, 501)
+    res = d.simulate(1.0, sample_times=times, rtol=1e-10, check_invariants=True)
+    ref, switches = _recontact_reference(times, J0, J1, c, dmp, gap, amp, freq)
+    got = _events(res, "k0")
+    assert len(switches) >= 6 and [e for _, e in got] == [e for _, e in switches]
+    assert np.max(np.abs(np.array([tt for tt, _ in got]) - [tt for tt, _ in switches])) < 1e-7
+    df = res.to_dataframe()
+    for col, i in (("J0.w_rad_s", 0), ("J1.w_rad_s", 1)):
+        assert np.max(np.abs(df[col].to_numpy() - ref[:, i])) < 1e-6 * np.ptp(ref[:, i]), col
+    phi = np.interp([tt for tt, e in got if e == "contact"], df["time_s"], df["J1.phi_rad"] - df["J0.phi_rad"])
+    assert np.sum(np.abs(phi) > 0.5 * gap + 1e-5) >= 2
+    assert abs(df["energy_error_J"]).max() < 1e-9
+
+
 # ----------------------------------------------------------------- nonlinear springs
 @pytest.mark.parametrize("kind", ["linear", "pchip"])
 def test_curve_spring_stores_the_integral_of_its_curve(kind):
@@ -321,6 +403,33 @@ def test_energy_balance_on_random_networks_with_every_element(d):
             assert np.all(np.diff(df[col].to_numpy()) >= -1e-8 * scale), col
         if col.startswith("f") and col.endswith(".w_rel_rad_s"):
             assert df[col].min() >= -1e-6 * max(1.0, df.filter(like=".w_rad_s").abs().max().max()), col
+
+
+def test_a_lossy_gear_at_rest_under_a_prescribed_speed_rolls_with_the_one_way_clutches_it_frees():
+    """Found by the property above: a prescribed speed (a sine from rest) on flange a of a lossy gear, two one-way
+    clutches behind it and a torque on the last inertia.  At t = 0 every item is at rest; held together, the gear's
+    hold contradicts the prescribed motion, so the torques of that set say nothing -- the first one-way clutch's
+    pointed backward and it was never released, the fallback never released the gear, and the network ran with
+    the speed at half its prescribed value and the gear making energy (its dissipation down to -1.5 J).  Now: the
+    gear rolls (a drives) and the first one-way clutch overruns from t = 0, the speed is the prescribed one, the
+    gear's loss is never negative and the balance closes."""
+    d = Driveline("owc_gear")
+    for i in range(4):
+        d.inertia(f"J{i}", J=1.0)
+    d.gear("g0", "J0", "J1", ratio=-1.0, efficiency=0.95)
+    d.one_way_clutch("f1", "J1", "J2")
+    d.one_way_clutch("f2", "J2", "J3")
+    d.speed("drive", "J0", Signal.sine(1.0, 1.0))
+    d.torque("T3", "J3", Signal.sine(1.0, 1.0, phase=4.0))
+    res = d.simulate(1.0, output_step=5e-3, rtol=1e-9, check_invariants=True)
+    df = res.to_dataframe()
+    t = df["time_s"].to_numpy()
+    assert np.max(np.abs(df["J0.w_rad_s"] - np.sin(2.0 * np.pi * t))) < 1e-7   # (measured 1.1e-8: before, 0.5)
+    assert np.max(np.abs(df["J1.w_rad_s"] + df["J0.w_rad_s"])) < 1e-7
+    first = res.events[res.events["time_s"] == 0.0]
+    assert set(zip(first["element"], first["event"])) == {("g0", "forward"), ("f1", "forward")}
+    assert np.all(np.diff(df["g0.dissipated_J"].to_numpy()) >= -1e-9)
+    assert abs(df["energy_error_J"]).max() < 1e-6   # (the property's bound; measured 1.3e-7 J)
 
 
 @pytest.mark.parametrize("normal", [Signal.ramp(1.0, 0.5, start=0.2), Signal.sine(1.0, 0.5)])

@@ -34,7 +34,7 @@ import numba
 import numpy as np
 
 from ..numerics import dispatch
-from ..numerics.borrow import shaped
+from ..numerics.borrow import borrow, shaped
 from ..numerics.core import record
 from ..numerics.interp import bracket
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -143,7 +143,7 @@ class DrivelineParams(NamedTuple):
 
 
 # ----------------------------------------------------------------- signals
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _table(data, start, n, t):
     """Piecewise-linear table ``data[start:start+n]`` (times), ``data[start+n:start+2n]`` (values), held outside."""
     if n == 1:
@@ -152,7 +152,7 @@ def _table(data, start, n, t):
     return data[start + n + lo] + w * (data[start + n + lo + 1] - data[start + n + lo])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _period(start, period, t):
     """Index ``k`` [-] (a float) of the period holding ``t >= start``: ``start + k period <= t < start + (k + 1)
     period`` with exactly those sums, the break times of :func:`signal_break` (a floor of the quotient alone
@@ -165,7 +165,7 @@ def _period(start, period, t):
     return k
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _corners(sig):
     """Offsets [s] of a periodic signal's corners within its period: a pulse's end of the on-part (the width,
     a fraction, times the period); a trapezoid's ends of rising, width and falling (MSL ``T_rising``,
@@ -176,7 +176,7 @@ def _corners(sig):
     return sig[2], sig[2] + sig[3], sig[2] + sig[3] + sig[4]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _periodic_at(sig, t):
     """A pulse's or trapezoid's period at ``t``: ``(active, t_k)``, the start ``t_k`` [s] of the period holding
     ``t`` and whether that period is one of its ``nperiod`` (MSL: 0 before ``startTime``, after ``nperiod``
@@ -193,7 +193,7 @@ def _periodic_at(sig, t):
     return True, start + k * period
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _basic_value(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_CONST:
@@ -236,7 +236,7 @@ def _basic_value(sig, data, t):
     return _table(data, int(sig[1]), int(sig[2]), t)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def signal_value(sig, data, t):
     """Value of one signal row at ``t`` (MSL ``Modelica.Blocks.Sources``: Constant, Step, Ramp, Sine, Pulse,
     Trapezoid, Exponentials, a table; ``Blocks.Math.Product`` of such signals).
@@ -259,7 +259,7 @@ def signal_value(sig, data, t):
     return _basic_value(sig, data, t)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _basic_break(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_STEP:
@@ -303,7 +303,7 @@ def _basic_break(sig, data, t):
     return np.inf
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def signal_break(sig, data, t):
     """Next time after ``t`` at which the signal has a jump or a kink (inf if none); a product's, the first of
     its factors'."""
@@ -316,7 +316,7 @@ def signal_break(sig, data, t):
     return _basic_break(sig, data, t)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _basic_rates(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_RAMP:
@@ -360,7 +360,7 @@ def _basic_rates(sig, data, t):
     return 0.0, 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def signal_rates(sig, data, t):
     """First and second time derivatives of one signal row at ``t``.
 
@@ -384,7 +384,7 @@ def signal_rates(sig, data, t):
 
 
 # ----------------------------------------------------------------- friction characteristic
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _characteristic(data, start, n, w):
     """Table value at ``w >= 0``: linear between points, extrapolated from the last two (MSL's ``LastTwoPoints``)."""
     if n == 1 or w <= data[start]:
@@ -396,7 +396,7 @@ def _characteristic(data, start, n, w):
     return _table(data, start, n, w)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
@@ -417,7 +417,7 @@ def friction_torque(p, r, t, w_abs):
     return p.coef[r, C_CGEO] * fn * val
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def normal_force(p, r, t):
     """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal);
     with a normal-force curve (``E_AUX`` points, an E-clutch's static curve), ``fn_max * curve(f(t))``:
@@ -428,7 +428,7 @@ def normal_force(p, r, t):
     return p.coef[r, C_FN_MAX] * f
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _is_free(p, r, t):
     """A clutch or brake is free when its normal force is negative, or zero and not rising (a force that
     leaves zero upwards at ``t`` engages now: its switching function starts on zero, which is no crossing).
@@ -451,7 +451,7 @@ def _is_free(p, r, t):
     return p.coef[r, C_FN_MAX] * rate <= 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
     clutch's, the most it holds against overrunning)."""
@@ -460,7 +460,7 @@ def static_limit(p, r, t):
     return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def holding_limit(p, r, t, tau):
     """Largest ``|tau|`` [N m] a stuck friction element row ``r`` holds in the direction of ``tau``: its static
     limit; a one-way clutch holds any torque against overrunning (``tau <= 0``) and its clutch's static limit
@@ -471,7 +471,7 @@ def holding_limit(p, r, t, tau):
 
 
 # ----------------------------------------------------------------- engines
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def engine_map(data, start, ns, nt, w, throttle):
     """Full-load/part-load torque [N m] of an engine map at speed ``w`` [rad/s] and throttle [-]: bilinear in
     the speed grid ``data[start:start+ns]`` and the throttle grid (``nt`` points after it), the values row by
@@ -494,7 +494,7 @@ def engine_map(data, start, ns, nt, w, throttle):
     return (1.0 - a) * ((1.0 - b) * f00 + b * f01) + a * ((1.0 - b) * f10 + b * f11)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def engine_torque(p, r, t, x, n):
     """Torque [N m] of engine row ``r`` on its flange, and the rate of its idle controller's integral [N m/s].
 
@@ -518,7 +518,7 @@ def engine_torque(p, r, t, x, n):
     return tq + out, p.coef[r, C_IDLE_KI] * err + kaw * (out - cmd)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def source_torque(p, r, t, x, n):
     """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, or an
     engine's (:func:`engine_torque`)."""
@@ -529,7 +529,7 @@ def source_torque(p, r, t, x, n):
 
 
 # ----------------------------------------------------------------- springs
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _segment_value(data, s, m, kind, seg, phi):
     """Elastic torque [N m] of a curve spring on segment ``seg`` (0 below the first point, ``i`` between
     points ``i-1`` and ``i``, ``m`` above the last), the segment's polynomial continued beyond its points:
@@ -555,7 +555,7 @@ def _segment_value(data, s, m, kind, seg, phi):
             + (u3 - u2) * h * ds[lo + 1])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _segment_energy(data, s, m, kind, seg, phi):
     """Integral of the curve from the first point to ``phi`` along segment ``seg``'s polynomial (as
     :func:`_segment_value`; the curve's own integral where ``phi`` lies on the segment) [J]."""
@@ -583,7 +583,7 @@ def _segment_energy(data, s, m, kind, seg, phi):
                          + fs[lo + 1] * (u3 - 0.5 * u4) + h * ds[lo + 1] * (0.25 * u4 - u3 / 3.0))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _spring_deflection(p, r, x, n):
     pa = 0.0 if p.elem[r, E_A] < 0 else x[p.elem[r, E_A]]
     pb = 0.0 if p.elem[r, E_B] < 0 else x[p.elem[r, E_B]]
@@ -592,20 +592,20 @@ def _spring_deflection(p, r, x, n):
 
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _lash_side(mode):
     """The side of a backlash's contact mode: 1 upper (odd modes), -1 lower (even), 0 in the gap."""
     return 0.0 if mode == LASH_GAP else (1.0 if mode % 2 == 1 else -1.0)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _lash_msl(p, r):
     """Does backlash row ``r`` follow MSL ``ElastoBacklash``'s damping law (with damping: without, both laws are
     the same spring)?"""
     return p.elem[r, E_AUX] == LASH_MSL and p.coef[r, C_DAMP] > 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def spring_torque(p, r, x, n, m):
     """Torque [N m] of spring-damper row ``r`` and its elastic part, ``(tau, tau_c)``.
 
@@ -638,7 +638,7 @@ def spring_torque(p, r, x, n, m):
     return tc + tau_d, tc
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def spring_energy(p, r, x, n, m):
     """Energy [J] stored in spring-damper row ``r`` (the integral of its elastic torque over the deflection;
     a backlash's in its contact mode ``m``)."""
@@ -656,12 +656,12 @@ def spring_energy(p, r, x, n, m):
 
 
 # ----------------------------------------------------------------- network evaluation
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _speed(x, n, i):
     return 0.0 if i < 0 else x[n + i]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _coefficients(p, r):
     """Flange weights of element row ``r``: its relative speed is ``cb w_b - ca w_a`` (a gear's, against its
     support: ``ratio (w_b - w_s) - (w_a - w_s)``), its torque ``tau`` acts ``+ca tau`` on flange a and ``-cb tau``
@@ -674,7 +674,7 @@ def _coefficients(p, r):
     return 1.0, 1.0
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _gear_column(data, start, n, col, w):
     """Column ``col`` (1 eta_mf1, 2 eta_mf2, 3 tau_bf1, 4 tau_bf2) of a gear's loss table at ``|w_a| = w``: linear
     between rows, extrapolated from the last two (MSL ``LossyGear``: ``LinearSegments``, ``LastTwoPoints``)."""
@@ -688,7 +688,7 @@ def _gear_column(data, start, n, col, w):
     return data[start + col * n + lo] + wt * (data[start + col * n + lo + 1] - data[start + col * n + lo])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_losses(p, r, w_abs):
     """Mesh efficiencies and bearing friction of lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (MSL
     ``LossyGear``): ``(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a)``: efficiency while flange a drives [-], while
@@ -707,7 +707,7 @@ def gear_losses(p, r, w_abs):
     return eta1, eta2, bf1, bf2, bfa
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_transfer(p, r, mode, w_abs):
     """Torque law of a rolling lossy gear row ``r`` in ``mode``: ``(f, c)`` with the torque on flange b's inertia
     ``ratio (f T_a - c)`` [N m], ``T_a = -tau`` the torque flange a's side applies to the gear (MSL
@@ -728,7 +728,7 @@ def gear_transfer(p, r, mode, w_abs):
     return 1.0, 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_band(p, r, t_a):
     """The loss torques that bound a stuck lossy gear row ``r`` carrying ``T_a`` [N m] on flange a (MSL
     ``LossyGear``, from the table at ``w_a = 0``): ``(tauLossMin_m, tauLossMax_p)``.  It rolls forward when the
@@ -741,7 +741,7 @@ def gear_band(p, r, t_a):
     return lo, hi
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_margin(p, r, t_a, hold, noise):
     """How far the loss torque ``hold`` [N m] a stuck lossy gear row ``r`` carrying ``T_a`` holds is inside its band
     (:func:`gear_band`, widened by ``noise``): ``(margin, width, direction)``, ``margin <= 0`` where it must roll,
@@ -753,7 +753,7 @@ def gear_margin(p, r, t_a, hold, noise):
     return min(up, down), hi - lo + noise, 1 if up < down else -1
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_tau_eta(p, r, mode, t_a, w_abs):
     """MSL ``LossyGear.tau_eta`` [N m] of a rolling gear: ``T_a - tau_bf_a`` forward, ``T_a + tau_bf_a``
     backward; its sign decides the quadrant (which flange drives)."""
@@ -761,20 +761,20 @@ def gear_tau_eta(p, r, mode, t_a, w_abs):
     return t_a - bfa if mode == GEAR_FWD_A or mode == GEAR_FWD_B else t_a + bfa
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_speed(p, r, x, n):
     """Speed of flange a against the gear's support ``w_a - w_s`` [rad/s] (MSL ``LossyGear.w_a``)."""
     return _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _gear_mode(p, r, m):
     """The mode of gear row ``r`` (``GEAR_STUCK`` for an ideal one, which has none)."""
     mi = p.elem[r, E_MODE]
     return m[mi] if mi >= 0 else GEAR_STUCK
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def relative_speed(p, r, x, n):
     """Relative speed ``cb w_b - ca w_a`` [rad/s] of element row ``r`` (``w_b - w_a`` but for gears, whose
     constraint speed is ``ratio (w_b - w_s) - (w_a - w_s)``, zero but for drift)."""
@@ -785,7 +785,7 @@ def relative_speed(p, r, x, n):
     return v
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _apply(F, Fa, elem, r, ca, cb, tq):
     """Torque ``tq`` of element row ``r`` on its inertias (``+ca tq`` on flange a, ``-cb tq`` on b), and its magnitude
     into ``Fa``."""
@@ -799,13 +799,13 @@ def _apply(F, Fa, elem, r, ca, cb, tq):
         Fa[a] += abs(ca * tq)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _add(F, i, v):
     if i >= 0:
         F[i] += v
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def evaluate_network(t, x, m, p, acc, tau):
     """Accelerations ``acc`` [rad/s^2] of the inertias and the torque ``tau`` [N m] of every element.
 
@@ -883,7 +883,7 @@ def evaluate_network(t, x, m, p, acc, tau):
     return ns
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
@@ -929,55 +929,55 @@ def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     return work
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _nk(p):
     """Largest constraint set: every friction element, every gear and motion source, and the hold of every lossy
     gear (``GEAR_STUCK``)."""
     return p.fric.shape[0] + p.cons.shape[0] + p.lossy.shape[0]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _offsets(p):
     return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0],
                    p.signals.shape[0])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _acc_tau(p):
     o = _offsets(p)
-    return p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]
+    return borrow((p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _slack(p):
     """Slack of the stick functions: the friction elements', then the lossy gears'."""
     o = _offsets(p)
-    return p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]]
+    return borrow(p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _holds(p):
     """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
     o = _offsets(p)
-    return p.work[o[12]:o[12] + p.lossy.shape[0]]
+    return borrow(p.work[o[12]:o[12] + p.lossy.shape[0]])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
-    return p.work[o[11]:o[11] + p.inertia.shape[0]]
+    return borrow(p.work[o[11]:o[11] + p.inertia.shape[0]])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
     o = _offsets(p)
-    return p.work[o[14]:p.work.shape[0] - 1]
+    return borrow(p.work[o[14]:p.work.shape[0] - 1])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def refresh_signals(p, t):
     """Evaluate every signal of the network at ``t`` once (:func:`signal_value`) into the signal cache; every
     evaluation of the network starts with this, and :func:`signal_at` reads from it at that time."""
@@ -988,13 +988,13 @@ def refresh_signals(p, t):
     w[o] = t
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def forget_signals(p):
     """Empty the signal cache (a run starts, or a signal's parameters change)."""
     p.work[_offsets(p)[13]] = np.nan
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def signal_at(p, s, t):
     """Value of signal ``s`` of the network at ``t``: from the cache of the last evaluation if it was at ``t``
     (:func:`refresh_signals`), else :func:`signal_value` itself.  The same value either way: a signal is a
@@ -1005,7 +1005,7 @@ def signal_at(p, s, t):
     return signal_value(p.signals[s], p.data, t)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def set_external(p, j, slide, limit, lock):
     """Set clutch model ``j``'s (``elem[r, E_AUX] = j``) sliding torque magnitude ``slide`` [N m] at the present
     relative speed, its static limit ``limit`` [N m] (the torque it holds while stuck: beyond it, it breaks
@@ -1018,7 +1018,7 @@ def set_external(p, j, slide, limit, lock):
     ext[3 * j + 2] = lock
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _member(p, m, x, n, rk, fl, gc, hc, k):
     """Flanges (three, -1 for none or the ground; stored as floats), constraint weights ``g`` and torque weights
     ``h`` of constraint member ``k`` (element row ``rk``, or ``-(row + 1)`` for a stuck lossy gear's hold): the
@@ -1052,7 +1052,7 @@ def _member(p, m, x, n, rk, fl, gc, hc, k):
         hc[o + 2] = ca - cb * f
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _in_band(p, r, t_a, hold, tol):
     """True if a stuck lossy gear row ``r`` carrying ``T_a`` holds the loss torque ``hold`` within its band (to
     ``tol``)."""
@@ -1060,7 +1060,7 @@ def _in_band(p, r, t_a, hold, tol):
     return lo - tol <= hold <= hi + tol
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _feasible(p, stuck, ns, lam, lo, hi, tol):
     """True if every bounded member of the set is within its bounds (a stuck lossy gear's hold within its band)."""
     for k in range(ns):
@@ -1077,7 +1077,7 @@ def _feasible(p, stuck, ns, lam, lo, hi, tol):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _null_vector(A, ns, S, cp, v, y):
     """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (the last pivot of Gaussian elimination
     with complete pivoting below 1e-10 of the first, the one before it above): True, ``v`` scaled to a largest
@@ -1130,7 +1130,7 @@ def _null_vector(A, ns, S, cp, v, y):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _searched_before(p, A, ns):
     """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A[:ns, :ns]``."""
     o = _offsets(p)[15]
@@ -1145,14 +1145,14 @@ def _searched_before(p, A, ns):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _full_rank_known(p, A, ns):
     """True if the last null-vector search was of exactly this ``A`` and found it of full rank (nothing to
     repair)."""
     return _searched_before(p, A, ns) and p.work[_offsets(p)[15] + 1] == 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _null_vector_cached(p, A, ns, S, cp, v, y):
     """:func:`_null_vector` of ``A[:ns, :ns]``, reusing the last search's result when ``A`` is exactly the matrix it
     searched (a stuck set evaluated again: the same set, the same ``A`` but for speed-dependent gear losses), so the
@@ -1177,7 +1177,7 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
     return found
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     """Move a statically indeterminate split into the stuck members' bounds (one redundant loop).
 
@@ -1225,7 +1225,13 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     if nb == 0:
         return False
     cs = cand[:nb]
-    cs.sort()
+    for i in range(1, nb):   # ascending (insertion sort: a handful of breakpoints, and no allocation)
+        c = cs[i]
+        j = i - 1
+        while j >= 0 and cs[j] > c:
+            cs[j + 1] = cs[j]
+            j -= 1
+        cs[j + 1] = c
     # the segment containing z = 0, or the nearest feasible one: scan the gaps between breakpoints
     best_lo, best_hi, best_d = 0.0, 0.0, np.inf
     for i in range(nb + 1):
@@ -1295,7 +1301,7 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     """Torques of the constraint set -- stuck friction elements, gears, stuck lossy gears' holds, motion sources
     -- solved together.
@@ -1421,7 +1427,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
                 Fa[i] += abs(hc[3 * k + q] * lam[k])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _lossy_index(p, r):
     for j in range(p.lossy.shape[0]):
         if p.lossy[j] == r:
@@ -1432,7 +1438,7 @@ def _lossy_index(p, r):
 
 
 # ----------------------------------------------------------------- the stick/slip items: friction elements and lossy gears
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _flanges_max(v, elem, r):
     """The largest of ``|v|`` over element row ``r``'s flanges (a, b and a gear's support; 0 for the ground)."""
     out = 0.0
@@ -1447,7 +1453,7 @@ def _flanges_max(v, elem, r):
     return out
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_noise(p, r, tau):
     """Rounding floor [N m] of the stick/slip decisions of element row ``r``: ``NOISE`` times one plus its torque and
     the torques on its own inertias at the last evaluation (local: an element elsewhere in the network does not move
@@ -1458,7 +1464,7 @@ def _item_noise(p, r, tau):
     return NOISE * (1.0 + scale)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_wtol(p, r, x, n):
     """Rounding width [rad/s] of a relative speed of element row ``r``: 1e-9 of the largest speed of its inertias
     (at least 1 rad/s)."""
@@ -1470,13 +1476,13 @@ def _item_wtol(p, r, x, n):
     return 1e-9 * w
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_row(p, i):
     nf = p.fric.shape[0]
     return p.fric[i] if i < nf else p.lossy[i - nf]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_stuck(p, m, i):
     """True if item ``i`` (a friction element, then the lossy gears) is stuck in the modes ``m``."""
     nf = p.fric.shape[0]
@@ -1485,7 +1491,7 @@ def _item_stuck(p, m, i):
     return m[p.elem[p.lossy[i - nf], E_MODE]] == GEAR_STUCK
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_set(p, m, i, direction):
     """Put item ``i`` (a friction element, then the lossy gears) in a mode: stuck (``direction`` 0), sliding or
     rolling forward (+1) or backward (-1; a lossy gear with flange a driving, its quadrant fixed by
@@ -1498,7 +1504,7 @@ def _item_set(p, m, i, direction):
                                                                                  else GEAR_BWD_A)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_speed(p, x, n, i):
     """Relative speed [rad/s] of item ``i``: a friction element's ``w_b - w_a``, a lossy gear's ``w_a - w_s``."""
     r = _item_row(p, i)
@@ -1507,7 +1513,7 @@ def _item_speed(p, x, n, i):
     return gear_speed(p, r, x, n)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_passed_rest(p, m, x, n, i):
     """True if sliding (rolling) item ``i`` has passed zero relative speed the wrong way for its mode: its stick
     function (the speed in its direction plus its slack) is at or below zero.  Two items on one relative motion (a
@@ -1528,7 +1534,7 @@ def _item_passed_rest(p, m, x, n, i):
     return d * _item_speed(p, x, n, i) + _slack(p)[i] <= 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_acc(p, acc, i):
     """Relative acceleration [rad/s^2] of item ``i`` (as :func:`_item_speed`)."""
     r = _item_row(p, i)
@@ -1537,7 +1543,7 @@ def _item_acc(p, acc, i):
     return (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]]) - (0.0 if p.elem[r, E_SUP] < 0 else acc[p.elem[r, E_SUP]])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_excess(t, p, tau, i, sticking):
     """How far stuck item ``i`` is beyond what it holds at the last evaluation, and the way it would move.
 
@@ -1561,7 +1567,7 @@ def _item_excess(t, p, tau, i, sticking):
     return -margin / width, d
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _evaluate(t, x, m, p, acc, tau):
     """The network at ``t`` with every rolling lossy gear in the quadrant its torque puts it in (MSL
     ``LossyGear.tau_eta``'s sign: which flange drives): evaluated, a gear whose quadrant disagrees beyond the noise
@@ -1592,7 +1598,7 @@ def _evaluate(t, x, m, p, acc, tau):
     return 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
     """True if the modes of the candidates (items at rest) agree with the forces of the last evaluation: every
     stuck one within what it holds, every released one accelerating its way (not against it beyond rounding)."""
@@ -1607,21 +1613,21 @@ def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_slips(p, acc, i):
     """True if stuck item ``i`` does not hold its relative acceleration at zero (a motion source prescribes the
     motion it would hold: the constraints contradict each other, the stuck set is no solution)."""
     return abs(_item_acc(p, acc, i)) > 1e3 * _item_anoise(p, _item_row(p, i), acc)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_anoise(p, r, acc):
     """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
     acceleration of its inertias."""
     return 1e-10 * (1.0 + _flanges_max(acc, p.elem, r))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
     """Turn every released item of ``pick`` that accelerates against its direction the other way (a one-way clutch
     cannot); True if one turned.  ``dirs`` follows."""
@@ -1638,7 +1644,7 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
     return turned
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _apply_subset(p, m, cand, nc, dirs, pick, s):
     for c in range(nc):
         _item_set(p, m, cand[c], 0)
@@ -1647,7 +1653,7 @@ def _apply_subset(p, m, cand, nc, dirs, pick, s):
         _item_set(p, m, cand[c], dirs[c])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def settle(t, x, m, p, log, old):
     """Modes consistent with the forces at ``t`` (the event iteration of MSL's friction elements and ``LossyGear``).
 
@@ -1697,7 +1703,10 @@ def settle(t, x, m, p, log, old):
         exc[c] = ex
         dirs[c] = d
         if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
-            dirs[c] = 0          # a one-way clutch never slides backward
+            # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
+            # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
+            # that set contradicts a prescribed motion.)
+            dirs[c] = 1
         worst = max(worst, ex)
     if worst >= 0.0:
         # the candidates, most overloaded first
@@ -1754,6 +1763,8 @@ def settle(t, x, m, p, log, old):
                     if not _item_stuck(p, m, i):
                         continue
                     ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+                    if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
+                        ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
                     if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
                         continue
                     if ex >= 0.0 and ex > best:
@@ -1792,7 +1803,7 @@ def settle(t, x, m, p, log, old):
 
 
 # ----------------------------------------------------------------- hooks
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_rhs(t, x, u, m, p, dx, g):
     """Angles and speeds of the inertias, work of the sources, energy dissipated by each element.
 
@@ -1917,7 +1928,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_power(p, r, x, n, m, tau):
     """Power [W] gear row ``r`` takes from the inertias it joins, ``-(sum of its torques on them times their
     speeds)``: its loss ``tauLoss (w_a - w_s)`` (MSL ``LossyGear.lossPower``), zero for an ideal or a stuck gear but
@@ -1935,7 +1946,7 @@ def gear_power(p, r, x, n, m, tau):
     return -(tau * _speed(x, n, p.elem[r, E_A]) + tb * _speed(x, n, p.elem[r, E_B]) + ts * _speed(x, n, p.elem[r, E_SUP]))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _lash_msl_switching(p, r, x, n, mode, phi):
     """The two switching functions of a backlash with MSL's damping law in contact mode ``mode``, each positive
     within the mode and falling through zero at one of its ends (direction -1), in radians (torques over ``c``);
@@ -1960,7 +1971,7 @@ def _lash_msl_switching(p, r, x, n, mode, phi):
     return -(a + b), side * phi - b2
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _lash_msl_update(p, r, x, n, mode, which):
     """The mode a backlash with MSL's damping law enters when its switching function ``which`` (0 or 1) of
     :func:`_lash_msl_switching` falls through zero in ``mode``; from the gap, the contact's mode at the edge
@@ -1985,7 +1996,7 @@ def _lash_msl_update(p, r, x, n, mode, which):
     return LASH_GAP
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_outputs(t, x, u, m, p, y):
     """Per element: torque [N m] (a source: its torque on flange b; a gear: ``tau``, on flange a) and, for
     springs and friction, the relative speed [rad/s]; per friction element also its MSL mode code [-] and
@@ -2034,7 +2045,7 @@ def driveline_outputs(t, x, u, m, p, y):
     y[q + 4] = work - lost - (kinetic + spring - p.work[p.work.shape[0] - 1])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def driveline_update(t, x, u, m, p, k, log):
     """Switching function ``k`` crossed: a sliding element reached zero relative speed (it sticks, or
     reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
@@ -2103,7 +2114,7 @@ def driveline_update(t, x, u, m, p, k, log):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
     :func:`forget_signals`)."""
@@ -2121,7 +2132,7 @@ INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign 
 INV_BASE, N_INV = 100, 6
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def check_invariants(t, x, m, p):
     """The invariants of the network at an accepted step: 0, or the model error code of the first violated.
 
@@ -2215,7 +2226,7 @@ def check_invariants(t, x, m, p):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_accept(t, x, u, m, p):
     """Nothing to commit (the network has no memories); with ``check[0]`` set, the invariants
     (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
@@ -2224,7 +2235,7 @@ def driveline_accept(t, x, u, m, p):
     return 0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_next_break(t, m, p):
     """Next jump or kink of any signal (steps, ramp corners, table points, a sine's start)."""
     tb = np.inf
@@ -2235,12 +2246,12 @@ def driveline_next_break(t, m, p):
     return tb
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_jacobian(t, x, u, m, p, J):
     """No analytic Jacobian (Dormand-Prince)."""
     return False
 
 
-dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
+dispatch.register(DrivelineParams, inline_stages=True, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
                   jacobian=driveline_jacobian)
