@@ -180,7 +180,7 @@ def test_without_damping_the_laws_are_one_and_the_default_is_kelvin_voigt():
     net.inertia("J1", J=1.0)
     net.backlash("lash", "J1", "ground", c=1.0, b_gap=0.1, d=1.0)
     assert net.pack().elem[0, K.E_AUX] == K.LASH_KELVIN_VOIGT
-    assert net.system().mode_values[0] == K.LASH_VALUES
+    assert net.system().mode_values[0] == K.LASH_KV_VALUES
     assert _network().system().mode_values[0] == K.LASH_MSL_VALUES
 
 

@@ -246,19 +246,15 @@ def _recontact_reference(t_out, J0, J1, c, dmp, gap, amp, freq):
     return out, switches
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue #30): a damped contact that separated beyond its edge and turns "
-                   "outward again before reaching it is not closed: the contact is watched at the edge only")
 def test_a_damped_contact_that_separated_beyond_its_edge_closes_again_where_it_pushes():
     """The damper of a contact pulls before the spring has relaxed: the contact separates beyond its edge, moving
     back.  Turned outward again before reaching the edge (a torque drives it), it closes where its torque would
     push -- not only at the edge, which it never reaches (hypothesis found that case on a random network: the
     deflection then went on outward in the gap, beyond the edge, with no torque).  Against an independent
     solution of the law written as a function of the state: every contact and separation to 1e-7 s, the speeds
-    to 1e-6 of their range; two of the contacts close beyond the edge.  Open: a fix of the switching functions
-    (the larger of the distance to the edge and the contact's torque over c) finds these contacts, but with the
-    spring's energy counted as lost at the separation its return at the re-contact makes a dissipation fall, and
-    counting it as stored beyond the edge put a kink in the energy's rate at the edge that cost the balance its
-    accuracy (3e-6 J at rtol 1e-8); see the closing note of 2026-11-29."""
+    to 1e-6 of their range; two of the contacts close beyond the edge; the dissipation only grows and the
+    balance closes (the contact is released beyond its edge, modes ``upper_released`` / ``lower_released``, its
+    spring's energy stored until the damper takes it on the way to the edge)."""
     J0, J1, c, dmp, gap, amp, freq = 0.75, 1.0, 10.0, 2.0, 0.01, 1.0, 5.0
     d = Driveline("recontact")
     d.inertia("J0", J=J0)
@@ -276,6 +272,8 @@ def test_a_damped_contact_that_separated_beyond_its_edge_closes_again_where_it_p
         assert np.max(np.abs(df[col].to_numpy() - ref[:, i])) < 1e-6 * np.ptp(ref[:, i]), col
     phi = np.interp([tt for tt, e in got if e == "contact"], df["time_s"], df["J1.phi_rad"] - df["J0.phi_rad"])
     assert np.sum(np.abs(phi) > 0.5 * gap + 1e-5) >= 2
+    assert {"upper_released", "lower_released"} & set(res.mode("k0"))
+    assert np.all(np.diff(df["k0.dissipated_J"].to_numpy()) >= -1e-12)
     assert abs(df["energy_error_J"]).max() < 1e-9
 
 

@@ -234,6 +234,27 @@ def test_two_elements_on_one_motion_stop_together(rtol):
     assert sorted(last) == [(0.99346, "bearing", "stick"), (0.99346, "brake", "stick")]
 
 
+def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_stuck_constraint():
+    """Found by the property below: two self-locking lossy gears in series (efficiency 0.5 and 0.25, reversing
+    ratios) behind bearing friction, a sine torque.  A stuck set holds accelerations, so a stuck speed keeps what
+    the located stick instant left (here 3e-10 rad/s on J0, 1.0001e-9 on J1 through the ratio 1/0.3).  When the
+    bearing broke away at 0.7701 s, g1 was released backward with its speed 1.0001e-9 the other way, just beyond
+    the rounding width 1e-9: its stick function started below zero and never crossed, and g1 rolled forward in
+    its backward mode (the compiled check stopped the run at rtol 1e-9, not at 1e-6 or 1e-11).  Now the slack of
+    a released item covers the drift: the same 30 mode changes at every tolerance, the invariants at every step."""
+    d = Driveline("self_locking_pair")
+    d.inertia("J0", J=0.5625).inertia("J1", J=1.0).inertia("J2", J=2.0)
+    d.gear("g0", "J0", "J1", ratio=-0.30078125, efficiency=0.5)
+    d.gear("g1", "J1", "J2", ratio=-1.0, efficiency=0.25)
+    d.bearing_friction("bearing", "J0", torque=0.25, peak=1.0)
+    d.torque("T0", "J0", Signal.sine(1.0, 2.0))
+    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True).events for rtol in (1e-6, 1e-9, 1e-11)]
+    for ev in runs:
+        assert list(zip(ev["element"], ev["event"])) == list(zip(runs[-1]["element"], runs[-1]["event"]))
+        assert len(ev) == 30
+        assert np.max(np.abs(ev["time_s"].to_numpy() - runs[-1]["time_s"].to_numpy())) < 1e-6
+
+
 # ----------------------------------------------------------------- random networks
 @st.composite
 def networks(draw, with_unrelated=False):

@@ -63,6 +63,10 @@ LASH_VALUES = ("gap", "upper", "lower")
 LASH_KELVIN_VOIGT, LASH_MSL = 0, 1
 LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED = 3, 4, 5, 6
 LASH_MSL_VALUES = LASH_VALUES + ("upper_limited", "lower_limited", "upper_released", "lower_released")
+# (Kelvin-Voigt's contact has the unloaded modes too: a damped contact separates beyond its edge, moving back, and
+# is released there until the deflection reaches the edge or its torque pushes again; it never enters the limited
+# ones, which keep their names)
+LASH_KV_VALUES = LASH_MSL_VALUES
 # modes of a friction element (index into MODE_VALUES); MSL's codes are MODE_CODES
 STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
@@ -1621,6 +1625,20 @@ def _item_slips(p, acc, i):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _start_slack(w, w_tol, d, was_stuck):
+    """Slack [rad/s] of the stick function ``d w + slack`` of an item that starts to move in direction ``d`` at
+    relative speed ``w``: ``w_tol`` if it starts from (about) rest, so that it watches the speed fall below
+    ``-w_tol`` the wrong way, not 0 (else, were it to stop at once, the crossing would be missed), 0 if it moves
+    clearly.  Released from stuck, its speed is the drift of the stuck constraint (held in acceleration, its speed
+    is what the located stick instant left: a few 1e-10 rad/s, times the ratios of gears between) and may lie the
+    wrong way beyond ``w_tol``: the slack then covers it, so the function starts positive and a motion the wrong
+    way is still seen."""
+    if was_stuck:
+        return w_tol + max(0.0, -d * w)
+    return w_tol if abs(w) <= w_tol else 0.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_anoise(p, r, acc):
     """Rounding floor [rad/s^2] of a relative acceleration of element row ``r``: 1e-10 of one plus the largest
     acceleration of its inertias."""
@@ -1784,7 +1802,8 @@ def settle(t, x, m, p, log, old):
             any_change = True
             w_rel = _item_speed(p, x, n, k)
             w_tol = _item_wtol(p, p.fric[k], x, n)
-            slack[k] = w_tol if abs(w_rel) <= w_tol else 0.0
+            d = 1.0 if m[k] == FORWARD else -1.0 if m[k] == BACKWARD else 0.0
+            slack[k] = _start_slack(w_rel, w_tol, d, old[k] == STUCK)
     for j in range(nl):
         mi = p.elem[p.lossy[j], E_MODE]
         new, was = m[mi], old[mi]
@@ -1795,7 +1814,7 @@ def settle(t, x, m, p, log, old):
             ev = EV_STICK if new == GEAR_STUCK else (EV_FORWARD if GEAR_CODES[new] > 0 else EV_BACKWARD)
             w_a = _item_speed(p, x, n, nf + j)
             w_tol = _item_wtol(p, p.lossy[j], x, n)
-            slack[nf + j] = w_tol if abs(w_a) <= w_tol else 0.0
+            slack[nf + j] = _start_slack(w_a, w_tol, GEAR_CODES[new], was == GEAR_STUCK)
         else:
             ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
         record(log, t, ev, nf + nsw + j)
@@ -1816,7 +1835,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     (either way: free or engaged), the turning point of a slow sliding speed; then three per switched spring.  A
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
-    pull); with MSL's damping law, the two of its mode that fall through zero at its kinks
+    pull); released beyond an edge (Kelvin-Voigt's damped separation), first ``tau / c`` signed positive while it
+    would pull (contact again), then the distance beyond the edge (into the gap); with MSL's damping law, the two of its mode that fall through zero at its kinks
     (:func:`_lash_msl_switching`); third, in the gap, the relative speed plus its rounding width on the nearer
     edge's side (its turning points, either way: a step ends there, and the edges' functions get the core's second
     look, so a touch of an edge within a step is found).  A curve spring: the deflection above the segment's lower
@@ -1904,6 +1924,14 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # in the gap: the distances to the edges; in contact: the torque over c, signed to be positive in the
         # contact (each falls through zero: contact with that edge; separation, as the torque would pull)
         lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
+        if mode == LASH_UPPER_RELEASED or mode == LASH_LOWER_RELEASED:
+            # released beyond its edge (a damped contact separated there, moving back): the contact's torque over c,
+            # signed to be positive while it would pull (falls through zero: it pushes again, contact), and the
+            # distance beyond the edge (falls through zero: into the gap)
+            s_ = 1.0 if mode == LASH_UPPER_RELEASED else -1.0
+            g[q] = -s_ * (phi - s_ * b2 + lag)
+            g[q + 1] = s_ * (phi - s_ * b2)
+            continue
         g[q] = phi - b2 + lag if mode == LASH_UPPER else b2 - phi
         g[q + 1] = -(phi + b2 + lag) if mode == LASH_LOWER else phi + b2
     nsw = p.swit.shape[0]
@@ -2089,14 +2117,27 @@ def driveline_update(t, x, u, m, p, k, log):
             return 0
         side = LASH_UPPER if (k - N_G * nf) % N_SW == 0 else LASH_LOWER   # b/2 - phi: the gap's upper side
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
-        if m[nf + j] == LASH_GAP and ((side == LASH_UPPER and w_rel > 0.0) or (side == LASH_LOWER and w_rel < 0.0)):
+        mode = m[nf + j]
+        if mode == LASH_UPPER_RELEASED or mode == LASH_LOWER_RELEASED:
+            if (k - N_G * nf) % N_SW == 1:   # the edge, inward: into the gap (no event: it separated already)
+                m[nf + j] = LASH_GAP
+                return 0
+            m[nf + j] = LASH_UPPER if mode == LASH_UPPER_RELEASED else LASH_LOWER   # it pushes again
+            record(log, t, EV_CONTACT, nf + j)
+        elif mode == LASH_GAP and ((side == LASH_UPPER and w_rel > 0.0) or (side == LASH_LOWER and w_rel < 0.0)):
             m[nf + j] = side
             record(log, t, EV_CONTACT, nf + j)
-        elif m[nf + j] == side:
-            # the energy left in the spring (a damped contact separates before the edge) is lost: the
-            # massless spring relaxes through its damper
-            x[2 * n + r] += spring_energy(p, r, x, n, m)
-            m[nf + j] = LASH_GAP
+        elif mode == side:
+            # a damped contact separates beyond its edge, moving back (its damper pulls first): released there, the
+            # spring still deflected, its energy stored until it goes to the damper on the way to the edge
+            # (spring_torque), or the contact closes again where it would push.  At (or, by the event's bracket,
+            # inside) the edge: into the gap, the energy left in the spring (~0) counted as dissipated
+            s_ = 1.0 if side == LASH_UPPER else -1.0
+            if s_ * (_spring_deflection(p, r, x, n) - s_ * 0.5 * p.coef[r, C_GAP]) > 0.0:
+                m[nf + j] = LASH_UPPER_RELEASED if side == LASH_UPPER else LASH_LOWER_RELEASED
+            else:
+                x[2 * n + r] += spring_energy(p, r, x, n, m)
+                m[nf + j] = LASH_GAP
             record(log, t, EV_SEPARATE, nf + j)
         else:
             return 0

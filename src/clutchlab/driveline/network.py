@@ -1375,12 +1375,12 @@ class Driveline:
             upper = phi > b2 or (phi == b2 and w_rel > 0)
             lower = phi < -b2 or (phi == -b2 and w_rel < 0)
             m[p.fric.size + j] = K.LASH_UPPER if upper else K.LASH_LOWER if lower else K.LASH_GAP
-            if e.aux == K.LASH_MSL and (upper or lower):   # which part of MSL's law: s tau_c = a, s tau_d = b
+            if upper or lower:   # which part of the law: s tau_c = a, s tau_d = b
                 s = 1.0 if upper else -1.0
                 a, b = s * e.coef[0] * (phi - s * b2), s * e.coef[1] * w_rel
-                if b >= a:
+                if e.aux == K.LASH_MSL and b >= a:
                     m[p.fric.size + j] = K.LASH_UPPER_LIMITED if upper else K.LASH_LOWER_LIMITED
-                elif a + b <= 0.0:
+                elif a + b <= 0.0 and a > 0.0:   # beyond the edge, the contact would pull: released (both laws)
                     m[p.fric.size + j] = K.LASH_UPPER_RELEASED if upper else K.LASH_LOWER_RELEASED
         for k, r in enumerate(p.fric):
             e = p.elem[r]
@@ -1468,7 +1468,7 @@ class Driveline:
         switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
                            for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1)))
         mode_names = named
-        swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_VALUES)
+        swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_KV_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
