@@ -582,8 +582,10 @@ class Driveline:
 
         ``damping_law``: ``"kelvin_voigt"`` (default): ``tau = tau_c + tau_d``; contact begins at the edge (the
         damping torque steps in with the impact speed) and ends when the torque would pull; both are located
-        events, ``contact`` and ``separate``.  The energy still in the spring at a damped separation is counted
-        as dissipated (the massless spring relaxes through its damper, taken as instantaneous).  ``"msl"``:
+        events, ``contact`` and ``separate``.  A damped contact separates beyond its edge, moving back: it is
+        released there (modes ``upper_released`` / ``lower_released``; the spring's energy stays stored and goes
+        to its damper as the deflection falls back to the edge) until it reaches the edge or its torque pushes
+        again (``contact``, beyond the edge).  ``"msl"``:
         MSL ``ElastoBacklash``'s law, ``tau = tau_c + min(tau_c, tau_d)`` beyond the upper edge and 0 where
         ``tau_c + tau_d <= 0`` (mirrored below), so the torque is continuous at impact and never pulls; its
         kinks are located events (no names), ``contact`` and ``separate`` are at the edge.  Its dissipation is
