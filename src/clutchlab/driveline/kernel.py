@@ -2293,6 +2293,6 @@ def driveline_jacobian(t, x, u, m, p, J):
     return False
 
 
-dispatch.register(DrivelineParams, inline_stages=True, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
+dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
                   jacobian=driveline_jacobian)
