@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 from hypothesis_budget import examples
 
 from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline import kernel as K
 from clutchlab.errors import ParameterError, SimulationError
 from clutchlab.system import simulate
 
@@ -160,8 +161,6 @@ def test_the_debug_check_catches_a_stuck_element_beyond_its_limit():
     d.torque("T", "J", 5.0)
     d.brake("b", "J", fn_max=2.0, mu=0.5)
     s = d.system(1e-8, check_invariants=True)
-    from clutchlab.driveline import kernel as K
-
     p = s.params
     x0 = s.x0.copy()
     m0 = s.m0.copy()    # a state the settle never makes: the check itself, at t = 0.5 s
@@ -212,6 +211,20 @@ def test_the_debug_check_names_a_missed_backlash_contact():
     m0 = system.m0.copy()
     m0[list(system.mode_names).index("k0")] = 0      # in the gap
     with pytest.raises(SimulationError, match="k0.*backlash in its gap beyond an edge"):
+        simulate(system.replace(x0=x0, m0=m0), 0.1)
+
+
+def test_the_debug_check_names_a_released_backlash_that_would_push():
+    """The same invariant for the released mode (a damped contact that separated beyond its edge): started released
+    beyond the edge where its contact pushes (no damping: the spring alone), it is reported at once; released where
+    it would pull (moving back fast enough, with damping) it is not."""
+    d = _rattle()
+    system = d.system(1e-8, check_invariants=True)
+    x0 = system.x0.copy()
+    x0[system.state_index("J1.phi")] = 0.02          # beyond the upper edge at 0.0156 rad
+    m0 = system.m0.copy()
+    m0[list(system.mode_names).index("k0")] = K.LASH_UPPER_RELEASED
+    with pytest.raises(SimulationError, match="k0.*released where its contact would push"):
         simulate(system.replace(x0=x0, m0=m0), 0.1)
 
 

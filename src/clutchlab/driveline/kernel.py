@@ -2169,7 +2169,8 @@ INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = 0, 1, 2, 3, 4, 
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",
-              "backlash in its gap beyond an edge, moving outward (a contact missed)")
+              "backlash in its gap beyond an edge moving outward, or released where its contact would push (a "
+              "contact missed)")
 INV_BASE, N_INV = 100, 6
 
 
@@ -2184,8 +2185,8 @@ def check_invariants(t, x, m, p):
       the element's inertias, what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
     * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding);
-    * a backlash in its gap is not beyond an edge moving on outward (a contact missed; beyond it and moving back is a
-      damped contact that has just separated, as its torque would pull);
+    * a backlash in its gap is not beyond an edge moving on outward, and one released beyond an edge (a damped contact
+      that separated there) is not where its contact would push (either: a contact missed);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
       that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed).
     """
@@ -2245,8 +2246,19 @@ def check_invariants(t, x, m, p):
             w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             w_tol = 1e3 * _item_wtol(p, r, x, n)
             tol = 1e-8 * max(1.0, b2)
-            # (a damped contact separates beyond its edge, moving back: only moving on outward is a missed contact)
+            # (a damped contact separates beyond its edge into its released mode, not into the gap)
             if (phi > b2 + tol and w_rel > w_tol) or (phi < -b2 - tol and w_rel < -w_tol):
+                return -(INV_BASE + N_INV * r + INV_GAP)
+        elif p.elem[r, E_LAW] == SPRING_BACKLASH and (m[nf + j] == LASH_UPPER_RELEASED or
+                                                       m[nf + j] == LASH_LOWER_RELEASED):
+            # released beyond an edge: never where its contact would push (tau / c past zero the contact's way)
+            s_ = 1.0 if m[nf + j] == LASH_UPPER_RELEASED else -1.0
+            b2 = 0.5 * p.coef[r, C_GAP]
+            phi = _spring_deflection(p, r, x, n)
+            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+            lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * w_rel
+            if s_ * (phi - s_ * b2 + lag) > 1e-6 * max(1.0, b2) + p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * 1e3 * \
+                    _item_wtol(p, r, x, n):
                 return -(INV_BASE + N_INV * r + INV_GAP)
     if p.check[1] > 0.0:
         kinetic, spring, work, lost = 0.0, 0.0, 0.0, 0.0
