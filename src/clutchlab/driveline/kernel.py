@@ -1836,7 +1836,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
     pull); released beyond an edge (Kelvin-Voigt's damped separation), first ``tau / c`` signed positive while it
-    would pull (contact again), then the distance beyond the edge (into the gap); with MSL's damping law, the two of its mode that fall through zero at its kinks
+    would pull (contact again), then the distance beyond the edge (into the gap); with MSL's damping law, the two
+    of its mode that fall through zero at its kinks
     (:func:`_lash_msl_switching`); third, in the gap, the relative speed plus its rounding width on the nearer
     edge's side (its turning points, either way: a step ends there, and the edges' functions get the core's second
     look, so a touch of an edge within a step is found).  A curve spring: the deflection above the segment's lower
