@@ -643,6 +643,18 @@ def spring_torque(p, r, x, n, m):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _lash_contact(p, r, x, n, s):
+    """Backlash row ``r``'s contact on side ``s`` (+1 upper, -1 lower edge): its deflection beyond that edge, ``s (phi
+    - s b/2)`` [rad] (> 0 beyond it), and the contact's torque over ``c`` signed the same way, ``s (phi - s b/2 + d/c
+    w_rel)`` [rad] (> 0: it pushes; the torque of :func:`spring_torque` in contact, over ``c``).  The one expression
+    the switching functions, the separation and the invariant check use."""
+    b2 = 0.5 * p.coef[r, C_GAP]
+    phi = _spring_deflection(p, r, x, n)
+    lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
+    return s * (phi - s * b2), s * (phi - s * b2 + lag)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def spring_energy(p, r, x, n, m):
     """Energy [J] stored in spring-damper row ``r`` (the integral of its elastic torque over the deflection;
     a backlash's in its contact mode ``m``)."""
@@ -887,6 +899,30 @@ def evaluate_network(t, x, m, p, acc, tau):
     return ns
 
 
+class WorkLayout(NamedTuple):
+    """Offsets of the blocks of ``DrivelineParams.work`` (:func:`_layout`): the constraint set's matrix ``a``, its
+    regularised copy ``m``, right-hand side ``b``, multipliers ``l``, weights ``c``, residual ``r``, member flanges
+    and weights ``g``, bounds and scratch ``lim``; accelerations ``acc``, element torques ``tau``, stick-function
+    slack ``slack``, torque magnitudes ``fabs``, gear holds ``hold``, signal cache ``sig``, null-vector cache ``nv``,
+    clutch models ``ext``."""
+    a: int
+    m: int
+    b: int
+    l: int
+    c: int
+    r: int
+    g: int
+    lim: int
+    acc: int
+    tau: int
+    slack: int
+    fabs: int
+    hold: int
+    sig: int
+    nv: int
+    ext: int
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
@@ -897,9 +933,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
     (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
     null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
-    :func:`set_external`) | initial stored energy (1).  Returns the offsets of A, A + eps D, right-hand side,
-    torques, weights, residual, member flanges, bounds, accelerations, element torques, slack, torque magnitudes,
-    holds, signal cache, clutch models, null-vector cache."""
+    :func:`set_external`) | initial stored energy (1).  Returns the offsets as a :class:`WorkLayout`."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -916,20 +950,21 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
     o_ext = o_nv + 2 + nk * nk + nk
-    return o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_ext, o_nv
+    return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
+                      o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
     signals (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig)[14] + 3 * nx + 1
+    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + 1
 
 
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
     work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig))
-    work[_layout.py_func(n, nk, ne, nf, nl, nsig)[13]] = np.nan
+    work[_layout.py_func(n, nk, ne, nf, nl, nsig).sig] = np.nan
     return work
 
 
@@ -949,28 +984,28 @@ def _offsets(p):
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _acc_tau(p):
     o = _offsets(p)
-    return borrow((p.work[o[8]:o[8] + p.inertia.shape[0]], p.work[o[9]:o[9] + p.elem.shape[0]]))
+    return borrow((p.work[o.acc:o.acc + p.inertia.shape[0]], p.work[o.tau:o.tau + p.elem.shape[0]]))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _slack(p):
     """Slack of the stick functions: the friction elements', then the lossy gears'."""
     o = _offsets(p)
-    return borrow(p.work[o[10]:o[10] + p.fric.shape[0] + p.lossy.shape[0]])
+    return borrow(p.work[o.slack:o.slack + p.fric.shape[0] + p.lossy.shape[0]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _holds(p):
     """The loss torque [N m] each lossy gear holds (stuck: the multiplier of its hold) at the last evaluation."""
     o = _offsets(p)
-    return borrow(p.work[o[12]:o[12] + p.lossy.shape[0]])
+    return borrow(p.work[o.hold:o.hold + p.lossy.shape[0]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
-    return borrow(p.work[o[11]:o[11] + p.inertia.shape[0]])
+    return borrow(p.work[o.fabs:o.fabs + p.inertia.shape[0]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -978,14 +1013,14 @@ def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
     o = _offsets(p)
-    return borrow(p.work[o[14]:p.work.shape[0] - 1])
+    return borrow(p.work[o.ext:p.work.shape[0] - 1])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def refresh_signals(p, t):
     """Evaluate every signal of the network at ``t`` once (:func:`signal_value`) into the signal cache; every
     evaluation of the network starts with this, and :func:`signal_at` reads from it at that time."""
-    o = _offsets(p)[13]
+    o = _offsets(p).sig
     w = p.work
     for s in range(p.signals.shape[0]):
         w[o + 1 + s] = signal_value(p.signals[s], p.data, t)
@@ -995,7 +1030,7 @@ def refresh_signals(p, t):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def forget_signals(p):
     """Empty the signal cache (a run starts, or a signal's parameters change)."""
-    p.work[_offsets(p)[13]] = np.nan
+    p.work[_offsets(p).sig] = np.nan
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1003,7 +1038,7 @@ def signal_at(p, s, t):
     """Value of signal ``s`` of the network at ``t``: from the cache of the last evaluation if it was at ``t``
     (:func:`refresh_signals`), else :func:`signal_value` itself.  The same value either way: a signal is a
     function of time alone."""
-    o = _offsets(p)[13]
+    o = _offsets(p).sig
     if p.work[o] == t:
         return p.work[o + 1 + s]
     return signal_value(p.signals[s], p.data, t)
@@ -1137,7 +1172,7 @@ def _null_vector(A, ns, S, cp, v, y):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _searched_before(p, A, ns):
     """True if the last null-vector search (:func:`_null_vector_cached`) was of exactly this ``A[:ns, :ns]``."""
-    o = _offsets(p)[15]
+    o = _offsets(p).nv
     nk = _nk(p)
     w = p.work
     if w[o] != ns:
@@ -1153,7 +1188,7 @@ def _searched_before(p, A, ns):
 def _full_rank_known(p, A, ns):
     """True if the last null-vector search was of exactly this ``A`` and found it of full rank (nothing to
     repair)."""
-    return _searched_before(p, A, ns) and p.work[_offsets(p)[15] + 1] == 0.0
+    return _searched_before(p, A, ns) and p.work[_offsets(p).nv + 1] == 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1161,7 +1196,7 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
     """:func:`_null_vector` of ``A[:ns, :ns]``, reusing the last search's result when ``A`` is exactly the matrix it
     searched (a stuck set evaluated again: the same set, the same ``A`` but for speed-dependent gear losses), so the
     answer is the same bit for bit."""
-    o = _offsets(p)[15]
+    o = _offsets(p).nv
     nk = _nk(p)
     w = p.work
     if _searched_before(p, A, ns):
@@ -1323,7 +1358,8 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     n = p.inertia.shape[0]
     nk = _nk(p)
     wk = p.work
-    o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim = _offsets(p)[:8]
+    lay = _offsets(p)
+    o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim = lay.a, lay.m, lay.b, lay.l, lay.c, lay.r, lay.g, lay.lim
     A = shaped(wk[o_a:o_a + nk * nk], (nk, nk))
     b = wk[o_b:o_b + nk]
     lam = wk[o_l:o_l + nk]
@@ -1924,17 +1960,16 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             continue
         # in the gap: the distances to the edges; in contact: the torque over c, signed to be positive in the
         # contact (each falls through zero: contact with that edge; separation, as the torque would pull)
-        lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * (_speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
         if mode == LASH_UPPER_RELEASED or mode == LASH_LOWER_RELEASED:
             # released beyond its edge (a damped contact separated there, moving back): the contact's torque over c,
             # signed to be positive while it would pull (falls through zero: it pushes again, contact), and the
             # distance beyond the edge (falls through zero: into the gap)
-            s_ = 1.0 if mode == LASH_UPPER_RELEASED else -1.0
-            g[q] = -s_ * (phi - s_ * b2 + lag)
-            g[q + 1] = s_ * (phi - s_ * b2)
+            beyond, push = _lash_contact(p, r, x, n, 1.0 if mode == LASH_UPPER_RELEASED else -1.0)
+            g[q] = -push
+            g[q + 1] = beyond
             continue
-        g[q] = phi - b2 + lag if mode == LASH_UPPER else b2 - phi
-        g[q + 1] = -(phi + b2 + lag) if mode == LASH_LOWER else phi + b2
+        g[q] = _lash_contact(p, r, x, n, 1.0)[1] if mode == LASH_UPPER else b2 - phi
+        g[q + 1] = _lash_contact(p, r, x, n, -1.0)[1] if mode == LASH_LOWER else phi + b2
     nsw = p.swit.shape[0]
     hold = _holds(p)
     for j in range(p.lossy.shape[0]):
@@ -2133,8 +2168,7 @@ def driveline_update(t, x, u, m, p, k, log):
             # spring still deflected, its energy stored until it goes to the damper on the way to the edge
             # (spring_torque), or the contact closes again where it would push.  At (or, by the event's bracket,
             # inside) the edge: into the gap, the energy left in the spring (~0) counted as dissipated
-            s_ = 1.0 if side == LASH_UPPER else -1.0
-            if s_ * (_spring_deflection(p, r, x, n) - s_ * 0.5 * p.coef[r, C_GAP]) > 0.0:
+            if _lash_contact(p, r, x, n, 1.0 if side == LASH_UPPER else -1.0)[0] > 0.0:
                 m[nf + j] = LASH_UPPER_RELEASED if side == LASH_UPPER else LASH_LOWER_RELEASED
             else:
                 x[2 * n + r] += spring_energy(p, r, x, n, m)
@@ -2253,12 +2287,8 @@ def check_invariants(t, x, m, p):
         elif p.elem[r, E_LAW] == SPRING_BACKLASH and (m[nf + j] == LASH_UPPER_RELEASED or
                                                        m[nf + j] == LASH_LOWER_RELEASED):
             # released beyond an edge: never where its contact would push (tau / c past zero the contact's way)
-            s_ = 1.0 if m[nf + j] == LASH_UPPER_RELEASED else -1.0
-            b2 = 0.5 * p.coef[r, C_GAP]
-            phi = _spring_deflection(p, r, x, n)
-            w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
-            lag = p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * w_rel
-            if s_ * (phi - s_ * b2 + lag) > 1e-6 * max(1.0, b2) + p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * 1e3 * \
+            _beyond, push = _lash_contact(p, r, x, n, 1.0 if m[nf + j] == LASH_UPPER_RELEASED else -1.0)
+            if push > 1e-6 * max(1.0, 0.5 * p.coef[r, C_GAP]) + p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * 1e3 * \
                     _item_wtol(p, r, x, n):
                 return -(INV_BASE + N_INV * r + INV_GAP)
     if p.check[1] > 0.0:
