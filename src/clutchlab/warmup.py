@@ -68,6 +68,9 @@ def _warm_driveline() -> None:
     d.clutch("c", "J1", "J2", fn_max=1.0, normal=Signal.step(1.0, 0.01))
     d.spring_damper("k", "J2", None, c=1.0, d=0.1)
     d.simulate(0.02, output_step=0.01)
+    from .numerics import outline
+
+    outline.prepare()   # the kernels called through their addresses (stuck-set repair, invariant check)
 
 
 def _warm_control() -> None:

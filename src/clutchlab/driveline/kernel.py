@@ -32,12 +32,18 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.core import types
 
 from ..numerics import dispatch
-from ..numerics.borrow import borrow, shaped
+from ..numerics.borrow import ByRef, borrow, shaped
 from ..numerics.core import record
 from ..numerics.interp import bracket
+from ..numerics.outline import outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
+
+#: an int64 zero: numba types a literal ``0`` (argument or first value of a counter) as ``Literal[int](0)`` and
+#: compiles every callee once more for it, with all of that callee's callees linked in (issue #30's first compilation)
+_ZERO = np.int64(0)
 
 # element kinds (DrivelineParams.elem[:, E_KIND])
 K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = 0, 1, 2, 3, 4
@@ -855,7 +861,7 @@ def evaluate_network(t, x, m, p, acc, tau):
         tau[r] = tq
         _apply(F, Fa, p.elem, r, 1.0, 1.0, tq)
     # sliding and free friction; the constraint set: stuck friction, gears, motion sources
-    ns = 0
+    ns = _ZERO   # (an int64 from the start: a literal 0 would compile the callees once more for it)
     stuck = wk[n:n + _nk(p)]  # element rows of the set (as floats; -(row + 1): a stuck lossy gear's hold)
     for k in range(nf):
         r = p.fric[k]
@@ -893,7 +899,7 @@ def evaluate_network(t, x, m, p, acc, tau):
     for j in range(hold.shape[0]):
         hold[j] = 0.0
     if ns > 0:
-        _solve_stuck(t, x, p, m, stuck, ns, F, tau)
+        _solve_stuck_outlined(t, x, p, m, stuck, ns, F, tau)
     for i in range(n):
         acc[i] = F[i] / p.inertia[i]
     return ns
@@ -1340,6 +1346,21 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     return True
 
 
+def _params_type():
+    """numba type of the :class:`DrivelineParams` reference every kernel function takes (one type for every network)."""
+    i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
+    return ByRef(numba.typeof(DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1)))
+
+
+_F1, _F2, _I1 = types.float64[::1], types.float64[:, ::1], types.int64[::1]
+
+#: :func:`_repair` called through its address (:mod:`clutchlab.numerics.outline`): it runs only where a stuck set is
+#: statically indeterminate, and linked it was compiled again into every function of the core below a hook (13 s of
+#: the driveline's first compilation)
+_repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, _F2, _F2, _I1, _F1, _F1, _F1, _F1, _F1,
+                                              _F1, _F1, types.float64), types.boolean)
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
     """Torques of the constraint set -- stuck friction elements, gears, stuck lossy gears' holds, motion sources
@@ -1450,7 +1471,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         tol = NOISE * (1.0 + big)
         # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
         # v keeps the constraints, v being A's null vector to rounding)
-        _repair(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
+        _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
     hold = _holds(p)
     Fa = _torque_magnitudes(p)
     for k in range(ns):
@@ -1465,6 +1486,13 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
             if i >= 0:
                 F[i] -= hc[3 * k + q] * lam[k]
                 Fa[i] += abs(hc[3 * k + q] * lam[k])
+
+
+#: :func:`_solve_stuck` called through its address (:mod:`clutchlab.numerics.outline`): large beside the rest of an
+#: evaluation of the network, which every function of the core links (4 s of the driveline's first compilation; the
+#: indirect call at each evaluation with a stuck set is within the run time's noise, docs/architecture.md)
+_solve_stuck_outlined = outlined(_solve_stuck, lambda: (types.float64, _F1, _params_type(), _I1, _F1, types.int64, _F1,
+                                                      _F1), types.none)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1701,7 +1729,7 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _apply_subset(p, m, cand, nc, dirs, pick, s):
     for c in range(nc):
-        _item_set(p, m, cand[c], 0)
+        _item_set(p, m, cand[c], _ZERO)
     for q in range(s):
         c = pick[q]
         _item_set(p, m, cand[c], dirs[c])
@@ -1738,7 +1766,7 @@ def settle(t, x, m, p, log, old):
     cand = np.empty(ni, dtype=np.int64)
     dirs = np.zeros(ni, dtype=np.int64)
     exc = np.empty(ni)
-    nc = 0
+    nc = _ZERO
     for i in range(ni):
         if i < nf and m[i] == FREE:
             continue
@@ -1746,7 +1774,7 @@ def settle(t, x, m, p, log, old):
                 _item_passed_rest(p, m, x, n, i):
             cand[nc] = i
             nc += 1
-            _item_set(p, m, i, 0)
+            _item_set(p, m, i, _ZERO)
     _evaluate(t, x, m, p, acc, tau)
     worst = -np.inf
     for c in range(nc):
@@ -1808,10 +1836,10 @@ def settle(t, x, m, p, log, old):
                 break
         if not found:   # release the most overloaded until the rest hold
             for c in range(nc):
-                _item_set(p, m, cand[c], 0)
+                _item_set(p, m, cand[c], _ZERO)
             for _it in range(nc):
                 _evaluate(t, x, m, p, acc, tau)
-                best, bi, bd = -np.inf, -1, 0
+                best, bi, bd = -np.inf, _ZERO - 1, _ZERO
                 for c in range(nc):
                     i = cand[c]
                     if not _item_stuck(p, m, i):
@@ -1855,6 +1883,16 @@ def settle(t, x, m, p, log, old):
             ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
         record(log, t, ev, nf + nsw + j)
     return any_change
+
+
+def _log_type():
+    from ..numerics.core import new_log
+    return numba.typeof(new_log(1))
+
+
+#: :func:`settle` called through its address (:mod:`clutchlab.numerics.outline`): it runs at events only, and linked
+#: it was compiled again into the update and restart hooks and every function of the core that calls them
+_settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_type(), _log_type(), _I1), types.boolean)
 
 
 # ----------------------------------------------------------------- hooks
@@ -2131,7 +2169,7 @@ def driveline_update(t, x, u, m, p, k, log):
             else:   # the other flange drives now
                 m[mi] = (GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_FWD_A if mode == GEAR_FWD_B else
                          GEAR_BWD_B if mode == GEAR_BWD_A else GEAR_BWD_A)
-        settle(t, x, m, p, log, old)
+        _settle_outlined(t, x, m, p, log, old)
         return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // N_SW
@@ -2178,7 +2216,7 @@ def driveline_update(t, x, u, m, p, k, log):
             return 0
         # the torque of a damped contact steps at impact: a stuck element may have to break away now (its
         # break-away function starts the next step beyond zero, which is no crossing)
-        settle(t, x, m, p, log, m.copy())
+        _settle_outlined(t, x, m, p, log, m.copy())
         return 0
     if k % N_G == G_TURN:   # a slow sliding speed's turning point: a step ends there, nothing changes
         return 0
@@ -2186,7 +2224,7 @@ def driveline_update(t, x, u, m, p, k, log):
     kf = k // N_G
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):
         m[kf] = STUCK
-    settle(t, x, m, p, log, old)
+    _settle_outlined(t, x, m, p, log, old)
     return 0
 
 
@@ -2195,7 +2233,7 @@ def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
     :func:`forget_signals`)."""
     forget_signals(p)
-    return settle(t, x, m, p, log, m.copy())
+    return _settle_outlined(t, x, m, p, log, m.copy())
 
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
@@ -2310,12 +2348,17 @@ def check_invariants(t, x, m, p):
     return 0
 
 
+#: :func:`check_invariants` called through its address (:mod:`clutchlab.numerics.outline`): a debugging option, kept
+#: out of the compilation of the accept hook and the core that calls it at every step
+_check_outlined = outlined(check_invariants, lambda: (types.float64, _F1, _I1, _params_type()), types.int64)
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_accept(t, x, u, m, p):
     """Nothing to commit (the network has no memories); with ``check[0]`` set, the invariants
     (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
     if p.check[0] != 0.0:
-        return check_invariants(t, x, m, p)
+        return _check_outlined(t, x, m, p)
     return 0
 
 

@@ -1,0 +1,96 @@
+"""Compiled functions called through their addresses (:mod:`clutchlab.numerics.outline`).
+
+The driveline's event iteration, stuck-set repair and invariant check are called this way so that the functions
+of the core below the hooks do not link (and compile again) their code.  The call must be the one numba makes:
+same result, exceptions reaching the caller's caller; a caller that cannot find the function raises, never calls
+through a bad address; and the caller's code does not contain the function.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numba
+import numpy as np
+import pytest
+from numba.core import types
+
+from clutchlab.numerics import outline
+
+
+@numba.njit
+def _weighted(x, k, out):
+    """A function with an array argument written into, a scalar and a result; raises for a negative ``k``."""
+    if k < 0:
+        raise ValueError("k must be >= 0")
+    s = 0.0
+    for i in range(x.shape[0]):
+        out[i] = x[i] * k
+        s += math.sin(x[i]) * k
+    return s
+
+
+_SIG = (types.float64[::1], types.int64, types.float64[::1])
+_weighted_outlined = outline.outlined(_weighted, lambda: _SIG, types.float64)
+
+
+@numba.njit
+def _caller(x, k, out):
+    return _weighted_outlined(x, k, out) + 1.0
+
+
+@numba.njit
+def _caller_other_types(x, k, out):
+    # a float k is not the outlined signature: an ordinary linked call
+    return _weighted_outlined(x, float(k), out) + 1.0
+
+
+def test_a_call_through_the_address_is_the_call_numba_makes():
+    x = np.linspace(0.0, 1.0, 7)
+    out = np.zeros(7)
+    assert _caller(x, 3, out) == pytest.approx(3.0 * np.sin(x).sum() + 1.0, rel=1e-15)
+    np.testing.assert_array_equal(out, 3 * x)
+    with pytest.raises(ValueError, match="k must be >= 0"):
+        _caller(x, -1, out)
+
+
+def test_the_caller_does_not_contain_the_function():
+    x, out = np.zeros(3), np.zeros(3)
+    _caller(x, 1, out)
+    ir = next(iter(_caller.inspect_llvm().values()))
+    assert outline.RESOLVE_SYMBOL in ir
+    defines = re.compile(r"_ZN\w*9_weightedB")   # the function's compiled name: defined, or inlined (its metadata)
+    assert not defines.search(ir)   # the outlined function's body is not in its caller
+    _caller_other_types(x, 1, out)
+    assert defines.search(next(iter(_caller_other_types.inspect_llvm().values())))   # other types: linked
+
+
+def test_a_caller_that_cannot_find_the_function_raises():
+    @numba.njit
+    def lost(x, k, out):
+        return x[0] * k
+
+    sig = (types.float64[::1], types.int64, types.float64[::1])
+    stub = outline.outlined(lost, lambda: sig, types.float64)
+
+    @numba.njit
+    def caller(x, k, out):
+        return stub(x, k, out)
+
+    x = np.ones(2)
+    caller.compile((types.float64[::1], types.int64, types.float64[::1]))
+    # the function is no longer known in this process (a cached caller older than the code): a clean error
+    outline._ENTRIES.remove(next(e for e in outline._ENTRIES if e.dispatcher is lost))
+    with pytest.raises(RuntimeError, match="not available in this process"):
+        caller(x, 2, x)
+    assert outline._resolve(12345) == 0
+
+
+def test_prepare_compiles_every_outlined_function_of_the_driveline():
+    from clutchlab.driveline import kernel as K
+
+    outline.prepare()
+    for fn in (K._repair, K.settle, K.check_invariants):
+        entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
+        assert entry.sig() in fn.overloads
