@@ -25,6 +25,7 @@ import numpy as np
 
 from .._limits import check_number
 from ..errors import ParameterError
+from ..numerics import outline
 from ..system import System, register_model, simulate as _simulate
 from . import kernel as K
 
@@ -1450,6 +1451,9 @@ class Driveline:
         accepted step (:func:`~clutchlab.driveline.kernel.check_invariants`; the energy balance to ``max(1e-7, 1000
         rtol)`` of the energy that flowed plus 1 J); a violation ends the run with a
         :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time."""
+        # the kernel functions called through their addresses, compiled or loaded here, on the calling thread: a
+        # batch's worker threads then only look their addresses up (clutchlab.numerics.outline)
+        outline.prepare()
         p = self.pack()
         if check_invariants:
             p.check[0] = 1.0

@@ -97,7 +97,8 @@ ll.add_symbol(RESOLVE_SYMBOL, ctypes.cast(_CALLBACK, ctypes.c_void_p).value)
 
 
 def prepare() -> None:
-    """Compile (or load from numba's cache) every outlined function now (``clutchlab warmup``)."""
+    """Compile (or load from numba's cache) every outlined function now, on the calling thread (``clutchlab
+    warmup``; a driveline's :meth:`~clutchlab.driveline.Driveline.system`).  Cheap once done in a process."""
     for e in _ENTRIES:
         if not native_address(e.dispatcher, e.sig(), e.returns):
             raise TypeError(f"{e.label}{e.sig()} does not return {e.returns}")
