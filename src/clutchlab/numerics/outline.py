@@ -14,13 +14,15 @@ How the address is found: each caller's code keeps it in a private global, NULL 
 call, it asks :func:`_resolve` -- a C callback registered with LLVM under one fixed symbol when this module
 is imported (no compilation at import) -- for the function whose key (a hash of its qualified name and
 signature, the same in every process) it was compiled for.  The callback compiles or loads that overload
-(:func:`prepare`, which ``clutchlab warmup`` calls ahead) and returns its native address, the one numba
-itself calls.  A key it does not know (a cached caller older than the function) or a compilation that
+and returns its native address, the one numba itself calls (:func:`prepare` does so ahead, on the calling
+thread: ``clutchlab warmup`` and every driveline's ``system()``).  A key it does not know (a cached caller older than the function) or a compilation that
 fails make the call raise ``RuntimeError`` in the caller, never a call through a bad address.
 
 The call is the one numba would make (its calling convention: status, exception and return value), so an
 exception raised in the function reaches the caller's caller as usual.  The cost per call is a load, a
-test and an indirect call: only for functions called at events, never on a step's path.
+test and an indirect call, and the function is never inlined into its caller: worth it for functions called
+at events, or large beside their call (the driveline's stuck-set solve, called at each evaluation of a
+network with a stuck set: its run time did not move beyond the noise, docs/architecture.md).
 """
 
 from __future__ import annotations
