@@ -94,3 +94,36 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
     for fn in (K._repair, K.settle, K.check_invariants):
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
+
+
+_NETWORKS = r"""
+import json
+from pathlib import Path
+from clutchlab.driveline import kernel as K
+from clutchlab.driveline.description import load_driveline
+from clutchlab.numerics import outline
+for name in ("coupled_clutches", "wet_sae2", "emtc_awd", "eclutch_launch"):
+    load_driveline(Path(r"{examples}") / f"driveline_{{name}}.toml").driveline.simulate(0.05, check_invariants=True)
+out = {{}}
+for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants):
+    entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
+    out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
+print(json.dumps(out))
+"""
+
+
+def test_the_example_networks_call_the_driveline_through_the_outlined_signatures():
+    """Plain, wet and EMTC networks call the outlined functions with the very types they are outlined for: a
+    signature drift (a new field of the parameter structure, another log type) would link them again silently,
+    compiled once more in every function of the core.  (A fresh process: tests here call kernel functions directly.)"""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    proc = subprocess.run([sys.executable, "-c", _NETWORKS.format(examples=examples)], capture_output=True,
+                          text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out == {name: [True] for name in ("settle", "_solve_stuck", "_repair", "check_invariants")}, out

@@ -210,7 +210,7 @@ def emtc_driveline_update(t, x, u, m, p, k, log):
     if res < 0:
         return res
     _coupling(t, x, m, p)
-    K._settle_outlined(t, x, m, byref(p.net), log, m.copy())
+    K.settle_outlined(t, x, m, byref(p.net), log, m.copy())
     _sync(x, m, p)
     return res
 

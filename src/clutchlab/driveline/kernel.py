@@ -1892,7 +1892,7 @@ def _log_type():
 
 #: :func:`settle` called through its address (:mod:`clutchlab.numerics.outline`): it runs at events only, and linked
 #: it was compiled again into the update and restart hooks and every function of the core that calls them
-_settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_type(), _log_type(), _I1), types.boolean)
+settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_type(), _log_type(), _I1), types.boolean)
 
 
 # ----------------------------------------------------------------- hooks
@@ -2169,7 +2169,7 @@ def driveline_update(t, x, u, m, p, k, log):
             else:   # the other flange drives now
                 m[mi] = (GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_FWD_A if mode == GEAR_FWD_B else
                          GEAR_BWD_B if mode == GEAR_BWD_A else GEAR_BWD_A)
-        _settle_outlined(t, x, m, p, log, old)
+        settle_outlined(t, x, m, p, log, old)
         return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // N_SW
@@ -2216,7 +2216,7 @@ def driveline_update(t, x, u, m, p, k, log):
             return 0
         # the torque of a damped contact steps at impact: a stuck element may have to break away now (its
         # break-away function starts the next step beyond zero, which is no crossing)
-        _settle_outlined(t, x, m, p, log, m.copy())
+        settle_outlined(t, x, m, p, log, m.copy())
         return 0
     if k % N_G == G_TURN:   # a slow sliding speed's turning point: a step ends there, nothing changes
         return 0
@@ -2224,7 +2224,7 @@ def driveline_update(t, x, u, m, p, k, log):
     kf = k // N_G
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):
         m[kf] = STUCK
-    _settle_outlined(t, x, m, p, log, old)
+    settle_outlined(t, x, m, p, log, old)
     return 0
 
 
@@ -2233,7 +2233,7 @@ def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
     :func:`forget_signals`)."""
     forget_signals(p)
-    return _settle_outlined(t, x, m, p, log, m.copy())
+    return settle_outlined(t, x, m, p, log, m.copy())
 
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is

@@ -16,7 +16,8 @@ is imported (no compilation at import) -- for the function whose key (a hash of 
 signature, the same in every process) it was compiled for.  The callback compiles or loads that overload
 and returns its native address, the one numba itself calls (:func:`prepare` does so ahead, on the calling
 thread: ``clutchlab warmup`` and every driveline's ``system()``).  A key it does not know (a cached caller older than the function) or a compilation that
-fails make the call raise ``RuntimeError`` in the caller, never a call through a bad address.
+fails make the call raise :class:`~clutchlab.errors.SimulationError` (a ``RuntimeError``) in the caller, never a
+call through a bad address.
 
 The call is the one numba would make (its calling convention: status, exception and return value), so an
 exception raised in the function reaches the caller's caller as usual.  The cost per call is a load, a
@@ -35,6 +36,7 @@ from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
+from ..errors import SimulationError
 from .session import native_address
 
 __all__ = ["outlined", "prepare", "RESOLVE_SYMBOL"]
@@ -42,7 +44,7 @@ __all__ = ["outlined", "prepare", "RESOLVE_SYMBOL"]
 #: the resolving callback's symbol (a new version of this protocol takes a new name)
 RESOLVE_SYMBOL = "clutchlab_outline_resolve_v1"
 
-#: key -> the text of the last failure to resolve it (for a debugger; the caller raises RuntimeError)
+#: key -> the text of the last failure to resolve it (for a debugger; the caller raises SimulationError)
 _ERRORS: dict = {}
 
 
@@ -89,7 +91,7 @@ def _resolve(key: int) -> int:
         if not address:
             _ERRORS[key] = f"{e.label}{e.sig()} does not return {e.returns}"
         return address
-    except BaseException as exc:  # noqa: BLE001 -- reported by the caller as RuntimeError
+    except BaseException as exc:  # noqa: BLE001 -- reported by the caller as SimulationError
         _ERRORS[key] = f"{type(exc).__name__}: {exc}"
         return 0
 
@@ -123,7 +125,7 @@ def _codegen_call(context, builder, key, label, returns, argtys, args):
         builder.store(found, cell)
         with builder.if_then(cgutils.is_null(builder, found), likely=False):
             context.call_conv.return_user_exc(
-                builder, RuntimeError,
+                builder, SimulationError,
                 (f"clutchlab: the compiled function {label} is not available in this process "
                  "(clutchlab.numerics.outline; clear numba's cache if clutchlab was updated)",))
     fnty = context.call_conv.get_function_type(returns, argtys)
