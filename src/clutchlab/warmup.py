@@ -67,10 +67,7 @@ def _warm_driveline() -> None:
     d.torque("T", "J1", Signal.sine(1.0, 5.0))
     d.clutch("c", "J1", "J2", fn_max=1.0, normal=Signal.step(1.0, 0.01))
     d.spring_damper("k", "J2", None, c=1.0, d=0.1)
-    d.simulate(0.02, output_step=0.01)
-    from .numerics import outline
-
-    outline.prepare()   # the kernels called through their addresses (stuck-set repair, invariant check)
+    d.simulate(0.02, output_step=0.01)   # (its system() also prepares the kernels called through their addresses)
 
 
 def _warm_control() -> None:

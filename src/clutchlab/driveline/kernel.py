@@ -36,7 +36,7 @@ from numba.core import types
 
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
-from ..numerics.core import record
+from ..numerics.core import new_log, record
 from ..numerics.interp import bracket
 from ..numerics.outline import outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -1886,7 +1886,6 @@ def settle(t, x, m, p, log, old):
 
 
 def _log_type():
-    from ..numerics.core import new_log
     return numba.typeof(new_log(1))
 
 
