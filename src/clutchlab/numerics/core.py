@@ -20,7 +20,10 @@ Both share the hybrid logic:
   watched; a crossing in the direction ``Options.gdir[k]`` (+1 rising
   through zero, -1 falling, 0 either; a start exactly on zero does not
   count) is located by root finding (Illinois) on the step's dense output,
-  the step is cut at the earliest root, and the model's ``update`` is called
+  the step is cut at the earliest root (Dormand-Prince: moved to where the
+  function crosses on the step's own order-5 solution of that length, the
+  state the run restarts from, :func:`_root_on_step`; Rodas3: one step of
+  the located length), and the model's ``update`` is called
   for every function that crossed there, which changes the modes and records
   named events (:func:`record`);
 * ``next_break`` times (input table corners, controller samples) end a step
@@ -346,6 +349,145 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
     return hi, n_rhs
 
 
+@register_jitable
+def _step_state(p, t, th, h, x, k1, u, m, Ks, xt, out, fe, ge):
+    """The Dormand-Prince order-5 solution of a step of ``th * h`` from ``(t, x)`` (slope ``k1``) into ``out``, and
+    the right-hand side and switching functions there into ``fe``, ``ge`` (6 evaluations: the stages 2-6 and the
+    end point; the error estimate is not needed: the fraction of an accepted step is as accurate as the step)."""
+    n = x.shape[0]
+    hh = th * h
+    k2 = Ks[0]
+    k3 = Ks[1]
+    k4 = Ks[2]
+    k5 = Ks[3]
+    k6 = Ks[4]
+    for i in range(n):
+        xt[i] = x[i] + hh * (A21 * k1[i])
+    model.rhs(t + C2 * hh, xt, u, m, p, k2, ge)
+    for i in range(n):
+        xt[i] = x[i] + hh * (A31 * k1[i] + A32 * k2[i])
+    model.rhs(t + C3 * hh, xt, u, m, p, k3, ge)
+    for i in range(n):
+        xt[i] = x[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+    model.rhs(t + C4 * hh, xt, u, m, p, k4, ge)
+    for i in range(n):
+        xt[i] = x[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+    model.rhs(t + C5 * hh, xt, u, m, p, k5, ge)
+    for i in range(n):
+        xt[i] = x[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+    model.rhs(t + hh, xt, u, m, p, k6, ge)
+    for i in range(n):
+        out[i] = x[i] + hh * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+    model.rhs(t + hh, out, u, m, p, fe, ge)
+
+
+@register_jitable
+def _illinois_step(p, t, h, x, k1, u, m, event_tol, Ks, xt, xs, fe, ge, k, lo, hi, glo, ghi, gref, gdir_k):
+    """:func:`_illinois` on the step's own solution (:func:`_step_state` of the fraction): ``(theta, n_rhs)``,
+    ``theta`` the bracket end just past the root of switching function ``k``."""
+    n_rhs = 0
+    side = 0
+    for _it in range(200):
+        if (hi - lo) * h <= event_tol:
+            break
+        if glo != ghi and _it < 40:
+            th = lo + (hi - lo) * glo / (glo - ghi)
+        else:
+            th = 0.5 * (lo + hi)
+        span = hi - lo
+        th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
+        _step_state(p, t, th, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+        n_rhs += 6
+        if _crossed(gref, ge[k], gdir_k):
+            hi = th
+            ghi = ge[k]
+            if side == 1:
+                glo *= 0.5
+            side = 1
+        else:
+            lo = th
+            glo = ge[k]
+            if side == -1:
+                ghi *= 0.5
+            side = -1
+    return hi, n_rhs
+
+
+@register_jitable
+def _root_on_step(p, t, h, x, k1, x1, g0, g1, ga, gdir, u, m, event_tol, theta, Ks, xt, xs, fe, ge, gs):
+    """The event located on the step's own solution: the root ``theta`` found on the dense output moved to where the
+    switching functions cross on :func:`_step_state` of the fraction, so that the state a run restarts from is an
+    order-5 solution on which the crossing shows (the dense output's order-4 error, which the step control does not
+    see, is not carried past the event: docs/driveline.md "Energy").
+
+    ``(theta, n_rhs, ok)``: ``ok`` False leaves the dense output's root and state (a crossing that the step's
+    solution does not show at all: a dip through zero seen on the dense output only).  ``xs`` receives the state.
+    """
+    ng = g0.shape[0]
+    n_rhs = 0
+    if theta >= 1.0:
+        return theta, 0, False
+    _step_state(p, t, theta, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+    n_rhs += 6
+    any_crossed = False
+    for k in range(ng):
+        gs[k] = ge[k]
+        if _crossed(ga[k], ge[k], gdir[k]):
+            any_crossed = True
+    if any_crossed:
+        # crossed at theta on the step too: is the root on the step earlier than the bracket's other end?
+        for _round in range(4):
+            lo = theta - 2.0 * event_tol / h
+            if lo <= 1e-6:
+                return theta, n_rhs, True
+            _step_state(p, t, lo, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+            n_rhs += 6
+            kk = -1
+            for k in range(ng):
+                if _crossed(ga[k], ge[k], gdir[k]):
+                    kk = k
+                    break
+            if kk < 0:
+                _step_state(p, t, theta, h, x, k1, u, m, Ks, xt, xs, fe, ge)   # (the state at theta again)
+                n_rhs += 6
+                return theta, n_rhs, True
+            start = 1e-6 if g0[kk] == 0.0 else 0.0
+            th, nr = _illinois_step(p, t, h, x, k1, u, m, event_tol, Ks, xt, xs, fe, ge, kk, start, lo, ga[kk],
+                                    ge[kk], ga[kk], gdir[kk])
+            n_rhs += nr
+            theta = th
+            _step_state(p, t, theta, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+            n_rhs += 6
+        return theta, n_rhs, True
+    # not crossed yet on the step: the root on the step lies after theta, for a function that crossed by its end
+    best = 2.0
+    for k in range(ng):
+        if not _crossed(ga[k], g1[k], gdir[k]):
+            continue
+        hi = 1.0 if best > 1.0 else best
+        ghi = g1[k]
+        if best <= 1.0:
+            _step_state(p, t, hi, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+            n_rhs += 6
+            if not _crossed(ga[k], ge[k], gdir[k]):
+                continue
+            ghi = ge[k]
+        th, nr = _illinois_step(p, t, h, x, k1, u, m, event_tol, Ks, xt, xs, fe, ge, k, theta, hi, gs[k], ghi,
+                                ga[k], gdir[k])
+        n_rhs += nr
+        if th < best:
+            best = th
+    if best > 1.0:
+        return theta, n_rhs, False
+    if best >= 1.0:
+        for i in range(x.shape[0]):
+            xs[i] = x1[i]
+        return 1.0, n_rhs, True
+    _step_state(p, t, best, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+    n_rhs += 6
+    return best, n_rhs, True
+
+
 @register_jitable(forceinline=True)
 def _apply_updates(p, t, x, u, m, g0, g1, gdir, log):
     """Call the model's ``update`` for every switching function that crossed.
@@ -483,9 +625,12 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     ge = np.empty(ng)
     ga = np.empty(ng)
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
+    Ks = np.empty((5, n))
+    xs = np.empty(n)
+    gs = np.empty(ng)
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c)
-    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs)
+    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs = borrow(owners)
     k1 = K[0]
     k2 = K[1]
     k3 = K[2]
@@ -612,6 +757,12 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if samples:
                 dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
         si[SI_NRHS] += nr
+        on_step = False
+        if theta < 1.0:
+            # the root moved to the step's own solution, the state the run restarts from
+            theta, nr, on_step = _root_on_step(p, t, h, x, k1, xn, g0, g1, ga, opt.gdir, u, m, opt.event_tol, theta,
+                                               Ks, xt, xs, fe, ge, gs)
+            si[SI_NRHS] += nr
         if theta <= 1.0:
             t_new = t + theta * h
         elif last:
@@ -620,13 +771,24 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             t_new = t + h
         # ---- samples in (t, t_new] on the dense output (modes of the step; the test here saves a call per step)
         if samples and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-            i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                                  want_y, xe, i_rec)
+            if on_step and theta < 1.0:
+                # on the dense output of the step to the event (its stages are in Ks, its end slope in fe), which
+                # ends on the state the run restarts from: samples and restart on one solution
+                dense_correction(theta * h, k1, Ks[1], Ks[2], Ks[3], Ks[4], fe, rc)
+                i_rec = _record_dense(p, t, theta * h, x, k1, xs, fe, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m,
+                                      rec_y, want_y, xe, i_rec)
+            else:
+                i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                                      want_y, xe, i_rec)
         si[SI_ACCEPTED] += 1
         if theta <= 1.0:
-            _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
-            for i in range(n):
-                x[i] = xe[i]
+            if on_step:
+                for i in range(n):
+                    x[i] = xs[i]
+            else:
+                _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
+                for i in range(n):
+                    x[i] = xe[i]
             t = t_new
             model.rhs(t, x, u, m, p, fe, g1)
             si[SI_NRHS] += 1
