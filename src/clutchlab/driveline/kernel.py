@@ -926,6 +926,7 @@ class WorkLayout(NamedTuple):
     hold: int
     sig: int
     nv: int
+    inst: int
     ext: int
 
 
@@ -938,7 +939,9 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
     inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
     (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
-    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
+    instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
+    modes before it (2 + nf + nl, :func:`settle`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | initial stored energy (1).  Returns the offsets as a :class:`WorkLayout`."""
     o_a = n + nk
     o_m = o_a + nk * nk
@@ -955,9 +958,10 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_hold = o_fabs + n
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
-    o_ext = o_nv + 2 + nk * nk + nk
+    o_inst = o_nv + 2 + nk * nk + nk
+    o_ext = o_inst + 2 + nf + nl
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
-                      o_ext)
+                      o_inst, o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
@@ -970,7 +974,9 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
     work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig))
-    work[_layout.py_func(n, nk, ne, nf, nl, nsig).sig] = np.nan
+    lay = _layout.py_func(n, nk, ne, nf, nl, nsig)
+    work[lay.sig] = np.nan
+    work[lay.inst] = np.nan
     return work
 
 
@@ -1012,6 +1018,14 @@ def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
     return borrow(p.work[o.fabs:o.fabs + p.inertia.shape[0]])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _instant(p):
+    """The instant [s] of the last stick/slip search, the event count before it, and the modes of the friction
+    elements and lossy gears before it (:func:`settle`)."""
+    o = _offsets(p)
+    return borrow(p.work[o.inst:o.inst + 2 + p.fric.shape[0] + p.lossy.shape[0]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1735,6 +1749,47 @@ def _apply_subset(p, m, cand, nc, dirs, pick, s):
         _item_set(p, m, cand[c], dirs[c])
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _one_search_per_instant(t, m, p, log, old):
+    """Several switching functions crossing at one instant call :func:`settle` once each (the core updates every
+    crossed function); each search must then start from the modes before the instant, not from those the one
+    before left, and its events replace the earlier search's: the result is one search over every function's own
+    change, independent of their order (a second search from the first's modes could undo it: a gear put stuck by
+    the first released by the second).  The first search at a new instant stores the friction elements' and lossy
+    gears' modes in ``old`` and the event count; a later one at the same instant puts them back into ``old`` and
+    drops the events the earlier searches recorded (theirs only: a backlash's contact is kept).  A restart (a
+    run's start, a resume, a signal's jump) begins a new instant (:func:`driveline_restart`)."""
+    nf = p.fric.shape[0]
+    nl = p.lossy.shape[0]
+    nsw = p.swit.shape[0]
+    inst = _instant(p)
+    if inst[0] == t:
+        for k in range(nf):
+            old[k] = np.int64(inst[2 + k])
+        for j in range(nl):
+            old[p.elem[p.lossy[j], E_MODE]] = np.int64(inst[2 + nf + j])
+        n0 = np.int64(inst[1])
+        w = n0
+        for q in range(n0, log.count[0]):
+            e = log.element[q]
+            c = log.code[q]
+            ours = ((e >= 0 and e < nf and c <= EV_FREE) or
+                    (e >= nf + nsw and e < nf + nsw + nl and (c <= EV_BACKWARD or c == EV_DRIVE_A or c == EV_DRIVE_B)))
+            if not ours:
+                log.time[w] = log.time[q]
+                log.code[w] = log.code[q]
+                log.element[w] = log.element[q]
+                w += 1
+        log.count[0] = w
+        return
+    inst[0] = t
+    inst[1] = float(log.count[0])
+    for k in range(nf):
+        inst[2 + k] = float(old[k])
+    for j in range(nl):
+        inst[2 + nf + j] = float(old[p.elem[p.lossy[j], E_MODE]])
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def settle(t, x, m, p, log, old):
     """Modes consistent with the forces at ``t`` (the event iteration of MSL's friction elements and ``LossyGear``).
@@ -1753,6 +1808,7 @@ def settle(t, x, m, p, log, old):
     nl = p.lossy.shape[0]
     nsw = p.swit.shape[0]
     acc, tau = _acc_tau(p)
+    _one_search_per_instant(t, m, p, log, old)
     for k in range(nf):
         r = p.fric[k]
         if _is_free(p, r, t):
@@ -2233,6 +2289,7 @@ def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
     :func:`forget_signals`)."""
     forget_signals(p)
+    _instant(p)[0] = np.nan   # a new instant (:func:`_one_search_per_instant`)
     return settle_outlined(t, x, m, p, log, m.copy())
 
 
