@@ -254,7 +254,11 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     bearing broke away at 0.7701 s, g1 was released backward with its speed 1.0001e-9 the other way, just beyond
     the rounding width 1e-9: its stick function started below zero and never crossed, and g1 rolled forward in
     its backward mode (the compiled check stopped the run at rtol 1e-9, not at 1e-6 or 1e-11).  Now the slack of
-    a released item covers the drift: the same 30 mode changes at every tolerance, the invariants at every step."""
+    a released item covers the drift: the same mode changes at every tolerance, the invariants at every step.
+    At each break-away of the bearing the gears carry ~1e-12 N m, within their rounding bands: whether they stay
+    stuck or roll on with the bearing is decided by where their load goes (``kernel._tie_breaks``: beyond their
+    band within ``T_TIE`` = 10 ns, so they roll at once; before it, they stayed stuck for 1.6 ps in one run and
+    rolled in another).  35 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11."""
     d = Driveline("self_locking_pair")
     d.inertia("J0", J=0.5625).inertia("J1", J=1.0).inertia("J2", J=2.0)
     d.gear("g0", "J0", "J1", ratio=-0.30078125, efficiency=0.5)
@@ -264,7 +268,7 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True).events for rtol in (1e-6, 1e-9, 1e-11)]
     for ev in runs:
         assert list(zip(ev["element"], ev["event"])) == list(zip(runs[-1]["element"], runs[-1]["event"]))
-        assert len(ev) == 30
+        assert len(ev) == 35
         assert np.max(np.abs(ev["time_s"].to_numpy() - runs[-1]["time_s"].to_numpy())) < 1e-6
 
 

@@ -1851,9 +1851,10 @@ T_TIE = 1e-8
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     """Second order: a stuck candidate at its limit to the rounding of the forces holds or breaks away by which
-    way its load moves.  Every stuck candidate within 1e-3 of its limit is probed at ``t + dt`` (angles and speeds
-    advanced by the speeds and accelerations of the decided modes); one whose excess reaches zero within
-    :data:`T_TIE` at its rate is marked in ``forced`` (then released by the search).  Without this the decision
+    way its load moves (a gear carrying 1e-12 N m is within its rounding band whatever its margin).  Every stuck
+    candidate is evaluated again at ``t + T_TIE`` (angles and speeds advanced by the speeds and accelerations of
+    the decided modes, an error of order ``T_TIE**2``); one beyond what it holds there is marked in ``forced``
+    (then released by the search).  Without this the decision
     at such an instant followed the sign the rounding left, so it changed with the tolerance or with an unrelated
     element (a self-locking gear stuck for 1.6 ps, or 0.6 ns, in one run and rolling in the other: issue #30).
     True if one was marked; ``acc`` and ``tau`` are those of the decided modes at ``t`` on return."""
@@ -1864,14 +1865,14 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
         i = cand[c]
         if forced[i] == 0 and _item_stuck(p, m, i):
             ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-            if -1e-3 < ex < 0.0:
+            if ex < 0.0:
                 near = True
     if not near:
         return False
     exs = np.empty(nc)
     for c in range(nc):
         exs[c] = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))[0]
-    dt = 1e-6
+    dt = T_TIE
     for q in range(xp.shape[0]):
         xp[q] = x[q]
     for j in range(n):
@@ -1882,11 +1883,10 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     for c in range(nc):
         i = cand[c]
         ex0 = exs[c]
-        if forced[i] != 0 or not _item_stuck(p, m, i) or not (-1e-3 < ex0 < 0.0):
+        if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0:
             continue
         ex1, _d = _item_excess(t + dt, p, tau, i, not _item_stuck(p, old, i))
-        rate = (ex1 - ex0) / dt
-        if rate > 0.0 and ex0 + rate * T_TIE >= 0.0:
+        if ex1 >= 0.0:
             forced[i] = 1
             marked = True
     _evaluate(t, x, m, p, acc, tau)
