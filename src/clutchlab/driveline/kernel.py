@@ -1854,7 +1854,8 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     way its load moves (a gear carrying 1e-12 N m is within its rounding band whatever its margin).  Every stuck
     candidate is evaluated again at ``t + T_TIE`` (angles and speeds advanced by the speeds and accelerations of
     the decided modes, an error of order ``T_TIE**2``); one beyond what it holds there is marked in ``forced``
-    (then released by the search).  Without this the decision
+    (then released by the search).  Against what a stuck element holds (a clutch model's static limit), not what
+    it needs to lock up (its lock-up limit: the search decides that at the instant itself).  Without this the decision
     at such an instant followed the sign the rounding left, so it changed with the tolerance or with an unrelated
     element (a self-locking gear stuck for 1.6 ps, or 0.6 ns, in one run and rolling in the other: issue #30).
     True if one was marked; ``acc`` and ``tau`` are those of the decided modes at ``t`` on return."""
@@ -1864,14 +1865,14 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     for c in range(nc):
         i = cand[c]
         if forced[i] == 0 and _item_stuck(p, m, i):
-            ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+            ex, _d = _item_excess(t, p, tau, i, False)
             if ex < 0.0:
                 near = True
     if not near:
         return False
     exs = np.empty(nc)
     for c in range(nc):
-        exs[c] = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))[0]
+        exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
     dt = T_TIE
     for q in range(xp.shape[0]):
         xp[q] = x[q]
@@ -1885,7 +1886,7 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
         ex0 = exs[c]
         if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0:
             continue
-        ex1, _d = _item_excess(t + dt, p, tau, i, not _item_stuck(p, old, i))
+        ex1, _d = _item_excess(t + dt, p, tau, i, False)
         if ex1 >= 0.0:
             forced[i] = 1
             marked = True
