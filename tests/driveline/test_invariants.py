@@ -258,18 +258,21 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     At each break-away of the bearing the gears carry ~1e-12 N m, within their rounding bands: whether they stay
     stuck or roll on with the bearing is decided by where their load goes (``kernel._tie_breaks``: beyond their
     band within ``T_TIE`` = 10 ns, so they roll at once; before it, they stayed stuck for 1.6 ps in one run and
-    rolled in another).  35 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11."""
+    rolled in another).  23 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11 (the gears' changes of driving
+    flange, ``a_drives``/``b_drives``, left out as in the random networks below: at 1e-12 N m they are located
+    to the rounding floor and may come or go with the step sequence)."""
     d = Driveline("self_locking_pair")
     d.inertia("J0", J=0.5625).inertia("J1", J=1.0).inertia("J2", J=2.0)
     d.gear("g0", "J0", "J1", ratio=-0.30078125, efficiency=0.5)
     d.gear("g1", "J1", "J2", ratio=-1.0, efficiency=0.25)
     d.bearing_friction("bearing", "J0", torque=0.25, peak=1.0)
     d.torque("T0", "J0", Signal.sine(1.0, 2.0))
-    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True).events for rtol in (1e-6, 1e-9, 1e-11)]
+    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in (1e-6, 1e-9, 1e-11)]
+    runs = [_mode_events(r) for r in runs]
     for ev in runs:
-        assert list(zip(ev["element"], ev["event"])) == list(zip(runs[-1]["element"], runs[-1]["event"]))
-        assert len(ev) == 35
-        assert np.max(np.abs(ev["time_s"].to_numpy() - runs[-1]["time_s"].to_numpy())) < 1e-6
+        assert [e[1:] for e in ev] == [e[1:] for e in runs[-1]]
+        assert len(ev) == 23
+        assert max(abs(a[0] - b[0]) for a, b in zip(ev, runs[-1])) < 1e-6
 
 
 def test_the_energy_balance_at_events_follows_the_tolerance():

@@ -1848,11 +1848,30 @@ def _decide(t, x, m, p, old, cand, nc, dirs, exc, forced, acc, tau):
 T_TIE = 1e-8
 
 
+#: a stuck item whose margin to its limit is below this many rounding floors (:func:`_item_noise`: 1e-6 of the
+#: torques on its inertias) is decided by where its load goes (:func:`_tie_breaks`)
+TIE_BAND = 1e6
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _near_limit(t, p, tau, i):
+    """True if stuck item ``i`` holds within :data:`TIE_BAND` rounding floors of its limit (a friction element's
+    holding limit; a lossy gear's band edge) at the last evaluation."""
+    nf = p.fric.shape[0]
+    r = _item_row(p, i)
+    noise = _item_noise(p, r, tau)
+    if i < nf:
+        tq = tau[r]
+        return max(holding_limit(p, r, t, tq), noise) - abs(tq) < TIE_BAND * noise
+    margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
+    return margin < TIE_BAND * noise
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     """Second order: a stuck candidate at its limit to the rounding of the forces holds or breaks away by which
     way its load moves (a gear carrying 1e-12 N m is within its rounding band whatever its margin).  Every stuck
-    candidate is evaluated again at ``t + T_TIE`` (angles and speeds advanced by the speeds and accelerations of
+    candidate within :data:`TIE_BAND` of its limit (:func:`_near_limit`) is evaluated again at ``t + T_TIE`` (angles and speeds advanced by the speeds and accelerations of
     the decided modes, an error of order ``T_TIE**2``); one beyond what it holds there is marked in ``forced``
     (then released by the search).  Against what a stuck element holds (a clutch model's static limit), not what
     it needs to lock up (its lock-up limit: the search decides that at the instant itself).  Without this the decision
@@ -1864,15 +1883,15 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     near = False
     for c in range(nc):
         i = cand[c]
-        if forced[i] == 0 and _item_stuck(p, m, i):
-            ex, _d = _item_excess(t, p, tau, i, False)
-            if ex < 0.0:
-                near = True
+        if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
+            near = True
     if not near:
         return False
     exs = np.empty(nc)
+    near_ = np.zeros(nc, dtype=np.bool_)
     for c in range(nc):
         exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
+        near_[c] = _near_limit(t, p, tau, cand[c])
     dt = T_TIE
     for q in range(xp.shape[0]):
         xp[q] = x[q]
@@ -1884,7 +1903,7 @@ def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
     for c in range(nc):
         i = cand[c]
         ex0 = exs[c]
-        if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0:
+        if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
             continue
         ex1, _d = _item_excess(t + dt, p, tau, i, False)
         if ex1 >= 0.0:
