@@ -256,7 +256,7 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     its backward mode (the compiled check stopped the run at rtol 1e-9, not at 1e-6 or 1e-11).  Now the slack of
     a released item covers the drift: the same mode changes at every tolerance, the invariants at every step.
     At each break-away of the bearing the gears carry ~1e-12 N m, within their rounding bands: whether they stay
-    stuck or roll on with the bearing is decided by where their load goes (``kernel._tie_breaks``: beyond their
+    stuck or roll on with the bearing is decided by where their load goes (the tie-break in ``kernel.settle``: beyond their
     band within ``T_TIE`` = 10 ns, so they roll at once; before it, they stayed stuck for 1.6 ps in one run and
     rolled in another).  23 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11 (the gears' changes of driving
     flange, ``a_drives``/``b_drives``, left out as in the random networks below: at 1e-12 N m they are located

@@ -1751,105 +1751,12 @@ def _apply_subset(p, m, cand, nc, dirs, pick, s):
         _item_set(p, m, cand[c], dirs[c])
 
 
-@numba.njit(cache=True, nogil=True, _nrt=True)
-def _decide(t, x, m, p, old, cand, nc, dirs, exc, forced, acc, tau):
-    """The stick/slip search of :func:`settle` over the candidates (every one stuck first; ``forced`` items count
-    as overloaded)."""
-    nf = p.fric.shape[0]
-    for c in range(nc):
-        _item_set(p, m, cand[c], _ZERO)
-    _evaluate(t, x, m, p, acc, tau)
-    worst = -np.inf
-    for c in range(nc):
-        ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
-        if forced[cand[c]] != 0:   # it would break away within T_TIE (_tie_breaks): overloaded
-            ex = max(ex, 0.0)
-        if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
-            a = _item_acc(p, acc, cand[c])
-            ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
-        exc[c] = ex
-        dirs[c] = d
-        if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
-            # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
-            # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
-            # that set contradicts a prescribed motion.)
-            dirs[c] = 1
-        worst = max(worst, ex)
-    if worst >= 0.0:
-        # the candidates, most overloaded first
-        order = np.argsort(-exc[:nc])
-        cs = cand[:nc][order].copy()
-        ds = dirs[:nc][order].copy()
-        for c in range(nc):
-            cand[c] = cs[c]
-            dirs[c] = ds[c]
-        found = False
-        pick = np.empty(max(nc, 1), dtype=np.int64)
-        smax = nc if nc <= 10 else 2
-        for s in range(1, smax + 1):
-            for q in range(s):
-                pick[q] = q
-            while True:
-                ok = True
-                for q in range(s):
-                    if dirs[pick[q]] == 0:
-                        ok = False
-                if ok:
-                    _apply_subset(p, m, cand, nc, dirs, pick, s)
-                    _evaluate(t, x, m, p, acc, tau)
-                    # released together, an item may move against the way its own torque pushed it (two gears
-                    # coupled through a reversing ratio): flip those to the way they accelerate, a few times
-                    for _flip in range(s + 1):
-                        if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
-                            found = True
-                            break
-                        if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
-                            break
-                        _evaluate(t, x, m, p, acc, tau)
-                    if found:
-                        break
-                # the next combination of s out of nc
-                q = s - 1
-                while q >= 0 and pick[q] == nc - s + q:
-                    q -= 1
-                if q < 0:
-                    break
-                pick[q] += 1
-                for qq in range(q + 1, s):
-                    pick[qq] = pick[qq - 1] + 1
-            if found:
-                break
-        if not found:   # release the most overloaded until the rest hold
-            for c in range(nc):
-                _item_set(p, m, cand[c], _ZERO)
-            for _it in range(nc):
-                _evaluate(t, x, m, p, acc, tau)
-                best, bi, bd = -np.inf, _ZERO - 1, _ZERO
-                for c in range(nc):
-                    i = cand[c]
-                    if not _item_stuck(p, m, i):
-                        continue
-                    ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-                    if forced[i] != 0:
-                        ex = max(ex, 0.0)
-                    if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
-                        ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
-                    if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
-                        continue
-                    if ex >= 0.0 and ex > best:
-                        best, bi, bd = ex, i, d
-                if bi < 0:
-                    break
-                _item_set(p, m, bi, bd)
-            _evaluate(t, x, m, p, acc, tau)
-
-
-#: a stuck item that would break away within this time [s] of the instant is released at it (:func:`_tie_breaks`)
+#: a stuck item that would break away within this time [s] of the instant is released at it (the tie-break in :func:`settle`)
 T_TIE = 1e-8
 
 
 #: a stuck item whose margin to its limit is below this many rounding floors (:func:`_item_noise`: 1e-6 of the
-#: torques on its inertias) is decided by where its load goes (:func:`_tie_breaks`)
+#: torques on its inertias) is decided by where its load goes (the tie-break in :func:`settle`)
 TIE_BAND = 1e6
 
 
@@ -1865,52 +1772,6 @@ def _near_limit(t, p, tau, i):
         return max(holding_limit(p, r, t, tq), noise) - abs(tq) < TIE_BAND * noise
     margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
     return margin < TIE_BAND * noise
-
-
-@numba.njit(cache=True, nogil=True, _nrt=True)
-def _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
-    """Second order: a stuck candidate at its limit to the rounding of the forces holds or breaks away by which
-    way its load moves (a gear carrying 1e-12 N m is within its rounding band whatever its margin).  Every stuck
-    candidate within :data:`TIE_BAND` of its limit (:func:`_near_limit`) is evaluated again at ``t + T_TIE`` (angles and speeds advanced by the speeds and accelerations of
-    the decided modes, an error of order ``T_TIE**2``); one beyond what it holds there is marked in ``forced``
-    (then released by the search).  Against what a stuck element holds (a clutch model's static limit), not what
-    it needs to lock up (its lock-up limit: the search decides that at the instant itself).  Without this the decision
-    at such an instant followed the sign the rounding left, so it changed with the tolerance or with an unrelated
-    element (a self-locking gear stuck for 1.6 ps, or 0.6 ns, in one run and rolling in the other: issue #30).
-    True if one was marked; ``acc`` and ``tau`` are those of the decided modes at ``t`` on return."""
-    n = p.inertia.shape[0]
-    nf = p.fric.shape[0]
-    near = False
-    for c in range(nc):
-        i = cand[c]
-        if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
-            near = True
-    if not near:
-        return False
-    exs = np.empty(nc)
-    near_ = np.zeros(nc, dtype=np.bool_)
-    for c in range(nc):
-        exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
-        near_[c] = _near_limit(t, p, tau, cand[c])
-    dt = T_TIE
-    for q in range(xp.shape[0]):
-        xp[q] = x[q]
-    for j in range(n):
-        xp[j] = x[j] + dt * x[n + j]
-        xp[n + j] = x[n + j] + dt * acc[j]
-    _evaluate(t + dt, xp, m, p, acc, tau)
-    marked = False
-    for c in range(nc):
-        i = cand[c]
-        ex0 = exs[c]
-        if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
-            continue
-        ex1, _d = _item_excess(t + dt, p, tau, i, False)
-        if ex1 >= 0.0:
-            forced[i] = 1
-            marked = True
-    _evaluate(t, x, m, p, acc, tau)
-    return marked
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1998,8 +1859,130 @@ def settle(t, x, m, p, log, old):
     forced = np.zeros(ni, dtype=np.int64)
     xp = np.empty(x.shape[0])
     for _tie in range(nc + 1):
-        _decide(t, x, m, p, old, cand, nc, dirs, exc, forced, acc, tau)
-        if not _tie_breaks(t, x, m, p, old, cand, nc, forced, acc, tau, xp):
+        # ---- the search over the candidates (every one stuck first; ``forced`` items count as overloaded)
+        for c in range(nc):
+            _item_set(p, m, cand[c], _ZERO)
+        _evaluate(t, x, m, p, acc, tau)
+        worst = -np.inf
+        for c in range(nc):
+            ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
+            if forced[cand[c]] != 0:   # it would break away within T_TIE (the tie-break below): overloaded
+                ex = max(ex, 0.0)
+            if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
+                a = _item_acc(p, acc, cand[c])
+                ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
+            exc[c] = ex
+            dirs[c] = d
+            if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
+                # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
+                # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
+                # that set contradicts a prescribed motion.)
+                dirs[c] = 1
+            worst = max(worst, ex)
+        if worst >= 0.0:
+            # the candidates, most overloaded first
+            order = np.argsort(-exc[:nc])
+            cs = cand[:nc][order].copy()
+            ds = dirs[:nc][order].copy()
+            for c in range(nc):
+                cand[c] = cs[c]
+                dirs[c] = ds[c]
+            found = False
+            pick = np.empty(max(nc, 1), dtype=np.int64)
+            smax = nc if nc <= 10 else 2
+            for s in range(1, smax + 1):
+                for q in range(s):
+                    pick[q] = q
+                while True:
+                    ok = True
+                    for q in range(s):
+                        if dirs[pick[q]] == 0:
+                            ok = False
+                    if ok:
+                        _apply_subset(p, m, cand, nc, dirs, pick, s)
+                        _evaluate(t, x, m, p, acc, tau)
+                        # released together, an item may move against the way its own torque pushed it (two gears
+                        # coupled through a reversing ratio): flip those to the way they accelerate, a few times
+                        for _flip in range(s + 1):
+                            if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
+                                found = True
+                                break
+                            if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+                                break
+                            _evaluate(t, x, m, p, acc, tau)
+                        if found:
+                            break
+                    # the next combination of s out of nc
+                    q = s - 1
+                    while q >= 0 and pick[q] == nc - s + q:
+                        q -= 1
+                    if q < 0:
+                        break
+                    pick[q] += 1
+                    for qq in range(q + 1, s):
+                        pick[qq] = pick[qq - 1] + 1
+                if found:
+                    break
+            if not found:   # release the most overloaded until the rest hold
+                for c in range(nc):
+                    _item_set(p, m, cand[c], _ZERO)
+                for _it in range(nc):
+                    _evaluate(t, x, m, p, acc, tau)
+                    best, bi, bd = -np.inf, _ZERO - 1, _ZERO
+                    for c in range(nc):
+                        i = cand[c]
+                        if not _item_stuck(p, m, i):
+                            continue
+                        ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+                        if forced[i] != 0:
+                            ex = max(ex, 0.0)
+                        if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
+                            ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
+                        if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
+                            continue
+                        if ex >= 0.0 and ex > best:
+                            best, bi, bd = ex, i, d
+                    if bi < 0:
+                        break
+                    _item_set(p, m, bi, bd)
+                _evaluate(t, x, m, p, acc, tau)
+        # ---- the second-order tie-break (T_TIE, TIE_BAND): a stuck candidate within TIE_BAND of its limit is
+        # evaluated again at t + T_TIE (angles and speeds advanced by the decided motion, an error of order
+        # T_TIE**2); one beyond what it holds there (its static limit, not its lock-up limit) is marked forced and
+        # the search repeated.  Without it the decision at such an instant followed the sign the rounding left,
+        # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
+        # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
+        # functions of their own they compiled 2.5 s more.)
+        near = False
+        marked = False
+        for c in range(nc):
+            i = cand[c]
+            if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
+                near = True
+        if near:
+            exs = np.empty(nc)
+            near_ = np.zeros(nc, dtype=np.bool_)
+            for c in range(nc):
+                exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
+                near_[c] = _near_limit(t, p, tau, cand[c])
+            dt = T_TIE
+            for q in range(xp.shape[0]):
+                xp[q] = x[q]
+            for j in range(n):
+                xp[j] = x[j] + dt * x[n + j]
+                xp[n + j] = x[n + j] + dt * acc[j]
+            _evaluate(t + dt, xp, m, p, acc, tau)
+            for c in range(nc):
+                i = cand[c]
+                ex0 = exs[c]
+                if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
+                    continue
+                ex1, _d = _item_excess(t + dt, p, tau, i, False)
+                if ex1 >= 0.0:
+                    forced[i] = 1
+                    marked = True
+            _evaluate(t, x, m, p, acc, tau)
+        if not marked:
             break
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
     # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the

@@ -226,7 +226,7 @@ def _dense(theta, h, x0, f0, x1, f1, rc, mass, out):
             out[i] += w * rc[i]
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _may_cross(g0, g1, gdir):
     """False if no switching function can have crossed in the step (then :func:`_locate` is skipped).
 
@@ -350,160 +350,189 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
 
 
 @register_jitable
-def _step_state(p, t, th, h, x, k1, u, m, Ks, xt, out, fe, ge):
-    """The Dormand-Prince order-5 solution of a step of ``th * h`` from ``(t, x)`` (slope ``k1``) into ``out``, and
-    the right-hand side and switching functions there into ``fe``, ``ge`` (6 evaluations: the stages 2-6 and the
-    end point; the error estimate is not needed: the fraction of an accepted step is as accurate as the step)."""
-    n = x.shape[0]
-    hh = th * h
-    k2 = Ks[0]
-    k3 = Ks[1]
-    k4 = Ks[2]
-    k5 = Ks[3]
-    k6 = Ks[4]
-    for i in range(n):
-        xt[i] = x[i] + hh * (A21 * k1[i])
-    model.rhs(t + C2 * hh, xt, u, m, p, k2, ge)
-    for i in range(n):
-        xt[i] = x[i] + hh * (A31 * k1[i] + A32 * k2[i])
-    model.rhs(t + C3 * hh, xt, u, m, p, k3, ge)
-    for i in range(n):
-        xt[i] = x[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-    model.rhs(t + C4 * hh, xt, u, m, p, k4, ge)
-    for i in range(n):
-        xt[i] = x[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-    model.rhs(t + C5 * hh, xt, u, m, p, k5, ge)
-    for i in range(n):
-        xt[i] = x[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-    model.rhs(t + hh, xt, u, m, p, k6, ge)
-    for i in range(n):
-        out[i] = x[i] + hh * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-    model.rhs(t + hh, out, u, m, p, fe, ge)
-
-
-@register_jitable
-def _illinois_step(p, t, h, x, k1, u, m, event_tol, Ks, xt, xs, fe, ge, k, lo, hi, glo, ghi, gref, gdir_k):
-    """:func:`_illinois` on the step's own solution (:func:`_step_state` of the fraction): ``(theta, n_rhs)``,
-    ``theta`` the bracket end just past the root of switching function ``k``."""
-    n_rhs = 0
-    side = 0
-    for _it in range(200):
-        if (hi - lo) * h <= event_tol:
-            break
-        if glo != ghi and _it < 40:
-            th = lo + (hi - lo) * glo / (glo - ghi)
-        else:
-            th = 0.5 * (lo + hi)
-        span = hi - lo
-        th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
-        _step_state(p, t, th, h, x, k1, u, m, Ks, xt, xs, fe, ge)
-        n_rhs += 6
-        if _crossed(gref, ge[k], gdir_k):
-            hi = th
-            ghi = ge[k]
-            if side == 1:
-                glo *= 0.5
-            side = 1
-        else:
-            lo = th
-            glo = ge[k]
-            if side == -1:
-                ghi *= 0.5
-            side = -1
-    return hi, n_rhs
-
-
-@register_jitable
-def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, event_tol, theta, Ks, xt, xs, fe, ge, gs):
+def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, event_tol, theta, Ks, xt, xs, fe, ge, gs,
+                  gd):
     """The event located on the step's own solution: the root ``theta`` found on the dense output moved to where the
-    switching function crosses on :func:`_step_state` of the fraction, so that the state a run restarts from is an
+    switching function crosses on a Dormand-Prince step of the fraction, so that the state a run restarts from is an
     order-5 solution on which the crossing shows (the dense output's order-4 error, which the step control does not
     see, is not carried past the event: docs/driveline.md "Energy").
 
-    The function followed is one that crossed at ``theta`` on the step, else the first to cross after it (by
-    linear interpolation to the step's end).  Its value on the step's solution at ``theta`` and its slope on the
-    dense output (where it crosses at ``theta``, to ``event_tol``) predict the root (a Newton step); where the
-    function has crossed just past the prediction (0.01 ``event_tol``, then 8 times as far, up to four times),
-    that is the event (mostly two steps of the fraction and one evaluation, 13 in all); else the Illinois
-    iteration on the step's solution (:func:`_illinois_step`) goes on from the bracket found.
+    The function followed: one that has crossed at ``theta`` on the step's solution (preferring one that crossed
+    there on the dense output too), else one whose root on the dense output ``theta`` is (it crosses just after
+    ``theta`` on the step; this includes a dip through zero that is back by the step's end, such as a backlash's
+    touch of an edge).  Its value on the step's solution at ``theta`` and its slope on the dense output predict the
+    root (a Newton step; the two solutions differ by the step's error, so the prediction is good to far below
+    ``event_tol``); where the function has crossed just past the prediction (0.01 ``event_tol``, then 8 times as far,
+    up to four times), that is the event (mostly two steps of the fraction and two evaluations, 14 in all); else
+    the Illinois iteration on the step's solution goes on from the bracket found.
 
-    ``(theta, n_rhs, ok)``: ``ok`` False leaves the dense output's root and state (no function crosses on the
-    step's solution by its end: a dip through zero seen on the dense output only).  ``xs`` receives the state.
+    ``(theta, n_rhs, ok)``: ``ok`` False leaves the dense output's root and state (the crossing does not show on the
+    step's solution where it can be bracketed: a dip through zero seen on the dense output only).  ``xs`` receives
+    the state, ``Ks`` and ``fe`` the stages and end slope of the step to it (its dense output for the samples).
+
+    Written as one loop with one evaluation of each kind (the dense output, a step of a fraction) and no helper
+    functions: the right-hand side is linked at two call sites in one compiled function (its compilation
+    dominates the core's: three helpers cost 4 s more of the driveline's first compilation).
     """
     ng = g0.shape[0]
     n_rhs = 0
     if theta >= 1.0:
         return theta, 0, False
-    _step_state(p, t, theta, h, x, k1, u, m, Ks, xt, xs, fe, ge)
-    n_rhs += 6
-    kk = -1
-    for k in range(ng):
-        gs[k] = ge[k]
-        if kk < 0 and _crossed(ga[k], ge[k], gdir[k]):
-            kk = k
-    at_theta = kk >= 0
-    if not at_theta:
-        best = 2.0
-        for k in range(ng):
-            if _crossed(ga[k], g1[k], gdir[k]) and gs[k] != g1[k]:
-                thk = theta + (1.0 - theta) * gs[k] / (gs[k] - g1[k])
-                if thk < best:
-                    best = thk
-                    kk = k
-        if kk < 0:
-            return theta, n_rhs, False
-    # the bracket known so far: lo (not crossed) and hi (crossed) for function kk
-    lo = 1e-6 if g0[kk] == 0.0 else 0.0
-    glo = ga[kk]
-    if at_theta:
-        hi = theta
-        ghi = gs[kk]
-    else:
-        lo = theta
-        glo = gs[kk]
-        hi = 1.0
-        ghi = g1[kk]
     tol = event_tol / h
-    # the slope of the function from the dense output (which crosses at theta to event_tol: its value there is ~0
-    # against its value 1e-6 of the step before), the value from the step's solution: a Newton step to the root
     d = max(1e-6, 64.0 * tol)
-    th2 = theta - d
-    last = theta
-    if th2 > 0.0:
-        _dense(th2, h, x, k1, x1, f1, rc, mass, xt)
-        model.rhs(t + th2 * h, xt, u, m, p, fe, ge)
+    # the dense output at theta (which functions cross there) and d before it (their slopes)
+    for j in range(2):
+        th = theta if j == 0 else theta - d
+        if th <= 0.0:
+            break
+        _dense(th, h, x, k1, x1, f1, rc, mass, xt)
+        model.rhs(t + th * h, xt, u, m, p, fe, ge)
         n_rhs += 1
-        slope = (0.0 - ge[kk]) / d
-        pred = theta - gs[kk] / slope if slope != 0.0 else theta
-        # just past the prediction (a secant through two points 1e-6 of the step apart, on a function crossing
-        # linearly: exact to far below event_tol); if it has crossed there, that is the event (its time within
-        # event_tol of the root), else the iteration below goes on from the tighter bracket
-        off = 0.01 * tol
-        for _probe in range(4):
-            q = pred + off
-            if not lo < q < hi:
-                break
-            _step_state(p, t, q, h, x, k1, u, m, Ks, xt, xs, fe, ge)
-            n_rhs += 6
-            last = q
-            if _crossed(ga[kk], ge[kk], gdir[kk]):
-                hi, ghi = q, ge[kk]
-                lo = max(lo, q - tol)
-                break
-            lo, glo = q, ge[kk]
-            off *= 8.0
-    if (hi - lo) * h > event_tol:
-        hi, nr = _illinois_step(p, t, h, x, k1, u, m, event_tol, Ks, xt, xs, fe, ge, kk, lo, hi, glo, ghi, ga[kk],
-                                gdir[kk])
-        n_rhs += nr
-        last = -1.0
-    if hi >= 1.0:
-        for i in range(x.shape[0]):
-            xs[i] = x1[i]
-        return 1.0, n_rhs, True
-    if last != hi:
-        _step_state(p, t, hi, h, x, k1, u, m, Ks, xt, xs, fe, ge)
+        for k in range(ng):
+            if j == 0:
+                gd[k] = ge[k]
+            else:
+                gs[k] = (gd[k] - ge[k]) / d   # (the slopes, until the step's values overwrite them)
+    slope_ok = theta - d > 0.0
+    # the evaluations on the step's solution: phase 0 at theta, 1 the probes past the Newton prediction, 2 the
+    # Illinois iteration, 3 the final state
+    kk = -1
+    at_theta = False
+    lo = glo = hi = ghi = 0.0
+    pred = off = 0.0
+    slope = 0.0
+    phase = 0
+    side = 0
+    n_probe = 0
+    n_it = 0
+    th = theta
+    last = -1.0
+    n = x.shape[0]
+    k2 = Ks[0]
+    k3 = Ks[1]
+    k4 = Ks[2]
+    k5 = Ks[3]
+    k6 = Ks[4]
+    for _ev in range(220):
+        # the Dormand-Prince order-5 solution of a step of th * h from (t, x) into xs, its stages 2-6 into Ks, the
+        # right-hand side and switching functions at its end into fe, ge (the error estimate is not needed: the
+        # fraction of an accepted step is as accurate as the step); the stages written out as in _advance_dopri,
+        # with one call of the right-hand side
+        hh = th * h
+        for stg in range(1, 7):
+            if stg == 1:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A21 * k1[i])
+                c = C2
+            elif stg == 2:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A31 * k1[i] + A32 * k2[i])
+                c = C3
+            elif stg == 3:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                c = C4
+            elif stg == 4:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+                c = C5
+            elif stg == 5:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+                c = 1.0
+            else:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+                    xs[i] = xt[i]
+                c = 1.0
+            model.rhs(t + c * hh, xt, u, m, p, fe if stg == 6 else Ks[stg - 1], ge)
         n_rhs += 6
+        last = th
+        if phase == 0:
+            for k in range(ng):
+                if _crossed(ga[k], ge[k], gdir[k]):
+                    if kk < 0 or (_crossed(ga[k], gd[k], gdir[k]) and not _crossed(ga[kk], gd[kk], gdir[kk])):
+                        kk = k
+            at_theta = kk >= 0
+            if not at_theta:
+                for k in range(ng):
+                    if _crossed(ga[k], gd[k], gdir[k]):
+                        kk = k
+                        break
+                if kk < 0:
+                    return theta, n_rhs, False
+            slope = gs[kk]
+            # the bracket known so far on the step's solution: lo (not crossed), hi (crossed; -1 not known yet)
+            if at_theta:
+                lo = 1e-6 if g0[kk] == 0.0 else 0.0
+                glo = ga[kk]
+                hi = theta
+                ghi = ge[kk]
+            else:
+                lo = theta
+                glo = ge[kk]
+                if _crossed(ga[kk], g1[kk], gdir[kk]):
+                    hi = 1.0
+                    ghi = g1[kk]
+                else:
+                    hi = -1.0
+            phase = 1
+            if slope_ok and slope != 0.0:
+                # the value on the step's solution, the slope on the dense output: a Newton step to the root
+                pred = theta - ge[kk] / slope
+                off = 0.01 * tol
+            else:
+                n_probe = 4
+        elif phase == 1:
+            if _crossed(ga[kk], ge[kk], gdir[kk]):
+                hi, ghi = th, ge[kk]
+                lo = max(lo, th - tol)
+                n_probe = 4
+            else:
+                lo, glo = th, ge[kk]
+                off *= 8.0
+                n_probe += 1
+        elif phase == 2:
+            if _crossed(ga[kk], ge[kk], gdir[kk]):
+                hi, ghi = th, ge[kk]
+                if side == 1:
+                    glo *= 0.5
+                side = 1
+            else:
+                lo, glo = th, ge[kk]
+                if side == -1:
+                    ghi *= 0.5
+                side = -1
+            n_it += 1
+        else:
+            break
+        # the next point
+        if phase == 1:
+            q = pred + off
+            if n_probe < 4 and lo < q and (hi < 0.0 or q < hi) and q < 1.0:
+                th = q
+                continue
+            if hi < 0.0:
+                # a dip through zero on the dense output that the step's solution does not show where looked for
+                return theta, n_rhs, False
+            phase = 2
+        if phase == 2 and (hi - lo) * h > event_tol and n_it < 200:
+            if glo != ghi and n_it < 40:
+                th = lo + (hi - lo) * glo / (glo - ghi)
+            else:   # (a function that jumps at its root: bisect)
+                th = 0.5 * (lo + hi)
+            span = hi - lo
+            th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
+            continue
+        # located: the state at hi
+        if hi >= 1.0:
+            for i in range(x.shape[0]):
+                xs[i] = x1[i]
+            return 1.0, n_rhs, True
+        if last == hi:
+            return hi, n_rhs, True
+        phase = 3
+        th = hi
     return hi, n_rhs, True
 
 
@@ -647,9 +676,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     Ks = np.empty((5, n))
     xs = np.empty(n)
     gs = np.empty(ng)
+    gd = np.empty(ng)
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs)
-    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs, gd)
+    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs, gd = borrow(owners)
     k1 = K[0]
     k2 = K[1]
     k3 = K[2]
@@ -780,7 +810,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if theta < 1.0:
             # the root moved to the step's own solution, the state the run restarts from
             theta, nr, on_step = _root_on_step(p, t, h, x, k1, xn, k7, rc, mass, g0, g1, ga, opt.gdir, u, m,
-                                               opt.event_tol, theta, Ks, xt, xs, fe, ge, gs)
+                                               opt.event_tol, theta, Ks, xt, xs, fe, ge, gs, gd)
             si[SI_NRHS] += nr
         if theta <= 1.0:
             t_new = t + theta * h
