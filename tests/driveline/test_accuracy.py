@@ -83,7 +83,10 @@ def test_coupled_clutches_error_shrinks_with_rtol():
                      "speed": np.max(np.abs(w - yy[0:4])),
                      "energy": df["energy_error_J"].abs().max()}
     _check(err, (1e-6, 1e-8, 1e-10), ("event", "speed", "energy"),
-           {"event": 6e-8, "speed": 1e-6, "energy": 5e-6}, 1e-8)
+           {"event": 5e-9, "speed": 1e-6, "energy": 5e-6}, 1e-8)
+    # restarted from the step's own solution at each event (numerics.core._root_on_step), not from the dense
+    # output: the events at rtol 1e-6 were 7.7e-7 s off with the dense output's state, now 1.9e-8 s
+    assert err[1e-6]["event"] < 1e-7, err[1e-6]
 
 
 def test_wet_sae2_error_shrinks_with_rtol():
@@ -141,7 +144,13 @@ def test_emtc_awd_error_shrinks_with_rtol():
 
 def test_launch_converges_as_rtol_tightens():
     """Richardson-style: the launch against itself at rtol 1e-9 (not an independent solution), whose own
-    error is bounded by its difference from rtol 1e-10; the energy balance needs no reference."""
+    error is bounded by its difference from rtol 1e-10; the energy balance needs no reference.
+
+    The errors shrink over the two decades from rtol 1e-5 to 1e-7, not at every decade: after the lash closes
+    they are the phase error of the driveshaft's lightly damped torsional oscillation, which scatters by a
+    factor of two either way between neighbouring tolerances (scanned at seven tolerances from 1e-5 to 1e-7,
+    docs/driveline.md "Energy"); the vehicle's speed error at 1e-5 and 1e-6 is of the same size, and falls
+    tenfold (9.7) from 1e-5 to 1e-7 (15-fold before issue #30's event location on the step's solution)."""
     f = load_driveline(EXAMPLES / "driveline_eclutch_launch.toml")
     assert f.rtol == 1e-6
     grid = np.arange(501) * 0.01
@@ -160,9 +169,11 @@ def test_launch_converges_as_rtol_tightens():
                 "energy": df["energy_error_J"].abs().max() / df["input_work_J"].iloc[-1]}
 
     err = {rtol: errors(rtol) for rtol in (1e-5, 1e-6, 1e-7)}
-    _check(err, (1e-5, 1e-6, 1e-7), ("event", "engine", "vehicle", "energy"),
-           {"event": 2e-5, "engine": 1e-2, "vehicle": 2e-4, "energy": 2e-7}, 1e-6)
+    _check(err, (1e-5, 1e-7), ("event", "engine", "vehicle", "energy"),
+           {"event": 5e-5, "engine": 1e-2, "vehicle": 3e-4, "energy": 2e-7}, 1e-6)
+    for key in ("event", "engine", "vehicle", "energy"):   # two decades: at least fivefold (measured 9.7 to 43)
+        assert err[1e-7][key] < err[1e-5][key] / 5, (key, err)
     # the reference's own error (1e-9 against 1e-10) is far below the default's error against it
     own = errors(1e-10)
-    assert own["event"] < 1e-7 and own["engine"] < 1e-4 and own["vehicle"] < 2e-6, own
+    assert own["event"] < 2e-7 and own["engine"] < 1e-4 and own["vehicle"] < 2e-6, own
     assert own["engine"] < err[1e-6]["engine"] / 30 and own["event"] < err[1e-6]["event"] / 30

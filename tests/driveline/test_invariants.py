@@ -254,18 +254,50 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     bearing broke away at 0.7701 s, g1 was released backward with its speed 1.0001e-9 the other way, just beyond
     the rounding width 1e-9: its stick function started below zero and never crossed, and g1 rolled forward in
     its backward mode (the compiled check stopped the run at rtol 1e-9, not at 1e-6 or 1e-11).  Now the slack of
-    a released item covers the drift: the same 30 mode changes at every tolerance, the invariants at every step."""
+    a released item covers the drift: the same mode changes at every tolerance, the invariants at every step.
+    At each break-away of the bearing the gears carry ~1e-12 N m, within their rounding bands: whether they stay
+    stuck or roll on with the bearing is decided by where their load goes (the tie-break in ``kernel.settle``: beyond their
+    band within ``T_TIE`` = 10 ns, so they roll at once; before it, they stayed stuck for 1.6 ps in one run and
+    rolled in another).  23 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11 (the gears' changes of driving
+    flange, ``a_drives``/``b_drives``, left out as in the random networks below: at 1e-12 N m they are located
+    to the rounding floor and may come or go with the step sequence)."""
     d = Driveline("self_locking_pair")
     d.inertia("J0", J=0.5625).inertia("J1", J=1.0).inertia("J2", J=2.0)
     d.gear("g0", "J0", "J1", ratio=-0.30078125, efficiency=0.5)
     d.gear("g1", "J1", "J2", ratio=-1.0, efficiency=0.25)
     d.bearing_friction("bearing", "J0", torque=0.25, peak=1.0)
     d.torque("T0", "J0", Signal.sine(1.0, 2.0))
-    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True).events for rtol in (1e-6, 1e-9, 1e-11)]
+    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in (1e-6, 1e-9, 1e-11)]
+    runs = [_mode_events(r) for r in runs]
     for ev in runs:
-        assert list(zip(ev["element"], ev["event"])) == list(zip(runs[-1]["element"], runs[-1]["event"]))
-        assert len(ev) == 30
-        assert np.max(np.abs(ev["time_s"].to_numpy() - runs[-1]["time_s"].to_numpy())) < 1e-6
+        assert [e[1:] for e in ev] == [e[1:] for e in runs[-1]]
+        assert len(ev) == 23
+        assert max(abs(a[0] - b[0]) for a, b in zip(ev, runs[-1])) < 1e-6
+
+
+def test_the_energy_balance_at_events_follows_the_tolerance():
+    """A loop at the edge of self-locking (an ideal gear of ratio -1, a lossy gear of ratio 1 and efficiency 0.21875,
+    a 1 N clutch) driven by a 19 N m sine at 4 Hz: 24 events in 1 s, 0.48 J of input work, speeds below 0.1 rad/s.
+    Found by the random networks: a run restarted from the dense output at each event (order 4, an error the step
+    control does not see) left 1.1e-6 J at rtol 1e-9 and 9.9e-6 J at 1e-8.  Restarted from the step's own solution
+    (the root located on it, ``numerics.core._root_on_step``): 1.8e-7 and 1.4e-6 J.  (The energy balance is exact
+    physics -- input work = kinetic energy + dissipation -- computed from columns the kernel integrates separately,
+    so it measures the integration error alone.)"""
+    d = Driveline("edge")
+    d.inertia("J0", J=1.0).inertia("J1", J=1.5).inertia("J2", J=1.0)
+    d.gear("g0", "J0", "J1", ratio=-1.0)
+    d.gear("g1", "J1", "J2", ratio=1.0, efficiency=0.21875)
+    d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5, peak=1.0, normal=1.0)
+    d.torque("T2", "J2", Signal.sine(19.0, 4.0))
+    err = {}
+    for rtol in (1e-8, 1e-9, 1e-10):
+        res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
+        df = res.to_dataframe()
+        assert len(res.events) == 24
+        assert df["input_work_J"].abs().max() == pytest.approx(0.4814, abs=1e-4)
+        err[rtol] = df["energy_error_J"].abs().max()
+    assert err[1e-8] > err[1e-9] > err[1e-10]
+    assert err[1e-8] < 4e-6 and err[1e-9] < 5e-7 and err[1e-10] < 5e-8, err
 
 
 # ----------------------------------------------------------------- random networks

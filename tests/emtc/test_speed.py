@@ -12,6 +12,9 @@ other than the controller's model), at the default tolerances.  The faster model
 * the same modes at every sample, the same events in the same order at the same instants (to 1e-10 s; the
   core locates them to 1e-12 s) and the same number of accepted steps.
 
+Since issue #30 the core restarts at an event from the step's own solution: the answers then moved within the
+integration error (:data:`SINCE_ISSUE_30`, :data:`EVENT_ATOL`), and the LuGre lock-up towards the tight solution.
+
 Nothing here is timed.
 """
 
@@ -39,6 +42,13 @@ SCENARIOS = list(MAKER.scenarios())
 #: apart after unrelated changes to the core's arithmetic) move the flight by about 2e-8 of its range even at
 #: rtol 1e-9; until then the states agree to 1e-15.  A changed equation or step still shows (>= 1e-6).
 RELATIVE = {"release": 1e-7}
+#: since the core restarts at an event from the step's own solution (located on it, not on the dense output:
+#: issue #30, docs/driveline.md "Energy"), the answers move within the integration error at rtol 1e-6: the
+#: armature's flight right after its events by up to 2.9e-6 of its range (its speed), the coil current and the
+#: forces by 3e-7, the rest by 1e-9; the event instants by up to 1.6e-7 s (the lock-up of ``lugre`` by 1.1e-5 s,
+#: towards the tight solution: checked against it below).  Modes and accepted steps are unchanged.
+SINCE_ISSUE_30 = 5e-6
+EVENT_ATOL = 2e-7
 
 
 @pytest.mark.parametrize("name, magnet, scenario, kwargs", SCENARIOS, ids=[s[0] for s in SCENARIOS])
@@ -59,10 +69,13 @@ def test_same_trajectories_events_and_steps_as_before(name, magnet, scenario, kw
         for q in range(ref.shape[1]):
             scale = np.max(np.abs(ref[:, q]))
             err = np.max(np.abs(got[:, q] - ref[:, q])) / max(scale, 1e-300)
-            assert err * scale <= RELATIVE.get(name, 1e-9) * scale + 1e-6 * floor[q], \
+            assert err * scale <= max(RELATIVE.get(name, 1e-9), SINCE_ISSUE_30) * scale + 1e-6 * floor[q], \
                 f"{name}: {label} {q} differs by {err:.2e} of its range"
     assert list(r.events["event"]) == [str(e) for e in data[f"{name}_event_name"]]
-    np.testing.assert_allclose(r.events["time_s"].to_numpy(), data[f"{name}_event_time"], rtol=0, atol=1e-10)
+    got, ref = r.events["time_s"].to_numpy(), data[f"{name}_event_time"]
+    if name == "lugre":   # the lock-up: see test_lugre_lockup_at_the_default_tolerance_is_where_the_tight_run_has_it
+        got, ref = np.delete(got, 2), np.delete(ref, 2)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=EVENT_ATOL)
     assert res.n_steps == int(data[f"{name}_steps"][0])
 
 
@@ -89,3 +102,22 @@ def test_figure_error_against_the_tight_reference_is_no_worse_than_before():
     ref, _ = wp.reference(magnet, scenario, rtol=1e-12, atol=ATOL * 1e-6, method="DOP853")
     r = simulate_bench(magnet, scenario, **kwargs).result
     assert wp.error(r.states[:, :2], ref) <= 4.75e-6
+
+
+def test_lugre_lockup_at_the_default_tolerance_is_where_the_tight_run_has_it():
+    """The LuGre scenario's lock-up at the default tolerances against the same model at rtol 1e-12: 1.9e-8 s
+    since the core restarts from the step's own solution at events; the snapshot above had it 1.08e-5 s late
+    (0.0118415 s against 0.0118307 s: located on the dense output, the bristle state it restarted from at the
+    armature's contact carried the interpolant's error)."""
+    from clutchlab.emtc import simulate_bench
+
+    name, magnet, scenario, kwargs = next(s for s in SCENARIOS if s[0] == "lugre")
+    ev = simulate_bench(magnet, scenario, **kwargs).result.events
+    tight = simulate_bench(magnet, scenario, rtol=1e-12, **kwargs).result.events
+    assert list(ev["event"]) == list(tight["event"]) == ["armature_leave_rest", "armature_contact", "lockup", "unlock"]
+    assert abs(ev["time_s"].iloc[2] - tight["time_s"].iloc[2]) < 1e-7
+    assert abs(data_lockup() - tight["time_s"].iloc[2]) > 1e-5   # (the snapshot's: what this test guards against)
+
+
+def data_lockup():
+    return float(np.load(DATA)["lugre_event_time"][2])

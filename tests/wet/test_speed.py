@@ -50,13 +50,16 @@ def test_piston_stroke_follows_the_tolerance():
     """Off its stop the piston reaches the actuator's speed limit within about a microsecond; the core now
     restarts the step size there (``wet_update`` returns ``RESTART``).  The stroke from leaving the stop to
     the film contact then follows the tolerance; with the step of before the event it was 2.6e-6 s too long
-    at every rtol from 1e-5 to 1e-7 (9.1e-4 s at 1e-3), and the whole engagement lagged behind."""
+    at every rtol from 1e-5 to 1e-7 (9.1e-4 s at 1e-3), and the whole engagement lagged behind.  Since the events
+    are located on the step's own solution (issue #30), the loosest tolerances no longer get the stroke right by
+    cancellation (both its ends are off by 1.6-1.9e-6 s at rtol 1e-3, as before): -2.9e-7 s at 1e-3, -1.9e-7 s
+    at 1e-4, below 5e-9 s from 1e-5 on."""
     from clutchlab.wet import simulate_engagement
 
     scen = EngagementProtocol(duration=0.3).scenario(CLUTCH, "speed")
     ref = _event_times(simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, rtol=1e-12, sample_rate=100))
     stroke_ref = ref["contact"] - ref["piston_leaves_stop"]
-    for rtol, bound in ((1e-3, 1e-7), (1e-5, 1e-8), (1e-6, 1e-8), (1e-7, 1e-8)):
+    for rtol, bound in ((1e-3, 1e-6), (1e-4, 1e-6), (1e-5, 1e-8), (1e-6, 1e-8), (1e-7, 1e-8)):
         ev = _event_times(simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, rtol=rtol, sample_rate=100))
         assert abs(ev["contact"] - ev["piston_leaves_stop"] - stroke_ref) < bound, rtol
 

@@ -926,6 +926,7 @@ class WorkLayout(NamedTuple):
     hold: int
     sig: int
     nv: int
+    inst: int
     ext: int
 
 
@@ -938,7 +939,9 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
     inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
     (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
-    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
+    instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
+    modes before it (2 + nf + nl, :func:`settle`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | initial stored energy (1).  Returns the offsets as a :class:`WorkLayout`."""
     o_a = n + nk
     o_m = o_a + nk * nk
@@ -955,9 +958,10 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_hold = o_fabs + n
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
-    o_ext = o_nv + 2 + nk * nk + nk
+    o_inst = o_nv + 2 + nk * nk + nk
+    o_ext = o_inst + 2 + nf + nl
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
-                      o_ext)
+                      o_inst, o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
@@ -970,7 +974,9 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
     work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig))
-    work[_layout.py_func(n, nk, ne, nf, nl, nsig).sig] = np.nan
+    lay = _layout.py_func(n, nk, ne, nf, nl, nsig)
+    work[lay.sig] = np.nan
+    work[lay.inst] = np.nan
     return work
 
 
@@ -1012,6 +1018,14 @@ def _torque_magnitudes(p):
     """The sum of the magnitudes of every torque on each inertia at the last evaluation [N m]."""
     o = _offsets(p)
     return borrow(p.work[o.fabs:o.fabs + p.inertia.shape[0]])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _instant(p):
+    """The instant [s] of the last stick/slip search, the event count before it, and the modes of the friction
+    elements and lossy gears before it (:func:`settle`)."""
+    o = _offsets(p)
+    return borrow(p.work[o.inst:o.inst + 2 + p.fric.shape[0] + p.lossy.shape[0]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1667,12 +1681,14 @@ def _evaluate(t, x, m, p, acc, tau):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
+def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
     """True if the modes of the candidates (items at rest) agree with the forces of the last evaluation: every
     stuck one within what it holds, every released one accelerating its way (not against it beyond rounding)."""
     for c in range(nc):
         i = cand[c]
         if _item_stuck(p, m, i):
+            if forced[i] != 0:
+                return False
             ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
             if ex >= 0.0 or _item_slips(p, acc, i):
                 return False
@@ -1735,6 +1751,70 @@ def _apply_subset(p, m, cand, nc, dirs, pick, s):
         _item_set(p, m, cand[c], dirs[c])
 
 
+#: a stuck item that would break away within this time [s] of the instant is released at it (the tie-break in :func:`settle`)
+T_TIE = 1e-8
+
+
+#: a stuck item whose margin to its limit is below this many rounding floors (:func:`_item_noise`: 1e-6 of the
+#: torques on its inertias) is decided by where its load goes (the tie-break in :func:`settle`)
+TIE_BAND = 1e6
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _near_limit(t, p, tau, i):
+    """True if stuck item ``i`` holds within :data:`TIE_BAND` rounding floors of its limit (a friction element's
+    holding limit; a lossy gear's band edge) at the last evaluation."""
+    nf = p.fric.shape[0]
+    r = _item_row(p, i)
+    noise = _item_noise(p, r, tau)
+    if i < nf:
+        tq = tau[r]
+        return max(holding_limit(p, r, t, tq), noise) - abs(tq) < TIE_BAND * noise
+    margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
+    return margin < TIE_BAND * noise
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _one_search_per_instant(t, m, p, log, old):
+    """Several switching functions crossing at one instant call :func:`settle` once each (the core updates every
+    crossed function); each search must then start from the modes before the instant, not from those the one
+    before left, and its events replace the earlier search's: the result is one search over every function's own
+    change, independent of their order (a second search from the first's modes could undo it: a gear put stuck by
+    the first released by the second).  The first search at a new instant stores the friction elements' and lossy
+    gears' modes in ``old`` and the event count; a later one at the same instant puts them back into ``old`` and
+    drops the events the earlier searches recorded (theirs only: a backlash's contact is kept).  A restart (a
+    run's start, a resume, a signal's jump) begins a new instant (:func:`driveline_restart`)."""
+    nf = p.fric.shape[0]
+    nl = p.lossy.shape[0]
+    nsw = p.swit.shape[0]
+    inst = _instant(p)
+    if inst[0] == t:
+        for k in range(nf):
+            old[k] = np.int64(inst[2 + k])
+        for j in range(nl):
+            old[p.elem[p.lossy[j], E_MODE]] = np.int64(inst[2 + nf + j])
+        n0 = np.int64(inst[1])
+        w = n0
+        for q in range(n0, log.count[0]):
+            e = log.element[q]
+            c = log.code[q]
+            ours = ((e >= 0 and e < nf and c <= EV_FREE) or
+                    (e >= nf + nsw and e < nf + nsw + nl and (c <= EV_BACKWARD or c == EV_DRIVE_A or c == EV_DRIVE_B)))
+            if not ours:
+                log.time[w] = log.time[q]
+                log.code[w] = log.code[q]
+                log.element[w] = log.element[q]
+                w += 1
+        log.count[0] = w
+        return
+    inst[0] = t
+    inst[1] = float(log.count[0])
+    for k in range(nf):
+        inst[2 + k] = float(old[k])
+    for j in range(nl):
+        inst[2 + nf + j] = float(old[p.elem[p.lossy[j], E_MODE]])
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def settle(t, x, m, p, log, old):
     """Modes consistent with the forces at ``t`` (the event iteration of MSL's friction elements and ``LossyGear``).
@@ -1753,6 +1833,7 @@ def settle(t, x, m, p, log, old):
     nl = p.lossy.shape[0]
     nsw = p.swit.shape[0]
     acc, tau = _acc_tau(p)
+    _one_search_per_instant(t, m, p, log, old)
     for k in range(nf):
         r = p.fric[k]
         if _is_free(p, r, t):
@@ -1775,86 +1856,134 @@ def settle(t, x, m, p, log, old):
             cand[nc] = i
             nc += 1
             _item_set(p, m, i, _ZERO)
-    _evaluate(t, x, m, p, acc, tau)
-    worst = -np.inf
-    for c in range(nc):
-        ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
-        if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
-            a = _item_acc(p, acc, cand[c])
-            ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
-        exc[c] = ex
-        dirs[c] = d
-        if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
-            # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
-            # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
-            # that set contradicts a prescribed motion.)
-            dirs[c] = 1
-        worst = max(worst, ex)
-    if worst >= 0.0:
-        # the candidates, most overloaded first
-        order = np.argsort(-exc[:nc])
-        cs = cand[:nc][order].copy()
-        ds = dirs[:nc][order].copy()
+    forced = np.zeros(ni, dtype=np.int64)
+    xp = np.empty(x.shape[0])
+    for _tie in range(nc + 1):
+        # ---- the search over the candidates (every one stuck first; ``forced`` items count as overloaded)
         for c in range(nc):
-            cand[c] = cs[c]
-            dirs[c] = ds[c]
-        found = False
-        pick = np.empty(max(nc, 1), dtype=np.int64)
-        smax = nc if nc <= 10 else 2
-        for s in range(1, smax + 1):
-            for q in range(s):
-                pick[q] = q
-            while True:
-                ok = True
-                for q in range(s):
-                    if dirs[pick[q]] == 0:
-                        ok = False
-                if ok:
-                    _apply_subset(p, m, cand, nc, dirs, pick, s)
-                    _evaluate(t, x, m, p, acc, tau)
-                    # released together, an item may move against the way its own torque pushed it (two gears
-                    # coupled through a reversing ratio): flip those to the way they accelerate, a few times
-                    for _flip in range(s + 1):
-                        if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old):
-                            found = True
-                            break
-                        if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
-                            break
-                        _evaluate(t, x, m, p, acc, tau)
-                    if found:
-                        break
-                # the next combination of s out of nc
-                q = s - 1
-                while q >= 0 and pick[q] == nc - s + q:
-                    q -= 1
-                if q < 0:
-                    break
-                pick[q] += 1
-                for qq in range(q + 1, s):
-                    pick[qq] = pick[qq - 1] + 1
-            if found:
-                break
-        if not found:   # release the most overloaded until the rest hold
+            _item_set(p, m, cand[c], _ZERO)
+        _evaluate(t, x, m, p, acc, tau)
+        worst = -np.inf
+        for c in range(nc):
+            ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
+            if forced[cand[c]] != 0:   # it would break away within T_TIE (the tie-break below): overloaded
+                ex = max(ex, 0.0)
+            if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
+                a = _item_acc(p, acc, cand[c])
+                ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
+            exc[c] = ex
+            dirs[c] = d
+            if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
+                # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
+                # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
+                # that set contradicts a prescribed motion.)
+                dirs[c] = 1
+            worst = max(worst, ex)
+        if worst >= 0.0:
+            # the candidates, most overloaded first
+            order = np.argsort(-exc[:nc])
+            cs = cand[:nc][order].copy()
+            ds = dirs[:nc][order].copy()
             for c in range(nc):
-                _item_set(p, m, cand[c], _ZERO)
-            for _it in range(nc):
-                _evaluate(t, x, m, p, acc, tau)
-                best, bi, bd = -np.inf, _ZERO - 1, _ZERO
-                for c in range(nc):
-                    i = cand[c]
-                    if not _item_stuck(p, m, i):
-                        continue
-                    ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-                    if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
-                        ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
-                    if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
-                        continue
-                    if ex >= 0.0 and ex > best:
-                        best, bi, bd = ex, i, d
-                if bi < 0:
+                cand[c] = cs[c]
+                dirs[c] = ds[c]
+            found = False
+            pick = np.empty(max(nc, 1), dtype=np.int64)
+            smax = nc if nc <= 10 else 2
+            for s in range(1, smax + 1):
+                for q in range(s):
+                    pick[q] = q
+                while True:
+                    ok = True
+                    for q in range(s):
+                        if dirs[pick[q]] == 0:
+                            ok = False
+                    if ok:
+                        _apply_subset(p, m, cand, nc, dirs, pick, s)
+                        _evaluate(t, x, m, p, acc, tau)
+                        # released together, an item may move against the way its own torque pushed it (two gears
+                        # coupled through a reversing ratio): flip those to the way they accelerate, a few times
+                        for _flip in range(s + 1):
+                            if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
+                                found = True
+                                break
+                            if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+                                break
+                            _evaluate(t, x, m, p, acc, tau)
+                        if found:
+                            break
+                    # the next combination of s out of nc
+                    q = s - 1
+                    while q >= 0 and pick[q] == nc - s + q:
+                        q -= 1
+                    if q < 0:
+                        break
+                    pick[q] += 1
+                    for qq in range(q + 1, s):
+                        pick[qq] = pick[qq - 1] + 1
+                if found:
                     break
-                _item_set(p, m, bi, bd)
+            if not found:   # release the most overloaded until the rest hold
+                for c in range(nc):
+                    _item_set(p, m, cand[c], _ZERO)
+                for _it in range(nc):
+                    _evaluate(t, x, m, p, acc, tau)
+                    best, bi, bd = -np.inf, _ZERO - 1, _ZERO
+                    for c in range(nc):
+                        i = cand[c]
+                        if not _item_stuck(p, m, i):
+                            continue
+                        ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+                        if forced[i] != 0:
+                            ex = max(ex, 0.0)
+                        if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
+                            ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
+                        if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
+                            continue
+                        if ex >= 0.0 and ex > best:
+                            best, bi, bd = ex, i, d
+                    if bi < 0:
+                        break
+                    _item_set(p, m, bi, bd)
+                _evaluate(t, x, m, p, acc, tau)
+        # ---- the second-order tie-break (T_TIE, TIE_BAND): a stuck candidate within TIE_BAND of its limit is
+        # evaluated again at t + T_TIE (angles and speeds advanced by the decided motion, an error of order
+        # T_TIE**2); one beyond what it holds there (its static limit, not its lock-up limit) is marked forced and
+        # the search repeated.  Without it the decision at such an instant followed the sign the rounding left,
+        # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
+        # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
+        # functions of their own they compiled 2.5 s more.)
+        near = False
+        marked = False
+        for c in range(nc):
+            i = cand[c]
+            if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
+                near = True
+        if near:
+            exs = np.empty(nc)
+            near_ = np.zeros(nc, dtype=np.bool_)
+            for c in range(nc):
+                exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
+                near_[c] = _near_limit(t, p, tau, cand[c])
+            dt = T_TIE
+            for q in range(xp.shape[0]):
+                xp[q] = x[q]
+            for j in range(n):
+                xp[j] = x[j] + dt * x[n + j]
+                xp[n + j] = x[n + j] + dt * acc[j]
+            _evaluate(t + dt, xp, m, p, acc, tau)
+            for c in range(nc):
+                i = cand[c]
+                ex0 = exs[c]
+                if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
+                    continue
+                ex1, _d = _item_excess(t + dt, p, tau, i, False)
+                if ex1 >= 0.0:
+                    forced[i] = 1
+                    marked = True
             _evaluate(t, x, m, p, acc, tau)
+        if not marked:
+            break
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
     # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the
     # crossing would be missed); one that moves clearly watches 0
@@ -2232,6 +2361,7 @@ def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
     :func:`forget_signals`)."""
     forget_signals(p)
+    _instant(p)[0] = np.nan   # a new instant (:func:`_one_search_per_instant`)
     return settle_outlined(t, x, m, p, log, m.copy())
 
 

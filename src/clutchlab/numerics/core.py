@@ -20,7 +20,10 @@ Both share the hybrid logic:
   watched; a crossing in the direction ``Options.gdir[k]`` (+1 rising
   through zero, -1 falling, 0 either; a start exactly on zero does not
   count) is located by root finding (Illinois) on the step's dense output,
-  the step is cut at the earliest root, and the model's ``update`` is called
+  the step is cut at the earliest root (Dormand-Prince: moved to where the
+  function crosses on the step's own order-5 solution of that length, the
+  state the run restarts from, :func:`_root_on_step`; Rodas3: one step of
+  the located length), and the model's ``update`` is called
   for every function that crossed there, which changes the modes and records
   named events (:func:`record`);
 * ``next_break`` times (input table corners, controller samples) end a step
@@ -223,7 +226,7 @@ def _dense(theta, h, x0, f0, x1, f1, rc, mass, out):
             out[i] += w * rc[i]
 
 
-@register_jitable(inline="always")
+@register_jitable
 def _may_cross(g0, g1, gdir):
     """False if no switching function can have crossed in the step (then :func:`_locate` is skipped).
 
@@ -344,6 +347,193 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
                 ghi *= 0.5
             side = -1
     return hi, n_rhs
+
+
+@register_jitable
+def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, event_tol, theta, Ks, xt, xs, fe, ge, gs,
+                  gd):
+    """The event located on the step's own solution: the root ``theta`` found on the dense output moved to where the
+    switching function crosses on a Dormand-Prince step of the fraction, so that the state a run restarts from is an
+    order-5 solution on which the crossing shows (the dense output's order-4 error, which the step control does not
+    see, is not carried past the event: docs/driveline.md "Energy").
+
+    The function followed: one that has crossed at ``theta`` on the step's solution (preferring one that crossed
+    there on the dense output too), else one whose root on the dense output ``theta`` is (it crosses just after
+    ``theta`` on the step; this includes a dip through zero that is back by the step's end, such as a backlash's
+    touch of an edge).  Its value on the step's solution at ``theta`` and its slope on the dense output predict the
+    root (a Newton step; the two solutions differ by the step's error, so the prediction is good to far below
+    ``event_tol``); where the function has crossed just past the prediction (0.01 ``event_tol``, then 8 times as far,
+    up to four times), that is the event (mostly two steps of the fraction and two evaluations, 14 in all); else
+    the Illinois iteration on the step's solution goes on from the bracket found.
+
+    ``(theta, n_rhs, ok)``: ``ok`` False leaves the dense output's root and state (the crossing does not show on the
+    step's solution where it can be bracketed: a dip through zero seen on the dense output only).  ``xs`` receives
+    the state, ``Ks`` and ``fe`` the stages and end slope of the step to it (its dense output for the samples).
+
+    Written as one loop with one evaluation of each kind (the dense output, a step of a fraction) and no helper
+    functions: the right-hand side is linked at two call sites in one compiled function (its compilation
+    dominates the core's: three helpers cost 4 s more of the driveline's first compilation).
+    """
+    ng = g0.shape[0]
+    n_rhs = 0
+    if theta >= 1.0:
+        return theta, 0, False
+    tol = event_tol / h
+    d = max(1e-6, 64.0 * tol)
+    # the dense output at theta (which functions cross there) and d before it (their slopes)
+    for j in range(2):
+        th = theta if j == 0 else theta - d
+        if th <= 0.0:
+            break
+        _dense(th, h, x, k1, x1, f1, rc, mass, xt)
+        model.rhs(t + th * h, xt, u, m, p, fe, ge)
+        n_rhs += 1
+        for k in range(ng):
+            if j == 0:
+                gd[k] = ge[k]
+            else:
+                gs[k] = (gd[k] - ge[k]) / d   # (the slopes, until the step's values overwrite them)
+    slope_ok = theta - d > 0.0
+    # the evaluations on the step's solution: phase 0 at theta, 1 the probes past the Newton prediction, 2 the
+    # Illinois iteration, 3 the final state
+    kk = -1
+    at_theta = False
+    lo = glo = hi = ghi = 0.0
+    pred = off = 0.0
+    slope = 0.0
+    phase = 0
+    side = 0
+    n_probe = 0
+    n_it = 0
+    th = theta
+    last = -1.0
+    n = x.shape[0]
+    k2 = Ks[0]
+    k3 = Ks[1]
+    k4 = Ks[2]
+    k5 = Ks[3]
+    k6 = Ks[4]
+    for _ev in range(220):
+        # the Dormand-Prince order-5 solution of a step of th * h from (t, x) into xs, its stages 2-6 into Ks, the
+        # right-hand side and switching functions at its end into fe, ge (the error estimate is not needed: the
+        # fraction of an accepted step is as accurate as the step); the stages written out as in _advance_dopri,
+        # with one call of the right-hand side
+        hh = th * h
+        for stg in range(1, 7):
+            if stg == 1:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A21 * k1[i])
+                c = C2
+            elif stg == 2:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A31 * k1[i] + A32 * k2[i])
+                c = C3
+            elif stg == 3:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+                c = C4
+            elif stg == 4:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+                c = C5
+            elif stg == 5:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+                c = 1.0
+            else:
+                for i in range(n):
+                    xt[i] = x[i] + hh * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+                    xs[i] = xt[i]
+                c = 1.0
+            model.rhs(t + c * hh, xt, u, m, p, fe if stg == 6 else Ks[stg - 1], ge)
+        n_rhs += 6
+        last = th
+        if phase == 0:
+            for k in range(ng):
+                if _crossed(ga[k], ge[k], gdir[k]):
+                    if kk < 0 or (_crossed(ga[k], gd[k], gdir[k]) and not _crossed(ga[kk], gd[kk], gdir[kk])):
+                        kk = k
+            at_theta = kk >= 0
+            if not at_theta:
+                for k in range(ng):
+                    if _crossed(ga[k], gd[k], gdir[k]):
+                        kk = k
+                        break
+                if kk < 0:
+                    return theta, n_rhs, False
+            slope = gs[kk]
+            # the bracket known so far on the step's solution: lo (not crossed), hi (crossed; -1 not known yet)
+            if at_theta:
+                lo = 1e-6 if g0[kk] == 0.0 else 0.0
+                glo = ga[kk]
+                hi = theta
+                ghi = ge[kk]
+            else:
+                lo = theta
+                glo = ge[kk]
+                if _crossed(ga[kk], g1[kk], gdir[kk]):
+                    hi = 1.0
+                    ghi = g1[kk]
+                else:
+                    hi = -1.0
+            phase = 1
+            if slope_ok and slope != 0.0:
+                # the value on the step's solution, the slope on the dense output: a Newton step to the root
+                pred = theta - ge[kk] / slope
+                off = 0.01 * tol
+            else:
+                n_probe = 4
+        elif phase == 1:
+            if _crossed(ga[kk], ge[kk], gdir[kk]):
+                hi, ghi = th, ge[kk]
+                lo = max(lo, th - tol)
+                n_probe = 4
+            else:
+                lo, glo = th, ge[kk]
+                off *= 8.0
+                n_probe += 1
+        elif phase == 2:
+            if _crossed(ga[kk], ge[kk], gdir[kk]):
+                hi, ghi = th, ge[kk]
+                if side == 1:
+                    glo *= 0.5
+                side = 1
+            else:
+                lo, glo = th, ge[kk]
+                if side == -1:
+                    ghi *= 0.5
+                side = -1
+            n_it += 1
+        else:
+            break
+        # the next point
+        if phase == 1:
+            q = pred + off
+            if n_probe < 4 and lo < q and (hi < 0.0 or q < hi) and q < 1.0:
+                th = q
+                continue
+            if hi < 0.0:
+                # a dip through zero on the dense output that the step's solution does not show where looked for
+                return theta, n_rhs, False
+            phase = 2
+        if phase == 2 and (hi - lo) * h > event_tol and n_it < 200:
+            if glo != ghi and n_it < 40:
+                th = lo + (hi - lo) * glo / (glo - ghi)
+            else:   # (a function that jumps at its root: bisect)
+                th = 0.5 * (lo + hi)
+            span = hi - lo
+            th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
+            continue
+        # located: the state at hi
+        if hi >= 1.0:
+            for i in range(x.shape[0]):
+                xs[i] = x1[i]
+            return 1.0, n_rhs, True
+        if last == hi:
+            return hi, n_rhs, True
+        phase = 3
+        th = hi
+    return hi, n_rhs, True
 
 
 @register_jitable(forceinline=True)
@@ -483,9 +673,13 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     ge = np.empty(ng)
     ga = np.empty(ng)
     tab_c = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
+    Ks = np.empty((5, n))
+    xs = np.empty(n)
+    gs = np.empty(ng)
+    gd = np.empty(ng)
     # work arrays without reference counting (their owners are kept alive to the end of the run)
-    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c)
-    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c = borrow(owners)
+    owners = (K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs, gd)
+    K, xt, xn, xe, fe, err, rc, g0, g1, ge, ga, tab_c, Ks, xs, gs, gd = borrow(owners)
     k1 = K[0]
     k2 = K[1]
     k3 = K[2]
@@ -612,6 +806,12 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if samples:
                 dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
         si[SI_NRHS] += nr
+        on_step = False
+        if theta < 1.0:
+            # the root moved to the step's own solution, the state the run restarts from
+            theta, nr, on_step = _root_on_step(p, t, h, x, k1, xn, k7, rc, mass, g0, g1, ga, opt.gdir, u, m,
+                                               opt.event_tol, theta, Ks, xt, xs, fe, ge, gs, gd)
+            si[SI_NRHS] += nr
         if theta <= 1.0:
             t_new = t + theta * h
         elif last:
@@ -620,13 +820,24 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             t_new = t + h
         # ---- samples in (t, t_new] on the dense output (modes of the step; the test here saves a call per step)
         if samples and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
-            i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
-                                  want_y, xe, i_rec)
+            if on_step and theta < 1.0:
+                # on the dense output of the step to the event (its stages are in Ks, its end slope in fe), which
+                # ends on the state the run restarts from: samples and restart on one solution
+                dense_correction(theta * h, k1, Ks[1], Ks[2], Ks[3], Ks[4], fe, rc)
+                i_rec = _record_dense(p, t, theta * h, x, k1, xs, fe, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m,
+                                      rec_y, want_y, xe, i_rec)
+            else:
+                i_rec = _record_dense(p, t, h, x, k1, xn, k7, rc, mass, t_new, u, m, ts, rec_t, rec_x, rec_m, rec_y,
+                                      want_y, xe, i_rec)
         si[SI_ACCEPTED] += 1
         if theta <= 1.0:
-            _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
-            for i in range(n):
-                x[i] = xe[i]
+            if on_step:
+                for i in range(n):
+                    x[i] = xs[i]
+            else:
+                _dense(theta, h, x, k1, xn, k7, rc, mass, xe)
+                for i in range(n):
+                    x[i] = xe[i]
             t = t_new
             model.rhs(t, x, u, m, p, fe, g1)
             si[SI_NRHS] += 1
