@@ -262,7 +262,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         if g0[k] == 0.0 and g1[k] != 0.0:
             if not probed:
                 _dense(th0, h, x0, f0, x1, f1, rc, mass, xe)
-                model.rhs(t + th0 * h, xe, u, m, p, fe, ge)
+                model.rhs_event(t + th0 * h, xe, u, m, p, fe, ge)
                 n_rhs += 1
                 probed = True
             ga[k] = ge[k]
@@ -275,7 +275,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         if hi < 1.0:
             # an earlier root is known: only look before it
             _dense(hi, h, x0, f0, x1, f1, rc, mass, xe)
-            model.rhs(t + hi * h, xe, u, m, p, fe, ge)
+            model.rhs_event(t + hi * h, xe, u, m, p, fe, ge)
             n_rhs += 1
             if not _crossed(glo, ge[k], gdir[k]):
                 continue
@@ -294,7 +294,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         if best >= 1.0:
             break
         _dense(best, h, x0, f0, x1, f1, rc, mass, xe)
-        model.rhs(t + best * h, xe, u, m, p, fe, ge)
+        model.rhs_event(t + best * h, xe, u, m, p, fe, ge)
         n_rhs += 1
         earliest = best
         gb = ge.copy()   # (rare: a step with an event; the searches below overwrite ge)
@@ -332,7 +332,7 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
         span = hi - lo
         th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
         _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
-        model.rhs(t + th * h, xe, u, m, p, fe, ge)
+        model.rhs_event(t + th * h, xe, u, m, p, fe, ge)
         n_rhs += 1
         if _crossed(gref, ge[k], gdir_k):
             hi = th
@@ -386,7 +386,7 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
         if th <= 0.0:
             break
         _dense(th, h, x, k1, x1, f1, rc, mass, xt)
-        model.rhs(t + th * h, xt, u, m, p, fe, ge)
+        model.rhs_event(t + th * h, xt, u, m, p, fe, ge)
         n_rhs += 1
         for k in range(ng):
             if j == 0:
@@ -445,7 +445,7 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
                     xt[i] = x[i] + hh * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
                     xs[i] = xt[i]
                 c = 1.0
-            model.rhs(t + c * hh, xt, u, m, p, fe if stg == 6 else Ks[stg - 1], ge)
+            model.rhs_event(t + c * hh, xt, u, m, p, fe if stg == 6 else Ks[stg - 1], ge)
         n_rhs += 6
         last = th
         if phase == 0:
@@ -622,7 +622,7 @@ def _at_break(p, t, x, u, m, log, f, g, si):
     """At a break time ``t`` (input corner, controller sample): the model's ``restart``, then ``f`` and ``g``
     at ``t``; returns the next break time."""
     model.restart(t, x, u, m, p, log)
-    model.rhs(t, x, u, m, p, f, g)
+    model.rhs_event(t, x, u, m, p, f, g)
     si[SI_NRHS] += 1
     return model.next_break(t, m, p)
 

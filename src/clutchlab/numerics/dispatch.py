@@ -25,6 +25,11 @@ and the parameters ``p``):
     Right-hand side into ``dx`` and the switching functions into ``g``.
     (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the same hook, inlined
     there for a model registered with ``inline_stages=True``.)
+``rhs_event(t, x, u, m, p, dx, g)`` (optional)
+    The same right-hand side, where the core evaluates it at events (locating a root, the step to it,
+    a break); ``rhs`` itself if not given.  A model whose right-hand side is large gives it called
+    through its address (:mod:`clutchlab.numerics.outline`), so that the core's event-time functions
+    do not each link and optimise it again (the driveline: docs/architecture.md).
 ``outputs(t, x, u, m, p, y)``
     Output vector into ``y``.
 ``update(t, x, u, m, p, k, log)``
@@ -63,12 +68,13 @@ from numba.extending import overload
 
 from .borrow import ByRef
 
-__all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "outputs", "update", "restart", "accept",
+__all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "rhs_event", "outputs", "update", "restart", "accept",
            "next_break", "jacobian", "time_derivative", "no_time_derivative"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
-#: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time)
-OPTIONAL_HOOKS = ("time_derivative",)
+#: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time;
+#: ``rhs_event``: the right-hand side where the core evaluates it at events, its ``rhs`` if not given)
+OPTIONAL_HOOKS = ("time_derivative", "rhs_event")
 
 
 def no_time_derivative(t, x, u, m, p, ft):
@@ -158,7 +164,10 @@ def _hook(p, name, key):
     if isinstance(p, ByRef):
         p = p.pointee
     if isinstance(p, types.BaseNamedTuple) and p.instance_class in _MODELS:
-        fn = _MODELS[p.instance_class].get(name)
+        hooks = _MODELS[p.instance_class]
+        if name == "rhs_event" and name not in hooks:
+            name = "rhs"
+        fn = hooks.get(name)
         if fn is not None and _options_key(fn) == key:
             return fn.py_func
     return None
@@ -179,6 +188,10 @@ def rhs(t, x, u, m, p, dx, g):  # pragma: no cover - replaced by the overload
 
 
 def rhs_stage(t, x, u, m, p, dx, g):  # pragma: no cover - replaced by the overload
+    raise NotImplementedError
+
+
+def rhs_event(t, x, u, m, p, dx, g):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
 
@@ -259,6 +272,6 @@ overload(time_derivative, jit_options={"cache": False})(
     functools.wraps(time_derivative)(_default_time_derivative))
 
 #: (stub, hook it resolves to)
-_STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
+_STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (rhs_event, "rhs_event"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
           (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"),
           (time_derivative, "time_derivative"))
