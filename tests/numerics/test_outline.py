@@ -91,7 +91,7 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
     from clutchlab.driveline import kernel as K
 
     outline.prepare()
-    for fn in (K._repair, K.settle, K.check_invariants, K.driveline_rhs, K.driveline_outputs):
+    for fn in (K._repair, K.settle, K.check_invariants, K.driveline_rhs):
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
 
@@ -105,7 +105,7 @@ from clutchlab.numerics import outline
 for name in ("coupled_clutches", "wet_sae2", "emtc_awd", "eclutch_launch"):
     load_driveline(Path(r"{examples}") / f"driveline_{{name}}.toml").driveline.simulate(0.05, check_invariants=True)
 out = {{}}
-for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs, K.driveline_outputs):
+for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs):
     entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
     out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
 print(json.dumps(out))
@@ -114,7 +114,7 @@ print(json.dumps(out))
 
 def test_the_example_networks_call_the_driveline_through_the_outlined_signatures():
     """Plain, wet and EMTC networks call the outlined functions with the very types they are outlined for (the
-    network's right-hand side at events and its outputs, through the core's ``rhs_event`` and ``outputs`` hooks): a
+    network's right-hand side at events too, through the core's ``rhs_event`` hook): a
     signature drift (a new field of the parameter structure, another log type) would link them again silently,
     compiled once more in every function of the core.  (A fresh process: tests here call kernel functions directly.)"""
     import json
@@ -127,5 +127,5 @@ def test_the_example_networks_call_the_driveline_through_the_outlined_signatures
                           text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    assert out == {name: [True] for name in ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs",
-                                             "driveline_outputs")}, out
+    names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs")
+    assert out == {name: [True] for name in names}, out

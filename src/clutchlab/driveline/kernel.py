@@ -2520,17 +2520,6 @@ def driveline_rhs_event(t, x, u, m, p, dx, g):
     _rhs_outlined(t, x, u, m, p, dx, g)
 
 
-#: :func:`driveline_outputs` through its address: the core's recorders and output evaluations (five functions) would
-#: otherwise each link and optimise it again; it is evaluated once per sample, never in a step's stages
-_outputs_outlined = outlined(driveline_outputs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1), types.none)
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def driveline_outputs_hook(t, x, u, m, p, y):
-    """:func:`driveline_outputs` through its address (the core's ``outputs`` hook)."""
-    _outputs_outlined(t, x, u, m, p, y)
-
-
-dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs_hook, update=driveline_update,
+dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
                   jacobian=driveline_jacobian, rhs_event=driveline_rhs_event)
