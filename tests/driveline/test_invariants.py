@@ -275,6 +275,170 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
         assert max(abs(a[0] - b[0]) for a, b in zip(ev, runs[-1])) < 1e-6
 
 
+def _clutch_loop_around_a_table_gear(J0, amplitude, peak, fn_c2, fn_loop, bearing):
+    """The network the thorough profile found (#30): a one-way clutch with a clutch, a loss-table gear reversing at
+    efficiency 0.5-0.55, a clutch, and a clutch closing the loop; a sine on the one-way clutch's driven side."""
+    d = Driveline("loop")
+    d.inertia("J0", J=J0, w0=0.0).inertia("J1", J=1.0).inertia("J2", J=1.0).inertia("J3", J=1.5)
+    d.one_way_clutch("f0", "J0", "J1", fn_max=1.0, mu=0.5, peak=peak, normal=Signal.step(1.0, 0.0))
+    d.gear("g1", "J1", "J2", ratio=-1.0, loss_table=[[0.0, 0.5, 0.5, 0.0, 0.0], [20.0, 0.55, 0.5, 0.0, 0.0]])
+    d.clutch("c2", "J2", "J3", fn_max=fn_c2, mu=0.5)
+    d.clutch("loop", "J0", "J3", fn_max=fn_loop, mu=0.5)
+    if bearing:
+        d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+    d.torque("T1", "J1", Signal.sine(amplitude, 2.0))
+    return d
+
+
+@pytest.mark.parametrize("case", ["bearing", "no bearing"])
+def test_a_clutch_reaching_rest_beside_a_stuck_gear_decides_by_the_forces_not_the_tolerance(case):
+    """Found by the thorough profile.  With the bearing: the gear sticks at 0.29376 s and the rest of the loop
+    reaches rest at 0.29627 s.  A stuck set holds accelerations, not speeds: the gear kept the speed its located
+    stick instant left, 1e-9 rad/s (its stick function's rounding width), so clutch c2 beside it reached "rest" with
+    1e-9 rad/s of slip, right at the width that tells rest from sliding: at rtol 1e-7, 1e-8 and 1e-11 it went on
+    sliding and the loop broke away at 0.472 s, at 1e-9 and 1e-10 it stuck and the loop held to 0.5 s (J0 1.7e-3
+    rad/s apart).  Now every stuck member's relative speed is put to zero when the modes are settled
+    (``kernel._project_speeds``): the stuck gear's flanges are at rest to rounding, and every tolerance takes the
+    same decisions at the same instants.  Without the bearing: the same, found as a different sequence of mode
+    changes at rtol 1e-7 and 1e-10."""
+    if case == "bearing":
+        d = _clutch_loop_around_a_table_gear(1.0, 8.0, 2.0, 5.0, 6.0, True)
+    else:
+        d = _clutch_loop_around_a_table_gear(0.5, -10.0, 1.0, 6.0, 5.0, False)
+    rtols = (1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
+    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in rtols]
+    ref = runs[-1]
+    for res in runs:
+        assert [e[1:] for e in _mode_events(res)] == [e[1:] for e in _mode_events(ref)]
+        assert max(abs(a[0] - b[0]) for a, b in zip(_mode_events(res), _mode_events(ref))) < 1e-6
+        for col in ("J0.w_rad_s", "J1.w_rad_s", "J3.w_rad_s"):
+            assert np.max(np.abs(res.to_dataframe()[col] - ref.to_dataframe()[col])) < 1e-5, col
+    if case == "bearing":
+        ev = _mode_events(ref)
+        assert [round(t, 5) for t, el, e in ev if el == "g1" and e == "stick"][0] == 0.29376
+        assert ("bearing", "stick") in {(el, e) for t, el, e in ev if abs(t - 0.296273) < 1e-6}
+        # the stuck gear's flanges at rest to rounding while the rest of the loop slides to rest (1e-9 before)
+        res = d.simulate(1.0, sample_times=np.linspace(0.2940, 0.2960, 5), rtol=1e-7)
+        df = res.to_dataframe()
+        assert (df["g1.mode_1"] == 0).all()
+        assert np.max(np.abs(df["J1.w_rad_s"])) < 1e-13 and np.max(np.abs(df["J2.w_rad_s"])) < 1e-13
+
+
+def test_a_stuck_lossy_gear_beside_a_bearing_holds_whatever_brakes_elsewhere_hold():
+    """Found by the thorough profile: a lossy gear (efficiency 0.875) and a bearing friction hold one shaft at rest
+    (a statically indeterminate pair: which carries what is a choice), a spring from a sine-driven inertia loading
+    it from zero.  The regularised split weighed the gear's hold as the strongest friction element in the whole
+    set, so a stuck brake on an inertia of its own elsewhere moved the split; and the split was moved into the
+    gear's band only once it left it by more than the rounding floor the gear's switching function sees, so
+    which came first was a rounding: with the unrelated brake the gear rolled backward at 0.11 ms (with 1.6e-12 N m
+    on it), without it stayed stuck for the whole run.  Now a member without a limit of its own weighs as the
+    strongest friction element on its own inertias, and the split is moved into the band before the switching
+    function's floor: stuck for the whole run with or without the brake."""
+    runs = []
+    for unrelated in (False, True):
+        d = Driveline("shaft")
+        d.inertia("J0", J=1.0, w0=0.0).inertia("J1", J=1.0).inertia("J2", J=1.0)
+        d.gear("g0", "J0", "J1", ratio=-0.3125, efficiency=0.875)
+        d.spring_damper("k1", "J1", "J2", c=1.0, d=0.0)
+        d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+        d.torque("T2", "J2", Signal.sine(1.0, 0.40625))
+        if unrelated:
+            d.inertia("U", J=1.0, w0=0.0)
+            d.brake("Ubrake", "U", fn_max=3.0, mu=0.5)
+            d.torque("UT", "U", Signal.sine(0.0, 1.0))
+        for rtol in (1e-7, 1e-10):
+            res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
+            runs.append(res)
+            assert not [e for e in _mode_events(res) if not str(e[1]).startswith("U")]
+            assert (res.to_dataframe()["g0.mode_1"] == 0).all()
+    # the spring's load reaches the bearing through the gear and the split between the gear's hold and the bearing
+    # is the same with and without the brake elsewhere (it differed by 2e-3 N m of 0.81 at 1 s): the bearing's
+    # torque agrees to the integration error (rtol 1e-10)
+    alone, both = runs[1].to_dataframe()["bearing.tau_Nm"], runs[3].to_dataframe()["bearing.tau_Nm"]
+    np.testing.assert_allclose(both, alone, rtol=0, atol=1e-6 * np.max(np.abs(alone)))
+
+
+def test_a_lossy_gear_in_a_rigid_loop_whose_torque_changes_sign_with_its_quadrant_holds():
+    """Found by the thorough profile: three reversing gears (efficiency 0.5, a loss table, ideal) and a clutch close
+    a loop that locks every inertia (J1 = -J0, J2 = J0, J3 = -J0 and the clutch J3 = J0).  At 0.41957 s the load
+    through g0 passes zero; its quadrant function crossed, but in the locked loop its torque is -6e-11 N m with
+    flange a driving and positive with flange b driving: neither quadrant is consistent.  The search released it
+    anyway (forward, flange a driving) and the compiled check stopped the run: "g0: negative loss (power
+    generated)".  Now a released lossy gear must be in the quadrant its torque puts it in (``kernel._consistent``),
+    so it holds and the clutch slides: the invariants at every step, the same mode changes at rtol 1e-7 and 1e-10."""
+    d = Driveline("rigid_loop")
+    for i in range(4):
+        d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
+    d.gear("g0", "J0", "J1", ratio=-1.0, efficiency=0.5)
+    d.gear("g1", "J1", "J2", ratio=-1.0, loss_table=[[0.0, 1.0, 0.5, 0.0, 1.0], [20.0, 1.0, 0.5, 0.0, 1.0]])
+    d.gear("g2", "J2", "J3", ratio=-1.0)
+    d.clutch("loop", "J0", "J3", fn_max=1.0, mu=0.5)
+    d.torque("T0", "J0", Signal.sine(1.0, 1.0))
+    d.torque("T2", "J2", Signal.sine(1.0, 0.5))
+    runs = [d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in (1e-7, 1e-10)]
+    ev = [_mode_events(r) for r in runs]
+    assert [e[1:] for e in ev[0]] == [e[1:] for e in ev[1]]
+    assert max(abs(a[0] - b[0]) for a, b in zip(*ev)) < 1e-6
+    at = {(el, e) for t, el, e in ev[1] if abs(t - 0.4195694) < 1e-6}
+    assert at == {("loop", "backward"), ("g0", "stick")}
+
+
+@pytest.mark.parametrize("hz", [2.0, 1.0])
+def test_a_slow_gear_is_decided_by_its_own_events_not_by_an_unrelated_element(hz):
+    """Found by the thorough profile: a self-locking gear (efficiency 0.203) between two springs, driven by 4e-8 N m
+    (it turns at about 1e-9 rad/s, the rounding width of a speed at rest), and an inertia of its own elsewhere,
+    braked and driven by a sine: its events came at other instants with that inertia than without it (its reversal
+    at 0.594 against 0.625 s, 0.607 against 0.680 s).  Two causes: every search at any event took every item
+    slower than its rounding width as at rest and decided it again (now only those linked to the element whose event
+    it is, ``kernel._linked``, or all at a restart), and an item reversing one width past zero watched -1e-9 rad/s
+    or 0 next by a rounding (``kernel._start_slack``: within two widths it is at rest).  The gear's mode changes
+    are the same with and without the unrelated inertia, at rtol 1e-8 and 1e-10."""
+    runs = {}
+    for unrelated in (False, True):
+        d = Driveline("slow")
+        for i in range(4):
+            d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
+        d.gear("g0", "J0", "J1", ratio=-1.0, efficiency=0.203125)
+        d.spring_damper("k1", "J1", "J2", c=1.0, d=0.0)
+        d.spring_damper("k2", "J2", "J3", c=1.0, d=0.0)
+        d.torque("T1", "J1", Signal.sine(4e-8, hz))
+        if unrelated:
+            d.inertia("U", J=1.0, w0=0.0)
+            d.brake("Ubrake", "U", fn_max=1.0, mu=0.5)
+            d.torque("UT", "U", Signal.sine(1.0, 1.0))
+        for rtol in (1e-8, 1e-10):
+            res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
+            runs[unrelated, rtol] = [e for e in _mode_events(res) if not str(e[1]).startswith("U")]
+            if unrelated:
+                assert any(el == "Ubrake" for el in res.events.element)   # it has events of its own
+    ref = runs[False, 1e-10]
+    assert len(ref) >= 2
+    for key, ev in runs.items():
+        assert [e[1:] for e in ev] == [e[1:] for e in ref], key
+        assert max(abs(a[0] - b[0]) for a, b in zip(ev, ref)) < 1e-6, key
+
+
+def test_a_bearing_and_a_stuck_gear_at_their_limits_together_are_labelled_the_same_at_every_tolerance():
+    """Found by the thorough profile: a bearing friction and a lossy gear with bearing friction in its loss table
+    hold one shaft at rest (a statically indeterminate pair), a brake the other shaft from 0.5 s, a 7 N m sine.  At
+    0.89217 s the split between the bearing and the gear's hold reaches both limits together: releasing either
+    alone is consistent (the other holds the shaft), and which one's excess was the larger was a rounding, so at
+    rtol 1e-7 the bearing slid at zero speed and at 1e-8 the gear rolled at zero speed.  Overloads within 1e-6 of
+    each other are now a tie, taken lossy gears first (``kernel.settle``): the gear rolls at every tolerance."""
+    d = Driveline("pair")
+    d.inertia("J0", J=1.0, w0=0.0).inertia("J1", J=1.0)
+    d.gear("g0", "J0", "J1", ratio=-3.0, loss_table=[[0.0, 1.0, 0.5, 1.0, 0.0], [20.0, 1.0, 0.5, 1.5, 0.0]])
+    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+    d.brake("brake", "J1", fn_max=1.0, mu=0.4, normal=Signal.step(1.0, 0.5))
+    d.torque("T1", "J1", Signal.sine(7.0, 3.0))
+    runs = [_mode_events(d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True))
+            for rtol in (1e-7, 1e-8, 1e-10, 1e-11)]
+    for ev in runs:
+        assert [e[1:] for e in ev] == [e[1:] for e in runs[-1]]
+        assert max(abs(a[0] - b[0]) for a, b in zip(ev, runs[-1])) < 1e-6
+    assert ("g0", "forward") in {(el, e) for t, el, e in runs[-1] if abs(t - 0.8921658) < 1e-6}
+
+
 def test_the_energy_balance_at_events_follows_the_tolerance():
     """A loop at the edge of self-locking (an ideal gear of ratio -1, a lossy gear of ratio 1 and efficiency 0.21875,
     a 1 N clutch) driven by a 19 N m sine at 4 Hz: 24 events in 1 s, 0.48 J of input work, speeds below 0.1 rad/s.

@@ -88,12 +88,42 @@ def test_a_caller_that_cannot_find_the_function_raises():
 
 
 def test_prepare_compiles_every_outlined_function_of_the_driveline():
+    """``prepare`` compiles every outlined function but the lazy ones (the invariant check, a debug option),
+    ``prepare(lazy=True)`` those too."""
     from clutchlab.driveline import kernel as K
 
+    assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K.check_invariants]
     outline.prepare()
-    for fn in (K._repair, K.settle, K.check_invariants, K.driveline_rhs):
+    for fn in (K._repair, K.settle, K.driveline_rhs):
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
+    outline.prepare(lazy=True)
+    entry = next(e for e in outline._ENTRIES if e.dispatcher is K.check_invariants)
+    assert entry.sig() in K.check_invariants.overloads
+
+
+_UNCHECKED = r"""
+import json
+from pathlib import Path
+from clutchlab.driveline import kernel as K
+from clutchlab.driveline.description import load_driveline
+load_driveline(Path(r"{examples}") / "driveline_coupled_clutches.toml").driveline.simulate(0.05)
+print(json.dumps([len(K.check_invariants.overloads), len(K.settle.overloads)]))
+"""
+
+
+def test_a_run_without_the_check_does_not_compile_it():
+    """A run without ``check_invariants`` neither compiles nor loads the check (a fresh process)."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    proc = subprocess.run([sys.executable, "-c", _UNCHECKED.format(examples=examples)], capture_output=True,
+                          text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == [0, 1]
 
 
 _NETWORKS = r"""

@@ -210,7 +210,7 @@ def emtc_driveline_update(t, x, u, m, p, k, log):
     if res < 0:
         return res
     _coupling(t, x, m, p)
-    K.settle_outlined(t, x, m, byref(p.net), log, m.copy())
+    K.settle_outlined(t, x, m, byref(p.net), log, m.copy(), np.int64(-1))
     _sync(x, m, p)
     return res
 

@@ -899,7 +899,7 @@ def evaluate_network(t, x, m, p, acc, tau):
     for j in range(hold.shape[0]):
         hold[j] = 0.0
     if ns > 0:
-        _solve_stuck_outlined(t, x, p, m, stuck, ns, F, tau)
+        _solve_stuck_outlined(t, x, p, m, stuck, ns, F, tau, _ZERO)
     for i in range(n):
         acc[i] = F[i] / p.inertia[i]
     return ns
@@ -1376,16 +1376,17 @@ _repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, 
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
+def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     """Torques of the constraint set -- stuck friction elements, gears, stuck lossy gears' holds, motion sources
-    -- solved together.
+    -- solved together.  (``speeds`` = 1: ``F`` holds the momenta ``J w`` and the set is solved for the impulses that
+    put every member's relative speed to zero, a motion source's left as it is: :func:`_project_speeds`.)
 
     Each member ``k`` holds its relative acceleration ``g_k . alpha`` at its target (zero, or the prescribed
     acceleration of a motion source) with a multiplier ``lam_k`` that puts ``-lam_k h_k`` on the inertias
     (:func:`_member`): ``A lam = g M^-1 F - target`` with ``A[k, j] = g_k . M^-1 h_j``.  Where stuck elements
     lock the same relative motion (two clutches in parallel) ``A`` is singular: the regularised solution splits
     the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
-    gears and motion sources weigh as the strongest friction element), from ``(A + eps D) lam = b`` with ``D =
+    gears and motion sources weigh as the strongest friction element on their own inertias, else in the set), from ``(A + eps D) lam = b`` with ``D =
     diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal, refined twice on the residual of ``A lam =
     b``; then :func:`_repair` moves that split within the members' bounds where it would leave them while
     another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
@@ -1420,16 +1421,16 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         _member(p, m, x, n, rk, flf, gc, hc, k)
         s = 0.0
         target = 0.0
-        if rk >= 0:
-            if p.elem[rk, E_KIND] == K_MOTION:
-                d1, d2 = signal_rates(p.signals[p.elem[rk, E_SIGNAL]], p.data, t)
-                target = d1 if p.elem[rk, E_LAW] == MOTION_SPEED else d2
+        motion = rk >= 0 and p.elem[rk, E_KIND] == K_MOTION
+        if motion and speeds == 0:
+            d1, d2 = signal_rates(p.signals[p.elem[rk, E_SIGNAL]], p.data, t)
+            target = d1 if p.elem[rk, E_LAW] == MOTION_SPEED else d2
         s = -target
         for q in range(3):
             i = int(flf[3 * k + q])
             if i >= 0:
                 s += gc[3 * k + q] * F[i] / p.inertia[i]
-        b[k] = s
+        b[k] = 0.0 if motion and speeds != 0 else s
         lam[k] = 0.0
         cap[k] = -1.0
         lo[k] = -np.inf
@@ -1444,10 +1445,28 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
             bounded = True
         elif rk < 0:
             bounded = True
+    # a member without a limit of its own (a gear, a stuck lossy gear's hold, a one-way clutch, a motion source)
+    # weighs as the strongest friction element on its own inertias, else as the strongest in the set: local, so an
+    # element elsewhere in the network does not move a split here (#30)
+    for k in range(ns):
+        c = cap[k]
+        if c < 0.0:
+            for j in range(ns):
+                if cap[j] < 0.0:
+                    continue
+                for q in range(3):
+                    i = int(flf[3 * k + q])
+                    if i < 0:
+                        continue
+                    for qq in range(3):
+                        if int(flf[3 * j + qq]) == i:
+                            c = max(c, cap[j])
+            if c < 0.0:
+                c = cmax if cmax > 0.0 else 1.0
+        res[k] = c
     scale = 0.0
     for k in range(ns):
-        if cap[k] < 0.0:
-            cap[k] = cmax if cmax > 0.0 else 1.0
+        cap[k] = res[k]
         for j in range(ns):
             v = 0.0
             for q in range(3):
@@ -1482,7 +1501,10 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
         big = fscale
         for k in range(ns):
             big = max(big, abs(lam[k]))
-        tol = NOISE * (1.0 + big)
+        # (relative to the torques only: a split is moved into the bounds before the switching functions, whose
+        # floor is NOISE (1 + torque), see it leave them -- else which comes first is a rounding, and a stuck lossy
+        # gear beside a bearing rolled or held by the step sequence, #30)
+        tol = NOISE * big
         # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
         # v keeps the constraints, v being A's null vector to rounding)
         _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
@@ -1506,7 +1528,7 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau):
 #: evaluation of the network, which every function of the core links (4 s of the driveline's first compilation; the
 #: indirect call at each evaluation with a stuck set is within the run time's noise, docs/architecture.md)
 _solve_stuck_outlined = outlined(_solve_stuck, lambda: (types.float64, _F1, _params_type(), _I1, _F1, types.int64, _F1,
-                                                      _F1), types.none)
+                                                      _F1, types.int64), types.none)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1683,7 +1705,11 @@ def _evaluate(t, x, m, p, acc, tau):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
     """True if the modes of the candidates (items at rest) agree with the forces of the last evaluation: every
-    stuck one within what it holds, every released one accelerating its way (not against it beyond rounding)."""
+    stuck one within what it holds, every released one accelerating its way (not against it beyond rounding), a
+    released lossy gear in the quadrant its torque puts it in (in a rigid loop a gear's torque may change sign with
+    its quadrant: then neither is, and it must hold)."""
+    nf = p.fric.shape[0]
+    n = p.inertia.shape[0]
     for c in range(nc):
         i = cand[c]
         if _item_stuck(p, m, i):
@@ -1694,6 +1720,14 @@ def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
                 return False
         elif _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             return False
+        elif i >= nf:   # a released lossy gear: in the quadrant its torque puts it in (else none is: stuck)
+            r = _item_row(p, i)
+            mode = m[p.elem[r, E_MODE]]
+            te = gear_tau_eta(p, r, mode, -tau[r], abs(_item_speed(p, x, n, i)))
+            noise = _item_noise(p, r, tau)
+            if ((mode == GEAR_FWD_A or mode == GEAR_BWD_B) and te <= -noise) or \
+                    ((mode == GEAR_FWD_B or mode == GEAR_BWD_A) and te >= noise):
+                return False
     return True
 
 
@@ -1715,7 +1749,10 @@ def _start_slack(w, w_tol, d, was_stuck):
     way is still seen."""
     if was_stuck:
         return w_tol + max(0.0, -d * w)
-    return w_tol if abs(w) <= w_tol else 0.0
+    # (within two widths: an item that reverses where its stick function crossed, one width past zero, is about at
+    # rest; with one width, whether it watched -w_tol or 0 next was a rounding, and so its next reversal's instant
+    # changed by 30 ms with an unrelated element in a network turning at 1e-9 rad/s, #30)
+    return w_tol if abs(w) <= 2.0 * w_tol else 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1753,6 +1790,9 @@ def _apply_subset(p, m, cand, nc, dirs, pick, s):
 
 #: a stuck item that would break away within this time [s] of the instant is released at it (the tie-break in :func:`settle`)
 T_TIE = 1e-8
+#: Crossings closer than this [s] are one instant (:func:`_one_search_per_instant`): four times the event location's
+#: tolerance of a driveline run (1e-12 s), within which the locator cannot tell two crossings apart
+T_INSTANT = 4e-12
 
 
 #: a stuck item whose margin to its limit is below this many rounding floors (:func:`_item_noise`: 1e-6 of the
@@ -1782,13 +1822,15 @@ def _one_search_per_instant(t, m, p, log, old):
     change, independent of their order (a second search from the first's modes could undo it: a gear put stuck by
     the first released by the second).  The first search at a new instant stores the friction elements' and lossy
     gears' modes in ``old`` and the event count; a later one at the same instant puts them back into ``old`` and
-    drops the events the earlier searches recorded (theirs only: a backlash's contact is kept).  A restart (a
+    drops the events the earlier searches recorded (theirs only: a backlash's contact is kept).  Instants within
+    :data:`T_INSTANT` of the first are one (two crossings the locator put 1e-12 s apart: a bearing reversed for
+    1e-12 s before the loop it is in locked, at some tolerances and not at others, #30).  A restart (a
     run's start, a resume, a signal's jump) begins a new instant (:func:`driveline_restart`)."""
     nf = p.fric.shape[0]
     nl = p.lossy.shape[0]
     nsw = p.swit.shape[0]
     inst = _instant(p)
-    if inst[0] == t:
+    if abs(t - inst[0]) <= T_INSTANT:
         for k in range(nf):
             old[k] = np.int64(inst[2 + k])
         for j in range(nl):
@@ -1815,8 +1857,103 @@ def _one_search_per_instant(t, m, p, log, old):
         inst[2 + nf + j] = float(old[p.elem[p.lossy[j], E_MODE]])
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _components(p, comp):
+    """The linked groups of inertias: ``comp[i]`` the lowest inertia linked to inertia ``i`` through elements
+    (any element between two inertias, a gear's support included; the ground links nothing, it does not move)."""
+    n = p.inertia.shape[0]
+    for i in range(n):
+        comp[i] = i
+    changed = True
+    while changed:   # (a handful of passes: networks are small)
+        changed = False
+        for r in range(p.elem.shape[0]):
+            lo = n
+            for q in range(3):
+                i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
+                    (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+                if i >= 0:
+                    lo = min(lo, comp[i])
+            for q in range(3):
+                i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
+                    (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+                if i >= 0 and comp[i] != lo:
+                    comp[i] = lo
+                    changed = True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _linked(p, comp, origin, r):
+    """True if element row ``r`` acts on the inertias element row ``origin`` acts on, through elements
+    (:func:`_components`), or if ``origin`` is -1 (every element: a restart)."""
+    if origin < 0:
+        return True
+    c = -1
+    for q in range(3):
+        i = p.elem[origin, E_A] if q == 0 else p.elem[origin, E_B] if q == 1 else \
+            (p.elem[origin, E_SUP] if p.elem[origin, E_KIND] == K_GEAR else -1)
+        if i >= 0:
+            c = comp[i]
+    for q in range(3):
+        i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
+            (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+        if i >= 0 and comp[i] == c:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _project_speeds(t, x, m, p, comp, origin):
+    """Put the relative speed of every member of the constraint set of the modes ``m`` (stuck friction elements,
+    gears, stuck lossy gears' holds) to zero, by the impulses along the members' torque directions that do it (the
+    set of :func:`evaluate_network` solved by :func:`_solve_stuck` for momenta instead of torques: ``A mu = g . w``,
+    ``w -= M^-1 h mu``).
+
+    The set holds its relative accelerations at zero, not its speeds: a stuck member keeps the speed the located
+    event left it (the stick function's root, up to its rounding width :func:`_item_wtol` the wrong way) and the
+    integration's drift.  Left there, that residue is a relative speed of the elements beside it: a clutch that
+    reaches rest next to a gear stuck 1e-9 rad/s off rest sees 1e-9 rad/s of slip and is at rest or sliding by a
+    rounding, which then decides the network's motion (a loop of clutches around a lossy gear, #30).  The impulses
+    are of that residue's size; the kinetic energy they change is of its square (below 1e-15 J), left out of the
+    balance.  A stuck member beyond 1e3 rounding widths (what :func:`check_invariants` allows) is no residue but a
+    mode forced by hand: nothing is moved, and the check names it.  Only the members linked to element row
+    ``origin`` (:func:`_linked`; all at a restart, ``origin`` -1): a stuck set elsewhere keeps its residue until an
+    event of its own, as in a network without the element whose event this is."""
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    wk = p.work
+    F = wk[0:n]
+    stuck = wk[n:n + _nk(p)]
+    ns = _ZERO
+    for k in range(nf):
+        r = p.fric[k]
+        if m[k] == STUCK and _linked(p, comp, origin, r):
+            if abs(_item_speed(p, x, n, k)) > 1e3 * _item_wtol(p, r, x, n):
+                return   # beyond a residue (a mode forced by hand): left for the invariant check to name
+            stuck[ns] = r
+            ns += 1
+    for k in range(p.cons.shape[0]):
+        if _linked(p, comp, origin, p.cons[k]):
+            stuck[ns] = p.cons[k]
+            ns += 1
+    for j in range(p.lossy.shape[0]):
+        r = p.lossy[j]
+        if m[p.elem[r, E_MODE]] == GEAR_STUCK and _linked(p, comp, origin, r):
+            if abs(_item_speed(p, x, n, nf + j)) > 1e3 * _item_wtol(p, r, x, n):
+                return
+            stuck[ns] = -(r + 1)
+            ns += 1
+    for i in range(n):
+        F[i] = p.inertia[i] * x[n + i]
+    if ns == 0:
+        return
+    _solve_stuck_outlined(t, x, p, m, stuck, ns, F, _acc_tau(p)[1], np.int64(1))
+    for i in range(n):
+        x[n + i] = F[i] / p.inertia[i]
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
-def settle(t, x, m, p, log, old):
+def settle(t, x, m, p, log, old, origin):
     """Modes consistent with the forces at ``t`` (the event iteration of MSL's friction elements and ``LossyGear``).
 
     Friction elements are free or engaged by their normal force.  The items at rest -- friction elements and lossy
@@ -1848,11 +1985,17 @@ def settle(t, x, m, p, log, old):
     dirs = np.zeros(ni, dtype=np.int64)
     exc = np.empty(ni)
     nc = _ZERO
+    # (an item moving slower than its rounding width is at rest for a search on its own motion -- a restart, or an
+    # event of an element it is linked to -- not for an event elsewhere: there it goes on until its own function
+    # crosses, as in a network without that element)
+    comp = np.empty(n, dtype=np.int64)
+    _components(p, comp)
     for i in range(ni):
         if i < nf and m[i] == FREE:
             continue
-        if _item_stuck(p, m, i) or abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) or \
-                _item_passed_rest(p, m, x, n, i):
+        if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i) or \
+                (abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and
+                 _linked(p, comp, origin, _item_row(p, i))):
             cand[nc] = i
             nc += 1
             _item_set(p, m, i, _ZERO)
@@ -1880,8 +2023,16 @@ def settle(t, x, m, p, log, old):
                 dirs[c] = 1
             worst = max(worst, ex)
         if worst >= 0.0:
-            # the candidates, most overloaded first
-            order = np.argsort(-exc[:nc])
+            # the candidates, most overloaded first; overloads within 1e-6 of each other are a tie (two members of a
+            # statically indeterminate group reach their limits together: which one's excess is the larger is a
+            # rounding), taken lossy gears first, then in element order (a gear rolling while a bearing holds its
+            # shaft, or the bearing sliding while the gear holds, are one motion: the labels then do not change
+            # with the tolerance, #30)
+            key = np.empty(nc)
+            for c in range(nc):
+                i = cand[c]
+                key[c] = -np.round(min(max(exc[c], -1e6), 1e6) * 1e6) * (2.0 * ni) + (i - nf if i >= nf else nl + i)
+            order = np.argsort(key)
             cs = cand[:nc][order].copy()
             ds = dirs[:nc][order].copy()
             for c in range(nc):
@@ -1987,6 +2138,7 @@ def settle(t, x, m, p, log, old):
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
     # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the
     # crossing would be missed); one that moves clearly watches 0
+    _project_speeds(t, x, m, p, comp, origin)
     slack = _slack(p)
     any_change = False
     for k in range(nf):
@@ -2020,7 +2172,8 @@ def _log_type():
 
 #: :func:`settle` called through its address (:mod:`clutchlab.numerics.outline`): it runs at events only, and linked
 #: it was compiled again into the update and restart hooks and every function of the core that calls them
-settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_type(), _log_type(), _I1), types.boolean)
+settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_type(), _log_type(), _I1, types.int64),
+                          types.boolean)
 
 
 # ----------------------------------------------------------------- hooks
@@ -2297,7 +2450,7 @@ def driveline_update(t, x, u, m, p, k, log):
             else:   # the other flange drives now
                 m[mi] = (GEAR_FWD_B if mode == GEAR_FWD_A else GEAR_FWD_A if mode == GEAR_FWD_B else
                          GEAR_BWD_B if mode == GEAR_BWD_A else GEAR_BWD_A)
-        settle_outlined(t, x, m, p, log, old)
+        settle_outlined(t, x, m, p, log, old, p.lossy[j])
         return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // N_SW
@@ -2344,7 +2497,7 @@ def driveline_update(t, x, u, m, p, k, log):
             return 0
         # the torque of a damped contact steps at impact: a stuck element may have to break away now (its
         # break-away function starts the next step beyond zero, which is no crossing)
-        settle_outlined(t, x, m, p, log, m.copy())
+        settle_outlined(t, x, m, p, log, m.copy(), r)
         return 0
     if k % N_G == G_TURN:   # a slow sliding speed's turning point: a step ends there, nothing changes
         return 0
@@ -2352,7 +2505,7 @@ def driveline_update(t, x, u, m, p, k, log):
     kf = k // N_G
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):
         m[kf] = STUCK
-    settle_outlined(t, x, m, p, log, old)
+    settle_outlined(t, x, m, p, log, old, p.fric[kf])
     return 0
 
 
@@ -2362,7 +2515,7 @@ def driveline_restart(t, x, u, m, p, log):
     :func:`forget_signals`)."""
     forget_signals(p)
     _instant(p)[0] = np.nan   # a new instant (:func:`_one_search_per_instant`)
-    return settle_outlined(t, x, m, p, log, m.copy())
+    return settle_outlined(t, x, m, p, log, m.copy(), _ZERO - 1)
 
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
@@ -2479,7 +2632,8 @@ def check_invariants(t, x, m, p):
 
 #: :func:`check_invariants` called through its address (:mod:`clutchlab.numerics.outline`): a debugging option, kept
 #: out of the compilation of the accept hook and the core that calls it at every step
-_check_outlined = outlined(check_invariants, lambda: (types.float64, _F1, _I1, _params_type()), types.int64)
+_check_outlined = outlined(check_invariants, lambda: (types.float64, _F1, _I1, _params_type()), types.int64,
+                           lazy=True)   # (a debug option: compiled where a run asks for it)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

@@ -1452,8 +1452,9 @@ class Driveline:
         rtol)`` of the energy that flowed plus 1 J); a violation ends the run with a
         :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time."""
         # the kernel functions called through their addresses, compiled or loaded here, on the calling thread: a
-        # batch's worker threads then only look their addresses up (clutchlab.numerics.outline)
-        outline.prepare()
+        # batch's worker threads then only look their addresses up (clutchlab.numerics.outline); the invariant
+        # check only where it is asked for (a debug option: not compiled on every first use)
+        outline.prepare(lazy=check_invariants)
         p = self.pack()
         if check_invariants:
             p.check[0] = 1.0

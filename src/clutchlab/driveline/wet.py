@@ -205,7 +205,7 @@ def wet_driveline_update(t, x, u, m, p, k, log):
     j = (k - ng) // N_SWITCH
     res = _wet_call(t, x, m, p, j, (k - ng) % N_SWITCH, log)
     _clutches(t, x, m, p)   # the network's modes at the clutch's new state (a piston on its stop, a film opening)
-    K.settle_outlined(t, x, m, byref(p.net), log, m.copy())
+    K.settle_outlined(t, x, m, byref(p.net), log, m.copy(), np.int64(-1))
     _sync(x, m, p)
     return res
 

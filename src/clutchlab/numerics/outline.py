@@ -49,13 +49,14 @@ _ERRORS: dict = {}
 
 
 class _Entry:
-    __slots__ = ("dispatcher", "signature", "returns", "label", "_sig")
+    __slots__ = ("dispatcher", "signature", "returns", "label", "lazy", "_sig")
 
-    def __init__(self, dispatcher, signature, returns, label):
+    def __init__(self, dispatcher, signature, returns, label, lazy=False):
         self.dispatcher = dispatcher
         self.signature = signature
         self.returns = returns
         self.label = label
+        self.lazy = lazy
         self._sig = None
 
     def sig(self) -> tuple:
@@ -100,10 +101,15 @@ _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_int64)(_resolve)
 ll.add_symbol(RESOLVE_SYMBOL, ctypes.cast(_CALLBACK, ctypes.c_void_p).value)
 
 
-def prepare() -> None:
+def prepare(lazy: bool = False) -> None:
     """Compile (or load from numba's cache) every outlined function now, on the calling thread (``clutchlab
-    warmup``; a driveline's :meth:`~clutchlab.driveline.Driveline.system`).  Cheap once done in a process."""
+    warmup``; a driveline's :meth:`~clutchlab.driveline.Driveline.system`).  Cheap once done in a process.
+
+    ``lazy``: the functions outlined with ``lazy=True`` too (a debug option's, such as the driveline's invariant
+    check: compiled only where a run asks for it, not on every first use)."""
     for e in _ENTRIES:
+        if e.lazy and not lazy:
+            continue
         if not native_address(e.dispatcher, e.sig(), e.returns):
             raise TypeError(f"{e.label}{e.sig()} does not return {e.returns}")
 
@@ -136,7 +142,7 @@ def _codegen_call(context, builder, key, label, returns, argtys, args):
     return res
 
 
-def outlined(dispatcher, signature, returns):
+def outlined(dispatcher, signature, returns, lazy=False):
     """A compiled stub that calls ``dispatcher`` through its address.
 
     Parameters
@@ -148,9 +154,12 @@ def outlined(dispatcher, signature, returns):
         once).  A call with other types compiles as an ordinary call, linked into its caller.
     returns : numba type
         Its return type (``types.none`` for none).
+    lazy : bool
+        Left out of :func:`prepare` unless asked for (``prepare(lazy=True)``): compiled on its first call, or by
+        the caller that enables it (a debug option).
     """
     label = f"{dispatcher.py_func.__module__}.{dispatcher.py_func.__qualname__}"
-    entry = _Entry(dispatcher, signature, returns, label)
+    entry = _Entry(dispatcher, signature, returns, label, lazy)
     _ENTRIES.append(entry)
     nargs = dispatcher.py_func.__code__.co_argcount
     names = ", ".join(f"a{i}" for i in range(nargs))
