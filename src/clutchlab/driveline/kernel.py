@@ -1386,9 +1386,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     (:func:`_member`): ``A lam = g M^-1 F - target`` with ``A[k, j] = g_k . M^-1 h_j``.  Where stuck elements
     lock the same relative motion (two clutches in parallel) ``A`` is singular: the regularised solution splits
     the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
-    gears and motion sources weigh as the strongest friction element on their own inertias, else in the set), from ``(A + eps D) lam = b`` with ``D =
-    diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal, refined twice on the residual of ``A lam =
-    b``; then :func:`_repair` moves that split within the members' bounds where it would leave them while
+    gears and motion sources weigh as the strongest friction element on their own inertias, else in the set),
+    from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal,
+    refined twice on the residual of ``A lam = b``; then :func:`_repair` moves that split within the members' bounds where it would leave them while
     another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
     """
     n = p.inertia.shape[0]
@@ -1970,9 +1970,12 @@ def settle(t, x, m, p, log, old, origin):
     first, each released the way its torque pushes it, until every stuck one holds and every released one
     accelerates its own way (up to ten items at rest; beyond, or if none agrees, the most overloaded is released
     until the rest hold).  The decision depends only on the forces, not on the order of the elements or on
-    elements elsewhere in the network (beyond rounding, :data:`NOISE`).  An event per item whose mode now differs
+    elements elsewhere in the network (beyond rounding, :data:`NOISE`; overloads within 1e-6 of each other, which
+    rounding would order, are taken lossy gears first, then in element order).  An event per item whose mode now differs
     from ``old`` (the modes before the event), named for the mode entered (a lossy gear's quadrant: ``a_drives``,
-    ``b_drives``).  Returns True if a mode changed."""
+    ``b_drives``).  ``origin``: the element row whose event this is, -1 at a restart (an item slower than its
+    rounding width is taken as at rest only where it is linked to that element, :func:`_linked`; the stuck speeds
+    put to rest there, :func:`_project_speeds`).  Returns True if a mode changed."""
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     nl = p.lossy.shape[0]
@@ -2143,10 +2146,10 @@ def settle(t, x, m, p, log, old, origin):
             _evaluate(t, x, m, p, acc, tau)
         if not marked:
             break
+    _project_speeds(t, x, m, p, comp, origin)
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
     # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the
     # crossing would be missed); one that moves clearly watches 0
-    _project_speeds(t, x, m, p, comp, origin)
     slack = _slack(p)
     any_change = False
     for k in range(nf):
