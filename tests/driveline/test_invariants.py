@@ -324,6 +324,14 @@ def test_a_clutch_reaching_rest_beside_a_stuck_gear_decides_by_the_forces_not_th
         assert np.max(np.abs(df["J1.w_rad_s"])) < 1e-13 and np.max(np.abs(df["J2.w_rad_s"])) < 1e-13
 
 
+def _add_unrelated(d, fn_max, amplitude):
+    """An inertia of its own, at rest, braked (``fn_max``, mu 0.5) and driven by ``amplitude sin(2 pi t)`` N m (as
+    the random networks' ``with_unrelated``)."""
+    d.inertia("U", J=1.0, w0=0.0)
+    d.brake("Ubrake", "U", fn_max=fn_max, mu=0.5)
+    d.torque("UT", "U", Signal.sine(amplitude, 1.0))
+
+
 def test_a_stuck_lossy_gear_beside_a_bearing_holds_whatever_brakes_elsewhere_hold():
     """Found by the thorough profile: a lossy gear (efficiency 0.875) and a bearing friction hold one shaft at rest
     (a statically indeterminate pair: which carries what is a choice), a spring from a sine-driven inertia loading
@@ -343,9 +351,7 @@ def test_a_stuck_lossy_gear_beside_a_bearing_holds_whatever_brakes_elsewhere_hol
         d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
         d.torque("T2", "J2", Signal.sine(1.0, 0.40625))
         if unrelated:
-            d.inertia("U", J=1.0, w0=0.0)
-            d.brake("Ubrake", "U", fn_max=3.0, mu=0.5)
-            d.torque("UT", "U", Signal.sine(0.0, 1.0))
+            _add_unrelated(d, fn_max=3.0, amplitude=0.0)
         for rtol in (1e-7, 1e-10):
             res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
             runs.append(res)
@@ -403,9 +409,7 @@ def test_a_slow_gear_is_decided_by_its_own_events_not_by_an_unrelated_element(hz
         d.spring_damper("k2", "J2", "J3", c=1.0, d=0.0)
         d.torque("T1", "J1", Signal.sine(4e-8, hz))
         if unrelated:
-            d.inertia("U", J=1.0, w0=0.0)
-            d.brake("Ubrake", "U", fn_max=1.0, mu=0.5)
-            d.torque("UT", "U", Signal.sine(1.0, 1.0))
+            _add_unrelated(d, fn_max=1.0, amplitude=1.0)
         for rtol in (1e-8, 1e-10):
             res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
             runs[unrelated, rtol] = [e for e in _mode_events(res) if not str(e[1]).startswith("U")]
