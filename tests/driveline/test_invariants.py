@@ -452,9 +452,10 @@ def test_a_brief_overload_of_a_stuck_element_is_found(rtol):
     and backward near 0.25 s.  While it is stuck nothing moves, the step grows to the sine's limit (an eighth of its
     period, 42 ms), and the break-away function is positive at both ends of the step that holds the peak: both
     overloads are missed at every tolerance (at 1.002 times the limit, 6.7 ms, the first is found and the second
-    missed; at 1.01 both).  The fix: a turning point of the margin of a stuck element near its limit (its rate by one
-    more evaluation of the network), so that a step ends at the peak load and the core looks at the break-away
-    function there, as it does for a slow sliding speed."""
+    missed; at 1.01 both).  The fix: a turning point of the margin of a stuck element near its limit, so that a
+    step ends at the peak load and the core looks at the break-away function there, as it does for a slow sliding
+    speed (tried on branch ``wip/overload`` with the rate from one more evaluation of the network: it passes this
+    test, but costs CoupledClutches 20-32 % of its run time; docs/driveline.md, Open)."""
     d = Driveline("dip")
     d.inertia("J", J=1.0, w0=0.0)
     d.brake("b", "J", fn_max=2.0, mu=0.5)
