@@ -449,12 +449,26 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
         n_rhs += 6
         last = th
         if phase == 0:
-            for k in range(ng):
-                if _crossed(ga[k], ge[k], gdir[k]):
-                    if kk < 0 or (_crossed(ga[k], gd[k], gdir[k]) and not _crossed(ga[kk], gd[kk], gdir[kk])):
-                        kk = k
-            at_theta = kk >= 0
-            if not at_theta:
+            # the function whose root on the dense output theta is (crossed there, not d before it), preferring one
+            # that has crossed on the step's solution too: another function that shows crossed at theta on the step
+            # but not there on the dense output, or already d before it, is no root at theta (a backlash at rest in
+            # its gap, whose turning-point function flips with the rounding sign of its deflection, was followed
+            # instead of a contact located at theta, and the contact was taken 48 ms late at the step's end, #30)
+            kr = -1
+            if slope_ok:
+                for k in range(ng):
+                    if _crossed(ga[k], gd[k], gdir[k]) and not _crossed(ga[k], gd[k] - d * gs[k], gdir[k]):
+                        if kr < 0 or (_crossed(ga[k], ge[k], gdir[k]) and not _crossed(ga[kr], ge[kr], gdir[kr])):
+                            kr = k
+            if kr >= 0:
+                kk = kr
+            else:
+                for k in range(ng):
+                    if _crossed(ga[k], ge[k], gdir[k]):
+                        if kk < 0 or (_crossed(ga[k], gd[k], gdir[k]) and not _crossed(ga[kk], gd[kk], gdir[kk])):
+                            kk = k
+            at_theta = kk >= 0 and _crossed(ga[kk], ge[kk], gdir[kk])
+            if not at_theta and kr < 0:
                 for k in range(ng):
                     if _crossed(ga[k], gd[k], gdir[k]):
                         kk = k
@@ -469,13 +483,13 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
                 hi = theta
                 ghi = ge[kk]
             else:
+                # it crosses just after theta on the step: bracketed by the probes past the prediction, or not at
+                # all (the dense output's root and state are kept).  (Not by the step's end: a function that
+                # jumps, such as a backlash's turning point at rest in its gap, was followed by the iteration up
+                # to 0.54 of the step, past another function's root, and a contact was taken 48 ms late, #30)
                 lo = theta
                 glo = ge[kk]
-                if _crossed(ga[kk], g1[kk], gdir[kk]):
-                    hi = 1.0
-                    ghi = g1[kk]
-                else:
-                    hi = -1.0
+                hi = -1.0
             phase = 1
             if slope_ok and slope != 0.0:
                 # the value on the step's solution, the slope on the dense output: a Newton step to the root
