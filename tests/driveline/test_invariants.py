@@ -419,7 +419,9 @@ def test_a_slow_gear_is_decided_by_its_own_events_not_by_an_unrelated_element(hz
     assert len(ref) >= 2
     for key, ev in runs.items():
         assert [e[1:] for e in ev] == [e[1:] for e in ref], key
-        assert max(abs(a[0] - b[0]) for a, b in zip(ev, ref)) < 1e-6, key
+        # (the instants to 1e-6 s at rtol 1e-10; at 1e-8 to 1e-5 s: a reversal at 4e-8 rad/s^2 moves by 2.5e-6 s for
+        # every 1e-13 rad/s of error in the speed, which a different step sequence leaves)
+        assert max(abs(a[0] - b[0]) for a, b in zip(ev, ref)) < (1e-6 if key[1] == 1e-10 else 1e-5), key
 
 
 def test_a_bearing_and_a_stuck_gear_at_their_limits_together_are_labelled_the_same_at_every_tolerance():
