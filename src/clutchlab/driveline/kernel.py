@@ -1858,6 +1858,17 @@ def _one_search_per_instant(t, m, p, log, old):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _flange(p, r, q):
+    """Inertia of flange ``q`` of element row ``r``: 0 flange a, 1 flange b, 2 a gear's support; -1 for the ground
+    (or no support)."""
+    if q == 0:
+        return p.elem[r, E_A]
+    if q == 1:
+        return p.elem[r, E_B]
+    return p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _components(p, comp):
     """The linked groups of inertias: ``comp[i]`` the lowest inertia linked to inertia ``i`` through elements
     (any element between two inertias, a gear's support included; the ground links nothing, it does not move)."""
@@ -1870,13 +1881,11 @@ def _components(p, comp):
         for r in range(p.elem.shape[0]):
             lo = n
             for q in range(3):
-                i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
-                    (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+                i = _flange(p, r, q)
                 if i >= 0:
                     lo = min(lo, comp[i])
             for q in range(3):
-                i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
-                    (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+                i = _flange(p, r, q)
                 if i >= 0 and comp[i] != lo:
                     comp[i] = lo
                     changed = True
@@ -1890,13 +1899,11 @@ def _linked(p, comp, origin, r):
         return True
     c = -1
     for q in range(3):
-        i = p.elem[origin, E_A] if q == 0 else p.elem[origin, E_B] if q == 1 else \
-            (p.elem[origin, E_SUP] if p.elem[origin, E_KIND] == K_GEAR else -1)
+        i = _flange(p, origin, q)
         if i >= 0:
             c = comp[i]
     for q in range(3):
-        i = p.elem[r, E_A] if q == 0 else p.elem[r, E_B] if q == 1 else \
-            (p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1)
+        i = _flange(p, r, q)
         if i >= 0 and comp[i] == c:
             return True
     return False
