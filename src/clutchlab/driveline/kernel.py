@@ -942,7 +942,9 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
     instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
     modes before it (2 + nf + nl, :func:`settle`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
-    :func:`set_external`) | initial stored energy (1).  Returns the offsets as a :class:`WorkLayout`."""
+    :func:`set_external`) | the angles and speeds saved while the rates of stuck margins are taken (2 n,
+    :func:`_margin_rates`, addressed from the end) | initial stored energy (1).  Returns the offsets as a
+    :class:`WorkLayout`."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -968,7 +970,7 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
     signals (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + 1
+    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + 2 * n + 1
 
 
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
@@ -2194,6 +2196,61 @@ settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_typ
                           types.boolean)
 
 
+#: a stuck friction element whose margin to its holding limit is below this share of the limit is watched for the
+#: turning point of that margin (:func:`_margin_rates`)
+NEAR_LIMIT = 0.1
+#: time step [s] of the difference that gives a stuck element's margin rate (:func:`_margin_rates`)
+T_RATE = 1e-6
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _stuck_margin(p, r, t, tau):
+    """The break-away function of stuck friction element row ``r`` (:func:`driveline_rhs`): what it holds minus its
+    torque [N m] (a one-way clutch: against its overrunning direction only)."""
+    lim = max(static_limit(p, r, t), _item_noise(p, r, tau))
+    return lim - tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else lim - abs(tau[r])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _margin_rates(t, x, m, p, dx, g):
+    """The turning points of the margins of the stuck friction elements near their limits: ``g[.. G_TURN]`` the
+    margin's rate [N m/s] (rising through zero at its minimum), by a difference over :data:`T_RATE` along ``dx``.
+
+    While a network is stuck nothing moves, and its steps grow to the limit its signals set (an eighth of a sine's
+    period): a load beyond an element's limit for less than the gap between two step ends (a brake at 1.0005 times
+    its limit under a 3 Hz sine is beyond it for 3.4 ms of every 42 ms step) was stepped over, the element stayed
+    stuck.  The root of the margin's rate ends a step at the peak load, and the core looks at the break-away
+    function there (its second look, ``numerics.core._locate``): a brief overload is found, as a slow sliding
+    speed's dip through zero is.  The angles and speeds are moved by ``T_RATE dx`` for the difference and put back
+    bit for bit (saved in the work array), and the network is evaluated at ``t`` again."""
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    wk = p.work
+    sv = wk[wk.shape[0] - 1 - 2 * n:wk.shape[0] - 1]
+    acc, tau = _acc_tau(p)
+    for i in range(2 * n):
+        sv[i] = x[i]
+        x[i] = sv[i] + T_RATE * dx[i]
+    evaluate_network(t + T_RATE, x, m, p, acc, tau)
+    for k in range(nf):
+        r = p.fric[k]
+        q = N_G * k + G_TURN
+        if m[k] != STUCK or g[q] != 0.0:   # (marked near by the caller with 0.0)
+            continue
+        noise = _item_noise(p, r, tau)
+        g[q] = (_stuck_margin(p, r, t + T_RATE, tau) - g[N_G * k + G_BREAK]) / T_RATE + 10.0 * noise / T_RATE
+    for i in range(2 * n):
+        x[i] = sv[i]
+    evaluate_network(t, x, m, p, acc, tau)
+
+
+#: :func:`_margin_rates` called through its address (:mod:`clutchlab.numerics.outline`): two more evaluations of the
+#: network, needed only while a stuck element is near its limit, kept out of the right-hand side every function of
+#: the core links
+_margin_rates_outlined = outlined(_margin_rates, lambda: (types.float64, _F1, _I1, _params_type(), _F1, _F1),
+                                  types.none)
+
+
 # ----------------------------------------------------------------- hooks
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_rhs(t, x, u, m, p, dx, g):
@@ -2205,7 +2262,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, four per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
-    (either way: free or engaged), the turning point of a slow sliding speed; then three per switched spring.  A
+    (either way: free or engaged), the turning point of a slow sliding speed, or of a stuck one's margin near its
+    limit (:func:`_margin_rates`: a brief overload is found); then three per switched spring.  A
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
     pull); released beyond an edge (Kelvin-Voigt's damped separation), first ``tau / c`` signed positive while it
@@ -2244,6 +2302,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             dx[2 * n + r] = gear_power(p, r, x, n, m, tau[r])
         else:
             dx[2 * n + r] = tau[r] * w_rel
+    near = False
     for k in range(nf):
         r = p.fric[k]
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
@@ -2258,6 +2317,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
         # the sliding direction), located so that a dip of the speed through zero within a step is seen
         g[N_G * k + G_TURN] = 1.0
+        if mk == STUCK and p.elem[r, E_LAW] != LAW_EXTERNAL and \
+                g[N_G * k + G_BREAK] < NEAR_LIMIT * max(static_limit(p, r, t), _item_noise(p, r, tau)):
+            g[N_G * k + G_TURN] = 0.0   # near its limit: its margin's turning point (_margin_rates, below)
+            near = True
         if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL and \
                 abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_rel = (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
@@ -2269,6 +2332,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_NORMAL] = p.coef[r, C_LIFTOFF] - signal_at(p, p.elem[r, E_SIGNAL], t)
         else:
             g[N_G * k + G_NORMAL] = signal_at(p, p.elem[r, E_SIGNAL], t)
+    if near:
+        _margin_rates_outlined(t, x, m, p, dx, g)
     for j in range(p.swit.shape[0]):
         r = p.swit[j]
         phi = _spring_deflection(p, r, x, n)
@@ -2517,7 +2582,7 @@ def driveline_update(t, x, u, m, p, k, log):
         # break-away function starts the next step beyond zero, which is no crossing)
         settle_outlined(t, x, m, p, log, m.copy(), r)
         return 0
-    if k % N_G == G_TURN:   # a slow sliding speed's turning point: a step ends there, nothing changes
+    if k % N_G == G_TURN:   # a slow sliding speed's or a stuck margin's turning point: a step ends there, no change
         return 0
     old = m.copy()
     kf = k // N_G
