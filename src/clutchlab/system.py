@@ -108,7 +108,10 @@ class System:
         Named, unit-carrying state, output and held-input vectors.
     switching : tuple of (str, int)
         Name and crossing direction (+1, -1, 0) of each switching function; +-2: the same direction, and a function
-        the core looks at again at the earliest root of a step (a dip through zero and back before it is located).
+        the core looks at again at the earliest root of a step (a dip through zero and back before it is located);
+        +-3: a waypoint, the same direction, whose crossing asks only for a step end just past it (no event: the
+        Dormand-Prince step is taken again to 1 % past its root; the driveline's stuck elements coming near their
+        limits).
     events : tuple of str
         Event names by code (what the hooks record).
     mode_names : tuple of str

@@ -370,8 +370,12 @@ def test_a_lossy_gear_in_a_rigid_loop_whose_torque_changes_sign_with_its_quadran
     through g0 passes zero; its quadrant function crossed, but in the locked loop its torque is -6e-11 N m with
     flange a driving and positive with flange b driving: neither quadrant is consistent.  The search released it
     anyway (forward, flange a driving) and the compiled check stopped the run: "g0: negative loss (power
-    generated)".  Now a released lossy gear must be in the quadrant its torque puts it in (``kernel._consistent``),
-    so it holds and the clutch slides: the invariants at every step, the same mode changes at rtol 1e-7 and 1e-10."""
+    generated)".  Now a released lossy gear must be in the quadrant its torque puts it in (``kernel._consistent``):
+    the invariants at every step, the same mode changes at rtol 1e-7 and 1e-10, and the loop at rest throughout.
+    (The loop is statically indeterminate and g0's torque there is a rounding: which consistent labels describe that
+    rest -- g0 stuck with the clutch "sliding" at zero speed, or g0 rolling at zero speed with flange b driving and
+    the clutch holding -- followed the step sequence when the stuck margins' waypoints moved a step end;
+    docs/driveline.md, "Invariants".)"""
     d = Driveline("rigid_loop")
     for i in range(4):
         d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
@@ -385,8 +389,11 @@ def test_a_lossy_gear_in_a_rigid_loop_whose_torque_changes_sign_with_its_quadran
     ev = [_mode_events(r) for r in runs]
     assert [e[1:] for e in ev[0]] == [e[1:] for e in ev[1]]
     assert max(abs(a[0] - b[0]) for a, b in zip(*ev)) < 1e-6
-    at = {(el, e) for t, el, e in ev[1] if abs(t - 0.4195694) < 1e-6}
-    assert at == {("loop", "backward"), ("g0", "stick")}
+    for res in runs:   # the quadrant's crossing is taken (an event of g0 there), and nothing moves
+        assert any(abs(t - 0.4195694) < 1e-6 and el == "g0" for t, el in zip(res.events.time_s, res.events.element))
+        df = res.to_dataframe()
+        for i in range(4):
+            assert np.max(np.abs(df[f"J{i}.w_rad_s"])) < 1e-12
 
 
 @pytest.mark.parametrize("hz", [2.0, 1.0])

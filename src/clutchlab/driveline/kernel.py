@@ -107,8 +107,8 @@ GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_driv
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
 # switching functions: four per friction element, then three per switched spring (``swit``: backlash and curves),
 # then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
-G_STICK, G_BREAK, G_NORMAL, G_TURN = 0, 1, 2, 3
-N_G = 4
+G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = 0, 1, 2, 3, 4
+N_G = 5
 N_GEAR_G = 3
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends) and the
 #: turning points of a backlash's deflection in its gap (G_LASH_TURN)
@@ -942,7 +942,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
     instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
     modes before it (2 + nf + nl, :func:`settle`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
-    :func:`set_external`) | the angles and speeds saved while the rates of stuck margins are taken (2 n,
+    :func:`set_external`) | the scratch of the rates of stuck margins: the moved state, its derivative and switching
+    functions, and the accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`,
     :func:`_margin_rates`, addressed from the end) | initial stored energy (1).  Returns the offsets as a
     :class:`WorkLayout`."""
     o_a = n + nk
@@ -970,7 +971,16 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
     signals (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + 2 * n + 1
+    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + rate_size.py_func(n, ne, nf, nl) + 1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def rate_size(n, ne, nf, nl):
+    """Length of the scratch of :func:`_margin_rates` at the end of the work array: a state and its derivative (at
+    most ``2 n + 2 ne`` each: angles, speeds, energies, engine integrals), the switching functions (at most
+    ``N_G nf + N_SW ne + N_GEAR_G nl``), and the accelerations, torques, holds and torque magnitudes (``2 n + ne +
+    nl``)."""
+    return 2 * (2 * n + 2 * ne) + (N_G * nf + N_SW * ne + N_GEAR_G * nl) + 2 * n + ne + nl
 
 
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
@@ -1035,7 +1045,8 @@ def _external(p):
     """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
     model."""
     o = _offsets(p)
-    return borrow(p.work[o.ext:p.work.shape[0] - 1])
+    return borrow(p.work[o.ext:p.work.shape[0] - 1 - rate_size(p.inertia.shape[0], p.elem.shape[0],
+                                                                    p.fric.shape[0], p.lossy.shape[0])])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1718,7 +1729,7 @@ def _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
             if forced[i] != 0:
                 return False
             ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-            if ex >= 0.0 or _item_slips(p, acc, i):
+            if (ex >= 0.0 and not _tied(t, p, tau, i)) or _item_slips(p, acc, i):
                 return False
         elif _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             return False
@@ -1814,6 +1825,26 @@ def _near_limit(t, p, tau, i):
         return max(holding_limit(p, r, t, tq), noise) - abs(tq) < TIE_BAND * noise
     margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
     return margin < TIE_BAND * noise
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _tied(t, p, tau, i):
+    """True if stuck item ``i`` is at or beyond its limit at the last evaluation by no more than the rounding the
+    invariants allow a stuck item (:func:`check_invariants`: a friction element ``1e-9`` of its limit plus one
+    rounding floor, a lossy gear's hold two floors): at its limit to rounding, which side of it is a rounding, so
+    the tie-break in :func:`settle` decides it by where its load goes, as for one just inside its limit."""
+    nf = p.fric.shape[0]
+    r = _item_row(p, i)
+    noise = _item_noise(p, r, tau)
+    if i < nf:
+        if p.elem[r, E_LAW] == LAW_EXTERNAL:
+            return False
+        tq = tau[r]
+        lim = max(holding_limit(p, r, t, tq), noise)
+        over = abs(tq) - lim
+        return over >= 0.0 and over <= 1e-9 * lim + noise
+    margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
+    return margin <= 0.0 and -margin <= noise   # (the margin is widened by one floor already)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1999,163 +2030,198 @@ def settle(t, x, m, p, log, old, origin):
             w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             w_tol = _item_wtol(p, r, x, n)
             m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
-    # the items at rest
     ni = nf + nl
-    cand = np.empty(ni, dtype=np.int64)
-    dirs = np.zeros(ni, dtype=np.int64)
-    exc = np.empty(ni)
-    nc = _ZERO
-    # (an item moving slower than its rounding width is at rest for a search on its own motion -- a restart, or an
-    # event of an element it is linked to -- not for an event elsewhere: there it goes on until its own function
-    # crosses, as in a network without that element)
     comp = np.empty(n, dtype=np.int64)
     _components(p, comp)
-    for i in range(ni):
-        if i < nf and m[i] == FREE:
-            continue
-        if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i) or \
-                (abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and
-                 _linked(p, comp, origin, _item_row(p, i))):
-            cand[nc] = i
-            nc += 1
-            _item_set(p, m, i, _ZERO)
-    forced = np.zeros(ni, dtype=np.int64)
-    xp = np.empty(x.shape[0])
-    for _tie in range(nc + 1):
-        # ---- the search over the candidates (every one stuck first; ``forced`` items count as overloaded)
-        for c in range(nc):
-            _item_set(p, m, cand[c], _ZERO)
-        _evaluate(t, x, m, p, acc, tau)
-        worst = -np.inf
-        for c in range(nc):
-            ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
-            if forced[cand[c]] != 0:   # it would break away within T_TIE (the tie-break below): overloaded
-                ex = max(ex, 0.0)
-            if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
-                a = _item_acc(p, acc, cand[c])
-                ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
-            exc[c] = ex
-            dirs[c] = d
-            if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
-                # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
-                # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
-                # that set contradicts a prescribed motion.)
-                dirs[c] = 1
-            worst = max(worst, ex)
-        if worst >= 0.0:
-            # the candidates, most overloaded first; overloads within 1e-6 of each other are a tie (two members of a
-            # statically indeterminate group reach their limits together: which one's excess is the larger is a
-            # rounding), taken lossy gears first, then in element order (a gear rolling while a bearing holds its
-            # shaft, or the bearing sliding while the gear holds, are one motion: the labels then do not change
-            # with the tolerance, #30)
-            key = np.empty(nc)
+    # (a second pass where the stuck speeds' projection brought a sliding item linked to them to rest: the search
+    # decides it too, else it would go on sliding at zero speed, labelled by the rounding its speed had before)
+    for _pass in range(ni + 1):
+        # the items at rest
+        cand = np.empty(ni, dtype=np.int64)
+        dirs = np.zeros(ni, dtype=np.int64)
+        exc = np.empty(ni)
+        nc = _ZERO
+        # (an item moving slower than its rounding width is at rest for a search on its own motion -- a restart, or an
+        # event of an element it is linked to -- not for an event elsewhere: there it goes on until its own function
+        # crosses, as in a network without that element)
+        for i in range(ni):
+            if i < nf and m[i] == FREE:
+                continue
+            if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i) or \
+                    (abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and
+                     _linked(p, comp, origin, _item_row(p, i))):
+                cand[nc] = i
+                nc += 1
+                _item_set(p, m, i, _ZERO)
+        forced = np.zeros(ni, dtype=np.int64)
+        xp = np.empty(x.shape[0])
+        for _tie in range(nc + 1):
+            # ---- the search over the candidates (every one stuck first; ``forced`` items count as overloaded)
+            for c in range(nc):
+                _item_set(p, m, cand[c], _ZERO)
+            _evaluate(t, x, m, p, acc, tau)
+            worst = -np.inf
+            for c in range(nc):
+                ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
+                if forced[cand[c]] != 0:   # it would break away within T_TIE (the tie-break below): overloaded
+                    ex = max(ex, 0.0)
+                elif ex >= 0.0 and _tied(t, p, tau, cand[c]):   # at its limit to rounding: the tie-break decides
+                    ex = -1e-300
+                if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
+                    a = _item_acc(p, acc, cand[c])
+                    ex, d = max(ex, 0.0), (1 if a > 0.0 else -1)
+                exc[c] = ex
+                dirs[c] = d
+                if cand[c] < nf and p.elem[p.fric[cand[c]]][E_LAW] == LAW_ONEWAY and d < 0:
+                    # a one-way clutch never slides backward; released, it slides forward, and the subset is kept only if
+                    # it then accelerates forward (_consistent).  (Its torque with every candidate stuck says nothing where
+                    # that set contradicts a prescribed motion.)
+                    dirs[c] = 1
+                worst = max(worst, ex)
+            if worst >= 0.0:
+                # the candidates, most overloaded first; overloads within 1e-6 of each other are a tie (two members of a
+                # statically indeterminate group reach their limits together: which one's excess is the larger is a
+                # rounding), taken lossy gears first, then in element order (a gear rolling while a bearing holds its
+                # shaft, or the bearing sliding while the gear holds, are one motion: the labels then do not change
+                # with the tolerance, #30)
+                key = np.empty(nc)
+                for c in range(nc):
+                    i = cand[c]
+                    key[c] = -np.round(min(max(exc[c], -1e6), 1e6) * 1e6) * (2.0 * ni) + (i - nf if i >= nf else nl + i)
+                order = np.argsort(key)
+                cs = cand[:nc][order].copy()
+                ds = dirs[:nc][order].copy()
+                for c in range(nc):
+                    cand[c] = cs[c]
+                    dirs[c] = ds[c]
+                found = False
+                pick = np.empty(max(nc, 1), dtype=np.int64)
+                smax = nc if nc <= 10 else 2
+                for s in range(1, smax + 1):
+                    for q in range(s):
+                        pick[q] = q
+                    while True:
+                        ok = True
+                        for q in range(s):
+                            if dirs[pick[q]] == 0:
+                                ok = False
+                        if ok:
+                            _apply_subset(p, m, cand, nc, dirs, pick, s)
+                            _evaluate(t, x, m, p, acc, tau)
+                            # released together, an item may move against the way its own torque pushed it (two gears
+                            # coupled through a reversing ratio): flip those to the way they accelerate, a few times
+                            for _flip in range(s + 1):
+                                if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
+                                    found = True
+                                    break
+                                if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+                                    break
+                                _evaluate(t, x, m, p, acc, tau)
+                            if found:
+                                break
+                        # the next combination of s out of nc
+                        q = s - 1
+                        while q >= 0 and pick[q] == nc - s + q:
+                            q -= 1
+                        if q < 0:
+                            break
+                        pick[q] += 1
+                        for qq in range(q + 1, s):
+                            pick[qq] = pick[qq - 1] + 1
+                    if found:
+                        break
+                if not found:   # release the most overloaded until the rest hold
+                    for c in range(nc):
+                        _item_set(p, m, cand[c], _ZERO)
+                    for _it in range(nc):
+                        _evaluate(t, x, m, p, acc, tau)
+                        best, bi, bd = -np.inf, _ZERO - 1, _ZERO
+                        for c in range(nc):
+                            i = cand[c]
+                            if not _item_stuck(p, m, i):
+                                continue
+                            ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+                            if forced[i] != 0:
+                                ex = max(ex, 0.0)
+                            if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
+                                ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
+                            if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
+                                continue
+                            if ex >= 0.0 and ex > best:
+                                best, bi, bd = ex, i, d
+                        if bi < 0:
+                            break
+                        _item_set(p, m, bi, bd)
+                    _evaluate(t, x, m, p, acc, tau)
+            # ---- the second-order tie-break (T_TIE, TIE_BAND): a stuck candidate within TIE_BAND of its limit is
+            # evaluated again at t + T_TIE (angles and speeds advanced by the decided motion, an error of order
+            # T_TIE**2); one beyond what it holds there (its static limit, not its lock-up limit) is marked forced and
+            # the search repeated.  Without it the decision at such an instant followed the sign the rounding left,
+            # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
+            # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
+            # functions of their own they compiled 2.5 s more.)
+            near = False
+            marked = False
             for c in range(nc):
                 i = cand[c]
-                key[c] = -np.round(min(max(exc[c], -1e6), 1e6) * 1e6) * (2.0 * ni) + (i - nf if i >= nf else nl + i)
-            order = np.argsort(key)
-            cs = cand[:nc][order].copy()
-            ds = dirs[:nc][order].copy()
-            for c in range(nc):
-                cand[c] = cs[c]
-                dirs[c] = ds[c]
-            found = False
-            pick = np.empty(max(nc, 1), dtype=np.int64)
-            smax = nc if nc <= 10 else 2
-            for s in range(1, smax + 1):
-                for q in range(s):
-                    pick[q] = q
-                while True:
-                    ok = True
-                    for q in range(s):
-                        if dirs[pick[q]] == 0:
-                            ok = False
-                    if ok:
-                        _apply_subset(p, m, cand, nc, dirs, pick, s)
-                        _evaluate(t, x, m, p, acc, tau)
-                        # released together, an item may move against the way its own torque pushed it (two gears
-                        # coupled through a reversing ratio): flip those to the way they accelerate, a few times
-                        for _flip in range(s + 1):
-                            if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
-                                found = True
-                                break
-                            if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
-                                break
-                            _evaluate(t, x, m, p, acc, tau)
-                        if found:
-                            break
-                    # the next combination of s out of nc
-                    q = s - 1
-                    while q >= 0 and pick[q] == nc - s + q:
-                        q -= 1
-                    if q < 0:
-                        break
-                    pick[q] += 1
-                    for qq in range(q + 1, s):
-                        pick[qq] = pick[qq - 1] + 1
-                if found:
-                    break
-            if not found:   # release the most overloaded until the rest hold
+                if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
+                    near = True
+            if near:
+                exs = np.empty(nc)
+                near_ = np.zeros(nc, dtype=np.bool_)
                 for c in range(nc):
-                    _item_set(p, m, cand[c], _ZERO)
-                for _it in range(nc):
-                    _evaluate(t, x, m, p, acc, tau)
-                    best, bi, bd = -np.inf, _ZERO - 1, _ZERO
+                    exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
+                    if exs[c] >= 0.0 and _tied(t, p, tau, cand[c]):
+                        exs[c] = -1e-300
+                    near_[c] = _near_limit(t, p, tau, cand[c])
+                dt = T_TIE
+                for q in range(xp.shape[0]):
+                    xp[q] = x[q]
+                for j in range(n):
+                    xp[j] = x[j] + dt * x[n + j]
+                    xp[n + j] = x[n + j] + dt * acc[j]
+                _evaluate(t + dt, xp, m, p, acc, tau)
+                # (the one most beyond its limit there, one per round: whether the others hold is decided again with
+                # it released -- marked together from one set, a brake beside a gear at its band's edge was released
+                # with it and slid for 2 ms where it holds once the gear rolls)
+                # (beyond by amounts within 1e-6 of each other: a tie, taken lossy gears first, then in element
+                # order, as in the search)
+                ex1s = np.full(nc, -np.inf)
+                worst1 = -np.inf
+                for c in range(nc):
+                    i = cand[c]
+                    ex0 = exs[c]
+                    if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
+                        continue
+                    ex1s[c] = _item_excess(t + dt, p, tau, i, False)[0]
+                    worst1 = max(worst1, ex1s[c])
+                iw = -1
+                if worst1 >= 0.0:
                     for c in range(nc):
                         i = cand[c]
-                        if not _item_stuck(p, m, i):
-                            continue
-                        ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
-                        if forced[i] != 0:
-                            ex = max(ex, 0.0)
-                        if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
-                            ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
-                        if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
-                            continue
-                        if ex >= 0.0 and ex > best:
-                            best, bi, bd = ex, i, d
-                    if bi < 0:
-                        break
-                    _item_set(p, m, bi, bd)
-                _evaluate(t, x, m, p, acc, tau)
-        # ---- the second-order tie-break (T_TIE, TIE_BAND): a stuck candidate within TIE_BAND of its limit is
-        # evaluated again at t + T_TIE (angles and speeds advanced by the decided motion, an error of order
-        # T_TIE**2); one beyond what it holds there (its static limit, not its lock-up limit) is marked forced and
-        # the search repeated.  Without it the decision at such an instant followed the sign the rounding left,
-        # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
-        # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
-        # functions of their own they compiled 2.5 s more.)
-        near = False
-        marked = False
-        for c in range(nc):
-            i = cand[c]
-            if forced[i] == 0 and _item_stuck(p, m, i) and _near_limit(t, p, tau, i):
-                near = True
-        if near:
-            exs = np.empty(nc)
-            near_ = np.zeros(nc, dtype=np.bool_)
-            for c in range(nc):
-                exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
-                near_[c] = _near_limit(t, p, tau, cand[c])
-            dt = T_TIE
-            for q in range(xp.shape[0]):
-                xp[q] = x[q]
-            for j in range(n):
-                xp[j] = x[j] + dt * x[n + j]
-                xp[n + j] = x[n + j] + dt * acc[j]
-            _evaluate(t + dt, xp, m, p, acc, tau)
-            for c in range(nc):
-                i = cand[c]
-                ex0 = exs[c]
-                if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
-                    continue
-                ex1, _d = _item_excess(t + dt, p, tau, i, False)
-                if ex1 >= 0.0:
-                    forced[i] = 1
+                        if ex1s[c] >= 0.0 and ex1s[c] >= worst1 - 1e-6 and \
+                                (iw < 0 or (i >= nf) > (iw >= nf) or ((i >= nf) == (iw >= nf) and i < iw)):
+                            iw = i
+                if iw >= 0:
+                    forced[iw] = 1
                     marked = True
-            _evaluate(t, x, m, p, acc, tau)
-        if not marked:
+                _evaluate(t, x, m, p, acc, tau)
+            if not marked:
+                break
+        _project_speeds(t, x, m, p, comp, origin)
+        rest = False
+        for i in range(ni):
+            if (i < nf and m[i] == FREE) or _item_stuck(p, m, i):
+                continue
+            taken = False
+            for c in range(nc):
+                if cand[c] == i:
+                    taken = True
+            if not taken and abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and \
+                    _linked(p, comp, origin, _item_row(p, i)):
+                rest = True
+        if not rest:
             break
-    _project_speeds(t, x, m, p, comp, origin)
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
     # stick function then watches the relative speed fall below -w_tol, not 0 (else, were it to stop at once, the
     # crossing would be missed); one that moves clearly watches 0
@@ -2197,7 +2263,7 @@ settle_outlined = outlined(settle, lambda: (types.float64, _F1, _I1, _params_typ
 
 
 #: a stuck friction element whose margin to its holding limit is below this share of the limit is watched for the
-#: turning point of that margin (:func:`_margin_rates`)
+#: turning point of that margin (:func:`_margin_rates`); a step ends where the margin comes into that band
 NEAR_LIMIT = 0.1
 #: time step [s] of the difference that gives a stuck element's margin rate (:func:`_margin_rates`)
 T_RATE = 1e-6
@@ -2212,43 +2278,61 @@ def _stuck_margin(p, r, t, tau):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _margin_rates(t, x, m, p, dx, g):
-    """The turning points of the margins of the stuck friction elements near their limits: ``g[.. G_TURN]`` the
-    margin's rate [N m/s] (rising through zero at its minimum), by a difference over :data:`T_RATE` along ``dx``.
+def _margin_rates(t, x, u, m, p, dx, g):
+    """The turning points of the margins of the stuck friction elements near their limits: ``g[.. G_TURN]`` (which
+    :func:`driveline_rhs` marks with 0.0) becomes the margin's rate [N m/s] (rising through zero at its minimum), by
+    a difference over :data:`T_RATE` along ``dx``.
 
     While a network is stuck nothing moves, and its steps grow to the limit its signals set (an eighth of a sine's
     period): a load beyond an element's limit for less than the gap between two step ends (a brake at 1.0005 times
     its limit under a 3 Hz sine is beyond it for 3.4 ms of every 42 ms step) was stepped over, the element stayed
     stuck.  The root of the margin's rate ends a step at the peak load, and the core looks at the break-away
     function there (its second look, ``numerics.core._locate``): a brief overload is found, as a slow sliding
-    speed's dip through zero is.  The angles and speeds are moved by ``T_RATE dx`` for the difference and put back
-    bit for bit (saved in the work array), and the network is evaluated at ``t`` again."""
+    speed's dip through zero is.  Called only where the core compares switching functions across a step (the
+    ``watch`` hook: step ends, events, probes), never at the stages: one more evaluation of the network (the
+    right-hand side through its address, at ``t + T_RATE`` and the state moved by ``T_RATE dx`` in a scratch
+    copy), after which the accelerations, torques, holds and torque magnitudes of the evaluation at ``t`` are put
+    back from the work array, bit for bit."""
     n = p.inertia.shape[0]
+    ne = p.elem.shape[0]
     nf = p.fric.shape[0]
+    nl = p.lossy.shape[0]
+    nx = x.shape[0]
+    ng = g.shape[0]
     wk = p.work
-    sv = wk[wk.shape[0] - 1 - 2 * n:wk.shape[0] - 1]
+    o = wk.shape[0] - 1 - rate_size(n, ne, nf, nl)
+    xs = wk[o:o + nx]
+    o += 2 * n + 2 * ne
+    ds = wk[o:o + nx]
+    o += 2 * n + 2 * ne
+    gs = wk[o:o + ng]
+    o += N_G * nf + N_SW * ne + N_GEAR_G * nl
     acc, tau = _acc_tau(p)
-    for i in range(2 * n):
-        sv[i] = x[i]
-        x[i] = sv[i] + T_RATE * dx[i]
-    evaluate_network(t + T_RATE, x, m, p, acc, tau)
+    hold = _holds(p)
+    fabs = _torque_magnitudes(p)
+    for i in range(n):
+        wk[o + i] = acc[i]
+        wk[o + n + i] = fabs[i]
+    for r in range(ne):
+        wk[o + 2 * n + r] = tau[r]
+    for j in range(nl):
+        wk[o + 2 * n + ne + j] = hold[j]
+    for i in range(nx):
+        xs[i] = x[i] + T_RATE * dx[i] if i < 2 * n else x[i]
+    _rhs_outlined(t + T_RATE, xs, u, m, p, ds, gs)
     for k in range(nf):
-        r = p.fric[k]
         q = N_G * k + G_TURN
-        if m[k] != STUCK or g[q] != 0.0:   # (marked near by the caller with 0.0)
-            continue
-        noise = _item_noise(p, r, tau)
-        g[q] = (_stuck_margin(p, r, t + T_RATE, tau) - g[N_G * k + G_BREAK]) / T_RATE + 10.0 * noise / T_RATE
-    for i in range(2 * n):
-        x[i] = sv[i]
-    evaluate_network(t, x, m, p, acc, tau)
-
-
-#: :func:`_margin_rates` called through its address (:mod:`clutchlab.numerics.outline`): two more evaluations of the
-#: network, needed only while a stuck element is near its limit, kept out of the right-hand side every function of
-#: the core links
-_margin_rates_outlined = outlined(_margin_rates, lambda: (types.float64, _F1, _I1, _params_type(), _F1, _F1),
-                                  types.none)
+        if m[k] == STUCK and g[q] == 0.0:
+            # (plus ten rounding floors over the difference's step: a margin that stays put has no turning point)
+            g[q] = (gs[N_G * k + G_BREAK] - g[N_G * k + G_BREAK]) / T_RATE + \
+                10.0 * _item_noise(p, p.fric[k], tau) / T_RATE
+    for i in range(n):
+        acc[i] = wk[o + i]
+        fabs[i] = wk[o + n + i]
+    for r in range(ne):
+        tau[r] = wk[o + 2 * n + r]
+    for j in range(nl):
+        hold[j] = wk[o + 2 * n + ne + j]
 
 
 # ----------------------------------------------------------------- hooks
@@ -2302,25 +2386,31 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             dx[2 * n + r] = gear_power(p, r, x, n, m, tau[r])
         else:
             dx[2 * n + r] = tau[r] * w_rel
-    near = False
     for k in range(nf):
         r = p.fric[k]
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         mk = m[k]
         g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
-        if mk != STUCK:
-            g[N_G * k + G_BREAK] = 1.0
-        elif p.elem[r, E_LAW] == LAW_ONEWAY:   # holds any torque against overrunning, its clutch's limit for it
-            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), _item_noise(p, r, tau)) - tau[r]
-        else:
-            g[N_G * k + G_BREAK] = max(static_limit(p, r, t), _item_noise(p, r, tau)) - abs(tau[r])
         # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
         # the sliding direction), located so that a dip of the speed through zero within a step is seen
         g[N_G * k + G_TURN] = 1.0
-        if mk == STUCK and p.elem[r, E_LAW] != LAW_EXTERNAL and \
-                g[N_G * k + G_BREAK] < NEAR_LIMIT * max(static_limit(p, r, t), _item_noise(p, r, tau)):
-            g[N_G * k + G_TURN] = 0.0   # near its limit: its margin's turning point (_margin_rates, below)
-            near = True
+        g[N_G * k + G_NEAR] = 1.0
+        if mk != STUCK:
+            g[N_G * k + G_BREAK] = 1.0
+        else:
+            noise = _item_noise(p, r, tau)
+            lim = max(static_limit(p, r, t), noise)
+            # (a one-way clutch holds any torque against overrunning, its clutch's limit for it)
+            g[N_G * k + G_BREAK] = lim - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
+            if p.elem[r, E_LAW] != LAW_EXTERNAL and lim > 1e3 * noise and lim < np.inf:
+                # a stuck element with a limit of its own watches its margin near that limit: the margin less
+                # NEAR_LIMIT of the limit (a waypoint, falling through zero: a step ends just past it as the load
+                # comes near), and inside that band the margin's rate in its turn function (rising through zero: the
+                # margin's minimum, where the core looks at the break-away function again), taken where the core
+                # compares the functions (driveline_watch: _margin_rates; 0.0 here, at a step's stages)
+                g[N_G * k + G_NEAR] = g[N_G * k + G_BREAK] - NEAR_LIMIT * lim
+                if g[N_G * k + G_NEAR] < 0.0:
+                    g[N_G * k + G_TURN] = 0.0
         if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL and \
                 abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_rel = (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
@@ -2332,8 +2422,6 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_NORMAL] = p.coef[r, C_LIFTOFF] - signal_at(p, p.elem[r, E_SIGNAL], t)
         else:
             g[N_G * k + G_NORMAL] = signal_at(p, p.elem[r, E_SIGNAL], t)
-    if near:
-        _margin_rates_outlined(t, x, m, p, dx, g)
     for j in range(p.swit.shape[0]):
         r = p.swit[j]
         phi = _spring_deflection(p, r, x, n)
@@ -2582,10 +2670,12 @@ def driveline_update(t, x, u, m, p, k, log):
         # break-away function starts the next step beyond zero, which is no crossing)
         settle_outlined(t, x, m, p, log, m.copy(), r)
         return 0
-    if k % N_G == G_TURN:   # a slow sliding speed's or a stuck margin's turning point: a step ends there, no change
+    kf = k // N_G
+    if k % N_G == G_TURN or k % N_G == G_NEAR:
+        # a slow sliding speed's or a stuck margin's turning point, or a stuck element coming near its limit: a step
+        # ends there, nothing changes
         return 0
     old = m.copy()
-    kf = k // N_G
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):
         m[kf] = STUCK
     settle_outlined(t, x, m, p, log, old, p.fric[kf])
@@ -2757,6 +2847,23 @@ def driveline_rhs_event(t, x, u, m, p, dx, g):
     _rhs_outlined(t, x, u, m, p, dx, g)
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def driveline_watch(t, x, u, m, p, dx, g, k):
+    """The core's ``watch`` hook (where it compares the switching functions across a step, never at a step's
+    stages): the margin rates of the stuck elements near their limits (:func:`_margin_rates`), one more evaluation of
+    the network while one is, and only where the core reads one of them (``k`` a stuck element's turn function, or
+    -1 for all: a probe locating a break-away reads only that); nothing else."""
+    nf = p.fric.shape[0]
+    if k >= 0:
+        if k < N_G * nf and k % N_G == G_TURN and m[k // N_G] == STUCK and g[k] == 0.0:
+            _margin_rates(t, x, u, m, p, dx, g)
+        return
+    for j in range(nf):
+        if m[j] == STUCK and g[N_G * j + G_TURN] == 0.0:
+            _margin_rates(t, x, u, m, p, dx, g)
+            return
+
+
 dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
-                  jacobian=driveline_jacobian, rhs_event=driveline_rhs_event)
+                  jacobian=driveline_jacobian, rhs_event=driveline_rhs_event, watch=driveline_watch)

@@ -1463,7 +1463,7 @@ class Driveline:
         states, outputs = self.variables()
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric
-                          for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1)))
+                          for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3)))
         swit = [self._elements[r] for r in p.swit]
         # (every function of a switched spring falls through zero; a backlash's edges get the core's second look at
         # the root of its turning point in the gap, direction -2: a touch of an edge within a step is located)

@@ -240,19 +240,23 @@ def _may_cross(g0, g1, gdir):
 
 
 @register_jitable
-def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga):
+def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe, fe, ge, ga, waypoints):
     """Earliest root of the crossed switching functions on the dense output of the step.
 
     Illinois iteration per crossed function on the step fraction; returns
-    ``(theta, n_rhs)`` with ``theta`` the bracket end just past the earliest
+    ``(theta, n_rhs, k)`` with ``theta`` the bracket end just past the earliest
     root (so that the crossing shows at the returned point), or 2.0 if none
-    crossed.  ``ga`` receives the value each function starts the step with:
+    crossed, and ``k`` the function whose root it is.  A *waypoint* (direction
+    +-3: a function whose crossing only asks for a step end just past it, no
+    event) is located to 1 % of the step, and not at all with ``waypoints``
+    False or where another function crossed in the step.  ``ga`` receives the value each function starts the step with:
     ``g0``, except that a function starting exactly on zero (after the event
     that put it there: a ball on the ground, a clutch that just broke away)
     takes its sign from a probe just after the start (``theta`` = 1e-6), so a
     return through zero later in the same step is still seen.
     """
     best = 2.0
+    kbest = -1
     n_rhs = 0
     ng = g0.shape[0]
     probed = False
@@ -263,11 +267,17 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
             if not probed:
                 _dense(th0, h, x0, f0, x1, f1, rc, mass, xe)
                 model.rhs_event(t + th0 * h, xe, u, m, p, fe, ge)
+                model.watch(t + th0 * h, xe, u, m, p, fe, ge, -1)
                 n_rhs += 1
                 probed = True
             ga[k] = ge[k]
+    # (a waypoint is not looked at where another function has crossed in the step: that event ends the step anyway,
+    # and its cost was the waypoint's, a stuck element's entry into its band just before its break-away)
     for k in range(ng):
-        if not _crossed(ga[k], g1[k], gdir[k]):
+        if abs(gdir[k]) != 3 and _crossed(ga[k], g1[k], gdir[k]):
+            waypoints = False
+    for k in range(ng):
+        if not _crossed(ga[k], g1[k], gdir[k]) or (abs(gdir[k]) == 3 and not waypoints):
             continue
         lo = th0 if g0[k] == 0.0 else 0.0
         hi = min(1.0, best)
@@ -276,17 +286,20 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
             # an earlier root is known: only look before it
             _dense(hi, h, x0, f0, x1, f1, rc, mass, xe)
             model.rhs_event(t + hi * h, xe, u, m, p, fe, ge)
+            model.watch(t + hi * h, xe, u, m, p, fe, ge, k)
             n_rhs += 1
             if not _crossed(glo, ge[k], gdir[k]):
                 continue
             ghi = ge[k]
         else:
             ghi = g1[k]
-        hi, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, lo, hi, glo, ghi,
-                           ga[k], gdir[k])
+        hi, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass,
+                           event_tol if abs(gdir[k]) != 3 else max(event_tol, 1e-2 * h), xe, fe, ge, k, lo, hi, glo,
+                           ghi, ga[k], gdir[k])
         n_rhs += nr
         if hi < best:
             best = hi
+            kbest = k
     # a function that had not crossed by the step's end may have crossed before the earliest root and come back
     # (a dip through zero that the root of a turning-point function reveals): look again at the earliest root and
     # locate any such crossing before it
@@ -295,6 +308,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
             break
         _dense(best, h, x0, f0, x1, f1, rc, mass, xe)
         model.rhs_event(t + best * h, xe, u, m, p, fe, ge)
+        model.watch(t + best * h, xe, u, m, p, fe, ge, -1)
         n_rhs += 1
         earliest = best
         gb = ge.copy()   # (rare: a step with an event; the searches below overwrite ge)
@@ -307,12 +321,16 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
             root, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k, 0.0, best, ga[k],
                                  gb[k], ga[k], gdir[k])
             n_rhs += nr
-            if root > 1e-3 * best:   # (a root at the very start of the step is the last event's, not a new one)
-                earliest = min(earliest, root)
+            # (a root within the event tolerance's reach of the step's start is the last event's, not a new one; a
+            # share of the step would drop a crossing a microsecond after a step end that a window's entry put
+            # just before it: the slip of a statically indeterminate pair found 6 ms late, #30)
+            if root * h > 64.0 * event_tol and root < earliest:
+                earliest = root
+                kbest = k
         if earliest >= best:
             break
         best = earliest
-    return best, n_rhs
+    return best, n_rhs, kbest
 
 
 @register_jitable
@@ -333,6 +351,7 @@ def _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass, event_tol, xe, fe, ge, k,
         th = min(max(th, lo + 0.01 * span), hi - 0.01 * span)
         _dense(th, h, x0, f0, x1, f1, rc, mass, xe)
         model.rhs_event(t + th * h, xe, u, m, p, fe, ge)
+        model.watch(t + th * h, xe, u, m, p, fe, ge, k)
         n_rhs += 1
         if _crossed(gref, ge[k], gdir_k):
             hi = th
@@ -387,6 +406,7 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
             break
         _dense(th, h, x, k1, x1, f1, rc, mass, xt)
         model.rhs_event(t + th * h, xt, u, m, p, fe, ge)
+        model.watch(t + th * h, xt, u, m, p, fe, ge, -1)
         n_rhs += 1
         for k in range(ng):
             if j == 0:
@@ -446,6 +466,8 @@ def _root_on_step(p, t, h, x, k1, x1, f1, rc, mass, g0, g1, ga, gdir, u, m, even
                     xs[i] = xt[i]
                 c = 1.0
             model.rhs_event(t + c * hh, xt, u, m, p, fe if stg == 6 else Ks[stg - 1], ge)
+        # (the functions at the fraction's end: every one read in phase 0, then only the one followed)
+        model.watch(t + hh, xs, u, m, p, fe, ge, -1 if phase == 0 else kk)
         n_rhs += 6
         last = th
         if phase == 0:
@@ -637,6 +659,7 @@ def _at_break(p, t, x, u, m, log, f, g, si):
     at ``t``; returns the next break time."""
     model.restart(t, x, u, m, p, log)
     model.rhs_event(t, x, u, m, p, f, g)
+    model.watch(t, x, u, m, p, f, g, -1)
     si[SI_NRHS] += 1
     return model.next_break(t, m, p)
 
@@ -709,6 +732,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     status = SUCCESS
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, k1, g0)
+    model.watch(t, x, u, m, p, k1, g0, -1)
     si[SI_NRHS] += 1
     i_rec = si[SI_IREC]
     if si[SI_STARTED] == 0:
@@ -726,6 +750,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     tb = model.next_break(t, m, p)
     prev_rej = False
     n_dips = 0
+    waypoint_retry = False
     while t < t_end:
         status = _run_limit(si, opt, grid, cap, i_rec)
         if status != SUCCESS:
@@ -791,6 +816,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 h = next_step(h, en, False)
             prev_rej = True
             continue
+        model.watch(t1s, xn, u, m, p, k7, g1, -1)   # (the accepted step end's functions, compared with the start's)
         # a switching function that changed sign at an inner stage but not by the step's end may have crossed
         # zero and come back within the step (a stuck clutch's slip dipping through zero): the step is retried
         # shorter, at most 4 times in a row, so that its end falls in the dip and the crossing is located
@@ -813,13 +839,22 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if _may_cross(g0, g1, opt.gdir):
             dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
             samples = grid
-            theta, nr = _locate(p, t, h, x, k1, xn, k7, rc, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe, ge,
-                                ga)
+            theta, nr, kw = _locate(p, t, h, x, k1, xn, k7, rc, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, fe,
+                                    ge, ga, not waypoint_retry)
         else:
-            theta, nr = 2.0, 0
+            theta, nr, kw = 2.0, 0, -1
             if samples:
                 dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
         si[SI_NRHS] += nr
+        if theta < 1.0 and kw >= 0 and abs(opt.gdir[kw]) == 3:
+            # the earliest root is a waypoint (a stuck element coming near its limit): the step is taken again,
+            # ending just past it on its own solution, with no event and no waypoint looked at (a precise event
+            # there cost CoupledClutches 17 % at rtol 1e-6)
+            si[SI_REJECTED] += 1
+            h = theta * h
+            waypoint_retry = True
+            continue
+        waypoint_retry = False
         on_step = False
         if theta < 1.0:
             # the root moved to the step's own solution, the state the run restarts from
@@ -854,6 +889,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                     x[i] = xe[i]
             t = t_new
             model.rhs(t, x, u, m, p, fe, g1)
+            model.watch(t, x, u, m, p, fe, g1, -1)
             si[SI_NRHS] += 1
             flag = _apply_updates(p, t, x, u, m, ga, g1, opt.gdir, log)
             r = model.accept(t, x, u, m, p)
@@ -862,6 +898,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 status = MODEL_ERROR
                 break
             model.rhs(t, x, u, m, p, k1, g0)
+            model.watch(t, x, u, m, p, k1, g0, -1)
             si[SI_NRHS] += 1
             if flag == RESTART:
                 # the dynamics changed abruptly at the event (a speed jumping to a limit within microseconds):
@@ -888,6 +925,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 break
             if r > 0:
                 model.rhs(t, x, u, m, p, k1, g0)
+                model.watch(t, x, u, m, p, k1, g0, -1)
                 si[SI_NRHS] += 1
             h = next_step(h, en, prev_rej)
         prev_rej = False
@@ -1090,6 +1128,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     status = SUCCESS
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, f0, g0)
+    model.watch(t, x, u, m, p, f0, g0, -1)
     si[SI_NRHS] += 1
     i_rec = si[SI_IREC]
     if si[SI_STARTED] == 0:
@@ -1140,6 +1179,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 status = SINGULAR
                 break
             model.rhs(t_new, x1, u, m, p, f1, g1)
+            model.watch(t_new, x1, u, m, p, f1, g1, -1)
             si[SI_NRHS] += 1
             if grid and i_rec < ts.shape[0] and ts[i_rec] <= t_new:
                 i_rec = _record_dense(p, t, h, x, f0, x1, f1, rc0, mass, t_new, u, m, ts, rec_t, rec_x, rec_m,
@@ -1161,6 +1201,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             # the derivative at the step end again, always (modes, restart or accept may have changed it):
             # every step evaluates the same number of right-hand sides
             model.rhs(t, x, u, m, p, f0, g0)
+            model.watch(t, x, u, m, p, f0, g0, -1)
             si[SI_NRHS] += 1
             if not grid:
                 i_rec = _record_step(p, t, x, u, m, rec_t, rec_x, rec_m, rec_y, want_y, i_rec)
@@ -1211,10 +1252,11 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             continue
         # step end: derivative (dense output, next step's f0) and switching functions
         model.rhs(t + h, x1, u, m, p, f1, g1)
+        model.watch(t + h, x1, u, m, p, f1, g1, -1)
         si[SI_NRHS] += 1
         if _may_cross(g0, g1, opt.gdir):
-            theta, nr = _locate(p, t, h, x, f0, x1, f1, rc0, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe, ftmp, gp,
-                                ga)
+            theta, nr, _kw = _locate(p, t, h, x, f0, x1, f1, rc0, u, m, g0, g1, opt.gdir, mass, opt.event_tol, xe,
+                                     ftmp, gp, ga, True)
         else:
             theta, nr = 2.0, 0
         si[SI_NRHS] += nr
@@ -1228,6 +1270,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             si[SI_NRHS] += 2
             if ok2:
                 model.rhs(t + hs, xe, u, m, p, ftmp, gp)
+                model.watch(t + hs, xe, u, m, p, ftmp, gp, -1)
                 si[SI_NRHS] += 1
                 for i in range(n):
                     x1[i] = xe[i]
@@ -1262,6 +1305,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             break
         if event or r > 0:
             model.rhs(t, x, u, m, p, f0, g0)
+            model.watch(t, x, u, m, p, f0, g0, -1)
             si[SI_NRHS] += 1
             if flag == RESTART:
                 # the model says the dynamics changed at the event (a mass breaking away from its stuck
@@ -1294,6 +1338,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 def _evaluate(p, t, x, u, m, dx, g):
     p = byref(borrow(p))  # the same specialisation of the hooks as the loops'
     model.rhs(t, x, u, m, p, dx, g)
+    model.watch(t, x, u, m, p, dx, g, -1)   # (the switching functions as the core compares them)
 
 
 @register_jitable

@@ -22,14 +22,25 @@ the held inputs ``u`` [float64 array], the mode vector ``m`` [int64 array]
 and the parameters ``p``):
 
 ``rhs(t, x, u, m, p, dx, g)``
-    Right-hand side into ``dx`` and the switching functions into ``g``.
-    (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the same hook, inlined
-    there for a model registered with ``inline_stages=True``.)
+    Right-hand side into ``dx`` and the switching functions into ``g``, at the stages of a step and
+    in its Jacobian.  (The core calls it as ``rhs_stage`` at the stages of a Dormand-Prince step: the
+    same hook, inlined there for a model registered with ``inline_stages=True``.)  The switching
+    functions read there serve only the stages' look for a sign change within the step: a function
+    that needs more than one evaluation may be left at 0.0 (never a sign change) and completed in
+    ``watch``.
 ``rhs_event(t, x, u, m, p, dx, g)`` (optional)
-    The same right-hand side, where the core evaluates it at events (locating a root, the step to it,
+    The same right-hand side where the core evaluates it at events (locating a root, the step to it,
     a break); ``rhs`` itself if not given.  A model whose right-hand side is large gives it called
     through its address (:mod:`clutchlab.numerics.outline`), so that the core's event-time functions
     do not each link and optimise it again (the driveline: docs/architecture.md).
+``watch(t, x, u, m, p, dx, g, k)`` (optional)
+    Completes the switching functions ``g`` just evaluated with ``dx`` at ``(t, x)`` wherever the core
+    compares them across a step: every step end, the start of a run, after an event or a break, each
+    probe locating a root, and :func:`~clutchlab.numerics.core.evaluate`; never at a step's stages.
+    ``k``: the one function the core reads there (a probe locating its root), -1 for all.  For
+    functions that cost more than one evaluation (the driveline: the rates of its stuck elements'
+    margins near their limits, one more evaluation of the network, docs/driveline.md "Events").
+    Nothing for a model that does not give it (compiled out).
 ``outputs(t, x, u, m, p, y)``
     Output vector into ``y``.
 ``update(t, x, u, m, p, k, log)``
@@ -69,12 +80,13 @@ from numba.extending import overload
 from .borrow import ByRef
 
 __all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "rhs_event", "outputs", "update", "restart", "accept",
-           "next_break", "jacobian", "time_derivative", "no_time_derivative"]
+           "next_break", "jacobian", "time_derivative", "no_time_derivative", "watch", "no_watch"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 #: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time;
-#: ``rhs_event``: the right-hand side where the core evaluates it at events, its ``rhs`` if not given)
-OPTIONAL_HOOKS = ("time_derivative", "rhs_event")
+#: ``rhs_event``: the right-hand side where the core evaluates it at events, its ``rhs`` if not given;
+#: ``watch``: nothing)
+OPTIONAL_HOOKS = ("time_derivative", "rhs_event", "watch")
 
 
 def no_time_derivative(t, x, u, m, p, ft):
@@ -267,6 +279,27 @@ def _typing(stub, hook, key, inline=None):
     return typing
 
 
+def no_watch(t, x, u, m, p, dx, g, k):
+    """What the ``watch`` stub compiles to for a model without the hook: nothing (compiled into the caller, as
+    :func:`no_time_derivative`)."""
+    return None
+
+
+def _default_watch(t, x, u, m, p, dx, g, k):
+    """Typing of the ``watch`` stub for a registered model that does not give the hook."""
+    q = p.pointee if isinstance(p, ByRef) else p
+    if isinstance(q, types.BaseNamedTuple) and q.instance_class in _MODELS and "watch" not in _MODELS[q.instance_class]:
+        return no_watch
+    return None
+
+
+def watch(t, x, u, m, p, dx, g, k):  # pragma: no cover
+    raise NotImplementedError
+
+
+# models without a ``watch`` hook: the stub compiles to nothing inside the caller
+overload(watch, jit_options={"cache": False})(functools.wraps(watch)(_default_watch))
+
 # models without a ``time_derivative`` hook: the stub compiles to ``return False`` inside the caller
 overload(time_derivative, jit_options={"cache": False})(
     functools.wraps(time_derivative)(_default_time_derivative))
@@ -274,4 +307,4 @@ overload(time_derivative, jit_options={"cache": False})(
 #: (stub, hook it resolves to)
 _STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (rhs_event, "rhs_event"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
           (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"),
-          (time_derivative, "time_derivative"))
+          (time_derivative, "time_derivative"), (watch, "watch"))
