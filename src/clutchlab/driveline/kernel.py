@@ -105,7 +105,7 @@ N_COEF = 5
 GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = 0, 1, 2, 3, 4
 GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
-# switching functions: four per friction element, then three per switched spring (``swit``: backlash and curves),
+# switching functions: five per friction element, then three per switched spring (``swit``: backlash and curves),
 # then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
 G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = 0, 1, 2, 3, 4
 N_G = 5
@@ -2270,14 +2270,6 @@ T_RATE = 1e-6
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _stuck_margin(p, r, t, tau):
-    """The break-away function of stuck friction element row ``r`` (:func:`driveline_rhs`): what it holds minus its
-    torque [N m] (a one-way clutch: against its overrunning direction only)."""
-    lim = max(static_limit(p, r, t), _item_noise(p, r, tau))
-    return lim - tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else lim - abs(tau[r])
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
 def _margin_rates(t, x, u, m, p, dx, g):
     """The turning points of the margins of the stuck friction elements near their limits: ``g[.. G_TURN]`` (which
     :func:`driveline_rhs` marks with 0.0) becomes the margin's rate [N m/s] (rising through zero at its minimum), by
@@ -2343,11 +2335,13 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     States: ``phi`` (n), ``w`` (n), then one energy per element in element order [J]: a source's work
     ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
     the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift); then
-    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, four per friction element: the relative speed of a sliding element in its
+    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, five per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged), the turning point of a slow sliding speed, or of a stuck one's margin near its
-    limit (:func:`_margin_rates`: a brief overload is found); then three per switched spring.  A
+    limit (0.0 here, its rate from :func:`driveline_watch`: a brief overload is found), and a stuck one's margin less
+    :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near); then three per switched
+    spring.  A
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
     pull); released beyond an edge (Kelvin-Voigt's damped separation), first ``tau / c`` signed positive while it
