@@ -1828,23 +1828,32 @@ def _near_limit(t, p, tau, i):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _tied(t, p, tau, i):
-    """True if stuck item ``i`` is at or beyond its limit at the last evaluation by no more than the rounding the
-    invariants allow a stuck item (:func:`check_invariants`: a friction element ``1e-9`` of its limit plus one
-    rounding floor, a lossy gear's hold two floors): at its limit to rounding, which side of it is a rounding, so
-    the tie-break in :func:`settle` decides it by where its load goes, as for one just inside its limit."""
+def _past_limit(t, p, tau, i):
+    """How far [N m] stuck item ``i`` is beyond its limit at the last evaluation (a friction element's holding
+    limit, a lossy gear's band edge, each at least its rounding floor), and how far beyond the rounding a stuck item
+    is allowed (a friction element ``1e-9`` of its limit plus one floor, a lossy gear's hold two floors): the
+    invariant's test (:func:`check_invariants`, beyond it where the second is > 0) and the tie's (:func:`_tied`)."""
     nf = p.fric.shape[0]
     r = _item_row(p, i)
     noise = _item_noise(p, r, tau)
     if i < nf:
-        if p.elem[r, E_LAW] == LAW_EXTERNAL:
-            return False
         tq = tau[r]
         lim = max(holding_limit(p, r, t, tq), noise)
         over = abs(tq) - lim
-        return over >= 0.0 and over <= 1e-9 * lim + noise
-    margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
-    return margin <= 0.0 and -margin <= noise   # (the margin is widened by one floor already)
+        return over, over - (1e-9 * lim + noise)
+    margin, _width, _d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)   # (widened by one floor already)
+    return -margin, -margin - noise
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _tied(t, p, tau, i):
+    """True if stuck item ``i`` is at or beyond its limit at the last evaluation by no more than the rounding the
+    invariants allow a stuck item (:func:`_past_limit`): at its limit to rounding, which side of it is a rounding, so
+    the tie-break in :func:`settle` decides it by where its load goes, as for one just inside its limit."""
+    if i < p.fric.shape[0] and p.elem[_item_row(p, i), E_LAW] == LAW_EXTERNAL:
+        return False
+    over, allowed = _past_limit(t, p, tau, i)
+    return over >= 0.0 and allowed <= 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2728,8 +2737,7 @@ def check_invariants(t, x, m, p):
         mk = m[k]
         tq = tau[r]
         if mk == STUCK:
-            lim = max(holding_limit(p, r, t, tq), noise)
-            if abs(tq) > lim * (1.0 + 1e-9) + noise:
+            if _past_limit(t, p, tau, k)[1] > 0.0:
                 return -(INV_BASE + N_INV * r + (INV_ONEWAY if p.elem[r, E_LAW] == LAW_ONEWAY else INV_LIMIT))
             if abs(w_rel) > w_tol:
                 return -(INV_BASE + N_INV * r + INV_MODE)
@@ -2739,7 +2747,6 @@ def check_invariants(t, x, m, p):
             cap = max(static_limit(p, r, t), friction_torque(p, r, t, abs(w_rel)), noise)
             if mk == BACKWARD or w_rel < -w_tol or tq > cap * (1.0 + 1e-9) + noise:
                 return -(INV_BASE + N_INV * r + INV_ONEWAY)
-    hold = _holds(p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
         mode = m[p.elem[r, E_MODE]]
@@ -2747,8 +2754,7 @@ def check_invariants(t, x, m, p):
         noise = _item_noise(p, r, tau)
         w_tol = 1e3 * _item_wtol(p, r, x, n)
         if mode == GEAR_STUCK:
-            lo, hi = gear_band(p, r, -tau[r])
-            if hold[j] > hi + 2.0 * noise or hold[j] < lo - 2.0 * noise:
+            if _past_limit(t, p, tau, nf + j)[1] > 0.0:
                 return -(INV_BASE + N_INV * r + INV_LIMIT)
             if abs(w_a) > w_tol:
                 return -(INV_BASE + N_INV * r + INV_MODE)
