@@ -714,6 +714,47 @@ def test_an_unrelated_element_changes_nothing(d):
     assert all(abs(x[0] - y[0]) <= 1e-6 for x, y in zip(ea, eb))
 
 
+@pytest.mark.parametrize("unrelated", ["event", "jump"])
+def test_an_unrelated_event_does_not_search_a_held_network_again(unrelated):
+    """Found by the thorough profile: a lossy gear at efficiency 0.5 (its band's edge when driven from flange b) in
+    a loop closed by a clutch, a bearing friction on the first inertia, a 1 N m sine: nothing moves for a second.
+    An unrelated inertia's brake breaks away at 1/12 s (its sine reaching the brake's 0.5 N m), where the loop's
+    clutch carries exactly its own 0.5 N m limit: the search run there for the brake searched the whole network,
+    and the gear, at its band's edge to rounding, came out rolling backward (at zero speed, held by the bearing).
+    A search now decides only the items linked to the element whose event it is (for a signal's jump, to the
+    elements whose signals jump): elsewhere a stuck item holds until its own function crosses.  The same where the
+    unrelated inertia gets a second brake by a step of its normal force (a jump of a signal: every item in the
+    network was searched again there, and the gear rolled backward from 0.2 s; searched only where the brake is,
+    the gear was held 1e-16 N m beyond its band from 0.325 s, its network's split moved by the second brake: the
+    set's null space had two directions, the loop's and the two brakes', and the split was repaired only where it
+    has one; each block of a stuck set sharing no inertia with the rest is now repaired on its own)."""
+    def network(with_u):
+        d = Driveline("held")
+        for i in range(4):
+            d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
+        d.spring_damper("k0", "J0", "J1", c=1.0, d=0.0).spring_damper("k1", "J1", "J2", c=1.0, d=0.0)
+        d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.5)
+        d.clutch("loop", "J0", "J3", fn_max=1.0, mu=0.5)
+        d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+        d.torque("T0", "J0", Signal.sine(1.0, 1.0))
+        if with_u:
+            d.inertia("U", J=1.0, w0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5)
+            if unrelated == "event":
+                d.torque("UT", "U", Signal.sine(1.0, 1.0))
+            else:   # a second brake on it, applied at 0.2 s: a restart of the whole run there
+                d.brake("Ub2", "U", fn_max=1.0, mu=0.5, normal=Signal.step(1.0, 0.2))
+        return d
+
+    alone = _mode_events(network(False).simulate(1.0, output_step=2e-3, check_invariants=True))
+    both = _mode_events(network(True).simulate(1.0, output_step=2e-3, check_invariants=True))
+    assert alone == []
+    if unrelated == "event":
+        assert [e[1:] for e in both] == [("Ubrake", "forward"), ("Ubrake", "backward")]
+        assert abs(both[0][0] - 1 / 12) < 1e-9
+    else:
+        assert [e for e in both if not e[1].startswith("U")] == []
+
+
 @settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
 @given(networks())
 def test_the_result_follows_the_tolerance_on_random_networks(d):

@@ -935,13 +935,14 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
     (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
     (nk) | three flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds,
-    null vector, its scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2) | accelerations (n) | element torques (ne) | slack of each friction element's
+    null vector, its scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2), one block's members, split,
+    bounds and the block of each member (5 nk, :func:`_repair_blocks`) | accelerations (n) | element torques (ne) | slack of each friction element's
     and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
     inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
     (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
     null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
     instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
-    modes before it (2 + nf + nl, :func:`settle`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    modes before it (2 + nf + nl, :func:`settle`), the last break time given to the core (1, :func:`_break_marker`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | the scratch of the rates of stuck margins: the moved state, its derivative and switching
     functions, and the accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`,
     :func:`_margin_rates`, addressed from the end) | initial stored energy (1).  Returns the offsets as a
@@ -954,7 +955,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_r = o_c + nk
     o_g = o_r + nk
     o_lim = o_g + 9 * nk
-    o_acc = o_lim + 11 * nk + 2 + nk * nk
+    o_acc = o_lim + 16 * nk + 2 + nk * nk
     o_tau = o_acc + n
     o_slack = o_tau + ne
     o_fabs = o_slack + nf + nl
@@ -962,7 +963,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
     o_inst = o_nv + 2 + nk * nk + nk
-    o_ext = o_inst + 2 + nf + nl
+    o_ext = o_inst + 3 + nf + nl
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
                       o_inst, o_ext)
 
@@ -989,6 +990,7 @@ def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     lay = _layout.py_func(n, nk, ne, nf, nl, nsig)
     work[lay.sig] = np.nan
     work[lay.inst] = np.nan
+    work[lay.inst + 2 + nf + nl] = np.nan
     return work
 
 
@@ -1038,6 +1040,15 @@ def _instant(p):
     elements and lossy gears before it (:func:`settle`)."""
     o = _offsets(p)
     return borrow(p.work[o.inst:o.inst + 2 + p.fric.shape[0] + p.lossy.shape[0]])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _break_marker(p):
+    """The break time :func:`driveline_next_break` last gave the core (NaN once a restart has taken it): a restart
+    at that time is a signal's jump, not a start or a resume (:func:`driveline_restart`)."""
+    o = _offsets(p)
+    k = o.inst + 2 + p.fric.shape[0] + p.lossy.shape[0]
+    return borrow(p.work[k:k + 1])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1373,6 +1384,84 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     return True
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
+    """:func:`_repair` for each block of a stuck set whose members fall into blocks that share no inertia (stuck
+    members in linked groups of their own, :func:`_components`): ``A`` is then block-diagonal, with a null
+    direction per redundant block, and the whole set's null space has more than one dimension, so :func:`_repair`
+    on it did nothing (a lossy gear at its band's edge held beyond it, its network's split moved by a second brake
+    applied elsewhere, #30).  Each block of two or more members is repaired on its own, as in a network of that
+    block alone.  Returns False (nothing done) if the set is one block."""
+    nk = _nk(p)
+    wk = p.work
+    lay = _offsets(p)
+    o = lay.lim + 11 * nk + 2 + nk * nk
+    sub = wk[o:o + nk]
+    lam_c = wk[o + nk:o + 2 * nk]
+    lo_c = wk[o + 2 * nk:o + 3 * nk]
+    hi_c = wk[o + 3 * nk:o + 4 * nk]
+    lab = wk[o + 4 * nk:o + 5 * nk]
+    # the blocks: members linked through shared inertias (labels: the lowest member of the block)
+    for k in range(ns):
+        lab[k] = k
+    changed = True
+    while changed:
+        changed = False
+        for k in range(ns):
+            for j in range(k + 1, ns):
+                if lab[k] == lab[j]:
+                    continue
+                share = False
+                for q in range(3):
+                    i = flf[3 * k + q]
+                    if i < 0.0:
+                        continue
+                    for qq in range(3):
+                        if flf[3 * j + qq] == i:
+                            share = True
+                if share:
+                    lo_lab = min(lab[k], lab[j])
+                    lab[k] = lo_lab
+                    lab[j] = lo_lab
+                    changed = True
+    one = True
+    for k in range(ns):
+        if lab[k] != 0.0:
+            one = False
+    if one:
+        return False
+    for b in range(ns):
+        nc = 0
+        for k in range(ns):
+            if lab[k] == b:
+                nc += 1
+        if nc < 2:
+            continue
+        Ac = shaped(wk[lay.m:lay.m + nc * nc], (nc, nc))
+        Sc = shaped(wk[lay.lim + 11 * nk + 2:lay.lim + 11 * nk + 2 + nc * nc], (nc, nc))
+        c = 0
+        for k in range(ns):
+            if lab[k] != b:
+                continue
+            sub[c] = stuck[k]
+            lam_c[c] = lam[k]
+            lo_c[c] = lo[k]
+            hi_c[c] = hi[k]
+            cj = 0
+            for j in range(ns):
+                if lab[j] == b:
+                    Ac[c, cj] = A[k, j]
+                    cj += 1
+            c += 1
+        if _repair_outlined(p, sub, nc, Ac, Sc, p.iwork, lam_c, lo_c, hi_c, v, tmp, cand, trial, tol):
+            c = 0
+            for k in range(ns):
+                if lab[k] == b:
+                    lam[k] = lam_c[c]
+                    c += 1
+    return True
+
+
 def _params_type():
     """numba type of the :class:`DrivelineParams` reference every kernel function takes (one type for every network)."""
     i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
@@ -1520,7 +1609,8 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         tol = NOISE * big
         # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
         # v keeps the constraints, v being A's null vector to rounding)
-        _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
+        if not _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, vnull, vtmp, cand, trial, tol):
+            _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
     hold = _holds(p)
     Fa = _torque_magnitudes(p)
     for k in range(ns):
@@ -1934,25 +2024,46 @@ def _components(p, comp):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _linked(p, comp, origin, r):
-    """True if element row ``r`` acts on the inertias element row ``origin`` acts on, through elements
-    (:func:`_components`), or if ``origin`` is -1 (every element: a restart)."""
-    if origin < 0:
-        return True
-    c = -1
-    for q in range(3):
-        i = _flange(p, origin, q)
-        if i >= 0:
-            c = comp[i]
+def _reach(t, p, comp, origin, reach):
+    """Mark in ``reach`` (by :func:`_components`' label) the linked groups of inertias a search at ``t`` decides:
+    those element row ``origin`` acts on (an event of its own); with ``origin`` -2 (a signal's jump) those of every
+    element whose signal jumps or kinks at ``t``; with ``origin`` -1 (a start or a resume), or a jump no element's
+    signal shows, every group."""
+    n = p.inertia.shape[0]
+    for i in range(n):
+        reach[i] = origin == -1
+    if origin == -1:
+        return
+    found = False
+    for r in range(p.elem.shape[0]):
+        if origin >= 0:
+            mine = r == origin
+        else:
+            s = p.elem[r, E_SIGNAL]
+            mine = s >= 0 and signal_break(p.signals[s], p.data, t - 1e-12 * max(1.0, abs(t))) == t
+        if mine:
+            for q in range(3):
+                i = _flange(p, r, q)
+                if i >= 0:
+                    reach[comp[i]] = True
+                    found = True
+    if not found and origin == -2:
+        for i in range(n):
+            reach[i] = True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _linked(p, comp, reach, r):
+    """True if element row ``r`` acts on an inertia of a linked group marked in ``reach`` (:func:`_reach`)."""
     for q in range(3):
         i = _flange(p, r, q)
-        if i >= 0 and comp[i] == c:
+        if i >= 0 and reach[comp[i]]:
             return True
     return False
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _project_speeds(t, x, m, p, comp, origin):
+def _project_speeds(t, x, m, p, comp, reach):
     """Put the relative speed of every member of the constraint set of the modes ``m`` (stuck friction elements,
     gears, stuck lossy gears' holds) to zero, by the impulses along the members' torque directions that do it (the
     set of :func:`evaluate_network` solved by :func:`_solve_stuck` for momenta instead of torques: ``A mu = g . w``,
@@ -1971,9 +2082,9 @@ def _project_speeds(t, x, m, p, comp, origin):
     ``test_a_clutch_reaching_rest_beside_a_stuck_gear_decides_by_the_forces_not_the_tolerance``; the launch's final
     engine speed at rtol 1e-8 moves by 3e-5 rad/s of 383 with it (its driveshaft backlash's contact sequence
     amplifies any change: the engine's inertia changed by 1e-11 of itself moves it by 8.5e-6, docs/driveline.md).
-    Only the members linked to element row
-    ``origin`` (:func:`_linked`; all at a restart, ``origin`` -1): a stuck set elsewhere keeps its residue until an
-    event of its own, as in a network without the element whose event this is."""
+    Only the members linked to the elements the search is for (``reach``, :func:`_reach`, :func:`_linked`): a stuck
+    set elsewhere keeps its residue until an event of its own, as in a network without the element whose event this
+    is."""
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     wk = p.work
@@ -1982,19 +2093,19 @@ def _project_speeds(t, x, m, p, comp, origin):
     ns = _ZERO
     for k in range(nf):
         r = p.fric[k]
-        if m[k] == STUCK and _linked(p, comp, origin, r):
+        if m[k] == STUCK and _linked(p, comp, reach, r):
             w, w_tol = abs(_item_speed(p, x, n, k)), _item_wtol(p, r, x, n)
             if w > 1e3 * w_tol:
                 return   # beyond a residue (a mode forced by hand): left for the invariant check to name
             stuck[ns] = r
             ns += 1
     for k in range(p.cons.shape[0]):
-        if _linked(p, comp, origin, p.cons[k]):
+        if _linked(p, comp, reach, p.cons[k]):
             stuck[ns] = p.cons[k]
             ns += 1
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
-        if m[p.elem[r, E_MODE]] == GEAR_STUCK and _linked(p, comp, origin, r):
+        if m[p.elem[r, E_MODE]] == GEAR_STUCK and _linked(p, comp, reach, r):
             w, w_tol = abs(_item_speed(p, x, n, nf + j)), _item_wtol(p, r, x, n)
             if w > 1e3 * w_tol:
                 return
@@ -2022,9 +2133,12 @@ def settle(t, x, m, p, log, old, origin):
     elements elsewhere in the network (beyond rounding, :data:`NOISE`; overloads within 1e-6 of each other, which
     rounding would order, are taken lossy gears first, then in element order).  An event per item whose mode now differs
     from ``old`` (the modes before the event), named for the mode entered (a lossy gear's quadrant: ``a_drives``,
-    ``b_drives``).  ``origin``: the element row whose event this is, -1 at a restart (an item slower than its
-    rounding width is taken as at rest only where it is linked to that element, :func:`_linked`; the stuck speeds
-    put to rest there, :func:`_project_speeds`).  Returns True if a mode changed."""
+    ``b_drives``).  ``origin``: the element row whose event this is, -2 at a signal's jump, -1 at a start or a
+    resume.  Only the items linked to that element (to the elements whose signals jump; every item at a start) are
+    searched, and only their stuck speeds put to rest (:func:`_reach`, :func:`_linked`, :func:`_project_speeds`): a
+    stuck item elsewhere holds or breaks away at its own function's crossing, and a sliding one goes on until its
+    own function crosses, as in a network without the element whose event this is.  Returns True if a mode
+    changed."""
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     nl = p.lossy.shape[0]
@@ -2042,6 +2156,8 @@ def settle(t, x, m, p, log, old, origin):
     ni = nf + nl
     comp = np.empty(n, dtype=np.int64)
     _components(p, comp)
+    reach = np.empty(n, dtype=np.bool_)
+    _reach(t, p, comp, origin, reach)
     # (a second pass where the stuck speeds' projection brought a sliding item linked to them to rest: the search
     # decides it too, else it would go on sliding at zero speed, labelled by the rounding its speed had before)
     for _pass in range(ni + 1):
@@ -2056,9 +2172,13 @@ def settle(t, x, m, p, log, old, origin):
         for i in range(ni):
             if i < nf and m[i] == FREE:
                 continue
+            # (only items linked to the element whose event this is: a stuck item elsewhere holds or breaks away at
+            # its own function's crossing, as in a network without that element -- searched again at an unrelated
+            # event, a lossy gear at its band's edge came out rolling where it had stayed stuck, #30)
+            if not _linked(p, comp, reach, _item_row(p, i)):
+                continue
             if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i) or \
-                    (abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and
-                     _linked(p, comp, origin, _item_row(p, i))):
+                    abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n):
                 cand[nc] = i
                 nc += 1
                 _item_set(p, m, i, _ZERO)
@@ -2217,7 +2337,7 @@ def settle(t, x, m, p, log, old, origin):
                 _evaluate(t, x, m, p, acc, tau)
             if not marked:
                 break
-        _project_speeds(t, x, m, p, comp, origin)
+        _project_speeds(t, x, m, p, comp, reach)
         rest = False
         for i in range(ni):
             if (i < nf and m[i] == FREE) or _item_stuck(p, m, i):
@@ -2227,7 +2347,7 @@ def settle(t, x, m, p, log, old, origin):
                 if cand[c] == i:
                     taken = True
             if not taken and abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and \
-                    _linked(p, comp, origin, _item_row(p, i)):
+                    _linked(p, comp, reach, _item_row(p, i)):
                 rest = True
         if not rest:
             break
@@ -2688,10 +2808,15 @@ def driveline_update(t, x, u, m, p, k, log):
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def driveline_restart(t, x, u, m, p, log):
     """Modes consistent with the forces at a start, a resume or a signal's jump (the signal cache emptied first:
-    :func:`forget_signals`)."""
+    :func:`forget_signals`).  At the break time last given to the core (:func:`_break_marker`) it is a signal's
+    jump: only the items linked to the elements whose signals jump are searched (:func:`settle`, origin -2); else
+    every item."""
     forget_signals(p)
     _instant(p)[0] = np.nan   # a new instant (:func:`_one_search_per_instant`)
-    return settle_outlined(t, x, m, p, log, m.copy(), _ZERO - 1)
+    mark = _break_marker(p)
+    origin = _ZERO - 2 if t == mark[0] else _ZERO - 1
+    mark[0] = np.nan
+    return settle_outlined(t, x, m, p, log, m.copy(), origin)
 
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
@@ -2826,6 +2951,7 @@ def driveline_next_break(t, m, p):
         v = signal_break(p.signals[s], p.data, t)
         if v < tb:
             tb = v
+    _break_marker(p)[0] = tb
     return tb
 
 
