@@ -1184,7 +1184,8 @@ def _null_vector(A, ns, S, cp, v, y):
                 return False
         if bv <= 1e-10 * first:
             if c != ns - 1:
-                return False        # more than one null direction
+                v[0] = np.nan       # more than one null direction (told apart from full rank by the caller)
+                return False
             break
         if c == ns - 1:
             return False            # full rank
@@ -1236,6 +1237,12 @@ def _full_rank_known(p, A, ns):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _several_null_known(p, A, ns):
+    """True if the last null-vector search was of exactly this ``A`` and found more than one null direction."""
+    return _searched_before(p, A, ns) and p.work[_offsets(p).nv + 1] == 2.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _null_vector_cached(p, A, ns, S, cp, v, y):
     """:func:`_null_vector` of ``A[:ns, :ns]``, reusing the last search's result when ``A`` is exactly the matrix it
     searched (a stuck set evaluated again: the same set, the same ``A`` but for speed-dependent gear losses), so the
@@ -1244,14 +1251,15 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
     nk = _nk(p)
     w = p.work
     if _searched_before(p, A, ns):
-        if w[o + 1] == 0.0:
+        if w[o + 1] != 1.0:
             return False
         for k in range(ns):
             v[k] = w[o + 2 + nk * nk + k]
         return True
+    v[0] = 0.0
     found = _null_vector(A, ns, S, cp, v, y)
     w[o] = ns
-    w[o + 1] = 1.0 if found else 0.0
+    w[o + 1] = 1.0 if found else (2.0 if np.isnan(v[0]) else 0.0)
     for k in range(ns):
         for j in range(ns):
             w[o + 2 + k * nk + j] = A[k, j]
@@ -1384,6 +1392,351 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     return True
 
 
+
+#: the margin [-] a split moved within a statically indeterminate set's bounds keeps from each of them, of its
+#: limit's width (:func:`_repair_space`; :func:`_repair` keeps 1 % of the feasible segment's width)
+SPACE_MARGIN = 1e-2
+#: a largest margin [-] (:func:`_repair_space`) above minus this is a pinch of the feasible splits, not their end
+SPACE_PINCH = 0.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _small_solve(M, b, k):
+    """Solve ``M[:k, :k] x = b[:k]`` in place into ``b`` (Gaussian elimination with partial pivoting, ``k <= 4``);
+    False if the matrix is singular to 1e-12 of its largest entry."""
+    big = 0.0
+    for i in range(k):
+        for j in range(k):
+            big = max(big, abs(M[i, j]))
+    if big == 0.0:
+        return False
+    for c in range(k):
+        piv, pv = c, abs(M[c, c])
+        for i in range(c + 1, k):
+            if abs(M[i, c]) > pv:
+                piv, pv = i, abs(M[i, c])
+        if pv <= 1e-12 * big:
+            return False
+        if piv != c:
+            for j in range(k):
+                M[c, j], M[piv, j] = M[piv, j], M[c, j]
+            b[c], b[piv] = b[piv], b[c]
+        for i in range(c + 1, k):
+            f = M[i, c] / M[c, c]
+            for j in range(c, k):
+                M[i, j] -= f * M[c, j]
+            b[i] -= f * b[c]
+    for i in range(k - 1, -1, -1):
+        acc_ = b[i]
+        for j in range(i + 1, k):
+            acc_ -= M[i, j] * b[j]
+        b[i] = acc_ / M[i, i]
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _next_subset(idx, k, m):
+    """The next ``k``-subset of ``range(m)`` after ``idx[:k]`` in lexicographic order; False after the last."""
+    q = k - 1
+    while q >= 0 and idx[q] == m - k + q:
+        q -= 1
+    if q < 0:
+        return False
+    idx[q] += 1
+    for j in range(q + 1, k):
+        idx[j] = idx[j - 1] + 1
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
+    """:func:`_repair` where a statically indeterminate set has two or three null directions (a rigid loop with a
+    bearing friction and two stuck lossy gears: seven members on four inertias).
+
+    Every ``lam + V z`` (``V`` an orthonormal basis of ``A``'s null space) balances the network.  The bounds are
+    linear in ``z``: a friction member's ``lo <= lam <= hi``; a stuck lossy gear's hold within its band, whose upper
+    edge is the larger of two lines in the torque it carries and whose lower edge the smaller (:func:`gear_band`),
+    so that the band is the union of four convex pieces, each bounded by one line per edge: every combination of
+    the gears' pieces is searched.  The split is kept where it keeps
+    ``theta`` of each member's width (its limit's span, its band's width) from its bounds, ``theta`` 1 % or half
+    the largest margin any split has (a linear programme over ``z`` and ``theta``, solved by its vertices: a handful
+    of members), and otherwise moved to the nearest split that does (the least ``|V z|``, by the active sets of at
+    most three bounds): continuous in the torques, so the switching functions that watch the members see no jump,
+    and every member keeps a margin until no split holds (the group must slip; the split is then left as it is,
+    for :func:`settle` to decide).  Returns True if ``lam`` changed."""
+    if ns < 3:
+        return False
+    # ---- an orthonormal basis of the null space (elimination with complete pivoting, as _null_vector)
+    S = np.empty((ns, ns))
+    cp = np.empty(ns, dtype=np.int64)
+    for k in range(ns):
+        cp[k] = k
+        for j in range(ns):
+            S[k, j] = A[k, j]
+    first = 0.0
+    rank = ns
+    for c in range(ns):
+        bi, bj, bv = c, c, -1.0
+        for i in range(c, ns):
+            for j in range(c, ns):
+                if abs(S[i, j]) > bv:
+                    bi, bj, bv = i, j, abs(S[i, j])
+        if c == 0:
+            first = bv
+            if first == 0.0:
+                return False
+        if bv <= 1e-10 * first:
+            rank = c
+            break
+        for j in range(ns):
+            S[c, j], S[bi, j] = S[bi, j], S[c, j]
+        for i in range(ns):
+            S[i, c], S[i, bj] = S[i, bj], S[i, c]
+        cp[c], cp[bj] = cp[bj], cp[c]
+        for i in range(c + 1, ns):
+            f = S[i, c] / S[c, c]
+            if f != 0.0:
+                for j in range(c, ns):
+                    S[i, j] -= f * S[c, j]
+    d = ns - rank
+    if d < 2 or d > 3:
+        return False
+    V = np.zeros((ns, d))
+    y = np.empty(ns)
+    for f in range(d):
+        for i in range(ns):
+            y[i] = 0.0
+        y[rank + f] = 1.0
+        for i in range(rank - 1, -1, -1):
+            acc_ = 0.0
+            for j in range(i + 1, ns):
+                acc_ += S[i, j] * y[j]
+            y[i] = -acc_ / S[i, i]
+        for i in range(ns):
+            V[cp[i], f] = y[i]
+    for f in range(d):   # Gram-Schmidt, twice
+        for _twice in range(2):
+            for g in range(f):
+                dot = 0.0
+                for i in range(ns):
+                    dot += V[i, f] * V[i, g]
+                for i in range(ns):
+                    V[i, f] -= dot * V[i, g]
+        nrm = 0.0
+        for i in range(ns):
+            nrm += V[i, f] * V[i, f]
+        nrm = math.sqrt(nrm)
+        if nrm == 0.0:
+            return False
+        for i in range(ns):
+            V[i, f] /= nrm
+    # ---- the bounds G z <= h, each with its width w: the friction members' first (fixed), then two per stuck lossy
+    # gear: its band's upper edge is the larger of two lines in the torque it carries, the lower the smaller, so
+    # the band is the union of four convex pieces (one line each): every combination of pieces is searched
+    mm = 2 * ns
+    G = np.zeros((mm, d))
+    h = np.empty(mm)
+    w = np.empty(mm)
+    gk = np.empty(ns, dtype=np.int64)     # per stuck lossy gear: its hold member, its gear member
+    gq = np.empty(ns, dtype=np.int64)
+    gl = np.empty((ns, 4, 2))            # its lines (slope, offset): upper 1, upper 2, lower 1, lower 2
+    gw = np.empty(ns)
+    ng = 0
+    m = 0
+    inside = True
+    for k in range(ns):
+        rk = int(stuck[k])
+        if rk >= 0:
+            span = (hi[k] - lo[k]) if np.isfinite(lo[k]) and np.isfinite(hi[k]) else \
+                (abs(hi[k]) if np.isfinite(hi[k]) else abs(lo[k]))
+            for side in range(2):
+                bound = lo[k] if side == 0 else hi[k]
+                if not np.isfinite(bound):
+                    continue
+                sg = -1.0 if side == 0 else 1.0
+                for f in range(d):
+                    G[m, f] = sg * V[k, f]
+                h[m] = sg * (bound - lam[k])
+                w[m] = span
+                if h[m] < SPACE_MARGIN * w[m]:
+                    inside = False
+                m += 1
+        else:
+            r = -rk - 1
+            q = -1
+            for qq in range(ns):
+                if int(stuck[qq]) == r:
+                    q = qq
+            if q < 0:
+                continue
+            eta1, eta2, bf1, bf2, _bfa = gear_losses(p, r, 0.0)
+            lo0, hi0 = gear_band(p, r, -lam[q])
+            gk[ng], gq[ng] = k, q
+            gl[ng, 0, 0], gl[ng, 0, 1] = 1.0 - eta1, bf1
+            gl[ng, 1, 0], gl[ng, 1, 1] = 1.0 - 1.0 / eta2, bf2
+            gl[ng, 2, 0], gl[ng, 2, 1] = 1.0 - 1.0 / eta2, -bf2
+            gl[ng, 3, 0], gl[ng, 3, 1] = 1.0 - eta1, -bf1
+            gw[ng] = hi0 - lo0 + tol
+            if min(hi0 - lam[k], lam[k] - lo0) < SPACE_MARGIN * gw[ng]:
+                inside = False
+            ng += 1
+    mf = m
+    m = mf + 2 * ng
+    if m == 0 or inside:   # (z = 0 keeps the full margin: left as it is)
+        return False
+    ncomb = 1
+    for _g in range(ng):
+        ncomb *= 4
+    M = np.empty((4, 4))
+    b = np.empty(4)
+    idx = np.empty(4, dtype=np.int64)
+    zt = np.empty(4)
+    best_theta = -np.inf
+    k1 = d + 1
+    R = np.zeros((3, 3))
+    GR = np.zeros((mm, 3))
+    theta = 0.0
+    best_n = np.inf
+    zb = np.zeros(3)
+    for pass_ in range(2):
+        # pass 0: the largest margin any split keeps, max theta with G z + theta w <= h (at a vertex of d + 1
+        # bounds); pass 1: the nearest split that keeps theta, min |z| over the active sets of 1..d bounds
+        if pass_ == 1:
+            # (no split holds: the group must slip.  A largest margin within rounding of zero is a pinch, not a
+            # slip: where the band of a gear on a kink of its edge closes to one split and opens again on the other
+            # side, a loop held through it at one step sequence and slipped at another, #30)
+            if not best_theta >= -SPACE_PINCH:
+                return False
+            theta = min(SPACE_MARGIN, 0.5 * max(best_theta, 0.0))
+        for comb in range(ncomb):
+            cc = comb
+            for j in range(ng):
+                k, q = gk[j], gq[j]
+                up, dn = cc % 2, (cc // 2) % 2
+                cc //= 4
+                # L <= s T_a + c with T_a = -(lam_q + V_q z), L = lam_k + V_k z
+                sl, c0 = gl[j, up, 0], gl[j, up, 1]
+                row = mf + 2 * j
+                for f in range(d):
+                    G[row, f] = V[k, f] + sl * V[q, f]
+                h[row] = c0 - lam[k] - sl * lam[q]
+                w[row] = gw[j]
+                sl, c0 = gl[j, 2 + dn, 0], gl[j, 2 + dn, 1]
+                for f in range(d):
+                    G[row + 1, f] = -(V[k, f] + sl * V[q, f])
+                h[row + 1] = lam[k] + sl * lam[q] - c0
+                w[row + 1] = gw[j]
+            if pass_ == 0:
+                # (in the span of the bounds' directions: a direction of z no bound sees -- a member without
+                # bounds, a gear's torque where its band does not reach -- leaves the linear programme without
+                # vertices, so the largest margin is sought in (zeta, theta) with z = R zeta, R an orthonormal basis
+                # of the span of G's rows)
+                gmax = 0.0
+                for i in range(m):
+                    for f in range(d):
+                        gmax = max(gmax, abs(G[i, f]))
+                nr = 0
+                for i in range(m):
+                    if nr == d:
+                        break
+                    for f in range(d):
+                        zt[f] = G[i, f]
+                    for _twice in range(2):
+                        for j in range(nr):
+                            dot = 0.0
+                            for f in range(d):
+                                dot += zt[f] * R[f, j]
+                            for f in range(d):
+                                zt[f] -= dot * R[f, j]
+                    nrm = 0.0
+                    for f in range(d):
+                        nrm += zt[f] * zt[f]
+                    nrm = math.sqrt(nrm)
+                    if nrm > 1e-9 * gmax:
+                        for f in range(d):
+                            R[f, nr] = zt[f] / nrm
+                        nr += 1
+                for i in range(m):
+                    for j in range(nr):
+                        v_ = 0.0
+                        for f in range(d):
+                            v_ += G[i, f] * R[f, j]
+                        GR[i, j] = v_
+                k1 = nr + 1
+                if m < k1:
+                    continue
+                for j in range(k1):
+                    idx[j] = j
+                while True:
+                    for a in range(k1):
+                        ri = idx[a]
+                        for f in range(nr):
+                            M[a, f] = GR[ri, f]
+                        M[a, nr] = w[ri]
+                        b[a] = h[ri]
+                    if _small_solve(M, b, k1):
+                        th = b[nr]
+                        if th > best_theta:
+                            ok = True
+                            for i in range(m):
+                                v_ = th * w[i]
+                                for f in range(nr):
+                                    v_ += GR[i, f] * b[f]
+                                if v_ > h[i] + tol:
+                                    ok = False
+                                    break
+                            if ok:
+                                best_theta = th
+                    if not _next_subset(idx, k1, m):
+                        break
+                continue
+            for k in range(1, d + 1):
+                if m < k:
+                    break
+                for j in range(k):
+                    idx[j] = j
+                while True:
+                    # z = G_S^T mu, (G_S G_S^T) mu = h_S - theta w_S
+                    for a in range(k):
+                        for c in range(k):
+                            v_ = 0.0
+                            for f in range(d):
+                                v_ += G[idx[a], f] * G[idx[c], f]
+                            M[a, c] = v_
+                        b[a] = h[idx[a]] - theta * w[idx[a]]
+                    if _small_solve(M, b, k):
+                        nz = 0.0
+                        for f in range(d):
+                            v_ = 0.0
+                            for a in range(k):
+                                v_ += G[idx[a], f] * b[a]
+                            zt[f] = v_
+                            nz += v_ * v_
+                        if nz < best_n:
+                            ok = True
+                            for i in range(m):
+                                v_ = theta * w[i]
+                                for f in range(d):
+                                    v_ += G[i, f] * zt[f]
+                                if v_ > h[i] + tol:
+                                    ok = False
+                                    break
+                            if ok:
+                                best_n = nz
+                                for f in range(d):
+                                    zb[f] = zt[f]
+                    if not _next_subset(idx, k, m):
+                        break
+    if best_n == np.inf:
+        return False
+    for k in range(ns):
+        v_ = 0.0
+        for f in range(d):
+            v_ += V[k, f] * zb[f]
+        lam[k] += v_
+    return True
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
     """:func:`_repair` for each block of a stuck set whose members fall into blocks that share no inertia (stuck
@@ -1453,7 +1806,10 @@ def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
                     Ac[c, cj] = A[k, j]
                     cj += 1
             c += 1
-        if _repair_outlined(p, sub, nc, Ac, Sc, p.iwork, lam_c, lo_c, hi_c, v, tmp, cand, trial, tol):
+        changed = _repair_outlined(p, sub, nc, Ac, Sc, p.iwork, lam_c, lo_c, hi_c, v, tmp, cand, trial, tol)
+        if not changed and _several_null_known(p, Ac, nc):
+            changed = _repair_space_outlined(p, sub, nc, Ac, lam_c, lo_c, hi_c, tol)
+        if changed:
             c = 0
             for k in range(ns):
                 if lab[k] == b:
@@ -1473,6 +1829,11 @@ _F1, _F2, _I1 = types.float64[::1], types.float64[:, ::1], types.int64[::1]
 #: :func:`_repair` called through its address (:mod:`clutchlab.numerics.outline`): it runs only where a stuck set is
 #: statically indeterminate, and linked it was compiled again into every function of the core below a hook (13 s of
 #: the driveline's first compilation)
+#: :func:`_repair_space` called through its address (it allocates its scratch: compiled with reference counting,
+#: apart from the kernel)
+_repair_space_outlined = outlined(_repair_space, lambda: (_params_type(), _F1, types.int64, _F2, _F1, _F1, _F1,
+                                                          types.float64), types.boolean)
+
 _repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, _F2, _F2, _I1, _F1, _F1, _F1, _F1, _F1,
                                               _F1, _F1, types.float64), types.boolean)
 
@@ -1610,7 +1971,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
         # v keeps the constraints, v being A's null vector to rounding)
         if not _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, vnull, vtmp, cand, trial, tol):
-            _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol)
+            if not _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol) and \
+                    _several_null_known(p, A, ns):
+                _repair_space_outlined(p, stuck, ns, A, lam, lo, hi, tol)
     hold = _holds(p)
     Fa = _torque_magnitudes(p)
     for k in range(ns):
