@@ -1144,6 +1144,17 @@ def _in_band(p, r, t_a, hold, tol):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _gear_member(stuck, ns, r):
+    """Index in the stuck set of lossy gear row ``r``'s own member (its kinematic constraint; its hold is
+    ``-(r + 1)``), -1 if it is not in the set."""
+    q = -1
+    for qq in range(ns):
+        if int(stuck[qq]) == r:
+            q = qq
+    return q
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _feasible(p, stuck, ns, lam, lo, hi, tol):
     """True if every bounded member of the set is within its bounds (a stuck lossy gear's hold within its band)."""
     for k in range(ns):
@@ -1161,12 +1172,10 @@ def _feasible(p, stuck, ns, lam, lo, hi, tol):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _null_vector(A, ns, S, cp, v, y):
-    """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (the last pivot of Gaussian elimination
-    with complete pivoting below 1e-10 of the first, the one before it above): True, ``v`` scaled to a largest
-    entry of 1.  ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
-    if ns < 2:
-        return False
+def _eliminate(A, ns, S, cp):
+    """Gaussian elimination with complete pivoting of ``A[:ns, :ns]`` into ``S`` (its columns in the order ``cp``):
+    the rank, a pivot below 1e-10 of the first taken as zero (0 for a zero matrix).  The first ``rank`` rows of
+    ``S`` are then upper triangular, the rest zero to that threshold."""
     for k in range(ns):
         cp[k] = k
         for j in range(ns):
@@ -1181,14 +1190,9 @@ def _null_vector(A, ns, S, cp, v, y):
         if c == 0:
             first = bv
             if first == 0.0:
-                return False
+                return 0
         if bv <= 1e-10 * first:
-            if c != ns - 1:
-                v[0] = np.nan       # more than one null direction (told apart from full rank by the caller)
-                return False
-            break
-        if c == ns - 1:
-            return False            # full rank
+            return c
         for j in range(ns):
             S[c, j], S[bi, j] = S[bi, j], S[c, j]
         for i in range(ns):
@@ -1199,6 +1203,22 @@ def _null_vector(A, ns, S, cp, v, y):
             if f != 0.0:
                 for j in range(c, ns):
                     S[i, j] -= f * S[c, j]
+    return ns
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _null_vector(A, ns, S, cp, v, y):
+    """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (:func:`_eliminate`): True, ``v`` scaled to
+    a largest entry of 1; False for full rank or a zero matrix, and with ``v[0]`` NaN for more than one null
+    direction.  ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
+    if ns < 2:
+        return False
+    rank = _eliminate(A, ns, S, cp)
+    if rank == 0 or rank == ns:
+        return False
+    if rank != ns - 1:
+        v[0] = np.nan       # more than one null direction (told apart from full rank by the caller)
+        return False
     # U y = 0 with y[ns-1] = 1, back substitution; v[cp[i]] = y[i]
     y[ns - 1] = 1.0
     for i in range(ns - 2, -1, -1):
@@ -1289,10 +1309,7 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
         rk = int(stuck[k])
         if rk < 0:
             r = -rk - 1
-            q = -1
-            for qq in range(ns):
-                if int(stuck[qq]) == r:
-                    q = qq
+            q = _gear_member(stuck, ns, r)
             if q < 0:
                 continue
             eta1, eta2, bf1, bf2, bfa = gear_losses(p, r, 0.0)
@@ -1449,6 +1466,18 @@ def _next_subset(idx, k, m):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
+def _keeps(G, nc, z, theta, w, h, m, tol):
+    """True if ``z`` keeps every one of the ``m`` bounds ``G[i, :nc] . z + theta w[i] <= h[i]`` (to ``tol``)."""
+    for i in range(m):
+        v_ = theta * w[i]
+        for f in range(nc):
+            v_ += G[i, f] * z[f]
+        if v_ > h[i] + tol:
+            return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
 def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     """:func:`_repair` where a statically indeterminate set has two or three null directions (a rigid loop with a
     bearing friction and two stuck lossy gears: seven members on four inertias).
@@ -1466,38 +1495,12 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     for :func:`settle` to decide).  Returns True if ``lam`` changed."""
     if ns < 3:
         return False
-    # ---- an orthonormal basis of the null space (elimination with complete pivoting, as _null_vector)
+    # ---- an orthonormal basis of the null space
     S = np.empty((ns, ns))
     cp = np.empty(ns, dtype=np.int64)
-    for k in range(ns):
-        cp[k] = k
-        for j in range(ns):
-            S[k, j] = A[k, j]
-    first = 0.0
-    rank = ns
-    for c in range(ns):
-        bi, bj, bv = c, c, -1.0
-        for i in range(c, ns):
-            for j in range(c, ns):
-                if abs(S[i, j]) > bv:
-                    bi, bj, bv = i, j, abs(S[i, j])
-        if c == 0:
-            first = bv
-            if first == 0.0:
-                return False
-        if bv <= 1e-10 * first:
-            rank = c
-            break
-        for j in range(ns):
-            S[c, j], S[bi, j] = S[bi, j], S[c, j]
-        for i in range(ns):
-            S[i, c], S[i, bj] = S[i, bj], S[i, c]
-        cp[c], cp[bj] = cp[bj], cp[c]
-        for i in range(c + 1, ns):
-            f = S[i, c] / S[c, c]
-            if f != 0.0:
-                for j in range(c, ns):
-                    S[i, j] -= f * S[c, j]
+    rank = _eliminate(A, ns, S, cp)
+    if rank == 0:
+        return False
     d = ns - rank
     if d < 2 or d > 3:
         return False
@@ -1563,10 +1566,7 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
                 m += 1
         else:
             r = -rk - 1
-            q = -1
-            for qq in range(ns):
-                if int(stuck[qq]) == r:
-                    q = qq
+            q = _gear_member(stuck, ns, r)
             if q < 0:
                 continue
             eta1, eta2, bf1, bf2, _bfa = gear_losses(p, r, 0.0)
@@ -1676,17 +1676,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
                         b[a] = h[ri]
                     if _small_solve(M, b, k1):
                         th = b[nr]
-                        if th > best_theta:
-                            ok = True
-                            for i in range(m):
-                                v_ = th * w[i]
-                                for f in range(nr):
-                                    v_ += GR[i, f] * b[f]
-                                if v_ > h[i] + tol:
-                                    ok = False
-                                    break
-                            if ok:
-                                best_theta = th
+                        if th > best_theta and _keeps(GR, nr, b, th, w, h, m, tol):
+                            best_theta = th
                     if not _next_subset(idx, k1, m):
                         break
                 continue
@@ -1712,19 +1703,10 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
                                 v_ += G[idx[a], f] * b[a]
                             zt[f] = v_
                             nz += v_ * v_
-                        if nz < best_n:
-                            ok = True
-                            for i in range(m):
-                                v_ = theta * w[i]
-                                for f in range(d):
-                                    v_ += G[i, f] * zt[f]
-                                if v_ > h[i] + tol:
-                                    ok = False
-                                    break
-                            if ok:
-                                best_n = nz
-                                for f in range(d):
-                                    zb[f] = zt[f]
+                        if nz < best_n and _keeps(G, d, zt, theta, w, h, m, tol):
+                            best_n = nz
+                            for f in range(d):
+                                zb[f] = zt[f]
                     if not _next_subset(idx, k, m):
                         break
     if best_n == np.inf:
