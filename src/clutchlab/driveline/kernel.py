@@ -1409,12 +1409,9 @@ def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     return True
 
 
-
 #: the margin [-] a split moved within a statically indeterminate set's bounds keeps from each of them, of its
 #: limit's width (:func:`_repair_space`; :func:`_repair` keeps 1 % of the feasible segment's width)
 SPACE_MARGIN = 1e-2
-#: a largest margin [-] (:func:`_repair_space`) above minus this is a pinch of the feasible splits, not their end
-SPACE_PINCH = 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1486,13 +1483,14 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     linear in ``z``: a friction member's ``lo <= lam <= hi``; a stuck lossy gear's hold within its band, whose upper
     edge is the larger of two lines in the torque it carries and whose lower edge the smaller (:func:`gear_band`),
     so that the band is the union of four convex pieces, each bounded by one line per edge: every combination of
-    the gears' pieces is searched.  The split is kept where it keeps
+    the gears' pieces is searched (with more than two stuck lossy gears, only the pieces of the torques they carry
+    now: a subset of the splits that hold, at 1/16 of the cost).  The split is kept where it keeps
     ``theta`` of each member's width (its limit's span, its band's width) from its bounds, ``theta`` 1 % or half
     the largest margin any split has (a linear programme over ``z`` and ``theta``, solved by its vertices: a handful
     of members), and otherwise moved to the nearest split that does (the least ``|V z|``, by the active sets of at
-    most three bounds): continuous in the torques, so the switching functions that watch the members see no jump,
-    and every member keeps a margin until no split holds (the group must slip; the split is then left as it is,
-    for :func:`settle` to decide).  Returns True if ``lam`` changed."""
+    most three bounds): continuous in the torques while one combination of pieces holds the set (it may move to
+    another where that one closes), and every member keeps a margin until no split holds (the group must slip;
+    the split is then left as it is, for :func:`settle` to decide).  Returns True if ``lam`` changed."""
     if ns < 3:
         return False
     # ---- an orthonormal basis of the null space
@@ -1544,6 +1542,7 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     gq = np.empty(ns, dtype=np.int64)
     gl = np.empty((ns, 4, 2))            # its lines (slope, offset): upper 1, upper 2, lower 1, lower 2
     gw = np.empty(ns)
+    gc = np.empty((ns, 2), dtype=np.int64)   # the pieces of the torque it carries now (gear_band's choice)
     ng = 0
     m = 0
     inside = True
@@ -1569,9 +1568,11 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
             q = _gear_member(stuck, ns, r)
             if q < 0:
                 continue
-            eta1, eta2, bf1, bf2, _bfa = gear_losses(p, r, 0.0)
+            eta1, eta2, bf1, bf2, bfa = gear_losses(p, r, 0.0)
             lo0, hi0 = gear_band(p, r, -lam[q])
             gk[ng], gq[ng] = k, q
+            gc[ng, 0] = 0 if -lam[q] - bfa > 0.0 else 1
+            gc[ng, 1] = 0 if -lam[q] + bfa > 0.0 else 1
             gl[ng, 0, 0], gl[ng, 0, 1] = 1.0 - eta1, bf1
             gl[ng, 1, 0], gl[ng, 1, 1] = 1.0 - 1.0 / eta2, bf2
             gl[ng, 2, 0], gl[ng, 2, 1] = 1.0 - 1.0 / eta2, -bf2
@@ -1585,8 +1586,9 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     if m == 0 or inside:   # (z = 0 keeps the full margin: left as it is)
         return False
     ncomb = 1
-    for _g in range(ng):
-        ncomb *= 4
+    if ng <= 2:
+        for _g in range(ng):
+            ncomb *= 4
     M = np.empty((4, 4))
     b = np.empty(4)
     idx = np.empty(4, dtype=np.int64)
@@ -1602,17 +1604,14 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
         # pass 0: the largest margin any split keeps, max theta with G z + theta w <= h (at a vertex of d + 1
         # bounds); pass 1: the nearest split that keeps theta, min |z| over the active sets of 1..d bounds
         if pass_ == 1:
-            # (no split holds: the group must slip.  A largest margin within rounding of zero is a pinch, not a
-            # slip: where the band of a gear on a kink of its edge closes to one split and opens again on the other
-            # side, a loop held through it at one step sequence and slipped at another, #30)
-            if not best_theta >= -SPACE_PINCH:
-                return False
-            theta = min(SPACE_MARGIN, 0.5 * max(best_theta, 0.0))
+            if not best_theta >= 0.0:
+                return False   # no split holds: the group must slip
+            theta = min(SPACE_MARGIN, 0.5 * best_theta)
         for comb in range(ncomb):
             cc = comb
             for j in range(ng):
                 k, q = gk[j], gq[j]
-                up, dn = cc % 2, (cc // 2) % 2
+                up, dn = (cc % 2, (cc // 2) % 2) if ng <= 2 else (gc[j, 0], gc[j, 1])
                 cc //= 4
                 # L <= s T_a + c with T_a = -(lam_q + V_q z), L = lam_k + V_k z
                 sl, c0 = gl[j, up, 0], gl[j, up, 1]
