@@ -327,6 +327,12 @@ def signal_break(sig, data, t):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _jumps_at(p, s, t):
+    """True if signal ``s`` has a jump or a kink at ``t`` (its next break after ``t`` less a rounding is ``t``)."""
+    return signal_break(p.signals[s], p.data, t - 1e-12 * max(1.0, abs(t))) == t
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _basic_rates(sig, data, t):
     kind = int(sig[0])
     if kind == SIG_RAMP:
@@ -1208,17 +1214,16 @@ def _eliminate(A, ns, S, cp):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _null_vector(A, ns, S, cp, v, y):
-    """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (:func:`_eliminate`): True, ``v`` scaled to
-    a largest entry of 1; False for full rank or a zero matrix, and with ``v[0]`` NaN for more than one null
-    direction.  ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
+    """The null vector ``v`` of ``A[:ns, :ns]`` if its rank is ``ns - 1`` (:func:`_eliminate`): 1, ``v`` scaled to a
+    largest entry of 1; 0 for full rank or a zero matrix, 2 for more than one null direction (``v`` untouched).
+    ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
     if ns < 2:
-        return False
+        return 0
     rank = _eliminate(A, ns, S, cp)
     if rank == 0 or rank == ns:
-        return False
+        return 0
     if rank != ns - 1:
-        v[0] = np.nan       # more than one null direction (told apart from full rank by the caller)
-        return False
+        return 2
     # U y = 0 with y[ns-1] = 1, back substitution; v[cp[i]] = y[i]
     y[ns - 1] = 1.0
     for i in range(ns - 2, -1, -1):
@@ -1231,7 +1236,7 @@ def _null_vector(A, ns, S, cp, v, y):
         big = max(big, abs(y[i]))
     for i in range(ns):
         v[cp[i]] = y[i] / big
-    return True
+    return 1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1276,10 +1281,10 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
         for k in range(ns):
             v[k] = w[o + 2 + nk * nk + k]
         return True
-    v[0] = 0.0
-    found = _null_vector(A, ns, S, cp, v, y)
+    code = _null_vector(A, ns, S, cp, v, y)
+    found = code == 1
     w[o] = ns
-    w[o + 1] = 1.0 if found else (2.0 if np.isnan(v[0]) else 0.0)
+    w[o + 1] = float(code)
     for k in range(ns):
         for j in range(ns):
             w[o + 2 + k * nk + j] = A[k, j]
@@ -2384,7 +2389,7 @@ def _reach(t, p, comp, origin, reach):
             mine = r == origin
         else:
             s = p.elem[r, E_SIGNAL]
-            mine = s >= 0 and signal_break(p.signals[s], p.data, t - 1e-12 * max(1.0, abs(t))) == t
+            mine = s >= 0 and _jumps_at(p, s, t)
         if mine:
             for q in range(3):
                 i = _flange(p, r, q)
@@ -3194,7 +3199,7 @@ def check_invariants(t, x, m, p):
     nf = p.fric.shape[0]
     ne = p.elem.shape[0]
     for s in range(p.signals.shape[0]):   # a step ending on a signal's jump: the restart there settles the modes
-        if signal_break(p.signals[s], p.data, t - 1e-12 * max(1.0, abs(t))) == t:
+        if _jumps_at(p, s, t):
             return 0
     acc, tau = _acc_tau(p)
     evaluate_network(t, x, m, p, acc, tau)
