@@ -149,13 +149,17 @@ def test_launch_converges_as_rtol_tightens():
     The errors shrink over the two decades from rtol 1e-5 to 1e-7, not at every decade: after the lash closes
     they are the phase error of the driveshaft's lightly damped torsional oscillation, which scatters by a
     factor of two either way between neighbouring tolerances (scanned at seven tolerances from 1e-5 to 1e-7,
-    docs/driveline.md "Energy"); the vehicle's speed error at 1e-5 and 1e-6 is of the same size, and falls
-    tenfold (9.7) from 1e-5 to 1e-7 (15-fold before issue #30's event location on the step's solution)."""
+    docs/driveline.md "Energy"); the vehicle's speed error at 1e-5 and 1e-6 is of the same size, and fell
+    tenfold (9.7) from 1e-5 to 1e-7 (15-fold before issue #30's event location on the step's solution), 4.8-fold
+    on the tenth session's machine with the same code (the scatter: the rounding of another processor or
+    library moves the phase).  So the two decades are compared on the median of three neighbouring tolerances
+    at each end (x1, x0.7, x0.5), which the scatter of one tolerance does not decide."""
     f = load_driveline(EXAMPLES / "driveline_eclutch_launch.toml")
     assert f.rtol == 1e-6
     grid = np.arange(501) * 0.01
     runs = {}
-    for rtol in (1e-5, 1e-6, 1e-7, 1e-9, 1e-10):
+    near = (1.0, 0.7, 0.5)
+    for rtol in sorted({lvl * k for lvl in (1e-5, 1e-7) for k in near} | {1e-6, 1e-9, 1e-10}):
         r = f.driveline.simulate(5.0, rtol=rtol, sample_times=grid)
         runs[rtol] = (r.events, r.to_dataframe())
     ev_ref, df_ref = runs[1e-9]
@@ -172,7 +176,9 @@ def test_launch_converges_as_rtol_tightens():
     _check(err, (1e-5, 1e-7), ("event", "engine", "vehicle", "energy"),
            {"event": 5e-5, "engine": 1e-2, "vehicle": 3e-4, "energy": 2e-7}, 1e-6)
     for key in ("event", "engine", "vehicle", "energy"):   # two decades: at least fivefold (measured 9.7 to 43)
-        assert err[1e-7][key] < err[1e-5][key] / 5, (key, err)
+        loose = np.median([errors(1e-5 * k)[key] for k in near])
+        tight = np.median([errors(1e-7 * k)[key] for k in near])
+        assert tight < loose / 5, (key, loose, tight, err)
     # the reference's own error (1e-9 against 1e-10) is far below the default's error against it
     own = errors(1e-10)
     assert own["event"] < 2e-7 and own["engine"] < 1e-4 and own["vehicle"] < 2e-6, own

@@ -911,12 +911,20 @@ def evaluate_network(t, x, m, p, acc, tau):
     return ns
 
 
+#: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16): the
+#: bounds of its largest margin's vertex (the rank of the bounds' span, then its 4 bounds) and the active set of its
+#: nearest split (its size, then its 3 bounds)
+SPACE_SLOTS, SPACE_HINT = 16, 9
+SPACE_CACHE = SPACE_SLOTS * SPACE_HINT
+
+
 class WorkLayout(NamedTuple):
     """Offsets of the blocks of ``DrivelineParams.work`` (:func:`_layout`): the constraint set's matrix ``a``, its
     regularised copy ``m``, right-hand side ``b``, multipliers ``l``, weights ``c``, residual ``r``, member flanges
     and weights ``g``, bounds and scratch ``lim``; accelerations ``acc``, element torques ``tau``, stick-function
     slack ``slack``, torque magnitudes ``fabs``, gear holds ``hold``, signal cache ``sig``, null-vector cache ``nv``,
-    clutch models ``ext``."""
+    the last search's instant ``inst``, the warm start of the split of a statically indeterminate set ``sp``
+    (:func:`_repair_space`), clutch models ``ext``."""
     a: int
     m: int
     b: int
@@ -933,6 +941,7 @@ class WorkLayout(NamedTuple):
     sig: int
     nv: int
     inst: int
+    sp: int
     ext: int
 
 
@@ -948,7 +957,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
     null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
     instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
-    modes before it (2 + nf + nl, :func:`settle`), the last break time given to the core (1, :func:`_break_marker`) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
+    modes before it (2 + nf + nl, :func:`settle`), the last break time given to the core (1, :func:`_break_marker`) |
+    the warm start of :func:`_repair_space` (``SPACE_CACHE``) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
     :func:`set_external`) | the scratch of the rates of stuck margins: the moved state, its derivative and switching
     functions, and the accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`,
     :func:`_margin_rates`, addressed from the end) | initial stored energy (1).  Returns the offsets as a
@@ -969,9 +979,10 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
     o_inst = o_nv + 2 + nk * nk + nk
-    o_ext = o_inst + 3 + nf + nl
+    o_sp = o_inst + 3 + nf + nl
+    o_ext = o_sp + SPACE_CACHE
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
-                      o_inst, o_ext)
+                      o_inst, o_sp, o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
@@ -1467,7 +1478,7 @@ def _next_subset(idx, k, m):
     return True
 
 
-@numba.njit(cache=True, nogil=True, _nrt=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _keeps(G, nc, z, theta, w, h, m, tol):
     """True if ``z`` keeps every one of the ``m`` bounds ``G[i, :nc] . z + theta w[i] <= h[i]`` (to ``tol``)."""
     for i in range(m):
@@ -1477,6 +1488,307 @@ def _keeps(G, nc, z, theta, w, h, m, tol):
         if v_ > h[i] + tol:
             return False
     return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _hint_at(hint, o, k, m, idx):
+    """Read ``k`` bound indices from ``hint[o:o + k]`` into ``idx``; False unless they increase and are below ``m`` (a
+    hint of another set, or none yet: the zeros of a new work array)."""
+    prev = -1
+    for a in range(k):
+        v_ = hint[o + a]
+        if not (v_ >= 0.0 and v_ < m):
+            return False
+        i = int(v_)
+        if i <= prev or i != v_:
+            return False
+        idx[a] = i
+        prev = i
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _span_basis(G, m, d, R, GR, zt):
+    """An orthonormal basis ``R[:, :nr]`` of the span of the rows of ``G[:m, :d]`` (Gram-Schmidt, twice) and the rows
+    in it, ``GR[:m, :nr]``; returns ``nr``.  (A direction of ``z`` no bound sees -- a member without bounds, a gear's
+    torque where its band does not reach -- leaves the largest-margin programme without vertices, so it is solved in
+    the span.)"""
+    gmax = 0.0
+    for i in range(m):
+        for f in range(d):
+            gmax = max(gmax, abs(G[i, f]))
+    nr = 0
+    for i in range(m):
+        if nr == d:
+            break
+        for f in range(d):
+            zt[f] = G[i, f]
+        for _twice in range(2):
+            for j in range(nr):
+                dot = 0.0
+                for f in range(d):
+                    dot += zt[f] * R[f, j]
+                for f in range(d):
+                    zt[f] -= dot * R[f, j]
+        nrm = 0.0
+        for f in range(d):
+            nrm += zt[f] * zt[f]
+        nrm = math.sqrt(nrm)
+        if nrm > 1e-9 * gmax:
+            for f in range(d):
+                R[f, nr] = zt[f] / nrm
+            nr += 1
+    for i in range(m):
+        for j in range(nr):
+            v_ = 0.0
+            for f in range(d):
+                v_ += G[i, f] * R[f, j]
+            GR[i, j] = v_
+    return nr
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _margin_vertex(GR, w, h, nr, m, idx, M, b, tol):
+    """The margin ``theta`` of the vertex where the bounds ``idx[:nr + 1]`` hold with equality (``GR zeta + theta w =
+    h``, solved into ``b``: ``zeta``, then ``theta``) if it keeps every bound; -inf if it does not, or if they meet in
+    no single point."""
+    k1 = nr + 1
+    for a in range(k1):
+        ri = idx[a]
+        for f in range(nr):
+            M[a, f] = GR[ri, f]
+        M[a, nr] = w[ri]
+        b[a] = h[ri]
+    if _small_solve(M, b, k1) and _keeps(GR, nr, b, b[nr], w, h, m, tol):
+        return b[nr]
+    return -np.inf
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _margin_optimal(GR, w, nr, idx, M, y):
+    """True if the vertex of the bounds ``idx[:nr + 1]`` has the largest margin of its linear programme (max ``theta``
+    with ``GR zeta + theta w <= h``): its dual multipliers, ``sum_a y_a (GR_a, w_a) = (0, 1)``, are all >= 0 (to
+    rounding)."""
+    k1 = nr + 1
+    for a in range(k1):
+        ri = idx[a]
+        for f in range(nr):
+            M[f, a] = GR[ri, f]
+        M[nr, a] = w[ri]
+        y[a] = 0.0
+    y[nr] = 1.0
+    if not _small_solve(M, y, k1):
+        return False
+    big = 0.0
+    for a in range(k1):
+        big = max(big, abs(y[a]))
+    for a in range(k1):
+        if y[a] < -1e-12 * big:
+            return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _swapped(base, k, a, r, idx):
+    """``idx[:k]``: the bounds ``base[:k]`` with ``base[a]`` replaced by ``r`` (``a == k``: ``r`` added; ``r < 0``:
+    ``base[a]`` dropped), in increasing order (the order the enumeration solves them in, so that a set gives the same
+    numbers bit for bit however it was found); returns the new size, or -1 if ``r`` is one of ``base`` already."""
+    n = 0
+    for c in range(k):
+        if base[c] == r:
+            return -1
+        if c != a:
+            idx[n] = base[c]
+            n += 1
+    if r >= 0:
+        j = n
+        while j > 0 and idx[j - 1] > r:
+            idx[j] = idx[j - 1]
+            j -= 1
+        idx[j] = r
+        n += 1
+    return n
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _margin_at(GR, w, h, nr, m, idx, M, b, y, tol):
+    """The margin of the vertex of the bounds ``idx[:nr + 1]`` if it is the optimum (:func:`_margin_vertex`,
+    :func:`_margin_optimal`), else -inf."""
+    th = _margin_vertex(GR, w, h, nr, m, idx, M, b, tol)
+    if th > -np.inf and _margin_optimal(GR, w, nr, idx, M, y):
+        return th
+    return -np.inf
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, hint, o, tol):
+    """The largest margin ``theta`` any split keeps under one combination of pieces: a linear programme in ``(zeta,
+    theta)`` over ``m`` bounds in ``nr`` dimensions, solved at its vertices.  Warm: the vertex of the hint
+    (``hint[o]`` the rank, ``hint[o + 1:o + nr + 2]`` its bounds), then those one bound away from it (the optimum
+    moved by one pivot of the simplex method), are taken where they are the optimum, certified by their dual
+    multipliers (:func:`_margin_at`); else every vertex is tried.  The optimum's bounds become the hint.  +inf with
+    fewer bounds than ``nr + 1`` (independent bounds: any margin is kept)."""
+    k1 = nr + 1
+    if m < k1:
+        return np.inf
+    if hint[o] == nr and _hint_at(hint, o + 1, k1, m, base):
+        for c in range(k1):
+            idx[c] = base[c]
+        th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
+        if th > -np.inf:
+            return th
+        for a in range(k1):
+            for r in range(m):
+                if _swapped(base, k1, a, r, idx) < 0:
+                    continue
+                th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
+                if th > -np.inf:
+                    for c in range(k1):
+                        hint[o + 1 + c] = idx[c]
+                    return th
+    best = -np.inf
+    for j in range(k1):
+        idx[j] = j
+    while True:
+        th = _margin_vertex(GR, w, h, nr, m, idx, M, b, tol)
+        if th > best:
+            best = th
+            hint[o] = nr
+            for a in range(k1):
+                hint[o + 1 + a] = idx[a]
+        if not _next_subset(idx, k1, m):
+            break
+    return best
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _active_split(G, d, h, w, theta, idx, k, M, b, z):
+    """The least ``z`` on which the bounds ``idx[:k]`` hold with margin ``theta`` exactly: ``z = G_S^T mu`` with
+    ``(G_S G_S^T) mu = h_S - theta w_S`` (``mu`` into ``b``); False if those bounds are dependent."""
+    for a in range(k):
+        for c in range(k):
+            v_ = 0.0
+            for f in range(d):
+                v_ += G[idx[a], f] * G[idx[c], f]
+            M[a, c] = v_
+        b[a] = h[idx[a]] - theta * w[idx[a]]
+    if not _small_solve(M, b, k):
+        return False
+    for f in range(d):
+        v_ = 0.0
+        for a in range(k):
+            v_ += G[idx[a], f] * b[a]
+        z[f] = v_
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _nearest_at(G, d, h, w, theta, m, idx, k, M, b, z, tol):
+    """``|z|^2`` of the split on which the bounds ``idx[:k]`` hold with margin ``theta`` (:func:`_active_split`; ``k
+    = 0``: ``z = 0``) if it is the optimum of :func:`_combo_nearest`: it keeps every bound and its multipliers have
+    the optimum's sign (``z = -G_S^T nu`` with ``nu >= 0``, the Karush-Kuhn-Tucker conditions of a convex programme);
+    else inf."""
+    for f in range(d):
+        z[f] = 0.0
+    if k > 0:
+        if not _active_split(G, d, h, w, theta, idx, k, M, b, z):
+            return np.inf
+        big = 0.0
+        for a in range(k):
+            big = max(big, abs(b[a]))
+        for a in range(k):
+            if b[a] > 1e-12 * big:
+                return np.inf
+    if not _keeps(G, d, z, theta, w, h, m, tol):
+        return np.inf
+    nz = 0.0
+    for f in range(d):
+        nz += z[f] * z[f]
+    return nz
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, hint, o, tol):
+    """The nearest split that keeps margin ``theta`` under one combination of pieces: the least ``|z|`` with ``G z +
+    theta w <= h`` (a convex quadratic programme in ``d <= 3`` dimensions), into ``z``; returns ``|z|^2`` (inf: no
+    split keeps it).  Warm: the hint's active set (``hint[o]`` its size, ``hint[o + 1:]`` its bounds), then the sets
+    one bound away from it (one bound dropped, added or swapped), are taken where their split is the optimum
+    (:func:`_nearest_at`); else ``z = 0`` where it keeps every bound, else the least ``|z|`` over the active sets of
+    1..d bounds.  The optimum's set becomes the hint."""
+    kh = hint[o]
+    if kh >= 0.0 and kh <= d and kh == math.floor(kh) and _hint_at(hint, o + 1, int(kh), m, base):
+        k = int(kh)
+        for c in range(k):
+            idx[c] = base[c]
+        nz = _nearest_at(G, d, h, w, theta, m, idx, k, M, b, z, tol)
+        if nz < np.inf:
+            return nz
+        for a in range(k + 1):
+            for r in range(-1, m):
+                if a == k and (r < 0 or k == d):
+                    continue
+                kk = _swapped(base, k, a, r, idx)
+                if kk < 0:
+                    continue
+                nz = _nearest_at(G, d, h, w, theta, m, idx, kk, M, b, z, tol)
+                if nz < np.inf:
+                    hint[o] = kk
+                    for c in range(kk):
+                        hint[o + 1 + c] = idx[c]
+                    return nz
+    for f in range(d):
+        z[f] = 0.0
+    if _keeps(G, d, z, theta, w, h, m, tol):
+        hint[o] = 0.0
+        return 0.0
+    best = np.inf
+    for k in range(1, d + 1):
+        if m < k:
+            break
+        for j in range(k):
+            idx[j] = j
+        while True:
+            if _active_split(G, d, h, w, theta, idx, k, M, b, zt):
+                nz = 0.0
+                for f in range(d):
+                    nz += zt[f] * zt[f]
+                if nz < best and _keeps(G, d, zt, theta, w, h, m, tol):
+                    best = nz
+                    for f in range(d):
+                        z[f] = zt[f]
+                    hint[o] = k
+                    for a in range(k):
+                        hint[o + 1 + a] = idx[a]
+            if not _next_subset(idx, k, m):
+                break
+    return best
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
+    """The stuck lossy gears' bounds under combination ``comb`` of their band pieces (two digits in base 2 per gear,
+    with at most two gears; else the pieces of the torques they carry now, ``gc``), into rows ``mf`` on of ``G z <=
+    h`` with widths ``w``: a hold ``L = lam_k + V_k z`` within ``s T_a + c`` of its piece's line, ``T_a = -(lam_q +
+    V_q z)``."""
+    cc = comb
+    for j in range(ng):
+        k, q = gk[j], gq[j]
+        if ng <= 2:
+            up, dn = cc % 2, (cc // 2) % 2
+        else:
+            up, dn = gc[j, 0], gc[j, 1]
+        cc //= 4
+        sl, c0 = gl[j, up, 0], gl[j, up, 1]
+        row = mf + 2 * j
+        for f in range(d):
+            G[row, f] = V[k, f] + sl * V[q, f]
+        h[row] = c0 - lam[k] - sl * lam[q]
+        w[row] = gw[j]
+        sl, c0 = gl[j, 2 + dn, 0], gl[j, 2 + dn, 1]
+        for f in range(d):
+            G[row + 1, f] = -(V[k, f] + sl * V[q, f])
+        h[row + 1] = lam[k] + sl * lam[q] - c0
+        w[row + 1] = gw[j]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1491,11 +1803,16 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     the gears' pieces is searched (with more than two stuck lossy gears, only the pieces of the torques they carry
     now: a subset of the splits that hold, at 1/16 of the cost).  The split is kept where it keeps
     ``theta`` of each member's width (its limit's span, its band's width) from its bounds, ``theta`` 1 % or half
-    the largest margin any split has (a linear programme over ``z`` and ``theta``, solved by its vertices: a handful
-    of members), and otherwise moved to the nearest split that does (the least ``|V z|``, by the active sets of at
-    most three bounds): continuous in the torques while one combination of pieces holds the set (it may move to
-    another where that one closes), and every member keeps a margin until no split holds (the group must slip;
-    the split is then left as it is, for :func:`settle` to decide).  Returns True if ``lam`` changed."""
+    the largest margin any split has (a linear programme over ``z`` and ``theta`` per combination,
+    :func:`_combo_margin`), and otherwise moved to the nearest split that does (the least ``|V z|``, a quadratic
+    programme per combination, :func:`_combo_nearest`): continuous in the torques while one combination of pieces
+    holds the set (it may move to another where that one closes), and every member keeps a margin until no split
+    holds (the group must slip; the split is then left as it is, for :func:`settle` to decide).
+
+    Both programmes start warm: each combination's last optimal vertex and active set (``WorkLayout.sp``) are tried
+    first and kept where their optimality conditions hold (the dual multipliers' signs), so that the answer is the
+    optimum whatever the hint; only where they fail (the set, its bounds or the optimum changed) are the vertices and
+    active sets enumerated.  Returns True if ``lam`` changed."""
     if ns < 3:
         return False
     # ---- an orthonormal basis of the null space
@@ -1594,127 +1911,44 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     if ng <= 2:
         for _g in range(ng):
             ncomb *= 4
+    hint = p.work
+    o_sp = _offsets(p).sp
     M = np.empty((4, 4))
     b = np.empty(4)
+    yb = np.empty(4)
     idx = np.empty(4, dtype=np.int64)
+    base = np.empty(4, dtype=np.int64)
     zt = np.empty(4)
-    best_theta = -np.inf
-    k1 = d + 1
+    zc = np.empty(3)
+    zb = np.zeros(3)
     R = np.zeros((3, 3))
     GR = np.zeros((mm, 3))
-    theta = 0.0
+    # the largest margin any split keeps, per combination of pieces
+    thc = np.empty(ncomb)
+    best_theta = -np.inf
+    for comb in range(ncomb):
+        _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+        nr = _span_basis(G, m, d, R, GR, zt)
+        thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, hint, o_sp + SPACE_HINT * comb, tol)
+        best_theta = max(best_theta, thc[comb])
+    if not best_theta >= 0.0:
+        return False   # no split holds: the group must slip
+    theta = min(SPACE_MARGIN, 0.5 * best_theta)
+    # the nearest split that keeps theta, over the combinations that can keep it
     best_n = np.inf
-    zb = np.zeros(3)
-    for pass_ in range(2):
-        # pass 0: the largest margin any split keeps, max theta with G z + theta w <= h (at a vertex of d + 1
-        # bounds); pass 1: the nearest split that keeps theta, min |z| over the active sets of 1..d bounds
-        if pass_ == 1:
-            if not best_theta >= 0.0:
-                return False   # no split holds: the group must slip
-            theta = min(SPACE_MARGIN, 0.5 * best_theta)
-        for comb in range(ncomb):
-            cc = comb
-            for j in range(ng):
-                k, q = gk[j], gq[j]
-                up, dn = (cc % 2, (cc // 2) % 2) if ng <= 2 else (gc[j, 0], gc[j, 1])
-                cc //= 4
-                # L <= s T_a + c with T_a = -(lam_q + V_q z), L = lam_k + V_k z
-                sl, c0 = gl[j, up, 0], gl[j, up, 1]
-                row = mf + 2 * j
-                for f in range(d):
-                    G[row, f] = V[k, f] + sl * V[q, f]
-                h[row] = c0 - lam[k] - sl * lam[q]
-                w[row] = gw[j]
-                sl, c0 = gl[j, 2 + dn, 0], gl[j, 2 + dn, 1]
-                for f in range(d):
-                    G[row + 1, f] = -(V[k, f] + sl * V[q, f])
-                h[row + 1] = lam[k] + sl * lam[q] - c0
-                w[row + 1] = gw[j]
-            if pass_ == 0:
-                # (in the span of the bounds' directions: a direction of z no bound sees -- a member without
-                # bounds, a gear's torque where its band does not reach -- leaves the linear programme without
-                # vertices, so the largest margin is sought in (zeta, theta) with z = R zeta, R an orthonormal basis
-                # of the span of G's rows)
-                gmax = 0.0
-                for i in range(m):
-                    for f in range(d):
-                        gmax = max(gmax, abs(G[i, f]))
-                nr = 0
-                for i in range(m):
-                    if nr == d:
-                        break
-                    for f in range(d):
-                        zt[f] = G[i, f]
-                    for _twice in range(2):
-                        for j in range(nr):
-                            dot = 0.0
-                            for f in range(d):
-                                dot += zt[f] * R[f, j]
-                            for f in range(d):
-                                zt[f] -= dot * R[f, j]
-                    nrm = 0.0
-                    for f in range(d):
-                        nrm += zt[f] * zt[f]
-                    nrm = math.sqrt(nrm)
-                    if nrm > 1e-9 * gmax:
-                        for f in range(d):
-                            R[f, nr] = zt[f] / nrm
-                        nr += 1
-                for i in range(m):
-                    for j in range(nr):
-                        v_ = 0.0
-                        for f in range(d):
-                            v_ += G[i, f] * R[f, j]
-                        GR[i, j] = v_
-                k1 = nr + 1
-                if m < k1:
-                    continue
-                for j in range(k1):
-                    idx[j] = j
-                while True:
-                    for a in range(k1):
-                        ri = idx[a]
-                        for f in range(nr):
-                            M[a, f] = GR[ri, f]
-                        M[a, nr] = w[ri]
-                        b[a] = h[ri]
-                    if _small_solve(M, b, k1):
-                        th = b[nr]
-                        if th > best_theta and _keeps(GR, nr, b, th, w, h, m, tol):
-                            best_theta = th
-                    if not _next_subset(idx, k1, m):
-                        break
-                continue
-            for k in range(1, d + 1):
-                if m < k:
-                    break
-                for j in range(k):
-                    idx[j] = j
-                while True:
-                    # z = G_S^T mu, (G_S G_S^T) mu = h_S - theta w_S
-                    for a in range(k):
-                        for c in range(k):
-                            v_ = 0.0
-                            for f in range(d):
-                                v_ += G[idx[a], f] * G[idx[c], f]
-                            M[a, c] = v_
-                        b[a] = h[idx[a]] - theta * w[idx[a]]
-                    if _small_solve(M, b, k):
-                        nz = 0.0
-                        for f in range(d):
-                            v_ = 0.0
-                            for a in range(k):
-                                v_ += G[idx[a], f] * b[a]
-                            zt[f] = v_
-                            nz += v_ * v_
-                        if nz < best_n and _keeps(G, d, zt, theta, w, h, m, tol):
-                            best_n = nz
-                            for f in range(d):
-                                zb[f] = zt[f]
-                    if not _next_subset(idx, k, m):
-                        break
+    for comb in range(ncomb):
+        if not thc[comb] >= theta:
+            continue
+        _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+        nz = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zc, hint, o_sp + SPACE_HINT * comb + 5, tol)
+        if nz < best_n:
+            best_n = nz
+            for f in range(d):
+                zb[f] = zc[f]
     if best_n == np.inf:
         return False
+    if best_n == 0.0:
+        return False   # (the split already keeps theta)
     for k in range(ns):
         v_ = 0.0
         for f in range(d):

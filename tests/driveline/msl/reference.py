@@ -578,6 +578,13 @@ class Network:
             if sol.status == 1:
                 hits = [evs[i][2] for i in range(len(evs)) if len(sol.t_events[i])
                         and abs(sol.t_events[i][-1] - te) <= 1e-13]
+                if any(tag[1] == "zero" for tag in hits):
+                    # an element on the same motion reaches zero speed at the same instant (a bearing on a
+                    # lossy gear's shaft): its root may be dropped as later by an ulp, or land an ulp past
+                    # zero, with the processor's rounding; it is stuck too (the settle releases it if its
+                    # torque is beyond its limit)
+                    hits += [tag for (fun, _d, tag) in evs if tag[1] == "zero" and tag not in hits
+                             and abs(fun(te, ye[:2 * n])) < 1e-12]
                 at_start = te - t < 1e-12
                 for tag in hits:
                     name, what = tag
