@@ -1508,6 +1508,14 @@ def _hint_at(hint, o, k, m, idx):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _set_hint(hint, o, head, idx, k):
+    """Keep ``head`` (a rank or a set's size) and the bounds ``idx[:k]`` as the hint at ``hint[o]``."""
+    hint[o] = head
+    for a in range(k):
+        hint[o + 1 + a] = idx[a]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _span_basis(G, m, d, R, GR, zt):
     """An orthonormal basis ``R[:, :nr]`` of the span of the rows of ``G[:m, :d]`` (Gram-Schmidt, twice) and the rows
     in it, ``GR[:m, :nr]``; returns ``nr``.  (A direction of ``z`` no bound sees -- a member without bounds, a gear's
@@ -1548,17 +1556,28 @@ def _span_basis(G, m, d, R, GR, zt):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _basis_rows(GR, w, nr, idx, M, transpose):
+    """``M[:nr + 1, :nr + 1]``: the rows ``(GR_i, w_i)`` of the bounds ``idx[:nr + 1]`` (their transpose if
+    ``transpose``)."""
+    for a in range(nr + 1):
+        ri = idx[a]
+        for f in range(nr + 1):
+            v_ = GR[ri, f] if f < nr else w[ri]
+            if transpose:
+                M[f, a] = v_
+            else:
+                M[a, f] = v_
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _margin_vertex(GR, w, h, nr, m, idx, M, b, tol):
     """The margin ``theta`` of the vertex where the bounds ``idx[:nr + 1]`` hold with equality (``GR zeta + theta w =
     h``, solved into ``b``: ``zeta``, then ``theta``) if it keeps every bound; -inf if it does not, or if they meet in
     no single point."""
     k1 = nr + 1
+    _basis_rows(GR, w, nr, idx, M, False)
     for a in range(k1):
-        ri = idx[a]
-        for f in range(nr):
-            M[a, f] = GR[ri, f]
-        M[a, nr] = w[ri]
-        b[a] = h[ri]
+        b[a] = h[idx[a]]
     if _small_solve(M, b, k1) and _keeps(GR, nr, b, b[nr], w, h, m, tol):
         return b[nr]
     return -np.inf
@@ -1570,11 +1589,8 @@ def _margin_optimal(GR, w, nr, idx, M, y):
     with ``GR zeta + theta w <= h``): its dual multipliers, ``sum_a y_a (GR_a, w_a) = (0, 1)``, are all >= 0 (to
     rounding)."""
     k1 = nr + 1
+    _basis_rows(GR, w, nr, idx, M, True)
     for a in range(k1):
-        ri = idx[a]
-        for f in range(nr):
-            M[f, a] = GR[ri, f]
-        M[nr, a] = w[ri]
         y[a] = 0.0
     y[nr] = 1.0
     if not _small_solve(M, y, k1):
@@ -1643,8 +1659,7 @@ def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, hint, o, tol):
                     continue
                 th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
                 if th > -np.inf:
-                    for c in range(k1):
-                        hint[o + 1 + c] = idx[c]
+                    _set_hint(hint, o, nr, idx, k1)
                     return th
     best = -np.inf
     for j in range(k1):
@@ -1653,9 +1668,7 @@ def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, hint, o, tol):
         th = _margin_vertex(GR, w, h, nr, m, idx, M, b, tol)
         if th > best:
             best = th
-            hint[o] = nr
-            for a in range(k1):
-                hint[o + 1 + a] = idx[a]
+            _set_hint(hint, o, nr, idx, k1)
         if not _next_subset(idx, k1, m):
             break
     return best
@@ -1732,9 +1745,7 @@ def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, hint, o, tol):
                     continue
                 nz = _nearest_at(G, d, h, w, theta, m, idx, kk, M, b, z, tol)
                 if nz < np.inf:
-                    hint[o] = kk
-                    for c in range(kk):
-                        hint[o + 1 + c] = idx[c]
+                    _set_hint(hint, o, kk, idx, kk)
                     return nz
     for f in range(d):
         z[f] = 0.0
@@ -1756,9 +1767,7 @@ def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, hint, o, tol):
                     best = nz
                     for f in range(d):
                         z[f] = zt[f]
-                    hint[o] = k
-                    for a in range(k):
-                        hint[o + 1 + a] = idx[a]
+                    _set_hint(hint, o, k, idx, k)
             if not _next_subset(idx, k, m):
                 break
     return best
