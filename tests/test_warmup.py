@@ -37,11 +37,34 @@ def test_group_compiles_in_another_process_and_this_one_loads_it(monkeypatch):
     assert _compile_notice.compile_seconds() - before < 1.0
 
 
+def test_full_warmup_compiles_the_rare_paths_and_the_demo_does_not(monkeypatch):
+    """``clutchlab warmup`` (:func:`warmup.run_parallel`) starts its processes in full (the functions outlined with
+    ``lazy=True`` too: the driveline's repair over several null directions and its invariant check, so that no run
+    compiles afterwards); the demo's background processes without (what their section runs); ``python -m
+    clutchlab.warmup --full`` passes it on to :func:`warmup.warm`."""
+    import subprocess
+    import sys
+
+    started, warmed = [], []
+
+    def recording_start(groups, full=False):
+        started.append((list(groups), full))
+        return subprocess.Popen([sys.executable, "-c", "pass"])
+
+    monkeypatch.setattr(warmup, "start", recording_start)
+    warmup.run_parallel(["wet", "driveline"], jobs=2)
+    assert sorted(started) == [(["driveline"], True), (["wet"], True)]
+    monkeypatch.setattr(warmup, "warm", lambda groups=None, full=False: warmed.append((groups, full)))
+    warmup.main(["--full", "driveline"])
+    warmup.main(["wet"])
+    assert warmed == [(["driveline"], True), (["wet"], False)]
+
+
 def test_failing_group_is_reported(monkeypatch):
     import subprocess
     import sys
 
-    def failing_start(groups):
+    def failing_start(groups, full=False):
         return subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
 
     monkeypatch.setattr(warmup, "start", failing_start)

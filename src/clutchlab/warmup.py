@@ -95,31 +95,42 @@ def _check(names) -> None:
         raise ParameterError(f"unknown kernel group(s) {unknown}; known: {', '.join(GROUPS)}")
 
 
-def warm(groups=None) -> dict:
-    """Compile (or load) the kernels of ``groups`` (default: all) in this process; seconds per group."""
+def warm(groups=None, full: bool = False) -> dict:
+    """Compile (or load) the kernels of ``groups`` (default: all) in this process; seconds per group.
+
+    ``full``: also the rare paths compiled only on their first call (:func:`clutchlab.numerics.outline.outlined`
+    with ``lazy=True``: the driveline's repair of a stuck set over several null directions, its invariant check),
+    so that no run compiles anything afterwards (``clutchlab warmup``).  Without it, each group compiles what its
+    demo section runs (the demo's background processes)."""
     names = list(GROUPS) if groups is None else list(groups)
     _check(names)
     seconds = {}
     for name in names:
         t0 = time.perf_counter()
         GROUPS[name]()
+        if full:
+            from .numerics import outline
+
+            outline.prepare(lazy=True)   # (the lazy functions of the modules this group imported)
         seconds[name] = time.perf_counter() - t0
     return seconds
 
 
-def start(groups) -> subprocess.Popen:
+def start(groups, full: bool = False) -> subprocess.Popen:
     """Compile ``groups`` in a background process (same interpreter and environment); returns the process.
 
-    Its output is discarded: a failure only means that the process that uses the kernels compiles them
-    itself.  Call ``.wait()`` before running those groups, so that they are not compiled twice.
+    ``full`` as in :func:`warm`.  Its output is discarded: a failure only means that the process that uses the
+    kernels compiles them itself.  Call ``.wait()`` before running those groups, so that they are not compiled
+    twice.
     """
     env = dict(os.environ, CLUTCHLAB_COMPILE_NOTICE="0", MPLBACKEND="Agg")
-    return subprocess.Popen([sys.executable, "-m", "clutchlab.warmup", *groups], env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+    return subprocess.Popen([sys.executable, "-m", "clutchlab.warmup", *(["--full"] if full else []), *groups],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
 
 
 def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
-    """Compile ``groups`` (default: all) in up to ``jobs`` processes (default: the cores); wall seconds."""
+    """Compile ``groups`` (default: all) in up to ``jobs`` processes (default: the cores), each in full (:func:`warm`:
+    the rare paths too, so that later runs compile nothing); wall seconds (``clutchlab warmup``)."""
     names = list(GROUPS) if groups is None else list(groups)
     _check(names)
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
@@ -128,7 +139,7 @@ def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
     order = [g for g in ("emtc", "eclutch", "wet") if g in names]
     order += [g for g in names if g not in order]
     lots = [order[i::jobs] for i in range(jobs)]
-    procs = [start(lot) for lot in lots if lot]
+    procs = [start(lot, full=True) for lot in lots if lot]
     failed = [lot for lot, p in zip(lots, procs) if p.wait() != 0]
     if failed:
         raise SimulationError(f"compiling kernel group(s) {failed} failed; run 'python -m clutchlab.warmup "
@@ -139,8 +150,11 @@ def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
 
 
 def main(argv=None) -> int:
+    """``python -m clutchlab.warmup [--full] [group ...]``: :func:`warm` in this process."""
     names = sys.argv[1:] if argv is None else list(argv)
-    warm(names or None)
+    full = "--full" in names
+    names = [n for n in names if n != "--full"]
+    warm(names or None, full=full)
     return 0
 
 

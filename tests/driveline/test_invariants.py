@@ -258,13 +258,16 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     At each break-away of the bearing the gears carry ~1e-12 N m, within their rounding bands: whether they stay
     stuck or roll on with the bearing is decided by where their load goes (the tie-break in ``kernel.settle``: beyond their
     band within ``T_TIE`` = 10 ns, so they roll at once; before it, they stayed stuck for 1.6 ps in one run and
-    rolled in another).  25 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11 (the gears' changes of driving
+    rolled in another).  21 mode changes, the same at rtol 1e-6, 1e-9 and 1e-11 (the gears' changes of driving
     flange, ``a_drives``/``b_drives``, left out as in the random networks below: at 1e-12 N m they are located
     to the rounding floor and may come or go with the step sequence).  (23 before the ninth session: g0 was
     released at t = 0 and whenever the bearing stuck, and "rolled" at zero speed, blocked by the bearing, while
     the three held J0 at rest; the stuck set -- the bearing, both gears and their holds, five members on three
     inertias -- has two null directions, and its split was moved into the members' bounds only where it has one.
-    Now g0 sticks and breaks away with the bearing: J0 cannot turn unless g0 rolls, its flange a being J0.)"""
+    Now g0 sticks and breaks away with the bearing: J0 cannot turn unless g0 rolls, its flange a being J0.  25
+    before the eleventh session: at each break-away g1 was released the way the rounding at the instant left it,
+    not the way its load goes 10 ns later, rolled the wrong way and reversed 41 us later; now it rolls its way from
+    the break-away, ``test_a_gear_released_at_its_limit_rolls_the_way_its_load_goes``.)"""
     d = Driveline("self_locking_pair")
     d.inertia("J0", J=0.5625).inertia("J1", J=1.0).inertia("J2", J=2.0)
     d.gear("g0", "J0", "J1", ratio=-0.30078125, efficiency=0.5)
@@ -275,8 +278,10 @@ def test_a_gear_released_from_stuck_watches_its_speed_beyond_the_drift_of_its_st
     runs = [_mode_events(r) for r in runs]
     for ev in runs:
         assert [e[1:] for e in ev] == [e[1:] for e in runs[-1]]
-        assert len(ev) == 25
+        assert len(ev) == 21
         assert max(abs(a[0] - b[0]) for a, b in zip(ev, runs[-1])) < 1e-6
+        g1 = [e for _t, el, e in ev if el == "g1"]   # no reversal after a release: it rolls until it sticks
+        assert all("stick" in (a, b) for a, b in zip(g1, g1[1:])), g1
     # g0 (its flange a the bearing's inertia J0) changes between stuck and rolling with the bearing, every time
     ev = runs[-1]
     for t, el, e in ev:
@@ -773,6 +778,51 @@ def test_an_unrelated_element_changes_nothing(d):
     eb = _mode_events(one)
     assert [e[1:] for e in ea] == [e[1:] for e in eb]
     assert all(abs(x[0] - y[0]) <= 1e-6 for x, y in zip(ea, eb))
+
+
+def _edge_gear_network(with_unrelated):
+    """The network the thorough profile found (eleventh session): a gear at efficiency 0.5 (ratio -1) whose flange b
+    is loaded through a backlash that closes at 0.2035133 s, in a loop closed by a clutch."""
+    d = Driveline("edge")
+    for name, J in (("J0", 1.0), ("J1", 1.0), ("J2", 1.0), ("J3", 0.5)):
+        d.inertia(name, J=J, w0=0.0, phi0=0.0)
+    d.spring_damper("k0", "J0", "J1", c=1.0, d=0.0)
+    d.gear("g1", "J1", "J2", ratio=-1.0, efficiency=0.5)
+    d.backlash("k2", "J2", "J3", c=10.0, b_gap=0.03125, d=0.0)
+    d.clutch("loop", "J0", "J3", fn_max=1.0, mu=0.5, peak=1.0)
+    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.25)
+    d.torque("T0", "J0", Signal.sine(1.0, 0.5))
+    d.torque("T3", "J3", Signal.sine(2.0, 1.0))
+    if with_unrelated:
+        d.inertia("U", J=1.0, w0=0.0, phi0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5, peak=1.0)
+        d.torque("UT", "U", Signal.sine(0.0, 1.0))
+    return d
+
+
+@pytest.mark.parametrize("t_end", [0.2036, 1.0])
+def test_a_gear_released_at_its_limit_rolls_the_way_its_load_goes(t_end):
+    """Found by the thorough profile (``test_an_unrelated_element_changes_nothing``): a stuck gear at efficiency 0.5
+    whose flange b the backlash ``k2`` starts to push at its contact, 0.2035133 s.  The load is zero at that
+    instant and grows from it, so the gear is at its limit there and the tie-break (``kernel.settle``, ``T_TIE``)
+    releases it from where the load goes 10 ns later.  It was then released the way the rounding at the instant
+    left it: ``forward_a_drives`` in some runs (with an unrelated inertia, or at another end time, another step
+    sequence), while J1 (flange a, ratio -1) turned backward from the start and the gear's dissipated energy was
+    negative; 33 us later it reversed to ``backward_b_drives``.  Released the way the load goes, it rolls backward
+    with flange b driving from the contact, in every run."""
+    runs = [_edge_gear_network(u).simulate(t_end, rtol=rtol, output_step=1e-6 if t_end < 1 else 1e-4,
+                                          check_invariants=True)
+            for u in (False, True) for rtol in (1e-7, 1e-10)]
+    for res in runs:
+        ev = [(t, el, e) for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)
+              if el == "g1"]
+        assert ev[0][1:] == ("g1", "backward") and abs(ev[0][0] - 0.2035133) < 1e-6, ev[:3]
+        assert not any(e == "forward" for _t, _el, e in ev if _t < 0.21), ev[:3]
+    df = runs[-1].to_dataframe()
+    after = df[(df["time_s"] > 0.2035134) & (df["time_s"] < min(t_end, 0.21))]
+    assert len(after) > 10
+    assert (after["J1.w_rad_s"] < 0).all() and (after["g1.mode_1"] == -1).all()
+    assert (after["g1"] == "backward_b_drives").all()
+    assert after["g1.dissipated_J"].min() >= 0.0
 
 
 @pytest.mark.parametrize("unrelated", ["event", "jump"])

@@ -947,22 +947,22 @@ class WorkLayout(NamedTuple):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
-    """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set
-    (nk) | A (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual
-    (nk) | three flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds,
-    null vector, its scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2), one block's members, split,
-    bounds and the block of each member (5 nk, :func:`_repair_blocks`) | accelerations (n) | element torques (ne) | slack of each friction element's
-    and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the torques on each
-    inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear holds or carries
-    (nl) | the time and the values of the signals at the last evaluation (1 + nsig, :func:`signal_at`) | the last
-    null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk, :func:`_null_vector_cached`) | the
-    instant of the last stick/slip search, the event count before it and the friction elements' and lossy gears'
-    modes before it (2 + nf + nl, :func:`settle`), the last break time given to the core (1, :func:`_break_marker`) |
-    the warm start of :func:`_repair_space` (``SPACE_CACHE``) | sliding torque, static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element,
-    :func:`set_external`) | the scratch of the rates of stuck margins: the moved state, its derivative and switching
-    functions, and the accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`,
-    :func:`_margin_rates`, addressed from the end) | initial stored energy (1).  Returns the offsets as a
-    :class:`WorkLayout`."""
+    """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set (nk) | A
+    (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual (nk) | three
+    flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds, null vector, its
+    scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2), one block's members, split, bounds and the
+    block of each member (5 nk, :func:`_repair_blocks`) | accelerations (n) | element torques (ne) | slack of each
+    friction element's and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the
+    torques on each inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear
+    holds or carries (nl) | the time and the values of the signals at the last evaluation (1 + nsig,
+    :func:`signal_at`) | the last null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk,
+    :func:`_null_vector_cached`) | the instant of the last stick/slip search, the event count before it and the
+    friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
+    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``) | sliding torque,
+    static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | the
+    scratch of the rates of stuck margins: the moved state, its derivative and switching functions, and the
+    accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`, :func:`_margin_rates`,
+    addressed from the end) | initial stored energy (1). Returns the offsets as a :class:`WorkLayout`."""
     o_a = n + nk
     o_m = o_a + nk * nk
     o_b = o_m + nk * nk
@@ -2059,9 +2059,12 @@ _F1, _F2, _I1 = types.float64[::1], types.float64[:, ::1], types.int64[::1]
 #: statically indeterminate, and linked it was compiled again into every function of the core below a hook (13 s of
 #: the driveline's first compilation)
 #: :func:`_repair_space` called through its address (it allocates its scratch: compiled with reference counting,
-#: apart from the kernel)
+#: apart from the kernel), lazily: it runs only where a stuck set loses its split along several null directions (a
+#: rare path), so it is compiled or loaded at its first call, not with every driveline (``prepare(lazy=True)`` and
+#: ``clutchlab warmup`` compile it ahead; the driveline group's first compilation 98.8 s against 114.3 s, medians of
+#: three alternated runs on the 2-core VM, 2026-11-30)
 _repair_space_outlined = outlined(_repair_space, lambda: (_params_type(), _F1, types.int64, _F2, _F1, _F1, _F1,
-                                                          types.float64), types.boolean)
+                                                          types.float64), types.boolean, lazy=True)
 
 _repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, _F2, _F2, _I1, _F1, _F1, _F1, _F1, _F1,
                                               _F1, _F1, types.float64), types.boolean)
@@ -2786,6 +2789,8 @@ def settle(t, x, m, p, log, old, origin):
                 ex, d = _item_excess(t, p, tau, cand[c], not _item_stuck(p, old, cand[c]))
                 if forced[cand[c]] != 0:   # it would break away within T_TIE (the tie-break below): overloaded
                     ex = max(ex, 0.0)
+                    if abs(forced[cand[c]]) == 2:   # the way its load goes there (here that way is a rounding)
+                        d = forced[cand[c]] // 2
                 elif ex >= 0.0 and _tied(t, p, tau, cand[c]):   # at its limit to rounding: the tie-break decides
                     ex = -1e-300
                 if _item_slips(p, acc, cand[c]):   # held against a prescribed motion: it must move, the way it is driven
@@ -2864,6 +2869,8 @@ def settle(t, x, m, p, log, old, origin):
                             ex, d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
                             if forced[i] != 0:
                                 ex = max(ex, 0.0)
+                                if abs(forced[i]) == 2:
+                                    d = forced[i] // 2
                             if _item_slips(p, acc, i):   # held against a prescribed motion (as above)
                                 ex, d = max(ex, 0.0), (1 if _item_acc(p, acc, i) > 0.0 else -1)
                             if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY and d < 0:
@@ -2890,11 +2897,16 @@ def settle(t, x, m, p, log, old, origin):
             if near:
                 exs = np.empty(nc)
                 near_ = np.zeros(nc, dtype=np.bool_)
+                flat = np.zeros(nc, dtype=np.bool_)
                 for c in range(nc):
                     exs[c] = _item_excess(t, p, tau, cand[c], False)[0]
                     if exs[c] >= 0.0 and _tied(t, p, tau, cand[c]):
                         exs[c] = -1e-300
                     near_[c] = _near_limit(t, p, tau, cand[c])
+                    if cand[c] >= nf:   # a gear whose band is within TIE_BAND floors wide (it carries ~no torque)
+                        r = _item_row(p, cand[c])
+                        noise = _item_noise(p, r, tau)
+                        flat[c] = gear_margin(p, r, -tau[r], _holds(p)[cand[c] - nf], noise)[1] <= TIE_BAND * noise
                 dt = T_TIE
                 for q in range(xp.shape[0]):
                     xp[q] = x[q]
@@ -2908,23 +2920,32 @@ def settle(t, x, m, p, log, old, origin):
                 # (beyond by amounts within 1e-6 of each other: a tie, taken lossy gears first, then in element
                 # order, as in the search)
                 ex1s = np.full(nc, -np.inf)
+                d1s = np.zeros(nc, dtype=np.int64)
                 worst1 = -np.inf
                 for c in range(nc):
                     i = cand[c]
                     ex0 = exs[c]
                     if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
                         continue
-                    ex1s[c] = _item_excess(t + dt, p, tau, i, False)[0]
+                    ex1s[c], d1s[c] = _item_excess(t + dt, p, tau, i, False)
                     worst1 = max(worst1, ex1s[c])
                 iw = -1
+                dw = _ZERO
                 if worst1 >= 0.0:
                     for c in range(nc):
                         i = cand[c]
                         if ex1s[c] >= 0.0 and ex1s[c] >= worst1 - 1e-6 and \
                                 (iw < 0 or (i >= nf) > (iw >= nf) or ((i >= nf) == (iw >= nf) and i < iw)):
                             iw = i
+                            dw = 2 * d1s[c] if flat[c] else 1
                 if iw >= 0:
-                    forced[iw] = 1
+                    # (a gear whose band is about no width at t is marked with the way it breaks away there (2 forward,
+                    # -2 backward): which side of its band it is on at t is a rounding; released the way the rounding
+                    # left, a gear at efficiency 0.5 driven from flange b by a backlash closing rolled forward for 33
+                    # us in one run and backward in another, #30.  Any other item keeps the way the search at t finds
+                    # (1): its load has a sign there, and taken from t + T_TIE, the way of a gear carrying torque in a
+                    # loop moved the loop's clutch 1e-7 beyond its limit in the next round, slipping it for 0.7 ns)
+                    forced[iw] = dw
                     marked = True
                 _evaluate(t, x, m, p, acc, tau)
             if not marked:
