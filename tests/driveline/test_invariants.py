@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from driveline_networks import indeterminate_loop
 from hypothesis_budget import examples
 
 from clutchlab.driveline import Driveline, Signal
@@ -922,15 +923,7 @@ def test_a_statically_indeterminate_loop_holds_while_any_split_holds():
     margin's turning point that crossed for good, not for the gear's margin that dipped through zero and came back).
     Now the events agree at every tolerance and the slip comes where SciPy's HiGHS finds no split any more
     (:func:`_loop_group_holds`, within 1e-6 s)."""
-    d = Driveline("loop")
-    for i in range(4):
-        d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
-    d.one_way_clutch("f0", "J0", "J1", fn_max=1.0, mu=0.5, peak=1.0, normal=Signal.step(1.0, 0.0))
-    d.gear("g1", "J1", "J2", ratio=-1.0, loss_table=[[0.0, 1.0, 0.5, 0.5, 0.0], [20.0, 1.0, 0.5, 0.75, 0.0]])
-    d.gear("g2", "J2", "J3", ratio=-3.0, efficiency=0.25)
-    d.clutch("loop", "J0", "J3", fn_max=3.0, mu=0.5)
-    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
-    d.torque("T1", "J1", Signal.sine(3.0, 1.0))
+    d = indeterminate_loop()
     runs = {rtol: d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in (1e-7, 1e-8, 1e-10)}
     events = {rtol: _mode_events(r) for rtol, r in runs.items()}
     for rtol in (1e-7, 1e-8):

@@ -129,48 +129,38 @@ def test_a_run_without_the_check_does_not_compile_it():
 
 
 _LOOP = r"""
-import json
-from clutchlab.driveline import Driveline, Signal
+import json, sys
+sys.path.insert(0, r"{support}")
+from driveline_networks import indeterminate_loop
 from clutchlab.driveline import kernel as K
 
-def loop():
-    d = Driveline("loop")
-    for i in range(4):
-        d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
-    d.one_way_clutch("f0", "J0", "J1", fn_max=1.0, mu=0.5, peak=1.0, normal=Signal.step(1.0, 0.0))
-    d.gear("g1", "J1", "J2", ratio=-1.0, loss_table=[[0.0, 1.0, 0.5, 0.5, 0.0], [20.0, 1.0, 0.5, 0.75, 0.0]])
-    d.gear("g2", "J2", "J3", ratio=-3.0, efficiency=0.25)
-    d.clutch("loop", "J0", "J3", fn_max=3.0, mu=0.5)
-    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
-    d.torque("T1", "J1", Signal.sine(3.0, 1.0))
-    return d
-
-if __name__ == "__main__":
-    before = len(K._repair_space.overloads)
-    res = loop().simulate(1.0, output_step=2e-3, rtol=1e-8)
-    ev = [[float(t), str(el), str(e)] for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)]
-    print(json.dumps([before, len(K._repair_space.overloads), ev]))
+before = len(K._repair_space.overloads)
+res = indeterminate_loop().simulate(1.0, output_step=2e-3, rtol=1e-8)
+ev = [[float(t), str(el), str(e)] for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)]
+print(json.dumps([before, len(K._repair_space.overloads), ev]))
 """
 
 
-def test_a_rare_path_is_compiled_at_its_first_call_and_gives_the_same_run(tmp_path):
+def test_a_rare_path_is_compiled_at_its_first_call_and_gives_the_same_run():
     """``_repair_space`` is outlined lazily: a fresh process whose network needs it (the rigid loop of
     ``test_a_statically_indeterminate_loop_holds_while_any_split_holds``, seven stuck members on four inertias)
     compiles or loads it from inside the running kernel, at its first call (:func:`outline._resolve`), and the run
     is the one this process makes with it prepared ahead."""
     import json
-    import runpy
     import subprocess
     import sys
+    from pathlib import Path
 
-    script = tmp_path / "loop_network.py"
-    script.write_text(_LOOP)
-    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=900)
+    from driveline_networks import indeterminate_loop
+
+    support = Path(__file__).resolve().parents[1] / "_support"
+    proc = subprocess.run([sys.executable, "-c", _LOOP.format(support=support)], capture_output=True, text=True,
+                          timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     before, after, events = json.loads(proc.stdout.strip().splitlines()[-1])
     assert (before, after) == (0, 1)
     outline.prepare(lazy=True)
-    res = runpy.run_path(str(script))["loop"]().simulate(1.0, output_step=2e-3, rtol=1e-8)
+    res = indeterminate_loop().simulate(1.0, output_step=2e-3, rtol=1e-8)
     here = [[float(t), str(el), str(e)] for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)]
     assert [e[1:] for e in events] == [e[1:] for e in here] and any(e[1] == "loop" for e in here)
     assert max(abs(a[0] - b[0]) for a, b in zip(events, here)) < 1e-9
