@@ -37,11 +37,11 @@ def test_group_compiles_in_another_process_and_this_one_loads_it(monkeypatch):
     assert _compile_notice.compile_seconds() - before < 1.0
 
 
-def test_full_warmup_compiles_the_rare_paths_and_the_demo_does_not(monkeypatch):
+def test_full_warmup_compiles_the_rare_paths(monkeypatch):
     """``clutchlab warmup`` (:func:`warmup.run_parallel`) starts its processes in full (the functions outlined with
     ``lazy=True`` too: the driveline's repair over several null directions and its invariant check, so that no run
-    compiles afterwards); the demo's background processes without (what their section runs); ``python -m
-    clutchlab.warmup --full`` passes it on to :func:`warmup.warm`."""
+    compiles afterwards); ``python -m clutchlab.warmup --full`` passes it on to :func:`warmup.warm`, and without
+    the flag (the demo's background processes, :func:`warmup.start` by default) it is not."""
     import subprocess
     import sys
 
