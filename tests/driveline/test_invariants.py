@@ -20,9 +20,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
-from hypothesis import strategies as st
-from driveline_networks import indeterminate_loop
+from hypothesis import given, settings
+from driveline_networks import indeterminate_loop, networks
 from hypothesis_budget import examples
 
 from clutchlab.driveline import Driveline, Signal
@@ -629,74 +628,7 @@ def test_the_energy_balance_at_events_follows_the_tolerance():
 
 
 # ----------------------------------------------------------------- random networks
-@st.composite
-def networks(draw, with_unrelated=False):
-    """A random network: a chain of 2-4 inertias whose links are springs, backlash, gears (ideal, a constant
-    efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
-    clutch); sometimes a clutch closing a loop from the first to the last, a second clutch in parallel with one,
-    bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
-    inertia turning."""
-    n = draw(st.integers(2, 4))
-    d = Driveline("random")
-    w0 = draw(st.sampled_from([0.0, 0.0, 3.0, -2.0]))
-    for i in range(n):
-        d.inertia(f"J{i}", J=draw(st.floats(0.05, 2.0)), w0=(w0 if i == 0 else None))
-    for i in range(n - 1):
-        a, b = f"J{i}", f"J{i + 1}"
-        kinds = ["spring", "backlash", "gear", "lossy", "table", "clutch", "oneway", "owc"]
-        kind = draw(st.sampled_from(kinds))
-        if kind == "spring":
-            d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
-        elif kind == "backlash":
-            d.backlash(f"k{i}", a, b, c=draw(st.floats(10.0, 500.0)), b_gap=draw(st.floats(0.01, 0.3)),
-                       d=draw(st.floats(0.0, 2.0)))
-        elif kind in ("gear", "lossy", "table"):
-            ratio = draw(st.floats(0.3, 4.0)) * draw(st.sampled_from([-1.0, 1.0]))
-            if kind == "gear":
-                d.gear(f"g{i}", a, b, ratio=ratio)
-            elif kind == "lossy":
-                d.gear(f"g{i}", a, b, ratio=ratio, efficiency=draw(st.floats(0.2, 1.0)))
-            else:
-                e1, e2 = draw(st.floats(0.3, 1.0)), draw(st.floats(0.3, 0.999))
-                bf1, bf2 = draw(st.floats(0.0, 2.0)), draw(st.floats(0.0, 2.0))   # (e2 < 1: a split of bf exists)
-                d.gear(f"g{i}", a, b, ratio=ratio, loss_table=[[0.0, e1, e2, bf1, bf2],
-                                                               [20.0, min(1.0, e1 + 0.05), e2, bf1 * 1.5, bf2]])
-        elif kind == "clutch":
-            d.clutch(f"c{i}", a, b, fn_max=draw(st.floats(0.0, 60.0)), mu=0.5, peak=draw(st.floats(1.0, 1.5)),
-                     normal=draw(st.sampled_from([1.0, Signal.ramp(1.0, 0.3, start=0.1),
-                                                  Signal.sine(1.0, 2.0, phase=1.0)])))
-        elif kind == "oneway":
-            d.one_way_clutch(f"f{i}", a, b)
-        else:
-            d.one_way_clutch(f"f{i}", a, b, fn_max=draw(st.floats(1.0, 20.0)), mu=0.5, peak=draw(st.floats(1.0, 2.0)),
-                             normal=Signal.step(1.0, draw(st.floats(0.0, 0.5))))
-    if n >= 3 and draw(st.booleans()):
-        d.clutch("loop", "J0", f"J{n - 1}", fn_max=draw(st.floats(1.0, 40.0)), mu=0.5)
-    if draw(st.booleans()):
-        j = draw(st.integers(0, n - 1))
-        d.bearing_friction("bearing", f"J{j}", torque=draw(st.floats(0.1, 3.0)), peak=draw(st.floats(1.0, 1.3)))
-    if draw(st.booleans()):
-        j = draw(st.integers(0, n - 1))
-        d.brake("brake", f"J{j}", fn_max=draw(st.floats(1.0, 30.0)), mu=0.4,
-                normal=Signal.step(1.0, draw(st.floats(0.1, 0.6))))
-    for i in range(n):
-        if draw(st.booleans()):
-            amp = draw(st.floats(-30.0, 30.0))
-            sig = draw(st.sampled_from(["sine", "ramp", "step"]))
-            s = (Signal.sine(amp, draw(st.floats(0.3, 5.0))) if sig == "sine" else
-                 Signal.ramp(amp, draw(st.floats(0.1, 1.0))) if sig == "ramp" else Signal.step(amp, draw(
-                     st.floats(0.0, 0.5))))
-            d.torque(f"T{i}", f"J{i}", s)
-    if with_unrelated:
-        d.inertia("U", J=draw(st.floats(0.1, 2.0)), w0=draw(st.floats(-5.0, 5.0)))
-        d.brake("Ubrake", "U", fn_max=draw(st.floats(1.0, 30.0)), mu=0.5)
-        d.torque("UT", "U", Signal.sine(draw(st.floats(0.0, 40.0)), draw(st.floats(0.5, 7.0))))
-    try:
-        d.system()
-    except ParameterError as exc:     # a one-way clutch started with b slower than a
-        assume("one-way" not in str(exc))
-        raise
-    return d
+# (the strategy: driveline_networks.networks, shared with test_inputs.py)
 
 
 def _check_columns(d, df, events=None):

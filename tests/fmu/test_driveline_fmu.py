@@ -369,3 +369,29 @@ def test_an_emtc_driveline_fmu_runs_from_its_resources(tmp_path, run_fmu):
     # the controller's held outputs from its first sample on (the FMU's row at t = 0 is before the first step)
     for n in ("emtc.current_command", "emtc.torque_reference"):
         assert np.max(np.abs(out[n][1:] - ref[n][1:])) < 1e-5 * np.max(np.abs(ref[n]))
+
+
+# ----------------------------------------------------------------- network inputs as FMI inputs
+def test_the_fmu_has_the_networks_inputs_and_a_host_drives_them(tmp_path, run_fmu, run_cosim):
+    """A host holds the load and opens the clutch at 0.5 s through FMI inputs: the FMU is the co-simulation, and
+    J2 decelerates alone at 2 N m / 1 kg m^2 from the locked speed (closed form)."""
+    import xml.etree.ElementTree as ET
+
+    from driveline_networks import INPUTS_TOML
+
+    description = tmp_path / "inputs.toml"
+    description.write_text(INPUTS_TOML)
+    path = export_fmu("driveline", tmp_path / "inputs.fmu", description=description)
+    with zipfile.ZipFile(path) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    found = {v.get("name"): v.get("causality") for v in root.iter("ScalarVariable")}
+    assert found["load"] == "input" and found["press"] == "input"
+    dt, n = 0.01, 100
+    inputs = {"load": np.full(n + 1, 2.0), "press": np.where(np.arange(n + 1) < 50, 1.0, 0.0)}
+    names = ["J1.w", "J2.w", "c.mode"]
+    fmu = run_fmu(path, inputs, dt, n, names)
+    ref = run_cosim(DrivelineCoSimulation.for_description(description)(), inputs, dt, n)
+    for name in names:
+        np.testing.assert_allclose(fmu[name], ref[name], rtol=1e-12, atol=1e-12, err_msg=name)
+    w_lock = 10.0 - 30.0 * 10.0 / 58.0 - 1.0 * (0.5 - 10.0 / 58.0)
+    assert fmu["J2.w"][-1] == pytest.approx(w_lock - 2.0 * 0.5, rel=1e-7)

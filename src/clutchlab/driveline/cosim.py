@@ -5,8 +5,10 @@
 :class:`~clutchlab.fmu.cosim.ContractCoSimulation` of the :class:`~clutchlab.system.System` that
 :meth:`Driveline.system <clutchlab.driveline.network.Driveline.system>` returns: each ``do_step``
 continues the integrator core's run (``clutchlab.system.Simulation.advance``) from the stored angles,
-speeds, energies, friction modes and step size.  The network has no inputs (its sources are the
-signals of the file); its outputs are every state and output column of the driveline; its parameters
+speeds, energies, friction modes and step size.  Its inputs are the network's (``[input.NAME]`` of the
+file, read by its signals as ``{ input = "NAME" }``: a throttle, a clutch's normal-force command, a load
+torque), held between communication points; a change restarts the run, so the stick/slip modes are
+decided again with the new value.  Its outputs are every state and output column of the driveline; its parameters
 are ``rtol``, ``solver.fixed_step`` (> 0: the core's fixed-step mode, a HIL frame; 0: step-size
 control) and the numeric fields of its components, ``<component>.<field>``
 (:class:`~clutchlab.driveline.variants.DrivelineDocument`).
@@ -16,6 +18,7 @@ control) and the numeric fields of its components, ``<component>.<field>``
     Cls = DrivelineCoSimulation.for_description("examples/driveline_coupled_clutches.toml")
     sim = Cls(**{"clutch1.fn_max": 25.0})
     y = sim.do_step(0.0, 1e-3, {})      # {"J1.w": ..., "clutch1.tau": ..., "clutch1.mode": ..., ...}
+    # a file with [input.throttle]: sim.do_step(t, dt, {"throttle": 0.4})
 """
 
 from __future__ import annotations
@@ -50,7 +53,8 @@ class DrivelineCoSimulation(ContractCoSimulation):
     control; a step > 0 runs the core's fixed-step mode, Rodas3 steps on the grid ``k * fixed_step`` with
     the mode changes at step ends, a HIL frame) and every numeric component field,
     ``<component>.<field>`` in SI (``J1.J`` [kg.m2], ``J1.w0`` [rad/s], ``clutch1.fn_max`` [N],
-    ``clutch1.mu`` [1], ...).  No inputs.
+    ``clutch1.mu`` [1], ...).  Inputs: the network's (:meth:`Driveline.input
+    <clutchlab.driveline.network.Driveline.input>`), in SI, starting at their ``start`` values.
 
     Parameters
     ----------
@@ -106,18 +110,20 @@ class DrivelineCoSimulation(ContractCoSimulation):
         system = base.driveline.system(base.rtol)
         outputs = tuple(Variable(v.name, _fmi_unit(v.unit), 0.0, v.description)
                         for v in (*system.states, *system.outputs))
+        inputs = tuple(Variable(v.name, _fmi_unit(v.unit), float(u), v.description)
+                       for v, u in zip(system.inputs, system.u0 if system.inputs else ()))
         parameters = (Variable("rtol", "1", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step "
                                                        "control ([simulation] rtol)"),
                       Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
                       *(Variable(p.name, fmi_unit(p.unit), p.value, p.description) for p in doc.parameters.values()))
-        names = [v.name for v in (*outputs, *parameters)]
+        names = [v.name for v in (*inputs, *outputs, *parameters)]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
             raise ParameterError(f"{path}: {twice[0]!r} would name two FMU variables (rename that component)")
         experiment = (base.t_end if base.t_end is not None else 1.0,
                       base.output_step if base.output_step is not None else 1e-3)
         return type(f"{cls.__name__}[{base.driveline.name}]", (cls,),
-                    {"document": doc, "base": base, "outputs": outputs, "parameters": parameters,
+                    {"document": doc, "base": base, "inputs": inputs, "outputs": outputs, "parameters": parameters,
                      "experiment": experiment, "__module__": cls.__module__, "__doc__": cls.__doc__})
 
     def __init__(self, **parameter_values):
@@ -142,8 +148,8 @@ class DrivelineCoSimulation(ContractCoSimulation):
         return system
 
     def input_vector(self, inputs: dict) -> np.ndarray:
-        """No inputs: an empty vector (``inputs`` is empty)."""
-        return np.empty(0)
+        """The network's held inputs ``u`` (SI, in the order of :attr:`inputs`)."""
+        return np.array([float(inputs[v.name]) for v in self.inputs], dtype=float)
 
     def output_sources(self) -> list:
         """Every state and then every output of the driveline (the order of :attr:`outputs`)."""

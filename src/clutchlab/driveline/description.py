@@ -58,7 +58,12 @@ the period it is on, in (0, 1]: ``0.5`` or ``"50 %"``; ``nperiod`` a whole numbe
 rising + width + falling <= period), ``{ exponentials = { out_max, rise_time, rise_time_const,
 fall_time_const, offset, start } }``, ``{ table = { times = [...], values = [...] } }`` (times in s, values
 in the signal's unit) or ``{ product = [S1, S2] }``, S1 a signal in the field's unit (a number, a quantity
-or one of these tables) and S2 a dimensionless one (MSL ``Blocks.Sources`` and ``Blocks.Math.Product``).
+or one of these tables) and S2 a dimensionless one (MSL ``Blocks.Sources`` and ``Blocks.Math.Product``),
+or ``{ input = "NAME" }``: the network input declared by an ``[input.NAME]`` table (``start``, a quantity
+in the unit of the fields that read it, default 0; ``description``), held by whatever drives the network
+(``Driveline.simulate``'s ``inputs``, a co-simulation master, an FMU's importer, a controller).  Torque and
+force sources, clutches' and brakes' normal signals and an engine's throttle take inputs; motion sources
+and the E-clutch, wet-clutch and EMTC models do not (yet).
 A friction characteristic (``mu``, a bearing's ``torque``) is a number or a table of rows
 ``[w_rad_s, value]``.  Every error names the file, the key and the value.
 """
@@ -138,6 +143,7 @@ SIGNAL_FIELDS = {
                      "offset": "value", "start": "s"},
     "table": {"times": "s", "values": "value"},
     "product": None,
+    "input": None,
 }
 #: the parameters a signal needs (the others have defaults)
 SIGNAL_REQUIRED = {"step": (), "ramp": ("height", "duration"), "sine": ("amplitude", "frequency"),
@@ -182,7 +188,15 @@ def _quantity(value, unit, key, src):
     return to_si(value, unit, name=key, source=src)
 
 
-def _signal(value, unit, key, src) -> Signal:
+#: the column suffix (clutchlab.units.COLUMN_UNITS) of an input driving a field of this unit
+_INPUT_SUFFIX = {"N*m": "Nm", "N": "N", "1": "1", "rad/s": "rad_s", "m/s": "m_s", "rad": "rad", "m": "m"}
+#: the fields of an [input.NAME] table
+INPUT_FIELDS = ("start", "description")
+
+
+def _signal(value, unit, key, src, uses=None) -> Signal:
+    """The signal of field ``key`` (values in ``unit``); an input it reads is noted in ``uses``: name -> [(unit,
+    key), ...]."""
     if not isinstance(value, dict):
         return Signal.constant(_quantity(value, unit, key, src))
     if len(value) != 1:
@@ -193,12 +207,18 @@ def _signal(value, unit, key, src) -> Signal:
         raise ParameterError(f"{src}: {key}: unknown signal {kind!r} (known: {', '.join(SIGNAL_FIELDS)})")
     if kind == "constant":
         return Signal.constant(_quantity(spec, unit, f"{key}.constant", src))
+    if kind == "input":
+        if not isinstance(spec, str) or not spec:
+            raise ParameterError(f"{src}: {key}.input = {spec!r}: expected the name of an [input.NAME] table")
+        if uses is not None:
+            uses.setdefault(spec, []).append((unit, key))
+        return Signal.input(spec)
     if kind == "product":   # [a signal in the field's unit, a dimensionless one]
         if not isinstance(spec, list) or len(spec) != 2:
             raise ParameterError(f"{src}: {key}.product = {spec!r}: expected two signals [S1, S2] (S1 in the "
                                  "field's unit, S2 dimensionless)")
-        return Signal.product(_signal(spec[0], unit, f"{key}.product[0]", src),
-                              _signal(spec[1], "1", f"{key}.product[1]", src))
+        return Signal.product(_signal(spec[0], unit, f"{key}.product[0]", src, uses),
+                              _signal(spec[1], "1", f"{key}.product[1]", src, uses))
     if not isinstance(spec, dict):
         raise ParameterError(f"{src}: {key}.{kind} = {spec!r}: expected a table of its parameters")
     fields = SIGNAL_FIELDS[kind]
@@ -345,6 +365,39 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
     getattr(d, _ADD[kind])(name, **args)
 
 
+def _declare_inputs(d: Driveline, declared: dict, uses: dict, src: str) -> None:
+    """The ``[input.NAME]`` tables: each input takes the unit of the fields that read it (``{ input = "NAME" }``),
+    its ``start`` a quantity in that unit (default 0); an input read nowhere, or read by fields of two units, or
+    read without a table, is an error naming the key."""
+    for name, (unit, key) in ((n, u[0]) for n, u in uses.items()):
+        if name not in declared:
+            raise ParameterError(f"{src}: {key}.input = {name!r}: no [input.{name}] table (inputs: "
+                                 f"{', '.join(declared) or 'none'})")
+    for name in declared:   # (every input's unit first: a clash names both fields, not a start it makes wrong)
+        units = sorted({u for u, _ in uses.get(name, ())})
+        if len(units) > 1:
+            raise ParameterError(f"{src}: [input.{name}] is read by fields of different units ({', '.join(units)}: "
+                                 f"{', '.join(k for _, k in uses[name])})")
+    for name, spec in declared.items():
+        key = f"input.{name}"
+        for f in spec:
+            if f not in INPUT_FIELDS:
+                raise ParameterError(f"{src}: {key}.{f}: unknown field (known: {', '.join(INPUT_FIELDS)}; the unit "
+                                     "is that of the fields the input drives)")
+        if name not in uses:
+            raise ParameterError(f"{src}: [{key}] drives nothing (read it in a signal field: {{ input = \"{name}\" }})")
+        unit = uses[name][0][0]
+        start = _quantity(spec.get("start", 0.0), unit, f"{key}.start", src)
+        description = spec.get("description", "")
+        if not isinstance(description, str):
+            raise ParameterError(f"{src}: {key}.description = {description!r}: expected text")
+        try:
+            d.input(name, unit=_INPUT_SUFFIX.get(unit, "1"), start=start,
+                    description=description or f"input {name} [{unit}] ({', '.join(k for _, k in uses[name])})")
+        except ParameterError as exc:
+            raise ParameterError(f"{src}: [{key}] {exc}") from None
+
+
 def load_driveline(path) -> DrivelineFile:
     """Read a driveline TOML file (format in this module's docstring).
 
@@ -384,7 +437,7 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
     """
     src = str(source)
     base = Path(base) if base is not None else Path(src).parent
-    known = {"driveline", "simulation", *FIELDS, *TRANSLATIONAL_FIELDS}
+    known = {"driveline", "simulation", "input", *FIELDS, *TRANSLATIONAL_FIELDS}
     for top in doc:
         if top not in known:
             raise ParameterError(f"{src}: unknown table [{top}] (known: {', '.join(sorted(known))})")
@@ -406,13 +459,17 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
             raise ParameterError(f"{src}: [simulation] {k}: unknown field (known: {', '.join(SIMULATION_FIELDS)})")
     settings = {k: _quantity(v, SIMULATION_FIELDS[k], f"simulation.{k}", src) for k, v in sim.items()}
     for top in doc:
-        if top in known and top not in table_fields and top not in ("driveline", "simulation"):
+        if top in known and top not in table_fields and top not in ("driveline", "simulation", "input"):
             other = "translational" if domain == "rotational" else "rotational"
             raise ParameterError(f"{src}: [{top}] belongs to a {other} driveline (this one is {domain}; set "
                                  f"[driveline] domain)")
     # bodies first: the elements name them
     body = "inertia" if domain == "rotational" else "mass"
     order = [body] + [k for k in doc if k in table_fields and k != body]
+    declared = doc.get("input", {})
+    if not isinstance(declared, dict) or not all(isinstance(v, dict) for v in declared.values()):
+        raise ParameterError(f"{src}: [input] must hold named inputs ([input.NAME] with start, description)")
+    uses: dict = {}
     for kind in order:
         table = doc.get(kind, {})
         if not isinstance(table, dict):
@@ -437,7 +494,7 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                         raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
                     args[f] = v
                 elif _SIGNALS.get(kind) == f:
-                    args[f] = _signal(v, unit, fkey, src)
+                    args[f] = _signal(v, unit, fkey, src, uses)
                 elif f == "mu" or (kind == "bearing_friction" and f == "torque"):
                     args[f] = _characteristic(v, unit, fkey, src, x_unit=speed_unit)
                 elif f == "curve":
@@ -474,5 +531,6 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                 raise ParameterError(f"{src}: [{key}] {exc}") from None
     if not d._inertias:
         raise ParameterError(f"{src}: no [{body}.NAME] table (a driveline needs at least one {body})")
+    _declare_inputs(d, declared, uses, src)
     return DrivelineFile(d, settings.get("t_end"), settings.get("output_step"), settings.get("rtol", 1e-8),
                          settings.get("max_step"))

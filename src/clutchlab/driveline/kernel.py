@@ -85,6 +85,7 @@ _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 # signals (rows of ``DrivelineParams.signals``, ``N_SIG`` wide: the kind and up to eight parameters)
 SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
 SIG_PULSE, SIG_TRAPEZOID, SIG_EXPONENTIALS, SIG_PRODUCT = 6, 7, 8, 9
+SIG_INPUT = 10   # a network input: ``[k, its number j, the number of inputs nu]``, held at ``data[-nu + j]``
 N_SIG = 9
 # columns of ``elem`` (ints) and ``coef`` (floats)
 E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = range(11)  # E_AUX: a curve's kind
@@ -243,6 +244,8 @@ def _basic_value(sig, data, t):
         if t < tr:
             return sig[5] - sig[1] * math.expm1(-(t - sig[6]) / sig[3])
         return sig[5] - sig[1] * math.expm1(-sig[2] / sig[3]) * math.exp(-(t - tr) / sig[4])
+    if kind == SIG_INPUT:   # held by the host (:func:`hold_inputs`): no break, no rate
+        return data[data.shape[0] - int(sig[2]) + int(sig[1])]
     return _table(data, int(sig[1]), int(sig[2]), t)
 
 
@@ -1092,6 +1095,25 @@ def refresh_signals(p, t):
 def forget_signals(p):
     """Empty the signal cache (a run starts, or a signal's parameters change)."""
     p.work[_offsets(p).sig] = np.nan
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def hold_inputs(data, u):
+    """Hold the network's inputs ``u`` (in the order of :meth:`Driveline.inputs
+    <clutchlab.driveline.network.Driveline.inputs>`, SI) where its input signals read them (:data:`SIG_INPUT`: the
+    last ``u.size`` numbers of ``data``, the network's ``p.data``); True if a value changed, and the caller then
+    empties the signal cache (:func:`forget_signals`).  Every hook of the core that evaluates the network does this
+    first, and only for a network with inputs (inlined there: a call that takes the parameters cost CoupledClutches
+    40 %), so whatever evaluates it (a step, an event, the outputs, the stuck-set searches at a restart) reads the
+    inputs the core holds."""
+    nu = u.shape[0]
+    o = data.shape[0] - nu
+    changed = False
+    for j in range(nu):
+        if data[o + j] != u[j]:
+            data[o + j] = u[j]
+            changed = True
+    return changed
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -3098,6 +3120,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed.
     Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0.
     """
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
@@ -3292,6 +3316,8 @@ def driveline_outputs(t, x, u, m, p, y):
     springs and friction, the relative speed [rad/s]; per friction element also its MSL mode code [-] and
     normal force [N]; then kinetic and spring energy, the sources' work, the dissipated energy and the
     energy balance error [J]."""
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
@@ -3341,6 +3367,8 @@ def driveline_update(t, x, u, m, p, k, log):
     reverses if it cannot hold), a stuck one reached its holding limit, a normal force changed sign, or a
     backlash closed (``contact``) or opened (``separate``) its gap, or (MSL's damping law) reached a kink of
     its contact law (:func:`_lash_msl_update`, no event)."""
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
     if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
@@ -3424,6 +3452,8 @@ def driveline_restart(t, x, u, m, p, log):
     :func:`forget_signals`).  At the break time last given to the core (:func:`_break_marker`) it is a signal's
     jump: only the items linked to the elements whose signals jump are searched (:func:`settle`, origin -2); else
     every item."""
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     forget_signals(p)
     _instant(p)[0] = np.nan   # a new instant (:func:`_one_search_per_instant`)
     mark = _break_marker(p)
@@ -3551,6 +3581,8 @@ _check_outlined = outlined(check_invariants, lambda: (types.float64, _F1, _I1, _
 def driveline_accept(t, x, u, m, p):
     """Nothing to commit (the network has no memories); with ``check[0]`` set, the invariants
     (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     if p.check[0] != 0.0:
         return _check_outlined(t, x, m, p)
     return 0
@@ -3592,6 +3624,8 @@ def driveline_watch(t, x, u, m, p, dx, g, k):
     stages): the margin rates of the stuck elements near their limits (:func:`_margin_rates`), one more evaluation of
     the network while one is, and only where the core reads one of them (``k`` a stuck element's turn function, or
     -1 for all: a probe locating a break-away reads only that); nothing else."""
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
     nf = p.fric.shape[0]
     if k >= 0:
         if k < N_G * nf and k % N_G == G_TURN and m[k // N_G] == STUCK and g[k] == 0.0:

@@ -66,12 +66,43 @@ class Signal:
         A sampled signal's corners (times [s]), the only points at which a step must end.
     factors : tuple
         A product's factors (signals, none of them a product: nested products are flattened).
+    name : str
+        The network input an input signal reads (:meth:`input`; "" for the others).
     """
 
     row: tuple
     points: tuple = ()
     breaks: tuple = ()
     factors: tuple = ()
+    name: str = ""
+
+    @classmethod
+    def input(cls, name: str) -> "Signal":
+        """The network input ``name`` (:meth:`Driveline.input`): the value its host holds -- a co-simulation
+        master or an FMU's importer between communication points, a controller, :meth:`Driveline.simulate`'s
+        ``inputs`` -- constant between two of its changes (a zero-order hold); in a :meth:`product` with other
+        signals, a scaled or modulated input."""
+        if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
+            raise ParameterError(f"input signal: name {name!r} must be letters, digits and underscores")
+        return cls((K.SIG_INPUT,), name=name)
+
+    def input_names(self) -> tuple:
+        """The network inputs this signal reads (a product's factors' too)."""
+        if self.row[0] == K.SIG_PRODUCT:
+            return tuple(n for f in self.factors for n in f.input_names())
+        return (self.name,) if self.row[0] == K.SIG_INPUT else ()
+
+    def with_inputs(self, signals: dict) -> "Signal":
+        """This signal with each input it reads replaced by ``signals[name]`` (a :class:`Signal`), those not in
+        ``signals`` kept."""
+        if self.row[0] == K.SIG_PRODUCT:
+            out = self.factors[0].with_inputs(signals)
+            for f in self.factors[1:]:
+                out = Signal.product(out, f.with_inputs(signals))
+            return out
+        if self.row[0] == K.SIG_INPUT and self.name in signals:
+            return signals[self.name]
+        return self
 
     @classmethod
     def constant(cls, value: float) -> "Signal":
@@ -232,20 +263,27 @@ class Signal:
                     f"falling with {a[3]:g} s" + (f", from {a[5]:g} s" if a[5] else ""))
         if k == K.SIG_PRODUCT:
             return " * ".join(f"({f.describe(unit if i == 0 else '')})" for i, f in enumerate(self.factors))
+        if k == K.SIG_INPUT:
+            return f"input {self.name}" + (f" [{unit}]" if unit else "")
         n = len(self.points) // 2
         what = "samples" if k == K.SIG_SAMPLED else "table of"
         return f"{what} {n} points from {self.points[0]:g} to {self.points[n - 1]:g} s"
 
-    def value_and_rate(self, t: float) -> tuple:
+    def value_and_rate(self, t: float, inputs=None) -> tuple:
         """Value and time derivative (from the right) at ``t`` [s], in Python (as the kernel's
-        :func:`~clutchlab.driveline.kernel.signal_value` and :func:`~clutchlab.driveline.kernel.signal_rates`)."""
+        :func:`~clutchlab.driveline.kernel.signal_value` and :func:`~clutchlab.driveline.kernel.signal_rates`);
+        ``inputs``: the held value of each network input by name (an input's rate is 0)."""
         k, *a = self.row
         if k == K.SIG_PRODUCT:   # the product rule, one factor at a time
             y, rate = 1.0, 0.0
             for f in self.factors:
-                v, r = f.value_and_rate(t)
+                v, r = f.value_and_rate(t, inputs)
                 y, rate = y * v, rate * v + y * r
             return y, rate
+        if k == K.SIG_INPUT:
+            if not inputs or self.name not in inputs:
+                raise ParameterError(f"input signal {self.name!r}: no value held (declare it with Driveline.input)")
+            return float(inputs[self.name]), 0.0
         if k == K.SIG_CONST:
             return a[0], 0.0
         if k == K.SIG_STEP:
@@ -288,6 +326,9 @@ class Signal:
         as a model with its own piecewise-linear profile takes them; ``what`` names the signal in the error a
         step or sine raises (:class:`~clutchlab.errors.ParameterError`)."""
         kind = self.row[0]
+        if self.input_names():
+            raise ParameterError(f"{what} cannot be a network input ({self.describe(unit)}) yet: this component "
+                                 "reads a piecewise-linear profile of its own (issue #31 makes its inputs ports)")
         if kind == K.SIG_CONST:
             return (0.0,), (self.row[1],)
         if kind == K.SIG_RAMP:
@@ -387,6 +428,10 @@ def _curve_energy_py(table, m, kind, phi):
 def _check_motion_signal(name, what, sig):
     """A motion source's signal may not jump (an infinite torque) nor, for a position, have a speed jump."""
     kind, *a = sig.row
+    if sig.input_names():
+        raise ParameterError(f"{name}: a motion source cannot follow a network input ({sig.describe()}): a held input "
+                             "jumps at every change, and a prescribed speed or position that jumps needs an infinite "
+                             "torque; drive a torque source (or an engine's throttle) with it")
     if what == "speed":
         if kind == K.SIG_PRODUCT:   # continuous if every factor is
             for f in sig.factors:
@@ -473,10 +518,82 @@ class Driveline:
         self.domain = domain
         self._inertias: dict = {}
         self._elements: list = []
+        self._inputs: dict = {}   # name -> (unit suffix, start value [SI], description)
 
     @property
     def _units(self):
         return DOMAINS[self.domain]
+
+    # ---- inputs
+    def input(self, name: str, unit: str = "1", start: float = 0.0, description: str = "") -> "Driveline":
+        """Declare a network input ``name`` [``unit``, a column suffix of :data:`clutchlab.units.COLUMN_UNITS`:
+        ``"Nm"``, ``"N"``, ``"1"``] starting at ``start`` (SI); a signal reads it with :meth:`Signal.input`.
+
+        The input is a port of the network's :meth:`system`: held constant between two changes (a zero-order
+        hold) by whatever drives it -- :meth:`simulate`'s ``inputs``, a co-simulation master or an FMU's importer
+        (``DrivelineCoSimulation``, ``clutchlab export-fmu driveline``: an FMI input), a controller in
+        :func:`clutchlab.control.closed_loop`, :func:`clutchlab.control.linearize` (its ``B`` and ``D`` columns).
+        A change restarts the run: the stick/slip modes are decided again with the new value (a torque input that
+        jumps beyond a stuck clutch's limit breaks it away at that instant).  Every declared input must drive
+        something.
+        """
+        from ..units import COLUMN_UNITS
+
+        if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
+            raise ParameterError(f"{self.name}: input name {name!r} must be letters, digits and underscores")
+        if name in self._inputs:
+            raise ParameterError(f"{self.name}: input {name!r} is declared twice")
+        if unit not in COLUMN_UNITS:
+            raise ParameterError(f"{self.name}: input {name!r}: unit = {unit!r} is not a column unit "
+                                 f"(e.g. Nm, N, 1, rad_s)")
+        self._inputs[name] = (unit, _finite(f"input {name}", "start", start), str(description))
+        return self
+
+    def _input_starts(self) -> dict:
+        return {n: v[1] for n, v in self._inputs.items()}
+
+    @property
+    def inputs(self) -> tuple:
+        """The names of the network's inputs, in the order of its :meth:`system`'s ``u``."""
+        return tuple(self._inputs)
+
+    def _check_inputs(self) -> None:
+        """Every input a signal reads is declared, and every declared input drives something."""
+        used = set()
+        for e in self._elements:
+            for n in (e.signal.input_names() if e.signal is not None else ()):
+                if n not in self._inputs:
+                    known = ", ".join(self._inputs) or "none declared"
+                    raise ParameterError(f"{e.name}: reads input {n!r}, which {self.name!r} does not declare "
+                                         f"(inputs: {known})")
+                used.add(n)
+        unused = [n for n in self._inputs if n not in used]
+        if unused:
+            raise ParameterError(f"{self.name}: input {unused[0]!r} drives nothing (a signal reads it with "
+                                 "Signal.input; or remove it)")
+
+    def with_inputs(self, values: dict) -> "Driveline":
+        """A copy of this network whose inputs named in ``values`` are replaced by signals: a number (held from
+        t = 0), a :class:`Signal`, or ``(times, values)`` (a :meth:`Signal.table`); the others stay inputs."""
+        import copy
+
+        signals = {}
+        for n, v in dict(values).items():
+            if n not in self._inputs:
+                known = ", ".join(self._inputs) or "none"
+                raise ParameterError(f"{self.name}: inputs: {n!r} is not an input of the network (inputs: {known})")
+            if isinstance(v, tuple) and len(v) == 2:
+                v = Signal.table(*v)
+            signals[n] = Signal.of(v, f"{self.name}: inputs[{n!r}]")
+        out = copy.copy(self)
+        out._elements = [copy.copy(e) for e in self._elements]
+        for e in out._elements:
+            if e.signal is not None and e.signal.input_names():
+                e.signal = e.signal.with_inputs(signals)
+                if e.kind == K.K_MOTION:
+                    _check_motion_signal(e.name, "speed" if e.law == K.MOTION_SPEED else "position", e.signal)
+        out._inputs = {n: v for n, v in self._inputs.items() if n not in signals}
+        return out
 
     # ---- components
     def _new_name(self, name):
@@ -1112,7 +1229,8 @@ class Driveline:
 
     # ---- the system
     def describe(self) -> str:
-        """A text schematic: the inertias, then every element between its flanges (``ground`` for none)."""
+        """A text schematic: the inertias, the inputs, then every element between its flanges (``ground`` for
+        none)."""
         fric = self.friction_names
         bodies = "masses" if self.domain == "translational" else "inertias"
         lines = [f"{self.name}: {len(self._inertias)} {bodies}, {len(self._elements)} elements "
@@ -1124,6 +1242,8 @@ class Driveline:
         st, dm = u["stiffness"], u["damping"]
         for i, (name, (J, _w0, _phi0)) in enumerate(self._inertias.items()):
             lines.append(f"  [{name}]  {jn} = {J:g} {ju}, {wn}0 = {x0[n + i]:g} {wu}, {an}0 = {x0[i]:g} {au}")
+        for name, (unit, start, _d) in self._inputs.items():
+            lines.append(f"  input {name} [{unit}], start {start:g}")
         for e in self._elements:
             a, b = e.a or GROUND, e.b or GROUND
             if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
@@ -1191,6 +1311,8 @@ class Driveline:
         if not self._inertias:
             raise ParameterError(f"{self.name}: no inertia")
         index = {n: i for i, n in enumerate(self._inertias)}
+        self._check_inputs()
+        inputs = list(self._inputs)
         signals, data = [], []
         elem = np.zeros((len(self._elements), K.N_ELEM), dtype=np.int64)
         coef = np.zeros((len(self._elements), K.N_COEF))
@@ -1207,6 +1329,8 @@ class Driveline:
                     corners = sorted({sig.points[0], sig.points[n - 1], *sig.breaks})
                     row += [float(len(data)), float(len(corners))]
                     data.extend(corners)
+            elif row[0] == K.SIG_INPUT:   # held at the end of data (kernel.hold_inputs)
+                row = [row[0], float(inputs.index(sig.name)), float(len(inputs))]
             elif row[0] == K.SIG_PRODUCT:
                 rows = [signal_row(f) for f in sig.factors]
                 row = [row[0], float(len(data)), float(len(rows))]
@@ -1254,6 +1378,7 @@ class Driveline:
         nk = fric.size + cons.size + lossy.size
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
         elem[ext, K.E_AUX] = np.arange(len(ext))
+        data.extend(v[1] for v in self._inputs.values())   # the inputs' held values, last (kernel.hold_inputs)
         sig = np.array(signals, dtype=float).reshape(-1, K.N_SIG)
         work = K.new_work(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0])
         inertia = np.array([v[0] for v in self._inertias.values()])
@@ -1390,10 +1515,10 @@ class Driveline:
             w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
             el = self._elements[r]
             if el.law == K.LAW_CLUTCH and el.ncurve:   # as kernel._is_free: beyond lift-off, or at it and not coming back
-                value, rate = el.signal.value_and_rate(0.0)
+                value, rate = el.signal.value_and_rate(0.0, self._input_starts())
                 free = value > el.liftoff or (value == el.liftoff and rate >= 0.0)
             elif el.law == K.LAW_CLUTCH:   # as kernel._is_free: negative, or zero and not rising
-                value, rate = (1.0, 0.0) if el.signal is None else el.signal.value_and_rate(0.0)
+                value, rate = (1.0, 0.0) if el.signal is None else el.signal.value_and_rate(0.0, self._input_starts())
                 fn, dfn = el.coef[0] * value, el.coef[0] * rate
                 free = fn < 0.0 or (fn == 0.0 and dfn <= 0.0)
             else:
@@ -1530,7 +1655,9 @@ class Driveline:
         freqs = [f.row[2] for e in self._elements if e.signal is not None
                  for f in (e.signal.factors or (e.signal,)) if f.row[0] == K.SIG_SINE]
         max_step = min((0.125 / f for f in freqs if f > 0), default=math.inf)
-        return System(name=self.name, params=p, states=states, outputs=outputs, inputs=(), x0=x0,
+        inputs = tuple((n, unit, d or f"network input {n}") for n, (unit, _start, d) in self._inputs.items())
+        u0 = np.array([v[1] for v in self._inputs.values()], dtype=float) if inputs else None
+        return System(name=self.name, params=p, states=states, outputs=outputs, inputs=inputs, u0=u0, x0=x0,
                       m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name, error_messages=error_messages)
@@ -1591,7 +1718,7 @@ class Driveline:
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
                  output_step: float | None = None, sample_times=None, fixed_step: float | None = None,
-                 check_invariants: bool = False):
+                 check_invariants: bool = False, inputs: dict | None = None):
         """Run the network from its initial state to ``t_end`` [s]; a :class:`~clutchlab.SimulationResult`.
 
         Parameters
@@ -1618,8 +1745,12 @@ class Driveline:
             mode agrees with the sign of its relative speed, no one-way clutch transmits torque in its free
             direction, no lossy gear generates power and the energy balance holds (:meth:`system`); a violation
             raises :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time.
+        inputs : dict, optional
+            What drives the network's inputs (:meth:`input`) in this run, by name: a number (held), a
+            :class:`Signal` or ``(times, values)`` (a table); an input not named holds its ``start``.
         """
-        return _simulate(self.system(rtol, check_invariants=check_invariants), t_end, atol=atol, max_step=max_step, output_step=output_step,
+        net = self.with_inputs(inputs) if inputs else self
+        return _simulate(net.system(rtol, check_invariants=check_invariants), t_end, atol=atol, max_step=max_step, output_step=output_step,
                          sample_times=sample_times, fixed_step=fixed_step)
 
 
