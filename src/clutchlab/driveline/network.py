@@ -18,6 +18,7 @@ are those of the Modelica Standard Library (MSL 4.x, :mod:`clutchlab.driveline.k
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -26,6 +27,7 @@ import numpy as np
 from .._limits import check_number
 from ..errors import ParameterError
 from ..numerics import outline
+from ..units import COLUMN_UNITS
 from ..system import System, register_model, simulate as _simulate
 from . import kernel as K
 
@@ -82,9 +84,7 @@ class Signal:
         master or an FMU's importer between communication points, a controller, :meth:`Driveline.simulate`'s
         ``inputs`` -- constant between two of its changes (a zero-order hold); in a :meth:`product` with other
         signals, a scaled or modulated input."""
-        if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
-            raise ParameterError(f"input signal: name {name!r} must be letters, digits and underscores")
-        return cls((K.SIG_INPUT,), name=name)
+        return cls((K.SIG_INPUT,), name=_word("input signal: name", name))
 
     def input_names(self) -> tuple:
         """The network inputs this signal reads (a product's factors' too)."""
@@ -350,6 +350,14 @@ class Signal:
         raise ParameterError(f"{what} = {value!r}: expected a number or a Signal")
 
 
+def _word(what: str, name) -> str:
+    """``name`` if it is letters, digits and underscores (a component's or an input's name), else a
+    ParameterError starting with ``what``."""
+    if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
+        raise ParameterError(f"{what} {name!r} must be letters, digits and underscores")
+    return name
+
+
 def _count(component, value):
     """A number of periods: a whole number (< 0: unlimited, as MSL's ``nperiod = -1``), as a float."""
     try:
@@ -537,10 +545,7 @@ class Driveline:
         jumps beyond a stuck clutch's limit breaks it away at that instant).  Every declared input must drive
         something.
         """
-        from ..units import COLUMN_UNITS
-
-        if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
-            raise ParameterError(f"{self.name}: input name {name!r} must be letters, digits and underscores")
+        name = _word(f"{self.name}: input name", name)
         if name in self._inputs:
             raise ParameterError(f"{self.name}: input {name!r} is declared twice")
         if unit not in COLUMN_UNITS:
@@ -575,8 +580,6 @@ class Driveline:
     def with_inputs(self, values: dict) -> "Driveline":
         """A copy of this network whose inputs named in ``values`` are replaced by signals: a number (held from
         t = 0), a :class:`Signal`, or ``(times, values)`` (a :meth:`Signal.table`); the others stay inputs."""
-        import copy
-
         signals = {}
         for n, v in dict(values).items():
             if n not in self._inputs:
@@ -597,8 +600,7 @@ class Driveline:
 
     # ---- components
     def _new_name(self, name):
-        if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
-            raise ParameterError(f"{self.name}: component name {name!r} must be letters, digits and underscores")
+        _word(f"{self.name}: component name", name)
         if name == GROUND or name in self._inertias or any(e.name == name for e in self._elements):
             raise ParameterError(f"{self.name}: component name {name!r} is used twice")
         return name
