@@ -134,6 +134,49 @@ def test_bouncing_ball_event_times_and_terminal_event(method):
     assert res.stats["final_time"] == pytest.approx(_bounce_times(1.0, 0.5, 4)[-1], abs=1e-9)
 
 
+@settings(max_examples=examples(40), deadline=None)
+@given(y0=st.lists(st.floats(-1e3, 1e3).filter(lambda v: v == 0.0 or abs(v) > 1e-30), min_size=1, max_size=4),
+       scale=st.sampled_from([1e-12, 1e-6, 1.0, 1e6, 1e12]), rtol=st.sampled_from([1e-3, 1e-6, 1e-9]),
+       span=st.sampled_from([1e-9, 1e-3, 1.0, 100.0]), seed=st.integers(0, 2**16))
+def test_the_starting_step_is_hairer_and_wanners_rule_as_scipy_writes_it(y0, scale, rtol, span, seed):
+    """``dopri.initial_step`` + ``dopri.starting_step`` against SciPy's own ``select_initial_step`` (RK45: error
+    order 4) on a linear right-hand side ``f(y) = A y + b``, capped as the core caps it (a tenth of the span,
+    10 ms), with no floor (``h_min = 0``).  Before #30's fix the core used the first guess ``0.01 d0 / d1`` alone, 1e-14 s for a state of
+    4e-12 against a derivative of 4 at rtol 1e-9 (the driveline's stall)."""
+    from scipy.integrate._ivp.common import select_initial_step
+
+    from clutchlab.numerics import dopri
+
+    rng = np.random.default_rng(seed)
+    n = len(y0)
+    y0 = np.array(y0)
+    A = rng.normal(size=(n, n)) * scale
+    b = rng.normal(size=n) * scale
+    atol = np.full(n, rtol * 1e-3)
+
+    def fun(t, y):
+        return A @ y + b
+
+    f0 = fun(0.0, y0)
+    expected = select_initial_step(fun, 0.0, y0, span, min(span / 10.0, 1e-2), f0, 1.0, 4, rtol, atol)
+    h0 = dopri.initial_step(y0, f0, rtol, atol, span, 4)
+    got = dopri.starting_step(h0, y0, f0, fun(h0, y0 + h0 * f0), rtol, atol, span, 4, 0.0)
+    assert got == pytest.approx(expected, rel=1e-12)
+
+
+def test_a_tiny_state_against_a_large_derivative_starts_above_the_time_resolution():
+    """The stall #30's thorough profile found (two driveline inertias, one at 4e-12 rad/s, the other driven by
+    4 N m): a tiny state against a large derivative made the first guess ``0.01 d0 / d1`` fall to the core's
+    floor, here 1e-17 s, and the run stopped at t = 0 (STEP_UNDERFLOW).  Hairer and Wanner's whole rule is not
+    enough here (``100 h0`` = 1e-15 s); its growth limit raised to 100 floors is: the run goes to the closed
+    form ``x1 = 4 t``, ``x0`` unchanged."""
+    sim = Simulation(toys.linear_system([[0.0, 0.0], [0.0, 0.0]], [4e-15, 0.0], b=[[0.0], [4.0]]), rtol=1e-9)
+    sim.advance(1.0, [1.0])
+    assert sim.time == 1.0
+    assert sim.x[1] == pytest.approx(4.0, rel=1e-12)
+    assert sim.x[0] == 4e-15
+
+
 @settings(max_examples=examples(15), deadline=None)
 @given(h0=st.floats(0.05, 5.0), e=st.floats(0.2, 0.9))
 def test_bouncing_ball_any_height_and_restitution(h0, e):
@@ -362,7 +405,9 @@ def test_batch_from_a_generator_grows_its_records(monkeypatch):
                            chunk=1)
     assert drawn.states.shape == listed.states.shape == (11, 31, 2)
     assert np.array_equal(drawn.states, listed.states, equal_nan=True) and drawn.events.equals(listed.events)
-    short = simulate_batch((toys.ball_system(h0, e) for h0, e in cases[:3]), 3.0, output_step=0.1, max_steps=8,
+    # (3 steps: the balls fall and bounce four times in 7 since the core's starting step is Hairer and Wanner's
+    # whole rule, #30)
+    short = simulate_batch((toys.ball_system(h0, e) for h0, e in cases[:3]), 3.0, output_step=0.1, max_steps=3,
                            chunk=1)
     assert all(s == Status.STEP_LIMIT for s in short.status)
     reached = ~np.isnan(short.states[:, :, 0])

@@ -69,7 +69,7 @@ from .borrow import borrow, byref
 from .dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
-    dense_correction, dense_hermite, error_norm, initial_step, next_step,
+    dense_correction, dense_hermite, error_norm, initial_step, next_step, starting_step,
 )
 from .rosenbrock import (A31 as R_A31, A41 as R_A41, A43 as R_A43, C21 as R_C21, C31 as R_C31, C32 as R_C32,
                          C41 as R_C41, C42 as R_C42, C43 as R_C43, GAMMA as R_GAMMA, GAMMA1 as R_GAMMA1,
@@ -686,6 +686,23 @@ def _save_state(sf, si, t, h, i_rec, status, owners):
 
 # ============================================================ Dormand-Prince 5(4)
 @register_jitable
+def _starting_step(p, t, x, u, m, k1, rtol, atol, span, xt, fe, ge):
+    """The starting step of Hairer & Wanner's rule: the guess ``0.01 d0 / d1``, one evaluation of the
+    right-hand side at its Euler step (the events' evaluation, ``rhs_event``; into the scratch ``xt``, ``fe``,
+    ``ge``), then ``min(100 h0, h1)`` from the second derivative (:func:`.dopri.starting_step`), its growth limit
+    never below 100 times the core's floor (``1e-14 max(1, |t|)``, where a step is ``STEP_UNDERFLOW``).  The
+    guess alone fell to that floor when a state is tiny but not zero, and the run stopped (docs/driveline.md,
+    #30)."""
+    h0 = initial_step(x, k1, rtol, atol, span, 4)
+    if h0 <= 0.0:
+        return h0
+    for i in range(x.shape[0]):
+        xt[i] = x[i] + h0 * k1[i]
+    model.rhs_event(t + h0, xt, u, m, p, fe, ge)
+    return starting_step(h0, x, k1, fe, rtol, atol, span, 4, 1e-12 * max(1.0, abs(t)))
+
+
+@register_jitable
 def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
     """Advance a model with Dormand-Prince 5(4) from the solver state to ``t_end`` (resumable).
 
@@ -744,9 +761,11 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if opt.first_step > 0.0:
             h = opt.first_step
         else:
-            h = initial_step(x, k1, rtol, atol, t_end - t, 5)
+            h = _starting_step(p, t, x, u, m, k1, rtol, atol, t_end - t, xt, fe, ge)
+            si[SI_NRHS] += 1
     if h <= 0.0:
-        h = initial_step(x, k1, rtol, atol, t_end - t, 5)
+        h = _starting_step(p, t, x, u, m, k1, rtol, atol, t_end - t, xt, fe, ge)
+        si[SI_NRHS] += 1
     tb = model.next_break(t, m, p)
     prev_rej = False
     n_dips = 0

@@ -97,7 +97,14 @@ def dense_correction(h, k1, k3, k4, k5, k6, k7, out):
 
 @numba.njit(cache=True, nogil=True)
 def initial_step(y0, f0, rtol, atol, t_span, order):
-    """Starting step from the scale of the state and its derivative (Hairer & Wanner II.4)."""
+    """First guess of the starting step, ``h0 = 0.01 d0 / d1`` (the first half of Hairer & Wanner's rule [2],
+    ``dopri5.f``'s ``hinit``; 1e-6 s when the state or its derivative is about zero), at most ``|t_span|``.
+
+    ``d0`` and ``d1`` are the RMS norms of the state and of its derivative scaled by ``atol + rtol |y0|``.  The
+    caller evaluates the right-hand side at ``y0 + h0 f0`` and completes the rule with :func:`starting_step`;
+    the guess alone can lie below the resolution of the time (a state of 4e-12 against a derivative of 4 at
+    rtol 1e-9 gives 1e-14 s: docs/driveline.md "Open", #30).  ``order`` is unused (kept for the callers).
+    """
     d0 = 0.0
     d1 = 0.0
     n = y0.shape[0]
@@ -105,10 +112,42 @@ def initial_step(y0, f0, rtol, atol, t_span, order):
         sc = atol[i] + rtol * abs(y0[i])
         d0 += (y0[i] / sc) ** 2
         d1 += (f0[i] / sc) ** 2
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
+    d0 = math.sqrt(d0 / max(n, 1))
+    d1 = math.sqrt(d1 / max(n, 1))
     if d0 < 1e-5 or d1 < 1e-5:
         h = 1e-6
     else:
         h = 0.01 * d0 / d1
-    return min(h, abs(t_span) / 10.0, 1e-2) if order > 0 else h
+    return min(h, abs(t_span))
+
+
+@numba.njit(cache=True, nogil=True)
+def starting_step(h0, y0, f0, f1, rtol, atol, t_span, order, h_min):
+    """The starting step of Hairer & Wanner's rule [2] (``dopri5.f``'s ``hinit``, SciPy's
+    ``select_initial_step``), from the first guess ``h0`` of :func:`initial_step` and the derivative ``f1``
+    at ``y0 + h0 f0``.
+
+    With ``d1`` the scaled norm of ``f0`` and ``d2 = |f1 - f0| / h0`` that of the second derivative,
+    ``h1 = (0.01 / max(d1, d2)) ** (1 / (order + 1))`` (``order`` that of the error estimate: 4 for
+    Dormand-Prince 5(4)), or ``max(1e-6, 1e-3 h0)`` when both vanish; the step is ``min(100 h0, h1)``, further
+    capped at a tenth of ``t_span`` and at 10 ms (the core's own caps, kept from before).
+
+    The growth limit ``100 h0`` is raised to ``h_min`` (0 gives the rule as published): the guess falls to
+    1e-17 s and below when a state lies a little above the rule's "zero" (``d0`` >= 1e-5, far below its
+    tolerance) while its derivative is large, under the core's resolution of the time; ``h1`` still bounds the
+    step by the second derivative, and the error control rejects a step too long.
+    """
+    d1 = 0.0
+    d2 = 0.0
+    n = y0.shape[0]
+    for i in range(n):
+        sc = atol[i] + rtol * abs(y0[i])
+        d1 += (f0[i] / sc) ** 2
+        d2 += ((f1[i] - f0[i]) / sc) ** 2
+    d1 = math.sqrt(d1 / max(n, 1))
+    d2 = math.sqrt(d2 / max(n, 1)) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1.0))
+    return min(max(100.0 * h0, h_min), h1, abs(t_span) / 10.0, 1e-2)
