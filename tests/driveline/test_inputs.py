@@ -230,3 +230,50 @@ def test_a_held_input_changes_nothing_but_its_value_on_random_networks(d):
     np.testing.assert_array_equal(a.x, b.x)
     ea, eb = a.events(), b.events()
     assert list(zip(ea.time_s, ea.element, ea.event)) == list(zip(eb.time_s, eb.element, eb.event))
+
+
+def test_the_cli_drives_inputs_with_values_quantities_and_csv_traces(tmp_path, description, capsys):
+    """``clutchlab driveline simulate --input``: ``load`` held at 4 N m (a quantity) and ``press`` at 0.5 (a plain
+    number) give the closed form: the clutch slides with 0.3 * 100 N * 0.5 = 15 N m, J1 decelerating at 15 and
+    J2 accelerating at 15 - 4 = 11 rad/s^2, so they meet at t = 10 / 26; then both decelerate at 4 / 2.  The same
+    values as CSV traces (time_s and a column named with its unit suffix) give the same run; bad options are one
+    line each."""
+    import pandas as pd
+
+    from cli_checks import one_line_error
+    from clutchlab.cli import main
+
+    out = tmp_path / "held.csv"
+    assert main(["driveline", "simulate", str(description), "-o", str(out), "--input", "load=4 N m",
+                 "--input", "press=0.5"]) == 0
+    frame = pd.read_csv(out)
+    t_lock = 10.0 / 26.0
+    w = 10.0 - 15.0 * t_lock - 2.0 * (1.0 - t_lock)
+    assert frame["J1.w_rad_s"].iloc[-1] == pytest.approx(w, rel=1e-8)
+    assert frame["J2.w_rad_s"].iloc[-1] == pytest.approx(w, rel=1e-8)
+    assert frame["T.tau_Nm"].iloc[-1] == pytest.approx(-4.0, rel=1e-12)
+    (tmp_path / "press.csv").write_text("# synthetic: a constant clutch command\ntime_s,press_1\n0,0.5\n2,0.5\n")
+    (tmp_path / "load.csv").write_text("time_s,load_Nm\n0,4\n0.5,4\n2,4\n")
+    traced = tmp_path / "traced.csv"
+    assert main(["driveline", "simulate", str(description), "-o", str(traced), "--input",
+                 f"press={tmp_path / 'press.csv'}", "--input", f"load={tmp_path / 'load.csv'}"]) == 0
+    again = pd.read_csv(traced)
+    np.testing.assert_allclose(again["J1.w_rad_s"], frame["J1.w_rad_s"], rtol=1e-8, atol=1e-9)
+    capsys.readouterr()
+    (tmp_path / "speed.csv").write_text("time_s,load_rad_s\n0,4\n1,4\n")
+    (tmp_path / "nounit.csv").write_text("time_s,load\n0,4\n1,4\n")
+    (tmp_path / "back.csv").write_text("time_s,load_Nm\n0,4\n0,4\n")
+    for option, match in (("nope=1", "has no input 'nope' (inputs: load, press)"),
+                          ("load", "expected NAME=VALUE"),
+                          ("load=3 kg", "--input load = '3 kg': wrong unit"),
+                          ("load=nan", "not a finite number"),
+                          (f"load={tmp_path / 'speed.csv'}", "load_rad_s"),
+                          (f"load={tmp_path / 'nounit.csv'}", "does not name its unit"),
+                          (f"load={tmp_path / 'back.csv'}", "strictly increasing"),
+                          (f"load={tmp_path / 'missing.csv'}", "no such file")):
+        line = one_line_error(capsys, ["driveline", "simulate", str(description), "-o", str(tmp_path / "x.csv"),
+                                       "--input", option])
+        assert match in line, line
+    line = one_line_error(capsys, ["driveline", "simulate", str(description), "-o", str(tmp_path / "x.csv"),
+                                   "--input", "load=1", "--input", "load=2"])
+    assert "given twice" in line

@@ -270,3 +270,29 @@ def test_the_files_a_description_names_are_read_beside_it_and_hashed(tmp_path, m
     curve.write_text(curve.read_text() + "\n")  # the same curve, other bytes: the sweep's inputs changed
     err = one_line_error(capsys, ["sweep", "../specs/sweep.toml", "-o", "res", "--no-progress"])
     assert "different sweep" in err and "my_diaphragm.csv" in err
+
+
+def test_an_input_start_is_a_sweep_parameter_held_through_each_run(tmp_path):
+    """``[input.engage] start`` is the parameter ``engage.start`` (in the unit of the fields reading it), held
+    through each variant's run: the clutch of :data:`TWO` pressed by ``engage * fn_max`` locks at the closed
+    form ``w0 / (mu engage fn_max (1/J1 + 1/J2))``.  A torque input's start is in N m.  The FMU keeps them out of
+    its parameters (each is its FMI input's start)."""
+    text = TWO + 'normal = { input = "engage" }\n\n[input.engage]\nstart = 1.0\n' \
+        + '\n[torque.load]\nflange = "J2"\ntorque = { input = "load" }\n\n[input.load]\nstart = "0 kN m"\n'
+    _, scenario = _scenario(tmp_path, text)
+    doc = DrivelineDocument(scenario, scenario["_source"])
+    assert {n: (p.unit, p.value) for n, p in doc.input_starts.items()} == {"engage.start": ("1", 1.0),
+                                                                          "load.start": ("N*m", 0.0)}
+    assert "engage.start" not in doc.parameters   # (the FMU's parameters)
+    described = S.describe(scenario)["parameters"]
+    assert described["engage.start"] == "1" and described["load.start"] == "N*m"
+    variants = _design(**{"engage.start": [0.5, 0.75, 1.0], "clutch.fn_max": [400.0]})
+    out = S.run_batch(variants, scenario, ["clutch.last_stick_s", "J2.w_final_rad_s", "status"])
+    T = 0.5 * 400.0 * variants["engage.start"].to_numpy()
+    np.testing.assert_allclose(out["clutch.last_stick_s"], 100.0 / (T * (1 / 2.0 + 1 / 1.0)), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out["J2.w_final_rad_s"], 2.0 * 100.0 / 3.0, rtol=1e-9)
+    assert (out["status"] == 0).all()
+    loaded = doc.load({"load.start": 5.0}).driveline
+    assert loaded.system().u0.tolist() == [1.0, 5.0]
+    with pytest.raises(ParameterError, match=r"'engage\.strat'.*did you mean 'engage\.start'"):
+        doc.load({"engage.strat": 2.0})

@@ -1,6 +1,6 @@
 """``clutchlab driveline`` sub-commands: a thin layer over :mod:`clutchlab.driveline`.
 
-``clutchlab driveline simulate FILE.toml -o OUT.csv [--output-step STEP] [--fixed-step STEP] [--check-invariants] [--events EVENTS.csv] [--plot fig.png] [--force]``
+``clutchlab driveline simulate FILE.toml -o OUT.csv [--input NAME=VALUE ...] [--output-step STEP] [--fixed-step STEP] [--check-invariants] [--events EVENTS.csv] [--plot fig.png] [--force]``
     run a driveline network and write its states and outputs (and its events);
 ``clutchlab driveline describe FILE.toml``
     print a text schematic of the network.
@@ -32,6 +32,11 @@ def register(subparsers) -> None:
                          epilog="Documentation: docs/driveline.md (file format)")
     sim.add_argument("file", help="driveline description (TOML with units)")
     sim.add_argument("-o", "--output", required=True, help="CSV of the states and outputs to write")
+    sim.add_argument("--input", action="append", default=[], metavar="NAME=VALUE",
+                     help="drive the network input [input.NAME] in this run (repeatable): a value held from t = 0 "
+                          "in the unit of the fields it drives, e.g. 'throttle=0.3' or 'load=20 N m', or a CSV "
+                          "file of time_s and one value column named with its unit suffix (load_Nm), read "
+                          "linearly between samples and held beyond them (default: the input's start)")
     sim.add_argument("--t-end", help="end time, e.g. '1.5 s' (default: [simulation] t_end)")
     sim.add_argument("--output-step", help="sample interval, e.g. '1 ms' (default: [simulation] output_step, "
                                            "else every accepted step)")
@@ -70,8 +75,9 @@ def _simulate(args) -> int:
         raise ParameterError(f"--output-step = {args.output_step!r}: must be > 0")
     if not t_end > 0:
         raise ParameterError(f"end time = {t_end!r} s: must be > 0")
+    inputs = _inputs(args.input, spec.driveline, args.file)
     res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step,
-                                  fixed_step=fixed_step, check_invariants=args.check_invariants)
+                                  fixed_step=fixed_step, check_invariants=args.check_invariants, inputs=inputs)
     frame = res.to_dataframe()
     events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
     # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
@@ -95,6 +101,75 @@ def _simulate(args) -> int:
           f"energy balance within {err:.2g} J of {float(frame['input_work_J'].abs().max()):.4g} J input work "
           f"and {float(frame['dissipated_energy_J'].abs().max()):.4g} J dissipated")
     return 0
+
+
+def _inputs(items, driveline, file) -> dict:
+    """``--input NAME=VALUE`` options as :meth:`~clutchlab.driveline.Driveline.simulate`'s ``inputs``: a number
+    (SI) or a quantity in the input's unit, held; or ``(times, values)`` from a CSV trace."""
+    from pathlib import Path
+
+    from ..units import COLUMN_UNITS, to_si
+
+    units = {v.name: v.unit for v in driveline.system().inputs}
+    out = {}
+    for item in items:
+        name, sep, value = (x.strip() for x in str(item).partition("="))
+        if not sep or not name or not value:
+            raise ParameterError(f"--input {item!r}: expected NAME=VALUE (e.g. throttle=0.3, load='20 N m' or "
+                                 "load=trace.csv)")
+        if name not in units:
+            raise ParameterError(f"--input {name}: {file} has no input {name!r} (inputs: "
+                                 f"{', '.join(units) or 'none; declare one with [input.NAME]'})")
+        if name in out:
+            raise ParameterError(f"--input {name}: given twice")
+        unit = COLUMN_UNITS[units[name]][0]
+        if value.lower().endswith(".csv") or Path(value).is_file():
+            out[name] = _trace(Path(value), unit, f"--input {name}")
+            continue
+        try:
+            out[name] = float(value)        # a plain number: SI, as in the description file
+        except ValueError:
+            out[name] = to_si(value, unit, name=f"--input {name}")
+        if out[name] != out[name] or abs(out[name]) == float("inf"):
+            raise ParameterError(f"--input {name} = {value!r}: not a finite number")
+    return out
+
+
+def _trace(path, unit: str, what: str):
+    """``(times [s], values [unit])`` of a CSV trace: ``time_s`` and one value column whose name ends in its unit
+    suffix (``load_Nm``, ``clutch_1``); lines starting with ``#`` are comments."""
+    import numpy as np
+    import pandas as pd
+
+    from ..io.channels import unit_conversion
+    from ..units import column_unit
+
+    if not path.is_file():
+        raise ParameterError(f"{what} = {str(path)!r}: no such file")
+    try:
+        frame = pd.read_csv(path, comment="#")
+    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
+        raise ParameterError(f"{what}: {path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
+    others = [c for c in frame.columns if c != "time_s"]
+    if "time_s" not in frame.columns or len(others) != 1:
+        raise ParameterError(f"{what}: {path}: expected the columns time_s and one value column (found "
+                             f"{', '.join(map(str, frame.columns)) or 'none'})")
+    column = str(others[0])
+    source = column_unit(column)
+    if source is None:
+        raise ParameterError(f"{what}: {path}: column {column!r} does not name its unit: end it with the unit's "
+                             f"suffix (e.g. {column}_Nm, {column}_1)")
+    scale, offset = unit_conversion(source, unit, name=column, where=f"{what}: {path}", error=ParameterError)
+    times = pd.to_numeric(frame["time_s"], errors="coerce").to_numpy(dtype=float)
+    values = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=float)
+    bad = ~(np.isfinite(times) & np.isfinite(values))
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        raise ParameterError(f"{what}: {path}: row {row + 1}: time_s = {frame['time_s'].iloc[row]!r}, {column} = "
+                             f"{frame[column].iloc[row]!r}: not a finite number")
+    if times.size == 0 or np.any(np.diff(times) <= 0):
+        raise ParameterError(f"{what}: {path}: time_s must hold strictly increasing times (at least one)")
+    return times, scale * values + offset
 
 
 def _describe(args) -> int:

@@ -365,6 +365,27 @@ def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
     getattr(d, _ADD[kind])(name, **args)
 
 
+def input_units(doc: dict, source: str) -> dict:
+    """The pint unit of each network input of a parsed description: that of the first field reading it
+    (``{ input = "NAME" }``), ``{name: unit}``.  A field the loader would refuse is left out (the loader names
+    it: :func:`parse_driveline`)."""
+    head = doc.get("driveline", {})
+    translational = isinstance(head, dict) and head.get("domain") == "translational"
+    table_fields = TRANSLATIONAL_FIELDS if translational else FIELDS
+    uses: dict = {}
+    for kind, field in _SIGNALS.items():
+        table = doc.get(kind, {})
+        if kind not in table_fields or field not in table_fields[kind] or not isinstance(table, dict):
+            continue
+        for name, comp in table.items():
+            if isinstance(comp, dict) and field in comp:
+                try:
+                    _signal(comp[field], table_fields[kind][field][0], f"{kind}.{name}.{field}", source, uses)
+                except ParameterError:
+                    pass
+    return {n: u[0][0] for n, u in uses.items()}
+
+
 def _declare_inputs(d: Driveline, declared: dict, uses: dict, src: str) -> None:
     """The ``[input.NAME]`` tables: each input takes the unit of the fields that read it (``{ input = "NAME" }``),
     its ``start`` a quantity in that unit (default 0); an input read nowhere, or read by fields of two units, or

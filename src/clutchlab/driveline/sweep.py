@@ -20,7 +20,8 @@ part of the sweep's hash (:func:`referenced_files`).
 
 The parameters are the numeric fields of the file's components, ``<component>.<field>``
 (:class:`~clutchlab.driveline.variants.DrivelineDocument`): ``J1.J``, ``J1.w0``, ``clutch1.fn_max``,
-``clutch1.mu``, ``clutch1.peak``, a spring's ``c``, ...  Written against the system contract: every
+``clutch1.mu``, ``clutch1.peak``, a spring's ``c``, ..., and the start value of each network input,
+``<input>.start`` (held through the run: ``[input.throttle] start``).  Written against the system contract: every
 variant is the :class:`~clutchlab.system.System` of its :class:`~clutchlab.driveline.Driveline`, and all
 variants of a chunk run in one :func:`clutchlab.system.simulate_batch` (one Dormand-Prince 5(4) solver
 of the integrator core per variant, ``numba.prange``), with the file's ``rtol`` and ``max_step``, sampled
@@ -100,7 +101,7 @@ def describe(scenario) -> dict:
         The parsed driveline description (``_source`` = its path).
     """
     doc, base = _base(scenario)
-    return {"parameters": {p.name: p.unit for p in doc.parameters.values()},
+    return {"parameters": {p.name: p.unit for p in (*doc.parameters.values(), *doc.input_starts.values())},
             "outputs": outputs_of(base.driveline)}
 
 

@@ -8,7 +8,9 @@ The FMU of a driveline (:mod:`clutchlab.driveline.cosim`) and the sweep target `
 (:data:`clutchlab.driveline.description.FIELDS`).  Every scalar field is one: a number or a quantity
 string given in the file, or a field the file leaves out whose default is a number (``w0 = 0``,
 ``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) and signals (a sine torque, a step
-of the normal force) are not parameters.
+of the normal force) are not parameters.  The start value of a network input (``[input.throttle] start``)
+is the parameter ``throttle.start`` of :attr:`DrivelineDocument.input_starts`, in the unit of the fields
+that read the input: a sweep holds it through each run; an FMU has it as its FMI input's start instead.
 
 ::
 
@@ -36,7 +38,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import FIELDS, NOT_QUANTITIES, TRANSLATIONAL_FIELDS, DrivelineFile, parse_driveline
+from .description import FIELDS, NOT_QUANTITIES, TRANSLATIONAL_FIELDS, DrivelineFile, input_units, parse_driveline
 from .network import Driveline
 
 __all__ = ["Parameter", "DrivelineDocument", "ReferencedFile"]
@@ -200,6 +202,18 @@ class DrivelineDocument:
                     si = to_si(value, unit, name=f"{kind}.{name}", source=self.source)
                     params[name] = Parameter(name, unit, si, f"{field} of {kind.replace('_', ' ')} {component}")
         self.parameters = params
+        # the start values of the network inputs, ``<input>.start`` in the unit of the fields reading the input:
+        # held through a run by a sweep (an FMU's inputs have their own start values, so they are apart)
+        starts = {}
+        declared = self.document.get("input", {})
+        units = input_units(self.document, self.source) if isinstance(declared, dict) else {}
+        for name, spec in (declared.items() if isinstance(declared, dict) else ()):
+            if not isinstance(spec, dict) or name not in units or not _is_scalar(spec.get("start", 0.0)):
+                continue   # the loader names the error
+            pname = f"{name}.start"
+            si = to_si(spec.get("start", 0.0), units[name], name=f"input.{name}.start", source=self.source)
+            starts[pname] = Parameter(pname, units[name], si, f"start value of input {name}, held through the run")
+        self.input_starts = starts
 
     @classmethod
     def read(cls, path) -> "DrivelineDocument":
@@ -266,15 +280,16 @@ class DrivelineDocument:
         Parameters
         ----------
         names : iterable of str
-            Parameter names (``"clutch1.fn_max"``).
+            Parameter names (``"clutch1.fn_max"``, or an input's ``"throttle.start"``).
         """
         for name in names:
-            if name not in self.parameters:
-                close = difflib.get_close_matches(str(name), list(self.parameters), n=1)
+            if name not in self.parameters and name not in self.input_starts:
+                close = difflib.get_close_matches(str(name), [*self.parameters, *self.input_starts], n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
                 raise ParameterError(
                     f"{self.source}: {name!r} is not a numeric parameter of this driveline (parameters are "
-                    f"<component>.<field> with a number, e.g. {', '.join(list(self.parameters)[:4])}){hint}")
+                    f"<component>.<field> with a number, e.g. {', '.join(list(self.parameters)[:4])}, or "
+                    f"<input>.start){hint}")
 
     def load(self, changes: dict | None = None) -> DrivelineFile:
         """The driveline of this file with some parameters changed, read by ``load_driveline``.
@@ -282,7 +297,8 @@ class DrivelineDocument:
         Parameters
         ----------
         changes : dict, optional
-            ``{parameter name: value in its SI unit}``.
+            ``{parameter name: value in its SI unit}``: component fields (:attr:`parameters`) and input starts
+            (:attr:`input_starts`).
 
         Returns
         -------
@@ -299,6 +315,9 @@ class DrivelineDocument:
         doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in self.document.items()}
         for name, value in changes.items():
             component, field = name.rsplit(".", 1)
+            if name in self.input_starts:
+                doc["input"] = {**doc["input"], component: {**doc["input"][component], field: float(value)}}
+                continue
             kind = next(k for k, table in doc.items() if k in self._fields and isinstance(table, dict)
                         and component in table)
             doc[kind] = {**doc[kind], component: {**doc[kind][component], field: float(value)}}
