@@ -37,6 +37,27 @@ def test_to_si(value, unit, expected):
 
 
 @pytest.mark.parametrize(
+    "value, unit, expected",
+    [("1 Hz", "rad/s", 2 * math.pi), ("1 rps", "rad/s", 2 * math.pi), ("10 Hz", "rad/s", 20 * math.pi),
+     ("1 kHz", "rad/s", 2000 * math.pi), ("60 rpm", "Hz", 1.0), ("100 rpm", "Hz", 100 / 60),
+     (f"{2 * math.pi} rad/s", "Hz", 1.0), ("360 deg/s", "Hz", 1.0), ("2 Hz/s", "rad/s**2", 4 * math.pi),
+     ("5 Hz", "Hz", 5.0), ("3 1/s", "rad/s", 3.0), ("3 1/s", "Hz", 3.0), ("1 N*m/deg", "N*m/rad", 180 / math.pi)],
+)
+def test_a_frequency_counts_cycles_where_an_angle_is_meant(value, unit, expected):
+    """pint takes the radian as 1 and alone read ``1 Hz`` as 1 rad/s and ``60 rpm`` as 6.28 Hz (#33: a silent
+    wrong answer).  A frequency in hertz counts cycles of 2 pi rad; ``1/s`` stays the SI radian per second."""
+    assert units.to_si(value, unit) == pytest.approx(expected, rel=1e-14)
+
+
+def test_logged_channels_in_hz_are_cycles_too():
+    from clutchlab.io.channels import unit_conversion
+
+    assert unit_conversion("Hz", "rad/s") == pytest.approx((2 * math.pi, 0.0), rel=1e-14)
+    assert unit_conversion("U/min", "Hz") == pytest.approx((1 / 60, 0.0), rel=1e-14)
+    assert unit_conversion("rad/s", "rad/s") == (1.0, 0.0)
+
+
+@pytest.mark.parametrize(
     "value, match",
     [("3 kg", "wrong unit"), ("abc mm", "cannot parse"), ("nan m", "not a finite"), ("3 blorps", "cannot parse"),
      (True, "expected a number"), ([1], "expected a number")],

@@ -109,9 +109,10 @@ def progress(message: str) -> None:
 
 def _demo(args) -> int:
     from .io.files import check_writable
-    from .report import write_report
+    from .report import check_report_folder, write_report
 
     check_writable(args.output, args.force, what="folder")  # before minutes of simulation
+    check_report_folder(args.output, args.force)             # (only a folder clutchlab wrote is replaced)
 
     sections = []
     t0 = time.perf_counter()

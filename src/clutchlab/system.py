@@ -39,7 +39,7 @@ from .numerics import status as st
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
-           "checked_grid", "check_fixed_step",
+           "checked_grid", "check_fixed_step", "check_fixed_step_span",
            "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
@@ -411,6 +411,40 @@ def check_fixed_step(fixed_step) -> float:
     return float(fixed_step)
 
 
+#: most steps of the fixed-step mode in one :meth:`Simulation.advance` (a co-simulation's communication step):
+#: ``solver.fixed_step = 1e-12`` made one 1 ms step of an FMU take minutes (#33)
+FIXED_STEP_BUDGET = 1e6
+
+
+def check_fixed_step_span(fixed: float, t0: float, t_end: float, output_step=None) -> None:
+    """A fixed step [s] no longer than the run and than its output step: a longer one is one step over the whole
+    run (an E-clutch peak force of 0 N, a driveline's energy balance off by 1,300 times its input work, #33).
+
+    Parameters
+    ----------
+    fixed : float
+        The fixed step [s] (0: step-size control, nothing to check).
+    t0, t_end : float
+        Start and end of the run [s].
+    output_step : float, optional
+        Sample interval of the run [s].
+
+    Raises
+    ------
+    ParameterError
+        Naming the step and the span it exceeds.
+    """
+    if not fixed > 0.0:
+        return
+    span = float(t_end) - float(t0)
+    if fixed > span * (1.0 + 1e-12):
+        raise ParameterError(f"fixed_step = {fixed:g} s is longer than the run ({span:g} s): choose a step of a "
+                             "fraction of the fastest dynamics, e.g. 1 ms")
+    if output_step is not None and fixed > float(output_step) * (1.0 + 1e-12):
+        raise ParameterError(f"fixed_step = {fixed:g} s is longer than the output step ({float(output_step):g} s): "
+                             "the samples between two steps would hold one state; choose a step <= the output step")
+
+
 def _index(vars_, name, kind, model):
     for i, v in enumerate(vars_):
         if name in (v.name, v.column):
@@ -566,6 +600,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
         raise ParameterError(f"t_end = {short_repr(t_end)}: must be finite and > t0 = {t0:g} s")
     opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, first_step=first_step,
                          event_tol=event_tol, fixed_step=fixed_step)
+    check_fixed_step_span(opt.fixed_step, t0, t_end, output_step)
     ts = sample_grid(t0, float(t_end), output_step, sample_times)
     nx, ny, nm = len(system.states), len(system.outputs), len(system.mode_names)
     x = system.x0.copy()
@@ -723,6 +758,8 @@ class Simulation:
         self._pack_after = 2
         self._dispatched = 0
         self._fast = None  # (callable, handle): the packed call, or (self._general, None); None: not decided
+        #: the longest advance of the fixed-step mode (FIXED_STEP_BUDGET steps), None for step-size control
+        self._fixed_span = FIXED_STEP_BUDGET * self.fixed_step if self.fixed_step > 0.0 else None
 
     # ---- the compiled calls
     def _call(self, t: float, what: int) -> int:
@@ -797,6 +834,8 @@ class Simulation:
         """Integrate to ``t_end`` [s] holding the inputs ``u``; returns the status code (raises on failure)."""
         if u is not None:
             self.set_inputs(u)
+        if self._fixed_span is not None and t_end - self._sf[0] > self._fixed_span:
+            self._refuse_span(t_end)
         code = self._call(float(t_end), _ADVANCE)
         if code:  # (SUCCESS is 0)
             _check_status(self.system, code, self._si, self.time, True)
@@ -814,10 +853,18 @@ class Simulation:
         SimulationError
             As :meth:`advance`.
         """
+        if self._fixed_span is not None and t_end - self._sf[0] > self._fixed_span:
+            self._refuse_span(t_end)
         code = self._call(float(t_end), _ADVANCE | _OUTPUTS)
         if code:
             _check_status(self.system, code, self._si, self.time, True)
         return self._r
+
+    def _refuse_span(self, t_end):
+        span = float(t_end) - self.time
+        raise SimulationError(f"{self.system.name}: fixed_step = {self.fixed_step:g} s: an advance of {span:g} s "
+                              f"would take {span / self.fixed_step:.3g} steps (more than {FIXED_STEP_BUDGET:.0e} "
+                              "in one call); choose a longer fixed step or advance in shorter intervals")
 
     def reported(self) -> np.ndarray:
         """The reported values (:meth:`report`) at the current point, without advancing; the array of :meth:`step`."""
@@ -1249,7 +1296,9 @@ def _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, 
     ts = sample_grid(0.0, float(t_end), output_step, sample_times)
     if ts is None:
         ts = np.array([float(t_end)])
-    return ts, first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
+    opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
+    check_fixed_step_span(opt.fixed_step, 0.0, t_end, output_step)
+    return ts, opt
 
 
 def _records(first, nv, ns, outputs, event_capacity, what):

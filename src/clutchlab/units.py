@@ -208,6 +208,53 @@ def _registry():
     return pint.UnitRegistry()
 
 
+def _radians(q) -> int:
+    """The power of the angle in the pint quantity ``q`` (rad/s: 1, rpm: 1, N*m/rad: -1, Hz: 0)."""
+    return int(dict(q.to_root_units().unit_items()).get("radian", 0))
+
+
+def _hertz(q) -> int:
+    """The power of hertz (any prefix) in the units ``q`` is written in."""
+    return int(sum(e for n, e in q.unit_items() if n.endswith("hertz")))
+
+
+def convert(q, target: str) -> float:
+    """The magnitude of the pint quantity ``q`` in the unit ``target``, a frequency counting cycles.
+
+    pint takes the radian as 1, so alone it reads ``1 Hz`` as 1 rad/s and ``60 rpm`` as 6.28 Hz.  Here a
+    frequency in hertz counts cycles of 2 pi rad wherever one side of the conversion has an angle and the
+    other has hertz in its place: ``1 Hz`` is 2 pi rad/s (a speed in Hz is revolutions per second, as
+    ``1 rps``), ``60 rpm`` and ``2 pi rad/s`` are 1 Hz (a frequency from an angular speed); ``1/s`` stays
+    1 rad/s (the SI radian), and every conversion with the same angle on both sides is pint's.
+
+    Raises
+    ------
+    pint.errors.DimensionalityError
+        The units do not convert.
+    """
+    ureg = _registry()
+    cycles_in, cycles_out = _cycles(str(q.units), target)
+    if cycles_in:      # cycles per second where an angle per second is meant
+        return float((q * ureg.turn ** cycles_in).to(target).magnitude)
+    if cycles_out:     # an angle per second where cycles per second are meant
+        return float(q.to(ureg.Unit(target) * ureg.turn ** cycles_out).magnitude)
+    return float(q.to(target).magnitude)
+
+
+@lru_cache(maxsize=512)
+def _cycles(source: str, target: str) -> tuple[int, int]:
+    """How :func:`convert` reads hertz between the units ``source`` and ``target`` (pint spellings): the power
+    of the turn to multiply the quantity by, or to add to the target; (0, 0) for pint's own conversion."""
+    ureg = _registry()
+    s, t = ureg.Quantity(1.0, source), ureg.Quantity(1.0, target)
+    k = _radians(t) - _radians(s)
+    if k and _hertz(s) == k:
+        return k, 0
+    if k and _hertz(t) == -k:
+        return 0, -k
+    return 0, 0
+
+
 def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -> float:
     """Convert a parameter value to the SI unit ``unit``.
 
@@ -254,7 +301,7 @@ def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -
         except Exception as exc:  # pint raises assorted tokenizer errors
             raise ParameterError(f"{where}{name} = {short_repr(value)}: cannot parse quantity ({exc})") from None
         try:
-            out = float(q.to(unit).magnitude)
+            out = convert(q, unit)
         except pint.errors.DimensionalityError:
             raise ParameterError(
                 f"{where}{name} = {short_repr(value)}: wrong unit, expected a quantity convertible to {unit!r}"

@@ -102,3 +102,57 @@ def test_emtc_coil_at_a_current_from_the_command_line(tmp_path, capsys):
     assert "--coil-drive is the EMTC's" in line
     line = one_line_error(capsys, ["control", "linearize", *common, "--branch", "i2", "-o", str(bad)])
     assert "--branch 'i2'" in line and not bad.exists()
+
+
+SPRING_DAMPER = """
+[driveline]
+name = "sd"
+[input.load]
+start = "1 N m"
+[inertia.J1]
+J = "0.5 kg m^2"
+[spring_damper.k]
+a = "J1"
+b = "ground"
+c = "100 N m/rad"
+d = "2 N m s/rad"
+[torque.T]
+flange = "J1"
+torque = { input = "load" }
+"""
+
+
+def test_linearize_and_bode_of_a_driveline_name_its_signals_for_python_control(tmp_path, capsys):
+    """Every ``control linearize``/``bode`` of a driveline failed with a traceback: python-control refuses the ``.``
+    of ``k.tau_Nm`` in a signal name (#33).  The signals are the columns with ``_`` for ``.``, mapped back in
+    ``columns``; the model is the closed form of J phi'' = -c phi - d phi' + T: A = [[0, 1], [-c/J, -d/J]],
+    B = [0, 1/J], and the spring-damper's torque per load torque is (c + i d w) / (c - J w^2 + i d w)."""
+    import control
+
+    from clutchlab.control import linearize
+    from clutchlab.control.linear import signal_name
+    from clutchlab.driveline.description import load_driveline
+
+    path = tmp_path / "sd.toml"
+    path.write_text(SPRING_DAMPER)
+    out = tmp_path / "lin.json"
+    assert main(["control", "linearize", "driveline", str(path), "-y", "k.tau_Nm", "-o", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["states"][:2] == ["J1_phi_rad", "J1_w_rad_s"] and doc["inputs"] == ["load_Nm"]
+    assert doc["outputs"] == ["k_tau_Nm"] and doc["columns"]["k_tau_Nm"] == "k.tau_Nm"
+    np.testing.assert_allclose(np.asarray(doc["A"])[:2, :2], [[0.0, 1.0], [-200.0, -4.0]], rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(np.asarray(doc["B"])[:2, 0], [0.0, 2.0], rtol=1e-7, atol=1e-9)
+    table = tmp_path / "bode.csv"
+    assert main(["control", "bode", "driveline", str(path), "-y", "k.tau_Nm", "-o", str(tmp_path / "bode.png"),
+                 "--table", str(table), "--fmin", "0.1 Hz", "--fmax", "10 Hz"]) == 0
+    frame = pd.read_csv(table)
+    w = 2 * np.pi * frame["frequency_Hz"].to_numpy()
+    expected = np.abs((100.0 + 2j * w) / (100.0 - 0.5 * w**2 + 2j * w))
+    np.testing.assert_allclose(frame["gain_k_tau_Nm__load_Nm"], expected, rtol=1e-6)
+    # python-control's own tools take the model: a unity feedback of the spring torque
+    sys = linearize(load_driveline(path).driveline.system(), outputs=["k.tau_Nm"])
+    assert signal_name("k.tau_Nm") in sys.output_labels
+    again = linearize(load_driveline(path).driveline.system(), outputs=["k_tau_Nm"])   # either spelling
+    assert list(again.output_labels) == ["k_tau_Nm"] and np.array_equal(again.C, sys.C)
+    loop = control.feedback(sys, 1)
+    assert np.all(np.real(control.poles(loop)) < 0)

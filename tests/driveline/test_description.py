@@ -294,3 +294,31 @@ points = 71
         bad.write_text(path.read_text().replace("model = 2\n", body))
         with pytest.raises(ParameterError, match=fragment):
             load_driveline(bad)
+
+
+def test_speeds_and_frequencies_in_hz_or_rpm_are_revolutions():
+    """``w0 = "1 Hz"`` is one revolution per second (2 pi rad/s, as ``"1 rps"``; pint alone gives 1 rad/s) and a
+    sine at ``frequency = "60 rpm"`` runs at 1 Hz (pint alone: 6.28 Hz).  Closed forms: a free inertia keeps
+    2 pi rad/s; one driven by ``sin(2 pi f t)`` N m from rest turns at ``(1 - cos(2 pi f t)) / (2 pi f J)``."""
+    import tomllib
+
+    from clutchlab.driveline.description import parse_driveline
+
+    doc = tomllib.loads("""
+[driveline]
+name = "hz"
+[inertia.free]
+J = "1 kg m^2"
+w0 = "1 Hz"
+[inertia.driven]
+J = "2 kg m^2"
+[torque.sine]
+flange = "driven"
+torque = { sine = { amplitude = "1 N m", frequency = "60 rpm" } }
+""")
+    res = parse_driveline(doc, "hz.toml").driveline.simulate(0.5, output_step=0.25)
+    frame = res.to_dataframe()
+    np.testing.assert_allclose(frame["free.w_rad_s"], 2 * math.pi, rtol=1e-12)
+    t = frame["time_s"].to_numpy()
+    np.testing.assert_allclose(frame["driven.w_rad_s"], (1 - np.cos(2 * math.pi * t)) / (2 * math.pi * 2.0),
+                               rtol=1e-5, atol=1e-9)

@@ -103,6 +103,17 @@ def test_wet_clutch_between_two_inertias_locks_and_conserves_energy():
     stored = cp * (df["clutch.temperature_C"].iloc[-1] - df["clutch.temperature_C"].iloc[0])
     heat = stored + df["clutch.heat_to_fluid_J"].iloc[-1] + df["clutch.heat_to_housing_J"].iloc[-1]
     assert abs(heat - diss) < 1e-6 * diss
+    # the clutch's own outputs, not its bench's (#33: heater_power, load_cell_force were reported), each in its
+    # place: the friction power is the network's |tau w_rel| while it slips, the clutch torque its tau
+    from clutchlab.driveline.wet import BENCH_ONLY, OUTPUTS
+
+    assert not [c for c in df.columns if any(c.startswith(f"clutch.{q}_") for q in BENCH_ONLY)]
+    assert all(any(c.startswith(f"clutch.{q}_") for c in df.columns) for q, _, _ in OUTPUTS)
+    slipping = (df["time_s"] > 0.01) & (df["time_s"] < stick[0] - 1e-3)
+    np.testing.assert_allclose(df["clutch.friction_power_W"][slipping],
+                               (df["clutch.tau_Nm"] * df["clutch.w_rel_rad_s"]).abs()[slipping], rtol=1e-6)
+    np.testing.assert_allclose(df["clutch.clutch_torque_Nm"][slipping].abs(), df["clutch.tau_Nm"][slipping].abs(),
+                               rtol=1e-9)
 
 
 def test_wet_clutch_slides_backward_and_stays_open_without_force():

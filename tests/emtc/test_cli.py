@@ -138,3 +138,18 @@ def test_simulate_refuses_a_bad_fixed_step(tmp_path, capsys, value, message):
     code, _, err = run(capsys, "emtc", "simulate", sc, "-o", out, "--fixed-step", value)
     assert code == 2 and err.startswith("clutchlab: error: --fixed-step = ") and message in err
     assert err.count("\n") == 1 and "Traceback" not in err and not out.exists()
+
+
+@pytest.mark.parametrize("tables, message", [
+    ("[vehicle]\ngear_ratios = []\n", "VehicleParameters: gear_ratios = []: needs one ratio > 0 per gear"),
+    ("[vehicle]\ngear_ratios = [3.0, -1.0]\n", "gear_ratios[1] = -1.0: must be > 0"),
+    ("[vehicle]\ngear_ratios = [3.0, 2.0]\n[scenario]\ngear = 4\n",
+     "[scenario] gear = 4: the vehicle has gears 1 to 2 ([vehicle] gear_ratios)")])
+def test_gears_the_vehicle_lacks_are_one_line_errors(tmp_path, capsys, tables, message):
+    """``[vehicle] gear_ratios = []`` passed ``params check`` and gave an IndexError in every run (#33)."""
+    from cli_checks import one_line_error
+
+    path = tmp_path / "veh.toml"
+    path.write_text(tables)
+    line = one_line_error(capsys, ["emtc", "simulate", str(path), "-o", str(tmp_path / "out.csv")])
+    assert f"{path}: " in line and message in line

@@ -196,3 +196,68 @@ def test_batch_runs_fixed_step_like_simulate():
         one = simulate(system, 0.2, output_step=0.01, fixed_step=1e-3)
         np.testing.assert_array_equal(batch.states[v], one.states)
     assert np.all(batch.stats["accepted_steps"] == 200)
+
+
+def test_a_fixed_step_longer_than_the_run_or_the_output_step_is_refused():
+    """``--fixed-step "1000 s"`` was one step over the whole run, a silent wrong answer (an E-clutch peak force of
+    0 N; #33): a fixed step longer than the run, or than the output step, is refused by name; equal is a run."""
+    from clutchlab.system import simulate_batch
+
+    system = toys.linear_system(A_OSC, X0)
+    with pytest.raises(ParameterError, match=r"fixed_step = 2 s is longer than the run \(1 s\)"):
+        simulate(system, 1.0, fixed_step=2.0)
+    with pytest.raises(ParameterError, match=r"fixed_step = 0.02 s is longer than the output step \(0.01 s\)"):
+        simulate(system, 1.0, fixed_step=0.02, output_step=0.01)
+    with pytest.raises(ParameterError, match=r"longer than the run"):
+        simulate_batch([system, system], 0.5, fixed_step=1.0)
+    res = simulate(system, 1.0, fixed_step=0.01, output_step=0.01)
+    assert res.stats["accepted_steps"] == 100
+    assert simulate(system, 1.0, fixed_step=1.0).stats["accepted_steps"] == 1
+
+
+@pytest.mark.parametrize("command", [["driveline", "simulate", "driveline_coupled_clutches.toml"],
+                                     ["eclutch", "simulate", "eclutch_launch.toml"],
+                                     ["wet", "simulate", "wet_engagement.toml"],
+                                     ["emtc", "simulate", "emtc_scenario.toml"]], ids=lambda c: c[0])
+def test_every_simulate_command_refuses_a_fixed_step_longer_than_its_run(tmp_path, capsys, command):
+    from pathlib import Path
+
+    from clutchlab.cli import main
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    out = tmp_path / "out.csv"
+    code = main([*command[:2], str(examples / command[2]), "-o", str(out), "--fixed-step", "1000 s"])
+    err = capsys.readouterr().err.strip().splitlines()   # (the E-clutch says what it builds first)
+    assert code == 2 and "Traceback" not in "\n".join(err)
+    assert err[-1].startswith("clutchlab: error: fixed_step = 1000 s is longer than the run"), err
+    assert not out.exists()
+
+
+def test_an_advance_of_more_than_a_million_fixed_steps_is_refused_at_once():
+    """``solver.fixed_step = 1e-12`` made one 1 ms FMU step take minutes (#33): an advance that needs more than
+    ``FIXED_STEP_BUDGET`` fixed steps is refused before it starts, through ``advance`` and ``step`` (the
+    co-simulations' path), and the session stays usable."""
+    import time
+
+    from clutchlab.errors import SimulationError
+    from clutchlab.system import FIXED_STEP_BUDGET
+
+    sim = Simulation(toys.linear_system(A_OSC, X0), fixed_step=1e-12)
+    t0 = time.perf_counter()
+    with pytest.raises(SimulationError, match=r"fixed_step = 1e-12 s: an advance of 0.001 s would take 1e\+09 steps"):
+        sim.advance(1e-3)
+    with pytest.raises(SimulationError, match="more than 1e\\+06 in one call"):
+        sim.step(1e-3)
+    assert time.perf_counter() - t0 < 5.0 and sim.time == 0.0
+    sim.advance(FIXED_STEP_BUDGET * 1e-12)      # the budget itself runs
+    assert sim.time == pytest.approx(1e-6) and sim.stats["accepted_steps"] == FIXED_STEP_BUDGET
+
+
+def test_an_fmu_co_simulation_with_a_tiny_fixed_step_fails_its_step_not_its_host():
+    from clutchlab.errors import SimulationError
+    from clutchlab.eclutch.cosim import EClutchCoSimulation
+
+    c = EClutchCoSimulation(**{"solver.fixed_step": 1e-12})
+    c.initial_outputs({v.name: v.start for v in c.inputs})
+    with pytest.raises(SimulationError, match="would take 1e\\+09 steps"):
+        c.do_step(0.0, 1e-3, {v.name: v.start for v in c.inputs})

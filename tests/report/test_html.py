@@ -60,3 +60,42 @@ def test_progress_per_figure(tmp_path):
     # two figures (and tables) of the same name: both kept beside the page
     assert sorted(p.name for p in (tmp_path / "rep" / "figures").iterdir()) == ["line.png", "line_2.png"]
     assert sorted(p.name for p in (tmp_path / "rep" / "tables").iterdir()) == ["t.csv", "t_2.csv"]
+
+
+def test_force_replaces_only_a_folder_clutchlab_wrote(tmp_path, monkeypatch, capsys):
+    """``--force`` replaced any folder (#33): ``report RUN -o mydata --force`` deleted the user's files, and
+    ``-o .`` ended in a traceback.  Now only a report folder (its marker, or only a report's entries) is
+    replaced; a folder with anything else, a file, the working folder and its parents are refused by name, the
+    files untouched."""
+    from clutchlab.cli import main
+    from clutchlab.errors import ParameterError
+    from clutchlab.report.html import MARKER
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    with pytest.raises(ParameterError, match=r"holds 'notes\.txt', which clutchlab did not write"):
+        write_report([section()], mine, overwrite=True)
+    assert (mine / "notes.txt").read_text() == "keep me" and len(list(mine.iterdir())) == 1
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(ParameterError, match="a file, not a report folder"):
+        write_report([section()], tmp_path / "afile", overwrite=True)
+    old = tmp_path / "old_report"            # a report written before the marker: only its own entries
+    (old / "figures").mkdir(parents=True)
+    (old / "index.html").write_text("old")
+    write_report([section()], old, overwrite=True)
+    assert (old / MARKER).exists() and "old" != (old / "index.html").read_text()
+    monkeypatch.chdir(mine)
+    with pytest.raises(ParameterError, match="the folder this command runs in"):
+        write_report([section()], ".", overwrite=True)
+    with pytest.raises(ParameterError, match="or holds it"):
+        write_report([section()], tmp_path, overwrite=True)
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "r.csv").write_text("time_s,x_1\n0,1\n1,2\n")
+    for argv in (["report", str(run), "-o", ".", "--force"], ["report", str(run), "-o", str(mine), "--force"],
+                 ["demo", "-o", str(mine), "--force"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("clutchlab: error: ") and "not replaced" in err[0], err
+    assert (mine / "notes.txt").read_text() == "keep me" and (run / "r.csv").exists()

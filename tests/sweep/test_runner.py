@@ -205,6 +205,24 @@ def test_foreign_folder_is_refused(tmp_path):
         run_sweep(spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 3")), out, progress=False)
 
 
+def test_force_removes_the_sweeps_own_chunks_and_never_a_users_file(tmp_path):
+    """Starting over (``--force``) removed the whole ``chunks/`` folder, user files in it too (#33): now it removes
+    the chunks a sweep writes and refuses, before removing anything, a folder holding anything else."""
+    out = tmp_path / "out"
+    small = SPEC.replace("n = 24", "n = 6")
+    run_sweep(spec_file(tmp_path, text=small), out, progress=False, plot=False)
+    other = spec_file(tmp_path, name="other.toml", text=small.replace("seed = 7", "seed = 8"))
+    (out / "chunks" / "my_notes.txt").write_text("keep me")
+    before = sorted(p.name for p in (out / "chunks").iterdir())
+    with pytest.raises(FileExistsError, match=r"holds 'my_notes\.txt', which the sweep did not write: not removed"):
+        run_sweep(other, out, force=True, progress=False, plot=False)
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == before
+    (out / "chunks" / "my_notes.txt").unlink()
+    res = run_sweep(other, out, force=True, progress=False, plot=False)
+    assert res.computed == [0, 1]
+    assert_complete(out, 6)
+
+
 def test_a_deleted_chunk_is_computed_again(tmp_path):
     out = tmp_path / "out"
     path = spec_file(tmp_path, text=SPEC.replace("n = 24", "n = 6"))

@@ -178,6 +178,27 @@ def test_grid_covers_every_combination_once_and_chunks_partition_the_ids(a, b, c
     combos = set(map(tuple, spec.design.to_numpy()))
     assert spec.n_variants == len(a) * len(b) * len(c) == len(combos)
     assert combos == set(itertools.product(a, b, c))
+    assert list(map(tuple, spec.design.to_numpy())) == list(itertools.product(a, b, c))   # the last key fastest
     ids = np.concatenate([spec.chunk(k).index.to_numpy() for k in range(spec.n_chunks)])
     np.testing.assert_array_equal(ids, np.arange(spec.n_variants))
     assert all(len(spec.chunk(k)) == chunk for k in range(spec.n_chunks - 1))
+
+
+def test_a_design_too_large_to_build_is_refused_before_it_is_built():
+    """A grid of 2e9 variants was built in memory (5.4 GB before a limit stopped it; #33): more than
+    ``MAX_VARIANTS`` (1e7) is refused at once, with the count and an estimate of the memory, for grids and Monte
+    Carlo alike."""
+    import time
+
+    axis = [1.0 + k / 1000 for k in range(1000)]
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError, match=r"\(1000 x 1000 x 2000 values\) gives 2e\+09 variants, more than "
+                                             r"1e\+07 \(about 112 GB"):
+        spec_from_dict({"sweep": {"model": "wet", "outputs": ["energy"]},
+                        "grid": {"batch.force_scale": axis, "batch.mu_scale": axis,
+                                 "batch.speed_scale": [1.0 + k / 1000 for k in range(2000)]}})
+    with pytest.raises(ParameterError, match=r"\[monte_carlo\] n = 20000000 gives 2e\+07 variants"):
+        spec_from_dict({"sweep": {"model": "wet", "outputs": ["energy"], "seed": 1},
+                        "monte_carlo": {"n": 20_000_000,
+                                        "batch.force_scale": {"dist": "uniform", "low": 0.9, "high": 1.1}}})
+    assert time.perf_counter() - t0 < 5.0

@@ -33,7 +33,7 @@ from ..system import System, evaluate
 from .trim import OperatingPoint, input_scale, resolve, state_scale
 
 __all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
-           "write_linear_model"]
+           "write_linear_model", "signal_name"]
 
 #: relative step of the central differences (about the cube root of the machine epsilon)
 FD_STEP = 6e-6
@@ -132,6 +132,14 @@ def jacobians(system: System, op: OperatingPoint, inputs=None, outputs=None, dir
     return {"A": A, "B": B, "C": C, "D": D, "analytic": analytic, "inputs": ins, "outputs": outs}
 
 
+def signal_name(column: str) -> str:
+    """The python-control signal name of a result column: the column with ``.`` written ``_``
+    (``clutch1.tau_Nm`` -> ``clutch1_tau_Nm``).  python-control refuses ``.`` in a signal name (it reads
+    ``sys.signal`` as a subsystem's signal in ``interconnect``); the other models' columns have none and keep
+    their names.  A linear model maps its signals back in its ``columns`` attribute."""
+    return str(column).replace(".", "_")
+
+
 def linearize(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
               directions: dict | None = None, keep_monitors: bool = False, name: str | None = None):
     """Linear model of ``system`` at ``op`` within its active mode, as a python-control ``StateSpace``.
@@ -160,9 +168,10 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     Returns
     -------
     control.StateSpace
-        Signals named by column (``bearing_position_m``); attributes ``operating_point``, ``mode``
-        (``{mode variable: value}``), ``directions`` (the branches asked for) and ``units``
-        (``{signal: unit}``).
+        Signals named by column (``bearing_position_m``; a driveline's ``clutch1.tau_Nm`` as
+        ``clutch1_tau_Nm``: :func:`signal_name`); attributes ``operating_point``, ``mode``
+        (``{mode variable: value}``), ``directions`` (the branches asked for), ``units``
+        (``{signal: unit}``) and ``columns`` (``{signal: result column}``).
 
     Raises
     ------
@@ -216,12 +225,21 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     out_vars = [(system.states if kind == "state" else system.outputs)[i] for kind, i in jac["outputs"]]
     mode = op.modes
     label = name or system.name
-    sys = control.ss(A_, B_, C_, D_, states=[v.column for v in state_vars], inputs=[v.column for v in in_vars],
-                     outputs=[v.column for v in out_vars], name=label)
+    columns = {}
+    for v in (*state_vars, *in_vars, *out_vars):
+        sig = signal_name(v.column)
+        if columns.get(sig, v.column) != v.column:
+            raise ParameterError(f"{system.name}: {columns[sig]!r} and {v.column!r} would both be the signal {sig!r} "
+                                 "of the linear model (rename a component)")
+        columns[sig] = v.column
+    sys = control.ss(A_, B_, C_, D_, states=[signal_name(v.column) for v in state_vars],
+                     inputs=[signal_name(v.column) for v in in_vars], outputs=[signal_name(v.column) for v in out_vars],
+                     name=label)
     sys.operating_point = op
     sys.mode = mode
     sys.directions = dict(directions or {})
-    sys.units = {v.column: v.unit for v in (*state_vars, *in_vars, *out_vars)}
+    sys.units = {signal_name(v.column): v.unit for v in (*state_vars, *in_vars, *out_vars)}
+    sys.columns = columns
     sys.analytic_jacobian = jac["analytic"]
     return sys
 
@@ -271,8 +289,10 @@ def nonlinear_iosystem(system: System, op: OperatingPoint | None = None, outputs
         y = evaluate(system, t, x, np.atleast_1d(np.asarray(u, float)), m)[2]
         return np.array([x[i] if kind == "state" else y[i] for kind, i in outs])
 
-    return control.nlsys(update, output, states=list(system.state_columns), inputs=list(system.input_columns),
-                         outputs=[(system.states if k == "state" else system.outputs)[i].column for k, i in outs],
+    return control.nlsys(update, output, states=[signal_name(c) for c in system.state_columns],
+                         inputs=[signal_name(c) for c in system.input_columns],
+                         outputs=[signal_name((system.states if k == "state" else system.outputs)[i].column)
+                                  for k, i in outs],
                          name=name or system.name)
 
 
@@ -306,6 +326,7 @@ def frequency_table(sys, frequencies_hz, *, over: str | None = None) -> "pandas.
     resp = np.reshape(resp, (sys.noutputs, sys.ninputs, -1))
     outs, ins = list(sys.output_labels), list(sys.input_labels)
     if over is not None:
+        over = over if over in outs else signal_name(over)   # (a result column: clutch1.tau_Nm)
         if over not in outs:
             raise ParameterError(f"over = {over!r} is not an output of the model ({', '.join(outs)})")
         if sys.ninputs != 1:
@@ -422,6 +443,7 @@ def write_linear_model(sys, path, *, force: bool = False) -> Path:
     if path.suffix.lower() == ".json":
         op = getattr(sys, "operating_point", None)
         doc = {"name": sys.name, "states": states, "inputs": ins, "outputs": outs, "units": units,
+               "columns": getattr(sys, "columns", {}),
                "mode": getattr(sys, "mode", {}), "directions": getattr(sys, "directions", {}), "A": np.asarray(sys.A).tolist(), "B": np.asarray(sys.B).tolist(),
                "C": np.asarray(sys.C).tolist(), "D": np.asarray(sys.D).tolist(),
                "operating_point": op.to_dict() if op is not None else None}

@@ -8,12 +8,12 @@ from ..plotting import legend_outside, new_figure
 from ..units import column_label
 
 
-def _name(column: str) -> str:
+def _column_name(column: str) -> str:
     """``bearing_position_m`` -> ``bearing position`` (the label without its unit)."""
     return column_label(column).split(" [")[0]
 
 
-def _unit(column: str) -> str:
+def _column_unit(column: str) -> str:
     label = column_label(column)
     return label[label.index("[") + 1:-1] if "[" in label else "1"
 
@@ -38,10 +38,19 @@ def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = N
     -------
     matplotlib.figure.Figure
     """
-    from .linear import frequency_table
+    from .linear import frequency_table, signal_name
 
     f = np.asarray(frequencies_hz, dtype=float)
+    over = None if over is None else signal_name(over)   # (a result column: clutch1.tau_Nm)
     fig, (ax_m, ax_p) = new_figure(2, 1, width=7.5, height=6.0, sharex=True)
+    columns = getattr(models[0][1], "columns", {}) if models else {}
+
+    def _name(signal):
+        return _column_name(columns.get(signal, signal))
+
+    def _unit(signal):
+        return _column_unit(columns.get(signal, signal))
+
     def pairs(sys):
         if over is None:
             return [(o, i) for o in sys.output_labels for i in sys.input_labels]

@@ -45,7 +45,8 @@ def resolve(system: System, name: str, kinds=("state", "output")) -> tuple[str, 
     system : System
         The system whose variables are searched.
     name : str
-        Variable name, with or without its unit suffix.
+        Variable name, with or without its unit suffix, or its signal in a linear model
+        (:func:`clutchlab.control.linear.signal_name`: ``clutch1_tau_Nm`` for ``clutch1.tau_Nm``).
     kinds : tuple of str
         Kinds searched in order (``"state"``, ``"output"``, ``"input"``).
 
@@ -62,6 +63,10 @@ def resolve(system: System, name: str, kinds=("state", "output")) -> tuple[str, 
     for kind in kinds:
         for i, v in enumerate(tables[kind]):
             if name in (v.name, v.column):
+                return kind, i
+    for kind in kinds:   # a linear model's signal name (a driveline's clutch1_tau_Nm for clutch1.tau_Nm)
+        for i, v in enumerate(tables[kind]):
+            if "." in v.column and name == v.column.replace(".", "_"):
                 return kind, i
     known = [v.column for kind in kinds for v in tables[kind]]
     raise ParameterError(f"{system.name}: unknown {'/'.join(kinds)} {name!r}; known: {', '.join(known)}")

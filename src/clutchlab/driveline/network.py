@@ -1620,8 +1620,10 @@ class Driveline:
                 named += (el.name, f"{el.name}.piston")
                 mode_names += tuple(f"{el.name}.{q}" for q in W.MODE_NAMES)
                 mode_values += W.MODE_VALUES
+            from .wet import OUTPUTS as WET_OUTPUTS
+
             for el, *_ in wet:
-                outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.OUTPUTS)
+                outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in WET_OUTPUTS)
             events = K.EVENTS + W.EVENTS
 
         emtc = self._emtc_parameters()

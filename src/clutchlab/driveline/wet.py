@@ -21,7 +21,8 @@ model's piston and film switching functions and events (``contact``, ``separatio
 
 States: the network's, then per clutch the wet model's twelve (its ``slip_speed`` follows the element's
 relative speed, integrated from the relative acceleration and reset to it at every event; its drive states
-stay zero).  Outputs: the network's, then per clutch the wet model's eighteen.  Any number of wet clutches:
+stay zero).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
+without the six of its bench, :data:`BENCH_ONLY`).  Any number of wet clutches:
 each is packed on its own and evaluated with its own hooks (its parameters one row of the stacked arrays).
 """
 
@@ -48,6 +49,15 @@ F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
 # buf (float): its states with the slip replaced | their derivative | switching values | inputs (zero) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
 N_BUF = B_Y + W.N_OUT
+#: outputs of the wet model that belong to its bench, not to the clutch: the drive motor, the speed controller
+#: and its slip acceleration, the torque sensor, the load cell and the reservoir heater.  A network reports
+#: the clutch's own (:data:`OUTPUTS`; #33)
+BENCH_ONLY = ("load_cell_force", "drive_torque", "slip_reference", "slip_acceleration", "sensor_torque",
+              "heater_power")
+#: a wet clutch's outputs in a network, ``(quantity, unit, description)``, and their places in the model's
+OUTPUTS = tuple(o for o in W.OUTPUTS if o[0] not in BENCH_ONLY)
+KEPT = np.array([i for i, o in enumerate(W.OUTPUTS) if o[0] not in BENCH_ONLY], dtype=np.int64)
+N_KEPT = len(OUTPUTS)
 
 
 class WetDrivelineParams(NamedTuple):
@@ -135,14 +145,14 @@ def wet_driveline_rhs(t, x, u, m, p, dx, g):
 
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_outputs(t, x, u, m, p, y):
-    """The network's outputs, then each wet clutch's eighteen (:data:`clutchlab.wet.system.OUTPUTS`)."""
+    """The network's outputs, then each wet clutch's own (:data:`OUTPUTS`: the model's without its bench's)."""
     _clutches(t, x, m, p)
     K.driveline_outputs(t, x, u, m, byref(p.net), y)
     nw = p.conf.shape[0]
-    q = y.shape[0] - nw * W.N_OUT
+    q = y.shape[0] - nw * N_KEPT
     for j in range(nw):
-        for i in range(W.N_OUT):
-            y[q + j * W.N_OUT + i] = p.buf[j][B_Y + i]
+        for i in range(N_KEPT):
+            y[q + j * N_KEPT + i] = p.buf[j][B_Y + KEPT[i]]
 
 
 @numba.njit(cache=True, nogil=True)

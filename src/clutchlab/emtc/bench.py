@@ -148,6 +148,9 @@ class VehicleParameters(ParameterSet):
         if not self.plate_inner_radius < self.plate_outer_radius:
             raise ParameterError("VehicleParameters: plate_inner_radius must be < plate_outer_radius")
         ratios = self.gear_ratios
+        if len(ratios) == 0 or any(not r > 0 for r in ratios):
+            raise ParameterError(f"VehicleParameters: gear_ratios = {list(ratios)!r}: needs one ratio > 0 per gear, "
+                                 "from 1st to top gear")
         if any(not a > b for a, b in zip(ratios, ratios[1:])):
             raise ParameterError(
                 f"VehicleParameters: gear_ratios = {list(ratios)!r}: must fall strictly from 1st to top gear")
@@ -526,6 +529,9 @@ def load_scenario(path):
         "coupling": CouplingGeometry.from_dict(data.get("coupling", {}), source=str(path)),
         "magnet": None,
     }
+    if out["scenario"].gear > len(out["vehicle"].gear_ratios):
+        raise ParameterError(f"{path}: [scenario] gear = {out['scenario'].gear}: the vehicle has gears 1 to "
+                             f"{len(out['vehicle'].gear_ratios)} ([vehicle] gear_ratios)")
     mag = data.get("magnet", {})
     if mag:
         if not isinstance(mag, dict) or set(mag) - {"model"}:

@@ -1130,6 +1130,9 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_CSEG:FM_CSEG + 8] = np.nan
     jf = float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2)  # [1], Eq. 29, J_F
     jr = float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2)  # [1], Eq. 29, J_R
+    if not 1 <= scenario.gear <= len(vehicle.gear_ratios):
+        raise ParameterError(f"BenchScenario: gear = {scenario.gear}: the vehicle has gears 1 to "
+                             f"{len(vehicle.gear_ratios)} (VehicleParameters.gear_ratios)")
     veh = VehicleData(
         front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
         gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]), inertia_front=jf, inertia_rear=jr,

@@ -77,13 +77,13 @@ def canonical_unit(name: str) -> str | None:
 
 @lru_cache(maxsize=512)
 def _conversion(source: str, target: str) -> tuple[float, float]:
-    from ..units import _registry
+    from ..units import _registry, convert
 
     ureg = _registry()
     src = normalise_unit(source) or "dimensionless"
     tgt = normalise_unit(target) or "dimensionless"
-    zero = ureg.Quantity(0.0, src).to(tgt).magnitude
-    one = ureg.Quantity(1.0, src).to(tgt).magnitude
+    zero = convert(ureg.Quantity(0.0, src), tgt)   # (a frequency in Hz counts cycles where an angle is meant)
+    one = convert(ureg.Quantity(1.0, src), tgt)
     return float(one - zero), float(zero)
 
 

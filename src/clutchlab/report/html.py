@@ -19,7 +19,50 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Figure", "Table", "Text", "Section", "write_report"]
+__all__ = ["Figure", "Table", "Text", "Section", "write_report", "check_report_folder"]
+
+#: the file that marks a folder as a report clutchlab wrote (only such a folder is replaced, with overwrite)
+MARKER = ".clutchlab-report"
+#: what a report folder holds (folders written before the marker hold these only)
+_REPORT_ENTRIES = {"index.html", "figures", "tables", MARKER}
+
+
+def check_report_folder(outdir, overwrite: bool = False) -> Path:
+    """Check, before any work, that the report folder ``outdir`` can be written: new, or replaceable.
+
+    An existing folder is replaced only with ``overwrite`` and only if clutchlab wrote it (it holds the
+    :data:`MARKER` file, or only a report's ``index.html``, ``figures`` and ``tables``): ``--force`` never
+    deletes a folder of the user's, the folder a command runs in or one that holds it.
+
+    Raises
+    ------
+    OutputExistsError
+        ``outdir`` exists and ``overwrite`` is false.
+    ParameterError
+        ``outdir`` is a file, the working folder or one holding it, or a folder clutchlab did not write.
+    """
+    from ..errors import ParameterError
+    from ..io.files import OutputExistsError
+
+    outdir = Path(outdir)
+    if not (outdir.exists() or outdir.is_symlink()):
+        return outdir
+    if not overwrite:
+        raise OutputExistsError(outdir, "folder")
+    where = outdir.resolve()
+    if outdir.is_symlink() or not outdir.is_dir():
+        raise ParameterError(f"{outdir}: is {'a link' if outdir.is_symlink() else 'a file'}, not a report folder: "
+                             "not replaced (even with --force); give a folder name")
+    cwd = Path.cwd().resolve()
+    if where == cwd or where in cwd.parents:
+        raise ParameterError(f"{outdir}: is the folder this command runs in{'' if where == cwd else ' or holds it'}: "
+                             "not replaced (even with --force); give a new folder, e.g. -o report")
+    entries = sorted(e.name for e in where.iterdir())
+    foreign = [e for e in entries if e not in _REPORT_ENTRIES]
+    if MARKER not in entries and foreign:
+        raise ParameterError(f"{outdir}: holds {foreign[0]!r}, which clutchlab did not write: not replaced (even "
+                             "with --force); give a new folder or empty this one")
+    return outdir
 
 
 @dataclass
@@ -121,7 +164,8 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
 
     The folder is assembled in a temporary sibling and moved into place, so an
     interrupted run never leaves half a report.  An existing ``outdir`` is
-    replaced only with ``overwrite=True``.
+    replaced only with ``overwrite=True``, and only if clutchlab wrote it
+    (:func:`check_report_folder`).
 
     Returns
     -------
@@ -132,11 +176,10 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
 
     from .. import __version__
 
-    outdir = Path(outdir)
-    if outdir.exists() and not overwrite:
-        raise FileExistsError(f"{outdir} exists; pass overwrite=True (CLI: --force) to replace it")
-    outdir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.", dir=outdir.parent))
+    outdir = check_report_folder(outdir, overwrite)
+    target = outdir.resolve()   # (a name to build the temporary and backup names from, also for "-o ..")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp creates 0700; the report folder gets the usual permissions
@@ -192,15 +235,18 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
                 parts.append(f"<details><summary>Parameters used</summary><table><tr><th>name</th><th>value</th></tr>{rows}</table></details>")
         parts.append("</body></html>")
         (tmp / "index.html").write_text("\n".join(parts), encoding="utf-8")
-        if outdir.exists():
-            backup = outdir.with_name(f".{outdir.name}.old")
+        (tmp / MARKER).write_text("a report written by clutchlab: `--force` may replace this folder\n",
+                                  encoding="utf-8")
+        if target.exists():
+            check_report_folder(outdir, overwrite)   # (again: it may have changed during the rendering)
+            backup = target.with_name(f".{target.name}.old")
             if backup.exists():
                 shutil.rmtree(backup)
-            os.replace(outdir, backup)
-            os.replace(tmp, outdir)
+            os.replace(target, backup)
+            os.replace(tmp, target)
             shutil.rmtree(backup)
         else:
-            os.replace(tmp, outdir)
+            os.replace(tmp, target)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -30,9 +30,9 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from ..errors import DataError
+from ..errors import DataError, ParameterError
 from ..units import NAME_UNITS, column_label, column_unit, unit_label
-from .html import Figure, Section, Table, Text, write_report
+from .html import Figure, Section, Table, Text, check_report_folder, write_report
 
 __all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "DEFAULT_OUTPUT"]
 
@@ -625,8 +625,10 @@ def report_run_dir(run_dir, output=None, *, overwrite: bool = False,
     """
     run_dir = Path(run_dir)
     output = Path(output) if output is not None else run_dir / DEFAULT_OUTPUT
-    if output.exists() and not overwrite:
-        raise FileExistsError(f"{output} exists; pass overwrite=True (CLI: --force) to replace it")
+    check_report_folder(output, overwrite)   # (before the scan: a folder of the user's is never replaced)
+    if run_dir.exists() and output.exists() and (run_dir.resolve() == output.resolve()
+                                                 or output.resolve() in run_dir.resolve().parents):
+        raise ParameterError(f"{output}: holds the results folder {run_dir}: not replaced; give another folder")
     sections = run_sections(run_dir, output=output, progress=progress)
     if progress:
         progress(f"writing {output}")

@@ -45,7 +45,7 @@ import json
 import math
 import multiprocessing
 import os
-import shutil
+import re
 import signal
 import sys
 import threading
@@ -310,9 +310,19 @@ def _prepare(spec: SweepSpec, output: Path, force: bool) -> dict:
     elif output.exists() and any(p.name != ".lock" for p in output.iterdir()) and not force:
         raise FileExistsError(f"{output} exists and is not a sweep folder (no {MANIFEST}); "
                               "pass force=True (CLI: --force) to use it")
-    # start over: remove what a previous sweep wrote
-    if (output / CHUNK_DIR).is_dir():
-        shutil.rmtree(output / CHUNK_DIR)
+    # start over: remove what a previous sweep wrote, and nothing else (a file of the user's in chunks/ stops it)
+    chunks = output / CHUNK_DIR
+    if chunks.is_symlink() or (chunks.exists() and not chunks.is_dir()):
+        raise FileExistsError(f"{chunks} is not a folder the sweep wrote (a link or a file): not removed")
+    if chunks.is_dir():
+        ours = [p for p in chunks.iterdir() if p.is_file() and not p.is_symlink()
+                and re.fullmatch(r"\.?chunk-\d+\.parquet(\.[\w.-]*tmp)?", p.name)]
+        foreign = sorted(p.name for p in chunks.iterdir() if p not in ours)
+        if foreign:
+            raise FileExistsError(f"{chunks} holds {foreign[0]!r}, which the sweep did not write: not removed (even "
+                                  "with --force); move it, or give another output folder")
+        for path in ours:
+            path.unlink()
     for name in (RESULTS, SUMMARY_CSV, SUMMARY_PNG, MANIFEST):
         (output / name).unlink(missing_ok=True)
     (output / CHUNK_DIR).mkdir(parents=True, exist_ok=True)
