@@ -319,6 +319,9 @@ def test_linear_curve_spring_equals_the_spring_damper():
     (lambda d: d.backlash("l", "J1", "J2", c=1.0, b_gap=0.0), "b_gap = 0.0 must be > 0"),
     (lambda d: d.spring("k", "J1", "J2", [[0.0, 1.0]]), "needs at least 2 samples"),
     (lambda d: d.spring("k", "J1", "J2", Curve([0, 1], [0, 1], extrapolation="error")), "needs 'linear'"),
+    # (#33: Unicode names reached the FMU's variable names, which the FMI validator rejects)
+    (lambda d: d.inertia("Kupplungsdämpfer", J=1.0), "must be ASCII letters, digits and underscores"),
+    (lambda d: d.input("drehmoment_µ"), "must be ASCII letters, digits and underscores"),
 ])
 def test_bad_elements_give_one_clear_error(build, match):
     d = Driveline("bad")

@@ -351,10 +351,11 @@ class Signal:
 
 
 def _word(what: str, name) -> str:
-    """``name`` if it is letters, digits and underscores (a component's or an input's name), else a
-    ParameterError starting with ``what``."""
-    if not isinstance(name, str) or not name or not name.replace("_", "").isalnum():
-        raise ParameterError(f"{what} {name!r} must be letters, digits and underscores")
+    """``name`` if it is ASCII letters, digits and underscores (a component's or an input's name: part of column
+    names and FMI variable names, which an FMI validator refuses in other characters), else a ParameterError
+    starting with ``what``."""
+    if not isinstance(name, str) or not name or not name.isascii() or not name.replace("_", "").isalnum():
+        raise ParameterError(f"{what} {name!r} must be ASCII letters, digits and underscores")
     return name
 
 
