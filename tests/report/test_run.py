@@ -220,3 +220,23 @@ def test_sweep_results_file_and_its_chunks_shown_once(tmp_path):
     assert "<img" not in sec["Data: summary.csv"] and "shown as it is" in sec["Data: summary.csv"]
     files = re.search(r"Tables found.*?</table>", html, re.S).group(0)
     assert files.count("<td>yes</td>") == 2
+
+
+def test_a_table_holding_inf_or_1e308_is_reported_not_a_traceback(tmp_path):
+    """A CSV holding +-1e308 made matplotlib's tick search overflow, a traceback for the whole report (#33): values
+    beyond ``PLOT_LIMIT`` are left out of the figures (the caption says how many), the metrics keep them, the
+    mean without overflow."""
+    import math
+
+    from clutchlab.report.run import PLOT_LIMIT
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "a.csv").write_text("time_s,force_N\n0,1\n1,inf\n2,3\n")
+    (run / "b.csv").write_text("time_s,force_N\n0,1\n1,1e308\n2,-1e308\n")
+    (run / "c.csv").write_text("time_s,force_N\n0,1e308\n1,1e308\n2,1e308\n")
+    html = report_run_dir(run).read_text(encoding="utf-8")
+    assert html.count(f"values beyond ±{PLOT_LIMIT:.0e} not drawn") >= 2
+    tables = {ds.name: metrics_table(ds).set_index("channel") for ds in find_datasets(run)[0]}
+    assert tables["c.csv"].loc["force_N", "mean"] == 1e308 and math.isfinite(tables["b.csv"].loc["force_N", "mean"])
+    assert tables["a.csv"].loc["force_N", "non-finite"] == 1

@@ -319,6 +319,24 @@ def _stem(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "table"
 
 
+#: values beyond this magnitude are not drawn (no SI quantity of a clutch reaches it; a column holding +-1e308
+#: made matplotlib's tick search overflow, a traceback for the whole report: #33)
+PLOT_LIMIT = 1e150
+
+
+def _plottable(values) -> tuple[np.ndarray, int]:
+    """``values`` as floats with the non-finite ones and those beyond :data:`PLOT_LIMIT` as NaN, and how many
+    finite values were left out."""
+    v = np.asarray(values, dtype=float).copy()
+    wild = np.isfinite(v) & (np.abs(v) > PLOT_LIMIT)
+    v[wild | ~np.isfinite(v)] = np.nan
+    return v, int(wild.sum())
+
+
+def _left_out(n: int) -> str:
+    return f"; {n} values beyond ±{PLOT_LIMIT:.0e} not drawn" if n else ""
+
+
 def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
     from ..plotting import new_figure
 
@@ -328,15 +346,18 @@ def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
         return []
     frame = ds.frame
     stride = max(1, math.ceil(len(frame) / MAX_PLOT_POINTS))
-    t = frame[tcol].to_numpy(dtype=float)[::stride]
+    t, wild = _plottable(frame[tcol].to_numpy(dtype=float)[::stride])
     groups = _groups(channels)
     figures = []
     for k in range(0, len(groups), MAX_AXES_PER_FIGURE):
         part = groups[k:k + MAX_AXES_PER_FIGURE]
         fig, axes = new_figure(len(part), 1, width=8.0, height=1.9 * len(part) + 0.6, sharex=True, squeeze=False)
+        left_out = wild
         for ax, (unit, cols) in zip(axes[:, 0], part):
             for c in cols:
-                ax.plot(t, frame[c].to_numpy(dtype=float)[::stride], lw=0.9, label=_words(c) if unit else str(c))
+                y, n = _plottable(frame[c].to_numpy(dtype=float)[::stride])
+                left_out += n
+                ax.plot(t, y, lw=0.9, label=_words(c) if unit else str(c))
             ax.set_ylabel(_axis_label(unit, cols), fontsize=8)
             if len(cols) > 1:  # one line: the axis label names it
                 ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
@@ -349,6 +370,7 @@ def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
         cap = f"{ds.name}: {names} against {tcol}" + (f" (part {n} of {total})" if total > 1 else "")
         if stride > 1:
             cap += f"; every {stride}th of {len(frame)} samples plotted"
+        cap += _left_out(left_out)
         if ds.synthetic:
             cap += " [synthetic data]"
         fig.tight_layout()
@@ -383,10 +405,14 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
         frame = frame.sample(MAX_SCATTER_POINTS, random_state=0)
     fig, axes = new_figure(len(outputs), len(inputs), width=2.9 * len(inputs) + 1.0, height=2.1 * len(outputs) + 0.5,
                            squeeze=False)
+    left_out = 0
     for i, out in enumerate(outputs):
         for j, inp in enumerate(inputs):
             ax = axes[i, j]
-            ax.scatter(frame[inp].to_numpy(dtype=float), frame[out].to_numpy(dtype=float), s=6, alpha=0.6)
+            x, nx = _plottable(frame[inp].to_numpy(dtype=float))
+            y, ny = _plottable(frame[out].to_numpy(dtype=float))
+            left_out += nx + ny
+            ax.scatter(x, y, s=6, alpha=0.6)
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=7)
             if i == len(outputs) - 1:
@@ -397,6 +423,7 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
     cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
     if len(frame) < len(ds.frame):
         cap += f"; {len(frame)} of {len(ds.frame)} rows drawn at random (seed 0)"
+    cap += _left_out(left_out)
     if ds.synthetic:
         cap += " [synthetic data]"
     return [Figure(f"{label}_scatter", fig, cap)]
@@ -425,9 +452,15 @@ def metrics_table(ds: Dataset) -> pd.DataFrame:
         unit = _unit_of(c)
         rows.append({"channel": str(c), "unit": unit_label(unit) if unit else "",
                      "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
-                     "min": float(fin.min()), "max": float(fin.max()), "mean": float(fin.mean()),
+                     "min": float(fin.min()), "max": float(fin.max()), "mean": _mean(fin),
                      "final": float(fin[-1])})
     return pd.DataFrame(rows, columns=["channel", "unit", "finite", "non-finite", "min", "max", "mean", "final"])
+
+
+def _mean(values) -> float:
+    """The mean of finite ``values`` without overflow (a column of 1e308 has the mean 1e308, not inf)."""
+    scale = float(np.abs(values).max()) if values.size else 0.0
+    return float(np.mean(values / scale) * scale) if scale > 0 else 0.0
 
 
 def _flatten(data, prefix=""):
