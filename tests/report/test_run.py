@@ -240,3 +240,24 @@ def test_a_table_holding_inf_or_1e308_is_reported_not_a_traceback(tmp_path):
     tables = {ds.name: metrics_table(ds).set_index("channel") for ds in find_datasets(run)[0]}
     assert tables["c.csv"].loc["force_N", "mean"] == 1e308 and math.isfinite(tables["b.csv"].loc["force_N", "mean"])
     assert tables["a.csv"].loc["force_N", "non-finite"] == 1
+
+
+def test_links_out_of_the_results_folder_are_named_not_read(tmp_path):
+    """The report followed links out of the results folder (#33): a table or parameter file behind such a link is
+    listed as not read; a link inside the folder is read."""
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "secret.csv").write_text("time_s,x_1\n0,1\n1,2\n")
+    (outside / "secret.toml").write_text("key = 1\n")
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "mine.csv").write_text("time_s,y_1\n0,1\n1,2\n")
+    (run / "link.csv").symlink_to(outside / "secret.csv")
+    (run / "link.toml").symlink_to(outside / "secret.toml")
+    (run / "again.csv").symlink_to(run / "mine.csv")
+    datasets, failed = find_datasets(run)
+    assert [d.name for d in datasets] == ["again.csv"]   # (mine.csv has the same rows: shown once)
+    assert [(p.name, why) for p, why in failed] == [("link.csv", "a link to a file outside the results folder: "
+                                                                  "not read")]
+    html = report_run_dir(run).read_text(encoding="utf-8")
+    assert "link.toml: a link to a file outside the results folder" in html and "secret" not in html

@@ -169,6 +169,20 @@ def _read_mdf(path: Path, name: str) -> Dataset:
     return Dataset(name, "MDF4", frame, prov, [path])
 
 
+def _outside(path: Path, run_dir: Path) -> bool:
+    """True if ``path`` (a link, or in a linked folder) leads out of ``run_dir``: its file is not read (#33: the
+    report followed links out of the results folder)."""
+    try:
+        path.resolve().relative_to(run_dir.resolve())
+        return False
+    except ValueError:
+        return True
+
+
+#: why a file behind a link out of the results folder is not read
+OUTSIDE = "a link to a file outside the results folder: not read"
+
+
 def _skipped(path: Path, run_dir: Path, output: Path | None) -> bool:
     rel = path.relative_to(run_dir)
     if any(part.startswith(".") for part in rel.parts):
@@ -210,7 +224,9 @@ def find_datasets(run_dir, *, output=None, progress: Callable[[str], None] | Non
     say = progress or (lambda msg: None)
     files = sorted(p for p in run_dir.rglob("*") if p.is_file() and p.suffix.lower() in TABLE_SUFFIXES
                    and not _skipped(p, run_dir, output))
-    datasets, failed = [], []
+    failed = [(p, OUTSIDE) for p in files if _outside(p, run_dir)]
+    files = [p for p in files if not _outside(p, run_dir)]
+    datasets = []
     parquet_groups: dict[tuple, list[Path]] = {}
     for n, path in enumerate(files, start=1):
         rel = path.relative_to(run_dir).as_posix()
@@ -494,6 +510,9 @@ def parameter_tables(run_dir: Path, output: Path | None) -> tuple[list, list[str
     items, problems = [], []
     for path in sorted(p for p in run_dir.rglob("*.toml") if p.is_file() and not _skipped(p, run_dir, output)):
         rel = path.relative_to(run_dir).as_posix()
+        if _outside(path, run_dir):
+            problems.append(f"{rel}: {OUTSIDE}")
+            continue
         try:
             data = load_toml(path)
         except ParameterError as exc:
@@ -516,7 +535,7 @@ def parameter_tables(run_dir: Path, output: Path | None) -> tuple[list, list[str
 def _read_manifests(run_dir: Path, output: Path | None) -> dict[str, dict]:
     out = {}
     for path in sorted(run_dir.rglob("manifest.json")):
-        if _skipped(path, run_dir, output):
+        if _skipped(path, run_dir, output) or _outside(path, run_dir):
             continue
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
