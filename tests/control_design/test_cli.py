@@ -156,3 +156,15 @@ def test_linearize_and_bode_of_a_driveline_name_its_signals_for_python_control(t
     assert list(again.output_labels) == ["k_tau_Nm"] and np.array_equal(again.C, sys.C)
     loop = control.feedback(sys, 1)
     assert np.all(np.real(control.poles(loop)) < 0)
+
+
+@pytest.mark.parametrize("option, value, message", [("--settle", "-1 s", "settle = -1.0: must be a time >= 0"),
+                                                    ("--time", "inf s", "--time = 'inf s': not a finite number")])
+def test_a_negative_settle_or_an_infinite_time_is_refused(tmp_path, capsys, option, value, message):
+    """``--settle -1 s`` was silently ignored (#33)."""
+    path = tmp_path / "sd.toml"
+    path.write_text(SPRING_DAMPER)
+    line = one_line_error(capsys, ["control", "linearize", "driveline", str(path), option, value,
+                                   "-o", str(tmp_path / "lin.json")])
+    assert message in line, line
+    assert not (tmp_path / "lin.json").exists()

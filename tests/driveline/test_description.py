@@ -322,3 +322,20 @@ torque = { sine = { amplitude = "1 N m", frequency = "60 rpm" } }
     t = frame["time_s"].to_numpy()
     np.testing.assert_allclose(frame["driven.w_rad_s"], (1 - np.cos(2 * math.pi * t)) / (2 * math.pi * 2.0),
                                rtol=1e-5, atol=1e-9)
+
+
+@pytest.mark.parametrize("tables, message", [
+    ("[inertia.J1]\nJ = 1.0\n[simulation]\nrtol = 0\n", "simulation.rtol = 0: must be in (0, 1)"),
+    ("[inertia.J1]\nJ = 1.0\n[simulation]\nt_end = \"-1 s\"\n", "simulation.t_end = '-1 s': must be > 0 [s]"),
+    ("[inertia.J1]\nJ = 1.0\n[simulation]\noutput_step = 0\n", "simulation.output_step = 0: must be > 0 [s]"),
+    ("[inertia.J1]\nJ = 1.0\nw0 = 2.0\n", "f: a one-way clutch cannot start with flange b slower than flange a")])
+def test_describe_refuses_what_simulate_refuses(tmp_path, capsys, tables, message):
+    """``describe`` passed ``rtol = 0`` and a one-way clutch started backward, which ``simulate`` refuses (#33)."""
+    path = tmp_path / "owc.toml"
+    path.write_text('[driveline]\nname = "owc"\n[inertia.J2]\nJ = 1.0\n[one_way_clutch.f]\na = "J1"\nb = "J2"\n'
+                    + tables)
+    for command in ("describe", "simulate"):
+        argv = ["driveline", command, str(path)] + (["-o", str(tmp_path / "o.csv"), "--t-end", "1 s"]
+                                                    if command == "simulate" else [])
+        line = one_line_error(capsys, argv)
+        assert message in line, (command, line)

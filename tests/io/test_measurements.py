@@ -230,3 +230,17 @@ def test_emtc_forc_table_reader_accepts_parquet(tmp_path):
     back = read_measurement(out, required=["airgap", "current", "force"], time=None)
     pd.testing.assert_frame_equal(back.frame, forc)
     assert back.units == {"airgap": "m", "current": "A", "force": "N"}
+
+
+def test_a_column_named_twice_is_an_error_not_a_renamed_channel(tmp_path):
+    """pandas renamed the second ``torque_Nm`` to ``torque_Nm.1`` and read it as another channel (#33)."""
+    from clutchlab.io import read_measurement
+    from clutchlab.report.run import find_datasets
+
+    path = tmp_path / "run" / "twice.csv"
+    path.parent.mkdir()
+    path.write_text("# units: time_s=s\ntime_s,torque_Nm,torque_Nm\n0,1,2\n1,3,4\n")
+    with pytest.raises(DataError, match=r"twice\.csv: column 'torque_Nm' appears twice in the header"):
+        read_measurement(path)
+    datasets, failed = find_datasets(path.parent)
+    assert not datasets and "column 'torque_Nm' appears twice" in failed[0][1]

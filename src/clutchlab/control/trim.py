@@ -24,6 +24,7 @@ CSC travel, the supply voltage) is refused, as is a steady state that is not uni
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -279,6 +280,11 @@ def operating_point(system: System, *, inputs: dict | None = None, states: dict 
     """
     inputs, states, targets = dict(inputs or {}), dict(states or {}), dict(targets or {})
     t = float(t)
+    if not math.isfinite(t):
+        raise ParameterError(f"{system.name}: t = {t!r}: the time of the operating point must be finite [s]")
+    if not (math.isfinite(float(settle)) and float(settle) >= 0.0):
+        raise ParameterError(f"{system.name}: settle = {settle!r}: must be a time >= 0 [s] (#33: a negative one "
+                             "was ignored)")
     u = system.u0.copy()
     for name, value in inputs.items():
         _, i = resolve(system, name, ("input",))

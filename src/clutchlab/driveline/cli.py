@@ -11,7 +11,7 @@ from __future__ import annotations
 import io
 
 from ..cli import add_fixed_step_option
-from ..errors import ParameterError
+from ..errors import DataError, ParameterError
 
 __all__ = ["register"]
 
@@ -144,10 +144,15 @@ def _trace(path, unit: str, what: str):
     from ..io.channels import unit_conversion
     from ..units import column_unit
 
+    from ..io.measurements import duplicate_columns
+
     if not path.is_file():
         raise ParameterError(f"{what} = {str(path)!r}: no such file")
     try:
+        duplicate_columns(path, f"{what}: {path}")
         frame = pd.read_csv(path, comment="#")
+    except DataError as exc:
+        raise ParameterError(str(exc)) from None
     except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
         raise ParameterError(f"{what}: {path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
     others = [c for c in frame.columns if c != "time_s"]
@@ -175,5 +180,10 @@ def _trace(path, unit: str, what: str):
 def _describe(args) -> int:
     from .description import load_driveline
 
-    print(load_driveline(args.file).driveline.describe())
+    spec = load_driveline(args.file)
+    try:   # every check simulate makes before its run (a one-way clutch started backward)
+        spec.driveline.system(spec.rtol)
+    except ParameterError as exc:
+        raise ParameterError(f"{args.file}: {exc}") from None
+    print(spec.driveline.describe())
     return 0

@@ -479,6 +479,10 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
         if k not in SIMULATION_FIELDS:
             raise ParameterError(f"{src}: [simulation] {k}: unknown field (known: {', '.join(SIMULATION_FIELDS)})")
     settings = {k: _quantity(v, SIMULATION_FIELDS[k], f"simulation.{k}", src) for k, v in sim.items()}
+    for k, v in settings.items():   # (refused here, so describe and simulate refuse alike: #33)
+        if not (0.0 < v < 1.0 if k == "rtol" else v > 0.0):
+            raise ParameterError(f"{src}: simulation.{k} = {sim[k]!r}: must be "
+                                 + ("in (0, 1)" if k == "rtol" else "> 0 [s]"))
     for top in doc:
         if top in known and top not in table_fields and top not in ("driveline", "simulation", "input"):
             other = "translational" if domain == "rotational" else "rotational"

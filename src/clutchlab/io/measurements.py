@@ -246,6 +246,20 @@ def _parse_units_line(text: str, label: str) -> dict[str, str]:
     return units
 
 
+def duplicate_columns(path, label) -> None:
+    """Raise :class:`DataError` naming ``label`` and the column if the CSV at ``path`` names a column twice (pandas
+    renames the second ``torque_Nm.1`` and reads it as another channel; #33)."""
+    try:
+        names = pd.read_csv(path, comment="#", header=None, nrows=1, dtype=str).iloc[0].tolist()
+    except Exception:   # (the full read names what is wrong)
+        return
+    seen = set()
+    for name in names:
+        if name in seen and isinstance(name, str):
+            raise DataError(f"{label}: column {name!r} appears twice in the header: rename one")
+        seen.add(name)
+
+
 def _read_csv(path: Path, label: str) -> _TableReader:
     comments, units = [], {}
     size = path.stat().st_size
@@ -260,6 +274,7 @@ def _read_csv(path: Path, label: str) -> _TableReader:
                     units.update(_parse_units_line(text, label))
                 else:
                     comments.append(text)
+        duplicate_columns(path, label)
         frame = pd.read_csv(path, comment="#")
     except UnicodeDecodeError:
         raise DataError(f"{label}: cannot read as CSV (not UTF-8 text)") from None

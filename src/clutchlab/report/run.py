@@ -117,7 +117,10 @@ def _csv_header(path: Path) -> list[str]:
 
 
 def _read_csv(path: Path, name: str) -> Dataset:
+    from ..io.measurements import duplicate_columns
+
     header = _csv_header(path)
+    duplicate_columns(path, str(path))
     try:
         frame = pd.read_csv(path, comment="#")
     except Exception as exc:  # pandas raises several parser errors
