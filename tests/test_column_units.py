@@ -83,3 +83,9 @@ def test_units_line_of_a_csv_output(tmp_path):
     assert back.units["line_flow_m3_s"] == "m**3/s"
     np.testing.assert_array_equal(back.frame["line_flow_m3_s"], frame["line_flow_m3_s"])
     assert list(back.frame["mode"]) == ["open", "locked"]
+
+
+def test_pint_spellings_outside_the_tables_are_printed_for_people():
+    """Sweep summaries showed ``[kg*m**2]`` (#33)."""
+    assert unit_label("kg*m**2") == "kg·m²" and unit_label("N*m/rad") == "N·m/rad"
+    assert unit_label("m**3/s") == "m³/s" and unit_label("N*s/m") == "N·s/m" and unit_label("1/s") == "1/s"

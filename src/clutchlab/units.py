@@ -388,12 +388,17 @@ def unit_label(unit: str) -> str:
     -------
     str
         ``"rad/s"``, ``"°C"``, ``"m³/s"``, ``"N·m"``, ``"dimensionless"``;
-        anything unknown comes back as given.
+        any other pint spelling as printed (``"N*m/rad"`` -> ``"N·m/rad"``).
     """
     unit = str(unit)
     if unit in COLUMN_UNITS:
         return COLUMN_UNITS[unit][1]
-    return _HUMAN.get(unit, unit)
+    if unit in _HUMAN:
+        return _HUMAN[unit]
+    # a pint spelling not in the tables, as printed (N*m/rad -> N·m/rad, kg*m**2 -> kg·m²; #33)
+    for spelled, printed in (("**-1", "⁻¹"), ("**2", "²"), ("**3", "³"), ("^2", "²"), ("^3", "³"), ("*", "·")):
+        unit = unit.replace(spelled, printed)
+    return unit
 
 
 def column_label(name: str) -> str:

@@ -261,3 +261,14 @@ def test_links_out_of_the_results_folder_are_named_not_read(tmp_path):
                                                                   "not read")]
     html = report_run_dir(run).read_text(encoding="utf-8")
     assert "link.toml: a link to a file outside the results folder" in html and "secret" not in html
+
+
+def test_columns_a_scatter_matrix_leaves_out_are_named_in_its_caption(tmp_path):
+    """A fourth sweep parameter was left out of the scatter matrix without a word (#33)."""
+    run = tmp_path / "run"
+    run.mkdir()
+    names = [f"p{k}_1" for k in range(12)]
+    rows = "\n".join(",".join(str((k + 1) * (r + 1) % 7 + r) for k in range(12)) for r in range(5))
+    (run / "variants.csv").write_text(",".join(names) + "\n" + rows + "\n")
+    html = report_run_dir(run).read_text(encoding="utf-8")
+    assert "not drawn (the matrix takes 3 inputs and 8 outputs): p11_1" in html

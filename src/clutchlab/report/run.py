@@ -397,7 +397,8 @@ def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
     return figures
 
 
-def _io_columns(ds: Dataset, manifest: dict) -> tuple[list[str], list[str]]:
+def _io_columns(ds: Dataset, manifest: dict) -> tuple[list[str], list[str], str]:
+    """The inputs and outputs of the scatter matrix, and what was left out of it (for the caption)."""
     numeric = [c for c in ds.numeric_columns() if not _is_index(c)]
     declared = manifest.get("outputs") if isinstance(manifest.get("outputs"), list) else None
     params = manifest.get("parameters")
@@ -406,17 +407,27 @@ def _io_columns(ds: Dataset, manifest: dict) -> tuple[list[str], list[str]]:
         outputs = [c for c in numeric if c in declared]
         if outputs:
             inputs = [c for c in numeric if c in params] or [c for c in numeric if c not in outputs]
-            return inputs[:MAX_SCATTER_INPUTS], outputs[:MAX_SCATTER_OUTPUTS]
+            left = [c for c in (*inputs[MAX_SCATTER_INPUTS:], *outputs[MAX_SCATTER_OUTPUTS:])]
+            return inputs[:MAX_SCATTER_INPUTS], outputs[:MAX_SCATTER_OUTPUTS], _not_drawn(left)
     if len(numeric) < 2:
-        return [], []
+        return [], [], ""
     n_in = max(1, min(MAX_SCATTER_INPUTS, len(numeric) // 2))
-    return numeric[:n_in], numeric[n_in:n_in + MAX_SCATTER_OUTPUTS]
+    return numeric[:n_in], numeric[n_in:n_in + MAX_SCATTER_OUTPUTS], _not_drawn(numeric[n_in + MAX_SCATTER_OUTPUTS:])
+
+
+def _not_drawn(columns) -> str:
+    """The caption's note of columns a scatter matrix leaves out (#33: a fourth sweep parameter was left out
+    without a word)."""
+    if not columns:
+        return ""
+    return f"; not drawn (the matrix takes {MAX_SCATTER_INPUTS} inputs and {MAX_SCATTER_OUTPUTS} outputs): " + \
+        ", ".join(map(str, columns))
 
 
 def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
     from ..plotting import new_figure
 
-    inputs, outputs = _io_columns(ds, manifest)
+    inputs, outputs, left = _io_columns(ds, manifest)
     if not inputs or not outputs:
         return []
     frame = ds.frame
@@ -442,7 +453,7 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
     cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
     if len(frame) < len(ds.frame):
         cap += f"; {len(frame)} of {len(ds.frame)} rows drawn at random (seed 0)"
-    cap += _left_out(left_out)
+    cap += _left_out(left_out) + left
     if ds.synthetic:
         cap += " [synthetic data]"
     return [Figure(f"{label}_scatter", fig, cap)]

@@ -534,6 +534,13 @@ def summarize(results: pd.DataFrame, outputs, units: dict | None = None) -> pd.D
     return pd.DataFrame(rows).set_index("output")
 
 
+def _printed(unit) -> str:
+    """A unit in an axis label as printed (``kg·m²``, not pint's ``kg*m**2``; ``1`` for none)."""
+    from ..units import unit_label
+
+    return "1" if unit in (None, "", "1") else unit_label(unit)
+
+
 def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict):
     import matplotlib
 
@@ -558,13 +565,15 @@ def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict):
                 if i == 0 and j == 0 and len(params) > 1:
                     ax.legend(fontsize=7)
             if i == len(outs) - 1:
-                ax.set_xlabel(f"{par} [{spec.units.get(par, '')}]", fontsize=8)
+                ax.set_xlabel(f"{par} [{_printed(spec.units.get(par))}]", fontsize=8)
             if j == 0:
-                ax.set_ylabel(f"{out} [{units.get(out, '')}]", fontsize=8)
+                ax.set_ylabel(f"{out} [{_printed(units.get(out))}]", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
-    fig.suptitle(f"sweep of {spec.model!r}: {spec.n_variants} variants ({spec.kind.replace('_', ' ')}; synthetic)",
-                 fontsize=10)
+    cut = [f"the first {len(shown)} of {len(every)} {what}" for shown, every, what in
+           ((params, spec.parameters, "parameters"), (outs, spec.outputs, "outputs")) if len(shown) < len(every)]
+    fig.suptitle(f"sweep of {spec.model!r}: {spec.n_variants} variants ({spec.kind.replace('_', ' ')}; synthetic)"
+                 + (f"\n{' and '.join(cut)} shown (all are in results.parquet)" if cut else ""), fontsize=10)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
