@@ -272,3 +272,13 @@ def test_columns_a_scatter_matrix_leaves_out_are_named_in_its_caption(tmp_path):
     (run / "variants.csv").write_text(",".join(names) + "\n" + rows + "\n")
     html = report_run_dir(run).read_text(encoding="utf-8")
     assert "not drawn (the matrix takes 3 inputs and 8 outputs): p11_1" in html
+
+
+def test_a_table_without_time_has_no_final_value():
+    """"final" metrics were shown for Monte Carlo rows, which have no last one (#33); a time series keeps it."""
+    from clutchlab.report.run import Dataset
+
+    samples = Dataset("mc", "CSV", pd.DataFrame({"variant_id": [0, 1, 2], "energy_J": [3.0, 1.0, 2.0]}), [], [])
+    run = Dataset("run", "CSV", pd.DataFrame({"time_s": [0.0, 1.0], "energy_J": [1.0, 2.0]}), [], [])
+    assert "final" not in metrics_table(samples).columns
+    assert metrics_table(run).set_index("channel").loc["energy_J", "final"] == 2.0

@@ -472,7 +472,8 @@ def metrics_table(ds: Dataset) -> pd.DataFrame:
     -------
     pandas.DataFrame
         One row per channel: ``channel, unit`` (for people: rad/s, °C, N·m), ``finite, non-finite, min, max,
-        mean, final``.
+        mean, final``; ``final`` (the value at the end of the run) only for a time series: the rows of a table
+        without time (sweep variants, Monte Carlo samples) have no order that makes one last (#33).
     """
     rows = []
     for c in ds.numeric_columns():
@@ -484,7 +485,10 @@ def metrics_table(ds: Dataset) -> pd.DataFrame:
                      "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
                      "min": float(fin.min()), "max": float(fin.max()), "mean": _mean(fin),
                      "final": float(fin[-1])})
-    return pd.DataFrame(rows, columns=["channel", "unit", "finite", "non-finite", "min", "max", "mean", "final"])
+    columns = ["channel", "unit", "finite", "non-finite", "min", "max", "mean", "final"]
+    if ds.time_column is None:
+        columns.remove("final")
+    return pd.DataFrame(rows, columns=columns)
 
 
 def _mean(values) -> float:
