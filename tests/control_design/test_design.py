@@ -256,3 +256,19 @@ def test_eclutch_loops_satisfy_the_nyquist_criterion():
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_the_phase_table_is_continuous_and_starts_within_one_turn():
+    """The Bode phase jumped to -600 deg (#33): ``frequency_table``'s phase is unwrapped (continuous) and its first
+    point in [-270, 90) deg.  Closed forms: -1/(s+1)^3 has the phase -180 - 3 atan(w) deg (np.angle starts it at
+    +180, so unwrapping alone gave 360 deg too much); s/(s+1), 90 - atan(w)."""
+    import control
+
+    from clutchlab.control import frequency_table
+
+    G = control.ss(control.tf([-1.0], [1.0, 3.0, 3.0, 1.0]))
+    f = np.logspace(-3, 2, 300)
+    phase = frequency_table(G, f).filter(like="phase_deg_").iloc[:, 0].to_numpy()
+    np.testing.assert_allclose(phase, -180.0 - 3.0 * np.degrees(np.arctan(2 * np.pi * f)), atol=1e-6)
+    lead = frequency_table(control.ss(control.tf([1.0, 0.0], [1.0, 1.0])), f).filter(like="phase_deg_").iloc[:, 0]
+    np.testing.assert_allclose(lead.to_numpy(), 90.0 - np.degrees(np.arctan(2 * np.pi * f)), atol=1e-6)

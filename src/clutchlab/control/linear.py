@@ -314,7 +314,8 @@ def frequency_table(sys, frequencies_hz, *, over: str | None = None) -> "pandas.
     -------
     pandas.DataFrame
         ``frequency_Hz``, then per pair ``gain_<out>__<in>`` (output unit per input unit; with ``over``
-        the pairs are ``<out>__<over>``), ``gain_dB_<out>__<in>`` and ``phase_deg_<out>__<in>`` (unwrapped).
+        the pairs are ``<out>__<over>``), ``gain_dB_<out>__<in>`` and ``phase_deg_<out>__<in>`` (unwrapped:
+        continuous over the frequencies, the first one's phase in [-270, 90) degrees).
     """
     import pandas as pd
 
@@ -341,7 +342,10 @@ def frequency_table(sys, frequencies_hz, *, over: str | None = None) -> "pandas.
             g = resp[i, j]
             cols[f"gain_{o}__{n}"] = np.abs(g)
             cols[f"gain_dB_{o}__{n}"] = 20 * np.log10(np.maximum(np.abs(g), 1e-300))
-            cols[f"phase_deg_{o}__{n}"] = np.degrees(np.unwrap(np.angle(g)))
+            # continuous, its first point in [-270, 90) deg: a lag of an integrator chain or a sign reads as one
+            # (-180, not +180), a lead up to a differentiator's +90 as one
+            phase = np.degrees(np.unwrap(np.angle(g)))
+            cols[f"phase_deg_{o}__{n}"] = phase - 360.0 * np.floor((phase[0] + 270.0) / 360.0)
     return pd.DataFrame(cols)
 
 
