@@ -97,7 +97,17 @@ def test_cli_static_500_mm(tmp_path, capsys):
     line = one_line_error(capsys, ["eclutch", "static", "--model", "1", "--travel", "500 mm", "--points", "20",
                                    "-o", str(out)])
     assert "Model 1: bearing position" in line and "'diaphragm' spring" in line and "extrapolation" in line
+    assert "--extrapolate" in line
     assert not out.exists()
+    # on request (#33: the API's extrapolate=True had no CLI option): the API's continuation, said in the header
+    from clutchlab.cli import main
+
+    assert main(["eclutch", "static", "--model", "1", "--travel", "500 mm", "--points", "20", "--extrapolate",
+                 "-o", str(out)]) == 0
+    got = pd.read_csv(out, comment="#")
+    ref = ClutchModel.preset(1).static_curve(np.linspace(0.0, 0.5, 20), extrapolate=True)
+    np.testing.assert_allclose(got["bearing_force_N"], ref["bearing_force_N"], rtol=1e-8)   # (9 digits in the file)
+    assert "--extrapolate: characteristics may be continued linearly" in out.read_text()
 
 
 # ------------------------------------------------------------ pedal beyond its stops

@@ -84,9 +84,11 @@ def _static(args) -> int:
     model = _model(args)
     # node positions, element forces and deflections at every point
     check_allocation(args.points, 3 * len(model.network.elements) + 8, f"--points {args.points}")
-    df = model.static_curve(np.linspace(0.0, travel, args.points))
+    df = model.static_curve(np.linspace(0.0, travel, args.points), extrapolate=args.extrapolate)
+    note = ("\n--extrapolate: characteristics may be continued linearly beyond their measured range (an assumption, "
+            "not a measurement)") if args.extrapolate else ""
     atomic_to_csv(df, args.output, overwrite=args.force,
-                  header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static")
+                  header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static{note}")
     if args.plot:
         from .validation import read_full_clutch_record
 
@@ -211,6 +213,9 @@ def register(subparsers) -> None:
     s.add_argument("--params", help="TOML parameter file ([eclutch] table; values may carry units)")
     s.add_argument("--travel", default="9 mm", help="release travel, with unit (default: %(default)s)")
     s.add_argument("--points", type=int, default=200, help="number of bearing positions (default: %(default)s)")
+    s.add_argument("--extrapolate", action="store_true",
+                   help="continue a measured characteristic linearly beyond its range where the travel needs it "
+                        "(said in the file's header); without it such a travel is refused")
     s.add_argument("-o", "--output", required=True, help="CSV to write")
     s.add_argument("--plot", help="also write a PNG figure: bearing force, normal force and torque over the travel")
     s.add_argument("--record", help="full-clutch record CSV to draw in the figure")

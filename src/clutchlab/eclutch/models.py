@@ -525,4 +525,4 @@ class ClutchModel:
                     f"{self.name}: bearing position {st['input'][i] * 1e3:.4g} mm deflects the {name!r} spring "
                     f"by {d[i] * 1e3:.4g} mm, outside its characterised range {lo * 1e3:.4g}..{hi * 1e3:.4g} mm "
                     f"(curve {e.curve.name!r}): the result would be an extrapolation; shorten the travel "
-                    "(or pass extrapolate=True)")
+                    "(or pass extrapolate=True; clutchlab eclutch static: --extrapolate)")
