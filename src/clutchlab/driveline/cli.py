@@ -137,43 +137,36 @@ def _inputs(items, driveline, file) -> dict:
 
 def _trace(path, unit: str, what: str):
     """``(times [s], values [unit])`` of a CSV trace: ``time_s`` and one value column whose name ends in its unit
-    suffix (``load_Nm``, ``clutch_1``); lines starting with ``#`` are comments."""
+    suffix (``load_Nm``, ``clutch_1``); lines starting with ``#`` are comments.  Read and checked (finite
+    numbers) by :func:`clutchlab.io.read_table`."""
     import numpy as np
-    import pandas as pd
 
+    from ..io import read_table
     from ..io.channels import unit_conversion
+    from ..io.measurements import duplicate_columns
     from ..units import column_unit
 
-    from ..io.measurements import duplicate_columns
-
-    if not path.is_file():
-        raise ParameterError(f"{what} = {str(path)!r}: no such file")
+    label = f"{what}: {path}"
     try:
-        duplicate_columns(path, f"{what}: {path}")
-        frame = pd.read_csv(path, comment="#")
+        if path.is_file():
+            duplicate_columns(path, label)
+        frame = read_table(path, ["time_s"], name=label)
+        others = [c for c in frame.columns if c != "time_s"]
+        if len(others) != 1:
+            raise ParameterError(f"{label}: expected the columns time_s and one value column (found "
+                                 f"{', '.join(map(str, frame.columns)) or 'none'})")
+        column = str(others[0])
+        frame = read_table(frame, [column], name=label)
     except DataError as exc:
         raise ParameterError(str(exc)) from None
-    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
-        raise ParameterError(f"{what}: {path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
-    others = [c for c in frame.columns if c != "time_s"]
-    if "time_s" not in frame.columns or len(others) != 1:
-        raise ParameterError(f"{what}: {path}: expected the columns time_s and one value column (found "
-                             f"{', '.join(map(str, frame.columns)) or 'none'})")
-    column = str(others[0])
     source = column_unit(column)
     if source is None:
-        raise ParameterError(f"{what}: {path}: column {column!r} does not name its unit: end it with the unit's "
-                             f"suffix (e.g. {column}_Nm, {column}_1)")
-    scale, offset = unit_conversion(source, unit, name=column, where=f"{what}: {path}", error=ParameterError)
-    times = pd.to_numeric(frame["time_s"], errors="coerce").to_numpy(dtype=float)
-    values = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=float)
-    bad = ~(np.isfinite(times) & np.isfinite(values))
-    if bad.any():
-        row = int(np.flatnonzero(bad)[0])
-        raise ParameterError(f"{what}: {path}: row {row + 1}: time_s = {frame['time_s'].iloc[row]!r}, {column} = "
-                             f"{frame[column].iloc[row]!r}: not a finite number")
+        raise ParameterError(f"{label}: column {column!r} does not name its unit: end it with the unit's suffix "
+                             f"(e.g. {column}_Nm, {column}_1)")
+    scale, offset = unit_conversion(source, unit, name=column, where=label, error=ParameterError)
+    times, values = frame["time_s"].to_numpy(dtype=float), frame[column].to_numpy(dtype=float)
     if times.size == 0 or np.any(np.diff(times) <= 0):
-        raise ParameterError(f"{what}: {path}: time_s must hold strictly increasing times (at least one)")
+        raise ParameterError(f"{label}: time_s must hold strictly increasing times (at least one)")
     return times, scale * values + offset
 
 

@@ -521,7 +521,6 @@ def _toml_value_text(value) -> str:
 
 def parameter_tables(run_dir: Path, output: Path | None) -> tuple[list, list[str]]:
     """One report Table per ``*.toml`` in ``run_dir`` (and messages for files that cannot be read)."""
-    from ..errors import ParameterError
     from ..params.base import load_toml
     from ..params.registry import load_model_file
 
