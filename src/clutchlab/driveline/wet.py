@@ -49,11 +49,9 @@ F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
 # buf (float): its states with the slip replaced | their derivative | switching values | inputs (zero) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
 N_BUF = B_Y + W.N_OUT
-#: outputs of the wet model that belong to its bench, not to the clutch: the drive motor, the speed controller
-#: and its slip acceleration, the torque sensor, the load cell and the reservoir heater.  A network reports
-#: the clutch's own (:data:`OUTPUTS`; #33)
-BENCH_ONLY = ("load_cell_force", "drive_torque", "slip_reference", "slip_acceleration", "sensor_torque",
-              "heater_power")
+#: outputs of the wet model that belong to its bench, as the wet model declares them
+#: (:data:`clutchlab.wet.system.BENCH_OUTPUTS`).  A network reports the clutch's own (:data:`OUTPUTS`; #33)
+BENCH_ONLY = W.BENCH_OUTPUTS
 #: a wet clutch's outputs in a network, ``(quantity, unit, description)``, and their places in the model's
 OUTPUTS = tuple(o for o in W.OUTPUTS if o[0] not in BENCH_ONLY)
 KEPT = np.array([i for i, o in enumerate(W.OUTPUTS) if o[0] not in BENCH_ONLY], dtype=np.int64)

@@ -85,7 +85,7 @@ __all__ = [
     "WetParams", "pack_parameters", "with_scenario", "fresh_buffers", "stacked_parameters", "new_work",
     "engagement_system", "initial_state",
     "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque", "tanh",
-    "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
+    "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "BENCH_OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",
 ]
 
 # ----------------------------------------------------------------- layout
@@ -130,6 +130,11 @@ OUTPUTS = (
 )
 (O_TAU, O_TC, O_TV, O_FC, O_FH, O_FLC, O_H, O_HBAR, O_MUF, O_MUV, O_TD, O_WREF, O_FREF, O_WDOT, O_TS,
  O_PF, O_QH, O_CAP) = range(18)
+#: the outputs that belong to the bench, not to the clutch (its drive motor, speed controller and slip
+#: acceleration, torque sensor, load cell and reservoir heater): a clutch placed elsewhere (a driveline) has
+#: none of them
+BENCH_OUTPUTS = ("load_cell_force", "drive_torque", "slip_reference", "slip_acceleration", "sensor_torque",
+                 "heater_power")
 N_OUT = 18
 
 #: held inputs, added to the scenario's reference profiles (zero in a scenario run)
