@@ -388,13 +388,24 @@ def test_parquet_without_checksums_absurd_value(work, capsys):
     force[37] = 9e242  # a corrupted page of a file written without checksums
     table = pa.table({"time_s": np.arange(100) * 1e-3, "force_N": force})
     pq.write_table(table, work / "logger.parquet", use_dictionary=False)
+    # the only channel: nothing to read (#33: a channel nobody asked for is skipped, not the whole file)
     refused(["convert", "logger.parquet", "-o", "out.csv"], work, capsys,
+            "logger.parquet", "no channel could be read", "force_N", "9e+242", "row 37")
+    # asked for by a channel map: an error naming the channel
+    (work / "map.toml").write_text("[channels.force_N]\nsource = 'force_N'\n")
+    refused(["convert", "logger.parquet", "--channel-map", "map.toml", "-o", "out.csv"], work, capsys,
             "logger.parquet", "'force_N'", "9e+242", "row 37")
+    # beside a good channel: skipped with a warning, the good one written
+    table = pa.table({"time_s": np.arange(100) * 1e-3, "force_N": force, "torque_Nm": np.ones(100)})
+    pq.write_table(table, work / "logger.parquet", use_dictionary=False)
+    assert main(["convert", "logger.parquet", "-o", "out.csv"]) == 0
+    assert "skipped force_N: an implausible value 9e+242 N at row 37" in capsys.readouterr().err
+    assert list(pd.read_csv(work / "out.csv", comment="#").columns) == ["time_s", "torque_Nm"]
 
 
 def test_temperature_below_absolute_zero(work, capsys):
     (work / "rec.csv").write_text("time_s,temperature_C\n0,20\n0.1,-300\n0.2,21\n")
-    refused(["convert", "rec.csv", "-o", "out.csv"], work, capsys, "rec.csv", "'temperature_C'", "-300",
+    refused(["convert", "rec.csv", "-o", "out.csv"], work, capsys, "rec.csv", "temperature_C", "-300",
             "absolute zero", "row 1")
     (work / "rec.csv").write_text("time_s,temperature_C\n0,20\n0.1,-270\n0.2,21\n")  # cold but possible
     assert main(["convert", "rec.csv", "-o", "out.csv"]) == 0

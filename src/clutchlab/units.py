@@ -19,6 +19,8 @@ from ._limits import short_repr
 from .errors import ParameterError
 
 __all__ = [
+    "ENGINEERS_UNITS",
+    "engineers_unit",
     "rpm_to_rad_s",
     "rad_s_to_rpm",
     "celsius_to_kelvin",
@@ -399,6 +401,37 @@ def unit_label(unit: str) -> str:
     for spelled, printed in (("**-1", "⁻¹"), ("**2", "²"), ("**3", "³"), ("^2", "²"), ("^3", "³"), ("*", "·")):
         unit = unit.replace(spelled, printed)
     return unit
+
+
+#: the unit engineers read each quantity in, by the SI (file) unit of the column: figures and tables of reports
+#: may show these; the columns and files stay SI (docs/report.md, "Engineers' units")
+ENGINEERS_UNITS: dict[str, str] = {
+    "rad/s": "rpm", "m/s": "km/h", "Pa": "bar", "kPa": "bar", "MPa": "bar", "m": "mm", "N": "kN",
+    "K": "degC", "rad": "deg", "W": "kW", "J": "kJ", "m**3/s": "l/min", "s": "s",
+}
+
+
+def engineers_unit(unit: str) -> tuple[str, float, float]:
+    """The engineers' unit of an SI column unit and the affine map to it.
+
+    Parameters
+    ----------
+    unit : str
+        The column's unit as :func:`column_unit` returns it (``"rad/s"``, ``"Pa"``, ``"N"``).
+
+    Returns
+    -------
+    (unit, scale, offset) : tuple
+        ``shown = scale * value + offset`` in ``unit`` (``("rpm", 9.549..., 0.0)`` for rad/s,
+        ``("degC", 1.0, -273.15)`` for K); the unit itself with ``(1, 0)`` where engineers read SI (N·m, °C).
+    """
+    target = ENGINEERS_UNITS.get(str(unit))
+    if not target or target == unit:
+        return str(unit), 1.0, 0.0
+    from .io.channels import unit_conversion
+
+    scale, offset = unit_conversion(unit, target, name=unit)
+    return target, scale, offset
 
 
 def column_label(name: str) -> str:

@@ -209,8 +209,8 @@ def test_convert_without_map_warns_once_per_skipped_channel(tmp_path, can_file, 
     warnings = stderr.splitlines()
     assert warnings == [
         f"clutchlab: warning: {can_file}: skipped group 1: raw bus frames (CAN1.CAN_DataFrame, CAN_DataFrame, "
-        "CAN_DataFrame.BusChannel, ...), not signals; decode them with a DBC file (asammdf extract_bus_logging) "
-        "or map their fields explicitly",
+        "CAN_DataFrame.BusChannel, ...), not signals; decode them with a DBC or ARXML file (--dbc, [bus] in a "
+        "channel map, databases=) or map their fields explicitly",
         f"clutchlab: warning: {can_file}: skipped TQ: occurs 2 times (group 0 index 2 [Nm] 'clutch torque'; "
         "group 0 index 3 [kNm] 'torque request'); map it with group and index",
         f"clutchlab: warning: {can_file}: skipped Label: non-numeric samples (text, structures or arrays)",

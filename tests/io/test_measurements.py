@@ -244,3 +244,29 @@ def test_a_column_named_twice_is_an_error_not_a_renamed_channel(tmp_path):
         read_measurement(path)
     datasets, failed = find_datasets(path.parent)
     assert not datasets and "column 'torque_Nm' appears twice" in failed[0][1]
+
+
+def test_an_implausible_channel_nobody_asked_for_is_skipped_not_the_whole_file(tmp_path, capsys):
+    """#33: a UNIX time in ns (1.7e18) or a conversion overflowing to -inf in one channel of a file read
+    without a map is a warning and the rest of the file, not a refusal; asked for, it stays an error."""
+    from clutchlab.cli import main
+
+    path = tmp_path / "log.csv"
+    path.write_text("# units: big_N=kN\ntime_s,stamp,force_N,big_N\n0,1.7e18,1,-1e306\n1,1.7e18,2,-1e306\n")
+    m = read_measurement(path)
+    assert m.channels == ("force_N",)
+    assert "implausible value 1.7e+18" in m.source.skipped["stamp"]
+    assert "implausible value -inf N" in m.source.skipped["big_N"]
+    with pytest.raises(DataError, match=r"channel 'stamp' has an implausible value 1\.7e\+18"):
+        read_measurement(path, required=["stamp"])
+    assert main(["convert", str(path), "-o", str(tmp_path / "out.parquet")]) == 0
+    err = capsys.readouterr().err
+    assert "skipped stamp: an implausible value" in err and "skipped big_N" in err
+    assert read_measurement(tmp_path / "out.parquet").channels == ("force_N",)
+    # the time column is never skipped: the error suggests its unit
+    path.write_text("time_s,force_N\n1.7e18,1\n1.8e18,2\n")
+    with pytest.raises(DataError, match=r"if it is a UNIX time in ns, us or ms, state the unit \(a '# units: "
+                                        r"time_s=ns' line"):
+        read_measurement(path)
+    path.write_text("# units: time_s=ns\ntime_s,force_N\n1.7e18,1\n1.8e18,2\n")
+    np.testing.assert_allclose(read_measurement(path)["time_s"], [1.7e9, 1.8e9])

@@ -143,13 +143,10 @@ def _trace(path, unit: str, what: str):
 
     from ..io import read_table
     from ..io.channels import unit_conversion
-    from ..io.measurements import duplicate_columns
     from ..units import column_unit
 
     label = f"{what}: {path}"
     try:
-        if path.is_file():
-            duplicate_columns(path, label)
         frame = read_table(path, ["time_s"], name=label)
         others = [c for c in frame.columns if c != "time_s"]
         if len(others) != 1:

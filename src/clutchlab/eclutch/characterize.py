@@ -43,6 +43,7 @@ from ..curves import Curve, series
 from .._limits import check_allocation, short_repr
 from ..errors import DataError, IdentificationError, ParameterError
 from ..io import Measurement, read_measurement
+from ..io.measurements import check_time as _check_time
 
 __all__ = [
     "CharacterizedCurve",
@@ -226,7 +227,7 @@ class _Cycles:
     label: str
 
 
-def _load_record(record, channels, name, channel_map=None):
+def _load_record(record, channels, name, channel_map=None, sample_rate=None):
     if isinstance(record, (str, Path)):
         label = name or str(record)
     elif isinstance(record, Measurement):
@@ -237,11 +238,26 @@ def _load_record(record, channels, name, channel_map=None):
         raise DataError(f"record must be a pandas.DataFrame or a file path, got {type(record).__name__}")
     # CSV, Parquet or MDF 4; units in the file converted to the ones the column names state; a channel
     # map renames a logger's channels to time_s, force_N, displacement_m (docs/measurements.md)
-    frame = read_measurement(record, channel_map, required=["time_s", "force_N", *channels], name=label).frame
-    t = frame["time_s"].to_numpy(dtype=float)
-    if t.size < MIN_SAMPLES:
-        raise DataError(f"{label}: record too short ({t.size} samples, need at least {MIN_SAMPLES})")
-    return frame, label  # time strictly increasing: checked by read_measurement
+    # The time column is optional: the characterisation needs only the order of the samples (#33); a record
+    # without time gets time_s from sample_rate, or NaN (it only labels the raw branches).
+    meas = read_measurement(record, channel_map, required=["force_N", *channels], time=None, name=label)
+    frame = meas.frame
+    if "time_s" in meas.source.skipped:
+        raise DataError(f"{label}: time column 'time_s': {meas.source.skipped['time_s']}")
+    if sample_rate is not None:
+        number = isinstance(sample_rate, (int, float, np.number)) and not isinstance(sample_rate, bool)
+        if not (number and np.isfinite(sample_rate) and sample_rate > 0):
+            raise ParameterError(f"sample_rate = {sample_rate!r} Hz: must be a positive number")
+    if "time_s" in frame.columns:
+        if sample_rate is not None:
+            raise ParameterError(f"sample_rate = {sample_rate!r} Hz, but {label} has its own time column time_s")
+        _check_time(frame["time_s"].to_numpy(dtype=float), label, "time_s", "row")
+    else:
+        n = len(frame)
+        frame.insert(0, "time_s", np.arange(n) / float(sample_rate) if sample_rate is not None else np.nan)
+    if len(frame) < MIN_SAMPLES:
+        raise DataError(f"{label}: record too short ({len(frame)} samples, need at least {MIN_SAMPLES})")
+    return frame, label
 
 
 def _cycles(frame: pd.DataFrame, label: str, drive: str, quantities: list[str], n_grid: int) -> _Cycles:
@@ -390,7 +406,7 @@ def _check_sign_convention(load: np.ndarray, unload: np.ndarray, frame: pd.DataF
 # ------------------------------------------------------------------------ characterize
 def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, kind: str = "pchip",
                  min_cycles: int = 1, turning_point_correction: bool = True,
-                 name: str | None = None, channel_map=None) -> CharacterizedCurve:
+                 name: str | None = None, channel_map=None, sample_rate: float | None = None) -> CharacterizedCurve:
     """Component characteristic from a press-rig record ([1], Section 4, Fig. 9).
 
     The procedure of [1], Section 4: "raw experimental results exhibit a
@@ -402,8 +418,9 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
     Parameters
     ----------
     record : pandas.DataFrame or path
-        Press record with ``time_s`` [s], ``force_N`` [N] and the displacement
-        ``channel`` [m]; a CSV file may carry ``#`` comment lines.
+        Press record with ``force_N`` [N], the displacement ``channel`` [m]
+        and optionally ``time_s`` [s]; a CSV file may carry ``#`` comment
+        lines and be in any dialect (:mod:`clutchlab.io.dialect`).
     channel : str
         Displacement column used as deflection (``"displacement_m"`` = LVDT 1;
         e.g. ``"displacement2_m"`` for the second LVDT).
@@ -425,8 +442,13 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         ``force_N`` and ``channel`` (a TOML file or a mapping, see
         :class:`~clutchlab.io.channels.ChannelMap` and docs/measurements.md).
         Without a map the record must use those names; units stated in the
-        file (a CSV ``# units:`` line, Parquet metadata, MDF channel units) are
-        converted to SI either way.
+        file (a CSV ``# units:`` line or unit row, Parquet metadata, MDF
+        channel units) are converted to SI either way.
+    sample_rate : float, optional
+        Sample rate [Hz] of a record without time column, for the ``time_s``
+        of ``branches``.  The characterisation itself needs only the order of
+        the samples, so a record without time is accepted; without
+        ``sample_rate`` its branches carry ``time_s = NaN``.
 
     Returns
     -------
@@ -495,7 +517,7 @@ def characterize(record, *, channel: str = "displacement_m", n_grid: int = 60, k
         raise ParameterError(f"kind = {kind!r}, expected 'pchip' or 'linear'")
     if isinstance(min_cycles, bool) or not isinstance(min_cycles, (int, np.integer)) or min_cycles < 1:
         raise ParameterError(f"min_cycles = {min_cycles!r} must be an integer >= 1")
-    frame, label = _load_record(record, [channel], None, channel_map)
+    frame, label = _load_record(record, [channel], None, channel_map, sample_rate)
     # kernel weights of the local linear regression: n_grid x samples of a branch, a few temporaries
     check_allocation(n_grid, 6 * len(frame), f"n_grid = {n_grid} points for {label} ({len(frame)} samples)")
     cyc = _cycles(frame, label, channel, ["force_N"], int(n_grid))

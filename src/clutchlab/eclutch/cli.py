@@ -12,6 +12,7 @@ from ..cli import add_fixed_step_option
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
 from ..io.files import check_outputs
+from ..io.cli import add_csv_options, csv_options
 from ..units import to_si
 
 
@@ -49,14 +50,17 @@ def _characterize(args) -> int:
     check_outputs([args.output, args.plot], args.force)
     # one read: the channel map (if any) renames the logger's channels, units in the file become SI
     try:
-        meas = read_measurement(args.record, args.channel_map, required=["time_s", "force_N", args.channel],
-                                name=str(args.record))
+        meas = read_measurement(args.record, args.channel_map, required=["force_N", args.channel], time=None,
+                                name=str(args.record), csv=csv_options(args))
     except DataError as exc:
         if args.channel_map or "missing column" not in str(exc):
             raise
         raise DataError(f"{exc}; map the logger's channel names with --channel-map MAP.toml "
                         "(docs/measurements.md)") from None
-    curve = characterize(meas, channel=args.channel, n_grid=args.points, name=Path(args.record).stem)
+    curve = characterize(meas, channel=args.channel, n_grid=args.points, name=Path(args.record).stem,
+                         sample_rate=args.sample_rate)
+    if meas.source.dialect is not None:
+        print(f"{args.record}: read as {meas.source.dialect.describe()}")
     mapped = f" with channel map {args.channel_map}" if args.channel_map else ""
     comment = f"characterised from {args.record}{mapped} by clutchlab eclutch characterize"
     if meas.source.synthetic:  # the record's own "synthetic: ..." lines travel with the curve
@@ -189,8 +193,8 @@ def register(subparsers) -> None:
                                    "of the models ([eclutch.curves] in a parameter file).",
                        epilog="Documentation: docs/pressrig.md (characterisation), docs/measurements.md "
                               "(channel maps), docs/eclutch.md (using your own component curve)")
-    c.add_argument("record", help="record (.csv, .parquet, .mf4) with time_s, force_N, displacement_m, or the "
-                                  "logger's channels named in --channel-map; units in the file are converted")
+    c.add_argument("record", help="record (.csv, .parquet, .mf4) with force_N, displacement_m and optionally time_s, "
+                                  "or the logger's channels named in --channel-map; units in the file are converted")
     c.add_argument("-o", "--output", required=True, help="curve CSV to write")
     c.add_argument("--channel", default="displacement_m", help="displacement column (default: %(default)s)")
     c.add_argument("--channel-map", metavar="MAP.toml",
@@ -198,7 +202,11 @@ def register(subparsers) -> None:
                         "displacement channel (docs/measurements.md)")
     c.add_argument("--points", type=int, default=60, help="samples of the returned curve (default: %(default)s)")
     c.add_argument("--plot", help="also write a PNG figure of raw record and curve")
+    c.add_argument("--sample-rate", type=float, metavar="HZ",
+                   help="sample rate of a record without time column (only labels the raw branches; the "
+                        "characterisation needs just the order of the samples)")
     c.add_argument("--force", action="store_true", help="overwrite existing output files")
+    add_csv_options(c)
     c.set_defaults(func=_characterize)
 
     s = sub.add_parser("static", help="static curves (bearing force, normal force, torque) of Model N",

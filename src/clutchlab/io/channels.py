@@ -20,6 +20,16 @@ mapping::
     interpolation = "previous"    # a state: hold, do not interpolate
     optional = true               # absent channels are skipped, not an error
 
+    [csv]                         # optional: how the logger writes text files, where detection needs help
+    encoding = "cp1252"           # (see clutchlab.io.dialect; every field may be left out and is then detected)
+    separator = ";"
+    decimal = ","
+    header_row = 2                # line of the column names, counted from 1
+    units_row = 3                 # line of the units, 0 for none
+
+    [bus]                         # optional: decode the raw CAN/LIN frames of an MDF bus log into signals
+    can = ["powertrain.dbc", {file = "chassis.arxml", channel = 2}]   # paths from the map's folder
+
 The target unit of an entry is the one its clutchlab name states (``_Nm`` ->
 N·m, ``_rad_s`` -> rad/s, ``_C`` -> °C, see :func:`canonical_unit`); names
 without a unit suffix need ``unit``.  Unit strings are parsed with pint
@@ -235,6 +245,12 @@ class ChannelMap:
         The entries, in the order the columns of the result should have.
     name : str
         How to call the map in error messages (its file name).
+    csv : CsvDialect or mapping, optional
+        How the logger writes its text files (a ``[csv]`` table:
+        :class:`~clutchlab.io.dialect.CsvDialect`); fields left out are detected.
+    bus : iterable of BusDatabase, optional
+        Bus databases decoding the raw CAN/LIN frames of an MDF bus log (a
+        ``[bus]`` table: :class:`~clutchlab.io.mdf.BusDatabase`).
 
     Examples
     --------
@@ -244,8 +260,15 @@ class ChannelMap:
     ['TQ_Clutch', 'N_Slip']
     """
 
-    def __init__(self, channels: Iterable[ChannelSpec], name: str = "channel map"):
+    def __init__(self, channels: Iterable[ChannelSpec], name: str = "channel map", csv=None, bus=()):
+        from .dialect import CsvDialect
+        from .mdf import BusDatabase
+
         self.name = name
+        #: how the logger writes its text files (:class:`~clutchlab.io.dialect.CsvDialect`), or None: detected
+        self.csv = None if csv is None else CsvDialect.coerce(csv, f"{name}: [csv]")
+        #: bus databases decoding the raw CAN/LIN frames of an MDF bus log (:class:`~clutchlab.io.mdf.BusDatabase`)
+        self.bus = tuple(BusDatabase.coerce(b) for b in bus)
         specs = list(channels)
         seen: dict[str, ChannelSpec] = {}
         for spec in specs:
@@ -257,7 +280,7 @@ class ChannelMap:
         self._specs = seen
 
     @classmethod
-    def from_dict(cls, mapping: Mapping, name: str = "channel map") -> "ChannelMap":
+    def from_dict(cls, mapping: Mapping, name: str = "channel map", base: Path | None = None) -> "ChannelMap":
         """Build a map from ``{name: source}`` or ``{name: {"source": ..., "unit": ..., ...}}``.
 
         Parameters
@@ -266,17 +289,39 @@ class ChannelMap:
             clutchlab name -> logger name, or clutchlab name -> table with the
             keys of :class:`ChannelSpec` (``source``, ``unit``,
             ``source_unit``, ``group``, ``index``, ``interpolation``, ``optional``).  A
-            mapping with the single key ``"channels"`` (the TOML layout) is
+            mapping with the key ``"channels"`` (the TOML layout, optionally with a ``"csv"`` table) is
             accepted too.
         name : str
             How to call the map in error messages.
+        base : Path, optional
+            Folder that relative bus-database paths of a ``[bus]`` table start
+            from (the map file's folder).
         """
         if not isinstance(mapping, Mapping):
             raise ParameterError(f"{name}: expected a mapping of channel names, got {type(mapping).__name__}")
+        csv, bus = None, []
         if "channels" in mapping and isinstance(mapping["channels"], Mapping):
-            unknown = [k for k in mapping if k != "channels"]
+            unknown = [k for k in mapping if k not in ("channels", "csv", "bus")]
             if unknown:
-                raise ParameterError(f"{name}: unknown table {unknown[0]!r} (expected only [channels.<name>])")
+                raise ParameterError(f"{name}: unknown table {unknown[0]!r} (expected [channels.<name>] and "
+                                     "optionally [csv] and [bus])")
+            csv = mapping.get("csv")
+            if csv is not None and not isinstance(csv, Mapping):
+                raise ParameterError(f"{name}: csv = {csv!r} must be a table ([csv] with encoding, separator, "
+                                     "decimal, header_row, units_row, thousands)")
+            table = mapping.get("bus", {})
+            if not isinstance(table, Mapping):
+                raise ParameterError(f"{name}: bus = {table!r} must be a table ([bus] with can = [...], lin = [...])")
+            for key, entries in table.items():
+                if key.upper() not in ("CAN", "LIN"):
+                    raise ParameterError(f"{name}: [bus] has unknown key {key!r} (expected can, lin)")
+                if isinstance(entries, (str, Mapping)):
+                    entries = [entries]
+                if not isinstance(entries, list):
+                    raise ParameterError(f"{name}: [bus] {key} = {entries!r} must be a list of database files")
+                from .mdf import BusDatabase
+
+                bus += [BusDatabase.coerce(e, base, key.upper()) for e in entries]
             mapping = mapping["channels"]
         specs = []
         for key, entry in mapping.items():
@@ -290,7 +335,7 @@ class ChannelMap:
                 specs.append(ChannelSpec(str(key), **dict(entry)))
             else:
                 raise ParameterError(f"{name}: channel {key!r} = {entry!r}: expected a source name or a table")
-        return cls(specs, name=name)
+        return cls(specs, name=name, csv=csv, bus=bus)
 
     @classmethod
     def from_toml(cls, path) -> "ChannelMap":
@@ -303,7 +348,7 @@ class ChannelMap:
         """
         from ..params import load_toml
 
-        return cls.from_dict(load_toml(path), name=str(path))
+        return cls.from_dict(load_toml(path), name=str(path), base=Path(path).parent)
 
     @classmethod
     def coerce(cls, value) -> "ChannelMap | None":
@@ -349,7 +394,14 @@ class ChannelMap:
             entry = {k: getattr(spec, k) for k in _SPEC_KEYS
                      if getattr(spec, k) is not None and not (k == "optional" and not spec.optional)}
             out[spec.name] = entry
-        return {"channels": out}
+        table = {}
+        if self.csv is not None and self.csv.to_dict():
+            table["csv"] = self.csv.to_dict()
+        for b in self.bus:
+            table.setdefault("bus", {}).setdefault(b.bus.lower(), []).append(
+                {"file": str(b.path), "channel": b.channel} if b.channel else str(b.path))
+        table["channels"] = out
+        return table
 
     def __repr__(self) -> str:
         return f"ChannelMap({', '.join(f'{s.name}<-{s.source}' for s in self)})"

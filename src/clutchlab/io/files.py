@@ -219,7 +219,8 @@ def read_table(source, required: Iterable[str], *, name: str | None = None, allo
     Parameters
     ----------
     source : str, Path or pandas.DataFrame
-        CSV file (lines starting with ``#`` are comments) or a DataFrame.
+        CSV file (lines starting with ``#`` are comments; the encoding, separator, decimal mark and
+        header rows are detected, :mod:`clutchlab.io.dialect`) or a DataFrame.
     required : iterable of str
         Columns that must be present, finite and numeric.
     name : str, optional
@@ -241,10 +242,11 @@ def read_table(source, required: Iterable[str], *, name: str | None = None, allo
         label = name or str(path)
         if not path.exists():
             raise DataError(f"{label}: no such file")
-        try:
-            frame = pd.read_csv(path, comment="#")
-        except Exception as exc:  # pandas raises several parser errors
-            raise DataError(f"{label}: cannot read as CSV ({exc})") from None
+        if path.is_dir():
+            raise DataError(f"{label}: is a directory, not a CSV file")
+        from .dialect import read_csv
+
+        frame = read_csv(path, label).frame  # any dialect rig software writes (clutchlab.io.dialect)
     allow_nan = set(allow_nan)
     for col in required:
         if col not in frame.columns:

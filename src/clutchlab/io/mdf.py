@@ -23,7 +23,8 @@ import numpy as np
 from ..errors import DataError
 from .files import check_writable, temporary_sibling
 
-__all__ = ["MDF_SUFFIXES", "UNFINALISED_ID", "RawChannel", "ChannelPlace", "MdfReader", "write_mdf"]
+__all__ = ["MDF_SUFFIXES", "UNFINALISED_ID", "BUS_TYPES", "BusDatabase", "RawChannel", "ChannelPlace", "MdfReader",
+           "write_mdf"]
 
 #: file name endings read and written as MDF
 MDF_SUFFIXES = (".mf4", ".mdf")
@@ -210,6 +211,86 @@ class ChannelPlace:
         return text + (f" {self.comment!r}" if self.comment else "")
 
 
+#: bus types asammdf's bus-logging extraction decodes, and the database formats canmatrix reads for them
+BUS_TYPES = ("CAN", "LIN")
+DATABASE_SUFFIXES = (".dbc", ".arxml", ".kcd", ".sym", ".ldf", ".xml")
+
+
+@dataclass(frozen=True)
+class BusDatabase:
+    """A bus database (DBC, ARXML, ...) that decodes the raw frames of an MDF bus log into signals.
+
+    Parameters
+    ----------
+    path : str or Path
+        The database file (``.dbc``, ``.arxml``, ``.kcd``, ``.sym``; ``.ldf`` for LIN).
+    bus : {"CAN", "LIN"}
+        Bus type of the frames it decodes.
+    channel : int
+        Bus channel it applies to (the frames' ``BusChannel``); 0 for every channel.
+    """
+
+    path: Path
+    bus: str = "CAN"
+    channel: int = 0
+
+    def __post_init__(self):
+        from ..errors import ParameterError
+
+        if not isinstance(self.path, (str, Path)) or not str(self.path):
+            raise ParameterError(f"bus database = {self.path!r}: expected a file path")
+        object.__setattr__(self, "path", Path(self.path))
+        bus = self.bus.upper() if isinstance(self.bus, str) else self.bus
+        if bus not in BUS_TYPES:
+            raise ParameterError(f"bus database {self.path}: bus = {self.bus!r}, expected one of {', '.join(BUS_TYPES)}")
+        object.__setattr__(self, "bus", bus)
+        if isinstance(self.channel, bool) or not isinstance(self.channel, int) or self.channel < 0:
+            raise ParameterError(f"bus database {self.path}: channel = {self.channel!r} must be a bus channel "
+                                 "number (0 for every channel)")
+
+    @classmethod
+    def coerce(cls, value, base: Path | None = None, bus: str = "CAN") -> "BusDatabase":
+        """A path, ``{"file": ..., "channel": ...}`` (a TOML table) or a BusDatabase; relative paths from ``base``."""
+        from ..errors import ParameterError
+
+        if isinstance(value, BusDatabase):
+            return value
+        if isinstance(value, (str, Path)):
+            path, channel = value, 0
+        elif isinstance(value, dict):
+            unknown = [k for k in value if k not in ("file", "channel")]
+            if unknown or "file" not in value:
+                raise ParameterError(f"bus database {value!r}: expected a file name or a table with 'file' and "
+                                     "optionally 'channel'")
+            path, channel = value["file"], value.get("channel", 0)
+        else:
+            raise ParameterError(f"bus database = {value!r}: expected a file name or a table with 'file'")
+        if not isinstance(path, (str, Path)):
+            raise ParameterError(f"bus database file = {path!r}: expected a file name")
+        path = Path(path)
+        if base is not None and not path.is_absolute():
+            path = base / path
+        return cls(path, bus, channel)
+
+    def load(self):
+        """The database as a :class:`canmatrix.CanMatrix`, or a :class:`DataError` naming the file."""
+        if not self.path.is_file():
+            raise DataError(f"{self.path}: no such bus database file")
+        if self.path.suffix.lower() not in DATABASE_SUFFIXES:
+            raise DataError(f"{self.path}: unknown bus database format {self.path.suffix!r} (expected "
+                            f"{', '.join(DATABASE_SUFFIXES)})")
+        try:
+            import canmatrix.formats
+
+            with _quiet_asammdf():
+                matrix = canmatrix.formats.loadp_flat(str(self.path))
+        except Exception as exc:   # canmatrix raises assorted parser errors
+            raise DataError(f"{self.path}: cannot read the bus database ({_one_line(exc)})") from None
+        if matrix is None or not matrix.frames:
+            raise DataError(f"{self.path}: the bus database defines no messages")
+        return matrix
+
+
 class MdfReader:
     """An open MDF file: its channel names, groups, header comment, and channel access.
 
@@ -225,15 +306,20 @@ class MdfReader:
         The ``.mf4`` (or ``.mdf``) file.
     label : str
         How to call the file in error messages.
+    databases : iterable of BusDatabase, optional
+        Bus databases decoding the raw CAN/LIN frames of a bus log into
+        signals (asammdf's bus-logging extraction, canmatrix's parsers): the
+        decoded signals become channels beside the file's own, in groups
+        numbered after them, and :attr:`decoding` says what was decoded.
 
     Raises
     ------
     DataError
         Missing file, not an MDF file, truncated, unfinalised beyond repair or
-        otherwise unreadable.
+        otherwise unreadable; an unreadable bus database.
     """
 
-    def __init__(self, path, label: str):
+    def __init__(self, path, label: str, databases=()):
         from asammdf import MDF
 
         self.path = Path(path)
@@ -276,25 +362,85 @@ class MdfReader:
                                 f"cannot finalise ({_one_line(exc)})") from None
             raise DataError(f"{label}: not a readable MDF file ({_one_line(exc)})") from None
         groups = self._mdf.groups
-        self._masters = {(g, i) for g, i in self._mdf.masters_db.items()}
         self.bus_groups = {g for g, grp in enumerate(groups)
                            if getattr(grp.channel_group, "flags", 0) & _CG_BUS_EVENT
                            or any(ch.name.split(".", 1)[0] in _BUS_FRAMES for ch in grp.channels)}
+        #: (asammdf MDF, number of its first group): the file, then the signals decoded from its bus frames
+        self._parts = [(self._mdf, 0)]
+        #: what the bus databases decoded (one line), or None without databases
+        self.decoding: str | None = None
+        databases = list(databases or ())
+        if databases:
+            try:
+                self._decode(databases)
+            except BaseException:
+                self.close()
+                raise
+        self._masters = set()
         self._occurrences: dict[str, list[tuple[int, int]]] = {}
-        for name, entries in self._mdf.channels_db.items():
-            for g, i in entries:
-                if (g, i) not in self._masters and (g, i) not in self._occurrences.get(name, []):
-                    self._occurrences.setdefault(name, []).append((g, i))
+        for mdf, first in self._parts:
+            self._masters |= {(first + g, i) for g, i in mdf.masters_db.items()}
+            for name, entries in mdf.channels_db.items():
+                for g, i in entries:
+                    g += first
+                    if (g, i) not in self._masters and (g, i) not in self._occurrences.get(name, []):
+                        self._occurrences.setdefault(name, []).append((g, i))
         for places in self._occurrences.values():
             places.sort()
+
+    def _decode(self, databases) -> None:
+        """Decode the raw bus frames with ``databases`` (asammdf ``extract_bus_logging``) into a second part."""
+        names = ", ".join(d.path.name + (f" (channel {d.channel})" if d.channel else "") for d in databases)
+        matrices = [(d, d.load()) for d in databases]
+        if not self.bus_groups:
+            self.decoding = f"no raw bus frames in the file to decode with {names}"
+            return
+        files = {}
+        for d, _ in matrices:
+            files.setdefault(d.bus, []).append((str(d.path), d.channel))
+        try:
+            with _quiet_asammdf():
+                decoded = self._mdf.extract_bus_logging(database_files=files)
+        except Exception as exc:   # asammdf/canmatrix errors on odd frames or databases
+            _defuse(exc)
+            raise DataError(f"{self.label}: cannot decode the bus frames with {names} ({_one_line(exc)})") from None
+        info = getattr(self._mdf, "last_call_info", None) or {}
+        found, unknown = [], set()
+        for bus in files:
+            part = info.get(bus, {}) or {}
+            for entries in (part.get("found_ids") or {}).values():
+                for ident, message in entries:
+                    number = ident[0] if isinstance(ident, tuple) else ident
+                    found.append(f"{message} 0x{int(number):X}")
+            unknown |= {u[0] if isinstance(u, tuple) else u for u in (part.get("unknown_ids") or ())}
+        found = sorted(set(found))
+        if decoded.groups:
+            self._parts.append((decoded, len(self._mdf.groups)))
+        else:
+            decoded.close()
+        text = (f"{len(found)} message{'s' if len(found) != 1 else ''} decoded with {names}"
+                + (f": {', '.join(found[:8])}{', ...' if len(found) > 8 else ''}" if found else ""))
+        if unknown:
+            ids = sorted(int(u) for u in unknown)
+            shown = ", ".join(f"0x{u:X}" for u in ids[:8]) + (", ..." if len(ids) > 8 else "")
+            text += f"; {len(ids)} ID{'s' if len(ids) != 1 else ''} of the log in no database: {shown}"
+        self.decoding = text
 
     def close(self) -> None:
         """Close the file (and delete a temporary finalised copy)."""
         try:
             with _quiet_asammdf():
-                self._mdf.close()
+                for mdf, _ in getattr(self, "_parts", [(self._mdf, 0)]):
+                    mdf.close()
         finally:
             self._fh.close()
+
+    def _part(self, g: int):
+        """(asammdf MDF, group number within it) of the reader's group ``g``."""
+        for mdf, first in reversed(self._parts):
+            if g >= first:
+                return mdf, g - first
+        raise IndexError(g)
 
     def __enter__(self):
         return self
@@ -323,7 +469,8 @@ class MdfReader:
         """Every (group, index) at which the non-master channel ``name`` occurs, with unit and comment."""
         out = []
         for g, i in self._occurrences.get(name, []):
-            ch = self._mdf.groups[g].channels[i]
+            mdf, local = self._part(g)
+            ch = mdf.groups[local].channels[i]
             comment = _plain_comment(getattr(ch, "comment", ""))
             out.append(ChannelPlace(g, i, str(getattr(ch, "unit", "") or "").strip(), comment))
         return out
@@ -362,6 +509,10 @@ class MdfReader:
 
             close = difflib.get_close_matches(name, list(self._occurrences), n=3)
             hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
+            if self.decoding is None and self.bus_groups:
+                hint += "; its raw bus frames are not decoded: give a bus database (--dbc, or [bus] in the map)"
+            elif self.decoding is not None:
+                hint += f"; bus log: {self.decoding}"
             raise DataError(f"{self.label}: missing {what}{hint} (the file has {len(self._occurrences)} channels)")
         found = [p for p in places if (group is None or p[0] == group) and (index is None or p[1] == index)]
         if not found:
@@ -404,8 +555,9 @@ class MdfReader:
         what = f"channel {name!r}" + (f" (for {target!r})" if target and target != name else "")
         g, i = self.locate(name, group, index, target=target)
         try:
+            mdf, local = self._part(g)
             with _quiet_asammdf():
-                sig = self._mdf.get(name, group=g, index=i)
+                sig = mdf.get(name, group=local, index=i)
         except Exception as exc:
             raise DataError(f"{self.label}: cannot read {what} in group {g} ({_one_line(exc)})") from None
         samples = np.asarray(sig.samples)
@@ -413,7 +565,7 @@ class MdfReader:
             if skip_nonnumeric:
                 return None
             kind = f"dtype {samples.dtype}" if samples.ndim == 1 else f"{samples.ndim}-D samples"
-            frames = " (raw bus frames: decode them with a DBC file first)" if g in self.bus_groups else ""
+            frames = " (raw bus frames: decode them with a DBC file first, --dbc or [bus])" if g in self.bus_groups else ""
             raise DataError(f"{self.label}: {what} in group {g} has non-numeric samples ({kind}){frames}; "
                             "only numeric channels can be read")
         if samples.size == 0:

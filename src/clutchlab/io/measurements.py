@@ -36,9 +36,10 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import DataError, ParameterError
 from ..units import normalise_unit
+from .dialect import CsvDialect, read_csv
 from .channels import INTERPOLATIONS, ChannelMap, ChannelSpec, canonical_unit, unit_conversion
 from .files import atomic_to_csv, atomic_write_bytes, check_writable
-from .mdf import MDF_SUFFIXES, MdfReader, RawChannel, write_mdf
+from .mdf import MDF_SUFFIXES, BusDatabase, MdfReader, RawChannel, write_mdf
 
 __all__ = [
     "CSV_SUFFIXES",
@@ -111,6 +112,12 @@ class MeasurementSource:
         Channels (or MDF groups) of the file that a read without channel map
         left out, with the reason (unknown unit, non-numeric samples, raw bus
         frames, a name occurring several times); empty when reading with a map.
+    dialect : CsvDialect or None
+        How a text table was written (encoding, separator, decimal mark,
+        name and unit rows), as detected or given; ``None`` for other formats.
+    bus : str or None
+        What the bus databases decoded from an MDF bus log (messages, IDs no
+        database defines); ``None`` without databases.
     """
 
     path: str | None
@@ -119,6 +126,8 @@ class MeasurementSource:
     channels: Mapping[str, ChannelOrigin] = field(default_factory=dict)
     time_base: str = "as recorded"
     skipped: Mapping[str, str] = field(default_factory=dict)
+    dialect: CsvDialect | None = None
+    bus: str | None = None
 
     @property
     def synthetic(self) -> bool:
@@ -128,6 +137,10 @@ class MeasurementSource:
     def describe(self) -> str:
         """A few lines of provenance for reports and file headers."""
         lines = [f"source: {self.path or 'in-memory table'} ({self.format}); time base {self.time_base}"]
+        if self.dialect is not None:
+            lines.append(f"read as {self.dialect.describe()}")
+        if self.bus is not None:
+            lines.append(f"bus log: {self.bus}")
         if self.synthetic:
             lines.append("synthetic data (not measured)")
         for name, o in self.channels.items():
@@ -232,57 +245,12 @@ class _TableReader:
         pass
 
 
-def _parse_units_line(text: str, label: str) -> dict[str, str]:
-    units = {}
-    body = text.strip()[len(_UNITS_PREFIX):]
-    for item in body.split(","):
-        item = item.strip()
-        if not item:
-            continue
-        if "=" not in item:
-            raise DataError(f"{label}: cannot read the '# units:' line at {item!r} (expected name=unit)")
-        k, v = item.split("=", 1)
-        units[k.strip()] = v.strip()
-    return units
-
-
-def duplicate_columns(path, label) -> None:
-    """Raise :class:`DataError` naming ``label`` and the column if the CSV at ``path`` names a column twice (pandas
-    renames the second ``torque_Nm.1`` and reads it as another channel; #33)."""
-    try:
-        names = pd.read_csv(path, comment="#", header=None, nrows=1, dtype=str).iloc[0].tolist()
-    except Exception:   # (the full read names what is wrong)
-        return
-    seen = set()
-    for name in names:
-        if name in seen and isinstance(name, str):
-            raise DataError(f"{label}: column {name!r} appears twice in the header: rename one")
-        seen.add(name)
-
-
-def _read_csv(path: Path, label: str) -> _TableReader:
-    comments, units = [], {}
-    size = path.stat().st_size
-    check_allocation(size, 2 / 8, f"{label}: CSV file of {size} bytes")  # parsed floats ~ twice the text
-    try:
-        with open(path, encoding="utf-8") as fh:
-            for line in fh:
-                if not line.startswith("#"):
-                    break
-                text = line[1:].strip()
-                if text.lower().startswith(_UNITS_PREFIX):
-                    units.update(_parse_units_line(text, label))
-                else:
-                    comments.append(text)
-        duplicate_columns(path, label)
-        frame = pd.read_csv(path, comment="#")
-    except UnicodeDecodeError:
-        raise DataError(f"{label}: cannot read as CSV (not UTF-8 text)") from None
-    except DataError:
-        raise
-    except Exception as exc:  # pandas raises several parser errors
-        raise DataError(f"{label}: cannot read as CSV ({exc})") from None
-    return _TableReader(frame, label, "csv", path, units, comments)
+def _read_csv(path: Path, label: str, dialect=None) -> _TableReader:
+    """A CSV (or other text table) in any dialect :func:`clutchlab.io.dialect.read_csv` detects."""
+    table = read_csv(path, label, dialect)
+    reader = _TableReader(table.frame, label, "csv", path, table.units, table.comments)
+    reader.dialect = table.dialect
+    return reader
 
 
 def _read_parquet(path: Path, label: str) -> _TableReader:
@@ -317,7 +285,7 @@ def _read_parquet(path: Path, label: str) -> _TableReader:
     return _TableReader(table.to_pandas(), label, "parquet", path, units, comments)
 
 
-def _open(source, name: str | None):
+def _open(source, name: str | None, dialect=None, databases=()):
     if isinstance(source, Measurement):
         frame = source.frame
         return _TableReader(frame, name or source.source.path or "record", "frame", source.source.path,
@@ -334,11 +302,11 @@ def _open(source, name: str | None):
         raise DataError(f"{label}: is a directory, not a record file")
     suffix = path.suffix.lower()
     if suffix in MDF_SUFFIXES:
-        return MdfReader(path, label)
+        return MdfReader(path, label, databases)
     if suffix in PARQUET_SUFFIXES:
         return _read_parquet(path, label)
     if suffix in CSV_SUFFIXES or suffix == "":
-        return _read_csv(path, label)
+        return _read_csv(path, label, dialect)
     raise DataError(f"{label}: unknown record format {path.suffix!r} (expected "
                     f"{', '.join(CSV_SUFFIXES + PARQUET_SUFFIXES + MDF_SUFFIXES)})")
 
@@ -365,6 +333,8 @@ def _check_plausible(values: np.ndarray, unit: str, label: str, what: str, sampl
 
 
 def _check_time(t: np.ndarray, label: str, what: str, sample_word: str) -> None:
+    """Raise :class:`DataError` naming ``label``, ``what`` and the sample if ``t`` is not finite and strictly
+    increasing."""
     bad = ~np.isfinite(t)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
@@ -374,6 +344,9 @@ def _check_time(t: np.ndarray, label: str, what: str, sample_word: str) -> None:
         k = int(np.flatnonzero(dt <= 0)[0]) + 1
         raise DataError(f"{label}: {what} must increase strictly, but {sample_word} {k} has {float(t[k])!r} after "
                         f"{float(t[k - 1])!r} (time not strictly increasing)")
+
+
+check_time = _check_time
 
 
 def resample(timestamps, samples, time_base, interpolation: str = "linear") -> np.ndarray:
@@ -418,14 +391,17 @@ def _rate(t: np.ndarray | None) -> float | None:
 
 def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), time: str | None = "time_s",
                      rate: float | None = None, time_base=None, interpolation: str = "linear",
-                     allow_nan: Iterable[str] = (), name: str | None = None) -> Measurement:
+                     allow_nan: Iterable[str] = (), name: str | None = None, csv=None,
+                     databases=()) -> Measurement:
     """Read a record from CSV, Parquet or MDF 4 into clutchlab's names and SI units.
 
     Parameters
     ----------
     source : str, Path, pandas.DataFrame or Measurement
-        ``.csv`` (``#`` comment lines skipped, an optional ``# units: a=s,
-        b=N*m`` line read), ``.parquet`` (units from the schema metadata),
+        ``.csv``/``.txt`` in any dialect rig software writes (encoding,
+        separator, decimal comma, title, name and unit rows detected:
+        :mod:`clutchlab.io.dialect`; ``#`` comment lines skipped, an optional
+        ``# units: a=s, b=N*m`` line read), ``.parquet`` (units from the schema metadata),
         ``.mf4``/``.mdf`` (ASAM MDF, units from the channels, conversions
         applied), or an in-memory table (units from ``frame.attrs["units"]``).
     channel_map : ChannelMap, mapping, str or Path, optional
@@ -456,6 +432,18 @@ def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), 
         clutchlab names in which NaN samples are allowed.
     name : str, optional
         How to call the source in error messages (default: the path).
+    csv : CsvDialect or mapping, optional
+        How a text table is written (``encoding``, ``separator``, ``decimal``,
+        ``header_row``, ``units_row``, ``thousands``); the fields not given
+        are detected (:mod:`clutchlab.io.dialect`), and what was read is in
+        ``result.source.dialect``.  Fields given here win over the channel
+        map's ``[csv]`` table.
+    databases : iterable of str, Path or BusDatabase
+        Bus databases (DBC, ARXML; CAN unless a :class:`BusDatabase` says
+        LIN) decoding the raw frames of an MDF bus log into signals, which
+        are then read like any channel (by their signal names); added to the
+        channel map's ``[bus]`` databases.  What was decoded is in
+        ``result.source.bus``.
 
     Returns
     -------
@@ -490,7 +478,13 @@ def read_measurement(source, channel_map=None, *, required: Iterable[str] = (), 
             raise ParameterError(f"{cmap.name}: required channel {unmapped[0]!r} is not in the channel map "
                                  f"(has: {', '.join(cmap.names)})")
 
-    reader = _open(source, name)
+    dialect = CsvDialect.coerce(csv, "csv")
+    if cmap is not None and cmap.csv is not None:
+        dialect = cmap.csv.merged(dialect)
+    if isinstance(databases, (str, Path, BusDatabase)):
+        databases = [databases]
+    buses = list(cmap.bus if cmap is not None else ()) + [BusDatabase.coerce(d) for d in databases]
+    reader = _open(source, name, dialect, buses)
     try:
         return _read(reader, cmap, required, time, rate, time_base, interpolation, allow_nan)
     finally:
@@ -522,7 +516,11 @@ def _table_time(reader, time: str, time_spec: ChannelSpec | None) -> np.ndarray:
     scale, offset = unit_conversion(tunit, "s", name=tsrc, where=reader.label)
     t = traw.samples * scale + offset
     _check_time(t, reader.label, time if tsrc == time else f"{tsrc} (time)", "row")
-    _check_plausible(t, "s", reader.label, f"time column {tsrc!r}", "row")
+    try:
+        _check_plausible(t, "s", reader.label, f"time column {tsrc!r}", "row")
+    except DataError as exc:
+        raise DataError(f"{exc}; if it is a UNIX time in ns, us or ms, state the unit (a '# units: {tsrc}=ns' "
+                        "line, or source_unit in a channel map)") from None
     return t
 
 
@@ -540,12 +538,13 @@ def _group_list(groups: list[int]) -> str:
 
 def _mdf_identity(reader: MdfReader, required, time, skipped: dict[str, str]) -> list[ChannelSpec]:
     """Channels of an identity read of an MDF file; raw bus frames and ambiguous names go to ``skipped``."""
-    if reader.bus_groups:
+    if reader.bus_groups and reader.decoding is None:
         bus = sorted(reader.bus_groups)
         names = sorted({n for n in reader.channel_names() if set(reader.groups_of(n)) & reader.bus_groups})
         shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-        skipped[_group_list(bus)] = (f"raw bus frames ({shown}), not signals; decode them with a DBC file "
-                                     "(asammdf extract_bus_logging) or map their fields explicitly")
+        skipped[_group_list(bus)] = (f"raw bus frames ({shown}), not signals; decode them with a DBC or ARXML "
+                                     "file (--dbc, [bus] in a channel map, databases=) or map their fields "
+                                     "explicitly")
     specs = []
     for n in reader.channel_names():
         if n == time:
@@ -722,8 +721,18 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
         raw = raws[spec.name]
         src_unit, target_unit, scale, offset = conversions[spec.name]
         grp = f" (group {raw.group})" if raw.group is not None else ""
-        _check_plausible(raw.samples * scale + offset if (scale != 1.0 or offset != 0.0) else raw.samples,
-                         target_unit, label, f"channel {spec.source!r}{grp}", "row" if raw.group is None else "sample")
+        try:
+            with np.errstate(over="ignore"):   # an overflow to inf is what the check reports
+                converted = raw.samples * scale + offset if (scale != 1.0 or offset != 0.0) else raw.samples
+            _check_plausible(converted, target_unit, label, f"channel {spec.source!r}{grp}",
+                             "row" if raw.group is None else "sample")
+        except DataError as exc:
+            if spec.name not in lenient:
+                raise
+            # a channel nobody asked for with values no sensor gives (a UNIX time in ns, an overflow to inf in
+            # the conversion): left out with the reason, the rest of the file is read (#33)
+            skipped[spec.source] = str(exc).removeprefix(f"{label}: channel {spec.source!r}{grp} has ")
+            continue
         values = raw.samples
         method = None
         if resampled:
@@ -733,6 +742,9 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
         units[spec.name] = target_unit
         origins[spec.name] = ChannelOrigin(spec.source, src_unit, target_unit, raw.group, int(raw.samples.size),
                                            _rate(raw.timestamps), method)
+    if not origins and skipped:
+        what, reason = next(iter(skipped.items()))
+        raise DataError(f"{label}: no channel could be read ({len(skipped)} skipped; {what}: {reason})")
     frame = pd.DataFrame(columns)
     if isinstance(reader, _TableReader) and cmap is None:
         # identity read of a table: other (non-numeric) columns pass through untouched, in the file's order
@@ -749,7 +761,8 @@ def _read(reader, cmap, required, time, rate, time_base, interpolation, allow_na
     else:
         comments = reader.comments
         path = None if reader.path is None else str(reader.path)
-    src = MeasurementSource(path, "mdf" if is_mdf else reader.format, comments, origins, how, skipped)
+    src = MeasurementSource(path, "mdf" if is_mdf else reader.format, comments, origins, how, skipped,
+                            getattr(reader, "dialect", None), getattr(reader, "decoding", None))
     return Measurement(frame.reset_index(drop=True), units, src, time if timeline is not None else None)
 
 

@@ -34,7 +34,8 @@ from ..errors import DataError, ParameterError
 from ..units import NAME_UNITS, column_label, column_unit, unit_label
 from .html import Figure, Section, Table, Text, check_report_folder, write_report
 
-__all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "DEFAULT_OUTPUT"]
+__all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "metrics_table", "display_label",
+           "DEFAULT_OUTPUT", "UNIT_SYSTEMS"]
 
 #: report folder written inside RUN_DIR when no output is given (skipped when scanning)
 DEFAULT_OUTPUT = "report"
@@ -106,26 +107,14 @@ class Dataset:
 
 
 # ---------------------------------------------------------------------- reading
-def _csv_header(path: Path) -> list[str]:
-    lines = []
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for line in fh:
-            if not line.startswith("#"):
-                break
-            lines.append(line[1:].strip())
-    return [line for line in lines if line]
-
-
 def _read_csv(path: Path, name: str) -> Dataset:
-    from ..io.measurements import duplicate_columns
+    from ..io.dialect import read_csv
 
-    header = _csv_header(path)
-    duplicate_columns(path, str(path))
-    try:
-        frame = pd.read_csv(path, comment="#")
-    except Exception as exc:  # pandas raises several parser errors
-        raise DataError(f"{path}: cannot read as CSV ({exc})") from None
-    return Dataset(name, "CSV", frame, header, [path])
+    table = read_csv(path, str(path))   # any dialect (clutchlab.io.dialect); '#' lines and a title are the header
+    d = table.dialect
+    plain = d.encoding == "utf-8" and d.separator == "," and d.decimal == "." and not d.units_row
+    return Dataset(name, "CSV", table.frame, list(table.comments) + ([] if plain else [f"read as {d.describe()}"]),
+                   [path])
 
 
 def _parquet_provenance(path: Path) -> list[str]:
@@ -281,6 +270,24 @@ def _unit_of(column: str) -> str:
     return "" if unit is None or name in NAME_UNITS else unit
 
 
+#: unit systems of a report's figures and tables (the files stay SI)
+UNIT_SYSTEMS = ("engineers", "si")
+
+
+def _display(column, units: str = "si") -> tuple[str, float, float]:
+    """(unit shown, scale, offset) of a channel in the chosen unit system (``""`` for none): engineers' units
+    (rpm, km/h, bar, °C, mm, kN; :data:`clutchlab.units.ENGINEERS_UNITS`) or the column's own."""
+    from ..units import engineers_unit
+
+    unit = _unit_of(column)
+    if not unit or units == "si":
+        return unit, 1.0, 0.0
+    try:
+        return engineers_unit(unit)
+    except Exception:   # a unit pint does not know: shown as it is
+        return unit, 1.0, 0.0
+
+
 def _stem_of(column: str) -> str:
     """Name without a trailing index (``i1`` -> ``i``, ``fn2`` -> ``fn``, ``omega_f`` -> ``omega``)."""
     return re.sub(r"(?:_?\d+|_[A-Za-z])$", "", str(column)) or str(column)
@@ -289,6 +296,11 @@ def _stem_of(column: str) -> str:
 def _words(column) -> str:
     """A channel name in words, without its unit (``slip_speed_rad_s`` -> ``slip speed``)."""
     return re.sub(r"\s*\[[^\]]*\]\s*$", "", column_label(column)) or str(column)
+
+
+def display_label(column, shown: str) -> str:
+    """Axis label of a channel shown in the unit ``shown`` (``speed [rpm]``); the name alone without a unit."""
+    return f"{_words(column)} [{unit_label(shown)}]" if shown else column_label(column)
 
 
 def _axis_label(unit: str, cols: list[str]) -> str:
@@ -356,7 +368,7 @@ def _left_out(n: int) -> str:
     return f"; {n} values beyond ±{PLOT_LIMIT:.0e} not drawn" if n else ""
 
 
-def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
+def _time_series_figures(ds: Dataset, label: str, units: str = "si") -> list[Figure]:
     from ..plotting import new_figure
 
     tcol = ds.time_column
@@ -373,11 +385,12 @@ def _time_series_figures(ds: Dataset, label: str) -> list[Figure]:
         fig, axes = new_figure(len(part), 1, width=8.0, height=1.9 * len(part) + 0.6, sharex=True, squeeze=False)
         left_out = wild
         for ax, (unit, cols) in zip(axes[:, 0], part):
+            shown, scale, offset = _display(cols[0], units) if unit else ("", 1.0, 0.0)
             for c in cols:
-                y, n = _plottable(frame[c].to_numpy(dtype=float)[::stride])
+                y, n = _plottable(frame[c].to_numpy(dtype=float)[::stride] * scale + offset)
                 left_out += n
                 ax.plot(t, y, lw=0.9, label=_words(c) if unit else str(c))
-            ax.set_ylabel(_axis_label(unit, cols), fontsize=8)
+            ax.set_ylabel(_axis_label(shown, cols), fontsize=8)
             if len(cols) > 1:  # one line: the axis label names it
                 ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
             ax.grid(alpha=0.3)
@@ -424,7 +437,7 @@ def _not_drawn(columns) -> str:
         ", ".join(map(str, columns))
 
 
-def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
+def _scatter_figures(ds: Dataset, label: str, manifest: dict, units: str = "si") -> list[Figure]:
     from ..plotting import new_figure
 
     inputs, outputs, left = _io_columns(ds, manifest)
@@ -439,16 +452,17 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
     for i, out in enumerate(outputs):
         for j, inp in enumerate(inputs):
             ax = axes[i, j]
-            x, nx = _plottable(frame[inp].to_numpy(dtype=float))
-            y, ny = _plottable(frame[out].to_numpy(dtype=float))
+            (iu, isc, ioff), (ou, osc, ooff) = _display(inp, units), _display(out, units)
+            x, nx = _plottable(frame[inp].to_numpy(dtype=float) * isc + ioff)
+            y, ny = _plottable(frame[out].to_numpy(dtype=float) * osc + ooff)
             left_out += nx + ny
             ax.scatter(x, y, s=6, alpha=0.6)
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=7)
             if i == len(outputs) - 1:
-                ax.set_xlabel(column_label(inp), fontsize=8)
+                ax.set_xlabel(display_label(inp, iu), fontsize=8)
             if j == 0:
-                ax.set_ylabel(column_label(out), fontsize=8)
+                ax.set_ylabel(display_label(out, ou), fontsize=8)
     fig.tight_layout()
     cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
     if len(frame) < len(ds.frame):
@@ -460,13 +474,15 @@ def _scatter_figures(ds: Dataset, label: str, manifest: dict) -> list[Figure]:
 
 
 # ---------------------------------------------------------------------- tables
-def metrics_table(ds: Dataset) -> pd.DataFrame:
+def metrics_table(ds: Dataset, units: str = "si") -> pd.DataFrame:
     """Count of finite values, min, max, mean and final (last finite) value of every numeric channel of ``ds``.
 
     Parameters
     ----------
     ds : Dataset
         The table.
+    units : {"si", "engineers"}
+        The columns' own (SI) units, or engineers' units (rpm, km/h, bar, °C, mm, kN).
 
     Returns
     -------
@@ -480,11 +496,11 @@ def metrics_table(ds: Dataset) -> pd.DataFrame:
         v = ds.frame[c].to_numpy(dtype=float)
         ok = np.isfinite(v)
         fin = v[ok]
-        unit = _unit_of(c)
+        unit, scale, offset = _display(c, units)
         rows.append({"channel": str(c), "unit": unit_label(unit) if unit else "",
                      "finite": int(ok.sum()), "non-finite": int((~ok).sum()),
-                     "min": float(fin.min()), "max": float(fin.max()), "mean": _mean(fin),
-                     "final": float(fin[-1])})
+                     "min": float(fin.min()) * scale + offset, "max": float(fin.max()) * scale + offset,
+                     "mean": _mean(fin) * scale + offset, "final": float(fin[-1]) * scale + offset})
     columns = ["channel", "unit", "finite", "non-finite", "min", "max", "mean", "final"]
     if ds.time_column is None:
         columns.remove("final")
@@ -578,7 +594,8 @@ def _manifest_synthetic(data: dict) -> bool:
 
 
 # ---------------------------------------------------------------------- assembly
-def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None = None) -> list[Section]:
+def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None = None,
+                 units: str = "engineers") -> list[Section]:
     """The report sections of a run directory (see the module docstring).
 
     Parameters
@@ -589,6 +606,9 @@ def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None
         Report folder inside ``run_dir`` to leave out when scanning.
     progress : callable, optional
         Called with a message per file read and per table plotted.
+    units : {"engineers", "si"}
+        Units of the figures and metrics: engineers' units (rpm, km/h, bar, °C, mm, kN) or the columns' SI
+        units.  The files stay SI.
 
     Returns
     -------
@@ -604,6 +624,8 @@ def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None
 
     run_dir = Path(run_dir)
     say = progress or (lambda msg: None)
+    if units not in UNIT_SYSTEMS:
+        raise ParameterError(f"units = {units!r}: expected one of {', '.join(UNIT_SYSTEMS)}")
     if not run_dir.is_dir():
         raise DataError(f"{run_dir}: no such run directory")
     output = Path(output) if output is not None else None
@@ -648,10 +670,11 @@ def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None
             ds_items.append(Table(label, ds.frame, caption=f"{ds.name}: a small labelled table, shown as it is"))
         else:
             if ds.time_column is not None:
-                ds_items += _time_series_figures(ds, label)
+                ds_items += _time_series_figures(ds, label, units)
             else:
-                ds_items += _scatter_figures(ds, label, manifest)
-            ds_items.append(Table(f"{label}_metrics", metrics_table(ds), caption="Metrics per channel"))
+                ds_items += _scatter_figures(ds, label, manifest, units)
+            ds_items.append(Table(f"{label}_metrics", metrics_table(ds, units), caption="Metrics per channel"
+                                  + (" (engineers' units)" if units == "engineers" else "")))
         synth = ds.synthetic
         lines = ds.provenance or ["no provenance recorded in the file"]
         text = ("SYNTHETIC: " if synth else "") + f"{ds.format} {ds.name}; " + " | ".join(lines)
@@ -662,7 +685,8 @@ def run_sections(run_dir, *, output=None, progress: Callable[[str], None] | None
 
 
 def report_run_dir(run_dir, output=None, *, overwrite: bool = False,
-                   progress: Callable[[str], None] | None = None, title: str | None = None) -> Path:
+                   progress: Callable[[str], None] | None = None, title: str | None = None,
+                   units: str = "engineers") -> Path:
     """Write a self-contained HTML report of a results folder.
 
     Parameters
@@ -679,6 +703,8 @@ def report_run_dir(run_dir, output=None, *, overwrite: bool = False,
         stderr).
     title : str, optional
         Page title; default ``"clutchlab report: <RUN_DIR name>"``.
+    units : {"engineers", "si"}
+        Units of figures and metrics (rpm, km/h, bar, °C, mm, kN, or the columns' SI units).
 
     Returns
     -------
@@ -698,7 +724,7 @@ def report_run_dir(run_dir, output=None, *, overwrite: bool = False,
     if run_dir.exists() and output.exists() and (run_dir.resolve() == output.resolve()
                                                  or output.resolve() in run_dir.resolve().parents):
         raise ParameterError(f"{output}: holds the results folder {run_dir}: not replaced; give another folder")
-    sections = run_sections(run_dir, output=output, progress=progress)
+    sections = run_sections(run_dir, output=output, progress=progress, units=units)
     if progress:
         progress(f"writing {output}")
     return write_report(sections, output, title=title or f"clutchlab report: {run_dir.resolve().name}",
