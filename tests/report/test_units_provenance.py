@@ -49,7 +49,7 @@ def test_run_report_writes_units_for_people(tmp_path, monkeypatch):
                           "fluid_temperature_C": 25 + t, "slip_speed_rad_s": 100 * t, "torque_Nm": 5 * t})
     write_measurement(frame, tmp_path / "run" / "r.csv", comment="synthetic: test data")
     seen = _capture_figures(monkeypatch)
-    index = report_run_dir(tmp_path / "run")
+    index = report_run_dir(tmp_path / "run", units="si")
     labels = [label for fig in seen for label in _labels(fig)]
     joined = " | ".join(labels)
     for human in ("[m³/s]", "[°C]", "[rad/s]", "[N·m]", "time [s]"):
@@ -61,6 +61,28 @@ def test_run_report_writes_units_for_people(tmp_path, monkeypatch):
     m = pd.read_csv(next((index.parent / "tables").glob("*metrics.csv")), keep_default_na=False).set_index("channel")
     assert m.loc["line_flow_m3_s", "unit"] == "m³/s" and m.loc["temperature_C", "unit"] == "°C"
     assert m.loc["torque_Nm", "unit"] == "N·m" and m.loc["slip_speed_rad_s", "unit"] == "rad/s"
+
+
+def test_run_report_shows_engineers_units_by_default(tmp_path, monkeypatch):
+    """#33: figures and tables in rpm, bar, kN, mm, l/min, km/h, °C; the files stay SI."""
+    t = np.linspace(0.0, 1.0, 50)
+    frame = pd.DataFrame({"time_s": t, "slip_speed_rad_s": 100 * t, "pressure_Pa": 3e5 + 0 * t,
+                          "force_N": 2000 * t, "travel_m": 8e-3 * t, "line_flow_m3_s": 1e-5 + 0 * t,
+                          "vehicle_speed_m_s": 10 * t, "oil_K": 353.15 + 0 * t, "torque_Nm": 5 * t})
+    write_measurement(frame, tmp_path / "run" / "r.csv", comment="synthetic: test data")
+    seen = _capture_figures(monkeypatch)
+    index = report_run_dir(tmp_path / "run")
+    axes = {ax.get_ylabel(): ax for fig in seen for ax in fig.axes if ax.get_ylabel()}
+    for label, value in [("slip speed [rpm]", 100 * 30 / np.pi), ("pressure [bar]", 3.0), ("force [kN]", 2.0),
+                         ("travel [mm]", 8.0), ("line flow [l/min]", 0.6), ("vehicle speed [km/h]", 36.0),
+                         ("oil [°C]", 80.0), ("torque [N·m]", 5.0)]:
+        assert label in axes, (label, list(axes))
+        assert axes[label].lines[0].get_ydata()[-1] == pytest.approx(value, rel=1e-9)
+    m = pd.read_csv(next((index.parent / "tables").glob("*metrics.csv")), keep_default_na=False).set_index("channel")
+    assert m.loc["slip_speed_rad_s", "unit"] == "rpm" and m.loc["slip_speed_rad_s", "max"] == pytest.approx(
+        100 * 30 / np.pi, rel=1e-9)
+    assert m.loc["oil_K", "unit"] == "°C" and m.loc["oil_K", "final"] == pytest.approx(80.0)
+    assert m.loc["pressure_Pa", "unit"] == "bar" and m.loc["pressure_Pa", "mean"] == pytest.approx(3.0)
 
 
 def test_metrics_unit_column_for_unknown_names(tmp_path):
