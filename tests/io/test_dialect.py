@@ -111,8 +111,8 @@ def test_header_and_unit_rows_can_be_set_by_line(tmp_path):
     path = tmp_path / "rows.csv"
     # a title of the table's width, holding a number: not a data row, because its text stands where numbers do
     path.write_text("Versuch;7;Prüfer\nt;x;F\ns;mm;N\n0;1;2\n1;2;3\n", encoding="utf-8")
-    for given in ({}, {"header_row": 2}):
-        t = read_csv(path, dialect=given)
+    for rows in ({}, {"header_row": 2}):
+        t = read_csv(path, dialect=rows)
         assert list(t.frame.columns) == ["t", "x", "F"] and t.units == {"t": "s", "x": "mm", "F": "N"}
         assert t.dialect.units_row == 3 and t.comments == ("Versuch;7;Prüfer",)
     # a title of numbers only is data to the detection: the header row says where the names are

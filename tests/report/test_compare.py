@@ -8,7 +8,7 @@ import pytest
 from clutchlab.cli import main
 from clutchlab.errors import DataError, ParameterError
 from clutchlab.io import atomic_to_csv
-from clutchlab.report.compare import compare_runs, compare_sections
+from clutchlab.report.compare import compare_sections
 from clutchlab.report.html import Figure, Table, Text
 
 T_A = np.linspace(0.0, 1.0, 201)

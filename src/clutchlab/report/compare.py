@@ -29,9 +29,9 @@ import pandas as pd
 from ..errors import DataError, ParameterError
 from ..units import unit_label
 from .html import Figure, Section, Table, Text, check_report_folder, write_report
-from .run import (DEFAULT_OUTPUT, MAX_PLOT_POINTS, MAX_SCATTER_POINTS, TABLE_SUFFIXES, UNIT_SYSTEMS, Dataset,
+from .run import (DEFAULT_OUTPUT, MAX_PLOT_POINTS, TABLE_SUFFIXES, UNIT_SYSTEMS, Dataset,
                   _display, _io_columns, _left_out, _plottable, _read_csv, _read_mdf, _read_parquet, _stem,
-                  display_label, find_datasets)
+                  display_label, find_datasets, scatter_matrix)
 
 __all__ = ["compare_runs", "compare_sections", "MAX_RUNS", "MAX_COMPARED_CHANNELS"]
 
@@ -193,36 +193,12 @@ def _time_overlays(key: str, label: str, tables: list[tuple[str, Dataset]], unit
 
 
 def _scatter_overlays(key: str, label: str, tables: list[tuple[str, Dataset]], units: str) -> list:
-    from ..plotting import new_figure
-
     inputs, outputs, left = _io_columns(tables[0][1], {})
     inputs = [c for c in inputs if all(c in ds.frame.columns for _, ds in tables)]
     outputs = [c for c in outputs if all(c in ds.frame.columns for _, ds in tables)]
     if not inputs or not outputs:
         return [Text(f"{key}: no inputs and outputs the runs share to draw")]
-    fig, axes = new_figure(len(outputs), len(inputs), width=2.9 * len(inputs) + 1.6,
-                           height=2.1 * len(outputs) + 0.5, squeeze=False)
-    wild = 0
-    for i, out in enumerate(outputs):
-        oshown, oscale, ooff = _display(out, units)
-        for j, inp in enumerate(inputs):
-            ishown, iscale, ioff = _display(inp, units)
-            ax = axes[i, j]
-            for r, (run, ds) in enumerate(tables):
-                frame = ds.frame if len(ds.frame) <= MAX_SCATTER_POINTS else ds.frame.sample(MAX_SCATTER_POINTS,
-                                                                                            random_state=0)
-                x, nx = _plottable(frame[inp].to_numpy(dtype=float) * iscale + ioff)
-                y, ny = _plottable(frame[out].to_numpy(dtype=float) * oscale + ooff)
-                wild += nx + ny
-                ax.scatter(x, y, s=7, alpha=0.6, color=f"C{r}", marker="os^Dv<>p"[r % 8], label=run)
-            ax.grid(alpha=0.3)
-            ax.tick_params(labelsize=7)
-            if i == len(outputs) - 1:
-                ax.set_xlabel(_label(inp, ishown), fontsize=8)
-            if j == 0:
-                ax.set_ylabel(_label(out, oshown), fontsize=8)
-    axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    fig.tight_layout()
+    fig, wild = scatter_matrix(tables, inputs, outputs, units)
     cap = (f"{key}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}, one colour per "
            f"run ({', '.join(r for r, _ in tables)})" + _left_out(wild) + left)
     if any(ds.synthetic for _, ds in tables):

@@ -35,6 +35,7 @@ from ..units import NAME_UNITS, column_label, column_unit, unit_label
 from .html import Figure, Section, Table, Text, check_report_folder, write_report
 
 __all__ = ["Dataset", "find_datasets", "report_run_dir", "run_sections", "metrics_table", "display_label",
+           "scatter_matrix",
            "DEFAULT_OUTPUT", "UNIT_SYSTEMS"]
 
 #: report folder written inside RUN_DIR when no output is given (skipped when scanning)
@@ -437,36 +438,63 @@ def _not_drawn(columns) -> str:
         ", ".join(map(str, columns))
 
 
-def _scatter_figures(ds: Dataset, label: str, manifest: dict, units: str = "si") -> list[Figure]:
+def scatter_matrix(tables: list, inputs: list[str], outputs: list[str], units: str = "si"):
+    """Outputs (rows) against inputs (columns) of one or more tables, one colour and marker per table.
+
+    Parameters
+    ----------
+    tables : list of (str, Dataset)
+        The tables and their legend names (a legend only for two or more); each drawn with at most
+        :data:`MAX_SCATTER_POINTS` rows, drawn at random (seed 0).
+    inputs, outputs : list of str
+        Columns every table has.
+    units : {"si", "engineers"}
+        Units of the axes.
+
+    Returns
+    -------
+    (figure, int)
+        The figure, and how many values beyond :data:`PLOT_LIMIT` it leaves out.
+    """
     from ..plotting import new_figure
 
-    inputs, outputs, left = _io_columns(ds, manifest)
-    if not inputs or not outputs:
-        return []
-    frame = ds.frame
-    if len(frame) > MAX_SCATTER_POINTS:
-        frame = frame.sample(MAX_SCATTER_POINTS, random_state=0)
-    fig, axes = new_figure(len(outputs), len(inputs), width=2.9 * len(inputs) + 1.0, height=2.1 * len(outputs) + 0.5,
-                           squeeze=False)
+    several = len(tables) > 1
+    fig, axes = new_figure(len(outputs), len(inputs), width=2.9 * len(inputs) + (1.6 if several else 1.0),
+                           height=2.1 * len(outputs) + 0.5, squeeze=False)
     left_out = 0
     for i, out in enumerate(outputs):
         for j, inp in enumerate(inputs):
             ax = axes[i, j]
             (iu, isc, ioff), (ou, osc, ooff) = _display(inp, units), _display(out, units)
-            x, nx = _plottable(frame[inp].to_numpy(dtype=float) * isc + ioff)
-            y, ny = _plottable(frame[out].to_numpy(dtype=float) * osc + ooff)
-            left_out += nx + ny
-            ax.scatter(x, y, s=6, alpha=0.6)
+            for r, (name, ds) in enumerate(tables):
+                frame = ds.frame
+                if len(frame) > MAX_SCATTER_POINTS:
+                    frame = frame.sample(MAX_SCATTER_POINTS, random_state=0)
+                x, nx = _plottable(frame[inp].to_numpy(dtype=float) * isc + ioff)
+                y, ny = _plottable(frame[out].to_numpy(dtype=float) * osc + ooff)
+                left_out += nx + ny
+                style = dict(color=f"C{r}", marker="os^Dv<>p"[r % 8], label=name) if several else {}
+                ax.scatter(x, y, s=6, alpha=0.6, **style)
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=7)
             if i == len(outputs) - 1:
                 ax.set_xlabel(display_label(inp, iu), fontsize=8)
             if j == 0:
                 ax.set_ylabel(display_label(out, ou), fontsize=8)
+    if several:
+        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
+    return fig, left_out
+
+
+def _scatter_figures(ds: Dataset, label: str, manifest: dict, units: str = "si") -> list[Figure]:
+    inputs, outputs, left = _io_columns(ds, manifest)
+    if not inputs or not outputs:
+        return []
+    fig, left_out = scatter_matrix([(ds.name, ds)], inputs, outputs, units)
     cap = f"{ds.name}: outputs {', '.join(map(str, outputs))} against {', '.join(map(str, inputs))}"
-    if len(frame) < len(ds.frame):
-        cap += f"; {len(frame)} of {len(ds.frame)} rows drawn at random (seed 0)"
+    if len(ds.frame) > MAX_SCATTER_POINTS:
+        cap += f"; {MAX_SCATTER_POINTS} of {len(ds.frame)} rows drawn at random (seed 0)"
     cap += _left_out(left_out) + left
     if ds.synthetic:
         cap += " [synthetic data]"
