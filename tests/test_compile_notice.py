@@ -64,3 +64,37 @@ print("compile_seconds", _compile_notice.compile_seconds())
     assert "value 2" in out.stdout
     assert NOTICE not in out.stderr
     assert _seconds(out) == 0.0
+
+
+def test_every_later_compilation_says_what_compiles_and_how_long_it_took(tmp_path):
+    """#33: the notice came once per process, so a second model kind compiling for a minute looked like a
+    hang. A compilation still running after ANNOUNCE_AFTER seconds says what it is, and when it ends how long
+    it took (here ANNOUNCE_AFTER = 0 s, so that a short compilation is announced)."""
+    script = SCRIPT.replace("from clutchlab import _compile_notice",
+                            "from clutchlab import _compile_notice\n_compile_notice.ANNOUNCE_AFTER = 0.0")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 0, out.stderr
+    lines = out.stderr.splitlines()
+    assert lines.count(NOTICE) == 1 and lines[0] == NOTICE            # the first: the explanation, once
+    assert "clutchlab: compiling numerics.dopri.error_norm ..." in lines
+    done = [line for line in lines if line.startswith("clutchlab: compiled numerics.dopri.error_norm in ")]
+    assert len(done) == 1 and done[0].endswith(" s; numba caches it for later runs")
+    assert 0.0 < float(done[0].split(" in ")[1].split(" s")[0]) < 300
+    # from the cache: nothing compiles, nothing is said
+    again = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                           env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)})
+    assert again.returncode == 0 and "clutchlab:" not in again.stderr, again.stderr
+
+
+def test_generated_kernels_are_named_for_people():
+    from clutchlab._compile_notice import describe
+
+    def advance():
+        pass
+
+    advance.__qualname__ = "advance"
+    advance.__module__ = "clutchlab.numerics._kernels.k_clutchlab_driveline_kernel_DrivelineParams_dopri_990cc79"
+    assert describe(advance) == "driveline kernel (dopri): advance"
+    advance.__module__ = "clutchlab.wet.system"
+    assert describe(advance) == "wet.system.advance"
