@@ -19,7 +19,7 @@ print("compile_seconds", _compile_notice.compile_seconds())
 
 
 def _run(cache_dir, **env):
-    full = {**os.environ, "NUMBA_CACHE_DIR": str(cache_dir), **env}
+    full = {**os.environ, "NUMBA_CACHE_DIR": str(cache_dir), "CLUTCHLAB_COMPILE_NOTICE": "1", **env}
     return subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=full, timeout=300)
 
 
@@ -58,7 +58,7 @@ ns["f"].__module__ = None
 print("value", numba.njit(ns["f"])(1))
 print("compile_seconds", _compile_notice.compile_seconds())
 """
-    full = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    full = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "CLUTCHLAB_COMPILE_NOTICE": "1"}
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=full, timeout=300)
     assert out.returncode == 0, out.stderr
     assert "value 2" in out.stdout
@@ -73,7 +73,7 @@ def test_every_later_compilation_says_what_compiles_and_how_long_it_took(tmp_pat
     script = SCRIPT.replace("from clutchlab import _compile_notice",
                             "from clutchlab import _compile_notice\n_compile_notice.ANNOUNCE_AFTER = 0.0")
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
-                         env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)})
+                         env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "CLUTCHLAB_COMPILE_NOTICE": "1"})
     assert out.returncode == 0, out.stderr
     lines = out.stderr.splitlines()
     assert lines.count(NOTICE) == 1 and lines[0] == NOTICE            # the first: the explanation, once
@@ -83,7 +83,7 @@ def test_every_later_compilation_says_what_compiles_and_how_long_it_took(tmp_pat
     assert 0.0 < float(done[0].split(" in ")[1].split(" s")[0]) < 300
     # from the cache: nothing compiles, nothing is said
     again = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
-                           env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)})
+                           env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "CLUTCHLAB_COMPILE_NOTICE": "1"})
     assert again.returncode == 0 and "clutchlab:" not in again.stderr, again.stderr
 
 
