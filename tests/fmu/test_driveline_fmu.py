@@ -159,7 +159,10 @@ def test_the_fmu_carries_its_description_and_runs_it(tmp_path, chains, run_fmu, 
 def test_export_fmu_command_for_a_driveline(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["export-fmu", "driveline", str(EXAMPLE)]) == 0
-    assert capsys.readouterr().out.strip() == "driveline_coupled_clutches.fmu"  # named after the file
+    out = capsys.readouterr().out.strip().splitlines()
+    assert out[-1] == "driveline_coupled_clutches.fmu"  # named after the file
+    # what of the user's went in is said (#33): here the description alone
+    assert out[:-1] == [f"driveline_coupled_clutches.fmu: packed {EXAMPLE} as resources/description.toml"]
     assert "exists" in one_line_error(capsys, ["export-fmu", "driveline", str(EXAMPLE)])
     assert "needs a description file" in one_line_error(capsys, ["export-fmu", "driveline", "-o", "x.fmu"])
     assert "takes no description file" in one_line_error(capsys, ["export-fmu", "wet", str(EXAMPLE)])
@@ -319,8 +322,15 @@ def test_bundle_names_every_copy_apart_and_the_copy_loads_as_the_original(tmp_pa
         "J2", "J3").replace("[eclutch.e]", '[eclutch.e2]').replace("eclutch/my_clutch.toml", "b/clutch.toml")
     desc = src / "dl.toml"
     desc.write_text('[driveline]\nname = "a/clutch.toml"\n' + text)
-    out = bundle_description(desc, tmp_path / "bundle")
+    told = []
+    out = bundle_description(desc, tmp_path / "bundle", report=lambda source, name: told.append((source, name)))
     files = sorted(str(p.relative_to(tmp_path / "bundle")) for p in (tmp_path / "bundle").rglob("*") if p.is_file())
+    # every file written is reported once, with the user's file it came from
+    assert sorted(name for _, name in told) == files
+    sources = dict((name, source) for source, name in told)
+    assert sources["description.toml"] == desc and sources["description_files/my_diaphragm.csv"] == \
+        src / "b" / "my_diaphragm.csv"
+    assert sources["description_files/curves/cushion.csv"] == src / "a" / "curves" / "cushion.csv"
     assert files == ["description.toml", "description_files/clutch.toml", "description_files/clutch_2.toml",
                      *(f"description_files/curves/{c}.csv" for c in sorted(
                          ("cushion", "diaphragm", "pp_spring", "return_springs", "support_ring", "yoke_spring"))),

@@ -34,9 +34,12 @@ def _export(args) -> int:
     check_writable(output, args.force)  # before the build
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
-        path = export_fmu(args.model, output, overwrite=args.force, description=args.file)
+        packed = []
+        path = export_fmu(args.model, output, overwrite=args.force, description=args.file, packed=packed)
     for w in caught:  # e.g. no C compiler for the fmi2Error shim: one line each
         print(f"clutchlab: warning: {w.message}", file=sys.stderr)
+    for source, name in packed:   # what of the user's files went into the FMU (#33)
+        print(f"{path.name}: packed {source} as {name}")
     print(path)
     return 0
 

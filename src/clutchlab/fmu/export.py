@@ -357,7 +357,7 @@ def _copy(value):
     return value
 
 
-def bundle_description(description, folder) -> Path:
+def bundle_description(description, folder, *, report=None) -> Path:
     """Copy a driveline description and every file it names into ``folder``, the copy naming the copies.
 
     Writes ``folder/description.toml`` (:data:`DESCRIPTION_RESOURCE`) and, if the description names
@@ -377,6 +377,10 @@ def bundle_description(description, folder) -> Path:
         The driveline description (TOML).
     folder : str or Path
         The folder to write into (the FMU's resources under construction); created if missing.
+    report : callable, optional
+        Called as ``report(source, name)`` for every file copied: its path and its name in ``folder``
+        (``description_files/wet.toml``; a curve folder's files one by one), so that a caller can say
+        what went into the FMU.
 
     Returns
     -------
@@ -404,6 +408,10 @@ def bundle_description(description, folder) -> Path:
     files = folder / FILES_RESOURCE
     taken, placed = set(), {}
 
+    def told(source, name) -> None:
+        if report is not None:
+            report(Path(source), name)
+
     def place(ref) -> str:
         """Name of the copy of ``ref`` in ``files`` (copied on first use)."""
         if (ref.path, ref.role) in placed:
@@ -414,13 +422,16 @@ def bundle_description(description, folder) -> Path:
             (files / name).mkdir()
             for child in ref.children:
                 shutil.copyfile(child.path, files / name / child.value)
+                told(child.path, f"{FILES_RESOURCE}/{name}/{child.value}")
         elif ref.role == "eclutch_parameters":  # its curve files beside it
             mapping = {child.value: place(child) for child in ref.children}
             raw = ref.path.read_bytes()
             (files / name).write_bytes(_rewrite_strings(raw, mapping, _curves_replaced(read_toml(ref.path), mapping),
                                                         f"E-clutch parameter file {ref.path.name}"))
+            told(ref.path, f"{FILES_RESOURCE}/{name}")
         else:
             shutil.copyfile(ref.path, files / name)
+            told(ref.path, f"{FILES_RESOURCE}/{name}")
         return name
 
     raw = description.read_bytes()
@@ -434,6 +445,7 @@ def bundle_description(description, folder) -> Path:
     out = folder / DESCRIPTION_RESOURCE
     out.write_bytes(_rewrite_strings(raw, mapping, expected, f"driveline description {description.name}"))
     DrivelineDocument.read(out).referenced_files(within=folder)  # self-contained
+    told(description, DESCRIPTION_RESOURCE)
     return out
 
 
@@ -568,7 +580,7 @@ def compile_shim(ident: str, step_error_vr: int, workdir) -> bytes:
     return out.read_bytes()
 
 
-def export_fmu(model: str, path, *, overwrite: bool = False, description=None) -> Path:
+def export_fmu(model: str, path, *, overwrite: bool = False, description=None, packed=None) -> Path:
     """Build an FMI 2.0 co-simulation FMU of a registered model.
 
     Parameters
@@ -582,7 +594,12 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None) -
     description : path-like, optional
         The description file of a model built from one (the driveline's TOML); copied into the FMU
         (``resources/description.toml``), so the FMU runs wherever clutchlab is installed.  Required
-        for such a model, refused for the others.
+        for such a model, refused for the others.  Only the description and the files it names that the
+        model reads are packed (each was read and checked by the model before the build), under names of
+        their own in ``resources/``.
+    packed : list, optional
+        Filled with ``(source, name in the FMU)`` of every file of the user's packed into the FMU's
+        resources (``clutchlab export-fmu`` prints them).
 
     Returns
     -------
@@ -641,7 +658,8 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None) -
         files = []
         if description is not None:  # the description and the files it names travel in the FMU's resources
             (tmp / "files").mkdir()
-            bundle_description(description, tmp / "files")
+            bundle_description(description, tmp / "files", report=None if packed is None else
+                               (lambda source, name: packed.append((source, f"resources/{name}"))))
             files = sorted((tmp / "files").iterdir())
         # several instances per process work once keep_namespace balances pythonfmu's release (issue #228)
         built = FmuBuilder.build_FMU(script, dest=tmp / "build" / f"{ident}.fmu", project_files=files,
