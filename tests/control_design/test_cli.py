@@ -1,4 +1,4 @@
-"""``clutchlab control trim|linearize|bode``: outputs, refusals, nothing left behind."""
+"""``clutchlab control trim|linearize|bode|design``: outputs, refusals, nothing left behind."""
 
 from __future__ import annotations
 
@@ -168,3 +168,55 @@ def test_a_negative_settle_or_an_infinite_time_is_refused(tmp_path, capsys, opti
                                    "-o", str(tmp_path / "lin.json")])
     assert message in line, line
     assert not (tmp_path / "lin.json").exists()
+
+
+def test_design_a_pi_and_run_the_closed_loop_from_the_command_line(tmp_path, capsys):
+    """#33: ``control design`` as the API has it. The JSON's PI is checked on the linear model the API gives
+    (|L(j w_c)| = 1 and the phase margin at the crossover, Astrom and Murray's loop-shaping conditions), and
+    its run equals ``closed_loop`` called with the same discrete controller."""
+    import control
+
+    from clutchlab.control import linearize
+    from clutchlab.control.design import PI
+    from clutchlab.control.loop import closed_loop
+    from clutchlab.eclutch import EClutch
+
+    pi_json, run = tmp_path / "pi.json", tmp_path / "run.csv"
+    assert main(["control", "design", "eclutch", "--at", "4 mm", "-u", "motor_voltage", "-y", "bearing_position",
+                 "--crossover", "5 Hz", "--phase-margin", "60 deg", "-o", str(pi_json), "--run", str(run),
+                 "--step", "0.2 mm", "--t-end", "0.15 s", "--sample-time", "1 ms"]) == 0
+    out = capsys.readouterr().out
+    assert "Kp = " in out and "final error" in out
+    doc = json.loads(pi_json.read_text())
+    assert doc["kp_unit"] == "V/m" and doc["input"] == "motor_voltage_V" and doc["output"] == "bearing_position_m"
+    assert doc["operating_output"] == pytest.approx(4e-3, rel=1e-9)
+    op = EClutch().operating_point(4e-3)
+    G = linearize(op, inputs=["motor_voltage"], outputs=["bearing_position"])
+    w = 2 * np.pi * 5.0
+    L = complex(np.squeeze(PI(doc["kp"], doc["ti_s"]).tf()(1j * w) * np.squeeze(G(1j * w))))
+    assert abs(L) == pytest.approx(1.0, rel=1e-6)
+    assert np.degrees(np.angle(L)) == pytest.approx(-180.0 + 60.0, abs=1e-4)
+    assert doc["achieved"]["phase_margin_deg"] == pytest.approx(60.0, abs=1e-4)
+    assert all(re < 0 for re, _ in doc["closed_loop_poles"])
+    ref = closed_loop(op, PI(doc["kp"], doc["ti_s"]).discrete(1e-3), 1e-3, 0.15, measure=["bearing_position"],
+                      actuate=["motor_voltage"], reference=4e-3 + 2e-4).frame
+    got = pd.read_csv(run, comment="#")
+    assert list(got.columns) == list(ref.columns) and len(got) == 151
+    for c in ("bearing_position_m", "motor_voltage_V", "reference_bearing_position_m"):
+        np.testing.assert_allclose(got[c], ref[c], rtol=1e-8, atol=1e-12, err_msg=c)
+    assert got["reference_bearing_position_m"].iloc[0] == pytest.approx(4.2e-3, rel=1e-9)
+    assert control.dcgain(G) > 0
+    # refusals: one line, nothing written
+    for argv, fragment in [
+        (["-u", "motor_voltage", "-u", "bearing_reference", "-y", "bearing_position", "--crossover", "5 Hz"],
+         "a PI drives one input from one output"),
+        (["-u", "motor_voltage", "-y", "bearing_position", "--crossover", "600 Hz", "--run", str(tmp_path / "r.csv")],
+         "at or above the Nyquist frequency 500 Hz"),
+        (["-u", "motor_voltage", "-y", "bearing_position", "--crossover", "5 Hz", "--phase-margin", "95 deg"],
+         "phase_margin_deg = 95"),
+    ]:
+        argv = ["control", "design", "eclutch", "--at", "4 mm", *argv, "-o", str(tmp_path / "x.json")]
+        if "--phase-margin" not in argv:
+            argv += ["--phase-margin", "60"]
+        assert fragment in one_line_error(capsys, argv)
+        assert not (tmp_path / "x.json").exists() and not (tmp_path / "r.csv").exists()

@@ -1,4 +1,4 @@
-"""``clutchlab control trim|linearize|bode MODEL ...``: a thin layer over :mod:`clutchlab.control`.
+"""``clutchlab control trim|linearize|bode|design MODEL ...``: a thin layer over :mod:`clutchlab.control`.
 
 ``clutchlab control trim eclutch --at "4 mm" -o op.json``
     the steady state holding the release bearing at 4 mm (motor voltage solved for);
@@ -7,6 +7,8 @@
 ``clutchlab control bode eclutch --at "0.5 mm" --at "4 mm" --at "8 mm" -u motor_voltage -y bearing_position -o bode.png``
     Bode diagram at several operating points (and ``--table`` its magnitude and phase as CSV, ``--poles``
     the poles at each point).
+``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" --phase-margin "60 deg" -o pi.json --run run.csv --step "0.5 mm"``
+    the PI for that margin (JSON), and the nonlinear model run with it in the loop for a reference step.
 
 Other models: ``wet``, ``emtc`` (their held inputs; ``--coil-drive current`` drives the EMTC's coil at
 the input ``coil_current_command``) and ``driveline FILE.toml``, with the generic trim options
@@ -63,6 +65,31 @@ def register(subparsers) -> None:
     bode.add_argument("--fmin", default="0.1 Hz", help="lowest frequency (default 0.1 Hz)")
     bode.add_argument("--fmax", default="2 kHz", help="highest frequency (default 2 kHz)")
     bode.set_defaults(func=_bode)
+    design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
+                            description="Linearise the model at a steady state (one input, one output), design "
+                                        "the PI C(s) = Kp (1 + 1/(Ti s)) giving the phase margin at the crossover "
+                                        "(loop shaping, Åström and Murray Ch. 11), check the closed loop's poles, "
+                                        "and write the controller as JSON; with --run, discretise it at "
+                                        "--sample-time and run the nonlinear model with it in the loop from the "
+                                        "operating point for a step of the reference.",
+                            epilog="Documentation: docs/control.md ('From the command line: design')")
+    _common(design)
+    design.add_argument("-u", "--u", dest="inputs", action="append", required=True, metavar="INPUT",
+                        help="the input the PI drives (one), e.g. motor_voltage")
+    design.add_argument("-y", "--y", dest="outputs", action="append", required=True, metavar="NAME",
+                        help="the state or output it controls (one), e.g. bearing_position")
+    design.add_argument("--branch", action="append", default=[], metavar="NAME=rising|falling",
+                        help="linearise a hysteretic element along one branch (as for linearize)")
+    design.add_argument("--crossover", required=True, help="gain crossover frequency, e.g. '10 Hz'")
+    design.add_argument("--phase-margin", required=True, help="phase margin, e.g. '60 deg' (0 to 90)")
+    design.add_argument("-o", "--output", required=True, help="JSON file of the controller")
+    design.add_argument("--run", metavar="RUN.csv",
+                        help="also run the closed loop (nonlinear model, discrete PI) and write it as CSV")
+    design.add_argument("--sample-time", default="1 ms", help="controller period of the run (default 1 ms)")
+    design.add_argument("--step", default="0", help="step of the reference at t = 0 in the output's unit, e.g. "
+                                                     "'0.5 mm' (default 0: the operating point held)")
+    design.add_argument("--t-end", default="0.5 s", help="length of the run (default 0.5 s)")
+    design.set_defaults(func=_design)
     top.set_defaults(func=lambda args: (top.print_help(), 2)[1])
 
 
@@ -263,4 +290,89 @@ def _bode(args) -> int:
                            directions=branches, name=name)
         atomic_to_csv(poles, args.poles, overwrite=args.force)
     print(args.output)
+    return 0
+
+
+def _unit_of(var) -> str:
+    """The pint unit of a system variable (its ``unit`` may be a column suffix: ``rad_s``)."""
+    from ..units import COLUMN_UNITS
+
+    return COLUMN_UNITS.get(var.unit, (var.unit,))[0] or "1"
+
+
+def _per(num: str, den: str) -> str:
+    """``num`` per ``den`` as a unit: ``V/m``, ``V/(rad/s)``."""
+    return f"{num}/{den}" if den.replace("_", "").isalnum() else f"{num}/({den})"
+
+
+def _design(args) -> int:
+    """``control design``: trim, linearise (SISO), PI for the margin; optionally the closed-loop run."""
+    import json
+
+    import numpy as np
+
+    from ..io.files import atomic_to_csv, atomic_write_text, check_outputs
+    from ..units import to_si
+    from .design import pi_for_phase_margin
+    from .linear import linearize
+    from .loop import closed_loop
+    from .trim import resolve
+
+    check_outputs([args.output, args.run], args.force)
+    if len(args.inputs) != 1 or len(args.outputs) != 1:
+        raise ParameterError(f"a PI drives one input from one output: got -u {args.inputs} and -y {args.outputs}")
+    crossover = to_si(args.crossover, "Hz", name="--crossover")
+    margin = to_si(args.phase_margin, "deg", name="--phase-margin")
+    sample_time = to_si(args.sample_time, "s", name="--sample-time")
+    t_end = to_si(args.t_end, "s", name="--t-end")
+    if args.run is not None and not (sample_time > 0 and t_end >= sample_time):
+        raise ParameterError(f"--sample-time {args.sample_time!r} and --t-end {args.t_end!r}: need 0 < sample time "
+                             "<= t_end")
+    if args.run is not None and crossover >= 0.5 / sample_time:
+        raise ParameterError(f"--crossover {args.crossover!r} at or above the Nyquist frequency "
+                             f"{0.5 / sample_time:g} Hz of --sample-time {args.sample_time!r}")
+    points = _points(args)
+    if len(points) != 1:
+        raise ParameterError("design works at one operating point: give one --at")
+    label, _, op = points[0]
+    system = op.system
+    plant = linearize(op, inputs=args.inputs, outputs=args.outputs, directions=_branches(args))
+    pi = pi_for_phase_margin(plant, crossover, margin)
+    _, ui = resolve(system, args.inputs[0], ("input",))
+    ykind, yi = resolve(system, args.outputs[0], ("state", "output"))
+    u, y = system.inputs[ui], (system.states if ykind == "state" else system.outputs)[yi]
+    import control
+
+    loop = control.ss(pi.tf()) * control.ss(plant)
+    margins = control.stability_margins(loop)   # (gm, pm, sm, w at -180 deg, gain crossover w, w of sm)
+    gm, pm, wp = margins[0], margins[1], margins[4]
+    poles = control.feedback(loop, 1).poles()
+    doc = {"controller": "PI", "law": "C(s) = Kp (1 + 1/(Ti s)) acting on reference - measured",
+           "kp": pi.kp, "kp_unit": _per(_unit_of(u), _unit_of(y)), "ti_s": pi.ti,
+           "input": u.column, "output": y.column, "operating_point": label, "at_time_s": op.t,
+           "operating_input": float(op.u[ui]), "operating_output": op.value(y.name),
+           "crossover_Hz": crossover, "phase_margin_deg": margin,
+           "achieved": {"phase_margin_deg": float(pm), "crossover_Hz": float(wp) / (2 * np.pi),
+                        "gain_margin": None if not np.isfinite(gm) else float(gm)},
+           "closed_loop_poles": [[float(p.real), float(p.imag)] for p in poles]}
+    atomic_write_text(args.output, json.dumps(doc, indent=1), overwrite=args.force)
+    print(f"{system.name} at {label}: Kp = {pi.kp:.6g} {doc['kp_unit']}, Ti = {pi.ti:.6g} s for {margin:g} deg at "
+          f"{crossover:g} Hz (achieved {pm:.2f} deg at {wp / (2 * np.pi):.4g} Hz) -> {args.output}")
+    if args.run is None:
+        return 0
+    step = to_si(args.step, _unit_of(y), name="--step")
+    target = doc["operating_output"] + step
+    result = closed_loop(op, pi.discrete(sample_time), sample_time, t_end, measure=[y.name], actuate=[u.name],
+                         reference=target)
+    frame = result.frame
+    atomic_to_csv(frame, args.run, overwrite=args.force,
+                  header_comment=f"closed loop of {system.name} at {label} with the PI of {args.output} "
+                                 f"(Kp = {pi.kp:.6g}, Ti = {pi.ti:.6g} s, Tustin at {sample_time:g} s), reference "
+                                 f"step {args.step} at t = 0; written by clutchlab control design")
+    out = frame[y.column].to_numpy()
+    rise = target - doc["operating_output"]
+    over = (np.max((out - target) * np.sign(rise)) / abs(rise) * 100.0) if rise else 0.0
+    print(f"{args.run}: {len(frame)} samples to {t_end:g} s; final error {out[-1] - target:.3g} "
+          f"{_unit_of(y)}" + (f", overshoot {max(over, 0.0):.1f} %" if rise else "")
+          + f", input limited in {int(frame['saturated_1'].sum())} samples")
     return 0
