@@ -263,8 +263,10 @@ def test_the_report_reads_a_rig_export_and_says_how(tmp_path, record):
     run.mkdir()
     (run / "feder.csv").write_bytes(_german(record).encode("iso-8859-1"))
     (ds,), failed = find_datasets(run)
-    assert not failed and list(ds.frame.columns) == ["Zeit", "Weg", "Kraft"]
+    # the units of the unit row travel in the names, where the report's figures find them
+    assert not failed and list(ds.frame.columns) == ["Zeit [s]", "Weg [mm]", "Kraft [kN]"]
     assert ds.provenance[0].startswith("Prüfstand 3")
     assert ds.provenance[-1].startswith("read as Windows-1252 (ISO-8859-1), ';' separator, decimal comma")
     m = metrics_table(ds).set_index("channel")
-    np.testing.assert_allclose(m.loc["Kraft", "max"], record["force_N"].max() / 1e3, rtol=1e-8)
+    np.testing.assert_allclose(m.loc["Kraft [kN]", "max"], record["force_N"].max() / 1e3, rtol=1e-8)
+    assert m.loc["Kraft [kN]", "unit"] == "kN" and m.loc["Weg [mm]", "unit"] == "mm"

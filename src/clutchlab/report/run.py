@@ -114,7 +114,10 @@ def _read_csv(path: Path, name: str) -> Dataset:
     table = read_csv(path, str(path))   # any dialect (clutchlab.io.dialect); '#' lines and a title are the header
     d = table.dialect
     plain = d.encoding == "utf-8" and d.separator == "," and d.decimal == "." and not d.units_row
-    return Dataset(name, "CSV", table.frame, list(table.comments) + ([] if plain else [f"read as {d.describe()}"]),
+    # a unit the file states (unit row, "Kraft [kN]", '# units:') travels in the name, where figures look for it
+    frame = table.frame.rename(columns={c: f"{c} [{u}]" for c, u in table.units.items()
+                                        if c in table.frame.columns and u and column_unit(str(c)) is None})
+    return Dataset(name, "CSV", frame, list(table.comments) + ([] if plain else [f"read as {d.describe()}"]),
                    [path])
 
 
