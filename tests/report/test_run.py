@@ -282,3 +282,28 @@ def test_a_table_without_time_has_no_final_value():
     run = Dataset("run", "CSV", pd.DataFrame({"time_s": [0.0, 1.0], "energy_J": [1.0, 2.0]}), [], [])
     assert "final" not in metrics_table(samples).columns
     assert metrics_table(run).set_index("channel").loc["energy_J", "final"] == 2.0
+
+
+def test_a_logger_file_of_many_channels_draws_a_bounded_number_of_figures(tmp_path):
+    """#33: a CSV of 3,000 channels made 125 figures (74 MB, 1.45 GB): at most MAX_FIGURES_PER_TABLE figures
+    per table are drawn, the rest are named, and every channel keeps its metrics row."""
+    from clutchlab.report.html import Figure, Text
+    from clutchlab.report.run import MAX_AXES_PER_FIGURE, MAX_FIGURES_PER_TABLE, run_sections
+
+    run = tmp_path / "run"
+    run.mkdir()
+    t = np.linspace(0.0, 1.0, 20)
+    frame = pd.DataFrame({"time_s": t, **{f"sig{k}_{u}": t * k for k in range(300) for u in ("N",)}})
+    frame.to_csv(run / "logger.csv", index=False)
+    (section,) = [s for s in run_sections(run) if s.title == "Data: logger.csv"]
+    figures = [i for i in section.items if isinstance(i, Figure)]
+    assert len(figures) == MAX_FIGURES_PER_TABLE
+    drawn = sum(len(ax.lines) for f in figures for ax in f.figure.axes)
+    assert drawn == MAX_FIGURES_PER_TABLE * MAX_AXES_PER_FIGURE * 6       # six lines per axes
+    (note,) = [i.text for i in section.items if isinstance(i, Text)]
+    assert f"{300 - drawn} of 300 channels not drawn" in note and f"sig{drawn}_N, " in note
+    metrics = [i.frame for i in section.items if hasattr(i, "frame") and "channel" in getattr(i, "frame").columns]
+    assert len(metrics[0]) == 301          # every channel and the time
+    import matplotlib.pyplot as plt
+
+    plt.close("all")

@@ -45,6 +45,8 @@ TABLE_SUFFIXES = {".csv": "CSV", ".parquet": "Parquet", ".mf4": "MDF4", ".mdf": 
 _TIME_NAMES = ("time_s", "time", "t_s", "t", "timestamp_s", "timestamps")
 MAX_LINES_PER_AXES = 6
 MAX_AXES_PER_FIGURE = 4
+#: at most this many time-series figures per table (the other channels are named, and in the metrics table)
+MAX_FIGURES_PER_TABLE = 10
 MAX_PLOT_POINTS = 4000
 MAX_SCATTER_POINTS = 5000
 MAX_SCATTER_OUTPUTS = 8
@@ -372,7 +374,7 @@ def _left_out(n: int) -> str:
     return f"; {n} values beyond ±{PLOT_LIMIT:.0e} not drawn" if n else ""
 
 
-def _time_series_figures(ds: Dataset, label: str, units: str = "si") -> list[Figure]:
+def _time_series_figures(ds: Dataset, label: str, units: str = "si") -> list:
     from ..plotting import new_figure
 
     tcol = ds.time_column
@@ -383,7 +385,17 @@ def _time_series_figures(ds: Dataset, label: str, units: str = "si") -> list[Fig
     stride = max(1, math.ceil(len(frame) / MAX_PLOT_POINTS))
     t, wild = _plottable(frame[tcol].to_numpy(dtype=float)[::stride])
     groups = _groups(channels)
-    figures = []
+    figures: list = []
+    drawn = MAX_FIGURES_PER_TABLE * MAX_AXES_PER_FIGURE
+    if len(groups) > drawn:
+        # a logger file of 3,000 channels made 125 figures, 74 MB and 1.45 GB of memory (#33): the first ones
+        # are drawn, the rest named; every channel keeps its row in the metrics table
+        rest = [str(c) for _, cols in groups[drawn:] for c in cols]
+        shown = ", ".join(rest[:20]) + (f", ... ({len(rest) - 20} more)" if len(rest) > 20 else "")
+        figures.append(Text(f"{ds.name}: {len(rest)} of {len(channels)} channels not drawn (at most "
+                            f"{MAX_FIGURES_PER_TABLE} figures of {MAX_AXES_PER_FIGURE} axes per table; all are "
+                            f"in the metrics table): {shown}"))
+        groups = groups[:drawn]
     for k in range(0, len(groups), MAX_AXES_PER_FIGURE):
         part = groups[k:k + MAX_AXES_PER_FIGURE]
         fig, axes = new_figure(len(part), 1, width=8.0, height=1.9 * len(part) + 0.6, sharex=True, squeeze=False)
