@@ -7,8 +7,9 @@
 ``clutchlab control bode eclutch --at "0.5 mm" --at "4 mm" --at "8 mm" -u motor_voltage -y bearing_position -o bode.png``
     Bode diagram at several operating points (and ``--table`` its magnitude and phase as CSV, ``--poles``
     the poles at each point).
-``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" --phase-margin "60 deg" -o pi.json --run run.csv --step "0.5 mm"``
-    the PI for that margin (JSON), and the nonlinear model run with it in the loop for a reference step.
+``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
+    with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
+    "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
 
 Other models: ``wet``, ``emtc`` (their held inputs; ``--coil-drive current`` drives the EMTC's coil at
 the input ``coil_current_command``) and ``driveline FILE.toml``, with the generic trim options

@@ -75,8 +75,8 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", required=True, help="file to write (.csv, .parquet, .mf4)")
     p.add_argument("--channel-map", metavar="MAP.toml",
                    help="TOML file with [channels.<name>] tables: source, unit, source_unit, group, index, "
-                        "interpolation, and optionally a [csv] table (without a map: every channel that can be converted; the others are "
-                        "skipped with a warning)")
+                        "interpolation, and optionally [csv] and [bus] tables (without a map: every channel that "
+                        "can be converted; the others are skipped with a warning)")
     p.add_argument("--rate", type=float, metavar="HZ", help="resample onto a uniform time base at this rate")
     p.add_argument("--interpolation", choices=("linear", "previous"), default="linear",
                    help="resampling between samples (default: %(default)s)")

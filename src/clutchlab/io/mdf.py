@@ -242,7 +242,8 @@ class BusDatabase:
         object.__setattr__(self, "path", Path(self.path))
         bus = self.bus.upper() if isinstance(self.bus, str) else self.bus
         if bus not in BUS_TYPES:
-            raise ParameterError(f"bus database {self.path}: bus = {self.bus!r}, expected one of {', '.join(BUS_TYPES)}")
+            raise ParameterError(f"bus database {self.path}: bus = {self.bus!r}, expected one of "
+                                 f"{', '.join(BUS_TYPES)}")
         object.__setattr__(self, "bus", bus)
         if isinstance(self.channel, bool) or not isinstance(self.channel, int) or self.channel < 0:
             raise ParameterError(f"bus database {self.path}: channel = {self.channel!r} must be a bus channel "
@@ -565,7 +566,8 @@ class MdfReader:
             if skip_nonnumeric:
                 return None
             kind = f"dtype {samples.dtype}" if samples.ndim == 1 else f"{samples.ndim}-D samples"
-            frames = " (raw bus frames: decode them with a DBC file first, --dbc or [bus])" if g in self.bus_groups else ""
+            frames = (" (raw bus frames: decode them with a DBC file first, --dbc or [bus])" if g in self.bus_groups
+                      else "")
             raise DataError(f"{self.label}: {what} in group {g} has non-numeric samples ({kind}){frames}; "
                             "only numeric channels can be read")
         if samples.size == 0:
