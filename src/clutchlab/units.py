@@ -21,6 +21,7 @@ from .errors import ParameterError
 __all__ = [
     "ENGINEERS_UNITS",
     "engineers_unit",
+    "affine_conversion",
     "rpm_to_rad_s",
     "rad_s_to_rpm",
     "celsius_to_kelvin",
@@ -428,10 +429,32 @@ def engineers_unit(unit: str) -> tuple[str, float, float]:
     target = ENGINEERS_UNITS.get(str(unit))
     if not target or target == unit:
         return str(unit), 1.0, 0.0
-    from .io.channels import unit_conversion
-
-    scale, offset = unit_conversion(unit, target, name=unit)
+    scale, offset = affine_conversion(unit, target)
     return target, scale, offset
+
+
+@lru_cache(maxsize=512)
+def affine_conversion(source: str, target: str) -> tuple[float, float]:
+    """``(scale, offset)`` with ``target_value = scale * source_value + offset`` (pint, logger spellings allowed).
+
+    Parameters
+    ----------
+    source, target : str
+        Unit strings (``""`` dimensionless); a frequency in Hz counts cycles where an angle is meant
+        (:func:`convert`).
+
+    Raises
+    ------
+    pint.errors.PintError
+        Unknown unit, or units of different dimension (:func:`clutchlab.io.unit_conversion` turns these
+        into clutchlab's errors naming the channel and the file).
+    """
+    ureg = _registry()
+    src = normalise_unit(source) or "dimensionless"
+    tgt = normalise_unit(target) or "dimensionless"
+    zero = convert(ureg.Quantity(0.0, src), tgt)
+    one = convert(ureg.Quantity(1.0, src), tgt)
+    return float(one - zero), float(zero)
 
 
 def column_label(name: str) -> str:

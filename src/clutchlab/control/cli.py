@@ -178,14 +178,14 @@ def _branches(args) -> dict:
 
 
 def _pairs(system, items, kinds, flag):
-    from ..units import COLUMN_UNITS, to_si
+    from ..units import to_si
     from .trim import resolve
 
     out = {}
     for name, value in _name_values(items, flag, "NAME=VALUE").items():
         kind, i = resolve(system, name, kinds)
         var = {"state": system.states, "output": system.outputs, "input": system.inputs}[kind][i]
-        out[var.name] = to_si(value, COLUMN_UNITS.get(var.unit, (var.unit,))[0], name=f"{flag} {name}")
+        out[var.name] = to_si(value, _unit_of(var, ""), name=f"{flag} {name}")
     return out
 
 
@@ -294,11 +294,12 @@ def _bode(args) -> int:
     return 0
 
 
-def _unit_of(var) -> str:
-    """The pint unit of a system variable (its ``unit`` may be a column suffix: ``rad_s``)."""
+def _unit_of(var, dimensionless: str = "1") -> str:
+    """The pint unit of a system variable (its ``unit`` may be a column suffix: ``rad_s``); ``dimensionless`` for
+    none."""
     from ..units import COLUMN_UNITS
 
-    return COLUMN_UNITS.get(var.unit, (var.unit,))[0] or "1"
+    return COLUMN_UNITS.get(var.unit, (var.unit,))[0] or dimensionless
 
 
 def _per(num: str, den: str) -> str:

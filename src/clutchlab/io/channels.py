@@ -45,12 +45,11 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Iterable, Iterator, Mapping
 
 from ..errors import ClutchlabError, DataError, ParameterError
-from ..units import UNIT_ALIASES, normalise_unit
+from ..units import UNIT_ALIASES
 
 __all__ = [
     "UNIT_ALIASES",
@@ -85,16 +84,10 @@ def canonical_unit(name: str) -> str | None:
     return column_unit(name)  # one suffix table for files, axis labels and reports: clutchlab.units.COLUMN_UNITS
 
 
-@lru_cache(maxsize=512)
 def _conversion(source: str, target: str) -> tuple[float, float]:
-    from ..units import _registry, convert
+    from ..units import affine_conversion
 
-    ureg = _registry()
-    src = normalise_unit(source) or "dimensionless"
-    tgt = normalise_unit(target) or "dimensionless"
-    zero = convert(ureg.Quantity(0.0, src), tgt)   # (a frequency in Hz counts cycles where an angle is meant)
-    one = convert(ureg.Quantity(1.0, src), tgt)
-    return float(one - zero), float(zero)
+    return affine_conversion(source, target)   # (a frequency in Hz counts cycles where an angle is meant)
 
 
 def unit_conversion(source: str, target: str, *, name: str = "channel", where: str = "",

@@ -436,7 +436,8 @@ def read_csv(path, label: str | None = None, dialect=None) -> CsvTable:
     if not body:
         raise DataError(f"{label}: cannot read as CSV (no lines besides comments)")
     sample = body[:_SAMPLE_LINES]
-    if len(body) == 1 and not any(_is_number(c, d) for d in DECIMALS for c in re.split(r"[,;\t|]", body[0][1])):
+    if len(body) == 1 and not any(_is_number(c, d) for d in DECIMALS for sep in SEPARATORS
+                                  for c in _split(body[0][1], sep)):
         # names only, no data rows: an empty table (its readers say "no samples")
         sep = given.separator or max(SEPARATORS, key=lambda c: len(_split(body[0][1], c)))
         names = _split(body[0][1], sep)

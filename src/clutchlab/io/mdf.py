@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import DataError, ParameterError
 from .files import check_writable, temporary_sibling
 
 __all__ = ["MDF_SUFFIXES", "UNFINALISED_ID", "BUS_TYPES", "BusDatabase", "RawChannel", "ChannelPlace", "MdfReader",
@@ -235,8 +235,6 @@ class BusDatabase:
     channel: int = 0
 
     def __post_init__(self):
-        from ..errors import ParameterError
-
         if not isinstance(self.path, (str, Path)) or not str(self.path):
             raise ParameterError(f"bus database = {self.path!r}: expected a file path")
         object.__setattr__(self, "path", Path(self.path))
@@ -252,8 +250,6 @@ class BusDatabase:
     @classmethod
     def coerce(cls, value, base: Path | None = None, bus: str = "CAN") -> "BusDatabase":
         """A path, ``{"file": ..., "channel": ...}`` (a TOML table) or a BusDatabase; relative paths from ``base``."""
-        from ..errors import ParameterError
-
         if isinstance(value, BusDatabase):
             return value
         if isinstance(value, (str, Path)):

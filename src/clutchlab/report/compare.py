@@ -30,7 +30,7 @@ from ..errors import DataError, ParameterError
 from ..units import unit_label
 from .html import Figure, Section, Table, Text, check_report_folder, write_report
 from .run import (DEFAULT_OUTPUT, MAX_PLOT_POINTS, TABLE_SUFFIXES, UNIT_SYSTEMS, Dataset,
-                  _display, _io_columns, _left_out, _plottable, _read_csv, _read_mdf, _read_parquet, _stem,
+                  _display, _io_columns, _left_out, _mean, _plottable, _read_csv, _read_mdf, _read_parquet, _stem,
                   display_label, find_datasets, scatter_matrix)
 
 __all__ = ["compare_runs", "compare_sections", "MAX_RUNS", "MAX_COMPARED_CHANNELS"]
@@ -170,7 +170,7 @@ def _time_overlays(key: str, label: str, tables: list[tuple[str, Dataset]], unit
             row = {"channel": str(c), "unit": unit_label(shown) if shown else "", "run": run}
             if fin.size:
                 row.update({"min": fin.min() * scale + offset, "max": fin.max() * scale + offset,
-                            "mean": float(np.mean(fin, dtype=np.longdouble)) * scale + offset,
+                            "mean": _mean(fin) * scale + offset,
                             "final": fin[-1] * scale + offset})
             if j > 0:
                 ok = np.isfinite(t) & np.isfinite(y)
@@ -212,7 +212,7 @@ def _scatter_overlays(key: str, label: str, tables: list[tuple[str, Dataset]], u
             rows.append({"output": str(c), "unit": unit_label(shown) if shown else "", "run": run, "rows": len(v),
                          "min": fin.min() * scale + offset if fin.size else np.nan,
                          "max": fin.max() * scale + offset if fin.size else np.nan,
-                         "mean": float(np.mean(fin, dtype=np.longdouble)) * scale + offset if fin.size else np.nan})
+                         "mean": _mean(fin) * scale + offset if fin.size else np.nan})
     return [Figure(f"{label}_scatter", fig, cap),
             Table(f"{label}_metrics", pd.DataFrame(rows), caption=f"{key}: outputs per run")]
 
