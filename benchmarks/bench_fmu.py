@@ -7,7 +7,7 @@ Scenario: wet-clutch inertia-dynamometer engagement (3 kN held from t = 0, free 
 0.45 s (slipping throughout), communication step 1 ms (450 steps) and 10 ms (45 steps).
 
 * native: one uninterrupted :func:`clutchlab.wet.engagement.simulate_engagement` run (rtol 1e-7).
-* co-simulation: :class:`clutchlab.fmu.cosim.WetCoSimulation`, ``do_step`` per communication step
+* co-simulation: :class:`clutchlab.fmu.wet.WetCoSimulation`, ``do_step`` per communication step
   (compiled DOPRI resumed from the stored state).
 * FMU: the exported FMU through FMPy (time of ``simulate_fmu`` inside the worker process, without the
   interpreter start).
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from clutchlab.fmu.cosim import WetCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 from clutchlab.numerics import core
 from clutchlab.wet import engagement as E
 from clutchlab.wet import system as W

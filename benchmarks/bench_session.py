@@ -119,7 +119,7 @@ class Wet(Case):
     u = [3000.0, 1500 * np.pi / 30]
 
     def build(self):
-        from clutchlab.fmu.cosim import WetCoSimulation
+        from clutchlab.fmu.wet import WetCoSimulation
 
         return WetCoSimulation(**{"scenario.free_inertia": 1.0})
 
@@ -129,7 +129,7 @@ class Emtc(Case):
     u = [300.0, 0.1, 8.0, 7.7]
 
     def build(self):
-        from clutchlab.fmu.cosim import EmtcCoSimulation
+        from clutchlab.fmu.emtc import EmtcCoSimulation
 
         return EmtcCoSimulation()
 
@@ -148,7 +148,7 @@ class EClutchCase(Case):
     n = 200
 
     def build(self):
-        from clutchlab.eclutch.cosim import EClutchCoSimulation
+        from clutchlab.fmu.eclutch import EClutchCoSimulation
 
         return EClutchCoSimulation()
 
@@ -159,7 +159,7 @@ class Driveline(Case):
     n = 300
 
     def build(self):
-        from clutchlab.driveline.cosim import DrivelineCoSimulation
+        from clutchlab.fmu.driveline import DrivelineCoSimulation
 
         return DrivelineCoSimulation.for_description(EXAMPLES / "driveline_coupled_clutches.toml")()
 

@@ -11,7 +11,7 @@ ramp-down, the piston leaving its stop, film contact, lock-up, stick), 12 states
   times it), and the core run alone, ``clutchlab.system.simulate(..., outputs=False)`` on a system built
   beforehand (states at the samples only).  Dormand-Prince 5(4), events on the dense output, steps end on
   the reference profiles' corners, largest step 10 ms.
-* SciPy: ``solve_ivp`` with the Python right-hand side of ``bench_wet.py`` (``make_python_model``),
+* SciPy: ``solve_ivp`` with the Python right-hand side of ``_python_wet.py`` (``make_python_model``),
   restarted at the lock-up / break-away events and, like clutchlab and the peer, at the piston leaving
   and reaching its stop (terminal event functions; ``solve_scipy``), largest step 10 ms, ``t_eval`` = the
   samples: RK45, DOP853, LSODA, Radau, BDF.  "Best SciPy" at an error level is the cheapest of these that
@@ -57,7 +57,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 import _peer_wet as peer_mod  # noqa: E402
 import _wp  # noqa: E402
-from bench_wet import make_python_model  # noqa: E402
+from _python_wet import make_python_model  # noqa: E402
 
 from clutchlab.system import simulate  # noqa: E402
 from clutchlab.wet import Bench, ParametricFriction, WetClutch, simulate_engagement  # noqa: E402

@@ -10,7 +10,7 @@ from clutchlab.errors import ParameterError
 def test_every_demo_section_has_a_group():
     from clutchlab.cli import DEMO_SECTIONS
 
-    assert {name.split(".")[1] for name in DEMO_SECTIONS} <= set(warmup.GROUPS)
+    assert {name.rsplit(".", 1)[1] for name in DEMO_SECTIONS} <= set(warmup.GROUPS)
 
 
 def test_unknown_group_is_refused():

@@ -64,7 +64,7 @@ def test_compiled_loop_with_two_signals_and_two_inputs():
 def test_compiled_scheduled_pi_on_the_wet_engagement_measures_an_output():
     """The wet worked design's controller (gain-scheduled PI with feedforward and conditional integration)
     reading the torque sensor, an output of the model: compiled and Python loops give the same run."""
-    from clutchlab.control import demo
+    from clutchlab.demo import control as demo
     from clutchlab.wet.bench import EngagementProtocol
     from clutchlab.wet.params import WetClutch
     from clutchlab.wet.system import engagement_system

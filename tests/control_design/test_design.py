@@ -115,7 +115,7 @@ def test_scheduled_pi_interpolates_its_gains():
 
 def test_eclutch_worked_design_linear_prediction_holds_on_the_nonlinear_model():
     """Worked design (1): PI for 60 deg at 5 Hz, scheduled over the travel, at 1 kHz on the nonlinear model."""
-    from clutchlab.control import demo
+    from clutchlab.demo import control as demo
 
     d = demo.design()
     assert d["ops"][d["touch"]].value("normal_force") == pytest.approx(0.0, abs=80.0)  # near the touch point
@@ -152,7 +152,7 @@ def test_anhysteretic_magnet_has_no_memory():
 
 def test_emtc_worked_design_inverse_preisach_removes_the_hysteresis_error():
     """Worked design (2): torque holds reached exactly with the inverse Preisach model, not without it."""
-    from clutchlab.control import demo
+    from clutchlab.demo import control as demo
 
     holds = demo.emtc_tracking()["holds"]
     comp = holds[holds.controller == "inverse Preisach"]
@@ -181,7 +181,7 @@ def test_loop_on_a_fixed_step_model_converges_to_the_sampled_data_loop():
 
 def test_wet_worked_design_pi_holds_the_torque_the_feedforward_loses():
     """Worked design (3): the wet engagement's torque, feedforward from trimmed points, PI on the linear model."""
-    from clutchlab.control import demo
+    from clutchlab.demo import control as demo
 
     wet = demo.wet_torque_control()
     m = wet["metrics"].set_index("controller")
@@ -238,7 +238,8 @@ def test_eclutch_loops_satisfy_the_nyquist_criterion():
     """The E-clutch position loops of worked design 1: the designed phase margin at the designed crossover,
     stable closed loops, and where the actuator is open-loop unstable (beyond the force peak) one
     counter-clockwise encirclement of -1 (N = -1), as Z = N + P = 0 requires."""
-    from clutchlab.control import demo, loop_margins
+    from clutchlab.control import loop_margins
+    from clutchlab.demo import control as demo
     from clutchlab.control.plots import nyquist_figure
 
     d = demo.design()

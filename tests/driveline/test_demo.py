@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from clutchlab.driveline import data
-from clutchlab.driveline.demo import EXAMPLES, demo_section, mode_intervals
+from clutchlab.demo.driveline import EXAMPLES, demo_section, mode_intervals
 from clutchlab.driveline.description import load_driveline
 from clutchlab.report import Figure, Section, Table
 
@@ -120,7 +120,7 @@ _SIGNATURES = """
 import gc, json
 from numba.core.dispatcher import Dispatcher
 from clutchlab import warmup
-from clutchlab.driveline.demo import EXAMPLES, run_example
+from clutchlab.demo.driveline import EXAMPLES, run_example
 
 def signatures():
     return {(id(d), str(s)) for d in gc.get_objects() if isinstance(d, Dispatcher) for s in d.signatures}

@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 
 from clutchlab.driveline import Driveline
 from clutchlab.driveline.description import load_driveline
-from clutchlab.driveline.emtc import drum_bench, engine_curve, rolling_curve
+from clutchlab.driveline.bench import drum_bench, engine_curve, rolling_curve
 from clutchlab.emtc import system as S
 from clutchlab.emtc.bench import BenchScenario, VehicleParameters, load_scenario
 from clutchlab.emtc.friction import FrictionMap, LuGreParameters

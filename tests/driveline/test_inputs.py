@@ -18,7 +18,7 @@ from hypothesis import assume, given, settings
 from clutchlab.control.linear import OperatingPoint, jacobians
 from clutchlab.driveline import Driveline, Signal
 from clutchlab.driveline import kernel as K
-from clutchlab.driveline.cosim import DrivelineCoSimulation
+from clutchlab.fmu.driveline import DrivelineCoSimulation
 from clutchlab.driveline.description import load_driveline, parse_driveline
 from clutchlab.errors import ParameterError
 from clutchlab.system import Simulation

@@ -20,7 +20,7 @@ import pytest
 from cli_checks import one_line_error
 from clutchlab.cli import main
 from clutchlab.driveline import Driveline, Signal
-from clutchlab.driveline import sweep as S
+from clutchlab.sweep import driveline as S
 from clutchlab.driveline.variants import DrivelineDocument
 from clutchlab.errors import ParameterError
 from clutchlab.sweep import load_spec

@@ -170,7 +170,7 @@ def test_wet_clutch_in_the_co_simulation_and_the_sweep_variants():
     """The FMU's co-simulation class of the SAE No. 2 file steps the wet clutch's states through the contract
     (a chain of 10 ms steps ends on the one-run result to the solver's tolerance), and its parameters include
     the clutch's initial temperatures (a changed pack temperature changes the run as the Python network)."""
-    from clutchlab.driveline.cosim import DrivelineCoSimulation
+    from clutchlab.fmu.driveline import DrivelineCoSimulation
 
     path = EXAMPLES / "driveline_wet_sae2.toml"
     cls = DrivelineCoSimulation.for_description(path)

@@ -130,7 +130,7 @@ def test_batch_rejects_different_structures():
 
 
 def test_cosimulation_continues_the_native_solution():
-    from clutchlab.eclutch.cosim import EClutchCoSimulation
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
 
     def gap(rtol):
         c = EClutchCoSimulation(rtol=rtol)
@@ -151,7 +151,7 @@ def test_cosimulation_continues_the_native_solution():
 
 
 def test_sweep_target_outputs():
-    from clutchlab.eclutch.sweep import run_batch
+    from clutchlab.sweep.eclutch import run_batch
 
     variants = pd.DataFrame({"clutch.lever_ratio": [-4.2, -3.8], "friction.pressure_plate_force": [0.0, 40.0]},
                             index=pd.Index([0, 1], name="variant_id"))

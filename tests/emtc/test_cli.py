@@ -78,7 +78,7 @@ def test_simulate_scenario_with_plot(tmp_path, capsys):
 
 
 def test_demo_section_is_synthetic_and_complete():
-    from clutchlab.emtc.demo import demo_section
+    from clutchlab.demo.emtc import demo_section
 
     msgs = []
     sec = demo_section(progress=msgs.append)

@@ -28,8 +28,9 @@ from hypothesis_budget import examples
 
 from clutchlab.errors import ParameterError, SimulationError
 from clutchlab.fmu import COSIMULATIONS
-from clutchlab.fmu.cosim import (CoSimulation, EmtcCoSimulation, Variable, WetCoSimulation, fmi_unit,
-                                 load_cosimulation)
+from clutchlab.fmu.cosim import CoSimulation, Variable, fmi_unit, load_cosimulation
+from clutchlab.fmu.emtc import EmtcCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 
 
 # ----------------------------------------------------------------- protocol
@@ -376,7 +377,8 @@ def test_public_api_is_documented():
     import importlib
     import inspect
 
-    for name in ("clutchlab.fmu", "clutchlab.fmu.cosim", "clutchlab.fmu.export"):
+    for name in ("clutchlab.fmu", "clutchlab.fmu.cosim", "clutchlab.fmu.export", "clutchlab.fmu.eclutch", "clutchlab.fmu.wet",
+                 "clutchlab.fmu.emtc", "clutchlab.fmu.driveline"):
         mod = importlib.import_module(name)
         for attr in mod.__all__:
             obj = getattr(mod, attr)

@@ -20,7 +20,7 @@ import pytest
 from cli_checks import one_line_error
 from clutchlab.cli import main
 from clutchlab.driveline import Driveline, Signal
-from clutchlab.driveline.cosim import DrivelineCoSimulation
+from clutchlab.fmu.driveline import DrivelineCoSimulation
 from clutchlab.driveline.description import load_driveline
 from clutchlab.errors import ParameterError
 from clutchlab.fmu.cosim import load_cosimulation

@@ -1,4 +1,4 @@
-"""FMU of the E-clutch dynamics (``clutchlab.eclutch.cosim.EClutchCoSimulation``, written against the protocol).
+"""FMU of the E-clutch dynamics (``clutchlab.fmu.eclutch.EClutchCoSimulation``, written against the protocol).
 
 Runs against the lead's class: the FMU loaded with FMPy must reproduce the
 in-process co-simulation (the same object behind pythonfmu, so equal to
@@ -14,7 +14,7 @@ from clutchlab.fmu.export import DEFAULT_EXPERIMENT
 
 def _cls():
     # imported per test (not at collection) so that a missing class fails these tests, not the whole run
-    from clutchlab.eclutch.cosim import EClutchCoSimulation
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
 
     return EClutchCoSimulation
 

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from clutchlab.errors import ParameterError
-from clutchlab.fmu.cosim import EmtcCoSimulation, WetCoSimulation
+from clutchlab.fmu.emtc import EmtcCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 from clutchlab.fmu.export import export_fmu, model_identifier, unit_definition
 
 fmpy = pytest.importorskip("fmpy")

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from clutchlab.errors import ParameterError
-from clutchlab.fmu.cosim import EmtcCoSimulation, WetCoSimulation
+from clutchlab.fmu.emtc import EmtcCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -58,7 +59,7 @@ def test_bad_fixed_step_parameter_is_refused(bad):
 
 def test_eclutch_cosimulation_runs_fixed_step(run_cosim):
     """The E-clutch (stiff, Rodas3 anyway) in 1 ms frames inside 5 ms communication steps follows its adaptive run."""
-    from clutchlab.eclutch.cosim import EClutchCoSimulation
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
 
     dt, n = 5e-3, 60
     k = np.arange(n + 1)
@@ -93,7 +94,7 @@ def _driveline_chain(cls, dt, n, start=None):
 def driveline():
     """Modelica's CoupledClutches (examples/driveline_coupled_clutches.toml) over 1.5 s in 1 ms communication steps:
     the adaptive co-simulation and the one in 1 ms frames (``solver.fixed_step = 1e-3``)."""
-    from clutchlab.driveline.cosim import DrivelineCoSimulation
+    from clutchlab.fmu.driveline import DrivelineCoSimulation
 
     cls = DrivelineCoSimulation.for_description(COUPLED_CLUTCHES)
     fixed = _driveline_chain(cls, 1e-3, 1500, {"solver.fixed_step": 1e-3})

@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clutchlab.fmu.cosim import EmtcCoSimulation, WetCoSimulation
+from clutchlab.fmu.emtc import EmtcCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 
 fmpy = pytest.importorskip("fmpy")
 

@@ -14,19 +14,21 @@ import pytest
 from session_check import assert_packed_as_compiled
 
 from clutchlab.errors import ParameterError, SimulationError
-from clutchlab.fmu.cosim import CoSimulation, EmtcCoSimulation, WetCoSimulation
+from clutchlab.fmu.cosim import CoSimulation
+from clutchlab.fmu.emtc import EmtcCoSimulation
+from clutchlab.fmu.wet import WetCoSimulation
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 
 
 def _eclutch():
-    from clutchlab.eclutch.cosim import EClutchCoSimulation
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
 
     return EClutchCoSimulation()
 
 
 def _driveline():
-    from clutchlab.driveline.cosim import DrivelineCoSimulation
+    from clutchlab.fmu.driveline import DrivelineCoSimulation
 
     return DrivelineCoSimulation.for_description(EXAMPLES / "driveline_coupled_clutches.toml")()
 

@@ -255,7 +255,7 @@ def test_an_advance_of_more_than_a_million_fixed_steps_is_refused_at_once():
 
 def test_an_fmu_co_simulation_with_a_tiny_fixed_step_fails_its_step_not_its_host():
     from clutchlab.errors import SimulationError
-    from clutchlab.eclutch.cosim import EClutchCoSimulation
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
 
     c = EClutchCoSimulation(**{"solver.fixed_step": 1e-12})
     c.initial_outputs({v.name: v.start for v in c.inputs})

@@ -45,8 +45,8 @@ def test_builtin_names_resolve_to_clutchlab_modules():
     wet = resolve_target("wet")
     assert wet.origin == "built-in" and wet.run_batch.__module__ == "clutchlab.sweep.wet"
     assert wet.describe_fn is not None and wet.check_fn is not None
-    assert resolve_target("eclutch").run_batch.__module__ == "clutchlab.eclutch.sweep"
-    assert resolve_target("driveline").run_batch.__module__ == "clutchlab.driveline.sweep"
+    assert resolve_target("eclutch").run_batch.__module__ == "clutchlab.sweep.eclutch"
+    assert resolve_target("driveline").run_batch.__module__ == "clutchlab.sweep.driveline"
     with pytest.raises(ParameterError, match=r"unknown model.*available: driveline, eclutch, eclutch-static, emtc, wet"):
         resolve_target("hydraulic")
 

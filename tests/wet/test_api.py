@@ -18,7 +18,7 @@ def test_every_public_function_documents_its_arguments():
 
 
 def test_import_compiles_nothing():
-    code = ("import numba, clutchlab.wet, clutchlab.wet.demo, clutchlab.wet.cli\n"
+    code = ("import numba, clutchlab.wet, clutchlab.demo.wet, clutchlab.cli.wet\n"
             "from clutchlab.wet import film, friction, system\n"
             "from clutchlab.numerics import entry\n"
             "fns = [system.wet_rhs, film.film_scalar, friction.mu_kernel]\n"

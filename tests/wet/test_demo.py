@@ -4,7 +4,7 @@ from clutchlab.report import Figure, Section, Table
 
 
 def test_demo_section_compares_identified_with_true():
-    from clutchlab.wet.demo import demo_section
+    from clutchlab.demo.wet import demo_section
 
     messages = []
     sec = demo_section(messages.append)

@@ -28,9 +28,9 @@ __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem
            "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error"]
 
 _WHERE = {
-    "OperatingPoint": "clutchlab.control.trim",
-    "operating_point": "clutchlab.control.trim",
-    "OperatingPointError": "clutchlab.control.trim",
+    "OperatingPoint": "clutchlab.trim",
+    "operating_point": "clutchlab.trim",
+    "OperatingPointError": "clutchlab.trim",
     "linearize": "clutchlab.control.linear",
     "jacobians": "clutchlab.control.linear",
     "nonlinear_iosystem": "clutchlab.control.linear",

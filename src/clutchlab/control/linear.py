@@ -4,14 +4,14 @@ For a system ``M x' = f(t, x, u, m)``, ``y = h(t, x, u, m)`` (:mod:`clutchlab.sy
 algebraic rows such as the E-clutch's massless finger tip) at an operating point ``(t, x0, u0, m)``:
 
 * ``A_full = df/dx`` from the model's analytic Jacobian hook where it has one, else central differences
-  (step ``6e-6`` times the state's typical magnitude, :func:`clutchlab.control.trim.state_scale`);
+  (step ``6e-6`` times the state's typical magnitude, :func:`clutchlab.trim.state_scale`);
   ``B = df/du``, ``C = dh/dx``, ``D = dh/du`` by central differences; the modes stay fixed, so a hybrid model
   is linearised within its active mode (stuck or sliding, in contact or not), and that mode is part of the
   result;
 * differential rows are divided by their mass, algebraic rows ``a`` are eliminated
   (``A = A_dd - A_da A_aa^-1 A_ad``, likewise ``B``, ``C``, ``D``): index-1 DAEs only;
 * states that no other kept state and no requested output reads are dropped, repeatedly (energy
-  integrals, see :mod:`clutchlab.control.trim`; the E-clutch's massless-tip velocity): they are
+  integrals, see :mod:`clutchlab.trim`; the E-clutch's massless-tip velocity): they are
   unobservable, so the input-output behaviour is unchanged (``keep_monitors=True`` keeps them); so are
   states the active mode holds still (a zero row in ``A`` and ``B``: the EMTC's armature at its stop),
   which stay at their operating values whatever the inputs do.
@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..system import System, evaluate
-from .trim import OperatingPoint, input_scale, resolve, state_scale
+from ..trim import OperatingPoint, input_scale, resolve, state_scale
 
 __all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
            "write_linear_model", "signal_name"]

@@ -35,7 +35,7 @@ import pandas as pd
 from .._limits import check_allocation
 from ..errors import ParameterError
 from ..system import Simulation, System
-from .trim import OperatingPoint, resolve
+from ..trim import OperatingPoint, resolve
 
 __all__ = ["ClosedLoopResult", "closed_loop", "discrete_matrices"]
 

@@ -139,7 +139,7 @@ def modes_figure(intervals, *, title: str = ""):
     ----------
     intervals : dict
         Element name -> list of ``(start [s], stop [s], mode)`` covering the run, mode one of stuck,
-        forward, backward, free (:func:`clutchlab.driveline.demo.mode_intervals`).
+        forward, backward, free (:func:`clutchlab.demo.driveline.mode_intervals`).
     title : str
         Title of the axes.
     """

@@ -1,7 +1,7 @@
 """A driveline description file whose numeric component parameters can be changed by name.
 
-The FMU of a driveline (:mod:`clutchlab.driveline.cosim`) and the sweep target ``driveline``
-(:mod:`clutchlab.driveline.sweep`) both start from a description file (the format of
+The FMU of a driveline (:mod:`clutchlab.fmu.driveline`) and the sweep target ``driveline``
+(:mod:`clutchlab.sweep.driveline`) both start from a description file (the format of
 :mod:`clutchlab.driveline.description`) and change some of its numbers: ``J1.J``, ``J1.w0``,
 ``clutch1.fn_max``, ``clutch1.mu``.  A parameter is named ``<component>.<field>`` after the file's
 ``[<kind>.<component>]`` table; its unit is the field's SI unit

@@ -61,6 +61,7 @@ from ..params import ParameterSet, quantity
 from ..result import BuiltOnFirstAccess, SimulationResult
 from . import system as S
 from .actuator import ActuatorParameters
+from .friction import FrictionElement
 from .models import ClutchModel
 from .network import AxialNetwork, Lever, Spring
 
@@ -110,61 +111,6 @@ class FrictionParameters(ParameterSet):
         """No friction at all (the setting of [1] Secs. 5-6)."""
         return cls(diaphragm_coefficient=0.0, pressure_plate_force=0.0, static_ratio=1.0, diaphragm_viscous=0.0,
                    pressure_plate_viscous=0.0)
-
-
-@dataclasses.dataclass(frozen=True)
-class FrictionElement:
-    """A friction element acting on one node of the network (or on the actuator).
-
-    Kinetic force ``F_c = coulomb + coefficient * |f_normal| + pressure_coefficient * |p|``,
-    opposing the slip, plus ``viscous * v``; static limit ``static_ratio * F_c``.
-
-    Parameters
-    ----------
-    name : str
-        Label (``"R_f.ds"``).
-    node : str
-        Network node name, or ``"master"`` / ``"bearing"`` for the actuator pistons.
-    coulomb : float
-        Constant Coulomb force [N].
-    coefficient : float
-        Friction per unit force of ``normal`` [-].
-    normal : str or None
-        Network element whose force presses the contact.
-    pressure_coefficient : float
-        Friction per unit chamber pressure [N/Pa] (seals).
-    pressure : str or None
-        ``"master"`` or ``"slave"`` chamber.
-    static_ratio : float
-        Static over kinetic friction (>= 1).
-    viscous : float
-        Viscous coefficient [N s/m].
-    """
-
-    name: str
-    node: str
-    coulomb: float = 0.0
-    coefficient: float = 0.0
-    normal: str | None = None
-    pressure_coefficient: float = 0.0
-    pressure: str | None = None
-    static_ratio: float = 1.0
-    viscous: float = 0.0
-
-    def __post_init__(self):
-        for fld in ("coulomb", "coefficient", "pressure_coefficient", "viscous"):
-            v = getattr(self, fld)
-            if not (np.isfinite(v) and v >= 0):
-                raise ParameterError(f"friction element {self.name!r}: {fld} = {v!r} must be finite and >= 0")
-        if not (np.isfinite(self.static_ratio) and self.static_ratio >= 1.0):
-            raise ParameterError(f"friction element {self.name!r}: static_ratio = {self.static_ratio!r} must be >= 1")
-        if self.pressure not in (None, "master", "slave"):
-            raise ParameterError(f"friction element {self.name!r}: pressure = {self.pressure!r} (use 'master' or 'slave')")
-
-    @property
-    def active(self) -> bool:
-        """True if the element can exert any Coulomb force."""
-        return self.coulomb > 0 or self.coefficient > 0 or self.pressure_coefficient > 0
 
 
 def clutch_friction_elements(network: AxialNetwork, friction: FrictionParameters) -> list[FrictionElement]:
@@ -761,7 +707,7 @@ class EClutch:
         clutchlab.control.OperatingPointError
             A position outside the travel; a voltage beyond the supply; no convergence.
         """
-        from ..control.trim import OperatingPointError, operating_point
+        from ..trim import OperatingPointError, operating_point
 
         if input not in ("voltage", "bearing_reference"):
             raise ParameterError(f"input = {input!r}: expected 'voltage' or 'bearing_reference'")

@@ -3,7 +3,7 @@
 The friction elements of the axial models (R_f.ds, R_f.pp of [1] Figs. 5b,
 11) and the actuator's seals and spindle
 (:func:`clutchlab.eclutch.dynamics.actuator_friction_elements`) share one law
-(:class:`clutchlab.eclutch.dynamics.FrictionElement`): a kinetic (Coulomb)
+(:class:`FrictionElement`): a kinetic (Coulomb)
 force that grows with a normal force and a chamber pressure, a static limit
 ``r_s`` times that, and a viscous part.  The stick-slip state machine that
 switches between them ([2], the Modelica Standard Library's friction element)
@@ -20,9 +20,69 @@ References
 
 from __future__ import annotations
 
-import numba
+import dataclasses
 
-__all__ = ["kinetic_level", "slip_force", "static_margin"]
+import numba
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["FrictionElement", "kinetic_level", "slip_force", "static_margin"]
+
+
+@dataclasses.dataclass(frozen=True)
+class FrictionElement:
+    """A friction element acting on one node of the network (or on the actuator).
+
+    Kinetic force ``F_c = coulomb + coefficient * |f_normal| + pressure_coefficient * |p|``,
+    opposing the slip, plus ``viscous * v``; static limit ``static_ratio * F_c``.
+
+    Parameters
+    ----------
+    name : str
+        Label (``"R_f.ds"``).
+    node : str
+        Network node name, or ``"master"`` / ``"bearing"`` for the actuator pistons.
+    coulomb : float
+        Constant Coulomb force [N].
+    coefficient : float
+        Friction per unit force of ``normal`` [-].
+    normal : str or None
+        Network element whose force presses the contact.
+    pressure_coefficient : float
+        Friction per unit chamber pressure [N/Pa] (seals).
+    pressure : str or None
+        ``"master"`` or ``"slave"`` chamber.
+    static_ratio : float
+        Static over kinetic friction (>= 1).
+    viscous : float
+        Viscous coefficient [N s/m].
+    """
+
+    name: str
+    node: str
+    coulomb: float = 0.0
+    coefficient: float = 0.0
+    normal: str | None = None
+    pressure_coefficient: float = 0.0
+    pressure: str | None = None
+    static_ratio: float = 1.0
+    viscous: float = 0.0
+
+    def __post_init__(self):
+        for fld in ("coulomb", "coefficient", "pressure_coefficient", "viscous"):
+            v = getattr(self, fld)
+            if not (np.isfinite(v) and v >= 0):
+                raise ParameterError(f"friction element {self.name!r}: {fld} = {v!r} must be finite and >= 0")
+        if not (np.isfinite(self.static_ratio) and self.static_ratio >= 1.0):
+            raise ParameterError(f"friction element {self.name!r}: static_ratio = {self.static_ratio!r} must be >= 1")
+        if self.pressure not in (None, "master", "slave"):
+            raise ParameterError(f"friction element {self.name!r}: pressure = {self.pressure!r} (use 'master' or 'slave')")
+
+    @property
+    def active(self) -> bool:
+        """True if the element can exert any Coulomb force."""
+        return self.coulomb > 0 or self.coefficient > 0 or self.pressure_coefficient > 0
 
 
 @numba.njit(cache=True, nogil=True)

@@ -40,10 +40,11 @@ import numpy as np
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..params import load_toml
+from ..system import register_model
 from ..units import to_si
 from .actuator import ActuatorParameters
-from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionParameters, apply_wear_and_expansion,
-                       pedal_reference)
+from .dynamics import (ClutchDynamics, DynamicsResult, EClutch, FrictionParameters, _as_table,
+                       apply_wear_and_expansion, pedal_reference)
 from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_dict", "run_scenario", "scenario_system", "simulate",
@@ -265,8 +266,6 @@ def _as_scenario(scenario) -> Scenario:
         keys = set(scenario)
         if len(keys) == 1 and keys <= {"voltage", "bearing_reference", "bearing_position"}:
             # an input table: the default E-clutch (Model 4, friction on) driven by it
-            from .dynamics import _as_table
-
             (kind, value), = scenario.items()
             t, v = _as_table(value, kind)
             return Scenario(input_kind=kind, time_s=t, value=v, t_end=float(t[-1]) if t[-1] > 0 else 1.0,
@@ -277,7 +276,7 @@ def _as_scenario(scenario) -> Scenario:
 
 
 def scenario_system(scenario=None, **options):
-    """The :class:`~clutchlab.system.System` of a scenario (what :func:`simulate` runs).
+    """The :class:`~clutchlab.system.System` of a scenario (what :func:`simulate` runs; the model ``"eclutch"``).
 
     Parameters
     ----------
@@ -336,3 +335,6 @@ def simulate(scenario=None, t_end: float | None = None, *, rtol: float | None = 
     system = scenario_system(sc)
     step = sc.output_step if output_step is None else output_step
     return run(system, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=step, max_steps=500_000)
+
+
+register_model("eclutch", scenario_system)

@@ -51,15 +51,15 @@ from ..errors import ParameterError
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
-from ..system import System, register_model, variables
+from ..system import System, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
                        controller_voltage, current_rate, drive_voltage, drive_voltage_slopes, line_flow_rate,
                        spindle_force, stop_contact, stop_contact_slopes, vent_opening, vent_opening_slope)
-from .friction import kinetic_level, slip_force, static_margin
+from .friction import FrictionElement, kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
 from .network import GROUND, Lever, element_force, element_force_segment, solve_static
 
-__all__ = ["EClutchParams", "Assembly", "eclutch_system", "rhs", "outputs", "update", "restart", "accept",
+__all__ = ["EClutchParams", "Assembly", "rhs", "outputs", "update", "restart", "accept",
            "next_break", "jacobian", "time_derivative", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
 
 # actuator parameter vector layout (EClutchParams.par)
@@ -1113,8 +1113,6 @@ class Assembly:
                                          dtype=np.int64)
 
     def _friction(self, elements):
-        from .dynamics import FrictionElement
-
         nz = self.nz
         self.fr_on = np.zeros(nz, dtype=np.bool_)
         self.fr_c0 = np.zeros(nz)
@@ -1423,23 +1421,3 @@ class Assembly:
         return {"bearing_position": travel, "bearing_reference": travel, "master_position": (0.0, float(a.master_stroke)),
                 "motor_voltage": (-float(a.supply_voltage), float(a.supply_voltage)),
                 "motor_current": (-float(a.current_limit), float(a.current_limit))}
-
-
-def eclutch_system(scenario=None, **options) -> System:
-    """The :class:`~clutchlab.system.System` of an E-clutch scenario (the factory registered as ``"eclutch"``).
-
-    Parameters
-    ----------
-    scenario : Scenario, str, Path or None
-        A :class:`~clutchlab.eclutch.scenario.Scenario`, a scenario TOML file, or None for the default
-        scenario (pedal press and release, Model 4, friction on).
-    **options
-        Run defaults passed to :meth:`Assembly.system` (``max_step``, ``event_tol``, ``jac_every``,
-        ``atol_scale``).
-    """
-    from .scenario import scenario_system
-
-    return scenario_system(scenario, **options)
-
-
-register_model("eclutch", eclutch_system)

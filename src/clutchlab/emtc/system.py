@@ -4,7 +4,7 @@ This module is the model, written once: the packed parameters (:class:`EmtcParam
 :func:`pack_parameters`), the equations as scalar compiled functions, the hooks of
 :mod:`clutchlab.numerics.dispatch` and the :class:`~clutchlab.system.System` factory
 :func:`bench_system` (registered as ``"emtc_bench"``).  :func:`simulate` is the uniform entry point;
-:func:`clutchlab.emtc.simulate_bench` and :class:`clutchlab.fmu.cosim.EmtcCoSimulation` are thin layers
+:func:`clutchlab.emtc.simulate_bench` and :class:`clutchlab.fmu.emtc.EmtcCoSimulation` are thin layers
 over it and over :class:`clutchlab.system.Simulation`.
 
 States ``x``: ``omega_f``, ``omega_r`` (coupling input and output shaft speeds, Eq. 27), ``theta`` (Torsen
@@ -54,7 +54,8 @@ from ..numerics.core import record
 from ..system import System, register_model
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance, lugre_mu, stribeck_g
-from .torque import UNLOCK_MARGIN, _cam_force, _locked, _locked_capacity, _slipping
+from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
+from .torque import UNLOCK_MARGIN, CouplingGeometry, _cam_force, _locked, _locked_capacity, _slipping
 
 __all__ = ["EmtcParams", "BenchOptions", "pack_parameters", "bench_system", "simulate", "STATES", "OUTPUTS",
            "INPUTS", "SWITCHING", "EVENTS", "EVENT_DESCRIPTIONS", "MODE_NAMES", "MODE_VALUES", "ERROR_MESSAGES",
@@ -1049,8 +1050,6 @@ def _fresh_memories(params: EmtcParams) -> EmtcParams:
 
 def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     """:func:`pack_parameters` without the memory of earlier requests: ``(magnet, options, params)``."""
-    from .bench import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
-    from .torque import CouplingGeometry
 
     given_options = options
     scenario = scenario or _default(BenchScenario)
@@ -1214,13 +1213,12 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
         lowest grid current; modes ``rest``, ``open``, ``positive``; first trial step ``min(0.1 ms,
         sample_time)`` (a resumed run and an uninterrupted one take the same steps).
     """
-    B = _bench_module()
     if magnet is None:
         from .magnet import bundled_magnet
 
         magnet = bundled_magnet()
-    scenario = scenario or B._default(B.BenchScenario)
-    vehicle = vehicle or B._default(B.VehicleParameters)
+    scenario = scenario or _default(BenchScenario)
+    vehicle = vehicle or _default(VehicleParameters)
     params = pack_parameters(magnet, scenario, vehicle, options, cosimulation=cosimulation, n_samples=n_samples)
     vf = scenario.drum_speed
     vr = scenario.drum_speed - scenario.speed_difference
@@ -1242,20 +1240,6 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
             _TEMPLATES[(first_step, current_range)] = template
     # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
     return template.variant(params=params, x0=x0, u0=u0)
-
-
-_BENCH = None
-
-
-def _bench_module():
-    """:mod:`clutchlab.emtc.bench` (imported on first use: it imports this module; an import statement in a
-    function costs about 1.5 us a call)."""
-    global _BENCH
-    if _BENCH is None:
-        from . import bench
-
-        _BENCH = bench
-    return _BENCH
 
 
 #: (first trial step, coil current range) -> a checked System of the model (names, units, tolerances), the base of :func:`bench_system`
@@ -1327,8 +1311,6 @@ def simulate(scenario=None, t_end: float | None = None, *, magnet=None, vehicle=
     clutchlab.SimulationResult
         States, outputs (:data:`OUTPUTS`), modes and named events (:data:`EVENTS`).
     """
-    from .bench import BenchScenario, _default
-
     scenario = scenario or _default(BenchScenario)
     if options is not None and not isinstance(options, BenchOptions):
         raise ParameterError(f"options = {options!r}: expected a BenchOptions")

@@ -1,8 +1,9 @@
 """FMI 2.0 co-simulation export of the clutchlab models (issue #6).
 
 :mod:`clutchlab.fmu.cosim` defines the step-by-step protocol
-(:class:`~clutchlab.fmu.cosim.CoSimulation`, :class:`~clutchlab.fmu.cosim.Variable`)
-and the wet-clutch and EMTC slaves; :func:`export_fmu` wraps any model of
+(:class:`~clutchlab.fmu.cosim.CoSimulation`, :class:`~clutchlab.fmu.cosim.Variable`);
+:mod:`~clutchlab.fmu.eclutch`, :mod:`~clutchlab.fmu.wet`, :mod:`~clutchlab.fmu.emtc` and
+:mod:`~clutchlab.fmu.driveline` hold the models' slaves; :func:`export_fmu` wraps any model of
 :data:`COSIMULATIONS` into an FMU with pythonfmu (``clutchlab export-fmu
 {eclutch,wet,emtc} -o NAME.fmu``; a driveline from its description file,
 ``clutchlab export-fmu driveline FILE.toml``).  See ``docs/fmu.md``.  The model modules
@@ -11,13 +12,7 @@ are imported on first use, so ``import clutchlab.fmu`` stays light.
 
 __all__ = ["COSIMULATIONS", "CoSimulation", "Variable", "load_cosimulation", "export_fmu"]
 
-#: model name -> "module:Class" of its co-simulation (imported on demand by ``load_cosimulation``)
-COSIMULATIONS = {
-    "wet": "clutchlab.fmu.cosim:WetCoSimulation",
-    "emtc": "clutchlab.fmu.cosim:EmtcCoSimulation",
-    "eclutch": "clutchlab.eclutch.cosim:EClutchCoSimulation",
-    "driveline": "clutchlab.driveline.cosim:DrivelineCoSimulation",
-}
+from .registry import COSIMULATIONS
 
 
 def __getattr__(name):

@@ -48,7 +48,7 @@ from xml.etree import ElementTree as ET
 from .. import __version__
 from ..errors import ClutchlabError, ParameterError
 from ..io import atomic_write_bytes, check_writable
-from . import COSIMULATIONS
+from .registry import COSIMULATIONS
 from .cosim import load_cosimulation
 
 __all__ = ["bundle_description", "compile_shim", "export_fmu", "keep_namespace", "model_identifier", "slave_script",

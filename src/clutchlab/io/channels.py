@@ -339,9 +339,9 @@ class ChannelMap:
         path : str or Path
             The TOML file (layout in the module docstring).
         """
-        from ..params import load_toml
+        from .files import read_toml
 
-        return cls.from_dict(load_toml(path), name=str(path), base=Path(path).parent)
+        return cls.from_dict(read_toml(path, ParameterError), name=str(path), base=Path(path).parent)
 
     @classmethod
     def coerce(cls, value) -> "ChannelMap | None":

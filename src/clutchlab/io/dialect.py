@@ -290,11 +290,11 @@ def _unit_of(field: str) -> str | None:
         return ""
     if _NUMBER["."].match(text) or _NUMBER[","].match(text):
         return None  # a number is data, not a unit
-    from .channels import unit_conversion
+    from ..units import affine_conversion
 
     try:
-        unit_conversion(text, text, name="", where="")
-    except Exception:
+        affine_conversion(text, text)
+    except Exception:  # pint's tokenizer raises assorted errors: whatever it cannot read is no unit
         return None
     return text
 

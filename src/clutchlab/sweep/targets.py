@@ -68,8 +68,8 @@ BUILTIN: types.MappingProxyType = types.MappingProxyType({
     "wet": "clutchlab.sweep.wet",
     "emtc": "clutchlab.sweep.emtc",
     "eclutch-static": "clutchlab.sweep.eclutch_static",
-    "eclutch": "clutchlab.eclutch.sweep",
-    "driveline": "clutchlab.driveline.sweep",
+    "eclutch": "clutchlab.sweep.eclutch",
+    "driveline": "clutchlab.sweep.driveline",
 })
 
 #: entry-point group of plugin targets

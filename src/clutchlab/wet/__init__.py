@@ -27,7 +27,7 @@ from .thermal import (
 )
 from .friction import FrictionMap, ParametricFriction
 from .params import Bench, WetClutch
-from .engagement import (  # also registers the model "wet" (clutchlab.wet.system)
+from .engagement import (
     BatchResult,
     EngagementResult,
     Event,
@@ -36,7 +36,7 @@ from .engagement import (  # also registers the model "wet" (clutchlab.wet.syste
     simulate_batch,
     simulate_engagement,
 )
-from .bench import (
+from .bench import (  # also registers the model "wet" (protocol_system)
     BenchRun,
     EngagementProtocol,
     MapProtocol,

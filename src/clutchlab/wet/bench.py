@@ -39,6 +39,8 @@ import pandas as pd
 from ..errors import DataError, ParameterError
 from ..io import read_measurement, write_measurement
 from ..params import ParameterSet, load_toml, quantity
+from ..system import register_model
+from . import system as W
 from .engagement import EngagementResult, Scenario, simulate_engagement
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
@@ -55,6 +57,7 @@ __all__ = [
     "write_bench_record",
     "load_protocol",
     "smoothed_ramp",
+    "protocol_system",
 ]
 
 #: channels of a bench record (CSV header), SI units, temperatures in degC
@@ -109,7 +112,19 @@ class MapProtocol(ParameterSet):
 
 
 def smoothed_ramp(time, start, duration, initial, final=0.0):
-    """Smoothed ramp from ``initial`` to ``final`` (cubic smoothstep, C1) [same unit as initial]."""
+    """Smoothed ramp from ``initial`` to ``final`` (cubic smoothstep, C1) [same unit as initial].
+
+    Parameters
+    ----------
+    time : float or array_like
+        Times [s] at which to evaluate the ramp.
+    start : float
+        Start of the ramp [s] (``initial`` before it).
+    duration : float
+        Length of the ramp [s] (``final`` after ``start + duration``).
+    initial, final : float
+        Values before and after the ramp.
+    """
     s = np.clip((np.asarray(time, dtype=float) - start) / duration, 0.0, 1.0)
     return initial + (final - initial) * (3.0 * s**2 - 2.0 * s**3)
 
@@ -392,3 +407,35 @@ def load_protocol(path):
     friction = ParametricFriction.from_dict(data["friction"], source=src, base=ParametricFriction.bench_truth()) \
         if "friction" in data else ParametricFriction.bench_truth()
     return protocol, ptype, clutch, bench, friction
+
+
+def protocol_system(protocol: EngagementProtocol | None = None, *, clutch: WetClutch | None = None,
+                    bench: Bench | None = None, friction=None, motor: str = "speed", rtol: float = 1e-7):
+    """The :class:`~clutchlab.system.System` of a bench protocol's engagement (the model ``"wet"``).
+
+    Parameters
+    ----------
+    protocol : EngagementProtocol, optional
+        Default ``EngagementProtocol()`` (protocol (b), Sec. 4, Fig. 14).
+    clutch : WetClutch, optional
+        Default :meth:`WetClutch.paper`.
+    bench : Bench, optional
+        Default ``Bench()``.
+    friction : ParametricFriction or FrictionMap, optional
+        Default :meth:`ParametricFriction.bench_truth`.
+    motor : {"speed", "free"}
+        The bench's speed-controlled motor or the inertia dynamometer.
+    rtol : float
+        The system's default relative tolerance.
+
+    Returns
+    -------
+    System
+        :func:`clutchlab.wet.system.engagement_system` of the protocol's scenario.
+    """
+    clutch = WetClutch.paper() if clutch is None else clutch
+    scenario = (EngagementProtocol() if protocol is None else protocol).scenario(clutch, motor)
+    return W.engagement_system(scenario, clutch=clutch, bench=bench, friction=friction, rtol=rtol)
+
+
+register_model("wet", protocol_system)

@@ -73,7 +73,7 @@ import numpy as np
 
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
-from ..system import System, register_model, variables
+from ..system import System, variables
 from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
                    squeeze_film_force_scalar)
 from .friction import KIND_PARAMETRIC, ParametricFriction, mu_kernel, parametric_mu_scalar
@@ -961,15 +961,18 @@ def _element_name(code: int, element: int) -> str:
     return ELEMENTS[element] if 0 <= element < len(ELEMENTS) else ""
 
 
-def engagement_system(scenario=None, *, clutch=None, bench=None, friction=None, params=None, x0=None,
+def engagement_system(scenario, *, clutch=None, bench=None, friction=None, params=None, x0=None,
                       rtol: float = 1e-7) -> System:
-    """The :class:`~clutchlab.system.System` of one wet-clutch engagement (registered as model ``"wet"``).
+    """The :class:`~clutchlab.system.System` of one wet-clutch engagement.
+
+    The model ``"wet"`` of :data:`clutchlab.system.MODELS` is this system for a bench protocol
+    (:func:`clutchlab.wet.bench.protocol_system`).
 
     Parameters
     ----------
-    scenario : Scenario, optional
-        Inputs of the run (default: the bench engagement of
-        :class:`~clutchlab.wet.bench.EngagementProtocol`, protocol (b)).
+    scenario : Scenario
+        Inputs of the run (:class:`~clutchlab.wet.engagement.Scenario`; a bench protocol's:
+        :meth:`clutchlab.wet.bench.EngagementProtocol.scenario`).
     clutch : WetClutch, optional
         Default :meth:`WetClutch.paper`.
     bench : Bench, optional
@@ -994,10 +997,6 @@ def engagement_system(scenario=None, *, clutch=None, bench=None, friction=None, 
 
     clutch = WetClutch.paper() if clutch is None else clutch
     bench = Bench() if bench is None else bench
-    if scenario is None:
-        from .bench import EngagementProtocol
-
-        scenario = EngagementProtocol().scenario(clutch, "speed")
     if params is None:
         params = pack_parameters(clutch, bench, scenario, friction)
     x0 = initial_state(scenario) if x0 is None else np.asarray(x0, dtype=float)
@@ -1006,6 +1005,3 @@ def engagement_system(scenario=None, *, clutch=None, bench=None, friction=None, 
         m0=initial_modes(x0, clutch.piston_h0), atol=absolute_tolerance(clutch, rtol), switching=SWITCHING,
         events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES, method="dopri", rtol=float(rtol), event_tol=1e-12,
         element_name=_element_name)
-
-
-register_model("wet", engagement_system)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import io
 
-from ..cli import add_fixed_step_option
+from .common import add_fixed_step_option
 from ..errors import DataError, ParameterError
 
 __all__ = ["register"]
@@ -59,10 +59,10 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
-    from ..cli import fixed_step_note, fixed_step_option
+    from .common import fixed_step_note, fixed_step_option
     from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
     from ..units import to_si
-    from .description import load_driveline
+    from ..driveline.description import load_driveline
 
     check_outputs([args.output, args.events, args.plot], args.force)
     fixed_step = fixed_step_option(args.fixed_step)
@@ -86,7 +86,7 @@ def _simulate(args) -> int:
     if args.events:
         atomic_to_csv(events, args.events, overwrite=args.force)
     if args.plot:
-        from .plots import driveline_figure
+        from ..driveline.plots import driveline_figure
 
         fig = driveline_figure(frame, events, title=f"{spec.driveline.name}: {args.file}")
         buf = io.BytesIO()
@@ -168,7 +168,7 @@ def _trace(path, unit: str, what: str):
 
 
 def _describe(args) -> int:
-    from .description import load_driveline
+    from ..driveline.description import load_driveline
 
     spec = load_driveline(args.file)
     try:   # every check simulate makes before its run (a one-way clutch started backward)

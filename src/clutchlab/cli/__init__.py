@@ -15,40 +15,40 @@ import argparse
 import errno
 import importlib
 import os
-import re
 import sys
 import time
 
-from . import __version__
-from .errors import ClutchlabError, ParameterError
+from .. import __version__
+from ..errors import ClutchlabError, ParameterError
+from .common import progress
 
 #: the sub-commands of the subsystems: command -> (module that registers it with ``register(subparsers)``, the
 #: one line ``clutchlab --help`` lists).  A command's parser is built only when that command runs (its module
 #: imports its models), so ``clutchlab --help`` imports none (tests/test_cli_help.py: the lines equal the
 #: modules' own).
 COMMANDS = {
-    "eclutch": ("clutchlab.eclutch.cli", "dry clutch-by-wire (E-clutch): press-rig characterisation, Models 0-4"),
-    "wet": ("clutchlab.wet.cli", "wet multi-plate clutch: virtual bench and friction/thermal identification"),
-    "emtc": ("clutchlab.emtc.cli", "electromagnetic torque-controlled coupling (Processes 2019)"),
-    "driveline": ("clutchlab.driveline.cli",
+    "eclutch": ("clutchlab.cli.eclutch", "dry clutch-by-wire (E-clutch): press-rig characterisation, Models 0-4"),
+    "wet": ("clutchlab.cli.wet", "wet multi-plate clutch: virtual bench and friction/thermal identification"),
+    "emtc": ("clutchlab.cli.emtc", "electromagnetic torque-controlled coupling (Processes 2019)"),
+    "driveline": ("clutchlab.cli.driveline",
                   "driveline networks: inertias, springs, sources and clutches with exact stick/slip"),
-    "control": ("clutchlab.control.cli", "operating points, linear models and Bode diagrams of any model "
+    "control": ("clutchlab.cli.control", "operating points, linear models and Bode diagrams of any model "
                                          "(python-control)"),
-    "params": ("clutchlab.params.cli", "show the parameter sets of a model, write or check parameter files"),
-    "export-fmu": ("clutchlab.fmu.cli", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs "
+    "params": ("clutchlab.cli.params", "show the parameter sets of a model, write or check parameter files"),
+    "export-fmu": ("clutchlab.cli.fmu", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs "
                                         "pythonfmu; runs with clutchlab installed)"),
-    "sweep": ("clutchlab.sweep.cli", "grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores "
+    "sweep": ("clutchlab.cli.sweep", "grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores "
                                      "or Dask)"),
-    "report": ("clutchlab.report.cli", "write a self-contained HTML report (figures, metrics, parameters, "
+    "report": ("clutchlab.cli.report", "write a self-contained HTML report (figures, metrics, parameters, "
                                        "provenance) of a results folder"),
-    "convert": ("clutchlab.io.cli", "convert a measurement file (CSV, Parquet, MDF 4) to clutchlab names and SI "
+    "convert": ("clutchlab.cli.io", "convert a measurement file (CSV, Parquet, MDF 4) to clutchlab names and SI "
                                     "units"),
 }
 #: modules that contribute a sub-command (``register(subparsers)``), in the order of ``clutchlab --help``
 SUBSYSTEM_CLIS = tuple(dict.fromkeys(module for module, _ in COMMANDS.values()))
 #: functions that contribute a section to ``clutchlab demo`` (``demo_section(workdir, progress)``)
-DEMO_SECTIONS = ("clutchlab.eclutch.demo", "clutchlab.wet.demo", "clutchlab.emtc.demo", "clutchlab.driveline.demo",
-                 "clutchlab.control.demo")
+DEMO_SECTIONS = ("clutchlab.demo.eclutch", "clutchlab.demo.wet", "clutchlab.demo.emtc", "clutchlab.demo.driveline",
+                 "clutchlab.demo.control")
 #: longest error line the CLI prints [characters]; longer messages lose their middle (file names stay whole
 #: at the start, the reason at the end)
 MESSAGE_LIMIT = 400
@@ -64,52 +64,9 @@ def _optional_module(name: str):
         raise
 
 
-#: help of ``--fixed-step`` on the simulate commands
-FIXED_STEP_HELP = ("run in the fixed-step (real-time, HIL frame) mode with steps of this length, e.g. '1 ms': "
-                   "Rodas3 on the grid k * STEP, mode changes at step ends (default: step-size control)")
-
-
-def add_fixed_step_option(parser) -> None:
-    """Add ``--fixed-step STEP`` (a time with its unit) to a simulate command's ``parser``.
-
-    A value that starts with a minus sign and a digit (``--fixed-step -1ms``) is taken as the option's value,
-    to be refused by :func:`fixed_step_option` in one line, not as an unknown option.
-    """
-    parser.add_argument("--fixed-step", metavar="STEP", help=FIXED_STEP_HELP)
-    parser._negative_number_matcher = re.compile(r"^-\.?\d")  # (argparse: "-1ms" is not an option)
-
-
-def fixed_step_option(text):
-    """The step [s] of ``--fixed-step TEXT`` (a time with its unit, ``"1 ms"``); None without the option.
-
-    Raises
-    ------
-    ParameterError
-        Not a time with its unit, not finite, or not > 0 -- naming the option and the value.
-    """
-    if text is None:
-        return None
-    from .units import to_si
-
-    step = to_si(text, "s", name="--fixed-step")
-    if not step > 0:
-        raise ParameterError(f"--fixed-step = {text!r}: must be a time > 0 with its unit, e.g. '1 ms'")
-    return step
-
-
-def fixed_step_note(step: float) -> str:
-    """The header line of a file written by a fixed-step run of ``step`` [s]."""
-    return f"solver: fixed-step (real-time) mode, step {step:.6g} s (Rodas3 on the grid k * step)"
-
-
-def progress(message: str) -> None:
-    """Print a progress line to stderr (long runs say what they are doing)."""
-    print(f"[clutchlab {time.strftime('%H:%M:%S')}] {message}", file=sys.stderr, flush=True)
-
-
 def _demo(args) -> int:
-    from .io.files import check_writable
-    from .report import check_report_folder, write_report
+    from ..io.files import check_writable
+    from ..report import check_report_folder, write_report
 
     check_writable(args.output, args.force, what="folder")  # before minutes of simulation
     check_report_folder(args.output, args.force)             # (only a folder clutchlab wrote is replaced)
@@ -123,10 +80,10 @@ def _demo(args) -> int:
     # better than any fixed split (measured on the 2-core machine, benchmarks/README.md)
     background = {}
     if (os.cpu_count() or 1) >= 2:
-        from . import warmup
+        from .. import warmup
 
         for name in DEMO_SECTIONS[1:]:
-            short = name.split(".")[1]
+            short = name.rsplit(".", 1)[1]
             if short in warmup.GROUPS and _optional_module(name) is not None:
                 background[short] = warmup.start([short])
     try:
@@ -134,7 +91,7 @@ def _demo(args) -> int:
             mod = _optional_module(name)
             if mod is None:
                 continue
-            short = name.split('.')[1]
+            short = name.rsplit('.', 1)[1]
             if short in background:
                 background.pop(short).wait()
             progress(f"running {short} demo ...")
@@ -150,7 +107,7 @@ def _demo(args) -> int:
 
 
 def _warmup(args) -> int:
-    from . import warmup
+    from .. import warmup
 
     unknown = [g for g in args.groups if g not in warmup.GROUPS]
     if unknown:
@@ -217,7 +174,7 @@ def error_message(exc: BaseException) -> str:
     are (they name file, field and value); operating-system errors name the
     path and the reason; the library's ``overwrite=True`` becomes ``--force``.
     """
-    from ._limits import one_line
+    from .._limits import one_line
 
     if isinstance(exc, FileExistsError) and hasattr(exc, "cli_message"):
         msg = exc.cli_message

@@ -18,9 +18,9 @@ from ..errors import ParameterError, SimulationError
 from ..fmu.cosim import (FIXED_STEP_DOC, CoSimulation, Variable, build_parameter_set, fixed_step_parameter,
                          parameter_set_variables, step_in_time)
 from ..system import Simulation
-from .actuator import ActuatorParameters
-from .dynamics import EClutch, FrictionParameters
-from .models import ClutchModel, EClutchParameters
+from ..eclutch.actuator import ActuatorParameters
+from ..eclutch.dynamics import EClutch, FrictionParameters
+from ..eclutch.models import ClutchModel, EClutchParameters
 
 __all__ = ["EClutchCoSimulation"]
 

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 
 from .._limits import check_allocation
-from ..cli import add_fixed_step_option
+from .common import add_fixed_step_option
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
 from ..io.files import check_outputs
-from ..io.cli import add_csv_options, csv_options
+from .io import add_csv_options, csv_options
 from ..units import to_si
 
 
@@ -27,11 +27,11 @@ def _save_figure(fig, path, overwrite):
 
 
 def _model(args):
-    from .models import ClutchModel
+    from ..eclutch.models import ClutchModel
 
     if getattr(args, "network", None):
-        from .models import EClutchParameters
-        from .variants import load_variant
+        from ..eclutch.models import EClutchParameters
+        from ..eclutch.variants import load_variant
 
         params = EClutchParameters.from_toml(args.params) if args.params else None
         return load_variant(args.network, params)
@@ -45,7 +45,7 @@ def _model(args):
 def _characterize(args) -> int:
     from ..io import read_measurement
     from ..plotting import mark_synthetic, press_characterization
-    from .characterize import characterize
+    from ..eclutch.characterize import characterize
 
     check_outputs([args.output, args.plot], args.force)
     # one read: the channel map (if any) renames the logger's channels, units in the file become SI
@@ -94,7 +94,7 @@ def _static(args) -> int:
     atomic_to_csv(df, args.output, overwrite=args.force,
                   header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static{note}")
     if args.plot:
-        from .validation import read_full_clutch_record
+        from ..eclutch.validation import read_full_clutch_record
 
         record = read_full_clutch_record(args.record) if args.record else None
         fig = static_curves_panels({model.name: df}, record, title=f"{model.name}: static curves (friction off)")
@@ -108,8 +108,8 @@ def _static(args) -> int:
 def _validate(args) -> int:
     import pandas as pd
 
-    from .models import MODEL_NUMBERS, ClutchModel, EClutchParameters
-    from .validation import compare, read_full_clutch_record
+    from ..eclutch.models import MODEL_NUMBERS, ClutchModel, EClutchParameters
+    from ..eclutch.validation import compare, read_full_clutch_record
 
     check_outputs([args.output], args.force)
     record = read_full_clutch_record(args.record, name=str(args.record))
@@ -123,7 +123,7 @@ def _validate(args) -> int:
 
 
 def _lever(args) -> int:
-    from .characterize import lever_stiffness
+    from ..eclutch.characterize import lever_stiffness
 
     check_outputs([args.output], args.force)
     result = lever_stiffness(args.record_b, args.record_c, args.ratio, reference=args.reference)
@@ -136,10 +136,10 @@ def _lever(args) -> int:
 
 def _simulate(args) -> int:
     from .. import __version__
-    from ..cli import fixed_step_note, fixed_step_option, progress
+    from .common import fixed_step_note, fixed_step_option, progress
     from ..io import write_measurement
     from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
-    from .scenario import load_scenario, run_scenario
+    from ..eclutch.scenario import load_scenario, run_scenario
 
     check_outputs([args.output, args.plot], args.force)
     fixed_step = fixed_step_option(args.fixed_step)

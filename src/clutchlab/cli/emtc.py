@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .._limits import short_repr
-from ..cli import add_fixed_step_option, fixed_step_note, fixed_step_option
+from .common import add_fixed_step_option, fixed_step_note, fixed_step_option
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
 from ..io.files import check_outputs
@@ -67,8 +67,8 @@ def _run(args) -> int:
 
 def _simulate(args) -> int:
     from ..hysteresis import Preisach
-    from .bench import load_scenario, simulate_bench
-    from .magnet import bundled_magnet
+    from ..emtc.bench import load_scenario, simulate_bench
+    from ..emtc.magnet import bundled_magnet
 
     check_outputs([args.output, args.plot], args.force)
     fixed_step = fixed_step_option(args.fixed_step)
@@ -92,7 +92,7 @@ def _simulate(args) -> int:
         from ..io import atomic_write_bytes
         from ..plotting import mark_synthetic
         from ..report.html import DPI
-        from .demo import bench_figure
+        from ..demo.emtc import bench_figure
         import io
 
         import matplotlib.pyplot as plt

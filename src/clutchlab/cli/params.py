@@ -17,7 +17,7 @@ __all__ = ["register"]
 
 def register(subparsers) -> None:
     """Add the ``params`` command and its sub-commands."""
-    from .registry import MODELS
+    from ..params.registry import MODELS
 
     par = subparsers.add_parser("params", help="show the parameter sets of a model, write or check parameter files",
                                 description="Show every parameter set of a model with values, units and sources, "
@@ -47,7 +47,7 @@ def register(subparsers) -> None:
 
 def _show(args) -> int:
     from ..io import atomic_write_text
-    from .registry import model_toml, show_table
+    from ..params.registry import model_toml, show_table
 
     if args.output:
         atomic_write_text(args.output, model_toml(args.model, paper=args.paper), overwrite=args.force)
@@ -60,7 +60,7 @@ def _show(args) -> int:
 
 
 def _check(args) -> int:
-    from .registry import load_model_file
+    from ..params.registry import load_model_file
 
     model, sets = load_model_file(args.file, args.model)
     counts = ", ".join(f"[{t}] {len(s.field_info())} fields" for t, s in sets.items())

@@ -14,7 +14,7 @@ import io
 import json
 import sys
 
-from ..cli import add_fixed_step_option
+from .common import add_fixed_step_option
 from ..errors import ParameterError
 
 __all__ = ["register"]
@@ -62,9 +62,9 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
-    from ..cli import fixed_step_note, fixed_step_option
+    from .common import fixed_step_note, fixed_step_option
     from ..io.files import check_outputs
-    from .bench import load_protocol, run_protocol, write_bench_record
+    from ..wet.bench import load_protocol, run_protocol, write_bench_record
 
     check_outputs([args.output, args.plot], args.force)
     fixed_step = fixed_step_option(args.fixed_step)
@@ -75,7 +75,7 @@ def _simulate(args) -> int:
     if args.plot:
         from ..io import atomic_write_bytes
         from ..plotting import mark_synthetic
-        from .plots import map_traces_figure
+        from ..wet.plots import map_traces_figure
 
         fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
         mark_synthetic(fig)  # the virtual bench's data are synthetic: the stamp travels with the image
@@ -95,8 +95,8 @@ def _identify(args) -> int:
     from ..errors import IdentificationError
     from ..io import atomic_write_bytes, atomic_write_text
     from ..io.files import check_outputs
-    from .identify import friction_samples, identify_friction_map, identify_thermal
-    from .params import WetClutch
+    from ..wet.identify import friction_samples, identify_friction_map, identify_thermal
+    from ..wet.params import WetClutch
 
     check_outputs([args.output, args.plot], args.force)
     if not args.sensor_lag >= 0 or args.sensor_lag == float("inf"):  # NaN fails the first test
@@ -114,7 +114,7 @@ def _identify(args) -> int:
         thermal_line = f"thermal identification skipped: {exc}"
     atomic_write_text(args.output, json.dumps(data, indent=1), overwrite=args.force)
     if args.plot:
-        from .plots import friction_map_figure
+        from ..wet.plots import friction_map_figure
 
         fig = friction_map_figure(fmap, samples=friction_samples(args.records, clutch,
                                                                  sensor_time_constant=args.sensor_lag))
@@ -131,7 +131,7 @@ def _identify(args) -> int:
 
 
 def _params(args) -> int:
-    from .params import WetClutch
+    from ..wet.params import WetClutch
 
     clutch = WetClutch.paper()
     if args.output:

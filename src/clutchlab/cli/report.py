@@ -36,12 +36,12 @@ def register(subparsers) -> None:
 def _report(args) -> int:
     import time
 
-    from ..cli import progress
-    from .run import report_run_dir
+    from .common import progress
+    from ..report.run import report_run_dir
 
     t0 = time.perf_counter()
     if len(args.run_dir) > 1:
-        from .compare import compare_runs
+        from ..report.compare import compare_runs
 
         index = compare_runs(args.run_dir, args.output, names=args.name, units=args.units, overwrite=args.force,
                              progress=progress, title=args.title)

@@ -12,10 +12,10 @@ import numpy as np
 import pandas as pd
 
 from ..report import Figure, Section, Table, Text
-from .datasets import PRESS_TESTS, SYNTHETIC_NOTE, characterize_components, load_full_clutch_record, load_press_record
-from .models import ClutchModel, EClutchParameters
-from .validation import compare, fit_model4_scales
-from .virtual import VirtualClutch
+from ..eclutch.datasets import PRESS_TESTS, SYNTHETIC_NOTE, characterize_components, load_full_clutch_record, load_press_record
+from ..eclutch.models import ClutchModel, EClutchParameters
+from ..eclutch.validation import compare, fit_model4_scales
+from ..eclutch.virtual import VirtualClutch
 
 __all__ = ["demo_section", "run_chain"]
 
@@ -45,7 +45,7 @@ def _dynamics_items(model4: ClutchModel, progress) -> list:
     import time
 
     from ..plotting import eclutch_response, hysteresis_loop
-    from .dynamics import ClutchDynamics, EClutch, FrictionParameters
+    from ..eclutch.dynamics import ClutchDynamics, EClutch, FrictionParameters
 
     ec = EClutch(clutch=model4, friction=FrictionParameters())
     inputs = {"bearing_reference": ([0.0, 0.05, 0.0501, 0.6, 0.6001], [0.0, 0.0, 6e-3, 6e-3, 0.0])}

@@ -179,7 +179,7 @@ def _branches(args) -> dict:
 
 def _pairs(system, items, kinds, flag):
     from ..units import to_si
-    from .trim import resolve
+    from ..trim import resolve
 
     out = {}
     for name, value in _name_values(items, flag, "NAME=VALUE").items():
@@ -192,7 +192,7 @@ def _pairs(system, items, kinds, flag):
 def _points(args):
     """The operating points the arguments ask for: ``[(label, value, OperatingPoint)]``."""
     from ..units import to_si
-    from .trim import operating_point
+    from ..trim import operating_point
 
     ec, system = _system(args)
     if ec is not None and args.at:
@@ -230,7 +230,7 @@ def _trim(args) -> int:
 
 def _linearize(args) -> int:
     from ..io.files import check_writable
-    from .linear import linearize, write_linear_model
+    from ..control.linear import linearize, write_linear_model
 
     check_writable(args.output, args.force)
     branches = _branches(args)
@@ -248,7 +248,7 @@ def _bode(args) -> int:
 
     from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
     from ..units import to_si
-    from .linear import frequency_table, linearize, pole_sweep
+    from ..control.linear import frequency_table, linearize, pole_sweep
 
     check_outputs([args.output, args.table, args.poles], args.force)
     fmin, fmax = to_si(args.fmin, "Hz", name="--fmin"), to_si(args.fmax, "Hz", name="--fmax")
@@ -263,7 +263,7 @@ def _bode(args) -> int:
         raise ParameterError(f"{points[0][2].system.name} has no held inputs: no frequency response")
     over = None
     if args.over is not None:
-        from .trim import resolve
+        from ..trim import resolve
 
         kind, i = resolve(points[0][2].system, args.over, ("state", "output"))
         over = (points[0][2].system.states if kind == "state" else points[0][2].system.outputs)[i].column
@@ -274,7 +274,7 @@ def _bode(args) -> int:
         tables.append(t)
     import pandas as pd
 
-    from .plots import bode_figure
+    from ..control.plots import bode_figure
 
     fig = bode_figure([(label, sys) for label, _, _, sys in models], f, over=over)
     buf = io.BytesIO()
@@ -315,10 +315,10 @@ def _design(args) -> int:
 
     from ..io.files import atomic_to_csv, atomic_write_text, check_outputs
     from ..units import to_si
-    from .design import pi_for_phase_margin
-    from .linear import linearize
-    from .loop import closed_loop
-    from .trim import resolve
+    from ..control.design import pi_for_phase_margin
+    from ..control.linear import linearize
+    from ..control.loop import closed_loop
+    from ..trim import resolve
 
     check_outputs([args.output, args.run], args.force)
     if len(args.inputs) != 1 or len(args.outputs) != 1:

@@ -39,10 +39,10 @@ from ..errors import ParameterError
 from ..numerics.status import Status
 from ..sweep.targets import check_outputs
 from ..system import simulate_batch
-from .actuator import ActuatorParameters
-from .dynamics import EClutch, FrictionParameters
-from .models import ClutchModel, EClutchParameters
-from .scenario import Scenario, scenario_from_dict
+from ..eclutch.actuator import ActuatorParameters
+from ..eclutch.dynamics import EClutch, FrictionParameters
+from ..eclutch.models import ClutchModel, EClutchParameters
+from ..eclutch.scenario import Scenario, scenario_from_dict
 
 __all__ = ["run_batch", "describe", "check_variants", "OUTPUTS"]
 
@@ -97,7 +97,7 @@ def _variant(sc: Scenario, row: dict, vid) -> EClutch:
         raise ParameterError(f"variant {vid}: {exc}") from None
     model = ClutchModel.preset(sc.model, built["clutch"])
     if sc.wear_m or sc.temperature_rise_k:
-        from .dynamics import apply_wear_and_expansion
+        from ..eclutch.dynamics import apply_wear_and_expansion
 
         model = apply_wear_and_expansion(model, wear_m=sc.wear_m, temperature_rise_k=sc.temperature_rise_k)
     actuator = built["actuator"]

@@ -49,7 +49,7 @@ from ..errors import ParameterError
 from ..numerics.status import Status
 from ..sweep.targets import check_outputs, nan_frame, rows
 from ..system import simulate, simulate_batch
-from .variants import DrivelineDocument
+from ..driveline.variants import DrivelineDocument
 
 __all__ = ["run_batch", "describe", "check_variants", "referenced_files", "outputs_of", "EVENT_CAPACITY"]
 

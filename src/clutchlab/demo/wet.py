@@ -17,13 +17,13 @@ __all__ = ["demo_section"]
 
 def demo_section(progress=lambda message: None) -> Section:
     """Build the wet-clutch report section (Figs. 13-15 and the identification tables)."""
-    from .bench import EngagementProtocol, read_bench_record
-    from .data import MAP_RECORDS, path
-    from .engagement import simulate_engagement
-    from .friction import ParametricFriction
-    from .identify import friction_samples, identify_friction_map, identify_thermal
-    from .params import Bench, WetClutch
-    from .plots import engagement_figure, friction_map_figure, map_traces_figure
+    from ..wet.bench import EngagementProtocol, read_bench_record
+    from ..wet.data import MAP_RECORDS, path
+    from ..wet.engagement import simulate_engagement
+    from ..wet.friction import ParametricFriction
+    from ..wet.identify import friction_samples, identify_friction_map, identify_thermal
+    from ..wet.params import Bench, WetClutch
+    from ..wet.plots import engagement_figure, friction_map_figure, map_traces_figure
 
     clutch = WetClutch.paper()
     bench = Bench()

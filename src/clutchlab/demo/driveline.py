@@ -71,7 +71,7 @@ def mode_intervals(result, events=None) -> dict:
         sample time.  An event is named for the mode it enters (``stick`` enters ``stuck``); an event of
         another name takes the mode sampled after it.
     """
-    from . import kernel as K
+    from ..driveline import kernel as K
 
     events = _event_table(result) if events is None else events
     entered = dict(zip(K.EVENTS, K.MODE_VALUES))
@@ -114,8 +114,8 @@ def run_example(name: str) -> dict:
         ``path`` of the file.
     """
     from ..errors import ParameterError
-    from .data import path
-    from .description import load_driveline
+    from ..driveline.data import path
+    from ..driveline.description import load_driveline
 
     file = path(name)
     spec = load_driveline(file)
@@ -192,7 +192,7 @@ def example_items(name: str, progress=None) -> tuple:
         ``(items, parameters, run)``: the Text, Figure and Table items, the parameters for the section
         (component lines and run settings, keyed ``<name>: ...``) and the run (:func:`run_example`).
     """
-    from .plots import energy_figure, friction_torques_figure, modes_figure, speeds_figure
+    from ..driveline.plots import energy_figure, friction_torques_figure, modes_figure, speeds_figure
 
     say = progress or (lambda message: None)
     stem = name.removesuffix(".toml")

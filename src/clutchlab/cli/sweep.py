@@ -18,8 +18,8 @@ def _log(message: str) -> None:
 
 
 def _sweep(args) -> int:
-    from .runner import run_sweep
-    from .spec import check_scheduler, load_spec
+    from ..sweep.runner import run_sweep
+    from ..sweep.spec import check_scheduler, load_spec
 
     check_scheduler(args.scheduler)
     spec = load_spec(args.spec)

@@ -12,12 +12,12 @@ import warnings
 from pathlib import Path
 
 from ..errors import ParameterError
-from . import COSIMULATIONS
+from ..fmu.registry import COSIMULATIONS
 
 
 def _export(args) -> int:
-    from .cosim import load_cosimulation
-    from .export import export_fmu
+    from ..fmu.cosim import load_cosimulation
+    from ..fmu.export import export_fmu
 
     from ..io.files import check_writable
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 
 def _convert(args) -> int:
-    from .files import check_writable
-    from .measurements import read_measurement, write_measurement
+    from ..io.files import check_writable
+    from ..io.measurements import read_measurement, write_measurement
 
     check_writable(args.output, args.force)  # refuse before reading a large file
     time = None if args.no_time else args.time

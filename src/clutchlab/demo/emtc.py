@@ -76,8 +76,8 @@ def demo_section(progress=print) -> Section:
     """EMTC demo: hysteresis loops, compensation, drum-bench experiments (synthetic data)."""
     import matplotlib.pyplot as plt
 
-    from .bench import BenchScenario, simulate_bench
-    from .magnet import bundled_identification, bundled_magnet, synthetic_magnet
+    from ..emtc.bench import BenchScenario, simulate_bench
+    from ..emtc.magnet import bundled_identification, bundled_magnet, synthetic_magnet
 
     items = []
     progress("emtc: identifying the Preisach model from the bundled synthetic FORC records")

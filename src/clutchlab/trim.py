@@ -28,8 +28,8 @@ import math
 
 import numpy as np
 
-from ..errors import ClutchlabError, ParameterError
-from ..system import Simulation, System, evaluate
+from .errors import ClutchlabError, ParameterError
+from .system import Simulation, System, evaluate
 
 __all__ = ["OperatingPoint", "operating_point", "OperatingPointError", "resolve"]
 

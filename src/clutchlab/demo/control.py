@@ -69,8 +69,8 @@ def design(eclutch=None) -> dict:
         position [m]), ``pis`` (:class:`clutchlab.control.design.PI`), ``touch`` (index of the touch point).
     """
     from ..eclutch import EClutch
-    from .design import pi_for_phase_margin
-    from .linear import linearize
+    from ..control.design import pi_for_phase_margin
+    from ..control.linear import linearize
 
     ec = EClutch() if eclutch is None else eclutch
     ops = [ec.operating_point(x) for x in POSITIONS]
@@ -98,8 +98,8 @@ def step_runs(d: dict, t_end: float = 1.0) -> list[dict]:
     """
     import control
 
-    from .design import ScheduledPI
-    from .loop import closed_loop
+    from ..control.design import ScheduledPI
+    from ..control.loop import closed_loop
 
     kp = np.array([p.kp for p in d["pis"]])
     ti = np.array([p.ti for p in d["pis"]])
@@ -189,10 +189,10 @@ def wet_torque_control() -> dict:
     from ..wet.engagement import Scenario
     from ..wet.params import WetClutch
     from ..wet.system import engagement_system
-    from .design import ScheduledPI, pi_for_phase_margin
-    from .linear import linearize
-    from .loop import closed_loop
-    from .trim import operating_point
+    from ..control.design import ScheduledPI, pi_for_phase_margin
+    from ..control.linear import linearize
+    from ..control.loop import closed_loop
+    from ..trim import operating_point
 
     steady = Scenario(force_time=[0.0, 1.0], force_value=[0.0, 0.0], speed_time=[0.0, 1.0],
                       speed_value=[WET_SLIP, WET_SLIP], duration=5.0, motor="speed", initial_slip_speed=WET_SLIP)
@@ -281,14 +281,14 @@ def _settling(T, y, band: float = 0.05) -> float:
 
 def _figures(d, runs):
     from ..plotting import legend_outside, mark_synthetic, new_figure
-    from .linear import pole_sweep
-    from .plots import bode_figure, nyquist_figure, pole_map_figure
+    from ..control.linear import pole_sweep
+    from ..control.plots import bode_figure, nyquist_figure, pole_map_figure
 
     f = np.logspace(-1, np.log10(2000.0), 400)
     chosen = [0, 3, d["touch"], len(POSITIONS) - 1]
     bode = bode_figure([(f"bearing at {POSITIONS[k] * 1e3:g} mm", d["models"][k]) for k in chosen], f,
                        title="E-clutch: motor voltage to bearing position")
-    from .linear import linearize
+    from ..control.linear import linearize
 
     current = bode_figure([(f"bearing at {POSITIONS[k] * 1e3:g} mm",
                             linearize(d["ops"][k], inputs=["motor_voltage"], outputs=["pressure", "motor_current"]))
@@ -313,7 +313,7 @@ def _figures(d, runs):
     steps.suptitle(f"E-clutch: {STEP * 1e3:g} mm reference steps, scheduled PI")
     import control
 
-    from .linear import loop_margins
+    from ..control.linear import loop_margins
 
     loops = [(f"bearing at {POSITIONS[k] * 1e3:g} mm", control.ss(d["pis"][k].tf()) * d["models"][k])
              for k in chosen]

@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..fmu.cosim import FIXED_STEP_DOC, ContractCoSimulation, Variable, fixed_step_parameter, fmi_unit
 from ..units import COLUMN_UNITS
-from .variants import DrivelineDocument
+from ..driveline.variants import DrivelineDocument
 
 __all__ = ["DrivelineCoSimulation"]
 

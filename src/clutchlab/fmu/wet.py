@@ -1,0 +1,276 @@
+"""The wet clutch on its bench as an FMI co-simulation slave (:class:`WetCoSimulation`).
+
+Its variables are the bench's parameter sets, the protocol's force and slip profile and the engagement
+outputs; the model is :func:`clutchlab.wet.system.engagement_system` run by the integrator core.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+
+from ..errors import ParameterError, SimulationError
+from .cosim import (FIXED_STEP_DOC, CoSimulation, Variable, _check_time, _flag, build_parameter_set,
+                    fixed_step_parameter, parameter_set_variables, step_in_time)
+
+__all__ = ["WetCoSimulation"]
+
+
+def _wet_variables():
+    from ..wet.params import Bench, WetClutch
+    from ..wet.thermal import steady_state_temperature
+
+    clutch = parameter_set_variables("clutch", WetClutch)
+    bench = parameter_set_variables("bench", Bench, skip=(
+        "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
+        "noise_fluid_temperature", "seed"))
+    scenario = (
+        Variable("scenario.free_inertia", "1", 0.0,
+                 "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)"),
+        Variable("scenario.initial_slip_speed", "rad/s", 1500 * math.pi / 30, "slip speed at t = 0"),
+        Variable("scenario.initial_temperature", "degC",
+                 steady_state_temperature(0.0, 80.0, 70.0, WetClutch().k1, WetClutch().k2),
+                 "pack temperature at t = 0 (default: Eq. 8 equilibrium of fluid and housing)"),
+        Variable("scenario.fluid_temperature", "degC", 80.0, "oil reservoir temperature at t = 0"),
+        Variable("scenario.housing_temperature", "degC", 70.0, "housing temperature at t = 0"),
+        Variable("scenario.heater_setpoint", "degC", 80.0, "reservoir thermostat set point"),
+        Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f"),
+        Variable("solver.rtol", "1", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
+        Variable("solver.max_step", "s", 0.01, "largest integration step"),
+        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
+    )
+    return clutch + bench + scenario
+
+
+#: (output name, unit, description, source) -- source: ("output", system output) or ("state", system state)
+#: or ("stick",)
+def _wet_output_table():
+    return (
+        ("clutch_torque", "N.m", "clutch torque tau = T_c + T_v (Eq. 3)", ("output", "clutch_torque")),
+        ("contact_torque", "N.m", "asperity contact torque T_c (Eq. 4)", ("output", "contact_torque")),
+        ("viscous_torque", "N.m", "viscous torque T_v (Eq. 5)", ("output", "viscous_torque")),
+        ("slip_speed", "rad/s", "slip speed = clutch shaft speed", ("state", "slip_speed")),
+        ("drive_torque", "N.m", "motor torque at the clutch shaft", ("output", "drive_torque")),
+        ("sensor_torque", "N.m", "torque at the shaft torque sensor", ("output", "sensor_torque")),
+        ("static_capacity", "N.m", "static torque capacity r_eff N_c mu_f F_c", ("output", "static_capacity")),
+        ("contact_force", "N", "asperity contact force F_c (Greenwood-Williamson)", ("output", "contact_force")),
+        ("squeeze_force", "N", "hydrodynamic squeeze-film force", ("output", "squeeze_force")),
+        ("load_cell_force", "N", "force at the actuator load cell", ("output", "load_cell_force")),
+        ("actuator_force", "N", "actuator force (first-order lag of the reference)", ("state", "actuator_force")),
+        ("piston_position", "m", "piston position x_p", ("state", "piston_position")),
+        ("nominal_separation", "m", "nominal film thickness h per interface (Eq. 1)", ("output", "nominal_separation")),
+        ("mean_film", "m", "Patir-Cheng mean film thickness h_bar (Eq. 2)", ("output", "mean_film")),
+        ("mu_f", "1", "asperity friction coefficient", ("output", "friction_coefficient")),
+        ("viscosity", "Pa.s", "oil viscosity mu_v (Eq. 7)", ("output", "viscosity")),
+        ("friction_power", "W", "friction power tau * omega", ("output", "friction_power")),
+        ("heater_power", "W", "reservoir heater power", ("output", "heater_power")),
+        ("temperature", "degC", "pack temperature T (Eq. 8)", ("state", "temperature")),
+        ("fluid_temperature", "degC", "oil reservoir temperature", ("state", "fluid_temperature")),
+        ("housing_temperature", "degC", "housing temperature", ("state", "housing_temperature")),
+        ("thermistor_temperature", "degC", "thermistor reading (first-order lag of T)", ("state", "thermistor_temperature")),
+        ("friction_work", "J", "friction work since t = 0", ("state", "friction_work")),
+        ("stick", "1", "1 while the clutch is locked (stick mode), 0 while slipping", ("stick",)),
+    )
+
+
+class WetCoSimulation(CoSimulation):
+    """The wet-clutch bench of Shin, Kim and Choi [1] as a co-simulation slave.
+
+    Inputs are the two references of the bench (Fig. 4): the actuator force
+    reference [N] (the bench presses the piston with a force-controlled
+    linear actuator; a piston pressure command is ``p * A_piston``) and the
+    slip-speed reference [rad/s] of the speed-controlled drive motor
+    (ignored with ``scenario.free_inertia = 1``).  Parameters are every
+    numeric field of :class:`~clutchlab.wet.params.WetClutch` (``clutch.*``,
+    Table 1 of [1] plus documented choices) and of
+    :class:`~clutchlab.wet.params.Bench` (``bench.*``, without the sensor
+    noise), the initial conditions (``scenario.*``, defaults of
+    :class:`~clutchlab.wet.bench.EngagementProtocol`) and the step control
+    (``solver.*``; ``solver.fixed_step`` > 0 runs the fixed-step mode of the core, a HIL frame).  Outputs: torques (Eqs. 3-6), forces, film thickness
+    (Eqs. 1-2), viscosity (Eq. 7), temperatures (Eq. 8), friction work and
+    the stick flag.
+
+    Written against the system contract: the model is the ``"wet"``
+    :class:`~clutchlab.system.System` (:func:`clutchlab.wet.system.engagement_system`)
+    with flat reference profiles, run by a :class:`clutchlab.system.Simulation`
+    whose held inputs are the two references.  Each :meth:`do_step`
+    continues the integration (``Simulation.advance``) from the stored
+    state, modes and step size; lock-up, break-away, contact and the piston
+    stop inside the step are located as in the native run and kept in
+    :attr:`events` (``result.events`` names of :func:`clutchlab.wet.simulate`
+    are in :attr:`simulation` ``.events()``).
+
+    Notes
+    -----
+    The friction law is the bench's true law
+    (:meth:`~clutchlab.wet.friction.ParametricFriction.bench_truth`).  The
+    integrator stops at every communication point, so the results differ
+    from one uninterrupted :func:`~clutchlab.wet.engagement.simulate_engagement`
+    run by the integration error (of order ``solver.rtol``), not more.
+    """
+
+    name = "wet"
+    inputs = (
+        Variable("force_reference", "N", 0.0, "actuator force reference (piston apply force)"),
+        Variable("slip_speed_reference", "rad/s", 1500 * math.pi / 30,
+                 "slip-speed reference of the speed-controlled drive motor"),
+    )
+    outputs = tuple(Variable(n, u, 0.0, d) for n, u, d, _ in _wet_output_table())
+    parameters = _wet_variables()
+
+    def __init__(self, **parameter_values):
+        from ..wet import engagement as E
+        from ..wet.params import Bench, WetClutch
+
+        values = self.resolve_parameters(parameter_values)
+        self.parameter_values = values
+        self.clutch = build_parameter_set("clutch", WetClutch, values)
+        self.bench = build_parameter_set("bench", Bench, values, skip=(
+            "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
+            "noise_fluid_temperature", "seed"))
+        free = _flag("scenario.free_inertia", values["scenario.free_inertia"])
+        self.rtol = values["solver.rtol"]
+        self.max_step = values["solver.max_step"]
+        if not (0 < self.rtol < 1):
+            raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
+        if not self.max_step > 0:
+            raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
+        self.fixed_step = fixed_step_parameter(values)
+        # flat (zero) profiles: the references are the held inputs of the system
+        self.scenario = E.Scenario(
+            force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
+            motor="free" if free else "speed", initial_slip_speed=values["scenario.initial_slip_speed"],
+            initial_temperature_c=values["scenario.initial_temperature"],
+            fluid_temperature_c=values["scenario.fluid_temperature"],
+            housing_temperature_c=values["scenario.housing_temperature"],
+            heater_setpoint_c=values["scenario.heater_setpoint"])
+        self._mu_scale = values["scenario.mu_scale"]
+        self._table = _wet_output_table()
+        self._output_names = tuple(v.name for v in self.outputs)
+        # the input checks of _inputs as two comparisons (NaN and infinities fail them as well)
+        self._force_max = self.bench.actuator_force_max * (1 + 1e-12)
+        self._speed_max = self.bench.drive_speed_max if self.scenario.motor == "speed" else sys.float_info.max
+        self.reset()
+
+    def reset(self) -> None:
+        self.time = 0.0
+        self.simulation = None  # created at the first step / initial_outputs (the actuator starts at its reference)
+        self.events = []
+        self._n_events = 0
+
+    @property
+    def state(self):
+        """State vector of the wet system (order of ``clutchlab.wet.system.STATES``), None before the start."""
+        return None if self.simulation is None else self.simulation.x
+
+    @property
+    def mode(self) -> int:
+        """Friction mode: 0 slip (positive), 1 stick, 2 slip (negative); -1 before the start."""
+        from ..wet import system as W
+
+        return -1 if self.simulation is None else int(self.simulation.m[W.M_FRICTION])
+
+    @property
+    def n_steps(self) -> int:
+        """Accepted integration steps since the start."""
+        return 0 if self.simulation is None else self.simulation.stats["accepted_steps"]
+
+    def _inputs(self, u):
+        fmax = self.bench.actuator_force_max
+        f = u["force_reference"]
+        w = u["slip_speed_reference"]
+        if f < 0 or f > fmax * (1 + 1e-12):
+            raise ParameterError(f"input force_reference = {f!r} N: must be within [0, {fmax:g}] N (actuator limit)")
+        if self.scenario.motor == "speed" and abs(w) > self.bench.drive_speed_max:
+            raise ParameterError(f"input slip_speed_reference = {w!r} rad/s exceeds the bench's speed limit "
+                                 f"{self.bench.drive_speed_max:.6g} rad/s")
+        return np.array([f, w])
+
+    def _start(self, u):
+        from ..system import Simulation
+        from ..wet import system as W
+
+        x0 = W.initial_state(self.scenario)
+        x0[W.S_FA] = u["force_reference"]  # the actuator force starts at its reference, as in the native run
+        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
+        system = W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params, x0=x0,
+                                     rtol=self.rtol)
+        self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000,
+                                     fixed_step=self.fixed_step)
+        # the FMI outputs, gathered by the compiled step (a name lookup per output and step cost more than the
+        # integration of a 1 ms step, and a dict of them as much again)
+        self.simulation.report([src if src[0] != "stick" else ("mode_is", W.M_FRICTION, 1)
+                                for _, _, _, src in self._table])
+        self._held = self.simulation.u  # the held references, written in place by every step
+        self._event_count = self.simulation.log.count
+        self.simulation.set_inputs(self._inputs(u))
+
+    def _outputs(self):
+        return dict(zip(self._output_names, self.simulation.reported().tolist()))
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        u = self.resolve_inputs(inputs)
+        if self.simulation is None or self.time != 0.0:
+            self.reset()
+            self._start(u)
+        self.simulation.set_inputs(self._inputs(u))
+        return self._outputs()
+
+    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
+        """Advance from ``t`` to ``t + dt`` with the references held; return the outputs at ``t + dt``.
+
+        Raises
+        ------
+        SimulationError
+            Non-contiguous step, step limit or step-size underflow.
+        ParameterError
+            Unknown or out-of-range input.
+        """
+        _check_time("WetCoSimulation", self.time, t, dt)
+        u = self.resolve_inputs(inputs)
+        y = self.do_step_array(t, dt, (u["force_reference"], u["slip_speed_reference"]))
+        return dict(zip(self._output_names, y.tolist()))
+
+    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
+        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
+        f, w = u
+        if (self.simulation is None
+                or not (step_in_time(self.time, t, dt) and 0.0 <= f <= self._force_max
+                        and abs(w) <= self._speed_max)):
+            return self._step_checked(t, dt, f, w)
+        held = self._held
+        held[0] = f
+        held[1] = w
+        return self._step(t, t + dt)
+
+    def _step_checked(self, t, dt, f, w):
+        # a step with every check of do_step, in its order (the first step, or one that fails a check)
+        _check_time("WetCoSimulation", self.time, t, dt)
+        u = self.resolve_inputs({"force_reference": f, "slip_speed_reference": w})
+        if self.simulation is None:
+            self._start(u)
+        self.simulation.set_inputs(self._inputs(u))
+        return self._step(t, t + dt)
+
+    def _step(self, t, t_end):
+        try:
+            y = self.simulation.step(t_end)
+        except SimulationError as exc:
+            raise SimulationError(f"WetCoSimulation: between t = {t} and {t_end} s: {exc}") from None
+        self.time = t_end
+        if self._event_count[0] > self._n_events:  # new events only (a DataFrame per step cost more than the step)
+            from ..wet import engagement as E
+
+            log = self.simulation.log
+            n = int(log.count[0])
+            names = self.simulation.system.events
+            for i in range(self._n_events, n):
+                name = names[int(log.code[i])]
+                if name in E.EVENT_KINDS:
+                    self.events.append(E.Event(float(log.time[i]), E.EVENT_KINDS[name]))
+            self._n_events = n
+        return y
+
+
