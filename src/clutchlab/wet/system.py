@@ -13,7 +13,8 @@ Eqs. 1-8, with the squeeze-film / asperity engagement dynamics of Deur et al.
   with :func:`clutchlab.numerics.dispatch.register`; the integrator core
   (:mod:`clutchlab.numerics.core`) compiles them in;
 * :func:`engagement_system` -- the :class:`~clutchlab.system.System` of one
-  engagement, registered as model ``"wet"``.
+  engagement (the model ``"wet"`` is it for a bench protocol,
+  :func:`clutchlab.wet.bench.protocol_system`).
 
 States, outputs and events
 --------------------------
