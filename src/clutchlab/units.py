@@ -329,8 +329,9 @@ def format_quantity(value: float, unit: str) -> str:
 COLUMN_UNITS: dict[str, tuple[str, str]] = {
     "s": ("s", "s"), "ms": ("ms", "ms"),
     "m": ("m", "m"), "mm": ("mm", "mm"), "m2": ("m**2", "m²"), "m3": ("m**3", "m³"),
-    "m_s": ("m/s", "m/s"), "m_s2": ("m/s**2", "m/s²"), "m3_s": ("m**3/s", "m³/s"), "m_per_N": ("m/N", "m/N"),
-    "rad": ("rad", "rad"), "rad_s": ("rad/s", "rad/s"), "rad_s2": ("rad/s**2", "rad/s²"), "rpm": ("rpm", "rpm"),
+    "m_s": ("m/s", "m/s"), "m_s2": ("m/s**2", "m/s²"), "m_s3": ("m/s**3", "m/s³"), "m3_s": ("m**3/s", "m³/s"), "m_per_N": ("m/N", "m/N"),
+    "rad": ("rad", "rad"), "rad_s": ("rad/s", "rad/s"), "rad_s2": ("rad/s**2", "rad/s²"),
+    "rad_s3": ("rad/s**3", "rad/s³"), "rpm": ("rpm", "rpm"),
     "N": ("N", "N"), "kN": ("kN", "kN"), "N_m": ("N/m", "N/m"), "Nm": ("N*m", "N·m"),
     "Pa": ("Pa", "Pa"), "kPa": ("kPa", "kPa"), "MPa": ("MPa", "MPa"), "bar": ("bar", "bar"), "Pa_s": ("Pa*s", "Pa·s"),
     "C": ("degC", "°C"), "c": ("degC", "°C"), "degC": ("degC", "°C"), "K": ("K", "K"), "deg": ("deg", "°"),

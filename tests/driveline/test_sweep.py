@@ -296,3 +296,69 @@ def test_an_input_start_is_a_sweep_parameter_held_through_each_run(tmp_path):
     assert loaded.system().u0.tolist() == [1.0, 5.0]
     with pytest.raises(ParameterError, match=r"'engage\.strat'.*did you mean 'engage\.start'"):
         doc.load({"engage.strat": 2.0})
+
+
+SINE = """
+[driveline]
+name = "sine"
+
+[simulation]
+t_end = "1.25 s"
+output_step = "1 ms"
+rtol = 1e-10
+
+[inertia.J1]
+J = "2 kg m^2"
+
+[torque.T]
+flange = "J1"
+torque = { sine = { amplitude = "10 N m", frequency = "1 Hz" } }
+
+[inertia.J2]
+J = "1 kg m^2"
+
+[torque.R]
+flange = "J2"
+torque = { table = { times = ["0 s", "1 s"], values = ["0 N m", "10 N m"] } }
+"""
+
+
+def test_metrics_and_signal_parameters_against_closed_forms(tmp_path):
+    """Sweep outputs over a run (#33: minimum speeds, peaks, jerk) and the numbers of signals as parameters (the
+    force profiles engineers vary).  J1 from rest under ``A sin(W t)``: ``w = A (1 - cos W t) / (J W)``, least 0,
+    largest ``2 A / (J W)`` at half a period, jerk ``d2w/dt2 = A W cos(W t) / J``, whose peak ``A W / J`` is reached
+    again at a full period (inside the run).  J2 (1 kg m^2) under the table ramp to 10 N m in 1 s, stretched in time by
+    ``s`` and scaled by ``k``: the integral of ``10 k t / s`` up to ``s``, then of ``10 k``, to 1.25 s."""
+    _, scenario = _scenario(tmp_path, SINE, "sine.toml")
+    doc = DrivelineDocument(scenario, scenario["_source"])
+    sp = doc.signal_parameters
+    assert (sp["T.torque.amplitude"].unit, sp["T.torque.amplitude"].value) == ("N*m", 10.0)
+    assert (sp["T.torque.frequency"].unit, sp["T.torque.frequency"].value) == ("Hz", 1.0)
+    assert sp["R.torque.time_scale"].value == sp["R.torque.value_scale"].value == 1.0
+    described = S.describe(scenario)
+    assert {"T.torque.amplitude", "R.torque.time_scale"} <= set(described["parameters"])
+    outputs = ["J1.w_min_rad_s", "J1.w_max_rad_s", "J1.w_final_rad_s", "J1.w_jerk_rad_s3", "J2.w_final_rad_s",
+               "T.tau_max_Nm", "status"]
+    assert described["outputs"]["J1.w_jerk_rad_s3"] == "rad/s**3"
+    variants = _design(**{"T.torque.amplitude": [5.0, 20.0], "T.torque.frequency": [1.0, 2.0],
+                          "R.torque.time_scale": [1.0, 2.0], "R.torque.value_scale": [0.5]})
+    out = S.run_batch(variants, scenario, outputs)
+    assert (out["status"] == 0).all()
+    for vid, row in variants.iterrows():
+        a, f, s, k = (row[c] for c in variants.columns)
+        w = 2 * math.pi * f
+        got = out.loc[vid]
+        assert abs(got["J1.w_min_rad_s"]) < 1e-9
+        assert got["J1.w_max_rad_s"] == pytest.approx(2 * a / (2.0 * w), rel=1e-5)
+        assert got["J1.w_final_rad_s"] == pytest.approx(a * (1 - math.cos(w * 1.25)) / (2.0 * w), rel=1e-6, abs=1e-9)
+        assert got["J1.w_jerk_rad_s3"] == pytest.approx(a * w / 2.0, rel=2e-3)
+        ramp = 10 * k / s   # N m/s, the stretched and scaled ramp, held at 10 k from t = s on
+        w2 = ramp * 1.25 ** 2 / 2 if s >= 1.25 else ramp * s ** 2 / 2 + 10 * k * (1.25 - s)
+        assert got["J2.w_final_rad_s"] == pytest.approx(w2, rel=1e-6)
+        assert got["T.tau_max_Nm"] == pytest.approx(a, rel=1e-6)
+
+
+def test_an_unknown_metric_is_refused_with_the_closest_name(tmp_path):
+    _, scenario = _scenario(tmp_path, SINE, "sine.toml")
+    with pytest.raises(ParameterError, match=r"unknown output 'J1\.w_minn_rad_s'; did you mean 'J1\.w_min_rad_s'"):
+        S.run_batch(_design(**{"J1.J": [1.0]}), scenario, ["J1.w_minn_rad_s"])

@@ -7,8 +7,10 @@ The FMU of a driveline (:mod:`clutchlab.fmu.driveline`) and the sweep target ``d
 ``[<kind>.<component>]`` table; its unit is the field's SI unit
 (:data:`clutchlab.driveline.description.FIELDS`).  Every scalar field is one: a number or a quantity
 string given in the file, or a field the file leaves out whose default is a number (``w0 = 0``,
-``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) and signals (a sine torque, a step
-of the normal force) are not parameters.  The start value of a network input (``[input.throttle] start``)
+``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) are not parameters; the scalar numbers
+of a signal a field is given as (a sine torque's amplitude and frequency, the duration of a ramp of the
+normal force) are :attr:`DrivelineDocument.signal_parameters`, ``<component>.<field>.<parameter>``, which a
+sweep varies (an FMU keeps the file's profiles).  The start value of a network input (``[input.throttle] start``)
 is the parameter ``throttle.start`` of :attr:`DrivelineDocument.input_starts`, in the unit of the fields
 that read the input: a sweep holds it through each run; an FMU has it as its FMI input's start instead.
 
@@ -38,7 +40,8 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import FIELDS, NOT_QUANTITIES, TRANSLATIONAL_FIELDS, DrivelineFile, input_units, parse_driveline
+from .description import (FIELDS, NOT_QUANTITIES, SIGNAL_FIELDS, TRANSLATIONAL_FIELDS, DrivelineFile, input_units,
+                          parse_driveline)
 from .network import Driveline
 
 __all__ = ["Parameter", "DrivelineDocument", "ReferencedFile"]
@@ -180,7 +183,7 @@ class DrivelineDocument:
     def __init__(self, document: dict, source: str):
         self.source = str(source)
         self.document = {k: v for k, v in document.items() if not str(k).startswith("_")}
-        params = {}
+        params, signals = {}, {}
         head = self.document.get("driveline", {})
         translational = isinstance(head, dict) and head.get("domain") == "translational"
         self._fields = TRANSLATIONAL_FIELDS if translational else FIELDS
@@ -201,7 +204,15 @@ class DrivelineDocument:
                     name = f"{component}.{field}"
                     si = to_si(value, unit, name=f"{kind}.{name}", source=self.source)
                     params[name] = Parameter(name, unit, si, f"{field} of {kind.replace('_', ' ')} {component}")
+                for field, (unit, _) in fields.items():
+                    self._signal_parameters(kind, component, field, unit, comp.get(field), signals)
         self.parameters = params
+        #: the numbers of the profiles the file gives as signals, ``<component>.<field>.<parameter>``: a sine
+        #: torque's ``torque.torque.amplitude`` [N m] and ``frequency`` [Hz], an E-clutch's bearing ramp
+        #: ``clutch.position.duration`` [s], a wet clutch's force step ``wet.force.height`` [N] (a sweep varies
+        #: them; an FMU keeps its profiles)
+        self.signal_parameters = {name: par for name, (par, _) in signals.items()}
+        self._signals = {name: where for name, (_, where) in signals.items()}
         # the start values of the network inputs, ``<input>.start`` in the unit of the fields reading the input:
         # held through a run by a sweep (an FMU's inputs have their own start values, so they are apart)
         starts = {}
@@ -214,6 +225,33 @@ class DrivelineDocument:
             si = to_si(spec.get("start", 0.0), units[name], name=f"input.{name}.start", source=self.source)
             starts[pname] = Parameter(pname, units[name], si, f"start value of input {name}, held through the run")
         self.input_starts = starts
+
+    def _signal_parameters(self, kind, component, field, unit, value, out) -> None:
+        """The scalar parameters of a signal the file gives field ``field`` of ``[kind.component]`` (a one-entry
+        table ``{ sine = { ... } }``), into ``out``: name -> (Parameter, (kind, component, field, signal kind,
+        parameter)).  Lists (a table's times), whole numbers (a pulse's ``nperiod``) and nested signals (a
+        product, an input) are not parameters."""
+        if not (isinstance(value, dict) and len(value) == 1):
+            return
+        (sig, spec), = value.items()
+        fields = SIGNAL_FIELDS.get(sig)
+        if not fields or not isinstance(spec, dict) or unit is None or unit in NOT_QUANTITIES:
+            return
+        if sig == "table":   # a profile as a whole: stretched in time, scaled in value
+            for param, what in (("time_scale", "times"), ("value_scale", "values")):
+                name = f"{component}.{field}.{param}"
+                out[name] = (Parameter(name, "1", 1.0, f"factor on the {what} of the table of {field} of "
+                                                       f"{kind.replace('_', ' ')} {component}"),
+                             (kind, component, field, sig, param))
+            return
+        for param, punit in fields.items():
+            if param not in spec or punit == "int" or not _is_scalar(spec[param]):
+                continue
+            u = unit if punit == "value" else punit
+            name = f"{component}.{field}.{param}"
+            si = to_si(spec[param], u, name=f"{kind}.{name}", source=self.source)
+            out[name] = (Parameter(name, u, si, f"{param} of the {sig} of {field} of {kind.replace('_', ' ')} "
+                                                f"{component}"), (kind, component, field, sig, param))
 
     @classmethod
     def read(cls, path) -> "DrivelineDocument":
@@ -283,13 +321,14 @@ class DrivelineDocument:
             Parameter names (``"clutch1.fn_max"``, or an input's ``"throttle.start"``).
         """
         for name in names:
-            if name not in self.parameters and name not in self.input_starts:
-                close = difflib.get_close_matches(str(name), [*self.parameters, *self.input_starts], n=1)
+            if name not in self.parameters and name not in self.input_starts and name not in self.signal_parameters:
+                close = difflib.get_close_matches(str(name), [*self.parameters, *self.input_starts,
+                                                              *self.signal_parameters], n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
                 raise ParameterError(
                     f"{self.source}: {name!r} is not a numeric parameter of this driveline (parameters are "
                     f"<component>.<field> with a number, e.g. {', '.join(list(self.parameters)[:4])}, or "
-                    f"<input>.start){hint}")
+                    f"<input>.start, or <component>.<field>.<parameter> of a signal){hint}")
 
     def load(self, changes: dict | None = None) -> DrivelineFile:
         """The driveline of this file with some parameters changed, read by ``load_driveline``.
@@ -314,6 +353,19 @@ class DrivelineDocument:
         self.check_names(changes)
         doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in self.document.items()}
         for name, value in changes.items():
+            if name in self._signals:
+                kind, component, field, sig, param = self._signals[name]
+                comp = doc[kind][component]
+                spec = dict(comp[field][sig])   # (a second change of one signal reads the copy the first one made)
+                if sig == "table":
+                    what = "times" if param == "time_scale" else "values"
+                    unit = "s" if what == "times" else self._fields[kind][field][0]
+                    spec[what] = [float(value) * to_si(v, unit, name=f"{kind}.{component}.{field}.table.{what}",
+                                                       source=self.source) for v in spec.get(what, [])]
+                else:
+                    spec[param] = float(value)
+                doc[kind] = {**doc[kind], component: {**comp, field: {sig: spec}}}
+                continue
             component, field = name.rsplit(".", 1)
             if name in self.input_starts:
                 doc["input"] = {**doc["input"], component: {**doc["input"][component], field: float(value)}}

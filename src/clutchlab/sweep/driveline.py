@@ -37,7 +37,26 @@ Outputs per variant (names carry their unit, as the driveline's columns):
 ``dissipated_energy_J``               J      energy dissipated in the whole network
 ``energy_error_J``                    J      largest ``abs(energy_error)`` over the samples (the balance)
 ``status``                            1      0 success; else the core's status code (outputs NaN)
+``<variable>_min_<unit>``             unit   least value of a state or output over the samples
+``<variable>_max_<unit>``             unit   largest value over the samples
+``<variable>_final_<unit>``           unit   value at ``t_end``
+``<speed>_jerk_<unit>3``              /s^2   largest ``abs(d^2 w / dt^2)`` of a speed over the samples
 ====================================  =====  =============================================================
+
+The metrics of the last four rows exist for every state and output of the network, named by its column
+(:meth:`~clutchlab.driveline.Driveline.simulate`): ``engine.w_min_rad_s`` (the least engine speed of a
+launch: a stall is below idle), ``clutch.temperature_max_C`` (a wet clutch's peak pack temperature),
+``vehicle.w_jerk_rad_s3`` (the vehicle's jerk, in rad/s^3 at its inertia: times the tyre radius for m/s^3),
+``clutch.tau_max_Nm``.  The jerk is the second derivative of the sampled speed by central differences
+(``numpy.gradient`` twice, on the samples' times), so it is the jerk a rig's speed signal shows when sampled
+every ``[simulation] output_step`` ``h``: an acceleration step (a clutch locking) reads as a jerk of about
+``delta_a / (2 h)``; a shift-quality metric states its sample interval, as a measured one states its filter.
+
+Besides the components' fields, the numbers of the signals the file gives are parameters,
+``<component>.<field>.<parameter>`` (:attr:`~clutchlab.driveline.variants.DrivelineDocument.signal_parameters`):
+a sine torque's ``torque.torque.amplitude``, a step of the normal force ``clutch.normal.start``, and a table
+profile as a whole, stretched in time (``clutch.position.time_scale``) or scaled in value
+(``clutch.position.value_scale``, ``wet.force.value_scale``): the clutch force profiles of a launch.
 """
 
 from __future__ import annotations
@@ -47,11 +66,18 @@ import pandas as pd
 
 from ..errors import ParameterError
 from ..numerics.status import Status
+from ..units import COLUMN_UNITS
 from ..sweep.targets import check_outputs, nan_frame, rows
 from ..system import simulate, simulate_batch
 from ..driveline.variants import DrivelineDocument
 
-__all__ = ["run_batch", "describe", "check_variants", "referenced_files", "outputs_of", "EVENT_CAPACITY"]
+__all__ = ["run_batch", "describe", "check_variants", "referenced_files", "outputs_of", "metrics_of", "REDUCTIONS",
+           "EVENT_CAPACITY"]
+
+#: reductions of a state or output over the samples of a run, the outputs ``<variable>_<reduction>_<unit>``
+REDUCTIONS = ("min", "max", "final")
+#: unit suffixes of speeds, whose jerk is an output ``<speed>_jerk_<unit>3``
+_SPEEDS = ("rad_s", "m_s")
 
 #: events kept per variant in the batch; a variant with more runs again alone (it keeps 100,000)
 EVENT_CAPACITY = 1024
@@ -72,6 +98,40 @@ def _base(scenario):
     return doc, base
 
 
+def metrics_of(system) -> dict:
+    """The metrics of a network's states and outputs over a run: name -> (unit, "state" or "output", index,
+    reduction), :data:`REDUCTIONS` of every variable but the mode codes, and ``"jerk"`` of every speed.
+
+    Parameters
+    ----------
+    system : clutchlab.system.System
+        The network's system (its variables name the metrics).
+    """
+    out = {}
+    for kind, variables in (("state", system.states), ("output", system.outputs)):
+        for i, v in enumerate(variables):
+            if v.name.endswith(".mode") or v.unit not in COLUMN_UNITS:
+                continue
+            for r in REDUCTIONS:
+                out[f"{v.name}_{r}_{v.unit}"] = (COLUMN_UNITS[v.unit][0], kind, i, r)
+            if v.unit in _SPEEDS:
+                out[f"{v.name}_jerk_{v.unit}3"] = (COLUMN_UNITS[v.unit + "3"][0], kind, i, "jerk")
+    return out
+
+
+def _metric(time, values, reduction) -> float:
+    """One metric of a variable's samples ``values`` at ``time`` (:func:`metrics_of`)."""
+    if reduction == "min":
+        return float(np.min(values))
+    if reduction == "max":
+        return float(np.max(values))
+    if reduction == "final":
+        return float(values[-1])
+    if values.size < 3 or not np.all(np.diff(time) > 0):
+        return np.nan
+    return float(np.max(np.abs(np.gradient(np.gradient(values, time), time))))
+
+
 def outputs_of(driveline) -> dict:
     """The sweep outputs of a driveline network, name -> unit.
 
@@ -89,6 +149,8 @@ def outputs_of(driveline) -> dict:
         out[f"{name}.last_stick_s"] = "s"
         out[f"{name}.peak_tau_Nm"] = "N*m"
     out.update({"dissipated_energy_J": "J", "energy_error_J": "J", "status": "1"})
+    for name, (unit, *_) in metrics_of(driveline.system()).items():
+        out.setdefault(name, unit)
     return out
 
 
@@ -101,7 +163,8 @@ def describe(scenario) -> dict:
         The parsed driveline description (``_source`` = its path).
     """
     doc, base = _base(scenario)
-    return {"parameters": {p.name: p.unit for p in (*doc.parameters.values(), *doc.input_starts.values())},
+    return {"parameters": {p.name: p.unit for p in (*doc.parameters.values(), *doc.input_starts.values(),
+                                                    *doc.signal_parameters.values())},
             "outputs": outputs_of(base.driveline)}
 
 
@@ -157,11 +220,17 @@ def _last_sticks(events) -> dict:
     return stick.groupby([variant, stick["element"]])["time_s"].max().to_dict()
 
 
-def _reduce(system, states, outputs, last_stick, status):
-    """Outputs of one variant: its samples ``states`` (n, n_x), ``outputs`` (n, n_y), ``{element: last stick}``."""
+def _reduce(system, time, states, outputs, last_stick, status, wanted=()):
+    """Outputs of one variant: its samples ``states`` (n, n_x), ``outputs`` (n, n_y) at ``time``, ``{element: last
+    stick}``, and the metrics of :func:`metrics_of` named in ``wanted``."""
     got = {"status": float(status)}
     if not Status(int(status)).ok:
         return got
+    metrics = metrics_of(system)
+    for name in wanted:
+        if name in metrics:
+            _, kind, i, reduction = metrics[name]
+            got[name] = _metric(time, (states if kind == "state" else outputs)[:, i], reduction)
     friction = set(system.mode_names)
     for i, v in enumerate(system.states):
         if v.name.endswith(".w"):
@@ -212,9 +281,9 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
         if dropped[k]:  # more events than the batch keeps: this variant again, alone, with every event
             one = simulate(_system(doc, vid, row), t_end, check=False, **options)
             alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
-            got = _reduce(system, one.states, one.outputs, alone, int(one.status))
+            got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs)
         else:
             mine = {e: sticks[(k, e)] for e in system.mode_names if (k, e) in sticks}
-            got = _reduce(system, res.states[k], res.outputs[k], mine, int(res.status[k]))
+            got = _reduce(system, res.time, res.states[k], res.outputs[k], mine, int(res.status[k]), outputs)
         values[k] = [got.get(name, np.nan) for name in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))

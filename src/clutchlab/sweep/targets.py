@@ -448,7 +448,14 @@ def check_outputs(model: str, outputs, known) -> None:
     """
     unknown = [o for o in outputs if o not in known]
     if unknown:
-        raise ParameterError(f"{model}: unknown output {unknown[0]!r} (known: {', '.join(known)})")
+        import difflib
+
+        names = list(known)
+        close = difflib.get_close_matches(str(unknown[0]), names, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        listed = ", ".join(names[:12]) + (f", ... ({len(names)} in all: clutchlab sweep SPEC --list-parameters)"
+                                          if len(names) > 12 else "")
+        raise ParameterError(f"{model}: unknown output {unknown[0]!r}{hint} (known: {listed})")
 
 
 def nan_frame(index, outputs) -> pd.DataFrame:
