@@ -39,8 +39,8 @@ from .numerics import status as st
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
-           "checked_grid", "check_fixed_step", "check_fixed_step_span",
-           "MODELS", "register_model"]
+           "checked_grid", "check_fixed_step", "check_fixed_step_span", "check_rtol", "check_atol", "RUN_OPTIONS",
+           "RTOL_MIN", "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
 CHUNK_ROWS = 4096
@@ -305,15 +305,8 @@ class System:
 
     def _build_options(self, Options, rtol, atol, max_step, max_steps, first_step, event_tol, fixed_step=None):
         fixed = check_fixed_step(fixed_step)
-        rtol = self.rtol if rtol is None else rtol
-        if not (isinstance(rtol, (int, float, np.floating)) and 0.0 < float(rtol) < 1.0):
-            raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
-        if atol is None:
-            atol_v = self.atol
-        else:
-            atol_v = np.broadcast_to(np.asarray(atol, dtype=float), self.atol.shape).copy()
-            if not np.all(np.isfinite(atol_v)) or np.any(atol_v <= 0):
-                raise ParameterError(f"atol = {short_repr(atol)}: must be > 0")
+        rtol = check_rtol(self.rtol if rtol is None else rtol)
+        atol_v = self.atol if atol is None else check_atol(atol, self.atol.shape)
         max_step = self.max_step if max_step is None else max_step
         if not (max_step > 0):
             raise ParameterError(f"max_step = {short_repr(max_step)}: must be > 0 [s]")
@@ -392,6 +385,71 @@ def _colour(pattern: np.ndarray, cols: np.ndarray) -> np.ndarray:
     for i, g in enumerate(groups):
         out[i, :len(g)] = g
     return out
+
+
+#: the options every entry point that runs a model takes, with one meaning each (docs/architecture.md, "One option
+#: set"): relative tolerance, absolute tolerance per state [its unit], largest step [s], sample interval of the
+#: result [s], step of the fixed-step mode [s]
+RUN_OPTIONS = ("rtol", "atol", "max_step", "output_step", "fixed_step")
+#: smallest relative tolerance a run accepts: 100 machine epsilons (SciPy's ``solve_ivp`` floor); below it no step
+#: of a double-precision integrator can meet the tolerance, and a run would end in a step-size underflow
+RTOL_MIN = 100.0 * float(np.finfo(float).eps)
+
+
+def check_rtol(rtol, name: str = "rtol") -> float:
+    """A relative tolerance, checked once for every model: finite, in (0, 1) and at least :data:`RTOL_MIN`.
+
+    Parameters
+    ----------
+    rtol : float
+        The relative tolerance [-].
+    name : str
+        How the caller names it in the message (``"rtol"``, ``"parameter solver.rtol"``, ``"simulation.rtol"``).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and the value.
+    """
+    if isinstance(rtol, (bool, np.bool_)) or not isinstance(rtol, (int, float, np.integer, np.floating)) \
+            or not 0.0 < float(rtol) < 1.0:
+        raise ParameterError(f"{name} = {short_repr(rtol)}: must be in (0, 1)")
+    if float(rtol) < RTOL_MIN:
+        raise ParameterError(f"{name} = {short_repr(rtol)}: below {RTOL_MIN:.2g} (100 machine epsilons), which no "
+                             "double-precision step can meet")
+    return float(rtol)
+
+
+def check_atol(atol, shape, name: str = "atol") -> np.ndarray:
+    """Absolute tolerances per state, checked once for every model: finite and > 0, a scalar or one per state.
+
+    Parameters
+    ----------
+    atol : float or array_like
+        One tolerance for every state, or one per state [the state's unit].
+    shape : tuple
+        The shape of the state vector.
+    name : str
+        How the caller names it in the message.
+
+    Returns
+    -------
+    ndarray
+        ``atol`` broadcast to ``shape`` (a copy).
+
+    Raises
+    ------
+    ParameterError
+        Not numbers, the wrong number of them, not finite or not > 0.
+    """
+    try:
+        v = np.broadcast_to(np.asarray(atol, dtype=float), shape).copy()
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} = {short_repr(atol)}: expected a number > 0 or one per state "
+                             f"({shape[0] if shape else 1})") from None
+    if not np.all(np.isfinite(v)) or np.any(v <= 0):
+        raise ParameterError(f"{name} = {short_repr(atol)}: must be > 0")
+    return v
 
 
 def check_fixed_step(fixed_step) -> float:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import io
 
-from .common import add_fixed_step_option
+from .common import add_run_options
 from ..errors import DataError, ParameterError
 
 __all__ = ["register"]
@@ -38,9 +38,7 @@ def register(subparsers) -> None:
                           "file of time_s and one value column named with its unit suffix (load_Nm), read "
                           "linearly between samples and held beyond them (default: the input's start)")
     sim.add_argument("--t-end", help="end time, e.g. '1.5 s' (default: [simulation] t_end)")
-    sim.add_argument("--output-step", help="sample interval, e.g. '1 ms' (default: [simulation] output_step, "
-                                           "else every accepted step)")
-    add_fixed_step_option(sim)
+    add_run_options(sim)
     sim.add_argument("--check-invariants", action="store_true",
                      help="debug: check at every step that stuck elements are within their limits, modes agree "
                           "with the relative speeds, one-way clutches never drive their free direction, lossy "
@@ -59,30 +57,32 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
-    from .common import fixed_step_note, fixed_step_option
+    from .common import run_note, run_options
     from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
     from ..units import to_si
     from ..driveline.description import load_driveline
 
     check_outputs([args.output, args.events, args.plot], args.force)
-    fixed_step = fixed_step_option(args.fixed_step)
+    options = run_options(args)
+    fixed_step = options["fixed_step"]
     spec = load_driveline(args.file)
     t_end = to_si(args.t_end, "s", name="--t-end") if args.t_end is not None else spec.t_end
     if t_end is None:
         raise ParameterError(f"{args.file}: no end time: give --t-end or [simulation] t_end")
-    step = to_si(args.output_step, "s", name="--output-step") if args.output_step is not None else spec.output_step
-    if step is not None and not step > 0:
-        raise ParameterError(f"--output-step = {args.output_step!r}: must be > 0")
+    step = spec.output_step if options["output_step"] is None else options["output_step"]
     if not t_end > 0:
         raise ParameterError(f"end time = {t_end!r} s: must be > 0")
     inputs = _inputs(args.input, spec.driveline, args.file)
-    res = spec.driveline.simulate(t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=step,
-                                  fixed_step=fixed_step, check_invariants=args.check_invariants, inputs=inputs)
+    res = spec.driveline.simulate(t_end, rtol=spec.rtol if options["rtol"] is None else options["rtol"],
+                                  atol=options["atol"],
+                                  max_step=spec.max_step if options["max_step"] is None else options["max_step"],
+                                  output_step=step, fixed_step=fixed_step, check_invariants=args.check_invariants,
+                                  inputs=inputs)
     frame = res.to_dataframe()
     events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
     # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
     atomic_to_csv(frame, args.output, overwrite=args.force,
-                  header_comment=None if fixed_step is None else fixed_step_note(fixed_step))
+                  header_comment=run_note(options))
     if args.events:
         atomic_to_csv(events, args.events, overwrite=args.force)
     if args.plot:

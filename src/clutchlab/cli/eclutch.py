@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .._limits import check_allocation
-from .common import add_fixed_step_option
+from .common import add_run_options
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
 from ..io.files import check_outputs
@@ -136,20 +136,22 @@ def _lever(args) -> int:
 
 def _simulate(args) -> int:
     from .. import __version__
-    from .common import fixed_step_note, fixed_step_option, progress
+    from .common import progress, run_note, run_options
     from ..io import write_measurement
     from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
     from ..eclutch.scenario import load_scenario, run_scenario
 
     check_outputs([args.output, args.plot], args.force)
-    fixed_step = fixed_step_option(args.fixed_step)
+    options = run_options(args)
+    fixed_step = options["fixed_step"]
     scenario = load_scenario(args.scenario)
-    res = run_scenario(scenario, progress=progress, fixed_step=fixed_step)
+    res = run_scenario(scenario, progress=progress, **options)
     frame = res.to_dataframe()
     comment = (f"synthetic: simulated by clutchlab {__version__} (E-clutch Model {scenario.model}, scenario "
                f"{args.scenario}); model output, not a measurement")
-    if fixed_step is not None:
-        comment += "\n" + fixed_step_note(fixed_step)
+    note = run_note(options)
+    if note is not None:
+        comment += "\n" + note
     write_measurement(frame, args.output, comment=comment, overwrite=args.force)
     if args.plot:
         if scenario.input_kind == "bearing_position":
@@ -262,7 +264,7 @@ def register(subparsers) -> None:
                         epilog="Documentation: docs/eclutch_dynamics.md (scenario format)")
     sm.add_argument("scenario", help="scenario TOML ([scenario], [input], optional parameter tables)")
     sm.add_argument("-o", "--output", required=True, help="results to write: .csv, .parquet or .mf4")
-    add_fixed_step_option(sm)
+    add_run_options(sm)
     sm.add_argument("--plot", help="also write a PNG figure (time response, or hysteresis loop)")
     sm.add_argument("--force", action="store_true", help="overwrite existing output files")
     sm.set_defaults(func=_simulate)

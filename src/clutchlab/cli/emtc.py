@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .._limits import short_repr
-from .common import add_fixed_step_option, fixed_step_note, fixed_step_option
+from .common import add_run_options, run_note, run_options
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
 from ..io.files import check_outputs
@@ -71,11 +71,11 @@ def _simulate(args) -> int:
     from ..emtc.magnet import bundled_magnet
 
     check_outputs([args.output, args.plot], args.force)
-    fixed_step = fixed_step_option(args.fixed_step)
+    options = run_options(args)
     sc = load_scenario(args.scenario)
     magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
     res = simulate_bench(magnet, sc["scenario"], vehicle=sc["vehicle"], actuator=sc["actuator"], coupling=sc["coupling"],
-                         fixed_step=fixed_step)
+                         **{k: v for k, v in options.items() if v is not None})
     frame = res.to_dataframe()
     from .. import __version__
     from ..io import write_measurement
@@ -83,8 +83,9 @@ def _simulate(args) -> int:
     magnet_src = sc["magnet"] or "bundled synthetic FORC data"
     comment = (f"synthetic: simulated by clutchlab {__version__} (emtc simulate {args.scenario}; magnet: "
                f"{magnet_src}); model output, not a measurement")
-    if fixed_step is not None:
-        comment += "\n" + fixed_step_note(fixed_step)
+    note = run_note(options)
+    if note is not None:
+        comment += "\n" + note
     write_measurement(frame, args.output, comment=comment, overwrite=args.force)
     if len(res.events):
         print(res.events[["time_s", "event", "description", "coupling_mode"]].to_string(index=False))
@@ -152,7 +153,7 @@ def register(subparsers) -> None:
                          epilog="Documentation: docs/emtc.md (scenario format)")
     sim.add_argument("scenario", type=Path, help="TOML with [scenario], [vehicle], [actuator], [coupling], [magnet]")
     sim.add_argument("-o", "--output", type=Path, required=True, help="CSV of the run")
-    add_fixed_step_option(sim)
+    add_run_options(sim)
     sim.add_argument("--plot", type=Path, help="PNG figure of the run")
     sim.add_argument("--force", action="store_true", help="overwrite the outputs")
     sim.set_defaults(func=_simulate)

@@ -14,7 +14,7 @@ import io
 import json
 import sys
 
-from .common import add_fixed_step_option
+from .common import add_run_options
 from ..errors import ParameterError
 
 __all__ = ["register"]
@@ -35,7 +35,7 @@ def register(subparsers) -> None:
                          epilog="Documentation: docs/wet.md (protocol format)")
     sim.add_argument("protocol", help="protocol file ([protocol] type = friction_map | engagement | inertia_dynamometer)")
     sim.add_argument("-o", "--output", required=True, help="record CSV to write")
-    add_fixed_step_option(sim)
+    add_run_options(sim)
     sim.add_argument("--plot", help="also write a PNG figure of the record (slip, torque, force, temperatures)")
     sim.add_argument("--force", action="store_true", help="overwrite the outputs")
     sim.set_defaults(func=_simulate)
@@ -62,15 +62,17 @@ def register(subparsers) -> None:
 
 
 def _simulate(args) -> int:
-    from .common import fixed_step_note, fixed_step_option
+    from .common import run_note, run_options
     from ..io.files import check_outputs
     from ..wet.bench import load_protocol, run_protocol, write_bench_record
 
     check_outputs([args.output, args.plot], args.force)
-    fixed_step = fixed_step_option(args.fixed_step)
+    options = run_options(args)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
-    run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype, fixed_step=fixed_step)
-    header = None if fixed_step is None else run.header() + "\n" + fixed_step_note(fixed_step)
+    run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype,
+                       **{k: v for k, v in options.items() if v is not None})
+    note = run_note(options)
+    header = None if note is None else run.header() + "\n" + note
     write_bench_record(run, args.output, overwrite=args.force, header=header)
     if args.plot:
         from ..io import atomic_write_bytes
@@ -86,7 +88,7 @@ def _simulate(args) -> int:
         plt.close(fig)
         atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
     events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
-    frames = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
+    frames = "" if options["fixed_step"] is None else f" in fixed steps of {options['fixed_step']:g} s"
     print(f"{args.output}: {len(run.record)} samples of protocol {ptype}{frames}; events: {events}")
     return 0
 

@@ -75,6 +75,7 @@ from pathlib import Path
 
 from ..errors import DataError, ParameterError
 from ..io.files import read_toml
+from ..system import check_rtol
 from ..units import to_si
 from .network import Driveline, Signal
 
@@ -483,6 +484,8 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
         if not (0.0 < v < 1.0 if k == "rtol" else v > 0.0):
             raise ParameterError(f"{src}: simulation.{k} = {sim[k]!r}: must be "
                                  + ("in (0, 1)" if k == "rtol" else "> 0 [s]"))
+        if k == "rtol":
+            check_rtol(v, f"{src}: simulation.rtol")   # (the one rule of every model: at least RTOL_MIN)
     for top in doc:
         if top in known and top not in table_fields and top not in ("driveline", "simulation", "input"):
             other = "translational" if domain == "rotational" else "rotational"

@@ -512,11 +512,13 @@ def _as_table(value, name: str):
     return np.ascontiguousarray(t), np.ascontiguousarray(v)
 
 
-def _check_run(t_end, rtol, max_steps):
+def _check_run(t_end, rtol, max_steps, atol=None, atol_scale=None):
     if not (np.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"t_end = {t_end!r} s must be finite and > 0")
-    if not (np.isfinite(rtol) and 1e-12 < rtol < 0.1):
-        raise ParameterError(f"rtol = {rtol!r} must be in (1e-12, 0.1)")
+    contract.check_rtol(rtol)
+    if atol is not None and atol_scale is not None:
+        raise ParameterError("atol and atol_scale: give one of them (atol sets the absolute tolerances, atol_scale "
+                             "scales the defaults)")
     if int(max_steps) < 10:
         raise ParameterError(f"max_steps = {max_steps!r} must be >= 10")
 
@@ -542,10 +544,11 @@ def _max_step(max_step, h_max):
     return value
 
 
-def _run(source, system: contract.System, t_end: float, max_steps: int, grid, fixed_step=None) -> DynamicsResult:
+def _run(source, system: contract.System, t_end: float, max_steps: int, grid, fixed_step=None,
+         atol=None) -> DynamicsResult:
     # without a grid every accepted step is kept, in chunks that grow with the run (not max_steps rows up front)
-    res = contract.simulate(system, t_end, max_steps=int(max_steps), sample_times=grid if grid.size else None,
-                            fixed_step=fixed_step)
+    res = contract.simulate(system, t_end, atol=atol, max_steps=int(max_steps),
+                            sample_times=grid if grid.size else None, fixed_step=fixed_step)
     return DynamicsResult.from_result(res, source)
 
 
@@ -594,7 +597,7 @@ class ClutchDynamics:
         return self.assembly.system(S.PRESCRIBED, tin, vin, 0, float(vin[0]), rtol=rtol, max_step=max_step,
                                     event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
 
-    def simulate(self, bearing_position, t_end: float | None = None, *, rtol: float = 1e-5,
+    def simulate(self, bearing_position, t_end: float | None = None, *, rtol: float = 1e-5, atol=None,
                  max_step: float | None = None, h_max: float | None = None, max_steps: int = 500_000,
                  output_step: float | None = None, event_tol: float = 1e-9, jac_every: int = 4,
                  atol_scale: float | None = None, fixed_step: float | None = None) -> DynamicsResult:
@@ -603,17 +606,19 @@ class ClutchDynamics:
         Tolerances: ``rtol`` and the default absolute tolerances (10 nm, 10 um/s, 10 Pa, ...) times
         ``atol_scale`` (default ``min(1, rtol / 1e-5)``: below the default rtol they shrink with it, so the error
         follows the tolerance -- with friction, fixed absolute tolerances held the pressure plate's stick-slip
-        phase, and the bearing force, at 2.6 % of peak from rtol 1e-5 to 1e-8, issue #30); ``bearing_position``,
-        ``t_end``, ``max_step`` (alias ``h_max``), ``max_steps``, ``output_step``, ``event_tol``, ``jac_every`` and
+        phase, and the bearing force, at 2.6 % of peak from rtol 1e-5 to 1e-8, issue #30), or ``atol``: absolute
+        tolerances given outright (one for every state or one per state, in the states' units: positions [m],
+        velocities [m/s], energies [J]; one of ``atol`` and ``atol_scale``); ``bearing_position``, ``t_end``,
+        ``max_step`` (alias ``h_max``), ``max_steps``, ``output_step``, ``event_tol``, ``jac_every`` and
         ``fixed_step`` as in :meth:`EClutch.simulate`.
         """
         tin, _vin = _as_table(bearing_position, "bearing_position")
         t_end = float(tin[-1]) if t_end is None else float(t_end)
-        _check_run(t_end, rtol, max_steps)
+        _check_run(t_end, rtol, max_steps, atol, atol_scale)
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self.as_system(bearing_position, rtol=rtol, max_step=_max_step(max_step, h_max),
                                 event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, grid, fixed_step)
+        return _run(self, system, t_end, max_steps, grid, fixed_step, atol)
 
 
 class EClutch:
@@ -730,9 +735,9 @@ class EClutch:
         return operating_point(system, inputs={"motor_voltage": voltage}, targets={"bearing_position": pos},
                                free_inputs=["motor_voltage"], modes=modes, guess=run.x)
 
-    def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, max_step: float | None = None,
+    def simulate(self, inputs, t_end: float, *, rtol: float = 1e-3, atol=None, max_step: float | None = None,
                  h_max: float | None = None, max_steps: int = 500_000, output_step: float | None = None,
-                 event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float = 1.0,
+                 event_tol: float = 1e-8, jac_every: int = 10, atol_scale: float | None = None,
                  fixed_step: float | None = None) -> DynamicsResult:
         """Simulate from rest (clutch engaged, actuator at its rest stop).
 
@@ -762,9 +767,14 @@ class EClutch:
         jac_every : int
             Reuse the finite-difference Jacobian for up to this many accepted
             steps (it is refreshed after every event and every rejected step).
-        atol_scale : float
+        atol : float or array_like, optional
+            Absolute tolerances given outright: one for every state or one
+            per state, in the states' units (positions [m], velocities [m/s],
+            pressures [Pa], current [A], energies [J]); one of ``atol`` and
+            ``atol_scale``.
+        atol_scale : float, optional
             Factor on the default absolute tolerances (0.1 um, 0.1 mm/s,
-            100 Pa, 1 mA, ...).
+            100 Pa, 1 mA, ...); default 1.
         fixed_step : float, optional
             Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3
             steps on the grid ``k * fixed_step``, no error control, the
@@ -783,11 +793,12 @@ class EClutch:
         t_end = float(t_end)
         imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
-        _check_run(t_end, rtol, max_steps)
+        _check_run(t_end, rtol, max_steps, atol, atol_scale)
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self._system(imode, interp, tin, vin, rtol=rtol, max_step=_max_step(max_step, h_max),
-                              event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
-        return _run(self, system, t_end, max_steps, grid, fixed_step)
+                              event_tol=event_tol, jac_every=jac_every,
+                              atol_scale=1.0 if atol_scale is None else atol_scale)
+        return _run(self, system, t_end, max_steps, grid, fixed_step, atol)
 
 
 def _input_mode(inputs):

@@ -225,7 +225,9 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
                     output_step=output_step, rtol=rtol, source=src)
 
 
-def run_scenario(scenario: Scenario, progress=None, *, fixed_step: float | None = None) -> DynamicsResult:
+def run_scenario(scenario: Scenario, progress=None, *, rtol: float | None = None, atol=None,
+                 max_step: float | None = None, output_step: float | None = None,
+                 fixed_step: float | None = None) -> DynamicsResult:
     """Simulate a scenario: the E-clutch (actuator + clutch), or the clutch alone for ``bearing_position``.
 
     Parameters
@@ -234,6 +236,12 @@ def run_scenario(scenario: Scenario, progress=None, *, fixed_step: float | None 
         What to simulate (:func:`load_scenario`).
     progress : callable, optional
         Called with a message string as the run proceeds.
+    rtol, output_step : float, optional
+        Relative tolerance and sample interval [s] (default: the scenario's).
+    atol : float or array_like, optional
+        Absolute tolerances per state (default: the model's, :meth:`EClutch.simulate`).
+    max_step : float, optional
+        Largest step [s] (default: the model's).
     fixed_step : float, optional
         Fixed-step (real-time, HIL frame) mode with this step [s] (:meth:`EClutch.simulate`); the
         scenario's ``rtol`` is then unused.  None (default): step-size control.
@@ -245,14 +253,13 @@ def run_scenario(scenario: Scenario, progress=None, *, fixed_step: float | None 
     if progress:
         frames = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
         progress(f"simulating {scenario.t_end:g} s ({scenario.input_kind} input){frames} ...")
+    options = dict(rtol=scenario.rtol if rtol is None else rtol, atol=atol, max_step=max_step,
+                   output_step=scenario.output_step if output_step is None else output_step, fixed_step=fixed_step)
     if scenario.input_kind == "bearing_position":
-        return ClutchDynamics(model, scenario.friction).simulate((t, v), scenario.t_end, rtol=scenario.rtol,
-                                                                 output_step=scenario.output_step,
-                                                                 fixed_step=fixed_step)
+        return ClutchDynamics(model, scenario.friction).simulate((t, v), scenario.t_end, **options)
     key = "voltage" if scenario.input_kind == "voltage" else "bearing_reference"
     ec = EClutch(scenario.actuator, model, scenario.friction)
-    return ec.simulate({key: (t, v)}, scenario.t_end, rtol=scenario.rtol, output_step=scenario.output_step,
-                       fixed_step=fixed_step)
+    return ec.simulate({key: (t, v)}, scenario.t_end, **options)
 
 
 def _as_scenario(scenario) -> Scenario:
@@ -298,7 +305,7 @@ def scenario_system(scenario=None, **options):
 
 
 def simulate(scenario=None, t_end: float | None = None, *, rtol: float | None = None, atol=None,
-             max_step: float | None = None, output_step: float | None = None):
+             max_step: float | None = None, output_step: float | None = None, fixed_step: float | None = None):
     """Simulate an E-clutch scenario with the integrator core: the uniform entry point.
 
     Parameters
@@ -318,6 +325,9 @@ def simulate(scenario=None, t_end: float | None = None, *, rtol: float | None = 
         Largest step [s] (default 0.01).
     output_step : float, optional
         Sample interval of the result [s] (dense output; default: the scenario's, else every accepted step).
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s] (:func:`clutchlab.system.simulate`); None
+        (default): step-size control.
 
     Returns
     -------
@@ -334,7 +344,8 @@ def simulate(scenario=None, t_end: float | None = None, *, rtol: float | None = 
         raise ParameterError(f"t_end = {t_end!r} s must be finite and > 0")
     system = scenario_system(sc)
     step = sc.output_step if output_step is None else output_step
-    return run(system, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=step, max_steps=500_000)
+    return run(system, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=step, max_steps=500_000,
+               fixed_step=fixed_step)
 
 
 register_model("eclutch", scenario_system)

@@ -28,6 +28,7 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..params.base import load_toml
+from ..system import sample_grid
 from . import system as S
 from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
 from .torque import LOCKED_CASE_NAMES, CouplingGeometry
@@ -255,13 +256,14 @@ _NONE7 = (None,) * 7
 def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: VehicleParameters | None = None,
                    actuator: ActuatorParameters | None = None, coupling: CouplingGeometry | None = None,
                    torque_map: TorqueMap | None = None, controller_model=None, friction_map=None, lugre=None,
-                   torque_reference=None, rtol=1e-6, atol=None, max_steps=2_000_000,
+                   torque_reference=None, rtol=1e-6, atol=None, max_step: float | None = None,
+                   output_step: float | None = None, max_steps=2_000_000,
                    fixed_step: float | None = None) -> BenchResult:
     """Simulate the vehicle with EMTC on the drum bench ([1], Eqs. 8-31, Figs. 11, 15-17).
 
     A thin layer over :func:`clutchlab.emtc.simulate` (the ``emtc_bench`` model run by the integrator
     core), kept for existing code: the result is recorded at every controller sample up to the last one
-    at or before ``scenario.duration`` and viewed as a :class:`BenchResult`.
+    at or before ``scenario.duration`` (or every ``output_step``) and viewed as a :class:`BenchResult`.
 
     Parameters
     ----------
@@ -290,6 +292,12 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     rtol, atol : float
         Integrator tolerances (atol per state; default: ``clutchlab.emtc.system.absolute_tolerance(rtol)``,
         scaled to each state and shrinking with ``rtol`` below its default 1e-6).
+    max_step : float, optional
+        Largest step [s] (default: none besides the controller samples).
+    output_step : float, optional
+        Sample interval of the result [s] up to ``scenario.duration`` (default: the controller samples,
+        ``scenario.sample_time``); off the controller samples the controller columns are the outputs held
+        between samples.
     max_steps : int
         Accepted steps after which the run stops with :class:`SimulationError`.
     fixed_step : float, optional
@@ -323,13 +331,15 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
                      f"duration = {scenario.duration!r} s at sample_time = {scenario.sample_time!r} s")
     n = int(round(scenario.duration / scenario.sample_time)) + 1
     samples = np.arange(n) * scenario.sample_time
+    if output_step is not None:
+        samples = sample_grid(0.0, float(scenario.duration), output_step)
 
     def build(cap):
         opts = options if cap is None else dataclasses.replace(options, memory_capacity=cap)
         return S.bench_system(magnet, scenario, vehicle, opts, n_samples=n)
 
-    system, res = S.run(build, float(samples[-1]), rtol=float(rtol), atol=atol, sample_times=samples,
-                        max_steps=int(max_steps), fixed_step=fixed_step)
+    system, res = S.run(build, float(samples[-1]), rtol=rtol, atol=atol, max_step=max_step,
+                        sample_times=samples, max_steps=int(max_steps), fixed_step=fixed_step)
     params, t_last, x_last, u0 = system.params, float(samples[-1]), res.stats["final_state"].copy(), system.u0
 
     def controller_log():

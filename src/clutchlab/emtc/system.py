@@ -1264,9 +1264,10 @@ def run(build, t_end: float, **kwargs):
     ``build(memory_capacity) -> System`` makes a fresh system; returns ``(system, result)``.  Without an
     ``atol``, a given ``rtol`` brings its :func:`absolute_tolerance`.
     """
-    from ..system import simulate as core_simulate
+    from ..system import check_rtol, simulate as core_simulate
 
     if kwargs.get("atol") is None and kwargs.get("rtol") is not None:
+        check_rtol(kwargs["rtol"])
         kwargs["atol"] = absolute_tolerance(kwargs["rtol"])  # the error control follows rtol below its default
     cap = None
     while True:
@@ -1281,7 +1282,7 @@ def run(build, t_end: float, **kwargs):
 
 def simulate(scenario=None, t_end: float | None = None, *, magnet=None, vehicle=None,
              options: BenchOptions | None = None, rtol: float | None = None, atol=None, max_step: float | None = None,
-             output_step: float | None = None):
+             output_step: float | None = None, fixed_step: float | None = None):
     """Simulate the vehicle with the EMTC on the drum bench ([1], Eqs. 8-31); the uniform entry point.
 
     Parameters
@@ -1305,6 +1306,9 @@ def simulate(scenario=None, t_end: float | None = None, *, magnet=None, vehicle=
         Largest step [s] (default: none besides the controller samples).
     output_step : float, optional
         Sample interval of the result [s] (default: ``scenario.sample_time``, the controller samples).
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s] (:func:`clutchlab.system.simulate`); None
+        (default): step-size control.
 
     Returns
     -------
@@ -1327,4 +1331,5 @@ def simulate(scenario=None, t_end: float | None = None, *, magnet=None, vehicle=
             opts = dataclasses.replace(opts, memory_capacity=cap)
         return bench_system(magnet, scenario, vehicle, opts)
 
-    return run(build, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=output_step)[1]
+    return run(build, t_end, rtol=rtol, atol=atol, max_step=max_step, output_step=output_step,
+               fixed_step=fixed_step)[1]

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
+from ..system import check_rtol
 from ..fmu.cosim import FIXED_STEP_DOC, ContractCoSimulation, Variable, fixed_step_parameter, fmi_unit
 from ..units import COLUMN_UNITS
 from ..driveline.variants import DrivelineDocument
@@ -131,8 +132,7 @@ class DrivelineCoSimulation(ContractCoSimulation):
             raise ParameterError("DrivelineCoSimulation: build the class of a file first, "
                                  "DrivelineCoSimulation.for_description(path)")
         values = self.resolve_parameters(parameter_values)
-        if not 0.0 < values["rtol"] < 1.0:
-            raise ParameterError(f"parameter rtol = {values['rtol']!r}: must be in (0, 1)")
+        check_rtol(values["rtol"], "parameter rtol")
         self.fixed_step = fixed_step_parameter(values)
         self.simulation_options = {"fixed_step": self.fixed_step}
         if self.base.max_step is not None:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..system import check_rtol
 from ..fmu.cosim import (FIXED_STEP_DOC, CoSimulation, Variable, build_parameter_set, fixed_step_parameter,
                          parameter_set_variables, step_in_time)
 from ..system import Simulation
@@ -83,8 +84,7 @@ class EClutchCoSimulation(CoSimulation):
         friction = build_parameter_set("friction", FrictionParameters, values) if values["friction_on"] else \
             FrictionParameters.off()
         self.rtol = values["rtol"]
-        if not 1e-10 < self.rtol < 0.1:
-            raise ParameterError(f"parameter rtol = {self.rtol!r}: expected a value in (1e-10, 0.1)")
+        check_rtol(self.rtol, "parameter rtol")
         self.fixed_step = fixed_step_parameter(values)
         self.input_name = "bearing_reference" if mode == 1.0 else "motor_voltage"
         self.eclutch = EClutch(actuator, ClutchModel.preset(int(model), clutch), friction)

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..system import check_rtol
 from .cosim import (FIXED_STEP_DOC, ContractCoSimulation, Variable, _check_time, build_parameter_set,
                     fixed_step_parameter, parameter_set_variables, step_in_time)
 
@@ -130,8 +131,7 @@ class EmtcCoSimulation(ContractCoSimulation):
         if not self.sample_time > 0:
             raise ParameterError(f"parameter scenario.sample_time = {self.sample_time!r}: must be > 0 [s]")
         self.rtol = values["solver.rtol"]
-        if not (0 < self.rtol < 1):
-            raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
+        check_rtol(self.rtol, "parameter solver.rtol")
         self.magnet = bundled_magnet()
         self._scenario = BenchScenario(gear=int(gear), drum_load_front=values["scenario.drum_load_front"],
                                        drum_load_rear=values["scenario.drum_load_rear"],

@@ -12,6 +12,7 @@ import sys
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..system import check_rtol
 from .cosim import (FIXED_STEP_DOC, CoSimulation, Variable, _check_time, _flag, build_parameter_set,
                     fixed_step_parameter, parameter_set_variables, step_in_time)
 
@@ -133,8 +134,7 @@ class WetCoSimulation(CoSimulation):
         free = _flag("scenario.free_inertia", values["scenario.free_inertia"])
         self.rtol = values["solver.rtol"]
         self.max_step = values["solver.max_step"]
-        if not (0 < self.rtol < 1):
-            raise ParameterError(f"parameter solver.rtol = {self.rtol!r}: must be in (0, 1)")
+        check_rtol(self.rtol, "parameter solver.rtol")
         if not self.max_step > 0:
             raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
         self.fixed_step = fixed_step_parameter(values)

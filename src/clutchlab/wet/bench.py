@@ -249,7 +249,8 @@ PROTOCOL_TYPES = ("friction_map", "engagement", "inertia_dynamometer")
 
 
 def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None = None, friction=None, *,
-                 protocol_type: str | None = None, seed: int | None = None,
+                 protocol_type: str | None = None, seed: int | None = None, rtol: float = 1e-7, atol=None,
+                 max_step: float = 0.01, output_step: float | None = None,
                  fixed_step: float | None = None) -> BenchRun:
     """Run a protocol on the virtual bench and return truth and noisy record.
 
@@ -268,6 +269,10 @@ def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None 
         Needed for an :class:`EngagementProtocol` (default "engagement").
     seed : int, optional
         Noise seed (default ``bench.seed``).
+    rtol, atol, max_step : optional
+        Step control of the run (:func:`~clutchlab.wet.engagement.simulate_engagement`).
+    output_step : float, optional
+        Record interval [s] instead of the bench's ``sample_rate``.
     fixed_step : float, optional
         Fixed-step (real-time, HIL frame) mode with this step [s]
         (:func:`~clutchlab.wet.engagement.simulate_engagement`).  None
@@ -286,8 +291,9 @@ def run_protocol(protocol, clutch: WetClutch | None = None, bench: Bench | None 
         scen = protocol.scenario(clutch, motor="speed" if ptype == "engagement" else "free")
     else:
         raise ParameterError(f"protocol = {protocol!r}: expected a MapProtocol or an EngagementProtocol")
-    res = simulate_engagement(clutch, scen, bench=bench, friction=friction, sample_rate=bench.sample_rate,
-                              fixed_step=fixed_step)
+    res = simulate_engagement(clutch, scen, bench=bench, friction=friction,
+                              sample_rate=bench.sample_rate if output_step is None else None, rtol=rtol, atol=atol,
+                              max_step=max_step, output_step=output_step, fixed_step=fixed_step)
     seed = bench.seed if seed is None else int(seed)
     return BenchRun(protocol, ptype, res, measure(res, bench, seed), clutch, bench, friction, seed)
 

@@ -62,7 +62,7 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..result import BuiltOnFirstAccess, SimulationResult
-from ..system import checked_grid, simulate as run
+from ..system import check_rtol, checked_grid, sample_grid, simulate as run
 from . import system as W
 from .friction import ParametricFriction
 from .params import Bench, WetClutch
@@ -378,10 +378,22 @@ def _check_friction(friction):
         raise ParameterError(f"friction = {friction!r}: expected a ParametricFriction or a FrictionMap")
 
 
-def _sample_times(duration, sample_rate, sample_times):
-    """The sample times: as given (checked by :func:`clutchlab.system.sample_grid`), or at ``sample_rate``."""
+#: samples per second of :func:`simulate_engagement` without ``sample_times``, ``output_step`` or ``sample_rate``
+SAMPLE_RATE = 1000.0
+
+
+def _sample_times(duration, sample_rate, sample_times, output_step=None):
+    """The sample times: as given (checked by :func:`clutchlab.system.sample_grid`), every ``output_step`` or at
+    ``sample_rate`` (at most one of the three; default :data:`SAMPLE_RATE`)."""
+    given = [n for n, v in (("sample_times", sample_times), ("output_step", output_step),
+                            ("sample_rate", sample_rate)) if v is not None]
+    if len(given) > 1:
+        raise ParameterError(f"{' and '.join(given)}: give one of them (they all set the samples)")
     if sample_times is not None:
         return sample_times
+    if output_step is not None:
+        return sample_grid(0.0, float(duration), output_step)
+    sample_rate = SAMPLE_RATE if sample_rate is None else sample_rate
     if not (sample_rate > 0):
         raise ParameterError(f"sample_rate = {sample_rate!r}: must be > 0 [Hz]")
     return _rate_grid(float(duration), float(sample_rate))
@@ -460,14 +472,14 @@ def _system(clutch, scenario, bench, friction, rtol):
     bench = _default_bench() if bench is None else bench
     check_scenario(bench, scenario)
     _check_friction(friction)
-    if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
-        raise ParameterError(f"rtol = {short_repr(rtol)}: must be in (0, 1)")
+    check_rtol(rtol)
     return W.engagement_system(scenario, clutch=clutch, bench=bench, friction=friction, rtol=rtol)
 
 
 def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutch | None = None,
              bench: Bench | None = None, friction=None, rtol: float = 1e-7, atol=None,
-             max_step: float = math.inf, output_step: float | None = None) -> SimulationResult:
+             max_step: float = math.inf, output_step: float | None = None,
+             fixed_step: float | None = None) -> SimulationResult:
     """Simulate one wet-clutch run: the uniform entry point, returning a :class:`~clutchlab.SimulationResult`.
 
     Parameters
@@ -491,6 +503,9 @@ def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutc
         Largest step [s] (the reference corners are break times, so no limit is needed).
     output_step : float, optional
         Sample interval [s]; without it every accepted step (and event) is kept.
+    fixed_step : float, optional
+        Fixed-step (real-time, HIL frame) mode with this step [s] (:func:`clutchlab.system.simulate`); None
+        (default): step-size control.
 
     Returns
     -------
@@ -510,13 +525,13 @@ def simulate(scenario: Scenario, t_end: float | None = None, *, clutch: WetClutc
     clutch = WetClutch.paper() if clutch is None else clutch
     t_end = scenario.duration if t_end is None else t_end
     return run(_run_system(clutch, scenario, bench, friction, rtol), t_end, atol=atol, max_step=max_step,
-               output_step=output_step)
+               output_step=output_step, fixed_step=fixed_step)
 
 
 def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench | None = None, friction=None,
-                        sample_rate: float = 1000.0, sample_times=None, rtol: float = 1e-7,
-                        max_step: float = 0.01, max_steps: int = 2_000_000, outputs: bool = True,
-                        fixed_step: float | None = None) -> EngagementResult:
+                        sample_rate: float | None = None, sample_times=None, rtol: float = 1e-7, atol=None,
+                        max_step: float = 0.01, output_step: float | None = None, max_steps: int = 2_000_000,
+                        outputs: bool = True, fixed_step: float | None = None) -> EngagementResult:
     """Simulate one engagement (or any bench run) of the wet clutch.
 
     A thin wrapper of :func:`clutchlab.system.simulate` on
@@ -534,16 +549,22 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
     friction : ParametricFriction or FrictionMap, optional
         Asperity friction law mu_f (default: the bench's true law,
         :meth:`ParametricFriction.bench_truth`).
-    sample_rate : float
-        Output rate [Hz] when ``sample_times`` is not given.
+    sample_rate : float, optional
+        Output rate [Hz] (default :data:`SAMPLE_RATE`, 1 kHz, when neither ``sample_times`` nor
+        ``output_step`` is given).
     sample_times : array_like, optional
         Explicit output times [s].
     rtol : float
         Relative tolerance of the DOPRI 5(4) step control; the absolute
         tolerances follow it (``rtol`` times the states' typical magnitudes,
         :func:`clutchlab.wet.system.absolute_tolerance`).
+    atol : float or array_like, optional
+        Absolute tolerance per state in its unit (default: those that follow ``rtol``).
     max_step : float
         Largest step [s].
+    output_step : float, optional
+        Sample interval [s] (the end time is always a sample); one of ``sample_rate``, ``sample_times`` and
+        ``output_step``.
     max_steps : int
         Accepted-step limit (a :class:`SimulationError` beyond it).
     outputs : bool
@@ -568,8 +589,8 @@ def simulate_engagement(clutch: WetClutch, scenario: Scenario, *, bench: Bench |
         Step limit reached or step size underflow.
     """
     sysm = _run_system(clutch, scenario, bench, friction, rtol)
-    ts = _sample_times(scenario.duration, sample_rate, sample_times)
-    res = run(sysm, float(scenario.duration), max_step=max_step, max_steps=max_steps, sample_times=ts,
+    ts = _sample_times(scenario.duration, sample_rate, sample_times, output_step)
+    res = run(sysm, float(scenario.duration), atol=atol, max_step=max_step, max_steps=max_steps, sample_times=ts,
               outputs=outputs, fixed_step=fixed_step)
     return EngagementResult.from_result(res, clutch.heat_capacity, W.peak_temperature(sysm.params),
                                         W.lockup_time(sysm.params))
