@@ -33,14 +33,7 @@ def fixed_step_option(text):
     ParameterError
         Not a time with its unit, not finite, or not > 0 -- naming the option and the value.
     """
-    if text is None:
-        return None
-    from ..units import to_si
-
-    step = to_si(text, "s", name="--fixed-step")
-    if not step > 0:
-        raise ParameterError(f"--fixed-step = {text!r}: must be a time > 0 with its unit, e.g. '1 ms'")
-    return step
+    return None if text is None else _time("--fixed-step", text)
 
 
 def fixed_step_note(step: float) -> str:

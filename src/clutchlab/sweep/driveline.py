@@ -140,8 +140,9 @@ def outputs_of(driveline) -> dict:
     driveline : Driveline
         The network of the scenario.
     """
+    system = driveline.system()
     out = {}
-    for v in driveline.system().states:
+    for v in system.states:
         if v.name.endswith(".w"):
             out[f"{v.name[:-2]}.w_final_rad_s"] = "rad/s"
     for name in driveline.friction_names:
@@ -149,7 +150,7 @@ def outputs_of(driveline) -> dict:
         out[f"{name}.last_stick_s"] = "s"
         out[f"{name}.peak_tau_Nm"] = "N*m"
     out.update({"dissipated_energy_J": "J", "energy_error_J": "J", "status": "1"})
-    for name, (unit, *_) in metrics_of(driveline.system()).items():
+    for name, (unit, *_) in metrics_of(system).items():
         out.setdefault(name, unit)
     return out
 
@@ -220,13 +221,14 @@ def _last_sticks(events) -> dict:
     return stick.groupby([variant, stick["element"]])["time_s"].max().to_dict()
 
 
-def _reduce(system, time, states, outputs, last_stick, status, wanted=()):
+def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metrics=None):
     """Outputs of one variant: its samples ``states`` (n, n_x), ``outputs`` (n, n_y) at ``time``, ``{element: last
-    stick}``, and the metrics of :func:`metrics_of` named in ``wanted``."""
+    stick}``, and the metrics of :func:`metrics_of` named in ``wanted`` (``metrics``: those of ``system``, or of
+    any variant of the same network: the variants share their variables)."""
     got = {"status": float(status)}
     if not Status(int(status)).ok:
         return got
-    metrics = metrics_of(system)
+    metrics = metrics_of(system) if metrics is None else metrics
     for name in wanted:
         if name in metrics:
             _, kind, i, reduction = metrics[name]
@@ -275,15 +277,17 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     options = {"output_step": step, "max_step": base.max_step, "max_steps": MAX_STEPS}
     res = simulate_batch([system for _, _, system in built], t_end, event_capacity=EVENT_CAPACITY, **options)
     sticks = _last_sticks(res.events)
+    metrics = metrics_of(built[0][2])   # (every variant has the same states and outputs)
     dropped = res.stats["events_dropped"]
     values = np.full((len(built), len(outputs)), np.nan)
     for k, (vid, row, system) in enumerate(built):
         if dropped[k]:  # more events than the batch keeps: this variant again, alone, with every event
             one = simulate(_system(doc, vid, row), t_end, check=False, **options)
             alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
-            got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs)
+            got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics)
         else:
             mine = {e: sticks[(k, e)] for e in system.mode_names if (k, e) in sticks}
-            got = _reduce(system, res.time, res.states[k], res.outputs[k], mine, int(res.status[k]), outputs)
+            got = _reduce(system, res.time, res.states[k], res.outputs[k], mine, int(res.status[k]), outputs,
+                          metrics)
         values[k] = [got.get(name, np.nan) for name in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))
