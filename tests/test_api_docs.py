@@ -9,7 +9,7 @@ from clutchlab.cli import _optional_module
 
 MODULES = ["clutchlab", "clutchlab.curves", "clutchlab.units", "clutchlab.eclutch", "clutchlab.params",
            "clutchlab.io", "clutchlab.report", "clutchlab.wet", "clutchlab.emtc", "clutchlab.hysteresis",
-           "clutchlab.system", "clutchlab.result", "clutchlab.numerics.core", "clutchlab.numerics.status",
+           "clutchlab.system", "clutchlab.component", "clutchlab.result", "clutchlab.numerics.core", "clutchlab.numerics.status",
            "clutchlab.driveline", "clutchlab.driveline.bench", "clutchlab.trim", "clutchlab.emtc.params", "clutchlab.wet.bench"]
 
 

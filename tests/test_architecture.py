@@ -21,7 +21,7 @@ ROOT = Path(clutchlab.__file__).parent
 #: face, ``clutchlab/__init__.py``)
 LAYERS = (
     ("foundation", {"errors", "_limits", "_compile_notice", "units", "numerics", "result", "curves", "plotting"}),
-    ("contract", {"clutchlab", "system", "trim", "io", "params", "hysteresis", "friction"}),
+    ("contract", {"clutchlab", "system", "component", "trim", "io", "params", "hysteresis", "friction"}),
     ("models", {"eclutch", "wet", "emtc"}),
     ("composition", {"driveline"}),
     ("built on the contract", {"fmu", "sweep", "control"}),

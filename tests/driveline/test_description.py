@@ -122,7 +122,7 @@ J = "2 kg m^2"
     ('[clutch.c]\na = "J1"\nb = "J9"\nfn_max = "1 N"\n', ["clutch.c", "'J9' is not an inertia"]),
     ('[clutch.c]\na = "J1"\nb = "J1"\nfn_max = "1 N"\n', ["clutch.c", "both flanges are 'J1'"]),
     ('[clutch.c]\na = "J1"\nfn_max = "1 N"\n', ["clutch.c", "missing field 'b'"]),
-    ('[inertia.J3]\nJ = "-1 kg m^2"\n', ["inertia.J3", "J = -1.0 must be > 0"]),
+    ('[inertia.J3]\nJ = "-1 kg m^2"\n', ["inertia.J3.J = '-1 kg m^2'", "must be > 0"]),
     ('[gearbox.g]\nratio = 3\n', ["unknown table [gearbox]"]),
     ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "1 N m"\n', ["clutch.c.fn_max", "wrong unit"]),
     ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "1 N"\ncolour = "red"\n', ["clutch.c.colour", "unknown field"]),
@@ -151,7 +151,7 @@ def test_bad_descriptions_name_file_key_and_value(tmp_path, capsys, body, fragme
     ('[spring.k]\na = "J1"\nb = "J2"\ncurve = [["0 rad", "0 N m"]]\n', ["spring.k", "at least 2 rows"]),
     ('[spring.k]\na = "J1"\nb = "J2"\ncurve = [[0, 0], [1, 2]]\ninterpolation = "spline"\n',
      ["spring.k.interpolation", "expected \"linear\" or \"pchip\""]),
-    ('[backlash.l]\na = "J1"\nb = "J2"\nc = "1 N m/rad"\nb_gap = "0 deg"\n', ["backlash.l", "b_gap = 0.0 must be > 0"]),
+    ('[backlash.l]\na = "J1"\nb = "J2"\nc = "1 N m/rad"\nb_gap = "0 deg"\n', ["backlash.l.b_gap = '0 deg'", "must be > 0"]),
     ('[mass.m]\nm = "1 kg"\n', ["[mass] belongs to a translational driveline"]),
     ('[driveline]\ndomain = "hydraulic"\n', ["driveline.domain = 'hydraulic'"]),
 ])
@@ -289,7 +289,7 @@ points = 71
         np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12, err_msg=col)
     assert a["clutch.fn_N"].max() > 1000.0
     for body, fragment in (('parameters = "nowhere.toml"\n', "clutch.parameters = 'nowhere.toml': no such file"),
-                           ('model = 7\n', "model = 7 must be one of the axial models 0-4")):
+                           ('model = 7\n', r"eclutch\.clutch\.model = 7: is above its range \[0, 4\]")):
         bad = tmp_path / "bad.toml"
         bad.write_text(path.read_text().replace("model = 2\n", body))
         with pytest.raises(ParameterError, match=fragment):

@@ -3,7 +3,10 @@
 ``clutchlab driveline simulate FILE.toml -o OUT.csv [--input NAME=VALUE ...] [--output-step STEP] [--fixed-step STEP] [--check-invariants] [--events EVENTS.csv] [--plot fig.png] [--force]``
     run a driveline network and write its states and outputs (and its events);
 ``clutchlab driveline describe FILE.toml``
-    print a text schematic of the network.
+    print a text schematic of the network;
+``clutchlab driveline components [KIND]``
+    list the component kinds a network file can use (built in, and registered by installed packages), or
+    the fields of one: kind, unit, default, range and description (:mod:`clutchlab.component`).
 """
 
 from __future__ import annotations
@@ -53,6 +56,13 @@ def register(subparsers) -> None:
                          epilog="Documentation: docs/driveline.md")
     des.add_argument("file", help="driveline description (TOML with units)")
     des.set_defaults(func=_describe)
+    comp = sub.add_parser("components", help="list the component kinds of driveline files, or one kind's fields",
+                          description="List the component kinds a driveline file can use (the built-in ones and "
+                                      "those that installed packages add), or print the fields of one kind: kind, "
+                                      "unit, default, physical range and description.",
+                          epilog="Documentation: docs/components.md")
+    comp.add_argument("kind", nargs="?", help="a component kind (the table name: clutch, gear, wet_clutch, ...)")
+    comp.set_defaults(func=_components)
     dl.set_defaults(func=lambda args: (dl.print_help(), 2)[1])
 
 
@@ -165,6 +175,22 @@ def _trace(path, unit: str, what: str):
     if times.size == 0 or np.any(np.diff(times) <= 0):
         raise ParameterError(f"{label}: time_s must hold strictly increasing times (at least one)")
     return times, scale * values + offset
+
+
+def _components(args) -> int:
+    from ..component import component_table, components
+    from ..driveline import BUILTIN
+
+    if args.kind is not None:
+        print(component_table(args.kind), end="")
+        return 0
+    builtin = {c.kind for c in BUILTIN}
+    known = components()
+    width = max(len(k) for k in known)
+    for kind, comp in known.items():
+        where = "" if kind in builtin else f"  [{getattr(comp.build, '__module__', '?')}]"
+        print(f"{kind:<{width}}  {comp.description}{where}")
+    return 0
 
 
 def _describe(args) -> int:

@@ -3,8 +3,11 @@ and friction elements between two flanges with the Modelica friction state machi
 
 See :mod:`clutchlab.driveline.network` (the description API) and :mod:`clutchlab.driveline.kernel`
 (the compiled hooks and the friction semantics).
+Its component kinds are declared in :mod:`clutchlab.driveline.components` (registered when this package is
+imported) on the contract of :mod:`clutchlab.component`.
 """
 
 from .network import GROUND, Driveline, Signal
+from .components import BUILTIN
 
-__all__ = ["Driveline", "Signal", "GROUND"]
+__all__ = ["Driveline", "Signal", "GROUND", "BUILTIN"]

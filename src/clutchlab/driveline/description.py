@@ -26,7 +26,10 @@
     peak = 1.1
     normal = { sine = { amplitude = 1, frequency = "0.2 Hz", phase = "90 deg" } }
 
-Component tables (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
+Component tables are the registered component kinds, each declared once with its fields' units,
+defaults and physical ranges (:mod:`clutchlab.component`, :mod:`clutchlab.driveline.components`;
+``clutchlab driveline components [KIND]``, docs/components.md); a value outside its range is refused
+naming the file, the key, the value and the range.  The built-in ones (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
 ``backlash`` (a, b, c, b_gap, d, phi_rel0, damping_law = "kelvin_voigt" (default) or "msl": MSL
 ``ElastoBacklash``'s), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1,
@@ -70,9 +73,11 @@ A friction characteristic (``mu``, a bearing's ``torque``) is a number or a tabl
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..component import check_range, components
 from ..errors import DataError, ParameterError
 from ..io.files import read_toml
 from ..system import check_rtol
@@ -81,57 +86,37 @@ from .network import Driveline, Signal
 
 __all__ = ["load_driveline", "parse_driveline", "DrivelineFile"]
 
-#: component tables and their fields: field -> (unit, required); "flange"/"a"/"b"/"support" are names
-FIELDS = {
-    "inertia": {"J": ("kg*m**2", True), "w0": ("rad/s", False), "phi0": ("rad", False)},
-    "spring_damper": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", False), "d": ("N*m*s/rad", False),
-                      "phi_rel0": ("rad", False)},
-    "spring": {"a": (None, True), "b": (None, True), "curve": ("N*m", True), "interpolation": ("text", False),
-               "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False)},
-    "backlash": {"a": (None, True), "b": (None, True), "c": ("N*m/rad", True), "b_gap": ("rad", True),
-                 "d": ("N*m*s/rad", False), "phi_rel0": ("rad", False), "damping_law": ("text", False)},
-    "gear": {"a": (None, True), "b": (None, True), "ratio": ("1", True), "efficiency": ("1", False),
-             "loss_table": ("losstable", False), "support": (None, False)},
-    "torque": {"flange": (None, True), "torque": ("N*m", True), "support": (None, False)},
-    "speed": {"flange": (None, True), "speed": ("rad/s", True)},
-    "position": {"flange": (None, True), "position": ("rad", True)},
-    "clutch": {"a": (None, True), "b": (None, True), "fn_max": ("N", True), "mu": ("1", False),
-               "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False), "mu_map": ("path", False),
-               "radius": ("m", False), "temperature": ("degC", False)},
-    "brake": {"flange": (None, True), "fn_max": ("N", True), "mu": ("1", False), "peak": ("1", False),
-              "cgeo": ("1", False), "normal": ("1", False), "support": (None, False), "mu_map": ("path", False),
-              "radius": ("m", False), "temperature": ("degC", False)},
-    "bearing_friction": {"flange": (None, True), "torque": ("N*m", False), "peak": ("1", False),
-                         "support": (None, False)},
-    "one_way_clutch": {"a": (None, True), "b": (None, True), "fn_max": ("N", False), "mu": ("1", False),
-                       "peak": ("1", False), "cgeo": ("1", False), "normal": ("1", False)},
-    "eclutch": {"a": (None, True), "b": (None, True), "position": ("m", True), "model": ("int", False),
-                "parameters": ("path", False), "travel": ("m", False), "points": ("int", False),
-                "peak": ("1", False), "actuator": ("bool", False), "actuator_step": ("s", False),
-                "pre_roll": ("s", False), "settle": ("s", False)},
-    "engine": {"flange": (None, True), "torque_map": ("map", True), "throttle": ("1", False),
-               "idle_speed": ("rad/s", False), "idle_kp": ("N*m*s/rad", False), "idle_ki": ("N*m/rad", False),
-               "idle_torque_max": ("N*m", False), "support": (None, False)},
-    "wet_clutch": {"a": (None, True), "b": (None, True), "force": ("N", True), "clutch": ("path", False),
-                   "bench": ("path", False), "friction": ("path", False), "temperature0": ("degC", False),
-                   "fluid_temperature0": ("degC", False), "housing_temperature0": ("degC", False)},
-    "emtc": {"a": (None, True), "b": (None, True), "bench": ("path", False), "magnet": ("path", False)},
-}
-#: fields that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("text", "int", "path", "bool", "map", "losstable")
-#: the words a text field takes
-CHOICES = {"interpolation": ("linear", "pchip"), "damping_law": ("kelvin_voigt", "msl")}
 #: a translational driveline: masses and forces, the units of its domain
 _TRANSLATE = {"kg*m**2": "kg", "rad/s": "m/s", "rad": "m", "N*m": "N", "N*m/rad": "N/m", "N*m*s/rad": "N*s/m"}
-_RENAME = {"inertia": ("mass", {"J": "m", "w0": "v0", "phi0": "s0"}), "torque": ("force", {"torque": "force"})}
-TRANSLATIONAL_FIELDS = {
-    _RENAME.get(kind, (kind, {}))[0]: {_RENAME.get(kind, (kind, {}))[1].get(f, f): (_TRANSLATE.get(u, u), req)
-                                       for f, (u, req) in fields.items()}
-    for kind, fields in FIELDS.items() if kind not in ("eclutch", "wet_clutch", "engine", "emtc")}
-#: signal fields carrying the signal's own unit, per component table
-_SIGNALS = {"torque": "torque", "force": "force", "speed": "speed", "position": "position", "clutch": "normal",
-            "brake": "normal", "eclutch": "position", "wet_clutch": "force", "engine": "throttle",
-            "one_way_clutch": "normal"}
+
+
+def tables(domain: str = "rotational") -> dict:
+    """The component tables of a network file of ``domain``, generated from the registered components
+    (:func:`clutchlab.component.components`): ``{table: (Component, {key: Field})}``, the fields in the
+    domain's names and units (a translational network's ``mass`` with ``m`` [kg], its clutch's ``mu`` over
+    m/s)."""
+    out = {}
+    for comp in components(domain).values():
+        if domain == "rotational":
+            out[comp.kind] = (comp, {f.name: f for f in comp.fields})
+            continue
+        table, renames = comp.translational or (comp.kind, {})
+        out[table] = (comp, {renames.get(f.name, f.name): dataclasses.replace(
+            f, name=renames.get(f.name, f.name), unit=_TRANSLATE.get(f.unit, f.unit)) for f in comp.fields})
+    return out
+
+
+def field_units(domain: str = "rotational") -> dict:
+    """``{table: {key: (unit, required)}}`` of :func:`tables`: the unit of a number, signal or characteristic,
+    None for a flange, else the field's kind (``"path"``, ``"int"``, ``"choice"``, ...)."""
+    return {table: {k: (None if f.kind == "flange" else f.unit if f.kind in _UNIT_KINDS else f.kind, f.required)
+                    for k, f in fields.items()} for table, (_, fields) in tables(domain).items()}
+
+
+#: field kinds whose value carries the field's unit
+_UNIT_KINDS = ("quantity", "signal", "characteristic", "curve")
+#: field kinds that are not quantities: a choice among words, a whole number, a file (relative to the description)
+NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable")
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -152,11 +137,6 @@ SIGNAL_REQUIRED = {"step": (), "ramp": ("height", "duration"), "sine": ("amplitu
                    "trapezoid": ("amplitude", "rising", "width", "falling", "period"),
                    "exponentials": ("out_max", "rise_time", "rise_time_const", "fall_time_const"),
                    "table": ("times", "values")}
-_ADD = {"inertia": "inertia", "mass": "mass", "spring_damper": "spring_damper", "spring": "spring",
-        "backlash": "backlash", "gear": "gear", "torque": "torque", "force": "force", "speed": "speed",
-        "position": "position", "clutch": "clutch", "brake": "brake", "bearing_friction": "bearing_friction",
-        "one_way_clutch": "one_way_clutch", "eclutch": "eclutch", "wet_clutch": "wet_clutch",
-        "engine": "engine", "emtc": "emtc"}
 SIMULATION_FIELDS = {"t_end": "s", "output_step": "s", "rtol": "1", "max_step": "s"}
 
 
@@ -308,62 +288,54 @@ def _engine_map(value, key, src):
     return (speeds, throttles, rows)
 
 
-def _add(d: Driveline, kind: str, name: str, args: dict) -> None:
-    """Add one component read from a file (``args`` converted to SI) through the Python API."""
-    if kind == "spring":
-        from ..curves import Curve
-
-        rows = args.pop("curve")
-        if len(rows) < 2:
-            raise ParameterError(f"curve needs at least 2 rows, got {len(rows)}")
-        args["curve"] = Curve([r[0] for r in rows], [r[1] for r in rows], kind=args.pop("interpolation", "linear"),
-                              name=name)
-    elif kind == "wet_clutch":
-        from ..wet.friction import FrictionMap, ParametricFriction
-        from ..wet.params import Bench, WetClutch
-
-        if "clutch" in args:
-            args["clutch"] = WetClutch.from_toml(args["clutch"])
-        if "bench" in args:
-            args["bench"] = Bench.from_toml(args["bench"])
-        if "friction" in args:
-            path = args["friction"]
-            args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
-                                else ParametricFriction.from_toml(path))
-    elif kind in ("clutch", "brake") and "mu_map" in args:
-        from ..wet.friction import FrictionMap
-
-        if "mu" in args:
-            raise ParameterError("give mu or mu_map, not both")
-        args["mu"] = FrictionMap.from_json(args.pop("mu_map"))
-    elif kind == "emtc":
-        from ..hysteresis import Preisach
-
-        if "bench" in args:
-            from ..emtc.bench import load_scenario
-            from ..emtc.system import BenchOptions
-
-            path = args.pop("bench")
-            bench = load_scenario(path)
-            if bench["magnet"] is not None:
-                raise ParameterError(f"bench = {path.name!r} names a magnet in its [magnet] table: give the model "
-                                     "as this component's magnet field instead")
-            args.update(scenario=bench["scenario"], vehicle=bench["vehicle"],
-                        options=BenchOptions(actuator=bench["actuator"], coupling=bench["coupling"]))
-        if "magnet" in args:
-            args["magnet"] = Preisach.from_json(args["magnet"])
-    elif kind == "engine":
-        args = dict(args)
-        flange = args.pop("flange")
-        d.engine(name, flange, **args)
-        return
-    elif kind in ("torque", "force", "speed", "position"):
-        args = dict(args)
-        flange = args.pop("flange")
-        signal = args.pop(kind)
-        getattr(d, kind)(name, flange, signal, **args)
-        return
-    getattr(d, _ADD[kind])(name, **args)
+def _field_value(field, v, fkey, src, base, uses, speed_unit, angle_unit):
+    """The value of one field of a component table, converted to SI and checked against its declaration
+    (:class:`clutchlab.component.Field`): its kind, its unit, its words, its range."""
+    kind = field.kind
+    if kind == "flange":
+        if not isinstance(v, str):
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
+        return v
+    if kind == "signal":
+        return _signal(v, field.unit, fkey, src, uses)
+    if kind == "characteristic":
+        value = _characteristic(v, field.unit, fkey, src, x_unit=speed_unit)
+        for i, y in ([(None, value)] if isinstance(value, float) else enumerate(r[1] for r in value)):
+            problem = field.range_problem(y)
+            if problem:
+                raise ParameterError(f"{src}: {fkey}" + ("" if i is None else f"[{i}][1]") + " = "
+                                     + (f"{v!r}" if i is None else f"{v[i][1]!r}") + f": {problem}")
+        return value
+    if kind == "curve":
+        return _characteristic(v, field.unit, fkey, src, x_unit=angle_unit, table_only=True)
+    if kind == "choice":
+        if v not in field.choices:
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected " + " or ".join(f'"{c}"' for c in field.choices))
+        return v
+    if kind == "bool":
+        if not isinstance(v, bool):
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected true or false")
+        return v
+    if kind == "map":
+        return _engine_map(v, fkey, src)
+    if kind == "losstable":
+        return _loss_table(v, fkey, src, speed_unit, "N*m" if speed_unit == "rad/s" else "N")
+    if kind == "int":
+        if not isinstance(v, int) or isinstance(v, bool):
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")
+        return int(check_range(field, v, f"{src}: {fkey}"))
+    if kind == "path":
+        if not isinstance(v, str) or not v:
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected a file name")
+        target = (base / v).resolve()
+        if not target.is_file():
+            raise ParameterError(f"{src}: {fkey} = {v!r}: no such file ({target})")
+        return target
+    value = _quantity(v, field.unit, fkey, src)
+    problem = field.range_problem(value)
+    if problem:
+        raise ParameterError(f"{src}: {fkey} = {v!r}: {problem}")
+    return value
 
 
 def input_units(doc: dict, source: str) -> dict:
@@ -372,18 +344,19 @@ def input_units(doc: dict, source: str) -> dict:
     it: :func:`parse_driveline`)."""
     head = doc.get("driveline", {})
     translational = isinstance(head, dict) and head.get("domain") == "translational"
-    table_fields = TRANSLATIONAL_FIELDS if translational else FIELDS
+    known = tables("translational" if translational else "rotational")
     uses: dict = {}
-    for kind, field in _SIGNALS.items():
-        table = doc.get(kind, {})
-        if kind not in table_fields or field not in table_fields[kind] or not isinstance(table, dict):
+    for kind, table in doc.items():
+        if kind not in known or not isinstance(table, dict):
             continue
+        signals = [f for f in known[kind][1].values() if f.kind == "signal"]
         for name, comp in table.items():
-            if isinstance(comp, dict) and field in comp:
-                try:
-                    _signal(comp[field], table_fields[kind][field][0], f"{kind}.{name}.{field}", source, uses)
-                except ParameterError:
-                    pass
+            for f in signals:
+                if isinstance(comp, dict) and f.name in comp:
+                    try:
+                        _signal(comp[f.name], f.unit, f"{kind}.{name}.{f.name}", source, uses)
+                    except ParameterError:
+                        pass
     return {n: u[0][0] for n, u in uses.items()}
 
 
@@ -459,7 +432,8 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
     """
     src = str(source)
     base = Path(base) if base is not None else Path(src).parent
-    known = {"driveline", "simulation", "input", *FIELDS, *TRANSLATIONAL_FIELDS}
+    by_domain = {dom: tables(dom) for dom in ("rotational", "translational")}
+    known = {"driveline", "simulation", "input", *by_domain["rotational"], *by_domain["translational"]}
     for top in doc:
         if top not in known:
             raise ParameterError(f"{src}: unknown table [{top}] (known: {', '.join(sorted(known))})")
@@ -470,7 +444,7 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
     if domain not in ("rotational", "translational"):
         raise ParameterError(f"{src}: driveline.domain = {domain!r}: expected \"rotational\" or \"translational\"")
     d = Driveline(str(head.get("name", "driveline")), domain=domain)
-    table_fields = FIELDS if domain == "rotational" else TRANSLATIONAL_FIELDS
+    table_fields = by_domain[domain]
     speed_unit = "rad/s" if domain == "rotational" else "m/s"
     angle_unit = "rad" if domain == "rotational" else "m"
     sim = doc.get("simulation", {})
@@ -506,55 +480,19 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
             key = f"{kind}.{name}"
             if not isinstance(comp, dict):
                 raise ParameterError(f"{src}: {key} = {comp!r}: expected a table [{key}]")
-            fields = table_fields[kind]
+            comp_decl, fields = table_fields[kind]
             for f in comp:
                 if f not in fields:
                     raise ParameterError(f"{src}: {key}.{f}: unknown field (known: {', '.join(fields)})")
-            missing = [f for f, (_, req) in fields.items() if req and f not in comp]
+            missing = [f for f, field in fields.items() if field.required and f not in comp]
             if missing:
                 raise ParameterError(f"{src}: {key}: missing field {missing[0]!r}")
-            args = {}
-            for f, v in comp.items():
-                unit = fields[f][0]
-                fkey = f"{key}.{f}"
-                if unit is None:
-                    if not isinstance(v, str):
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
-                    args[f] = v
-                elif _SIGNALS.get(kind) == f:
-                    args[f] = _signal(v, unit, fkey, src, uses)
-                elif f == "mu" or (kind == "bearing_friction" and f == "torque"):
-                    args[f] = _characteristic(v, unit, fkey, src, x_unit=speed_unit)
-                elif f == "curve":
-                    args[f] = _characteristic(v, unit, fkey, src, x_unit=angle_unit, table_only=True)
-                elif unit == "text":
-                    if v not in CHOICES[f]:
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected "
-                                             + " or ".join(f'"{c}"' for c in CHOICES[f]))
-                    args[f] = v
-                elif unit == "bool":
-                    if not isinstance(v, bool):
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected true or false")
-                    args[f] = v
-                elif unit == "map":
-                    args[f] = _engine_map(v, fkey, src)
-                elif unit == "losstable":
-                    args[f] = _loss_table(v, fkey, src, speed_unit, "N*m" if domain == "rotational" else "N")
-                elif unit == "int":
-                    if not isinstance(v, int) or isinstance(v, bool):
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")
-                    args[f] = v
-                elif unit == "path":
-                    if not isinstance(v, str) or not v:
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: expected a file name")
-                    target = (base / v).resolve()
-                    if not target.is_file():
-                        raise ParameterError(f"{src}: {fkey} = {v!r}: no such file ({target})")
-                    args[f] = target
-                else:
-                    args[f] = _quantity(v, unit, fkey, src)
+            renames = (comp_decl.translational or (kind, {}))[1] if domain == "translational" else {}
+            back = {v: k for k, v in renames.items()}
+            args = {back.get(f, f): _field_value(fields[f], v, f"{key}.{f}", src, base, uses, speed_unit, angle_unit)
+                    for f, v in comp.items()}
             try:
-                _add(d, kind, name, args)
+                comp_decl.build(d, name, **args)
             except (ParameterError, DataError) as exc:
                 raise ParameterError(f"{src}: [{key}] {exc}") from None
     if not d._inertias:

@@ -5,7 +5,7 @@ The FMU of a driveline (:mod:`clutchlab.fmu.driveline`) and the sweep target ``d
 :mod:`clutchlab.driveline.description`) and change some of its numbers: ``J1.J``, ``J1.w0``,
 ``clutch1.fn_max``, ``clutch1.mu``.  A parameter is named ``<component>.<field>`` after the file's
 ``[<kind>.<component>]`` table; its unit is the field's SI unit
-(:data:`clutchlab.driveline.description.FIELDS`).  Every scalar field is one: a number or a quantity
+(the declarations of :mod:`clutchlab.driveline.components`, :func:`clutchlab.driveline.description.tables`).  Every scalar field is one: a number or a quantity
 string given in the file, or a field the file leaves out whose default is a number (``w0 = 0``,
 ``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) are not parameters; the scalar numbers
 of a signal a field is given as (a sine torque's amplitude and frequency, the duration of a ramp of the
@@ -33,16 +33,14 @@ resources, the sweep hashes them.
 from __future__ import annotations
 
 import difflib
-import inspect
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import (FIELDS, NOT_QUANTITIES, SIGNAL_FIELDS, TRANSLATIONAL_FIELDS, DrivelineFile, input_units,
-                          parse_driveline)
-from .network import Driveline
+from .description import NOT_QUANTITIES, SIGNAL_FIELDS, DrivelineFile, input_units, parse_driveline, tables
 
 __all__ = ["Parameter", "DrivelineDocument", "ReferencedFile"]
 
@@ -61,12 +59,31 @@ class Parameter:
         Value in the file (or the field's default) [unit].
     description : str
         One line for people (``"fn_max of clutch clutch1"``).
+    minimum, maximum : float, optional
+        Its physical range (inclusive), from the component's declaration (:class:`clutchlab.component.Field`).
+    positive : bool
+        It must be > 0.
     """
 
     name: str
     unit: str
     value: float
     description: str
+    minimum: float | None = None
+    maximum: float | None = None
+    positive: bool = False
+
+    def range_problem(self, value: float) -> str | None:
+        """Why ``value`` [SI] lies outside the parameter's range, or None."""
+        if not math.isfinite(value):
+            return "is not finite"
+        if self.positive and not value > 0.0:
+            return f"must be > 0 [{self.unit}]"
+        if self.minimum is not None and value < self.minimum:
+            return f"is below its minimum {self.minimum:g} [{self.unit}]"
+        if self.maximum is not None and value > self.maximum:
+            return f"is above its maximum {self.maximum:g} [{self.unit}]"
+        return None
 
 
 @dataclass(frozen=True)
@@ -150,19 +167,6 @@ def _is_scalar(value) -> bool:
     return isinstance(value, (int, float, str)) and not isinstance(value, bool)
 
 
-def _defaults(kind: str) -> dict:
-    """Number defaults of the fields of ``kind`` (the keyword defaults of the ``Driveline`` method of that name)."""
-    method = getattr(Driveline, kind, None)
-    if method is None:
-        return {}
-    out = {p.name: p.default for p in inspect.signature(method).parameters.values()
-           if isinstance(p.default, (int, float)) and not isinstance(p.default, bool)}
-    # a body's initial speed and angle left out follow from its gears and sources, else rest: 0 to vary from
-    out.update({p.name: 0.0 for p in inspect.signature(method).parameters.values()
-                if p.default is None and p.name in ("w0", "phi0", "v0", "s0")})
-    return out
-
-
 class DrivelineDocument:
     """A parsed driveline description file: its numeric parameters by name, and variants of it.
 
@@ -186,25 +190,28 @@ class DrivelineDocument:
         params, signals = {}, {}
         head = self.document.get("driveline", {})
         translational = isinstance(head, dict) and head.get("domain") == "translational"
-        self._fields = TRANSLATIONAL_FIELDS if translational else FIELDS
-        for kind, fields in self._fields.items():
+        self._tables = tables("translational" if translational else "rotational")
+        self._fields = {table: {k: (None if f.kind == "flange" else f.unit if f.kind not in NOT_QUANTITIES else f.kind,
+                                    f.required) for k, f in fields.items()}
+                        for table, (_, fields) in self._tables.items()}
+        for kind, (_, fields) in self._tables.items():
             table = self.document.get(kind, {})
             if not isinstance(table, dict):
                 continue  # the loader names the error
-            defaults = _defaults(kind)
             for component, comp in table.items():
                 if not isinstance(comp, dict):
                     continue
-                for field, (unit, _) in fields.items():
-                    if unit is None or unit in NOT_QUANTITIES:
+                for field, f in fields.items():
+                    if not f.is_numeric:
                         continue
-                    value = comp.get(field, defaults.get(field))
+                    value = comp.get(field, f.default)
                     if not _is_scalar(value):
                         continue
                     name = f"{component}.{field}"
-                    si = to_si(value, unit, name=f"{kind}.{name}", source=self.source)
-                    params[name] = Parameter(name, unit, si, f"{field} of {kind.replace('_', ' ')} {component}")
-                for field, (unit, _) in fields.items():
+                    si = to_si(value, f.unit, name=f"{kind}.{name}", source=self.source)
+                    params[name] = Parameter(name, f.unit, si, f"{f.description} ({kind.replace('_', ' ')} "
+                                                               f"{component})", f.minimum, f.maximum, f.positive)
+                for field, (unit, _) in self._fields[kind].items():
                     self._signal_parameters(kind, component, field, unit, comp.get(field), signals)
         self.parameters = params
         #: the numbers of the profiles the file gives as signals, ``<component>.<field>.<parameter>``: a sine
@@ -267,7 +274,7 @@ class DrivelineDocument:
     def referenced_files(self, within=None) -> list:
         """Every file the description names, relative to its folder, and the files those name in turn.
 
-        The fields whose unit is ``"path"`` (:data:`~clutchlab.driveline.description.FIELDS`): an
+        The fields whose unit is ``"path"`` (:func:`~clutchlab.driveline.description.tables`): an
         E-clutch's ``parameters`` (with the curve files of its ``[eclutch.curves]`` table, relative to
         the parameter file) and a wet clutch's ``clutch``, ``bench`` and ``friction``.
 

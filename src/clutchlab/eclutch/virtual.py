@@ -1,7 +1,7 @@
 """The virtual clutch: ground truth for the synthetic press-rig and full-clutch records.
 
 clutchlab cannot ship the measurements of Haramina et al. [1], so it ships a
-virtual clutch built from the component laws of :mod:`.components`, richer
+virtual clutch built from the component laws of :mod:`clutchlab.eclutch.components`, richer
 than any of the paper's Models 0-4:
 
 * the Belleville body of the diaphragm acts on the *rotation* of the lever

@@ -100,12 +100,21 @@ class Variable:
         Start (default) value in ``unit``.
     description : str
         One line for the modelDescription.
+    minimum, maximum : float, optional
+        Range of a parameter (inclusive, in ``unit``): the modelDescription's ``min`` and ``max``; a value
+        outside it is refused when the model is instantiated (a component's declared range,
+        :class:`clutchlab.component.Field`).
+    positive : bool
+        The value must be > 0 (written as ``min="0"``, the bound itself refused).
     """
 
     name: str
     unit: str
     start: float
     description: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    positive: bool = False
 
     def __post_init__(self):
         if not self.name or not isinstance(self.name, str):
@@ -228,6 +237,7 @@ class CoSimulation(abc.ABC):
             Unknown parameter name or non-finite value.
         """
         known = {v.name: v.start for v in cls.parameters}
+        declared = {v.name: v for v in cls.parameters}
         for key, val in values.items():
             if key not in known:
                 raise ParameterError(f"{cls.__name__}: unknown parameter {key!r}")
@@ -237,6 +247,14 @@ class CoSimulation(abc.ABC):
                 raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is not a number") from None
             if not math.isfinite(fv):
                 raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is not finite")
+            v = declared[key]
+            if (v.positive and not fv > 0.0) or (v.minimum is not None and fv < v.minimum) \
+                    or (v.maximum is not None and fv > v.maximum):
+                lo = "(0" if v.positive and (v.minimum is None or v.minimum <= 0) else \
+                    f"[{v.minimum:g}" if v.minimum is not None else "(-inf"
+                hi = f"{v.maximum:g}]" if v.maximum is not None else "inf)"
+                raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is outside its range "
+                                     f"{lo}, {hi} [{v.unit}]")
             known[key] = fv
         return known
 

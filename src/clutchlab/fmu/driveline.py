@@ -34,6 +34,11 @@ from ..driveline.variants import DrivelineDocument
 __all__ = ["DrivelineCoSimulation"]
 
 
+def _fmi_range(p) -> tuple:
+    """``(minimum, maximum, positive)`` of a description's parameter: its component's declared range."""
+    return p.minimum, p.maximum, p.positive
+
+
 def _fmi_unit(suffix: str) -> str:
     """FMI unit of a column suffix (``"rad_s"`` -> ``"rad/s"``, ``"Nm"`` -> ``"N.m"``)."""
     return fmi_unit(COLUMN_UNITS[suffix][0])
@@ -116,7 +121,8 @@ class DrivelineCoSimulation(ContractCoSimulation):
         parameters = (Variable("rtol", "1", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step "
                                                        "control ([simulation] rtol)"),
                       Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
-                      *(Variable(p.name, fmi_unit(p.unit), p.value, p.description) for p in doc.parameters.values()))
+                      *(Variable(p.name, fmi_unit(p.unit), p.value, p.description, *_fmi_range(p))
+                        for p in doc.parameters.values()))
         names = [v.name for v in (*inputs, *outputs, *parameters)]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:

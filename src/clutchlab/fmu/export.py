@@ -489,15 +489,20 @@ def unit_definition(unit: str) -> ET.Element:
     return elem
 
 
-def _add_units(xml_bytes: bytes, units: dict) -> bytes:
-    """modelDescription.xml with ``unit`` attributes, ``<UnitDefinitions>`` and ``<InitialUnknowns>``."""
+def _add_units(xml_bytes: bytes, units: dict, ranges: dict | None = None) -> bytes:
+    """modelDescription.xml with ``unit`` attributes, ``min``/``max`` of the parameters with a range
+    (``ranges``: name -> (min or None, max or None)), ``<UnitDefinitions>`` and ``<InitialUnknowns>``."""
     root = ET.fromstring(xml_bytes)
     used = []
+    ranges = ranges or {}
     for sv in root.iter("ScalarVariable"):
         unit = units.get(sv.get("name"))
         real = sv.find("Real")
         if unit is None or real is None:
             continue
+        for attr, value in zip(("min", "max"), ranges.get(sv.get("name"), (None, None))):
+            if value is not None:
+                real.set(attr, repr(float(value)))
         real.set("unit", unit)
         if unit not in used:
             used.append(unit)
@@ -650,6 +655,9 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None, p
     except ImportError as exc:  # pragma: no cover - pythonfmu is in the test extras
         raise ClutchlabError(f"export-fmu needs pythonfmu ({exc}); pip install pythonfmu") from None
     units = {v.name: v.unit for group in (cls.parameters, cls.inputs, cls.outputs) for v in group}
+    # a parameter's declared range (a component's Field): FMI min/max, inclusive; "> 0" is written as min 0
+    ranges = {v.name: (0.0 if v.positive and (v.minimum is None or v.minimum < 0) else v.minimum, v.maximum)
+              for v in cls.parameters if v.minimum is not None or v.maximum is not None or v.positive}
     with tempfile.TemporaryDirectory(prefix="clutchlab_fmu_") as tmp:
         tmp = Path(tmp)
         script = tmp / "src" / f"{ident.lower()}_slave.py"
@@ -679,7 +687,7 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None, p
             for info in src.infolist():
                 data = src.read(info.filename)
                 if info.filename == "modelDescription.xml":
-                    data = _add_units(data, units)
+                    data = _add_units(data, units, ranges)
                 if info.filename == linux_lib and shim is not None:
                     dst.writestr(f"binaries/linux64/{ident}_pythonfmu.so", data)  # pythonfmu's, unmodified
                     data = shim

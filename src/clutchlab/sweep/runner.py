@@ -384,10 +384,15 @@ def _die_with_parent(parent_pid: int, poll: float = 0.5) -> None:
     threading.Thread(target=watch, name="clutchlab-sweep-parent-watchdog", daemon=True).start()
 
 
-def _worker_init(parent_pid: int | None = None):
-    """Die with the parent; one compiled thread per worker process (the processes are the parallelism)."""
+def _worker_init(parent_pid: int | None = None, components=()):
+    """Die with the parent; one compiled thread per worker process (the processes are the parallelism); the
+    parent's registered components (:func:`clutchlab.component.component_sources`: a component registered by a
+    module of the user's, not only by an installed package's entry point, is known to the workers too)."""
     if parent_pid is not None:
         _die_with_parent(parent_pid)
+    from ..component import load_component_sources
+
+    load_component_sources(components)
     try:
         import numba
 
@@ -404,8 +409,10 @@ def _run_local(spec, todo, write, bar):
 
 def _run_processes(spec, todo, write, bar, workers):
     ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold compiled thread pools
+    from ..component import component_sources
+
     with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
-                                initargs=(os.getpid(),)) as pool:
+                                initargs=(os.getpid(), component_sources())) as pool:
         futures = {pool.submit(compute_chunk, spec.target, spec.scenario, spec.outputs, spec.chunk(k)): k for k in todo}
         try:
             for fut in cf.as_completed(futures):

@@ -1,0 +1,277 @@
+"""The network's own component kinds, declared once (:mod:`clutchlab.component`).
+
+Each declaration gives a component's table name in a network file, its fields (ports and parameters with
+their unit, default, physical range, description and source) and the function that adds it to a
+:class:`~clutchlab.driveline.Driveline`.  The file format (:mod:`clutchlab.driveline.description`), the
+parameters of sweeps and FMUs (:mod:`clutchlab.driveline.variants`), ``clutchlab driveline components``
+and docs/components.md are generated from these declarations; a component of a package of its own is
+declared the same way and registered with :func:`clutchlab.component.register_component` or the
+entry-point group ``clutchlab.components`` (docs/architecture.md, "Adding a component").
+
+The ranges are physical, not the ranges of the examples: an inertia, a stiffness or a normal force has no
+upper limit here (the parameter sets of the models have theirs, :mod:`clutchlab.params`); a friction
+coefficient lies in [0, 2] (dry and wet clutch linings 0.05-0.6, rubber on dry asphalt up to about 1.2), an
+efficiency in (0, 1], a static-to-sliding ratio ``peak`` at least 1 (MSL ``peak >= 1``).  The defaults are
+those of the :class:`~clutchlab.driveline.Driveline` methods (a test compares them).
+"""
+
+from __future__ import annotations
+
+from ..component import Component, Field, register_component
+from ..errors import ParameterError
+
+__all__ = ["BUILTIN"]
+
+_ABS_ZERO_C = -273.15
+_MSL = "Modelica.Mechanics.Rotational"
+
+
+def _flange(name, description, required=True):
+    return Field(name, "flange", required=required, description=description)
+
+
+_A = _flange("a", "flange a: the body (an inertia, or \"ground\") on its driving side")
+_B = _flange("b", "flange b: the body on its driven side")
+_FLANGE = _flange("flange", "the body it acts on")
+_SUPPORT = _flange("support", "the body its reaction acts on (default the ground)", required=False)
+
+
+def _friction_fields(fn_required=True, fn_default=None, with_map=True):
+    fields = [
+        Field("fn_max", "quantity", "N", required=fn_required, default=fn_default, minimum=0.0,
+              description="largest normal force; the normal force is fn_max * normal(t)"),
+        Field("mu", "characteristic", "1", default=0.5, minimum=0.0, maximum=2.0,
+              description="sliding friction coefficient: a number or rows [w_rad_s, mu] over |w_rel|",
+              source="physical range: linings and tyres stay below 2"),
+        Field("peak", "quantity", "1", default=1.0, minimum=1.0,
+              description="static limit over the sliding torque at rest", source=f"{_MSL}.Components.Clutch"),
+        Field("cgeo", "quantity", "1", default=1.0, positive=True,
+              description="geometry constant: torque = cgeo * fn * mu (MSL's unitless Real; physically an "
+                          "effective radius times the number of friction surfaces)"),
+        Field("normal", "signal", "1", default=1.0,
+              description="normal-force signal, 0-1 (free where <= 0)"),
+    ]
+    if with_map:
+        fields += [
+            Field("mu_map", "path", description="a friction map .json of clutchlab wet identify (instead of mu)"),
+            Field("radius", "quantity", "m", positive=True,
+                  description="radius at which a friction map is read (slip velocity = radius |w_rel|)"),
+            Field("temperature", "quantity", "degC", minimum=_ABS_ZERO_C,
+                  description="friction-surface temperature a friction map is read at"),
+        ]
+    return tuple(fields)
+
+
+def _mu_of(args):
+    if "mu_map" in args:
+        from ..wet.friction import FrictionMap
+
+        if "mu" in args:
+            raise ParameterError("give mu or mu_map, not both")
+        args["mu"] = FrictionMap.from_json(args.pop("mu_map"))
+    return args
+
+
+def _inertia(net, name, **args):
+    if net.domain == "translational":
+        net.mass(name, args.pop("J"), v0=args.pop("w0", None), s0=args.pop("phi0", None))
+    else:
+        net.inertia(name, **args)
+
+
+def _source(kind):
+    def build(net, name, **args):
+        flange = args.pop("flange")
+        signal = args.pop(kind)
+        if kind == "torque" and net.domain == "translational":
+            net.force(name, flange, signal, **args)
+        else:
+            getattr(net, kind)(name, flange, signal, **args)
+    return build
+
+
+def _spring(net, name, **args):
+    from ..curves import Curve
+
+    rows = args.pop("curve")
+    if len(rows) < 2:
+        raise ParameterError(f"curve needs at least 2 rows, got {len(rows)}")
+    args["curve"] = Curve([r[0] for r in rows], [r[1] for r in rows], kind=args.pop("interpolation", "linear"),
+                          name=name)
+    net.spring(name, **args)
+
+
+def _wet_clutch(net, name, **args):
+    from ..wet.friction import FrictionMap, ParametricFriction
+    from ..wet.params import Bench, WetClutch
+
+    if "clutch" in args:
+        args["clutch"] = WetClutch.from_toml(args["clutch"])
+    if "bench" in args:
+        args["bench"] = Bench.from_toml(args["bench"])
+    if "friction" in args:
+        path = args["friction"]
+        args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
+                            else ParametricFriction.from_toml(path))
+    net.wet_clutch(name, **args)
+
+
+def _emtc(net, name, **args):
+    from ..hysteresis import Preisach
+
+    if "bench" in args:
+        from ..emtc.bench import load_scenario
+        from ..emtc.system import BenchOptions
+
+        path = args.pop("bench")
+        bench = load_scenario(path)
+        if bench["magnet"] is not None:
+            raise ParameterError(f"bench = {path.name!r} names a magnet in its [magnet] table: give the model "
+                                 "as this component's magnet field instead")
+        args.update(scenario=bench["scenario"], vehicle=bench["vehicle"],
+                    options=BenchOptions(actuator=bench["actuator"], coupling=bench["coupling"]))
+    if "magnet" in args:
+        args["magnet"] = Preisach.from_json(args["magnet"])
+    net.emtc(name, **args)
+
+
+def _method(kind):
+    def build(net, name, **args):
+        getattr(net, kind)(name, **args)
+    build.__name__ = f"_{kind}"
+    return build
+
+
+def _clutch_like(kind):
+    def build(net, name, **args):
+        getattr(net, kind)(name, **_mu_of(args))
+    return build
+
+
+_BOTH = ("rotational", "translational")
+
+#: the built-in component kinds, in the order of the docs
+BUILTIN = (
+    Component("inertia", "A rigid inertia (a mass in a translational network).", (
+        Field("J", "quantity", "kg*m**2", required=True, positive=True, description="moment of inertia"),
+        Field("w0", "quantity", "rad/s", default=0.0,
+              description="initial speed; left out it follows from the gears and motion sources that bind this "
+                          "body to another (0 without any)"),
+        Field("phi0", "quantity", "rad", default=0.0,
+              description="initial angle; left out it follows from a position source (0 without one)"),
+    ), _inertia, f"{_MSL}.Components.Inertia", _BOTH, ("mass", {"J": "m", "w0": "v0", "phi0": "s0"})),
+    Component("spring_damper", "A linear spring and a damper in parallel: tau = c (phi_rel - phi_rel0) + d w_rel.", (
+        _A, _B,
+        Field("c", "quantity", "N*m/rad", default=0.0, minimum=0.0, description="stiffness"),
+        Field("d", "quantity", "N*m*s/rad", default=0.0, minimum=0.0, description="damping"),
+        Field("phi_rel0", "quantity", "rad", default=0.0, description="unstretched relative angle"),
+    ), _method("spring_damper"), f"{_MSL}.Components.SpringDamper", _BOTH),
+    Component("spring", "A nonlinear spring (a curve of the relative angle) and a damper in parallel.", (
+        _A, _B,
+        Field("curve", "curve", "N*m", required=True, description="rows [phi_rel, tau] of the spring"),
+        Field("interpolation", "choice", default="linear", choices=("linear", "pchip"),
+              description="between the rows: piecewise linear or monotone cubic"),
+        Field("d", "quantity", "N*m*s/rad", default=0.0, minimum=0.0, description="damping"),
+        Field("phi_rel0", "quantity", "rad", default=0.0, description="unstretched relative angle"),
+    ), _spring, "clutchlab.curves.Curve, energy as its exact integral", _BOTH),
+    Component("backlash", "A spring-damper behind a gap (MSL ElastoBacklash).", (
+        _A, _B,
+        Field("c", "quantity", "N*m/rad", required=True, positive=True, description="contact stiffness"),
+        Field("b_gap", "quantity", "rad", required=True, positive=True, description="total backlash"),
+        Field("d", "quantity", "N*m*s/rad", default=0.0, minimum=0.0, description="contact damping"),
+        Field("phi_rel0", "quantity", "rad", default=0.0, description="relative angle of the gap's centre"),
+        Field("damping_law", "choice", default="kelvin_voigt", choices=("kelvin_voigt", "msl"),
+              description="kelvin_voigt: damping with contact; msl: ElastoBacklash's limited damping"),
+    ), _method("backlash"), f"{_MSL}.Components.ElastoBacklash", _BOTH),
+    Component("gear", "A gear on a support: ideal, or lossy with MSL LossyGear's efficiencies and bearing friction.", (
+        _A, _B,
+        Field("ratio", "quantity", "1", required=True, description="w_a / w_b (not 0)"),
+        Field("efficiency", "quantity", "1", default=1.0, positive=True, maximum=1.0,
+              description="mesh efficiency in both directions (instead of loss_table)"),
+        Field("loss_table", "losstable", description="MSL lossTable rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]"),
+        _SUPPORT,
+    ), _method("gear"), f"{_MSL}.Components.IdealGear, LossyGear", _BOTH),
+    Component("torque", "A torque source (a force source in a translational network).", (
+        _FLANGE,
+        Field("torque", "signal", "N*m", required=True, description="torque on the flange"),
+        _SUPPORT,
+    ), _source("torque"), f"{_MSL}.Sources.Torque", _BOTH, ("force", {"torque": "force"})),
+    Component("speed", "A speed source: the flange follows the signal, whatever torque it takes.", (
+        _FLANGE,
+        Field("speed", "signal", "rad/s", required=True, description="speed of the flange (continuous)"),
+    ), _source("speed"), f"{_MSL}.Sources.Speed (exact = true)", _BOTH),
+    Component("position", "A position source: the flange follows the signal.", (
+        _FLANGE,
+        Field("position", "signal", "rad", required=True,
+              description="angle of the flange (a constant or a sine starting at 0)"),
+    ), _source("position"), f"{_MSL}.Sources.Position (exact = true)", _BOTH),
+    Component("clutch", "A clutch between two flanges: sliding torque cgeo fn mu(|w_rel|), static limit peak times "
+                        "that at rest.", (_A, _B, *_friction_fields()),
+              _clutch_like("clutch"), f"{_MSL}.Components.Clutch", _BOTH),
+    Component("brake", "A brake between a flange and its support (the ground by default).", (
+        _FLANGE, *_friction_fields(), _SUPPORT,
+    ), _clutch_like("brake"), f"{_MSL}.Components.Brake", _BOTH),
+    Component("bearing_friction", "Bearing friction against a support; never free.", (
+        _FLANGE,
+        Field("torque", "characteristic", "N*m", default=1.0, minimum=0.0,
+              description="sliding torque: a number or rows [w_rad_s, tau] over |w_rel|"),
+        Field("peak", "quantity", "1", default=1.0, minimum=1.0, description="static limit over the sliding torque "
+                                                                               "at rest"),
+        _SUPPORT,
+    ), _method("bearing_friction"), f"{_MSL}.Components.BearingFriction", _BOTH),
+    Component("one_way_clutch", "A freewheel in parallel with a clutch: flange b may overrun flange a.", (
+        _A, _B, *_friction_fields(fn_required=False, fn_default=0.0, with_map=False),
+    ), _method("one_way_clutch"), f"{_MSL}.Components.OneWayClutch", _BOTH),
+    Component("eclutch", "The dry E-clutch of seed 000: torque 2 F_n r_eff mu, F_n from its axial Model 0-4 at the "
+                         "release-bearing position, or from its actuator.", (
+        _A, _B,
+        Field("position", "signal", "m", required=True,
+              description="release-bearing position (0 engaged); with actuator = true its actuator's reference"),
+        Field("model", "int", default=4, minimum=0, maximum=4, description="axial model 0-4"),
+        Field("parameters", "path", description="an E-clutch parameter file (default the paper's)"),
+        Field("travel", "quantity", "m", default=8e-3, positive=True,
+              description="bearing travel over which the static curve is solved"),
+        Field("points", "int", default=161, minimum=2, description="positions the static curve is solved at"),
+        Field("peak", "quantity", "1", default=1.0, minimum=1.0, description="static limit over the sliding torque"),
+        Field("actuator", "bool", default=False,
+              description="drive the clutch through its hydrostatic actuator and position controller"),
+        Field("actuator_step", "quantity", "s", default=1e-3, positive=True,
+              description="sample interval of the actuator's normal-force profile"),
+        Field("pre_roll", "quantity", "s", default=1.0, minimum=0.0,
+              description="actuator run before t = 0 (settles its controller)"),
+        Field("settle", "quantity", "s", default=0.5, minimum=0.0, description="actuator run after the reference ends"),
+    ), _method("eclutch"), "seed 000, Sec. 3.2"),
+    Component("engine", "A combustion engine: torque map(w, throttle) plus an optional idle-speed PI controller.", (
+        _FLANGE,
+        Field("torque_map", "map", required=True,
+              description="{ speeds, throttles, torques } (bilinear) or full-load rows [[w, T], ...]"),
+        Field("throttle", "signal", "1", default=1.0, description="throttle, 0-1"),
+        Field("idle_speed", "quantity", "rad/s", positive=True,
+              description="set speed of the idle controller (left out: no controller)"),
+        Field("idle_kp", "quantity", "N*m*s/rad", default=2.0, minimum=0.0, description="idle controller's gain"),
+        Field("idle_ki", "quantity", "N*m/rad", default=20.0, minimum=0.0, description="idle controller's integral gain"),
+        Field("idle_torque_max", "quantity", "N*m", default=50.0, minimum=0.0, description="idle torque limit"),
+        _SUPPORT,
+    ), _method("engine"), "mean-value engine (torque map)"),
+    Component("wet_clutch", "The wet clutch of seed 001 with its actuator, piston, squeeze film and temperatures.", (
+        _A, _B,
+        Field("force", "signal", "N", required=True, description="actuator force reference (constant, ramp or table)"),
+        Field("clutch", "path", description="a wet-clutch parameter file (default WetClutch.paper())"),
+        Field("bench", "path", description="a bench parameter file: actuator, oil loop, housing (default Bench())"),
+        Field("friction", "path", description="a friction law (.toml) or an identified map (.json)"),
+        Field("temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+              description="initial pack temperature"),
+        Field("fluid_temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+              description="initial oil temperature (the heater's set point)"),
+        Field("housing_temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+              description="initial housing temperature"),
+    ), _wet_clutch, "seed 001, Eqs. 1-8"),
+    Component("emtc", "The electromagnetic torque-controlled coupling of seed 002 with its controller.", (
+        _flange("a", "its input shaft (front)"), _flange("b", "its output shaft (rear)"),
+        Field("bench", "path", description="an EMTC scenario file (its [scenario], [vehicle], [actuator], "
+                                           "[coupling] tables; no [magnet])"),
+        Field("magnet", "path", description="a Preisach model .json (default the bundled synthetic one)"),
+    ), _emtc, "seed 002, Eqs. 1-26 and 31"),
+)
+for _c in BUILTIN:
+    register_component(_c)

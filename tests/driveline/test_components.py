@@ -1,0 +1,308 @@
+"""The component contract (clutchlab.component): declarations, the file format, parameters and docs generated
+from them, and a component added from outside -- the toy cone clutch of tests/_support/cone_clutch.py, one
+file and one registration -- used in a TOML driveline, simulate, a sweep and control.linearize (its FMU:
+tests/fmu/test_cone_clutch_fmu.py).
+
+Closed form of the cone clutch between two free inertias (Shigley Sec. 16-4): it slides with the constant
+torque ``T = mu F_a r_m / sin(alpha)``, braking J1 and driving J2, so the relative speed falls linearly and
+it locks at ``t* = w0 / (T (1/J1 + 1/J2))``; then both turn at ``J1 w0 / (J1 + J2)`` and it has dissipated
+``w0^2 J1 J2 / (2 (J1 + J2))``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import cone_clutch
+from cli_checks import one_line_error
+from clutchlab import component as C
+from clutchlab.cli import main
+from clutchlab.driveline import BUILTIN, Driveline
+from clutchlab.driveline.description import load_driveline, parse_driveline
+from clutchlab.driveline.variants import DrivelineDocument
+from clutchlab.errors import ParameterError
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "components.md"
+
+J1, J2, W0, F, R, ALPHA, MU = 0.1, 0.3, 100.0, 500.0, 0.05, math.radians(12.0), 0.3
+
+CONE = f"""
+[driveline]
+name = "cone"
+
+[simulation]
+t_end = "0.4 s"
+output_step = "1 ms"
+rtol = 1e-10
+
+[inertia.J1]
+J = "{J1} kg m^2"
+w0 = "{W0} rad/s"
+
+[inertia.J2]
+J = "{J2} kg m^2"
+
+[cone_clutch.c]
+a = "J1"
+b = "J2"
+force = "{F} N"
+r_mean = "{R * 1e3} mm"
+alpha = "12 deg"
+mu = {MU}
+"""
+
+
+def lock_time(force=F, r_mean=R, alpha=ALPHA, mu=MU):
+    torque = mu * force * r_mean / math.sin(alpha)
+    return W0 / (torque * (1 / J1 + 1 / J2))
+
+
+@pytest.fixture
+def cone():
+    """The cone clutch registered for one test (the one line a user writes), and gone after it."""
+    C.register_component(cone_clutch.CONE_CLUTCH)
+    yield cone_clutch.CONE_CLUTCH
+    C.unregister_component("cone_clutch")
+
+
+# ---- the declarations of the built-in kinds
+
+#: fields the component's build function reads into another argument of the method (a spring's rows and their
+#: interpolation are its curve; a friction map file is its mu; an EMTC scenario file its scenario, vehicle, options)
+BUILDER_ONLY = {("spring", "interpolation"), ("clutch", "mu_map"), ("brake", "mu_map"), ("emtc", "bench")}
+
+def test_every_builtin_kind_is_declared_with_the_defaults_of_its_method():
+    kinds = {c.kind for c in BUILTIN}
+    assert kinds == {"inertia", "spring_damper", "spring", "backlash", "gear", "torque", "speed", "position", "clutch",
+                     "brake", "bearing_friction", "one_way_clutch", "eclutch", "engine", "wet_clutch", "emtc"}
+    for comp in BUILTIN:
+        sig = inspect.signature(getattr(Driveline, comp.kind)).parameters
+        for f in comp.fields:
+            if (comp.kind, f.name) in BUILDER_ONLY:
+                continue
+            # the file's keys are the method's arguments (a source's signal is its table's own name)
+            arg = "signal" if f.name == comp.kind and comp.kind in ("torque", "speed", "position") else f.name
+            assert arg in sig, (comp.kind, f.name)
+            p = sig[arg]
+            if f.required:
+                assert p.default is inspect.Parameter.empty or f.kind == "signal", (comp.kind, f.name)
+            elif f.name in ("w0", "phi0"):
+                assert p.default is None and f.default == 0.0  # left out: worked out; varied from 0
+            elif isinstance(p.default, (int, float)) and not isinstance(p.default, bool) and f.kind != "flange":
+                assert f.default == p.default, (comp.kind, f.name, f.default, p.default)
+            if f.default is not None and f.is_numeric:
+                assert f.range_problem(float(f.default)) is None
+
+
+def test_the_docs_tables_are_generated_from_the_declarations():
+    text = DOCS.read_text()
+    start, end = "<!-- generated: components -->", "<!-- end generated -->"
+    assert start in text and end in text
+    generated = text.split(start)[1].split(end)[0].strip()
+    want = "\n".join(C.component_table(c.kind) for c in BUILTIN).strip()
+    assert generated == want, "docs/components.md is out of date: regenerate it (docs/components.md, top)"
+
+
+def test_declarations_are_checked():
+    with pytest.raises(ParameterError, match="kind = 'number'"):
+        C.Field("x", "number")
+    with pytest.raises(ParameterError, match="default 3.0 is above its range"):
+        C.Field("mu", "quantity", default=3.0, maximum=2.0)
+    with pytest.raises(ParameterError, match="minimum 2 > maximum 1"):
+        C.Field("x", minimum=2, maximum=1)
+    with pytest.raises(ParameterError, match="a choice needs its words"):
+        C.Field("law", "choice")
+    with pytest.raises(ParameterError, match="field 'a' is declared twice"):
+        C.Component("twice", "", (C.Field("a", "flange"), C.Field("a", "flange")), print)
+    with pytest.raises(ParameterError, match="kind 'clutch' is registered already"):
+        C.register_component(C.Component("clutch", "another clutch", (), print))
+    with pytest.raises(ParameterError, match="did you mean 'clutch'"):
+        C.component("clutc")
+    f = C.Field("eta", positive=True, maximum=1.0)
+    assert (f.range_text(), f.range_problem(0.0), f.range_problem(1.0)) == ("(0, 1]", "must be > 0 [1]", None)
+    assert C.Field("T", unit="N*m", minimum=0.0).range_text() == ">= 0 N*m"
+
+
+@pytest.mark.parametrize("body, fragments", [
+    ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "1 N"\nmu = 3\n', ["clutch.c.mu = 3", "above its range [0, 2]"]),
+    ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "1 N"\nmu = [[0, 0.5], [1, -0.1]]\n',
+     ["clutch.c.mu[1][1] = -0.1", "below its range [0, 2]"]),
+    ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "1 N"\npeak = 0.5\n', ["clutch.c.peak = 0.5", "below its range"]),
+    ('[gear.g]\na = "J1"\nb = "J2"\nratio = 2\nefficiency = 1.5\n', ["gear.g.efficiency = 1.5", "(0, 1]"]),
+    ('[clutch.c]\na = "J1"\nb = "J2"\nfn_max = "-1 N"\n', ["clutch.c.fn_max = '-1 N'", ">= 0 N"]),
+    ('[wet_clutch.w]\na = "J1"\nb = "J2"\nforce = "1 kN"\ntemperature0 = "-300 degC"\n',
+     ["wet_clutch.w.temperature0 = '-300 degC'", "below its range >= -273.15 degC"]),
+])
+def test_values_outside_their_declared_range_are_refused_naming_file_key_value_and_range(tmp_path, body, fragments):
+    path = tmp_path / "bad.toml"
+    path.write_text('[inertia.J1]\nJ = 1\n[inertia.J2]\nJ = 1\n' + body)
+    with pytest.raises(ParameterError) as exc:
+        load_driveline(path)
+    for fragment in [str(path), *fragments]:
+        assert fragment in str(exc.value), str(exc.value)
+
+
+def test_parameters_carry_their_declared_range():
+    doc = DrivelineDocument(__import__("tomllib").loads(
+        '[inertia.J1]\nJ = 1\n[gear.g]\na = "J1"\nb = "ground"\nratio = 2\n'), "mem.toml")
+    eff = doc.parameters["g.efficiency"]
+    assert (eff.value, eff.minimum, eff.maximum, eff.positive) == (1.0, None, 1.0, True)
+    assert doc.parameters["J1.J"].positive and doc.parameters["J1.w0"].range_problem(-5.0) is None
+    assert "range" not in (doc.parameters["g.efficiency"].range_problem(0.5) or "")
+    with pytest.raises(ParameterError, match=r"mem\.toml with g\.efficiency = 1\.2: gear\.g\.efficiency = 1\.2: "
+                                             r"is above its range \(0, 1\]"):
+        doc.load({"g.efficiency": 1.2})
+
+
+def test_the_components_command_lists_the_kinds_and_prints_a_kinds_fields(capsys, cone):
+    assert main(["driveline", "components"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"^clutch +A clutch between two flanges", out, re.M)
+    assert re.search(r"^cone_clutch +A cone clutch.*\[cone_clutch\]$", out, re.M)  # where it comes from
+    assert main(["driveline", "components", "cone_clutch"]) == 0
+    out = capsys.readouterr().out
+    assert "| `alpha` | quantity | rad | 0.20944 | (0, 1.5708] rad | cone half-angle" in out
+    err = one_line_error(capsys, ["driveline", "components", "cone"])
+    assert "unknown component kind 'cone'" in err and "did you mean 'cone_clutch'" in err
+
+
+# ---- a component from outside: the cone clutch
+
+def test_an_unregistered_kind_is_an_unknown_table(tmp_path):
+    path = tmp_path / "cone.toml"
+    path.write_text(CONE)
+    with pytest.raises(ParameterError, match=r"unknown table \[cone_clutch\]"):
+        load_driveline(path)
+
+
+def test_the_cone_clutch_in_a_file_follows_its_closed_form(tmp_path, cone):
+    path = tmp_path / "cone.toml"
+    path.write_text(CONE)
+    spec = load_driveline(path)
+    res = spec.driveline.simulate(spec.t_end, output_step=spec.output_step, rtol=spec.rtol)
+    ev = res.events
+    assert list(zip(ev.element, ev.event)) == [("c", "stick")]
+    t_lock = lock_time()
+    assert abs(ev.time_s.iloc[0] - t_lock) < 1e-9 * t_lock + 1e-12
+    df = res.to_dataframe()
+    torque = MU * F * R / math.sin(ALPHA)
+    slip = df.time_s < t_lock - 1e-3
+    np.testing.assert_allclose(np.abs(df["c.tau_Nm"][slip]), torque, rtol=1e-12)
+    np.testing.assert_allclose(df["c.fn_N"], F, rtol=1e-15)   # the axial force is the element's normal force
+    last = df.iloc[-1]
+    w_end = J1 * W0 / (J1 + J2)
+    assert abs(last["J1.w_rad_s"] - w_end) < 1e-8 and abs(last["J2.w_rad_s"] - w_end) < 1e-8
+    assert last["c.dissipated_J"] == pytest.approx(W0**2 * J1 * J2 / (2 * (J1 + J2)), rel=1e-9)
+    assert abs(last["energy_error_J"]) < 1e-8
+    # its parameters are the declaration's: defaults, units and ranges, for sweeps and FMUs
+    doc = DrivelineDocument.read(path)
+    p = doc.parameters
+    assert (p["c.alpha"].value, p["c.alpha"].unit, p["c.alpha"].maximum) == (pytest.approx(ALPHA), "rad", math.pi / 2)
+    assert (p["c.r_mean"].value, p["c.peak"].value, p["c.force"].value) == (pytest.approx(R), 1.0, F)
+    # and the command line runs it
+    assert main(["driveline", "simulate", str(path), "-o", str(tmp_path / "out.csv"),
+                 "--events", str(tmp_path / "ev.csv")]) == 0
+    ev_cli = pd.read_csv(tmp_path / "ev.csv")
+    assert abs(ev_cli.time_s.iloc[0] - t_lock) < 1e-9
+
+
+def test_a_flat_disc_is_the_networks_clutch(tmp_path, cone):
+    """alpha = 90 deg: the cone is a disc, T = mu F r_m: the network's own clutch with cgeo = r_m."""
+    path = tmp_path / "cone.toml"
+    path.write_text(CONE.replace('alpha = "12 deg"', 'alpha = "90 deg"'))
+    a = load_driveline(path).driveline.simulate(0.4, output_step=1e-3, rtol=1e-10).to_dataframe()
+    d = Driveline("disc")
+    d.inertia("J1", J1, w0=W0).inertia("J2", J2).clutch("c", "J1", "J2", fn_max=F, mu=MU, cgeo=R)
+    b = d.simulate(0.4, output_step=1e-3, rtol=1e-10).to_dataframe()
+    for col in ("J1.w_rad_s", "J2.w_rad_s", "c.tau_Nm", "c.dissipated_J"):
+        np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12, err_msg=col)
+
+
+SWEEP = """
+[sweep]
+model = "driveline"
+scenario = "cone.toml"
+outputs = ["c.last_stick_s", "c.dissipated_J", "J2.w_final_rad_s", "c.peak_tau_Nm"]
+chunk_size = 2
+
+[grid]
+"c.alpha" = ["10 deg", "15 deg"]
+"c.r_mean" = ["40 mm", "60 mm"]
+"""
+
+
+def test_a_sweep_over_the_cone_in_worker_processes_follows_the_closed_form(tmp_path, capsys, cone):
+    """Two worker processes (spawned: they import the modules of the parent's registered components)."""
+    (tmp_path / "cone.toml").write_text(CONE)
+    (tmp_path / "sweep.toml").write_text(SWEEP)
+    out = tmp_path / "res"
+    assert main(["sweep", str(tmp_path / "sweep.toml"), "-o", str(out), "--workers", "2", "--no-progress",
+                 "--no-plot"]) == 0
+    frame = pd.read_parquet(out / "results.parquet")
+    assert len(frame) == 4
+    for row in frame.to_dict("records"):
+        t_lock = lock_time(r_mean=row["c.r_mean"], alpha=row["c.alpha"])
+        assert abs(row["c.last_stick_s"] - t_lock) < 1e-8, row
+        assert row["c.peak_tau_Nm"] == pytest.approx(MU * F * row["c.r_mean"] / math.sin(row["c.alpha"]), rel=1e-9)
+        assert row["J2.w_final_rad_s"] == pytest.approx(J1 * W0 / (J1 + J2), rel=1e-9)
+        assert row["c.dissipated_J"] == pytest.approx(W0**2 * J1 * J2 / (2 * (J1 + J2)), rel=1e-8)
+    # a value outside the declared range is refused before anything runs, naming it and the range
+    capsys.readouterr()
+    (tmp_path / "bad.toml").write_text(SWEEP.replace('"c.alpha" = ["10 deg", "15 deg"]', '"c.alpha" = ["100 deg"]'))
+    err = one_line_error(capsys, ["sweep", str(tmp_path / "bad.toml"), "-o", str(tmp_path / "bad"), "--no-progress"])
+    assert "c.alpha" in err and "above its range (0, 1.5708] rad" in err
+
+
+def test_the_cone_clutch_linearises_in_its_two_modes(tmp_path, cone):
+    """A load torque on J1 (a network input): locked, the pair is one inertia, 1 / ((J1 + J2) s) to either
+    speed; slipping (constant mu), the clutch torque does not depend on the speeds, so J1 alone answers,
+    1 / (J1 s), and J2 not at all."""
+    import control as ct
+
+    from clutchlab.control import linearize
+
+    text = CONE.replace("[inertia.J2]", "[torque.load]\nflange = \"J1\"\ntorque = { input = \"load\" }\n\n"
+                                        "[input.load]\nstart = \"1 N m\"\n\n[inertia.J2]")
+    for w2, want in ((W0, {"J1.w": 1 / (J1 + J2), "J2.w": 1 / (J1 + J2)}), (0.0, {"J1.w": 1 / J1, "J2.w": 0.0})):
+        path = tmp_path / "lin.toml"
+        path.write_text(text.replace(f'[inertia.J2]\nJ = "{J2} kg m^2"', f'[inertia.J2]\nJ = "{J2} kg m^2"\n'
+                                                                         f'w0 = "{w2} rad/s"'))
+        system = load_driveline(path).driveline.system(1e-10)
+        lin = linearize(system, inputs=["load"], outputs=["J1.w", "J2.w"])
+        assert set(lin.mode.values()) == ({"stuck"} if w2 == W0 else {"backward"}), lin.mode
+        for i, (name, gain) in enumerate(want.items()):
+            # an integrator: s G(s) is the gain at every frequency
+            for s in (0.1j, 10j):
+                got = complex(ct.evalfr(lin[i, 0], s)) * s
+                assert abs(got - gain) < 1e-6 * max(1.0, abs(gain)), (name, s, got, gain)
+
+
+def test_a_component_of_an_installed_package_is_found_by_its_entry_point(tmp_path, monkeypatch):
+    """The entry-point group clutchlab.components: a package's dist-info names the declaration; nothing is
+    registered by hand."""
+    site = tmp_path / "site"
+    info = site / "clutchlab_cone_example-1.0.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: clutchlab-cone-example\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text("[clutchlab.components]\ncone_clutch = cone_clutch:CONE_CLUTCH\n")
+    monkeypatch.syspath_prepend(str(site))
+    monkeypatch.setattr(C, "_ENTRY_POINTS_READ", False)
+    C.unregister_component("cone_clutch")
+    try:
+        assert C.component("cone_clutch") is cone_clutch.CONE_CLUTCH
+        spec = parse_driveline(__import__("tomllib").loads(CONE), str(tmp_path / "cone.toml"))
+        assert "c" in spec.driveline.friction_names
+    finally:
+        C.unregister_component("cone_clutch")
+    (info / "entry_points.txt").write_text("[clutchlab.components]\nbroken = cone_clutch:NOTHING\n")
+    monkeypatch.setattr(C, "_ENTRY_POINTS_READ", False)
+    with pytest.raises(ParameterError, match=r"entry point broken = 'cone_clutch:NOTHING'.*does not load"):
+        C.components()
+    monkeypatch.setattr(C, "_ENTRY_POINTS_READ", True)
