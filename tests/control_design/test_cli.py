@@ -104,6 +104,22 @@ def test_emtc_coil_at_a_current_from_the_command_line(tmp_path, capsys):
     assert "--branch 'i2'" in line and not bad.exists()
 
 
+def test_emtc_trimmed_far_from_the_origin_of_time_is_the_same_model(tmp_path, capsys):
+    """``--time 1e12 s --settle 0.5 s`` hung (#33): a run starting far past the controller's samples caught up
+    with them one sample at a time (1e14 of them).  It now starts at the next sample, and the EMTC, whose
+    inputs hold beyond its profiles, linearises there as at 1000 s."""
+    out = {}
+    for t in ("1e12 s", "1000 s"):
+        path = tmp_path / f"lin_{t.split()[0]}.json"
+        assert main(["control", "linearize", "emtc", "--time", t, "--settle", "0.5 s", "-o", str(path)]) == 0
+        out[t] = json.loads(path.read_text())
+    capsys.readouterr()
+    assert out["1e12 s"]["operating_point"]["time_s"] == 1e12
+    for k in "ABCD":
+        a, b = np.array(out["1e12 s"][k]), np.array(out["1000 s"][k])
+        assert np.max(np.abs(a - b)) <= 1e-9 * np.max(np.abs(b)), k
+
+
 SPRING_DAMPER = """
 [driveline]
 name = "sd"

@@ -851,6 +851,8 @@ def _restart(t, x, u, m, p, log):
     if t >= k * ts - 1e-9 * ts:  # a controller sample is due (break time, or a resumed run that starts on it)
         _controller(t, x, u, p)
         k += 1
+        if k * ts <= t + 1e-9 * ts:   # a run that starts far past the samples so far (a trim at t = 1e12 s, #33):
+            k = int(np.floor((t + 1e-9 * ts) / ts))   # to the next sample at once, not one sample at a time
         while k * ts <= t + 1e-9 * ts:
             k += 1
         imem[IM_KNEXT] = k
