@@ -40,8 +40,25 @@ def test_model_description_lists_every_variable_with_causality_and_unit(build_fm
         assert (mv.causality, mv.variability, mv.type, mv.unit) == (causality, variability, "Real", var.unit)
         if causality != "output":
             assert float(mv.start) == pytest.approx(var.start, rel=1e-15)
+        if causality == "parameter":   # the declared range (a parameter set's checks) as min and max
+            lo = 0.0 if var.positive and (var.minimum is None or var.minimum < 0) else var.minimum
+            assert (mv.min, mv.max) == tuple(None if b is None else repr(float(b)) for b in (lo, var.maximum))
+            assert (lo is None or float(mv.start) >= lo) and (var.maximum is None or float(mv.start) <= var.maximum)
     assert {u.name for u in md.unitDefinitions} == {v.unit for v, _, _ in expected}
     assert {o.variable.name for o in md.outputs} == {v.name for v in cls.outputs}
+
+
+def test_parameter_set_fields_carry_their_checks_as_ranges():
+    """A parameter set's checks (bounds, sign, the plausibility limit of the unit) are the FMU's min and max, and
+    the co-simulation refuses a value outside them naming it."""
+    from clutchlab.fmu.cosim import load_cosimulation
+
+    cls = load_cosimulation("wet")
+    v = {p.name: p for p in cls.parameters}
+    assert (v["clutch.r_outer"].minimum, v["clutch.r_outer"].maximum, v["clutch.r_outer"].positive) == (0.0, 100.0, True)
+    assert (v["bench.ambient_temperature"].minimum, v["bench.ambient_temperature"].maximum) == (-273.15, 1e4)
+    with pytest.raises(ParameterError, match=r"'clutch\.r_outer' = -0\.1 is outside its range \(0, 100\] \[m\]"):
+        cls(**{"clutch.r_outer": -0.1})
 
 
 def test_unit_definitions_carry_si_base_units():

@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..params.base import field_range
 from .registry import COSIMULATIONS
 
 __all__ = [
@@ -294,7 +295,8 @@ def parameter_set_variables(prefix: str, cls, skip=()) -> tuple:
     -------
     tuple of Variable
         Scalars as ``prefix.field``, tuples as ``prefix.field[i]`` (1-based,
-        FMI structured naming); units and descriptions from the field metadata.
+        FMI structured naming); units, descriptions and ranges (:func:`clutchlab.params.base.field_range`)
+        from the field metadata.
     """
     out = []
     default = cls()
@@ -304,11 +306,13 @@ def parameter_set_variables(prefix: str, cls, skip=()) -> tuple:
         value = getattr(default, f.name)
         unit = fmi_unit(f.metadata["unit"])
         doc = f.metadata.get("doc", "")
+        limits = field_range(f.metadata)   # the set's own checks, as the FMU's min and max
         if isinstance(value, tuple):
             for i, v in enumerate(value):
-                out.append(Variable(f"{prefix}.{f.name}[{i + 1}]", unit, float(v), f"{doc} (element {i + 1})"))
+                out.append(Variable(f"{prefix}.{f.name}[{i + 1}]", unit, float(v), f"{doc} (element {i + 1})",
+                                    *limits))
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            out.append(Variable(f"{prefix}.{f.name}", unit, float(value), doc))
+            out.append(Variable(f"{prefix}.{f.name}", unit, float(value), doc, *limits))
     return tuple(out)
 
 

@@ -19,7 +19,7 @@ from .._limits import short_repr
 from ..errors import ParameterError
 from ..units import format_quantity, to_si
 
-__all__ = ["quantity", "ParameterSet", "load_toml", "registered_sets"]
+__all__ = ["quantity", "ParameterSet", "load_toml", "registered_sets", "field_range"]
 
 #: every ParameterSet subclass, in definition order (filled by ``ParameterSet.__init_subclass__``)
 _REGISTERED: list[type] = []
@@ -109,6 +109,27 @@ def _number_problem(value, meta) -> str | None:
     if hi is not None and value > hi:
         return f"above the upper bound {hi} [{meta['unit']}]"
     return None
+
+
+def field_range(meta) -> tuple:
+    """``(minimum, maximum, positive)`` a field with metadata ``meta`` (:func:`quantity`) accepts: its
+    ``bounds``, else the plausibility limit of its unit (:data:`PLAUSIBLE_LIMITS`, the absolute zero for a
+    temperature), ``nonnegative`` as a minimum of 0, ``positive`` as a strict lower bound of 0.  An FMU writes it
+    as a parameter's ``min`` and ``max``.
+
+    Parameters
+    ----------
+    meta : mapping
+        The field's metadata (``dataclasses.fields(cls)[i].metadata``).
+    """
+    lo, hi = meta.get("bounds", (None, None))
+    if lo is None and hi is None:
+        unit = meta.get("unit", "1")
+        limit = PLAUSIBLE_LIMITS.get(unit, (MAGNITUDE_LIMIT, ""))[0]
+        lo, hi = (ABSOLUTE_ZERO_C if unit == "degC" else -limit), limit
+    if meta.get("nonnegative") or meta.get("positive"):
+        lo = 0.0 if lo is None else max(float(lo), 0.0)
+    return (None if lo is None else float(lo)), (None if hi is None else float(hi)), bool(meta.get("positive"))
 
 
 def _check_number(cls_name, fname, value, meta, source):
