@@ -12,6 +12,7 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import assume, given, settings
 
@@ -204,6 +205,57 @@ def test_an_input_reaches_a_network_with_a_wet_clutch():
     sim.advance(0.3)
     held = d.simulate(0.3, rtol=1e-8, output_step=0.3, inputs={"load": -20.0}).to_dataframe()
     assert sim.x[len(d._inertias)] == pytest.approx(held["dyno.w_rad_s"].to_numpy()[-1], rel=1e-7)
+
+
+def _wet_sae2(force, start=None):
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    text = (examples / "driveline_wet_sae2.toml").read_text()
+    old = 'force = { table = { times = [0.0, 0.05, 0.25], values = ["0 N", "0 N", "3 kN"] } }'
+    assert old in text
+    text = text.replace(old, force) + ("" if start is None else f'\n[input.F]\nstart = "{start}"\n')
+    return parse_driveline(tomllib.loads(text), "wet_force.toml", examples).driveline
+
+
+def test_a_wet_clutchs_force_is_a_network_input():
+    """The wet clutch's force as a network input (its model's force_reference on a zero profile): held at its
+    start it is the run of that constant profile, column for column; driven by a session (a host, an FMU, a
+    controller) with a step at 0.05 s it follows the run of the profile that steps within 1 us (and without it the
+    dynamometer keeps its speed but for the open clutch's drag); a negative reference releases, as zero."""
+    held = _wet_sae2('force = { input = "F" }', "3 kN")
+    profile = _wet_sae2('force = "3 kN"')
+    a = held.simulate(0.3, rtol=1e-8, output_step=1e-3).to_dataframe()
+    b = profile.simulate(0.3, rtol=1e-8, output_step=1e-3).to_dataframe()
+    assert list(a.columns) == list(b.columns)
+    for col in a.columns:
+        if not pd.api.types.is_numeric_dtype(b[col]):   # the mode names
+            assert list(a[col]) == list(b[col]), col
+            continue
+        np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12 * max(1.0, np.max(np.abs(b[col]))),
+                                   err_msg=col)
+    stepped = _wet_sae2('force = { input = "F" }', "0 N")
+    system = stepped.system(1e-8)
+    sim = Simulation(system)
+    sim.advance(0.05, [0.0])
+    sim.advance(0.4, [3000.0])
+    ref = stepped.simulate(0.4, rtol=1e-8, output_step=0.4,
+                           inputs={"F": ([0.0, 0.05, 0.05 + 1e-6, 1.0], [0.0, 0.0, 3000.0, 3000.0])}).to_dataframe()
+    n = len(stepped._inertias)
+    w = sim.x[n]
+    assert w == pytest.approx(ref["dyno.w_rad_s"].to_numpy()[-1], rel=1e-5)
+    assert w < 0.5 * 1500 * math.pi / 30   # the input engaged the clutch: it braked the dynamometer
+    untouched = _wet_sae2('force = { input = "F" }', "0 N")
+    sim0 = Simulation(untouched.system(1e-8))
+    sim0.advance(0.4, [0.0])
+    assert sim0.x[n] > 0.99 * 1500 * math.pi / 30   # without it, only the open clutch's drag
+    # a negative force reference releases (the actuator pushes only): as zero
+    sim_neg = Simulation(untouched.system(1e-8))
+    sim_neg.advance(0.4, [-5000.0])
+    np.testing.assert_allclose(sim_neg.x, sim0.x, rtol=1e-12, atol=1e-12)
+
+
+def test_a_wet_clutchs_force_input_is_one_input_not_a_product():
+    with pytest.raises(ParameterError, match="a wet clutch's force is a profile or one network input"):
+        _wet_sae2('force = { product = [{ input = "F" }, 2] }', "0 N")
 
 
 @settings(max_examples=examples(10), deadline=None, derandomize=True)

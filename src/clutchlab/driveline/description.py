@@ -65,8 +65,9 @@ or one of these tables) and S2 a dimensionless one (MSL ``Blocks.Sources`` and `
 or ``{ input = "NAME" }``: the network input declared by an ``[input.NAME]`` table (``start``, a quantity
 in the unit of the fields that read it, default 0; ``description``), held by whatever drives the network
 (``Driveline.simulate``'s ``inputs``, a co-simulation master, an FMU's importer, a controller).  Torque and
-force sources, clutches' and brakes' normal signals and an engine's throttle take inputs; motion sources
-and the E-clutch, wet-clutch and EMTC models do not (yet).
+force sources, clutches' and brakes' normal signals, an engine's throttle, an E-clutch's bearing position
+(without its actuator) and a wet clutch's force (one input, not in a product) take inputs; motion sources,
+the E-clutch with its actuator and the EMTC do not (yet).
 A friction characteristic (``mu``, a bearing's ``torque``) is a number or a table of rows
 ``[w_rad_s, value]``.  Every error names the file, the key and the value.
 """

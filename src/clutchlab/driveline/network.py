@@ -1105,9 +1105,7 @@ class Driveline:
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         sig = Signal.of(force, f"{name}: force")
-        times, values = sig.breakpoints(f"{name}: force (the actuator's force reference)", "N")
-        if min(values) < 0.0:
-            raise ParameterError(f"{name}: force reference {min(values):g} N is negative")
+        self._wet_profile(name, sig)   # a profile the model reads, or one network input
         temps = {}
         for what, value in (("temperature0", temperature0), ("fluid_temperature0", fluid_temperature0),
                             ("housing_temperature0", housing_temperature0)):
@@ -1125,7 +1123,7 @@ class Driveline:
             raise ParameterError(f"{name}: a wet clutch and an EMTC coupling cannot share a network")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
         el = self._elements[-1]
-        el.wet = dict(clutch=clutch, bench=bench, friction=friction, times=times, values=values, **temps)
+        el.wet = dict(clutch=clutch, bench=bench, friction=friction, **temps)
         el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
         return self
 
@@ -1207,13 +1205,29 @@ class Driveline:
             if el.wet is None:
                 continue
             w = el.wet
-            scenario = Scenario(force_time=w["times"], force_value=w["values"], speed_time=[0.0], speed_value=[0.0],
+            times, values = self._wet_profile(el.name, el.signal)
+            scenario = Scenario(force_time=times, force_value=values, speed_time=[0.0], speed_value=[0.0],
                                 duration=1.0, motor="free", initial_temperature_c=w["temperature0"],
                                 fluid_temperature_c=w["fluid_temperature0"],
                                 housing_temperature_c=w["housing_temperature0"])
             params = W.pack_parameters(w["clutch"], w["bench"], scenario, w["friction"])
             out.append((el, params, W.initial_state(scenario), w["clutch"]))
         return out
+
+    @staticmethod
+    def _wet_profile(name, sig) -> tuple:
+        """The force profile ``(times, values)`` [s, N] a wet clutch's model reads: the corners of a constant,
+        ramp or table signal, or zero when the force is one network input (added to the profile by the graft,
+        :mod:`clutchlab.driveline.wet`)."""
+        if sig.input_names():
+            if sig.row[0] != K.SIG_INPUT:
+                raise ParameterError(f"{name}: force = {sig.describe('N')}: a wet clutch's force is a profile or "
+                                     "one network input ({ input = \"NAME\" }), not a product with one")
+            return (0.0,), (0.0,)
+        times, values = sig.breakpoints(f"{name}: force (the actuator's force reference)", "N")
+        if min(values) < 0.0:
+            raise ParameterError(f"{name}: force reference {min(values):g} N is negative")
+        return times, values
 
     def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
                        normal=1.0) -> "Driveline":
@@ -1683,8 +1697,13 @@ class Driveline:
                 x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
             xw = xw.copy()
             xw[W.S_W] = w_rel
+            names = el.signal.input_names()
+            iu = list(self._inputs).index(names[0]) if names else -1
+            if names:   # the actuator starts at the input's start (as at a profile's first value), saturated
+                most = float(np.ravel(wp.constants["actuator_force_max"])[0])
+                xw[W.S_FA] = min(max(self._inputs[names[0]][1], 0.0), most)
             conf.append([k, r, nx + j * W.N_STATE, ng + j * W.N_SWITCH, nm + j * DW.N_MODE, len(K.EVENTS),
-                         nel + 2 * j])
+                         nel + 2 * j, iu])
             xs.append(xw)
             ms.append(W.initial_modes(xw, clutch.piston_h0))
             tols.append(W.absolute_tolerance(clutch, rtol))

@@ -21,7 +21,9 @@ model's piston and film switching functions and events (``contact``, ``separatio
 
 States: the network's, then per clutch the wet model's twelve (its ``slip_speed`` follows the element's
 relative speed, integrated from the relative acceleration and reset to it at every event; its drive states
-stay zero).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
+stay zero).  Its force is a piecewise-linear profile of its model's, or a network input (``{ input = "F" }``:
+the model's ``force_reference`` input on a zero profile, saturated at 0 N; the actuator starts at the
+input's start).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
 without the six of its bench, :data:`BENCH_ONLY`).  Any number of wet clutches:
 each is packed on its own and evaluated with its own hooks (its parameters one row of the stacked arrays).
 """
@@ -43,10 +45,11 @@ __all__ = ["WetDrivelineParams", "N_STATE", "N_SWITCH", "N_MODE"]
 
 N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
 # conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
-# states, switching functions and modes in the whole system's, the number of the network's events and the index of
-# its first named element (``<name>``, then ``<name>.piston``)
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
-# buf (float): its states with the slip replaced | their derivative | switching values | inputs (zero) | outputs
+# states, switching functions and modes in the whole system's, the number of the network's events, the index of
+# its first named element (``<name>``, then ``<name>.piston``) and the network input its force reads (-1: none)
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = range(8)
+# buf (float): its states with the slip replaced | their derivative | switching values | its model's inputs (the
+# force reference added to its profile: a network input, else zero; no slip reference) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
 N_BUF = B_Y + W.N_OUT
 #: outputs of the wet model that belong to its bench, as the wet model declares them
@@ -111,6 +114,15 @@ def _clutch(t, x, m, p, j):
 
 
 @numba.njit(cache=True, nogil=True)
+def _hold(u, p):
+    """Each clutch's force input (its model's ``force_reference`` input, added to its zero profile): the network
+    input it reads, saturated at 0 (an actuator pushes; a negative reference releases it), else zero."""
+    for j in range(p.conf.shape[0]):
+        iu = p.conf[j][F_U]
+        p.buf[j][B_U + W.U_FORCE] = max(u[iu], 0.0) if iu >= 0 else 0.0
+
+
+@numba.njit(cache=True, nogil=True)
 def _clutches(t, x, m, p):
     """Evaluate every wet clutch (:func:`_clutch`)."""
     for j in range(p.conf.shape[0]):
@@ -121,6 +133,7 @@ def _clutches(t, x, m, p):
 def wet_driveline_rhs(t, x, u, m, p, dx, g):
     """The network's right-hand side and switching functions, then each wet clutch's (its slip speed follows
     the element's relative acceleration; its lock-up and break-away functions are held off)."""
+    _hold(u, p)
     _clutches(t, x, m, p)
     K.driveline_rhs(t, x, u, m, byref(p.net), dx, g)
     net = byref(p.net)
@@ -144,6 +157,7 @@ def wet_driveline_rhs(t, x, u, m, p, dx, g):
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_outputs(t, x, u, m, p, y):
     """The network's outputs, then each wet clutch's own (:data:`OUTPUTS`: the model's without its bench's)."""
+    _hold(u, p)
     _clutches(t, x, m, p)
     K.driveline_outputs(t, x, u, m, byref(p.net), y)
     nw = p.conf.shape[0]
@@ -203,6 +217,7 @@ def _wet_call(t, x, m, p, j, k, log):
 def wet_driveline_update(t, x, u, m, p, k, log):
     """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or a wet clutch's
     piston and film functions (:func:`clutchlab.wet.system.wet_update`)."""
+    _hold(u, p)
     _sync(x, m, p)
     _clutches(t, x, m, p)
     ng = p.conf[0][F_G]
@@ -221,6 +236,7 @@ def wet_driveline_update(t, x, u, m, p, k, log):
 @numba.njit(cache=True, nogil=True)
 def wet_driveline_restart(t, x, u, m, p, log):
     """Each wet clutch's restart (piston on or off its stop, film contact), then the network's."""
+    _hold(u, p)
     _sync(x, m, p)
     _clutches(t, x, m, p)
     changed = False
