@@ -306,3 +306,56 @@ def test_a_component_of_an_installed_package_is_found_by_its_entry_point(tmp_pat
     with pytest.raises(ParameterError, match=r"entry point broken = 'cone_clutch:NOTHING'.*does not load"):
         C.components()
     monkeypatch.setattr(C, "_ENTRY_POINTS_READ", True)
+
+
+# ---- the declarations agree with the network: a value in its declared range is one the component takes
+
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+from hypothesis_budget import examples  # noqa: E402
+
+#: kinds whose fields are all numbers, signals and flanges (the others need files, tables or maps)
+SIMPLE = ("spring_damper", "backlash", "gear", "torque", "clutch", "brake", "bearing_friction", "one_way_clutch")
+
+
+def _value(f):
+    lo = f.minimum if f.minimum is not None else (1e-6 if f.positive else -1e3)
+    hi = f.maximum if f.maximum is not None else max(lo, 0.0) + 1e3
+    if f.positive:
+        lo = max(lo, 1e-6)
+    return st.floats(min_value=lo, max_value=hi, allow_nan=False)
+
+
+@st.composite
+def declared_tables(draw):
+    """A driveline file with one component of a simple kind whose numeric fields are drawn from their declared
+    ranges (J1 and J2 both at rest, so a one-way clutch starts legally)."""
+    comp = C.component(draw(st.sampled_from(SIMPLE)))
+    table = {}
+    for f in comp.fields:
+        if f.name in ("radius", "temperature"):
+            continue   # where a friction map is read: they go with mu_map (a file), refused without one
+        if f.kind == "flange":
+            table[f.name] = {"a": "J1", "b": "J2", "flange": "J1"}.get(f.name, "ground")
+        elif f.is_numeric and f.kind != "signal" and (f.required or draw(st.booleans())):
+            table[f.name] = draw(_value(f))
+        elif f.kind == "signal" and f.required:
+            table[f.name] = draw(st.floats(-1e3, 1e3, allow_nan=False))
+    return comp.kind, table
+
+
+@settings(max_examples=examples(60), deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(declared_tables())
+def test_every_value_in_a_declared_range_is_taken_by_the_component(spec):
+    """What a declaration accepts, the component accepts: a sweep or an FMU's importer given a value within the
+    published range (the FMU's min and max) never meets a refusal the range did not announce.  (A gear's ratio
+    must also be non-zero: its one condition that is not a range, named by the network.)"""
+    kind, table = spec
+    doc = {"inertia": {"J1": {"J": 1.0}, "J2": {"J": 2.0}}, kind: {"x": table}}
+    try:
+        net = parse_driveline(doc, "random.toml").driveline
+    except ParameterError as exc:
+        assert kind == "gear" and table["ratio"] == 0.0, (kind, table, exc)
+        return
+    net.system(1e-8)   # and it packs
