@@ -41,7 +41,8 @@ from typing import Any, Callable
 from .errors import ParameterError
 
 __all__ = ["Field", "Component", "FIELD_KINDS", "ENTRY_POINT_GROUP", "register_component", "component",
-           "components", "component_table", "check_range", "unregister_component", "component_sources", "load_component_sources"]
+           "components", "component_table", "check_range", "unregister_component", "component_sources",
+           "load_component_sources"]
 
 #: what a field holds; "flange" fields are the component's ports (the name of a body, or "ground")
 FIELD_KINDS = {

@@ -29,7 +29,8 @@
 Component tables are the registered component kinds, each declared once with its fields' units,
 defaults and physical ranges (:mod:`clutchlab.component`, :mod:`clutchlab.driveline.components`;
 ``clutchlab driveline components [KIND]``, docs/components.md); a value outside its range is refused
-naming the file, the key, the value and the range.  The built-in ones (rotational): ``inertia`` (J, w0, phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
+naming the file, the key, the value and the range.  The built-in ones (rotational): ``inertia`` (J, w0,
+phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
 ``backlash`` (a, b, c, b_gap, d, phi_rel0, damping_law = "kelvin_voigt" (default) or "msl": MSL
 ``ElastoBacklash``'s), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1,

@@ -5,7 +5,8 @@ The FMU of a driveline (:mod:`clutchlab.fmu.driveline`) and the sweep target ``d
 :mod:`clutchlab.driveline.description`) and change some of its numbers: ``J1.J``, ``J1.w0``,
 ``clutch1.fn_max``, ``clutch1.mu``.  A parameter is named ``<component>.<field>`` after the file's
 ``[<kind>.<component>]`` table; its unit is the field's SI unit
-(the declarations of :mod:`clutchlab.driveline.components`, :func:`clutchlab.driveline.description.tables`).  Every scalar field is one: a number or a quantity
+(the declarations of :mod:`clutchlab.driveline.components`,
+:func:`clutchlab.driveline.description.tables`).  Every scalar field is one: a number or a quantity
 string given in the file, or a field the file leaves out whose default is a number (``w0 = 0``,
 ``mu = 0.5``, a clutch's ``normal = 1``).  Tables (a ``mu`` table) are not parameters; the scalar numbers
 of a signal a field is given as (a sine torque's amplitude and frequency, the duration of a ramp of the
@@ -40,7 +41,8 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
-from .description import NOT_QUANTITIES, SIGNAL_FIELDS, DrivelineFile, input_units, parse_driveline, tables
+from .description import (NOT_QUANTITIES, SIGNAL_FIELDS, DrivelineFile, field_units, input_units, parse_driveline,
+                          tables)
 
 __all__ = ["Parameter", "DrivelineDocument", "ReferencedFile"]
 
@@ -191,9 +193,7 @@ class DrivelineDocument:
         head = self.document.get("driveline", {})
         translational = isinstance(head, dict) and head.get("domain") == "translational"
         self._tables = tables("translational" if translational else "rotational")
-        self._fields = {table: {k: (None if f.kind == "flange" else f.unit if f.kind not in NOT_QUANTITIES else f.kind,
-                                    f.required) for k, f in fields.items()}
-                        for table, (_, fields) in self._tables.items()}
+        self._fields = field_units("translational" if translational else "rotational")
         for kind, (_, fields) in self._tables.items():
             table = self.document.get(kind, {})
             if not isinstance(table, dict):
