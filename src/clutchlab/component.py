@@ -42,7 +42,7 @@ from .errors import ParameterError
 
 __all__ = ["Field", "Component", "FIELD_KINDS", "ENTRY_POINT_GROUP", "register_component", "component",
            "components", "component_table", "check_range", "unregister_component", "component_sources",
-           "load_component_sources"]
+           "load_component_sources", "range_problem", "range_text"]
 
 #: what a field holds; "flange" fields are the component's ports (the name of a body, or "ground")
 FIELD_KINDS = {
@@ -144,34 +144,62 @@ class Field:
 
     def range_problem(self, value: float) -> str | None:
         """Why ``value`` (SI) is outside the field's range, or None."""
-        if not math.isfinite(value):
-            return "is not finite"
-        if self.positive and not value > 0.0:
-            return f"must be > 0 [{self.unit}]"
-        if self.minimum is not None and value < self.minimum:
-            return f"is below its range {self.range_text()}"
-        if self.maximum is not None and value > self.maximum:
-            return f"is above its range {self.range_text()}"
-        return None
+        return range_problem(value, self.minimum, self.maximum, self.positive,
+                             self.unit if self.is_numeric else "1")
 
     def range_text(self) -> str:
-        """The range as people read it: ``[0, 1] 1``, ``> 0 N``, ``>= 1 1``, ``any``."""
-        unit = f" {self.unit}" if self.is_numeric and self.unit != "1" else ""
-        lo = self.minimum
-        if self.positive and (lo is None or lo <= 0.0):
-            low = "(0"
-        elif lo is not None:
-            low = f"[{lo:g}"
-        else:
-            low = None
-        high = f"{self.maximum:g}]" if self.maximum is not None else None
-        if low and high:
-            return f"{low}, {high}{unit}"
-        if low:
-            return (f"> 0{unit}" if low == "(0" else f">= {lo:g}{unit}")
-        if high:
-            return f"<= {self.maximum:g}{unit}"
-        return "any"
+        """The range as people read it: ``[0, 2]``, ``> 0 N``, ``>= 1``, ``any``."""
+        return range_text(self.minimum, self.maximum, self.positive, self.unit if self.is_numeric else "1")
+
+
+def range_text(minimum=None, maximum=None, positive: bool = False, unit: str = "1") -> str:
+    """A range as people read it: ``[0, 2]``, ``(0, 1]``, ``> 0 N``, ``>= -273.15 degC``, ``any``.
+
+    Parameters
+    ----------
+    minimum, maximum : float, optional
+        Inclusive bounds [``unit``].
+    positive : bool
+        A strict lower bound of 0.
+    unit : str
+        Unit shown after the range (none for ``"1"``).
+    """
+    u = f" {unit}" if unit and unit != "1" else ""
+    open_zero = positive and (minimum is None or minimum <= 0.0)
+    if open_zero or minimum is not None:
+        low = "(0" if open_zero else f"[{minimum:g}"
+        if maximum is not None:
+            return f"{low}, {maximum:g}]{u}"
+        return f"> 0{u}" if open_zero else f">= {minimum:g}{u}"
+    if maximum is not None:
+        return f"<= {maximum:g}{u}"
+    return "any"
+
+
+def range_problem(value: float, minimum=None, maximum=None, positive: bool = False, unit: str = "1") -> str | None:
+    """Why ``value`` lies outside a range (:func:`range_text`), or None: the one check of a component's field, a
+    file's parameter and an FMU's parameter.
+
+    Parameters
+    ----------
+    value : float
+        The value [``unit``].
+    minimum, maximum : float, optional
+        Inclusive bounds.
+    positive : bool
+        A strict lower bound of 0.
+    unit : str
+        Its unit, named in the message.
+    """
+    if not math.isfinite(value):
+        return "is not finite"
+    if positive and not value > 0.0:
+        return f"must be > 0 [{unit}]"
+    if minimum is not None and value < minimum:
+        return f"is below its range {range_text(minimum, maximum, positive, unit)}"
+    if maximum is not None and value > maximum:
+        return f"is above its range {range_text(minimum, maximum, positive, unit)}"
+    return None
 
 
 def check_range(field: Field, value: float, where: str) -> float:

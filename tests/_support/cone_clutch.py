@@ -23,7 +23,7 @@ import math
 
 from clutchlab.component import Component, Field
 
-__all__ = ["CONE_CLUTCH", "cone_torque_factor"]
+__all__ = ["CONE_CLUTCH", "cone_torque_factor", "EXAMPLE"]
 
 #: defaults of the fields the file may leave out: half-angle [rad] (Shigley: 10-15 deg usual), mu, peak
 ALPHA, MU, PEAK = math.radians(12.0), 0.3, 1.0
@@ -72,3 +72,32 @@ CONE_CLUTCH = Component(
     _build,
     source="Shigley, Mechanical Engineering Design, Sec. 16-4, Eq. (16-26)",
 )
+
+
+#: the worked example's network: J1 spinning at 100 rad/s coupled to J2 at rest through the cone clutch under a
+#: constant axial force (J1 = 0.1, J2 = 0.3 kg m^2, F_a = 500 N, r_m = 50 mm, alpha = 12 deg, mu = 0.3; it
+#: locks at 0.208 s)
+EXAMPLE = """
+[driveline]
+name = "cone"
+
+[simulation]
+t_end = "0.4 s"
+output_step = "1 ms"
+rtol = 1e-10
+
+[inertia.J1]
+J = "0.1 kg m^2"
+w0 = "100 rad/s"
+
+[inertia.J2]
+J = "0.3 kg m^2"
+
+[cone_clutch.c]
+a = "J1"
+b = "J2"
+force = "500 N"
+r_mean = "50 mm"
+alpha = "12 deg"
+mu = 0.3
+"""

@@ -33,30 +33,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs" / "components.md"
 
 J1, J2, W0, F, R, ALPHA, MU = 0.1, 0.3, 100.0, 500.0, 0.05, math.radians(12.0), 0.3
 
-CONE = f"""
-[driveline]
-name = "cone"
-
-[simulation]
-t_end = "0.4 s"
-output_step = "1 ms"
-rtol = 1e-10
-
-[inertia.J1]
-J = "{J1} kg m^2"
-w0 = "{W0} rad/s"
-
-[inertia.J2]
-J = "{J2} kg m^2"
-
-[cone_clutch.c]
-a = "J1"
-b = "J2"
-force = "{F} N"
-r_mean = "{R * 1e3} mm"
-alpha = "12 deg"
-mu = {MU}
-"""
+CONE = cone_clutch.EXAMPLE
 
 
 def lock_time(force=F, r_mean=R, alpha=ALPHA, mu=MU):

@@ -24,29 +24,7 @@ SUPPORT = Path(cone_clutch.__file__).resolve().parent
 
 J1, J2, W0, F, R, MU = 0.1, 0.3, 100.0, 500.0, 0.05, 0.3
 
-CONE = f"""
-[driveline]
-name = "cone"
-
-[simulation]
-t_end = "0.3 s"
-output_step = "1 ms"
-rtol = 1e-10
-
-[inertia.J1]
-J = "{J1} kg m^2"
-w0 = "{W0} rad/s"
-
-[inertia.J2]
-J = "{J2} kg m^2"
-
-[cone_clutch.c]
-a = "J1"
-b = "J2"
-force = "{F} N"
-r_mean = "{R} m"
-mu = {MU}
-"""
+CONE = cone_clutch.EXAMPLE.replace('t_end = "0.4 s"', 't_end = "0.3 s"')
 
 
 @pytest.fixture

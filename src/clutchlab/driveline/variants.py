@@ -34,10 +34,10 @@ resources, the sweep hashes them.
 from __future__ import annotations
 
 import difflib
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..component import range_problem
 from ..errors import ParameterError
 from ..io.files import read_toml
 from ..units import to_si
@@ -76,16 +76,14 @@ class Parameter:
     positive: bool = False
 
     def range_problem(self, value: float) -> str | None:
-        """Why ``value`` [SI] lies outside the parameter's range, or None."""
-        if not math.isfinite(value):
-            return "is not finite"
-        if self.positive and not value > 0.0:
-            return f"must be > 0 [{self.unit}]"
-        if self.minimum is not None and value < self.minimum:
-            return f"is below its minimum {self.minimum:g} [{self.unit}]"
-        if self.maximum is not None and value > self.maximum:
-            return f"is above its maximum {self.maximum:g} [{self.unit}]"
-        return None
+        """Why ``value`` [SI] lies outside the parameter's range, or None (:func:`clutchlab.component.range_problem`).
+
+        Parameters
+        ----------
+        value : float
+            The value [SI].
+        """
+        return range_problem(value, self.minimum, self.maximum, self.positive, self.unit)
 
 
 @dataclass(frozen=True)

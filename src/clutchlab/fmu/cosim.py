@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..component import range_problem, range_text
 from ..params.base import field_range
 from .registry import COSIMULATIONS
 
@@ -249,13 +250,9 @@ class CoSimulation(abc.ABC):
             if not math.isfinite(fv):
                 raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is not finite")
             v = declared[key]
-            if (v.positive and not fv > 0.0) or (v.minimum is not None and fv < v.minimum) \
-                    or (v.maximum is not None and fv > v.maximum):
-                lo = "(0" if v.positive and (v.minimum is None or v.minimum <= 0) else \
-                    f"[{v.minimum:g}" if v.minimum is not None else "(-inf"
-                hi = f"{v.maximum:g}]" if v.maximum is not None else "inf)"
+            if range_problem(fv, v.minimum, v.maximum, v.positive) is not None:
                 raise ParameterError(f"{cls.__name__}: parameter {key!r} = {val!r} is outside its range "
-                                     f"{lo}, {hi} [{v.unit}]")
+                                     f"{range_text(v.minimum, v.maximum, v.positive)} [{v.unit}]")
             known[key] = fv
         return known
 
