@@ -244,6 +244,11 @@ def check_params_show(work, out):
     assert rows["r_outer"] == "0.08315"
 
 
+def check_components(work, out):
+    assert out.startswith("### `clutch`")
+    assert "| `mu` | characteristic | 1 | 0.5 | [0, 2] |" in out and "| `peak` | quantity | 1 | 1 | >= 1 |" in out
+
+
 def check_my_params(work, out):
     text = (work / "my_params.toml").read_text()
     assert "[eclutch]" in text and "bearing_preload" in text
@@ -361,6 +366,7 @@ CHECKS = {
     "run.csv": check_run,
     "launch.csv": check_launch,
     "params show wet --paper": check_params_show,
+    "driveline components clutch": check_components,
     "my_params.toml": check_my_params,
     "params check my_params.toml": check_params_check,
     "record.csv": check_record,

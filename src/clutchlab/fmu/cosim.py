@@ -52,6 +52,9 @@ __all__ = [
     "COSIMULATIONS",
     "load_cosimulation",
     "parameter_set_variables",
+    "field_variable",
+    "rtol_variable",
+    "fixed_step_variable",
     "build_parameter_set",
     "fmi_unit",
     "fixed_step_parameter",
@@ -311,6 +314,48 @@ def parameter_set_variables(prefix: str, cls, skip=()) -> tuple:
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
             out.append(Variable(f"{prefix}.{f.name}", unit, float(value), doc, *limits))
     return tuple(out)
+
+
+def field_variable(name: str, cls, field: str, description: str | None = None) -> Variable:
+    """The :class:`Variable` of one field of a :class:`~clutchlab.params.ParameterSet` class: its default as the
+    start value, its unit, its description and its range (:func:`clutchlab.params.base.field_range`).
+
+    Parameters
+    ----------
+    name : str
+        FMI name (``"scenario.gear"``).
+    cls : type
+        The ParameterSet subclass.
+    field : str
+        The field's name in it.
+    description : str, optional
+        Instead of the field's own.
+    """
+    meta = {f.name: f for f in dataclasses.fields(cls)}[field].metadata
+    return Variable(name, fmi_unit(meta["unit"]), float(getattr(cls(), field)),
+                    meta.get("doc", "") if description is None else description, *field_range(meta))
+
+
+def rtol_variable(name: str, start: float, description: str) -> Variable:
+    """A relative-tolerance parameter in [RTOL_MIN, 1] (:func:`clutchlab.system.check_rtol`, which also refuses 1).
+
+    Parameters
+    ----------
+    name : str
+        FMI name.
+    start : float
+        Its start value.
+    description : str
+        One line.
+    """
+    from ..system import RTOL_MIN
+
+    return Variable(name, "1", start, description, RTOL_MIN, 1.0)
+
+
+def fixed_step_variable() -> Variable:
+    """The ``solver.fixed_step`` parameter [s] of every co-simulation, >= 0 (0: step-size control)."""
+    return Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC, 0.0)
 
 
 def build_parameter_set(prefix: str, cls, values: dict, skip=()):

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..system import check_rtol
-from ..fmu.cosim import FIXED_STEP_DOC, ContractCoSimulation, Variable, fixed_step_parameter, fmi_unit
+from ..fmu.cosim import (ContractCoSimulation, Variable, fixed_step_parameter, fixed_step_variable,
+                         fmi_unit, rtol_variable)
 from ..units import COLUMN_UNITS
 from ..driveline.variants import DrivelineDocument
 
@@ -118,9 +119,9 @@ class DrivelineCoSimulation(ContractCoSimulation):
                         for v in (*system.states, *system.outputs))
         inputs = tuple(Variable(v.name, _fmi_unit(v.unit), float(u), v.description)
                        for v, u in zip(system.inputs, system.u0 if system.inputs else ()))
-        parameters = (Variable("rtol", "1", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step "
-                                                       "control ([simulation] rtol)"),
-                      Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
+        parameters = (rtol_variable("rtol", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step control "
+                                                     "([simulation] rtol)"),
+                      fixed_step_variable(),
                       *(Variable(p.name, fmi_unit(p.unit), p.value, p.description, *_fmi_range(p))
                         for p in doc.parameters.values()))
         names = [v.name for v in (*inputs, *outputs, *parameters)]

@@ -16,8 +16,8 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..system import check_rtol
-from ..fmu.cosim import (FIXED_STEP_DOC, CoSimulation, Variable, build_parameter_set, fixed_step_parameter,
-                         parameter_set_variables, step_in_time)
+from ..fmu.cosim import (CoSimulation, Variable, build_parameter_set, fixed_step_parameter, fixed_step_variable,
+                         parameter_set_variables, rtol_variable, step_in_time)
 from ..system import Simulation
 from ..eclutch.actuator import ActuatorParameters
 from ..eclutch.dynamics import EClutch, FrictionParameters
@@ -59,11 +59,11 @@ class EClutchCoSimulation(CoSimulation):
         Variable("clutch_torque", "N.m", 0.0, "transmissible clutch torque 2 F_n r_eff mu"),
     )
     parameters = (
-        Variable("model", "1", 4.0, "axial model of Haramina et al. (2024), 0-4"),
-        Variable("control_mode", "1", 1.0, "1: bearing position control, 0: motor voltage"),
-        Variable("friction_on", "1", 1.0, "1: clutch friction elements R_f.ds, R_f.pp on"),
-        Variable("rtol", "1", 1e-3, "relative tolerance of the Rodas3 integrator"),
-        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
+        Variable("model", "1", 4.0, "axial model of Haramina et al. (2024), 0-4", 0.0, 4.0),
+        Variable("control_mode", "1", 1.0, "1: bearing position control, 0: motor voltage", 0.0, 1.0),
+        Variable("friction_on", "1", 1.0, "1: clutch friction elements R_f.ds, R_f.pp on", 0.0, 1.0),
+        rtol_variable("rtol", 1e-3, "relative tolerance of the Rodas3 integrator"),
+        fixed_step_variable(),
         *parameter_set_variables("clutch", EClutchParameters, skip=_CLUTCH_SKIP),
         *parameter_set_variables("actuator", ActuatorParameters),
         *parameter_set_variables("friction", FrictionParameters),

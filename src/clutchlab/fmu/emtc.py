@@ -13,8 +13,8 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..system import check_rtol
-from .cosim import (FIXED_STEP_DOC, ContractCoSimulation, Variable, _check_time, build_parameter_set,
-                    fixed_step_parameter, parameter_set_variables, step_in_time)
+from .cosim import (ContractCoSimulation, Variable, _check_time, build_parameter_set, field_variable,
+                    fixed_step_parameter, fixed_step_variable, parameter_set_variables, rtol_variable, step_in_time)
 
 __all__ = ["EmtcCoSimulation"]
 
@@ -49,17 +49,19 @@ def _emtc_variables():
     from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
     from ..emtc.torque import CouplingGeometry
 
-    scen = BenchScenario()
     return (parameter_set_variables("vehicle", VehicleParameters)
             + parameter_set_variables("actuator", ActuatorParameters)
             + parameter_set_variables("coupling", CouplingGeometry)
-            + (Variable("scenario.gear", "1", float(scen.gear), "engaged gear (1-6)"),
-               Variable("scenario.drum_load_front", "N.m", scen.drum_load_front, "extra drum resistance, front axle"),
-               Variable("scenario.drum_load_rear", "N.m", scen.drum_load_rear, "extra drum resistance, rear axle"),
-               Variable("scenario.sample_time", "s", scen.sample_time,
-                        "EMTC controller sample time (any communication step: the controller samples at its own instants)"),
-               Variable("solver.rtol", "1", 1e-6, "relative tolerance of the DOPRI 5(4) step control"),
-               Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC)))
+            + (field_variable("scenario.gear", BenchScenario, "gear"),
+               field_variable("scenario.drum_load_front", BenchScenario, "drum_load_front",
+                              "extra drum resistance, front axle"),
+               field_variable("scenario.drum_load_rear", BenchScenario, "drum_load_rear",
+                              "extra drum resistance, rear axle"),
+               field_variable("scenario.sample_time", BenchScenario, "sample_time",
+                              "EMTC controller sample time (any communication step: the controller samples at its "
+                              "own instants)"),
+               rtol_variable("solver.rtol", 1e-6, "relative tolerance of the DOPRI 5(4) step control"),
+               fixed_step_variable()))
 
 
 class EmtcCoSimulation(ContractCoSimulation):

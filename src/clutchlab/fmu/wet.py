@@ -12,9 +12,10 @@ import sys
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
+from ..params.base import ABSOLUTE_ZERO_C
 from ..system import check_rtol
-from .cosim import (FIXED_STEP_DOC, CoSimulation, Variable, _check_time, _flag, build_parameter_set,
-                    fixed_step_parameter, parameter_set_variables, step_in_time)
+from .cosim import (CoSimulation, Variable, _check_time, _flag, build_parameter_set, fixed_step_parameter,
+                    fixed_step_variable, parameter_set_variables, rtol_variable, step_in_time)
 
 __all__ = ["WetCoSimulation"]
 
@@ -29,18 +30,19 @@ def _wet_variables():
         "noise_fluid_temperature", "seed"))
     scenario = (
         Variable("scenario.free_inertia", "1", 0.0,
-                 "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)"),
+                 "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)",
+                 0.0, 1.0),
         Variable("scenario.initial_slip_speed", "rad/s", 1500 * math.pi / 30, "slip speed at t = 0"),
         Variable("scenario.initial_temperature", "degC",
                  steady_state_temperature(0.0, 80.0, 70.0, WetClutch().k1, WetClutch().k2),
-                 "pack temperature at t = 0 (default: Eq. 8 equilibrium of fluid and housing)"),
-        Variable("scenario.fluid_temperature", "degC", 80.0, "oil reservoir temperature at t = 0"),
-        Variable("scenario.housing_temperature", "degC", 70.0, "housing temperature at t = 0"),
-        Variable("scenario.heater_setpoint", "degC", 80.0, "reservoir thermostat set point"),
-        Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f"),
-        Variable("solver.rtol", "1", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
-        Variable("solver.max_step", "s", 0.01, "largest integration step"),
-        Variable("solver.fixed_step", "s", 0.0, FIXED_STEP_DOC),
+                 "pack temperature at t = 0 (default: Eq. 8 equilibrium of fluid and housing)", ABSOLUTE_ZERO_C),
+        Variable("scenario.fluid_temperature", "degC", 80.0, "oil reservoir temperature at t = 0", ABSOLUTE_ZERO_C),
+        Variable("scenario.housing_temperature", "degC", 70.0, "housing temperature at t = 0", ABSOLUTE_ZERO_C),
+        Variable("scenario.heater_setpoint", "degC", 80.0, "reservoir thermostat set point", ABSOLUTE_ZERO_C),
+        Variable("scenario.mu_scale", "1", 1.0, "factor on the asperity friction coefficient mu_f", 0.0),
+        rtol_variable("solver.rtol", 1e-7, "relative tolerance of the DOPRI 5(4) step control"),
+        Variable("solver.max_step", "s", 0.01, "largest integration step", positive=True),
+        fixed_step_variable(),
     )
     return clutch + bench + scenario
 
