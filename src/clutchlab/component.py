@@ -122,8 +122,8 @@ class Field:
                 raise ParameterError(f"field {self.name}: {what} = {v!r}: expected a finite number")
         if self.minimum is not None and self.maximum is not None and self.minimum > self.maximum:
             raise ParameterError(f"field {self.name}: minimum {self.minimum!r} > maximum {self.maximum!r}")
-        if self.default is not None and self.is_numeric and isinstance(self.default, (int, float)) \
-                and not isinstance(self.default, bool):
+        if self.default is not None and (self.is_numeric or self.kind == "int") \
+                and isinstance(self.default, (int, float)) and not isinstance(self.default, bool):
             problem = self.range_problem(float(self.default))
             if problem:
                 raise ParameterError(f"field {self.name}: default {self.default!r} {problem}")
@@ -137,10 +137,6 @@ class Field:
     def is_numeric(self) -> bool:
         """The field can hold a plain number (a parameter of the file when it does)."""
         return self.kind in NUMERIC_KINDS
-
-    @property
-    def has_range(self) -> bool:
-        return self.minimum is not None or self.maximum is not None or self.positive
 
     def range_problem(self, value: float) -> str | None:
         """Why ``value`` (SI) is outside the field's range, or None."""
@@ -293,6 +289,9 @@ class Component:
         return tuple(f for f in self.fields if f.is_numeric)
 
 
+#: table names of a network file that are not components
+RESERVED = ("driveline", "simulation", "input")
+
 _REGISTRY: dict[str, Component] = {}
 _ENTRY_POINTS_READ = False
 
@@ -314,6 +313,13 @@ def register_component(comp: Component, *, replace: bool = False) -> Component:
     """
     if not isinstance(comp, Component):
         raise ParameterError(f"register_component({comp!r}): expected a Component")
+    names = {comp.kind, *((comp.translational[0],) if comp.translational else ())}
+    taken = {c.translational[0]: c.kind for c in _REGISTRY.values() if c.translational and c is not comp}
+    for name in sorted(names):
+        if name in RESERVED:
+            raise ParameterError(f"component kind {name!r}: a table of every network file ({', '.join(RESERVED)})")
+        if name in taken and not replace:
+            raise ParameterError(f"component kind {name!r} is the translational form of {taken[name]!r}")
     old = _REGISTRY.get(comp.kind)
     if old is not None and old is not comp and not replace:
         raise ParameterError(f"component kind {comp.kind!r} is registered already (by "
