@@ -121,6 +121,12 @@ class Variable:
     maximum: float | None = None
     positive: bool = False
 
+    @property
+    def fmi_bounds(self) -> tuple:
+        """``(min, max)`` as the modelDescription writes them (None: no attribute): a strict ``> 0`` as min 0."""
+        low = 0.0 if self.positive and (self.minimum is None or self.minimum < 0.0) else self.minimum
+        return low, self.maximum
+
     def __post_init__(self):
         if not self.name or not isinstance(self.name, str):
             raise ParameterError(f"Variable.name = {self.name!r}: expected a non-empty string")

@@ -35,11 +35,6 @@ from ..driveline.variants import DrivelineDocument
 __all__ = ["DrivelineCoSimulation"]
 
 
-def _fmi_range(p) -> tuple:
-    """``(minimum, maximum, positive)`` of a description's parameter: its component's declared range."""
-    return p.minimum, p.maximum, p.positive
-
-
 def _fmi_unit(suffix: str) -> str:
     """FMI unit of a column suffix (``"rad_s"`` -> ``"rad/s"``, ``"Nm"`` -> ``"N.m"``)."""
     return fmi_unit(COLUMN_UNITS[suffix][0])
@@ -122,7 +117,7 @@ class DrivelineCoSimulation(ContractCoSimulation):
         parameters = (rtol_variable("rtol", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step control "
                                                      "([simulation] rtol)"),
                       fixed_step_variable(),
-                      *(Variable(p.name, fmi_unit(p.unit), p.value, p.description, *_fmi_range(p))
+                      *(Variable(p.name, fmi_unit(p.unit), p.value, p.description, p.minimum, p.maximum, p.positive)
                         for p in doc.parameters.values()))
         names = [v.name for v in (*inputs, *outputs, *parameters)]
         twice = sorted({n for n in names if names.count(n) > 1})

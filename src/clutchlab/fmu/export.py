@@ -655,9 +655,7 @@ def export_fmu(model: str, path, *, overwrite: bool = False, description=None, p
     except ImportError as exc:  # pragma: no cover - pythonfmu is in the test extras
         raise ClutchlabError(f"export-fmu needs pythonfmu ({exc}); pip install pythonfmu") from None
     units = {v.name: v.unit for group in (cls.parameters, cls.inputs, cls.outputs) for v in group}
-    # a parameter's declared range (a component's Field): FMI min/max, inclusive; "> 0" is written as min 0
-    ranges = {v.name: (0.0 if v.positive and (v.minimum is None or v.minimum < 0) else v.minimum, v.maximum)
-              for v in cls.parameters if v.minimum is not None or v.maximum is not None or v.positive}
+    ranges = {v.name: v.fmi_bounds for v in cls.parameters}   # a parameter's declared range: FMI min/max
     with tempfile.TemporaryDirectory(prefix="clutchlab_fmu_") as tmp:
         tmp = Path(tmp)
         script = tmp / "src" / f"{ident.lower()}_slave.py"
