@@ -280,6 +280,14 @@ def check_fmu(work, out):
     assert 'fmiVersion="2.0"' in xml and "bearing_force" in xml
 
 
+def check_native_fmu(work, out):
+    with zipfile.ZipFile(work / "cc.fmu") as z:
+        xml = z.read("modelDescription.xml").decode()
+        names = z.namelist()
+    assert 'modelIdentifier="Clutchlab_coupled_clutches"' in xml and "binaries/linux64/Clutchlab_coupled_clutches.so" in names
+    assert not any(n.startswith("resources/") for n in names)   # nothing of Python: the network is compiled in
+
+
 def check_results(work, out):
     frame = pd.read_parquet(work / "results" / "results.parquet")
     assert len(frame) == 12                                     # the 4 x 3 grid of the spec
@@ -372,6 +380,7 @@ CHECKS = {
     "record.csv": check_record,
     "report results/": check_report,
     "eclutch.fmu": check_fmu,
+    "cc.fmu": check_native_fmu,
     "results/": check_results,
 }
 

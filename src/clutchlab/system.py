@@ -848,12 +848,16 @@ class Simulation:
         """
         from .numerics import session as S
 
-        params = self.system.params
-        opened = S.open_session(self._core.entry_points(type(params), self._method()),
-                                self._core.entry_points(type(params), "dopri"),
-                                (params, self.x, self.m, self.u, self._sf, self._si, self._opt, self.log, self._empty,
-                                 self._rt, self._rx, self._rm, self._ry, False, self._y, self._report_spec, self._r))
+        opened = S.open_session(*self._session_parts())
         return opened if opened is not None else (self._general, None)
+
+    def _session_parts(self):
+        """``(module, outputs_module, args)`` of the packed session (:func:`clutchlab.numerics.session.open_session`;
+        a native FMU copies the same arguments, :mod:`clutchlab.fmu.native`)."""
+        params = self.system.params
+        return (self._core.entry_points(type(params), self._method()), self._core.entry_points(type(params), "dopri"),
+                (params, self.x, self.m, self.u, self._sf, self._si, self._opt, self.log, self._empty,
+                 self._rt, self._rx, self._rm, self._ry, False, self._y, self._report_spec, self._r))
 
     def _dispatch(self, name: str, method: str, args):
         """The compiled entry ``name`` of the model's entry module for ``method``, called through numba's dispatcher."""

@@ -158,12 +158,12 @@ def test_the_fmu_carries_its_description_and_runs_it(tmp_path, chains, run_fmu, 
 
 def test_export_fmu_command_for_a_driveline(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    assert main(["export-fmu", "driveline", str(EXAMPLE)]) == 0
+    assert main(["export-fmu", "driveline", str(EXAMPLE), "--backend", "python"]) == 0
     out = capsys.readouterr().out.strip().splitlines()
     assert out[-1] == "driveline_coupled_clutches.fmu"  # named after the file
     # what of the user's went in is said (#33): here the description alone
     assert out[:-1] == [f"driveline_coupled_clutches.fmu: packed {EXAMPLE} as resources/description.toml"]
-    assert "exists" in one_line_error(capsys, ["export-fmu", "driveline", str(EXAMPLE)])
+    assert "exists" in one_line_error(capsys, ["export-fmu", "driveline", str(EXAMPLE), "--backend", "python"])
     assert "needs a description file" in one_line_error(capsys, ["export-fmu", "driveline", "-o", "x.fmu"])
     assert "takes no description file" in one_line_error(capsys, ["export-fmu", "wet", str(EXAMPLE)])
     bad = tmp_path / "bad.toml"

@@ -1,4 +1,9 @@
-"""``clutchlab export-fmu MODEL [FILE] -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.export.export_fmu`.
+"""``clutchlab export-fmu MODEL [FILE] -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.native.export_native_fmu`
+and :func:`clutchlab.fmu.export.export_fmu`.
+
+A model whose co-simulation is written on the system contract (the driveline, the EMTC) is exported as a
+**native** FMU by default (``--backend native``: compiled code, nothing of Python on the importing machine);
+``--backend python`` (the only one for the E-clutch and the wet clutch) wraps the model with pythonfmu.
 
 ``clutchlab export-fmu {eclutch,wet,emtc} -o NAME.fmu`` exports a model with its bundled parameters;
 ``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes
@@ -16,7 +21,7 @@ from ..fmu.registry import COSIMULATIONS
 
 
 def _export(args) -> int:
-    from ..fmu.cosim import load_cosimulation
+    from ..fmu.cosim import ContractCoSimulation, load_cosimulation
     from ..fmu.export import export_fmu
 
     from ..io.files import check_writable
@@ -32,6 +37,20 @@ def _export(args) -> int:
     default = Path(args.file).stem if args.file is not None else args.model
     output = args.output if args.output is not None else Path(f"{default}.fmu")
     check_writable(output, args.force)  # before the build
+    native = issubclass(cls, ContractCoSimulation)
+    backend = args.backend or ("native" if native else "python")
+    if backend == "native":
+        if not native:
+            raise ParameterError(f"export-fmu {args.model}: no native FMU yet (its co-simulation is not on the "
+                                 "system contract); use --backend python")
+        from ..fmu.native import export_native_fmu
+
+        if args.file is not None:
+            cls = cls.for_description(args.file)
+        path = export_native_fmu(cls, output, overwrite=args.force, platforms=args.platform,
+                                 report=lambda text: print(f"clutchlab: {text}", file=sys.stderr))
+        print(path)
+        return 0
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
         packed = []
@@ -48,13 +67,16 @@ def register(subparsers) -> None:
     """Add the ``export-fmu`` sub-command."""
     p = subparsers.add_parser(
         "export-fmu",
-        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (needs pythonfmu; runs with "
-             "clutchlab installed)",
+        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (native: no Python needed "
+             "where it runs)",
         description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
-                    "units). The FMU runs the model through pythonfmu: the importing tool needs a Python with "
-                    "clutchlab installed. A driveline is exported from its description file, which the FMU "
-                    "carries with a copy of every file it names (parameter files, a friction map, curves): "
-                    "'export-fmu driveline FILE.toml'.",
+                    "units). A driveline and the EMTC become native FMUs by default: the model's compiled code "
+                    "with an FMI layer, for linux64 (and win64 where the MinGW-w64 cross compiler is installed); "
+                    "the importing tool needs nothing, the exporting machine a C and C++ compiler. "
+                    "'--backend python' (the only one for eclutch and wet) runs the model through pythonfmu: the "
+                    "importing tool then needs a Python with clutchlab installed, and a driveline's FMU carries "
+                    "its description file with a copy of every file it names. A driveline is exported from its "
+                    "description file: 'export-fmu driveline FILE.toml'.",
         epilog="Documentation: docs/fmu.md (drivelines: docs/driveline.md)")
     p.add_argument("model", choices=sorted(COSIMULATIONS), help="model to export")
     p.add_argument("file", nargs="?", default=None,
@@ -62,4 +84,10 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", type=Path, default=None,
                    help="FMU file to write (default: MODEL.fmu, for a driveline FILE's name with .fmu)")
     p.add_argument("--force", action="store_true", help="replace the FMU if it exists")
+    p.add_argument("--backend", choices=("native", "python"), default=None,
+                   help="native: compiled, no Python where the FMU runs (default for driveline and emtc); "
+                        "python: through pythonfmu (default, and the only one, for eclutch and wet)")
+    p.add_argument("--platform", action="append", choices=("linux64", "win64"), default=None,
+                   help="platform of a native FMU's binary (repeat for several; default: linux64, and win64 "
+                        "where its cross compiler is installed)")
     p.set_defaults(func=_export)

@@ -33,7 +33,8 @@ from numba.extending import NativeValue, intrinsic, models, register_jitable, re
 from .borrow import _strip
 from .status import SUCCESS, TERMINATED
 
-__all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "FIELDS",
+__all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "table_layout",
+           "FIELDS",
            "ADVANCE", "OUTPUTS", "REPORT_OUTPUT", "REPORT_STATE", "REPORT_MODE", "REPORT_MODE_IS"]
 
 #: bits of ``what`` in :func:`call`: advance to the end time; evaluate the outputs and fill the report
@@ -332,13 +333,15 @@ def _flattener(context, ty, base, fields):
 _PLANS: dict = {}
 
 
-def _plan(args_ty):
-    """``(bytes, struct, flat)`` that writes the table of a session with packed arguments of type ``args_ty``
-    from Python, or None (a type this does not know, or a layout that is not numba's)."""
-    if args_ty in _PLANS:
-        return _PLANS[args_ty]
-    import struct
+def table_layout(args_ty):
+    """``(bytes, fields, flat)`` of the table of a session with packed arguments of numba type ``args_ty``, or
+    None (a type this does not know, or a layout that is not numba's).
 
+    ``fields`` lists ``(offset, struct code)`` of every scalar of the table in order: the addresses of
+    ``advance`` and ``evaluate_outputs``, then the arguments' scalars (an array: its owner, parent, size,
+    item size, data pointer, shape and strides; pointers have the code ``"Q"``); ``flat(args, out)``
+    appends their values in the same order.  A native FMU (:mod:`clutchlab.fmu.native`) writes the table
+    from the same layout."""
     from numba.core.registry import cpu_target
 
     context = cpu_target.target_context
@@ -347,8 +350,22 @@ def _plan(args_ty):
     fields = [(offsets[0], "Q"), (offsets[1], "Q")]
     flat = _flattener(context, args_ty, offsets[2], fields)
     nbytes = context.get_abi_sizeof(table)
+    if flat is None or _size_align(context, table)[0] != nbytes:
+        return None
+    return nbytes, fields, flat
+
+
+def _plan(args_ty):
+    """``(bytes, struct, flat)`` that writes the table of a session with packed arguments of type ``args_ty``
+    from Python, or None (a type this does not know, or a layout that is not numba's)."""
+    if args_ty in _PLANS:
+        return _PLANS[args_ty]
+    import struct
+
+    layout = table_layout(args_ty)
     plan = None
-    if flat is not None and _size_align(context, table)[0] == nbytes:
+    if layout is not None:
+        nbytes, fields, flat = layout
         fmt, at = "=", 0
         for offset, code in fields:
             if offset < at:

@@ -1,0 +1,682 @@
+/* The FMI 2.0 co-simulation layer of a clutchlab native FMU (clutchlab.fmu.native).
+ *
+ * Compiled, with the generated model.h of one model, into the FMU's shared library beside the object code
+ * of the model's compiled session (clutchlab.fmu.native.codegen) and numba's runtime (nrt.cpp).  Nothing
+ * of Python is involved: an instance is a private copy of the session's image (the table of the compiled
+ * session entry and the memory of its arrays, clutchlab.fmu.native.image) whose pointers are relocated to
+ * the copy; a step is one call of the compiled session entry, which advances the integrator core to the
+ * communication point and writes the outputs.
+ *
+ * No globals but constants and the one-time initialisation of numba's runtime, so instances may live side
+ * by side and in threads (one thread per instance at a time, as FMI requires).  Every refusal returns
+ * fmi2Error (or fmi2Discard for a step the model cannot take) with a message through the logger.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "model.h"
+
+/* ---------------------------------------------------------------- numba's runtime, once per process */
+extern void NRT_MemSys_init(void);
+
+static volatile int cl_nrt_state = 0; /* 0 not started, 1 starting, 2 done */
+
+static void cl_nrt_init(void) {
+    if (__atomic_load_n(&cl_nrt_state, __ATOMIC_ACQUIRE) == 2) return;
+    int expected = 0;
+    if (__atomic_compare_exchange_n(&cl_nrt_state, &expected, 1, 0, __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE)) {
+        NRT_MemSys_init();
+        __atomic_store_n(&cl_nrt_state, 2, __ATOMIC_RELEASE);
+    } else {
+        while (__atomic_load_n(&cl_nrt_state, __ATOMIC_ACQUIRE) != 2) { /* another thread initialises */ }
+    }
+}
+
+/* the outline resolver the compiled code calls for a function it calls through an address
+ * (clutchlab.numerics.outline): here, a table of the functions linked into this library */
+void *clutchlab_outline_resolve_v1(int64_t key) { return cl_outline_lookup(key); }
+
+/* ---------------------------------------------------------------- instances */
+enum { CL_INSTANTIATED, CL_INITIALIZATION, CL_STEPPING, CL_TERMINATED, CL_ERROR };
+
+typedef struct {
+    unsigned char *mem;      /* the instance's copy of the image (CL_IMAGE_BYTES) */
+    double *values;          /* the value of every parameter, constant and input (by value reference) */
+    int outputs_stale;       /* inputs or parameters changed since the outputs were computed */
+    int state;
+    int terminated;
+    int logging;
+    char *name;
+    fmi2CallbackFunctions cb;
+} cl_instance;
+
+#define CL_MAGIC 0x434c4653u /* "CLFS": a clutchlab FMU state */
+
+typedef struct {
+    uint32_t magic;
+    uint32_t version;
+    uint64_t image_bytes;
+    unsigned char *mem;
+    double *values;
+    int outputs_stale;
+    int terminated;
+    int state;
+} cl_state;
+
+static void cl_log(cl_instance *c, fmi2Status status, const char *category, const char *fmt, ...) {
+    char buf[1024];
+    va_list ap;
+    if (c == NULL || c->cb.logger == NULL) return;
+    if (status == fmi2OK && !c->logging) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "?", status, category, "%s", buf);
+}
+
+static double *cl_at(cl_instance *c, uint64_t offset) { return (double *)(c->mem + offset); }
+
+static void cl_relocate(unsigned char *mem) {
+    size_t k;
+    for (k = 0; k < CL_NRELOC; k++) {
+        uint64_t address = (uint64_t)(uintptr_t)(mem + cl_reloc[k][1]);
+        memcpy(mem + cl_reloc[k][0], &address, sizeof address);
+    }
+    {
+        uint64_t a = (uint64_t)(uintptr_t)cl_advance_address();
+        uint64_t o = (uint64_t)(uintptr_t)cl_outputs_address();
+        memcpy(mem + CL_SLOT_ADVANCE, &a, sizeof a);
+        memcpy(mem + CL_SLOT_OUTPUTS, &o, sizeof o);
+    }
+}
+
+static void cl_apply(cl_instance *c, int vr) {
+    const cl_variable *v = &cl_variables[vr];
+    int k;
+    double value = c->values[vr];
+    if (v->kind == CL_PARAMETER) {
+        for (k = 0; k < v->ntargets; k++) {
+            const cl_target *t = &cl_targets[v->first + k];
+            *cl_at(c, t->offset) = t->reciprocal ? t->a / value + t->b
+                                   : t->a == 1.0 && t->b == 0.0 ? value : t->a * value + t->b;
+        }
+    } else if (v->kind == CL_INPUT) {
+        *cl_at(c, v->offset) = value;
+    }
+}
+
+static void cl_load_image(cl_instance *c) {
+    size_t k;
+    memcpy(c->mem, cl_image, CL_IMAGE_BYTES);
+    cl_relocate(c->mem);
+    for (k = 0; k < CL_NVARIABLES; k++) c->values[k] = cl_variables[k].start;
+    c->outputs_stale = 1;
+    c->terminated = 0;
+}
+
+/* one call of the compiled session entry: numba's calling convention (status; result through a pointer) */
+static int cl_call(cl_instance *c, double t_end, int64_t what, int64_t *code) {
+    int64_t result = 0;
+    void *excinfo = NULL;
+    int32_t status = cl_session_call(&result, &excinfo, c->mem, t_end, what);
+    if (status != 0 && status != -2) { /* (-2: returned None; anything else an exception) */
+        cl_log(c, fmi2Error, "logStatusError",
+               "the compiled model raised an exception (status %d) at t = %g s", (int)status, *cl_at(c, CL_OFF_TIME));
+        return 0;
+    }
+    *code = result;
+    return 1;
+}
+
+static int cl_outputs(cl_instance *c) {
+    int64_t code;
+    if (!c->outputs_stale) return 1;
+    if (!cl_call(c, 0.0, CL_OUTPUTS, &code)) return 0;
+    c->outputs_stale = 0;
+    return 1;
+}
+
+static cl_instance *cl_check(fmi2Component comp, const char *where) {
+    cl_instance *c = (cl_instance *)comp;
+    (void)where;
+    return c;
+}
+
+#define CL_REFUSE_IF_ERROR(c, fn)                                                                      \
+    do {                                                                                               \
+        if ((c) == NULL) return fmi2Error;                                                             \
+        if ((c)->state == CL_ERROR) {                                                                  \
+            cl_log((c), fmi2Error, "logStatusError", fn ": the instance is in the error state (reset or free it)"); \
+            return fmi2Error;                                                                          \
+        }                                                                                              \
+    } while (0)
+
+/* ---------------------------------------------------------------- inquiry */
+FMI2_Export const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+FMI2_Export const char *fmi2GetVersion(void) { return fmi2Version; }
+
+FMI2_Export fmi2Status fmi2SetDebugLogging(fmi2Component comp, fmi2Boolean on, size_t n, const fmi2String cats[]) {
+    cl_instance *c = cl_check(comp, "fmi2SetDebugLogging");
+    (void)n;
+    (void)cats;
+    if (c == NULL) return fmi2Error;
+    c->logging = on ? 1 : 0;
+    return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- life cycle */
+FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
+                                          const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                                          fmi2Boolean logging) {
+    cl_instance *c;
+    (void)resources;
+    (void)visible;
+    if (functions == NULL || functions->logger == NULL) return NULL;
+    if (name == NULL || name[0] == '\0') {
+        functions->logger(functions->componentEnvironment, "?", fmi2Error, "logStatusError",
+                          "fmi2Instantiate: missing instance name");
+        return NULL;
+    }
+    if (type != fmi2CoSimulation) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: this FMU is for co-simulation only (%s)", CL_MODEL_IDENTIFIER);
+        return NULL;
+    }
+    if (guid == NULL || strcmp(guid, CL_GUID) != 0) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: GUID %s does not match this FMU's %s", guid ? guid : "(none)", CL_GUID);
+        return NULL;
+    }
+    cl_nrt_init();
+    c = (cl_instance *)calloc(1, sizeof *c);
+    if (c == NULL) return NULL;
+    c->cb = *functions;
+    c->logging = logging ? 1 : 0;
+    c->name = (char *)malloc(strlen(name) + 1);
+    c->mem = (unsigned char *)malloc(CL_IMAGE_BYTES);
+    c->values = (double *)calloc(CL_NVARIABLES ? CL_NVARIABLES : 1, sizeof(double));
+    if (c->name == NULL || c->mem == NULL || c->values == NULL) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: out of memory");
+        free(c->name);
+        free(c->mem);
+        free(c->values);
+        free(c);
+        return NULL;
+    }
+    strcpy(c->name, name);
+    cl_load_image(c);
+    c->state = CL_INSTANTIATED;
+    return c;
+}
+
+FMI2_Export void fmi2FreeInstance(fmi2Component comp) {
+    cl_instance *c = (cl_instance *)comp;
+    if (c == NULL) return;
+    free(c->mem);
+    free(c->values);
+    free(c->name);
+    free(c);
+}
+
+FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tolerance_defined, fmi2Real tolerance,
+                                           fmi2Real start, fmi2Boolean stop_defined, fmi2Real stop) {
+    cl_instance *c = cl_check(comp, "fmi2SetupExperiment");
+    (void)stop_defined;
+    (void)stop;
+    CL_REFUSE_IF_ERROR(c, "fmi2SetupExperiment");
+    if (c->state != CL_INSTANTIATED) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SetupExperiment: only before initialisation");
+        return fmi2Error;
+    }
+    if (!isfinite(start)) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SetupExperiment: start time %g is not finite", start);
+        return fmi2Error;
+    }
+    *cl_at(c, CL_OFF_TIME) = start;
+    *cl_at(c, CL_OFF_T0) = start;
+    if (tolerance_defined)
+        cl_log(c, fmi2OK, "logEvents",
+               "fmi2SetupExperiment: tolerance %g ignored: the parameter rtol sets the model's tolerance", tolerance);
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2EnterInitializationMode(fmi2Component comp) {
+    cl_instance *c = cl_check(comp, "fmi2EnterInitializationMode");
+    CL_REFUSE_IF_ERROR(c, "fmi2EnterInitializationMode");
+    if (c->state != CL_INSTANTIATED) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2EnterInitializationMode: called twice");
+        return fmi2Error;
+    }
+    c->state = CL_INITIALIZATION;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
+    cl_instance *c = cl_check(comp, "fmi2ExitInitializationMode");
+    CL_REFUSE_IF_ERROR(c, "fmi2ExitInitializationMode");
+    if (c->state != CL_INITIALIZATION) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2ExitInitializationMode: not in initialisation mode");
+        return fmi2Error;
+    }
+    if (!cl_outputs(c)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    c->state = CL_STEPPING;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2Terminate(fmi2Component comp) {
+    cl_instance *c = cl_check(comp, "fmi2Terminate");
+    CL_REFUSE_IF_ERROR(c, "fmi2Terminate");
+    c->state = CL_TERMINATED;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2Reset(fmi2Component comp) {
+    cl_instance *c = (cl_instance *)comp;
+    if (c == NULL) return fmi2Error;
+    cl_load_image(c);
+    c->state = CL_INSTANTIATED;
+    return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- variables */
+static int cl_bad_vr(cl_instance *c, const char *fn, fmi2ValueReference vr) {
+    if (vr >= CL_NVARIABLES) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: no variable with value reference %u", fn, (unsigned)vr);
+        return 1;
+    }
+    return 0;
+}
+
+FMI2_Export fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Real value[]) {
+    cl_instance *c = cl_check(comp, "fmi2GetReal");
+    size_t k;
+    CL_REFUSE_IF_ERROR(c, "fmi2GetReal");
+    if (n && (vr == NULL || value == NULL)) return fmi2Error;
+    for (k = 0; k < n; k++) {
+        const cl_variable *v;
+        if (cl_bad_vr(c, "fmi2GetReal", vr[k])) return fmi2Error;
+        v = &cl_variables[vr[k]];
+        if (v->kind == CL_OUTPUT) {
+            if (!cl_outputs(c)) {
+                c->state = CL_ERROR;
+                return fmi2Error;
+            }
+            value[k] = *cl_at(c, v->offset);
+        } else {
+            value[k] = c->values[vr[k]];
+        }
+    }
+    return fmi2OK;
+}
+
+static int cl_in_range(cl_instance *c, const char *fn, const cl_variable *v, double x) {
+    if (!isfinite(x)) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s = %g is not a finite number", fn, v->name, x);
+        return 0;
+    }
+    if ((v->has_min && x < v->min) || (v->has_max && x > v->max) || (v->positive && x <= 0.0)) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s = %.17g [%s] is outside its range %s", fn, v->name, x, v->unit,
+               v->range_text);
+        return 0;
+    }
+    return 1;
+}
+
+FMI2_Export fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
+                                   const fmi2Real value[]) {
+    cl_instance *c = cl_check(comp, "fmi2SetReal");
+    size_t k;
+    CL_REFUSE_IF_ERROR(c, "fmi2SetReal");
+    if (n && (vr == NULL || value == NULL)) return fmi2Error;
+    for (k = 0; k < n; k++) { /* all checked before any is written */
+        const cl_variable *v;
+        if (cl_bad_vr(c, "fmi2SetReal", vr[k])) return fmi2Error;
+        v = &cl_variables[vr[k]];
+        if (v->kind == CL_OUTPUT || v->kind == CL_CONSTANT) {
+            cl_log(c, fmi2Error, "logStatusError", "fmi2SetReal: %s is %s and cannot be set", v->name,
+                   v->kind == CL_OUTPUT ? "an output" : "fixed at export");
+            return fmi2Error;
+        }
+        if (v->kind == CL_PARAMETER && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION) {
+            cl_log(c, fmi2Error, "logStatusError", "fmi2SetReal: parameter %s can be set only before initialisation "
+                   "ends (variability fixed)", v->name);
+            return fmi2Error;
+        }
+        if (!cl_in_range(c, "fmi2SetReal", v, value[k])) return fmi2Error;
+    }
+    for (k = 0; k < n; k++) {
+        c->values[vr[k]] = value[k];
+        cl_apply(c, (int)vr[k]);
+    }
+    if (n) c->outputs_stale = 1;
+    return fmi2OK;
+}
+
+static fmi2Status cl_no_variables(cl_instance *c, const char *fn, size_t n) {
+    if (c == NULL) return fmi2Error;
+    if (n == 0) return fmi2OK;
+    cl_log(c, fmi2Error, "logStatusError", "%s: this FMU has only Real variables", fn);
+    return fmi2Error;
+}
+
+FMI2_Export fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2GetInteger", n);
+}
+FMI2_Export fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2GetBoolean", n);
+}
+FMI2_Export fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2GetString", n);
+}
+FMI2_Export fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                      const fmi2Integer v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2SetInteger", n);
+}
+FMI2_Export fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                      const fmi2Boolean v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2SetBoolean", n);
+}
+FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
+    (void)vr; (void)v;
+    return cl_no_variables((cl_instance *)c, "fmi2SetString", n);
+}
+
+/* ---------------------------------------------------------------- FMU state (rollback, Monte Carlo) */
+FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *out) {
+    cl_instance *c = cl_check(comp, "fmi2GetFMUstate");
+    cl_state *s;
+    CL_REFUSE_IF_ERROR(c, "fmi2GetFMUstate");
+    if (out == NULL) return fmi2Error;
+    s = (cl_state *)*out;
+    if (s == NULL) {
+        s = (cl_state *)calloc(1, sizeof *s);
+        if (s == NULL) return fmi2Error;
+        s->mem = (unsigned char *)malloc(CL_IMAGE_BYTES);
+        s->values = (double *)calloc(CL_NVARIABLES ? CL_NVARIABLES : 1, sizeof(double));
+        if (s->mem == NULL || s->values == NULL) {
+            free(s->mem);
+            free(s->values);
+            free(s);
+            cl_log(c, fmi2Error, "logStatusError", "fmi2GetFMUstate: out of memory");
+            return fmi2Error;
+        }
+    } else if (s->magic != CL_MAGIC) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2GetFMUstate: not a state of this FMU");
+        return fmi2Error;
+    }
+    s->magic = CL_MAGIC;
+    s->version = 1;
+    s->image_bytes = CL_IMAGE_BYTES;
+    memcpy(s->mem, c->mem, CL_IMAGE_BYTES);
+    memcpy(s->values, c->values, CL_NVARIABLES * sizeof(double));
+    s->outputs_stale = c->outputs_stale;
+    s->terminated = c->terminated;
+    s->state = c->state;
+    *out = (fmi2FMUstate)s;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state) {
+    cl_instance *c = cl_check(comp, "fmi2SetFMUstate");
+    cl_state *s = (cl_state *)state;
+    if (c == NULL) return fmi2Error;
+    if (s == NULL || s->magic != CL_MAGIC || s->image_bytes != CL_IMAGE_BYTES) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SetFMUstate: not a state of this FMU");
+        return fmi2Error;
+    }
+    memcpy(c->mem, s->mem, CL_IMAGE_BYTES);
+    cl_relocate(c->mem); /* (a state taken from another instance points into that one's memory) */
+    memcpy(c->values, s->values, CL_NVARIABLES * sizeof(double));
+    c->outputs_stale = s->outputs_stale;
+    c->terminated = s->terminated;
+    c->state = s->state;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state) {
+    cl_state *s;
+    (void)comp;
+    if (state == NULL) return fmi2OK;
+    s = (cl_state *)*state;
+    if (s != NULL) {
+        if (s->magic != CL_MAGIC) return fmi2Error;
+        s->magic = 0;
+        free(s->mem);
+        free(s->values);
+        free(s);
+    }
+    *state = NULL;
+    return fmi2OK;
+}
+
+/* serialised: "CLFS", version, the GUID, the image, the values, three flags (all little-endian, as written) */
+#define CL_SER_HEADER (4 + 4 + 40)
+#define CL_SER_BYTES (CL_SER_HEADER + CL_IMAGE_BYTES + CL_NVARIABLES * sizeof(double) + 3 * sizeof(int32_t))
+
+FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size) {
+    (void)state;
+    if (comp == NULL || size == NULL) return fmi2Error;
+    *size = CL_SER_BYTES;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte out[], size_t size) {
+    cl_instance *c = (cl_instance *)comp;
+    cl_state *s = (cl_state *)state;
+    unsigned char *p = (unsigned char *)out;
+    uint32_t magic = CL_MAGIC, version = 1;
+    int32_t flags[3];
+    char guid[40];
+    if (c == NULL) return fmi2Error;
+    if (s == NULL || s->magic != CL_MAGIC || out == NULL || size < CL_SER_BYTES) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: not a state of this FMU, or %u bytes "
+               "given for %u", (unsigned)size, (unsigned)CL_SER_BYTES);
+        return fmi2Error;
+    }
+    memset(guid, 0, sizeof guid);
+    strncpy(guid, CL_GUID, sizeof guid - 1);
+    memcpy(p, &magic, 4);
+    memcpy(p + 4, &version, 4);
+    memcpy(p + 8, guid, 40);
+    p += CL_SER_HEADER;
+    memcpy(p, s->mem, CL_IMAGE_BYTES);
+    p += CL_IMAGE_BYTES;
+    memcpy(p, s->values, CL_NVARIABLES * sizeof(double));
+    p += CL_NVARIABLES * sizeof(double);
+    flags[0] = s->outputs_stale;
+    flags[1] = s->terminated;
+    flags[2] = s->state;
+    memcpy(p, flags, sizeof flags);
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte in[], size_t size,
+                                               fmi2FMUstate *state) {
+    cl_instance *c = (cl_instance *)comp;
+    const unsigned char *p = (const unsigned char *)in;
+    uint32_t magic, version;
+    char guid[40];
+    int32_t flags[3];
+    cl_state *s;
+    fmi2Status status;
+    if (c == NULL || state == NULL) return fmi2Error;
+    memset(guid, 0, sizeof guid);
+    strncpy(guid, CL_GUID, sizeof guid - 1);
+    if (in == NULL || size != CL_SER_BYTES) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: %u bytes, a state of this FMU has %u",
+               (unsigned)size, (unsigned)CL_SER_BYTES);
+        return fmi2Error;
+    }
+    memcpy(&magic, p, 4);
+    memcpy(&version, p + 4, 4);
+    if (magic != CL_MAGIC || version != 1 || memcmp(p + 8, guid, 40) != 0) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: not a serialised state of this FMU");
+        return fmi2Error;
+    }
+    *state = NULL;
+    status = fmi2GetFMUstate(comp, state); /* (a state of the right size, overwritten below) */
+    if (status != fmi2OK) return status;
+    s = (cl_state *)*state;
+    p += CL_SER_HEADER;
+    memcpy(s->mem, p, CL_IMAGE_BYTES);
+    p += CL_IMAGE_BYTES;
+    memcpy(s->values, p, CL_NVARIABLES * sizeof(double));
+    p += CL_NVARIABLES * sizeof(double);
+    memcpy(flags, p, sizeof flags);
+    s->outputs_stale = flags[0];
+    s->terminated = flags[1];
+    s->state = flags[2] < CL_INSTANTIATED || flags[2] > CL_TERMINATED ? CL_STEPPING : flags[2];
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2ValueReference u[], size_t nu,
+                                                    const fmi2ValueReference z[], size_t nz, const fmi2Real du[],
+                                                    fmi2Real dz[]) {
+    (void)u; (void)nu; (void)z; (void)nz; (void)du; (void)dz;
+    cl_log((cl_instance *)comp, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative: not provided");
+    return fmi2Error;
+}
+
+/* ---------------------------------------------------------------- co-simulation */
+FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
+                                                   const fmi2Integer order[], const fmi2Real value[]) {
+    (void)vr; (void)order; (void)value;
+    if (n == 0) return fmi2OK;
+    cl_log((cl_instance *)comp, fmi2Error, "logStatusError",
+           "fmi2SetRealInputDerivatives: inputs are held constant over a step (canInterpolateInputs is false)");
+    return fmi2Error;
+}
+
+FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t n,
+                                                    const fmi2Integer order[], fmi2Real value[]) {
+    (void)vr; (void)order; (void)value;
+    if (n == 0) return fmi2OK;
+    cl_log((cl_instance *)comp, fmi2Error, "logStatusError",
+           "fmi2GetRealOutputDerivatives: not provided (maxOutputDerivativeOrder is 0)");
+    return fmi2Error;
+}
+
+FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, fmi2Boolean no_prior) {
+    cl_instance *c = cl_check(comp, "fmi2DoStep");
+    double now, t_end;
+    int64_t code;
+    (void)no_prior;
+    CL_REFUSE_IF_ERROR(c, "fmi2DoStep");
+    if (c->state != CL_STEPPING) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: %s", c->state == CL_TERMINATED
+               ? "the run has terminated" : "initialisation has not ended (fmi2ExitInitializationMode)");
+        return fmi2Error;
+    }
+    if (c->terminated) {
+        cl_log(c, fmi2Discard, "logStatusDiscard", "fmi2DoStep: a terminal event has stopped the run");
+        return fmi2Discard;
+    }
+    now = *cl_at(c, CL_OFF_TIME);
+    if (!isfinite(t) || !isfinite(dt) || dt <= 0.0) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: step from %g s of %g s: expected a finite step > 0",
+               t, dt);
+        return fmi2Error;
+    }
+    if (fabs(t - now) > 1e-9 * (fabs(now) > 1.0 ? fabs(now) : 1.0) + 1e-12) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: the step starts at %.17g s but the model is at %.17g s",
+               t, now);
+        return fmi2Error;
+    }
+    t_end = t + dt;
+    if (CL_FIXED_STEP > 0.0 && (t_end - now) / CL_FIXED_STEP > CL_FIXED_STEP_BUDGET) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: a step of %g s would take more than %g steps of the "
+               "fixed step %g s", dt, CL_FIXED_STEP_BUDGET, CL_FIXED_STEP);
+        return fmi2Error;
+    }
+    if (!cl_call(c, t_end, CL_ADVANCE | CL_OUTPUTS, &code)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    if (code == CL_STATUS_TERMINATED) {
+        c->terminated = 1;
+        c->outputs_stale = 0;
+        cl_log(c, fmi2Discard, "logStatusDiscard", "a terminal event stopped the run at t = %g s",
+               *cl_at(c, CL_OFF_TIME));
+        return fmi2Discard;
+    }
+    if (code != CL_STATUS_SUCCESS) {
+        const char *message = cl_status_message(code);
+        if (code == CL_STATUS_MODEL_ERROR) {
+            const char *model = cl_model_error(*(int64_t *)(c->mem + CL_OFF_MODEL_CODE));
+            if (model != NULL) message = model;
+        }
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s (at t = %g s)", CL_MODEL_NAME, message,
+               *cl_at(c, CL_OFF_TIME));
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    c->outputs_stale = 0;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2CancelStep(fmi2Component comp) {
+    cl_log((cl_instance *)comp, fmi2Error, "logStatusError", "fmi2CancelStep: steps are not asynchronous");
+    return fmi2Error;
+}
+
+FMI2_Export fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Status *value) {
+    (void)kind;
+    if (comp == NULL || value == NULL) return fmi2Error;
+    *value = fmi2OK;
+    return fmi2Discard;
+}
+
+FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Real *value) {
+    cl_instance *c = (cl_instance *)comp;
+    if (c == NULL || value == NULL) return fmi2Error;
+    if (kind == fmi2LastSuccessfulTime) {
+        *value = *cl_at(c, CL_OFF_TIME);
+        return fmi2OK;
+    }
+    return fmi2Discard;
+}
+
+FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Integer *value) {
+    (void)kind;
+    (void)value;
+    return comp == NULL ? fmi2Error : fmi2Discard;
+}
+
+FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Boolean *value) {
+    cl_instance *c = (cl_instance *)comp;
+    if (c == NULL || value == NULL) return fmi2Error;
+    if (kind == fmi2Terminated) {
+        *value = c->terminated ? fmi2True : fmi2False;
+        return fmi2OK;
+    }
+    return fmi2Discard;
+}
+
+FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2String *value) {
+    (void)kind;
+    (void)value;
+    return comp == NULL ? fmi2Error : fmi2Discard;
+}
+
+#ifdef CL_BENCHMARK
+/* benchmarks/bench_native_fmu.py only (never in an exported FMU): the compiled session call of a step without
+ * the FMI layer around it, to measure what the layer adds per step */
+FMI2_Export int cl_benchmark_session(fmi2Component comp, double t_end) {
+    int64_t code = -1;
+    return cl_call((cl_instance *)comp, t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
+}
+#endif

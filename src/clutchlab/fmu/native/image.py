@@ -1,0 +1,360 @@
+"""A co-simulation's compiled session as data: the image a native FMU copies into each instance.
+
+A :class:`~clutchlab.system.Simulation` runs a model through one compiled entry, ``session(table, t_end,
+what)`` (:mod:`clutchlab.numerics.session`), whose only argument of substance is the session's *table*: the
+addresses of the model's ``advance`` and ``evaluate_outputs``, then every argument of theirs (parameters,
+state, modes, inputs, solver state, options, event log, buffers) in the layout of numba's data model, each
+array as its native structure whose data pointer points into the array's memory.
+
+:func:`session_image` copies that table and the memory of every array it points into one byte string, the
+*image*: the table first, then the arrays' memory in blocks (arrays that share memory share a block), and
+lists the *relocations*, the table's slots that hold a pointer into a block.  An instance of a native FMU
+copies the image into memory of its own and writes into each relocation slot the address of its own copy
+of that block -- nothing else of the image depends on where it lies -- and the two function slots take the
+addresses of the compiled functions linked into the FMU's library.  Where a variable lives (an input in
+``u``, an output in the report ``r``, the time in the solver state) is an offset into the image.
+
+:func:`parameter_map` finds where each FMU parameter lands in the image, by building the model again with
+the parameter changed (:class:`~clutchlab.fmu.cosim.ContractCoSimulation` builds it from the component
+declarations): a parameter whose every changed number is an affine function of it (``a * value + b``; most
+are copies, ``a = 1, b = 0``) is written by the native FMU itself; one that changes the image in any other
+way (an inertia stored as its inverse, a table rebuilt, the arrays' sizes) is fixed at export.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import dataclasses
+import math
+
+import numpy as np
+
+from ...errors import ClutchlabError
+
+__all__ = ["Image", "session_image", "parameter_map", "NativeExportError", "LOG_CAPACITY"]
+
+#: events a native FMU's session log holds (the FMU reports no events; an overflow is only counted)
+LOG_CAPACITY = 16
+
+#: the session's arguments whose contents the FMU never reads before the compiled code writes them (buffers
+#: and the event log): copied as zeros, so that the image does not depend on uninitialised memory
+_SCRATCH = ("log", "ts", "rt", "rx", "rm", "ry", "y", "r")
+
+_ALIGN = 16
+
+
+class NativeExportError(ClutchlabError):
+    """A model cannot become a native FMU (its session has a form the image does not know, a compiler is
+    missing, a compilation failed); the message says which and what to do."""
+
+
+@dataclasses.dataclass
+class Image:
+    """The session of one co-simulation as bytes (module docstring).
+
+    Attributes
+    ----------
+    data : bytes
+        The table (``table_bytes`` long), then the blocks; the scratch arrays are zeros.
+    table_bytes : int
+    relocations : list of (int, int)
+        ``(slot, target)``: the 8 bytes at offset ``slot`` hold the address of the image's byte ``target``.
+    function_slots : tuple of int
+        Offsets of the addresses of ``advance`` and ``evaluate_outputs``.
+    method : str
+        The core's method of the session (``"dopri"`` or ``"rodas"``): which compiled functions it calls.
+    args : tuple
+        The session's arguments (the objects the image was copied from).
+    """
+
+    data: bytes
+    table_bytes: int
+    relocations: list
+    function_slots: tuple
+    method: str
+    args: tuple
+    _where: dict = dataclasses.field(repr=False, default_factory=dict)
+    _blocks: list = dataclasses.field(repr=False, default_factory=list)
+    pointer_slots: frozenset = frozenset()
+    #: ``(module, outputs_module, args)``: the compiled entry modules of the session and its arguments
+    entry_modules: tuple = ()
+
+    def offset(self, array: np.ndarray, index: int = 0) -> int:
+        """Image offset of element ``index`` of ``array`` (one of the session's arrays, C-contiguous)."""
+        address = array.__array_interface__["data"][0] + index * array.itemsize
+        for start, end, at in self._blocks:
+            if start <= address < end or (start == address == end):
+                return at + (address - start)
+        raise NativeExportError(f"an array of {array.nbytes} bytes is not part of the session's image")
+
+    def same_layout(self, other: "Image") -> bool:
+        """Whether ``other`` has the same size, relocations and method (so its numbers can be compared)."""
+        return (len(self.data) == len(other.data) and self.relocations == other.relocations
+                and self.method == other.method)
+
+
+def _arrays(value, out: list) -> None:
+    if isinstance(value, np.ndarray):
+        out.append(value)
+    elif isinstance(value, tuple):
+        for v in value:
+            _arrays(v, out)
+
+
+def session_arguments(simulation):
+    """``(module, outputs_module, args)`` of a :class:`~clutchlab.system.Simulation`'s packed session, with
+    its event log replaced by a short one (:data:`LOG_CAPACITY`)."""
+    simulation.log = simulation._core.new_log(LOG_CAPACITY)
+    return simulation._session_parts()
+
+
+def session_image(simulation) -> Image:
+    """The image of a :class:`~clutchlab.system.Simulation`'s session (module docstring).
+
+    Raises
+    ------
+    NativeExportError
+        The session's table has a layout this does not know, or points outside its arrays.
+    """
+    from ...numerics import session as S
+
+    module, outputs_module, args = session_arguments(simulation)
+    args_ty = module.session.typeof_pyval(args)
+    layout = S.table_layout(args_ty)
+    if layout is None:
+        raise NativeExportError(f"{simulation.system.name}: its session's arguments have a type the native "
+                                f"FMU's image does not know ({args_ty})")
+    nbytes, fields, flat = layout
+    values = [0, 0]
+    flat(args, values)
+    arrays = []
+    _arrays(args, arrays)
+    scratch = []
+    for name, value in zip(S.FIELDS, args):
+        if name in _SCRATCH:
+            _arrays(value, scratch)
+    # blocks: the arrays' memory, merged where it overlaps, in the order the arguments first name them (not by
+    # address: two builds of one model then give the same image)
+    spans = sorted((a.__array_interface__["data"][0], a.__array_interface__["data"][0] + a.nbytes, k)
+                   for k, a in enumerate(arrays))
+    merged = []
+    for start, end, k in spans:
+        if merged and start < merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], end)
+            merged[-1][2] = min(merged[-1][2], k)
+        else:
+            merged.append([start, end, k])
+    merged.sort(key=lambda b: b[2])
+    at = -(-nbytes // _ALIGN) * _ALIGN
+    blocks = []
+    for start, end, _ in merged:
+        blocks.append((start, end, at))
+        at += -(-max(end - start, 1) // _ALIGN) * _ALIGN
+    data = bytearray(at)
+    for start, end, off in blocks:
+        if end > start:
+            data[off:off + end - start] = ctypes.string_at(start, end - start)
+    image = Image(b"", nbytes, [], (fields[0][0], fields[1][0]), simulation._method(), args, {}, blocks)
+    for a in scratch:   # zeros, not whatever the buffers held
+        if a.nbytes:
+            off = image.offset(a)
+            data[off:off + a.nbytes] = bytes(a.nbytes)
+    import struct
+
+    table = bytearray(nbytes)
+    relocations = []
+    for (offset, code), value in zip(fields, values):
+        struct.pack_into("=" + code, table, offset, value)
+        if code == "Q" and value and offset not in image.function_slots:
+            for start, end, off in blocks:
+                if start <= value <= end:
+                    relocations.append((offset, off + value - start))
+                    struct.pack_into("=Q", table, offset, 0)
+                    break
+            else:
+                raise NativeExportError(f"{simulation.system.name}: its session's table points outside its "
+                                        "arrays (a pointer the native FMU cannot relocate)")
+    for slot in image.function_slots:
+        struct.pack_into("=Q", table, slot, 0)
+    data[:nbytes] = table
+    image.data = bytes(data)
+    image.relocations = relocations
+    image.entry_modules = (module, outputs_module, args)
+    image.pointer_slots = frozenset([s for s, _ in relocations] + list(image.function_slots))
+    return image
+
+
+def _words(image: Image) -> np.ndarray:
+    n = len(image.data) // 8
+    return np.frombuffer(image.data[:n * 8], dtype=np.uint64)
+
+
+def _trials(variable) -> list:
+    """Values of a parameter to build the model with, beside its start: inside its range, whole numbers for a
+    whole-number start, in order of preference."""
+    v = float(variable.start)
+    lo, hi = variable.minimum, variable.maximum
+    cand = [v * 1.25 + 0.125, v * 0.8 + 0.0625, v + 1.0, v - 1.0, v * 2.0, v * 0.5, v + 0.5, v - 0.5]
+    if float(v).is_integer():
+        cand = [v + 1.0, v - 1.0, v + 2.0, v - 2.0] + cand
+    out = []
+    for c in cand:
+        if c == v or not math.isfinite(c) or c in out:
+            continue
+        if lo is not None and c < lo or hi is not None and c > hi or variable.positive and c <= 0.0:
+            continue
+        out.append(c)
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class Target:
+    """Where a parameter lands in the image: the float64 at ``offset`` is ``a * value + b`` (``reciprocal``:
+    ``a / value + b``, a time constant stored as its rate)."""
+
+    offset: int
+    a: float
+    b: float
+    reciprocal: bool = False
+
+    def value(self, v: float) -> float:
+        if self.a == 1.0 and self.b == 0.0 and not self.reciprocal:
+            return v
+        return (self.a / v if self.reciprocal else self.a * v) + self.b
+
+
+def _fit(v0, v1, v2, y0, y1, y2):
+    """The :class:`Target` law (without its offset) that maps the three values to the three numbers, or None."""
+    scale = max(abs(y0), abs(y1), abs(y2), 1e-300)
+    if y0 == v0 and y1 == v1 and y2 == v2:
+        return (1.0, 0.0, False)
+    for reciprocal in (False, True):
+        if reciprocal and 0.0 in (v0, v1, v2):
+            continue
+        f = (lambda v: 1.0 / v) if reciprocal else (lambda v: v)
+        a = (y1 - y0) / (f(v1) - f(v0))
+        b = y0 - a * f(v0)
+        if abs(a * f(v2) + b - y2) <= 1e-13 * scale and abs(a * f(v1) + b - y1) <= 1e-13 * scale:
+            return (a, b, reciprocal)
+    return None
+
+
+def parameter_map(cls, base: Image, build) -> dict:
+    """Where each parameter of the co-simulation class ``cls`` lands in the image ``base`` (module docstring).
+
+    Parameters
+    ----------
+    cls : type
+        A :class:`~clutchlab.fmu.cosim.ContractCoSimulation` class.
+    base : Image
+        The image of ``cls()`` (every parameter at its start).
+    build : callable
+        ``build(values) -> Image``: the image of ``cls(**values)``, or None if the model refuses the values.
+
+    Returns
+    -------
+    dict
+        Parameter name -> tuple of :class:`Target` (an empty tuple: the parameter changes nothing), or None
+        where the parameter changes the image in a way the FMU cannot repeat (fixed at export).
+    """
+    w0 = _words(base)
+    again = build({})
+    if again is None or not base.same_layout(again):
+        raise NativeExportError(f"{cls.__name__}: two builds of the same model differ in layout")
+    noise = w0 != _words(again)
+    skip = np.zeros_like(noise)
+    for slot in base.pointer_slots:
+        skip[slot // 8] = True
+    out = {}
+    f0 = w0.view(np.float64)
+    for var in cls.parameters:
+        v0 = float(var.start)
+        images = []
+        for trial in _trials(var):
+            img = build({var.name: trial})
+            if img is not None:
+                images.append((trial, img))
+            if len(images) == 2:
+                break
+        if len(images) < 2 or not all(base.same_layout(img) for _, img in images):
+            out[var.name] = None
+            continue
+        (v1, i1), (v2, i2) = images
+        w1, w2 = _words(i1), _words(i2)
+        changed = ((w1 != w0) | (w2 != w0))
+        if np.any(changed & (noise | skip)):
+            out[var.name] = None
+            continue
+        targets = []
+        f1, f2 = w1.view(np.float64), w2.view(np.float64)
+        ok = True
+        for k in np.flatnonzero(changed):
+            y0, y1, y2 = float(f0[k]), float(f1[k]), float(f2[k])
+            if not all(math.isfinite(y) and (y == 0.0 or abs(y) >= 2.2250738585072014e-308) for y in (y0, y1, y2)):
+                ok = False   # (not a float: an integer, a flag)
+                break
+            law = _fit(v0, v1, v2, y0, y1, y2)
+            if law is None:
+                ok = False
+                break
+            targets.append(Target(int(k) * 8, *law))
+        out[var.name] = tuple(targets) if ok else None
+    # a number two parameters change (a sum, a product) cannot be written by either alone: both fixed
+    owners = {}
+    for name, targets in out.items():
+        for t in targets or ():
+            owners.setdefault(t.offset, []).append(name)
+    for names in owners.values():
+        if len(names) > 1:
+            for name in names:
+                out[name] = None
+    return _checked_jointly(cls, base, build, out, noise | skip)
+
+
+def _apply(image: Image, where: dict, values: dict) -> np.ndarray:
+    """The image's numbers with ``values`` written as a native FMU writes them (float64 words)."""
+    words = _words(image).view(np.float64).copy()
+    for name, v in values.items():
+        for t in where[name] or ():
+            words[t.offset // 8] = t.value(v)
+    return words
+
+
+def _written(where: dict, values: dict) -> np.ndarray:
+    """Word indices the targets of the parameters in ``values`` write."""
+    return np.array(sorted({t.offset // 8 for name in values for t in where[name] or ()}), dtype=np.int64)
+
+
+def _checked_jointly(cls, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
+    """Build the model with every writable parameter changed at once and compare with the image the FMU would
+    write; a parameter whose numbers differ is fixed (repeated until they agree).  ``ignore``: the words that
+    differ between two builds of the same values, and the pointers."""
+    for _ in range(len(where) + 1):
+        changed = {}
+        for var in cls.parameters:
+            if where.get(var.name):
+                trials = _trials(var)
+                if trials:
+                    changed[var.name] = trials[0]
+        if not changed:
+            return where
+        img = build(changed)
+        if img is None or not base.same_layout(img):
+            for name in changed:   # (refused together though each alone was taken: all fixed)
+                where[name] = None
+            return where
+        expected = _apply(base, where, changed)
+        got = _words(img).view(np.float64)
+        with np.errstate(invalid="ignore", over="ignore"):
+            same = ((expected == got) | (np.abs(expected - got) <= 1e-13 * np.abs(got))
+                    | (_words(img) == _words(base)) & ~np.isin(np.arange(got.size), _written(where, changed))
+                    | ignore)
+        bad = set(np.flatnonzero(~same).tolist())
+        if not bad:
+            return where
+        offenders = [name for name in changed if any(t.offset // 8 in bad for t in where[name])]
+        if not offenders:   # (a number no target writes changed: nothing can be trusted)
+            offenders = list(changed)
+        for name in offenders:
+            where[name] = None
+    return where
