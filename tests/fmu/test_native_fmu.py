@@ -264,8 +264,6 @@ def test_export_fmu_command_builds_a_native_fmu_by_default(tmp_path, monkeypatch
     assert "native FMU Clutchlab_coupled_clutches (linux64" in captured.err
     names = zipfile.ZipFile(tmp_path / "driveline_coupled_clutches.fmu").namelist()
     assert "binaries/linux64/Clutchlab_coupled_clutches.so" in names and not any("resources" in n for n in names)
-    assert main(["export-fmu", "wet", "--backend", "native", "-o", "w.fmu"]) == 2
-    assert "no native FMU yet" in capsys.readouterr().err
     with pytest.raises(NativeExportError, match="ContractCoSimulation"):
         export_native_fmu(object, tmp_path / "x.fmu")
 
@@ -329,3 +327,54 @@ def test_the_win64_binary_under_wine_gives_the_same_numbers(tmp_path):
                            capture_output=True, text=True, timeout=600, env=env)
     a, b, c = map(float, state.stdout.split()[-3:])
     assert a == b == c and a != 0.0
+
+
+def test_native_fmu_of_the_eclutch(tmp_path, host):
+    """The E-clutch (Rodas3 with its stick/slip friction) as a native FMU: equal to the Python co-simulation
+    in FMPy with a held reference, and in the C host.  (With a reference that steps, FMPy's own timing of the
+    input changes its value by a rounding, and the E-clutch's 120 friction events amplify a change of one ulp
+    in one step's reference to 1e-8 of the bearing position: the run is compared where the input is exact.)"""
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
+
+    lines = []
+    path = export_native_fmu(EClutchCoSimulation, tmp_path / "e.fmu", platforms=["linux64"], report=lines.append)
+    assert lines[0].startswith("native FMU ClutchlabEclutch (linux64): 2 inputs, 9 outputs")
+    n, dt = 500, 1e-3
+    inputs = {"bearing_reference": np.full(n + 1, 2e-3)}
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(EClutchCoSimulation, n, dt, inputs=inputs)
+    for name in python:
+        _close(native[name], python[name], name)
+    assert np.ptp(python["bearing_position"]) > 1e-3   # (the actuator moved)
+    with zipfile.ZipFile(path) as z:
+        z.extractall(tmp_path / "fmu")
+    root, svs = _variables(path)
+    vr = {name: int(sv.get("valueReference")) for name, sv in svs.items()}
+    lib = tmp_path / "fmu" / "binaries" / "linux64" / "ClutchlabEclutch.so"
+    values = np.loadtxt(_host(host, lib, root.get("guid"), "run", n, dt, -1, 0, vr["bearing_position"],
+                              vr["clutch_torque"]).stdout.splitlines())
+    held = _python_run(EClutchCoSimulation, n, dt)   # (the reference at its start value, 5 mm)
+    for j, name in enumerate(["bearing_position", "clutch_torque"]):
+        _close(values[:, j], held[name], name)
+
+
+def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_path):
+    """The wet clutch on its bench: its run starts at the first inputs (the actuator force at its reference),
+    which the native FMU repeats (an input's target in the state is written until initialisation ends);
+    the bench's limits are the inputs' ranges."""
+    from clutchlab.fmu.wet import WetCoSimulation
+
+    lines = []
+    path = export_native_fmu(WetCoSimulation, tmp_path / "w.fmu", platforms=["linux64"], report=lines.append)
+    assert lines[0].startswith("native FMU ClutchlabWet (linux64): 2 inputs, 24 outputs")
+    root, svs = _variables(path)
+    force = svs["force_reference"].find("Real")
+    assert force.get("min") == "0.0" and float(force.get("max")) == WetCoSimulation().bench.actuator_force_max
+    n, dt = 400, 1e-3
+    k = np.arange(n + 1)
+    inputs = {"force_reference": np.where(k * dt > 0.05, 3000.0, 1000.0), "slip_speed_reference": np.full(n + 1, 150.0)}
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(WetCoSimulation, n, dt, inputs=inputs)
+    for name in python:
+        _close(native[name], python[name], name)
+    assert native["actuator_force"][0] == 1000.0   # (started at the reference, not at 0)

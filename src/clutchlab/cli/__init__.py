@@ -36,7 +36,7 @@ COMMANDS = {
                                          "(python-control)"),
     "params": ("clutchlab.cli.params", "show the parameter sets of a model, write or check parameter files"),
     "export-fmu": ("clutchlab.cli.fmu", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file "
-                                        "(native: no Python needed where it runs)"),
+                                        "(native: nothing needed where it runs)"),
     "sweep": ("clutchlab.cli.sweep", "grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores "
                                      "or Dask)"),
     "report": ("clutchlab.cli.report", "write a self-contained HTML report (figures, metrics, parameters, "

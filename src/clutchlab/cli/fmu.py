@@ -1,13 +1,14 @@
 """``clutchlab export-fmu MODEL [FILE] -o NAME.fmu``: thin layer over :func:`clutchlab.fmu.native.export_native_fmu`
 and :func:`clutchlab.fmu.export.export_fmu`.
 
-A model whose co-simulation is written on the system contract (the driveline, the EMTC) is exported as a
-**native** FMU by default (``--backend native``: compiled code, nothing of Python on the importing machine);
-``--backend python`` (the only one for the E-clutch and the wet clutch) wraps the model with pythonfmu.
+Every model is exported as a **native** FMU by default (``--backend native``: compiled code, nothing of
+Python on the importing machine); ``--backend python`` wraps the model with pythonfmu (the importing machine
+then needs Python and clutchlab).
 
 ``clutchlab export-fmu {eclutch,wet,emtc} -o NAME.fmu`` exports a model with its bundled parameters;
-``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes
-(the FMU carries the file and every file it names, :func:`clutchlab.fmu.export.bundle_description`).
+``clutchlab export-fmu driveline FILE.toml -o NAME.fmu`` the driveline that ``FILE.toml`` describes (with
+``--backend python`` the FMU carries the file and every file it names,
+:func:`clutchlab.fmu.export.bundle_description`).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from ..fmu.registry import COSIMULATIONS
 
 
 def _export(args) -> int:
-    from ..fmu.cosim import ContractCoSimulation, load_cosimulation
+    from ..fmu.cosim import load_cosimulation
     from ..fmu.export import export_fmu
 
     from ..io.files import check_writable
@@ -37,12 +38,12 @@ def _export(args) -> int:
     default = Path(args.file).stem if args.file is not None else args.model
     output = args.output if args.output is not None else Path(f"{default}.fmu")
     check_writable(output, args.force)  # before the build
-    native = issubclass(cls, ContractCoSimulation)
+    native = cls.native
     backend = args.backend or ("native" if native else "python")
     if backend == "native":
         if not native:
-            raise ParameterError(f"export-fmu {args.model}: no native FMU yet (its co-simulation is not on the "
-                                 "system contract); use --backend python")
+            raise ParameterError(f"export-fmu {args.model}: no native FMU for this model (its co-simulation "
+                                 "is not on the system contract); use --backend python")
         from ..fmu.native import export_native_fmu
 
         if args.file is not None:
@@ -67,13 +68,13 @@ def register(subparsers) -> None:
     """Add the ``export-fmu`` sub-command."""
     p = subparsers.add_parser(
         "export-fmu",
-        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (native: no Python needed "
-             "where it runs)",
+        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (native: nothing needed where "
+             "it runs)",
         description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
-                    "units). A driveline and the EMTC become native FMUs by default: the model's compiled code "
+                    "units). Every model becomes a native FMU by default: the model's compiled code "
                     "with an FMI layer, for linux64 (and win64 where the MinGW-w64 cross compiler is installed); "
                     "the importing tool needs nothing, the exporting machine a C and C++ compiler. "
-                    "'--backend python' (the only one for eclutch and wet) runs the model through pythonfmu: the "
+                    "'--backend python' runs the model through pythonfmu: the "
                     "importing tool then needs a Python with clutchlab installed, and a driveline's FMU carries "
                     "its description file with a copy of every file it names. A driveline is exported from its "
                     "description file: 'export-fmu driveline FILE.toml'.",
@@ -85,8 +86,8 @@ def register(subparsers) -> None:
                    help="FMU file to write (default: MODEL.fmu, for a driveline FILE's name with .fmu)")
     p.add_argument("--force", action="store_true", help="replace the FMU if it exists")
     p.add_argument("--backend", choices=("native", "python"), default=None,
-                   help="native: compiled, no Python where the FMU runs (default for driveline and emtc); "
-                        "python: through pythonfmu (default, and the only one, for eclutch and wet)")
+                   help="native (default): compiled, no Python where the FMU runs; python: through pythonfmu (the "
+                        "importing machine needs Python and clutchlab)")
     p.add_argument("--platform", action="append", choices=("linux64", "win64"), default=None,
                    help="platform of a native FMU's binary (repeat for several; default: linux64, and win64 "
                         "where its cross compiler is installed)")

@@ -169,6 +169,12 @@ class CoSimulation(abc.ABC):
     parameters: tuple = ()
     description_file: str = ""
     experiment: tuple | None = None
+    #: the class can become a native FMU (:mod:`clutchlab.fmu.native`): after ``hold_inputs(inputs)`` (the
+    #: inputs by name, missing ones at their start; nothing evaluated), an instance runs a
+    #: :class:`~clutchlab.system.Simulation` (``simulation``) that reports the outputs in order and holds the
+    #: inputs; an optional ``input_bounds()`` gives ``{input: (min, max)}`` where an input's range follows the
+    #: parameters
+    native: bool = False
 
     @abc.abstractmethod
     def __init__(self, **parameter_values):
@@ -482,6 +488,7 @@ class ContractCoSimulation(CoSimulation):
     """
 
     simulation_options: dict = {}
+    native = True
 
     def __init__(self, **parameter_values):
         self._values = self.resolve_parameters(parameter_values)
@@ -518,9 +525,13 @@ class ContractCoSimulation(CoSimulation):
     def _output_dict(self, values) -> dict:
         return dict(zip(self._output_names, values.tolist()))
 
+    def hold_inputs(self, inputs: dict) -> None:
+        """Hold the FMI ``inputs`` (by name; missing ones at their start), evaluating nothing."""
+        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
+
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 with the given inputs held."""
-        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
+        self.hold_inputs(inputs)
         return self._output_dict(self.simulation.reported())
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:

@@ -43,6 +43,7 @@ class EClutchCoSimulation(CoSimulation):
     """
 
     name = "eclutch"
+    native = True
     inputs = (
         Variable("bearing_reference", "m", 5e-3, "bearing position reference (control_mode = 1)"),
         Variable("motor_voltage", "V", 0.0, "motor voltage (control_mode = 0)"),
@@ -106,10 +107,14 @@ class EClutchCoSimulation(CoSimulation):
         self._by_reference = self.input_name == "bearing_reference"
         self.t = 0.0
 
+    def hold_inputs(self, inputs: dict) -> None:
+        """Hold the FMI ``inputs`` (by name; missing ones at their start): the bearing reference under position
+        control, else the motor voltage (the other input is unused)."""
+        self.simulation.set_inputs([self.resolve_inputs(inputs)[self.input_name]])
+
     def _outputs(self, inputs) -> dict:
-        sim = self.simulation
-        sim.set_inputs([self.resolve_inputs(inputs)[self.input_name]])
-        return dict(zip(self._names, sim.reported().tolist()))
+        self.hold_inputs(inputs)
+        return dict(zip(self._names, self.simulation.reported().tolist()))
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 (the rest state)."""

@@ -108,7 +108,7 @@ class EmtcCoSimulation(ContractCoSimulation):
     name = "emtc"
     inputs = (
         Variable("torque_request", "N.m", 0.0, "coupling torque request T_cal of the AWD controller"),
-        Variable("throttle", "1", 0.1, "engine throttle (0-1)"),
+        Variable("throttle", "1", 0.1, "engine throttle (0-1)", 0.0, 1.0),
         Variable("drum_speed_front", "m/s", 8.0, "front drum surface speed"),
         Variable("drum_speed_rear", "m/s", 7.7, "rear drum surface speed"),
     )

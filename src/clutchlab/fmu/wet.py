@@ -115,6 +115,7 @@ class WetCoSimulation(CoSimulation):
     """
 
     name = "wet"
+    native = True
     inputs = (
         Variable("force_reference", "N", 0.0, "actuator force reference (piston apply force)"),
         Variable("slip_speed_reference", "rad/s", 1500 * math.pi / 30,
@@ -179,6 +180,14 @@ class WetCoSimulation(CoSimulation):
         """Accepted integration steps since the start."""
         return 0 if self.simulation is None else self.simulation.stats["accepted_steps"]
 
+    def input_bounds(self) -> dict:
+        """The inputs' ranges with these parameters: the actuator's force limit, and the drive's speed limit
+        when the drive holds the slip speed (a native FMU checks them, :mod:`clutchlab.fmu.native`)."""
+        out = {"force_reference": (0.0, float(self.bench.actuator_force_max))}
+        if self.scenario.motor == "speed":
+            out["slip_speed_reference"] = (-float(self.bench.drive_speed_max), float(self.bench.drive_speed_max))
+        return out
+
     def _inputs(self, u):
         fmax = self.bench.actuator_force_max
         f = u["force_reference"]
@@ -212,12 +221,17 @@ class WetCoSimulation(CoSimulation):
     def _outputs(self):
         return dict(zip(self._output_names, self.simulation.reported().tolist()))
 
-    def initial_outputs(self, inputs: dict) -> dict:
+    def hold_inputs(self, inputs: dict) -> None:
+        """Hold the references ``inputs`` (by name; missing ones at their start), starting the run with them at
+        t = 0 (the actuator force starts at its reference); evaluates nothing."""
         u = self.resolve_inputs(inputs)
         if self.simulation is None or self.time != 0.0:
             self.reset()
             self._start(u)
         self.simulation.set_inputs(self._inputs(u))
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        self.hold_inputs(inputs)
         return self._outputs()
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:

@@ -1,8 +1,9 @@
 """Native FMUs: a clutchlab model as an FMI 2.0 co-simulation FMU with no Python on the importing machine.
 
 ``clutchlab export-fmu driveline NETWORK.toml -o X.fmu`` (:func:`export_native_fmu`) builds, from the
-model's co-simulation class (:class:`~clutchlab.fmu.cosim.ContractCoSimulation`, whose variables come from
-the component declarations), a shared library per platform that holds
+model's co-simulation class (a :class:`~clutchlab.fmu.cosim.CoSimulation` on the system contract,
+``native = True``: the driveline's, the EMTC's and the E-clutch's, whose variables come from the component
+declarations and parameter sets), a shared library per platform that holds
 
 * the object code of the model's compiled session -- the integrator core with the model's equations, the
   same functions, compiled by the same numba, that run the model in Python (:mod:`.codegen`);
@@ -15,13 +16,13 @@ So a step of the FMU is the step of ``clutchlab`` itself: the results equal the 
 the same communication points.  What the importing tool needs: nothing (the library links only the C
 library and libm).  Limits, stated in docs/fmu.md: co-simulation only (no Model Exchange yet); parameters
 whose value the model stores other than as an affine function of it (an inertia kept as its inverse, an
-initial speed that decides a start mode) are fixed at export (``variability="constant"``); a model whose
-co-simulation class is not a ``ContractCoSimulation`` (the wet clutch's, the E-clutch's) is exported through
-pythonfmu.
+initial speed that decides a start mode) are fixed at export (``variability="constant"``); the wet clutch's
+co-simulation (its system is built at the first step) is exported through pythonfmu.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import hashlib
 import io
@@ -133,12 +134,12 @@ def _model_header(cls, name, ident, guid, image, functions, variables, targets, 
     lines += [f"    {{{s}u, {t}u}}," for s, t in image.relocations] or ["    {0u, 0u},"]
     lines.append("};")
     # variables
-    lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal; } cl_target;",
+    lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal, initial; } cl_target;",
               "typedef struct { const char *name; const char *unit; int kind; double start; int has_min, has_max, "
               "positive; double min, max; const char *range_text; uint64_t offset; int first, ntargets; } cl_variable;",
               f"static const cl_target cl_targets[{max(len(targets), 1)}] = {{"]
-    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}}}," for t in targets] \
-        or ["    {0u, 0.0, 0.0, 0},"]
+    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}, {int(t.initial)}}},"
+              for t in targets] or ["    {0u, 0.0, 0.0, 0, 0},"]
     lines.append("};")
     lines.append(f"static const cl_variable cl_variables[{len(variables)}] = {{")
     for v in variables:
@@ -224,7 +225,7 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     Parameters
     ----------
     cls : type
-        A :class:`~clutchlab.fmu.cosim.ContractCoSimulation` class (a driveline's:
+        A co-simulation class with ``native = True`` (a driveline's:
         :meth:`DrivelineCoSimulation.for_description <clutchlab.fmu.driveline.DrivelineCoSimulation.for_description>`).
     path : path-like
         The ``.fmu`` file to write (atomically).
@@ -252,7 +253,7 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         The path does not end in ``.fmu``, or exists and ``overwrite`` is false.
     """
     from ...io.files import atomic_write_bytes, check_writable
-    from ..cosim import ContractCoSimulation
+    from ..cosim import CoSimulation
     from .codegen import emit_object, session_functions
     from .toolchain import available_platforms, library_name, toolchain
 
@@ -260,9 +261,9 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     if path.suffix.lower() != ".fmu":
         raise ParameterError(f"output {str(path)!r}: the file name must end in .fmu")
     check_writable(path, overwrite)
-    if not (isinstance(cls, type) and issubclass(cls, ContractCoSimulation)):
-        raise NativeExportError(f"{getattr(cls, '__name__', cls)!r}: a native FMU is built from a "
-                                "ContractCoSimulation class")
+    if not (isinstance(cls, type) and issubclass(cls, CoSimulation) and cls.native):
+        raise NativeExportError(f"{getattr(cls, '__name__', cls)!r}: a native FMU is built from a co-simulation "
+                                "class on the system contract (CoSimulation.native; the wet clutch's is not yet)")
     if platforms is None:
         platforms = ["linux64"] + [p for p in available_platforms() if p != "linux64"]
     platforms = list(dict.fromkeys(platforms))
@@ -271,20 +272,30 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             raise ParameterError(f"platform {p!r}: expected one of {', '.join(PLATFORMS)}")
     chains = [toolchain(p) for p in platforms]   # (a missing compiler is refused before anything is built)
     base_obj = cls()
+    base_obj.hold_inputs({})   # (a model that starts its run at the first inputs starts it here)
     network = getattr(getattr(getattr(cls, "base", None), "driveline", None), "name", None)
     if name is None:
         name = network or cls.name or "model"
     ident = native_identifier(name) if network is not None or name != cls.name else _model_identifier(cls.name)
     image = session_image(base_obj.simulation)
 
-    def build(values):
+    def build(parameters=None, inputs=None):
         try:
-            obj = cls(**values)
+            obj = cls(**(parameters or {}))
+            obj.hold_inputs(inputs or {})
         except (ParameterError, ValueError):
             return None
         return session_image(obj.simulation)
 
-    where = parameter_map(cls, image, build)
+    where = parameter_map(cls.parameters, image, lambda values: build(parameters=values), cls.__name__)
+    inputs_at = parameter_map(cls.inputs, image, lambda values: build(inputs=values), cls.__name__)
+    for v in cls.inputs:
+        if inputs_at[v.name] is None:
+            raise NativeExportError(f"{cls.__name__}: input {v.name} reaches the model in a way a native FMU "
+                                    "cannot repeat (not a * value + b)")
+    bounds = dict(getattr(base_obj, "input_bounds", lambda: {})())
+    x = image.args[1]
+    x_span = (image.offset(x), image.offset(x) + x.nbytes) if x.size else (0, 0)
     functions = session_functions(image)
     simulation = base_obj.simulation
     fixed_step = float(simulation.fixed_step)
@@ -298,11 +309,16 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             targets.extend(t)
             entry["ntargets"] = len(t)
         variables.append(entry)
-    u, r = image.args[3], image.args[16]
-    for i, v in enumerate(cls.inputs):
+    r = image.args[16]
+    for v in cls.inputs:
+        if v.name in bounds:   # (a range that follows the parameters: the bench's actuator limit)
+            v = dataclasses.replace(v, minimum=bounds[v.name][0], maximum=bounds[v.name][1])
         variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
-                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v),
-                          "offset": image.offset(u, i), "first": 0, "ntargets": 0, "kind": _INPUT})
+                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "offset": 0,
+                          "first": len(targets), "ntargets": len(inputs_at[v.name]), "kind": _INPUT})
+        # an input that also sets a state (the wet bench's actuator force starts at its reference) sets it only
+        # until initialisation ends, as the model's own run takes it at its start
+        targets.extend(dataclasses.replace(t, initial=x_span[0] <= t.offset < x_span[1]) for t in inputs_at[v.name])
     if r.shape[0] != len(cls.outputs):
         raise NativeExportError(f"{cls.__name__}: {r.shape[0]} reported values for {len(cls.outputs)} outputs")
     for k, v in enumerate(cls.outputs):

@@ -99,14 +99,13 @@ static void cl_apply(cl_instance *c, int vr) {
     const cl_variable *v = &cl_variables[vr];
     int k;
     double value = c->values[vr];
-    if (v->kind == CL_PARAMETER) {
+    if (v->kind == CL_PARAMETER || v->kind == CL_INPUT) {
         for (k = 0; k < v->ntargets; k++) {
             const cl_target *t = &cl_targets[v->first + k];
+            if (t->initial && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION) continue;
             *cl_at(c, t->offset) = t->reciprocal ? t->a / value + t->b
                                    : t->a == 1.0 && t->b == 0.0 ? value : t->a * value + t->b;
         }
-    } else if (v->kind == CL_INPUT) {
-        *cl_at(c, v->offset) = value;
     }
 }
 

@@ -15,8 +15,8 @@ addresses of the compiled functions linked into the FMU's library.  Where a vari
 ``u``, an output in the report ``r``, the time in the solver state) is an offset into the image.
 
 :func:`parameter_map` finds where each FMU parameter lands in the image, by building the model again with
-the parameter changed (:class:`~clutchlab.fmu.cosim.ContractCoSimulation` builds it from the component
-declarations): a parameter whose every changed number is an affine function of it (``a * value + b``; most
+the parameter changed (the co-simulation class builds it from the component declarations or parameter
+sets): a parameter whose every changed number is an affine function of it (``a * value + b``; most
 are copies, ``a = 1, b = 0``) is written by the native FMU itself; one that changes the image in any other
 way (an inertia stored as its inverse, a table rebuilt, the arrays' sizes) is fixed at export.
 """
@@ -216,6 +216,8 @@ class Target:
     a: float
     b: float
     reciprocal: bool = False
+    #: written only until initialisation ends (an input's start value of a state)
+    initial: bool = False
 
     def value(self, v: float) -> float:
         if self.a == 1.0 and self.b == 0.0 and not self.reciprocal:
@@ -239,35 +241,38 @@ def _fit(v0, v1, v2, y0, y1, y2):
     return None
 
 
-def parameter_map(cls, base: Image, build) -> dict:
-    """Where each parameter of the co-simulation class ``cls`` lands in the image ``base`` (module docstring).
+def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
+    """Where each of ``variables`` (parameters, or inputs) lands in the image ``base`` (module docstring).
 
     Parameters
     ----------
-    cls : type
-        A :class:`~clutchlab.fmu.cosim.ContractCoSimulation` class.
+    variables : sequence of clutchlab.fmu.cosim.Variable
+        A co-simulation class's parameters or inputs (their ``start``, ranges and names).
     base : Image
-        The image of ``cls()`` (every parameter at its start).
+        The image with every variable at its start.
     build : callable
-        ``build(values) -> Image``: the image of ``cls(**values)``, or None if the model refuses the values.
+        ``build(values) -> Image``: the image with the variables named in ``values`` changed (the others at
+        their start), or None if the model refuses the values.
+    label : str
+        For messages.
 
     Returns
     -------
     dict
-        Parameter name -> tuple of :class:`Target` (an empty tuple: the parameter changes nothing), or None
-        where the parameter changes the image in a way the FMU cannot repeat (fixed at export).
+        Name -> tuple of :class:`Target` (an empty tuple: the variable changes nothing), or None where it
+        changes the image in a way the FMU cannot repeat (fixed at export).
     """
     w0 = _words(base)
     again = build({})
     if again is None or not base.same_layout(again):
-        raise NativeExportError(f"{cls.__name__}: two builds of the same model differ in layout")
+        raise NativeExportError(f"{label}: two builds of the same model differ in layout")
     noise = w0 != _words(again)
     skip = np.zeros_like(noise)
     for slot in base.pointer_slots:
         skip[slot // 8] = True
     out = {}
     f0 = w0.view(np.float64)
-    for var in cls.parameters:
+    for var in variables:
         v0 = float(var.start)
         images = []
         for trial in _trials(var):
@@ -281,8 +286,10 @@ def parameter_map(cls, base: Image, build) -> dict:
             continue
         (v1, i1), (v2, i2) = images
         w1, w2 = _words(i1), _words(i2)
-        changed = ((w1 != w0) | (w2 != w0))
-        if np.any(changed & (noise | skip)):
+        # (a word that differs between two builds of the same values is memory the model never initialised:
+        # not a target, and no reason to refuse one)
+        changed = ((w1 != w0) | (w2 != w0)) & ~noise
+        if np.any(changed & skip):
             out[var.name] = None
             continue
         targets = []
@@ -308,7 +315,7 @@ def parameter_map(cls, base: Image, build) -> dict:
         if len(names) > 1:
             for name in names:
                 out[name] = None
-    return _checked_jointly(cls, base, build, out, noise | skip)
+    return _checked_jointly(variables, base, build, out, noise | skip)
 
 
 def _apply(image: Image, where: dict, values: dict) -> np.ndarray:
@@ -325,13 +332,13 @@ def _written(where: dict, values: dict) -> np.ndarray:
     return np.array(sorted({t.offset // 8 for name in values for t in where[name] or ()}), dtype=np.int64)
 
 
-def _checked_jointly(cls, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
+def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
     """Build the model with every writable parameter changed at once and compare with the image the FMU would
     write; a parameter whose numbers differ is fixed (repeated until they agree).  ``ignore``: the words that
     differ between two builds of the same values, and the pointers."""
     for _ in range(len(where) + 1):
         changed = {}
-        for var in cls.parameters:
+        for var in variables:
             if where.get(var.name):
                 trials = _trials(var)
                 if trials:
