@@ -240,7 +240,7 @@ int main(int argc, char **argv) {
         return 0;
     }
     if (strcmp(mode, "misuse") == 0) {
-        fmi2Component me = instantiate("me", fmi2ModelExchange, guid, "", &callbacks, fmi2False, fmi2False);
+        fmi2Component me = instantiate("me", (fmi2Type)7, guid, "", &callbacks, fmi2False, fmi2False);
         fmi2Component c = start(-1, 0.0);
         fmi2ValueReference bad = 99999;
         double y;

@@ -53,6 +53,7 @@ import numpy as np
 
 from clutchlab.numerics import core as _core
 from clutchlab.numerics import sampled as _sampled
+from clutchlab.numerics import exchange as _exchange
 from clutchlab.numerics import session as _session
 from clutchlab.numerics.borrow import borrow as _borrow, byref as _byref, take as _take
 from clutchlab.numerics.entry import rehome as _rehome
@@ -157,6 +158,13 @@ def evaluate_outputs(p, t, x, u, m, y):
 @numba.njit(cache=True, nogil=True)
 def outputs_at(p, T, X, u, M, Y):
     _core._outputs_at(p, T, X, u, M, Y)
+
+
+@numba.njit(cache=True, nogil=True)
+def model_exchange(s, what):
+    # the model's equations for an external integrator (clutchlab.numerics.exchange; a native FMU's Model
+    # Exchange), compiled only where a native FMU is exported
+    return _exchange.call(s, what)
 '''
 
 def rehome(fn, path: str, module: str, name: str):

@@ -41,7 +41,7 @@ __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATF
 #: the platforms a native FMU can carry
 PLATFORMS = ("linux64", "win64")
 
-_PARAMETER, _CONSTANT, _INPUT, _OUTPUT = 0, 1, 2, 3
+_PARAMETER, _CONSTANT, _INPUT, _OUTPUT, _STATE, _DERIVATIVE = 0, 1, 2, 3, 4, 5
 
 
 def native_identifier(name: str) -> str:
@@ -81,31 +81,108 @@ def _range_text(var) -> str:
     return f"{left}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
 
 
-def _model_header(cls, name, ident, guid, image, functions, variables, targets, fixed_step, system) -> str:
-    from ...numerics import status as st
+def _unit(unit: str) -> str:
+    """A column suffix's FMI unit (``"rad_s"`` -> ``"rad/s"``), or the unit itself."""
+    from ...units import COLUMN_UNITS
+    from ..cosim import fmi_unit
+
+    return fmi_unit(COLUMN_UNITS[unit][0]) if unit in COLUMN_UNITS else fmi_unit(unit) if unit else ""
+
+
+def _bind(image, variables, maps) -> tuple:
+    """Per variable, where it lives in ``image`` (``(offset, first target, number of targets)``), and the
+    targets; ``maps``: name -> targets in this image (parameters and inputs)."""
+    x, r = image.arg("x"), image.arg("r")
+    dx = image.arg("dx") if "dx" in image.names else None
+    x_span = (image.offset(x), image.offset(x) + x.nbytes) if x.size else (0, 0)
+    bindings, targets = [], []
+    for v in variables:
+        kind = v["kind"]
+        offset, first, n = 0, len(targets), 0
+        if kind in (_PARAMETER, _INPUT):
+            ts = maps[v["name"]] or ()
+            # an input that also sets a state (the wet bench's actuator force starts at its reference) sets it
+            # only until initialisation ends, as the model's own run takes it at its start
+            targets.extend(dataclasses.replace(t, initial=kind == _INPUT and x_span[0] <= t.offset < x_span[1])
+                           for t in ts)
+            n = len(ts)
+        elif kind == _OUTPUT:
+            offset = image.offset(r, v["index"])
+        elif kind == _STATE:
+            offset = image.offset(x, v["index"])
+        elif kind == _DERIVATIVE and dx is not None:
+            offset = image.offset(dx, v["index"])
+        bindings.append((offset, first, n))
+    return bindings, targets
+
+
+def _layout(tag, image, bindings, targets) -> list:
     from ...numerics.core import SF_T, SF_T0, SI_MODEL_CODE
+
+    sf, si = image.arg("sf"), image.arg("si")
+    data = image.data
+    lines = [f"static const unsigned char cl_image_{tag}[{len(data)}] = {{"]
+    for k in range(0, len(data), 32):
+        lines.append("    " + ",".join(str(b) for b in data[k:k + 32]) + ",")
+    lines.append("};")
+    lines.append(f"static const uint64_t cl_reloc_{tag}[{max(len(image.relocations), 1)}][2] = {{")
+    lines += [f"    {{{s}u, {t}u}}," for s, t in image.relocations] or ["    {0u, 0u},"]
+    lines.append("};")
+    lines.append(f"static const cl_target cl_targets_{tag}[{max(len(targets), 1)}] = {{")
+    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}, {int(t.initial)}}},"
+              for t in targets] or ["    {0u, 0.0, 0.0, 0, 0},"]
+    lines.append("};")
+    lines.append(f"static const cl_binding cl_bindings_{tag}[{len(bindings)}] = {{")
+    lines += [f"    {{{o}u, {f}, {n}}}," for o, f, n in bindings]
+    lines.append("};")
+    exchange = image.method == "exchange"
+    x = image.arg("x")
+    me = (f"{image.offset(x) if x.size else 0}u, {image.offset(image.arg('dx')) if x.size else 0}u, "
+          f"{image.offset(image.arg('g0')) if image.arg('g0').size else 0}u, "
+          f"{image.offset(image.arg('g1')) if image.arg('g1').size else 0}u, {image.offset(image.arg('out'))}u"
+          if exchange else "0u, 0u, 0u, 0u, 0u")
+    lines.append(f"static const cl_layout cl_layout_{tag} = {{cl_image_{tag}, {len(data)}u, cl_reloc_{tag}, "
+                 f"{len(image.relocations)}u, {image.function_slots[0]}u, {image.function_slots[1]}u, "
+                 f"{image.offset(sf, SF_T)}u, {image.offset(sf, SF_T0)}u, {image.offset(si, SI_MODEL_CODE)}u, "
+                 f"{me}, cl_targets_{tag}, cl_bindings_{tag}, {int(exchange)}}};")
+    return lines
+
+
+def model_exchange_possible(image) -> bool:
+    """Whether a model can be given to an external integrator: every state has a derivative (a model with
+    algebraic states, a zero in its mass matrix such as the E-clutch's massless tip, is solved by the core's
+    Rosenbrock method only)."""
+    import numpy as np
+
+    return bool(np.all(np.asarray(image.arg("opt").mass) != 0.0))
+
+
+def _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system) -> str:
+    from ...numerics import exchange as X, status as st
     from ...numerics.session import ADVANCE, OUTPUTS
     from ...system import FIXED_STEP_BUDGET
 
-    sim_args = image.args
-    sf, si = sim_args[4], sim_args[5]
+    cs, me = images
+    gdir = me.arg("opt").gdir
     lines = ["/* generated by clutchlab.fmu.native for one model; do not edit */", "#include <stddef.h>",
              "#include <stdint.h>",
              f"#define CL_MODEL_IDENTIFIER {_c_string(ident)}", f"#define CL_MODEL_NAME {_c_string(name)}",
-             f"#define CL_GUID {_c_string(guid)}", f"#define CL_IMAGE_BYTES {len(image.data)}u",
-             f"#define CL_NRELOC {len(image.relocations)}u",
-             f"#define CL_SLOT_ADVANCE {image.function_slots[0]}u", f"#define CL_SLOT_OUTPUTS {image.function_slots[1]}u",
-             f"#define CL_OFF_TIME {image.offset(sf, SF_T)}u", f"#define CL_OFF_T0 {image.offset(sf, SF_T0)}u",
-             f"#define CL_OFF_MODEL_CODE {image.offset(si, SI_MODEL_CODE)}u",
+             f"#define CL_GUID {_c_string(guid)}",
              f"#define CL_ADVANCE {ADVANCE}", f"#define CL_OUTPUTS {OUTPUTS}",
              f"#define CL_FIXED_STEP {_c_double(fixed_step)}", f"#define CL_FIXED_STEP_BUDGET {_c_double(FIXED_STEP_BUDGET)}",
              f"#define CL_STATUS_SUCCESS {st.SUCCESS}", f"#define CL_STATUS_TERMINATED {st.TERMINATED}",
              f"#define CL_STATUS_MODEL_ERROR {st.MODEL_ERROR}",
              f"#define CL_PARAMETER {_PARAMETER}", f"#define CL_CONSTANT {_CONSTANT}", f"#define CL_INPUT {_INPUT}",
-             f"#define CL_OUTPUT {_OUTPUT}", f"#define CL_NVARIABLES {len(variables)}u", ""]
+             f"#define CL_OUTPUT {_OUTPUT}", f"#define CL_STATE {_STATE}", f"#define CL_DERIVATIVE {_DERIVATIVE}",
+             f"#define CL_NVARIABLES {len(variables)}u", f"#define CL_NSTATES {me.arg('x').size}u",
+             f"#define CL_NINDICATORS {gdir.size}u", f"#define CL_HAS_ME {int(model_exchange_possible(cs))}",
+             *(f"#define CL_{k} {getattr(X, k)}" for k in ("ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART",
+                                                         "ME_STORE", "ME_OUTPUTS")), ""]
     # the compiled functions (hidden symbols of the model's object code)
     lines += [f"extern int32_t cl_session_call(int64_t *, void **, void *, double, int64_t) "
               f"__asm__({_c_string(functions.session)});",
+              f"extern int32_t cl_exchange_call(int64_t *, void **, void *, int64_t) "
+              f"__asm__({_c_string(functions.exchange)});",
               f"extern char cl_advance_symbol[] __asm__({_c_string(functions.advance)});",
               f"extern char cl_outputs_symbol[] __asm__({_c_string(functions.outputs)});",
               "static void *cl_advance_address(void) { return (void *)cl_advance_symbol; }",
@@ -116,52 +193,54 @@ def _model_header(cls, name, ident, guid, image, functions, variables, targets, 
     for k, (key, sym) in enumerate(sorted(functions.outlined.items())):
         lines.append(f"    if (key == (int64_t){key}LL) return (void *)cl_outlined_{k};")
     lines += ["    return NULL;", "}", ""]
-    # status and model error messages
     lines.append("static const char *cl_status_message(int64_t code) {")
-    for s in st.Status:
-        lines.append(f"    if (code == {int(s)}) return {_c_string(s.message)};")
+    for s_ in st.Status:
+        lines.append(f"    if (code == {int(s_)}) return {_c_string(s_.message)};")
     lines += ['    return "unknown status";', "}", "static const char *cl_model_error(int64_t code) {"]
     for code, text in sorted((getattr(system, "error_messages", None) or {}).items()):
         lines.append(f"    if (code == {int(code)}) return {_c_string(text)};")
     lines += ["    return NULL;", "}", ""]
-    # image and relocations
-    data = image.data
-    lines.append(f"static const unsigned char cl_image[{len(data)}] = {{")
-    for k in range(0, len(data), 32):
-        lines.append("    " + ",".join(str(b) for b in data[k:k + 32]) + ",")
-    lines.append("};")
-    lines.append(f"static const uint64_t cl_reloc[{max(len(image.relocations), 1)}][2] = {{")
-    lines += [f"    {{{s}u, {t}u}}," for s, t in image.relocations] or ["    {0u, 0u},"]
-    lines.append("};")
-    # variables
+    # which switching functions are events (a waypoint, |gdir| = 3, only guides the core's steps)
+    lines.append(f"static const int cl_event_indicator[{max(gdir.size, 1)}] = {{"
+                 + ", ".join(str(int(abs(int(d)) != 3)) for d in gdir) + ("" if gdir.size else "0") + "};")
+    lines.append(f"static const int cl_gdir[{max(gdir.size, 1)}] = {{"
+                 + ", ".join(str(int(d)) for d in gdir) + ("" if gdir.size else "0") + "};")
     lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal, initial; } cl_target;",
+              "typedef struct { uint64_t offset; int first, ntargets; } cl_binding;",
+              "typedef struct { const unsigned char *image; uint64_t bytes; const uint64_t (*reloc)[2]; uint64_t nreloc; "
+              "uint64_t slot_advance, slot_outputs, off_time, off_t0, off_model_code, off_x, off_dx, off_g0, off_g1, off_out; "
+              "const cl_target *targets; const cl_binding *bindings; int exchange; } cl_layout;",
               "typedef struct { const char *name; const char *unit; int kind; double start; int has_min, has_max, "
-              "positive; double min, max; const char *range_text; uint64_t offset; int first, ntargets; } cl_variable;",
-              f"static const cl_target cl_targets[{max(len(targets), 1)}] = {{"]
-    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}, {int(t.initial)}}},"
-              for t in targets] or ["    {0u, 0.0, 0.0, 0, 0},"]
-    lines.append("};")
+              "positive; double min, max; const char *range_text; } cl_variable;"]
+    for tag, image, (bindings, targets) in zip(("cs", "me"), images, layouts):
+        lines += _layout(tag, image, bindings, targets)
     lines.append(f"static const cl_variable cl_variables[{len(variables)}] = {{")
     for v in variables:
         lo, hi = v["bounds"]
         lines.append(f"    {{{_c_string(v['name'])}, {_c_string(v['unit'])}, {v['kind']}, {_c_double(v['start'])}, "
                      f"{int(lo is not None)}, {int(hi is not None)}, {int(v['positive'])}, "
                      f"{_c_double(lo if lo is not None else 0.0)}, {_c_double(hi if hi is not None else 0.0)}, "
-                     f"{_c_string(v['range'])}, {v['offset']}u, {v['first']}, {v['ntargets']}}},")
+                     f"{_c_string(v['range'])}}},")
     lines.append("};")
     return "\n".join(lines) + "\n"
 
 
-def _description(cls, name, ident, guid, variables, experiment) -> bytes:
+def _description(cls, name, ident, guid, variables, experiment, n_indicators, exchange=True) -> bytes:
     from ... import __version__
     from ..export import unit_definition
 
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": name, "guid": guid,
-        "description": f"clutchlab {cls.name or 'model'} {name} (native co-simulation FMU: no Python needed)",
+        "description": f"clutchlab {cls.name or 'model'} {name} (native FMU: no Python needed)",
         "generationTool": f"clutchlab {__version__} (native)",
         "generationDateAndTime": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "variableNamingConvention": "structured", "numberOfEventIndicators": "0"})
+        "variableNamingConvention": "structured", "numberOfEventIndicators": str(n_indicators)})
+    if exchange:
+        ET.SubElement(root, "ModelExchange", {
+            "modelIdentifier": ident, "completedIntegratorStepNotNeeded": "false",
+            "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
+            "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
+            "providesDirectionalDerivative": "false"})
     ET.SubElement(root, "CoSimulation", {
         "modelIdentifier": ident, "canHandleVariableCommunicationStepSize": "true",
         "canInterpolateInputs": "false", "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
@@ -180,7 +259,7 @@ def _description(cls, name, ident, guid, variables, experiment) -> bytes:
     ET.SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(stop)),
                                               "stepSize": repr(float(step))})
     mv = ET.SubElement(root, "ModelVariables")
-    outputs = []
+    outputs, derivatives, states = [], [], []
     for vr, v in enumerate(variables):
         attrs = {"name": v["name"], "valueReference": str(vr)}
         if v["description"]:
@@ -188,16 +267,23 @@ def _description(cls, name, ident, guid, variables, experiment) -> bytes:
         real = {}
         if v["unit"]:
             real["unit"] = v["unit"]
-        if v["kind"] == _PARAMETER:
+        kind = v["kind"]
+        if kind == _PARAMETER:
             attrs.update(causality="parameter", variability="fixed", initial="exact")
-        elif v["kind"] == _CONSTANT:
+        elif kind == _CONSTANT:
             attrs.update(causality="local", variability="constant", initial="exact")
-        elif v["kind"] == _INPUT:
+        elif kind == _INPUT:
             attrs.update(causality="input", variability="continuous")
-        else:
+        elif kind == _OUTPUT:
             attrs.update(causality="output", variability="continuous", initial="calculated")
             outputs.append(vr + 1)
-        if v["kind"] != _OUTPUT:
+        elif kind == _STATE:
+            attrs.update(causality="local", variability="continuous", initial="calculated")
+        else:
+            attrs.update(causality="local", variability="continuous", initial="calculated")
+            real["derivative"] = str(v["state_vr"] + 1)
+            derivatives.append(vr + 1)
+        if kind in (_PARAMETER, _CONSTANT, _INPUT):
             real["start"] = repr(float(v["start"]))
             lo, hi = v["bounds"]
             if lo is not None:
@@ -211,9 +297,14 @@ def _description(cls, name, ident, guid, variables, experiment) -> bytes:
         out = ET.SubElement(ms, "Outputs")
         for i in outputs:
             ET.SubElement(out, "Unknown", {"index": str(i)})
-        init = ET.SubElement(ms, "InitialUnknowns")
-        for i in outputs:
-            ET.SubElement(init, "Unknown", {"index": str(i)})
+    if derivatives:
+        der = ET.SubElement(ms, "Derivatives")
+        for i in derivatives:
+            ET.SubElement(der, "Unknown", {"index": str(i)})
+    init = ET.SubElement(ms, "InitialUnknowns")
+    states = [v["state_vr"] + 1 for v in variables if v["kind"] == _DERIVATIVE and variables[v["state_vr"]]["kind"] == _STATE]
+    for i in sorted(set(outputs) | set(derivatives) | set(states)):
+        ET.SubElement(init, "Unknown", {"index": str(i)})
     ET.indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
 
@@ -277,62 +368,89 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     if name is None:
         name = network or cls.name or "model"
     ident = native_identifier(name) if network is not None or name != cls.name else _model_identifier(cls.name)
-    image = session_image(base_obj.simulation)
+    images = (session_image(base_obj.simulation), session_image(base_obj.simulation, exchange=True))
+    built = {}
 
     def build(parameters=None, inputs=None):
-        try:
-            obj = cls(**(parameters or {}))
-            obj.hold_inputs(inputs or {})
-        except (ParameterError, ValueError):
-            return None
-        return session_image(obj.simulation)
+        """Both images of the model with these parameters and inputs (None: refused)."""
+        key = (tuple(sorted((parameters or {}).items())), tuple(sorted((inputs or {}).items())))
+        if key == ((), ()):   # (built afresh: two builds of the same values tell the model's uninitialised memory)
+            built.pop(key, None)
+        if key not in built:
+            try:
+                obj = cls(**(parameters or {}))
+                obj.hold_inputs(inputs or {})
+            except (ParameterError, ValueError):
+                built[key] = None
+            else:
+                built[key] = (session_image(obj.simulation), session_image(obj.simulation, exchange=True))
+        return built[key]
 
-    where = parameter_map(cls.parameters, image, lambda values: build(parameters=values), cls.__name__)
-    inputs_at = parameter_map(cls.inputs, image, lambda values: build(inputs=values), cls.__name__)
+    def pick(images_or_none, k):
+        return None if images_or_none is None else images_or_none[k]
+
+    where = [parameter_map(cls.parameters, images[k], lambda v, k=k: pick(build(parameters=v), k), cls.__name__)
+             for k in (0, 1)]
+    inputs_at = [parameter_map(cls.inputs, images[k], lambda v, k=k: pick(build(inputs=v), k), cls.__name__)
+                 for k in (0, 1)]
+    built.clear()
     for v in cls.inputs:
-        if inputs_at[v.name] is None:
+        if inputs_at[0][v.name] is None or inputs_at[1][v.name] is None:
             raise NativeExportError(f"{cls.__name__}: input {v.name} reaches the model in a way a native FMU "
                                     "cannot repeat (not a * value + b)")
     bounds = dict(getattr(base_obj, "input_bounds", lambda: {})())
-    x = image.args[1]
-    x_span = (image.offset(x), image.offset(x) + x.nbytes) if x.size else (0, 0)
-    functions = session_functions(image)
+    functions = session_functions(images[0]).with_exchange(session_functions(images[1]))
     simulation = base_obj.simulation
+    system = simulation.system
     fixed_step = float(simulation.fixed_step)
-    variables, targets = [], []
+    variables = []
     for v in cls.parameters:
-        t = where.get(v.name)
-        entry = {"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
-                 "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "offset": 0,
-                 "first": len(targets), "ntargets": 0, "kind": _PARAMETER if t is not None else _CONSTANT}
-        if t is not None:
-            targets.extend(t)
-            entry["ntargets"] = len(t)
-        variables.append(entry)
-    r = image.args[16]
+        writable = where[0].get(v.name) is not None and where[1].get(v.name) is not None
+        variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
+                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v),
+                          "kind": _PARAMETER if writable else _CONSTANT})
     for v in cls.inputs:
         if v.name in bounds:   # (a range that follows the parameters: the bench's actuator limit)
             v = dataclasses.replace(v, minimum=bounds[v.name][0], maximum=bounds[v.name][1])
         variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
-                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "offset": 0,
-                          "first": len(targets), "ntargets": len(inputs_at[v.name]), "kind": _INPUT})
-        # an input that also sets a state (the wet bench's actuator force starts at its reference) sets it only
-        # until initialisation ends, as the model's own run takes it at its start
-        targets.extend(dataclasses.replace(t, initial=x_span[0] <= t.offset < x_span[1]) for t in inputs_at[v.name])
+                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "kind": _INPUT})
+    r = images[0].arg("r")
     if r.shape[0] != len(cls.outputs):
         raise NativeExportError(f"{cls.__name__}: {r.shape[0]} reported values for {len(cls.outputs)} outputs")
+    report_spec = images[0].arg("report")
+    state_vr = {}
     for k, v in enumerate(cls.outputs):
+        if int(report_spec[k, 0]) == 1 and int(report_spec[k, 1]) not in state_vr:   # (REPORT_STATE)
+            state_vr[int(report_spec[k, 1])] = len(variables)
         variables.append({"name": v.name, "unit": v.unit, "start": 0.0, "description": v.description,
-                          "bounds": (None, None), "positive": False, "range": "", "offset": image.offset(r, k),
-                          "first": 0, "ntargets": 0, "kind": _OUTPUT})
+                          "bounds": (None, None), "positive": False, "range": "", "kind": _OUTPUT, "index": k})
+    names = {v["name"] for v in variables}
+    for i, sv in enumerate(system.states):   # the states no output reports: locals of their own
+        if i not in state_vr:
+            state_vr[i] = len(variables)
+            label = f"state.{sv.name}" if f"state.{sv.name}" not in names else f"state[{i + 1}]"
+            variables.append({"name": label, "unit": _unit(sv.unit), "start": 0.0, "description": sv.description,
+                              "bounds": (None, None), "positive": False, "range": "", "kind": _STATE, "index": i})
+    for i, sv in enumerate(system.states):
+        state = variables[state_vr[i]]
+        unit = f"{state['unit']}/s" if state["unit"] not in ("", "1") else "1/s"
+        variables.append({"name": f"der({state['name']})", "unit": unit, "start": 0.0,
+                          "description": f"time derivative of {state['name']}", "bounds": (None, None),
+                          "positive": False, "range": "", "kind": _DERIVATIVE, "index": i, "state_vr": state_vr[i]})
+    layouts = [_bind(images[k], variables, {**where[k], **inputs_at[k]}) for k in (0, 1)]
     objects = {p: emit_object(functions, p) for p in platforms}
-    digest = hashlib.sha256(image.data + repr([(v["name"], v["kind"]) for v in variables]).encode()
+    digest = hashlib.sha256(images[0].data + images[1].data + repr([(v["name"], v["kind"]) for v in variables]).encode()
                             + b"".join(hashlib.sha256(o).digest() for o in objects.values()))
     guid = "{" + str(uuid.UUID(bytes=digest.digest()[:16])) + "}"
-    header = _model_header(cls, name, ident, guid, image, functions, variables, targets, fixed_step,
-                           simulation.system)
+    header = _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system)
     experiment = cls.experiment or (1.0, 1e-3)
-    description = _description(cls, name, ident, guid, variables, experiment)
+    exchange = model_exchange_possible(images[0])
+    if not exchange:   # (no model exchange: the states and derivatives are not listed)
+        variables = [v for v in variables if v["kind"] not in (_STATE, _DERIVATIVE)]
+        layouts = [(b[:len(variables)], t) for b, t in layouts]
+        header = _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system)
+    description = _description(cls, name, ident, guid, variables, experiment,
+                               images[1].arg("g1").size if exchange else 0, exchange)
     buf = io.BytesIO()
     with tempfile.TemporaryDirectory(prefix="clutchlab_native_") as tmp:
         tmp = Path(tmp)
@@ -353,6 +471,7 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
                 z.writestr(info, data)
     if report is not None:
         n_fixed = sum(v["kind"] == _CONSTANT for v in variables)
-        report(f"native FMU {ident} ({', '.join(platforms)}): {len(cls.inputs)} inputs, {len(cls.outputs)} outputs, "
+        report(f"native FMU {ident} ({', '.join(platforms)}; {'co-simulation and model exchange' if exchange else 'co-simulation'}): "
+               f"{len(cls.inputs)} inputs, {len(cls.outputs)} outputs, "
                f"{len(cls.parameters) - n_fixed} parameters ({n_fixed} fixed at export)")
     return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)

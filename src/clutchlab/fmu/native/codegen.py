@@ -47,6 +47,15 @@ class SessionFunctions:
     outlined: dict
     #: (symbol, llvm module for linking) of every entry
     modules: list
+    #: the model-exchange entry's symbol (:func:`exchange_function`), or None
+    exchange: str | None = None
+
+    def with_exchange(self, other: "SessionFunctions") -> "SessionFunctions":
+        """These functions and the model-exchange entry of ``other`` (one object for both)."""
+        have = {name for name, _ in self.modules}
+        modules = self.modules + [(n, m) for n, m in other.modules if n not in have]
+        return SessionFunctions(self.session, self.advance, self.outputs, {**self.outlined, **other.outlined},
+                                modules, other.exchange)
 
     def cache_key(self, triple: str) -> str:
         import llvmlite
@@ -75,17 +84,21 @@ def _cres(dispatcher, sig):
 
 def session_functions(image) -> SessionFunctions:
     """The compiled functions a session (:class:`~clutchlab.fmu.native.image.Image`) calls, with their LLVM
-    modules."""
+    modules; for a model-exchange image, its ``model_exchange`` entry (``exchange``)."""
     from numba.core import types
 
     from ...numerics import outline, session as S
 
-    module, outputs_module, args = image.entry_modules
+    module, outputs_module, _ = image.entry_modules
+    args = image.args
     args_ty = module.session.typeof_pyval(args)
     a = args_ty.types
-    c_adv = _cres(module.advance, a[:4] + (types.float64,) + a[4:14])
-    c_out = _cres(outputs_module.evaluate_outputs, (a[0], types.float64, a[1], a[3], a[2], a[14]))
-    c_ses = _cres(module.session, (S.SessionType(args_ty), types.float64, types.int64))
+    if image.method == "exchange":
+        firsts = [_cres(outputs_module.model_exchange, (S.SessionType(args_ty), types.int64))]
+    else:
+        firsts = [_cres(module.session, (S.SessionType(args_ty), types.float64, types.int64)),
+                  _cres(module.advance, a[:4] + (types.float64,) + a[4:14]),
+                  _cres(outputs_module.evaluate_outputs, (a[0], types.float64, a[1], a[3], a[2], a[14]))]
     modules = []
     seen = set()
     todo = set()
@@ -97,7 +110,7 @@ def session_functions(image) -> SessionFunctions:
         todo.update(int(k, 16) for k in _OUTLINED.findall(str(mod)))
         return name
 
-    names = [add(c) for c in (c_ses, c_adv, c_out)]
+    names = [add(c) for c in firsts]
     outlined = {}
     while todo:
         key = todo.pop()
@@ -111,6 +124,8 @@ def session_functions(image) -> SessionFunctions:
         if not S.native_address(entry.dispatcher, entry.sig(), entry.returns):
             raise NativeExportError(f"{entry.label}{entry.sig()} does not return {entry.returns}")
         outlined[key] = add(_cres(entry.dispatcher, entry.sig()))
+    if image.method == "exchange":
+        return SessionFunctions("", "", "", outlined, modules, names[0])
     return SessionFunctions(names[0], names[1], names[2], outlined, modules)
 
 

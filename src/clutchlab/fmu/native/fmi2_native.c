@@ -1,11 +1,13 @@
-/* The FMI 2.0 co-simulation layer of a clutchlab native FMU (clutchlab.fmu.native).
+/* The FMI 2.0 layer (co-simulation and model exchange) of a clutchlab native FMU (clutchlab.fmu.native).
  *
  * Compiled, with the generated model.h of one model, into the FMU's shared library beside the object code
  * of the model's compiled session (clutchlab.fmu.native.codegen) and numba's runtime (nrt.cpp).  Nothing
  * of Python is involved: an instance is a private copy of the session's image (the table of the compiled
  * session entry and the memory of its arrays, clutchlab.fmu.native.image) whose pointers are relocated to
  * the copy; a step is one call of the compiled session entry, which advances the integrator core to the
- * communication point and writes the outputs.
+ * communication point and writes the outputs.  In model exchange an instance is a copy of the model-exchange
+ * image instead, and the host's solver calls the compiled model_exchange entry (clutchlab.numerics.exchange)
+ * for derivatives, event indicators and the mode updates at events.
  *
  * No globals but constants and the one-time initialisation of numba's runtime, so instances may live side
  * by side and in threads (one thread per instance at a time, as FMI requires).  Every refusal returns
@@ -42,15 +44,18 @@ static void cl_nrt_init(void) {
 void *clutchlab_outline_resolve_v1(int64_t key) { return cl_outline_lookup(key); }
 
 /* ---------------------------------------------------------------- instances */
-enum { CL_INSTANTIATED, CL_INITIALIZATION, CL_STEPPING, CL_TERMINATED, CL_ERROR };
+enum { CL_INSTANTIATED, CL_INITIALIZATION, CL_STEPPING, CL_TERMINATED, CL_ERROR, CL_EVENT, CL_CONTINUOUS };
 
 typedef struct {
-    unsigned char *mem;      /* the instance's copy of the image (CL_IMAGE_BYTES) */
+    const cl_layout *L;      /* the image of the instance's kind: co-simulation or model exchange */
+    unsigned char *mem;      /* the instance's copy of the image (L->bytes) */
     double *values;          /* the value of every parameter, constant and input (by value reference) */
     int outputs_stale;       /* inputs or parameters changed since the outputs were computed */
     int state;
     int terminated;
     int logging;
+    int inputs_changed;      /* model exchange: an input was set since the last event */
+    double next_time;        /* model exchange: the next time event (INFINITY: none) */
     char *name;
     fmi2CallbackFunctions cb;
 } cl_instance;
@@ -66,6 +71,8 @@ typedef struct {
     int outputs_stale;
     int terminated;
     int state;
+    int inputs_changed;
+    double next_time;
 } cl_state;
 
 static void cl_log(cl_instance *c, fmi2Status status, const char *category, const char *fmt, ...) {
@@ -81,27 +88,28 @@ static void cl_log(cl_instance *c, fmi2Status status, const char *category, cons
 
 static double *cl_at(cl_instance *c, uint64_t offset) { return (double *)(c->mem + offset); }
 
-static void cl_relocate(unsigned char *mem) {
+static void cl_relocate(const cl_layout *L, unsigned char *mem) {
     size_t k;
-    for (k = 0; k < CL_NRELOC; k++) {
-        uint64_t address = (uint64_t)(uintptr_t)(mem + cl_reloc[k][1]);
-        memcpy(mem + cl_reloc[k][0], &address, sizeof address);
+    for (k = 0; k < L->nreloc; k++) {
+        uint64_t address = (uint64_t)(uintptr_t)(mem + L->reloc[k][1]);
+        memcpy(mem + L->reloc[k][0], &address, sizeof address);
     }
-    {
+    if (!L->exchange) {
         uint64_t a = (uint64_t)(uintptr_t)cl_advance_address();
         uint64_t o = (uint64_t)(uintptr_t)cl_outputs_address();
-        memcpy(mem + CL_SLOT_ADVANCE, &a, sizeof a);
-        memcpy(mem + CL_SLOT_OUTPUTS, &o, sizeof o);
+        memcpy(mem + L->slot_advance, &a, sizeof a);
+        memcpy(mem + L->slot_outputs, &o, sizeof o);
     }
 }
 
 static void cl_apply(cl_instance *c, int vr) {
     const cl_variable *v = &cl_variables[vr];
+    const cl_binding *b = &c->L->bindings[vr];
     int k;
     double value = c->values[vr];
     if (v->kind == CL_PARAMETER || v->kind == CL_INPUT) {
-        for (k = 0; k < v->ntargets; k++) {
-            const cl_target *t = &cl_targets[v->first + k];
+        for (k = 0; k < b->ntargets; k++) {
+            const cl_target *t = &c->L->targets[b->first + k];
             if (t->initial && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION) continue;
             *cl_at(c, t->offset) = t->reciprocal ? t->a / value + t->b
                                    : t->a == 1.0 && t->b == 0.0 ? value : t->a * value + t->b;
@@ -111,31 +119,51 @@ static void cl_apply(cl_instance *c, int vr) {
 
 static void cl_load_image(cl_instance *c) {
     size_t k;
-    memcpy(c->mem, cl_image, CL_IMAGE_BYTES);
-    cl_relocate(c->mem);
+    memcpy(c->mem, c->L->image, c->L->bytes);
+    cl_relocate(c->L, c->mem);
     for (k = 0; k < CL_NVARIABLES; k++) c->values[k] = cl_variables[k].start;
     c->outputs_stale = 1;
     c->terminated = 0;
+    c->inputs_changed = 0;
+    c->next_time = INFINITY;
 }
 
 /* one call of the compiled session entry: numba's calling convention (status; result through a pointer) */
 static int cl_call(cl_instance *c, double t_end, int64_t what, int64_t *code) {
     int64_t result = 0;
     void *excinfo = NULL;
-    int32_t status = cl_session_call(&result, &excinfo, c->mem, t_end, what);
+    int32_t status = c->L->exchange ? cl_exchange_call(&result, &excinfo, c->mem, what)
+                                     : cl_session_call(&result, &excinfo, c->mem, t_end, what);
     if (status != 0 && status != -2) { /* (-2: returned None; anything else an exception) */
         cl_log(c, fmi2Error, "logStatusError",
-               "the compiled model raised an exception (status %d) at t = %g s", (int)status, *cl_at(c, CL_OFF_TIME));
+               "the compiled model raised an exception (status %d) at t = %g s", (int)status,
+               *cl_at(c, c->L->off_time));
         return 0;
     }
     *code = result;
     return 1;
 }
 
+/* model exchange: one operation of the compiled model_exchange entry; a model error is logged */
+static int cl_exchange(cl_instance *c, int64_t what, int64_t *code) {
+    if (!cl_call(c, 0.0, what, code)) return 0;
+    if (*code < 0) {
+        const char *model = cl_model_error(*code);
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s (at t = %g s)", CL_MODEL_NAME,
+               model != NULL ? model : "the model reported an error", *cl_at(c, c->L->off_time));
+        return 0;
+    }
+    return 1;
+}
+
 static int cl_outputs(cl_instance *c) {
     int64_t code;
     if (!c->outputs_stale) return 1;
-    if (!cl_call(c, 0.0, CL_OUTPUTS, &code)) return 0;
+    if (c->L->exchange) {
+        if (!cl_exchange(c, CL_ME_OUTPUTS | CL_ME_DERIVATIVES, &code)) return 0;
+    } else if (!cl_call(c, 0.0, CL_OUTPUTS, &code)) {
+        return 0;
+    }
     c->outputs_stale = 0;
     return 1;
 }
@@ -181,9 +209,15 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
                           "fmi2Instantiate: missing instance name");
         return NULL;
     }
-    if (type != fmi2CoSimulation) {
+    if (type != fmi2CoSimulation && type != fmi2ModelExchange) {
         functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
-                          "fmi2Instantiate: this FMU is for co-simulation only (%s)", CL_MODEL_IDENTIFIER);
+                          "fmi2Instantiate: unknown FMU type %d (%s)", (int)type, CL_MODEL_IDENTIFIER);
+        return NULL;
+    }
+    if (type == fmi2ModelExchange && !CL_HAS_ME) {
+        functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: %s has algebraic states (solved by clutchlab's Rosenbrock method): "
+                          "co-simulation only", CL_MODEL_IDENTIFIER);
         return NULL;
     }
     if (guid == NULL || strcmp(guid, CL_GUID) != 0) {
@@ -195,9 +229,10 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     c = (cl_instance *)calloc(1, sizeof *c);
     if (c == NULL) return NULL;
     c->cb = *functions;
+    c->L = type == fmi2ModelExchange ? &cl_layout_me : &cl_layout_cs;
     c->logging = logging ? 1 : 0;
     c->name = (char *)malloc(strlen(name) + 1);
-    c->mem = (unsigned char *)malloc(CL_IMAGE_BYTES);
+    c->mem = (unsigned char *)malloc(c->L->bytes);
     c->values = (double *)calloc(CL_NVARIABLES ? CL_NVARIABLES : 1, sizeof(double));
     if (c->name == NULL || c->mem == NULL || c->values == NULL) {
         functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
@@ -237,8 +272,8 @@ FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean toler
         cl_log(c, fmi2Error, "logStatusError", "fmi2SetupExperiment: start time %g is not finite", start);
         return fmi2Error;
     }
-    *cl_at(c, CL_OFF_TIME) = start;
-    *cl_at(c, CL_OFF_T0) = start;
+    *cl_at(c, c->L->off_time) = start;
+    *cl_at(c, c->L->off_t0) = start;
     if (tolerance_defined)
         cl_log(c, fmi2OK, "logEvents",
                "fmi2SetupExperiment: tolerance %g ignored: the parameter rtol sets the model's tolerance", tolerance);
@@ -262,6 +297,18 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
     if (c->state != CL_INITIALIZATION) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2ExitInitializationMode: not in initialisation mode");
         return fmi2Error;
+    }
+    if (c->L->exchange) { /* the modes decided at the start, as the core's first step does; then event mode */
+        int64_t code;
+        if (!cl_exchange(c, CL_ME_RESTART | CL_ME_STORE | CL_ME_OUTPUTS, &code)) {
+            c->state = CL_ERROR;
+            return fmi2Error;
+        }
+        c->next_time = *cl_at(c, c->L->off_out);   /* (the next time event, from the start) */
+        c->outputs_stale = 0;
+        c->inputs_changed = 0;
+        c->state = CL_EVENT;
+        return fmi2OK;
     }
     if (!cl_outputs(c)) {
         c->state = CL_ERROR;
@@ -304,12 +351,19 @@ FMI2_Export fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference 
         const cl_variable *v;
         if (cl_bad_vr(c, "fmi2GetReal", vr[k])) return fmi2Error;
         v = &cl_variables[vr[k]];
-        if (v->kind == CL_OUTPUT) {
+        if (v->kind == CL_OUTPUT || v->kind == CL_DERIVATIVE) {
+            if (v->kind == CL_DERIVATIVE && !c->L->exchange) {
+                cl_log(c, fmi2Error, "logStatusError", "fmi2GetReal: %s: derivatives are given in model exchange",
+                       v->name);
+                return fmi2Error;
+            }
             if (!cl_outputs(c)) {
                 c->state = CL_ERROR;
                 return fmi2Error;
             }
-            value[k] = *cl_at(c, v->offset);
+            value[k] = *cl_at(c, c->L->bindings[vr[k]].offset);
+        } else if (v->kind == CL_STATE) {
+            value[k] = *cl_at(c, c->L->bindings[vr[k]].offset);
         } else {
             value[k] = c->values[vr[k]];
         }
@@ -340,9 +394,10 @@ FMI2_Export fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference 
         const cl_variable *v;
         if (cl_bad_vr(c, "fmi2SetReal", vr[k])) return fmi2Error;
         v = &cl_variables[vr[k]];
-        if (v->kind == CL_OUTPUT || v->kind == CL_CONSTANT) {
+        if (v->kind != CL_PARAMETER && v->kind != CL_INPUT) {
             cl_log(c, fmi2Error, "logStatusError", "fmi2SetReal: %s is %s and cannot be set", v->name,
-                   v->kind == CL_OUTPUT ? "an output" : "fixed at export");
+                   v->kind == CL_OUTPUT ? "an output" : v->kind == CL_CONSTANT ? "fixed at export"
+                   : "a state or derivative (fmi2SetContinuousStates sets the states)");
             return fmi2Error;
         }
         if (v->kind == CL_PARAMETER && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION) {
@@ -355,6 +410,7 @@ FMI2_Export fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference 
     for (k = 0; k < n; k++) {
         c->values[vr[k]] = value[k];
         cl_apply(c, (int)vr[k]);
+        if (cl_variables[vr[k]].kind == CL_INPUT) c->inputs_changed = 1;
     }
     if (n) c->outputs_stale = 1;
     return fmi2OK;
@@ -404,7 +460,7 @@ FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *out) {
     if (s == NULL) {
         s = (cl_state *)calloc(1, sizeof *s);
         if (s == NULL) return fmi2Error;
-        s->mem = (unsigned char *)malloc(CL_IMAGE_BYTES);
+        s->mem = (unsigned char *)malloc(c->L->bytes);
         s->values = (double *)calloc(CL_NVARIABLES ? CL_NVARIABLES : 1, sizeof(double));
         if (s->mem == NULL || s->values == NULL) {
             free(s->mem);
@@ -419,12 +475,14 @@ FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *out) {
     }
     s->magic = CL_MAGIC;
     s->version = 1;
-    s->image_bytes = CL_IMAGE_BYTES;
-    memcpy(s->mem, c->mem, CL_IMAGE_BYTES);
+    s->image_bytes = c->L->bytes;
+    memcpy(s->mem, c->mem, c->L->bytes);
     memcpy(s->values, c->values, CL_NVARIABLES * sizeof(double));
     s->outputs_stale = c->outputs_stale;
     s->terminated = c->terminated;
     s->state = c->state;
+    s->inputs_changed = c->inputs_changed;
+    s->next_time = c->next_time;
     *out = (fmi2FMUstate)s;
     return fmi2OK;
 }
@@ -433,16 +491,18 @@ FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state) {
     cl_instance *c = cl_check(comp, "fmi2SetFMUstate");
     cl_state *s = (cl_state *)state;
     if (c == NULL) return fmi2Error;
-    if (s == NULL || s->magic != CL_MAGIC || s->image_bytes != CL_IMAGE_BYTES) {
+    if (s == NULL || s->magic != CL_MAGIC || s->image_bytes != c->L->bytes) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2SetFMUstate: not a state of this FMU");
         return fmi2Error;
     }
-    memcpy(c->mem, s->mem, CL_IMAGE_BYTES);
-    cl_relocate(c->mem); /* (a state taken from another instance points into that one's memory) */
+    memcpy(c->mem, s->mem, c->L->bytes);
+    cl_relocate(c->L, c->mem); /* (a state taken from another instance points into that one's memory) */
     memcpy(c->values, s->values, CL_NVARIABLES * sizeof(double));
     c->outputs_stale = s->outputs_stale;
     c->terminated = s->terminated;
     c->state = s->state;
+    c->inputs_changed = s->inputs_changed;
+    c->next_time = s->next_time;
     return fmi2OK;
 }
 
@@ -464,12 +524,13 @@ FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
 
 /* serialised: "CLFS", version, the GUID, the image, the values, three flags (all little-endian, as written) */
 #define CL_SER_HEADER (4 + 4 + 40)
-#define CL_SER_BYTES (CL_SER_HEADER + CL_IMAGE_BYTES + CL_NVARIABLES * sizeof(double) + 3 * sizeof(int32_t))
+#define CL_SER_BYTES(c) (CL_SER_HEADER + (c)->L->bytes + CL_NVARIABLES * sizeof(double) + 4 * sizeof(int32_t) \
+                         + sizeof(double))
 
 FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size) {
     (void)state;
     if (comp == NULL || size == NULL) return fmi2Error;
-    *size = CL_SER_BYTES;
+    *size = CL_SER_BYTES((cl_instance *)comp);
     return fmi2OK;
 }
 
@@ -478,12 +539,12 @@ FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate st
     cl_state *s = (cl_state *)state;
     unsigned char *p = (unsigned char *)out;
     uint32_t magic = CL_MAGIC, version = 1;
-    int32_t flags[3];
+    int32_t flags[4];
     char guid[40];
     if (c == NULL) return fmi2Error;
-    if (s == NULL || s->magic != CL_MAGIC || out == NULL || size < CL_SER_BYTES) {
-        cl_log(c, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: not a state of this FMU, or %u bytes "
-               "given for %u", (unsigned)size, (unsigned)CL_SER_BYTES);
+    if (s == NULL || s->magic != CL_MAGIC || out == NULL || size < CL_SER_BYTES(c) || s->image_bytes != c->L->bytes) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: not a state of this instance, or %u bytes "
+               "given for %u", (unsigned)size, (unsigned)CL_SER_BYTES(c));
         return fmi2Error;
     }
     memset(guid, 0, sizeof guid);
@@ -492,14 +553,16 @@ FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate st
     memcpy(p + 4, &version, 4);
     memcpy(p + 8, guid, 40);
     p += CL_SER_HEADER;
-    memcpy(p, s->mem, CL_IMAGE_BYTES);
-    p += CL_IMAGE_BYTES;
+    memcpy(p, s->mem, c->L->bytes);
+    p += c->L->bytes;
     memcpy(p, s->values, CL_NVARIABLES * sizeof(double));
     p += CL_NVARIABLES * sizeof(double);
     flags[0] = s->outputs_stale;
     flags[1] = s->terminated;
     flags[2] = s->state;
+    flags[3] = s->inputs_changed;
     memcpy(p, flags, sizeof flags);
+    memcpy(p + sizeof flags, &s->next_time, sizeof(double));
     return fmi2OK;
 }
 
@@ -509,15 +572,15 @@ FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byt
     const unsigned char *p = (const unsigned char *)in;
     uint32_t magic, version;
     char guid[40];
-    int32_t flags[3];
+    int32_t flags[4];
     cl_state *s;
     fmi2Status status;
     if (c == NULL || state == NULL) return fmi2Error;
     memset(guid, 0, sizeof guid);
     strncpy(guid, CL_GUID, sizeof guid - 1);
-    if (in == NULL || size != CL_SER_BYTES) {
-        cl_log(c, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: %u bytes, a state of this FMU has %u",
-               (unsigned)size, (unsigned)CL_SER_BYTES);
+    if (in == NULL || size != CL_SER_BYTES(c)) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: %u bytes, a state of this instance has %u",
+               (unsigned)size, (unsigned)CL_SER_BYTES(c));
         return fmi2Error;
     }
     memcpy(&magic, p, 4);
@@ -531,14 +594,17 @@ FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byt
     if (status != fmi2OK) return status;
     s = (cl_state *)*state;
     p += CL_SER_HEADER;
-    memcpy(s->mem, p, CL_IMAGE_BYTES);
-    p += CL_IMAGE_BYTES;
+    memcpy(s->mem, p, c->L->bytes);
+    p += c->L->bytes;
     memcpy(s->values, p, CL_NVARIABLES * sizeof(double));
     p += CL_NVARIABLES * sizeof(double);
     memcpy(flags, p, sizeof flags);
+    memcpy(&s->next_time, p + sizeof flags, sizeof(double));
     s->outputs_stale = flags[0];
     s->terminated = flags[1];
-    s->state = flags[2] < CL_INSTANTIATED || flags[2] > CL_TERMINATED ? CL_STEPPING : flags[2];
+    s->state = flags[2] < CL_INSTANTIATED || flags[2] > CL_CONTINUOUS || flags[2] == CL_ERROR
+               ? (c->L->exchange ? CL_EVENT : CL_STEPPING) : flags[2];
+    s->inputs_changed = flags[3];
     return fmi2OK;
 }
 
@@ -548,6 +614,171 @@ FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fm
     (void)u; (void)nu; (void)z; (void)nz; (void)du; (void)dz;
     cl_log((cl_instance *)comp, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative: not provided");
     return fmi2Error;
+}
+
+/* ---------------------------------------------------------------- model exchange */
+/* a switching function went from a to b through zero in its direction d (clutchlab.numerics.core._crossed) */
+static int cl_crossed(double a, double b, int d) {
+    return (d >= 0 && a < 0.0 && b >= 0.0) || (d <= 0 && a > 0.0 && b <= 0.0);
+}
+
+static cl_instance *cl_me(fmi2Component comp, const char *fn) {
+    cl_instance *c = (cl_instance *)comp;
+    if (c == NULL) return NULL;
+    if (!c->L->exchange) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: a co-simulation instance (instantiate for model exchange)", fn);
+        return NULL;
+    }
+    if (c->state == CL_ERROR) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: the instance is in the error state (reset or free it)", fn);
+        return NULL;
+    }
+    return c;
+}
+
+FMI2_Export fmi2Status fmi2EnterEventMode(fmi2Component comp) {
+    cl_instance *c = cl_me(comp, "fmi2EnterEventMode");
+    if (c == NULL) return fmi2Error;
+    c->state = CL_EVENT;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *info) {
+    cl_instance *c = cl_me(comp, "fmi2NewDiscreteStates");
+    int64_t code, what = CL_ME_EVENT | CL_ME_STORE | CL_ME_OUTPUTS;
+    double t, *x;
+    unsigned char before[CL_NSTATES ? CL_NSTATES * sizeof(double) : 1];
+    if (c == NULL || info == NULL) return fmi2Error;
+    if (c->state != CL_EVENT) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2NewDiscreteStates: not in event mode");
+        return fmi2Error;
+    }
+    t = *cl_at(c, c->L->off_time);
+    /* a time event (an input's corner, a controller sample) or new inputs: the modes decided again, as at the
+     * core's breaks */
+    if (c->inputs_changed || t >= c->next_time - 1e-12 * (fabs(t) > 1.0 ? fabs(t) : 1.0)) what |= CL_ME_RESTART;
+    x = cl_at(c, c->L->off_x);
+    memcpy(before, x, CL_NSTATES * sizeof(double));
+    if (!cl_exchange(c, what, &code)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    c->next_time = *cl_at(c, c->L->off_out);   /* (the break after this event; set at events only) */
+    c->inputs_changed = 0;
+    c->outputs_stale = 0;
+    info->newDiscreteStatesNeeded = fmi2False;
+    info->terminateSimulation = code == 1 ? fmi2True : fmi2False;
+    info->nominalsOfContinuousStatesChanged = fmi2False;
+    info->valuesOfContinuousStatesChanged = memcmp(before, x, CL_NSTATES * sizeof(double)) != 0 ? fmi2True : fmi2False;
+    info->nextEventTimeDefined = isfinite(c->next_time) ? fmi2True : fmi2False;
+    info->nextEventTime = isfinite(c->next_time) ? c->next_time : 0.0;
+    if (code == 1) c->terminated = 1;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp) {
+    cl_instance *c = cl_me(comp, "fmi2EnterContinuousTimeMode");
+    if (c == NULL) return fmi2Error;
+    c->state = CL_CONTINUOUS;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean no_set_prior,
+                                                   fmi2Boolean *enter_event_mode, fmi2Boolean *terminate) {
+    cl_instance *c = cl_me(comp, "fmi2CompletedIntegratorStep");
+    int64_t code;
+    size_t k;
+    int crossed = 0;
+    const double *g0, *g1;
+    (void)no_set_prior;
+    if (c == NULL || enter_event_mode == NULL || terminate == NULL) return fmi2Error;
+    /* the model's accept at the step's end.  The switching functions there become what the next event's
+     * crossings are judged against, unless one crossed since the last step (the host's solver stopped at its
+     * root and calls this before the event): then the values before the crossing are kept for the event */
+    if (!cl_exchange(c, CL_ME_ACCEPT | CL_ME_DERIVATIVES, &code)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    c->outputs_stale = 1;   /* (the derivatives were evaluated, the outputs not) */
+    g0 = cl_at(c, c->L->off_g0);
+    g1 = cl_at(c, c->L->off_g1);
+    for (k = 0; k < CL_NINDICATORS; k++)
+        if (cl_event_indicator[k] && cl_crossed(g0[k], g1[k], cl_gdir[k])) crossed = 1;
+    if (!crossed) memcpy(cl_at(c, c->L->off_g0), g1, CL_NINDICATORS * sizeof(double));
+    *enter_event_mode = code > 0 || crossed ? fmi2True : fmi2False;
+    *terminate = fmi2False;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real t) {
+    cl_instance *c = cl_me(comp, "fmi2SetTime");
+    if (c == NULL) return fmi2Error;
+    if (!isfinite(t)) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SetTime: %g is not finite", t);
+        return fmi2Error;
+    }
+    *cl_at(c, c->L->off_time) = t;
+    c->outputs_stale = 1;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_t nx) {
+    cl_instance *c = cl_me(comp, "fmi2SetContinuousStates");
+    size_t k;
+    if (c == NULL) return fmi2Error;
+    if (nx != CL_NSTATES || (nx && x == NULL)) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2SetContinuousStates: %u states given, the model has %u",
+               (unsigned)nx, (unsigned)CL_NSTATES);
+        return fmi2Error;
+    }
+    for (k = 0; k < nx; k++) {
+        if (!isfinite(x[k])) {
+            cl_log(c, fmi2Error, "logStatusError", "fmi2SetContinuousStates: state %u = %g is not finite",
+                   (unsigned)k, x[k]);
+            return fmi2Error;
+        }
+    }
+    memcpy(cl_at(c, c->L->off_x), x, nx * sizeof(double));
+    c->outputs_stale = 1;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) {
+    cl_instance *c = cl_me(comp, "fmi2GetContinuousStates");
+    if (c == NULL || nx != CL_NSTATES || (nx && x == NULL)) return fmi2Error;
+    memcpy(x, cl_at(c, c->L->off_x), nx * sizeof(double));
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real nominal[], size_t nx) {
+    cl_instance *c = cl_me(comp, "fmi2GetNominalsOfContinuousStates");
+    size_t k;
+    if (c == NULL || nx != CL_NSTATES || (nx && nominal == NULL)) return fmi2Error;
+    for (k = 0; k < nx; k++) nominal[k] = 1.0;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {
+    cl_instance *c = cl_me(comp, "fmi2GetDerivatives");
+    if (c == NULL || nx != CL_NSTATES || (nx && dx == NULL)) return fmi2Error;
+    if (!cl_outputs(c)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    memcpy(dx, cl_at(c, c->L->off_dx), nx * sizeof(double));
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetEventIndicators(fmi2Component comp, fmi2Real g[], size_t ng) {
+    cl_instance *c = cl_me(comp, "fmi2GetEventIndicators");
+    size_t k;
+    if (c == NULL || ng != CL_NINDICATORS || (ng && g == NULL)) return fmi2Error;
+    if (!cl_outputs(c)) {
+        c->state = CL_ERROR;
+        return fmi2Error;
+    }
+    for (k = 0; k < ng; k++) g[k] = cl_event_indicator[k] ? cl_at(c, c->L->off_g1)[k] : 1.0;
+    return fmi2OK;
 }
 
 /* ---------------------------------------------------------------- co-simulation */
@@ -575,6 +806,10 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, f
     int64_t code;
     (void)no_prior;
     CL_REFUSE_IF_ERROR(c, "fmi2DoStep");
+    if (c->L->exchange) {
+        cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: a model-exchange instance is not stepped");
+        return fmi2Error;
+    }
     if (c->state != CL_STEPPING) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: %s", c->state == CL_TERMINATED
                ? "the run has terminated" : "initialisation has not ended (fmi2ExitInitializationMode)");
@@ -584,7 +819,7 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, f
         cl_log(c, fmi2Discard, "logStatusDiscard", "fmi2DoStep: a terminal event has stopped the run");
         return fmi2Discard;
     }
-    now = *cl_at(c, CL_OFF_TIME);
+    now = *cl_at(c, c->L->off_time);
     if (!isfinite(t) || !isfinite(dt) || dt <= 0.0) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: step from %g s of %g s: expected a finite step > 0",
                t, dt);
@@ -609,17 +844,17 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, f
         c->terminated = 1;
         c->outputs_stale = 0;
         cl_log(c, fmi2Discard, "logStatusDiscard", "a terminal event stopped the run at t = %g s",
-               *cl_at(c, CL_OFF_TIME));
+               *cl_at(c, c->L->off_time));
         return fmi2Discard;
     }
     if (code != CL_STATUS_SUCCESS) {
         const char *message = cl_status_message(code);
         if (code == CL_STATUS_MODEL_ERROR) {
-            const char *model = cl_model_error(*(int64_t *)(c->mem + CL_OFF_MODEL_CODE));
+            const char *model = cl_model_error(*(int64_t *)(c->mem + c->L->off_model_code));
             if (model != NULL) message = model;
         }
         cl_log(c, fmi2Error, "logStatusError", "%s: %s (at t = %g s)", CL_MODEL_NAME, message,
-               *cl_at(c, CL_OFF_TIME));
+               *cl_at(c, c->L->off_time));
         c->state = CL_ERROR;
         return fmi2Error;
     }
@@ -643,7 +878,7 @@ FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKin
     cl_instance *c = (cl_instance *)comp;
     if (c == NULL || value == NULL) return fmi2Error;
     if (kind == fmi2LastSuccessfulTime) {
-        *value = *cl_at(c, CL_OFF_TIME);
+        *value = *cl_at(c, c->L->off_time);
         return fmi2OK;
     }
     return fmi2Discard;

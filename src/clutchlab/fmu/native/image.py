@@ -78,6 +78,12 @@ class Image:
     pointer_slots: frozenset = frozenset()
     #: ``(module, outputs_module, args)``: the compiled entry modules of the session and its arguments
     entry_modules: tuple = ()
+    #: the names of ``args`` (:data:`clutchlab.numerics.session.FIELDS` or ``exchange.FIELDS``)
+    names: tuple = ()
+
+    def arg(self, name: str):
+        """The session's argument ``name`` (``"x"``, ``"u"``, ``"r"``, ...)."""
+        return self.args[self.names.index(name)]
 
     def offset(self, array: np.ndarray, index: int = 0) -> int:
         """Image offset of element ``index`` of ``array`` (one of the session's arrays, C-contiguous)."""
@@ -108,17 +114,30 @@ def session_arguments(simulation):
     return simulation._session_parts()
 
 
-def session_image(simulation) -> Image:
-    """The image of a :class:`~clutchlab.system.Simulation`'s session (module docstring).
+#: the model-exchange session's arguments whose contents the FMU never reads before the compiled code writes them
+_EXCHANGE_SCRATCH = ("log", "dx", "g0", "g1", "out", "y", "r")
+
+
+def session_image(simulation, exchange: bool = False) -> Image:
+    """The image of a :class:`~clutchlab.system.Simulation`'s session (module docstring); ``exchange``: of its
+    model-exchange session (:mod:`clutchlab.numerics.exchange`: the same parameters, state, modes, inputs,
+    solver state, options and log, with buffers for the derivatives, the switching functions and the
+    outputs), called through the model's ``model_exchange`` entry.
 
     Raises
     ------
     NativeExportError
         The session's table has a layout this does not know, or points outside its arrays.
     """
-    from ...numerics import session as S
+    from ...numerics import exchange as X, session as S
 
     module, outputs_module, args = session_arguments(simulation)
+    names, scratch_names = S.FIELDS, _SCRATCH
+    if exchange:
+        p, x, m, u, sf, si, opt, log = args[:8]
+        args = (p, x, m, u, sf, si, opt, log, np.zeros(x.size), np.zeros(opt.gdir.size), np.zeros(opt.gdir.size),
+                np.zeros(2), args[14], args[15], args[16])
+        names, scratch_names = X.FIELDS, _EXCHANGE_SCRATCH
     args_ty = module.session.typeof_pyval(args)
     layout = S.table_layout(args_ty)
     if layout is None:
@@ -130,8 +149,8 @@ def session_image(simulation) -> Image:
     arrays = []
     _arrays(args, arrays)
     scratch = []
-    for name, value in zip(S.FIELDS, args):
-        if name in _SCRATCH:
+    for name, value in zip(names, args):
+        if name in scratch_names:
             _arrays(value, scratch)
     # blocks: the arrays' memory, merged where it overlaps, in the order the arguments first name them (not by
     # address: two builds of one model then give the same image)
@@ -154,7 +173,9 @@ def session_image(simulation) -> Image:
     for start, end, off in blocks:
         if end > start:
             data[off:off + end - start] = ctypes.string_at(start, end - start)
-    image = Image(b"", nbytes, [], (fields[0][0], fields[1][0]), simulation._method(), args, {}, blocks)
+    image = Image(b"", nbytes, [], (fields[0][0], fields[1][0]), "exchange" if exchange else simulation._method(),
+                  args, {}, blocks)
+    image.names = names
     for a in scratch:   # zeros, not whatever the buffers held
         if a.nbytes:
             off = image.offset(a)
