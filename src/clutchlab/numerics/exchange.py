@@ -38,7 +38,7 @@ from numba.extending import register_jitable
 from . import dispatch as model
 from .borrow import borrow, byref
 from .core import SF_T, _apply_updates
-from .session import REPORT_MODE, REPORT_OUTPUT, REPORT_STATE, _args
+from .session import _args, fill_report
 
 __all__ = ["call", "FIELDS", "ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART", "ME_STORE", "ME_OUTPUTS"]
 
@@ -83,16 +83,6 @@ def call(s, what):
             g0[k] = g1[k]
     if what & ME_OUTPUTS:
         model.outputs(t, x, u, m, p, y)
-        for k in range(r.shape[0]):
-            kind = report[k, 0]
-            i = report[k, 1]
-            if kind == REPORT_OUTPUT:
-                r[k] = y[i]
-            elif kind == REPORT_STATE:
-                r[k] = x[i]
-            elif kind == REPORT_MODE:
-                r[k] = m[i]
-            else:
-                r[k] = 1.0 if m[i] == report[k, 2] else 0.0
+        fill_report(report, y, x, m, r)
     out[0] = model.next_break(t, m, p)
     return code

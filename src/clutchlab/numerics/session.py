@@ -206,18 +206,25 @@ def call(s, t_end, what):
             return code
     if what & OUTPUTS:
         _outputs(s, p, sf[0], x, u, m, y)
-        for k in range(r.shape[0]):
-            kind = report[k, 0]
-            i = report[k, 1]
-            if kind == REPORT_OUTPUT:
-                r[k] = y[i]
-            elif kind == REPORT_STATE:
-                r[k] = x[i]
-            elif kind == REPORT_MODE:
-                r[k] = m[i]
-            else:
-                r[k] = 1.0 if m[i] == report[k, 2] else 0.0
+        fill_report(report, y, x, m, r)
     return code
+
+
+@register_jitable
+def fill_report(report, y, x, m, r):
+    """The reported values ``r`` from the outputs ``y``, state ``x`` and modes ``m`` as ``report`` chooses them
+    (``report[k] = (kind, index, value)``, :data:`REPORT_OUTPUT` ...)."""
+    for k in range(r.shape[0]):
+        kind = report[k, 0]
+        i = report[k, 1]
+        if kind == REPORT_OUTPUT:
+            r[k] = y[i]
+        elif kind == REPORT_STATE:
+            r[k] = x[i]
+        elif kind == REPORT_MODE:
+            r[k] = m[i]
+        else:
+            r[k] = 1.0 if m[i] == report[k, 2] else 0.0
 
 
 # ---------------------------------------------------------------- Python side
