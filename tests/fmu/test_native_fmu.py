@@ -272,7 +272,7 @@ def test_export_fmu_command_builds_a_native_fmu_by_default(tmp_path, monkeypatch
         export_native_fmu(object, tmp_path / "x.fmu")
 
 
-def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path):
+def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host):
     """The EMTC's co-simulation (a ContractCoSimulation of the model's own System) as a native FMU: its four
     inputs driven by a host, equal to the Python co-simulation."""
     from clutchlab.fmu.emtc import EmtcCoSimulation
@@ -290,6 +290,18 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path):
     for name in python:
         _close(native[name], python[name], name)
     assert np.max(python["coupling_torque"]) > 100.0   # (the request went through)
+    # a count the model takes only whole (friction pairs) is refused as a fraction, as the model refuses it
+    with zipfile.ZipFile(path) as z:
+        z.extractall(tmp_path / "fmu")
+    root, svs = _variables(path)
+    lib = tmp_path / "fmu" / "binaries" / "linux64" / "ClutchlabEmtc.so"
+    assert svs["coupling.pairs[1]"].get("causality") == "parameter"
+    for value, expected in (("2.5", "coupling.pairs[1] = 2.5 is not a whole number"), ("2", None),
+                            ("1.5", "throttle = 1.5 [1] is outside its range [0, 1]")):
+        name = "throttle" if value == "1.5" else "coupling.pairs[1]"
+        status, text = _host(host, lib, root.get("guid"), "refuse", int(svs[name].get("valueReference")),
+                             value).stdout.split(" ", 1)
+        assert (int(status), expected is None or expected in text) == ((0, True) if expected is None else (3, True)), text
 
 
 def _wine():

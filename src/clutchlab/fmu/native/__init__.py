@@ -1,23 +1,26 @@
-"""Native FMUs: a clutchlab model as an FMI 2.0 co-simulation FMU with no Python on the importing machine.
+"""Native FMUs: a clutchlab model as an FMI 2.0 FMU (co-simulation and model exchange) with nothing of Python
+on the importing machine.
 
-``clutchlab export-fmu driveline NETWORK.toml -o X.fmu`` (:func:`export_native_fmu`) builds, from the
-model's co-simulation class (a :class:`~clutchlab.fmu.cosim.CoSimulation` on the system contract,
-``native = True``: the driveline's, the EMTC's and the E-clutch's, whose variables come from the component
+``clutchlab export-fmu MODEL [NETWORK.toml] -o X.fmu`` (:func:`export_native_fmu`) builds, from the model's
+co-simulation class (a :class:`~clutchlab.fmu.cosim.CoSimulation` on the system contract, ``native = True``:
+every driveline's, the EMTC's, the E-clutch's and the wet bench's, whose variables come from the component
 declarations and parameter sets), a shared library per platform that holds
 
 * the object code of the model's compiled session -- the integrator core with the model's equations, the
-  same functions, compiled by the same numba, that run the model in Python (:mod:`.codegen`);
-* the session's *image*: its parameters, state, modes, inputs, options and buffers as bytes, copied into
-  each instance (:mod:`.image`);
+  same functions, compiled by the same numba, that run the model in Python -- and of its model-exchange
+  entry (:mod:`clutchlab.numerics.exchange`) (:mod:`.codegen`);
+* two *images* of the session: its parameters, state, modes, inputs, options and buffers as bytes, copied
+  into each instance, one for co-simulation and one for model exchange (:mod:`.image`);
 * numba's runtime (``nrt.cpp``) and the FMI 2.0 layer (``fmi2_native.c``) with the generated tables of the
   model's variables (``model.h``) (:mod:`.toolchain`).
 
-So a step of the FMU is the step of ``clutchlab`` itself: the results equal the Python co-simulation's at
-the same communication points.  What the importing tool needs: nothing (the library links only the C
-library and libm).  Limits, stated in docs/fmu.md: co-simulation only (no Model Exchange yet); parameters
-whose value the model stores other than as an affine function of it (an inertia kept as its inverse, an
-initial speed that decides a start mode) are fixed at export (``variability="constant"``); the wet clutch's
-co-simulation (its system is built at the first step) is exported through pythonfmu.
+So a co-simulation step of the FMU is the step of ``clutchlab`` itself: the results equal the Python
+co-simulation's at the same communication points; in model exchange the host's solver calls the model's own
+hooks.  What the importing tool needs: nothing (the library links only the C library and libm).  Limits,
+stated in docs/fmu.md: parameters whose value the model stores other than as ``a * value + b`` or
+``a / value + b`` (an initial speed that decides a start mode, a number derived from several parameters)
+are fixed at export (``variability="constant"``); a model with an algebraic state (the E-clutch's massless
+tip) is co-simulation only; no FMI 3.0.
 """
 
 from __future__ import annotations
@@ -214,7 +217,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
               "uint64_t slot_advance, slot_outputs, off_time, off_t0, off_model_code, off_x, off_dx, off_g0, off_g1, off_out; "
               "const cl_target *targets; const cl_binding *bindings; int exchange; } cl_layout;",
               "typedef struct { const char *name; const char *unit; int kind; double start; int has_min, has_max, "
-              "positive; double min, max; const char *range_text; } cl_variable;"]
+              "positive, whole; double min, max; const char *range_text; } cl_variable;"]
     for tag, image, (bindings, targets) in zip(("cs", "me"), images, layouts):
         lines += _layout(tag, image, bindings, targets)
     if not exchange:   # (never used: a model-exchange instantiation is refused)
@@ -223,7 +226,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
     for v in variables:
         lo, hi = v["bounds"]
         lines.append(f"    {{{_c_string(v['name'])}, {_c_string(v['unit'])}, {v['kind']}, {_c_double(v['start'])}, "
-                     f"{int(lo is not None)}, {int(hi is not None)}, {int(v['positive'])}, "
+                     f"{int(lo is not None)}, {int(hi is not None)}, {int(v['positive'])}, {int(v.get('whole', False))}, "
                      f"{_c_double(lo if lo is not None else 0.0)}, {_c_double(hi if hi is not None else 0.0)}, "
                      f"{_c_string(v['range'])}}},")
     lines.append("};")
@@ -316,7 +319,8 @@ def _description(cls, name, ident, guid, variables, experiment, n_indicators, ex
 
 def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, name: str | None = None,
                       report=None, _benchmark: bool = False) -> Path:
-    """Build a native FMI 2.0 co-simulation FMU of the co-simulation class ``cls``.
+    """Build a native FMI 2.0 FMU (co-simulation, and model exchange where the model has no algebraic state) of
+    the co-simulation class ``cls``.
 
     Parameters
     ----------
@@ -344,7 +348,8 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     ------
     NativeExportError
         A compiler is missing for a platform asked for, the model's session has a form the native FMU does not
-        know, or a compilation failed (the message says which).
+        know, an input reaches the model in a way the FMU cannot repeat, or a compilation failed (the message
+        says which).
     ParameterError
         The path does not end in ``.fmu``, or exists and ``overwrite`` is false.
     """
@@ -416,9 +421,14 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     variables = []
     for v in cls.parameters:
         writable = all(m.get(v.name) is not None for m in where)
+        whole = False
+        if writable and float(v.start).is_integer():
+            # a whole number the model refuses halves of (a count of friction pairs): the FMU refuses them too
+            half = float(v.start) + 0.5 if v.maximum is None or float(v.start) + 0.5 <= v.maximum else float(v.start) - 0.5
+            whole = build(parameters={v.name: half}) is None
         variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
                           "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v),
-                          "kind": _PARAMETER if writable else _CONSTANT})
+                          "kind": _PARAMETER if writable else _CONSTANT, "whole": whole})
     for v in cls.inputs:
         if v.name in bounds:   # (a range that follows the parameters: the bench's actuator limit)
             v = dataclasses.replace(v, minimum=bounds[v.name][0], maximum=bounds[v.name][1])

@@ -376,6 +376,10 @@ static int cl_in_range(cl_instance *c, const char *fn, const cl_variable *v, dou
         cl_log(c, fmi2Error, "logStatusError", "%s: %s = %g is not a finite number", fn, v->name, x);
         return 0;
     }
+    if (v->whole && x != floor(x)) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s = %.17g is not a whole number", fn, v->name, x);
+        return 0;
+    }
     if ((v->has_min && x < v->min) || (v->has_max && x > v->max) || (v->positive && x <= 0.0)) {
         cl_log(c, fmi2Error, "logStatusError", "%s: %s = %.17g [%s] is outside its range %s", fn, v->name, x, v->unit,
                v->range_text);

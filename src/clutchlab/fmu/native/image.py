@@ -14,11 +14,18 @@ of that block -- nothing else of the image depends on where it lies -- and the t
 addresses of the compiled functions linked into the FMU's library.  Where a variable lives (an input in
 ``u``, an output in the report ``r``, the time in the solver state) is an offset into the image.
 
-:func:`parameter_map` finds where each FMU parameter lands in the image, by building the model again with
-the parameter changed (the co-simulation class builds it from the component declarations or parameter
-sets): a parameter whose every changed number is an affine function of it (``a * value + b``; most
-are copies, ``a = 1, b = 0``) is written by the native FMU itself; one that changes the image in any other
-way (an inertia stored as its inverse, a table rebuilt, the arrays' sizes) is fixed at export.
+:func:`parameter_map` finds where each FMU parameter (or input) lands in the image, by building the model
+again with it changed (the co-simulation class builds it from the component declarations or parameter
+sets): one whose every changed number is ``a * value + b`` (most are copies, ``a = 1, b = 0``) or
+``a / value + b`` (a time constant kept as a rate) is written by the native FMU itself.  One that changes the
+image in any other way (an initial speed that decides a start mode, a table rebuilt, the arrays' sizes, a
+number two parameters share) is fixed at export.  Words that differ between two builds of the same values
+are memory the model never initialised and are ignored; a last build with every writable parameter changed
+at once must equal what the FMU writes.
+
+With ``exchange=True``, :func:`session_image` gives the image of the model-exchange session
+(:mod:`clutchlab.numerics.exchange`): the same arguments with buffers for the derivatives, the switching
+functions and the outputs in place of the integrator's.
 """
 
 from __future__ import annotations
@@ -180,6 +187,9 @@ def session_image(simulation, exchange: bool = False) -> Image:
         if a.nbytes:
             off = image.offset(a)
             data[off:off + a.nbytes] = bytes(a.nbytes)
+    for a in arrays:   # a record's padding (after a bool field) as zeros: memory numpy never writes
+        if a.dtype.fields and a.nbytes and a.flags.c_contiguous:
+            _zero_padding(data, image.offset(a), a)
     import struct
 
     table = bytearray(nbytes)
@@ -203,6 +213,18 @@ def session_image(simulation, exchange: bool = False) -> Image:
     image.entry_modules = (module, outputs_module, args)
     image.pointer_slots = frozenset([s for s, _ in relocations] + list(image.function_slots))
     return image
+
+
+def _zero_padding(data: bytearray, at: int, a: np.ndarray) -> None:
+    """Zero the bytes of the records of ``a`` (copied to ``data[at:]``) that no field covers."""
+    covered = np.zeros(a.dtype.itemsize, dtype=bool)
+    for field in a.dtype.fields.values():
+        dt, offset = field[0], field[1]
+        covered[offset:offset + dt.itemsize] = True
+    if covered.all():
+        return
+    view = np.frombuffer(memoryview(data)[at:at + a.nbytes], dtype=np.uint8).reshape(-1, a.dtype.itemsize)
+    view[:, ~covered] = 0
 
 
 def _words(image: Image) -> np.ndarray:
