@@ -410,6 +410,17 @@ FMI2_Export fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference 
             return fmi2Error;
         }
         if (!cl_in_range(c, "fmi2SetReal", v, value[k])) return fmi2Error;
+        if (value[k] == 0.0) { /* (a value the model keeps as its reciprocal, a time constant's rate, cannot be 0) */
+            const cl_binding *b = &c->L->bindings[vr[k]];
+            int j;
+            for (j = 0; j < b->ntargets; j++) {
+                if (c->L->targets[b->first + j].reciprocal) {
+                    cl_log(c, fmi2Error, "logStatusError", "fmi2SetReal: %s = 0: the model keeps its reciprocal",
+                           v->name);
+                    return fmi2Error;
+                }
+            }
+        }
     }
     for (k = 0; k < n; k++) {
         c->values[vr[k]] = value[k];
