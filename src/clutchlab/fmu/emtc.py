@@ -219,12 +219,18 @@ class EmtcCoSimulation(ContractCoSimulation):
             self._n_logged = n
         return y
 
-    def initial_outputs(self, inputs: dict) -> dict:
-        """Outputs at t = 0 with the given inputs held (the shaft speeds start free rolling on the drums)."""
+    def hold_inputs(self, inputs: dict) -> None:
+        """Hold the FMI ``inputs`` (by name; missing ones at their start), starting the run with them at t = 0:
+        the shaft speeds start free rolling on the drums (:meth:`initial_outputs`; a native FMU takes the
+        drum speeds' start values until initialisation ends)."""
         uv = self.input_vector(self.resolve_inputs(inputs))
         if self.time != 0.0 or not self._started:
             self.reset()
             self._start(uv)
+        super().hold_inputs(inputs)
+
+    def initial_outputs(self, inputs: dict) -> dict:
+        """Outputs at t = 0 with the given inputs held (the shaft speeds start free rolling on the drums)."""
         return super().initial_outputs(inputs)
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
