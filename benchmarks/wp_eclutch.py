@@ -15,7 +15,8 @@ Solvers, each over rtol = 1e-3 ... 1e-7 (clutchlab also 1e-8):
   with a numba ``cfunc`` right-hand side and an ``njit`` driver that locates the friction events.
 
 Absolute tolerances: every solver gets the model's default absolute tolerances (``Assembly.atol``: 0.1 um,
-0.1 mm/s, 100 Pa, 1 mA, ...), fixed; only rtol varies.  (Scaling atol with rtol makes every solver resolve
+0.1 mm/s, 100 Pa, 1 mA, ...), fixed; only rtol varies (clutchlab's passed as ``atol_scale=1``: since issue #30's
+eighteenth-session fix ``EClutch`` scales them with rtol below its default unless told otherwise).  (Scaling atol with rtol makes every solver resolve
 the seals' stick-slip micro-motions: clutchlab at rtol 1e-6, atol x 1e-3 takes 106,000 steps and 1,003 events.)
 The peer integrates the state scaled by those atol (``w = y / atol``) with LSODA's scalar atol 1.
 
@@ -179,10 +180,11 @@ def main(quick: bool = False, scipy_cap: float | None = None, with_scipy: bool =
     ec.simulate(INPUT, T_END)  # compile / load cache
     core, sim = Series("clutchlab core run (Rodas3)"), Series("clutchlab EClutch.simulate")
     for r in cl_rtols:
-        system = ec.as_system(INPUT, rtol=r)
+        system = ec.as_system(INPUT, rtol=r, atol_scale=1.0)
         n = rep_cl if r >= 1e-7 else max(3, rep_cl // 3)
         tk, out = timed(lambda: contract.simulate(system, T_END, outputs=False, max_steps=2_000_000), n)
-        ts, res = timed(lambda: ec.simulate(INPUT, T_END, rtol=r, output_step=GRID[1], max_steps=2_000_000), n)
+        ts, res = timed(lambda: ec.simulate(INPUT, T_END, rtol=r, output_step=GRID[1], max_steps=2_000_000,
+                                                 atol_scale=1.0), n)
         e = err(np.interp(GRID, res.outputs.time_s, res.outputs.bearing_force_N))
         note = f"{out.stats['accepted_steps']} steps, {len(out.events)} events"
         core.points.append(Point(r, e, tk, note))

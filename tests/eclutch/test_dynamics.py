@@ -419,3 +419,58 @@ def test_step_budget_is_reported(model4):
     ec = EClutch(clutch=model4)
     with pytest.raises(SimulationError, match="max_steps"):
         ec.simulate({"voltage": ([0.0, 0.01], [0.0, 8.0])}, 0.5, max_steps=10)
+
+
+# ----------------------------------------------------------------- accuracy that follows the tolerance
+def test_closed_loop_accuracy_follows_rtol_against_an_independent_solution():
+    """The closed-loop E-clutch (actuator, position controller, clutch with friction) from just after the
+    bearing's break-away, against SciPy's DOP853 at rtol 1e-12 on the same equations in state-space form
+    (the massless tip solved by Newton's method at every evaluation, written here): the error shrinks with
+    ``rtol``.  Before issue #30's fix the absolute tolerances stayed at their defaults below the default
+    ``rtol`` (1e-3), and the bearing-side velocities stayed 3.5e-4 (relative) off from rtol 1e-10 down,
+    whatever the tolerance."""
+    import dataclasses
+
+    from scipy.integrate import solve_ivp
+
+    from clutchlab.system import evaluate, simulate
+
+    ec = EClutch(friction=FrictionParameters())
+    inputs = {"bearing_reference": 0.005}
+    t0, t1 = 0.0036, 0.005   # (the bearing broke away at 3.54 ms; the next event is at 5.3 ms)
+    start = simulate(ec.as_system(inputs, rtol=1e-12), t0, output_step=t0)
+    system = ec.as_system(inputs)
+    x0 = np.array(start.states[-1], dtype=float)
+    m0 = np.array(start.modes[-1], dtype=np.int64)
+    mass = system.options().mass
+    alg = np.flatnonzero(mass == 0.0)
+    dif = np.flatnonzero(mass != 0.0)
+    assert alg.size == 1
+    full = x0.copy()
+
+    def f(t, y):
+        full[dif] = y
+        for _ in range(50):   # Newton on the tip's force balance (its residual is its row of the rhs)
+            r = evaluate(system, t, full, None, m0)[0][alg[0]]
+            h = 1e-9 * max(1e-3, abs(full[alg[0]]))
+            full[alg[0]] += h
+            slope = (evaluate(system, t, full, None, m0)[0][alg[0]] - r) / h
+            full[alg[0]] -= h
+            step = -r / slope
+            full[alg[0]] += step
+            if abs(step) <= 1e-15:
+                break
+        return evaluate(system, t, full, None, m0)[0][dif]
+
+    ref = solve_ivp(f, (t0, t1), x0[dif], method="DOP853", rtol=1e-12,
+                    atol=1e-15 * np.maximum(1.0, np.abs(x0[dif]))).y[:, -1]
+    scale = np.abs(ref) + system.options().atol[dif]
+    errors = []
+    for rtol in (1e-6, 1e-8, 1e-10):
+        run = simulate(dataclasses.replace(ec.as_system(inputs, rtol=rtol), x0=x0, m0=m0), t1, t0=t0,
+                       output_step=t1 - t0)
+        assert np.array_equal(run.modes[-1], m0)   # (no event between t0 and t1)
+        x1 = run.states[-1]
+        errors.append(float(np.max(np.abs(x1[dif] - ref) / scale)))
+    assert errors[0] > 10 * errors[1] > 100 * errors[2], errors
+    assert errors[2] < 1e-6, errors

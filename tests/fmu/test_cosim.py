@@ -428,3 +428,26 @@ def test_wet_dissipation_and_actuator_closed_form(levels):
         if out["slip_speed"] > 0 and out["stick"] == 0.0:
             assert out["clutch_torque"] > 0.0 and out["contact_torque"] >= 0.0
         prev = out
+
+
+@pytest.mark.parametrize("model", ["eclutch", "wet", "emtc"])
+def test_a_cosimulation_s_absolute_tolerances_follow_its_rtol(model):
+    """Below its default ``rtol`` a co-simulation's absolute tolerances shrink with it (issue #30), as the
+    model's own runs' do (validated against independent solutions: tests/eclutch/test_dynamics.py,
+    tests/emtc/test_accuracy.py, tests/wet).  The E-clutch's and the EMTC's kept their defaults at every rtol
+    until the eighteenth session, so their error stopped following the tolerance (and with it their native
+    FMUs' in co-simulation)."""
+    from clutchlab.fmu.cosim import load_cosimulation
+
+    cls = load_cosimulation(model)
+    rtol = next(v for v in cls.parameters if v.name.endswith("rtol"))
+
+    def atol(value):
+        sim = cls(**{rtol.name: value})
+        sim.hold_inputs({})
+        return np.asarray(sim.simulation._opt.atol, dtype=float)
+
+    default = atol(float(rtol.start))
+    assert np.all(default > 0)
+    np.testing.assert_allclose(atol(float(rtol.start) * 1e-4), default * 1e-4, rtol=1e-12)
+    np.testing.assert_array_equal(atol(min(1e-2, float(rtol.start) * 10)), default)

@@ -512,6 +512,13 @@ def _as_table(value, name: str):
     return np.ascontiguousarray(t), np.ascontiguousarray(v)
 
 
+def _follow_rtol(rtol, atol_scale, default_rtol=1e-3):
+    """The absolute tolerances' factor of a closed-loop E-clutch run: ``atol_scale`` where given, else
+    ``min(1, rtol / default_rtol)`` (the defaults at the default tolerance, shrinking with a tighter one: the
+    accuracy follows ``rtol``, issue #30)."""
+    return float(atol_scale) if atol_scale is not None else min(1.0, float(rtol) / default_rtol)
+
+
 def _check_run(t_end, rtol, max_steps, atol=None, atol_scale=None):
     if not (np.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"t_end = {t_end!r} s must be finite and > 0")
@@ -652,7 +659,7 @@ class EClutch:
         self.rest_position = self.assembly.rest_position()
 
     def as_system(self, inputs, *, rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8,
-                  jac_every: int = 10, atol_scale: float = 1.0, held_input: bool = False,
+                  jac_every: int = 10, atol_scale: float | None = None, held_input: bool = False,
                   first_step: float = 1e-5) -> contract.System:
         """The :class:`~clutchlab.system.System` of a run from rest (for :func:`clutchlab.system.simulate`).
 
@@ -672,7 +679,8 @@ class EClutch:
         imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
         return self._system(imode, interp, tin, vin, held_input=held_input, rtol=rtol, max_step=max_step,
-                            event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale, first_step=first_step)
+                            event_tol=event_tol, jac_every=jac_every, atol_scale=_follow_rtol(rtol, atol_scale),
+                            first_step=first_step)
 
     def _system(self, imode, interp, tin, vin, **options) -> contract.System:
         """:meth:`as_system` of a checked input table."""
@@ -774,7 +782,11 @@ class EClutch:
             ``atol_scale``.
         atol_scale : float, optional
             Factor on the default absolute tolerances (0.1 um, 0.1 mm/s,
-            100 Pa, 1 mA, ...); default 1.
+            100 Pa, 1 mA, ...); default ``min(1, rtol / 1e-3)``: below the
+            default ``rtol`` they shrink with it, so that the error follows
+            the tolerance (with them fixed, the bearing's velocity after its
+            break-away stayed 3.5e-4 off an independent solution from rtol
+            1e-10 down, issue #30; docs/eclutch_dynamics.md).
         fixed_step : float, optional
             Fixed-step (real-time, HIL frame) mode with this step [s]: Rodas3
             steps on the grid ``k * fixed_step``, no error control, the
@@ -796,8 +808,7 @@ class EClutch:
         _check_run(t_end, rtol, max_steps, atol, atol_scale)
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self._system(imode, interp, tin, vin, rtol=rtol, max_step=_max_step(max_step, h_max),
-                              event_tol=event_tol, jac_every=jac_every,
-                              atol_scale=1.0 if atol_scale is None else atol_scale)
+                              event_tol=event_tol, jac_every=jac_every, atol_scale=_follow_rtol(rtol, atol_scale))
         return _run(self, system, t_end, max_steps, grid, fixed_step, atol)
 
 

@@ -118,7 +118,7 @@ class EmtcCoSimulation(ContractCoSimulation):
     def __init__(self, **parameter_values):
         from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
         from ..emtc.magnet import bundled_magnet
-        from ..emtc.system import BenchOptions
+        from ..emtc.system import BenchOptions, absolute_tolerance
         from ..emtc.torque import CouplingGeometry
 
         values = self.resolve_parameters(parameter_values)
@@ -140,7 +140,10 @@ class EmtcCoSimulation(ContractCoSimulation):
                                        sample_time=self.sample_time, duration=max(4.0, self.sample_time))
         self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling)
         self.fixed_step = fixed_step_parameter(values)
-        self.simulation_options = {"rtol": self.rtol, "max_steps": 2_000_000, "fixed_step": self.fixed_step}
+        # (the absolute tolerances follow rtol below its default, as the bench's own runs do: with them fixed the
+        # co-simulation's error stopped following rtol, issue #30)
+        self.simulation_options = {"rtol": self.rtol, "atol": absolute_tolerance(self.rtol), "max_steps": 2_000_000,
+                                   "fixed_step": self.fixed_step}
         super().__init__(**parameter_values)
 
     # ---- the contract
