@@ -8,9 +8,14 @@
  *   native_host LIBRARY GUID refuse VR VALUE                         sets VR = VALUE; prints the status and message
  *   native_host LIBRARY GUID misuse                                  refused calls: prints "<what> <status> <message>"
  *   native_host LIBRARY GUID maps                                    prints 1 if a libpython is mapped, else 0
+ *   native_host LIBRARY GUID me N DT H NX NZ VR_OUT...               model exchange: the host integrates the NX
+ *                                                                   states by explicit Euler steps of H with the
+ *                                                                   NZ event indicators and time events (FMI
+ *                                                                   2.0's ME loop, as fmusim's); prints the
+ *                                                                   outputs at 0, DT, ..., N DT
  *
  * VR_SET/VALUE_SET: a value reference and value set before initialisation (-1: none).  Built for Linux with cc,
- * for Windows with MinGW-w64 (run under wine: "run" and "state").
+ * for Windows with MinGW-w64 (run under wine: "run", "state" and "me").
  */
 #ifdef _WIN32
 #include <windows.h>
@@ -177,6 +182,84 @@ int main(int argc, char **argv) {
             for (i = 0; i < nout; i++) printf("%s%.17g", i ? " " : "", jobs[0].values[(size_t)k * nout + i]);
             printf("\n");
         }
+        return 0;
+    }
+    if (strcmp(mode, "me") == 0) {
+        fmi2EnterEventModeTYPE *enter_event = (fmi2EnterEventModeTYPE *)sym(lib, "fmi2EnterEventMode");
+        fmi2NewDiscreteStatesTYPE *new_states = (fmi2NewDiscreteStatesTYPE *)sym(lib, "fmi2NewDiscreteStates");
+        fmi2EnterContinuousTimeModeTYPE *enter_ct =
+            (fmi2EnterContinuousTimeModeTYPE *)sym(lib, "fmi2EnterContinuousTimeMode");
+        fmi2CompletedIntegratorStepTYPE *completed =
+            (fmi2CompletedIntegratorStepTYPE *)sym(lib, "fmi2CompletedIntegratorStep");
+        fmi2SetTimeTYPE *set_time = (fmi2SetTimeTYPE *)sym(lib, "fmi2SetTime");
+        fmi2SetContinuousStatesTYPE *set_x = (fmi2SetContinuousStatesTYPE *)sym(lib, "fmi2SetContinuousStates");
+        fmi2GetContinuousStatesTYPE *get_x = (fmi2GetContinuousStatesTYPE *)sym(lib, "fmi2GetContinuousStates");
+        fmi2GetDerivativesTYPE *get_dx = (fmi2GetDerivativesTYPE *)sym(lib, "fmi2GetDerivatives");
+        fmi2GetEventIndicatorsTYPE *get_z = (fmi2GetEventIndicatorsTYPE *)sym(lib, "fmi2GetEventIndicators");
+        int n = atoi(argv[4]), nx = atoi(argv[7]), nz = atoi(argv[8]), nout = argc - 9, k, i, sample = 1;
+        double dt = atof(argv[5]), h = atof(argv[6]), t = 0.0, t_end = n * dt;
+        double *x = calloc((size_t)nx + 1, sizeof(double)), *dx = calloc((size_t)nx + 1, sizeof(double));
+        double *z = calloc((size_t)nz + 1, sizeof(double)), *z1 = calloc((size_t)nz + 1, sizeof(double));
+        double *y = calloc((size_t)nout + 1, sizeof(double));
+        fmi2ValueReference *out = malloc(sizeof *out * (size_t)nout + 1);
+        fmi2EventInfo info;
+        fmi2Boolean step_event, terminate;
+        fmi2Component c = instantiate("me", fmi2ModelExchange, guid, "", &callbacks, fmi2False, fmi2False);
+        for (i = 0; i < nout; i++) out[i] = (fmi2ValueReference)atoi(argv[9 + i]);
+        if (c == NULL || setup(c, fmi2False, 0.0, 0.0, fmi2True, t_end) != fmi2OK || enter_init(c) != fmi2OK ||
+            exit_init(c) != fmi2OK) {
+            fprintf(stderr, "initialisation failed: %s\n", last_message);
+            return 4;
+        }
+#define ME_EVENT_ITERATION()                                                               \
+    do {                                                                                   \
+        info.newDiscreteStatesNeeded = fmi2True;                                           \
+        while (info.newDiscreteStatesNeeded)                                               \
+            if (new_states(c, &info) != fmi2OK) {                                          \
+                fprintf(stderr, "fmi2NewDiscreteStates failed: %s\n", last_message);       \
+                return 5;                                                                  \
+            }                                                                              \
+    } while (0)
+        ME_EVENT_ITERATION();
+        if (enter_ct(c) != fmi2OK || get_x(c, x, (size_t)nx) != fmi2OK || get_z(c, z, (size_t)nz) != fmi2OK) return 6;
+        get_real(c, out, (size_t)nout, y);
+        for (i = 0; i < nout; i++) printf("%s%.17g", i ? " " : "", y[i]);
+        printf("\n");
+        while (sample <= n) {
+            double t_next = sample * dt, step;
+            int time_event, state_event = 0;
+            if (get_dx(c, dx, (size_t)nx) != fmi2OK) {
+                fprintf(stderr, "fmi2GetDerivatives failed: %s\n", last_message);
+                return 7;
+            }
+            step = t + h < t_next - 1e-12 * h ? h : t_next - t;
+            time_event = info.nextEventTimeDefined && info.nextEventTime <= t + step;
+            if (time_event) step = info.nextEventTime - t;
+            t += step;
+            for (i = 0; i < nx; i++) x[i] += step * dx[i];
+            if (set_time(c, t) != fmi2OK || set_x(c, x, (size_t)nx) != fmi2OK || get_z(c, z1, (size_t)nz) != fmi2OK) {
+                fprintf(stderr, "a step failed: %s\n", last_message);
+                return 8;
+            }
+            for (i = 0; i < nz; i++)
+                if ((z[i] > 0.0) != (z1[i] > 0.0)) state_event = 1;
+            if (completed(c, fmi2True, &step_event, &terminate) != fmi2OK) return 9;
+            if (time_event || state_event || step_event) {
+                if (enter_event(c) != fmi2OK) return 10;
+                ME_EVENT_ITERATION();
+                if (enter_ct(c) != fmi2OK) return 11;
+                if (info.valuesOfContinuousStatesChanged) get_x(c, x, (size_t)nx);
+                get_z(c, z1, (size_t)nz);
+            }
+            memcpy(z, z1, sizeof(double) * (size_t)nz);
+            if (fabs(t - t_next) <= 1e-12 * dt) {
+                get_real(c, out, (size_t)nout, y);
+                for (i = 0; i < nout; i++) printf("%s%.17g", i ? " " : "", y[i]);
+                printf("\n");
+                sample++;
+            }
+        }
+        free_instance(c);
         return 0;
     }
     if (strcmp(mode, "cycles") == 0) {

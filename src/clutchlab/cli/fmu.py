@@ -49,9 +49,13 @@ def _export(args) -> int:
         if args.file is not None:
             cls = cls.for_description(args.file)
         path = export_native_fmu(cls, output, overwrite=args.force, platforms=args.platform,
+                                 fmi_version=args.fmi_version,
                                  report=lambda text: print(f"clutchlab: {text}", file=sys.stderr))
         print(path)
         return 0
+    if args.fmi_version != "2.0":
+        raise ParameterError(f"export-fmu --backend python: FMI {args.fmi_version} is built by the native backend "
+                             "only (pythonfmu writes FMI 2.0)")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
         packed = []
@@ -68,9 +72,10 @@ def register(subparsers) -> None:
     """Add the ``export-fmu`` sub-command."""
     p = subparsers.add_parser(
         "export-fmu",
-        help="build an FMI 2.0 co-simulation FMU of a model or of a driveline file (native: nothing needed where "
+        help="build an FMI 2.0 (or 3.0) FMU of a model or of a driveline file (native: nothing needed where "
              "it runs)",
-        description="Build an FMI 2.0 co-simulation FMU exposing the model's inputs, outputs and parameters (with "
+        description="Build an FMI 2.0 co-simulation and model-exchange FMU (--fmi-version 3.0: an FMI 3.0 "
+                    "co-simulation FMU) exposing the model's inputs, outputs and parameters (with "
                     "units). Every model becomes a native FMU by default: the model's compiled code "
                     "with an FMI layer, for linux64 (and win64 where the MinGW-w64 cross compiler is installed); "
                     "the importing tool needs nothing, the exporting machine a C and C++ compiler. "
@@ -91,4 +96,6 @@ def register(subparsers) -> None:
     p.add_argument("--platform", action="append", choices=("linux64", "win64"), default=None,
                    help="platform of a native FMU's binary (repeat for several; default: linux64, and win64 "
                         "where its cross compiler is installed)")
+    p.add_argument("--fmi-version", choices=("2.0", "3.0"), default="2.0",
+                   help="2.0 (default): co-simulation and model exchange; 3.0: co-simulation (native backend)")
     p.set_defaults(func=_export)

@@ -1,5 +1,5 @@
-"""Native FMUs: a clutchlab model as an FMI 2.0 FMU (co-simulation and model exchange) with nothing of Python
-on the importing machine.
+"""Native FMUs: a clutchlab model as an FMI 2.0 FMU (co-simulation and model exchange) or an FMI 3.0 one
+(co-simulation) with nothing of Python on the importing machine.
 
 ``clutchlab export-fmu MODEL [NETWORK.toml] -o X.fmu`` (:func:`export_native_fmu`) builds, from the model's
 co-simulation class (a :class:`~clutchlab.fmu.cosim.CoSimulation` on the system contract, ``native = True``:
@@ -11,16 +11,17 @@ declarations and parameter sets), a shared library per platform that holds
   entry (:mod:`clutchlab.numerics.exchange`) (:mod:`.codegen`);
 * two *images* of the session: its parameters, state, modes, inputs, options and buffers as bytes, copied
   into each instance, one for co-simulation and one for model exchange (:mod:`.image`);
-* numba's runtime (``nrt.cpp``) and the FMI 2.0 layer (``fmi2_native.c``) with the generated tables of the
+* numba's runtime (``nrt.cpp``) and the FMI 2.0 layer (``fmi2_native.c``, whose end includes the FMI 3.0
+  entry points ``fmi3_native.c``: adapters onto the FMI 2.0 functions) with the generated tables of the
   model's variables (``model.h``) (:mod:`.toolchain`).
 
 So a co-simulation step of the FMU is the step of ``clutchlab`` itself: the results equal the Python
 co-simulation's at the same communication points; in model exchange the host's solver calls the model's own
-hooks.  What the importing tool needs: nothing (the library links only the C library and libm).  Limits,
-stated in docs/fmu.md: parameters whose value the model stores other than as ``a * value + b`` or
+hooks, and the FMU solves a model's algebraic states (the E-clutch's massless tip) at every evaluation, so the
+host sees an ODE.  What the importing tool needs: nothing (the library links only the C library and libm).
+Limits, stated in docs/fmu.md: parameters whose value the model stores other than as ``a * value + b`` or
 ``a / value + b`` (an initial speed that decides a start mode, a number derived from several parameters)
-are fixed at export (``variability="constant"``); a model with an algebraic state (the E-clutch's massless
-tip) is co-simulation only; no FMI 3.0.
+are fixed at export (``variability="constant"``); the FMI 3.0 FMU is for co-simulation.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from pathlib import Path
 from ...errors import ParameterError
 from .image import NativeExportError, parameter_map, session_image
 
-__all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS"]
+__all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
 
 #: the platforms a native FMU can carry
 PLATFORMS = ("linux64", "win64")
@@ -152,12 +153,33 @@ def _layout(tag, image, bindings, targets) -> list:
 
 
 def model_exchange_possible(image) -> bool:
-    """Whether a model can be given to an external integrator: every state has a derivative (a model with
-    algebraic states, a zero in its mass matrix such as the E-clutch's massless tip, is solved by the core's
-    Rosenbrock method only)."""
+    """Whether a model can be given to an external integrator: always, since the algebraic states of a model
+    with zeros in its mass matrix (the E-clutch's massless nodes) are solved inside the FMU at every evaluation
+    (:mod:`clutchlab.numerics.exchange`) and only the differential states are the host's."""
+    return image.arg("x").size > 0
+
+
+def state_nominals(image):
+    """The typical magnitude of each state (FMI's ``nominal``, which a host scales its absolute tolerance by:
+    FMPy's CVode takes ``rtol * nominal``): the model's own absolute tolerance over its relative one, so that a
+    host weighs the states as the core does (``atol + rtol |x|``); the difference scale where that is zero."""
     import numpy as np
 
-    return bool(np.all(np.asarray(image.arg("opt").mass) != 0.0))
+    opt = image.arg("opt")
+    atol = np.broadcast_to(np.asarray(opt.atol, dtype=float), image.arg("x").shape)
+    nominal = atol / opt.rtol if opt.rtol > 0 else np.zeros_like(atol)
+    scale = np.asarray(opt.fd_scale, dtype=float)
+    for i in np.flatnonzero(~(nominal > 0) | ~np.isfinite(nominal)):
+        nominal[i] = scale[i] if i < scale.size and scale[i] > 0 else 1.0
+    return [float(v) for v in nominal]
+
+
+def differential_states(image):
+    """The indices of the states with a derivative (a non-zero in the mass matrix): the FMU's continuous
+    states, in this order."""
+    import numpy as np
+
+    return [int(i) for i in np.flatnonzero(np.asarray(image.arg("opt").mass) != 0.0)]
 
 
 def _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system) -> str:
@@ -178,7 +200,9 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
              f"#define CL_STATUS_MODEL_ERROR {st.MODEL_ERROR}",
              f"#define CL_PARAMETER {_PARAMETER}", f"#define CL_CONSTANT {_CONSTANT}", f"#define CL_INPUT {_INPUT}",
              f"#define CL_OUTPUT {_OUTPUT}", f"#define CL_STATE {_STATE}", f"#define CL_DERIVATIVE {_DERIVATIVE}",
-             f"#define CL_NVARIABLES {len(variables)}u", f"#define CL_NSTATES {cs.arg('x').size if exchange else 0}u",
+             f"#define CL_NVARIABLES {len(variables)}u",
+             f"#define CL_NSTATES {len(differential_states(cs)) if exchange else 0}u",
+             f"#define CL_ME_ALGEBRAIC_FAILED {X.ALGEBRAIC_FAILED}",
              f"#define CL_NINDICATORS {gdir.size}u", f"#define CL_HAS_ME {int(exchange)}",
              *(f"#define CL_{k} {getattr(X, k)}" for k in ("ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART",
                                                          "ME_STORE", "ME_OUTPUTS")), ""]
@@ -199,10 +223,18 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
     for k, (key, sym) in enumerate(sorted(functions.outlined.items())):
         lines.append(f"    if (key == (int64_t){key}LL) return (void *)cl_outlined_{k};")
     lines += ["    return NULL;", "}", ""]
+    states = differential_states(cs) if exchange else []
+    lines.append(f"static const uint32_t cl_states[{max(len(states), 1)}] = {{"
+                 + (", ".join(f"{i}u" for i in states) or "0u") + "};   /* the host's states: the differential ones */")
+    nominals = state_nominals(cs)
+    lines.append(f"static const double cl_nominals[{max(len(states), 1)}] = {{"
+                 + (", ".join(_c_double(nominals[i]) for i in states) or "1.0") + "};")
     lines.append("static const char *cl_status_message(int64_t code) {")
     for s_ in st.Status:
         lines.append(f"    if (code == {int(s_)}) return {_c_string(s_.message)};")
-    lines += ['    return "unknown status";', "}", "static const char *cl_model_error(int64_t code) {"]
+    lines += ['    return "unknown status";', "}", "static const char *cl_model_error(int64_t code) {",
+              "    if (code == CL_ME_ALGEBRAIC_FAILED) return \"the algebraic equations (a massless node's force balance) "
+              "could not be solved by Newton's method at the states the host set\";"]
     for code, text in sorted((getattr(system, "error_messages", None) or {}).items()):
         lines.append(f"    if (code == {int(code)}) return {_c_string(text)};")
     lines += ["    return NULL;", "}", ""]
@@ -291,6 +323,8 @@ def _description(cls, name, ident, guid, variables, experiment, n_indicators, ex
             attrs.update(causality="local", variability="continuous", initial="calculated")
             real["derivative"] = str(v["state_vr"] + 1)
             derivatives.append(vr + 1)
+        if exchange and "nominal" in v:
+            real["nominal"] = repr(float(v["nominal"]))
         if kind in (_PARAMETER, _CONSTANT, _INPUT):
             real["start"] = repr(float(v["start"]))
             lo, hi = v["bounds"]
@@ -317,10 +351,89 @@ def _description(cls, name, ident, guid, variables, experiment, n_indicators, ex
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
 
 
+def _description3(cls, name, ident, guid, variables, experiment) -> bytes:
+    """The FMI 3.0 model description (co-simulation) of the same variables as :func:`_description`'s: Float64
+    variables with the same value references, the independent variable ``time`` after them."""
+    from ... import __version__
+    from ..export import unit_definition
+
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "3.0", "modelName": name, "instantiationToken": guid,
+        "description": f"clutchlab {cls.name or 'model'} {name} (native FMU: no Python needed)",
+        "generationTool": f"clutchlab {__version__} (native)",
+        "generationDateAndTime": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "variableNamingConvention": "structured"})
+    ET.SubElement(root, "CoSimulation", {
+        "modelIdentifier": ident, "canHandleVariableCommunicationStepSize": "true",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canGetAndSetFMUState": "true",
+        "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false",
+        "providesAdjointDerivatives": "false", "hasEventMode": "false", "maxOutputDerivativeOrder": "0",
+        "canReturnEarlyAfterIntermediateUpdate": "false", "providesIntermediateUpdate": "false"})
+    units = sorted({v["unit"] for v in variables if v["unit"]})
+    if units:
+        ud = ET.SubElement(root, "UnitDefinitions")
+        for u in units:
+            ud.append(unit_definition(u))
+    cats = ET.SubElement(root, "LogCategories")
+    for c in ("logEvents", "logStatusDiscard", "logStatusError"):
+        ET.SubElement(cats, "Category", {"name": c})
+    stop, step = experiment
+    ET.SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(stop)),
+                                              "stepSize": repr(float(step))})
+    mv = ET.SubElement(root, "ModelVariables")
+    outputs = []
+    for vr, v in enumerate(variables):
+        attrs = {"name": v["name"], "valueReference": str(vr)}
+        if v["description"]:
+            attrs["description"] = v["description"]
+        kind = v["kind"]
+        if kind == _PARAMETER:
+            attrs.update(causality="parameter", variability="fixed", initial="exact")
+        elif kind == _CONSTANT:
+            attrs.update(causality="local", variability="constant", initial="exact")
+        elif kind == _INPUT:
+            attrs.update(causality="input", variability="continuous")
+        elif kind == _OUTPUT:
+            attrs.update(causality="output", variability="continuous", initial="calculated")
+            outputs.append(vr)
+        else:   # (states and derivatives are model exchange's: the FMI 3.0 FMU is for co-simulation)
+            raise NativeExportError(f"{name}: {v['name']}: a state variable in an FMI 3.0 co-simulation FMU")
+        if v["unit"]:
+            attrs["unit"] = v["unit"]
+        if kind in (_PARAMETER, _CONSTANT, _INPUT):
+            attrs["start"] = repr(float(v["start"]))
+            lo, hi = v["bounds"]
+            if lo is not None:
+                attrs["min"] = repr(float(lo))
+            if hi is not None:
+                attrs["max"] = repr(float(hi))
+        ET.SubElement(mv, "Float64", attrs)
+    ET.SubElement(mv, "Float64", {"name": "time", "valueReference": str(len(variables)), "causality": "independent",
+                                  "variability": "continuous", "description": "simulation time", "unit": "s"})
+    if "s" not in units:   # (time's unit)
+        ud = root.find("UnitDefinitions")
+        if ud is None:
+            ud = ET.Element("UnitDefinitions")
+            root.insert(1, ud)
+        ud.append(unit_definition("s"))
+    ms = ET.SubElement(root, "ModelStructure")
+    for vr in outputs:
+        ET.SubElement(ms, "Output", {"valueReference": str(vr)})
+    for vr in outputs:
+        ET.SubElement(ms, "InitialUnknown", {"valueReference": str(vr)})
+    ET.indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
+
+
+#: FMI versions of a native FMU: the FMI 2.0 one has co-simulation and model exchange, the FMI 3.0 one
+#: co-simulation (the same library: its FMI 3.0 functions adapt onto the FMI 2.0 ones, fmi3_native.c)
+FMI_VERSIONS = ("2.0", "3.0")
+
+
 def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, name: str | None = None,
-                      report=None, _benchmark: bool = False) -> Path:
-    """Build a native FMI 2.0 FMU (co-simulation, and model exchange where the model has no algebraic state) of
-    the co-simulation class ``cls``.
+                      report=None, fmi_version: str = "2.0", _benchmark: bool = False) -> Path:
+    """Build a native FMU of the co-simulation class ``cls``: FMI 2.0 co-simulation and model exchange, or
+    FMI 3.0 co-simulation.
 
     Parameters
     ----------
@@ -339,6 +452,9 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         (``Clutchlab_coupled_clutches``), a registered model's as with pythonfmu (``ClutchlabEmtc``).
     report : callable, optional
         ``report(text)`` for one line on what was built (the CLI prints it).
+    fmi_version : {"2.0", "3.0"}
+        ``"2.0"`` (default): co-simulation and model exchange; ``"3.0"``: co-simulation, the library in
+        ``binaries/x86_64-linux`` and ``binaries/x86_64-windows``.
 
     Returns
     -------
@@ -367,6 +483,9 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
                                 "class on the system contract (CoSimulation.native; the wet clutch's is not yet)")
     if platforms is None:
         platforms = ["linux64"] + [p for p in available_platforms() if p != "linux64"]
+    fmi_version = {"2": "2.0", "3": "3.0"}.get(str(fmi_version), str(fmi_version))
+    if fmi_version not in FMI_VERSIONS:
+        raise ParameterError(f"fmi_version {fmi_version!r}: expected one of {', '.join(FMI_VERSIONS)}")
     platforms = list(dict.fromkeys(platforms))
     for p in platforms:
         if p not in PLATFORMS:
@@ -379,7 +498,7 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         name = network or cls.name or "model"
     ident = native_identifier(name) if network is not None or name != cls.name else _model_identifier(cls.name)
     cs_image = session_image(base_obj.simulation)
-    exchange = model_exchange_possible(cs_image)
+    exchange = fmi_version == "2.0" and model_exchange_possible(cs_image)
     kinds = (False, True) if exchange else (False,)   # (images: co-simulation, model exchange)
     images = tuple(cs_image if not k else session_image(base_obj.simulation, exchange=True) for k in kinds)
     built = {}
@@ -451,8 +570,10 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             label = f"state.{sv.name}" if f"state.{sv.name}" not in names else f"state[{i + 1}]"
             variables.append({"name": label, "unit": _unit(sv.unit), "start": 0.0, "description": sv.description,
                               "bounds": (None, None), "positive": False, "range": "", "kind": _STATE, "index": i})
-    for i, sv in enumerate(system.states):
+    nominals = state_nominals(images[0])
+    for i in differential_states(images[0]):   # (an algebraic state has none: the FMU solves it)
         state = variables[state_vr[i]]
+        state["nominal"] = nominals[i]
         unit = f"{state['unit']}/s" if state["unit"] not in ("", "1") else "1/s"
         variables.append({"name": f"der({state['name']})", "unit": unit, "start": 0.0,
                           "description": f"time derivative of {state['name']}", "bounds": (None, None),
@@ -466,8 +587,11 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     guid = "{" + str(uuid.UUID(bytes=digest.digest()[:16])) + "}"
     header = _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system)
     experiment = cls.experiment or (1.0, 1e-3)
-    description = _description(cls, name, ident, guid, variables, experiment,
-                               images[1].arg("g1").size if exchange else 0, exchange)
+    if fmi_version == "3.0":
+        description = _description3(cls, name, ident, guid, variables, experiment)
+    else:
+        description = _description(cls, name, ident, guid, variables, experiment,
+                                   images[1].arg("g1").size if exchange else 0, exchange)
     buf = io.BytesIO()
     with tempfile.TemporaryDirectory(prefix="clutchlab_native_") as tmp:
         tmp = Path(tmp)
@@ -482,13 +606,14 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", description)
             for p, data in libs.items():
-                info = zipfile.ZipInfo(library_name(p, ident), date_time=(2020, 1, 1, 0, 0, 0))
+                info = zipfile.ZipInfo(library_name(p, ident, fmi_version), date_time=(2020, 1, 1, 0, 0, 0))
                 info.external_attr = 0o755 << 16
                 info.compress_type = zipfile.ZIP_DEFLATED
                 z.writestr(info, data)
     if report is not None:
         n_fixed = sum(v["kind"] == _CONSTANT for v in variables)
-        report(f"native FMU {ident} ({', '.join(platforms)}; {'co-simulation and model exchange' if exchange else 'co-simulation'}): "
+        kind = "co-simulation and model exchange" if exchange else "co-simulation"
+        report(f"native FMU {ident} ({', '.join(platforms)}; FMI {fmi_version} {kind}): "
                f"{len(cls.inputs)} inputs, {len(cls.outputs)} outputs, "
                f"{len(cls.parameters) - n_fixed} parameters ({n_fixed} fixed at export)")
     return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)

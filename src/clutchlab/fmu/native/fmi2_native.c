@@ -216,8 +216,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     }
     if (type == fmi2ModelExchange && !CL_HAS_ME) {
         functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
-                          "fmi2Instantiate: %s has algebraic states (solved by clutchlab's Rosenbrock method): "
-                          "co-simulation only", CL_MODEL_IDENTIFIER);
+                          "fmi2Instantiate: %s has no continuous states: co-simulation only", CL_MODEL_IDENTIFIER);
         return NULL;
     }
     if (guid == NULL || strcmp(guid, CL_GUID) != 0) {
@@ -662,7 +661,9 @@ FMI2_Export fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *
     cl_instance *c = cl_me(comp, "fmi2NewDiscreteStates");
     int64_t code, what = CL_ME_EVENT | CL_ME_STORE | CL_ME_OUTPUTS;
     double t, *x;
-    unsigned char before[CL_NSTATES ? CL_NSTATES * sizeof(double) : 1];
+    double before[CL_NSTATES ? CL_NSTATES : 1];
+    int changed = 0;
+    size_t k;
     if (c == NULL || info == NULL) return fmi2Error;
     if (c->state != CL_EVENT) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2NewDiscreteStates: not in event mode");
@@ -673,7 +674,7 @@ FMI2_Export fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *
      * core's breaks */
     if (c->inputs_changed || t >= c->next_time - 1e-12 * (fabs(t) > 1.0 ? fabs(t) : 1.0)) what |= CL_ME_RESTART;
     x = cl_at(c, c->L->off_x);
-    memcpy(before, x, CL_NSTATES * sizeof(double));
+    for (k = 0; k < CL_NSTATES; k++) before[k] = x[cl_states[k]];
     if (!cl_exchange(c, what, &code)) {
         c->state = CL_ERROR;
         return fmi2Error;
@@ -684,7 +685,8 @@ FMI2_Export fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *
     info->newDiscreteStatesNeeded = fmi2False;
     info->terminateSimulation = code == 1 ? fmi2True : fmi2False;
     info->nominalsOfContinuousStatesChanged = fmi2False;
-    info->valuesOfContinuousStatesChanged = memcmp(before, x, CL_NSTATES * sizeof(double)) != 0 ? fmi2True : fmi2False;
+    for (k = 0; k < CL_NSTATES; k++) if (memcmp(&before[k], &x[cl_states[k]], sizeof(double)) != 0) changed = 1;
+    info->valuesOfContinuousStatesChanged = changed ? fmi2True : fmi2False;
     info->nextEventTimeDefined = isfinite(c->next_time) ? fmi2True : fmi2False;
     info->nextEventTime = isfinite(c->next_time) ? c->next_time : 0.0;
     if (code == 1) c->terminated = 1;
@@ -753,15 +755,16 @@ FMI2_Export fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Rea
             return fmi2Error;
         }
     }
-    memcpy(cl_at(c, c->L->off_x), x, nx * sizeof(double));
+    for (k = 0; k < nx; k++) cl_at(c, c->L->off_x)[cl_states[k]] = x[k];
     c->outputs_stale = 1;
     return fmi2OK;
 }
 
 FMI2_Export fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) {
     cl_instance *c = cl_me(comp, "fmi2GetContinuousStates");
+    size_t k;
     if (c == NULL || nx != CL_NSTATES || (nx && x == NULL)) return fmi2Error;
-    memcpy(x, cl_at(c, c->L->off_x), nx * sizeof(double));
+    for (k = 0; k < nx; k++) x[k] = cl_at(c, c->L->off_x)[cl_states[k]];
     return fmi2OK;
 }
 
@@ -769,18 +772,19 @@ FMI2_Export fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi
     cl_instance *c = cl_me(comp, "fmi2GetNominalsOfContinuousStates");
     size_t k;
     if (c == NULL || nx != CL_NSTATES || (nx && nominal == NULL)) return fmi2Error;
-    for (k = 0; k < nx; k++) nominal[k] = 1.0;
+    for (k = 0; k < nx; k++) nominal[k] = cl_nominals[k];
     return fmi2OK;
 }
 
 FMI2_Export fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {
     cl_instance *c = cl_me(comp, "fmi2GetDerivatives");
+    size_t k;
     if (c == NULL || nx != CL_NSTATES || (nx && dx == NULL)) return fmi2Error;
     if (!cl_outputs(c)) {
         c->state = CL_ERROR;
         return fmi2Error;
     }
-    memcpy(dx, cl_at(c, c->L->off_dx), nx * sizeof(double));
+    for (k = 0; k < nx; k++) dx[k] = cl_at(c, c->L->off_dx)[cl_states[k]];
     return fmi2OK;
 }
 
@@ -929,3 +933,6 @@ FMI2_Export int cl_benchmark_session(fmi2Component comp, double t_end) {
     return cl_call((cl_instance *)comp, t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
 }
 #endif
+
+/* ---------------------------------------------------------------- FMI 3.0: the same functions, adapted */
+#include "fmi3_native.c"

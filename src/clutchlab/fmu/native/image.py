@@ -122,7 +122,7 @@ def session_arguments(simulation):
 
 
 #: the model-exchange session's arguments whose contents the FMU never reads before the compiled code writes them
-_EXCHANGE_SCRATCH = ("log", "dx", "g0", "g1", "out", "y", "r")
+_EXCHANGE_SCRATCH = ("log", "dx", "g0", "g1", "out", "y", "r", "jac", "sub", "piv", "xp", "fp", "gp", "dls")
 
 
 def session_image(simulation, exchange: bool = False) -> Image:
@@ -143,7 +143,7 @@ def session_image(simulation, exchange: bool = False) -> Image:
     if exchange:
         p, x, m, u, sf, si, opt, log = args[:8]
         args = (p, x, m, u, sf, si, opt, log, np.zeros(x.size), np.zeros(opt.gdir.size), np.zeros(opt.gdir.size),
-                np.zeros(2), args[14], args[15], args[16])
+                np.zeros(2), args[14], args[15], args[16], *X.workspace(opt.mass, opt.gdir.size))
         names, scratch_names = X.FIELDS, _EXCHANGE_SCRATCH
     args_ty = module.session.typeof_pyval(args)
     layout = S.table_layout(args_ty)

@@ -81,15 +81,21 @@ class Toolchain:
             cmd += ["-static-libgcc", "-Wl,-Bstatic", "-lstdc++", "-lpthread", "-Wl,-Bdynamic", "-lm"]
         else:
             script = workdir / "exports.map"
-            script.write_text("{ global: fmi2*;%s local: *; };\n" % (" cl_benchmark_*;" if benchmark else ""))
+            script.write_text("{ global: fmi2*; fmi3*;%s local: *; };\n" % (" cl_benchmark_*;" if benchmark else ""))
             cmd += [f"-Wl,--version-script={script}", "-Wl,-z,defs", "-Wl,-z,noexecstack", "-lm"]
         self._run([str(c) for c in cmd], "linking the FMU's library")
         return out
 
 
-def library_name(platform: str, ident: str) -> str:
-    """Path of the library inside the FMU (``binaries/linux64/<ident>.so``)."""
-    return f"binaries/{platform}/{ident}{'.dll' if platform == 'win64' else '.so'}"
+#: the binaries' folder of a platform in an FMI 3.0 FMU (FMI 3.0, 2.5.1.4: architecture-os)
+FMI3_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-windows"}
+
+
+def library_name(platform: str, ident: str, fmi_version: str = "2.0") -> str:
+    """Path of the library inside the FMU (``binaries/linux64/<ident>.so``; FMI 3.0:
+    ``binaries/x86_64-linux/<ident>.so``)."""
+    folder = FMI3_PLATFORMS[platform] if fmi_version.startswith("3") else platform
+    return f"binaries/{folder}/{ident}{'.dll' if platform == 'win64' else '.so'}"
 
 
 def toolchain(platform: str) -> Toolchain:
