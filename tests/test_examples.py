@@ -288,6 +288,14 @@ def check_native_fmu(work, out):
     assert not any(n.startswith("resources/") for n in names)   # nothing of Python: the network is compiled in
 
 
+def check_native_fmu3(work, out):
+    with zipfile.ZipFile(work / "cc3.fmu") as z:
+        xml = z.read("modelDescription.xml").decode()
+        names = z.namelist()
+    assert 'fmiVersion="3.0"' in xml and 'causality="independent"' in xml
+    assert "binaries/x86_64-linux/Clutchlab_coupled_clutches.so" in names
+
+
 def check_results(work, out):
     frame = pd.read_parquet(work / "results" / "results.parquet")
     assert len(frame) == 12                                     # the 4 x 3 grid of the spec
@@ -381,6 +389,7 @@ CHECKS = {
     "report results/": check_report,
     "eclutch.fmu": check_fmu,
     "cc.fmu": check_native_fmu,
+    "cc3.fmu": check_native_fmu3,
     "results/": check_results,
 }
 

@@ -35,7 +35,7 @@ COMMANDS = {
     "control": ("clutchlab.cli.control", "operating points, linear models and Bode diagrams of any model "
                                          "(python-control)"),
     "params": ("clutchlab.cli.params", "show the parameter sets of a model, write or check parameter files"),
-    "export-fmu": ("clutchlab.cli.fmu", "build an FMI 2.0 co-simulation FMU of a model or of a driveline file "
+    "export-fmu": ("clutchlab.cli.fmu", "build an FMI 2.0 (or 3.0) FMU of a model or of a driveline file "
                                         "(native: nothing needed where it runs)"),
     "sweep": ("clutchlab.cli.sweep", "grid or Monte Carlo sweep of a model, in resumable Parquet chunks (local cores "
                                      "or Dask)"),

@@ -265,9 +265,26 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
     return "\n".join(lines) + "\n"
 
 
+def _units_logs_experiment(root, variables, experiment, extra_units=()) -> None:
+    """A model description's ``UnitDefinitions`` (of the variables' units and ``extra_units``), ``LogCategories``
+    and ``DefaultExperiment`` (the same in FMI 2.0 and 3.0)."""
+    from ..export import unit_definition
+
+    units = sorted({v["unit"] for v in variables if v["unit"]} | set(extra_units))
+    if units:
+        ud = ET.SubElement(root, "UnitDefinitions")
+        for u in units:
+            ud.append(unit_definition(u))
+    cats = ET.SubElement(root, "LogCategories")
+    for c in ("logEvents", "logStatusDiscard", "logStatusError"):
+        ET.SubElement(cats, "Category", {"name": c})
+    stop, step = experiment
+    ET.SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(stop)),
+                                              "stepSize": repr(float(step))})
+
+
 def _description(cls, name, ident, guid, variables, experiment, n_indicators, exchange=True) -> bytes:
     from ... import __version__
-    from ..export import unit_definition
 
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": name, "guid": guid,
@@ -287,17 +304,7 @@ def _description(cls, name, ident, guid, variables, experiment, n_indicators, ex
         "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
         "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
         "providesDirectionalDerivative": "false"})
-    units = sorted({v["unit"] for v in variables if v["unit"]})
-    if units:
-        ud = ET.SubElement(root, "UnitDefinitions")
-        for u in units:
-            ud.append(unit_definition(u))
-    cats = ET.SubElement(root, "LogCategories")
-    for c in ("logEvents", "logStatusDiscard", "logStatusError"):
-        ET.SubElement(cats, "Category", {"name": c})
-    stop, step = experiment
-    ET.SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(stop)),
-                                              "stepSize": repr(float(step))})
+    _units_logs_experiment(root, variables, experiment)
     mv = ET.SubElement(root, "ModelVariables")
     outputs, derivatives, states = [], [], []
     for vr, v in enumerate(variables):
@@ -355,7 +362,6 @@ def _description3(cls, name, ident, guid, variables, experiment) -> bytes:
     """The FMI 3.0 model description (co-simulation) of the same variables as :func:`_description`'s: Float64
     variables with the same value references, the independent variable ``time`` after them."""
     from ... import __version__
-    from ..export import unit_definition
 
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "3.0", "modelName": name, "instantiationToken": guid,
@@ -369,17 +375,7 @@ def _description3(cls, name, ident, guid, variables, experiment) -> bytes:
         "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false",
         "providesAdjointDerivatives": "false", "hasEventMode": "false", "maxOutputDerivativeOrder": "0",
         "canReturnEarlyAfterIntermediateUpdate": "false", "providesIntermediateUpdate": "false"})
-    units = sorted({v["unit"] for v in variables if v["unit"]})
-    if units:
-        ud = ET.SubElement(root, "UnitDefinitions")
-        for u in units:
-            ud.append(unit_definition(u))
-    cats = ET.SubElement(root, "LogCategories")
-    for c in ("logEvents", "logStatusDiscard", "logStatusError"):
-        ET.SubElement(cats, "Category", {"name": c})
-    stop, step = experiment
-    ET.SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(stop)),
-                                              "stepSize": repr(float(step))})
+    _units_logs_experiment(root, variables, experiment, extra_units=("s",))
     mv = ET.SubElement(root, "ModelVariables")
     outputs = []
     for vr, v in enumerate(variables):
@@ -410,12 +406,6 @@ def _description3(cls, name, ident, guid, variables, experiment) -> bytes:
         ET.SubElement(mv, "Float64", attrs)
     ET.SubElement(mv, "Float64", {"name": "time", "valueReference": str(len(variables)), "causality": "independent",
                                   "variability": "continuous", "description": "simulation time", "unit": "s"})
-    if "s" not in units:   # (time's unit)
-        ud = root.find("UnitDefinitions")
-        if ud is None:
-            ud = ET.Element("UnitDefinitions")
-            root.insert(1, ud)
-        ud.append(unit_definition("s"))
     ms = ET.SubElement(root, "ModelStructure")
     for vr in outputs:
         ET.SubElement(ms, "Output", {"valueReference": str(vr)})
