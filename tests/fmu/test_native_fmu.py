@@ -235,10 +235,11 @@ json.dump({"rows": rows, "again": again, "time": time, "refused": refused}, open
 
 
 def test_fmi3_cosimulation_from_the_same_library(built, tmp_path):
-    """``fmi_version="3.0"``: an FMI 3.0 co-simulation FMU of the same network whose library is the FMI 2.0 one
-    (its ``fmi3*`` functions adapt onto the ``fmi2*`` ones), in FMPy without clutchlab: valid, the numbers of
-    the Python run with parameters and inputs set, rollback through ``fmi3Get/SetFMUState``, refused values
-    with their messages through FMI 3.0's log callback; the win64 library in ``binaries/x86_64-windows``."""
+    """``fmi_version="3.0"``: an FMI 3.0 co-simulation FMU of the same network, whose ``fmi3*`` functions adapt
+    onto the ``fmi2*`` ones of the same library, in FMPy without clutchlab: valid, the numbers of
+    the Python run with parameters and inputs set, ``fmi3Reset``, rollback through ``fmi3Get/SetFMUState``,
+    refused values (a NaN input, a write to time, an unknown value reference) with their messages through FMI
+    3.0's log callback; the win64 library in ``binaries/x86_64-windows``."""
     _, cls, _ = built["inputs"]
     lines = []
     platforms = ["linux64"] + (["win64"] if not _wine() else [])
