@@ -24,6 +24,7 @@ from clutchlab.cli import main
 from clutchlab.errors import ParameterError
 from clutchlab.fmu.driveline import DrivelineCoSimulation
 from clutchlab.fmu.native import NativeExportError, export_native_fmu, native_identifier
+from clutchlab.fmu.native.image import accepted_range
 from driveline_networks import INPUTS_TOML
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "driveline_coupled_clutches.toml"
@@ -440,6 +441,17 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host):
     for name in python:
         _close(native[name], python[name], name)
     assert np.max(python["coupling_torque"]) > 100.0   # (the request went through)
+    # parameters a host sets (the coupling's kinetic friction, the armature's spring, the vehicle's mass)
+    root, svs = _variables(path)
+    start = {"coupling.mu_k[1]": 0.09, "actuator.stiffness": 1.1 * float(svs["actuator.stiffness"].find("Real")
+                                                                        .get("start")), "vehicle.mass": 1900.0}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    assert svs["solver.rtol"].get("variability") == "constant"   # (its atol follow it only below the default)
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(EmtcCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    assert np.max(np.abs(changed["coupling_torque"] - python["coupling_torque"])) > 1.0
     # a count the model takes only whole (friction pairs) is refused as a fraction, as the model refuses it
     with zipfile.ZipFile(path) as z:
         z.extractall(tmp_path / "fmu")
@@ -542,6 +554,21 @@ def test_native_fmu_of_the_eclutch(tmp_path, host):
     for name in python:
         _close(native[name], python[name], name)
     assert np.ptp(python["bearing_position"]) > 1e-3   # (the actuator moved)
+    # parameters a host sets (found writable by rebuilding the model, and checked jointly): the controller's
+    # gains, the motor's resistance, the clutch's friction coefficient and the seals' static ratio
+    start = {"actuator.kp": 2500.0, "actuator.resistance": 0.25, "clutch.mu": 0.3, "friction.static_ratio": 1.3}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    assert svs["rtol"].get("variability") == "constant"   # (its atol follow it only below the default)
+    assert sum(sv.get("causality") == "parameter" for sv in svs.values()) >= 30
+    # a bound the model's own code sets beyond its declared range (the CSC's lower travel limit must be < 0,
+    # declared [-100, 100]) is the FMU variable's max, found at export by bisection
+    slave_min = svs["actuator.slave_min"].find("Real")
+    assert float(slave_min.get("min")) == -100.0 and -1e-12 < float(slave_min.get("max")) < 0.0
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(EClutchCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    assert np.max(np.abs(changed["clutch_torque"] - python["clutch_torque"])) > 1.0
     with zipfile.ZipFile(path) as z:
         z.extractall(tmp_path / "fmu")
     root, svs = _variables(path)
@@ -584,6 +611,15 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     for name in python:
         _close(native[name], python[name], name)
     assert native["actuator_force"][0] == 1000.0   # (started at the reference, not at 0)
+    # parameters a host sets: the friction law's coefficients, the bench's speed controller, the start temperature
+    start = {"clutch.mu_v1": 1.1 * float(svs["clutch.mu_v1"].find("Real").get("start")), "bench.speed_kp":
+             1.3 * float(svs["bench.speed_kp"].find("Real").get("start")), "scenario.initial_temperature": 90.0}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(WetCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    assert np.max(np.abs(changed["clutch_torque"] - python["clutch_torque"])) > 1e-3 * np.max(np.abs(python["clutch_torque"]))
 
 
 # ------------------------------------------------------------------------------------------ model exchange
@@ -661,3 +697,20 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     for name in speeds:
         scale = float(np.max(np.abs(tight[name])))
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-4 * scale, err_msg=name)
+
+
+def test_the_accepted_range_is_found_by_bisection_within_the_declared_one():
+    """accepted_range: a model that refuses more than its declared range (a bound in its own code) gets the
+    interval it accepts; a side it accepts to the declared bound keeps it; whole numbers stay whole."""
+    calls = []
+
+    def below_zero(v):
+        calls.append(v)
+        return v < 0.0
+
+    low, high = accepted_range(below_zero, -0.0015, -100.0, 100.0)
+    assert low == -100.0 and -1e-15 < high < 0.0 and len(calls) < 120
+    assert accepted_range(lambda v: True, 2000.0, None, None, positive=True) == (0.0, None)
+    assert accepted_range(lambda v: v <= 7, 3.0, 1.0, 100.0, whole=True) == (1.0, 7.0)
+    low, high = accepted_range(lambda v: 0.5 < v < 4.0, 1.0)
+    assert 0.5 < low < 0.5 + 1e-12 and 4.0 - 1e-12 < high < 4.0

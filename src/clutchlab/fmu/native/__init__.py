@@ -37,8 +37,8 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
-from ...errors import ParameterError
-from .image import NativeExportError, parameter_map, session_image
+from ...errors import ClutchlabError, ParameterError
+from .image import NativeExportError, accepted_range, parameter_map, session_image
 
 __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
 
@@ -508,6 +508,18 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
                 built[key] = tuple(session_image(obj.simulation, exchange=k) for k in kinds)
         return built[key]
 
+    def accepts(parameters):
+        """Whether the model takes these parameter values (built without its images: a range probe)."""
+        import warnings
+
+        try:
+            with warnings.catch_warnings():   # (values far out: overflow warnings of a model that takes them)
+                warnings.simplefilter("ignore", RuntimeWarning)
+                cls(**parameters).hold_inputs({})
+        except (ClutchlabError, ValueError, ArithmeticError):   # (refused, or a build that fails there)
+            return False
+        return True
+
     def pick(images_or_none, k):
         return None if images_or_none is None else images_or_none[k]
 
@@ -535,6 +547,14 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             # a whole number the model refuses halves of (a count of friction pairs): the FMU refuses them too
             half = float(v.start) + 0.5 if v.maximum is None or float(v.start) + 0.5 <= v.maximum else float(v.start) - 0.5
             whole = build(parameters={v.name: half}) is None
+        if writable:   # the interval the model accepts, where its own code refuses more than the declared range
+            low, high = accepted_range(lambda x, name=v.name: accepts({name: x}), float(v.start), v.minimum,
+                                       v.maximum, v.positive, whole)
+            # (a positive one's lower end 0 is its strict > 0, already declared)
+            minimum = v.minimum if low is None or v.positive and low == 0.0 else low
+            maximum = v.maximum if high is None else high
+            if (minimum, maximum) != (v.minimum, v.maximum):
+                v = dataclasses.replace(v, minimum=minimum, maximum=maximum)
         variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
                           "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v),
                           "kind": _PARAMETER if writable else _CONSTANT, "whole": whole})

@@ -21,7 +21,8 @@ sets): one whose every changed number is ``a * value + b`` (most are copies, ``a
 image in any other way (an initial speed that decides a start mode, a table rebuilt, the arrays' sizes, a
 number two parameters share) is fixed at export.  Words that differ between two builds of the same values
 are memory the model never initialised and are ignored; a last build with every writable parameter changed
-at once must equal what the FMU writes.
+at once must equal what the FMU writes; where the model refuses such a combination (a check across
+parameters), the parameters of the smallest refused set are fixed.
 
 With ``exchange=True``, :func:`session_image` gives the image of the model-exchange session
 (:mod:`clutchlab.numerics.exchange`): the same arguments with buffers for the derivatives, the switching
@@ -237,7 +238,11 @@ def _trials(variable) -> list:
     whole-number start, in order of preference."""
     v = float(variable.start)
     lo, hi = variable.minimum, variable.maximum
-    cand = [v * 1.25 + 0.125, v * 0.8 + 0.0625, v + 1.0, v - 1.0, v * 2.0, v * 0.5, v + 0.5, v - 0.5]
+    # one value above the start and one below, relative to it: a law that changes at the start (a tolerance
+    # whose absolute tolerances follow it only below its default, min(1, rtol / default)) is seen as not affine
+    # and fixed; two values on one side (v * 1.25 + 0.125 and v * 0.8 + 0.0625 for rtol = 1e-3) saw a line
+    cand = ([v * 1.25, v * 0.8, v * 2.0, v * 0.5, v * 1.5, v * 0.75] if v != 0.0 else []) \
+        + [v + 1.0, v - 1.0, v + 0.5, v - 0.5, v + 0.125, v - 0.0625]
     if float(v).is_integer():
         cand = [v + 1.0, v - 1.0, v + 2.0, v - 2.0] + cand
     out = []
@@ -361,6 +366,73 @@ def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
     return _checked_jointly(variables, base, build, out, noise | skip)
 
 
+def accepted_range(accepts, start: float, lo=None, hi=None, positive: bool = False, whole: bool = False,
+                   reach: float = 2.0 ** 40, iterations: int = 48) -> tuple:
+    """The interval around ``start`` in which the model accepts a parameter, within its declared range.
+
+    A model may refuse values its declared range allows (a check in the model's own code: the E-clutch's
+    ``actuator.slave_min`` must be < 0 though its range is [-100, 100]); a native FMU cannot run that check,
+    so it takes the interval found here as the variable's ``min``/``max``.  On each side the distance from
+    ``start`` doubles (from ``|start| / 2``, or 1/2 where ``start`` is 0) until the model refuses the value
+    or the declared bound (else ``reach`` times the first distance) is passed; between the last accepted and
+    the first refused value, bisection (``iterations`` halvings, whole numbers for ``whole``) finds the
+    bound, and the last accepted value is returned.
+
+    Parameters
+    ----------
+    accepts : callable
+        ``accepts(value) -> bool``: the model built with the parameter at ``value`` (the others at their start).
+    start, lo, hi : float
+        The start value (accepted) and the declared bounds (None: none).
+    positive : bool
+        The declared range excludes 0 and below.
+
+    Returns
+    -------
+    (low, high) : tuple
+        The accepted interval's ends (None where the declared side has no bound and nothing was refused
+        within ``reach``).
+    """
+    v0 = float(start)
+    base = abs(v0) / 2.0 if v0 != 0.0 else 0.5
+    if whole:
+        base = max(1.0, math.floor(base))
+    out = []
+    for sign, bound in ((-1.0, lo), (1.0, hi)):
+        if positive and sign < 0 and (bound is None or bound < 0.0):
+            bound = 0.0
+        good, bad, d = v0, None, base
+        while d <= base * reach:
+            value = v0 + sign * d
+            if bound is not None and (value < bound if sign < 0 else value > bound):
+                value = bound
+            if positive and value <= 0.0 or value == good:
+                break
+            if accepts(value):
+                good = value
+                if value == bound:
+                    break
+            else:
+                bad = value
+                break
+            d *= 2.0
+        if bad is None:   # (nothing refused up to the declared bound, or within reach: the declared side)
+            out.append(bound)
+            continue
+        for _ in range(iterations):
+            mid = 0.5 * (good + bad)
+            if whole:
+                mid = math.floor(mid) if sign > 0 else math.ceil(mid)
+            if mid == good or mid == bad:
+                break
+            if accepts(mid):
+                good = mid
+            else:
+                bad = mid
+        out.append(good)
+    return out[0], out[1]
+
+
 def _apply(image: Image, where: dict, values: dict) -> np.ndarray:
     """The image's numbers with ``values`` written as a native FMU writes them (float64 words)."""
     words = _words(image).view(np.float64).copy()
@@ -375,24 +447,66 @@ def _written(where: dict, values: dict) -> np.ndarray:
     return np.array(sorted({t.offset // 8 for name in values for t in where[name] or ()}), dtype=np.int64)
 
 
+def _joint_values(variables, names) -> dict:
+    """The joint build's values of the variables ``names``: their first trial values."""
+    changed = {}
+    for var in variables:
+        if var.name in names:
+            trials = _trials(var)
+            if trials:
+                changed[var.name] = trials[0]
+    return changed
+
+
 def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
     """Build the model with every writable parameter changed at once and compare with the image the FMU would
     write; a parameter whose numbers differ is fixed (repeated until they agree).  ``ignore``: the words that
-    differ between two builds of the same values, and the pointers."""
-    for _ in range(len(where) + 1):
-        changed = {}
-        for var in variables:
-            if where.get(var.name):
-                trials = _trials(var)
-                if trials:
-                    changed[var.name] = trials[0]
+    differ between two builds of the same values, and the pointers.  Where the model refuses the combination
+    (a check across parameters: the E-clutch's preload balance, a travel's two ends), the smallest refused
+    set is found by delta debugging (Zeller's ddmin) and its members are fixed: a host could otherwise write a
+    combination the model refuses, which the FMU cannot check."""
+    names = [var.name for var in variables if where.get(var.name)]
+    _check_set(variables, base, build, where, ignore, names)
+    return where
+
+
+def _refused(variables, base, build, names) -> bool:
+    img = build(_joint_values(variables, set(names)))
+    return img is None or not base.same_layout(img)
+
+
+def _minimal_refused(variables, base, build, names) -> list:
+    """A smallest subset of ``names`` (refused together) that the model still refuses (ddmin on the
+    complements)."""
+    s, n = list(names), 2
+    while len(s) >= 2:
+        size = -(-len(s) // n)
+        chunks = [s[i:i + size] for i in range(0, len(s), size)]
+        for chunk in chunks:
+            rest = [x for x in s if x not in chunk]
+            if rest and _refused(variables, base, build, rest):
+                s, n = rest, max(n - 1, 2)
+                break
+        else:
+            if n >= len(s):
+                break
+            n = min(len(s), 2 * n)
+    return s
+
+
+def _check_set(variables, base, build, where, ignore, names) -> None:
+    for _ in range(2 * len(names) + 1):
+        names = [n for n in names if where.get(n)]
+        if not names:
+            return
+        changed = _joint_values(variables, set(names))
         if not changed:
-            return where
+            return
         img = build(changed)
         if img is None or not base.same_layout(img):
-            for name in changed:   # (refused together though each alone was taken: all fixed)
+            for name in _minimal_refused(variables, base, build, names):
                 where[name] = None
-            return where
+            continue
         expected = _apply(base, where, changed)
         got = _words(img).view(np.float64)
         with np.errstate(invalid="ignore", over="ignore"):
@@ -401,10 +515,11 @@ def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndar
                     | ignore)
         bad = set(np.flatnonzero(~same).tolist())
         if not bad:
-            return where
+            return
         offenders = [name for name in changed if any(t.offset // 8 in bad for t in where[name])]
         if not offenders:   # (a number no target writes changed: nothing can be trusted)
             offenders = list(changed)
         for name in offenders:
             where[name] = None
-    return where
+    for name in names:   # (not settled within the rounds: nothing unverified stays writable)
+        where[name] = None
