@@ -452,6 +452,15 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host):
     for name in changed:
         _close(native[name], changed[name], name)
     assert np.max(np.abs(changed["coupling_torque"] - python["coupling_torque"])) > 1.0
+    # a request that reverses with a shrinking amplitude at every sample fills the magnets' memories (more than
+    # the Python co-simulation's 64 turning points: it replays with 256); the native FMU, which cannot grow
+    # them at run time, starts with 1024 (EmtcCoSimulation.for_native) and gives the same run
+    assert EmtcCoSimulation.for_native()()._options.memory_capacity == 1024
+    reversing = dict(inputs, torque_request=300.0 + 250.0 * (-1.0) ** k * (1.0 - k / n))
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=reversing)
+    python = _python_run(EmtcCoSimulation, n, dt, inputs=reversing)
+    for name in python:
+        _close(native[name], python[name], name)
     # a count the model takes only whole (friction pairs) is refused as a fraction, as the model refuses it
     with zipfile.ZipFile(path) as z:
         z.extractall(tmp_path / "fmu")

@@ -176,6 +176,12 @@ class CoSimulation(abc.ABC):
     #: parameters
     native: bool = False
 
+    @classmethod
+    def for_native(cls) -> type:
+        """The class a native FMU is built from (itself; a model whose Python co-simulation grows a buffer at
+        run time, which compiled code cannot, gives a subclass that starts with a larger one: the EMTC)."""
+        return cls
+
     @abc.abstractmethod
     def __init__(self, **parameter_values):
         ...

@@ -114,6 +114,19 @@ class EmtcCoSimulation(ContractCoSimulation):
     )
     outputs = tuple(Variable(n, u, 0.0, d) for n, u, d, _ in _EMTC_OUTPUTS)
     parameters = _emtc_variables()
+    #: turning points each hysteresis memory starts with (``BenchOptions.memory_capacity``); a full memory
+    #: replays the run with four times as many (:meth:`_advance`)
+    memory_capacity = 64
+    #: ... and a native FMU's, which cannot grow its memory at run time (:meth:`for_native`)
+    NATIVE_MEMORY_CAPACITY = 1024
+
+    @classmethod
+    def for_native(cls) -> type:
+        """The class a native FMU is built from: memories of :data:`NATIVE_MEMORY_CAPACITY` turning points
+        (16 times the start of this class's, which replays with a larger one when full; the results do not
+        depend on the size)."""
+        return type(cls.__name__, (cls,), {"memory_capacity": cls.NATIVE_MEMORY_CAPACITY,
+                                           "__doc__": cls.__doc__, "__module__": cls.__module__})
 
     def __init__(self, **parameter_values):
         from ..emtc.bench import ActuatorParameters, BenchScenario, VehicleParameters
@@ -138,7 +151,8 @@ class EmtcCoSimulation(ContractCoSimulation):
         self._scenario = BenchScenario(gear=int(gear), drum_load_front=values["scenario.drum_load_front"],
                                        drum_load_rear=values["scenario.drum_load_rear"],
                                        sample_time=self.sample_time, duration=max(4.0, self.sample_time))
-        self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling)
+        self._options = BenchOptions(actuator=self.actuator, coupling=self.coupling,
+                                     memory_capacity=self.memory_capacity)
         self.fixed_step = fixed_step_parameter(values)
         # (the absolute tolerances follow rtol below its default, as the bench's own runs do: with them fixed the
         # co-simulation's error stopped following rtol, issue #30)

@@ -481,6 +481,7 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         if p not in PLATFORMS:
             raise ParameterError(f"platform {p!r}: expected one of {', '.join(PLATFORMS)}")
     chains = [toolchain(p) for p in platforms]   # (a missing compiler is refused before anything is built)
+    cls = cls.for_native()   # (a model whose buffers grow at run time starts with larger ones)
     base_obj = cls()
     base_obj.hold_inputs({})   # (a model that starts its run at the first inputs starts it here)
     network = getattr(getattr(getattr(cls, "base", None), "driveline", None), "name", None)
