@@ -851,6 +851,26 @@ class Simulation:
         opened = S.open_session(*self._session_parts())
         return opened if opened is not None else (self._general, None)
 
+    def session(self, log_capacity: int | None = None) -> tuple:
+        """The packed arguments of this run's compiled session, for code that runs the model's compiled session
+        itself (a native FMU, :mod:`clutchlab.fmu.native`, copies them into its image).
+
+        Parameters
+        ----------
+        log_capacity : int, optional
+            First replace the event log with an empty one of this many events.
+
+        Returns
+        -------
+        (module, outputs_module, args, method) : tuple
+            The model's compiled entry points for the run's integrator and for its outputs (Dormand-Prince's),
+            the arguments (:data:`clutchlab.numerics.session.FIELDS`, in that order) and the integrator,
+            ``"dopri"`` or ``"rodas"`` (Rosenbrock for a stiff model or a fixed step).
+        """
+        if log_capacity is not None:
+            self.log = self._core.new_log(int(log_capacity))
+        return (*self._session_parts(), self._method())
+
     def _session_parts(self):
         """``(module, outputs_module, args)`` of the packed session (:func:`clutchlab.numerics.session.open_session`;
         a native FMU copies the same arguments, :mod:`clutchlab.fmu.native`)."""

@@ -339,6 +339,15 @@ int main(int argc, char **argv) {
         printf("vr %d %s\n", (int)st, last_message);
         st = do_step(c, 0.0, 1e-3, fmi2True);
         printf("valid %d -\n", (int)st);
+        {   /* a handle that is not an instance of this FMU (zeroed memory): refused, not followed */
+            void *foreign = calloc(1, 4096);
+            st = do_step((fmi2Component)foreign, 0.0, 1e-3, fmi2True);
+            printf("foreign %d -\n", (int)st);
+            st = get_real((fmi2Component)foreign, &bad, 1, &y);
+            printf("foreign_get %d -\n", (int)st);
+            free_instance((fmi2Component)foreign);   /* (not freed by the FMU: it is not its instance) */
+            free(foreign);
+        }
         free_instance(c);
         return 0;
     }

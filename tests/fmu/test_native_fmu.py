@@ -380,7 +380,8 @@ def test_bad_values_return_fmi2error_with_a_message(host, unpacked, name, value,
 
 def test_misuse_returns_fmi2error_and_the_instance_goes_on(host, unpacked):
     """An unknown FMU type (NULL from fmi2Instantiate), a step not starting at the model's time, of zero or NaN length,
-    an unknown value reference: refused with a message; a valid step afterwards still works."""
+    an unknown value reference: refused with a message; a valid step afterwards still works; a handle that is not
+    an instance of the FMU (zeroed memory) is refused by the instances' magic number, and not freed."""
     lib, guid, _, _ = unpacked
     lines = _host(host, lib, guid, "misuse").stdout.splitlines()
     assert lines[0] == "me 1"
@@ -390,6 +391,7 @@ def test_misuse_returns_fmi2error_and_the_instance_goes_on(host, unpacked):
     assert statuses["nan"][0] == 3 and "expected a finite step > 0" in statuses["nan"][1]
     assert statuses["vr"][0] == 3 and "no variable with value reference 99999" in statuses["vr"][1]
     assert statuses["valid"][0] == 0
+    assert statuses["foreign"][0] == 3 and statuses["foreign_get"][0] == 3   # (a handle that is no instance)
 
 
 def test_a_wrong_guid_is_refused_and_a_null_instance_does_not_crash(host, unpacked):

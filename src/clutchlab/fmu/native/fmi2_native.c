@@ -46,7 +46,10 @@ void *clutchlab_outline_resolve_v1(int64_t key) { return cl_outline_lookup(key);
 /* ---------------------------------------------------------------- instances */
 enum { CL_INSTANTIATED, CL_INITIALIZATION, CL_STEPPING, CL_TERMINATED, CL_ERROR, CL_EVENT, CL_CONTINUOUS };
 
+#define CL_INSTANCE_MAGIC 0x434c494eu /* "CLIN": a live clutchlab instance */
+
 typedef struct {
+    uint32_t magic;          /* CL_INSTANCE_MAGIC while the instance lives (cleared by fmi2FreeInstance) */
     const cl_layout *L;      /* the image of the instance's kind: co-simulation or model exchange */
     unsigned char *mem;      /* the instance's copy of the image (L->bytes) */
     double *values;          /* the value of every parameter, constant and input (by value reference) */
@@ -168,9 +171,12 @@ static int cl_outputs(cl_instance *c) {
     return 1;
 }
 
+/* the instance behind a handle, or NULL for NULL or a handle that is not a live instance of this library (a
+ * freed one, another FMU's: best effort, by the magic number at its start) */
 static cl_instance *cl_check(fmi2Component comp, const char *where) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = (cl_instance *)comp;   /* (the one cast) */
     (void)where;
+    if (c == NULL || c->magic != CL_INSTANCE_MAGIC) return NULL;
     return c;
 }
 
@@ -243,14 +249,16 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         return NULL;
     }
     strcpy(c->name, name);
+    c->magic = CL_INSTANCE_MAGIC;
     cl_load_image(c);
     c->state = CL_INSTANTIATED;
     return c;
 }
 
 FMI2_Export void fmi2FreeInstance(fmi2Component comp) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, "fmi2FreeInstance");
     if (c == NULL) return;
+    c->magic = 0;
     free(c->mem);
     free(c->values);
     free(c->name);
@@ -325,7 +333,7 @@ FMI2_Export fmi2Status fmi2Terminate(fmi2Component comp) {
 }
 
 FMI2_Export fmi2Status fmi2Reset(fmi2Component comp) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, "fmi2Reset");
     if (c == NULL) return fmi2Error;
     cl_load_image(c);
     c->state = CL_INSTANTIATED;
@@ -439,29 +447,29 @@ static fmi2Status cl_no_variables(cl_instance *c, const char *fn, size_t n) {
 
 FMI2_Export fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2GetInteger", n);
+    return cl_no_variables(cl_check(c, "fmi2GetInteger"), "fmi2GetInteger", n);
 }
 FMI2_Export fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2GetBoolean", n);
+    return cl_no_variables(cl_check(c, "fmi2GetBoolean"), "fmi2GetBoolean", n);
 }
 FMI2_Export fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2GetString", n);
+    return cl_no_variables(cl_check(c, "fmi2GetString"), "fmi2GetString", n);
 }
 FMI2_Export fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                       const fmi2Integer v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2SetInteger", n);
+    return cl_no_variables(cl_check(c, "fmi2SetInteger"), "fmi2SetInteger", n);
 }
 FMI2_Export fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                       const fmi2Boolean v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2SetBoolean", n);
+    return cl_no_variables(cl_check(c, "fmi2SetBoolean"), "fmi2SetBoolean", n);
 }
 FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
     (void)vr; (void)v;
-    return cl_no_variables((cl_instance *)c, "fmi2SetString", n);
+    return cl_no_variables(cl_check(c, "fmi2SetString"), "fmi2SetString", n);
 }
 
 /* ---------------------------------------------------------------- FMU state (rollback, Monte Carlo) */
@@ -543,13 +551,14 @@ FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
 
 FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size) {
     (void)state;
-    if (comp == NULL || size == NULL) return fmi2Error;
-    *size = CL_SER_BYTES((cl_instance *)comp);
+    cl_instance *c = cl_check(comp, __func__);
+    if (c == NULL || size == NULL) return fmi2Error;
+    *size = CL_SER_BYTES(c);
     return fmi2OK;
 }
 
 FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte out[], size_t size) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, __func__);
     cl_state *s = (cl_state *)state;
     unsigned char *p = (unsigned char *)out;
     uint32_t magic = CL_MAGIC, version = 1;
@@ -582,7 +591,7 @@ FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate st
 
 FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte in[], size_t size,
                                                fmi2FMUstate *state) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, __func__);
     const unsigned char *p = (const unsigned char *)in;
     uint32_t magic, version;
     char guid[40];
@@ -626,7 +635,7 @@ FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fm
                                                     const fmi2ValueReference z[], size_t nz, const fmi2Real du[],
                                                     fmi2Real dz[]) {
     (void)u; (void)nu; (void)z; (void)nz; (void)du; (void)dz;
-    cl_log((cl_instance *)comp, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative: not provided");
+    cl_log(cl_check(comp, __func__), fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative: not provided");
     return fmi2Error;
 }
 
@@ -637,7 +646,7 @@ static int cl_crossed(double a, double b, int d) {
 }
 
 static cl_instance *cl_me(fmi2Component comp, const char *fn) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, fn);
     if (c == NULL) return NULL;
     if (!c->L->exchange) {
         cl_log(c, fmi2Error, "logStatusError", "%s: a co-simulation instance (instantiate for model exchange)", fn);
@@ -805,7 +814,7 @@ FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi
                                                    const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr; (void)order; (void)value;
     if (n == 0) return fmi2OK;
-    cl_log((cl_instance *)comp, fmi2Error, "logStatusError",
+    cl_log(cl_check(comp, __func__), fmi2Error, "logStatusError",
            "fmi2SetRealInputDerivatives: inputs are held constant over a step (canInterpolateInputs is false)");
     return fmi2Error;
 }
@@ -814,7 +823,7 @@ FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fm
                                                     const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)order; (void)value;
     if (n == 0) return fmi2OK;
-    cl_log((cl_instance *)comp, fmi2Error, "logStatusError",
+    cl_log(cl_check(comp, __func__), fmi2Error, "logStatusError",
            "fmi2GetRealOutputDerivatives: not provided (maxOutputDerivativeOrder is 0)");
     return fmi2Error;
 }
@@ -882,19 +891,19 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, f
 }
 
 FMI2_Export fmi2Status fmi2CancelStep(fmi2Component comp) {
-    cl_log((cl_instance *)comp, fmi2Error, "logStatusError", "fmi2CancelStep: steps are not asynchronous");
+    cl_log(cl_check(comp, __func__), fmi2Error, "logStatusError", "fmi2CancelStep: steps are not asynchronous");
     return fmi2Error;
 }
 
 FMI2_Export fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Status *value) {
     (void)kind;
-    if (comp == NULL || value == NULL) return fmi2Error;
+    if (cl_check(comp, __func__) == NULL || value == NULL) return fmi2Error;
     *value = fmi2OK;
     return fmi2Discard;
 }
 
 FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Real *value) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, __func__);
     if (c == NULL || value == NULL) return fmi2Error;
     if (kind == fmi2LastSuccessfulTime) {
         *value = *cl_at(c, c->L->off_time);
@@ -906,11 +915,11 @@ FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKin
 FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Integer *value) {
     (void)kind;
     (void)value;
-    return comp == NULL ? fmi2Error : fmi2Discard;
+    return cl_check(comp, __func__) == NULL ? fmi2Error : fmi2Discard;
 }
 
 FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2Boolean *value) {
-    cl_instance *c = (cl_instance *)comp;
+    cl_instance *c = cl_check(comp, __func__);
     if (c == NULL || value == NULL) return fmi2Error;
     if (kind == fmi2Terminated) {
         *value = c->terminated ? fmi2True : fmi2False;
@@ -922,7 +931,7 @@ FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2Status
 FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind kind, fmi2String *value) {
     (void)kind;
     (void)value;
-    return comp == NULL ? fmi2Error : fmi2Discard;
+    return cl_check(comp, __func__) == NULL ? fmi2Error : fmi2Discard;
 }
 
 #ifdef CL_BENCHMARK
@@ -930,7 +939,7 @@ FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusK
  * the FMI layer around it, to measure what the layer adds per step */
 FMI2_Export int cl_benchmark_session(fmi2Component comp, double t_end) {
     int64_t code = -1;
-    return cl_call((cl_instance *)comp, t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
+    return cl_check(comp, __func__) == NULL ? -1 : cl_call(cl_check(comp, __func__), t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
 }
 #endif
 

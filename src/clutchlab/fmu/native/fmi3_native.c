@@ -102,7 +102,7 @@ FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3
 }
 
 FMI3_Export void fmi3FreeInstance(fmi3Instance instance) {
-    cl_instance *c = (cl_instance *)instance;
+    cl_instance *c = cl_check((fmi2Component)instance, "fmi3FreeInstance");
     void *env;
     if (c == NULL) return;
     env = c->cb.logger == cl_fmi3_logger ? c->cb.componentEnvironment : NULL;
@@ -113,7 +113,7 @@ FMI3_Export void fmi3FreeInstance(fmi3Instance instance) {
 /* an FMI 3.0 call on an instance made by fmi2Instantiate is refused (and the reverse does not arise: the
  * FMI 2.0 functions take any instance) */
 static cl_instance *cl_fmi3(fmi3Instance instance, const char *fn) {
-    cl_instance *c = (cl_instance *)instance;
+    cl_instance *c = cl_check((fmi2Component)instance, fn);
     if (c == NULL) return NULL;
     if (c->cb.logger != cl_fmi3_logger) {
         cl_log(c, fmi2Error, "logStatusError", "%s: an FMI 2.0 instance", fn);

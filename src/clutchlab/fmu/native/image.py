@@ -116,10 +116,10 @@ def _arrays(value, out: list) -> None:
 
 
 def session_arguments(simulation):
-    """``(module, outputs_module, args)`` of a :class:`~clutchlab.system.Simulation`'s packed session, with
-    its event log replaced by a short one (:data:`LOG_CAPACITY`)."""
-    simulation.log = simulation._core.new_log(LOG_CAPACITY)
-    return simulation._session_parts()
+    """``(module, outputs_module, args, method)`` of a :class:`~clutchlab.system.Simulation`'s packed session
+    (:meth:`~clutchlab.system.Simulation.session`), with its event log replaced by a short one
+    (:data:`LOG_CAPACITY`)."""
+    return simulation.session(LOG_CAPACITY)
 
 
 #: the model-exchange session's arguments whose contents the FMU never reads before the compiled code writes them
@@ -139,7 +139,7 @@ def session_image(simulation, exchange: bool = False) -> Image:
     """
     from ...numerics import exchange as X, session as S
 
-    module, outputs_module, args = session_arguments(simulation)
+    module, outputs_module, args, method = session_arguments(simulation)
     names, scratch_names = S.FIELDS, _SCRATCH
     if exchange:
         p, x, m, u, sf, si, opt, log = args[:8]
@@ -181,7 +181,7 @@ def session_image(simulation, exchange: bool = False) -> Image:
     for start, end, off in blocks:
         if end > start:
             data[off:off + end - start] = ctypes.string_at(start, end - start)
-    image = Image(b"", nbytes, [], (fields[0][0], fields[1][0]), "exchange" if exchange else simulation._method(),
+    image = Image(b"", nbytes, [], (fields[0][0], fields[1][0]), "exchange" if exchange else method,
                   args, {}, blocks)
     image.names = names
     for a in scratch:   # zeros, not whatever the buffers held
