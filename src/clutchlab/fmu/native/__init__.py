@@ -265,6 +265,39 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
     return "\n".join(lines) + "\n"
 
 
+#: causality, variability and initial of each kind of variable (FMI 2.0 and 3.0 alike)
+_CAUSALITY = {
+    _PARAMETER: {"causality": "parameter", "variability": "fixed", "initial": "exact"},
+    _CONSTANT: {"causality": "local", "variability": "constant", "initial": "exact"},
+    _INPUT: {"causality": "input", "variability": "continuous"},
+    _OUTPUT: {"causality": "output", "variability": "continuous", "initial": "calculated"},
+    _STATE: {"causality": "local", "variability": "continuous", "initial": "calculated"},
+    _DERIVATIVE: {"causality": "local", "variability": "continuous", "initial": "calculated"},
+}
+
+
+def _attributes(vr, v, nominal: bool) -> tuple:
+    """``(variable, value)``: a variable's attributes (name, value reference, description, causality,
+    variability, initial) and its value's (unit, nominal where ``nominal``, start, min, max)."""
+    attrs = {"name": v["name"], "valueReference": str(vr)}
+    if v["description"]:
+        attrs["description"] = v["description"]
+    attrs.update(_CAUSALITY[v["kind"]])
+    value = {}
+    if v["unit"]:
+        value["unit"] = v["unit"]
+    if nominal and "nominal" in v:
+        value["nominal"] = repr(float(v["nominal"]))
+    if v["kind"] in (_PARAMETER, _CONSTANT, _INPUT):
+        value["start"] = repr(float(v["start"]))
+        lo, hi = v["bounds"]
+        if lo is not None:
+            value["min"] = repr(float(lo))
+        if hi is not None:
+            value["max"] = repr(float(hi))
+    return attrs, value
+
+
 def _units_logs_experiment(root, variables, experiment, extra_units=()) -> None:
     """A model description's ``UnitDefinitions`` (of the variables' units and ``extra_units``), ``LogCategories``
     and ``DefaultExperiment`` (the same in FMI 2.0 and 3.0)."""
@@ -308,37 +341,12 @@ def _description(cls, name, ident, guid, variables, experiment, n_indicators, ex
     mv = ET.SubElement(root, "ModelVariables")
     outputs, derivatives, states = [], [], []
     for vr, v in enumerate(variables):
-        attrs = {"name": v["name"], "valueReference": str(vr)}
-        if v["description"]:
-            attrs["description"] = v["description"]
-        real = {}
-        if v["unit"]:
-            real["unit"] = v["unit"]
-        kind = v["kind"]
-        if kind == _PARAMETER:
-            attrs.update(causality="parameter", variability="fixed", initial="exact")
-        elif kind == _CONSTANT:
-            attrs.update(causality="local", variability="constant", initial="exact")
-        elif kind == _INPUT:
-            attrs.update(causality="input", variability="continuous")
-        elif kind == _OUTPUT:
-            attrs.update(causality="output", variability="continuous", initial="calculated")
+        attrs, real = _attributes(vr, v, nominal=exchange)
+        if v["kind"] == _OUTPUT:
             outputs.append(vr + 1)
-        elif kind == _STATE:
-            attrs.update(causality="local", variability="continuous", initial="calculated")
-        else:
-            attrs.update(causality="local", variability="continuous", initial="calculated")
+        elif v["kind"] == _DERIVATIVE:
             real["derivative"] = str(v["state_vr"] + 1)
             derivatives.append(vr + 1)
-        if exchange and "nominal" in v:
-            real["nominal"] = repr(float(v["nominal"]))
-        if kind in (_PARAMETER, _CONSTANT, _INPUT):
-            real["start"] = repr(float(v["start"]))
-            lo, hi = v["bounds"]
-            if lo is not None:
-                real["min"] = repr(float(lo))
-            if hi is not None:
-                real["max"] = repr(float(hi))
         sv = ET.SubElement(mv, "ScalarVariable", attrs)
         ET.SubElement(sv, "Real", real)
     ms = ET.SubElement(root, "ModelStructure")
@@ -379,30 +387,12 @@ def _description3(cls, name, ident, guid, variables, experiment) -> bytes:
     mv = ET.SubElement(root, "ModelVariables")
     outputs = []
     for vr, v in enumerate(variables):
-        attrs = {"name": v["name"], "valueReference": str(vr)}
-        if v["description"]:
-            attrs["description"] = v["description"]
-        kind = v["kind"]
-        if kind == _PARAMETER:
-            attrs.update(causality="parameter", variability="fixed", initial="exact")
-        elif kind == _CONSTANT:
-            attrs.update(causality="local", variability="constant", initial="exact")
-        elif kind == _INPUT:
-            attrs.update(causality="input", variability="continuous")
-        elif kind == _OUTPUT:
-            attrs.update(causality="output", variability="continuous", initial="calculated")
-            outputs.append(vr)
-        else:   # (states and derivatives are model exchange's: the FMI 3.0 FMU is for co-simulation)
+        if v["kind"] in (_STATE, _DERIVATIVE):   # (model exchange's: the FMI 3.0 FMU is for co-simulation)
             raise NativeExportError(f"{name}: {v['name']}: a state variable in an FMI 3.0 co-simulation FMU")
-        if v["unit"]:
-            attrs["unit"] = v["unit"]
-        if kind in (_PARAMETER, _CONSTANT, _INPUT):
-            attrs["start"] = repr(float(v["start"]))
-            lo, hi = v["bounds"]
-            if lo is not None:
-                attrs["min"] = repr(float(lo))
-            if hi is not None:
-                attrs["max"] = repr(float(hi))
+        attrs, value = _attributes(vr, v, nominal=False)
+        attrs.update(value)   # (FMI 3.0: the value's attributes on the variable itself)
+        if v["kind"] == _OUTPUT:
+            outputs.append(vr)
         ET.SubElement(mv, "Float64", attrs)
     ET.SubElement(mv, "Float64", {"name": "time", "valueReference": str(len(variables)), "causality": "independent",
                                   "variability": "continuous", "description": "simulation time", "unit": "s"})

@@ -386,55 +386,25 @@ FMI3_Export fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boole
 }
 
 /* model exchange (not provided by the FMI 3.0 FMU: its instances are co-simulation ones) */
-FMI3_Export fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
-    return cl_fmi3_refuse(instance, "fmi3EnterContinuousTimeMode", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean no_set_prior,
-                                                   fmi3Boolean *enter_event_mode, fmi3Boolean *terminate) {
-    (void)no_set_prior; (void)enter_event_mode; (void)terminate;
-    return cl_fmi3_refuse(instance, "fmi3CompletedIntegratorStep", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
-    (void)time;
-    return cl_fmi3_refuse(instance, "fmi3SetTime", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t nx) {
-    (void)x; (void)nx;
-    return cl_fmi3_refuse(instance, "fmi3SetContinuousStates", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t nx) {
-    (void)dx; (void)nx;
-    return cl_fmi3_refuse(instance, "fmi3GetContinuousStateDerivatives", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 g[], size_t ng) {
-    (void)g; (void)ng;
-    return cl_fmi3_refuse(instance, "fmi3GetEventIndicators", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t nx) {
-    (void)x; (void)nx;
-    return cl_fmi3_refuse(instance, "fmi3GetContinuousStates", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nx) {
-    (void)nominals; (void)nx;
-    return cl_fmi3_refuse(instance, "fmi3GetNominalsOfContinuousStates", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
-    (void)n;
-    return cl_fmi3_refuse(instance, "fmi3GetNumberOfEventIndicators", "a co-simulation instance");
-}
-
-FMI3_Export fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
-    (void)n;
-    return cl_fmi3_refuse(instance, "fmi3GetNumberOfContinuousStates", "a co-simulation instance");
-}
+#define CL_FMI3_NO_ME(NAME, ARGS, UNUSED)                                                                \
+    FMI3_Export fmi3Status NAME ARGS {                                                                   \
+        UNUSED;                                                                                          \
+        return cl_fmi3_refuse(instance, #NAME, "a co-simulation instance");                              \
+    }
+CL_FMI3_NO_ME(fmi3EnterContinuousTimeMode, (fmi3Instance instance), (void)0)
+CL_FMI3_NO_ME(fmi3CompletedIntegratorStep, (fmi3Instance instance, fmi3Boolean no_set_prior,
+              fmi3Boolean *enter_event_mode, fmi3Boolean *terminate),
+              (void)no_set_prior; (void)enter_event_mode; (void)terminate)
+CL_FMI3_NO_ME(fmi3SetTime, (fmi3Instance instance, fmi3Float64 time), (void)time)
+CL_FMI3_NO_ME(fmi3SetContinuousStates, (fmi3Instance instance, const fmi3Float64 x[], size_t nx), (void)x; (void)nx)
+CL_FMI3_NO_ME(fmi3GetContinuousStateDerivatives, (fmi3Instance instance, fmi3Float64 dx[], size_t nx),
+              (void)dx; (void)nx)
+CL_FMI3_NO_ME(fmi3GetEventIndicators, (fmi3Instance instance, fmi3Float64 g[], size_t ng), (void)g; (void)ng)
+CL_FMI3_NO_ME(fmi3GetContinuousStates, (fmi3Instance instance, fmi3Float64 x[], size_t nx), (void)x; (void)nx)
+CL_FMI3_NO_ME(fmi3GetNominalsOfContinuousStates, (fmi3Instance instance, fmi3Float64 nominals[], size_t nx),
+              (void)nominals; (void)nx)
+CL_FMI3_NO_ME(fmi3GetNumberOfEventIndicators, (fmi3Instance instance, size_t *n), (void)n)
+CL_FMI3_NO_ME(fmi3GetNumberOfContinuousStates, (fmi3Instance instance, size_t *n), (void)n)
 
 /* ---------------------------------------------------------------- co-simulation */
 FMI3_Export fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
