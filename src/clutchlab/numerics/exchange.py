@@ -38,8 +38,9 @@ the model's analytic ``jacobian`` or by differences, factored by
 :func:`~clutchlab.numerics.rosenbrock.lu_factor`), to rounding: ``|dx_a| <= 1e-12 (atol + |x_a|)``, or, where
 rounding in the residual stops the steps shrinking, within a thousandth of the model's own tolerance
 ``atol + rtol |x_a|``.  (FMI 2.0 does not tell the FMU the host's tolerance; an algebraic error at the
-model's tolerance is noise in the derivatives that a host integrating more tightly cannot get through.)  The host then integrates
-the ODE ``x_d' = f_d(x_d, x_a(x_d))`` (the state-space form of an index-1 DAE; Hairer & Wanner II, VI.1).
+model's tolerance is noise in the derivatives that a host integrating more tightly cannot get through.)
+The host then integrates the ODE ``x_d' = f_d(x_d, x_a(x_d))`` (the state-space form of an index-1 DAE;
+Hairer & Wanner II, VI.1).
 ``alg`` lists the algebraic rows; ``jac`` (n x n), ``sub`` and ``piv`` (n_a) and ``xp``, ``fp``, ``gp``,
 ``dls`` are its work arrays (empty for a model without algebraic rows).  A Newton iteration that does not
 converge in :data:`NEWTON_ITERATIONS` returns :data:`ALGEBRAIC_FAILED`.

@@ -938,8 +938,9 @@ FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusK
 /* benchmarks/bench_native_fmu.py only (never in an exported FMU): the compiled session call of a step without
  * the FMI layer around it, to measure what the layer adds per step */
 FMI2_Export int cl_benchmark_session(fmi2Component comp, double t_end) {
+    cl_instance *c = cl_check(comp, __func__);
     int64_t code = -1;
-    return cl_check(comp, __func__) == NULL ? -1 : cl_call(cl_check(comp, __func__), t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
+    return c != NULL && cl_call(c, t_end, CL_ADVANCE | CL_OUTPUTS, &code) ? (int)code : -1;
 }
 #endif
 
