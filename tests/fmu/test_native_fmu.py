@@ -1,11 +1,13 @@
-"""Native FMUs (:mod:`clutchlab.fmu.native`, issue #32): the model's compiled code with an FMI 2.0 layer, run with
-no Python, numba or clutchlab in the host.
+"""Native FMUs (:mod:`clutchlab.fmu.native`, issue #32): the model's compiled code with an FMI 2.0 (and 3.0)
+layer, run with no Python, numba or clutchlab in the host.
 
 Checked against the Python co-simulation of the same class (``ContractCoSimulation``, the same compiled
 functions run through numba) at the same communication points, in FMPy in a virtual environment without
-clutchlab, numba and llvmlite (and with them refused by an import hook there as well), and in a small C host (``native_host.c``) with no Python in the process: two instances
-in two threads, 10,000 instantiate/free cycles with flat memory, rollback through ``fmi2Get/SetFMUstate`` and
-serialisation, refused values with their messages, 100 fresh processes ending with exit code 0.
+clutchlab, numba and llvmlite (and with them refused by an import hook there as well), and in a small C host
+(``native_host.c``) with no Python in the process: two instances in two threads, 10,000 instantiate/free
+cycles with flat memory, rollback through ``fmi2Get/SetFMUstate`` and serialisation, refused values with their
+messages, 100 fresh processes ending with exit code 0, the model-exchange loop on linux64 and win64.  The FMI
+3.0 co-simulation FMU in FMPy's FMI 3.0 slave.
 """
 
 import json
