@@ -376,7 +376,9 @@ def accepted_range(accepts, start: float, lo=None, hi=None, positive: bool = Fal
     ``start`` doubles (from ``|start| / 2``, or 1/2 where ``start`` is 0) until the model refuses the value
     or the declared bound (else ``reach`` times the first distance) is passed; between the last accepted and
     the first refused value, bisection (``iterations`` halvings, whole numbers for ``whole``) finds the
-    bound, and the last accepted value is returned.
+    bound, and the last accepted value is returned.  A side whose far end (the declared bound, or ``reach``
+    first distances away) the model takes costs one build: the values a model refuses are taken to lie
+    beyond a threshold (its checks compare a value with a limit).
 
     Parameters
     ----------
@@ -401,6 +403,12 @@ def accepted_range(accepts, start: float, lo=None, hi=None, positive: bool = Fal
     for sign, bound in ((-1.0, lo), (1.0, hi)):
         if positive and sign < 0 and (bound is None or bound < 0.0):
             bound = 0.0
+        # the far end first: a side the model takes to its bound (or to reach) costs one build (refusals lie
+        # beyond a threshold: checks compare a value with a limit)
+        far = v0 + sign * base * reach if bound is None else bound
+        if far != v0 and not (positive and far <= 0.0) and accepts(far):
+            out.append(bound)
+            continue
         good, bad, d = v0, None, base
         while d <= base * reach:
             value = v0 + sign * d
