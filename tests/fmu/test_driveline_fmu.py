@@ -19,6 +19,7 @@ import pytest
 
 from cli_checks import one_line_error
 from clutchlab.cli import main
+from clutchlab.cli.fmu import PYTHON_BACKEND_WARNING
 from clutchlab.driveline import Driveline, Signal
 from clutchlab.fmu.driveline import DrivelineCoSimulation
 from clutchlab.driveline.description import load_driveline
@@ -159,7 +160,9 @@ def test_the_fmu_carries_its_description_and_runs_it(tmp_path, chains, run_fmu, 
 def test_export_fmu_command_for_a_driveline(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["export-fmu", "driveline", str(EXAMPLE), "--backend", "python"]) == 0
-    out = capsys.readouterr().out.strip().splitlines()
+    captured = capsys.readouterr()
+    out = captured.out.strip().splitlines()
+    assert captured.err.strip().splitlines() == [f"clutchlab: warning: {PYTHON_BACKEND_WARNING}"]
     assert out[-1] == "driveline_coupled_clutches.fmu"  # named after the file
     # what of the user's went in is said (#33): here the description alone
     assert out[:-1] == [f"driveline_coupled_clutches.fmu: packed {EXAMPLE} as resources/description.toml"]

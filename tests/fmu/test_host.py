@@ -31,8 +31,9 @@ def _host(tmp_path, script, *args, known_exit_abort=False):
 
     ``known_exit_abort`` admits exactly one other outcome: SIGABRT with glibc's "corrupted
     double-linked list" *after* the script printed its results -- the open defect at interpreter exit
-    (docs/fmu.md, "Second instance in one process": about 1 run in 20 with two instances; "Exit": a
-    single instance in some process layouts). It is reported as a warning in the test summary, never
+    (docs/fmu.md, "Second instance in one process": 0 to 15 of 80 processes with two instances, depending on
+    the process's memory layout; "Exit": a single instance in some process layouts).  The native FMUs have
+    no such exit: tests/fmu/test_native_fmu.py runs the same protocol and requires code 0 every time. It is reported as a warning in the test summary, never
     passed over silently.
     """
     path = tmp_path / "host.py"
@@ -189,7 +190,8 @@ def test_without_a_c_compiler_the_fmu_works_and_returns_fmi2discard(tmp_path, bu
         assert len(err) == 1 and "needs a C and a C++ compiler" in err[0] and "--backend python" in err[0], err
         assert main(["export-fmu", "emtc", "-o", str(path), "--backend", "python"]) == 0
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("clutchlab: warning:") and "fmi2Discard" in err[0], err
+    assert len(err) == 2 and all(e.startswith("clutchlab: warning:") for e in err) and "fmi2Discard" in err[0], err
+    assert "may abort at exit" in err[1] and "native" in err[1], err   # (every pythonfmu export says what it costs)
     with zipfile.ZipFile(path) as z:
         names = z.namelist()
     assert "binaries/linux64/ClutchlabEmtc.so" in names and not any("_pythonfmu" in n for n in names)

@@ -51,6 +51,26 @@ def built(tmp_path_factory):
     return out
 
 
+@pytest.fixture(scope="module")
+def native_model(tmp_path_factory):
+    """``native_model(model)`` -> (path, export report lines) of the native FMU of ``"wet"``, ``"emtc"`` or
+    ``"eclutch"``'s co-simulation, exported once per module (each export links the model's compiled code)."""
+    from clutchlab.fmu.cosim import load_cosimulation
+
+    folder = tmp_path_factory.mktemp("native_models")
+    cache = {}
+
+    def build(model):
+        if model not in cache:
+            lines = []
+            path = export_native_fmu(load_cosimulation(model), folder / f"{model}.fmu", platforms=["linux64"],
+                                     report=lines.append)
+            cache[model] = (path, lines)
+        return cache[model]
+
+    return build
+
+
 def _variables(path):
     root = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
     return root, {sv.get("name"): sv for sv in root.iter("ScalarVariable")}
@@ -426,13 +446,71 @@ def test_export_fmu_command_builds_a_native_fmu_by_default(tmp_path, monkeypatch
         export_native_fmu(DrivelineCoSimulation.for_description(EXAMPLE), tmp_path / "y.fmu", fmi_version="4.0")
 
 
-def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host):
+_TWICE_THEN_SIDE_BY_SIDE = r"""
+import json, sys
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+path, output, dt, n = sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4])
+runs = [fmpy.simulate_fmu(path, stop_time=n * dt, step_size=dt, output_interval=dt, output=[output])[output].tolist()
+        for _ in range(2)]
+md = fmpy.read_model_description(path)
+vr = next(v.valueReference for v in md.modelVariables if v.name == output)
+slaves = [FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path), modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName=f"instance{i}") for i in range(2)]
+for s in slaves:
+    s.instantiate()
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+together = [[s.getReal([vr])[0]] for s in slaves]
+for k in range(n):   # (side by side: each step of one instance between two of the other's)
+    for s, values in zip(slaves, together):
+        s.doStep(k * dt, (k + 1) * dt - k * dt)
+        values.append(s.getReal([vr])[0])
+for s in slaves:
+    s.terminate()
+    s.freeInstance()   # (FMPy's freeInstance also unloads the library)
+print(json.dumps({"runs": runs, "together": together}))
+"""
+
+
+@pytest.mark.parametrize("model, output", [("driveline", "clutch1.tau"), ("wet", "clutch_torque"),
+                                           ("emtc", "coupling_torque"), ("eclutch", "clutch_torque")])
+def test_a_python_host_runs_each_native_fmu_twice_then_two_side_by_side_and_exits_cleanly(
+        tmp_path, built, native_model, model, output):
+    """Issue #33's host protocol (the pythonfmu FMU aborted at exit in 15 of 80 such processes): FMPy, in a
+    virtual environment without clutchlab, runs the FMU twice with ``simulate_fmu``, then two instances side by
+    side; every process exits with code 0, the two runs are equal bit for bit, the two instances equal each
+    other and the Python co-simulation.  3 processes per model in CI (``examples``: 60 in the thorough
+    profile)."""
+    from clutchlab.fmu.cosim import load_cosimulation
+    from hypothesis_budget import examples
+
+    path, cls = (built["cc"][0], built["cc"][1]) if model == "driveline" else (native_model(model)[0],
+                                                                             load_cosimulation(model))
+    n, dt = 5, 0.01
+    python = _python_run(cls, n, dt)[output]
+    assert np.max(np.abs(python)) > 0.0
+    script = tmp_path / "host.py"
+    script.write_text(_TWICE_THEN_SIDE_BY_SIDE)
+    for _ in range(examples(3)):
+        proc = subprocess.run([str(_isolated_python()), str(script), str(path), output, str(dt), str(n)],
+                              capture_output=True, text=True, timeout=300, cwd=tmp_path)
+        assert proc.returncode == 0, (proc.returncode, proc.stderr[-2000:])
+        out = json.loads(proc.stdout.strip().splitlines()[-1])
+        assert out["runs"][0] == out["runs"][1]   # a fresh instance of the same model: the same run, bit for bit
+        assert out["together"][0] == out["together"][1]
+        _close(np.array(out["together"][0]), python, output)
+        # (simulate_fmu's own communication points may differ from k dt by a rounding)
+        np.testing.assert_allclose(out["runs"][0], python, rtol=1e-8, atol=1e-12 * np.max(np.abs(python)))
+
+
+def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host, native_model):
     """The EMTC's co-simulation (a ContractCoSimulation of the model's own System) as a native FMU: its four
     inputs driven by a host, equal to the Python co-simulation."""
     from clutchlab.fmu.emtc import EmtcCoSimulation
 
-    lines = []
-    path = export_native_fmu(EmtcCoSimulation, tmp_path / "emtc.fmu", platforms=["linux64"], report=lines.append)
+    path, lines = native_model("emtc")
     assert lines[0].startswith("native FMU ClutchlabEmtc (linux64; FMI 2.0 co-simulation and model exchange): 4 inputs, "
                                "18 outputs")
     n, dt = 150, 0.01
@@ -541,15 +619,14 @@ def test_the_win64_binary_under_wine_gives_the_same_numbers(tmp_path, host):
         np.testing.assert_allclose(linux[:, j], python[name], rtol=0, atol=2e-3 * scale, err_msg=name)
 
 
-def test_native_fmu_of_the_eclutch(tmp_path, host):
+def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     """The E-clutch (Rodas3 with its stick/slip friction) as a native FMU: equal to the Python co-simulation
     in FMPy with a held reference, and in the C host.  (With a reference that steps, FMPy's own timing of the
     input changes its value by a rounding, and the E-clutch's 120 friction events amplify a change of one ulp
     in one step's reference to 1e-8 of the bearing position: the run is compared where the input is exact.)"""
     from clutchlab.fmu.eclutch import EClutchCoSimulation
 
-    lines = []
-    path = export_native_fmu(EClutchCoSimulation, tmp_path / "e.fmu", platforms=["linux64"], report=lines.append)
+    path, lines = native_model("eclutch")
     assert lines[0].startswith("native FMU ClutchlabEclutch (linux64; FMI 2.0 co-simulation and model exchange): 2 inputs, "
                                "9 outputs")
     root, svs = _variables(path)
@@ -603,14 +680,13 @@ def test_native_fmu_of_the_eclutch(tmp_path, host):
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-6 * scale, err_msg=name)
 
 
-def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_path):
+def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_path, native_model):
     """The wet clutch on its bench: its run starts at the first inputs (the actuator force at its reference),
     which the native FMU repeats (an input's target in the state is written until initialisation ends);
     the bench's limits are the inputs' ranges."""
     from clutchlab.fmu.wet import WetCoSimulation
 
-    lines = []
-    path = export_native_fmu(WetCoSimulation, tmp_path / "w.fmu", platforms=["linux64"], report=lines.append)
+    path, lines = native_model("wet")
     assert lines[0].startswith("native FMU ClutchlabWet (linux64; FMI 2.0 co-simulation and model exchange): 2 inputs, "
                                "24 outputs")
     root, svs = _variables(path)
@@ -661,13 +737,13 @@ def test_model_exchange_of_a_driveline_under_fmpys_cvode(built, tmp_path):
 
 
 @pytest.mark.parametrize("model", ["emtc", "wet"])
-def test_model_exchange_of_each_model_agrees_with_its_cosimulation(tmp_path, model):
+def test_model_exchange_of_each_model_agrees_with_its_cosimulation(tmp_path, model, native_model):
     """The EMTC's and the wet bench's native FMUs for model exchange (CVode at rtol 1e-9) against the Python
     co-simulation at rtol 1e-8.  (The E-clutch's, with its algebraic state: test_native_fmu_of_the_eclutch.)"""
     from clutchlab.fmu.cosim import load_cosimulation
 
     cls = load_cosimulation(model)
-    path = export_native_fmu(cls, tmp_path / f"{model}.fmu", platforms=["linux64"])
+    path, _ = native_model(model)
     n, dt = {"emtc": (100, 0.01), "wet": (300, 1e-3)}[model]
     rtol_name = next(v.name for v in cls.parameters if v.name in ("rtol", "solver.rtol"))
     me = _fmpy_run(tmp_path, path, n, dt, fmi_type="ModelExchange", rtol=1e-9)

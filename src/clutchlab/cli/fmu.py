@@ -20,6 +20,11 @@ from pathlib import Path
 from ..errors import ParameterError
 from ..fmu.registry import COSIMULATIONS
 
+#: what ``--backend python`` costs, said at every such export (docs/fmu.md, "Hosts: exit, re-instantiation")
+PYTHON_BACKEND_WARNING = ("a pythonfmu FMU needs Python and clutchlab where it runs, and its host process may "
+                          "abort at exit after correct results (a latent heap corruption in that layer, "
+                          "docs/fmu.md); the default native FMU has neither limit")
+
 
 def _export(args) -> int:
     from ..fmu.cosim import load_cosimulation
@@ -62,6 +67,7 @@ def _export(args) -> int:
         path = export_fmu(args.model, output, overwrite=args.force, description=args.file, packed=packed)
     for w in caught:  # e.g. no C compiler for the fmi2Error shim: one line each
         print(f"clutchlab: warning: {w.message}", file=sys.stderr)
+    print(f"clutchlab: warning: {PYTHON_BACKEND_WARNING}", file=sys.stderr)
     for source, name in packed:   # what of the user's files went into the FMU (#33)
         print(f"{path.name}: packed {source} as {name}")
     print(path)
