@@ -21,7 +21,7 @@ import re
 
 from .errors import ParameterError
 
-__all__ = ["MEMORY_ENV", "memory_budget", "check_allocation", "format_bytes", "short_repr", "one_line"]
+__all__ = ["MEMORY_ENV", "memory_budget", "check_allocation", "format_bytes", "short_repr", "one_line", "as_numbers"]
 
 #: environment variable overriding the memory budget (bytes, or with a suffix: ``"512 MB"``, ``"2G"``)
 MEMORY_ENV = "CLUTCHLAB_MEMORY_LIMIT"
@@ -215,3 +215,30 @@ def one_line(text: str, limit: int = 300) -> str:
         keep = (limit - 5) // 2
         text = text[:keep] + " ... " + text[-keep:]
     return text
+
+
+def as_numbers(value, what: str, error=ParameterError):
+    """``value`` as a float array, or ``error`` naming ``what`` and the value: the one conversion of a user's
+    list or table of numbers at the edge (not NumPy's ``could not convert string to float`` or "inhomogeneous
+    shape", and never a string of digits read as a number).
+
+    Parameters
+    ----------
+    value : array_like
+        A number, a list or nested lists of numbers (every row of one length), or an array.
+    what : str
+        What to name in the error (the file and the field, or the argument).
+    error : type
+        The exception class (:class:`~clutchlab.errors.ParameterError` for parameters, ``DataError`` for
+        files of data).
+    """
+    import numpy as np
+
+    if isinstance(value, (str, bytes, dict, set)) or value is None:
+        raise error(f"{what} = {short_repr(value)}: expected numbers (a list or table of numbers), not "
+                    f"{type(value).__name__}")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise error(f"{what} = {short_repr(value)}: expected numbers (a list or table of numbers, every row "
+                    "of the same length)") from None

@@ -39,7 +39,8 @@ from .numerics import status as st
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
-           "checked_grid", "check_fixed_step", "check_fixed_step_span", "check_rtol", "check_atol", "RUN_OPTIONS",
+           "checked_grid", "check_fixed_step", "check_fixed_step_span", "check_fixed_step_dynamics",
+           "fastest_time_constant", "FixedStepWarning", "check_rtol", "check_atol", "RUN_OPTIONS",
            "RTOL_MIN", "MODELS", "register_model"]
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
@@ -503,6 +504,60 @@ def check_fixed_step_span(fixed: float, t0: float, t_end: float, output_step=Non
                              "the samples between two steps would hold one state; choose a step <= the output step")
 
 
+#: a fixed step longer than this many times the fastest time constant at the start is said in a warning (#33)
+FIXED_STEP_WARN_FACTOR = 100.0
+
+
+class FixedStepWarning(UserWarning):
+    """A fixed step far longer than the model's fastest time constant (:func:`check_fixed_step_dynamics`)."""
+
+
+def fastest_time_constant(system: System, t: float = 0.0) -> float:
+    """The fastest time constant [s] of ``system`` at its start: ``1 / max |lambda|`` over the eigenvalues of the
+    linearisation at ``(t, x0, u0, m0)`` in its start modes (forward differences of :func:`evaluate`; with a mass
+    matrix, the generalised eigenvalues of ``(J, M)``, whose algebraic rows give infinite ones, left out);
+    ``inf`` where every eigenvalue is zero (free inertias)."""
+    import scipy.linalg
+
+    n = len(system.states)
+    if n == 0:
+        return math.inf
+    opt = system.options()
+    x0 = system.x0.astype(float)
+    f0 = evaluate(system, t, x0)[0]
+    scale = np.maximum(np.abs(x0), np.broadcast_to(opt.atol, (n,)) / opt.rtol)
+    jac = np.empty((n, n))
+    for j in range(n):
+        h = math.sqrt(np.finfo(float).eps) * float(scale[j])
+        x = x0.copy()
+        x[j] += h
+        jac[:, j] = (evaluate(system, t, x)[0] - f0) / h
+    mass = np.asarray(opt.mass, dtype=float)
+    with np.errstate(all="ignore"):
+        lam = scipy.linalg.eigvals(jac, np.diag(mass) if mass.ndim == 1 and mass.size == n else None)
+    lam = np.abs(lam[np.isfinite(lam)])
+    top = float(lam.max()) if lam.size else 0.0
+    return 1.0 / top if top > 0.0 else math.inf
+
+
+def check_fixed_step_dynamics(system: System, fixed: float, t0: float = 0.0) -> None:
+    """Warn (:class:`FixedStepWarning`) where a fixed step [s] is more than :data:`FIXED_STEP_WARN_FACTOR` times
+    the model's fastest time constant at its start (:func:`fastest_time_constant`): Rodas3 is L-stable, so the
+    run stays stable and damps what is faster than its step, but it does not resolve it (a transient of the
+    actuator, a contact, a lock-up shorter than a step).  A HIL frame chosen on purpose may do this; the
+    warning says so once per run.  Nothing for step-size control (``fixed`` 0)."""
+    if not fixed > 0.0:
+        return
+    tau = fastest_time_constant(system, t0)
+    if fixed > FIXED_STEP_WARN_FACTOR * tau:
+        import warnings
+
+        warnings.warn(f"{system.name}: fixed_step = {fixed:g} s is {fixed / tau:.3g} times the model's fastest time "
+                      f"constant at its start ({tau:.3g} s): the run stays stable but does not resolve what is "
+                      f"faster than a step; for its transients choose a step near {10.0 * tau:.2g} s, or step-size "
+                      "control", FixedStepWarning, stacklevel=3)
+
+
 def _index(vars_, name, kind, model):
     for i, v in enumerate(vars_):
         if name in (v.name, v.column):
@@ -659,6 +714,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     opt = system.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, first_step=first_step,
                          event_tol=event_tol, fixed_step=fixed_step)
     check_fixed_step_span(opt.fixed_step, t0, t_end, output_step)
+    check_fixed_step_dynamics(system, opt.fixed_step, t0)
     ts = sample_grid(t0, float(t_end), output_step, sample_times)
     nx, ny, nm = len(system.states), len(system.outputs), len(system.mode_names)
     x = system.x0.copy()
@@ -1380,6 +1436,7 @@ def _batch_setup(first, t_end, sample_times, output_step, rtol, atol, max_step, 
         ts = np.array([float(t_end)])
     opt = first.options(rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps, fixed_step=fixed_step)
     check_fixed_step_span(opt.fixed_step, 0.0, t_end, output_step)
+    check_fixed_step_dynamics(first, opt.fixed_step)
     return ts, opt
 
 

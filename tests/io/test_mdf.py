@@ -2,6 +2,7 @@
 
 import gc
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -228,3 +229,50 @@ def test_channel_map_from_toml_reads_the_logger_file(tmp_path, logger_file):
     m = read_measurement(logger_file, tmp_path / "map.toml")
     assert m.channels == cmap.names == ("torque_Nm", "slip_speed_rad_s", "gear")
     assert m.source.channels["torque_Nm"].source == "TQ_Clutch"
+
+
+_BAD_MDF_HOST = r"""
+import gc, random, sys
+from pathlib import Path
+from clutchlab.cli import main
+data = Path(sys.argv[1]).read_bytes()
+out = Path(sys.argv[2])
+files = []
+for cut in (10, 64, 200, 1000, len(data) // 3, len(data) // 2, len(data) - 40, len(data) - 1):
+    files.append(out / f"cut{cut}.mf4")
+    files[-1].write_bytes(data[:cut])
+rng = random.Random(1)
+for k in range(6):   # (20 bytes flipped after the identification block)
+    b = bytearray(data)
+    for _ in range(20):
+        b[rng.randrange(64, len(b))] = rng.randrange(256)
+    files.append(out / f"flip{k}.mf4")
+    files[-1].write_bytes(bytes(b))
+files.append(out / "header_only.mf4")
+files[-1].write_bytes(data[:64] + bytes(2000))
+codes = [main(["convert", str(f), "-o", str(out / (f.stem + ".csv"))]) for f in files]
+gc.collect()
+print(codes)
+"""
+
+
+def test_bad_mdf_files_give_one_line_each_and_nothing_at_collection_or_exit(tmp_path):
+    """#33: asammdf's own ``__del__`` traceback ("Exception ignored in MDF4.__del__ ... no attribute 'header'")
+    was printed after the clean message.  Fifteen bad files (truncated, bytes flipped, a header alone) through
+    ``clutchlab convert`` in one process, then a garbage collection and a normal interpreter exit: stderr holds
+    exactly one ``clutchlab: error:`` line per file and nothing else (without ``io.mdf._defuse`` it held seven
+    such tracebacks)."""
+    import subprocess
+    import sys
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "press_logger.mf4"
+    script = tmp_path / "host.py"
+    script.write_text(_BAD_MDF_HOST)
+    (tmp_path / "out").mkdir()
+    proc = subprocess.run([sys.executable, str(script), str(example), str(tmp_path / "out")], capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip() == str([2] * 15)
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 15 and all(line.startswith("clutchlab: error: ") for line in lines), proc.stderr[-3000:]
+    assert not list((tmp_path / "out").glob("*.csv"))

@@ -17,8 +17,10 @@ import importlib
 import os
 import sys
 import time
+import warnings
 
 from .. import __version__
+from .._limits import one_line
 from ..errors import ClutchlabError, ParameterError
 from .common import progress
 
@@ -211,6 +213,10 @@ def main(argv=None) -> int:
     if not hasattr(args, "func"):
         parser.print_help()
         return 2
+    shown = warnings.showwarning
+    # a warning of clutchlab's is one line, as its errors are (not Python's file:line and source line)
+    warnings.showwarning = lambda message, category, *rest, **kw: print(
+        f"clutchlab: warning: {one_line(str(message), MESSAGE_LIMIT)}", file=sys.stderr)
     try:
         return int(args.func(args) or 0)
     except (ClutchlabError, OSError, UnicodeDecodeError, RecursionError, MemoryError) as exc:
@@ -220,6 +226,8 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("clutchlab: interrupted", file=sys.stderr)
         return 130
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":  # pragma: no cover

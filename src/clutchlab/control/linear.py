@@ -50,6 +50,9 @@ def _signals(system: System, names, kinds, default):
 def _directions(system: System, directions) -> dict:
     """``{("state"|"input", index): +1.0 | -1.0}`` from ``{name: "rising" | "falling"}``."""
     out = {}
+    if directions is not None and not isinstance(directions, dict):
+        raise ParameterError(f"{system.name}: directions = {directions!r}: expected a mapping "
+                             "{name: 'rising' | 'falling'} of the states or inputs with a direction")
     for name, d in (directions or {}).items():
         if d not in ("rising", "falling"):
             raise ParameterError(f"{system.name}: direction of {name!r} = {d!r}: expected 'rising' or 'falling'")

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from ..component import Component, Field, register_component
 from ..errors import ParameterError
+from ..params.base import FRICTION_COEFFICIENT_MAX, WET_TEMPERATURES_C
 
 __all__ = ["BUILTIN"]
 
@@ -40,7 +41,7 @@ def _friction_fields(fn_required=True, fn_default=None, with_map=True):
     fields = [
         Field("fn_max", "quantity", "N", required=fn_required, default=fn_default, minimum=0.0,
               description="largest normal force; the normal force is fn_max * normal(t)"),
-        Field("mu", "characteristic", "1", default=0.5, minimum=0.0, maximum=2.0,
+        Field("mu", "characteristic", "1", default=0.5, minimum=0.0, maximum=FRICTION_COEFFICIENT_MAX,
               description="sliding friction coefficient: a number or rows [w_rad_s, mu] over |w_rel|",
               source="physical range: linings and tyres stay below 2"),
         Field("peak", "quantity", "1", default=1.0, minimum=1.0,
@@ -245,7 +246,8 @@ BUILTIN = (
         _FLANGE,
         Field("torque_map", "map", required=True,
               description="{ speeds, throttles, torques } (bilinear) or full-load rows [[w, T], ...]"),
-        Field("throttle", "signal", "1", default=1.0, description="throttle, 0-1"),
+        Field("throttle", "signal", "1", default=1.0, minimum=0.0, maximum=1.0,
+              description="throttle, 0 (closed: the map's drag torque) to 1 (full load)"),
         Field("idle_speed", "quantity", "rad/s", positive=True,
               description="set speed of the idle controller (left out: no controller)"),
         Field("idle_kp", "quantity", "N*m*s/rad", default=2.0, minimum=0.0, description="idle controller's gain"),
@@ -260,11 +262,11 @@ BUILTIN = (
         Field("clutch", "path", description="a wet-clutch parameter file (default WetClutch.paper())"),
         Field("bench", "path", description="a bench parameter file: actuator, oil loop, housing (default Bench())"),
         Field("friction", "path", description="a friction law (.toml) or an identified map (.json)"),
-        Field("temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+        Field("temperature0", "quantity", "degC", default=80.0, minimum=WET_TEMPERATURES_C[0], maximum=WET_TEMPERATURES_C[1],
               description="initial pack temperature"),
-        Field("fluid_temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+        Field("fluid_temperature0", "quantity", "degC", default=80.0, minimum=WET_TEMPERATURES_C[0], maximum=WET_TEMPERATURES_C[1],
               description="initial oil temperature (the heater's set point)"),
-        Field("housing_temperature0", "quantity", "degC", default=80.0, minimum=_ABS_ZERO_C,
+        Field("housing_temperature0", "quantity", "degC", default=80.0, minimum=WET_TEMPERATURES_C[0], maximum=WET_TEMPERATURES_C[1],
               description="initial housing temperature"),
     ), _wet_clutch, "seed 001, Eqs. 1-8"),
     Component("emtc", "The electromagnetic torque-controlled coupling of seed 002 with its controller.", (

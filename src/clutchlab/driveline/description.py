@@ -299,7 +299,14 @@ def _field_value(field, v, fkey, src, base, uses, speed_unit, angle_unit):
             raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
         return v
     if kind == "signal":
-        return _signal(v, field.unit, fkey, src, uses)
+        sig = _signal(v, field.unit, fkey, src, uses)
+        if field.minimum is not None or field.maximum is not None or field.positive:
+            for bound in dict.fromkeys(sig.bounds()):   # (an input's values: its host's, see [input.NAME])
+                problem = None if bound is None else field.range_problem(bound)
+                if problem:
+                    shown = sig.describe("" if field.unit == "1" else field.unit)
+                    raise ParameterError(f"{src}: {fkey} = {shown} reaches {bound:g}: {problem}")
+        return sig
     if kind == "characteristic":
         value = _characteristic(v, field.unit, fkey, src, x_unit=speed_unit)
         for i, y in ([(None, value)] if isinstance(value, float) else enumerate(r[1] for r in value)):
@@ -433,6 +440,9 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
     DrivelineFile
     """
     src = str(source)
+    if not isinstance(doc, dict):
+        raise ParameterError(f"{src}: expected a driveline document (a table of component tables, as tomllib "
+                             f"reads a file), not {type(doc).__name__}")
     base = Path(base) if base is not None else Path(src).parent
     by_domain = {dom: tables(dom) for dom in ("rotational", "translational")}
     known = {"driveline", "simulation", "input", *by_domain["rotational"], *by_domain["translational"]}

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._limits import check_number
+from .._limits import as_numbers, check_number
 from ..errors import ParameterError
 from ..numerics import outline
 from ..units import COLUMN_UNITS
@@ -189,8 +189,8 @@ class Signal:
     @classmethod
     def table(cls, times, values) -> "Signal":
         """Piecewise linear through ``(times [s], values)``, held beyond the ends."""
-        t = np.asarray(times, dtype=float).ravel()
-        v = np.asarray(values, dtype=float).ravel()
+        t = as_numbers(times, "table signal: times").ravel()
+        v = as_numbers(values, "table signal: values").ravel()
         if t.size < 1 or t.size != v.size or not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
             raise ParameterError(f"table signal: times and values need the same non-zero length and finite values "
                                  f"({t.size} times, {v.size} values)")
@@ -204,7 +204,7 @@ class Signal:
         not corners of the signal: a step ends only at ``breaks`` [s] (its real corners) and at its ends, so a
         densely sampled trajectory does not cut the integrator's steps to the sampling interval."""
         sig = cls.table(times, values)
-        b = np.asarray(breaks, dtype=float).ravel()
+        b = as_numbers(breaks, "sampled signal: breaks").ravel()
         if not np.all(np.isfinite(b)):
             raise ParameterError("sampled signal: breaks must be finite times")
         return cls((K.SIG_SAMPLED,), sig.points, tuple(np.unique(b)))
@@ -320,6 +320,40 @@ class Signal:
             return value, 0.0
         lo = int(np.searchsorted(ts, t, side="right")) - 1
         return value, float((vs[lo + 1] - vs[lo]) / (ts[lo + 1] - ts[lo]))
+
+    def bounds(self) -> tuple:
+        """``(lowest, highest)`` value the signal takes at any time, or ``(None, None)`` where a network input
+        decides it (a product's bounds: the extremes of its factors' bounds' products).  A component's declared
+        range is checked against them (:mod:`clutchlab.driveline.description`: a throttle in [0, 1])."""
+        k, *a = self.row
+        if k == K.SIG_INPUT:
+            return None, None
+        if k == K.SIG_PRODUCT:
+            lo, hi = 1.0, 1.0
+            for f in self.factors:
+                flo, fhi = f.bounds()
+                if flo is None:
+                    return None, None
+                corners = (lo * flo, lo * fhi, hi * flo, hi * fhi)
+                lo, hi = min(corners), max(corners)
+            return lo, hi
+        if k == K.SIG_CONST:
+            ends = (a[0],)
+        elif k == K.SIG_STEP:
+            ends = (a[2], a[2] + a[0])
+        elif k == K.SIG_RAMP:
+            ends = (a[3], a[3] + a[0])
+        elif k == K.SIG_SINE:
+            ends = (a[3] - abs(a[0]), a[3] + abs(a[0]))
+        elif k == K.SIG_PULSE:
+            ends = (a[4], a[4] + a[0])
+        elif k == K.SIG_TRAPEZOID:
+            ends = (a[6], a[6] + a[0])
+        elif k == K.SIG_EXPONENTIALS:   # (its peak, at the end of the rise)
+            ends = (a[4], a[4] - a[0] * math.expm1(-a[1] / a[2]))
+        else:
+            ends = self.points[len(self.points) // 2:]
+        return float(min(ends)), float(max(ends))
 
     def breakpoints(self, what: str, unit: str = "") -> tuple:
         """The corners ``(times [s], values)`` of a piecewise-linear signal (constant, ramp, table or sampled),
@@ -677,7 +711,7 @@ class Driveline:
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         if not isinstance(curve, Curve):
-            arr = np.asarray(curve, dtype=float) if not isinstance(curve, (str, bytes)) else np.empty(0)
+            arr = as_numbers(curve, f"{name}: curve") if not isinstance(curve, (str, bytes)) else np.empty(0)
             if arr.ndim != 2 or arr.shape[1] != 2:
                 raise ParameterError(f"{name}: curve must be a Curve or rows [[phi_rad, tau_Nm], ...]")
             curve = Curve(arr[:, 0], arr[:, 1], name=name)
@@ -863,9 +897,10 @@ class Driveline:
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
         if isinstance(torque_map, tuple) and len(torque_map) == 3:
-            ws, th, tq = (np.asarray(v, dtype=float) for v in torque_map)
+            ws, th, tq = (as_numbers(v, f"{name}: torque_map {what}")
+                          for v, what in zip(torque_map, ("speeds", "throttles", "torques")))
         else:
-            rows = np.asarray(torque_map, dtype=float)
+            rows = as_numbers(torque_map, f"{name}: torque_map")
             if rows.ndim != 2 or rows.shape[1] != 2:
                 raise ParameterError(f"{name}: torque_map must be (speeds, throttles, torques) or rows [w_rad_s, N m]")
             ws, th = rows[:, 0], np.array([0.0, 1.0])
@@ -911,7 +946,7 @@ class Driveline:
         """A constant or a table ``[[w, value], ...]`` (w >= 0 increasing) as (speeds, values)."""
         if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
             return (0.0, _finite(name, what, value, nonneg=True))
-        arr = np.asarray(value, dtype=float)
+        arr = as_numbers(value, f"{name}: {what}")
         if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or not np.all(np.isfinite(arr)):
             raise ParameterError(f"{name}: {what} must be a number or a table of rows [w_rad_s, value]")
         if arr[0, 0] != 0.0 or np.any(np.diff(arr[:, 0]) <= 0) or np.any(arr[:, 1] < 0):
@@ -1070,7 +1105,10 @@ class Driveline:
         if n > 5_000_000:
             raise ParameterError(f"{name}: {n} actuator samples ({t_end:g} s every {step:g} s): choose a larger "
                                  "actuator_step")
-        run = EClutch(actuator, cm).simulate({"bearing_reference": (times, values)}, n * step, output_step=step)
+        try:
+            run = EClutch(actuator, cm).simulate({"bearing_reference": (times, values)}, n * step, output_step=step)
+        except ParameterError as exc:   # (e.g. a reference beyond the CSC travel: name the component)
+            raise ParameterError(f"{name}: {exc}") from None
         df = run.to_dataframe()
         t = df["time_s"].to_numpy() - pre_roll
         fn = np.maximum(df["normal_force_N"].to_numpy(), 0.0)
@@ -1100,16 +1138,19 @@ class Driveline:
         ``housing_temperature0``: the temperatures [degC] at the start of the pack, the oil reservoir (also the
         heater's set point) and the housing.  Any number of wet clutches per network.
         """
-        from ..wet.params import Bench, WetClutch
+        from ..wet.params import Bench, WetClutch, temperature_problem
 
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         sig = Signal.of(force, f"{name}: force")
-        self._wet_profile(name, sig)   # a profile the model reads, or one network input
+        _, forces = self._wet_profile(name, sig)   # a profile the model reads, or one network input
         temps = {}
         for what, value in (("temperature0", temperature0), ("fluid_temperature0", fluid_temperature0),
                             ("housing_temperature0", housing_temperature0)):
             temps[what] = _finite(name, what, value)
+            problem = temperature_problem(temps[what])
+            if problem:
+                raise ParameterError(f"{name}: {what} = {temps[what]:g} degC: {problem}")
         from ..wet.friction import FrictionMap, ParametricFriction
 
         clutch = WetClutch.paper() if clutch is None else clutch
@@ -1119,6 +1160,9 @@ class Driveline:
                                          "ParametricFriction or FrictionMap")):
             if not isinstance(value, cls):
                 raise ParameterError(f"{name}: {what} must be a {label}, not {type(value).__name__}")
+        if max(forces) > bench.actuator_force_max * (1.0 + 1e-12):   # (an input is saturated there by the model)
+            raise ParameterError(f"{name}: force reference {max(forces):g} N exceeds the actuator's "
+                                 f"{bench.actuator_force_max:g} N (bench.actuator_force_max)")
         if any(e.emtc is not None for e in self._elements):
             raise ParameterError(f"{name}: a wet clutch and an EMTC coupling cannot share a network")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)

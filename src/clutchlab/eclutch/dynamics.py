@@ -678,9 +678,20 @@ class EClutch:
         """
         imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
+        self._check_reference(key, vin)
         return self._system(imode, interp, tin, vin, held_input=held_input, rtol=rtol, max_step=max_step,
                             event_tol=event_tol, jac_every=jac_every, atol_scale=_follow_rtol(rtol, atol_scale),
                             first_step=first_step)
+
+    def _check_reference(self, key: str, values) -> None:
+        """A bearing reference inside the CSC travel (the actuator's end stops; #33: 50 mm was taken)."""
+        if key != "bearing_reference":
+            return
+        lo, hi = self.actuator.slave_min, self.actuator.slave_max
+        bad = np.flatnonzero((values < lo) | (values > hi))
+        if bad.size:
+            raise ParameterError(f"input 'bearing_reference' = {float(values[bad[0]]):g} m is outside the CSC travel "
+                                 f"[{lo:g}, {hi:g}] m (ActuatorParameters.slave_min, slave_max)")
 
     def _system(self, imode, interp, tin, vin, **options) -> contract.System:
         """:meth:`as_system` of a checked input table."""
@@ -696,8 +707,8 @@ class EClutch:
 
         Parameters
         ----------
-        bearing_position : float
-            Bearing position [m], inside the CSC travel (``ActuatorParameters.slave_min`` ... ``slave_max``).
+        bearing_position : float or str
+            Bearing position [m] (or a quantity string such as ``"4 mm"``), inside the CSC travel (``ActuatorParameters.slave_min`` ... ``slave_max``).
         input : {"voltage", "bearing_reference"}
             The held input of the system trimmed: the motor voltage (open loop; the voltage is solved for)
             or the position controller's reference (closed loop; all states steady, the integral action
@@ -726,7 +737,9 @@ class EClutch:
             raise ParameterError(f"input = {input!r}: expected 'voltage' or 'bearing_reference'")
         if friction not in ("slip_forward", "slip_backward"):
             raise ParameterError(f"friction = {friction!r}: expected 'slip_forward' or 'slip_backward'")
-        pos = float(bearing_position)
+        from ..units import to_si
+
+        pos = to_si(bearing_position, "m", name="bearing_position")   # (a number [m], or a quantity: "4 mm")
         lo, hi = self.actuator.slave_min, self.actuator.slave_max
         if not lo <= pos <= hi:
             raise OperatingPointError(f"eclutch: bearing_position = {pos:.6g} m is outside the CSC travel "
@@ -805,6 +818,7 @@ class EClutch:
         t_end = float(t_end)
         imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
+        self._check_reference(key, vin)
         _check_run(t_end, rtol, max_steps, atol, atol_scale)
         grid = _grid(output_step, t_end)  # refused before anything is built
         system = self._system(imode, interp, tin, vin, rtol=rtol, max_step=_max_step(max_step, h_max),

@@ -220,6 +220,16 @@ def scenario_from_dict(data: dict, source: str = "scenario") -> Scenario:
         else FrictionParameters.off()
     if "eclutch_actuator" not in data or "csc_preload" not in data.get("eclutch_actuator", {}):
         actuator = actuator.replace(csc_preload=clutch.bearing_preload)
+    lo, hi = actuator.slave_min, actuator.slave_max
+    if kind == "bearing_reference":   # (the actuator's position reference: inside its travel, #33)
+        bad = np.flatnonzero((v < lo) | (v > hi))
+        if bad.size:
+            where = f"{f}: row {int(bad[0])} value" if file_input else f"[input] value[{int(bad[0])}]"
+            raise ParameterError(f"{src}: {where} = {float(v[bad[0]]):g} m is outside the CSC travel [{lo:g}, {hi:g}] m "
+                                 "([eclutch_actuator] slave_min, slave_max)")
+    if kind == "pedal" and release_travel > hi:
+        raise ParameterError(f"{src}: [input] release_travel = {release_travel:g} m is beyond the CSC travel "
+                             f"{hi:g} m ([eclutch_actuator] slave_max)")
     return Scenario(model=model, t_end=t_end, input_kind=kind, time_s=t, value=v, release_travel=release_travel,
                     clutch=clutch, actuator=actuator, friction=friction, wear_m=wear, temperature_rise_k=rise,
                     output_step=output_step, rtol=rtol, source=src)

@@ -29,7 +29,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._limits import as_numbers
 from ..errors import DataError, ParameterError
+from ..params.base import PLAUSIBLE_LIMITS
+
+#: The largest FORC value [N] a model may hold: the plausibility limit of a force (``params.base``)
+FORCE_LIMIT_N = PLAUSIBLE_LIMITS["N"][0]
+#: The largest air gap [m]: an electromagnet's gap is millimetres; a metre is a slip of unit
+GAP_LIMIT_M = 1.0
 from . import _kernels as K
 
 __all__ = ["Preisach", "PreisachState", "InverseResult", "forc_table_from_masses"]
@@ -108,7 +115,7 @@ class InverseResult:
 
 
 def _as_1d(name, values):
-    arr = np.asarray(values, dtype=float)
+    arr = as_numbers(values, name, DataError)
     if arr.ndim > 1:  # never flattened silently: a table passed as a grid is a mistake
         raise DataError(f"{name}: expected a 1-D list of values, got an array of shape {arr.shape}")
     arr = arr.ravel()
@@ -182,7 +189,7 @@ class Preisach:
         if np.any(np.diff(grid) <= 0):
             i = int(np.flatnonzero(np.diff(grid) <= 0)[0])
             raise DataError(f"grid: not strictly increasing at index {i + 1} ({float(grid[i])!r} -> {float(grid[i + 1])!r})")
-        tables = np.asarray(tables, dtype=float)
+        tables = as_numbers(tables, "tables", DataError)
         if tables.ndim == 2:
             tables = tables[None]
         n = grid.size
@@ -192,6 +199,10 @@ class Preisach:
         for k in range(tables.shape[0]):
             if not np.all(np.isfinite(tables[k][low])):
                 raise DataError(f"table {k}: non-finite FORC value on or below the diagonal")
+            top = float(np.max(np.abs(tables[k][low])))
+            if top > FORCE_LIMIT_N:   # (the plausibility limit of a force: a slip of unit or exponent)
+                raise DataError(f"table {k}: FORC value of magnitude {top:g} N is implausible for a magnet's force "
+                                f"(above {FORCE_LIMIT_N:g} N); check the unit and the exponent")
         tables = np.where(low[None], tables, 0.0)
         if airgaps is None:
             if tables.shape[0] != 1:
@@ -200,6 +211,9 @@ class Preisach:
             self._has_gap = False
         else:
             gaps = _as_1d("airgaps", airgaps)
+            if np.any(gaps > GAP_LIMIT_M):
+                raise ParameterError(f"airgaps: {float(np.max(gaps)):g} m is implausible for an air gap (above "
+                                     f"{GAP_LIMIT_M:g} m); check the unit and the exponent")
             if gaps.size != tables.shape[0]:
                 raise ParameterError(f"airgaps: {gaps.size} values for {tables.shape[0]} tables")
             if np.any(np.diff(gaps) <= 0):
@@ -552,7 +566,7 @@ class Preisach:
         if not isinstance(body, dict) or body.get("kind") != "clutchlab.preisach":
             raise DataError(f"{path}: not a clutchlab Preisach model (missing kind='clutchlab.preisach')")
         try:
-            grid = np.asarray(body["grid_A"], dtype=float)
+            grid = as_numbers(body["grid_A"], f"{path}: grid_A", DataError)
             if grid.ndim != 1:
                 raise DataError(f"{path}: grid_A must be a 1-D list of currents [A], got an array of shape "
                                 f"{grid.shape}")
@@ -560,11 +574,13 @@ class Preisach:
             check_allocation(n, n * (1 + len(body["tables_N"])), f"{path}: grid_A of {n} currents")
             i, j = np.tril_indices(n)
             tabs = []
-            for vals in body["tables_N"]:
+            for k, vals in enumerate(body["tables_N"]):
                 t = np.zeros((n, n))
-                t[i, j] = np.asarray(vals, dtype=float)
+                t[i, j] = as_numbers(vals, f"{path}: tables_N[{k}]", DataError)
                 tabs.append(t)
             gaps = body.get("airgaps_m")
+            if gaps is not None:
+                gaps = _as_1d(f"{path}: airgaps_m", gaps)
         except DataError:
             raise
         except (KeyError, TypeError, ValueError) as exc:

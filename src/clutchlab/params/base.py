@@ -84,6 +84,17 @@ PLAUSIBLE_LIMITS = {
 MAGNITUDE_LIMIT = 1e15
 #: No temperature [degC] lies below the absolute zero.
 ABSOLUTE_ZERO_C = -273.15
+#: The temperatures [degC] the wet clutch's model takes (pack, oil and housing, at the start and as the heater's
+#: set point): from about the pour point of automatic-transmission fluids (-40 to -50 degC; below it there is no
+#: film to squeeze) to well above the destruction of paper friction linings (about 300-400 degC) and the oil's
+#: flash point (about 200-250 degC), so that a slip of unit or exponent ("1e6 degC") is refused while any
+#: temperature a bench or a vehicle reaches is taken.  One range: the scenario, the driveline's wet clutch and
+#: its declaration read it (a light module, so reading it imports no model).
+WET_TEMPERATURES_C = (-60.0, 600.0)
+#: The largest friction coefficient a clutch, brake or friction map may have: dry and wet clutch linings run at
+#: 0.05-0.6, clean metals in vacuum reach about 1-1.5; above 2 it is a typing or unit slip (a percentage, a
+#: torque).  The clutch's declared range and the friction map's check read it.
+FRICTION_COEFFICIENT_MAX = 2.0
 
 
 def _number_problem(value, meta) -> str | None:

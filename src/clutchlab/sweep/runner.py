@@ -59,7 +59,7 @@ import pandas as pd
 from .. import __version__
 from ..errors import ClutchlabError, DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, atomic_write_text
-from .spec import VARIANT_ID, SweepSpec, check_scheduler, load_spec
+from .spec import VARIANT_ID, SweepSpec, check_scheduler, load_spec, spec_from_dict
 
 __all__ = ["run_sweep", "SweepResult", "compute_chunk", "chunk_path", "read_results", "summarize",
            "MANIFEST", "CHUNK_DIR", "PROVENANCE"]
@@ -609,8 +609,9 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
 
     Parameters
     ----------
-    spec : SweepSpec or str or Path
-        The spec (or its TOML file, read with :func:`~clutchlab.sweep.spec.load_spec`).
+    spec : SweepSpec or str or Path or dict
+        The spec (or its TOML file, read with :func:`~clutchlab.sweep.spec.load_spec`, or its tables as a
+        dict, read with :func:`~clutchlab.sweep.spec.spec_from_dict`).
     output : str or Path
         Results folder (created; resumed if it holds the same spec).
     workers : int, optional
@@ -640,7 +641,9 @@ def run_sweep(spec, output, *, workers: int | None = None, scheduler=None, force
     ParameterError
         Bad spec, or a variant the model rejects (naming the spec file, chunk and variant).
     """
-    if not isinstance(spec, SweepSpec):
+    if isinstance(spec, dict):   # (a spec's tables as a TOML file holds them; files named relative to here)
+        spec = spec_from_dict(spec)
+    elif not isinstance(spec, SweepSpec):
         spec = load_spec(spec)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"workers = {workers!r}: expected a whole number >= 1")

@@ -337,6 +337,9 @@ def load_spec(path) -> SweepSpec:
         that do not parse or have the wrong unit, an empty design, a
         variant the model rejects -- naming the file, the key and the value.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"sweep spec = {short_repr(path)}: expected the path of a spec file (or a SweepSpec, "
+                             f"or its tables as a dict), not {type(path).__name__}")
     path = Path(path)
     data = load_toml(path)
     return spec_from_dict(data, source=path)

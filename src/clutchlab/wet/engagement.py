@@ -65,7 +65,7 @@ from ..result import BuiltOnFirstAccess, SimulationResult
 from ..system import check_rtol, checked_grid, sample_grid, simulate as run
 from . import system as W
 from .friction import ParametricFriction
-from .params import Bench, WetClutch
+from .params import Bench, WetClutch, temperature_problem
 
 __all__ = [
     "Scenario",
@@ -168,9 +168,12 @@ class Scenario:
             raise ParameterError(f"Scenario.duration = {self.duration!r}: must be > 0 [s]")
         if self.motor not in ("speed", "free"):
             raise ParameterError(f"Scenario.motor = {self.motor!r}: expected 'speed' or 'free'")
-        for name in ("initial_slip_speed", "initial_temperature_c", "fluid_temperature_c", "housing_temperature_c"):
-            if not math.isfinite(getattr(self, name)):
-                raise ParameterError(f"Scenario.{name} = {getattr(self, name)!r}: not finite")
+        if not math.isfinite(self.initial_slip_speed):
+            raise ParameterError(f"Scenario.initial_slip_speed = {self.initial_slip_speed!r}: not finite")
+        for name in ("initial_temperature_c", "fluid_temperature_c", "housing_temperature_c", "heater_setpoint_c"):
+            problem = None if getattr(self, name) is None else temperature_problem(float(getattr(self, name)))
+            if problem:
+                raise ParameterError(f"Scenario.{name} = {getattr(self, name)!r}: {problem}")
 
     @property
     def setpoint_c(self) -> float:

@@ -29,7 +29,9 @@ from typing import ClassVar
 import numba
 import numpy as np
 
+from .._limits import as_numbers, short_repr
 from ..errors import DataError
+from ..params.base import FRICTION_COEFFICIENT_MAX
 from ..numerics.interp import bracket
 from ..params import ParameterSet, quantity
 
@@ -76,7 +78,10 @@ class ParametricFriction(ParameterSet):
 
 
 def _check_grid(name, grid):
-    g = np.asarray(grid, dtype=float).ravel()
+    g = as_numbers(grid, f"FrictionMap.{name}", DataError)
+    if g.ndim > 1:
+        raise DataError(f"FrictionMap.{name}: expected a list of values, got a table of shape {g.shape}")
+    g = g.ravel()
     if g.size < 1 or not np.all(np.isfinite(g)):
         raise DataError(f"FrictionMap.{name}: needs finite values, got {grid!r}")
     if g.size > 1 and np.any(np.diff(g) <= 0):
@@ -128,16 +133,33 @@ class FrictionMap:
         self.speed_grid = _check_grid("speed_grid", speed_grid)
         self.temperature_grid = _check_grid("temperature_grid", temperature_grid)
         self.force_grid = _check_grid("force_grid", force_grid) if force_grid is not None else None
-        vals = np.asarray(values, dtype=float)
+        vals = as_numbers(values, "FrictionMap.values", DataError)
         shape = (self.temperature_grid.size, self.speed_grid.size)
         if self.force_grid is not None:
             shape = (self.force_grid.size,) + shape
         if vals.shape != shape:
             raise DataError(f"FrictionMap.values: shape {vals.shape} does not match the grids {shape}")
-        if not np.all(np.isfinite(vals)) or np.any(vals < 0):
-            raise DataError("FrictionMap.values: must be finite and >= 0")
+        if not np.all(np.isfinite(vals)):
+            raise DataError(f"FrictionMap.values: must be finite (got {float(vals[~np.isfinite(vals)][0])!r})")
+        if np.any(vals < 0) or np.any(vals > FRICTION_COEFFICIENT_MAX):
+            bad = vals[~((vals >= 0) & (vals <= FRICTION_COEFFICIENT_MAX))][0]
+            raise DataError(f"FrictionMap.values: {float(bad):g} is not a friction coefficient in [0, "
+                            f"{FRICTION_COEFFICIENT_MAX:g}] (params.base.FRICTION_COEFFICIENT_MAX)")
         self.values = vals
-        self.covered = np.ones(shape, bool) if covered is None else np.asarray(covered, dtype=bool).reshape(shape)
+        if covered is None:
+            self.covered = np.ones(shape, bool)
+        else:
+            cov = as_numbers(covered, "FrictionMap.covered", DataError)
+            if cov.shape != shape or not np.all((cov == 0) | (cov == 1)):
+                raise DataError(f"FrictionMap.covered: expected 0 or 1 for each value, shape {shape}; got shape "
+                                f"{cov.shape}")
+            self.covered = cov.astype(bool)
+        if law is not None and not isinstance(law, ParametricFriction):
+            raise DataError(f"FrictionMap.law: expected a ParametricFriction or None, not {type(law).__name__}")
+        for what, value in (("statistics", statistics), ("region", region)):
+            if value is not None and not isinstance(value, dict):
+                raise DataError(f"FrictionMap.{what} = {short_repr(value)}: expected a table of named values (a "
+                                f"JSON object), not {type(value).__name__}")
         self.law = law
         self.statistics = dict(statistics or {})
         self.region = dict(region or {})
@@ -203,12 +225,19 @@ class FrictionMap:
         """Rebuild a map from :meth:`to_dict` output."""
         if not isinstance(data, dict):
             raise DataError(f"{source}: expected a friction map (a JSON object), got {type(data).__name__}")
+        missing = [k for k in ("speed_grid", "temperature_grid", "values") if k not in data]
+        if missing:
+            raise DataError(f"{source}: friction map lacks the key {missing[0]!r}")
+        law = data.get("law")
+        if law is not None and not isinstance(law, dict):
+            raise DataError(f"{source}: FrictionMap.law = {short_repr(law)}: expected the parameters of a "
+                            "ParametricFriction (a JSON object) or null")
+        law = ParametricFriction.from_dict(law, source=source) if law else None
         try:
-            law = ParametricFriction.from_dict(data["law"], source=source) if data.get("law") else None
             return cls(data["speed_grid"], data["temperature_grid"], data["values"], data.get("force_grid"),
                        data.get("covered"), law, data.get("statistics"), data.get("region"))
-        except KeyError as exc:
-            raise DataError(f"{source}: friction map lacks the key {exc.args[0]!r}") from None
+        except DataError as exc:   # (a field of the file: name the file)
+            raise DataError(f"{source}: {exc}") from None
 
     @classmethod
     def from_json(cls, path) -> "FrictionMap":

@@ -22,6 +22,7 @@ from typing import ClassVar
 
 from ..errors import ParameterError
 from ..params import ParameterSet, quantity
+from ..params.base import WET_TEMPERATURES_C
 from .film import effective_radius, gw_pressure_scale, squeeze_film_coefficient
 
 __all__ = ["WetClutch", "Bench"]
@@ -29,6 +30,21 @@ __all__ = ["WetClutch", "Bench"]
 T1 = "Shin et al., Table 1"
 _RO, _RI = 0.08315, 0.07174
 _AREA = math.pi * (_RO**2 - _RI**2)
+
+
+#: The temperatures [degC] the wet clutch's model takes (:data:`clutchlab.params.base.WET_TEMPERATURES_C`).
+TEMPERATURE_RANGE_C = WET_TEMPERATURES_C
+
+
+def temperature_problem(value: float) -> str | None:
+    """Why ``value`` [degC] is not a temperature of the wet clutch's model (:data:`TEMPERATURE_RANGE_C`), or None."""
+    lo, hi = TEMPERATURE_RANGE_C
+    if not math.isfinite(value):
+        return "not finite"
+    if not lo <= value <= hi:
+        return (f"outside the wet clutch's temperatures [{lo:g}, {hi:g}] degC (from the oil's pour point to "
+                "beyond the linings' destruction)")
+    return None
 
 
 @dataclasses.dataclass(frozen=True)
