@@ -63,6 +63,22 @@ def test_run_report_writes_units_for_people(tmp_path, monkeypatch):
     assert m.loc["torque_Nm", "unit"] == "N·m" and m.loc["slip_speed_rad_s", "unit"] == "rad/s"
 
 
+def test_run_report_keeps_the_underscores_of_channel_names(tmp_path, monkeypatch):
+    """#33 R3: axis labels and legends spell a name as it is typed (``ice.idle_kp``, ``clutch.fn_max``),
+    with and without a unit suffix; only the suffix becomes a unit."""
+    t = np.linspace(0.0, 1.0, 50)
+    frame = pd.DataFrame({"time_s": t, "ice.idle_kp": 0.5 + 0 * t, "clutch.fn_max_N": 2000 * t,
+                          "clutch.fn_min_N": 1000 * t, "slip_speed_rad_s": 100 * t})
+    write_measurement(frame, tmp_path / "run" / "r.csv", comment="synthetic: test data")
+    seen = _capture_figures(monkeypatch)
+    report_run_dir(tmp_path / "run", units="si")
+    ylabels = [ax.get_ylabel() for fig in seen for ax in fig.axes]
+    legends = [t.get_text() for fig in seen for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert "ice.idle_kp" in ylabels and "slip_speed [rad/s]" in ylabels, ylabels
+    assert {"clutch.fn_max", "clutch.fn_min"} <= set(legends), legends
+    assert not any(s in " | ".join(ylabels + legends) for s in ("idle kp", "fn max", "fn min", "slip speed"))
+
+
 def test_run_report_shows_engineers_units_by_default(tmp_path, monkeypatch):
     """#33: figures and tables in rpm, bar, kN, mm, l/min, km/h, °C; the files stay SI."""
     t = np.linspace(0.0, 1.0, 50)
@@ -73,8 +89,8 @@ def test_run_report_shows_engineers_units_by_default(tmp_path, monkeypatch):
     seen = _capture_figures(monkeypatch)
     index = report_run_dir(tmp_path / "run")
     axes = {ax.get_ylabel(): ax for fig in seen for ax in fig.axes if ax.get_ylabel()}
-    for label, value in [("slip speed [rpm]", 100 * 30 / np.pi), ("pressure [bar]", 3.0), ("force [kN]", 2.0),
-                         ("travel [mm]", 8.0), ("line flow [l/min]", 0.6), ("vehicle speed [km/h]", 36.0),
+    for label, value in [("slip_speed [rpm]", 100 * 30 / np.pi), ("pressure [bar]", 3.0), ("force [kN]", 2.0),
+                         ("travel [mm]", 8.0), ("line_flow [l/min]", 0.6), ("vehicle_speed [km/h]", 36.0),
                          ("oil [°C]", 80.0), ("torque [N·m]", 5.0)]:
         assert label in axes, (label, list(axes))
         assert axes[label].lines[0].get_ydata()[-1] == pytest.approx(value, rel=1e-9)

@@ -9,7 +9,7 @@ from ..units import column_label
 
 
 def _column_name(column: str) -> str:
-    """``bearing_position_m`` -> ``bearing position`` (the label without its unit)."""
+    """``bearing_position_m`` -> ``bearing_position`` (the label without its unit)."""
     return column_label(column).split(" [")[0]
 
 
