@@ -1,13 +1,14 @@
 """Sphinx configuration of the clutchlab documentation site.
 
 Build (warnings are errors): ``tools/build-docs`` or
-``python -m sphinx -W --keep-going -b html docs docs/_build/html``.
+``python -m sphinx -W --keep-going -b html -d docs/_build/doctrees docs docs/_build/html`` (the doctrees,
+Sphinx's cache, outside the site: they were 29 MB of a 67 MB folder, #33).
 Needs the ``docs`` extra: ``pip install -e ".[docs]"``.
 
 The pages are Markdown (MyST); the API reference is generated from the numpydoc
 docstrings by autodoc; equations are ``$...$``/``$$...$$`` rendered by MathJax,
-which is shipped with the site (``sphinx-mathjax-offline``), so neither the build
-nor viewing the pages needs the network.
+which is shipped with the site (the part of ``sphinx-mathjax-offline``'s copy the
+pages load), so neither the build nor viewing the pages needs the network.
 """
 
 import os
@@ -35,7 +36,6 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
-    "sphinx-mathjax-offline",  # MathJax 3 copied into _static: pages render math offline
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
@@ -56,6 +56,33 @@ autodoc_preserve_defaults = True
 numpydoc_show_class_members = False   # members are documented by autodoc itself, once
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
+
+# -- MathJax, shipped with the site: pages render math offline --------------------------------------------------------
+# sphinx-mathjax-offline would copy all of MathJax 3 (24 MB: SVG and MathML outputs and combined builds the pages never
+# load).  The site takes what tex-chtml.js loads: the TeX extensions it autoloads, its CHTML fonts, and the menu's
+# accessibility explorer with its speech rules (a11y, sre, ui); 7 MB.
+mathjax_path = "mathjax/tex-chtml.js"
+MATHJAX_FILES = ("tex-chtml.js", "input/tex", "output/chtml/fonts/woff-v2", "a11y", "sre", "ui")
+
+
+def _copy_mathjax(app, exc):
+    import importlib.util
+    import shutil
+
+    if exc is not None or app.builder.format != "html":
+        return
+    spec = importlib.util.find_spec("sphinx-mathjax-offline")  # the docs extra's MathJax, no network
+    if spec is None or spec.origin is None:
+        raise RuntimeError("MathJax for the offline site: pip install -e '.[docs]' (sphinx-mathjax-offline)")
+    source = pathlib.Path(spec.origin).parent / "static" / "mathjax"
+    target = pathlib.Path(app.outdir) / "_static" / "mathjax"
+    for part in MATHJAX_FILES:
+        if (source / part).is_dir():
+            shutil.copytree(source / part, target / part, dirs_exist_ok=True)
+        else:
+            (target / part).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(source / part, target / part)
+
 
 # -- HTML ------------------------------------------------------------------------------------------------------------
 html_theme = "furo"
@@ -114,4 +141,5 @@ def _numpydoc_warnings_as_sphinx_warnings():
 
 def setup(app):
     app.connect("autodoc-process-docstring", _module_sections_as_rubrics, priority=400)
+    app.connect("build-finished", _copy_mathjax)
     _numpydoc_warnings_as_sphinx_warnings()

@@ -1,6 +1,7 @@
 """The public API polices itself: every public callable has a docstring naming each of its arguments."""
 
 import enum
+import importlib
 import inspect
 
 import pytest
@@ -54,3 +55,43 @@ def test_public_callable_is_documented(qualname, obj):
     else:
         missing = [n for n in names if n not in doc]
     assert not missing, f"{qualname}: arguments not documented: {missing}"
+
+
+def test_api_pages_document_only_public_api():
+    """#33 R8: docs/api/driveline.md documented ``clutchlab.driveline.kernel`` (``driveline_rhs``,
+    ``DrivelineParams``, ...).  An API page documents no compiled internal (a kernel module, a ``_`` module, a
+    registered hook or its parameter class), only names of a module's ``__all__``, and widens nothing."""
+    import api_pages
+
+    internals = api_pages.registered_internals()
+    problems = []
+    for page, name, options in api_pages.entries():
+        why = api_pages.compiled_internal(name)
+        if why:
+            problems.append(f"{page}: {name} is {why}")
+            continue
+        problems += [f"{page}: {name} has :{o}:" for o in api_pages.WIDENING if o in options]
+        module = importlib.import_module(name)
+        names = api_pages.documented_names(module, options)
+        public = getattr(module, "__all__", None)
+        if names and public is None:
+            problems.append(f"{page}: {name} declares no __all__, so the page lists whatever it defines: {names}")
+            continue
+        problems += [f"{page}: {name}.{n} is not in its __all__" for n in names if n not in (public or [])]
+        problems += [f"{page}: {name}.{n} is {internals[id(getattr(module, n))]}" for n in names
+                     if id(getattr(module, n, None)) in internals]
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("module", ["clutchlab.driveline.kernel", "clutchlab.numerics.dopri",
+                                    "clutchlab.numerics.rosenbrock", "clutchlab.hysteresis._kernels"])
+def test_compiled_internals_are_recognised(module):
+    """The check above knows a kernel module when it sees one (else it could not fail)."""
+    import api_pages
+
+    assert api_pages.compiled_internal(module)
+    assert not api_pages.compiled_internal("clutchlab.driveline.network")
+    internals = api_pages.registered_internals()
+    from clutchlab.driveline import kernel
+
+    assert id(kernel.driveline_rhs) in internals and id(kernel.DrivelineParams) in internals

@@ -45,7 +45,7 @@ def test_every_suffix_of_nomenclature(suffix, human, file_unit):
     assert canonical_unit(name) == file_unit  # what the readers convert to
     assert unit_label(suffix) == human  # axis labels and report tables
     assert unit_label(file_unit) == human
-    assert column_label(name) == f"some quantity [{human}]"
+    assert column_label(name) == f"some_quantity [{human}]"
     # the unit people read and the unit written in files are the same unit
     assert unit_conversion(human, file_unit) == pytest.approx((1.0, 0.0))
 
@@ -54,10 +54,26 @@ def test_units_named_in_the_issue():
     assert column_unit("line_flow_m3_s") == "m**3/s"  # was "s": the shortest suffix won
     assert unit_label("rad_s") == "rad/s" and unit_label("C") == "°C" and unit_label("m3_s") == "m³/s"
     assert unit_label("Nm") == "N·m" and unit_label("1") == "dimensionless"
-    assert column_label("slip_speed_rad_s") == "slip speed [rad/s]"
+    assert column_label("slip_speed_rad_s") == "slip_speed [rad/s]"
     assert column_label("temperature_C") == "temperature [°C]"
-    assert column_label("coupling_mode") == "coupling mode" and column_unit("coupling_mode") is None
+    assert column_label("coupling_mode") == "coupling_mode" and column_unit("coupling_mode") is None
     assert column_label("time") == "time [s]"
+
+
+@pytest.mark.parametrize("name, label", [
+    ("ice.idle_kp", "ice.idle_kp"),                       # a parameter without a unit suffix
+    ("clutch1.fn_max", "clutch1.fn_max"),
+    ("coupling_mode", "coupling_mode"),
+    ("ice.idle_kp_Nm", "ice.idle_kp [N·m]"),              # underscores before a unit suffix
+    ("slip_speed_rad_s", "slip_speed [rad/s]"),
+    ("vehicle.w_jerk_rad_s3", "vehicle.w_jerk [rad/s³]"),
+    ("line_flow_m3_s", "line_flow [m³/s]"),
+    ("peak_temperature_c", "peak_temperature [°C]"),
+])
+def test_column_label_keeps_the_underscores_of_a_name(name, label):
+    """#33 R3: a name is what people type in a spec or a query (``ice.idle_kp``); labels keep it as it is
+    spelled and turn only the unit suffix into a unit."""
+    assert column_label(name) == label
 
 
 @given(stem=st.from_regex(r"[a-z]{1,8}(_[a-z]{1,8}){0,2}", fullmatch=True), suffix=st.sampled_from(sorted(COLUMN_UNITS)))

@@ -29,12 +29,37 @@ def new_figure(nrows=1, ncols=1, *, width=7.0, height=4.5, **kw):
 SYNTHETIC_GID = "clutchlab-synthetic-data"
 
 
+def _content_box(fig, stamp, renderer):
+    """The display box of everything ``fig`` draws except ``stamp`` and the figure's background, with its
+    right edge held inside the figure (where the stamp is right-aligned)."""
+    from matplotlib.transforms import Bbox
+
+    boxes = []
+    for artist in fig.get_children():
+        if artist is stamp or artist is fig.patch or not artist.get_visible() or not artist.get_in_layout():
+            continue
+        box = artist.get_tightbbox(renderer)
+        if box is not None and np.isfinite(box.width) and np.isfinite(box.height) and (box.width or box.height):
+            boxes.append(box)
+    if not boxes:
+        return fig.bbox
+    box = Bbox.union(boxes)
+    return Bbox.from_extents(box.x0, box.y0, min(box.x1, fig.bbox.x1), box.y1)
+
+
 def mark_synthetic(fig, note: str = "SYNTHETIC DATA (not measured)"):
     """Stamp a figure as drawn from synthetic data (virtual rigs, simulations, bundled synthetic records).
 
-    The stamp is a small red text in the bottom right corner of the figure,
-    added once (calling it again changes nothing), so the mark travels with
-    the image wherever it is copied.
+    The stamp is a small red text right-aligned just below everything else the
+    figure draws (axes, their labels and tick labels, legends, texts), placed
+    anew at every drawing, after the layout: it never covers an axis label or a
+    tick label (#33).  A constrained or tight layout engine of the figure is
+    told to leave a strip for it at the bottom; where a figure laid out once
+    has no room below its axes, the stamp lies below the figure's edge and a
+    figure saved with ``bbox_inches="tight"`` (as clutchlab saves every figure)
+    grows to hold it.
+    It is added once (calling it again changes nothing), so the mark travels
+    with the image wherever it is copied.
 
     Parameters
     ----------
@@ -49,13 +74,37 @@ def mark_synthetic(fig, note: str = "SYNTHETIC DATA (not measured)"):
         ``fig``.
     """
     if not is_marked_synthetic(fig):
-        fig.text(0.995, 0.005, note, ha="right", va="bottom", fontsize=7, color="#b00020", gid=SYNTHETIC_GID)
+        from matplotlib.text import Annotation
+
+        def below_the_rest(renderer):   # a callable anchor: matplotlib asks it at every drawing
+            return _content_box(fig, stamp, renderer)
+
+        stamp = Annotation(note, xy=(1.0, 0.0), xycoords=below_the_rest, xytext=(0.0, -3.0),
+                           textcoords="offset points", ha="right", va="top", fontsize=7, color="#b00020",
+                           gid=SYNTHETIC_GID, annotation_clip=False)
+        fig.add_artist(stamp)
+        _leave_a_strip(fig, (7.0 * 1.5 + 3.0) / 72.0)   # the stamp's line and its offset [in]
     return fig
+
+
+def _leave_a_strip(fig, height_in: float) -> None:
+    """Make a figure's layout engine (constrained or tight) leave ``height_in`` inches free at the bottom, so
+    the stamp placed below the axes stays inside the figure; other figures keep their layout."""
+    from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
+
+    engine = fig.get_layout_engine()
+    strip = min(0.2, height_in / max(fig.get_figheight(), 1e-6))
+    if isinstance(engine, ConstrainedLayoutEngine):     # rect = (left, bottom, width, height)
+        x, y, w, h = engine.get()["rect"]
+        engine.set(rect=(x, y + strip, w, h - strip))
+    elif isinstance(engine, TightLayoutEngine):         # rect = (left, bottom, right, top)
+        left, bottom, right, top = engine.get()["rect"] or (0.0, 0.0, 1.0, 1.0)
+        engine.set(rect=(left, bottom + strip, right, top))
 
 
 def is_marked_synthetic(fig) -> bool:
     """Whether :func:`mark_synthetic` stamped ``fig``."""
-    return any(t.get_gid() == SYNTHETIC_GID for t in fig.texts)
+    return any(a.get_gid() == SYNTHETIC_GID for a in (*fig.texts, *fig.artists))
 
 
 def legend_outside(ax_or_fig, handles=None, *, where: str = "right", ncol: int = 1, fontsize: float = 8):

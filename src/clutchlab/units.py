@@ -459,7 +459,11 @@ def affine_conversion(source: str, target: str) -> tuple[float, float]:
 
 
 def column_label(name: str) -> str:
-    """Axis or table label of a column: its name in words and its unit (``slip_speed_rad_s`` -> ``slip speed [rad/s]``).
+    """Axis or table label of a column: its name and its unit (``slip_speed_rad_s`` -> ``slip_speed [rad/s]``).
+
+    The name is kept as it is spelled (``ice.idle_kp`` stays ``ice.idle_kp``): it is what people type
+    in a spec, a parameter file or a query, so a label must not turn its underscores into spaces (#33).
+    Only the unit suffix is taken off and written as people read it.
 
     Parameters
     ----------
@@ -469,14 +473,13 @@ def column_label(name: str) -> str:
     Returns
     -------
     str
-        ``"<words> [<unit>]"``; a name without a unit suffix is only put into
-        words (``coupling_mode`` -> ``coupling mode``).
+        ``"<name without its unit suffix> [<unit>]"``; a name without a unit suffix is returned as
+        it is (``coupling_mode`` -> ``coupling_mode``).
     """
     name = str(name)
     if name in NAME_UNITS:
         return f"{name} [{unit_label(NAME_UNITS[name])}]"
     suffix = _suffix(name)
     if suffix is None:
-        return name.replace("_", " ")
-    stem = name[: -len(suffix) - 1].replace("_", " ")
-    return f"{stem} [{COLUMN_UNITS[suffix][1]}]"
+        return name
+    return f"{name[: -len(suffix) - 1]} [{COLUMN_UNITS[suffix][1]}]"

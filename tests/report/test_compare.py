@@ -96,7 +96,7 @@ def test_sweeps_are_overlaid_one_colour_per_run(runs):
     sections = compare_sections([a, b])
     fig = _items(sections[2:3], Figure)[0]
     ax = fig.figure.axes[0]
-    assert ax.get_xlabel() == "force [kN]" and ax.get_ylabel() == "lockup time [s]"
+    assert ax.get_xlabel() == "force [kN]" and ax.get_ylabel() == "lockup_time [s]"
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["baseline", "stiffer"]
     np.testing.assert_allclose(ax.collections[1].get_offsets()[:, 1], 1.1e3 / np.linspace(1e3, 4e3, 12))
     assert "one colour per run (baseline, stiffer)" in fig.caption

@@ -8,14 +8,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.text import Text
 
 import clutchlab.report.html as report_html
 from clutchlab.cli import main
 from clutchlab.eclutch.datasets import _data_root
 from clutchlab.io import atomic_to_csv, read_measurement, write_measurement
-from clutchlab.plotting import is_marked_synthetic, mark_synthetic, new_figure
+from clutchlab.plotting import SYNTHETIC_GID, is_marked_synthetic, mark_synthetic, new_figure
 from clutchlab.report import Figure, Section, write_report
-from clutchlab.report.run import metrics_table, find_datasets, report_run_dir
+from clutchlab.report.run import Dataset, metrics_table, find_datasets, report_run_dir, scatter_matrix
 
 ROOT = Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location("figure_checks", ROOT / "tests" / "figure_checks.py")
@@ -63,6 +64,22 @@ def test_run_report_writes_units_for_people(tmp_path, monkeypatch):
     assert m.loc["torque_Nm", "unit"] == "N·m" and m.loc["slip_speed_rad_s", "unit"] == "rad/s"
 
 
+def test_run_report_keeps_the_underscores_of_channel_names(tmp_path, monkeypatch):
+    """#33 R3: axis labels and legends spell a name as it is typed (``ice.idle_kp``, ``clutch.fn_max``),
+    with and without a unit suffix; only the suffix becomes a unit."""
+    t = np.linspace(0.0, 1.0, 50)
+    frame = pd.DataFrame({"time_s": t, "ice.idle_kp": 0.5 + 0 * t, "clutch.fn_max_N": 2000 * t,
+                          "clutch.fn_min_N": 1000 * t, "slip_speed_rad_s": 100 * t})
+    write_measurement(frame, tmp_path / "run" / "r.csv", comment="synthetic: test data")
+    seen = _capture_figures(monkeypatch)
+    report_run_dir(tmp_path / "run", units="si")
+    ylabels = [ax.get_ylabel() for fig in seen for ax in fig.axes]
+    legends = [t.get_text() for fig in seen for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert "ice.idle_kp" in ylabels and "slip_speed [rad/s]" in ylabels, ylabels
+    assert {"clutch.fn_max", "clutch.fn_min"} <= set(legends), legends
+    assert not any(s in " | ".join(ylabels + legends) for s in ("idle kp", "fn max", "fn min", "slip speed"))
+
+
 def test_run_report_shows_engineers_units_by_default(tmp_path, monkeypatch):
     """#33: figures and tables in rpm, bar, kN, mm, l/min, km/h, °C; the files stay SI."""
     t = np.linspace(0.0, 1.0, 50)
@@ -73,8 +90,8 @@ def test_run_report_shows_engineers_units_by_default(tmp_path, monkeypatch):
     seen = _capture_figures(monkeypatch)
     index = report_run_dir(tmp_path / "run")
     axes = {ax.get_ylabel(): ax for fig in seen for ax in fig.axes if ax.get_ylabel()}
-    for label, value in [("slip speed [rpm]", 100 * 30 / np.pi), ("pressure [bar]", 3.0), ("force [kN]", 2.0),
-                         ("travel [mm]", 8.0), ("line flow [l/min]", 0.6), ("vehicle speed [km/h]", 36.0),
+    for label, value in [("slip_speed [rpm]", 100 * 30 / np.pi), ("pressure [bar]", 3.0), ("force [kN]", 2.0),
+                         ("travel [mm]", 8.0), ("line_flow [l/min]", 0.6), ("vehicle_speed [km/h]", 36.0),
                          ("oil [°C]", 80.0), ("torque [N·m]", 5.0)]:
         assert label in axes, (label, list(axes))
         assert axes[label].lines[0].get_ydata()[-1] == pytest.approx(value, rel=1e-9)
@@ -115,7 +132,52 @@ def test_mark_synthetic_once():
     fig, _ = new_figure()
     assert not is_marked_synthetic(fig)
     mark_synthetic(mark_synthetic(fig))
-    assert is_marked_synthetic(fig) and sum("SYNTHETIC" in t.get_text() for t in fig.texts) == 1
+    assert is_marked_synthetic(fig)
+    assert sum("SYNTHETIC" in t.get_text() for t in fig.findobj(Text)) == 1
+
+
+def _report_scatter_matrix():
+    rng = np.random.default_rng(0)
+    names = ["clutch.r_outer", "protocol.force", "clutch.mu_scale"]
+    ds = Dataset("results.parquet", "parquet", pd.DataFrame({n: rng.uniform(1.0, 2.0, 40) for n in names}))
+    return scatter_matrix([("results", ds)], names, names, "engineers")[0]
+
+
+def _panels(layout):
+    fig, axes = new_figure(2, 2, width=7.0, height=3.0, squeeze=False, layout=layout)
+    for ax in axes.ravel():
+        ax.plot([0.0, 1e3], [0.0, 1.0])
+        ax.set_ylabel("torque [N·m]")
+    for ax in axes[-1]:
+        ax.set_xlabel("protocol.force [kN]", fontsize=8)
+    return fig
+
+
+@pytest.mark.parametrize("make", [_report_scatter_matrix, lambda: _panels("constrained"), lambda: _panels(None)],
+                         ids=["report scatter matrix (tight layout)", "constrained layout", "no layout engine"])
+def test_synthetic_stamp_covers_no_label(make):
+    """#33 R4: the stamp sat at figure coordinates (0.995, 0.005), over the x label of the bottom-right axes;
+    drawn, it overlaps no axes' labels, tick labels, title or legend, nor any other text of the figure, and it
+    is inside what a ``bbox_inches="tight"`` save writes."""
+    fig = mark_synthetic(make())
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    stamp = next(a for a in fig.get_children() if a.get_gid() == SYNTHETIC_GID)
+    box = stamp.get_window_extent(renderer)
+    assert box.width > 0 and box.height > 0
+    for ax in fig.axes:
+        texts = [ax.xaxis.label, ax.yaxis.label, ax.title, *ax.get_xticklabels(), *ax.get_yticklabels()]
+        hit = [t.get_text() for t in texts if t.get_visible() and t.get_text()
+               and box.overlaps(t.get_window_extent(renderer))]
+        assert not hit, hit
+        assert not box.overlaps(ax.get_tightbbox(renderer))   # labels, tick labels, title, legend together
+    for other in fig.get_children():
+        if other is not stamp and other is not fig.patch and isinstance(other, Text) and other.get_text():
+            assert not box.overlaps(other.get_window_extent(renderer)), other.get_text()
+    saved = fig.get_tightbbox(renderer).transformed(fig.dpi_scale_trans)   # the tight save, in pixels
+    assert saved.x0 <= box.x0 and box.x1 <= saved.x1 + 1e-6 and saved.y0 <= box.y0 + 1e-6 and box.y1 <= saved.y1
+    if fig.get_layout_engine() is not None:   # a layout engine leaves it room inside the figure
+        assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 and fig.bbox.y0 <= box.y0
 
 
 def test_eclutch_simulate_output_is_synthetic_and_units_right(tmp_path, capsys):

@@ -11,6 +11,8 @@ and exit code 2 -- never a traceback.
 
 from __future__ import annotations
 
+__all__ = ["main", "build_parser", "error_message"]
+
 import argparse
 import errno
 import importlib

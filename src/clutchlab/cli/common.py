@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+__all__ = ["add_fixed_step_option", "fixed_step_option", "fixed_step_note", "progress", "add_run_options", "run_options", "run_note"]
+
 import math
 import re
 import sys

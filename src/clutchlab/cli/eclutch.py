@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+__all__ = ["register"]
+
 import io
 from pathlib import Path
 

@@ -13,6 +13,8 @@ then needs Python and clutchlab).
 
 from __future__ import annotations
 
+__all__ = ["register"]
+
 import sys
 import warnings
 from pathlib import Path

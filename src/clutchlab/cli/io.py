@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+__all__ = ["register", "add_csv_options", "csv_options"]
+
 
 def _convert(args) -> int:
     from ..io.files import check_writable

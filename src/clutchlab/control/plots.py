@@ -9,7 +9,7 @@ from ..units import column_label
 
 
 def _column_name(column: str) -> str:
-    """``bearing_position_m`` -> ``bearing position`` (the label without its unit)."""
+    """``bearing_position_m`` -> ``bearing_position`` (the label without its unit)."""
     return column_label(column).split(" [")[0]
 
 
@@ -18,6 +18,23 @@ def _column_unit(column: str) -> str:
     return label[label.index("[") + 1:-1] if "[" in label else "1"
 
 __all__ = ["bode_figure", "nyquist_figure", "pole_map_figure"]
+
+
+def _fitted(label: str, fig, rows: int = 2, fontsize: float = 10.0) -> str:
+    """A y label broken into lines that fit beside one of ``rows`` axes stacked in ``fig`` (at a word gap;
+    a signal name is never broken, the unit in brackets starts a line of its own when the label is broken).
+
+    A y label longer than its axes' height runs past the figure's edge, where no layout brings it back
+    (#33: ``|clutch1.normal_force / actuator.motor_voltage| [dB re 1 N/V]`` was cut at the top)."""
+    import textwrap
+
+    # an axes' height in points, less the title and the x label, over a character's mean advance (~0.6 em)
+    chars = max(12, int((fig.get_figheight() * 72.0 / rows - 40.0) / (0.6 * fontsize)))
+    if len(label) <= chars:
+        return label
+    name, bracket, unit = label.partition(" [")
+    lines = textwrap.wrap(name, chars, break_long_words=False, break_on_hyphens=False)
+    return "\n".join(lines + ([bracket.strip() + unit] if bracket else []))
 
 
 def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = None):
@@ -42,7 +59,8 @@ def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = N
 
     f = np.asarray(frequencies_hz, dtype=float)
     over = None if over is None else signal_name(over)   # (a result column: clutch1.tau_Nm)
-    fig, (ax_m, ax_p) = new_figure(2, 1, width=7.5, height=6.0, sharex=True)
+    # constrained layout: the y labels, the legends beside the axes and the title all stay inside the figure (#33)
+    fig, (ax_m, ax_p) = new_figure(2, 1, width=7.5, height=6.0, sharex=True, layout="constrained")
     columns = getattr(models[0][1], "columns", {}) if models else {}
 
     def _name(signal):
@@ -65,7 +83,7 @@ def bode_figure(models, frequencies_hz, *, title: str = "", over: str | None = N
     first = pairs(models[0][1])
     if len(first) == 1:
         o, i = first[0]
-        ax_m.set_ylabel(f"|{_name(o)} / {_name(i)}| [dB re 1 {_unit(o)}/{_unit(i)}]")
+        ax_m.set_ylabel(_fitted(f"|{_name(o)} / {_name(i)}| [dB re 1 {_unit(o)}/{_unit(i)}]", fig))
     else:
         ax_m.set_ylabel("magnitude [dB]")
     ax_p.set_ylabel("phase [deg]")

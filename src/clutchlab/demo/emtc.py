@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+__all__ = ["demo_section", "bench_figure"]
+
 import numpy as np
 import pandas as pd
 

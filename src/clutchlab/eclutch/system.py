@@ -59,8 +59,9 @@ from .friction import FrictionElement, kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
 from .network import GROUND, Lever, element_force, element_force_segment, solve_static
 
-__all__ = ["EClutchParams", "Assembly", "rhs", "outputs", "update", "restart", "accept",
-           "next_break", "jacobian", "time_derivative", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
+# the compiled hooks (rhs, outputs, update, restart, accept, next_break, jacobian, time_derivative) and their
+# EClutchParams are the kernel's internals, registered with numerics.dispatch below: not API (#33)
+__all__ = ["Assembly", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
 
 # actuator parameter vector layout (EClutchParams.par)
 P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF = range(13)

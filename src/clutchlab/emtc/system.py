@@ -57,7 +57,8 @@ from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance,
 from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
 from .torque import UNLOCK_MARGIN, CouplingGeometry, _cam_force, _locked, _locked_capacity, _slipping
 
-__all__ = ["EmtcParams", "BenchOptions", "pack_parameters", "bench_system", "simulate", "STATES", "OUTPUTS",
+# EmtcParams, the parameters of the compiled hooks, is the kernel's internal: not API (#33)
+__all__ = ["BenchOptions", "pack_parameters", "bench_system", "simulate", "STATES", "OUTPUTS",
            "INPUTS", "SWITCHING", "EVENTS", "EVENT_DESCRIPTIONS", "MODE_NAMES", "MODE_VALUES", "ERROR_MESSAGES",
            "memory_full", "run", "run_controller", "controller_log", "VehicleData", "CouplingData", "ActuatorData",
            "armature_acceleration", "primary_clamp_force", "bench_loads", "lock_torque", "commanded_magnet_force"]

@@ -300,7 +300,7 @@ def _stem_of(column: str) -> str:
 
 
 def _words(column) -> str:
-    """A channel name in words, without its unit (``slip_speed_rad_s`` -> ``slip speed``)."""
+    """A channel name without its unit suffix, spelled as it is (``slip_speed_rad_s`` -> ``slip_speed``)."""
     return re.sub(r"\s*\[[^\]]*\]\s*$", "", column_label(column)) or str(column)
 
 
@@ -310,9 +310,9 @@ def display_label(column, shown: str) -> str:
 
 
 def _axis_label(unit: str, cols: list[str]) -> str:
-    """y label of an axes of channels ``cols``: their common name in words and the unit for people."""
+    """y label of an axes of channels ``cols``: their common name (underscores kept) and the unit for people."""
     if not unit:
-        return _stem_of(cols[0]).replace("_", " ")
+        return _stem_of(cols[0])
     if len(cols) == 1:
         return f"{_words(cols[0])} [{unit_label(unit)}]"
     return f"[{unit_label(unit)}]"

@@ -516,7 +516,7 @@ def summarize(results: pd.DataFrame, outputs, units: dict | None = None) -> pd.D
     outputs : list of str
         Columns to summarise.
     units : dict, optional
-        Unit per output, copied into the table.
+        Unit per output (pint spelling, ``"kg*m**2"``), written into the table as printed (``"kg·m²"``).
 
     Returns
     -------
@@ -530,7 +530,9 @@ def summarize(results: pd.DataFrame, outputs, units: dict | None = None) -> pd.D
     for name in outputs:
         v = results[name].to_numpy(dtype=float)
         f = v[np.isfinite(v)]
-        row = {"output": name, "unit": (units or {}).get(name, ""), "count": int(f.size), "n_nan": int(v.size - f.size)}
+        unit = (units or {}).get(name)
+        row = {"output": name, "unit": _printed(unit) if unit else "", "count": int(f.size),
+               "n_nan": int(v.size - f.size)}
         if f.size:
             q = np.quantile(f, QUANTILES)
             row.update(mean=float(f.mean()), std=float(f.std(ddof=1)) if f.size > 1 else float("nan"),
@@ -548,14 +550,22 @@ def _printed(unit) -> str:
     return "1" if unit in (None, "", "1") else unit_label(unit)
 
 
-def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict):
+#: at most this many swept parameters (columns) and outputs (rows) in ``summary.png``
+MAX_PLOT_PARAMETERS = MAX_PLOT_OUTPUTS = 6
+
+
+def _figure(results: pd.DataFrame, spec: SweepSpec, units: dict):
+    """The figure of ``summary.png``: each output against each swept parameter, in units as printed; the title
+    names every parameter and output left out."""
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    params = list(spec.parameters)[:6]
-    outs = list(spec.outputs)[:6]
+    params = list(spec.parameters)[:MAX_PLOT_PARAMETERS]
+    outs = list(spec.outputs)[:MAX_PLOT_OUTPUTS]
     fig, axes = plt.subplots(len(outs), len(params), figsize=(3.4 * len(params) + 0.6, 2.7 * len(outs) + 0.8),
                              squeeze=False, constrained_layout=True)
     alpha = float(np.clip(30.0 / max(len(results), 1) ** 0.5, 0.15, 0.9))
@@ -577,10 +587,22 @@ def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict):
                 ax.set_ylabel(f"{out} [{_printed(units.get(out))}]", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
-    cut = [f"the first {len(shown)} of {len(every)} {what}" for shown, every, what in
-           ((params, spec.parameters, "parameters"), (outs, spec.outputs, "outputs")) if len(shown) < len(every)]
-    fig.suptitle(f"sweep of {spec.model!r}: {spec.n_variants} variants ({spec.kind.replace('_', ' ')}; synthetic)"
-                 + (f"\n{' and '.join(cut)} shown (all are in results.parquet)" if cut else ""), fontsize=10)
+    # #33: "the first 6 of 8 parameters" named none of the two left out
+    cut = [f"{what} {', '.join(map(str, every[len(shown):]))}" for shown, every, what in
+           ((params, list(spec.parameters), "parameters"), (outs, list(spec.outputs), "outputs"))
+           if len(shown) < len(every)]
+    note = f"not shown: {'; '.join(cut)} (all are in results.parquet)" if cut else ""
+    width = max(60, int(fig.get_figwidth() * 72 / 6.0))   # characters of 10 pt across the figure
+    fig.suptitle("\n".join([f"sweep of {spec.model!r}: {spec.n_variants} variants "
+                            f"({spec.kind.replace('_', ' ')}; synthetic)"] + textwrap.wrap(note, width)), fontsize=10)
+    return fig
+
+
+def _plot(results: pd.DataFrame, spec: SweepSpec, units: dict) -> bytes:
+    """``summary.png`` (:func:`_figure`) as PNG bytes."""
+    import matplotlib.pyplot as plt
+
+    fig = _figure(results, spec, units)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)

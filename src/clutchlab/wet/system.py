@@ -82,8 +82,9 @@ from .thermal import heat_balance_scalar
 from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque_scalar
 from .viscosity import viscosity_scalar
 
+# WetParams, the parameters of the compiled hooks, is the kernel's internal: not API (#33)
 __all__ = [
-    "WetParams", "pack_parameters", "with_scenario", "fresh_buffers", "stacked_parameters", "new_work",
+    "pack_parameters", "with_scenario", "fresh_buffers", "stacked_parameters", "new_work",
     "engagement_system", "initial_state",
     "initial_modes", "absolute_tolerance", "peak_temperature", "lockup_time", "piston_speed", "drive_torque", "tanh",
     "CONSTANTS", "STATE_SCALES", "STATES", "OUTPUTS", "BENCH_OUTPUTS", "INPUTS", "SWITCHING", "EVENTS", "MODE_NAMES", "MODE_VALUES",

@@ -15,6 +15,8 @@ References
 
 from __future__ import annotations
 
+__all__ = ["generate", "main"]
+
 import argparse
 from pathlib import Path
 

@@ -4,6 +4,8 @@ Every file here was produced by clutchlab's virtual bench with a fixed seed;
 none of it is measured data.
 """
 
+__all__ = ["path"]
+
 from pathlib import Path
 
 DATA_DIR = Path(__file__).resolve().parent

@@ -9,6 +9,8 @@ keep the files small, the engagement record at 500 Hz.
 
 from __future__ import annotations
 
+__all__ = ["generate", "main"]
+
 import argparse
 import math
 
