@@ -4,7 +4,10 @@ Nothing a user wrote is overwritten unless ``overwrite=True`` is given (the
 CLI's ``--force``); every file is written to a hidden temporary sibling
 (``.NAME.PID.XXXXXXXX.tmp``) and moved into place, so a crash never leaves
 half a file behind, and the temporary file of a writer that was killed is
-removed by the next write of the same output.
+removed by the next write of the same output.  A folder assembled beside its
+output (a report, :func:`temporary_folder`) is ``.NAME.PID.XXXXXXXX.tmp`` with a
+marker file inside; the next write of that output removes it once process
+``PID`` is gone (only a folder so named that holds a marker, or nothing).
 """
 
 from __future__ import annotations
@@ -12,6 +15,8 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
+import shutil
 import tempfile
 import tomllib
 from pathlib import Path
@@ -24,7 +29,16 @@ from .._limits import check_allocation, format_bytes, short_repr
 from ..errors import DataError, ParameterError
 
 __all__ = ["OutputExistsError", "check_writable", "check_outputs", "atomic_write_text", "atomic_write_bytes",
-           "atomic_to_csv", "read_table", "read_toml", "read_json", "temporary_sibling", "remove_stale_temporaries"]
+           "atomic_to_csv", "read_table", "read_toml", "read_json", "temporary_sibling", "temporary_folder",
+           "remove_stale_temporaries"]
+
+#: the file that marks a hidden temporary folder as clutchlab's (:func:`temporary_folder`)
+TEMPORARY_MARKER = ".clutchlab-temporary"
+#: the file that marks a report folder as clutchlab's (:data:`clutchlab.report.html.MARKER`); a report is
+#: assembled in a temporary folder that holds it from the start
+REPORT_MARKER = ".clutchlab-report"
+#: a temporary folder of a writer that is gone is removed only if it holds one of these (or nothing)
+_FOLDER_MARKERS = (TEMPORARY_MARKER, REPORT_MARKER)
 
 #: a text document (TOML, JSON) larger than this many times the memory budget is refused unread
 _DOCUMENT_EXPANSION = 20
@@ -125,17 +139,35 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
+def _stale_folder(entry, prefix: str) -> bool:
+    """Whether the folder ``entry`` beside an output is a temporary folder of clutchlab's whose writer is gone:
+    named ``PREFIX + PID.XXXXXXXX.tmp`` (:func:`temporary_folder`), not a link, process ``PID`` not running, and
+    holding a marker file (:data:`_FOLDER_MARKERS`) or nothing.  A folder of the user's (no marker) never is."""
+    match = re.fullmatch(r"(\d+)\.[A-Za-z0-9_]{8}\.tmp", entry.name[len(prefix):])
+    if match is None or not entry.is_dir(follow_symlinks=False) or _pid_alive(int(match[1])):
+        return False
+    try:
+        names = os.listdir(entry.path)
+    except OSError:
+        return False
+    return not names or any(os.path.isfile(os.path.join(entry.path, m)) and
+                            not os.path.islink(os.path.join(entry.path, m)) for m in _FOLDER_MARKERS if m in names)
+
+
 def remove_stale_temporaries(path) -> list[Path]:
     """Remove hidden temporary siblings of ``path`` left by a writer that no longer runs.
 
     A writer's temporary file is ``.NAME.PID.XXXXXXXX.tmp`` (or ``.mf4``); it
     is stale if process ``PID`` is gone (killed before it could rename or
-    remove the file).  Temporary files of running writers are left alone.
+    remove the file).  A temporary folder (:func:`temporary_folder`,
+    ``.NAME.PID.XXXXXXXX.tmp``) is removed under the same condition, and only
+    if it holds a clutchlab marker file (or nothing).  Temporaries of running
+    writers are left alone.
 
     Returns
     -------
     list of Path
-        The files removed.
+        The files and folders removed.
     """
     path = Path(path)
     removed = []
@@ -146,7 +178,17 @@ def remove_stale_temporaries(path) -> list[Path]:
         return removed
     for entry in entries:
         name = entry.name
-        if not (name.startswith(prefix) and name.endswith((".tmp", ".mf4"))):
+        if not name.startswith(prefix):
+            continue
+        try:
+            if entry.is_dir(follow_symlinks=False):
+                if _stale_folder(entry, prefix):
+                    shutil.rmtree(entry.path)
+                    removed.append(Path(entry.path))
+                continue
+        except OSError:
+            continue
+        if not name.endswith((".tmp", ".mf4")):
             continue
         pid_text = name[len(prefix):].split(".", 1)[0]
         if pid_text.isdigit() and _pid_alive(int(pid_text)):
@@ -158,6 +200,29 @@ def remove_stale_temporaries(path) -> list[Path]:
         except OSError:
             pass
     return removed
+
+
+def temporary_folder(path, marker: str = TEMPORARY_MARKER, note: str = "") -> Path:
+    """Create a hidden temporary folder beside ``path`` (``.NAME.PID.XXXXXXXX.tmp``) holding the file ``marker``.
+
+    Stale temporaries of ``path`` are removed first (:func:`remove_stale_temporaries`: a later run removes
+    this folder too, if its process was killed before it could) and the parent folder is created if missing.
+    The folder gets the usual permissions (``mkdtemp`` creates 0700); ``note`` is the marker's text.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
+    folder = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent))
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(folder, 0o777 & ~umask)
+        (folder / marker).write_text(note or "a temporary folder of clutchlab's: removed once its process is gone\n",
+                                     encoding="utf-8")
+    except BaseException:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+    return folder
 
 
 def temporary_sibling(path: Path, suffix: str = ".tmp") -> tuple[int, str]:
