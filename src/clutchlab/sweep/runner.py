@@ -239,6 +239,8 @@ def _clean_temporaries(output: Path) -> list[Path]:
     for folder in (output, output / CHUNK_DIR):
         if folder.is_dir():
             for tmp in folder.glob(".*.tmp"):
+                if tmp.is_dir() and not tmp.is_symlink():
+                    continue   # (a temporary folder, e.g. of a report written in here: clutchlab.io.files's)
                 tmp.unlink(missing_ok=True)
                 removed.append(tmp)
     return removed
