@@ -450,6 +450,35 @@ def test_temporary_of_a_killed_writer_is_removed(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
 
 
+def test_outputs_of_a_run_are_replaced_together_or_not_at_all(tmp_path):
+    """:class:`OutputSet` (#33): an error while a run writes its outputs leaves every old one and no temporary
+    folder; so does an output that appeared during the run (not replaced without ``overwrite``); a normal run
+    replaces them all and leaves nothing else.  (Killed runs: tests/driveline/test_description.py.)"""
+    from clutchlab.io.files import OutputExistsError, OutputSet
+
+    a, b = tmp_path / "a.csv", tmp_path / "b.png"
+    a.write_text("old a")
+    b.write_text("old b")
+    outputs = OutputSet([a, b, None], overwrite=True)
+    with pytest.raises(RuntimeError, match="the figure failed"):
+        with outputs:
+            atomic_write_text(outputs.staged(a), "new a")
+            raise RuntimeError("the figure failed")
+    assert (a.read_text(), b.read_text()) == ("old a", "old b") and sorted(tmp_path.iterdir()) == [a, b]
+    c, d = tmp_path / "c.csv", tmp_path / "d.csv"
+    outputs = OutputSet([d, c])
+    c.write_text("the user's, written while the run ran")
+    with pytest.raises(OutputExistsError):
+        with outputs:
+            atomic_write_text(outputs.staged(d), "new d")
+            atomic_write_text(outputs.staged(c), "new c")
+    assert c.read_text().startswith("the user's") and sorted(tmp_path.iterdir()) == [a, b, c]
+    with OutputSet([a, b], overwrite=True) as outputs:
+        atomic_write_text(outputs.staged(a), "new a")
+        atomic_write_text(outputs.staged(b), "new b")
+    assert (a.read_text(), b.read_text()) == ("new a", "new b") and sorted(tmp_path.iterdir()) == [a, b, c]
+
+
 def test_sweep_refused_leaves_no_lock(work, capsys):
     (work / "results").mkdir()
     (work / "results" / "notes.txt").write_text("mine")

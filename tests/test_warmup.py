@@ -70,3 +70,72 @@ def test_failing_group_is_reported(monkeypatch):
     monkeypatch.setattr(warmup, "start", failing_start)
     with pytest.raises(Exception, match=r"compiling kernel group\(s\) \[\['wet'\]\] failed"):
         warmup.run_parallel(["wet"], jobs=1)
+
+
+def _stat(pid):
+    """(state, start time) of a process from Linux's /proc, or None if it is gone."""
+    import pathlib
+
+    try:
+        text = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+    fields = text[text.rindex(")") + 2:].split()
+    return fields[0], int(fields[19])
+
+
+@pytest.mark.skipif(not __import__("pathlib").Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_compile_processes_end_when_their_parent_is_killed(tmp_path):
+    """#33: ``clutchlab demo`` stopped its background compile processes only in a ``finally``, which SIGKILL
+    skips: a killed demo's processes compiled on.  A parent starts them as the demo does (:func:`warmup.start`,
+    one per group) and is killed with SIGKILL while they work; they end within seconds.  Their work is a stub
+    that compiles nothing: a ``numba`` earlier on the path that says it started and sleeps."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    import clutchlab
+
+    stub, started = tmp_path / "stub" / "numba", tmp_path / "started"
+    stub.mkdir(parents=True)
+    started.mkdir()
+    (stub / "__init__.py").write_text("import os, pathlib, time\n"
+                                      "pathlib.Path(os.environ['STUB_STARTED'], str(os.getpid())).touch()\n"
+                                      "time.sleep(600)\n")
+    script = ("import time\nfrom clutchlab import warmup\n"
+              "procs = [warmup.start([group]) for group in ('wet', 'emtc')]\n"
+              "print(*(p.pid for p in procs), flush=True)\ntime.sleep(600)\n")
+    src = Path(clutchlab.__file__).resolve().parents[1]
+    env = dict(os.environ, STUB_STARTED=str(started), PYTHONPATH=os.pathsep.join([str(stub.parent), str(src)]))
+    parent = subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE, text=True)
+    children = {}
+    try:
+        children = {pid: _stat(pid) for pid in map(int, parent.stdout.readline().split())}
+        assert len(children) == 2 and all(children.values())
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and len(list(started.iterdir())) < 2:
+            time.sleep(0.05)
+        assert {int(p.name) for p in started.iterdir()} == set(children)   # both at work (in the stub)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait(timeout=30)
+
+        def alive(pid):
+            st = _stat(pid)
+            return st is not None and st[1] == children[pid][1] and st[0] != "Z"   # (not a reused pid, no zombie)
+
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and any(map(alive, children)):
+            time.sleep(0.05)
+        assert not [pid for pid in children if alive(pid)], "compile processes of the killed parent still run"
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+            parent.wait()
+        for pid, st in children.items():   # never leave a 10-minute sleeper behind, even if the test failed
+            now = _stat(pid)
+            if st and now and now[1] == st[1] and now[0] != "Z":
+                os.kill(pid, signal.SIGKILL)
+        parent.stdout.close()

@@ -11,7 +11,8 @@ atomically), so the process that runs the model later loads them.
 
 ``clutchlab warmup`` compiles every group (``--jobs`` processes); ``clutchlab
 demo`` compiles the groups of its later sections in a background process while
-its first section runs (:func:`start`).  Each group exercises the same compiled
+its first section runs (:func:`start`; they end with the process that started them, even one killed with
+SIGKILL).  Each group exercises the same compiled
 functions as its model's demo section, on tiny problems.
 """
 
@@ -121,10 +122,12 @@ def start(groups, full: bool = False) -> subprocess.Popen:
 
     ``full`` as in :func:`warm`.  Its output is discarded: a failure only means that the process that uses the
     kernels compiles them itself.  Call ``.wait()`` before running those groups, so that they are not compiled
-    twice.
+    twice.  The process ends when this one does, even when this one is killed with SIGKILL
+    (:func:`clutchlab._process.die_with_parent`; #33: a killed demo's compile processes ran on).
     """
     env = dict(os.environ, CLUTCHLAB_COMPILE_NOTICE="0", MPLBACKEND="Agg")
-    return subprocess.Popen([sys.executable, "-m", "clutchlab.warmup", *(["--full"] if full else []), *groups],
+    return subprocess.Popen([sys.executable, "-m", "clutchlab.warmup", f"--parent={os.getpid()}",
+                             *(["--full"] if full else []), *groups],
                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
 
 
@@ -150,10 +153,21 @@ def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
 
 
 def main(argv=None) -> int:
-    """``python -m clutchlab.warmup [--full] [group ...]``: :func:`warm` in this process."""
+    """``python -m clutchlab.warmup [--parent=PID] [--full] [group ...]``: :func:`warm` in this process.
+
+    ``--parent=PID`` (:func:`start` gives its own): end when process PID does, before anything is imported
+    or compiled."""
     names = sys.argv[1:] if argv is None else list(argv)
+    parents = [n for n in names if n.startswith("--parent=")]
+    for option in parents:
+        from ._process import die_with_parent
+
+        value = option.partition("=")[2]
+        if not value.isdigit():
+            raise ParameterError(f"{option}: expected --parent=PID")
+        die_with_parent(int(value), name="clutchlab-warmup-parent-watchdog")
     full = "--full" in names
-    names = [n for n in names if n != "--full"]
+    names = [n for n in names if n != "--full" and n not in parents]
     warm(names or None, full=full)
     return 0
 

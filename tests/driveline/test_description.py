@@ -64,6 +64,56 @@ def test_simulate_writes_states_outputs_and_events(tmp_path, capsys):
     assert len(pd.read_csv(out)) == 21
 
 
+@pytest.mark.parametrize("killed", ["while writing", "while moving into place"])
+def test_simulate_killed_between_its_writes_leaves_one_run(tmp_path, capsys, killed):
+    """#33: ``driveline simulate`` wrote its CSV, events and figure one after the other; a run killed between
+    two writes left the new CSV beside the old run's events and figure.  Now they replace the old ones together
+    (:class:`clutchlab.io.files.OutputSet`): a run killed (``os._exit``, no ``finally``) after writing its first
+    file leaves every old output; one killed while moving them into place leaves its journal, and the next run
+    finishes the moves first (every output the killed run's).  No run leaves a temporary file behind."""
+    import os
+    import subprocess
+    import sys
+
+    import clutchlab
+
+    out, ev, fig = tmp_path / "tf.csv", tmp_path / "ev.csv", tmp_path / "tf.png"
+    argv = ["driveline", "simulate", str(EXAMPLES / "driveline_test_friction.toml"), "-o", str(out),
+            "--events", str(ev), "--plot", str(fig)]
+    assert main(argv + ["--t-end", "0.2 s"]) == 0
+    old = {p: p.read_bytes() for p in (out, ev, fig)}
+    assert sorted(tmp_path.iterdir()) == sorted(old)
+    if killed == "while writing":   # killed as the second file is to be written
+        die = ("real, calls = files.atomic_write_bytes, []\n"
+               "def write(*args, **kwargs):\n"
+               "    if calls:\n"
+               "        os._exit(9)\n"
+               "    calls.append(args[0])\n"
+               "    return real(*args, **kwargs)\n"
+               "files.atomic_write_bytes = write\n")
+    else:                           # killed as the events file is to be moved into place
+        die = ("real = os.replace\n"
+               f"os.replace = lambda a, b: os._exit(9) if os.path.abspath(b) == {str(ev)!r} else real(a, b)\n")
+    script = "import os, sys\nimport clutchlab.io.files as files\n" + die + \
+        "from clutchlab.cli import main\nmain(sys.argv[1:])\n"
+    env = dict(os.environ, PYTHONPATH=str(Path(clutchlab.__file__).resolve().parents[1]), MPLBACKEND="Agg")
+    # the new run goes to 0.6 s: the clutch sticks at 0.53 s, an event the old run's file does not have
+    run = subprocess.run([sys.executable, "-c", script, *argv, "--t-end", "0.6 s", "--force"], env=env,
+                         timeout=600, capture_output=True, text=True)
+    assert run.returncode == 9, run.stderr
+    if killed == "while writing":
+        assert {p: p.read_bytes() for p in old} == old                   # every output the old run's
+        assert main(argv + ["--t-end", "0.6 s", "--force"]) == 0           # the next run
+    else:
+        assert main(argv) == 2   # the next run finishes the killed run's moves, then refuses to overwrite them
+        assert "use --force" in capsys.readouterr().err
+    frame, events = pd.read_csv(out), pd.read_csv(ev)
+    assert frame.time_s.iloc[-1] == pytest.approx(0.6)
+    assert ("clutch", "stick") in set(zip(events.component, events.event))
+    assert fig.read_bytes() != old[fig]
+    assert sorted(tmp_path.iterdir()) == sorted(old)                       # no temporary file left
+
+
 def test_simulate_fixed_step_follows_the_adaptive_run(tmp_path, capsys):
     """``--fixed-step "1 ms"``: the core's fixed-step mode (1100 frames of 1 ms), said in the file's comment line.
 

@@ -99,3 +99,50 @@ def test_force_replaces_only_a_folder_clutchlab_wrote(tmp_path, monkeypatch, cap
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("clutchlab: error: ") and "not replaced" in err[0], err
     assert (mine / "notes.txt").read_text() == "keep me" and (run / "r.csv").exists()
+
+
+@pytest.mark.parametrize("killed_at", ["rendering", "moving into place"])
+def test_a_killed_run_leaves_nothing_the_next_run_does_not_remove(tmp_path, killed_at):
+    """#33: a killed ``clutchlab demo`` left its hidden ``.NAME.*`` folders (2.9 MB each) beside the report, and
+    no later run removed them.  A run killed (SIGKILL has no ``finally``) while it renders a figure, or between
+    moving the old report aside and the new one in, leaves folders; the next report written there removes
+    them -- its own kind only: named ``.NAME.PID.XXXXXXXX.tmp``, holding the marker, process PID gone.  A
+    look-alike folder of the user's (no marker) and one of a writer still running stay."""
+    import os
+    import subprocess
+    import sys
+    import textwrap
+    from pathlib import Path
+
+    import clutchlab
+    from clutchlab.report.html import MARKER
+
+    out = tmp_path / "rep"
+    if killed_at == "moving into place":
+        write_report([section()], out)
+    die = ("h._figure_png = lambda fig: os._exit(9)" if killed_at == "rendering" else
+           "real = os.replace\nh.os.replace = lambda a, b: os._exit(9) if os.path.basename(b) != 'rep' else real(a, b)")
+    script = textwrap.dedent(f"""
+        import os
+        import clutchlab.report.html as h
+        from clutchlab.plotting import new_figure
+        from clutchlab.report import Figure, Section
+        """) + die + textwrap.dedent(f"""
+        fig, ax = new_figure()
+        ax.plot([0, 1], [0, 1])
+        h.write_report([Section("A", [Figure("f", fig)])], {str(out)!r}, overwrite=True)
+        """)
+    env = dict(os.environ, PYTHONPATH=str(Path(clutchlab.__file__).resolve().parents[1]), MPLBACKEND="Agg")
+    assert subprocess.run([sys.executable, "-c", script], env=env, timeout=300).returncode == 9
+    left = [p for p in tmp_path.iterdir() if p.name.startswith(".rep.")]
+    assert left and all(p.is_dir() for p in left)          # what the killed run left: its folder(s)
+    mine = tmp_path / ".rep.4194305.abcdefgh.tmp"           # the pattern, a pid above any Linux pid_max, no marker
+    (mine / "figures").mkdir(parents=True)
+    (mine / "notes.txt").write_text("keep me")
+    running = tmp_path / f".rep.{os.getpid()}.abcdefgh.tmp"  # a writer still running (this process)
+    running.mkdir()
+    (running / MARKER).write_text("")
+    write_report([section()], out, overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["rep", mine.name, running.name])
+    assert (mine / "notes.txt").read_text() == "keep me" and (mine / "figures").is_dir()
+    assert (out / "index.html").exists() and (out / "figures" / "line.png").exists()

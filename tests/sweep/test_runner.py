@@ -269,3 +269,19 @@ def test_any_set_of_missing_chunks_is_redone_exactly(tmp_path_factory, small_run
     assert_complete(out, 10)
     assert not list((out / CHUNK_DIR).glob(".*.tmp"))
     pd.testing.assert_frame_equal(res.results, full, check_exact=True)
+
+
+def test_a_temporary_folder_in_the_results_folder_is_not_a_partial_file(tmp_path):
+    """A report written into a sweep's folder assembles itself in a hidden ``.NAME.PID.XXXXXXXX.tmp`` folder
+    (clutchlab.io.files.temporary_folder, #33); the sweep's clean-up of its own partial ``.*.tmp`` files on
+    start removes those files and leaves such a folder to its owner (``unlink`` on it raised IsADirectoryError,
+    and the sweep could not resume)."""
+    from clutchlab.sweep.runner import _clean_temporaries
+
+    (tmp_path / CHUNK_DIR).mkdir()
+    partial = tmp_path / CHUNK_DIR / ".chunk-00001.parquet.x1y2.tmp"
+    partial.write_bytes(b"PAR1 half a file")
+    folder = tmp_path / ".report.4194305.abcdefgh.tmp"
+    (folder / "figures").mkdir(parents=True)
+    assert _clean_temporaries(tmp_path) == [partial]
+    assert not partial.exists() and (folder / "figures").is_dir()

@@ -69,11 +69,14 @@ def _optional_module(name: str):
 
 
 def _demo(args) -> int:
-    from ..io.files import check_writable
+    from pathlib import Path
+
+    from ..io.files import check_writable, remove_stale_temporaries
     from ..report import check_report_folder, write_report
 
     check_writable(args.output, args.force, what="folder")  # before minutes of simulation
     check_report_folder(args.output, args.force)             # (only a folder clutchlab wrote is replaced)
+    remove_stale_temporaries(Path(args.output).resolve())    # what a killed demo left beside it
 
     sections = []
     t0 = time.perf_counter()

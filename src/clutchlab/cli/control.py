@@ -246,11 +246,11 @@ def _linearize(args) -> int:
 def _bode(args) -> int:
     import numpy as np
 
-    from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_bytes
     from ..units import to_si
     from ..control.linear import frequency_table, linearize, pole_sweep
 
-    check_outputs([args.output, args.table, args.poles], args.force)
+    outputs = OutputSet([args.output, args.table, args.poles], args.force)   # checked first; written together
     fmin, fmax = to_si(args.fmin, "Hz", name="--fmin"), to_si(args.fmax, "Hz", name="--fmax")
     if not 0 < fmin < fmax:
         raise ParameterError(f"--fmin {args.fmin!r} and --fmax {args.fmax!r}: need 0 < fmin < fmax")
@@ -282,14 +282,15 @@ def _bode(args) -> int:
     import matplotlib.pyplot as plt
 
     plt.close(fig)
-    atomic_write_bytes(args.output, buf.getvalue(), overwrite=args.force)
-    if args.table:
-        atomic_to_csv(pd.concat(tables, ignore_index=True), args.table, overwrite=args.force)
-    if args.poles:
-        name = "bearing_position_m" if args.model == "eclutch" and args.at else "operating_point_1"
-        poles = pole_sweep([(value, op) for _, value, op, _ in models], inputs=args.inputs, outputs=args.outputs,
-                           directions=branches, name=name)
-        atomic_to_csv(poles, args.poles, overwrite=args.force)
+    with outputs:
+        atomic_write_bytes(outputs.staged(args.output), buf.getvalue(), overwrite=args.force)
+        if args.table:
+            atomic_to_csv(pd.concat(tables, ignore_index=True), outputs.staged(args.table), overwrite=args.force)
+        if args.poles:
+            name = "bearing_position_m" if args.model == "eclutch" and args.at else "operating_point_1"
+            poles = pole_sweep([(value, op) for _, value, op, _ in models], inputs=args.inputs,
+                               outputs=args.outputs, directions=branches, name=name)
+            atomic_to_csv(poles, outputs.staged(args.poles), overwrite=args.force)
     print(args.output)
     return 0
 
@@ -313,14 +314,14 @@ def _design(args) -> int:
 
     import numpy as np
 
-    from ..io.files import atomic_to_csv, atomic_write_text, check_outputs
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_text
     from ..units import to_si
     from ..control.design import pi_for_phase_margin
     from ..control.linear import linearize
     from ..control.loop import closed_loop
     from ..trim import resolve
 
-    check_outputs([args.output, args.run], args.force)
+    outputs = OutputSet([args.output, args.run], args.force)   # checked first; the two written together
     if len(args.inputs) != 1 or len(args.outputs) != 1:
         raise ParameterError(f"a PI drives one input from one output: got -u {args.inputs} and -y {args.outputs}")
     crossover = to_si(args.crossover, "Hz", name="--crossover")
@@ -357,20 +358,24 @@ def _design(args) -> int:
            "achieved": {"phase_margin_deg": float(pm), "crossover_Hz": float(wp) / (2 * np.pi),
                         "gain_margin": None if not np.isfinite(gm) else float(gm)},
            "closed_loop_poles": [[float(p.real), float(p.imag)] for p in poles]}
-    atomic_write_text(args.output, json.dumps(doc, indent=1), overwrite=args.force)
+    frame = None
+    if args.run is not None:
+        step = to_si(args.step, _unit_of(y), name="--step")
+        target = doc["operating_output"] + step
+        result = closed_loop(op, pi.discrete(sample_time), sample_time, t_end, measure=[y.name], actuate=[u.name],
+                             reference=target)
+        frame = result.frame
+    with outputs:   # the PI file and its closed-loop run replace the old ones together
+        atomic_write_text(outputs.staged(args.output), json.dumps(doc, indent=1), overwrite=args.force)
+        if frame is not None:
+            atomic_to_csv(frame, outputs.staged(args.run), overwrite=args.force,
+                          header_comment=f"closed loop of {system.name} at {label} with the PI of {args.output} "
+                                         f"(Kp = {pi.kp:.6g}, Ti = {pi.ti:.6g} s, Tustin at {sample_time:g} s), "
+                                         f"reference step {args.step} at t = 0; written by clutchlab control design")
     print(f"{system.name} at {label}: Kp = {pi.kp:.6g} {doc['kp_unit']}, Ti = {pi.ti:.6g} s for {margin:g} deg at "
           f"{crossover:g} Hz (achieved {pm:.2f} deg at {wp / (2 * np.pi):.4g} Hz) -> {args.output}")
-    if args.run is None:
+    if frame is None:
         return 0
-    step = to_si(args.step, _unit_of(y), name="--step")
-    target = doc["operating_output"] + step
-    result = closed_loop(op, pi.discrete(sample_time), sample_time, t_end, measure=[y.name], actuate=[u.name],
-                         reference=target)
-    frame = result.frame
-    atomic_to_csv(frame, args.run, overwrite=args.force,
-                  header_comment=f"closed loop of {system.name} at {label} with the PI of {args.output} "
-                                 f"(Kp = {pi.kp:.6g}, Ti = {pi.ti:.6g} s, Tustin at {sample_time:g} s), reference "
-                                 f"step {args.step} at t = 0; written by clutchlab control design")
     out = frame[y.column].to_numpy()
     rise = target - doc["operating_output"]
     over = (np.max((out - target) * np.sign(rise)) / abs(rise) * 100.0) if rise else 0.0

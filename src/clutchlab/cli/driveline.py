@@ -68,11 +68,11 @@ def register(subparsers) -> None:
 
 def _simulate(args) -> int:
     from .common import run_note, run_options
-    from ..io.files import atomic_to_csv, atomic_write_bytes, check_outputs
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_bytes
     from ..units import to_si
     from ..driveline.description import load_driveline
 
-    check_outputs([args.output, args.events, args.plot], args.force)
+    outputs = OutputSet([args.output, args.events, args.plot], args.force)   # checked before the run
     options = run_options(args)
     fixed_step = options["fixed_step"]
     spec = load_driveline(args.file)
@@ -90,21 +90,22 @@ def _simulate(args) -> int:
                                   inputs=inputs)
     frame = res.to_dataframe()
     events = res.events.rename(columns={"element": "component"})[["time_s", "component", "event"]]
-    # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
-    atomic_to_csv(frame, args.output, overwrite=args.force,
-                  header_comment=run_note(options))
-    if args.events:
-        atomic_to_csv(events, args.events, overwrite=args.force)
-    if args.plot:
-        from ..driveline.plots import driveline_figure
+    with outputs:   # the CSV, the events and the figure replace the old ones together, or none does
+        # a fixed-step run says so in a comment line (an adaptive run's file has none: plain CSV, as before)
+        atomic_to_csv(frame, outputs.staged(args.output), overwrite=args.force,
+                      header_comment=run_note(options))
+        if args.events:
+            atomic_to_csv(events, outputs.staged(args.events), overwrite=args.force)
+        if args.plot:
+            from ..driveline.plots import driveline_figure
 
-        fig = driveline_figure(frame, events, title=f"{spec.driveline.name}: {args.file}")
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=130, bbox_inches="tight")
-        import matplotlib.pyplot as plt
+            fig = driveline_figure(frame, events, title=f"{spec.driveline.name}: {args.file}")
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=130, bbox_inches="tight")
+            import matplotlib.pyplot as plt
 
-        plt.close(fig)
-        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+            plt.close(fig)
+            atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
     err = float(frame["energy_error_J"].abs().max())
     mode = "" if fixed_step is None else f" in fixed steps of {fixed_step:g} s"
     print(f"{args.output}: {len(frame)} samples to {t_end:g} s{mode}; {len(events)} events; "

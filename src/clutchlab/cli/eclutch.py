@@ -13,7 +13,7 @@ from .._limits import check_allocation
 from .common import add_run_options
 from ..errors import DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, check_writable
-from ..io.files import check_outputs
+from ..io.files import OutputSet, check_outputs
 from .io import add_csv_options, csv_options
 from ..units import to_si
 
@@ -49,7 +49,7 @@ def _characterize(args) -> int:
     from ..plotting import mark_synthetic, press_characterization
     from ..eclutch.characterize import characterize
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the work; written together
     # one read: the channel map (if any) renames the logger's channels, units in the file become SI
     try:
         meas = read_measurement(args.record, args.channel_map, required=["force_N", args.channel], time=None,
@@ -67,11 +67,13 @@ def _characterize(args) -> int:
     comment = f"characterised from {args.record}{mapped} by clutchlab eclutch characterize"
     if meas.source.synthetic:  # the record's own "synthetic: ..." lines travel with the curve
         comment = "\n".join([c for c in meas.source.comments if c.lower().startswith("synthetic")] + [comment])
-    atomic_to_csv(curve.to_frame(), args.output, overwrite=args.force, header_comment=comment)
-    if args.plot:
-        fig = press_characterization([dict(title=str(args.record), record=meas.frame, curve=curve,
-                                           channel=args.channel)], ncols=1)
-        _save_figure(mark_synthetic(fig) if meas.source.synthetic else fig, args.plot, args.force)
+    with outputs:
+        atomic_to_csv(curve.to_frame(), outputs.staged(args.output), overwrite=args.force, header_comment=comment)
+        if args.plot:
+            fig = press_characterization([dict(title=str(args.record), record=meas.frame, curve=curve,
+                                               channel=args.channel)], ncols=1)
+            _save_figure(mark_synthetic(fig) if meas.source.synthetic else fig, outputs.staged(args.plot),
+                         args.force)
     print(f"{args.output}: {curve.deflection.size} samples, {curve.n_cycles} cycles, "
           f"hysteresis half-width {np.median(curve.hysteresis_half_width):.3g} N, "
           f"cycle scatter <= {np.max(curve.cycle_scatter):.3g} N")
@@ -81,7 +83,7 @@ def _characterize(args) -> int:
 def _static(args) -> int:
     from ..plotting import static_curves_panels
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the work; written together
     travel = to_si(args.travel, "m", name="--travel")
     if not travel > 0:
         raise ParameterError(f"--travel = {args.travel!r}: must be > 0")
@@ -93,14 +95,15 @@ def _static(args) -> int:
     df = model.static_curve(np.linspace(0.0, travel, args.points), extrapolate=args.extrapolate)
     note = ("\n--extrapolate: characteristics may be continued linearly beyond their measured range (an assumption, "
             "not a measurement)") if args.extrapolate else ""
-    atomic_to_csv(df, args.output, overwrite=args.force,
-                  header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static{note}")
-    if args.plot:
-        from ..eclutch.validation import read_full_clutch_record
+    with outputs:
+        atomic_to_csv(df, outputs.staged(args.output), overwrite=args.force,
+                      header_comment=f"static curves of {model.name} (friction off), clutchlab eclutch static{note}")
+        if args.plot:
+            from ..eclutch.validation import read_full_clutch_record
 
-        record = read_full_clutch_record(args.record) if args.record else None
-        fig = static_curves_panels({model.name: df}, record, title=f"{model.name}: static curves (friction off)")
-        _save_figure(fig, args.plot, args.force)
+            record = read_full_clutch_record(args.record) if args.record else None
+            fig = static_curves_panels({model.name: df}, record, title=f"{model.name}: static curves (friction off)")
+            _save_figure(fig, outputs.staged(args.plot), args.force)
     peak = df["bearing_force_N"].max()
     print(f"{args.output}: {model.name}, {len(df)} points, peak bearing force {peak:.1f} N, "
           f"engaged torque {df['torque_Nm'].iloc[0]:.1f} N*m")
@@ -143,7 +146,7 @@ def _simulate(args) -> int:
     from ..plotting import eclutch_response, hysteresis_loop, mark_synthetic
     from ..eclutch.scenario import load_scenario, run_scenario
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the run; written together
     options = run_options(args)
     fixed_step = options["fixed_step"]
     scenario = load_scenario(args.scenario)
@@ -154,16 +157,17 @@ def _simulate(args) -> int:
     note = run_note(options)
     if note is not None:
         comment += "\n" + note
-    write_measurement(frame, args.output, comment=comment, overwrite=args.force)
-    if args.plot:
-        if scenario.input_kind == "bearing_position":
-            static = scenario.clutch_model().static_curve(
-                np.linspace(frame.bearing_position_m.min(), frame.bearing_position_m.max(), 200))
-            fig = hysteresis_loop({f"Model {scenario.model}": frame}, static,
-                                  title=f"Model {scenario.model}: bearing force over the prescribed cycle")
-        else:
-            fig = eclutch_response(res.outputs, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
-        _save_figure(mark_synthetic(fig), args.plot, args.force)
+    with outputs:
+        write_measurement(frame, outputs.staged(args.output), comment=comment, overwrite=args.force)
+        if args.plot:
+            if scenario.input_kind == "bearing_position":
+                static = scenario.clutch_model().static_curve(
+                    np.linspace(frame.bearing_position_m.min(), frame.bearing_position_m.max(), 200))
+                fig = hysteresis_loop({f"Model {scenario.model}": frame}, static,
+                                      title=f"Model {scenario.model}: bearing force over the prescribed cycle")
+            else:
+                fig = eclutch_response(res.outputs, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
+            _save_figure(mark_synthetic(fig), outputs.staged(args.plot), args.force)
     st = res.stats
     steps = (f"({st['rejected_steps']} rejected)" if fixed_step is None else
              f"(fixed steps of {fixed_step:g} s)")

@@ -12,7 +12,7 @@ from .._limits import short_repr
 from .common import add_run_options, run_note, run_options
 from ..errors import DataError
 from ..io import atomic_to_csv, check_writable, read_measurement, read_table
-from ..io.files import check_outputs
+from ..io.files import OutputSet, check_outputs
 
 
 def _identify(args) -> int:
@@ -72,7 +72,7 @@ def _simulate(args) -> int:
     from ..emtc.bench import load_scenario, simulate_bench
     from ..emtc.magnet import bundled_magnet
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the run; written together
     options = run_options(args)
     sc = load_scenario(args.scenario)
     magnet = Preisach.from_json(sc["magnet"]) if sc["magnet"] is not None else bundled_magnet()
@@ -88,26 +88,27 @@ def _simulate(args) -> int:
     note = run_note(options)
     if note is not None:
         comment += "\n" + note
-    write_measurement(frame, args.output, comment=comment, overwrite=args.force)
-    if len(res.events):
-        print(res.events[["time_s", "event", "description", "coupling_mode"]].to_string(index=False))
-    if args.plot:
-        from ..io import atomic_write_bytes
-        from ..plotting import mark_synthetic
-        from ..report.html import DPI
-        from ..demo.emtc import bench_figure
-        import io
+    with outputs:
+        write_measurement(frame, outputs.staged(args.output), comment=comment, overwrite=args.force)
+        if len(res.events):
+            print(res.events[["time_s", "event", "description", "coupling_mode"]].to_string(index=False))
+        if args.plot:
+            from ..io import atomic_write_bytes
+            from ..plotting import mark_synthetic
+            from ..report.html import DPI
+            from ..demo.emtc import bench_figure
+            import io
 
-        import matplotlib.pyplot as plt
+            import matplotlib.pyplot as plt
 
-        fig = mark_synthetic(bench_figure(res, "EMTC drum-bench simulation"))
-        buf = io.BytesIO()
-        try:
-            fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
-        finally:
-            plt.close(fig)  # a CLI run (or many in one process) must not leave figures open
-        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
-        print(args.plot)
+            fig = mark_synthetic(bench_figure(res, "EMTC drum-bench simulation"))
+            buf = io.BytesIO()
+            try:
+                fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+            finally:
+                plt.close(fig)  # a CLI run (or many in one process) must not leave figures open
+            atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
+            print(args.plot)
     print(args.output)
     return 0
 

@@ -63,30 +63,31 @@ def register(subparsers) -> None:
 
 def _simulate(args) -> int:
     from .common import run_note, run_options
-    from ..io.files import check_outputs
+    from ..io.files import OutputSet
     from ..wet.bench import load_protocol, run_protocol, write_bench_record
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the run; written together
     options = run_options(args)
     protocol, ptype, clutch, bench, friction = load_protocol(args.protocol)
     run = run_protocol(protocol, clutch, bench, friction, protocol_type=ptype,
                        **{k: v for k, v in options.items() if v is not None})
     note = run_note(options)
     header = None if note is None else run.header() + "\n" + note
-    write_bench_record(run, args.output, overwrite=args.force, header=header)
-    if args.plot:
-        from ..io import atomic_write_bytes
-        from ..plotting import mark_synthetic
-        from ..wet.plots import map_traces_figure
+    with outputs:
+        write_bench_record(run, outputs.staged(args.output), overwrite=args.force, header=header)
+        if args.plot:
+            from ..io import atomic_write_bytes
+            from ..plotting import mark_synthetic
+            from ..wet.plots import map_traces_figure
 
-        fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
-        mark_synthetic(fig)  # the virtual bench's data are synthetic: the stamp travels with the image
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")
-        import matplotlib.pyplot as plt
+            fig = map_traces_figure(run.record, title=f"virtual bench, protocol {ptype}: {args.protocol} (synthetic)")
+            mark_synthetic(fig)  # the virtual bench's data are synthetic: the stamp travels with the image
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=150, bbox_inches="tight")
+            import matplotlib.pyplot as plt
 
-        plt.close(fig)
-        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+            plt.close(fig)
+            atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
     events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
     frames = "" if options["fixed_step"] is None else f" in fixed steps of {options['fixed_step']:g} s"
     print(f"{args.output}: {len(run.record)} samples of protocol {ptype}{frames}; events: {events}")
@@ -96,11 +97,11 @@ def _simulate(args) -> int:
 def _identify(args) -> int:
     from ..errors import IdentificationError
     from ..io import atomic_write_bytes, atomic_write_text
-    from ..io.files import check_outputs
+    from ..io.files import OutputSet
     from ..wet.identify import friction_samples, identify_friction_map, identify_thermal
     from ..wet.params import WetClutch
 
-    check_outputs([args.output, args.plot], args.force)
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the work; written together
     if not args.sensor_lag >= 0 or args.sensor_lag == float("inf"):  # NaN fails the first test
         raise ParameterError(f"--sensor-lag = {args.sensor_lag!r}: must be finite and >= 0 [s]")
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
@@ -114,18 +115,19 @@ def _identify(args) -> int:
     except IdentificationError as exc:
         data["thermal"] = {"error": str(exc)}
         thermal_line = f"thermal identification skipped: {exc}"
-    atomic_write_text(args.output, json.dumps(data, indent=1), overwrite=args.force)
-    if args.plot:
-        from ..wet.plots import friction_map_figure
+    with outputs:
+        atomic_write_text(outputs.staged(args.output), json.dumps(data, indent=1), overwrite=args.force)
+        if args.plot:
+            from ..wet.plots import friction_map_figure
 
-        fig = friction_map_figure(fmap, samples=friction_samples(args.records, clutch,
-                                                                 sensor_time_constant=args.sensor_lag))
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-        import matplotlib.pyplot as plt
+            fig = friction_map_figure(fmap, samples=friction_samples(args.records, clutch,
+                                                                     sensor_time_constant=args.sensor_lag))
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+            import matplotlib.pyplot as plt
 
-        plt.close(fig)
-        atomic_write_bytes(args.plot, buf.getvalue(), overwrite=args.force)
+            plt.close(fig)
+            atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
     law = fmap.law
     print(f"{args.output}: mu_f = {law.mu0:.4g} + {law.mu_t:.3g} (T - {law.t_ref:g}) + {law.mu_e:.3g} exp(-v/{law.v_s:.3g}); "
           f"rmse {fmap.statistics['rmse']:.2g}, {fmap.statistics['cells_covered']} covered cells; {thermal_line}")

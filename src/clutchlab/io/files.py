@@ -4,7 +4,10 @@ Nothing a user wrote is overwritten unless ``overwrite=True`` is given (the
 CLI's ``--force``); every file is written to a hidden temporary sibling
 (``.NAME.PID.XXXXXXXX.tmp``) and moved into place, so a crash never leaves
 half a file behind, and the temporary file of a writer that was killed is
-removed by the next write of the same output.
+removed by the next write of the same output.  A folder assembled beside its
+output (a report, :func:`temporary_folder`) is ``.NAME.PID.XXXXXXXX.tmp`` with a
+marker file inside; the next write of that output removes it once process
+``PID`` is gone (only a folder so named that holds a marker, or nothing).
 """
 
 from __future__ import annotations
@@ -12,6 +15,8 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
+import shutil
 import tempfile
 import tomllib
 from pathlib import Path
@@ -24,7 +29,18 @@ from .._limits import check_allocation, format_bytes, short_repr
 from ..errors import DataError, ParameterError
 
 __all__ = ["OutputExistsError", "check_writable", "check_outputs", "atomic_write_text", "atomic_write_bytes",
-           "atomic_to_csv", "read_table", "read_toml", "read_json", "temporary_sibling", "remove_stale_temporaries"]
+           "atomic_to_csv", "read_table", "read_toml", "read_json", "temporary_sibling", "temporary_folder",
+           "remove_stale_temporaries", "OutputSet"]
+
+#: the file that marks a hidden temporary folder as clutchlab's (:func:`temporary_folder`)
+TEMPORARY_MARKER = ".clutchlab-temporary"
+#: the file that marks a report folder as clutchlab's (:data:`clutchlab.report.html.MARKER`); a report is
+#: assembled in a temporary folder that holds it from the start
+REPORT_MARKER = ".clutchlab-report"
+#: a temporary folder of a writer that is gone is removed only if it holds one of these (or nothing)
+_FOLDER_MARKERS = (TEMPORARY_MARKER, REPORT_MARKER)
+#: the journal of an :class:`OutputSet`, in its first temporary folder: the moves still to make
+_JOURNAL = ".clutchlab-commit"
 
 #: a text document (TOML, JSON) larger than this many times the memory budget is refused unread
 _DOCUMENT_EXPANSION = 20
@@ -125,17 +141,79 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
+def _stale_folder(path) -> bool:
+    """Whether the folder ``path`` is a temporary folder of clutchlab's whose writer is gone: named
+    ``.NAME.PID.XXXXXXXX.tmp`` (:func:`temporary_folder`), not a link, process ``PID`` not running, and holding
+    a marker file (:data:`_FOLDER_MARKERS`) or nothing.  A folder of the user's (no marker) never is."""
+    path = os.fspath(path)
+    match = re.fullmatch(r"\..+\.(\d+)\.[A-Za-z0-9_]{8}\.tmp", os.path.basename(path))
+    if match is None or os.path.islink(path) or not os.path.isdir(path) or _pid_alive(int(match[1])):
+        return False
+    try:
+        names = os.listdir(path)
+    except OSError:
+        return False
+    return not names or any(os.path.isfile(os.path.join(path, m)) and not os.path.islink(os.path.join(path, m))
+                            for m in _FOLDER_MARKERS if m in names)
+
+
+def _marker(folder: Path) -> dict:
+    """What the marker of a temporary folder of an :class:`OutputSet` says (``{}`` for any other)."""
+    try:
+        info = json.loads((folder / TEMPORARY_MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return info if isinstance(info, dict) else {}
+
+
+def _settle(folder: Path) -> list[Path]:
+    """Finish or remove the stale temporary folder ``folder`` (:func:`_stale_folder`) and those of its run.
+
+    A folder of an :class:`OutputSet` names the run's first folder (its ``lead``), which lists the others;
+    if the lead holds the run's journal, the run was killed while moving its outputs into place: the moves
+    are finished first (every output of that run, complete, as it would have been).  Otherwise the run was
+    killed before: its folders are removed, its outputs untouched.  Returns the folders removed.
+    """
+    info = _marker(folder)
+    lead = Path(info["lead"]) if isinstance(info.get("lead"), str) and info["lead"] else folder
+    if lead != folder and not _stale_folder(lead):
+        lead = folder
+    members = [Path(m) for m in _marker(lead).get("members", []) if isinstance(m, str)]
+    journal = lead / _JOURNAL
+    if journal.is_file():
+        try:
+            pairs = json.loads(journal.read_text(encoding="utf-8"))
+            for staged, target in pairs:
+                staged, target = Path(staged), Path(target)
+                # (only a file of a temporary folder beside its own output moves)
+                if (staged.name == target.name and staged.parent.parent == target.parent
+                        and staged.parent.name.startswith(f".{target.name}.") and os.path.lexists(staged)):
+                    os.replace(staged, target)
+        except (OSError, ValueError, TypeError):
+            return []   # (left as it is: the next run tries again)
+    removed = []
+    for f in dict.fromkeys([folder, *members, lead]):   # the lead (and its journal) last
+        if _stale_folder(f):
+            shutil.rmtree(f, ignore_errors=True)
+            removed.append(f)
+    return removed
+
+
 def remove_stale_temporaries(path) -> list[Path]:
     """Remove hidden temporary siblings of ``path`` left by a writer that no longer runs.
 
     A writer's temporary file is ``.NAME.PID.XXXXXXXX.tmp`` (or ``.mf4``); it
     is stale if process ``PID`` is gone (killed before it could rename or
-    remove the file).  Temporary files of running writers are left alone.
+    remove the file).  A temporary folder (:func:`temporary_folder`,
+    ``.NAME.PID.XXXXXXXX.tmp``) is removed under the same condition, and only
+    if it holds a clutchlab marker file (or nothing); one of an
+    :class:`OutputSet` killed while moving its outputs into place has those
+    moves finished first.  Temporaries of running writers are left alone.
 
     Returns
     -------
     list of Path
-        The files removed.
+        The files and folders removed.
     """
     path = Path(path)
     removed = []
@@ -146,7 +224,16 @@ def remove_stale_temporaries(path) -> list[Path]:
         return removed
     for entry in entries:
         name = entry.name
-        if not (name.startswith(prefix) and name.endswith((".tmp", ".mf4"))):
+        if not name.startswith(prefix):
+            continue
+        try:
+            if entry.is_dir(follow_symlinks=False):
+                if _stale_folder(entry.path):
+                    removed += _settle(Path(entry.path))
+                continue
+        except OSError:
+            continue
+        if not name.endswith((".tmp", ".mf4")):
             continue
         pid_text = name[len(prefix):].split(".", 1)[0]
         if pid_text.isdigit() and _pid_alive(int(pid_text)):
@@ -158,6 +245,29 @@ def remove_stale_temporaries(path) -> list[Path]:
         except OSError:
             pass
     return removed
+
+
+def temporary_folder(path, marker: str = TEMPORARY_MARKER, note: str = "") -> Path:
+    """Create a hidden temporary folder beside ``path`` (``.NAME.PID.XXXXXXXX.tmp``) holding the file ``marker``.
+
+    Stale temporaries of ``path`` are removed first (:func:`remove_stale_temporaries`: a later run removes
+    this folder too, if its process was killed before it could) and the parent folder is created if missing.
+    The folder gets the usual permissions (``mkdtemp`` creates 0700); ``note`` is the marker's text.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
+    folder = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent))
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(folder, 0o777 & ~umask)
+        (folder / marker).write_text(note or "a temporary folder of clutchlab's: removed once its process is gone\n",
+                                     encoding="utf-8")
+    except BaseException:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+    return folder
 
 
 def temporary_sibling(path: Path, suffix: str = ".tmp") -> tuple[int, str]:
@@ -211,6 +321,99 @@ def atomic_to_csv(frame: pd.DataFrame, path, overwrite: bool = False, header_com
     if header_comment:
         text = "".join(f"# {line}\n" for line in header_comment.splitlines()) + text
     return atomic_write_text(path, text, overwrite)
+
+
+class OutputSet:
+    """The outputs of one run, replaced together: all of them or none (#33).
+
+    Parameters
+    ----------
+    paths : iterable of str or Path
+        The run's outputs (``None`` entries skipped), checked at once (:func:`check_outputs`) -- after
+        what an interrupted run of the same outputs left was settled (:func:`remove_stale_temporaries`).
+    overwrite : bool
+        Whether existing outputs may be replaced (the CLI's ``--force``).
+
+    Each output is written, by any writer, to :meth:`staged` ``(path)``: the same name in a hidden
+    temporary folder beside it (:func:`temporary_folder`).  At the end of a ``with`` block
+    (:meth:`commit`) the run's journal is written, every staged file is moved into place and the folders
+    are removed; an exception in the block removes them and leaves the outputs as they were.  So a run
+    killed while it writes leaves every old output (its folders are removed by the next write of one of
+    them), and one killed while moving them into place leaves its journal: the next write of any of them
+    finishes the moves first, and all outputs are that run's.  Never a mix of two runs.
+
+    Examples
+    --------
+    >>> outputs = OutputSet([csv, events], overwrite=False)      # before the run: checked
+    >>> with outputs:                                            # doctest: +SKIP
+    ...     atomic_to_csv(frame, outputs.staged(csv))
+    ...     atomic_to_csv(table, outputs.staged(events))
+    """
+
+    def __init__(self, paths, overwrite: bool = False):
+        self.paths = [Path(p) for p in paths if p is not None]
+        for p in self.paths:
+            remove_stale_temporaries(p)
+        check_outputs(self.paths, overwrite)
+        self.overwrite = overwrite
+        self._targets = {os.path.abspath(p): p for p in self.paths}
+        self._folders: dict[str, Path] = {}
+        self._lead: Path | None = None
+        self._moving = False
+
+    def staged(self, path) -> Path:
+        """The path to write the output ``path`` to (in its temporary folder, created on the first call)."""
+        key = os.path.abspath(path)
+        if key not in self._targets:
+            raise ValueError(f"{path}: not an output of this set ({', '.join(map(str, self.paths))})")
+        if key not in self._folders:
+            target = self._targets[key]
+            lead = "" if self._lead is None else str(self._lead)
+            folder = Path(os.path.abspath(temporary_folder(target, note=json.dumps({"lead": lead}) + "\n")))
+            self._folders[key] = folder
+            if self._lead is None:
+                self._lead = folder
+            members = [str(f) for f in self._folders.values() if f != self._lead]
+            atomic_write_text(self._lead / TEMPORARY_MARKER, json.dumps({"lead": "", "members": members}) + "\n",
+                              overwrite=True)
+        return self._folders[key] / self._targets[key].name
+
+    def commit(self) -> list[Path]:
+        """Move every staged output into place (after writing the journal); returns the outputs replaced."""
+        pairs = [(folder / self._targets[key].name, self._targets[key]) for key, folder in self._folders.items()
+                 if os.path.lexists(folder / self._targets[key].name)]
+        try:
+            for _, target in pairs:
+                check_writable(target, self.overwrite)   # (again: one may have appeared during the run)
+            if len(pairs) > 1:
+                atomic_write_text(self._lead / _JOURNAL,
+                                  json.dumps([[str(a), os.path.abspath(b)] for a, b in pairs]) + "\n")
+            self._moving = True   # from here on only forward: a failure leaves the journal to the next run
+            for staged, target in pairs:
+                os.replace(staged, target)
+            self._moving = False
+        finally:
+            self.discard()
+        return [target for _, target in pairs]
+
+    def discard(self) -> None:
+        """Remove the temporary folders (the staged outputs with them); the outputs stay as they were."""
+        if self._moving:
+            return
+        for folder in [f for f in self._folders.values() if f != self._lead] + [self._lead]:
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)
+        self._folders.clear()
+        self._lead = None
+
+    def __enter__(self) -> "OutputSet":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
 
 
 def read_table(source, required: Iterable[str], *, name: str | None = None, allow_nan: Iterable[str] = ()) -> pd.DataFrame:

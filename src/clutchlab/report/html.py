@@ -12,8 +12,8 @@ import datetime as _dt
 import html
 import io
 import os
+import secrets
 import shutil
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,9 +22,10 @@ import pandas as pd
 __all__ = ["Figure", "Table", "Text", "Section", "write_report", "check_report_folder"]
 
 #: the file that marks a folder as a report clutchlab wrote (only such a folder is replaced, with overwrite)
-MARKER = ".clutchlab-report"
+MARKER = ".clutchlab-report"   # (clutchlab.io.files.REPORT_MARKER: a temporary folder holding it is clutchlab's)
 #: what a report folder holds (folders written before the marker hold these only)
 _REPORT_ENTRIES = {"index.html", "figures", "tables", MARKER}
+_MARKER_TEXT = "a report written by clutchlab: `--force` may replace this folder\n"
 
 
 def check_report_folder(outdir, overwrite: bool = False) -> Path:
@@ -162,8 +163,10 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
     stamped "synthetic data" (:func:`clutchlab.plotting.mark_synthetic`), so
     it stays marked when copied out of the page.
 
-    The folder is assembled in a temporary sibling and moved into place, so an
-    interrupted run never leaves half a report.  An existing ``outdir`` is
+    The folder is assembled in a hidden temporary sibling (``.NAME.PID.XXXXXXXX.tmp``, holding
+    :data:`MARKER` from the start) and moved into place, so an interrupted run never leaves half a
+    report; the temporary folders of a run that was killed are removed by the next report written to
+    ``outdir`` (:func:`clutchlab.io.files.remove_stale_temporaries`).  An existing ``outdir`` is
     replaced only with ``overwrite=True``, and only if clutchlab wrote it
     (:func:`check_report_folder`).
 
@@ -176,13 +179,13 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
 
     from .. import __version__
 
+    from ..io.files import temporary_folder
+
     outdir = check_report_folder(outdir, overwrite)
     target = outdir.resolve()   # (a name to build the temporary and backup names from, also for "-o ..")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp creates 0700; the report folder gets the usual permissions
+    # a hidden .NAME.PID.XXXXXXXX.tmp holding the marker from the start: if this process is killed, the next
+    # report written to the same folder removes it (and those of earlier killed runs now)
+    tmp = temporary_folder(target, MARKER, _MARKER_TEXT)
     try:
         (tmp / "figures").mkdir()
         (tmp / "tables").mkdir()
@@ -235,13 +238,13 @@ def write_report(sections: list[Section], outdir, *, title: str = "clutchlab rep
                 parts.append(f"<details><summary>Parameters used</summary><table><tr><th>name</th><th>value</th></tr>{rows}</table></details>")
         parts.append("</body></html>")
         (tmp / "index.html").write_text("\n".join(parts), encoding="utf-8")
-        (tmp / MARKER).write_text("a report written by clutchlab: `--force` may replace this folder\n",
-                                  encoding="utf-8")
         if target.exists():
             check_report_folder(outdir, overwrite)   # (again: it may have changed during the rendering)
-            backup = target.with_name(f".{target.name}.old")
-            if backup.exists():
-                shutil.rmtree(backup)
+            # the old report moves aside under a temporary name of this process, marked, so that a kill before
+            # it is removed leaves nothing a later run does not remove
+            if not (target / MARKER).exists():
+                (target / MARKER).write_text(_MARKER_TEXT, encoding="utf-8")
+            backup = target.with_name(f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
             os.replace(target, backup)
             os.replace(tmp, target)
             shutil.rmtree(backup)

@@ -46,7 +46,6 @@ import math
 import multiprocessing
 import os
 import re
-import signal
 import sys
 import threading
 import time
@@ -57,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from .._process import die_with_parent
 from ..errors import ClutchlabError, DataError, ParameterError
 from ..io import atomic_to_csv, atomic_write_bytes, atomic_write_text
 from .spec import VARIANT_ID, SweepSpec, check_scheduler, load_spec, spec_from_dict
@@ -239,6 +239,8 @@ def _clean_temporaries(output: Path) -> list[Path]:
     for folder in (output, output / CHUNK_DIR):
         if folder.is_dir():
             for tmp in folder.glob(".*.tmp"):
+                if tmp.is_dir() and not tmp.is_symlink():
+                    continue   # (a temporary folder, e.g. of a report written in here: clutchlab.io.files's)
                 tmp.unlink(missing_ok=True)
                 removed.append(tmp)
     return removed
@@ -353,35 +355,9 @@ def _existing_chunks(spec: SweepSpec, output: Path, manifest: dict) -> list[int]
 
 
 # ----------------------------------------------------------------- executors
-PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
-
-
 def _die_with_parent(parent_pid: int, poll: float = 0.5) -> None:
-    """End this process when ``parent_pid`` dies, even by SIGKILL.
-
-    On Linux the kernel sends SIGKILL on the parent's death
-    (``prctl(PR_SET_PDEATHSIG)``); everywhere a daemon thread also polls the
-    parent pid (``os.getppid`` changes when the process is re-parented) and
-    exits.  If the parent is already gone, exit at once.
-    """
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
-        except (OSError, AttributeError):  # pragma: no cover - no prctl: the watchdog remains
-            pass
-    if os.getppid() != parent_pid:
-        os._exit(1)
-
-    def watch():
-        while True:
-            time.sleep(poll)
-            if os.getppid() != parent_pid:
-                os._exit(1)
-
-    threading.Thread(target=watch, name="clutchlab-sweep-parent-watchdog", daemon=True).start()
+    """End this worker when ``parent_pid`` dies, even by SIGKILL (:func:`clutchlab._process.die_with_parent`)."""
+    die_with_parent(parent_pid, poll, name="clutchlab-sweep-parent-watchdog")
 
 
 def _worker_init(parent_pid: int | None = None, components=()):
