@@ -516,7 +516,15 @@ def fastest_time_constant(system: System, t: float = 0.0) -> float:
     """The fastest time constant [s] of ``system`` at its start: ``1 / max |lambda|`` over the eigenvalues of the
     linearisation at ``(t, x0, u0, m0)`` in its start modes (forward differences of :func:`evaluate`; with a mass
     matrix, the generalised eigenvalues of ``(J, M)``, whose algebraic rows give infinite ones, left out);
-    ``inf`` where every eigenvalue is zero (free inertias)."""
+    ``inf`` where every eigenvalue is zero (free inertias).
+
+    Parameters
+    ----------
+    system : System
+        The system, at its initial state, inputs and modes.
+    t : float
+        The time [s] of the linearisation.
+    """
     import scipy.linalg
 
     n = len(system.states)
@@ -545,7 +553,17 @@ def check_fixed_step_dynamics(system: System, fixed: float, t0: float = 0.0) -> 
     the model's fastest time constant at its start (:func:`fastest_time_constant`): Rodas3 is L-stable, so the
     run stays stable and damps what is faster than its step, but it does not resolve it (a transient of the
     actuator, a contact, a lock-up shorter than a step).  A HIL frame chosen on purpose may do this; the
-    warning says so once per run.  Nothing for step-size control (``fixed`` 0)."""
+    warning says so once per run.  Nothing for step-size control (``fixed`` 0).
+
+    Parameters
+    ----------
+    system : System
+        The system about to run.
+    fixed : float
+        Its fixed step [s] (0: step-size control).
+    t0 : float
+        The start time [s], where the time constants are taken.
+    """
     if not fixed > 0.0:
         return
     tau = fastest_time_constant(system, t0)
