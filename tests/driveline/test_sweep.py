@@ -362,3 +362,30 @@ def test_an_unknown_metric_is_refused_with_the_closest_name(tmp_path):
     _, scenario = _scenario(tmp_path, SINE, "sine.toml")
     with pytest.raises(ParameterError, match=r"unknown output 'J1\.w_minn_rad_s'; did you mean 'J1\.w_min_rad_s'"):
         S.run_batch(_design(**{"J1.J": [1.0]}), scenario, ["J1.w_minn_rad_s"])
+
+
+def test_a_friction_map_s_level_is_a_sweep_parameter(tmp_path):
+    """#33 "sweeps over friction coefficients or maps": ``<clutch>.mu_scale`` scales a clutch's or brake's friction
+    coefficient, a number, a table or a map alike.  A brake with a uniform map (mu 0.1) stops J (0.5 kg m^2 from
+    100 rad/s) under 200 N at ``J w0 / (fn mu s)``: 2.5 s / s; the same with the coefficient as a number."""
+    from clutchlab.wet.friction import FrictionMap
+
+    FrictionMap([0.0, 10.0], [20.0, 120.0], np.full((2, 2), 0.1)).to_json(tmp_path / "map.json")
+    text = ('[inertia.J]\nJ = "0.5 kg m^2"\nw0 = "100 rad/s"\n'
+            '[brake.brake]\nflange = "J"\nfn_max = "200 N"\nmu_map = "map.json"\nradius = "100 mm"\n'
+            'temperature = "80 degC"\n[simulation]\nt_end = "4 s"\n')
+    _, scenario = _scenario(tmp_path, text, "map.toml")
+    described = S.describe(scenario)
+    assert "brake.mu_scale" in described["parameters"]
+    variants = _design(**{"brake.mu_scale": [0.8, 1.0, 1.25, 2.0]})
+    out = S.run_batch(variants, scenario, ["brake.last_stick_s", "status"])
+    assert (out["status"] == 0).all()
+    for vid, row in variants.iterrows():
+        assert out.loc[vid, "brake.last_stick_s"] == pytest.approx(2.5 / row["brake.mu_scale"], rel=1e-7)
+    _, number = _scenario(tmp_path, text.replace('mu_map = "map.json"\nradius = "100 mm"\ntemperature = "80 degC"\n',
+                                                 "mu = 0.1\n"), "number.toml")
+    again = S.run_batch(variants, number, ["brake.last_stick_s"])
+    np.testing.assert_allclose(again["brake.last_stick_s"], out["brake.last_stick_s"], rtol=1e-9)
+    # a level that takes the coefficient beyond its physical range is refused by name
+    with pytest.raises(ParameterError, match=r"brake: mu_scale = 30 makes its friction coefficient 3"):
+        Driveline("x").inertia("J", J=1.0).brake("brake", "J", fn_max=1.0, mu=0.1, mu_scale=30.0)

@@ -954,40 +954,59 @@ class Driveline:
         return tuple(arr[:, 0]) + tuple(arr[:, 1])
 
     def clutch(self, name: str, a, b, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
-               normal=1.0, radius: float | None = None, temperature: float | None = None) -> "Driveline":
+               normal=1.0, radius: float | None = None, temperature: float | None = None,
+               mu_scale: float = 1.0) -> "Driveline":
         """A clutch between flanges a and b (MSL ``Clutch``): sliding torque ``cgeo fn mu(|w_rel|)``,
         ``fn = fn_max * normal(t)`` [N] (free when ``<= 0``), static limit ``peak`` times the sliding
         torque at rest.  ``mu``: a number, a table ``[[w_rad_s, mu], ...]``, or a friction map
         ``mu(v, T)`` identified by :mod:`clutchlab.wet` (:class:`clutchlab.wet.friction.FrictionMap`) read
         at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
-        [degC] (both required with a map, refused without one; :meth:`_map_characteristic`)."""
+        [degC] (both required with a map, refused without one; :meth:`_map_characteristic`).  ``mu_scale``:
+        a factor on the friction coefficient, whether a number, a table or a map (a sweep's friction level;
+        the scaled coefficient stays within ``params.base.FRICTION_COEFFICIENT_MAX``)."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak, fn_max,
-                              cgeo, normal)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
+                              fn_max, cgeo, normal)
 
     def brake(self, name: str, flange, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
               normal=1.0, support=None, radius: float | None = None,
-              temperature: float | None = None) -> "Driveline":
+              temperature: float | None = None, mu_scale: float = 1.0) -> "Driveline":
         """A brake between ``flange`` and ``support`` (default the ground), as :meth:`clutch` (MSL ``Brake``)."""
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak, fn_max,
-                              cgeo, normal)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
+                              fn_max, cgeo, normal)
 
     @classmethod
-    def _mu(cls, name, mu, radius, temperature):
+    def _mu(cls, name, mu, radius, temperature, scale=1.0):
         """A clutch's or brake's friction characteristic: a number or table, or a map with its radius and
-        temperature."""
+        temperature; its coefficients times ``scale``."""
         from ..wet.friction import FrictionMap
 
         if isinstance(mu, FrictionMap):
-            return cls._map_characteristic(name, mu, radius, temperature)
+            return cls._scaled(name, cls._map_characteristic(name, mu, radius, temperature), scale)
         for what, value in (("radius", radius), ("temperature", temperature)):
             if value is not None:
                 raise ParameterError(f"{name}: {what} = {value!r} is for a friction map mu(v, T); mu is "
                                      f"{type(mu).__name__}")
-        return cls._characteristic(name, "mu", mu)
+        return cls._scaled(name, cls._characteristic(name, "mu", mu), scale)
+
+    @staticmethod
+    def _scaled(name, table, scale):
+        """A friction characteristic ``(speeds..., coefficients...)`` with its coefficients times ``scale`` (>= 0),
+        refused where one passes ``FRICTION_COEFFICIENT_MAX``."""
+        from ..params.base import FRICTION_COEFFICIENT_MAX
+
+        scale = _finite(name, "mu_scale", scale, nonneg=True)
+        if scale == 1.0:
+            return table
+        half = len(table) // 2
+        values = tuple(scale * v for v in table[half:])
+        if max(values) > FRICTION_COEFFICIENT_MAX:
+            raise ParameterError(f"{name}: mu_scale = {scale:g} makes its friction coefficient {max(values):g}, above "
+                                 f"{FRICTION_COEFFICIENT_MAX:g} (params.base.FRICTION_COEFFICIENT_MAX)")
+        return tuple(table[:half]) + values
 
     @staticmethod
     def _map_characteristic(name, fmap, radius, temperature):
@@ -1274,7 +1293,7 @@ class Driveline:
         return times, values
 
     def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
-                       normal=1.0) -> "Driveline":
+                       normal=1.0, mu_scale: float = 1.0) -> "Driveline":
         """A one-way clutch between flanges a and b (MSL ``OneWayClutch``: a freewheel in parallel with a clutch).
 
         Flange b may overrun flange a (``w_b > w_a``); the freewheel locks, holding any torque, when b would turn
@@ -1282,10 +1301,11 @@ class Driveline:
         (``fn = fn_max * normal(t)``, ``cgeo``, ``mu`` and ``peak`` as :meth:`clutch`; no torque where ``fn <= 0``)
         holds up to ``peak * cgeo * fn * mu(0)`` against overrunning and slides with ``cgeo * fn * mu(w_rel)``
         while b overruns.  Events ``stick`` when it locks or its clutch holds, ``forward`` when b overruns; it
-        never slides backward, so it may not start with ``w_b < w_a``."""
+        never slides backward, so it may not start with ``w_b < w_a``.  ``mu_scale`` as :meth:`clutch`."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_ONEWAY, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
+        return self._friction(name, a, b, K.LAW_ONEWAY, self._scaled(name, self._characteristic(name, "mu", mu),
+                                                                     mu_scale), peak, fn_max, cgeo,
                               None if fn_max == 0.0 else normal)
 
     # ---- the system
