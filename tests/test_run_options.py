@@ -166,3 +166,32 @@ def test_driveline_simulate_with_run_options_says_so(tmp_path):
                  "--rtol", "1e-6", "--atol", "1e-9", "--max-step", "5 ms"]) == 0
     first = out.read_text().splitlines()[0]
     assert first.startswith("#") and "rtol = 1e-06" in first and "max_step = 0.005 s" in first, first
+
+
+def test_a_tighter_rtol_brings_a_systems_absolute_tolerances_down_through_the_contract():
+    """Issue #30: ``simulate(system, rtol=...)`` below the system's own rtol scales its absolute tolerances by
+    ``rtol / system.rtol`` (``follow_rtol``, once in ``System.options``), so the error against the closed form
+    follows the tolerance.  An undamped oscillator (J = 1 kg m^2 on 100 N m/rad) from 0.01 rad/s, a system built at
+    rtol 1e-4 (its atol 1e-4: the angle's amplitude is 1e-3 rad): ``w = w0 cos(10 t)``.  With the absolute
+    tolerances kept at the system's (what every contract-level run did), the error stays at 8.6 % of w0 at rtol
+    1e-6, 1e-8 and 1e-10 alike; following them it is 5e-4, 7e-6, 9e-8."""
+    from clutchlab.driveline import Driveline
+    from clutchlab.system import follow_rtol, simulate
+
+    d = Driveline("oscillator")
+    d.inertia("J", J=1.0, w0=1e-2)
+    d.spring_damper("c", "J", "ground", c=100.0)
+    system = d.system(rtol=1e-4)
+    assert np.all(system.options(rtol=1e-9).atol == follow_rtol(system.atol, 1e-9, 1e-4))
+    assert np.all(system.options(rtol=1e-3).atol == system.atol)      # (at and above its rtol: its own)
+    assert np.all(system.options(rtol=1e-9, atol=1e-3).atol == 1e-3)  # (a given atol is taken as it is)
+
+    def error(rtol, atol=None):
+        r = simulate(system, 1.0, rtol=rtol, atol=atol, output_step=0.01)
+        w = r.states[:, system.state_index("J.w")]
+        return float(np.max(np.abs(w - 1e-2 * np.cos(10.0 * r.time)))) / 1e-2
+
+    followed = [error(rtol) for rtol in (1e-6, 1e-8, 1e-10)]
+    kept = [error(rtol, system.atol) for rtol in (1e-6, 1e-8, 1e-10)]
+    assert followed[0] > 30 * followed[1] > 900 * followed[2] and followed[2] < 1e-6, followed
+    assert min(kept) > 0.05, kept   # (the floor the fixed absolute tolerances set)

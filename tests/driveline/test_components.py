@@ -109,7 +109,8 @@ def test_declarations_are_checked():
         C.Field("model", "int", default=7, maximum=4)
     clutch = C.component("clutch")
     assert [f.name for f in clutch.ports] == ["a", "b"] and clutch.field("fn_max").unit == "N"
-    assert [f.name for f in clutch.parameters] == ["fn_max", "mu", "peak", "cgeo", "normal", "radius", "temperature"]
+    assert [f.name for f in clutch.parameters] == ["fn_max", "mu", "mu_scale", "peak", "cgeo", "normal", "radius",
+                                                        "temperature"]
     f = C.Field("eta", positive=True, maximum=1.0)
     assert (f.range_text(), f.range_problem(0.0), f.range_problem(1.0)) == ("(0, 1]", "must be > 0 [1]", None)
     assert C.Field("T", unit="N*m", minimum=0.0).range_text() == ">= 0 N*m"

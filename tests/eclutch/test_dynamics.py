@@ -311,14 +311,18 @@ def test_voltage_saturation_and_current_limit():
     assert (res.events.event == "end stop hit").any()
 
 
-def test_reference_beyond_travel_is_clamped():
+def test_reference_at_the_end_of_travel_holds_there_and_one_beyond_it_is_refused():
+    """A reference at the CSC's end stop drives the bearing there (finite, the current within its limit); one
+    beyond the travel is a bad value (#33: 50 mm was taken and clamped by the model), refused by name."""
     act = ActuatorParameters()
     ec = EClutch(act, friction=FrictionParameters())
-    res = ec.simulate({"bearing_reference": ([0.0, 0.1], [0.0, 0.05])}, 1.0)
+    res = ec.simulate({"bearing_reference": ([0.0, 0.1], [0.0, act.slave_max])}, 1.0)
     o = res.outputs
     assert np.all(np.isfinite(o.to_numpy(dtype=float)))
     assert o.bearing_position_m.iloc[-1] == pytest.approx(act.slave_max, abs=0.3e-3)
     assert o.motor_current_A.abs().max() < 1.5 * act.current_limit
+    with pytest.raises(ParameterError, match=r"'bearing_reference' = 0.05 m is outside the CSC travel"):
+        ec.simulate({"bearing_reference": ([0.0, 0.1], [0.0, 0.05])}, 1.0)
 
 
 @settings(max_examples=examples(8), deadline=None)

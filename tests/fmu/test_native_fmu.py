@@ -184,7 +184,11 @@ def _fmpy_run(tmp_path, path, n, dt, start=None, inputs=None, fmi_type="CoSimula
 def test_native_fmu_of_a_driveline_in_fmpy_without_clutchlab_equals_the_python_cosimulation(built, tmp_path):
     path, cls, lines = built["cc"]
     assert lines == ["native FMU Clutchlab_coupled_clutches (linux64; FMI 2.0 co-simulation and model exchange): 0 inputs, "
-                     "30 outputs, 21 parameters (5 fixed at export)"]
+                     "30 outputs, 21 parameters (8 fixed at export)"]
+    # (each clutch's mu_scale multiplies its mu: the later of the two is fixed at export, mu stays writable)
+    _, svs = _variables(path)
+    assert [svs[f"clutch{i}.mu_scale"].get("variability") for i in (1, 2, 3)] == ["constant"] * 3
+    assert [svs[f"clutch{i}.mu"].get("causality") for i in (1, 2, 3)] == ["parameter"] * 3
     names = zipfile.ZipFile(path).namelist()
     assert sorted(names) == ["binaries/linux64/Clutchlab_coupled_clutches.so", "modelDescription.xml"]
     n, dt = 1200, 1e-3

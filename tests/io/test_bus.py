@@ -136,6 +136,22 @@ def test_can_frames_decode_with_the_dbc_to_the_values_they_were_encoded_from(bus
     assert meas.source.channels["pressure_Pa"].source_unit == "bar"   # the DBC's unit, converted
 
 
+def test_the_same_frames_decode_alike_with_the_database_as_arxml(bus_log, tmp_path):
+    """#33 "decode them with a DBC (or ARXML)": the test's DBC written as AUTOSAR XML by canmatrix decodes the same
+    bus log to the same values, units and messages (the ARXML names its frames FRAME_<message>)."""
+    import canmatrix.formats
+
+    canmatrix.formats.dumpp({"": canmatrix.formats.loadp_flat(str(bus_log / "pt.dbc"))}, str(tmp_path / "pt.arxml"))
+    assert b"AUTOSAR" in (tmp_path / "pt.arxml").read_bytes()[:2000]
+    by_dbc = read_measurement(bus_log / "log.mf4", MAP, databases=[bus_log / "pt.dbc"])
+    by_arxml = read_measurement(bus_log / "log.mf4", MAP, databases=[tmp_path / "pt.arxml"])
+    for column in MAP:
+        np.testing.assert_array_equal(by_arxml[column], by_dbc[column], err_msg=column)
+        assert by_arxml.source.channels[column].source_unit == by_dbc.source.channels[column].source_unit
+    assert by_arxml.source.bus == ("2 messages decoded with pt.arxml: FRAME_Clutch 0x190, FRAME_Engine 0x18F; "
+                                   "1 ID of the log in no database: 0x7FF")
+
+
 def test_a_map_names_its_databases_and_convert_takes_dbc(bus_log, tmp_path, capsys):
     cmap = bus_log / "map.toml"
     cmap.write_text("[bus]\ncan = ['pt.dbc']\n\n[channels.torque_Nm]\nsource = 'EngineTorque'\n"

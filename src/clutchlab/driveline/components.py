@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from ..component import Component, Field, register_component
 from ..errors import ParameterError
-from ..params.base import FRICTION_COEFFICIENT_MAX, WET_TEMPERATURES_C
+from ..params.base import FRICTION_COEFFICIENT_MAX, MU_SCALE_MAX, WET_TEMPERATURES_C
 
 __all__ = ["BUILTIN"]
 
@@ -44,9 +44,9 @@ def _friction_fields(fn_required=True, fn_default=None, with_map=True):
         Field("mu", "characteristic", "1", default=0.5, minimum=0.0, maximum=FRICTION_COEFFICIENT_MAX,
               description="sliding friction coefficient: a number or rows [w_rad_s, mu] over |w_rel|",
               source="physical range: linings and tyres stay below 2"),
-        Field("mu_scale", "quantity", "1", default=1.0, minimum=0.0,
+        Field("mu_scale", "quantity", "1", default=1.0, minimum=0.0, maximum=MU_SCALE_MAX,
               description="factor on the friction coefficient (a number, a table or a map): a sweep's friction "
-                          "level"),
+                          "level (the scaled coefficient may pass mu's own range by it)"),
         Field("peak", "quantity", "1", default=1.0, minimum=1.0,
               description="static limit over the sliding torque at rest", source=f"{_MSL}.Components.Clutch"),
         Field("cgeo", "quantity", "1", default=1.0, positive=True,

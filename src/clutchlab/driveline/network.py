@@ -963,7 +963,7 @@ class Driveline:
         at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
         [degC] (both required with a map, refused without one; :meth:`_map_characteristic`).  ``mu_scale``:
         a factor on the friction coefficient, whether a number, a table or a map (a sweep's friction level;
-        the scaled coefficient stays within ``params.base.FRICTION_COEFFICIENT_MAX``)."""
+        ``mu_scale`` in [0, 2], a factor on a coefficient checked on its own)."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
@@ -994,19 +994,19 @@ class Driveline:
 
     @staticmethod
     def _scaled(name, table, scale):
-        """A friction characteristic ``(speeds..., coefficients...)`` with its coefficients times ``scale`` (>= 0),
-        refused where one passes ``FRICTION_COEFFICIENT_MAX``."""
-        from ..params.base import FRICTION_COEFFICIENT_MAX
+        """A friction characteristic ``(speeds..., coefficients...)`` with its coefficients times ``scale``, in
+        [0, 2]: a sensitivity factor on a coefficient checked on its own (so a value in each declared range is
+        taken together, as a sweep or an FMU's importer expects)."""
+        from ..params.base import MU_SCALE_MAX
 
         scale = _finite(name, "mu_scale", scale, nonneg=True)
+        if scale > MU_SCALE_MAX:
+            raise ParameterError(f"{name}: mu_scale = {scale:g} is above {MU_SCALE_MAX:g} (a factor on a friction "
+                                 "coefficient, not a coefficient)")
         if scale == 1.0:
             return table
         half = len(table) // 2
-        values = tuple(scale * v for v in table[half:])
-        if max(values) > FRICTION_COEFFICIENT_MAX:
-            raise ParameterError(f"{name}: mu_scale = {scale:g} makes its friction coefficient {max(values):g}, above "
-                                 f"{FRICTION_COEFFICIENT_MAX:g} (params.base.FRICTION_COEFFICIENT_MAX)")
-        return tuple(table[:half]) + values
+        return tuple(table[:half]) + tuple(scale * v for v in table[half:])
 
     @staticmethod
     def _map_characteristic(name, fmap, radius, temperature):

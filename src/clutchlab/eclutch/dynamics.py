@@ -516,7 +516,7 @@ def _follow_rtol(rtol, atol_scale, default_rtol=1e-3):
     """The absolute tolerances' factor of a closed-loop E-clutch run: ``atol_scale`` where given, else
     ``min(1, rtol / default_rtol)`` (the defaults at the default tolerance, shrinking with a tighter one: the
     accuracy follows ``rtol``, issue #30)."""
-    return float(atol_scale) if atol_scale is not None else min(1.0, float(rtol) / default_rtol)
+    return float(atol_scale) if atol_scale is not None else contract.follow_rtol(1.0, rtol, default_rtol)
 
 
 def _check_run(t_end, rtol, max_steps, atol=None, atol_scale=None):
@@ -599,8 +599,7 @@ class ClutchDynamics:
             Defaults of the run, as in :meth:`simulate`.
         """
         tin, vin = _as_table(bearing_position, "bearing_position")
-        if atol_scale is None:   # the absolute tolerances follow rtol below its default (accuracy follows rtol)
-            atol_scale = min(1.0, float(rtol) / 1e-5)
+        atol_scale = _follow_rtol(rtol, atol_scale, 1e-5)   # (below its default rtol the atol follow it)
         return self.assembly.system(S.PRESCRIBED, tin, vin, 0, float(vin[0]), rtol=rtol, max_step=max_step,
                                     event_tol=event_tol, jac_every=jac_every, atol_scale=atol_scale)
 

@@ -51,7 +51,7 @@ from ..hysteresis._kernels import (combine_tables, commit, gap_weights, invert_c
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
-from ..system import System, register_model
+from ..system import System, follow_rtol, register_model
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance, lugre_mu, stribeck_g
 from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
@@ -198,7 +198,7 @@ def absolute_tolerance(rtol: float = ATOL_RTOL) -> np.ndarray:
     rtol : float
         Relative tolerance of the run.
     """
-    return ATOL * min(1.0, float(rtol) / ATOL_RTOL)
+    return follow_rtol(ATOL, rtol, ATOL_RTOL)   # (the contract's one rule)
 
 
 class VehicleData(NamedTuple):

@@ -95,6 +95,9 @@ WET_TEMPERATURES_C = (-60.0, 600.0)
 #: 0.05-0.6, clean metals in vacuum reach about 1-1.5; above 2 it is a typing or unit slip (a percentage, a
 #: torque).  The clutch's declared range and the friction map's check read it.
 FRICTION_COEFFICIENT_MAX = 2.0
+#: The largest ``mu_scale`` of a driveline's clutch, brake or one-way clutch: a sweep's factor on a friction
+#: coefficient (a number, a table or a map) that is checked on its own.
+MU_SCALE_MAX = 2.0
 
 
 def _number_problem(value, meta) -> str | None:

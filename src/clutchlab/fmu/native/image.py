@@ -354,15 +354,16 @@ def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
                 break
             targets.append(Target(int(k) * 8, *law))
         out[var.name] = tuple(targets) if ok else None
-    # a number two parameters change (a sum, a product) cannot be written by either alone: both fixed
+    # a number two parameters change (a sum, a product: a clutch's mu and mu_scale) cannot be written by either
+    # while the other may change too: the first in declaration order stays writable (the others fixed at their
+    # start, it alone changes that number, as it was found to), the others are fixed
     owners = {}
     for name, targets in out.items():
         for t in targets or ():
             owners.setdefault(t.offset, []).append(name)
     for names in owners.values():
-        if len(names) > 1:
-            for name in names:
-                out[name] = None
+        for name in names[1:]:
+            out[name] = None
     return _checked_jointly(variables, base, build, out, noise | skip)
 
 
@@ -468,7 +469,8 @@ def _joint_values(variables, names) -> dict:
 
 def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
     """Build the model with every writable parameter changed at once and compare with the image the FMU would
-    write; a parameter whose numbers differ is fixed (repeated until they agree).  ``ignore``: the words that
+    write; a parameter whose numbers differ is fixed (repeated until they agree; of parameters that write one
+    differing number together, the later is fixed and the others checked again).  ``ignore``: the words that
     differ between two builds of the same values, and the pointers.  Where the model refuses the combination
     (a check across parameters: the E-clutch's preload balance, a travel's two ends), the smallest refused
     set is found by delta debugging (Zeller's ddmin) and its members are fixed: a host could otherwise write a
@@ -524,9 +526,16 @@ def _check_set(variables, base, build, where, ignore, names) -> None:
         bad = set(np.flatnonzero(~same).tolist())
         if not bad:
             return
-        offenders = [name for name in changed if any(t.offset // 8 in bad for t in where[name])]
+        # a word two parameters write (a product: a clutch's mu and mu_scale) is wrong only jointly: fixing the
+        # later one of them leaves the other writable (checked again in the next round)
+        owners = {}
+        for name in changed:
+            for t in where[name]:
+                if t.offset // 8 in bad:
+                    owners.setdefault(t.offset // 8, []).append(name)
+        offenders = {names_[-1] for names_ in owners.values()}
         if not offenders:   # (a number no target writes changed: nothing can be trusted)
-            offenders = list(changed)
+            offenders = set(changed)
         for name in offenders:
             where[name] = None
     for name in names:   # (not settled within the rounds: nothing unverified stays writable)
