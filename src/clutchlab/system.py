@@ -1002,6 +1002,12 @@ class Simulation:
         """Current time [s]."""
         return float(self._sf[0])
 
+    @property
+    def options(self):
+        """The core's :class:`~clutchlab.numerics.core.Options` this session runs with (its tolerances as they
+        follow ``rtol``, :func:`follow_rtol`; read-only: a named tuple)."""
+        return self._opt
+
     def set_inputs(self, u) -> None:
         """Hold new input values (``u`` in the order of ``system.inputs``, SI)."""
         u = np.asarray(u, dtype=float).ravel()

@@ -163,24 +163,24 @@ def test_compiled_function_controller_equals_the_python_loop():
 
 
 def test_a_tighter_rtol_brings_the_absolute_tolerances_down(monkeypatch):
-    """``closed_loop(..., rtol=...)`` below the system's rtol scales its absolute tolerances in proportion (as
-    every model's own runs do, issue #30): with them at the system's, the error stopped at their floor."""
+    """``closed_loop(..., rtol=...)`` below the system's rtol runs with its absolute tolerances scaled in proportion
+    (the contract's ``follow_rtol``, issue #30): with them at the system's, the error stopped at their floor."""
     import clutchlab.control.loop as loop
 
     seen = []
     real = loop.Simulation
 
     def spy(system, **options):
-        seen.append(options)
-        return real(system, **options)
+        seen.append(real(system, **options))
+        return seen[-1]
 
     monkeypatch.setattr(loop, "Simulation", spy)
     s = linear_system(A, np.zeros(2), B)
     pi = PI(0.5, 0.2).discrete(1e-2)
     for rtol in (None, s.rtol * 1e-3, s.rtol * 10):
         closed_loop(s, pi, 1e-2, 0.1, measure=["x0"], actuate=["u0"], reference=1.0, rtol=rtol)
-    assert seen[0]["atol"] is None
-    np.testing.assert_allclose(seen[1]["atol"], s.atol * 1e-3, rtol=1e-12)
-    np.testing.assert_array_equal(seen[2]["atol"], s.atol)
+    np.testing.assert_array_equal(seen[0].options.atol, s.atol)
+    np.testing.assert_allclose(seen[1].options.atol, s.atol * 1e-3, rtol=1e-12)
+    np.testing.assert_array_equal(seen[2].options.atol, s.atol)
     with pytest.raises(ParameterError, match="rtol"):
         closed_loop(s, pi, 1e-2, 0.1, measure=["x0"], actuate=["u0"], rtol="x")

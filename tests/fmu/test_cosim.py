@@ -445,7 +445,7 @@ def test_a_cosimulation_s_absolute_tolerances_follow_its_rtol(model):
     def atol(value):
         sim = cls(**{rtol.name: value})
         sim.hold_inputs({})
-        return np.asarray(sim.simulation._opt.atol, dtype=float)
+        return np.asarray(sim.simulation.options.atol, dtype=float)
 
     default = atol(float(rtol.start))
     assert np.all(default > 0)

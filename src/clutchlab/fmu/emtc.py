@@ -246,10 +246,6 @@ class EmtcCoSimulation(ContractCoSimulation):
             self._start(uv)
         super().hold_inputs(inputs)
 
-    def initial_outputs(self, inputs: dict) -> dict:
-        """Outputs at t = 0 with the given inputs held (the shaft speeds start free rolling on the drums)."""
-        return super().initial_outputs(inputs)
-
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` (any step > 0); outputs at ``t + dt``.
 
