@@ -5,6 +5,7 @@ from cli_checks import one_line_error
 
 from clutchlab import warmup
 from clutchlab.errors import ParameterError
+from processes import proc_stat as _stat
 
 
 def test_every_demo_section_has_a_group():
@@ -72,18 +73,6 @@ def test_failing_group_is_reported(monkeypatch):
         warmup.run_parallel(["wet"], jobs=1)
 
 
-def _stat(pid):
-    """(state, start time) of a process from Linux's /proc, or None if it is gone."""
-    import pathlib
-
-    try:
-        text = pathlib.Path(f"/proc/{pid}/stat").read_text()
-    except (FileNotFoundError, ProcessLookupError):
-        return None
-    fields = text[text.rindex(")") + 2:].split()
-    return fields[0], int(fields[19])
-
-
 @pytest.mark.skipif(not __import__("pathlib").Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 def test_compile_processes_end_when_their_parent_is_killed(tmp_path):
     """#33: ``clutchlab demo`` stopped its background compile processes only in a ``finally``, which SIGKILL
@@ -124,7 +113,7 @@ def test_compile_processes_end_when_their_parent_is_killed(tmp_path):
 
         def alive(pid):
             st = _stat(pid)
-            return st is not None and st[1] == children[pid][1] and st[0] != "Z"   # (not a reused pid, no zombie)
+            return st is not None and st[2] == children[pid][2] and st[0] != "Z"   # (not a reused pid, no zombie)
 
         deadline = time.monotonic() + 10
         while time.monotonic() < deadline and any(map(alive, children)):
@@ -136,6 +125,6 @@ def test_compile_processes_end_when_their_parent_is_killed(tmp_path):
             parent.wait()
         for pid, st in children.items():   # never leave a 10-minute sleeper behind, even if the test failed
             now = _stat(pid)
-            if st and now and now[1] == st[1] and now[0] != "Z":
+            if st and now and now[2] == st[2] and now[0] != "Z":
                 os.kill(pid, signal.SIGKILL)
         parent.stdout.close()

@@ -10,6 +10,7 @@ import time
 import pytest
 
 from clutchlab.sweep.runner import _die_with_parent
+from processes import proc_stat as _stat
 
 SRC = pathlib.Path(__file__).parents[2] / "src"
 
@@ -23,16 +24,6 @@ chunk_size = 1
 """
 
 pytestmark = pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
-
-
-def _stat(pid):
-    """(state, ppid, start time) of a process from /proc, or None if it is gone."""
-    try:
-        text = pathlib.Path(f"/proc/{pid}/stat").read_text()
-    except (FileNotFoundError, ProcessLookupError):
-        return None
-    fields = text[text.rindex(")") + 2:].split()
-    return fields[0], int(fields[1]), int(fields[19])
 
 
 def _children(pid):
