@@ -561,6 +561,36 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host, native_model):
         assert (int(status), expected is None or expected in text) == ((0, True) if expected is None else (3, True)), text
 
 
+def test_the_emtc_native_fmu_snaps_a_step_end_onto_the_controller_s_sample(tmp_path, native_model):
+    """A communication point within 1e-9 of a period of a controller sample counts as that sample, in the native
+    FMU as in the Python co-simulation (``CoSimulation.step_grid_parameter``, ``cosim.snap_to_grid``; the C layer
+    reads the parameter's current value).  Steps of 2 ms (1 + 1e-12): every step ends 4e-15 s to 4e-13 s after a
+    sample instant (``scenario.sample_time`` 2 ms), and the request changes at every step, so a sample taken at the
+    end of a step rather than the start of the next reads another request.  The native FMU equals the Python run;
+    the same FMU without the grid does not (the test can fail)."""
+    from clutchlab.fmu.emtc import EmtcCoSimulation
+    from clutchlab.fmu.cosim import snap_to_grid
+
+    assert snap_to_grid(0.004 * (1 + 1e-12), 0.002) == 2 * 0.002 and snap_to_grid(0.0041, 0.002) == 0.0041
+    path, _ = native_model("emtc")
+    n, dt = 100, 0.002 * (1.0 + 1e-12)
+    k = np.arange(n + 1)
+    inputs = {"torque_request": np.where(k % 2 == 0, 150.0, 350.0) * (k * dt > 0.02), "throttle": np.full(n + 1, 0.3),
+              "drum_speed_front": np.full(n + 1, 9.0), "drum_speed_rear": np.full(n + 1, 8.6)}
+    python = _python_run(EmtcCoSimulation, n, dt, inputs=inputs)
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    for name in python:
+        _close(native[name], python[name], name)
+
+    class WithoutGrid(EmtcCoSimulation):
+        step_grid_parameter = None
+
+    plain = export_native_fmu(WithoutGrid, tmp_path / "plain.fmu", platforms=["linux64"])
+    off = _fmpy_run(tmp_path, plain, n, dt, inputs=inputs)
+    assert np.max(np.abs(off["coupling_torque"] - python["coupling_torque"])) > 1e-6 * np.max(
+        np.abs(python["coupling_torque"])), "the grid made no difference: the test cannot fail"
+
+
 def _wine():
     """``wine`` and the MinGW-w64 compiler, or the reason the win64 test cannot run here."""
     missing = [tool for tool in ("x86_64-w64-mingw32-gcc", "x86_64-w64-mingw32-g++", "wine") if not shutil.which(tool)]

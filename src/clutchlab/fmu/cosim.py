@@ -46,6 +46,7 @@ from ..params.base import field_range
 from .registry import COSIMULATIONS
 
 __all__ = [
+    "snap_to_grid",
     "Variable",
     "CoSimulation",
     "ContractCoSimulation",
@@ -135,6 +136,23 @@ class Variable:
         object.__setattr__(self, "start", float(self.start))
 
 
+def snap_to_grid(t_end: float, grid: float) -> float:
+    """``t_end`` [s], or the instant ``k * grid`` it lies within ``1e-9 * grid`` of (:attr:`CoSimulation.
+    step_grid_parameter`; the native FMU's ``fmi2DoStep`` computes the same, ``floor(t_end / grid + 0.5) * grid``).
+
+    Parameters
+    ----------
+    t_end : float
+        A step's end [s].
+    grid : float
+        The grid's period [s] (``<= 0``: none).
+    """
+    if not grid > 0.0:
+        return t_end
+    k = math.floor(t_end / grid + 0.5)
+    return k * grid if abs(k * grid - t_end) <= 1e-9 * grid else t_end
+
+
 class CoSimulation(abc.ABC):
     """Protocol of a model run step by step by a co-simulation master (an FMU).
 
@@ -175,6 +193,11 @@ class CoSimulation(abc.ABC):
     #: inputs; an optional ``input_bounds()`` gives ``{input: (min, max)}`` where an input's range follows the
     #: parameters
     native: bool = False
+    #: the parameter whose value [s] is the grid a step's end snaps to, a sampled controller's period (the EMTC's
+    #: ``scenario.sample_time``): a communication point within ``1e-9`` of a period from an instant ``k * period``
+    #: counts as that instant (:func:`snap_to_grid`), so a master's rounding of ``t + dt`` never moves a step
+    #: across a sample; None: no grid.  A native FMU applies the same rule to the parameter's current value.
+    step_grid_parameter: str | None = None
 
     @classmethod
     def for_native(cls) -> type:

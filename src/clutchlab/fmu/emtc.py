@@ -14,7 +14,8 @@ import numpy as np
 from ..errors import ParameterError, SimulationError
 from ..system import check_rtol
 from .cosim import (ContractCoSimulation, Variable, _check_time, build_parameter_set, field_variable,
-                    fixed_step_parameter, fixed_step_variable, parameter_set_variables, rtol_variable, step_in_time)
+                    fixed_step_parameter, fixed_step_variable, parameter_set_variables, rtol_variable, snap_to_grid,
+                    step_in_time)
 
 __all__ = ["EmtcCoSimulation"]
 
@@ -104,6 +105,9 @@ class EmtcCoSimulation(ContractCoSimulation):
     restart makes the modes consistent with them, e.g. an unlock).  The shaft
     speeds start at the free-rolling speeds of the drum-speed inputs at t = 0.
     """
+
+    #: the controller's sample instants: a step's end within 1e-9 of a period of one counts as it (the native FMU too)
+    step_grid_parameter = "scenario.sample_time"
 
     name = "emtc"
     inputs = (
@@ -279,10 +283,8 @@ class EmtcCoSimulation(ContractCoSimulation):
     def _step(self, t, dt, uv):
         if not self._started:
             self._start(uv)
-        ts = self.sample_time
         t_end = t + dt
-        k = round(t_end / ts)
-        target = k * ts if abs(k * ts - t_end) <= 1e-9 * ts else t_end  # a sample instant counts as itself
+        target = snap_to_grid(t_end, self.sample_time)   # a sample instant counts as itself
         if target > self.simulation.time:
             y = self._advance(target, uv)
         else:  # (nothing to integrate: the outputs with the inputs held so far)

@@ -182,7 +182,8 @@ def differential_states(image):
     return [int(i) for i in np.flatnonzero(np.asarray(image.arg("opt").mass) != 0.0)]
 
 
-def _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system) -> str:
+def _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system,
+                  step_grid_vr: int = -1) -> str:
     from ...numerics import exchange as X, status as st
     from ...numerics.session import ADVANCE, OUTPUTS
     from ...system import FIXED_STEP_BUDGET
@@ -196,6 +197,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
              f"#define CL_GUID {_c_string(guid)}",
              f"#define CL_ADVANCE {ADVANCE}", f"#define CL_OUTPUTS {OUTPUTS}",
              f"#define CL_FIXED_STEP {_c_double(fixed_step)}", f"#define CL_FIXED_STEP_BUDGET {_c_double(FIXED_STEP_BUDGET)}",
+             f"#define CL_STEP_GRID_VR {int(step_grid_vr)}",
              f"#define CL_STATUS_SUCCESS {st.SUCCESS}", f"#define CL_STATUS_TERMINATED {st.TERMINATED}",
              f"#define CL_STATUS_MODEL_ERROR {st.MODEL_ERROR}",
              f"#define CL_PARAMETER {_PARAMETER}", f"#define CL_CONSTANT {_CONSTANT}", f"#define CL_INPUT {_INPUT}",
@@ -586,7 +588,13 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     digest = hashlib.sha256(b"".join(i.data for i in images) + repr([(v["name"], v["kind"]) for v in variables]).encode()
                             + b"".join(hashlib.sha256(o).digest() for o in objects.values()))
     guid = "{" + str(uuid.UUID(bytes=digest.digest()[:16])) + "}"
-    header = _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system)
+    # the grid a step's end snaps to (CoSimulation.step_grid_parameter): that parameter's current value
+    grid = cls.step_grid_parameter
+    step_grid_vr = -1 if grid is None else next((k for k, v in enumerate(variables) if v["name"] == grid), None)
+    if step_grid_vr is None:
+        raise NativeExportError(f"{cls.__name__}: step_grid_parameter {grid!r} is not one of its parameters")
+    header = _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system,
+                           step_grid_vr)
     experiment = cls.experiment or (1.0, 1e-3)
     if fmi_version == "3.0":
         description = _description3(cls, name, ident, guid, variables, experiment)

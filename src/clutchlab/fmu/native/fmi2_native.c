@@ -859,6 +859,16 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real dt, f
         return fmi2Error;
     }
     t_end = t + dt;
+#if CL_STEP_GRID_VR >= 0
+    {   /* a step's end within 1e-9 of a period of the model's grid instant k * period counts as that instant
+           (clutchlab.fmu.cosim.snap_to_grid: a sampled controller's sample is never moved across by a rounding) */
+        double grid = c->values[CL_STEP_GRID_VR], k;
+        if (grid > 0.0) {
+            k = floor(t_end / grid + 0.5);
+            if (fabs(k * grid - t_end) <= 1e-9 * grid) t_end = k * grid;
+        }
+    }
+#endif
     if (CL_FIXED_STEP > 0.0 && (t_end - now) / CL_FIXED_STEP > CL_FIXED_STEP_BUDGET) {
         cl_log(c, fmi2Error, "logStatusError", "fmi2DoStep: a step of %g s would take more than %g steps of the "
                "fixed step %g s", dt, CL_FIXED_STEP_BUDGET, CL_FIXED_STEP);
