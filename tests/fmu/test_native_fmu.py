@@ -541,7 +541,7 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host, native_model):
     # a request that reverses with a shrinking amplitude at every sample fills the magnets' memories (more than
     # the Python co-simulation's 64 turning points: it replays with 256); the native FMU, which cannot grow
     # them at run time, starts with 1024 (EmtcCoSimulation.for_native) and gives the same run
-    assert EmtcCoSimulation.for_native()()._options.memory_capacity == 1024
+    assert EmtcCoSimulation.for_native()().bench_options.memory_capacity == 1024
     reversing = dict(inputs, torque_request=300.0 + 250.0 * (-1.0) ** k * (1.0 - k / n))
     native = _fmpy_run(tmp_path, path, n, dt, inputs=reversing)
     python = _python_run(EmtcCoSimulation, n, dt, inputs=reversing)

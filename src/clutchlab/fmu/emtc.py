@@ -240,6 +240,12 @@ class EmtcCoSimulation(ContractCoSimulation):
             self._n_logged = n
         return y
 
+    @property
+    def bench_options(self):
+        """The :class:`~clutchlab.emtc.system.BenchOptions` the run uses (its magnets' memories start with
+        :attr:`memory_capacity` turning points and grow fourfold when a run fills them)."""
+        return self._options
+
     def hold_inputs(self, inputs: dict) -> None:
         """Hold the FMI ``inputs`` (by name; missing ones at their start), starting the run with them at t = 0:
         the shaft speeds start free rolling on the drums (:meth:`initial_outputs`; a native FMU takes the
