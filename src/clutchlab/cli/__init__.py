@@ -181,7 +181,6 @@ def error_message(exc: BaseException) -> str:
     are (they name file, field and value); operating-system errors name the
     path and the reason; the library's ``overwrite=True`` becomes ``--force``.
     """
-    from .._limits import one_line
 
     if isinstance(exc, FileExistsError) and hasattr(exc, "cli_message"):
         msg = exc.cli_message

@@ -469,8 +469,7 @@ def _joint_values(variables, names) -> dict:
 
 def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndarray) -> dict:
     """Build the model with every writable parameter changed at once and compare with the image the FMU would
-    write; a parameter whose numbers differ is fixed (repeated until they agree; of parameters that write one
-    differing number together, the later is fixed and the others checked again).  ``ignore``: the words that
+    write; a parameter whose numbers differ is fixed (repeated until they agree).  ``ignore``: the words that
     differ between two builds of the same values, and the pointers.  Where the model refuses the combination
     (a check across parameters: the E-clutch's preload balance, a travel's two ends), the smallest refused
     set is found by delta debugging (Zeller's ddmin) and its members are fixed: a host could otherwise write a
@@ -526,16 +525,10 @@ def _check_set(variables, base, build, where, ignore, names) -> None:
         bad = set(np.flatnonzero(~same).tolist())
         if not bad:
             return
-        # a word two parameters write (a product: a clutch's mu and mu_scale) is wrong only jointly: fixing the
-        # later one of them leaves the other writable (checked again in the next round)
-        owners = {}
-        for name in changed:
-            for t in where[name]:
-                if t.offset // 8 in bad:
-                    owners.setdefault(t.offset // 8, []).append(name)
-        offenders = {names_[-1] for names_ in owners.values()}
+        # (no two writable parameters write one word: parameter_map left the first of them writable)
+        offenders = [name for name in changed if any(t.offset // 8 in bad for t in where[name])]
         if not offenders:   # (a number no target writes changed: nothing can be trusted)
-            offenders = set(changed)
+            offenders = list(changed)
         for name in offenders:
             where[name] = None
     for name in names:   # (not settled within the rounds: nothing unverified stays writable)
