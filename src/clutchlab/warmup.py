@@ -71,6 +71,18 @@ def _warm_driveline() -> None:
     d.simulate(0.02, output_step=0.01)   # (its system() also prepares the kernels called through their addresses)
 
 
+def _warm_components() -> None:
+    # the one kernel of every network with model components (wet clutches and EMTC couplings, any number and mix:
+    # clutchlab.driveline.coupled); the plain network's functions it calls are the driveline group's
+    from .driveline import Driveline, Signal
+
+    d = Driveline("warmup_components")
+    d.inertia("a", J=1.0, w0=10.0).inertia("b", J=1.0).inertia("c", J=1.0)
+    d.wet_clutch("w", "a", "b", force=Signal.ramp(1000.0, 0.01))
+    d.emtc("e", "b", "c")
+    d.simulate(0.01, output_step=0.005)
+
+
 def _warm_control() -> None:
     # what control design adds to the E-clutch's and the EMTC's kernels: the point evaluations of the
     # contract (right-hand side, outputs, analytic Jacobian) that trim and linearisation call
@@ -87,7 +99,7 @@ def _warm_control() -> None:
 
 #: compile groups: name -> function that runs the group's kernels once on a tiny problem
 GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "driveline": _warm_driveline,
-          "control": _warm_control}
+          "components": _warm_components, "control": _warm_control}
 
 
 def _check(names) -> None:
@@ -138,8 +150,8 @@ def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
     _check(names)
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
     t0 = time.perf_counter()
-    # deal the groups round-robin to the processes, the costliest first (measured: emtc, eclutch, wet)
-    order = [g for g in ("emtc", "eclutch", "wet") if g in names]
+    # deal the groups round-robin to the processes, the costliest first (measured: components, emtc, eclutch, wet)
+    order = [g for g in ("components", "emtc", "eclutch", "wet") if g in names]
     order += [g for g in names if g not in order]
     lots = [order[i::jobs] for i in range(jobs)]
     procs = [start(lot, full=True) for lot in lots if lot]

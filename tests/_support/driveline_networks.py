@@ -66,22 +66,33 @@ normal = { input = "press" }
 
 # ----------------------------------------------------------------- random networks (test_invariants, test_inputs)
 @st.composite
-def networks(draw, with_unrelated=False):
+def networks(draw, with_unrelated=False, with_components=False):
     """A random network: a chain of 2-4 inertias whose links are springs, backlash, gears (ideal, a constant
     efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
     clutch); sometimes a clutch closing a loop from the first to the last, a second clutch in parallel with one,
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
-    inertia turning."""
+    inertia turning.  ``with_components``: links may also be wet clutches (a force ramp or constant) and EMTC couplings
+    (their default scenario and controller), and at least one link is one of them."""
     n = draw(st.integers(2, 4))
     d = Driveline("random")
     w0 = draw(st.sampled_from([0.0, 0.0, 3.0, -2.0]))
     for i in range(n):
         d.inertia(f"J{i}", J=draw(st.floats(0.05, 2.0)), w0=(w0 if i == 0 else None))
+    forced = draw(st.integers(0, n - 2)) if with_components else -1
     for i in range(n - 1):
         a, b = f"J{i}", f"J{i + 1}"
         kinds = ["spring", "backlash", "gear", "lossy", "table", "clutch", "oneway", "owc"]
-        kind = draw(st.sampled_from(kinds))
-        if kind == "spring":
+        if with_components:
+            kinds += ["wet", "emtc"]
+        kind = draw(st.sampled_from(["wet", "emtc"] if i == forced else kinds))
+        if kind == "wet":
+            force = draw(st.sampled_from([Signal.ramp(draw(st.floats(300.0, 3000.0)), draw(st.floats(0.05, 0.4)),
+                                                      start=draw(st.floats(0.0, 0.3))),
+                                          Signal.constant(draw(st.floats(300.0, 3000.0)))]))
+            d.wet_clutch(f"w{i}", a, b, force=force)
+        elif kind == "emtc":
+            d.emtc(f"e{i}", a, b)
+        elif kind == "spring":
             d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
         elif kind == "backlash":
             d.backlash(f"k{i}", a, b, c=draw(st.floats(10.0, 500.0)), b_gap=draw(st.floats(0.01, 0.3)),

@@ -234,16 +234,8 @@ def test_refusals(tmp_path):
     with pytest.raises(ParameterError, match="LuGre"):
         d.emtc("c", "a", "b", options=S.BenchOptions(lugre=LuGreParameters()))
     d.emtc("c", "a", "b")
-    with pytest.raises(ParameterError, match="one EMTC"):
-        d.emtc("c2", "a", "b")
-    with pytest.raises(ParameterError, match="wet clutch and an EMTC"):
-        d.wet_clutch("w", "a", "b", force=100.0)
-    w = Driveline("y")
-    w.inertia("a", J=1.0)
-    w.inertia("b", J=1.0)
-    w.wet_clutch("w", "a", "b", force=100.0)
-    with pytest.raises(ParameterError, match="cannot share a network"):
-        w.emtc("c", "a", "b")
+    with pytest.raises(ParameterError, match="used twice"):
+        d.emtc("c", "a", "b")
     # a bench file that names its own magnet: the component's field names it
     src = tmp_path / "bench.toml"
     src.write_text('[scenario]\ngear = 2\n[magnet]\nmodel = "m.json"\n')

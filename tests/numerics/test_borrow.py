@@ -1,4 +1,5 @@
-"""The core's views without reference counting: ``take`` (one variant of stacked parameters) and ``shaped``."""
+"""The core's views without reference counting: ``take`` (one variant of stacked parameters), ``row`` (one of
+several structures of different sizes, ``stack_rows``) and ``shaped``."""
 
 from __future__ import annotations
 
@@ -6,11 +7,12 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hypothesis_budget import examples
-from clutchlab.numerics.borrow import byref, shaped, take
+from clutchlab.numerics.borrow import byref, row, row_of, shaped, stack_rows, take
 
 
 class Inner(NamedTuple):
@@ -67,3 +69,80 @@ def test_shaped_views_a_block_as_numpy_reshape_does(start, a, b):
     view, strides, last = _shaped_sum(flat, start, a, b)
     ref = flat[start:start + a * b].reshape(a, b)
     assert np.array_equal(view, ref) and strides == ref.strides and last == ref[-1, -1]
+
+
+# ---------------------------------------------------------------- rows of different sizes (stack_rows / row)
+class Model(NamedTuple):
+    inner: Inner
+    pair: tuple
+    curve: np.ndarray
+    memory: np.ndarray
+    grid: np.ndarray
+
+
+@numba.njit(cache=True)
+def _model_sum(p):
+    """What a model's hook reads of its structure: numbers, nested tuples, array shapes and elements."""
+    s = p.inner.k * p.inner.n + p.pair[0] - p.pair[1]
+    for i in range(p.curve.shape[0]):
+        for j in range(p.curve.shape[1]):
+            s += (i + 1) * (j + 2) * p.curve[i, j]
+    return s + p.memory.shape[0] * 1000.0 + p.grid[p.grid.shape[0] - 1]
+
+
+@numba.njit(cache=True)
+def _row_sum(P, j):
+    return _model_sum(row(P, j))
+
+
+@numba.njit(cache=True)
+def _row_sum_byref(P, j):
+    return _model_sum(row(byref(P), j))
+
+
+@numba.njit(cache=True)
+def _row_write(P, j, value):
+    r = row(P, j)
+    r.memory[r.memory.shape[0] - 1] = value
+
+
+def _model(rng, a, b, m):
+    return Model(Inner(float(rng.normal()), int(rng.integers(1, 9))), (float(rng.normal()), float(rng.normal())),
+                 rng.normal(size=(a, b)), np.arange(m, dtype=np.int64), np.sort(rng.normal(size=a + 1)))
+
+
+@settings(max_examples=examples(30), deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(1, 5), st.integers(0, 6)), min_size=1, max_size=5),
+       st.integers(0, 2 ** 32 - 1))
+def test_row_gives_each_structure_back_whatever_its_sizes(sizes, seed):
+    """``stack_rows`` of structures whose arrays differ in size (empty ones too), and ``row``: each row is its
+    structure, to the bit, in compiled code (directly and through a reference) and in Python (``row_of``); a write
+    into a row's array lands in that row's part only; and the row has the numba type of the structure, so a model's
+    function compiled for one serves the rows unchanged."""
+    rng = np.random.default_rng(seed)
+    models = [_model(rng, *s) for s in sizes]
+    P = stack_rows(models)
+    for j, p in enumerate(models):
+        assert _row_sum(P, j) == _model_sum(p) == _row_sum_byref(P, j)
+        back = row_of(P, j)
+        assert numba.typeof(back) == numba.typeof(p)
+        assert np.array_equal(back.curve, p.curve) and np.array_equal(back.grid, p.grid)
+        assert back.inner == p.inner and back.pair == p.pair
+    assert len(_model_sum.signatures) == 1
+    for j, p in enumerate(models):
+        if p.memory.size:
+            _row_write(P, j, -5)
+            assert row_of(P, j).memory[-1] == -5
+            assert all(np.array_equal(row_of(P, i).memory, q.memory) for i, q in enumerate(models) if i != j)
+            P.memory.data[P.memory.start[j] + p.memory.size - 1] = p.memory[-1]
+
+
+def test_stack_rows_of_none_has_the_type_of_any_number():
+    """No structure (a network without that component), from a template: the same numba type as for any number of
+    rows, so one compiled kernel serves them all; a structure of another kind is refused by name."""
+    rng = np.random.default_rng(1)
+    one, two = _model(rng, 2, 3, 4), _model(rng, 1, 1, 0)
+    assert numba.typeof(stack_rows([], template=one)) == numba.typeof(stack_rows([one, two]))
+    assert numba.typeof(stack_rows([one])) == numba.typeof(stack_rows([two, one, two]))
+    with pytest.raises(TypeError, match="dimensions"):
+        stack_rows([one, one._replace(curve=np.zeros(3))])

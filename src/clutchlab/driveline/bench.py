@@ -13,7 +13,8 @@ from .network import Driveline, Signal
 __all__ = ["drum_bench", "engine_curve", "rolling_curve"]
 
 
-def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: str = "emtc_awd"):
+def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: str = "emtc_awd", into=None,
+               prefix: str = ""):
     """The AWD vehicle with its EMTC on the drum bench of seed 002 (Sec. 4, Eq. 27) as a
     :class:`~clutchlab.driveline.Driveline`: the same equations as :func:`clutchlab.emtc.system.simulate`,
     written as a network.
@@ -32,7 +33,9 @@ def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: 
     free rolling on the drums, as the bench's.  ``scenario``
     (:class:`~clutchlab.emtc.bench.BenchScenario`), ``vehicle``
     (:class:`~clutchlab.emtc.bench.VehicleParameters`), ``magnet`` and ``options`` as
-    :func:`clutchlab.emtc.system.simulate`; ``name``: the network's name.
+    :func:`clutchlab.emtc.system.simulate`; ``name``: the network's name.  ``into``: a
+    :class:`~clutchlab.driveline.Driveline` to add the bench to (several benches, each with its coupling, in one
+    network), ``prefix``: put before every component's name (``"front_"``: ``front_emtc``).
     """
     sc = scenario or BenchScenario()
     veh = vehicle or VehicleParameters()
@@ -40,27 +43,28 @@ def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: 
     i_tr = float(veh.gear_ratios[sc.gear - 1]) * float(veh.front_final_drive)
     vf, vr = float(sc.drum_speed), float(sc.drum_speed - sc.speed_difference)
     fzf, fzr = veh.axle_loads()
-    d = Driveline(name)
-    d.inertia("front_shaft", J=veh.inertia_input_shaft, w0=vf / r * ic)
-    d.inertia("rear_shaft", J=veh.inertia_output_shaft, w0=vr / r * ic)
-    d.inertia("front_axle", J=veh.inertia_front_axle, w0=vf / r)
-    d.inertia("rear_axle", J=veh.inertia_rear_axle, w0=vr / r)
-    d.inertia("drum_front", J=1.0, w0=vf / r)
-    d.inertia("drum_rear", J=1.0, w0=vr / r)
-    d.speed("drum_front_drive", "drum_front", vf / r)
-    d.speed("drum_rear_drive", "drum_rear", vr / r)
-    d.gear("front_drive", "front_shaft", "front_axle", ratio=ic)
-    d.gear("rear_drive", "rear_shaft", "rear_axle", ratio=ic)
+    d = Driveline(name) if into is None else into
+    P = prefix
+    d.inertia(P + "front_shaft", J=veh.inertia_input_shaft, w0=vf / r * ic)
+    d.inertia(P + "rear_shaft", J=veh.inertia_output_shaft, w0=vr / r * ic)
+    d.inertia(P + "front_axle", J=veh.inertia_front_axle, w0=vf / r)
+    d.inertia(P + "rear_axle", J=veh.inertia_rear_axle, w0=vr / r)
+    d.inertia(P + "drum_front", J=1.0, w0=vf / r)
+    d.inertia(P + "drum_rear", J=1.0, w0=vr / r)
+    d.speed(P + "drum_front_drive", P + "drum_front", vf / r)
+    d.speed(P + "drum_rear_drive", P + "drum_rear", vr / r)
+    d.gear(P + "front_drive", P + "front_shaft", P + "front_axle", ratio=ic)
+    d.gear(P + "rear_drive", P + "rear_shaft", P + "rear_axle", ratio=ic)
     speeds, torques = engine_curve(veh, i_tr)
-    d.engine("engine", "front_axle", torque_map=np.column_stack([speeds, torques]),
+    d.engine(P + "engine", P + "front_axle", torque_map=np.column_stack([speeds, torques]),
              throttle=Signal.table([0.0, sc.ramp_start, max(sc.ramp_end, sc.ramp_start + 1e-9)],
                                    [sc.throttle_start, sc.throttle_start, sc.throttle_end]))
     for side, v, fz, load in (("front", vf, fzf, sc.drum_load_front), ("rear", vr, fzr, sc.drum_load_rear)):
         k = 2.0 * veh.tyre_slip_stiffness * r / max(abs(v), veh.slip_speed_floor)
-        d.spring_damper(f"tyres_{side}", f"{side}_axle", f"drum_{side}", d=k * r * r)
-        d.bearing_friction(f"rolling_{side}", f"{side}_axle", torque=rolling_curve(veh.rolling_resistance * fz * r,
-                                                                                   load))
-    d.emtc("emtc", "front_shaft", "rear_shaft", magnet=magnet, scenario=sc, vehicle=veh, options=options)
+        d.spring_damper(f"{P}tyres_{side}", f"{P}{side}_axle", f"{P}drum_{side}", d=k * r * r)
+        d.bearing_friction(f"{P}rolling_{side}", f"{P}{side}_axle",
+                           torque=rolling_curve(veh.rolling_resistance * fz * r, load))
+    d.emtc(P + "emtc", P + "front_shaft", P + "rear_shaft", magnet=magnet, scenario=sc, vehicle=veh, options=options)
     return d
 
 

@@ -31,14 +31,17 @@ the Torsen twist of Eq. 30 stays zero (its terms vanish identically while both s
 The armature events (``armature_rest``, ``armature_contact``, ``armature_leave_rest``,
 ``armature_leave_contact``) are kept and named for the element (``<name>.armature``).
 
-States: the network's, then the coupling's seven (:data:`clutchlab.emtc.system.STATES`; its two shaft
-speeds follow the flanges, integrated from their accelerations and reset to them at every event, its
-Torsen twist stays zero).  Outputs: the network's, then the coupling's :data:`OUTPUTS`.  One EMTC per
-network (its parameters are one :class:`~clutchlab.emtc.system.EmtcParams`).
+States: per coupling its seven (:data:`clutchlab.emtc.system.STATES`; its two shaft speeds follow the flanges,
+integrated from their accelerations and reset to them at every event, its Torsen twist stays zero), after the
+network's and its wet clutches'.  Outputs: per coupling its :data:`OUTPUTS`.  Any number of couplings per
+network, each with its own magnet, maps and controller: their parameters are rows of one :class:`EmtcBlock`,
+called here one by one through the EMTC model's own hooks (:mod:`clutchlab.driveline.coupled` joins them to the
+network and its wet clutches).
 """
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numba
@@ -46,17 +49,19 @@ import numpy as np
 
 from ..emtc import system as S
 from ..numerics import dispatch
-from ..numerics.borrow import byref
-from .kernel import DrivelineParams
+from ..numerics.borrow import byref, member, row, stack_rows
 from . import kernel as K
 
-__all__ = ["EmtcDrivelineParams", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX"]
+__all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
 
 N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
 # conf (int64): the friction index of the coupling, its element row, then the offsets of its states, switching
 # functions and modes in the whole system's, the number of the network's events and the index of its first named
 # element (``<name>.armature``, then ``<name>.coupling``)
 F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
+N_CONF = 7
+#: coupling j's model errors are its model's codes minus ``ERROR_STRIDE j`` (clutchlab.emtc.system.ERROR_MESSAGES)
+ERROR_STRIDE = 1_000_000
 # buf (float): its states with the shaft speeds replaced | their derivative | switching values | inputs (zero) |
 # outputs
 B_X, B_DX, B_G, B_U = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH
@@ -79,182 +84,178 @@ _REST = S.MODE_VALUES[_ARM].index("rest")
 _SLIP_ZERO, _UNLOCK = ([q[0] for q in S.SWITCHING].index(q) for q in ("slip_speed_zero", "lock_capacity_exceeded"))
 
 
-class EmtcDrivelineParams(NamedTuple):
-    """Packed parameters of a driveline with an EMTC coupling: the network, the coupling's parameters packed
-    by :func:`clutchlab.emtc.system.pack_parameters` (its vehicle data used only by its controller's map and
-    its drag data), ``conf`` (int64, the layout ``F_*``), ``buf`` (float, scratch ``B_*``), ``mbuf`` (int64,
-    its modes) and ``index`` (int64, :data:`OUTPUT_INDEX`)."""
+class EmtcBlock(NamedTuple):
+    """The EMTC couplings of a network (rows ``j``, none or more): ``params``, their parameters packed by
+    :func:`clutchlab.emtc.system.pack_parameters` and stacked as rows (:func:`clutchlab.numerics.borrow.stack_rows`:
+    any number of couplings, each with its own magnet and table sizes, is one type; its vehicle data used only by
+    its controller's map and its drag data), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch
+    ``B_*``), ``mbuf[j]`` (int64, its modes) and ``index`` (int64, :data:`OUTPUT_INDEX`).  A member of
+    :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
-    net: DrivelineParams
-    emtc: S.EmtcParams
+    params: S.EmtcParams
     conf: np.ndarray
     buf: np.ndarray
     mbuf: np.ndarray
     index: np.ndarray
 
 
-@numba.njit(cache=True, nogil=True)
-def _load(x, m, p):
-    """The coupling's own states and modes from the network's into ``p.buf``/``p.mbuf``: its shaft speeds
+@functools.lru_cache(maxsize=1)
+def _template():
+    """An :class:`~clutchlab.emtc.system.EmtcParams` of a tiny magnet: the types of an empty :class:`EmtcBlock`."""
+    from ..emtc.bench import BenchScenario, VehicleParameters
+    from ..hysteresis import Preisach
+
+    return S.pack_parameters(Preisach([0.0, 1.0], np.zeros((2, 2))), BenchScenario(), VehicleParameters(),
+                             S.BenchOptions())
+
+
+def block(params, conf) -> EmtcBlock:
+    """The block of the couplings packed as ``params`` (a list of :class:`~clutchlab.emtc.system.EmtcParams`) with
+    their layouts ``conf`` (rows ``F_*``); no coupling for empty lists."""
+    n = len(params)
+    return EmtcBlock(stack_rows(params, template=None if params else _template()),
+                     np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
+                     np.zeros((n, N_MODE), dtype=np.int64), OUTPUT_INDEX.copy())
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _load(x, m, net, e, j):
+    """Coupling ``j``'s own states and modes from the network's into ``e.buf[j]``/``e.mbuf[j]``: its shaft speeds
     are the flanges', its coupling mode ``slipping`` while the armature presses (else ``open``), its slip
     direction the network's (stuck: ``positive``; the torque magnitudes do not depend on it)."""
-    cf = p.conf
-    net = byref(p.net)
+    cf = e.conf[j]
     n = net.inertia.shape[0]
-    e = net.elem[cf[F_ROW]]
-    b = p.buf
+    el = net.elem[cf[F_ROW]]
+    b = e.buf[j]
     for i in range(N_STATE):
         b[B_X + i] = x[cf[F_X] + i]
-    b[B_X] = K._speed(x, n, e[K.E_A])
-    b[B_X + 1] = K._speed(x, n, e[K.E_B])
+    b[B_X] = K._speed(x, n, el[K.E_A])
+    b[B_X + 1] = K._speed(x, n, el[K.E_B])
     b[B_X + 2] = 0.0
-    ms = p.mbuf
+    ms = e.mbuf[j]
     ms[_ARM] = m[cf[F_M] + _ARM]
     ms[_CPL] = _SLIPPING if ms[_ARM] == _CONTACT else _OPEN
     ms[_DIR] = _NEGATIVE if m[cf[F_K]] == K.FORWARD else _POSITIVE
 
 
-@numba.njit(cache=True, nogil=True)
-def _coupling(t, x, m, p):
-    """Evaluate the coupling at the network's state (:func:`_load`) through its hooks: its derivative,
-    switching values and outputs into ``p.buf``, its sliding torque (its output ``coupling_torque``) and
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _coupling(t, x, m, net, e, j):
+    """Evaluate coupling ``j`` at the network's state (:func:`_load`) through its hooks: its derivative,
+    switching values and outputs into ``e.buf[j]``, its sliding torque (its output ``coupling_torque``) and
     static and lock-up limits (from ``capacity_locked``) into the network (:func:`kernel.set_external`)."""
-    _load(x, m, p)
-    b = p.buf
+    _load(x, m, net, e, j)
+    b = e.buf[j]
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
-    dispatch.rhs(t, xs, us, p.mbuf, byref(p.emtc), b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
-    dispatch.outputs(t, xs, us, p.mbuf, byref(p.emtc), b[B_Y:N_BUF])   # (the same point: the model reuses it)
-    net = byref(p.net)
-    cap = b[B_Y + _Y_CAP] if p.mbuf[_ARM] == _CONTACT else 0.0
-    K.set_external(net, net.elem[p.conf[F_ROW]][K.E_AUX], abs(b[B_Y + _Y_TC]), p.emtc.coupling.unlock_margin * cap,
+    ep = byref(row(member(e, "params"), j))   # (the row built and stored once: both hooks read it by reference)
+    dispatch.rhs(t, xs, us, e.mbuf[j], ep, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    dispatch.outputs(t, xs, us, e.mbuf[j], ep, b[B_Y:N_BUF])   # (the same point: the model reuses it)
+    cap = b[B_Y + _Y_CAP] if e.mbuf[j][_ARM] == _CONTACT else 0.0
+    K.set_external(net, net.elem[e.conf[j][F_ROW]][K.E_AUX], abs(b[B_Y + _Y_TC]), ep.coupling.unlock_margin * cap,
                    cap)
 
 
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_rhs(t, x, u, m, p, dx, g):
-    """The network's right-hand side and switching functions, then the coupling's (its shaft speeds follow
-    the flanges' accelerations; its lock-up and unlock functions are held off)."""
-    _coupling(t, x, m, p)
-    net = byref(p.net)
-    K.driveline_rhs(t, x, u, m, net, dx, g)
-    acc, _tau = K._acc_tau(net)
-    cf = p.conf
-    b = p.buf
-    e = net.elem[cf[F_ROW]]
-    for i in range(N_STATE):
-        dx[cf[F_X] + i] = b[B_DX + i]
-    dx[cf[F_X]] = 0.0 if e[K.E_A] < 0 else acc[e[K.E_A]]
-    dx[cf[F_X] + 1] = 0.0 if e[K.E_B] < 0 else acc[e[K.E_B]]
-    dx[cf[F_X] + 2] = 0.0
-    for i in range(N_SWITCH):
-        g[cf[F_G] + i] = b[B_G + i]
-    g[cf[F_G] + _SLIP_ZERO] = 1.0
-    g[cf[F_G] + _UNLOCK] = 1.0
-    return None
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def evaluate(t, x, m, net, e):
+    """Evaluate every coupling (:func:`_coupling`)."""
+    for j in range(e.conf.shape[0]):
+        _coupling(t, x, m, net, e, j)
 
 
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_outputs(t, x, u, m, p, y):
-    """The network's outputs, then the coupling's (:data:`OUTPUTS`)."""
-    _coupling(t, x, m, p)
-    K.driveline_outputs(t, x, u, m, byref(p.net), y)
-    b = p.buf
-    q = y.shape[0] - p.index.shape[0]
-    for i in range(p.index.shape[0]):
-        y[q + i] = b[B_Y + p.index[i]]
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def derivatives(net, e, acc, dx, g):
+    """Each coupling's derivatives and switching functions after the network's right-hand side (its shaft speeds
+    follow the flanges' accelerations ``acc``; its lock-up and unlock functions are held off)."""
+    for j in range(e.conf.shape[0]):
+        cf = e.conf[j]
+        b = e.buf[j]
+        el = net.elem[cf[F_ROW]]
+        for i in range(N_STATE):
+            dx[cf[F_X] + i] = b[B_DX + i]
+        dx[cf[F_X]] = 0.0 if el[K.E_A] < 0 else acc[el[K.E_A]]
+        dx[cf[F_X] + 1] = 0.0 if el[K.E_B] < 0 else acc[el[K.E_B]]
+        dx[cf[F_X] + 2] = 0.0
+        for i in range(N_SWITCH):
+            g[cf[F_G] + i] = b[B_G + i]
+        g[cf[F_G] + _SLIP_ZERO] = 1.0
+        g[cf[F_G] + _UNLOCK] = 1.0
 
 
-@numba.njit(cache=True, nogil=True)
-def _sync(x, m, p):
-    """The coupling's shaft-speed states reset to its flanges' speeds, its twist to zero (an event, a restart)."""
-    net = byref(p.net)
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def outputs(e, y, q):
+    """Each coupling's outputs (:data:`OUTPUTS`) into ``y`` from ``q`` on; returns the index after them."""
+    for j in range(e.conf.shape[0]):
+        b = e.buf[j]
+        for i in range(e.index.shape[0]):
+            y[q + i] = b[B_Y + e.index[i]]
+        q += e.index.shape[0]
+    return q
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def sync(x, net, e):
+    """Each coupling's shaft-speed states reset to its flanges' speeds, its twist to zero (an event, a restart)."""
     n = net.inertia.shape[0]
-    cf = p.conf
-    e = net.elem[cf[F_ROW]]
-    x[cf[F_X]] = K._speed(x, n, e[K.E_A])
-    x[cf[F_X] + 1] = K._speed(x, n, e[K.E_B])
-    x[cf[F_X] + 2] = 0.0
+    for j in range(e.conf.shape[0]):
+        cf = e.conf[j]
+        el = net.elem[cf[F_ROW]]
+        x[cf[F_X]] = K._speed(x, n, el[K.E_A])
+        x[cf[F_X] + 1] = K._speed(x, n, el[K.E_B])
+        x[cf[F_X] + 2] = 0.0
 
 
-@numba.njit(cache=True, nogil=True)
-def _write_back(x, m, p, start, log):
-    """The coupling's armature and current states and its armature mode from ``p.buf``/``p.mbuf`` into the
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _write_back(x, m, e, j, start, log):
+    """Coupling ``j``'s armature and current states and its armature mode from ``e.buf[j]``/``e.mbuf[j]`` into the
     network's, its events from ``start`` on renamed (codes after the network's, elements after its names)."""
-    cf = p.conf
+    cf = e.conf[j]
     for i in range(3, N_STATE):
-        x[cf[F_X] + i] = p.buf[B_X + i]
-    m[cf[F_M] + _ARM] = p.mbuf[_ARM]
+        x[cf[F_X] + i] = e.buf[j][B_X + i]
+    m[cf[F_M] + _ARM] = e.mbuf[j][_ARM]
     for i in range(start, min(log.count[0], log.time.shape[0])):
         log.code[i] += cf[F_EV]
         log.element[i] += cf[F_EL]
 
 
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_update(t, x, u, m, p, k, log):
-    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or one of the
-    coupling's armature functions (its own update: rest stop, contact, leaving them); then the network's
-    modes at the coupling's new torque."""
-    _sync(x, m, p)
-    _coupling(t, x, m, p)
-    ng = p.conf[F_G]
-    if k < ng:
-        res = K.driveline_update(t, x, u, m, byref(p.net), k, log)
-        _sync(x, m, p)
-        return res
-    _load(x, m, p)
-    b = p.buf
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def error_code(code, j):
+    """Coupling ``j``'s model error ``code`` (:data:`clutchlab.emtc.system.ERROR_MESSAGES`) as the network's:
+    ``code - ERROR_STRIDE j``, so the message names the coupling."""
+    return code - ERROR_STRIDE * j
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def call(t, x, m, net, e, j, k, log):
+    """Coupling ``j``'s model hook on its own states and modes (``k >= 0``: its update for switching function
+    ``k``; ``k < 0``: its restart, 1 if it changed something), its events renamed, its states and armature mode
+    written back; a model error as :func:`error_code`."""
+    _load(x, m, net, e, j)
+    b = e.buf[j]
     start = log.count[0]
-    res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc), k - ng, log)
-    _write_back(x, m, p, start, log)
-    if res < 0:
-        return res
-    _coupling(t, x, m, p)
-    K.settle_outlined(t, x, m, byref(p.net), log, m.copy(), np.int64(-1))
-    _sync(x, m, p)
-    return res
+    ep = row(member(e, "params"), j)
+    if k >= 0:
+        res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(ep), k, log)
+    else:
+        res = 1 if dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(ep), log) else 0
+    _write_back(x, m, e, j, start, log)
+    return error_code(res, j) if res < 0 else res
 
 
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_restart(t, x, u, m, p, log):
-    """The coupling's restart (its controller sample when one is due; the armature's modes at a start), then
-    the network's modes at its torque."""
-    _sync(x, m, p)
-    _load(x, m, p)
-    b = p.buf
-    start = log.count[0]
-    changed = dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc), log)
-    _write_back(x, m, p, start, log)
-    _coupling(t, x, m, p)
-    if K.driveline_restart(t, x, u, m, byref(p.net), log):
-        changed = True
-    _sync(x, m, p)
-    return changed
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def accept(t, x, u, m, net, e):
+    """Each coupling's commit of its plant magnet's memory; the first model error (a full memory), else 0."""
+    for j in range(e.conf.shape[0]):
+        _load(x, m, net, e, j)
+        b = e.buf[j]
+        res = dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(row(member(e, "params"), j)))
+        if res < 0:
+            return error_code(res, j)
+    return 0
 
 
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_accept(t, x, u, m, p):
-    """The coupling's commit of its plant magnet's memory (or its model error: a full memory)."""
-    _load(x, m, p)
-    b = p.buf
-    return dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], p.mbuf, byref(p.emtc))
-
-
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_next_break(t, m, p):
-    """The next corner of the network's signals or the coupling's next controller sample."""
-    return min(K.driveline_next_break(t, m, byref(p.net)), dispatch.next_break(t, p.mbuf, byref(p.emtc)))
-
-
-@numba.njit(cache=True, nogil=True)
-def emtc_driveline_jacobian(t, x, u, m, p, J):
-    """No analytic Jacobian (Dormand-Prince)."""
-    return False
-
-
-dispatch.register(EmtcDrivelineParams, rhs=emtc_driveline_rhs, outputs=emtc_driveline_outputs,
-                  update=emtc_driveline_update, restart=emtc_driveline_restart, accept=emtc_driveline_accept,
-                  next_break=emtc_driveline_next_break, jacobian=emtc_driveline_jacobian)
-
-
-# ------------------------------------------------------------------ the drum bench as a network
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def next_break(t, e, tb):
+    """The earlier of ``tb`` and a coupling's next controller sample."""
+    for j in range(e.conf.shape[0]):
+        tb = min(tb, dispatch.next_break(t, e.mbuf[j], byref(row(member(e, "params"), j))))
+    return tb

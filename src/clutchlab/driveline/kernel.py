@@ -426,7 +426,7 @@ def friction_torque(p, r, t, w_abs):
     """
     law = p.elem[r, E_LAW]
     if law == LAW_EXTERNAL:
-        return _external(p)[3 * p.elem[r, E_AUX]]
+        return external_value(p, p.elem[r, E_AUX], 0, t)
     val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
     if law == LAW_TABLE:
         return val
@@ -475,7 +475,7 @@ def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
     clutch's, the most it holds against overrunning)."""
     if p.elem[r, E_LAW] == LAW_EXTERNAL:
-        return _external(p)[3 * p.elem[r, E_AUX] + 1]
+        return external_value(p, p.elem[r, E_AUX], 1, t)
     return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 
@@ -962,7 +962,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     :func:`_null_vector_cached`) | the instant of the last stick/slip search, the event count before it and the
     friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
     the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``) | sliding torque,
-    static limit and lock-up limit of each clutch model (3 per ``LAW_EXTERNAL`` element, :func:`set_external`) | the
+    static limit and lock-up limit of each clutch model, their rates and the time of those (``N_EXT`` per
+    ``LAW_EXTERNAL`` element, :func:`set_external`, :func:`set_external_rates`) | the
     scratch of the rates of stuck margins: the moved state, its derivative and switching functions, and the
     accelerations, torques, holds and torque magnitudes saved meanwhile (:func:`rate_size`, :func:`_margin_rates`,
     addressed from the end) | initial stored energy (1). Returns the offsets as a :class:`WorkLayout`."""
@@ -992,7 +993,7 @@ def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
     signals (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + 3 * nx + rate_size.py_func(n, ne, nf, nl) + 1
+    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + N_EXT * nx + rate_size.py_func(n, ne, nf, nl) + 1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1071,10 +1072,15 @@ def _break_marker(p):
     return borrow(p.work[k:k + 1])
 
 
+#: words per clutch model in the work array: its sliding torque, static limit and lock-up limit, then their rates,
+#: then the time those rates start from (:func:`set_external`, :func:`set_external_rates`)
+N_EXT = 7
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _external(p):
-    """The sliding torques, static limits and lock-up limits of the clutch models (``LAW_EXTERNAL``), three per
-    model."""
+    """The clutch models' words (``LAW_EXTERNAL``, :data:`N_EXT` per model): the sliding torques, static limits and
+    lock-up limits (three per model), then their rates (three per model), then the time of each model's rates."""
     o = _offsets(p)
     return borrow(p.work[o.ext:p.work.shape[0] - 1 - rate_size(p.inertia.shape[0], p.elem.shape[0],
                                                                     p.fric.shape[0], p.lossy.shape[0])])
@@ -1135,9 +1141,42 @@ def set_external(p, j, slide, limit, lock):
     reaches zero; MSL's friction elements use their static limit for both), for the network's evaluations at
     the present state.  Its model's hooks call this before every hook of the network."""
     ext = _external(p)
+    nx = ext.shape[0] // N_EXT
     ext[3 * j] = slide
     ext[3 * j + 1] = limit
     ext[3 * j + 2] = lock
+    for q in range(3):
+        ext[3 * nx + 3 * j + q] = 0.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def set_external_rates(p, j, t0, d_slide, d_limit, d_lock):
+    """Clutch model ``j``'s rates [N m/s] of the three numbers :func:`set_external` gave at ``t0`` (until its next
+    call, which sets them to zero): the network's evaluations at another time (the tie-break of :func:`settle` at
+    ``t + T_TIE``, the margin rates at ``t + T_RATE``) then see the model's torques move, as a source's signal moves.
+    Without them a bearing friction beside a wet clutch whose drag grew past the bearing's limit was judged holding
+    at its break-away instant (its load looked to fall with a falling sine torque, the clutch's rise unseen) and
+    stayed stuck at twice its limit (issue #31)."""
+    ext = _external(p)
+    nx = ext.shape[0] // N_EXT
+    ext[3 * nx + 3 * j] = d_slide
+    ext[3 * nx + 3 * j + 1] = d_limit
+    ext[3 * nx + 3 * j + 2] = d_lock
+    ext[6 * nx + j] = t0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def external_value(p, j, which, t):
+    """Clutch model ``j``'s number ``which`` (0 sliding torque, 1 static limit, 2 lock-up limit) [N m] at time ``t``:
+    as :func:`set_external` gave it, moved by its rate (:func:`set_external_rates`) from the time of the rate (never
+    below zero)."""
+    ext = _external(p)
+    nx = ext.shape[0] // N_EXT
+    v = ext[3 * j + which]
+    rate = ext[3 * nx + 3 * j + which]
+    if rate != 0.0:
+        v = max(0.0, v + (t - ext[6 * nx + j]) * rate)
+    return v
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2383,7 +2422,7 @@ def _item_excess(t, p, tau, i, sticking):
         tq = tau[r]
         lim = holding_limit(p, r, t, tq)
         if sticking and p.elem[r, E_LAW] == LAW_EXTERNAL:
-            lim = _external(p)[3 * p.elem[r, E_AUX] + 2]
+            lim = external_value(p, p.elem[r, E_AUX], 2, t)
         thr = max(lim, noise)
         d = 1 if tq > 0.0 else -1
         return (abs(tq) - thr) / thr, d

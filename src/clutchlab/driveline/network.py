@@ -1155,7 +1155,8 @@ class Driveline:
         is not used) and ``friction`` (a friction law or map of :mod:`clutchlab.wet.friction`, default the
         bench's): as :func:`clutchlab.wet.system.pack_parameters`.  ``temperature0``, ``fluid_temperature0``,
         ``housing_temperature0``: the temperatures [degC] at the start of the pack, the oil reservoir (also the
-        heater's set point) and the housing.  Any number of wet clutches per network.
+        heater's set point) and the housing.  Any number of wet clutches and EMTC couplings per network
+        (:mod:`clutchlab.driveline.coupled`).
         """
         from ..wet.params import Bench, WetClutch, temperature_problem
 
@@ -1182,8 +1183,6 @@ class Driveline:
         if max(forces) > bench.actuator_force_max * (1.0 + 1e-12):   # (an input is saturated there by the model)
             raise ParameterError(f"{name}: force reference {max(forces):g} N exceeds the actuator's "
                                  f"{bench.actuator_force_max:g} N (bench.actuator_force_max)")
-        if any(e.emtc is not None for e in self._elements):
-            raise ParameterError(f"{name}: a wet clutch and an EMTC coupling cannot share a network")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
         el = self._elements[-1]
         el.wet = dict(clutch=clutch, bench=bench, friction=friction, **temps)
@@ -1208,7 +1207,8 @@ class Driveline:
         (:class:`~clutchlab.emtc.bench.VehicleParameters`: the map's vehicle speed and the drag of Eq. 25)
         and ``options`` (:class:`~clutchlab.emtc.system.BenchOptions`: actuator, coupling geometry, torque map,
         controller model, friction map, reference, memory capacity; LuGre friction is refused): as
-        :func:`clutchlab.emtc.system.pack_parameters`.  One EMTC per network, and not with a wet clutch.
+        :func:`clutchlab.emtc.system.pack_parameters`.  Any number of EMTC couplings and wet clutches per network
+        (:mod:`clutchlab.driveline.coupled`).
         """
         from ..emtc.bench import BenchScenario, VehicleParameters
         from ..emtc.system import BenchOptions
@@ -1227,11 +1227,6 @@ class Driveline:
         if options is not None and options.lugre is not None:
             raise ParameterError(f"{name}: LuGre friction is not available in a driveline (its bristle state "
                                  "follows the drum bench's own lock-up logic); give a friction map or none")
-        for e in self._elements:
-            if e.emtc is not None:
-                raise ParameterError(f"{name}: a network holds one EMTC coupling ({e.name} is one)")
-            if e.wet is not None:
-                raise ParameterError(f"{name}: an EMTC coupling and a wet clutch ({e.name}) cannot share a network")
         if a is None or b is None:
             raise ParameterError(f"{name}: an EMTC coupling sits between two inertias (its shafts), not on the ground")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0)
@@ -1241,21 +1236,22 @@ class Driveline:
         el.model = "EMTC coupling (seed 002: three friction elements, ball-cam, Preisach magnet, controller)"
         return self
 
-    def _emtc_parameters(self):
-        """The EMTC coupling's element and packed parameters (:func:`clutchlab.emtc.system.pack_parameters`),
-        or None."""
-        from ..emtc import system as S
-
+    def _emtc_parameters(self) -> list:
+        """Per EMTC coupling: its element, packed parameters (:func:`clutchlab.emtc.system.pack_parameters`) and
+        magnet (an empty list without one)."""
+        out = []
         for el in self._elements:
             if el.emtc is not None:
+                from ..emtc import system as S
+
                 w = el.emtc
                 magnet = w["magnet"]
                 if magnet is None:
                     from ..emtc.magnet import bundled_magnet
 
                     magnet = bundled_magnet()
-                return el, S.pack_parameters(magnet, w["scenario"], w["vehicle"], w["options"]), magnet
-        return None
+                out.append((el, S.pack_parameters(magnet, w["scenario"], w["vehicle"], w["options"]), magnet))
+        return out
 
     def _wet_parameters(self) -> list:
         """Per wet clutch: its element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
@@ -1647,14 +1643,13 @@ class Driveline:
     def system(self, rtol: float = 1e-8, check_invariants: bool = False) -> System:
         """The :class:`~clutchlab.system.System` of this network (Dormand-Prince 5(4), events to 1e-12 s).
 
-        With a wet clutch (:meth:`wet_clutch`) its parameters are a
-        :class:`~clutchlab.driveline.wet.WetDrivelineParams` and its states, outputs, switching functions,
-        modes and events follow the network's (named ``<clutch>.<quantity>``); with an EMTC coupling
-        (:meth:`emtc`), a :class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`, the same way (a full
-        hysteresis memory of its magnet is a model error naming the coupling).  That system holds the
-        coupling's memories (magnet, controller) as the EMTC bench's does: one run per system
-        (:meth:`simulate` builds one per call).  ``check_invariants``: check the invariants of every element at every
-        accepted step (:func:`~clutchlab.driveline.kernel.check_invariants`; the energy balance to ``max(1e-7, 1000
+        With wet clutches (:meth:`wet_clutch`) or EMTC couplings (:meth:`emtc`), any number of each, its
+        parameters are a :class:`~clutchlab.driveline.coupled.CoupledParams` (one compiled kernel for every mix)
+        and its states, outputs, switching functions, modes and events follow the network's, the wet clutches'
+        first (named ``<component>.<quantity>``; a full hysteresis memory of a coupling's magnet is a model error
+        naming the coupling).  That system holds the couplings' memories (magnet, controller) as the EMTC
+        bench's does: one run per system (:meth:`simulate` builds one per call).  ``check_invariants``: check
+        the invariants of every element at every accepted step (:func:`~clutchlab.driveline.kernel.check_invariants`; the energy balance to ``max(1e-7, 1000
         rtol)`` of the energy that flowed plus 1 J); a violation ends the run with a
         :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time."""
         # the kernel functions called through their addresses, compiled or loaded here, on the calling thread: a
@@ -1689,38 +1684,34 @@ class Driveline:
         atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
         events = K.EVENTS
         wet = self._wet_parameters()
-        if wet:
-            p, x0, m0, atol = self._with_wet(p, x0, m0, atol, wet, rtol, len(switching), len(named))
+        emtcs = self._emtc_parameters()
+        error_messages = None
+        if wet or emtcs:
+            from ..emtc import system as S
             from ..wet import system as W
+            from . import emtc as DE
+            from .wet import OUTPUTS as WET_OUTPUTS
 
+            p, x0, m0, atol = self._with_components(p, x0, m0, atol, wet, emtcs, rtol, len(switching), len(named))
             for el, *_ in wet:
                 states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.STATES)
                 switching += tuple((f"{el.name}.{q}", d) for q, d in W.SWITCHING)
                 named += (el.name, f"{el.name}.piston")
                 mode_names += tuple(f"{el.name}.{q}" for q in W.MODE_NAMES)
                 mode_values += W.MODE_VALUES
-            from .wet import OUTPUTS as WET_OUTPUTS
-
+            for el, *_ in emtcs:
+                states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in S.STATES)
+                switching += tuple((f"{el.name}.{q}", d) for q, d in S.SWITCHING)
+                named += tuple(f"{el.name}.{q}" for q in S.ELEMENTS)
+                mode_names += tuple(f"{el.name}.{q}" for q in S.MODE_NAMES)
+                mode_values += S.MODE_VALUES
             for el, *_ in wet:
                 outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in WET_OUTPUTS)
-            events = K.EVENTS + W.EVENTS
-
-        emtc = self._emtc_parameters()
-        error_messages = None
-        if emtc is not None:
-            from ..emtc import system as S
-            from . import emtc as DE
-
-            el, ep, magnet = emtc
-            p, x0, m0, atol = self._with_emtc(p, x0, m0, atol, el, ep, magnet, rtol, len(switching), len(named))
-            states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in S.STATES)
-            switching += tuple((f"{el.name}.{q}", d) for q, d in S.SWITCHING)
-            named += tuple(f"{el.name}.{q}" for q in S.ELEMENTS)
-            mode_names += tuple(f"{el.name}.{q}" for q in S.MODE_NAMES)
-            mode_values += S.MODE_VALUES
-            outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in DE.OUTPUTS)
-            events = K.EVENTS + S.EVENTS
-            error_messages = {code: f"{el.name}: {text}" for code, text in S.ERROR_MESSAGES.items()}
+            for el, *_ in emtcs:
+                outputs += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in DE.OUTPUTS)
+            events = K.EVENTS + W.EVENTS + S.EVENTS
+            error_messages = {code - DE.ERROR_STRIDE * j: f"{el.name}: {text}" for j, (el, *_) in enumerate(emtcs)
+                              for code, text in S.ERROR_MESSAGES.items()}
 
         names_rows = [e.name for e in self._elements]
         invariant_messages = {-(K.INV_BASE + K.N_INV * r + kind): f"invariant violated: {nm}: {what}"
@@ -1745,18 +1736,28 @@ class Driveline:
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name, error_messages=error_messages)
 
-    def _with_wet(self, p, x0, m0, atol, wet, rtol, ng, nel):
-        """The network's parameters, initial state and modes and absolute tolerances joined with the wet
-        clutches' (:class:`~clutchlab.driveline.wet.WetDrivelineParams`)."""
+    def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel):
+        """The network's parameters, initial state and modes and absolute tolerances joined with its wet clutches'
+        and EMTC couplings' (:class:`~clutchlab.driveline.coupled.CoupledParams`; the layout in
+        :mod:`clutchlab.driveline.coupled`).  A coupling starts with its armature at rest, its coil current at its
+        magnet's lowest grid current and its shaft speeds the flanges'."""
+        from ..emtc import system as S
         from ..wet import system as W
+        from . import coupled as DC
+        from . import emtc as DE
         from . import wet as DW
 
         n = len(self._inertias)
-        conf, xs, ms, tols, consts, datas = [], [x0], [m0], [atol], [], []
-        nx, nm = x0.size, m0.size
-        for j, (el, wp, xw, clutch) in enumerate(wet):
+        nx, nm, nw = x0.size, m0.size, len(wet)
+        xs, ms, tols = [x0], [m0], [atol]
+
+        def friction_index(el):
             r = self._elements.index(el)
-            k = int(np.flatnonzero(p.fric == r)[0])
+            return r, int(np.flatnonzero(p.fric == r)[0])
+
+        conf, consts, datas = [], [], []
+        for j, (el, wp, xw, clutch) in enumerate(wet):
+            r, k = friction_index(el)
             w_rel = (x0[n + p.elem[r][K.E_B]] if p.elem[r][K.E_B] >= 0 else 0.0) - (
                 x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
             xw = xw.copy()
@@ -1773,36 +1774,34 @@ class Driveline:
             tols.append(W.absolute_tolerance(clutch, rtol))
             consts.append(wp.constants)
             datas.append(wp.data)
-        width = max(d.size for d in datas)
-        data = np.zeros((len(datas), width))
-        for j, d in enumerate(datas):
-            data[j, :d.size] = d
-        nw = len(wet)
-        params = DW.WetDrivelineParams(p, np.ascontiguousarray(np.stack(consts)), data,
-                                       np.array(conf, dtype=np.int64), np.zeros((nw, DW.N_BUF)),
-                                       np.zeros((nw, DW.N_MODE), dtype=np.int64))
+        if wet:
+            width = max(d.size for d in datas)
+            data = np.zeros((nw, width))
+            for j, d in enumerate(datas):
+                data[j, :d.size] = d
+            wblock = DW.WetBlock(np.ascontiguousarray(np.stack(consts)), data, np.array(conf, dtype=np.int64),
+                                 np.zeros((nw, DW.N_BUF)), np.zeros((nw, DW.N_MODE), dtype=np.int64))
+        else:
+            wblock = DW.empty_block()
+        nx += nw * W.N_STATE
+        ng += nw * W.N_SWITCH
+        nm += nw * DW.N_MODE
+        nel += 2 * nw
+        conf, packed = [], []
+        for j, (el, ep, magnet) in enumerate(emtcs):
+            r, k = friction_index(el)
+            i0 = float(magnet.grid[0])
+            xs.append(np.array([x0[n + p.elem[r][K.E_A]], x0[n + p.elem[r][K.E_B]], 0.0, 0.0, 0.0, i0, i0]))
+            conf.append([k, r, nx + j * DE.N_STATE, ng + j * DE.N_SWITCH, nm + j * DE.N_MODE,
+                         len(K.EVENTS) + len(W.EVENTS), nel + len(S.ELEMENTS) * j])
+            ms.append(np.array([DE._REST, DE._OPEN, DE._POSITIVE], dtype=np.int64))   # armature at rest, open
+            # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
+            ae = S.ATOL * (float(rtol) / 1e-6)
+            ae[:3] = float(rtol)
+            tols.append(ae)
+            packed.append(ep)
+        params = DC.CoupledParams(p, wblock, DE.block(packed, conf))
         return params, np.concatenate(xs), np.concatenate(ms), np.concatenate(tols)
-
-    def _with_emtc(self, p, x0, m0, atol, el, ep, magnet, rtol, ng, nel):
-        """The network's parameters, initial state and modes and absolute tolerances joined with the EMTC
-        coupling's (:class:`~clutchlab.driveline.emtc.EmtcDrivelineParams`): armature at rest, coil current at
-        the magnet's lowest grid current, shaft speeds the flanges'."""
-        from ..emtc import system as S
-        from . import emtc as DE
-
-        n = len(self._inertias)
-        r = self._elements.index(el)
-        k = int(np.flatnonzero(p.fric == r)[0])
-        i0 = float(magnet.grid[0])
-        xe = np.array([x0[n + p.elem[r][K.E_A]], x0[n + p.elem[r][K.E_B]], 0.0, 0.0, 0.0, i0, i0])
-        conf = np.array([k, r, x0.size, ng, m0.size, len(K.EVENTS), nel], dtype=np.int64)
-        params = DE.EmtcDrivelineParams(p, ep, conf, np.zeros(DE.N_BUF), np.zeros(DE.N_MODE, dtype=np.int64),
-                                        DE.OUTPUT_INDEX.copy())
-        me = np.array([DE._REST, DE._OPEN, DE._POSITIVE], dtype=np.int64)   # armature at rest, open
-        # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
-        ae = S.ATOL * (float(rtol) / 1e-6)
-        ae[:3] = float(rtol)
-        return params, np.concatenate([x0, xe]), np.concatenate([m0, me]), np.concatenate([atol, ae])
 
     def simulate(self, t_end: float, *, rtol: float = 1e-8, atol=None, max_step: float | None = None,
                  output_step: float | None = None, sample_times=None, fixed_step: float | None = None,

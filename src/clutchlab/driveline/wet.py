@@ -25,7 +25,8 @@ stay zero).  Its force is a piecewise-linear profile of its model's, or a networ
 the model's ``force_reference`` input on a zero profile, saturated at 0 N; the actuator starts at the
 input's start).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
 without the six of its bench, :data:`BENCH_ONLY`).  Any number of wet clutches:
-each is packed on its own and evaluated with its own hooks (its parameters one row of the stacked arrays).
+each is packed on its own and evaluated with its own hooks (its parameters one row of a :class:`WetBlock`;
+:mod:`clutchlab.driveline.coupled` joins them to the network and its EMTC couplings).
 """
 
 from __future__ import annotations
@@ -35,19 +36,18 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..numerics import dispatch
 from ..numerics.borrow import byref
 from ..wet import system as W
 from . import kernel as K
-from .kernel import DrivelineParams
 
-__all__ = ["WetDrivelineParams", "N_STATE", "N_SWITCH", "N_MODE"]
+__all__ = ["WetBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "BENCH_ONLY"]
 
 N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
 # conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
 # states, switching functions and modes in the whole system's, the number of the network's events, the index of
 # its first named element (``<name>``, then ``<name>.piston``) and the network input its force reads (-1: none)
 F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = range(8)
+N_CONF = 8
 # buf (float): its states with the slip replaced | their derivative | switching values | its model's inputs (the
 # force reference added to its profile: a network input, else zero; no slip reference) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
@@ -61,14 +61,13 @@ KEPT = np.array([i for i, o in enumerate(W.OUTPUTS) if o[0] not in BENCH_ONLY], 
 N_KEPT = len(OUTPUTS)
 
 
-class WetDrivelineParams(NamedTuple):
-    """Packed parameters of a driveline with wet clutches: the network, then per clutch ``j`` (rows): its
-    parameters packed by :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft
-    (``constants[j]``, ``data[j]``: the rows of the clutches' :class:`~clutchlab.wet.system.WetParams`, the data
-    padded to one length), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch ``B_*``) and
-    ``mbuf[j]`` (int64, its modes)."""
+class WetBlock(NamedTuple):
+    """The wet clutches of a network (rows ``j``, none or more): their parameters packed by
+    :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft (``constants[j]``,
+    ``data[j]``: the rows of the clutches' :class:`~clutchlab.wet.system.WetParams`, the data padded to one
+    length), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch ``B_*``) and ``mbuf[j]``
+    (int64, its modes).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
-    net: DrivelineParams
     constants: np.ndarray
     data: np.ndarray
     conf: np.ndarray
@@ -76,34 +75,39 @@ class WetDrivelineParams(NamedTuple):
     mbuf: np.ndarray
 
 
-@numba.njit(cache=True, nogil=True)
-def _wet(p, j):
+def empty_block() -> WetBlock:
+    """No wet clutch."""
+    return WetBlock(np.zeros((0, 1), dtype=W.CONSTANTS_DTYPE), np.zeros((0, 1)), np.zeros((0, N_CONF), dtype=np.int64),
+                    np.zeros((0, N_BUF)), np.zeros((0, N_MODE), dtype=np.int64))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _wet(w, j):
     """Clutch ``j``'s :class:`~clutchlab.wet.system.WetParams` (views of its rows)."""
-    return W.WetParams(p.constants[j], p.data[j])
+    return W.WetParams(w.constants[j], w.data[j])
 
 
-@numba.njit(cache=True, nogil=True)
-def _clutch(t, x, m, p, j):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _clutch(t, x, m, net, w, j):
     """Evaluate wet clutch ``j`` at the network's state: its derivative, switching values and outputs into
-    ``p.buf[j]``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
+    ``w.buf[j]``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
     Returns the element's relative speed [rad/s]."""
-    cf = p.conf[j]
-    net = byref(p.net)
+    cf = w.conf[j]
     n = net.inertia.shape[0]
     r = cf[F_ROW]
     w_rel = K.relative_speed(net, r, x, n)
-    b = p.buf[j]
+    b = w.buf[j]
     xs = b[B_X:B_X + N_STATE]
     for i in range(N_STATE):
         xs[i] = x[cf[F_X] + i]
     xs[W.S_W] = w_rel
-    ms = p.mbuf[j]
+    ms = w.mbuf[j]
     for i in range(N_MODE):
         ms[i] = m[cf[F_M] + i]
     mk = m[cf[F_K]]
     ms[W.M_FRICTION] = W.STICK if mk == K.STUCK else (W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0)
                                                     else W.SLIP)
-    wp = _wet(p, j)
+    wp = _wet(w, j)
     W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, byref(wp), b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
@@ -113,34 +117,29 @@ def _clutch(t, x, m, p, j):
     return w_rel
 
 
-@numba.njit(cache=True, nogil=True)
-def _hold(u, p):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def hold(u, w):
     """Each clutch's force input (its model's ``force_reference`` input, added to its zero profile): the network
     input it reads, saturated at 0 (an actuator pushes; a negative reference releases it), else zero."""
-    for j in range(p.conf.shape[0]):
-        iu = p.conf[j][F_U]
-        p.buf[j][B_U + W.U_FORCE] = max(u[iu], 0.0) if iu >= 0 else 0.0
+    for j in range(w.conf.shape[0]):
+        iu = w.conf[j][F_U]
+        w.buf[j][B_U + W.U_FORCE] = max(u[iu], 0.0) if iu >= 0 else 0.0
 
 
-@numba.njit(cache=True, nogil=True)
-def _clutches(t, x, m, p):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def evaluate(t, x, m, net, w):
     """Evaluate every wet clutch (:func:`_clutch`)."""
-    for j in range(p.conf.shape[0]):
-        _clutch(t, x, m, p, j)
+    for j in range(w.conf.shape[0]):
+        _clutch(t, x, m, net, w, j)
 
 
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_rhs(t, x, u, m, p, dx, g):
-    """The network's right-hand side and switching functions, then each wet clutch's (its slip speed follows
-    the element's relative acceleration; its lock-up and break-away functions are held off)."""
-    _hold(u, p)
-    _clutches(t, x, m, p)
-    K.driveline_rhs(t, x, u, m, byref(p.net), dx, g)
-    net = byref(p.net)
-    acc, _tau = K._acc_tau(net)
-    for j in range(p.conf.shape[0]):
-        cf = p.conf[j]
-        b = p.buf[j]
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def derivatives(net, w, acc, dx, g):
+    """Each clutch's derivatives and switching functions after the network's right-hand side (its slip speed
+    follows the element's relative acceleration ``acc``; its lock-up and break-away functions are held off)."""
+    for j in range(w.conf.shape[0]):
+        cf = w.conf[j]
+        b = w.buf[j]
         e = net.elem[cf[F_ROW]]
         for i in range(N_STATE):
             dx[cf[F_X] + i] = b[B_DX + i]
@@ -151,38 +150,34 @@ def wet_driveline_rhs(t, x, u, m, p, dx, g):
             g[cf[F_G] + i] = b[B_G + i]
         g[cf[F_G] + W.G_LOCKUP] = 1.0
         g[cf[F_G] + W.G_BREAKAWAY] = -1.0
-    return None
 
 
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_outputs(t, x, u, m, p, y):
-    """The network's outputs, then each wet clutch's own (:data:`OUTPUTS`: the model's without its bench's)."""
-    _hold(u, p)
-    _clutches(t, x, m, p)
-    K.driveline_outputs(t, x, u, m, byref(p.net), y)
-    nw = p.conf.shape[0]
-    q = y.shape[0] - nw * N_KEPT
-    for j in range(nw):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def outputs(w, y, q):
+    """Each clutch's own outputs (:data:`OUTPUTS`: the model's without its bench's) into ``y`` from ``q`` on;
+    returns the index after them."""
+    for j in range(w.conf.shape[0]):
         for i in range(N_KEPT):
-            y[q + j * N_KEPT + i] = p.buf[j][B_Y + KEPT[i]]
+            y[q + i] = w.buf[j][B_Y + KEPT[i]]
+        q += N_KEPT
+    return q
 
 
-@numba.njit(cache=True, nogil=True)
-def _rename(log, start, p, j):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _rename(log, start, w, j):
     """Clutch ``j``'s events recorded from ``start`` on: codes after the network's, elements after its names."""
     for i in range(start, min(log.count[0], log.time.shape[0])):
-        log.code[i] += p.conf[j][F_EV]
-        log.element[i] += p.conf[j][F_EL]
+        log.code[i] += w.conf[j][F_EV]
+        log.element[i] += w.conf[j][F_EL]
 
 
-@numba.njit(cache=True, nogil=True)
-def _sync(x, m, p):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def sync(x, m, net, w):
     """Each clutch's slip-speed state reset to its element's relative speed, and its friction mode to the
     network's (at an event or a restart)."""
-    net = byref(p.net)
     n = net.inertia.shape[0]
-    for j in range(p.conf.shape[0]):
-        cf = p.conf[j]
+    for j in range(w.conf.shape[0]):
+        cf = w.conf[j]
         w_rel = K.relative_speed(net, cf[F_ROW], x, n)
         x[cf[F_X] + W.S_W] = w_rel
         mk = m[cf[F_K]]
@@ -190,21 +185,21 @@ def _sync(x, m, p):
             W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0) else W.SLIP)
 
 
-@numba.njit(cache=True, nogil=True)
-def _wet_call(t, x, m, p, j, k, log):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def call(t, x, m, w, j, k, log):
     """Clutch ``j``'s model hook on its own states and modes (``k >= 0``: its update for switching function
     ``k``; ``k < 0``: its restart), its events renamed; the states and the piston and film modes written back."""
-    cf = p.conf[j]
-    b = p.buf[j]
+    cf = w.conf[j]
+    b = w.buf[j]
     xs = b[B_X:B_X + N_STATE]
-    ms = p.mbuf[j]
+    ms = w.mbuf[j]
     start = log.count[0]
     res = 0
     if k >= 0:
-        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, _wet(p, j), k, log)
-    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, _wet(p, j), log):
+        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, _wet(w, j), k, log)
+    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, _wet(w, j), log):
         res = 1
-    _rename(log, start, p, j)
+    _rename(log, start, w, j)
     for i in range(N_STATE):
         if i != W.S_W:
             x[cf[F_X] + i] = xs[i]
@@ -213,67 +208,17 @@ def _wet_call(t, x, m, p, j, k, log):
     return res
 
 
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_update(t, x, u, m, p, k, log):
-    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`) or a wet clutch's
-    piston and film functions (:func:`clutchlab.wet.system.wet_update`)."""
-    _hold(u, p)
-    _sync(x, m, p)
-    _clutches(t, x, m, p)
-    ng = p.conf[0][F_G]
-    if k < ng:
-        res = K.driveline_update(t, x, u, m, byref(p.net), k, log)
-        _sync(x, m, p)
-        return res
-    j = (k - ng) // N_SWITCH
-    res = _wet_call(t, x, m, p, j, (k - ng) % N_SWITCH, log)
-    _clutches(t, x, m, p)   # the network's modes at the clutch's new state (a piston on its stop, a film opening)
-    K.settle_outlined(t, x, m, byref(p.net), log, m.copy(), np.int64(-1))
-    _sync(x, m, p)
-    return res
-
-
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_restart(t, x, u, m, p, log):
-    """Each wet clutch's restart (piston on or off its stop, film contact), then the network's."""
-    _hold(u, p)
-    _sync(x, m, p)
-    _clutches(t, x, m, p)
-    changed = False
-    for j in range(p.conf.shape[0]):
-        if _wet_call(t, x, m, p, j, -1, log) != 0:
-            changed = True
-    _clutches(t, x, m, p)
-    if K.driveline_restart(t, x, u, m, byref(p.net), log):
-        changed = True
-    _sync(x, m, p)
-    return changed
-
-
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_accept(t, x, u, m, p):
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def accept(t, x, u, m, w):
     """Each wet clutch's peak-temperature memory."""
-    for j in range(p.conf.shape[0]):
-        o = p.conf[j][F_X]
-        W.wet_accept(t, x[o:o + N_STATE], u, m, _wet(p, j))
-    return 0
+    for j in range(w.conf.shape[0]):
+        o = w.conf[j][F_X]
+        W.wet_accept(t, x[o:o + N_STATE], u, m, _wet(w, j))
 
 
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_next_break(t, m, p):
-    """The next corner of the network's signals or of a clutch's force profile."""
-    tb = K.driveline_next_break(t, m, byref(p.net))
-    for j in range(p.conf.shape[0]):
-        tb = min(tb, W.wet_next_break(t, m, _wet(p, j)))
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def next_break(t, m, w, tb):
+    """The earlier of ``tb`` and the next corner of a clutch's force profile."""
+    for j in range(w.conf.shape[0]):
+        tb = min(tb, W.wet_next_break(t, m, _wet(w, j)))
     return tb
-
-
-@numba.njit(cache=True, nogil=True)
-def wet_driveline_jacobian(t, x, u, m, p, J):
-    """No analytic Jacobian (Dormand-Prince)."""
-    return False
-
-
-dispatch.register(WetDrivelineParams, rhs=wet_driveline_rhs, outputs=wet_driveline_outputs,
-                  update=wet_driveline_update, restart=wet_driveline_restart, accept=wet_driveline_accept,
-                  next_break=wet_driveline_next_break, jacobian=wet_driveline_jacobian)

@@ -1078,6 +1078,11 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     if options.friction_map is not None:
         fm = options.friction_map
         fmap, fmode = (fm.slip_speed, fm.temperature_c, fm.mu), FRICTION_MAP
+        # as for LuGre below: the locked capacity (Eq. 21) must cover the map's kinetic friction at zero slip, else
+        # a slip that reaches zero can neither lock (its torque exceeds the capacity) nor reverse (the kinetic torque
+        # then drives it back): the bench chattered and left the slip running the wrong way, the driveline missed
+        # the crossing (issue #30).  Each element's static coefficient is at least the map's largest at zero slip
+        geo[3:6] = [max(g, float(np.max(fm.mu[0]))) for g in geo[3:6]]
     elif options.lugre is not None:
         lugre = tuple(float(q) for q in options.lugre.kernel_data())
         # the locked capacity must use LuGre's own breakaway coefficient, else the friction just after

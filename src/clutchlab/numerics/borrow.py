@@ -18,13 +18,16 @@ returned to Python or stored beyond the call.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
+import numpy as np
 from numba.core import cgutils, types
 from numba.core.imputils import impl_ret_borrowed, lower_getattr_generic
 from numba.core.typing.templates import AttributeTemplate, infer_getattr
 from numba.extending import intrinsic, models, register_model
 from numba.np.arrayobj import load_item
 
-__all__ = ["borrow", "byref", "ByRef", "take", "shaped"]
+__all__ = ["borrow", "byref", "ByRef", "member", "take", "shaped", "Ragged", "stack_rows", "row", "row_of"]
 
 
 def _has_arrays(ty) -> bool:
@@ -122,20 +125,43 @@ def byref(typingctx, value):
     return sig, codegen
 
 
+@intrinsic
+def member(typingctx, ref, name):
+    """A :class:`ByRef` to member ``name`` (a literal string) of the tuple a :class:`ByRef` points to: its address,
+    nothing loaded.  ``ref.name`` loads the member, and in reference-counted code counts every array in it (a model's
+    stacked parameters: about sixty calls); this passes it on as one pointer (``row(member(e, "params"), j)``)."""
+    if not isinstance(ref, ByRef) or not isinstance(name, types.StringLiteral):
+        return None
+    pointee = ref.pointee
+    fields = getattr(pointee, "fields", ())
+    if name.literal_value not in fields:
+        return None
+    i = fields.index(name.literal_value)
+    sig = ByRef(pointee.types[i])(ref, name)
+
+    def codegen(context, builder, signature, args):
+        return cgutils.gep_inbounds(builder, args[0], 0, i)
+
+    return sig, codegen
+
+
 # ---------------------------------------------------------------- one variant of stacked parameters
-def _row_type(ty):
+def _row_type(ty, ragged=False):
     """Type of one variant of a stacked structure (None if ``ty`` is not one).
 
     An array becomes the array of one less dimension (its row), a one-dimensional array the scalar of
-    its dtype (a number field), a tuple/NamedTuple the tuple of its members' rows.
+    its dtype (a number field), a tuple/NamedTuple the tuple of its members' rows; with ``ragged``, a
+    :class:`Ragged` member the C-contiguous array of its ``ndim`` (:func:`row`).
     """
+    if ragged and _is_ragged(ty):
+        return types.Array(ty.types[0].dtype, ty.instance_class.ndim, "C")
     if isinstance(ty, types.Array):
         if ty.ndim == 1:
             return ty.dtype
         return ty.copy(ndim=ty.ndim - 1, layout="C" if ty.layout == "C" else "A")
     if not isinstance(ty, types.BaseTuple) or not len(ty.types):
         return None
-    members = [_row_type(t) for t in ty.types]
+    members = [_row_type(t, ragged) for t in ty.types]
     if any(m is None for m in members):
         return None
     if isinstance(ty, types.BaseNamedTuple):  # as numba types a NamedTuple object
@@ -146,6 +172,8 @@ def _row_type(ty):
 
 
 def _take_row(context, builder, ty, row_ty, value, idx):
+    if isinstance(row_ty, types.Array) and _is_ragged(ty):   # (only row() types a Ragged member as an array)
+        return _ragged_row(context, builder, ty, row_ty, value, idx)
     if isinstance(ty, types.Array):
         src = context.make_array(ty)(context, builder, value=value)
         shape = cgutils.unpack_tuple(builder, src.shape)
@@ -186,6 +214,161 @@ def take(typingctx, stacked, v):
     def codegen(context, builder, signature, args):
         value, idx = args
         if ref:  # (a parallel loop takes the structure by reference: its gufunc cannot pass nested tuples)
+            value = builder.load(value)
+        idx = context.cast(builder, idx, signature.args[1], types.intp)
+        return _take_row(context, builder, sty, signature.return_type, value, idx)
+
+    return sig, codegen
+
+
+# ---------------------------------------------------------------- rows of different sizes
+class Ragged(NamedTuple):
+    """One array field of several structures whose arrays differ in size (:func:`stack_rows`): the arrays
+    flattened one after the other into ``data``, row ``j``'s first element ``start[j]`` and its shape
+    ``shape[j]`` (int64, ``(n, ndim)``).  Its subclasses (:func:`_ragged_class`) carry ``ndim`` for the compiler."""
+
+    data: np.ndarray
+    start: np.ndarray
+    shape: np.ndarray
+
+
+class Ragged1(Ragged):
+    """Rows of one-dimensional arrays."""
+    __slots__ = ()
+    ndim = 1
+
+
+class Ragged2(Ragged):
+    """Rows of two-dimensional arrays."""
+    __slots__ = ()
+    ndim = 2
+
+
+class Ragged3(Ragged):
+    """Rows of three-dimensional arrays."""
+    __slots__ = ()
+    ndim = 3
+
+
+class Ragged4(Ragged):
+    """Rows of four-dimensional arrays."""
+    __slots__ = ()
+    ndim = 4
+
+
+_RAGGED = {1: Ragged1, 2: Ragged2, 3: Ragged3, 4: Ragged4}
+
+
+def _ragged_class(ndim: int) -> type:
+    """The :class:`Ragged` subclass of arrays of ``ndim`` dimensions (module-level classes: cached kernels and
+    pickles name them)."""
+    if ndim not in _RAGGED:
+        raise TypeError(f"stack_rows: arrays of {ndim} dimensions (at most 4)")
+    return _RAGGED[ndim]
+
+
+def _is_ragged(ty) -> bool:
+    return isinstance(ty, types.BaseNamedTuple) and issubclass(ty.instance_class, Ragged)
+
+
+def _ragged_row(context, builder, ty, row_ty, value, idx):
+    """Row ``idx`` of a :class:`Ragged` member: a borrowed C-contiguous view of its part of ``data``."""
+    data_ty, start_ty, shape_ty = ty.types
+    data = context.make_array(data_ty)(context, builder, value=builder.extract_value(value, 0))
+    start = context.make_array(start_ty)(context, builder, value=builder.extract_value(value, 1))
+    shp = context.make_array(shape_ty)(context, builder, value=builder.extract_value(value, 2))
+    intp = context.get_value_type(types.intp)
+    first = builder.load(cgutils.gep_inbounds(builder, start.data, idx))
+    ndim = row_ty.ndim
+    base = builder.mul(idx, context.get_constant(types.intp, ndim))
+    dims = [builder.load(cgutils.gep_inbounds(builder, shp.data,
+                                              builder.add(base, context.get_constant(types.intp, d))))
+            for d in range(ndim)]
+    dims = [builder.sext(d, intp) if d.type.width < intp.width else d for d in dims]
+    itemsize = context.get_constant(types.intp, context.get_abi_sizeof(context.get_data_type(data_ty.dtype)))
+    strides, step = [], itemsize
+    for d in reversed(dims):
+        strides.append(step)
+        step = builder.mul(step, d)
+    strides.reverse()
+    ptr = cgutils.gep_inbounds(builder, data.data, first)
+    out = context.make_array(row_ty)(context, builder)
+    context.populate_array(out, data=ptr, shape=cgutils.pack_array(builder, dims),
+                           strides=cgutils.pack_array(builder, strides), itemsize=data.itemsize, meminfo=None)
+    return out._getvalue()
+
+
+def _stack_member(values, template, what):
+    """The values of one member over the rows (numbers: a vector, arrays: a :class:`Ragged`, tuples: member-wise)."""
+    if isinstance(template, np.ndarray):
+        arrays = [np.ascontiguousarray(v) for v in values]
+        for v in arrays:
+            if v.ndim != template.ndim or v.dtype != template.dtype:
+                raise TypeError(f"{what}: an array of {v.ndim} dimensions of {v.dtype} where the first row has "
+                                f"{template.ndim} of {template.dtype}")
+        sizes = np.array([v.size for v in arrays], dtype=np.int64)
+        start = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if len(arrays) else sizes
+        data = (np.concatenate([v.ravel() for v in arrays]) if arrays else np.zeros(0, dtype=template.dtype))
+        shape = (np.array([v.shape for v in arrays], dtype=np.int64).reshape(len(arrays), template.ndim))
+        return _ragged_class(template.ndim)(np.ascontiguousarray(data), start, np.ascontiguousarray(shape))
+    if isinstance(template, tuple):
+        members = [_stack_member([v[k] for v in values], t, f"{what}[{k}]") for k, t in enumerate(template)]
+        return type(template)(*members) if hasattr(template, "_fields") else tuple(members)
+    if isinstance(template, (bool, np.bool_)):
+        dtype = np.bool_
+    elif isinstance(template, (int, np.integer)):
+        dtype = np.int64
+    elif isinstance(template, (float, np.floating)):
+        dtype = np.float64
+    else:
+        raise TypeError(f"{what}: {type(template).__name__} is neither a number, an array nor a tuple")
+    return np.array(values, dtype=dtype).reshape(len(values))
+
+
+def stack_rows(structures, template=None):
+    """Several structures of one kind (a model's parameter NamedTuple) as one structure of rows, whatever the sizes
+    of their arrays: a number field becomes a vector, an array a :class:`Ragged`, a tuple is stacked member by
+    member.  Its numba type does not depend on the number of rows or on their sizes, so a compiled function that
+    takes it serves any number of them (a network's wet clutches or EMTC couplings).  ``template``: a structure
+    of the kind, giving the types where ``structures`` is empty.  :func:`row` (compiled) and :func:`row_of`
+    (Python) give row ``j`` back as views."""
+    structures = list(structures)
+    if template is None:
+        if not structures:
+            raise ValueError("stack_rows: no structures and no template")
+        template = structures[0]
+    return _stack_member(structures, template, type(template).__name__)
+
+
+def row_of(stacked, j: int):
+    """Row ``j`` of :func:`stack_rows`'s result in Python: the structure with views of its arrays."""
+    if isinstance(stacked, Ragged):
+        first, shape = int(stacked.start[j]), tuple(int(d) for d in stacked.shape[j])
+        return stacked.data[first:first + int(np.prod(shape, dtype=np.int64))].reshape(shape)
+    if isinstance(stacked, np.ndarray):
+        return stacked[j].item()
+    members = [row_of(s, j) for s in stacked]
+    return type(stacked)(*members) if hasattr(stacked, "_fields") else tuple(members)
+
+
+@intrinsic
+def row(typingctx, stacked, j):
+    """Row ``j`` of :func:`stack_rows`'s result (or a :class:`ByRef` to it): the structure of that row, its arrays
+    borrowed views of their parts of the :class:`Ragged` data (C-contiguous, the row's own shape), its numbers
+    scalars; valid while ``stacked`` is alive.  ``j`` is not bounds-checked.  The row has the numba type of the
+    structure it was stacked from, so the model's compiled functions serve it unchanged."""
+    ref = isinstance(stacked, ByRef)
+    sty = stacked.pointee if ref else stacked
+    if not isinstance(sty, types.BaseTuple) or not isinstance(j, types.Integer) or not len(sty.types):
+        return None
+    row_ty = _row_type(sty, ragged=True)
+    if row_ty is None:
+        return None
+    sig = row_ty(stacked, j)
+
+    def codegen(context, builder, signature, args):
+        value, idx = args
+        if ref:
             value = builder.load(value)
         idx = context.cast(builder, idx, signature.args[1], types.intp)
         return _take_row(context, builder, sty, signature.return_type, value, idx)

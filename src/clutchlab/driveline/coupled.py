@@ -1,0 +1,275 @@
+"""A network with model components: wet clutches (:mod:`clutchlab.driveline.wet`) and EMTC couplings
+(:mod:`clutchlab.driveline.emtc`), any number of each, in one compiled kernel.
+
+The network's parameters are a :class:`CoupledParams`: the plain network (:class:`~clutchlab.driveline.kernel.
+DrivelineParams`), a :class:`~clutchlab.driveline.wet.WetBlock` of its wet clutches and an
+:class:`~clutchlab.driveline.emtc.EmtcBlock` of its couplings, each a block of rows (none or more).  The
+couplings' parameter structures are stacked as rows whatever their sizes (:func:`clutchlab.numerics.borrow.
+stack_rows`; each coupling its own magnet and maps), so the type, and with it the compiled kernel, is the same for
+a dual-clutch transmission of two wet clutches, a front and a rear EMTC, a wet clutch with an EMTC or any other
+mix: a network of known component kinds never run before compiles nothing (issue #31).
+
+Layout (what :meth:`Driveline.system <clutchlab.driveline.network.Driveline.system>` names): states, switching
+functions, modes and named elements are the network's, then each wet clutch's, then each coupling's; outputs the
+network's, then each wet clutch's :data:`~clutchlab.driveline.wet.OUTPUTS`, then each coupling's
+:data:`~clutchlab.driveline.emtc.OUTPUTS`; events the network's :data:`~clutchlab.driveline.kernel.EVENTS`, then the
+wet model's, then the EMTC's.  Every evaluation first gives each component's sliding torque and static limit to
+the network (:func:`~clutchlab.driveline.kernel.set_external`), then the network's friction state machine decides
+stick and slip for all of them at once (one stuck-set solve over the network).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..numerics import dispatch
+from ..numerics.borrow import member
+from . import emtc as DE
+from . import kernel as K
+from . import wet as DW
+from .kernel import DrivelineParams
+
+__all__ = ["CoupledParams"]
+
+
+class CoupledParams(NamedTuple):
+    """Packed parameters of a network with model components: the network, its wet clutches, its EMTC couplings."""
+
+    net: DrivelineParams
+    wet: DW.WetBlock
+    emtc: DE.EmtcBlock
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _evaluate(t, x, u, m, net, w, e):
+    """Every component at the network's state: its derivatives and switching values into its block's scratch, its
+    torques into the network's.  (Without reference counting: only the EMTC's own hooks keep it, called where a
+    network has a coupling.)"""
+    if w.conf.shape[0] > 0:
+        DW.hold(u, w)
+        DW.evaluate(t, x, m, net, w)
+    if e.conf.shape[0] > 0:
+        DE.evaluate(t, x, m, net, e)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _sync(x, m, net, w, e):
+    """The components' copies of the network's speeds and friction modes (an event, a restart)."""
+    DW.sync(x, m, net, w)
+    DE.sync(x, net, e)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _at_rest(x, m, net):
+    """True if a friction element or lossy gear of the network is stuck or at rest to 1e-6 of its speeds: the only
+    items a stick/slip search looks ahead for (:func:`_with_rates`)."""
+    n = net.inertia.shape[0]
+    for k in range(net.fric.shape[0]):
+        r = net.fric[k]
+        if m[k] == K.STUCK or abs(K.relative_speed(net, r, x, n)) <= 1e3 * K._item_wtol(net, r, x, n):
+            return True
+    return net.lossy.shape[0] > 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _with_rates(t, x, u, m, p):
+    """Every component's torques at ``(t, x)`` given to the network with their rates (:func:`kernel.
+    set_external_rates`: a forward difference over ``T_RATE`` along the whole system's derivative), before a
+    stick/slip search: its look-ahead (the tie-break at ``t + T_TIE``) then sees the components' torques move.  At
+    events only, and only where an item is stuck or at rest (:func:`_at_rest`, the items the search looks ahead
+    for; one more evaluation of the whole system each)."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    if not _at_rest(x, m, net):
+        return
+    nx, ng, nm = _network_sizes(w, e)
+    dx = np.empty(x.shape[0])
+    g = np.empty(ng + w.conf.shape[0] * DW.N_SWITCH + e.conf.shape[0] * DE.N_SWITCH)
+    coupled_rhs(t, x, u, m, p, dx, g)
+    ext = K._external(net)
+    nj = ext.shape[0] // K.N_EXT
+    v0 = ext[:3 * nj].copy()
+    _evaluate(t + K.T_RATE, x + K.T_RATE * dx, u, m, net, w, e)
+    v1 = ext[:3 * nj].copy()
+    _evaluate(t, x, u, m, net, w, e)   # (the components' own scratch back at t, as their calls read it)
+    for j in range(nj):
+        K.set_external_rates(net, j, t, (v1[3 * j] - v0[3 * j]) / K.T_RATE,
+                             (v1[3 * j + 1] - v0[3 * j + 1]) / K.T_RATE, (v1[3 * j + 2] - v0[3 * j + 2]) / K.T_RATE)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_rhs(t, x, u, m, p, dx, g):
+    """The network's right-hand side and switching functions, then each component's."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    _evaluate(t, x, u, m, net, w, e)
+    K.driveline_rhs(t, x, u, m, net, dx, g)
+    acc, _tau = K._acc_tau(net)
+    DW.derivatives(net, w, acc, dx, g)
+    DE.derivatives(net, e, acc, dx, g)
+    return None
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_outputs(t, x, u, m, p, y):
+    """The network's outputs, then each wet clutch's, then each coupling's."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    _evaluate(t, x, u, m, net, w, e)
+    K.driveline_outputs(t, x, u, m, net, y)
+    q = y.shape[0] - w.conf.shape[0] * DW.N_KEPT - e.conf.shape[0] * e.index.shape[0]
+    q = DW.outputs(w, y, q)
+    DE.outputs(e, y, q)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def coupled_update(t, x, u, m, p, k, log):
+    """Switching function ``k`` crossed: the network's (:func:`kernel.driveline_update`), a wet clutch's piston or
+    film function or a coupling's armature function (the component's own update); then the network's modes at
+    the component's new torque."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    _sync(x, m, net, w, e)
+    _evaluate(t, x, u, m, net, w, e)
+    nw, ne = w.conf.shape[0], e.conf.shape[0]
+    ng = w.conf[0][DW.F_G] if nw > 0 else e.conf[0][DE.F_G]
+    if k < ng:
+        _with_rates(t, x, u, m, p)
+        res = K.driveline_update(t, x, u, m, net, k, log)
+        _sync(x, m, net, w, e)
+        return res
+    if nw > 0 and k < ng + nw * DW.N_SWITCH:
+        res = DW.call(t, x, m, w, (k - ng) // DW.N_SWITCH, (k - ng) % DW.N_SWITCH, log)
+    elif ne > 0:
+        ke = k - ng - nw * DW.N_SWITCH
+        res = DE.call(t, x, m, net, e, ke // DE.N_SWITCH, ke % DE.N_SWITCH, log)
+    else:
+        return 0
+    if res < 0:
+        return res
+    _with_rates(t, x, u, m, p)   # the network's modes at the component's new state
+    K.settle_outlined(t, x, m, net, log, m.copy(), np.int64(-1))
+    _sync(x, m, net, w, e)
+    return res
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def coupled_restart(t, x, u, m, p, log):
+    """Each component's restart (a wet clutch's piston and film, a coupling's controller sample when one is due and
+    its armature at a start), then the network's modes at their torques."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    _sync(x, m, net, w, e)
+    _evaluate(t, x, u, m, net, w, e)
+    changed = False
+    for j in range(w.conf.shape[0]):
+        if DW.call(t, x, m, w, j, np.int64(-1), log) != 0:
+            changed = True
+    for j in range(e.conf.shape[0]):
+        if DE.call(t, x, m, net, e, j, np.int64(-1), log) != 0:
+            changed = True
+    _with_rates(t, x, u, m, p)
+    if K.driveline_restart(t, x, u, m, net, log):
+        changed = True
+    _sync(x, m, net, w, e)
+    return changed
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_accept(t, x, u, m, p):
+    """Each wet clutch's peak-temperature memory, each coupling's commit of its magnet's memory (or its model
+    error: a full memory); then, with ``check_invariants``, the network's invariants at the step's state with every
+    component's torques at that state (:func:`kernel.driveline_accept`; before issue #31 a network with a wet clutch
+    or an EMTC never checked them)."""
+    net = member(p, "net")
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    DW.accept(t, x, u, m, w)
+    res = DE.accept(t, x, u, m, net, e)
+    if res < 0:
+        return res
+    if net.check[0] != 0.0:
+        _evaluate(t, x, u, m, net, w, e)
+        return K.driveline_accept(t, x, u, m, net)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_next_break(t, m, p):
+    """The next corner of the network's signals or a wet clutch's force profile, or a coupling's next controller
+    sample."""
+    tb = K.driveline_next_break(t, m, member(p, "net"))
+    tb = DW.next_break(t, m, member(p, "wet"), tb)
+    return DE.next_break(t, member(p, "emtc"), tb)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _network_sizes(w, e):
+    """The numbers of the network's own states, switching functions and modes (the first component's offsets)."""
+    if w.conf.shape[0] > 0:
+        return w.conf[0][DW.F_X], w.conf[0][DW.F_G], w.conf[0][DW.F_M]
+    return e.conf[0][DE.F_X], e.conf[0][DE.F_G], e.conf[0][DE.F_M]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _wants_rates(m, g, nf, k):
+    """True where :func:`kernel.driveline_watch` takes margin rates: a stuck element's turn function marked 0.0 (the
+    one read, ``k``, or any, ``k < 0``)."""
+    if k >= 0:
+        return k < K.N_G * nf and k % K.N_G == K.G_TURN and m[k // K.N_G] == K.STUCK and g[k] == 0.0
+    for j in range(nf):
+        if m[j] == K.STUCK and g[K.N_G * j + K.G_TURN] == 0.0:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_watch(t, x, u, m, p, dx, g, k):
+    """The network's ``watch`` (:func:`kernel.driveline_watch`: the margin rates of its stuck elements near their
+    limits, where the core compares switching functions) on its own states, functions and modes; nothing for a
+    component's function.  The network's rate is a difference of its evaluation at ``t`` and at ``t + T_RATE``
+    along ``dx``: the components' torques at that second point are evaluated first (every state moved along ``dx``,
+    theirs too) and put back at ``t`` after, so the rate has theirs in it.
+
+    Without it (before issue #31 moved the grafts here) a stuck element's turn function stayed at the 0.0 that marks
+    it for the watch, and the rate that decides a stuck element at its limit missed the components' torques: a
+    bearing friction beside a wet clutch whose drag grew past the bearing's limit, under a falling sine torque,
+    stayed stuck at twice its limit (found by the invariant check once it ran for these networks)."""
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    nx, ng, nm = _network_sizes(w, e)
+    net = member(p, "net")
+    if k < ng and _wants_rates(m, g, net.fric.shape[0], k):   # (rare: a stuck element near its limit)
+        _watch_rates(t, x, u, m, p, dx, g, k)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _watch_rates(t, x, u, m, p, dx, g, k):
+    """:func:`coupled_watch`'s rates (reference-counted: it allocates the moved state)."""
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    nx, ng, nm = _network_sizes(w, e)
+    net = member(p, "net")
+    xs = x + K.T_RATE * dx
+    _evaluate(t + K.T_RATE, xs, u, m, net, w, e)
+    K.driveline_watch(t, x[:nx], u, m[:nm], net, dx[:nx], g[:ng], k)
+    _evaluate(t, x, u, m, net, w, e)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_jacobian(t, x, u, m, p, J):
+    """No analytic Jacobian (Dormand-Prince)."""
+    return False
+
+
+dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs, update=coupled_update,
+                  restart=coupled_restart, accept=coupled_accept, next_break=coupled_next_break,
+                  jacobian=coupled_jacobian, watch=coupled_watch)

@@ -1,0 +1,296 @@
+"""Model components composed freely (:mod:`clutchlab.driveline.coupled`, issue #31): two EMTC couplings, a wet
+clutch with EMTCs, a dual-clutch transmission of two wet clutches, in one network and one compiled kernel.
+
+The references are independent: each EMTC against its own drum-bench model (:func:`clutchlab.emtc.system.run`,
+which writes the vehicle, the lock torque and the lock-up logic itself), each wet clutch against its own bench
+(:func:`clutchlab.wet.engagement.simulate_engagement`), the joined networks against the energy balance and the
+invariants of every element (``check_invariants``).  Components that share a network but no flange must each give
+their own run: a layout offset, an event or a parameter row mixed up between components shows there.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+from driveline_networks import networks
+from hypothesis_budget import examples
+
+from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline.bench import drum_bench
+from clutchlab.driveline.coupled import CoupledParams
+from clutchlab.emtc import system as S
+from clutchlab.emtc.bench import load_scenario
+from clutchlab.emtc.friction import FrictionMap
+from clutchlab.errors import SimulationError
+from clutchlab.numerics.borrow import row_of
+from clutchlab.system import simulate
+from clutchlab.wet.engagement import Scenario, simulate_engagement
+from clutchlab.wet.params import Bench, WetClutch
+
+from .test_invariants import _check_columns
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+RTOL = 1e-10
+FMAP = FrictionMap(slip_speed=[0.0, 2.0, 10.0], temperature_c=[20.0, 100.0],
+                   mu=[[0.14, 0.12], [0.12, 0.11], [0.10, 0.09]])
+
+
+@pytest.fixture(scope="module")
+def scenarios():
+    base = load_scenario(EXAMPLES / "emtc_scenario.toml")
+    sc = base["scenario"].replace(duration=0.8)
+    # the second coupling: another drum speed difference (it locks at 0.48 s), throttle and controller sample, and
+    # other parameter sizes (a friction map, a smaller hysteresis memory): its rows differ in size from the first's
+    return (base["vehicle"], sc, S.BenchOptions(),
+            sc.replace(speed_difference=-0.3, throttle_end=0.6, sample_time=0.005),
+            S.BenchOptions(friction_map=FMAP, memory_capacity=200))
+
+
+def _times(duration):
+    return np.arange(0.00025, duration, 0.005)
+
+
+def _bench(scenario, vehicle, options):
+    """The EMTC drum bench's own model (independent of the network)."""
+    def build(cap):
+        return S.bench_system(None, scenario, vehicle,
+                              options if cap is None else dataclasses.replace(options, memory_capacity=cap))
+
+    return S.run(build, scenario.duration, rtol=RTOL, atol=S.ATOL * RTOL * 10,
+                 sample_times=_times(scenario.duration))[1]
+
+
+def _check_emtc(rb, N, ev, p):
+    """The coupling named ``p + "emtc"`` in the network's frame ``N`` (events ``ev``) against its bench run."""
+    B = rb.to_dataframe()
+    w = max(B["omega_f_rad_s"].abs().max(), 1.0)
+    assert np.max(np.abs(B["omega_f_rad_s"] - N[f"{p}front_shaft.w_rad_s"])) < 1e-6 * w
+    assert np.max(np.abs(B["omega_r_rad_s"] - N[f"{p}rear_shaft.w_rad_s"])) < 1e-6 * w
+    tau = max(B["coupling_torque_Nm"].abs().max(), 1.0)
+    assert np.max(np.abs(B["coupling_torque_Nm"] + N[f"{p}emtc.tau_Nm"])) < 1e-5 * tau
+    assert np.max(np.abs(B["i2_A"] - N[f"{p}emtc.i2_A"])) < 1e-6
+    assert np.max(np.abs(B["current_command_A"] - N[f"{p}emtc.current_command_A"])) < 1e-6
+    assert np.max(np.abs(B["magnet_force_N"] - N[f"{p}emtc.magnet_force_N"])) < 1e-4 * B["magnet_force_N"].abs().max()
+    be = rb.events
+    arm_b = [(t, e) for t, e in zip(be["time_s"], be["event"]) if e.startswith("armature")]
+    arm_n = [(t, e) for t, e, el in zip(ev["time_s"], ev["event"], ev["element"]) if el == f"{p}emtc.armature"]
+    assert [e for _, e in arm_b] == [e for _, e in arm_n] and arm_b
+    assert np.allclose([t for t, _ in arm_b], [t for t, _ in arm_n], rtol=0, atol=1e-7)
+    lock_b = be[be["event"] == "lockup"]["time_s"].to_numpy()
+    lock_n = ev[(ev["element"] == f"{p}emtc") & (ev["event"] == "stick")]["time_s"].to_numpy()
+    assert lock_b.size == lock_n.size
+    assert np.allclose(lock_b, lock_n, rtol=0, atol=1e-7)
+
+
+def _dyno(d, name, clutch, w0, force, temperature):
+    """A wet clutch between the ground and a free inertia dynamometer (the wet bench's protocol (c))."""
+    bench = Bench()
+    d.inertia(f"{name}_dyno", J=bench.total_inertia, w0=w0)
+    d.wet_clutch(name, "ground", f"{name}_dyno", force=force, clutch=clutch, bench=bench, temperature0=temperature,
+                 fluid_temperature0=temperature, housing_temperature0=temperature)
+
+
+def _wet_reference(clutch, w0, ramp, temperature, duration, times):
+    sc = Scenario(force_time=[ramp[2], ramp[2] + ramp[1]], force_value=[0.0, ramp[0]], speed_time=[0.0],
+                  speed_value=[0.0], duration=duration, motor="free", initial_slip_speed=w0,
+                  initial_temperature_c=temperature, fluid_temperature_c=temperature,
+                  housing_temperature_c=temperature)
+    return simulate_engagement(clutch, sc, bench=Bench(), sample_times=times, rtol=1e-9)
+
+
+def test_two_emtcs_and_a_wet_clutch_each_give_their_own_run(scenarios):
+    """Two drum benches, each with its EMTC (the second with a friction map and a smaller magnet memory, so its
+    parameter rows differ in size), and a wet clutch on its dynamometer, in one network: every coupling equals
+    its own drum-bench model (speeds, torque, currents, magnet force, armature events, lock-up) and the wet clutch
+    its own bench (speed, torque, temperature, lock-up); the events are named per component."""
+    vehicle, sc1, o1, sc2, o2 = scenarios
+    d = drum_bench(sc1, vehicle, options=o1, name="three", prefix="a_")
+    drum_bench(sc2, vehicle, options=o2, into=d, prefix="b_")
+    ramp = (3000.0, 0.3, 0.05)
+    _dyno(d, "wet", WetClutch.paper(n_c=6), 120.0, Signal.ramp(*ramp[:2], start=ramp[2]), 60.0)
+    system = d.system(RTOL)
+    assert type(system.params) is CoupledParams
+    # the second coupling's rows have their own sizes (ragged rows, one type)
+    first, second = row_of(system.params.emtc.params, 0), row_of(system.params.emtc.params, 1)
+    assert first.plant_stack.size != second.plant_stack.size and first.cold.size != second.cold.size
+    times = _times(sc1.duration)
+    r = d.simulate(sc1.duration, rtol=RTOL, sample_times=times)
+    assert r.ok
+    N, ev = r.to_dataframe(), r.events
+    _check_emtc(_bench(sc1, vehicle, o1), N, ev, "a_")
+    _check_emtc(_bench(sc2, vehicle, o2), N, ev, "b_")
+    assert ((ev["element"] == "b_emtc") & (ev["event"] == "stick")).any()   # the second locks, the first does not
+    assert not ((ev["element"] == "a_emtc") & (ev["event"] == "stick")).any()
+    ref = _wet_reference(WetClutch.paper(n_c=6), 120.0, ramp, 60.0, sc1.duration, times)
+    R = ref.result.to_dataframe()
+    np.testing.assert_allclose(N["wet_dyno.w_rad_s"], R["slip_speed_rad_s"], rtol=0, atol=1e-6 * 120.0)
+    np.testing.assert_allclose(N["wet.clutch_torque_Nm"], R["clutch_torque_Nm"], rtol=0,
+                               atol=1e-6 * np.abs(R["clutch_torque_Nm"]).max())
+    np.testing.assert_allclose(N["wet.temperature_C"], R["temperature_C"], rtol=0, atol=1e-6)
+    stick = ev[(ev["element"] == "wet") & (ev["event"] == "stick")]["time_s"].to_numpy()
+    assert stick.size == 1 and abs(stick[0] - ref.lockup_time) < 1e-7
+    assert {"a_emtc.armature", "b_emtc.armature", "wet.piston"} <= set(ev["element"])
+    assert abs(N["energy_error_J"]).max() < 1e-6 * abs(N["input_work_J"]).max()
+
+
+def _awd_with_launch_clutch():
+    """A launch through a wet clutch into an AWD driveline whose rear axle an EMTC couples: engine (torque, inertia)
+    -> wet clutch -> gearbox input -> gear -> front shaft -> EMTC -> rear shaft; each shaft drives its axle through
+    a final drive, each axle has a road load and a drag."""
+    vehicle = load_scenario(EXAMPLES / "emtc_scenario.toml")["vehicle"]
+    sc = load_scenario(EXAMPLES / "emtc_scenario.toml")["scenario"].replace(throttle_start=0.2, throttle_end=0.8,
+                                                                          ramp_start=0.05, ramp_end=0.4)
+    d = Driveline("launch_awd")
+    d.inertia("engine", J=0.2, w0=180.0).inertia("input", J=0.02).inertia("front_shaft", J=0.05)
+    d.inertia("rear_shaft", J=0.05).inertia("front_axle", J=40.0).inertia("rear_axle", J=40.0)
+    d.torque("engine_torque", "engine", 150.0)
+    d.wet_clutch("launch", "input", "engine", force=Signal.ramp(5000.0, 0.3, start=0.02))
+    d.gear("gearbox", "input", "front_shaft", ratio=3.0)
+    d.gear("front_drive", "front_shaft", "front_axle", ratio=3.5)
+    d.gear("rear_drive", "rear_shaft", "rear_axle", ratio=3.5)
+    for side in ("front", "rear"):
+        d.bearing_friction(f"road_{side}", f"{side}_axle", torque=40.0)
+        d.spring_damper(f"drag_{side}", f"{side}_axle", None, d=2.0)
+    d.emtc("awd", "front_shaft", "rear_shaft", scenario=sc, vehicle=vehicle)
+    return d
+
+
+def test_a_launch_through_a_wet_clutch_into_an_emtc_awd_keeps_every_invariant():
+    """The wet clutch and the EMTC coupled through the network: the wet clutch locks the engine to the gearbox, the
+    EMTC then drives the rear axle.  Every invariant of every element holds at every accepted step (stuck within
+    its static limit, modes consistent with the speeds, dissipation >= 0, the energy balance); the network's energy
+    balance closes; the wet clutch's dissipation equals its own model's friction work, and the heat it stored and
+    gave away."""
+    d = _awd_with_launch_clutch()
+    r = d.simulate(1.0, rtol=1e-9, output_step=1e-3, check_invariants=True)
+    assert r.ok
+    N, ev = r.to_dataframe(), r.events
+    stick = ev[(ev["element"] == "launch") & (ev["event"] == "stick")]["time_s"].to_numpy()
+    assert stick.size >= 1 and 0.05 < stick[0] < 1.0
+    assert ((ev["element"] == "awd.armature") & (ev["event"] == "armature_contact")).any()
+    after = N["time_s"] > stick[0] + 1e-3
+    np.testing.assert_allclose(N["engine.w_rad_s"][after], N["input.w_rad_s"][after], rtol=0, atol=1e-6)
+    # the EMTC carries torque to the rear axle once its armature presses
+    contact = ev[(ev["element"] == "awd.armature") & (ev["event"] == "armature_contact")]["time_s"].iloc[0]
+    late = N["time_s"] > contact + 0.05
+    assert N.loc[late, "awd.tau_Nm"].abs().max() > 10.0
+    work = N["input_work_J"].abs().max()
+    assert abs(N["energy_error_J"]).max() < 1e-7 * work
+    diss = N["launch.dissipated_J"].iloc[-1]
+    assert diss > 100.0 and abs(diss - N["launch.friction_work_J"].iloc[-1]) < 1e-6 * diss
+    assert N["awd.dissipated_J"].iloc[-1] > 0.0 and np.all(np.diff(N["awd.dissipated_J"]) >= -1e-9 * work)
+
+
+def test_a_dual_clutch_shift_conserves_energy():
+    """A dual-clutch upshift (1st, ratio 3, to 2nd, ratio 2) by two wet clutches: the off-going clutch locks the
+    engine to the odd shaft, then releases (it slides backward: the torque phase hands the engine's torque to the
+    on-coming clutch, the inertia phase pulls the engine down) while the on-coming one is applied and ends locked
+    with the engine at twice the vehicle's speed.  Both dissipate, every invariant holds at every step, and the
+    network's energy balance closes with both clutches' dissipation equal to their own model's friction work."""
+    d = Driveline("dct")
+    d.inertia("engine", J=0.25, w0=300.0).inertia("odd", J=0.03, w0=300.0).inertia("even", J=0.03, w0=200.0)
+    d.inertia("vehicle", J=120.0, w0=100.0)
+    d.torque("engine_torque", "engine", 120.0)
+    d.wet_clutch("c1", "odd", "engine", force=Signal.table([0.0, 0.2, 0.35], [6000.0, 6000.0, 0.0]), temperature0=90.0)
+    d.wet_clutch("c2", "even", "engine", force=Signal.table([0.0, 0.2, 0.35], [0.0, 0.0, 6000.0]), temperature0=90.0)
+    d.gear("first", "odd", "vehicle", ratio=3.0)
+    d.gear("second", "even", "vehicle", ratio=2.0)
+    d.spring_damper("drag", "vehicle", None, d=0.5)
+    r = d.simulate(1.2, rtol=1e-9, output_step=1e-3, check_invariants=True)
+    assert r.ok
+    N, ev = r.to_dataframe(), r.events
+    c1 = ev[ev["element"] == "c1"]
+    c2 = ev[ev["element"] == "c2"]
+    assert list(c1["event"]) == ["forward", "contact", "stick", "backward", "separation"]
+    assert list(c2["event"]) == ["contact", "stick"]
+    t_lock1, t_release1, t_lock2 = (float(c1["time_s"].iloc[2]), float(c1["time_s"].iloc[3]),
+                                    float(c2["time_s"].iloc[1]))
+    assert t_lock1 < t_release1 < t_lock2
+    first = (N["time_s"] > t_lock1 + 1e-3) & (N["time_s"] < t_release1 - 1e-3)
+    np.testing.assert_allclose(N["engine.w_rad_s"][first], 3.0 * N["vehicle.w_rad_s"][first], rtol=1e-9)
+    end = N["time_s"] > t_lock2 + 1e-3
+    np.testing.assert_allclose(N["engine.w_rad_s"][end], 2.0 * N["vehicle.w_rad_s"][end], rtol=1e-9)
+    assert N["vehicle.w_rad_s"].iloc[-1] > N["vehicle.w_rad_s"].iloc[0] + 2.0
+    work = N["input_work_J"].abs().max()
+    assert abs(N["energy_error_J"]).max() < 1e-7 * work
+    for c in ("c1", "c2"):
+        diss = N[f"{c}.dissipated_J"].iloc[-1]
+        assert diss > 10.0 and abs(diss - N[f"{c}.friction_work_J"].iloc[-1]) < 1e-6 * diss
+
+
+def test_every_mix_of_components_is_one_compiled_type(scenarios):
+    """Wet clutches alone, EMTCs alone, two EMTCs of different sizes, both kinds together: the parameters have one
+    numba type, so the kernel compiled for one serves all (a mix never run before compiles nothing)."""
+    vehicle, sc1, o1, sc2, o2 = scenarios
+    wet = Driveline("w")
+    _dyno(wet, "c", WetClutch.paper(), 100.0, 2000.0, 80.0)
+    one = drum_bench(sc1, vehicle)
+    two = drum_bench(sc1, vehicle, prefix="a_")
+    drum_bench(sc2, vehicle, options=o2, into=two, prefix="b_")
+    both = drum_bench(sc1, vehicle)
+    _dyno(both, "c1", WetClutch.paper(), 100.0, 2000.0, 80.0)
+    _dyno(both, "c2", WetClutch.paper(n_c=6), 100.0, 2000.0, 80.0)
+    kinds = {numba.typeof(d.system().params) for d in (wet, one, two, both)}
+    assert len(kinds) == 1
+
+
+@pytest.mark.parametrize("kind", ["wet", "emtc"])
+def test_check_invariants_runs_in_a_network_with_components(scenarios, kind):
+    """``check_invariants`` checks a network with model components too (before, its accept hook skipped the
+    network's check): with the energy tolerance made impossible the run must stop on the invariant, naming it."""
+    vehicle, sc1, o1, _, _ = scenarios
+    if kind == "wet":
+        d = Driveline("w")
+        _dyno(d, "c", WetClutch.paper(), 100.0, Signal.ramp(3000.0, 0.1, start=0.01), 80.0)
+    else:
+        d = drum_bench(sc1, vehicle)
+    system = d.system(1e-8, check_invariants=True)
+    assert simulate(system, 0.05).ok
+    system = d.system(1e-8, check_invariants=True)
+    system.params.net.check[1] = 1e-300   # |energy error| <= 1e-300 (energy that flowed + 1 J): fails at any rounding
+    with pytest.raises(SimulationError, match="invariant violated: the network's energy balance"):
+        simulate(system, 0.05)
+
+
+@settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(networks(with_components=True))
+def test_invariants_hold_on_random_networks_with_components(d):
+    """Random chains of plain elements with wet clutches and EMTC couplings among their links (at least one): every
+    invariant holds at every accepted step (the compiled check) and in the samples (checked from the columns by code
+    independent of the kernel: energy balance, modes consistent with the relative speeds, one-way clutches)."""
+    res = d.simulate(0.6, output_step=2e-3, rtol=1e-9, check_invariants=True)
+    assert res.ok
+    _check_columns(d, res.to_dataframe(), res.events)
+
+
+def test_a_bearing_beside_a_wet_clutch_breaks_away_at_its_limit():
+    """The network the random property found once the invariant check ran here: a bearing friction (1 N m) holds an
+    inertia against a falling sine torque while a wet clutch's drag on it grows.  The bearing must break away where
+    the torque it holds reaches its limit (0.051 s), not stay stuck at up to twice it: the decision at its limit
+    looks a moment ahead, and that look must see the clutch's torque rise (kernel.set_external_rates), not only the
+    sine fall."""
+    d = Driveline("bearing_beside_wet")
+    d.inertia("J0", J=1.0, w0=3.0).inertia("J1", J=1.0)
+    d.wet_clutch("w0", "J0", "J1", force=Signal.constant(300.0))
+    d.bearing_friction("bearing", "J1", torque=1.0, peak=1.0)
+    d.torque("T1", "J1", Signal.sine(-1.0, 1.0))
+    r = d.simulate(0.1, output_step=1e-4, rtol=1e-9, check_invariants=True)
+    ev = r.events
+    away = ev[(ev["element"] == "bearing") & (ev["event"] == "forward")]["time_s"].to_numpy()
+    assert away.size == 1
+    N = r.to_dataframe()
+    held = N["time_s"] < away[0]
+    # until then it holds the inertia at rest, within its limit; then it slides at its limit
+    assert np.all(N.loc[held, "J1.w_rad_s"] == 0.0)
+    assert N.loc[held, "bearing.tau_Nm"].abs().max() <= 1.0 + 1e-9
+    crossing = np.interp(1.0, N.loc[held, "bearing.tau_Nm"].to_numpy(), N.loc[held, "time_s"].to_numpy())
+    assert abs(away[0] - crossing) < 2e-4 and 0.04 < away[0] < 0.06
+    after = N["time_s"] > away[0] + 1e-3
+    assert np.all(N.loc[after, "J1.w_rad_s"] > 0.0)
+    np.testing.assert_allclose(N.loc[after, "bearing.tau_Nm"], 1.0, rtol=1e-12)
