@@ -170,13 +170,10 @@ def derivatives(net, e, acc, dx, g):
         cf = e.conf[j]
         b = e.buf[j]
         el = net.elem[cf[F_ROW]]
-        for i in range(N_STATE):
-            dx[cf[F_X] + i] = b[B_DX + i]
+        K.copy_component(dx, g, b, cf[F_X], cf[F_G], N_STATE, N_SWITCH, B_DX, B_G)
         dx[cf[F_X]] = 0.0 if el[K.E_A] < 0 else acc[el[K.E_A]]
         dx[cf[F_X] + 1] = 0.0 if el[K.E_B] < 0 else acc[el[K.E_B]]
         dx[cf[F_X] + 2] = 0.0
-        for i in range(N_SWITCH):
-            g[cf[F_G] + i] = b[B_G + i]
         g[cf[F_G] + _SLIP_ZERO] = 1.0
         g[cf[F_G] + _UNLOCK] = 1.0
 

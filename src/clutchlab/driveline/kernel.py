@@ -1166,6 +1166,17 @@ def set_external_rates(p, j, t0, d_slide, d_limit, d_lock):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def copy_component(dx, g, b, xo, go, nx, ng, bdx, bg):
+    """A model component's derivatives ``b[bdx:bdx + nx]`` and switching values ``b[bg:bg + ng]`` (its scratch) into
+    the whole system's ``dx`` from ``xo`` and ``g`` from ``go`` on (:mod:`clutchlab.driveline.coupled`; the
+    component then overwrites what the network decides for it)."""
+    for i in range(nx):
+        dx[xo + i] = b[bdx + i]
+    for i in range(ng):
+        g[go + i] = b[bg + i]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def external_value(p, j, which, t):
     """Clutch model ``j``'s number ``which`` (0 sliding torque, 1 static limit, 2 lock-up limit) [N m] at time ``t``:
     as :func:`set_external` gave it, moved by its rate (:func:`set_external_rates`) from the time of the rate (never

@@ -141,13 +141,10 @@ def derivatives(net, w, acc, dx, g):
         cf = w.conf[j]
         b = w.buf[j]
         e = net.elem[cf[F_ROW]]
-        for i in range(N_STATE):
-            dx[cf[F_X] + i] = b[B_DX + i]
+        K.copy_component(dx, g, b, cf[F_X], cf[F_G], N_STATE, N_SWITCH, B_DX, B_G)
         dx[cf[F_X] + W.S_W] = (0.0 if e[K.E_B] < 0 else acc[e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else acc[e[K.E_A]])
         dx[cf[F_X] + W.S_I] = 0.0
         dx[cf[F_X] + W.S_ED] = 0.0
-        for i in range(N_SWITCH):
-            g[cf[F_G] + i] = b[B_G + i]
         g[cf[F_G] + W.G_LOCKUP] = 1.0
         g[cf[F_G] + W.G_BREAKAWAY] = -1.0
 
