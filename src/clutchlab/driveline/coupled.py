@@ -76,7 +76,7 @@ def _at_rest(x, m, net):
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _with_rates(t, x, u, m, p):
-    """Every component's torques at ``(t, x)`` given to the network with their rates (:func:`kernel.
+    """Every component's torques at ``(t, x)`` given to the network (always) with their rates (:func:`kernel.
     set_external_rates`: a forward difference over ``T_RATE`` along the whole system's derivative), before a
     stick/slip search: its look-ahead (the tie-break at ``t + T_TIE``) then sees the components' torques move.  At
     events only, and only where an item is stuck or at rest (:func:`_at_rest`, the items the search looks ahead
@@ -85,6 +85,7 @@ def _with_rates(t, x, u, m, p):
     w = member(p, "wet")
     e = member(p, "emtc")
     if not _at_rest(x, m, net):
+        _evaluate(t, x, u, m, net, w, e)   # (the torques at t, without rates)
         return
     nx, ng, nm = _network_sizes(w, e)
     dx = np.empty(x.shape[0])
