@@ -138,14 +138,14 @@ def coupled_update(t, x, u, m, p, k, log):
     w = member(p, "wet")
     e = member(p, "emtc")
     _sync(x, m, net, w, e)
-    _evaluate(t, x, u, m, net, w, e)
     nw, ne = w.conf.shape[0], e.conf.shape[0]
     ng = w.conf[0][DW.F_G] if nw > 0 else e.conf[0][DE.F_G]
     if k < ng:
-        _with_rates(t, x, u, m, p)
+        _with_rates(t, x, u, m, p)   # (the components' torques at t, and their rates where an item is at rest)
         res = K.driveline_update(t, x, u, m, net, k, log)
         _sync(x, m, net, w, e)
         return res
+    _evaluate(t, x, u, m, net, w, e)   # (the component's hook reads its scratch at t)
     if nw > 0 and k < ng + nw * DW.N_SWITCH:
         res = DW.call(t, x, m, w, (k - ng) // DW.N_SWITCH, (k - ng) % DW.N_SWITCH, log)
     elif ne > 0:
