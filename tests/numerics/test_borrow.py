@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hypothesis_budget import examples
-from clutchlab.numerics.borrow import byref, row, row_of, shaped, stack_rows, take
+from clutchlab.numerics.borrow import byref, keep_row, kept_row, member, row, row_of, row_words, shaped, stack_rows, take
 
 
 class Inner(NamedTuple):
@@ -35,7 +35,8 @@ def _sum_variant(P, v):
 
 @numba.njit(cache=True)
 def _sum_variant_byref(P, v):
-    return take(byref(P), v).table[1, 0]
+    p = take(byref(P), v)   # (through a reference: only the members the row needs are read)
+    return p.table.sum() + p.gain + p.inner.k * p.inner.n + p.pair[0] - p.pair[1]
 
 
 @numba.njit(cache=True)
@@ -48,10 +49,11 @@ def test_take_gives_each_variants_row_of_arrays_numbers_and_nested_tuples():
     P = Stacked(np.arange(n * 6, dtype=float).reshape(n, 3, 2), np.array([1.0, 2.0, 3.0]),
                 Inner(np.array([0.5, 1.5, 2.5]), np.array([2, 3, 4], dtype=np.int64)),
                 (np.array([10.0, 20.0, 30.0]), np.array([1.0, 1.0, 2.0])))
+    strided = P._replace(gain=np.array([1.0, -9.0, 2.0, -9.0, 3.0, -9.0])[::2])   # (a vector that is not contiguous)
     for v in range(n):
         expect = (P.table[v].sum() + P.gain[v] + P.inner.k[v] * P.inner.n[v] + P.pair[0][v] - P.pair[1][v])
-        assert _sum_variant(P, v) == expect
-        assert _sum_variant_byref(P, v) == P.table[v, 1, 0]
+        assert _sum_variant(P, v) == expect == _sum_variant(strided, v)
+        assert _sum_variant_byref(P, v) == expect == _sum_variant_byref(strided, v)
     _write_variant(P, 1, -7.0)  # a view: writes land in the stacked array, row 1 only
     assert P.table[1, 0, 0] == -7.0 and P.table[0, 0, 0] == 0.0 and P.table[2, 0, 0] == 12.0
 
@@ -100,6 +102,28 @@ def _row_sum_byref(P, j):
     return _model_sum(row(byref(P), j))
 
 
+class Holder(NamedTuple):
+    params: Model
+    rows: np.ndarray
+
+
+@numba.njit(cache=True)
+def _kept_sums(H):
+    """Every row kept (built once into ``H.rows``), then each read back by reference."""
+    for j in range(H.rows.shape[0]):
+        keep_row(member(byref(H), "params"), H.rows, j)
+    out = np.empty(H.rows.shape[0])
+    for j in range(H.rows.shape[0]):
+        out[j] = _model_sum_ref(kept_row(member(byref(H), "params"), H.rows, j))
+    return out
+
+
+@numba.njit(cache=True)
+def _model_sum_ref(q):
+    return q.inner.k * q.inner.n + q.pair[0] - q.pair[1] + q.curve.sum() * 7.0 + q.memory.shape[0] * 1000.0 \
+        + q.grid[q.grid.shape[0] - 1]
+
+
 @numba.njit(cache=True)
 def _row_write(P, j, value):
     r = row(P, j)
@@ -129,6 +153,11 @@ def test_row_gives_each_structure_back_whatever_its_sizes(sizes, seed):
         assert np.array_equal(back.curve, p.curve) and np.array_equal(back.grid, p.grid)
         assert back.inner == p.inner and back.pair == p.pair
     assert len(_model_sum.signatures) == 1
+    # rows kept once and read by reference (a model's ``prepare`` hook): the same values, each row in its own slot
+    H = Holder(P, np.full((len(models), row_words(P)), np.nan))
+    kept = _kept_sums(H)
+    for j, p in enumerate(models):
+        assert kept[j] == _model_sum_ref(p)   # (the same function on the structure itself: the same sums, bitwise)
     for j, p in enumerate(models):
         if p.memory.size:
             _row_write(P, j, -5)

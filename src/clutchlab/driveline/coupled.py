@@ -266,6 +266,13 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_prepare(p):
+    """Once per call of the core: each EMTC coupling's parameter structure built from its row
+    (:func:`clutchlab.driveline.emtc.prepare`)."""
+    DE.prepare(member(p, "emtc"))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_jacobian(t, x, u, m, p, J):
     """No analytic Jacobian (Dormand-Prince)."""
     return False
@@ -273,4 +280,4 @@ def coupled_jacobian(t, x, u, m, p, J):
 
 dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs, update=coupled_update,
                   restart=coupled_restart, accept=coupled_accept, next_break=coupled_next_break,
-                  jacobian=coupled_jacobian, watch=coupled_watch)
+                  jacobian=coupled_jacobian, watch=coupled_watch, prepare=coupled_prepare)

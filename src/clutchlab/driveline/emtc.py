@@ -49,7 +49,7 @@ import numpy as np
 
 from ..emtc import system as S
 from ..numerics import dispatch
-from ..numerics.borrow import byref, member, row, stack_rows
+from ..numerics.borrow import keep_row, kept_row, member, row_words, stack_rows
 from . import kernel as K
 
 __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
@@ -89,14 +89,16 @@ class EmtcBlock(NamedTuple):
     :func:`clutchlab.emtc.system.pack_parameters` and stacked as rows (:func:`clutchlab.numerics.borrow.stack_rows`:
     any number of couplings, each with its own magnet and table sizes, is one type; its vehicle data used only by
     its controller's map and its drag data), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch
-    ``B_*``), ``mbuf[j]`` (int64, its modes) and ``index`` (int64, :data:`OUTPUT_INDEX`).  A member of
-    :class:`clutchlab.driveline.coupled.CoupledParams`."""
+    ``B_*``), ``mbuf[j]`` (int64, its modes), ``index`` (int64, :data:`OUTPUT_INDEX`) and ``rows[j]`` (float64, the
+    coupling's :class:`~clutchlab.emtc.system.EmtcParams` built from its row of ``params`` once per call of the core,
+    :func:`prepare`; its hooks read it by reference).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
     params: S.EmtcParams
     conf: np.ndarray
     buf: np.ndarray
     mbuf: np.ndarray
     index: np.ndarray
+    rows: np.ndarray
 
 
 @functools.lru_cache(maxsize=1)
@@ -113,9 +115,24 @@ def block(params, conf) -> EmtcBlock:
     """The block of the couplings packed as ``params`` (a list of :class:`~clutchlab.emtc.system.EmtcParams`) with
     their layouts ``conf`` (rows ``F_*``); no coupling for empty lists."""
     n = len(params)
-    return EmtcBlock(stack_rows(params, template=None if params else _template()),
-                     np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
-                     np.zeros((n, N_MODE), dtype=np.int64), OUTPUT_INDEX.copy())
+    stacked = stack_rows(params, template=None if params else _template())
+    return EmtcBlock(stacked, np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
+                     np.zeros((n, N_MODE), dtype=np.int64), OUTPUT_INDEX.copy(), np.zeros((n, row_words(stacked))))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def prepare(e):
+    """Each coupling's :class:`~clutchlab.emtc.system.EmtcParams` built from its row of the stacked ``e.params`` into
+    ``e.rows`` (:func:`clutchlab.numerics.borrow.keep_row`): the network's ``prepare`` hook, once per call of the
+    core.  Built at every evaluation instead, the rows cost a tenth of an EMTC network's run (issue #31)."""
+    for j in range(e.conf.shape[0]):
+        keep_row(member(e, "params"), e.rows, j)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _params(e, j):
+    """A reference to coupling ``j``'s parameters as :func:`prepare` built them."""
+    return kept_row(member(e, "params"), e.rows, j)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -147,7 +164,7 @@ def _coupling(t, x, m, net, e, j):
     b = e.buf[j]
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
-    ep = byref(row(member(e, "params"), j))   # (the row built and stored once: both hooks read it by reference)
+    ep = _params(e, j)
     dispatch.rhs(t, xs, us, e.mbuf[j], ep, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     dispatch.outputs(t, xs, us, e.mbuf[j], ep, b[B_Y:N_BUF])   # (the same point: the model reuses it)
     cap = b[B_Y + _Y_CAP] if e.mbuf[j][_ARM] == _CONTACT else 0.0
@@ -229,11 +246,11 @@ def call(t, x, m, net, e, j, k, log):
     _load(x, m, net, e, j)
     b = e.buf[j]
     start = log.count[0]
-    ep = row(member(e, "params"), j)
+    ep = _params(e, j)
     if k >= 0:
-        res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(ep), k, log)
+        res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], ep, k, log)
     else:
-        res = 1 if dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(ep), log) else 0
+        res = 1 if dispatch.restart(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], ep, log) else 0
     _write_back(x, m, e, j, start, log)
     return error_code(res, j) if res < 0 else res
 
@@ -244,7 +261,7 @@ def accept(t, x, u, m, net, e):
     for j in range(e.conf.shape[0]):
         _load(x, m, net, e, j)
         b = e.buf[j]
-        res = dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], byref(row(member(e, "params"), j)))
+        res = dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], _params(e, j))
         if res < 0:
             return error_code(res, j)
     return 0
@@ -254,5 +271,5 @@ def accept(t, x, u, m, net, e):
 def next_break(t, e, tb):
     """The earlier of ``tb`` and a coupling's next controller sample."""
     for j in range(e.conf.shape[0]):
-        tb = min(tb, dispatch.next_break(t, e.mbuf[j], byref(row(member(e, "params"), j))))
+        tb = min(tb, dispatch.next_break(t, e.mbuf[j], _params(e, j)))
     return tb

@@ -27,7 +27,8 @@ from numba.core.typing.templates import AttributeTemplate, infer_getattr
 from numba.extending import intrinsic, models, register_model
 from numba.np.arrayobj import load_item
 
-__all__ = ["borrow", "byref", "ByRef", "member", "take", "shaped", "Ragged", "stack_rows", "row", "row_of"]
+__all__ = ["borrow", "byref", "ByRef", "member", "take", "shaped", "Ragged", "stack_rows", "row", "row_of", "row_words",
+           "keep_row", "kept_row"]
 
 
 def _has_arrays(ty) -> bool:
@@ -191,6 +192,28 @@ def _take_row(context, builder, ty, row_ty, value, idx):
     return context.make_tuple(builder, row_ty, members)
 
 
+def _take_row_ref(context, builder, ty, row_ty, ptr, idx):
+    """:func:`_take_row` of the value ``ptr`` points to (a :class:`ByRef`), reading only what the row needs: the
+    data pointer of each stacked array (and the starts and shapes of a :class:`Ragged`), never the whole stacked
+    structure (hundreds of array headers: loaded as one value, LLVM copied all of it at every row, a fifth of an
+    EMTC network's run)."""
+    if isinstance(row_ty, types.Array) and _is_ragged(ty):
+        return _ragged_row_ref(context, builder, ty, row_ty, ptr, idx)
+    if isinstance(ty, types.Array):
+        src = context.make_array(ty)(context, builder, ref=ptr)
+        if ty.ndim == 1:
+            if ty.layout == "C":
+                data = cgutils.gep_inbounds(builder, src.data, idx)
+            else:
+                stride = builder.extract_value(src.strides, 0)
+                data = cgutils.pointer_add(builder, src.data, builder.mul(idx, stride))
+            return load_item(context, builder, ty, data)
+        return _take_row(context, builder, ty, row_ty, builder.load(ptr), idx)
+    members = [_take_row_ref(context, builder, t, r, cgutils.gep_inbounds(builder, ptr, 0, k), idx)
+               for k, (t, r) in enumerate(zip(ty.types, row_ty.types))]
+    return context.make_tuple(builder, row_ty, members)
+
+
 @intrinsic
 def take(typingctx, stacked, v):
     """Variant ``v`` of stacked parameters: ``stacked`` with every array ``a`` replaced by ``a[v]`` (borrowed).
@@ -213,9 +236,9 @@ def take(typingctx, stacked, v):
 
     def codegen(context, builder, signature, args):
         value, idx = args
-        if ref:  # (a parallel loop takes the structure by reference: its gufunc cannot pass nested tuples)
-            value = builder.load(value)
         idx = context.cast(builder, idx, signature.args[1], types.intp)
+        if ref:  # (a parallel loop takes the structure by reference: its gufunc cannot pass nested tuples)
+            return _take_row_ref(context, builder, sty, signature.return_type, value, idx)
         return _take_row(context, builder, sty, signature.return_type, value, idx)
 
     return sig, codegen
@@ -274,14 +297,19 @@ def _is_ragged(ty) -> bool:
 def _ragged_row(context, builder, ty, row_ty, value, idx):
     """Row ``idx`` of a :class:`Ragged` member: a borrowed C-contiguous view of its part of ``data``."""
     data_ty, start_ty, shape_ty = ty.types
-    data = context.make_array(data_ty)(context, builder, value=builder.extract_value(value, 0))
-    start = context.make_array(start_ty)(context, builder, value=builder.extract_value(value, 1))
-    shp = context.make_array(shape_ty)(context, builder, value=builder.extract_value(value, 2))
+    data = context.make_array(data_ty)(context, builder, value=builder.extract_value(value, 0)).data
+    start = context.make_array(start_ty)(context, builder, value=builder.extract_value(value, 1)).data
+    shp = context.make_array(shape_ty)(context, builder, value=builder.extract_value(value, 2)).data
+    return _ragged_view(context, builder, data_ty, row_ty, data, start, shp, idx)
+
+
+def _ragged_view(context, builder, data_ty, row_ty, data, start, shp, idx):
+    """The borrowed C-contiguous view of row ``idx`` of a :class:`Ragged` from its three data pointers."""
     intp = context.get_value_type(types.intp)
-    first = builder.load(cgutils.gep_inbounds(builder, start.data, idx))
+    first = builder.load(cgutils.gep_inbounds(builder, start, idx))
     ndim = row_ty.ndim
     base = builder.mul(idx, context.get_constant(types.intp, ndim))
-    dims = [builder.load(cgutils.gep_inbounds(builder, shp.data,
+    dims = [builder.load(cgutils.gep_inbounds(builder, shp,
                                               builder.add(base, context.get_constant(types.intp, d))))
             for d in range(ndim)]
     dims = [builder.sext(d, intp) if d.type.width < intp.width else d for d in dims]
@@ -291,11 +319,20 @@ def _ragged_row(context, builder, ty, row_ty, value, idx):
         strides.append(step)
         step = builder.mul(step, d)
     strides.reverse()
-    ptr = cgutils.gep_inbounds(builder, data.data, first)
+    ptr = cgutils.gep_inbounds(builder, data, first)
     out = context.make_array(row_ty)(context, builder)
     context.populate_array(out, data=ptr, shape=cgutils.pack_array(builder, dims),
-                           strides=cgutils.pack_array(builder, strides), itemsize=data.itemsize, meminfo=None)
+                           strides=cgutils.pack_array(builder, strides), itemsize=itemsize, meminfo=None)
     return out._getvalue()
+
+
+def _ragged_row_ref(context, builder, ty, row_ty, ptr, idx):
+    """:func:`_ragged_row` of the :class:`Ragged` ``ptr`` points to (its three data pointers read, nothing else)."""
+    data_ty, start_ty, shape_ty = ty.types
+    data = context.make_array(data_ty)(context, builder, ref=cgutils.gep_inbounds(builder, ptr, 0, 0)).data
+    start = context.make_array(start_ty)(context, builder, ref=cgutils.gep_inbounds(builder, ptr, 0, 1)).data
+    shp = context.make_array(shape_ty)(context, builder, ref=cgutils.gep_inbounds(builder, ptr, 0, 2)).data
+    return _ragged_view(context, builder, data_ty, row_ty, data, start, shp, idx)
 
 
 def _stack_member(values, template, what):
@@ -368,10 +405,89 @@ def row(typingctx, stacked, j):
 
     def codegen(context, builder, signature, args):
         value, idx = args
-        if ref:
-            value = builder.load(value)
         idx = context.cast(builder, idx, signature.args[1], types.intp)
+        if ref:
+            return _take_row_ref(context, builder, sty, signature.return_type, value, idx)
         return _take_row(context, builder, sty, signature.return_type, value, idx)
+
+    return sig, codegen
+
+
+# ---------------------------------------------------------------- rows built once, read by reference
+# Building a row (:func:`row`) reads each of its numbers from its own stacked vector and each array's place in its
+# Ragged: for an EMTC coupling about 110 values, a tenth of a network's run when done at every evaluation.  A
+# model builds its rows once per call of the core instead (its ``prepare`` hook, :mod:`clutchlab.numerics.dispatch`)
+# into a float64 array of :func:`row_words` words per row (:func:`keep_row`) and its hooks read them by reference
+# (:func:`kept_row`).  A kept row holds the addresses of the stacked arrays: valid while they are alive and unmoved,
+# so it is built again at every entry of the core (a copied or rewritten structure is never read stale).
+def _row_bytes(stacked_type) -> int:
+    from numba.core.registry import cpu_target
+
+    row_ty = _row_type(stacked_type, ragged=True)
+    if row_ty is None:
+        raise TypeError(f"row_words: {stacked_type} is not a structure of stacked rows")
+    context = cpu_target.target_context
+    return int(context.get_abi_sizeof(context.get_value_type(row_ty)))
+
+
+def row_words(stacked) -> int:
+    """The float64 words one row of ``stacked`` (:func:`stack_rows`'s result) takes as numba holds it in memory: the
+    width of the array :func:`keep_row` fills."""
+    import numba
+
+    return -(-_row_bytes(numba.typeof(stacked)) // 8)
+
+
+def _kept_slot(context, builder, row_ty, rows_ty, rows, idx):
+    """The address of row ``idx``'s slot in ``rows`` (a C-contiguous float64 array, a row per slot), as a pointer
+    to the row's value type."""
+    ary = context.make_array(rows_ty)(context, builder, value=rows)
+    stride = builder.extract_value(ary.strides, 0)
+    ptr = cgutils.pointer_add(builder, ary.data, builder.mul(idx, stride))
+    return builder.bitcast(ptr, context.get_value_type(row_ty).as_pointer())
+
+
+def _rows_args(stacked, rows, j):
+    if not (isinstance(stacked, ByRef) and isinstance(stacked.pointee, types.BaseTuple)
+            and isinstance(rows, types.Array) and rows.ndim == 2 and rows.dtype == types.float64
+            and rows.layout == "C" and isinstance(j, types.Integer)):
+        return None
+    return _row_type(stacked.pointee, ragged=True)
+
+
+@intrinsic
+def keep_row(typingctx, stacked, rows, j):
+    """Build row ``j`` of the stacked structure ``stacked`` refers to (:func:`row`) into slot ``j`` of ``rows``
+    (float64, ``(n, row_words)``, C-contiguous): :func:`kept_row` reads it by reference until the stacked arrays
+    change.  The caller sized ``rows`` with :func:`row_words`."""
+    row_ty = _rows_args(stacked, rows, j)
+    if row_ty is None:
+        return None
+    sig = types.none(stacked, rows, j)
+
+    def codegen(context, builder, signature, args):
+        ref, rows_v, idx = args
+        idx = context.cast(builder, idx, signature.args[2], types.intp)
+        value = _take_row_ref(context, builder, signature.args[0].pointee, row_ty, ref, idx)
+        builder.store(value, _kept_slot(context, builder, row_ty, signature.args[1], rows_v, idx))
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def kept_row(typingctx, stacked, rows, j):
+    """A :class:`ByRef` to row ``j`` of ``stacked`` as :func:`keep_row` built it into ``rows``: its address,
+    nothing loaded or built (the row has the numba type :func:`row` gives)."""
+    row_ty = _rows_args(stacked, rows, j)
+    if row_ty is None:
+        return None
+    sig = ByRef(row_ty)(stacked, rows, j)
+
+    def codegen(context, builder, signature, args):
+        _ref, rows_v, idx = args
+        idx = context.cast(builder, idx, signature.args[2], types.intp)
+        return _kept_slot(context, builder, row_ty, signature.args[1], rows_v, idx)
 
     return sig, codegen
 

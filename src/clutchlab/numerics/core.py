@@ -711,6 +711,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y = borrow(
         (p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y))
     p = byref(p)  # (after borrow: the members read through the reference are not reference-counted)
+    model.prepare(p)
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0
@@ -1107,6 +1108,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y = borrow(
         (p, x, m, u, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y))
     p = byref(p)  # (after borrow: the members read through the reference are not reference-counted)
+    model.prepare(p)
     n = x.shape[0]
     ng = opt.gdir.shape[0]
     grid = ts.shape[0] > 0
@@ -1359,6 +1361,7 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
 @register_jitable
 def _evaluate(p, t, x, u, m, dx, g):
     p = byref(borrow(p))  # the same specialisation of the hooks as the loops'
+    model.prepare(p)
     model.rhs(t, x, u, m, p, dx, g)
     model.watch(t, x, u, m, p, dx, g, -1)   # (the switching functions as the core compares them)
 
@@ -1366,18 +1369,21 @@ def _evaluate(p, t, x, u, m, dx, g):
 @register_jitable
 def _evaluate_jacobian(p, t, x, u, m, J):
     p = byref(borrow(p))
+    model.prepare(p)
     return model.jacobian(t, x, u, m, p, J)
 
 
 @register_jitable
 def _evaluate_outputs(p, t, x, u, m, y):
     p = byref(borrow(p))
+    model.prepare(p)
     model.outputs(t, x, u, m, p, y)
 
 
 @register_jitable
 def _outputs_at(p, T, X, u, M, Y):
     p = byref(borrow(p))
+    model.prepare(p)
     y = np.empty(Y.shape[1])
     for i in range(T.shape[0]):
         model.outputs(T[i], X[i], u, M[i], p, y)

@@ -63,6 +63,13 @@ and the parameters ``p``):
 ``jacobian(t, x, u, m, p, J)``
     Fills ``J = df/dx`` and returns True where the model has an analytic
     Jacobian; returns False to let the core difference ``rhs``.
+``prepare(p)`` (optional)
+    Called once by every entry of the core that takes the parameters (a run's loop, each call of
+    :func:`~clutchlab.numerics.core.evaluate` and its siblings, each model-exchange call), before any other
+    hook, with the reference the hooks get: a model derives there what stays fixed for the call from
+    structures that may have been copied or rewritten since the last one (the driveline's EMTC couplings
+    build each coupling's parameter structure from its stacked rows once per call, not at every
+    evaluation: :mod:`clutchlab.driveline.emtc`).  Nothing for a model that does not give it.
 ``time_derivative(t, x, u, m, p, ft)`` (optional)
     Fills ``ft = df/dt`` at fixed state (inputs that vary within a step,
     for the Rosenbrock stages) and returns True; False (the default for a
@@ -85,8 +92,8 @@ __all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "r
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 #: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time;
 #: ``rhs_event``: the right-hand side where the core evaluates it at events, its ``rhs`` if not given;
-#: ``watch``: nothing)
-OPTIONAL_HOOKS = ("time_derivative", "rhs_event", "watch")
+#: ``watch``, ``prepare``: nothing)
+OPTIONAL_HOOKS = ("time_derivative", "rhs_event", "watch", "prepare")
 
 
 def no_time_derivative(t, x, u, m, p, ft):
@@ -297,8 +304,27 @@ def watch(t, x, u, m, p, dx, g, k):  # pragma: no cover
     raise NotImplementedError
 
 
+def no_prepare(p):
+    """What the ``prepare`` stub compiles to for a model without the hook: nothing (compiled into the caller)."""
+    return None
+
+
+def _default_prepare(p):
+    """Typing of the ``prepare`` stub for a registered model that does not give the hook."""
+    q = p.pointee if isinstance(p, ByRef) else p
+    if isinstance(q, types.BaseNamedTuple) and q.instance_class in _MODELS and "prepare" not in _MODELS[q.instance_class]:
+        return no_prepare
+    return None
+
+
+def prepare(p):  # pragma: no cover
+    raise NotImplementedError
+
+
 # models without a ``watch`` hook: the stub compiles to nothing inside the caller
 overload(watch, jit_options={"cache": False})(functools.wraps(watch)(_default_watch))
+# models without a ``prepare`` hook: the same
+overload(prepare, jit_options={"cache": False})(functools.wraps(prepare)(_default_prepare))
 
 # models without a ``time_derivative`` hook: the stub compiles to ``return False`` inside the caller
 overload(time_derivative, jit_options={"cache": False})(
@@ -307,4 +333,4 @@ overload(time_derivative, jit_options={"cache": False})(
 #: (stub, hook it resolves to)
 _STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (rhs_event, "rhs_event"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
           (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"),
-          (time_derivative, "time_derivative"), (watch, "watch"))
+          (time_derivative, "time_derivative"), (watch, "watch"), (prepare, "prepare"))

@@ -140,6 +140,7 @@ def call(s, what):
     ``accept``/``update`` (> 0), or a model error (< 0).  Compiled as each model's ``model_exchange`` entry."""
     p0, x, m, u, sf, si, opt, log, dx, g0, g1, out, y, report, r, alg, jac, sub, piv, xp, fp, gp, dls = _args(s)
     p = byref(borrow(p0))
+    model.prepare(p)
     t = sf[SF_T]
     code = 0
     if alg.shape[0] and what & (ME_DERIVATIVES | ME_EVENT | ME_RESTART | ME_OUTPUTS):
