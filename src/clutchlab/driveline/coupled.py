@@ -267,8 +267,8 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_prepare(p):
-    """Once per call of the core: each EMTC coupling's parameter structure built from its row
-    (:func:`clutchlab.driveline.emtc.prepare`)."""
+    """Once per call of the core: each EMTC coupling's parameter structure built from its row, and each wet clutch's (:func:`clutchlab.driveline.emtc.prepare`, :func:`clutchlab.driveline.wet.prepare`)."""
+    DW.prepare(member(p, "wet"))
     DE.prepare(member(p, "emtc"))
 
 

@@ -1755,7 +1755,7 @@ class Driveline:
             r = self._elements.index(el)
             return r, int(np.flatnonzero(p.fric == r)[0])
 
-        conf, consts, datas = [], [], []
+        conf, packed = [], []
         for j, (el, wp, xw, clutch) in enumerate(wet):
             r, k = friction_index(el)
             w_rel = (x0[n + p.elem[r][K.E_B]] if p.elem[r][K.E_B] >= 0 else 0.0) - (
@@ -1772,17 +1772,8 @@ class Driveline:
             xs.append(xw)
             ms.append(W.initial_modes(xw, clutch.piston_h0))
             tols.append(W.absolute_tolerance(clutch, rtol))
-            consts.append(wp.constants)
-            datas.append(wp.data)
-        if wet:
-            width = max(d.size for d in datas)
-            data = np.zeros((nw, width))
-            for j, d in enumerate(datas):
-                data[j, :d.size] = d
-            wblock = DW.WetBlock(np.ascontiguousarray(np.stack(consts)), data, np.array(conf, dtype=np.int64),
-                                 np.zeros((nw, DW.N_BUF)), np.zeros((nw, DW.N_MODE), dtype=np.int64))
-        else:
-            wblock = DW.empty_block()
+            packed.append(wp)
+        wblock = DW.block(packed, conf)
         nx += nw * W.N_STATE
         ng += nw * W.N_SWITCH
         nm += nw * DW.N_MODE

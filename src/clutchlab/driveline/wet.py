@@ -31,16 +31,17 @@ each is packed on its own and evaluated with its own hooks (its parameters one r
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numba
 import numpy as np
 
-from ..numerics.borrow import byref
+from ..numerics.borrow import keep_row, kept_row, member, row_words, stack_rows
 from ..wet import system as W
 from . import kernel as K
 
-__all__ = ["WetBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "BENCH_ONLY"]
+__all__ = ["WetBlock", "block", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "BENCH_ONLY"]
 
 N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
 # conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
@@ -62,29 +63,49 @@ N_KEPT = len(OUTPUTS)
 
 
 class WetBlock(NamedTuple):
-    """The wet clutches of a network (rows ``j``, none or more): their parameters packed by
-    :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft (``constants[j]``,
-    ``data[j]``: the rows of the clutches' :class:`~clutchlab.wet.system.WetParams`, the data padded to one
-    length), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch ``B_*``) and ``mbuf[j]``
-    (int64, its modes).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
+    """The wet clutches of a network (rows ``j``, none or more): ``params``, their parameters packed by
+    :func:`clutchlab.wet.system.pack_parameters` with the inertia dynamometer's free shaft and stacked as rows
+    (:func:`clutchlab.numerics.borrow.stack_rows`, as the EMTC block's: any number of clutches, each with its own
+    profiles and friction law, is one type), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch
+    ``B_*``), ``mbuf[j]`` (int64, its modes) and ``rows[j]`` (float64, the clutch's
+    :class:`~clutchlab.wet.system.WetParams` built from its row once per call of the core, :func:`prepare`).  A member
+    of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
-    constants: np.ndarray
-    data: np.ndarray
+    params: W.WetParams
     conf: np.ndarray
     buf: np.ndarray
     mbuf: np.ndarray
+    rows: np.ndarray
 
 
-def empty_block() -> WetBlock:
-    """No wet clutch."""
-    return WetBlock(np.zeros((0, 1), dtype=W.CONSTANTS_DTYPE), np.zeros((0, 1)), np.zeros((0, N_CONF), dtype=np.int64),
-                    np.zeros((0, N_BUF)), np.zeros((0, N_MODE), dtype=np.int64))
+@functools.lru_cache(maxsize=1)
+def _template():
+    """A :class:`~clutchlab.wet.system.WetParams` of the packed kind: the types of an empty :class:`WetBlock`."""
+    return W.WetParams(np.zeros(1, dtype=W.CONSTANTS_DTYPE), np.zeros(1))
+
+
+def block(params, conf) -> WetBlock:
+    """The block of the clutches packed as ``params`` (a list of :class:`~clutchlab.wet.system.WetParams`) with their
+    layouts ``conf`` (rows ``F_*``); no clutch for empty lists."""
+    n = len(params)
+    stacked = stack_rows(params, template=None if params else _template())
+    return WetBlock(stacked, np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
+                    np.zeros((n, N_MODE), dtype=np.int64), np.zeros((n, row_words(stacked))))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def prepare(w):
+    """Each clutch's :class:`~clutchlab.wet.system.WetParams` built from its row of the stacked ``w.params`` into
+    ``w.rows`` (:func:`clutchlab.numerics.borrow.keep_row`): the network's ``prepare`` hook, once per call of the
+    core."""
+    for j in range(w.conf.shape[0]):
+        keep_row(member(w, "params"), w.rows, j)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _wet(w, j):
-    """Clutch ``j``'s :class:`~clutchlab.wet.system.WetParams` (views of its rows)."""
-    return W.WetParams(w.constants[j], w.data[j])
+    """A reference to clutch ``j``'s :class:`~clutchlab.wet.system.WetParams` as :func:`prepare` built them."""
+    return kept_row(member(w, "params"), w.rows, j)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -108,7 +129,7 @@ def _clutch(t, x, m, net, w, j):
     ms[W.M_FRICTION] = W.STICK if mk == K.STUCK else (W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0)
                                                     else W.SLIP)
     wp = _wet(w, j)
-    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, byref(wp), b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
+    W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, wp, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
     K.set_external(net, net.elem[r][K.E_AUX], cap + abs(wk[W.W_OUT + W.O_TV]), cap, cap)
