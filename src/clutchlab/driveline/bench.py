@@ -14,7 +14,7 @@ __all__ = ["drum_bench", "engine_curve", "rolling_curve"]
 
 
 def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: str = "emtc_awd", into=None,
-               prefix: str = ""):
+               prefix: str = "", torque_request=None, throttle=None, coil_current=None):
     """The AWD vehicle with its EMTC on the drum bench of seed 002 (Sec. 4, Eq. 27) as a
     :class:`~clutchlab.driveline.Driveline`: the same equations as :func:`clutchlab.emtc.system.simulate`,
     written as a network.
@@ -35,7 +35,10 @@ def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: 
     (:class:`~clutchlab.emtc.bench.VehicleParameters`), ``magnet`` and ``options`` as
     :func:`clutchlab.emtc.system.simulate`; ``name``: the network's name.  ``into``: a
     :class:`~clutchlab.driveline.Driveline` to add the bench to (several benches, each with its coupling, in one
-    network), ``prefix``: put before every component's name (``"front_"``: ``front_emtc``).
+    network), ``prefix``: put before every component's name (``"front_"``: ``front_emtc``).  ``torque_request``,
+    ``throttle`` and ``coil_current``: the coupling's ports (:meth:`~clutchlab.driveline.Driveline.emtc`; a
+    :class:`~clutchlab.driveline.Signal` or a number; a network input with ``Signal.input``, declared with
+    :meth:`~clutchlab.driveline.Driveline.input`); the throttle port drives the engine too.
     """
     sc = scenario or BenchScenario()
     veh = vehicle or VehicleParameters()
@@ -56,15 +59,18 @@ def drum_bench(scenario=None, vehicle=None, *, magnet=None, options=None, name: 
     d.gear(P + "front_drive", P + "front_shaft", P + "front_axle", ratio=ic)
     d.gear(P + "rear_drive", P + "rear_shaft", P + "rear_axle", ratio=ic)
     speeds, torques = engine_curve(veh, i_tr)
+    ports = dict(torque_request=torque_request, throttle=throttle, coil_current=coil_current)
     d.engine(P + "engine", P + "front_axle", torque_map=np.column_stack([speeds, torques]),
-             throttle=Signal.table([0.0, sc.ramp_start, max(sc.ramp_end, sc.ramp_start + 1e-9)],
-                                   [sc.throttle_start, sc.throttle_start, sc.throttle_end]))
+             throttle=throttle if throttle is not None else
+             Signal.table([0.0, sc.ramp_start, max(sc.ramp_end, sc.ramp_start + 1e-9)],
+                          [sc.throttle_start, sc.throttle_start, sc.throttle_end]))
     for side, v, fz, load in (("front", vf, fzf, sc.drum_load_front), ("rear", vr, fzr, sc.drum_load_rear)):
         k = 2.0 * veh.tyre_slip_stiffness * r / max(abs(v), veh.slip_speed_floor)
         d.spring_damper(f"{P}tyres_{side}", f"{P}{side}_axle", f"{P}drum_{side}", d=k * r * r)
         d.bearing_friction(f"{P}rolling_{side}", f"{P}{side}_axle",
                            torque=rolling_curve(veh.rolling_resistance * fz * r, load))
-    d.emtc(P + "emtc", P + "front_shaft", P + "rear_shaft", magnet=magnet, scenario=sc, vehicle=veh, options=options)
+    d.emtc(P + "emtc", P + "front_shaft", P + "rear_shaft", magnet=magnet, scenario=sc, vehicle=veh, options=options,
+           **ports)
     return d
 
 

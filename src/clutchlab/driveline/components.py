@@ -277,6 +277,14 @@ BUILTIN = (
         Field("bench", "path", description="an EMTC scenario file (its [scenario], [vehicle], [actuator], "
                                            "[coupling] tables; no [magnet])"),
         Field("magnet", "path", description="a Preisach model .json (default the bundled synthetic one)"),
+        Field("torque_request", "signal", "N*m",
+              description="port: the controller's torque reference, sampled every sample time (replaces the map of "
+                          "Eq. 31); a network input or any signal"),
+        Field("throttle", "signal", "1", minimum=0.0, maximum=1.0,
+              description="port: the map's throttle (Eq. 31), sampled every sample time (replaces the scenario's "
+                          "ramp)"),
+        Field("coil_current", "signal", "A",
+              description="port: the coil current set point of a current drive (Fig. 15; no torque controller)"),
     ), _emtc, "seed 002, Eqs. 1-26 and 31"),
 )
 for _c in BUILTIN:

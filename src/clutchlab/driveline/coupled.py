@@ -52,6 +52,7 @@ def _evaluate(t, x, u, m, net, w, e):
         DW.hold(u, w)
         DW.evaluate(t, x, m, net, w)
     if e.conf.shape[0] > 0:
+        DE.hold(t, u, net, e)
         DE.evaluate(t, x, m, net, e)
 
 
@@ -111,8 +112,10 @@ def coupled_rhs(t, x, u, m, p, dx, g):
     _evaluate(t, x, u, m, net, w, e)
     K.driveline_rhs(t, x, u, m, net, dx, g)
     acc, _tau = K._acc_tau(net)
-    DW.derivatives(net, w, acc, dx, g)
-    DE.derivatives(net, e, acc, dx, g)
+    if w.conf.shape[0] > 0:   # (a kind the network has none of costs no call)
+        DW.derivatives(net, w, acc, dx, g)
+    if e.conf.shape[0] > 0:
+        DE.derivatives(net, e, acc, dx, g)
     return None
 
 
@@ -194,6 +197,7 @@ def coupled_accept(t, x, u, m, p):
     w = member(p, "wet")
     e = member(p, "emtc")
     DW.accept(t, x, u, m, w)
+    DE.hold(t, u, net, e)
     res = DE.accept(t, x, u, m, net, e)
     if res < 0:
         return res

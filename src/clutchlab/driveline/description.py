@@ -50,7 +50,10 @@ friction law file or an identified map ``.json``; temperature0, fluid_temperatur
 [degC]) and ``emtc`` (a = its input shaft, b = its output shaft; bench = an EMTC scenario file of
 ``clutchlab emtc simulate`` (its ``[scenario]``, ``[vehicle]``, ``[actuator]``, ``[coupling]`` tables: the
 controller's throttle ramp, gear and sample time, the coupling's data; no ``[magnet]`` table), magnet = a
-Preisach model ``.json`` (default the bundled synthetic one)).  With ``[driveline] domain =
+Preisach model ``.json`` (default the bundled synthetic one); its ports torque_request [N m] (the controller's
+torque reference in place of the map of Eq. 31), throttle [1] (the map's throttle in place of the scenario's
+ramp), coil_current [A] (a current drive's set point, no torque controller): signals, a network input
+``{ input = "NAME" }`` included).  With ``[driveline] domain =
 "translational"`` the bodies are ``mass`` (m, v0, s0) and the sources ``force`` (flange, force,
 support); every other table is the same, in N, m, m/s, N/m, N s/m.  Quantities are numbers in SI or
 strings with units, converted once here.  A signal is a number or
@@ -67,8 +70,8 @@ or ``{ input = "NAME" }``: the network input declared by an ``[input.NAME]`` tab
 in the unit of the fields that read it, default 0; ``description``), held by whatever drives the network
 (``Driveline.simulate``'s ``inputs``, a co-simulation master, an FMU's importer, a controller).  Torque and
 force sources, clutches' and brakes' normal signals, an engine's throttle, an E-clutch's bearing position
-(without its actuator) and a wet clutch's force (one input, not in a product) take inputs; motion sources,
-the E-clutch with its actuator and the EMTC do not (yet).
+(without its actuator), a wet clutch's force (one input, not in a product) and an EMTC's ports take inputs;
+motion sources and the E-clutch with its actuator do not (yet).
 A friction characteristic (``mu``, a bearing's ``torque``) is a number or a table of rows
 ``[w_rad_s, value]``.  Every error names the file, the key and the value.
 """
@@ -172,7 +175,7 @@ def _quantity(value, unit, key, src):
 
 
 #: the column suffix (clutchlab.units.COLUMN_UNITS) of an input driving a field of this unit
-_INPUT_SUFFIX = {"N*m": "Nm", "N": "N", "1": "1", "rad/s": "rad_s", "m/s": "m_s", "rad": "rad", "m": "m"}
+_INPUT_SUFFIX = {"N*m": "Nm", "N": "N", "1": "1", "rad/s": "rad_s", "m/s": "m_s", "rad": "rad", "m": "m", "A": "A"}
 #: the fields of an [input.NAME] table
 INPUT_FIELDS = ("start", "description")
 

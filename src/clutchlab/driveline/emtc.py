@@ -31,6 +31,11 @@ the Torsen twist of Eq. 30 stays zero (its terms vanish identically while both s
 The armature events (``armature_rest``, ``armature_contact``, ``armature_leave_rest``,
 ``armature_leave_contact``) are kept and named for the element (``<name>.armature``).
 
+Its ports (:meth:`Driveline.emtc <clutchlab.driveline.network.Driveline.emtc>`: ``torque_request``, ``throttle``,
+``coil_current``) are network signals, inputs included; :func:`hold` puts their values at the evaluation's time into
+the model's inputs (``torque_request``, ``throttle``, ``coil_current_command``), which the packed model reads as its
+drum-bench co-simulation does.
+
 States: per coupling its seven (:data:`clutchlab.emtc.system.STATES`; its two shaft speeds follow the flanges,
 integrated from their accelerations and reset to them at every event, its Torsen twist stays zero), after the
 network's and its wet clutches'.  Outputs: per coupling its :data:`OUTPUTS`.  Any number of couplings per
@@ -56,14 +61,19 @@ __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDE
 
 N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
 # conf (int64): the friction index of the coupling, its element row, then the offsets of its states, switching
-# functions and modes in the whole system's, the number of the network's events and the index of its first named
-# element (``<name>.armature``, then ``<name>.coupling``)
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL = range(7)
-N_CONF = 7
+# functions and modes in the whole system's, the number of the network's events, the index of its first named
+# element (``<name>.armature``, then ``<name>.coupling``), then the network signal of each of its ports (-1: none;
+# :data:`PORT_INPUTS`)
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_PORT = range(8)
+#: the model inputs its ports hold, in the order of :data:`clutchlab.driveline.network.EMTC_PORTS`: the torque
+#: request, the throttle, the coil current set point
+PORT_INPUTS = np.array([S.U_TORQUE, S.U_THROTTLE, S.U_COIL], dtype=np.int64)
+N_PORT = PORT_INPUTS.size
+N_CONF = F_PORT + N_PORT
 #: coupling j's model errors are its model's codes minus ``ERROR_STRIDE j`` (clutchlab.emtc.system.ERROR_MESSAGES)
 ERROR_STRIDE = 1_000_000
-# buf (float): its states with the shaft speeds replaced | their derivative | switching values | inputs (zero) |
-# outputs
+# buf (float): its states with the shaft speeds replaced | their derivative | switching values | inputs (its ports'
+# values at the evaluation's time, :func:`hold`; zero for the others) | outputs
 B_X, B_DX, B_G, B_U = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH
 B_Y = B_U + N_IN
 N_BUF = B_Y + len(S.OUTPUTS)
@@ -133,6 +143,23 @@ def prepare(e):
 def _params(e, j):
     """A reference to coupling ``j``'s parameters as :func:`prepare` built them."""
     return kept_row(member(e, "params"), e.rows, j)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def hold(t, u, net, e):
+    """Each coupling's model inputs: its ports' network signals at ``t`` (a network input held by the host, or any
+    signal), zero where it has no port.  The network's held inputs are brought up to ``u`` first (the components are
+    evaluated before the network's right-hand side, which would do it)."""
+    if e.conf.shape[0] == 0:
+        return
+    if u.shape[0] > 0 and K.hold_inputs(net.data, u):
+        K.forget_signals(net)
+    for j in range(e.conf.shape[0]):
+        cf = e.conf[j]
+        b = e.buf[j]
+        for q in range(N_PORT):
+            s = cf[F_PORT + q]
+            b[B_U + PORT_INPUTS[q]] = K.signal_at(net, s, t) if s >= 0 else 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

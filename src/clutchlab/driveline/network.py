@@ -384,6 +384,17 @@ class Signal:
         raise ParameterError(f"{what} = {value!r}: expected a number or a Signal")
 
 
+def _port_inputs(e) -> tuple:
+    """The network inputs an element's ports read (an EMTC coupling's :meth:`Driveline.emtc` ports)."""
+    if getattr(e, "emtc", None) is None:
+        return ()
+    return tuple(n for v in e.emtc["ports"].values() if v is not None for n in v.input_names())
+
+
+#: an EMTC coupling's ports, in the order of its block's columns (:mod:`clutchlab.driveline.emtc`), and their units
+EMTC_PORTS = (("torque_request", "N*m"), ("throttle", "1"), ("coil_current", "A"))
+
+
 def _word(what: str, name) -> str:
     """``name`` if it is ASCII letters, digits and underscores (a component's or an input's name: part of column
     names and FMI variable names, which an FMI validator refuses in other characters), else a ParameterError
@@ -601,7 +612,7 @@ class Driveline:
         """Every input a signal reads is declared, and every declared input drives something."""
         used = set()
         for e in self._elements:
-            for n in (e.signal.input_names() if e.signal is not None else ()):
+            for n in [*(e.signal.input_names() if e.signal is not None else ()), *_port_inputs(e)]:
                 if n not in self._inputs:
                     known = ", ".join(self._inputs) or "none declared"
                     raise ParameterError(f"{e.name}: reads input {n!r}, which {self.name!r} does not declare "
@@ -626,6 +637,9 @@ class Driveline:
         out = copy.copy(self)
         out._elements = [copy.copy(e) for e in self._elements]
         for e in out._elements:
+            if _port_inputs(e):
+                ports = {q: (None if v is None else v.with_inputs(signals)) for q, v in e.emtc["ports"].items()}
+                e.emtc = dict(e.emtc, ports=ports)
             if e.signal is not None and e.signal.input_names():
                 e.signal = e.signal.with_inputs(signals)
                 if e.kind == K.K_MOTION:
@@ -1189,7 +1203,8 @@ class Driveline:
         el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
         return self
 
-    def emtc(self, name: str, a, b, magnet=None, scenario=None, vehicle=None, options=None) -> "Driveline":
+    def emtc(self, name: str, a, b, magnet=None, scenario=None, vehicle=None, options=None, *, torque_request=None,
+             throttle=None, coil_current=None) -> "Driveline":
         """The electromagnetic torque-controlled coupling of seed 002 between flanges a (its input, front shaft)
         and b (its output, rear shaft), with states of its own: coil current lags, armature, Preisach magnet
         memory, and its controller (:mod:`clutchlab.emtc.system`, Processes 7 (2019) 557, Eqs. 1-26 and 31;
@@ -1209,6 +1224,14 @@ class Driveline:
         controller model, friction map, reference, memory capacity; LuGre friction is refused): as
         :func:`clutchlab.emtc.system.pack_parameters`.  Any number of EMTC couplings and wet clutches per network
         (:mod:`clutchlab.driveline.coupled`).
+
+        Its ports (each a :class:`Signal` or a number; a network input with :meth:`Signal.input`, so a host, a
+        controller or an FMU's importer drives it): ``torque_request`` [N m], the controller's torque reference,
+        sampled every ``sample_time`` in place of the map of Eq. 31 and of ``options.torque_reference``;
+        ``throttle`` [1], the map's throttle, sampled likewise in place of ``scenario``'s ramp; ``coil_current``
+        [A], the set point of a current drive: the coil current lags of Fig. 15 follow it at once, with no torque
+        controller (Eqs. 6-7 and 31 left out), as ``options.coil_drive = "current"`` in a co-simulation.  A port
+        left out keeps what ``scenario`` and ``options`` say.
         """
         from ..emtc.bench import BenchScenario, VehicleParameters
         from ..emtc.system import BenchOptions
@@ -1229,10 +1252,21 @@ class Driveline:
                                  "follows the drum bench's own lock-up logic); give a friction map or none")
         if a is None or b is None:
             raise ParameterError(f"{name}: an EMTC coupling sits between two inertias (its shafts), not on the ground")
+        ports = {q: (None if v is None else Signal.of(v, f"{name}: {q}"))
+                 for q, v in (("torque_request", torque_request), ("throttle", throttle), ("coil_current", coil_current))}
+        if ports["torque_request"] is not None and ports["coil_current"] is not None:
+            raise ParameterError(f"{name}: torque_request and coil_current: a current drive (coil_current) has no "
+                                 "torque controller to take a torque request; give one of them")
+        if ports["torque_request"] is not None and options is not None and options.torque_reference is not None:
+            raise ParameterError(f"{name}: torque_request and options.torque_reference both give the controller's "
+                                 "torque reference; give one of them")
+        if ports["coil_current"] is not None and options is not None and options.coil_drive != "controller":
+            raise ParameterError(f"{name}: coil_current with options.coil_drive = {options.coil_drive!r}: the port "
+                                 "makes the drive a current drive; leave coil_drive at 'controller'")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0)
         el = self._elements[-1]
         el.emtc = dict(magnet=magnet, scenario=scenario or BenchScenario(), vehicle=vehicle or VehicleParameters(),
-                       options=options or BenchOptions())
+                       options=options or BenchOptions(), ports=ports)
         el.model = "EMTC coupling (seed 002: three friction elements, ball-cam, Preisach magnet, controller)"
         return self
 
@@ -1250,7 +1284,15 @@ class Driveline:
                     from ..emtc.magnet import bundled_magnet
 
                     magnet = bundled_magnet()
-                out.append((el, S.pack_parameters(magnet, w["scenario"], w["vehicle"], w["options"]), magnet))
+                packed = S.pack_parameters(magnet, w["scenario"], w["vehicle"], w["options"])
+                ports = w["ports"]
+                if ports["torque_request"] is not None:   # the controller samples the port (u) for its reference
+                    packed = packed._replace(reference_source=S.REFERENCE_INPUT)
+                if ports["coil_current"] is not None:     # a current drive: the lags follow the port (u) at once
+                    packed = packed._replace(reference_source=S.REFERENCE_CURRENT)
+                if ports["throttle"] is not None:         # the map's throttle read from the port (u), not a ramp
+                    packed = packed._replace(throttle=np.zeros((2, 0)))
+                out.append((el, packed, magnet))
         return out
 
     def _wet_parameters(self) -> list:
@@ -1355,6 +1397,8 @@ class Driveline:
                 sc = e.emtc["scenario"]
                 what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
                         f"{sc.ramp_start:g}-{sc.ramp_end:g} s, controller every {sc.sample_time * 1e3:g} ms")
+                what += "".join(f", {q} {v.describe({'N*m': 'N m', '1': '', 'A': 'A'}[unit])}" for (q, unit), v in
+                                zip(EMTC_PORTS, (e.emtc["ports"][q] for q, _ in EMTC_PORTS)) if v is not None)
             elif e.law == K.LAW_EXTERNAL:
                 what = f"{e.model}, force reference {e.signal.describe('N')}"
             else:
@@ -1444,6 +1488,10 @@ class Driveline:
                 coef[r, K.C_LIFTOFF] = e.liftoff
                 elem[r, K.E_AUX] = len(e.ncurve) // 2
                 data.extend(e.ncurve)
+        # each EMTC coupling's ports, after every element's signal (its block reads them: _with_components)
+        self._port_signals = {e.name: [-1 if e.emtc["ports"][q] is None else add_signal(e.emtc["ports"][q])
+                                       for q, _ in EMTC_PORTS]
+                              for e in self._elements if e.emtc is not None}
         fric = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_FRICTION], dtype=np.int64)
         cons = np.array([r for r, e in enumerate(self._elements) if e.kind in (K.K_GEAR, K.K_MOTION)], dtype=np.int64)
         swit = np.array([r for r, e in enumerate(self._elements)
@@ -1784,7 +1832,7 @@ class Driveline:
             i0 = float(magnet.grid[0])
             xs.append(np.array([x0[n + p.elem[r][K.E_A]], x0[n + p.elem[r][K.E_B]], 0.0, 0.0, 0.0, i0, i0]))
             conf.append([k, r, nx + j * DE.N_STATE, ng + j * DE.N_SWITCH, nm + j * DE.N_MODE,
-                         len(K.EVENTS) + len(W.EVENTS), nel + len(S.ELEMENTS) * j])
+                         len(K.EVENTS) + len(W.EVENTS), nel + len(S.ELEMENTS) * j, *self._port_signals[el.name]])
             ms.append(np.array([DE._REST, DE._OPEN, DE._POSITIVE], dtype=np.int64))   # armature at rest, open
             # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
             ae = S.ATOL * (float(rtol) / 1e-6)
