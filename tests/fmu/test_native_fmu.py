@@ -837,3 +837,56 @@ def test_the_accepted_range_is_found_by_bisection_within_the_declared_one():
     assert accepted_range(lambda v: v <= 7, 3.0, 1.0, 100.0, whole=True) == (1.0, 7.0)
     low, high = accepted_range(lambda v: 0.5 < v < 4.0, 1.0)
     assert 0.5 < low < 0.5 + 1e-12 and 4.0 - 1e-12 < high < 4.0
+
+
+_EMTC_PORT_TOML = """
+[simulation]
+t_end = "0.1 s"
+output_step = "1 ms"
+
+[inertia.f]
+J = 0.05
+w0 = "60 rad/s"
+
+[inertia.r]
+J = 0.05
+w0 = "50 rad/s"
+
+[speed.drive]
+flange = "f"
+speed = "60 rad/s"
+
+[spring_damper.load]
+a = "r"
+b = "ground"
+d = "0.5 N*m*s/rad"
+
+[input.T]
+start = "40 N*m"
+description = "the EMTC's torque request"
+
+[emtc.c]
+a = "f"
+b = "r"
+torque_request = { input = "T" }
+"""
+
+
+def test_a_host_drives_an_emtc_port_through_the_native_fmu(tmp_path):
+    """An EMTC coupling's torque request is an FMI input of the network's native FMU (issue #31, inputs are ports):
+    FMPy, without clutchlab, steps the request from 40 to 150 N m halfway; the FMU equals the Python co-simulation
+    and its controller's reference follows the request at its samples."""
+    description = tmp_path / "emtc_port.toml"
+    description.write_text(_EMTC_PORT_TOML)
+    cls = DrivelineCoSimulation.for_description(description)
+    path = export_native_fmu(cls, tmp_path / "port.fmu", platforms=["linux64"], report=None)
+    _, svs = _variables(path)
+    assert svs["T"].get("causality") == "input"
+    n, dt = 100, 1e-3
+    inputs = {"T": np.where(np.arange(n + 1) < 50, 40.0, 150.0)}
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(cls, n, dt, inputs=inputs)
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-9)
+    ref = native["c.torque_reference"]
+    assert np.all(ref[5:45] == 40.0) and np.all(ref[55:] == 150.0)
