@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from ..numerics import dispatch
-from ..numerics.borrow import member
+from ..numerics.borrow import keep_rows, member
 from . import emtc as DE
 from . import kernel as K
 from . import wet as DW
@@ -271,9 +271,10 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_prepare(p):
-    """Once per call of the core: each EMTC coupling's parameter structure built from its row, and each wet clutch's (:func:`clutchlab.driveline.emtc.prepare`, :func:`clutchlab.driveline.wet.prepare`)."""
-    DW.prepare(member(p, "wet"))
-    DE.prepare(member(p, "emtc"))
+    """Once per call of the core: each wet clutch's and each EMTC coupling's parameter structure built from its row of
+    its block (:func:`clutchlab.numerics.borrow.keep_rows`), which their hooks then read by reference."""
+    keep_rows(member(p, "wet"))
+    keep_rows(member(p, "emtc"))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

@@ -54,7 +54,7 @@ import numpy as np
 
 from ..emtc import system as S
 from ..numerics import dispatch
-from ..numerics.borrow import keep_row, kept_row, member, row_words, stack_rows
+from ..numerics.borrow import block_row, row_words, stack_rows
 from . import kernel as K
 
 __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
@@ -101,7 +101,8 @@ class EmtcBlock(NamedTuple):
     its controller's map and its drag data), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch
     ``B_*``), ``mbuf[j]`` (int64, its modes), ``index`` (int64, :data:`OUTPUT_INDEX`) and ``rows[j]`` (float64, the
     coupling's :class:`~clutchlab.emtc.system.EmtcParams` built from its row of ``params`` once per call of the core,
-    :func:`prepare`; its hooks read it by reference).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
+    :func:`clutchlab.numerics.borrow.keep_rows`; its hooks read it by reference, ``block_row``: built at every
+    evaluation instead, the rows cost a tenth of an EMTC network's run).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
     params: S.EmtcParams
     conf: np.ndarray
@@ -128,21 +129,6 @@ def block(params, conf) -> EmtcBlock:
     stacked = stack_rows(params, template=None if params else _template())
     return EmtcBlock(stacked, np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
                      np.zeros((n, N_MODE), dtype=np.int64), OUTPUT_INDEX.copy(), np.zeros((n, row_words(stacked))))
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def prepare(e):
-    """Each coupling's :class:`~clutchlab.emtc.system.EmtcParams` built from its row of the stacked ``e.params`` into
-    ``e.rows`` (:func:`clutchlab.numerics.borrow.keep_row`): the network's ``prepare`` hook, once per call of the
-    core.  Built at every evaluation instead, the rows cost a tenth of an EMTC network's run (issue #31)."""
-    for j in range(e.conf.shape[0]):
-        keep_row(member(e, "params"), e.rows, j)
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def _params(e, j):
-    """A reference to coupling ``j``'s parameters as :func:`prepare` built them."""
-    return kept_row(member(e, "params"), e.rows, j)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -191,7 +177,7 @@ def _coupling(t, x, m, net, e, j):
     b = e.buf[j]
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
-    ep = _params(e, j)
+    ep = block_row(e, j)
     dispatch.rhs(t, xs, us, e.mbuf[j], ep, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     dispatch.outputs(t, xs, us, e.mbuf[j], ep, b[B_Y:N_BUF])   # (the same point: the model reuses it)
     cap = b[B_Y + _Y_CAP] if e.mbuf[j][_ARM] == _CONTACT else 0.0
@@ -273,7 +259,7 @@ def call(t, x, m, net, e, j, k, log):
     _load(x, m, net, e, j)
     b = e.buf[j]
     start = log.count[0]
-    ep = _params(e, j)
+    ep = block_row(e, j)
     if k >= 0:
         res = dispatch.update(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], ep, k, log)
     else:
@@ -288,7 +274,7 @@ def accept(t, x, u, m, net, e):
     for j in range(e.conf.shape[0]):
         _load(x, m, net, e, j)
         b = e.buf[j]
-        res = dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], _params(e, j))
+        res = dispatch.accept(t, b[B_X:B_X + N_STATE], b[B_U:B_U + N_IN], e.mbuf[j], block_row(e, j))
         if res < 0:
             return error_code(res, j)
     return 0
@@ -298,5 +284,5 @@ def accept(t, x, u, m, net, e):
 def next_break(t, e, tb):
     """The earlier of ``tb`` and a coupling's next controller sample."""
     for j in range(e.conf.shape[0]):
-        tb = min(tb, dispatch.next_break(t, e.mbuf[j], _params(e, j)))
+        tb = min(tb, dispatch.next_break(t, e.mbuf[j], block_row(e, j)))
     return tb

@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..numerics.borrow import keep_row, kept_row, member, row_words, stack_rows
+from ..numerics.borrow import block_row, row_words, stack_rows
 from ..wet import system as W
 from . import kernel as K
 
@@ -68,7 +68,8 @@ class WetBlock(NamedTuple):
     (:func:`clutchlab.numerics.borrow.stack_rows`, as the EMTC block's: any number of clutches, each with its own
     profiles and friction law, is one type), ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch
     ``B_*``), ``mbuf[j]`` (int64, its modes) and ``rows[j]`` (float64, the clutch's
-    :class:`~clutchlab.wet.system.WetParams` built from its row once per call of the core, :func:`prepare`).  A member
+    :class:`~clutchlab.wet.system.WetParams` built from its row once per call of the core,
+    :func:`clutchlab.numerics.borrow.keep_rows`; read by reference, ``block_row``).  A member
     of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
     params: W.WetParams
@@ -94,21 +95,6 @@ def block(params, conf) -> WetBlock:
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def prepare(w):
-    """Each clutch's :class:`~clutchlab.wet.system.WetParams` built from its row of the stacked ``w.params`` into
-    ``w.rows`` (:func:`clutchlab.numerics.borrow.keep_row`): the network's ``prepare`` hook, once per call of the
-    core."""
-    for j in range(w.conf.shape[0]):
-        keep_row(member(w, "params"), w.rows, j)
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def _wet(w, j):
-    """A reference to clutch ``j``'s :class:`~clutchlab.wet.system.WetParams` as :func:`prepare` built them."""
-    return kept_row(member(w, "params"), w.rows, j)
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
 def _clutch(t, x, m, net, w, j):
     """Evaluate wet clutch ``j`` at the network's state: its derivative, switching values and outputs into
     ``w.buf[j]``, its sliding torque and static limit into the network (:func:`kernel.set_external`).
@@ -128,7 +114,7 @@ def _clutch(t, x, m, net, w, j):
     mk = m[cf[F_K]]
     ms[W.M_FRICTION] = W.STICK if mk == K.STUCK else (W.SLIP_NEG if mk == K.BACKWARD or (mk == K.FREE and w_rel < 0.0)
                                                     else W.SLIP)
-    wp = _wet(w, j)
+    wp = block_row(w, j)
     W.wet_rhs(t, xs, b[B_U:B_U + 2], ms, wp, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     wk = wp.data
     cap = wk[W.W_OUT + W.O_CAP]
@@ -214,8 +200,8 @@ def call(t, x, m, w, j, k, log):
     start = log.count[0]
     res = 0
     if k >= 0:
-        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, _wet(w, j), k, log)
-    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, _wet(w, j), log):
+        res = W.wet_update(t, xs, b[B_U:B_U + 2], ms, block_row(w, j), k, log)
+    elif W.wet_restart(t, xs, b[B_U:B_U + 2], ms, block_row(w, j), log):
         res = 1
     _rename(log, start, w, j)
     for i in range(N_STATE):
@@ -231,12 +217,12 @@ def accept(t, x, u, m, w):
     """Each wet clutch's peak-temperature memory."""
     for j in range(w.conf.shape[0]):
         o = w.conf[j][F_X]
-        W.wet_accept(t, x[o:o + N_STATE], u, m, _wet(w, j))
+        W.wet_accept(t, x[o:o + N_STATE], u, m, block_row(w, j))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def next_break(t, m, w, tb):
     """The earlier of ``tb`` and the next corner of a clutch's force profile."""
     for j in range(w.conf.shape[0]):
-        tb = min(tb, W.wet_next_break(t, m, _wet(w, j)))
+        tb = min(tb, W.wet_next_break(t, m, block_row(w, j)))
     return tb

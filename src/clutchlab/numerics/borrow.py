@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import numba
 import numpy as np
 from numba.core import cgutils, types
 from numba.core.imputils import impl_ret_borrowed, lower_getattr_generic
@@ -28,7 +29,7 @@ from numba.extending import intrinsic, models, register_model
 from numba.np.arrayobj import load_item
 
 __all__ = ["borrow", "byref", "ByRef", "member", "take", "shaped", "Ragged", "stack_rows", "row", "row_of", "row_words",
-           "keep_row", "kept_row"]
+           "keep_row", "kept_row", "keep_rows", "block_row"]
 
 
 def _has_arrays(ty) -> bool:
@@ -490,6 +491,21 @@ def kept_row(typingctx, stacked, rows, j):
         return _kept_slot(context, builder, row_ty, signature.args[1], rows_v, idx)
 
     return sig, codegen
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def keep_rows(block):
+    """Every row of a block kept (:func:`keep_row`): ``block`` a :class:`ByRef` to a structure with members
+    ``params`` (:func:`stack_rows`'s result) and ``rows`` (float64, a slot of :func:`row_words` words per row), the
+    driveline's blocks of model components.  A component's ``prepare`` hook, once per call of the core."""
+    for j in range(block.rows.shape[0]):
+        keep_row(member(block, "params"), block.rows, j)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def block_row(block, j):
+    """A :class:`ByRef` to row ``j`` of a block as :func:`keep_rows` built it."""
+    return kept_row(member(block, "params"), block.rows, j)
 
 
 # ---------------------------------------------------------------- a contiguous block viewed with a shape
