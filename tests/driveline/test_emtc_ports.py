@@ -66,6 +66,23 @@ def test_a_torque_request_table_given_to_the_run_equals_the_bench_with_that_tabl
     _check_emtc(ref, r.to_dataframe(), r.events, "")
 
 
+def test_a_throttle_port_feeds_the_map_as_the_scenario_s_ramp_does(bench):
+    """The scenario's throttle ramp given to the ``throttle`` port instead (the map of Eq. 31 then reads the port;
+    ``drum_bench`` gives the port to its engine too): the drum bench's own run with that ramp, and the throttle
+    output is the port's value."""
+    vehicle, sc = bench
+    ramp = Signal.table([0.0, sc.ramp_start, sc.ramp_end], [sc.throttle_start, sc.throttle_start, sc.throttle_end])
+    d = drum_bench(sc, vehicle, throttle=ramp)
+    times = _times(sc.duration)
+    r = d.simulate(sc.duration, rtol=RTOL, sample_times=times)
+    assert r.ok
+    N = r.to_dataframe()
+    _check_emtc(_bench(sc, vehicle, S.BenchOptions()), N, r.events, "")
+    expect = np.interp(times, [0.0, sc.ramp_start, sc.ramp_end], [sc.throttle_start, sc.throttle_start, sc.throttle_end])
+    np.testing.assert_allclose(N["emtc.throttle_1"], expect, rtol=0, atol=1e-12)   # (the port's value at each time)
+    assert d.system(RTOL).params.emtc.params.throttle.data.size == 0   # (the map reads the port, not a packed ramp)
+
+
 def _pair(coil_current, w0=50.0):
     """An EMTC between two shafts turning together, the front one driven at a constant speed, the rear one free."""
     d = Driveline("coil")
