@@ -102,7 +102,8 @@ class EmtcBlock(NamedTuple):
     ``B_*``), ``mbuf[j]`` (int64, its modes), ``index`` (int64, :data:`OUTPUT_INDEX`) and ``rows[j]`` (float64, the
     coupling's :class:`~clutchlab.emtc.system.EmtcParams` built from its row of ``params`` once per call of the core,
     :func:`clutchlab.numerics.borrow.keep_rows`; its hooks read it by reference, ``block_row``: built at every
-    evaluation instead, the rows cost a tenth of an EMTC network's run).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
+    evaluation instead, the rows cost a tenth of an EMTC network's run).  A member of
+    :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
     params: S.EmtcParams
     conf: np.ndarray

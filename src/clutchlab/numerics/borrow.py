@@ -196,8 +196,8 @@ def _take_row(context, builder, ty, row_ty, value, idx):
 def _take_row_ref(context, builder, ty, row_ty, ptr, idx):
     """:func:`_take_row` of the value ``ptr`` points to (a :class:`ByRef`), reading only what the row needs: the
     data pointer of each stacked array (and the starts and shapes of a :class:`Ragged`), never the whole stacked
-    structure (hundreds of array headers: loaded as one value, LLVM copied all of it at every row, a fifth of an
-    EMTC network's run)."""
+    structure (hundreds of array headers loaded as one value at every row: measured on an EMTC network, 2 % of its
+    run)."""
     if isinstance(row_ty, types.Array) and _is_ragged(ty):
         return _ragged_row_ref(context, builder, ty, row_ty, ptr, idx)
     if isinstance(ty, types.Array):
@@ -434,8 +434,6 @@ def _row_bytes(stacked_type) -> int:
 def row_words(stacked) -> int:
     """The float64 words one row of ``stacked`` (:func:`stack_rows`'s result) takes as numba holds it in memory: the
     width of the array :func:`keep_row` fills."""
-    import numba
-
     return -(-_row_bytes(numba.typeof(stacked)) // 8)
 
 
