@@ -71,8 +71,10 @@ def networks(draw, with_unrelated=False, with_components=False):
     efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
     clutch); sometimes a clutch closing a loop from the first to the last, a second clutch in parallel with one,
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
-    inertia turning.  ``with_components``: links may also be wet clutches (a force ramp or constant) and EMTC couplings
-    (their default scenario and controller), and at least one link is one of them."""
+    inertia turning.  ``with_components``: links may also be wet clutches (their force port a ramp, a constant, a
+    sine, a pulse or the product of a network input and a ramp) and EMTC couplings (their default scenario and
+    controller, or a port: a torque request ramp, a throttle ramp, a coil current step or a network input), and at
+    least one link is one of them."""
     n = draw(st.integers(2, 4))
     d = Driveline("random")
     w0 = draw(st.sampled_from([0.0, 0.0, 3.0, -2.0]))
@@ -85,13 +87,27 @@ def networks(draw, with_unrelated=False, with_components=False):
         if with_components:
             kinds += ["wet", "emtc"]
         kind = draw(st.sampled_from(["wet", "emtc"] if i == forced else kinds))
-        if kind == "wet":
-            force = draw(st.sampled_from([Signal.ramp(draw(st.floats(300.0, 3000.0)), draw(st.floats(0.05, 0.4)),
-                                                      start=draw(st.floats(0.0, 0.3))),
-                                          Signal.constant(draw(st.floats(300.0, 3000.0)))]))
+        if kind == "wet":   # its force port: any signal within [0, 8 kN], or a network input (held at its start)
+            top = draw(st.floats(300.0, 3000.0))
+            force = draw(st.sampled_from([
+                Signal.ramp(top, draw(st.floats(0.05, 0.4)), start=draw(st.floats(0.0, 0.3))),
+                Signal.constant(top),
+                Signal.sine(0.5 * top, draw(st.floats(1.0, 6.0)), offset=0.5 * top),
+                Signal.pulse(top, 0.5, draw(st.floats(0.1, 0.4)), start=draw(st.floats(0.0, 0.2))),
+                Signal.product(Signal.input(f"w{i}_force"), Signal.ramp(1.0, 0.2))]))
+            if force.input_names():
+                d.input(f"w{i}_force", unit="N", start=top)
             d.wet_clutch(f"w{i}", a, b, force=force)
-        elif kind == "emtc":
-            d.emtc(f"e{i}", a, b)
+        elif kind == "emtc":   # sometimes through a port: a torque request, a throttle or a current drive
+            port = draw(st.sampled_from(["", "torque_request", "throttle", "coil_current", "input"]))
+            ports = {"torque_request": {"torque_request": Signal.ramp(draw(st.floats(20.0, 300.0)), 0.3)},
+                     "throttle": {"throttle": Signal.ramp(draw(st.floats(0.1, 0.9)), 0.4, offset=0.1)},
+                     "coil_current": {"coil_current": Signal.step(draw(st.floats(0.3, 2.0)),
+                                                                  draw(st.floats(0.0, 0.3)))},
+                     "input": {"torque_request": Signal.input(f"e{i}_request")}, "": {}}[port]
+            if port == "input":
+                d.input(f"e{i}_request", unit="Nm", start=draw(st.floats(0.0, 200.0)))
+            d.emtc(f"e{i}", a, b, **ports)
         elif kind == "spring":
             d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
         elif kind == "backlash":

@@ -253,9 +253,22 @@ def test_a_wet_clutchs_force_is_a_network_input():
     np.testing.assert_allclose(sim_neg.x, sim0.x, rtol=1e-12, atol=1e-12)
 
 
-def test_a_wet_clutchs_force_input_is_one_input_not_a_product():
-    with pytest.raises(ParameterError, match="a wet clutch's force is a profile or one network input"):
-        _wet_sae2('force = { product = [{ input = "F" }, 2] }', "0 N")
+def test_a_wet_clutchs_force_port_takes_a_product_with_an_input():
+    """The force is a port, so an input in a product works (before, only one bare input): twice an input held at
+    1.5 kN is the run of a constant 3 kN to the last digits; and the actuator starts at the product's start."""
+    doubled = _wet_sae2('force = { product = [{ input = "F" }, 2] }', "1.5 kN")
+    profile = _wet_sae2('force = "3 kN"')
+    a = doubled.simulate(0.3, rtol=1e-8, output_step=1e-2).to_dataframe()
+    b = profile.simulate(0.3, rtol=1e-8, output_step=1e-2).to_dataframe()
+    assert a["clutch.actuator_force_N"].iloc[0] == 3000.0
+    for col in b.columns:
+        if pd.api.types.is_numeric_dtype(b[col]):
+            np.testing.assert_allclose(a[col], b[col], rtol=1e-12, atol=1e-12 * max(1.0, np.max(np.abs(b[col]))),
+                                       err_msg=col)
+    # driven by a host: the product follows the held input
+    sim = Simulation(doubled.system(1e-8))
+    sim.advance(0.3, [1500.0])
+    assert sim.x[len(doubled._inertias)] == pytest.approx(b["dyno.w_rad_s"].to_numpy()[-1], rel=1e-9)
 
 
 @settings(max_examples=examples(10), deadline=None, derandomize=True)

@@ -135,10 +135,14 @@ def test_wet_clutch_slides_backward_and_stays_open_without_force():
 
 
 def test_wet_clutch_errors():
-    with pytest.raises(ParameterError, match="constant, a ramp or a table"):
+    # the force is a port: any signal, but within [0, the actuator's maximum] where its range is known
+    with pytest.raises(ParameterError, match=r"clutch: force = 100 N sine.*reaches -100 N; an actuator only pushes"):
         _launch(force=Signal.sine(100.0, 1.0))
-    with pytest.raises(ParameterError, match="negative"):
+    with pytest.raises(ParameterError, match="reaches -5 N"):
         _launch(force=Signal.table([0.0, 1.0], [0.0, -5.0]))
+    with pytest.raises(ParameterError, match=r"reaches 18000 N, beyond the actuator's 16000 N"):
+        _launch(force=Signal.product(Signal.constant(3000.0), Signal.step(5.0, 0.1, offset=1.0)))
+    _launch(force=Signal.sine(100.0, 1.0, offset=100.0)).system()   # (touches 0: an actuator at rest)
     with pytest.raises(ParameterError, match="temperature0"):
         _launch(temperature0=math.nan)
     with pytest.raises(ParameterError, match="clutch: clutch must be a WetClutch, not Bench"):
@@ -223,3 +227,49 @@ def test_two_wet_clutches_each_equal_their_own_bench(bench_run):
                                atol=1e-6 * np.abs(r2["clutch_torque_Nm"]).max())
     assert abs(ev[(ev.element == "c2") & (ev.event == "stick")].time_s.iloc[0] - ref2.lockup_time) < 1e-7
     assert {"c1.piston", "c2.piston"} <= set(ev.element)
+
+
+def test_a_periodic_force_port_equals_the_bench_run_of_its_corners():
+    """The force is a port (:func:`clutchlab.driveline.wet.hold`): a network signal read at every evaluation, so any
+    signal drives the clutch.  A trapezoid (MSL ``Blocks.Sources.Trapezoid``: the network evaluates its formula)
+    pressing the clutch of a spinning dynamometer twice, and the same trapezoid as the product of a constant and a
+    dimensionless one, each equal the wet bench's own model run with the trapezoid's corners as its
+    piecewise-linear profile (an independent reading of the same reference): speed, torque and pack temperature
+    to the solver's tolerance, piston and film events to 1e-7 s."""
+    from clutchlab.wet.engagement import Scenario
+
+    clutch, bench = WetClutch.paper(), Bench()
+    # 0 -> 900 N over 0.05 s from 0.05 s, held 0.1 s, back to 0 over 0.05 s; every 0.4 s, twice
+    trap = Signal.trapezoid(900.0, 0.05, 0.1, 0.05, 0.4, nperiod=2, start=0.05)
+    unit = Signal.trapezoid(1.0, 0.05, 0.1, 0.05, 0.4, nperiod=2, start=0.05)
+    corners_t, corners_f = [0.0], [0.0]
+    for k in range(2):
+        t0 = 0.05 + 0.4 * k
+        corners_t += [t0, t0 + 0.05, t0 + 0.15, t0 + 0.2]
+        corners_f += [0.0, 900.0, 900.0, 0.0]
+    sc = Scenario(force_time=corners_t, force_value=corners_f, speed_time=[0.0], speed_value=[0.0], duration=0.9,
+                  motor="free", initial_slip_speed=150.0, initial_temperature_c=60.0, fluid_temperature_c=60.0,
+                  housing_temperature_c=60.0)
+    times = np.linspace(0.0, 0.9, 181)
+    ref = simulate_engagement(clutch, sc, bench=bench, sample_times=times, rtol=1e-9)
+    R = ref.result.to_dataframe()
+    assert R["contact_force_N"].max() > 100.0   # (the film closes)
+    for force in (trap, Signal.product(Signal.constant(900.0), unit)):
+        d = Driveline("pulsed")
+        d.inertia("dyno", J=bench.total_inertia, w0=150.0)
+        d.wet_clutch("c", "ground", "dyno", force=force, clutch=clutch, bench=bench, temperature0=60.0,
+                     fluid_temperature0=60.0, housing_temperature0=60.0)
+        r = d.simulate(0.9, rtol=1e-9, sample_times=times)
+        df = r.to_dataframe()
+        np.testing.assert_allclose(df["dyno.w_rad_s"], R["slip_speed_rad_s"], rtol=0, atol=1e-6 * 150.0)
+        tau = np.abs(R["clutch_torque_Nm"]).max()
+        np.testing.assert_allclose(df["c.clutch_torque_Nm"], R["clutch_torque_Nm"], rtol=0, atol=1e-6 * tau)
+        np.testing.assert_allclose(df["c.temperature_C"], R["temperature_C"], rtol=0, atol=1e-6)
+        np.testing.assert_allclose(df["c.actuator_force_N"], R["actuator_force_N"], rtol=0, atol=1e-6 * 900.0)
+        bev, ev = ref.result.events, r.events
+        for name in ("piston_leaves_stop", "contact", "separation", "piston_reaches_stop"):
+            mine = ev[ev["event"] == name]["time_s"].to_numpy()
+            theirs = bev[bev["event"] == name]["time_s"].to_numpy()
+            assert mine.size == theirs.size, name
+            np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-7, err_msg=name)
+        assert (ev["event"] == "contact").sum() == 2   # (pressed twice)

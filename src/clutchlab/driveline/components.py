@@ -261,7 +261,7 @@ BUILTIN = (
     ), _method("engine"), "mean-value engine (torque map)"),
     Component("wet_clutch", "The wet clutch of seed 001 with its actuator, piston, squeeze film and temperatures.", (
         _A, _B,
-        Field("force", "signal", "N", required=True, description="actuator force reference (constant, ramp or table)"),
+        Field("force", "signal", "N", required=True, description="actuator force reference, a port: any signal in [0, the actuator's maximum]"),
         Field("clutch", "path", description="a wet-clutch parameter file (default WetClutch.paper())"),
         Field("bench", "path", description="a bench parameter file: actuator, oil loop, housing (default Bench())"),
         Field("friction", "path", description="a friction law (.toml) or an identified map (.json)"),

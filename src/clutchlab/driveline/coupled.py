@@ -44,15 +44,25 @@ class CoupledParams(NamedTuple):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _hold(t, u, net, w, e):
+    """Every component's ports at ``t`` (a wet clutch's force, an EMTC coupling's torque request, throttle and coil
+    current: each a network signal), after the network's held inputs are brought up to the core's ``u`` (the
+    components are evaluated before the network's right-hand side, which would do that)."""
+    if u.shape[0] > 0 and K.hold_inputs(net.data, u):
+        K.forget_signals(net)
+    DW.hold(t, net, w)
+    DE.hold(t, net, e)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _evaluate(t, x, u, m, net, w, e):
-    """Every component at the network's state: its derivatives and switching values into its block's scratch, its
-    torques into the network's.  (Without reference counting: only the EMTC's own hooks keep it, called where a
-    network has a coupling.)"""
+    """Every component at the network's state (its ports first, :func:`_hold`): its derivatives and switching values
+    into its block's scratch, its torques into the network's.  (Without reference counting: only the EMTC's own
+    hooks keep it, called where a network has a coupling.)"""
+    _hold(t, u, net, w, e)
     if w.conf.shape[0] > 0:
-        DW.hold(u, w)
         DW.evaluate(t, x, m, net, w)
     if e.conf.shape[0] > 0:
-        DE.hold(t, u, net, e)
         DE.evaluate(t, x, m, net, e)
 
 
@@ -70,7 +80,7 @@ def _at_rest(x, m, net):
     n = net.inertia.shape[0]
     for k in range(net.fric.shape[0]):
         r = net.fric[k]
-        if m[k] == K.STUCK or abs(K.relative_speed(net, r, x, n)) <= 1e3 * K._item_wtol(net, r, x, n):
+        if m[k] == K.STUCK or abs(K.relative_speed(net, r, x, n)) <= 1e3 * K.speed_tolerance(net, r, x, n):
             return True
     return net.lossy.shape[0] > 0
 
@@ -92,15 +102,20 @@ def _with_rates(t, x, u, m, p):
     dx = np.empty(x.shape[0])
     g = np.empty(ng + w.conf.shape[0] * DW.N_SWITCH + e.conf.shape[0] * DE.N_SWITCH)
     coupled_rhs(t, x, u, m, p, dx, g)
-    ext = K._external(net)
-    nj = ext.shape[0] // K.N_EXT
-    v0 = ext[:3 * nj].copy()
-    _evaluate(t + K.T_RATE, x + K.T_RATE * dx, u, m, net, w, e)
-    v1 = ext[:3 * nj].copy()
+    nj = K.external_count(net)
+    v0 = np.empty(3 * nj)
+    for j in range(nj):
+        for q in range(3):
+            v0[3 * j + q] = K.external_value(net, j, q, t)   # (as the components set them: no rate yet)
+    t1 = t + K.T_RATE
+    _evaluate(t1, x + K.T_RATE * dx, u, m, net, w, e)
+    d = np.empty(3 * nj)
+    for j in range(nj):
+        for q in range(3):
+            d[3 * j + q] = (K.external_value(net, j, q, t1) - v0[3 * j + q]) / K.T_RATE
     _evaluate(t, x, u, m, net, w, e)   # (the components' own scratch back at t, as their calls read it)
     for j in range(nj):
-        K.set_external_rates(net, j, t, (v1[3 * j] - v0[3 * j]) / K.T_RATE,
-                             (v1[3 * j + 1] - v0[3 * j + 1]) / K.T_RATE, (v1[3 * j + 2] - v0[3 * j + 2]) / K.T_RATE)
+        K.set_external_rates(net, j, t, d[3 * j], d[3 * j + 1], d[3 * j + 2])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -111,7 +126,7 @@ def coupled_rhs(t, x, u, m, p, dx, g):
     e = member(p, "emtc")
     _evaluate(t, x, u, m, net, w, e)
     K.driveline_rhs(t, x, u, m, net, dx, g)
-    acc, _tau = K._acc_tau(net)
+    acc = K.accelerations(net)
     if w.conf.shape[0] > 0:   # (a kind the network has none of costs no call)
         DW.derivatives(net, w, acc, dx, g)
     if e.conf.shape[0] > 0:
@@ -197,7 +212,7 @@ def coupled_accept(t, x, u, m, p):
     w = member(p, "wet")
     e = member(p, "emtc")
     DW.accept(t, x, u, m, w)
-    DE.hold(t, u, net, e)
+    _hold(t, u, net, w, e)
     res = DE.accept(t, x, u, m, net, e)
     if res < 0:
         return res

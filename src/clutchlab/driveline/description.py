@@ -45,7 +45,7 @@ temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support;
 position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
 (flange, torque_map = ``{ speeds, throttles, torques }`` or full-load rows ``[[w, T], ...]``, throttle,
 idle_speed, idle_kp, idle_ki, idle_torque_max, support) and ``wet_clutch``
-(a, b, force [N] = a constant, ramp or table; clutch, bench = wet-clutch parameter files, friction = a
+(a, b, force [N] = its port, any signal; clutch, bench = wet-clutch parameter files, friction = a
 friction law file or an identified map ``.json``; temperature0, fluid_temperature0, housing_temperature0
 [degC]) and ``emtc`` (a = its input shaft, b = its output shaft; bench = an EMTC scenario file of
 ``clutchlab emtc simulate`` (its ``[scenario]``, ``[vehicle]``, ``[actuator]``, ``[coupling]`` tables: the
@@ -70,7 +70,7 @@ or ``{ input = "NAME" }``: the network input declared by an ``[input.NAME]`` tab
 in the unit of the fields that read it, default 0; ``description``), held by whatever drives the network
 (``Driveline.simulate``'s ``inputs``, a co-simulation master, an FMU's importer, a controller).  Torque and
 force sources, clutches' and brakes' normal signals, an engine's throttle, an E-clutch's bearing position
-(without its actuator), a wet clutch's force (one input, not in a product) and an EMTC's ports take inputs;
+(without its actuator), a wet clutch's force and an EMTC's ports (any signal) take inputs;
 motion sources and the E-clutch with its actuator do not (yet).
 A friction characteristic (``mu``, a bearing's ``torque``) is a number or a table of rows
 ``[w_rad_s, value]``.  Every error names the file, the key and the value.

@@ -133,14 +133,11 @@ def block(params, conf) -> EmtcBlock:
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def hold(t, u, net, e):
+def hold(t, net, e):
     """Each coupling's model inputs: its ports' network signals at ``t`` (a network input held by the host, or any
-    signal), zero where it has no port.  The network's held inputs are brought up to ``u`` first (the components are
-    evaluated before the network's right-hand side, which would do it)."""
-    if e.conf.shape[0] == 0:
-        return
-    if u.shape[0] > 0 and K.hold_inputs(net.data, u):
-        K.forget_signals(net)
+    signal), zero where it has no port.  The caller has brought the network's held inputs up to the core's ``u``
+    (:func:`clutchlab.driveline.coupled._hold`: the components are evaluated before the network's right-hand side,
+    which would do it)."""
     for j in range(e.conf.shape[0]):
         cf = e.conf[j]
         b = e.buf[j]
@@ -160,8 +157,8 @@ def _load(x, m, net, e, j):
     b = e.buf[j]
     for i in range(N_STATE):
         b[B_X + i] = x[cf[F_X] + i]
-    b[B_X] = K._speed(x, n, el[K.E_A])
-    b[B_X + 1] = K._speed(x, n, el[K.E_B])
+    b[B_X] = K.flange_speed(x, n, el[K.E_A])
+    b[B_X + 1] = K.flange_speed(x, n, el[K.E_B])
     b[B_X + 2] = 0.0
     ms = e.mbuf[j]
     ms[_ARM] = m[cf[F_M] + _ARM]
@@ -227,8 +224,8 @@ def sync(x, net, e):
     for j in range(e.conf.shape[0]):
         cf = e.conf[j]
         el = net.elem[cf[F_ROW]]
-        x[cf[F_X]] = K._speed(x, n, el[K.E_A])
-        x[cf[F_X] + 1] = K._speed(x, n, el[K.E_B])
+        x[cf[F_X]] = K.flange_speed(x, n, el[K.E_A])
+        x[cf[F_X] + 1] = K.flange_speed(x, n, el[K.E_B])
         x[cf[F_X] + 2] = 0.0
 
 

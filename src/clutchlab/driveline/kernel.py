@@ -1176,6 +1176,24 @@ def copy_component(dx, g, b, xo, go, nx, ng, bdx, bg):
         g[go + i] = b[bg + i]
 
 
+# ---- what a model component's block reads of the network (driveline.coupled, driveline.wet, driveline.emtc): it
+# gives its torques with set_external/set_external_rates and its derivatives with copy_component, and reads these
+
+#: the speed [rad/s] of inertia ``i`` in the state ``x`` of a network of ``n`` inertias (0 for the ground, ``i < 0``)
+flange_speed = _speed
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def accelerations(p):
+    """The inertias' accelerations [rad/s^2] of the network's last evaluation (its right-hand side), borrowed."""
+    return _acc_tau(p)[0]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def external_count(p):
+    """The number of clutch models (``LAW_EXTERNAL`` elements) whose torques :func:`set_external` sets."""
+    return _external(p).shape[0] // N_EXT
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def external_value(p, j, which, t):
     """Clutch model ``j``'s number ``which`` (0 sliding torque, 1 static limit, 2 lock-up limit) [N m] at time ``t``:
@@ -2348,6 +2366,11 @@ def _item_wtol(p, r, x, n):
         if i >= 0:
             w = max(w, abs(x[n_ + i]))
     return 1e-9 * w
+
+
+#: the rounding width [rad/s] of element row ``r``'s relative speed (1e-9 of its inertias' largest speed, >= 1 rad/s;
+#: a model component's block reads it, driveline.coupled)
+speed_tolerance = _item_wtol
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

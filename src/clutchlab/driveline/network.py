@@ -1162,8 +1162,10 @@ class Driveline:
 
         Its torque is the asperity torque ``R_eff N_c mu_f F_c`` (Eq. 4) plus the viscous torque (Eq. 5)
         while it slides, and at most ``R_eff N_c mu_f F_c`` while stuck; the network's friction state machine
-        decides which.  ``force`` [N]: the actuator force reference (a constant, ramp or table signal: the
-        model's piecewise-linear profile; the actuator follows it with its lag).  ``clutch``
+        decides which.  ``force`` [N]: the actuator force reference, a port: any :class:`Signal` (a table, a
+        sine, a pulse, a product, a network input ``Signal.input``) or a number, read at every evaluation; the
+        actuator follows it with its lag.  A signal must stay within ``[0, bench.actuator_force_max]``; a network
+        input is saturated there (the actuator only pushes: a negative reference releases it).  ``clutch``
         (:class:`~clutchlab.wet.params.WetClutch`, default ``WetClutch.paper()``), ``bench``
         (:class:`~clutchlab.wet.params.Bench`: actuator, oil loop and housing; default ``Bench()``; its drive
         is not used) and ``friction`` (a friction law or map of :mod:`clutchlab.wet.friction`, default the
@@ -1177,7 +1179,6 @@ class Driveline:
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         sig = Signal.of(force, f"{name}: force")
-        _, forces = self._wet_profile(name, sig)   # a profile the model reads, or one network input
         temps = {}
         for what, value in (("temperature0", temperature0), ("fluid_temperature0", fluid_temperature0),
                             ("housing_temperature0", housing_temperature0)):
@@ -1194,9 +1195,13 @@ class Driveline:
                                          "ParametricFriction or FrictionMap")):
             if not isinstance(value, cls):
                 raise ParameterError(f"{name}: {what} must be a {label}, not {type(value).__name__}")
-        if max(forces) > bench.actuator_force_max * (1.0 + 1e-12):   # (an input is saturated there by the model)
-            raise ParameterError(f"{name}: force reference {max(forces):g} N exceeds the actuator's "
-                                 f"{bench.actuator_force_max:g} N (bench.actuator_force_max)")
+        lo, hi = sig.bounds()   # (None where a network input decides it: saturated at 0 and the maximum)
+        if lo is not None and lo < 0.0:
+            raise ParameterError(f"{name}: force = {sig.describe('N')}: the force reference reaches {lo:g} N; an "
+                                 "actuator only pushes (a reference >= 0)")
+        if hi is not None and hi > bench.actuator_force_max * (1.0 + 1e-12):
+            raise ParameterError(f"{name}: force = {sig.describe('N')}: the force reference reaches {hi:g} N, "
+                                 f"beyond the actuator's {bench.actuator_force_max:g} N (bench.actuator_force_max)")
         self._friction(name, a, b, K.LAW_EXTERNAL, (0.0, 0.0), 1.0, 0.0, 0.0, sig)
         el = self._elements[-1]
         el.wet = dict(clutch=clutch, bench=bench, friction=friction, **temps)
@@ -1306,29 +1311,15 @@ class Driveline:
             if el.wet is None:
                 continue
             w = el.wet
-            times, values = self._wet_profile(el.name, el.signal)
-            scenario = Scenario(force_time=times, force_value=values, speed_time=[0.0], speed_value=[0.0],
+            # the model's own force profile is zero: the force reaches it through its port (its element's signal,
+            # read by the block at every evaluation, driveline.wet.hold)
+            scenario = Scenario(force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0],
                                 duration=1.0, motor="free", initial_temperature_c=w["temperature0"],
                                 fluid_temperature_c=w["fluid_temperature0"],
                                 housing_temperature_c=w["housing_temperature0"])
             params = W.pack_parameters(w["clutch"], w["bench"], scenario, w["friction"])
             out.append((el, params, W.initial_state(scenario), w["clutch"]))
         return out
-
-    @staticmethod
-    def _wet_profile(name, sig) -> tuple:
-        """The force profile ``(times, values)`` [s, N] a wet clutch's model reads: the corners of a constant,
-        ramp or table signal, or zero when the force is one network input (added to the profile by the graft,
-        :mod:`clutchlab.driveline.wet`)."""
-        if sig.input_names():
-            if sig.row[0] != K.SIG_INPUT:
-                raise ParameterError(f"{name}: force = {sig.describe('N')}: a wet clutch's force is a profile or "
-                                     "one network input ({ input = \"NAME\" }), not a product with one")
-            return (0.0,), (0.0,)
-        times, values = sig.breakpoints(f"{name}: force (the actuator's force reference)", "N")
-        if min(values) < 0.0:
-            raise ParameterError(f"{name}: force reference {min(values):g} N is negative")
-        return times, values
 
     def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
                        normal=1.0, mu_scale: float = 1.0) -> "Driveline":
@@ -1429,6 +1420,11 @@ class Driveline:
 
     def pack(self) -> K.DrivelineParams:
         """The packed parameters (:class:`~clutchlab.driveline.kernel.DrivelineParams`)."""
+        return self._pack()[0]
+
+    def _pack(self) -> tuple:
+        """The packed parameters and each EMTC coupling's port rows: ``{name: [signal row or -1 per port of
+        EMTC_PORTS]}``, their signals packed after every element's (its block reads them: :meth:`_with_components`)."""
         if not self._inertias:
             raise ParameterError(f"{self.name}: no inertia")
         index = {n: i for i, n in enumerate(self._inertias)}
@@ -1489,7 +1485,7 @@ class Driveline:
                 elem[r, K.E_AUX] = len(e.ncurve) // 2
                 data.extend(e.ncurve)
         # each EMTC coupling's ports, after every element's signal (its block reads them: _with_components)
-        self._port_signals = {e.name: [-1 if e.emtc["ports"][q] is None else add_signal(e.emtc["ports"][q])
+        port_rows = {e.name: [-1 if e.emtc["ports"][q] is None else add_signal(e.emtc["ports"][q])
                                        for q, _ in EMTC_PORTS]
                               for e in self._elements if e.emtc is not None}
         fric = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_FRICTION], dtype=np.int64)
@@ -1512,7 +1508,7 @@ class Driveline:
                               np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2))
         x0 = self.initial_state()
         work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
-        return p
+        return p, port_rows
 
     def _spring_energy(self, p, x0):
         """Energy stored in the springs at ``x0`` [J] (as :func:`~clutchlab.driveline.kernel.spring_energy`)."""
@@ -1704,7 +1700,7 @@ class Driveline:
         # batch's worker threads then only look their addresses up (clutchlab.numerics.outline); the invariant
         # check only where it is asked for (a debug option: not compiled on every first use)
         outline.prepare(lazy=check_invariants)
-        p = self.pack()
+        p, port_rows = self._pack()
         if check_invariants:
             p.check[0] = 1.0
             p.check[1] = _check_tol(rtol)
@@ -1740,7 +1736,8 @@ class Driveline:
             from . import emtc as DE
             from .wet import OUTPUTS as WET_OUTPUTS
 
-            p, x0, m0, atol = self._with_components(p, x0, m0, atol, wet, emtcs, rtol, len(switching), len(named))
+            p, x0, m0, atol = self._with_components(p, x0, m0, atol, wet, emtcs, rtol, len(switching), len(named),
+                                                  port_rows)
             for el, *_ in wet:
                 states += tuple((f"{el.name}.{q}", unit, d) for q, unit, d in W.STATES)
                 switching += tuple((f"{el.name}.{q}", d) for q, d in W.SWITCHING)
@@ -1784,7 +1781,7 @@ class Driveline:
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name, error_messages=error_messages)
 
-    def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel):
+    def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel, port_rows):
         """The network's parameters, initial state and modes and absolute tolerances joined with its wet clutches'
         and EMTC couplings' (:class:`~clutchlab.driveline.coupled.CoupledParams`; the layout in
         :mod:`clutchlab.driveline.coupled`).  A coupling starts with its armature at rest, its coil current at its
@@ -1810,13 +1807,11 @@ class Driveline:
                 x0[n + p.elem[r][K.E_A]] if p.elem[r][K.E_A] >= 0 else 0.0)
             xw = xw.copy()
             xw[W.S_W] = w_rel
-            names = el.signal.input_names()
-            iu = list(self._inputs).index(names[0]) if names else -1
-            if names:   # the actuator starts at the input's start (as at a profile's first value), saturated
-                most = float(np.ravel(wp.constants["actuator_force_max"])[0])
-                xw[W.S_FA] = min(max(self._inputs[names[0]][1], 0.0), most)
+            # the actuator starts at its reference's start (the inputs at their starts), saturated as the model does
+            most = float(np.ravel(wp.constants["actuator_force_max"])[0])
+            xw[W.S_FA] = min(max(el.signal.value_and_rate(0.0, self._input_starts())[0], 0.0), most)
             conf.append([k, r, nx + j * W.N_STATE, ng + j * W.N_SWITCH, nm + j * DW.N_MODE, len(K.EVENTS),
-                         nel + 2 * j, iu])
+                         nel + 2 * j, p.elem[r][K.E_SIGNAL]])
             xs.append(xw)
             ms.append(W.initial_modes(xw, clutch.piston_h0))
             tols.append(W.absolute_tolerance(clutch, rtol))
@@ -1832,7 +1827,7 @@ class Driveline:
             i0 = float(magnet.grid[0])
             xs.append(np.array([x0[n + p.elem[r][K.E_A]], x0[n + p.elem[r][K.E_B]], 0.0, 0.0, 0.0, i0, i0]))
             conf.append([k, r, nx + j * DE.N_STATE, ng + j * DE.N_SWITCH, nm + j * DE.N_MODE,
-                         len(K.EVENTS) + len(W.EVENTS), nel + len(S.ELEMENTS) * j, *self._port_signals[el.name]])
+                         len(K.EVENTS) + len(W.EVENTS), nel + len(S.ELEMENTS) * j, *port_rows[el.name]])
             ms.append(np.array([DE._REST, DE._OPEN, DE._POSITIVE], dtype=np.int64))   # armature at rest, open
             # the bench's tolerances are for its rtol 1e-6; the shaft speeds and twist follow the network's
             ae = S.ATOL * (float(rtol) / 1e-6)

@@ -21,9 +21,11 @@ model's piston and film switching functions and events (``contact``, ``separatio
 
 States: the network's, then per clutch the wet model's twelve (its ``slip_speed`` follows the element's
 relative speed, integrated from the relative acceleration and reset to it at every event; its drive states
-stay zero).  Its force is a piecewise-linear profile of its model's, or a network input (``{ input = "F" }``:
-the model's ``force_reference`` input on a zero profile, saturated at 0 N; the actuator starts at the
-input's start).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
+stay zero).  Its force is a port: the element's network signal (any signal: a table, a sine, a pulse, a
+product, a network input ``{ input = "F" }``) read at every evaluation (:func:`hold`) into the model's
+``force_reference`` input on a zero profile, saturated at 0 N, as the EMTC coupling's ports
+(:mod:`clutchlab.driveline.emtc`); its corners are the network's breaks, and the actuator starts at the signal's
+value at t = 0 (an input's start).  Outputs: the network's, then per clutch the wet model's own twelve (:data:`OUTPUTS`: its eighteen
 without the six of its bench, :data:`BENCH_ONLY`).  Any number of wet clutches:
 each is packed on its own and evaluated with its own hooks (its parameters one row of a :class:`WetBlock`;
 :mod:`clutchlab.driveline.coupled` joins them to the network and its EMTC couplings).
@@ -46,11 +48,11 @@ __all__ = ["WetBlock", "block", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "BEN
 N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
 # conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
 # states, switching functions and modes in the whole system's, the number of the network's events, the index of
-# its first named element (``<name>``, then ``<name>.piston``) and the network input its force reads (-1: none)
+# its first named element (``<name>``, then ``<name>.piston``) and the network signal its force port reads
 F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = range(8)
 N_CONF = 8
 # buf (float): its states with the slip replaced | their derivative | switching values | its model's inputs (the
-# force reference added to its profile: a network input, else zero; no slip reference) | outputs
+# force reference added to its zero profile: the force port's value; no slip reference) | outputs
 B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
 N_BUF = B_Y + W.N_OUT
 #: outputs of the wet model that belong to its bench, as the wet model declares them
@@ -125,12 +127,13 @@ def _clutch(t, x, m, net, w, j):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def hold(u, w):
-    """Each clutch's force input (its model's ``force_reference`` input, added to its zero profile): the network
-    input it reads, saturated at 0 (an actuator pushes; a negative reference releases it), else zero."""
+def hold(t, net, w):
+    """Each clutch's force port at ``t``: its model's ``force_reference`` input (added to its zero profile) is the
+    value of the network signal it reads (any signal; a network input as the host holds it: the caller has brought
+    the network's held inputs up to the core's ``u``), saturated at 0 (an actuator pushes; a negative reference
+    releases it; the model saturates at its maximum)."""
     for j in range(w.conf.shape[0]):
-        iu = w.conf[j][F_U]
-        w.buf[j][B_U + W.U_FORCE] = max(u[iu], 0.0) if iu >= 0 else 0.0
+        w.buf[j][B_U + W.U_FORCE] = max(K.signal_at(net, w.conf[j][F_U], t), 0.0)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
