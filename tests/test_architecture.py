@@ -20,7 +20,7 @@ ROOT = Path(clutchlab.__file__).parent
 #: or sub-package of clutchlab is named by its first name after ``clutchlab`` (``"clutchlab"``: the package's
 #: face, ``clutchlab/__init__.py``)
 LAYERS = (
-    ("foundation", {"errors", "_limits", "_compile_notice", "_process", "units", "numerics", "result", "curves", "plotting"}),
+    ("foundation", {"errors", "_limits", "_compile_notice", "_process", "_cache", "units", "numerics", "result", "curves", "plotting"}),
     ("contract", {"clutchlab", "system", "component", "trim", "io", "params", "hysteresis", "friction"}),
     ("models", {"eclutch", "wet", "emtc"}),
     ("composition", {"driveline"}),

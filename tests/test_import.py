@@ -21,3 +21,25 @@ def test_import_compiles_nothing():
     n_kernels, n_compiled = map(int, out.stdout.split())
     assert n_kernels > 20, "the kernels of all subsystems were found"
     assert n_compiled == 0
+
+
+PLAIN = """
+import sys
+from pathlib import Path
+from clutchlab.driveline.description import load_driveline
+f = load_driveline(Path({examples!r}) / "driveline_coupled_clutches.toml")
+f.driveline.pack()
+f.driveline._wet_parameters(), f.driveline._emtc_parameters()
+print(sorted(m for m in ("clutchlab.wet", "clutchlab.emtc", "clutchlab.eclutch", "scipy.special") if m in sys.modules))
+"""
+
+
+def test_a_plain_network_loads_no_model_package():
+    """A driveline file of plain elements (CoupledClutches) is read and packed without importing the wet, EMTC or
+    E-clutch packages (the wet one brings SciPy's special functions: 0.13 s of every start of the command line)."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    out = subprocess.run([sys.executable, "-c", PLAIN.format(examples=str(examples))], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "[]"

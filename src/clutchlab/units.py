@@ -4,11 +4,22 @@ Inside the package every quantity is SI (m, N, N·m, rad/s, Pa, Pa·s, kg, s);
 temperatures are carried in °C where the name says so (``temperature_c``) and in
 K otherwise.  Parameter files may carry units as strings (``"83.15 mm"``,
 ``"300 kPa"``); :func:`to_si` converts them once, at the edge, with :mod:`pint`.
+
+pint builds its registry of units in about 0.3 s and imports in about as long: more than a warm
+``clutchlab driveline simulate`` spends simulating.  So the factor of every multiplicative conversion
+pint made (a unit as written and the SI unit it was converted to, ``"mm" -> "m": 0.001``) is kept in a
+small JSON file of clutchlab's cache (:func:`clutchlab._cache.cache_folder`, one file per pint version),
+and a later process converts the same unit without importing pint.  pint converts a magnitude as
+``value * factor`` (``PlainRegistry._convert``), so the kept factor gives the same number to the last
+bit; a unit with an offset (``degF``), a number inside the unit (``"N/(10 mm)"``) or a conversion that
+fails goes to pint every time, and pint writes every error message.
 """
 
 from __future__ import annotations
 
+import json
 import math
+import os
 import re
 from functools import lru_cache
 from numbers import Real
@@ -258,6 +269,80 @@ def _cycles(source: str, target: str) -> tuple[int, int]:
     return 0, 0
 
 
+# ---------------------------------------------------------------- conversions kept between processes
+#: a unit as written that may be kept: no number in it but an exponent (``m^2``, ``m**-1``): pint folds other
+#: numbers (``N/(10 mm)``) into the magnitude, and the product would then round differently
+_KEEPABLE = re.compile(r"^(?:[^\d]|(?<=\^)-?\d+|(?<=\*\*)-?\d+|(?<=\d)\d)*$")
+_KEPT: dict | None = None   # "unit as written|target" -> factor (loaded on first use)
+_KEPT_FORMAT = 1
+
+
+def _kept_file():
+    """The file of kept factors for the installed pint (None where there is no cache folder or no pint)."""
+    from importlib import metadata
+
+    from ._cache import cache_folder
+
+    try:
+        version = metadata.version("pint")
+        return cache_folder("units") / f"conversions-pint{version}-v{_KEPT_FORMAT}.json"
+    except (OSError, metadata.PackageNotFoundError):
+        return None
+
+
+def _kept() -> dict:
+    """The kept factors, read once per process; a file that is not a mapping of names to finite numbers (damaged,
+    written by hand) is ignored and later replaced."""
+    global _KEPT
+    if _KEPT is None:
+        _KEPT = {}
+        path = _kept_file()
+        try:
+            data = json.loads(path.read_text(encoding="utf-8")) if path is not None else {}
+        except (OSError, ValueError):
+            data = {}
+        if isinstance(data, dict):
+            _KEPT = {k: float(v) for k, v in data.items() if isinstance(k, str) and type(v) in (int, float)
+                     and math.isfinite(v) and v != 0.0}
+    return _KEPT
+
+
+def _keep(text: str, unit: str, factor: float) -> None:
+    """Keep pint's factor from ``text`` to ``unit``, for this process and the next (written atomically: a temporary
+    file renamed over the old one; where that fails, only for this process)."""
+    key = f"{text}|{unit}"
+    kept = _kept()
+    if kept.get(key) == factor:
+        return
+    kept[key] = factor
+    path = _kept_file()
+    if path is None:
+        return
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(json.dumps(kept, sort_keys=True), encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+
+
+def _factor(ureg, text: str, unit: str) -> float | None:
+    """pint's multiplicative factor from ``text`` to ``unit`` if the conversion is one (``f(x) = x * f(1)``, no
+    offset), else None."""
+    try:
+        zero = convert(ureg.Quantity(0.0, text), unit)
+        one = convert(ureg.Quantity(1.0, text), unit)
+        three = convert(ureg.Quantity(3.0, text), unit)
+    except Exception:  # noqa: BLE001 (an offset unit in a product, ...: not kept)
+        return None
+    if zero != 0.0 or not math.isfinite(one) or one == 0.0 or three != 3.0 * one:
+        return None
+    return one
+
+
 def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -> float:
     """Convert a parameter value to the SI unit ``unit``.
 
@@ -291,10 +376,17 @@ def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -
     if isinstance(value, Real):
         out = float(value)
     elif isinstance(value, str):
+        m = _NUMBER_UNIT.match(value)
+        text = (m.group(2).strip() or "dimensionless") if m is not None else ""
+        factor = _kept().get(f"{text}|{unit}") if m is not None else None
+        if factor is not None:   # (a conversion pint made before: its factor, without importing pint)
+            out = float(m.group(1)) * factor
+            if not math.isfinite(out):
+                raise ParameterError(f"{where}{name} = {short_repr(value)}: not a finite number")
+            return out
         ureg = _registry()
         import pint
 
-        m = _NUMBER_UNIT.match(value)
         try:
             if m is None:
                 raise ValueError("expected '<number> <unit>'")
@@ -309,6 +401,10 @@ def to_si(value, unit: str, *, name: str = "value", source: str | None = None) -
             raise ParameterError(
                 f"{where}{name} = {short_repr(value)}: wrong unit, expected a quantity convertible to {unit!r}"
             ) from None
+        if _KEEPABLE.match(text) and math.isfinite(out):
+            factor = _factor(ureg, text, unit)
+            if factor is not None and float(m.group(1)) * factor == out:
+                _keep(text, unit, factor)
     else:
         raise ParameterError(f"{where}{name} = {short_repr(value)}: expected a number or a quantity string")
     if not math.isfinite(out):

@@ -121,7 +121,7 @@ def _inputs(items, driveline, file) -> dict:
 
     from ..units import COLUMN_UNITS, to_si
 
-    units = {v.name: v.unit for v in driveline.system().inputs}
+    units = driveline.input_units   # (not from driveline.system(): that would build the network twice)
     out = {}
     for item in items:
         name, sep, value = (x.strip() for x in str(item).partition("="))

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import copy
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -608,6 +609,12 @@ class Driveline:
         """The names of the network's inputs, in the order of its :meth:`system`'s ``u``."""
         return tuple(self._inputs)
 
+    @property
+    def input_units(self) -> dict:
+        """Each network input's unit by name (a column suffix of :data:`clutchlab.units.COLUMN_UNITS`: ``"Nm"``,
+        ``"1"``), in the order of :attr:`inputs`: its :meth:`system`'s input variables' units, without building it."""
+        return {n: v[0] for n, v in self._inputs.items()}
+
     def _check_inputs(self) -> None:
         """Every input a signal reads is declared, and every declared input drives something."""
         used = set()
@@ -996,9 +1003,10 @@ class Driveline:
     def _mu(cls, name, mu, radius, temperature, scale=1.0):
         """A clutch's or brake's friction characteristic: a number or table, or a map with its radius and
         temperature; its coefficients times ``scale``."""
-        from ..wet.friction import FrictionMap
-
-        if isinstance(mu, FrictionMap):
+        # a FrictionMap exists only once its module is imported: not importing the wet package for a plain clutch
+        # keeps a driveline file's start-up short (the package imports SciPy's special functions, 0.13 s)
+        friction = sys.modules.get("clutchlab.wet.friction")
+        if friction is not None and isinstance(mu, friction.FrictionMap):
             return cls._scaled(name, cls._map_characteristic(name, mu, radius, temperature), scale)
         for what, value in (("radius", radius), ("temperature", temperature)):
             if value is not None:
@@ -1303,6 +1311,8 @@ class Driveline:
     def _wet_parameters(self) -> list:
         """Per wet clutch: its element, packed parameters (:func:`clutchlab.wet.system.pack_parameters`, free
         shaft), initial state and clutch parameters (an empty list without one)."""
+        if all(el.wet is None for el in self._elements):
+            return []   # (without importing the wet package: a plain network starts sooner)
         from ..wet import system as W
         from ..wet.engagement import Scenario
 

@@ -35,7 +35,6 @@ import hashlib
 import importlib.util
 import os
 import sys
-import tempfile
 import time
 import types
 from pathlib import Path
@@ -204,52 +203,11 @@ _MAX_AGE_S = 7 * 24 * 3600.0
 
 
 def kernel_dir() -> Path:
-    """Folder of the generated entry modules (created if needed)."""
-    candidates = []
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        candidates.append(Path(os.environ["NUMBA_CACHE_DIR"]) / "clutchlab-kernels")
-    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    candidates.append(Path(xdg) / "clutchlab" / "kernels")
-    shared = Path(tempfile.gettempdir()) / f"clutchlab-kernels-{os.getuid() if hasattr(os, 'getuid') else 0}"
-    candidates.append(shared)
-    refused = ""
-    for path in candidates:
-        try:
-            if path == shared:
-                # in a folder every user writes to, another user could have made it first, or a link: its modules
-                # are imported and numba's pickles read from it, so it must be this user's own and private
-                refused = _private_folder(path)
-                if refused:
-                    continue
-            else:
-                path.mkdir(parents=True, exist_ok=True)
-            if os.access(path, os.W_OK):
-                return path
-        except OSError:
-            continue
-    raise OSError("no writable folder for clutchlab's compiled kernels (tried: "
-                  + ", ".join(str(c) for c in candidates) + ")" + (f"; {refused}" if refused else "")
-                  + ": set NUMBA_CACHE_DIR to a folder of your own")
+    """Folder of the generated entry modules (created if needed; :func:`clutchlab._cache.cache_folder`:
+    ``$NUMBA_CACHE_DIR/clutchlab-kernels``, ``~/.cache/clutchlab/kernels`` or a private temporary folder)."""
+    from .._cache import cache_folder
 
-
-def _private_folder(path: Path) -> str:
-    """Make ``path`` (in the shared temporary folder) this user's private folder: created with mode 0700, or,
-    if it exists, a real folder (not a link) owned by this user, then set to 0700.  Returns "" if it is, else
-    why it is refused."""
-    import stat
-
-    try:
-        path.mkdir(mode=0o700)
-    except FileExistsError:
-        pass
-    st = os.lstat(path)
-    if stat.S_ISLNK(st.st_mode) or not stat.S_ISDIR(st.st_mode):
-        return f"{path} is not a folder of its own (a link or a file): refused"
-    if hasattr(os, "getuid") and st.st_uid != os.getuid():
-        return f"{path} belongs to another user (uid {st.st_uid}): refused"
-    if stat.S_IMODE(st.st_mode) != 0o700:
-        os.chmod(path, 0o700)
-    return ""
+    return cache_folder("kernels")
 
 
 def _file_stamp(path: str) -> str:

@@ -1,0 +1,71 @@
+"""clutchlab's cache folders: one place that decides where a cache lives (the compiled kernels' entry modules,
+:func:`clutchlab.numerics.entry.kernel_dir`; the unit conversions a file used, :mod:`clutchlab.units`).
+
+A cache is never an input: deleting it costs only time, and what is read from it is checked (a kernel folder must be
+this user's own; a conversion must be a finite number).  Without numba or pint: it is read before either is imported.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+__all__ = ["cache_folder"]
+
+
+def cache_folder(name: str) -> Path:
+    """The writable folder of cache ``name`` (created if needed), the first of: ``$NUMBA_CACHE_DIR/clutchlab-NAME``
+    (numba's cache and clutchlab's together: one variable empties both), ``$XDG_CACHE_HOME/clutchlab/NAME``
+    (``~/.cache`` without it), a private ``clutchlab-NAME-UID`` in the temporary folder (refused if it is a link or
+    belongs to another user: a kernel folder's modules are imported from it).
+
+    Raises
+    ------
+    OSError
+        None of them can be written.
+    """
+    candidates = []
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        candidates.append(Path(os.environ["NUMBA_CACHE_DIR"]) / f"clutchlab-{name}")
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    candidates.append(Path(xdg) / "clutchlab" / name)
+    shared = Path(tempfile.gettempdir()) / f"clutchlab-{name}-{os.getuid() if hasattr(os, 'getuid') else 0}"
+    candidates.append(shared)
+    refused = ""
+    for path in candidates:
+        try:
+            if path == shared:
+                # in a folder every user writes to, another user could have made it first, or a link: its modules
+                # are imported and numba's pickles read from it, so it must be this user's own and private
+                refused = _private_folder(path)
+                if refused:
+                    continue
+            else:
+                path.mkdir(parents=True, exist_ok=True)
+            if os.access(path, os.W_OK):
+                return path
+        except OSError:
+            continue
+    raise OSError(f"no writable folder for clutchlab's {name} cache (tried: "
+                  + ", ".join(str(c) for c in candidates) + ")" + (f"; {refused}" if refused else "")
+                  + ": set NUMBA_CACHE_DIR to a folder of your own")
+
+
+def _private_folder(path: Path) -> str:
+    """Make ``path`` (in the shared temporary folder) this user's private folder: created with mode 0700, or,
+    if it exists, a real folder (not a link) owned by this user, then set to 0700.  Returns "" if it is, else
+    why it is refused."""
+    try:
+        path.mkdir(mode=0o700)
+    except FileExistsError:
+        pass
+    st = os.lstat(path)
+    if stat.S_ISLNK(st.st_mode) or not stat.S_ISDIR(st.st_mode):
+        return f"{path} is not a folder of its own (a link or a file): refused"
+    if hasattr(os, "getuid") and st.st_uid != os.getuid():
+        return f"{path} belongs to another user (uid {st.st_uid}): refused"
+    if stat.S_IMODE(st.st_mode) != 0o700:
+        os.chmod(path, 0o700)
+    return ""
