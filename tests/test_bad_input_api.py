@@ -156,7 +156,7 @@ _ENGINE = ('[inertia.J1]\nJ = "0.2 kg m^2"\n[engine.ice]\nflange = "J1"\n'
 
 
 @pytest.mark.parametrize("text, named", [
-    (_WET.format(force="1e12 N", temperature="80 degC"), "force reference 1e+12 N exceeds the actuator's 16000 N"),
+    (_WET.format(force="1e12 N", temperature="80 degC"), "the force reference reaches 1e+12 N, beyond the actuator's 16000 N"),
     (_WET.format(force="2000 N", temperature="1e6 degC"), "temperature0 = '1e6 degC': is above its range [-60, 600] degC"),
     (_WET.format(force="2000 N", temperature="-100 degC"), "temperature0 = '-100 degC': is below its range [-60, 600] degC"),
     (_ENGINE.format(throttle="2"), "engine.ice.throttle = 2 reaches 2: is above its range [0, 1]"),
