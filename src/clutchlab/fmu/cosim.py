@@ -536,11 +536,23 @@ class ContractCoSimulation(CoSimulation):
         """Where each FMI output comes from, in the order of :attr:`outputs`: ``("output", name)``,
         ``("state", name)`` or ``("mode", index)`` of the System (:meth:`clutchlab.system.Simulation.report`)."""
 
+    def start_state(self, x: np.ndarray, inputs: dict) -> None:
+        """The states that the inputs decide at the start, written into ``x`` (the run's state at t = 0, in place):
+        called with the inputs held (by name, checked) until the first step succeeds, so the last inputs held before
+        it decide them.  Nothing by default; the wet bench's actuator force starts at its reference, as in the
+        model's own run.  (A native FMU writes such an input into its state until initialisation ends.)"""
+
+    def _hold(self, inputs: dict) -> None:
+        """Hold the checked FMI ``inputs`` (all present), and before the first step the states they decide."""
+        u = self.input_vector(inputs)
+        if self._at_start:
+            self.start_state(self.simulation.x, inputs)
+        self.simulation.set_inputs(u)
+
     def write_inputs(self, u) -> None:
         """Hold the FMI input values ``u`` (in the order of :attr:`inputs`), checked as :meth:`do_step` checks
         them: this default goes through :meth:`resolve_inputs` and :meth:`input_vector`."""
-        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(
-            {v.name: x for v, x in zip(self.inputs, u)})))
+        self._hold(self.resolve_inputs({v.name: x for v, x in zip(self.inputs, u)}))
 
     def reset(self) -> None:
         """Back to the initial state at t = 0 (same parameters)."""
@@ -550,13 +562,14 @@ class ContractCoSimulation(CoSimulation):
         self.simulation = Simulation(self.system, **self.simulation_options)
         self.simulation.report(self.output_sources())
         self._output_names = tuple(v.name for v in self.outputs)
+        self._at_start = True
 
     def _output_dict(self, values) -> dict:
         return dict(zip(self._output_names, values.tolist()))
 
     def hold_inputs(self, inputs: dict) -> None:
         """Hold the FMI ``inputs`` (by name; missing ones at their start), evaluating nothing."""
-        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
+        self._hold(self.resolve_inputs(inputs))
 
     def initial_outputs(self, inputs: dict) -> dict:
         """Outputs at t = 0 with the given inputs held."""
@@ -566,8 +579,10 @@ class ContractCoSimulation(CoSimulation):
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` [s] with ``inputs`` held; outputs at ``t + dt``."""
         _check_time(type(self).__name__, self.simulation.time, t, dt)
-        self.simulation.set_inputs(self.input_vector(self.resolve_inputs(inputs)))
-        return self._output_dict(self.simulation.step(t + dt))
+        self._hold(self.resolve_inputs(inputs))
+        y = self.simulation.step(t + dt)
+        self._at_start = False
+        return self._output_dict(y)
 
     def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
@@ -577,4 +592,6 @@ class ContractCoSimulation(CoSimulation):
             _check_time(type(self).__name__, t_model, t, dt)
         if len(u) or self.inputs:
             self.write_inputs(u)
-        return sim.step(t + dt)
+        y = sim.step(t + dt)
+        self._at_start = False
+        return y

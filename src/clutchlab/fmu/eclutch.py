@@ -1,6 +1,8 @@
 """The E-clutch as a co-simulation slave (FMI 2.0 co-simulation semantics, :mod:`clutchlab.fmu`).
 
-Written against the system contract: ``do_step`` advances a resumable
+Written against the system contract (:class:`~clutchlab.fmu.cosim.ContractCoSimulation`: the model gives its
+System, its held input and where each output comes from; stepping, input checks and the FMU's fast path are the
+contract's): ``do_step`` advances a resumable
 :class:`clutchlab.system.Simulation` of the E-clutch system
 (:meth:`clutchlab.eclutch.dynamics.EClutch.as_system` with a held input) over
 one communication interval with the inputs held constant; the integrator's
@@ -14,11 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ParameterError, SimulationError
+from ..errors import ParameterError
 from ..system import check_rtol
-from ..fmu.cosim import (CoSimulation, Variable, build_parameter_set, fixed_step_parameter, fixed_step_variable,
-                         parameter_set_variables, rtol_variable, step_in_time)
-from ..system import Simulation
+from ..fmu.cosim import (ContractCoSimulation, Variable, build_parameter_set, fixed_step_parameter,
+                         fixed_step_variable, parameter_set_variables, rtol_variable)
 from ..eclutch.actuator import ActuatorParameters
 from ..eclutch.dynamics import EClutch, FrictionParameters
 from ..eclutch.models import ClutchModel, EClutchParameters
@@ -26,10 +27,9 @@ from ..eclutch.models import ClutchModel, EClutchParameters
 __all__ = ["EClutchCoSimulation"]
 
 _CLUTCH_SKIP = ("k_fl_model1",)
-_INF = float("inf")
 
 
-class EClutchCoSimulation(CoSimulation):
+class EClutchCoSimulation(ContractCoSimulation):
     """E-clutch dynamics (actuator + axial Model 0-4 with stick-slip friction) stepped by a master.
 
     Inputs: ``bearing_reference`` [m] (tracked by the position controller when
@@ -87,60 +87,31 @@ class EClutchCoSimulation(CoSimulation):
         self.rtol = values["rtol"]
         check_rtol(self.rtol, "parameter rtol")
         self.fixed_step = fixed_step_parameter(values)
+        self.simulation_options = {"fixed_step": self.fixed_step}
         self.input_name = "bearing_reference" if mode == 1.0 else "motor_voltage"
         self.eclutch = EClutch(actuator, ClutchModel.preset(int(model), clutch), friction)
+        self._values = values
         self.reset()
 
-    def reset(self) -> None:
-        """Back to rest at t = 0: clutch engaged, actuator at its rest stop."""
+    def build_system(self, values: dict):
+        """The E-clutch's System at rest at t = 0 (clutch engaged, actuator at its rest stop), its one held input the
+        bearing reference under position control, else the motor voltage."""
         key = "bearing_reference" if self.input_name == "bearing_reference" else "voltage"
         start = next(v.start for v in self.inputs if v.name == self.input_name)
-        system = self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
-        self.simulation = Simulation(system, fixed_step=self.fixed_step)
-        self._nz = self.eclutch.assembly.nz
-        b0 = 2 * self._nz
-        # the outputs (in the order of `outputs`), gathered by the compiled step from the states and outputs
-        self.simulation.report([("state", 1), ("output", 1), ("state", b0 + 2), ("state", b0), ("state", 0),
-                                ("state", b0 + 3), ("output", 0), ("output", 3), ("output", 4)])
-        self._held = self.simulation.u
-        self._names = tuple(v.name for v in self.outputs)
-        self._by_reference = self.input_name == "bearing_reference"
-        self.t = 0.0
+        return self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
 
-    def hold_inputs(self, inputs: dict) -> None:
-        """Hold the FMI ``inputs`` (by name; missing ones at their start): the bearing reference under position
-        control, else the motor voltage (the other input is unused)."""
-        self.simulation.set_inputs([self.resolve_inputs(inputs)[self.input_name]])
+    def input_vector(self, inputs: dict) -> np.ndarray:
+        """The held input: the bearing reference under position control, else the motor voltage (the other FMI
+        input is unused)."""
+        return np.array([inputs[self.input_name]])
 
-    def _outputs(self, inputs) -> dict:
-        self.hold_inputs(inputs)
-        return dict(zip(self._names, self.simulation.reported().tolist()))
+    def output_sources(self) -> list:
+        """The FMI outputs (in the order of :attr:`outputs`) from the E-clutch's states and outputs."""
+        b0 = 2 * self.eclutch.assembly.nz
+        return [("state", 1), ("output", 1), ("state", b0 + 2), ("state", b0), ("state", 0), ("state", b0 + 3),
+                ("output", 0), ("output", 3), ("output", 4)]
 
-    def initial_outputs(self, inputs: dict) -> dict:
-        """Outputs at t = 0 (the rest state)."""
-        return self._outputs(inputs)
-
-    def do_step(self, t: float, dt: float, inputs: dict) -> dict:
-        """Advance from ``t`` to ``t + dt`` with the inputs held; return the outputs at ``t + dt``."""
-        if not (np.isfinite(dt) and dt > 0):
-            raise ParameterError(f"communication step dt = {dt!r} s must be finite and > 0")
-        if abs(t - self.t) > 1e-9 * max(1.0, abs(t)):
-            raise SimulationError(f"do_step at t = {t!r} s but the E-clutch is at t = {self.t!r} s "
-                                  "(steps must be contiguous; call reset() to start again)")
-        u = self.resolve_inputs(inputs)[self.input_name]
-        self.simulation.set_inputs([u])
-        y = self.simulation.step(float(t + dt))
-        self.t = t + dt
-        return dict(zip(self._names, y.tolist()))
-
-    def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
-        """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
-        reference, voltage = u
-        # every check of do_step, in its order, as comparisons
-        if not (step_in_time(self.t, t, dt) and -_INF < reference < _INF and -_INF < voltage < _INF):
-            out = self.do_step(t, dt, {"bearing_reference": reference, "motor_voltage": voltage})
-            return np.array([out[name] for name in self._names])
-        self._held[0] = reference if self._by_reference else voltage
-        y = self.simulation.step(t + dt)
-        self.t = t + dt
-        return y
+    @property
+    def t(self) -> float:
+        """The model's time [s]."""
+        return self.simulation.time

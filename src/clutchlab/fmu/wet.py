@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import ParameterError, SimulationError
 from ..params.base import ABSOLUTE_ZERO_C
 from ..system import check_rtol
-from .cosim import (CoSimulation, Variable, _check_time, _flag, build_parameter_set, fixed_step_parameter,
+from .cosim import (ContractCoSimulation, Variable, _check_time, _flag, build_parameter_set, fixed_step_parameter,
                     fixed_step_variable, parameter_set_variables, rtol_variable, step_in_time)
 
 __all__ = ["WetCoSimulation"]
@@ -78,7 +78,7 @@ def _wet_output_table():
     )
 
 
-class WetCoSimulation(CoSimulation):
+class WetCoSimulation(ContractCoSimulation):
     """The wet-clutch bench of Shin, Kim and Choi [1] as a co-simulation slave.
 
     Inputs are the two references of the bench (Fig. 4): the actuator force
@@ -95,15 +95,15 @@ class WetCoSimulation(CoSimulation):
     (Eqs. 1-2), viscosity (Eq. 7), temperatures (Eq. 8), friction work and
     the stick flag.
 
-    Written against the system contract: the model is the ``"wet"``
-    :class:`~clutchlab.system.System` (:func:`clutchlab.wet.system.engagement_system`)
-    with flat reference profiles, run by a :class:`clutchlab.system.Simulation`
-    whose held inputs are the two references.  Each :meth:`do_step`
-    continues the integration (``Simulation.advance``) from the stored
-    state, modes and step size; lock-up, break-away, contact and the piston
-    stop inside the step are located as in the native run and kept in
-    :attr:`events` (``result.events`` names of :func:`clutchlab.wet.simulate`
-    are in :attr:`simulation` ``.events()``).
+    Written against the system contract (:class:`~clutchlab.fmu.cosim.ContractCoSimulation`): the model is
+    the ``"wet"`` :class:`~clutchlab.system.System` (:func:`clutchlab.wet.system.engagement_system`) with
+    flat reference profiles, whose held inputs are the two references; this class gives only the System,
+    the input vector with its range checks, where each output comes from and the one state the inputs
+    decide at the start (the actuator force starts at its reference, :meth:`start_state`).  Each
+    :meth:`do_step` continues the integration from the stored state, modes and step size; lock-up,
+    break-away, contact and the piston stop inside the step are located as in the native run and listed in
+    :attr:`events` (``result.events`` names of :func:`clutchlab.wet.simulate` are in :attr:`simulation`
+    ``.events()``).
 
     Notes
     -----
@@ -141,6 +141,8 @@ class WetCoSimulation(CoSimulation):
         if not self.max_step > 0:
             raise ParameterError(f"parameter solver.max_step = {self.max_step!r}: must be > 0 [s]")
         self.fixed_step = fixed_step_parameter(values)
+        self.simulation_options = {"max_step": self.max_step, "max_steps": 2_000_000_000,
+                                   "fixed_step": self.fixed_step}
         # flat (zero) profiles: the references are the held inputs of the system
         self.scenario = E.Scenario(
             force_time=[0.0], force_value=[0.0], speed_time=[0.0], speed_value=[0.0], duration=1.0,
@@ -150,35 +152,78 @@ class WetCoSimulation(CoSimulation):
             housing_temperature_c=values["scenario.housing_temperature"],
             heater_setpoint_c=values["scenario.heater_setpoint"])
         self._mu_scale = values["scenario.mu_scale"]
-        self._table = _wet_output_table()
-        self._output_names = tuple(v.name for v in self.outputs)
-        # the input checks of _inputs as two comparisons (NaN and infinities fail them as well)
+        # the input checks of input_vector as two comparisons (NaN and infinities fail them as well)
         self._force_max = self.bench.actuator_force_max * (1 + 1e-12)
         self._speed_max = self.bench.drive_speed_max if self.scenario.motor == "speed" else sys.float_info.max
+        self._values = values
         self.reset()
 
-    def reset(self) -> None:
-        self.time = 0.0
-        self.simulation = None  # created at the first step / initial_outputs (the actuator starts at its reference)
-        self.events = []
-        self._n_events = 0
+    def build_system(self, values: dict):
+        """The ``"wet"`` System of the bench with flat reference profiles (the references are its held inputs)."""
+        from ..wet import system as W
+
+        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
+        return W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params,
+                                   x0=W.initial_state(self.scenario), rtol=self.rtol)
+
+    def input_vector(self, inputs: dict) -> np.ndarray:
+        """The two references, checked: the force within the actuator's limit, the slip speed within the drive's
+        when the drive holds it."""
+        f = inputs["force_reference"]
+        w = inputs["slip_speed_reference"]
+        if not 0.0 <= f <= self._force_max:
+            raise ParameterError(f"input force_reference = {f!r} N: must be within "
+                                 f"[0, {self.bench.actuator_force_max:g}] N (actuator limit)")
+        if not abs(w) <= self._speed_max:
+            raise ParameterError(f"input slip_speed_reference = {w!r} rad/s exceeds the bench's speed limit "
+                                 f"{self.bench.drive_speed_max:.6g} rad/s")
+        return np.array([f, w])
+
+    def output_sources(self) -> list:
+        """The FMI outputs from the system's outputs and states, and the stick flag from its friction mode."""
+        from ..wet import system as W
+
+        return [src if src[0] != "stick" else ("mode_is", W.M_FRICTION, 1) for _, _, _, src in _wet_output_table()]
+
+    def start_state(self, x: np.ndarray, inputs: dict) -> None:
+        """The actuator force starts at its reference, as in the model's own run."""
+        from ..wet import system as W
+
+        x[W.S_FA] = inputs["force_reference"]
+
+    @property
+    def time(self) -> float:
+        """The model's time [s]."""
+        return self.simulation.time
 
     @property
     def state(self):
-        """State vector of the wet system (order of ``clutchlab.wet.system.STATES``), None before the start."""
-        return None if self.simulation is None else self.simulation.x
+        """State vector of the wet system (order of ``clutchlab.wet.system.STATES``)."""
+        return self.simulation.x
 
     @property
     def mode(self) -> int:
-        """Friction mode: 0 slip (positive), 1 stick, 2 slip (negative); -1 before the start."""
+        """Friction mode: 0 slip (positive), 1 stick, 2 slip (negative)."""
         from ..wet import system as W
 
-        return -1 if self.simulation is None else int(self.simulation.m[W.M_FRICTION])
+        return int(self.simulation.m[W.M_FRICTION])
 
     @property
     def n_steps(self) -> int:
         """Accepted integration steps since the start."""
-        return 0 if self.simulation is None else self.simulation.stats["accepted_steps"]
+        return self.simulation.stats["accepted_steps"]
+
+    @property
+    def events(self) -> list:
+        """Lock-up, break-away, contact, separation and slip reversal so far, as :class:`clutchlab.wet.engagement.
+        Event` in time order (the piston-stop events are in :attr:`simulation` ``.events()``)."""
+        from ..wet import engagement as E
+
+        log = self.simulation.log
+        names = self.system.events
+        n = min(int(log.count[0]), log.time.shape[0])
+        return [E.Event(float(log.time[i]), E.EVENT_KINDS[names[int(log.code[i])]]) for i in range(n)
+                if names[int(log.code[i])] in E.EVENT_KINDS]
 
     def input_bounds(self) -> dict:
         """The inputs' ranges with these parameters: the actuator's force limit, and the drive's speed limit
@@ -187,52 +232,6 @@ class WetCoSimulation(CoSimulation):
         if self.scenario.motor == "speed":
             out["slip_speed_reference"] = (-float(self.bench.drive_speed_max), float(self.bench.drive_speed_max))
         return out
-
-    def _inputs(self, u):
-        fmax = self.bench.actuator_force_max
-        f = u["force_reference"]
-        w = u["slip_speed_reference"]
-        if f < 0 or f > fmax * (1 + 1e-12):
-            raise ParameterError(f"input force_reference = {f!r} N: must be within [0, {fmax:g}] N (actuator limit)")
-        if self.scenario.motor == "speed" and abs(w) > self.bench.drive_speed_max:
-            raise ParameterError(f"input slip_speed_reference = {w!r} rad/s exceeds the bench's speed limit "
-                                 f"{self.bench.drive_speed_max:.6g} rad/s")
-        return np.array([f, w])
-
-    def _start(self, u):
-        from ..system import Simulation
-        from ..wet import system as W
-
-        x0 = W.initial_state(self.scenario)
-        x0[W.S_FA] = u["force_reference"]  # the actuator force starts at its reference, as in the native run
-        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
-        system = W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params, x0=x0,
-                                     rtol=self.rtol)
-        self.simulation = Simulation(system, max_step=self.max_step, max_steps=2_000_000_000,
-                                     fixed_step=self.fixed_step)
-        # the FMI outputs, gathered by the compiled step (a name lookup per output and step cost more than the
-        # integration of a 1 ms step, and a dict of them as much again)
-        self.simulation.report([src if src[0] != "stick" else ("mode_is", W.M_FRICTION, 1)
-                                for _, _, _, src in self._table])
-        self._held = self.simulation.u  # the held references, written in place by every step
-        self._event_count = self.simulation.log.count
-        self.simulation.set_inputs(self._inputs(u))
-
-    def _outputs(self):
-        return dict(zip(self._output_names, self.simulation.reported().tolist()))
-
-    def hold_inputs(self, inputs: dict) -> None:
-        """Hold the references ``inputs`` (by name; missing ones at their start), starting the run with them at
-        t = 0 (the actuator force starts at its reference); evaluates nothing."""
-        u = self.resolve_inputs(inputs)
-        if self.simulation is None or self.time != 0.0:
-            self.reset()
-            self._start(u)
-        self.simulation.set_inputs(self._inputs(u))
-
-    def initial_outputs(self, inputs: dict) -> dict:
-        self.hold_inputs(inputs)
-        return self._outputs()
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` with the references held; return the outputs at ``t + dt``.
@@ -244,49 +243,28 @@ class WetCoSimulation(CoSimulation):
         ParameterError
             Unknown or out-of-range input.
         """
-        _check_time("WetCoSimulation", self.time, t, dt)
-        u = self.resolve_inputs(inputs)
-        y = self.do_step_array(t, dt, (u["force_reference"], u["slip_speed_reference"]))
-        return dict(zip(self._output_names, y.tolist()))
+        _check_time("WetCoSimulation", self.simulation.time, t, dt)
+        self._hold(self.resolve_inputs(inputs))
+        return self._output_dict(self._step(t, t + dt))
 
     def do_step_array(self, t: float, dt: float, u) -> np.ndarray:
         """:meth:`do_step` with the inputs and outputs in order (:meth:`CoSimulation.do_step_array`)."""
         f, w = u
-        if (self.simulation is None
-                or not (step_in_time(self.time, t, dt) and 0.0 <= f <= self._force_max
-                        and abs(w) <= self._speed_max)):
-            return self._step_checked(t, dt, f, w)
-        held = self._held
+        sim = self.simulation
+        if not (step_in_time(sim.time, t, dt) and 0.0 <= f <= self._force_max and abs(w) <= self._speed_max):
+            out = self.do_step(t, dt, {"force_reference": f, "slip_speed_reference": w})   # (every check, in order)
+            return np.array([out[n] for n in self._output_names])
+        held = sim.u
         held[0] = f
         held[1] = w
+        if self._at_start:
+            self.start_state(sim.x, {"force_reference": f})
         return self._step(t, t + dt)
 
-    def _step_checked(self, t, dt, f, w):
-        # a step with every check of do_step, in its order (the first step, or one that fails a check)
-        _check_time("WetCoSimulation", self.time, t, dt)
-        u = self.resolve_inputs({"force_reference": f, "slip_speed_reference": w})
-        if self.simulation is None:
-            self._start(u)
-        self.simulation.set_inputs(self._inputs(u))
-        return self._step(t, t + dt)
-
-    def _step(self, t, t_end):
+    def _step(self, t: float, t_end: float) -> np.ndarray:
         try:
             y = self.simulation.step(t_end)
         except SimulationError as exc:
             raise SimulationError(f"WetCoSimulation: between t = {t} and {t_end} s: {exc}") from None
-        self.time = t_end
-        if self._event_count[0] > self._n_events:  # new events only (a DataFrame per step cost more than the step)
-            from ..wet import engagement as E
-
-            log = self.simulation.log
-            n = int(log.count[0])
-            names = self.simulation.system.events
-            for i in range(self._n_events, n):
-                name = names[int(log.code[i])]
-                if name in E.EVENT_KINDS:
-                    self.events.append(E.Event(float(log.time[i]), E.EVENT_KINDS[name]))
-            self._n_events = n
+        self._at_start = False
         return y
-
-
