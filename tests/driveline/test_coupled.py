@@ -33,7 +33,7 @@ from clutchlab.system import simulate
 from clutchlab.wet.engagement import Scenario, simulate_engagement
 from clutchlab.wet.params import Bench, WetClutch
 
-from .test_invariants import _check_columns, _mode_events
+from .test_invariants import _check_columns, same_at_two_tolerances
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 RTOL = 1e-10
@@ -284,14 +284,7 @@ def test_the_result_follows_the_tolerance_on_random_networks_with_components(d):
     pulses, steps and held inputs: at rtol 1e-7 and 1e-10 the same events (every element's and component's modes,
     the pistons', films' and armatures' events) and the speeds within 1e-4 of their range, as for the plain
     networks (``test_invariants.py``): the decisions do not depend on the tolerance."""
-    kw = dict(output_step=2e-3)
-    lo = d.simulate(0.6, rtol=1e-7, **kw)
-    hi = d.simulate(0.6, rtol=1e-10, **kw)
-    a, b = lo.to_dataframe(), hi.to_dataframe()
-    for col in b.columns:
-        if col.endswith(".w_rad_s"):
-            assert np.max(np.abs(a[col] - b[col])) <= 1e-4 * max(1.0, np.ptp(b[col])), col
-    assert [e[1:] for e in _mode_events(lo)] == [e[1:] for e in _mode_events(hi)]
+    same_at_two_tolerances(d, 0.6)
 
 
 def test_a_bearing_beside_a_wet_clutch_breaks_away_at_its_limit():
