@@ -1182,6 +1182,7 @@ def copy_component(dx, g, b, xo, go, nx, ng, bdx, bg):
 #: the speed [rad/s] of inertia ``i`` in the state ``x`` of a network of ``n`` inertias (0 for the ground, ``i < 0``)
 flange_speed = _speed
 
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def accelerations(p):
     """The inertias' accelerations [rad/s^2] of the network's last evaluation (its right-hand side), borrowed."""

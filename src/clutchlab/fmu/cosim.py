@@ -504,7 +504,9 @@ class ContractCoSimulation(CoSimulation):
     A model's co-simulation subclasses this and supplies only :meth:`build_system` (its
     :class:`~clutchlab.system.System` from the parameter values), :meth:`input_vector` (the held
     inputs ``u`` from the FMI inputs) and :meth:`output_sources` (where each FMI output comes from: an
-    output, state or mode of the system).  Stepping is the core's resumable ``advance``
+    output, state or mode of the system); and, where the inputs held at the start decide a state,
+    :meth:`start_state`.  Every model's co-simulation is one: the wet bench, the EMTC, the E-clutch and any
+    driveline.  Stepping is the core's resumable ``advance``
     (:class:`clutchlab.system.Simulation`): each ``do_step`` continues the integration from the
     stored state, modes, step size and memories, with the inputs held (zero-order hold); the FMI
     outputs are gathered in the same compiled call (:meth:`~clutchlab.system.Simulation.step`).
