@@ -21,6 +21,7 @@ import json
 import math
 import os
 import re
+import threading
 from functools import lru_cache
 from numbers import Real
 
@@ -318,7 +319,7 @@ def _keep(text: str, unit: str, factor: float) -> None:
     path = _kept_file()
     if path is None:
         return
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")   # (one per writer)
     try:
         tmp.write_text(json.dumps(kept, sort_keys=True), encoding="utf-8")
         os.replace(tmp, path)
