@@ -163,7 +163,7 @@ torque_request = { input = "T" }
     r = simulate(system, 0.05, rtol=1e-8, output_step=0.01)
     assert r.ok and np.allclose(r["c.torque_reference_Nm"][r.time > 0.0], 80.0)
     # a co-simulation master (the FMU's slave) holds the request: the controller takes each new value at its next
-    # sample (every 10 ms; the example's controller), no earlier
+    # sample (every 2 ms: the default scenario's controller), no earlier
     from clutchlab.fmu.driveline import DrivelineCoSimulation
 
     cls = DrivelineCoSimulation.for_description(path)

@@ -1496,8 +1496,8 @@ class Driveline:
                 data.extend(e.ncurve)
         # each EMTC coupling's ports, after every element's signal (its block reads them: _with_components)
         port_rows = {e.name: [-1 if e.emtc["ports"][q] is None else add_signal(e.emtc["ports"][q])
-                                       for q, _ in EMTC_PORTS]
-                              for e in self._elements if e.emtc is not None}
+                              for q, _ in EMTC_PORTS]
+                     for e in self._elements if e.emtc is not None}
         fric = np.array([r for r, e in enumerate(self._elements) if e.kind == K.K_FRICTION], dtype=np.int64)
         cons = np.array([r for r, e in enumerate(self._elements) if e.kind in (K.K_GEAR, K.K_MOTION)], dtype=np.int64)
         swit = np.array([r for r, e in enumerate(self._elements)
