@@ -977,8 +977,9 @@ class Simulation:
                  self._rt, self._rx, self._rm, self._ry, False, self._y, self._report_spec, self._r))
 
     def _dispatch(self, name: str, method: str, args):
-        """The compiled entry ``name`` of the model's entry module for ``method``, called through numba's dispatcher."""
-        return getattr(self._core.entry_points(type(self.system.params), method), name)(*args)
+        """The compiled entry ``name`` of the model's entry module for ``method``, called as numba's dispatcher would
+        (:func:`clutchlab.numerics.entry.fast_entry`)."""
+        return self._core.fast_entry(type(self.system.params), method, name)(*args)
 
     def _general(self, _handle, t: float, what: int) -> int:
         """:meth:`_call` through numba's dispatcher with all the arguments (no packed table)."""

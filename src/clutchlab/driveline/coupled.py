@@ -47,9 +47,12 @@ class CoupledParams(NamedTuple):
 def _hold(t, u, net, w, e):
     """Every component's ports at ``t`` (a wet clutch's force, an EMTC coupling's torque request, throttle and coil
     current: each a network signal), after the network's held inputs are brought up to the core's ``u`` (the
-    components are evaluated before the network's right-hand side, which would do that)."""
+    components are evaluated before the network's right-hand side, which would do that); the network's signals are
+    evaluated at ``t`` here, once for the ports and the network (:func:`~clutchlab.driveline.kernel.refresh_signals`:
+    read from the cache, a port costs no signal evaluation of its own)."""
     if u.shape[0] > 0 and K.hold_inputs(net.data, u):
         K.forget_signals(net)
+    K.refresh_signals(net, t)
     DW.hold(t, net, w)
     DE.hold(t, net, e)
 

@@ -1088,10 +1088,16 @@ def _external(p):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def refresh_signals(p, t):
-    """Evaluate every signal of the network at ``t`` once (:func:`signal_value`) into the signal cache; every
-    evaluation of the network starts with this, and :func:`signal_at` reads from it at that time."""
+    """Evaluate every signal of the network at ``t`` once (:func:`signal_value`) into the signal cache, unless it
+    already holds them at ``t``; every evaluation of the network starts with this, and :func:`signal_at` reads from
+    it at that time.  A signal is a function of time and of ``p.data`` alone, and whatever changes ``p.data`` (a
+    held input, :func:`hold_inputs`) or starts a run (:func:`driveline_restart`) empties the cache
+    (:func:`forget_signals`), so a cache at ``t`` is that time's values: a component's port that read its signal
+    before the network (a wet clutch's force, an EMTC's ports) fills it once for both."""
     o = _offsets(p).sig
     w = p.work
+    if w[o] == t:
+        return
     for s in range(p.signals.shape[0]):
         w[o + 1 + s] = signal_value(p.signals[s], p.data, t)
     w[o] = t

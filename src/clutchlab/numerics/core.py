@@ -1431,8 +1431,8 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     the error estimate missed it and the piston lagged 2.6e-7 m behind for the rest of the run, at every
     ``rtol`` from 1e-3 to 1e-7.)
     """
-    return entry_points(type(p), "dopri").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
-                                                  rec_y, want_y)
+    return fast_entry(type(p), "dopri", "advance")(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
+                                                   rec_y, want_y)
 
 
 def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, rec_y, want_y):
@@ -1486,8 +1486,8 @@ def advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
     (The E-clutch's clutch alone asks for it at every stick and break-away: a first step of the stuck
     phase's length damped the pressure plate's stick-slip ringing away unseen, issue #30.)
     """
-    return entry_points(type(p), "rodas").advance(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
-                                                  rec_y, want_y)
+    return fast_entry(type(p), "rodas", "advance")(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
+                                                   rec_y, want_y)
 
 
 def batch(method, P, X0, M0, U, t_end, ts, opt, OUT_X, OUT_M, OUT_Y, want_y, STATS, EV_T, EV_C, EV_E, EV_N):
@@ -1563,14 +1563,14 @@ def closed_loop(method, p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, mea
         Status of the last advance (-1: the function controller returned the wrong number of values) and
         the number of samples done.
     """
-    return entry_points(type(p), method).closed_loop(p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx, act,
-                                                     lo, hi, delay, kind, f, A, B, C, D, xc, sched, par, memory, u_op,
-                                                     Y, U, S)
+    return fast_entry(type(p), method, "closed_loop")(p, x, m, u, sf, si, opt, log, ybuf, T, R, meas_kind, meas_idx,
+                                                      act, lo, hi, delay, kind, f, A, B, C, D, xc, sched, par, memory,
+                                                      u_op, Y, U, S)
 
 
 def evaluate(p, t, x, u, m, dx, g):
     """The model's right-hand side ``dx`` and switching functions ``g`` at one point (linearisation, tests)."""
-    entry_points(type(p), "dopri").evaluate(p, t, x, u, m, dx, g)
+    fast_entry(type(p), "dopri", "evaluate")(p, t, x, u, m, dx, g)
 
 
 def evaluate_jacobian(p, t, x, u, m, J):
@@ -1578,17 +1578,17 @@ def evaluate_jacobian(p, t, x, u, m, J):
 
     Returns ``False`` (``J`` untouched) if the model has none (the core then differences ``rhs``).
     """
-    return bool(entry_points(type(p), "dopri").evaluate_jacobian(p, t, x, u, m, J))
+    return bool(fast_entry(type(p), "dopri", "evaluate_jacobian")(p, t, x, u, m, J))
 
 
 def evaluate_outputs(p, t, x, u, m, y):
     """The model's outputs ``y`` at one point ``(t, x, u, m)``."""
-    entry_points(type(p), "dopri").evaluate_outputs(p, t, x, u, m, y)
+    fast_entry(type(p), "dopri", "evaluate_outputs")(p, t, x, u, m, y)
 
 
 def outputs_at(p, T, X, u, M, Y):
     """Outputs at recorded points ``(T[i], X[i], M[i])`` into ``Y[i]``."""
-    entry_points(type(p), "dopri").outputs_at(p, T, X, u, M, Y)
+    fast_entry(type(p), "dopri", "outputs_at")(p, T, X, u, M, Y)
 
 
-from .entry import entry_points  # noqa: E402  (entry imports this module's names lazily)
+from .entry import entry_points, fast_entry  # noqa: E402  (entry imports this module's names lazily)
