@@ -56,27 +56,28 @@ from ..emtc import system as S
 from ..numerics import dispatch
 from ..numerics.borrow import block_row, row_words, stack_rows
 from . import kernel as K
+from .block import buffer_slots, conf_slots
 
 __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
 
 N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
-# conf (int64): the friction index of the coupling, its element row, then the offsets of its states, switching
-# functions and modes in the whole system's, the number of the network's events, the index of its first named
-# element (``<name>.armature``, then ``<name>.coupling``), then the network signal of each of its ports (-1: none;
-# :data:`PORT_INPUTS`)
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_PORT = range(8)
 #: the model inputs its ports hold, in the order of :data:`clutchlab.driveline.network.EMTC_PORTS`: the torque
 #: request, the throttle, the coil current set point
 PORT_INPUTS = np.array([S.U_TORQUE, S.U_THROTTLE, S.U_COIL], dtype=np.int64)
 N_PORT = PORT_INPUTS.size
-N_CONF = F_PORT + N_PORT
+#: conf (int64, :func:`~clutchlab.driveline.block.conf_slots`): the block's head (its first named element
+#: ``<name>.armature``, then ``<name>.coupling``), then the network signal of each of its ports (-1: none;
+#: :data:`PORT_INPUTS`)
+CONF = conf_slots(("ports", N_PORT))
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_PORT = CONF.of(*CONF.offset)
+N_CONF = CONF.total
 #: coupling j's model errors are its model's codes minus ``ERROR_STRIDE j`` (clutchlab.emtc.system.ERROR_MESSAGES)
 ERROR_STRIDE = 1_000_000
 # buf (float): its states with the shaft speeds replaced | their derivative | switching values | inputs (its ports'
 # values at the evaluation's time, :func:`hold`; zero for the others) | outputs
-B_X, B_DX, B_G, B_U = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH
-B_Y = B_U + N_IN
-N_BUF = B_Y + len(S.OUTPUTS)
+BUF = buffer_slots(S.STATES, S.SWITCHING, S.INPUTS, S.OUTPUTS)
+B_X, B_DX, B_G, B_U, B_Y = BUF.of("states", "derivative", "switching", "inputs", "outputs")
+N_BUF = BUF.total
 #: the coupling's outputs in a network (the bench model's others describe its vehicle: here the network's)
 OUTPUTS = tuple(o for o in S.OUTPUTS if o[0] in ("airgap", "magnet_force", "fn1", "capacity_locked",
                                                  "current_command", "torque_reference", "throttle",

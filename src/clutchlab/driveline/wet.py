@@ -42,19 +42,22 @@ import numpy as np
 from ..numerics.borrow import block_row, row_words, stack_rows
 from ..wet import system as W
 from . import kernel as K
+from .block import buffer_slots, conf_slots
 
 __all__ = ["WetBlock", "block", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "BENCH_ONLY"]
 
-N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, 3
-# conf (int64, a row per clutch): the friction index of the wet clutch, its element row, then the offsets of its
-# states, switching functions and modes in the whole system's, the number of the network's events, the index of
-# its first named element (``<name>``, then ``<name>.piston``) and the network signal its force port reads
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = range(8)
-N_CONF = 8
-# buf (float): its states with the slip replaced | their derivative | switching values | its model's inputs (the
-# force reference added to its zero profile: the force port's value; no slip reference) | outputs
-B_X, B_DX, B_G, B_U, B_Y = 0, N_STATE, 2 * N_STATE, 2 * N_STATE + N_SWITCH, 2 * N_STATE + N_SWITCH + 2
-N_BUF = B_Y + W.N_OUT
+N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, len(W.MODE_NAMES)
+#: conf (int64, a row per clutch, :func:`~clutchlab.driveline.block.conf_slots`): the block's head (its first named
+#: element ``<name>``, then ``<name>.piston``) and the network signal its force port reads
+CONF = conf_slots(("force_port", 1))
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = CONF.of(*CONF.offset)
+N_CONF = CONF.total
+#: buf (float, :func:`~clutchlab.driveline.block.buffer_slots`): its states with the slip replaced, their
+#: derivative, switching values, its model's inputs (the force reference added to its zero profile: the force
+#: port's value; no slip reference), outputs
+BUF = buffer_slots(W.STATES, W.SWITCHING, W.INPUTS, W.OUTPUTS)
+B_X, B_DX, B_G, B_U, B_Y = BUF.of("states", "derivative", "switching", "inputs", "outputs")
+N_BUF = BUF.total
 #: outputs of the wet model that belong to its bench, as the wet model declares them
 #: (:data:`clutchlab.wet.system.BENCH_OUTPUTS`).  A network reports the clutch's own (:data:`OUTPUTS`; #33)
 BENCH_ONLY = W.BENCH_OUTPUTS

@@ -51,6 +51,7 @@ from ..hysteresis._kernels import (combine_tables, commit, gap_weights, invert_c
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
+from ..numerics.layout import indices, slots
 from ..system import System, follow_rtol, register_model
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance, lugre_mu, stribeck_g
@@ -126,14 +127,23 @@ MODE_NAMES = ("armature_mode", "coupling_mode", "slip_direction")
 MODE_VALUES = (("rest", "free", "contact"), ("open", "slipping", "locked"), ("negative", "positive"))
 ELEMENTS = ("armature", "coupling")
 
-EV_ARM_REST, EV_ARM_CONTACT, EV_ARM_LEAVE_REST, EV_ARM_LEAVE_CONTACT, EV_LOCK, EV_SLIP_REVERSAL, EV_UNLOCK = range(7)
-EL_ARMATURE, EL_COUPLING = 0, 1
-ARM_REST, ARM_FREE, ARM_CONTACT = 0, 1, 2
-OPEN, SLIPPING, LOCKED = 0, 1, 2
-NEGATIVE, POSITIVE = 0, 1
-U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR, U_COIL = range(5)
-FRICTION_CONSTANT, FRICTION_MAP, FRICTION_LUGRE = 0, 1, 2
-REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT, REFERENCE_CURRENT = 0, 1, 2, 3  # CURRENT: coil current from u
+EV_ARM_REST, EV_ARM_CONTACT, EV_ARM_LEAVE_REST, EV_ARM_LEAVE_CONTACT, EV_LOCK, EV_SLIP_REVERSAL, EV_UNLOCK = indices(
+    EVENTS, "armature_rest", "armature_contact", "armature_leave_rest", "armature_leave_contact", "lockup",
+    "slip_reversal", "unlock")
+EL_ARMATURE, EL_COUPLING = indices(ELEMENTS, "armature", "coupling")
+_M_ARM, _M_CPL, _M_DIR = indices(MODE_NAMES, "armature_mode", "coupling_mode", "slip_direction")
+ARM_REST, ARM_FREE, ARM_CONTACT = indices(MODE_VALUES[_M_ARM], "rest", "free", "contact")
+OPEN, SLIPPING, LOCKED = indices(MODE_VALUES[_M_CPL], "open", "slipping", "locked")
+NEGATIVE, POSITIVE = indices(MODE_VALUES[_M_DIR], "negative", "positive")
+U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR, U_COIL = indices(
+    INPUTS, "torque_request", "throttle", "drum_speed_front", "drum_speed_rear", "coil_current_command")
+#: the friction laws of ``EmtcParams.friction_mode`` and the torque-reference sources of ``reference_source``
+#: (REFERENCE_CURRENT: the coil current from the input, no torque controller)
+FRICTION_MODES = ("constant", "map", "lugre")
+REFERENCE_SOURCES = ("map", "table", "input", "current")
+FRICTION_CONSTANT, FRICTION_MAP, FRICTION_LUGRE = indices(FRICTION_MODES, "constant", "map", "lugre")
+REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT, REFERENCE_CURRENT = indices(
+    REFERENCE_SOURCES, "map", "table", "input", "current")
 
 # model errors (negative codes of the hooks)
 ERR_PLANT_MEMORY, ERR_CONTROLLER_MEMORY = -1, -2
@@ -142,37 +152,53 @@ ERROR_MESSAGES = {
     ERR_CONTROLLER_MEMORY: "the controller model's hysteresis memory is full (BenchOptions.memory_capacity)",
 }
 
-# per-run integer memories (EmtcParams.imem)
-IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX = 0, 1, 2, 3, 4, 7, 10
-IM_PVER, IM_CVER = 13, 14  # changes of the plant's and the controller's hysteresis stacks so far (their lengths)
-N_IMEM = 15
-# per-run float memories and scratch (EmtcParams.fmem)
-FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST = range(8)
-FM_GW = 8  # 4: airgap weights of the plant tables and the airgap they were built for (cache)
-FM_CW = 12  # 3: weights of the controller model's table (one table at the engaged airgap: 1, 0, 0)
-FM_ULAST = 15  # 5: inputs seen at the last restart
-FM_AUX = 20  # N_AUX model intermediates of the last evaluation
+#: per-run integer memories (EmtcParams.imem)
+IMEM = slots(("plant_length", 1), ("controller_length", 1), ("next_sample", 1), ("error", 1),
+             ("plant_table_index", 3), ("controller_table_index", 3), ("friction_map_index", 3),
+             ("plant_version", 1),        # changes of the plant's hysteresis stack so far (its length)
+             ("controller_version", 1))   # the same for the controller model's
+IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX, IM_PVER, IM_CVER = IMEM.of(
+    "plant_length", "controller_length", "next_sample", "error", "plant_table_index", "controller_table_index",
+    "friction_map_index", "plant_version", "controller_version")
+N_IMEM = IMEM.total
+#: the model intermediates of an evaluation (FMEM's "aux")
+AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
+       "capacity_locked", "locked_case", "fn2", "engine_torque", "throttle")
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
- AUX_THR) = range(13)
-N_AUX = 13
-FM_SPLIT = FM_AUX + N_AUX  # 6: element torques and capacities of the torque split
-FM_DX = FM_SPLIT + 6  # 7: scratch derivative
-FM_G = FM_DX + 7  # 6: scratch switching functions
-FM_KEY = FM_G + 6  # 16: point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
-FM_DXM = FM_KEY + 16  # 7: derivative of the last evaluation
-FM_GM = FM_DXM + 7  # 6: switching functions of the last evaluation
-FM_FW = FM_GM + 6  # 3: airgap weights of the plant tables at the last evaluation with the armature moving
-FM_SEG = FM_FW + 3  # 9: the plant magnet's force as a quadratic in the coil current on the stretch of the last
-#                          evaluation (lo, hi, a0, a1, a2, kind: hysteresis._kernels.peek_segment) and the stack
-#                          version (IM_PVER), last input and airgap it is for
-FM_CSEG = FM_SEG + 9  # 8: the controller model's rising stretch (hysteresis._kernels.invert_combined)
-N_FMEM = FM_CSEG + 8
-# controller log (one row per sample, for the per-sample view of simulate_bench)
-LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = range(4)
-# the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
+ AUX_THR) = indices(AUX, *AUX)
+N_AUX = len(AUX)
+#: per-run float memories and scratch (EmtcParams.fmem)
+FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torque_reference", 1), ("feasible", 1),
+             ("z", 1), ("t_last", 1), ("dw_last", 1),
+             ("plant_weights", 4),        # airgap weights of the plant tables and the airgap they were built for
+             ("controller_weights", 3),   # weights of the controller model's table (one at the engaged airgap)
+             ("inputs_at_restart", len(INPUTS)),    # inputs seen at the last restart
+             ("aux", N_AUX),              # model intermediates of the last evaluation (AUX)
+             ("split", 6),                # element torques and capacities of the torque split
+             ("derivative", len(STATES)), ("switching", len(SWITCHING)),     # scratch
+             # the point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
+             ("key", 1 + len(STATES) + len(MODE_NAMES) + len(INPUTS)),
+             ("last_derivative", len(STATES)), ("last_switching", len(SWITCHING)),   # of the last evaluation
+             ("moving_weights", 3),       # airgap weights of the plant tables at the last evaluation, armature moving
+             ("plant_segment", 9),        # the plant magnet's force as a quadratic in the coil current on the
+             #                              stretch of the last evaluation (lo, hi, a0, a1, a2, kind:
+             #                              hysteresis._kernels.peek_segment), the stack version (IM_PVER), last
+             #                              input and airgap it is for
+             ("controller_segment", 8))   # the controller model's rising stretch (hysteresis._kernels.invert_combined)
+(FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
+ FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(*FMEM.offset)
+N_FMEM = FMEM.total
+#: controller log (one row per sample, for the per-sample view of simulate_bench)
+LOG_COLUMNS = ("command", "torque_reference", "throttle", "feasible")
+LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = indices(LOG_COLUMNS, *LOG_COLUMNS)
+#: the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
+TABLES = ("plant_tables", "plant_gaps", "controller_tables", "controller_grid", "controller_stack",
+          "controller_prefix", "map_throttle", "map_speed", "map_torque", "reference_time", "reference_value",
+          "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log")
 (L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
- L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = range(15)
-N_LAYOUT = 15
+ L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = indices(
+    TABLES, *TABLES)
+N_LAYOUT = len(TABLES)
 
 #: absolute tolerances of the states at rtol 1e-6 and above: omega_f, omega_r [rad/s], theta [rad], x [m],
 #: v [m/s], i1, i2 [A]

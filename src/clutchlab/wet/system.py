@@ -74,6 +74,7 @@ import numpy as np
 
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
+from ..numerics.layout import indices, slots
 from ..system import System, variables
 from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
                    squeeze_film_force_scalar)
@@ -106,8 +107,11 @@ STATES = (
     ("heat_to_housing", "J", "heat from the pack to the housing, integral of k2 (T - T_housing)"),
     ("drive_work", "J", "work of the drive motor, integral of T_drive * dw"),
 )
-(S_X, S_FA, S_W, S_I, S_T, S_TF, S_TH, S_TM, S_EF, S_EK1, S_EK2, S_ED) = range(12)
-N_STATE = 12
+(S_X, S_FA, S_W, S_I, S_T, S_TF, S_TH, S_TM, S_EF, S_EK1, S_EK2, S_ED) = indices(
+    STATES, "piston_position", "actuator_force", "slip_speed", "controller_integral", "temperature",
+    "fluid_temperature", "housing_temperature", "thermistor_temperature", "friction_work", "heat_to_fluid",
+    "heat_to_housing", "drive_work")
+N_STATE = len(STATES)
 
 #: outputs: (name, unit, description)
 OUTPUTS = (
@@ -131,42 +135,49 @@ OUTPUTS = (
     ("static_capacity", "Nm", "static torque capacity R_eff N_c mu_f F_c (Eq. 4)"),
 )
 (O_TAU, O_TC, O_TV, O_FC, O_FH, O_FLC, O_H, O_HBAR, O_MUF, O_MUV, O_TD, O_WREF, O_FREF, O_WDOT, O_TS,
- O_PF, O_QH, O_CAP) = range(18)
+ O_PF, O_QH, O_CAP) = indices(
+    OUTPUTS, "clutch_torque", "contact_torque", "viscous_torque", "contact_force", "squeeze_force",
+    "load_cell_force", "nominal_separation", "mean_film", "friction_coefficient", "viscosity", "drive_torque",
+    "slip_reference", "force_reference", "slip_acceleration", "sensor_torque", "friction_power", "heater_power",
+    "static_capacity")
 #: the outputs that belong to the bench, not to the clutch (its drive motor, speed controller and slip
 #: acceleration, torque sensor, load cell and reservoir heater): a clutch placed elsewhere (a driveline) has
 #: none of them
 BENCH_OUTPUTS = ("load_cell_force", "drive_torque", "slip_reference", "slip_acceleration", "sensor_torque",
                  "heater_power")
-N_OUT = 18
+N_OUT = len(OUTPUTS)
 
 #: held inputs, added to the scenario's reference profiles (zero in a scenario run)
 INPUTS = (
     ("force_reference", "N", "actuator force reference, added to the scenario's force profile"),
     ("slip_speed_reference", "rad_s", "slip-speed reference, added to the scenario's speed profile"),
 )
-U_FORCE, U_SPEED = 0, 1
+U_FORCE, U_SPEED = indices(INPUTS, "force_reference", "slip_speed_reference")
 
 #: modes: friction, piston, film
 MODE_NAMES = ("friction", "piston", "film")
 MODE_VALUES = (("slip_positive", "stick", "slip_negative"), ("free", "at_stop"), ("open", "contact"))
-M_FRICTION, M_PISTON, M_FILM = 0, 1, 2
-SLIP, STICK, SLIP_NEG = 0, 1, 2
-FREE, AT_STOP = 0, 1
-OPEN, CONTACT = 0, 1
+M_FRICTION, M_PISTON, M_FILM = indices(MODE_NAMES, "friction", "piston", "film")
+SLIP, STICK, SLIP_NEG = indices(MODE_VALUES[M_FRICTION], "slip_positive", "stick", "slip_negative")
+FREE, AT_STOP = indices(MODE_VALUES[M_PISTON], "free", "at_stop")
+OPEN, CONTACT = indices(MODE_VALUES[M_FILM], "open", "contact")
 
 #: switching functions: (name, crossing direction)
 SWITCHING = (("lockup", -1), ("breakaway", 1), ("contact", 0), ("piston_leaves_stop", 1),
              ("piston_reaches_stop", -1))
-G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES = range(5)
-N_SWITCH = 5
+G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES = indices(
+    SWITCHING, "lockup", "breakaway", "contact", "piston_leaves_stop", "piston_reaches_stop")
+N_SWITCH = len(SWITCHING)
 
 #: event names by code
 EVENTS = ("contact", "separation", "lockup", "breakaway", "slip_reversal", "piston_reaches_stop",
           "piston_leaves_stop")
-EV_CONTACT, EV_SEPARATION, EV_LOCKUP, EV_BREAKAWAY, EV_REVERSAL, EV_REACHES, EV_LEAVES = range(7)
+EV_CONTACT, EV_SEPARATION, EV_LOCKUP, EV_BREAKAWAY, EV_REVERSAL, EV_REACHES, EV_LEAVES = indices(
+    EVENTS, "contact", "separation", "lockup", "breakaway", "slip_reversal", "piston_reaches_stop",
+    "piston_leaves_stop")
 #: elements an event concerns, and the element of each event
 ELEMENTS = ("clutch", "piston")
-EL_CLUTCH, EL_PISTON = 0, 1
+EL_CLUTCH, EL_PISTON = indices(ELEMENTS, "clutch", "piston")
 EVENT_ELEMENT = np.array([EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_CLUTCH, EL_PISTON, EL_PISTON])
 
 #: scalar parameters: (field, unit, description) -- the named fields of ``WetParams.constants``
@@ -234,13 +245,14 @@ CONSTANTS_DTYPE = np.dtype([(n, np.float64) for n, _, _ in CONSTANTS if n not in
 
 #: layout of the per-run buffer at the head of ``WetParams.data``: memories, then scratch for outputs,
 #: derivative, switching values, and the segments of the force and slip-speed profiles found last
-W_PEAK, W_LOCKUP = 0, 1          # peak pack temperature [degC], first lock-up time [s] (NaN: none yet)
-W_OUT = 2
-W_DX = W_OUT + N_OUT
-W_G = W_DX + N_STATE
-W_FSEG = W_G + N_SWITCH          # index into data of the force profile's segment last read (0: none yet)
-W_SSEG = W_FSEG + 1              # the same for the slip-speed profile
-N_WORK = W_SSEG + 1
+WORK = slots(("peak_temperature", 1),     # peak pack temperature [degC]
+             ("first_lockup", 1),         # first lock-up time [s] (NaN: none yet)
+             ("outputs", N_OUT), ("derivative", N_STATE), ("switching", N_SWITCH),
+             ("force_segment", 1),        # index into data of the force profile's segment last read (0: none yet)
+             ("speed_segment", 1))        # the same for the slip-speed profile
+W_PEAK, W_LOCKUP, W_OUT, W_DX, W_G, W_FSEG, W_SSEG = WORK.of(
+    "peak_temperature", "first_lockup", "outputs", "derivative", "switching", "force_segment", "speed_segment")
+N_WORK = WORK.total
 
 
 class WetParams(NamedTuple):

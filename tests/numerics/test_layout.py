@@ -1,0 +1,107 @@
+"""Index constants generated from declarations (:mod:`clutchlab.numerics.layout`), and the modules that use them
+written without a hand-written index: every module-level integer constant of theirs comes from a declaration."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+from pathlib import Path
+
+import pytest
+
+import clutchlab
+from clutchlab.numerics.layout import indices, slots
+
+ROOT = Path(clutchlab.__file__).parent
+
+#: the modules whose layouts are generated: the wet and EMTC models and their driveline blocks
+GENERATED = ("wet/system.py", "emtc/system.py", "driveline/wet.py", "driveline/emtc.py", "driveline/block.py")
+#: integers in them that are numbers, not positions (name: why)
+NOT_INDICES = {
+    "ERR_PLANT_MEMORY": "a model error code (negative: the hooks' convention)",
+    "ERR_CONTROLLER_MEMORY": "a model error code",
+    "ERROR_STRIDE": "the spacing of the couplings' error codes",
+}
+
+
+def test_indices_follow_the_declaration_by_name():
+    decl = (("x", "m", "position"), ("v", "m_s", "speed"), ("a", "m_s2", "acceleration"))
+    assert indices(decl, "v") == 1
+    assert indices(decl, "a", "x") == (2, 0)
+    assert indices(("p", "q"), "q") == 1
+    with pytest.raises(KeyError, match="'w' is not declared.*x, v, a"):
+        indices(decl, "w")
+    with pytest.raises(ValueError, match="names x twice"):
+        indices((("x",), ("x",)), "x")
+
+
+def test_slots_are_consecutive_and_sum_to_the_total():
+    s = slots(("x", 12), ("dx", 12), ("g", 5), ("none", 0), ("y", 3))
+    assert s.of("x", "dx", "g", "none", "y") == (0, 12, 24, 29, 29)
+    assert s["y"] == 29 and s.total == 32 and s.size["g"] == 5
+    with pytest.raises(KeyError, match="no slot 'z'"):
+        s["z"]
+    for bad in ((("x", 1), ("x", 2)), (("x", -1),), (("x", 1.0),), (("x", True),)):
+        with pytest.raises(ValueError):
+            slots(*bad)
+
+
+@pytest.mark.parametrize("module, declaration, prefix", [
+    ("clutchlab.wet.system", "STATES", "S_"), ("clutchlab.wet.system", "OUTPUTS", "O_"),
+    ("clutchlab.wet.system", "SWITCHING", "G_"), ("clutchlab.wet.system", "EVENTS", "EV_"),
+    ("clutchlab.emtc.system", "EVENTS", "EV_"), ("clutchlab.emtc.system", "AUX", "AUX_"),
+    ("clutchlab.emtc.system", "TABLES", "L_"),
+])
+def test_each_declared_entry_has_exactly_one_constant(module, declaration, prefix):
+    """The constants of a declaration are a permutation of its positions (none missing, none twice)."""
+    mod = importlib.import_module(module)
+    values = sorted(v for k, v in vars(mod).items() if k.startswith(prefix) and k.isupper() and type(v) is int)
+    assert values == list(range(len(getattr(mod, declaration))))
+
+
+def test_the_block_layouts_are_their_models_declarations():
+    from clutchlab.driveline import emtc as DE, wet as DW
+    from clutchlab.emtc import system as S
+    from clutchlab.wet import system as W
+
+    for block, model in ((DW, W), (DE, S)):
+        n_x, n_g, n_u, n_y = len(model.STATES), len(model.SWITCHING), len(model.INPUTS), len(model.OUTPUTS)
+        assert (block.B_X, block.B_DX, block.B_G, block.B_U, block.B_Y, block.N_BUF) == (
+            0, n_x, 2 * n_x, 2 * n_x + n_g, 2 * n_x + n_g + n_u, 2 * n_x + n_g + n_u + n_y)
+        assert (block.F_K, block.F_ROW, block.F_X, block.F_G, block.F_M, block.F_EV, block.F_EL) == tuple(range(7))
+    assert (DW.F_U, DW.N_CONF) == (7, 8)
+    assert (DE.F_PORT, DE.N_CONF) == (7, 7 + DE.N_PORT)
+    assert W.N_WORK == 2 + W.N_OUT + W.N_STATE + W.N_SWITCH + 2
+
+
+def _hand_written(path: Path, root: Path = ROOT) -> list:
+    """Module-level assignments of integer literals (alone, in a tuple, or ``range(n)``) to upper-case names."""
+    found = []
+    for node in ast.parse(path.read_text(encoding="utf-8"), str(path)).body:
+        if not isinstance(node, (ast.Assign, ast.AnnAssign)):
+            continue
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+        names = [n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name) and n.id.isupper()]
+        value = node.value
+        literal = (isinstance(value, ast.Constant) and type(value.value) is int) or (
+            isinstance(value, ast.UnaryOp) and isinstance(value.operand, ast.Constant)
+            and type(value.operand.value) is int) or (
+            isinstance(value, ast.Call) and isinstance(value.func, ast.Name) and value.func.id == "range")
+        if isinstance(value, ast.Tuple):
+            literal = any(isinstance(e, ast.Constant) and type(e.value) is int for e in value.elts)
+        if isinstance(value, ast.BinOp):   # an offset computed by hand: NAME + 6
+            literal = any(isinstance(n, ast.Constant) and type(n.value) is int for n in ast.walk(value))
+        if literal:
+            found += [f"{path.relative_to(root)}:{node.lineno} {n}" for n in names if n not in NOT_INDICES]
+    return found
+
+
+@pytest.mark.parametrize("relative", GENERATED)
+def test_no_hand_written_index_in_the_generated_modules(relative):
+    assert _hand_written(ROOT / relative) == []
+
+
+def test_the_check_sees_a_hand_written_index(tmp_path):
+    f = tmp_path / "m.py"
+    f.write_text("A, B = range(2)\nC = 3\nD = (0, 1)\nE = A + 6\nF = -1\nG = len(())\nH = 1e-6\nI = X.of('a')\n")
+    assert [s.split()[-1] for s in _hand_written(f, tmp_path)] == ["A", "B", "C", "D", "E", "F"]
