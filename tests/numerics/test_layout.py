@@ -14,8 +14,9 @@ from clutchlab.numerics.layout import indices, slots
 
 ROOT = Path(clutchlab.__file__).parent
 
-#: the modules whose layouts are generated: the wet and EMTC models and their driveline blocks
-GENERATED = ("wet/system.py", "emtc/system.py", "driveline/wet.py", "driveline/emtc.py", "driveline/block.py")
+#: the modules whose layouts are generated: the three models and the driveline blocks of two of them
+GENERATED = ("wet/system.py", "emtc/system.py", "eclutch/system.py", "driveline/wet.py", "driveline/emtc.py",
+             "driveline/block.py")
 #: integers in them that are numbers, not positions (name: why)
 NOT_INDICES = {
     "ERR_PLANT_MEMORY": "a model error code (negative: the hooks' convention)",
@@ -50,7 +51,8 @@ def test_slots_are_consecutive_and_sum_to_the_total():
     ("clutchlab.wet.system", "STATES", "S_"), ("clutchlab.wet.system", "OUTPUTS", "O_"),
     ("clutchlab.wet.system", "SWITCHING", "G_"), ("clutchlab.wet.system", "EVENTS", "EV_"),
     ("clutchlab.emtc.system", "EVENTS", "EV_"), ("clutchlab.emtc.system", "AUX", "AUX_"),
-    ("clutchlab.emtc.system", "TABLES", "L_"),
+    ("clutchlab.emtc.system", "TABLES", "L_"), ("clutchlab.eclutch.system", "ACTUATOR_VECTOR", "P_"),
+    ("clutchlab.eclutch.system", "EVENTS", "EV_"), ("clutchlab.eclutch.system", "WORK_ROWS", "W_"),
 ])
 def test_each_declared_entry_has_exactly_one_constant(module, declaration, prefix):
     """The constants of a declaration are a permutation of its positions (none missing, none twice)."""

@@ -51,6 +51,7 @@ from ..errors import ParameterError
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
+from ..numerics.layout import indices
 from ..system import System, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
                        controller_voltage, current_rate, drive_voltage, drive_voltage_slopes, line_flow_rate,
@@ -63,24 +64,37 @@ from .network import GROUND, Lever, element_force, element_force_segment, solve_
 # EClutchParams are the kernel's internals, registered with numerics.dispatch below: not API (#33)
 __all__ = ["Assembly", "EVENTS", "MODE_VALUES", "VOLTAGE", "POSITION", "PRESCRIBED"]
 
-# actuator parameter vector layout (EClutchParams.par)
-P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF = range(13)
-P_R, P_L, P_KT, P_VSUP, P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX = range(13, 25)
-P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN, P_REFMAX = range(25, 33)
-N_PAR = 33
+#: the actuator parameter vector (EClutchParams.par), in order: the fields of
+#: :class:`~clutchlab.eclutch.actuator.ActuatorParameters` the hooks read (:func:`_actuator_vector` packs them;
+#: ``snifting_edge`` is the port plus its width, ``cavitation_sharpness`` the fixed 1e3, the reference limits the
+#: slave's travel limits)
+ACTUATOR_VECTOR = (
+    "master_area", "slave_area", "master_equivalent_mass", "slave_mass", "master_compliance", "slave_compliance",
+    "line_inertance", "line_resistance", "snifting_conductance", "snifting_edge", "snifting_width",
+    "vapour_pressure", "cavitation_sharpness", "resistance", "inductance", "torque_constant", "supply_voltage",
+    "current_limit", "current_limit_gain", "spindle_ratio", "csc_preload", "csc_spring_rate", "slave_min",
+    "slave_max", "master_stroke", "stop_stiffness", "stop_damping", "kp", "ki", "kd", "anti_windup",
+    "reference_min", "reference_max")
+(P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
+ P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
+ P_REFMAX) = indices(ACTUATOR_VECTOR, *ACTUATOR_VECTOR)
+N_PAR = len(ACTUATOR_VECTOR)
 
 #: input modes: motor voltage (held between table rows), bearing reference (position control), prescribed bearing
-VOLTAGE, POSITION, PRESCRIBED = 0, 1, 2
+INPUT_MODES = ("voltage", "position", "prescribed")
+VOLTAGE, POSITION, PRESCRIBED = indices(INPUT_MODES, *INPUT_MODES)
 #: friction modes of a coordinate
-FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = 0, 1, 2, 3
 MODE_VALUES = ("free", "slip_forward", "stuck", "slip_backward")
+FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = indices(MODE_VALUES, *MODE_VALUES)
 #: event names by code (what the hooks record)
 EVENTS = ("stick", "breakaway", "slip_reversal", "contact_close", "contact_open", "stop_hit", "stop_leave",
           "cavitation_start", "cavitation_end", "friction_free", "friction_engage")
-EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_CONTACT_CLOSE, EV_CONTACT_OPEN, EV_STOP_HIT, EV_STOP_LEAVE = range(7)
-EV_CAVITATION_START, EV_CAVITATION_END = 7, 8
+(EV_STICK, EV_BREAKAWAY, EV_REVERSAL, EV_CONTACT_CLOSE, EV_CONTACT_OPEN, EV_STOP_HIT, EV_STOP_LEAVE,
+ EV_CAVITATION_START, EV_CAVITATION_END) = indices(
+    EVENTS, "stick", "breakaway", "slip_reversal", "contact_close", "contact_open", "stop_hit", "stop_leave",
+    "cavitation_start", "cavitation_end")
 #: a friction coordinate whose kinetic level F_c fell to exactly zero (free), or left zero (engages)
-EV_FREE, EV_ENGAGE = 9, 10
+EV_FREE, EV_ENGAGE = indices(EVENTS, "friction_free", "friction_engage")
 #: the four end stops and the two chambers (elements of stop and cavitation events)
 STOPS = ("master_rest_stop", "master_stroke_end", "csc_engaged_stop", "csc_travel_end")
 CHAMBERS = ("master_chamber", "csc_chamber")
@@ -91,20 +105,29 @@ OTHER_SWITCHING = STOPS + ("master_cavitation", "csc_cavitation", "current_limit
 N_OTHER = len(OTHER_SWITCHING)
 #: a massless node closer than this to its equilibrium [m] is not moved before the outputs are read (_equilibrate)
 EQUILIBRIUM_TOL = 1e-10
-#: auxiliary values of the right-hand side: drive voltage, clutch bearing force, reference, bearing position,
-#: then the friction force of every coordinate
-N_AUX = 4
+#: auxiliary values of the right-hand side, then the friction force of every coordinate
+AUX = ("drive_voltage", "bearing_force", "reference", "bearing_position")
+AUX_VDRIVE, AUX_FB, AUX_REF, AUX_UB = indices(AUX, *AUX)
+N_AUX = len(AUX)
 
 
 # rows of the packed per-coordinate, per-element and scratch arrays of EClutchParams
-CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = range(6)  # coord [float]
-CI_FRICTION, CI_NORMAL, CI_PRESSURE = range(3)  # coord_int: Coulomb friction on, pressing element, chamber
-NE_D0, NE_GB, NE_SCALE = range(3)  # net [float]: pre-deflection, input gain, stiffness scale
-NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = range(4)  # net_int: curve offsets, kind, extrapolation, contact
-# work rows; W_K: element stiffnesses (rhs, jacobian); W_KEY: the point (t, x, m) of the last rhs evaluation;
-# W_SEG: each element curve's segment at the last look-up (a search hint; integers held as floats)
-W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = range(10)
-N_WORK = 10
+COORD_ROWS = ("mass", "coulomb", "mu_normal", "mu_pressure", "static_ratio", "viscous")  # coord [float]
+CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = indices(COORD_ROWS, *COORD_ROWS)
+#: coord_int: Coulomb friction on, pressing element, chamber
+COORD_INT_ROWS = ("friction", "normal", "pressure")
+CI_FRICTION, CI_NORMAL, CI_PRESSURE = indices(COORD_INT_ROWS, *COORD_INT_ROWS)
+NET_ROWS = ("pre_deflection", "input_gain", "stiffness_scale")  # net [float]
+NE_D0, NE_GB, NE_SCALE = indices(NET_ROWS, *NET_ROWS)
+#: net_int: curve offsets, kind, extrapolation, contact (unilateral)
+NET_INT_ROWS = ("offsets", "kinds", "extrapolations", "unilateral")
+NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = indices(NET_INT_ROWS, *NET_INT_ROWS)
+#: work rows; "stiffness": element stiffnesses (rhs, jacobian); "key": the point (t, x, m) of the last rhs
+#: evaluation; "segment": each element curve's segment at the last look-up (a search hint; integers as floats)
+WORK_ROWS = ("force", "free", "coordinate_force", "aux", "derivative", "switching", "state", "stiffness", "key",
+             "segment")
+W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = indices(WORK_ROWS, *WORK_ROWS)
+N_WORK = len(WORK_ROWS)
 
 
 class EClutchParams(NamedTuple):
@@ -356,10 +379,10 @@ def rhs(t, x, u, m, p, dx, g):
     else:
         for k in range(N_OTHER):
             g[ne + k] = 1.0
-    aux[0] = v_drive
-    aux[1] = bearing_force
-    aux[2] = ref
-    aux[3] = ub
+    aux[AUX_VDRIVE] = v_drive
+    aux[AUX_FB] = bearing_force
+    aux[AUX_REF] = ref
+    aux[AUX_UB] = ub
     _store_key(work[W_KEY], t, x, m)
 
 
@@ -474,13 +497,13 @@ def outputs(t, x, u, m, p, y):
     f = work[W_F]
     n_el = p.GA.shape[0]
     fn = f[p.normal_element]
-    y[0] = aux[0]
+    y[0] = aux[AUX_VDRIVE]
     y[1] = xs[2 * nz + 2] * p.par[P_ASL]  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
-    y[2] = aux[1]
+    y[2] = aux[AUX_FB]
     y[3] = fn
     y[4] = torque_of_clamp_force(fn, p.r_eff, p.mu)
     y[5] = xs[nz] / p.par[P_NS] * 60.0 / (2.0 * math.pi)
-    y[6] = aux[2]
+    y[6] = aux[AUX_REF]
     for e in range(n_el):
         y[7 + e] = f[e]
     fo = p.friction_outputs
