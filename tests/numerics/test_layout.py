@@ -14,14 +14,16 @@ from clutchlab.numerics.layout import indices, slots
 
 ROOT = Path(clutchlab.__file__).parent
 
-#: the modules whose layouts are generated: the three models and the driveline blocks of two of them
-GENERATED = ("wet/system.py", "emtc/system.py", "eclutch/system.py", "driveline/wet.py", "driveline/emtc.py",
-             "driveline/block.py")
+#: the modules whose layouts are generated: the three models, the driveline's kernel and its blocks
+GENERATED = ("wet/system.py", "emtc/system.py", "eclutch/system.py", "driveline/kernel.py", "driveline/wet.py",
+             "driveline/emtc.py", "driveline/block.py")
 #: integers in them that are numbers, not positions (name: why)
 NOT_INDICES = {
     "ERR_PLANT_MEMORY": "a model error code (negative: the hooks' convention)",
     "ERR_CONTROLLER_MEMORY": "a model error code",
     "ERROR_STRIDE": "the spacing of the couplings' error codes",
+    "INV_BASE": "the base of the driveline's invariant error codes",
+    "SPACE_SLOTS": "a capacity: the stuck-set repair's warm starts kept",
 }
 
 
@@ -53,6 +55,8 @@ def test_slots_are_consecutive_and_sum_to_the_total():
     ("clutchlab.emtc.system", "EVENTS", "EV_"), ("clutchlab.emtc.system", "AUX", "AUX_"),
     ("clutchlab.emtc.system", "TABLES", "L_"), ("clutchlab.eclutch.system", "ACTUATOR_VECTOR", "P_"),
     ("clutchlab.eclutch.system", "EVENTS", "EV_"), ("clutchlab.eclutch.system", "WORK_ROWS", "W_"),
+    ("clutchlab.driveline.kernel", "EVENTS", "EV_"), ("clutchlab.driveline.kernel", "ELEM_COLUMNS", "E_"),
+    ("clutchlab.driveline.kernel", "SIGNAL_KINDS", "SIG_"), ("clutchlab.driveline.kernel", "ELEMENT_KINDS", "K_"),
 ])
 def test_each_declared_entry_has_exactly_one_constant(module, declaration, prefix):
     """The constants of a declaration are a permutation of its positions (none missing, none twice)."""

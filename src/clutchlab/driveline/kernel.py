@@ -38,6 +38,7 @@ from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
 from ..numerics.core import new_log, record
 from ..numerics.interp import bracket
+from ..numerics.layout import indices, slots
 from ..numerics.outline import outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
 
@@ -45,76 +46,103 @@ from ..numerics.rosenbrock import lu_factor, lu_solve
 #: compiles every callee once more for it, with all of that callee's callees linked in (issue #30's first compilation)
 _ZERO = np.int64(0)
 
-# element kinds (DrivelineParams.elem[:, E_KIND])
-K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = 0, 1, 2, 3, 4
-# friction laws
-LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = 0, 1, 2, 3  # cgeo * fn * mu(|w|); table(|w|) (bearing friction);
-# freewheel; a clutch model with states of its own (its sliding torque and static limit set by the model's hooks
-# before each evaluation of the network: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
-# spring laws
-SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = 0, 1, 2
-# torque sources (K_SOURCE): a signal, or an engine (a torque map over speed and throttle plus an idle-speed PI
-# controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``)
-SOURCE_SIGNAL, SOURCE_ENGINE = 0, 1
-# motion sources (K_MOTION): prescribed speed or position of flange b
-MOTION_SPEED, MOTION_POSITION = 0, 1
+# Every integer below is generated from a declaration (:mod:`clutchlab.numerics.layout`): the position of a name
+# in its tuple, or an offset of consecutive slots.
+#: element kinds (DrivelineParams.elem[:, E_KIND])
+ELEMENT_KINDS = ("spring", "friction", "source", "gear", "motion")
+K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = indices(ELEMENT_KINDS, *ELEMENT_KINDS)
+#: friction laws: cgeo * fn * mu(|w|); table(|w|) (bearing friction); freewheel; a clutch model with states of its
+#: own (its sliding torque and static limit set by the model's hooks before each evaluation of the network:
+#: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
+FRICTION_LAWS = ("clutch", "table", "oneway", "external")
+LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = indices(FRICTION_LAWS, *FRICTION_LAWS)
+#: spring laws
+SPRING_LAWS = ("linear", "curve", "backlash")
+SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = indices(SPRING_LAWS, *SPRING_LAWS)
+#: torque sources (K_SOURCE): a signal, or an engine (a torque map over speed and throttle plus an idle-speed PI
+#: controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``)
+SOURCE_LAWS = ("signal", "engine")
+SOURCE_SIGNAL, SOURCE_ENGINE = indices(SOURCE_LAWS, *SOURCE_LAWS)
+#: motion sources (K_MOTION): prescribed speed or position of flange b
+MOTION_LAWS = ("speed", "position")
+MOTION_SPEED, MOTION_POSITION = indices(MOTION_LAWS, *MOTION_LAWS)
 # modes of a switched spring (after the friction elements' in the mode vector): a backlash in its gap, or in
 # contact beyond either side; a curve spring: the segment of its curve it is on (0 below the first point, i
 # between points i-1 and i, m above the last of m points)
-LASH_GAP, LASH_UPPER, LASH_LOWER = 0, 1, 2
 LASH_VALUES = ("gap", "upper", "lower")
+LASH_GAP, LASH_UPPER, LASH_LOWER = indices(LASH_VALUES, *LASH_VALUES)
 # a backlash's damping law (``elem[r, E_AUX]``): Kelvin-Voigt in contact, or MSL ``ElastoBacklash``'s, whose contact
 # has two more modes per side (odd: upper, even: lower): the damping torque limited to the spring torque
 # (tau = 2 tau_c) and the contact unloaded (tau = 0, where tau_c + tau_d would pull)
-LASH_KELVIN_VOIGT, LASH_MSL = 0, 1
-LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED = 3, 4, 5, 6
+LASH_DAMPING_LAWS = ("kelvin_voigt", "msl")
+LASH_KELVIN_VOIGT, LASH_MSL = indices(LASH_DAMPING_LAWS, *LASH_DAMPING_LAWS)
 LASH_MSL_VALUES = LASH_VALUES + ("upper_limited", "lower_limited", "upper_released", "lower_released")
+LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED = indices(
+    LASH_MSL_VALUES, "upper_limited", "lower_limited", "upper_released", "lower_released")
 # (Kelvin-Voigt's contact has the unloaded modes too: a damped contact separates beyond its edge, moving back, and
 # is released there until the deflection reaches the edge or its torque pushes again; it never enters the limited
 # ones, which keep their names)
 LASH_KV_VALUES = LASH_MSL_VALUES
 # modes of a friction element (index into MODE_VALUES); MSL's codes are MODE_CODES
-STUCK, FORWARD, BACKWARD, FREE = 0, 1, 2, 3
 MODE_VALUES = ("stuck", "forward", "backward", "free")
+STUCK, FORWARD, BACKWARD, FREE = indices(MODE_VALUES, *MODE_VALUES)
 MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Forward 1, Backward -1, Free 2
 # events: named for the mode entered (friction and lossy gears: stick, forward, backward; a lossy gear's driving
 # flange: a_drives, b_drives), or for a backlash closing or opening its gap
-EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = range(8)
 EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives")
+EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = indices(EVENTS, *EVENTS)
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
-# signals (rows of ``DrivelineParams.signals``, ``N_SIG`` wide: the kind and up to eight parameters)
-SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED = 0, 1, 2, 3, 4, 5
-SIG_PULSE, SIG_TRAPEZOID, SIG_EXPONENTIALS, SIG_PRODUCT = 6, 7, 8, 9
-SIG_INPUT = 10   # a network input: ``[k, its number j, the number of inputs nu]``, held at ``data[-nu + j]``
-N_SIG = 9
-# columns of ``elem`` (ints) and ``coef`` (floats)
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = range(11)  # E_AUX: a curve's kind
-N_ELEM = 11      # (0 linear, 1 pchip), an engine map's throttle points; E_MODE: index in m; E_STATE: of a controller state;
-#                  E_SUP: a gear's support (housing) inertia, -1 the ground
-C_STIFF, C_DAMP, C_PHI0, C_GAP = 0, 1, 2, 3        # spring-damper (curve: its points at E_TABLE; backlash: gap)
-C_FN_MAX, C_CGEO, C_PEAK = 0, 1, 2                 # friction (table: speed grid | values at E_TABLE)
-C_NCURVE, C_LIFTOFF = 3, 4                         # friction with a normal-force curve (E_AUX points): its
-C_RATIO = 0                                        # data offset and lift-off input; gear: w_a = ratio * w_b (its loss
-#                                                    table, MSL lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2,
-#                                                    tau_bf1, tau_bf2, stored column by column at E_TABLE)
-C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = 0, 1, 2, 3   # an engine's idle controller: set speed [rad/s], gains
-                                                   # [N m s/rad], [N m/rad], torque limit [N m]
-N_COEF = 5
+#: signal kinds (rows of ``DrivelineParams.signals``, ``N_SIG`` wide: the kind and up to eight parameters); an
+#: input is a network input: ``[k, its number j, the number of inputs nu]``, held at ``data[-nu + j]``
+SIGNAL_KINDS = ("const", "step", "ramp", "sine", "table", "sampled", "pulse", "trapezoid", "exponentials",
+                "product", "input")
+(SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED, SIG_PULSE, SIG_TRAPEZOID, SIG_EXPONENTIALS,
+ SIG_PRODUCT, SIG_INPUT) = indices(SIGNAL_KINDS, *SIGNAL_KINDS)
+N_SIG = slots(("kind", 1), ("parameters", 8)).total
+#: columns of ``elem`` (ints): "aux" is a curve's kind (0 linear, 1 pchip) or an engine map's throttle points;
+#: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
+#: inertia, -1 the ground
+ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support")
+E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = indices(
+    ELEM_COLUMNS, *ELEM_COLUMNS)
+N_ELEM = len(ELEM_COLUMNS)
+#: columns of ``coef`` (floats), their meaning by the element's kind: a spring-damper (a curve: its points at
+#: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
+#: curve of E_AUX points: its data offset and lift-off input); a gear, w_a = ratio * w_b (its loss table, MSL
+#: lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2, stored column by column at E_TABLE);
+#: an engine's idle controller: set speed [rad/s], gains [N m s/rad], [N m/rad], torque limit [N m]
+COEF_COLUMNS = {
+    "spring": ("stiffness", "damping", "phi0", "gap"),
+    "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff"),
+    "gear": ("ratio",),
+    "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
+}
+C_STIFF, C_DAMP, C_PHI0, C_GAP = indices(COEF_COLUMNS["spring"], "stiffness", "damping", "phi0", "gap")
+C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF = indices(
+    COEF_COLUMNS["friction"], "fn_max", "cgeo", "peak", "ncurve", "liftoff")
+C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
+C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = indices(
+    COEF_COLUMNS["engine"], "idle_speed", "idle_kp", "idle_ki", "idle_max")
+N_COEF = max(len(columns) for columns in COEF_COLUMNS.values())
 # modes of a lossy gear (after the switched springs' in the mode vector; MSL LossyGear): stuck (locked), or rolling
 # forward (w_a > 0) or backward, with the flange that drives (MSL's quadrants: tau_eta >= 0 forward is quadrant 1,
 # flange a drives; < 0 quadrant 2, b drives; backward tau_eta >= 0 quadrant 4, b drives; < 0 quadrant 3, a drives)
-GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = 0, 1, 2, 3, 4
 GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
+GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(GEAR_VALUES, *GEAR_VALUES)
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
 # switching functions: five per friction element, then three per switched spring (``swit``: backlash and curves),
 # then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
-G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = 0, 1, 2, 3, 4
-N_G = 5
-N_GEAR_G = 3
+FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near")
+G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = indices(FRICTION_SWITCHING, *FRICTION_SWITCHING)
+N_G = len(FRICTION_SWITCHING)
+#: a lossy gear's: its stick or break-away function, its driving flange's, its turning point
+GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn")
+N_GEAR_G = len(GEAR_SWITCHING)
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends) and the
 #: turning points of a backlash's deflection in its gap (G_LASH_TURN)
-N_SW = 3
-G_LASH_TURN = 2
+SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn")
+N_SW = len(SPRING_SWITCHING)
+G_LASH_TURN = indices(SPRING_SWITCHING, "turn")
 #: a sliding element's relative speed below this share of the largest speed (at least 1) is watched for its turning
 #: point (G_TURN), so that a dip through zero shorter than a step is not stepped over
 TURN_WATCH = 1e-2
@@ -917,7 +945,8 @@ def evaluate_network(t, x, m, p, acc, tau):
 #: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16): the
 #: bounds of its largest margin's vertex (the rank of the bounds' span, then its 4 bounds) and the active set of its
 #: nearest split (its size, then its 3 bounds)
-SPACE_SLOTS, SPACE_HINT = 16, 9
+SPACE_SLOTS = 16
+SPACE_HINT = slots(("vertex_rank", 1), ("vertex_bounds", 4), ("active_size", 1), ("active_bounds", 3)).total
 SPACE_CACHE = SPACE_SLOTS * SPACE_HINT
 
 
@@ -1074,7 +1103,7 @@ def _break_marker(p):
 
 #: words per clutch model in the work array: its sliding torque, static limit and lock-up limit, then their rates,
 #: then the time those rates start from (:func:`set_external`, :func:`set_external_rates`)
-N_EXT = 7
+N_EXT = slots(("limits", 3), ("rates", 3), ("rate_start", 1)).total
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -3544,13 +3573,15 @@ def driveline_restart(t, x, u, m, p, log):
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
-INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = 0, 1, 2, 3, 4, 5
+INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap")
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = indices(INVARIANT_NAMES, *INVARIANT_NAMES)
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",
               "backlash in its gap beyond an edge moving outward, or released where its contact would push (a "
               "contact missed)")
-INV_BASE, N_INV = 100, 6
+INV_BASE = 100
+N_INV = len(INVARIANT_NAMES)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
