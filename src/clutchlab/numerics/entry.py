@@ -292,14 +292,14 @@ class _FastEntry:
             key = _fingerprint(rest)
             sig = tuple(d.typeof_pyval(a) for a in (p, *rest))
             call = d.overloads[sig].entry_point
-        except Exception:   # no exact overload (a conversion) or no fingerprint: the dispatcher every time
-            return out
-        hit = self.known.get(id(p))
-        if hit is None or hit[0] is not p:
-            while len(self.known) >= _FAST_KEEP:
-                self.known.pop(next(iter(self.known)))
-            hit = self.known[id(p)] = (p, {})
-        hit[1][key] = call
+            hit = self.known.get(id(p))
+            if hit is None or hit[0] is not p:
+                for old in list(self.known)[:max(len(self.known) - _FAST_KEEP + 1, 0)]:
+                    self.known.pop(old, None)   # (another thread may have forgotten it already)
+                hit = self.known[id(p)] = (p, {})
+            hit[1][key] = call
+        except Exception:   # no exact overload (a conversion), no fingerprint: the dispatcher every time
+            pass            # (never fail a call that has run because its overload could not be remembered)
         return out
 
 
