@@ -300,6 +300,7 @@ def test_a_wet_clutch_breaking_away_slowly_follows_the_tolerance_from_1e_8():
     d.inertia("J2", J=1.0)
     d.wet_clutch("w0", "J0", "J1", force=Signal.pulse(481.0, 0.5, 0.109375, start=0.0))
     d.spring_damper("k1", "J1", "J2", c=1.0, d=0.0)
+    d.torque("T0", "J0", Signal.sine(0.0, 1.0))   # (as drawn: a source of zero torque, whose work is a state)
     d.torque("T1", "J1", Signal.sine(1.0, 1.0))
     res = {rtol: d.simulate(0.6, rtol=rtol, output_step=2e-3) for rtol in (1e-7, 1e-8, 1e-10, 1e-12)}
     runs = {rtol: r.to_dataframe() for rtol, r in res.items()}
