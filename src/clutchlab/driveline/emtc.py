@@ -69,7 +69,8 @@ N_PORT = PORT_INPUTS.size
 #: ``<name>.armature``, then ``<name>.coupling``), then the network signal of each of its ports (-1: none;
 #: :data:`PORT_INPUTS`)
 CONF = conf_slots(("ports", N_PORT))
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_PORT = CONF.of(*CONF.offset)
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_PORT = CONF.of(
+    "friction", "row", "states", "switching", "modes", "events", "element", "ports")
 N_CONF = CONF.total
 #: coupling j's model errors are its model's codes minus ``ERROR_STRIDE j`` (clutchlab.emtc.system.ERROR_MESSAGES)
 ERROR_STRIDE = 1_000_000

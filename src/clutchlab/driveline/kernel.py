@@ -50,32 +50,33 @@ _ZERO = np.int64(0)
 # in its tuple, or an offset of consecutive slots.
 #: element kinds (DrivelineParams.elem[:, E_KIND])
 ELEMENT_KINDS = ("spring", "friction", "source", "gear", "motion")
-K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = indices(ELEMENT_KINDS, *ELEMENT_KINDS)
+K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = indices(
+    ELEMENT_KINDS, "spring", "friction", "source", "gear", "motion")
 #: friction laws: cgeo * fn * mu(|w|); table(|w|) (bearing friction); freewheel; a clutch model with states of its
 #: own (its sliding torque and static limit set by the model's hooks before each evaluation of the network:
 #: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
 FRICTION_LAWS = ("clutch", "table", "oneway", "external")
-LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = indices(FRICTION_LAWS, *FRICTION_LAWS)
+LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = indices(FRICTION_LAWS, "clutch", "table", "oneway", "external")
 #: spring laws
 SPRING_LAWS = ("linear", "curve", "backlash")
-SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = indices(SPRING_LAWS, *SPRING_LAWS)
+SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = indices(SPRING_LAWS, "linear", "curve", "backlash")
 #: torque sources (K_SOURCE): a signal, or an engine (a torque map over speed and throttle plus an idle-speed PI
 #: controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``)
 SOURCE_LAWS = ("signal", "engine")
-SOURCE_SIGNAL, SOURCE_ENGINE = indices(SOURCE_LAWS, *SOURCE_LAWS)
+SOURCE_SIGNAL, SOURCE_ENGINE = indices(SOURCE_LAWS, "signal", "engine")
 #: motion sources (K_MOTION): prescribed speed or position of flange b
 MOTION_LAWS = ("speed", "position")
-MOTION_SPEED, MOTION_POSITION = indices(MOTION_LAWS, *MOTION_LAWS)
+MOTION_SPEED, MOTION_POSITION = indices(MOTION_LAWS, "speed", "position")
 # modes of a switched spring (after the friction elements' in the mode vector): a backlash in its gap, or in
 # contact beyond either side; a curve spring: the segment of its curve it is on (0 below the first point, i
 # between points i-1 and i, m above the last of m points)
 LASH_VALUES = ("gap", "upper", "lower")
-LASH_GAP, LASH_UPPER, LASH_LOWER = indices(LASH_VALUES, *LASH_VALUES)
+LASH_GAP, LASH_UPPER, LASH_LOWER = indices(LASH_VALUES, "gap", "upper", "lower")
 # a backlash's damping law (``elem[r, E_AUX]``): Kelvin-Voigt in contact, or MSL ``ElastoBacklash``'s, whose contact
 # has two more modes per side (odd: upper, even: lower): the damping torque limited to the spring torque
 # (tau = 2 tau_c) and the contact unloaded (tau = 0, where tau_c + tau_d would pull)
 LASH_DAMPING_LAWS = ("kelvin_voigt", "msl")
-LASH_KELVIN_VOIGT, LASH_MSL = indices(LASH_DAMPING_LAWS, *LASH_DAMPING_LAWS)
+LASH_KELVIN_VOIGT, LASH_MSL = indices(LASH_DAMPING_LAWS, "kelvin_voigt", "msl")
 LASH_MSL_VALUES = LASH_VALUES + ("upper_limited", "lower_limited", "upper_released", "lower_released")
 LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED = indices(
     LASH_MSL_VALUES, "upper_limited", "lower_limited", "upper_released", "lower_released")
@@ -85,26 +86,29 @@ LASH_UPPER_LIMITED, LASH_LOWER_LIMITED, LASH_UPPER_RELEASED, LASH_LOWER_RELEASED
 LASH_KV_VALUES = LASH_MSL_VALUES
 # modes of a friction element (index into MODE_VALUES); MSL's codes are MODE_CODES
 MODE_VALUES = ("stuck", "forward", "backward", "free")
-STUCK, FORWARD, BACKWARD, FREE = indices(MODE_VALUES, *MODE_VALUES)
+STUCK, FORWARD, BACKWARD, FREE = indices(MODE_VALUES, "stuck", "forward", "backward", "free")
 MODE_CODES = np.array([0.0, 1.0, -1.0, 2.0])  # MSL PartialFriction: Stuck 0, Forward 1, Backward -1, Free 2
 # events: named for the mode entered (friction and lossy gears: stick, forward, backward; a lossy gear's driving
 # flange: a_drives, b_drives), or for a backlash closing or opening its gap
 EVENTS = ("stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives")
-EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = indices(EVENTS, *EVENTS)
+EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE, EV_CONTACT, EV_SEPARATE, EV_DRIVE_A, EV_DRIVE_B = indices(
+    EVENTS, "stick", "forward", "backward", "free", "contact", "separate", "a_drives", "b_drives")
 _EVENT_OF_MODE = np.array([EV_STICK, EV_FORWARD, EV_BACKWARD, EV_FREE])
 #: signal kinds (rows of ``DrivelineParams.signals``, ``N_SIG`` wide: the kind and up to eight parameters); an
 #: input is a network input: ``[k, its number j, the number of inputs nu]``, held at ``data[-nu + j]``
 SIGNAL_KINDS = ("const", "step", "ramp", "sine", "table", "sampled", "pulse", "trapezoid", "exponentials",
                 "product", "input")
 (SIG_CONST, SIG_STEP, SIG_RAMP, SIG_SINE, SIG_TABLE, SIG_SAMPLED, SIG_PULSE, SIG_TRAPEZOID, SIG_EXPONENTIALS,
- SIG_PRODUCT, SIG_INPUT) = indices(SIGNAL_KINDS, *SIGNAL_KINDS)
+ SIG_PRODUCT, SIG_INPUT) = indices(
+    SIGNAL_KINDS, "const", "step", "ramp", "sine", "table", "sampled", "pulse", "trapezoid", "exponentials",
+    "product", "input")
 N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: columns of ``elem`` (ints): "aux" is a curve's kind (0 linear, 1 pchip) or an engine map's throttle points;
 #: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
 #: inertia, -1 the ground
 ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support")
 E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = indices(
-    ELEM_COLUMNS, *ELEM_COLUMNS)
+    ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support")
 N_ELEM = len(ELEM_COLUMNS)
 #: columns of ``coef`` (floats), their meaning by the element's kind: a spring-damper (a curve: its points at
 #: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
@@ -128,12 +132,13 @@ N_COEF = max(len(columns) for columns in COEF_COLUMNS.values())
 # forward (w_a > 0) or backward, with the flange that drives (MSL's quadrants: tau_eta >= 0 forward is quadrant 1,
 # flange a drives; < 0 quadrant 2, b drives; backward tau_eta >= 0 quadrant 4, b drives; < 0 quadrant 3, a drives)
 GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
-GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(GEAR_VALUES, *GEAR_VALUES)
+GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(
+    GEAR_VALUES, "stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
 # switching functions: five per friction element, then three per switched spring (``swit``: backlash and curves),
 # then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
 FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near")
-G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = indices(FRICTION_SWITCHING, *FRICTION_SWITCHING)
+G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = indices(FRICTION_SWITCHING, "stick", "break", "normal", "turn", "near")
 N_G = len(FRICTION_SWITCHING)
 #: a lossy gear's: its stick or break-away function, its driving flange's, its turning point
 GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn")
@@ -3574,7 +3579,8 @@ def driveline_restart(t, x, u, m, p, log):
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
 INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap")
-INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = indices(INVARIANT_NAMES, *INVARIANT_NAMES)
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = indices(
+    INVARIANT_NAMES, "limit", "mode", "oneway", "loss", "energy", "gap")
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",

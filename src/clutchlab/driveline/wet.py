@@ -50,7 +50,8 @@ N_STATE, N_SWITCH, N_MODE = W.N_STATE, W.N_SWITCH, len(W.MODE_NAMES)
 #: conf (int64, a row per clutch, :func:`~clutchlab.driveline.block.conf_slots`): the block's head (its first named
 #: element ``<name>``, then ``<name>.piston``) and the network signal its force port reads
 CONF = conf_slots(("force_port", 1))
-F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = CONF.of(*CONF.offset)
+F_K, F_ROW, F_X, F_G, F_M, F_EV, F_EL, F_U = CONF.of(
+    "friction", "row", "states", "switching", "modes", "events", "element", "force_port")
 N_CONF = CONF.total
 #: buf (float, :func:`~clutchlab.driveline.block.buffer_slots`): its states with the slip replaced, their
 #: derivative, switching values, its model's inputs (the force reference added to its zero profile: the force

@@ -77,15 +77,21 @@ ACTUATOR_VECTOR = (
     "reference_min", "reference_max")
 (P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
  P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
- P_REFMAX) = indices(ACTUATOR_VECTOR, *ACTUATOR_VECTOR)
+ P_REFMAX) = indices(
+    ACTUATOR_VECTOR, "master_area", "slave_area", "master_equivalent_mass", "slave_mass", "master_compliance",
+    "slave_compliance", "line_inertance", "line_resistance", "snifting_conductance", "snifting_edge",
+    "snifting_width", "vapour_pressure", "cavitation_sharpness", "resistance", "inductance", "torque_constant",
+    "supply_voltage", "current_limit", "current_limit_gain", "spindle_ratio", "csc_preload", "csc_spring_rate",
+    "slave_min", "slave_max", "master_stroke", "stop_stiffness", "stop_damping", "kp", "ki", "kd", "anti_windup",
+    "reference_min", "reference_max")
 N_PAR = len(ACTUATOR_VECTOR)
 
 #: input modes: motor voltage (held between table rows), bearing reference (position control), prescribed bearing
 INPUT_MODES = ("voltage", "position", "prescribed")
-VOLTAGE, POSITION, PRESCRIBED = indices(INPUT_MODES, *INPUT_MODES)
+VOLTAGE, POSITION, PRESCRIBED = indices(INPUT_MODES, "voltage", "position", "prescribed")
 #: friction modes of a coordinate
 MODE_VALUES = ("free", "slip_forward", "stuck", "slip_backward")
-FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = indices(MODE_VALUES, *MODE_VALUES)
+FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = indices(MODE_VALUES, "free", "slip_forward", "stuck", "slip_backward")
 #: event names by code (what the hooks record)
 EVENTS = ("stick", "breakaway", "slip_reversal", "contact_close", "contact_open", "stop_hit", "stop_leave",
           "cavitation_start", "cavitation_end", "friction_free", "friction_engage")
@@ -107,26 +113,30 @@ N_OTHER = len(OTHER_SWITCHING)
 EQUILIBRIUM_TOL = 1e-10
 #: auxiliary values of the right-hand side, then the friction force of every coordinate
 AUX = ("drive_voltage", "bearing_force", "reference", "bearing_position")
-AUX_VDRIVE, AUX_FB, AUX_REF, AUX_UB = indices(AUX, *AUX)
+AUX_VDRIVE, AUX_FB, AUX_REF, AUX_UB = indices(AUX, "drive_voltage", "bearing_force", "reference", "bearing_position")
 N_AUX = len(AUX)
 
 
 # rows of the packed per-coordinate, per-element and scratch arrays of EClutchParams
 COORD_ROWS = ("mass", "coulomb", "mu_normal", "mu_pressure", "static_ratio", "viscous")  # coord [float]
-CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = indices(COORD_ROWS, *COORD_ROWS)
+CO_MASS, CO_COULOMB, CO_MU_NORMAL, CO_MU_PRESSURE, CO_STATIC_RATIO, CO_VISCOUS = indices(
+    COORD_ROWS, "mass", "coulomb", "mu_normal", "mu_pressure", "static_ratio", "viscous")
 #: coord_int: Coulomb friction on, pressing element, chamber
 COORD_INT_ROWS = ("friction", "normal", "pressure")
-CI_FRICTION, CI_NORMAL, CI_PRESSURE = indices(COORD_INT_ROWS, *COORD_INT_ROWS)
+CI_FRICTION, CI_NORMAL, CI_PRESSURE = indices(COORD_INT_ROWS, "friction", "normal", "pressure")
 NET_ROWS = ("pre_deflection", "input_gain", "stiffness_scale")  # net [float]
-NE_D0, NE_GB, NE_SCALE = indices(NET_ROWS, *NET_ROWS)
+NE_D0, NE_GB, NE_SCALE = indices(NET_ROWS, "pre_deflection", "input_gain", "stiffness_scale")
 #: net_int: curve offsets, kind, extrapolation, contact (unilateral)
 NET_INT_ROWS = ("offsets", "kinds", "extrapolations", "unilateral")
-NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = indices(NET_INT_ROWS, *NET_INT_ROWS)
+NI_OFFSETS, NI_KINDS, NI_EXTRAPS, NI_UNILATERAL = indices(
+    NET_INT_ROWS, "offsets", "kinds", "extrapolations", "unilateral")
 #: work rows; "stiffness": element stiffnesses (rhs, jacobian); "key": the point (t, x, m) of the last rhs
 #: evaluation; "segment": each element curve's segment at the last look-up (a search hint; integers as floats)
 WORK_ROWS = ("force", "free", "coordinate_force", "aux", "derivative", "switching", "state", "stiffness", "key",
              "segment")
-W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = indices(WORK_ROWS, *WORK_ROWS)
+W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = indices(
+    WORK_ROWS, "force", "free", "coordinate_force", "aux", "derivative", "switching", "state", "stiffness", "key",
+    "segment")
 N_WORK = len(WORK_ROWS)
 
 

@@ -165,7 +165,9 @@ N_IMEM = IMEM.total
 AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
        "capacity_locked", "locked_case", "fn2", "engine_torque", "throttle")
 (AUX_FM, AUX_FN1, AUX_T1, AUX_T2, AUX_T3, AUX_TC, AUX_TLOCK, AUX_TTRANS, AUX_CAP, AUX_CASE, AUX_FN2, AUX_TE,
- AUX_THR) = indices(AUX, *AUX)
+ AUX_THR) = indices(
+    AUX, "magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
+    "capacity_locked", "locked_case", "fn2", "engine_torque", "throttle")
 N_AUX = len(AUX)
 #: per-run float memories and scratch (EmtcParams.fmem)
 FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torque_reference", 1), ("feasible", 1),
@@ -186,18 +188,23 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              #                              input and airgap it is for
              ("controller_segment", 8))   # the controller model's rising stretch (hysteresis._kernels.invert_combined)
 (FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
- FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(*FMEM.offset)
+ FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(
+    "plant_input", "controller_input", "command", "torque_reference", "feasible", "z", "t_last", "dw_last",
+    "plant_weights", "controller_weights", "inputs_at_restart", "aux", "split", "derivative", "switching", "key",
+    "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment")
 N_FMEM = FMEM.total
 #: controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_COLUMNS = ("command", "torque_reference", "throttle", "feasible")
-LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = indices(LOG_COLUMNS, *LOG_COLUMNS)
+LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = indices(LOG_COLUMNS, "command", "torque_reference", "throttle", "feasible")
 #: the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
 TABLES = ("plant_tables", "plant_gaps", "controller_tables", "controller_grid", "controller_stack",
           "controller_prefix", "map_throttle", "map_speed", "map_torque", "reference_time", "reference_value",
           "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log")
 (L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
  L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = indices(
-    TABLES, *TABLES)
+    TABLES, "plant_tables", "plant_gaps", "controller_tables", "controller_grid", "controller_stack",
+    "controller_prefix", "map_throttle", "map_speed", "map_torque", "reference_time", "reference_value",
+    "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log")
 N_LAYOUT = len(TABLES)
 
 #: absolute tolerances of the states at rtol 1e-6 and above: omega_f, omega_r [rad/s], theta [rad], x [m],
