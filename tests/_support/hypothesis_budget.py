@@ -3,7 +3,9 @@
 Profiles (chosen by ``HYPOTHESIS_PROFILE``, else ``ci`` when the environment
 variable ``CI`` is set, as ``.ci/run`` does, else ``dev``):
 
-- ``ci``: derandomised, so a CI run is reproducible; each test's own count.
+- ``ci``: derandomised, so a CI run is reproducible; each test's own count.  Its draws
+  do not depend on what the process imported before (:func:`without_local_constants`),
+  so a CI worker draws what a local ``CI=true`` run of the same test draws.
 - ``dev`` (a developer's run): new random examples every run, 3x the count.
 - ``thorough``: 20x the count (and 2,000 for tests that set none).
 
@@ -31,9 +33,30 @@ def examples(n: int) -> int:
     return int(n) * FACTORS.get(profile(), 1)
 
 
+def without_local_constants() -> bool:
+    """Draw no constants from the process's own modules; True if hypothesis has them to switch off.
+
+    Hypothesis (6.1xx) mixes into its draws the literal constants of every local module in ``sys.modules``, and
+    clutchlab imports its packages and compiled entry modules when a test first needs them, so a derandomised
+    property drew other examples depending on what its pytest-xdist worker had run before (measured 2026-12-01:
+    the components' tolerance property drew J0 = 1.556 kg m^2 alone and 1.3 after ``test_invariants.py``, and CI
+    failed on networks a local run never drew).  Done once, before any test draws, so hypothesis's cache of
+    permitted constants never holds a local one.
+    """
+    from hypothesis.internal.conjecture import providers
+
+    if not (hasattr(providers, "_get_local_constants") and hasattr(providers, "Constants")):
+        return False
+    empty = providers.Constants()
+    providers._get_local_constants = lambda: empty
+    return True
+
+
 def load() -> None:
     """Register the profiles and load the active one (called by ``tests/conftest.py``)."""
     settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
     settings.register_profile("thorough", max_examples=2000, deadline=None, print_blob=True)
     settings.register_profile("dev", max_examples=300, deadline=None, print_blob=True)
     settings.load_profile(profile())
+    if profile() == "ci":
+        without_local_constants()

@@ -283,21 +283,8 @@ def test_invariants_hold_on_random_networks_with_components(d):
 # at their limit differ between tolerances (two CI runs and a local one drew three such networks: a lossy gear
 # rolling forward at rtol 1e-11 only, a bearing and a brake sticking in another order), the open rounding-floor
 # family of docs/driveline.md; the invariants property above keeps them.
-@pytest.fixture
-def no_local_constants(monkeypatch):
-    """Draws that do not depend on what the process imported before: hypothesis (6.170) mixes into its draws the
-    literal constants of every local module in ``sys.modules``, and clutchlab imports its packages when a test first
-    needs them, so under pytest-xdist this derandomised property drew other networks in CI than alone (measured
-    2026-12-01: its fifth network had J0 = 1.556 kg m^2 alone and 1.3 after ``test_invariants.py``)."""
-    from hypothesis.internal.conjecture import providers
-
-    empty = providers.Constants()
-    monkeypatch.setattr(providers, "_get_local_constants", lambda: empty)
-
-
-@pytest.mark.usefixtures("no_local_constants")
 @settings(max_examples=examples(10), deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+          suppress_health_check=[HealthCheck.too_slow])
 @given(networks(with_components=True, settled_only=True))
 def test_the_result_follows_the_tolerance_on_random_networks_with_components(d):
     """Random networks with wet clutches and EMTC couplings among their links, their ports driven by ramps, sines,
