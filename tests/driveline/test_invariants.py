@@ -889,7 +889,7 @@ def test_the_result_follows_the_tolerance_on_random_networks(d):
 
 def same_at_two_tolerances(d, t_end, rtols=(1e-7, 1e-10)):
     """``d`` run to ``t_end`` at the two ``rtols`` (1e-7 and 1e-10): the same mode events, the speeds within 1e-4
-    of their range."""
+    of their range.  A touch one run has and the other has not (:func:`_grazing_touches`) is not a difference."""
     kw = dict(output_step=2e-3)
     lo = d.simulate(t_end, rtol=rtols[0], **kw)
     hi = d.simulate(t_end, rtol=rtols[1], **kw)
@@ -898,7 +898,56 @@ def same_at_two_tolerances(d, t_end, rtols=(1e-7, 1e-10)):
         if col.endswith(".w_rad_s"):
             span = max(1.0, np.ptp(b[col]))
             assert np.max(np.abs(a[col] - b[col])) <= 1e-4 * span, col
-    assert [e[1:] for e in _mode_events(lo)] == [e[1:] for e in _mode_events(hi)]
+    ev_lo, ev_hi = _mode_events(lo), _mode_events(hi)
+    if [e[1:] for e in ev_lo] != [e[1:] for e in ev_hi]:
+        drop_lo = _grazing_touches(ev_lo, ev_hi, d, t_end, rtols[1], b)
+        drop_hi = _grazing_touches(ev_hi, ev_lo, d, t_end, rtols[0], a)
+        ev_lo = [e for k, e in enumerate(ev_lo) if k not in drop_lo]
+        ev_hi = [e for k, e in enumerate(ev_hi) if k not in drop_hi]
+    assert [e[1:] for e in ev_lo] == [e[1:] for e in ev_hi]
+
+
+#: a touch is a grazing if the other run's relative speed stays this close to zero (times max(1, its range)): ten
+#: times tighter than the speeds' agreement above
+TOUCH_RESOLUTION = 1e-5
+
+
+def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
+    """Positions in ``ev`` of the touches the other run does not have, where it came within its error of one.
+
+    A touch is an element that sticks at t1 and leaves at t2 to the mode it had before (a one-way clutch whose
+    driven side reaches its free side's speed at the top of its own motion, and overruns again).  Where the two
+    speeds meet tangentially (an exact tie: a speed's maximum equal to a free inertia's speed, drawn by symmetry),
+    whether they meet at all is decided by the integration error, and either run is right within its tolerance.  It
+    is a grazing only if the other run has no stick of that element within the touch and its relative speed, at t1,
+    the midpoint and t2 (a run sampled there), stays within ``TOUCH_RESOLUTION`` of its range of zero; any other
+    difference stays one.  (The twenty-fourth session's thorough draws: a one-way clutch whose driven inertia's
+    speed peaks at exactly the free inertia's speed at t = 0.375 s stuck for 28 us at rtol 1e-7 and 1e-8, where its
+    speed was 4.4e-9 rad/s above the exact peak, and not at 1e-9 or tighter.)"""
+    drop, last = set(), {}
+    for k, (t, el, event) in enumerate(ev):
+        before = last.get(el)
+        last[el] = (k, t, event)
+        if before is None or event == "stick":
+            continue
+        k_stick, t1, was = before
+        if was != "stick":
+            continue
+        # the mode before the stick
+        prior = [e for e in ev[:k_stick] if e[1] == el]
+        if not prior or prior[-1][2] != event:
+            continue
+        if any(o[1] == el and o[2] == "stick" and t1 - 1e-3 <= o[0] <= t + 1e-3 for o in other):
+            continue
+        column = f"{el}.w_rel_rad_s"
+        if column not in frame_other.columns:
+            continue
+        times = np.array([t1, 0.5 * (t1 + t), t])
+        sampled = d.simulate(t_end, rtol=rtol_other, sample_times=times).to_dataframe()
+        span = max(1.0, np.ptp(frame_other[column]))
+        if np.max(np.abs(sampled[column].to_numpy())) <= TOUCH_RESOLUTION * span:
+            drop |= {k_stick, k}
+    return drop
 
 
 def test_the_debug_check_from_the_command_line(tmp_path):
