@@ -119,3 +119,20 @@ def test_the_check_sees_a_hand_written_index(tmp_path):
     f.write_text("A, B = range(2)\nC = 3\nD = (0, 1)\nE = A + 6\nF = -1\nG = len(())\nH = 1e-6\nI = X.of('a')\n"
                  "J, K = indices(Q, *Q)\nL, M = X.of(*X.offset)\nN, O = indices(Q, 'n', 'o')\n")
     assert [s.split()[1] for s in _hand_written(f, tmp_path)] == ["A", "B", "C", "D", "E", "F", "J", "K", "L", "M"]
+
+
+def test_the_eclutch_outputs_are_its_declaration():
+    """The E-clutch's outputs hook writes each output at its declared position: the named head (:data:`OUTPUTS`),
+    the input of the input mode, then the elements' forces (the names the system publishes, in that order)."""
+    from clutchlab import system as contract
+    from clutchlab.eclutch import system as E
+
+    assert set(E.INPUT_OUTPUTS) == set(E.INPUT_MODES)
+    assert (E.Y_INPUT, E.Y_ELEMENTS) == (len(E.OUTPUTS), len(E.OUTPUTS) + 1)
+    system = contract.MODELS["eclutch"]()
+    for name, *_ in E.OUTPUTS:
+        assert system.output_index(name) == E.indices(E.OUTPUTS, name)
+    _dx, _g, y = contract.evaluate(system)
+    assert y[E.Y_BEARING_FORCE_CLUTCH] == y[system.output_index("bearing_force_clutch")]
+    names = [v.name for v in system.outputs]
+    assert names[E.Y_INPUT] in [spec[0] for spec in E.INPUT_OUTPUTS.values()]

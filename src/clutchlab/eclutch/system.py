@@ -51,7 +51,7 @@ from ..errors import ParameterError
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
-from ..numerics.layout import indices
+from ..numerics.layout import indices, slots
 from ..system import System, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
                        controller_voltage, current_rate, drive_voltage, drive_voltage_slopes, line_flow_rate,
@@ -89,6 +89,22 @@ N_PAR = len(ACTUATOR_VECTOR)
 #: input modes: motor voltage (held between table rows), bearing reference (position control), prescribed bearing
 INPUT_MODES = ("voltage", "position", "prescribed")
 VOLTAGE, POSITION, PRESCRIBED = indices(INPUT_MODES, "voltage", "position", "prescribed")
+#: the outputs of every assembly, in order: these, then the input of its input mode (:data:`INPUT_OUTPUTS`), the
+#: force of each network element, the friction force of each friction output (:meth:`Assembly.output_variables`)
+OUTPUTS = (("motor_voltage", "V", "voltage the drive applies (after saturation and current limit)"),
+           ("bearing_force", "N", "bearing force from the CSC pressure, p A_sl"),
+           ("bearing_force_clutch", "N", "force the clutch exerts on the release bearing"),
+           ("normal_force", "N", "clamp force on the friction plate F_n"),
+           ("torque", "Nm", "transmissible clutch torque 2 F_n r_eff mu"),
+           ("motor_speed", "rpm", "motor speed"))
+Y_VOLTAGE, Y_BEARING_FORCE, Y_BEARING_FORCE_CLUTCH, Y_NORMAL_FORCE, Y_TORQUE, Y_MOTOR_SPEED = indices(
+    OUTPUTS, "motor_voltage", "bearing_force", "bearing_force_clutch", "normal_force", "torque", "motor_speed")
+#: the output after :data:`OUTPUTS`: the input, by input mode (:data:`INPUT_MODES`)
+INPUT_OUTPUTS = {"voltage": ("voltage_command", "V", "motor voltage commanded (input)"),
+                 "position": ("reference", "m", "bearing position reference (input)"),
+                 "prescribed": ("prescribed_position", "m", "prescribed bearing position (input)")}
+#: the input's output and the first element force
+Y_INPUT, Y_ELEMENTS = slots(("named", len(OUTPUTS)), ("input", 1), ("elements", 0)).of("input", "elements")
 #: friction modes of a coordinate
 MODE_VALUES = ("free", "slip_forward", "stuck", "slip_backward")
 FREE, SLIP_FORWARD, STUCK, SLIP_BACKWARD = indices(MODE_VALUES, "free", "slip_forward", "stuck", "slip_backward")
@@ -507,18 +523,18 @@ def outputs(t, x, u, m, p, y):
     f = work[W_F]
     n_el = p.GA.shape[0]
     fn = f[p.normal_element]
-    y[0] = aux[AUX_VDRIVE]
-    y[1] = xs[2 * nz + 2] * p.par[P_ASL]  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
-    y[2] = aux[AUX_FB]
-    y[3] = fn
-    y[4] = torque_of_clamp_force(fn, p.r_eff, p.mu)
-    y[5] = xs[nz] / p.par[P_NS] * 60.0 / (2.0 * math.pi)
-    y[6] = aux[AUX_REF]
+    y[Y_VOLTAGE] = aux[AUX_VDRIVE]
+    y[Y_BEARING_FORCE] = xs[2 * nz + 2] * p.par[P_ASL]  # F_b = p A_sl, as the rig measures it ([1] Sec. 6)
+    y[Y_BEARING_FORCE_CLUTCH] = aux[AUX_FB]
+    y[Y_NORMAL_FORCE] = fn
+    y[Y_TORQUE] = torque_of_clamp_force(fn, p.r_eff, p.mu)
+    y[Y_MOTOR_SPEED] = xs[nz] / p.par[P_NS] * 60.0 / (2.0 * math.pi)
+    y[Y_INPUT] = aux[AUX_REF]
     for e in range(n_el):
-        y[7 + e] = f[e]
+        y[Y_ELEMENTS + e] = f[e]
     fo = p.friction_outputs
     for k in range(fo.shape[0]):
-        y[7 + n_el + k] = aux[N_AUX + fo[k]]
+        y[Y_ELEMENTS + n_el + k] = aux[N_AUX + fo[k]]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -1224,16 +1240,7 @@ class Assembly:
         return self._names[key]
 
     def _output_spec(self, imode: int) -> tuple:
-        ref = {VOLTAGE: ("voltage_command", "V", "motor voltage commanded (input)"),
-               POSITION: ("reference", "m", "bearing position reference (input)"),
-               PRESCRIBED: ("prescribed_position", "m", "prescribed bearing position (input)")}[imode]
-        out = [("motor_voltage", "V", "voltage the drive applies (after saturation and current limit)"),
-               ("bearing_force", "N", "bearing force from the CSC pressure, p A_sl"),
-               ("bearing_force_clutch", "N", "force the clutch exerts on the release bearing"),
-               ("normal_force", "N", "clamp force on the friction plate F_n"),
-               ("torque", "Nm", "transmissible clutch torque 2 F_n r_eff mu"),
-               ("motor_speed", "rpm", "motor speed"),
-               ref]
+        out = list(OUTPUTS) + [INPUT_OUTPUTS[INPUT_MODES[imode]]]
         out += [(f"force_{e}", "N", f"force of network element {e}") for e in self.element_names]
         out += [(f"friction_{self.coord_names[j]}", "N", f"friction force on {self.coord_names[j]}")
                 for j in self.friction_outputs]
