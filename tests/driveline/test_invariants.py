@@ -915,38 +915,58 @@ TOUCH_RESOLUTION = 1e-5
 def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
     """Positions in ``ev`` of the touches the other run does not have, where it came within its error of one.
 
-    A touch is an element that sticks at t1 and leaves at t2 to the mode it had before (a one-way clutch whose
-    driven side reaches its free side's speed at the top of its own motion, and overruns again).  Where the two
-    speeds meet tangentially (an exact tie: a speed's maximum equal to a free inertia's speed, drawn by symmetry),
-    whether they meet at all is decided by the integration error, and either run is right within its tolerance.  It
-    is a grazing only if the other run has no stick of that element within the touch and its relative speed, at t1,
+    A touch is an element that leaves its state and comes back at once: a friction element that sticks at t1 and
+    leaves at t2 to the mode it had before (a one-way clutch whose driven side reaches its free side's speed at
+    the top of its own motion, and overruns again), or a backlash that closes and opens its gap again (or opens
+    and closes it).  Where the two sides meet tangentially (an exact tie: a speed's maximum equal to a free
+    inertia's speed, drawn by symmetry; a twist whose extreme is the gap's edge), whether they meet at all is
+    decided by the integration error, and either run is right within its tolerance.  It is a grazing only if the
+    other run has no such event of that element within the touch and its grazing quantity (a friction element's
+    relative speed; a backlash closing from its gap: its twist past the gap's edge, ``|phi_b - phi_a - phi_rel0| -
+    b_gap / 2``; a backlash released from its contact: its torque, which the contact must not pull), at t1,
     the midpoint and t2 (a run sampled there), stays within ``TOUCH_RESOLUTION`` of its range of zero; any other
     difference stays one.  (The twenty-fourth session's thorough draws: a one-way clutch whose driven inertia's
     speed peaks at exactly the free inertia's speed at t = 0.375 s stuck for 28 us at rtol 1e-7 and 1e-8, where its
-    speed was 4.4e-9 rad/s above the exact peak, and not at 1e-9 or tighter.)"""
+    speed was 4.4e-9 rad/s above the exact peak, and not at 1e-9 or tighter; a backlash whose contact torque dips
+    to -1.8e-4 N m (its range 73 N m) and back was released for 275 us at rtol 1e-11 and not at 1e-8.)"""
+    lash = {e.name: e for e in d._elements if e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH}
     drop, last = set(), {}
     for k, (t, el, event) in enumerate(ev):
         before = last.get(el)
         last[el] = (k, t, event)
-        if before is None or event == "stick":
+        if before is None:
             continue
-        k_stick, t1, was = before
-        if was != "stick":
+        k_first, t1, first = before
+        if el in lash:
+            if {first, event} != {"contact", "separate"}:
+                continue
+        else:
+            if first != "stick" or event == "stick":
+                continue
+            prior = [e for e in ev[:k_first] if e[1] == el]     # the mode before the stick
+            if not prior or prior[-1][2] != event:
+                continue
+        if any(o[1] == el and o[2] == first and t1 - 1e-3 <= o[0] <= t + 1e-3 for o in other):
             continue
-        # the mode before the stick
-        prior = [e for e in ev[:k_stick] if e[1] == el]
-        if not prior or prior[-1][2] != event:
-            continue
-        if any(o[1] == el and o[2] == "stick" and t1 - 1e-3 <= o[0] <= t + 1e-3 for o in other):
-            continue
-        column = f"{el}.w_rel_rad_s"
-        if column not in frame_other.columns:
-            continue
-        times = np.array([t1, 0.5 * (t1 + t), t])
-        sampled = d.simulate(t_end, rtol=rtol_other, sample_times=times).to_dataframe()
-        span = max(1.0, np.ptp(frame_other[column]))
-        if np.max(np.abs(sampled[column].to_numpy())) <= TOUCH_RESOLUTION * span:
-            drop |= {k_stick, k}
+        sampled = d.simulate(t_end, rtol=rtol_other, sample_times=np.array([t1, 0.5 * (t1 + t), t])).to_dataframe()
+        if el in lash and first == "contact":      # in its gap, the twist grazes the edge
+            e = lash[el]
+
+            def twist(frame, e=e):
+                phi = [frame[f"{q}.phi_rad"].to_numpy() if q is not None else 0.0 for q in (e.a, e.b)]
+                return np.abs(phi[1] - phi[0] - e.coef[K.C_PHI0]) - 0.5 * e.coef[K.C_GAP]
+
+            near, span = twist(sampled), max(1.0, np.ptp(twist(frame_other)))
+        elif el in lash:     # in contact, its torque grazes zero (the contact would pull: released)
+            column = f"{el}.tau_Nm"
+            near, span = sampled[column].to_numpy(), max(1.0, np.ptp(frame_other[column]))
+        else:
+            column = f"{el}.w_rel_rad_s"
+            if column not in frame_other.columns:
+                continue
+            near, span = sampled[column].to_numpy(), max(1.0, np.ptp(frame_other[column]))
+        if np.max(np.abs(near)) <= TOUCH_RESOLUTION * span:
+            drop |= {k_first, k}
     return drop
 
 
