@@ -910,6 +910,8 @@ def same_at_two_tolerances(d, t_end, rtols=(1e-7, 1e-10)):
 #: a touch is a grazing if the other run's relative speed stays this close to zero (times max(1, its range)): ten
 #: times tighter than the speeds' agreement above
 TOUCH_RESOLUTION = 1e-5
+#: and lasts no longer than this [s] (the ones found: 15 us to 275 us), so three samples of the other run see it
+TOUCH_DURATION = 1e-3
 
 
 def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
@@ -924,8 +926,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
     other run has no such event of that element within the touch and its grazing quantity (a friction element's
     relative speed; a backlash closing from its gap: its twist past the gap's edge, ``|phi_b - phi_a - phi_rel0| -
     b_gap / 2``; a backlash released from its contact: its torque, which the contact must not pull), at t1,
-    the midpoint and t2 (a run sampled there), stays within ``TOUCH_RESOLUTION`` of its range of zero; any other
-    difference stays one.  (The twenty-fourth session's thorough draws: a one-way clutch whose driven inertia's
+    the midpoint and t2 (a run sampled there), stays within ``TOUCH_RESOLUTION`` of its range of zero, and the
+    touch lasts at most ``TOUCH_DURATION``; any other difference stays one.  (The twenty-fourth session's thorough draws: a one-way clutch whose driven inertia's
     speed peaks at exactly the free inertia's speed at t = 0.375 s stuck for 28 us at rtol 1e-7 and 1e-8, where its
     speed was 4.4e-9 rad/s above the exact peak, and not at 1e-9 or tighter; a backlash whose contact torque dips
     to -1.8e-4 N m (its range 73 N m) and back was released for 275 us at rtol 1e-11 and not at 1e-8.)"""
@@ -937,6 +939,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
         if before is None:
             continue
         k_first, t1, first = before
+        if t - t1 > TOUCH_DURATION:
+            continue
         if el in lash:
             if {first, event} != {"contact", "separate"}:
                 continue
