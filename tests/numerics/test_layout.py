@@ -14,9 +14,11 @@ from clutchlab.numerics.layout import indices, slots
 
 ROOT = Path(clutchlab.__file__).parent
 
-#: the modules whose layouts are generated: the three models, the driveline's kernel and its blocks
+#: the modules whose layouts are generated: the three models, the driveline's kernel and its blocks, the core's
+#: solver state, the session's report kinds, the sampled controllers' and the wet friction laws' kinds
 GENERATED = ("wet/system.py", "emtc/system.py", "eclutch/system.py", "driveline/kernel.py", "driveline/wet.py",
-             "driveline/emtc.py", "driveline/block.py")
+             "driveline/emtc.py", "driveline/block.py", "numerics/core.py", "numerics/session.py",
+             "numerics/sampled.py", "wet/friction.py")
 #: integers in them that are numbers, not positions (name: why)
 NOT_INDICES = {
     "ERR_PLANT_MEMORY": "a model error code (negative: the hooks' convention)",
@@ -24,6 +26,10 @@ NOT_INDICES = {
     "ERROR_STRIDE": "the spacing of the couplings' error codes",
     "INV_BASE": "the base of the driveline's invariant error codes",
     "SPACE_SLOTS": "a capacity: the stuck-set repair's warm starts kept",
+    "TERMINAL": "a code a model's update returns (0 is go on, negative an error)",
+    "RESTART": "a code a model's update returns",
+    "ADVANCE": "a bit of a session call's request",
+    "OUTPUTS": "a bit of a session call's request",
 }
 
 
@@ -57,6 +63,8 @@ def test_slots_are_consecutive_and_sum_to_the_total():
     ("clutchlab.eclutch.system", "EVENTS", "EV_"), ("clutchlab.eclutch.system", "WORK_ROWS", "W_"),
     ("clutchlab.driveline.kernel", "EVENTS", "EV_"), ("clutchlab.driveline.kernel", "ELEM_COLUMNS", "E_"),
     ("clutchlab.driveline.kernel", "SIGNAL_KINDS", "SIG_"), ("clutchlab.driveline.kernel", "ELEMENT_KINDS", "K_"),
+    ("clutchlab.numerics.core", "SOLVER_FLOATS", "SF_"), ("clutchlab.numerics.core", "SOLVER_INTS", "SI_"),
+    ("clutchlab.numerics.session", "REPORT_KINDS", "REPORT_"), ("clutchlab.wet.friction", "FRICTION_KINDS", "KIND_"),
 ])
 def test_each_declared_entry_has_exactly_one_constant(module, declaration, prefix):
     """The constants of a declaration are a permutation of its positions (none missing, none twice)."""

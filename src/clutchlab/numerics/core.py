@@ -66,6 +66,7 @@ from numba.extending import register_jitable
 
 from . import dispatch as model
 from .borrow import borrow, byref
+from .layout import indices
 from .dopri import (
     A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65,
     B1, B3, B4, B5, B6, C2, C3, C4, C5, E1, E3, E4, E5, E6, E7,
@@ -83,10 +84,18 @@ __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "adva
            "SI_STARTED", "SI_MODEL_CODE", "N_SF", "N_SI", "TERMINAL", "RESTART"]
 
 # ---- solver state (resumable): float and int vectors
-SF_T, SF_H, SF_T0 = 0, 1, 2  # time, step size, start of the run (origin of a fixed-step grid)
-N_SF = 3
-SI_ACCEPTED, SI_REJECTED, SI_NRHS, SI_NJAC, SI_STATUS, SI_IREC, SI_STARTED, SI_MODEL_CODE = range(8)
-N_SI = 8
+#: its floats: time, step size, start of the run (origin of a fixed-step grid)
+SOLVER_FLOATS = ("time", "step", "start")
+SF_T, SF_H, SF_T0 = indices(SOLVER_FLOATS, "time", "step", "start")
+N_SF = len(SOLVER_FLOATS)
+#: its integers: steps accepted and rejected, right-hand sides and Jacobians evaluated, the status, the next row of
+#: the record, whether the run has started, the model's error code
+SOLVER_INTS = ("accepted", "rejected", "rhs_evaluations", "jacobians", "status", "record_row", "started",
+               "model_code")
+SI_ACCEPTED, SI_REJECTED, SI_NRHS, SI_NJAC, SI_STATUS, SI_IREC, SI_STARTED, SI_MODEL_CODE = indices(
+    SOLVER_INTS, "accepted", "rejected", "rhs_evaluations", "jacobians", "status", "record_row", "started",
+    "model_code")
+N_SI = len(SOLVER_INTS)
 #: what a model's ``update`` returns besides 0 (go on) and negative error codes: end the run (1), or go on with
 #: the step size started afresh from a short step (2; Dormand-Prince only, see :func:`advance_dopri`)
 TERMINAL, RESTART = 1, 2

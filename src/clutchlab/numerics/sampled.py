@@ -32,13 +32,14 @@ from numba import types
 from numba.extending import intrinsic, register_jitable
 
 from . import core as _core
+from .layout import indices
 
 __all__ = ["LTI", "SCHEDULED_PI", "FUNCTION", "SIGNATURE", "measure", "lti_update", "scheduled_pi_update", "hold",
            "function_pointer", "placeholder"]
 
-LTI = 0
-SCHEDULED_PI = 1
-FUNCTION = 2
+#: kinds of sampled controller
+CONTROLLER_KINDS = ("lti", "scheduled_pi", "function")
+LTI, SCHEDULED_PI, FUNCTION = indices(CONTROLLER_KINDS, "lti", "scheduled_pi", "function")
 
 #: C signature of a function controller's entry: ``status = f(t, y address, len(y), memory address,
 #: len(memory), u address, len(u))``; status 0, or 1 if the function returned another number of values.

@@ -31,6 +31,7 @@ from numba.core import cgutils, types
 from numba.extending import NativeValue, intrinsic, models, register_jitable, register_model, typeof_impl, unbox
 
 from .borrow import _strip
+from .layout import indices
 from .status import SUCCESS, TERMINATED
 
 __all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "table_layout",
@@ -42,10 +43,8 @@ ADVANCE = 1
 OUTPUTS = 2
 
 #: kinds of reported values (``report[k, 0]``; ``report[k, 1]`` is the index, ``report[k, 2]`` the value compared)
-REPORT_OUTPUT = 0
-REPORT_STATE = 1
-REPORT_MODE = 2
-REPORT_MODE_IS = 3
+REPORT_KINDS = ("output", "state", "mode", "mode_is")
+REPORT_OUTPUT, REPORT_STATE, REPORT_MODE, REPORT_MODE_IS = indices(REPORT_KINDS, "output", "state", "mode", "mode_is")
 
 #: members of the packed arguments (a tuple, in this order)
 FIELDS = ("p", "x", "m", "u", "sf", "si", "opt", "log", "ts", "rt", "rx", "rm", "ry", "want_y", "y", "report", "r")

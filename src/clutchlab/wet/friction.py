@@ -34,11 +34,13 @@ from ..errors import DataError
 from ..params.base import FRICTION_COEFFICIENT_MAX
 from ..numerics.interp import bracket
 from ..params import ParameterSet, quantity
+from ..numerics.layout import indices
 
 __all__ = ["ParametricFriction", "FrictionMap", "KIND_PARAMETRIC", "KIND_TABLE", "mu_kernel"]
 
-KIND_PARAMETRIC = 0
-KIND_TABLE = 1
+#: kinds of friction law
+FRICTION_KINDS = ("parametric", "table")
+KIND_PARAMETRIC, KIND_TABLE = indices(FRICTION_KINDS, "parametric", "table")
 
 
 @dataclasses.dataclass(frozen=True)
