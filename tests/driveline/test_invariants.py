@@ -952,6 +952,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
                 continue
         if any(o[1] == el and o[2] == first and t1 - 1e-3 <= o[0] <= t + 1e-3 for o in other):
             continue
+        if el not in lash and f"{el}.w_rel_rad_s" not in frame_other.columns:
+            continue
         sampled = d.simulate(t_end, rtol=rtol_other, sample_times=np.array([t1, 0.5 * (t1 + t), t])).to_dataframe()
         if el in lash and first == "contact":      # in its gap, the twist grazes the edge
             e = lash[el]
@@ -966,8 +968,6 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
             near, span = sampled[column].to_numpy(), max(1.0, np.ptp(frame_other[column]))
         else:
             column = f"{el}.w_rel_rad_s"
-            if column not in frame_other.columns:
-                continue
             near, span = sampled[column].to_numpy(), max(1.0, np.ptp(frame_other[column]))
         if np.max(np.abs(near)) <= TOUCH_RESOLUTION * span:
             drop |= {k_first, k}
