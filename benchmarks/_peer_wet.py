@@ -59,7 +59,9 @@ LSODA_SIG = types.void(types.double, types.CPointer(types.double), types.CPointe
                        types.CPointer(types.double))
 
 N = W.N_STATE
-NG = W.N_SWITCH
+#: the switching functions the peer watches: clutchlab's first five (not the piston's ``piston_runs`` and
+#: ``piston_turns``, which change no equation: clutchlab ends a step at the turn for its error control)
+NG = W.G_RUNS
 SLIP, STICK, SLIP_NEG = W.SLIP, W.STICK, W.SLIP_NEG
 FREE, AT_STOP = W.FREE, W.AT_STOP
 G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES = (W.G_LOCKUP, W.G_BREAKAWAY, W.G_CONTACT, W.G_LEAVES,

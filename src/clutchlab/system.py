@@ -1530,6 +1530,11 @@ def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):
     x = system.x0.copy() if x is None else np.ascontiguousarray(x, dtype=float)
     u = system.u0.copy() if u is None else np.ascontiguousarray(u, dtype=float)
     m = system.m0.copy() if m is None else np.ascontiguousarray(m, dtype=np.int64)
+    # the compiled hooks read the declared positions without bounds checks: a short array is refused here
+    for field, a, want in (("x", x, system.x0.shape), ("u", u, system.u0.shape), ("m", m, system.m0.shape)):
+        if a.shape != want:
+            raise ValueError(f"evaluate: {field} of system {system.name!r} has shape {a.shape}, its declaration "
+                             f"{want}")
     dx = np.empty(len(system.states))
     g = np.empty(len(system.switching))
     y = np.empty(len(system.outputs))

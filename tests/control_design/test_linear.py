@@ -234,7 +234,7 @@ def test_wet_clutch_small_signal_step_matches_the_nonlinear_model(slip, torque, 
     s, temps = _wet_slipping(slip)
     op = operating_point(s, states=temps, targets={"clutch_torque": torque}, free_inputs=["force_reference"],
                          inputs={"force_reference": 1500.0}, t=0.5, settle=2.0)
-    assert op.modes == {"friction": "slip_positive", "piston": "free", "film": "contact"}
+    assert op.modes == {"friction": "slip_positive", "piston": "free", "film": "contact", "piston_run": "settling"}
     assert op.value("clutch_torque") == pytest.approx(torque, rel=1e-8)
     assert op.value("slip_speed") == pytest.approx(slip, rel=1e-8)  # the drive holds the speed
     G = linearize(op, inputs=["force_reference"], outputs=["clutch_torque"])

@@ -498,6 +498,16 @@ def test_evaluate_through_the_contract():
     assert np.allclose(dx, [-1.0, -9.81]) and np.allclose(g, [0.5]) and np.allclose(y, [0.5, -1.0])
 
 
+@pytest.mark.parametrize("field", ["x", "m"])
+def test_evaluate_refuses_arrays_shorter_than_the_declaration(field):
+    """The compiled hooks read declared positions unchecked: a state or mode array of the wrong length (a
+    caller written before a model declared one more mode) is refused by name, not read past its end."""
+    system = toys.ball_system()
+    short = {"x": dict(x=[0.5]), "m": dict(m=np.zeros(system.m0.size + 1, dtype=np.int64))}[field]
+    with pytest.raises(ValueError, match=rf"evaluate: {field} of system 'ball' has shape"):
+        evaluate(system, 0.0, **short)
+
+
 def test_nan_error_norm_rejects_the_step():
     """x' = -sqrt(x) style blow-up: a NaN trial step is rejected and the run still ends correctly."""
     # x' = -50 x on [0, 1] started with a huge first step: the trial overflows to inf/NaN and must be rejected

@@ -209,7 +209,7 @@ def test_model_is_registered_and_describes_itself():
     assert isinstance(system, System) and system.name == "wet" and isinstance(system.params, W.WetParams)
     assert system.state_columns[:3] == ("piston_position_m", "actuator_force_N", "slip_speed_rad_s")
     assert [name for name, _ in system.switching] == ["lockup", "breakaway", "contact", "piston_leaves_stop",
-                                                      "piston_reaches_stop"]
+                                                      "piston_reaches_stop", "piston_runs", "piston_turns"]
     assert set(system.events) == {"contact", "separation", "lockup", "breakaway", "slip_reversal",
                                   "piston_reaches_stop", "piston_leaves_stop"}
     assert set(W.CONSTANTS_DTYPE.names) == {name for name, _, _ in W.CONSTANTS}
@@ -300,7 +300,7 @@ def test_initial_modes_of_one_run_are_those_of_a_batch_row(w, xp):
     x0[W.S_X] = xp
     one = W.initial_modes(x0, CLUTCH.piston_h0)
     rows = W.initial_modes(np.vstack([x0, x0]), CLUTCH.piston_h0)
-    assert one.dtype == np.int64 and one.shape == (3,)
+    assert one.dtype == np.int64 and one.shape == (len(W.MODE_NAMES),)
     np.testing.assert_array_equal(one, rows[0])
     assert one[W.M_FRICTION] == (W.SLIP if w > 0 else W.SLIP_NEG if w < 0 else W.STICK)
 

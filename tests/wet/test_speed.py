@@ -73,7 +73,7 @@ def test_friction_law_is_smooth_through_zero_slip_within_a_slip_mode(speed_syste
     scen, sysm = speed_system
     x = sysm.x0.copy()
     x[W.S_X] = CLUTCH.piston_h0 + 2e-4    # pressed: contact force and capacity
-    m = np.array([mode, W.FREE, W.CONTACT], dtype=np.int64)
+    m = np.array([mode, W.FREE, W.CONTACT, W.SETTLING], dtype=np.int64)
     eps = 1e-3
     wdot = [evaluate(sysm, 0.5, np.where(np.arange(x.size) == W.S_W, s * eps, x), m=m)[0][W.S_W] for s in (-1, 0, 1)]
     first = abs(wdot[2] - wdot[0]) / 2
@@ -120,7 +120,7 @@ def test_outputs_hook_gives_what_the_right_hand_side_leaves_in_its_scratch(speed
         x[W.S_FA] = rng.uniform(0.0, 5000.0)
         x[W.S_W] = rng.uniform(-150.0, 150.0)
         x[W.S_T] = rng.uniform(30.0, 120.0)
-        m = np.array([rng.integers(0, 3), rng.integers(0, 2), rng.integers(0, 2)], dtype=np.int64)
+        m = np.array([rng.integers(0, len(v)) for v in W.MODE_VALUES], dtype=np.int64)
         t = float(rng.uniform(0.0, 1.0))
         dx, g, y = evaluate(sysm, t, x, m=m)      # rhs first (scratch), then the outputs hook
         assert np.array_equal(y, sysm.params.data[W.W_OUT:W.W_OUT + W.N_OUT])

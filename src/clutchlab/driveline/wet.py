@@ -17,7 +17,8 @@ The network's friction state machine decides stick and slip (the wet model's own
 switching functions are held off: they watch the bench's shaft, which is now a body of the network); the
 network's mode is passed to the wet model, so its friction heat ``tau * w`` is zero while stuck.  The wet
 model's piston and film switching functions and events (``contact``, ``separation``, ``piston_reaches_stop``,
-``piston_leaves_stop``) are kept, named for the element (``<name>`` and ``<name>.piston``).
+``piston_leaves_stop``) are kept, named for the element (``<name>`` and ``<name>.piston``), and so are its
+``piston_runs`` / ``piston_turns`` functions (the turn of a running piston ends a step; no event).
 
 States: the network's, then per clutch the wet model's twelve (its ``slip_speed`` follows the element's
 relative speed, integrated from the relative acceleration and reset to it at every event; its drive states
@@ -199,7 +200,7 @@ def sync(x, m, net, w):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def call(t, x, m, w, j, k, log):
     """Clutch ``j``'s model hook on its own states and modes (``k >= 0``: its update for switching function
-    ``k``; ``k < 0``: its restart), its events renamed; the states and the piston and film modes written back."""
+    ``k``; ``k < 0``: its restart), its events renamed; the states and the piston, film and piston-run modes written back."""
     cf = w.conf[j]
     b = w.buf[j]
     xs = b[B_X:B_X + N_STATE]
@@ -214,8 +215,9 @@ def call(t, x, m, w, j, k, log):
     for i in range(N_STATE):
         if i != W.S_W:
             x[cf[F_X] + i] = xs[i]
-    m[cf[F_M] + W.M_PISTON] = ms[W.M_PISTON]
-    m[cf[F_M] + W.M_FILM] = ms[W.M_FILM]
+    for i in range(N_MODE):  # the piston, film and piston-run modes (the friction mode is the network's)
+        if i != W.M_FRICTION:
+            m[cf[F_M] + i] = ms[i]
     return res
 
 

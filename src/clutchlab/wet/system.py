@@ -41,6 +41,17 @@ output, so nothing in the right-hand side has a kink inside a step):
   the right-hand side, an unlocated kink.)
 * ``film``: ``open`` / ``contact`` -- the nominal separation ``h`` (Eq. 1)
   crosses zero (Fig. 3 (b) -> (c)): ``contact`` / ``separation``.
+* ``piston_run``: ``settling`` / ``engaging`` / ``releasing`` -- whether a
+  turn of the free piston is watched, and from which direction (no event is
+  recorded for it).  The piston leaving its stop is ``engaging``;
+  ``piston_runs``: ``|F_net|`` rises through ``PISTON_RUNNING c v_max``
+  (76 % of the speed limit) while settling; ``piston_turns``: the net
+  force of an engaging piston falls through zero, of a releasing one rises
+  (the tanh of :func:`piston_speed` turns from one speed limit to the other
+  within microseconds where the open film resists little; the step size
+  starts afresh there, and the piston is ``settling``).  The hysteresis
+  between the two keeps a piston settling on an equilibrium, its net force
+  hovering at zero, from triggering a turn again and again.
 
 The corners of the force and slip-speed reference profiles are break times
 (``next_break``): steps end on them exactly.
@@ -155,18 +166,25 @@ INPUTS = (
 U_FORCE, U_SPEED = indices(INPUTS, "force_reference", "slip_speed_reference")
 
 #: modes: friction, piston, film
-MODE_NAMES = ("friction", "piston", "film")
-MODE_VALUES = (("slip_positive", "stick", "slip_negative"), ("free", "at_stop"), ("open", "contact"))
-M_FRICTION, M_PISTON, M_FILM = indices(MODE_NAMES, "friction", "piston", "film")
+#: modes: friction, piston, film, and whether a turn of the free piston is watched (and from which direction)
+MODE_NAMES = ("friction", "piston", "film", "piston_run")
+MODE_VALUES = (("slip_positive", "stick", "slip_negative"), ("free", "at_stop"), ("open", "contact"),
+               ("settling", "engaging", "releasing"))
+M_FRICTION, M_PISTON, M_FILM, M_RUN = indices(MODE_NAMES, "friction", "piston", "film", "piston_run")
 SLIP, STICK, SLIP_NEG = indices(MODE_VALUES[M_FRICTION], "slip_positive", "stick", "slip_negative")
 FREE, AT_STOP = indices(MODE_VALUES[M_PISTON], "free", "at_stop")
 OPEN, CONTACT = indices(MODE_VALUES[M_FILM], "open", "contact")
+SETTLING, ENGAGING, RELEASING = indices(MODE_VALUES[M_RUN], "settling", "engaging", "releasing")
+#: the piston runs (``piston_run`` engaging or releasing) once the argument of its speed law's tanh,
+#: ``F_net / (c v_max)``, reaches this magnitude (tanh(1) = 0.76 of the speed limit); see :func:`piston_speed`
+PISTON_RUNNING = 1.0
 
 #: switching functions: (name, crossing direction)
 SWITCHING = (("lockup", -1), ("breakaway", 1), ("contact", 0), ("piston_leaves_stop", 1),
-             ("piston_reaches_stop", -1))
-G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES = indices(
-    SWITCHING, "lockup", "breakaway", "contact", "piston_leaves_stop", "piston_reaches_stop")
+             ("piston_reaches_stop", -1), ("piston_runs", -1), ("piston_turns", -1))
+G_LOCKUP, G_BREAKAWAY, G_CONTACT, G_LEAVES, G_REACHES, G_RUNS, G_TURNS = indices(
+    SWITCHING, "lockup", "breakaway", "contact", "piston_leaves_stop", "piston_reaches_stop", "piston_runs",
+    "piston_turns")
 N_SWITCH = len(SWITCHING)
 
 #: event names by code
@@ -490,15 +508,29 @@ def _model(t, x, u, m, p, dx, g, y):
     fsp = c.spring_preload + c.spring_stiffness * xp
     # squeeze-film force per unit piston speed (dh/dt = -x_p'/N_c), the N_c films in series
     csq = squeeze_film_force_scalar(c.squeeze_coefficient, muv, -1.0 / nc, hbar)
-    vfree = piston_speed(fa - fsp - fc, csq, c.actuator_speed_max)
+    fnet = fa - fsp - fc
+    vfree = piston_speed(fnet, csq, c.actuator_speed_max)
+    run = m[M_RUN]
     if at_stop:
         xdot = 0.0
         g[G_LEAVES] = vfree
         g[G_REACHES] = 1.0
+        g[G_RUNS] = 1.0
+        g[G_TURNS] = 1.0
     else:
         xdot = vfree
         g[G_LEAVES] = -1.0
         g[G_REACHES] = xp
+        # the turn of a running piston (its net force through zero) ends a step: the tanh of its speed law
+        # turns from one speed limit to the other within microseconds there, faster than an error estimate
+        # over a step sees; armed only once the piston runs (|F_net| >= PISTON_RUNNING c v_max), so that a
+        # piston settling on an equilibrium, its net force hovering at zero, never triggers it
+        if run == SETTLING:
+            g[G_RUNS] = PISTON_RUNNING * csq * c.actuator_speed_max - abs(fnet)
+            g[G_TURNS] = 1.0
+        else:
+            g[G_RUNS] = 1.0
+            g[G_TURNS] = fnet if run == ENGAGING else -fnet
     g[G_CONTACT] = h
     dx[S_X] = xdot
     dx[S_FA] = (fref - fa) / c.actuator_time_constant
@@ -585,11 +617,23 @@ def wet_update(t, x, u, m, p, k, log):
             m[M_FILM] = OPEN
             code = EV_SEPARATION
     elif k == G_LEAVES:
+        # off its stop the piston runs out towards the pack (its net force rose through zero): armed at once,
+        # so that an engagement pays no located ``piston_runs``
         m[M_PISTON] = FREE
+        m[M_RUN] = ENGAGING
         code = EV_LEAVES
+    elif k == G_RUNS:
+        # the piston reaches a speed near its limit: watch for its turn (no event recorded)
+        _evaluate(t, x, u, m, p)
+        m[M_RUN] = ENGAGING if wk[W_DX + S_X] > 0.0 else RELEASING
+    elif k == G_TURNS:
+        # the running piston turns: the step size starts afresh (no event recorded)
+        m[M_RUN] = SETTLING
+        return RESTART
     elif k == G_REACHES:
         x[S_X] = 0.0
         m[M_PISTON] = AT_STOP
+        m[M_RUN] = SETTLING
         _evaluate(t, x, u, m, p)
         if wk[W_G + G_LEAVES] > 0.0:
             # the force balance pushes it off the stop again at once (a touch): stays free
@@ -618,9 +662,8 @@ def wet_restart(t, x, u, m, p, log):
     if m[M_FILM] != film:
         m[M_FILM] = film
         changed = True
-    if m[M_FRICTION] != STICK and m[M_PISTON] == FREE and x[S_X] > 0.0:
-        return changed
     _evaluate(t, x, u, m, p)
+    code = -1
     for check in range(2):  # the friction, then the piston; one call site of ``record``
         code = -1
         if check == 0 and m[M_FRICTION] == STICK and abs(wk[W_OUT + O_TD]) > wk[W_OUT + O_CAP]:
@@ -629,6 +672,7 @@ def wet_restart(t, x, u, m, p, log):
             code = EV_BREAKAWAY
         elif check == 1 and m[M_PISTON] == AT_STOP and wk[W_G + G_LEAVES] > 0.0:
             m[M_PISTON] = FREE
+            m[M_RUN] = ENGAGING  # (as in ``wet_update``)
             code = EV_LEAVES
         elif check == 1 and m[M_PISTON] == FREE and x[S_X] <= 0.0 and wk[W_DX + S_X] <= 0.0:
             x[S_X] = 0.0
@@ -637,6 +681,23 @@ def wet_restart(t, x, u, m, p, log):
         if code >= 0:
             record(log, t, code, EVENT_ELEMENT[code])
             changed = True
+    # whether the piston runs (its net force, continuous across a restart, decides; at t0 or a set state
+    # it may start running): settling on its stop, running one way at its speed limit, or armed no more
+    run = m[M_RUN]
+    if m[M_PISTON] == AT_STOP:
+        run = SETTLING
+    else:
+        if code >= 0:
+            _evaluate(t, x, u, m, p)
+        if run != SETTLING and wk[W_G + G_TURNS] < 0.0:
+            run = SETTLING
+            m[M_RUN] = run
+            _evaluate(t, x, u, m, p)
+        if run == SETTLING and wk[W_G + G_RUNS] < 0.0:
+            run = ENGAGING if wk[W_DX + S_X] > 0.0 else RELEASING
+    if m[M_RUN] != run:
+        m[M_RUN] = run
+        changed = True
     return changed
 
 
@@ -921,7 +982,7 @@ def initial_modes(x0, piston_h0: float) -> np.ndarray:
     Parameters
     ----------
     x0 : ndarray
-        Initial state, or initial states ``(m, n)`` (one row per variant: modes ``(m, 3)``).
+        Initial state, or initial states ``(m, n)`` (one row per variant: modes ``(m, 4)``).
     piston_h0 : float
         Piston position at zero separation [m] (Eq. 1).
     """
@@ -929,12 +990,13 @@ def initial_modes(x0, piston_h0: float) -> np.ndarray:
     if x0.ndim == 1:  # one run (the same rules as below, without the array machinery)
         w, xp = float(x0[S_W]), float(x0[S_X])
         return np.array([SLIP if w > 0.0 else SLIP_NEG if w < 0.0 else STICK, AT_STOP if xp <= 0.0 else FREE,
-                         CONTACT if piston_h0 - xp <= 0.0 else OPEN], dtype=np.int64)
-    m = np.zeros(x0.shape[:-1] + (3,), dtype=np.int64)
+                         CONTACT if piston_h0 - xp <= 0.0 else OPEN, SETTLING], dtype=np.int64)
+    m = np.zeros(x0.shape[:-1] + (len(MODE_NAMES),), dtype=np.int64)
     w = x0[..., S_W]
     m[..., M_FRICTION] = np.where(w > 0.0, SLIP, np.where(w < 0.0, SLIP_NEG, STICK))
     m[..., M_PISTON] = np.where(x0[..., S_X] <= 0.0, AT_STOP, FREE)
     m[..., M_FILM] = np.where(piston_h0 - x0[..., S_X] <= 0.0, CONTACT, OPEN)
+    m[..., M_RUN] = SETTLING  # (the restart at t0 arms a piston that starts running)
     return m
 
 
