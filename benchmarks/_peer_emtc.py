@@ -173,8 +173,8 @@ def magnet_force(d, i2, xa):
     """Plant magnet force [N] at coil current ``i2`` and armature position ``xa`` (memory not committed)."""
     grid = _grid(d)
     gaps = _gaps(d)
-    idx = np.zeros(3, dtype=np.int64)
-    w = np.zeros(3)
+    idx = np.zeros(K.GAP_TABLES, dtype=np.int64)
+    w = np.zeros(K.GAP_TABLES)
     gap = d[D_DOPEN] - xa
     K.gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), idx, w)
     i = min(max(i2, grid[0]), grid[grid.shape[0] - 1])
@@ -444,8 +444,8 @@ def run(funcptr, d, z0, ts, n_samples, nsub, rtol, atol, ctl_tab, ctl_grid, ctl_
     cpref = np.zeros((ctl_tab.shape[0], cap // 2 + 2))
     cmem = np.zeros(2)
     cmem[1] = ctl_grid[0]
-    cidx = np.zeros(3, dtype=np.int64)
-    cw = np.zeros(3)
+    cidx = np.zeros(K.GAP_TABLES, dtype=np.int64)
+    cw = np.zeros(K.GAP_TABLES)
     lo_gap = d[D_DOPEN] - d[D_SIGMA]
     K.gap_weights(ctl_gaps, min(max(lo_gap, ctl_gaps[0]), ctl_gaps[ctl_gaps.shape[0] - 1]), cidx, cw)
     S = d[D_SCALE:D_SCALE + NX].copy()

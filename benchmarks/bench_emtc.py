@@ -52,8 +52,8 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
     pstack, ppref = np.zeros(cap), np.zeros((magnet.n_airgaps, cap // 2 + 2))
     cstack, cpref = np.zeros(cap), np.zeros((magnet.n_airgaps, cap // 2 + 2))
     mem = {"pl": 0, "pu": grid[0], "cl": 0, "cu": grid[0]}
-    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
-    cidx, cw = np.zeros(3, dtype=np.int64), np.zeros(3)
+    idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
+    cidx, cw = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
     K.gap_weights(gaps, d - sigma, cidx, cw)
     vdf = sc.drum_speed
     vdr = sc.drum_speed - sc.speed_difference

@@ -116,8 +116,10 @@ def example_scenario():
 
 def test_awd_example_equals_the_drum_bench(example_scenario):
     """``examples/driveline_emtc_awd.toml`` is the drum bench of ``examples/emtc_scenario.toml``: the armature
-    leaves its rest stop at 13.19 ms and presses the primary clutch at 18.02 ms (both to 1e-7 s of the
-    bench's), the coupling slips for the whole run, and speeds, torque, current and magnet force agree."""
+    leaves its rest stop at 13.21 ms and presses the primary clutch at 18.05 ms (both to 1e-7 s of the
+    bench's; 13.19 and 18.02 ms with the airgap read through the nearest three calibration airgaps, until the
+    twenty-fifth session, docs/emtc.md), the coupling slips for the whole run, and speeds, torque, current and
+    magnet force agree."""
     f = load_driveline(EXAMPLES / "driveline_emtc_awd.toml")
     sc = example_scenario["scenario"]
     assert f.t_end == sc.duration
@@ -126,13 +128,14 @@ def test_awd_example_equals_the_drum_bench(example_scenario):
     _compare(rb, rn)
     ev = rn.events
     assert list(ev["event"]) == ["armature_leave_rest", "armature_contact"]
-    assert abs(ev["time_s"].iloc[0] - 0.0131941) < 1e-6 and abs(ev["time_s"].iloc[1] - 0.0180190) < 1e-6
+    assert abs(ev["time_s"].iloc[0] - 0.0132128) < 1e-6 and abs(ev["time_s"].iloc[1] - 0.0180471) < 1e-6
     # the file's numbers are the bench's: the builder gives the same run
     rd = _network(sc, example_scenario["vehicle"])
     assert np.max(np.abs(rd.to_dataframe()["front_shaft.w_rad_s"] - rn.to_dataframe()["front_shaft.w_rad_s"])) < 1e-7
 
 
-@pytest.mark.parametrize("dv, lock", [(0.0, 0.031328), (0.02, 0.414601), (-0.3, 0.482046)])
+@pytest.mark.parametrize("dv, lock", [(0.0, 0.031313), (0.02, 0.414601), (-0.3, 0.482046)])  # (0.031328 until
+# the C1 airgap reading, docs/emtc.md)
 def test_lockup_equals_the_bench(example_scenario, dv, lock):
     """Drum speed differences at which the coupling locks: the network's stick event is the bench's lock-up
     (its capacity covers Eq. 29's lock torque), and while stuck the network's constraint torque is Eq. 29's

@@ -3,6 +3,10 @@ the lock-up as a located event, hysteresis memories as model errors.
 
 Regression tolerances (``data/regression_traces.npz``: the pre-port model at rtol = 1e-9, see data/README.md)
 ---------------------------------------------------------------------------------------------------------------
+Since the twenty-fifth session the traces are the *ported* model's at rtol = 1e-9 with the C1 airgap reading
+(regenerated on purpose, data/README.md: the reading moved the answers by up to 5.8e-3 of the current
+command's range); the tolerances and the departures below are those measured against the pre-port traces, kept
+as they were (the same model at rtol 1e-9 meets them with room).
 The ported model runs at its default rtol = 1e-6 and is compared column by column with the traces, relative to
 each column's largest magnitude: ``rtol`` itself.  The integration error of either run is far below it
 (measured: speeds 2e-8, coil current and magnet force 3e-7, armature 2e-8), so a changed equation would show;
@@ -12,7 +16,7 @@ equality is not expected.  Two documented departures from the pre-port answers:
 * ``lock_unlock``: the lock-up is now an event located where the slip crosses zero.  The pre-port model
   flipped the friction sign inside the slipping mode, so the slip slid along zero until a step happened to end
   past it: its lock-up instant depended on the step sequence (9.85-10.4 ms with rtol and sample time) instead
-  of converging.  The ported lock-up is at 9.636 ms for every rtol (``test_lockup_converges``); the common
+  of converging.  The ported lock-up is at 9.636 ms (9.662 ms with the C1 reading) for every rtol (``test_lockup_converges``); the common
   speed of the locked shafts shifts by 3e-4 rad/s (5e-6 of the speed): speeds are compared to 1e-5, the
   lock-up instant to 3e-4 s.
 * ``lugre``: after the unlock the pre-port model reported the coupling torque evaluated after committing the
@@ -44,8 +48,14 @@ RTOL = 1e-6
 #: 20 us, measured 2026-11-25), as a fraction of the range: x_armature 1.8e-6 in ``slipping`` (a sample inside
 #: a 5 ms step, read off the dense output), i2 7.6e-7 and the magnet force 9.2e-7 in ``lock_unlock``.  The port
 #: at rtol 1e-6 is off the converged solution by 2.9e-6, 4.4e-7 and 5.4e-7 there; the two errors add.
+#: ``lugre``'s speeds: after the unlock (1.93 s) the LuGre coupling slips again, and there the run at rtol 1e-6 is
+#: 9.7e-5 of the range off the traces regenerated at rtol 1e-9 (twenty-fifth session), and the rtol 1e-9 run is still
+#: 8e-4 rad/s (1.3e-5 of the range) off an rtol 1e-11 run: the error does not follow the tolerance there (open,
+#: docs/emtc.md; the same to four digits with the nearest-three airgap reading).  The pre-port traces had agreed with
+#: the rtol 1e-6 run to 4e-9: the pre-port kernel's "rtol 1e-9" run carried the same error.
 TRACE_TOL = {("slipping", "x_armature_m"): 6e-6, ("lock_unlock", "i2_A"): 2e-6, ("lock_unlock", "magnet_force_N"): 2e-6,
-             ("lock_unlock", "omega_f_rad_s"): 1e-5, ("lock_unlock", "omega_r_rad_s"): 1e-5}
+             ("lock_unlock", "omega_f_rad_s"): 1e-5, ("lock_unlock", "omega_r_rad_s"): 1e-5,
+             ("lugre", "omega_f_rad_s"): 2e-4, ("lugre", "omega_r_rad_s"): 2e-4}
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +103,9 @@ def test_reproduces_the_pre_port_traces(magnet, name, scenario, kwargs):
 
 def test_lockup_converges(magnet):
     """Equal drum speeds, a reference well above the lock torque: the slip crosses zero once and the lock-up is
-    located there, the same instant for every tolerance (the pre-port model: 9.85-10.4 ms)."""
+    located there, the same instant for every tolerance (the pre-port model: 9.85-10.4 ms; 9.636 ms with the airgap
+    read through the nearest three calibration airgaps, until the twenty-fifth session; 9.662 ms with the C1 reading,
+    docs/emtc.md)."""
     sc = BenchScenario(duration=0.012, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9, ramp_start=0.3,
                        ramp_end=2.8)
     times = []
@@ -101,7 +113,7 @@ def test_lockup_converges(magnet):
         ev = simulate_bench(magnet, sc, rtol=rtol, torque_reference=([0.0, 10.0], [250.0, 250.0])).events
         times.append(ev.loc[ev["event"] == "lockup", "time_s"].iloc[0])
     assert max(times) - min(times) < 1e-6
-    assert times[-1] == pytest.approx(9.636e-3, abs=2e-6)
+    assert times[-1] == pytest.approx(9.662e-3, abs=2e-6)
 
 
 def test_uniform_simulate_returns_a_simulation_result(magnet):

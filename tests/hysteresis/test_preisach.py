@@ -228,21 +228,54 @@ def test_airgap_quadratic_interpolation_exact_for_quadratic_tables():
         np.testing.assert_allclose(fam.simulate(u, airgap=g), expect, rtol=1e-9, atol=1e-9)
 
 
-def test_airgap_uses_three_nearest_calibration_points():
+def _lagrange(x, g):
+    """Quadratic Lagrange weights through the three airgaps ``x`` at ``g`` (written out, for the tests)."""
+    return [np.prod([(g - x[m]) / (x[k] - x[m]) for m in range(3) if m != k]) for k in range(3)]
+
+
+def test_airgap_blends_the_two_quadratics_of_its_interval():
+    """In [0.4, 0.6] mm of four calibration airgaps: (1 - s) times the quadratic through 0.2, 0.4, 0.6 plus s times
+    the one through 0.4, 0.6, 0.8 (s the position in the interval); in the first and the last interval the one
+    quadratic that exists ([1], Sec. 2.1 "second-order polynomial interpolation", read C1: docs/emtc.md)."""
     gaps = np.array([0.2, 0.4, 0.6, 0.8]) * 1e-3
     tabs = [random_table(s) for s in range(4)]
     fam = Preisach(GRID, np.array(tabs), gaps)
     u = [0.0, 3.0, 1.0]
-    g = 0.45e-3  # nearest three: 0.2, 0.4, 0.6 (0.8 is farther than 0.2? 0.35 vs 0.25 -> 0.2, 0.4, 0.6)
-    vals = [Preisach(GRID, T).simulate(u)[-1] for T in tabs[:3]]
-    x = gaps[:3]
-    lag = [np.prod([(g - x[m]) / (x[k] - x[m]) for m in range(3) if m != k]) for k in range(3)]
-    assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(np.dot(lag, vals)), rel=1e-12)
-    g = 0.55e-3  # nearest three: 0.4, 0.6, 0.8
-    vals = [Preisach(GRID, T).simulate(u)[-1] for T in tabs[1:]]
-    x = gaps[1:]
-    lag = [np.prod([(g - x[m]) / (x[k] - x[m]) for m in range(3) if m != k]) for k in range(3)]
-    assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(np.dot(lag, vals)), rel=1e-12)
+    vals = np.array([Preisach(GRID, T).simulate(u)[-1] for T in tabs])
+    for g in (0.45e-3, 0.5e-3, 0.55e-3, 0.599e-3):
+        s = (g - gaps[1]) / (gaps[2] - gaps[1])
+        expect = (1 - s) * np.dot(_lagrange(gaps[:3], g), vals[:3]) + s * np.dot(_lagrange(gaps[1:], g), vals[1:])
+        assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(expect), rel=1e-12)
+    for g, three in ((0.25e-3, slice(0, 3)), (0.75e-3, slice(1, 4))):
+        expect = np.dot(_lagrange(gaps[three], g), vals[three])
+        assert fam.simulate(u, airgap=g)[-1] == pytest.approx(float(expect), rel=1e-12)
+
+
+def test_airgap_interpolation_is_continuous_with_its_slope():
+    """Across every calibration airgap and every interval's middle (where the quadratic through the nearest three,
+    the reading until the twenty-fifth session, jumped: an armature parked there had no force balance) the output
+    is continuous and so is its slope in the airgap: one-sided differences agree to their truncation error."""
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4]) * 1e-3
+    tabs = [random_table(s) * (1.0 + 0.3 * k) for k, s in enumerate(range(7))]
+    fam = Preisach(GRID, np.array(tabs), gaps)
+    u = [0.0, 4.0, 1.5, 3.0]
+
+    def out(g):
+        return fam.simulate(u, airgap=g)[-1]
+
+    h = 1e-9  # m
+    scale = max(abs(out(g)) for g in gaps)
+    points = np.concatenate([gaps[1:-1], 0.5 * (gaps[:-1] + gaps[1:])])
+    for g in points:
+        left, mid, right = out(g - h), out(g), out(g + h)
+        assert abs(right - left) < 1e-4 * scale, g      # no jump (a 0.4 % jump would be 4e-3 of the scale)
+        slope_l, slope_r = (mid - left) / h, (right - mid) / h
+        assert abs(slope_r - slope_l) < 1e-3 * max(abs(slope_l), scale / 1e-3), (g, slope_l, slope_r)
+    # the nearest three do jump at 1.1 mm (the parked armature's airgap): what this test rules out
+    g = 1.1e-3
+    below = np.dot(_lagrange(gaps[3:6], g), [Preisach(GRID, T).simulate(u)[-1] for T in tabs[3:6]])
+    above = np.dot(_lagrange(gaps[4:7], g), [Preisach(GRID, T).simulate(u)[-1] for T in tabs[4:7]])
+    assert abs(above - below) > 1e-3 * scale
 
 
 def test_family_inverse_at_off_grid_airgap():
@@ -309,7 +342,7 @@ def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
     fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
     fam.simulate(history, airgap=gap)
-    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
     K.gap_weights(fam.airgaps, gap, idx, w)
     comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
     K.combine_tables(fam.kernel_tables, idx, w, comb)
@@ -334,7 +367,7 @@ def test_peek_segment_is_the_combined_peek_on_its_whole_stretch(history, v, gap,
     fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
     if history:
         fam.simulate(history, airgap=gap)
-    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
     K.gap_weights(fam.airgaps, gap, idx, w)
     comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
     K.combine_tables(fam.kernel_tables, idx, w, comb)
@@ -388,11 +421,11 @@ def test_invert_combined_is_invert_one_along_a_command_sequence(history, targets
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
     fam = Preisach(GRID, np.array([np.maximum.accumulate(np.maximum.accumulate(random_table(s), 0), 1) * (1 + s)
                                    for s in range(5)]), gaps)
-    idx, w = np.zeros(3, dtype=np.int64), np.zeros(3)
+    idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
     K.gap_weights(fam.airgaps, gap, idx, w)
     comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
     K.combine_tables(fam.kernel_tables, idx, w, comb)
-    one, ow = np.zeros(3, dtype=np.int64), np.array([1.0, 0.0, 0.0])
+    one, ow = np.zeros(K.GAP_TABLES, dtype=np.int64), np.eye(K.GAP_TABLES)[0]
     cap = 64
     stack, pref = np.zeros(cap), np.zeros((1, cap // 2 + 2))
     length, u = 0, float(fam.grid[0])

@@ -94,8 +94,8 @@ def demo_section(progress=print) -> Section:
                          t["value"].to_numpy() - truth.forc(t["alpha"].to_numpy(), t["beta"].to_numpy(), airgap=gap))))})
     items.append(Text("The magnet force is a classical Preisach model of the coil current (Eqs. 2-3) identified "
                       "from FORC records at seven airgaps 0.2-1.4 mm on the paper's 0-4.5 A / 0.5 A grid "
-                      "(Figs. 2-4); between grid points Eqs. 4-5, between airgaps quadratic interpolation through "
-                      "the three nearest calibration airgaps."))
+                      "(Figs. 2-4); between grid points Eqs. 4-5, between airgaps the two quadratic interpolants of "
+                      "the interval blended across it (continuous with its slope)."))
     items.append(Table("emtc_identification", pd.DataFrame(rows), "FORC identification per calibration airgap"))
 
     # Figs. 5-6: major and minor loops on and off the calibration airgaps

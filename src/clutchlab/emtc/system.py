@@ -46,8 +46,8 @@ import numba
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import (combine_tables, commit, gap_weights, invert_combined, invert_one, peek,
-                                   peek_segment)
+from ..hysteresis._kernels import (GAP_TABLES, combine_tables, commit, gap_weights, invert_combined, invert_one,
+                                   peek, peek_segment)
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import borrow, byref, shaped
 from ..numerics.core import record
@@ -154,12 +154,13 @@ ERROR_MESSAGES = {
 
 #: per-run integer memories (EmtcParams.imem)
 IMEM = slots(("plant_length", 1), ("controller_length", 1), ("next_sample", 1), ("error", 1),
-             ("plant_table_index", 3), ("controller_table_index", 3), ("friction_map_index", 3),
+             ("plant_table_index", GAP_TABLES), ("controller_table_index", GAP_TABLES),
+             ("moving_table_index", GAP_TABLES),   # the plant tables' indices at the last evaluation, armature moving
              ("plant_version", 1),        # changes of the plant's hysteresis stack so far (its length)
              ("controller_version", 1))   # the same for the controller model's
 IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX, IM_PVER, IM_CVER = IMEM.of(
     "plant_length", "controller_length", "next_sample", "error", "plant_table_index", "controller_table_index",
-    "friction_map_index", "plant_version", "controller_version")
+    "moving_table_index", "plant_version", "controller_version")
 N_IMEM = IMEM.total
 #: the model intermediates of an evaluation (FMEM's "aux")
 AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
@@ -172,8 +173,8 @@ N_AUX = len(AUX)
 #: per-run float memories and scratch (EmtcParams.fmem)
 FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torque_reference", 1), ("feasible", 1),
              ("z", 1), ("t_last", 1), ("dw_last", 1),
-             ("plant_weights", 4),        # airgap weights of the plant tables and the airgap they were built for
-             ("controller_weights", 3),   # weights of the controller model's table (one at the engaged airgap)
+             ("plant_weights", GAP_TABLES + 1),   # airgap weights of the plant tables, the airgap they are for
+             ("controller_weights", GAP_TABLES),  # weights of the controller model's table (one at the engaged airgap)
              ("inputs_at_restart", len(INPUTS)),    # inputs seen at the last restart
              ("aux", N_AUX),              # model intermediates of the last evaluation (AUX)
              ("split", 6),                # element torques and capacities of the torque split
@@ -181,7 +182,7 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              # the point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
              ("key", 1 + len(STATES) + len(MODE_NAMES) + len(INPUTS)),
              ("last_derivative", len(STATES)), ("last_switching", len(SWITCHING)),   # of the last evaluation
-             ("moving_weights", 3),       # airgap weights of the plant tables at the last evaluation, armature moving
+             ("moving_weights", GAP_TABLES),      # airgap weights of the plant tables at the last evaluation, moving
              ("plant_segment", 9),        # the plant magnet's force as a quadratic in the coil current on the
              #                              stretch of the last evaluation (lo, hi, a0, a1, a2, kind:
              #                              hysteresis._kernels.peek_segment), the stack version (IM_PVER), last
@@ -593,8 +594,8 @@ def _controller(t, x, u, p):
     tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (1, n, n, 4))
     grid = _cold(p.cold, p.layout, L_CTL_GRID)
     prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (1, stack.shape[0] // 2 + 2))
-    cidx = imem[IM_CIDX:IM_CIDX + 3]
-    cw = fmem[FM_CW:FM_CW + 3]
+    cidx = imem[IM_CIDX:IM_CIDX + GAP_TABLES]
+    cw = fmem[FM_CW:FM_CW + GAP_TABLES]
     cu = fmem[FM_CU]
     i_new, ok = invert_combined(tables, grid, stack, prefix, clen, cu, fm_req, cidx, cw, 1e-9,
                                 fmem[FM_CSEG:FM_CSEG + 8], imem[IM_CVER])  # [1], Eq. 7 on the kept stretch
@@ -632,8 +633,8 @@ def _magnet_force(p, moving, gap, icoil):
     kept in ``fmem[FM_SEG:]`` does not hold: Preisach output for the next input, memory not committed ([1],
     Eqs. 1-5), interpolated over the calibration airgaps (Eq. 12).
 
-    ``moving``: the armature is free, another airgap at every stage: the weighted output of the nearest
-    calibration tables (building the weighted cell table would cost more than the evaluation).  At a stop the
+    ``moving``: the armature is free, another airgap at every stage: the weighted output of the
+    calibration tables around it (building the weighted cell table would cost more than the evaluation).  At a stop the
     airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in it) and the stretch
     of :func:`~clutchlab.hysteresis._kernels.peek_segment` around ``icoil`` is kept with the stack version,
     last input and airgap it is for.
@@ -644,16 +645,16 @@ def _magnet_force(p, moving, gap, icoil):
     plen = p.imem[IM_PLEN]
     gaps = _cold(p.cold, p.layout, L_PLANT_GAPS)
     if moving:
-        fidx = p.imem[IM_FIDX:IM_FIDX + 3]
-        fw = fmem[FM_FW:FM_FW + 3]
+        fidx = p.imem[IM_FIDX:IM_FIDX + GAP_TABLES]
+        fw = fmem[FM_FW:FM_FW + GAP_TABLES]
         gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), fidx, fw)
         return peek(p.plant_tables, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, fidx, fw)
-    gw = fmem[FM_GW:FM_GW + 4]
-    gidx = p.imem[IM_GIDX:IM_GIDX + 3]
-    if gap != gw[3]:
+    gw = fmem[FM_GW:FM_GW + GAP_TABLES + 1]
+    gidx = p.imem[IM_GIDX:IM_GIDX + GAP_TABLES]
+    if gap != gw[GAP_TABLES]:
         gap_weights(gaps, min(max(gap, gaps[0]), gaps[gaps.shape[0] - 1]), gidx, gw)
         combine_tables(p.plant_tables, gidx, gw, p.plant_comb)
-        gw[3] = gap
+        gw[GAP_TABLES] = gap
     seg = fmem[FM_SEG:FM_SEG + 9]
     fm = peek_segment(p.plant_comb, grid, p.plant_stack, p.plant_prefix, plen, pu, icoil, gidx, gw, seg)
     seg[6] = p.imem[IM_PVER]
@@ -1163,7 +1164,7 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_PU] = magnet.grid[0]
     fmem[FM_CU] = ctl.grid[0]
     fmem[FM_TLAST] = np.nan
-    fmem[FM_GW + 3] = np.nan
+    fmem[FM_GW + GAP_TABLES] = np.nan
     fmem[FM_ULAST:FM_ULAST + len(INPUTS)] = np.nan
     fmem[FM_KEY] = np.nan
     fmem[FM_SEG:FM_SEG + 9] = np.nan
@@ -1211,8 +1212,8 @@ def _table_at(model, gap):
     are linear in the table; :func:`~clutchlab.hysteresis._kernels.combine_tables`)."""
     gaps = _f(model.airgaps)
     tables = _f(model.kernel_tables)
-    idx = np.zeros(3, dtype=np.int64)
-    w = np.zeros(3)
+    idx = np.zeros(GAP_TABLES, dtype=np.int64)
+    w = np.zeros(GAP_TABLES)
     gap_weights(gaps, float(min(max(gap, gaps[0]), gaps[-1])), idx, w)
     out = np.zeros((1,) + tables.shape[1:])
     combine_tables(tables, idx, w, out)

@@ -81,15 +81,46 @@ def forc_value(tables, k, grid, a, b):
     return forc_value_ij(tables, k, grid, a, locate(grid, a), b, locate(grid, b))
 
 
+#: calibration tables an airgap's interpolation weighs at most (:func:`gap_weights`): the four around its interval
+GAP_TABLES = 4
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH, inline="always")
+def _add_quadratic(gaps, s, gap, scale, idx, w, q0):
+    """Add ``scale`` times the quadratic Lagrange weights through calibration airgaps ``s, s+1, s+2`` at ``gap``
+    into slots ``q0, q0+1, q0+2`` (whose table indices are ``s, s+1, s+2``)."""
+    x0 = gaps[s]
+    x1 = gaps[s + 1]
+    x2 = gaps[s + 2]
+    idx[q0] = s
+    idx[q0 + 1] = s + 1
+    idx[q0 + 2] = s + 2
+    w[q0] += scale * (gap - x1) * (gap - x2) / ((x0 - x1) * (x0 - x2))
+    w[q0 + 1] += scale * (gap - x0) * (gap - x2) / ((x1 - x0) * (x1 - x2))
+    w[q0 + 2] += scale * (gap - x0) * (gap - x1) / ((x2 - x0) * (x2 - x1))
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def gap_weights(gaps, gap, idx, w):
-    """Quadratic Lagrange weights through the three calibration airgaps nearest ``gap``.
+    """Airgap interpolation weights over the calibration airgaps ``gaps`` ([1], Sec. 2.1: "second-order
+    polynomial interpolation" between the seven calibration airgaps), read so that the force is continuous
+    with a continuous derivative in the airgap (C1).
 
-    Fills ``idx[0:3]`` (table indices) and ``w[0:3]`` (weights; unused slots get
-    weight 0).  One table: weight 1; two tables: linear interpolation.
+    In the interval ``[gaps[j], gaps[j+1]]`` the two quadratic Lagrange interpolants through
+    ``j-1, j, j+1`` and ``j, j+1, j+2`` are blended linearly across it, ``(1 - s) Q_left + s Q_right`` with
+    ``s = (gap - gaps[j]) / (gaps[j+1] - gaps[j])`` (a cubic through four tables; in the first and last
+    interval the one quadratic that exists).  Both interpolants pass through every calibration airgap of
+    theirs, so the blend does (each table's own output at its airgap), and at ``gaps[j+1]`` its slope is the
+    slope of the quadratic the next interval starts from.  (The quadratic through the *nearest* three, read
+    until the twenty-fifth session, jumps where the nearest three change, at the middle of every interval:
+    an armature parked there has no force balance, docs/emtc.md.)
+
+    Fills ``idx[0:GAP_TABLES]`` (table indices) and ``w[0:GAP_TABLES]`` (weights; unused slots get weight 0).
+    Three tables: the quadratic through them; two: linear interpolation; one: weight 1.  ``gap`` is clamped
+    by the caller to the calibration range.
     """
     k = gaps.shape[0]
-    for q in range(3):
+    for q in range(GAP_TABLES):
         idx[q] = 0
         w[q] = 0.0
     if k == 1:
@@ -103,23 +134,16 @@ def gap_weights(gaps, gap, idx, w):
         w[1] = t
         return
     j = locate(gaps, gap)
-    if j == 0:
-        s = 0
-    elif j + 1 >= k - 1:
-        s = k - 3
-    elif gap - gaps[j - 1] < gaps[j + 2] - gap:
-        s = j - 1
+    left = j >= 1            # the quadratic through j-1, j, j+1 exists
+    right = j + 2 <= k - 1   # the one through j, j+1, j+2
+    if left and right:
+        s = (gap - gaps[j]) / (gaps[j + 1] - gaps[j])
+        _add_quadratic(gaps, j - 1, gap, 1.0 - s, idx, w, 0)
+        _add_quadratic(gaps, j, gap, s, idx, w, 1)
+    elif left:
+        _add_quadratic(gaps, j - 1, gap, 1.0, idx, w, 0)
     else:
-        s = j
-    x0 = gaps[s]
-    x1 = gaps[s + 1]
-    x2 = gaps[s + 2]
-    idx[0] = s
-    idx[1] = s + 1
-    idx[2] = s + 2
-    w[0] = (gap - x1) * (gap - x2) / ((x0 - x1) * (x0 - x2))
-    w[1] = (gap - x0) * (gap - x2) / ((x1 - x0) * (x1 - x2))
-    w[2] = (gap - x0) * (gap - x1) / ((x2 - x0) * (x2 - x1))
+        _add_quadratic(gaps, j, gap, 1.0, idx, w, 0)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -172,7 +196,7 @@ def weighted_output(tables, grid, stack, length, pref, v, idx, w):
     ib2 = locate(grid, b2)
     p = length // 2
     f = 0.0
-    for q in range(3):
+    for q in range(GAP_TABLES):
         if w[q] != 0.0:
             k = idx[q]
             g = pref[k, p] + forc_value_ij(tables, k, grid, a, ia, v, iv)  # [1], Eq. 3 (rising) or Eq. 2 (falling)
@@ -227,8 +251,8 @@ def simulate_kernel(tables, grid, gaps, stack, pref, length, u, inputs, airgaps,
     ``airgaps`` has the length of ``inputs`` or length 1 (constant airgap).
     Stops early (``n_done < len``) only when the stack is full.
     """
-    idx = np.zeros(3, dtype=np.int64)
-    w = np.zeros(3)
+    idx = np.zeros(GAP_TABLES, dtype=np.int64)
+    w = np.zeros(GAP_TABLES)
     n = inputs.shape[0]
     const_gap = airgaps.shape[0] == 1
     single = tables.shape[0] == 1
@@ -269,7 +293,7 @@ def peek(tables, grid, stack, pref, length, u, v, idx, w):
                 prev = stack[L - 2] if L >= 3 else u
                 ip = locate(grid, prev)
                 f = 0.0
-                for q in range(3):
+                for q in range(GAP_TABLES):
                     if w[q] != 0.0:
                         k = idx[q]
                         term = forc_value_ij(tables, k, grid, mx, im, u, iu)
@@ -289,7 +313,7 @@ def peek(tables, grid, stack, pref, length, u, v, idx, w):
                 prev = stack[L - 1] if L >= 1 else v
                 ip = locate(grid, prev)
                 f = 0.0
-                for q in range(3):
+                for q in range(GAP_TABLES):
                     if w[q] != 0.0:
                         k = idx[q]
                         g = pref[k, L // 2] + forc_value_ij(tables, k, grid, u, iu, v, iv)
@@ -377,8 +401,8 @@ def invert_kernel(tables, grid, gaps, stack, pref, length, u, targets, airgaps, 
     ``lo_reach``/``hi_reach`` receive the output reachable at the grid ends
     from the memory before each step.
     """
-    idx = np.zeros(3, dtype=np.int64)
-    w = np.zeros(3)
+    idx = np.zeros(GAP_TABLES, dtype=np.int64)
+    w = np.zeros(GAP_TABLES)
     n = targets.shape[0]
     const_gap = airgaps.shape[0] == 1
     if const_gap:
@@ -459,7 +483,7 @@ def combine_tables(tables, idx, w, out):
         for j in range(i + 1):
             for c in range(4):
                 acc = 0.0
-                for q in range(3):
+                for q in range(GAP_TABLES):
                     if w[q] != 0.0:
                         acc += w[q] * tables[idx[q], i, j, c]
                 out[0, i, j, c] = acc
@@ -468,7 +492,7 @@ def combine_tables(tables, idx, w, out):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _wpref(pref, p, idx, w):
     acc = 0.0
-    for q in range(3):
+    for q in range(GAP_TABLES):
         if w[q] != 0.0:
             acc += w[q] * pref[idx[q], p]
     return acc

@@ -8,8 +8,10 @@ output after the input rises from the lowest grid value to alpha and falls to
 beta), Eqs. 2-3, interpolated between grid points by Eqs. 4-5.  The inverse
 (Eqs. 6-7) gives the current that produces a desired force (open-loop
 hysteresis compensation, Fig. 7).  One table per calibration airgap, with
-quadratic interpolation through the three nearest airgaps ([1], Sec. 2.1); the
-hysteresis memory is in the current only.
+second-order polynomial interpolation between them ([1], Sec. 2.1): the two
+quadratics of an interval blended linearly across it, continuous with its
+slope (:func:`~clutchlab.hysteresis._kernels.gap_weights`); the hysteresis
+memory is in the current only.
 
 References
 ----------
@@ -449,8 +451,8 @@ class Preisach:
     def output(self, airgap=None) -> float:
         """Output for the present memory and input [N] (without changing it)."""
         gaps = self._gap_array(airgap, 1)
-        idx = np.zeros(3, dtype=np.int64)
-        w = np.zeros(3)
+        idx = np.zeros(K.GAP_TABLES, dtype=np.int64)
+        w = np.zeros(K.GAP_TABLES)
         K.gap_weights(self.airgaps, gaps[0], idx, w)
         return float(K.weighted_output(self._coef, self.grid, self._stack, self._length, self._pref, self._u, idx, w))
 
@@ -462,11 +464,11 @@ class Preisach:
         if np.any(b > a + 1e-12):
             raise DataError("forc: beta must not exceed alpha")
         gaps = self._gap_array(airgap, 1)
-        idx = np.zeros(3, dtype=np.int64)
-        w = np.zeros(3)
+        idx = np.zeros(K.GAP_TABLES, dtype=np.int64)
+        w = np.zeros(K.GAP_TABLES)
         K.gap_weights(self.airgaps, gaps[0], idx, w)
         out = np.zeros(a.size)
-        for q in range(3):
+        for q in range(K.GAP_TABLES):
             if w[q] != 0.0:
                 k = int(idx[q])
                 out += w[q] * np.array([K.forc_value(self._coef, k, self.grid, x, y) for x, y in zip(a, b)])

@@ -3,7 +3,8 @@
 Provenance: run on the model code of commit 45cc909 (the last one with the model's own Dormand-Prince loop,
 ``emtc/_bench_kernel.py``), ``python tests/emtc/data/make_regression_traces.py``.  Rerunning it on a
 later commit would overwrite the pre-port reference with the ported model's answer: don't, unless the
-physics changed on purpose (then say so in the README).
+physics changed on purpose (then say so in the README: rerun once, in the twenty-fifth session, on the ported model
+with the C1 airgap reading).
 
 Three scenarios, each at rtol = 1e-9 (tight: the integration error is far below the tolerances of the
 regression test), 8 columns subsampled to at most 250 rows, and the named events.

@@ -3,7 +3,9 @@
 Provenance: run on commit 5eb22d8 (main before the branch ``speed-emtc``) with
 ``PYTHONPATH=src python tests/emtc/data/make_speed_traces.py``.  ``tests/emtc/test_speed.py`` checks that the
 faster model gives the same trajectories (every sample, every state and output) and the same event times.
-Rerunning it on a later commit would replace the reference by the answer it is meant to check: don't.
+Rerunning it on a later commit would replace the reference by the answer it is meant to check: don't, unless the
+physics changed on purpose (then say so in the README: rerun once, in the twenty-fifth session, for the C1 airgap
+reading).
 
 Scenarios, each at the default tolerances (rtol 1e-6, the figure of issue #14 is run so; ``release`` at
 1e-9), recorded at the
