@@ -16,9 +16,9 @@ equality is not expected.  Two documented departures from the pre-port answers:
 * ``lock_unlock``: the lock-up is now an event located where the slip crosses zero.  The pre-port model
   flipped the friction sign inside the slipping mode, so the slip slid along zero until a step happened to end
   past it: its lock-up instant depended on the step sequence (9.85-10.4 ms with rtol and sample time) instead
-  of converging.  The ported lock-up is at 9.636 ms (9.662 ms with the C1 reading) for every rtol (``test_lockup_converges``); the common
-  speed of the locked shafts shifts by 3e-4 rad/s (5e-6 of the speed): speeds are compared to 1e-5, the
-  lock-up instant to 3e-4 s.
+  of converging.  The ported lock-up is at 9.636 ms (9.662 ms with the C1 reading) for every rtol
+  (``test_lockup_converges``); the common speed of the locked shafts shifts by 3e-4 rad/s (5e-6 of the speed):
+  speeds are compared to 1e-5, the lock-up instant to 3e-4 s.
 * ``lugre``: after the unlock the pre-port model reported the coupling torque evaluated after committing the
   bristle state at the mid-step slip (a spurious ``sigma1 dz/dt`` of 4 % in the output rows only); the core
   records the outputs with the stage semantics (bristles advanced from the step start), which sit on the

@@ -200,7 +200,8 @@ def sync(x, m, net, w):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def call(t, x, m, w, j, k, log):
     """Clutch ``j``'s model hook on its own states and modes (``k >= 0``: its update for switching function
-    ``k``; ``k < 0``: its restart), its events renamed; the states and the piston, film and piston-run modes written back."""
+    ``k``; ``k < 0``: its restart), its events renamed; the states and the piston, film and piston-run modes
+    written back."""
     cf = w.conf[j]
     b = w.buf[j]
     xs = b[B_X:B_X + N_STATE]

@@ -165,7 +165,6 @@ INPUTS = (
 )
 U_FORCE, U_SPEED = indices(INPUTS, "force_reference", "slip_speed_reference")
 
-#: modes: friction, piston, film
 #: modes: friction, piston, film, and whether a turn of the free piston is watched (and from which direction)
 MODE_NAMES = ("friction", "piston", "film", "piston_run")
 MODE_VALUES = (("slip_positive", "stick", "slip_negative"), ("free", "at_stop"), ("open", "contact"),
