@@ -1533,8 +1533,8 @@ def evaluate(system: System, t: float = 0.0, x=None, u=None, m=None):
     # the compiled hooks read the declared positions without bounds checks: a short array is refused here
     for field, a, want in (("x", x, system.x0.shape), ("u", u, system.u0.shape), ("m", m, system.m0.shape)):
         if a.shape != want:
-            raise ValueError(f"evaluate: {field} of system {system.name!r} has shape {a.shape}, its declaration "
-                             f"{want}")
+            raise ParameterError(f"evaluate: {field} of system {system.name!r} has shape {a.shape}, its "
+                                 f"declaration {want}")
     dx = np.empty(len(system.states))
     g = np.empty(len(system.switching))
     y = np.empty(len(system.outputs))
