@@ -38,7 +38,15 @@ from clutchlab.hysteresis import _kernels as K
 from clutchlab.system import simulate as core_simulate
 
 
-def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
+def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lugre=None):
+    """The drum bench's equations with a Python right-hand side, solved by ``solve_ivp`` between the controller
+    samples; returns ``(out, n_steps)``, ``out`` the samples' rows ``[t, omega_f, omega_r, theta, x, v, i1, i2]``.
+
+    ``lugre`` (a :class:`clutchlab.emtc.LuGreParameters`): the three elements slip with the LuGre coefficient
+    of [1] Eqs. 22-24 written out here, its bristle deflection ``z`` an eighth state of the ODE (stiff where
+    the slip is fast: give a stiff ``method``, "Radau"); it starts at its steady state when the armature
+    presses the clutch.  Without it, the coupling's kinetic coefficients ``mu_k``.
+    """
     veh, act, geo_p, tmap = VehicleParameters(), ActuatorParameters(), CouplingGeometry(), TorqueMap()
     ic = veh.rear_final_drive
     jf = veh.inertia_input_shaft + veh.inertia_front_axle / ic**2
@@ -69,8 +77,14 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
         i = min(max(i, grid[0]), grid[-1])
         return K.peek(tab, grid, pstack, ppref, mem["pl"], mem["pu"], i, idx, w)
 
+    if lugre is not None:
+        s0, s1, s2, mu_c, mu_p, v_s = (lugre.sigma0, lugre.sigma1, lugre.sigma2, lugre.mu_c, lugre.mu_p, lugre.v_s)
+
+        def stribeck(v):
+            return mu_c + (mu_p - mu_c) * math.exp(-((v / v_s) ** 2))  # [1], Eq. 24
+
     def rhs(t, y, arm, i_cmd):
-        wf, wr, _, x, xd, i1, i2 = y
+        wf, wr, _, x, xd, i1, i2 = y[:7]
         fm = magnet_force(i2, x)
         if arm == 1:
             dx, dxd, fn1 = xd, (fm - fk0 - kspr * x - csp * xd) / m0, 0.0  # Eq. 9
@@ -87,15 +101,28 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
         a_f = (te * ig * i0 - fxf * rw - rrf) / ic
         a_r = (fxr * rw + rrr) / ic
         dw = wf - wr
-        if arm == 2:
+        dz = 0.0
+        if arm == 2 and lugre is not None:
+            z = y[7]
+            dz = dw - s0 * abs(dw) / stribeck(dw) * z  # [1], Eq. 23
+            mu = s0 * z + s1 * dz + s2 * dw  # [1], Eq. 22: the same coefficient on all three elements
+            t1 = 2 / 3 * mu * geo_p.radius1 * fn1 * geo_p.pairs1  # Eq. 15, in the direction of mu
+            den_mu = 3 * geo_p.cam_radius - 2 * geo_p.cam_ratio * abs(mu) * geo_p.radius3
+            tc = t1 * (1 + (2 * geo_p.cam_ratio * abs(mu) * geo_p.radius2 * geo_p.pairs2
+                            + 2 * geo_p.cam_ratio * abs(mu) * geo_p.radius3) / den_mu)
+        elif arm == 2:
             t1 = 2 / 3 * geo_p.mu_k1 * geo_p.radius1 * fn1 * geo_p.pairs1 * math.copysign(1.0, dw)  # Eq. 15
             tc = t1 * gain
         else:
             tc = kdrag * dw  # Eqs. 25-26
-        return [(a_f - tc) / jf, (tc - a_r) / jr, 0.0, dx, dxd, (i_cmd - i1) / tau1, (i1 - i2) / tau2]
+        out = [(a_f - tc) / jf, (tc - a_r) / jr, 0.0, dx, dxd, (i_cmd - i1) / tau1, (i1 - i2) / tau2]
+        return out if lugre is None else out + [dz]
 
     atol = np.array([1e-4, 1e-4, 1e-7, 1e-9, 1e-6, 1e-5, 1e-5]) if atol is None else atol
     y = np.array([vdf / rw * ic, vdr / rw * ic, 0, 0, 0, 0, 0], float)
+    if lugre is not None:   # the bristles: about mu_p / sigma0 = 6.5e-5 rad at most
+        atol = np.append(atol, 1e-9 * float(np.min(atol[:2])) / 1e-4)
+        y = np.append(y, 0.0)
     arm = 0
     ts = sc.sample_time
     n = int(round(sc.duration / ts)) + 1
@@ -111,7 +138,7 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
         mem["cl"] = K.commit(tab, grid, cstack, cpref, mem["cl"], mem["cu"], i_cmd)
         mem["cu"] = i_cmd
         out[k, 0] = t
-        out[k, 1:] = y
+        out[k, 1:] = y[:7]
         if k == n - 1:
             break
         t_end = t + ts
@@ -143,6 +170,8 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45"):
             if sol.status == 1:
                 if arm == 1 and sol.t_events[1].size:
                     arm, y[3], y[4] = 2, sigma, 0.0
+                    if lugre is not None and y[0] != y[1]:   # bristles at their steady state (Eq. 23, dz/dt = 0)
+                        y[7] = stribeck(y[0] - y[1]) / s0 * math.copysign(1.0, y[0] - y[1])
                 elif arm == 1:
                     arm, y[3], y[4] = 0, 0.0, 0.0
                 elif arm == 0:

@@ -2,7 +2,9 @@
 
 Three friction options: a constant coefficient, a coefficient map
 ``mu(slip speed, temperature)``, and the LuGre model (Eqs. 22-24) whose
-bristle state is advanced exactly over each step (stable for any step size).
+bristle state is advanced in closed form over each step (stable for any step size):
+:func:`lugre_advance` at a held slip (a sampled slip history), :func:`lugre_advance_path`
+along the slip's path over an integrator step (the drum bench, docs/emtc.md).
 The open-clutch drag torque is Eq. 25; Eq. 26 selects drag or friction torque.
 
 References
@@ -116,6 +118,84 @@ def lugre_advance(z, v, h, p):
     g = stribeck_g(v, p)
     zss = g / p[0] * (1.0 if v > 0.0 else -1.0)
     return zss + (z - zss) * math.exp(-p[0] * abs(v) * h / g)
+
+
+@numba.njit(cache=True, nogil=True)
+def _lugre_path(z, v0, v1, a0, h, p):
+    """:func:`lugre_advance_path` over an interval in which the slip keeps one sign (``v0 * v1 >= 0``)."""
+    s = 1.0 if v0 + v1 > 0.0 else -1.0
+    vm = 0.5 * (v0 + v1)
+    am = p[0] * abs(vm) / stribeck_g(vm, p) * h  # lambda h at the middle speed
+    # the speed at which lambda and z_ss' are held: the centre of the kernel exp(-lambda (h - s)) that weighs the
+    # forcing over the interval: the middle where the bristles are slow, the end where they are fast
+    back = 0.5 - am / 12.0 if am < 1e-3 else 1.0 / am - 1.0 / math.expm1(am)
+    ve = v1 - back * (v1 - v0)
+    lam = p[0] * abs(ve) / stribeck_g(ve, p)  # relaxation rate of Eq. 23 [1/s]
+    a = lam * h
+    decay = math.exp(-a)
+    # the forcing int_0^h exp(-lambda (h - s)) dv/ds ds for dv/ds linear from a0 to a1 = 2 (v1 - v0)/h - a0 (the
+    # quadratic path): a1 phi - (a1 - a0) psi, phi = (1 - e^-a)/lambda, psi = (1 - e^-a (1 + a))/(lambda^2 h)
+    if a < 1e-4:
+        phi_h = 1.0 - 0.5 * a + a * a / 6.0          # phi / h
+        psi_h = 0.5 - a / 3.0 + a * a / 8.0          # psi / h
+    else:
+        phi_h = -math.expm1(-a) / a
+        psi_h = (-math.expm1(-a) - a * decay) / (a * a)
+    dv = v1 - v0
+    forcing = 2.0 * dv * (phi_h - psi_h) + a0 * h * (2.0 * psi_h - phi_h)
+    dg = -2.0 * (p[4] - p[3]) * ve / (p[5] * p[5]) * math.exp(-((ve / p[5]) ** 2))  # g'(v) of Eq. 24
+    z0 = s * stribeck_g(v0, p) / p[0]
+    z1 = s * stribeck_g(v1, p) / p[0]
+    # w = z - z_ss(v) obeys dw/dt = -lambda(v) w - z_ss'(v) dv/dt; lambda and z_ss' held at ve
+    return z1 + (z - z0) * decay - s * dg / p[0] * forcing
+
+
+@numba.njit(cache=True, nogil=True)
+def lugre_advance_path(z, v0, v1, a0, h, p):
+    """Bristle state after ``h`` seconds of a slip speed moving from ``v0`` to ``v1`` ([1], Eq. 23).
+
+    The slip follows the quadratic path that starts with the slope ``a0`` (the slip acceleration at the start,
+    [rad/s^2]) and ends at ``v1``.  Eq. 23 is written for the deviation from the steady state,
+    ``w = z - z_ss(v)`` with ``z_ss = g(v) sgn(v) / sigma0``: while the slip keeps its sign it reads
+    ``dw/dt = -lambda(v) w - z_ss'(v) dv/dt`` with ``lambda = sigma0 |v| / g(v)``, solved exactly with
+    ``lambda`` and ``z_ss'`` held at one speed: the centre of the kernel ``exp(-lambda (h - s))`` that weighs
+    the forcing, which is the middle speed where the bristles are slow (``lambda h`` small: second order in
+    ``h``) and the end speed where they are fast (``1/lambda`` is 30 us at 2 rad/s).  There the result is the
+    steady state at ``v1`` plus the bristles' lag behind the slip's acceleration *at the end*, which Eq. 22's
+    damping ``sigma1 dz/dt`` multiplies by ``sigma1 lambda`` (about 2e5): a path with the acceleration of the
+    interval's secant (a straight ramp) would put the lag half a step behind, an error first order in the step
+    that no error estimate of the integrator sees (docs/emtc.md); an update at a held mid-interval slip
+    (:func:`lugre_advance`) leaves ``z`` on the steady state of the middle speed, a far larger one.  A slip that
+    changes sign within the interval is advanced along a straight ramp to its zero and on from there.
+    ``h <= 0`` returns ``z``.
+
+    Parameters
+    ----------
+    z : float
+        Bristle deflection at the start [rad].
+    v0, v1 : float
+        Slip speed at the start and the end of the interval [rad/s].
+    a0 : float
+        Slip acceleration at the start [rad/s^2].
+    h : float
+        Interval [s].
+    p : ndarray
+        :meth:`LuGreParameters.kernel_data`.
+
+    Returns
+    -------
+    float
+        Bristle deflection at the end [rad].
+    """
+    if h <= 0.0:
+        return z
+    if v0 == 0.0 and v1 == 0.0:
+        return z  # Eq. 23: dz/dt = 0 at zero slip
+    if v0 * v1 >= 0.0:
+        return _lugre_path(z, v0, v1, a0, h, p)
+    h0 = h * v0 / (v0 - v1)  # the slip's zero (on the straight ramp)
+    ramp = (v1 - v0) / h
+    return _lugre_path(_lugre_path(z, v0, 0.0, ramp, h0, p), 0.0, v1, ramp, h - h0, p)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -26,7 +26,8 @@ Hybrid structure:
 * the plant magnet's hysteresis memory and the LuGre bristle state are committed once per accepted step
   (:func:`_accept`, or at an event before the mode changes), never inside the stages: stages evaluate the
   magnet with :func:`~clutchlab.hysteresis._kernels.peek_segment` (:func:`~clutchlab.hysteresis._kernels.peek`
-  while the armature moves) and advance the bristles from their committed value;
+  while the armature moves) and advance the bristles from their committed value along the slip's path from
+  the step's start (:func:`~clutchlab.emtc.friction.lugre_advance_path`, anchored by :func:`_anchor_bristles`);
 * a full hysteresis memory is a model error (codes in :data:`ERROR_MESSAGES`), not a solver status.
 
 References
@@ -54,7 +55,7 @@ from ..numerics.core import record
 from ..numerics.layout import indices, slots
 from ..system import System, follow_rtol, register_model
 from ._lookup import bilinear, interp1
-from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance, lugre_mu, stribeck_g
+from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance_path, lugre_mu, stribeck_g
 from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
 from .torque import UNLOCK_MARGIN, CouplingGeometry, _cam_force, _locked, _locked_capacity, _slipping
 
@@ -172,7 +173,7 @@ AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque"
 N_AUX = len(AUX)
 #: per-run float memories and scratch (EmtcParams.fmem)
 FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torque_reference", 1), ("feasible", 1),
-             ("z", 1), ("t_last", 1), ("dw_last", 1),
+             ("z", 1), ("t_last", 1), ("dw_last", 1), ("dv_last", 1),
              ("plant_weights", GAP_TABLES + 1),   # airgap weights of the plant tables, the airgap they are for
              ("controller_weights", GAP_TABLES),  # weights of the controller model's table (one at the engaged airgap)
              ("inputs_at_restart", len(INPUTS)),    # inputs seen at the last restart
@@ -188,10 +189,10 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              #                              hysteresis._kernels.peek_segment), the stack version (IM_PVER), last
              #                              input and airgap it is for
              ("controller_segment", 8))   # the controller model's rising stretch (hysteresis._kernels.invert_combined)
-(FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
+(FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_DVLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
  FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(
     "plant_input", "controller_input", "command", "torque_reference", "feasible", "z", "t_last", "dw_last",
-    "plant_weights", "controller_weights", "inputs_at_restart", "aux", "split", "derivative", "switching", "key",
+    "dv_last", "plant_weights", "controller_weights", "inputs_at_restart", "aux", "split", "derivative", "switching", "key",
     "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment")
 N_FMEM = FMEM.total
 #: controller log (one row per sample, for the per-sample view of simulate_bench)
@@ -537,9 +538,8 @@ def _commit(t, x, p):
             imem[IM_PVER] += 1
     fmem[FM_PU] = inew
     tlast = fmem[FM_TLAST]
-    if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # exact update at the mid-step slip (Eq. 23)
-        dw_mid = 0.5 * ((x[0] - x[1]) + fmem[FM_DWLAST])
-        fmem[FM_Z] = lugre_advance(fmem[FM_Z], dw_mid, t - tlast, p.lugre)
+    if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # Eq. 23 over the step, as its stages saw it
+        fmem[FM_Z] = lugre_advance_path(fmem[FM_Z], fmem[FM_DWLAST], x[0] - x[1], fmem[FM_DVLAST], t - tlast, p.lugre)
     fmem[FM_TLAST] = t
     return 0
 
@@ -748,9 +748,12 @@ def _rhs(t, x, u, m, p, dx, g):
             m2 = m1
             m3 = m1
         elif p.friction_mode == FRICTION_LUGRE:
-            # [1], Eqs. 22-23: bristles advanced exactly from their committed value at the step start
+            # [1], Eqs. 22-23: bristles advanced from their committed value at the step start along the slip
+            # from there to this stage (the update _commit makes at the step's end: the last stage's friction is
+            # the friction of the committed state)
             tlast = fmem[FM_TLAST]
-            zb = lugre_advance(fmem[FM_Z], dw, t - tlast if tlast == tlast else 0.0, p.lugre)
+            zb = lugre_advance_path(fmem[FM_Z], fmem[FM_DWLAST], dw, fmem[FM_DVLAST], t - tlast if tlast == tlast else 0.0,
+                                    p.lugre)
             mu = lugre_mu(zb, dw, p.lugre)
             if mu != 0.0:
                 sl = mu
@@ -870,7 +873,22 @@ def _update(t, x, u, m, p, k, log):
     if r < 0:
         return r
     _switch(k, t, x, u, m, p, log)
+    _anchor_bristles(t, x, u, m, p)  # the bristles go on from the slip after the event (a lock-up sets it)
     return 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _anchor_bristles(t, x, u, m, p):
+    """The start of the slip's path along which the stages advance the LuGre bristles ([1], Eq. 23): the slip
+    speed and, with LuGre friction, the slip acceleration at ``(t, x)`` with the bristles committed there
+    (:func:`~clutchlab.emtc.friction.lugre_advance_path`).  After every commit, event and restart."""
+    fmem = p.fmem
+    fmem[FM_DWLAST] = x[0] - x[1]
+    fmem[FM_DVLAST] = 0.0
+    if p.friction_mode == FRICTION_LUGRE and fmem[FM_TLAST] == t:
+        fmem[FM_KEY] = np.nan
+        _evaluate(t, x, u, m, p)
+        fmem[FM_DVLAST] = fmem[FM_DX] - fmem[FM_DX + 1]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -878,9 +896,9 @@ def _restart(t, x, u, m, p, log):
     fmem = p.fmem
     imem = p.imem
     changed = False
-    if fmem[FM_TLAST] != fmem[FM_TLAST]:  # first start: the memories begin here
+    first = fmem[FM_TLAST] != fmem[FM_TLAST]
+    if first:  # first start: the memories begin here
         fmem[FM_TLAST] = t
-        fmem[FM_DWLAST] = x[0] - x[1]
     ts = p.sample_time
     k = imem[IM_KNEXT]
     if t >= k * ts - 1e-9 * ts:  # a controller sample is due (break time, or a resumed run that starts on it)
@@ -914,13 +932,13 @@ def _restart(t, x, u, m, p, log):
                 break
             _switch(kk, t, x, u, m, p, log)
             changed = True
+    if first or jumped:
+        _anchor_bristles(t, x, u, m, p)
     return changed
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _accept(t, x, u, m, p):
-    if p.friction_mode == FRICTION_LUGRE:
-        p.fmem[FM_KEY] = np.nan  # the committed bristle state changes the friction at the same point
     # (committing the magnet memory at the current coil current leaves the magnet force there unchanged)
     e = p.imem[IM_ERROR]
     if e != 0:
@@ -929,9 +947,9 @@ def _accept(t, x, u, m, p):
     if r < 0:
         p.imem[IM_ERROR] = r
         return r
-    p.fmem[FM_DWLAST] = x[0] - x[1]
-    # the committed bristle state changes the friction: the derivative at the new point must be recomputed
-    return 1 if p.friction_mode == FRICTION_LUGRE else 0
+    _anchor_bristles(t, x, u, m, p)
+    # (the last stage advanced the bristles as the commit did: its derivative is the one at the new point)
+    return 0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)

@@ -10,6 +10,7 @@ Three scenarios, each at rtol = 1e-9 (tight: the integration error is far below 
 regression test), 8 columns subsampled to at most 250 rows, and the named events.
 """
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +33,13 @@ def scenarios():
 
 def main():
     magnet = bundled_magnet()
-    data = {}
+    # ``python make_regression_traces.py NAME ...`` rewrites only the named scenarios and keeps the others' data
+    only = set(sys.argv[1:])
+    path = Path(__file__).with_name("regression_traces.npz")
+    data = dict(np.load(path)) if only else {}
     for name, sc, kw in scenarios():
+        if only and name not in only:
+            continue
         res = simulate_bench(magnet, sc, rtol=1e-9, **kw)
         df = res.to_dataframe()
         step = max(1, len(df) // 250)
@@ -41,7 +47,7 @@ def main():
         data[f"{name}_values"] = df[list(COLUMNS)].to_numpy()[::step]
         data[f"{name}_event_time"] = res.events["time_s"].to_numpy()
         data[f"{name}_event_name"] = res.events["event"].to_numpy().astype(str)
-    np.savez_compressed(Path(__file__).with_name("regression_traces.npz"), **data)
+    np.savez_compressed(path, **data)
 
 
 if __name__ == "__main__":

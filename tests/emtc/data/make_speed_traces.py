@@ -27,6 +27,7 @@ the named events and the number of accepted steps:
   the controller.
 """
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -60,8 +61,13 @@ def scenarios():
 
 
 def main():
-    data = {}
+    # ``python make_speed_traces.py NAME ...`` rewrites only the named scenarios and keeps the others' data
+    only = set(sys.argv[1:])
+    path = Path(__file__).with_name("speed_traces.npz")
+    data = dict(np.load(path)) if only else {}
     for name, magnet, sc, kw in scenarios():
+        if only and name not in only:
+            continue
         res = simulate_bench(magnet, sc, **kw)
         r = res.result
         rows = slice(None, None, max(1, r.time.size // 60))
@@ -74,7 +80,7 @@ def main():
         data[f"{name}_event_name"] = r.events["event"].to_numpy().astype(str)
         data[f"{name}_steps"] = np.array([res.n_steps])
         print(name, res.n_steps, list(r.events["event"]))
-    np.savez_compressed(Path(__file__).with_name("speed_traces.npz"), **data)
+    np.savez_compressed(path, **data)
 
 
 if __name__ == "__main__":
