@@ -278,6 +278,24 @@ def test_airgap_interpolation_is_continuous_with_its_slope():
     assert abs(above - below) > 1e-3 * scale
 
 
+def test_airgap_weights_refuse_arrays_too_short_for_four_tables():
+    """A caller sized for the three tables of the reading before the twenty-fifth session (a benchmark did) gets
+    NaN weights, and nothing is written past its arrays (compiled code does not check bounds: the writes past
+    their end had corrupted memory).  Arrays of GAP_TABLES get finite weights that sum to one."""
+    from clutchlab.hysteresis import _kernels as K
+
+    gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4]) * 1e-3
+    guard = np.full(8, 7.0)
+    iguard = np.full(8, 7, dtype=np.int64)
+    idx, w = iguard[:3], guard[:3]
+    K.gap_weights(gaps, 0.7e-3, idx, w)
+    assert np.all(np.isnan(w)) and np.all(idx == 0)
+    assert np.all(guard[3:] == 7.0) and np.all(iguard[3:] == 7)
+    idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
+    K.gap_weights(gaps, 0.7e-3, idx, w)
+    assert np.all(np.isfinite(w)) and w.sum() == pytest.approx(1.0, rel=1e-14)
+
+
 def test_family_inverse_at_off_grid_airgap():
     gaps = np.array([0.2, 0.6, 1.0, 1.4]) * 1e-3
     fam = Preisach(GRID, np.array([random_table(s) * (1.5 - 0.3 * k) for k, s in enumerate(range(4))]), gaps)

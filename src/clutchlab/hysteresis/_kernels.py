@@ -117,8 +117,17 @@ def gap_weights(gaps, gap, idx, w):
 
     Fills ``idx[0:GAP_TABLES]`` (table indices) and ``w[0:GAP_TABLES]`` (weights; unused slots get weight 0).
     Three tables: the quadratic through them; two: linear interpolation; one: weight 1.  ``gap`` is clamped
-    by the caller to the calibration range.
+    by the caller to the calibration range.  Arrays shorter than ``GAP_TABLES`` (a caller sized for the
+    three tables of the reading before: compiled code does not check bounds, and the writes past their end
+    corrupted memory) get NaN weights, which every force read with them carries, and nothing is written past
+    their end.
     """
+    if idx.shape[0] < GAP_TABLES or w.shape[0] < GAP_TABLES:
+        for q in range(idx.shape[0]):
+            idx[q] = 0
+        for q in range(w.shape[0]):
+            w[q] = np.nan
+        return
     k = gaps.shape[0]
     for q in range(GAP_TABLES):
         idx[q] = 0
