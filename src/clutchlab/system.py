@@ -35,7 +35,9 @@ import pandas as pd
 
 from ._limits import check_allocation, short_repr
 from .errors import ParameterError, SimulationError
+from .numerics import calls
 from .numerics import status as st
+from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
@@ -823,12 +825,8 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
                             system.name)
 
 
-#: bits of a session call (``clutchlab.numerics.session.ADVANCE`` and ``OUTPUTS``): advance to the end time;
-#: evaluate the outputs and the report at the time reached
-_ADVANCE = 1
-_OUTPUTS = 2
-#: kinds of reported values (``clutchlab.numerics.session.REPORT_*``) by the names :meth:`Simulation.report` takes
-_REPORT_KINDS = {"output": 0, "state": 1, "mode": 2, "mode_is": 3}
+#: kinds of reported values (``clutchlab.numerics.calls.REPORT_*``) by the names :meth:`Simulation.report` takes
+_REPORT_KINDS = {name: k for k, name in enumerate(calls.REPORT_KINDS)}
 
 
 def _held(name: str, doc: str) -> property:

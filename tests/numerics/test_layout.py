@@ -18,7 +18,8 @@ ROOT = Path(clutchlab.__file__).parent
 #: solver state, the session's report kinds, the sampled controllers' and the wet friction laws' kinds
 GENERATED = ("wet/system.py", "emtc/system.py", "eclutch/system.py", "driveline/kernel.py", "driveline/wet.py",
              "driveline/emtc.py", "driveline/block.py", "numerics/core.py", "numerics/session.py",
-             "numerics/sampled.py", "wet/friction.py")
+             "numerics/sampled.py", "wet/friction.py", "numerics/rosenbrock.py", "numerics/exchange.py",
+             "numerics/status.py", "numerics/calls.py", "fmu/native/__init__.py", "system.py", "emtc/bench.py")
 #: integers in them that are numbers, not positions (name: why)
 NOT_INDICES = {
     "ERR_PLANT_MEMORY": "a model error code (negative: the hooks' convention)",
@@ -30,6 +31,14 @@ NOT_INDICES = {
     "RESTART": "a code a model's update returns",
     "ADVANCE": "a bit of a session call's request",
     "OUTPUTS": "a bit of a session call's request",
+    "ALGEBRAIC_FAILED": "a model error code of the model exchange",
+    "NEWTON_ITERATIONS": "a count: the algebraic rows' Newton iterations",
+    "ORDER_EST": "a number: the local order of Rodas3's error estimate",
+    "CHUNK_ROWS": "a capacity: rows of a recorded chunk",
+    "FIRST_CHUNK_ROWS": "a capacity: rows of the first recorded chunk",
+    "EVENT_CAPACITY": "a capacity: events recorded",
+    "_CHECKED_GRIDS_SIZE": "a capacity: output grids remembered as checked",
+    "_PIPELINE_RESERVE": "a capacity: a pipeline's reserve of rows",
 }
 
 
@@ -42,6 +51,18 @@ def test_indices_follow_the_declaration_by_name():
         indices(decl, "w")
     with pytest.raises(ValueError, match="names x twice"):
         indices((("x",), ("x",)), "x")
+
+
+def test_bits_are_one_flag_per_entry():
+    from clutchlab.numerics import calls, exchange
+    from clutchlab.numerics.layout import bits
+
+    assert bits(("a", "b", "c"), "c") == 4 and bits(("a", "b", "c"), "b", "a") == (2, 1)
+    with pytest.raises(KeyError, match="'d' is not declared"):
+        bits(("a", "b"), "d")
+    flags = [getattr(exchange, "ME_" + n.upper()) for n in exchange.ME_REQUESTS]
+    assert flags == [1 << k for k in range(len(flags))]
+    assert (calls.ADVANCE, calls.OUTPUTS) == (1, 2)
 
 
 def test_slots_are_consecutive_and_sum_to_the_total():
@@ -64,12 +85,17 @@ def test_slots_are_consecutive_and_sum_to_the_total():
     ("clutchlab.driveline.kernel", "EVENTS", "EV_"), ("clutchlab.driveline.kernel", "ELEM_COLUMNS", "E_"),
     ("clutchlab.driveline.kernel", "SIGNAL_KINDS", "SIG_"), ("clutchlab.driveline.kernel", "ELEMENT_KINDS", "K_"),
     ("clutchlab.numerics.core", "SOLVER_FLOATS", "SF_"), ("clutchlab.numerics.core", "SOLVER_INTS", "SI_"),
-    ("clutchlab.numerics.session", "REPORT_KINDS", "REPORT_"), ("clutchlab.wet.friction", "FRICTION_KINDS", "KIND_"),
+    ("clutchlab.numerics.calls", "REPORT_KINDS", "REPORT_"), ("clutchlab.wet.friction", "FRICTION_KINDS", "KIND_"),
+    ("clutchlab.numerics.status", "STATUSES", "="), ("clutchlab.numerics.rosenbrock", "ROW_KINDS", "="),
+    ("clutchlab.fmu.native", "ROLES", "=_"),
 ])
 def test_each_declared_entry_has_exactly_one_constant(module, declaration, prefix):
     """The constants of a declaration are a permutation of its positions (none missing, none twice)."""
     mod = importlib.import_module(module)
-    values = sorted(v for k, v in vars(mod).items() if k.startswith(prefix) and k.isupper() and type(v) is int)
+    if prefix.startswith("="):   # an enumeration whose constants are its names (SUCCESS, KEEP, _PARAMETER, ...)
+        values = sorted(getattr(mod, prefix[1:] + e.upper()) for e in getattr(mod, declaration))
+    else:
+        values = sorted(v for k, v in vars(mod).items() if k.startswith(prefix) and k.isupper() and type(v) is int)
     assert values == list(range(len(getattr(mod, declaration))))
 
 

@@ -250,9 +250,6 @@ _AFTER = {
 }
 
 
-_NONE7 = (None,) * 7
-
-
 def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: VehicleParameters | None = None,
                    actuator: ActuatorParameters | None = None, coupling: CouplingGeometry | None = None,
                    torque_map: TorqueMap | None = None, controller_model=None, friction_map=None, lugre=None,
@@ -320,7 +317,7 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
     """
     scenario = scenario or _default(BenchScenario)
     given = (actuator, coupling, torque_map, controller_model, friction_map, lugre, torque_reference)
-    if given == _NONE7:
+    if all(g is None for g in given):
         options = _default(S.BenchOptions)
     else:
         options = S.BenchOptions(actuator=actuator, coupling=coupling, torque_map=torque_map,

@@ -54,18 +54,17 @@ from numba.extending import register_jitable
 from . import dispatch as model
 from .borrow import borrow, byref
 from .core import SF_T, _apply_updates, _fd_jacobian
+from .layout import bits
 from .rosenbrock import lu_factor, lu_solve
 from .session import _args, fill_report
 
 __all__ = ["call", "FIELDS", "ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART", "ME_STORE", "ME_OUTPUTS",
            "ALGEBRAIC_FAILED", "NEWTON_ITERATIONS", "workspace"]
 
-ME_DERIVATIVES = 1
-ME_ACCEPT = 2
-ME_EVENT = 4
-ME_RESTART = 8
-ME_STORE = 16
-ME_OUTPUTS = 32
+#: what a model-exchange call may be asked for, one bit each (a native FMU's C layer gets them as #defines)
+ME_REQUESTS = ("derivatives", "accept", "event", "restart", "store", "outputs")
+ME_DERIVATIVES, ME_ACCEPT, ME_EVENT, ME_RESTART, ME_STORE, ME_OUTPUTS = bits(
+    ME_REQUESTS, "derivatives", "accept", "event", "restart", "store", "outputs")
 
 #: a model error of the exchange itself: the algebraic rows' Newton iteration did not converge
 ALGEBRAIC_FAILED = -9001

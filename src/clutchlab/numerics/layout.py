@@ -8,6 +8,7 @@ declaration, at import:
 * :func:`indices` -- the position of each named entry of a declaration
   (``S_W = indices(STATES, "slip_speed")``): reordering the declaration moves the constant with its entry, and a
   renamed or removed entry is refused at import, never silently read from another row;
+* :func:`bits` -- one bit per named entry (a request made of flags: ``1 << indices(...)``);
 * :func:`slots` -- consecutive named slots of a flat array from ``(name, size)`` pairs (a driveline block's buffer:
   its states, their derivatives, switching values, inputs, outputs; a model's work memory): each offset is the
   sum of the sizes before it, and :attr:`Slots.total` the array's length.
@@ -17,7 +18,7 @@ Everything here is plain Python ``int``; nothing is compiled.
 
 from __future__ import annotations
 
-__all__ = ["indices", "slots", "Slots"]
+__all__ = ["indices", "bits", "slots", "Slots"]
 
 
 def _names(declaration) -> list:
@@ -50,6 +51,17 @@ def indices(declaration, *names: str):
             raise KeyError(f"{n!r} is not declared (declared: {', '.join(known)})")
         out.append(where[n])
     return out[0] if len(out) == 1 else tuple(out)
+
+
+def bits(declaration, *names: str):
+    """The flag ``1 << position`` of each of ``names`` in ``declaration`` (as :func:`indices`: one name gives an
+    ``int``, several a tuple).
+
+    >>> bits(("derivatives", "accept", "event"), "event", "derivatives")
+    (4, 1)
+    """
+    at = indices(declaration, *names)
+    return 1 << at if isinstance(at, int) else tuple(1 << a for a in at)
 
 
 class Slots:

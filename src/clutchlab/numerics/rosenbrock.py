@@ -39,6 +39,7 @@ import numba
 from numba import uintp as _u
 
 from .borrow import shaped
+from .layout import indices, slots
 
 __all__ = ["GAMMA", "lu_factor", "lu_solve", "plan_reduction", "reduced_factor", "reduced_solve", "reduction_sizes",
            "rodas_next_step"]
@@ -143,9 +144,14 @@ def lu_solve(lu, piv, b):
 # position: the usual effective stiffness k h gamma / m of an implicit mass-spring step) and solving the
 # trailing rows last leaves a smaller dense system for the partial-pivoting LU.  On the E-clutch (20 states):
 # 5 kinematic, 4 trailing, 11 kept; an LU of 20 x 20 and four solves were most of a step's cost.
-KEEP, KINEMATIC, TRAILING = 0, 1, 2
-_NK, _NKIN, _NTR, _MODE, _DENSE_NOW = 0, 1, 2, 3, 4
-_HEAD = 8
+#: the kinds of rows (``plan_reduction``)
+ROW_KINDS = ("keep", "kinematic", "trailing")
+KEEP, KINEMATIC, TRAILING = indices(ROW_KINDS, "keep", "kinematic", "trailing")
+#: the head of the plan's integer work (the row lists follow it): the counts of kept, kinematic and trailing
+#: rows, whether the reduction is used, whether the dense factors are current; three spare slots
+PLAN_HEAD = slots(("kept", 1), ("kinematic", 1), ("trailing", 1), ("reduced", 1), ("dense_now", 1), ("spare", 3))
+_NK, _NKIN, _NTR, _MODE, _DENSE_NOW = PLAN_HEAD.of("kept", "kinematic", "trailing", "reduced", "dense_now")
+_HEAD = PLAN_HEAD.total
 
 
 @numba.njit(cache=True, nogil=True)

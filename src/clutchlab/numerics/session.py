@@ -31,20 +31,15 @@ from numba.core import cgutils, types
 from numba.extending import NativeValue, intrinsic, models, register_jitable, register_model, typeof_impl, unbox
 
 from .borrow import _strip
-from .layout import indices
+from .calls import ADVANCE, OUTPUTS, REPORT_KINDS, REPORT_MODE, REPORT_MODE_IS, REPORT_OUTPUT, REPORT_STATE  # noqa: F401
 from .status import SUCCESS, TERMINATED
 
 __all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "table_layout",
            "FIELDS",
            "ADVANCE", "OUTPUTS", "REPORT_OUTPUT", "REPORT_STATE", "REPORT_MODE", "REPORT_MODE_IS"]
 
-#: bits of ``what`` in :func:`call`: advance to the end time; evaluate the outputs and fill the report
-ADVANCE = 1
-OUTPUTS = 2
-
-#: kinds of reported values (``report[k, 0]``; ``report[k, 1]`` is the index, ``report[k, 2]`` the value compared)
-REPORT_KINDS = ("output", "state", "mode", "mode_is")
-REPORT_OUTPUT, REPORT_STATE, REPORT_MODE, REPORT_MODE_IS = indices(REPORT_KINDS, "output", "state", "mode", "mode_is")
+# the bits of ``what`` in :func:`call` (ADVANCE, OUTPUTS) and the kinds of reported values (REPORT_*):
+# clutchlab.numerics.calls, declared there once
 
 #: members of the packed arguments (a tuple, in this order)
 FIELDS = ("p", "x", "m", "u", "sf", "si", "opt", "log", "ts", "rt", "rx", "rm", "ry", "want_y", "y", "report", "r")

@@ -4,17 +4,16 @@ from __future__ import annotations
 
 import enum
 
+from .layout import indices
+
 __all__ = ["Status", "SUCCESS", "STEP_LIMIT", "STEP_UNDERFLOW", "TERMINATED", "RECORD_FULL", "SINGULAR",
            "MODEL_ERROR", "message"]
 
+#: the statuses in the order of their codes (the C layer of a native FMU reads them from here too)
+STATUSES = ("success", "step_limit", "step_underflow", "terminated", "record_full", "singular", "model_error")
 # plain ints for the compiled core (numba reads module-level ints as constants)
-SUCCESS = 0
-STEP_LIMIT = 1
-STEP_UNDERFLOW = 2
-TERMINATED = 3
-RECORD_FULL = 4
-SINGULAR = 5
-MODEL_ERROR = 6
+SUCCESS, STEP_LIMIT, STEP_UNDERFLOW, TERMINATED, RECORD_FULL, SINGULAR, MODEL_ERROR = indices(
+    STATUSES, "success", "step_limit", "step_underflow", "terminated", "record_full", "singular", "model_error")
 
 
 class Status(enum.IntEnum):

@@ -38,6 +38,7 @@ import zipfile
 from pathlib import Path
 
 from ...errors import ClutchlabError, ParameterError
+from ...numerics.layout import indices
 from .image import NativeExportError, accepted_range, parameter_map, session_image
 
 __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
@@ -45,7 +46,10 @@ __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATF
 #: the platforms a native FMU can carry
 PLATFORMS = ("linux64", "win64")
 
-_PARAMETER, _CONSTANT, _INPUT, _OUTPUT, _STATE, _DERIVATIVE = 0, 1, 2, 3, 4, 5
+#: the roles of a native FMU's variables (its C layer gets them as #defines)
+ROLES = ("parameter", "constant", "input", "output", "state", "derivative")
+_PARAMETER, _CONSTANT, _INPUT, _OUTPUT, _STATE, _DERIVATIVE = indices(
+    ROLES, "parameter", "constant", "input", "output", "state", "derivative")
 
 
 def native_identifier(name: str) -> str:
