@@ -199,6 +199,20 @@ def test_the_cone_clutch_in_a_file_follows_its_closed_form(tmp_path, cone):
     assert abs(ev_cli.time_s.iloc[0] - t_lock) < 1e-9
 
 
+def test_the_element_listing_names_a_file_s_component_types(tmp_path, cone):
+    """Driveline.elements: a component of a file is listed with its file's type (the cone clutch, built by the
+    network's clutch), its flanges and its describe() line."""
+    path = tmp_path / "cone.toml"
+    path.write_text(CONE)
+    d = load_driveline(path).driveline
+    (e,) = d.elements
+    assert (e.name, e.kind, e.flange_a, e.flange_b, e.support) == ("c", "cone_clutch", "J1", "J2", None)
+    assert "  " + e.summary in d.describe().splitlines()
+    direct = Driveline("cone").inertia("J1", J1, w0=W0).inertia("J2", J2)
+    cone_clutch.CONE_CLUTCH.build(direct, "c", a="J1", b="J2", force=F, r_mean=R)
+    assert direct.elements[0].kind == "clutch"   # built through the method: the method's name
+
+
 def test_a_flat_disc_is_the_networks_clutch(tmp_path, cone):
     """alpha = 90 deg: the cone is a disc, T = mu F r_m: the network's own clutch with cgeo = r_m."""
     path = tmp_path / "cone.toml"

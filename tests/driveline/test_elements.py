@@ -581,3 +581,31 @@ def test_lossy_gear_holds_within_its_loss_band_and_releases_at_its_edge():
     j_eff = J1 + J2 / (i ** 2 * eta)
     assert df["J1.w_rad_s"].iloc[1] == pytest.approx(0.5 * (0.6 - 0.125) ** 2 / j_eff, rel=1e-8)
     assert abs(df["energy_error_J"]).max() < 1e-9
+
+
+def test_the_element_listing_is_what_each_method_added():
+    """Driveline.elements lists every element in the order added, with the method that added it, its flanges
+    (``ground`` for none: a brake's and a bearing friction's flange_a is their support), a gear's support and its
+    line of describe(); it is a read-only view (a copy of each row)."""
+    d = (Driveline("listing")
+         .inertia("J1", 1.0).inertia("J2", 2.0).inertia("H", 5.0)
+         .torque("T", "J1", Signal.step(10.0))
+         .spring_damper("S", "J1", "J2", c=100.0, d=1.0)
+         .gear("G", "J2", "H", ratio=3.0, efficiency=0.9, support="J1")
+         .clutch("C", "J1", "J2", fn_max=100.0)
+         .brake("B", "J2", fn_max=50.0)
+         .bearing_friction("BF", "H", torque=0.5)
+         .one_way_clutch("OW", "J1", "H"))
+    rows = d.elements
+    assert [(e.name, e.kind, e.flange_a, e.flange_b, e.support) for e in rows] == [
+        ("T", "torque", "ground", "J1", None), ("S", "spring_damper", "J1", "J2", None),
+        ("G", "gear", "J2", "H", "J1"), ("C", "clutch", "J1", "J2", None), ("B", "brake", "ground", "J2", None),
+        ("BF", "bearing_friction", "ground", "H", None), ("OW", "one_way_clutch", "J1", "H", None)]
+    lines = d.describe().splitlines()
+    assert lines[-len(rows):] == ["  " + e.summary for e in rows]
+    assert "efficiency 0.9" in rows[2].summary and "on support J1" in rows[2].summary
+    with pytest.raises(AttributeError):
+        rows[0].name = "other"
+    assert [e.name for e in Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements] \
+        == ["G"] and Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements[0].support \
+        == "ground"

@@ -506,10 +506,13 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
             back = {v: k for k, v in renames.items()}
             args = {back.get(f, f): _field_value(fields[f], v, f"{key}.{f}", src, base, uses, speed_unit, angle_unit)
                     for f, v in comp.items()}
+            n_before = len(d._elements)
             try:
                 comp_decl.build(d, name, **args)
             except (ParameterError, DataError) as exc:
                 raise ParameterError(f"{src}: [{key}] {exc}") from None
+            for e in d._elements[n_before:]:   # (Driveline.elements: the file's component type, cone_clutch)
+                e.kind_name = kind
     if not d._inertias:
         raise ParameterError(f"{src}: no [{body}.NAME] table (a driveline needs at least one {body})")
     _declare_inputs(d, declared, uses, src)

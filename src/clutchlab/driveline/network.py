@@ -19,6 +19,7 @@ are those of the Modelica Standard Library (MSL 4.x, :mod:`clutchlab.driveline.k
 from __future__ import annotations
 
 import copy
+import functools
 import math
 import sys
 from dataclasses import dataclass
@@ -32,7 +33,7 @@ from ..units import COLUMN_UNITS
 from ..system import System, register_model, simulate as _simulate
 from . import kernel as K
 
-__all__ = ["Driveline", "Signal", "GROUND"]
+__all__ = ["Driveline", "Signal", "GROUND", "ElementInfo"]
 
 GROUND = "ground"
 
@@ -549,6 +550,40 @@ class _Element:
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
     emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
     sup: str | None = None    # a gear's support (housing) inertia; None: the ground
+    kind_name: str = ""       # what added it: a builder's name ("clutch", "brake", ...) or a component's type
+
+
+@dataclass(frozen=True)
+class ElementInfo:
+    """One element of a :class:`Driveline`, as :attr:`Driveline.elements` lists it (a read-only view).
+
+    ``name``: the element's name (its result columns' prefix); ``kind``: what added it, the name of the
+    :class:`Driveline` method (``"clutch"``, ``"brake"``, ``"gear"``, ``"wet_clutch"``, ...) or of the
+    component type of a driveline file (``"cone_clutch"``); ``flange_a``, ``flange_b``: the inertias it acts
+    between (``"ground"`` for the fixed ground: a brake's ``flange_a`` is its support); ``support``: a
+    gear's housing inertia (``"ground"`` if fixed, ``None`` for other elements); ``summary``: its line of
+    :meth:`Driveline.describe`."""
+
+    name: str
+    kind: str
+    flange_a: str
+    flange_b: str
+    support: str | None
+    summary: str
+
+
+def _adds(kind: str):
+    """Marks a :class:`Driveline` method as adding elements of ``kind`` (:attr:`ElementInfo.kind`)."""
+    def wrap(method):
+        @functools.wraps(method)
+        def run(self, *args, **kwargs):
+            n = len(self._elements)
+            out = method(self, *args, **kwargs)
+            for e in self._elements[n:]:
+                e.kind_name = kind
+            return out
+        return run
+    return wrap
 
 
 class Driveline:
@@ -702,12 +737,14 @@ class Driveline:
                                 None if phi0 is None else _finite(name, labels[2], phi0))
         return self
 
+    @_adds("force")
     def force(self, name: str, flange, signal, support=None) -> "Driveline":
         """A force source [N] pushing ``flange`` (translational drivelines; as :meth:`torque`)."""
         if self.domain != "translational":
             raise ParameterError(f"{name}: a rotational driveline has torque sources (torque(...)), not forces")
         return self.torque(name, flange, signal, support)
 
+    @_adds("spring_damper")
     def spring_damper(self, name: str, a, b, c: float = 0.0, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
         """Spring ``c`` [N m/rad] and damper ``d`` [N m s/rad] in parallel between flanges a and b
         (``tau = c (phi_b - phi_a - phi_rel0) + d (w_b - w_a)``)."""
@@ -718,6 +755,7 @@ class Driveline:
                                                                  _finite(name, "phi_rel0", phi_rel0), 0.0)))
         return self
 
+    @_adds("spring")
     def spring(self, name: str, a, b, curve, d: float = 0.0, phi_rel0: float = 0.0) -> "Driveline":
         """A nonlinear spring and a damper ``d`` [N m s/rad] in parallel between flanges a and b:
         ``tau = curve(phi_b - phi_a - phi_rel0) + d (w_b - w_a)``.
@@ -749,6 +787,7 @@ class Driveline:
                                        law=K.SPRING_CURVE, table=table, aux=int(kind)))
         return self
 
+    @_adds("backlash")
     def backlash(self, name: str, a, b, c: float, b_gap: float, d: float = 0.0, phi_rel0: float = 0.0,
                  damping_law: str = "kelvin_voigt") -> "Driveline":
         """A spring-damper behind a gap between flanges a and b (as MSL ``ElastoBacklash``): no torque in the
@@ -781,6 +820,7 @@ class Driveline:
                                        aux=laws[damping_law] if d > 0.0 else K.LASH_KELVIN_VOIGT))
         return self
 
+    @_adds("gear")
     def gear(self, name: str, a, b, ratio: float, efficiency: float = 1.0, loss_table=None,
              support=None) -> "Driveline":
         """A gear between flanges a and b on a support (MSL ``IdealGear``, ``LossyGear``): ``phi_a - phi_s = ratio
@@ -878,6 +918,7 @@ class Driveline:
         self._elements.append(_Element(K.K_MOTION, name, None, b, law=law, signal=sig))
         return self
 
+    @_adds("speed")
     def speed(self, name: str, flange, signal) -> "Driveline":
         """A speed source (MSL ``Speed`` with ``exact = true``): ``flange`` turns at ``signal(t)`` [rad/s]
         against the ground, whatever torque it takes (reported as the source's torque).  The signal must
@@ -885,12 +926,14 @@ class Driveline:
         flange's initial speed."""
         return self._motion(name, flange, signal, K.MOTION_SPEED, "speed")
 
+    @_adds("position")
     def position(self, name: str, flange, signal) -> "Driveline":
         """A position source (MSL ``Position`` with ``exact = true``): ``flange`` follows ``signal(t)`` [rad].
         The signal must have a continuous speed: a constant or a sine starting at t = 0; its value and
         rate at 0 are the flange's initial angle and speed.  (For a ramp or table, prescribe the speed.)"""
         return self._motion(name, flange, signal, K.MOTION_POSITION, "position")
 
+    @_adds("torque")
     def torque(self, name: str, flange, signal, support=None) -> "Driveline":
         """A torque source [N m] accelerating ``flange`` (its reaction on ``support``, default the ground)."""
         name = self._new_name(name)
@@ -903,6 +946,7 @@ class Driveline:
         self._elements.append(_Element(K.K_SOURCE, name, a, b, signal=Signal.of(signal, f"{name}: torque")))
         return self
 
+    @_adds("engine")
     def engine(self, name: str, flange, torque_map, throttle=1.0, idle_speed: float | None = None,
                idle_kp: float = 2.0, idle_ki: float = 20.0, idle_torque_max: float = 50.0, support=None) -> "Driveline":
         """A combustion engine driving ``flange`` (its crankshaft inertia; reaction on ``support``, default ground).
@@ -974,6 +1018,7 @@ class Driveline:
             raise ParameterError(f"{name}: {what} table must start at w = 0, increase in w and be >= 0")
         return tuple(arr[:, 0]) + tuple(arr[:, 1])
 
+    @_adds("clutch")
     def clutch(self, name: str, a, b, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
                normal=1.0, radius: float | None = None, temperature: float | None = None,
                mu_scale: float = 1.0) -> "Driveline":
@@ -990,6 +1035,7 @@ class Driveline:
         return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
                               fn_max, cgeo, normal)
 
+    @_adds("brake")
     def brake(self, name: str, flange, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
               normal=1.0, support=None, radius: float | None = None,
               temperature: float | None = None, mu_scale: float = 1.0) -> "Driveline":
@@ -1055,6 +1101,7 @@ class Driveline:
         values = np.concatenate([values, [values[-1]]])
         return tuple(float(q) for q in w) + tuple(float(q) for q in values)
 
+    @_adds("bearing_friction")
     def bearing_friction(self, name: str, flange, torque=1.0, peak: float = 1.0, support=None) -> "Driveline":
         """Bearing friction of ``flange`` against ``support`` (default the ground; MSL ``BearingFriction``):
         sliding torque ``torque`` [N m], a number or a table ``[[w_rad_s, N m], ...]``; never free."""
@@ -1062,6 +1109,7 @@ class Driveline:
         a, b = self._two(name, support, flange)
         return self._friction(name, a, b, K.LAW_TABLE, self._characteristic(name, "torque", torque), peak)
 
+    @_adds("eclutch")
     def eclutch(self, name: str, a, b, position, model: int = 4, parameters=None, travel: float = 8e-3,
                 points: int = 161, peak: float = 1.0, actuator=None, actuator_step: float = 1e-3,
                 pre_roll: float = 1.0, settle: float = 0.5) -> "Driveline":
@@ -1161,6 +1209,7 @@ class Driveline:
         corners = np.concatenate([t[change], t[change + 1]])
         return t, fn, corners, f"{len(t)} samples every {step * 1e3:g} ms, pre-roll {pre_roll:g} s"
 
+    @_adds("wet_clutch")
     def wet_clutch(self, name: str, a, b, force, clutch=None, bench=None, friction=None,
                    temperature0: float = 80.0, fluid_temperature0: float = 80.0,
                    housing_temperature0: float = 80.0) -> "Driveline":
@@ -1216,6 +1265,7 @@ class Driveline:
         el.model = f"wet clutch (seed 001, N_c = {clutch.n_c:g}, R_eff = {clutch.r_eff:g} m)"
         return self
 
+    @_adds("emtc")
     def emtc(self, name: str, a, b, magnet=None, scenario=None, vehicle=None, options=None, *, torque_request=None,
              throttle=None, coil_current=None) -> "Driveline":
         """The electromagnetic torque-controlled coupling of seed 002 between flanges a (its input, front shaft)
@@ -1331,6 +1381,7 @@ class Driveline:
             out.append((el, params, W.initial_state(scenario), w["clutch"]))
         return out
 
+    @_adds("one_way_clutch")
     def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
                        normal=1.0, mu_scale: float = 1.0) -> "Driveline":
         """A one-way clutch between flanges a and b (MSL ``OneWayClutch``: a freewheel in parallel with a clutch).
@@ -1358,65 +1409,68 @@ class Driveline:
         x0 = self.initial_state()
         n = len(self._inertias)
         u = self._units
-        (jn, ju), (an, _, au), (wn, _, wu), (_, _, tu) = u["inertia"], u["angle"], u["speed"], u["torque"]
-        st, dm = u["stiffness"], u["damping"]
+        (jn, ju), (an, _, au), (wn, _, wu) = u["inertia"], u["angle"], u["speed"]
         for i, (name, (J, _w0, _phi0)) in enumerate(self._inertias.items()):
             lines.append(f"  [{name}]  {jn} = {J:g} {ju}, {wn}0 = {x0[n + i]:g} {wu}, {an}0 = {x0[i]:g} {au}")
         for name, (unit, start, _d) in self._inputs.items():
             lines.append(f"  input {name} [{unit}], start {start:g}")
         for e in self._elements:
-            a, b = e.a or GROUND, e.b or GROUND
-            if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
-                lines.append(f"  {a} --({e.name}: {e.model}, throttle {e.signal.describe()})--> [{b}]")
-                continue
-            if e.kind == K.K_SOURCE:
-                lines.append(f"  {a} --({e.name}: {u['words'][2]} {e.signal.describe(tu)})--> [{b}]")
-                continue
-            if e.kind == K.K_MOTION:
-                what, unit = ("speed", wu) if e.law == K.MOTION_SPEED else (u["words"][1], au)
-                lines.append(f"  {a} --({e.name}: {what} {e.signal.describe(unit)})--> [{b}]")
-                continue
-            if e.kind == K.K_GEAR:
-                nrow = len(e.table) // 5
-                what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
-                if self._is_lossy(e):
-                    what += (f", efficiency {e.table[nrow]:g}" if nrow == 1 and e.table[nrow] == e.table[2 * nrow]
-                             and e.table[3 * nrow] == e.table[4 * nrow] == 0.0 else f", loss table of {nrow} rows")
-                if e.sup is not None:
-                    what += f", on support {e.sup}"
-            elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
-                what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
-            elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
-                what = (f"backlash gap {e.coef[3]:g} {au}, c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
-                        + (", MSL damping law" if e.aux == K.LASH_MSL else ""))
-            elif e.kind == K.K_SPRING:
-                what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
-            elif e.law == K.LAW_ONEWAY:
-                what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
-                        f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")
-            elif e.law == K.LAW_EXTERNAL and e.emtc is not None:
-                sc = e.emtc["scenario"]
-                what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
-                        f"{sc.ramp_start:g}-{sc.ramp_end:g} s, controller every {sc.sample_time * 1e3:g} ms")
-                what += "".join(f", {q} {v.describe({'N*m': 'N m', '1': '', 'A': 'A'}[unit])}" for (q, unit), v in
-                                zip(EMTC_PORTS, (e.emtc["ports"][q] for q, _ in EMTC_PORTS)) if v is not None)
-            elif e.law == K.LAW_EXTERNAL:
-                what = f"{e.model}, force reference {e.signal.describe('N')}"
-            else:
-                n = len(e.table) // 2
-                char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
-                if e.law == K.LAW_TABLE:
-                    what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
-                elif e.reference is not None:
-                    what = f"{e.model}, bearing reference {e.reference.describe('m')}"
-                elif e.ncurve:
-                    what = (f"{e.model}, static curve of {len(e.ncurve) // 2} points, lift-off at "
-                            f"{e.liftoff * 1e3:g} mm, position {e.signal.describe('m')}")
-                else:
-                    normal = "" if e.signal is None else f", normal {e.signal.describe()}"
-                    what = f"friction fn_max = {e.coef[0]:g} N, mu {char}, peak {e.coef[2]:g}{normal}"
-            lines.append(f"  [{a}] --({e.name}: {what})-- [{b}]")
+            lines.append("  " + self._element_line(e))
         return "\n".join(lines)
+
+    def _element_line(self, e) -> str:
+        """An element's line of :meth:`describe` (without its indent)."""
+        u = self._units
+        wn, wu, au, tu = u["speed"][0], u["speed"][2], u["angle"][2], u["torque"][2]
+        st, dm = u["stiffness"], u["damping"]
+        a, b = e.a or GROUND, e.b or GROUND
+        if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
+            return f"{a} --({e.name}: {e.model}, throttle {e.signal.describe()})--> [{b}]"
+        if e.kind == K.K_SOURCE:
+            return f"{a} --({e.name}: {u['words'][2]} {e.signal.describe(tu)})--> [{b}]"
+        if e.kind == K.K_MOTION:
+            what, unit = ("speed", wu) if e.law == K.MOTION_SPEED else (u["words"][1], au)
+            return f"{a} --({e.name}: {what} {e.signal.describe(unit)})--> [{b}]"
+        if e.kind == K.K_GEAR:
+            nrow = len(e.table) // 5
+            what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
+            if self._is_lossy(e):
+                what += (f", efficiency {e.table[nrow]:g}" if nrow == 1 and e.table[nrow] == e.table[2 * nrow]
+                         and e.table[3 * nrow] == e.table[4 * nrow] == 0.0 else f", loss table of {nrow} rows")
+            if e.sup is not None:
+                what += f", on support {e.sup}"
+        elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
+            what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
+        elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
+            what = (f"backlash gap {e.coef[3]:g} {au}, c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+                    + (", MSL damping law" if e.aux == K.LASH_MSL else ""))
+        elif e.kind == K.K_SPRING:
+            what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+        elif e.law == K.LAW_ONEWAY:
+            what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
+                    f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")
+        elif e.law == K.LAW_EXTERNAL and e.emtc is not None:
+            sc = e.emtc["scenario"]
+            what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
+                    f"{sc.ramp_start:g}-{sc.ramp_end:g} s, controller every {sc.sample_time * 1e3:g} ms")
+            what += "".join(f", {q} {v.describe({'N*m': 'N m', '1': '', 'A': 'A'}[unit])}" for (q, unit), v in
+                            zip(EMTC_PORTS, (e.emtc["ports"][q] for q, _ in EMTC_PORTS)) if v is not None)
+        elif e.law == K.LAW_EXTERNAL:
+            what = f"{e.model}, force reference {e.signal.describe('N')}"
+        else:
+            n = len(e.table) // 2
+            char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
+            if e.law == K.LAW_TABLE:
+                what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
+            elif e.reference is not None:
+                what = f"{e.model}, bearing reference {e.reference.describe('m')}"
+            elif e.ncurve:
+                what = (f"{e.model}, static curve of {len(e.ncurve) // 2} points, lift-off at "
+                        f"{e.liftoff * 1e3:g} mm, position {e.signal.describe('m')}")
+            else:
+                normal = "" if e.signal is None else f", normal {e.signal.describe()}"
+                what = f"friction fn_max = {e.coef[0]:g} N, mu {char}, peak {e.coef[2]:g}{normal}"
+        return f"[{a}] --({e.name}: {what})-- [{b}]"
 
     def __repr__(self) -> str:
         try:
@@ -1427,6 +1481,15 @@ class Driveline:
     @property
     def friction_names(self) -> tuple:
         return tuple(e.name for e in self._elements if e.kind == K.K_FRICTION)
+
+    @property
+    def elements(self) -> tuple:
+        """The network's elements in the order they were added, each an :class:`ElementInfo` (name, kind,
+        flanges, a gear's support, its :meth:`describe` line): a read-only view; change a network through its
+        methods or its file."""
+        return tuple(ElementInfo(e.name, e.kind_name, e.a or GROUND, e.b or GROUND,
+                                 (e.sup or GROUND) if e.kind == K.K_GEAR else None, self._element_line(e))
+                     for e in self._elements)
 
     def pack(self) -> K.DrivelineParams:
         """The packed parameters (:class:`~clutchlab.driveline.kernel.DrivelineParams`)."""
