@@ -35,9 +35,8 @@ import pandas as pd
 
 from ._limits import check_allocation, short_repr
 from .errors import ParameterError, SimulationError
-from .numerics import calls
 from .numerics import status as st
-from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS
+from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS, REPORT_KINDS
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
@@ -826,7 +825,7 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
 
 
 #: kinds of reported values (``clutchlab.numerics.calls.REPORT_*``) by the names :meth:`Simulation.report` takes
-_REPORT_KINDS = {name: k for k, name in enumerate(calls.REPORT_KINDS)}
+_REPORT_KINDS = {name: k for k, name in enumerate(REPORT_KINDS)}
 
 
 def _held(name: str, doc: str) -> property:

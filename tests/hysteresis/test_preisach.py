@@ -291,6 +291,17 @@ def test_airgap_weights_refuse_arrays_too_short_for_four_tables():
     K.gap_weights(gaps, 0.7e-3, idx, w)
     assert np.all(np.isnan(w)) and np.all(idx == 0)
     assert np.all(guard[3:] == 7.0) and np.all(iguard[3:] == 7)
+    # the readers take no weight past the arrays' end either (there a table index would be garbage): NaN out
+    iguard[3:] = 10**9
+    guard[3:] = 1.0
+    fam = Preisach(GRID, np.array([random_table(s) for s in range(7)]), gaps)
+    fam.simulate([0.0, 3.0, 1.0], airgap=0.7e-3)
+    assert np.isnan(K.weighted_output(fam.kernel_tables, fam.grid, fam._stack, fam._length, fam._pref, fam._u,
+                                      idx, w))
+    assert np.isnan(K.peek(fam.kernel_tables, fam.grid, fam._stack, fam._pref, fam._length, fam._u, 2.0, idx, w))
+    comb = np.zeros((1,) + fam.kernel_tables.shape[1:])
+    K.combine_tables(fam.kernel_tables, idx, w, comb)
+    assert np.all(np.isnan(comb[0][np.tril_indices(comb.shape[1])]))
     idx, w = np.zeros(K.GAP_TABLES, dtype=np.int64), np.zeros(K.GAP_TABLES)
     K.gap_weights(gaps, 0.7e-3, idx, w)
     assert np.all(np.isfinite(w)) and w.sum() == pytest.approx(1.0, rel=1e-14)

@@ -100,6 +100,14 @@ def _add_quadratic(gaps, s, gap, scale, idx, w, q0):
     w[q0 + 2] += scale * (gap - x0) * (gap - x1) / ((x2 - x0) * (x2 - x1))
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _weights_read(idx, w):
+    """How many airgap weights a reader of ``idx``, ``w`` takes: :data:`GAP_TABLES`, or as many as a shorter array
+    holds (:func:`gap_weights` gave such arrays NaN weights: the output is NaN, and nothing is read past their
+    end, where a table index would be garbage)."""
+    return min(GAP_TABLES, idx.shape[0], w.shape[0])
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def gap_weights(gaps, gap, idx, w):
     """Airgap interpolation weights over the calibration airgaps ``gaps`` ([1], Sec. 2.1: "second-order
@@ -119,8 +127,8 @@ def gap_weights(gaps, gap, idx, w):
     Three tables: the quadratic through them; two: linear interpolation; one: weight 1.  ``gap`` is clamped
     by the caller to the calibration range.  Arrays shorter than ``GAP_TABLES`` (a caller sized for the
     three tables of the reading before: compiled code does not check bounds, and the writes past their end
-    corrupted memory) get NaN weights, which every force read with them carries, and nothing is written past
-    their end.
+    corrupted memory) get NaN weights, which every force read with them carries, and nothing is written or
+    read past their end (the readers take :func:`_weights_read` weights).
     """
     if idx.shape[0] < GAP_TABLES or w.shape[0] < GAP_TABLES:
         for q in range(idx.shape[0]):
@@ -205,7 +213,7 @@ def weighted_output(tables, grid, stack, length, pref, v, idx, w):
     ib2 = locate(grid, b2)
     p = length // 2
     f = 0.0
-    for q in range(GAP_TABLES):
+    for q in range(_weights_read(idx, w)):
         if w[q] != 0.0:
             k = idx[q]
             g = pref[k, p] + forc_value_ij(tables, k, grid, a, ia, v, iv)  # [1], Eq. 3 (rising) or Eq. 2 (falling)
@@ -302,7 +310,7 @@ def peek(tables, grid, stack, pref, length, u, v, idx, w):
                 prev = stack[L - 2] if L >= 3 else u
                 ip = locate(grid, prev)
                 f = 0.0
-                for q in range(GAP_TABLES):
+                for q in range(_weights_read(idx, w)):
                     if w[q] != 0.0:
                         k = idx[q]
                         term = forc_value_ij(tables, k, grid, mx, im, u, iu)
@@ -322,7 +330,7 @@ def peek(tables, grid, stack, pref, length, u, v, idx, w):
                 prev = stack[L - 1] if L >= 1 else v
                 ip = locate(grid, prev)
                 f = 0.0
-                for q in range(GAP_TABLES):
+                for q in range(_weights_read(idx, w)):
                     if w[q] != 0.0:
                         k = idx[q]
                         g = pref[k, L // 2] + forc_value_ij(tables, k, grid, u, iu, v, iv)
@@ -488,11 +496,12 @@ def combine_tables(tables, idx, w, out):
     interpolation can be applied to the coefficients once per airgap change.
     """
     n = tables.shape[1]
+    nw = _weights_read(idx, w)
     for i in range(n):
         for j in range(i + 1):
             for c in range(4):
                 acc = 0.0
-                for q in range(GAP_TABLES):
+                for q in range(nw):
                     if w[q] != 0.0:
                         acc += w[q] * tables[idx[q], i, j, c]
                 out[0, i, j, c] = acc
@@ -501,7 +510,7 @@ def combine_tables(tables, idx, w, out):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _wpref(pref, p, idx, w):
     acc = 0.0
-    for q in range(GAP_TABLES):
+    for q in range(_weights_read(idx, w)):
         if w[q] != 0.0:
             acc += w[q] * pref[idx[q], p]
     return acc
