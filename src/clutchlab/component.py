@@ -57,6 +57,8 @@ FIELD_KINDS = {
     "path": "a file, relative to the network file",
     "map": "a table of its own format (the field's description)",
     "losstable": "rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2] (MSL lossTable)",
+    "thermal": "the name of a thermal mass ([thermal_mass.NAME]): a heat port of the component",
+    "names": "a list of the names of other components of the network",
 }
 #: the field kinds whose value can be a plain number: the parameters of a file (sweeps, FMUs)
 NUMERIC_KINDS = ("quantity", "signal", "characteristic")

@@ -286,6 +286,23 @@ BUILTIN = (
         Field("coil_current", "signal", "A",
               description="port: the coil current set point of a current drive (Fig. 15; no torque controller)"),
     ), _emtc, "seed 002, Eqs. 1-26 and 31"),
+    Component("thermal_mass", "A thermal mass that the losses of elements heat, with a conductance to its ambient: "
+                              "C dT/dt = sum P_loss - G (T - T_ambient) - its conductors' flows.", (
+        Field("capacity", "quantity", "J/K", required=True, positive=True, description="heat capacity"),
+        Field("T0", "quantity", "degC", default=20.0, minimum=_ABS_ZERO_C, description="initial temperature"),
+        Field("conductance", "quantity", "W/K", default=0.0, minimum=0.0,
+              description="thermal conductance to its ambient (0: insulated)"),
+        Field("ambient", "quantity", "degC", default=20.0, minimum=_ABS_ZERO_C,
+              description="the ambient's temperature"),
+        Field("heat_from", "names", description="the elements whose losses heat it (their heat ports; each heats "
+                                                "one mass; not sources, wet clutches or EMTCs)"),
+    ), _method("thermal_mass"), "Modelica.Thermal.HeatTransfer.Components.HeatCapacitor, ThermalConductor, "
+                                f"FixedTemperature; {_MSL}.Interfaces.PartialElementaryConditionalHeatPort", _BOTH),
+    Component("thermal_conductor", "A thermal conductor between two thermal masses: heat flow G (T_a - T_b).", (
+        Field("a", "thermal", required=True, description="the thermal mass at its port a"),
+        Field("b", "thermal", required=True, description="the thermal mass at its port b"),
+        Field("conductance", "quantity", "W/K", required=True, minimum=0.0, description="thermal conductance G"),
+    ), _method("thermal_conductor"), "Modelica.Thermal.HeatTransfer.Components.ThermalConductor", _BOTH),
 )
 for _c in BUILTIN:
     register_component(_c)

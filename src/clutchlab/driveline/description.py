@@ -121,7 +121,7 @@ def field_units(domain: str = "rotational") -> dict:
 #: field kinds whose value carries the field's unit
 _UNIT_KINDS = ("quantity", "signal", "characteristic", "curve")
 #: field kinds that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable")
+NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable", "thermal", "names")
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -301,6 +301,16 @@ def _field_value(field, v, fkey, src, base, uses, speed_unit, angle_unit):
         if not isinstance(v, str):
             raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of an inertia or \"ground\"")
         return v
+    if kind == "thermal":
+        if not isinstance(v, str) or not v:
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected the name of a thermal mass")
+        return v
+    if kind == "names":
+        if isinstance(v, str):
+            v = [v]
+        if not isinstance(v, list) or not all(isinstance(n, str) and n for n in v):
+            raise ParameterError(f"{src}: {fkey} = {v!r}: expected a list of component names ([\"C1\", \"D1\"])")
+        return tuple(v)
     if kind == "signal":
         sig = _signal(v, field.unit, fkey, src, uses)
         if field.minimum is not None or field.maximum is not None or field.positive:
@@ -515,6 +525,10 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
                 e.kind_name = kind
     if not d._inertias:
         raise ParameterError(f"{src}: no [{body}.NAME] table (a driveline needs at least one {body})")
+    try:   # the heat ports name elements anywhere in the file: checked once all are built
+        d._heat_rows()
+    except ParameterError as exc:
+        raise ParameterError(f"{src}: {exc}") from None
     _declare_inputs(d, declared, uses, src)
     return DrivelineFile(d, settings.get("t_end"), settings.get("output_step"), settings.get("rtol", 1e-8),
                          settings.get("max_step"))

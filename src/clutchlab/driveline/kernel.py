@@ -105,11 +105,27 @@ SIGNAL_KINDS = ("const", "step", "ramp", "sine", "table", "sampled", "pulse", "t
 N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: columns of ``elem`` (ints): "aux" is a curve's kind (0 linear, 1 pchip) or an engine map's throttle points;
 #: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
-#: inertia, -1 the ground
-ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support")
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP = indices(
-    ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support")
+#: inertia, -1 the ground; "heat" the thermal mass (row of ``thermal``) its losses flow into, -1 none
+ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat")
+E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP, E_HEAT = indices(
+    ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat")
 N_ELEM = len(ELEM_COLUMNS)
+#: columns of ``thermal`` (one row per thermal mass, MSL ``Thermal.HeatTransfer.Components.HeatCapacitor`` with a
+#: ``ThermalConductor`` to a ``FixedTemperature``): heat capacity [J/K], conductance to its ambient [W/K], the
+#: ambient's temperature [degC], its initial temperature [degC], and the position of its temperature in the state
+#: vector (its heat given to the ambient [J] follows it), a whole number held as a float
+THERMAL_COLUMNS = ("capacity", "conductance", "ambient", "initial", "state")
+T_CAP, T_COND, T_AMB, T_INIT, T_STATE = indices(THERMAL_COLUMNS, "capacity", "conductance", "ambient", "initial",
+                                                "state")
+N_THERMAL = len(THERMAL_COLUMNS)
+#: states of a thermal mass, from its ``state`` column on
+THERMAL_STATES = ("temperature", "heat_out")
+TS_TEMP, TS_OUT = indices(THERMAL_STATES, "temperature", "heat_out")
+#: columns of ``links`` (one row per thermal conductor between two masses, MSL ``ThermalConductor``): the rows of
+#: its masses in ``thermal`` (whole numbers held as floats) and its conductance [W/K]
+LINK_COLUMNS = ("a", "b", "conductance")
+L_A, L_B, L_COND = indices(LINK_COLUMNS, "a", "b", "conductance")
+N_LINK = len(LINK_COLUMNS)
 #: columns of ``coef`` (floats), their meaning by the element's kind: a spring-damper (a curve: its points at
 #: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
 #: curve of E_AUX points: its data offset and lift-off input); a gear, w_a = ratio * w_b (its loss table, MSL
@@ -169,7 +185,8 @@ class DrivelineParams(NamedTuple):
     ``elem[r, E_MODE]``); ``lossy``: of each gear with losses (MSL ``LossyGear``; its mode at ``elem[r, E_MODE]``);
     ``check``: ``[on, energy tolerance]``, the invariants checked at every accepted step (:func:`check_invariants`);
     ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
-    scratch of the hooks (per run).
+    scratch of the hooks (per run); ``thermal`` (columns ``T_*``): the thermal masses the elements' losses heat
+    (``elem[r, E_HEAT]``), ``links`` (``L_*``): the thermal conductors between them (:func:`thermal_rates`).
     """
 
     inertia: np.ndarray
@@ -184,6 +201,8 @@ class DrivelineParams(NamedTuple):
     work: np.ndarray
     iwork: np.ndarray
     check: np.ndarray
+    thermal: np.ndarray
+    links: np.ndarray
 
 
 # ----------------------------------------------------------------- signals
@@ -2181,7 +2200,7 @@ def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
 def _params_type():
     """numba type of the :class:`DrivelineParams` reference every kernel function takes (one type for every network)."""
     i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
-    return ByRef(numba.typeof(DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1)))
+    return ByRef(numba.typeof(DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1, f2, f2)))
 
 
 _F1, _F2, _I1 = types.float64[::1], types.float64[:, ::1], types.int64[::1]
@@ -3213,7 +3232,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     States: ``phi`` (n), ``w`` (n), then one energy per element in element order [J]: a source's work
     ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
     the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift); then
-    the integral of each engine's idle controller [N m] (:func:`engine_torque`).  Switching functions, five per friction element: the relative speed of a sliding element in its
+    the integral of each engine's idle controller [N m] (:func:`engine_torque`); then each thermal mass's temperature
+    [degC] and heat given to its ambient [J] (:func:`thermal_rates`).  Switching functions, five per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged), the turning point of a slow sliding speed, or of a stuck one's margin near its
@@ -3247,19 +3267,15 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         dx[n + i] = acc[i]
     for r in range(ne):
         kind = p.elem[r, E_KIND]
-        w_rel = relative_speed(p, r, x, n)
-        if kind == K_SPRING:
-            _tq, tc = spring_torque(p, r, x, n, m)
-            dx[2 * n + r] = (tau[r] - tc) * w_rel
-        elif kind == K_SOURCE or kind == K_MOTION:
-            dx[2 * n + r] = -tau[r] * w_rel
+        if kind == K_SOURCE or kind == K_MOTION:
+            dx[2 * n + r] = -tau[r] * relative_speed(p, r, x, n)
             if kind == K_SOURCE and p.elem[r, E_LAW] == SOURCE_ENGINE and p.elem[r, E_STATE] >= 0:
                 _tq, rate = engine_torque(p, r, t, x, n)
                 dx[2 * n + ne + p.elem[r, E_STATE]] = rate
-        elif kind == K_GEAR:   # the power the gear takes from its flanges: its loss (and the constraint's drift)
-            dx[2 * n + r] = gear_power(p, r, x, n, m, tau[r])
         else:
-            dx[2 * n + r] = tau[r] * w_rel
+            dx[2 * n + r] = loss_power(p, r, x, n, m, tau[r])
+    if p.thermal.shape[0] > 0:
+        thermal_rates(p, x, n, dx)
     for k in range(nf):
         r = p.fric[k]
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
@@ -3357,6 +3373,71 @@ def driveline_rhs(t, x, u, m, p, dx, g):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def loss_power(p, r, x, n, m, tau):
+    """Power [W] element row ``r`` (not a source) dissipates, MSL ``lossPower``, with ``tau`` its torque: the rate of
+    its dissipated energy: a friction element's ``tau w_rel``; a spring-damper's ``(tau - tau_c) w_rel``, its
+    damper's part (``tau_c`` the spring's); a gear's :func:`gear_power` (its mesh and bearing losses, zero for an
+    ideal or a stuck one but for the constraints' drift)."""
+    kind = p.elem[r, E_KIND]
+    w_rel = relative_speed(p, r, x, n)
+    if kind == K_SPRING:
+        _tq, tc = spring_torque(p, r, x, n, m)
+        return (tau - tc) * w_rel
+    if kind == K_GEAR:   # the power the gear takes from its flanges
+        return gear_power(p, r, x, n, m, tau)
+    return tau * w_rel
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def thermal_rates(p, x, n, dx):
+    """Rates of the thermal masses' states, from the elements' loss rates already in ``dx[2 n + r]``.
+
+    A thermal mass ``k`` (MSL ``HeatCapacitor``, its port joined to the heat ports of the elements whose losses flow
+    into it, ``useHeatPort = true``, ``heatPort.Q_flow = -lossPower``; a ``ThermalConductor`` to a
+    ``FixedTemperature`` ambient; ``ThermalConductor`` links to other masses)::
+
+        C_k dT_k/dt = sum_{r -> k} P_r - G_k (T_k - T_amb,k) - sum_{links l at k} G_l (T_k - T_other)
+        dQ_out,k/dt = G_k (T_k - T_amb,k)
+
+    with ``P_r`` the power element ``r`` dissipates (MSL ``lossPower``: a friction element's ``tau w_rel``, a
+    damper's ``d w_rel^2``, a lossy gear's mesh and bearing losses).  ``T`` [degC], ``C`` [J/K], ``G`` [W/K],
+    ``P`` [W], ``Q_out`` [J] (the heat given to the ambient since the start).  The losses leave the mechanical
+    network as the dissipated energies do, so the heat the masses store plus what they gave their ambients equals
+    the energy their elements dissipated (a linear invariant of the states, kept by the integrator to rounding).
+    """
+    th = p.thermal
+    nt = th.shape[0]
+    for k in range(nt):
+        s = int(th[k, T_STATE])
+        q = th[k, T_COND] * (x[s + TS_TEMP] - th[k, T_AMB])
+        dx[s + TS_TEMP] = -q
+        dx[s + TS_OUT] = q
+    for r in range(p.elem.shape[0]):
+        h = p.elem[r, E_HEAT]
+        if h >= 0:
+            dx[int(th[h, T_STATE]) + TS_TEMP] += dx[2 * n + r]
+    for j in range(p.links.shape[0]):
+        sa = int(th[int(p.links[j, L_A]), T_STATE])
+        sb = int(th[int(p.links[j, L_B]), T_STATE])
+        q = p.links[j, L_COND] * (x[sa + TS_TEMP] - x[sb + TS_TEMP])
+        dx[sa + TS_TEMP] -= q
+        dx[sb + TS_TEMP] += q
+    for k in range(nt):
+        s = int(th[k, T_STATE])
+        dx[s + TS_TEMP] /= th[k, T_CAP]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def dissipate(p, x, n, r, energy):
+    """Energy ``energy`` [J] dissipated by element row ``r`` at an instant (what a spring held as its contact
+    opens): into its dissipated energy and, where its losses heat a thermal mass, into that mass's temperature."""
+    x[2 * n + r] += energy
+    h = p.elem[r, E_HEAT]
+    if h >= 0:
+        x[int(p.thermal[h, T_STATE]) + TS_TEMP] += energy / p.thermal[h, T_CAP]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_power(p, r, x, n, m, tau):
     """Power [W] gear row ``r`` takes from the inertias it joins, ``-(sum of its torques on them times their
     speeds)``: its loss ``tauLoss (w_a - w_s)`` (MSL ``LossyGear.lossPower``), zero for an ideal or a stuck gear but
@@ -3429,7 +3510,8 @@ def driveline_outputs(t, x, u, m, p, y):
     """Per element: torque [N m] (a source: its torque on flange b; a gear: ``tau``, on flange a) and, for
     springs and friction, the relative speed [rad/s]; per friction element also its MSL mode code [-] and
     normal force [N]; then kinetic and spring energy, the sources' work, the dissipated energy and the
-    energy balance error [J]."""
+    energy balance error [J]; then per thermal mass the power its elements dissipate into it and the heat flow to
+    its ambient [W] (:func:`thermal_rates`)."""
     if u.shape[0] > 0 and hold_inputs(p.data, u):
         forget_signals(p)
     n = p.inertia.shape[0]
@@ -3473,6 +3555,16 @@ def driveline_outputs(t, x, u, m, p, y):
     y[q + 2] = work
     y[q + 3] = lost
     y[q + 4] = work - lost - (kinetic + spring - p.work[p.work.shape[0] - 1])
+    q += 5
+    th = p.thermal
+    for k in range(th.shape[0]):   # per thermal mass: the power its elements dissipate into it, the heat flow out
+        y[q] = 0.0
+        y[q + 1] = th[k, T_COND] * (x[int(th[k, T_STATE]) + TS_TEMP] - th[k, T_AMB])
+        q += 2
+    for r in range(ne):
+        h = p.elem[r, E_HEAT]
+        if h >= 0:
+            y[q - 2 * th.shape[0] + 2 * h] += loss_power(p, r, x, n, m, tau[r])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -3514,7 +3606,7 @@ def driveline_update(t, x, u, m, p, k, log):
             old = m[nf + j]
             new = _lash_msl_update(p, r, x, n, old, (k - N_G * nf) % N_SW)
             if new == LASH_GAP:   # at the edge: what the spring holds is ~0 (as below)
-                x[2 * n + r] += spring_energy(p, r, x, n, m)
+                dissipate(p, x, n, r, spring_energy(p, r, x, n, m))
             m[nf + j] = new
             if old == LASH_GAP or new == LASH_GAP:
                 record(log, t, EV_CONTACT if new != LASH_GAP else EV_SEPARATE, nf + j)
@@ -3539,7 +3631,7 @@ def driveline_update(t, x, u, m, p, k, log):
             if _lash_contact(p, r, x, n, 1.0 if side == LASH_UPPER else -1.0)[0] > 0.0:
                 m[nf + j] = LASH_UPPER_RELEASED if side == LASH_UPPER else LASH_LOWER_RELEASED
             else:
-                x[2 * n + r] += spring_energy(p, r, x, n, m)
+                dissipate(p, x, n, r, spring_energy(p, r, x, n, m))
                 m[nf + j] = LASH_GAP
             record(log, t, EV_SEPARATE, nf + j)
         else:
@@ -3604,7 +3696,9 @@ def check_invariants(t, x, m, p):
     * a backlash in its gap is not beyond an edge moving on outward, and one released beyond an edge (a damped contact
       that separated there) is not where its contact would push (either: a contact missed);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
-      that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed).
+      that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed), and the
+      thermal masses' heat balance (heat stored plus heat given to the ambients against the energy their elements
+      dissipated, :func:`thermal_rates`) within ``check[1]`` of those plus 1 J.
     """
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
@@ -3685,6 +3779,18 @@ def check_invariants(t, x, m, p):
         flow = abs(work) + abs(lost) + kinetic + spring + e0
         if abs(work - lost - (kinetic + spring - e0)) > p.check[1] * (flow + 1.0):
             return -(INV_BASE + N_INV * ne + INV_ENERGY)
+        if p.thermal.shape[0] > 0:
+            # the heat balance of the thermal masses: what they store and gave their ambients is what their
+            # elements dissipated (the links move heat between them)
+            heat, given = 0.0, 0.0
+            for k in range(p.thermal.shape[0]):
+                s = int(p.thermal[k, T_STATE])
+                heat += p.thermal[k, T_CAP] * (x[s + TS_TEMP] - p.thermal[k, T_INIT]) + x[s + TS_OUT]
+            for r in range(ne):
+                if p.elem[r, E_HEAT] >= 0:
+                    given += x[2 * n + r]
+            if abs(heat - given) > p.check[1] * (abs(heat) + abs(given) + 1.0):
+                return -(INV_BASE + N_INV * ne + INV_ENERGY)
     return 0
 
 

@@ -33,6 +33,8 @@ from ..units import COLUMN_UNITS
 from ..system import System, register_model, simulate as _simulate
 from . import kernel as K
 
+_ABS_ZERO_C = -273.15
+
 __all__ = ["Driveline", "Signal", "GROUND", "ElementInfo"]
 
 GROUND = "ground"
@@ -554,6 +556,26 @@ class _Element:
 
 
 @dataclass(frozen=True)
+class _ThermalMass:
+    """A thermal mass (:meth:`Driveline.thermal_mass`): SI, temperatures in degC."""
+    name: str
+    capacity: float      # [J/K]
+    T0: float            # initial temperature [degC]
+    conductance: float   # to its ambient [W/K]
+    ambient: float       # the ambient's temperature [degC]
+    heat_from: tuple     # the elements whose losses flow into it
+
+
+@dataclass(frozen=True)
+class _ThermalLink:
+    """A thermal conductor between two thermal masses (:meth:`Driveline.thermal_conductor`)."""
+    name: str
+    a: str
+    b: str
+    conductance: float   # [W/K]
+
+
+@dataclass(frozen=True)
 class ElementInfo:
     """One element of a :class:`Driveline`, as :attr:`Driveline.elements` lists it (a read-only view).
 
@@ -609,6 +631,8 @@ class Driveline:
         self._inertias: dict = {}
         self._elements: list = []
         self._inputs: dict = {}   # name -> (unit suffix, start value [SI], description)
+        self._thermal: dict = {}  # name -> _ThermalMass (thermal_mass)
+        self._links: list = []    # _ThermalLink (thermal_conductor)
 
     @property
     def _units(self):
@@ -692,7 +716,8 @@ class Driveline:
     # ---- components
     def _new_name(self, name):
         _word(f"{self.name}: component name", name)
-        if name == GROUND or name in self._inertias or any(e.name == name for e in self._elements):
+        if name == GROUND or name in self._inertias or any(e.name == name for e in self._elements) or \
+                name in self._thermal or any(link.name == name for link in self._links):
             raise ParameterError(f"{self.name}: component name {name!r} is used twice")
         return name
 
@@ -1399,6 +1424,111 @@ class Driveline:
                               None if fn_max == 0.0 else normal)
 
     # ---- the system
+    # ---- heat
+    def thermal_mass(self, name: str, capacity: float, T0: float = 20.0, conductance: float = 0.0,
+                     ambient: float = 20.0, heat_from=()) -> "Driveline":
+        """A thermal mass heated by the losses of elements of the network (MSL ``HeatCapacitor`` whose port the
+        elements' heat ports join, ``useHeatPort = true``, with a ``ThermalConductor`` to a ``FixedTemperature``).
+
+        ``C dT/dt = sum of the losses of heat_from - conductance (T - ambient) - the flows of its conductors``
+        (:func:`~clutchlab.driveline.kernel.thermal_rates`).  Its states are ``<name>.temperature_C`` and
+        ``<name>.heat_out_J`` (the heat given to its ambient since the start); its outputs ``<name>.loss_power_W``
+        (what its elements dissipate into it) and ``<name>.heat_flow_W`` (to its ambient).  The temperature is an
+        output of the losses; no friction law reads it.
+
+        Parameters
+        ----------
+        name : str
+            Its name (unique among the network's components).
+        capacity : float
+            Heat capacity [J/K] (> 0).
+        T0 : float
+            Initial temperature [degC].
+        conductance : float
+            Thermal conductance to its ambient [W/K] (>= 0; 0: insulated).
+        ambient : float
+            The ambient's temperature [degC].
+        heat_from : sequence of str
+            The elements whose losses heat it (springs and dampers, backlash, gears, clutches, brakes, bearing
+            friction, one-way clutches, E-clutches), named here or added later: they are looked up when the
+            network is packed.  An element heats at most one mass; sources dissipate nothing, and a wet clutch or
+            an EMTC carries its own thermal model.
+        """
+        name = self._new_name(name)
+        capacity = _finite(name, "capacity", capacity, positive=True)
+        T0 = _finite(name, "T0", T0)
+        conductance = _finite(name, "conductance", conductance, nonneg=True)
+        ambient = _finite(name, "ambient", ambient)
+        for t, what in ((T0, "T0"), (ambient, "ambient")):
+            if t <= _ABS_ZERO_C:
+                raise ParameterError(f"{name}: {what} = {t:g} degC is not above absolute zero (-273.15 degC)")
+        if isinstance(heat_from, str):
+            heat_from = (heat_from,)
+        heat_from = tuple(heat_from)
+        for e in heat_from:
+            if not isinstance(e, str) or not e:
+                raise ParameterError(f"{name}: heat_from = {heat_from!r}: expected names of elements")
+        if len(set(heat_from)) != len(heat_from):
+            raise ParameterError(f"{name}: heat_from = {list(heat_from)!r} names an element twice")
+        self._thermal[name] = _ThermalMass(name, capacity, T0, conductance, ambient, heat_from)
+        return self
+
+    def thermal_conductor(self, name: str, a: str, b: str, conductance: float) -> "Driveline":
+        """A thermal conductor between the thermal masses ``a`` and ``b`` (MSL ``ThermalConductor``): the heat flow
+        ``conductance (T_a - T_b)`` [W] from ``a`` to ``b``; ``conductance`` [W/K] >= 0.  The masses may be added
+        later (looked up when the network is packed)."""
+        name = self._new_name(name)
+        for which, v in (("a", a), ("b", b)):
+            if not isinstance(v, str) or not v:
+                raise ParameterError(f"{name}: {which} = {v!r}: expected the name of a thermal mass")
+        if a == b:
+            raise ParameterError(f"{name}: a and b are both {a!r} (a conductor joins two thermal masses)")
+        self._links.append(_ThermalLink(name, a, b, _finite(name, "conductance", conductance, nonneg=True)))
+        return self
+
+    def _heat_rows(self) -> tuple:
+        """``(heat, thermal, links)``: the thermal mass (row) each element's losses heat (-1 none), and the kernel's
+        ``thermal`` and ``links`` tables (:data:`~clutchlab.driveline.kernel.THERMAL_COLUMNS`, ``LINK_COLUMNS``)."""
+        rows = {e.name: r for r, e in enumerate(self._elements)}
+        heat = np.full(len(self._elements), -1, dtype=np.int64)
+        masses = list(self._thermal.values())
+        o = 2 * len(self._inertias) + len(self._elements) + len(self._controllers)
+        thermal = np.zeros((len(masses), K.N_THERMAL))
+        for k, tm in enumerate(masses):
+            thermal[k, K.T_CAP] = tm.capacity
+            thermal[k, K.T_COND] = tm.conductance
+            thermal[k, K.T_AMB] = tm.ambient
+            thermal[k, K.T_INIT] = tm.T0
+            thermal[k, K.T_STATE] = o + len(K.THERMAL_STATES) * k
+            for name in tm.heat_from:
+                if name not in rows:
+                    known = ", ".join(e.name for e in self._elements) or "none"
+                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, not an element of {self.name!r} "
+                                         f"(elements: {known})")
+                e = self._elements[rows[name]]
+                if e.kind in (K.K_SOURCE, K.K_MOTION):
+                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, a source: it does work and "
+                                         "dissipates nothing")
+                if e.wet is not None or e.emtc is not None:
+                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, a "
+                                         f"{'wet clutch' if e.wet is not None else 'EMTC coupling'}: it carries its "
+                                         "own thermal model")
+                if heat[rows[name]] >= 0:
+                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, whose losses already heat "
+                                         f"{masses[heat[rows[name]]].name!r} (an element heats one thermal mass)")
+                heat[rows[name]] = k
+        index = {tm.name: k for k, tm in enumerate(masses)}
+        links = np.zeros((len(self._links), K.N_LINK))
+        for j, link in enumerate(self._links):
+            for col, which, v in ((K.L_A, "a", link.a), (K.L_B, "b", link.b)):
+                if v not in index:
+                    known = ", ".join(index) or "none"
+                    raise ParameterError(f"{link.name}: {which} = {v!r} is not a thermal mass of {self.name!r} "
+                                         f"(thermal masses: {known})")
+                links[j, col] = index[v]
+            links[j, K.L_COND] = link.conductance
+        return heat, thermal, links
+
     def describe(self) -> str:
         """A text schematic: the inertias, the inputs, then every element between its flanges (``ground`` for
         none)."""
@@ -1416,6 +1546,12 @@ class Driveline:
             lines.append(f"  input {name} [{unit}], start {start:g}")
         for e in self._elements:
             lines.append("  " + self._element_line(e))
+        for tm in self._thermal.values():
+            lines.append(f"  thermal mass {tm.name}: C = {tm.capacity:g} J/K, T0 = {tm.T0:g} degC, "
+                         f"G = {tm.conductance:g} W/K to {tm.ambient:g} degC, heated by "
+                         + (", ".join(tm.heat_from) or "nothing"))
+        for link in self._links:
+            lines.append(f"  thermal conductor {link.name}: {link.a} - {link.b}, G = {link.conductance:g} W/K")
         return "\n".join(lines)
 
     def _element_line(self, e) -> str:
@@ -1568,6 +1704,7 @@ class Driveline:
         elem[swit, K.E_MODE] = fric.size + np.arange(swit.size)
         lossy = np.array([r for r, e in enumerate(self._elements) if self._is_lossy(e)], dtype=np.int64)
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
+        elem[:, K.E_HEAT], thermal, links = self._heat_rows()
         n, ne = len(index), len(self._elements)
         nk = fric.size + cons.size + lossy.size
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
@@ -1578,7 +1715,7 @@ class Driveline:
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
-                              np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2))
+                              np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2), thermal, links)
         x0 = self.initial_state()
         work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
         return p, port_rows
@@ -1602,6 +1739,11 @@ class Driveline:
                 total += 0.5 * e.coef[0] * phi * phi
         return total
 
+    def _state_count(self) -> int:
+        """The network's own states: angles, speeds, an energy per element, the controllers', the thermal masses'."""
+        return (2 * len(self._inertias) + len(self._elements) + len(self._controllers)
+                + len(K.THERMAL_STATES) * len(self._thermal))
+
     def initial_state(self) -> np.ndarray:
         """Angles, speeds, then the energy states (zero).
 
@@ -1612,7 +1754,10 @@ class Driveline:
         names = list(self._inertias)
         index = {nm: i for i, nm in enumerate(names)}
         n = len(names)
-        x = np.zeros(2 * n + len(self._elements) + len(self._controllers))
+        x = np.zeros(self._state_count())
+        o = 2 * n + len(self._elements) + len(self._controllers)
+        for k, tm in enumerate(self._thermal.values()):   # (kernel.THERMAL_STATES: the temperature, the heat out)
+            x[o + len(K.THERMAL_STATES) * k + K.TS_TEMP] = tm.T0
         w = [v[1] for v in self._inertias.values()]
         phi = [v[2] for v in self._inertias.values()]
         groups = _Groups(n)
@@ -1744,6 +1889,9 @@ class Driveline:
                 outputs.append((f"{e.name}.{rn}", ru, f"relative speed of {e.name}, flange b minus flange a"))
         states += [(f"{e.name}.idle_integral", tu, f"integral of the idle-speed controller of {e.name}")
                    for e in self._controllers]
+        for tm in self._thermal.values():   # (in the order of kernel.THERMAL_STATES)
+            states += [(f"{tm.name}.temperature", "C", f"temperature of the thermal mass {tm.name}"),
+                       (f"{tm.name}.heat_out", "J", f"heat {tm.name} gave its ambient since the start")]
         for name in self.friction_names:
             outputs.append((f"{name}.mode", "1", f"mode of {name}: 1 forward, 0 stuck, -1 backward, 2 free (MSL)"))
             outputs.append((f"{name}.fn", "N", f"normal force of {name}"))
@@ -1755,6 +1903,9 @@ class Driveline:
                     ("input_work", "J", "work of the sources since the start"),
                     ("dissipated_energy", "J", "energy dissipated since the start"),
                     ("energy_error", "J", "input work - dissipated - change of the stored energy")]
+        for tm in self._thermal.values():
+            outputs += [(f"{tm.name}.loss_power", "W", f"power the elements heating {tm.name} dissipate into it"),
+                        (f"{tm.name}.heat_flow", "W", f"heat flow from {tm.name} to its ambient")]
         return tuple(states), tuple(outputs)
 
     def system(self, rtol: float = 1e-8, check_invariants: bool = False) -> System:
@@ -1798,7 +1949,7 @@ class Driveline:
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
         n = len(self._inertias)
-        atol = float(rtol) * np.ones(2 * n + len(self._elements) + len(self._controllers))
+        atol = float(rtol) * np.ones(self._state_count())
         events = K.EVENTS
         wet = self._wet_parameters()
         emtcs = self._emtc_parameters()
