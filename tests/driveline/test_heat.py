@@ -330,3 +330,33 @@ def test_a_thermal_mass_linearises_through_the_contract():
         assert abs(w - 1.0 / (J * s)) < 1e-6 * abs(1.0 / (J * s))
         want = TF / (J * s * (C * s + G))
         assert abs(temp - want) < 1e-6 * abs(want), (s, temp, want)
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-10])
+def test_a_brief_overload_beside_thermal_masses_is_found_as_without_them(rtol):
+    """The margin rates of a stuck element near its limit (``kernel._margin_rates``) move a copy of the whole state
+    in the work array's scratch: with three masses the network has more states (10) than angles, speeds and one
+    per element (6), the scratch's size before the masses came; it holds them all (``kernel.state_bound``), and the
+    brake under ``1.0005 sin(2 pi 3 t)`` N m against its 1 N m limit slips and sticks as without them."""
+    def dip(masses):
+        d = Driveline("dip")
+        d.inertia("J", J=1.0, w0=0.0)
+        d.brake("b", "J", fn_max=2.0, mu=0.5)
+        d.torque("T", "J", Signal.sine(1.0005, 3.0))
+        for k in range(masses):
+            d.thermal_mass(f"m{k}", 1e-3, heat_from=["b"] if k == 0 else ())
+            if k:
+                d.thermal_conductor(f"l{k}", f"m{k - 1}", f"m{k}", 1e-3)
+        return d
+    d = dip(3)
+    p = d.pack()
+    n, ne, nt = p.inertia.shape[0], p.elem.shape[0], p.thermal.shape[0]
+    assert d.initial_state().size == 10 > 2 * n + 2 * ne
+    assert K.state_bound(n, ne, nt) >= d.initial_state().size
+    got = d.simulate(0.3, output_step=1e-3, rtol=rtol, check_invariants=True)
+    want = dip(0).simulate(0.3, output_step=1e-3, rtol=rtol, check_invariants=True)
+    assert list(got.events.event) == list(want.events.event) == ["forward", "stick", "backward", "stick"]
+    assert np.allclose(got.events.time_s, want.events.time_s, atol=1e-6 if rtol > 1e-8 else 1e-9)
+    df = got.to_dataframe()
+    heat = sum(1e-3 * (df[f"m{k}.temperature_C"] - 20.0) for k in range(3))
+    assert np.max(np.abs(heat - df["b.dissipated_J"])) < 1e-9 + 1e-6 * df["b.dissipated_J"].max()

@@ -1042,25 +1042,31 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
                       o_inst, o_sp, o_ext)
 
 
-def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0):
+def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0, nt=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
-    signals (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + N_EXT * nx + rate_size.py_func(n, ne, nf, nl) + 1
+    signals, ``nt`` thermal masses (the layout of :func:`_layout`)."""
+    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + N_EXT * nx + rate_size.py_func(n, ne, nf, nl, nt) + 1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def rate_size(n, ne, nf, nl):
+def state_bound(n, ne, nt):
+    """Most states a network of ``n`` inertias, ``ne`` elements and ``nt`` thermal masses has: angles, speeds,
+    energies, engine integrals (at most one per element), the thermal masses' (:data:`THERMAL_STATES`)."""
+    return 2 * n + 2 * ne + len(THERMAL_STATES) * nt
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def rate_size(n, ne, nf, nl, nt):
     """Length of the scratch of :func:`_margin_rates` at the end of the work array: a state and its derivative (at
-    most ``2 n + 2 ne`` each: angles, speeds, energies, engine integrals), the switching functions (at most
-    ``N_G nf + N_SW ne + N_GEAR_G nl``), and the accelerations, torques, holds and torque magnitudes (``2 n + ne +
-    nl``)."""
-    return 2 * (2 * n + 2 * ne) + (N_G * nf + N_SW * ne + N_GEAR_G * nl) + 2 * n + ne + nl
+    most :func:`state_bound` each), the switching functions (at most ``N_G nf + N_SW ne + N_GEAR_G nl``), and the
+    accelerations, torques, holds and torque magnitudes (``2 n + ne + nl``)."""
+    return 2 * state_bound(n, ne, nt) + (N_G * nf + N_SW * ne + N_GEAR_G * nl) + 2 * n + ne + nl
 
 
-def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0):
+def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0, nt=0):
     """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
-    work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig))
+    work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig, nt))
     lay = _layout.py_func(n, nk, ne, nf, nl, nsig)
     work[lay.sig] = np.nan
     work[lay.inst] = np.nan
@@ -1136,7 +1142,8 @@ def _external(p):
     lock-up limits (three per model), then their rates (three per model), then the time of each model's rates."""
     o = _offsets(p)
     return borrow(p.work[o.ext:p.work.shape[0] - 1 - rate_size(p.inertia.shape[0], p.elem.shape[0],
-                                                                    p.fric.shape[0], p.lossy.shape[0])])
+                                                                    p.fric.shape[0], p.lossy.shape[0],
+                                                                    p.thermal.shape[0])])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -3189,11 +3196,12 @@ def _margin_rates(t, x, u, m, p, dx, g):
     nx = x.shape[0]
     ng = g.shape[0]
     wk = p.work
-    o = wk.shape[0] - 1 - rate_size(n, ne, nf, nl)
+    nb = state_bound(n, ne, p.thermal.shape[0])
+    o = wk.shape[0] - 1 - rate_size(n, ne, nf, nl, p.thermal.shape[0])
     xs = wk[o:o + nx]
-    o += 2 * n + 2 * ne
+    o += nb
     ds = wk[o:o + nx]
-    o += 2 * n + 2 * ne
+    o += nb
     gs = wk[o:o + ng]
     o += N_G * nf + N_SW * ne + N_GEAR_G * nl
     acc, tau = _acc_tau(p)

@@ -1711,7 +1711,7 @@ class Driveline:
         elem[ext, K.E_AUX] = np.arange(len(ext))
         data.extend(v[1] for v in self._inputs.values())   # the inputs' held values, last (kernel.hold_inputs)
         sig = np.array(signals, dtype=float).reshape(-1, K.N_SIG)
-        work = K.new_work(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0])
+        work = K.new_work(n, nk, ne, fric.size, len(ext), lossy.size, sig.shape[0], len(self._thermal))
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
