@@ -59,6 +59,7 @@ FIELD_KINDS = {
     "losstable": "rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2] (MSL lossTable)",
     "thermal": "the name of a thermal mass ([thermal_mass.NAME]): a heat port of the component",
     "names": "a list of the names of other components of the network",
+    "temperature_table": "a table of rows [T, value] over a temperature (T in degC or with its unit)",
 }
 #: the field kinds whose value can be a plain number: the parameters of a file (sweeps, FMUs)
 NUMERIC_KINDS = ("quantity", "signal", "characteristic")

@@ -280,6 +280,13 @@ def _with_masses(d, data):
     names = [e.name for e in d._elements if e.kind not in (K.K_SOURCE, K.K_MOTION) and e.wet is None
              and e.emtc is None]
     owner = {n: data.draw(st.integers(-1, nm - 1)) for n in names}
+    for e in d._elements:   # some heated clutches, brakes and one-way clutches fade (set on the element: the
+        # networks are drawn before their masses)
+        if e.kind == K.K_FRICTION and e.law in (K.LAW_CLUTCH, K.LAW_ONEWAY) and owner.get(e.name, -1) >= 0 \
+                and data.draw(st.booleans()):
+            lo = data.draw(st.floats(-20.0, 60.0))
+            e.fade = (lo, lo + data.draw(st.floats(1.0, 100.0)), data.draw(st.floats(0.0, 1.5)),
+                      data.draw(st.floats(0.0, 1.5)))
     for k in range(nm):
         d.thermal_mass(f"m{k}", capacity=data.draw(st.floats(0.1, 50.0)), T0=data.draw(st.floats(-20.0, 90.0)),
                        conductance=data.draw(st.sampled_from([0.0, data.draw(st.floats(0.0, 5.0))])),
@@ -294,7 +301,8 @@ def _with_masses(d, data):
 @settings(max_examples=examples(15), deadline=None, derandomize=True)
 @given(networks(), st.data())
 def test_the_heat_balance_and_its_bounds_hold_on_random_networks(d, data):
-    """Whatever the network and its masses: the kernel's invariants (its heat balance included) hold at every step;
+    """Whatever the network, its masses and its fading friction elements: the kernel's invariants (its heat balance,
+    and a stuck element within its faded limit, included) hold at every step;
     from the columns, the masses store and give away what their elements dissipated, no loss power is negative,
     and no mass falls below the coldest of the starts and ambients (the losses only heat)."""
     d = _with_masses(d, data)
@@ -309,7 +317,9 @@ def test_the_heat_balance_and_its_bounds_hold_on_random_networks(d, data):
     floor = min([m.T0 for m in masses] + [m.ambient for m in masses if m.conductance > 0.0])
     for m in masses:
         assert df[f"{m.name}.loss_power_W"].min() >= -1e-7 * (1.0 + df[f"{m.name}.loss_power_W"].abs().max())
-        assert df[f"{m.name}.temperature_C"].min() >= floor - 1e-9 * (1.0 + abs(floor))
+        # (a stuck element's drift power, tau times a relative speed at the rounding floor, may be a hair negative:
+        # the balance's tolerance over the mass's capacity)
+        assert df[f"{m.name}.temperature_C"].min() >= floor - 1e-9 * (1.0 + abs(floor)) - 1e-7 * scale / m.capacity
 
 
 def test_a_thermal_mass_linearises_through_the_contract():
@@ -360,3 +370,86 @@ def test_a_brief_overload_beside_thermal_masses_is_found_as_without_them(rtol):
     df = got.to_dataframe()
     heat = sum(1e-3 * (df[f"m{k}.temperature_C"] - 20.0) for k in range(3))
     assert np.max(np.abs(heat - df["b.dissipated_J"])) < 1e-9 + 1e-6 * df["b.dissipated_J"].max()
+
+
+# ----------------------------------------------------------------- fade: the temperature back into the friction law
+def test_a_fading_brake_stops_the_flywheel_as_the_closed_form():
+    """Insulated, the disc's temperature follows the kinetic energy whatever the friction, ``T = T0 + J (w0^2 -
+    w^2) / (2 C)`` (30 to 50 degC); the fade ``f(T) = 1 - 0.025 (T - 30)`` then makes the braking torque
+    ``T_f (0.5 + 5e-5 w^2)``, so ``J dw/dt = -T_f f`` gives ``w(t) = 100 tan(pi/4 - t/100)``: it stops at
+    ``25 pi`` s (50 s without the fade)."""
+    d = Driveline("fade")
+    d.inertia("J", J, w0=W0)
+    d.brake("B", "J", fn_max=100.0, mu=0.4, cgeo=0.1, mu_temperature=[[30.0, 1.0], [50.0, 0.5]])
+    d.thermal_mass("disc", capacity=C, T0=T0, heat_from=["B"])
+    res = d.simulate(90.0, rtol=1e-10, output_step=0.5, check_invariants=True)
+    df = res.to_dataframe()
+    t, w = df["time_s"].to_numpy(), df["J.w_rad_s"].to_numpy()
+    sliding = t < 25 * math.pi
+    assert np.max(np.abs(w[sliding] - 100.0 * np.tan(math.pi / 4 - t[sliding] / 100.0))) < 1e-6
+    assert list(res.events.event) == ["stick"] and abs(res.events.time_s[0] - 25 * math.pi) < 1e-6
+    assert abs(df["disc.temperature_C"].iloc[-1] - 50.0) < 1e-7
+    assert np.allclose(df["B.tau_Nm"].abs()[sliding], TF * (0.5 + 5e-5 * w[sliding] ** 2), rtol=1e-7)
+
+
+def test_a_stuck_brake_breaks_away_where_its_faded_limit_meets_its_load():
+    """Brake B1 holds J1 against a 3 N m load (limit 1.2 x 5 N m = 6 N m) while brake B2, slipping at a constant
+    10 rad/s under 5 N m, heats their shared mass (10 J/K) at 50 W: T = 20 + 5 t.  B1's fade ``1 - (T - 20)/200``
+    brings its limit down to the load at T = 120 degC, t = 20 s: it breaks away there (``forward``), and not before."""
+    d = Driveline("fade_limit")
+    d.inertia("J1", 1.0)
+    d.inertia("J2", 1.0, w0=10.0)
+    d.torque("load", "J1", 3.0)
+    d.brake("B1", "J1", fn_max=10.0, mu=0.5, peak=1.2, mu_temperature=[[20.0, 1.0], [220.0, 0.0]])
+    d.speed("drive", "J2", 10.0)
+    d.brake("B2", "J2", fn_max=10.0, mu=0.5)
+    d.thermal_mass("pack", capacity=10.0, T0=20.0, heat_from=["B1", "B2"])
+    for rtol in (1e-6, 1e-10):
+        res = d.simulate(25.0, rtol=rtol, output_step=0.5, check_invariants=True)
+        ev = [(t, e) for t, el, e in zip(res.events.time_s, res.events.element, res.events.event) if el == "B1"]
+        assert [e for _t, e in ev] == ["forward"], ev
+        assert abs(ev[0][0] - 20.0) < 1e-6, (rtol, ev)
+
+
+def test_the_fade_reaches_linearize():
+    """Around the sliding start (w0 = 100 rad/s, T0 = 30 degC, fade ``1.2 - 0.005 T``: 1.05 falling 0.005 per K):
+    ``dw/dt = (u - T_f f(T)) / J``, ``C dT/dt = T_f f(T) w - G (T - T_a)``, so from the load u to the speed
+    ``(s - a22) / (J (s (s - a22) - a12 a21))`` with ``a12 = -T_f f' / J``, ``a21 = T_f f / C``,
+    ``a22 = (T_f f' w0 - G) / C``."""
+    import control as ct
+
+    from clutchlab.control import linearize
+
+    d = Driveline("fade_lin")
+    d.inertia("J", J, w0=W0)
+    d.brake("B", "J", fn_max=100.0, mu=0.4, cgeo=0.1, mu_temperature=[[0.0, 1.2], [100.0, 0.7]])
+    d.thermal_mass("disc", capacity=C, T0=T0, conductance=G, ambient=TA, heat_from=["B"])
+    d.input("load", unit="Nm", start=0.0)
+    d.torque("load_torque", "J", Signal.input("load"))
+    lin = linearize(d.system(1e-10), inputs=["load"], outputs=["J.w"])
+    f, df = 1.2 - 0.005 * T0, -0.005
+    a12, a21, a22 = -TF * df / J, TF * f / C, (TF * df * W0 - G) / C
+    for s in (0.01j, 0.1j, 1j):
+        want = (s - a22) / (J * (s * (s - a22) - a12 * a21))
+        got = complex(ct.evalfr(lin[0, 0], s))
+        assert abs(got - want) < 1e-5 * abs(want), (s, got, want)
+
+
+def test_the_fade_in_a_file_and_its_errors(tmp_path):
+    doc = {"inertia": {"J": {"J": J, "w0": W0}},
+           "brake": {"B": {"flange": "J", "fn_max": 100.0, "mu": 0.4, "cgeo": 0.1,
+                           "mu_temperature": [["30 degC", 1.0], ["50 degC", 0.5]]}},
+           "thermal_mass": {"disc": {"capacity": "500 J/K", "T0": "30 degC", "heat_from": ["B"]}}}
+    f = parse_driveline(doc, "mem.toml")
+    res = f.driveline.simulate(90.0, rtol=1e-10, output_step=1.0)
+    assert abs(res.events.time_s[0] - 25 * math.pi) < 1e-6
+    bad = dict(doc, thermal_mass={})
+    with pytest.raises(ParameterError, match=r"mem.toml: B: mu_temperature reads the temperature of the thermal mass "
+                                             r"its losses heat, and none does"):
+        parse_driveline(bad, "mem.toml")
+    bad = {**doc, "brake": {"B": dict(doc["brake"]["B"], mu_temperature=[[50.0, 1.0], [30.0, 0.5]])}}
+    with pytest.raises(ParameterError, match=r"mu_temperature must increase in T"):
+        parse_driveline(bad, "mem.toml")
+    bad = {**doc, "brake": {"B": dict(doc["brake"]["B"], mu_temperature=[[30.0, 1.0], [50.0, -0.5]])}}
+    with pytest.raises(ParameterError, match=r"mem.toml: brake.B.mu_temperature\[1\]\[1\] = -0.5: is below"):
+        parse_driveline(bad, "mem.toml")

@@ -37,6 +37,13 @@ _FLANGE = _flange("flange", "the body it acts on")
 _SUPPORT = _flange("support", "the body its reaction acts on (default the ground)", required=False)
 
 
+_MU_TEMPERATURE = Field(
+    "mu_temperature", "temperature_table", "1", minimum=0.0,
+    description="factor on the friction over the temperature of the thermal mass its losses heat: rows "
+                "[T_degC, factor], linear, held beyond them (fade); the element must be in that mass's heat_from",
+    source="fade of dry linings; MSL's heat port temperature")
+
+
 def _friction_fields(fn_required=True, fn_default=None, with_map=True):
     fields = [
         Field("fn_max", "quantity", "N", required=fn_required, default=fn_default, minimum=0.0,
@@ -54,6 +61,7 @@ def _friction_fields(fn_required=True, fn_default=None, with_map=True):
                           "effective radius times the number of friction surfaces)"),
         Field("normal", "signal", "1", default=1.0,
               description="normal-force signal, 0-1 (free where <= 0)"),
+        _MU_TEMPERATURE,
     ]
     if with_map:
         fields += [
@@ -244,6 +252,7 @@ BUILTIN = (
         Field("pre_roll", "quantity", "s", default=1.0, minimum=0.0,
               description="actuator run before t = 0 (settles its controller)"),
         Field("settle", "quantity", "s", default=0.5, minimum=0.0, description="actuator run after the reference ends"),
+        _MU_TEMPERATURE,
     ), _method("eclutch"), "seed 000, Sec. 3.2"),
     Component("engine", "A combustion engine: torque map(w, throttle) plus an optional idle-speed PI controller.", (
         _FLANGE,

@@ -121,7 +121,7 @@ def field_units(domain: str = "rotational") -> dict:
 #: field kinds whose value carries the field's unit
 _UNIT_KINDS = ("quantity", "signal", "characteristic", "curve")
 #: field kinds that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable", "thermal", "names")
+NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable", "thermal", "names", "temperature_table")
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -330,6 +330,13 @@ def _field_value(field, v, fkey, src, base, uses, speed_unit, angle_unit):
         return value
     if kind == "curve":
         return _characteristic(v, field.unit, fkey, src, x_unit=angle_unit, table_only=True)
+    if kind == "temperature_table":
+        rows = _characteristic(v, field.unit, fkey, src, x_unit="degC", table_only=True)
+        for i, (_temp, y) in enumerate(rows):
+            problem = field.range_problem(y)
+            if problem:
+                raise ParameterError(f"{src}: {fkey}[{i}][1] = {v[i][1]!r}: {problem}")
+        return rows
     if kind == "choice":
         if v not in field.choices:
             raise ParameterError(f"{src}: {fkey} = {v!r}: expected " + " or ".join(f'"{c}"' for c in field.choices))

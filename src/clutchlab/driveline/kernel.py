@@ -105,10 +105,14 @@ SIGNAL_KINDS = ("const", "step", "ramp", "sine", "table", "sampled", "pulse", "t
 N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: columns of ``elem`` (ints): "aux" is a curve's kind (0 linear, 1 pchip) or an engine map's throttle points;
 #: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
-#: inertia, -1 the ground; "heat" the thermal mass (row of ``thermal``) its losses flow into, -1 none
-ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat")
-E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP, E_HEAT = indices(
-    ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat")
+#: inertia, -1 the ground; "heat" the thermal mass (row of ``thermal``) its losses flow into, -1 none; "fade" and
+#: "fade_n" a friction element's factor over that mass's temperature: its table's start in ``data`` (-1 none) and
+#: its number of rows (temperatures, then factors; :func:`fade_factor`)
+ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat",
+                "fade", "fade_n")
+(E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP, E_HEAT, E_FADE,
+ E_FADE_N) = indices(ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state",
+                     "support", "heat", "fade", "fade_n")
 N_ELEM = len(ELEM_COLUMNS)
 #: columns of ``thermal`` (one row per thermal mass, MSL ``Thermal.HeatTransfer.Components.HeatCapacitor`` with a
 #: ``ThermalConductor`` to a ``FixedTemperature``): heat capacity [J/K], conductance to its ambient [W/K], the
@@ -485,7 +489,24 @@ def friction_torque(p, r, t, w_abs):
     fn = normal_force(p, r, t)
     if law == LAW_ONEWAY:
         fn = max(fn, 0.0)
+    if p.elem[r, E_FADE] >= 0:
+        val *= fade_factor(p, r)
     return p.coef[r, C_CGEO] * fn * val
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def fade_factor(p, r):
+    """Factor [-] on the friction of element row ``r`` at the temperature [degC] of the thermal mass its losses heat
+    (``mu_temperature``: linear between its rows, held beyond them), read from the temperatures of the network's last
+    evaluation (:func:`evaluate_network` keeps them: :func:`temperatures`).  The friction coefficient of a dry
+    lining falls as it heats (fade); the factor scales the sliding torque and the static limit alike."""
+    s, n = p.elem[r, E_FADE], p.elem[r, E_FADE_N]
+    temp = temperatures(p)[p.elem[r, E_HEAT]]
+    if n == 1 or temp <= p.data[s]:
+        return p.data[s + n]
+    if temp >= p.data[s + n - 1]:
+        return p.data[s + 2 * n - 1]
+    return _table(p.data, s, n, temp)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -905,6 +926,10 @@ def evaluate_network(t, x, m, p, acc, tau):
     nc = p.cons.shape[0]
     wk = p.work
     refresh_signals(p, t)
+    if p.thermal.shape[0] > 0:   # (the temperatures the fading friction laws read)
+        temp = temperatures(p)
+        for k in range(p.thermal.shape[0]):
+            temp[k] = x[int(p.thermal[k, T_STATE]) + TS_TEMP]
     F = wk[0:n]
     Fa = _torque_magnitudes(p)
     for i in range(n):
@@ -980,7 +1005,7 @@ class WorkLayout(NamedTuple):
     and weights ``g``, bounds and scratch ``lim``; accelerations ``acc``, element torques ``tau``, stick-function
     slack ``slack``, torque magnitudes ``fabs``, gear holds ``hold``, signal cache ``sig``, null-vector cache ``nv``,
     the last search's instant ``inst``, the warm start of the split of a statically indeterminate set ``sp``
-    (:func:`_repair_space`), clutch models ``ext``."""
+    (:func:`_repair_space`), the thermal masses' temperatures ``temp``, clutch models ``ext``."""
     a: int
     m: int
     b: int
@@ -998,11 +1023,12 @@ class WorkLayout(NamedTuple):
     nv: int
     inst: int
     sp: int
+    temp: int
     ext: int
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
+def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     """Offsets in ``DrivelineParams.work`` (``nk``: the largest constraint set): net torques F (n) | the set (nk) | A
     (nk^2) | A + eps D (nk^2) | right-hand side (nk) | its torques (nk) | weights (nk) | residual (nk) | three
     flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds, null vector, its
@@ -1014,7 +1040,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     :func:`signal_at`) | the last null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk,
     :func:`_null_vector_cached`) | the instant of the last stick/slip search, the event count before it and the
     friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
-    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``) | sliding torque,
+    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``) | the thermal
+    masses' temperatures at the last evaluation (nt, :func:`temperatures`) | sliding torque,
     static limit and lock-up limit of each clutch model, their rates and the time of those (``N_EXT`` per
     ``LAW_EXTERNAL`` element, :func:`set_external`, :func:`set_external_rates`) | the
     scratch of the rates of stuck margins: the moved state, its derivative and switching functions, and the
@@ -1037,16 +1064,17 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0):
     o_nv = o_sig + 1 + nsig
     o_inst = o_nv + 2 + nk * nk + nk
     o_sp = o_inst + 3 + nf + nl
-    o_ext = o_sp + SPACE_CACHE
+    o_temp = o_sp + SPACE_CACHE
+    o_ext = o_temp + nt
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
-                      o_inst, o_sp, o_ext)
+                      o_inst, o_sp, o_temp, o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0, nt=0):
     """Length of ``DrivelineParams.work`` for ``n`` inertias, ``nk`` members of the largest constraint set, ``ne``
     elements, ``nf`` friction elements, ``nx`` clutch models with states of their own, ``nl`` lossy gears, ``nsig``
     signals, ``nt`` thermal masses (the layout of :func:`_layout`)."""
-    return _layout.py_func(n, nk, ne, nf, nl, nsig).ext + N_EXT * nx + rate_size.py_func(n, ne, nf, nl, nt) + 1
+    return _layout.py_func(n, nk, ne, nf, nl, nsig, nt).ext + N_EXT * nx + rate_size.py_func(n, ne, nf, nl, nt) + 1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1060,14 +1088,14 @@ def state_bound(n, ne, nt):
 def rate_size(n, ne, nf, nl, nt):
     """Length of the scratch of :func:`_margin_rates` at the end of the work array: a state and its derivative (at
     most :func:`state_bound` each), the switching functions (at most ``N_G nf + N_SW ne + N_GEAR_G nl``), and the
-    accelerations, torques, holds and torque magnitudes (``2 n + ne + nl``)."""
-    return 2 * state_bound(n, ne, nt) + (N_G * nf + N_SW * ne + N_GEAR_G * nl) + 2 * n + ne + nl
+    accelerations, torques, holds, torque magnitudes and temperatures (``2 n + ne + nl + nt``)."""
+    return 2 * state_bound(n, ne, nt) + (N_G * nf + N_SW * ne + N_GEAR_G * nl) + 2 * n + ne + nl + nt
 
 
 def new_work(n, nk, ne, nf, nx=0, nl=0, nsig=0, nt=0):
     """A zeroed ``DrivelineParams.work`` of :func:`work_size` with its signal cache empty (:func:`signal_at`)."""
     work = np.zeros(work_size(n, nk, ne, nf, nx, nl, nsig, nt))
-    lay = _layout.py_func(n, nk, ne, nf, nl, nsig)
+    lay = _layout.py_func(n, nk, ne, nf, nl, nsig, nt)
     work[lay.sig] = np.nan
     work[lay.inst] = np.nan
     work[lay.inst + 2 + nf + nl] = np.nan
@@ -1084,7 +1112,15 @@ def _nk(p):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _offsets(p):
     return _layout(p.inertia.shape[0], _nk(p), p.elem.shape[0], p.fric.shape[0], p.lossy.shape[0],
-                   p.signals.shape[0])
+                   p.signals.shape[0], p.thermal.shape[0])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def temperatures(p):
+    """The thermal masses' temperatures [degC] at the network's last evaluation (:func:`evaluate_network`), which
+    the friction laws that fade read (:func:`fade_factor`)."""
+    o = _offsets(p)
+    return p.work[o.temp:o.ext]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -3187,8 +3223,8 @@ def _margin_rates(t, x, u, m, p, dx, g):
     speed's dip through zero is.  Called only where the core compares switching functions across a step (the
     ``watch`` hook: step ends, events, probes), never at the stages: one more evaluation of the network (the
     right-hand side through its address, at ``t + T_RATE`` and the state moved by ``T_RATE dx`` in a scratch
-    copy), after which the accelerations, torques, holds and torque magnitudes of the evaluation at ``t`` are put
-    back from the work array, bit for bit."""
+    copy), after which the accelerations, torques, holds, torque magnitudes and temperatures of the evaluation at
+    ``t`` are put back from the work array, bit for bit."""
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
@@ -3214,8 +3250,13 @@ def _margin_rates(t, x, u, m, p, dx, g):
         wk[o + 2 * n + r] = tau[r]
     for j in range(nl):
         wk[o + 2 * n + ne + j] = hold[j]
+    temp = temperatures(p)
+    for k in range(temp.shape[0]):
+        wk[o + 2 * n + ne + nl + k] = temp[k]
+    # (the angles, speeds and the thermal masses' states move; the energies and integrals, which nothing reads, do not)
+    th0 = int(p.thermal[0, T_STATE]) if p.thermal.shape[0] > 0 else nx
     for i in range(nx):
-        xs[i] = x[i] + T_RATE * dx[i] if i < 2 * n else x[i]
+        xs[i] = x[i] + T_RATE * dx[i] if i < 2 * n or i >= th0 else x[i]
     _rhs_outlined(t + T_RATE, xs, u, m, p, ds, gs)
     for k in range(nf):
         q = N_G * k + G_TURN
@@ -3230,6 +3271,8 @@ def _margin_rates(t, x, u, m, p, dx, g):
         tau[r] = wk[o + 2 * n + r]
     for j in range(nl):
         hold[j] = wk[o + 2 * n + ne + j]
+    for k in range(temp.shape[0]):
+        temp[k] = wk[o + 2 * n + ne + nl + k]
 
 
 # ----------------------------------------------------------------- hooks

@@ -552,6 +552,7 @@ class _Element:
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
     emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
     sup: str | None = None    # a gear's support (housing) inertia; None: the ground
+    fade: tuple = ()          # a friction element's factor over its heat port's temperature: temperatures, factors
     kind_name: str = ""       # what added it: a builder's name ("clutch", "brake", ...) or a component's type
 
 
@@ -1022,14 +1023,29 @@ class Driveline:
         """The elements with a controller state (engines with an idle controller), in state order."""
         return [e for e in self._elements if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE and e.coef[3] > 0]
 
-    def _friction(self, name, a, b, law, table, peak, fn_max=1.0, cgeo=1.0, normal=None):
+    def _friction(self, name, a, b, law, table, peak, fn_max=1.0, cgeo=1.0, normal=None, mu_temperature=None):
         peak = _finite(name, "peak", peak)
         if peak < 1.0:
             raise ParameterError(f"{name}: peak = {peak!r} must be >= 1 (static limit = peak x sliding torque at rest)")
         coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak, 0.0)
         sig = None if normal is None else Signal.of(normal, f"{name}: normal")
-        self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, table))
+        self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, table,
+                                       fade=self._fade(name, mu_temperature)))
         return self
+
+    @staticmethod
+    def _fade(name, rows):
+        """A factor over temperature, rows ``[[T_degC, factor], ...]`` (T increasing, factor >= 0), as (temperatures,
+        factors); ``()`` for none."""
+        if rows is None:
+            return ()
+        arr = as_numbers(rows, f"{name}: mu_temperature")
+        if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or not np.all(np.isfinite(arr)):
+            raise ParameterError(f"{name}: mu_temperature must be a table of rows [T_degC, factor]")
+        if np.any(np.diff(arr[:, 0]) <= 0) or np.any(arr[:, 1] < 0) or np.any(arr[:, 0] <= _ABS_ZERO_C):
+            raise ParameterError(f"{name}: mu_temperature must increase in T (above -273.15 degC) with factors >= 0 "
+                                 f"(got {arr.tolist()!r})")
+        return tuple(float(v) for v in arr[:, 0]) + tuple(float(v) for v in arr[:, 1])
 
     @staticmethod
     def _characteristic(name, what, value):
@@ -1046,7 +1062,7 @@ class Driveline:
     @_adds("clutch")
     def clutch(self, name: str, a, b, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
                normal=1.0, radius: float | None = None, temperature: float | None = None,
-               mu_scale: float = 1.0) -> "Driveline":
+               mu_scale: float = 1.0, mu_temperature=None) -> "Driveline":
         """A clutch between flanges a and b (MSL ``Clutch``): sliding torque ``cgeo fn mu(|w_rel|)``,
         ``fn = fn_max * normal(t)`` [N] (free when ``<= 0``), static limit ``peak`` times the sliding
         torque at rest.  ``mu``: a number, a table ``[[w_rad_s, mu], ...]``, or a friction map
@@ -1054,21 +1070,24 @@ class Driveline:
         at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
         [degC] (both required with a map, refused without one; :meth:`_map_characteristic`).  ``mu_scale``:
         a factor on the friction coefficient, whether a number, a table or a map (a sweep's friction level;
-        ``mu_scale`` in [0, 2], a factor on a coefficient checked on its own)."""
+        ``mu_scale`` in [0, 2], a factor on a coefficient checked on its own).  ``mu_temperature``: rows
+        ``[[T_degC, factor], ...]``, a factor on the sliding torque and the static limit over the temperature of the
+        thermal mass its losses heat (linear between rows, held beyond them; fade): the element must be in that
+        mass's ``heat_from`` (:meth:`thermal_mass`)."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
-                              fn_max, cgeo, normal)
+                              fn_max, cgeo, normal, mu_temperature)
 
     @_adds("brake")
     def brake(self, name: str, flange, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
               normal=1.0, support=None, radius: float | None = None,
-              temperature: float | None = None, mu_scale: float = 1.0) -> "Driveline":
+              temperature: float | None = None, mu_scale: float = 1.0, mu_temperature=None) -> "Driveline":
         """A brake between ``flange`` and ``support`` (default the ground), as :meth:`clutch` (MSL ``Brake``)."""
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
         return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
-                              fn_max, cgeo, normal)
+                              fn_max, cgeo, normal, mu_temperature)
 
     @classmethod
     def _mu(cls, name, mu, radius, temperature, scale=1.0):
@@ -1137,7 +1156,7 @@ class Driveline:
     @_adds("eclutch")
     def eclutch(self, name: str, a, b, position, model: int = 4, parameters=None, travel: float = 8e-3,
                 points: int = 161, peak: float = 1.0, actuator=None, actuator_step: float = 1e-3,
-                pre_roll: float = 1.0, settle: float = 0.5) -> "Driveline":
+                pre_roll: float = 1.0, settle: float = 0.5, mu_temperature=None) -> "Driveline":
         """The dry E-clutch of seed 000 between flanges a and b: sliding torque ``2 F_n r_eff mu`` ([1] Sec. 3.2,
         :func:`clutchlab.eclutch.models.torque_of_clamp_force`), ``r_eff`` and ``mu`` its axial model's.
 
@@ -1157,6 +1176,8 @@ class Driveline:
           from rest through a ``pre_roll`` [s] holding the reference's first value (the actuator settles there
           before t = 0) to ``settle`` [s] past its last corner; ``F_n(t)`` is read linearly between samples
           ``actuator_step`` [s] apart (held after the run: the reference is constant there).
+
+        ``mu_temperature``: a factor over the temperature of the thermal mass its losses heat, as :meth:`clutch`.
         """
         from ..eclutch.models import ClutchModel, EClutchParameters
 
@@ -1179,7 +1200,7 @@ class Driveline:
             fn = np.maximum(cm.static_curve(u)["normal_force_N"].to_numpy(), 0.0)
             zero = np.flatnonzero(fn <= 0.0)
             liftoff = float(u[zero[0]]) if zero.size else math.inf
-            self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo, sig)
+            self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo, sig, mu_temperature)
             el = self._elements[-1]
             el.ncurve = tuple(u) + tuple(fn)
             el.liftoff = liftoff
@@ -1187,7 +1208,7 @@ class Driveline:
             return self
         times, fn, corners, info = self._eclutch_dynamics(name, cm, sig, actuator, actuator_step, pre_roll, settle)
         self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo,
-                       Signal.sampled(times, fn, corners))
+                       Signal.sampled(times, fn, corners), mu_temperature)
         el = self._elements[-1]
         el.model = f"{label} with its actuator ({info})"
         el.reference = sig
@@ -1408,7 +1429,7 @@ class Driveline:
 
     @_adds("one_way_clutch")
     def one_way_clutch(self, name: str, a, b, fn_max: float = 0.0, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
-                       normal=1.0, mu_scale: float = 1.0) -> "Driveline":
+                       normal=1.0, mu_scale: float = 1.0, mu_temperature=None) -> "Driveline":
         """A one-way clutch between flanges a and b (MSL ``OneWayClutch``: a freewheel in parallel with a clutch).
 
         Flange b may overrun flange a (``w_b > w_a``); the freewheel locks, holding any torque, when b would turn
@@ -1416,12 +1437,13 @@ class Driveline:
         (``fn = fn_max * normal(t)``, ``cgeo``, ``mu`` and ``peak`` as :meth:`clutch`; no torque where ``fn <= 0``)
         holds up to ``peak * cgeo * fn * mu(0)`` against overrunning and slides with ``cgeo * fn * mu(w_rel)``
         while b overruns.  Events ``stick`` when it locks or its clutch holds, ``forward`` when b overruns; it
-        never slides backward, so it may not start with ``w_b < w_a``.  ``mu_scale`` as :meth:`clutch`."""
+        never slides backward, so it may not start with ``w_b < w_a``.  ``mu_scale`` and ``mu_temperature`` as
+        :meth:`clutch`."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
         return self._friction(name, a, b, K.LAW_ONEWAY, self._scaled(name, self._characteristic(name, "mu", mu),
                                                                      mu_scale), peak, fn_max, cgeo,
-                              None if fn_max == 0.0 else normal)
+                              None if fn_max == 0.0 else normal, mu_temperature)
 
     # ---- the system
     # ---- heat
@@ -1433,8 +1455,9 @@ class Driveline:
         ``C dT/dt = sum of the losses of heat_from - conductance (T - ambient) - the flows of its conductors``
         (:func:`~clutchlab.driveline.kernel.thermal_rates`).  Its states are ``<name>.temperature_C`` and
         ``<name>.heat_out_J`` (the heat given to its ambient since the start); its outputs ``<name>.loss_power_W``
-        (what its elements dissipate into it) and ``<name>.heat_flow_W`` (to its ambient).  The temperature is an
-        output of the losses; no friction law reads it.
+        (what its elements dissipate into it) and ``<name>.heat_flow_W`` (to its ambient).  A friction element
+        among ``heat_from`` with ``mu_temperature`` (:meth:`clutch`) fades with this temperature; otherwise the
+        temperature is an output of the losses only.
 
         Parameters
         ----------
@@ -1517,6 +1540,10 @@ class Driveline:
                     raise ParameterError(f"{tm.name}: heat_from names {name!r}, whose losses already heat "
                                          f"{masses[heat[rows[name]]].name!r} (an element heats one thermal mass)")
                 heat[rows[name]] = k
+        for r, e in enumerate(self._elements):
+            if e.fade and heat[r] < 0:
+                raise ParameterError(f"{e.name}: mu_temperature reads the temperature of the thermal mass its losses "
+                                     f"heat, and none does: name {e.name!r} in a thermal mass's heat_from")
         index = {tm.name: k for k, tm in enumerate(masses)}
         links = np.zeros((len(self._links), K.N_LINK))
         for j, link in enumerate(self._links):
@@ -1688,6 +1715,11 @@ class Driveline:
             elem[r, K.E_MODE] = -1
             elem[r, K.E_STATE] = self._controllers.index(e) if e in self._controllers else -1
             coef[r, :len(e.coef)] = e.coef
+            elem[r, K.E_FADE] = -1
+            if e.fade:
+                elem[r, K.E_FADE] = len(data)
+                elem[r, K.E_FADE_N] = len(e.fade) // 2
+                data.extend(e.fade)
             if e.ncurve:
                 coef[r, K.C_NCURVE] = len(data)
                 coef[r, K.C_LIFTOFF] = e.liftoff
