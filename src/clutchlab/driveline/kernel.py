@@ -3423,7 +3423,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
 
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")   # (in the right-hand side's loop: no call per element)
 def loss_power(p, r, x, n, m, tau):
     """Power [W] element row ``r`` (not a source) dissipates, MSL ``lossPower``, with ``tau`` its torque: the rate of
     its dissipated energy: a friction element's ``tau w_rel``; a spring-damper's ``(tau - tau_c) w_rel``, its
