@@ -879,6 +879,174 @@ def test_a_statically_indeterminate_loop_holds_while_any_split_holds():
     assert abs(slip[0] - hi) < 1e-6, (slip[0], hi)
 
 
+# two self-locking gears (no bearing friction in their tables) and a bearing, in a chain from rest (found by the
+# twenty-seventh session's thorough draws of the heat property): the numbers of that draw
+_CHAIN_R0, _CHAIN_R1 = -3.0703125, -0.3
+_CHAIN_ETA0, _CHAIN_ETA1 = 0.5, 0.2
+_CHAIN_BEARING, _CHAIN_PEAK = 1.21875, 1.28515625
+_CHAIN_T0, _CHAIN_T2 = -28.37655133170772, 0.46875
+
+
+def _self_locking_chain():
+    """J0 -g0- J1 -g1- J2 (1 kg m^2 each, from rest), a bearing friction on J2, a 0.5 Hz sine on J0 and a 2 Hz one
+    on J2."""
+    d = Driveline("self-locking chain")
+    for i in range(3):
+        d.inertia(f"J{i}", 1.0, w0=0.0 if i == 0 else None)
+    d.gear("g0", "J0", "J1", ratio=_CHAIN_R0, loss_table=[[0.0, _CHAIN_ETA0, _CHAIN_ETA0, 0.0, 0.0]])
+    d.gear("g1", "J1", "J2", ratio=_CHAIN_R1, loss_table=[[0.0, _CHAIN_ETA1, _CHAIN_ETA1, 0.0, 0.0]])
+    d.bearing_friction("bearing", "J2", torque=_CHAIN_BEARING, peak=_CHAIN_PEAK)
+    d.torque("T0", "J0", Signal.sine(_CHAIN_T0, 0.5))
+    d.torque("T2", "J2", Signal.sine(_CHAIN_T2, 2.0))
+    return d
+
+
+def _chain_sources(t):
+    return _CHAIN_T0 * math.sin(math.pi * t), _CHAIN_T2 * math.sin(4.0 * math.pi * t)
+
+
+def _chain_holds(t):
+    """Independent of the kernel: whether :func:`_self_locking_chain` at rest has a split within every member's
+    bounds (SciPy's HiGHS), from MSL ``LossyGear``'s locked equations.  J0 at rest puts its source torque on g0's
+    flange a, ``T_a0 = T0``; g0's balance ``0 = tau_b + ratio (T_a - L)`` with its held loss ``L0`` gives J1's
+    balance ``T_a1 = r0 (T_a0 - L0)``, and J2's ``r1 (T_a1 - L1) + T2 = f`` with the bearing's ``|f| <= peak
+    torque``.  Each gear's loss lies between ``tauLossMin_m`` and ``tauLossMax_p``; with no bearing friction in its
+    table, ``quadrant1_p = (1 - eta_mf1) T_a`` and ``quadrant2_p = (1 - 1/eta_mf2) T_a`` bound it from above (the
+    larger: the first for ``T_a > 0``) and ``quadrant4_m = (1 - 1/eta_mf2) T_a``, ``quadrant3_m = (1 - eta_mf1)
+    T_a`` from below (the smaller): a union of pieces, each a linear programme.  Unknowns ``(L0, T_a1, L1, f)``."""
+    import itertools
+
+    from scipy.optimize import linprog
+
+    t0, t2 = _chain_sources(t)
+    a_eq = np.array([[_CHAIN_R0, 1.0, 0.0, 0.0], [0.0, _CHAIN_R1, -_CHAIN_R1, -1.0]])
+    b_eq = np.array([_CHAIN_R0 * t0, -t2])
+    lim = _CHAIN_BEARING * _CHAIN_PEAK
+    lines = {eta: ((1.0 - eta), (1.0 - 1.0 / eta)) for eta in (_CHAIN_ETA0, _CHAIN_ETA1)}
+    s0 = lines[_CHAIN_ETA0]
+    l0_lo, l0_hi = min(s0[0] * t0, s0[1] * t0), max(s0[0] * t0, s0[1] * t0)   # g0's band: its T_a is t0
+    s1 = lines[_CHAIN_ETA1]
+    bounds = [(l0_lo, l0_hi), (None, None), (None, None), (-lim, lim)]
+    for u, dn in itertools.product(range(2), repeat=2):
+        # L1 <= s_u T_a1 and L1 >= s_d T_a1 (one line of each edge: the union over the pieces)
+        a_ub = [[0.0, -s1[u], 1.0, 0.0], [0.0, s1[dn], -1.0, 0.0]]
+        if linprog(np.zeros(4), A_ub=np.array(a_ub), b_ub=[0.0, 0.0], A_eq=a_eq, b_eq=b_eq, bounds=bounds,
+                   method="highs").status == 0:
+            return True
+    return False
+
+
+def _chain_rolling_rhs(t, y):
+    """Independent of the kernel: :func:`_self_locking_chain` after its break-away, one degree of freedom (the
+    gears' constraints ``w0 = r0 w1``, ``w1 = r1 w2``).  MSL ``LossyGear`` rolling with flange a driving: the torque
+    on flange b's inertia is ``ratio eta_mf1 T_a`` in quadrants 1 and 3; the bearing slides backward
+    (``+torque`` on J2).  ``T_a0 = T0 - J0 r0 r1 a2``, ``T_a1 = r0 eta0 T_a0 - J1 r1 a2``, ``J2 a2 = r1 eta1 T_a1 + T2
+    + torque``, solved for ``a2``.  State ``(w2,)``."""
+    t0, t2 = _chain_sources(t)
+    r0, r1, e0, e1 = _CHAIN_R0, _CHAIN_R1, _CHAIN_ETA0, _CHAIN_ETA1
+    a2 = (r1 * e1 * r0 * e0 * t0 + t2 + _CHAIN_BEARING) / (1.0 + r1 ** 2 * e1 * r0 ** 2 * e0 + r1 ** 2 * e1)
+    return [a2]
+
+
+@pytest.mark.parametrize("rtol", [1e-8, 1e-10])
+@pytest.mark.parametrize("sampled", [True, False])
+def test_a_self_locking_chain_breaks_away_where_no_split_holds_whether_sampled_or_not(rtol, sampled):
+    """Found by the twenty-seventh session's thorough draws (present before them): :func:`_self_locking_chain`
+    is stuck from rest, a statically indeterminate set (two gears, their holds and the bearing on three inertias).
+    Its group reaches the edge of the splits that hold it at one instant for all three members; sampled (outputs
+    every 2 ms), the network then stayed stuck for good, g0 holding twice its band's edge, at every tolerance and
+    without a word (the invariant check stopped it at 0.226151 s).  The warm start of the split's linear
+    programmes had certified a vertex to the search's tolerance there, so two evaluations of one state disagreed
+    on whether the group holds (a sample's evaluation between them moved the hints): the one that located the
+    event saw it slip, the one after it saw it hold, and the next step started beyond the limit, where nothing
+    crosses.  An observer's evaluation (the outputs at a sample, the invariant check) now reads the hints from a
+    copy and leaves them as they were (``kernel.observe``): the sampled run takes the unsampled run's decisions.
+
+    Now, sampled every 2 ms or at every step: the three leave stuck together where an independent linear programme from MSL's
+    equations finds no split any more (within 1e-6 s), the bearing and g0 backward and g1 forward; the motion
+    after it follows the one-degree-of-freedom solution from MSL's rolling equations (SciPy, to 1e-7 rad/s); no
+    invariant fails at any step."""
+    from scipy.integrate import solve_ivp
+
+    d = _self_locking_chain()
+    kw = {"output_step": 2e-3} if sampled else {}   # (else every accepted step)
+    res = d.simulate(0.3, rtol=rtol, check_invariants=True, **kw)
+    t_slip = _first_slip(_chain_holds, 0.2, 0.25)
+    ev = _mode_events(res)
+    assert [e[1:] for e in ev[:3]] == [("bearing", "backward"), ("g0", "backward"), ("g1", "forward")], ev
+    assert all(abs(e[0] - t_slip) < 1e-6 for e in ev[:3]), (ev[:3], t_slip)
+    t_next = ev[3][0] if len(ev) > 3 else 0.3
+    sol = solve_ivp(_chain_rolling_rhs, (t_slip, t_next), [0.0], rtol=1e-12, atol=1e-14, dense_output=True)
+    df = res.to_dataframe()
+    after = (df.time_s > t_slip + 1e-4) & (df.time_s < t_next)
+    assert after.sum() >= (10 if sampled else 2)   # (every step: the steps up to the next event)
+    w2 = sol.sol(df.time_s[after].to_numpy())[0]
+    assert np.max(np.abs(df["J2.w_rad_s"][after] - w2)) < 1e-7
+    assert np.max(np.abs(df["J1.w_rad_s"][after] - _CHAIN_R1 * w2)) < 1e-7
+    assert np.max(np.abs(w2)) > 1e-3   # (it does move)
+
+
+def test_the_speed_projection_at_an_event_moves_no_momentum_into_a_loop_with_a_rolling_lossy_gear():
+    """Found by the twenty-eighth session's thorough draws of the heat property (present before the heat ports): a
+    one-way clutch J0-J1, a self-locking gear J1-J2 (ratio 1, efficiency 0.5, on the ground) and a clutch J0-J2
+    (0.5 N m) close a rigid loop, a 1 N m sine at 1 Hz on J0, all from rest.  Where the gear rolls (0.0833 s) the
+    event's projection of the stuck speeds (``kernel._project_speeds``: impulses of the residue's size, 1e-18
+    rad/s here) moved its impulses along a null direction into the members' *torque* limits, and they grew to the
+    split's size: the three inertias jumped to -1.25e-3 rad/s at the event, against the torque, and each later
+    search added as much again.  The projection now keeps the regularised impulses: the group leaves rest with the
+    speed it had, as one body (J0, J1 and J2 together) of 3 kg m^2 under the sine while the gear carries about
+    nothing, ``w(t) = (cos(2 pi t0) - cos(2 pi t)) / (6 pi)`` from the event ``t0`` (to 1e-8 rad/s over its first
+    5 ms; later the regularised split routes a small torque through the gear, whose loss then slows the group: a
+    statically indeterminate loop, docs/driveline.md).
+
+    The instant, from MSL's locked ``LossyGear`` (``0 = tau_b + ratio (T_a - L)``) and the inertias at rest: J1
+    puts the one-way clutch's torque on the gear, ``T_a = tau_f0 >= 0``; J2 takes the clutch's, ``tau_loop = tau_b
+    = L - T_a``; J0 then gives ``T0 = tau_f0 + tau_loop = L``: the gear's loss holds the whole source torque.  Its
+    band ``L <= (1 - eta) T_a`` needs ``T_a >= 2 L``, so the clutch carries ``|tau_loop| = T_a - L >= T0``, at most
+    0.5 N m: the group holds to ``T0 = sin(2 pi t) = 0.5``, ``t0 = 1/12`` s."""
+    d = Driveline("loop with a rolling gear")
+    for i in range(3):
+        d.inertia(f"J{i}", 1.0, w0=0.0)
+    d.one_way_clutch("f0", "J0", "J1")
+    d.gear("g1", "J1", "J2", ratio=1.0, efficiency=0.5)
+    d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5)
+    d.torque("T0", "J0", Signal.sine(1.0, 1.0))
+    res = d.simulate(0.2, rtol=1e-8, output_step=1e-4)
+    ev = _events(res, "g1")
+    assert ev and ev[0][1] == "forward"
+    t0 = ev[0][0]
+    assert abs(t0 - 1.0 / 12.0) < 1e-6   # (the closed form of the docstring)
+    df = res.to_dataframe()
+    on = (df.time_s > t0) & (df.time_s < t0 + 5e-3)
+    assert on.sum() >= 40
+    want = (math.cos(2 * math.pi * t0) - np.cos(2 * math.pi * df.time_s[on])) / (6 * math.pi)
+    for j in ("J0", "J1", "J2"):
+        assert np.max(np.abs(df[f"{j}.w_rad_s"][on] - want)) < 1e-8, j
+    before = df.time_s < t0
+    assert np.max(np.abs(df.loc[before, ["J0.w_rad_s", "J1.w_rad_s", "J2.w_rad_s"]].to_numpy())) < 1e-12
+
+
+@settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
+@given(networks())
+def test_samples_change_nothing_on_random_networks(d):
+    """Whatever the network, the result is the same sampled every 2 ms or at every accepted step: the outputs at a
+    sample evaluate the network, and nothing that evaluation leaves behind (the split search's warm start, the
+    caches of the work array) may change a decision (``kernel.observe``).  Before it, a
+    self-locking chain sampled every 2 ms stayed stuck beyond its limit where the run without samples broke away
+    (:func:`test_a_self_locking_chain_breaks_away_where_no_split_holds_whether_sampled_or_not`).  The same mode
+    changes at the same instants (1e-9 s), and the final angles and speeds within 1e-9 of their largest plus 1e-12."""
+    a = d.simulate(1.0, output_step=2e-3, rtol=1e-9)
+    b = d.simulate(1.0, rtol=1e-9)
+    ea, eb = _mode_events(a), _mode_events(b)
+    assert [e[1:] for e in ea] == [e[1:] for e in eb]
+    assert all(abs(x[0] - y[0]) <= 1e-9 for x, y in zip(ea, eb))
+    assert abs(a.time[-1] - 1.0) <= 1e-12 and abs(b.time[-1] - 1.0) <= 1e-12   # (a signal's break may end it 1 ulp short)
+    q = [i for i, c in enumerate(a.state_columns) if c.endswith((".phi_rad", ".w_rad_s"))]   # (energies follow)
+    xa, xb = a.states[-1, q], b.states[-1, q]
+    scale = np.max(np.abs(b.states[:, q]), axis=0)
+    assert np.all(np.abs(xa - xb) <= 1e-9 * scale + 1e-12), (xa, xb)
+
+
 @settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
 @given(networks())
 def test_the_result_follows_the_tolerance_on_random_networks(d):

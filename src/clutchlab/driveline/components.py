@@ -19,11 +19,10 @@ from __future__ import annotations
 
 from ..component import Component, Field, register_component
 from ..errors import ParameterError
-from ..params.base import FRICTION_COEFFICIENT_MAX, MU_SCALE_MAX, WET_TEMPERATURES_C
+from ..params.base import ABSOLUTE_ZERO_C, FRICTION_COEFFICIENT_MAX, MU_SCALE_MAX, WET_TEMPERATURES_C
 
 __all__ = ["BUILTIN"]
 
-_ABS_ZERO_C = -273.15
 _MSL = "Modelica.Mechanics.Rotational"
 
 
@@ -68,7 +67,7 @@ def _friction_fields(fn_required=True, fn_default=None, with_map=True):
             Field("mu_map", "path", description="a friction map .json of clutchlab wet identify (instead of mu)"),
             Field("radius", "quantity", "m", positive=True,
                   description="radius at which a friction map is read (slip velocity = radius |w_rel|)"),
-            Field("temperature", "quantity", "degC", minimum=_ABS_ZERO_C,
+            Field("temperature", "quantity", "degC", minimum=ABSOLUTE_ZERO_C,
                   description="friction-surface temperature a friction map is read at"),
         ]
     return tuple(fields)
@@ -298,10 +297,10 @@ BUILTIN = (
     Component("thermal_mass", "A thermal mass that the losses of elements heat, with a conductance to its ambient: "
                               "C dT/dt = sum P_loss - G (T - T_ambient) - its conductors' flows.", (
         Field("capacity", "quantity", "J/K", required=True, positive=True, description="heat capacity"),
-        Field("T0", "quantity", "degC", default=20.0, minimum=_ABS_ZERO_C, description="initial temperature"),
+        Field("T0", "quantity", "degC", default=20.0, minimum=ABSOLUTE_ZERO_C, description="initial temperature"),
         Field("conductance", "quantity", "W/K", default=0.0, minimum=0.0,
               description="thermal conductance to its ambient (0: insulated)"),
-        Field("ambient", "quantity", "degC", default=20.0, minimum=_ABS_ZERO_C,
+        Field("ambient", "quantity", "degC", default=20.0, minimum=ABSOLUTE_ZERO_C,
               description="the ambient's temperature"),
         Field("heat_from", "names", description="the elements whose losses heat it (their heat ports; each heats "
                                                 "one mass; not sources, wet clutches or EMTCs)"),

@@ -143,6 +143,7 @@ def coupled_outputs(t, x, u, m, p, y):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    K.observe(net, True)   # (an observer: K.driveline_outputs, which ends the mark)
     _evaluate(t, x, u, m, net, w, e)
     K.driveline_outputs(t, x, u, m, net, y)
     q = y.shape[0] - w.conf.shape[0] * DW.N_KEPT - e.conf.shape[0] * e.index.shape[0]
@@ -220,6 +221,7 @@ def coupled_accept(t, x, u, m, p):
     if res < 0:
         return res
     if net.check[0] != 0.0:
+        K.observe(net, True)   # (a debug option changes no decision: K.driveline_accept ends the mark)
         _evaluate(t, x, u, m, net, w, e)
         return K.driveline_accept(t, x, u, m, net)
     return 0

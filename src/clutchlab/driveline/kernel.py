@@ -122,8 +122,14 @@ THERMAL_COLUMNS = ("capacity", "conductance", "ambient", "initial", "state")
 T_CAP, T_COND, T_AMB, T_INIT, T_STATE = indices(THERMAL_COLUMNS, "capacity", "conductance", "ambient", "initial",
                                                 "state")
 N_THERMAL = len(THERMAL_COLUMNS)
-#: states of a thermal mass, from its ``state`` column on
-THERMAL_STATES = ("temperature", "heat_out")
+#: states of a thermal mass, from its ``state`` column on: (quantity, unit, description of mass ``{}``), declared
+#: once (the network's state columns are generated from it)
+THERMAL_STATE_DECL = (("temperature", "C", "temperature of the thermal mass {}"),
+                      ("heat_out", "J", "heat {} gave its ambient since the start"))
+THERMAL_STATES = tuple(q for q, _unit, _what in THERMAL_STATE_DECL)
+#: outputs of a thermal mass, in :func:`driveline_outputs`' order (as :data:`THERMAL_STATE_DECL`)
+THERMAL_OUTPUT_DECL = (("loss_power", "W", "power the elements heating {} dissipate into it"),
+                       ("heat_flow", "W", "heat flow from {} to its ambient"))
 TS_TEMP, TS_OUT = indices(THERMAL_STATES, "temperature", "heat_out")
 #: columns of ``links`` (one row per thermal conductor between two masses, MSL ``ThermalConductor``): the rows of
 #: its masses in ``thermal`` (whole numbers held as floats) and its conductance [W/K]
@@ -500,13 +506,7 @@ def fade_factor(p, r):
     (``mu_temperature``: linear between its rows, held beyond them), read from the temperatures of the network's last
     evaluation (:func:`evaluate_network` keeps them: :func:`temperatures`).  The friction coefficient of a dry
     lining falls as it heats (fade); the factor scales the sliding torque and the static limit alike."""
-    s, n = p.elem[r, E_FADE], p.elem[r, E_FADE_N]
-    temp = temperatures(p)[p.elem[r, E_HEAT]]
-    if n == 1 or temp <= p.data[s]:
-        return p.data[s + n]
-    if temp >= p.data[s + n - 1]:
-        return p.data[s + 2 * n - 1]
-    return _table(p.data, s, n, temp)
+    return _table(p.data, p.elem[r, E_FADE], p.elem[r, E_FADE_N], temperatures(p)[p.elem[r, E_HEAT]])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1040,7 +1040,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     :func:`signal_at`) | the last null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk,
     :func:`_null_vector_cached`) | the instant of the last stick/slip search, the event count before it and the
     friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
-    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``) | the thermal
+    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``), then whether an
+    observer evaluates the network (1, :func:`observe`) | the thermal
     masses' temperatures at the last evaluation (nt, :func:`temperatures`) | sliding torque,
     static limit and lock-up limit of each clutch model, their rates and the time of those (``N_EXT`` per
     ``LAW_EXTERNAL`` element, :func:`set_external`, :func:`set_external_rates`) | the
@@ -1064,7 +1065,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     o_nv = o_sig + 1 + nsig
     o_inst = o_nv + 2 + nk * nk + nk
     o_sp = o_inst + 3 + nf + nl
-    o_temp = o_sp + SPACE_CACHE
+    o_temp = o_sp + SPACE_CACHE + 1
     o_ext = o_temp + nt
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
                       o_inst, o_sp, o_temp, o_ext)
@@ -1121,6 +1122,15 @@ def temperatures(p):
     the friction laws that fade read (:func:`fade_factor`)."""
     o = _offsets(p)
     return p.work[o.temp:o.ext]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def observe(p, on):
+    """Mark the evaluations of the network that follow as an observer's (``on`` True: the outputs at a sample, the
+    invariant check, the margin rates' probe) or not: an observer's evaluation leaves the warm start of
+    :func:`_repair_space` as it was, so that the decisions of a run do not depend on where it is sampled or whether
+    it is checked."""
+    p.work[_offsets(p).sp + SPACE_CACHE] = 1.0 if on else 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -2014,7 +2024,10 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     Both programmes start warm: each combination's last optimal vertex and active set (``WorkLayout.sp``) are tried
     first and kept where their optimality conditions hold (the dual multipliers' signs), so that the answer is the
     optimum whatever the hint; only where they fail (the set, its bounds or the optimum changed) are the vertices and
-    active sets enumerated.  Returns True if ``lam`` changed."""
+    active sets enumerated.  The optimum is certified only to ``tol``, so at a group's edge whether it holds may
+    follow the hints: an observer's evaluation (the outputs at a sample, the invariant check: :func:`observe`) reads
+    them from a copy and leaves them as they were, so that no sample and no check changes a decision.  Returns True
+    if ``lam`` changed."""
     if ns < 3:
         return False
     # ---- an orthonormal basis of the null space
@@ -2115,6 +2128,12 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
             ncomb *= 4
     hint = p.work
     o_sp = _offsets(p).sp
+    if hint[o_sp + SPACE_CACHE] != 0.0:
+        # an observer's evaluation (:func:`observe`): the hints from a copy, so that it leaves them as they were (a
+        # sample's outputs moved them, and at a group's edge, where the optimum is certified only to ``tol``, a
+        # self-locking chain sampled every 2 ms then stayed stuck beyond its limit, #30)
+        hint = p.work[o_sp:o_sp + SPACE_CACHE].copy()
+        o_sp = 0
     M = np.empty((4, 4))
     b = np.empty(4)
     yb = np.empty(4)
@@ -2385,7 +2404,10 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
-    if bounded and ns > 1 and not _full_rank_known(p, A, ns):
+    # (not for the impulses of a projection: they are of the residue's size, and moved along a null direction into
+    # the torque limits they grew to the split's own size, 5e-3 N m s where a lossy gear rolling in a loop makes a
+    # null direction with a net impulse, and the projection gave the loop a speed of its own, #30)
+    if bounded and ns > 1 and speeds == 0 and not _full_rank_known(p, A, ns):
         big = fscale
         for k in range(ns):
             big = max(big, abs(lam[k]))
@@ -2860,7 +2882,8 @@ def _project_speeds(t, x, m, p, comp, reach):
     """Put the relative speed of every member of the constraint set of the modes ``m`` (stuck friction elements,
     gears, stuck lossy gears' holds) to zero, by the impulses along the members' torque directions that do it (the
     set of :func:`evaluate_network` solved by :func:`_solve_stuck` for momenta instead of torques: ``A mu = g . w``,
-    ``w -= M^-1 h mu``).
+    ``w -= M^-1 h mu``, the regularised split of ``mu`` as it is: the members' torque limits bound no impulse, and
+    moved into them along a null direction the impulses grew to the split's size).
 
     The set holds its relative accelerations at zero, not its speeds: a stuck member keeps the speed the located
     event left it (the stick function's root, up to its rounding width :func:`_item_wtol` the wrong way) and the
@@ -3224,7 +3247,8 @@ def _margin_rates(t, x, u, m, p, dx, g):
     ``watch`` hook: step ends, events, probes), never at the stages: one more evaluation of the network (the
     right-hand side through its address, at ``t + T_RATE`` and the state moved by ``T_RATE dx`` in a scratch
     copy), after which the accelerations, torques, holds, torque magnitudes and temperatures of the evaluation at
-    ``t`` are put back from the work array, bit for bit."""
+    ``t`` are put back from the work array, bit for bit; the warm start of the split search is left as it was (an
+    observer's evaluation, :func:`observe`), so that the network evaluated at ``t`` again decides as it did."""
     n = p.inertia.shape[0]
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
@@ -3257,7 +3281,9 @@ def _margin_rates(t, x, u, m, p, dx, g):
     th0 = int(p.thermal[0, T_STATE]) if p.thermal.shape[0] > 0 else nx
     for i in range(nx):
         xs[i] = x[i] + T_RATE * dx[i] if i < 2 * n or i >= th0 else x[i]
+    observe(p, True)   # (a probe: the warm start of the split search is left as the evaluation at t left it)
     _rhs_outlined(t + T_RATE, xs, u, m, p, ds, gs)
+    observe(p, False)
     for k in range(nf):
         q = N_G * k + G_TURN
         if m[k] == STUCK and g[q] == 0.0:
@@ -3569,7 +3595,9 @@ def driveline_outputs(t, x, u, m, p, y):
     ne = p.elem.shape[0]
     nf = p.fric.shape[0]
     acc, tau = _acc_tau(p)
+    observe(p, True)   # (an observer: the warm start of the split search is left as it was)
     evaluate_network(t, x, m, p, acc, tau)
+    observe(p, False)
     q = 0
     kinetic = 0.0
     for i in range(n):
@@ -3858,7 +3886,10 @@ def driveline_accept(t, x, u, m, p):
     if u.shape[0] > 0 and hold_inputs(p.data, u):
         forget_signals(p)
     if p.check[0] != 0.0:
-        return _check_outlined(t, x, m, p)
+        observe(p, True)   # (a debug option: it changes no decision)
+        code = _check_outlined(t, x, m, p)
+        observe(p, False)
+        return code
     return 0
 
 

@@ -29,11 +29,11 @@ import numpy as np
 from .._limits import as_numbers, check_number
 from ..errors import ParameterError
 from ..numerics import outline
+from ..params.base import ABSOLUTE_ZERO_C
 from ..units import COLUMN_UNITS
 from ..system import System, register_model, simulate as _simulate
 from . import kernel as K
 
-_ABS_ZERO_C = -273.15
 
 __all__ = ["Driveline", "Signal", "GROUND", "ElementInfo"]
 
@@ -1042,7 +1042,7 @@ class Driveline:
         arr = as_numbers(rows, f"{name}: mu_temperature")
         if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or not np.all(np.isfinite(arr)):
             raise ParameterError(f"{name}: mu_temperature must be a table of rows [T_degC, factor]")
-        if np.any(np.diff(arr[:, 0]) <= 0) or np.any(arr[:, 1] < 0) or np.any(arr[:, 0] <= _ABS_ZERO_C):
+        if np.any(np.diff(arr[:, 0]) <= 0) or np.any(arr[:, 1] < 0) or np.any(arr[:, 0] <= ABSOLUTE_ZERO_C):
             raise ParameterError(f"{name}: mu_temperature must increase in T (above -273.15 degC) with factors >= 0 "
                                  f"(got {arr.tolist()!r})")
         return tuple(float(v) for v in arr[:, 0]) + tuple(float(v) for v in arr[:, 1])
@@ -1483,7 +1483,7 @@ class Driveline:
         conductance = _finite(name, "conductance", conductance, nonneg=True)
         ambient = _finite(name, "ambient", ambient)
         for t, what in ((T0, "T0"), (ambient, "ambient")):
-            if t <= _ABS_ZERO_C:
+            if t <= ABSOLUTE_ZERO_C:
                 raise ParameterError(f"{name}: {what} = {t:g} degC is not above absolute zero (-273.15 degC)")
         if isinstance(heat_from, str):
             heat_from = (heat_from,)
@@ -1515,7 +1515,7 @@ class Driveline:
         rows = {e.name: r for r, e in enumerate(self._elements)}
         heat = np.full(len(self._elements), -1, dtype=np.int64)
         masses = list(self._thermal.values())
-        o = 2 * len(self._inertias) + len(self._elements) + len(self._controllers)
+        o = self._thermal_offset()
         thermal = np.zeros((len(masses), K.N_THERMAL))
         for k, tm in enumerate(masses):
             thermal[k, K.T_CAP] = tm.capacity
@@ -1771,10 +1771,14 @@ class Driveline:
                 total += 0.5 * e.coef[0] * phi * phi
         return total
 
+    def _thermal_offset(self) -> int:
+        """Where the thermal masses' states start in the state vector: after the angles, the speeds, one energy per
+        element and the engines' idle integrals (:func:`~clutchlab.driveline.kernel.driveline_rhs`)."""
+        return 2 * len(self._inertias) + len(self._elements) + len(self._controllers)
+
     def _state_count(self) -> int:
         """The network's own states: angles, speeds, an energy per element, the controllers', the thermal masses'."""
-        return (2 * len(self._inertias) + len(self._elements) + len(self._controllers)
-                + len(K.THERMAL_STATES) * len(self._thermal))
+        return self._thermal_offset() + len(K.THERMAL_STATES) * len(self._thermal)
 
     def initial_state(self) -> np.ndarray:
         """Angles, speeds, then the energy states (zero).
@@ -1787,7 +1791,7 @@ class Driveline:
         index = {nm: i for i, nm in enumerate(names)}
         n = len(names)
         x = np.zeros(self._state_count())
-        o = 2 * n + len(self._elements) + len(self._controllers)
+        o = self._thermal_offset()
         for k, tm in enumerate(self._thermal.values()):   # (kernel.THERMAL_STATES: the temperature, the heat out)
             x[o + len(K.THERMAL_STATES) * k + K.TS_TEMP] = tm.T0
         w = [v[1] for v in self._inertias.values()]
@@ -1921,9 +1925,8 @@ class Driveline:
                 outputs.append((f"{e.name}.{rn}", ru, f"relative speed of {e.name}, flange b minus flange a"))
         states += [(f"{e.name}.idle_integral", tu, f"integral of the idle-speed controller of {e.name}")
                    for e in self._controllers]
-        for tm in self._thermal.values():   # (in the order of kernel.THERMAL_STATES)
-            states += [(f"{tm.name}.temperature", "C", f"temperature of the thermal mass {tm.name}"),
-                       (f"{tm.name}.heat_out", "J", f"heat {tm.name} gave its ambient since the start")]
+        states += [(f"{tm.name}.{q}", unit, what.format(tm.name)) for tm in self._thermal.values()
+                   for q, unit, what in K.THERMAL_STATE_DECL]
         for name in self.friction_names:
             outputs.append((f"{name}.mode", "1", f"mode of {name}: 1 forward, 0 stuck, -1 backward, 2 free (MSL)"))
             outputs.append((f"{name}.fn", "N", f"normal force of {name}"))
@@ -1935,9 +1938,8 @@ class Driveline:
                     ("input_work", "J", "work of the sources since the start"),
                     ("dissipated_energy", "J", "energy dissipated since the start"),
                     ("energy_error", "J", "input work - dissipated - change of the stored energy")]
-        for tm in self._thermal.values():
-            outputs += [(f"{tm.name}.loss_power", "W", f"power the elements heating {tm.name} dissipate into it"),
-                        (f"{tm.name}.heat_flow", "W", f"heat flow from {tm.name} to its ambient")]
+        outputs += [(f"{tm.name}.{q}", unit, what.format(tm.name)) for tm in self._thermal.values()
+                    for q, unit, what in K.THERMAL_OUTPUT_DECL]
         return tuple(states), tuple(outputs)
 
     def system(self, rtol: float = 1e-8, check_invariants: bool = False) -> System:
