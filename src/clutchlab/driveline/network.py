@@ -1043,8 +1043,8 @@ class Driveline:
         if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1 or not np.all(np.isfinite(arr)):
             raise ParameterError(f"{name}: mu_temperature must be a table of rows [T_degC, factor]")
         if np.any(np.diff(arr[:, 0]) <= 0) or np.any(arr[:, 1] < 0) or np.any(arr[:, 0] <= ABSOLUTE_ZERO_C):
-            raise ParameterError(f"{name}: mu_temperature must increase in T (above -273.15 degC) with factors >= 0 "
-                                 f"(got {arr.tolist()!r})")
+            raise ParameterError(f"{name}: mu_temperature must increase in T (above {ABSOLUTE_ZERO_C} degC) with "
+                                 f"factors >= 0 (got {arr.tolist()!r})")
         return tuple(float(v) for v in arr[:, 0]) + tuple(float(v) for v in arr[:, 1])
 
     @staticmethod
@@ -1484,7 +1484,7 @@ class Driveline:
         ambient = _finite(name, "ambient", ambient)
         for t, what in ((T0, "T0"), (ambient, "ambient")):
             if t <= ABSOLUTE_ZERO_C:
-                raise ParameterError(f"{name}: {what} = {t:g} degC is not above absolute zero (-273.15 degC)")
+                raise ParameterError(f"{name}: {what} = {t:g} degC is not above absolute zero ({ABSOLUTE_ZERO_C} degC)")
         if isinstance(heat_from, str):
             heat_from = (heat_from,)
         heat_from = tuple(heat_from)
