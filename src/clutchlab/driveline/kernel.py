@@ -1508,6 +1508,57 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _rolling_gear_in(p, m, stuck, ns):
+    """True if a member of the constraint set is a rolling lossy gear (its torque weights ``h`` are not its
+    constraint weights ``g``, :func:`_member`, so ``A`` is not symmetric)."""
+    for k in range(ns):
+        rk = int(stuck[k])
+        if rk >= 0 and p.elem[rk, E_KIND] == K_GEAR and p.elem[rk, E_MODE] >= 0 and \
+                m[p.elem[rk, E_MODE]] != GEAR_STUCK:
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _split_limit(p, A, ns, S, cp, lam, d, v, u, y):
+    """The regularised split of a set with one null direction, moved along it onto its own limit (``eps`` -> 0).
+
+    ``(A + eps D) lam = b`` gives ``u . D lam = 0`` for every ``eps``, ``u`` the left null vector of ``A`` (``u A =
+    0``, and ``u . b = 0`` for a consistent ``b``), and so does each refinement on the residual: that condition picks
+    the split among ``lam + z v`` (``v`` the right null vector), the minimum of ``sum(lam_k^2 D_k)`` where ``A`` is
+    symmetric.  In floating point the residual's rounding (1e-17 of the torques) has a component along ``u``
+    that the solve divides by ``eps`` (1e-8 of ``A``): the split lands 1e-9 of the torques off its limit along ``v``.
+    Where ``A`` is not symmetric (a rolling lossy gear in a rigid loop) that moves the gear's torque, which the
+    split may leave at zero, by 1e-9 N m of either sign: its quadrant followed the residue, its loss power came out
+    negative, and its quadrant changed back and forth (#30).  Here ``z = u . D lam / u . D v`` is taken off, so the
+    split is its limit to rounding.  ``d`` holds ``D``'s diagonal; ``S``, ``cp``, ``y`` are scratch; ``A`` is
+    transposed in place for ``u`` and back (exact)."""
+    if not _null_vector_cached(p, A, ns, S, cp, v, y):
+        return
+    for k in range(ns):
+        for j in range(k + 1, ns):
+            A[k, j], A[j, k] = A[j, k], A[k, j]
+    code = _null_vector(A, ns, S, cp, u, y)
+    for k in range(ns):
+        for j in range(k + 1, ns):
+            A[k, j], A[j, k] = A[j, k], A[k, j]
+    if code != 1:
+        return
+    num = 0.0
+    den = 0.0
+    mag = 0.0
+    for k in range(ns):
+        num += u[k] * d[k] * lam[k]
+        den += u[k] * d[k] * v[k]
+        mag += abs(u[k] * d[k] * v[k])
+    if abs(den) <= 1e-8 * mag:
+        return
+    z = num / den
+    for k in range(ns):
+        lam[k] -= z * v[k]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _repair(p, stuck, ns, A, S, cp, lam, lo, hi, v, tmp, cand, trial, tol):
     """Move a statically indeterminate split into the stuck members' bounds (one redundant loop).
 
@@ -2280,6 +2331,8 @@ _repair_space_outlined = outlined(_repair_space, lambda: (_params_type(), _F1, t
 
 _repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, _F2, _F2, _I1, _F1, _F1, _F1, _F1, _F1,
                                               _F1, _F1, types.float64), types.boolean)
+_split_limit_outlined = outlined(_split_limit, lambda: (_params_type(), _F2, types.int64, _F2, _I1, _F1, _F1, _F1, _F1,
+                                                      _F1), types.none)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2295,8 +2348,9 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
     gears and motion sources weigh as the strongest friction element on their own inertias, else in the set),
     from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal,
-    refined twice on the residual of ``A lam = b``; then :func:`_repair` moves that split within the members' bounds where it would leave them while
-    another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
+    refined twice on the residual of ``A lam = b``; where a rolling lossy gear makes ``A`` unsymmetric,
+    :func:`_split_limit` takes off what the rounding left along the null direction; then :func:`_repair` moves that
+    split within the members' bounds where it would leave them while another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
     """
     n = p.inertia.shape[0]
     nk = _nk(p)
@@ -2404,6 +2458,10 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
+    if ns > 1 and speeds == 0 and _rolling_gear_in(p, m, stuck, ns) and not _full_rank_known(p, A, ns):
+        for k in range(ns):   # (D's diagonal, as in M above)
+            res[k] = cmax / max(cap[k], 1e-6 * cmax, 1e-300) if cmax > 0.0 else 1.0
+        _split_limit_outlined(p, A, ns, S, p.iwork, lam, res, vnull, trial, vtmp)
     # (not for the impulses of a projection: they are of the residue's size, and moved along a null direction into
     # the torque limits they grew to the split's own size, 5e-3 N m s where a lossy gear rolling in a loop makes a
     # null direction with a net impulse, and the projection gave the loop a speed of its own, #30)
