@@ -1083,6 +1083,50 @@ def test_a_rolling_lossy_gear_in_a_rigid_loop_carries_no_residue_and_keeps_its_q
         assert all(abs(a[0] - b[0]) < 1e-6 for a, b in zip(ev, ref))
 
 
+@pytest.mark.parametrize("delta", [1e-2, 1e-3, 1e-4, 1e-5, 1e-6])
+def test_a_loop_whose_gear_ratios_miss_one_locks_and_its_clutch_slips(delta):
+    """Found by the twenty-ninth session's thorough draws: a gear J0-J1 of ratio ``r = 1 - delta`` (``w_0 = r
+    w_1``), a clutch c1 J1-J2 and a clutch "loop" J0-J2 (0.5 N m each) close a loop that, with both clutches stuck,
+    admits no motion at all (the constraints' determinant is ``delta``); a 1 N m sine at 0.5 Hz on J2 (0.5 kg m^2;
+    J0 1 kg m^2, J1 0.5), all from rest.
+
+    At rest the balance of the three inertias (MSL's ``IdealGear`` and the stuck clutches' torques, flange
+    conventions of ``kernel._member``) is ``tau_g + tau_loop = 0``, ``tau_c1 = r tau_g``, ``tau_c1 + tau_loop =
+    T2``: ``tau_loop = T2 / delta``, the largest, so the loop clutch breaks away forward where ``sin(pi t) = 0.5
+    delta``.  Then c1 holds J1 and J2 together, J0 turns at ``r`` times their speed ``u``, the loop slips at
+    ``delta u > 0`` carrying its 0.5 N m, and virtual power gives ``(J0 r^2 + J1 + J2) du/dt = sin(pi t) - 0.5
+    delta``.  Before, the regularisation of the stuck set's solve (1e-8 of ``A``) biased a full-rank but
+    ill-conditioned set (``A``'s last pivot is about ``delta^2``): the break-away came late by up to nine times
+    (delta 1e-4: 1.38e-4 s against 1.59e-5 s), and from delta 1e-5 the set was taken as singular (a rigid loop):
+    both clutches "stuck" for the whole run while c1's relative speed grew to 1e-5 of the group's, which the
+    invariant check stopped ("c1: mode inconsistent").  A full-rank set is now solved without the regularisation,
+    and a pivot counts as zero below 1e-13 of the first, not 1e-10: a loop is rigid only where ``delta`` lies below
+    about 3e-7, whose drift stays within the invariant check's 1e-6 of the speeds (docs/driveline.md)."""
+    r = 1.0 - delta
+    d = Driveline("nearly rigid loop")
+    d.inertia("J0", 1.0, w0=0.0)
+    d.inertia("J1", 0.5, w0=0.0)
+    d.inertia("J2", 0.5, w0=0.0)
+    d.gear("g0", "J0", "J1", ratio=r)
+    d.clutch("c1", "J1", "J2", fn_max=1.0, mu=0.5)
+    d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5)
+    d.torque("T2", "J2", Signal.sine(1.0, 0.5))
+    res = d.simulate(1.0, rtol=1e-9, output_step=1e-3, check_invariants=True)
+    t0 = math.asin(0.5 * delta) / math.pi
+    assert [(e[1], e[2]) for e in _mode_events(res)] == [("loop", "forward")]
+    t = float(res.events.time_s.iloc[0])
+    assert abs(t - t0) <= 1e-9, (t, t0)   # (the set's condition, 1 / delta^2, costs digits: 1.1e-10 s at 1e-6)
+    df = res.to_dataframe()
+    on = df.time_s > t0
+    tt = df.time_s[on]
+    u = ((math.cos(math.pi * t0) - np.cos(math.pi * tt)) / math.pi - 0.5 * delta * (tt - t0)) / (r * r + 1.0)
+    assert np.max(np.abs(df["J2.w_rad_s"][on] - u)) < 1e-8
+    assert np.max(np.abs(df["J1.w_rad_s"][on] - u)) < 1e-8
+    assert np.max(np.abs(df["J0.w_rad_s"][on] - r * u)) < 1e-8
+    assert np.max(np.abs(df["loop.w_rel_rad_s"][on] - delta * u)) < 1e-8 * delta + 1e-14
+    assert np.all(df["loop.tau_Nm"][on] == 0.5)
+
+
 @settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
 @given(networks())
 def test_samples_change_nothing_on_random_networks(d):

@@ -1394,7 +1394,7 @@ def _feasible(p, stuck, ns, lam, lo, hi, tol):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _eliminate(A, ns, S, cp):
     """Gaussian elimination with complete pivoting of ``A[:ns, :ns]`` into ``S`` (its columns in the order ``cp``):
-    the rank, a pivot below 1e-10 of the first taken as zero (0 for a zero matrix).  The first ``rank`` rows of
+    the rank, a pivot below 1e-13 of the first taken as zero (0 for a zero matrix).  The first ``rank`` rows of
     ``S`` are then upper triangular, the rest zero to that threshold."""
     for k in range(ns):
         cp[k] = k
@@ -1411,7 +1411,7 @@ def _eliminate(A, ns, S, cp):
             first = bv
             if first == 0.0:
                 return 0
-        if bv <= 1e-10 * first:
+        if bv <= 1e-13 * first:
             return c
         for j in range(ns):
             S[c, j], S[bi, j] = S[bi, j], S[c, j]
@@ -1505,6 +1505,14 @@ def _null_vector_cached(p, A, ns, S, cp, v, y):
         if found:
             w[o + 2 + nk * nk + k] = v[k]
     return found
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _rank_full(p, A, ns, S, v, y):
+    """True if ``A[:ns, :ns]`` is of full rank (:func:`_null_vector_cached`: searched once while ``A`` is the same;
+    its column order goes to ``p.iwork``, free before the factorisation)."""
+    _null_vector_cached(p, A, ns, S, p.iwork, v, y)
+    return _full_rank_known(p, A, ns)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2347,8 +2355,8 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     lock the same relative motion (two clutches in parallel) ``A`` is singular: the regularised solution splits
     the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
     gears and motion sources weigh as the strongest friction element on their own inertias, else in the set),
-    from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal,
-    refined twice on the residual of ``A lam = b``; where a rolling lossy gear makes ``A`` unsymmetric,
+    from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal (``eps``
+    = 0 where ``A`` is of full rank, :func:`_rank_full`), refined twice on the residual of ``A lam = b``; where a rolling lossy gear makes ``A`` unsymmetric,
     :func:`_split_limit` takes off what the rounding left along the null direction; then :func:`_repair` moves that
     split within the members' bounds where it would leave them while another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
     """
@@ -2442,12 +2450,18 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     cmax = 0.0
     for k in range(ns):
         cmax = max(cmax, cap[k])
+    # a set of full rank (:func:`_null_vector`'s elimination, cached while ``A`` is the same) has one solution:
+    # solved without the regularisation, which biased it where ``A`` is ill-conditioned (a loop whose gear ratios
+    # multiply to 1 - 1e-4 locks it; its last pivot, about 1e-8 of the first, is the regularisation's size, and the
+    # break-away came nine times late, #30)
+    exact = ns > 1 and scale > 0.0 and _rank_full(p, A, ns, S, vnull, vtmp)
     M = shaped(wk[o_m:o_m + ns * ns], (ns, ns))
     for k in range(ns):
         for j in range(ns):
             M[k, j] = A[k, j]
         c = max(cap[k], 1e-6 * cmax, 1e-300)
-        M[k, k] += 1e-8 * scale * (cmax / c if cmax > 0.0 else 1.0)
+        if not exact:
+            M[k, k] += 1e-8 * scale * (cmax / c if cmax > 0.0 else 1.0)
     lu_factor(M, p.iwork)
     for _it in range(3):  # the regularised solution, then two refinements on the residual
         for k in range(ns):
