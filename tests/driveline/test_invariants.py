@@ -1003,14 +1003,7 @@ def test_the_speed_projection_at_an_event_moves_no_momentum_into_a_loop_with_a_r
     = L - T_a``; J0 then gives ``T0 = tau_f0 + tau_loop = L``: the gear's loss holds the whole source torque.  Its
     band ``L <= (1 - eta) T_a`` needs ``T_a >= 2 L``, so the clutch carries ``|tau_loop| = T_a - L >= T0``, at most
     0.5 N m: the group holds to ``T0 = sin(2 pi t) = 0.5``, ``t0 = 1/12`` s."""
-    d = Driveline("loop with a rolling gear")
-    for i in range(3):
-        d.inertia(f"J{i}", 1.0, w0=0.0)
-    d.one_way_clutch("f0", "J0", "J1")
-    d.gear("g1", "J1", "J2", ratio=1.0, efficiency=0.5)
-    d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5)
-    d.torque("T0", "J0", Signal.sine(1.0, 1.0))
-    res = d.simulate(0.2, rtol=1e-8, output_step=1e-4)
+    res = _rolling_gear_loop(False).simulate(0.2, rtol=1e-8, output_step=1e-4)
     ev = _events(res, "g1")
     assert ev and ev[0][1] == "forward"
     t0 = ev[0][0]
@@ -1026,6 +1019,7 @@ def test_the_speed_projection_at_an_event_moves_no_momentum_into_a_loop_with_a_r
 
 
 def _rolling_gear_loop(thermal):
+    """The network of the test above (with a thermal mass on the gear: its twenty-eighth session's draw)."""
     d = Driveline("loop with a rolling gear")
     for i in range(3):
         d.inertia(f"J{i}", 1.0, w0=0.0)
