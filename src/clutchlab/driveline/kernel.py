@@ -2356,9 +2356,10 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     the torque in proportion to the static limits (minimising ``sum(lam_k^2 / limit_k)``; one-way clutches,
     gears and motion sources weigh as the strongest friction element on their own inertias, else in the set),
     from ``(A + eps D) lam = b`` with ``D = diag(max limit / limit_k)`` and ``eps`` 1e-8 of ``A``'s diagonal (``eps``
-    = 0 where ``A`` is of full rank, :func:`_rank_full`), refined twice on the residual of ``A lam = b``; where a rolling lossy gear makes ``A`` unsymmetric,
-    :func:`_split_limit` takes off what the rounding left along the null direction; then :func:`_repair` moves that
-    split within the members' bounds where it would leave them while another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
+    = 0 where ``A`` is of full rank, :func:`_rank_full`), refined twice on the residual of ``A lam = b``; where a
+    rolling lossy gear makes ``A`` unsymmetric, :func:`_split_limit` takes off what the rounding left along the null
+    direction; then :func:`_repair` moves that split within the members' bounds where it would leave them while
+    another split holds.  ``F`` is updated with the torques; a stuck lossy gear's hold goes to :func:`_holds`.
     """
     n = p.inertia.shape[0]
     nk = _nk(p)
