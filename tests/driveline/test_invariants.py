@@ -1121,6 +1121,76 @@ def test_a_loop_whose_gear_ratios_miss_one_locks_and_its_clutch_slips(delta):
     assert np.all(df["loop.tau_Nm"][on] == 0.5)
 
 
+def _overrun_loop():
+    """The network of the test below (the twenty-ninth session's seed-99 draw of the heat property, without its
+    thermal mass)."""
+    d = Driveline("locked loop")
+    for i in range(4):
+        d.inertia(f"J{i}", 1.0, w0=0.0)
+    d.gear("g0", "J0", "J1", ratio=1.25, loss_table=[[0.0, 0.75, 0.5, 0.0, 2.0], [20.0, 0.8, 0.5, 0.0, 2.0]])
+    d.one_way_clutch("f1", "J1", "J2", fn_max=1.0, normal=Signal.step(1.0, 0.0))
+    d.one_way_clutch("f2", "J2", "J3", fn_max=1.0, normal=Signal.step(1.0, 0.5))
+    d.clutch("loop", "J0", "J3", fn_max=16.0, mu=0.5)
+    d.bearing_friction("bearing", "J2", 1.0)
+    d.torque("T0", "J0", Signal.sine(2.0, 1.0))
+    return d
+
+
+def test_a_locked_loop_breaks_away_with_its_one_way_clutch_overrunning():
+    """Found by the twenty-ninth session's thorough draws (seed 99 of the heat property): J0 to J3 (1 kg m^2 each,
+    from rest) in a loop of a lossy gear J0-J1 (ratio 1.25, MSL ``lossTable`` rows ``eta_mf2`` 0.5, ``tau_bf2`` 2 N
+    m), a one-way clutch f1 J1-J2, a one-way clutch f2 J2-J3 with no normal force before 0.5 s (a bare freewheel)
+    and an 8 N m clutch "loop" J0-J3; a 1 N m bearing friction on J2 and ``T0 = 2 sin(2 pi t)`` on J0.
+
+    The loop holds from rest, the split circulating torque in it, until the loop clutch reaches its 8 N m at ``te =
+    asin(0.8) / (2 pi)``, with the bearing at its limit and the gear at its band's edge.  The motion there: f1 and
+    the loop clutch hold, f2 overruns (``w3 - w2 = w0 - w1 = 0.25 w1 > 0``, no torque), the bearing slides, the gear
+    rolls forward with flange b driving (``tau_eta = T_a - tau_bf_a < 0``, ``tau_bf_a = (tau_bf1 - tau_bf2) /
+    (eta_mf1 - 1/eta_mf2) = 1.6`` N m at rest): with ``w0 = w3 = 1.25 u``, ``w1 = w2 = u``, the gear's law ``tau_b =
+    1.25 (T_a / eta_mf2 - tau_bf2)`` and the two groups' balances, ``8.25 du/dt = 5 sin(2 pi t) - 3.5``, until ``u``
+    is back at zero.  Before, the search at ``te`` released the gear alone (rolling in a rigid loop: no motion), and
+    the tie-break's probe at ``te + T_TIE`` left the gear in the other quadrant, whose split put f2 0.63 N m the
+    free way (the check stopped the run, "f2: one-way clutch transmits torque in its free direction"; without it
+    the run went on 68 us so); with the quadrant kept, the loop clutch was released at zero acceleration and slid
+    backward against its forward torque for 68 us.  Now a released item at rest in acceleration must accelerate
+    its own way at ``te + T_TIE`` too, and where none agrees with the items the probe marked, the search is repeated
+    with each subset held to ``te + T_TIE`` (``kernel._probe_fails``).  Checked at three tolerances and two output
+    grids: the events, the speeds on the closed form until f2 engages at 0.5 s, f2's torque zero while it overruns
+    as a bare freewheel, the motion's end at one instant at every tolerance."""
+    te = math.asin(0.8) / (2 * math.pi)
+
+    def u_of(t):
+        return (5.0 * (math.cos(2 * math.pi * te) - np.cos(2 * math.pi * t)) / (2 * math.pi) - 3.5 * (t - te)) / 8.25
+
+    assert u_of(0.5) > 0.0 and u_of(0.52) < 0.0   # (f2 engages at 0.5 s and only brakes: the motion ends before)
+    runs, stops = [], []
+    for rtol, t_end, step in ((1e-8, 1.0, 2e-3), (1e-9, 1.0, 2e-3), (1e-10, 1.0, 2e-3), (1e-9, 0.1477, 1e-5)):
+        res = _overrun_loop().simulate(t_end, rtol=rtol, output_step=step, check_invariants=True)
+        ev = _mode_events(res)
+        first = [e for e in ev if e[0] < 0.2]
+        assert [(e[1], e[2]) for e in first] == [("bearing", "forward"), ("f2", "forward"), ("g0", "forward")], ev
+        assert all(abs(e[0] - te) < 1e-9 for e in first), (first, te)
+        drive = [(t, e) for t, el, e in zip(res.events.time_s, res.events.element, res.events.event) if el == "g0"]
+        assert [e for t, e in drive if t < 0.2] in (["forward"], ["forward", "b_drives"]), drive
+        df = res.to_dataframe()
+        on = (df.time_s > te + 1e-6) & (df.time_s < min(t_end, 0.5))
+        assert on.sum() > 8
+        t = df.time_s[on].to_numpy()
+        u = u_of(t)
+        for j, k in (("J0", 1.25), ("J1", 1.0), ("J2", 1.0), ("J3", 1.25)):
+            assert np.max(np.abs(df[f"{j}.w_rad_s"][on] - k * u)) < 1e-7, (rtol, j)
+        assert np.all(df["f2.tau_Nm"][on] == 0.0)
+        assert np.all(df["g0"][on] == "forward_b_drives")
+        if t_end == 1.0:
+            later = [e for e in ev if e[0] >= 0.2]
+            assert [(e[1], e[2]) for e in later[:3]] == [("bearing", "stick"), ("f2", "stick"), ("g0", "stick")]
+            assert all(0.5 < e[0] < 0.52 and abs(e[0] - later[0][0]) < 1e-7 for e in later[:3]), later
+            runs.append([(e[1], e[2]) for e in ev])
+            stops.append(later[0][0])
+    assert runs[0] == runs[1] == runs[2]
+    assert max(stops) - min(stops) < 1e-6, stops
+
+
 @settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
 @given(networks())
 def test_samples_change_nothing_on_random_networks(d):

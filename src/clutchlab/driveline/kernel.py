@@ -2770,6 +2770,58 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
     return turned
 
 
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
+    """True if a released item of ``pick`` whose relative acceleration at ``t`` is within :data:`TIE_BAND` rounding
+    floors of zero accelerates against its direction at ``t + T_TIE`` (angles and speeds advanced by the decided
+    motion, as the tie-break in :func:`settle`): its way is a tie at first order that the load's rate decides, and
+    this subset is no solution beyond ``t``.  (A loop clutch released at the instant its torque reached its limit,
+    with the loop's one-way clutch stuck, started at zero acceleration and slid backward against its forward
+    torque for 68 us, the one-way clutch then stuck 8 N m deep, until its slip crossed the rounding width; the
+    solution is the one-way clutch overrunning with the loop clutch stuck, #30.)  The network is evaluated at ``t``
+    again before it returns, the quadrants it had kept.  ``stuck_too``: probe in any case, and fail too if a stuck
+    candidate is beyond its limit there (not at it to rounding)."""
+    tie = stuck_too
+    for q in range(s):
+        c = pick[q]
+        i = cand[c]
+        if abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc):
+            tie = True
+    if not tie:
+        return False
+    n = p.inertia.shape[0]
+    nl = p.lossy.shape[0]
+    near = np.zeros(s, dtype=np.bool_)
+    for q in range(s):
+        i = cand[pick[q]]
+        near[q] = abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc)
+    quad = np.empty(nl, dtype=np.int64)
+    for j in range(nl):
+        quad[j] = m[p.elem[p.lossy[j], E_MODE]]
+    for q in range(xp.shape[0]):
+        xp[q] = x[q]
+    for j in range(n):
+        xp[j] = x[j] + T_TIE * x[n + j]
+        xp[n + j] = x[n + j] + T_TIE * acc[j]
+    _evaluate(t + T_TIE, xp, m, p, acc, tau)
+    turns = False
+    for q in range(s):
+        c = pick[q]
+        i = cand[c]
+        if near[q] and _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
+            turns = True
+    if stuck_too:
+        for c in range(nc):
+            i = cand[c]
+            if _item_stuck(p, m, i) and _item_excess(t + T_TIE, p, tau, i, False)[0] >= 0.0 and \
+                    not _tied(t + T_TIE, p, tau, i):
+                turns = True
+    for j in range(nl):
+        m[p.elem[p.lossy[j], E_MODE]] = quad[j]
+    _evaluate(t, x, m, p, acc, tau)
+    return turns
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _apply_subset(p, m, cand, nc, dirs, pick, s):
     for c in range(nc):
@@ -3117,39 +3169,59 @@ def settle(t, x, m, p, log, old, origin):
                 found = False
                 pick = np.empty(max(nc, 1), dtype=np.int64)
                 smax = nc if nc <= 10 else 2
-                for s in range(1, smax + 1):
-                    for q in range(s):
-                        pick[q] = q
-                    while True:
-                        ok = True
-                        for q in range(s):
-                            if dirs[pick[q]] == 0:
-                                ok = False
-                        if ok:
-                            _apply_subset(p, m, cand, nc, dirs, pick, s)
-                            _evaluate(t, x, m, p, acc, tau)
-                            # released together, an item may move against the way its own torque pushed it (two gears
-                            # coupled through a reversing ratio): flip those to the way they accelerate, a few times
-                            for _flip in range(s + 1):
-                                if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced):
-                                    found = True
-                                    break
-                                if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
-                                    break
-                                _evaluate(t, x, m, p, acc, tau)
-                            if found:
-                                break
-                        # the next combination of s out of nc
-                        q = s - 1
-                        while q >= 0 and pick[q] == nc - s + q:
-                            q -= 1
-                        if q < 0:
+                # (a second attempt where none agrees with the items marked to break away (``forced``, taken from the
+                # all-stuck set at t + T_TIE): the search again with them free to hold, each subset kept only if it
+                # holds at t + T_TIE as well -- a loop clutch marked so, because the loop's one-way clutch held, was
+                # released with everything else for 74 ps where it holds once the one-way clutch overruns, #30)
+                marks = forced
+                for attempt in range(2):
+                    if attempt == 1:
+                        if found:
                             break
-                        pick[q] += 1
-                        for qq in range(q + 1, s):
-                            pick[qq] = pick[qq - 1] + 1
-                    if found:
-                        break
+                        marks = np.zeros(ni, dtype=np.int64)
+                        anyf = False
+                        for c in range(nc):
+                            if forced[cand[c]] != 0:
+                                anyf = True
+                        if not anyf:
+                            break
+                    for s in range(1, smax + 1):
+                        for q in range(s):
+                            pick[q] = q
+                        while True:
+                            ok = True
+                            for q in range(s):
+                                if dirs[pick[q]] == 0:
+                                    ok = False
+                            if ok:
+                                _apply_subset(p, m, cand, nc, dirs, pick, s)
+                                _evaluate(t, x, m, p, acc, tau)
+                                # released together, an item may move against the way its own torque pushed it (two
+                                # gears coupled through a reversing ratio): flip those to the way they accelerate, a
+                                # few times
+                                for _flip in range(s + 1):
+                                    if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, marks):
+                                        if _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s,
+                                                        attempt == 1):
+                                            break   # not a solution beyond t (one turns back, or one breaks away)
+                                        found = True
+                                        break
+                                    if not _flip_released(p, m, acc, cand, dirs, pick, s, nf):
+                                        break
+                                    _evaluate(t, x, m, p, acc, tau)
+                                if found:
+                                    break
+                            # the next combination of s out of nc
+                            q = s - 1
+                            while q >= 0 and pick[q] == nc - s + q:
+                                q -= 1
+                            if q < 0:
+                                break
+                            pick[q] += 1
+                            for qq in range(q + 1, s):
+                                pick[qq] = pick[qq - 1] + 1
+                        if found:
+                            break
                 if not found:   # release the most overloaded until the rest hold
                     for c in range(nc):
                         _item_set(p, m, cand[c], _ZERO)
@@ -3207,7 +3279,15 @@ def settle(t, x, m, p, log, old, origin):
                 for j in range(n):
                     xp[j] = x[j] + dt * x[n + j]
                     xp[n + j] = x[n + j] + dt * acc[j]
+                # (the probe's quadrants are the probe's: a released gear whose quadrant flips by t + dt keeps the
+                # one decided at t -- taken over, a gear released in a rigid loop carried the other quadrant's split
+                # at t, which put a one-way clutch 0.63 N m the free way, #30)
+                quad = np.empty(nl, dtype=np.int64)
+                for j in range(nl):
+                    quad[j] = m[p.elem[p.lossy[j], E_MODE]]
                 _evaluate(t + dt, xp, m, p, acc, tau)
+                for j in range(nl):
+                    m[p.elem[p.lossy[j], E_MODE]] = quad[j]
                 # (the one most beyond its limit there, one per round: whether the others hold is decided again with
                 # it released -- marked together from one set, a brake beside a gear at its band's edge was released
                 # with it and slid for 2 ms where it holds once the gear rolls)
