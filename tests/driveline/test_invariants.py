@@ -1043,8 +1043,9 @@ def test_a_rolling_lossy_gear_in_a_rigid_loop_carries_no_residue_and_keeps_its_q
     tau_loop = -T0 / 3`` accelerate the other two inertias with J0 as one body of 3 kg m^2,
     ``w = (cos(2 pi t0) - cos(2 pi t)) / (6 pi)``.  That holds until the sine nears its turn at 0.5 s, where the
     one-way clutch, which cannot pull, comes within 1 % of the feasible splits' width of its edge and the split is
-    moved to keep that margin (``kernel._repair``): from about 0.497 s the gear carries torque (checked to 0.49 s).  Before the fix the solve's rounding (1e-17 of the torques, divided by the
-    regularisation's 1e-8) left the gear 1e-9 N m of either sign: its quadrant changed back and forth with it
+    moved to keep that margin (``kernel._repair``): from about 0.497 s the gear carries torque (checked to 0.49
+    s).  Before the fix the solve's rounding (1e-17 of the torques, divided by the regularisation's 1e-8) left the
+    gear 1e-9 N m of either sign: its quadrant changed back and forth with it
     (``b_drives``/``a_drives`` at 0.127, 0.176, 0.481 s... at every tolerance), and the invariant check found its
     loss power negative (rtol 1e-9 and 1e-10 without the thermal mass, 1e-8 and 1e-10 with it)
     (``kernel._split_limit``).  Now, at three tolerances, checked: no quadrant change before 0.5 s, the gear's torque
@@ -1189,6 +1190,46 @@ def test_a_locked_loop_breaks_away_with_its_one_way_clutch_overrunning():
             stops.append(later[0][0])
     assert runs[0] == runs[1] == runs[2]
     assert max(stops) - min(stops) < 1e-6, stops
+
+
+def test_a_locked_loop_at_rest_keeps_its_split_within_its_bounds_from_sample_to_sample():
+    """Found by the twenty-ninth session's thorough draws (seed 5 of the invariants property): J0 (0.125 kg m^2, 3
+    rad/s), J1 (1 kg m^2, -1 rad/s), J2 (1 kg m^2, at rest); a gear J0-J1 of ratio -3 and efficiency 0.99999, a
+    plain one-way clutch f1 J1-J2, a 0.5 N m clutch J0-J2, a 1 N m bearing friction on J0 and a 6.1e-5 N m sine at
+    0.5 Hz on J0.  From 0.875552 s everything is at rest in a locked loop whose stuck set (with the gear's hold) has
+    two null directions, under a load of 1e-5 N m.  Before, the nearest split that keeps the members' margins
+    (``kernel._repair_space``) was found at some evaluations and not at others: the solution of an active set
+    missed its own bounds by 1e-16 (rounding of the 1 N m bounds), beyond the tolerance of 1e-12 of the *torques*
+    (2e-17 N m); so the split jumped from sample to sample (f1 -0.49, 6e-7, 2.35e-6, 0, -0.49 N m every 2 ms),
+    2.35e-6 N m of it the one-way clutch's free way, and the mode changes at rest differed with the tolerance (an
+    f1 break-away 70 us long at rtol 1e-7, none of f1's stick at 1e-10).  Now ``kernel._keeps`` allows the
+    programme's own rounding: at every tolerance the same events, and at rest f1 never carries torque the free
+    way and its torque moves with the load (no jump between samples beyond the load's own change)."""
+    def net():
+        d = Driveline("r5")
+        d.inertia("J0", 0.125, w0=3.0)
+        d.inertia("J1", 1.0, w0=-1.0)
+        d.inertia("J2", 1.0, w0=0.0)
+        d.gear("g0", "J0", "J1", ratio=-3.0, efficiency=0.99999)
+        d.one_way_clutch("f1", "J1", "J2")
+        d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5)
+        d.bearing_friction("bearing", "J0", 1.0)
+        d.torque("T0", "J0", Signal.sine(6.10352e-05, 0.5))
+        return d
+
+    want = [("loop", "forward"), ("bearing", "stick"), ("g0", "stick"), ("f1", "stick"), ("loop", "stick")]
+    for rtol in (1e-7, 1e-8, 1e-9, 1e-10):
+        res = net().simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True)
+        ev = _mode_events(res)
+        assert [(e[1], e[2]) for e in ev] == sorted(want[:1]) + sorted(want[1:3]) + sorted(want[3:]), (rtol, ev)
+        assert abs(ev[-1][0] - 0.875552) < 1e-6
+        df = res.to_dataframe()
+        rest = df[df.time_s > 0.8756]
+        assert len(rest) > 50 and np.all(rest["f1.mode_1"] == 0.0)
+        assert rest["f1.tau_Nm"].max() <= 1e-12, (rtol, rest["f1.tau_Nm"].max())   # (never the free way)
+        assert np.max(np.abs(np.diff(rest["f1.tau_Nm"]))) < 1e-6, rtol   # (the load moves 4e-7 N m in 2 ms)
+        bal = rest["f1.tau_Nm"] + rest["loop.tau_Nm"]   # (J2 at rest: what f1 holds, the loop clutch gives back)
+        assert np.max(np.abs(bal)) < 1e-12
 
 
 @settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)

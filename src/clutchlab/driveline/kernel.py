@@ -1742,12 +1742,23 @@ def _next_subset(idx, k, m):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _keeps(G, nc, z, theta, w, h, m, tol):
-    """True if ``z`` keeps every one of the ``m`` bounds ``G[i, :nc] . z + theta w[i] <= h[i]`` (to ``tol``)."""
+    """True if ``z`` keeps every one of the ``m`` bounds ``G[i, :nc] . z + theta w[i] <= h[i]`` (to ``tol``, and to
+    the rounding of the programme itself: 1e-15 of its largest bound plus ``|z|``, for ``G``'s rows are of unit
+    size).  (``tol`` is relative to the torques, which may be 1e-5 N m where the bounds are 1 N m: the solution of an
+    active set then misses its own bounds by 1e-16, and no split was taken -- a rigid loop at rest under a 6e-5 N m
+    load kept the regularised split, a one-way clutch 2.4e-6 N m the free way at one sample and 0.49 N m the other
+    way at the next, #30.)"""
+    big = 0.0
+    for i in range(m):
+        big = max(big, abs(h[i]))
+    for f in range(nc):
+        big += abs(z[f])
+    tol_ = tol + 1e-15 * big
     for i in range(m):
         v_ = theta * w[i]
         for f in range(nc):
             v_ += G[i, f] * z[f]
-        if v_ > h[i] + tol:
+        if v_ > h[i] + tol_:
             return False
     return True
 
@@ -2778,9 +2789,13 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
     this subset is no solution beyond ``t``.  (A loop clutch released at the instant its torque reached its limit,
     with the loop's one-way clutch stuck, started at zero acceleration and slid backward against its forward
     torque for 68 us, the one-way clutch then stuck 8 N m deep, until its slip crossed the rounding width; the
-    solution is the one-way clutch overrunning with the loop clutch stuck, #30.)  The network is evaluated at ``t``
-    again before it returns, the quadrants it had kept.  ``stuck_too``: probe in any case, and fail too if a stuck
-    candidate is beyond its limit there (not at it to rounding)."""
+    solution is the one-way clutch overrunning with the loop clutch stuck, #30.)  ``stuck_too``: probe in any case,
+    and fail too if a stuck candidate is beyond its limit there (not at it to rounding).
+
+    It leaves the work array (the evaluation at ``t``: accelerations, torques, holds, the splits' warm starts) and
+    the quadrants as it found them.  (Evaluated at ``t`` again instead, a set at its group's edge that held in the
+    search's evaluation held no more -- at the edge the split follows the warm starts, which the probe had moved --
+    and a lossy gear was kept stuck 0.11 N m beyond its band.)"""
     tie = stuck_too
     for q in range(s):
         c = pick[q]
@@ -2798,6 +2813,7 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
     quad = np.empty(nl, dtype=np.int64)
     for j in range(nl):
         quad[j] = m[p.elem[p.lossy[j], E_MODE]]
+    saved = p.work.copy()
     for q in range(xp.shape[0]):
         xp[q] = x[q]
     for j in range(n):
@@ -2818,7 +2834,8 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
                 turns = True
     for j in range(nl):
         m[p.elem[p.lossy[j], E_MODE]] = quad[j]
-    _evaluate(t, x, m, p, acc, tau)
+    for q in range(saved.shape[0]):   # (element by element: a slice assignment's size check calls Python on its
+        p.work[q] = saved[q]            # error path, which a native FMU cannot link)
     return turns
 
 
