@@ -220,6 +220,10 @@ def coupled_accept(t, x, u, m, p):
     res = DE.accept(t, x, u, m, net, e)
     if res < 0:
         return res
+    if net.lossy.shape[0] > 0:
+        res = K.table_error(x, net)
+        if res != 0:
+            return res
     if net.check[0] != 0.0:
         K.observe(net, True)   # (a debug option changes no decision: K.driveline_accept ends the mark)
         _evaluate(t, x, u, m, net, w, e)

@@ -467,13 +467,16 @@ def signal_rates(sig, data, t):
 # ----------------------------------------------------------------- friction characteristic
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _characteristic(data, start, n, w):
-    """Table value at ``w >= 0``: linear between points, extrapolated from the last two (MSL's ``LastTwoPoints``)."""
+    """Table value at ``w >= 0``: linear between points, extrapolated from the last two (MSL's ``LastTwoPoints``) but
+    never below 0 (every row is >= 0, checked when the element is built): a friction coefficient or a bearing
+    friction torque extrapolated below 0 turned a brake into a motor -- 10 N m on an inertia at 100 rad/s with ``mu``
+    0.5 at rest and 0.3 at 10 rad/s drove it to 117 rad/s in 1 s, #30."""
     if n == 1 or w <= data[start]:
         return data[start + n]
     if w >= data[start + n - 1]:
         x0, x1 = data[start + n - 2], data[start + n - 1]
         y0, y1 = data[start + 2 * n - 2], data[start + 2 * n - 1]
-        return y1 + (y1 - y0) * (w - x1) / (x1 - x0)
+        return max(y1 + (y1 - y0) * (w - x1) / (x1 - x0), 0.0)
     return _table(data, start, n, w)
 
 
@@ -792,18 +795,30 @@ def _gear_column(data, start, n, col, w):
     return data[start + col * n + lo] + wt * (data[start + col * n + lo + 1] - data[start + col * n + lo])
 
 
+#: the smallest mesh efficiency a loss table's extrapolation beyond its last row gives the law [-] (it keeps the law
+#: finite in the step that crosses an extrapolated efficiency of 0; the step's end is then a model error,
+#: :func:`table_error`)
+ETA_MIN = 1e-6
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_losses(p, r, w_abs):
     """Mesh efficiencies and bearing friction of lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (MSL
     ``LossyGear``): ``(eta_mf1, eta_mf2, tau_bf1, tau_bf2, tau_bf_a)``: efficiency while flange a drives [-], while
     b drives [-], the resultant bearing friction with respect to flange a in those two cases [N m] (absolute
     values), and the bearing friction on flange a's side, ``(tau_bf1 - tau_bf2) / (eta_mf1 - 1/eta_mf2)`` (half of
-    ``tau_bf1`` where both efficiencies are 1: MSL's arbitrary split)."""
+    ``tau_bf1`` where both efficiencies are 1: MSL's arbitrary split).  Beyond the table's last row, linear from its
+    last two rows (MSL) but an efficiency within ``[ETA_MIN, 1]`` and a bearing friction ``>= 0``: a gear never
+    generates power."""
     s, n = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
-    eta1 = _gear_column(p.data, s, n, 1, w_abs)
-    eta2 = _gear_column(p.data, s, n, 2, w_abs)
-    bf1 = abs(_gear_column(p.data, s, n, 3, w_abs))
-    bf2 = abs(_gear_column(p.data, s, n, 4, w_abs))
+    # (every row is within (0, 1] and >= 0, checked when the gear is built; extrapolated beyond the last row the
+    # values are kept where a gear can be: an efficiency at most 1 (MSL's LastTwoPoints took a rising one beyond 1,
+    # and the gear generated power, #30), a bearing friction at least 0 (MSL's abs turned a falling one around), an
+    # efficiency at least ETA_MIN; one extrapolated to 0 or below is a model error, :func:`table_error`)
+    eta1 = min(max(_gear_column(p.data, s, n, 1, w_abs), ETA_MIN), 1.0)
+    eta2 = min(max(_gear_column(p.data, s, n, 2, w_abs), ETA_MIN), 1.0)
+    bf1 = max(_gear_column(p.data, s, n, 3, w_abs), 0.0)
+    bf2 = max(_gear_column(p.data, s, n, 4, w_abs), 0.0)
     if abs(eta1 - 1.0) <= 2.2e-16 and abs(eta2 - 1.0) <= 2.2e-16:
         bfa = 0.5 * bf1
     else:
@@ -2354,6 +2369,12 @@ _split_limit_outlined = outlined(_split_limit, lambda: (_params_type(), _F2, typ
                                                       _F1), types.none)
 
 
+#: refinements of the stuck set's regularised solution at most (:func:`_solve_stuck`: three always, then while the
+#: residual of the members' relative accelerations is above ``REFINE_TOL`` of the largest of ``b`` and ``A lam``)
+REFINE_MAX = 40
+REFINE_TOL = 1e-13
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     """Torques of the constraint set -- stuck friction elements, gears, stuck lossy gears' holds, motion sources
@@ -2475,12 +2496,24 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         if not exact:
             M[k, k] += 1e-8 * scale * (cmax / c if cmax > 0.0 else 1.0)
     lu_factor(M, p.iwork)
-    for _it in range(3):  # the regularised solution, then two refinements on the residual
+    # the regularised solution, then two refinements on the residual; and more while the members' relative
+    # accelerations are not held to rounding (at most REFINE_MAX): each refinement takes the residual down by about
+    # eps D / (A's smallest non-zero eigenvalue + eps D), and where a member's limit is 1e-6 of the set's largest (a
+    # clutch whose force falls through zero) eps D is 1e-2 of A's diagonal -- two left a stuck ring's members apart
+    # at 1e-6 of their acceleration, and in a step that reached a clutch's free event the members' speeds parted by
+    # 1e-6 rad/s while labelled stuck (#30)
+    for _it in range(REFINE_MAX):
+        big = 0.0
+        worst = 0.0
         for k in range(ns):
             r = b[k]
             for j in range(ns):
                 r -= A[k, j] * lam[j]
             res[k] = r
+            worst = max(worst, abs(r))
+            big = max(big, abs(b[k]), scale * abs(lam[k]))
+        if _it >= 3 and not worst > REFINE_TOL * big:
+            break
         lu_solve(M, p.iwork, res)
         for k in range(ns):
             lam[k] += res[k]
@@ -2620,12 +2653,16 @@ def _item_speed(p, x, n, i):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _item_passed_rest(p, m, x, n, i):
-    """True if sliding (rolling) item ``i`` has passed zero relative speed the wrong way for its mode: its stick
-    function (the speed in its direction plus its slack) is at or below zero.  Two items on one relative motion (a
-    bearing and a brake on one inertia) reach zero together; the event is located for the first, and the other's
-    speed at the located instant may lie a hair past zero, beyond the rounding width (the root is bracketed to the
-    event tolerance in time): it is at rest too."""
+def _item_passed_rest(p, m, x, n, i, acc):
+    """True if sliding (rolling) item ``i`` has passed zero relative speed the wrong way for its mode, or passes it
+    within :data:`T_INSTANT`: its stick function (the speed in its direction plus its slack) is at or below zero, or
+    falls to it at its rate (the relative acceleration ``acc`` gives, the evaluation at the instant) within that
+    time.  Two items on one relative motion (a bearing and a brake on one inertia) reach zero together; the event is
+    located for the first, and the other's speed at the located instant may lie a hair past zero, beyond the
+    rounding width (the root is bracketed to the event tolerance in time): it is at rest too.  Or a hair before it:
+    two clutches on either side of an inertia whose neighbours are stuck, started together with one slack, reach
+    zero 6e-17 s apart (the neighbours' drift speeds, 2e-16 rad/s); counted at rest only from its zero on, the
+    second slid on the wrong way, driving the inertia with its 7 N m, at one tolerance (#30)."""
     nf = p.fric.shape[0]
     if i < nf:
         mode = m[i]
@@ -2637,7 +2674,7 @@ def _item_passed_rest(p, m, x, n, i):
         if mode == GEAR_STUCK:
             return False
         d = 1.0 if mode == GEAR_FWD_A or mode == GEAR_FWD_B else -1.0
-    return d * _item_speed(p, x, n, i) + _slack(p)[i] <= 0.0
+    return d * _item_speed(p, x, n, i) + _slack(p)[i] <= max(-d * _item_acc(p, acc, i), 0.0) * T_INSTANT
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -3135,7 +3172,7 @@ def settle(t, x, m, p, log, old, origin):
             # event, a lossy gear at its band's edge came out rolling where it had stayed stuck, #30)
             if not _linked(p, comp, reach, _item_row(p, i)):
                 continue
-            if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i) or \
+            if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i, acc) or \
                     abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n):
                 cand[nc] = i
                 nc += 1
@@ -3919,14 +3956,18 @@ def driveline_restart(t, x, u, m, p, log):
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
-INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap")
-INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP = indices(
-    INVARIANT_NAMES, "limit", "mode", "oneway", "loss", "energy", "gap")
+# (the last, "table", is not an invariant but a model error every run checks, :func:`table_error`: its message has no
+# "invariant violated")
+INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap", "table")
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP, INV_TABLE = indices(
+    INVARIANT_NAMES, "limit", "mode", "oneway", "loss", "energy", "gap", "table")
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",
               "backlash in its gap beyond an edge moving outward, or released where its contact would push (a "
-              "contact missed)")
+              "contact missed)",
+              "its loss table, extrapolated beyond its last row, gives an efficiency <= 0 at the speed the gear "
+              "turns at; give rows up to the speeds the run reaches")
 INV_BASE = 100
 N_INV = len(INVARIANT_NAMES)
 
@@ -3941,7 +3982,8 @@ def check_invariants(t, x, m, p):
     * modes agree with the relative speeds: forward >= 0, backward <= 0, stuck ~0 (to 1e-6 of the largest speed of
       the element's inertias, what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
-    * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding);
+    * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding), and so does
+      every sliding friction element's (its law's magnitude is >= 0);
     * a backlash in its gap is not beyond an edge moving on outward, and one released beyond an edge (a damped contact
       that separated there) is not where its contact would push (either: a contact missed);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
@@ -3971,6 +4013,11 @@ def check_invariants(t, x, m, p):
                 return -(INV_BASE + N_INV * r + INV_MODE)
         elif (mk == FORWARD and w_rel < -w_tol) or (mk == BACKWARD and w_rel > w_tol):
             return -(INV_BASE + N_INV * r + INV_MODE)
+        elif (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL and \
+                friction_torque(p, r, t, abs(w_rel)) < -10.0 * noise:
+            # sliding: the torque opposes the slip with the law's magnitude, so its loss power is that magnitude
+            # times |w_rel|, >= 0 only while the magnitude is (a model component's law is its own)
+            return -(INV_BASE + N_INV * r + INV_LOSS)
         if p.elem[r, E_LAW] == LAW_ONEWAY:
             cap = max(static_limit(p, r, t), friction_torque(p, r, t, abs(w_rel)), noise)
             if mk == BACKWARD or w_rel < -w_tol or tq > cap * (1.0 + 1e-9) + noise:
@@ -4050,11 +4097,36 @@ _check_outlined = outlined(check_invariants, lambda: (types.float64, _F1, _I1, _
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def table_error(x, p):
+    """0, or the model error code (``-(INV_BASE + N_INV r + INV_TABLE)``) of the first lossy gear row ``r`` whose loss
+    table, extrapolated beyond its last row (MSL ``LossyGear``: linear from the last two rows), gives a mesh
+    efficiency ``<= 0`` at the speed ``|w_a|`` [rad/s] it turns at in state ``x``: no gear has one, and the law
+    (:func:`gear_losses`) holds it at :data:`ETA_MIN` only within the step that crosses it."""
+    n = p.inertia.shape[0]
+    for j in range(p.lossy.shape[0]):
+        r = p.lossy[j]
+        s, k = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
+        if k < 2:
+            continue
+        w = abs(gear_speed(p, r, x, n))
+        if w <= p.data[s + k - 1]:
+            continue
+        if _gear_column(p.data, s, k, 1, w) <= 0.0 or _gear_column(p.data, s, k, 2, w) <= 0.0:
+            return -(INV_BASE + N_INV * r + INV_TABLE)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_accept(t, x, u, m, p):
-    """Nothing to commit (the network has no memories); with ``check[0]`` set, the invariants
-    (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
+    """Nothing to commit (the network has no memories); a lossy gear whose loss table's extrapolation reached an
+    efficiency <= 0 ends the run with a model error naming it (:func:`table_error`); with ``check[0]`` set, the
+    invariants (:func:`check_invariants`): a violation ends the run with a model error naming the element."""
     if u.shape[0] > 0 and hold_inputs(p.data, u):
         forget_signals(p)
+    if p.lossy.shape[0] > 0:
+        code = table_error(x, p)
+        if code != 0:
+            return code
     if p.check[0] != 0.0:
         observe(p, True)   # (a debug option: it changes no decision)
         code = _check_outlined(t, x, m, p)

@@ -609,6 +609,22 @@ def _adds(kind: str):
     return wrap
 
 
+def _table_limit(table) -> str:
+    """What a lossy gear's loss table (``table``: its columns one after the other) extrapolates to an efficiency <= 0
+    beyond its last row: the message of its model error (:func:`clutchlab.driveline.kernel.table_error`)."""
+    rows = np.asarray(table, dtype=float).reshape(5, -1).T
+    w = rows[:, 0]
+    where = []
+    for col, label in ((1, "eta_mf1"), (2, "eta_mf2")):
+        if len(w) >= 2:
+            slope = (rows[-1, col] - rows[-2, col]) / (w[-1] - w[-2])
+            if slope < 0.0:
+                where.append(f"{label} reaches 0 at |w_a| = {w[-1] - rows[-1, col] / slope:.6g} rad/s")
+    return (f"loss_table extrapolated beyond its last row (|w_a| = {w[-1]:.6g} rad/s, linear from the last two as "
+            f"in MSL) gives an efficiency <= 0 ({', '.join(where) or 'no column'}), and the gear turned faster; give "
+            "rows up to the speeds the run reaches")
+
+
 class Driveline:
     """A driveline network: inertias, springs, dampers, backlash, gears, torque, speed and position sources,
     and friction elements (clutches, brakes, bearing friction, one-way clutches).
@@ -871,7 +887,9 @@ class Driveline:
             Constant mesh efficiency in (0, 1] for both directions [-] (MSL ``lossTable = [0, eta, eta, 0, 0]``).
         loss_table : array_like, optional
             MSL ``lossTable``: rows ``[|w_a| rad/s, eta_mf1, eta_mf2, tau_bf1 N m, tau_bf2 N m]``, ``|w_a|``
-            increasing from 0, linear between rows and extrapolated from the last two; give it or ``efficiency``.
+            increasing from 0, linear between rows and extrapolated from the last two, within ``eta <= 1`` and
+            ``tau_bf >= 0`` (an efficiency extrapolated to 0 or below ends a run with a model error naming the
+            gear); give it or ``efficiency``.
         support : str, optional
             The inertia the gear's housing is (MSL ``useSupport``; its reaction torque acts there); default the
             ground.
@@ -1065,7 +1083,8 @@ class Driveline:
                mu_scale: float = 1.0, mu_temperature=None) -> "Driveline":
         """A clutch between flanges a and b (MSL ``Clutch``): sliding torque ``cgeo fn mu(|w_rel|)``,
         ``fn = fn_max * normal(t)`` [N] (free when ``<= 0``), static limit ``peak`` times the sliding
-        torque at rest.  ``mu``: a number, a table ``[[w_rad_s, mu], ...]``, or a friction map
+        torque at rest.  ``mu``: a number, a table ``[[w_rad_s, mu], ...]`` (linear between rows, extrapolated
+        from the last two but never below 0), or a friction map
         ``mu(v, T)`` identified by :mod:`clutchlab.wet` (:class:`clutchlab.wet.friction.FrictionMap`) read
         at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
         [degC] (both required with a map, refused without one; :meth:`_map_characteristic`).  ``mu_scale``:
@@ -1148,7 +1167,8 @@ class Driveline:
     @_adds("bearing_friction")
     def bearing_friction(self, name: str, flange, torque=1.0, peak: float = 1.0, support=None) -> "Driveline":
         """Bearing friction of ``flange`` against ``support`` (default the ground; MSL ``BearingFriction``):
-        sliding torque ``torque`` [N m], a number or a table ``[[w_rad_s, N m], ...]``; never free."""
+        sliding torque ``torque`` [N m], a number or a table ``[[w_rad_s, N m], ...]`` (linear between rows,
+        extrapolated from the last two but never below 0); never free."""
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
         return self._friction(name, a, b, K.LAW_TABLE, self._characteristic(name, "torque", torque), peak)
@@ -2018,7 +2038,11 @@ class Driveline:
 
         names_rows = [e.name for e in self._elements]
         invariant_messages = {-(K.INV_BASE + K.N_INV * r + kind): f"invariant violated: {nm}: {what}"
-                              for r, nm in enumerate(names_rows) for kind, what in enumerate(K.INVARIANTS)}
+                              for r, nm in enumerate(names_rows) for kind, what in enumerate(K.INVARIANTS)
+                              if kind != K.INV_TABLE}
+        for r, e in enumerate(self._elements):
+            if e.kind == K.K_GEAR and self._is_lossy(e):
+                invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_TABLE)] = f"{e.name}: {_table_limit(e.table)}"
         invariant_messages[-(K.INV_BASE + K.N_INV * len(names_rows) + K.INV_ENERGY)] = (
             f"invariant violated: the network's {K.INVARIANTS[K.INV_ENERGY]} ({_check_tol(rtol):.3g} of the energy "
             "that flowed)")
