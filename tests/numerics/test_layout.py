@@ -33,6 +33,7 @@ NOT_INDICES = {
     "OUTPUTS": "a bit of a session call's request",
     "ALGEBRAIC_FAILED": "a model error code of the model exchange",
     "NEWTON_ITERATIONS": "a count: the algebraic rows' Newton iterations",
+    "REFINE_MAX": "a count: the stuck set's refinements at most",
     "ORDER_EST": "a number: the local order of Rodas3's error estimate",
     "CHUNK_ROWS": "a capacity: rows of a recorded chunk",
     "FIRST_CHUNK_ROWS": "a capacity: rows of the first recorded chunk",
