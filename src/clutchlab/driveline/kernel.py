@@ -2834,29 +2834,15 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
     search's evaluation held no more -- at the edge the split follows the warm starts, which the probe had moved --
     and a lossy gear was kept stuck 0.11 N m beyond its band.)"""
     tie = stuck_too
-    for q in range(s):
-        c = pick[q]
-        i = cand[c]
-        if abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc):
-            tie = True
-    if not tie:
-        return False
-    n = p.inertia.shape[0]
-    nl = p.lossy.shape[0]
     near = np.zeros(s, dtype=np.bool_)
     for q in range(s):
         i = cand[pick[q]]
         near[q] = abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc)
-    quad = np.empty(nl, dtype=np.int64)
-    for j in range(nl):
-        quad[j] = m[p.elem[p.lossy[j], E_MODE]]
+        tie = tie or near[q]
+    if not tie:
+        return False
     saved = p.work.copy()
-    for q in range(xp.shape[0]):
-        xp[q] = x[q]
-    for j in range(n):
-        xp[j] = x[j] + T_TIE * x[n + j]
-        xp[n + j] = x[n + j] + T_TIE * acc[j]
-    _evaluate(t + T_TIE, xp, m, p, acc, tau)
+    _evaluate_ahead(t, x, xp, m, p, acc, tau, np.empty(p.lossy.shape[0], dtype=np.int64))
     turns = False
     for q in range(s):
         c = pick[q]
@@ -2869,11 +2855,40 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
             if _item_stuck(p, m, i) and _item_excess(t + T_TIE, p, tau, i, False)[0] >= 0.0 and \
                     not _tied(t + T_TIE, p, tau, i):
                 turns = True
+    _put_back(p, saved)
+    return turns
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _evaluate_ahead(t, x, xp, m, p, acc, tau, quad):
+    """The network evaluated at ``t + T_TIE`` into the work array (``acc``, ``tau``), with angles and speeds advanced
+    by the motion decided at ``t`` (``xp``: ``x`` plus ``T_TIE`` times its rates, an error of order ``T_TIE**2``)
+    and each lossy gear's quadrant kept as decided at ``t``: the probe of the tie-break in :func:`settle` and of
+    :func:`_probe_fails`.  (A released gear whose quadrant flips by ``t + T_TIE`` keeps the one decided at ``t`` --
+    taken over, a gear released in a rigid loop carried the other quadrant's split at ``t``, which put a one-way
+    clutch 0.63 N m the free way, #30.)  ``quad``: room for the quadrants (one per lossy gear), the caller's:
+    compiled without reference counting, this function allocates nothing (docs/architecture.md)."""
+    n = p.inertia.shape[0]
+    nl = p.lossy.shape[0]
+    for j in range(nl):
+        quad[j] = m[p.elem[p.lossy[j], E_MODE]]
+    for q in range(xp.shape[0]):
+        xp[q] = x[q]
+    for j in range(n):
+        xp[j] = x[j] + T_TIE * x[n + j]
+        xp[n + j] = x[n + j] + T_TIE * acc[j]
+    _evaluate(t + T_TIE, xp, m, p, acc, tau)
     for j in range(nl):
         m[p.elem[p.lossy[j], E_MODE]] = quad[j]
-    for q in range(saved.shape[0]):   # (element by element: a slice assignment's size check calls Python on its
-        p.work[q] = saved[q]            # error path, which a native FMU cannot link)
-    return turns
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _put_back(p, saved):
+    """The work array as ``saved`` (a copy taken before a probe: the evaluation at ``t``, its holds and the splits'
+    warm starts), element by element: a slice assignment's size check calls Python on its error path, which a
+    native FMU cannot link."""
+    for q in range(saved.shape[0]):
+        p.work[q] = saved[q]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -3307,7 +3322,8 @@ def settle(t, x, m, p, log, old, origin):
             # the search repeated.  Without it the decision at such an instant followed the sign the rounding left,
             # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
             # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
-            # functions of their own they compiled 2.5 s more.)
+            # functions of their own they compiled 2.5 s more; the probe's evaluation is :func:`_evaluate_ahead`, as
+            # in :func:`_probe_fails`.)
             near = False
             marked = False
             for c in range(nc):
@@ -3328,20 +3344,8 @@ def settle(t, x, m, p, log, old, origin):
                         noise = _item_noise(p, r, tau)
                         flat[c] = gear_margin(p, r, -tau[r], _holds(p)[cand[c] - nf], noise)[1] <= TIE_BAND * noise
                 dt = T_TIE
-                for q in range(xp.shape[0]):
-                    xp[q] = x[q]
-                for j in range(n):
-                    xp[j] = x[j] + dt * x[n + j]
-                    xp[n + j] = x[n + j] + dt * acc[j]
-                # (the probe's quadrants are the probe's: a released gear whose quadrant flips by t + dt keeps the
-                # one decided at t -- taken over, a gear released in a rigid loop carried the other quadrant's split
-                # at t, which put a one-way clutch 0.63 N m the free way, #30)
-                quad = np.empty(nl, dtype=np.int64)
-                for j in range(nl):
-                    quad[j] = m[p.elem[p.lossy[j], E_MODE]]
-                _evaluate(t + dt, xp, m, p, acc, tau)
-                for j in range(nl):
-                    m[p.elem[p.lossy[j], E_MODE]] = quad[j]
+                saved = p.work.copy()
+                _evaluate_ahead(t, x, xp, m, p, acc, tau, np.empty(p.lossy.shape[0], dtype=np.int64))
                 # (the one most beyond its limit there, one per round: whether the others hold is decided again with
                 # it released -- marked together from one set, a brake beside a gear at its band's edge was released
                 # with it and slid for 2 ms where it holds once the gear rolls)
@@ -3375,7 +3379,9 @@ def settle(t, x, m, p, log, old, origin):
                     # loop moved the loop's clutch 1e-7 beyond its limit in the next round, slipping it for 0.7 ns)
                     forced[iw] = dw
                     marked = True
-                _evaluate(t, x, m, p, acc, tau)
+                # (the work array as the probe found it -- evaluated at t again instead, the splits' warm starts
+                # the probe had moved stayed moved, as in :func:`_probe_fails`)
+                _put_back(p, saved)
             if not marked:
                 break
         _project_speeds(t, x, m, p, comp, reach)
