@@ -317,6 +317,36 @@ def test_a_wet_clutch_breaking_away_slowly_follows_the_tolerance_from_1e_8():
     assert [e[1:] for e in _mode_events(res[1e-8])] == [e[1:] for e in _mode_events(res[1e-12])]
 
 
+def test_a_wet_clutch_carrying_an_identical_ones_sliding_torque_breaks_away_with_it():
+    """The network the thorough profile drew (thirty-second session, seed 502 of the components' invariants
+    property): two identical wet clutches in series at a constant 300 N, w1 between J1 (driven by a -12 N m 5 Hz
+    sine, and by J0 through a 1 N clutch) and J2, w2 between J2 and J3, which a 1 N m bearing friction holds.  At
+    0.0023062 s w1's slip reverses; w2 would have to carry w1's sliding torque, equal to its own capacity at the
+    instant (the clutches' states are the same) and beyond it at once (w1's contact torque grows with its slip).
+    So both slide on from there.  Before, the search's look-ahead read the components' torques moving as they did
+    before the instant (w1's falling with its slip), kept w2 stuck, and held it beyond its capacity, by up to 1.4 %
+    for 45 ms; the invariant check stopped the run at every tolerance ("w2: stuck beyond its static limit")."""
+    d = Driveline("two wet clutches in series")
+    d.inertia("J0", J=1.0, w0=3.0).inertia("J1", J=1.0).inertia("J2", J=2.0).inertia("J3", J=1.0)
+    d.clutch("c0", "J0", "J1", fn_max=1.0, mu=0.5)
+    d.wet_clutch("w1", "J1", "J2", force=Signal.constant(300.0))
+    d.wet_clutch("w2", "J2", "J3", force=Signal.constant(300.0))
+    d.bearing_friction("bearing", "J3", torque=1.0)
+    d.torque("T1", "J1", Signal.sine(-12.0, 5.0))
+    first = {}
+    for rtol in (1e-7, 1e-9, 1e-10):
+        res = d.simulate(0.6, rtol=rtol, output_step=1e-3, check_invariants=True)   # (raises where one fails)
+        ev = [e for e in _mode_events(res) if e[0] > 0.0]
+        first[rtol] = ev[:2]
+        assert sorted(e[1:] for e in ev[:2]) == [("w1", "forward"), ("w2", "forward")], ev[:4]
+        assert abs(ev[0][0] - 0.0023062) < 1e-6 and ev[0][0] == ev[1][0], ev[:2]
+        df = res.to_dataframe()
+        stuck = df["w2.mode_1"] == 0
+        over = df["w2.tau_Nm"].abs()[stuck] - df["w2.static_capacity_Nm"][stuck]
+        assert (over <= 1e-9 * df["w2.static_capacity_Nm"][stuck] + 1e-10).all(), over.max()
+    assert abs(first[1e-7][0][0] - first[1e-10][0][0]) < 1e-8, first
+
+
 def test_a_wet_piston_turning_at_its_speed_limit_follows_the_tolerance():
     """The network the thorough profile drew (twenty-fourth session, seed 9): a 1 kN force pulse on a wet clutch
     between J0 (3 rad/s, a -3 N m 1 Hz sine on it) and J1.  When the reference falls, the piston running out at
