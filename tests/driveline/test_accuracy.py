@@ -163,6 +163,7 @@ def test_launch_error_shrinks_with_rtol():
     ref_launch = _load("launch_scipy", ROOT / "tests" / "driveline" / "launch_scipy.py")
     f = load_driveline(EXAMPLES / "driveline_eclutch_launch.toml")
     assert f.rtol == 1e-6
+    ref_launch.check_parameters(f.driveline)   # (its constants are the example's: an edited file is named here)
     grid = np.arange(501) * 0.01
     samples = ref_launch.clamp_force_samples()
     ref = ref_launch.reference(5.0, grid=grid, fn_samples=samples)
