@@ -189,9 +189,12 @@ def test_launch_error_shrinks_with_rtol():
     err = {rtol: errors(rtol) for rtol in sorted({lvl * k for lvl in (1e-5, 1e-7) for k in near} | {1e-6, 1e-9})}
     _check(err, (1e-5, 1e-7), ("event", "engine", "vehicle", "energy"),
            {"event": 2e-5, "engine": 8e-3, "vehicle": 1.2e-4, "energy": 2e-7}, 1e-6)
-    for key in ("event", "engine", "vehicle", "energy"):   # two decades: at least fivefold (measured 8 to 90)
+    # two decades: at least fivefold (medians measured 14 / 22 / 27 times smaller for the events, the engine and
+    # the energy), the vehicle threefold (6.0 measured: its error peaks in the shuffle after lock-up, at 3.9-4.8 s,
+    # where the lash's contacts move its phase, 2.2e-5 rad/s at rtol 5e-8 against 6.6e-6 at 1e-7)
+    for key, factor in (("event", 5), ("engine", 5), ("vehicle", 3), ("energy", 5)):
         loose = np.median([err[1e-5 * k][key] for k in near])
         tight = np.median([err[1e-7 * k][key] for k in near])
-        assert tight < loose / 5, (key, loose, tight, err)
+        assert tight < loose / factor, (key, loose, tight, err)
     # and on at rtol 1e-9, within what the reference's own error leaves (measured 4.9e-8 s, 1.4e-5 rad/s)
     assert err[1e-9]["event"] < 2e-7 and err[1e-9]["engine"] < 1e-4 and err[1e-9]["vehicle"] < 2e-6, err[1e-9]
