@@ -160,13 +160,7 @@ class ClampForce:
         self.kinks = [self.t[k] for k in range(self.n) if sl_ext[k] != sl_ext[k + 1]]
 
     def __call__(self, t):
-        if t <= self.t[0]:
-            return self.v[0]
-        if t >= self.t[-1]:
-            return self.v[-1]
-        k = bisect.bisect_right(self.t, t) - 1
-        w = (t - self.t[k]) / (self.t[k + 1] - self.t[k])
-        return self.v[k] + w * (self.v[k + 1] - self.v[k])
+        return _lin(self.t, self.v, t)
 
     def rate_right(self, t):
         """Slope from the right at t."""
