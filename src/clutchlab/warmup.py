@@ -25,7 +25,7 @@ import time
 
 from .errors import ParameterError, SimulationError
 
-__all__ = ["GROUPS", "warm", "start", "run_parallel", "main"]
+__all__ = ["GROUPS", "LOTS", "lots", "warm", "start", "run_parallel", "main"]
 
 
 def _warm_eclutch() -> None:
@@ -102,9 +102,22 @@ GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "drive
           "components": _warm_components, "control": _warm_control}
 
 
-#: each group's first compilation alone [s of one core] (2-core VM, 2026-12-01, empty cache): how the processes share
-#: them (the components group compiles the driveline's functions it calls too, where the driveline group has not)
-COSTS = {"components": 90.0, "driveline": 35.0, "emtc": 32.0, "eclutch": 32.0, "control": 17.0, "wet": 12.0}
+#: groups that compile many of the same functions, dealt to one process together and in this order, so that the later
+#: ones load what the first compiled instead of compiling it again in another process at the same time: the
+#: components' one kernel calls the plain network's functions (the stuck-set solve, the event iteration: about 30 s of
+#: one core), and the control group evaluates the E-clutch's and the EMTC's kernels (17 s alone, 2.4 s after them)
+LOTS = (("driveline", "components"), ("eclutch", "emtc", "control"), ("wet",))
+
+#: each group's first compilation after the groups before it in its lot [s of one core] (2-core VM, 2026-12-03, empty
+#: cache, one process per lot): how :func:`run_parallel` deals the lots to its processes
+COSTS = {"driveline": 75.0, "components": 62.0, "emtc": 41.0, "eclutch": 36.0, "wet": 15.0, "control": 2.4}
+
+
+def lots(names) -> list:
+    """``names`` in lots (:data:`LOTS`: groups sharing functions together, in their order), each a list."""
+    out = [[g for g in lot if g in names] for lot in LOTS]
+    out += [[g] for g in names if not any(g in lot for lot in LOTS)]
+    return [lot for lot in out if lot]
 
 
 def _check(names) -> None:
@@ -129,7 +142,7 @@ def warm(groups=None, full: bool = False) -> dict:
         if full:
             from .numerics import outline
 
-            outline.prepare(lazy=True)   # (the lazy functions of the modules this group imported)
+            outline.prepare(lazy=True, groups=None)   # (the lazy functions of the modules this group imported)
         seconds[name] = time.perf_counter() - t0
     return seconds
 
@@ -150,19 +163,23 @@ def start(groups, full: bool = False) -> subprocess.Popen:
 
 def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
     """Compile ``groups`` (default: all) in up to ``jobs`` processes (default: the cores), each in full (:func:`warm`:
-    the rare paths too, so that later runs compile nothing); wall seconds (``clutchlab warmup``)."""
+    the rare paths too, so that later runs compile nothing); wall seconds (``clutchlab warmup``).  The groups of a lot
+    (:data:`LOTS`) go to one process, in their order."""
     names = list(GROUPS) if groups is None else list(groups)
     _check(names)
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
     t0 = time.perf_counter()
-    # deal the groups to the processes, the costliest first, each to the least loaded (by their measured costs)
-    lots, load = [[] for _ in range(jobs)], [0.0] * jobs
-    for g in sorted(names, key=lambda g: -COSTS.get(g, 10.0)):
+    # deal the lots (groups sharing functions, kept together) to the processes, the costliest first, each to the
+    # least loaded (by their measured costs)
+    units = lots(names)
+    jobs = min(jobs, len(units))
+    dealt, load = [[] for _ in range(jobs)], [0.0] * jobs
+    for unit in sorted(units, key=lambda u: -sum(COSTS.get(g, 10.0) for g in u)):
         i = load.index(min(load))
-        lots[i].append(g)
-        load[i] += COSTS.get(g, 10.0)
-    procs = [start(lot, full=True) for lot in lots if lot]
-    failed = [lot for lot, p in zip(lots, procs) if p.wait() != 0]
+        dealt[i].extend(unit)
+        load[i] += sum(COSTS.get(g, 10.0) for g in unit)
+    procs = [start(lot, full=True) for lot in dealt if lot]
+    failed = [lot for lot, p in zip(dealt, procs) if p.wait() != 0]
     if failed:
         raise SimulationError(f"compiling kernel group(s) {failed} failed; run 'python -m clutchlab.warmup "
                            f"{' '.join(failed[0])}' to see why")

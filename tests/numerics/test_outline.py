@@ -89,12 +89,23 @@ def test_a_caller_that_cannot_find_the_function_raises():
 
 def test_prepare_compiles_every_outlined_function_of_the_driveline():
     """``prepare`` compiles every outlined function but the lazy ones (the repair of a stuck set over several null
-    directions, a rare path; the invariant check, a debug option), ``prepare(lazy=True)`` those too."""
+    directions, a rare path; the invariant check, a debug option) and those of a group (the hooks of a network with
+    model components), ``prepare(groups=("coupled",))`` the group's, ``prepare(lazy=True)`` the lazy ones."""
     from clutchlab.driveline import kernel as K
 
+    from clutchlab.driveline import coupled as DC
+
     assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K._repair_space, K.check_invariants]
+    coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
+    assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
+                       DC.coupled_accept, DC._watch_rates]
+    assert all(e.group is None for e in outline._ENTRIES if e.dispatcher.py_func.__module__ == K.__name__)
     outline.prepare()
     for fn in (K._repair, K.settle, K.driveline_rhs, K._solve_stuck):
+        entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
+        assert entry.sig() in fn.overloads
+    outline.prepare(groups=("coupled",))
+    for fn in coupled:
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
     outline.prepare(lazy=True)
@@ -106,16 +117,18 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
 _UNCHECKED = r"""
 import json
 from pathlib import Path
-from clutchlab.driveline import kernel as K
+from clutchlab.driveline import coupled as DC, kernel as K
 from clutchlab.driveline.description import load_driveline
 load_driveline(Path(r"{examples}") / "driveline_coupled_clutches.toml").driveline.simulate(0.05)
-print(json.dumps([len(K.check_invariants.overloads), len(K._repair_space.overloads), len(K.settle.overloads)]))
+print(json.dumps([len(K.check_invariants.overloads), len(K._repair_space.overloads), len(K.settle.overloads),
+                  len(DC.coupled_update.overloads) + len(DC.coupled_rhs.overloads) + len(DC._evaluate.overloads)]))
 """
 
 
 def test_a_run_without_the_check_does_not_compile_it():
-    """A run without ``check_invariants`` neither compiles nor loads the check, and one whose stuck sets never lose
-    their split along several null directions neither the repair over them (a fresh process)."""
+    """A run without ``check_invariants`` neither compiles nor loads the check, one whose stuck sets never lose
+    their split along several null directions neither the repair over them, and a plain network none of the hooks of
+    a network with model components (a fresh process)."""
     import json
     import subprocess
     import sys
@@ -125,7 +138,7 @@ def test_a_run_without_the_check_does_not_compile_it():
     proc = subprocess.run([sys.executable, "-c", _UNCHECKED.format(examples=examples)], capture_output=True,
                           text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    assert json.loads(proc.stdout.strip().splitlines()[-1]) == [0, 0, 1]
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == [0, 0, 1, 0]
 
 
 _LOOP = r"""
@@ -174,8 +187,10 @@ from clutchlab.driveline.description import load_driveline
 from clutchlab.numerics import outline
 for name in ("coupled_clutches", "wet_sae2", "emtc_awd", "eclutch_launch"):
     load_driveline(Path(r"{examples}") / f"driveline_{{name}}.toml").driveline.simulate(0.05, check_invariants=True)
+from clutchlab.driveline import coupled as DC
 out = {{}}
-for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs):
+for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs, DC._evaluate, DC.coupled_rhs,
+           DC.coupled_outputs, DC.coupled_update, DC.coupled_restart, DC.coupled_accept):
     entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
     out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
 print(json.dumps(out))
@@ -184,7 +199,8 @@ print(json.dumps(out))
 
 def test_the_example_networks_call_the_driveline_through_the_outlined_signatures():
     """Plain, wet and EMTC networks call the outlined functions with the very types they are outlined for (the
-    network's right-hand side at events too, through the core's ``rhs_event`` hook): a
+    network's right-hand side at events too, through the core's ``rhs_event`` hook; a network with model components
+    its hooks and its components' evaluation at events, :mod:`clutchlab.driveline.coupled`): a
     signature drift (a new field of the parameter structure, another log type) would link them again silently,
     compiled once more in every function of the core.  (A fresh process: tests here call kernel functions directly.)"""
     import json
@@ -197,5 +213,6 @@ def test_the_example_networks_call_the_driveline_through_the_outlined_signatures
                           text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs")
+    names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs", "_evaluate", "coupled_rhs",
+             "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept")
     assert out == {name: [True] for name in names}, out

@@ -20,13 +20,16 @@ stick and slip for all of them at once (one stuck-set solve over the network).
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.core import types
 
 from ..numerics import dispatch
-from ..numerics.borrow import keep_rows, member
+from ..numerics.borrow import ByRef, keep_rows, member
+from ..numerics.outline import outlined
 from . import emtc as DE
 from . import kernel as K
 from . import wet as DW
@@ -99,24 +102,24 @@ def _with_rates(t, x, u, m, p):
     w = member(p, "wet")
     e = member(p, "emtc")
     if not _at_rest(x, m, net):
-        _evaluate(t, x, u, m, net, w, e)   # (the torques at t, without rates)
+        _evaluate_outlined(t, x, u, m, net, w, e)   # (the torques at t, without rates)
         return
     nx, ng, nm = _network_sizes(w, e)
     dx = np.empty(x.shape[0])
     g = np.empty(ng + w.conf.shape[0] * DW.N_SWITCH + e.conf.shape[0] * DE.N_SWITCH)
-    coupled_rhs(t, x, u, m, p, dx, g)
+    _rhs_outlined(t, x, u, m, p, dx, g)
     nj = K.external_count(net)
     v0 = np.empty(3 * nj)
     for j in range(nj):
         for q in range(3):
             v0[3 * j + q] = K.external_value(net, j, q, t)   # (as the components set them: no rate yet)
     t1 = t + K.T_RATE
-    _evaluate(t1, x + K.T_RATE * dx, u, m, net, w, e)
+    _evaluate_outlined(t1, x + K.T_RATE * dx, u, m, net, w, e)
     d = np.empty(3 * nj)
     for j in range(nj):
         for q in range(3):
             d[3 * j + q] = (K.external_value(net, j, q, t1) - v0[3 * j + q]) / K.T_RATE
-    _evaluate(t, x, u, m, net, w, e)   # (the components' own scratch back at t, as their calls read it)
+    _evaluate_outlined(t, x, u, m, net, w, e)   # (the components' own scratch back at t, as their calls read it)
     for j in range(nj):
         K.set_external_rates(net, j, t, d[3 * j], d[3 * j + 1], d[3 * j + 2])
 
@@ -158,7 +161,7 @@ def coupled_outputs(t, x, u, m, p, y):
     w = member(p, "wet")
     e = member(p, "emtc")
     K.observe(net, True)   # (an observer: K.driveline_outputs, which ends the mark)
-    _evaluate(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e)
     K.driveline_outputs(t, x, u, m, net, y)
     q = y.shape[0] - w.conf.shape[0] * DW.N_KEPT - e.conf.shape[0] * e.index.shape[0]
     q = DW.outputs(w, y, q)
@@ -192,7 +195,7 @@ def coupled_update(t, x, u, m, p, k, log):
             K.settle_outlined(t, x, m, net, log, m.copy(), net.fric[k // K.N_G])
         _sync(x, m, net, w, e)
         return res
-    _evaluate(t, x, u, m, net, w, e)   # (the component's hook reads its scratch at t)
+    _evaluate_outlined(t, x, u, m, net, w, e)   # (the component's hook reads its scratch at t)
     if nw > 0 and k < ng + nw * DW.N_SWITCH:
         res = DW.call(t, x, m, w, (k - ng) // DW.N_SWITCH, (k - ng) % DW.N_SWITCH, log)
     elif ne > 0:
@@ -216,7 +219,7 @@ def coupled_restart(t, x, u, m, p, log):
     w = member(p, "wet")
     e = member(p, "emtc")
     _sync(x, m, net, w, e)
-    _evaluate(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e)
     changed = False
     for j in range(w.conf.shape[0]):
         if DW.call(t, x, m, w, j, np.int64(-1), log) != 0:
@@ -251,7 +254,7 @@ def coupled_accept(t, x, u, m, p):
             return res
     if net.check[0] != 0.0:
         K.observe(net, True)   # (a debug option changes no decision: K.driveline_accept ends the mark)
-        _evaluate(t, x, u, m, net, w, e)
+        _evaluate_outlined(t, x, u, m, net, w, e)
         return K.driveline_accept(t, x, u, m, net)
     return 0
 
@@ -302,7 +305,7 @@ def coupled_watch(t, x, u, m, p, dx, g, k):
     nx, ng, nm = _network_sizes(w, e)
     net = member(p, "net")
     if k < ng and _wants_rates(m, g, net.fric.shape[0], k):   # (rare: a stuck element near its limit)
-        _watch_rates(t, x, u, m, p, dx, g, k)
+        _watch_rates_outlined(t, x, u, m, p, dx, g, k)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -313,9 +316,9 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
     nx, ng, nm = _network_sizes(w, e)
     net = member(p, "net")
     xs = x + K.T_RATE * dx
-    _evaluate(t + K.T_RATE, xs, u, m, net, w, e)
+    _evaluate_outlined(t + K.T_RATE, xs, u, m, net, w, e)
     K.driveline_watch(t, x[:nx], u, m[:nm], net, dx[:nx], g[:ng], k)
-    _evaluate(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -332,6 +335,72 @@ def coupled_jacobian(t, x, u, m, p, J):
     return False
 
 
-dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs, update=coupled_update,
-                  restart=coupled_restart, accept=coupled_accept, next_break=coupled_next_break,
-                  jacobian=coupled_jacobian, watch=coupled_watch, prepare=coupled_prepare)
+# ---- the hooks the core calls at events, samples and step ends, called through their addresses
+# (:mod:`clutchlab.numerics.outline`).  Linked, each of them -- with the network's evaluation and both components'
+# below it -- was optimised and emitted again in every function of the core that calls it (the core's root finder,
+# its event step, its breaks, its three record functions, its loop): measured on ``clutchlab warmup``'s components
+# group, the final modules held 4.4 times the code they define (docs/architecture.md, "Compile time").  The step's
+# stages still call :func:`coupled_rhs` directly (inlined where LLVM finds it worth it); these run at most once per
+# step, where one indirect call is nothing beside the network's evaluation.
+
+
+@functools.lru_cache(maxsize=1)
+def _params_type():
+    """numba type of the reference to a :class:`CoupledParams` every hook takes (one type for every network)."""
+    empty = CoupledParams(K.params_template(), DW.block([], []), DE.block([], []))
+    return ByRef(numba.typeof(empty))
+
+
+_F1, _I1 = types.float64[::1], types.int64[::1]
+def _member_types():
+    """numba types of the references to a :class:`CoupledParams`' members (``member(p, "net")``, ...)."""
+    return tuple(ByRef(t) for t in _params_type().pointee.types)
+
+
+_evaluate_outlined = outlined(_evaluate, lambda: (types.float64, _F1, _F1, _I1, *_member_types()), types.none, group="coupled")
+_rhs_outlined = outlined(coupled_rhs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1), types.none, group="coupled")
+_outputs_outlined = outlined(coupled_outputs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1), types.none, group="coupled")
+_update_outlined = outlined(coupled_update, lambda: (types.float64, _F1, _F1, _I1, _params_type(), types.int64,
+                                                     K._log_type()), types.int64, group="coupled")
+_restart_outlined = outlined(coupled_restart, lambda: (types.float64, _F1, _F1, _I1, _params_type(), K._log_type()),
+                             types.boolean, group="coupled")
+_accept_outlined = outlined(coupled_accept, lambda: (types.float64, _F1, _F1, _I1, _params_type()), types.int64, group="coupled")
+_watch_rates_outlined = outlined(_watch_rates, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1,
+                                                        types.int64), types.none, group="coupled")
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_rhs_event(t, x, u, m, p, dx, g):
+    """:func:`coupled_rhs` through its address (the core's ``rhs_event`` hook: locating a root, the step to it, a
+    break)."""
+    _rhs_outlined(t, x, u, m, p, dx, g)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_outputs_hook(t, x, u, m, p, y):
+    """:func:`coupled_outputs` through its address (the core's ``outputs`` hook)."""
+    _outputs_outlined(t, x, u, m, p, y)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_update_hook(t, x, u, m, p, k, log):
+    """:func:`coupled_update` through its address (the core's ``update`` hook)."""
+    return _update_outlined(t, x, u, m, p, k, log)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_restart_hook(t, x, u, m, p, log):
+    """:func:`coupled_restart` through its address (the core's ``restart`` hook)."""
+    return _restart_outlined(t, x, u, m, p, log)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_accept_hook(t, x, u, m, p):
+    """:func:`coupled_accept` through its address (the core's ``accept`` hook)."""
+    return _accept_outlined(t, x, u, m, p)
+
+
+dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs_hook, update=coupled_update_hook,
+                  restart=coupled_restart_hook, accept=coupled_accept_hook, next_break=coupled_next_break,
+                  jacobian=coupled_jacobian, rhs_event=coupled_rhs_event, watch=coupled_watch,
+                  prepare=coupled_prepare)

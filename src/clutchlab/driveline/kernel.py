@@ -2344,10 +2344,16 @@ def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
     return True
 
 
+def params_template() -> DrivelineParams:
+    """A :class:`DrivelineParams` of tiny arrays: the types of every network's (for the signatures of the functions
+    called through their addresses, :mod:`clutchlab.numerics.outline`)."""
+    i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
+    return DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1, f2, f2)
+
+
 def _params_type():
     """numba type of the :class:`DrivelineParams` reference every kernel function takes (one type for every network)."""
-    i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
-    return ByRef(numba.typeof(DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1, f2, f2)))
+    return ByRef(numba.typeof(params_template()))
 
 
 _F1, _F2, _I1 = types.float64[::1], types.float64[:, ::1], types.int64[::1]

@@ -1976,8 +1976,10 @@ class Driveline:
         :class:`~clutchlab.errors.SimulationError` naming the element, the invariant and the time."""
         # the kernel functions called through their addresses, compiled or loaded here, on the calling thread: a
         # batch's worker threads then only look their addresses up (clutchlab.numerics.outline); the invariant
-        # check only where it is asked for (a debug option: not compiled on every first use)
-        outline.prepare(lazy=check_invariants)
+        # check only where it is asked for (a debug option: not compiled on every first use), the hooks of a network
+        # with model components only for one (clutchlab.driveline.coupled)
+        components = any(el.wet is not None or el.emtc is not None for el in self._elements)
+        outline.prepare(lazy=check_invariants, groups=("coupled",) if components else ())
         p, port_rows = self._pack()
         if check_invariants:
             p.check[0] = 1.0

@@ -49,14 +49,15 @@ _ERRORS: dict = {}
 
 
 class _Entry:
-    __slots__ = ("dispatcher", "signature", "returns", "label", "lazy", "_sig")
+    __slots__ = ("dispatcher", "signature", "returns", "label", "lazy", "group", "_sig")
 
-    def __init__(self, dispatcher, signature, returns, label, lazy=False):
+    def __init__(self, dispatcher, signature, returns, label, lazy=False, group=None):
         self.dispatcher = dispatcher
         self.signature = signature
         self.returns = returns
         self.label = label
         self.lazy = lazy
+        self.group = group
         self._sig = None
 
     def sig(self) -> tuple:
@@ -101,14 +102,18 @@ _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_int64)(_resolve)
 ll.add_symbol(RESOLVE_SYMBOL, ctypes.cast(_CALLBACK, ctypes.c_void_p).value)
 
 
-def prepare(lazy: bool = False) -> None:
+def prepare(lazy: bool = False, groups=()) -> None:
     """Compile (or load from numba's cache) every outlined function now, on the calling thread (``clutchlab
     warmup``; a driveline's :meth:`~clutchlab.driveline.Driveline.system`).  Cheap once done in a process.
 
     ``lazy``: the functions outlined with ``lazy=True`` too (a debug option's, such as the driveline's invariant
-    check: compiled only where a run asks for it, not on every first use)."""
+    check: compiled only where a run asks for it, not on every first use).  ``groups``: the functions outlined
+    with one of these ``group`` names too (a kind of model the caller runs: ``"coupled"``, the hooks of a network
+    with model components, which a plain network never calls); ``None`` for every group (``clutchlab warmup``)."""
     for e in _ENTRIES:
         if e.lazy and not lazy:
+            continue
+        if e.group is not None and groups is not None and e.group not in groups:
             continue
         if not native_address(e.dispatcher, e.sig(), e.returns):
             raise TypeError(f"{e.label}{e.sig()} does not return {e.returns}")
@@ -142,7 +147,7 @@ def _codegen_call(context, builder, key, label, returns, argtys, args):
     return res
 
 
-def outlined(dispatcher, signature, returns, lazy=False):
+def outlined(dispatcher, signature, returns, lazy=False, group=None):
     """A compiled stub that calls ``dispatcher`` through its address.
 
     Parameters
@@ -157,9 +162,12 @@ def outlined(dispatcher, signature, returns, lazy=False):
     lazy : bool
         Left out of :func:`prepare` unless asked for (``prepare(lazy=True)``): compiled on its first call, or by
         the caller that enables it (a debug option).
+    group : str, optional
+        Left out of :func:`prepare` unless its caller names the group (``prepare(groups=("coupled",))``): the
+        functions of one kind of model, prepared by the caller that runs one.
     """
     label = f"{dispatcher.py_func.__module__}.{dispatcher.py_func.__qualname__}"
-    entry = _Entry(dispatcher, signature, returns, label, lazy)
+    entry = _Entry(dispatcher, signature, returns, label, lazy, group)
     _ENTRIES.append(entry)
     nargs = dispatcher.py_func.__code__.co_argcount
     names = ", ".join(f"a{i}" for i in range(nargs))
