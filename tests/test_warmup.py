@@ -62,7 +62,8 @@ def test_full_warmup_compiles_the_rare_paths(monkeypatch):
 
 
 def test_groups_sharing_functions_are_dealt_to_one_process_in_order(monkeypatch):
-    """``clutchlab warmup`` keeps the groups of a lot (:data:`warmup.LOTS`) in one process, in their order: the
+    """``clutchlab warmup`` with fewer processes than groups keeps the groups of a lot (:data:`warmup.LOTS`) in one
+    process, in their order: the
     components' kernel after the plain network's, whose functions it calls, and the control group after the E-clutch
     and the EMTC, whose kernels it evaluates (in two processes at once each compiled them: measured 2026-12-03,
     the components 115 s alone and 62 s after the driveline, the control group 17 s alone and 2.4 s after them)."""
@@ -79,8 +80,11 @@ def test_groups_sharing_functions_are_dealt_to_one_process_in_order(monkeypatch)
     warmup.run_parallel(None, jobs=2)
     assert sorted(started) == [["driveline", "components"], ["eclutch", "emtc", "control", "wet"]]
     started.clear()
-    warmup.run_parallel(["control", "components", "wet"], jobs=8)   # (a lot's members that were asked for)
-    assert sorted(started) == [["components"], ["control"], ["wet"]]
+    warmup.run_parallel(["control", "components", "wet"], jobs=2)   # (a lot's members that were asked for)
+    assert sorted(started) == [["components"], ["wet", "control"]]   # (lots dealt by cost, the costliest first)
+    started.clear()
+    warmup.run_parallel(None, jobs=6)   # (a process for every group: each alone, the wall time the longest group's)
+    assert sorted(started) == sorted([g] for g in warmup.GROUPS)
     started.clear()
     warmup.run_parallel(None, jobs=1)
     assert started == [["driveline", "components", "eclutch", "emtc", "control", "wet"]]

@@ -163,15 +163,16 @@ def start(groups, full: bool = False) -> subprocess.Popen:
 
 def run_parallel(groups=None, jobs: int | None = None, progress=None) -> float:
     """Compile ``groups`` (default: all) in up to ``jobs`` processes (default: the cores), each in full (:func:`warm`:
-    the rare paths too, so that later runs compile nothing); wall seconds (``clutchlab warmup``).  The groups of a lot
-    (:data:`LOTS`) go to one process, in their order."""
+    the rare paths too, so that later runs compile nothing); wall seconds (``clutchlab warmup``).  With fewer processes
+    than groups, the groups of a lot (:data:`LOTS`) go to one process, in their order."""
     names = list(GROUPS) if groups is None else list(groups)
     _check(names)
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
     t0 = time.perf_counter()
     # deal the lots (groups sharing functions, kept together) to the processes, the costliest first, each to the
-    # least loaded (by their measured costs)
-    units = lots(names)
+    # least loaded (by their measured costs); with a process for every group, each group alone (the wall time is then
+    # the longest group's, where its lot's would be longer: the cores pay for the functions compiled twice)
+    units = lots(names) if jobs < len(names) else [[g] for g in names]
     jobs = min(jobs, len(units))
     dealt, load = [[] for _ in range(jobs)], [0.0] * jobs
     for unit in sorted(units, key=lambda u: -sum(COSTS.get(g, 10.0) for g in u)):
