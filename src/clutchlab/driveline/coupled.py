@@ -339,7 +339,7 @@ def coupled_jacobian(t, x, u, m, p, J):
 # (:mod:`clutchlab.numerics.outline`).  Linked, each of them -- with the network's evaluation and both components'
 # below it -- was optimised and emitted again in every function of the core that calls it (the core's root finder,
 # its event step, its breaks, its three record functions, its loop): measured on ``clutchlab warmup``'s components
-# group, the final modules held 4.4 times the code they define (docs/architecture.md, "Compile time").  The step's
+# group, the final modules held 4.4 times the code they define (docs/architecture.md).  The step's
 # stages still call :func:`coupled_rhs` directly (inlined where LLVM finds it worth it); these run at most once per
 # step, where one indirect call is nothing beside the network's evaluation.
 
@@ -352,21 +352,28 @@ def _params_type():
 
 
 _F1, _I1 = types.float64[::1], types.int64[::1]
+
+
 def _member_types():
     """numba types of the references to a :class:`CoupledParams`' members (``member(p, "net")``, ...)."""
     return tuple(ByRef(t) for t in _params_type().pointee.types)
 
 
-_evaluate_outlined = outlined(_evaluate, lambda: (types.float64, _F1, _F1, _I1, *_member_types()), types.none, group="coupled")
-_rhs_outlined = outlined(coupled_rhs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1), types.none, group="coupled")
-_outputs_outlined = outlined(coupled_outputs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1), types.none, group="coupled")
-_update_outlined = outlined(coupled_update, lambda: (types.float64, _F1, _F1, _I1, _params_type(), types.int64,
-                                                     K._log_type()), types.int64, group="coupled")
-_restart_outlined = outlined(coupled_restart, lambda: (types.float64, _F1, _F1, _I1, _params_type(), K._log_type()),
-                             types.boolean, group="coupled")
-_accept_outlined = outlined(coupled_accept, lambda: (types.float64, _F1, _F1, _I1, _params_type()), types.int64, group="coupled")
-_watch_rates_outlined = outlined(_watch_rates, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1,
-                                                        types.int64), types.none, group="coupled")
+def _hook_args(*rest):
+    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)``."""
+    return (types.float64, _F1, _F1, _I1, _params_type(), *rest)
+
+
+_evaluate_outlined = outlined(_evaluate, lambda: (types.float64, _F1, _F1, _I1, *_member_types()), types.none,
+                              group="coupled")
+_rhs_outlined = outlined(coupled_rhs, lambda: _hook_args(_F1, _F1), types.none, group="coupled")
+_outputs_outlined = outlined(coupled_outputs, lambda: _hook_args(_F1), types.none, group="coupled")
+_update_outlined = outlined(coupled_update, lambda: _hook_args(types.int64, K._log_type()), types.int64,
+                            group="coupled")
+_restart_outlined = outlined(coupled_restart, lambda: _hook_args(K._log_type()), types.boolean, group="coupled")
+_accept_outlined = outlined(coupled_accept, lambda: _hook_args(), types.int64, group="coupled")
+_watch_rates_outlined = outlined(_watch_rates, lambda: _hook_args(_F1, _F1, types.int64), types.none,
+                                 group="coupled")
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
