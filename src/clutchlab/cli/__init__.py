@@ -150,11 +150,13 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     demo.add_argument("--force", action="store_true", help="replace the report folder if it exists")
     demo.set_defaults(func=_demo)
     warm = sub.add_parser("warmup", help="compile every numba kernel ahead of use, in parallel processes",
-                          description="Compile (or load from the cache) the numerical kernels of every model, one "
-                                      "group per process, rare paths included (the driveline's repair over several "
-                                      "null directions, its invariant check), so that later runs start at once.",
+                          description="Compile (or load from the cache) the numerical kernels of every model in "
+                                      "parallel processes (groups that share functions in one, in order), rare "
+                                      "paths included (the driveline's repair over several null directions, its "
+                                      "invariant check), so that later runs start at once.",
                           epilog="Documentation: docs/architecture.md")
-    warm.add_argument("groups", nargs="*", metavar="GROUP", help="eclutch, wet, emtc, driveline, control (default: all)")
+    warm.add_argument("groups", nargs="*", metavar="GROUP",
+                      help="eclutch, wet, emtc, driveline, components, control (default: all)")
     warm.add_argument("-j", "--jobs", type=int, default=None, help="processes (default: the number of cores)")
     warm.set_defaults(func=_warmup)
     registered = set()
