@@ -95,10 +95,13 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
 
     from clutchlab.driveline import coupled as DC
 
+    from clutchlab.emtc import system as ES
+
     assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K._repair_space, K.check_invariants]
     coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
     assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
                        DC.coupled_accept, DC._watch_rates]
+    assert [e.dispatcher for e in outline._ENTRIES if e.group == "emtc"] == [ES._evaluate_into, ES._update]
     assert all(e.group is None for e in outline._ENTRIES if e.dispatcher.py_func.__module__ == K.__name__)
     outline.prepare()
     for fn in (K._repair, K.settle, K.driveline_rhs, K._solve_stuck):
@@ -216,3 +219,70 @@ def test_the_example_networks_call_the_driveline_through_the_outlined_signatures
     names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs", "_evaluate", "coupled_rhs",
              "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept")
     assert out == {name: [True] for name in names}, out
+
+
+_BENCH = r"""
+import json
+from clutchlab.emtc import system as S
+from clutchlab.emtc.bench import BenchScenario, simulate_bench
+from clutchlab.emtc.magnet import bundled_magnet
+from clutchlab.numerics import outline
+model = bundled_magnet()
+res = simulate_bench(model, BenchScenario(duration=0.3), controller_model=model)
+out = {{}}
+for fn in (S._evaluate_into, S._update):
+    entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
+    out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
+print(json.dumps([out, len(res.events.time_s)]))
+"""
+
+
+def test_the_emtc_bench_calls_its_hooks_through_the_outlined_signatures():
+    """The EMTC's evaluation at a point and its event update run through their addresses, with the very types they
+    are outlined for (:mod:`clutchlab.emtc.system`): each compiled once, for that signature only.  A signature drift (a
+    new field of :class:`~clutchlab.emtc.system.EmtcParams` the template lacks) would compile a second, linked copy
+    into every function of the core that calls the hook.  (A fresh process, running only the bench.)"""
+    import json
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-c", _BENCH.format()], capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out, events = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out == {"_evaluate_into": [True], "_update": [True]}, out
+    assert events > 0   # (the run had events: its update hook ran)
+
+
+def test_the_emtc_hooks_do_not_contain_the_outlined_functions():
+    """The EMTC's registered update hook and its evaluation at a point, compiled for the hooks' signature, call the
+    update and the right-hand side through their addresses: their code holds neither the update's memory commit nor
+    the right-hand side (which would be compiled again into every function of the core that calls them)."""
+    from clutchlab.emtc import system as S
+    from clutchlab.numerics import dispatch
+
+    assert dispatch._MODELS[S.EmtcParams]["update"] is S._update_hook
+    bodies = re.compile(r"_ZN\w*(4_rhs|7_commit|7_switch)B")   # compiled names: defined, declared or inlined
+    for fn, sig in ((S._update_hook, S._hook_args(types.int64, S._log_type())), (S._evaluate, S._hook_args()),
+                    (S._update, S._hook_args(types.int64, S._log_type()))):
+        fresh = numba.njit(fn.py_func)   # (not from numba's cache: its code is kept to be read)
+        fresh.compile(sig)
+        ir = fresh.inspect_llvm(sig)
+        if fn is S._update:   # the update itself holds them: the pattern finds what it looks for
+            assert bodies.search(ir)
+        else:
+            assert outline.RESOLVE_SYMBOL in ir and not bodies.search(ir), fn.__name__
+
+
+def test_the_emtc_template_has_the_type_of_a_packed_bench():
+    """The signatures of the EMTC's outlined hooks come from :func:`~clutchlab.emtc.system.params_template`: its numba
+    type must be that of the parameters of a bench as packed for a run, with a friction map and with LuGre."""
+    from clutchlab.emtc import system as S
+    from clutchlab.emtc.friction import LuGreParameters
+    from clutchlab.emtc.magnet import bundled_magnet
+
+    template = numba.typeof(S.params_template())
+    magnet = bundled_magnet()
+    for options in (None, S.BenchOptions(lugre=LuGreParameters()), S.BenchOptions(coil_drive="current")):
+        for cosimulation in (False, True):
+            packed = S.pack_parameters(magnet, options=options, cosimulation=cosimulation, n_samples=3)
+            assert numba.typeof(packed) == template

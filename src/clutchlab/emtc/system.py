@@ -40,19 +40,22 @@ References
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.core import types
 
 from ..errors import ParameterError, SimulationError
 from ..hysteresis._kernels import (GAP_TABLES, combine_tables, commit, gap_weights, invert_combined, invert_one,
                                    peek, peek_segment)
 from ..numerics import FASTMATH, dispatch
-from ..numerics.borrow import borrow, byref, shaped
-from ..numerics.core import record
+from ..numerics.borrow import ByRef, borrow, byref, shaped
+from ..numerics.core import new_log, record
 from ..numerics.layout import indices, slots
+from ..numerics.outline import outlined, prepare
 from ..system import System, follow_rtol, register_model
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance_path, lugre_mu, stribeck_g
@@ -442,12 +445,19 @@ def _switching(x, m, a, margin, aux, g):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _evaluate(t, x, u, m, p):
+def _evaluate_into(t, x, u, m, p):
     """The model at one point into the scratch of ``p.fmem`` (derivative, switching functions, ``aux``)."""
     fmem = p.fmem
-    aux = fmem[FM_AUX:FM_AUX + N_AUX]
     dispatch.rhs(t, x, u, m, p, fmem[FM_DX:FM_DX + 7], fmem[FM_G:FM_G + 6])
-    return aux
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _evaluate(t, x, u, m, p):
+    """The model at one point into the scratch of ``p.fmem`` (:func:`_evaluate_into`, called through its address at
+    the hooks' signature); returns ``aux``, the intermediates (``AUX_*``)."""
+    _evaluate_outlined(t, x, u, m, p)
+    fmem = p.fmem
+    return fmem[FM_AUX:FM_AUX + N_AUX]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
@@ -972,7 +982,61 @@ def run_controller(p, t, x, u):
         p.imem[IM_KNEXT] = k + 1
 
 
-dispatch.register(EmtcParams, inline_stages=True, rhs=_rhs, outputs=_outputs, update=_update, restart=_restart,
+# ---- the model's evaluation at events and its event update, called through their addresses
+# (:mod:`clutchlab.numerics.outline`).  Linked, :func:`_evaluate` (the whole model: the Preisach magnet's segment
+# lookups of Eqs. 1-5, the ball-cam and the friction elements) was optimised and emitted again in every function of
+# the core below a hook that evaluates at a point (outputs, the mode update, a restart), and the update with its
+# memory commit in every function of the core that handles an event: counted on ``clutchlab warmup``'s EMTC group,
+# the final modules held 4.3 times the code they define (256,000 instructions), 3.3 times (196,000) with these two
+# outlined.  The hooks the core calls at every step or controller sample (the stages' right-hand side, ``accept``,
+# ``restart``, ``outputs``) stay linked: outlined too (154,000 instructions) they cost the bench's 1 s run 9 %
+# of its time, against 2 % for these two (docs/architecture.md).
+def params_template() -> EmtcParams:
+    """An :class:`EmtcParams` of tiny arrays: the numba type of every bench's (for the signatures of the functions
+    called through their addresses; ``tests/numerics/test_outline.py`` checks it against packed benches)."""
+    f1, f2, f4, i1 = np.zeros(1), np.zeros((1, 1)), np.zeros((1, 1, 1, 1)), np.zeros(1, np.int64)
+
+    def zeros(cls):
+        return cls(*([0.0] * len(cls._fields)))
+
+    geometry = (0.0,) * len(_default(CouplingGeometry).kernel_data())
+    return EmtcParams(
+        vehicle=zeros(VehicleData), coupling=zeros(CouplingData), actuator=zeros(ActuatorData),
+        geometry=geometry, lugre=(0.0,) * 6, sample_time=0.0, friction_mode=0, reference_source=0,
+        n_airgaps=0, n_cells=0, n_ctl_cells=0, n_fmap_speed=0, n_fmap_temp=0, n_map_throttle=0, n_map_speed=0,
+        layout=(0,) * (2 * N_LAYOUT), throttle=f2, plant_tables=f4, plant_grid=f1, plant_stack=f1.copy(),
+        plant_prefix=f2.copy(), plant_comb=f4.copy(), imem=i1, fmem=f1.copy(), cold=f1.copy())
+
+
+@functools.lru_cache(maxsize=1)
+def _params_type():
+    """numba type of the reference to an :class:`EmtcParams` every hook takes."""
+    return ByRef(numba.typeof(params_template()))
+
+
+_F1, _I1 = types.float64[::1], types.int64[::1]
+
+
+def _hook_args(*rest):
+    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)``."""
+    return (types.float64, _F1, _F1, _I1, _params_type(), *rest)
+
+
+def _log_type():
+    return numba.typeof(new_log(1))
+
+
+_evaluate_outlined = outlined(_evaluate_into, lambda: _hook_args(), types.none, group="emtc")
+_update_outlined = outlined(_update, lambda: _hook_args(types.int64, _log_type()), types.int64, group="emtc")
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
+def _update_hook(t, x, u, m, p, k, log):
+    """:func:`_update` through its address."""
+    return _update_outlined(t, x, u, m, p, k, log)
+
+
+dispatch.register(EmtcParams, inline_stages=True, rhs=_rhs, outputs=_outputs, update=_update_hook, restart=_restart,
                   accept=_accept, next_break=_next_break, jacobian=_jacobian)
 
 
@@ -1298,6 +1362,9 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
                           error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range})
         if len(_TEMPLATES) < 64:
             _TEMPLATES[(first_step, current_range)] = template
+    # the hooks called through their addresses, compiled (or loaded) here on the calling thread, not at a batch
+    # worker's first call
+    prepare(groups=("emtc",), ungrouped=False)
     # every run builds a system: the checked, constant parts are shared, the parameters and start are its own
     return template.variant(params=params, x0=x0, u0=u0)
 

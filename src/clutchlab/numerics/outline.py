@@ -49,7 +49,7 @@ _ERRORS: dict = {}
 
 
 class _Entry:
-    __slots__ = ("dispatcher", "signature", "returns", "label", "lazy", "group", "_sig")
+    __slots__ = ("dispatcher", "signature", "returns", "label", "lazy", "group", "_sig", "ready")
 
     def __init__(self, dispatcher, signature, returns, label, lazy=False, group=None):
         self.dispatcher = dispatcher
@@ -59,6 +59,7 @@ class _Entry:
         self.lazy = lazy
         self.group = group
         self._sig = None
+        self.ready = False   # compiled or loaded in this process (:func:`prepare`)
 
     def sig(self) -> tuple:
         if self._sig is None:
@@ -102,21 +103,26 @@ _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_int64)(_resolve)
 ll.add_symbol(RESOLVE_SYMBOL, ctypes.cast(_CALLBACK, ctypes.c_void_p).value)
 
 
-def prepare(lazy: bool = False, groups=()) -> None:
+def prepare(lazy: bool = False, groups=(), ungrouped: bool = True) -> None:
     """Compile (or load from numba's cache) every outlined function now, on the calling thread (``clutchlab
     warmup``; a driveline's :meth:`~clutchlab.driveline.Driveline.system`).  Cheap once done in a process.
 
     ``lazy``: the functions outlined with ``lazy=True`` too (a debug option's, such as the driveline's invariant
     check: compiled only where a run asks for it, not on every first use).  ``groups``: the functions outlined
     with one of these ``group`` names too (a kind of model the caller runs: ``"coupled"``, the hooks of a network
-    with model components, which a plain network never calls); ``None`` for every group (``clutchlab warmup``)."""
+    with model components, which a plain network never calls; ``"emtc"``, the EMTC's hooks); ``None`` for every
+    group (``clutchlab warmup``).  ``ungrouped``: the functions of no group too (``False``: a model that prepares
+    only its own group, such as the EMTC bench, leaves the driveline's alone)."""
     for e in _ENTRIES:
         if e.lazy and not lazy:
+            continue
+        if e.ready or (e.group is None and not ungrouped):
             continue
         if e.group is not None and groups is not None and e.group not in groups:
             continue
         if not native_address(e.dispatcher, e.sig(), e.returns):
             raise TypeError(f"{e.label}{e.sig()} does not return {e.returns}")
+        e.ready = True
 
 
 def _codegen_call(context, builder, key, label, returns, argtys, args):
