@@ -97,14 +97,14 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
 
     from clutchlab.emtc import system as ES
 
-    assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K._repair_space, K.check_invariants]
+    assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K._repair_space, K._small_solve, K.check_invariants]
     coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
     assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
                        DC.coupled_accept, DC._watch_rates]
     assert [e.dispatcher for e in outline._ENTRIES if e.group == "emtc"] == [ES._evaluate_into, ES._update]
     assert all(e.group is None for e in outline._ENTRIES if e.dispatcher.py_func.__module__ == K.__name__)
     outline.prepare()
-    for fn in (K._repair, K.settle, K.driveline_rhs, K._solve_stuck):
+    for fn in (K._repair, K.settle, K.driveline_rhs, K._solve_stuck, K._margin_rates, K._eliminate):
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
     outline.prepare(groups=("coupled",))
@@ -112,7 +112,7 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
     outline.prepare(lazy=True)
-    for fn in (K._repair_space, K.check_invariants):
+    for fn in (K._repair_space, K._small_solve, K.check_invariants):
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
 
@@ -153,7 +153,10 @@ from clutchlab.driveline import kernel as K
 before = len(K._repair_space.overloads)
 res = indeterminate_loop().simulate(1.0, output_step=2e-3, rtol=1e-8)
 ev = [[float(t), str(el), str(e)] for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)]
-print(json.dumps([before, len(K._repair_space.overloads), ev]))
+from clutchlab.numerics import outline
+sigs = {{fn.__name__: [sig == next(e for e in outline._ENTRIES if e.dispatcher is fn).sig() for sig in fn.overloads]
+        for fn in (K._repair_space, K._small_solve, K._eliminate)}}
+print(json.dumps([before, len(K._repair_space.overloads), ev, sigs]))
 """
 
 
@@ -173,8 +176,10 @@ def test_a_rare_path_is_compiled_at_its_first_call_and_gives_the_same_run():
     proc = subprocess.run([sys.executable, "-c", _LOOP.format(support=support)], capture_output=True, text=True,
                           timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    before, after, events = json.loads(proc.stdout.strip().splitlines()[-1])
+    before, after, events, sigs = json.loads(proc.stdout.strip().splitlines()[-1])
     assert (before, after) == (0, 1)
+    # (the repair's own calls, compiled at its first call, go through the outlined signatures too)
+    assert sigs == {"_repair_space": [True], "_small_solve": [True], "_eliminate": [True]}, sigs
     outline.prepare(lazy=True)
     res = indeterminate_loop().simulate(1.0, output_step=2e-3, rtol=1e-8)
     here = [[float(t), str(el), str(e)] for t, el, e in zip(res.events.time_s, res.events.element, res.events.event)]
@@ -192,8 +197,8 @@ for name in ("coupled_clutches", "wet_sae2", "emtc_awd", "eclutch_launch"):
     load_driveline(Path(r"{examples}") / f"driveline_{{name}}.toml").driveline.simulate(0.05, check_invariants=True)
 from clutchlab.driveline import coupled as DC
 out = {{}}
-for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs, DC._evaluate, DC.coupled_rhs,
-           DC.coupled_outputs, DC.coupled_update, DC.coupled_restart, DC.coupled_accept):
+for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs, K._margin_rates, DC._evaluate,
+           DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart, DC.coupled_accept):
     entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
     out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
 print(json.dumps(out))
@@ -216,8 +221,8 @@ def test_the_example_networks_call_the_driveline_through_the_outlined_signatures
                           text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs", "_evaluate", "coupled_rhs",
-             "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept")
+    names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs", "_margin_rates", "_evaluate",
+             "coupled_rhs", "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept")
     assert out == {name: [True] for name in names}, out
 
 

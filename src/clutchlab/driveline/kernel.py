@@ -1448,7 +1448,7 @@ def _null_vector(A, ns, S, cp, v, y):
     ``S``, ``cp`` and ``y`` are scratch (a copy of ``A``, the column order, the permuted vector)."""
     if ns < 2:
         return 0
-    rank = _eliminate(A, ns, S, cp)
+    rank = _eliminate_outlined(A, ns, S, cp)
     if rank == 0 or rank == ns:
         return 0
     if rank != ns - 1:
@@ -1866,7 +1866,7 @@ def _margin_vertex(GR, w, h, nr, m, idx, M, b, tol):
     _basis_rows(GR, w, nr, idx, M, False)
     for a in range(k1):
         b[a] = h[idx[a]]
-    if _small_solve(M, b, k1) and _keeps(GR, nr, b, b[nr], w, h, m, tol):
+    if _small_solve_outlined(M, b, k1) and _keeps(GR, nr, b, b[nr], w, h, m, tol):
         return b[nr]
     return -np.inf
 
@@ -1881,7 +1881,7 @@ def _margin_optimal(GR, w, nr, idx, M, y):
     for a in range(k1):
         y[a] = 0.0
     y[nr] = 1.0
-    if not _small_solve(M, y, k1):
+    if not _small_solve_outlined(M, y, k1):
         return False
     big = 0.0
     for a in range(k1):
@@ -1973,7 +1973,7 @@ def _active_split(G, d, h, w, theta, idx, k, M, b, z):
                 v_ += G[idx[a], f] * G[idx[c], f]
             M[a, c] = v_
         b[a] = h[idx[a]] - theta * w[idx[a]]
-    if not _small_solve(M, b, k):
+    if not _small_solve_outlined(M, b, k):
         return False
     for f in range(d):
         v_ = 0.0
@@ -2118,7 +2118,7 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     # ---- an orthonormal basis of the null space
     S = np.empty((ns, ns))
     cp = np.empty(ns, dtype=np.int64)
-    rank = _eliminate(A, ns, S, cp)
+    rank = _eliminate_outlined(A, ns, S, cp)
     if rank == 0:
         return False
     d = ns - rank
@@ -2373,6 +2373,13 @@ _repair_outlined = outlined(_repair, lambda: (_params_type(), _F1, types.int64, 
                                               _F1, _F1, types.float64), types.boolean)
 _split_limit_outlined = outlined(_split_limit, lambda: (_params_type(), _F2, types.int64, _F2, _I1, _F1, _F1, _F1, _F1,
                                                       _F1), types.none)
+#: :func:`_eliminate` (the stuck set's rank and null vector, :func:`_repair_space`'s null space) and
+#: :func:`_small_solve` (the vertex and active-set searches of :func:`_repair_space`, lazily with it) called through
+#: their addresses: each elimination is O(ns^3) work beside the call, and linked they were optimised and emitted
+#: again in every function that reaches them (8 and 9 copies, 16,300 of the driveline group's 247,000 instructions;
+#: docs/architecture.md)
+_eliminate_outlined = outlined(_eliminate, lambda: (_F2, types.int64, _F2, _I1), types.int64)
+_small_solve_outlined = outlined(_small_solve, lambda: (_F2, _F1, types.int64), types.boolean, lazy=True)
 
 
 #: refinements of the stuck set's regularised solution at most (:func:`_solve_stuck`: three always, then while the
@@ -4169,6 +4176,11 @@ def driveline_jacobian(t, x, u, m, p, J):
 #: at events (locating a root, the step to it, a break): each of those functions of the core would otherwise link the
 #: network's evaluation and optimise it again (docs/architecture.md); the step's stages call it directly
 _rhs_outlined = outlined(driveline_rhs, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1), types.none)
+#: :func:`_margin_rates` through its address: it runs only while a stuck element is near its limit, and linked it was
+#: optimised and emitted again in the watch hook and in every function of the core that calls it (seven copies,
+#: 16,700 of the driveline group's 263,000 instructions; docs/architecture.md)
+_margin_rates_outlined = outlined(_margin_rates, lambda: (types.float64, _F1, _F1, _I1, _params_type(), _F1, _F1),
+                                  types.none)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4180,19 +4192,19 @@ def driveline_rhs_event(t, x, u, m, p, dx, g):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_watch(t, x, u, m, p, dx, g, k):
     """The core's ``watch`` hook (where it compares the switching functions across a step, never at a step's
-    stages): the margin rates of the stuck elements near their limits (:func:`_margin_rates`), one more evaluation of
-    the network while one is, and only where the core reads one of them (``k`` a stuck element's turn function, or
-    -1 for all: a probe locating a break-away reads only that); nothing else."""
+    stages): the margin rates of the stuck elements near their limits (:func:`_margin_rates`, through its address),
+    one more evaluation of the network while one is, and only where the core reads one of them (``k`` a stuck
+    element's turn function, or -1 for all: a probe locating a break-away reads only that); nothing else."""
     if u.shape[0] > 0 and hold_inputs(p.data, u):
         forget_signals(p)
     nf = p.fric.shape[0]
     if k >= 0:
         if k < N_G * nf and k % N_G == G_TURN and m[k // N_G] == STUCK and g[k] == 0.0:
-            _margin_rates(t, x, u, m, p, dx, g)
+            _margin_rates_outlined(t, x, u, m, p, dx, g)
         return
     for j in range(nf):
         if m[j] == STUCK and g[N_G * j + G_TURN] == 0.0:
-            _margin_rates(t, x, u, m, p, dx, g)
+            _margin_rates_outlined(t, x, u, m, p, dx, g)
             return
 
 
