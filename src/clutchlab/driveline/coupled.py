@@ -29,7 +29,7 @@ from numba.core import types
 
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, keep_rows, member
-from ..numerics.outline import outlined
+from ..numerics.outline import hook_args, outlined
 from . import emtc as DE
 from . import kernel as K
 from . import wet as DW
@@ -360,8 +360,8 @@ def _member_types():
 
 
 def _hook_args(*rest):
-    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)``."""
-    return (types.float64, _F1, _F1, _I1, _params_type(), *rest)
+    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)`` (:func:`~clutchlab.numerics.outline.hook_args`)."""
+    return hook_args(_params_type(), *rest)
 
 
 _evaluate_outlined = outlined(_evaluate, lambda: (types.float64, _F1, _F1, _I1, *_member_types()), types.none,

@@ -36,10 +36,10 @@ from numba.core import types
 
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
-from ..numerics.core import new_log, record
+from ..numerics.core import record
 from ..numerics.interp import bracket
 from ..numerics.layout import indices, slots
-from ..numerics.outline import outlined
+from ..numerics.outline import log_type, outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
 
 #: an int64 zero: numba types a literal ``0`` (argument or first value of a counter) as ``Literal[int](0)`` and
@@ -3441,8 +3441,7 @@ def settle(t, x, m, p, log, old, origin):
     return any_change
 
 
-def _log_type():
-    return numba.typeof(new_log(1))
+_log_type = log_type
 
 
 #: :func:`settle` called through its address (:mod:`clutchlab.numerics.outline`): it runs at events only, and linked

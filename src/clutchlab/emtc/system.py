@@ -53,9 +53,9 @@ from ..hysteresis._kernels import (GAP_TABLES, combine_tables, commit, gap_weigh
                                    peek, peek_segment)
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import ByRef, borrow, byref, shaped
-from ..numerics.core import new_log, record
+from ..numerics.core import record
 from ..numerics.layout import indices, slots
-from ..numerics.outline import outlined, prepare
+from ..numerics.outline import hook_args, log_type, outlined, prepare
 from ..system import System, follow_rtol, register_model
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance_path, lugre_mu, stribeck_g
@@ -1014,16 +1014,12 @@ def _params_type():
     return ByRef(numba.typeof(params_template()))
 
 
-_F1, _I1 = types.float64[::1], types.int64[::1]
-
-
 def _hook_args(*rest):
-    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)``."""
-    return (types.float64, _F1, _F1, _I1, _params_type(), *rest)
+    """The types of a hook's arguments: ``(t, x, u, m, p, *rest)`` (:func:`~clutchlab.numerics.outline.hook_args`)."""
+    return hook_args(_params_type(), *rest)
 
 
-def _log_type():
-    return numba.typeof(new_log(1))
+_log_type = log_type
 
 
 _evaluate_outlined = outlined(_evaluate_into, lambda: _hook_args(), types.none, group="emtc")

@@ -32,11 +32,13 @@ import ctypes
 import hashlib
 
 import llvmlite.binding as ll
+from numba import typeof as _typeof
 from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 from ..errors import SimulationError
+from .core import new_log
 from .session import native_address
 
 __all__ = ["outlined", "prepare", "RESOLVE_SYMBOL"]
@@ -202,3 +204,17 @@ def outlined(dispatcher, signature, returns, lazy=False, group=None):
     call.__name__ = call.__qualname__ = f"outlined_{dispatcher.py_func.__name__}"
     call.__doc__ = f"``{label}`` called through its address (:mod:`clutchlab.numerics.outline`)."
     return intrinsic(call)
+
+
+_F1, _I1 = types.float64[::1], types.int64[::1]
+
+
+def hook_args(params, *rest) -> tuple:
+    """The numba types of a model hook's arguments, ``(t, x, u, m, p, *rest)``, for the type ``params`` of its
+    parameter reference: the signature of a hook called through its address."""
+    return (types.float64, _F1, _F1, _I1, params, *rest)
+
+
+def log_type():
+    """numba type of the core's event log (the ``log`` argument of the ``update`` and ``restart`` hooks)."""
+    return _typeof(new_log(1))
