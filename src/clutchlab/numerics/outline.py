@@ -32,8 +32,8 @@ import ctypes
 import hashlib
 
 import llvmlite.binding as ll
-from numba import typeof as _typeof
 from llvmlite import ir
+from numba import typeof as _typeof
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
@@ -41,7 +41,7 @@ from ..errors import SimulationError
 from .core import new_log
 from .session import native_address
 
-__all__ = ["outlined", "prepare", "RESOLVE_SYMBOL"]
+__all__ = ["outlined", "prepare", "hook_args", "log_type", "RESOLVE_SYMBOL"]
 
 #: the resolving callback's symbol (a new version of this protocol takes a new name)
 RESOLVE_SYMBOL = "clutchlab_outline_resolve_v1"
