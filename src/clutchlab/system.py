@@ -36,7 +36,7 @@ import pandas as pd
 from ._limits import check_allocation, short_repr
 from .errors import ParameterError, SimulationError
 from .numerics import status as st
-from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS, REPORT_KINDS
+from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS, REPORT_KINDS, START as _START
 from .result import SimulationResult
 
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
@@ -147,6 +147,13 @@ class System:
         Physical range ``name -> (low, high)`` [SI] of states, inputs or outputs (an actuator's travel,
         a drive's supply voltage): operating points outside it are refused
         (:func:`clutchlab.control.operating_point`).
+    decided_at_start : tuple of (str, int, int or None)
+        What the model's compiled ``start`` hook writes from the initial state (:mod:`clutchlab.numerics.dispatch`),
+        as ``(where, start, stop)`` slices: ``"m"`` the mode vector, ``"params.<field>[.<field>...]"`` an array of
+        the parameters (the driveline: its network's modes and the stored energy it starts from,
+        ``("params.work", -1, None)``).  A run derives them again, so ``m0`` is not where a run starts from
+        there; a native FMU's exporter does not look for a parameter's image in them (its ``start`` decides them
+        again from the start values a host sets, :mod:`clutchlab.fmu.native.image`).
     """
 
     name: str
@@ -176,6 +183,7 @@ class System:
     element_name: Callable | None = None
     error_messages: dict = dataclasses.field(default_factory=dict)
     limits: dict = dataclasses.field(default_factory=dict)
+    decided_at_start: tuple = ()
 
     def __post_init__(self):
         n = len(self.states)
@@ -981,6 +989,8 @@ class Simulation:
     def _general(self, _handle, t: float, what: int) -> int:
         """:meth:`_call` through numba's dispatcher with all the arguments (no packed table)."""
         code = st.SUCCESS
+        if what & _START:
+            self._dispatch("start", "dopri", (self.system.params, self.time, self.x, self.u, self.m))
         if what & _ADVANCE:
             code = int(self._dispatch("advance", self._method(), (
                 self.system.params, self.x, self.m, self.u, t, self._sf, self._si, self._opt, self.log, self._empty,
@@ -1049,9 +1059,15 @@ class Simulation:
                               f"would take {span / self.fixed_step:.3g} steps (more than {FIXED_STEP_BUDGET:.0e} "
                               "in one call); choose a longer fixed step or advance in shorter intervals")
 
-    def reported(self) -> np.ndarray:
-        """The reported values (:meth:`report`) at the current point, without advancing; the array of :meth:`step`."""
-        self._call(0.0, _OUTPUTS)
+    def reported(self, start: bool = False) -> np.ndarray:
+        """The reported values (:meth:`report`) at the current point, without advancing; the array of :meth:`step`.
+
+        ``start``: first decide what the run derives from its initial state at the inputs now held (the model's
+        ``start`` hook: a driveline's start modes; what a native FMU reports after its initialisation).  For a run
+        that has not advanced yet (its first advance decides them again, from the same state)."""
+        if start and int(self._si[self._core.SI_STARTED]) != 0:
+            raise SimulationError(f"{self.system.name}: reported(start=True) after the run has started")
+        self._call(self.time, _OUTPUTS | _START if start else _OUTPUTS)
         return self._r
 
     def report(self, sources) -> None:

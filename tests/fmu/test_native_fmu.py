@@ -184,7 +184,7 @@ def _fmpy_run(tmp_path, path, n, dt, start=None, inputs=None, fmi_type="CoSimula
 def test_native_fmu_of_a_driveline_in_fmpy_without_clutchlab_equals_the_python_cosimulation(built, tmp_path):
     path, cls, lines = built["cc"]
     assert lines == ["native FMU Clutchlab_coupled_clutches (linux64; FMI 2.0 co-simulation and model exchange): 0 inputs, "
-                     "30 outputs, 21 parameters (8 fixed at export)"]
+                     "30 outputs, 25 parameters (4 fixed at export)"]
     # (each clutch's mu_scale multiplies its mu: the later of the two is fixed at export, mu stays writable)
     _, svs = _variables(path)
     assert [svs[f"clutch{i}.mu_scale"].get("variability") for i in (1, 2, 3)] == ["constant"] * 3
@@ -200,6 +200,58 @@ def test_native_fmu_of_a_driveline_in_fmpy_without_clutchlab_equals_the_python_c
     # and the parameters changed the run (so the FMU did write them)
     default = _python_run(cls, n, dt)
     assert np.max(np.abs(default["J2.w"] - python["J2.w"])) > 1e-2
+
+
+#: initial speeds a host sets that change the mode the run starts from and the stored energy (the example starts
+#: with J1 at 10 rad/s and the others at rest: clutch1 sliding backward, w_b - w_a = -10 rad/s; clutch2 and clutch3
+#: free until their forces rise): J1 at rest and J2 at 3 rad/s put clutch1 forward
+_SPEEDS = {"J1.w0": 0.0, "J2.w0": 3.0, "J4.w0": -2.0}
+
+
+def test_a_host_sets_the_initial_speeds_and_the_fmu_decides_the_start_modes_again(built, tmp_path):
+    """The initial speeds are parameters of the native FMU (not fixed at export): each is a copy into the state, and
+    the FMU runs the network's ``start`` again before the run (the modes it starts from, from the signs of the
+    relative speeds, and the stored energy its energy balance starts from).  Set by a host, co-simulation equals
+    clutchlab's own run built with those speeds (at t = 0 too: the modes and the energy balance), and model
+    exchange under CVode agrees within the tolerance."""
+    path, cls, _ = built["cc"]
+    _, svs = _variables(path)
+    for i in (1, 2, 3, 4):
+        assert svs[f"J{i}.w0"].get("causality") == "parameter", i
+        assert svs[f"J{i}.w0"].get("variability") == "fixed", i
+    n, dt = 600, 1e-3
+    native = _fmpy_run(tmp_path, path, n, dt, _SPEEDS)
+    python = _python_run(cls, n, dt, _SPEEDS)
+    for name in python:
+        _close(native[name], python[name], name)
+    default = _python_run(cls, n, dt)
+    codes = {name: (python[name][0], default[name][0]) for name in ("clutch1.mode", "clutch2.mode", "clutch3.mode")}
+    assert codes == {"clutch1.mode": (1.0, -1.0), "clutch2.mode": (2.0, 2.0), "clutch3.mode": (2.0, 2.0)}, codes
+    # (the energy balance starts from the stored energy of the speeds the host set: 6.5 J, not the file's 50 J)
+    assert native["kinetic_energy"][0] == pytest.approx(0.5 * 1.0 * 3.0 ** 2 + 0.5 * 1.0 * 2.0 ** 2)
+    assert abs(native["energy_error"][0]) < 1e-12
+    assert np.max(np.abs(native["energy_error"])) < 1e-6 * np.max(np.abs(native["kinetic_energy"]))
+    (tmp_path / "me").mkdir()
+    me = _fmpy_run(tmp_path / "me", path, n, dt, _SPEEDS, fmi_type="ModelExchange", rtol=1e-9)
+    same = np.all([me[f"clutch{i}.mode"] == python[f"clutch{i}.mode"] for i in (1, 2, 3)], axis=0)
+    assert same[0] and same.sum() >= n - 10
+    for name in ("J1.w", "J2.w", "J3.w", "J4.w", "clutch1.tau"):
+        scale = float(np.max(np.abs(python[name])))
+        np.testing.assert_allclose(me[name][same], python[name][same], rtol=0, atol=2e-5 * scale, err_msg=name)
+
+
+def test_a_parameter_s_range_ends_where_its_law_stops_holding(built, host, unpacked):
+    """The FMU writes ``a * value + b`` found near the start; its range ends where the model builds something else
+    (``image.law_holds``, searched as the accepted range is): the coupled clutches' absolute tolerances follow
+    ``rtol`` down to a floor of 1e-12, so ``rtol``'s ``min`` is 1e-12 (it was the declared 100 eps, and a host's
+    rtol of 1e-13 got absolute tolerances of 1e-13, not clutchlab's 1e-12), and a host's 1e-13 is refused."""
+    path, _, _ = built["cc"]
+    _, svs = _variables(path)
+    low = float(svs["rtol"].find("Real").get("min"))
+    assert 1e-12 <= low <= 1.001e-12, low
+    lib, guid, vr, _ = unpacked
+    status, text = _host(host, lib, guid, "refuse", vr["rtol"], "1e-13").stdout.split(" ", 1)
+    assert int(status) == 3 and re.search(r"rtol = 1e-13 \[1\] is outside its range", text), text
 
 
 def test_network_inputs_are_fmu_inputs(built, tmp_path):
@@ -324,9 +376,12 @@ def test_model_description_from_the_declarations(built):
     mu = svs["clutch1.mu"]
     assert (mu.get("causality"), mu.get("variability")) == ("parameter", "fixed")
     assert mu.find("Real").get("min") == "0.0" and mu.find("Real").get("max") == "2.0"
-    # an initial speed decides the start modes (not an affine copy): fixed at export, said in the description
+    # a factor that multiplies another parameter in one number (not an affine copy): fixed at export, said in the
+    # description; an initial speed is a parameter (the FMU decides the start modes again)
+    scale = svs["clutch1.mu_scale"]
+    assert (scale.get("causality"), scale.get("variability")) == ("local", "constant")
     w0 = svs["J1.w0"]
-    assert (w0.get("causality"), w0.get("variability")) == ("local", "constant")
+    assert (w0.get("causality"), w0.get("variability")) == ("parameter", "fixed")
     assert svs["J1.w"].get("causality") == "output" and svs["J1.w"].find("Real").get("unit") == "rad/s"
     units = {u.get("name") for u in root.iter("Unit")}
     assert {"rad/s", "N.m", "kg.m2"} <= units
@@ -395,7 +450,7 @@ def test_instantiate_free_keeps_memory_flat_and_fresh_processes_exit_cleanly(hos
     ("clutch1.mu", "3.0", r"clutch1\.mu = 3 \[1\] is outside its range \[0, 2\]"),
     ("clutch1.fn_max", "nan", r"clutch1\.fn_max = nan is not a finite number"),
     ("J1.J", "-1", r"J1\.J = -1 \[kg\.m2\] is outside its range \(0, inf\]"),
-    ("J1.w0", "5", r"J1\.w0 is fixed at export and cannot be set"),
+    ("clutch1.mu_scale", "1.5", r"clutch1\.mu_scale is fixed at export and cannot be set"),
     ("J1.w", "5", r"J1\.w is an output and cannot be set"),
 ])
 def test_bad_values_return_fmi2error_with_a_message(host, unpacked, name, value, message):
@@ -678,6 +733,12 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     for name in python:
         _close(native[name], python[name], name)
     assert np.ptp(python["bearing_position"]) > 1e-3   # (the actuator moved)
+    # a stiffness the model turns into its curves (not a line: 2.7e-5 off at 1.02 times its start) is fixed, where
+    # trials one newton per metre apart from its 1175810 N/m had taken it for one
+    assert svs["clutch.k_fl_model2"].get("variability") == "constant"
+    # a gain is a proportion down to 0+ (at 0 the model switches its integrator off: refused)
+    ki = svs["actuator.ki"].find("Real")
+    assert 0.0 < float(ki.get("min")) < 1e-9 and svs["actuator.ki"].get("causality") == "parameter"
     # parameters a host sets (found writable by rebuilding the model, and checked jointly): the controller's
     # gains, the motor's resistance, the clutch's friction coefficient and the seals' static ratio
     start = {"actuator.kp": 2500.0, "actuator.resistance": 0.25, "clutch.mu": 0.3, "friction.static_ratio": 1.3}
@@ -726,6 +787,10 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     root, svs = _variables(path)
     force = svs["force_reference"].find("Real")
     assert force.get("min") == "0.0" and float(force.get("max")) == WetCoSimulation().bench.actuator_force_max
+    # the initial slip speed decides the slip direction the run starts in (a mode the wet bench's builder
+    # decides): the FMU takes it > 0 only, where its law holds (a host's -1 rad/s had started slipping forward)
+    slip = float(svs["scenario.initial_slip_speed"].find("Real").get("min"))
+    assert 0.0 < slip < 1e-9
     n, dt = 400, 1e-3
     k = np.arange(n + 1)
     inputs = {"force_reference": np.where(k * dt > 0.05, 3000.0, 1000.0), "slip_speed_reference": np.full(n + 1, 150.0)}
@@ -820,6 +885,28 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     for name in speeds:
         scale = float(np.max(np.abs(tight[name])))
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-4 * scale, err_msg=name)
+
+
+def test_trials_of_a_whole_number_are_relative_and_a_proportion_has_no_offset():
+    """A whole-number start is tried at a quarter above and a fifth below it (whole) before one apart: trials one
+    apart from 1175810 had taken a curve for a line; a law whose offset is the fit's rounding is a proportion."""
+    from types import SimpleNamespace
+
+    from clutchlab.fmu.native.image import _fit, _trials
+
+    var = SimpleNamespace(start=1175810.0, minimum=0.0, maximum=None, positive=False)
+    assert _trials(var)[:2] == [1469762.0, 940648.0]
+    pairs = SimpleNamespace(start=6.0, minimum=1.0, maximum=20.0, positive=True)
+    assert _trials(pairs)[:4] == [8.0, 5.0, 7.0, 4.0]   # (6 * 1.25 = 7.5 rounds to 8; 6 * 0.8 to 5)
+    # y = 1e-8 v, with the rounding of the slope fitted from close points: no offset, exact near zero
+    v0, v1, v2 = 8000.0, 10000.0, 6400.0
+    a, b, reciprocal = _fit(v0, v1, v2, 1e-8 * v0, 1e-8 * v1, 1e-8 * v2)
+    assert (b, reciprocal) == (0.0, False) and a == pytest.approx(1e-8, rel=1e-15)
+    # a true offset stays
+    a, b, _ = _fit(v0, v1, v2, 2.0 * v0 + 3.0, 2.0 * v1 + 3.0, 2.0 * v2 + 3.0)
+    assert (a, b) == pytest.approx((2.0, 3.0), rel=1e-12)
+    # a curve is no line
+    assert _fit(v0, v1, v2, v0 ** 2, v1 ** 2, v2 ** 2) is None
 
 
 def test_the_accepted_range_is_found_by_bisection_within_the_declared_one():

@@ -407,7 +407,15 @@ def coupled_accept_hook(t, x, u, m, p):
     return _accept_outlined(t, x, u, m, p)
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def coupled_start(t, x, u, m, p):
+    """The network's start modes and stored energy from its initial state (:func:`kernel.driveline_start`, through
+    its address; the core's ``start`` hook).  The components' own modes are their builders' (their restart at the
+    start settles them)."""
+    K._start_outlined(t, x, u, m, member(p, "net"))
+
+
 dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs_hook, update=coupled_update_hook,
                   restart=coupled_restart_hook, accept=coupled_accept_hook, next_break=coupled_next_break,
                   jacobian=coupled_jacobian, rhs_event=coupled_rhs_event, watch=coupled_watch,
-                  prepare=coupled_prepare)
+                  prepare=coupled_prepare, start=coupled_start)

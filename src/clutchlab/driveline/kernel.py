@@ -3972,6 +3972,65 @@ def driveline_restart(t, x, u, m, p, log):
     return settle_outlined(t, x, m, p, log, m.copy(), origin)
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def driveline_start(t, x, u, m, p):
+    """What a run derives from its initial state alone (the core's ``start`` hook, before its first restart; the
+    network's Python side calls it for the modes a :class:`~clutchlab.system.System` starts from, and a native FMU
+    again after a host set an initial speed or angle): the modes below, then the stored energy (kinetic and elastic,
+    [J]) the energy balance starts from, in the last word of ``p.work``.  The modes are a guess from the state that
+    the restart at the start settles at the forces (:func:`driveline_restart`):
+
+    * a friction element free where its normal force is negative, or zero and not rising (:func:`_is_free`), else
+      sliding the way it turns, stuck at zero relative speed;
+    * a backlash in contact beyond the edge of its gap (at the edge, if moving into it); with MSL's damping law,
+      limited where its damping torque would exceed the elastic one; beyond the edge where the contact would pull,
+      released (either law);
+    * a curve spring on the segment it lies on (at a point, the one it moves onto);
+    * a lossy gear rolling the way its flange a turns on its support, or stuck.
+    """
+    if u.shape[0] > 0 and hold_inputs(p.data, u):
+        forget_signals(p)
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    for j in range(p.lossy.shape[0]):
+        r = p.lossy[j]
+        w_a = _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
+        m[p.elem[r, E_MODE]] = GEAR_FWD_A if w_a > 0.0 else GEAR_BWD_A if w_a < 0.0 else GEAR_STUCK
+    for j in range(p.swit.shape[0]):
+        r = p.swit[j]
+        phi = _spring_deflection(p, r, x, n)
+        w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+        k = p.elem[r, E_MODE]
+        if p.elem[r, E_LAW] == SPRING_CURVE:
+            s = p.elem[r, E_TABLE]
+            xs = p.data[s:s + p.elem[r, E_TABLE_N]]
+            m[k] = np.searchsorted(xs, phi, side="left") if w_rel < 0.0 else np.searchsorted(xs, phi, side="right")
+            continue
+        b2 = 0.5 * p.coef[r, C_GAP]
+        upper = phi > b2 or (phi == b2 and w_rel > 0.0)
+        lower = phi < -b2 or (phi == -b2 and w_rel < 0.0)
+        m[k] = LASH_UPPER if upper else LASH_LOWER if lower else LASH_GAP
+        if upper or lower:   # which part of the law: side * tau_c = a, side * tau_d = b
+            side = 1.0 if upper else -1.0
+            a = side * p.coef[r, C_STIFF] * (phi - side * b2)
+            b = side * p.coef[r, C_DAMP] * w_rel
+            if p.elem[r, E_AUX] == LASH_MSL and b >= a:
+                m[k] = LASH_UPPER_LIMITED if upper else LASH_LOWER_LIMITED
+            elif a + b <= 0.0 and a > 0.0:   # beyond the edge, the contact would pull: released (both laws)
+                m[k] = LASH_UPPER_RELEASED if upper else LASH_LOWER_RELEASED
+    for k in range(nf):
+        r = p.fric[k]
+        w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+        m[k] = FREE if _is_free(p, r, t) else FORWARD if w_rel > 0.0 else BACKWARD if w_rel < 0.0 else STUCK
+    stored = 0.0
+    for i in range(n):
+        stored += 0.5 * p.inertia[i] * x[n + i] ** 2
+    for r in range(p.elem.shape[0]):
+        if p.elem[r, E_KIND] == K_SPRING:
+            stored += spring_energy(p, r, x, n, m)
+    p.work[p.work.shape[0] - 1] = stored
+
+
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
 # (the last, "table", is not an invariant but a model error every run checks, :func:`table_error`: its message has no
@@ -4207,6 +4266,18 @@ def driveline_watch(t, x, u, m, p, dx, g, k):
             return
 
 
+#: :func:`driveline_start` through its address: it runs once per run (and per call of a session or model exchange
+#: that asks for it), so it is compiled once, not into each entry of the core that may start a run
+_start_outlined = outlined(driveline_start, lambda: (types.float64, _F1, _F1, _I1, _params_type()), types.none)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def driveline_start_hook(t, x, u, m, p):
+    """:func:`driveline_start` through its address (the core's ``start`` hook)."""
+    _start_outlined(t, x, u, m, p)
+
+
 dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
-                  jacobian=driveline_jacobian, rhs_event=driveline_rhs_event, watch=driveline_watch)
+                  jacobian=driveline_jacobian, rhs_event=driveline_rhs_event, watch=driveline_watch,
+                  start=driveline_start_hook)

@@ -28,7 +28,7 @@ import numpy as np
 
 from .._limits import as_numbers, check_number
 from ..errors import ParameterError
-from ..numerics import outline
+from ..numerics import core, outline
 from ..params.base import ABSOLUTE_ZERO_C
 from ..units import COLUMN_UNITS
 from ..system import System, register_model, simulate as _simulate
@@ -464,7 +464,8 @@ def _curve_integrals(xs, fs, ds, kind):
 
 
 def _curve_energy_py(table, m, kind, phi):
-    """Python twin of :func:`clutchlab.driveline.kernel._curve_energy` (the initial stored energy)."""
+    """The curve's energy at ``phi`` as :func:`clutchlab.driveline.kernel._segment_energy` integrates it (at build
+    time: the integration constants that make the stored energy 0 at zero deflection)."""
     xs, fs, ds, cs = table[:m], table[m:2 * m], table[2 * m:3 * m], table[3 * m:4 * m]
     if phi <= xs[0] or phi >= xs[-1]:
         end = 0 if phi <= xs[0] else m - 1
@@ -1768,28 +1769,8 @@ class Driveline:
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
                               np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2), thermal, links)
-        x0 = self.initial_state()
-        work[-1] = 0.5 * float(np.sum(inertia * x0[n:2 * n] ** 2)) + self._spring_energy(p, x0)
+        self._initial_modes(p, self.initial_state())   # (and the start's stored energy, work[-1])
         return p, port_rows
-
-    def _spring_energy(self, p, x0):
-        """Energy stored in the springs at ``x0`` [J] (as :func:`~clutchlab.driveline.kernel.spring_energy`)."""
-        total = 0.0
-        for r, e in enumerate(self._elements):
-            if e.kind != K.K_SPRING:
-                continue
-            pa = 0.0 if e.a is None else x0[list(self._inertias).index(e.a)]
-            pb = 0.0 if e.b is None else x0[list(self._inertias).index(e.b)]
-            phi = pb - pa - e.coef[2]
-            if e.law == K.SPRING_CURVE:
-                m = len(e.table) // 4
-                total += _curve_energy_py(np.asarray(e.table), m, e.aux, phi)
-            elif e.law == K.SPRING_BACKLASH:   # in the initial contact mode, from the deflection
-                q = abs(phi) - 0.5 * e.coef[3]
-                total += 0.5 * e.coef[0] * q * q if q > 0 else 0.0
-            else:
-                total += 0.5 * e.coef[0] * phi * phi
-        return total
 
     def _thermal_offset(self) -> int:
         """Where the thermal masses' states start in the state vector: after the angles, the speeds, one energy per
@@ -1874,54 +1855,21 @@ class Driveline:
         return x
 
     def _initial_modes(self, p, x0):
-        """Friction modes from the initial relative speeds and normal forces, then the backlash contacts
-        from the deflections (at the edge of the gap, in contact if moving into it) and the segments of the
-        curve springs (at a point, the segment it moves onto); lossy gears roll the way their flange a turns on
-        their support, or are stuck (the restart at t0 settles them)."""
+        """The modes a run starts from, guessed from the initial state (the restart at t0 settles them at the
+        forces), and the stored energy the energy balance starts from, in ``p.work[-1]``: both by the compiled
+        :func:`~clutchlab.driveline.kernel.driveline_start`, the run's own ``start`` (so a native FMU decides them
+        again from the initial speeds a host sets).  A one-way clutch may not start turning backward."""
         n = len(self._inertias)
-        m = np.empty(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
-        for j, r in enumerate(p.lossy):   # rolling the way flange a turns on its support, or stuck (the restart
-            e = p.elem[r]                 # at t0 settles them and the flange that drives)
-            w_a = (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]]) - (0.0 if e[K.E_SUP] < 0 else x0[n + e[K.E_SUP]])
-            m[p.fric.size + p.swit.size + j] = K.GEAR_FWD_A if w_a > 0 else K.GEAR_BWD_A if w_a < 0 else K.GEAR_STUCK
-        for j, r in enumerate(p.swit):
-            e = self._elements[r]
-            pa = 0.0 if e.a is None else x0[p.elem[r][K.E_A]]
-            pb = 0.0 if e.b is None else x0[p.elem[r][K.E_B]]
-            w_rel = (0.0 if e.b is None else x0[n + p.elem[r][K.E_B]]) - (0.0 if e.a is None else x0[n + p.elem[r][K.E_A]])
-            phi = pb - pa - e.coef[2]
-            if e.law == K.SPRING_CURVE:
-                xs = np.asarray(e.table[:len(e.table) // 4])
-                m[p.fric.size + j] = int(np.searchsorted(xs, phi, side="left" if w_rel < 0 else "right"))
-                continue
-            b2 = 0.5 * e.coef[3]
-            upper = phi > b2 or (phi == b2 and w_rel > 0)
-            lower = phi < -b2 or (phi == -b2 and w_rel < 0)
-            m[p.fric.size + j] = K.LASH_UPPER if upper else K.LASH_LOWER if lower else K.LASH_GAP
-            if upper or lower:   # which part of the law: s tau_c = a, s tau_d = b
-                s = 1.0 if upper else -1.0
-                a, b = s * e.coef[0] * (phi - s * b2), s * e.coef[1] * w_rel
-                if e.aux == K.LASH_MSL and b >= a:
-                    m[p.fric.size + j] = K.LASH_UPPER_LIMITED if upper else K.LASH_LOWER_LIMITED
-                elif a + b <= 0.0 and a > 0.0:   # beyond the edge, the contact would pull: released (both laws)
-                    m[p.fric.size + j] = K.LASH_UPPER_RELEASED if upper else K.LASH_LOWER_RELEASED
-        for k, r in enumerate(p.fric):
+        for r in p.fric:
             e = p.elem[r]
             w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
-            el = self._elements[r]
-            if el.law == K.LAW_CLUTCH and el.ncurve:   # as kernel._is_free: beyond lift-off, or at it and not coming back
-                value, rate = el.signal.value_and_rate(0.0, self._input_starts())
-                free = value > el.liftoff or (value == el.liftoff and rate >= 0.0)
-            elif el.law == K.LAW_CLUTCH:   # as kernel._is_free: negative, or zero and not rising
-                value, rate = (1.0, 0.0) if el.signal is None else el.signal.value_and_rate(0.0, self._input_starts())
-                fn, dfn = el.coef[0] * value, el.coef[0] * rate
-                free = fn < 0.0 or (fn == 0.0 and dfn <= 0.0)
-            else:
-                free = False
             if e[K.E_LAW] == K.LAW_ONEWAY and w_rel < 0:
                 raise ParameterError(f"{self._elements[r].name}: a one-way clutch cannot start with flange b slower "
                                      f"than flange a (w_b - w_a = {w_rel:g} rad/s)")
-            m[k] = K.FREE if free else K.FORWARD if w_rel > 0 else K.BACKWARD if w_rel < 0 else K.STUCK
+        m = np.zeros(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
+        u0 = np.array([v[1] for v in self._inputs.values()], dtype=float)
+        # (through the core's entry, as a run calls it: one compiled specialisation, the run's)
+        core.start(p, 0.0, np.ascontiguousarray(x0, dtype=float), u0, m)
         return m
 
     def variables(self):
@@ -2004,6 +1952,7 @@ class Driveline:
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         m0 = self._initial_modes(p, x0)
+        named_modes = m0   # (the network's own: driveline_start decides them)
         n = len(self._inertias)
         atol = float(rtol) * np.ones(self._state_count())
         events = K.EVENTS
@@ -2063,7 +2012,9 @@ class Driveline:
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=inputs, u0=u0, x0=x0,
                       m0=m0, atol=atol, switching=switching, events=events, mode_names=mode_names,
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
-                      element_name=element_name, error_messages=error_messages)
+                      element_name=element_name, error_messages=error_messages,
+                      decided_at_start=(("m", 0, len(named_modes)),
+                                        ("params.net.work" if wet or emtcs else "params.work", -1, None)))
 
     def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel, port_rows):
         """The network's parameters, initial state and modes and absolute tolerances joined with its wet clutches'

@@ -574,9 +574,10 @@ class ContractCoSimulation(CoSimulation):
         self._hold(self.resolve_inputs(inputs))
 
     def initial_outputs(self, inputs: dict) -> dict:
-        """Outputs at t = 0 with the given inputs held."""
+        """Outputs at t = 0 with the given inputs held, the modes the run starts from decided at them (the model's
+        ``start``, as a native FMU decides them at its initialisation)."""
         self.hold_inputs(inputs)
-        return self._output_dict(self.simulation.reported())
+        return self._output_dict(self.simulation.reported(start=True))
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:
         """Advance from ``t`` to ``t + dt`` [s] with ``inputs`` held; outputs at ``t + dt``."""

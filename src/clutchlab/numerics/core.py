@@ -26,6 +26,9 @@ Both share the hybrid logic:
   the located length), and the model's ``update`` is called
   for every function that crossed there, which changes the modes and records
   named events (:func:`record`);
+* a run that has not started calls the model's ``start`` (what it derives
+  from its initial state alone: the modes it starts from) before its first
+  ``restart``;
 * ``next_break`` times (input table corners, controller samples) end a step
   exactly and call the model's ``restart``;
 * after every accepted step the model's ``accept`` runs (hysteresis memory
@@ -757,6 +760,8 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     atol = opt.atol
     mass = opt.mass
     status = SUCCESS
+    if si[SI_STARTED] == 0:   # what the run derives from its initial state (the model's start modes)
+        model.start(t, x, u, m, p)
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, k1, g0)
     model.watch(t, x, u, m, p, k1, g0, -1)
@@ -1159,6 +1164,8 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     t = sf[SF_T]
     h = sf[SF_H]
     status = SUCCESS
+    if si[SI_STARTED] == 0:   # what the run derives from its initial state (the model's start modes)
+        model.start(t, x, u, m, p)
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, f0, g0)
     model.watch(t, x, u, m, p, f0, g0, -1)
@@ -1383,6 +1390,15 @@ def _evaluate_jacobian(p, t, x, u, m, J):
 
 
 @register_jitable
+def _start(p, t, x, u, m):
+    """The model's ``start`` at ``(t, x, u)``: the modes ``m`` (and what else it derives) from the state alone, as a run
+    that has not started decides them (a co-simulation's outputs before its first step)."""
+    p = byref(borrow(p))
+    model.prepare(p)
+    model.start(t, x, u, m, p)
+
+
+@register_jitable
 def _evaluate_outputs(p, t, x, u, m, y):
     p = byref(borrow(p))
     model.prepare(p)
@@ -1593,6 +1609,12 @@ def evaluate_jacobian(p, t, x, u, m, J):
 def evaluate_outputs(p, t, x, u, m, y):
     """The model's outputs ``y`` at one point ``(t, x, u, m)``."""
     fast_entry(type(p), "dopri", "evaluate_outputs")(p, t, x, u, m, y)
+
+
+def start(p, t, x, u, m):
+    """The model's ``start`` at ``(t, x, u)``: the modes ``m`` a run starts from (and what else the model derives from
+    its initial state alone), as the run itself decides them; nothing for a model without the hook."""
+    fast_entry(type(p), "dopri", "start")(p, t, x, u, m)
 
 
 def outputs_at(p, T, X, u, M, Y):

@@ -70,6 +70,14 @@ and the parameters ``p``):
     structures that may have been copied or rewritten since the last one (the driveline's EMTC couplings
     build each coupling's parameter structure from its stacked rows once per call, not at every
     evaluation: :mod:`clutchlab.driveline.emtc`).  Nothing for a model that does not give it.
+``start(t, x, u, m, p)`` (optional)
+    Decides what a run derives from its initial state alone, once, before its first ``restart``: the modes
+    it starts from and the quantities its outputs compare with the start (the driveline: each element's mode
+    from the sign of its relative speed, and the stored energy its energy balance starts from).  The core
+    calls it when a run has not started (:data:`~clutchlab.numerics.core.SI_STARTED`), a session when asked
+    (``START``: a native FMU after a host set start values) and model exchange at its first restart.  Being
+    compiled, it is also what the model's Python side calls for its initial modes, so the modes a run starts
+    from are written once.  Nothing for a model that does not give it.
 ``time_derivative(t, x, u, m, p, ft)`` (optional)
     Fills ``ft = df/dt`` at fixed state (inputs that vary within a step,
     for the Rosenbrock stages) and returns True; False (the default for a
@@ -87,13 +95,13 @@ from numba.extending import overload
 from .borrow import ByRef
 
 __all__ = ["register", "registered", "inlines_stages", "hook_sources", "rhs", "rhs_stage", "rhs_event", "outputs", "update", "restart", "accept",
-           "next_break", "jacobian", "time_derivative", "no_time_derivative", "watch", "no_watch"]
+           "next_break", "jacobian", "time_derivative", "no_time_derivative", "watch", "no_watch", "start", "no_start"]
 
 HOOKS = ("rhs", "outputs", "update", "restart", "accept", "next_break", "jacobian")
 #: hooks a model may leave out (``time_derivative``: the core differences the right-hand side in time;
 #: ``rhs_event``: the right-hand side where the core evaluates it at events, its ``rhs`` if not given;
-#: ``watch``, ``prepare``: nothing)
-OPTIONAL_HOOKS = ("time_derivative", "rhs_event", "watch", "prepare")
+#: ``watch``, ``prepare``, ``start``: nothing)
+OPTIONAL_HOOKS = ("time_derivative", "rhs_event", "watch", "prepare", "start")
 
 
 def no_time_derivative(t, x, u, m, p, ft):
@@ -321,10 +329,29 @@ def prepare(p):  # pragma: no cover
     raise NotImplementedError
 
 
+def no_start(t, x, u, m, p):
+    """What the ``start`` stub compiles to for a model without the hook: nothing (compiled into the caller)."""
+    return None
+
+
+def _default_start(t, x, u, m, p):
+    """Typing of the ``start`` stub for a registered model that does not give the hook."""
+    q = p.pointee if isinstance(p, ByRef) else p
+    if isinstance(q, types.BaseNamedTuple) and q.instance_class in _MODELS and "start" not in _MODELS[q.instance_class]:
+        return no_start
+    return None
+
+
+def start(t, x, u, m, p):  # pragma: no cover
+    raise NotImplementedError
+
+
 # models without a ``watch`` hook: the stub compiles to nothing inside the caller
 overload(watch, jit_options={"cache": False})(functools.wraps(watch)(_default_watch))
 # models without a ``prepare`` hook: the same
 overload(prepare, jit_options={"cache": False})(functools.wraps(prepare)(_default_prepare))
+# models without a ``start`` hook: the same
+overload(start, jit_options={"cache": False})(functools.wraps(start)(_default_start))
 
 # models without a ``time_derivative`` hook: the stub compiles to ``return False`` inside the caller
 overload(time_derivative, jit_options={"cache": False})(
@@ -333,4 +360,4 @@ overload(time_derivative, jit_options={"cache": False})(
 #: (stub, hook it resolves to)
 _STUBS = ((rhs, "rhs"), (rhs_stage, "rhs"), (rhs_event, "rhs_event"), (outputs, "outputs"), (update, "update"), (restart, "restart"),
           (accept, "accept"), (next_break, "next_break"), (jacobian, "jacobian"),
-          (time_derivative, "time_derivative"), (watch, "watch"), (prepare, "prepare"))
+          (time_derivative, "time_derivative"), (watch, "watch"), (prepare, "prepare"), (start, "start"))

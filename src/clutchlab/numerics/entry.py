@@ -155,6 +155,11 @@ def evaluate_outputs(p, t, x, u, m, y):
 
 
 @numba.njit(cache=True, nogil=True)
+def start(p, t, x, u, m):
+    _core._start(p, t, x, u, m)
+
+
+@numba.njit(cache=True, nogil=True)
 def outputs_at(p, T, X, u, M, Y):
     _core._outputs_at(p, T, X, u, M, Y)
 

@@ -20,6 +20,9 @@ session's model exactly those operations, compiled as each model's ``model_excha
 ``ME_RESTART``
     the modes decided again from the state and inputs (initialisation, a time event, inputs changed):
     the model's ``restart``, then ``rhs_event`` and ``watch`` as at the core's breaks.
+``ME_START``
+    before the others: the model's ``start`` (what it derives from its initial state alone: its start modes),
+    at the initialisation, again after a host set a start value.
 ``ME_STORE``
     after the others: ``g0 = g1`` (the functions an event is looked for against).
 ``ME_OUTPUTS``
@@ -58,13 +61,13 @@ from .layout import bits
 from .rosenbrock import lu_factor, lu_solve
 from .session import _args, fill_report
 
-__all__ = ["call", "FIELDS", "ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART", "ME_STORE", "ME_OUTPUTS",
+__all__ = ["call", "FIELDS", "ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART", "ME_STORE", "ME_OUTPUTS", "ME_START",
            "ALGEBRAIC_FAILED", "NEWTON_ITERATIONS", "workspace"]
 
 #: what a model-exchange call may be asked for, one bit each (a native FMU's C layer gets them as #defines)
-ME_REQUESTS = ("derivatives", "accept", "event", "restart", "store", "outputs")
-ME_DERIVATIVES, ME_ACCEPT, ME_EVENT, ME_RESTART, ME_STORE, ME_OUTPUTS = bits(
-    ME_REQUESTS, "derivatives", "accept", "event", "restart", "store", "outputs")
+ME_REQUESTS = ("derivatives", "accept", "event", "restart", "store", "outputs", "start")
+ME_DERIVATIVES, ME_ACCEPT, ME_EVENT, ME_RESTART, ME_STORE, ME_OUTPUTS, ME_START = bits(
+    ME_REQUESTS, "derivatives", "accept", "event", "restart", "store", "outputs", "start")
 
 #: a model error of the exchange itself: the algebraic rows' Newton iteration did not converge
 ALGEBRAIC_FAILED = -9001
@@ -142,6 +145,8 @@ def call(s, what):
     model.prepare(p)
     t = sf[SF_T]
     code = 0
+    if what & ME_START:
+        model.start(t, x, u, m, p)
     if alg.shape[0] and what & (ME_DERIVATIVES | ME_EVENT | ME_RESTART | ME_OUTPUTS):
         # (the algebraic rows solved for the differential states the host set; again after an event or a
         # restart that moved them or changed the modes)

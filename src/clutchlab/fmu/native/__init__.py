@@ -39,7 +39,7 @@ from pathlib import Path
 
 from ...errors import ClutchlabError, ParameterError
 from ...numerics.layout import indices
-from .image import NativeExportError, accepted_range, parameter_map, session_image
+from .image import NativeExportError, accepted_range, law_holds, parameter_map, session_image
 
 __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
 
@@ -189,7 +189,7 @@ def differential_states(image):
 def _model_header(name, ident, guid, images, functions, variables, layouts, fixed_step, system,
                   step_grid_vr: int = -1) -> str:
     from ...numerics import exchange as X, status as st
-    from ...numerics.session import ADVANCE, OUTPUTS
+    from ...numerics.session import ADVANCE, OUTPUTS, START
     from ...system import FIXED_STEP_BUDGET
 
     cs = images[0]
@@ -199,7 +199,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
              "#include <stdint.h>",
              f"#define CL_MODEL_IDENTIFIER {_c_string(ident)}", f"#define CL_MODEL_NAME {_c_string(name)}",
              f"#define CL_GUID {_c_string(guid)}",
-             f"#define CL_ADVANCE {ADVANCE}", f"#define CL_OUTPUTS {OUTPUTS}",
+             f"#define CL_ADVANCE {ADVANCE}", f"#define CL_OUTPUTS {OUTPUTS}", f"#define CL_START {START}",
              f"#define CL_FIXED_STEP {_c_double(fixed_step)}", f"#define CL_FIXED_STEP_BUDGET {_c_double(FIXED_STEP_BUDGET)}",
              f"#define CL_STEP_GRID_VR {int(step_grid_vr)}",
              f"#define CL_STATUS_SUCCESS {st.SUCCESS}", f"#define CL_STATUS_TERMINATED {st.TERMINATED}",
@@ -211,7 +211,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
              f"#define CL_ME_ALGEBRAIC_FAILED {X.ALGEBRAIC_FAILED}",
              f"#define CL_NINDICATORS {gdir.size}u", f"#define CL_HAS_ME {int(exchange)}",
              *(f"#define CL_{k} {getattr(X, k)}" for k in ("ME_DERIVATIVES", "ME_ACCEPT", "ME_EVENT", "ME_RESTART",
-                                                         "ME_STORE", "ME_OUTPUTS")), ""]
+                                                         "ME_STORE", "ME_OUTPUTS", "ME_START")), ""]
     # the compiled functions (hidden symbols of the model's object code)
     lines += [f"extern int32_t cl_session_call(int64_t *, void **, void *, double, int64_t) "
               f"__asm__({_c_string(functions.session)});",
@@ -496,26 +496,18 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         if key == ((), ()):   # (built afresh: two builds of the same values tell the model's uninitialised memory)
             built.pop(key, None)
         if key not in built:
+            import warnings
+
             try:
-                obj = cls(**(parameters or {}))
-                obj.hold_inputs(inputs or {})
-            except (ParameterError, ValueError):
+                with warnings.catch_warnings():   # (values far out: overflow warnings of a model that takes them)
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    obj = cls(**(parameters or {}))
+                    obj.hold_inputs(inputs or {})
+            except (ClutchlabError, ValueError, ArithmeticError):   # (refused, or a build that fails there)
                 built[key] = None
             else:
                 built[key] = tuple(session_image(obj.simulation, exchange=k) for k in kinds)
         return built[key]
-
-    def accepts(parameters):
-        """Whether the model takes these parameter values (built without its images: a range probe)."""
-        import warnings
-
-        try:
-            with warnings.catch_warnings():   # (values far out: overflow warnings of a model that takes them)
-                warnings.simplefilter("ignore", RuntimeWarning)
-                cls(**parameters).hold_inputs({})
-        except (ClutchlabError, ValueError, ArithmeticError):   # (refused, or a build that fails there)
-            return False
-        return True
 
     def pick(images_or_none, k):
         return None if images_or_none is None else images_or_none[k]
@@ -544,9 +536,16 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             # a whole number the model refuses halves of (a count of friction pairs): the FMU refuses them too
             half = float(v.start) + 0.5 if v.maximum is None or float(v.start) + 0.5 <= v.maximum else float(v.start) - 0.5
             whole = build(parameters={v.name: half}) is None
-        if writable:   # the interval the model accepts, where its own code refuses more than the declared range
-            low, high = accepted_range(lambda x, name=v.name: accepts({name: x}), float(v.start), v.minimum,
-                                       v.maximum, v.positive, whole)
+        if writable:
+            # the interval the model accepts (where its own code refuses more than the declared range) and where
+            # the laws found near the start hold (an absolute tolerance with a floor: rtol's range ends there)
+            def takes(x, name=v.name):
+                got = build(parameters={name: x})
+                return got is not None and all(law_holds(images[k], where[k], got[k], {name: x})
+                                               for k in range(len(kinds)))
+
+            low, high = accepted_range(takes, float(v.start), v.minimum, v.maximum, v.positive, whole)
+            built.clear()
             # (a positive one's lower end 0 is its strict > 0, already declared)
             minimum = v.minimum if low is None or v.positive and low == 0.0 else low
             maximum = v.maximum if high is None else high

@@ -135,7 +135,11 @@ static void cl_load_image(cl_instance *c) {
 static int cl_call(cl_instance *c, double t_end, int64_t what, int64_t *code) {
     int64_t result = 0;
     void *excinfo = NULL;
-    int32_t status = c->L->exchange ? cl_exchange_call(&result, &excinfo, c->mem, what)
+    int32_t status;
+    /* before the run: what the model derives from its initial state (its start modes, the stored energy an
+       energy balance starts from) decided again from the start values the host may have set */
+    if (c->state == CL_INSTANTIATED || c->state == CL_INITIALIZATION) what |= c->L->exchange ? CL_ME_START : CL_START;
+    status = c->L->exchange ? cl_exchange_call(&result, &excinfo, c->mem, what)
                                      : cl_session_call(&result, &excinfo, c->mem, t_end, what);
     if (status != 0 && status != -2) { /* (-2: returned None; anything else an exception) */
         cl_log(c, fmi2Error, "logStatusError",
