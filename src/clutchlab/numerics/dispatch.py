@@ -74,8 +74,9 @@ and the parameters ``p``):
     Decides what a run derives from its initial state alone, once, before its first ``restart``: the modes
     it starts from and the quantities its outputs compare with the start (the driveline: each element's mode
     from the sign of its relative speed, and the stored energy its energy balance starts from).  The core
-    calls it when a run has not started (:data:`~clutchlab.numerics.core.SI_STARTED`), a session when asked
-    (``START``: a native FMU after a host set start values) and model exchange at its first restart.  Being
+    calls it when a run has not started (:data:`~clutchlab.numerics.core.SI_STARTED`); a session and model
+    exchange when asked (``START``, ``ME_START``: a native FMU at every call before its run, after a host may
+    have set start values; a co-simulation's outputs before its first step).  Being
     compiled, it is also what the model's Python side calls for its initial modes, so the modes a run starts
     from are written once.  Nothing for a model that does not give it.
 ``time_derivative(t, x, u, m, p, ft)`` (optional)

@@ -18,8 +18,9 @@ addresses of the compiled functions linked into the FMU's library.  Where a vari
 again with it changed (the co-simulation class builds it from the component declarations or parameter
 sets): one whose every changed number is ``a * value + b`` (most are copies, ``a = 1, b = 0``) or
 ``a / value + b`` (a time constant kept as a rate) is written by the native FMU itself.  One that changes the
-image in any other way (an initial speed that decides a start mode, a table rebuilt, the arrays' sizes, a
-number two parameters share) is fixed at export.  The words the model's compiled ``start`` derives from the
+image in any other way (a table rebuilt, the arrays' sizes, a number two parameters share) is fixed at
+export, and a writable one's range ends where its law stops holding (:func:`law_holds`, searched by
+:func:`accepted_range` as the values the model refuses are).  The words the model's compiled ``start`` derives from the
 initial state (:attr:`clutchlab.system.System.decided_at_start`: a driveline's start modes and the stored
 energy its energy balance starts from) are no parameter's target: the FMU runs ``start`` again after a host
 set start values (before the run, :mod:`clutchlab.fmu.native`), so an initial speed is a copy into the
