@@ -512,8 +512,8 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     def pick(images_or_none, k):
         return None if images_or_none is None else images_or_none[k]
 
-    where = [parameter_map(cls.parameters, images[k], lambda v, k=k: pick(build(parameters=v), k), cls.__name__)
-             for k in range(len(kinds))]
+    where = [parameter_map(cls.parameters, images[k], lambda v, k=k: pick(build(parameters=v), k), cls.__name__,
+                           one_sided=True) for k in range(len(kinds))]
     inputs_at = [parameter_map(cls.inputs, images[k], lambda v, k=k: pick(build(inputs=v), k), cls.__name__)
                  for k in range(len(kinds))]
     built.clear()

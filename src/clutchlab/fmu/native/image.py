@@ -326,7 +326,7 @@ def _fit(v0, v1, v2, y0, y1, y2):
     return None
 
 
-def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
+def parameter_map(variables, base: Image, build, label: str = "model", one_sided: bool = False) -> dict:
     """Where each of ``variables`` (parameters, or inputs) lands in the image ``base`` (module docstring).
 
     Parameters
@@ -340,6 +340,10 @@ def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
         their start), or None if the model refuses the values.
     label : str
         For messages.
+    one_sided : bool
+        Where the law changes at the start (a line on each side), take the one below it: for
+        parameters, whose range the exporter then ends at the start on the other side (:func:`law_holds`); not
+        for inputs, which have no such range.
 
     Returns
     -------
@@ -357,63 +361,91 @@ def parameter_map(variables, base: Image, build, label: str = "model") -> dict:
     skip = np.zeros_like(noise)
     for slot in base.pointer_slots:
         skip[slot // 8] = True
-    out = {}
-    f0 = w0.view(np.float64)
+    out = ParameterMap()
+    out.trial = {}
+    sided = set()   # (found on one side of the start only)
     for var in variables:
         v0 = float(var.start)
         images = []
         for trial in _trials(var):
             img = build({var.name: trial})
-            if img is not None:
+            if img is not None and base.same_layout(img):
                 images.append((trial, img))
             if len(images) == 2:
                 break
-        if len(images) < 2 or not all(base.same_layout(img) for _, img in images):
-            out[var.name] = None
-            continue
-        (v1, i1), (v2, i2) = images
-        w1, w2 = _words(i1), _words(i2)
-        # (a word that differs between two builds of the same values is memory the model never initialised:
-        # not a target, and no reason to refuse one)
-        changed = ((w1 != w0) | (w2 != w0)) & ~noise
-        if np.any(changed & skip):
-            out[var.name] = None
-            continue
-        targets = []
-        f1, f2 = w1.view(np.float64), w2.view(np.float64)
-        ok = True
-        for k in np.flatnonzero(changed):
-            y0, y1, y2 = float(f0[k]), float(f1[k]), float(f2[k])
-            if not all(math.isfinite(y) and (y == 0.0 or abs(y) >= 2.2250738585072014e-308) for y in (y0, y1, y2)):
-                ok = False   # (not a float: an integer, a flag)
-                break
-            law = _fit(v0, v1, v2, y0, y1, y2)
-            if law is None:
-                ok = False
-                break
-            targets.append(Target(int(k) * 8, *law))
-        out[var.name] = tuple(targets) if ok else None
+        out[var.name] = None
+        # the two trials around the start; where the law changes there (an absolute tolerance that follows rtol
+        # only below the model's default), the two below it: the range then ends at the start above (law_holds,
+        # searched by accepted_range)
+        targets = _law(w0, noise, skip, v0, images[0], images[1]) if len(images) >= 2 else None
+        if targets is not None:
+            out[var.name] = targets
+            out.trial[var.name] = images[0][0]
+        elif one_sided:
+            # a kink at the start: a line on each side (each side's two trials and the start follow one), the one
+            # below taken (a tolerance a host tightens); a law that holds on neither side stays fixed
+            # (trials a tenth or more from the start: one apart from a large whole number shows no curve)
+            far = [c for c in _trials(var) if abs(c - v0) >= 0.1 * abs(v0)]
+            below, above = [], []
+            for side, values in ((below, [c for c in far if c < v0]), (above, [c for c in far if c > v0])):
+                for c in values:
+                    img = build({var.name: c})
+                    if img is not None and base.same_layout(img):
+                        side.append((c, img))
+                    if len(side) == 2:
+                        break
+            if len(below) == 2 and len(above) == 2:
+                lower = _law(w0, noise, skip, v0, *below)
+                if lower is not None and _law(w0, noise, skip, v0, *above) is not None:
+                    out[var.name] = lower
+                    out.trial[var.name] = below[0][0]
+                    sided.add(var.name)
     # a number two parameters change (a sum, a product: a clutch's mu and mu_scale) cannot be written by either
     # while the other may change too: the first in declaration order stays writable (the others fixed at their
-    # start, it alone changes that number, as it was found to), the others are fixed
+    # start, it alone changes that number, as it was found to), the others are fixed; one whose law holds on
+    # both sides of its start before one that has a law below it only (the E-clutch's actuator.ki before its rtol,
+    # whose tolerance of the controller's integral both change)
     owners = {}
     for name, targets in out.items():
         for t in targets or ():
             owners.setdefault(t.offset, []).append(name)
     for names in owners.values():
-        for name in names[1:]:
+        for name in sorted(names, key=lambda n: n in sided)[1:]:
             out[name] = None
-    out = ParameterMap(out)
     out.ignore = noise | skip
     return _checked_jointly(variables, base, build, out, noise | skip)
 
 
+def _law(w0: np.ndarray, noise: np.ndarray, skip: np.ndarray, v0: float, trial1, trial2):
+    """The targets of a parameter from the images of two trials ``(value, image)`` beside the start's words ``w0``
+    (a tuple of :class:`Target`, empty if it changes nothing), or None if a changed word follows no law."""
+    (v1, i1), (v2, i2) = trial1, trial2
+    w1, w2 = _words(i1), _words(i2)
+    # (a word that differs between two builds of the same values is memory the model never initialised:
+    # not a target, and no reason to refuse one)
+    changed = ((w1 != w0) | (w2 != w0)) & ~noise
+    if np.any(changed & skip):
+        return None
+    targets = []
+    f0, f1, f2 = w0.view(np.float64), w1.view(np.float64), w2.view(np.float64)
+    for k in np.flatnonzero(changed):
+        y0, y1, y2 = float(f0[k]), float(f1[k]), float(f2[k])
+        if not all(math.isfinite(y) and (y == 0.0 or abs(y) >= 2.2250738585072014e-308) for y in (y0, y1, y2)):
+            return None   # (not a float: an integer, a flag)
+        law = _fit(v0, v1, v2, y0, y1, y2)
+        if law is None:
+            return None
+        targets.append(Target(int(k) * 8, *law))
+    return tuple(targets)
+
+
 class ParameterMap(dict):
-    """:func:`parameter_map`'s result: name -> tuple of :class:`Target` or None (fixed at export), and ``ignore``,
-    the words a comparison of two images leaves out (memory the model never initialised, pointers, the words its
-    ``start`` decides)."""
+    """:func:`parameter_map`'s result: name -> tuple of :class:`Target` or None (fixed at export); ``ignore``, the
+    words a comparison of two images leaves out (memory the model never initialised, pointers, the words its
+    ``start`` decides); ``trial``, name -> the value a writable one's law was found at first (the joint build's)."""
 
     ignore: np.ndarray
+    trial: dict
 
 
 def law_holds(base: Image, where: ParameterMap, img: Image, values: dict) -> bool:
@@ -529,14 +561,17 @@ def _written(where: dict, values: dict) -> np.ndarray:
     return np.array(sorted({t.offset // 8 for name in values for t in where[name] or ()}), dtype=np.int64)
 
 
-def _joint_values(variables, names) -> dict:
-    """The joint build's values of the variables ``names``: their first trial values."""
+def _joint_values(variables, names, where) -> dict:
+    """The joint build's values of the variables ``names``: the trial values their laws were found at first."""
     changed = {}
     for var in variables:
         if var.name in names:
-            trials = _trials(var)
-            if trials:
-                changed[var.name] = trials[0]
+            trial = where.trial.get(var.name)
+            if trial is None:
+                trials = _trials(var)
+                trial = trials[0] if trials else None
+            if trial is not None:
+                changed[var.name] = trial
     return changed
 
 
@@ -552,12 +587,12 @@ def _checked_jointly(variables, base: Image, build, where: dict, ignore: np.ndar
     return where
 
 
-def _refused(variables, base, build, names) -> bool:
-    img = build(_joint_values(variables, set(names)))
+def _refused(variables, base, build, names, where) -> bool:
+    img = build(_joint_values(variables, set(names), where))
     return img is None or not base.same_layout(img)
 
 
-def _minimal_refused(variables, base, build, names) -> list:
+def _minimal_refused(variables, base, build, names, where) -> list:
     """A smallest subset of ``names`` (refused together) that the model still refuses (ddmin on the
     complements)."""
     s, n = list(names), 2
@@ -566,7 +601,7 @@ def _minimal_refused(variables, base, build, names) -> list:
         chunks = [s[i:i + size] for i in range(0, len(s), size)]
         for chunk in chunks:
             rest = [x for x in s if x not in chunk]
-            if rest and _refused(variables, base, build, rest):
+            if rest and _refused(variables, base, build, rest, where):
                 s, n = rest, max(n - 1, 2)
                 break
         else:
@@ -581,12 +616,12 @@ def _check_set(variables, base, build, where, ignore, names) -> None:
         names = [n for n in names if where.get(n)]
         if not names:
             return
-        changed = _joint_values(variables, set(names))
+        changed = _joint_values(variables, set(names), where)
         if not changed:
             return
         img = build(changed)
         if img is None or not base.same_layout(img):
-            for name in _minimal_refused(variables, base, build, names):
+            for name in _minimal_refused(variables, base, build, names, where):
                 where[name] = None
             continue
         same = _same_words(_apply(base, where, changed), img, base, _written(where, changed), ignore)
