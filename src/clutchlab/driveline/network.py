@@ -1680,8 +1680,9 @@ class Driveline:
         return self._pack()[0]
 
     def _pack(self) -> tuple:
-        """The packed parameters and each EMTC coupling's port rows: ``{name: [signal row or -1 per port of
-        EMTC_PORTS]}``, their signals packed after every element's (its block reads them: :meth:`_with_components`)."""
+        """The packed parameters, each EMTC coupling's port rows (``{name: [signal row or -1 per port of
+        EMTC_PORTS]}``, their signals packed after every element's: its block reads them, :meth:`_with_components`)
+        and the modes the network starts from (:meth:`_initial_modes`, which also stores the start's energy)."""
         if not self._inertias:
             raise ParameterError(f"{self.name}: no inertia")
         index = {n: i for i, n in enumerate(self._inertias)}
@@ -1769,8 +1770,8 @@ class Driveline:
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
                               np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2), thermal, links)
-        self._initial_modes(p, self.initial_state())   # (and the start's stored energy, work[-1])
-        return p, port_rows
+        m0 = self._initial_modes(p, self.initial_state())   # (and the start's stored energy, work[-1])
+        return p, port_rows, m0
 
     def _thermal_offset(self) -> int:
         """Where the thermal masses' states start in the state vector: after the angles, the speeds, one energy per
@@ -1928,7 +1929,7 @@ class Driveline:
         # with model components only for one (clutchlab.driveline.coupled)
         components = any(el.wet is not None or el.emtc is not None for el in self._elements)
         outline.prepare(lazy=check_invariants, groups=("coupled",) if components else ())
-        p, port_rows = self._pack()
+        p, port_rows, m0 = self._pack()
         if check_invariants:
             p.check[0] = 1.0
             p.check[1] = _check_tol(rtol)
@@ -1951,7 +1952,6 @@ class Driveline:
         swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_KV_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
-        m0 = self._initial_modes(p, x0)
         named_modes = m0   # (the network's own: driveline_start decides them)
         n = len(self._inertias)
         atol = float(rtol) * np.ones(self._state_count())
