@@ -25,6 +25,8 @@ point, for linearisation and tests).
 from __future__ import annotations
 
 import collections
+import contextlib
+import contextvars
 import dataclasses
 import functools
 import math
@@ -42,7 +44,29 @@ from .result import SimulationResult
 __all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
            "checked_grid", "follow_rtol", "check_fixed_step", "check_fixed_step_span", "check_fixed_step_dynamics",
            "fastest_time_constant", "FixedStepWarning", "check_rtol", "check_atol", "RUN_OPTIONS",
-           "RTOL_MIN", "MODELS", "register_model"]
+           "RTOL_MIN", "MODELS", "register_model", "start_checked_later", "start_checks_deferred"]
+
+_START_LATER = contextvars.ContextVar("clutchlab_start_checked_later", default=False)
+
+
+@contextlib.contextmanager
+def start_checked_later():
+    """Within this context a model's build does not refuse an initial state that its compiled ``start`` hook refuses
+    (a one-way clutch turning backward, :mod:`clutchlab.numerics.dispatch`): whoever builds there runs ``start``
+    itself before the run and refuses the state then.  A native FMU's exporter builds its trial models so: the FMU
+    runs the model's ``start`` at its initialisation with the start values the host set, so the range of each
+    initial speed is not cut where it crosses another's at their start values (a constraint between two start
+    values, which no range of one can state)."""
+    token = _START_LATER.set(True)
+    try:
+        yield
+    finally:
+        _START_LATER.reset(token)
+
+
+def start_checks_deferred() -> bool:
+    """Whether a build runs inside :func:`start_checked_later`."""
+    return _START_LATER.get()
 
 #: rows recorded per chunk when every accepted step is kept (memory grows with the run, not with max_steps)
 CHUNK_ROWS = 4096
@@ -990,7 +1014,11 @@ class Simulation:
         """:meth:`_call` through numba's dispatcher with all the arguments (no packed table)."""
         code = st.SUCCESS
         if what & _START:
-            self._dispatch("start", "dopri", (self.system.params, self.time, self.x, self.u, self.m))
+            started = int(self._dispatch("start", "dopri", (self.system.params, self.time, self.x, self.u, self.m)))
+            if started < 0:   # (an initial state the model cannot start from: as the session entry reports it)
+                self._si[self._core.SI_MODEL_CODE] = started
+                self._si[self._core.SI_STATUS] = st.MODEL_ERROR
+                return st.MODEL_ERROR
         if what & _ADVANCE:
             code = int(self._dispatch("advance", self._method(), (
                 self.system.params, self.x, self.m, self.u, t, self._sf, self._si, self._opt, self.log, self._empty,
@@ -1067,7 +1095,9 @@ class Simulation:
         that has not advanced yet (its first advance decides them again, from the same state)."""
         if start and int(self._si[self._core.SI_STARTED]) != 0:
             raise SimulationError(f"{self.system.name}: reported(start=True) after the run has started")
-        self._call(self.time, _OUTPUTS | _START if start else _OUTPUTS)
+        code = self._call(self.time, _OUTPUTS | _START if start else _OUTPUTS)
+        if code != st.SUCCESS:   # (start refused the initial state: the model's message)
+            _check_status(self.system, code, self._si, self.time, True)
         return self._r
 
     def report(self, sources) -> None:

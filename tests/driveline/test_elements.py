@@ -341,7 +341,7 @@ def test_initial_speeds_follow_gears_and_sources_and_conflicts_are_named():
     bad.inertia("J1", J=1.0, w0=10.0).inertia("J2", J=1.0, w0=4.0)
     bad.gear("g", "J1", "J2", 2.0)
     with pytest.raises(ParameterError, match=r"J2: w0 = 4 rad/s but g from J1 gives 5 rad/s"):
-        bad.initial_state()
+        bad.system()
     ow = Driveline("ow").inertia("J1", J=1.0, w0=3.0).inertia("J2", J=1.0, w0=1.0)
     ow.one_way_clutch("fw", "J1", "J2")
     with pytest.raises(ParameterError, match="fw: a one-way clutch cannot start"):

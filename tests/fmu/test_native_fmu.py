@@ -30,6 +30,27 @@ from clutchlab.fmu.native.image import accepted_range
 from driveline_networks import INPUTS_TOML
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "driveline_coupled_clutches.toml"
+#: a one-way clutch whose flange b (J2) overruns flange a (J1) at the start; J1's drive catches J2 up at t = 1 s
+FREEWHEEL_TOML = """
+[driveline]
+name = "freewheel"
+
+[inertia.J1]
+J = "1 kg m^2"
+w0 = "2 rad/s"
+
+[inertia.J2]
+J = "0.5 kg m^2"
+w0 = "3 rad/s"
+
+[one_way_clutch.f]
+a = "J1"
+b = "J2"
+
+[torque.drive]
+flange = "J1"
+torque = "1 N m"
+"""
 HERE = Path(__file__).resolve().parent
 HEADERS = HERE.parents[1] / "src" / "clutchlab" / "fmu" / "shim"
 
@@ -39,11 +60,12 @@ pytestmark = pytest.mark.skipif(not (sys.platform.startswith("linux") and shutil
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    """The native FMUs of the coupled clutches and of a network with inputs, and their classes."""
+    """The native FMUs of the coupled clutches, of a network with inputs and of a freewheel, and their classes."""
     folder = tmp_path_factory.mktemp("native")
     (folder / "inputs.toml").write_text(INPUTS_TOML)
     out = {}
-    for key, desc in (("cc", EXAMPLE), ("inputs", folder / "inputs.toml")):
+    (folder / "freewheel.toml").write_text(FREEWHEEL_TOML)
+    for key, desc in (("cc", EXAMPLE), ("inputs", folder / "inputs.toml"), ("freewheel", folder / "freewheel.toml")):
         cls = DrivelineCoSimulation.for_description(desc)
         lines = []
         path = export_native_fmu(cls, folder / f"{key}.fmu", platforms=["linux64"], report=lines.append)
@@ -252,6 +274,90 @@ def test_a_parameter_s_range_ends_where_its_law_stops_holding(built, host, unpac
     lib, guid, vr, _ = unpacked
     status, text = _host(host, lib, guid, "refuse", vr["rtol"], "1e-13").stdout.split(" ", 1)
     assert int(status) == 3 and re.search(r"rtol = 1e-13 \[1\] is outside its range", text), text
+
+
+_START_VALUES_HOST = r"""
+import importlib.abc, json, sys
+class Refuse(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in ("clutchlab", "numba", "llvmlite", "pythonfmu"):
+            raise ImportError(f"{name} is not importable in this host")
+        return None
+sys.meta_path.insert(0, Refuse())
+from ctypes import byref
+from fmpy import calloc, extract, free, read_model_description
+from fmpy.logging import addLoggerProxy
+from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+spec = json.load(open(sys.argv[1]))
+md = read_model_description(spec["path"])
+vr = {v.name: v.valueReference for v in md.modelVariables}
+folder = extract(spec["path"])
+out = []
+for kind, cls, ident in (("cs", FMU2Slave, md.coSimulation.modelIdentifier),
+                         ("me", FMU2Model, md.modelExchange.modelIdentifier)):
+    for k, values in enumerate(spec["cases"]):
+        messages = []
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, category, message:
+                                                  messages.append(message.decode()))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        addLoggerProxy(byref(callbacks))   # (FMPy's C proxy formats the logger's variadic arguments)
+        fmu = cls(guid=md.guid, unzipDirectory=folder, modelIdentifier=ident, instanceName=f"{kind}{k}")
+        fmu.instantiate(callbacks=callbacks)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setReal([vr[n] for n in values], list(values.values()))
+        try:
+            fmu.exitInitializationMode()
+        except Exception:
+            out.append([kind, "refused", messages[-1] if messages else "no message"])
+        else:
+            names = spec["outputs"]
+            out.append([kind, "ok", dict(zip(names, fmu.getReal([vr[n] for n in names])))])
+        fmu.freeInstance()
+loaded = sorted(m for m in sys.modules if m.split(".")[0] in ("clutchlab", "numba", "llvmlite"))
+assert not loaded, loaded
+json.dump(out, open(spec["result"], "w"))
+"""
+
+
+def test_a_one_way_clutch_a_host_starts_backward_is_refused_and_the_speeds_are_not_cut_by_ranges(built, tmp_path):
+    """A one-way clutch never slides backward (MSL ``OneWayClutch``), so no run starts with its flange b slower than
+    its flange a.  The network's compiled ``start`` refuses that state (a model error with the element's name), so
+    the FMU refuses speeds a host sets that way at ``fmi2ExitInitializationMode``, in co-simulation and in model
+    exchange, with the message clutchlab gives.  And the initial speeds carry no ranges cut where one meets the
+    other's start value: before, J1.w0 had ``max`` 3 rad/s (J2's start) and J2.w0 ``min`` 2 rad/s, so J1 = 5,
+    J2 = 6 rad/s (a valid start) was refused and J1 = 2.8, J2 = 2.2 rad/s (backward) ran."""
+    path, cls, _ = built["freewheel"]
+    _, svs = _variables(path)
+    for name in ("J1.w0", "J2.w0"):
+        real = svs[name].find("Real")
+        assert svs[name].get("causality") == "parameter" and real.get("min") is None and real.get("max") is None
+    with pytest.raises(ParameterError, match=r"f: a one-way clutch cannot start with flange b slower than flange a "
+                                             r"\(it never slides backward\): w_b - w_a = -0\.6 rad/s"):
+        cls(**{"J1.w0": 2.8, "J2.w0": 2.2})
+    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
+    script.write_text(_START_VALUES_HOST)
+    names = [v.name for v in cls.outputs]
+    cases = [{"J1.w0": 2.8, "J2.w0": 2.2}, {"J1.w0": 5.0, "J2.w0": 6.0}, {"J2.w0": 1.0}]
+    spec.write_text(json.dumps({"path": str(path), "cases": cases, "outputs": names, "result": str(result)}))
+    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    got = json.loads(result.read_text())
+    assert [(kind, what) for kind, what, _ in got] == [("cs", "refused"), ("cs", "ok"), ("cs", "refused"),
+                                                      ("me", "refused"), ("me", "ok"), ("me", "refused")]
+    for kind, what, detail in got:
+        if what == "refused":
+            assert re.search(r"^freewheel: f: a one-way clutch cannot start with flange b slower than "
+                             r"flange a \(it never slides backward\) \(at t = 0 s\)", detail), detail
+        else:   # (the start clutchlab's own co-simulation reports with those speeds: f overrunning, J1 at 5 rad/s)
+            python = cls(**cases[1]).initial_outputs({})
+            assert detail["f.mode"] == python["f.mode"] == 1.0 and detail["J1.w"] == 5.0
+            for name in names:
+                assert detail[name] == pytest.approx(python[name], rel=1e-12, abs=1e-12), name
 
 
 def test_network_inputs_are_fmu_inputs(built, tmp_path):
@@ -890,6 +996,38 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     for name in speeds:
         scale = float(np.max(np.abs(tight[name])))
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-4 * scale, err_msg=name)
+    if example == "driveline_emtc_awd":
+        _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt)
+
+
+def _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt):
+    """The AWD vehicle's initial speeds (the shafts, the axles and the drums, bound by the final drives and the
+    drums' speed sources) are parameters of its FMU (they were fixed at export, each trial of one alone breaking
+    a gear's ratio): a host sets the vehicle at 80 % of the file's speed, all of them together, and co-simulation
+    equals clutchlab's run built with them; one speed set alone disagrees with its final drive, and the FMU
+    refuses it at its initialisation with the gear's name, as clutchlab refuses it (kernel.kinematic_error)."""
+    speeds = {v.name: float(v.start) for v in cls.parameters if v.name.endswith((".w0", "_drive.speed"))}
+    _, svs = _variables(path)
+    assert len(speeds) == 8 and all(svs[k].get("causality") == "parameter" for k in speeds), speeds
+    slower = {k: 0.8 * v for k, v in speeds.items()}
+    (tmp_path / "slow").mkdir()
+    native = _fmpy_run(tmp_path / "slow", path, n, dt, slower)
+    python = _python_run(cls, n, dt, slower)
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-9 if name == "energy_error" else 1e-12)
+    assert native["front_axle.w"][0] == pytest.approx(0.8 * speeds["front_axle.w0"], rel=1e-12)
+    with pytest.raises(ParameterError, match=r"front_axle: w0 = [\d.]+ rad/s but front_drive from front_shaft gives"):
+        cls(**{"front_axle.w0": 0.8 * speeds["front_axle.w0"]})
+    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
+    script.write_text(_START_VALUES_HOST)
+    spec.write_text(json.dumps({"path": str(path), "cases": [{"front_axle.w0": 0.8 * speeds["front_axle.w0"]}],
+                                "outputs": ["front_axle.w"], "result": str(result)}))
+    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    for kind, what, detail in json.loads(result.read_text()):
+        assert what == "refused" and re.search(r"front_drive: the initial speeds of its flanges disagree with its "
+                                               r"ratio", detail), (kind, detail)
 
 
 def test_trials_of_a_whole_number_are_relative_and_a_proportion_has_no_offset():

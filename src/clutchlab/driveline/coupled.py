@@ -412,7 +412,7 @@ def coupled_start(t, x, u, m, p):
     """The network's start modes and stored energy from its initial state (:func:`kernel.driveline_start`, through
     its address; the core's ``start`` hook).  The components' own modes are their builders' (their restart at the
     start settles them)."""
-    K._start_outlined(t, x, u, m, member(p, "net"))
+    return K._start_outlined(t, x, u, m, member(p, "net"))
 
 
 dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs_hook, update=coupled_update_hook,

@@ -3987,11 +3987,19 @@ def driveline_start(t, x, u, m, p):
       released (either law);
     * a curve spring on the segment it lies on (at a point, the one it moves onto);
     * a lossy gear rolling the way its flange a turns on its support, or stuck.
+
+    Returns 0, or the model error code ``-(INV_BASE + N_INV r + INV_START)`` of the first element (row ``r``) whose
+    initial state no run can start from: a gear or a motion source whose flanges' speeds (angles) disagree with it
+    (:func:`kinematic_error`), else a one-way clutch whose flange b turns slower than its flange a (it never slides
+    backward: MSL ``OneWayClutch`` locks that way, so no mode of it holds that state).  The run does not start; a
+    native FMU refuses the start values a host set with the element's message.
     """
-    if u.shape[0] > 0 and hold_inputs(p.data, u):
-        forget_signals(p)
+    if u.shape[0] > 0:
+        hold_inputs(p.data, u)
+    forget_signals(p)   # (a host may have set a signal's parameters since the cache was filled)
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
+    code = kinematic_error(t, x, p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
         w_a = _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
@@ -4022,6 +4030,8 @@ def driveline_start(t, x, u, m, p):
         r = p.fric[k]
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         m[k] = FREE if _is_free(p, r, t) else FORWARD if w_rel > 0.0 else BACKWARD if w_rel < 0.0 else STUCK
+        if code == 0 and p.elem[r, E_LAW] == LAW_ONEWAY and w_rel < 0.0:
+            code = -(INV_BASE + N_INV * r + INV_START)   # (it never slides backward: no state to start from)
     stored = 0.0
     for i in range(n):
         stored += 0.5 * p.inertia[i] * x[n + i] ** 2
@@ -4029,22 +4039,61 @@ def driveline_start(t, x, u, m, p):
         if p.elem[r, E_KIND] == K_SPRING:
             stored += spring_energy(p, r, x, n, m)
     p.work[p.work.shape[0] - 1] = stored
+    return code
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def kinematic_error(t, x, p):
+    """0, or the model error code ``-(INV_BASE + N_INV r + INV_START)`` of the first gear or motion source (row
+    ``r``) that the state ``x`` at ``t`` breaks: a gear's flanges turn ``w_a - w_s = ratio (w_b - w_s)`` about its
+    support (MSL ``IdealGear``; a flange on the ground at rest), a speed source's flange at its signal's value, a
+    position source's at its signal's value [rad] and rate [rad/s] -- each to 1e-9 relative, 1e-12 absolute (as
+    :func:`math.isclose`).  A network's initial speeds follow from these where they are left out
+    (:meth:`~clutchlab.driveline.Driveline.initial_state`); where given, they must agree (a native FMU's host may set
+    any of them: the FMU's ``start`` refuses a disagreement)."""
+    n = p.inertia.shape[0]
+    for r in range(p.elem.shape[0]):
+        kind = p.elem[r, E_KIND]
+        if kind == K_GEAR:
+            ws = _speed(x, n, p.elem[r, E_SUP])
+            a = _speed(x, n, p.elem[r, E_A]) - ws
+            b = p.coef[r, C_RATIO] * (_speed(x, n, p.elem[r, E_B]) - ws)
+            if not _isclose(a, b):
+                return -(INV_BASE + N_INV * r + INV_START)
+        elif kind == K_MOTION:
+            i = p.elem[r, E_B]
+            s = p.elem[r, E_SIGNAL]
+            if p.elem[r, E_LAW] == MOTION_SPEED:
+                if not _isclose(_speed(x, n, i), signal_at(p, s, t)):
+                    return -(INV_BASE + N_INV * r + INV_START)
+            else:
+                rate = signal_rates(p.signals[s], p.data, t)[0]
+                if not (_isclose(x[i], signal_at(p, s, t)) and _isclose(_speed(x, n, i), rate)):
+                    return -(INV_BASE + N_INV * r + INV_START)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _isclose(a, b):
+    """``math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-12)``."""
+    return abs(a - b) <= max(1e-9 * max(abs(a), abs(b)), 1e-12)
 
 
 # invariants a run must keep (:func:`check_invariants`): the model error code of a violation is
 # -(INV_BASE + N_INV * row + kind), the row of the element (the network's energy balance: row = the element count)
-# (the last, "table", is not an invariant but a model error every run checks, :func:`table_error`: its message has no
-# "invariant violated")
-INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap", "table")
-INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP, INV_TABLE = indices(
-    INVARIANT_NAMES, "limit", "mode", "oneway", "loss", "energy", "gap", "table")
+# (the last two are not invariants but model errors every run checks, without "invariant violated" in their messages:
+# "table", :func:`table_error`; "start", an initial state no mode holds, :func:`driveline_start`)
+INVARIANT_NAMES = ("limit", "mode", "oneway", "loss", "energy", "gap", "table", "start")
+INV_LIMIT, INV_MODE, INV_ONEWAY, INV_LOSS, INV_ENERGY, INV_GAP, INV_TABLE, INV_START = indices(
+    INVARIANT_NAMES, "limit", "mode", "oneway", "loss", "energy", "gap", "table", "start")
 INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign of its relative speed",
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",
               "backlash in its gap beyond an edge moving outward, or released where its contact would push (a "
               "contact missed)",
               "its loss table, extrapolated beyond its last row, gives an efficiency <= 0 at the speed the gear "
-              "turns at; give rows up to the speeds the run reaches")
+              "turns at; give rows up to the speeds the run reaches",
+              "a one-way clutch cannot start with flange b slower than flange a (it never slides backward)")
 INV_BASE = 100
 N_INV = len(INVARIANT_NAMES)
 
@@ -4268,13 +4317,13 @@ def driveline_watch(t, x, u, m, p, dx, g, k):
 
 #: :func:`driveline_start` through its address: it runs once per run (and per call of a session or model exchange
 #: that asks for it), so it is compiled once, not into each entry of the core that may start a run
-_start_outlined = outlined(driveline_start, lambda: (types.float64, _F1, _F1, _I1, _params_type()), types.none)
+_start_outlined = outlined(driveline_start, lambda: (types.float64, _F1, _F1, _I1, _params_type()), types.int64)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_start_hook(t, x, u, m, p):
     """:func:`driveline_start` through its address (the core's ``start`` hook)."""
-    _start_outlined(t, x, u, m, p)
+    return _start_outlined(t, x, u, m, p)
 
 
 dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,

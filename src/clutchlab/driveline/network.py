@@ -31,7 +31,7 @@ from ..errors import ParameterError
 from ..numerics import core, outline
 from ..params.base import ABSOLUTE_ZERO_C
 from ..units import COLUMN_UNITS
-from ..system import System, register_model, simulate as _simulate
+from ..system import System, register_model, simulate as _simulate, start_checks_deferred
 from . import kernel as K
 
 
@@ -1786,8 +1786,10 @@ class Driveline:
         """Angles, speeds, then the energy states (zero).
 
         Speeds left out follow from the motion sources and gears (a source sets its flange, a gear
-        ``w_a = ratio w_b`` carries it on); speeds given must agree with them, to 1e-9 relative.  Raises
-        :class:`~clutchlab.errors.ParameterError` on a disagreement or a loop of gears and motion sources.
+        ``w_a = ratio w_b`` carries it on); speeds given are kept, and must agree with them to 1e-9 relative:
+        :meth:`system` refuses a disagreement (the network's compiled start,
+        :func:`~clutchlab.driveline.kernel.kinematic_error`, which a native FMU runs again on the speeds a host sets).
+        Raises :class:`~clutchlab.errors.ParameterError` on a loop of gears and motion sources.
         """
         names = list(self._inertias)
         index = {nm: i for i, nm in enumerate(names)}
@@ -1812,9 +1814,7 @@ class Driveline:
             if e.kind == K.K_MOTION:
                 v, rate = e.signal.value_and_rate(0.0)
                 fixed[ib] = (v if e.law == K.MOTION_SPEED else rate, e.name)
-                if e.law == K.MOTION_POSITION:
-                    if phi[ib] is not None and not math.isclose(phi[ib], v, rel_tol=1e-9, abs_tol=1e-12):
-                        raise ParameterError(f"{names[ib]}: phi0 = {phi[ib]:g} rad but {e.name} starts it at {v:g} rad")
+                if e.law == K.MOTION_POSITION and phi[ib] is None:   # (a given one is checked by the start)
                     phi[ib] = v
             elif ia >= 0 and ib >= 0:   # w_a - w_s = ratio (w_b - w_s), the support at its own initial speed
                 ratio = e.coef[0]
@@ -1825,10 +1825,8 @@ class Driveline:
                 fixed[ia if ia >= 0 else ib] = (0.0, e.name)
         value = [None] * n
 
-        def assign(i, v, why):
-            if w[i] is not None and not math.isclose(w[i], v, rel_tol=1e-9, abs_tol=1e-12):
-                raise ParameterError(f"{names[i]}: w0 = {w[i]:g} rad/s but {why} gives {v:g} rad/s")
-            value[i] = v
+        def assign(i, v, why):   # (a speed given is kept: the start refuses a disagreement, kinematic_error)
+            value[i] = v if w[i] is None else w[i]
 
         def spread(start):
             todo = [start]
@@ -1860,18 +1858,38 @@ class Driveline:
         forces), and the stored energy the energy balance starts from, in ``p.work[-1]``: both by the compiled
         :func:`~clutchlab.driveline.kernel.driveline_start`, the run's own ``start`` (so a native FMU decides them
         again from the initial speeds a host sets).  A one-way clutch may not start turning backward."""
-        n = len(self._inertias)
-        for r in p.fric:
-            e = p.elem[r]
-            w_rel = (0.0 if e[K.E_B] < 0 else x0[n + e[K.E_B]]) - (0.0 if e[K.E_A] < 0 else x0[n + e[K.E_A]])
-            if e[K.E_LAW] == K.LAW_ONEWAY and w_rel < 0:
-                raise ParameterError(f"{self._elements[r].name}: a one-way clutch cannot start with flange b slower "
-                                     f"than flange a (w_b - w_a = {w_rel:g} rad/s)")
         m = np.zeros(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
         u0 = np.array([v[1] for v in self._inputs.values()], dtype=float)
         # (through the core's entry, as a run calls it: one compiled specialisation, the run's)
-        core.start(p, 0.0, np.ascontiguousarray(x0, dtype=float), u0, m)
+        code = core.start(p, 0.0, np.ascontiguousarray(x0, dtype=float), u0, m)
+        if code < 0 and not start_checks_deferred():
+            raise ParameterError(self._start_refusal((-code - K.INV_BASE) // K.N_INV, p, x0))
         return m
+
+    def _start_refusal(self, r, p, x0) -> str:
+        """The message for element row ``r`` that the network's compiled start refused (``K.INV_START``): a gear or
+        motion source its flanges' initial speeds (angles) disagree with, or a one-way clutch turning backward."""
+        n, e, el = len(self._inertias), p.elem[r], self._elements[r]
+        names = list(self._inertias)
+
+        def w(i):
+            return 0.0 if i < 0 else float(x0[n + i])
+
+        if el.kind == K.K_GEAR:
+            ws = w(e[K.E_SUP])
+            if e[K.E_A] < 0 or e[K.E_B] < 0:
+                i = max(e[K.E_A], e[K.E_B])
+                return f"{names[i]}: w0 = {w(i):g} rad/s but {el.name} gives 0 rad/s"
+            want = ws + (w(e[K.E_A]) - ws) / p.coef[r, K.C_RATIO]
+            return f"{names[e[K.E_B]]}: w0 = {w(e[K.E_B]):g} rad/s but {el.name} from {names[e[K.E_A]]} gives {want:g} rad/s"
+        if el.kind == K.K_MOTION:
+            v, rate = el.signal.value_and_rate(0.0, self._input_starts())
+            i = e[K.E_B]
+            if el.law == K.MOTION_POSITION and not math.isclose(x0[i], v, rel_tol=1e-9, abs_tol=1e-12):
+                return f"{names[i]}: phi0 = {x0[i]:g} rad but {el.name} starts it at {v:g} rad"
+            return (f"{names[i]}: w0 = {w(i):g} rad/s but {el.name} gives "
+                    f"{v if el.law == K.MOTION_SPEED else rate:g} rad/s")
+        return f"{el.name}: {K.INVARIANTS[K.INV_START]}: w_b - w_a = {w(e[K.E_B]) - w(e[K.E_A]):g} rad/s"
 
     def variables(self):
         """States and outputs as ``(name, unit, description)`` (column ``<component>.<quantity>_<unit>``)."""
@@ -1990,10 +2008,18 @@ class Driveline:
         names_rows = [e.name for e in self._elements]
         invariant_messages = {-(K.INV_BASE + K.N_INV * r + kind): f"invariant violated: {nm}: {what}"
                               for r, nm in enumerate(names_rows) for kind, what in enumerate(K.INVARIANTS)
-                              if kind != K.INV_TABLE}
+                              if kind not in (K.INV_TABLE, K.INV_START)}
         for r, e in enumerate(self._elements):
             if e.kind == K.K_GEAR and self._is_lossy(e):
                 invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_TABLE)] = f"{e.name}: {_table_limit(e.table)}"
+            if e.kind == K.K_FRICTION and e.law == K.LAW_ONEWAY:
+                invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_START)] = (
+                    f"{e.name}: {K.INVARIANTS[K.INV_START]}")
+            elif e.kind in (K.K_GEAR, K.K_MOTION):   # (kernel.kinematic_error)
+                invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_START)] = (
+                    f"{e.name}: the initial speeds of its flanges disagree with its ratio (w_a - w_s = ratio (w_b - "
+                    "w_s))" if e.kind == K.K_GEAR else
+                    f"{e.name}: the initial speed (or angle) of its flange disagrees with the motion it imposes")
         invariant_messages[-(K.INV_BASE + K.N_INV * len(names_rows) + K.INV_ENERGY)] = (
             f"invariant violated: the network's {K.INVARIANTS[K.INV_ENERGY]} ({_check_tol(rtol):.3g} of the energy "
             "that flowed)")

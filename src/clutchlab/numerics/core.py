@@ -761,7 +761,10 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     mass = opt.mass
     status = SUCCESS
     if si[SI_STARTED] == 0:   # what the run derives from its initial state (the model's start modes)
-        model.start(t, x, u, m, p)
+        r = model.start(t, x, u, m, p)
+        if r < 0:   # (an initial state the model cannot start from)
+            si[SI_MODEL_CODE] = r
+            return _save_state(sf, si, t, h, si[SI_IREC], MODEL_ERROR, owners)
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, k1, g0)
     model.watch(t, x, u, m, p, k1, g0, -1)
@@ -1165,7 +1168,10 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     h = sf[SF_H]
     status = SUCCESS
     if si[SI_STARTED] == 0:   # what the run derives from its initial state (the model's start modes)
-        model.start(t, x, u, m, p)
+        r = model.start(t, x, u, m, p)
+        if r < 0:   # (an initial state the model cannot start from)
+            si[SI_MODEL_CODE] = r
+            return _save_state(sf, si, t, h, si[SI_IREC], MODEL_ERROR, owners)
     model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, f0, g0)
     model.watch(t, x, u, m, p, f0, g0, -1)
@@ -1395,7 +1401,7 @@ def _start(p, t, x, u, m):
     that has not started decides them (a co-simulation's outputs before its first step)."""
     p = byref(borrow(p))
     model.prepare(p)
-    model.start(t, x, u, m, p)
+    return model.start(t, x, u, m, p)
 
 
 @register_jitable
@@ -1613,8 +1619,9 @@ def evaluate_outputs(p, t, x, u, m, y):
 
 def start(p, t, x, u, m):
     """The model's ``start`` at ``(t, x, u)``: the modes ``m`` a run starts from (and what else the model derives from
-    its initial state alone), as the run itself decides them; nothing for a model without the hook."""
-    fast_entry(type(p), "dopri", "start")(p, t, x, u, m)
+    its initial state alone), as the run itself decides them; nothing for a model without the hook.  Returns 0, or
+    the model error code of an initial state the model cannot start from (:mod:`clutchlab.numerics.dispatch`)."""
+    return int(fast_entry(type(p), "dopri", "start")(p, t, x, u, m))
 
 
 def outputs_at(p, T, X, u, M, Y):

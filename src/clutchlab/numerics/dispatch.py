@@ -78,7 +78,10 @@ and the parameters ``p``):
     exchange when asked (``START``, ``ME_START``: a native FMU at every call before its run, after a host may
     have set start values; a co-simulation's outputs before its first step).  Being
     compiled, it is also what the model's Python side calls for its initial modes, so the modes a run starts
-    from are written once.  Nothing for a model that does not give it.
+    from are written once.  Returns 0, or a negative model error code where the initial state is one the model
+    cannot start from (a one-way clutch turning backward): the run ends there with that error, as at a failed
+    ``accept`` (a native FMU refuses the start values a host set, with the model's message).  0 for a model
+    that does not give it.
 ``time_derivative(t, x, u, m, p, ft)`` (optional)
     Fills ``ft = df/dt`` at fixed state (inputs that vary within a step,
     for the Rosenbrock stages) and returns True; False (the default for a
@@ -331,8 +334,8 @@ def prepare(p):  # pragma: no cover
 
 
 def no_start(t, x, u, m, p):
-    """What the ``start`` stub compiles to for a model without the hook: nothing (compiled into the caller)."""
-    return None
+    """What the ``start`` stub compiles to for a model without the hook: 0 (compiled into the caller)."""
+    return 0
 
 
 def _default_start(t, x, u, m, p):

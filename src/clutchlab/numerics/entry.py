@@ -156,7 +156,7 @@ def evaluate_outputs(p, t, x, u, m, y):
 
 @numba.njit(cache=True, nogil=True)
 def start(p, t, x, u, m):
-    _core._start(p, t, x, u, m)
+    return _core._start(p, t, x, u, m)
 
 
 @numba.njit(cache=True, nogil=True)

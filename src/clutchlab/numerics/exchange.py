@@ -146,7 +146,9 @@ def call(s, what):
     t = sf[SF_T]
     code = 0
     if what & ME_START:
-        model.start(t, x, u, m, p)
+        code = model.start(t, x, u, m, p)
+        if code < 0:   # (an initial state the model cannot start from)
+            return code
     if alg.shape[0] and what & (ME_DERIVATIVES | ME_EVENT | ME_RESTART | ME_OUTPUTS):
         # (the algebraic rows solved for the differential states the host set; again after an event or a
         # restart that moved them or changed the modes)

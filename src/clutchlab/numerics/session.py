@@ -33,7 +33,8 @@ from numba.extending import NativeValue, intrinsic, models, register_jitable, re
 from . import dispatch as model
 from .borrow import _strip, byref
 from .calls import ADVANCE, OUTPUTS, START, REPORT_KINDS, REPORT_MODE, REPORT_MODE_IS, REPORT_OUTPUT, REPORT_STATE  # noqa: F401
-from .status import SUCCESS, TERMINATED
+from .core import SI_MODEL_CODE, SI_STATUS
+from .status import MODEL_ERROR, SUCCESS, TERMINATED
 
 __all__ = ["SessionType", "Handle", "open_session", "native_address", "pack", "call", "table_bytes", "table_layout",
            "FIELDS",
@@ -191,7 +192,8 @@ def call(s, t_end, what):
     advance to ``t_end`` (``what & ADVANCE``), then, if the advance succeeded (or ended at a terminal event), the
     outputs at the time reached and the report (``what & OUTPUTS``).
 
-    Returns the advance's status (``SUCCESS`` without an advance).  Compiled as each model's ``session``
+    Returns the advance's status (``SUCCESS`` without an advance; ``MODEL_ERROR`` where ``start`` refused the
+    initial state, its code in the solver state's ``model_code``).  Compiled as each model's ``session``
     entry (:mod:`clutchlab.numerics.entry`, the function itself rehomed into the generated module).
     """
     p, x, m, u, sf, si, opt, log, ts, rt, rx, rm, ry, want_y, y, report, r = _args(s)
@@ -199,7 +201,11 @@ def call(s, t_end, what):
     if what & START:
         pr = byref(p)
         model.prepare(pr)
-        model.start(sf[0], x, u, m, pr)
+        started = model.start(sf[0], x, u, m, pr)
+        if started < 0:   # (an initial state the model cannot start from: its error, as a run's)
+            si[SI_MODEL_CODE] = started
+            si[SI_STATUS] = MODEL_ERROR
+            return MODEL_ERROR
     if what & ADVANCE:
         code = _advance(s, p, x, m, u, t_end, sf, si, opt, log, ts, rt, rx, rm, ry, want_y)
         if code != SUCCESS and code != TERMINATED:

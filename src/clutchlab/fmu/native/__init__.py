@@ -39,6 +39,7 @@ from pathlib import Path
 
 from ...errors import ClutchlabError, ParameterError
 from ...numerics.layout import indices
+from ...system import start_checked_later
 from .image import NativeExportError, accepted_range, law_holds, parameter_map, session_image
 
 __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
@@ -499,7 +500,9 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
             import warnings
 
             try:
-                with warnings.catch_warnings():   # (values far out: overflow warnings of a model that takes them)
+                # (values far out: overflow warnings of a model that takes them; an initial state the model's start
+                # refuses is refused by the FMU at its start, not by the ranges: start_checked_later)
+                with warnings.catch_warnings(), start_checked_later():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     obj = cls(**(parameters or {}))
                     obj.hold_inputs(inputs or {})

@@ -170,6 +170,11 @@ static int cl_outputs(cl_instance *c) {
         if (!cl_exchange(c, CL_ME_OUTPUTS | CL_ME_DERIVATIVES, &code)) return 0;
     } else if (!cl_call(c, 0.0, CL_OUTPUTS, &code)) {
         return 0;
+    } else if (code == CL_STATUS_MODEL_ERROR) { /* (the model's start refused the start values set) */
+        const char *model = cl_model_error(*(int64_t *)(c->mem + c->L->off_model_code));
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s (at t = %g s)", CL_MODEL_NAME,
+               model != NULL ? model : cl_status_message(code), *cl_at(c, c->L->off_time));
+        return 0;
     }
     c->outputs_stale = 0;
     return 1;
