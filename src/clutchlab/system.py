@@ -173,9 +173,11 @@ class System:
         (:func:`clutchlab.control.operating_point`).
     decided_at_start : tuple of (str, int, int or None)
         What the model's compiled ``start`` hook writes from the initial state (:mod:`clutchlab.numerics.dispatch`),
-        as ``(where, start, stop)`` slices: ``"m"`` the mode vector, ``"params.<field>[.<field>...]"`` an array of
-        the parameters (the driveline: its network's modes and the stored energy it starts from,
-        ``("params.work", -1, None)``).  A run derives them again, so ``m0`` is not where a run starts from
+        and from the parameters alone, as ``(where, start, stop)`` slices: ``"m"`` the mode vector,
+        ``"params.<field>[.<field>...]"`` an array of the parameters or a field of a record array (the driveline:
+        its network's modes and the stored energy it starts from, ``("params.work", -1, None)``; the wet clutch:
+        the heat capacity and Greenwood-Williamson scale derived from its masses and roughness,
+        ``("params.constants.heat_capacity", 0, None)``).  A run derives them again, so ``m0`` is not where a run starts from
         there; a native FMU's exporter does not look for a parameter's image in them (its ``start`` decides them
         again from the start values a host sets, :mod:`clutchlab.fmu.native.image`).
     """

@@ -851,6 +851,12 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     # parameters a host sets (found writable by rebuilding the model, and checked jointly): the controller's
     # gains, the motor's resistance, the clutch's friction coefficient and the seals' static ratio
     start = {"actuator.kp": 2500.0, "actuator.resistance": 0.25, "clutch.mu": 0.3, "friction.static_ratio": 1.3}
+    # and the hydraulics (line, fluid, hose, volumes, snifting port), from which the compiled start derives the
+    # compliances, the line's inertance and resistance and the snifting edge again in the FMU (derive_actuator):
+    # fixed at export before (a product or a quotient of two parameters, a sum two of them share)
+    assert "47 parameters (19 fixed at export)" in lines[0], lines[0]
+    start.update({"actuator.line_diameter": 4e-3, "actuator.bulk_modulus": 3e8, "actuator.hose_compliance": 4e-13,
+                  "actuator.fluid_viscosity": 0.012, "actuator.slave_volume": 8e-6, "actuator.snifting_width": 4e-4})
     assert all(svs[name].get("causality") == "parameter" for name in start)
     # (its atol follow it only below the default, a line on each side; and the controller's integral's tolerance
     # follows it and ki: the gain, whose law holds on both sides, keeps that number)
@@ -919,6 +925,21 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     for name in changed:
         _close(native[name], changed[name], name)
     assert np.max(np.abs(changed["clutch_torque"] - python["clutch_torque"])) > 1e-3 * np.max(np.abs(python["clutch_torque"]))
+    # the pack's masses and heat capacities and the asperities' roughness, from which the model's compiled start
+    # derives its heat capacity (Eq. 8) and Greenwood-Williamson scale (Eq. 11) again in the FMU (wet_start): they
+    # were fixed at export (a product of two parameters, a power law); the run equals clutchlab's built with them
+    assert "46 parameters (7 fixed at export)" in lines[0], lines[0]
+    pack = {"clutch.m_core": 1.3, "clutch.cp_lining": 0.8, "clutch.sigma": 1.2, "clutch.contact_modulus": 0.7,
+            "clutch.asperity_radius": 1.5, "clutch.asperity_density": 0.9}
+    start = {name: factor * float(svs[name].find("Real").get("start")) for name, factor in pack.items()}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(WetCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    for name in ("temperature", "clutch_torque"):   # (the parameters changed the run: the FMU derived with them)
+        column = next(k for k in python if k.startswith(name))
+        assert np.max(np.abs(changed[column] - python[column])) > 1e-4 * np.max(np.abs(python[column])), column
 
 
 # ------------------------------------------------------------------------------------------ model exchange

@@ -206,6 +206,7 @@ def reflected_mass(piston_mass, rotor_inertia, ratio):
     return piston_mass + rotor_inertia / ratio ** 2
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def chamber_compliance(volume, bulk_modulus, extra=0.0):
     """Hydraulic capacitance ``C = V / beta_eff + C_extra`` [m^3/Pa].
 
@@ -221,23 +222,28 @@ def chamber_compliance(volume, bulk_modulus, extra=0.0):
     Notes
     -----
     Constant volume and bulk modulus (small-signal); the change of volume with
-    piston travel is neglected.  Actuator model of [1] Fig. 5a ([2]).
+    piston travel is neglected.  Actuator model of [1] Fig. 5a ([2]).  Compiled: the E-clutch's compiled start
+    derives its chambers' compliances with it (:func:`clutchlab.eclutch.system.start`).
     """
     return volume / bulk_modulus + extra
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def line_inertance(density, length, diameter):
-    """Fluid inertia of a pipe ``L_h = rho l / A`` [kg/m^4] (one-dimensional plug flow)."""
+    """Fluid inertia of a pipe ``L_h = rho l / A`` [kg/m^4] (one-dimensional plug flow; [1] Fig. 5a, [2]): density
+    [kg/m^3], length [m], inner diameter [m].  Compiled, as :func:`chamber_compliance`."""
     return density * length / (math.pi * diameter ** 2 / 4.0)
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def line_resistance(viscosity, length, diameter):
     """Laminar (Hagen-Poiseuille) pipe resistance ``R_h = 128 mu l / (pi d^4)`` [Pa s/m^3].
 
     Notes
     -----
     Valid for Reynolds numbers below about 2000: a 5 mm line at 3e-5 m^3/s
-    (a fast release) has Re ~ 1350 with DOT 4 fluid.
+    (a fast release) has Re ~ 1350 with DOT 4 fluid.  Viscosity [Pa s], length and inner diameter [m]; [1]
+    Fig. 5a, [2].  Compiled, as :func:`chamber_compliance`.
     """
     return 128.0 * viscosity * length / (math.pi * diameter ** 4)
 

@@ -53,9 +53,10 @@ from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
 from ..numerics.layout import indices, slots
 from ..system import System, variables
-from .actuator import (ActuatorParameters, cavitating_compliance, chamber_pressure_rate, controller_integral_rate,
-                       controller_voltage, current_rate, drive_voltage, drive_voltage_slopes, line_flow_rate,
-                       spindle_force, stop_contact, stop_contact_slopes, vent_opening, vent_opening_slope)
+from .actuator import (ActuatorParameters, cavitating_compliance, chamber_compliance, chamber_pressure_rate,
+                       controller_integral_rate, controller_voltage, current_rate, drive_voltage, drive_voltage_slopes,
+                       line_flow_rate, line_inertance, line_resistance, spindle_force, stop_contact,
+                       stop_contact_slopes, vent_opening, vent_opening_slope)
 from .friction import FrictionElement, kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
 from .network import GROUND, Lever, element_force, element_force_segment, solve_static
@@ -74,7 +75,16 @@ ACTUATOR_VECTOR = (
     "vapour_pressure", "cavitation_sharpness", "resistance", "inductance", "torque_constant", "supply_voltage",
     "current_limit", "current_limit_gain", "spindle_ratio", "csc_preload", "csc_spring_rate", "slave_min",
     "slave_max", "master_stroke", "stop_stiffness", "stop_damping", "kp", "ki", "kd", "anti_windup",
-    "reference_min", "reference_max")
+    "reference_min", "reference_max",
+    # the fields the start derives the compliances, the line's inertance and resistance and the snifting edge
+    # from (:func:`derive_actuator`)
+    "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density", "fluid_viscosity",
+    "line_length", "line_diameter", "snifting_port")
+(P_VMC, P_VSL, P_BULK, P_HOSE, P_RHO, P_VISC, P_LLEN, P_DLINE, P_XPORT) = indices(
+    ACTUATOR_VECTOR, "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density",
+    "fluid_viscosity", "line_length", "line_diameter", "snifting_port")
+#: the words of ``par`` the start derives (:func:`eclutch_start`; :attr:`clutchlab.system.System.decided_at_start`)
+DERIVED_AT_START = (("params.par", 4, 8), ("params.par", 9, 10))
 (P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
  P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
  P_REFMAX) = indices(
@@ -989,8 +999,32 @@ def time_derivative(t, x, u, m, p, ft):
     return True
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def derive_actuator(par):
+    """The actuator's derived words of ``par`` (the ``P_*`` layout) from the fields packed beside them: the chamber
+    compliances ``C = V / beta + C_hose / 2`` (:func:`~clutchlab.eclutch.actuator.chamber_compliance`), the line's
+    inertance and laminar resistance (:func:`~clutchlab.eclutch.actuator.line_inertance`,
+    :func:`~clutchlab.eclutch.actuator.line_resistance`) and the snifting port's closing edge (port + width);
+    [1] Fig. 5a, [2].  Called by the packing and by the start (:func:`eclutch_start`)."""
+    par[P_CM] = chamber_compliance(par[P_VMC], par[P_BULK], par[P_HOSE] / 2.0)
+    par[P_CS] = chamber_compliance(par[P_VSL], par[P_BULK], par[P_HOSE] / 2.0)
+    par[P_LH] = line_inertance(par[P_RHO], par[P_LLEN], par[P_DLINE])
+    par[P_RH] = line_resistance(par[P_VISC], par[P_LLEN], par[P_DLINE])
+    par[P_XSN] = par[P_XPORT] + par[P_WSN]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def eclutch_start(t, x, u, m, p):
+    """What a run derives from its parameters alone, once before its first restart (the core's ``start`` hook): the
+    actuator's compliances, line inertance and resistance and snifting edge (:func:`derive_actuator`).  The packing
+    derives them with the same function; a native FMU runs it again after a host set the volumes, the fluid or the
+    line, which it then writes as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
+    derive_actuator(p.par)
+    return 0
+
+
 dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restart=restart, accept=accept,
-                  next_break=next_break, jacobian=jacobian, time_derivative=time_derivative)
+                  next_break=next_break, jacobian=jacobian, time_derivative=time_derivative, start=eclutch_start)
 
 
 # ---------------------------------------------------------------- packing and the System
@@ -1053,12 +1087,7 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par[P_ASL] = a.slave_area
     par[P_MMC] = a.master_equivalent_mass
     par[P_MSL] = a.slave_mass
-    par[P_CM] = a.master_compliance
-    par[P_CS] = a.slave_compliance
-    par[P_LH] = a.line_inertance
-    par[P_RH] = a.line_resistance
     par[P_GV] = a.snifting_conductance
-    par[P_XSN] = a.snifting_port + a.snifting_width
     par[P_WSN] = a.snifting_width
     par[P_PCAV] = a.vapour_pressure
     par[P_CAVF] = 1e3
@@ -1082,6 +1111,16 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par[P_KAW] = a.anti_windup
     par[P_REFMIN] = a.slave_min
     par[P_REFMAX] = a.slave_max
+    par[P_VMC] = a.master_volume
+    par[P_VSL] = a.slave_volume
+    par[P_BULK] = a.bulk_modulus
+    par[P_HOSE] = a.hose_compliance
+    par[P_RHO] = a.fluid_density
+    par[P_VISC] = a.fluid_viscosity
+    par[P_LLEN] = a.line_length
+    par[P_DLINE] = a.line_diameter
+    par[P_XPORT] = a.snifting_port
+    derive_actuator(par)   # (the words the start derives: written once)
     return par
 
 
@@ -1451,6 +1490,7 @@ class Assembly:
             mass=self.mvec, jac_cols=np.arange(n_jac), fd_scale=self.typ, nonautonomous=bool(nonauto),
             jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
             event_tol=float(event_tol), element_name=self.element_name, limits=self.limits(),
+            decided_at_start=DERIVED_AT_START,
         )
 
     def limits(self) -> dict:

@@ -51,6 +51,8 @@ __all__ = [
     "asperity_contact_pressure",
     "squeeze_film_coefficient",
     "squeeze_film_force",
+    "gw_pressure_scale",
+    "gw_pressure_scale_scalar",
 ]
 
 _SQRT2 = math.sqrt(2.0)
@@ -317,11 +319,23 @@ def asperity_contact_pressure(h, sigma, asperity_radius, asperity_density, conta
 
 
 def gw_pressure_scale(sigma, asperity_radius, asperity_density, contact_modulus):
-    """Pressure scale ``4/3 E' eta sqrt(beta) sigma^{3/2}`` of the GW model [Pa]."""
+    """Pressure scale ``4/3 E' eta sqrt(beta) sigma^{3/2}`` of the GW model [Pa] (:func:`gw_pressure_scale_scalar`,
+    its arguments checked > 0)."""
     b = float(_positive("asperity_radius", asperity_radius))
     e = float(_positive("asperity_density", asperity_density))
     m = float(_positive("contact_modulus", contact_modulus))
-    return 4.0 / 3.0 * m * e * math.sqrt(b) * float(sigma) ** 1.5  # [3], Eq. 11 prefactor
+    return gw_pressure_scale_scalar(float(sigma), b, e, m)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def gw_pressure_scale_scalar(sigma, asperity_radius, asperity_density, contact_modulus):
+    """Pressure scale ``4/3 E' eta sqrt(beta) sigma^{3/2}`` of the Greenwood-Williamson contact [Pa] ([3], Eq. 11,
+    the prefactor of ``F_{3/2}(h / sigma)``), compiled: the wet model's compiled ``start`` derives it with this.
+
+    Parameters: ``sigma`` RMS roughness [m], ``asperity_radius`` beta [m], ``asperity_density`` eta [1/m^2],
+    ``contact_modulus`` E' [Pa].  Assumes Gaussian asperity heights and Hertzian tips of one radius.
+    """
+    return 4.0 / 3.0 * contact_modulus * asperity_density * math.sqrt(asperity_radius) * sigma ** 1.5  # [3], Eq. 11
 
 
 @lru_cache(maxsize=1)

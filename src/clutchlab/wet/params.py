@@ -24,6 +24,7 @@ from ..errors import ParameterError
 from ..params import ParameterSet, quantity
 from ..params.base import WET_TEMPERATURES_C
 from .film import effective_radius, gw_pressure_scale, squeeze_film_coefficient
+from .thermal import pack_heat_capacity_scalar
 
 __all__ = ["WetClutch", "Bench"]
 
@@ -128,7 +129,7 @@ class WetClutch(ParameterSet):
     @property
     def heat_capacity(self) -> float:
         """Heat capacity of the pack ``{(m c_p)_lining + (m c_p)_core} N_c`` [J/K] (Eq. 8)."""
-        return (self.m_lining * self.cp_lining + self.m_core * self.cp_core) * self.n_c
+        return pack_heat_capacity_scalar(float(self.n_c), self.m_lining, self.cp_lining, self.m_core, self.cp_core)
 
     @functools.cached_property
     def gw_scale(self) -> float:

@@ -83,14 +83,15 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from ..errors import ParameterError
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.layout import indices, slots
 from ..system import System, variables
-from .film import (asperity_force_scalar, film_scalar, separation_scalar, slip_velocity_scalar,
-                   squeeze_film_force_scalar)
+from .film import (asperity_force_scalar, film_scalar, gw_pressure_scale_scalar, separation_scalar,
+                   slip_velocity_scalar, squeeze_film_force_scalar)
 from .friction import KIND_PARAMETRIC, ParametricFriction, mu_kernel, parametric_mu_scalar
-from .thermal import heat_balance_scalar
+from .thermal import heat_balance_scalar, pack_heat_capacity_scalar
 from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque_scalar
 from .viscosity import viscosity_scalar
 
@@ -208,10 +209,10 @@ CONSTANTS = (
     ("mu_v2", "1/K", "viscosity exponent (Eq. 7)"),
     ("mu_v3", "Pa*s", "viscosity parameter (Eq. 7)"),
     ("mu_v4", "1/K", "viscosity exponent (Eq. 7)"),
-    ("heat_capacity", "J/K", "pack heat capacity (Eq. 8)"),
+    ("heat_capacity", "J/K", "pack heat capacity (Eq. 8; derived by the start, wet_start)"),
     ("k1", "W/K", "conductance pack -> oil (Eq. 8)"),
     ("k2", "W/K", "conductance pack -> housing (Eq. 8)"),
-    ("gw_scale", "Pa", "Greenwood-Williamson pressure scale"),
+    ("gw_scale", "Pa", "Greenwood-Williamson pressure scale (Eq. 11; derived by the start, wet_start)"),
     ("squeeze_coefficient", "m^4", "squeeze-film factor (groove factor x K)"),
     ("spring_stiffness", "N/m", "piston return spring"),
     ("spring_preload", "N", "return spring preload at x_p = 0"),
@@ -234,6 +235,13 @@ CONSTANTS = (
     ("housing_cooling", "W/K", "natural cooling of the housing"),
     ("fluid_housing_conductance", "W/K", "oil -> housing"),
     ("ambient_temperature", "degC", "laboratory"),
+    ("m_lining", "kg", "mass of one lining (Table 1)"),
+    ("cp_lining", "J/(kg*K)", "specific heat capacity of the lining (Table 1)"),
+    ("m_core", "kg", "mass of one core disk (Table 1)"),
+    ("cp_core", "J/(kg*K)", "specific heat capacity of the core (Table 1)"),
+    ("asperity_radius", "m", "asperity tip radius beta (Table 1)"),
+    ("asperity_density", "1/m^2", "asperity density eta (Table 1)"),
+    ("contact_modulus", "Pa", "composite elastic modulus E' of the asperities"),
     ("force_scale", "1", "factor on the force profile (batch variants)"),
     ("mu_scale", "1", "factor on mu_f (batch variants)"),
     ("speed_scale", "1", "factor on the slip-speed profile (batch variants)"),
@@ -741,8 +749,35 @@ def wet_jacobian(t, x, u, m, p, J):
     return False
 
 
+@numba.njit(**_HOOK)
+def wet_start(t, x, u, m, p):
+    """What a run derives from its parameters alone, once before its first restart (the core's ``start`` hook): the
+    pack's heat capacity ([1], Eq. 8: :func:`~clutchlab.wet.thermal.pack_heat_capacity_scalar`) and the
+    Greenwood-Williamson pressure scale ([3], Eq. 11: :func:`~clutchlab.wet.film.gw_pressure_scale_scalar`) from
+    the masses, heat capacities and roughness parameters packed beside them, with the functions the Python side
+    computes them with (the same numbers).  So a native FMU, which runs it again after a host set those
+    parameters, writes them as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
+    c = p.constants[0]
+    c.heat_capacity = pack_heat_capacity_scalar(c.n_c, c.m_lining, c.cp_lining, c.m_core, c.cp_core)
+    c.gw_scale = gw_pressure_scale_scalar(c.sigma, c.asperity_radius, c.asperity_density, c.contact_modulus)
+    return 0
+
+
+#: the constants :func:`wet_start` derives (:attr:`clutchlab.system.System.decided_at_start`)
+DERIVED_AT_START = (("params.constants.heat_capacity", 0, None), ("params.constants.gw_scale", 0, None))
+#: ... and what each is derived from (an override of one would be replaced at the start: refused)
+_DERIVED_FROM = {"heat_capacity": "n_c, m_lining, cp_lining, m_core, cp_core",
+                 "gw_scale": "sigma, asperity_radius, asperity_density, contact_modulus"}
+
+
+def _refuse_derived(overrides, where):
+    for name in overrides:
+        if name in _DERIVED_FROM:
+            raise ParameterError(f"{where}: {name} is derived at the start of a run from {_DERIVED_FROM[name]} "
+                                 "(wet_start): override those")
+
 dispatch.register(WetParams, rhs=wet_rhs, outputs=wet_outputs, update=wet_update, restart=wet_restart,
-                  accept=wet_accept, next_break=wet_next_break, jacobian=wet_jacobian)
+                  accept=wet_accept, next_break=wet_next_break, jacobian=wet_jacobian, start=wet_start)
 
 
 # ----------------------------------------------------------------- packing
@@ -793,6 +828,9 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
         heater_gain=bench.heater_gain, heater_setpoint=scenario.setpoint_c, reservoir_cooling=bench.reservoir_cooling,
         housing_heat_capacity=bench.housing_heat_capacity, housing_cooling=bench.housing_cooling,
         fluid_housing_conductance=bench.fluid_housing_conductance, ambient_temperature=bench.ambient_temperature,
+        m_lining=clutch.m_lining, cp_lining=clutch.cp_lining, m_core=clutch.m_core, cp_core=clutch.cp_core,
+        asperity_radius=clutch.asperity_radius, asperity_density=clutch.asperity_density,
+        contact_modulus=clutch.contact_modulus,
         force_scale=1.0, mu_scale=1.0, speed_scale=1.0,
         free_inertia=scenario.motor == "free", friction_kind=int(kind),
         force_start=int(starts[0]), force_n=parts[0].size, speed_start=int(starts[2]), speed_n=parts[2].size,
@@ -803,6 +841,7 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
     unknown = [k for k in overrides if k not in values]
     if unknown:
         raise TypeError(f"pack_parameters: unknown field {unknown[0]!r} (known: {', '.join(values)})")
+    _refuse_derived(overrides, "pack_parameters")
     values.update(overrides)
     constants = np.array([tuple(values[n] for n in CONSTANTS_DTYPE.names)], dtype=CONSTANTS_DTYPE)
     return WetParams(constants, np.concatenate([new_work(scenario.initial_temperature_c)] + parts))
@@ -901,6 +940,7 @@ def fresh_buffers(params: WetParams, initial_temperature_c: float, **overrides) 
     """
     constants = params.constants
     if overrides:
+        _refuse_derived(overrides, "fresh_buffers")
         constants = constants.copy()
         for name, value in overrides.items():
             constants[name] = value
@@ -1079,4 +1119,4 @@ def engagement_system(scenario, *, clutch=None, bench=None, friction=None, param
         name="wet", params=params, states=_STATE_VARIABLES, outputs=_OUTPUT_VARIABLES, inputs=_INPUT_VARIABLES, x0=x0,
         m0=initial_modes(x0, clutch.piston_h0), atol=absolute_tolerance(clutch, rtol), switching=SWITCHING,
         events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES, method="dopri", rtol=float(rtol), event_tol=1e-12,
-        element_name=_element_name)
+        element_name=_element_name, decided_at_start=DERIVED_AT_START)

@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = [
-    "pack_heat_capacity",
+    "pack_heat_capacity", "pack_heat_capacity_scalar",
     "heat_balance",
     "thermal_time_constant",
     "steady_state_temperature",
@@ -31,6 +31,18 @@ __all__ = [
 
 def _out(x):
     return float(x) if np.ndim(x) == 0 else x
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def pack_heat_capacity_scalar(n_c, m_lining, cp_lining, m_core, cp_core):
+    """Heat capacity ``{(m c_p)_lining + (m c_p)_core} N_c`` of the pack [J/K] ([1], Eq. 8, left side), compiled:
+    the equation itself (:func:`pack_heat_capacity` checks its result; the wet model's compiled ``start`` derives
+    its pack's heat capacity with it, so a native FMU's host may set the masses and heat capacities).
+
+    Parameters: ``n_c`` clutches [-], ``m_lining``, ``m_core`` the masses of one lining and one core disk [kg],
+    ``cp_lining``, ``cp_core`` their specific heat capacities [J/(kg*K)].  Assumes a lumped pack (one temperature).
+    """
+    return (m_lining * cp_lining + m_core * cp_core) * n_c  # [1], Eq. 8
 
 
 def pack_heat_capacity(n_c, m_lining, cp_lining, m_core, cp_core):
@@ -45,7 +57,7 @@ def pack_heat_capacity(n_c, m_lining, cp_lining, m_core, cp_core):
     cp_lining, cp_core : float
         Their specific heat capacities [J/(kg*K)].
     """
-    c = (float(m_lining) * float(cp_lining) + float(m_core) * float(cp_core)) * float(n_c)  # [1], Eq. 8
+    c = pack_heat_capacity_scalar(float(n_c), float(m_lining), float(cp_lining), float(m_core), float(cp_core))
     if not c > 0:
         raise ParameterError(f"pack heat capacity = {c!r}: masses and heat capacities must be > 0")
     return c
