@@ -125,9 +125,11 @@ def test_prescribed_motion_is_followed_exactly():
 
 def test_the_start_derives_the_actuator_s_compliances_and_line_from_the_fields_beside_them():
     """``derive_actuator`` (the packing's and the core's ``start``; a native FMU runs it again after a host set the
-    line, the fluid, the hose or a volume) gives the chamber compliances ``V / beta + C_hose / 2``, the line's
-    inertance ``rho l / A`` and Hagen-Poiseuille resistance ``128 mu l / (pi d^4)`` and the snifting edge (port +
-    width) from the fields packed beside them: the closed forms, with parameters far from the defaults."""
+    line, the fluid, the hose, a volume, the spindle or the piston's mass) gives the chamber compliances
+    ``V / beta + C_hose / 2``, the line's inertance ``rho l / A`` and Hagen-Poiseuille resistance
+    ``128 mu l / (pi d^4)``, the snifting edge (port + width), the spindle ratio ``lead / 2 pi`` and the equivalent
+    mass ``m + J / n_s^2`` from the fields packed beside them: the closed forms, with parameters far from the
+    defaults."""
     import collections
     import math
 
@@ -135,15 +137,19 @@ def test_the_start_derives_the_actuator_s_compliances_and_line_from_the_fields_b
     from clutchlab.eclutch.actuator import ActuatorParameters
 
     a = ActuatorParameters(line_diameter=4e-3, line_length=1.5, bulk_modulus=3e8, hose_compliance=4e-13,
-                           fluid_density=990.0, fluid_viscosity=0.012, slave_volume=8e-6, snifting_width=4e-4)
+                           fluid_density=990.0, fluid_viscosity=0.012, slave_volume=8e-6, snifting_width=4e-4,
+                           lead=5e-3, master_mass=0.15, rotor_inertia=2e-5)
     par = S._actuator_vector(a)
     expected = {S.P_CM: a.master_volume / 3e8 + 2e-13, S.P_CS: 8e-6 / 3e8 + 2e-13,
                 S.P_LH: 990.0 * 1.5 / (math.pi * 4e-3 ** 2 / 4), S.P_RH: 128 * 0.012 * 1.5 / (math.pi * 4e-3 ** 4),
-                S.P_XSN: a.snifting_port + 4e-4}
+                S.P_XSN: a.snifting_port + 4e-4, S.P_NS: 5e-3 / (2 * math.pi),
+                S.P_MMC: 0.15 + 2e-5 / (5e-3 / (2 * math.pi)) ** 2}
     for k, value in expected.items():
         assert par[k] == pytest.approx(value, rel=1e-14), S.ACTUATOR_VECTOR[k]
         par[k] = 0.0
-    only = collections.namedtuple("Only", "par")   # (the one field the start reads)
-    assert S.eclutch_start(0.0, np.zeros(1), np.zeros(0), np.zeros(1, dtype=np.int64), only(par)) == 0
+    only = collections.namedtuple("Only", "par coord")   # (the fields the start reads)
+    coord = np.zeros((6, 3))
+    assert S.eclutch_start(0.0, np.zeros(1), np.zeros(0), np.zeros(1, dtype=np.int64), only(par, coord)) == 0
     for k, value in expected.items():
         assert par[k] == pytest.approx(value, rel=1e-14), S.ACTUATOR_VECTOR[k]
+    assert coord[S.CO_MASS, 0] == par[S.P_MMC] and not coord[:, 1:].any()   # (the master's mass)

@@ -851,12 +851,14 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     # parameters a host sets (found writable by rebuilding the model, and checked jointly): the controller's
     # gains, the motor's resistance, the clutch's friction coefficient and the seals' static ratio
     start = {"actuator.kp": 2500.0, "actuator.resistance": 0.25, "clutch.mu": 0.3, "friction.static_ratio": 1.3}
-    # and the hydraulics (line, fluid, hose, volumes, snifting port), from which the compiled start derives the
-    # compliances, the line's inertance and resistance and the snifting edge again in the FMU (derive_actuator):
+    # and the hydraulics (line, fluid, hose, volumes, snifting port) and the spindle and piston, from which the
+    # compiled start derives the compliances, the line's inertance and resistance, the snifting edge, the spindle
+    # ratio and the equivalent mass again in the FMU (derive_actuator):
     # fixed at export before (a product or a quotient of two parameters, a sum two of them share)
-    assert "47 parameters (19 fixed at export)" in lines[0], lines[0]
+    assert "49 parameters (17 fixed at export)" in lines[0], lines[0]
     start.update({"actuator.line_diameter": 4e-3, "actuator.bulk_modulus": 3e8, "actuator.hose_compliance": 4e-13,
-                  "actuator.fluid_viscosity": 0.012, "actuator.slave_volume": 8e-6, "actuator.snifting_width": 4e-4})
+                  "actuator.fluid_viscosity": 0.012, "actuator.slave_volume": 8e-6, "actuator.snifting_width": 4e-4,
+                  "actuator.lead": 5e-3, "actuator.master_mass": 0.12})
     assert all(svs[name].get("causality") == "parameter" for name in start)
     # (its atol follow it only below the default, a line on each side; and the controller's integral's tolerance
     # follows it and ki: the gain, whose law holds on both sides, keeps that number)

@@ -175,6 +175,7 @@ class ActuatorParameters(ParameterSet):
         }
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def spindle_ratio(lead):
     """Spindle transmission ``n_s = lead / (2 pi)`` [m/rad] ([1] Sec. 2.1: planetary spindle).
 
@@ -182,10 +183,14 @@ def spindle_ratio(lead):
     ----------
     lead : float
         Axial travel per revolution [m].
+
+    Compiled: the E-clutch's compiled start derives its spindle ratio with it
+    (:func:`clutchlab.eclutch.system.derive_actuator`).
     """
     return lead / (2.0 * math.pi)
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def reflected_mass(piston_mass, rotor_inertia, ratio):
     """Equivalent translational mass of piston and rotor, ``m + J / n_s^2`` [kg].
 
@@ -201,7 +206,7 @@ def reflected_mass(piston_mass, rotor_inertia, ratio):
     Notes
     -----
     Assumes a rigid spindle (its compliance is far stiffer than the
-    hydraulics); [1] Sec. 2.1.
+    hydraulics); [1] Sec. 2.1.  Compiled, as :func:`spindle_ratio`.
     """
     return piston_mass + rotor_inertia / ratio ** 2
 

@@ -55,8 +55,8 @@ from ..numerics.layout import indices, slots
 from ..system import System, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_compliance, chamber_pressure_rate,
                        controller_integral_rate, controller_voltage, current_rate, drive_voltage, drive_voltage_slopes,
-                       line_flow_rate, line_inertance, line_resistance, spindle_force, stop_contact,
-                       stop_contact_slopes, vent_opening, vent_opening_slope)
+                       line_flow_rate, line_inertance, line_resistance, reflected_mass, spindle_force,
+                       spindle_ratio, stop_contact, stop_contact_slopes, vent_opening, vent_opening_slope)
 from .friction import FrictionElement, kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
 from .network import GROUND, Lever, element_force, element_force_segment, solve_static
@@ -79,12 +79,15 @@ ACTUATOR_VECTOR = (
     # the fields the start derives the compliances, the line's inertance and resistance and the snifting edge
     # from (:func:`derive_actuator`)
     "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density", "fluid_viscosity",
-    "line_length", "line_diameter", "snifting_port")
-(P_VMC, P_VSL, P_BULK, P_HOSE, P_RHO, P_VISC, P_LLEN, P_DLINE, P_XPORT) = indices(
+    "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia")
+(P_VMC, P_VSL, P_BULK, P_HOSE, P_RHO, P_VISC, P_LLEN, P_DLINE, P_XPORT, P_LEAD, P_MMASS, P_JROT) = indices(
     ACTUATOR_VECTOR, "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density",
-    "fluid_viscosity", "line_length", "line_diameter", "snifting_port")
-#: the words of ``par`` the start derives (:func:`eclutch_start`; :attr:`clutchlab.system.System.decided_at_start`)
-DERIVED_AT_START = (("params.par", 4, 8), ("params.par", 9, 10))
+    "fluid_viscosity", "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia")
+#: the words the start derives (:func:`eclutch_start`; :attr:`clutchlab.system.System.decided_at_start`): of
+#: ``par``, the master's equivalent mass (2), the compliances, line inertance and resistance (4-7), the snifting
+#: edge (9), the spindle ratio (19); of ``coord``, the master's mass (its first word, ``coord[CO_MASS, 0]``)
+DERIVED_AT_START = (("params.par", 2, 3), ("params.par", 4, 8), ("params.par", 9, 10), ("params.par", 19, 20),
+                    ("params.coord", 0, 1))
 (P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
  P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
  P_REFMAX) = indices(
@@ -1004,22 +1007,27 @@ def derive_actuator(par):
     """The actuator's derived words of ``par`` (the ``P_*`` layout) from the fields packed beside them: the chamber
     compliances ``C = V / beta + C_hose / 2`` (:func:`~clutchlab.eclutch.actuator.chamber_compliance`), the line's
     inertance and laminar resistance (:func:`~clutchlab.eclutch.actuator.line_inertance`,
-    :func:`~clutchlab.eclutch.actuator.line_resistance`) and the snifting port's closing edge (port + width);
-    [1] Fig. 5a, [2].  Called by the packing and by the start (:func:`eclutch_start`)."""
+    :func:`~clutchlab.eclutch.actuator.line_resistance`), the snifting port's closing edge (port + width), the
+    spindle ratio ``lead / 2 pi`` and the master's equivalent mass ``m + J / n_s^2``
+    (:func:`~clutchlab.eclutch.actuator.spindle_ratio`, :func:`~clutchlab.eclutch.actuator.reflected_mass`);
+    [1] Sec. 2.1, Fig. 5a, [2].  Called by the packing and by the start (:func:`eclutch_start`)."""
     par[P_CM] = chamber_compliance(par[P_VMC], par[P_BULK], par[P_HOSE] / 2.0)
     par[P_CS] = chamber_compliance(par[P_VSL], par[P_BULK], par[P_HOSE] / 2.0)
     par[P_LH] = line_inertance(par[P_RHO], par[P_LLEN], par[P_DLINE])
     par[P_RH] = line_resistance(par[P_VISC], par[P_LLEN], par[P_DLINE])
     par[P_XSN] = par[P_XPORT] + par[P_WSN]
+    par[P_NS] = spindle_ratio(par[P_LEAD])
+    par[P_MMC] = reflected_mass(par[P_MMASS], par[P_JROT], par[P_NS])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def eclutch_start(t, x, u, m, p):
     """What a run derives from its parameters alone, once before its first restart (the core's ``start`` hook): the
-    actuator's compliances, line inertance and resistance and snifting edge (:func:`derive_actuator`).  The packing
+    actuator's words of :func:`derive_actuator`, and the master coordinate's mass (its equivalent mass).  The packing
     derives them with the same function; a native FMU runs it again after a host set the volumes, the fluid or the
     line, which it then writes as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
     derive_actuator(p.par)
+    p.coord[CO_MASS, 0] = p.par[P_MMC]   # (the master's coordinate carries the equivalent mass: Assembly)
     return 0
 
 
@@ -1085,7 +1093,6 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par = np.zeros(N_PAR)
     par[P_AMC] = a.master_area
     par[P_ASL] = a.slave_area
-    par[P_MMC] = a.master_equivalent_mass
     par[P_MSL] = a.slave_mass
     par[P_GV] = a.snifting_conductance
     par[P_WSN] = a.snifting_width
@@ -1097,7 +1104,6 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par[P_VSUP] = a.supply_voltage
     par[P_IMAX] = a.current_limit
     par[P_KIL] = a.current_limit_gain
-    par[P_NS] = a.spindle_ratio
     par[P_FPRE] = a.csc_preload
     par[P_KPRE] = a.csc_spring_rate
     par[P_UMIN] = a.slave_min
@@ -1120,6 +1126,9 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par[P_LLEN] = a.line_length
     par[P_DLINE] = a.line_diameter
     par[P_XPORT] = a.snifting_port
+    par[P_LEAD] = a.lead
+    par[P_MMASS] = a.master_mass
+    par[P_JROT] = a.rotor_inertia
     derive_actuator(par)   # (the words the start derives: written once)
     return par
 
