@@ -118,7 +118,8 @@ def _close(native, python, name, floor=1e-12):
     np.testing.assert_allclose(native, python, rtol=0, atol=1e-9 * scale + floor, err_msg=name)
 
 
-_FMPY_WITHOUT_CLUTCHLAB = r"""
+#: the head of every host script: clutchlab, numba, llvmlite and pythonfmu refused by an import hook
+_REFUSE_IMPORTS = r"""
 import importlib.abc, json, sys
 class Refuse(importlib.abc.MetaPathFinder):
     def find_spec(self, name, path=None, target=None):
@@ -126,7 +127,10 @@ class Refuse(importlib.abc.MetaPathFinder):
             raise ImportError(f"{name} is not importable in this host")
         return None
 sys.meta_path.insert(0, Refuse())
-import numpy as np
+"""
+
+
+_FMPY_WITHOUT_CLUTCHLAB = _REFUSE_IMPORTS + r"""import numpy as np
 import fmpy
 from fmpy.validation import validate_fmu
 spec = json.load(open(sys.argv[1]))
@@ -276,15 +280,7 @@ def test_a_parameter_s_range_ends_where_its_law_stops_holding(built, host, unpac
     assert int(status) == 3 and re.search(r"rtol = 1e-13 \[1\] is outside its range", text), text
 
 
-_START_VALUES_HOST = r"""
-import importlib.abc, json, sys
-class Refuse(importlib.abc.MetaPathFinder):
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in ("clutchlab", "numba", "llvmlite", "pythonfmu"):
-            raise ImportError(f"{name} is not importable in this host")
-        return None
-sys.meta_path.insert(0, Refuse())
-from ctypes import byref
+_START_VALUES_HOST = _REFUSE_IMPORTS + r"""from ctypes import byref
 from fmpy import calloc, extract, free, read_model_description
 from fmpy.logging import addLoggerProxy
 from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
