@@ -923,12 +923,15 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     for name in changed:
         _close(native[name], changed[name], name)
     assert np.max(np.abs(changed["clutch_torque"] - python["clutch_torque"])) > 1e-3 * np.max(np.abs(python["clutch_torque"]))
-    # the pack's masses and heat capacities and the asperities' roughness, from which the model's compiled start
-    # derives its heat capacity (Eq. 8) and Greenwood-Williamson scale (Eq. 11) again in the FMU (wet_start): they
-    # were fixed at export (a product of two parameters, a power law); the run equals clutchlab's built with them
-    assert "46 parameters (7 fixed at export)" in lines[0], lines[0]
+    # the pack's masses and heat capacities, the asperities' roughness and the plate's radii, from which the
+    # model's compiled start derives its heat capacity (Eq. 8), Greenwood-Williamson scale (Eq. 11), effective
+    # radius (Eq. 1') and squeeze coefficient again in the FMU (wet_start): they were fixed at export (a product of
+    # two parameters, a power law); the run equals clutchlab's built with them.  (The radii only outward: the
+    # friction area is the whole annulus at the start)
+    assert "48 parameters (5 fixed at export)" in lines[0], lines[0]
     pack = {"clutch.m_core": 1.3, "clutch.cp_lining": 0.8, "clutch.sigma": 1.2, "clutch.contact_modulus": 0.7,
-            "clutch.asperity_radius": 1.5, "clutch.asperity_density": 0.9}
+            "clutch.asperity_radius": 1.5, "clutch.asperity_density": 0.9, "clutch.r_outer": 1.05,
+            "clutch.r_inner": 0.97}
     start = {name: factor * float(svs[name].find("Real").get("start")) for name, factor in pack.items()}
     assert all(svs[name].get("causality") == "parameter" for name in start)
     native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)

@@ -409,23 +409,31 @@ def test_scenario_refuses_bad_profiles_on_both_paths(n):
 
 def test_the_start_derives_the_heat_capacity_and_contact_scale_from_the_fields_beside_them():
     """``wet_start`` (the core's ``start`` hook, run once before a run; a native FMU runs it again after a host set
-    the masses, heat capacities or roughness) derives the pack's heat capacity ([1], Eq. 8) and the
-    Greenwood-Williamson pressure scale ([3], Eq. 11) from the fields packed beside them: the closed forms, and the
-    packing's numbers to the last bit (the same compiled functions).  An override of either is refused: the start
+    the masses, heat capacities, roughness or radii) derives the pack's heat capacity ([1], Eq. 8), the
+    Greenwood-Williamson pressure scale ([3], Eq. 11), the effective radius ([1], Eq. 1': Table 1's 0.07758 m) and
+    the squeeze-film coefficient from the fields packed beside them: the closed forms, and the packing's numbers to
+    the last bit (the same compiled functions).  An override of either is refused: the start
     would replace it."""
     from clutchlab.errors import ParameterError
 
     clutch = CLUTCH.replace(m_core=0.1, cp_lining=1700.0, sigma=7e-4, contact_modulus=3e6)
     scen = Scenario([0.0, 0.05], [0.0, 2500.0], [0.0], [0.0], duration=0.3, motor="free")
     p = W.pack_parameters(clutch, BENCH, scen)
-    packed = {name: float(p.constants[name][0]) for name in ("heat_capacity", "gw_scale")}
-    p.constants["heat_capacity"] = 0.0
-    p.constants["gw_scale"] = 0.0
+    derived = ("heat_capacity", "gw_scale", "r_eff", "squeeze_coefficient")
+    packed = {name: float(p.constants[name][0]) for name in derived}
+    for name in derived:
+        p.constants[name] = 0.0
     assert W.wet_start(0.0, np.zeros(W.N_STATE), np.zeros(0), np.zeros(1, dtype=np.int64), p) == 0
     assert float(p.constants["heat_capacity"][0]) == packed["heat_capacity"] == pytest.approx(
         (clutch.m_lining * clutch.cp_lining + clutch.m_core * clutch.cp_core) * clutch.n_c, rel=1e-15)
     assert float(p.constants["gw_scale"][0]) == packed["gw_scale"] == pytest.approx(
         4.0 / 3.0 * 3e6 * clutch.asperity_density * math.sqrt(clutch.asperity_radius) * 7e-4 ** 1.5, rel=1e-14)
+    ro, ri = clutch.r_outer, clutch.r_inner
+    assert float(p.constants["r_eff"][0]) == packed["r_eff"] == pytest.approx(
+        2.0 / 3.0 * (ro ** 3 - ri ** 3) / (ro ** 2 - ri ** 2), rel=1e-14) == pytest.approx(0.077585, abs=5e-7)
+    assert float(p.constants["squeeze_coefficient"][0]) == packed["squeeze_coefficient"] == pytest.approx(
+        clutch.squeeze_flow_factor * 1.5 * math.pi * (ro ** 4 - ri ** 4 - (ro ** 2 - ri ** 2) ** 2 / math.log(ro / ri)),
+        rel=1e-12)
     with pytest.raises(ParameterError, match=r"pack_parameters: heat_capacity is derived at the start of a run "
                                              r"from n_c, m_lining"):
         W.pack_parameters(clutch, BENCH, scen, heat_capacity=100.0)

@@ -53,6 +53,8 @@ __all__ = [
     "squeeze_film_force",
     "gw_pressure_scale",
     "gw_pressure_scale_scalar",
+    "effective_radius_scalar",
+    "squeeze_film_coefficient_scalar",
 ]
 
 _SQRT2 = math.sqrt(2.0)
@@ -96,8 +98,16 @@ def effective_radius(r_outer, r_inner):
     ri = np.asarray(r_inner, dtype=float)
     if not np.all(np.isfinite(ri)) or np.any(ri < 0) or np.any(ri >= ro):
         raise ParameterError(f"r_inner = {r_inner!r}: must satisfy 0 <= r_inner < r_outer = {r_outer!r}")
-    out = 2.0 / 3.0 * (ro**3 - ri**3) / (ro**2 - ri**2)  # [1], Eq. (1')
+    out = np.asarray(effective_radius_scalar.py_func(ro, ri))   # [1], Eq. (1')
     return float(out) if out.ndim == 0 else out
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def effective_radius_scalar(r_outer, r_inner):
+    """``R_eff = 2/3 (R_o^3 - R_i^3) / (R_o^2 - R_i^2)`` [m] (Shin et al. [1], Eq. (1')), compiled scalar form: the
+    wet model's compiled start derives its effective radius with it (:func:`effective_radius` checks its
+    arguments, ``0 <= R_i < R_o`` [m]).  Uniform contact pressure over the face."""
+    return 2.0 / 3.0 * (r_outer ** 3 - r_inner ** 3) / (r_outer ** 2 - r_inner ** 2)  # [1], Eq. (1')
 
 
 def slip_velocity(slip_speed, r_eff):
@@ -489,7 +499,16 @@ def squeeze_film_coefficient(r_outer, r_inner):
     ri = float(_positive("r_inner", r_inner))
     if ri >= ro:
         raise ParameterError(f"r_inner = {ri!r}: must be < r_outer = {ro!r}")
-    return 1.5 * math.pi * (ro**4 - ri**4 - (ro**2 - ri**2) ** 2 / math.log(ro / ri))
+    return squeeze_film_coefficient_scalar(ro, ri)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def squeeze_film_coefficient_scalar(r_outer, r_inner):
+    """``K = 3 pi / 2 [R_o^4 - R_i^4 - (R_o^2 - R_i^2)^2 / ln(R_o/R_i)]`` [m^4] of the Reynolds squeeze film between
+    rigid parallel annular plates (Deur et al. [4]), compiled scalar form: the wet model's compiled start derives
+    its squeeze coefficient with it (:func:`squeeze_film_coefficient` checks ``0 < R_i < R_o`` [m])."""
+    return 1.5 * math.pi * (r_outer ** 4 - r_inner ** 4 - (r_outer ** 2 - r_inner ** 2) ** 2
+                            / math.log(r_outer / r_inner))
 
 
 def squeeze_film_force(mean_film, dh_dt, viscosity, r_outer, r_inner):

@@ -23,7 +23,7 @@ from typing import ClassVar
 from ..errors import ParameterError
 from ..params import ParameterSet, quantity
 from ..params.base import WET_TEMPERATURES_C
-from .film import effective_radius, gw_pressure_scale, squeeze_film_coefficient
+from .film import effective_radius, effective_radius_scalar, gw_pressure_scale, squeeze_film_coefficient
 from .thermal import pack_heat_capacity_scalar
 
 __all__ = ["WetClutch", "Bench"]
@@ -124,7 +124,8 @@ class WetClutch(ParameterSet):
     @functools.cached_property
     def r_eff(self) -> float:
         """Torque effective radius [m] (Eq. (1'))."""
-        return effective_radius(self.r_outer, self.r_inner)
+        effective_radius(self.r_outer, self.r_inner)   # (its checks)
+        return effective_radius_scalar(self.r_outer, self.r_inner)   # (the compiled start's number, wet_start)
 
     @property
     def heat_capacity(self) -> float:
@@ -139,7 +140,7 @@ class WetClutch(ParameterSet):
     @functools.cached_property
     def squeeze_coefficient(self) -> float:
         """Squeeze-film factor ``squeeze_flow_factor * K`` [m^4] (smooth-annulus K times the groove factor)."""
-        return self.squeeze_flow_factor * squeeze_film_coefficient(self.r_outer, self.r_inner)
+        return self.squeeze_flow_factor * squeeze_film_coefficient(self.r_outer, self.r_inner)   # (as wet_start)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -88,8 +88,8 @@ from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.layout import indices, slots
 from ..system import System, variables
-from .film import (asperity_force_scalar, film_scalar, gw_pressure_scale_scalar, separation_scalar,
-                   slip_velocity_scalar, squeeze_film_force_scalar)
+from .film import (asperity_force_scalar, effective_radius_scalar, film_scalar, gw_pressure_scale_scalar,
+                   separation_scalar, slip_velocity_scalar, squeeze_film_coefficient_scalar, squeeze_film_force_scalar)
 from .friction import KIND_PARAMETRIC, ParametricFriction, mu_kernel, parametric_mu_scalar
 from .thermal import heat_balance_scalar, pack_heat_capacity_scalar
 from .torque import asperity_torque_scalar, clutch_torque_scalar, viscous_torque_scalar
@@ -235,6 +235,9 @@ CONSTANTS = (
     ("housing_cooling", "W/K", "natural cooling of the housing"),
     ("fluid_housing_conductance", "W/K", "oil -> housing"),
     ("ambient_temperature", "degC", "laboratory"),
+    ("r_outer", "m", "outer radius of the friction face R_o (Table 1)"),
+    ("r_inner", "m", "inner radius of the friction face R_i (Table 1)"),
+    ("squeeze_flow_factor", "1", "squeeze resistance of the grooved pack relative to a smooth annulus"),
     ("m_lining", "kg", "mass of one lining (Table 1)"),
     ("cp_lining", "J/(kg*K)", "specific heat capacity of the lining (Table 1)"),
     ("m_core", "kg", "mass of one core disk (Table 1)"),
@@ -752,22 +755,28 @@ def wet_jacobian(t, x, u, m, p, J):
 @numba.njit(**_HOOK)
 def wet_start(t, x, u, m, p):
     """What a run derives from its parameters alone, once before its first restart (the core's ``start`` hook): the
-    pack's heat capacity ([1], Eq. 8: :func:`~clutchlab.wet.thermal.pack_heat_capacity_scalar`) and the
-    Greenwood-Williamson pressure scale ([3], Eq. 11: :func:`~clutchlab.wet.film.gw_pressure_scale_scalar`) from
-    the masses, heat capacities and roughness parameters packed beside them, with the functions the Python side
+    pack's heat capacity ([1], Eq. 8: :func:`~clutchlab.wet.thermal.pack_heat_capacity_scalar`), the
+    Greenwood-Williamson pressure scale ([3], Eq. 11: :func:`~clutchlab.wet.film.gw_pressure_scale_scalar`), the
+    effective radius ([1], Eq. (1'): :func:`~clutchlab.wet.film.effective_radius_scalar`) and the squeeze-film
+    coefficient ([4]: :func:`~clutchlab.wet.film.squeeze_film_coefficient_scalar`) from the masses, heat
+    capacities, roughness parameters and radii packed beside them, with the functions the Python side
     computes them with (the same numbers).  So a native FMU, which runs it again after a host set those
     parameters, writes them as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
     c = p.constants[0]
     c.heat_capacity = pack_heat_capacity_scalar(c.n_c, c.m_lining, c.cp_lining, c.m_core, c.cp_core)
     c.gw_scale = gw_pressure_scale_scalar(c.sigma, c.asperity_radius, c.asperity_density, c.contact_modulus)
+    c.r_eff = effective_radius_scalar(c.r_outer, c.r_inner)
+    c.squeeze_coefficient = c.squeeze_flow_factor * squeeze_film_coefficient_scalar(c.r_outer, c.r_inner)
     return 0
 
 
 #: the constants :func:`wet_start` derives (:attr:`clutchlab.system.System.decided_at_start`)
-DERIVED_AT_START = (("params.constants.heat_capacity", 0, None), ("params.constants.gw_scale", 0, None))
+DERIVED_AT_START = tuple((f"params.constants.{name}", 0, None)
+                         for name in ("heat_capacity", "gw_scale", "r_eff", "squeeze_coefficient"))
 #: ... and what each is derived from (an override of one would be replaced at the start: refused)
 _DERIVED_FROM = {"heat_capacity": "n_c, m_lining, cp_lining, m_core, cp_core",
-                 "gw_scale": "sigma, asperity_radius, asperity_density, contact_modulus"}
+                 "gw_scale": "sigma, asperity_radius, asperity_density, contact_modulus",
+                 "r_eff": "r_outer, r_inner", "squeeze_coefficient": "squeeze_flow_factor, r_outer, r_inner"}
 
 
 def _refuse_derived(overrides, where):
@@ -828,6 +837,7 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
         heater_gain=bench.heater_gain, heater_setpoint=scenario.setpoint_c, reservoir_cooling=bench.reservoir_cooling,
         housing_heat_capacity=bench.housing_heat_capacity, housing_cooling=bench.housing_cooling,
         fluid_housing_conductance=bench.fluid_housing_conductance, ambient_temperature=bench.ambient_temperature,
+        r_outer=clutch.r_outer, r_inner=clutch.r_inner, squeeze_flow_factor=clutch.squeeze_flow_factor,
         m_lining=clutch.m_lining, cp_lining=clutch.cp_lining, m_core=clutch.m_core, cp_core=clutch.cp_core,
         asperity_radius=clutch.asperity_radius, asperity_density=clutch.asperity_density,
         contact_modulus=clutch.contact_modulus,
