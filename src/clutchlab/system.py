@@ -52,8 +52,9 @@ _START_LATER = contextvars.ContextVar("clutchlab_start_checked_later", default=F
 @contextlib.contextmanager
 def start_checked_later():
     """Within this context a model's build does not refuse an initial state that its compiled ``start`` hook refuses
-    (a one-way clutch turning backward, :mod:`clutchlab.numerics.dispatch`): whoever builds there runs ``start``
-    itself before the run and refuses the state then.  A native FMU's exporter builds its trial models so: the FMU
+    (a driveline's one-way clutch turning backward, a gear or motion source its flanges' initial speeds disagree
+    with: :func:`clutchlab.driveline.kernel.driveline_start`, :mod:`clutchlab.numerics.dispatch`): whoever builds
+    there runs ``start`` itself before the run and refuses the state then.  A native FMU's exporter builds its trial models so: the FMU
     runs the model's ``start`` at its initialisation with the start values the host set, so the range of each
     initial speed is not cut where it crosses another's at their start values (a constraint between two start
     values, which no range of one can state)."""
