@@ -84,10 +84,11 @@ ACTUATOR_VECTOR = (
     ACTUATOR_VECTOR, "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density",
     "fluid_viscosity", "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia")
 #: the words the start derives (:func:`eclutch_start`; :attr:`clutchlab.system.System.decided_at_start`): of
-#: ``par``, the master's equivalent mass (2), the compliances, line inertance and resistance (4-7), the snifting
-#: edge (9), the spindle ratio (19); of ``coord``, the master's mass (its first word, ``coord[CO_MASS, 0]``)
-DERIVED_AT_START = (("params.par", 2, 3), ("params.par", 4, 8), ("params.par", 9, 10), ("params.par", 19, 20),
-                    ("params.coord", 0, 1))
+#: ``par``, the equivalent mass, the compliances, the line's inertance and resistance, the snifting edge and the
+#: spindle ratio (:func:`derive_actuator`); of ``coord``, the master's mass (``coord[CO_MASS, 0]``,
+#: :data:`DERIVED_COORD`)
+DERIVED_PAR = ("master_equivalent_mass", "master_compliance", "slave_compliance", "line_inertance", "line_resistance",
+               "snifting_edge", "spindle_ratio")
 (P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
  P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
  P_REFMAX) = indices(
@@ -1499,7 +1500,8 @@ class Assembly:
             mass=self.mvec, jac_cols=np.arange(n_jac), fd_scale=self.typ, nonautonomous=bool(nonauto),
             jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
             event_tol=float(event_tol), element_name=self.element_name, limits=self.limits(),
-            decided_at_start=DERIVED_AT_START,
+            decided_at_start=tuple(("params.par", k, k + 1) for k in indices(ACTUATOR_VECTOR, *DERIVED_PAR))
+            + (("params.coord", CO_MASS * self.nz, CO_MASS * self.nz + 1),),   # (coord[CO_MASS, 0], C order)
         )
 
     def limits(self) -> dict:

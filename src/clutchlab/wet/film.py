@@ -98,8 +98,9 @@ def effective_radius(r_outer, r_inner):
     ri = np.asarray(r_inner, dtype=float)
     if not np.all(np.isfinite(ri)) or np.any(ri < 0) or np.any(ri >= ro):
         raise ParameterError(f"r_inner = {r_inner!r}: must satisfy 0 <= r_inner < r_outer = {r_outer!r}")
-    out = np.asarray(effective_radius_scalar.py_func(ro, ri))   # [1], Eq. (1')
-    return float(out) if out.ndim == 0 else out
+    if ri.ndim == 0 and np.ndim(ro) == 0:   # (the compiled form: the number the wet model's start derives)
+        return float(effective_radius_scalar(float(ro), float(ri)))   # [1], Eq. (1')
+    return np.asarray(effective_radius_scalar.py_func(ro, ri))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

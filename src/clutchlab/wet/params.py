@@ -23,7 +23,7 @@ from typing import ClassVar
 from ..errors import ParameterError
 from ..params import ParameterSet, quantity
 from ..params.base import WET_TEMPERATURES_C
-from .film import effective_radius, effective_radius_scalar, gw_pressure_scale, squeeze_film_coefficient
+from .film import effective_radius, gw_pressure_scale, squeeze_film_coefficient
 from .thermal import pack_heat_capacity_scalar
 
 __all__ = ["WetClutch", "Bench"]
@@ -124,8 +124,7 @@ class WetClutch(ParameterSet):
     @functools.cached_property
     def r_eff(self) -> float:
         """Torque effective radius [m] (Eq. (1'))."""
-        effective_radius(self.r_outer, self.r_inner)   # (its checks)
-        return effective_radius_scalar(self.r_outer, self.r_inner)   # (the compiled start's number, wet_start)
+        return effective_radius(self.r_outer, self.r_inner)   # (the compiled start's number, wet_start)
 
     @property
     def heat_capacity(self) -> float:
