@@ -33,6 +33,7 @@ import io
 import re
 import tempfile
 import uuid
+import warnings
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
@@ -497,8 +498,6 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         if key == ((), ()):   # (built afresh: two builds of the same values tell the model's uninitialised memory)
             built.pop(key, None)
         if key not in built:
-            import warnings
-
             try:
                 # (values far out: overflow warnings of a model that takes them; an initial state the model's start
                 # refuses is refused by the FMU at its start, not by the ranges: start_checked_later)

@@ -21,10 +21,12 @@ sets): one whose every changed number is ``a * value + b`` (most are copies, ``a
 image in any other way (a table rebuilt, the arrays' sizes, a number two parameters share) is fixed at
 export, and a writable one's range ends where its law stops holding (:func:`law_holds`, searched by
 :func:`accepted_range` as the values the model refuses are).  The words the model's compiled ``start`` derives from the
-initial state (:attr:`clutchlab.system.System.decided_at_start`: a driveline's start modes and the stored
-energy its energy balance starts from) are no parameter's target: the FMU runs ``start`` again after a host
-set start values (before the run, :mod:`clutchlab.fmu.native`), so an initial speed is a copy into the
-state.  Words that differ between two builds of the same values
+initial state or from several parameters (:attr:`clutchlab.system.System.decided_at_start`: a driveline's start
+modes and the stored energy its energy balance starts from; the wet clutch's heat capacity, the E-clutch's
+compliances) are no parameter's target: the FMU runs ``start`` again after a host set start values (before the
+run, :mod:`clutchlab.fmu.native`), so an initial speed, a mass or a line diameter is a copy.  (Whether ``start``
+derives there what the model's build derives is not checked here, where the start words are left out: the tests
+compare the FMU's runs with clutchlab's at parameters a host set.)  Words that differ between two builds of the same values
 are memory the model never initialised and are ignored; a last build with every writable parameter changed
 at once must equal what the FMU writes; where the model refuses such a combination (a check across
 parameters), the parameters of the smallest refused set are fixed.
