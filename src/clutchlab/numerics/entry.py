@@ -295,7 +295,7 @@ class _FastEntry:
             return out
         try:
             key = _fingerprint(rest)
-            sig = tuple(d.typeof_pyval(a) for a in (p, *rest))
+            sig = tuple(_typeof(d, a) for a in (p, *rest))
             call = d.overloads[sig].entry_point
             hit = self.known.get(id(p))
             if hit is None or hit[0] is not p:
@@ -310,6 +310,23 @@ class _FastEntry:
 
 _FAST_KEEP = 4      # parameter structures a fast entry remembers (each held alive while remembered)
 _FAST: dict = {}
+#: numba types by fingerprint, the key of numba's own type cache (a structured dtype's is its canonical copy,
+#: which numba interns and keeps): numba's ``typeof_pyval`` builds a record array's type anew at every call
+#: (0.17 ms: the EMTC's vehicle and actuator records cost a bench run of 1 ms 20 %)
+_TYPES: dict = {}
+_TYPES_KEEP = 4096
+
+
+def _typeof(dispatcher, value):
+    """``dispatcher.typeof_pyval(value)``, remembered by ``value``'s fingerprint."""
+    fp = _fingerprint(value)
+    t = _TYPES.get(fp)
+    if t is None:
+        t = dispatcher.typeof_pyval(value)
+        if len(_TYPES) >= _TYPES_KEEP:
+            _TYPES.clear()
+        _TYPES[fp] = t
+    return t
 
 try:
     from numba._dispatcher import compute_fingerprint as _fingerprint
