@@ -174,7 +174,8 @@ class System:
         (:func:`clutchlab.control.operating_point`).
     decided_at_start : tuple of (str, int, int or None)
         What the model's compiled ``start`` hook writes from the initial state (:mod:`clutchlab.numerics.dispatch`),
-        and from the parameters alone, as ``(where, start, stop)`` slices: ``"m"`` the mode vector,
+        and from the parameters alone, as ``(where, start, stop)`` slices: ``"m"`` the mode vector, ``"x"`` the
+        state (the EMTC bench's shaft speeds, from its drum speed inputs),
         ``"params.<field>[.<field>...]"`` an array of the parameters or a field of a record array (the driveline:
         its network's modes and the stored energy it starts from, ``("params.work", -1, None)``; the wet clutch:
         the heat capacity and Greenwood-Williamson scale derived from its masses and roughness,

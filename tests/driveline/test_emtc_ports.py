@@ -101,7 +101,7 @@ def test_a_coil_current_port_makes_a_current_drive_whose_lags_follow_the_closed_
     system = d.system(1e-10)
     assert [(v.name, v.unit) for v in system.inputs] == [("i", "A")]
     p = system.params.emtc.params
-    tau1, tau2 = float(p.actuator.tau1[0]), float(p.actuator.tau2[0])
+    tau1, tau2 = float(p.actuator.data["tau1"][0]), float(p.actuator.data["tau2"][0])   # (one record per coupling)
     assert tau1 != tau2
     i0 = float(system.x0[[v.name for v in system.states].index("c.i2")])
     times = np.linspace(0.001, 0.05, 50)

@@ -197,3 +197,69 @@ def test_repeated_runs_get_fresh_memories_from_the_remembered_packing(magnet):
     # a different scenario is packed anew (its throttle profile)
     c = bench_system(magnet, BenchScenario(duration=0.2, sample_time=0.002, throttle_end=0.3), n_samples=101)
     assert not np.array_equal(c.params.throttle, b.params.throttle)
+
+
+def test_the_start_derives_the_vehicle_and_actuator_numbers_the_packing_derived(magnet):
+    """What the model derives from several parameters (Eq. 29's shaft inertias and lock shares, the axle loads, the
+    gear's ratio, the current lags' rates, the controller's table at the engaged airgap, the shafts' speeds on the
+    drums) is written by its compiled start (``emtc_start``, a native FMU runs it again after a host set the
+    parameters): equal to the closed forms, and to the packing's numbers bit for bit when the start finds them
+    erased; a combination no run can start from is refused by the start with its message."""
+    from clutchlab.emtc.bench import ActuatorParameters, VehicleParameters
+
+    veh = VehicleParameters(cg_to_front=1.2, cg_to_rear=1.7, wheelbase=2.9, rear_final_drive=2.8)
+    sc = BenchScenario(duration=0.05, gear=3, drum_speed=9.0, speed_difference=0.4)
+    act = ActuatorParameters(free_travel=0.45e-3, airgap_open=1.0e-3)
+    system = bench_system(magnet, sc, veh, BenchOptions(actuator=act))
+    v, a = system.params.vehicle[0], system.params.actuator[0]
+    jf = veh.inertia_input_shaft + veh.inertia_front_axle / 2.8 ** 2
+    jr = veh.inertia_output_shaft + veh.inertia_rear_axle / 2.8 ** 2
+    closed = {"gear_ratio": 1.556, "inertia_front": jf, "inertia_rear": jr, "lock_share_front": jr / (jf + jr),
+              "lock_share_rear": jf / (jf + jr), "axle_load_front": 2162.0 * 9.80665 * 1.7 / 2.9,
+              "axle_load_rear": 2162.0 * 9.80665 * 1.2 / 2.9, "inv_axle_ratio": 1.0 / 2.8}
+    for name, value in closed.items():
+        assert v[name] == pytest.approx(value, rel=1e-14), name
+    assert a["inv_tau1"] == 1.0 / act.tau1 and a["inv_tau2"] == 1.0 / act.tau2
+    # the controller's table: the calibration tables' C1 airgap reading at d - sigma = 0.55 mm (between the
+    # calibration airgaps 0.4 and 0.6 mm: the quadratics through 0.2-0.6 and 0.4-0.8 mm blended linearly,
+    # hysteresis._kernels.gap_weights), lower triangle
+    gaps, tables = magnet.airgaps, magnet.kernel_tables
+    gap, j = 0.55e-3, 1
+    assert gaps[j] < gap < gaps[j + 1]
+
+    def quadratic(first):
+        idx = range(first, first + 3)
+        return sum(tables[i] * np.prod([(gap - gaps[q]) / (gaps[i] - gaps[q]) for q in idx if q != i]) for i in idx)
+
+    s = (gap - gaps[j]) / (gaps[j + 1] - gaps[j])
+    lower = np.tril(np.ones(tables.shape[1:3], dtype=bool))
+    expected = (1.0 - s) * quadratic(j - 1) + s * quadratic(j)
+    np.testing.assert_allclose(system.params.controller_table[0][lower], expected[lower], rtol=1e-12, atol=1e-12)
+    assert not np.allclose(expected, tables[np.argmin(np.abs(gaps - 0.7e-3))])   # (not the default airgap's)
+    packed = {name: v[name] for name in S.DERIVED_VEHICLE}
+    table = system.params.controller_table.copy()
+    # erased, derived again by the start of a run, bit for bit
+    for name in S.DERIVED_VEHICLE:
+        system.params.vehicle[0][name] = 0.0
+    system.params.actuator[0]["inv_tau1"] = 0.0
+    system.params.controller_table[:] = 0.0
+    x0 = system.x0.copy()
+    system.x0[0] = system.x0[1] = 0.0
+    res = core_simulate(system, 0.05)
+    assert {name: system.params.vehicle[0][name] for name in S.DERIVED_VEHICLE} == packed
+    assert system.params.actuator[0]["inv_tau1"] == 1.0 / act.tau1
+    np.testing.assert_array_equal(system.params.controller_table, table)
+    np.testing.assert_array_equal(res.states[0, :2], x0[:2])
+    assert x0[0] == 9.0 / veh.tyre_radius * 2.8 and x0[1] == 8.6 / veh.tyre_radius * 2.8
+    np.testing.assert_array_equal(res.states, core_simulate(bench_system(magnet, sc, veh, BenchOptions(actuator=act)),
+                                                            0.05).states)
+    # refused at the start (a host of the native FMU sets the parameters one by one)
+    for record, name, value, message in (("vehicle", "wheelbase", 3.0, "must equal vehicle.wheelbase"),
+                                         ("vehicle", "gear", 7.0, "scenario.gear must be a whole number"),
+                                         ("vehicle", "gear", 2.5, "scenario.gear must be a whole number"),
+                                         ("actuator", "free_travel", 1.0e-3, "airgap_open must exceed"),
+                                         ("actuator", "airgap_open", 1.6e-3, "calibration airgaps")):
+        bad = bench_system(magnet, sc, veh, BenchOptions(actuator=act))
+        getattr(bad.params, record)[0][name] = value
+        with pytest.raises(SimulationError, match=message):
+            core_simulate(bad, 0.05)

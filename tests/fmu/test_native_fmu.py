@@ -721,6 +721,68 @@ def test_native_fmu_of_the_emtc_with_its_inputs(tmp_path, host, native_model):
         assert (int(status), expected is None or expected in text) == ((0, True) if expected is None else (3, True)), text
 
 
+def test_the_emtc_s_vehicle_and_actuator_are_derived_by_its_start_in_the_fmu(tmp_path, native_model):
+    """The EMTC's geometry, inertias, axle ratio, gear and airgaps were fixed at export (12 parameters): what the
+    model derives from them (the axle loads, ``J_F``, ``J_R`` and the lock torque's shares of Eq. 29, the gear's
+    ratio, the controller's table at the engaged airgap, the shafts' speeds on the drums) is a product, a quotient
+    or a table of several.  The compiled start derives them now (``emtc.system.emtc_start``), so a host sets them
+    and the run equals clutchlab's built with them; a combination no run can start from (a wheel base that is not
+    the sum of its lever arms, a free travel beyond the airgap, airgaps outside the magnet's calibration) is
+    refused at ``fmi2ExitInitializationMode`` with its message, as clutchlab refuses it."""
+    from clutchlab.fmu.emtc import EmtcCoSimulation
+
+    path, lines = native_model("emtc")
+    assert "57 parameters (1 fixed at export)" in lines[0], lines[0]
+    root, svs = _variables(path)
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == ["solver.fixed_step"]
+    start = {"vehicle.cg_to_front": 1.2, "vehicle.cg_to_rear": 1.7, "vehicle.wheelbase": 2.9,
+             "vehicle.rear_final_drive": 2.8, "vehicle.inertia_front_axle": 4.0, "vehicle.inertia_rear_axle": 2.9,
+             "vehicle.inertia_input_shaft": 0.06, "vehicle.inertia_output_shaft": 0.03,
+             "actuator.free_travel": 0.45e-3, "actuator.airgap_open": 1.0e-3, "scenario.gear": 3.0}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    n, dt = 150, 0.01
+    k = np.arange(n + 1)
+    inputs = {"torque_request": np.where(k * dt > 0.3, 400.0, 0.0), "throttle": np.full(n + 1, 0.3),
+              "drum_speed_front": np.full(n + 1, 9.0), "drum_speed_rear": 8.6 - 0.5 * (k * dt > 0.9)}
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(EmtcCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    plain = _python_run(EmtcCoSimulation, n, dt, inputs=inputs)
+    # (the shafts start free rolling on the drums through the new axle ratio: 9 m/s / 0.3622 m * 2.8)
+    assert native["front_shaft_speed"][0] == pytest.approx(9.0 / 0.3622 * 2.8, rel=1e-15)
+    for name in ("front_shaft_speed", "coupling_torque", "lock_torque"):
+        assert np.max(np.abs(changed[name] - plain[name])) > 1e-3 * np.max(np.abs(plain[name])), name
+    # refused by clutchlab (with the values) and by the FMU's start (with its message)
+    with pytest.raises(ParameterError, match="cg_to_front \\+ cg_to_rear = 2.7000 m differs from wheelbase = 2.9000"):
+        EmtcCoSimulation(**{"vehicle.wheelbase": 2.9})
+    # (a fractional gear is refused already by fmi2SetReal, as a fractional count of friction pairs)
+    cases = [{"vehicle.wheelbase": 2.9}, {"actuator.free_travel": 1.3e-3}, {"actuator.airgap_open": 1.6e-3}, start]
+    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
+    script.write_text(_START_VALUES_HOST)
+    names = [v.name for v in EmtcCoSimulation.outputs]
+    spec.write_text(json.dumps({"path": str(path), "cases": cases, "outputs": names, "result": str(result)}))
+    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    got = json.loads(result.read_text())
+    expected = ["cg_to_front + vehicle.cg_to_rear must equal vehicle.wheelbase",
+                "airgap_open must exceed actuator.free_travel",
+                "must lie within the magnet's calibration airgaps", None]
+    assert [(kind, what) for kind, what, _ in got] == [(kind, "refused" if e else "ok")
+                                                      for kind in ("cs", "me") for e in expected]
+    python = EmtcCoSimulation(**start).initial_outputs({})
+    for (kind, what, detail), message in zip(got, expected * 2):
+        if message:
+            assert message in detail and "(at t = 0 s)" in detail, detail
+        else:   # (the start clutchlab's own co-simulation reports: in model exchange too, the states the start set;
+            # there the controller's first sample, a time event at t = 0, is taken at the end of initialisation
+            # already, so its current command is the sample's, not the co-simulation's 0 before it)
+            for name in names:
+                if kind == "cs" or name != "current_command":
+                    assert detail[name] == pytest.approx(python[name], rel=1e-12, abs=1e-12), (kind, name)
+
+
 def test_the_emtc_native_fmu_snaps_a_step_end_onto_the_controller_s_sample(tmp_path, native_model):
     """A communication point within 1e-9 of a period of a controller sample counts as that sample, in the native
     FMU as in the Python co-simulation (``CoSimulation.step_grid_parameter``, ``cosim.snap_to_grid``; the C layer

@@ -15,14 +15,28 @@ from __future__ import annotations
 
 import dataclasses
 
+import numba
 import numpy as np
 
 from ..errors import ParameterError
 from ..params import ParameterSet, quantity
+from ..system import start_checks_deferred
 from ._lookup import bilinear
 from .friction import drag_torque
 
-__all__ = ["ActuatorParameters", "VehicleParameters", "BenchScenario", "TorqueMap"]
+__all__ = ["ActuatorParameters", "VehicleParameters", "BenchScenario", "TorqueMap", "static_axle_load", "GRAVITY"]
+
+#: standard gravity [m/s^2]
+GRAVITY = 9.80665
+
+
+@numba.njit(cache=True, nogil=True)
+def static_axle_load(mass, cg_to_other_axle, wheelbase):
+    """Static load of one axle [N]: the vehicle's weight ``mass`` [kg] times ``g`` shared by the lever arms,
+    ``F_z = m g l_other / L`` ([1], Table 1: the centre of mass ``cg_to_other_axle`` [m] from the *other* axle,
+    wheel base ``wheelbase`` [m]); the front axle's with ``l_r``, the rear's with ``l_f``.  Level ground, at rest
+    (no load transfer)."""
+    return mass * GRAVITY * cg_to_other_axle / wheelbase
 
 
 @dataclasses.dataclass(frozen=True)
@@ -44,7 +58,9 @@ class ActuatorParameters(ParameterSet):
     tau2: float = quantity(0.004, "s", "second current-control lag tau2 (Fig. 15)", source="representative", positive=True)
 
     def check(self) -> None:
-        if not self.airgap_open > self.free_travel:
+        # (a check across parameters that every run's start makes again: deferred to it in a native FMU's trial
+        # builds, :func:`clutchlab.system.start_checked_later`, so that no range of one is cut at the other's start)
+        if not self.airgap_open > self.free_travel and not start_checks_deferred():
             raise ParameterError(
                 f"ActuatorParameters: airgap_open = {self.airgap_open!r} m must exceed free_travel = "
                 f"{self.free_travel!r} m (Eq. 12: d > sigma)")
@@ -90,7 +106,8 @@ class VehicleParameters(ParameterSet):
     plate_inner_radius: float = quantity(0.055, "m", "inner radius R_1 of the wetted plates (Eq. 25)", source="representative", nonnegative=True)
 
     def check(self) -> None:
-        if abs(self.cg_to_front + self.cg_to_rear - self.wheelbase) > 1e-3:
+        # (checked again by every run's start: deferred to it in a native FMU's trial builds, as the actuator's)
+        if abs(self.cg_to_front + self.cg_to_rear - self.wheelbase) > 1e-3 and not start_checks_deferred():
             raise ParameterError(
                 f"VehicleParameters: cg_to_front + cg_to_rear = {self.cg_to_front + self.cg_to_rear:.4f} m "
                 f"differs from wheelbase = {self.wheelbase:.4f} m")
@@ -105,9 +122,9 @@ class VehicleParameters(ParameterSet):
                 f"VehicleParameters: gear_ratios = {list(ratios)!r}: must fall strictly from 1st to top gear")
 
     def axle_loads(self) -> tuple[float, float]:
-        """Static front and rear axle loads [N]."""
-        w = self.mass * 9.80665
-        return w * self.cg_to_rear / self.wheelbase, w * self.cg_to_front / self.wheelbase
+        """Static front and rear axle loads [N] (:func:`static_axle_load`)."""
+        return (float(static_axle_load(self.mass, self.cg_to_rear, self.wheelbase)),
+                float(static_axle_load(self.mass, self.cg_to_front, self.wheelbase)))
 
     def drag_coefficient(self) -> float:
         """``T_drag / omega`` of Eq. 25 [N*m*s/rad]."""

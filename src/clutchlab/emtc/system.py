@@ -56,16 +56,16 @@ from ..numerics.borrow import ByRef, borrow, byref, shaped
 from ..numerics.core import record
 from ..numerics.layout import indices, slots
 from ..numerics.outline import hook_args, log_type, outlined, prepare
-from ..system import System, follow_rtol, register_model
+from ..system import System, follow_rtol, register_model, start_checks_deferred
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance_path, lugre_mu, stribeck_g
-from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
+from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default, static_axle_load
 from .torque import UNLOCK_MARGIN, CouplingGeometry, _cam_force, _locked, _locked_capacity, _slipping
 
 # EmtcParams, the parameters of the compiled hooks, is the kernel's internal: not API (#33)
 __all__ = ["BenchOptions", "pack_parameters", "bench_system", "simulate", "STATES", "OUTPUTS",
            "INPUTS", "SWITCHING", "EVENTS", "EVENT_DESCRIPTIONS", "MODE_NAMES", "MODE_VALUES", "ERROR_MESSAGES",
-           "memory_full", "run", "run_controller", "controller_log", "VehicleData", "CouplingData", "ActuatorData",
+           "memory_full", "run", "run_controller", "controller_log", "VEHICLE_DTYPE", "CouplingData", "ACTUATOR_DTYPE",
            "armature_acceleration", "primary_clamp_force", "bench_loads", "lock_torque", "commanded_magnet_force"]
 
 # ------------------------------------------------------------------ the self-description
@@ -136,6 +136,8 @@ EV_ARM_REST, EV_ARM_CONTACT, EV_ARM_LEAVE_REST, EV_ARM_LEAVE_CONTACT, EV_LOCK, E
     "slip_reversal", "unlock")
 EL_ARMATURE, EL_COUPLING = indices(ELEMENTS, "armature", "coupling")
 _M_ARM, _M_CPL, _M_DIR = indices(MODE_NAMES, "armature_mode", "coupling_mode", "slip_direction")
+#: the shafts' speeds (the states the start writes from the drum speeds)
+X_OMEGA_F, X_OMEGA_R = indices(STATES, "omega_f", "omega_r")
 ARM_REST, ARM_FREE, ARM_CONTACT = indices(MODE_VALUES[_M_ARM], "rest", "free", "contact")
 OPEN, SLIPPING, LOCKED = indices(MODE_VALUES[_M_CPL], "open", "slipping", "locked")
 NEGATIVE, POSITIVE = indices(MODE_VALUES[_M_DIR], "negative", "positive")
@@ -151,9 +153,17 @@ REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT, REFERENCE_CURRENT = indices(
 
 # model errors (negative codes of the hooks)
 ERR_PLANT_MEMORY, ERR_CONTROLLER_MEMORY = -1, -2
+# ... and the start's refusals of parameters no run can start from (a native FMU's host sets them one by one;
+# clutchlab's own packing refuses them first, with their values)
+ERR_GEAR, ERR_GEOMETRY, ERR_AIRGAP, ERR_AIRGAP_RANGE = -3, -4, -5, -6
 ERROR_MESSAGES = {
     ERR_PLANT_MEMORY: "the plant magnet's hysteresis memory is full (BenchOptions.memory_capacity)",
     ERR_CONTROLLER_MEMORY: "the controller model's hysteresis memory is full (BenchOptions.memory_capacity)",
+    ERR_GEAR: "scenario.gear must be a whole number from 1 to the vehicle's number of gear ratios",
+    ERR_GEOMETRY: "vehicle.cg_to_front + vehicle.cg_to_rear must equal vehicle.wheelbase (within 1 mm)",
+    ERR_AIRGAP: "actuator.airgap_open must exceed actuator.free_travel ([1], Eq. 12: d > sigma)",
+    ERR_AIRGAP_RANGE: "the actuator's airgaps [airgap_open - free_travel, airgap_open] must lie within the magnet's "
+                      "calibration airgaps",
 }
 
 #: per-run integer memories (EmtcParams.imem)
@@ -202,14 +212,21 @@ N_FMEM = FMEM.total
 LOG_COLUMNS = ("command", "torque_reference", "throttle", "feasible")
 LOG_CMD, LOG_TREF, LOG_THR, LOG_FEASIBLE = indices(LOG_COLUMNS, "command", "torque_reference", "throttle", "feasible")
 #: the tables of EmtcParams.cold: (offset, size) pairs in EmtcParams.layout
+#: (``plant_tables`` and ``controller_tables`` are fields of their own, ``EmtcParams.plant_tables`` and
+#: ``controller_table``, empty here; the controller's table at its one airgap is derived by
+#: :func:`derive_actuator` from the controller model's tables at its calibration airgaps,
+#: ``controller_all_tables`` and ``controller_gaps``, and the gear ratio from ``gear_ratios``: read at the start)
 TABLES = ("plant_tables", "plant_gaps", "controller_tables", "controller_grid", "controller_stack",
           "controller_prefix", "map_throttle", "map_speed", "map_torque", "reference_time", "reference_value",
-          "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log")
+          "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log", "controller_all_tables",
+          "controller_gaps", "gear_ratios")
 (L_PLANT_TABLES, L_PLANT_GAPS, L_CTL_TABLES, L_CTL_GRID, L_CTL_STACK, L_CTL_PREFIX, L_MAP_THROTTLE,
- L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG) = indices(
+ L_MAP_SPEED, L_MAP_TORQUE, L_REF_TIME, L_REF_VALUE, L_FMAP_SPEED, L_FMAP_TEMP, L_FMAP_MU, L_LOG, L_CTL_ALL,
+ L_CTL_GAPS, L_GEAR_RATIOS) = indices(
     TABLES, "plant_tables", "plant_gaps", "controller_tables", "controller_grid", "controller_stack",
     "controller_prefix", "map_throttle", "map_speed", "map_torque", "reference_time", "reference_value",
-    "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log")
+    "friction_map_speed", "friction_map_temperature", "friction_map_mu", "log", "controller_all_tables",
+    "controller_gaps", "gear_ratios")
 N_LAYOUT = len(TABLES)
 
 #: absolute tolerances of the states at rtol 1e-6 and above: omega_f, omega_r [rad/s], theta [rad], x [m],
@@ -239,31 +256,27 @@ def absolute_tolerance(rtol: float = ATOL_RTOL) -> np.ndarray:
     return follow_rtol(ATOL, rtol, ATOL_RTOL)   # (the contract's one rule)
 
 
-class VehicleData(NamedTuple):
-    """Vehicle and drum-bench scalars of the model (SI; [1] Table 1, Eqs. 27-30 and clutchlab's bench)."""
-
-    front_final_drive: float
-    axle_ratio: float
-    gear_ratio: float
-    inertia_front: float
-    inertia_rear: float
-    tyre_radius: float
-    axle_load_front: float
-    axle_load_rear: float
-    rolling_resistance: float
-    tyre_slip_stiffness: float
-    slip_speed_floor: float
-    engine_torque_max: float
-    engine_power: float
-    torsen_stiffness: float
-    torsen_damping: float
-    drum_load_front: float
-    drum_load_rear: float
-    inv_axle_ratio: float  # 1 / axle_ratio, and below: the divisions of every evaluation done once when packing
-    inv_inertia_front: float
-    inv_inertia_rear: float
-    lock_share_front: float  # J_R / (J_F + J_R): the weight of A_f in T_lock (Eq. 29)
-    lock_share_rear: float  # J_F / (J_F + J_R)
+#: the vehicle and drum-bench numbers of a run (SI; [1] Table 1, Eqs. 27-30 and clutchlab's bench), one record
+#: (``EmtcParams.vehicle``, shape ``(1,)``): the parameters as given (``axle_ratio`` is
+#: ``VehicleParameters.rear_final_drive``, ``gear`` the scenario's, a whole number), then what
+#: :func:`derive_vehicle` derives from them (:data:`DERIVED_VEHICLE`), at the packing and again at the start of
+#: every run (a native FMU's host may have set the parameters)
+VEHICLE_PARAMETERS = ("mass", "cg_to_front", "cg_to_rear", "wheelbase", "gear", "front_final_drive", "axle_ratio",
+                      "tyre_radius", "inertia_front_axle", "inertia_rear_axle", "inertia_input_shaft",
+                      "inertia_output_shaft", "rolling_resistance", "tyre_slip_stiffness", "slip_speed_floor",
+                      "engine_torque_max", "engine_power", "torsen_stiffness", "torsen_damping", "drum_load_front",
+                      "drum_load_rear")
+DERIVED_VEHICLE = ("gear_ratio",         # the scenario's gear's ratio
+                   "inertia_front",      # J_F = J_sf + J_wf / i^2 ([1], Eq. 29)
+                   "inertia_rear",       # J_R = J_sr + J_wr / i^2
+                   "axle_load_front",    # static axle loads (Table 1's geometry)
+                   "axle_load_rear",
+                   "inv_axle_ratio",     # 1 / i, and below: the divisions of every evaluation, done once
+                   "inv_inertia_front",
+                   "inv_inertia_rear",
+                   "lock_share_front",   # J_R / (J_F + J_R): the weight of A_f in T_lock (Eq. 29)
+                   "lock_share_rear")    # J_F / (J_F + J_R)
+VEHICLE_DTYPE = np.dtype([(name, np.float64) for name in VEHICLE_PARAMETERS + DERIVED_VEHICLE])
 
 
 class CouplingData(NamedTuple):
@@ -278,27 +291,20 @@ class CouplingData(NamedTuple):
     temperature_c: float
 
 
-class ActuatorData(NamedTuple):
-    """Armature, return spring and current lags ([1], Eqs. 8-12, Fig. 15), SI."""
-
-    mass: float
-    stiffness: float
-    preload: float
-    damping: float
-    free_travel: float
-    airgap_open: float
-    tau1: float
-    tau2: float
-    inv_tau1: float  # 1 / tau1, 1 / tau2: the divisions of every evaluation done once when packing
-    inv_tau2: float
+#: the armature, return spring and current lags ([1], Eqs. 8-12, Fig. 15), SI, one record
+#: (``EmtcParams.actuator``, shape ``(1,)``): the parameters, then what :func:`derive_actuator` derives
+ACTUATOR_PARAMETERS = ("mass", "stiffness", "preload", "damping", "free_travel", "airgap_open", "tau1", "tau2")
+DERIVED_ACTUATOR = ("inv_tau1", "inv_tau2")   # 1 / tau1, 1 / tau2: the divisions of every evaluation, done once
+ACTUATOR_DTYPE = np.dtype([(name, np.float64) for name in ACTUATOR_PARAMETERS + DERIVED_ACTUATOR])
 
 
 class EmtcParams(NamedTuple):
     """Packed parameters and per-run memories of the EMTC drum-bench model (built by :func:`pack_parameters`).
 
-    Scalars are grouped in NamedTuples of floats (:class:`VehicleData`, :class:`CouplingData`,
-    :class:`ActuatorData`), the coupling geometry (:meth:`CouplingGeometry.kernel_data`) and the LuGre data
-    are tuples.  The core passes the structure to the hooks by reference with its arrays borrowed (no
+    The vehicle's and the actuator's numbers are one record each (arrays of shape ``(1,)``, :data:`VEHICLE_DTYPE`,
+    :data:`ACTUATOR_DTYPE`: the run's start writes what it derives there, :func:`emtc_start`), the coupling's
+    drag scalars a NamedTuple (:class:`CouplingData`), the coupling geometry
+    (:meth:`CouplingGeometry.kernel_data`) and the LuGre data tuples.  The core passes the structure to the hooks by reference with its arrays borrowed (no
     reference counting; see docs/architecture.md).  The arrays: the throttle profile and the plant magnet's memory
     (read on every evaluation), the integer and float memories of the run (``imem``, ``fmem``, offsets
     ``IM_*``, ``FM_*``), and one array ``cold`` with everything read only at controller samples, airgap
@@ -306,9 +312,9 @@ class EmtcParams(NamedTuple):
     run (or batch variant).
     """
 
-    vehicle: VehicleData
+    vehicle: np.ndarray
     coupling: CouplingData
-    actuator: ActuatorData
+    actuator: np.ndarray
     geometry: tuple
     lugre: tuple
     sample_time: float
@@ -328,6 +334,7 @@ class EmtcParams(NamedTuple):
     plant_stack: np.ndarray
     plant_prefix: np.ndarray
     plant_comb: np.ndarray
+    controller_table: np.ndarray
     imem: np.ndarray
     fmem: np.ndarray
     cold: np.ndarray
@@ -339,7 +346,7 @@ def armature_acceleration(fm, x, v, a):
     """Acceleration of the free armature ([1], Eq. 9 with ``F_n0 = F_n1 = 0``) [m/s^2].
 
     ``m0 a = F_m - F_k0 - K x - c v`` with the magnet force ``fm`` [N], displacement ``x`` [m], speed
-    ``v`` [m/s] and the armature data ``a`` (:class:`ActuatorData`).
+    ``v`` [m/s] and the armature data ``a`` (a record of :data:`ACTUATOR_DTYPE`).
     """
     return (fm - a.preload - a.stiffness * x - a.damping * v) / a.mass  # [1], Eq. 9
 
@@ -348,7 +355,7 @@ def armature_acceleration(fm, x, v, a):
 def primary_clamp_force(fm, a):
     """Force of the armature on the primary clutch at ``x = sigma``: ``F_m - F_k0 - K sigma`` ([1], Eq. 11) [N].
 
-    ``fm``: magnet force [N]; ``a``: :class:`ActuatorData`.  Negative values mean the armature leaves the
+    ``fm``: magnet force [N]; ``a``: a record of :data:`ACTUATOR_DTYPE`.  Negative values mean the armature leaves the
     clutch (the clamp force itself is ``max(., 0)``).
     """
     return fm - a.preload - a.stiffness * a.free_travel  # [1], Eq. 11
@@ -360,7 +367,7 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
 
     ``J_F dw_f/dt = A_f - T_c``, ``J_R dw_r/dt = T_c - A_r`` with ``A_f = (T_trans i0 - F_xf r - T_ff)/i``,
     ``A_r = (F_xr r + T_fr)/i`` at the shaft speeds ``wf``, ``wr`` [rad/s], throttle [-] and drum surface
-    speeds [m/s]; ``v``: :class:`VehicleData`.  Tyre force on a drum
+    speeds [m/s]; ``v``: a record of :data:`VEHICLE_DTYPE`.  Tyre force on a drum
     ``F_x = 2 C_x r (w_w r - v_d)/max(|v_d|, v_floor)`` per axle, rolling resistance
     ``f_rr F_z r tanh(w_w / 0.5 rad/s)`` plus the drum load, engine torque ``throttle min(T_max, P/w_e)``
     (clutchlab's assumptions: the paper does not model the tyre-drum contact or the engine).
@@ -395,7 +402,7 @@ def bench_loads(wf, wr, throttle, v_front, v_rear, v):
 def lock_torque(a_f, a_r, v):
     """Torque that keeps both shafts at the same acceleration, ``(J_R A_f + J_F A_r)/(J_F + J_R)`` ([1], Eq. 29) [N*m].
 
-    ``a_f``, ``a_r``: the loads of Eq. 27 [N*m]; ``v``: :class:`VehicleData`.
+    ``a_f``, ``a_r``: the loads of Eq. 27 [N*m]; ``v``: a record of :data:`VEHICLE_DTYPE`.
     """
     return v.lock_share_front * a_f + v.lock_share_rear * a_r  # [1], Eq. 29 (the shares J_R, J_F / (J_F + J_R))
 
@@ -406,7 +413,7 @@ def commanded_magnet_force(t_ref, g, a, split):
 
     ``F_n1 = T_ref / (T_c/F_n1)`` with the slipping-mode torque per newton of Eqs. 13-15 at the kinetic
     coefficients of the geometry ``g``, then ``F_m = F_n1 + F_k0 + K sigma`` (Eq. 11 solved for ``F_m``;
-    ``a``: :class:`ActuatorData`); 0 for ``t_ref <= 0``.  ``split`` is scratch (3 values).  Returns [N].
+    ``a``: a record of :data:`ACTUATOR_DTYPE`); 0 for ``t_ref <= 0``.  ``split`` is scratch (3 values).  Returns [N].
     """
     if not t_ref > 0.0:
         return 0.0
@@ -426,7 +433,7 @@ def _cold(cold, layout, k):
 def _switching(x, m, a, margin, aux, g):
     """Switching functions (:data:`SWITCHING`) from the state and the intermediates; inactive ones are +1.
 
-    ``a``: :class:`ActuatorData`; ``margin``: unlock margin of Fig. 11.
+    ``a``: a record of :data:`ACTUATOR_DTYPE`; ``margin``: unlock margin of Fig. 11.
     """
     for k in range(6):
         g[k] = 1.0
@@ -464,8 +471,8 @@ def _evaluate(t, x, u, m, p):
 def _switch(k, t, x, u, m, p, log):
     """Mode change when switching function ``k`` crossed at ``t`` ([1], Eqs. 8-11, Fig. 11); records the event."""
     fmem = p.fmem
-    a = p.actuator
-    v = p.vehicle
+    a = p.actuator[0]
+    v = p.vehicle[0]
     if k == 0:
         if m[0] != ARM_FREE:
             return
@@ -570,7 +577,7 @@ def _controller(t, x, u, p):
     """One controller sample at ``t``: reference (Eq. 31, table or input), force (Eqs. 13, 15, 11), current (Eqs. 6-7)."""
     fmem = p.fmem
     imem = p.imem
-    a = p.actuator
+    a = p.actuator[0]
     thr = u[U_THROTTLE] if p.throttle.shape[1] == 0 else interp1(p.throttle[0], p.throttle[1], t)
     if p.reference_source == REFERENCE_CURRENT:  # current drive: the coil's set point is an input, no controller
         fmem[FM_CMD] = u[U_COIL]
@@ -589,7 +596,8 @@ def _controller(t, x, u, p):
     elif p.reference_source == REFERENCE_TABLE:
         t_ref = interp1(_cold(p.cold, p.layout, L_REF_TIME), _cold(p.cold, p.layout, L_REF_VALUE), t)
     else:
-        vx = x[0] / p.vehicle.axle_ratio * p.vehicle.tyre_radius
+        v = p.vehicle[0]
+        vx = x[0] / v.axle_ratio * v.tyre_radius
         t_ref = bilinear(_cold(p.cold, p.layout, L_MAP_THROTTLE), _cold(p.cold, p.layout, L_MAP_SPEED),
                          shaped(_cold(p.cold, p.layout, L_MAP_TORQUE), (p.n_map_throttle, p.n_map_speed)), thr, vx)  # [1], Eq. 31
     fm_req = commanded_magnet_force(t_ref, p.geometry, a, fmem[FM_SPLIT:FM_SPLIT + 3])
@@ -600,8 +608,7 @@ def _controller(t, x, u, p):
         return
     # the controller's model at its one airgap, the engaged d - sigma: the airgap interpolation (Eqs. 2-5 are
     # linear in the table) applied to the cell coefficients once by pack_parameters, one table of weight 1
-    n = p.n_ctl_cells
-    tables = shaped(_cold(p.cold, p.layout, L_CTL_TABLES), (1, n, n, 4))
+    tables = p.controller_table
     grid = _cold(p.cold, p.layout, L_CTL_GRID)
     prefix = shaped(_cold(p.cold, p.layout, L_CTL_PREFIX), (1, stack.shape[0] // 2 + 2))
     cidx = imem[IM_CIDX:IM_CIDX + GAP_TABLES]
@@ -682,7 +689,7 @@ def _rhs(t, x, u, m, p, dx, g):
     the intermediates go to ``fmem[FM_AUX:]`` and the point of the evaluation to ``fmem[FM_KEY:]`` (an
     output sample at the end of a step reuses it).
     """
-    a = p.actuator
+    a = p.actuator[0]
     fmem = p.fmem
     if abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)) and _same_point(t, x, u, m, fmem):  # (the time first)
         # the point of the last evaluation again (a controller sample at the end of a step): only the
@@ -694,7 +701,7 @@ def _rhs(t, x, u, m, p, dx, g):
         dx[5] = (_command(u, p) - x[5]) * a.inv_tau1
         return
     aux = fmem[FM_AUX:FM_AUX + N_AUX]
-    v = p.vehicle
+    v = p.vehicle[0]
     c = p.coupling
     geo = p.geometry
     arm = m[0]
@@ -857,7 +864,7 @@ def _outputs(t, x, u, m, p, y):
     # a sample at the end of a step reuses the step's last evaluation (same point, memories not yet committed)
     aux = fmem[FM_AUX:FM_AUX + N_AUX] if _same_point(t, x, u, m, fmem) else _evaluate(t, x, u, m, p)
     y[0] = x[0] - x[1]
-    y[1] = p.actuator.airgap_open - x[3]
+    y[1] = p.actuator[0].airgap_open - x[3]
     y[2] = aux[AUX_FM]
     y[3] = aux[AUX_FN1]
     y[4] = aux[AUX_FN2]
@@ -999,13 +1006,17 @@ def params_template() -> EmtcParams:
     def zeros(cls):
         return cls(*([0.0] * len(cls._fields)))
 
+    def record(dtype):
+        return np.zeros(1, dtype=dtype)
+
     geometry = (0.0,) * len(_default(CouplingGeometry).kernel_data())
     return EmtcParams(
-        vehicle=zeros(VehicleData), coupling=zeros(CouplingData), actuator=zeros(ActuatorData),
+        vehicle=record(VEHICLE_DTYPE), coupling=zeros(CouplingData), actuator=record(ACTUATOR_DTYPE),
         geometry=geometry, lugre=(0.0,) * 6, sample_time=0.0, friction_mode=0, reference_source=0,
         n_airgaps=0, n_cells=0, n_ctl_cells=0, n_fmap_speed=0, n_fmap_temp=0, n_map_throttle=0, n_map_speed=0,
         layout=(0,) * (2 * N_LAYOUT), throttle=f2, plant_tables=f4, plant_grid=f1, plant_stack=f1.copy(),
-        plant_prefix=f2.copy(), plant_comb=f4.copy(), imem=i1, fmem=f1.copy(), cold=f1.copy())
+        plant_prefix=f2.copy(), plant_comb=f4.copy(), controller_table=f4.copy(), imem=i1, fmem=f1.copy(),
+        cold=f1.copy())
 
 
 @functools.lru_cache(maxsize=1)
@@ -1032,8 +1043,114 @@ def _update_hook(t, x, u, m, p, k, log):
     return _update_outlined(t, x, u, m, p, k, log)
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def coupling_shaft_inertia(j_shaft, j_axle, ratio):
+    """Inertia of one side of the coupling at its shaft [kg*m^2]: ``J = J_s + J_w / i^2`` ([1], Eq. 29: ``J_F``
+    from the input shaft's ``J_sf`` and the front axle's ``J_wf``, ``J_R`` from ``J_sr`` and ``J_wr``), the axle
+    and wheels ``j_axle`` [kg*m^2] reflected through the axle ratio ``ratio`` (``i_f = i_r``, Eq. 28) onto the
+    shaft ``j_shaft`` [kg*m^2].  Rigid drive shafts, no gear losses."""
+    return j_shaft + j_axle / (ratio * ratio)   # [1], Eq. 29
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def derive_vehicle(vehicle, ratios):
+    """What a run derives from the vehicle's parameters (:data:`DERIVED_VEHICLE`), written into its record
+    ``vehicle[0]`` (:data:`VEHICLE_DTYPE`): the gear's ratio from ``ratios`` (``VehicleParameters.gear_ratios``),
+    the shaft inertias ``J_F``, ``J_R`` ([1], Eq. 29, :func:`coupling_shaft_inertia`) and the lock torque's
+    shares of them, the static axle loads (:func:`~clutchlab.emtc.params.static_axle_load`) and the reciprocals
+    every evaluation uses.  Called by the packing and by every run's start (:func:`emtc_start`).
+
+    Returns 0, or :data:`ERR_GEAR` (the gear is not a whole number from 1 to ``len(ratios)``) or
+    :data:`ERR_GEOMETRY` (``cg_to_front + cg_to_rear`` is not ``wheelbase`` within 1 mm) with nothing written.
+    """
+    v = vehicle[0]
+    if not (1.0 <= v.gear <= ratios.shape[0] and v.gear == math.floor(v.gear)):
+        return ERR_GEAR
+    if not abs(v.cg_to_front + v.cg_to_rear - v.wheelbase) <= 1e-3:
+        return ERR_GEOMETRY
+    v.gear_ratio = ratios[int(v.gear) - 1]
+    jf = coupling_shaft_inertia(v.inertia_input_shaft, v.inertia_front_axle, v.axle_ratio)   # [1], Eq. 29, J_F
+    jr = coupling_shaft_inertia(v.inertia_output_shaft, v.inertia_rear_axle, v.axle_ratio)   # [1], Eq. 29, J_R
+    v.inertia_front = jf
+    v.inertia_rear = jr
+    v.axle_load_front = static_axle_load(v.mass, v.cg_to_rear, v.wheelbase)
+    v.axle_load_rear = static_axle_load(v.mass, v.cg_to_front, v.wheelbase)
+    v.inv_axle_ratio = 1.0 / v.axle_ratio
+    v.inv_inertia_front = 1.0 / jf
+    v.inv_inertia_rear = 1.0 / jr
+    v.lock_share_front = jr / (jf + jr)
+    v.lock_share_rear = jf / (jf + jr)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _outside(gaps, lo, hi):
+    """Whether the airgaps ``[lo, hi]`` [m] leave the calibration airgaps ``gaps`` (one airgap: never)."""
+    n = gaps.shape[0]
+    return n > 1 and (lo < gaps[0] - 1e-12 or hi > gaps[n - 1] + 1e-12)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def derive_actuator(actuator, cold, layout, table):
+    """What a run derives from the actuator's parameters (:data:`DERIVED_ACTUATOR`), written into its record
+    ``actuator[0]`` (:data:`ACTUATOR_DTYPE`): the current lags' rates, and into ``table`` (``(1, N, N, 4)``,
+    ``EmtcParams.controller_table``) the controller model's cell coefficients at its one airgap, the engaged
+    ``d - sigma`` ([1], Eq. 12), interpolated over its calibration airgaps (Eqs. 2-5 are linear in the table:
+    :func:`~clutchlab.hysteresis._kernels.gap_weights`, :func:`~clutchlab.hysteresis._kernels.combine_tables`),
+    from the tables packed in ``cold`` (``controller_all_tables``, ``controller_gaps``; ``layout``:
+    ``EmtcParams.layout``).  Called by the packing and by every run's start (:func:`emtc_start`).
+
+    Returns 0, or :data:`ERR_AIRGAP` (``airgap_open <= free_travel``) or :data:`ERR_AIRGAP_RANGE` (the
+    airgaps from ``airgap_open - free_travel`` to ``airgap_open`` leave the plant's or the controller's
+    calibration airgaps) with nothing written.
+    """
+    a = actuator[0]
+    if not a.airgap_open > a.free_travel:
+        return ERR_AIRGAP
+    lo = a.airgap_open - a.free_travel
+    gaps = _cold(cold, layout, L_CTL_GAPS)
+    if _outside(_cold(cold, layout, L_PLANT_GAPS), lo, a.airgap_open) or _outside(gaps, lo, a.airgap_open):
+        return ERR_AIRGAP_RANGE
+    a.inv_tau1 = 1.0 / a.tau1
+    a.inv_tau2 = 1.0 / a.tau2
+    ng = gaps.shape[0]
+    n = table.shape[1]
+    idx = np.zeros(GAP_TABLES, dtype=np.int64)
+    w = np.zeros(GAP_TABLES)
+    gap_weights(gaps, min(max(lo, gaps[0]), gaps[ng - 1]), idx, w)
+    combine_tables(shaped(_cold(cold, layout, L_CTL_ALL), (ng, n, n, 4)), idx, w, table)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def emtc_start(t, x, u, m, p):
+    """What a run derives from its parameters and inputs alone, once before its first restart (the core's
+    ``start`` hook): the vehicle's (:func:`derive_vehicle`) and the actuator's (:func:`derive_actuator`) derived
+    numbers, and the shafts' speeds of free rolling on the drums, ``omega = v_drum / r_w * i`` (the drum speed
+    inputs ``u``), as :func:`bench_system` starts them.  So a native FMU, which runs it again after a host set
+    parameters or the drum speeds' start values, writes the parameters as plain copies
+    (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0 or the refusal's negative code
+    (:data:`ERROR_MESSAGES`)."""
+    e = derive_vehicle(p.vehicle, _cold(p.cold, p.layout, L_GEAR_RATIOS))
+    if e != 0:
+        return e
+    e = derive_actuator(p.actuator, p.cold, p.layout, p.controller_table)
+    if e != 0:
+        return e
+    v = p.vehicle[0]
+    x[X_OMEGA_F] = u[U_DRUM_FRONT] / v.tyre_radius * v.axle_ratio
+    x[X_OMEGA_R] = u[U_DRUM_REAR] / v.tyre_radius * v.axle_ratio
+    return 0
+
+
+#: the words :func:`emtc_start` writes (:attr:`clutchlab.system.System.decided_at_start`)
+#: (each record's one element; the whole table; the two shafts' speeds)
+DECIDED_AT_START = tuple([(f"params.vehicle.{name}", 0, None) for name in DERIVED_VEHICLE]
+                         + [(f"params.actuator.{name}", 0, None) for name in DERIVED_ACTUATOR]
+                         + [("params.controller_table", 0, None), ("x", X_OMEGA_F, X_OMEGA_R + 1)])
+
 dispatch.register(EmtcParams, inline_stages=True, rhs=_rhs, outputs=_outputs, update=_update_hook, restart=_restart,
-                  accept=_accept, next_break=_next_break, jacobian=_jacobian)
+                  accept=_accept, next_break=_next_break, jacobian=_jacobian, start=emtc_start)
 
 
 # ------------------------------------------------------------------ packing (the only place)
@@ -1157,10 +1274,12 @@ _PACKED: dict = {}
 
 
 def _fresh_memories(params: EmtcParams) -> EmtcParams:
-    """``params`` with its own copy of every array a run writes (memories, stacks, the controller log)."""
+    """``params`` with its own copy of every array a run writes (memories, stacks, the controller log, what its
+    start derives)."""
     return params._replace(imem=params.imem.copy(), fmem=params.fmem.copy(), plant_stack=params.plant_stack.copy(),
                            plant_prefix=params.plant_prefix.copy(), plant_comb=params.plant_comb.copy(),
-                           cold=params.cold.copy())
+                           cold=params.cold.copy(), vehicle=params.vehicle.copy(), actuator=params.actuator.copy(),
+                           controller_table=params.controller_table.copy())
 
 
 def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
@@ -1176,13 +1295,15 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     ctl = options.controller_model or magnet
     lo_gap = actuator.airgap_open - actuator.free_travel
     for name, model in (("magnet", magnet), ("controller_model", ctl)):
+        if start_checks_deferred():
+            break   # (a check across parameters the start makes again: its own refusal, ERR_AIRGAP_RANGE)
         if model.n_airgaps > 1 and (lo_gap < model.airgaps[0] - 1e-12
                                     or actuator.airgap_open > model.airgaps[-1] + 1e-12):
             raise ParameterError(
                 f"{name}: airgap range [{lo_gap:g}, {actuator.airgap_open:g}] m of the actuator is outside the "
                 f"calibration airgaps [{model.airgaps[0]:g}, {model.airgaps[-1]:g}] m")
     ic = vehicle.rear_final_drive
-    fzf, fzr = vehicle.axle_loads()
+    ratios = np.asarray(vehicle.gear_ratios, dtype=float)
     geo = [float(g) for g in coupling.kernel_data()]
     lugre = (0.0,) * 6
     fmap = (np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.ones((2, 2)))
@@ -1223,7 +1344,10 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     cold = _Cold()
     cold.add(L_PLANT_TABLES, np.zeros(0))  # a field of its own (every accepted step reads it)
     cold.add(L_PLANT_GAPS, magnet.airgaps)
-    cold.add(L_CTL_TABLES, _table_at(ctl, lo_gap))
+    cold.add(L_CTL_TABLES, np.zeros(0))  # a field of its own (derived from the two below by the start)
+    cold.add(L_CTL_ALL, ctl.kernel_tables)
+    cold.add(L_CTL_GAPS, ctl.airgaps)
+    cold.add(L_GEAR_RATIOS, ratios)
     cold.add(L_CTL_GRID, ctl.grid)
     cold.add(L_CTL_STACK, np.zeros(cap))
     cold.add(L_CTL_PREFIX, np.zeros((1, cap // 2 + 2)))
@@ -1247,55 +1371,40 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_KEY] = np.nan
     fmem[FM_SEG:FM_SEG + 9] = np.nan
     fmem[FM_CSEG:FM_CSEG + 8] = np.nan
-    jf = float(vehicle.inertia_input_shaft + vehicle.inertia_front_axle / ic**2)  # [1], Eq. 29, J_F
-    jr = float(vehicle.inertia_output_shaft + vehicle.inertia_rear_axle / ic**2)  # [1], Eq. 29, J_R
     if not 1 <= scenario.gear <= len(vehicle.gear_ratios):
         raise ParameterError(f"BenchScenario: gear = {scenario.gear}: the vehicle has gears 1 to "
                              f"{len(vehicle.gear_ratios)} (VehicleParameters.gear_ratios)")
-    veh = VehicleData(
-        front_final_drive=float(vehicle.front_final_drive), axle_ratio=float(ic),
-        gear_ratio=float(vehicle.gear_ratios[scenario.gear - 1]), inertia_front=jf, inertia_rear=jr,
-        tyre_radius=float(vehicle.tyre_radius), axle_load_front=float(fzf), axle_load_rear=float(fzr),
-        rolling_resistance=float(vehicle.rolling_resistance), tyre_slip_stiffness=float(vehicle.tyre_slip_stiffness),
-        slip_speed_floor=float(vehicle.slip_speed_floor), engine_torque_max=float(vehicle.engine_torque_max),
-        engine_power=float(vehicle.engine_power), torsen_stiffness=float(vehicle.torsen_stiffness),
-        torsen_damping=float(vehicle.torsen_damping), drum_load_front=float(scenario.drum_load_front),
-        drum_load_rear=float(scenario.drum_load_rear), inv_axle_ratio=1.0 / float(ic), inv_inertia_front=1.0 / jf,
-        inv_inertia_rear=1.0 / jr, lock_share_front=jr / (jf + jr), lock_share_rear=jf / (jf + jr))
+    given = dict(axle_ratio=ic, gear=scenario.gear, drum_load_front=scenario.drum_load_front,
+                 drum_load_rear=scenario.drum_load_rear)
+    veh = np.zeros(1, dtype=VEHICLE_DTYPE)
+    for name in VEHICLE_PARAMETERS:
+        veh[0][name] = float(given[name] if name in given else getattr(vehicle, name))
     cpl = CouplingData(
         drag_pairs=float(vehicle.drag_pairs), oil_viscosity=float(vehicle.oil_viscosity),
         plate_clearance=float(vehicle.plate_clearance), plate_outer_radius=float(vehicle.plate_outer_radius),
         plate_inner_radius=float(vehicle.plate_inner_radius), unlock_margin=float(UNLOCK_MARGIN),
         temperature_c=float(scenario.temperature_c))
-    act = ActuatorData(
-        mass=float(actuator.mass), stiffness=float(actuator.stiffness), preload=float(actuator.preload),
-        damping=float(actuator.damping), free_travel=float(actuator.free_travel),
-        airgap_open=float(actuator.airgap_open), tau1=float(actuator.tau1), tau2=float(actuator.tau2),
-        inv_tau1=1.0 / float(actuator.tau1), inv_tau2=1.0 / float(actuator.tau2))
+    act = np.zeros(1, dtype=ACTUATOR_DTYPE)
+    for name in ACTUATOR_PARAMETERS:
+        act[0][name] = float(getattr(actuator, name))
+    cold_array = cold.array()
+    layout = tuple(int(q) for q in cold.layout)
+    table = np.zeros((1, nc, nc, 4))
+    # what the start derives, with its functions (the parameters were checked above, with their values, unless the
+    # start is to refuse them: start_checked_later)
+    refused = [e for e in (derive_vehicle(veh, ratios), derive_actuator(act, cold_array, layout, table)) if e]
+    if refused and not start_checks_deferred():
+        raise ParameterError(f"EMTC bench: {ERROR_MESSAGES[refused[0]]}")
     return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
         n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_cells=int(nc),
         n_fmap_speed=int(np.shape(fmap[2])[0]), n_fmap_temp=int(np.shape(fmap[2])[1]),
         n_map_throttle=int(torque_map.torque.shape[0]), n_map_speed=int(torque_map.torque.shape[1]),
-        layout=tuple(int(q) for q in cold.layout), throttle=_f(throttle), plant_tables=_f(magnet.kernel_tables),
+        layout=layout, throttle=_f(throttle), plant_tables=_f(magnet.kernel_tables),
         plant_grid=_f(magnet.grid),
         plant_stack=np.zeros(cap), plant_prefix=np.zeros((magnet.n_airgaps, cap // 2 + 2)),
-        plant_comb=np.zeros((1, n, n, 4)), imem=imem, fmem=fmem, cold=cold.array())
-
-
-def _table_at(model, gap):
-    """``model``'s cell coefficients at the airgap ``gap`` [m] (clamped to its calibration airgaps): one table,
-    shape ``(1, N, N, 4)``, the weights of its airgap interpolation applied to the coefficients ([1], Eqs. 2-5
-    are linear in the table; :func:`~clutchlab.hysteresis._kernels.combine_tables`)."""
-    gaps = _f(model.airgaps)
-    tables = _f(model.kernel_tables)
-    idx = np.zeros(GAP_TABLES, dtype=np.int64)
-    w = np.zeros(GAP_TABLES)
-    gap_weights(gaps, float(min(max(gap, gaps[0]), gaps[-1])), idx, w)
-    out = np.zeros((1,) + tables.shape[1:])
-    combine_tables(tables, idx, w, out)
-    return out
+        plant_comb=np.zeros((1, n, n, 4)), controller_table=table, imem=imem, fmem=fmem, cold=cold_array)
 
 
 def controller_log(params: EmtcParams) -> np.ndarray:
@@ -1343,6 +1452,7 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     vf = scenario.drum_speed
     vr = scenario.drum_speed - scenario.speed_difference
     ic = vehicle.rear_final_drive
+    # (free rolling on the drums: emtc_start writes the shafts' speeds again from the drum speeds in u0)
     x0 = np.array([vf / vehicle.tyre_radius * ic, vr / vehicle.tyre_radius * ic, 0.0, 0.0, 0.0,
                    magnet.grid[0], magnet.grid[0]])
     u0 = np.array([0.0, scenario.throttle_start, vf, vr, magnet.grid[0]])
@@ -1355,7 +1465,8 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
                           ATOL.copy(), switching=SWITCHING, events=EVENTS, mode_names=MODE_NAMES,
                           mode_values=MODE_VALUES, inputs=INPUTS, u0=u0, method="dopri", rtol=1e-6,
                           first_step=first_step, event_tol=1e-12, element_name=_element_name,
-                          error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range})
+                          error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range},
+                          decided_at_start=DECIDED_AT_START)
         if len(_TEMPLATES) < 64:
             _TEMPLATES[(first_step, current_range)] = template
     # the hooks called through their addresses, compiled (or loaded) here on the calling thread, not at a batch

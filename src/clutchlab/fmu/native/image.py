@@ -232,15 +232,15 @@ def _start_words(image: Image, decided) -> list:
     out = []
     for where, start, stop in decided:
         head, *path = where.split(".")
-        if head == "m" and not path:
-            value = image.arg("m")
+        if head in ("m", "x") and not path:
+            value = image.arg(head)
         elif head == "params" and path:
             value = image.arg("p")
             for name in path:   # (a field of a record array: its column, a strided view)
                 names = value.dtype.names if isinstance(value, np.ndarray) else None
                 value = value[name] if names and name in names else getattr(value, name)
         else:
-            raise NativeExportError(f"decided_at_start: {where!r}: expected 'm' or 'params.<field>[.<field>...]'")
+            raise NativeExportError(f"decided_at_start: {where!r}: expected 'm', 'x' or 'params.<field>[.<field>...]'")
         array = value.reshape(-1)
         for k in range(*slice(start, stop).indices(array.size)):
             out.append(image.offset(array[k:], 0) // 8)
