@@ -12,7 +12,7 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["cache_folder"]
+__all__ = ["cache_folder", "guard_stale_indexes"]
 
 
 def cache_folder(name: str) -> Path:
@@ -51,6 +51,35 @@ def cache_folder(name: str) -> Path:
     raise OSError(f"no writable folder for clutchlab's {name} cache (tried: "
                   + ", ".join(str(c) for c in candidates) + ")" + (f"; {refused}" if refused else "")
                   + ": set NUMBA_CACHE_DIR to a folder of your own")
+
+
+def guard_stale_indexes() -> None:
+    """Read a numba cache index that cannot be unpickled as an empty one (idempotent; compiles nothing).
+
+    numba loads a cached function's index by unpickling it whole and only then compares the source file's stamp
+    (``numba.core.caching.IndexDataCacheFile._load_index``), so an index written by an older clutchlab whose
+    signatures name a class since removed or renamed raised instead of being the stale cache it is: ``AttributeError:
+    Can't get attribute 'VehicleData' on <module 'clutchlab.emtc.system'>`` after an upgrade over an existing cache
+    (an editable install after a pull, ``NUMBA_CACHE_DIR`` kept across versions; found when the EMTC's vehicle
+    record replaced its NamedTuple).  Such an index is now a miss: numba compiles the function again and writes a
+    fresh index over it.  Applies to every numba cache of the process, which gains the same robustness."""
+    import pickle
+
+    from numba.core import caching
+
+    load = caching.IndexDataCacheFile._load_index
+    if getattr(load, "_clutchlab_guard", False):
+        return
+
+    def _load_index(self):
+        try:
+            return load(self)
+        except (AttributeError, ImportError, pickle.UnpicklingError, EOFError, IndexError, TypeError, ValueError):
+            return {}   # (an index of classes that no longer exist: stale, compiled again and overwritten)
+
+    _load_index._clutchlab_guard = True
+    _load_index.__doc__ = load.__doc__
+    caching.IndexDataCacheFile._load_index = _load_index
 
 
 def _private_folder(path: Path) -> str:

@@ -56,3 +56,38 @@ def test_a_folder_another_user_made_is_refused(only_the_shared_folder):
     os.chown(only_the_shared_folder, 65534, 65534)
     with pytest.raises(OSError, match="belongs to another user.*refused"):
         entry.kernel_dir()
+
+
+_RECORDS_V1 = "from typing import NamedTuple\n\n\nclass VehicleData(NamedTuple):\n    mass: float\n"
+_RECORDS_V2 = "from typing import NamedTuple\n\n\nclass Vehicle(NamedTuple):\n    mass: float\n    extra: float = 0.0\n"
+_KERNEL = ("import numba\nfrom records import {cls}\n\n\n@numba.njit(cache=True)\ndef weight(v):\n"
+           "    return v.mass * 9.80665\n\n\nprint(weight({cls}(2.0)))\n")
+
+
+def test_a_cache_index_naming_a_class_an_upgrade_removed_is_compiled_again(tmp_path):
+    """numba unpickles a cached function's index before it compares the source's stamp, so an index an older
+    version wrote naming a class since renamed raised ``AttributeError: Can't get attribute ...`` (an upgrade over
+    an existing cache; the EMTC's ``VehicleData`` became a record).  With clutchlab imported the stale index is a
+    miss: the function compiles again and runs.  Without it the same cache fails (so the test can fail)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "records.py").write_text(_RECORDS_V1)
+    (tmp_path / "kernel.py").write_text(_KERNEL.format(cls="VehicleData"))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+
+    def run(head):
+        return subprocess.run([sys.executable, "-c", head + "import kernel"], capture_output=True, text=True,
+                              env=env, cwd=tmp_path, timeout=300)
+
+    first = run("")
+    assert first.returncode == 0 and first.stdout.split() == ["19.6133"], first.stderr[-2000:]
+    assert list((tmp_path / "cache").rglob("*.nbi"))   # (the index written)
+    (tmp_path / "records.py").write_text(_RECORDS_V2)   # the upgrade: the class renamed, the kernel with it
+    (tmp_path / "kernel.py").write_text(_KERNEL.format(cls="Vehicle"))
+    plain = run("")
+    assert plain.returncode != 0 and "Can't get attribute 'VehicleData'" in plain.stderr, plain.stderr[-2000:]
+    guarded = run("import clutchlab.numerics\n")
+    assert guarded.returncode == 0 and guarded.stdout.split() == ["19.6133"], guarded.stderr[-2000:]
+    again = run("")   # (the fresh index written over the stale one: numba alone reads it now)
+    assert again.returncode == 0, again.stderr[-2000:]
