@@ -204,13 +204,14 @@ def test_the_start_derives_the_vehicle_and_actuator_numbers_the_packing_derived(
     gear's ratio, the current lags' rates, the controller's table at the engaged airgap, the shafts' speeds on the
     drums) is written by its compiled start (``emtc_start``, a native FMU runs it again after a host set the
     parameters): equal to the closed forms, and to the packing's numbers bit for bit when the start finds them
-    erased; a combination no run can start from is refused by the start with its message."""
+    erased (the shafts' speeds where the system starts on the drums, as a co-simulation's does); a combination
+    no run can start from is refused by the start with its message."""
     from clutchlab.emtc.bench import ActuatorParameters, VehicleParameters
 
     veh = VehicleParameters(cg_to_front=1.2, cg_to_rear=1.7, wheelbase=2.9, rear_final_drive=2.8)
     sc = BenchScenario(duration=0.05, gear=3, drum_speed=9.0, speed_difference=0.4)
     act = ActuatorParameters(free_travel=0.45e-3, airgap_open=1.0e-3)
-    system = bench_system(magnet, sc, veh, BenchOptions(actuator=act))
+    system = bench_system(magnet, sc, veh, BenchOptions(actuator=act), start_on_drums=True)   # (as a co-simulation)
     v, a = system.params.vehicle[0], system.params.actuator[0]
     jf = veh.inertia_input_shaft + veh.inertia_front_axle / 2.8 ** 2
     jr = veh.inertia_output_shaft + veh.inertia_rear_axle / 2.8 ** 2
@@ -251,8 +252,11 @@ def test_the_start_derives_the_vehicle_and_actuator_numbers_the_packing_derived(
     np.testing.assert_array_equal(system.params.controller_table, table)
     np.testing.assert_array_equal(res.states[0, :2], x0[:2])
     assert x0[0] == 9.0 / veh.tyre_radius * 2.8 and x0[1] == 8.6 / veh.tyre_radius * 2.8
-    np.testing.assert_array_equal(res.states, core_simulate(bench_system(magnet, sc, veh, BenchOptions(actuator=act)),
-                                                            0.05).states)
+    plain = bench_system(magnet, sc, veh, BenchOptions(actuator=act))
+    np.testing.assert_array_equal(res.states, core_simulate(plain, 0.05).states)
+    # without start_on_drums a run starts from the state it is given (an operating point's), not the drums'
+    given = plain.variant(x0=np.concatenate([[x0[0] + 1.0, x0[1] - 1.0], x0[2:]]))
+    np.testing.assert_array_equal(core_simulate(given, 0.05).states[0, :2], [x0[0] + 1.0, x0[1] - 1.0])
     # refused at the start (a host of the native FMU sets the parameters one by one)
     for record, name, value, message in (("vehicle", "wheelbase", 3.0, "must equal vehicle.wheelbase"),
                                          ("vehicle", "gear", 7.0, "scenario.gear must be a whole number"),

@@ -266,6 +266,10 @@ VEHICLE_PARAMETERS = ("mass", "cg_to_front", "cg_to_rear", "wheelbase", "gear", 
                       "inertia_output_shaft", "rolling_resistance", "tyre_slip_stiffness", "slip_speed_floor",
                       "engine_torque_max", "engine_power", "torsen_stiffness", "torsen_damping", "drum_load_front",
                       "drum_load_rear")
+#: a run option beside them: 1 where the start puts the shafts on the drums, free rolling at the drum speed inputs
+#: (a co-simulation, whose host sets the drum speeds and the vehicle: :func:`bench_system`'s ``start_on_drums``); 0
+#: where the run starts from the system's ``x0`` as given (an operating point's state, a resumed run)
+VEHICLE_OPTIONS = ("start_on_drums",)
 DERIVED_VEHICLE = ("gear_ratio",         # the scenario's gear's ratio
                    "inertia_front",      # J_F = J_sf + J_wf / i^2 ([1], Eq. 29)
                    "inertia_rear",       # J_R = J_sr + J_wr / i^2
@@ -276,7 +280,7 @@ DERIVED_VEHICLE = ("gear_ratio",         # the scenario's gear's ratio
                    "inv_inertia_rear",
                    "lock_share_front",   # J_R / (J_F + J_R): the weight of A_f in T_lock (Eq. 29)
                    "lock_share_rear")    # J_F / (J_F + J_R)
-VEHICLE_DTYPE = np.dtype([(name, np.float64) for name in VEHICLE_PARAMETERS + DERIVED_VEHICLE])
+VEHICLE_DTYPE = np.dtype([(name, np.float64) for name in VEHICLE_PARAMETERS + VEHICLE_OPTIONS + DERIVED_VEHICLE])
 
 
 class CouplingData(NamedTuple):
@@ -304,12 +308,13 @@ class EmtcParams(NamedTuple):
     The vehicle's and the actuator's numbers are one record each (arrays of shape ``(1,)``, :data:`VEHICLE_DTYPE`,
     :data:`ACTUATOR_DTYPE`: the run's start writes what it derives there, :func:`emtc_start`), the coupling's
     drag scalars a NamedTuple (:class:`CouplingData`), the coupling geometry
-    (:meth:`CouplingGeometry.kernel_data`) and the LuGre data tuples.  The core passes the structure to the hooks by reference with its arrays borrowed (no
-    reference counting; see docs/architecture.md).  The arrays: the throttle profile and the plant magnet's memory
-    (read on every evaluation), the integer and float memories of the run (``imem``, ``fmem``, offsets
-    ``IM_*``, ``FM_*``), and one array ``cold`` with everything read only at controller samples, airgap
-    changes or in the friction-map mode (offsets and sizes in ``layout``, indices ``L_*``).  One instance per
-    run (or batch variant).
+    (:meth:`CouplingGeometry.kernel_data`) and the LuGre data tuples.  The core passes the structure to the hooks by
+    reference with its arrays borrowed (no reference counting; see docs/architecture.md).  The arrays: the throttle
+    profile and the plant magnet's memory (read on every evaluation), the controller model's table at its one airgap
+    (``controller_table``, which the start derives), the integer and float memories of the run
+    (``imem``, ``fmem``, offsets ``IM_*``, ``FM_*``), and one array ``cold`` with everything read only at controller
+    samples, airgap changes or in the friction-map mode (offsets and sizes in ``layout``, indices ``L_*``).  One
+    instance per run (or batch variant).
     """
 
     vehicle: np.ndarray
@@ -1126,10 +1131,11 @@ def derive_actuator(actuator, cold, layout, table):
 def emtc_start(t, x, u, m, p):
     """What a run derives from its parameters and inputs alone, once before its first restart (the core's
     ``start`` hook): the vehicle's (:func:`derive_vehicle`) and the actuator's (:func:`derive_actuator`) derived
-    numbers, and the shafts' speeds of free rolling on the drums, ``omega = v_drum / r_w * i`` (the drum speed
-    inputs ``u``), as :func:`bench_system` starts them.  So a native FMU, which runs it again after a host set
-    parameters or the drum speeds' start values, writes the parameters as plain copies
-    (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0 or the refusal's negative code
+    numbers, and, where the vehicle record's ``start_on_drums`` is set (a co-simulation's system), the shafts' speeds
+    of free rolling on the drums, ``omega = v_drum / r_w * i`` (the drum speed inputs ``u``), as :func:`bench_system`
+    starts them; elsewhere the run starts from the state it is given (an operating point's).  So a native FMU,
+    which runs it again after a host set parameters or the drum speeds' start values, writes the parameters as plain
+    copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0 or the refusal's negative code
     (:data:`ERROR_MESSAGES`)."""
     e = derive_vehicle(p.vehicle, _cold(p.cold, p.layout, L_GEAR_RATIOS))
     if e != 0:
@@ -1138,13 +1144,14 @@ def emtc_start(t, x, u, m, p):
     if e != 0:
         return e
     v = p.vehicle[0]
-    x[X_OMEGA_F] = u[U_DRUM_FRONT] / v.tyre_radius * v.axle_ratio
-    x[X_OMEGA_R] = u[U_DRUM_REAR] / v.tyre_radius * v.axle_ratio
+    if v.start_on_drums != 0.0:
+        x[X_OMEGA_F] = u[U_DRUM_FRONT] / v.tyre_radius * v.axle_ratio
+        x[X_OMEGA_R] = u[U_DRUM_REAR] / v.tyre_radius * v.axle_ratio
     return 0
 
 
 #: the words :func:`emtc_start` writes (:attr:`clutchlab.system.System.decided_at_start`)
-#: (each record's one element; the whole table; the two shafts' speeds)
+#: (each record's one element; the whole table; the two shafts' speeds, written where ``start_on_drums`` is set)
 DECIDED_AT_START = tuple([(f"params.vehicle.{name}", 0, None) for name in DERIVED_VEHICLE]
                          + [(f"params.actuator.{name}", 0, None) for name in DERIVED_ACTUATOR]
                          + [("params.controller_table", 0, None), ("x", X_OMEGA_F, X_OMEGA_R + 1)])
@@ -1421,7 +1428,7 @@ def _element_name(code: int, element: int) -> str:
 
 
 def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions | None = None, *,
-                 cosimulation: bool = False, n_samples: int = 0) -> System:
+                 cosimulation: bool = False, n_samples: int = 0, start_on_drums: bool = False) -> System:
     """The drum-bench model as a :class:`~clutchlab.system.System` (registered as ``"emtc_bench"``).
 
     Parameters
@@ -1434,6 +1441,10 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
         Throttle, drum speeds and torque request from the held inputs (see :func:`pack_parameters`).
     n_samples : int
         Rows of the per-sample controller log (:func:`controller_log`).
+    start_on_drums : bool
+        The run's start puts the shafts on the drums at the drum speed inputs it holds then (:func:`emtc_start`:
+        a co-simulation, whose host sets them and the vehicle); else the run starts from ``x0`` as given (the
+        same shaft speeds unless a caller gives another state, as an operating point does).
 
     Returns
     -------
@@ -1449,6 +1460,7 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     scenario = scenario or _default(BenchScenario)
     vehicle = vehicle or _default(VehicleParameters)
     params = pack_parameters(magnet, scenario, vehicle, options, cosimulation=cosimulation, n_samples=n_samples)
+    params.vehicle[0]["start_on_drums"] = float(bool(start_on_drums))   # (a copy of its own: _fresh_memories)
     vf = scenario.drum_speed
     vr = scenario.drum_speed - scenario.speed_difference
     ic = vehicle.rear_final_drive

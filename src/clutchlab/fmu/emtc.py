@@ -169,7 +169,8 @@ class EmtcCoSimulation(ContractCoSimulation):
         """The ``emtc_bench`` system with the inputs held by the master (``values``: the parameters, by name)."""
         from ..emtc.system import bench_system
 
-        return bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True)
+        return bench_system(self.magnet, self._scenario, self.vehicle, self._options, cosimulation=True,
+                            start_on_drums=True)
 
     def input_vector(self, inputs: dict) -> np.ndarray:
         """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear, coil_current_command]`` from the
