@@ -1058,6 +1058,15 @@ def coupling_shaft_inertia(j_shaft, j_axle, ratio):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def free_rolling_speed(v_drum, tyre_radius, axle_ratio):
+    """Speed of a coupling shaft whose wheels roll free on their drum [rad/s]: ``omega = v_drum / r_w * i`` (the
+    drum bench of [1], Sec. 4: no tyre slip, the axle ratio ``i_f = i_r = i`` of Eq. 28), from the drum's surface
+    speed ``v_drum`` [m/s], the tyre radius ``tyre_radius`` [m] and the axle ratio ``axle_ratio`` [-].  How a bench
+    run starts (:func:`bench_system`, :func:`emtc_start`)."""
+    return v_drum / tyre_radius * axle_ratio
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def derive_vehicle(vehicle, ratios):
     """What a run derives from the vehicle's parameters (:data:`DERIVED_VEHICLE`), written into its record
     ``vehicle[0]`` (:data:`VEHICLE_DTYPE`): the gear's ratio from ``ratios`` (``VehicleParameters.gear_ratios``),
@@ -1145,8 +1154,8 @@ def emtc_start(t, x, u, m, p):
         return e
     v = p.vehicle[0]
     if v.start_on_drums != 0.0:
-        x[X_OMEGA_F] = u[U_DRUM_FRONT] / v.tyre_radius * v.axle_ratio
-        x[X_OMEGA_R] = u[U_DRUM_REAR] / v.tyre_radius * v.axle_ratio
+        x[X_OMEGA_F] = free_rolling_speed(u[U_DRUM_FRONT], v.tyre_radius, v.axle_ratio)
+        x[X_OMEGA_R] = free_rolling_speed(u[U_DRUM_REAR], v.tyre_radius, v.axle_ratio)
     return 0
 
 
@@ -1465,7 +1474,8 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     vr = scenario.drum_speed - scenario.speed_difference
     ic = vehicle.rear_final_drive
     # (free rolling on the drums: emtc_start writes the shafts' speeds again from the drum speeds in u0)
-    x0 = np.array([vf / vehicle.tyre_radius * ic, vr / vehicle.tyre_radius * ic, 0.0, 0.0, 0.0,
+    x0 = np.array([free_rolling_speed(vf, vehicle.tyre_radius, ic), free_rolling_speed(vr, vehicle.tyre_radius, ic),
+                   0.0, 0.0, 0.0,
                    magnet.grid[0], magnet.grid[0]])
     u0 = np.array([0.0, scenario.throttle_start, vf, vr, magnet.grid[0]])
     first_step = min(1e-4, scenario.sample_time)

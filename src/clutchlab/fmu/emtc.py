@@ -200,11 +200,13 @@ class EmtcCoSimulation(ContractCoSimulation):
         return self.simulation.stats["accepted_steps"]
 
     def _start(self, u):
+        from ..emtc.system import U_DRUM_FRONT, U_DRUM_REAR, X_OMEGA_F, X_OMEGA_R, free_rolling_speed
+
         r = self.vehicle.tyre_radius
         ic = self.vehicle.rear_final_drive
-        x = self.simulation.x  # free rolling at t = 0, as simulate_bench
-        x[0] = u[2] / r * ic
-        x[1] = u[3] / r * ic
+        x = self.simulation.x  # free rolling at t = 0, as simulate_bench (and the model's start, start_on_drums)
+        x[X_OMEGA_F] = free_rolling_speed(u[U_DRUM_FRONT], r, ic)
+        x[X_OMEGA_R] = free_rolling_speed(u[U_DRUM_REAR], r, ic)
         self._started = True
 
     def _advance(self, target, uv):
