@@ -28,6 +28,9 @@ __all__ = ["ActuatorParameters", "VehicleParameters", "BenchScenario", "TorqueMa
 
 #: standard gravity [m/s^2]
 GRAVITY = 9.80665
+#: how far the lever arms' sum may differ from the wheel base [m] (``VehicleParameters.check`` and the EMTC
+#: model's start, ``clutchlab.emtc.system.derive_vehicle``)
+GEOMETRY_TOLERANCE = 1e-3
 
 
 @numba.njit(cache=True, nogil=True)
@@ -107,7 +110,7 @@ class VehicleParameters(ParameterSet):
 
     def check(self) -> None:
         # (checked again by every run's start: deferred to it in a native FMU's trial builds, as the actuator's)
-        if abs(self.cg_to_front + self.cg_to_rear - self.wheelbase) > 1e-3 and not start_checks_deferred():
+        if abs(self.cg_to_front + self.cg_to_rear - self.wheelbase) > GEOMETRY_TOLERANCE and not start_checks_deferred():
             raise ParameterError(
                 f"VehicleParameters: cg_to_front + cg_to_rear = {self.cg_to_front + self.cg_to_rear:.4f} m "
                 f"differs from wheelbase = {self.wheelbase:.4f} m")

@@ -59,7 +59,8 @@ from ..numerics.outline import hook_args, log_type, outlined, prepare
 from ..system import System, follow_rtol, register_model, start_checks_deferred
 from ._lookup import bilinear, interp1
 from .friction import coupling_torque_scalar, drag_torque_scalar, lugre_advance_path, lugre_mu, stribeck_g
-from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default, static_axle_load
+from .params import (GEOMETRY_TOLERANCE, ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default,
+                     static_axle_load)
 from .torque import UNLOCK_MARGIN, CouplingGeometry, _cam_force, _locked, _locked_capacity, _slipping
 
 # EmtcParams, the parameters of the compiled hooks, is the kernel's internal: not API (#33)
@@ -1080,7 +1081,7 @@ def derive_vehicle(vehicle, ratios):
     v = vehicle[0]
     if not (1.0 <= v.gear <= ratios.shape[0] and v.gear == math.floor(v.gear)):
         return ERR_GEAR
-    if not abs(v.cg_to_front + v.cg_to_rear - v.wheelbase) <= 1e-3:
+    if not abs(v.cg_to_front + v.cg_to_rear - v.wheelbase) <= GEOMETRY_TOLERANCE:
         return ERR_GEOMETRY
     v.gear_ratio = ratios[int(v.gear) - 1]
     jf = coupling_shaft_inertia(v.inertia_input_shaft, v.inertia_front_axle, v.axle_ratio)   # [1], Eq. 29, J_F
@@ -1313,8 +1314,7 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     for name, model in (("magnet", magnet), ("controller_model", ctl)):
         if start_checks_deferred():
             break   # (a check across parameters the start makes again: its own refusal, ERR_AIRGAP_RANGE)
-        if model.n_airgaps > 1 and (lo_gap < model.airgaps[0] - 1e-12
-                                    or actuator.airgap_open > model.airgaps[-1] + 1e-12):
+        if _outside(_f(model.airgaps), float(lo_gap), float(actuator.airgap_open)):   # (the start's own test)
             raise ParameterError(
                 f"{name}: airgap range [{lo_gap:g}, {actuator.airgap_open:g}] m of the actuator is outside the "
                 f"calibration airgaps [{model.airgaps[0]:g}, {model.airgaps[-1]:g}] m")
