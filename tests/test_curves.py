@@ -207,3 +207,37 @@ def test_inverse_exact_at_a_sample_and_on_a_steep_segment():
     assert abs(steep(steep.inverse(force)) - force) < 1e-9
     forces = np.linspace(1.0, 2872.0, 101)
     assert np.max(np.abs(steep(steep.inverse(forces)) - forces)) < 1e-9 * 2873.0
+
+
+@pytest.mark.parametrize("kind", ["linear", "pchip"])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_the_compiled_inverse_of_one_force_is_the_curve_s_inverse(kind, sign):
+    """``curve_inverse_one`` (the E-clutch's start derives pre-strains with it) equals :meth:`Curve.inverse` inside
+    the samples and on the end slopes' extrapolation, for increasing and decreasing curves of both kinds; and it
+    reaches the force it is asked for."""
+    from clutchlab.curves import curve_inverse_one
+
+    x = np.array([0.0, 1e-3, 2.5e-3, 4e-3, 6e-3])
+    c = Curve(x, sign * np.array([0.0, 300.0, 1100.0, 1500.0, 2600.0]), kind=kind)
+    xs, fs, ds, k, e = c.kernel_data()
+    for force in sign * np.array([-200.0, 0.0, 150.0, 300.0, 1234.5, 2600.0, 3000.0]):
+        got = curve_inverse_one(xs, fs, ds, k, e, force)
+        assert got == pytest.approx(float(c.inverse(force)), rel=1e-13, abs=1e-18), force
+        assert curve_eval(xs, fs, ds, k, 0, got)[0] == pytest.approx(force, rel=1e-12, abs=1e-9)
+
+
+def test_the_compiled_inverse_refuses_what_the_curve_s_inverse_refuses():
+    """NaN where :meth:`Curve.inverse` raises: a curve that is not monotone, a force outside the samples of a curve
+    that may not be extrapolated, a force that is not finite."""
+    from clutchlab.curves import curve_inverse_one
+
+    bump = Curve([0.0, 1e-3, 2e-3], [0.0, 100.0, 50.0])
+    with pytest.raises(ParameterError):
+        bump.inverse(20.0)
+    assert np.isnan(curve_inverse_one(*bump.kernel_data(), 20.0))
+    strict = Curve([0.0, 1e-3, 2e-3], [0.0, 100.0, 150.0], extrapolation="error")
+    with pytest.raises(ParameterError):
+        strict.inverse(200.0)
+    assert np.isnan(curve_inverse_one(*strict.kernel_data(), 200.0))
+    assert curve_inverse_one(*strict.kernel_data(), 120.0) == pytest.approx(float(strict.inverse(120.0)), rel=1e-13)
+    assert np.isnan(curve_inverse_one(*strict.kernel_data(), np.nan))

@@ -202,6 +202,59 @@ def curve_inverse(xs, fs, ds, fz, sign, g, out):
         out[k] = x
 
 
+@numba.njit(cache=True, nogil=True)
+def curve_inverse_one(xs, fs, ds, kind, extrap, force):
+    """Deflection [m] at which a strictly monotone sampled curve reaches ``force`` [N] (compiled; one value).
+
+    :meth:`Curve.inverse` for one force, for compiled callers (the E-clutch's start derives pre-strains with it,
+    :func:`clutchlab.eclutch.system.derive_clutch`): inside the samples the linear segment's root or the
+    cubic's (:func:`curve_inverse`), outside them the end slopes' extrapolation.  Returns NaN where the curve is
+    not strictly monotone, the force is not finite, or the force lies outside the samples of a curve whose
+    ``extrapolation`` is ``"error"`` (``extrap`` 1), where :meth:`Curve.inverse` raises.
+    """
+    n = xs.shape[0]
+    up = True
+    down = True
+    for i in range(n - 1):
+        if not fs[i + 1] > fs[i]:
+            up = False
+        if not fs[i + 1] < fs[i]:
+            down = False
+    if not (up or down) or not np.isfinite(force):
+        return np.nan
+    sign = 1.0 if up else -1.0
+    g = force * sign
+    f0 = fs[0] * sign
+    f1 = fs[n - 1] * sign
+    if extrap == 1 and (g < f0 - 1e-9 * max(1.0, abs(f0)) or g > f1 + 1e-9 * max(1.0, abs(f1))):
+        return np.nan
+    if kind == 0:
+        s0 = (fs[1] * sign - f0) / (xs[1] - xs[0])
+        s1 = (f1 - fs[n - 2] * sign) / (xs[n - 1] - xs[n - 2])
+    else:
+        s0 = ds[0] * sign
+        s1 = ds[n - 1] * sign
+    if g < f0:
+        return xs[0] + (g - f0) / s0
+    if g > f1:
+        return xs[n - 1] + (g - f1) / s1
+    if kind == 0:
+        i = n - 2
+        for j in range(n - 1):
+            if fs[j + 1] * sign > g:
+                i = j
+                break
+        return xs[i] + (g - fs[i] * sign) * (xs[i + 1] - xs[i]) / (fs[i + 1] * sign - fs[i] * sign)
+    fz = np.empty(n)
+    for i in range(n):
+        fz[i] = fs[i] * sign
+    gv = np.empty(1)
+    gv[0] = g
+    out = np.empty(1)
+    curve_inverse(xs, fs, ds, fz, sign, gv, out)
+    return out[0]
+
+
 def _eval_numpy(xs, fs, ds, kind, x):
     """Vectorised twin of :func:`curve_eval` without the extrapolation check."""
     x = np.asarray(x, dtype=float)

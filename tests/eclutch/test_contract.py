@@ -130,7 +130,6 @@ def test_the_start_derives_the_actuator_s_compliances_and_line_from_the_fields_b
     ``128 mu l / (pi d^4)``, the snifting edge (port + width), the spindle ratio ``lead / 2 pi`` and the equivalent
     mass ``m + J / n_s^2`` from the fields packed beside them: the closed forms, with parameters far from the
     defaults."""
-    import collections
     import math
 
     from clutchlab.eclutch import system as S
@@ -138,18 +137,125 @@ def test_the_start_derives_the_actuator_s_compliances_and_line_from_the_fields_b
 
     a = ActuatorParameters(line_diameter=4e-3, line_length=1.5, bulk_modulus=3e8, hose_compliance=4e-13,
                            fluid_density=990.0, fluid_viscosity=0.012, slave_volume=8e-6, snifting_width=4e-4,
-                           lead=5e-3, master_mass=0.15, rotor_inertia=2e-5)
+                           lead=5e-3, master_mass=0.15, rotor_inertia=2e-5, master_diameter=0.019,
+                           spindle_efficiency=0.8)
     par = S._actuator_vector(a)
-    expected = {S.P_CM: a.master_volume / 3e8 + 2e-13, S.P_CS: 8e-6 / 3e8 + 2e-13,
+    expected = {S.P_AMC: math.pi * 0.019 ** 2 / 4, S.P_CM: a.master_volume / 3e8 + 2e-13, S.P_CS: 8e-6 / 3e8 + 2e-13,
                 S.P_LH: 990.0 * 1.5 / (math.pi * 4e-3 ** 2 / 4), S.P_RH: 128 * 0.012 * 1.5 / (math.pi * 4e-3 ** 4),
                 S.P_XSN: a.snifting_port + 4e-4, S.P_NS: 5e-3 / (2 * math.pi),
                 S.P_MMC: 0.15 + 2e-5 / (5e-3 / (2 * math.pi)) ** 2}
     for k, value in expected.items():
         assert par[k] == pytest.approx(value, rel=1e-14), S.ACTUATOR_VECTOR[k]
         par[k] = 0.0
-    only = collections.namedtuple("Only", "par coord")   # (the fields the start reads)
-    coord = np.zeros((6, 3))
-    assert S.eclutch_start(0.0, np.zeros(1), np.zeros(0), np.zeros(1, dtype=np.int64), only(par, coord)) == 0
+    from clutchlab.eclutch.dynamics import ClutchDynamics, EClutch
+    from clutchlab.eclutch.models import ClutchModel
+
+    p = EClutch(a).assembly.params(S.POSITION, np.empty(0), np.empty(0), 0)
+    assert np.array_equal(p.par, S._actuator_vector(a))
+    coord = p.coord
+    mu_pressure = coord[S.CO_MU_PRESSURE, 0]
+    for k in expected:   # (erased: the start writes them again)
+        p.par[k] = 0.0
+    coord[[S.CO_MASS, S.CO_MU_PRESSURE], 0] = 0.0
+    others = coord.copy()
+    x, m = np.zeros(2 * p.nz + 8), np.zeros(p.nz + 1, dtype=np.int64)
+    assert S.eclutch_start(0.0, x, np.zeros(1), m, p) == 0
     for k, value in expected.items():
-        assert par[k] == pytest.approx(value, rel=1e-14), S.ACTUATOR_VECTOR[k]
-    assert coord[S.CO_MASS, 0] == par[S.P_MMC] and not coord[:, 1:].any()   # (the master's mass)
+        assert p.par[k] == pytest.approx(value, rel=1e-14), S.ACTUATOR_VECTOR[k]
+    assert coord[S.CO_MASS, 0] == p.par[S.P_MMC]   # (the master's mass)
+    # the master seal + spindle's friction per pressure: the spindle's loss per load (1 / eta - 1) times the area,
+    # as the packing has it (actuator_friction_elements)
+    assert coord[S.CO_MU_PRESSURE, 0] == pytest.approx((1 / 0.8 - 1) * math.pi * 0.019 ** 2 / 4, rel=1e-14)
+    assert coord[S.CO_MU_PRESSURE, 0] == mu_pressure
+    coord[[S.CO_MASS, S.CO_MU_PRESSURE], 0] = 0.0
+    assert np.array_equal(coord, others) and not x.any() and not m.any()   # (a run of its own: its state as given)
+    # a bearing moved by a prescribed input: no actuator, no seal friction on the master
+    p = ClutchDynamics(ClutchModel.preset(4)).assembly.params(S.PRESCRIBED, np.zeros(1), np.zeros(1), 0)
+    assert S.eclutch_start(0.0, np.zeros(2 * p.nz + 8), np.zeros(1), np.zeros(p.nz + 1, dtype=np.int64), p) == 0
+    assert p.coord[S.CO_MU_PRESSURE, 0] == 0.0
+
+
+@pytest.mark.parametrize("number", [0, 1, 2, 3, 4])
+def test_a_co_simulation_s_start_derives_the_clutch_as_build_model_does(number):
+    """A co-simulation's start (``eclutch_start`` with ``at_start``: a native FMU runs it after a host set the
+    parameters) derives the preset's pre-deflections -- the bearing zeroed at its preload, the lever's ``F / k_fl``,
+    the pressure-plate spring's and the support's by their curves' inverses, Model 4's bearing zeroed again -- the
+    CSC's rest position and the static state and friction modes there, as the Python build does
+    (``models.build_model`` on the networks' own assemblies, ``Assembly.rest_position``, ``initial_state``): erased,
+    they come back to 1e-15 m.  With parameters away from the defaults, and a CSC preload above the clutch's, so
+    the bearing rests released."""
+    from clutchlab.eclutch import system as S
+    from clutchlab.eclutch.actuator import ActuatorParameters
+    from clutchlab.eclutch.dynamics import EClutch, FrictionParameters
+    from clutchlab.eclutch.models import ClutchModel, EClutchParameters
+
+    clutch = EClutchParameters(lever_ratio=-3.6, diaphragm_prestrain=4.6e-3, cushion_prestrain=0.75e-3,
+                               return_prestrain=7.5e-3, bearing_stiffness=6e6, k_fl_model1=1.4e6, k_fl_model2=1.3e6,
+                               support_scale=15.0, diaphragm_scale=1.2, bearing_preload=70.0)
+    ec = EClutch(ActuatorParameters(csc_preload=90.0), ClutchModel.preset(number, clutch), FrictionParameters())
+    a = ec.assembly
+    assert ec.rest_position > 1e-6
+    p = a.params(S.POSITION, np.empty(0), np.empty(0), 0, at_start=True)
+    x0, m0 = a.initial_state(ec.rest_position)
+    names = a.element_names
+    derived = [names.index(e) for e in ("bearing", "lever", "pp_spring", "support") if e in names]
+    assert len(derived) == {0: 1, 1: 2, 2: 3, 3: 4, 4: 4}[number]
+    packed = p.net[S.NE_D0].copy()
+    p.net[S.NE_D0, derived] = 0.0
+    x, m = np.zeros_like(x0), np.full(a.nz + 1, 7, dtype=np.int64)
+    assert S.eclutch_start(0.0, x, np.zeros(1), m, p) == 0
+    np.testing.assert_allclose(p.net[S.NE_D0], packed, rtol=0, atol=1e-15)
+    assert p.net[S.NE_D0, derived].min() != 0.0 or number == 0
+    assert p.clutch[S.CL_REST] == pytest.approx(ec.rest_position, rel=1e-12)
+    np.testing.assert_allclose(x[1:a.nz], x0[1:a.nz], rtol=0, atol=1e-15)
+    assert np.array_equal(m[:a.nz], m0[:a.nz]) and m[a.nz] == 7   # (the input row is the restart's)
+    assert (m[:a.nz] == S.STUCK).sum() >= 2   # (the seals and the clutch's friction start stuck)
+    # a run that is not a co-simulation's starts from its packing: the start leaves the clutch and the state alone
+    p = a.params(S.POSITION, np.empty(0), np.empty(0), 0)
+    p.net[S.NE_D0, derived] = 0.0
+    x = np.zeros_like(x0)
+    assert S.eclutch_start(0.0, x, np.zeros(1), m, p) == 0
+    assert not p.net[S.NE_D0, derived].any() and not x.any()
+
+
+def test_a_network_of_your_own_derives_no_clutch_at_the_start():
+    """A :class:`ClutchModel` around a network that is not the preset's (or without a derivation) packs no
+    derivation (number -1): the start keeps its pre-deflections, and still finds the rest state."""
+    import dataclasses
+
+    from clutchlab.eclutch import system as S
+    from clutchlab.eclutch.dynamics import EClutch
+    from clutchlab.eclutch.models import ClutchModel
+
+    preset = ClutchModel.preset(2)
+    for model in (dataclasses.replace(preset, derivation=None),
+                  dataclasses.replace(preset, network=ClutchModel.preset(2).network)):
+        a = EClutch(clutch=model).assembly
+        assert a.clutch_int[S.CLI_NUMBER] == -1
+        p = a.params(S.POSITION, np.empty(0), np.empty(0), 0, at_start=True)
+        packed = p.net.copy()
+        x0, m0 = a.initial_state(0.0)
+        x, m = np.zeros_like(x0), np.zeros(a.nz + 1, dtype=np.int64)
+        assert S.eclutch_start(0.0, x, np.zeros(1), m, p) == 0
+        assert np.array_equal(p.net, packed)
+        np.testing.assert_allclose(x, x0, rtol=0, atol=1e-15)
+        assert np.array_equal(m, np.append(m0[:a.nz], 0))
+
+
+def test_the_start_refuses_a_clutch_no_run_can_start_from():
+    """The start's model errors, each with its message (``ERROR_MESSAGES``): a bearing preload no pre-strain of the
+    bearing reaches, a CSC preload with no rest position in the travel."""
+    from clutchlab.eclutch import system as S
+    from clutchlab.eclutch.dynamics import EClutch
+
+    p = EClutch().assembly.params(S.POSITION, np.empty(0), np.empty(0), 0, at_start=True)
+    x, m = np.zeros(2 * p.nz + 8), np.zeros(p.nz + 1, dtype=np.int64)
+    for field, value, code in ((S.CL_PRELOAD, 1e5, S.ERR_ZEROING), (None, None, S.ERR_REST)):
+        q = EClutch().assembly.params(S.POSITION, np.empty(0), np.empty(0), 0, at_start=True)
+        if field is not None:
+            q.clutch[field] = value
+        else:
+            q.par[S.P_FPRE] = 1e4   # (the CSC pushes 10 kN: beyond every force of the clutch within the travel)
+        assert S.eclutch_start(0.0, x, np.zeros(1), m, q) == code
+        assert S.ERROR_MESSAGES[code]
+    assert S.eclutch_start(0.0, x, np.zeros(1), m, p) == 0

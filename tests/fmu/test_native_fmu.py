@@ -319,6 +319,18 @@ json.dump(out, open(spec["result"], "w"))
 """
 
 
+def _start_values(tmp_path, path, cases, names):
+    """``[kind, "ok" | "refused", outputs | message]`` of each case of start values set in FMPy (without clutchlab)
+    before ``fmi2ExitInitializationMode``, in co-simulation, then in model exchange (:data:`_START_VALUES_HOST`)."""
+    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
+    script.write_text(_START_VALUES_HOST)
+    spec.write_text(json.dumps({"path": str(path), "cases": cases, "outputs": names, "result": str(result)}))
+    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(result.read_text())
+
+
 def test_a_one_way_clutch_a_host_starts_backward_is_refused_and_the_speeds_are_not_cut_by_ranges(built, tmp_path):
     """A one-way clutch never slides backward (MSL ``OneWayClutch``), so no run starts with its flange b slower than
     its flange a.  The network's compiled ``start`` refuses that state (a model error with the element's name), so
@@ -334,15 +346,9 @@ def test_a_one_way_clutch_a_host_starts_backward_is_refused_and_the_speeds_are_n
     with pytest.raises(ParameterError, match=r"f: a one-way clutch cannot start with flange b slower than flange a "
                                              r"\(it never slides backward\): w_b - w_a = -0\.6 rad/s"):
         cls(**{"J1.w0": 2.8, "J2.w0": 2.2})
-    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
-    script.write_text(_START_VALUES_HOST)
     names = [v.name for v in cls.outputs]
     cases = [{"J1.w0": 2.8, "J2.w0": 2.2}, {"J1.w0": 5.0, "J2.w0": 6.0}, {"J2.w0": 1.0}]
-    spec.write_text(json.dumps({"path": str(path), "cases": cases, "outputs": names, "result": str(result)}))
-    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    got = json.loads(result.read_text())
+    got = _start_values(tmp_path, path, cases, names)
     assert [(kind, what) for kind, what, _ in got] == [("cs", "refused"), ("cs", "ok"), ("cs", "refused"),
                                                       ("me", "refused"), ("me", "ok"), ("me", "refused")]
     for kind, what, detail in got:
@@ -758,14 +764,8 @@ def test_the_emtc_s_vehicle_and_actuator_are_derived_by_its_start_in_the_fmu(tmp
         EmtcCoSimulation(**{"vehicle.wheelbase": 2.9})
     # (a fractional gear is refused already by fmi2SetReal, as a fractional count of friction pairs)
     cases = [{"vehicle.wheelbase": 2.9}, {"actuator.free_travel": 1.3e-3}, {"actuator.airgap_open": 1.6e-3}, start]
-    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
-    script.write_text(_START_VALUES_HOST)
     names = [v.name for v in EmtcCoSimulation.outputs]
-    spec.write_text(json.dumps({"path": str(path), "cases": cases, "outputs": names, "result": str(result)}))
-    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    got = json.loads(result.read_text())
+    got = _start_values(tmp_path, path, cases, names)
     expected = ["cg_to_front + vehicle.cg_to_rear must equal vehicle.wheelbase",
                 "airgap_open must exceed actuator.free_travel",
                 "must lie within the magnet's calibration airgaps", None]
@@ -900,9 +900,10 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     for name in python:
         _close(native[name], python[name], name)
     assert np.ptp(python["bearing_position"]) > 1e-3   # (the actuator moved)
-    # a stiffness the model turns into its curves (not a line: 2.7e-5 off at 1.02 times its start) is fixed, where
-    # trials one newton per metre apart from its 1175810 N/m had taken it for one
-    assert svs["clutch.k_fl_model2"].get("variability") == "constant"
+    # a stiffness the model turns into its curves and its pre-strains: writable since the start derives the
+    # pre-strains (test_the_eclutch_s_clutch_is_derived_by_its_start_in_the_fmu); before, trials one newton per metre
+    # apart from its 1175810 N/m had taken the pre-strains' curve for a line
+    assert svs["clutch.k_fl_model2"].get("causality") == "parameter"
     # a gain is a proportion down to 0+ (at 0 the model switches its integrator off: refused)
     ki = svs["actuator.ki"].find("Real")
     assert 0.0 < float(ki.get("min")) < 1e-9 and svs["actuator.ki"].get("causality") == "parameter"
@@ -913,14 +914,15 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     # compiled start derives the compliances, the line's inertance and resistance, the snifting edge, the spindle
     # ratio and the equivalent mass again in the FMU (derive_actuator):
     # fixed at export before (a product or a quotient of two parameters, a sum two of them share)
-    assert "49 parameters (17 fixed at export)" in lines[0], lines[0]
+    assert "61 parameters (5 fixed at export)" in lines[0], lines[0]
     start.update({"actuator.line_diameter": 4e-3, "actuator.bulk_modulus": 3e8, "actuator.hose_compliance": 4e-13,
                   "actuator.fluid_viscosity": 0.012, "actuator.slave_volume": 8e-6, "actuator.snifting_width": 4e-4,
                   "actuator.lead": 5e-3, "actuator.master_mass": 0.12})
     assert all(svs[name].get("causality") == "parameter" for name in start)
-    # (its atol follow it only below the default, a line on each side; and the controller's integral's tolerance
-    # follows it and ki: the gain, whose law holds on both sides, keeps that number)
-    assert svs["rtol"].get("variability") == "constant"
+    # (its atol follow it only below the default, a line on each side: a host tightens it, max = the default; the
+    # controller's integral's tolerance is a voltage, no longer 1e-9 ki, a number the gain and rtol both changed)
+    assert svs["rtol"].get("causality") == "parameter"
+    assert float(svs["rtol"].find("Real").get("max")) == pytest.approx(1e-3, rel=1e-9)
     assert sum(sv.get("causality") == "parameter" for sv in svs.values()) >= 30
     # a bound the model's own code sets beyond its declared range (the CSC's lower travel limit must be < 0,
     # declared [-100, 100]) is the FMU variable's max, found at export by bisection
@@ -950,6 +952,68 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     for name in tight:
         scale = float(np.max(np.abs(tight[name])))
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-6 * scale, err_msg=name)
+
+
+def test_the_eclutch_s_clutch_is_derived_by_its_start_in_the_fmu(tmp_path, native_model):
+    """The E-clutch's lever ratio, pre-strains, stiffnesses, scales and preloads and its master bore were fixed at
+    export (12 parameters): the model builds its network from them in Python (Model 0's bearing zeroed at the
+    preload, the engaged state's loads, the pre-strains of the compliances Models 1-4 add, Model 4's bearing zeroed
+    again, the CSC's rest position and the static state there), and the bore's area multiplies the spindle's loss in
+    the master seal's friction.  The compiled start of a co-simulation derives them again
+    (``eclutch.system.derive_clutch``, ``start_at_rest``, ``derive_actuator``), so a host sets them and the run
+    equals clutchlab's built with them; a combination no run can start from (a preload no bearing pre-strain
+    reaches, a CSC preload with no rest position, a master volume below the swept one, a snifting port beyond the
+    stroke) is refused at ``fmi2ExitInitializationMode`` with its message, as clutchlab refuses it."""
+    from clutchlab.fmu.eclutch import EClutchCoSimulation
+
+    path, lines = native_model("eclutch")
+    root, svs = _variables(path)
+    # (what stays fixed: the structure -- model, control mode, friction switch, fixed step -- and the force up to
+    # which the yoke support's measured curve is extrapolated, from which its table is built)
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == [
+        "model", "control_mode", "friction_on", "solver.fixed_step", "clutch.support_max_force"]
+    start = {"clutch.lever_ratio": -4.2, "clutch.diaphragm_prestrain": 4.4e-3, "clutch.cushion_prestrain": 0.72e-3,
+             "clutch.return_prestrain": 8.1e-3, "clutch.bearing_stiffness": 9e6, "clutch.k_fl_model2": 1.25e6,
+             "clutch.support_scale": 18.0, "clutch.diaphragm_scale": 1.25, "clutch.bearing_preload": 85.0,
+             "actuator.csc_preload": 95.0, "actuator.master_diameter": 0.017, "actuator.spindle_efficiency": 0.8,
+             "rtol": 5e-4}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    n, dt = 300, 1e-3
+    inputs = {"bearing_reference": np.full(n + 1, 2e-3)}
+    native = _fmpy_run(tmp_path, path, n, dt, start, inputs=inputs)
+    changed = _python_run(EClutchCoSimulation, n, dt, start, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    plain = _python_run(EClutchCoSimulation, n, dt, inputs=inputs)
+    # (the CSC's preload above the clutch's: the bearing rests 10 N / (k_pre + the clutch's stiffness) released)
+    rest = EClutchCoSimulation(**start).eclutch.rest_position
+    assert native["bearing_position"][0] == pytest.approx(rest, rel=1e-12) and rest > 1e-6
+    assert plain["bearing_position"][0] == 0.0
+    for name in ("normal_force", "clutch_torque", "master_pressure"):
+        assert np.max(np.abs(changed[name] - plain[name])) > 1e-3 * np.max(np.abs(plain[name])), name
+    # refused by clutchlab and by the FMU's start (with its message)
+    cases = [{"clutch.bearing_preload": 900.0, "actuator.csc_preload": 10.0},
+             {"clutch.cushion_prestrain": 0.0137, "clutch.bearing_preload": 900.0},
+             {"actuator.master_volume": 1e-7}, {"actuator.snifting_port": 0.0399}, start]
+    expected = ["with actuator.csc_preload the CSC finds no rest position within its travel",
+                "bearing cannot be zeroed at clutch.bearing_preload",
+                "master_volume is smaller than the volume the master piston sweeps",
+                "must be below actuator.master_stroke", None]
+    for case, message in zip(cases, expected):
+        if message:
+            with pytest.raises(ParameterError):
+                EClutchCoSimulation(**case)
+    names = [v.name for v in EClutchCoSimulation.outputs]
+    got = _start_values(tmp_path, path, cases, names)
+    assert [(kind, what) for kind, what, _ in got] == [(kind, "refused" if e else "ok")
+                                                      for kind in ("cs", "me") for e in expected]
+    python = EClutchCoSimulation(**start).initial_outputs({})
+    for (kind, what, detail), message in zip(got, expected * 2):
+        if message:
+            assert message in detail and "(at t = 0 s)" in detail, detail
+        else:
+            for name in ("bearing_position", "normal_force", "clutch_torque"):
+                assert detail[name] == pytest.approx(python[name], rel=1e-12, abs=1e-15), (kind, name)
 
 
 def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_path, native_model):
@@ -1102,14 +1166,8 @@ def _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt):
     assert native["front_axle.w"][0] == pytest.approx(0.8 * speeds["front_axle.w0"], rel=1e-12)
     with pytest.raises(ParameterError, match=r"front_axle: w0 = [\d.]+ rad/s but front_drive from front_shaft gives"):
         cls(**{"front_axle.w0": 0.8 * speeds["front_axle.w0"]})
-    script, spec, result = tmp_path / "host.py", tmp_path / "spec.json", tmp_path / "result.json"
-    script.write_text(_START_VALUES_HOST)
-    spec.write_text(json.dumps({"path": str(path), "cases": [{"front_axle.w0": 0.8 * speeds["front_axle.w0"]}],
-                                "outputs": ["front_axle.w"], "result": str(result)}))
-    proc = subprocess.run([str(_isolated_python()), str(script), str(spec)], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    for kind, what, detail in json.loads(result.read_text()):
+    for kind, what, detail in _start_values(tmp_path, path, [{"front_axle.w0": 0.8 * speeds["front_axle.w0"]}],
+                                            ["front_axle.w"]):
         assert what == "refused" and re.search(r"front_drive: the initial speeds of its flanges disagree with its "
                                                r"ratio", detail), (kind, detail)
 

@@ -659,7 +659,7 @@ class EClutch:
 
     def as_system(self, inputs, *, rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8,
                   jac_every: int = 10, atol_scale: float | None = None, held_input: bool = False,
-                  first_step: float = 1e-5) -> contract.System:
+                  first_step: float = 1e-5, at_start: bool = False) -> contract.System:
         """The :class:`~clutchlab.system.System` of a run from rest (for :func:`clutchlab.system.simulate`).
 
         Parameters
@@ -674,13 +674,16 @@ class EClutch:
             table's first value (co-simulation).
         first_step : float
             First trial step [s].
+        at_start : bool
+            The run's start derives the clutch's pre-deflections and its state at rest again from the packed
+            parameters (a co-simulation, whose host may set them: :func:`clutchlab.eclutch.system.eclutch_start`).
         """
         imode, interp, key, value = _input_mode(inputs)
         tin, vin = _as_table(value, key)
         self._check_reference(key, vin)
         return self._system(imode, interp, tin, vin, held_input=held_input, rtol=rtol, max_step=max_step,
                             event_tol=event_tol, jac_every=jac_every, atol_scale=_follow_rtol(rtol, atol_scale),
-                            first_step=first_step)
+                            first_step=first_step, at_start=at_start)
 
     def _check_reference(self, key: str, values) -> None:
         """A bearing reference inside the CSC travel (the actuator's end stops; #33: 50 mm was taken)."""

@@ -44,7 +44,7 @@ from ..units import to_si
 from .network import GROUND, AxialNetwork, Lever, Node, Spring, modified_parts, solve_static, zero_input
 
 __all__ = ["EClutchParameters", "ComponentCurves", "COMPONENTS", "read_component_curve",
-           "ClutchModel", "build_model", "clutch_torque", "torque_of_clamp_force", "MODEL_NUMBERS"]
+           "ClutchModel", "PresetDerivation", "build_model", "clutch_torque", "torque_of_clamp_force", "MODEL_NUMBERS"]
 
 MODEL_NUMBERS = (0, 1, 2, 3, 4)
 #: A measured characteristic may be continued beyond its characterised deflection range by this
@@ -398,6 +398,53 @@ def build_model(number: int, params: EClutchParameters | None = None, curves: Co
 
 
 @dataclasses.dataclass(frozen=True)
+class PresetDerivation:
+    """What Model ``number`` derives from its parameters, for the compiled start to derive it again.
+
+    :func:`build_model` zeroes Model 0's bearing at ``bearing_preload``, solves Model 0's engaged state at bearing
+    position 0 and gives each compliance Models 1-4 add the pre-strain at which it carries its share of that state
+    (the lever ``F_lever / k_fl``; the pressure-plate spring and the yoke support by their curves' inverses), then
+    zeroes Model 4's bearing again.  :func:`clutchlab.eclutch.system.derive_clutch` repeats that chain, compiled,
+    from copies of these numbers and Model 0's assembly, so a native FMU derives the network a host's pre-strains,
+    lever ratio, stiffnesses and preload give (docs/fmu.md).
+
+    Attributes
+    ----------
+    number : int
+        Model number (0-4).
+    model0 : AxialNetwork
+        Model 0 before its bearing is zeroed (the engaged state's network).
+    network : AxialNetwork
+        The network the derivation belongs to (a model built around another network derives nothing).
+    bearing_preload : float
+        Bearing force at bearing position 0 [N].
+    lever_ratio : float
+        ``i_ds`` [-].
+    k_fl : float
+        Lever stiffness of the model (Model 1: ``k_fl_model1``, Models 2-4: ``k_fl_model2``) [N/m].
+    support_scale : float
+        Scale of the yoke support the support's pre-strain is found with (Model 3: 1, Model 4:
+        ``support_scale``) [-].
+    """
+
+    number: int
+    model0: AxialNetwork
+    network: AxialNetwork
+    bearing_preload: float
+    lever_ratio: float
+    k_fl: float
+    support_scale: float
+
+    @classmethod
+    def of(cls, number: int, p: EClutchParameters, curves: ComponentCurves,
+           network: AxialNetwork) -> "PresetDerivation":
+        """The derivation of Model ``number`` built with ``p`` and ``curves`` as ``network``."""
+        return cls(int(number), _model0(p, curves), network, float(p.bearing_preload), float(p.lever_ratio),
+                   float(p.k_fl_model1 if number == 1 else p.k_fl_model2),
+                   float(p.support_scale if number == 4 else 1.0))
+
+
+@dataclasses.dataclass(frozen=True)
 class ClutchModel:
     """An E-clutch axial model: network plus torque parameters.
 
@@ -414,12 +461,20 @@ class ClutchModel:
         Friction coefficient [-].
     number : int or None
         Model number of [1] for presets.
+    derivation : PresetDerivation or None
+        How a preset derived its network from its parameters (set by :meth:`preset`; a co-simulation's start
+        derives it again, so a native FMU takes a host's pre-strains and preloads); None for a network of your own,
+        and ignored unless ``network`` is the one it was derived for.
     """
 
     network: AxialNetwork
     r_eff: float = 0.1026
     mu: float = 0.27
     number: int | None = None
+    #: how a preset derives its network from its parameters (:class:`PresetDerivation`): the compiled start of
+    #: the dynamics derives it again (:func:`clutchlab.eclutch.system.derive_clutch`); None for a network of
+    #: your own
+    derivation: "PresetDerivation | None" = dataclasses.field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         if not isinstance(self.network, AxialNetwork):
@@ -433,7 +488,9 @@ class ClutchModel:
     def preset(cls, n: int, params: EClutchParameters | None = None, curves: ComponentCurves | None = None) -> "ClutchModel":
         """Model ``n`` (0-4) of [1] with the bundled default parameters (or the given ones)."""
         params = params or EClutchParameters()
-        return cls(build_model(n, params, curves), r_eff=params.r_eff, mu=params.mu, number=int(n))
+        network = build_model(n, params, curves)
+        return cls(network, r_eff=params.r_eff, mu=params.mu, number=int(n),
+                   derivation=PresetDerivation.of(int(n), params, curves or ComponentCurves.bundled(), network))
 
     @classmethod
     def from_toml(cls, n: int, path) -> "ClutchModel":

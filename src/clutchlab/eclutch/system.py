@@ -52,14 +52,16 @@ from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
 from ..numerics.layout import indices, slots
-from ..system import System, variables
+from ..system import System, start_checks_deferred, variables
+from ..curves import curve_inverse_one
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_compliance, chamber_pressure_rate,
                        controller_integral_rate, controller_voltage, current_rate, drive_voltage, drive_voltage_slopes,
-                       line_flow_rate, line_inertance, line_resistance, reflected_mass, spindle_force,
+                       line_flow_rate, line_inertance, line_resistance, piston_area, reflected_mass, spindle_force,
                        spindle_ratio, stop_contact, stop_contact_slopes, vent_opening, vent_opening_slope)
 from .friction import FrictionElement, kinetic_level, slip_force, static_margin
 from .models import ClutchModel, torque_of_clamp_force
-from .network import GROUND, Lever, element_force, element_force_segment, solve_static
+from .network import (GROUND, Lever, _static_path, _zeroing_residual, _zeroing_root, element_force,
+                      element_force_segment, element_forces, solve_static)
 
 # the compiled hooks (rhs, outputs, update, restart, accept, next_break, jacobian, time_derivative) and their
 # EClutchParams are the kernel's internals, registered with numerics.dispatch below: not API (#33)
@@ -79,16 +81,20 @@ ACTUATOR_VECTOR = (
     # the fields the start derives the compliances, the line's inertance and resistance and the snifting edge
     # from (:func:`derive_actuator`)
     "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density", "fluid_viscosity",
-    "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia")
-(P_VMC, P_VSL, P_BULK, P_HOSE, P_RHO, P_VISC, P_LLEN, P_DLINE, P_XPORT, P_LEAD, P_MMASS, P_JROT) = indices(
+    "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia", "master_diameter",
+    "load_friction")
+(P_VMC, P_VSL, P_BULK, P_HOSE, P_RHO, P_VISC, P_LLEN, P_DLINE, P_XPORT, P_LEAD, P_MMASS, P_JROT, P_DMC,
+ P_LOADF) = indices(
     ACTUATOR_VECTOR, "master_volume", "slave_volume", "bulk_modulus", "hose_compliance", "fluid_density",
-    "fluid_viscosity", "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia")
+    "fluid_viscosity", "line_length", "line_diameter", "snifting_port", "lead", "master_mass", "rotor_inertia",
+    "master_diameter", "load_friction")
 #: the words the start derives (:func:`eclutch_start`; :attr:`clutchlab.system.System.decided_at_start`): of
-#: ``par``, the equivalent mass, the compliances, the line's inertance and resistance, the snifting edge and the
-#: spindle ratio (:func:`derive_actuator`); of ``coord``, the master's mass (``coord[CO_MASS, 0]``,
-#: :data:`DERIVED_COORD`)
-DERIVED_PAR = ("master_equivalent_mass", "master_compliance", "slave_compliance", "line_inertance", "line_resistance",
-               "snifting_edge", "spindle_ratio")
+#: ``par``, the master piston's area, the equivalent mass, the compliances, the line's inertance and resistance,
+#: the snifting edge and the spindle ratio (:func:`derive_actuator`); of ``coord``, the master's mass
+#: (``coord[CO_MASS, 0]``) and its seal's friction per pressure (``coord[CO_MU_PRESSURE, 0]``, the spindle's load
+#: friction times the master area)
+DERIVED_PAR = ("master_area", "master_equivalent_mass", "master_compliance", "slave_compliance", "line_inertance",
+               "line_resistance", "snifting_edge", "spindle_ratio")
 (P_AMC, P_ASL, P_MMC, P_MSL, P_CM, P_CS, P_LH, P_RH, P_GV, P_XSN, P_WSN, P_PCAV, P_CAVF, P_R, P_L, P_KT, P_VSUP,
  P_IMAX, P_KIL, P_NS, P_FPRE, P_KPRE, P_UMIN, P_UMAX, P_XMAX, P_KSTOP, P_CSTOP, P_KP, P_KI, P_KD, P_KAW, P_REFMIN,
  P_REFMAX) = indices(
@@ -170,6 +176,41 @@ W_F, W_FREE, W_FZ, W_AUX, W_DX, W_G, W_X, W_K, W_KEY, W_SEG = indices(
 N_WORK = len(WORK_ROWS)
 
 
+#: absolute tolerance of the position controller's integral action ``K_i int(e) dt`` [V] (times 10 with the actuator:
+#: 80 uV).  A voltage, bounded by the supply whatever the gain: until the thirty-ninth session it was ``1e-9 K_i``
+#: (the same at the default gain, 8000 V/(m s)), which made a gain and the tolerance ``rtol`` (that the absolute
+#: tolerances follow below the default) change one number, so a native FMU could take only one of them
+INTEGRAL_ATOL = 8e-6
+
+#: the numbers a preset derives its network from (``EClutchParams.clutch``; :func:`derive_clutch`), then the bearing
+#: position the start finds at rest (:func:`start_at_rest`)
+CLUTCH_VECTOR = ("bearing_preload", "lever_ratio", "k_fl", "support_scale", "rest_position")
+CL_PRELOAD, CL_RATIO, CL_KFL, CL_SUPPORT_SCALE, CL_REST = indices(
+    CLUTCH_VECTOR, "bearing_preload", "lever_ratio", "k_fl", "support_scale", "rest_position")
+#: ``EClutchParams.clutch_int``: the preset's number (-1: a network of your own, nothing derived), whether the start
+#: derives the network and the state at rest (1: a co-simulation, whose host may have set the parameters), then the
+#: elements of the network and of Model 0 the derivation reads (-1: none)
+CLUTCH_INT = ("number", "at_start", "bearing", "diaphragm", "lever", "return", "cushion", "pp_spring", "support",
+              "model0_bearing", "model0_diaphragm", "model0_return", "model0_cushion")
+(CLI_NUMBER, CLI_AT_START, CLI_BEARING, CLI_DIAPHRAGM, CLI_LEVER, CLI_RETURN, CLI_CUSHION, CLI_PP_SPRING, CLI_SUPPORT,
+ CLI_M0_BEARING, CLI_M0_DIAPHRAGM, CLI_M0_RETURN, CLI_M0_CUSHION) = indices(CLUTCH_INT, *CLUTCH_INT)
+#: model errors of the start (:attr:`clutchlab.system.System.error_messages`)
+ERR_ZEROING, ERR_REST, ERR_STATIC, ERR_PRESTRAIN, ERR_STROKE, ERR_MASTER_VOLUME = -3, -4, -5, -6, -7, -8
+ERROR_MESSAGES = {
+    ERR_STROKE: "actuator.snifting_port + actuator.snifting_width must be below actuator.master_stroke (the port must "
+                "close within the stroke)",
+    ERR_MASTER_VOLUME: "actuator.master_volume is smaller than the volume the master piston sweeps up to the snifting "
+                       "port",
+    ERR_ZEROING: "the clutch's bearing cannot be zeroed at clutch.bearing_preload: no pre-strain of the bearing "
+                 "within [-0.05, 0.05] m gives that bearing force at bearing position 0",
+    ERR_REST: "with actuator.csc_preload the CSC finds no rest position within its travel "
+              "(clutch.bearing_preload and actuator.csc_preload should match)",
+    ERR_STATIC: "no static equilibrium of the clutch at its rest position",
+    ERR_PRESTRAIN: "a compliance's engaged load lies outside its characteristic (extrapolation 'error'): "
+                   "no pre-strain carries it",
+}
+
+
 class EClutchParams(NamedTuple):
     """Packed parameters of one E-clutch run (:meth:`Assembly.params`; SI units).
 
@@ -200,6 +241,12 @@ class EClutchParams(NamedTuple):
     r_eff: float             # effective friction radius [m]
     mu: float                # friction coefficient of the facings [-]
     work: np.ndarray         # (N_WORK, n): scratch rows W_*
+    clutch: np.ndarray       # CL_* layout: what a preset derives its network from (derive_clutch)
+    clutch_int: np.ndarray   # CLI_* layout: preset number, derive at start, the elements the derivation reads
+    GA0: np.ndarray          # Model 0 (the engaged state's network): assembly as GA, net, net_int, curve
+    net0: np.ndarray
+    net0_int: np.ndarray
+    curve0: np.ndarray
 
 
 # ---------------------------------------------------------------- compiled hooks
@@ -1005,13 +1052,15 @@ def time_derivative(t, x, u, m, p, ft):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def derive_actuator(par):
-    """The actuator's derived words of ``par`` (the ``P_*`` layout) from the fields packed beside them: the chamber
-    compliances ``C = V / beta + C_hose / 2`` (:func:`~clutchlab.eclutch.actuator.chamber_compliance`), the line's
+    """The actuator's derived words of ``par`` (the ``P_*`` layout) from the fields packed beside them: the master
+    piston's area (:func:`~clutchlab.eclutch.actuator.piston_area`), the chamber compliances
+    ``C = V / beta + C_hose / 2`` (:func:`~clutchlab.eclutch.actuator.chamber_compliance`), the line's
     inertance and laminar resistance (:func:`~clutchlab.eclutch.actuator.line_inertance`,
     :func:`~clutchlab.eclutch.actuator.line_resistance`), the snifting port's closing edge (port + width), the
     spindle ratio ``lead / 2 pi`` and the master's equivalent mass ``m + J / n_s^2``
     (:func:`~clutchlab.eclutch.actuator.spindle_ratio`, :func:`~clutchlab.eclutch.actuator.reflected_mass`);
     [1] Sec. 2.1, Fig. 5a, [2].  Called by the packing and by the start (:func:`eclutch_start`)."""
+    par[P_AMC] = piston_area(par[P_DMC])
     par[P_CM] = chamber_compliance(par[P_VMC], par[P_BULK], par[P_HOSE] / 2.0)
     par[P_CS] = chamber_compliance(par[P_VSL], par[P_BULK], par[P_HOSE] / 2.0)
     par[P_LH] = line_inertance(par[P_RHO], par[P_LLEN], par[P_DLINE])
@@ -1021,15 +1070,338 @@ def derive_actuator(par):
     par[P_MMC] = reflected_mass(par[P_MMASS], par[P_JROT], par[P_NS])
 
 
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True)
+def network_arrays(GA, net, net_int, curve):
+    """The arrays of the static solver (:meth:`clutchlab.eclutch.network.AxialNetwork.kernel_data`'s order and
+    types) from a packed network (``GA``, ``net``, ``net_int``, ``curve``; ``NE_*``, ``NI_*`` rows), as copies:
+    the pre-deflections ``d0`` (third) may be changed without touching the packing."""
+    n_el = GA.shape[0]
+    unilateral = np.empty(n_el, dtype=np.bool_)
+    for e in range(n_el):
+        unilateral[e] = net_int[NI_UNILATERAL, e] != 0
+    return (GA.copy(), net[NE_GB].copy(), net[NE_D0].copy(), curve[0].copy(), curve[1].copy(), curve[2].copy(),
+            net_int[NI_OFFSETS].copy(), net_int[NI_KINDS, :n_el].copy(), net_int[NI_EXTRAPS, :n_el].copy(),
+            net[NE_SCALE].copy(), unilateral)
+
+
+@numba.njit(cache=True, nogil=True)
+def _path(u_grid, q0, data):
+    """:func:`~clutchlab.eclutch.network._static_path` on :func:`network_arrays` (force 1e-7 N, step 1e-14 m, as
+    :func:`~clutchlab.eclutch.network.solve_static`)."""
+    GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral = data
+    return _static_path(u_grid, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, 1e-7, 1e-14)
+
+
+@numba.njit(cache=True, nogil=True)
+def _zeroing_residual_at(prestrain, k, force, data):
+    u0 = np.zeros(1)
+    q0 = np.zeros(data[0].shape[1])
+    GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral = data
+    return _zeroing_residual(prestrain, k, 0.0, Gb, force, u0, q0, GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps,
+                             scale, unilateral)
+
+
+@numba.njit(cache=True, nogil=True)
+def zeroed_prestrain(k, start, force, data):
+    """The pre-strain [m] of element ``k`` (the bearing) at which the input force at input position 0 is ``force``
+    [N] ([1] Sec. 3.2: the bearing's origin is the engaged clutch pressed by the CSC preload), as
+    :func:`~clutchlab.eclutch.network.zero_input` finds it: secant steps from ``start``, else Brent's method on
+    [-0.05, 0.05] m (tolerance 1e-13 m + 1e-12 relative).  ``data``: :func:`network_arrays` (its ``d0[k]`` is left
+    at the root).  NaN where no pre-strain in that interval reaches the force."""
+    u0 = np.zeros(1)
+    q0 = np.zeros(data[0].shape[1])
+    GA, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral = data
+    p = _zeroing_root(start, start + 1e-6, -0.05, 0.05, 1e-13, 1e-12, k, 0.0, Gb, force, u0, q0, GA, Gb, d0, cx, cf,
+                      cd, offsets, kinds, extraps, scale, unilateral)
+    if np.isnan(p):
+        p = _brent(0, k, force, 0.0, data, -0.05, 0.05, 1e-13, 2e-12)
+    if not np.isnan(p):
+        data[2][k] = p
+    return p
+
+
+@numba.njit(cache=True, nogil=True)
+def _residual_of(which, x, k, force, rate, data):
+    """The residual of a root the start finds: ``which`` 0, the bearing's zeroing (:func:`_zeroing_residual_at`,
+    element ``k``, input force ``force``); 1, the rest position's (:func:`_rest_residual`, preload ``force``, rate
+    ``rate``)."""
+    if which == 0:
+        return _zeroing_residual_at(x, k, force, data)
+    return _rest_residual(x, force, rate, data)
+
+
+@numba.njit(cache=True, nogil=True)
+def _brent(which, k, force, rate, data, a, b, xtol, rtol):
+    """Brent's method (scipy's ``brentq``'s bracketing; converged within ``rtol |x| + xtol / 2``) on
+    :func:`_residual_of` over ``[a, b]``; NaN without a sign change or where the residual is not finite."""
+    fa = _residual_of(which, a, k, force, rate, data)
+    fb = _residual_of(which, b, k, force, rate, data)
+    if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0.0:
+        return np.nan
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    c, fc, d, e = a, fa, b - a, b - a
+    for _ in range(200):
+        if fb * fc > 0.0:
+            c, fc = a, fa
+            d = e = b - a
+        if abs(fc) < abs(fb):
+            a, b, c = b, c, b
+            fa, fb, fc = fb, fc, fb
+        tol = rtol * abs(b) + 0.5 * xtol
+        mid = 0.5 * (c - b)
+        if abs(mid) <= tol or fb == 0.0:
+            return b
+        if abs(e) >= tol and abs(fa) > abs(fb):
+            s = fb / fa
+            if a == c:
+                pp = 2.0 * mid * s
+                qq = 1.0 - s
+            else:
+                qa = fa / fc
+                r = fb / fc
+                pp = s * (2.0 * mid * qa * (qa - r) - (b - a) * (r - 1.0))
+                qq = (qa - 1.0) * (r - 1.0) * (s - 1.0)
+            if pp > 0.0:
+                qq = -qq
+            pp = abs(pp)
+            if 2.0 * pp < min(3.0 * mid * qq - abs(tol * qq), abs(e * qq)):
+                e = d
+                d = pp / qq
+            else:
+                d = mid
+                e = d
+        else:
+            d = mid
+            e = d
+        a, fa = b, fb
+        b = b + (d if abs(d) > tol else (tol if mid > 0.0 else -tol))
+        fb = _residual_of(which, b, k, force, rate, data)
+        if not np.isfinite(fb):
+            return np.nan
+    return b
+
+
+@numba.njit(cache=True, nogil=True)
+def derive_clutch(clutch, clutch_int, GA0, net0, net0_int, curve0, net, net_int, curve, GA):
+    """A preset's pre-deflections from its parameters ([1] Secs. 3.2, 5.1-5.4;
+    :func:`clutchlab.eclutch.models.build_model`): Model 0's bearing zeroed at ``bearing_preload`` (:func:`zeroed_prestrain`), Model 0's engaged state at bearing
+    position 0 (the static solver), the loads of its rigid connections -- the lever ``F_b - F_ds``, the pressure
+    plate ``F_cushion + F_return``, the support ``-(1 - i_ds) F_lever`` -- and the pre-strain at which each
+    compliance a later model adds carries its load: the lever ``F_lever / k_fl`` (Eq. 1), the pressure-plate
+    spring and the yoke support by their characteristics' inverses (the support's at ``F / support_scale``,
+    Model 4), then Model 4's bearing zeroed again.  Writes the bearing's, the lever's, the pressure-plate spring's
+    and the support's ``net[NE_D0]``.  The compiled twin of that chain in :func:`~clutchlab.eclutch.models.build_model`
+    (in Python, on the networks' own assemblies; the two agree to 1e-17 m), for the start of a co-simulation
+    (:func:`eclutch_start`), whose host may have set the parameters.  Returns 0, or
+    :data:`ERR_ZEROING`, :data:`ERR_STATIC`, :data:`ERR_PRESTRAIN`."""
+    number = clutch_int[CLI_NUMBER]
+    if number < 0:
+        return 0
+    preload = clutch[CL_PRELOAD]
+    data0 = network_arrays(GA0, net0, net0_int, curve0)
+    k0 = clutch_int[CLI_M0_BEARING]
+    pb = zeroed_prestrain(k0, data0[2][k0], preload, data0)
+    if np.isnan(pb):
+        return ERR_ZEROING
+    _q, F, _d, status = _path(np.zeros(1), np.zeros(GA0.shape[1]), data0)
+    if status:
+        return ERR_STATIC
+    f = F[0]
+    lever = f[k0] - f[clutch_int[CLI_M0_DIAPHRAGM]]
+    plate = f[clutch_int[CLI_M0_CUSHION]] + f[clutch_int[CLI_M0_RETURN]]
+    support = -(1.0 - clutch[CL_RATIO]) * lever
+    d0 = net[NE_D0]
+    offsets = net_int[NI_OFFSETS]
+    eb = clutch_int[CLI_BEARING]
+    d0[eb] = pb
+    if number >= 1:
+        d0[clutch_int[CLI_LEVER]] = lever / clutch[CL_KFL]
+    for e, load in ((clutch_int[CLI_PP_SPRING], plate), (clutch_int[CLI_SUPPORT], support / clutch[CL_SUPPORT_SCALE])):
+        if e >= 0:
+            lo, hi = offsets[e], offsets[e + 1]
+            d = curve_inverse_one(curve[0, lo:hi], curve[1, lo:hi], curve[2, lo:hi], net_int[NI_KINDS, e],
+                                  net_int[NI_EXTRAPS, e], load)
+            if np.isnan(d):
+                return ERR_PRESTRAIN
+            d0[e] = d
+    if number == 4:   # (the scaled diaphragm changes the engaged state: the bearing zeroed again)
+        data = network_arrays(GA, net, net_int, curve)
+        pb4 = zeroed_prestrain(eb, pb, preload, data)
+        if np.isnan(pb4):
+            return ERR_ZEROING
+        d0[eb] = pb4
+    return 0
+
+
+@numba.njit(cache=True, nogil=True)
+def static_state(u, data, q):
+    """The clutch's static equilibrium at bearing position ``u`` [m] as
+    :func:`~clutchlab.eclutch.network.solve_static` finds it for :meth:`Assembly.initial_state` (walked from the
+    assembled state in 8 steps, then Newton there), in the node-aligned coordinates of the packing: the
+    independent nodes' positions into ``q`` [m]; returns the bearing force [N] (NaN: not found).  ``data``:
+    :func:`network_arrays`.  For the start of a co-simulation (:func:`start_at_rest`)."""
+    for j in range(q.shape[0]):
+        q[j] = 0.0
+    if u != 0.0:
+        pre = np.empty(9)
+        for i in range(9):
+            pre[i] = u * i / 8.0
+        Qp, _f, _d, st = _path(pre, q, data)
+        if st == 0:
+            for j in range(q.shape[0]):   # (element by element: a slice assignment's error is built in Python)
+                q[j] = Qp[8, j]
+    uu = np.empty(1)
+    uu[0] = u
+    Q, F, _d, status = _path(uu, q, data)
+    if status:
+        return np.nan
+    for j in range(q.shape[0]):
+        q[j] = Q[0, j]
+    s = 0.0
+    for e in range(F.shape[1]):
+        s += F[0, e] * data[1][e]
+    return s
+
+
+@numba.njit(cache=True, nogil=True)
+def _rest_residual(u, preload, rate, data):
+    q = np.empty(data[0].shape[1])
+    return preload - rate * u - static_state(u, data, q)
+
+
+@numba.njit(cache=True, nogil=True)
+def rest_position(preload, rate, lo, hi, data):
+    """Bearing position at rest [m]: the CSC preload spring (``preload - rate u`` [N]) balances the clutch's bearing
+    force, the first stable root from position 0 within the travel ``[lo, hi]`` (201 positions towards release,
+    40 towards the engaged stop, then Brent's method to 1e-13 m); 0 where the preload balances the bearing force
+    there within 1e-9 N, NaN where no root lies in the travel.  ``data``: :func:`network_arrays`.  The compiled
+    twin of :meth:`Assembly.rest_position` (the same grid and bracket), for the start of a co-simulation
+    (:func:`start_at_rest`): calling it from the packing too would compile it as an entry of its own (18 s more
+    at an E-clutch's first use)."""
+    q = np.empty(data[0].shape[1])
+    g0 = preload - static_state(0.0, data, q)
+    if not np.isfinite(g0):
+        return np.nan
+    if abs(g0) < 1e-9:
+        return 0.0
+    n_up = 201
+    up = np.empty(n_up)
+    for i in range(n_up):
+        up[i] = hi * i / (n_up - 1)
+    Q, F, _d, status = _path(up, np.zeros(data[0].shape[1]), data)
+    if status:
+        return np.nan
+    gu = np.empty(n_up)
+    for i in range(n_up):
+        s = 0.0
+        for e in range(F.shape[1]):
+            s += F[i, e] * data[1][e]
+        gu[i] = preload - rate * up[i] - s
+    a = b = np.nan
+    if gu[0] > 0.0:   # pushed towards release: the first stable root (g from + to -) going up
+        for i in range(n_up - 1):
+            if gu[i] > 0.0 and gu[i + 1] <= 0.0:
+                a, b = up[i], up[i + 1]
+                break
+    elif lo < 0.0:    # pulled towards the engaged side
+        n_down = 40
+        down = np.empty(n_down)
+        for i in range(n_down):
+            down[i] = lo * (i + 1) / n_down
+        Qd, Fd, _d, status = _path(down, np.zeros(data[0].shape[1]), data)
+        if status:
+            return np.nan
+        g_prev, u_prev = gu[0], 0.0
+        for i in range(n_down):
+            s = 0.0
+            for e in range(Fd.shape[1]):
+                s += Fd[i, e] * data[1][e]
+            g = preload - rate * down[i] - s
+            if g_prev <= 0.0 and g > 0.0:
+                a, b = down[i], u_prev
+                break
+            g_prev, u_prev = g, down[i]
+    if np.isnan(a):
+        return np.nan
+    return _brent(1, 0, preload, rate, data, a, b, 1e-13, 4.4e-16)
+
+
+@numba.njit(cache=True, nogil=True)
+def start_modes(u, q, m, GA, net, net_int, curve, coord, coord_int):
+    """The friction modes at rest (bearing at ``u``, nodes at ``q``) into ``m[:nz]``: stuck where the kinetic level
+    ``F_c + mu_n |F_n|`` is positive (the state machine breaks away if the force exceeds the limit), free where it
+    is zero (no Coulomb part, the pressing element unloaded; the chambers start at 0 Pa)."""
+    data = network_arrays(GA, net, net_int, curve)
+    n_el = GA.shape[0]
+    f = np.empty(n_el)
+    k = np.empty(n_el)
+    d = np.empty(n_el)
+    GA_, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral = data
+    element_forces(q, u, GA_, Gb, d0, cx, cf, cd, offsets, kinds, extraps, scale, unilateral, f, k, d)
+    for j in range(coord.shape[1]):
+        m[j] = FREE
+        if coord_int[CI_FRICTION, j]:
+            e = coord_int[CI_NORMAL, j]
+            fn = f[e] if e >= 0 else 0.0
+            m[j] = STUCK if coord[CO_COULOMB, j] + coord[CO_MU_NORMAL, j] * abs(fn) > 0.0 else FREE
+
+
+@numba.njit(cache=True, nogil=True)
+def start_at_rest(x, m, p):
+    """The state at rest of a run whose host may have set the parameters (a co-simulation): the bearing at its rest
+    position (:func:`rest_position` of ``csc_preload``, ``csc_spring_rate`` and the CSC travel) into ``x[1]`` and
+    ``clutch[CL_REST]``, the nodes at the static equilibrium there (:func:`static_state`) into ``x[2:nz]``, the
+    friction modes (:func:`start_modes`).  Returns 0, :data:`ERR_REST` or :data:`ERR_STATIC`."""
+    par = p.par
+    data = network_arrays(p.GA, p.net, p.net_int, p.curve)
+    if p.imode == PRESCRIBED:
+        u = x[1]
+    else:
+        u = rest_position(par[P_FPRE], par[P_KPRE], par[P_UMIN], par[P_UMAX], data)
+        if np.isnan(u):
+            return ERR_REST
+    q = np.empty(p.GA.shape[1])
+    if np.isnan(static_state(u, data, q)):
+        return ERR_STATIC
+    p.clutch[CL_REST] = u
+    x[1] = u
+    for j in range(q.shape[0]):
+        x[2 + j] = q[j]
+    start_modes(u, q, m, p.GA, p.net, p.net_int, p.curve, p.coord, p.coord_int)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True)
 def eclutch_start(t, x, u, m, p):
     """What a run derives from its parameters alone, once before its first restart (the core's ``start`` hook): the
-    actuator's words of :func:`derive_actuator`, and the master coordinate's mass (its equivalent mass).  The packing
-    derives them with the same function; a native FMU runs it again after a host set the volumes, the fluid or the
-    line, which it then writes as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
-    derive_actuator(p.par)
-    p.coord[CO_MASS, 0] = p.par[P_MMC]   # (the master's coordinate carries the equivalent mass: Assembly)
-    return 0
+    actuator's words of :func:`derive_actuator`, and the master coordinate's mass (its equivalent mass); in a
+    co-simulation (``clutch_int[CLI_AT_START]``, whose host may have set the clutch's parameters) also the
+    preset's pre-deflections (:func:`derive_clutch`) and the state at rest (:func:`start_at_rest`).  The packing
+    derives the actuator's with the same function, the clutch's in Python
+    (:func:`~clutchlab.eclutch.models.build_model`, :meth:`Assembly.rest_position`, :meth:`Assembly.initial_state`; the same to 1e-17 m); a native FMU runs the
+    start again after a host set the volumes, the fluid, the line, the pre-strains, the lever ratio, the
+    stiffnesses or the preloads, which it then writes as plain copies
+    (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0 or a model error (:data:`ERROR_MESSAGES`)."""
+    par = p.par
+    derive_actuator(par)
+    p.coord[CO_MASS, 0] = par[P_MMC]   # (the master's coordinate carries the equivalent mass: Assembly)
+    if p.imode != PRESCRIBED:   # (the master seal + spindle: actuator_friction_elements, the last on the master)
+        p.coord[CO_MU_PRESSURE, 0] = par[P_LOADF] * par[P_AMC]
+    if p.clutch_int[CLI_AT_START] == 0:
+        return 0
+    # (what ActuatorParameters.check refuses across fields, for a host's values)
+    if par[P_XSN] >= par[P_XMAX]:
+        return ERR_STROKE
+    if par[P_VMC] < par[P_AMC] * par[P_XPORT]:
+        return ERR_MASTER_VOLUME
+    code = derive_clutch(p.clutch, p.clutch_int, p.GA0, p.net0, p.net0_int, p.curve0, p.net, p.net_int, p.curve,
+                         p.GA)
+    if code:
+        return code
+    return start_at_rest(x, m, p)
 
 
 dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restart=restart, accept=accept,
@@ -1130,6 +1502,8 @@ def _actuator_vector(a: ActuatorParameters) -> np.ndarray:
     par[P_LEAD] = a.lead
     par[P_MMASS] = a.master_mass
     par[P_JROT] = a.rotor_inertia
+    par[P_DMC] = a.master_diameter
+    par[P_LOADF] = a.load_friction
     derive_actuator(par)   # (the words the start derives: written once)
     return par
 
@@ -1199,8 +1573,10 @@ class Assembly:
         atol = np.empty(n)
         atol[: self.nz] = 1e-8
         atol[self.nz: b0] = 1e-5
-        # energy bookkeeping states: 10 nJ, so the energy balance of a small input (tens of uJ) closes too
-        atol[b0: b0 + 8] = [10.0, 1e-10, 10.0, 1e-4, 1e-9 * ki, 1e-8, 1e-8, 1e-8]
+        # energy bookkeeping states: 10 nJ, so the energy balance of a small input (tens of uJ) closes too; the
+        # controller's integral action in volts (INTEGRAL_ATOL: not scaled by the gain, whose integral of the
+        # same voltage it is)
+        atol[b0: b0 + 8] = [10.0, 1e-10, 10.0, 1e-4, INTEGRAL_ATOL, 1e-8, 1e-8, 1e-8]
         if not prescribed:
             # with the actuator: 0.1 um, 0.1 mm/s, 100 Pa, 1 mA, ... (far below what a rig resolves; tighter
             # values only resolve stick-slip micro-motions of the seals, see docs/eclutch_dynamics.md)
@@ -1210,6 +1586,41 @@ class Assembly:
         self.normal_element = self.element_names.index(nf)
         self.friction_outputs = np.array([j for j in range(self.nz) if self.fr_on[j] or self.fr_c[j] > 0],
                                          dtype=np.int64)
+        self._derivation_arrays()
+
+    def _derivation_arrays(self) -> None:
+        """``clutch``, ``clutch_int`` and Model 0's assembly for :func:`derive_clutch` (a preset's; a network of
+        your own derives nothing: number -1 and empty arrays)."""
+        d = self.model.derivation
+        self.clutch = np.zeros(len(CLUTCH_VECTOR))
+        self.clutch_int = -np.ones(len(CLUTCH_INT), dtype=np.int64)
+        self.clutch_int[CLI_AT_START] = 0
+        if d is None or d.network is not self.model.network:
+            self.model0 = (np.zeros((0, 0)), np.zeros((3, 0)), np.zeros((4, 1), dtype=np.int64), np.zeros((3, 0)))
+            return
+        self.clutch[[CL_PRELOAD, CL_RATIO, CL_KFL, CL_SUPPORT_SCALE]] = (d.bearing_preload, d.lever_ratio, d.k_fl,
+                                                                         d.support_scale)
+        self.clutch_int[CLI_NUMBER] = d.number
+        names = self.element_names
+        for slot, name in ((CLI_BEARING, "bearing"), (CLI_DIAPHRAGM, "diaphragm"), (CLI_LEVER, "lever"),
+                           (CLI_RETURN, "return"), (CLI_CUSHION, "cushion"), (CLI_PP_SPRING, "pp_spring"),
+                           (CLI_SUPPORT, "support")):
+            self.clutch_int[slot] = names.index(name) if name in names else -1
+        asm0 = _node_aligned(d.model0)
+        kd = d.model0.kernel_data()
+        names0 = asm0["elements"]
+        for slot, name in ((CLI_M0_BEARING, "bearing"), (CLI_M0_DIAPHRAGM, "diaphragm"), (CLI_M0_RETURN, "return"),
+                           (CLI_M0_CUSHION, "cushion")):
+            self.clutch_int[slot] = names0.index(name)
+        n0 = len(names0)
+        net0_int = np.zeros((4, n0 + 1), dtype=np.int64)
+        net0_int[NI_OFFSETS] = kd[6]
+        net0_int[NI_KINDS, :n0] = kd[7]
+        net0_int[NI_EXTRAPS, :n0] = kd[8]
+        net0_int[NI_UNILATERAL, :n0] = kd[10]
+        self.model0 = (np.ascontiguousarray(asm0["GA"], dtype=float),
+                       np.ascontiguousarray(np.stack([asm0["d0"], asm0["Gb"], kd[9]]), dtype=float), net0_int,
+                       np.ascontiguousarray(np.stack([kd[3], kd[4], kd[5]]), dtype=float))
 
     def _friction(self, elements):
         nz = self.nz
@@ -1382,6 +1793,8 @@ class Assembly:
             k = np.flatnonzero((gg[:-1] <= 0) & (gg[1:] > 0))
             if k.size:
                 return float(brentq(g, uu[k[0] + 1], uu[k[0]], xtol=1e-13))
+        if start_checks_deferred():   # (a native FMU's trial build: its start refuses it, start_at_rest)
+            return 0.0
         raise ParameterError(
             f"inconsistent parameters: with csc_preload = {a.csc_preload!r} N the CSC finds no rest position within "
             f"its travel [{lo:g}, {hi:g}] m (the clutch's bearing force at position 0 is {a.csc_preload - g(0.0):.4g} N; "
@@ -1404,11 +1817,13 @@ class Assembly:
             net_int[NI_EXTRAPS, :n_el] = self.extraps
             net_int[NI_UNILATERAL, :n_el] = self.unilateral
             curve = f64(np.stack([self.cx, self.cf, self.cd]))
+            # (a preset's derived pre-deflections are the network's, built in Python by build_model; a
+            # co-simulation's start derives them again, compiled: derive_clutch, equal to 1e-17 m)
             self._constant = (f64(self.par), coord, coord_int, np.ascontiguousarray(self.friction_outputs, np.int64),
-                              f64(a["GA"]), net, net_int, curve)
+                              f64(a["GA"]), net, net_int, curve, self.clutch.copy(), self.clutch_int.copy())
         return self._constant
 
-    def params(self, imode: int, tin, vin, interp: int) -> EClutchParams:
+    def params(self, imode: int, tin, vin, interp: int, at_start: bool = False) -> EClutchParams:
         """The packed parameters of one run (fresh scratch arrays: one per run or batch variant).
 
         Parameters
@@ -1419,17 +1834,24 @@ class Assembly:
             Input table: times [s] and values [V or m]; empty: the held input ``u[0]`` is the input.
         interp : int
             0 linear between rows, 1 held.
+        at_start : bool
+            The start derives the preset's pre-deflections and the state at rest again (:func:`eclutch_start`; a
+            co-simulation, whose host may set the parameters).
         """
-        par, coord, coord_int, fo, GA, net, net_int, curve = self._packed()
+        par, coord, coord_int, fo, GA, net, net_int, curve, clutch, clutch_int = self._packed()
         width = max(self.n, len(self.switching()), N_AUX + self.nz, 2 + self.n + self.nz)
+        if at_start:   # (the start writes the pre-deflections and the rest position: this run's own copies)
+            net, clutch, clutch_int = net.copy(), clutch.copy(), clutch_int.copy()
+            clutch_int[CLI_AT_START] = 1
         return EClutchParams(
             int(self.nz), int(imode), int(interp), np.ascontiguousarray(tin, dtype=np.float64),
             np.ascontiguousarray(vin, dtype=np.float64), par, coord, coord_int, fo, GA, net, net_int, curve,
-            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((N_WORK, width)))
+            int(self.normal_element), float(self.model.r_eff), float(self.model.mu), np.zeros((N_WORK, width)),
+            clutch, clutch_int, *self.model0)
 
     def system(self, imode: int, tin, vin, interp: int, u0: float, *, held_input: bool = False,
                rtol: float = 1e-3, max_step: float = 0.01, event_tol: float = 1e-8, jac_every: int = 10,
-               atol_scale: float = 1.0, first_step: float = 1e-5) -> System:
+               atol_scale: float = 1.0, first_step: float = 1e-5, at_start: bool = False) -> System:
         """The :class:`~clutchlab.system.System` of one run.
 
         Parameters
@@ -1451,6 +1873,10 @@ class Assembly:
             Accepted steps a finite-difference Jacobian is kept.
         atol_scale : float
             Factor on the default absolute tolerances.
+        at_start : bool
+            The run's start derives the preset's pre-deflections, the rest position and the state at rest again
+            (``u0`` must be the rest position; a co-simulation, whose host may set the parameters:
+            :func:`eclutch_start`).
         """
         if not (np.isfinite(atol_scale) and atol_scale > 0):
             raise ParameterError(f"atol_scale = {atol_scale!r} must be finite and > 0")
@@ -1460,31 +1886,31 @@ class Assembly:
         # fresh parameter structure (its scratch rows belong to one run), without building and checking the
         # System again (tens of microseconds against a run of about a millisecond)
         key = (int(imode), tin.tobytes(), vin.tobytes(), int(interp), float(u0), bool(held_input), float(rtol),
-               float(max_step), float(event_tol), int(jac_every), float(atol_scale), float(first_step))
+               float(max_step), float(event_tol), int(jac_every), float(atol_scale), float(first_step), bool(at_start))
         known = self._systems.get(key)
         if known is not None:
             params = known.params
             return known.variant(params=params._replace(work=np.zeros_like(params.work)))
         system = self._build_system(imode, tin, vin, interp, u0, held_input, rtol, max_step, event_tol, jac_every,
-                                    atol_scale, first_step)
+                                    atol_scale, first_step, bool(at_start))
         if len(self._systems) >= 16:
             self._systems.pop(next(iter(self._systems)))
         self._systems[key] = system
         return system
 
     def _build_system(self, imode, tin, vin, interp, u0, held_input, rtol, max_step, event_tol, jac_every,
-                      atol_scale, first_step) -> System:
+                      atol_scale, first_step, at_start) -> System:
         x0, m0 = self.initial_state(u0)
         name = {VOLTAGE: ("motor_voltage", "V"), POSITION: ("bearing_reference", "m"),
                 PRESCRIBED: ("bearing_position", "m")}[imode]
         if held_input:
             inputs, u_start = (name,), np.array([float(vin[0])])
-            params = self.params(imode, np.empty(0), np.empty(0), interp)
+            params = self.params(imode, np.empty(0), np.empty(0), interp, at_start)
             nonauto = False
             segments = ("held input",)
         else:
             inputs, u_start = (), None
-            params = self.params(imode, tin, vin, interp)
+            params = self.params(imode, tin, vin, interp, at_start)
             # inputs that vary inside a step: a linear table (position reference, prescribed motion)
             nonauto = tin.size > 1 and (imode != VOLTAGE or interp == 0)
             segments = ("before the table",) + tuple(f"row {k} ({t:g} s)" for k, t in enumerate(tin))
@@ -1501,8 +1927,21 @@ class Assembly:
             jac_every=int(jac_every), rtol=float(rtol), max_step=float(max_step), first_step=float(first_step),
             event_tol=float(event_tol), element_name=self.element_name, limits=self.limits(),
             decided_at_start=tuple(("params.par", k, k + 1) for k in indices(ACTUATOR_VECTOR, *DERIVED_PAR))
-            + (("params.coord", CO_MASS * self.nz, CO_MASS * self.nz + 1),),   # (coord[CO_MASS, 0], C order)
+            + (("params.coord", CO_MASS * self.nz, CO_MASS * self.nz + 1),)   # (coord[CO_MASS, 0], C order)
+            + ((("params.coord", CO_MU_PRESSURE * self.nz, CO_MU_PRESSURE * self.nz + 1),) if not self.prescribed
+               else ())
+            + (self._derived_at_start() if at_start else ()),
+            error_messages=dict(ERROR_MESSAGES),
         )
+
+    def _derived_at_start(self) -> tuple:
+        """The words a co-simulation's start writes beyond the actuator's (:func:`eclutch_start`): the preset's
+        derived pre-deflections (``net[NE_D0]`` of the bearing, the lever, the pressure-plate spring and the
+        support), the rest position, the bearing's and the nodes' positions and the friction modes."""
+        n_el = len(self.element_names)
+        out = [("params.net", NE_D0 * n_el + e, NE_D0 * n_el + e + 1)
+               for e in self.clutch_int[[CLI_BEARING, CLI_LEVER, CLI_PP_SPRING, CLI_SUPPORT]] if e >= 0]
+        return tuple(out) + (("params.clutch", CL_REST, CL_REST + 1), ("x", 1, self.nz), ("m", 0, self.nz))
 
     def limits(self) -> dict:
         """Physical range of the actuator [SI]: CSC travel, master stroke, supply voltage, current limit."""

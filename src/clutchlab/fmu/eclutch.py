@@ -99,7 +99,7 @@ class EClutchCoSimulation(ContractCoSimulation):
         bearing reference under position control, else the motor voltage."""
         key = "bearing_reference" if self.input_name == "bearing_reference" else "voltage"
         start = next(v.start for v in self.inputs if v.name == self.input_name)
-        return self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True)
+        return self.eclutch.as_system({key: start}, rtol=self.rtol, held_input=True, at_start=True)
 
     def input_vector(self, inputs: dict) -> np.ndarray:
         """The held input: the bearing reference under position control, else the motor voltage (the other FMI
