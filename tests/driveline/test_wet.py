@@ -273,3 +273,46 @@ def test_a_periodic_force_port_equals_the_bench_run_of_its_corners():
             assert mine.size == theirs.size, name
             np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-7, err_msg=name)
         assert (ev["event"] == "contact").sum() == 2   # (pressed twice)
+
+
+def test_a_wet_clutch_s_parameter_sets_are_parameters_of_its_network(tmp_path):
+    """A description's wet clutch takes its ``clutch`` and ``bench`` from files (or their defaults); their numeric
+    fields are parameters of the network (``<component>.clutch.<field>``, ``<component>.bench.<field>``: a sweep's
+    and a native FMU's), the bench's drive and the virtual rig's sensors left out (the network is the drive).
+    Changed by name they give the run a file carrying those values gives (the same numbers, bit for bit); a
+    whole-number field takes whole numbers only, and the set's own checks name the parameter."""
+    from clutchlab.driveline.variants import DrivelineDocument
+    from clutchlab.wet.params import BENCH_DRIVE, Bench, WetClutch
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "driveline_wet_sae2.toml"
+    doc = DrivelineDocument.read(example)
+    params = doc.parameters
+    paper, bench = WetClutch.paper(), Bench()
+    assert params["clutch.clutch.r_outer"].value == paper.r_outer and params["clutch.clutch.r_outer"].unit == "m"
+    assert params["clutch.bench.actuator_time_constant"].value == bench.actuator_time_constant
+    assert not any(f"clutch.bench.{f}" in params for f in BENCH_DRIVE) and "clutch.bench.seed" not in params
+    changes = {"clutch.clutch.r_outer": 0.085, "clutch.clutch.n_c": 7.0, "clutch.clutch.m_lining": 0.0019,
+               "clutch.bench.actuator_time_constant": 0.03}
+    loaded = doc.load(changes)
+    wet = next(e for e in loaded.driveline._elements if e.wet)
+    assert wet.wet["clutch"] == paper.replace(r_outer=0.085, n_c=7, m_lining=0.0019)
+    assert wet.wet["bench"] == bench.replace(actuator_time_constant=0.03)
+    # the same values from files the description names (an independent route: the sets' own readers)
+    folder = tmp_path / "files"
+    folder.mkdir()
+    paper.replace(r_outer=0.085, n_c=7, m_lining=0.0019).to_toml(folder / "pack.toml")
+    bench.replace(actuator_time_constant=0.03).to_toml(folder / "bench.toml")
+    text = example.read_text().replace('[wet_clutch.clutch]\n', '[wet_clutch.clutch]\nclutch = "pack.toml"\n'
+                                                                 'bench = "bench.toml"\n')
+    (folder / "wet.toml").write_text(text)
+    from_files = DrivelineDocument.read(folder / "wet.toml")
+    assert from_files.parameters["clutch.clutch.n_c"].value == 7.0   # (a file's value is the parameter's start)
+    a = loaded.driveline.simulate(0.3, rtol=1e-8, output_step=1e-3).to_dataframe()
+    b = from_files.load().driveline.simulate(0.3, rtol=1e-8, output_step=1e-3).to_dataframe()
+    assert a.equals(b)
+    plain = doc.load().driveline.simulate(0.3, rtol=1e-8, output_step=1e-3).to_dataframe()
+    assert not a.equals(plain)
+    with pytest.raises(ParameterError, match=r"clutch\.clutch\.n_c = 6\.5: must be a whole number"):
+        doc.load({"clutch.clutch.n_c": 6.5})
+    with pytest.raises(ParameterError, match=r"clutch\.clutch"):
+        doc.load({"clutch.clutch.r_inner": 0.09})   # (beyond r_outer: the set's own check)

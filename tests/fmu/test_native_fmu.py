@@ -210,19 +210,25 @@ def _fmpy_run(tmp_path, path, n, dt, start=None, inputs=None, fmi_type="CoSimula
 def test_native_fmu_of_a_driveline_in_fmpy_without_clutchlab_equals_the_python_cosimulation(built, tmp_path):
     path, cls, lines = built["cc"]
     assert lines == ["native FMU Clutchlab_coupled_clutches (linux64; FMI 2.0 co-simulation and model exchange): 0 inputs, "
-                     "30 outputs, 25 parameters (4 fixed at export)"]
-    # (each clutch's mu_scale multiplies its mu: the later of the two is fixed at export, mu stays writable)
+                     "30 outputs, 28 parameters (1 fixed at export)"]
+    # (each clutch's mu_scale is a factor of its own in the kernel, not multiplied into its mu: both writable; until
+    # the thirty-ninth session the two shared one number and mu_scale was fixed at export)
     _, svs = _variables(path)
-    assert [svs[f"clutch{i}.mu_scale"].get("variability") for i in (1, 2, 3)] == ["constant"] * 3
+    assert [svs[f"clutch{i}.mu_scale"].get("causality") for i in (1, 2, 3)] == ["parameter"] * 3
     assert [svs[f"clutch{i}.mu"].get("causality") for i in (1, 2, 3)] == ["parameter"] * 3
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == ["solver.fixed_step"]
     names = zipfile.ZipFile(path).namelist()
     assert sorted(names) == ["binaries/linux64/Clutchlab_coupled_clutches.so", "modelDescription.xml"]
     n, dt = 1200, 1e-3
-    start = {"clutch1.fn_max": 25.0, "J2.J": 2.0, "clutch2.mu": 0.4}
+    start = {"clutch1.fn_max": 25.0, "J2.J": 2.0, "clutch2.mu": 0.4, "clutch2.mu_scale": 1.3, "clutch3.mu_scale": 0.7}
     native = _fmpy_run(tmp_path, path, n, dt, start)
     python = _python_run(cls, n, dt, start)
     for name in python:
         _close(native[name], python[name], name)
+    # (mu and its factor set together: the clutch slides with their product, as clutchlab's own run built so)
+    product = _python_run(cls, n, dt, {"clutch1.fn_max": 25.0, "J2.J": 2.0, "clutch2.mu": 0.52, "clutch3.mu": 0.35})
+    for name in python:
+        np.testing.assert_allclose(python[name], product[name], rtol=1e-6, atol=1e-9, err_msg=name)
     # and the parameters changed the run (so the FMU did write them)
     default = _python_run(cls, n, dt)
     assert np.max(np.abs(default["J2.w"] - python["J2.w"])) > 1e-2
@@ -484,10 +490,12 @@ def test_model_description_from_the_declarations(built):
     mu = svs["clutch1.mu"]
     assert (mu.get("causality"), mu.get("variability")) == ("parameter", "fixed")
     assert mu.find("Real").get("min") == "0.0" and mu.find("Real").get("max") == "2.0"
-    # a factor that multiplies another parameter in one number (not an affine copy): fixed at export, said in the
-    # description; an initial speed is a parameter (the FMU decides the start modes again)
-    scale = svs["clutch1.mu_scale"]
-    assert (scale.get("causality"), scale.get("variability")) == ("local", "constant")
+    # what chooses the integrator (a step of the fixed-step mode or step-size control): fixed at export, said in the
+    # description; a factor on a friction coefficient and an initial speed are parameters (the FMU decides the
+    # start modes again)
+    fixed = svs["solver.fixed_step"]
+    assert (fixed.get("causality"), fixed.get("variability")) == ("local", "constant")
+    assert svs["clutch1.mu_scale"].get("causality") == "parameter"
     w0 = svs["J1.w0"]
     assert (w0.get("causality"), w0.get("variability")) == ("parameter", "fixed")
     assert svs["J1.w"].get("causality") == "output" and svs["J1.w"].find("Real").get("unit") == "rad/s"
@@ -558,7 +566,8 @@ def test_instantiate_free_keeps_memory_flat_and_fresh_processes_exit_cleanly(hos
     ("clutch1.mu", "3.0", r"clutch1\.mu = 3 \[1\] is outside its range \[0, 2\]"),
     ("clutch1.fn_max", "nan", r"clutch1\.fn_max = nan is not a finite number"),
     ("J1.J", "-1", r"J1\.J = -1 \[kg\.m2\] is outside its range \(0, inf\]"),
-    ("clutch1.mu_scale", "1.5", r"clutch1\.mu_scale is fixed at export and cannot be set"),
+    ("solver.fixed_step", "0.001", r"solver\.fixed_step is fixed at export and cannot be set"),
+    ("clutch1.mu_scale", "2.5", r"clutch1\.mu_scale = 2\.5 \[1\] is outside its range \[0, 2\]"),
     ("J1.w", "5", r"J1\.w is an output and cannot be set"),
 ])
 def test_bad_values_return_fmi2error_with_a_message(host, unpacked, name, value, message):
@@ -1146,6 +1155,35 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-4 * scale, err_msg=name)
     if example == "driveline_emtc_awd":
         _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt)
+    if example == "driveline_wet_sae2":
+        _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
+
+
+def _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, line):
+    """A wet clutch's own parameter sets (its ``clutch`` and ``bench``, files the description names or their
+    defaults) are parameters of the network's FMU, ``<component>.clutch.<field>`` and ``<component>.bench.<field>``
+    (before, only the component's own fields were: the pack, the friction face, the film and the actuator were fixed
+    in the file).  What the clutch derives from several of them (its pack's heat capacity from the masses and
+    specific heats, Eq. 8; the Greenwood-Williamson scale from the roughness, Eq. 11; the effective radius, Eq.
+    (1')) is derived again by the network's start (``wet_start`` on the clutch's row, ``coupled_start``), so a host
+    sets those too, and the run equals clutchlab's built with them."""
+    assert "41 parameters (2 fixed at export)" in line, line
+    _, svs = _variables(path)
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == ["solver.fixed_step",
+                                                                                    "clutch.clutch.piston_h0"]
+    assert "clutch.bench.gear_ratio" not in svs and "clutch.bench.noise_torque" not in svs   # (the bench's drive, rig)
+    start = {"clutch.clutch.m_lining": 0.0019, "clutch.clutch.cp_core": 520.0, "clutch.clutch.r_outer": 0.085,
+             "clutch.clutch.sigma": 2.2e-6, "clutch.clutch.n_c": 7.0, "clutch.bench.actuator_time_constant": 0.03,
+             "clutch.clutch.mu_v1": 1.1e-4}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    (tmp_path / "sets").mkdir()
+    native = _fmpy_run(tmp_path / "sets", path, n, dt, start)
+    python = _python_run(cls, n, dt, start)
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-12)
+    plain = _python_run(cls, n, dt)
+    for name in ("clutch.temperature", "dyno.w"):
+        assert np.max(np.abs(python[name] - plain[name])) > 1e-3 * np.max(np.abs(plain[name])), name
 
 
 def _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt):

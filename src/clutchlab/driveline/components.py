@@ -112,14 +112,44 @@ def _spring(net, name, **args):
     net.spring(name, **args)
 
 
+def parameter_sets(kind: str) -> dict:
+    """The parameter sets the path fields of a component of type ``kind`` name, whose numeric fields are parameters
+    of the network (``<component>.<field>.<set field>``: a sweep's and a native FMU's, as its own fields are):
+    ``{field: (ParameterSet class, its default when the field is left out, the set's fields the element does not
+    read)}``.  A wet clutch's ``clutch`` (:class:`~clutchlab.wet.params.WetClutch`, default the paper's) and
+    ``bench`` (:class:`~clutchlab.wet.params.Bench`: its actuator, oil loop and housing; not its drive, which the
+    network is, nor the virtual rig's sensors)."""
+    if kind != "wet_clutch":
+        return {}
+    from ..wet.params import BENCH_DRIVE, BENCH_SENSORS, Bench, WetClutch
+
+    return {"clutch": (WetClutch, WetClutch.paper, ()), "bench": (Bench, Bench, BENCH_DRIVE + BENCH_SENSORS)}
+
+
+def set_with(cls, base, changes: dict, where: str):
+    """``base`` (a :class:`~clutchlab.params.ParameterSet` of class ``cls``) with some numeric fields changed (SI;
+    a whole-number field takes a whole number only), validated again; errors name ``where``."""
+    values = {}
+    for field, value in changes.items():
+        if isinstance(getattr(base, field), int):
+            if float(value) != round(float(value)):
+                raise ParameterError(f"{where}.{field} = {value!r}: must be a whole number")
+            value = int(round(float(value)))
+        values[field] = value
+    try:
+        return base.replace(**values)
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: {exc}") from None
+
+
 def _wet_clutch(net, name, **args):
     from ..wet.friction import FrictionMap, ParametricFriction
-    from ..wet.params import Bench, WetClutch
 
-    if "clutch" in args:
-        args["clutch"] = WetClutch.from_toml(args["clutch"])
-    if "bench" in args:
-        args["bench"] = Bench.from_toml(args["bench"])
+    changes = args.pop("set_changes", None) or {}
+    for field, (cls, default, _unread) in parameter_sets("wet_clutch").items():
+        if field in args or field in changes:
+            value = cls.from_toml(args[field]) if field in args else default()
+            args[field] = set_with(cls, value, changes[field], f"{name}.{field}") if field in changes else value
     if "friction" in args:
         path = args["friction"]
         args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"

@@ -28,7 +28,7 @@ import numpy as np
 from numba.core import types
 
 from ..numerics import dispatch
-from ..numerics.borrow import ByRef, keep_rows, member
+from ..numerics.borrow import ByRef, keep_rows, member, row
 from ..numerics.outline import hook_args, outlined
 from . import emtc as DE
 from . import kernel as K
@@ -410,9 +410,20 @@ def coupled_accept_hook(t, x, u, m, p):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_start(t, x, u, m, p):
     """The network's start modes and stored energy from its initial state (:func:`kernel.driveline_start`, through
-    its address; the core's ``start`` hook).  The components' own modes are their builders' (their restart at the
-    start settles them)."""
-    return K._start_outlined(t, x, u, m, member(p, "net"))
+    its address; the core's ``start`` hook), and what each wet clutch derives from its parameters alone (its pack's
+    heat capacity, Greenwood-Williamson scale, effective radius and squeeze coefficient:
+    :func:`clutchlab.wet.system.wet_start` on its row, whose numbers are views of the block's), so a native FMU
+    takes a host's masses, roughness and radii of a clutch in the network.  The components' own modes are their
+    builders' (their restart at the start settles them)."""
+    code = K._start_outlined(t, x, u, m, member(p, "net"))
+    if code:
+        return code
+    w = member(p, "wet")
+    for j in range(w.conf.shape[0]):
+        code = DW.W.wet_start(t, x, u, m, row(member(w, "params"), j))
+        if code:
+            return code
+    return 0
 
 
 dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs_hook, update=coupled_update_hook,

@@ -443,7 +443,7 @@ def load_driveline(path) -> DrivelineFile:
     return parse_driveline(read_toml(path), str(path), Path(path).parent)
 
 
-def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
+def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None = None) -> DrivelineFile:
     """A driveline from a parsed TOML document (the format of :func:`load_driveline`).
 
     Parameters
@@ -454,6 +454,10 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
         What to name in error messages (the file, or the file and the changes of a variant).
     base : str or Path, optional
         Folder that files named in the document are relative to (default: the folder of ``source``).
+    set_changes : dict, optional
+        ``{(kind, component): {field: {set field: value}}}``: numeric fields of the parameter sets a component's
+        path fields name, changed (:func:`clutchlab.driveline.components.parameter_sets`;
+        :meth:`~clutchlab.driveline.variants.DrivelineDocument.load`).
 
     Returns
     -------
@@ -523,6 +527,8 @@ def parse_driveline(doc: dict, source: str, base=None) -> DrivelineFile:
             back = {v: k for k, v in renames.items()}
             args = {back.get(f, f): _field_value(fields[f], v, f"{key}.{f}", src, base, uses, speed_unit, angle_unit)
                     for f, v in comp.items()}
+            if set_changes and (kind, name) in set_changes:
+                args["set_changes"] = set_changes[(kind, name)]
             n_before = len(d._elements)
             try:
                 comp_decl.build(d, name, **args)

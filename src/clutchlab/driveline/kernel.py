@@ -138,18 +138,18 @@ L_A, L_B, L_COND = indices(LINK_COLUMNS, "a", "b", "conductance")
 N_LINK = len(LINK_COLUMNS)
 #: columns of ``coef`` (floats), their meaning by the element's kind: a spring-damper (a curve: its points at
 #: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
-#: curve of E_AUX points: its data offset and lift-off input); a gear, w_a = ratio * w_b (its loss table, MSL
+#: curve of E_AUX points: its data offset and lift-off input; the factor on its friction coefficient); a gear, w_a = ratio * w_b (its loss table, MSL
 #: lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2, stored column by column at E_TABLE);
 #: an engine's idle controller: set speed [rad/s], gains [N m s/rad], [N m/rad], torque limit [N m]
 COEF_COLUMNS = {
     "spring": ("stiffness", "damping", "phi0", "gap"),
-    "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff"),
+    "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale"),
     "gear": ("ratio",),
     "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
 }
 C_STIFF, C_DAMP, C_PHI0, C_GAP = indices(COEF_COLUMNS["spring"], "stiffness", "damping", "phi0", "gap")
-C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF = indices(
-    COEF_COLUMNS["friction"], "fn_max", "cgeo", "peak", "ncurve", "liftoff")
+C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF, C_MU_SCALE = indices(
+    COEF_COLUMNS["friction"], "fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale")
 C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = indices(
     COEF_COLUMNS["engine"], "idle_speed", "idle_kp", "idle_ki", "idle_max")
@@ -484,10 +484,11 @@ def _characteristic(data, start, n, w):
 def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
-    Clutch and brake (MSL ``Clutch``/``Brake``): ``cgeo * fn * mu(|w|)`` with ``fn = fn_max * f(t)``;
-    bearing friction (``BearingFriction``): the table itself; a one-way clutch (MSL ``OneWayClutch``: a
-    freewheel in parallel with a clutch): its clutch's ``cgeo * max(fn, 0) * mu(|w|)`` while it overruns (none
-    without a normal force).  At ``w = 0`` this is ``tau0``; the static limit is ``peak * tau0``.
+    Clutch and brake (MSL ``Clutch``/``Brake``): ``cgeo * fn * mu(|w|)`` with ``fn = fn_max * f(t)`` and
+    ``mu`` the characteristic times ``mu_scale``; bearing friction (``BearingFriction``): the table itself; a
+    one-way clutch (MSL ``OneWayClutch``: a freewheel in parallel with a clutch): its clutch's
+    ``cgeo * max(fn, 0) * mu(|w|)`` while it overruns (none without a normal force).  At ``w = 0`` this is
+    ``tau0``; the static limit is ``peak * tau0``.
     """
     law = p.elem[r, E_LAW]
     if law == LAW_EXTERNAL:
@@ -495,6 +496,7 @@ def friction_torque(p, r, t, w_abs):
     val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
     if law == LAW_TABLE:
         return val
+    val *= p.coef[r, C_MU_SCALE]   # (a factor of its own, not in the table: a host or a sweep sets it with mu)
     fn = normal_force(p, r, t)
     if law == LAW_ONEWAY:
         fn = max(fn, 0.0)

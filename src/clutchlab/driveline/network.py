@@ -1042,11 +1042,13 @@ class Driveline:
         """The elements with a controller state (engines with an idle controller), in state order."""
         return [e for e in self._elements if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE and e.coef[3] > 0]
 
-    def _friction(self, name, a, b, law, table, peak, fn_max=1.0, cgeo=1.0, normal=None, mu_temperature=None):
+    def _friction(self, name, a, b, law, table, peak, fn_max=1.0, cgeo=1.0, normal=None, mu_temperature=None,
+                  mu_scale=1.0):
         peak = _finite(name, "peak", peak)
         if peak < 1.0:
             raise ParameterError(f"{name}: peak = {peak!r} must be >= 1 (static limit = peak x sliding torque at rest)")
-        coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak, 0.0)
+        coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak, 0.0,
+                0.0, self._mu_scale(name, mu_scale))
         sig = None if normal is None else Signal.of(normal, f"{name}: normal")
         self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, table,
                                        fade=self._fade(name, mu_temperature)))
@@ -1096,8 +1098,8 @@ class Driveline:
         mass's ``heat_from`` (:meth:`thermal_mass`)."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
-                              fn_max, cgeo, normal, mu_temperature)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak,
+                              fn_max, cgeo, normal, mu_temperature, mu_scale)
 
     @_adds("brake")
     def brake(self, name: str, flange, fn_max: float, mu=0.5, peak: float = 1.0, cgeo: float = 1.0,
@@ -1106,39 +1108,37 @@ class Driveline:
         """A brake between ``flange`` and ``support`` (default the ground), as :meth:`clutch` (MSL ``Brake``)."""
         name = self._new_name(name)
         a, b = self._two(name, support, flange)
-        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature, mu_scale), peak,
-                              fn_max, cgeo, normal, mu_temperature)
+        return self._friction(name, a, b, K.LAW_CLUTCH, self._mu(name, mu, radius, temperature), peak,
+                              fn_max, cgeo, normal, mu_temperature, mu_scale)
 
     @classmethod
-    def _mu(cls, name, mu, radius, temperature, scale=1.0):
+    def _mu(cls, name, mu, radius, temperature):
         """A clutch's or brake's friction characteristic: a number or table, or a map with its radius and
-        temperature; its coefficients times ``scale``."""
+        temperature (its factor ``mu_scale`` is a column of its own: :meth:`_mu_scale`)."""
         # a FrictionMap exists only once its module is imported: not importing the wet package for a plain clutch
         # keeps a driveline file's start-up short (the package imports SciPy's special functions, 0.13 s)
         friction = sys.modules.get("clutchlab.wet.friction")
         if friction is not None and isinstance(mu, friction.FrictionMap):
-            return cls._scaled(name, cls._map_characteristic(name, mu, radius, temperature), scale)
+            return cls._map_characteristic(name, mu, radius, temperature)
         for what, value in (("radius", radius), ("temperature", temperature)):
             if value is not None:
                 raise ParameterError(f"{name}: {what} = {value!r} is for a friction map mu(v, T); mu is "
                                      f"{type(mu).__name__}")
-        return cls._scaled(name, cls._characteristic(name, "mu", mu), scale)
+        return cls._characteristic(name, "mu", mu)
 
     @staticmethod
-    def _scaled(name, table, scale):
-        """A friction characteristic ``(speeds..., coefficients...)`` with its coefficients times ``scale``, in
-        [0, 2]: a sensitivity factor on a coefficient checked on its own (so a value in each declared range is
-        taken together, as a sweep or an FMU's importer expects)."""
+    def _mu_scale(name, scale):
+        """A friction element's factor on its friction coefficient, in [0, 2]: a sensitivity factor on a coefficient
+        checked on its own (so a value in each declared range is taken together, as a sweep or an FMU's importer
+        expects), kept in a column of its own (``kernel.C_MU_SCALE``: the sliding torque multiplies it), not
+        multiplied into the characteristic, so a native FMU's host sets it and the coefficient alike."""
         from ..params.base import MU_SCALE_MAX
 
         scale = _finite(name, "mu_scale", scale, nonneg=True)
         if scale > MU_SCALE_MAX:
             raise ParameterError(f"{name}: mu_scale = {scale:g} is above {MU_SCALE_MAX:g} (a factor on a friction "
                                  "coefficient, not a coefficient)")
-        if scale == 1.0:
-            return table
-        half = len(table) // 2
-        return tuple(table[:half]) + tuple(scale * v for v in table[half:])
+        return scale
 
     @staticmethod
     def _map_characteristic(name, fmap, radius, temperature):
@@ -1462,9 +1462,8 @@ class Driveline:
         :meth:`clutch`."""
         name = self._new_name(name)
         a, b = self._two(name, a, b)
-        return self._friction(name, a, b, K.LAW_ONEWAY, self._scaled(name, self._characteristic(name, "mu", mu),
-                                                                     mu_scale), peak, fn_max, cgeo,
-                              None if fn_max == 0.0 else normal, mu_temperature)
+        return self._friction(name, a, b, K.LAW_ONEWAY, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
+                              None if fn_max == 0.0 else normal, mu_temperature, mu_scale)
 
     # ---- the system
     # ---- heat
@@ -1644,6 +1643,8 @@ class Driveline:
         else:
             n = len(e.table) // 2
             char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
+            if e.coef[K.C_MU_SCALE] != 1.0 and e.law != K.LAW_TABLE:
+                char += f" x mu_scale {e.coef[K.C_MU_SCALE]:g}"
             if e.law == K.LAW_TABLE:
                 what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
             elif e.reference is not None:
@@ -2040,7 +2041,9 @@ class Driveline:
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name, error_messages=error_messages,
                       decided_at_start=(("m", 0, len(named_modes)),
-                                        ("params.net.work" if wet or emtcs else "params.work", -1, None)))
+                                        ("params.net.work" if wet or emtcs else "params.work", -1, None))
+                      + (tuple((f"params.wet.params.constants.data.{name}", 0, None)
+                               for name in W.DERIVED_CONSTANTS) if wet else ()))
 
     def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel, port_rows):
         """The network's parameters, initial state and modes and absolute tolerances joined with its wet clutches'

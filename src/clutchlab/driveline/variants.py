@@ -211,7 +211,8 @@ class DrivelineDocument:
                                                                f"{component})", f.minimum, f.maximum, f.positive)
                 for field, (unit, _) in self._fields[kind].items():
                     self._signal_parameters(kind, component, field, unit, comp.get(field), signals)
-        self.parameters = params
+        self._own_parameters = params
+        self._sets = None   # (the parameter sets' fields: read when first asked for, _set_parameters)
         #: the numbers of the profiles the file gives as signals, ``<component>.<field>.<parameter>``: a sine
         #: torque's ``torque.torque.amplitude`` [N m] and ``frequency`` [Hz], an E-clutch's bearing ramp
         #: ``clutch.position.duration`` [s], a wet clutch's force step ``wet.force.height`` [N] (a sweep varies
@@ -230,6 +231,54 @@ class DrivelineDocument:
             si = to_si(spec.get("start", 0.0), units[name], name=f"input.{name}.start", source=self.source)
             starts[pname] = Parameter(pname, units[name], si, f"start value of input {name}, held through the run")
         self.input_starts = starts
+
+    @property
+    def parameters(self) -> dict:
+        """The numeric parameters by name: each component's numeric fields (``<component>.<field>``), then the
+        numeric fields of the parameter sets its path fields name (``<component>.<field>.<set field>``: a wet
+        clutch's ``clutch`` and ``bench``, read from their files, or their defaults where the file names none;
+        :func:`~clutchlab.driveline.components.parameter_sets`).  The sets' files are read when this is first
+        asked for (after :meth:`referenced_files` checked where they are)."""
+        if self._sets is None:
+            self._sets = self._set_parameters()
+        return {**self._own_parameters, **{name: par for name, (par, _) in self._sets.items()}}
+
+    def _set_parameters(self) -> dict:
+        """name -> (Parameter, (kind, component, field, set field)) of the parameter sets' numeric fields."""
+        import dataclasses
+
+        from ..params.base import field_range
+        from .components import parameter_sets
+
+        out = {}
+        base = Path(self.source).parent
+        for kind in self._tables:
+            table = self.document.get(kind, {})
+            sets = parameter_sets(kind) if isinstance(table, dict) else {}
+            for component, comp in (table.items() if sets else ()):
+                if not isinstance(comp, dict):
+                    continue
+                for field, (cls, default, unread) in sets.items():
+                    value = comp.get(field)
+                    if value is None:
+                        instance = default()
+                    elif isinstance(value, str) and value:
+                        instance = cls.from_toml(_resolve(base, value, self.source, f"{kind}.{component}.{field}",
+                                                          None))
+                    else:
+                        continue   # (the loader names the error)
+                    for f in dataclasses.fields(cls):
+                        v = getattr(instance, f.name)
+                        if (f.name in unread or "unit" not in f.metadata or isinstance(v, bool)
+                                or not isinstance(v, (int, float))):
+                            continue
+                        name = f"{component}.{field}.{f.name}"
+                        lo, hi, positive = field_range(f.metadata)
+                        out[name] = (Parameter(name, f.metadata["unit"], float(v),
+                                               f"{f.metadata.get('doc', f.name)} ({kind.replace('_', ' ')} "
+                                               f"{component}, its {field})", lo, hi, positive),
+                                     (kind, component, field, f.name))
+        return out
 
     def _signal_parameters(self, kind, component, field, unit, value, out) -> None:
         """The scalar parameters of a signal the file gives field ``field`` of ``[kind.component]`` (a one-entry
@@ -357,7 +406,12 @@ class DrivelineDocument:
         changes = dict(changes or {})
         self.check_names(changes)
         doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in self.document.items()}
+        set_changes = {}
         for name, value in changes.items():
+            if self._sets and name in self._sets:   # (a field of a parameter set a component's file names)
+                kind, component, field, set_field = self._sets[name][1]
+                set_changes.setdefault((kind, component), {}).setdefault(field, {})[set_field] = float(value)
+                continue
             if name in self._signals:
                 kind, component, field, sig, param = self._signals[name]
                 comp = doc[kind][component]
@@ -378,11 +432,11 @@ class DrivelineDocument:
             kind = next(k for k, table in doc.items() if k in self._fields and isinstance(table, dict)
                         and component in table)
             doc[kind] = {**doc[kind], component: {**doc[kind][component], field: float(value)}}
-        return _load_document(doc, self.source, changes)
+        return _load_document(doc, self.source, changes, set_changes)
 
 
-def _load_document(doc: dict, source: str, changes: dict) -> DrivelineFile:
+def _load_document(doc: dict, source: str, changes: dict, set_changes: dict | None = None) -> DrivelineFile:
     """:func:`~clutchlab.driveline.description.parse_driveline` of a changed document; its errors name
     ``source`` and the changes."""
     what = ", ".join(f"{k} = {float(v)!r}" for k, v in changes.items())
-    return parse_driveline(doc, f"{source} with {what}" if what else source, Path(source).parent)
+    return parse_driveline(doc, f"{source} with {what}" if what else source, Path(source).parent, set_changes)

@@ -21,13 +21,11 @@ __all__ = ["WetCoSimulation"]
 
 
 def _wet_variables():
-    from ..wet.params import Bench, WetClutch
+    from ..wet.params import BENCH_SENSORS, Bench, WetClutch
     from ..wet.thermal import steady_state_temperature
 
     clutch = parameter_set_variables("clutch", WetClutch)
-    bench = parameter_set_variables("bench", Bench, skip=(
-        "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
-        "noise_fluid_temperature", "seed"))
+    bench = parameter_set_variables("bench", Bench, skip=BENCH_SENSORS)
     scenario = (
         Variable("scenario.free_inertia", "1", 0.0,
                  "drive: 0 speed-controlled bench motor (Fig. 4), 1 free inertia (inertia dynamometer, SAE No. 2)",
@@ -126,14 +124,12 @@ class WetCoSimulation(ContractCoSimulation):
 
     def __init__(self, **parameter_values):
         from ..wet import engagement as E
-        from ..wet.params import Bench, WetClutch
+        from ..wet.params import BENCH_SENSORS, Bench, WetClutch
 
         values = self.resolve_parameters(parameter_values)
         self.parameter_values = values
         self.clutch = build_parameter_set("clutch", WetClutch, values)
-        self.bench = build_parameter_set("bench", Bench, values, skip=(
-            "sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
-            "noise_fluid_temperature", "seed"))
+        self.bench = build_parameter_set("bench", Bench, values, skip=BENCH_SENSORS)
         free = _flag("scenario.free_inertia", values["scenario.free_inertia"])
         self.rtol = values["solver.rtol"]
         self.max_step = values["solver.max_step"]

@@ -26,7 +26,15 @@ from ..params.base import WET_TEMPERATURES_C
 from .film import effective_radius, gw_pressure_scale, squeeze_film_coefficient
 from .thermal import pack_heat_capacity_scalar
 
-__all__ = ["WetClutch", "Bench"]
+__all__ = ["WetClutch", "Bench", "BENCH_SENSORS", "BENCH_DRIVE"]
+
+#: fields of :class:`Bench` that only the virtual rig's measurements read (its sample rate, sensor noise, seed)
+BENCH_SENSORS = ("sample_rate", "noise_torque", "noise_speed", "noise_force", "noise_position", "noise_temperature",
+                 "noise_fluid_temperature", "seed")
+#: fields of :class:`Bench` of its drive (motor, gear, shaft, speed controller): a driveline's wet clutch, whose drive
+#: is the network, does not read them
+BENCH_DRIVE = ("motor_torque_max", "motor_power_max", "motor_speed_max", "gear_ratio", "motor_inertia",
+               "shaft_inertia", "speed_kp", "speed_ki")
 
 T1 = "Shin et al., Table 1"
 _RO, _RI = 0.08315, 0.07174

@@ -770,9 +770,10 @@ def wet_start(t, x, u, m, p):
     return 0
 
 
-#: the constants :func:`wet_start` derives (:attr:`clutchlab.system.System.decided_at_start`)
-DERIVED_AT_START = tuple((f"params.constants.{name}", 0, None)
-                         for name in ("heat_capacity", "gw_scale", "r_eff", "squeeze_coefficient"))
+#: the constants :func:`wet_start` derives
+DERIVED_CONSTANTS = ("heat_capacity", "gw_scale", "r_eff", "squeeze_coefficient")
+#: ... as words of a run's parameters (:attr:`clutchlab.system.System.decided_at_start`)
+DERIVED_AT_START = tuple((f"params.constants.{name}", 0, None) for name in DERIVED_CONSTANTS)
 #: ... and what each is derived from (an override of one would be replaced at the start: refused)
 _DERIVED_FROM = {"heat_capacity": "n_c, m_lining, cp_lining, m_core, cp_core",
                  "gw_scale": "sigma, asperity_radius, asperity_density, contact_modulus",

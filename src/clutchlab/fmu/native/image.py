@@ -403,7 +403,7 @@ def parameter_map(variables, base: Image, build, label: str = "model", one_sided
                     out[var.name] = lower
                     out.trial[var.name] = below[0][0]
                     sided.add(var.name)
-    # a number two parameters change (a sum, a product: a clutch's mu and mu_scale) cannot be written by either
+    # a number two parameters change (a sum, a product of two) cannot be written by either
     # while the other may change too: the first in declaration order stays writable (the others fixed at their
     # start, it alone changes that number, as it was found to), the others are fixed; one whose law holds on
     # both sides of its start before one that has a law below it only (the E-clutch's actuator.ki before its rtol,
