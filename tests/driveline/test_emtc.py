@@ -271,3 +271,47 @@ def test_cli_simulates_the_example(tmp_path):
     assert list(ev["component"]) == ["emtc.armature", "emtc.armature"]
     df = pd.read_csv(out, comment="#")
     assert "emtc.current_command_A" in df.columns and len(df) == 301
+
+
+def test_an_emtc_coupling_s_actuator_and_geometry_are_parameters_of_its_network(tmp_path):
+    """An EMTC coupling's ``[actuator]`` and ``[coupling]`` tables (of the scenario file its ``bench`` names, or
+    their defaults) are parameters of the network, ``<component>.actuator.<field>``, ``<component>.coupling.<field>``
+    (a sweep's and a native FMU's); changed by name they give the coupling the sets a file carrying those values
+    gives, and the same run, bit for bit; the scenario's and the vehicle's tables are not parameters."""
+    import tomllib
+
+    import tomli_w
+
+    from clutchlab.driveline.variants import DrivelineDocument
+    from clutchlab.emtc.bench import load_scenario
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    doc = DrivelineDocument.read(examples / "driveline_emtc_awd.toml")
+    bench = load_scenario(examples / "emtc_scenario.toml")
+    params = doc.parameters
+    assert params["emtc.actuator.airgap_open"].value == bench["actuator"].airgap_open
+    assert params["emtc.coupling.cam_ratio"].value == bench["coupling"].cam_ratio
+    assert not any(n.startswith(("emtc.vehicle.", "emtc.scenario.")) for n in params)
+    changes = {"emtc.actuator.airgap_open": 1.0e-3, "emtc.actuator.free_travel": 0.45e-3,
+               "emtc.coupling.cam_ratio": 5.5}
+    loaded = doc.load(changes)
+    e = next(e for e in loaded.driveline._elements if e.emtc)
+    actuator = bench["actuator"].replace(airgap_open=1.0e-3, free_travel=0.45e-3)
+    coupling = bench["coupling"].replace(cam_ratio=5.5)
+    assert e.emtc["options"].actuator == actuator and e.emtc["options"].coupling == coupling
+    # the same values from a scenario file (the sets' own reader): the same run
+    text = (examples / "emtc_scenario.toml").read_text()
+    folder = tmp_path / "files"
+    folder.mkdir()
+    scenario = folder / "emtc_scenario.toml"
+    data = tomllib.loads(text)
+    data["actuator"] = actuator.to_dict(with_units=True)
+    data["coupling"] = coupling.to_dict(with_units=True)
+    scenario.write_text(tomli_w.dumps(data))
+    (folder / "awd.toml").write_text((examples / "driveline_emtc_awd.toml").read_text())
+    from_file = DrivelineDocument.read(folder / "awd.toml")
+    assert from_file.parameters["emtc.coupling.cam_ratio"].value == 5.5
+    a = loaded.driveline.simulate(0.4, rtol=1e-8, output_step=1e-2).to_dataframe()
+    b = from_file.load().driveline.simulate(0.4, rtol=1e-8, output_step=1e-2).to_dataframe()
+    assert a.equals(b)
+    assert not a.equals(doc.load().driveline.simulate(0.4, rtol=1e-8, output_step=1e-2).to_dataframe())

@@ -1155,8 +1155,38 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
         np.testing.assert_allclose(me[name], tight[name], rtol=0, atol=1e-4 * scale, err_msg=name)
     if example == "driveline_emtc_awd":
         _a_host_sets_the_vehicle_s_initial_speed(tmp_path, path, cls, n, dt)
+        _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
     if example == "driveline_wet_sae2":
         _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
+
+
+def _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, line):
+    """An EMTC coupling's actuator and coupling geometry (the ``[actuator]`` and ``[coupling]`` tables of the scenario
+    file its ``bench`` names) are parameters of the network's FMU, ``emtc.actuator.<field>`` and
+    ``emtc.coupling.<field>``; what the coupling derives from them (its current lags' rates, its controller's table
+    at the engaged airgap ``d - sigma``, Eq. 12) the network's start derives again (``derive_actuator`` on its row,
+    ``coupled_start``), so a host sets the airgaps too, and the run equals clutchlab's built with them; an airgap a
+    host sets below the free travel is refused at the start with the coupling's message.  What stays fixed: the
+    fixed step and the ideal final drives' efficiencies (an ideal gear is another element than a lossy one, as
+    MSL's IdealGear and LossyGear)."""
+    assert "44 parameters (3 fixed at export)" in line, line
+    _, svs = _variables(path)
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == [
+        "solver.fixed_step", "front_drive.efficiency", "rear_drive.efficiency"]
+    start = {"emtc.actuator.airgap_open": 1.0e-3, "emtc.actuator.free_travel": 0.45e-3, "emtc.actuator.tau1": 0.012,
+             "emtc.coupling.cam_ratio": 5.5}
+    assert all(svs[name].get("causality") == "parameter" for name in start)
+    (tmp_path / "coupling").mkdir()
+    native = _fmpy_run(tmp_path / "coupling", path, n, dt, start)
+    python = _python_run(cls, n, dt, start)
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-9 if name == "energy_error" else 1e-12)
+    plain = _python_run(cls, n, dt)
+    for name in ("emtc.tau", "emtc.airgap"):
+        assert np.max(np.abs(python[name] - plain[name])) > 1e-3 * np.max(np.abs(plain[name])), name
+    for kind, what, detail in _start_values(tmp_path, path, [{"emtc.actuator.free_travel": 1.3e-3}], ["emtc.tau"]):
+        assert what == "refused" and "emtc: actuator.airgap_open must exceed actuator.free_travel" in detail, \
+            (kind, detail)
 
 
 def _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, line):

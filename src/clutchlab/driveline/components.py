@@ -17,6 +17,9 @@ those of the :class:`~clutchlab.driveline.Driveline` methods (a test compares th
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 from ..component import Component, Field, register_component
 from ..errors import ParameterError
 from ..params.base import ABSOLUTE_ZERO_C, FRICTION_COEFFICIENT_MAX, MU_SCALE_MAX, WET_TEMPERATURES_C
@@ -112,18 +115,57 @@ def _spring(net, name, **args):
     net.spring(name, **args)
 
 
-def parameter_sets(kind: str) -> dict:
-    """The parameter sets the path fields of a component of type ``kind`` name, whose numeric fields are parameters
-    of the network (``<component>.<field>.<set field>``: a sweep's and a native FMU's, as its own fields are):
-    ``{field: (ParameterSet class, its default when the field is left out, the set's fields the element does not
-    read)}``.  A wet clutch's ``clutch`` (:class:`~clutchlab.wet.params.WetClutch`, default the paper's) and
-    ``bench`` (:class:`~clutchlab.wet.params.Bench`: its actuator, oil loop and housing; not its drive, which the
-    network is, nor the virtual rig's sensors)."""
-    if kind != "wet_clutch":
-        return {}
-    from ..wet.params import BENCH_DRIVE, BENCH_SENSORS, Bench, WetClutch
+@dataclass(frozen=True)
+class ParameterSetSource:
+    """A parameter set a component's path field names (:func:`parameter_sets`).
 
-    return {"clutch": (WetClutch, WetClutch.paper, ()), "bench": (Bench, Bench, BENCH_DRIVE + BENCH_SENSORS)}
+    Attributes
+    ----------
+    field : str
+        The component's path field (``"clutch"``, ``"bench"``).
+    name : str
+        The set's name in the parameters' names (``<component>.<name>.<set field>``).
+    cls : type
+        Its :class:`~clutchlab.params.ParameterSet` class.
+    read : callable
+        ``read(path)``: the set in the file the field names.
+    default : callable
+        ``default()``: the set the component takes when the field is left out.
+    unread : tuple of str
+        The set's fields the component does not read (not parameters of the network).
+    """
+
+    field: str
+    name: str
+    cls: type
+    read: Callable
+    default: Callable
+    unread: tuple = ()
+
+
+def parameter_sets(kind: str) -> tuple:
+    """The parameter sets the path fields of a component of type ``kind`` name, whose numeric fields are parameters
+    of the network (``<component>.<set>.<field>``: a sweep's and a native FMU's, as its own fields are), as
+    :class:`ParameterSetSource`.  A wet clutch's ``clutch`` (:class:`~clutchlab.wet.params.WetClutch`, default the
+    paper's) and ``bench`` (:class:`~clutchlab.wet.params.Bench`: its actuator, oil loop and housing; not its drive,
+    which the network is, nor the virtual rig's sensors); an EMTC coupling's ``actuator``
+    (:class:`~clutchlab.emtc.bench.ActuatorParameters`) and ``coupling``
+    (:class:`~clutchlab.emtc.torque.CouplingGeometry`), the tables of the scenario file its ``bench`` names (its
+    scenario and vehicle are the bench's: the network is the vehicle)."""
+    if kind == "wet_clutch":
+        from ..wet.params import BENCH_DRIVE, BENCH_SENSORS, Bench, WetClutch
+
+        return (ParameterSetSource("clutch", "clutch", WetClutch, WetClutch.from_toml, WetClutch.paper),
+                ParameterSetSource("bench", "bench", Bench, Bench.from_toml, Bench, BENCH_DRIVE + BENCH_SENSORS))
+    if kind == "emtc":
+        from ..emtc.bench import ActuatorParameters, load_scenario
+        from ..emtc.torque import CouplingGeometry
+
+        return (ParameterSetSource("bench", "actuator", ActuatorParameters, lambda p: load_scenario(p)["actuator"],
+                                   ActuatorParameters),
+                ParameterSetSource("bench", "coupling", CouplingGeometry, lambda p: load_scenario(p)["coupling"],
+                                   CouplingGeometry))
+    return ()
 
 
 def set_with(cls, base, changes: dict, where: str):
@@ -146,10 +188,11 @@ def _wet_clutch(net, name, **args):
     from ..wet.friction import FrictionMap, ParametricFriction
 
     changes = args.pop("set_changes", None) or {}
-    for field, (cls, default, _unread) in parameter_sets("wet_clutch").items():
-        if field in args or field in changes:
-            value = cls.from_toml(args[field]) if field in args else default()
-            args[field] = set_with(cls, value, changes[field], f"{name}.{field}") if field in changes else value
+    for src in parameter_sets("wet_clutch"):
+        if src.field in args or src.name in changes:
+            value = src.read(args[src.field]) if src.field in args else src.default()
+            args[src.field] = (set_with(src.cls, value, changes[src.name], f"{name}.{src.name}")
+                               if src.name in changes else value)
     if "friction" in args:
         path = args["friction"]
         args["friction"] = (FrictionMap.from_json(path) if path.suffix.lower() == ".json"
@@ -160,17 +203,25 @@ def _wet_clutch(net, name, **args):
 def _emtc(net, name, **args):
     from ..hysteresis import Preisach
 
-    if "bench" in args:
+    changes = args.pop("set_changes", None) or {}
+    if "bench" in args or changes:
         from ..emtc.bench import load_scenario
         from ..emtc.system import BenchOptions
 
-        path = args.pop("bench")
-        bench = load_scenario(path)
-        if bench["magnet"] is not None:
-            raise ParameterError(f"bench = {path.name!r} names a magnet in its [magnet] table: give the model "
-                                 "as this component's magnet field instead")
-        args.update(scenario=bench["scenario"], vehicle=bench["vehicle"],
-                    options=BenchOptions(actuator=bench["actuator"], coupling=bench["coupling"]))
+        sets = {src.name: src for src in parameter_sets("emtc")}
+        if "bench" in args:
+            path = args.pop("bench")
+            bench = load_scenario(path)
+            if bench["magnet"] is not None:
+                raise ParameterError(f"bench = {path.name!r} names a magnet in its [magnet] table: give the model "
+                                     "as this component's magnet field instead")
+            args.update(scenario=bench["scenario"], vehicle=bench["vehicle"])
+        else:
+            bench = {n: src.default() for n, src in sets.items()}
+        for n, src in sets.items():
+            if n in changes:
+                bench[n] = set_with(src.cls, bench[n], changes[n], f"{name}.{n}")
+        args["options"] = BenchOptions(actuator=bench["actuator"], coupling=bench["coupling"])
     if "magnet" in args:
         args["magnet"] = Preisach.from_json(args["magnet"])
     net.emtc(name, **args)

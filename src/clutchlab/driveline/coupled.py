@@ -410,11 +410,13 @@ def coupled_accept_hook(t, x, u, m, p):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_start(t, x, u, m, p):
     """The network's start modes and stored energy from its initial state (:func:`kernel.driveline_start`, through
-    its address; the core's ``start`` hook), and what each wet clutch derives from its parameters alone (its pack's
-    heat capacity, Greenwood-Williamson scale, effective radius and squeeze coefficient:
-    :func:`clutchlab.wet.system.wet_start` on its row, whose numbers are views of the block's), so a native FMU
-    takes a host's masses, roughness and radii of a clutch in the network.  The components' own modes are their
-    builders' (their restart at the start settles them)."""
+    its address; the core's ``start`` hook), and what each component derives from its parameters alone, on its
+    row (whose numbers are views of the block's): a wet clutch's pack heat capacity, Greenwood-Williamson scale,
+    effective radius and squeeze coefficient (:func:`clutchlab.wet.system.wet_start`), an EMTC coupling's current
+    lags' rates and controller table at its engaged airgap (:func:`clutchlab.emtc.system.derive_actuator`; a
+    refusal as the coupling's error, :func:`~clutchlab.driveline.emtc.error_code`).  So a native FMU takes a host's
+    masses, roughness and radii of a wet clutch and the airgaps of a coupling in the network.  The components' own
+    modes are their builders' (their restart at the start settles them)."""
     code = K._start_outlined(t, x, u, m, member(p, "net"))
     if code:
         return code
@@ -423,6 +425,12 @@ def coupled_start(t, x, u, m, p):
         code = DW.W.wet_start(t, x, u, m, row(member(w, "params"), j))
         if code:
             return code
+    e = member(p, "emtc")
+    for j in range(e.conf.shape[0]):
+        r = row(member(e, "params"), j)
+        code = DE.S.derive_actuator(r.actuator, r.cold, r.layout, r.controller_table)
+        if code:
+            return DE.error_code(code, j)
     return 0
 
 

@@ -455,7 +455,7 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
     base : str or Path, optional
         Folder that files named in the document are relative to (default: the folder of ``source``).
     set_changes : dict, optional
-        ``{(kind, component): {field: {set field: value}}}``: numeric fields of the parameter sets a component's
+        ``{(kind, component): {set: {set field: value}}}``: numeric fields of the parameter sets a component's
         path fields name, changed (:func:`clutchlab.driveline.components.parameter_sets`;
         :meth:`~clutchlab.driveline.variants.DrivelineDocument.load`).
 

@@ -138,8 +138,9 @@ L_A, L_B, L_COND = indices(LINK_COLUMNS, "a", "b", "conductance")
 N_LINK = len(LINK_COLUMNS)
 #: columns of ``coef`` (floats), their meaning by the element's kind: a spring-damper (a curve: its points at
 #: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
-#: curve of E_AUX points: its data offset and lift-off input; the factor on its friction coefficient); a gear, w_a = ratio * w_b (its loss table, MSL
-#: lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2, stored column by column at E_TABLE);
+#: curve of E_AUX points: its data offset and lift-off input; the factor on its friction coefficient); a gear,
+#: w_a = ratio * w_b (its loss table, MSL lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2,
+#: stored column by column at E_TABLE);
 #: an engine's idle controller: set speed [rad/s], gains [N m s/rad], [N m/rad], torque limit [N m]
 COEF_COLUMNS = {
     "spring": ("stiffness", "damping", "phi0", "gap"),

@@ -2043,7 +2043,9 @@ class Driveline:
                       decided_at_start=(("m", 0, len(named_modes)),
                                         ("params.net.work" if wet or emtcs else "params.work", -1, None))
                       + (tuple((f"params.wet.params.constants.data.{name}", 0, None)
-                               for name in W.DERIVED_CONSTANTS) if wet else ()))
+                               for name in W.DERIVED_CONSTANTS) if wet else ())
+                      + (tuple((f"params.emtc.params.actuator.data.{name}", 0, None) for name in S.DERIVED_ACTUATOR)
+                         + (("params.emtc.params.controller_table.data", 0, None),) if emtcs else ()))
 
     def _with_components(self, p, x0, m0, atol, wet, emtcs, rtol, ng, nel, port_rows):
         """The network's parameters, initial state and modes and absolute tolerances joined with its wet clutches'

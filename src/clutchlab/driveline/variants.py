@@ -254,30 +254,30 @@ class DrivelineDocument:
         base = Path(self.source).parent
         for kind in self._tables:
             table = self.document.get(kind, {})
-            sets = parameter_sets(kind) if isinstance(table, dict) else {}
+            sets = parameter_sets(kind) if isinstance(table, dict) else ()
             for component, comp in (table.items() if sets else ()):
                 if not isinstance(comp, dict):
                     continue
-                for field, (cls, default, unread) in sets.items():
-                    value = comp.get(field)
+                for src in sets:
+                    value = comp.get(src.field)
                     if value is None:
-                        instance = default()
+                        instance = src.default()
                     elif isinstance(value, str) and value:
-                        instance = cls.from_toml(_resolve(base, value, self.source, f"{kind}.{component}.{field}",
-                                                          None))
+                        instance = src.read(_resolve(base, value, self.source, f"{kind}.{component}.{src.field}",
+                                                     None))
                     else:
                         continue   # (the loader names the error)
-                    for f in dataclasses.fields(cls):
+                    for f in dataclasses.fields(src.cls):
                         v = getattr(instance, f.name)
-                        if (f.name in unread or "unit" not in f.metadata or isinstance(v, bool)
+                        if (f.name in src.unread or "unit" not in f.metadata or isinstance(v, bool)
                                 or not isinstance(v, (int, float))):
                             continue
-                        name = f"{component}.{field}.{f.name}"
+                        name = f"{component}.{src.name}.{f.name}"
                         lo, hi, positive = field_range(f.metadata)
                         out[name] = (Parameter(name, f.metadata["unit"], float(v),
                                                f"{f.metadata.get('doc', f.name)} ({kind.replace('_', ' ')} "
-                                               f"{component}, its {field})", lo, hi, positive),
-                                     (kind, component, field, f.name))
+                                               f"{component}, its {src.name})", lo, hi, positive),
+                                     (kind, component, src.name, f.name))
         return out
 
     def _signal_parameters(self, kind, component, field, unit, value, out) -> None:

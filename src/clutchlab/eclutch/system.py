@@ -47,13 +47,13 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from ..curves import curve_inverse_one
 from ..errors import ParameterError
 from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
 from ..numerics.layout import indices, slots
 from ..system import System, start_checks_deferred, variables
-from ..curves import curve_inverse_one
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_compliance, chamber_pressure_rate,
                        controller_integral_rate, controller_voltage, current_rate, drive_voltage, drive_voltage_slopes,
                        line_flow_rate, line_inertance, line_resistance, piston_area, reflected_mass, spindle_force,
@@ -1187,16 +1187,16 @@ def _brent(which, k, force, rate, data, a, b, xtol, rtol):
 @numba.njit(cache=True, nogil=True)
 def derive_clutch(clutch, clutch_int, GA0, net0, net0_int, curve0, net, net_int, curve, GA):
     """A preset's pre-deflections from its parameters ([1] Secs. 3.2, 5.1-5.4;
-    :func:`clutchlab.eclutch.models.build_model`): Model 0's bearing zeroed at ``bearing_preload`` (:func:`zeroed_prestrain`), Model 0's engaged state at bearing
-    position 0 (the static solver), the loads of its rigid connections -- the lever ``F_b - F_ds``, the pressure
-    plate ``F_cushion + F_return``, the support ``-(1 - i_ds) F_lever`` -- and the pre-strain at which each
-    compliance a later model adds carries its load: the lever ``F_lever / k_fl`` (Eq. 1), the pressure-plate
-    spring and the yoke support by their characteristics' inverses (the support's at ``F / support_scale``,
-    Model 4), then Model 4's bearing zeroed again.  Writes the bearing's, the lever's, the pressure-plate spring's
-    and the support's ``net[NE_D0]``.  The compiled twin of that chain in :func:`~clutchlab.eclutch.models.build_model`
-    (in Python, on the networks' own assemblies; the two agree to 1e-17 m), for the start of a co-simulation
-    (:func:`eclutch_start`), whose host may have set the parameters.  Returns 0, or
-    :data:`ERR_ZEROING`, :data:`ERR_STATIC`, :data:`ERR_PRESTRAIN`."""
+    :func:`clutchlab.eclutch.models.build_model`): Model 0's bearing zeroed at ``bearing_preload``
+    (:func:`zeroed_prestrain`), Model 0's engaged state at bearing position 0 (the static solver), the loads of
+    its rigid connections -- the lever ``F_b - F_ds``, the pressure plate ``F_cushion + F_return``, the support
+    ``-(1 - i_ds) F_lever`` -- and the pre-strain at which each compliance a later model adds carries its load: the
+    lever ``F_lever / k_fl`` (Eq. 1), the pressure-plate spring and the yoke support by their characteristics'
+    inverses (the support's at ``F / support_scale``, Model 4), then Model 4's bearing zeroed again.  Writes the
+    bearing's, the lever's, the pressure-plate spring's and the support's ``net[NE_D0]``.  The compiled twin of
+    that chain in :func:`~clutchlab.eclutch.models.build_model` (in Python, on the networks' own assemblies; the two
+    agree to 1e-17 m), for the start of a co-simulation (:func:`eclutch_start`), whose host may have set the
+    parameters.  Returns 0, or :data:`ERR_ZEROING`, :data:`ERR_STATIC`, :data:`ERR_PRESTRAIN`."""
     number = clutch_int[CLI_NUMBER]
     if number < 0:
         return 0
@@ -1381,9 +1381,10 @@ def eclutch_start(t, x, u, m, p):
     co-simulation (``clutch_int[CLI_AT_START]``, whose host may have set the clutch's parameters) also the
     preset's pre-deflections (:func:`derive_clutch`) and the state at rest (:func:`start_at_rest`).  The packing
     derives the actuator's with the same function, the clutch's in Python
-    (:func:`~clutchlab.eclutch.models.build_model`, :meth:`Assembly.rest_position`, :meth:`Assembly.initial_state`; the same to 1e-17 m); a native FMU runs the
-    start again after a host set the volumes, the fluid, the line, the pre-strains, the lever ratio, the
-    stiffnesses or the preloads, which it then writes as plain copies
+    (:func:`~clutchlab.eclutch.models.build_model`, :meth:`Assembly.rest_position`,
+    :meth:`Assembly.initial_state`; the same to 1e-17 m); a native FMU runs the start again after a host set the
+    volumes, the fluid, the line, the pre-strains, the lever ratio, the stiffnesses or the preloads, which it then
+    writes as plain copies
     (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0 or a model error (:data:`ERROR_MESSAGES`)."""
     par = p.par
     derive_actuator(par)
