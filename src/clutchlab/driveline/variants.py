@@ -235,16 +235,17 @@ class DrivelineDocument:
     @property
     def parameters(self) -> dict:
         """The numeric parameters by name: each component's numeric fields (``<component>.<field>``), then the
-        numeric fields of the parameter sets its path fields name (``<component>.<field>.<set field>``: a wet
-        clutch's ``clutch`` and ``bench``, read from their files, or their defaults where the file names none;
-        :func:`~clutchlab.driveline.components.parameter_sets`).  The sets' files are read when this is first
-        asked for (after :meth:`referenced_files` checked where they are)."""
+        numeric fields of the parameter sets its path fields name (``<component>.<set>.<set field>``: a wet
+        clutch's ``clutch`` and ``bench``, an EMTC coupling's ``actuator`` and ``coupling``, read from their files,
+        or their defaults where the file names none; :func:`~clutchlab.driveline.components.parameter_sets`).  The
+        sets' files are read when this is first asked for (after :meth:`referenced_files` checked where they
+        are)."""
         if self._sets is None:
             self._sets = self._set_parameters()
         return {**self._own_parameters, **{name: par for name, (par, _) in self._sets.items()}}
 
     def _set_parameters(self) -> dict:
-        """name -> (Parameter, (kind, component, field, set field)) of the parameter sets' numeric fields."""
+        """name -> (Parameter, (kind, component, set, set field)) of the parameter sets' numeric fields."""
         import dataclasses
 
         from ..params.base import field_range
@@ -409,8 +410,8 @@ class DrivelineDocument:
         set_changes = {}
         for name, value in changes.items():
             if self._sets and name in self._sets:   # (a field of a parameter set a component's file names)
-                kind, component, field, set_field = self._sets[name][1]
-                set_changes.setdefault((kind, component), {}).setdefault(field, {})[set_field] = float(value)
+                kind, component, which, set_field = self._sets[name][1]
+                set_changes.setdefault((kind, component), {}).setdefault(which, {})[set_field] = float(value)
                 continue
             if name in self._signals:
                 kind, component, field, sig, param = self._signals[name]

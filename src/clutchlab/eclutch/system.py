@@ -193,7 +193,9 @@ CL_PRELOAD, CL_RATIO, CL_KFL, CL_SUPPORT_SCALE, CL_REST = indices(
 CLUTCH_INT = ("number", "at_start", "bearing", "diaphragm", "lever", "return", "cushion", "pp_spring", "support",
               "model0_bearing", "model0_diaphragm", "model0_return", "model0_cushion")
 (CLI_NUMBER, CLI_AT_START, CLI_BEARING, CLI_DIAPHRAGM, CLI_LEVER, CLI_RETURN, CLI_CUSHION, CLI_PP_SPRING, CLI_SUPPORT,
- CLI_M0_BEARING, CLI_M0_DIAPHRAGM, CLI_M0_RETURN, CLI_M0_CUSHION) = indices(CLUTCH_INT, *CLUTCH_INT)
+ CLI_M0_BEARING, CLI_M0_DIAPHRAGM, CLI_M0_RETURN, CLI_M0_CUSHION) = indices(
+    CLUTCH_INT, "number", "at_start", "bearing", "diaphragm", "lever", "return", "cushion", "pp_spring", "support",
+    "model0_bearing", "model0_diaphragm", "model0_return", "model0_cushion")
 #: model errors of the start (:attr:`clutchlab.system.System.error_messages`)
 ERR_ZEROING, ERR_REST, ERR_STATIC, ERR_PRESTRAIN, ERR_STROKE, ERR_MASTER_VOLUME = -3, -4, -5, -6, -7, -8
 ERROR_MESSAGES = {
