@@ -46,6 +46,7 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.core import types
 
 from ..curves import curve_inverse_one
 from ..errors import ParameterError
@@ -53,6 +54,7 @@ from ..numerics import dispatch
 from ..numerics.core import RESTART, record
 from ..numerics.interp import bracket
 from ..numerics.layout import indices, slots
+from ..numerics.outline import outlined, prepare
 from ..system import System, start_checks_deferred, variables
 from .actuator import (ActuatorParameters, cavitating_compliance, chamber_compliance, chamber_pressure_rate,
                        controller_integral_rate, controller_voltage, current_rate, drive_voltage, drive_voltage_slopes,
@@ -1352,28 +1354,53 @@ def start_modes(u, q, m, GA, net, net_int, curve, coord, coord_int):
 
 
 @numba.njit(cache=True, nogil=True)
-def start_at_rest(x, m, p):
+def start_at_rest(x, m, par, coord, coord_int, GA, net, net_int, curve, clutch, imode):
     """The state at rest of a run whose host may have set the parameters (a co-simulation): the bearing at its rest
     position (:func:`rest_position` of ``csc_preload``, ``csc_spring_rate`` and the CSC travel) into ``x[1]`` and
     ``clutch[CL_REST]``, the nodes at the static equilibrium there (:func:`static_state`) into ``x[2:nz]``, the
     friction modes (:func:`start_modes`).  Returns 0, :data:`ERR_REST` or :data:`ERR_STATIC`."""
-    par = p.par
-    data = network_arrays(p.GA, p.net, p.net_int, p.curve)
-    if p.imode == PRESCRIBED:
+    data = network_arrays(GA, net, net_int, curve)
+    if imode == PRESCRIBED:
         u = x[1]
     else:
         u = rest_position(par[P_FPRE], par[P_KPRE], par[P_UMIN], par[P_UMAX], data)
         if np.isnan(u):
             return ERR_REST
-    q = np.empty(p.GA.shape[1])
+    q = np.empty(GA.shape[1])
     if np.isnan(static_state(u, data, q)):
         return ERR_STATIC
-    p.clutch[CL_REST] = u
+    clutch[CL_REST] = u
     x[1] = u
     for j in range(q.shape[0]):
         x[2 + j] = q[j]
-    start_modes(u, q, m, p.GA, p.net, p.net_int, p.curve, p.coord, p.coord_int)
+    start_modes(u, q, m, GA, net, net_int, curve, coord, coord_int)
     return 0
+
+
+@numba.njit(cache=True, nogil=True)
+def clutch_at_start(x, m, par, coord, coord_int, GA, net, net_int, curve, clutch, clutch_int, GA0, net0, net0_int,
+                    curve0, imode):
+    """What a co-simulation's start derives beyond the actuator's words (:func:`eclutch_start`): the checks across
+    the actuator's fields that :meth:`ActuatorParameters.check <clutchlab.eclutch.actuator.ActuatorParameters.check>`
+    makes, the preset's pre-deflections (:func:`derive_clutch`) and the state at rest (:func:`start_at_rest`).
+    Called through its address (:func:`clutchlab.numerics.outline.outlined`, :data:`_CLUTCH_AT_START`): compiled on
+    its own the first time a co-simulation asks for it, not linked into every E-clutch session (linked, it added
+    about 18 s to an E-clutch's first compilation).  Returns 0 or a model error (:data:`ERROR_MESSAGES`)."""
+    if par[P_XSN] >= par[P_XMAX]:
+        return ERR_STROKE
+    if par[P_VMC] < par[P_AMC] * par[P_XPORT]:
+        return ERR_MASTER_VOLUME
+    code = derive_clutch(clutch, clutch_int, GA0, net0, net0_int, curve0, net, net_int, curve, GA)
+    if code:
+        return code
+    return start_at_rest(x, m, par, coord, coord_int, GA, net, net_int, curve, clutch, imode)
+
+
+_F1, _F2, _I1, _I2 = types.float64[::1], types.float64[:, ::1], types.int64[::1], types.int64[:, ::1]
+#: :func:`clutch_at_start` called through its address, in the group ``"eclutch_cosim"`` (prepared by a co-simulation's
+#: system, :meth:`Assembly.system` with ``at_start``)
+_CLUTCH_AT_START = outlined(clutch_at_start, lambda: (_F1, _I1, _F1, _F2, _I2, _F2, _F2, _I2, _F2, _F1, _I1, _F2, _F2,
+                                                      _I2, _F2, types.int64), types.int64, group="eclutch_cosim")
 
 
 @numba.njit(cache=True, nogil=True)
@@ -1395,16 +1422,8 @@ def eclutch_start(t, x, u, m, p):
         p.coord[CO_MU_PRESSURE, 0] = par[P_LOADF] * par[P_AMC]
     if p.clutch_int[CLI_AT_START] == 0:
         return 0
-    # (what ActuatorParameters.check refuses across fields, for a host's values)
-    if par[P_XSN] >= par[P_XMAX]:
-        return ERR_STROKE
-    if par[P_VMC] < par[P_AMC] * par[P_XPORT]:
-        return ERR_MASTER_VOLUME
-    code = derive_clutch(p.clutch, p.clutch_int, p.GA0, p.net0, p.net0_int, p.curve0, p.net, p.net_int, p.curve,
-                         p.GA)
-    if code:
-        return code
-    return start_at_rest(x, m, p)
+    return _CLUTCH_AT_START(x, m, par, p.coord, p.coord_int, p.GA, p.net, p.net_int, p.curve, p.clutch, p.clutch_int,
+                            p.GA0, p.net0, p.net0_int, p.curve0, p.imode)
 
 
 dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restart=restart, accept=accept,
@@ -1894,6 +1913,8 @@ class Assembly:
         if known is not None:
             params = known.params
             return known.variant(params=params._replace(work=np.zeros_like(params.work)))
+        if at_start:   # (the start's clutch derivation, called through its address: compiled here, on this thread)
+            prepare(groups=("eclutch_cosim",), ungrouped=False)
         system = self._build_system(imode, tin, vin, interp, u0, held_input, rtol, max_step, event_tol, jac_every,
                                     atol_scale, first_step, bool(at_start))
         if len(self._systems) >= 16:
