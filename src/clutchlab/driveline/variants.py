@@ -240,9 +240,11 @@ class DrivelineDocument:
         or their defaults where the file names none; :func:`~clutchlab.driveline.components.parameter_sets`).  The
         sets' files are read when this is first asked for (after :meth:`referenced_files` checked where they
         are)."""
-        if self._sets is None:
+        if self._sets is None:   # (once: check_names asks for it per name)
             self._sets = self._set_parameters()
-        return {**self._own_parameters, **{name: par for name, (par, _) in self._sets.items()}}
+            self._all_parameters = {**self._own_parameters,
+                                    **{name: par for name, (par, _) in self._sets.items()}}
+        return self._all_parameters
 
     def _set_parameters(self) -> dict:
         """name -> (Parameter, (kind, component, set, set field)) of the parameter sets' numeric fields."""
