@@ -348,6 +348,102 @@ def test_initial_speeds_follow_gears_and_sources_and_conflicts_are_named():
         ow.system()
 
 
+@st.composite
+def _geared_trees(draw):
+    """A random forest of 2-7 inertias bound by gears (each new inertia geared to an earlier one, or not; some gears
+    lossy, some on a support inertia of their own, turning or at rest), and per group of bound inertias one of: no
+    speed given, one speed given, a speed source, a gear to the ground (so no two disagree)."""
+    n = draw(st.integers(2, 7))
+    parent = list(range(n))
+
+    def root(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    gears = []
+    for i in range(1, n):
+        if draw(st.booleans()):
+            j = draw(st.integers(0, i - 1))
+            a, b = (i, j) if draw(st.booleans()) else (j, i)
+            gears.append((a, b, draw(st.sampled_from([-3.0, -0.5, 0.7, 2.0, 4.2])),
+                          draw(st.sampled_from([1.0, 1.0, 0.9])), draw(st.booleans())))
+            parent[root(i)] = root(j)
+    groups = {}
+    for i in range(n):
+        groups.setdefault(root(i), []).append(i)
+    speeds, drives = [None] * n, []
+    for members in groups.values():
+        what = draw(st.sampled_from(["none", "given", "source", "ground"]))
+        at = draw(st.sampled_from(members))
+        if what == "given":
+            speeds[at] = draw(st.sampled_from([-7.0, 0.0, 3.3, 12.5]))
+        elif what != "none":
+            drives.append((what, at, draw(st.sampled_from([-2.0, 5.0]))))
+    d = Driveline("tree")
+    for i in range(n):
+        d.inertia(f"J{i}", J=1.0, w0=speeds[i])
+    for k, (a, b, ratio, eta, housed) in enumerate(gears):
+        support = None
+        if housed:   # (a housing of its own, given a speed or at rest)
+            d.inertia(f"H{k}", J=2.0, w0=draw(st.sampled_from([None, 0.0, 1.5])))
+            support = f"H{k}"
+        d.gear(f"g{k}", f"J{a}", f"J{b}", ratio=ratio, efficiency=eta, support=support)
+    for what, at, value in drives:
+        if what == "source":
+            d.speed(f"s{at}", f"J{at}", Signal.ramp(1.0, 1.0, offset=value))
+        else:
+            d.gear(f"ground{at}", f"J{at}", "ground", ratio=2.0)
+    return d
+
+
+@settings(max_examples=examples(40), deadline=None)
+@given(_geared_trees())
+def test_the_start_derives_the_speeds_left_out_as_the_build_does(d):
+    """The speeds a description leaves out follow the gears from the ones it gives (Driveline.initial_state); the
+    network's compiled start derives them again (kernel.derive_speeds, so a native FMU carries a host's speeds
+    and ratios): from a state whose derived speeds are wiped it gives the build's speeds bit for bit, and the
+    gear constraints hold (w_a - w_s = ratio (w_b - w_s), MSL IdealGear)."""
+    from clutchlab.driveline import kernel as K
+
+    system = d.system(1e-8)
+    x0 = system.x0.copy()
+    n = len(d._inertias)
+    derived = [list(d._inertias).index(nm) for nm in d.derived_speeds()]
+    words = [w for where, w, _ in system.decided_at_start if where == "x"]
+    x = x0.copy()
+    x[words] = np.nan
+    assert K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params) == 0
+    assert np.array_equal(x, x0)
+    p = system.params
+    carried = sorted(n + p.elem[r, K.E_B if p.elem[r, K.E_SPREAD] > 0 else K.E_A]
+                     for r in range(p.elem.shape[0]) if p.elem[r, K.E_SPREAD] != 0)
+    assert sorted(words) == carried and set(carried) <= {n + i for i in derived}
+    assert np.all(np.isfinite(x[n:2 * n]))
+    for r in range(p.elem.shape[0]):   # (w_a - w_s = ratio (w_b - w_s); a flange or support on the ground at rest)
+        if p.elem[r, K.E_KIND] == K.K_GEAR:
+            ws, wa, wb = (0.0 if p.elem[r, c] < 0 else x[n + p.elem[r, c]] for c in (K.E_SUP, K.E_A, K.E_B))
+            assert math.isclose(wa - ws, p.coef[r, K.C_RATIO] * (wb - ws), rel_tol=1e-9, abs_tol=1e-12)
+
+
+def test_a_host_s_speed_and_ratio_are_carried_along_the_gears_by_the_start():
+    """The start carries the speeds a run starts from (not the build's numbers): a seed's speed and a ratio changed
+    in the packed arrays (as a native FMU's host writes them) reach every speed derived from them."""
+    from clutchlab.driveline import kernel as K
+
+    d = Driveline("chain")
+    d.inertia("J0", J=1.0).inertia("J1", J=1.0).inertia("J2", J=1.0).inertia("J3", J=1.0, w0=4.0)
+    d.gear("g1", "J0", "J1", 2.0).gear("g2", "J2", "J1", -4.0)
+    system = d.system(1e-8)
+    assert d.derived_speeds() == ["J1", "J2"]   # (J0 its group's seed, at rest unless set; J3 given)
+    x = system.x0.copy()
+    n = 4
+    x[n + 0] = 6.0
+    system.params.coef[0, K.C_RATIO] = 3.0
+    K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params)
+    assert (x[n + 1], x[n + 2]) == (6.0 / 3.0, -4.0 * (6.0 / 3.0))
+
+
 # ----------------------------------------------------------------- energy as a property
 @st.composite
 def networks(draw):

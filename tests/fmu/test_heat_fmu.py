@@ -28,14 +28,23 @@ def test_the_heat_example_fmu_carries_its_thermal_parameters_and_runs_in_a_host(
     assert (cap.causality, cap.unit, float(cap.min), float(cap.start)) == ("parameter", "J/K", 0.0, 900.0)
     assert md["plate_to_housing.conductance"].unit == "W/K" and md["housing.ambient"].unit == "degC"
     assert md["plate.temperature"].causality == "output" and md["plate.temperature"].unit == "degC"
-    start = {"plate.capacity": 1800.0}
-    names = ["engine.w", "plate.temperature", "housing.temperature", "plate.loss_power", "clutch.dissipated"]
+    # the vehicle's initial speed, left out of the file, follows the gearbox's through the final gear: the network's
+    # start derives it (kernel.derive_speeds), so it is no parameter, and a host sets the gearbox's speed and the
+    # gear's ratio together (before, both speeds were fixed at export: the vehicle's was gearbox.w0 / final.ratio,
+    # a quotient of two parameters, written at the build)
+    assert "vehicle.w0" not in md
+    assert (md["gearbox.w0"].causality, md["gearbox.w0"].variability) == ("parameter", "fixed")
+    assert (md["final.ratio"].causality, md["final.ratio"].variability) == ("parameter", "fixed")
+    start = {"plate.capacity": 1800.0, "gearbox.w0": 6.0, "final.ratio": 10.0}
+    names = ["engine.w", "gearbox.w", "vehicle.w", "plate.temperature", "housing.temperature", "plate.loss_power",
+             "clutch.dissipated"]
     dt, n = 0.01, 300
     got = run_fmu(fmu, {}, dt, n, names, start)
     ref = run_cosim(DrivelineCoSimulation.for_description(path)(**start), {}, dt, n)
     for name in names:
         np.testing.assert_allclose(got[name], ref[name], rtol=1e-12, atol=1e-12 * np.max(np.abs(ref[name])),
                                    err_msg=name)
+    assert (got["gearbox.w"][0], got["vehicle.w"][0]) == (6.0, 1.0 / 10.0 * 6.0)   # (w_b = (1 / ratio) w_a)
     # the host's capacity holds: the plate and housing keep the clutch's losses (the housing's air loss is small)
     stored = 1800.0 * (got["plate.temperature"] - 40.0) + 5000.0 * (got["housing.temperature"] - 40.0)
     assert stored[-1] == pytest.approx(got["clutch.dissipated"][-1], rel=0.02)

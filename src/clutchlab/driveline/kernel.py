@@ -107,12 +107,16 @@ N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
 #: inertia, -1 the ground; "heat" the thermal mass (row of ``thermal``) its losses flow into, -1 none; "fade" and
 #: "fade_n" a friction element's factor over that mass's temperature: its table's start in ``data`` (-1 none) and
-#: its number of rows (temperatures, then factors; :func:`fade_factor`)
+#: its number of rows (temperatures, then factors; :func:`fade_factor`); "spread" a gear's part in the initial
+#: speeds left out of the description (:func:`derive_speeds`): 0 none, +d its flange b's speed derived from flange
+#: a's, -d flange a's from flange b's, d the derived flange's depth below the speed it follows; "spread_support" 1
+#: where the gear's support speed enters that derivation (given in the description), 0 where it is taken as rest
 ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat",
-                "fade", "fade_n")
+                "fade", "fade_n", "spread", "spread_support")
 (E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP, E_HEAT, E_FADE,
- E_FADE_N) = indices(ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state",
-                     "support", "heat", "fade", "fade_n")
+ E_FADE_N, E_SPREAD, E_SPREAD_SUP) = indices(ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n",
+                                             "aux", "mode", "state", "support", "heat", "fade", "fade_n", "spread",
+                                             "spread_support")
 N_ELEM = len(ELEM_COLUMNS)
 #: columns of ``thermal`` (one row per thermal mass, MSL ``Thermal.HeatTransfer.Components.HeatCapacitor`` with a
 #: ``ThermalConductor`` to a ``FixedTemperature``): heat capacity [J/K], conductance to its ambient [W/K], the
@@ -4002,6 +4006,7 @@ def driveline_start(t, x, u, m, p):
     forget_signals(p)   # (a host may have set a signal's parameters since the cache was filled)
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
+    derive_speeds(x, p)
     code = kinematic_error(t, x, p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
@@ -4074,6 +4079,36 @@ def kinematic_error(t, x, p):
                 if not (_isclose(x[i], signal_at(p, s, t)) and _isclose(_speed(x, n, i), rate)):
                     return -(INV_BASE + N_INV * r + INV_START)
     return 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def derive_speeds(x, p):
+    """The initial speeds the description left out, carried from the ones it gives along the gears (MSL
+    ``IdealGear``: ``w_a - w_s = ratio (w_b - w_s)``), into ``x`` (part of :func:`driveline_start`).
+
+    Each gear with ``elem[r, E_SPREAD] = +d`` sets its flange b's speed from flange a's, ``-d`` flange a's from
+    flange b's, in order of depth ``d`` (a flange at depth d follows one at d - 1, given or derived before), with the
+    support's speed where ``elem[r, E_SPREAD_SUP]`` is 1 and rest otherwise: the arithmetic of
+    :meth:`~clutchlab.driveline.Driveline.initial_state`, which fills those columns (so a run's speeds are the
+    description's to the last bit), again at the start of every run.  A native FMU so derives them from the speeds
+    and ratios a host set (a gear's ratio and a given speed are parameters; a speed left out is not).  The speeds a
+    motion source or a gear to the ground sets are not derived here: :func:`kinematic_error` checks them."""
+    n = p.inertia.shape[0]
+    deepest = 0
+    for r in range(p.elem.shape[0]):
+        deepest = max(deepest, abs(p.elem[r, E_SPREAD]))
+    for d in range(1, deepest + 1):
+        for r in range(p.elem.shape[0]):
+            s = p.elem[r, E_SPREAD]
+            if s != d and s != -d:
+                continue
+            ratio = p.coef[r, C_RATIO]
+            ws = x[n + p.elem[r, E_SUP]] if p.elem[r, E_SPREAD_SUP] == 1 else 0.0
+            if s > 0:   # w_b from w_a
+                factor = 1.0 / ratio
+                x[n + p.elem[r, E_B]] = factor * x[n + p.elem[r, E_A]] + (1.0 - 1.0 / ratio) * ws
+            else:       # w_a from w_b
+                x[n + p.elem[r, E_A]] = ratio * x[n + p.elem[r, E_B]] + (1.0 - ratio) * ws
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")

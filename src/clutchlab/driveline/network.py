@@ -1760,6 +1760,9 @@ class Driveline:
         lossy = np.array([r for r, e in enumerate(self._elements) if self._is_lossy(e)], dtype=np.int64)
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
         elem[:, K.E_HEAT], thermal, links = self._heat_rows()
+        for r, (sign, depth, given) in self._speed_plan()[2].items():   # (kernel.derive_speeds)
+            elem[r, K.E_SPREAD] = sign * depth
+            elem[r, K.E_SPREAD_SUP] = int(given)
         n, ne = len(index), len(self._elements)
         nk = fric.size + cons.size + lossy.size
         ext = [r for r in fric if self._elements[r].law == K.LAW_EXTERNAL]
@@ -1790,21 +1793,40 @@ class Driveline:
         ``w_a = ratio w_b`` carries it on); speeds given are kept, and must agree with them to 1e-9 relative:
         :meth:`system` refuses a disagreement (the network's compiled start,
         :func:`~clutchlab.driveline.kernel.kinematic_error`, which a native FMU runs again on the speeds a host sets).
+        The network's compiled start carries the speeds along the gears again
+        (:func:`~clutchlab.driveline.kernel.derive_speeds`, from the plan :meth:`_speed_plan` packs), so a native
+        FMU derives them from the given speeds and ratios a host set.
         Raises :class:`~clutchlab.errors.ParameterError` on a loop of gears and motion sources.
         """
-        names = list(self._inertias)
-        index = {nm: i for i, nm in enumerate(names)}
-        n = len(names)
+        n = len(self._inertias)
         x = np.zeros(self._state_count())
         o = self._thermal_offset()
         for k, tm in enumerate(self._thermal.values()):   # (kernel.THERMAL_STATES: the temperature, the heat out)
             x[o + len(K.THERMAL_STATES) * k + K.TS_TEMP] = tm.T0
+        value, phi, _, _ = self._speed_plan()
+        for i in range(n):
+            x[i] = 0.0 if phi[i] is None else phi[i]
+            x[n + i] = value[i]
+        return x
+
+    def _speed_plan(self):
+        """``(speeds, angles, rows, seeds)``: the initial speeds (given, or carried from the motion sources and gears
+        that bind an inertia to another, else rest), the angles (given, a position source's, else None) and the
+        gears that carry a speed left out, ``{row: (sign, depth, support given)}`` -- sign +1 where flange b's
+        speed follows flange a's, -1 the other way, depth that of the derived flange below the speed it follows
+        (the columns ``E_SPREAD`` and ``E_SPREAD_SUP`` of :func:`~clutchlab.driveline.kernel.derive_speeds`, which
+        repeats this arithmetic in the network's start), and the seeds, the inertias (indices) whose speed, left
+        out, a group follows.  The speed a group of bound inertias follows: its motion source or gear to the ground,
+        else its first speed given, else its first inertia's, at rest (a seed)."""
+        names = list(self._inertias)
+        index = {nm: i for i, nm in enumerate(names)}
+        n = len(names)
         w = [v[1] for v in self._inertias.values()]
         phi = [v[2] for v in self._inertias.values()]
         groups = _Groups(n)
         links = {i: [] for i in range(n)}
         fixed = {}
-        for e in self._elements:
+        for r, e in enumerate(self._elements):
             if e.kind not in (K.K_GEAR, K.K_MOTION):
                 continue
             ia = -1 if e.a is None else index[e.a]
@@ -1814,45 +1836,61 @@ class Driveline:
                                      "(the network is over-constrained)")
             if e.kind == K.K_MOTION:
                 v, rate = e.signal.value_and_rate(0.0)
-                fixed[ib] = (v if e.law == K.MOTION_SPEED else rate, e.name)
+                fixed[ib] = v if e.law == K.MOTION_SPEED else rate
                 if e.law == K.MOTION_POSITION and phi[ib] is None:   # (a given one is checked by the start)
                     phi[ib] = v
             elif ia >= 0 and ib >= 0:   # w_a - w_s = ratio (w_b - w_s), the support at its own initial speed
                 ratio = e.coef[0]
-                ws = 0.0 if e.sup is None or w[index[e.sup]] is None else w[index[e.sup]]
-                links[ia].append((ib, 1.0 / ratio, (1.0 - 1.0 / ratio) * ws, e.name))   # w_b from w_a
-                links[ib].append((ia, ratio, (1.0 - ratio) * ws, e.name))               # w_a from w_b
+                given = e.sup is not None and w[index[e.sup]] is not None
+                ws = w[index[e.sup]] if given else 0.0
+                links[ia].append((ib, 1.0 / ratio, (1.0 - 1.0 / ratio) * ws, r, 1, given))   # w_b from w_a
+                links[ib].append((ia, ratio, (1.0 - ratio) * ws, r, -1, given))               # w_a from w_b
             else:   # a gear to the ground holds its flange at rest
-                fixed[ia if ia >= 0 else ib] = (0.0, e.name)
+                fixed[ia if ia >= 0 else ib] = 0.0
         value = [None] * n
+        depth = [0] * n
+        rows = {}
 
-        def assign(i, v, why):   # (a speed given is kept: the start refuses a disagreement, kinematic_error)
-            value[i] = v if w[i] is None else w[i]
-
-        def spread(start):
+        def spread(start):   # (a speed given is kept, and carried on: the start refuses a disagreement)
             todo = [start]
             while todo:
                 i = todo.pop()
-                for j, factor, offset, gname in links[i]:
+                for j, factor, offset, r, sign, given in links[i]:
                     if value[j] is None:
-                        assign(j, factor * value[i] + offset, f"{gname} from {names[i]}")
+                        if w[j] is None:
+                            value[j] = factor * value[i] + offset
+                            depth[j] = depth[i] + 1
+                            rows[r] = (sign, depth[j], given)
+                        else:
+                            value[j] = w[j]
                         todo.append(j)
 
-        for i, (v, why) in fixed.items():
-            assign(i, v, why)
+        for i, v in fixed.items():
+            value[i] = v if w[i] is None else w[i]
             spread(i)
         for i in range(n):   # the first speed given in each remaining group, else rest
             if value[i] is None and w[i] is not None:
                 value[i] = w[i]
                 spread(i)
+        seeds = []
         for i in range(n):
             if value[i] is None:
                 value[i] = 0.0
+                seeds.append(i)
                 spread(i)
-        for i in range(n):
-            x[i] = 0.0 if phi[i] is None else phi[i]
-            x[n + i] = value[i]
-        return x
+        return value, phi, rows, seeds
+
+    def _inertia_index(self, e, sign) -> int:
+        """The index of the inertia a gear ``e`` derives (flange b for ``sign`` > 0, else a)."""
+        return list(self._inertias).index(e.b if sign > 0 else e.a)
+
+    def derived_speeds(self) -> list:
+        """Names of the inertias whose initial speed the description leaves out and that follow another speed
+        through gears, a motion source or a gear to the ground (:meth:`initial_state`; the network's start carries
+        them along the gears again): not parameters of a native FMU, whose host sets the speeds they follow.  An
+        inertia left out that nothing given binds is the one its group follows (at rest unless set)."""
+        seeds = self._speed_plan()[3]
+        return [nm for i, (nm, v) in enumerate(self._inertias.items()) if v[1] is None and i not in seeds]
 
     def _initial_modes(self, p, x0):
         """The modes a run starts from, guessed from the initial state (the restart at t0 settles them at the
@@ -1973,6 +2011,8 @@ class Driveline:
         mode_values = tuple(K.MODE_VALUES for _ in fric) + swit_values + tuple(K.GEAR_VALUES for _ in self._lossy)
         named_modes = m0   # (the network's own: driveline_start decides them)
         n = len(self._inertias)
+        derived = sorted({self._inertia_index(self._elements[r], sign)
+                          for r, (sign, _, _) in self._speed_plan()[2].items()})
         atol = float(rtol) * np.ones(self._state_count())
         events = K.EVENTS
         wet = self._wet_parameters()
@@ -2042,6 +2082,7 @@ class Driveline:
                       element_name=element_name, error_messages=error_messages,
                       decided_at_start=(("m", 0, len(named_modes)),
                                         ("params.net.work" if wet or emtcs else "params.work", -1, None))
+                      + tuple(("x", n + i, n + i + 1) for i in derived)   # (kernel.derive_speeds)
                       + (tuple((f"params.wet.params.constants.data.{name}", 0, None)
                                for name in W.DERIVED_CONSTANTS) if wet else ())
                       + (tuple((f"params.emtc.params.actuator.data.{name}", 0, None) for name in S.DERIVED_ACTUATOR)

@@ -114,11 +114,15 @@ class DrivelineCoSimulation(ContractCoSimulation):
                         for v in (*system.states, *system.outputs))
         inputs = tuple(Variable(v.name, _fmi_unit(v.unit), float(u), v.description)
                        for v, u in zip(system.inputs, system.u0 if system.inputs else ()))
+        # (an initial speed the file leaves out that follows another through gears or a motion source is the
+        # network start's to derive, kernel.derive_speeds: the host sets the speed it follows, not it)
+        derived = {f"{nm}.{'v0' if base.driveline.domain == 'translational' else 'w0'}"
+                   for nm in base.driveline.derived_speeds()}
         parameters = (rtol_variable("rtol", base.rtol, "relative tolerance of the Dormand-Prince 5(4) step control "
                                                      "([simulation] rtol)"),
                       fixed_step_variable(),
                       *(Variable(p.name, fmi_unit(p.unit), p.value, p.description, p.minimum, p.maximum, p.positive)
-                        for p in doc.parameters.values()))
+                        for p in doc.parameters.values() if p.name not in derived))
         names = [v.name for v in (*inputs, *outputs, *parameters)]
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
@@ -144,7 +148,8 @@ class DrivelineCoSimulation(ContractCoSimulation):
     # ---- the contract
     def build_system(self, values: dict):
         """The driveline's System with the parameter ``values`` (by name, SI) in place of the file's."""
-        changes = {p.name: values[p.name] for p in self.document.parameters.values() if values[p.name] != p.value}
+        changes = {p.name: values[p.name] for p in self.document.parameters.values()
+                   if p.name in values and values[p.name] != p.value}
         spec = self.document.load(changes) if changes else self.base
         system = spec.driveline.system(values["rtol"])
         return system
