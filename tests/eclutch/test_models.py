@@ -173,3 +173,35 @@ def test_parameter_file_round_trip_and_errors(tmp_path, true_curves):
     m = ClutchModel.from_toml(1, good)
     assert m.r_eff == pytest.approx(0.105)
     assert m.network.element("lever").stiffness == pytest.approx(1.3e6)
+
+
+def test_every_parameter_changes_some_model():
+    """No dead parameter: each field of EClutchParameters, changed by 10 %, changes the network or the friction
+    numbers of at least one of Models 0-4, built from the bundled press-rig curves (whose yoke support is measured
+    below ``support_max_force``, so it is extrapolated there) (until the fortieth session ``pp_spring_prestrain`` and
+    ``support_prestrain`` were fields nothing read: Models 2-4 derive those pre-strains from Model 0's engaged
+    loads, so a value in a file, a sweep or an FMU changed nothing)."""
+    base = EClutchParameters()
+
+    def numbers(obj):   # (every number of a network, its elements and their curves, in order)
+        if isinstance(obj, Curve):
+            return [*np.asarray(obj.deflection, float), *np.asarray(obj.force, float)]
+        if dataclasses.is_dataclass(obj):
+            return [v for fl in dataclasses.fields(obj) for v in numbers(getattr(obj, fl.name))]
+        if isinstance(obj, (tuple, list)):
+            return [v for item in obj for v in numbers(item)]
+        return [float(obj)] if isinstance(obj, (int, float, np.floating)) and not isinstance(obj, bool) else []
+
+    def built(params):
+        out = []
+        for n in range(5):
+            model = ClutchModel.preset(n, params)
+            out += numbers(model.network) + [float(model.r_eff), float(model.mu)]
+        return np.array(out)
+
+    reference = built(base)
+    assert np.array_equal(built(base), reference)   # (the same parameters build the same numbers)
+    for f in dataclasses.fields(EClutchParameters):
+        value = getattr(base, f.name)
+        changed = built(base.replace(**{f.name: value * 1.1 if value else 1e-4}))
+        assert changed.shape != reference.shape or not np.array_equal(changed, reference), f.name

@@ -923,7 +923,7 @@ def test_native_fmu_of_the_eclutch(tmp_path, host, native_model):
     # compiled start derives the compliances, the line's inertance and resistance, the snifting edge, the spindle
     # ratio and the equivalent mass again in the FMU (derive_actuator):
     # fixed at export before (a product or a quotient of two parameters, a sum two of them share)
-    assert "61 parameters (5 fixed at export)" in lines[0], lines[0]
+    assert "59 parameters (5 fixed at export)" in lines[0], lines[0]
     start.update({"actuator.line_diameter": 4e-3, "actuator.bulk_modulus": 3e8, "actuator.hose_compliance": 4e-13,
                   "actuator.fluid_viscosity": 0.012, "actuator.slave_volume": 8e-6, "actuator.snifting_width": 4e-4,
                   "actuator.lead": 5e-3, "actuator.master_mass": 0.12})
@@ -1035,8 +1035,10 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     assert lines[0].startswith("native FMU ClutchlabWet (linux64; FMI 2.0 co-simulation and model exchange): 2 inputs, "
                                "24 outputs")
     root, svs = _variables(path)
+    # (the inputs' ranges follow the parameters: no max in the description, the FMU checks the model's numbers)
     force = svs["force_reference"].find("Real")
-    assert force.get("min") == "0.0" and float(force.get("max")) == WetCoSimulation().bench.actuator_force_max
+    assert force.get("min") == "0.0" and force.get("max") is None
+    assert "bench.actuator_force_max" in svs["force_reference"].get("description")
     # the initial slip speed decides the slip direction the run starts in (a mode the wet bench's builder
     # decides): the FMU takes it > 0 only, where its law holds (a host's -1 rad/s had started slipping forward)
     slip = float(svs["scenario.initial_slip_speed"].find("Real").get("min"))
@@ -1063,7 +1065,9 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     # radius (Eq. 1') and squeeze coefficient again in the FMU (wet_start): they were fixed at export (a product of
     # two parameters, a power law); the run equals clutchlab's built with them.  (The radii only outward: the
     # friction area is the whole annulus at the start)
-    assert "48 parameters (5 fixed at export)" in lines[0], lines[0]
+    assert "51 parameters (2 fixed at export)" in lines[0], lines[0]
+    assert sorted(n for n, sv in svs.items() if sv.get("variability") == "constant") == [
+        "scenario.free_inertia", "solver.fixed_step"]
     pack = {"clutch.m_core": 1.3, "clutch.cp_lining": 0.8, "clutch.sigma": 1.2, "clutch.contact_modulus": 0.7,
             "clutch.asperity_radius": 1.5, "clutch.asperity_density": 0.9, "clutch.r_outer": 1.05,
             "clutch.r_inner": 0.97}
@@ -1076,6 +1080,47 @@ def test_native_fmu_of_the_wet_bench_whose_actuator_starts_at_its_reference(tmp_
     for name in ("temperature", "clutch_torque"):   # (the parameters changed the run: the FMU derived with them)
         column = next(k for k in python if k.startswith(name))
         assert np.max(np.abs(changed[column] - python[column])) > 1e-4 * np.max(np.abs(python[column])), column
+    # the bench's drive: its gear and the shaft's and motor's inertias and limits, from which the model's start
+    # derives the drive at the clutch shaft (total_inertia = shaft + motor gear^2, the torque limit motor x gear, the
+    # speed limit motor / gear: wet_start's derive_drive in a co-simulation); they were fixed at export (a number
+    # two parameters share, the gear squared), and the slip-speed reference's range followed the gear at export only
+    drive = {"bench.gear_ratio": 2.5, "bench.shaft_inertia": 0.05, "bench.motor_inertia": 0.1,
+             "bench.motor_torque_max": 60.0, "bench.motor_speed_max": 700.0}
+    assert all(svs[name].get("causality") == "parameter" for name in drive)
+    (tmp_path / "drive").mkdir()
+    native = _fmpy_run(tmp_path / "drive", path, n, dt, drive, inputs=inputs)
+    changed = _python_run(WetCoSimulation, n, dt, drive, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    assert np.max(np.abs(changed["drive_torque"] - python["drive_torque"])) > 1e-2 * np.max(np.abs(python["drive_torque"]))
+    # the inputs' ranges follow the limits the host set, checked once the parameters are fixed (at the end of
+    # initialisation): 400 rad/s is beyond the file's drive (6000 rpm / 2 = 314 rad/s) and within a 1:1 gear's
+    cases = [{"bench.gear_ratio": 1.0, "slip_speed_reference": 400.0}, {"slip_speed_reference": 400.0},
+             {"bench.actuator_force_max": 8000.0, "force_reference": 9000.0}]
+    got = _start_values(tmp_path, path, cases, ["slip_speed"])
+    for kind in ("cs", "me"):
+        results = [r for r in got if r[0] == kind]
+        assert results[0][1] == "ok", results[0]
+        assert results[1][1] == "refused" and re.search(r"slip_speed_reference = 400 \[rad/s\] is outside its range "
+                                                        r"\[-314\.159\d+, 314\.159\d+\] \(bench\.motor_speed_max / "
+                                                        r"bench\.gear_ratio\)", results[1][2]), results[1]
+        assert results[2][1] == "refused" and re.search(r"force_reference = 9000 \[N\] is outside its range \[0, "
+                                                        r"8000\]", results[2][2]), results[2]
+    WetCoSimulation(**{"bench.gear_ratio": 1.0}).input_vector({"force_reference": 0.0, "slip_speed_reference": 400.0})
+    # the tolerance below its default 1e-7 and the piston's travel, whose product is the piston position's absolute
+    # tolerance (wet.system.absolute_tolerance): a number two parameters share as a product, which the FMU writes
+    # from both (image.Target.partner); before, solver.rtol was fixed at export
+    rtol = svs["solver.rtol"].find("Real")
+    assert float(rtol.get("max")) == pytest.approx(1e-7, rel=1e-9) and float(rtol.get("min")) < 1e-10
+    tight = {"solver.rtol": 1e-9, "clutch.piston_h0": 0.015}
+    (tmp_path / "tight").mkdir()
+    native = _fmpy_run(tmp_path / "tight", path, n, dt, tight, inputs=inputs)
+    changed = _python_run(WetCoSimulation, n, dt, tight, inputs=inputs)
+    for name in changed:
+        _close(native[name], changed[name], name)
+    assert WetCoSimulation(**tight).simulation.options.atol[0] == pytest.approx(1e-9 * 0.015, rel=1e-12)
+    with pytest.raises(ParameterError, match="exceeds the bench's speed limit 314.159"):
+        WetCoSimulation().input_vector({"force_reference": 0.0, "slip_speed_reference": 400.0})
 
 
 # ------------------------------------------------------------------------------------------ model exchange
@@ -1197,14 +1242,15 @@ def _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, lin
     specific heats, Eq. 8; the Greenwood-Williamson scale from the roughness, Eq. 11; the effective radius, Eq.
     (1')) is derived again by the network's start (``wet_start`` on the clutch's row, ``coupled_start``), so a host
     sets those too, and the run equals clutchlab's built with them."""
-    assert "41 parameters (2 fixed at export)" in line, line
+    assert "42 parameters (1 fixed at export)" in line, line
     _, svs = _variables(path)
-    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == ["solver.fixed_step",
-                                                                                    "clutch.clutch.piston_h0"]
+    # (the piston's travel was fixed until the fortieth session: its product with rtol is the piston position's
+    # absolute tolerance, a number the FMU now writes from both, image.Target.partner)
+    assert [n for n, sv in svs.items() if sv.get("variability") == "constant"] == ["solver.fixed_step"]
     assert "clutch.bench.gear_ratio" not in svs and "clutch.bench.noise_torque" not in svs   # (the bench's drive, rig)
     start = {"clutch.clutch.m_lining": 0.0019, "clutch.clutch.cp_core": 520.0, "clutch.clutch.r_outer": 0.085,
              "clutch.clutch.sigma": 2.2e-6, "clutch.clutch.n_c": 7.0, "clutch.bench.actuator_time_constant": 0.03,
-             "clutch.clutch.mu_v1": 1.1e-4}
+             "clutch.clutch.mu_v1": 1.1e-4, "clutch.clutch.piston_h0": 0.013, "rtol": 5e-9}
     assert all(svs[name].get("causality") == "parameter" for name in start)
     (tmp_path / "sets").mkdir()
     native = _fmpy_run(tmp_path / "sets", path, n, dt, start)

@@ -109,7 +109,13 @@ class EClutchParameters(ParameterSet):
     Defaults are those of the bundled (synthetic) data set: lever stiffnesses
     identified with Eq. (1) from the bundled press-rig records, pre-strains from
     inspection of the virtual clutch, scale factors from [1] Sec. 5.4, and
-    representative values for a passenger-car clutch otherwise.
+    representative values for a passenger-car clutch otherwise.  The pre-strains
+    of the compliances Models 1-4 add (the fingers, the pressure-plate spring, the
+    yoke support) are no parameters: each is derived from the load its rigid
+    connection carries in Model 0's engaged state (:meth:`ClutchModel.preset`,
+    docs/eclutch.md Sec. 4).  Until the fortieth session ``pp_spring_prestrain``
+    and ``support_prestrain`` were fields that nothing read; a file naming them is
+    now refused as naming an unknown field.
     """
 
     kind = "eclutch"
@@ -122,8 +128,6 @@ class EClutchParameters(ParameterSet):
     diaphragm_prestrain: float = quantity(4.27457e-3, "m", "diaphragm tip deflection in the assembled clutch", source=_INSPECT)
     cushion_prestrain: float = quantity(0.695635e-3, "m", "cushion spring compression in the engaged clutch", source=_INSPECT)
     return_prestrain: float = quantity(7.94563e-3, "m", "return spring pre-stretch in the engaged clutch", source=_INSPECT)
-    pp_spring_prestrain: float = quantity(0.124305e-3, "m", "pressure-plate spring compression in the engaged clutch", source=_INSPECT)
-    support_prestrain: float = quantity(0.0, "m", "yoke support deflection at zero support load", source=_REP)
     support_scale: float = quantity(20.0, "1", "Model 4 stiffness scale of the yoke support k_ys.eq", source=_PAPER, positive=True)
     diaphragm_scale: float = quantity(1.3, "1", "Model 4 stiffness scale of the diaphragm spring", source=_PAPER, positive=True)
     support_max_force: float = quantity(12e3, "N", "force up to which k_ys.eq is extrapolated", source=_REP, positive=True)

@@ -190,8 +190,9 @@ class CoSimulation(abc.ABC):
     #: the class can become a native FMU (:mod:`clutchlab.fmu.native`): after ``hold_inputs(inputs)`` (the
     #: inputs by name, missing ones at their start; nothing evaluated), an instance runs a
     #: :class:`~clutchlab.system.Simulation` (``simulation``) that reports the outputs in order and holds the
-    #: inputs; an optional ``input_bounds()`` gives ``{input: (min, max)}`` where an input's range follows the
-    #: parameters
+    #: inputs; an optional ``input_bound_words()`` gives ``{input: (path, symmetric, label)}`` where an input's
+    #: range follows the parameters: its upper bound is the packed model's number at ``path`` (a
+    #: :attr:`~clutchlab.system.System.decided_at_start` path), its lower bound ``-`` that where ``symmetric``
     native: bool = False
     #: the parameter whose value [s] is the grid a step's end snaps to, a sampled controller's period (the EMTC's
     #: ``scenario.sample_time``): a communication point within ``1e-9`` of a period from an instant ``k * period``

@@ -115,7 +115,7 @@ class WetCoSimulation(ContractCoSimulation):
     name = "wet"
     native = True
     inputs = (
-        Variable("force_reference", "N", 0.0, "actuator force reference (piston apply force)"),
+        Variable("force_reference", "N", 0.0, "actuator force reference (piston apply force)", 0.0),
         Variable("slip_speed_reference", "rad/s", 1500 * math.pi / 30,
                  "slip-speed reference of the speed-controlled drive motor"),
     )
@@ -158,7 +158,9 @@ class WetCoSimulation(ContractCoSimulation):
         """The ``"wet"`` System of the bench with flat reference profiles (the references are its held inputs)."""
         from ..wet import system as W
 
-        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale)
+        # (the drive at the clutch shaft derived by the start from the motor's numbers and the gear, so a native
+        # FMU's host sets those: wet_start's derive_drive)
+        params = W.pack_parameters(self.clutch, self.bench, self.scenario, mu_scale=self._mu_scale, derive_drive=1)
         return W.engagement_system(self.scenario, clutch=self.clutch, bench=self.bench, params=params,
                                    x0=W.initial_state(self.scenario), rtol=self.rtol)
 
@@ -221,12 +223,16 @@ class WetCoSimulation(ContractCoSimulation):
         return [E.Event(float(log.time[i]), E.EVENT_KINDS[names[int(log.code[i])]]) for i in range(n)
                 if names[int(log.code[i])] in E.EVENT_KINDS]
 
-    def input_bounds(self) -> dict:
-        """The inputs' ranges with these parameters: the actuator's force limit, and the drive's speed limit
-        when the drive holds the slip speed (a native FMU checks them, :mod:`clutchlab.fmu.native`)."""
-        out = {"force_reference": (0.0, float(self.bench.actuator_force_max))}
+    def input_bound_words(self) -> dict:
+        """The inputs whose range follows the parameters, ``{input: (path, symmetric, label)}``: the force reference
+        within ``[0, actuator_force_max]`` and, when the drive holds the slip speed, the slip-speed reference within
+        ``+-drive_speed_max`` (the motor's limit through the gear, derived by the model's start): a native FMU reads
+        those numbers of the packed model to check them (:mod:`clutchlab.fmu.native`), as :meth:`input_vector`
+        checks the bench's."""
+        out = {"force_reference": ("params.constants.actuator_force_max", False, "bench.actuator_force_max")}
         if self.scenario.motor == "speed":
-            out["slip_speed_reference"] = (-float(self.bench.drive_speed_max), float(self.bench.drive_speed_max))
+            out["slip_speed_reference"] = ("params.constants.drive_speed_max", True,
+                                           "bench.motor_speed_max / bench.gear_ratio")
         return out
 
     def do_step(self, t: float, dt: float, inputs: dict) -> dict:

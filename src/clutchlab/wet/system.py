@@ -219,6 +219,11 @@ CONSTANTS = (
     ("total_inertia", "kg*m^2", "rotating inertia at the clutch shaft"),
     ("shaft_inertia", "kg*m^2", "inertia between torque sensor and clutch"),
     ("drive_torque_max", "N*m", "motor torque limit at the clutch shaft"),
+    ("drive_speed_max", "rad/s", "motor speed limit at the clutch shaft (the slip-speed reference's range)"),
+    ("motor_inertia", "kg*m^2", "motor and flywheel at the motor shaft (a copy: derive_drive)"),
+    ("motor_torque_max", "N*m", "motor torque limit at the motor shaft (a copy: derive_drive)"),
+    ("motor_speed_max", "rad/s", "motor speed limit at the motor shaft (a copy: derive_drive)"),
+    ("gear_ratio", "1", "gear motor -> clutch shaft (a copy: derive_drive)"),
     ("motor_power_max", "W", "motor power limit"),
     ("speed_kp", "N*m*s/rad", "speed controller gain"),
     ("speed_ki", "N*m/rad", "speed controller integral gain"),
@@ -263,8 +268,12 @@ CONSTANTS = (
     ("map_force_n", "1", "friction map: its length (an int)"),
     ("map_table_start", "1", "friction map: values in data (an int)"),
     ("map_table_n", "1", "friction map: their number (an int)"),
+    ("derive_drive", "1", "1: the start derives the drive's numbers at the clutch shaft (total_inertia, "
+                          "drive_torque_max, drive_speed_max) from the motor's and the gear (a co-simulation: "
+                          "wet_start); 0: they are as packed, where a batch variant may override total_inertia "
+                          "(an int)"),
 )
-_INT_CONSTANTS = ("friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start",
+_INT_CONSTANTS = ("derive_drive", "friction_kind", "force_start", "force_n", "speed_start", "speed_n", "friction_start",
                   "map_speed_start", "map_speed_n", "map_temperature_start", "map_temperature_n", "map_force_start",
                   "map_force_n", "map_table_start", "map_table_n")
 #: the record type of ``WetParams.constants`` (floats, one bool, ints)
@@ -761,12 +770,21 @@ def wet_start(t, x, u, m, p):
     coefficient ([4]: :func:`~clutchlab.wet.film.squeeze_film_coefficient_scalar`) from the masses, heat
     capacities, roughness parameters and radii packed beside them, with the functions the Python side
     computes them with (the same numbers).  So a native FMU, which runs it again after a host set those
-    parameters, writes them as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Returns 0."""
+    parameters, writes them as plain copies (:attr:`clutchlab.system.System.decided_at_start`).  Where
+    ``derive_drive`` is 1 (a co-simulation's run: :class:`~clutchlab.fmu.wet.WetCoSimulation`), also the bench's
+    drive at the clutch shaft from the motor's numbers and the gear (:class:`~clutchlab.wet.params.Bench`'s
+    ``total_inertia = shaft_inertia + motor_inertia gear_ratio^2``, ``drive_torque_max = motor_torque_max
+    gear_ratio``, ``drive_speed_max = motor_speed_max / gear_ratio``; [1] Sec. 3.1: a 1:2 gear from the motor);
+    elsewhere a batch variant may override ``total_inertia`` as packed.  Returns 0."""
     c = p.constants[0]
     c.heat_capacity = pack_heat_capacity_scalar(c.n_c, c.m_lining, c.cp_lining, c.m_core, c.cp_core)
     c.gw_scale = gw_pressure_scale_scalar(c.sigma, c.asperity_radius, c.asperity_density, c.contact_modulus)
     c.r_eff = effective_radius_scalar(c.r_outer, c.r_inner)
     c.squeeze_coefficient = c.squeeze_flow_factor * squeeze_film_coefficient_scalar(c.r_outer, c.r_inner)
+    if c.derive_drive == 1:   # (the bench's drive referred to the clutch shaft: Bench's properties, Sec. 3.1)
+        c.total_inertia = c.shaft_inertia + c.motor_inertia * c.gear_ratio ** 2
+        c.drive_torque_max = c.motor_torque_max * c.gear_ratio
+        c.drive_speed_max = c.motor_speed_max / c.gear_ratio
     return 0
 
 
@@ -774,6 +792,9 @@ def wet_start(t, x, u, m, p):
 DERIVED_CONSTANTS = ("heat_capacity", "gw_scale", "r_eff", "squeeze_coefficient")
 #: ... as words of a run's parameters (:attr:`clutchlab.system.System.decided_at_start`)
 DERIVED_AT_START = tuple((f"params.constants.{name}", 0, None) for name in DERIVED_CONSTANTS)
+#: the constants :func:`wet_start` derives where ``derive_drive`` is 1, as words of a run's parameters
+DERIVED_DRIVE_AT_START = tuple((f"params.constants.{name}", 0, None)
+                               for name in ("total_inertia", "drive_torque_max", "drive_speed_max"))
 #: ... and what each is derived from (an override of one would be replaced at the start: refused)
 _DERIVED_FROM = {"heat_capacity": "n_c, m_lining, cp_lining, m_core, cp_core",
                  "gw_scale": "sigma, asperity_radius, asperity_density, contact_modulus",
@@ -811,7 +832,8 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
     **overrides
         Values of fields of :data:`CONSTANTS` that replace the packed ones
         (batch variants: ``force_scale``, ``mu_scale``, ``speed_scale``,
-        ``total_inertia``, ``k1``, ``k2``, ``heater_setpoint``).
+        ``total_inertia``, ``k1``, ``k2``, ``heater_setpoint``; a co-simulation:
+        ``derive_drive=1``, :func:`wet_start`).
 
     Returns
     -------
@@ -830,7 +852,10 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
         heat_capacity=clutch.heat_capacity, k1=clutch.k1, k2=clutch.k2, gw_scale=clutch.gw_scale,
         squeeze_coefficient=clutch.squeeze_coefficient, spring_stiffness=clutch.spring_stiffness,
         spring_preload=clutch.spring_preload, total_inertia=bench.total_inertia, shaft_inertia=bench.shaft_inertia,
-        drive_torque_max=bench.drive_torque_max, motor_power_max=bench.motor_power_max, speed_kp=bench.speed_kp,
+        drive_torque_max=bench.drive_torque_max, drive_speed_max=bench.drive_speed_max,
+        motor_inertia=bench.motor_inertia, motor_torque_max=bench.motor_torque_max,
+        motor_speed_max=bench.motor_speed_max, gear_ratio=bench.gear_ratio, derive_drive=0,
+        motor_power_max=bench.motor_power_max, speed_kp=bench.speed_kp,
         speed_ki=bench.speed_ki, actuator_time_constant=bench.actuator_time_constant,
         actuator_force_max=bench.actuator_force_max, actuator_speed_max=bench.actuator_speed_max,
         thermistor_time_constant=bench.thermistor_time_constant,
@@ -853,6 +878,11 @@ def pack_parameters(clutch, bench, scenario, friction=None, **overrides) -> WetP
     if unknown:
         raise TypeError(f"pack_parameters: unknown field {unknown[0]!r} (known: {', '.join(values)})")
     _refuse_derived(overrides, "pack_parameters")
+    if overrides.get("derive_drive"):
+        for name in ("total_inertia", "drive_torque_max", "drive_speed_max"):
+            if name in overrides:
+                raise ParameterError(f"pack_parameters: {name} is derived at the start of a run with derive_drive "
+                                     "from the motor's numbers and the gear: override those")
     values.update(overrides)
     constants = np.array([tuple(values[n] for n in CONSTANTS_DTYPE.names)], dtype=CONSTANTS_DTYPE)
     return WetParams(constants, np.concatenate([new_work(scenario.initial_temperature_c)] + parts))
@@ -1130,4 +1160,5 @@ def engagement_system(scenario, *, clutch=None, bench=None, friction=None, param
         name="wet", params=params, states=_STATE_VARIABLES, outputs=_OUTPUT_VARIABLES, inputs=_INPUT_VARIABLES, x0=x0,
         m0=initial_modes(x0, clutch.piston_h0), atol=absolute_tolerance(clutch, rtol), switching=SWITCHING,
         events=EVENTS, mode_names=MODE_NAMES, mode_values=MODE_VALUES, method="dopri", rtol=float(rtol), event_tol=1e-12,
-        element_name=_element_name, decided_at_start=DERIVED_AT_START)
+        element_name=_element_name,
+        decided_at_start=DERIVED_AT_START + (DERIVED_DRIVE_AT_START if params.constants["derive_drive"][0] else ()))

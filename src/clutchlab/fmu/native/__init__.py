@@ -41,7 +41,7 @@ from pathlib import Path
 from ...errors import ClutchlabError, ParameterError
 from ...numerics.layout import indices
 from ...system import start_checked_later
-from .image import NativeExportError, accepted_range, law_holds, parameter_map, session_image
+from .image import NativeExportError, accepted_range, law_holds, parameter_map, session_image, word_indices
 
 __all__ = ["export_native_fmu", "NativeExportError", "native_identifier", "PLATFORMS", "FMI_VERSIONS"]
 
@@ -106,16 +106,20 @@ def _bind(image, variables, maps) -> tuple:
     dx = image.arg("dx") if "dx" in image.names else None
     x_span = (image.offset(x), image.offset(x) + x.nbytes) if x.size else (0, 0)
     bindings, targets = [], []
+    vr = {v["name"]: k for k, v in enumerate(variables)}
     for v in variables:
         kind = v["kind"]
         offset, first, n = 0, len(targets), 0
         if kind in (_PARAMETER, _INPUT):
             ts = maps[v["name"]] or ()
             # an input that also sets a state (the wet bench's actuator force starts at its reference) sets it
-            # only until initialisation ends, as the model's own run takes it at its start
-            targets.extend(dataclasses.replace(t, initial=kind == _INPUT and x_span[0] <= t.offset < x_span[1])
-                           for t in ts)
+            # only until initialisation ends, as the model's own run takes it at its start; a product's partner
+            # by its value reference
+            targets.extend((dataclasses.replace(t, initial=kind == _INPUT and x_span[0] <= t.offset < x_span[1]),
+                            -1 if t.partner is None else vr[t.partner]) for t in ts)
             n = len(ts)
+        if kind == _INPUT and v.get("bound_at"):   # (the word its range follows: cl_follows_bound)
+            offset = word_indices(image, ((v["bound_path"], 0, 1),))[0] * 8
         elif kind == _OUTPUT:
             offset = image.offset(r, v["index"])
         elif kind == _STATE:
@@ -139,8 +143,9 @@ def _layout(tag, image, bindings, targets) -> list:
     lines += [f"    {{{s}u, {t}u}}," for s, t in image.relocations] or ["    {0u, 0u},"]
     lines.append("};")
     lines.append(f"static const cl_target cl_targets_{tag}[{max(len(targets), 1)}] = {{")
-    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}, {int(t.initial)}}},"
-              for t in targets] or ["    {0u, 0.0, 0.0, 0, 0},"]
+    lines += [f"    {{{t.offset}u, {_c_double(t.a)}, {_c_double(t.b)}, {int(t.reciprocal)}, {int(t.initial)}, "
+              f"{partner}}},"
+              for t, partner in targets] or ["    {0u, 0.0, 0.0, 0, 0, -1},"]
     lines.append("};")
     lines.append(f"static const cl_binding cl_bindings_{tag}[{len(bindings)}] = {{")
     lines += [f"    {{{o}u, {f}, {n}}}," for o, f, n in bindings]
@@ -251,13 +256,13 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
                  + ", ".join(str(int(abs(int(d)) != 3)) for d in gdir) + ("" if gdir.size else "0") + "};")
     lines.append(f"static const int cl_gdir[{max(gdir.size, 1)}] = {{"
                  + ", ".join(str(int(d)) for d in gdir) + ("" if gdir.size else "0") + "};")
-    lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal, initial; } cl_target;",
+    lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal, initial, partner; } cl_target;",
               "typedef struct { uint64_t offset; int first, ntargets; } cl_binding;",
               "typedef struct { const unsigned char *image; uint64_t bytes; const uint64_t (*reloc)[2]; uint64_t nreloc; "
               "uint64_t slot_advance, slot_outputs, off_time, off_t0, off_model_code, off_x, off_dx, off_g0, off_g1, off_out; "
               "const cl_target *targets; const cl_binding *bindings; int exchange; } cl_layout;",
               "typedef struct { const char *name; const char *unit; int kind; double start; int has_min, has_max, "
-              "positive, whole; double min, max; const char *range_text; } cl_variable;"]
+              "positive, whole; double min, max; const char *range_text; int bound_at; } cl_variable;"]
     for tag, image, (bindings, targets) in zip(("cs", "me"), images, layouts):
         lines += _layout(tag, image, bindings, targets)
     if not exchange:   # (never used: a model-exchange instantiation is refused)
@@ -268,7 +273,7 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
         lines.append(f"    {{{_c_string(v['name'])}, {_c_string(v['unit'])}, {v['kind']}, {_c_double(v['start'])}, "
                      f"{int(lo is not None)}, {int(hi is not None)}, {int(v['positive'])}, {int(v.get('whole', False))}, "
                      f"{_c_double(lo if lo is not None else 0.0)}, {_c_double(hi if hi is not None else 0.0)}, "
-                     f"{_c_string(v['range'])}}},")
+                     f"{_c_string(v['range'])}, {int(v.get('bound_at', 0))}}},")
     lines.append("};")
     return "\n".join(lines) + "\n"
 
@@ -523,7 +528,9 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         if any(m[v.name] is None for m in inputs_at):
             raise NativeExportError(f"{cls.__name__}: input {v.name} reaches the model in a way a native FMU "
                                     "cannot repeat (not a * value + b)")
-    bounds = dict(getattr(base_obj, "input_bounds", lambda: {})())
+    # inputs whose range follows the parameters (the wet bench's actuator and drive limits): the model's number that
+    # bounds each, read by the FMU from its memory (cl_follows_bound)
+    followed = dict(getattr(base_obj, "input_bound_words", lambda: {})())
     functions = session_functions(images[0])
     if exchange:
         functions = functions.with_exchange(session_functions(images[1]))
@@ -557,10 +564,16 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
                           "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v),
                           "kind": _PARAMETER if writable else _CONSTANT, "whole": whole})
     for v in cls.inputs:
-        if v.name in bounds:   # (a range that follows the parameters: the bench's actuator limit)
-            v = dataclasses.replace(v, minimum=bounds[v.name][0], maximum=bounds[v.name][1])
-        variables.append({"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
-                          "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "kind": _INPUT})
+        entry = {"name": v.name, "unit": v.unit, "start": float(v.start), "description": v.description,
+                 "bounds": v.fmi_bounds, "positive": v.positive, "range": _range_text(v), "kind": _INPUT}
+        if v.name in followed:   # (no max in the description: it follows a parameter a host may set)
+            word, symmetric, label = followed[v.name]
+            entry.update(bound_at=2 if symmetric else 1, bound_path=word, range=label,
+                         bounds=(None, None) if symmetric else (v.fmi_bounds[0], None),
+                         description=f"{v.description} (within " + (f"+-{label}" if symmetric else
+                                                                     f"[{v.fmi_bounds[0]:g}, {label}]")
+                         + ", a parameter the FMU checks it against)")
+        variables.append(entry)
     r = images[0].arg("r")
     if r.shape[0] != len(cls.outputs):
         raise NativeExportError(f"{cls.__name__}: {r.shape[0]} reported values for {len(cls.outputs)} outputs")

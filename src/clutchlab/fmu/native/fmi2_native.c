@@ -90,6 +90,7 @@ static void cl_log(cl_instance *c, fmi2Status status, const char *category, cons
 }
 
 static double *cl_at(cl_instance *c, uint64_t offset) { return (double *)(c->mem + offset); }
+static int cl_inputs_in_bounds(cl_instance *c, const char *fn);
 
 static void cl_relocate(const cl_layout *L, unsigned char *mem) {
     size_t k;
@@ -114,7 +115,9 @@ static void cl_apply(cl_instance *c, int vr) {
         for (k = 0; k < b->ntargets; k++) {
             const cl_target *t = &c->L->targets[b->first + k];
             if (t->initial && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION) continue;
-            *cl_at(c, t->offset) = t->reciprocal ? t->a / value + t->b
+            /* (a product of two parameters, an absolute tolerance rtol times a length: a v w, w the partner's) */
+            *cl_at(c, t->offset) = t->partner >= 0 ? t->a * value * c->values[t->partner]
+                                   : t->reciprocal ? t->a / value + t->b
                                    : t->a == 1.0 && t->b == 0.0 ? value : t->a * value + t->b;
         }
     }
@@ -316,7 +319,8 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
     }
     if (c->L->exchange) { /* the modes decided at the start, as the core's first step does; then event mode */
         int64_t code;
-        if (!cl_exchange(c, CL_ME_RESTART | CL_ME_STORE | CL_ME_OUTPUTS, &code)) {
+        if (!cl_exchange(c, CL_ME_RESTART | CL_ME_STORE | CL_ME_OUTPUTS, &code)
+            || !cl_inputs_in_bounds(c, "fmi2ExitInitializationMode")) {
             c->state = CL_ERROR;
             return fmi2Error;
         }
@@ -326,7 +330,7 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
         c->state = CL_EVENT;
         return fmi2OK;
     }
-    if (!cl_outputs(c)) {
+    if (!cl_outputs(c) || !cl_inputs_in_bounds(c, "fmi2ExitInitializationMode")) {
         c->state = CL_ERROR;
         return fmi2Error;
     }
@@ -387,6 +391,31 @@ FMI2_Export fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference 
     return fmi2OK;
 }
 
+/* an input whose range follows the parameters (the wet bench's actuator and drive limits): its bound is a number
+   of the model's own (a copy of a parameter, or one its start derives), read from the instance's memory */
+static int cl_follows_bound(cl_instance *c, const char *fn, fmi2ValueReference vr, double x) {
+    const cl_variable *v = &cl_variables[vr];
+    double hi = *cl_at(c, c->L->bindings[vr].offset);
+    double lo = v->bound_at == 2 ? -hi : (v->has_min ? v->min : -INFINITY);
+    if (x < lo || x > hi * (1.0 + 1e-12)) {
+        cl_log(c, fmi2Error, "logStatusError", "%s: %s = %.17g [%s] is outside its range [%.17g, %.17g] (%s)", fn,
+               v->name, x, v->unit, lo, hi, v->range_text);
+        return 0;
+    }
+    return 1;
+}
+
+/* at the end of initialisation, after the model's start derived its numbers from the parameters the host set:
+   every input whose range follows them (set before, it was checked for a number only) */
+static int cl_inputs_in_bounds(cl_instance *c, const char *fn) {
+    int k;
+    for (k = 0; k < CL_NVARIABLES; k++) {
+        if (cl_variables[k].kind == CL_INPUT && cl_variables[k].bound_at
+            && !cl_follows_bound(c, fn, (fmi2ValueReference)k, c->values[k])) return 0;
+    }
+    return 1;
+}
+
 static int cl_in_range(cl_instance *c, const char *fn, const cl_variable *v, double x) {
     if (!isfinite(x)) {
         cl_log(c, fmi2Error, "logStatusError", "%s: %s = %g is not a finite number", fn, v->name, x);
@@ -426,6 +455,10 @@ FMI2_Export fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference 
             return fmi2Error;
         }
         if (!cl_in_range(c, "fmi2SetReal", v, value[k])) return fmi2Error;
+        /* (a range that follows the parameters: checked once they are fixed, here after initialisation, else at
+           its end) */
+        if (v->bound_at && c->state != CL_INSTANTIATED && c->state != CL_INITIALIZATION
+            && !cl_follows_bound(c, "fmi2SetReal", vr[k], value[k])) return fmi2Error;
         if (value[k] == 0.0) { /* (a value the model keeps as its reciprocal, a time constant's rate, cannot be 0) */
             const cl_binding *b = &c->L->bindings[vr[k]];
             int j;

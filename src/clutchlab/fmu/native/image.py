@@ -46,7 +46,8 @@ import numpy as np
 
 from ...errors import ClutchlabError
 
-__all__ = ["Image", "session_image", "parameter_map", "ParameterMap", "law_holds", "NativeExportError", "LOG_CAPACITY"]
+__all__ = ["Image", "session_image", "parameter_map", "ParameterMap", "law_holds", "NativeExportError", "LOG_CAPACITY",
+           "word_indices"]
 
 #: events a native FMU's session log holds (the FMU reports no events; an overflow is only counted)
 LOG_CAPACITY = 16
@@ -223,12 +224,13 @@ def session_image(simulation, exchange: bool = False) -> Image:
     image.relocations = relocations
     image.entry_modules = (module, outputs_module, args)
     image.pointer_slots = frozenset([s for s, _ in relocations] + list(image.function_slots))
-    image.start_words = frozenset(_start_words(image, simulation.system.decided_at_start))
+    image.start_words = frozenset(word_indices(image, simulation.system.decided_at_start))
     return image
 
 
-def _start_words(image: Image, decided) -> list:
-    """Word indices of the slices ``decided`` (:attr:`clutchlab.system.System.decided_at_start`) in ``image``."""
+def word_indices(image: Image, decided) -> list:
+    """Word indices of the slices ``decided`` (``(path, start, stop)``, as
+    :attr:`clutchlab.system.System.decided_at_start`) in ``image``."""
     out = []
     for where, start, stop in decided:
         head, *path = where.split(".")
@@ -300,8 +302,16 @@ class Target:
     reciprocal: bool = False
     #: written only until initialisation ends (an input's start value of a state)
     initial: bool = False
+    #: a number two parameters share as a product (an absolute tolerance ``rtol`` times a length): the float64 is
+    #: ``a * value * value of partner`` (``b`` 0); ``partner_start``, the partner's start
+    partner: str | None = None
+    partner_start: float = 0.0
 
-    def value(self, v: float) -> float:
+    def value(self, v: float, values: dict | None = None) -> float:
+        """The number the FMU writes for the value ``v`` (``values``: the other parameters' values by name, a
+        product's partner at its start where it is not there)."""
+        if self.partner is not None:
+            return self.a * v * (values or {}).get(self.partner, self.partner_start)
         if self.a == 1.0 and self.b == 0.0 and not self.reciprocal:
             return v
         return (self.a / v if self.reciprocal else self.a * v) + self.b
@@ -412,11 +422,44 @@ def parameter_map(variables, base: Image, build, label: str = "model", one_sided
     for name, targets in out.items():
         for t in targets or ():
             owners.setdefault(t.offset, []).append(name)
-    for names in owners.values():
+    starts = {var.name: float(var.start) for var in variables}
+    for offset, names in owners.items():
+        if len(names) == 2 and _product(base, build, w0, noise, skip, out, offset, names, starts):
+            continue
         for name in sorted(names, key=lambda n: n in sided)[1:]:
             out[name] = None
     out.ignore = noise | skip
     return _checked_jointly(variables, base, build, out, noise | skip)
+
+
+def _product(base, build, w0, noise, skip, out, offset, names, starts) -> bool:
+    """Whether the word at ``offset``, which both parameters ``names`` change in proportion (``a v``, no offset), is
+    their product ``c v1 v2`` (an absolute tolerance ``rtol`` times a length): checked by a build with both at their
+    trial values; then both targets there become the product's (:attr:`Target.partner`) and True."""
+    n1, n2 = names
+    if out.get(n1) is None or out.get(n2) is None:
+        return False
+    t1 = next(t for t in out[n1] if t.offset == offset)
+    t2 = next(t for t in out[n2] if t.offset == offset)
+    v1, v2 = starts[n1], starts[n2]
+    if t1.b != 0.0 or t2.b != 0.0 or t1.reciprocal or t2.reciprocal or t1.partner or t2.partner or 0.0 in (v1, v2):
+        return False
+    c = t1.a / v2
+    if abs(c - t2.a / v1) > 1e-12 * abs(c):
+        return False
+    trial = {n1: out.trial[n1], n2: out.trial[n2]}
+    img = build(trial)
+    if img is None or not base.same_layout(img):
+        return False
+    got = float(_words(img).view(np.float64)[offset // 8])
+    want = c * trial[n1] * trial[n2]
+    if not abs(want - got) <= WORD_RTOL * abs(got):
+        return False
+    out[n1] = tuple(dataclasses.replace(t, a=c, partner=n2, partner_start=v2) if t.offset == offset else t
+                    for t in out[n1])
+    out[n2] = tuple(dataclasses.replace(t, a=c, partner=n1, partner_start=v1) if t.offset == offset else t
+                    for t in out[n2])
+    return True
 
 
 def _law(w0: np.ndarray, noise: np.ndarray, skip: np.ndarray, v0: float, trial1, trial2):
@@ -555,7 +598,7 @@ def _apply(image: Image, where: dict, values: dict) -> np.ndarray:
     words = _words(image).view(np.float64).copy()
     for name, v in values.items():
         for t in where[name] or ():
-            words[t.offset // 8] = t.value(v)
+            words[t.offset // 8] = t.value(v, values)
     return words
 
 
