@@ -1,6 +1,7 @@
 """ParameterSet base: units metadata, validation, TOML round trip, clear errors."""
 
 import dataclasses
+from pathlib import Path
 
 import pytest
 
@@ -90,3 +91,32 @@ def test_from_toml_names_file_table_key_and_value(tmp_path):
         Toy.from_toml(path)
     path.write_text('r_outer = "90 mm"\n')  # a file without the table is read from the top level
     assert Toy.from_toml(path).r_outer == pytest.approx(0.09)
+
+
+def test_a_reference_number_the_model_does_not_read_is_no_parameter():
+    """A paper's table entry the equations do not read (``quantity(..., reference=True)``: the wet clutch's core
+    thickness beside its core's mass, the EMTC vehicle's centre-of-mass height and reverse ratio) stays in the set
+    and its files, but is no parameter of an FMU, a sweep or a network, where a value would change nothing (the
+    native exporter found each changing no number of its model)."""
+    import dataclasses
+
+    from clutchlab.driveline.variants import DrivelineDocument
+    from clutchlab.emtc.params import VehicleParameters
+    from clutchlab.fmu.emtc import EmtcCoSimulation
+    from clutchlab.fmu.wet import WetCoSimulation
+    from clutchlab.params.base import is_reference
+    from clutchlab.sweep.targets import sweepable_fields
+    from clutchlab.wet.params import WetClutch
+
+    marked = {(cls.__name__, f.name) for cls in (WetClutch, VehicleParameters) for f in dataclasses.fields(cls)
+              if is_reference(f)}
+    assert marked == {("WetClutch", "core_thickness"), ("VehicleParameters", "cg_height"),
+                      ("VehicleParameters", "reverse_ratio")}
+    assert WetClutch(core_thickness=2e-3).core_thickness == 2e-3   # (kept, and checked, in the set)
+    wet = {v.name for v in WetCoSimulation.parameters}
+    emtc = {v.name for v in EmtcCoSimulation.parameters}
+    assert "clutch.core_thickness" not in wet and "clutch.m_core" in wet
+    assert {"vehicle.cg_height", "vehicle.reverse_ratio"}.isdisjoint(emtc) and "vehicle.cg_to_front" in emtc
+    assert "clutch.core_thickness" not in sweepable_fields("clutch", WetClutch)
+    doc = DrivelineDocument.read(Path(__file__).resolve().parents[2] / "examples" / "driveline_wet_sae2.toml")
+    assert "clutch.clutch.core_thickness" not in doc.parameters and "clutch.clutch.m_core" in doc.parameters

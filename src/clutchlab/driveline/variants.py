@@ -250,7 +250,7 @@ class DrivelineDocument:
         """name -> (Parameter, (kind, component, set, set field)) of the parameter sets' numeric fields."""
         import dataclasses
 
-        from ..params.base import field_range
+        from ..params.base import field_range, is_reference
         from .components import parameter_sets
 
         out = {}
@@ -272,7 +272,7 @@ class DrivelineDocument:
                         continue   # (the loader names the error)
                     for f in dataclasses.fields(src.cls):
                         v = getattr(instance, f.name)
-                        if (f.name in src.unread or "unit" not in f.metadata or isinstance(v, bool)
+                        if (f.name in src.unread or "unit" not in f.metadata or isinstance(v, bool) or is_reference(f)
                                 or not isinstance(v, (int, float))):
                             continue
                         name = f"{component}.{src.name}.{f.name}"

@@ -83,11 +83,13 @@ class VehicleParameters(ParameterSet):
     mass: float = quantity(2162.0, "kg", "curb weight", source="[1] Table 1", positive=True)
     cg_to_front: float = quantity(1.1043, "m", "centre of mass to front axle", source="[1] Table 1", positive=True)
     cg_to_rear: float = quantity(1.5957, "m", "centre of mass to rear axle", source="[1] Table 1", positive=True)
-    cg_height: float = quantity(0.670, "m", "height of the centre of mass", source="[1] Table 1", positive=True)
+    cg_height: float = quantity(0.670, "m", "height of the centre of mass (for the record: the drum bench's axle "
+                                "loads are static, [1] Sec. 4)", source="[1] Table 1", positive=True, reference=True)
     wheelbase: float = quantity(2.700, "m", "wheel base", source="[1] Table 1", positive=True)
     gear_ratios: tuple = quantity((4.044, 2.371, 1.556, 1.159, 0.852, 0.672), "1", "transmission gear ratios 1st-6th",
                                   source="[1] Table 1", positive=True)
-    reverse_ratio: float = quantity(3.19, "1", "reverse gear ratio", source="[1] Table 1", positive=True)
+    reverse_ratio: float = quantity(3.19, "1", "reverse gear ratio (for the record: the scenarios drive forward "
+                                    "gears 1-6)", source="[1] Table 1", positive=True, reference=True)
     front_final_drive: float = quantity(3.75, "1", "front main retarder ratio i0", source="[1] Table 1", positive=True)
     rear_final_drive: float = quantity(2.533, "1", "rear main retarder ratio i_r = i_f (Eq. 28)", source="[1] Table 1", positive=True)
     engine_power: float = quantity(125e3, "W", "engine power", source="[1] Table 1", positive=True)

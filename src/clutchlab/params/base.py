@@ -26,7 +26,8 @@ _REGISTERED: list[type] = []
 
 
 def quantity(default, unit: str, doc: str, *, source: str = "", positive: bool = False,
-             nonnegative: bool = False, bounds: tuple[float | None, float | None] = (None, None)):
+             nonnegative: bool = False, bounds: tuple[float | None, float | None] = (None, None),
+             reference: bool = False):
     """Declare a parameter field with its SI unit and documentation.
 
     Parameters
@@ -45,11 +46,22 @@ def quantity(default, unit: str, doc: str, *, source: str = "", positive: bool =
         Optional inclusive bounds checked on construction.  Without them the
         magnitude must not exceed the plausibility limit of the unit
         (:data:`PLAUSIBLE_LIMITS`, else :data:`MAGNITUDE_LIMIT`).
+    reference : bool
+        A number of the paper's tables that the model's equations do not read (a core disk's thickness beside
+        its mass): kept in the set and its files for the record, but no parameter of an FMU, a sweep or a
+        network (:func:`is_reference`), where changing it would change nothing.
     """
-    meta = dict(unit=unit, doc=doc, source=source, positive=positive, nonnegative=nonnegative, bounds=bounds)
+    meta = dict(unit=unit, doc=doc, source=source, positive=positive, nonnegative=nonnegative, bounds=bounds,
+                reference=reference)
     if isinstance(default, (list, tuple)):
         default = tuple(float(v) for v in default)
     return dataclasses.field(default=default, metadata=meta)
+
+
+def is_reference(field) -> bool:
+    """Whether a parameter-set field (a :class:`dataclasses.Field`) is a reference number the model does not read
+    (:func:`quantity`'s ``reference``)."""
+    return bool(field.metadata.get("reference", False))
 
 
 #: Largest magnitude [SI] a parameter of each unit may have: generous limits for the clutches and

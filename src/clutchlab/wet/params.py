@@ -69,7 +69,8 @@ class WetClutch(ParameterSet):
     n_c: int = quantity(8, "1", "number of clutches N_c", source=T1, positive=True)
     r_outer: float = quantity(_RO, "m", "outer radius of the clutch disk R_o", source=T1, positive=True)
     r_inner: float = quantity(_RI, "m", "inner radius of the clutch disk R_i", source=T1, positive=True)
-    core_thickness: float = quantity(1.7e-3, "m", "core disk thickness", source=T1, positive=True)
+    core_thickness: float = quantity(1.7e-3, "m", "core disk thickness (for the record: the model reads the core's "
+                                     "mass, m_core)", source=T1, positive=True, reference=True)
     sigma: float = quantity(6e-4, "m", "RMS roughness of the friction material sigma", source=T1, positive=True)
     asperity_radius: float = quantity(5e-4, "m", "asperity tip radius beta", source=T1, positive=True)
     mu_v1: float = quantity(0.1502, "Pa*s", "viscosity parameter mu_v1 (Eq. 7)", source=T1, positive=True)

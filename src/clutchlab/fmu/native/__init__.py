@@ -538,7 +538,14 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
     system = simulation.system
     fixed_step = float(simulation.fixed_step)
     variables = []
+    # a parameter whose change reaches no number of the model (an engine's idle gains where it has no idle
+    # controller): left out of the FMU, where a host's value would change nothing (the grid parameter the FMU's
+    # own step logic reads stays)
+    idle = [v.name for v in cls.parameters
+            if all(m.get(v.name) == () for m in where) and v.name != cls.step_grid_parameter]
     for v in cls.parameters:
+        if v.name in idle:
+            continue
         writable = all(m.get(v.name) is not None for m in where)
         whole = False
         if writable and float(v.start).is_integer():
@@ -642,5 +649,6 @@ def export_native_fmu(cls, path, *, overwrite: bool = False, platforms=None, nam
         kind = "co-simulation and model exchange" if exchange else "co-simulation"
         report(f"native FMU {ident} ({', '.join(platforms)}; FMI {fmi_version} {kind}): "
                f"{len(cls.inputs)} inputs, {len(cls.outputs)} outputs, "
-               f"{len(cls.parameters) - n_fixed} parameters ({n_fixed} fixed at export)")
+               f"{sum(v['kind'] == _PARAMETER for v in variables)} parameters ({n_fixed} fixed at export)"
+               + (f"; left out, changing nothing in this model: {', '.join(idle)}" if idle else ""))
     return atomic_write_bytes(path, buf.getvalue(), overwrite=overwrite)
