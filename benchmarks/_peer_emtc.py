@@ -40,7 +40,7 @@ import numba
 import numpy as np
 from numba import types
 
-from clutchlab.hysteresis import _kernels as K
+from clutchlab.hysteresis import kernels as K
 
 
 

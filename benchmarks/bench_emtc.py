@@ -34,7 +34,7 @@ from scipy.integrate import solve_ivp
 from clutchlab.emtc import ActuatorParameters, BenchScenario, CouplingGeometry, VehicleParameters, TorqueMap, bundled_magnet, simulate_bench
 from clutchlab.emtc import bench_system
 from clutchlab.emtc.system import ATOL
-from clutchlab.hysteresis import _kernels as K
+from clutchlab.hysteresis import kernels as K
 from clutchlab.system import simulate as core_simulate
 
 

@@ -50,7 +50,7 @@ from scipy.integrate import solve_ivp  # noqa: E402
 from clutchlab.emtc import (ActuatorParameters, BenchScenario, CouplingGeometry, TorqueMap,  # noqa: E402
                             VehicleParameters, bench_system, bundled_magnet, simulate_bench)
 from clutchlab.emtc.system import ATOL  # noqa: E402
-from clutchlab.hysteresis import _kernels as K  # noqa: E402
+from clutchlab.hysteresis import kernels as K  # noqa: E402
 from clutchlab.system import simulate as core_simulate  # noqa: E402
 
 SCENARIO = dict(duration=1.0, speed_difference=0.3, throttle_start=0.1, throttle_end=0.6, ramp_start=0.1,

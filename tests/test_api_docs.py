@@ -84,7 +84,7 @@ def test_api_pages_document_only_public_api():
 
 
 @pytest.mark.parametrize("module", ["clutchlab.driveline.kernel", "clutchlab.numerics.dopri",
-                                    "clutchlab.numerics.rosenbrock", "clutchlab.hysteresis._kernels"])
+                                    "clutchlab.numerics.rosenbrock", "clutchlab.hysteresis.kernels"])
 def test_compiled_internals_are_recognised(module):
     """The check above knows a kernel module when it sees one (else it could not fail)."""
     import api_pages

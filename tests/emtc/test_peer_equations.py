@@ -23,7 +23,7 @@ from hypothesis_budget import examples
 
 from clutchlab.emtc import ActuatorParameters, BenchScenario, bench_system, bundled_magnet
 from clutchlab.emtc import system as S
-from clutchlab.hysteresis import _kernels as K
+from clutchlab.hysteresis import kernels as K
 from clutchlab.system import evaluate
 
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks"

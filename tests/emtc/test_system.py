@@ -223,7 +223,7 @@ def test_the_start_derives_the_vehicle_and_actuator_numbers_the_packing_derived(
     assert a["inv_tau1"] == 1.0 / act.tau1 and a["inv_tau2"] == 1.0 / act.tau2
     # the controller's table: the calibration tables' C1 airgap reading at d - sigma = 0.55 mm (between the
     # calibration airgaps 0.4 and 0.6 mm: the quadratics through 0.2-0.6 and 0.4-0.8 mm blended linearly,
-    # hysteresis._kernels.gap_weights), lower triangle
+    # hysteresis.kernels.gap_weights), lower triangle
     gaps, tables = magnet.airgaps, magnet.kernel_tables
     gap, j = 0.55e-3, 1
     assert gaps[j] < gap < gaps[j + 1]

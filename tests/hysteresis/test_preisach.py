@@ -282,7 +282,7 @@ def test_airgap_weights_refuse_arrays_too_short_for_four_tables():
     """A caller sized for the three tables of the reading before the twenty-fifth session (a benchmark did) gets
     NaN weights, and nothing is written past its arrays (compiled code does not check bounds: the writes past
     their end had corrupted memory).  Arrays of GAP_TABLES get finite weights that sum to one."""
-    from clutchlab.hysteresis import _kernels as K
+    from clutchlab.hysteresis import kernels as K
 
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.4]) * 1e-3
     guard = np.full(8, 7.0)
@@ -366,7 +366,7 @@ def test_json_roundtrip(tmp_path):
        gap=st.floats(0.2e-3, 1.0e-3))
 def test_peek_with_combined_airgap_table_equals_weighted_peek(history, v, gap):
     """The compiled bench evaluates the family through one airgap-combined table (linearity of Eqs. 2-5)."""
-    from clutchlab.hysteresis import _kernels as K
+    from clutchlab.hysteresis import kernels as K
 
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
     fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
@@ -390,7 +390,7 @@ def test_peek_segment_is_the_combined_peek_on_its_whole_stretch(history, v, gap,
     """:func:`peek_segment` (the drum bench's stage evaluations while the armature rests on a stop): the
     quadratic it returns for the stretch around ``v`` equals the combined-table peek at ``v`` and at any input
     strictly inside that stretch, for any memory."""
-    from clutchlab.hysteresis import _kernels as K
+    from clutchlab.hysteresis import kernels as K
 
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
     fam = Preisach(GRID, np.array([random_table(s) * (1 + s) for s in range(5)]), gaps)
@@ -445,7 +445,7 @@ def test_invert_combined_is_invert_one_along_a_command_sequence(history, targets
     """:func:`invert_combined` (the drum bench's controller, one combined table, its rising stretch kept between
     samples) gives the inverse of :func:`invert_one` at every sample of a sequence of targets committed one
     after the other (mostly rising ones with ``rising``: the stretch is reused), to rounding."""
-    from clutchlab.hysteresis import _kernels as K
+    from clutchlab.hysteresis import kernels as K
 
     gaps = np.array([0.2, 0.4, 0.6, 0.8, 1.0]) * 1e-3
     fam = Preisach(GRID, np.array([np.maximum.accumulate(np.maximum.accumulate(random_table(s), 0), 1) * (1 + s)

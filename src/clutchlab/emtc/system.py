@@ -25,7 +25,7 @@ Hybrid structure:
   the same instants;
 * the plant magnet's hysteresis memory and the LuGre bristle state are committed once per accepted step
   (:func:`_accept`, or at an event before the mode changes), never inside the stages: stages evaluate the
-  magnet with :func:`~clutchlab.hysteresis._kernels.peek_segment` (:func:`~clutchlab.hysteresis._kernels.peek`
+  magnet with :func:`~clutchlab.hysteresis.kernels.peek_segment` (:func:`~clutchlab.hysteresis.kernels.peek`
   while the armature moves) and advance the bristles from their committed value along the slip's path from
   the step's start (:func:`~clutchlab.emtc.friction.lugre_advance_path`, anchored by :func:`_anchor_bristles`);
 * a full hysteresis memory is a model error (codes in :data:`ERROR_MESSAGES`), not a solver status.
@@ -49,7 +49,7 @@ import numpy as np
 from numba.core import types
 
 from ..errors import ParameterError, SimulationError
-from ..hysteresis._kernels import (GAP_TABLES, combine_tables, commit, gap_weights, invert_combined, invert_one,
+from ..hysteresis.kernels import (GAP_TABLES, combine_tables, commit, gap_weights, invert_combined, invert_one,
                                    peek, peek_segment)
 from ..numerics import FASTMATH, dispatch
 from ..numerics.borrow import ByRef, borrow, byref, shaped
@@ -200,9 +200,9 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              ("moving_weights", GAP_TABLES),      # airgap weights of the plant tables at the last evaluation, moving
              ("plant_segment", 9),        # the plant magnet's force as a quadratic in the coil current on the
              #                              stretch of the last evaluation (lo, hi, a0, a1, a2, kind:
-             #                              hysteresis._kernels.peek_segment), the stack version (IM_PVER), last
+             #                              hysteresis.kernels.peek_segment), the stack version (IM_PVER), last
              #                              input and airgap it is for
-             ("controller_segment", 8))   # the controller model's rising stretch (hysteresis._kernels.invert_combined)
+             ("controller_segment", 8))   # the controller model's rising stretch (hysteresis.kernels.invert_combined)
 (FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_DVLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
  FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(
     "plant_input", "controller_input", "command", "torque_reference", "feasible", "z", "t_last", "dw_last",
@@ -570,7 +570,7 @@ def _commit(t, x, p):
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
 def _stack_stays(stack, length, u, v):
     """True if moving a hysteresis memory from input ``u`` to ``v`` leaves its stack as it is (no turning point
-    pushed, nothing wiped: :func:`~clutchlab.hysteresis._kernels.commit` would only move the last input)."""
+    pushed, nothing wiped: :func:`~clutchlab.hysteresis.kernels.commit` would only move the last input)."""
     if v > u:
         return length % 2 == 0 and (length < 2 or v < stack[length - 2])
     if v < u:
@@ -659,7 +659,7 @@ def _magnet_force(p, moving, gap, icoil):
     ``moving``: the armature is free, another airgap at every stage: the weighted output of the
     calibration tables around it (building the weighted cell table would cost more than the evaluation).  At a stop the
     airgap stays: the weighted cell table is built once per stop (Eqs. 2-5 are linear in it) and the stretch
-    of :func:`~clutchlab.hysteresis._kernels.peek_segment` around ``icoil`` is kept with the stack version,
+    of :func:`~clutchlab.hysteresis.kernels.peek_segment` around ``icoil`` is kept with the stack version,
     last input and airgap it is for.
     """
     fmem = p.fmem
@@ -1111,7 +1111,7 @@ def derive_actuator(actuator, cold, layout, table):
     ``actuator[0]`` (:data:`ACTUATOR_DTYPE`): the current lags' rates, and into ``table`` (``(1, N, N, 4)``,
     ``EmtcParams.controller_table``) the controller model's cell coefficients at its one airgap, the engaged
     ``d - sigma`` ([1], Eq. 12), interpolated over its calibration airgaps (Eqs. 2-5 are linear in the table:
-    :func:`~clutchlab.hysteresis._kernels.gap_weights`, :func:`~clutchlab.hysteresis._kernels.combine_tables`),
+    :func:`~clutchlab.hysteresis.kernels.gap_weights`, :func:`~clutchlab.hysteresis.kernels.combine_tables`),
     from the tables packed in ``cold`` (``controller_all_tables``, ``controller_gaps``; ``layout``:
     ``EmtcParams.layout``).  Called by the packing and by every run's start (:func:`emtc_start`).
 

@@ -10,7 +10,7 @@ beta), Eqs. 2-3, interpolated between grid points by Eqs. 4-5.  The inverse
 hysteresis compensation, Fig. 7).  One table per calibration airgap, with
 second-order polynomial interpolation between them ([1], Sec. 2.1): the two
 quadratics of an interval blended linearly across it, continuous with its
-slope (:func:`~clutchlab.hysteresis._kernels.gap_weights`); the hysteresis
+slope (:func:`~clutchlab.hysteresis.kernels.gap_weights`); the hysteresis
 memory is in the current only.
 
 References
@@ -39,7 +39,7 @@ from ..params.base import PLAUSIBLE_LIMITS
 FORCE_LIMIT_N = PLAUSIBLE_LIMITS["N"][0]
 #: The largest air gap [m]: an electromagnet's gap is millimetres; a metre is a slip of unit
 GAP_LIMIT_M = 1.0
-from . import _kernels as K
+from . import kernels as K
 
 __all__ = ["Preisach", "PreisachState", "InverseResult", "forc_table_from_masses"]
 
