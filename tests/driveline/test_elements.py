@@ -408,8 +408,8 @@ def test_the_start_derives_the_speeds_left_out_as_the_build_does(d):
 
     system = d.system(1e-8)
     x0 = system.x0.copy()
-    n = len(d._inertias)
-    derived = [list(d._inertias).index(nm) for nm in d.derived_speeds()]
+    n = len(d.inertia_names)
+    derived = [d.inertia_names.index(nm) for nm in d.derived_speeds()]
     words = [w for where, w, _ in system.decided_at_start if where == "x"]
     x = x0.copy()
     x[words] = np.nan

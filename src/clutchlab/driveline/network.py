@@ -1668,6 +1668,12 @@ class Driveline:
         return tuple(e.name for e in self._elements if e.kind == K.K_FRICTION)
 
     @property
+    def inertia_names(self) -> tuple:
+        """The inertias' (masses') names in the order they were added: the order of their angles, then their
+        speeds, at the head of the state vector."""
+        return tuple(self._inertias)
+
+    @property
     def elements(self) -> tuple:
         """The network's elements in the order they were added, each an :class:`ElementInfo` (name, kind,
         flanges, a gear's support, its :meth:`describe` line): a read-only view; change a network through its
