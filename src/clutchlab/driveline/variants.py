@@ -248,9 +248,7 @@ class DrivelineDocument:
 
     def _set_parameters(self) -> dict:
         """name -> (Parameter, (kind, component, set, set field)) of the parameter sets' numeric fields."""
-        import dataclasses
-
-        from ..params.base import field_range, is_reference
+        from ..params.base import field_range, model_fields
         from .components import parameter_sets
 
         out = {}
@@ -270,9 +268,9 @@ class DrivelineDocument:
                                                      None))
                     else:
                         continue   # (the loader names the error)
-                    for f in dataclasses.fields(src.cls):
+                    for f in model_fields(src.cls):
                         v = getattr(instance, f.name)
-                        if (f.name in src.unread or "unit" not in f.metadata or isinstance(v, bool) or is_reference(f)
+                        if (f.name in src.unread or isinstance(v, bool)
                                 or not isinstance(v, (int, float))):
                             continue
                         name = f"{component}.{src.name}.{f.name}"

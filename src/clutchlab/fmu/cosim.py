@@ -42,7 +42,7 @@ import numpy as np
 
 from ..errors import ParameterError, SimulationError
 from ..component import range_problem, range_text
-from ..params.base import field_range, is_reference
+from ..params.base import field_range, model_fields
 from .registry import COSIMULATIONS
 
 __all__ = [
@@ -342,8 +342,8 @@ def parameter_set_variables(prefix: str, cls, skip=()) -> tuple:
     """
     out = []
     default = cls()
-    for f in dataclasses.fields(cls):
-        if f.name in skip or "unit" not in f.metadata or is_reference(f):   # (a number the model does not read)
+    for f in model_fields(cls):
+        if f.name in skip:
             continue
         value = getattr(default, f.name)
         unit = fmi_unit(f.metadata["unit"])
@@ -426,8 +426,8 @@ def build_parameter_set(prefix: str, cls, values: dict, skip=()):
     """
     default = cls()
     kwargs = {}
-    for f in dataclasses.fields(cls):
-        if f.name in skip or "unit" not in f.metadata or is_reference(f):   # (no variable: its default)
+    for f in model_fields(cls):   # (a reference number has no variable: it keeps its default)
+        if f.name in skip:
             continue
         dv = getattr(default, f.name)
         if isinstance(dv, tuple):

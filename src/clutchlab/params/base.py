@@ -64,6 +64,13 @@ def is_reference(field) -> bool:
     return bool(field.metadata.get("reference", False))
 
 
+def model_fields(cls) -> tuple:
+    """The fields of a :class:`ParameterSet` class (or instance) that a model reads: those declared with
+    :func:`quantity` (a unit), less the reference numbers (:func:`is_reference`).  The parameters an FMU, a sweep
+    and a network take from a set are these."""
+    return tuple(f for f in dataclasses.fields(cls) if "unit" in f.metadata and not is_reference(f))
+
+
 #: Largest magnitude [SI] a parameter of each unit may have: generous limits for the clutches and
 #: drivelines of road vehicles (a factor of 10-1000 above the largest value any model uses), so a
 #: slip of the unit or the exponent (``r_outer = 1e300``, ``"83 km"``) is refused on construction

@@ -37,6 +37,7 @@ import pandas as pd
 
 from ..errors import ParameterError
 from ..numerics.status import Status
+from ..params.base import model_fields
 from ..sweep.targets import check_outputs
 from ..system import simulate_batch
 from ..eclutch.actuator import ActuatorParameters
@@ -77,9 +78,8 @@ def describe(scenario) -> dict:
     _scenario(scenario)
     params = {}
     for prefix, cls, _ in _SETS:
-        for f in dataclasses.fields(cls):
-            if "unit" in f.metadata:
-                params[f"{prefix}.{f.name}"] = f.metadata["unit"]
+        for f in model_fields(cls):
+            params[f"{prefix}.{f.name}"] = f.metadata["unit"]
     return {"parameters": params, "outputs": dict(OUTPUTS)}
 
 

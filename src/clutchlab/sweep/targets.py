@@ -59,7 +59,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ClutchlabError, ParameterError
-from ..params.base import is_reference
+from ..params.base import model_fields
 
 __all__ = ["BUILTIN", "ENTRY_POINT_GROUP", "Target", "TargetInfo", "available_targets", "register_target",
            "unregister_target", "resolve_target", "file_digest", "files_in", "sweepable_fields", "vary_parameter_set"]
@@ -380,8 +380,8 @@ def sweepable_fields(prefix: str, cls) -> dict[str, str]:
         A :class:`~clutchlab.params.ParameterSet` subclass; tuple-valued fields are left out.
     """
     out = {}
-    for f in dataclasses.fields(cls):
-        if "unit" not in f.metadata or isinstance(f.default, tuple) or is_reference(f):   # (not read by the model)
+    for f in model_fields(cls):
+        if isinstance(f.default, tuple):
             continue
         out[f"{prefix}.{f.name}"] = f.metadata["unit"]
     return out
