@@ -62,24 +62,39 @@ def guard_stale_indexes() -> None:
     Can't get attribute 'VehicleData' on <module 'clutchlab.emtc.system'>`` after an upgrade over an existing cache
     (an editable install after a pull, ``NUMBA_CACHE_DIR`` kept across versions; found when the EMTC's vehicle
     record replaced its NamedTuple).  Such an index is now a miss: numba compiles the function again and writes a
-    fresh index over it.  Applies to every numba cache of the process, which gains the same robustness."""
+    fresh index over it.  The same for a cached function's data (``IndexDataCacheFile.load``): a function whose own
+    file is unchanged keeps its index, and its data names the modules of the compiled functions it calls, whose
+    environments numba rebuilds by importing them; a module an upgrade renamed raised ``ModuleNotFoundError: No
+    module named 'clutchlab.hysteresis._kernels'`` (found when the Preisach kernels became
+    ``clutchlab.hysteresis.kernels``: the wet clutch's network function, in an unchanged file, called them).  Such
+    data is now a miss too.  Applies to every numba cache of the process, which gains the same robustness."""
     import pickle
 
     from numba.core import caching
 
-    load = caching.IndexDataCacheFile._load_index
-    if getattr(load, "_clutchlab_guard", False):
+    load_index = caching.IndexDataCacheFile._load_index
+    if getattr(load_index, "_clutchlab_guard", False):
         return
+    load = caching.IndexDataCacheFile.load
+    stale = (AttributeError, ImportError, pickle.UnpicklingError, EOFError, IndexError, TypeError, ValueError)
 
     def _load_index(self):
         try:
-            return load(self)
-        except (AttributeError, ImportError, pickle.UnpicklingError, EOFError, IndexError, TypeError, ValueError):
+            return load_index(self)
+        except stale:
             return {}   # (an index of classes that no longer exist: stale, compiled again and overwritten)
 
+    def _load(self, key):
+        try:
+            return load(self, key)
+        except stale:
+            return None   # (data naming a module or class that no longer exists: compiled again and overwritten)
+
     _load_index._clutchlab_guard = True
-    _load_index.__doc__ = load.__doc__
+    _load_index.__doc__ = load_index.__doc__
+    _load.__doc__ = load.__doc__
     caching.IndexDataCacheFile._load_index = _load_index
+    caching.IndexDataCacheFile.load = _load
 
 
 def _private_folder(path: Path) -> str:

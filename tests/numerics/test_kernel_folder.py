@@ -91,3 +91,40 @@ def test_a_cache_index_naming_a_class_an_upgrade_removed_is_compiled_again(tmp_p
     assert guarded.returncode == 0 and guarded.stdout.split() == ["19.6133"], guarded.stderr[-2000:]
     again = run("")   # (the fresh index written over the stale one: numba alone reads it now)
     assert again.returncode == 0, again.stderr[-2000:]
+
+
+_INNER = ("import numba\nimport numpy as np\nTABLE = np.array([1.0, 2.0])\n\n\n@numba.njit(cache=True)\ndef h(x):\n"
+          "    if x < 0:\n        raise ValueError('negative')\n    return x * TABLE[1]\n")
+_HELPERS = "import numba\nfrom {inner} import h\n\n\n@numba.njit(cache=True)\ndef g(x):\n    return h(x) + 1.0\n"
+_CALLER = ("import numba\nfrom helpers import g\n\n\n@numba.njit(cache=True)\ndef weight(x):\n    return g(x) * 2.0\n\n\n"
+           "print(weight(2.0))\n")
+
+
+def test_cached_data_naming_a_module_an_upgrade_renamed_is_compiled_again(tmp_path):
+    """A cached function whose own file did not change keeps its index, but its data names the modules of the
+    compiled functions it calls (numba rebuilds their environments by importing them): after
+    ``clutchlab.hysteresis._kernels`` became ``clutchlab.hysteresis.kernels``, the wet clutch's network function
+    raised ``ModuleNotFoundError`` from an existing cache.  With clutchlab imported such data is a miss: the
+    function compiles again and runs.  Without it the same cache fails (so the test can fail)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "inner.py").write_text(_INNER)
+    (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner"))
+    (tmp_path / "kernel.py").write_text(_CALLER)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+
+    def run(head):
+        return subprocess.run([sys.executable, "-c", head + "import kernel"], capture_output=True, text=True,
+                              env=env, cwd=tmp_path, timeout=300)
+
+    first = run("")
+    assert first.returncode == 0 and first.stdout.split() == ["10.0"], first.stderr[-2000:]
+    (tmp_path / "inner.py").rename(tmp_path / "inner2.py")   # the upgrade: the callee's module renamed
+    (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner2"))
+    plain = run("")
+    assert plain.returncode != 0 and "No module named 'inner'" in plain.stderr, plain.stderr[-2000:]
+    guarded = run("import clutchlab.numerics\n")
+    assert guarded.returncode == 0 and guarded.stdout.split() == ["10.0"], guarded.stderr[-2000:]
+    again = run("")   # (the fresh data written over the stale one: numba alone reads it now)
+    assert again.returncode == 0 and again.stdout.split() == ["10.0"], again.stderr[-2000:]
