@@ -64,33 +64,52 @@ _KERNEL = ("import numba\nfrom records import {cls}\n\n\n@numba.njit(cache=True)
            "    return v.mass * 9.80665\n\n\nprint(weight({cls}(2.0)))\n")
 
 
+def _importer(folder):
+    """``run(head)``: a fresh Python that runs ``head`` and then imports ``kernel`` from ``folder``, with its own
+    numba cache there."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "cache"), PYTHONPATH=str(folder))
+
+    def run(head):
+        return subprocess.run([sys.executable, "-c", head + "import kernel"], capture_output=True, text=True,
+                              env=env, cwd=folder, timeout=300)
+
+    run.folder = folder
+    return run
+
+
+def _stale_then_compiled_again(run, upgrade, printed, failure):
+    """The kernel runs and caches; after ``upgrade`` plain numba fails on the cache with ``failure``, with clutchlab
+    imported it compiles again and prints ``printed``, and then numba alone reads the fresh cache."""
+    first = run("")
+    assert first.returncode == 0 and first.stdout.split() == [printed], first.stderr[-2000:]
+    assert list(run.folder.joinpath("cache").rglob("*.nbi"))   # (the index written)
+    upgrade()
+    plain = run("")
+    assert plain.returncode != 0 and failure in plain.stderr, plain.stderr[-2000:]
+    guarded = run("import clutchlab.numerics\n")
+    assert guarded.returncode == 0 and guarded.stdout.split() == [printed], guarded.stderr[-2000:]
+    again = run("")   # (the fresh cache written over the stale one: numba alone reads it now)
+    assert again.returncode == 0 and again.stdout.split() == [printed], again.stderr[-2000:]
+
+
 def test_a_cache_index_naming_a_class_an_upgrade_removed_is_compiled_again(tmp_path):
     """numba unpickles a cached function's index before it compares the source's stamp, so an index an older
     version wrote naming a class since renamed raised ``AttributeError: Can't get attribute ...`` (an upgrade over
     an existing cache; the EMTC's ``VehicleData`` became a record).  With clutchlab imported the stale index is a
     miss: the function compiles again and runs.  Without it the same cache fails (so the test can fail)."""
-    import subprocess
-    import sys
-
     (tmp_path / "records.py").write_text(_RECORDS_V1)
     (tmp_path / "kernel.py").write_text(_KERNEL.format(cls="VehicleData"))
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    run = _importer(tmp_path)
 
-    def run(head):
-        return subprocess.run([sys.executable, "-c", head + "import kernel"], capture_output=True, text=True,
-                              env=env, cwd=tmp_path, timeout=300)
 
-    first = run("")
-    assert first.returncode == 0 and first.stdout.split() == ["19.6133"], first.stderr[-2000:]
-    assert list((tmp_path / "cache").rglob("*.nbi"))   # (the index written)
-    (tmp_path / "records.py").write_text(_RECORDS_V2)   # the upgrade: the class renamed, the kernel with it
-    (tmp_path / "kernel.py").write_text(_KERNEL.format(cls="Vehicle"))
-    plain = run("")
-    assert plain.returncode != 0 and "Can't get attribute 'VehicleData'" in plain.stderr, plain.stderr[-2000:]
-    guarded = run("import clutchlab.numerics\n")
-    assert guarded.returncode == 0 and guarded.stdout.split() == ["19.6133"], guarded.stderr[-2000:]
-    again = run("")   # (the fresh index written over the stale one: numba alone reads it now)
-    assert again.returncode == 0, again.stderr[-2000:]
+    def upgrade():   # the class renamed, the kernel with it
+        (tmp_path / "records.py").write_text(_RECORDS_V2)
+        (tmp_path / "kernel.py").write_text(_KERNEL.format(cls="Vehicle"))
+
+    _stale_then_compiled_again(run, upgrade, "19.6133", "Can't get attribute 'VehicleData'")
 
 
 _INNER = ("import numba\nimport numpy as np\nTABLE = np.array([1.0, 2.0])\n\n\n@numba.njit(cache=True)\ndef h(x):\n"
@@ -106,25 +125,14 @@ def test_cached_data_naming_a_module_an_upgrade_renamed_is_compiled_again(tmp_pa
     ``clutchlab.hysteresis._kernels`` became ``clutchlab.hysteresis.kernels``, the wet clutch's network function
     raised ``ModuleNotFoundError`` from an existing cache.  With clutchlab imported such data is a miss: the
     function compiles again and runs.  Without it the same cache fails (so the test can fail)."""
-    import subprocess
-    import sys
-
     (tmp_path / "inner.py").write_text(_INNER)
     (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner"))
     (tmp_path / "kernel.py").write_text(_CALLER)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    run = _importer(tmp_path)
 
-    def run(head):
-        return subprocess.run([sys.executable, "-c", head + "import kernel"], capture_output=True, text=True,
-                              env=env, cwd=tmp_path, timeout=300)
 
-    first = run("")
-    assert first.returncode == 0 and first.stdout.split() == ["10.0"], first.stderr[-2000:]
-    (tmp_path / "inner.py").rename(tmp_path / "inner2.py")   # the upgrade: the callee's module renamed
-    (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner2"))
-    plain = run("")
-    assert plain.returncode != 0 and "No module named 'inner'" in plain.stderr, plain.stderr[-2000:]
-    guarded = run("import clutchlab.numerics\n")
-    assert guarded.returncode == 0 and guarded.stdout.split() == ["10.0"], guarded.stderr[-2000:]
-    again = run("")   # (the fresh data written over the stale one: numba alone reads it now)
-    assert again.returncode == 0 and again.stdout.split() == ["10.0"], again.stderr[-2000:]
+    def upgrade():   # the callee's module renamed, the caller's file unchanged
+        (tmp_path / "inner.py").rename(tmp_path / "inner2.py")
+        (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner2"))
+
+    _stale_then_compiled_again(run, upgrade, "10.0", "No module named 'inner'")
