@@ -16,6 +16,7 @@ result again from its columns, by code written here.  The closed forms are deriv
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -816,11 +817,13 @@ def test_an_unrelated_event_does_not_search_a_held_network_again(unrelated):
         assert [e for e in both if not e[1].startswith("U")] == []
 
 
-def _loop_group_holds(t):
+def _loop_group_holds(t, bearing2=0.0):
     """Independent of the kernel: whether the rigid loop of :func:`test_a_statically_indeterminate_loop_holds_while_any_split_holds`,
     every member stuck and every inertia at rest, has a split of its torques within every member's bounds at ``t``
-    (SciPy's HiGHS on the static balance of the four inertias).  Unknowns: the one-way clutch's torque ``f0`` (its
-    multiplier: ``-f0`` on J1, at most its clutch's 0.5 N m overrunning, any locking), each gear's torque on its
+    (SciPy's HiGHS on the static balance of the four inertias); ``bearing2`` > 0: with a second bearing friction of
+    that torque on J2 (:func:`test_a_loop_with_four_null_directions_holds_while_any_split_holds`).  Unknowns: the
+    one-way clutch's torque ``f0`` (its multiplier: ``-f0`` on J1, at most its clutch's 0.5 N m overrunning, any
+    locking), the second bearing's, each gear's torque on its
     flange-a inertia ``lg = -T_a`` and the loss torque ``L`` it holds (MSL ``LossyGear``: ``flange_b.tau = -ratio
     (flange_a.tau - tauLoss)``), the loop clutch's (1.5 N m) and the bearing's (1 N m).  A stuck gear's ``L`` lies
     between MSL's ``tauLossMin_m`` and ``tauLossMax_p`` at ``w_a = 0``: the upper edge the larger of
@@ -836,24 +839,25 @@ def _loop_group_holds(t):
 
     t1 = 3.0 * math.sin(2 * math.pi * t)
     r1, r2 = -1.0, -3.0
-    # columns f0, lg1, L1, lg2, L2, loop, bearing; rows: the torque balance of J0..J3 at rest
-    a_eq = np.array([[1, 0, 0, 0, 0, 1, -1], [-1, 1, 0, 0, 0, 0, 0], [0, -r1, -r1, 1, 0, 0, 0],
-                     [0, 0, 0, -r2, -r2, -1, 0]], dtype=float)
+    # columns f0, lg1, L1, lg2, L2, loop, bearing, bearing2; rows: the torque balance of J0..J3 at rest
+    a_eq = np.array([[1, 0, 0, 0, 0, 1, -1, 0], [-1, 1, 0, 0, 0, 0, 0, 0], [0, -r1, -r1, 1, 0, 0, 0, -1],
+                     [0, 0, 0, -r2, -r2, -1, 0, 0]], dtype=float)
     b_eq = np.array([0.0, -t1, 0.0, 0.0])
-    bounds = [(None, 0.5), (None, None), (None, None), (None, None), (None, None), (-1.5, 1.5), (-1.0, 1.0)]
+    bounds = [(None, 0.5), (None, None), (None, None), (None, None), (None, None), (-1.5, 1.5), (-1.0, 1.0),
+              (-bearing2, bearing2)]
     gears = ((1, 2, lines(1.0, 0.5, 0.5, 0.0)), (3, 4, lines(0.25, 0.25, 0.0, 0.0)))
     for pieces in itertools.product(range(2), repeat=4):
         a_ub, b_ub = [], []
         for (lg, hold, (up, lo)), u, d in zip(gears, pieces[::2], pieces[1::2]):
-            row = np.zeros(7)
+            row = np.zeros(8)
             row[hold], row[lg] = 1.0, up[u][0]       # L <= s T_a + c, T_a = -lg
             a_ub.append(row)
             b_ub.append(up[u][1])
-            row = np.zeros(7)
+            row = np.zeros(8)
             row[hold], row[lg] = -1.0, -lo[d][0]     # L >= s T_a + c
             a_ub.append(row)
             b_ub.append(-lo[d][1])
-        if linprog(np.zeros(7), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
+        if linprog(np.zeros(8), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
                    method="highs").status == 0:
             return True
     return False
@@ -894,6 +898,41 @@ def test_a_statically_indeterminate_loop_holds_while_any_split_holds():
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if _loop_group_holds(mid) else (lo, mid)
     assert abs(slip[0] - hi) < 1e-6, (slip[0], hi)
+
+
+def _edge(holds, lo, hi):
+    """The instant in ``(lo, hi)`` where ``holds`` turns False (bisection to 1e-13 s)."""
+    assert holds(lo) and not holds(hi), (lo, hi)
+    for _ in range(45):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+    return hi
+
+
+def test_a_loop_with_four_null_directions_holds_while_any_split_holds():
+    """The rigid loop of :func:`test_a_statically_indeterminate_loop_holds_while_any_split_holds` with a second
+    bearing friction (0.05 N m) on J2: from rest, eight stuck members on four inertias, a null space of four
+    dimensions.  Before, the repair over several null directions stopped at three (``kernel._repair_space``) and
+    the regularised split stood: the one-way clutch was "overloaded" at 0.0348 s and released while a split within
+    every member's bounds held the loop until 0.1197 s (SciPy's HiGHS); the run then went its own way (a gear
+    rolling backward at 0.615 s for the 0.3 N m bearing, whose loop HiGHS finds held throughout).  Now the loop
+    holds from rest to the instant HiGHS finds no split, slips there, sticks again, and its second slip (0.7143 s)
+    is HiGHS's too, within 1e-6 s, at two tolerances, with the invariant check on."""
+    d = indeterminate_loop()
+    d.bearing_friction("bearing2", "J2", torque=0.05, peak=1.0)
+    runs = {rtol: d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True) for rtol in (1e-8, 1e-10)}
+    events = {rtol: _mode_events(r) for rtol, r in runs.items()}
+    assert [e[1:] for e in events[1e-8]] == [e[1:] for e in events[1e-10]]
+    assert max(abs(a[0] - b[0]) for a, b in zip(events[1e-8], events[1e-10])) < 1e-6
+    holds = functools.partial(_loop_group_holds, bearing2=0.05)
+    first, second = _edge(holds, 0.0, 0.14), _edge(holds, 0.6, 0.75)
+    ev = events[1e-10]
+    assert abs(ev[0][0] - first) < 1e-6, (ev[0], first)            # nothing moves before: the loop holds
+    assert {el for t, el, e in ev if abs(t - first) < 1e-6} == {"f0", "bearing", "bearing2", "g1", "g2"}
+    slip = [t for t, el, e in ev if el == "loop" and e == "forward"]
+    assert len(slip) == 1 and abs(slip[0] - second) < 1e-6, (slip, second)
+    stuck = [t for t, el, e in ev if el == "g1" and e == "stick"]
+    assert stuck and not any(stuck[0] + 1e-6 < t < slip[0] - 1e-6 for t, _el, _e in ev)   # held in between
 
 
 # two self-locking gears (no bearing friction in their tables) and a bearing, in a chain from rest (found by the

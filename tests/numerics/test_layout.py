@@ -34,6 +34,8 @@ NOT_INDICES = {
     "ALGEBRAIC_FAILED": "a model error code of the model exchange",
     "NEWTON_ITERATIONS": "a count: the algebraic rows' Newton iterations",
     "REFINE_MAX": "a count: the stuck set's refinements at most",
+    "ACTIVE_STEPS": "a count: the split search's simplex and active-set steps per variable and bound at most",
+    "ENUMERATED_DIMENSIONS": "a dimension: the split search enumerates up to it",
     "ORDER_EST": "a number: the local order of Rodas3's error estimate",
     "CHUNK_ROWS": "a capacity: rows of a recorded chunk",
     "FIRST_CHUNK_ROWS": "a capacity: rows of the first recorded chunk",

@@ -1013,12 +1013,23 @@ def evaluate_network(t, x, m, p, acc, tau):
     return ns
 
 
-#: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16): the
-#: bounds of its largest margin's vertex (the rank of the bounds' span, then its 4 bounds) and the active set of its
-#: nearest split (its size, then its 3 bounds)
+#: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16)
 SPACE_SLOTS = 16
-SPACE_HINT = slots(("vertex_rank", 1), ("vertex_bounds", 4), ("active_size", 1), ("active_bounds", 3)).total
-SPACE_CACHE = SPACE_SLOTS * SPACE_HINT
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def space_hint(nk):
+    """Words of one combination's warm start of :func:`_repair_space` in a network whose largest constraint set has
+    ``nk`` members (so at most ``nk`` null directions): the bounds of its largest margin's vertex (the rank of the
+    bounds' span, then up to ``nk + 1`` bounds) and the active set of its nearest split (its size, then up to ``nk``
+    bounds)."""
+    return 1 + (nk + 1) + 1 + nk
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def space_cache(nk):
+    """Words of the warm start of :func:`_repair_space`: :data:`SPACE_SLOTS` combinations of :func:`space_hint`."""
+    return SPACE_SLOTS * space_hint(nk)
 
 
 class WorkLayout(NamedTuple):
@@ -1062,7 +1073,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     :func:`signal_at`) | the last null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk,
     :func:`_null_vector_cached`) | the instant of the last stick/slip search, the event count before it and the
     friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
-    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (``SPACE_CACHE``), then whether an
+    the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (:func:`space_cache`), then whether an
     observer evaluates the network (1, :func:`observe`) | the thermal
     masses' temperatures at the last evaluation (nt, :func:`temperatures`) | sliding torque,
     static limit and lock-up limit of each clutch model, their rates and the time of those (``N_EXT`` per
@@ -1087,7 +1098,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     o_nv = o_sig + 1 + nsig
     o_inst = o_nv + 2 + nk * nk + nk
     o_sp = o_inst + 3 + nf + nl
-    o_temp = o_sp + SPACE_CACHE + 1
+    o_temp = o_sp + space_cache(nk) + 1
     o_ext = o_temp + nt
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
                       o_inst, o_sp, o_temp, o_ext)
@@ -1152,7 +1163,7 @@ def observe(p, on):
     invariant check, the margin rates' probe) or not: an observer's evaluation leaves the warm start of
     :func:`_repair_space` as it was, so that the decisions of a run do not depend on where it is sampled or whether
     it is checked."""
-    p.work[_offsets(p).sp + SPACE_CACHE] = 1.0 if on else 0.0
+    p.work[_offsets(p).sp + space_cache(_nk(p))] = 1.0 if on else 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1716,7 +1727,8 @@ SPACE_MARGIN = 1e-2
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _small_solve(M, b, k):
-    """Solve ``M[:k, :k] x = b[:k]`` in place into ``b`` (Gaussian elimination with partial pivoting, ``k <= 4``);
+    """Solve ``M[:k, :k] x = b[:k]`` in place into ``b`` (Gaussian elimination with partial pivoting; small ``k``:
+    a vertex or an active set of :func:`_repair_space`, at most one more than its null directions);
     False if the matrix is singular to 1e-12 of its largest entry."""
     big = 0.0
     for i in range(k):
@@ -1931,14 +1943,370 @@ def _margin_at(GR, w, h, nr, m, idx, M, b, y, tol):
     return -np.inf
 
 
+#: the largest dimension in which the split search enumerates its vertices and active sets where its hint fails (the
+#: search every test and thorough draw before the forty-first session was checked against: the largest margin
+#: over every vertex that keeps the bounds, which at a band of nearly zero width -- a lossy gear carrying 1e-14 N m
+#: -- is the most favourable of vertices that differ by rounding); above it the simplex and active-set methods
+#: (:func:`_lp_max`, :func:`_qp_nearest`), whose vertex there may round 1e-8 the other way
+ENUMERATED_DIMENSIONS = 3
+#: steps of :func:`_lp_max` and :func:`_qp_nearest` per variable and bound before they give up (then the vertices
+#: are enumerated): each step adds or drops one bound, so a solve takes about as many steps as it has bounds
+ACTIVE_STEPS = 8
+#: the rows of the cold solves (:func:`_row_at`): a bound's directions alone (the nearest split), with its width
+#: (the largest margin), or with a unit width for the bounds of zero width only (the margin's first phase)
+ROW_KINDS = ("plain", "width", "phase_one")
+ROWS_PLAIN, ROWS_WIDTH, ROWS_PHASE_ONE = indices(ROW_KINDS, "plain", "width", "phase_one")
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _row_at(A, wv, i, f, nc, mode):
+    """Entry ``f`` of bound ``i``'s row: ``A[i, f]`` for the ``nc`` columns of ``A``, then (``mode`` not
+    ``ROWS_PLAIN``) its width ``wv[i]``, or 1 in the first phase (:data:`ROWS_PHASE_ONE`)."""
+    if f < nc:
+        return A[i, f]
+    return wv[i] if mode == ROWS_WIDTH else 1.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _ncols(nc, mode):
+    """The rows' length (:func:`_row_at`)."""
+    return nc if mode == ROWS_PLAIN else nc + 1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _skipped(wv, i, mode):
+    """True for a bound the first phase leaves out (one of nonzero width: any margin low enough keeps it)."""
+    return mode == ROWS_PHASE_ONE and wv[i] > 0.0
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, hint, o, tol):
+def _qr(A, wv, nc, mode, W, k, Q, R):
+    """``A_W^T = Q R`` for the rows ``W[:k]`` (:func:`_row_at`): ``Q[:n, :k]`` orthonormal columns, ``R[:k, :k]``
+    upper triangular (modified Gram-Schmidt, twice).  False if a row depends on those before it (what is left of it
+    below 1e-13 of its norm).  (Not the normal equations: a lossy gear's band of nearly zero width gives two bounds
+    of nearly opposite rows, whose normal matrix is singular to rounding where their QR is not.)"""
+    n = _ncols(nc, mode)
+    for j in range(k):
+        nrm0 = 0.0
+        for f in range(n):
+            v_ = _row_at(A, wv, W[j], f, nc, mode)
+            Q[f, j] = v_
+            nrm0 += v_ * v_
+        nrm0 = math.sqrt(nrm0)
+        for i in range(k):
+            R[i, j] = 0.0
+        for _twice in range(2):
+            for i in range(j):
+                dot = 0.0
+                for f in range(n):
+                    dot += Q[f, i] * Q[f, j]
+                R[i, j] += dot
+                for f in range(n):
+                    Q[f, j] -= dot * Q[f, i]
+        nrm = 0.0
+        for f in range(n):
+            nrm += Q[f, j] * Q[f, j]
+        nrm = math.sqrt(nrm)
+        if not nrm > 1e-13 * nrm0:
+            return False
+        R[j, j] = nrm
+        for f in range(n):
+            Q[f, j] /= nrm
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _project(A, wv, nc, mode, W, k, v, p, u, Q, R):
+    """``p``: ``v`` projected onto the null space of the rows ``W[:k]`` (:func:`_row_at`), ``u`` the multipliers of
+    that projection (``v - p = A_W^T u``; where ``p`` is zero, ``v = A_W^T u``; ``v`` and ``p`` may be one array),
+    through their QR (:func:`_qr`).  False if the rows are dependent."""
+    n = _ncols(nc, mode)
+    if not _qr(A, wv, nc, mode, W, k, Q, R):
+        return False
+    for a in range(k):
+        t_ = 0.0
+        for f in range(n):
+            t_ += Q[f, a] * v[f]
+        u[a] = t_
+    for f in range(n):
+        s_ = v[f]
+        for a in range(k):
+            s_ -= Q[f, a] * u[a]
+        p[f] = s_
+    for a in range(k - 1, -1, -1):   # R u = Q^T v
+        s_ = u[a]
+        for c in range(a + 1, k):
+            s_ -= R[a, c] * u[c]
+        u[a] = s_ / R[a, a]
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _polish(A, wv, h, nc, mode, W, k, x, u, Q, R):
+    """``x`` moved onto the bounds held, ``W[:k]``, by the least correction (``x += Q y``, ``R^T y = h_W - A_W x``),
+    twice: the steps leave their rounding in ``x``, and the ratio tests read it."""
+    n = _ncols(nc, mode)
+    if k == 0 or not _qr(A, wv, nc, mode, W, k, Q, R):
+        return
+    for _twice in range(2):
+        for a in range(k):
+            s_ = h[W[a]]
+            for f in range(n):
+                s_ -= _row_at(A, wv, W[a], f, nc, mode) * x[f]
+            for c in range(a):
+                s_ -= R[c, a] * u[c]
+            u[a] = s_ / R[a, a]
+        for f in range(n):
+            for a in range(k):
+                x[f] += Q[f, a] * u[a]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _kept(A, wv, h, nc, mode, m, x, tol):
+    """True if ``x`` keeps every bound to ``tol`` and the rounding of the bounds' and the point's sizes (1e-15 of
+    them: :func:`_keeps`'s test, which the enumeration applies to its vertices; the invariant check holds a stuck
+    member to its limit within the torques' rounding)."""
+    n = _ncols(nc, mode)
+    big = 0.0
+    for i in range(m):
+        big = max(big, abs(h[i]))
+    for f in range(n):
+        big += abs(x[f])
+    for i in range(m):
+        if _skipped(wv, i, mode):
+            continue
+        v_ = 0.0
+        for f in range(n):
+            v_ += _row_at(A, wv, i, f, nc, mode) * x[f]
+        if v_ > h[i] + tol + 1e-15 * big:
+            return False
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _blocking(A, wv, h, nc, mode, m, W, k, x, p, pn):
+    """The ratio test of a step ``x + alpha p`` (``|p| = pn``) within the bounds ``row_i . x <= h_i``: the first bound
+    not in ``W[:k]`` it reaches (the lowest index among ties: Bland's rule) and ``alpha``; ``(-1, inf)`` if none
+    lies ahead."""
+    n = _ncols(nc, mode)
+    alpha = np.inf
+    j = -1
+    for i in range(m):
+        if _skipped(wv, i, mode):
+            continue
+        inw = False
+        for a in range(k):
+            if W[a] == i:
+                inw = True
+        if inw:
+            continue
+        ap = 0.0
+        ax = 0.0
+        an = 0.0
+        for f in range(n):
+            r_ = _row_at(A, wv, i, f, nc, mode)
+            ap += r_ * p[f]
+            ax += r_ * x[f]
+            an += r_ * r_
+        if ap <= 1e-13 * math.sqrt(an) * pn:
+            continue
+        a_ = max(h[i] - ax, 0.0) / ap
+        if a_ < alpha:
+            alpha = a_
+            j = i
+    return j, alpha
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _norm(p, n):
+    """The Euclidean norm of ``p[:n]``."""
+    s_ = 0.0
+    for f in range(n):
+        s_ += p[f] * p[f]
+    return math.sqrt(s_)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _leaving(A, wv, nc, mode, u, W, k, scale):
+    """The bound held whose multiplier is negative, the one of lowest index (Bland's rule); -1 if none (optimal).
+    Negative: ``u_a |row_a| < -1e-12 scale``, ``scale`` the size of the gradient the multipliers balance (1 for the
+    margin, ``|z|`` for the nearest split): a multiplier's own size follows its row's, and relative to the largest
+    multiplier (the test before) a truly negative one was taken for zero where two nearly opposite bounds (a lossy
+    gear's band of nearly zero width) held multipliers of 1e12, and a vertex 5e-9 below the optimum was kept."""
+    n = _ncols(nc, mode)
+    q = -1
+    for a in range(k):
+        rn = 0.0
+        for f in range(n):
+            r_ = _row_at(A, wv, W[a], f, nc, mode)
+            rn += r_ * r_
+        if u[a] * math.sqrt(rn) < -1e-12 * scale and (q < 0 or W[a] < W[q]):
+            q = a
+    return q
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _sort_ints(idx, k):
+    """``idx[:k]`` in increasing order (insertion sort: a hint's bounds, :func:`_hint_at`)."""
+    for a in range(1, k):
+        v_ = idx[a]
+        c = a
+        while c > 0 and idx[c - 1] > v_:
+            idx[c] = idx[c - 1]
+            c -= 1
+        idx[c] = v_
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
+    """The simplex steps of :func:`_lp_max` from ``x`` (which keeps every bound) holding ``W[:k]``: ``(theta, k)``."""
+    n = nc + 1
+    for _it in range(ACTIVE_STEPS * (m + n) + 20):
+        if x[nc] >= stop:
+            if not _kept(A, wv, h, nc, mode, m, x, tol):
+                return np.nan, 0
+            return x[nc], k
+        for f in range(n):
+            p[f] = 0.0
+        p[nc] = 1.0
+        if not _project(A, wv, nc, mode, W, k, p, p, u, M, R):
+            return np.nan, 0
+        pn = _norm(p, n)   # (|c| = 1)
+        if k >= n or pn <= 1e-10:   # the gradient lies in the span of the bounds held: their multipliers decide
+            q = _leaving(A, wv, nc, mode, u, W, k, 1.0)
+            if q < 0:   # (the point on the bounds held, free of the path's rounding: at a vertex, its solution)
+                _polish(A, wv, h, nc, mode, W, k, x, u, M, R)
+                if not _kept(A, wv, h, nc, mode, m, x, tol):
+                    return np.nan, 0
+                return x[nc], k
+            W[q] = W[k - 1]
+            k -= 1
+            continue
+        j, alpha = _blocking(A, wv, h, nc, mode, m, W, k, x, p, pn)
+        if j < 0:
+            if stop < np.inf:   # (unbounded: step to the margin asked for)
+                alpha = (stop - x[nc]) / p[nc]
+                for f in range(n):
+                    x[f] += alpha * p[f]
+                x[nc] = stop
+                return stop, k
+            return np.inf, 0
+        for f in range(n):
+            x[f] += alpha * p[f]
+        W[k] = j
+        k += 1
+        _polish(A, wv, h, nc, mode, W, k, x, u, M, R)
+    return np.nan, 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _lp_max(A, wv, h, nc, m, stop, W, x, p, u, M, R, tol):
+    """``max theta`` over ``x = (zeta, theta)`` with ``A_i . zeta + theta wv_i <= h_i`` for the ``m`` bounds
+    (``wv >= 0``), by the primal active-set (simplex) method with Bland's rule.  A first phase finds a ``zeta``
+    that keeps the bounds of zero width (a one-way clutch's free side: no margin relaxes it), the same method on
+    them alone with unit widths, from ``zeta = 0``; none: ``-inf`` (no split holds).  Then from that ``zeta`` and the
+    largest margin there, which keeps every bound: a step along the objective's gradient projected onto the bounds
+    held (``W``) to the first bound it reaches, which joins them; where the gradient lies in their span, the one of
+    lowest index whose multiplier is negative leaves them (none: optimal).  Stops early once ``theta >= stop``.
+    Returns ``(theta, k)``, ``W[:k]`` the bounds held at the end (``k = nc + 1``: a vertex), ``x`` the point;
+    ``(inf, 0)`` if unbounded; ``(nan, 0)`` if it did not end within :data:`ACTIVE_STEPS` steps per variable and
+    bound, met dependent bounds or ended off its bounds (the caller then enumerates).
+
+    The cold start of :func:`_combo_margin` and :func:`_combo_nearest` where their hints fail (forty-first
+    session): a few steps of small solves, where enumerating the vertices costs ``C(m, nc + 1)`` of them (four
+    null directions and more)."""
+    n = nc + 1
+    for f in range(n):
+        x[f] = 0.0
+    t0 = np.inf
+    j = -1
+    for i in range(m):
+        if wv[i] <= 0.0 and h[i] < t0:
+            t0 = h[i]
+            j = i
+    if t0 < 0.0:   # a bound of zero width fails at zeta = 0: the first phase
+        x[nc] = t0
+        W[0] = j
+        t1, k = _ascend(A, wv, h, nc, ROWS_PHASE_ONE, m, 0.0, W, 1, x, p, u, M, R, tol)
+        if t1 != t1:
+            return np.nan, 0
+        if t1 < 0.0:
+            return -np.inf, 0
+    th = np.inf
+    j = -1
+    for i in range(m):
+        if wv[i] > 0.0:
+            v_ = h[i]
+            for f in range(nc):
+                v_ -= A[i, f] * x[f]
+            if v_ / wv[i] < th:
+                th = v_ / wv[i]
+                j = i
+    if j < 0:
+        return np.inf, 0   # (no bound has a width: any margin)
+    x[nc] = th
+    W[0] = j
+    return _ascend(A, wv, h, nc, ROWS_WIDTH, m, stop, W, 1, x, p, u, M, R, tol)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _qp_nearest(G, hb, d, m, W, k, z, p, u, M, R, tol):
+    """The least ``|z|`` with ``G_i . z <= hb_i`` for the ``m`` bounds, by the primal active-set method from ``z``
+    (which keeps every bound) holding ``W[:k]``: a step to the least ``|z|`` on the bounds held (``z`` projected
+    onto their null space), shortened to the first bound it reaches, which joins them; where it does not move, the
+    bound of lowest index whose multiplier has the wrong sign leaves them (none: optimal; the programme is strictly
+    convex, so that optimum is the one).  Returns ``(|z|^2, k)``, ``W[:k]`` the bounds held at the optimum; ``(nan,
+    0)`` if it did not end within :data:`ACTIVE_STEPS` steps per variable and bound, met dependent bounds or ended
+    off its bounds."""
+    big = 0.0   # (the problem's scale: the bounds' rows are of unit size, so the splits are of the bounds' size)
+    for i in range(m):
+        big = max(big, abs(hb[i]))
+    for _it in range(ACTIVE_STEPS * (m + d) + 20):
+        for f in range(d):
+            p[f] = -z[f]
+        if not _project(G, hb, d, ROWS_PLAIN, W, k, p, p, u, M, R):
+            return np.nan, 0
+        pn = _norm(p, d)
+        scale = max(_norm(z, d), big)
+        if k >= d or pn <= 1e-13 * scale:
+            # at the least |z| on the bounds held (to the rounding of the problem's size, not of |z|: a split at
+            # 1e-14 N m beside bounds of 1 N m moved by rounding noise onto a bound opposite one held, which then
+            # could not join it); -z = G_W^T u, and a held bound with u < 0 pulls the wrong way
+            q = _leaving(G, hb, d, ROWS_PLAIN, u, W, k, scale)
+            if q < 0:
+                if not _kept(G, hb, hb, d, ROWS_PLAIN, m, z, tol):
+                    return np.nan, 0
+                return _norm(z, d) ** 2, k
+            W[q] = W[k - 1]
+            k -= 1
+            continue
+        j, alpha = _blocking(G, hb, hb, d, ROWS_PLAIN, m, W, k, z, p, pn)
+        if alpha >= 1.0 or j < 0:
+            for f in range(d):
+                z[f] += p[f]
+            continue
+        if k >= d:   # (no bound can join d independent ones: rounding)
+            return np.nan, 0
+        for f in range(d):
+            z[f] += alpha * p[f]
+        W[k] = j
+        k += 1
+        _polish(G, hb, hb, d, ROWS_PLAIN, W, k, z, u, M, R)
+    return np.nan, 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, sc, R, hint, o, tol, small):
     """The largest margin ``theta`` any split keeps under one combination of pieces: a linear programme in ``(zeta,
-    theta)`` over ``m`` bounds in ``nr`` dimensions, solved at its vertices.  Warm: the vertex of the hint
-    (``hint[o]`` the rank, ``hint[o + 1:o + nr + 2]`` its bounds), then those one bound away from it (the optimum
-    moved by one pivot of the simplex method), are taken where they are the optimum, certified by their dual
-    multipliers (:func:`_margin_at`); else every vertex is tried.  The optimum's bounds become the hint.  +inf with
-    fewer bounds than ``nr + 1`` (independent bounds: any margin is kept)."""
+    theta)`` over ``m`` bounds in ``nr`` dimensions, solved at a vertex.  Warm: the vertex of the hint (``hint[o]``
+    the rank, ``hint[o + 1:o + nr + 2]`` its bounds) is taken where it is the optimum, certified by its dual
+    multipliers (:func:`_margin_at`).  Where it is not: for a set of at most :data:`ENUMERATED_DIMENSIONS` null
+    directions (``small``), the vertices one bound away from it (the optimum moved by one pivot), then every
+    vertex; for more, the simplex method from the hint where
+    it keeps every bound (:func:`_ascend`: a pivot or two, the torques having moved a little), else from its cold
+    start (:func:`_lp_max`; ``sc[0]`` and ``R`` their scratch), and every vertex only where that fails (enumerating
+    costs ``C(m, nr + 1)`` solves: 3 s for one simulated second of a loop with six null directions).  The optimum's
+    bounds become the hint.  +inf with fewer bounds than ``nr + 1`` (independent bounds: any margin is kept)."""
     k1 = nr + 1
     if m < k1:
         return np.inf
@@ -1948,14 +2316,32 @@ def _combo_margin(GR, w, h, nr, m, idx, base, M, b, y, hint, o, tol):
         th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
         if th > -np.inf:
             return th
-        for a in range(k1):
-            for r in range(m):
-                if _swapped(base, k1, a, r, idx) < 0:
-                    continue
-                th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
-                if th > -np.inf:
-                    _set_hint(hint, o, nr, idx, k1)
+        if small:
+            for a in range(k1):
+                for r in range(m):
+                    if _swapped(base, k1, a, r, idx) < 0:
+                        continue
+                    th = _margin_at(GR, w, h, nr, m, idx, M, b, y, tol)
+                    if th > -np.inf:
+                        _set_hint(hint, o, nr, idx, k1)
+                        return th
+        else:
+            for c in range(k1):
+                idx[c] = base[c]
+            if _margin_vertex(GR, w, h, nr, m, idx, M, b, tol) > -np.inf:
+                th, k = _ascend(GR, w, h, nr, ROWS_WIDTH, m, np.inf, idx, k1, b, sc[0], y, M, R, tol)
+                if th == th:
+                    if k == k1:
+                        _sort_ints(idx, k)
+                        _set_hint(hint, o, nr, idx, k1)
                     return th
+    if not small:
+        th, k = _lp_max(GR, w, h, nr, m, np.inf, idx, b, sc[0], y, M, R, tol)
+        if th == th:
+            if k == k1:
+                _sort_ints(idx, k)
+                _set_hint(hint, o, nr, idx, k1)
+            return th
     best = -np.inf
     for j in range(k1):
         idx[j] = j
@@ -2016,13 +2402,32 @@ def _nearest_at(G, d, h, w, theta, m, idx, k, M, b, z, tol):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, hint, o, tol):
+def _nearest_from(G, d, h, w, theta, m, idx, k, M, b, z, sc, R, hint, o, tol):
+    """:func:`_qp_nearest` from the split ``z`` (which keeps every bound at margin ``theta``) holding ``idx[:k]``, the
+    bounds shifted by the margin into ``sc[1]``; its optimum's set becomes the hint.  Returns ``|z|^2`` (nan: it
+    failed)."""
+    hb = sc[1]
+    for i in range(m):
+        hb[i] = h[i] - theta * w[i]
+    nz, k = _qp_nearest(G, hb, d, m, idx, k, z, sc[0], b, M, R, tol)
+    if nz == nz:
+        _sort_ints(idx, k)
+        _set_hint(hint, o, k, idx, k)
+    return nz
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, sc, R, hint, o, tol, small):
     """The nearest split that keeps margin ``theta`` under one combination of pieces: the least ``|z|`` with ``G z +
-    theta w <= h`` (a convex quadratic programme in ``d <= 3`` dimensions), into ``z``; returns ``|z|^2`` (inf: no
-    split keeps it).  Warm: the hint's active set (``hint[o]`` its size, ``hint[o + 1:]`` its bounds), then the sets
-    one bound away from it (one bound dropped, added or swapped), are taken where their split is the optimum
-    (:func:`_nearest_at`); else ``z = 0`` where it keeps every bound, else the least ``|z|`` over the active sets of
-    1..d bounds.  The optimum's set becomes the hint."""
+    theta w <= h`` (a convex quadratic programme in ``d`` dimensions), into ``z``; returns ``|z|^2`` (inf: no
+    split keeps it).  Warm: the hint's active set (``hint[o]`` its size, ``hint[o + 1:]`` its bounds) is taken where
+    its split is the optimum (:func:`_nearest_at`).  Where it is not: for a set of at most
+    :data:`ENUMERATED_DIMENSIONS` null directions (``small``, as :func:`_combo_margin`), the sets one bound away
+    from it (one bound dropped, added or swapped); for more, the active-set method from the hint's split where it
+    keeps every bound (:func:`_qp_nearest`).  Else ``z = 0`` where it keeps every bound; else, where ``small``, the
+    least ``|z|`` over the active sets of 1..d bounds, and for more the active-set method from a split that keeps
+    ``theta``, found by :func:`_lp_max` (``sc[0]``, ``sc[1]``, ``R``: their scratch), enumerating only where that
+    fails.  The optimum's set becomes the hint."""
     kh = hint[o]
     if kh >= 0.0 and kh <= d and kh == math.floor(kh) and _hint_at(hint, o + 1, int(kh), m, base):
         k = int(kh)
@@ -2031,22 +2436,42 @@ def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, hint, o, tol):
         nz = _nearest_at(G, d, h, w, theta, m, idx, k, M, b, z, tol)
         if nz < np.inf:
             return nz
-        for a in range(k + 1):
-            for r in range(-1, m):
-                if a == k and (r < 0 or k == d):
-                    continue
-                kk = _swapped(base, k, a, r, idx)
-                if kk < 0:
-                    continue
-                nz = _nearest_at(G, d, h, w, theta, m, idx, kk, M, b, z, tol)
-                if nz < np.inf:
-                    _set_hint(hint, o, kk, idx, kk)
+        if small:
+            for a in range(k + 1):
+                for r in range(-1, m):
+                    if a == k and (r < 0 or k == d):
+                        continue
+                    kk = _swapped(base, k, a, r, idx)
+                    if kk < 0:
+                        continue
+                    nz = _nearest_at(G, d, h, w, theta, m, idx, kk, M, b, z, tol)
+                    if nz < np.inf:
+                        _set_hint(hint, o, kk, idx, kk)
+                        return nz
+        else:
+            for c in range(k):
+                idx[c] = base[c]
+            for f in range(d):
+                z[f] = 0.0
+            if (k == 0 or _active_split(G, d, h, w, theta, idx, k, M, b, z)) and _keeps(G, d, z, theta, w, h, m,
+                                                                                           tol):
+                nz = _nearest_from(G, d, h, w, theta, m, idx, k, M, b, z, sc, R, hint, o, tol)
+                if nz == nz:
                     return nz
     for f in range(d):
         z[f] = 0.0
     if _keeps(G, d, z, theta, w, h, m, tol):
         hint[o] = 0.0
         return 0.0
+    th, k = (np.nan, 0) if small else _lp_max(G, w, h, d, m, theta, idx, zt, sc[0], b, M, R, tol)
+    if th == th and th < np.inf:
+        if th < theta:
+            return np.inf   # (no split keeps theta)
+        for f in range(d):
+            z[f] = zt[f]
+        nz = _nearest_from(G, d, h, w, theta, m, idx, 0, M, b, z, sc, R, hint, o, tol)
+        if nz == nz:
+            return nz
     best = np.inf
     for k in range(1, d + 1):
         if m < k:
@@ -2097,8 +2522,9 @@ def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
-    """:func:`_repair` where a statically indeterminate set has two or three null directions (a rigid loop with a
-    bearing friction and two stuck lossy gears: seven members on four inertias).
+    """:func:`_repair` where a statically indeterminate set has two or more null directions (a rigid loop with a
+    bearing friction and two stuck lossy gears: seven members on four inertias, three; a second bearing friction on
+    it, four).
 
     Every ``lam + V z`` (``V`` an orthonormal basis of ``A``'s null space) balances the network.  The bounds are
     linear in ``z``: a friction member's ``lo <= lam <= hi``; a stuck lossy gear's hold within its band, whose upper
@@ -2115,11 +2541,15 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
 
     Both programmes start warm: each combination's last optimal vertex and active set (``WorkLayout.sp``) are tried
     first and kept where their optimality conditions hold (the dual multipliers' signs), so that the answer is the
-    optimum whatever the hint; only where they fail (the set, its bounds or the optimum changed) are the vertices and
-    active sets enumerated.  The optimum is certified only to ``tol``, so at a group's edge whether it holds may
-    follow the hints: an observer's evaluation (the outputs at a sample, the invariant check: :func:`observe`) reads
-    them from a copy and leaves them as they were, so that no sample and no check changes a decision.  Returns True
-    if ``lam`` changed."""
+    optimum whatever the hint.  Where they fail: with at most :data:`ENUMERATED_DIMENSIONS` null directions, the
+    sets one bound away, then every vertex and active set; with more (the work array's warm start is sized for any
+    number, :func:`space_hint`), the simplex and active-set methods from the hint where it keeps every bound, else
+    from their cold start (:func:`_lp_max`, :func:`_qp_nearest`), enumerating only where those fail (forty-first
+    session; before, a set of more than three null directions kept its regularised split, and a member was
+    released while another split held the set).  The optimum is certified only to ``tol``, so at a group's
+    edge whether it holds may follow the hints: an observer's evaluation (the outputs at a sample, the invariant
+    check: :func:`observe`) reads them from a copy and leaves them as they were, so that no sample and no check
+    changes a decision.  Returns True if ``lam`` changed."""
     if ns < 3:
         return False
     # ---- an orthonormal basis of the null space
@@ -2129,7 +2559,7 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     if rank == 0:
         return False
     d = ns - rank
-    if d < 2 or d > 3:
+    if d < 2:
         return False
     V = np.zeros((ns, d))
     y = np.empty(ns)
@@ -2220,29 +2650,34 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
             ncomb *= 4
     hint = p.work
     o_sp = _offsets(p).sp
-    if hint[o_sp + SPACE_CACHE] != 0.0:
+    nk = _nk(p)
+    size = space_hint(nk)   # (one combination's warm start: a vertex of up to nk + 1 bounds, an active set of nk)
+    if hint[o_sp + space_cache(nk)] != 0.0:
         # an observer's evaluation (:func:`observe`): the hints from a copy, so that it leaves them as they were (a
         # sample's outputs moved them, and at a group's edge, where the optimum is certified only to ``tol``, a
         # self-locking chain sampled every 2 ms then stayed stuck beyond its limit, #30)
-        hint = p.work[o_sp:o_sp + SPACE_CACHE].copy()
+        hint = p.work[o_sp:o_sp + space_cache(nk)].copy()
         o_sp = 0
-    M = np.empty((4, 4))
-    b = np.empty(4)
-    yb = np.empty(4)
-    idx = np.empty(4, dtype=np.int64)
-    base = np.empty(4, dtype=np.int64)
-    zt = np.empty(4)
-    zc = np.empty(3)
-    zb = np.zeros(3)
-    R = np.zeros((3, 3))
-    GR = np.zeros((mm, 3))
+    M = np.empty((d + 1, d + 1))
+    b = np.empty(d + 1)
+    yb = np.empty(d + 1)
+    idx = np.empty(d + 1, dtype=np.int64)
+    base = np.empty(d + 1, dtype=np.int64)
+    zt = np.empty(d + 1)
+    zc = np.empty(d)
+    zb = np.zeros(d)
+    R = np.zeros((d, d))
+    GR = np.zeros((mm, d))
+    sc = np.zeros((2, max(mm, d + 1)))   # (the cold solves' step and shifted bounds: _lp_max, _qp_nearest)
+    Rq = np.zeros((d + 1, d + 1))        # (and the triangle of their QR, M holding its Q)
+    small = d <= ENUMERATED_DIMENSIONS   # (enumerated where the hints fail; above, the simplex and active sets)
     # the largest margin any split keeps, per combination of pieces
     thc = np.empty(ncomb)
     best_theta = -np.inf
     for comb in range(ncomb):
         _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
         nr = _span_basis(G, m, d, R, GR, zt)
-        thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, hint, o_sp + SPACE_HINT * comb, tol)
+        thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size * comb, tol, small)
         best_theta = max(best_theta, thc[comb])
     if not best_theta >= 0.0:
         return False   # no split holds: the group must slip
@@ -2253,7 +2688,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
         if not thc[comb] >= theta:
             continue
         _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
-        nz = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zc, hint, o_sp + SPACE_HINT * comb + 5, tol)
+        nz = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zc, sc, Rq, hint,
+                            o_sp + size * comb + nk + 2, tol, small)
         if nz < best_n:
             best_n = nz
             for f in range(d):
