@@ -2158,6 +2158,17 @@ def _sort_ints(idx, k):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _step_onto(A, wv, h, nc, mode, W, k, x, p, alpha, j, u, M, R):
+    """A step of :func:`_ascend` or :func:`_qp_nearest`: ``x += alpha p`` onto bound ``j``, which joins the bounds
+    held (``W[k]``), and ``x`` put back on them (:func:`_polish`); returns their number."""
+    for f in range(_ncols(nc, mode)):
+        x[f] += alpha * p[f]
+    W[k] = j
+    _polish(A, wv, h, nc, mode, W, k + 1, x, u, M, R)
+    return k + 1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
     """The simplex steps of :func:`_lp_max` from ``x`` (which keeps every bound) holding ``W[:k]``: ``(theta, k)``."""
     n = nc + 1
@@ -2191,11 +2202,7 @@ def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
                 x[nc] = stop
                 return stop, k
             return np.inf, 0
-        for f in range(n):
-            x[f] += alpha * p[f]
-        W[k] = j
-        k += 1
-        _polish(A, wv, h, nc, mode, W, k, x, u, M, R)
+        k = _step_onto(A, wv, h, nc, mode, W, k, x, p, alpha, j, u, M, R)
     return np.nan, 0
 
 
@@ -2287,11 +2294,7 @@ def _qp_nearest(G, hb, d, m, W, k, z, p, u, M, R, tol):
             continue
         if k >= d:   # (no bound can join d independent ones: rounding)
             return np.nan, 0
-        for f in range(d):
-            z[f] += alpha * p[f]
-        W[k] = j
-        k += 1
-        _polish(G, hb, hb, d, ROWS_PLAIN, W, k, z, u, M, R)
+        k = _step_onto(G, hb, hb, d, ROWS_PLAIN, W, k, z, p, alpha, j, u, M, R)
     return np.nan, 0
 
 
