@@ -1752,12 +1752,19 @@ def _small_solve(M, b, k):
             for j in range(c, k):
                 M[i, j] -= f * M[c, j]
             b[i] -= f * b[c]
+    _back_substitute(M, b, k)
+    return True
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _back_substitute(U, b, k):
+    """Solve ``U[:k, :k] x = b[:k]`` in place into ``b``, ``U`` upper triangular (:func:`_small_solve`'s
+    elimination, :func:`_project`'s QR)."""
     for i in range(k - 1, -1, -1):
         acc_ = b[i]
         for j in range(i + 1, k):
-            acc_ -= M[i, j] * b[j]
-        b[i] = acc_ / M[i, i]
-    return True
+            acc_ -= U[i, j] * b[j]
+        b[i] = acc_ / U[i, i]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -1980,6 +1987,26 @@ def _skipped(wv, i, mode):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _orthogonalise(Q, j, n, R, record):
+    """Column ``j`` of ``Q[:n]`` made orthogonal to its columns before it (Gram-Schmidt, twice; the coefficients
+    added into ``R[:j, j]`` where ``record``); returns the norm left of it (:func:`_qr`, :func:`_repair_space`'s
+    null-space basis)."""
+    for _twice in range(2):
+        for i in range(j):
+            dot = 0.0
+            for f in range(n):
+                dot += Q[f, i] * Q[f, j]
+            if record:
+                R[i, j] += dot
+            for f in range(n):
+                Q[f, j] -= dot * Q[f, i]
+    nrm = 0.0
+    for f in range(n):
+        nrm += Q[f, j] * Q[f, j]
+    return math.sqrt(nrm)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _qr(A, wv, nc, mode, W, k, Q, R):
     """``A_W^T = Q R`` for the rows ``W[:k]`` (:func:`_row_at`): ``Q[:n, :k]`` orthonormal columns, ``R[:k, :k]``
     upper triangular (modified Gram-Schmidt, twice).  False if a row depends on those before it (what is left of it
@@ -1995,18 +2022,7 @@ def _qr(A, wv, nc, mode, W, k, Q, R):
         nrm0 = math.sqrt(nrm0)
         for i in range(k):
             R[i, j] = 0.0
-        for _twice in range(2):
-            for i in range(j):
-                dot = 0.0
-                for f in range(n):
-                    dot += Q[f, i] * Q[f, j]
-                R[i, j] += dot
-                for f in range(n):
-                    Q[f, j] -= dot * Q[f, i]
-        nrm = 0.0
-        for f in range(n):
-            nrm += Q[f, j] * Q[f, j]
-        nrm = math.sqrt(nrm)
+        nrm = _orthogonalise(Q, j, n, R, True)
         if not nrm > 1e-13 * nrm0:
             return False
         R[j, j] = nrm
@@ -2033,11 +2049,7 @@ def _project(A, wv, nc, mode, W, k, v, p, u, Q, R):
         for a in range(k):
             s_ -= Q[f, a] * u[a]
         p[f] = s_
-    for a in range(k - 1, -1, -1):   # R u = Q^T v
-        s_ = u[a]
-        for c in range(a + 1, k):
-            s_ -= R[a, c] * u[c]
-        u[a] = s_ / R[a, a]
+    _back_substitute(R, u, k)   # R u = Q^T v
     return True
 
 
@@ -2577,18 +2589,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
             y[i] = -acc_ / S[i, i]
         for i in range(ns):
             V[cp[i], f] = y[i]
-    for f in range(d):   # Gram-Schmidt, twice
-        for _twice in range(2):
-            for g in range(f):
-                dot = 0.0
-                for i in range(ns):
-                    dot += V[i, f] * V[i, g]
-                for i in range(ns):
-                    V[i, f] -= dot * V[i, g]
-        nrm = 0.0
-        for i in range(ns):
-            nrm += V[i, f] * V[i, f]
-        nrm = math.sqrt(nrm)
+    for f in range(d):
+        nrm = _orthogonalise(V, f, ns, V, False)
         if nrm == 0.0:
             return False
         for i in range(ns):
