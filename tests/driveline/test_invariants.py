@@ -817,13 +817,13 @@ def test_an_unrelated_event_does_not_search_a_held_network_again(unrelated):
         assert [e for e in both if not e[1].startswith("U")] == []
 
 
-def _loop_group_holds(t, bearing2=0.0):
+def _loop_group_holds(t, extra=()):
     """Independent of the kernel: whether the rigid loop of :func:`test_a_statically_indeterminate_loop_holds_while_any_split_holds`,
     every member stuck and every inertia at rest, has a split of its torques within every member's bounds at ``t``
-    (SciPy's HiGHS on the static balance of the four inertias); ``bearing2`` > 0: with a second bearing friction of
-    that torque on J2 (:func:`test_a_loop_with_four_null_directions_holds_while_any_split_holds`).  Unknowns: the
-    one-way clutch's torque ``f0`` (its multiplier: ``-f0`` on J1, at most its clutch's 0.5 N m overrunning, any
-    locking), the second bearing's, each gear's torque on its
+    (SciPy's HiGHS on the static balance of the four inertias); ``extra``: more bearing frictions or brakes, ``(i,
+    limit)`` on inertia ``Ji`` (:func:`test_a_loop_with_four_null_directions_holds_while_any_split_holds`).
+    Unknowns: the one-way clutch's torque ``f0`` (its multiplier: ``-f0`` on J1, at most its clutch's 0.5 N m
+    overrunning, any locking), the extra members', each gear's torque on its
     flange-a inertia ``lg = -T_a`` and the loss torque ``L`` it holds (MSL ``LossyGear``: ``flange_b.tau = -ratio
     (flange_a.tau - tauLoss)``), the loop clutch's (1.5 N m) and the bearing's (1 N m).  A stuck gear's ``L`` lies
     between MSL's ``tauLossMin_m`` and ``tauLossMax_p`` at ``w_a = 0``: the upper edge the larger of
@@ -839,25 +839,29 @@ def _loop_group_holds(t, bearing2=0.0):
 
     t1 = 3.0 * math.sin(2 * math.pi * t)
     r1, r2 = -1.0, -3.0
-    # columns f0, lg1, L1, lg2, L2, loop, bearing, bearing2; rows: the torque balance of J0..J3 at rest
-    a_eq = np.array([[1, 0, 0, 0, 0, 1, -1, 0], [-1, 1, 0, 0, 0, 0, 0, 0], [0, -r1, -r1, 1, 0, 0, 0, -1],
-                     [0, 0, 0, -r2, -r2, -1, 0, 0]], dtype=float)
+    # columns f0, lg1, L1, lg2, L2, loop, bearing, then the extra members; rows: the torque balance of J0..J3 at rest
+    nv = 7 + len(extra)
+    a_eq = np.zeros((4, nv))
+    a_eq[:, :7] = [[1, 0, 0, 0, 0, 1, -1], [-1, 1, 0, 0, 0, 0, 0], [0, -r1, -r1, 1, 0, 0, 0],
+                   [0, 0, 0, -r2, -r2, -1, 0]]
+    for c, (i, _limit) in enumerate(extra):
+        a_eq[i, 7 + c] = -1.0
     b_eq = np.array([0.0, -t1, 0.0, 0.0])
-    bounds = [(None, 0.5), (None, None), (None, None), (None, None), (None, None), (-1.5, 1.5), (-1.0, 1.0),
-              (-bearing2, bearing2)]
+    bounds = [(None, 0.5), (None, None), (None, None), (None, None), (None, None), (-1.5, 1.5), (-1.0, 1.0)] + [
+        (-limit, limit) for _i, limit in extra]
     gears = ((1, 2, lines(1.0, 0.5, 0.5, 0.0)), (3, 4, lines(0.25, 0.25, 0.0, 0.0)))
     for pieces in itertools.product(range(2), repeat=4):
         a_ub, b_ub = [], []
         for (lg, hold, (up, lo)), u, d in zip(gears, pieces[::2], pieces[1::2]):
-            row = np.zeros(8)
+            row = np.zeros(nv)
             row[hold], row[lg] = 1.0, up[u][0]       # L <= s T_a + c, T_a = -lg
             a_ub.append(row)
             b_ub.append(up[u][1])
-            row = np.zeros(8)
+            row = np.zeros(nv)
             row[hold], row[lg] = -1.0, -lo[d][0]     # L >= s T_a + c
             a_ub.append(row)
             b_ub.append(-lo[d][1])
-        if linprog(np.zeros(8), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
+        if linprog(np.zeros(nv), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
                    method="highs").status == 0:
             return True
     return False
@@ -924,7 +928,7 @@ def test_a_loop_with_four_null_directions_holds_while_any_split_holds():
     events = {rtol: _mode_events(r) for rtol, r in runs.items()}
     assert [e[1:] for e in events[1e-8]] == [e[1:] for e in events[1e-10]]
     assert max(abs(a[0] - b[0]) for a, b in zip(events[1e-8], events[1e-10])) < 1e-6
-    holds = functools.partial(_loop_group_holds, bearing2=0.05)
+    holds = functools.partial(_loop_group_holds, extra=((2, 0.05),))
     first, second = _edge(holds, 0.0, 0.14), _edge(holds, 0.6, 0.75)
     ev = events[1e-10]
     assert abs(ev[0][0] - first) < 1e-6, (ev[0], first)            # nothing moves before: the loop holds
@@ -933,6 +937,27 @@ def test_a_loop_with_four_null_directions_holds_while_any_split_holds():
     assert len(slip) == 1 and abs(slip[0] - second) < 1e-6, (slip, second)
     stuck = [t for t, el, e in ev if el == "g1" and e == "stick"]
     assert stuck and not any(stuck[0] + 1e-6 < t < slip[0] - 1e-6 for t, _el, _e in ev)   # held in between
+
+
+@pytest.mark.parametrize("more", [2, 3])
+def test_a_loop_with_five_and_six_null_directions_breaks_away_where_no_split_holds(more):
+    """The loop of :func:`test_a_loop_with_four_null_directions_holds_while_any_split_holds` with a third bearing
+    friction (0.05 N m, J1) and a brake (0.05 N m, J3): five and six null directions, the split search's simplex and
+    active-set methods (``kernel._lp_max``, ``kernel._qp_nearest``; a version that solved their last vertex by
+    elimination held the one-way clutch beyond its limit here, caught by the invariant check).  Nothing moves until
+    SciPy's HiGHS finds no split any more, within 1e-6 s; the same events at rtol 1e-8 and 1e-10."""
+    d = indeterminate_loop()
+    d.bearing_friction("b2", "J2", torque=0.05, peak=1.0).bearing_friction("b3", "J1", torque=0.05, peak=1.0)
+    extra = ((2, 0.05), (1, 0.05))
+    if more == 3:
+        d.brake("b4", "J3", fn_max=0.1, mu=0.5)
+        extra += ((3, 0.05),)
+    events = {rtol: _mode_events(d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True))
+              for rtol in (1e-8, 1e-10)}
+    assert [e[1:] for e in events[1e-8]] == [e[1:] for e in events[1e-10]]
+    assert max(abs(a[0] - b[0]) for a, b in zip(events[1e-8], events[1e-10])) < 1e-6
+    first = _edge(functools.partial(_loop_group_holds, extra=extra), 0.0, 0.2)
+    assert abs(events[1e-10][0][0] - first) < 1e-6, (events[1e-10][0], first)
 
 
 # two self-locking gears (no bearing friction in their tables) and a bearing, in a chain from rest (found by the
