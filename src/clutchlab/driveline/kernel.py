@@ -2032,12 +2032,12 @@ def _qr(A, wv, nc, mode, W, k, Q, R):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _project(A, wv, nc, mode, W, k, v, p, u, Q, R):
+def _project(A, wv, nc, mode, W, k, v, p, u, Q, R, known):
     """``p``: ``v`` projected onto the null space of the rows ``W[:k]`` (:func:`_row_at`), ``u`` the multipliers of
     that projection (``v - p = A_W^T u``; where ``p`` is zero, ``v = A_W^T u``; ``v`` and ``p`` may be one array),
-    through their QR (:func:`_qr`).  False if the rows are dependent."""
+    through their QR (:func:`_qr`; ``known``: ``Q``, ``R`` hold it already).  False if the rows are dependent."""
     n = _ncols(nc, mode)
-    if not _qr(A, wv, nc, mode, W, k, Q, R):
+    if not known and not _qr(A, wv, nc, mode, W, k, Q, R):
         return False
     for a in range(k):
         t_ = 0.0
@@ -2054,12 +2054,13 @@ def _project(A, wv, nc, mode, W, k, v, p, u, Q, R):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _polish(A, wv, h, nc, mode, W, k, x, u, Q, R):
+def _polish(A, wv, h, nc, mode, W, k, x, u, Q, R, known):
     """``x`` moved onto the bounds held, ``W[:k]``, by the least correction (``x += Q y``, ``R^T y = h_W - A_W x``),
-    twice: the steps leave their rounding in ``x``, and the ratio tests read it."""
+    twice: the steps leave their rounding in ``x``, and the ratio tests read it.  Their QR from :func:`_qr` (or
+    ``Q``, ``R`` where ``known``); returns True if ``Q``, ``R`` hold it after (the next projection then reuses it)."""
     n = _ncols(nc, mode)
-    if k == 0 or not _qr(A, wv, nc, mode, W, k, Q, R):
-        return
+    if k == 0 or not (known or _qr(A, wv, nc, mode, W, k, Q, R)):
+        return False
     for _twice in range(2):
         for a in range(k):
             s_ = h[W[a]]
@@ -2071,6 +2072,7 @@ def _polish(A, wv, h, nc, mode, W, k, x, u, Q, R):
         for f in range(n):
             for a in range(k):
                 x[f] += Q[f, a] * u[a]
+    return True
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2172,18 +2174,19 @@ def _sort_ints(idx, k):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _step_onto(A, wv, h, nc, mode, W, k, x, p, alpha, j, u, M, R):
     """A step of :func:`_ascend` or :func:`_qp_nearest`: ``x += alpha p`` onto bound ``j``, which joins the bounds
-    held (``W[k]``), and ``x`` put back on them (:func:`_polish`); returns their number."""
+    held (``W[k]``), and ``x`` put back on them (:func:`_polish`); returns their number and whether ``M``, ``R``
+    hold their QR."""
     for f in range(_ncols(nc, mode)):
         x[f] += alpha * p[f]
     W[k] = j
-    _polish(A, wv, h, nc, mode, W, k + 1, x, u, M, R)
-    return k + 1
+    return k + 1, _polish(A, wv, h, nc, mode, W, k + 1, x, u, M, R, False)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
     """The simplex steps of :func:`_lp_max` from ``x`` (which keeps every bound) holding ``W[:k]``: ``(theta, k)``."""
     n = nc + 1
+    known = False   # (whether M, R hold the QR of the bounds held: computed once per set of them)
     for _it in range(ACTIVE_STEPS * (m + n) + 20):
         if x[nc] >= stop:
             if not _kept(A, wv, h, nc, mode, m, x, tol):
@@ -2192,18 +2195,20 @@ def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
         for f in range(n):
             p[f] = 0.0
         p[nc] = 1.0
-        if not _project(A, wv, nc, mode, W, k, p, p, u, M, R):
+        if not _project(A, wv, nc, mode, W, k, p, p, u, M, R, known):
             return np.nan, 0
+        known = True
         pn = _norm(p, n)   # (|c| = 1)
         if k >= n or pn <= 1e-10:   # the gradient lies in the span of the bounds held: their multipliers decide
             q = _leaving(A, wv, nc, mode, u, W, k, 1.0)
             if q < 0:   # (the point on the bounds held, free of the path's rounding: at a vertex, its solution)
-                _polish(A, wv, h, nc, mode, W, k, x, u, M, R)
+                _polish(A, wv, h, nc, mode, W, k, x, u, M, R, True)
                 if not _kept(A, wv, h, nc, mode, m, x, tol):
                     return np.nan, 0
                 return x[nc], k
             W[q] = W[k - 1]
             k -= 1
+            known = False
             continue
         j, alpha = _blocking(A, wv, h, nc, mode, m, W, k, x, p, pn)
         if j < 0:
@@ -2214,7 +2219,7 @@ def _ascend(A, wv, h, nc, mode, m, stop, W, k, x, p, u, M, R, tol):
                 x[nc] = stop
                 return stop, k
             return np.inf, 0
-        k = _step_onto(A, wv, h, nc, mode, W, k, x, p, alpha, j, u, M, R)
+        k, known = _step_onto(A, wv, h, nc, mode, W, k, x, p, alpha, j, u, M, R)
     return np.nan, 0
 
 
@@ -2280,11 +2285,13 @@ def _qp_nearest(G, hb, d, m, W, k, z, p, u, M, R, tol):
     big = 0.0   # (the problem's scale: the bounds' rows are of unit size, so the splits are of the bounds' size)
     for i in range(m):
         big = max(big, abs(hb[i]))
+    known = False   # (whether M, R hold the QR of the bounds held)
     for _it in range(ACTIVE_STEPS * (m + d) + 20):
         for f in range(d):
             p[f] = -z[f]
-        if not _project(G, hb, d, ROWS_PLAIN, W, k, p, p, u, M, R):
+        if not _project(G, hb, d, ROWS_PLAIN, W, k, p, p, u, M, R, known):
             return np.nan, 0
+        known = True
         pn = _norm(p, d)
         scale = max(_norm(z, d), big)
         if k >= d or pn <= 1e-13 * scale:
@@ -2298,6 +2305,7 @@ def _qp_nearest(G, hb, d, m, W, k, z, p, u, M, R, tol):
                 return _norm(z, d) ** 2, k
             W[q] = W[k - 1]
             k -= 1
+            known = False
             continue
         j, alpha = _blocking(G, hb, hb, d, ROWS_PLAIN, m, W, k, z, p, pn)
         if alpha >= 1.0 or j < 0:
@@ -2306,7 +2314,7 @@ def _qp_nearest(G, hb, d, m, W, k, z, p, u, M, R, tol):
             continue
         if k >= d:   # (no bound can join d independent ones: rounding)
             return np.nan, 0
-        k = _step_onto(G, hb, hb, d, ROWS_PLAIN, W, k, z, p, alpha, j, u, M, R)
+        k, known = _step_onto(G, hb, hb, d, ROWS_PLAIN, W, k, z, p, alpha, j, u, M, R)
     return np.nan, 0
 
 
