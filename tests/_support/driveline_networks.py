@@ -26,6 +26,27 @@ def indeterminate_loop() -> Driveline:
     return d
 
 
+def gear_loop(gears, extra=(), amp=3.0) -> Driveline:
+    """A rigid loop like :func:`indeterminate_loop` with a chain of lossy gears: J0, a one-way clutch (with a 0.5 N m
+    clutch) to J1, gear ``k`` (``(ratio, efficiency)``) from J``k`` to J``k+1``, a clutch (1.5 N m) closing the
+    loop to J0, a 1 N m bearing friction on J0, ``extra`` bearing frictions ``(i, limit)`` on J``i``, and a sine of
+    ``amp`` N m at 1 Hz on J1.  From rest every member is stuck (``kernel._repair_space``): with three or more
+    gears the split search covers every combination of their band pieces (``kernel._pieces_margin``)."""
+    ng = len(gears)
+    d = Driveline("gear_loop")
+    for i in range(ng + 2):
+        d.inertia(f"J{i}", J=1.0, w0=(0.0 if i == 0 else None))
+    d.one_way_clutch("f0", "J0", "J1", fn_max=1.0, mu=0.5, peak=1.0, normal=Signal.step(1.0, 0.0))
+    for k, (ratio, eta) in enumerate(gears):
+        d.gear(f"g{k + 1}", f"J{k + 1}", f"J{k + 2}", ratio=ratio, efficiency=eta)
+    d.clutch("loop", "J0", f"J{ng + 1}", fn_max=3.0, mu=0.5)
+    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+    for c, (i, limit) in enumerate(extra):
+        d.bearing_friction(f"b{c}", f"J{i}", torque=limit, peak=1.0)
+    d.torque("T1", "J1", Signal.sine(amp, 1.0))
+    return d
+
+
 #: two inertias and a Coulomb clutch (30 N m) with two network inputs: a load torque on J2 (through a product with
 #: -1) and the clutch's normal signal (tests/driveline/test_inputs.py, tests/fmu/test_driveline_fmu.py)
 INPUTS_TOML = """

@@ -22,7 +22,7 @@ import math
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from driveline_networks import indeterminate_loop, networks
+from driveline_networks import gear_loop, indeterminate_loop, networks
 from hypothesis_budget import examples
 
 from clutchlab.driveline import Driveline, Signal
@@ -829,14 +829,8 @@ def _loop_group_holds(t, extra=()):
     between MSL's ``tauLossMin_m`` and ``tauLossMax_p`` at ``w_a = 0``: the upper edge the larger of
     ``quadrant1_p = (1 - eta_mf1) T_a + tau_bf1`` and ``quadrant2_p = (1 - 1/eta_mf2) T_a + tau_bf2`` (they meet at
     ``tau_bf_a``), the lower the smaller of ``quadrant4_m = (1 - 1/eta_mf2) T_a - tau_bf2`` and ``quadrant3_m =
-    (1 - eta_mf1) T_a - tau_bf1``: a union of convex pieces, each combination of pieces one linear programme."""
-    import itertools
-
-    from scipy.optimize import linprog
-
-    def lines(eta1, eta2, bf1, bf2):
-        return [(1 - eta1, bf1), (1 - 1 / eta2, bf2)], [(1 - 1 / eta2, -bf2), (1 - eta1, -bf1)]
-
+    (1 - eta_mf1) T_a - tau_bf1``: a union of convex pieces, each combination of pieces one linear programme
+    (:func:`_split_exists`)."""
     t1 = 3.0 * math.sin(2 * math.pi * t)
     r1, r2 = -1.0, -3.0
     # columns f0, lg1, L1, lg2, L2, loop, bearing, then the extra members; rows: the torque balance of J0..J3 at rest
@@ -849,8 +843,33 @@ def _loop_group_holds(t, extra=()):
     b_eq = np.array([0.0, -t1, 0.0, 0.0])
     bounds = [(None, 0.5), (None, None), (None, None), (None, None), (None, None), (-1.5, 1.5), (-1.0, 1.0)] + [
         (-limit, limit) for _i, limit in extra]
-    gears = ((1, 2, lines(1.0, 0.5, 0.5, 0.0)), (3, 4, lines(0.25, 0.25, 0.0, 0.0)))
-    for pieces in itertools.product(range(2), repeat=4):
+    return _split_exists(a_eq, b_eq, bounds, ((1, 2, _band_lines(1.0, 0.5, 0.5, 0.0)),
+                                              (3, 4, _band_lines(0.25, 0.25, 0.0, 0.0))))
+
+
+def _band_lines(eta1, eta2, bf1, bf2):
+    """A stuck lossy gear's band edges at ``w_a = 0`` as lines ``(slope, offset)`` in ``T_a`` (MSL ``LossyGear``):
+    the upper edge the larger of ``quadrant1_p``, ``quadrant2_p``, the lower the smaller of ``quadrant4_m``,
+    ``quadrant3_m``."""
+    return [(1 - eta1, bf1), (1 - 1 / eta2, bf2)], [(1 - 1 / eta2, -bf2), (1 - eta1, -bf1)]
+
+
+#: HiGHS's feasibility tolerances for the static balances (its defaults, 1e-7, move a loop's edge by up to 3e-6 s
+#: in :func:`test_three_and_four_stuck_lossy_gears_hold_while_any_combination_of_their_pieces_holds`)
+HIGHS_TIGHT = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
+
+
+def _split_exists(a_eq, b_eq, bounds, gears):
+    """Whether the static balance ``a_eq x = b_eq`` of stuck members within ``bounds`` has a solution in which every
+    stuck lossy gear ``(lg, hold, lines)`` (columns of its torque on its flange-a inertia ``lg = -T_a`` and of the
+    loss torque ``L`` it holds) keeps ``L`` in its band: a union of convex pieces, so one SciPy HiGHS linear
+    programme per combination of pieces (``4**len(gears)``)."""
+    import itertools
+
+    from scipy.optimize import linprog
+
+    nv = a_eq.shape[1]
+    for pieces in itertools.product(range(2), repeat=2 * len(gears)):
         a_ub, b_ub = [], []
         for (lg, hold, (up, lo)), u, d in zip(gears, pieces[::2], pieces[1::2]):
             row = np.zeros(nv)
@@ -861,8 +880,8 @@ def _loop_group_holds(t, extra=()):
             row[hold], row[lg] = -1.0, -lo[d][0]     # L >= s T_a + c
             a_ub.append(row)
             b_ub.append(-lo[d][1])
-        if linprog(np.zeros(nv), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
-                   method="highs").status == 0:
+        if linprog(np.zeros(nv), A_ub=np.array(a_ub), b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds, method="highs",
+                   options=HIGHS_TIGHT).status == 0:
             return True
     return False
 
@@ -937,6 +956,54 @@ def test_a_loop_with_four_null_directions_holds_while_any_split_holds():
     assert len(slip) == 1 and abs(slip[0] - second) < 1e-6, (slip, second)
     stuck = [t for t, el, e in ev if el == "g1" and e == "stick"]
     assert stuck and not any(stuck[0] + 1e-6 < t < slip[0] - 1e-6 for t, _el, _e in ev)   # held in between
+
+
+def _gear_loop_holds(t, gears, extra, amp):
+    """Independent of the kernel: whether the loop of ``driveline_networks.gear_loop`` (every member stuck, every
+    inertia at rest) has a split of its torques within every member's bounds at ``t`` (:func:`_split_exists`: the
+    static balance of its inertias, every combination of its gears' band pieces).  Columns: the one-way clutch's
+    ``f0`` (at most 0.5 N m), each gear's ``lg`` and ``L`` (:func:`_loop_group_holds`), the loop clutch's, the
+    bearing's and the extra bearings'."""
+    ng = len(gears)
+    nv = 3 + 2 * ng + len(extra)
+    a_eq = np.zeros((ng + 2, nv))
+    a_eq[0, 0], a_eq[1, 0] = 1.0, -1.0
+    for k, (ratio, _eta) in enumerate(gears):
+        a_eq[k + 1, 1 + 2 * k] += 1.0
+        a_eq[k + 2, 1 + 2 * k] -= ratio
+        a_eq[k + 2, 2 + 2 * k] -= ratio
+    c = 1 + 2 * ng
+    a_eq[0, c], a_eq[ng + 1, c], a_eq[0, c + 1] = 1.0, -1.0, -1.0
+    for e, (i, _limit) in enumerate(extra):
+        a_eq[i, c + 2 + e] = -1.0
+    b_eq = np.zeros(ng + 2)
+    b_eq[1] = -amp * math.sin(2 * math.pi * t)
+    bounds = [(None, 0.5)] + [(None, None)] * (2 * ng) + [(-1.5, 1.5), (-1.0, 1.0)] + [(-lim, lim) for _i, lim in extra]
+    return _split_exists(a_eq, b_eq, bounds, [(1 + 2 * k, 2 + 2 * k, _band_lines(eta, eta, 0.0, 0.0))
+                                              for k, (_ratio, eta) in enumerate(gears)])
+
+
+@pytest.mark.parametrize("gears, extra, amp", [
+    ([(1.0, 0.95), (1.0, 0.8), (3.0, 0.8)], (), 4.74),
+    ([(2.0, 0.95), (-3.0, 0.8), (-2.0, 0.25), (1.0, 0.5)], ((2, 0.05),), 2.73),
+])
+def test_three_and_four_stuck_lossy_gears_hold_while_any_combination_of_their_pieces_holds(gears, extra, amp):
+    """A loop of three (four) lossy gears, a one-way clutch and a clutch, stuck from rest: the split search covers
+    every combination of the gears' band pieces (``kernel._pieces_margin``, ``_pieces_nearest``: branch and bound
+    over 64 and 256 combinations).  Before, with more than two stuck lossy gears it searched only the pieces of the
+    torques they carried, and a gear rolled forward at 0.003 s where SciPy's HiGHS holds the loop until 0.0261 s.
+    Now nothing moves until HiGHS finds no split (within 1e-6 s), at two tolerances, with the invariant check on."""
+    d = gear_loop(gears, extra, amp)
+    events = {rtol: _mode_events(d.simulate(0.3, output_step=5e-3, rtol=rtol, check_invariants=True))
+              for rtol in (1e-8, 1e-10)}
+    assert [e[1:] for e in events[1e-8]] == [e[1:] for e in events[1e-10]]
+    assert max(abs(a[0] - b[0]) for a, b in zip(events[1e-8], events[1e-10])) < 1e-6
+    holds = functools.partial(_gear_loop_holds, gears=gears, extra=extra, amp=amp)
+    grid = np.linspace(1e-9, 0.3, 121)
+    first = _edge(holds, 1e-9, next(t for t in grid if not holds(t)))
+    ev = [e for e in events[1e-10] if e[0] > 1e-9]
+    assert abs(ev[0][0] - first) < 1e-6, (ev[0], first)   # nothing moves before: the loop holds
+    assert "f0" in {el for t, el, _e in ev if abs(t - first) < 1e-6}
 
 
 @pytest.mark.parametrize("more", [2, 3])

@@ -2517,30 +2517,105 @@ def _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, z, sc, R, hint, o,
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _piece_bound(t, piece, gk, gq, gl, gw, V, lam, d, row, G, h, w):
+    """Bound ``t`` of the stuck lossy gears (``t // 2`` the gear; even: its band's upper edge, odd: the lower) on
+    its piece ``piece`` (0 or 1: the edge's first or second line, :func:`gear_band`), into row ``row`` of ``G z <=
+    h`` with width ``w``: the hold ``L = lam_k + V_k z`` within ``s T_a + c`` of the line, ``T_a = -(lam_q + V_q
+    z)``."""
+    j = t // 2
+    k, q = gk[j], gq[j]
+    if t % 2 == 0:
+        sl, c0 = gl[j, piece, 0], gl[j, piece, 1]
+        for f in range(d):
+            G[row, f] = V[k, f] + sl * V[q, f]
+        h[row] = c0 - lam[k] - sl * lam[q]
+    else:
+        sl, c0 = gl[j, 2 + piece, 0], gl[j, 2 + piece, 1]
+        for f in range(d):
+            G[row, f] = -(V[k, f] + sl * V[q, f])
+        h[row] = lam[k] + sl * lam[q] - c0
+    w[row] = gw[j]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
-    """The stuck lossy gears' bounds under combination ``comb`` of their band pieces (two digits in base 2 per gear,
-    with at most two gears; else the pieces of the torques they carry now, ``gc``), into rows ``mf`` on of ``G z <=
-    h`` with widths ``w``: a hold ``L = lam_k + V_k z`` within ``s T_a + c`` of its piece's line, ``T_a = -(lam_q +
-    V_q z)``."""
+    """The stuck lossy gears' bounds under combination ``comb`` of their band pieces (per gear two digits in base 2,
+    its upper and lower edge's line: :func:`_pieces_code`; -1: the pieces of the torques they carry now, ``gc``),
+    into rows ``mf`` on of ``G z <= h`` with widths ``w`` (:func:`_piece_bound`)."""
     cc = comb
     for j in range(ng):
-        k, q = gk[j], gq[j]
-        if ng <= 2:
+        if comb >= 0:
             up, dn = cc % 2, (cc // 2) % 2
         else:
             up, dn = gc[j, 0], gc[j, 1]
         cc //= 4
-        sl, c0 = gl[j, up, 0], gl[j, up, 1]
-        row = mf + 2 * j
-        for f in range(d):
-            G[row, f] = V[k, f] + sl * V[q, f]
-        h[row] = c0 - lam[k] - sl * lam[q]
-        w[row] = gw[j]
-        sl, c0 = gl[j, 2 + dn, 0], gl[j, 2 + dn, 1]
-        for f in range(d):
-            G[row + 1, f] = -(V[k, f] + sl * V[q, f])
-        h[row + 1] = lam[k] + sl * lam[q] - c0
-        w[row + 1] = gw[j]
+        _piece_bound(2 * j, up, gk, gq, gl, gw, V, lam, d, mf + 2 * j, G, h, w)
+        _piece_bound(2 * j + 1, dn, gk, gq, gl, gw, V, lam, d, mf + 2 * j + 1, G, h, w)
+
+
+#: the largest margin the search over every gear's pieces (:func:`_pieces_margin`) needs to know: beyond twice
+#: ``SPACE_MARGIN`` the margin kept is ``SPACE_MARGIN`` whatever it is (a bound ``theta <= PIECES_CAP``, which also
+#: keeps the programmes of its partial combinations, where a gear's edge is not yet bounded, from growing without
+#: bound)
+PIECES_CAP = 2.0 * SPACE_MARGIN
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best, dig, idx, base, M, b, yb, zt, R, GR, sc, Rq,
+                   bh, tol, small):
+    """The largest margin (up to :data:`PIECES_CAP`) any split keeps over **every** combination of the pieces of
+    three or more stuck lossy gears (``4**ng`` linear programmes: :func:`_combo_margin`), by branch and bound: a
+    depth-first search over the gears' edges, one digit (the edge's line) at a time, each partial combination's
+    programme (the bounds chosen so far, the gears' other edges dropped: a relaxation, so its margin bounds every
+    combination below it) pruned where it cannot beat ``best`` (the margin of the pieces of the torques the gears
+    carry now, or the last combination that held the set), and where it cannot hold the set (below zero: only
+    whether any combination holds it matters there).  Rows: the friction members' ``mf``, the cap, then
+    one per digit.  The programmes start cold (``bh``: a scratch warm start, cleared before each).  Returns the
+    largest margin found above ``best`` and its combination's code (:func:`_pieces_code`), else ``best`` and -1."""
+    nd = 2 * ng
+    row0 = mf + 1
+    for f in range(d):
+        G[mf, f] = 0.0
+    h[mf] = PIECES_CAP
+    w[mf] = 1.0
+    for t in range(nd):
+        dig[t] = -1
+    code = -1
+    depth = 0
+    while depth >= 0:
+        if best >= PIECES_CAP:
+            break
+        dig[depth] += 1
+        if dig[depth] > 1:
+            dig[depth] = -1
+            depth -= 1
+            continue
+        _piece_bound(depth, dig[depth], gk, gq, gl, gw, V, lam, d, row0 + depth, G, h, w)
+        m = row0 + depth + 1
+        nr = _span_basis(G, m, d, R, GR, zt)
+        bh[0] = -1.0
+        th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, bh, 0, tol, small)
+        if not (th > best and th >= 0.0):
+            continue   # (nothing below it beats the best or holds the set: pruned)
+        if depth == nd - 1:
+            best = th
+            code = _pieces_code(ng, dig)
+            continue
+        depth += 1
+    return best, code
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _pieces_code(ng, dig):
+    """The code of a combination of the pieces of ``ng`` stuck lossy gears, ``dig[j, 0]`` (``dig[2 j]``) the line of
+    gear ``j``'s upper edge and ``dig[j, 1]`` (``dig[2 j + 1]``) its lower edge's: ``sum (up + 2 dn) 4**j``."""
+    code = 0
+    scale = 1
+    flat = dig.reshape(-1)
+    for j in range(ng):
+        code += (flat[2 * j] + 2 * flat[2 * j + 1]) * scale
+        scale *= 4
+    return code
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -2553,10 +2628,13 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     linear in ``z``: a friction member's ``lo <= lam <= hi``; a stuck lossy gear's hold within its band, whose upper
     edge is the larger of two lines in the torque it carries and whose lower edge the smaller (:func:`gear_band`),
     so that the band is the union of four convex pieces, each bounded by one line per edge: every combination of
-    the gears' pieces is searched (with more than two stuck lossy gears, only the pieces of the torques they carry
-    now: a subset of the splits that hold, at 1/16 of the cost).  The split is kept where it keeps
-    ``theta`` of each member's width (its limit's span, its band's width) from its bounds, ``theta`` 1 % or half
-    the largest margin any split has (a linear programme over ``z`` and ``theta`` per combination,
+    the gears' pieces is searched (with up to two stuck lossy gears one by one, each with its warm start; with more,
+    the pieces of the torques they carry now, where they keep less than :data:`PIECES_CAP` the last combination
+    that held the set, and where that keeps less too every combination by branch and bound, :func:`_pieces_margin`:
+    before the forty-second session only the current pieces were searched, and a gear rolled where another piece
+    held the set; the margin kept and the nearest split are then those of the combination found).  The split is
+    kept where it keeps ``theta`` of each member's width (its limit's span, its band's width) from its bounds,
+    ``theta`` 1 % or half the largest margin any split has (a linear programme over ``z`` and ``theta`` per combination,
     :func:`_combo_margin`), and otherwise moved to the nearest split that does (the least ``|V z|``, a quadratic
     programme per combination, :func:`_combo_nearest`): continuous in the torques while one combination of pieces
     holds the set (it may move to another where that one closes), and every member keeps a margin until no split
@@ -2606,7 +2684,7 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     # ---- the bounds G z <= h, each with its width w: the friction members' first (fixed), then two per stuck lossy
     # gear: its band's upper edge is the larger of two lines in the torque it carries, the lower the smaller, so
     # the band is the union of four convex pieces (one line each): every combination of pieces is searched
-    mm = 2 * ns
+    mm = 2 * ns + 1   # (and a row for the search over every gear's pieces: _pieces_margin's cap)
     G = np.zeros((mm, d))
     h = np.empty(mm)
     w = np.empty(mm)
@@ -2684,20 +2762,51 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     sc = np.zeros((2, max(mm, d + 1)))   # (the cold solves' step and shifted bounds: _lp_max, _qp_nearest)
     Rq = np.zeros((d + 1, d + 1))        # (and the triangle of their QR, M holding its Q)
     small = d <= ENUMERATED_DIMENSIONS   # (enumerated where the hints fail; above, the simplex and active sets)
-    # the largest margin any split keeps, per combination of pieces
+    # the largest margin any split keeps, per combination of pieces (with three or more stuck lossy gears, the
+    # pieces of the torques they carry now first: combination -1)
+    deep = ng > 2
     thc = np.empty(ncomb)
     best_theta = -np.inf
     for comb in range(ncomb):
-        _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+        _combo_bounds(-1 if deep else comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
         nr = _span_basis(G, m, d, R, GR, zt)
         thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size * comb, tol, small)
         best_theta = max(best_theta, thc[comb])
+    # with three or more (4**ng combinations): where the current pieces keep less than PIECES_CAP (a margin near
+    # zero is not enough: at 1e-15 no split keeping half of it is found), the last combination that held the set
+    # (its warm start in slot 1, its code + 1 in slot 2), and where that keeps less too, every combination by branch
+    # and bound
+    pick = -1
+    if deep and best_theta < PIECES_CAP:
+        o_code = o_sp + 2 * size
+        last = int(hint[o_code]) - 1
+        if last >= 0 and last != _pieces_code(ng, gc):
+            _combo_bounds(last, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+            nr = _span_basis(G, m, d, R, GR, zt)
+            th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size, tol, small)
+            if th > best_theta:
+                best_theta, pick = th, last
+        if best_theta < PIECES_CAP:
+            dig = np.empty(2 * ng, dtype=np.int64)
+            th, code = _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M, b,
+                                      yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
+            if code >= 0:
+                best_theta, pick = th, code
+                hint[o_code] = code + 1.0
+                hint[o_sp + size] = -1.0            # (its warm start: found anew at its next use)
+                hint[o_sp + size + nk + 2] = -1.0
     if not best_theta >= 0.0:
         return False   # no split holds: the group must slip
     theta = min(SPACE_MARGIN, 0.5 * best_theta)
-    # the nearest split that keeps theta, over the combinations that can keep it
+    # the nearest split that keeps theta, over the combinations that can keep it (with three or more stuck lossy
+    # gears, in the combination that keeps the largest margin found: the current pieces', or ``pick``)
     best_n = np.inf
     for comb in range(ncomb):
+        if deep:
+            _combo_bounds(pick, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+            best_n = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zb, sc, Rq, hint,
+                                    o_sp + (size if pick >= 0 else 0) + nk + 2, tol, small)
+            break
         if not thc[comb] >= theta:
             continue
         _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
