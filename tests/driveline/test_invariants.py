@@ -15,7 +15,6 @@ result again from its columns, by code written here.  The closed forms are deriv
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 
@@ -27,7 +26,7 @@ from hypothesis_budget import examples
 
 from clutchlab.driveline import Driveline, Signal
 from clutchlab.driveline import kernel as K
-from clutchlab.errors import ParameterError, SimulationError
+from clutchlab.errors import SimulationError
 from clutchlab.system import Simulation, simulate
 
 
@@ -82,8 +81,6 @@ def test_the_launch_with_lossy_gears_pulls_away():
     """Finding 1, second layout: efficiencies 0.96 and 0.98 on the launch example's gears.  The vehicle was held at
     0 for 5 s and the engine stalled; it pulls away as with ideal gears, a little slower, and no less than
     0.96 x 0.98 of the ideal gears' final speed (the losses take at most that share of the power)."""
-    from clutchlab.driveline.description import load_driveline
-
     from clutchlab.driveline.description import parse_driveline
     from clutchlab.io.files import read_toml
 
@@ -1605,7 +1602,7 @@ def test_a_loss_table_extrapolated_to_an_efficiency_of_zero_is_a_model_error_nam
         d.simulate(1.0, output_step=1e-3)
     text = str(err.value)
     label = "eta_mf1" if column == 1 else "eta_mf2"
-    assert f"g: loss_table extrapolated beyond its last row (|w_a| = 10 rad/s" in text
+    assert "g: loss_table extrapolated beyond its last row (|w_a| = 10 rad/s" in text
     assert f"{label} reaches 0 at |w_a| = 90 rad/s" in text
     t = float(text.rsplit("at t = ", 1)[1].split(" s")[0])
     assert 0.75 <= t <= 0.76
