@@ -2561,8 +2561,8 @@ PIECES_CAP = 2.0 * SPACE_MARGIN
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best, dig, idx, base, M, b, yb, zt, R, GR, sc, Rq,
-                   bh, tol, small):
+def _pieces_margin(ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w, best, dig, idx, base, M, b, yb, zt, R, GR, sc,
+                   Rq, bh, tol, small):
     """The largest margin (up to :data:`PIECES_CAP`) any split keeps over **every** combination of the pieces of
     three or more stuck lossy gears (``4**ng`` linear programmes: :func:`_combo_margin`), by branch and bound: a
     depth-first search over the gears' edges, one digit (the edge's line) at a time, each partial combination's
@@ -2599,21 +2599,25 @@ def _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best, dig, idx, b
             continue   # (nothing below it beats the best or holds the set: pruned)
         if depth == nd - 1:
             best = th
-            code = _pieces_code(ng, dig)
+            code = _pieces_code(ng, dig, gc)
             continue
         depth += 1
     return best, code
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
-def _pieces_code(ng, dig):
-    """The code of a combination of the pieces of ``ng`` stuck lossy gears, ``dig[j, 0]`` (``dig[2 j]``) the line of
-    gear ``j``'s upper edge and ``dig[j, 1]`` (``dig[2 j + 1]``) its lower edge's: ``sum (up + 2 dn) 4**j``."""
+def _pieces_code(ng, dig, gc):
+    """The code of a combination of the pieces of ``ng`` stuck lossy gears: ``sum (up + 2 dn) 4**j`` over gear
+    ``j``'s upper edge's line ``up`` and lower edge's ``dn``, read from the digits ``dig[2 j]``, ``dig[2 j + 1]``, or
+    where ``dig`` is empty from ``gc[j, 0]``, ``gc[j, 1]`` (the pieces of the torques they carry now).  (Written
+    without a reshape: numba's reshape calls its runtime helper, which a native FMU does not link.)"""
     code = 0
     scale = 1
-    flat = dig.reshape(-1)
     for j in range(ng):
-        code += (flat[2 * j] + 2 * flat[2 * j + 1]) * scale
+        if dig.shape[0] > 0:
+            code += (dig[2 * j] + 2 * dig[2 * j + 1]) * scale
+        else:
+            code += (gc[j, 0] + 2 * gc[j, 1]) * scale
         scale *= 4
     return code
 
@@ -2777,19 +2781,19 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     # (its warm start in slot 1, its code + 1 in slot 2), and where that keeps less too, every combination by branch
     # and bound
     pick = -1
+    dig = np.empty(2 * ng, dtype=np.int64)   # (the branch and bound's digits)
     if deep and best_theta < PIECES_CAP:
         o_code = o_sp + 2 * size
         last = int(hint[o_code]) - 1
-        if last >= 0 and last != _pieces_code(ng, gc):
+        if last >= 0 and last != _pieces_code(ng, dig[:0], gc):
             _combo_bounds(last, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
             nr = _span_basis(G, m, d, R, GR, zt)
             th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size, tol, small)
             if th > best_theta:
                 best_theta, pick = th, last
         if best_theta < PIECES_CAP:
-            dig = np.empty(2 * ng, dtype=np.int64)
-            th, code = _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M, b,
-                                      yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
+            th, code = _pieces_margin(ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M,
+                                      b, yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
             if code >= 0:
                 best_theta, pick = th, code
                 hint[o_code] = code + 1.0
