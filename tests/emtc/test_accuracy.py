@@ -9,23 +9,27 @@ grid values and closed forms, ``tests/hysteresis``) and the parameter sets.  It 
 ``examples/emtc_scenario.toml`` (the coupling slips throughout; its lock-up converges to 1e-6 s,
 ``test_system.py::test_lockup_converges``).  ``simulate_bench`` at rtol 1e-4, 1e-6 (its default) and 1e-8.
 
-Measured (2026-11-29), worst error over the 301 controller samples of the shaft speeds (about 48 rad/s), the
-coil current and the armature position, and of the armature's two events:
+Measured (2026-12-04, the Preisach grid's lines located), worst error over the 301 controller samples of the
+shaft speeds (about 48 rad/s), the coil current and the armature position, and of the armature's two events:
 
 =====  ===============  ==========  ==========  ===================
 rtol   speeds [rad/s]   i2 [A]      x [m]       events [s]
 =====  ===============  ==========  ==========  ===================
-1e-4   1.5e-3           2.2e-5      1.0e-8      1.1e-6
-1e-6   3.0e-4           1.7e-5      8.2e-9      1.9e-7
-1e-8   4.8e-7           1.3e-7      2.1e-11     2.5e-9
+1e-4   1.5e-3           2.2e-5      1.1e-8      2.5e-7
+1e-6   1.5e-4           1.6e-5      2.2e-9      5.1e-8
+1e-8   4.7e-7           1.3e-7      5.7e-11     1.3e-9
 =====  ===============  ==========  ==========  ===================
+
+(2026-11-29, before: 1.5e-3 / 2.2e-5 / 1.0e-8 / 1.1e-6, 3.0e-4 / 1.7e-5 / 8.2e-9 / 1.9e-7, 4.8e-7 / 1.3e-7 /
+2.1e-11 / 2.5e-9.)
 
 At the default rtol the speeds' error is set by their absolute tolerance (1e-4 rad/s); before issue #30 that
 stayed fixed below the default, and the error stopped at 1.3e-4 rad/s from rtol 1e-7 down.  Now the absolute
-tolerances shrink with rtol (``clutchlab.emtc.system.absolute_tolerance``).  Left: around t = 1.14 s, where the
-coil current crosses the 2.5 A grid line of the Preisach table (a kink of the magnet force that clutchlab does
-not locate), the speeds are off by 3.2e-7 to 4.8e-7 rad/s at rtol 1e-8, 1e-9 and 1e-10 alike (the error decays
-within a few milliseconds through the tyres); at rtol 1e-11 clutchlab meets the reference there.
+tolerances shrink with rtol (``clutchlab.emtc.system.absolute_tolerance``).  Until the forty-second session the
+coil current's crossings of the Preisach grid's lines (1.0, 1.5 and 2.5 A at about 0.21, 0.50 and 1.14 s: kinks
+of the magnet force) were not located, and the speeds were off by 4.4e-7 / 4.1e-7 rad/s at rtol 1e-9 / 1e-10
+wherever a step straddled one (``test_the_grid_lines_of_the_magnet_are_located``).  Re-measured with them located
+(2026-12-04): speeds 1.5e-4 / 4.7e-7 / 6.0e-8 / 5.2e-9 rad/s at rtol 1e-6 / 1e-8 / 1e-9 / 1e-10.
 """
 
 from __future__ import annotations
@@ -137,3 +141,40 @@ def test_lugre_bench_error_shrinks_with_rtol_against_a_stiff_reference():
     loose, default, tight = (err[r] for r in RTOLS)
     assert tight < default / 20 and default < loose / 3, err
     assert default < BOUND["speed"] and tight < 1e-5, err
+
+
+def test_the_grid_lines_of_the_magnet_are_located(example):
+    """The coil current crosses lines of the plant magnet's Preisach grid (kinks of the magnet force: Eqs. 2-5
+    interpolate the Everett function between them).  Before they were switching functions
+    (``emtc.system.grid_line_function``) a step straddled them and the speeds were off by 4.4e-7 rad/s at rtol
+    1e-9 and 4.1e-7 at 1e-10, the tolerance not followed; now (waypoints: a step ends just past each line) the
+    error follows rtol (6.0e-8 and 5.2e-9 measured), and the crossings name no event."""
+    magnet, scenario, (ref, _ref_events) = example
+    err = {}
+    for rtol in (1e-9, 1e-10):
+        run = simulate_bench(magnet, scenario, rtol=rtol)
+        df = run.to_dataframe()
+        err[rtol] = max(np.max(np.abs(df["omega_f_rad_s"] - ref[:, 1])), np.max(np.abs(df["omega_r_rad_s"] - ref[:, 2])))
+        assert list(run.events["event"]) == ["armature_leave_rest", "armature_contact"]
+    assert err[1e-9] < 1.5e-7 and err[1e-10] < 2e-8 and err[1e-10] < err[1e-9] / 4, err
+
+
+def test_the_grid_line_function_changes_sign_at_every_line_and_nowhere_else():
+    """``grid_line_function`` against the grid it is for, on a non-uniform grid as well: zero exactly at every
+    line, one sign per cell alternating from cell to cell (also beyond the grid), continuous."""
+    from clutchlab.emtc.system import grid_line_function
+
+    for grid in (np.arange(0.0, 5.0, 0.5), np.array([-1.0, 0.0, 0.3, 2.0, 2.1, 4.0])):
+        assert all(grid_line_function(g, grid) == 0.0 for g in grid)
+        edges = np.concatenate([[grid[0] - 1.0], grid, [grid[-1] + 1.0]])
+        signs = []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            inner = np.linspace(lo, hi, 41)[1:-1]
+            values = np.array([grid_line_function(i, grid) for i in inner])
+            assert np.all(values != 0.0)
+            assert len(set(np.sign(values))) == 1
+            signs.append(np.sign(values[0]))
+        assert all(a == -b for a, b in zip(signs[:-1], signs[1:]))
+        i = np.linspace(grid[0] - 1.0, grid[-1] + 1.0, 20001)
+        v = np.array([grid_line_function(q, grid) for q in i])
+        assert np.max(np.abs(np.diff(v))) < 2 * (i[1] - i[0])   # continuous (slope at most 1)

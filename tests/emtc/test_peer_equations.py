@@ -69,6 +69,18 @@ def _cfunc_dy(t, y, d):
 currents = st.floats(-0.5, 5.0, allow_nan=False)
 
 
+def _grid_line(i, grid):
+    """``(-1)**k (i - grid[k]) (grid[k+1] - i) / (grid[k+1] - grid[k])`` in the grid's cell ``k`` holding ``i``,
+    ``i - grid[0]`` below it, ``(-1)**(n-1) (i - grid[n-1])`` above (``emtc.system.grid_line_function``)."""
+    n = len(grid)
+    if i <= grid[0]:
+        return i - grid[0]
+    if i >= grid[-1]:
+        return (-1) ** (n - 1) * (i - grid[-1])
+    k = int(np.searchsorted(grid, i, side="right")) - 1
+    return (-1) ** k * (i - grid[k]) * (grid[k + 1] - i) / (grid[k + 1] - grid[k])
+
+
 @settings(deadline=None, max_examples=examples(60))
 @given(t=st.floats(0.0, 1.2), wf=st.floats(-10.0, 90.0), dw=st.floats(-3.0, 3.0), theta=st.floats(-0.05, 0.05),
        xa=st.floats(-1e-4, 6e-4), xd=st.floats(-0.5, 0.5), i1=currents, i2=currents, icmd=st.floats(0.0, 4.5),
@@ -102,7 +114,13 @@ def test_rhs_matches_clutchlab(t, wf, dw, theta, xa, xd, i1, i2, icmd, vf, vr, a
     assert fm == pytest.approx(y_cl[2], rel=1e-10, abs=1e-9)
     assert tc == pytest.approx(y_cl[8], rel=1e-10, abs=1e-9)
     np.testing.assert_allclose(dy, dx_cl, rtol=1e-9, atol=1e-7)
-    np.testing.assert_allclose(gsw, g_cl, rtol=1e-9, atol=1e-9)
+    # the mode changes' functions (the peer's six); the coil current's grid-line waypoints are clutchlab's alone,
+    # checked against their definition written out here
+    modes = [k for k, (_name, d) in enumerate(S.SWITCHING) if abs(d) != 3]
+    np.testing.assert_allclose(gsw, g_cl[modes], rtol=1e-9, atol=1e-9)
+    for name in ("coil_current_grid_line_falling", "coil_current_grid_line_rising"):
+        k = [q[0] for q in S.SWITCHING].index(name)
+        assert g_cl[k] == pytest.approx(_grid_line(i2, MAGNET.grid), rel=1e-12, abs=1e-15)
     # the cfunc numbalsoda calls (scaled state) gives the same derivative
     np.testing.assert_allclose(_cfunc_dy(t, x, d), dy, rtol=1e-12, atol=1e-12)
 

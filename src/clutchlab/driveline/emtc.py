@@ -24,7 +24,9 @@ here.  The two parts meet through three numbers per evaluation (:func:`clutchlab
   (below it the slip reverses, Fig. 11).
 
 The network's friction state machine decides stick and slip (the bench model's ``slip_speed_zero`` and
-``lock_capacity_exceeded`` switching functions are held off).  A stuck coupling carries the torque the
+``lock_capacity_exceeded`` switching functions are held off).  Its ``coil_current_grid_line_falling`` and ``_rising``
+functions (the coil current crossing a line of the Preisach grid, a kink of the magnet force: waypoints) are the
+network's too: a step ends just past the line, nothing changes mode.  A stuck coupling carries the torque the
 network's constraint solve gives it: for the two shafts of the bench, that is Eq. 29's ``T_lock``, and
 the Torsen twist of Eq. 30 stays zero (its terms vanish identically while both shafts turn together).
 

@@ -1013,7 +1013,8 @@ def evaluate_network(t, x, m, p, acc, tau):
     return ns
 
 
-#: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16)
+#: the warm start of :func:`_repair_space`, per combination of the stuck lossy gears' band pieces (at most 16; with
+#: three or more gears, slot 0 the current pieces', slot 1 the last combination that held the set, slot 2 its code)
 SPACE_SLOTS = 16
 
 
