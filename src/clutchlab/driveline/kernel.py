@@ -2548,7 +2548,7 @@ def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
         if comb >= 0:
             up, dn = cc % 2, (cc // 2) % 2
         else:
-            up, dn = gc[j, 0], gc[j, 1]
+            up, dn = gc[2 * j], gc[2 * j + 1]
         cc //= 4
         _piece_bound(2 * j, up, gk, gq, gl, gw, V, lam, d, mf + 2 * j, G, h, w)
         _piece_bound(2 * j + 1, dn, gk, gq, gl, gw, V, lam, d, mf + 2 * j + 1, G, h, w)
@@ -2562,8 +2562,8 @@ PIECES_CAP = 2.0 * SPACE_MARGIN
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _pieces_margin(ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w, best, dig, idx, base, M, b, yb, zt, R, GR, sc,
-                   Rq, bh, tol, small):
+def _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best, dig, idx, base, M, b, yb, zt, R, GR, sc, Rq,
+                   bh, tol, small):
     """The largest margin (up to :data:`PIECES_CAP`) any split keeps over **every** combination of the pieces of
     three or more stuck lossy gears (``4**ng`` linear programmes: :func:`_combo_margin`), by branch and bound: a
     depth-first search over the gears' edges, one digit (the edge's line) at a time, each partial combination's
@@ -2600,25 +2600,20 @@ def _pieces_margin(ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w, best, dig, id
             continue   # (nothing below it beats the best or holds the set: pruned)
         if depth == nd - 1:
             best = th
-            code = _pieces_code(ng, dig, gc)
+            code = _pieces_code(ng, dig)
             continue
         depth += 1
     return best, code
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
-def _pieces_code(ng, dig, gc):
-    """The code of a combination of the pieces of ``ng`` stuck lossy gears: ``sum (up + 2 dn) 4**j`` over gear
-    ``j``'s upper edge's line ``up`` and lower edge's ``dn``, read from the digits ``dig[2 j]``, ``dig[2 j + 1]``, or
-    where ``dig`` is empty from ``gc[j, 0]``, ``gc[j, 1]`` (the pieces of the torques they carry now).  (Written
-    without a reshape: numba's reshape calls its runtime helper, which a native FMU does not link.)"""
+def _pieces_code(ng, dig):
+    """The code of a combination of the pieces of ``ng`` stuck lossy gears, ``dig[2 j]`` the line of gear ``j``'s
+    upper edge and ``dig[2 j + 1]`` its lower edge's: ``sum (up + 2 dn) 4**j`` (:func:`_combo_bounds` reads it)."""
     code = 0
     scale = 1
     for j in range(ng):
-        if dig.shape[0] > 0:
-            code += (dig[2 * j] + 2 * dig[2 * j + 1]) * scale
-        else:
-            code += (gc[j, 0] + 2 * gc[j, 1]) * scale
+        code += (dig[2 * j] + 2 * dig[2 * j + 1]) * scale
         scale *= 4
     return code
 
@@ -2697,7 +2692,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     gq = np.empty(ns, dtype=np.int64)
     gl = np.empty((ns, 4, 2))            # its lines (slope, offset): upper 1, upper 2, lower 1, lower 2
     gw = np.empty(ns)
-    gc = np.empty((ns, 2), dtype=np.int64)   # the pieces of the torque it carries now (gear_band's choice)
+    gc = np.empty(2 * ns, dtype=np.int64)    # the pieces of the torque it carries now (gear_band's choice):
+    #                                          its upper edge's line, its lower edge's (:func:`_pieces_code`)
     ng = 0
     m = 0
     inside = True
@@ -2726,8 +2722,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
             eta1, eta2, bf1, bf2, bfa = gear_losses(p, r, 0.0)
             lo0, hi0 = gear_band(p, r, -lam[q])
             gk[ng], gq[ng] = k, q
-            gc[ng, 0] = 0 if -lam[q] - bfa > 0.0 else 1
-            gc[ng, 1] = 0 if -lam[q] + bfa > 0.0 else 1
+            gc[2 * ng] = 0 if -lam[q] - bfa > 0.0 else 1
+            gc[2 * ng + 1] = 0 if -lam[q] + bfa > 0.0 else 1
             gl[ng, 0, 0], gl[ng, 0, 1] = 1.0 - eta1, bf1
             gl[ng, 1, 0], gl[ng, 1, 1] = 1.0 - 1.0 / eta2, bf2
             gl[ng, 2, 0], gl[ng, 2, 1] = 1.0 - 1.0 / eta2, -bf2
@@ -2786,15 +2782,15 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     if deep and best_theta < PIECES_CAP:
         o_code = o_sp + 2 * size
         last = int(hint[o_code]) - 1
-        if last >= 0 and last != _pieces_code(ng, dig[:0], gc):
+        if last >= 0 and last != _pieces_code(ng, gc):
             _combo_bounds(last, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
             nr = _span_basis(G, m, d, R, GR, zt)
             th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size, tol, small)
             if th > best_theta:
                 best_theta, pick = th, last
         if best_theta < PIECES_CAP:
-            th, code = _pieces_margin(ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M,
-                                      b, yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
+            th, code = _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M, b,
+                                      yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
             if code >= 0:
                 best_theta, pick = th, code
                 hint[o_code] = code + 1.0
@@ -2806,12 +2802,11 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     # the nearest split that keeps theta, over the combinations that can keep it (with three or more stuck lossy
     # gears, in the combination that keeps the largest margin found: the current pieces', or ``pick``)
     best_n = np.inf
-    for comb in range(ncomb):
-        if deep:
-            _combo_bounds(pick, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
-            best_n = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zb, sc, Rq, hint,
-                                    o_sp + (size if pick >= 0 else 0) + nk + 2, tol, small)
-            break
+    if deep:
+        _combo_bounds(pick, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+        best_n = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zb, sc, Rq, hint,
+                                o_sp + (size if pick >= 0 else 0) + nk + 2, tol, small)
+    for comb in range(0 if deep else ncomb):
         if not thc[comb] >= theta:
             continue
         _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
