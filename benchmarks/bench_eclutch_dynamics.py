@@ -346,9 +346,9 @@ def compare(ec: EClutch, label: str, methods, repeats: int, n: int = 201):
           f"{T_END / t_sim:,.0f}x real time (medians of {n} runs, min-max)")
     tight = ec.simulate(INPUT, T_END, rtol=1e-8, atol_scale=1e-2)
     grid = np.linspace(0.0, T_END, 2001)
-    fb_tight = np.interp(grid, tight.outputs.time_s, tight.outputs.bearing_force_N)
+    fb_tight = np.interp(grid, tight.outputs_table.time_s, tight.outputs_table.bearing_force_N)
     peak = np.abs(fb_tight).max()
-    err_cl = np.abs(np.interp(grid, res.outputs.time_s, res.outputs.bearing_force_N) - fb_tight).max() / peak
+    err_cl = np.abs(np.interp(grid, res.outputs_table.time_s, res.outputs_table.bearing_force_N) - fb_tight).max() / peak
     print(f"  clutchlab error vs an rtol 1e-8 run: max |dF_b| = {err_cl * 100:.3f} % of peak; energy balance "
           f"residual {res.energy_balance()['relative']:.1e} of the input work")
     for method in methods:

@@ -185,7 +185,7 @@ def main(quick: bool = False, scipy_cap: float | None = None, with_scipy: bool =
         tk, out = timed(lambda: contract.simulate(system, T_END, outputs=False, max_steps=2_000_000), n)
         ts, res = timed(lambda: ec.simulate(INPUT, T_END, rtol=r, output_step=GRID[1], max_steps=2_000_000,
                                                  atol_scale=1.0), n)
-        e = err(np.interp(GRID, res.outputs.time_s, res.outputs.bearing_force_N))
+        e = err(np.interp(GRID, res.outputs_table.time_s, res.outputs_table.bearing_force_N))
         note = f"{out.stats['accepted_steps']} steps, {len(out.events)} events"
         core.points.append(Point(r, e, tk, note))
         sim.points.append(Point(r, e, ts))

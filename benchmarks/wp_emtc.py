@@ -257,7 +257,7 @@ def main(argv=None):
         tt, r = timed(lambda: simulate_bench(magnet, sc, rtol=rtol, atol=atol), 3)
         reps = repeats_for(min(tt), budget_fast, 5)
         tt, r = timed(lambda: simulate_bench(magnet, sc, rtol=rtol, atol=atol), reps)
-        cl.points.append(Point(rtol, error(r.states.to_numpy()[:, :2], ref), tt, f"{r.n_steps} steps"))
+        cl.points.append(Point(rtol, error(r.states[:, :2], ref), tt, f"{r.n_steps} steps"))
         systems = [bench_system(magnet, sc) for _ in range(reps + 1)]
         core_simulate(systems[0], float(samples[-1]), sample_times=samples, rtol=rtol, atol=atol)
         tk = []

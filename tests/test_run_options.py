@@ -108,7 +108,7 @@ def test_the_eclutch_takes_atol_and_its_error_control_follows_it():
     ec = EClutch()
     ref = {"bearing_reference": ([0.0, 0.2, 0.6], [0.0, 6e-3, 6e-3])}
     runs = {a: ec.simulate(ref, 0.6, rtol=1e-2, atol=a, output_step=0.01) for a in (1.0, 1e-6, 1e-10)}
-    end = {a: float(r.outputs["bearing_position_m"].iloc[-1]) for a, r in runs.items()}
+    end = {a: float(r.outputs_table["bearing_position_m"].iloc[-1]) for a, r in runs.items()}
     steps = [runs[a].stats["accepted_steps"] for a in (1.0, 1e-6, 1e-10)]
     assert steps[0] < steps[1] < steps[2], steps
     loose, tight = abs(end[1.0] - end[1e-10]), abs(end[1e-6] - end[1e-10])
@@ -195,3 +195,48 @@ def test_a_tighter_rtol_brings_a_systems_absolute_tolerances_down_through_the_co
     kept = [error(rtol, system.atol) for rtol in (1e-6, 1e-8, 1e-10)]
     assert followed[0] > 30 * followed[1] > 900 * followed[2] and followed[2] < 1e-6, followed
     assert min(kept) > 0.05, kept   # (the floor the fixed absolute tolerances set)
+
+
+def _short_runs():
+    """Each model's own entry point on a short run (the kernels are the ones the rest of the suite compiles)."""
+    from clutchlab.emtc import BenchScenario, bundled_magnet
+
+    clutch = WetClutch.paper()
+    return {
+        "clutchlab.wet.simulate_engagement":
+            lambda: simulate_engagement(clutch, EngagementProtocol(duration=0.3).scenario(clutch), output_step=0.01),
+        "clutchlab.emtc.bench.simulate_bench": lambda: simulate_bench(bundled_magnet(), BenchScenario(duration=0.1)),
+        "clutchlab.eclutch.EClutch.simulate":
+            lambda: EClutch().simulate({"bearing_reference": ([0.0, 0.05], [0.0, 4e-3])}, 0.1, output_step=0.01),
+        "clutchlab.eclutch.ClutchDynamics.simulate":
+            lambda: ClutchDynamics(ClutchModel.preset(0)).simulate(([0.0, 0.1], [0.0, 4e-3]), output_step=0.01),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(_short_runs()))
+def test_every_model_entry_point_returns_a_simulation_result(name):
+    """#31: the public entry points return a :class:`~clutchlab.SimulationResult` (a subclass with what the model
+    adds), not a view of their own: its arrays, unit-suffixed columns, named events and the one ``to_dataframe``
+    contract hold for each, and it pickles whole (a sweep worker returns it)."""
+    import pickle
+
+    from clutchlab.result import SimulationResult
+
+    res = _short_runs()[name]()
+    assert isinstance(res, SimulationResult) and type(res) is not SimulationResult, type(res)
+    assert res.ok and res.model and isinstance(res.states, np.ndarray) and isinstance(res.outputs, np.ndarray)
+    n = res.time.size
+    assert res.states.shape == (n, len(res.state_columns)) and res.outputs.shape == (n, len(res.output_columns))
+    assert res.modes.shape == (n, len(res.mode_names)) and res.modes.dtype.kind == "i"
+    for col in res.state_columns + res.output_columns:
+        assert res[col].shape == (n,), col
+    assert list(res.events.columns[:3]) == ["time_s", "event", "element"]
+    assert all(isinstance(e, str) and e.isidentifier() for e in res.events["event"]), list(res.events["event"])
+    assert res.stats["accepted_steps"] > 0
+    frame = res.to_dataframe()
+    assert "time_s" in frame.columns and len(frame) == n
+    back = pickle.loads(pickle.dumps(res))
+    assert type(back) is type(res)
+    np.testing.assert_array_equal(back.states, res.states)
+    assert back.events.equals(res.events)
+    assert back.to_dataframe().equals(frame)

@@ -85,6 +85,15 @@ class SimulationResult:
         self.events  # noqa: B018  (build the events before pickling: no callable in the state)
         return self.__dict__
 
+    @classmethod
+    def fields_of(cls, result: "SimulationResult") -> dict:
+        """The fields of ``result`` as keyword arguments of a subclass's constructor (a model's entry point returns
+        its own subclass, :class:`clutchlab.wet.EngagementResult`, ..., built from the core's run with them).  The
+        events stay unbuilt where they were (their callable is passed on)."""
+        kw = {f.name: getattr(result, f.name) for f in dataclasses.fields(SimulationResult) if f.name != "events"}
+        kw["events"] = result.__dict__["_built_events"]
+        return kw
+
     @property
     def batch(self) -> bool:
         """True for a stacked batch (leading variant axis)."""
@@ -150,6 +159,6 @@ class SimulationResult:
 
     def __repr__(self) -> str:
         shape = f"{self.states.shape[0]} variants x " if self.batch else ""
-        return (f"SimulationResult(model={self.model!r}, {shape}{self.time.size} samples, "
+        return (f"{type(self).__name__}(model={self.model!r}, {shape}{self.time.size} samples, "
                 f"{len(self.state_columns)} states, {len(self.output_columns)} outputs, "
                 f"{len(self.events)} events, status={self.status if self.batch else Status(int(self.status)).name})")

@@ -40,8 +40,12 @@ def test_the_table_view_keeps_its_labels_and_holds_the_result():
     dyn = EClutch(friction=FrictionParameters()).simulate(PEDAL, 1.0)
     assert isinstance(dyn.result, SimulationResult)
     assert len(dyn.events) == len(dyn.result.events)
-    assert "contact opens" in set(dyn.events.event) and "pp (R_f.pp)" in set(dyn.events["where"])
-    np.testing.assert_array_equal(dyn.outputs.torque_Nm.to_numpy(), dyn.result["torque_Nm"])
+    assert isinstance(dyn, SimulationResult) and dyn.result is dyn
+    assert list(dyn.events.columns[:3]) == ["time_s", "event", "element"]   # the run's, then the rig's labels
+    assert "contact_open" in set(dyn.events.event) and "contact opens" in set(dyn.events.description)
+    assert "pp (R_f.pp)" in set(dyn.events["where"])
+    np.testing.assert_array_equal(dyn.outputs_table.torque_Nm.to_numpy(), dyn["torque_Nm"])
+    np.testing.assert_array_equal(dyn["bearing_position_m"], dyn.outputs_table.bearing_position_m.to_numpy())
 
 
 def test_every_step_without_output_step_in_growing_chunks():
@@ -62,7 +66,7 @@ def test_same_options_everywhere_and_h_max_is_max_step():
     c = simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, max_step=2e-3, rtol=1e-3)
     d = EClutch(friction=FrictionParameters()).simulate({"voltage": ([0.0, 0.01], [0.0, 6.0])}, 0.2, max_step=2e-3)
     np.testing.assert_array_equal(c.time, d.time)
-    np.testing.assert_array_equal(c["pressure_Pa"], d.outputs.pressure_Pa.to_numpy())
+    np.testing.assert_array_equal(c["pressure_Pa"], d.outputs_table.pressure_Pa.to_numpy())
 
 
 def test_registered_model_and_evaluation_through_the_contract():
@@ -85,7 +89,7 @@ def test_cosimulation_session_equals_one_run_at_its_communication_points():
         xs.append(sim.x[1])
     one = ec.simulate({"bearing_reference": ([0.0, 0.02, 0.02 + 1e-12], [0.0, 0.0, 5e-3])}, 0.2, rtol=1e-6,
                       output_step=2e-3)
-    assert np.abs(np.array(xs) - one.outputs.bearing_position_m.to_numpy()[1:]).max() < 2e-6
+    assert np.abs(np.array(xs) - one.outputs_table.bearing_position_m.to_numpy()[1:]).max() < 2e-6
     assert set(sim.events().event) <= set(EVENTS)
 
 

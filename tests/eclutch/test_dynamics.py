@@ -67,7 +67,7 @@ def test_stick_slip_matches_closed_form():
     assert stk[0] == pytest.approx(ts, abs=1e-8)
     assert brk[1] == pytest.approx(t2, abs=1e-7)
     # the mass stands still between stick and the next breakaway, at the predicted position
-    o = res.outputs
+    o = res.outputs_table
     held = o[(o.time_s > stk[0] + 1e-4) & (o.time_s < brk[1] - 1e-4)]
     assert len(held) > 0
     assert np.allclose(held.x_pp_m, x_slip, atol=1e-9)
@@ -85,8 +85,8 @@ def test_zero_normal_force_means_free():
     dyn = ClutchDynamics(single_mass(k, m), [el])
     res = dyn.simulate(([0.0, 0.05], [0.0, 0.0]))
     # no load, no friction: the mass never sticks against a force and nothing moves
-    assert np.allclose(res.outputs.x_pp_m, 0.0, atol=1e-12)
-    assert np.allclose(res.outputs.friction_pp_N, 0.0, atol=1e-9)
+    assert np.allclose(res.outputs_table.x_pp_m, 0.0, atol=1e-12)
+    assert np.allclose(res.outputs_table.friction_pp_N, 0.0, atol=1e-9)
 
 
 # issue #30 finding 4: an element whose normal force is zero is free from the start, at every rtol (it
@@ -102,13 +102,13 @@ def test_element_without_normal_force_is_free_from_the_start(number, rtol):
     unloaded = FrictionElement("unloaded", "pp", coefficient=0.3)  # per unit normal force, but no normal element
     res = ClutchDynamics(model, [unloaded]).simulate(RELEASE_ENGAGE, rtol=rtol, output_step=2e-3)
     ref = ClutchDynamics(model).simulate(RELEASE_ENGAGE, rtol=rtol, output_step=2e-3)
-    assert set(res.events.event) <= {"contact opens", "contact closes"}, res.events
+    assert set(res.events.event) <= {"contact_open", "contact_close"}, res.events
     assert np.all(res.result.mode("friction_mode_pp") == "free")
-    assert np.all(res.outputs.friction_pp_N == 0.0)
-    peak = ref.outputs.bearing_force_clutch_N.abs().max()
+    assert np.all(res.outputs_table.friction_pp_N == 0.0)
+    peak = ref.outputs_table.bearing_force_clutch_N.abs().max()
     for col in ("bearing_force_clutch_N", "x_pp_m"):
         scale = peak if col.endswith("_N") else 1e-3
-        assert np.abs(res.outputs[col] - ref.outputs[col]).max() <= 1e-9 * scale, col
+        assert np.abs(res.outputs_table[col] - ref.outputs_table[col]).max() <= 1e-9 * scale, col
 
 
 @pytest.mark.parametrize("rtol", [1e-3, 1e-5, 1e-6])
@@ -119,13 +119,13 @@ def test_friction_engages_when_its_normal_force_rises_and_frees_when_it_returns_
     el = FrictionElement("cushion friction", "pp", coefficient=0.3, normal="cushion", static_ratio=1.2)
     res = ClutchDynamics(model, [el]).simulate(RELEASE_ENGAGE, rtol=rtol, output_step=1e-3)
     ev = res.events
-    opened = ev[(ev.event == "contact opens") & (ev.element == "cushion")].time_s.to_numpy()
-    closed = ev[(ev.event == "contact closes") & (ev.element == "cushion")].time_s.to_numpy()
-    freed = ev[ev.event == "friction free"].time_s.to_numpy()
-    engaged = ev[ev.event == "friction engages"].time_s.to_numpy()
+    opened = ev[(ev.event == "contact_open") & (ev.element == "cushion")].time_s.to_numpy()
+    closed = ev[(ev.event == "contact_close") & (ev.element == "cushion")].time_s.to_numpy()
+    freed = ev[ev.event == "friction_free"].time_s.to_numpy()
+    engaged = ev[ev.event == "friction_engage"].time_s.to_numpy()
     assert len(opened) == len(closed) == len(freed) == len(engaged) == 1, ev
     assert freed[0] == opened[0] and engaged[0] == closed[0]  # at once, at the located contact events
-    o = res.outputs
+    o = res.outputs_table
     mode = res.result.mode("friction_mode_pp")
     t = o.time_s.to_numpy()
     inside = (t > freed[0]) & (t < engaged[0])
@@ -135,12 +135,12 @@ def test_friction_engages_when_its_normal_force_rises_and_frees_when_it_returns_
     released = ([0.0, 4.0], [8e-3, 0.0])
     res = ClutchDynamics(model, [el]).simulate(released, rtol=rtol, output_step=1e-3)
     ev = res.events
-    closed = ev[(ev.event == "contact closes") & (ev.element == "cushion")].time_s.to_numpy()
-    engaged = ev[ev.event == "friction engages"].time_s.to_numpy()
+    closed = ev[(ev.event == "contact_close") & (ev.element == "cushion")].time_s.to_numpy()
+    engaged = ev[ev.event == "friction_engage"].time_s.to_numpy()
     assert len(closed) == 1 and list(engaged) == list(closed)
     assert not np.any(ev.event.isin(["stick", "breakaway", "slip reversal"]) & (ev.time_s < closed[0]))
     mode = res.result.mode("friction_mode_pp")
-    t = res.outputs.time_s.to_numpy()
+    t = res.outputs_table.time_s.to_numpy()
     assert np.all(mode[t < closed[0]] == "free") and not np.any(mode[t > closed[0]] == "free")
 
 
@@ -150,7 +150,7 @@ def test_slow_cycle_without_friction_reproduces_static_curve(number):
     model = ClutchModel.preset(number)
     t, x = smooth_cycle(7.5e-3, 4.0)
     res = ClutchDynamics(model).simulate((t, x), rtol=1e-6)
-    o = res.outputs
+    o = res.outputs_table
     static = model.static_curve(o.bearing_position_m.to_numpy())
     peak = static.bearing_force_N.abs().max()
     err = np.abs(o.bearing_force_clutch_N.to_numpy() - static.bearing_force_N.to_numpy()).max()
@@ -172,7 +172,7 @@ def test_reversal_of_the_bearing_follows_the_static_curve_at_the_default_rtol(nu
     errors = {}
     for rtol in (None, 1e-4, 1e-6, 1e-8):
         options = {} if rtol is None else {"rtol": rtol}
-        o = dyn.simulate(RELEASE_ENGAGE, output_step=2e-3, **options).outputs
+        o = dyn.simulate(RELEASE_ENGAGE, output_step=2e-3, **options).outputs_table
         static = model.static_curve(o.bearing_position_m.to_numpy())
         peak = static.bearing_force_N.abs().max()
         errors[rtol] = np.abs(o.bearing_force_clutch_N.to_numpy() - static.bearing_force_N.to_numpy()).max() / peak
@@ -183,7 +183,7 @@ def test_reversal_of_the_bearing_follows_the_static_curve_at_the_default_rtol(nu
 def test_hysteresis_area_equals_friction_dissipation(model4):
     t, x = smooth_cycle(7.5e-3, 1.0)
     res = ClutchDynamics(model4, FrictionParameters()).simulate((t, x), rtol=1e-6)
-    o = res.outputs
+    o = res.outputs_table
     u = o.bearing_position_m.to_numpy()
     f = o.bearing_force_clutch_N.to_numpy()
     loop_area = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(u)))  # closed cycle: integral of F du
@@ -216,7 +216,7 @@ def test_energy_balance_over_a_cycle(friction):
     assert e["input_J"] > 1.0
     assert abs(e["relative"]) < 0.005, e
     # it really released and re-engaged the clutch
-    o = res.outputs
+    o = res.outputs_table
     assert o.bearing_position_m.max() > 5e-3
     assert o.torque_Nm.iloc[-1] > 0.9 * o.torque_Nm.iloc[0]
 
@@ -226,7 +226,7 @@ def test_position_control_tracks_the_pedal_reference():
     t = np.array([0.0, 0.1, 0.3, 1.0, 1.2])
     ref = pedal_reference([0.0, 0.0, 1.0, 1.0, 0.5], release_travel=8e-3)
     res = ec.simulate({"bearing_reference": (t, ref)}, 2.0)
-    o = res.outputs
+    o = res.outputs_table
     at = lambda tt: float(np.interp(tt, o.time_s, o.bearing_position_m))  # noqa: E731
     # seal and diaphragm friction leave a stick-slip tracking error of a few tenths of a millimetre
     # (the frictionless loop settles to 5 um: test_held_position_pressure_equals_spring_load_over_area)
@@ -248,11 +248,14 @@ def test_result_tables_survive_pickling_before_they_are_read():
     inp = {"bearing_reference": ([0.0, 0.1, 0.3], [0.0, 0.0, 6e-3])}
     read = ec.simulate(inp, 0.4)
     shipped = pickle.loads(pickle.dumps(ec.simulate(inp, 0.4)))
-    for name in ("states", "outputs", "events"):
+    for name in ("states_table", "outputs_table", "events"):
         assert getattr(shipped, name).equals(getattr(read, name)), name
-    assert len(read.events) > 0 and read.outputs.shape[0] == read.time.size
+    assert len(read.events) > 0 and read.outputs_table.shape[0] == read.time.size
     assert shipped.energy.equals(read.energy)
-    assert shipped.stats == read.stats
+    np.testing.assert_array_equal(shipped.states, read.states)
+    assert shipped.stats.keys() == read.stats.keys()
+    for key, value in read.stats.items():
+        np.testing.assert_array_equal(shipped.stats[key], value, err_msg=key)
 
 # ----------------------------------------------------------------- actuator steady states
 def frictionless_actuator(**kw):
@@ -263,7 +266,7 @@ def frictionless_actuator(**kw):
 def test_rest_is_an_equilibrium_without_flow():
     ec = EClutch(friction=FrictionParameters())
     res = ec.simulate({"voltage": 0.0}, 0.5)
-    o = res.outputs
+    o = res.outputs_table
     assert np.allclose(o.line_flow_m3_s, 0.0, atol=1e-12)
     assert np.allclose(o.pressure_Pa, 0.0, atol=1e-6)
     assert np.allclose(o.bearing_position_m, 0.0, atol=1e-12)
@@ -276,7 +279,7 @@ def test_held_position_pressure_equals_spring_load_over_area(target):
     rig = actuator_test_rig(stiffness=3e5, preload=act.csc_preload)
     ec = EClutch(act, rig)
     res = ec.simulate({"bearing_reference": ([0.0, 0.05, 0.25], [0.0, 0.0, target])}, 2.5)
-    o = res.outputs.iloc[-1]
+    o = res.outputs_table.iloc[-1]
     load = act.csc_preload + 3e5 * o.bearing_position_m
     p_expected = static_pressure(load, o.bearing_position_m, act)
     assert o.bearing_position_m == pytest.approx(target, abs=5e-6)
@@ -292,7 +295,7 @@ def test_clutch_steady_state_pressure(model4):
     act = frictionless_actuator()
     ec = EClutch(act, model4)
     res = ec.simulate({"bearing_reference": ([0.0, 0.05, 0.3], [0.0, 0.0, 5e-3])}, 1.5)
-    o = res.outputs.iloc[-1]
+    o = res.outputs_table.iloc[-1]
     fb = model4.static_curve([o.bearing_position_m]).bearing_force_N.iloc[0]
     assert o.pressure_Pa == pytest.approx(static_pressure(fb, o.bearing_position_m, act), rel=2e-3)
 
@@ -302,13 +305,13 @@ def test_voltage_saturation_and_current_limit():
     act = ActuatorParameters()
     ec = EClutch(act)
     res = ec.simulate({"voltage": ([0.0, 0.01, 0.3], [0.0, 1000.0, -1000.0])}, 0.6)
-    o = res.outputs
+    o = res.outputs_table
     assert np.all(np.isfinite(o.to_numpy(dtype=float)))
     assert o.motor_voltage_V.abs().max() <= act.supply_voltage + 1e-9
     assert o.motor_current_A.abs().max() < 1.5 * act.current_limit
     # the CSC ends on its travel stop instead of running away
     assert o.bearing_position_m.max() < act.slave_max + 0.5e-3
-    assert (res.events.event == "end stop hit").any()
+    assert (res.events.event == "stop_hit").any()
 
 
 def test_reference_at_the_end_of_travel_holds_there_and_one_beyond_it_is_refused():
@@ -317,7 +320,7 @@ def test_reference_at_the_end_of_travel_holds_there_and_one_beyond_it_is_refused
     act = ActuatorParameters()
     ec = EClutch(act, friction=FrictionParameters())
     res = ec.simulate({"bearing_reference": ([0.0, 0.1], [0.0, act.slave_max])}, 1.0)
-    o = res.outputs
+    o = res.outputs_table
     assert np.all(np.isfinite(o.to_numpy(dtype=float)))
     assert o.bearing_position_m.iloc[-1] == pytest.approx(act.slave_max, abs=0.3e-3)
     assert o.motor_current_A.abs().max() < 1.5 * act.current_limit
@@ -333,7 +336,7 @@ def test_any_voltage_sequence_stays_bounded(volts):
     ec = EClutch(act)
     t = np.linspace(0.0, 0.3, len(volts))
     res = ec.simulate({"voltage": (t, volts)}, 0.35, max_steps=100_000)
-    o = res.outputs
+    o = res.outputs_table
     assert np.all(np.isfinite(o.to_numpy(dtype=float)))
     assert act.slave_min - 1e-3 < o.bearing_position_m.min() and o.bearing_position_m.max() < act.slave_max + 1e-3
     e = res.energy_balance()
@@ -353,11 +356,11 @@ def test_cavitation_at_default_tolerance_follows_a_tight_run():
     loose = ec.simulate(scenario, 0.35, output_step=0.01)
     tight = ec.simulate(scenario, 0.35, output_step=0.01, rtol=1e-8, jac_every=1)
     assert loose.energy_balance()["input_J"] == pytest.approx(tight.energy_balance()["input_J"], rel=2e-3)
-    p_end = tight.outputs.pressure_Pa.iloc[-1]
+    p_end = tight.outputs_table.pressure_Pa.iloc[-1]
     assert p_end > 1e6  # the CSC pushes the clutch: the chamber is far above the vapour pressure
-    assert loose.outputs.pressure_Pa.iloc[-1] == pytest.approx(p_end, rel=2e-3)
-    assert loose.outputs.bearing_position_m.iloc[-1] == pytest.approx(
-        tight.outputs.bearing_position_m.iloc[-1], abs=5e-6)
+    assert loose.outputs_table.pressure_Pa.iloc[-1] == pytest.approx(p_end, rel=2e-3)
+    assert loose.outputs_table.bearing_position_m.iloc[-1] == pytest.approx(
+        tight.outputs_table.bearing_position_m.iloc[-1], abs=5e-6)
 
 
 # ----------------------------------------------------------------- wear and expansion
@@ -392,8 +395,8 @@ def test_worn_clutch_rests_where_the_preload_balances(model4):
     act = ec.actuator
     assert fb == pytest.approx(act.csc_preload - act.csc_spring_rate * u0, abs=1e-6)
     res = ec.simulate({"voltage": 0.0}, 0.2)
-    assert np.allclose(res.outputs.bearing_position_m, u0, atol=1e-10)
-    assert np.allclose(res.outputs.pressure_Pa, 0.0, atol=1e-6)
+    assert np.allclose(res.outputs_table.bearing_position_m, u0, atol=1e-10)
+    assert np.allclose(res.outputs_table.pressure_Pa, 0.0, atol=1e-6)
 
 
 def test_actuator_consistency_errors():

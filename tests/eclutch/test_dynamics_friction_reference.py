@@ -51,7 +51,7 @@ def _compare(number, friction=None, **options):
     grid, ref = _reference(number)
     dyn = ClutchDynamics(ClutchModel.preset(number), FrictionParameters() if friction is None else friction)
     res = dyn.simulate(SCENARIOS[number], output_step=grid[1] - grid[0], **options)
-    o = res.outputs
+    o = res.outputs_table
     assert len(o) == len(grid) and np.allclose(o.time_s.to_numpy(), grid, atol=1e-12)
     fb, fn = ref["bearing_force_N"], ref["normal_force_N"]
     return {"Fb": np.abs(o.bearing_force_clutch_N.to_numpy() - fb).max() / np.abs(fb).max(),

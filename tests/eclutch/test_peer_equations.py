@@ -44,7 +44,7 @@ def _setup():
         system = ec.as_system(INPUT, rtol=1e-3)
         # states along the physical trajectory: a clutchlab run, sampled
         out = ec.simulate(INPUT, 1.0, rtol=1e-3, output_step=0.01)
-        _CACHE.update(ec=ec, tin=tin, vin=vin, system=system, out=out.outputs)
+        _CACHE.update(ec=ec, tin=tin, vin=vin, system=system, out=out.outputs_table)
     return _CACHE
 
 
@@ -123,7 +123,7 @@ def test_peer_run_matches_clutchlab():
     assert ok
     grid = np.linspace(0.0, 1.0, 2001)
     tight = ec.simulate(INPUT, 1.0, rtol=1e-7, output_step=5e-4)
-    ref = np.interp(grid, tight.outputs.time_s, tight.outputs.bearing_force_N)
+    ref = np.interp(grid, tight.outputs_table.time_s, tight.outputs_table.bearing_force_N)
     err = np.abs(np.interp(grid, T, FB) - ref).max() / np.abs(ref).max()
     # the two integrators resolve the seals' stick-slip differently: F_b agrees to 1 % of its peak
     assert err < 1e-2, err

@@ -57,26 +57,26 @@ def check(name, outputs, tol):
 def test_without_friction_the_trajectory_is_the_former_kernels():
     res = EClutch(SC.frictionless_actuator(), ClutchModel.preset(4), FrictionParameters.off()).simulate(
         SC.bench_input(), 1.0, rtol=2e-12, atol_scale=1e-4, output_step=2.5e-3, max_steps=2_000_000)
-    check("smooth", res.outputs, 5e-6)
+    check("smooth", res.outputs_table, 5e-6)
 
 
 def test_position_control_with_friction_follows_the_former_kernel():
     res = EClutch(clutch=ClutchModel.preset(4), friction=FrictionParameters()).simulate(
         SC.bench_input(), 1.0, rtol=1e-10, atol_scale=1e-2, output_step=2.5e-3, max_steps=2_000_000)
-    check("position", res.outputs, 1e-2)
+    check("position", res.outputs_table, 1e-2)
 
 
 def test_voltage_steps_through_cavitation_follow_the_former_kernel():
     res = EClutch().simulate(SC.voltage_input(), 0.35, rtol=1e-10, atol_scale=1e-2, output_step=1e-3,
                              max_steps=2_000_000)
-    out = res.outputs.assign(input_work_J=res.energy["input_work_J"].to_numpy())
+    out = res.outputs_table.assign(input_work_J=res.energy["input_work_J"].to_numpy())
     check("voltage", out, 5e-3)
 
 
 def test_prescribed_hysteresis_cycle_follows_the_former_kernel():
     res = ClutchDynamics(ClutchModel.preset(4), FrictionParameters()).simulate(
         SC.prescribed_cycle(), rtol=1e-9, atol_scale=1e-2, output_step=5e-3, max_steps=5_000_000)
-    out = res.outputs.assign(friction_dissipated_J=res.energy["friction_dissipated_J"].to_numpy())
+    out = res.outputs_table.assign(friction_dissipated_J=res.energy["friction_dissipated_J"].to_numpy())
     check("prescribed", out, 6e-3)
 
 
@@ -87,4 +87,4 @@ def test_default_tolerances_stay_close_to_the_reference(rtol, tol):
         {"bearing_reference": BENCH}, 1.0, rtol=rtol, output_step=2.5e-3)
     for col in ("bearing_position_m", "torque_Nm", "bearing_force_clutch_N"):
         ref = REF[f"position__{col}"]
-        assert np.abs(res.outputs[col].to_numpy() - ref).max() < tol * np.abs(ref).max(), col
+        assert np.abs(res.outputs_table[col].to_numpy() - ref).max() < tol * np.abs(ref).max(), col

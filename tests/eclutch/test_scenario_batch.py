@@ -42,7 +42,7 @@ def test_scenario_units_are_converted(scenario_file):
     t, ref = sc.input_table()
     assert ref.max() == pytest.approx(7e-3)
     res = run_scenario(sc)
-    o = res.outputs
+    o = res.outputs_table
     assert len(o) == 301
     assert float(np.interp(0.33, o.time_s, o.bearing_position_m)) == pytest.approx(7e-3, abs=0.4e-3)
 
@@ -99,7 +99,7 @@ def test_batch_equals_single_runs():
     batch = simulate_batch(ecs, inp, 0.6, output_step=2e-3)
     assert (batch.stats.status == 0).all()
     for k, ec in enumerate(ecs):
-        single = ec.simulate(inp, 0.6, output_step=2e-3).outputs
+        single = ec.simulate(inp, 0.6, output_step=2e-3).outputs_table
         np.testing.assert_array_equal(batch.outputs["bearing_force_N"][k], single.bearing_force_N.to_numpy())
         np.testing.assert_allclose(batch.outputs["torque_Nm"][k], single.torque_Nm.to_numpy(), rtol=1e-14)
     # a larger lever ratio magnitude needs less bearing force for the same clamp load
@@ -138,14 +138,14 @@ def test_cosimulation_continues_the_native_solution():
         native = EClutch(friction=FrictionParameters()).simulate({"bearing_reference": 5e-3}, 0.3, output_step=2e-3,
                                                                  rtol=rtol)
         x = np.array([s["bearing_position"] for s in steps])
-        return np.abs(x - native.outputs.bearing_position_m.to_numpy()[1:]).max(), steps, native
+        return np.abs(x - native.outputs_table.bearing_position_m.to_numpy()[1:]).max(), steps, native
 
     # restarting at each communication point changes the steps, not the solution beyond the tolerance:
     # the gap shrinks with the tolerance (a model mismatch would not)
     loose, _, _ = gap(1e-3)
     tight, steps, native = gap(1e-6)
     assert tight < 1e-6 and tight < loose / 3, (loose, tight)
-    assert steps[-1]["bearing_force"] == pytest.approx(native.outputs.bearing_force_N.iloc[-1], rel=1e-3)
+    assert steps[-1]["bearing_force"] == pytest.approx(native.outputs_table.bearing_force_N.iloc[-1], rel=1e-3)
     with pytest.raises(ParameterError, match="control_mode"):
         EClutchCoSimulation(control_mode=3.0)
 
@@ -172,7 +172,7 @@ def test_example_scenarios_run(name):
 
     sc = load_scenario(pathlib.Path(__file__).parents[2] / "examples" / name)
     res = run_scenario(sc)
-    o = res.outputs
+    o = res.outputs_table
     assert o.time_s.iloc[-1] == pytest.approx(sc.t_end)
     assert o.bearing_position_m.max() > 6e-3  # both release the clutch
     assert o.torque_Nm.iloc[-1] > 0.9 * o.torque_Nm.iloc[0]  # and engage it again

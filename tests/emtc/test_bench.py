@@ -75,7 +75,7 @@ def test_slipping_torques_follow_eq15(slipping_run):
     expect = np.array([slipping_torques(f, 1.0, g) for f in slip["fn1_N"]])
     np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), expect, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(slip["coupling_torque_Nm"], expect.sum(axis=1), rtol=1e-12)
-    assert slipping_run.events["name"].str.contains("lock").sum() == 0
+    assert slipping_run.events["description"].str.contains("lock").sum() == 0
 
 
 def test_torque_reference_tracking_through_inverse_preisach(slipping_run):
@@ -89,7 +89,7 @@ def test_torque_reference_tracking_through_inverse_preisach(slipping_run):
 
 def test_locked_mode_logic_fig11(locked_run):
     ev = locked_run.events
-    names = list(ev["name"])
+    names = list(ev["description"])
     lock = [i for i, n in enumerate(names) if n.startswith("lock-up")]
     unlock = [i for i, n in enumerate(names) if n.startswith("unlock")]
     assert len(lock) == 1 and len(unlock) == 1  # no chattering
@@ -191,7 +191,7 @@ def test_no_chattering_property(thr_end, ref, dv):
                        ramp_start=0.1, ramp_end=1.4)
     res = simulate_bench(_MAGNET, sc, torque_reference=([0.0, 2.0], [ref, ref]))
     ev = res.events
-    mode_ev = ev[ev["name"].str.startswith(("lock-up", "unlock", "slip reversal"))]
+    mode_ev = ev[ev["description"].str.startswith(("lock-up", "unlock", "slip reversal"))]
     assert len(mode_ev) <= 6
     if len(mode_ev) > 1:
         assert np.diff(mode_ev["time_s"].to_numpy()).min() > 0.01
@@ -252,7 +252,7 @@ def test_lugre_lock_and_unlock_without_chattering(magnet):
     sc = BenchScenario(duration=3.0, speed_difference=0.0, throttle_start=0.0, throttle_end=0.9, ramp_start=0.3,
                        ramp_end=2.8)
     res = simulate_bench(magnet, sc, torque_reference=([0.0, 10.0], [150.0, 150.0]), lugre=LuGreParameters())
-    names = list(res.events["name"])
+    names = list(res.events["description"])
     assert sum(n.startswith("lock-up") for n in names) == 1
     assert sum(n.startswith("unlock") for n in names) == 1
     assert not any(n.startswith("slip reversal") for n in names)

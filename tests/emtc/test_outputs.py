@@ -30,9 +30,9 @@ def test_every_column_has_a_unit_suffix_and_modes_are_names(locked_run):
     assert set(df["armature_mode"]) <= set(ARMATURE_MODE_NAMES.values())
     assert df["coupling_mode"].map(type).eq(str).all() and df["armature_mode"].map(type).eq(str).all()
     # the names are the kernel codes translated, sample by sample; quantities are the kernel's values
-    out, st = locked_run.outputs, locked_run.states
+    out, st = locked_run.kernel_outputs, locked_run.kernel_states
     assert (df["coupling_mode"] == out["coupling_mode"].map(MODE_NAMES)).all()
-    assert (df["coupling_mode"] == locked_run.modes).all()
+    assert (df["coupling_mode"] == locked_run.coupling_modes).all()
     np.testing.assert_array_equal(df["coupling_torque_Nm"], out["t_coupling"])
     np.testing.assert_array_equal(df["omega_f_rad_s"], st["omega_f"])
     np.testing.assert_array_equal(df["time_s"], locked_run.time)
@@ -50,8 +50,9 @@ def test_events_are_named(locked_run):
     df = locked_run.to_dataframe()
     after = df[(df["time_s"] > lock["time_s"].iloc[0] + 1e-9)]
     assert after["coupling_mode"].iloc[0] == "locked"
-    # old columns still there for existing code
-    assert (ev["time"] == ev["time_s"]).all() and ev["kind"].dtype.kind == "i" and (ev["name"] == ev["description"]).all()
+    # the run's own columns first (a BenchResult is a SimulationResult); no integer event codes
+    assert list(ev.columns[:3]) == ["time_s", "event", "element"]
+    assert not {"time", "kind", "name"} & set(ev.columns)
 
 
 def test_simulate_csv_has_units_names_and_synthetic_mark(tmp_path, capsys):

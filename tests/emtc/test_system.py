@@ -175,7 +175,7 @@ def test_controller_log_of_the_last_sample_is_built_when_read_and_before_picklin
     S.run_controller(system.params, 0.2, run.stats["final_state"], system.u0)
     log = S.controller_log(system.params)
     for res in (first, back):
-        out = res.outputs
+        out = res.kernel_outputs
         np.testing.assert_array_equal(out["current_command"], log[:, 0])
         np.testing.assert_array_equal(out["torque_reference"], log[:, 1])
     assert log[-1, 1] == pytest.approx(100.0)  # the last sample's reference: the table's end

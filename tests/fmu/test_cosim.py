@@ -227,8 +227,8 @@ def _emtc_native(cosim, tk, torque, throttle_step_time, **overrides):
 
 def _emtc_compare(out, nat, tk, sample_time):
     idx = np.round(tk / sample_time).astype(int)
-    o = nat.outputs
-    s = nat.states
+    o = nat.kernel_outputs
+    s = nat.kernel_states
     pairs = {"coupling_torque": o["t_coupling"], "coil_current": s["i2"], "slip_speed": o["slip_speed"],
              "magnet_force": o["magnet_force"], "armature_position": s["x"], "coupling_mode": o["coupling_mode"],
              "current_command": o["current_command"]}
@@ -279,14 +279,14 @@ def test_emtc_input_step_that_unlocks_agrees_within_solver_tolerance():
     out = _run(c, lambda k: {"torque_request": torque[k], "throttle": throttle[k]}, dt, n)
     nat = _emtc_native(c, tk, torque, 0.4)
     unlock = [t for t, name in c.events if name.startswith("unlock")]
-    native_unlock = nat.events.time[nat.events.name.str.startswith("unlock")].to_numpy()
+    native_unlock = nat.events.time_s[nat.events.description.str.startswith("unlock")].to_numpy()
     assert len(unlock) == len(native_unlock) == 1 and abs(unlock[0] - 0.4) < 1e-9
     assert abs(native_unlock[0] - unlock[0]) < 2e-9
     keep = np.abs(tk - 0.4) > 1e-9
     idx = np.round(tk / c.sample_time).astype(int)
-    slip = nat.outputs["slip_speed"].to_numpy()[idx]
+    slip = nat["slip_speed_rad_s"][idx]
     assert np.max(np.abs(out["slip_speed"] - slip)[keep]) < 1e-4 * np.max(np.abs(slip))
-    assert np.max(np.abs(out["coupling_torque"] - nat.outputs["t_coupling"].to_numpy()[idx])[keep]) < 1e-4 * 300.0
+    assert np.max(np.abs(out["coupling_torque"] - nat["coupling_torque_Nm"][idx])[keep]) < 1e-4 * 300.0
 
 
 def _emtc_master(cosim, dt, duration, torque_at, throttle_at):
@@ -321,7 +321,7 @@ def test_emtc_accepts_any_communication_step_and_follows_the_native_run(dt):
     common = np.flatnonzero((np.abs(tk / ts - np.round(tk / ts)) < 1e-6) & (np.abs(tk - 0.084) > 1e-9))[1:]
     assert len(common) >= 7
     idx = np.round(tk[common] / ts).astype(int)
-    o, s = nat.outputs, nat.states
+    o, s = nat.kernel_outputs, nat.kernel_states
     np.testing.assert_allclose(out["coupling_torque"][common], o["t_coupling"].to_numpy()[idx], rtol=0, atol=3e-3)
     np.testing.assert_allclose(out["coil_current"][common], s["i2"].to_numpy()[idx], rtol=0, atol=2e-5)
     np.testing.assert_allclose(out["magnet_force"][common], o["magnet_force"].to_numpy()[idx], rtol=0, atol=0.1)
@@ -329,8 +329,8 @@ def test_emtc_accepts_any_communication_step_and_follows_the_native_run(dt):
     np.testing.assert_array_equal(out["coupling_mode"][common], o["coupling_mode"].to_numpy()[idx])
     # the command is sampled exactly as natively: the one applied over the last sample before each point
     np.testing.assert_array_equal(out["current_command"][common], o["current_command"].to_numpy()[idx - 1])
-    assert [name for _, name in c.events] == list(nat.events.name)
-    np.testing.assert_allclose([t for t, _ in c.events], nat.events.time, rtol=0, atol=1e-6)
+    assert [name for _, name in c.events] == list(nat.events.description)
+    np.testing.assert_allclose([t for t, _ in c.events], nat.events.time_s, rtol=0, atol=1e-6)
     assert np.max(out["coupling_torque"]) > 250.0  # the coupling did engage
 
 

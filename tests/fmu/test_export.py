@@ -154,9 +154,9 @@ def test_emtc_fmu_reproduces_simulate_bench(build_fmu, run_fmu):
     sc = BenchScenario(duration=tk[-1], throttle_start=0.6, throttle_end=0.6)
     nat = simulate_bench(c.magnet, sc, actuator=c.actuator, torque_reference=(tt, tv))
     idx = np.round(tk / sc.sample_time).astype(int)
-    refs = {"coupling_torque": nat.outputs["t_coupling"], "slip_speed": nat.outputs["slip_speed"],
-            "coil_current": nat.states["i2"], "magnet_force": nat.outputs["magnet_force"],
-            "coupling_mode": nat.outputs["coupling_mode"], "torque_capacity": nat.outputs["capacity_locked"]}
+    refs = {"coupling_torque": nat["coupling_torque_Nm"], "slip_speed": nat["slip_speed_rad_s"],
+            "coil_current": nat["i2_A"], "magnet_force": nat["magnet_force_N"],
+            "coupling_mode": nat.modes[:, 1], "torque_capacity": nat["capacity_locked_Nm"]}
     for name, ref in refs.items():
         ref = np.asarray(ref, float)[idx]
         np.testing.assert_allclose(fmu[name][1:], ref[1:], rtol=1e-12, atol=1e-12 * max(np.max(np.abs(ref)), 1.0),

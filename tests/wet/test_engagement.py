@@ -30,12 +30,12 @@ def test_inertia_dynamometer_energy_balance():
     # ... and goes into the pack or out to oil and housing (Eq. 8)
     assert eb["heat_into_pack"] + eb["heat_out"] == pytest.approx(kinetic, rel=5e-3)
     assert eb["heat_into_pack"] > 0 and eb["heat_out"] > 0
-    kinds = [e.kind for e in res.events]
+    kinds = [e.kind for e in res.event_list]
     assert kinds == ["contact", "lock-up"]
     t_lock = res.lockup_time
-    assert t_lock == pytest.approx(res.events[1].time)
+    assert t_lock == pytest.approx(res.event_list[1].time)
     after = res.time > t_lock
-    assert np.all(res.state("slip_speed_rad_s")[after] == 0.0) and np.all(res.modes[after] == "stick")
+    assert np.all(res.state("slip_speed_rad_s")[after] == 0.0) and np.all(res.slip_stick[after] == "stick")
     assert np.all(res.state("slip_speed_rad_s")[res.time < t_lock] > 0.0)
 
 
@@ -50,7 +50,7 @@ def test_bench_engagement_mechanical_energy_balance():
     # the motor keeps the slip on the smoothed ramp-down reference
     err = res.state("slip_speed_rad_s") - res.output("slip_reference_rad_s")
     assert np.max(np.abs(err)) < 0.05 * proto.initial_slip_speed
-    assert "lock-up" in [e.kind for e in res.events]
+    assert "lock-up" in [e.kind for e in res.event_list]
     # unlike the dynamometer, the bench's motor supplies positive torque while the clutch brakes
     assert res.output("drive_torque_Nm").max() > 50.0
 
@@ -63,7 +63,7 @@ def test_delayed_torque_rise_from_the_squeeze_film():
         return res.time[np.argmax(res.output("contact_force_N") > 1800.0)]
 
     # contact starts after the free stroke; the stiffer film delays the asperity load and the torque
-    assert fast.events[0].kind == "contact" and fast.events[0].time > 0.05
+    assert fast.event_list[0].kind == "contact" and fast.event_list[0].time > 0.05
     assert t_load(slow) > t_load(fast) + 0.1
     assert slow.lockup_time > fast.lockup_time + 0.05
     assert slow.output("squeeze_force_N").max() > fast.output("squeeze_force_N").max()
@@ -80,7 +80,7 @@ def test_kernel_outputs_equal_the_pure_functions():
     np.testing.assert_allclose(res.output("mean_film_m"), hb, rtol=1e-12)
     tv = viscous_torque(CLUTCH.r_eff, CLUTCH.n_c, atf_viscosity(temp, *CLUTCH.viscosity), CLUTCH.friction_area,
                         CLUTCH.r_eff * w, hb)
-    slip = res.modes == "slip"
+    slip = res.slip_stick == "slip"
     np.testing.assert_allclose(res.output("viscous_torque_Nm")[slip], tv[slip], rtol=1e-10, atol=1e-12)
     fc = CLUTCH.friction_area * asperity_contact_pressure(h, CLUTCH.sigma, CLUTCH.asperity_radius,
                                                           CLUTCH.asperity_density, CLUTCH.contact_modulus)
@@ -98,7 +98,7 @@ def test_steady_film_force_balance():
     spring = CLUTCH.spring_preload + CLUTCH.spring_stiffness * x
     assert res.output("contact_force_N")[-1] + spring == pytest.approx(2000.0, rel=1e-3)
     assert abs(res.output("squeeze_force_N")[-1]) < 2.0
-    assert np.all(res.modes == "stick")
+    assert np.all(res.slip_stick == "stick")
 
 
 def test_lockup_time_converges_with_tolerance():
@@ -113,9 +113,9 @@ def test_break_away_event_when_drive_exceeds_capacity():
     # clutch pressed at standstill, then the motor is asked to turn: stick until the torque exceeds capacity
     scen = Scenario([0.0, 0.2], [0.0, 1500.0], [0.0, 1.0, 1.5], [0.0, 0.0, 20.0], duration=2.5)
     res = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, sample_rate=200.0)
-    kinds = [e.kind for e in res.events]
+    kinds = [e.kind for e in res.event_list]
     assert "break-away" in kinds
-    t_b = res.events[kinds.index("break-away")].time
+    t_b = res.event_list[kinds.index("break-away")].time
     assert 1.0 < t_b < 2.5
     before = res.time < t_b
     assert np.all(res.state("slip_speed_rad_s")[before] == 0.0)

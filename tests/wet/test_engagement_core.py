@@ -176,8 +176,8 @@ def test_reproduces_the_traces_of_the_former_kernel(name):
     scen, ts = scenarios()[name]
     res = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=TRUTH, sample_times=ts, rtol=RTOL)
     np.testing.assert_array_equal(res.time, data[f"{name}/time_s"])
-    assert [e.kind for e in res.events] == list(data[f"{name}/event"])
-    np.testing.assert_allclose([e.time for e in res.events], data[f"{name}/event_time_s"], rtol=0, atol=3e-5)
+    assert [e.kind for e in res.event_list] == list(data[f"{name}/event"])
+    np.testing.assert_allclose([e.time for e in res.event_list], data[f"{name}/event_time_s"], rtol=0, atol=3e-5)
     for col in STATES + OUTPUTS:
         ref = data[f"{name}/{col}"]
         new = res.state(col) if col in STATES else res.output(col)

@@ -166,7 +166,7 @@ def _simulate(args) -> int:
                 fig = hysteresis_loop({f"Model {scenario.model}": frame}, static,
                                       title=f"Model {scenario.model}: bearing force over the prescribed cycle")
             else:
-                fig = eclutch_response(res.outputs, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
+                fig = eclutch_response(res.outputs_table, title=f"E-clutch, Model {scenario.model}: {args.scenario}")
             _save_figure(mark_synthetic(fig), outputs.staged(args.plot), args.force)
     st = res.stats
     steps = (f"({st['rejected_steps']} rejected)" if fixed_step is None else

@@ -88,7 +88,7 @@ def _simulate(args) -> int:
 
             plt.close(fig)
             atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
-    events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.events) or "none"
+    events = ", ".join(f"{e.kind} at {e.time:.4g} s" for e in run.result.event_list) or "none"
     frames = "" if options["fixed_step"] is None else f" in fixed steps of {options['fixed_step']:g} s"
     print(f"{args.output}: {len(run.record)} samples of protocol {ptype}{frames}; events: {events}")
     return 0

@@ -68,21 +68,21 @@ def _dynamics_items(model4: ClutchModel, progress) -> list:
     loops, rows = {}, []
     for label, fr in (("friction off", FrictionParameters.off()), ("friction on", FrictionParameters())):
         res = ClutchDynamics(model4, fr).simulate((t, x), output_step=2e-3)
-        loops[f"Model 4, {label}"] = res.outputs
-        o = res.outputs
+        loops[f"Model 4, {label}"] = res.outputs_table
+        o = res.outputs_table
         u, f = o.bearing_position_m.to_numpy(), o.bearing_force_clutch_N.to_numpy()
         e = res.energy_balance()
         rows.append({"run": f"prescribed cycle, {label}", "loop area [J]": float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(u))),
                      "friction work [J]": e["friction_dissipated_J"], "stick/slip events": int(
-                         res.events.event.isin(["stick", "breakaway", "slip reversal"]).sum()),
+                         res.events.event.isin(["stick", "breakaway", "slip_reversal"]).sum()),
                      "steps": res.stats["accepted_steps"]})
     e = step.energy_balance()
     rows.append({"run": "actuator step 0 -> 6 mm -> 0", "loop area [J]": np.nan,
                  "friction work [J]": e["friction_dissipated_J"], "stick/slip events": int(
-                     step.events.event.isin(["stick", "breakaway", "slip reversal"]).sum()),
+                     step.events.event.isin(["stick", "breakaway", "slip_reversal"]).sum()),
                  "steps": step.stats["accepted_steps"]})
     static = model4.static_curve(np.linspace(0.0, 7.5e-3, 300))
-    fig_step = eclutch_response(step.outputs, title="E-clutch step response: bearing position 0 -> 6 mm -> 0 "
+    fig_step = eclutch_response(step.outputs_table, title="E-clutch step response: bearing position 0 -> 6 mm -> 0 "
                                                      "(Model 4, friction on)")
     fig_loop = hysteresis_loop(loops, static, title="Release/engage cycle: friction hysteresis (Model 4)")
     energy = pd.DataFrame([{"quantity": k, "value [J]": v} for k, v in e.items() if k.endswith("_J")])

@@ -75,7 +75,7 @@ def demo_section(progress=lambda message: None) -> Section:
         "95 % low": [thermal.ci95["k1"][0], thermal.ci95["k2"][0]],
         "95 % high": [thermal.ci95["k1"][1], thermal.ci95["k2"][1]],
     })
-    ev = lambda r: ", ".join(f"{e.kind} {e.time:.3f} s" for e in r.events)  # noqa: E731
+    ev = lambda r: ", ".join(f"{e.kind} {e.time:.3f} s" for e in r.event_list)  # noqa: E731
     eng_table = pd.DataFrame({
         "run": ["bench, speed-controlled motor (b)", "inertia dynamometer, SAE No. 2 (c)"],
         "events": [ev(res_bench), ev(res_dyno)],

@@ -307,16 +307,8 @@ def _events_frame(result, asm) -> pd.DataFrame:
             where.append(f"{element} ({asm.friction_names[asm.coord_names.index(element)]})")
         else:
             where.append(_STOPS.get(element, _CHAMBERS.get(element, element)))
-    return pd.DataFrame({"time_s": ev["time_s"].to_numpy(float), "event": [_LABELS.get(n, n) for n in kinds],
-                         "where": where, "element": elements})
-
-
-def _stats(result) -> dict:
-    """Solver counters of a run and its status (0: the end time was reached)."""
-    rs = result.stats
-    return {"accepted_steps": int(rs.get("accepted_steps", 0)), "rejected_steps": int(rs.get("rejected_steps", 0)),
-            "rhs_evaluations": int(rs.get("rhs_evaluations", 0)), "jacobians": int(rs.get("jacobians", 0)),
-            "status": int(result.status)}
+    return pd.DataFrame({"time_s": ev["time_s"].to_numpy(float), "event": kinds, "element": elements,
+                         "description": [_LABELS.get(n, n) for n in kinds], "where": where})
 
 
 def _curve_energy(curve, scale, unilateral, d_values, d_ref):
@@ -334,51 +326,44 @@ def _curve_energy(curve, scale, unilateral, d_values, d_ref):
     return np.interp(d_values, x, cum) - np.interp(d_ref, x, cum)
 
 
-@dataclasses.dataclass
-class DynamicsResult:
-    """Result of an E-clutch simulation: a table view of a :class:`~clutchlab.SimulationResult`.
+@dataclasses.dataclass(repr=False, kw_only=True)
+class DynamicsResult(SimulationResult):
+    """Result of an E-clutch simulation: the :class:`~clutchlab.SimulationResult` of the ``eclutch`` (or
+    ``eclutch_prescribed``) model with the rig's tables and the energy bookkeeping.
+
+    Every field of a :class:`~clutchlab.SimulationResult` is the core's run (``states``, ``outputs`` and ``modes``
+    arrays with their unit-suffixed columns, ``stats`` with the run's ``status`` added); ``events`` adds to its
+    ``time_s``, ``event`` (:data:`clutchlab.eclutch.system.EVENTS`: ``stick``, ``breakaway``, ``contact_open``, ...)
+    and ``element`` the ``description`` (:data:`EVENT_KINDS`: "contact opens", ...) and ``where`` (coordinate and
+    friction element, end stop or chamber).  ``result["bearing_position_m"]`` reads a column of the run or of
+    its tables.
 
     Attributes
     ----------
-    time : ndarray
-        Time [s] of the recorded points.
-    states : pandas.DataFrame
-        State vector (positions, velocities, pressures, current, controller integral, energies), unit-suffixed
-        columns.
-    outputs : pandas.DataFrame
-        Measured and derived quantities (see :meth:`to_dataframe`).
-    events : pandas.DataFrame
-        Located events: ``time_s``, ``event`` (a label of :data:`EVENT_KINDS`), ``where`` (coordinate and
-        friction element, network element, end stop or chamber) and ``element`` (the element's name as in
-        ``result.events``).
-    stats : dict
-        Accepted and rejected steps, right-hand-side evaluations, Jacobians, status (0: the end time was
-        reached).
+    outputs_table : pandas.DataFrame
+        Measured and derived quantities (``time_s``, ``bearing_position_m``, ``pressure_Pa``,
+        ``bearing_force_N``, ``x_<node>_m``, ``friction_<coordinate>_N``, ``stuck_<coordinate>``, ...).
+    states_table : pandas.DataFrame
+        ``time_s`` and the states (positions, velocities, pressures, current, controller integral, energies).
     energy_source : callable or DataFrame, optional
         What :attr:`energy` returns: energy bookkeeping per recorded point [J]: ``input_work_J``,
         ``dissipated_J``, ``friction_dissipated_J`` (integrated with the
         states) and ``stored_J`` (computed from the states).
-    result : SimulationResult, optional
-        The run as the integrator core returned it (named events ``stick``, ``breakaway``, ...).
     """
 
-    time: np.ndarray
-    states: pd.DataFrame = BuiltOnFirstAccess()
-    outputs: pd.DataFrame = BuiltOnFirstAccess()
-    events: pd.DataFrame = BuiltOnFirstAccess()
-    stats: dict
+    outputs_table: pd.DataFrame = BuiltOnFirstAccess()
+    states_table: pd.DataFrame = BuiltOnFirstAccess()
     energy_source: object = dataclasses.field(default=None, repr=False)
-    result: object = dataclasses.field(default=None, repr=False)
 
     def __getstate__(self):
         # the tables are built on first access (:meth:`from_result`): build them before pickling, so the
         # state holds no callable
-        self.states, self.outputs, self.events, self.energy  # noqa: B018
-        return self.__dict__
+        self.states_table, self.outputs_table, self.energy  # noqa: B018
+        return super().__getstate__()
 
     @classmethod
     def from_result(cls, result: SimulationResult, source) -> "DynamicsResult":
-        """The table view of a run of ``source`` (an :class:`EClutch` or a :class:`ClutchDynamics`).
+        """The E-clutch result of a run of ``source`` (an :class:`EClutch` or a :class:`ClutchDynamics`).
 
         Parameters
         ----------
@@ -388,14 +373,29 @@ class DynamicsResult:
             The model that was simulated (names, masses and curves for the energy bookkeeping).
         """
         asm = source.assembly
-        T = np.asarray(result.time)
         Y = np.asarray(result.states)
         nz = asm.nz
+        kw = SimulationResult.fields_of(result)
+        kw["events"] = lambda: _events_frame(result, asm)
+        kw["stats"] = {**result.stats, "status": int(result.status)}
         # the tables are built when first read (pandas costs about 0.6 ms per run, as much as a fifth of a
         # 1 s run: a Monte Carlo loop that reads a few columns, or none, does not pay for them)
-        return cls(T, lambda: _states_frame(result), lambda: _outputs_frame(result, asm),
-                   lambda: _events_frame(result, asm), _stats(result), lambda: _energy(asm, Y, Y[:, 1], Y[:, nz + 1]),
-                   result)
+        return cls(**kw, outputs_table=lambda: _outputs_frame(result, asm), states_table=lambda: _states_frame(result),
+                   energy_source=lambda: _energy(asm, Y, Y[:, 1], Y[:, nz + 1]))
+
+    @property
+    def result(self) -> "DynamicsResult":
+        """The run itself (a :class:`DynamicsResult` is a :class:`~clutchlab.SimulationResult`; kept for code that
+        read the run from here)."""
+        return self
+
+    def _column(self, name: str):
+        if name in self.state_columns or name in self.output_columns:
+            return super()._column(name)
+        for table in (self.outputs_table, self.states_table):
+            if name in table.columns:
+                return table[name].to_numpy()
+        return super()._column(name)
 
     @property
     def energy(self) -> pd.DataFrame | None:
@@ -407,8 +407,8 @@ class DynamicsResult:
 
     def to_dataframe(self) -> pd.DataFrame:
         """One table of time, every state and every output (SI units in the column names)."""
-        extra = [c for c in self.states.columns if c not in self.outputs.columns]
-        return pd.concat([self.outputs, self.states[extra]], axis=1)
+        extra = [c for c in self.states_table.columns if c not in self.outputs_table.columns]
+        return pd.concat([self.outputs_table, self.states_table[extra]], axis=1)
 
     def energy_balance(self) -> dict:
         """Input work, dissipated energy and change of stored energy over the run [J].

@@ -28,6 +28,7 @@ import pandas as pd
 from .._limits import check_allocation, short_repr
 from ..errors import ParameterError
 from ..params.base import load_toml
+from ..result import SimulationResult
 from ..system import sample_grid
 from . import system as S
 from .params import ActuatorParameters, BenchScenario, TorqueMap, VehicleParameters, _default
@@ -76,13 +77,18 @@ COLUMN_NAMES = {
 }
 
 
-class BenchResult:
-    """Result of :func:`simulate_bench`: a per-sample view of a :class:`clutchlab.SimulationResult`.
+@dataclasses.dataclass(repr=False)
+class BenchResult(SimulationResult):
+    """Result of :func:`simulate_bench`: the :class:`clutchlab.SimulationResult` of the ``emtc_bench`` model, recorded
+    at the controller samples, with the bench's tables.
+
+    Every field of a :class:`~clutchlab.SimulationResult` is the core's run (``states``, ``outputs`` and ``modes``
+    arrays with their unit-suffixed columns, ``stats``, ``status``); ``events`` adds to its ``time_s``, ``event``
+    (:data:`EVENT_KEYS`: ``lockup``, ``unlock``, ...) and ``element`` the ``description`` and the
+    ``armature_mode`` and ``coupling_mode`` after the event (names).
 
     Parameters
     ----------
-    result : clutchlab.SimulationResult
-        A run of the ``emtc_bench`` model recorded at the controller samples.
     controller_log : numpy.ndarray or callable, optional
         ``(samples, 4)``: command [A], reference [N*m], throttle [-] and feasible (1/0) computed by the
         controller at each sample (see :meth:`from_result`), or a zero-argument callable returning it, called
@@ -91,22 +97,13 @@ class BenchResult:
 
     Attributes
     ----------
-    result : clutchlab.SimulationResult
-        The run as every model returns it: unit-suffixed states and outputs, modes and named events.
-    time : numpy.ndarray
-        Sample times [s] (the controller samples).
-    states : pandas.DataFrame
-        Kernel names, kept for existing code: ``omega_f, omega_r`` [rad/s],
-        ``theta`` [rad], ``x`` [m], ``xdot`` [m/s], ``i1, i2`` [A].
-    outputs : pandas.DataFrame
-        Kernel names, kept for existing code: magnet force, clamp forces,
-        element torques, lock torque, capacity, integer mode codes
-        (:data:`MODE_NAMES`, :data:`ARMATURE_MODE_NAMES`), commands.
-    events : pandas.DataFrame
-        ``time_s``, ``event`` (:data:`EVENT_KEYS`: ``lockup``, ``unlock``,
-        ...), ``description``, ``armature_mode`` and ``coupling_mode`` after
-        the event (names); the former ``time``, ``kind`` (integer code) and
-        ``name`` (= ``description``) columns are kept for existing code.
+    kernel_states, kernel_outputs : pandas.DataFrame
+        The states (``omega_f, omega_r`` [rad/s], ``theta`` [rad], ``x`` [m], ``xdot`` [m/s], ``i1, i2`` [A]) and
+        outputs (magnet force, clamp forces, element torques, lock torque, capacity, integer mode codes of
+        :data:`MODE_NAMES` and :data:`ARMATURE_MODE_NAMES`, the controller's columns) by the kernel's names, from
+        which :meth:`to_dataframe` names them as docs/nomenclature.md does.
+    coupling_modes : pandas.Series
+        The coupling mode's name at every sample.
     n_steps : int
         Accepted integration steps.
 
@@ -116,20 +113,18 @@ class BenchResult:
     named with its unit suffix and modes as names (docs/nomenclature.md).
     The controller columns (``current_command``, ``torque_reference``,
     ``throttle``, ``command_feasible``) of row ``k`` are those the controller
-    computed at sample ``k`` (the command applied from there on); the
-    :attr:`result` reports at each sample the command held up to it.
+    computed at sample ``k`` (the command applied from there on); the run's
+    own outputs report at each sample the command held up to it.
     """
 
-    def __init__(self, result, controller_log=None):
-        self.result = result
-        self._log_source = controller_log
-        self.n_steps = int(result.stats.get("accepted_steps", 0))
-        self.time = np.asarray(result.time, dtype=float).copy()
+    controller_log: object = dataclasses.field(default=None, repr=False)
+
+    def __post_init__(self):
         self._cache = {}
 
     @classmethod
     def from_result(cls, result, controller_log=None) -> "BenchResult":
-        """The per-sample view of a drum-bench :class:`clutchlab.SimulationResult`.
+        """The bench result of a drum-bench :class:`clutchlab.SimulationResult`.
 
         Parameters
         ----------
@@ -139,79 +134,67 @@ class BenchResult:
             ``(samples, 4)``: command [A], reference [N*m], throttle [-], feasible (1/0) computed at each
             sample (:func:`clutchlab.emtc.system.controller_log`); without it the held values the result reports are used.
         """
-        return cls(result, controller_log)
+        kw = SimulationResult.fields_of(result)
+        kw["time"] = np.asarray(result.time, dtype=float).copy()
+        kw["events"] = lambda: _bench_events(result)
+        return cls(**kw, controller_log=controller_log)
+
+    @property
+    def result(self) -> "BenchResult":
+        """The run itself (a :class:`BenchResult` is a :class:`~clutchlab.SimulationResult`; kept for code that
+        read the run from here)."""
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        return int(self.stats.get("accepted_steps", 0))
 
     @property
     def _log(self):
         """The controller log (built from its callable on first read)."""
-        if callable(self._log_source):
-            self._log_source = self._log_source()
-        return self._log_source
+        if callable(self.controller_log):
+            self.controller_log = self.controller_log()
+        return self.controller_log
 
     def __getstate__(self):
-        state = dict(self.__dict__)
-        state["_log_source"] = self._log  # (no callable in the state)
-        return state
-
-    def _out(self, name):
-        return self.result[name]
+        self._log  # noqa: B018  (no callable in the state)
+        return super().__getstate__()
 
     @property
-    def states(self) -> pd.DataFrame:
+    def kernel_states(self) -> pd.DataFrame:
         if "states" not in self._cache:
-            x = self.result.states
+            x = self.states
             self._cache["states"] = pd.DataFrame({c: x[:, q] for q, c in enumerate(_STATE_COLS)})
         return self._cache["states"]
 
     @property
-    def outputs(self) -> pd.DataFrame:
+    def kernel_outputs(self) -> pd.DataFrame:
         if "outputs" not in self._cache:
-            r = self.result
-            cols = {c: np.asarray(r[name], float) for c, name in _AUX_COLS}
+            cols = {c: np.asarray(self[name], float) for c, name in _AUX_COLS}
             cols["locked_case"] = cols["locked_case"].astype(int)
             log = self._log
             if log is not None and log.shape[0] == self.time.size:
                 cmd, tref, thr, ok = log[:, 0], log[:, 1], log[:, 2], log[:, 3] > 0.5
             else:
-                cmd, tref = r["current_command_A"], r["torque_reference_Nm"]
-                thr, ok = r["throttle_1"], r["command_feasible_1"] > 0.5
+                cmd, tref = self["current_command_A"], self["torque_reference_Nm"]
+                thr, ok = self["throttle_1"], self["command_feasible_1"] > 0.5
             cols.update({
-                "armature_mode": r.modes[:, 0].astype(int),
-                "coupling_mode": r.modes[:, 1].astype(int),
+                "armature_mode": self.modes[:, 0].astype(int),
+                "coupling_mode": self.modes[:, 1].astype(int),
                 "current_command": np.asarray(cmd, float),
                 "torque_reference": np.asarray(tref, float),
                 "throttle": np.asarray(thr, float),
                 "command_feasible": np.asarray(ok, bool),
-                "slip_speed": np.asarray(r["slip_speed_rad_s"], float),
-                "airgap": np.asarray(r["airgap_m"], float),
+                "slip_speed": np.asarray(self["slip_speed_rad_s"], float),
+                "airgap": np.asarray(self["airgap_m"], float),
             })
             self._cache["outputs"] = pd.DataFrame(cols)
         return self._cache["outputs"]
 
     @property
-    def events(self) -> pd.DataFrame:
-        if "events" not in self._cache:
-            e = self.result.events
-            keys = [str(k) for k in e["event"]]
-            kinds = np.array([_EVENTS.index(k) for k in keys], dtype=int)
-            names = [_DESCRIPTIONS[k] for k in kinds]
-            # the modes after each event follow from the event alone (Fig. 11; the armature stops)
-            arm, cpl = (int(v) for v in self.result.modes[0, :2]) if len(self.time) else (0, 0)
-            arm_after, cpl_after = [], []
-            for k in keys:
-                arm, cpl = _AFTER[k](arm, cpl)
-                arm_after.append(ARMATURE_MODE_NAMES[arm])
-                cpl_after.append(MODE_NAMES[cpl])
-            t = e["time_s"].to_numpy(dtype=float)
-            self._cache["events"] = pd.DataFrame({
-                "time_s": t, "event": keys, "description": names, "armature_mode": arm_after,
-                "coupling_mode": cpl_after, "time": t, "kind": kinds, "name": names})
-        return self._cache["events"]
-
-    @property
-    def modes(self) -> pd.Series:
+    def coupling_modes(self) -> pd.Series:
         """Coupling mode name at every sample."""
-        return self.outputs["coupling_mode"].map(MODE_NAMES)
+        return self.kernel_outputs["coupling_mode"].map(MODE_NAMES)
 
     def to_dataframe(self) -> pd.DataFrame:
         """One table with time, states and outputs, in the names and units of docs/nomenclature.md.
@@ -225,11 +208,28 @@ class BenchResult:
             ``coupling_mode`` (``open``/``slipping``/``locked``) and
             ``locked_case`` (the case of Fig. 12, ``""`` unless locked) as names.
         """
-        frame = pd.concat([pd.DataFrame({"time": self.time}), self.states, self.outputs], axis=1)
+        frame = pd.concat([pd.DataFrame({"time": self.time}), self.kernel_states, self.kernel_outputs], axis=1)
         frame["armature_mode"] = frame["armature_mode"].map(ARMATURE_MODE_NAMES)
         frame["coupling_mode"] = frame["coupling_mode"].map(MODE_NAMES)
         frame["locked_case"] = frame["locked_case"].map(lambda c: LOCKED_CASE_NAMES.get(int(c), ""))
         return frame.rename(columns=COLUMN_NAMES)
+
+
+def _bench_events(result) -> pd.DataFrame:
+    """The run's named events with their description and the modes after each (names): the modes after an event
+    follow from the event alone (Fig. 11; the armature stops)."""
+    e = result.events
+    keys = [str(k) for k in e["event"]]
+    names = [_DESCRIPTIONS[_EVENTS.index(k)] for k in keys]
+    arm, cpl = (int(v) for v in result.modes[0, :2]) if len(result.time) else (0, 0)
+    arm_after, cpl_after = [], []
+    for k in keys:
+        arm, cpl = _AFTER[k](arm, cpl)
+        arm_after.append(ARMATURE_MODE_NAMES[arm])
+        cpl_after.append(MODE_NAMES[cpl])
+    return pd.DataFrame({"time_s": e["time_s"].to_numpy(dtype=float), "event": keys,
+                         "element": list(e["element"]), "description": names, "armature_mode": arm_after,
+                         "coupling_mode": cpl_after})
 
 
 _STATE_COLS = ["omega_f", "omega_r", "theta", "x", "xdot", "i1", "i2"]
@@ -345,7 +345,7 @@ def simulate_bench(magnet, scenario: BenchScenario | None = None, *, vehicle: Ve
         S.run_controller(params, t_last, x_last, u0)
         return S.controller_log(params)
 
-    return BenchResult(res, controller_log)
+    return BenchResult.from_result(res, controller_log)
 
 
 def load_scenario(path):

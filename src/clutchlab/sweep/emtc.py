@@ -184,10 +184,10 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
                 # a full hysteresis memory: this variant alone, with a memory that grows as needed
                 alone = simulate_bench(magnet, sets["scenario"], vehicle=sets["vehicle"], actuator=sets["actuator"],
                                        coupling=sets["coupling"])
-                tc = alone.outputs["t_coupling"].to_numpy()
-                slip = alone.outputs["slip_speed"].to_numpy()
-                fm = alone.outputs["magnet_force"].to_numpy()
-                ev = alone.result.events
+                tc = alone["coupling_torque_Nm"]
+                slip = alone["slip_speed_rad_s"]
+                fm = alone["magnet_force_N"]
+                ev = alone.events
                 n_steps = alone.n_steps
             else:
                 tc, slip, fm = tc_all[j], slip_all[j], fm_all[j]

@@ -86,7 +86,7 @@ __all__ = [
 STATE_NAMES = tuple(f"{n}_{u}" for n, u, _ in W.STATES)
 #: column names of :attr:`EngagementResult.outputs` (the system's, ``mu_f`` for ``friction_coefficient_1``)
 OUTPUT_NAMES = tuple("mu_f" if n == "friction_coefficient" else f"{n}_{u}" for n, u, _ in W.OUTPUTS)
-#: the event kinds of :attr:`EngagementResult.events`, by the system's event name
+#: the event kinds of :attr:`EngagementResult.event_list`, by the system's event name
 EVENT_KINDS = {"contact": "contact", "separation": "separation", "lockup": "lock-up", "breakaway": "break-away",
                "slip_reversal": "slip reversal"}
 _MODE_NAMES = np.array(["slip", "stick", "slip"])
@@ -234,60 +234,46 @@ def _event_list(result: SimulationResult) -> list:
     return events
 
 
-@dataclass
-class EngagementResult:
-    """Result of :func:`simulate_engagement`: a view of the :class:`~clutchlab.SimulationResult`.
+@dataclass(repr=False)
+class EngagementResult(SimulationResult):
+    """Result of :func:`simulate_engagement`: the :class:`~clutchlab.SimulationResult` of the ``"wet"`` model with
+    what the engagement adds.
+
+    Every field of a :class:`~clutchlab.SimulationResult` is the core's run: ``states`` ``(n, 12)`` and ``outputs``
+    ``(n, 18)`` with their unit-suffixed ``state_columns`` and ``output_columns`` (temperatures in degC, ``_C``),
+    ``modes`` the mode codes per sample with ``mode_names`` and ``mode_values``, ``events`` the named events
+    (``lockup``, ``breakaway``, ``piston_leaves_stop``, ...; ``time_s``, ``event``, ``element``), ``stats``.
 
     Attributes
     ----------
-    time : numpy.ndarray
-        Sample times [s].
-    states : numpy.ndarray
-        ``(n, 12)`` states, columns :data:`STATE_NAMES` (SI, temperatures in degC).
-    outputs : numpy.ndarray
-        ``(n, 18)`` outputs, columns :data:`OUTPUT_NAMES`.
-    modes : numpy.ndarray
-        Mode per sample: ``"slip"`` or ``"stick"``.
-    events : list of Event
-        Contact, separation, lock-up, break-away, slip reversal in time order
-        (the piston-stop events are in ``result.events``).
-    n_steps : int
-        Accepted integration steps.
-    final_state : numpy.ndarray
-        State at ``duration``.
     heat_capacity : float
         Heat capacity of the pack used in Eq. 8 [J/K].
-    state_names, output_names : tuple of str
-        Column names of ``states`` and ``outputs``.
     peak_temperature_c : float
         Highest pack temperature [degC] over the accepted steps.
     lockup_time : float
         Time of the first lock-up [s] (NaN if the clutch did not lock).
-    result : SimulationResult, optional
-        The run through the system contract (named events ``lockup``,
-        ``piston_leaves_stop``, ..., modes, unit-suffixed columns).
+    n_steps : int
+        Accepted integration steps.
+    final_state : numpy.ndarray
+        State at ``duration``.
+    slip_stick : numpy.ndarray of str
+        ``"slip"`` or ``"stick"`` per sample.
+    event_list : list of Event
+        Contact, separation, lock-up, break-away, slip reversal in time order (the piston-stop events are in
+        ``events``).
+    state_names, output_names : tuple of str
+        The columns of ``states`` and ``outputs`` (``mu_f`` for ``friction_coefficient_1``: :meth:`output`
+        takes either).
     """
 
-    time: np.ndarray
-    states: np.ndarray
-    outputs: np.ndarray
-    # from_result passes callables for these two, built when first read (a loop of runs that does not read
-    # the mode names or the events does not pay for them)
-    modes: np.ndarray = BuiltOnFirstAccess()
-    events: list = BuiltOnFirstAccess()
-    n_steps: int
-    final_state: np.ndarray
-    heat_capacity: float
-    state_names: tuple = STATE_NAMES
-    output_names: tuple = OUTPUT_NAMES
+    heat_capacity: float = float("nan")
     peak_temperature_c: float = float("nan")
     lockup_time: float = float("nan")
-    result: SimulationResult | None = None
 
     @classmethod
     def from_result(cls, result: SimulationResult, heat_capacity: float, peak_temperature_c: float,
                     lockup_time: float) -> "EngagementResult":
-        """The view of a :class:`~clutchlab.SimulationResult` of the ``"wet"`` model.
+        """The engagement result of a :class:`~clutchlab.SimulationResult` of the ``"wet"`` model.
 
         Parameters
         ----------
@@ -298,27 +284,42 @@ class EngagementResult:
         peak_temperature_c, lockup_time : float
             The run's peak pack temperature [degC] and first lock-up time [s].
         """
-        modes = functools.partial(_mode_names, result)
-        events = functools.partial(_event_list, result)
-        return cls(result.time, result.states, result.outputs, modes, events, int(result.stats["accepted_steps"]),
-                   np.array(result.stats["final_state"]), float(heat_capacity),
-                   peak_temperature_c=float(peak_temperature_c), lockup_time=float(lockup_time), result=result)
+        return cls(**SimulationResult.fields_of(result), heat_capacity=float(heat_capacity),
+                   peak_temperature_c=float(peak_temperature_c), lockup_time=float(lockup_time))
+
+    @property
+    def result(self) -> "EngagementResult":
+        """The run itself (an :class:`EngagementResult` is a :class:`~clutchlab.SimulationResult`; kept for code
+        that read the run from here)."""
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        return int(self.stats["accepted_steps"])
+
+    @property
+    def final_state(self) -> np.ndarray:
+        return np.array(self.stats["final_state"])
+
+    state_names = STATE_NAMES
+    output_names = OUTPUT_NAMES
+
+    @property
+    def slip_stick(self) -> np.ndarray:
+        return _mode_names(self)
+
+    @property
+    def event_list(self) -> list:
+        return _event_list(self)
 
     def state(self, name: str) -> np.ndarray:
         """One state trace by name."""
         return self.states[:, self.state_names.index(name)]
 
     def output(self, name: str) -> np.ndarray:
-        """One output trace by name."""
-        return self.outputs[:, self.output_names.index(name)]
-
-    def to_dataframe(self) -> pd.DataFrame:
-        """All samples as a DataFrame with ``time_s``, states, outputs and ``mode``."""
-        frame = pd.DataFrame(self.states, columns=list(self.state_names))
-        frame = pd.concat([frame, pd.DataFrame(self.outputs, columns=list(self.output_names))], axis=1)
-        frame.insert(0, "time_s", self.time)
-        frame["mode"] = self.modes
-        return frame
+        """One output trace by name (``mu_f`` or ``friction_coefficient_1``)."""
+        cols = self.output_names if name in self.output_names else self.output_columns
+        return self.outputs[:, cols.index(name)]
 
     def energy_balance(self) -> dict:
         """Friction work against heat into the pack plus heat out, from the final state [J].

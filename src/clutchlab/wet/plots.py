@@ -92,7 +92,7 @@ def engagement_figure(bench_result, dyno_result):
         axs[1].plot(t, res.output("viscous_torque_Nm"), ls, label=f"viscous τ_v, {name.split(' ')[0]}")
         axs[2].plot(t, res.output("contact_force_N"), ls, label=f"F_c, {name.split(' ')[0]}")
         axs[2].plot(t, res.output("squeeze_force_N"), ls, label=f"squeeze film, {name.split(' ')[0]}")
-        for ev in res.events:
+        for ev in res.event_list:
             if ev.kind == "lock-up":
                 axs[0].axvline(ev.time, color="0.5", lw=0.8, ls=ls, label=f"lock-up, {name.split(' ')[0]}")
     axs[0].plot(bench_result.time, bench_result.output("slip_reference_rad_s") * 30 / np.pi, ":", color="k",

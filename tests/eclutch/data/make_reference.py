@@ -54,33 +54,33 @@ def main():
     # 1. no friction anywhere: position control, bearing reference 0 -> 7 mm -> 0 (the benchmark input)
     r = EClutch(frictionless_actuator(), ClutchModel.preset(4), FrictionParameters.off()).simulate(
         bench_input(), 1.0, rtol=2e-12, atol_scale=1e-4, output_step=2.5e-3, max_steps=2_000_000)
-    out["smooth_time_s"] = r.outputs.time_s.to_numpy()
+    out["smooth_time_s"] = r.outputs_table.time_s.to_numpy()
     for c in ["bearing_position_m", "pressure_Pa", "master_pressure_Pa", "master_position_m", "motor_current_A",
               "torque_Nm", "bearing_force_clutch_N"]:
-        out[f"smooth__{c}"] = r.outputs[c].to_numpy()
+        out[f"smooth__{c}"] = r.outputs_table[c].to_numpy()
     print("smooth", r.stats, len(r.events))
     # 2. the same with friction everywhere (seals, spindle, R_f.ds, R_f.pp): the benchmark scenario
     r = EClutch(clutch=ClutchModel.preset(4), friction=FrictionParameters()).simulate(
         bench_input(), 1.0, rtol=RTOL, atol_scale=1e-2, output_step=2.5e-3, max_steps=2_000_000)
-    out["position_time_s"] = r.outputs.time_s.to_numpy()
+    out["position_time_s"] = r.outputs_table.time_s.to_numpy()
     for c in ["bearing_position_m", "pressure_Pa", "master_position_m", "motor_current_A", "torque_Nm",
               "bearing_force_clutch_N"]:
-        out[f"position__{c}"] = r.outputs[c].to_numpy()
+        out[f"position__{c}"] = r.outputs_table[c].to_numpy()
     print("position", r.stats, len(r.events))
     # 3. voltage steps into cavitation and back (no clutch friction; seal friction on)
     r = EClutch().simulate(voltage_input(), 0.35, rtol=RTOL, atol_scale=1e-2, output_step=1e-3,
                            max_steps=2_000_000)
-    out["voltage_time_s"] = r.outputs.time_s.to_numpy()
+    out["voltage_time_s"] = r.outputs_table.time_s.to_numpy()
     for c in ["bearing_position_m", "pressure_Pa", "master_pressure_Pa", "motor_current_A", "line_flow_m3_s"]:
-        out[f"voltage__{c}"] = r.outputs[c].to_numpy()
+        out[f"voltage__{c}"] = r.outputs_table[c].to_numpy()
     out["voltage__input_work_J"] = r.energy["input_work_J"].to_numpy()
     print("voltage", r.stats, len(r.events))
     # 4. clutch alone, prescribed smooth release/engage cycle with friction (hysteresis loop)
     r = ClutchDynamics(ClutchModel.preset(4), FrictionParameters()).simulate(
         prescribed_cycle(), rtol=1e-9, atol_scale=1e-2, output_step=5e-3, max_steps=5_000_000)
-    out["prescribed_time_s"] = r.outputs.time_s.to_numpy()
+    out["prescribed_time_s"] = r.outputs_table.time_s.to_numpy()
     for c in ["bearing_force_clutch_N", "normal_force_N", "x_pp_m", "x_edge_m"]:
-        out[f"prescribed__{c}"] = r.outputs[c].to_numpy()
+        out[f"prescribed__{c}"] = r.outputs_table[c].to_numpy()
     out["prescribed__friction_dissipated_J"] = r.energy["friction_dissipated_J"].to_numpy()
     print("prescribed", r.stats, len(r.events))
     np.savez_compressed("dynamics_reference.npz", **out)

@@ -48,8 +48,8 @@ def main():
             data[f"{name}/{col}"] = res.state(col)
         for col in OUTPUTS:
             data[f"{name}/{col}"] = res.output(col)
-        data[f"{name}/event_time_s"] = np.array([e.time for e in res.events])
-        data[f"{name}/event"] = np.array([e.kind for e in res.events])
+        data[f"{name}/event_time_s"] = np.array([e.time for e in res.event_list])
+        data[f"{name}/event"] = np.array([e.kind for e in res.event_list])
     out = pathlib.Path(__file__).with_name("engagement_traces.npz")
     np.savez_compressed(out, **data)
     print(f"{out}: {out.stat().st_size} bytes")
