@@ -38,7 +38,8 @@ from clutchlab.hysteresis import kernels as K
 from clutchlab.system import simulate as core_simulate
 
 
-def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lugre=None):
+def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lugre=None, torque_reference=None,
+              reversals=False):
     """The drum bench's equations with a Python right-hand side, solved by ``solve_ivp`` between the controller
     samples; returns ``(out, n_steps)``, ``out`` the samples' rows ``[t, omega_f, omega_r, theta, x, v, i1, i2]``.
 
@@ -46,6 +47,12 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lu
     of [1] Eqs. 22-24 written out here, its bristle deflection ``z`` an eighth state of the ODE (stiff where
     the slip is fast: give a stiff ``method``, "Radau"); it starts at its steady state when the armature
     presses the clutch.  Without it, the coupling's kinetic coefficients ``mu_k``.
+
+    ``torque_reference`` ``(times, torques)``: the reference of Eq. 31 read linearly from this table instead of the
+    map (as :func:`clutchlab.emtc.simulate_bench`'s).  ``reversals``: the coil current's turning points
+    (``i1 = i2``, Eq. 8's second lag at rest) are terminal events, so the magnet's memory is committed exactly at
+    each (without them, at the step end after it: its turning point off by the current's curvature times the
+    step's square).
     """
     veh, act, geo_p, tmap = VehicleParameters(), ActuatorParameters(), CouplingGeometry(), TorqueMap()
     ic = veh.rear_final_drive
@@ -131,7 +138,8 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lu
     for k in range(n):
         t = k * ts
         vx = y[0] / ic * rw
-        t_ref = tmap(throttle(t), vx)
+        t_ref = (tmap(throttle(t), vx) if torque_reference is None
+                 else float(np.interp(t, torque_reference[0], torque_reference[1])))
         fn1_req = max(t_ref, 0) / gain / (2 / 3 * geo_p.mu_k1 * geo_p.radius1 * geo_p.pairs1)
         fm_req = fn1_req + fk0 + kspr * sigma if t_ref > 0 else 0.0
         i_cmd, _ = K.invert_one(tab, grid, cstack, cpref, mem["cl"], mem["cu"], fm_req, cidx, cw, 1e-9)
@@ -142,6 +150,7 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lu
         if k == n - 1:
             break
         t_end = t + ts
+        turned = False
         while t < t_end - 1e-12:
             evs = []
             if arm == 1:
@@ -158,6 +167,12 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lu
                 e_open = lambda tt, yy, *a: magnet_force(yy[6], yy[3]) - fk0 - kspr * sigma
                 e_open.terminal, e_open.direction = True, -1
                 evs = [e_open]
+            turn = reversals and not turned
+            if turn:   # a turning point of i2: i1 - i2 through zero, either way (at most one between two samples,
+                # where the command is constant: i1 relaxes monotonically towards it and i2 follows)
+                e_turn = lambda tt, yy, *a: yy[5] - yy[6]
+                e_turn.terminal, e_turn.direction = True, 0
+                evs = evs + [e_turn]
             sol = solve_ivp(rhs, (t, t_end), y, method=method, rtol=rtol, atol=atol, args=(arm, i_cmd),
                             events=evs)
             n_steps += sol.t.size - 1
@@ -167,6 +182,9 @@ def reference(magnet, sc: BenchScenario, rtol=1e-6, atol=None, method="RK45", lu
                 mem["pu"] = i2
             y = sol.y[:, -1].copy()
             t = sol.t[-1]
+            if sol.status == 1 and turn and sol.t_events[-1].size:
+                turned = True
+                continue   # a turning point: committed above, the run goes on in the same mode
             if sol.status == 1:
                 if arm == 1 and sol.t_events[1].size:
                     arm, y[3], y[4] = 2, sigma, 0.0

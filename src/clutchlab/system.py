@@ -138,7 +138,7 @@ class System:
         the core looks at again at the earliest root of a step (a dip through zero and back before it is located);
         +-3: a waypoint, the same direction, whose crossing asks only for a step end just past it (no event: the
         Dormand-Prince step is taken again to 1 % past its root; the driveline's stuck elements coming near their
-        limits).
+        limits); 4: a waypoint either way (the EMTC's coil current crossing a Preisach grid line, or turning).
     events : tuple of str
         Event names by code (what the hooks record).
     mode_names : tuple of str

@@ -159,6 +159,37 @@ def test_the_grid_lines_of_the_magnet_are_located(example):
     assert err[1e-9] < 1.5e-7 and err[1e-10] < 2e-8 and err[1e-10] < err[1e-9] / 4, err
 
 
+def test_the_turns_of_the_coil_current_are_located():
+    """Where the coil current turns (i1 = i2), the Preisach output turns onto another branch, and the magnet's memory
+    takes the turning point from the input it is committed at, an accepted step's end.  Before the turns were
+    a waypoint (``coil_current_turn``) a step straddled each and its end, up to a step
+    past the turn, became the memory's turning point: under a torque reference that rises, falls and rises again
+    (three turns of i2), against a reference that commits the memory at each turn exactly (``reversals=True``:
+    without that the reference itself moves by 3e-5 rad/s), the speeds were off by 1.8e-4 / 5.8e-5 / 4.3e-5 rad/s at
+    rtol 1e-6 / 1e-8 / 1e-9, the tolerance not followed.  Now 4.7e-6 / 5.8e-7 / 5.2e-8 (measured), and the turns
+    name no event."""
+    from clutchlab.emtc import BenchScenario
+
+    magnet = bundled_magnet()
+    scenario = BenchScenario(duration=1.0, speed_difference=0.3, throttle_start=0.1, throttle_end=0.6,
+                             ramp_start=0.1, ramp_end=0.9, sample_time=0.002)
+    reference = ([0.0, 0.3, 0.5, 0.7, 1.0], [40.0, 250.0, 80.0, 220.0, 120.0])
+    bench = _bench_emtc()
+    kw = dict(rtol=1e-12, atol=ATOL * 1e-6, method="DOP853", torque_reference=reference)
+    ref, _ = bench.reference(magnet, scenario, reversals=True, **kw)
+    unlocated, _ = bench.reference(magnet, scenario, **kw)
+    i2 = ref[:, 7]
+    turns = np.flatnonzero(np.diff(np.sign(np.diff(i2))) != 0)
+    assert len(turns) == 3, ref[turns + 1, 0]   # the scenario turns the current where the reference turns
+    assert np.max(np.abs(unlocated[:, 1:3] - ref[:, 1:3])) > 1e-5   # (what committing at a turn is worth)
+    err = {}
+    for rtol in (1e-8, 1e-9):
+        run = simulate_bench(magnet, scenario, rtol=rtol, torque_reference=reference)
+        err[rtol] = max(np.max(np.abs(run["omega_f_rad_s"] - ref[:, 1])), np.max(np.abs(run["omega_r_rad_s"] - ref[:, 2])))
+        assert list(run.events["event"]) == ["armature_leave_rest", "armature_contact"]
+    assert err[1e-8] < 1.5e-6 and err[1e-9] < 1.5e-7 and err[1e-9] < err[1e-8] / 4, err
+
+
 def test_the_grid_line_function_changes_sign_at_every_line_and_nowhere_else():
     """``grid_line_function`` against the grid it is for, on a non-uniform grid as well: zero exactly at every
     line, one sign per cell alternating from cell to cell (also beyond the grid), continuous."""

@@ -114,13 +114,16 @@ def test_rhs_matches_clutchlab(t, wf, dw, theta, xa, xd, i1, i2, icmd, vf, vr, a
     assert fm == pytest.approx(y_cl[2], rel=1e-10, abs=1e-9)
     assert tc == pytest.approx(y_cl[8], rel=1e-10, abs=1e-9)
     np.testing.assert_allclose(dy, dx_cl, rtol=1e-9, atol=1e-7)
-    # the mode changes' functions (the peer's six); the coil current's grid-line waypoints are clutchlab's alone,
+    # the mode changes' functions (the peer's six); the coil current's waypoints are clutchlab's alone,
     # checked against their definition written out here
-    modes = [k for k, (_name, d) in enumerate(S.SWITCHING) if abs(d) != 3]
+    modes = [k for k, (_name, d) in enumerate(S.SWITCHING) if abs(d) < 3]   # (3, 4: waypoints)
     np.testing.assert_allclose(gsw, g_cl[modes], rtol=1e-9, atol=1e-9)
-    for name in ("coil_current_grid_line_falling", "coil_current_grid_line_rising"):
-        k = [q[0] for q in S.SWITCHING].index(name)
-        assert g_cl[k] == pytest.approx(_grid_line(i2, MAGNET.grid), rel=1e-12, abs=1e-15)
+    names = [q[0] for q in S.SWITCHING]
+    assert g_cl[names.index("coil_current_grid_line")] == pytest.approx(_grid_line(i2, MAGNET.grid), rel=1e-12,
+                                                                        abs=1e-15)
+    # and the coil current's turn: i2' = (i1 - i2) / tau2 through zero, 1e-9 A past it from the side the current
+    # last moved to (a fresh run: rising)
+    assert g_cl[names.index("coil_current_turn")] == pytest.approx(x[5] - x[6] + 1e-9, rel=0, abs=1e-15)
     # the cfunc numbalsoda calls (scaled state) gives the same derivative
     np.testing.assert_allclose(_cfunc_dy(t, x, d), dy, rtol=1e-12, atol=1e-12)
 

@@ -231,6 +231,23 @@ def test_event_direction_flags(direction, expected):
     assert np.allclose(res.events.time_s, expected, atol=1e-9)
 
 
+@pytest.mark.parametrize("direction, roots", [(4, [math.pi, 2 * math.pi, 3 * math.pi]), (3, [2 * math.pi]),
+                                              (-3, [math.pi, 3 * math.pi])])
+def test_a_waypoint_ends_a_step_just_past_its_root_and_records_nothing(direction, roots):
+    """A waypoint (direction +3 rising, -3 falling, 4 either way: the EMTC's coil current crossing a Preisach grid
+    line or turning) ends a Dormand-Prince step just past each crossing in its direction, within 1 % of that step,
+    and is no event; crossings the other way are stepped over."""
+    free = simulate(toys.sine_system(0), 10.0)   # (every step recorded: no output grid)
+    res = simulate(toys.sine_system(direction), 10.0)
+    assert len(res.events) == 0 and len(free.events) == 3
+    t = res.time
+    assert np.allclose(res.states[:, 0], np.sin(t), atol=1e-8)
+    for r in (math.pi, 2 * math.pi, 3 * math.pi):
+        k = int(np.searchsorted(t, r))   # the first step end at or past the root
+        located = 0.0 <= t[k] - r <= 0.0101 * (t[k] - t[k - 1])
+        assert located == (r in roots), (direction, r, t[k - 1], t[k])
+
+
 @pytest.mark.parametrize("method", METHODS)
 def test_break_times_end_steps_and_restart_the_model(method):
     res = simulate(toys.sine_system(0, period=0.25, method=method), 2.0, output_step=0.5)

@@ -198,7 +198,7 @@ def coupled_update(t, x, u, m, p, k, log):
     _evaluate_outlined(t, x, u, m, net, w, e)   # (the component's hook reads its scratch at t)
     if nw > 0 and k < ng + nw * DW.N_SWITCH:
         res = DW.call(t, x, m, w, (k - ng) // DW.N_SWITCH, (k - ng) % DW.N_SWITCH, log)
-    elif ne > 0:   # (an EMTC's functions, DE.N_SWITCH each: its coil current's grid line among them)
+    elif ne > 0:   # (an EMTC's functions, DE.N_SWITCH each: its coil current's grid lines and turns among them)
         ke = k - ng - nw * DW.N_SWITCH
         res = DE.call(t, x, m, net, e, ke // DE.N_SWITCH, ke % DE.N_SWITCH, log)
     else:

@@ -24,9 +24,10 @@ here.  The two parts meet through three numbers per evaluation (:func:`clutchlab
   (below it the slip reverses, Fig. 11).
 
 The network's friction state machine decides stick and slip (the bench model's ``slip_speed_zero`` and
-``lock_capacity_exceeded`` switching functions are held off).  Its ``coil_current_grid_line_falling`` and ``_rising``
-functions (the coil current crossing a line of the Preisach grid, a kink of the magnet force: waypoints) are the
-network's too: a step ends just past the line, nothing changes mode.  A stuck coupling carries the torque the
+``lock_capacity_exceeded`` switching functions are held off).  Its ``coil_current_grid_line`` (the coil current
+crossing a line of the Preisach grid, a kink of the magnet force) and ``coil_current_turn`` (the coil current
+turning, where the magnet's memory takes a turning point) are waypoints either way and the network's too: a step
+ends just past each, nothing changes mode.  A stuck coupling carries the torque the
 network's constraint solve gives it: for the two shafts of the bench, that is Eq. 29's ``T_lock``, and
 the Torsen twist of Eq. 30 stays zero (its terms vanish identically while both shafts turn together).
 
@@ -62,6 +63,8 @@ from .block import buffer_slots, conf_slots
 
 __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
 
+# (compile-time constants of this module's kernels: numba's cache is keyed by this file alone, so a change of the
+# EMTC's declarations must change this file too, or an editable install keeps kernels of the old layout)
 N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
 #: the model inputs its ports hold, in the order of :data:`clutchlab.driveline.network.EMTC_PORTS`: the torque
 #: request, the throttle, the coil current set point

@@ -117,14 +117,21 @@ SWITCHING = (
     ("slip_speed_zero", -1),
     ("lock_capacity_exceeded", -1),
     # the coil current crossing a line of the Preisach grid: a kink of the magnet force (Eqs. 2-5 interpolate the
-    # Everett function between the lines), so that no step straddles one: waypoints (direction -3 and +3: the core
-    # ends a step just past the crossing, no event is located or named, no mode changes), the one function
-    # (grid_line_function, which crosses falling and rising at alternate lines) declared once per direction
-    ("coil_current_grid_line_falling", -3),
-    ("coil_current_grid_line_rising", 3),
+    # Everett function between the lines), so that no step straddles one: a waypoint either way (direction 4: the
+    # core ends a step just past the crossing, no event is located or named, no mode changes)
+    ("coil_current_grid_line", 4),
+    # the coil current turning (i1 = i2: the second current lag at rest): the Preisach output turns onto another
+    # branch there, and the magnet's memory takes its turning point from the input it is committed at, a step's end
+    # (commit): a waypoint either way, so that a step ends just past each turn (i1 - i2 beyond a band of TURN_BAND,
+    # the side it was last on: rounding between two equal currents is no turn)
+    ("coil_current_turn", 4),
 )
 N_SWITCH = len(SWITCHING)
-G_GRID_FALLING, G_GRID_RISING = indices(SWITCHING, "coil_current_grid_line_falling", "coil_current_grid_line_rising")
+G_GRID, G_TURN = indices(SWITCHING, "coil_current_grid_line", "coil_current_turn")
+#: [A] how far the first current lag must pass the second before the coil current's turn counts (a turn is located
+#: that much late: the turning point committed then lies (TURN_BAND / tau2)^2 / (2 |i2''|) below the true one, 1e-13 A
+#: for tau2 = 1 ms and a turn as slow as 1 A/s^2)
+TURN_BAND = 1e-9
 #: event names by code (docs/nomenclature.md)
 EVENTS = ("armature_rest", "armature_contact", "armature_leave_rest", "armature_leave_contact", "lockup",
           "slip_reversal", "unlock")
@@ -181,10 +188,11 @@ IMEM = slots(("plant_length", 1), ("controller_length", 1), ("next_sample", 1), 
              ("plant_table_index", GAP_TABLES), ("controller_table_index", GAP_TABLES),
              ("moving_table_index", GAP_TABLES),   # the plant tables' indices at the last evaluation, armature moving
              ("plant_version", 1),        # changes of the plant's hysteresis stack so far (its length)
-             ("controller_version", 1))   # the same for the controller model's
-IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX, IM_PVER, IM_CVER = IMEM.of(
+             ("controller_version", 1),   # the same for the controller model's
+             ("current_falling", 1))      # 1 if the coil current i2 fell at the last accepted step beyond TURN_BAND
+IM_PLEN, IM_CLEN, IM_KNEXT, IM_ERROR, IM_GIDX, IM_CIDX, IM_FIDX, IM_PVER, IM_CVER, IM_FALLING = IMEM.of(
     "plant_length", "controller_length", "next_sample", "error", "plant_table_index", "controller_table_index",
-    "moving_table_index", "plant_version", "controller_version")
+    "moving_table_index", "plant_version", "controller_version", "current_falling")
 N_IMEM = IMEM.total
 #: the model intermediates of an evaluation (FMEM's "aux")
 AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
@@ -454,7 +462,7 @@ def grid_line_function(i, grid):
     between the grid lines, and its input is clamped to the grid: the force's slope in ``i`` jumps at every line.
     An integrator step that straddles such a kink makes an error its error estimate does not see (the speeds
     were off by 4e-7 rad/s at rtol 1e-10 where ``i2`` crossed 1.5 A and 2.5 A, docs/emtc.md); as the switching
-    functions ``coil_current_grid_line_falling`` and ``_rising`` (waypoints) a step ends just past every line.
+    function ``coil_current_grid_line`` (a waypoint either way) a step ends just past every line.
     Continuous, smooth inside each cell."""
     n = grid.shape[0]
     if i <= grid[0]:
@@ -474,16 +482,18 @@ def grid_line_function(i, grid):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
-def _switching(x, m, a, margin, aux, grid, g):
+def _switching(x, m, a, margin, aux, grid, falling, g):
     """Switching functions (:data:`SWITCHING`) from the state and the intermediates; inactive ones are +1.
 
     ``a``: a record of :data:`ACTUATOR_DTYPE`; ``margin``: unlock margin of Fig. 11; ``grid``: the plant's Preisach
-    grid [A] (:func:`grid_line_function`).
+    grid [A] (:func:`grid_line_function`); ``falling``: 1 if the coil current fell at the last accepted step
+    (``imem[IM_FALLING]``, :func:`_commit`).
     """
     for k in range(N_SWITCH):
         g[k] = 1.0
-    g[G_GRID_FALLING] = grid_line_function(x[6], grid)
-    g[G_GRID_RISING] = g[G_GRID_FALLING]
+    g[G_GRID] = grid_line_function(x[6], grid)
+    # the turn: di2/dt = (i1 - i2) / tau2 through zero, TURN_BAND past it, from the side the current last moved
+    g[G_TURN] = x[5] - x[6] + (-TURN_BAND if falling else TURN_BAND)
     arm = m[0]
     if arm == ARM_FREE:
         g[0] = x[3]  # reaches the rest stop
@@ -601,6 +611,11 @@ def _commit(t, x, p):
             imem[IM_PLEN] = new
             imem[IM_PVER] += 1
     fmem[FM_PU] = inew
+    d = x[5] - x[6]   # (the side the coil current moves to, beyond TURN_BAND: the turn function's next side)
+    if d > TURN_BAND:
+        imem[IM_FALLING] = 0
+    elif d < -TURN_BAND:
+        imem[IM_FALLING] = 1
     tlast = fmem[FM_TLAST]
     if p.friction_mode == FRICTION_LUGRE and tlast == tlast:  # Eq. 23 over the step, as its stages saw it
         fmem[FM_Z] = lugre_advance_path(fmem[FM_Z], fmem[FM_DWLAST], x[0] - x[1], fmem[FM_DVLAST], t - tlast, p.lugre)
@@ -864,7 +879,7 @@ def _rhs(t, x, u, m, p, dx, g):
     aux[AUX_THR] = thr
     dx[0] = (a_f - tc) * v.inv_inertia_front  # [1], Eq. 27 (rows 1 and 3)
     dx[1] = (tc - a_r) * v.inv_inertia_rear  # [1], Eq. 27 (rows 2 and 4)
-    _switching(x, m, a, c.unlock_margin, aux, grid, g)
+    _switching(x, m, a, c.unlock_margin, aux, grid, p.imem[IM_FALLING], g)
     fmem[FM_KEY] = t
     for i in range(7):
         fmem[FM_KEY + 1 + i] = x[i]

@@ -202,7 +202,10 @@ def record(log, t, code, element):
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _crossed(a, b, d):
-    """True if a switching value went from ``a`` to ``b`` through zero in direction ``d``."""
+    """True if a switching value went from ``a`` to ``b`` through zero in direction ``d`` (4: a waypoint either
+    way)."""
+    if d == 4:
+        d = 0
     if d >= 0 and a < 0.0 and b >= 0.0:
         return True
     if d <= 0 and a > 0.0 and b <= 0.0:
@@ -259,7 +262,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
     ``(theta, n_rhs, k)`` with ``theta`` the bracket end just past the earliest
     root (so that the crossing shows at the returned point), or 2.0 if none
     crossed, and ``k`` the function whose root it is.  A *waypoint* (direction
-    +-3: a function whose crossing only asks for a step end just past it, no
+    +-3, or 4 either way: a function whose crossing only asks for a step end just past it, no
     event) is located to 1 % of the step, and not at all with ``waypoints``
     False or where another function crossed in the step.  ``ga`` receives the value each function starts the step with:
     ``g0``, except that a function starting exactly on zero (after the event
@@ -286,10 +289,10 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
     # (a waypoint is not looked at where another function has crossed in the step: that event ends the step anyway,
     # and its cost was the waypoint's, a stuck element's entry into its band just before its break-away)
     for k in range(ng):
-        if abs(gdir[k]) != 3 and _crossed(ga[k], g1[k], gdir[k]):
+        if abs(gdir[k]) < 3 and _crossed(ga[k], g1[k], gdir[k]):
             waypoints = False
     for k in range(ng):
-        if not _crossed(ga[k], g1[k], gdir[k]) or (abs(gdir[k]) == 3 and not waypoints):
+        if not _crossed(ga[k], g1[k], gdir[k]) or (abs(gdir[k]) >= 3 and not waypoints):
             continue
         lo = th0 if g0[k] == 0.0 else 0.0
         hi = min(1.0, best)
@@ -306,7 +309,7 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         else:
             ghi = g1[k]
         hi, nr = _illinois(p, t, h, x0, f0, x1, f1, rc, u, m, mass,
-                           event_tol if abs(gdir[k]) != 3 else max(event_tol, 1e-2 * h), xe, fe, ge, k, lo, hi, glo,
+                           event_tol if abs(gdir[k]) < 3 else max(event_tol, 1e-2 * h), xe, fe, ge, k, lo, hi, glo,
                            ghi, ga[k], gdir[k])
         n_rhs += nr
         if hi < best:
@@ -886,7 +889,7 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             if samples:
                 dense_correction(h, k1, k3, k4, k5, k6, k7, rc)
         si[SI_NRHS] += nr
-        if theta < 1.0 and kw >= 0 and abs(opt.gdir[kw]) == 3:
+        if theta < 1.0 and kw >= 0 and abs(opt.gdir[kw]) >= 3:
             # the earliest root is a waypoint (a stuck element coming near its limit): the step is taken again,
             # ending just past it on its own solution, with no event and no waypoint looked at (a precise event
             # there cost CoupledClutches 17 % at rtol 1e-6)

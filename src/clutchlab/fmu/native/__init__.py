@@ -251,9 +251,9 @@ def _model_header(name, ident, guid, images, functions, variables, layouts, fixe
     for code, text in sorted((getattr(system, "error_messages", None) or {}).items()):
         lines.append(f"    if (code == {int(code)}) return {_c_string(text)};")
     lines += ["    return NULL;", "}", ""]
-    # which switching functions are events (a waypoint, |gdir| = 3, only guides the core's steps)
+    # which switching functions are events (a waypoint, |gdir| = 3 or 4, only guides the core's steps)
     lines.append(f"static const int cl_event_indicator[{max(gdir.size, 1)}] = {{"
-                 + ", ".join(str(int(abs(int(d)) != 3)) for d in gdir) + ("" if gdir.size else "0") + "};")
+                 + ", ".join(str(int(abs(int(d)) < 3)) for d in gdir) + ("" if gdir.size else "0") + "};")
     lines.append(f"static const int cl_gdir[{max(gdir.size, 1)}] = {{"
                  + ", ".join(str(int(d)) for d in gdir) + ("" if gdir.size else "0") + "};")
     lines += ["typedef struct { uint64_t offset; double a, b; int reciprocal, initial, partner; } cl_target;",
