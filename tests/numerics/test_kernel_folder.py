@@ -136,3 +136,77 @@ def test_cached_data_naming_a_module_an_upgrade_renamed_is_compiled_again(tmp_pa
         (tmp_path / "helpers.py").write_text(_HELPERS.format(inner="inner2"))
 
     _stale_then_compiled_again(run, upgrade, "10.0", "No module named 'inner'")
+
+
+_DECL = "N_SWITCH = {n}\n"
+_PKG_KERNEL = ("import numba\nfrom .decl import N_SWITCH\n\n\n@numba.njit(cache=True)\ndef slots(x):\n"
+               "    return x * N_SWITCH\n")
+
+
+def test_a_kernel_reading_another_modules_constant_is_compiled_again_when_that_module_changes(tmp_path):
+    """numba keys a cached function by its own file, so a kernel that reads a constant of another module (the
+    driveline's coupled network lays out its buffers by the EMTC's number of switching functions) kept the value it
+    was compiled with after that module changed: in an editable install after a pull a worker crashed on such a
+    stale kernel (the forty-second session).  With clutchlab's guard the kernel's stamp carries the contents of the
+    package files it imports (:func:`clutchlab._cache.dependency_stamp`): it compiles again and reads the new value.
+    Without the guard the same cache answers with the old one (so the test can fail)."""
+    import subprocess
+    import sys
+
+    pkg = tmp_path / "pkgx"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "decl.py").write_text(_DECL.format(n=8))
+    (pkg / "kernel.py").write_text(_PKG_KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    guard = f"import clutchlab._cache as c\nc.guard_cross_module_constants({str(pkg)!r})\n"
+
+    def run(head):
+        out = subprocess.run([sys.executable, "-c", head + "from pkgx.kernel import slots\nprint(slots(1.0))"],
+                             capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        assert out.returncode == 0, out.stderr[-2000:]
+        return out.stdout.split()
+
+    assert run("") == ["8.0"]        # cached by plain numba
+    (pkg / "decl.py").write_text(_DECL.format(n=10))   # the declaration changes, the kernel's file does not
+    assert run("") == ["8.0"]        # plain numba: the stale kernel (its own file's stamp unchanged)
+    assert run(guard) == ["10.0"]    # guarded: compiled again with the new constant (its stamp carries decl's)
+    assert run(guard) == ["10.0"]    # (and cached so)
+    (pkg / "decl.py").write_text(_DECL.format(n=12))
+    assert run(guard) == ["12.0"]    # a guarded cache renews itself
+
+
+def test_the_dependency_stamp_follows_the_imports(tmp_path):
+    """A file's dependency stamp changes with any package file it imports, directly, through another module or
+    inside a function, and not with one it does not import nor with its own text (numba's own stamp has that)."""
+    from clutchlab._cache import _package_graph, dependency_stamp
+
+    pkg = tmp_path / "pkgy"
+    (pkg / "sub").mkdir(parents=True)
+    files = {
+        "__init__.py": "",
+        "a.py": "from .b import X\n\n\ndef f():\n    from .sub import c\n    return c\n",
+        "b.py": "from . import d as D\nX = 1\n",
+        "d.py": "Y = 2\n",
+        "e.py": "Z = 3\n",
+        "sub/__init__.py": "",
+        "sub/c.py": "from .. import (\n    e,\n)\n",
+    }
+    for name, text in files.items():
+        (pkg / name).write_text(text)
+
+    def stamps():
+        _package_graph.cache_clear()
+        return {name: dependency_stamp(pkg / name, pkg) for name in files}
+
+    before = stamps()
+    assert dependency_stamp(tmp_path / "elsewhere.py", pkg) == ""
+    (pkg / "d.py").write_text("Y = 20\n")   # imported by b, so by a; not by c or e
+    after = stamps()
+    changed = {n for n in files if after[n] != before[n]}
+    assert changed == {"a.py", "b.py"}, changed
+    (pkg / "e.py").write_text("Z = 30\n")   # imported by sub/c (a parenthesised list), which a imports in f
+    again = stamps()
+    assert {n for n in files if again[n] != after[n]} == {"a.py", "sub/c.py"}
+    (pkg / "a.py").write_text(files["a.py"] + "# an edit\n")   # its own text: not in its dependency stamp
+    assert stamps()["a.py"] == again["a.py"]

@@ -14,6 +14,7 @@ from .. import _cache, _compile_notice
 _compile_notice.install()  # one stderr line when kernels are compiled (never at import); every compiled module
 # imports this package (its interpolation and step helpers), so the notice is in place before any compilation
 _cache.guard_stale_indexes()  # an index an older clutchlab cached with classes since renamed is a miss, not a crash
+_cache.guard_cross_module_constants()  # a kernel is compiled again when a module it imports changes
 
 from .dopri import dense_correction, dense_hermite, error_norm, initial_step, next_step  # noqa: E402
 from .interp import bracket  # noqa: E402
