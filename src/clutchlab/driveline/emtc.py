@@ -63,8 +63,8 @@ from .block import buffer_slots, conf_slots
 
 __all__ = ["EmtcBlock", "N_STATE", "N_SWITCH", "N_MODE", "OUTPUTS", "OUTPUT_INDEX", "ERROR_STRIDE"]
 
-# (compile-time constants of this module's kernels: numba's cache is keyed by this file alone, so a change of the
-# EMTC's declarations must change this file too, or an editable install keeps kernels of the old layout)
+# (compile-time constants of this module's kernels, read from the EMTC's declarations: a change there renews them,
+# clutchlab._cache.guard_cross_module_constants)
 N_STATE, N_SWITCH, N_MODE, N_IN = len(S.STATES), len(S.SWITCHING), len(S.MODE_NAMES), len(S.INPUTS)
 #: the model inputs its ports hold, in the order of :data:`clutchlab.driveline.network.EMTC_PORTS`: the torque
 #: request, the throttle, the coil current set point

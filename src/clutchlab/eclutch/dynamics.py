@@ -71,8 +71,8 @@ __all__ = [
     "BatchResult",
 ]
 
-#: labels of the events in :attr:`DynamicsResult.events` by event code (the :class:`~clutchlab.SimulationResult`
-#: of :attr:`DynamicsResult.result` names them as :data:`clutchlab.eclutch.system.EVENTS`: ``stick``,
+#: readable labels of the events by event code (the ``description`` column of :attr:`DynamicsResult.events`, whose
+#: ``event`` column names them as :data:`clutchlab.eclutch.system.EVENTS`: ``stick``,
 #: ``breakaway``, ``slip_reversal``, ``contact_close``, ``contact_open``, ``stop_hit``, ``stop_leave``,
 #: ``cavitation_start``, ``cavitation_end``, ``friction_free``, ``friction_engage``)
 EVENT_KINDS = {S.EV_STICK: "stick", S.EV_BREAKAWAY: "breakaway", S.EV_REVERSAL: "slip reversal",
