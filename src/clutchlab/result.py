@@ -37,6 +37,10 @@ class BuiltOnFirstAccess:
     def __set__(self, obj, value):
         obj.__dict__[self.slot] = value
 
+    def stored(self, obj):
+        """What ``obj`` holds in this field: the value, or the callable not called yet."""
+        return obj.__dict__[self.slot]
+
 
 @dataclasses.dataclass
 class SimulationResult:
@@ -91,7 +95,7 @@ class SimulationResult:
         its own subclass, :class:`clutchlab.wet.EngagementResult`, ..., built from the core's run with them).  The
         events stay unbuilt where they were (their callable is passed on)."""
         kw = {f.name: getattr(result, f.name) for f in dataclasses.fields(SimulationResult) if f.name != "events"}
-        kw["events"] = result.__dict__["_built_events"]
+        kw["events"] = SimulationResult.__dict__["events"].stored(result)
         return kw
 
     @property
