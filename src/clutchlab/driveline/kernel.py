@@ -3116,6 +3116,14 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
             if not _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol) and \
                     _several_null_known(p, A, ns):
                 _repair_space_outlined(p, stuck, ns, A, lam, lo, hi, tol)
+        # a member the split leaves on its bound to within the repair's tolerance is put on it exactly: the split is
+        # the network's choice here, and "on its limit" must not read as "beyond it" by a rounding (the tie-break in
+        # settle keeps a member exactly on its limit at t + T_TIE stuck, while another member takes the growth, #30)
+        for k in range(ns):
+            if hi[k] < lam[k] <= hi[k] + tol:
+                lam[k] = hi[k]
+            elif lo[k] - tol <= lam[k] < lo[k]:
+                lam[k] = lo[k]
     hold = _holds(p)
     Fa = _torque_magnitudes(p)
     for k in range(ns):
@@ -3439,8 +3447,9 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _evaluate_ahead(t, x, xp, m, p, acc, tau, quad):
-    """The network evaluated at ``t + T_TIE`` into the work array (``acc``, ``tau``), with angles and speeds advanced
-    by the motion decided at ``t`` (``xp``: ``x`` plus ``T_TIE`` times its rates, an error of order ``T_TIE**2``)
+    """The network evaluated at ``t + T_TIE`` into the work array (``acc``, ``tau``), with angles, speeds and the
+    thermal masses' temperatures advanced by the motion decided at ``t`` (``xp``: ``x`` plus ``T_TIE`` times its rates,
+    an error of order ``T_TIE**2``)
     and each lossy gear's quadrant kept as decided at ``t``: the probe of the tie-break in :func:`settle` and of
     :func:`_probe_fails`.  (A released gear whose quadrant flips by ``t + T_TIE`` keeps the one decided at ``t`` --
     taken over, a gear released in a rigid loop carried the other quadrant's split at ``t``, which put a one-way
@@ -3450,7 +3459,22 @@ def _evaluate_ahead(t, x, xp, m, p, acc, tau, quad):
     nl = p.lossy.shape[0]
     for j in range(nl):
         quad[j] = m[p.elem[p.lossy[j], E_MODE]]
+    nt = p.thermal.shape[0]
+    if nt > 0:
+        # the thermal masses' temperatures too, by their rates at t (``xp`` holds the rates first: the elements'
+        # loss powers, then :func:`thermal_rates`): a limit that fades as its lining heats moves with them, and a
+        # brake at its faded limit is then beyond it at t + T_TIE as it is a moment later
+        ne = p.elem.shape[0]
+        for r in range(ne):
+            kind = p.elem[r, E_KIND]
+            xp[2 * n + r] = 0.0 if kind == K_SOURCE or kind == K_MOTION else loss_power(p, r, x, n, m, tau[r])
+        thermal_rates(p, x, n, xp)
+        for k in range(nt):
+            s = int(p.thermal[k, T_STATE]) + TS_TEMP
+            xp[s] = x[s] + T_TIE * xp[s]
     for q in range(xp.shape[0]):
+        if nt > 0 and _is_temperature(p, q):
+            continue
         xp[q] = x[q]
     for j in range(n):
         xp[j] = x[j] + T_TIE * x[n + j]
@@ -3458,6 +3482,15 @@ def _evaluate_ahead(t, x, xp, m, p, acc, tau, quad):
     _evaluate(t + T_TIE, xp, m, p, acc, tau)
     for j in range(nl):
         m[p.elem[p.lossy[j], E_MODE]] = quad[j]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _is_temperature(p, q):
+    """True if state ``q`` is a thermal mass's temperature."""
+    for k in range(p.thermal.shape[0]):
+        if int(p.thermal[k, T_STATE]) + TS_TEMP == q:
+            return True
+    return False
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
@@ -3938,6 +3971,14 @@ def settle(t, x, m, p, log, old, origin):
                     if forced[i] != 0 or not _item_stuck(p, m, i) or not ex0 < 0.0 or not near_[c]:
                         continue
                     ex1s[c], d1s[c] = _item_excess(t + dt, p, tau, i, False)
+                    if i < nf and ex1s[c] >= 0.0 and _past_limit(t + dt, p, tau, i)[0] <= 0.0:
+                        # (exactly on its limit there, not beyond: the split of its statically indeterminate group was
+                        # moved onto its bound (:func:`_repair`) while another member takes the load's growth, so it
+                        # holds.  Marked, a clutch beside a brake was released at its limit and the group broke away 2
+                        # ms early, or the brake "slid" at zero speed while the clutch held its inertia, #30.  An item
+                        # whose load grows beyond its limit is beyond it there by the growth over T_TIE, and one left
+                        # stuck here has its break-away function >= 0, so its next crossing is seen)
+                        ex1s[c] = -1e-300
                     worst1 = max(worst1, ex1s[c])
                 iw = -1
                 dw = _ZERO
