@@ -994,6 +994,62 @@ def test_a_group_reaching_rest_sticks_while_the_load_is_within_the_sum_of_its_li
         assert abs(ev[0][0] - 0.6579263) < 1e-6 and all(abs(e[0] - t_break) < 1e-6 for e in ev[3:]), (rtol, ev)
 
 
+@pytest.mark.parametrize("efficiency", [0.4, 0.5])
+def test_an_overload_of_a_group_beside_a_stuck_gear_is_found_at_every_tolerance(efficiency):
+    """Found by random draws (forty-fourth session): J0 held by a bearing friction (0.65625 N m x 1.203125 peak), a
+    brake (1.2 N m from 0.5 s) and a stuck lossy gear (ratio -1, efficiency 0.5 or 0.4) whose output J1 runs free,
+    under a 2 N m sine at 1 Hz.  The gear holds nothing (its flange b carries no torque), so the group is overloaded
+    while ``|2 sin(2 pi t)|`` exceeds the two limits, 1.989551 N m: 33 ms around 0.75 s, from
+    ``t = 0.5 + asin(0.9947755) / (2 pi)`` = 0.733724 s (closed form).  Before, at rtol 1e-10 (efficiency
+    0.5) or 1e-9 (0.4) a 96 ms step stepped over it and nothing moved: the bearing, pinned on its limit by the split
+    while the brake took the load's growth, had its break-away function at 0 (a rounding either side), which the
+    core counts as a crossing, and the brake's waypoint into its near-limit band was dropped for it.  The break-away
+    function of a stuck friction element now carries its rounding floor (``lim + noise - |tau|``, as a lossy gear's
+    margin does), so a member on its limit has not crossed."""
+    d = Driveline("group beside a stuck gear")
+    d.inertia("J0", J=1.0, w0=0.0).inertia("J1", J=0.25, w0=0.0)
+    d.gear("g0", "J0", "J1", ratio=-1.0, efficiency=efficiency)
+    d.bearing_friction("bearing", "J0", torque=0.65625, peak=1.203125)
+    d.brake("brake", "J0", fn_max=3.0, mu=0.4, peak=1.0, normal=Signal.step(1.0, 0.5))
+    d.torque("T0", "J0", Signal.sine(2.0, 1.0))
+    limit = 0.65625 * 1.203125 + 1.2
+    t_slip = 0.5 + math.asin(limit / 2.0) / (2.0 * math.pi)   # (2 sin(2 pi t) = -limit on the sine's negative half)
+    for rtol in (1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12):
+        ev = _mode_events(d.simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True))
+        late = [e for e in ev if 0.7 < e[0] < 0.8]
+        assert [e[1:] for e in late[:3]] == [("bearing", "backward"), ("brake", "backward"), ("g0", "backward")], \
+            (rtol, ev)
+        assert abs(late[0][0] - t_slip) < 1e-6, (rtol, late[0][0], t_slip)
+
+
+def test_a_group_beside_a_freewheeling_gear_breaks_away_at_its_capacity_whatever_else_runs():
+    """Found by random draws of ``test_an_unrelated_element_changes_nothing``: a ramp ``4 t`` N m on J0, held by a
+    bearing friction (0.5 x 1.1875 = 0.59375 N m) and a loss-table gear (ratio -0.3, ``eta_mf1`` 0.875,
+    ``tau_bf1`` 1.75 N m at rest) whose output a one-way clutch lets overrun.  The gear holds at most
+    ``tau_bf1 / eta_mf1`` = 2 N m (its flange b carries nothing: ``(1 - eta_mf1) T_a + tau_bf1 >= T_a``), so the
+    group breaks away at ``4 t = 2.59375``, t = 0.6484375 s.  Before, it broke away there in one step sequence and
+    at 0.6410071 s in another (with an unrelated braked inertia beside it; J0's speed 8e-5 rad/s apart)."""
+    def network(unrelated):
+        d = Driveline("freewheeling gear")
+        for name, J in (("J0", 1.0), ("J1", 0.5), ("J2", 1.0), ("J3", 0.5)):
+            d.inertia(name, J=J, w0=0.0)
+        d.gear("g0", "J0", "J1", ratio=-0.3, loss_table=[[0.0, 0.875, 0.5, 1.75, 0.0], [20.0, 0.925, 0.5, 2.625, 0.0]])
+        d.one_way_clutch("f1", "J1", "J2")
+        d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.625)
+        d.bearing_friction("bearing", "J0", torque=0.5, peak=1.1875)
+        d.torque("T0", "J0", Signal.ramp(4.0, 1.0))
+        if unrelated:
+            d.inertia("U", J=1.0, w0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5, peak=1.0)
+            d.torque("UT", "U", Signal.sine(0.0, 1.0))
+        return d
+
+    for unrelated in (False, True):
+        for rtol in (1e-7, 1e-10):
+            ev = _mode_events(network(unrelated).simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True))
+            slip = [t for t, el, e in ev if el == "bearing" and e == "forward"]
+            assert slip and abs(slip[0] - 0.6484375) < 1e-6, (unrelated, rtol, ev)
+
+
 def test_a_brake_beside_a_clutch_never_slides_while_their_group_holds():
     """The other network of that draw: a 1 N m sine at 1 Hz, within the group's 1.15 N m (brake 0.4, c1 0.75) at
     every instant after everything sticks at 0.5529 s: nothing moves and nothing changes mode to the end.  Before,

@@ -4198,8 +4198,12 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         else:
             noise = _item_noise(p, r, tau)
             lim = max(static_limit(p, r, t), noise)
-            # (a one-way clutch holds any torque against overrunning, its clutch's limit for it)
-            g[N_G * k + G_BREAK] = lim - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
+            # (a one-way clutch holds any torque against overrunning, its clutch's limit for it; plus the rounding floor,
+            # as a lossy gear's margin: a member a statically indeterminate split pins on its limit is at 0 to a
+            # rounding, which the core counts as a crossing (falling to <= 0), and the waypoint of another member
+            # coming near its own limit was dropped for it -- a group's 33 ms overload stepped over at one tolerance,
+            # #30; crossed only beyond the floor, the decision at the crossing is the tie-break's, _tied)
+            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
             if p.elem[r, E_LAW] != LAW_EXTERNAL and lim > 1e3 * noise and lim < np.inf:
                 # a stuck element with a limit of its own watches its margin near that limit: the margin less
                 # NEAR_LIMIT of the limit (a waypoint, falling through zero: a step ends just past it as the load
