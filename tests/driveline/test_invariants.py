@@ -1069,6 +1069,81 @@ def test_a_brake_beside_a_clutch_never_slides_while_their_group_holds():
         assert (df.loc[late, "brake.mode_1"] == 0).all() and np.abs(df.loc[late, "J2.w_rad_s"]).max() < 1e-12
 
 
+def _free_gear_behind_springs(unrelated):
+    """J0 (1 kg m2, a 1 N m bearing friction, ``2 sin(2 pi t)`` N m) -- spring k0 (1 N m/rad) -- J1 (0.25) --
+    spring-damper k1 (1 N m/rad, 1 N m s/rad) -- J2 (1) -- lossy gear g2 (ratio -1, efficiency 0.5) -- J3 (1), free;
+    with ``unrelated`` a braked inertia of its own beside it (:func:`_add_unrelated`)."""
+    d = Driveline("free gear behind springs")
+    for name, J in (("J0", 1.0), ("J1", 0.25), ("J2", 1.0), ("J3", 1.0)):
+        d.inertia(name, J=J, w0=0.0)
+    d.spring_damper("k0", "J0", "J1", c=1.0, d=0.0)
+    d.spring_damper("k1", "J1", "J2", c=1.0, d=1.0)
+    d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.5)
+    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+    d.torque("T0", "J0", Signal.sine(2.0, 1.0))
+    if unrelated:
+        _add_unrelated(d, 1.0, 0.0)
+    return d
+
+
+def _free_gear_reference(t_out, eta=0.5):
+    """The speeds of J0..J2 of :func:`_free_gear_behind_springs`, written from the equations (SciPy DOP853 at rtol
+    1e-12, restarted where the gear's driving flange changes).  Everything is at rest until the sine reaches the
+    bearing's 1 N m, ``t0 = 1/12`` s (the springs undeflected, the stuck gear holds nothing).  From there J0 slides
+    forward (``J0 a0 = 2 sin(2 pi t) - 1 - c0 (phi0 - phi1)``, checked to stay > 0 to the end) and the gear rolls:
+    a stuck gear whose output is a free inertia holds no torque on flange a, so it cannot stay stuck under any load.
+    Rolling, MSL ``LossyGear``'s quadrants give J2 the inertia ``J2 + J3 / eta`` while the load ``tau_k1`` and
+    ``w2`` agree in sign (flange a drives J3 through the mesh) and ``J2 + eta J3`` while they do not (J3 drives back),
+    so ``a2 = tau_k1 / J_eff``; switched where ``tau_k1 w2`` crosses zero."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y, jeff):
+        p0, w0, p1, w1, p2, w2 = y
+        tk0 = p0 - p1
+        tk1 = (p1 - p2) + (w1 - w2)
+        return [w0, 2.0 * math.sin(2.0 * math.pi * t) - 1.0 - tk0, w1, (tk0 - tk1) / 0.25, w2, tk1 / jeff]
+
+    def turn(t, y, jeff):
+        return ((y[2] - y[4]) + (y[3] - y[5])) * y[5]
+
+    turn.terminal = True
+    t, y = 1.0 / 12.0, np.zeros(6)
+    out = np.zeros((len(t_out), 6))
+    accel = True
+    while t < t_out[-1]:
+        turn.direction = -1 if accel else 1
+        sol = solve_ivp(rhs, (t, t_out[-1]), y, args=(1.0 + (1.0 / eta if accel else eta),), method="DOP853",
+                        rtol=1e-12, atol=1e-16, events=[turn], dense_output=True)
+        sel = (t_out > t) & (t_out <= sol.t[-1])
+        if sel.any():
+            out[sel] = sol.sol(t_out[sel]).T
+        t, y, accel = sol.t[-1], sol.y[:, -1], not accel
+    assert out[t_out > 0.09, 1].min() > 0.0   # J0 slides forward throughout
+    return out[:, [1, 3, 5]]
+
+
+@pytest.mark.parametrize("unrelated", [False, True])
+def test_a_free_gear_behind_springs_rolls_from_rest_at_every_tolerance(unrelated):
+    """Found by random draws of ``test_an_unrelated_element_changes_nothing`` (forty-fourth session, fixed in the
+    forty-fifth): :func:`_free_gear_behind_springs`.  Its gear holds nothing, so it rolls from the bearing's
+    break-away at 1/12 s on; its load there grows from zero like ``(t - t0)^4``, so for a millisecond it is of
+    the size of the integrator's own error (1e-12 N m), and which way the gear first moves is a rounding (it may
+    roll backward for a few ms at ~1e-12 rad/s at coarse tolerances: the speeds agree).  Before, at rtol 1e-7 it
+    reached rest again at 0.0925 s inside its band before the speed projection and a third of its band's width
+    beyond it after (the damper k1 moved with the projected speed), and at rtol 1e-10 the tie-break kept it stuck
+    where the integrator's rounding turned its 2e-12 N m load back, its break-away function left at -2e-21: in
+    both it stayed stuck for half a second, J2's speed up to 1.7e-3 rad/s off (``check_invariants`` named g2).
+    Now J2's and J0's speeds follow the tolerance against the independent solution :func:`_free_gear_reference`."""
+    t_out = np.arange(0.0, 0.6 + 1e-12, 2e-3)
+    ref = _free_gear_reference(t_out)
+    d = _free_gear_behind_springs(unrelated)
+    for rtol in (1e-7, 1e-8, 1e-10):
+        df = d.simulate(0.6, rtol=rtol, output_step=2e-3, check_invariants=True).to_dataframe()
+        for col, name in enumerate(("J0", "J1", "J2")):
+            got = np.interp(t_out, df["time_s"], df[f"{name}.w_rad_s"])
+            err = np.abs(got - ref[:, col]).max()
+            assert err <= 1e3 * rtol * np.ptp(ref[:, col]), (unrelated, rtol, name, err, np.ptp(ref[:, col]))
+
 def _edge(holds, lo, hi):
     """The instant in ``(lo, hi)`` where ``holds`` turns False (bisection to 1e-13 s)."""
     assert holds(lo) and not holds(hi), (lo, hi)

@@ -3563,7 +3563,7 @@ def _tied(t, p, tau, i):
     if i < p.fric.shape[0] and p.elem[_item_row(p, i), E_LAW] == LAW_EXTERNAL:
         return False
     over, allowed = _past_limit(t, p, tau, i)
-    return over >= 0.0 and allowed <= 0.0
+    return over >= 0.0 and allowed < 0.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4003,8 +4003,14 @@ def settle(t, x, m, p, log, old, origin):
                 _put_back(p, saved)
             if not marked:
                 break
+        for j in range(n):
+            xp[j] = x[n + j]
         _project_speeds(t, x, m, p, comp, reach)
         rest = False
+        moved = False
+        for j in range(n):
+            if x[n + j] != xp[j]:
+                moved = True
         for i in range(ni):
             if (i < nf and m[i] == FREE) or _item_stuck(p, m, i):
                 continue
@@ -4015,6 +4021,24 @@ def settle(t, x, m, p, log, old, origin):
             if not taken and abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n) and \
                     _linked(p, comp, reach, _item_row(p, i)):
                 rest = True
+        if not rest and moved:
+            # (the projection moved speeds, and a damper's or a speed-dependent law's torque with them: a stuck
+            # candidate beyond what it holds in the projected state is decided again there.  Decided before the
+            # projection only, a lossy gear at efficiency 0.5 with a free output reached rest carrying 1.5e-12 N m,
+            # inside its band; the projection took the 1e-9 rad/s its rolling had left from its input, the damper
+            # beside it then loaded it with 1e-9 N m, a third of its band's width beyond its edge, and it stayed
+            # stuck there, its break-away function below zero, for half a second, #30)
+            mq = m.copy()
+            _evaluate(t, x, m, p, acc, tau)
+            for c in range(nc):
+                i = cand[c]
+                if _item_stuck(p, m, i):
+                    ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
+                    if ex >= 0.0 and not _tied(t, p, tau, i):
+                        rest = True
+            if not rest:
+                for q in range(m.shape[0]):
+                    m[q] = mq[q]
         if not rest:
             break
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
@@ -4044,7 +4068,54 @@ def settle(t, x, m, p, log, old, origin):
         else:
             ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
         record(log, t, ev, nf + nsw + j)
+    _break_slack(t, x, m, p, comp, reach)
     return any_change
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _break_slack(t, x, m, p, comp, reach):
+    """The slack of the break-away function of every stuck item :func:`settle` decided (those linked to its event,
+    :func:`_linked`): 0, but for one left stuck with its function at or below zero -- at its limit to rounding
+    (:func:`_tied`), kept by the tie-break because its load does not grow beyond the limit by ``t + T_TIE`` -- half
+    the way from where it is to the edge of what the invariants allow a stuck item (:func:`_past_limit`).  The
+    function then starts above zero and falls through it where the load has grown by half that room, so the core sees
+    the next crossing, and the item never leaves that band unseen.  (Without it, a lossy gear at efficiency 0.5 with a
+    free output, its load 2e-12 N m, the integrator's rounding at rtol 1e-10, crossed its band's edge as that
+    rounding turned; kept stuck with its function at -2e-21 it never crossed again, and held its growing load until
+    an unrelated break-away half a second later, #30.)  The evaluation it takes leaves the work array as it found it, its own slacks aside."""
+    n = p.inertia.shape[0]
+    nf = p.fric.shape[0]
+    ni = nf + p.lossy.shape[0]
+    new = np.zeros(ni)
+    any_stuck = False
+    for i in range(ni):
+        if _item_stuck(p, m, i) and _linked(p, comp, reach, _item_row(p, i)):
+            any_stuck = True
+    if not any_stuck:
+        return
+    acc, tau = _acc_tau(p)
+    saved = p.work.copy()
+    evaluate_network(t, x, m, p, acc, tau)
+    for i in range(ni):
+        r = _item_row(p, i)
+        if not _item_stuck(p, m, i) or not _linked(p, comp, reach, r):
+            continue
+        if i < nf and p.elem[r, E_LAW] == LAW_EXTERNAL:
+            continue
+        noise = _item_noise(p, r, tau)
+        if i < nf:
+            f0 = max(static_limit(p, r, t), noise) + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
+        else:
+            f0 = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)[0]
+        if f0 <= 0.0:
+            allowed = _past_limit(t, p, tau, i)[1]
+            if allowed < 0.0:
+                new[i] = -f0 - 0.5 * allowed
+    _put_back(p, saved)
+    slack = _slack(p)
+    for i in range(ni):
+        if _item_stuck(p, m, i) and _linked(p, comp, reach, _item_row(p, i)):
+            slack[i] = new[i]
 
 
 _log_type = log_type
@@ -4203,7 +4274,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             # rounding, which the core counts as a crossing (falling to <= 0), and the waypoint of another member
             # coming near its own limit was dropped for it -- a group's 33 ms overload stepped over at one tolerance,
             # #30; crossed only beyond the floor, the decision at the crossing is the tie-break's, _tied)
-            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
+            # (plus its slack: 0 but where the tie-break kept it stuck at its limit, :func:`_break_slack`)
+            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r])) + slack[k]
             if p.elem[r, E_LAW] != LAW_EXTERNAL and lim > 1e3 * noise and lim < np.inf:
                 # a stuck element with a limit of its own watches its margin near that limit: the margin less
                 # NEAR_LIMIT of the limit (a waypoint, falling through zero: a step ends just past it as the load
@@ -4271,7 +4343,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         noise = _item_noise(p, r, tau)
         g[q + 2] = 1.0
         if mode == GEAR_STUCK:
-            g[q], _w, _d = gear_margin(p, r, -tau[r], hold[j], noise)
+            g[q] = gear_margin(p, r, -tau[r], hold[j], noise)[0] + slack[nf + j]   # (its slack: _break_slack)
             g[q + 1] = 1.0
             continue
         w_a = gear_speed(p, r, x, n)
