@@ -1144,6 +1144,50 @@ def test_a_free_gear_behind_springs_rolls_from_rest_at_every_tolerance(unrelated
             err = np.abs(got - ref[:, col]).max()
             assert err <= 1e3 * rtol * np.ptp(ref[:, col]), (unrelated, rtol, name, err, np.ptp(ref[:, col]))
 
+def test_a_one_way_clutch_between_lossy_gears_locks_where_its_input_overtakes_its_output():
+    """Found by random draws of ``test_an_unrelated_element_changes_nothing`` (forty-fifth session), a defect of that
+    session's first break slack: a ``2 sin(2 pi t)`` N m torque on J0, held by a 1 N m bearing friction, drives J1
+    through a loss-table gear (ratio -0.9); a one-way clutch f1 (J2 may overrun J1) drives J2, and through a gear at
+    efficiency 0.5 (ratio -1) a free J3.  J0 comes to rest at 0.5824 s and breaks away backward where the sine
+    reaches -1 N m, ``t = 7/12`` s (closed form); J1 then turns forward (ratio -0.9) faster than J2, so f1 locks
+    and drives J2 and J3 (g2 forward) until ``t = 11/12`` s, where the sine passes +1 N m and J0 turns back.
+    At 0.5824 s f1 stuck and slid forward again within one instant; its break-away slack, written into the stick
+    functions' slack, replaced the slack it had before the instant, and at rtol 1e-10 it slid on at 7/12 s while J1
+    overtook J2 (``check_invariants``: "f1: mode inconsistent with the sign of its relative speed" at 0.598 s; J1's
+    speed 0.086 rad/s off).  The break slacks have an array of their own."""
+    def network(unrelated):
+        d = Driveline("one-way clutch between lossy gears")
+        d.inertia("J0", J=1.5625, w0=0.0)
+        for name, J in (("J1", 0.2522701160569879), ("J2", 1.3633488847926407), ("J3", 0.8268281056166955)):
+            d.inertia(name, J=J)
+        d.gear("g0", "J0", "J1", ratio=-0.9, loss_table=[[0.0, 0.4961874313082941, 0.3, 0.0, 0.0],
+                                                         [20.0, 0.5461874313082942, 0.3, 0.0, 0.0]])
+        d.one_way_clutch("f1", "J1", "J2")
+        d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.5)
+        d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+        d.torque("T0", "J0", Signal.sine(2.0, 1.0))
+        if unrelated:
+            _add_unrelated(d, 1.0, 0.0)
+        return d
+
+    frames = {}
+    for unrelated in (False, True):
+        for rtol in (1e-7, 1e-10, 1e-12):
+            res = network(unrelated).simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True)
+            ev = _mode_events(res)
+            at = sorted((el, e) for t, el, e in ev if abs(t - 7.0 / 12.0) < 1e-6)
+            assert ("f1", "stick") in at and ("g2", "forward") in at, (unrelated, rtol, ev)
+            assert [t for t, el, e in ev if el == "f1" and e == "forward" and t > 0.59] and \
+                abs([t for t, el, e in ev if el == "f1" and e == "forward" and t > 0.59][0] - 11.0 / 12.0) < 1e-6
+            df = res.to_dataframe()
+            locked = (df["time_s"] > 7.0 / 12.0 + 1e-3) & (df["time_s"] < 11.0 / 12.0 - 1e-3)
+            assert (df.loc[locked, "J2.w_rad_s"] > 0.0).all()
+            assert np.abs(df.loc[locked, "J2.w_rad_s"] - df.loc[locked, "J1.w_rad_s"]).max() < 1e-9
+            frames[unrelated, rtol] = df
+    for col in ("J0.w_rad_s", "J1.w_rad_s", "J2.w_rad_s", "J3.w_rad_s"):
+        a, b = frames[True, 1e-10][col], frames[False, 1e-10][col]
+        assert np.abs(a - b).max() <= 1e-6 * max(1.0, np.ptp(b)), col
+
 def _edge(holds, lo, hi):
     """The instant in ``(lo, hi)`` where ``holds`` turns False (bisection to 1e-13 s)."""
     assert holds(lo) and not holds(hi), (lo, hi)

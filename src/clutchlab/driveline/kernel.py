@@ -1068,7 +1068,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     flanges, their constraint and torque weights of each member (9 nk) | lower and upper bounds, null vector, its
     scratch, a trial split, breakpoints (11 nk + 2), a copy of A (nk^2), one block's members, split, bounds and the
     block of each member (5 nk, :func:`_repair_blocks`) | accelerations (n) | element torques (ne) | slack of each
-    friction element's and lossy gear's stick function (nf + nl, :func:`settle`) | the sum of the magnitudes of the
+    friction element's and lossy gear's stick function (nf + nl, :func:`settle`), then of its break-away function
+    (nf + nl, :func:`_break_slack`) | the sum of the magnitudes of the
     torques on each inertia (n, the local scale of rounding, :func:`_item_noise`) | the loss torque each lossy gear
     holds or carries (nl) | the time and the values of the signals at the last evaluation (1 + nsig,
     :func:`signal_at`) | the last null-vector search: its set size, result, matrix and vector (2 + nk^2 + nk,
@@ -1093,7 +1094,7 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     o_acc = o_lim + 16 * nk + 2 + nk * nk
     o_tau = o_acc + n
     o_slack = o_tau + ne
-    o_fabs = o_slack + nf + nl
+    o_fabs = o_slack + 2 * (nf + nl)
     o_hold = o_fabs + n
     o_sig = o_hold + nl
     o_nv = o_sig + 1 + nsig
@@ -1178,6 +1179,17 @@ def _slack(p):
     """Slack of the stick functions: the friction elements', then the lossy gears'."""
     o = _offsets(p)
     return borrow(p.work[o.slack:o.slack + p.fric.shape[0] + p.lossy.shape[0]])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=True)
+def _break_slacks(p):
+    """Slack of the break-away functions of stuck items (:func:`_break_slack`): the friction elements', then the
+    lossy gears'.  Apart from the stick functions' (:func:`_slack`): an item stuck and released again within one
+    instant keeps the stick slack it had before it (:func:`_one_search_per_instant`), and a break slack written over
+    it changed the next stick decision of a one-way clutch (#30)."""
+    o = _offsets(p)
+    ni = p.fric.shape[0] + p.lossy.shape[0]
+    return borrow(p.work[o.slack + ni:o.slack + 2 * ni])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -4029,6 +4041,7 @@ def settle(t, x, m, p, log, old, origin):
             # beside it then loaded it with 1e-9 N m, a third of its band's width beyond its edge, and it stayed
             # stuck there, its break-away function below zero, for half a second, #30)
             mq = m.copy()
+            saved = p.work.copy()
             _evaluate(t, x, m, p, acc, tau)
             for c in range(nc):
                 i = cand[c]
@@ -4036,9 +4049,10 @@ def settle(t, x, m, p, log, old, origin):
                     ex, _d = _item_excess(t, p, tau, i, not _item_stuck(p, old, i))
                     if ex >= 0.0 and not _tied(t, p, tau, i):
                         rest = True
-            if not rest:
+            if not rest:   # (the modes and the work array as the search left them)
                 for q in range(m.shape[0]):
                     m[q] = mq[q]
+                _put_back(p, saved)
         if not rest:
             break
     # an item that starts to move from (about) rest may start a rounding's width on the wrong side of zero: its
@@ -4112,7 +4126,7 @@ def _break_slack(t, x, m, p, comp, reach):
             if allowed < 0.0:
                 new[i] = -f0 - 0.5 * allowed
     _put_back(p, saved)
-    slack = _slack(p)
+    slack = _break_slacks(p)
     for i in range(ni):
         if _item_stuck(p, m, i) and _linked(p, comp, reach, _item_row(p, i)):
             slack[i] = new[i]
@@ -4240,6 +4254,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     nf = p.fric.shape[0]
     acc, tau = _acc_tau(p)
     slack = _slack(p)
+    bslack = _break_slacks(p)
     evaluate_network(t, x, m, p, acc, tau)
     for i in range(n):
         dx[i] = x[n + i]
@@ -4275,7 +4290,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             # coming near its own limit was dropped for it -- a group's 33 ms overload stepped over at one tolerance,
             # #30; crossed only beyond the floor, the decision at the crossing is the tie-break's, _tied)
             # (plus its slack: 0 but where the tie-break kept it stuck at its limit, :func:`_break_slack`)
-            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r])) + slack[k]
+            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r])) + bslack[k]
             if p.elem[r, E_LAW] != LAW_EXTERNAL and lim > 1e3 * noise and lim < np.inf:
                 # a stuck element with a limit of its own watches its margin near that limit: the margin less
                 # NEAR_LIMIT of the limit (a waypoint, falling through zero: a step ends just past it as the load
@@ -4343,7 +4358,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         noise = _item_noise(p, r, tau)
         g[q + 2] = 1.0
         if mode == GEAR_STUCK:
-            g[q] = gear_margin(p, r, -tau[r], hold[j], noise)[0] + slack[nf + j]   # (its slack: _break_slack)
+            g[q] = gear_margin(p, r, -tau[r], hold[j], noise)[0] + bslack[nf + j]   # (its slack: _break_slack)
             g[q + 1] = 1.0
             continue
         w_a = gear_speed(p, r, x, n)
