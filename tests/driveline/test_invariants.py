@@ -1078,6 +1078,13 @@ def _free_gear_behind_springs(unrelated):
         d.inertia(name, J=J, w0=0.0)
     d.spring_damper("k0", "J0", "J1", c=1.0, d=0.0)
     d.spring_damper("k1", "J1", "J2", c=1.0, d=1.0)
+    return _free_gear_on_j2(d, unrelated)
+
+
+def _free_gear_on_j2(d, unrelated):
+    """What the two networks of the forty-fifth session share: a gear at efficiency 0.5 (ratio -1) from J2 to a free
+    J3, a 1 N m bearing friction and a ``2 sin(2 pi t)`` N m torque on J0, and with ``unrelated`` a braked inertia
+    of its own (:func:`_add_unrelated`)."""
     d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.5)
     d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
     d.torque("T0", "J0", Signal.sine(2.0, 1.0))
@@ -1163,12 +1170,7 @@ def test_a_one_way_clutch_between_lossy_gears_locks_where_its_input_overtakes_it
         d.gear("g0", "J0", "J1", ratio=-0.9, loss_table=[[0.0, 0.4961874313082941, 0.3, 0.0, 0.0],
                                                          [20.0, 0.5461874313082942, 0.3, 0.0, 0.0]])
         d.one_way_clutch("f1", "J1", "J2")
-        d.gear("g2", "J2", "J3", ratio=-1.0, efficiency=0.5)
-        d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
-        d.torque("T0", "J0", Signal.sine(2.0, 1.0))
-        if unrelated:
-            _add_unrelated(d, 1.0, 0.0)
-        return d
+        return _free_gear_on_j2(d, unrelated)
 
     frames = {}
     for unrelated in (False, True):
