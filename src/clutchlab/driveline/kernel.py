@@ -4096,7 +4096,8 @@ def _break_slack(t, x, m, p, comp, reach):
     the next crossing, and the item never leaves that band unseen.  (Without it, a lossy gear at efficiency 0.5 with a
     free output, its load 2e-12 N m, the integrator's rounding at rtol 1e-10, crossed its band's edge as that
     rounding turned; kept stuck with its function at -2e-21 it never crossed again, and held its growing load until
-    an unrelated break-away half a second later, #30.)  The evaluation it takes leaves the work array as it found it, its own slacks aside."""
+    an unrelated break-away half a second later, #30.)  The evaluation it takes leaves the work array as it found
+    it, its own slacks aside."""
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     ni = nf + p.lossy.shape[0]
