@@ -1190,6 +1190,38 @@ def test_a_one_way_clutch_between_lossy_gears_locks_where_its_input_overtakes_it
         a, b = frames[True, 1e-10][col], frames[False, 1e-10][col]
         assert np.abs(a - b).max() <= 1e-6 * max(1.0, np.ptp(b)), col
 
+@pytest.mark.parametrize("unrelated", [False, True])
+def test_a_gear_holding_nothing_beside_a_bearing_stays_stuck_whatever_brakes_elsewhere(unrelated):
+    """Found by random draws of ``test_an_unrelated_element_changes_nothing`` (forty-fifth session): J1 is held by a
+    1 N m bearing friction against a ``sin(4 pi t)`` N m torque; a gear at efficiency 0.5 (ratio -0.5) links it to
+    J2, which a one-way clutch lets overrun a free J3, so the gear can hold nothing and the bearing holds J1 alone;
+    J0 turns free under a ramp ``-8 t`` N m until its backlash (gap 0.25 rad) closes at ``4 t^3 / 3 = 0.125``,
+    t = 0.4542801 s (closed form).  Before, with an inertia elsewhere braked by 2 N m (sliding from 1 rad/s), the
+    split of J1's statically indeterminate pair (bearing, gear) was repaired only to 1e-12 of the largest torque
+    on *any* inertia, 2e-12 N m where the pair carries 1e-11: the gear was left 4e-12 N m beyond its band at the
+    first step (1e-12 s) and rolled "forward" at zero speed until the contact; without that inertia it held.  The
+    repair's tolerance is now 1e-12 of the torques on the set's own inertias."""
+    d = Driveline("gear holding nothing")
+    d.inertia("J0", J=1.0, w0=0.0)
+    for name in ("J1", "J2", "J3"):
+        d.inertia(name, J=1.0)
+    d.backlash("k0", "J0", "J1", c=10.0, b_gap=0.25)
+    d.gear("g1", "J1", "J2", ratio=-0.5, efficiency=0.5)
+    d.one_way_clutch("f2", "J2", "J3")
+    d.bearing_friction("bearing", "J1", torque=1.0, peak=1.0)
+    d.torque("T0", "J0", Signal.ramp(-4.0, 0.5))
+    d.torque("T1", "J1", Signal.sine(1.0, 2.0))
+    if unrelated:
+        d.inertia("U", J=1.0, w0=1.0)
+        d.brake("Ubrake", "U", fn_max=4.0, mu=0.5)
+        d.torque("UT", "U", Signal.sine(0.0, 1.0))
+    contact = (0.09375) ** (1.0 / 3.0)
+    for rtol in (1e-7, 1e-10):
+        res = d.simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True)
+        ev = [e for e in _mode_events(res) if not str(e[1]).startswith("U")]
+        assert [e[1:] for e in ev if e[0] < 0.6] == [("k0", "contact")], (unrelated, rtol, ev)
+        assert abs(ev[0][0] - contact) < 1e-6, (unrelated, rtol, ev)
+
 def _edge(holds, lo, hi):
     """The instant in ``(lo, hi)`` where ``holds`` turns False (bisection to 1e-13 s)."""
     assert holds(lo) and not holds(hi), (lo, hi)

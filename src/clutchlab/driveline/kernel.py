@@ -3004,9 +3004,6 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     cand = wk[o_lim + 5 * nk:o_lim + 11 * nk + 2]
     S = shaped(wk[o_lim + 11 * nk + 2:o_lim + 11 * nk + 2 + ns * ns], (ns, ns))
     cmax = 0.0
-    fscale = 0.0
-    for i in range(n):
-        fscale = max(fscale, abs(F[i]))
     bounded = False
     for k in range(ns):
         rk = int(stuck[k])
@@ -3115,9 +3112,17 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
     # the torque limits they grew to the split's own size, 5e-3 N m s where a lossy gear rolling in a loop makes a
     # null direction with a net impulse, and the projection gave the loop a speed of its own, #30)
     if bounded and ns > 1 and speeds == 0 and not _full_rank_known(p, A, ns):
-        big = fscale
+        # (the torques on the members' own inertias, not on every inertia: an inertia elsewhere, braked with 2 N m,
+        # made the tolerance 2e-12 N m where this set carries 1e-11, and a lossy gear holding nothing was left with
+        # 4e-12 N m of a bearing's load and rolled at the first step with that inertia beside the network and not
+        # without it, #30)
+        big = 0.0
         for k in range(ns):
             big = max(big, abs(lam[k]))
+            for q in range(3):
+                i = int(flf[3 * k + q])
+                if i >= 0:
+                    big = max(big, abs(F[i]))
         # (relative to the torques only: a split is moved into the bounds before the switching functions, whose
         # floor is NOISE (1 + torque), see it leave them -- else which comes first is a rounding, and a stuck lossy
         # gear beside a bearing rolled or held by the step sequence, #30)
