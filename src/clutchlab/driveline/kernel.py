@@ -4091,6 +4091,16 @@ def settle(t, x, m, p, log, old, origin):
     return any_change
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def friction_break(p, r, t, tq, noise):
+    """Break-away function of stuck friction element row ``r`` carrying ``tq`` [N m], without its slack, and the
+    limit it uses: ``lim + noise - |tq|`` (a one-way clutch ``- tq``: it holds any torque against overrunning) with
+    ``lim`` its static limit, at least its rounding floor ``noise``.  The one expression the switching function
+    (:func:`driveline_rhs`) and :func:`_break_slack` use, as :func:`gear_margin` is a lossy gear's."""
+    lim = max(static_limit(p, r, t), noise)
+    return lim + noise - (tq if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tq)), lim
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _break_slack(t, x, m, p, comp, reach):
     """The slack of the break-away function of every stuck item :func:`settle` decided (those linked to its event,
@@ -4124,7 +4134,7 @@ def _break_slack(t, x, m, p, comp, reach):
             continue
         noise = _item_noise(p, r, tau)
         if i < nf:
-            f0 = max(static_limit(p, r, t), noise) + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r]))
+            f0 = friction_break(p, r, t, tau[r], noise)[0]
         else:
             f0 = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)[0]
         if f0 <= 0.0:
@@ -4289,14 +4299,14 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_BREAK] = 1.0
         else:
             noise = _item_noise(p, r, tau)
-            lim = max(static_limit(p, r, t), noise)
+            f_break, lim = friction_break(p, r, t, tau[r], noise)
             # (a one-way clutch holds any torque against overrunning, its clutch's limit for it; plus the rounding floor,
             # as a lossy gear's margin: a member a statically indeterminate split pins on its limit is at 0 to a
             # rounding, which the core counts as a crossing (falling to <= 0), and the waypoint of another member
             # coming near its own limit was dropped for it -- a group's 33 ms overload stepped over at one tolerance,
             # #30; crossed only beyond the floor, the decision at the crossing is the tie-break's, _tied)
             # (plus its slack: 0 but where the tie-break kept it stuck at its limit, :func:`_break_slack`)
-            g[N_G * k + G_BREAK] = lim + noise - (tau[r] if p.elem[r, E_LAW] == LAW_ONEWAY else abs(tau[r])) + bslack[k]
+            g[N_G * k + G_BREAK] = f_break + bslack[k]
             if p.elem[r, E_LAW] != LAW_EXTERNAL and lim > 1e3 * noise and lim < np.inf:
                 # a stuck element with a limit of its own watches its margin near that limit: the margin less
                 # NEAR_LIMIT of the limit (a waypoint, falling through zero: a step ends just past it as the load
