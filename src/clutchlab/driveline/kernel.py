@@ -167,13 +167,16 @@ GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(
     GEAR_VALUES, "stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
 # switching functions: five per friction element, then three per switched spring (``swit``: backlash and curves),
-# then three per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point)
+# then four per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point, its
+# band's pieces)
 FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near")
 G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = indices(FRICTION_SWITCHING, "stick", "break", "normal", "turn", "near")
 N_G = len(FRICTION_SWITCHING)
-#: a lossy gear's: its stick or break-away function, its driving flange's, its turning point
-GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn")
+#: a lossy gear's: its stick or break-away function, its driving flange's, its turning point, and (stuck) the piece
+#: of its band (a waypoint where the torque it carries passes zero, its band's corner without bearing friction)
+GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn", "piece")
 N_GEAR_G = len(GEAR_SWITCHING)
+GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends) and the
 #: turning points of a backlash's deflection in its gap (G_LASH_TURN)
 SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn")
@@ -4258,9 +4261,11 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     edge's side (its turning points, either way: a step ends there, and the edges' functions get the core's second
     look, so a touch of an edge within a step is found).  A curve spring: the deflection above the segment's lower
     point and below its upper one (either falling through zero moves it to the next segment), third unused.  Then
-    three per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
+    four per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
-    ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed.
+    ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed; stuck,
+    ``T_a`` of one without bearing friction (a waypoint either way: a step ends where its band closes; 1 within a
+    rounding floor of zero or in a set with several null directions).
     Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0.
     """
     if u.shape[0] > 0 and hold_inputs(p.data, u):
@@ -4372,19 +4377,39 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         mode = m[p.elem[r, E_MODE]]
         q = N_G * nf + N_SW * nsw + N_GEAR_G * j
         noise = _item_noise(p, r, tau)
-        g[q + 2] = 1.0
+        g[q + GG_TURN] = 1.0
+        g[q + GG_PIECE] = 1.0
         if mode == GEAR_STUCK:
-            g[q] = gear_margin(p, r, -tau[r], hold[j], noise)[0] + bslack[nf + j]   # (its slack: _break_slack)
-            g[q + 1] = 1.0
+            # (plus its slack: _break_slack)
+            g[q + GG_BREAK] = gear_margin(p, r, -tau[r], hold[j], noise)[0] + bslack[nf + j]
+            g[q + GG_FLANGE] = 1.0
+            # the corners of its band's edges (gear_band: the upper edge's pieces meet where T_a = tau_bf_a0, the
+            # lower edge's where T_a = -tau_bf_a0; without bearing friction both at T_a = 0, where the band closes to
+            # a point and any loss held is beyond it): the margin is V-shaped there, and a V-shaped dip below zero
+            # shorter than the gap between a step's stages was stepped over where everything is at rest and the steps
+            # are an eighth of a sine's period (a self-locking gear between two sines held stuck through the 25 ms
+            # it must roll, #30).  Where the gear has no bearing friction, a waypoint either way where T_a passes zero:
+            # a step ends there, where the break-away function is read.  It is 1 (no waypoint) within a rounding
+            # floor of zero (a gear holding nothing carries T_a = 0 to a rounding, whose sign would end every step),
+            # and where the stuck set has several null directions (the last null-vector search, this evaluation's
+            # where its set has two members or more): its split is then :func:`_repair_space`'s optimum, whose vertex
+            # may move with its warm start, and T_a with it, so a waypoint on it ended every step (a bearing and three
+            # stuck gears: 3,284 steps and 4,072 retries where 22 and 7 do, 44 s).  With bearing friction the band
+            # keeps a width at its corners (T_a = +-tau_bf_a0), so the margin is not forced below zero there, and no
+            # waypoint is set
+            _e1, _e2, _b1, _b2, bfa = gear_losses(p, r, 0.0)
+            ta = -tau[r]
+            if abs(bfa) <= noise and abs(ta) > noise and p.work[_offsets(p).nv + 1] != 2.0:
+                g[q + GG_PIECE] = ta
             continue
         w_a = gear_speed(p, r, x, n)
         forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
         g[q] = (w_a if forward else -w_a) + slack[nf + j]
         if abs(w_a) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
             a_a = _item_acc(p, acc, nf + j)
-            g[q + 2] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
+            g[q + GG_TURN] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
-        g[q + 1] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
+        g[q + GG_FLANGE] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")   # (in the right-hand side's loop: no call per element)
@@ -4597,8 +4622,8 @@ def driveline_update(t, x, u, m, p, k, log):
     if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
         j = (k - N_G * nf - N_SW * nsw) // N_GEAR_G
         which = (k - N_G * nf - N_SW * nsw) % N_GEAR_G
-        if which == 2:   # its speed's turning point: a step ends there, nothing changes
-            return 0
+        if which == GG_TURN or which == GG_PIECE:   # a turning point, a corner of a stuck one's band: a step ends
+            return 0                                   # there, nothing changes
         mi = p.elem[p.lossy[j], E_MODE]
         old = m.copy()
         mode = m[mi]
