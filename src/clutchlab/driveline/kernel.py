@@ -4397,9 +4397,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             # stuck gears: 3,284 steps and 4,072 retries where 22 and 7 do, 44 s).  With bearing friction the band
             # keeps a width at its corners (T_a = +-tau_bf_a0), so the margin is not forced below zero there, and no
             # waypoint is set
-            _e1, _e2, _b1, _b2, bfa = gear_losses(p, r, 0.0)
             ta = -tau[r]
-            if abs(bfa) <= noise and abs(ta) > noise and p.work[_offsets(p).nv + 1] != 2.0:
+            if abs(ta) > noise and p.work[_offsets(p).nv + 1] != 2.0 and abs(gear_losses(p, r, 0.0)[4]) <= noise:
                 g[q + GG_PIECE] = ta
             continue
         w_a = gear_speed(p, r, x, n)
