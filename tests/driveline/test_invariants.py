@@ -1893,8 +1893,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
         if el in lash:
             if {first, event} != {"contact", "separate"}:
                 continue
-        else:       # a stick, or a reversal of its sliding (an element with no capacity to speak of), and back
-            if first == event:
+        else:       # a stick, or a reversal of its sliding (an element with no capacity to speak of), and back (not
+            if first == event or event == "stick":   # a stuck element's slip and stick: a break-away one run misses)
                 continue
             prior = [e for e in ev[:k_first] if e[1] == el]     # the mode before the touch
             if not prior or prior[-1][2] != event:
@@ -1903,7 +1903,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
     paired = set().union(*(q[0] for q in touches)) if touches else set()
     for el, (k, t, event) in last.items():    # a touch the end of the run cuts: its other half lies beyond t_end
         earlier = [e for e in ev[:k] if e[1] == el]
-        if el not in lash and k not in paired and earlier and earlier[-1][2] != event and t_end - t <= TOUCH_DURATION:
+        if el not in lash and k not in paired and earlier and earlier[-1][2] not in (event, "stick") and \
+                t_end - t <= TOUCH_DURATION:
             touches.append(({k}, el, event, t, t_end))
     drop = set()
     for positions, el, first, t1, t2 in touches:
