@@ -1527,7 +1527,15 @@ def _full_rank_known(p, A, ns):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _several_null_known(p, A, ns):
     """True if the last null-vector search was of exactly this ``A`` and found more than one null direction."""
-    return _searched_before(p, A, ns) and p.work[_offsets(p).nv + 1] == 2.0
+    return _searched_before(p, A, ns) and _several_null_last(p)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _several_null_last(p):
+    """True if the last null-vector search (:func:`_null_vector_cached`, whatever ``A`` it was of: in
+    :func:`driveline_rhs`, the evaluation's own stuck set where it has two members or more) found more than one null
+    direction."""
+    return p.work[_offsets(p).nv + 1] == 2.0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4398,7 +4406,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             # keeps a width at its corners (T_a = +-tau_bf_a0), so the margin is not forced below zero there, and no
             # waypoint is set
             ta = -tau[r]
-            if abs(ta) > noise and p.work[_offsets(p).nv + 1] != 2.0 and abs(gear_losses(p, r, 0.0)[4]) <= noise:
+            if abs(ta) > noise and not _several_null_last(p) and abs(gear_losses(p, r, 0.0)[4]) <= noise:
                 g[q + GG_PIECE] = ta
             continue
         w_a = gear_speed(p, r, x, n)
