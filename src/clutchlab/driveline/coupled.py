@@ -252,6 +252,9 @@ def coupled_accept(t, x, u, m, p):
         res = K.table_error(x, net)
         if res != 0:
             return res
+    res = K.shift_error(x, net)
+    if res != 0:
+        return res
     if net.check[0] != 0.0:
         K.observe(net, True)   # (a debug option changes no decision: K.driveline_accept ends the mark)
         _evaluate_outlined(t, x, u, m, net, w, e)

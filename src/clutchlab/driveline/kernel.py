@@ -148,13 +148,19 @@ N_LINK = len(LINK_COLUMNS)
 #: an engine's idle controller: set speed [rad/s], gains [N m s/rad], [N m/rad], torque limit [N m]
 COEF_COLUMNS = {
     "spring": ("stiffness", "damping", "phi0", "gap"),
-    "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale"),
+    "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale", "levels", "wear0", "wear_rate", "expansion",
+                 "t_ref"),
     "gear": ("ratio",),
     "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
 }
 C_STIFF, C_DAMP, C_PHI0, C_GAP = indices(COEF_COLUMNS["spring"], "stiffness", "damping", "phi0", "gap")
 C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF, C_MU_SCALE = indices(
     COEF_COLUMNS["friction"], "fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale")
+#: an E-clutch whose working point moves (:func:`shifted_curve`): its curve's number of shift levels (0: a plain
+#: normal-force curve), its initial facing wear [m], its wear per joule it dissipates [m/J], its stack's thermal
+#: expansion [m/K] and the temperature [degC] at which its curve is the model's
+C_LEVELS, C_WEAR0, C_WEAR_RATE, C_EXPANSION, C_T_REF = indices(
+    COEF_COLUMNS["friction"], "levels", "wear0", "wear_rate", "expansion", "t_ref")
 C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = indices(
     COEF_COLUMNS["engine"], "idle_speed", "idle_kp", "idle_ki", "idle_max")
@@ -523,13 +529,106 @@ def fade_factor(p, r):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _shift_bracket(data, o, nl, s):
+    """The levels ``data[o:o+nl]`` (increasing) bracketing the shift ``s`` [m]: ``(i, w)``, ``s`` at ``(1 - w)
+    s_i + w s_(i+1)``, held at the ends (:func:`shift_error` ends a run whose shift leaves them)."""
+    if nl == 1:
+        return 0, 0.0
+    return bracket(data[o:o + nl], s)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def shifted_liftoff(data, o, nl, s):
+    """Lift-off position [m] of a shifted normal-force curve (:func:`shifted_curve`) at the shift ``s`` [m]: its
+    levels' lift-offs, linear between them."""
+    i, w = _shift_bracket(data, o, nl, s)
+    if nl == 1:
+        return data[o + nl]
+    return (1.0 - w) * data[o + nl + i] + w * data[o + nl + i + 1]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def shifted_curve(data, o, nl, npt, s, u):
+    """Normal force [N] of an E-clutch whose working point facing wear and thermal expansion moved by ``s`` [m] (the
+    cushion pre-strain's change, ``-w + alpha dT h``: seed 000, Sec. 7, future work iii; :func:`clutchlab.eclutch.
+    dynamics.apply_wear_and_expansion`), at the release-bearing position ``u`` [m].
+
+    The table at ``data[o:]`` (:meth:`Driveline.eclutch <clutchlab.driveline.network.Driveline.eclutch>` builds it
+    from the axial model's static curves): ``nl`` shifts ``s_i`` (increasing), their lift-off positions ``L_i``,
+    the first and the step of a grid of ``npt`` distances to lift-off ``xi_k <= 0`` (the last 0), then for each
+    level its force at ``L_i + xi_k``.  Between two levels the lift-off is linear in ``s`` and the force is linear
+    in ``s`` at the same distance to lift-off ``u - L(s)``: the curves are interpolated aligned at their lift-offs,
+    so the force is 0 exactly beyond ``L(s)`` (where the clutch is free) and the interpolation follows the curve's
+    shift along the bearing travel.  Held beyond the grid's ends."""
+    i, w = _shift_bracket(data, o, nl, s)
+    lift = shifted_liftoff(data, o, nl, s)
+    xi0 = data[o + 2 * nl]
+    dxi = data[o + 2 * nl + 1]
+    q = o + 2 * nl + 2
+    z = (u - lift - xi0) / dxi
+    if z >= npt - 1:
+        return 0.0
+    if z <= 0.0:
+        k, v = 0, 0.0
+    else:
+        k = int(z)
+        v = z - k
+    f0 = data[q + i * npt + k] + v * (data[q + i * npt + k + 1] - data[q + i * npt + k])
+    if nl == 1:
+        return f0
+    f1 = data[q + (i + 1) * npt + k] + v * (data[q + (i + 1) * npt + k + 1] - data[q + (i + 1) * npt + k])
+    return (1.0 - w) * f0 + w * f1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _shift(p, r):
+    """The working point's shift [m] of friction element row ``r`` at the network's last evaluation
+    (:func:`update_shifts`)."""
+    return p.work[_offsets(p).shift + r]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def update_shifts(p, x):
+    """Each shifted E-clutch's working point at the state ``x`` (:func:`shifted_curve`): ``s = -(w0 + k_w E) +
+    e (T - T_ref)``, its facing wear growing with the energy ``E`` [J] it dissipated (a wear proportional to the
+    friction work, Archard's law at a constant friction coefficient: ``k_w`` [m/J]) and its stack expanding ``e``
+    [m/K] with the temperature ``T`` [degC] of the thermal mass its losses heat (``T_ref`` without one).  Kept for
+    the network's evaluations at that state (every evaluation of the network starts with this)."""
+    n = p.inertia.shape[0]
+    o = _offsets(p).shift
+    for k in range(p.fric.shape[0]):
+        r = p.fric[k]
+        if p.coef[r, C_LEVELS] <= 0.0:
+            continue
+        temp = p.coef[r, C_T_REF]
+        h = p.elem[r, E_HEAT]
+        if h >= 0:
+            temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
+        wear = p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * n + r], 0.0)
+        p.work[o + r] = -wear + p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _liftoff(p, r):
+    """The release-bearing position [m] beyond which friction element row ``r``'s normal-force curve is 0."""
+    if p.coef[r, C_LEVELS] > 0.0:
+        return shifted_liftoff(p.data, int(p.coef[r, C_NCURVE]), int(p.coef[r, C_LEVELS]), _shift(p, r))
+    return p.coef[r, C_LIFTOFF]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def normal_force(p, r, t):
     """Normal force [N] of friction element row ``r``: ``fn_max * f(t)`` (``fn_max`` alone without a signal);
     with a normal-force curve (``E_AUX`` points, an E-clutch's static curve), ``fn_max * curve(f(t))``:
-    the signal is then the actuator input (the release bearing position [m])."""
+    the signal is then the actuator input (the release bearing position [m]); a curve whose working point wear
+    and thermal expansion move (``C_LEVELS`` levels) at its shift (:func:`shifted_curve`)."""
     f = 1.0 if p.elem[r, E_SIGNAL] < 0 else signal_at(p, p.elem[r, E_SIGNAL], t)
     if p.elem[r, E_AUX] > 0 and p.elem[r, E_LAW] == LAW_CLUTCH:
-        f = _table(p.data, int(p.coef[r, C_NCURVE]), p.elem[r, E_AUX], f)
+        if p.coef[r, C_LEVELS] > 0.0:
+            f = shifted_curve(p.data, int(p.coef[r, C_NCURVE]), int(p.coef[r, C_LEVELS]), p.elem[r, E_AUX],
+                              _shift(p, r), f)
+        else:
+            f = _table(p.data, int(p.coef[r, C_NCURVE]), p.elem[r, E_AUX], f)
     return p.coef[r, C_FN_MAX] * f
 
 
@@ -542,7 +641,7 @@ def _is_free(p, r, t):
         return False
     if p.elem[r, E_AUX] > 0:   # a normal-force curve: free beyond its lift-off input, or at it and not coming back
         u = signal_at(p, p.elem[r, E_SIGNAL], t)
-        lift = p.coef[r, C_LIFTOFF]
+        lift = _liftoff(p, r)
         if u != lift:
             return u > lift
         rate, _d2 = signal_rates(p.signals[p.elem[r, E_SIGNAL]], p.data, t)
@@ -955,6 +1054,10 @@ def evaluate_network(t, x, m, p, acc, tau):
         temp = temperatures(p)
         for k in range(p.thermal.shape[0]):
             temp[k] = x[int(p.thermal[k, T_STATE]) + TS_TEMP]
+    for k in range(p.fric.shape[0]):   # (a shifted E-clutch's working point at this state; no call without one)
+        if p.coef[p.fric[k], C_LEVELS] > 0.0:
+            update_shifts(p, x)
+            break
     F = wk[0:n]
     Fa = _torque_magnitudes(p)
     for i in range(n):
@@ -1042,7 +1145,8 @@ class WorkLayout(NamedTuple):
     and weights ``g``, bounds and scratch ``lim``; accelerations ``acc``, element torques ``tau``, stick-function
     slack ``slack``, torque magnitudes ``fabs``, gear holds ``hold``, signal cache ``sig``, null-vector cache ``nv``,
     the last search's instant ``inst``, the warm start of the split of a statically indeterminate set ``sp``
-    (:func:`_repair_space`), the thermal masses' temperatures ``temp``, clutch models ``ext``."""
+    (:func:`_repair_space`), the thermal masses' temperatures ``temp``, the elements' working-point shifts ``shift``,
+    clutch models ``ext``."""
     a: int
     m: int
     b: int
@@ -1061,6 +1165,7 @@ class WorkLayout(NamedTuple):
     inst: int
     sp: int
     temp: int
+    shift: int
     ext: int
 
 
@@ -1080,7 +1185,8 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     friction elements' and lossy gears' modes before it (2 + nf + nl, :func:`settle`), the last break time given to
     the core (1, :func:`_break_marker`) | the warm start of :func:`_repair_space` (:func:`space_cache`), then whether an
     observer evaluates the network (1, :func:`observe`) | the thermal
-    masses' temperatures at the last evaluation (nt, :func:`temperatures`) | sliding torque,
+    masses' temperatures at the last evaluation (nt, :func:`temperatures`) | each element's working-point shift at
+    the last evaluation (ne, :func:`update_shifts`; an E-clutch's wear and thermal expansion) | sliding torque,
     static limit and lock-up limit of each clutch model, their rates and the time of those (``N_EXT`` per
     ``LAW_EXTERNAL`` element, :func:`set_external`, :func:`set_external_rates`) | the
     scratch of the rates of stuck margins: the moved state, its derivative and switching functions, and the
@@ -1104,9 +1210,10 @@ def _layout(n, nk, ne, nf=0, nl=0, nsig=0, nt=0):
     o_inst = o_nv + 2 + nk * nk + nk
     o_sp = o_inst + 3 + nf + nl
     o_temp = o_sp + space_cache(nk) + 1
-    o_ext = o_temp + nt
+    o_shift = o_temp + nt
+    o_ext = o_shift + ne
     return WorkLayout(o_a, o_m, o_b, o_l, o_c, o_r, o_g, o_lim, o_acc, o_tau, o_slack, o_fabs, o_hold, o_sig, o_nv,
-                      o_inst, o_sp, o_temp, o_ext)
+                      o_inst, o_sp, o_temp, o_shift, o_ext)
 
 
 def work_size(n, nk, ne, nf, nx=0, nl=0, nsig=0, nt=0):
@@ -1159,7 +1266,7 @@ def temperatures(p):
     """The thermal masses' temperatures [degC] at the network's last evaluation (:func:`evaluate_network`), which
     the friction laws that fade read (:func:`fade_factor`)."""
     o = _offsets(p)
-    return p.work[o.temp:o.ext]
+    return p.work[o.temp:o.shift]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4337,7 +4444,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         if p.elem[r, E_LAW] != LAW_CLUTCH or p.elem[r, E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif p.elem[r, E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
-            g[N_G * k + G_NORMAL] = p.coef[r, C_LIFTOFF] - signal_at(p, p.elem[r, E_SIGNAL], t)
+            g[N_G * k + G_NORMAL] = _liftoff(p, r) - signal_at(p, p.elem[r, E_SIGNAL], t)
         else:
             g[N_G * k + G_NORMAL] = signal_at(p, p.elem[r, E_SIGNAL], t)
     for j in range(p.swit.shape[0]):
@@ -4745,7 +4852,10 @@ def driveline_start(t, x, u, m, p):
     n = p.inertia.shape[0]
     nf = p.fric.shape[0]
     derive_speeds(x, p)
+    update_shifts(p, x)   # (a shifted E-clutch's lift-off at the initial state: whether it starts free)
     code = kinematic_error(t, x, p)
+    if code == 0:
+        code = shift_error(x, p)
     for j in range(p.lossy.shape[0]):
         r = p.lossy[j]
         w_a = _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
@@ -5019,6 +5129,30 @@ def table_error(x, p):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def shift_error(x, p):
+    """0, or the model error code (``-(INV_BASE + N_INV r + INV_TABLE)``) of the first shifted E-clutch (row ``r``,
+    :func:`shifted_curve`) whose working point's shift at the state ``x`` (:func:`update_shifts`) left the levels
+    its table was built for (by more than a micrometre's thousandth): its wear beyond ``wear_max`` or its
+    temperature beyond the table's span.  Held at the last level, its force would be a silent guess."""
+    n = p.inertia.shape[0]
+    for k in range(p.fric.shape[0]):
+        r = p.fric[k]
+        nl = int(p.coef[r, C_LEVELS])
+        if nl <= 0:
+            continue
+        temp = p.coef[r, C_T_REF]
+        h = p.elem[r, E_HEAT]
+        if h >= 0:
+            temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
+        s = -(p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * n + r], 0.0)) + \
+            p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
+        o = int(p.coef[r, C_NCURVE])
+        if s < p.data[o] - 1e-9 or s > p.data[o + nl - 1] + 1e-9:
+            return -(INV_BASE + N_INV * r + INV_TABLE)
+    return 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def driveline_accept(t, x, u, m, p):
     """Nothing to commit (the network has no memories); a lossy gear whose loss table's extrapolation reached an
     efficiency <= 0 ends the run with a model error naming it (:func:`table_error`); with ``check[0]`` set, the
@@ -5029,6 +5163,9 @@ def driveline_accept(t, x, u, m, p):
         code = table_error(x, p)
         if code != 0:
             return code
+    code = shift_error(x, p)
+    if code != 0:
+        return code
     if p.check[0] != 0.0:
         observe(p, True)   # (a debug option: it changes no decision)
         code = _check_outlined(t, x, m, p)

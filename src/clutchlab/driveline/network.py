@@ -548,6 +548,7 @@ class _Element:
     aux: int = 0        # a spring curve's kind (0 linear, 1 pchip)
     ncurve: tuple = ()  # a friction element's normal-force curve: inputs, then forces [N]
     liftoff: float = math.inf   # the input beyond which that force is 0
+    levels: int = 0     # an E-clutch whose working point moves: its curve's shift levels (ncurve: kernel.shifted_curve)
     model: str = ""     # what built it (for describe)
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
@@ -608,6 +609,101 @@ def _adds(kind: str):
             return out
         return run
     return wrap
+
+
+#: the temperatures [degC] an expanding E-clutch's table spans (:meth:`Driveline.eclutch`): a dry clutch's linings
+#: are destroyed long before its hottest end; a thermal mass leaving the span ends the run with an error
+SHIFT_TEMPERATURES = (-50.0, 500.0)
+#: an E-clutch's shift levels are added until the curve interpolated halfway between two of them is within this
+#: fraction of its peak force of the axial model's own curve there (as close as the 161-point curve of an unshifted
+#: clutch reads it)
+SHIFT_TOLERANCE = 2e-4
+#: the widest first spacing of the shift levels [m], and how many times an interval is halved at most
+SHIFT_STEP, SHIFT_HALVINGS = 50e-6, 6
+
+
+def _shifted_model(cm, s):
+    """The axial model ``cm`` with its cushion pre-strain changed by ``s`` [m] (:func:`clutchlab.eclutch.dynamics.
+    apply_wear_and_expansion`: wear ``-s`` where ``s < 0``, an expansion ``s`` where ``s > 0``)."""
+    from ..eclutch.dynamics import apply_wear_and_expansion
+
+    return apply_wear_and_expansion(cm, wear_m=max(-s, 0.0), temperature_rise_k=max(s, 0.0),
+                                    expansion_coefficient=1.0, stack_height_m=1.0)
+
+
+def _force(cm, u):
+    return np.maximum(cm.static_curve(np.asarray(u, dtype=float))["normal_force_N"].to_numpy(), 0.0)
+
+
+def _lift_off(name, cm, s, travel, points):
+    """The release-bearing position [m] where the static curve of ``cm`` shifted by ``s`` reaches zero force: the
+    first of ``points`` positions over ``[0, travel]`` with none, then narrowed three times between its neighbours
+    (64 positions each: to 1e-5 of the spacing)."""
+    m = _shifted_model(cm, s)
+    u = np.linspace(0.0, travel, points)
+    zero = np.flatnonzero(_force(m, u) <= 0.0)
+    if not zero.size:
+        raise ParameterError(f"{name}: at a working-point shift of {s * 1e6:.4g} um its static curve does not lift "
+                             f"off within travel = {travel:g} m: choose a longer travel")
+    if zero[0] == 0:
+        raise ParameterError(f"{name}: at a working-point shift of {s * 1e6:.4g} um it is open at the engaged "
+                             "position (worn through): lower wear_max")
+    lo, hi = u[zero[0] - 1], u[zero[0]]
+    for _ in range(3):
+        uu = np.linspace(lo, hi, 65)
+        j = int(np.flatnonzero(_force(m, uu) <= 0.0)[0])
+        lo, hi = uu[j - 1], uu[j]
+    return float(hi)
+
+
+def _shift_table(name, cm, travel, points, lo, hi):
+    """The table of :func:`clutchlab.driveline.kernel.shifted_curve` for the axial model ``cm`` at shifts ``lo`` to
+    ``hi`` [m]: ``(data, levels)``.  Levels at most :data:`SHIFT_STEP` apart, each interval halved (up to
+    :data:`SHIFT_HALVINGS` times) until the table's curve halfway is within :data:`SHIFT_TOLERANCE` of the peak
+    force of the model's own there, on ``points`` positions over ``[0, travel]`` (kinks of the curve that move
+    along the travel with the shift, not with its lift-off, need the halvings: Model 4's above about +50 um)."""
+    n0 = max(2, int(math.ceil((hi - lo) / SHIFT_STEP)) + 1)
+    levels = list(np.linspace(lo, hi, n0)) if hi > lo else [lo]
+    lifts = {s: _lift_off(name, cm, s, travel, points) for s in levels}
+    xi = np.linspace(-max(lifts.values()), 0.0, points)   # (widened below as levels come in)
+    u = np.linspace(0.0, travel, points)
+
+    def curve(s, grid):
+        f = _force(_shifted_model(cm, s), lifts[s] + grid)
+        f[-1] = 0.0
+        return f
+
+    peak = max(float(_force(_shifted_model(cm, s), [0.0])[0]) for s in (lo, hi))
+    tol = SHIFT_TOLERANCE * peak
+    todo = [(levels[i], levels[i + 1], 0) for i in range(len(levels) - 1)]
+    while todo:
+        a, b, depth = todo.pop()
+        mid = 0.5 * (a + b)
+        lifts[mid] = _lift_off(name, cm, mid, travel, points)
+        lm = 0.5 * (lifts[a] + lifts[b])
+        grid = np.linspace(-max(lifts[a], lifts[b]), 0.0, points)
+        fa, fb = curve(a, grid), curve(b, grid)
+        table = 0.5 * (np.interp(u - lm, grid, fa) + np.interp(u - lm, grid, fb))
+        err = float(np.max(np.abs(table - _force(_shifted_model(cm, mid), u))))
+        # (the floor: how closely the grid of distances reads each end's own curve; a kink of the curve between its
+        # points is no matter of the levels, and halving them would not bring the middle closer than that)
+        floor = max(float(np.max(np.abs(np.interp(u - lifts[q], grid, f) - _force(_shifted_model(cm, q), u))))
+                    for q, f in ((a, fa), (b, fb)))
+        if err > max(tol, 2.0 * floor) and depth < SHIFT_HALVINGS:
+            levels.append(mid)
+            todo += [(a, mid, depth + 1), (mid, b, depth + 1)]
+        else:
+            del lifts[mid]
+    levels = sorted(levels)
+    xi = np.linspace(-max(lifts[s] for s in levels), 0.0, points)
+    rows = [curve(s, xi) for s in levels]
+    data = (*levels, *(lifts[s] for s in levels), float(xi[0]), float(xi[1] - xi[0]), *np.concatenate(rows))
+    return tuple(float(v) for v in data), len(levels)
+
+
+def shifted_liftoff_py(data, levels, s) -> float:
+    """:func:`clutchlab.driveline.kernel.shifted_liftoff` in Python (for :meth:`Driveline.describe`)."""
+    return float(np.interp(s, data[:levels], data[levels:2 * levels]))
 
 
 def _table_limit(table) -> str:
@@ -1177,7 +1273,9 @@ class Driveline:
     @_adds("eclutch")
     def eclutch(self, name: str, a, b, position, model: int = 4, parameters=None, travel: float = 8e-3,
                 points: int = 161, peak: float = 1.0, actuator=None, actuator_step: float = 1e-3,
-                pre_roll: float = 1.0, settle: float = 0.5, mu_temperature=None) -> "Driveline":
+                pre_roll: float = 1.0, settle: float = 0.5, mu_temperature=None, wear: float = 0.0,
+                wear_rate: float = 0.0, wear_max: float = 1e-3, expansion: float = 0.0,
+                reference_temperature: float = 20.0) -> "Driveline":
         """The dry E-clutch of seed 000 between flanges a and b: sliding torque ``2 F_n r_eff mu`` ([1] Sec. 3.2,
         :func:`clutchlab.eclutch.models.torque_of_clamp_force`), ``r_eff`` and ``mu`` its axial model's.
 
@@ -1199,6 +1297,21 @@ class Driveline:
           ``actuator_step`` [s] apart (held after the run: the reference is constant there).
 
         ``mu_temperature``: a factor over the temperature of the thermal mass its losses heat, as :meth:`clutch`.
+
+        **Wear and thermal expansion** move the working point ([1] Sec. 7, future work iii; :func:`clutchlab.eclutch.
+        dynamics.apply_wear_and_expansion`): the cushion pre-strain changes by ``s = -w + e (T - T_ref)``, so the
+        static curve shifts along the bearing travel.  ``wear`` [m]: the facing wear at the start (both faces);
+        ``wear_rate`` [m/J]: wear per joule the clutch dissipates, ``w = wear + wear_rate E`` (wear proportional to
+        the friction work: Archard's law at a constant friction coefficient); ``expansion`` [m/K]: the stack's
+        growth per kelvin, ``alpha h`` (cast iron 12e-6 1/K over a 30 mm stack: 3.6e-7 m/K), at the temperature
+        ``T`` [degC] of the thermal mass its losses heat (it must heat one), ``reference_temperature`` the
+        temperature at which its curve is the model's.  With any of the three, its normal force is read from its
+        static curves at shifts from ``-wear_max`` (and the coldest :data:`SHIFT_TEMPERATURES`) to the hottest,
+        interpolated at the same distance to their lift-offs (:func:`~clutchlab.driveline.kernel.shifted_curve`;
+        levels added until a midpoint's curve is within :data:`SHIFT_TOLERANCE` of the peak force); a run whose
+        wear passes ``wear_max`` or whose temperature leaves that span ends with an error naming the clutch.  Not
+        with ``actuator`` (its clamp force is solved before the network: a worn clutch's actuator is given
+        ``apply_wear_and_expansion`` itself).
         """
         from ..eclutch.models import ClutchModel, EClutchParameters
 
@@ -1216,17 +1329,44 @@ class Driveline:
         sig = Signal.of(position, f"{name}: position")
         cgeo = 2.0 * float(cm.r_eff)
         label = f"E-clutch Model {int(model)} (r_eff = {cm.r_eff:g} m, mu = {cm.mu:g})"
+        wear = _finite(name, "wear", wear, nonneg=True)
+        wear_rate = _finite(name, "wear_rate", wear_rate, nonneg=True)
+        wear_max = _finite(name, "wear_max", wear_max, positive=True)
+        expansion = _finite(name, "expansion", expansion, nonneg=True)
+        t_ref = _finite(name, "reference_temperature", reference_temperature)
+        lo_t, hi_t = SHIFT_TEMPERATURES
+        if not lo_t <= t_ref <= hi_t:
+            raise ParameterError(f"{name}: reference_temperature = {t_ref:g} degC must lie in [{lo_t:g}, {hi_t:g}]")
+        shifted = wear > 0.0 or wear_rate > 0.0 or expansion > 0.0
+        if shifted and wear > wear_max:
+            raise ParameterError(f"{name}: wear = {wear:g} m is beyond wear_max = {wear_max:g} m")
         if actuator is None or actuator is False:
+            self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo, sig, mu_temperature)
+            el = self._elements[-1]
+            el.model = label
+            if shifted:
+                lo = -wear_max + expansion * (lo_t - t_ref)
+                hi = expansion * (hi_t - t_ref)
+                el.ncurve, el.levels = _shift_table(name, cm, travel, int(points), lo, hi)
+                el.coef = el.coef + (float(el.levels), wear, wear_rate, expansion, t_ref)
+                el.liftoff = shifted_liftoff_py(el.ncurve, el.levels, -wear)
+                el.model = (f"{label}, worn {wear * 1e6:g} um + {wear_rate:g} m/J, expanding {expansion:g} m/K "
+                            f"from {t_ref:g} degC ({el.levels} shift levels)")
+                return self
             u = np.linspace(0.0, travel, int(points))
             fn = np.maximum(cm.static_curve(u)["normal_force_N"].to_numpy(), 0.0)
             zero = np.flatnonzero(fn <= 0.0)
             liftoff = float(u[zero[0]]) if zero.size else math.inf
-            self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo, sig, mu_temperature)
-            el = self._elements[-1]
             el.ncurve = tuple(u) + tuple(fn)
             el.liftoff = liftoff
-            el.model = label
             return self
+        if wear_rate > 0.0 or expansion > 0.0:
+            raise ParameterError(f"{name}: wear_rate and expansion need the clutch without its actuator (its clamp "
+                                 "force is solved before the network); a worn clutch's actuator takes wear")
+        if wear > 0.0:
+            from ..eclutch.dynamics import apply_wear_and_expansion
+
+            cm = apply_wear_and_expansion(cm, wear_m=wear)
         times, fn, corners, info = self._eclutch_dynamics(name, cm, sig, actuator, actuator_step, pre_roll, settle)
         self._friction(name, a, b, K.LAW_CLUTCH, (0.0, float(cm.mu)), peak, 1.0, cgeo,
                        Signal.sampled(times, fn, corners), mu_temperature)
@@ -1649,6 +1789,10 @@ class Driveline:
                 what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
             elif e.reference is not None:
                 what = f"{e.model}, bearing reference {e.reference.describe('m')}"
+            elif e.ncurve and e.levels:
+                npt = (len(e.ncurve) - 2 * e.levels - 2) // e.levels
+                what = (f"{e.model}, static curves of {npt} points, lift-off at {e.liftoff * 1e3:g} mm at the "
+                        f"start, position {e.signal.describe('m')}")
             elif e.ncurve:
                 what = (f"{e.model}, static curve of {len(e.ncurve) // 2} points, lift-off at "
                         f"{e.liftoff * 1e3:g} mm, position {e.signal.describe('m')}")
@@ -1752,7 +1896,7 @@ class Driveline:
             if e.ncurve:
                 coef[r, K.C_NCURVE] = len(data)
                 coef[r, K.C_LIFTOFF] = e.liftoff
-                elem[r, K.E_AUX] = len(e.ncurve) // 2
+                elem[r, K.E_AUX] = (len(e.ncurve) - 2 * e.levels - 2) // e.levels if e.levels else len(e.ncurve) // 2
                 data.extend(e.ncurve)
         # each EMTC coupling's ports, after every element's signal (its block reads them: _with_components)
         port_rows = {e.name: [-1 if e.emtc["ports"][q] is None else add_signal(e.emtc["ports"][q])
@@ -1766,6 +1910,9 @@ class Driveline:
         lossy = np.array([r for r, e in enumerate(self._elements) if self._is_lossy(e)], dtype=np.int64)
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
         elem[:, K.E_HEAT], thermal, links = self._heat_rows()
+        for r, e in enumerate(self._elements):   # (an E-clutch that expands reads the temperature of its heat port)
+            if e.levels:
+                self._check_shift(e, coef[r], thermal[elem[r, K.E_HEAT]] if elem[r, K.E_HEAT] >= 0 else None)
         for r, (sign, depth, given) in self._speed_plan()[2].items():   # (kernel.derive_speeds)
             elem[r, K.E_SPREAD] = sign * depth
             elem[r, K.E_SPREAD_SUP] = int(given)
@@ -1911,10 +2058,32 @@ class Driveline:
             raise ParameterError(self._start_refusal((-code - K.INV_BASE) // K.N_INV, p, x0))
         return m
 
+    @staticmethod
+    def _shift_message(el) -> str:
+        """The model error of a shifted E-clutch whose working point left its table (``K.shift_error``)."""
+        return (f"{el.name}: its wear and thermal expansion moved its working point beyond the table it was built "
+                f"for (wear up to wear_max, temperatures {SHIFT_TEMPERATURES[0]:g} to {SHIFT_TEMPERATURES[1]:g} "
+                "degC): raise wear_max, or check the wear rate and the heat it gets")
+
+    def _check_shift(self, el, coef, thermal_row) -> None:
+        """Refuse an E-clutch that expands without a heat port, or whose initial working point is off its table."""
+        expansion, t_ref = coef[K.C_EXPANSION], coef[K.C_T_REF]
+        if expansion > 0.0 and thermal_row is None:
+            raise ParameterError(f"{el.name}: expansion = {expansion:g} m/K needs the temperature of a thermal mass its "
+                                 "losses heat (list it in a thermal_mass's heat_from), or expansion = 0")
+        temp = t_ref if thermal_row is None else float(thermal_row[K.T_INIT])
+        lo_t, hi_t = SHIFT_TEMPERATURES
+        if expansion > 0.0 and not lo_t <= temp <= hi_t:
+            raise ParameterError(f"{el.name}: its thermal mass starts at {temp:g} degC, outside [{lo_t:g}, {hi_t:g}] "
+                                 "degC, the span of its expansion's table")
+
     def _start_refusal(self, r, p, x0) -> str:
         """The message for element row ``r`` that the network's compiled start refused (``K.INV_START``): a gear or
-        motion source its flanges' initial speeds (angles) disagree with, or a one-way clutch turning backward."""
+        motion source its flanges' initial speeds (angles) disagree with, or a one-way clutch turning backward (or
+        ``K.INV_TABLE``: a shifted E-clutch off its table)."""
         n, e, el = len(self._inertias), p.elem[r], self._elements[r]
+        if el.levels:
+            return self._shift_message(el)
         names = list(self._inertias)
 
         def w(i):
@@ -2059,6 +2228,8 @@ class Driveline:
         for r, e in enumerate(self._elements):
             if e.kind == K.K_GEAR and self._is_lossy(e):
                 invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_TABLE)] = f"{e.name}: {_table_limit(e.table)}"
+            if e.levels:
+                invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_TABLE)] = self._shift_message(e)
             if e.kind == K.K_FRICTION and e.law == K.LAW_ONEWAY:
                 invariant_messages[-(K.INV_BASE + K.N_INV * r + K.INV_START)] = (
                     f"{e.name}: {K.INVARIANTS[K.INV_START]}")
