@@ -665,7 +665,6 @@ def _shift_table(name, cm, travel, points, lo, hi):
     n0 = max(2, int(math.ceil((hi - lo) / SHIFT_STEP)) + 1)
     levels = list(np.linspace(lo, hi, n0)) if hi > lo else [lo]
     lifts = {s: _lift_off(name, cm, s, travel, points) for s in levels}
-    xi = np.linspace(-max(lifts.values()), 0.0, points)   # (widened below as levels come in)
     u = np.linspace(0.0, travel, points)
 
     def curve(s, grid):
@@ -701,7 +700,7 @@ def _shift_table(name, cm, travel, points, lo, hi):
     return tuple(float(v) for v in data), len(levels)
 
 
-def shifted_liftoff_py(data, levels, s) -> float:
+def _shifted_liftoff(data, levels, s) -> float:
     """:func:`clutchlab.driveline.kernel.shifted_liftoff` in Python (for :meth:`Driveline.describe`)."""
     return float(np.interp(s, data[:levels], data[levels:2 * levels]))
 
@@ -1349,7 +1348,7 @@ class Driveline:
                 hi = expansion * (hi_t - t_ref)
                 el.ncurve, el.levels = _shift_table(name, cm, travel, int(points), lo, hi)
                 el.coef = el.coef + (float(el.levels), wear, wear_rate, expansion, t_ref)
-                el.liftoff = shifted_liftoff_py(el.ncurve, el.levels, -wear)
+                el.liftoff = _shifted_liftoff(el.ncurve, el.levels, -wear)
                 el.model = (f"{label}, worn {wear * 1e6:g} um + {wear_rate:g} m/J, expanding {expansion:g} m/K "
                             f"from {t_ref:g} degC ({el.levels} shift levels)")
                 return self
