@@ -1377,3 +1377,54 @@ def test_a_host_drives_an_emtc_port_through_the_native_fmu(tmp_path):
         _close(native[name], python[name], name, floor=1e-9)
     ref = native["c.torque_reference"]
     assert np.all(ref[5:45] == 40.0) and np.all(ref[55:] == 150.0)
+
+
+#: a wearing E-clutch (tests/driveline/test_wear.py): flange a driven at 100 rad/s, the clutch sliding on a free shaft
+_WEAR_TOML = '''
+[driveline]
+name = "worn_clutch"
+[simulation]
+t_end = "1 s"
+rtol = 1e-8
+[inertia.e]
+J = 1.0
+w0 = "100 rad/s"
+[inertia.v]
+J = 1.0
+[speed.drive]
+flange = "e"
+speed = "100 rad/s"
+[eclutch.c]
+a = "e"
+b = "v"
+position = "3 mm"
+wear = "0.05 mm"
+wear_rate = "1e-7 m/J"
+'''
+
+
+def test_a_host_sets_the_wear_of_an_e_clutch_in_a_native_fmu(tmp_path):
+    """The wear fields of an E-clutch whose working point moves are FMU parameters from its declaration: the initial
+    wear and the wear rate (copies into the element table) written by the FMU itself, the table's span (``wear_max``,
+    ``expansion``: its levels are built from them) fixed at export.  A host (FMPy without clutchlab) sets a larger
+    initial wear and another rate: the FMU equals the Python co-simulation built with them, which differs from the
+    default."""
+    path_toml = tmp_path / "worn.toml"
+    path_toml.write_text(_WEAR_TOML)
+    cls = DrivelineCoSimulation.for_description(path_toml)
+    lines = []
+    path = export_native_fmu(cls, tmp_path / "worn.fmu", platforms=["linux64"], report=lines.append)
+    assert "(4 fixed at export)" in lines[0], lines
+    _, svs = _variables(path)
+    assert [(svs[q].get("causality"), svs[q].find("Real").get("unit")) for q in ("c.wear", "c.wear_rate")] == [
+        ("parameter", "m"), ("parameter", "m/J")]
+    assert [svs[q].get("variability") for q in ("c.wear_max", "c.expansion", "c.travel")] == ["constant"] * 3
+    n, dt = 100, 0.01
+    start = {"c.wear": 1e-4, "c.wear_rate": 5e-8}
+    native = _fmpy_run(tmp_path, path, n, dt, start)
+    python = _python_run(cls, n, dt, start)
+    for name in python:
+        _close(native[name], python[name], name)
+    default = _python_run(cls, n, dt)
+    assert native["c.fn"][0] < default["c.fn"][0] - 100.0   # (the host's initial wear took clamp force)
+    assert np.max(np.abs(native["c.dissipated"] - default["c.dissipated"])) > 1.0

@@ -1894,7 +1894,9 @@ class Driveline:
                 data.extend(e.fade)
             if e.ncurve:
                 coef[r, K.C_NCURVE] = len(data)
-                coef[r, K.C_LIFTOFF] = e.liftoff
+                # (a shifted curve's lift-off follows its shift, kernel.shifted_liftoff: no word of its own, so its
+                # initial wear stays a copy a native FMU writes)
+                coef[r, K.C_LIFTOFF] = 0.0 if e.levels else e.liftoff
                 elem[r, K.E_AUX] = (len(e.ncurve) - 2 * e.levels - 2) // e.levels if e.levels else len(e.ncurve) // 2
                 data.extend(e.ncurve)
         # each EMTC coupling's ports, after every element's signal (its block reads them: _with_components)
