@@ -41,7 +41,8 @@ from .numerics import status as st
 from .numerics.calls import ADVANCE as _ADVANCE, OUTPUTS as _OUTPUTS, REPORT_KINDS, START as _START
 from .result import SimulationResult
 
-__all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "evaluate", "sample_grid",
+__all__ = ["Variable", "System", "Variants", "simulate", "Simulation", "simulate_batch", "batch_groups", "evaluate",
+           "sample_grid",
            "checked_grid", "follow_rtol", "check_fixed_step", "check_fixed_step_span", "check_fixed_step_dynamics",
            "fastest_time_constant", "FixedStepWarning", "check_rtol", "check_atol", "RUN_OPTIONS",
            "RTOL_MIN", "MODELS", "register_model", "start_checked_later", "start_checks_deferred"]
@@ -1279,6 +1280,19 @@ def _row(stacked, v):
         return stacked[v] if stacked.ndim > 1 else stacked[v].item()
     members = [_row(s_, v) for s_ in stacked]
     return type(stacked)(*members) if hasattr(stacked, "_fields") else tuple(members)
+
+
+def batch_groups(systems) -> list:
+    """The indices of ``systems`` grouped by structure (model, state size and every parameter's sizes), each group
+    what one :func:`simulate_batch` takes together, in the order their first members appear.  A sweep over a field
+    that changes a model's structure (an E-clutch's table of shift levels present or not, a curve's number of
+    points) runs one batch per group instead of refusing the variants."""
+    groups: dict = {}
+    for i, s in enumerate(systems):
+        key = (type(s.params), s.x0.shape, s.m0.shape, s.u0.shape,
+               tuple(_field_layout(s.params[k]) for k in range(len(s.params))))
+        groups.setdefault(key, []).append(i)
+    return list(groups.values())
 
 
 def _field_layout(value):

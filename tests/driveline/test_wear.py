@@ -157,3 +157,49 @@ wear_rate = "2e-9 m/J"
     for i in range(len(df)):
         assert abs(df["c.fn_N"].iloc[i] - _force(1e-3, wear=wear[i])) <= SHIFT_TOLERANCE * PEAK
     assert df["c.fn_N"].iloc[0] < _force(1e-3) - 300.0   # (the initial wear took its share)
+
+
+def test_a_sweep_over_the_initial_wear_follows_the_axial_model(tmp_path):
+    """The wear fields are sweep parameters from the declaration: a launch at a fixed bearing position (the clutch
+    slides with the constant torque ``mu 2 r_eff F_n(u, w)`` until both inertias turn together) swept over the
+    initial wear.  Its lock time is ``J1 J2 w0 / ((J1 + J2) T)`` with ``F_n`` the axial model's at each wear."""
+    import pandas as pd
+
+    from clutchlab.cli import main
+
+    (tmp_path / "launch.toml").write_text('''
+[driveline]
+name = "launch"
+[simulation]
+t_end = "4 s"
+rtol = 1e-9
+[inertia.engine]
+J = 0.5
+w0 = "100 rad/s"
+[inertia.vehicle]
+J = 2.0
+[eclutch.c]
+a = "engine"
+b = "vehicle"
+position = "4 mm"
+''')
+    (tmp_path / "sweep.toml").write_text('''
+[sweep]
+model = "driveline"
+scenario = "launch.toml"
+outputs = ["c.last_stick_s", "c.peak_tau_Nm"]
+
+[grid]
+"c.wear" = ["0 mm", "0.1 mm", "0.25 mm"]
+''')
+    out = tmp_path / "res"
+    assert main(["sweep", str(tmp_path / "sweep.toml"), "-o", str(out), "--workers", "1", "--no-progress",
+                 "--no-plot"]) == 0
+    frame = pd.read_parquet(out / "results.parquet")
+    assert sorted(frame["c.wear"]) == pytest.approx([0.0, 1e-4, 2.5e-4])
+    for row in frame.to_dict("records"):
+        torque = MODEL.mu * 2.0 * MODEL.r_eff * _force(4e-3, wear=row["c.wear"])
+        assert row["c.peak_tau_Nm"] == pytest.approx(torque, rel=SHIFT_TOLERANCE * PEAK / torque)
+        assert row["c.last_stick_s"] == pytest.approx(0.5 * 2.0 * 100.0 / (2.5 * torque), rel=2 * SHIFT_TOLERANCE *
+                                                      PEAK / torque)
+    assert frame["c.last_stick_s"].is_monotonic_increasing == (list(frame["c.wear"]) == sorted(frame["c.wear"]))

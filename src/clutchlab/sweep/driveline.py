@@ -68,7 +68,7 @@ from ..errors import ParameterError
 from ..numerics.status import Status
 from ..units import COLUMN_UNITS
 from ..sweep.targets import check_outputs, nan_frame, rows
-from ..system import simulate, simulate_batch
+from ..system import batch_groups, simulate, simulate_batch
 from ..driveline.variants import DrivelineDocument
 
 __all__ = ["run_batch", "describe", "check_variants", "referenced_files", "outputs_of", "metrics_of", "REDUCTIONS",
@@ -275,19 +275,22 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
     t_end = base.t_end
     step = base.output_step if base.output_step is not None else t_end / 1000.0
     options = {"output_step": step, "max_step": base.max_step, "max_steps": MAX_STEPS}
-    res = simulate_batch([system for _, _, system in built], t_end, event_capacity=EVENT_CAPACITY, **options)
-    sticks = _last_sticks(res.events)
-    metrics = metrics_of(built[0][2])   # (every variant has the same states and outputs)
-    dropped = res.stats["events_dropped"]
     values = np.full((len(built), len(outputs)), np.nan)
-    for k, (vid, row, system) in enumerate(built):
-        if dropped[k]:  # more events than the batch keeps: this variant again, alone, with every event
-            one = simulate(_system(doc, vid, row), t_end, check=False, **options)
-            alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
-            got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics)
-        else:
-            mine = {e: sticks[(k, e)] for e in system.mode_names if (k, e) in sticks}
-            got = _reduce(system, res.time, res.states[k], res.outputs[k], mine, int(res.status[k]), outputs,
-                          metrics)
-        values[k] = [got.get(name, np.nan) for name in outputs]
+    # (one batch per structure: a field that changes the network's sizes, an E-clutch's wear from zero, splits them)
+    for group in batch_groups([system for _, _, system in built]):
+        res = simulate_batch([built[k][2] for k in group], t_end, event_capacity=EVENT_CAPACITY, **options)
+        sticks = _last_sticks(res.events)
+        metrics = metrics_of(built[group[0]][2])   # (every variant has the same states and outputs)
+        dropped = res.stats["events_dropped"]
+        for j, k in enumerate(group):
+            vid, row, system = built[k]
+            if dropped[j]:  # more events than the batch keeps: this variant again, alone, with every event
+                one = simulate(_system(doc, vid, row), t_end, check=False, **options)
+                alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
+                got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics)
+            else:
+                mine = {e: sticks[(j, e)] for e in system.mode_names if (j, e) in sticks}
+                got = _reduce(system, res.time, res.states[j], res.outputs[j], mine, int(res.status[j]), outputs,
+                              metrics)
+            values[k] = [got.get(name, np.nan) for name in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))
