@@ -71,7 +71,8 @@ def _friction_fields(fn_required=True, fn_default=None, with_map=True):
             Field("radius", "quantity", "m", positive=True,
                   description="radius at which a friction map is read (slip velocity = radius |w_rel|)"),
             Field("temperature", "quantity", "degC", minimum=ABSOLUTE_ZERO_C,
-                  description="friction-surface temperature a friction map is read at"),
+                  description="friction-surface temperature a friction map is read at (left out: its heat port's, "
+                              "as the run heats it)"),
         ]
     return tuple(fields)
 

@@ -37,7 +37,7 @@ from numba.core import types
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
 from ..numerics.core import record
-from ..numerics.interp import bracket
+from ..numerics.interp import bracket, bracket_range
 from ..numerics.layout import indices, slots
 from ..numerics.outline import log_type, outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -110,13 +110,15 @@ N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: its number of rows (temperatures, then factors; :func:`fade_factor`); "spread" a gear's part in the initial
 #: speeds left out of the description (:func:`derive_speeds`): 0 none, +d its flange b's speed derived from flange
 #: a's, -d flange a's from flange b's, d the derived flange's depth below the speed it follows; "spread_support" 1
-#: where the gear's support speed enters that derivation (given in the description), 0 where it is taken as rest
+#: where the gear's support speed enters that derivation (given in the description), 0 where it is taken as rest;
+#: "map_t" a friction element's number of temperatures of a friction map mu(|w|, T) read at its heat port's
+#: temperature (:func:`friction_map`), 0 for a characteristic of |w| alone
 ELEM_COLUMNS = ("kind", "a", "b", "law", "signal", "table", "table_n", "aux", "mode", "state", "support", "heat",
-                "fade", "fade_n", "spread", "spread_support")
+                "fade", "fade_n", "spread", "spread_support", "map_t")
 (E_KIND, E_A, E_B, E_LAW, E_SIGNAL, E_TABLE, E_TABLE_N, E_AUX, E_MODE, E_STATE, E_SUP, E_HEAT, E_FADE,
- E_FADE_N, E_SPREAD, E_SPREAD_SUP) = indices(ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table", "table_n",
-                                             "aux", "mode", "state", "support", "heat", "fade", "fade_n", "spread",
-                                             "spread_support")
+ E_FADE_N, E_SPREAD, E_SPREAD_SUP, E_MAP_T) = indices(ELEM_COLUMNS, "kind", "a", "b", "law", "signal", "table",
+                                                      "table_n", "aux", "mode", "state", "support", "heat", "fade",
+                                                      "fade_n", "spread", "spread_support", "map_t")
 N_ELEM = len(ELEM_COLUMNS)
 #: columns of ``thermal`` (one row per thermal mass, MSL ``Thermal.HeatTransfer.Components.HeatCapacitor`` with a
 #: ``ThermalConductor`` to a ``FixedTemperature``): heat capacity [J/K], conductance to its ambient [W/K], the
@@ -495,6 +497,30 @@ def _characteristic(data, start, n, w):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def friction_map(data, start, nw, nt, w, temp):
+    """Friction coefficient [-] of a map ``mu(|w|, T)`` at the relative speed ``w`` [rad/s] and the temperature
+    ``temp`` [degC] of the thermal mass the element's losses heat: a friction map ``mu(v, T)`` identified on the wet
+    clutch's bench (seed 001, Sec. 5: :class:`clutchlab.wet.friction.FrictionMap`, its slip velocities over the
+    element's radius), bilinear between its nodes and constant beyond them, as the map itself is read.  Layout at
+    ``data[start:]``: ``nw >= 2`` speeds (increasing, the first 0), ``nt`` temperatures (increasing), then ``nt``
+    rows of ``nw`` values."""
+    iw, fw = bracket_range(data, start, start + nw, w)
+    iw -= start
+    q = start + nw
+    v = q + nt
+    a = data[v + iw] + fw * (data[v + iw + 1] - data[v + iw])
+    if nt == 1:
+        return a
+    it, ft = bracket_range(data, q, q + nt, temp)
+    it -= q
+    j0 = v + it * nw + iw
+    j1 = j0 + nw
+    a = data[j0] + fw * (data[j0 + 1] - data[j0])
+    b = data[j1] + fw * (data[j1 + 1] - data[j1])
+    return a + ft * (b - a)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def friction_torque(p, r, t, w_abs):
     """Sliding torque magnitude [N m] of friction element row ``r`` at relative speed ``|w|`` and time ``t``.
 
@@ -507,7 +533,11 @@ def friction_torque(p, r, t, w_abs):
     law = p.elem[r, E_LAW]
     if law == LAW_EXTERNAL:
         return external_value(p, p.elem[r, E_AUX], 0, t)
-    val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
+    if p.elem[r, E_MAP_T] > 0:
+        val = friction_map(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_MAP_T], w_abs,
+                           temperatures(p)[p.elem[r, E_HEAT]])
+    else:
+        val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
     if law == LAW_TABLE:
         return val
     val *= p.coef[r, C_MU_SCALE]   # (a factor of its own, not in the table: a host or a sweep sets it with mu)

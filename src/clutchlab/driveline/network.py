@@ -549,6 +549,7 @@ class _Element:
     ncurve: tuple = ()  # a friction element's normal-force curve: inputs, then forces [N]
     liftoff: float = math.inf   # the input beyond which that force is 0
     levels: int = 0     # an E-clutch whose working point moves: its curve's shift levels (ncurve: kernel.shifted_curve)
+    map_t: int = 0      # a friction map read at its heat port's temperature: its temperatures (table: kernel.friction_map)
     model: str = ""     # what built it (for describe)
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
@@ -703,6 +704,16 @@ def _shift_table(name, cm, travel, points, lo, hi):
 def _shifted_liftoff(data, levels, s) -> float:
     """:func:`clutchlab.driveline.kernel.shifted_liftoff` in Python (for :meth:`Driveline.describe`)."""
     return float(np.interp(s, data[:levels], data[levels:2 * levels]))
+
+
+class _LiveMap(tuple):
+    """A friction map ``mu(|w|, T)`` read at the temperature of the element's heat port (:func:`clutchlab.driveline.
+    kernel.friction_map`): its speeds, temperatures and values, one after the other; ``nt`` its temperatures."""
+
+    def __new__(cls, values, nt):
+        out = super().__new__(cls, values)
+        out.nt = int(nt)
+        return out
 
 
 def _table_limit(table) -> str:
@@ -1145,8 +1156,12 @@ class Driveline:
         coef = (_finite(name, "fn_max", fn_max, nonneg=True), _finite(name, "cgeo", cgeo, nonneg=True), peak, 0.0,
                 0.0, self._mu_scale(name, mu_scale))
         sig = None if normal is None else Signal.of(normal, f"{name}: normal")
-        self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, table,
-                                       fade=self._fade(name, mu_temperature)))
+        map_t = table.nt if isinstance(table, _LiveMap) else 0
+        if map_t and mu_temperature is not None:
+            raise ParameterError(f"{name}: a friction map read at its heat port's temperature already depends on it; "
+                                 "mu_temperature would count the temperature twice")
+        self._elements.append(_Element(K.K_FRICTION, name, a, b, coef, law, sig, tuple(table),
+                                       fade=self._fade(name, mu_temperature), map_t=map_t))
         return self
 
     @staticmethod
@@ -1185,7 +1200,9 @@ class Driveline:
         from the last two but never below 0), or a friction map
         ``mu(v, T)`` identified by :mod:`clutchlab.wet` (:class:`clutchlab.wet.friction.FrictionMap`) read
         at the slip velocity ``v = radius |w_rel|`` [m/s] and the constant friction-surface ``temperature``
-        [degC] (both required with a map, refused without one; :meth:`_map_characteristic`).  ``mu_scale``:
+        [degC] (``radius`` required with a map, both refused without one; :meth:`_map_characteristic`); without
+        ``temperature`` the map is read at the temperature of the thermal mass the clutch's losses heat, as the
+        run heats it (:func:`~clutchlab.driveline.kernel.friction_map`; it must heat one).  ``mu_scale``:
         a factor on the friction coefficient, whether a number, a table or a map (a sweep's friction level;
         ``mu_scale`` in [0, 2], a factor on a coefficient checked on its own).  ``mu_temperature``: rows
         ``[[T_degC, factor], ...]``, a factor on the sliding torque and the static limit over the temperature of the
@@ -1242,15 +1259,25 @@ class Driveline:
         speed nodes divided by ``radius`` [m], the map's value there at that temperature, held at the first
         node's value down to ``w = 0`` and beyond the last node (exact: at a fixed temperature the map is
         piecewise linear in ``v`` between its nodes).  A map over the pressing force too (3-D) is refused."""
-        if radius is None or temperature is None:
+        if radius is None:
             raise ParameterError(f"{name}: a friction map mu(v, T) needs radius [m] (v = radius |w_rel|) and "
-                                 "temperature [degC]")
+                                 "temperature [degC], or no temperature and a thermal mass its losses heat")
         radius = _finite(name, "radius", radius, positive=True)
-        temperature = _finite(name, "temperature", temperature)
         if fmap.force_grid is not None:
             raise ParameterError(f"{name}: the friction map depends on the pressing force too "
                                  f"({fmap.force_grid.size} forces); a clutch takes a map mu(v, T) (the wet clutch "
                                  "element takes any)")
+        if temperature is None:   # read at its heat port's temperature as the run goes (kernel.friction_map)
+            v = np.asarray(fmap.speed_grid, dtype=float)
+            temps = np.asarray(fmap.temperature_grid, dtype=float)
+            values = np.asarray(fmap.values, dtype=float).reshape(temps.size, v.size)
+            w = v / radius
+            if w[0] > 0.0:
+                w, values = np.concatenate([[0.0], w]), np.concatenate([values[:, :1], values], axis=1)
+            if w.size == 1:   # (one speed: constant in w)
+                w, values = np.array([0.0, 1.0]), np.concatenate([values, values], axis=1)
+            return _LiveMap(tuple(float(q) for q in (*w, *temps, *values.ravel())), temps.size)
+        temperature = _finite(name, "temperature", temperature)
         v = np.asarray(fmap.speed_grid, dtype=float)
         values = np.asarray(fmap.mu(v, np.full(v.shape, temperature)), dtype=float)
         w = v / radius
@@ -1782,6 +1809,9 @@ class Driveline:
         else:
             n = len(e.table) // 2
             char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
+            if e.map_t:
+                nw = (len(e.table) - e.map_t) // (1 + e.map_t)
+                char = f"map of {nw} speeds x {e.map_t} temperatures at its heat port's temperature"
             if e.coef[K.C_MU_SCALE] != 1.0 and e.law != K.LAW_TABLE:
                 char += f" x mu_scale {e.coef[K.C_MU_SCALE]:g}"
             if e.law == K.LAW_TABLE:
@@ -1880,6 +1910,9 @@ class Driveline:
                     elem[r, K.E_TABLE_N] = len(e.table) // 5
                 elif e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
                     elem[r, K.E_TABLE_N] = (len(e.table) - e.aux) // (1 + e.aux)
+                elif e.map_t:
+                    elem[r, K.E_TABLE_N] = (len(e.table) - e.map_t) // (1 + e.map_t)
+                    elem[r, K.E_MAP_T] = e.map_t
                 else:
                     elem[r, K.E_TABLE_N] = len(e.table) // (4 if e.kind == K.K_SPRING else 2)
                 data.extend(e.table)
@@ -1912,6 +1945,10 @@ class Driveline:
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
         elem[:, K.E_HEAT], thermal, links = self._heat_rows()
         for r, e in enumerate(self._elements):   # (an E-clutch that expands reads the temperature of its heat port)
+            if e.map_t and elem[r, K.E_HEAT] < 0:
+                raise ParameterError(f"{e.name}: a friction map without a temperature is read at the temperature of "
+                                     "the thermal mass its losses heat: list it in a thermal_mass's heat_from, or "
+                                     "give temperature")
             if e.levels:
                 self._check_shift(e, coef[r], thermal[elem[r, K.E_HEAT]] if elem[r, K.E_HEAT] >= 0 else None)
         for r, (sign, depth, given) in self._speed_plan()[2].items():   # (kernel.derive_speeds)
