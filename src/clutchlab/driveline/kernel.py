@@ -564,7 +564,8 @@ def _shift_bracket(data, o, nl, s):
     s_i + w s_(i+1)``, held at the ends (:func:`shift_error` ends a run whose shift leaves them)."""
     if nl == 1:
         return 0, 0.0
-    return bracket(data[o:o + nl], s)
+    i, w = bracket_range(data, o, o + nl, s)
+    return i - o, w
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -618,24 +619,29 @@ def _shift(p, r):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def working_point_shift(p, r, x):
+    """The working point's shift [m] of the shifted E-clutch at element row ``r`` in the state ``x``
+    (:func:`shifted_curve`; seed 000, Sec. 7, future work iii): ``s = -(w0 + k_w E) + e (T - T_ref)``, its facing
+    wear growing with the energy ``E`` [J] it dissipated (wear proportional to the friction work: Archard's law at a
+    constant friction coefficient, ``k_w`` [m/J]) and its stack expanding ``e`` [m/K] with the temperature ``T``
+    [degC] of the thermal mass its losses heat (``T_ref`` without one)."""
+    temp = p.coef[r, C_T_REF]
+    h = p.elem[r, E_HEAT]
+    if h >= 0:
+        temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
+    wear = p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * p.inertia.shape[0] + r], 0.0)
+    return -wear + p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def update_shifts(p, x):
-    """Each shifted E-clutch's working point at the state ``x`` (:func:`shifted_curve`): ``s = -(w0 + k_w E) +
-    e (T - T_ref)``, its facing wear growing with the energy ``E`` [J] it dissipated (a wear proportional to the
-    friction work, Archard's law at a constant friction coefficient: ``k_w`` [m/J]) and its stack expanding ``e``
-    [m/K] with the temperature ``T`` [degC] of the thermal mass its losses heat (``T_ref`` without one).  Kept for
-    the network's evaluations at that state (every evaluation of the network starts with this)."""
-    n = p.inertia.shape[0]
+    """Each shifted E-clutch's working point at the state ``x`` (:func:`working_point_shift`), kept for the
+    network's evaluations at that state (every evaluation of the network starts with this)."""
     o = _offsets(p).shift
     for k in range(p.fric.shape[0]):
         r = p.fric[k]
-        if p.coef[r, C_LEVELS] <= 0.0:
-            continue
-        temp = p.coef[r, C_T_REF]
-        h = p.elem[r, E_HEAT]
-        if h >= 0:
-            temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
-        wear = p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * n + r], 0.0)
-        p.work[o + r] = -wear + p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
+        if p.coef[r, C_LEVELS] > 0.0:
+            p.work[o + r] = working_point_shift(p, r, x)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4379,6 +4385,10 @@ def _margin_rates(t, x, u, m, p, dx, g):
         hold[j] = wk[o + 2 * n + ne + j]
     for k in range(temp.shape[0]):
         temp[k] = wk[o + 2 * n + ne + nl + k]
+    for k in range(nf):   # (a shifted E-clutch's working point back at x: the probe moved its mass's temperature)
+        if p.coef[p.fric[k], C_LEVELS] > 0.0:
+            update_shifts(p, x)
+            break
 
 
 # ----------------------------------------------------------------- hooks
@@ -5164,18 +5174,12 @@ def shift_error(x, p):
     :func:`shifted_curve`) whose working point's shift at the state ``x`` (:func:`update_shifts`) left the levels
     its table was built for (by more than a micrometre's thousandth): its wear beyond ``wear_max`` or its
     temperature beyond the table's span.  Held at the last level, its force would be a silent guess."""
-    n = p.inertia.shape[0]
     for k in range(p.fric.shape[0]):
         r = p.fric[k]
         nl = int(p.coef[r, C_LEVELS])
         if nl <= 0:
             continue
-        temp = p.coef[r, C_T_REF]
-        h = p.elem[r, E_HEAT]
-        if h >= 0:
-            temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
-        s = -(p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * n + r], 0.0)) + \
-            p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
+        s = working_point_shift(p, r, x)
         o = int(p.coef[r, C_NCURVE])
         if s < p.data[o] - 1e-9 or s > p.data[o + nl - 1] + 1e-9:
             return -(INV_BASE + N_INV * r + INV_TABLE)
