@@ -209,7 +209,8 @@ class DrivelineParams(NamedTuple):
     each friction element; ``cons``: of each constraint (gears and motion sources, always held);
     ``swit``: of each switched spring (backlash, curve spring; its place in the mode vector is
     ``elem[r, E_MODE]``); ``lossy``: of each gear with losses (MSL ``LossyGear``; its mode at ``elem[r, E_MODE]``);
-    ``check``: ``[on, energy tolerance]``, the invariants checked at every accepted step (:func:`check_invariants`);
+    ``check``: ``[on, energy tolerance, shifted]``, the invariants checked at every accepted step
+    (:func:`check_invariants`), and the number of E-clutches whose working point moves (:func:`_shifted`);
     ``work`` and ``iwork`` (int64, the pivots of the constraint set's factorisation):
     scratch of the hooks (per run); ``thermal`` (columns ``T_*``): the thermal masses the elements' losses heat
     (``elem[r, E_HEAT]``), ``links`` (``L_*``): the thermal conductors between them (:func:`thermal_rates`).
@@ -534,8 +535,8 @@ def friction_torque(p, r, t, w_abs):
     if law == LAW_EXTERNAL:
         return external_value(p, p.elem[r, E_AUX], 0, t)
     if p.elem[r, E_MAP_T] > 0:
-        val = friction_map(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_MAP_T], w_abs,
-                           temperatures(p)[p.elem[r, E_HEAT]])
+        val = _friction_map_outlined(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_MAP_T], w_abs,
+                                     temperatures(p)[p.elem[r, E_HEAT]])
     else:
         val = _characteristic(p.data, p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], w_abs)
     if law == LAW_TABLE:
@@ -612,6 +613,14 @@ def shifted_curve(data, o, nl, npt, s, u):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _shifted(p):
+    """True if the network has a shifted E-clutch (:func:`shifted_curve`): ``check[2]``, written when the network is
+    packed, so that a network without one reads nothing for it (a word of the work array, behind its layout's
+    offsets, cost CoupledClutches and the launch 6-7 % at every evaluation)."""
+    return p.check[2] > 0.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _shift(p, r):
     """The working point's shift [m] of friction element row ``r`` at the network's last evaluation
     (:func:`update_shifts`)."""
@@ -648,7 +657,8 @@ def update_shifts(p, x):
 def _liftoff(p, r):
     """The release-bearing position [m] beyond which friction element row ``r``'s normal-force curve is 0."""
     if p.coef[r, C_LEVELS] > 0.0:
-        return shifted_liftoff(p.data, int(p.coef[r, C_NCURVE]), int(p.coef[r, C_LEVELS]), _shift(p, r))
+        return _shifted_liftoff_outlined(p.data, np.int64(p.coef[r, C_NCURVE]), np.int64(p.coef[r, C_LEVELS]),
+                                         _shift(p, r))
     return p.coef[r, C_LIFTOFF]
 
 
@@ -661,8 +671,8 @@ def normal_force(p, r, t):
     f = 1.0 if p.elem[r, E_SIGNAL] < 0 else signal_at(p, p.elem[r, E_SIGNAL], t)
     if p.elem[r, E_AUX] > 0 and p.elem[r, E_LAW] == LAW_CLUTCH:
         if p.coef[r, C_LEVELS] > 0.0:
-            f = shifted_curve(p.data, int(p.coef[r, C_NCURVE]), int(p.coef[r, C_LEVELS]), p.elem[r, E_AUX],
-                              _shift(p, r), f)
+            f = _shifted_curve_outlined(p.data, np.int64(p.coef[r, C_NCURVE]), np.int64(p.coef[r, C_LEVELS]),
+                                        p.elem[r, E_AUX], _shift(p, r), f)
         else:
             f = _table(p.data, int(p.coef[r, C_NCURVE]), p.elem[r, E_AUX], f)
     return p.coef[r, C_FN_MAX] * f
@@ -1090,10 +1100,8 @@ def evaluate_network(t, x, m, p, acc, tau):
         temp = temperatures(p)
         for k in range(p.thermal.shape[0]):
             temp[k] = x[int(p.thermal[k, T_STATE]) + TS_TEMP]
-    for k in range(p.fric.shape[0]):   # (a shifted E-clutch's working point at this state; no call without one)
-        if p.coef[p.fric[k], C_LEVELS] > 0.0:
-            update_shifts(p, x)
-            break
+    if _shifted(p):   # (a shifted E-clutch's working point at this state)
+        update_shifts(p, x)
     F = wk[0:n]
     Fa = _torque_magnitudes(p)
     for i in range(n):
@@ -3079,7 +3087,7 @@ def params_template() -> DrivelineParams:
     """A :class:`DrivelineParams` of tiny arrays: the types of every network's (for the signatures of the functions
     called through their addresses, :mod:`clutchlab.numerics.outline`)."""
     i1, i2, f1, f2 = (np.zeros(1, np.int64), np.zeros((1, 1), np.int64), np.zeros(1), np.zeros((1, 1)))
-    return DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, f1, f2, f2)
+    return DrivelineParams(f1, i2, f2, f2, f1, i1, i1, i1, i1, f1, i1, np.zeros(3), f2, f2)
 
 
 def _params_type():
@@ -3111,6 +3119,16 @@ _split_limit_outlined = outlined(_split_limit, lambda: (_params_type(), _F2, typ
 #: docs/architecture.md)
 _eliminate_outlined = outlined(_eliminate, lambda: (_F2, types.int64, _F2, _I1), types.int64)
 _small_solve_outlined = outlined(_small_solve, lambda: (_F2, _F1, types.int64), types.boolean, lazy=True)
+# the laws of an E-clutch whose working point moves and of a friction map read at a heat port's temperature: called
+# through their addresses, so that the friction laws every network evaluates stay as small as before them (linked,
+# their code in the normal force and the sliding torque cost CoupledClutches and the launch 5-10 %), and compiled
+# only for a network that has such an element
+_shifted_curve_outlined = outlined(shifted_curve, lambda: (_F1, types.int64, types.int64, types.int64, types.float64,
+                                                           types.float64), types.float64, lazy=True)
+_shifted_liftoff_outlined = outlined(shifted_liftoff, lambda: (_F1, types.int64, types.int64, types.float64),
+                                     types.float64, lazy=True)
+_friction_map_outlined = outlined(friction_map, lambda: (_F1, types.int64, types.int64, types.int64, types.float64,
+                                                         types.float64), types.float64, lazy=True)
 
 
 #: refinements of the stuck set's regularised solution at most (:func:`_solve_stuck`: three always, then while the
@@ -4385,10 +4403,8 @@ def _margin_rates(t, x, u, m, p, dx, g):
         hold[j] = wk[o + 2 * n + ne + j]
     for k in range(temp.shape[0]):
         temp[k] = wk[o + 2 * n + ne + nl + k]
-    for k in range(nf):   # (a shifted E-clutch's working point back at x: the probe moved its mass's temperature)
-        if p.coef[p.fric[k], C_LEVELS] > 0.0:
-            update_shifts(p, x)
-            break
+    if _shifted(p):   # (a shifted E-clutch's working point back at x: the probe moved its mass's temperature)
+        update_shifts(p, x)
 
 
 # ----------------------------------------------------------------- hooks
@@ -5174,6 +5190,8 @@ def shift_error(x, p):
     :func:`shifted_curve`) whose working point's shift at the state ``x`` (:func:`update_shifts`) left the levels
     its table was built for (by more than a micrometre's thousandth): its wear beyond ``wear_max`` or its
     temperature beyond the table's span.  Held at the last level, its force would be a silent guess."""
+    if not _shifted(p):
+        return 0
     for k in range(p.fric.shape[0]):
         r = p.fric[k]
         nl = int(p.coef[r, C_LEVELS])

@@ -1964,7 +1964,8 @@ class Driveline:
         inertia = np.array([v[0] for v in self._inertias.values()])
         p = K.DrivelineParams(inertia, elem, coef, sig,
                               np.array(data, dtype=float), fric, cons, swit, lossy, work,
-                              np.zeros(max(nk, 1), dtype=np.int64), np.zeros(2), thermal, links)
+                              np.zeros(max(nk, 1), dtype=np.int64),
+                              np.array([0.0, 0.0, float(sum(1 for e in self._elements if e.levels))]), thermal, links)
         m0 = self._initial_modes(p, self.initial_state())   # (and the start's stored energy, work[-1])
         return p, port_rows, m0
 
