@@ -89,15 +89,17 @@ def test_a_caller_that_cannot_find_the_function_raises():
 
 def test_prepare_compiles_every_outlined_function_of_the_driveline():
     """``prepare`` compiles every outlined function but the lazy ones (the repair of a stuck set over several null
-    directions, a rare path; the invariant check, a debug option) and those of a group (the hooks of a network with
-    model components), ``prepare(groups=("coupled",))`` the group's, ``prepare(lazy=True)`` the lazy ones."""
+    directions, a rare path; the laws of a shifted E-clutch and of a friction map read at a heat port's temperature,
+    for networks that have one; the invariant check, a debug option) and those of a group (the hooks of a network
+    with model components), ``prepare(groups=("coupled",))`` the group's, ``prepare(lazy=True)`` the lazy ones."""
     from clutchlab.driveline import kernel as K
 
     from clutchlab.driveline import coupled as DC
 
     from clutchlab.emtc import system as ES
 
-    assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == [K._repair_space, K._small_solve, K.check_invariants]
+    lazy = [K._repair_space, K._small_solve, K.shifted_curve, K.shifted_liftoff, K.friction_map, K.check_invariants]
+    assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == lazy
     coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
     assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
                        DC.coupled_accept, DC._watch_rates]
@@ -112,7 +114,7 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
     outline.prepare(lazy=True)
-    for fn in (K._repair_space, K._small_solve, K.check_invariants):
+    for fn in lazy:
         entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
         assert entry.sig() in fn.overloads
 
