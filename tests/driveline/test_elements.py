@@ -705,3 +705,25 @@ def test_the_element_listing_is_what_each_method_added():
     assert [e.name for e in Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements] \
         == ["G"] and Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements[0].support \
         == "ground"
+
+
+def test_a_network_without_a_part_runs_as_one_built_without_it_and_leaves_the_original_whole():
+    """``Driveline.without``: a brake and its inertia taken out give the run of the network built without them (the
+    closed form of a clutch locking two inertias, ``J1 w0 / (J1 + J2)``), and the original still has them; an element
+    left acting on a removed inertia, or a thermal mass left taking a removed element's losses, is refused."""
+    d = Driveline("with")
+    d.inertia("J1", J=1.0, w0=10.0).inertia("J2", J=3.0).inertia("U", J=1.0, w0=5.0)
+    d.clutch("c", "J1", "J2", fn_max=10.0, mu=0.5)
+    d.brake("Ubrake", "U", fn_max=1.0, mu=0.5)
+    alone = d.without("U", "Ubrake")
+    assert [e.name for e in alone.elements] == ["c"] and alone.inertia_names == ("J1", "J2")
+    assert [e.name for e in d.elements] == ["c", "Ubrake"] and d.inertia_names == ("J1", "J2", "U")
+    df = alone.simulate(5.0, rtol=1e-10).to_dataframe()
+    assert df["J2.w_rad_s"].iloc[-1] == pytest.approx(10.0 / 4.0, rel=1e-9)
+    with pytest.raises(ParameterError, match="with: without 'U': Ubrake acts on it"):
+        d.without("U")
+    with pytest.raises(ParameterError, match="with: without: no inertia or element 'V'"):
+        d.without("V")
+    d.thermal_mass("housing", capacity=100.0, heat_from=["Ubrake"])
+    with pytest.raises(ParameterError, match="without 'Ubrake': the thermal mass housing takes its losses"):
+        d.without("U", "Ubrake")

@@ -1855,6 +1855,33 @@ class Driveline:
                                  (e.sup or GROUND) if e.kind == K.K_GEAR else None, self._element_line(e))
                      for e in self._elements)
 
+    def without(self, *names: str) -> "Driveline":
+        """A copy of this network without the inertias and elements ``names`` (this one is left as it is): to run a
+        network with and without a part of it (the unrelated-element property of issue #30, a what-if without a
+        brake).  An element left in that acts on a removed inertia, or a thermal mass left in that a removed element
+        heats, is refused naming both: leave it out too."""
+        known = set(self._inertias) | {e.name for e in self._elements}
+        unknown = [n for n in names if n not in known]
+        if unknown:
+            raise ParameterError(f"{self.name}: without: no inertia or element {unknown[0]!r}")
+        gone = set(names)
+        out = copy.copy(self)
+        out._inertias = {k: v for k, v in self._inertias.items() if k not in gone}
+        out._elements = [copy.copy(e) for e in self._elements if e.name not in gone]
+        for e in out._elements:
+            for flange in (e.a, e.b, e.sup):
+                if flange in gone:
+                    raise ParameterError(f"{self.name}: without {flange!r}: {e.name} acts on it (leave it out too)")
+        for tm in self._thermal.values():
+            heated = gone.intersection(tm.heat_from)
+            if heated:
+                raise ParameterError(f"{self.name}: without {sorted(heated)[0]!r}: the thermal mass {tm.name} takes "
+                                     "its losses (leave the element in, or the mass out of the file)")
+        out._inputs = dict(self._inputs)
+        out._thermal = dict(self._thermal)
+        out._links = list(self._links)
+        return out
+
     def pack(self) -> K.DrivelineParams:
         """The packed parameters (:class:`~clutchlab.driveline.kernel.DrivelineParams`)."""
         return self._pack()[0]
