@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import copy
 import functools
+import hashlib
 import math
+import pickle
 import sys
 from dataclasses import dataclass
 
@@ -657,7 +659,25 @@ def _lift_off(name, cm, s, travel, points):
     return float(hi)
 
 
+#: shift tables built in this process, by the hash of their axial model and span (:func:`_shift_table`); a sweep's
+#: variants and an FMU export's parameter probes build the same network again and again
+_SHIFT_TABLES: dict = {}
+_SHIFT_TABLES_MAX = 16
+
+
 def _shift_table(name, cm, travel, points, lo, hi):
+    """The table of :func:`clutchlab.driveline.kernel.shifted_curve` for the axial model ``cm`` at shifts ``lo`` to
+    ``hi`` [m]: ``(data, levels)`` (:func:`_build_shift_table`), kept for the same model, travel, points and span
+    (0.5-1.5 s of static curves each)."""
+    key = hashlib.sha1(pickle.dumps((cm, float(travel), int(points), float(lo), float(hi)))).hexdigest()
+    if key not in _SHIFT_TABLES:
+        if len(_SHIFT_TABLES) >= _SHIFT_TABLES_MAX:
+            _SHIFT_TABLES.pop(next(iter(_SHIFT_TABLES)))
+        _SHIFT_TABLES[key] = _build_shift_table(name, cm, travel, points, lo, hi)
+    return _SHIFT_TABLES[key]
+
+
+def _build_shift_table(name, cm, travel, points, lo, hi):
     """The table of :func:`clutchlab.driveline.kernel.shifted_curve` for the axial model ``cm`` at shifts ``lo`` to
     ``hi`` [m]: ``(data, levels)``.  Levels at most :data:`SHIFT_STEP` apart, each interval halved (up to
     :data:`SHIFT_HALVINGS` times) until the table's curve halfway is within :data:`SHIFT_TOLERANCE` of the peak
