@@ -1760,6 +1760,13 @@ class Driveline:
                                          f"(thermal masses: {known})")
                 links[j, col] = index[v]
             links[j, K.L_COND] = link.conductance
+        for r, e in enumerate(self._elements):   # (what reads the temperature of its heat port: one must exist)
+            if e.map_t and heat[r] < 0:
+                raise ParameterError(f"{e.name}: a friction map without a temperature is read at the temperature of "
+                                     "the thermal mass its losses heat: list it in a thermal_mass's heat_from, or "
+                                     "give temperature")
+            if e.levels:
+                self._check_shift(e, e.coef, thermal[heat[r]] if heat[r] >= 0 else None)
         return heat, thermal, links
 
     def describe(self) -> str:
@@ -1991,13 +1998,6 @@ class Driveline:
         lossy = np.array([r for r, e in enumerate(self._elements) if self._is_lossy(e)], dtype=np.int64)
         elem[lossy, K.E_MODE] = fric.size + swit.size + np.arange(lossy.size)
         elem[:, K.E_HEAT], thermal, links = self._heat_rows()
-        for r, e in enumerate(self._elements):   # (an E-clutch that expands reads the temperature of its heat port)
-            if e.map_t and elem[r, K.E_HEAT] < 0:
-                raise ParameterError(f"{e.name}: a friction map without a temperature is read at the temperature of "
-                                     "the thermal mass its losses heat: list it in a thermal_mass's heat_from, or "
-                                     "give temperature")
-            if e.levels:
-                self._check_shift(e, coef[r], thermal[elem[r, K.E_HEAT]] if elem[r, K.E_HEAT] >= 0 else None)
         for r, (sign, depth, given) in self._speed_plan()[2].items():   # (kernel.derive_speeds)
             elem[r, K.E_SPREAD] = sign * depth
             elem[r, K.E_SPREAD_SUP] = int(given)
