@@ -199,6 +199,10 @@ def check_map(work, out):
     err = fmap.mu(vv[cov], tt[cov]) - truth.mu(vv[cov], tt[cov])
     assert np.max(np.abs(err)) < 0.006                          # the bench's true map, recovered
     assert _is_png(work / "map.png")
+    # the bench's lining rises with slip (mu_e < 0): the verdict the file and the line report is the map's own
+    doc = json.loads((work / "map.json").read_text())
+    assert doc["anti_shudder"] == fmap.shudder_summary() and doc["anti_shudder"]["intervals"] > 0
+    assert "anti-shudder:" in out
 
 
 def _truth_magnet():
@@ -361,7 +365,19 @@ def check_bode(work, out):
     assert (poles[poles.bearing_position_m == 7e-3].pole_real_1_s > 0).any()   # beyond the force peak
 
 
+def check_judder(work, out):
+    import json
+
+    doc = json.loads((work / "judder.json").read_text())
+    assert doc["unstable"] is True and doc["modes"]["clutch"] == "backward"      # sliding with a falling mu
+    (clutch,) = [f for f in doc["friction"] if f["element"] == "clutch"]
+    assert clutch["damping_Nms_rad"] == pytest.approx(0.22 * 3000 * (-0.08 / 150), rel=1e-6)
+    assert any(9.0 < m["frequency_Hz"] < 13.0 and m["unstable"] for m in doc["oscillating_modes"])
+    assert "JUDDER" in out
+
+
 CHECKS = {
+    "judder.json": check_judder,
     "awd.csv": check_awd,
     "lin.json": check_lin,
     "bode.png": check_bode,

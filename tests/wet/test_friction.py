@@ -85,3 +85,29 @@ def test_map_bad_input(tmp_path):
     (tmp_path / "lack.json").write_text('{"speed_grid": [0, 1]}')
     with pytest.raises(DataError, match="temperature_grid"):
         FrictionMap.from_json(tmp_path / "lack.json")
+
+
+def test_the_speed_slopes_of_a_map_are_its_own():
+    """``d mu/d v`` between speed nodes of a map linear in v per temperature (falling at 60 degC, rising at 100):
+    the slopes exactly, the measured intervals only in the verdict, a 3-D map per force."""
+    v = np.array([0.0, 0.5, 1.5, 3.0])
+    temps = np.array([60.0, 100.0])
+    values = np.array([0.14 - 0.004 * v, 0.11 + 0.006 * v])
+    covered = np.ones_like(values, dtype=bool)
+    covered[0, 3] = False                      # the hot end of the falling row filled from the law
+    fmap = FrictionMap(v, temps, values, covered=covered)
+    table = fmap.speed_slopes()
+    assert list(table.columns) == ["temperature_C", "speed_from_m_s", "speed_to_m_s", "dmu_dv_s_m", "covered"]
+    assert len(table) == 6
+    np.testing.assert_allclose(table.dmu_dv_s_m, [-0.004] * 3 + [0.006] * 3, rtol=1e-12)
+    assert list(table.covered) == [True, True, False, True, True, True]
+    verdict = fmap.shudder_summary()
+    assert verdict["intervals"] == 5 and verdict["falling"] == 2 and verdict["shudder_prone"]
+    assert verdict["min_dmu_dv_s_m"] == pytest.approx(-0.004) and verdict["at_temperature_C"] == 60.0
+    rising = FrictionMap(v, temps, np.array([0.11 + 0.006 * v, 0.12 + 0.001 * v]))
+    assert not rising.shudder_summary()["shudder_prone"]
+    cube = FrictionMap(v, temps, np.stack([values, values + 0.01]), force_grid=[500.0, 1500.0])
+    t3 = cube.speed_slopes()
+    assert list(t3.columns)[0] == "force_N" and len(t3) == 12 and set(t3.force_N) == {500.0, 1500.0}
+    none = FrictionMap(v, temps, values, covered=np.zeros_like(values, dtype=bool)).shudder_summary()
+    assert none["intervals"] == 0 and none["min_dmu_dv_s_m"] is None and not none["shudder_prone"]

@@ -1,4 +1,4 @@
-"""``clutchlab control trim|linearize|bode|design MODEL ...``: a thin layer over :mod:`clutchlab.control`.
+"""``clutchlab control trim|linearize|bode|judder|design MODEL ...``: a thin layer over :mod:`clutchlab.control`.
 
 ``clutchlab control trim eclutch --at "4 mm" -o op.json``
     the steady state holding the release bearing at 4 mm (motor voltage solved for);
@@ -7,6 +7,9 @@
 ``clutchlab control bode eclutch --at "0.5 mm" --at "4 mm" --at "8 mm" -u motor_voltage -y bearing_position -o bode.png``
     Bode diagram at several operating points (and ``--table`` its magnitude and phase as CSV, ``--poles``
     the poles at each point).
+``clutchlab control judder driveline FILE.toml --run-to "0.3 s" -o modes.csv``
+    the oscillating modes of the network in the mode its run is in at 0.3 s (frequency, damping ratio, growth
+    rate) and the damping each sliding clutch adds to them: judder where a mode grows;
 ``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
     with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
     "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
@@ -66,6 +69,20 @@ def register(subparsers) -> None:
     bode.add_argument("--fmin", default="0.1 Hz", help="lowest frequency (default 0.1 Hz)")
     bode.add_argument("--fmax", default="2 kHz", help="highest frequency (default 2 kHz)")
     bode.set_defaults(func=_bode)
+    jud = sub.add_parser("judder", help="oscillating modes and the damping of sliding clutches (judder)",
+                         description="The torsional modes of a model in its active mode (frequency, damping ratio, "
+                                     "growth rate) and the damping d tau/d w_rel each sliding friction element adds "
+                                     "(negative where its friction falls with the slip speed), at a steady state "
+                                     "(the trim options) or at the state a run reaches (--run-to); exit status 0 "
+                                     "either way (the verdict is printed and written).",
+                         epilog="Documentation: docs/control.md (Judder)")
+    _common(jud)
+    jud.add_argument("--run-to", metavar="TIME",
+                     help="run the model from its start to TIME (e.g. '0.3 s') and analyse the state it reaches there, "
+                          "frozen in its mode (instead of a trim)")
+    jud.add_argument("-o", "--output", help="file to write: .json (modes, friction elements, verdict) or .csv (the "
+                                            "modes)")
+    jud.set_defaults(func=_judder)
     design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
                             description="Linearise the model at a steady state (one input, one output), design "
                                         "the PI C(s) = Kp (1 + 1/(Ti s)) giving the phase margin at the crossover "
@@ -240,6 +257,37 @@ def _linearize(args) -> int:
     sys = linearize(points[0][2], inputs=args.inputs, outputs=args.outputs, directions=branches)
     write_linear_model(sys, args.output, force=args.force)
     print(f"{sys.nstates} states, {sys.ninputs} inputs, {sys.noutputs} outputs -> {args.output}")
+    return 0
+
+
+def _judder(args) -> int:
+    import json
+
+    from ..io.files import atomic_to_csv, atomic_write_text, check_writable
+    from ..units import to_si
+    from ..control.judder import judder_modes
+
+    if args.output is not None:
+        if not args.output.lower().endswith((".json", ".csv")):
+            raise ParameterError(f"-o {args.output}: expected a .json or .csv file")
+        check_writable(args.output, args.force)
+    if args.run_to is not None:
+        if any((args.at, args.set, args.hold, args.target, args.free, args.mode)):
+            raise ParameterError("--run-to analyses the state a run reaches; drop the trim options "
+                                 "(--at/--set/--hold/--target/--free/--mode)")
+        _, system = _system(args)
+        result = judder_modes(system, run_to=to_si(args.run_to, "s", name="--run-to"))
+    else:
+        points = _points(args)
+        if len(points) != 1:
+            raise ParameterError("judder analyses one operating point: give one --at")
+        result = judder_modes(points[0][2])
+    if args.output is not None:
+        if args.output.lower().endswith(".json"):
+            atomic_write_text(args.output, json.dumps(result.to_dict(), indent=1), overwrite=args.force)
+        else:
+            atomic_to_csv(result.table, args.output, overwrite=args.force)
+    print(result)
     return 0
 
 

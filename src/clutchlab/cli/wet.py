@@ -107,6 +107,15 @@ def _identify(args) -> int:
     clutch = WetClutch.from_toml(args.clutch) if args.clutch else WetClutch.paper()
     fmap = identify_friction_map(args.records, clutch, sensor_time_constant=args.sensor_lag)
     data = fmap.to_dict()
+    shudder = data["anti_shudder"] = fmap.shudder_summary()
+    if shudder["intervals"] == 0:
+        shudder_line = "anti-shudder: no measured speed interval"
+    elif shudder["shudder_prone"]:
+        shudder_line = (f"anti-shudder: mu falls with slip speed in {shudder['falling']} of {shudder['intervals']} "
+                        f"measured intervals (steepest {shudder['min_dmu_dv_s_m']:.3g} s/m at "
+                        f"{shudder['at_temperature_C']:g} degC, {shudder['at_speed_m_s']:.3g} m/s): shudder-prone")
+    else:
+        shudder_line = f"anti-shudder: mu rises with slip speed in all {shudder['intervals']} measured intervals"
     try:
         th = identify_thermal(args.records, clutch, sensor_time_constant=args.sensor_lag)
         data["thermal"] = {"k1_W_K": th.k1, "k2_W_K": th.k2, "stderr": th.stderr, "ci95": th.ci95,
@@ -130,7 +139,8 @@ def _identify(args) -> int:
             atomic_write_bytes(outputs.staged(args.plot), buf.getvalue(), overwrite=args.force)
     law = fmap.law
     print(f"{args.output}: mu_f = {law.mu0:.4g} + {law.mu_t:.3g} (T - {law.t_ref:g}) + {law.mu_e:.3g} exp(-v/{law.v_s:.3g}); "
-          f"rmse {fmap.statistics['rmse']:.2g}, {fmap.statistics['cells_covered']} covered cells; {thermal_line}")
+          f"rmse {fmap.statistics['rmse']:.2g}, {fmap.statistics['cells_covered']} covered cells; {thermal_line}; "
+          f"{shudder_line}")
     return 0
 
 

@@ -9,6 +9,9 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   unit in the name, ``bearing_position_m``), within the active mode of a hybrid model;
   :func:`nonlinear_iosystem` -- the model as a python-control ``NonlinearIOSystem`` (one mode);
 * :func:`frequency_table`, :func:`pole_sweep` -- frequency responses and poles over an operating range;
+* :func:`judder_modes`, :func:`friction_damping`, :func:`oscillation` -- judder: the oscillating modes in the
+  active mode, the damping a sliding clutch adds to them (negative where its friction falls with the slip speed),
+  and the oscillation in a band of a run or a measurement;
   :func:`loop_margins` -- gain, phase and stability margins of loops, checked by the Nyquist criterion;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
 * :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling;
@@ -25,7 +28,8 @@ import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
-           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error"]
+           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes",
+           "friction_damping", "oscillation", "Oscillation", "reduced_matrices"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.trim",
@@ -38,6 +42,12 @@ _WHERE = {
     "pole_sweep": "clutchlab.control.linear",
     "loop_margins": "clutchlab.control.linear",
     "write_linear_model": "clutchlab.control.linear",
+    "reduced_matrices": "clutchlab.control.linear",
+    "judder_modes": "clutchlab.control.judder",
+    "JudderModes": "clutchlab.control.judder",
+    "friction_damping": "clutchlab.control.judder",
+    "oscillation": "clutchlab.control.judder",
+    "Oscillation": "clutchlab.control.judder",
     "closed_loop": "clutchlab.control.loop",
     "ClosedLoopResult": "clutchlab.control.loop",
     "PI": "clutchlab.control.design",

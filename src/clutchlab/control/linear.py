@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from ..errors import ParameterError
 from ..system import System, evaluate
 from ..trim import OperatingPoint, input_scale, resolve, state_scale
 
-__all__ = ["jacobians", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
+__all__ = ["jacobians", "reduced_matrices", "Reduced", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
            "write_linear_model", "signal_name"]
 
 #: relative step of the central differences (about the cube root of the machine epsilon)
@@ -143,46 +144,27 @@ def signal_name(column: str) -> str:
     return str(column).replace(".", "_")
 
 
-def linearize(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
-              directions: dict | None = None, keep_monitors: bool = False, name: str | None = None):
-    """Linear model of ``system`` at ``op`` within its active mode, as a python-control ``StateSpace``.
+class Reduced(NamedTuple):
+    """A system's linear matrices at an operating point within its active mode, its algebraic rows eliminated and
+    its unread states dropped (:func:`reduced_matrices`): ``x' = A x + B u``, ``y = C x + D u`` [SI per SI] over
+    the kept ``states``, ``inputs`` and ``outputs`` (:class:`~clutchlab.system.Variable`)."""
 
-    Parameters
-    ----------
-    system : System or OperatingPoint
-        The system; an :class:`OperatingPoint` alone stands for its system and itself.
-    op : OperatingPoint, optional
-        Where to linearise (default: the system's initial state, inputs and modes at t = 0).
-    inputs : sequence of str, optional
-        Held inputs of the model (default: all), names with or without unit.
-    outputs : sequence of str, optional
-        States or outputs (default: all outputs).
-    directions : dict, optional
-        ``{state or input: "rising" | "falling"}``: linearise a hysteretic element along one branch
-        (:func:`jacobians`), e.g. ``{"i2": "rising"}`` for the EMTC magnet driven up.  Without it the
-        slopes are central differences: on a hysteresis branch point, the mean of the rising and falling
-        slopes.
-    keep_monitors : bool
-        Keep states that no other state and no requested output reads (unobservable poles) and states the
-        mode holds still (poles at zero that no input reaches).
-    name : str, optional
-        Name of the ``StateSpace`` (default: the system's name and the mode).
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    states: list
+    inputs: list
+    outputs: list
+    operating_point: OperatingPoint
+    analytic: bool
 
-    Returns
-    -------
-    control.StateSpace
-        Signals named by column (``bearing_position_m``; a driveline's ``clutch1.tau_Nm`` as
-        ``clutch1_tau_Nm``: :func:`signal_name`); attributes ``operating_point``, ``mode``
-        (``{mode variable: value}``), ``directions`` (the branches asked for), ``units``
-        (``{signal: unit}``) and ``columns`` (``{signal: result column}``).
 
-    Raises
-    ------
-    ParameterError
-        Unknown names, a system without the requested inputs, an algebraic block that is singular.
-    """
-    import control
-
+def reduced_matrices(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
+                     directions: dict | None = None, keep_monitors: bool = False) -> Reduced:
+    """The matrices :func:`linearize` builds its ``StateSpace`` from (the module docstring: the differential rows
+    divided by their mass, the algebraic rows eliminated, unread and frozen states dropped), as plain arrays with
+    their variables: also for a system without inputs, which a python-control model cannot hold."""
     if isinstance(system, OperatingPoint):
         system, op = system.system, system
     if op is None:
@@ -226,6 +208,59 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     state_vars = [system.states[i] for i in dif[keep]]
     in_vars = [system.inputs[j] for _, j in jac["inputs"]]
     out_vars = [(system.states if kind == "state" else system.outputs)[i] for kind, i in jac["outputs"]]
+    return Reduced(A_, B_, C_, D_, state_vars, in_vars, out_vars, op, bool(jac["analytic"]))
+
+
+def linearize(system: System, op: OperatingPoint | None = None, inputs=None, outputs=None, *,
+              directions: dict | None = None, keep_monitors: bool = False, name: str | None = None):
+    """Linear model of ``system`` at ``op`` within its active mode, as a python-control ``StateSpace``.
+
+    Parameters
+    ----------
+    system : System or OperatingPoint
+        The system; an :class:`OperatingPoint` alone stands for its system and itself.
+    op : OperatingPoint, optional
+        Where to linearise (default: the system's initial state, inputs and modes at t = 0).
+    inputs : sequence of str, optional
+        Held inputs of the model (default: all), names with or without unit.
+    outputs : sequence of str, optional
+        States or outputs (default: all outputs).
+    directions : dict, optional
+        ``{state or input: "rising" | "falling"}``: linearise a hysteretic element along one branch
+        (:func:`jacobians`), e.g. ``{"i2": "rising"}`` for the EMTC magnet driven up.  Without it the
+        slopes are central differences: on a hysteresis branch point, the mean of the rising and falling
+        slopes.
+    keep_monitors : bool
+        Keep states that no other state and no requested output reads (unobservable poles) and states the
+        mode holds still (poles at zero that no input reaches).
+    name : str, optional
+        Name of the ``StateSpace`` (default: the system's name and the mode).
+
+    Returns
+    -------
+    control.StateSpace
+        Signals named by column (``bearing_position_m``; a driveline's ``clutch1.tau_Nm`` as
+        ``clutch1_tau_Nm``: :func:`signal_name`); attributes ``operating_point``, ``mode``
+        (``{mode variable: value}``), ``directions`` (the branches asked for), ``units``
+        (``{signal: unit}``) and ``columns`` (``{signal: result column}``).
+
+    Raises
+    ------
+    ParameterError
+        Unknown names, a system without the requested inputs, an algebraic block that is singular.
+    """
+    import control
+
+    if isinstance(system, OperatingPoint):
+        system, op = system.system, system
+    reduced = reduced_matrices(system, op, inputs, outputs, directions=directions, keep_monitors=keep_monitors)
+    A_, B_, C_, D_ = reduced.A, reduced.B, reduced.C, reduced.D
+    state_vars, in_vars, out_vars, op = reduced.states, reduced.inputs, reduced.outputs, reduced.operating_point
+    if not in_vars and out_vars:
+        # (python-control 0.10 stores an empty D as 0 x 0 and then refuses it: name the cause, not its shape)
+        raise ParameterError(f"{system.name}: a linear model needs at least one input (the system has "
+                             f"{'none' if not system.inputs else 'none asked for'}); its poles and modes without "
+                             "inputs: clutchlab.control.judder_modes")
     mode = op.modes
     label = name or system.name
     columns = {}
@@ -243,7 +278,7 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     sys.directions = dict(directions or {})
     sys.units = {signal_name(v.column): v.unit for v in (*state_vars, *in_vars, *out_vars)}
     sys.columns = columns
-    sys.analytic_jacobian = jac["analytic"]
+    sys.analytic_jacobian = reduced.analytic
     return sys
 
 
@@ -377,8 +412,8 @@ def pole_sweep(points, inputs=None, outputs=None, *, directions: dict | None = N
 
     rows = []
     for value, op in points:
-        sys = linearize(op, inputs=inputs, outputs=outputs, directions=directions)
-        for p in np.linalg.eigvals(sys.A) if sys.nstates else []:
+        A = reduced_matrices(op, inputs=inputs, outputs=outputs, directions=directions).A   # (also without inputs)
+        for p in np.linalg.eigvals(A) if A.size else []:
             wn = abs(p)
             rows.append({name: float(value), "pole_real_1_s": float(p.real), "pole_imag_1_s": float(p.imag),
                          "natural_frequency_Hz": wn / (2 * np.pi),

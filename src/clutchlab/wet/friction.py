@@ -193,6 +193,56 @@ class FrictionMap:
 
     __call__ = mu
 
+    def speed_slopes(self):
+        """The map's slope over the slip velocity, ``d mu_f / d v`` [s/m] between neighbouring speed nodes, per
+        temperature (and force) row: the anti-shudder criterion of a friction pairing.
+
+        A pairing whose friction falls with the slip speed (``d mu_f / d v < 0``) damps a driveline's torsional
+        modes negatively while it slides, by ``c_geo F_n r d mu_f / d v`` per rad/s at the radius ``r`` (docs/
+        control.md, "Judder"); Mäki et al. (SAE 2005-01-0878, reference of seed 001) require ``d mu / d v > 0``
+        over the engagement's slip speeds.  The map is linear between its nodes, so these are its slopes, not
+        estimates.
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``force_N`` (a 3-D map only), ``temperature_C``, ``speed_from_m_s``, ``speed_to_m_s``, ``dmu_dv_s_m``
+            and ``covered`` (both nodes measured, not filled from the law).
+        """
+        import pandas as pd
+
+        values = self.values.reshape(-1, *self.values.shape[-2:])   # (a 2-D map as one force row)
+        covered = self.covered.reshape(values.shape)
+        v = self.speed_grid
+        rows = []
+        for k in range(values.shape[0]):
+            for i, temp in enumerate(self.temperature_grid):
+                for j in range(v.size - 1):
+                    row = {} if self.force_grid is None else {"force_N": float(self.force_grid[k])}
+                    row.update(temperature_C=float(temp), speed_from_m_s=float(v[j]), speed_to_m_s=float(v[j + 1]),
+                               dmu_dv_s_m=float((values[k, i, j + 1] - values[k, i, j]) / (v[j + 1] - v[j])),
+                               covered=bool(covered[k, i, j] and covered[k, i, j + 1]))
+                    rows.append(row)
+        columns = ([] if self.force_grid is None else ["force_N"]) + [
+            "temperature_C", "speed_from_m_s", "speed_to_m_s", "dmu_dv_s_m", "covered"]
+        return pd.DataFrame(rows, columns=columns)
+
+    def shudder_summary(self) -> dict:
+        """The anti-shudder verdict over the map's measured intervals (:meth:`speed_slopes` with ``covered``):
+        ``intervals`` (how many), ``falling`` (how many with ``d mu_f / d v < 0``), ``shudder_prone`` (any
+        falling), and the steepest fall, ``min_dmu_dv_s_m`` with its ``at_temperature_C`` and ``at_speed_m_s`` (the
+        interval's middle); None for those three with no measured interval."""
+        table = self.speed_slopes()
+        table = table[table.covered]
+        out = {"intervals": int(len(table)), "falling": int((table.dmu_dv_s_m < 0).sum()),
+               "shudder_prone": bool((table.dmu_dv_s_m < 0).any()), "min_dmu_dv_s_m": None,
+               "at_temperature_C": None, "at_speed_m_s": None}
+        if len(table):
+            row = table.loc[table.dmu_dv_s_m.idxmin()]
+            out.update(min_dmu_dv_s_m=float(row.dmu_dv_s_m), at_temperature_C=float(row.temperature_C),
+                       at_speed_m_s=0.5 * float(row.speed_from_m_s + row.speed_to_m_s))
+        return out
+
     def kernel_data(self):
         """Arrays for :func:`mu_kernel`: (kind, coef, grid_v, grid_t, grid_f, table)."""
         gf = self.force_grid if self.force_grid is not None else np.zeros(1)
