@@ -210,3 +210,37 @@ d = {D}
     line = one_line_error(capsys, ["control", "judder", "driveline", example, "--run-to", "0.6 s", "-o", str(out)])
     assert "exists" in line or "--force" in line
     assert not (tmp_path / "j.txt").exists() and not (tmp_path / "j.json").exists()
+
+
+def test_a_timeline_along_the_example_launch(tmp_path, capsys):
+    """The clutch's damping follows its normal force, a ramp from 0.1 to 0.4 s: ``-0.352 N m s/rad`` times
+    ``(t - 0.1) / 0.3`` while it slides, NaN while it is free (before 0.1 s) or stuck (after the lock-up at
+    0.66 s); the first mode grows exactly where its damping ratio is negative."""
+    from clutchlab.control import judder_timeline
+    from clutchlab.driveline.description import load_driveline
+
+    spec = load_driveline(ROOT / "examples" / "driveline_judder.toml")
+    system = spec.driveline.system(spec.rtol)
+    times = [0.05, 0.2, 0.3, 0.5, 0.8]
+    tl = judder_timeline(system, times)
+    assert list(tl.time_s) == times
+    full = 0.22 * 3000.0 * (-0.08 / 150.0)
+    want = [math.nan, full / 3, full * 2 / 3, full, math.nan]
+    np.testing.assert_allclose(tl["clutch.damping_Nms_rad"], want, rtol=1e-6)
+    assert list(tl.unstable) == [False, False, True, True, False]
+    assert ((tl.growth_rate_1_s > 0) == tl.unstable).all() and ((tl.damping_1 < 0) == tl.unstable).all()
+    # the same rows as a single analysis at that time (within the run's tolerance: stopping at the earlier times
+    # changes its steps)
+    single = judder_modes(system, run_to=0.5)
+    assert tl.growth_rate_1_s[3] == pytest.approx(single.table.growth_rate_1_s.max(), rel=1e-6)
+    with pytest.raises(ParameterError, match=r"increasing"):
+        judder_timeline(system, [0.3, 0.2])
+    out = tmp_path / "timeline.csv"
+    assert main(["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
+                 "--run-to", "0.2 s", "--run-to", "0.5 s", "-o", str(out)]) == 0
+    table = pd.read_csv(out)
+    assert list(table.time_s) == [0.2, 0.5] and table["clutch.damping_Nms_rad"][1] == pytest.approx(full, rel=1e-6)
+    assert "clutch.damping_Nms_rad" in capsys.readouterr().out
+    line = one_line_error(capsys, ["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
+                                   "--run-to", "0.5 s", "--run-to", "0.2 s"])
+    assert "must increase" in line

@@ -9,7 +9,8 @@
     the poles at each point).
 ``clutchlab control judder driveline FILE.toml --run-to "0.3 s" -o modes.csv``
     the oscillating modes of the network in the mode its run is in at 0.3 s (frequency, damping ratio, growth
-    rate) and the damping each sliding clutch adds to them: judder where a mode grows;
+    rate) and the damping each sliding clutch adds to them: judder where a mode grows (``--run-to`` repeated:
+    a timeline along the run);
 ``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
     with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
     "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
@@ -77,11 +78,12 @@ def register(subparsers) -> None:
                                      "either way (the verdict is printed and written).",
                          epilog="Documentation: docs/control.md (Judder)")
     _common(jud)
-    jud.add_argument("--run-to", metavar="TIME",
+    jud.add_argument("--run-to", metavar="TIME", action="append", default=[],
                      help="run the model from its start to TIME (e.g. '0.3 s') and analyse the state it reaches there, "
-                          "frozen in its mode (instead of a trim)")
-    jud.add_argument("-o", "--output", help="file to write: .json (modes, friction elements, verdict) or .csv (the "
-                                            "modes)")
+                          "frozen in its mode (instead of a trim); repeat for a timeline along the run (the least "
+                          "damped mode and the sliding elements' damping at each time)")
+    jud.add_argument("-o", "--output", help="file to write: .json (modes, friction elements, verdict; a timeline's "
+                                            "rows) or .csv (the modes; a timeline's rows)")
     jud.set_defaults(func=_judder)
     design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
                             description="Linearise the model at a steady state (one input, one output), design "
@@ -265,18 +267,31 @@ def _judder(args) -> int:
 
     from ..io.files import atomic_to_csv, atomic_write_text, check_writable
     from ..units import to_si
-    from ..control.judder import judder_modes
+    from ..control.judder import judder_modes, judder_timeline
 
     if args.output is not None:
         if not args.output.lower().endswith((".json", ".csv")):
             raise ParameterError(f"-o {args.output}: expected a .json or .csv file")
         check_writable(args.output, args.force)
-    if args.run_to is not None:
+    if args.run_to:
         if any((args.at, args.set, args.hold, args.target, args.free, args.mode)):
             raise ParameterError("--run-to analyses the state a run reaches; drop the trim options "
                                  "(--at/--set/--hold/--target/--free/--mode)")
         _, system = _system(args)
-        result = judder_modes(system, run_to=to_si(args.run_to, "s", name="--run-to"))
+        times = [to_si(t, "s", name="--run-to") for t in args.run_to]
+        if len(times) > 1:
+            if any(b <= a for a, b in zip(times, times[1:])):
+                raise ParameterError(f"--run-to: a timeline's times must increase (got {', '.join(args.run_to)})")
+            table = judder_timeline(system, times)
+            if args.output is not None:
+                if args.output.lower().endswith(".json"):
+                    atomic_write_text(args.output, json.dumps({"model": system.name, "timeline": table.to_dict(
+                        orient="records")}, indent=1), overwrite=args.force)
+                else:
+                    atomic_to_csv(table, args.output, overwrite=args.force)
+            print(table.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+            return 0
+        result = judder_modes(system, run_to=times[0])
     else:
         points = _points(args)
         if len(points) != 1:

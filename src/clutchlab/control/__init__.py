@@ -28,7 +28,7 @@ import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
-           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes",
+           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes", "judder_timeline",
            "friction_damping", "oscillation", "Oscillation", "reduced_matrices"]
 
 _WHERE = {
@@ -45,6 +45,7 @@ _WHERE = {
     "reduced_matrices": "clutchlab.control.linear",
     "judder_modes": "clutchlab.control.judder",
     "JudderModes": "clutchlab.control.judder",
+    "judder_timeline": "clutchlab.control.judder",
     "friction_damping": "clutchlab.control.judder",
     "oscillation": "clutchlab.control.judder",
     "Oscillation": "clutchlab.control.judder",
