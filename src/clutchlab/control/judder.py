@@ -163,7 +163,7 @@ def friction_damping(op: OperatingPoint):
         if c_w[j] == 0.0:
             raise ParameterError(f"{system.name}: {name}'s relative speed moves with no state at t = {op.t:g} s")
         rows.append({"element": name, "mode": mode, "slip_rad_s": op.value(f"{name}.w_rel"),
-                     "tau_Nm": op.value(f"{name}.tau"), "damping_Nms_rad": float(c_tau[j] / c_w[j])})
+                     "tau_Nm": op.value(f"{name}.tau"), "damping_Nms_rad": float(c_tau[j] / c_w[j]) + 0.0})   # (no -0)
     return pd.DataFrame(rows, columns=["element", "mode", "slip_rad_s", "tau_Nm", "damping_Nms_rad"])
 
 
