@@ -399,7 +399,8 @@ BUILTIN = (
         Field("ambient", "quantity", "degC", default=20.0, minimum=ABSOLUTE_ZERO_C,
               description="the ambient's temperature"),
         Field("heat_from", "names", description="the elements whose losses heat it (their heat ports; each heats "
-                                                "one mass; not sources, wet clutches or EMTCs)"),
+                                                "one mass; not sources or wet clutches; an EMTC with a friction map reads it at this mass's "
+                                                "temperature)"),
     ), _method("thermal_mass"), "Modelica.Thermal.HeatTransfer.Components.HeatCapacitor, ThermalConductor, "
                                 f"FixedTemperature; {_MSL}.Interfaces.PartialElementaryConditionalHeatPort", _BOTH),
     Component("thermal_conductor", "A thermal conductor between two thermal masses: heat flow G (T_a - T_b).", (

@@ -183,6 +183,12 @@ def _coupling(t, x, m, net, e, j):
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
     ep = block_row(e, j)
+    h = net.elem[e.conf[j][F_ROW], K.E_HEAT]
+    if h >= 0:   # its losses heat a thermal mass: its friction map is read at that mass's temperature
+        temp = x[int(net.thermal[h, K.T_STATE]) + K.TS_TEMP]
+        if ep.fmem[S.FM_TEMP] != temp:
+            ep.fmem[S.FM_TEMP] = temp
+            ep.fmem[S.FM_KEY] = np.nan   # (its last evaluation, kept by its point, was at another temperature)
     dispatch.rhs(t, xs, us, e.mbuf[j], ep, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     dispatch.outputs(t, xs, us, e.mbuf[j], ep, b[B_Y:N_BUF])   # (the same point: the model reuses it)
     cap = b[B_Y + _Y_CAP] if e.mbuf[j][_ARM] == _CONTACT else 0.0

@@ -1679,9 +1679,11 @@ class Driveline:
             The ambient's temperature [degC].
         heat_from : sequence of str
             The elements whose losses heat it (springs and dampers, backlash, gears, clutches, brakes, bearing
-            friction, one-way clutches, E-clutches), named here or added later: they are looked up when the
-            network is packed.  An element heats at most one mass; sources dissipate nothing, and a wet clutch or
-            an EMTC carries its own thermal model.
+            friction, one-way clutches, E-clutches, EMTC couplings), named here or added later: they are looked up
+            when the network is packed.  An element heats at most one mass; sources dissipate nothing, and a wet
+            clutch carries its own thermal model.  An EMTC coupling with a friction map reads it at this mass's
+            temperature (instead of its scenario's ``temperature_c``; seed 002, Sec. 5: the coupling's thermal
+            behaviour, its future work).
         """
         name = self._new_name(name)
         capacity = _finite(name, "capacity", capacity, positive=True)
@@ -1738,10 +1740,9 @@ class Driveline:
                 if e.kind in (K.K_SOURCE, K.K_MOTION):
                     raise ParameterError(f"{tm.name}: heat_from names {name!r}, a source: it does work and "
                                          "dissipates nothing")
-                if e.wet is not None or e.emtc is not None:
-                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, a "
-                                         f"{'wet clutch' if e.wet is not None else 'EMTC coupling'}: it carries its "
-                                         "own thermal model")
+                if e.wet is not None:
+                    raise ParameterError(f"{tm.name}: heat_from names {name!r}, a wet clutch: it carries its own "
+                                         "thermal model (pack, oil and housing, Eq. 8 of seed 001)")
                 if heat[rows[name]] >= 0:
                     raise ParameterError(f"{tm.name}: heat_from names {name!r}, whose losses already heat "
                                          f"{masses[heat[rows[name]]].name!r} (an element heats one thermal mass)")

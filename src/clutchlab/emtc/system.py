@@ -219,12 +219,16 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              #                              stretch of the last evaluation (lo, hi, a0, a1, a2, kind:
              #                              hysteresis.kernels.peek_segment), the stack version (IM_PVER), last
              #                              input and airgap it is for
-             ("controller_segment", 8))   # the controller model's rising stretch (hysteresis.kernels.invert_combined)
+             ("controller_segment", 8),   # the controller model's rising stretch (hysteresis.kernels.invert_combined)
+             # the temperature [degC] the friction map is read at when a network's thermal mass gives it (the mass
+             # the coupling's losses heat, clutchlab.driveline.emtc); NaN: the coupling's own temperature_c
+             ("heat_port_temperature", 1))
 (FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_DVLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
- FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(
+ FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG, FM_TEMP) = FMEM.of(
     "plant_input", "controller_input", "command", "torque_reference", "feasible", "z", "t_last", "dw_last",
     "dv_last", "plant_weights", "controller_weights", "inputs_at_restart", "aux", "split", "derivative", "switching", "key",
-    "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment")
+    "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment",
+    "heat_port_temperature")
 N_FMEM = FMEM.total
 #: controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_COLUMNS = ("command", "torque_reference", "throttle", "feasible")
@@ -822,8 +826,11 @@ def _rhs(t, x, u, m, p, dx, g):
         # slide along zero until a step happened to end past it; see docs/emtc.md)
         sl = 1.0 if m[2] == POSITIVE else -1.0
         if p.friction_mode == FRICTION_MAP:
+            # at the coupling's temperature, or at its heat port's in a network (the paper's future work: the
+            # coupling's heat, Sec. 5; FM_TEMP is NaN without one)
+            temp = fmem[FM_TEMP] if fmem[FM_TEMP] == fmem[FM_TEMP] else c.temperature_c
             m1 = bilinear(_cold(p.cold, p.layout, L_FMAP_SPEED), _cold(p.cold, p.layout, L_FMAP_TEMP),
-                          shaped(_cold(p.cold, p.layout, L_FMAP_MU), (p.n_fmap_speed, p.n_fmap_temp)), abs(dw), c.temperature_c)
+                          shaped(_cold(p.cold, p.layout, L_FMAP_MU), (p.n_fmap_speed, p.n_fmap_temp)), abs(dw), temp)
             m2 = m1
             m3 = m1
         elif p.friction_mode == FRICTION_LUGRE:
@@ -1443,6 +1450,7 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_KEY] = np.nan
     fmem[FM_SEG:FM_SEG + 9] = np.nan
     fmem[FM_CSEG:FM_CSEG + 8] = np.nan
+    fmem[FM_TEMP] = np.nan   # (the coupling's temperature_c; a network's heat port writes its mass's)
     if not 1 <= scenario.gear <= len(vehicle.gear_ratios):
         raise ParameterError(f"BenchScenario: gear = {scenario.gear}: the vehicle has gears 1 to "
                              f"{len(vehicle.gear_ratios)} (VehicleParameters.gear_ratios)")
