@@ -28,8 +28,8 @@ import importlib
 
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
-           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes", "judder_timeline",
-           "friction_damping", "oscillation", "Oscillation", "reduced_matrices"]
+           "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes",
+           "judder_timeline", "friction_damping", "oscillation", "Oscillation", "reduced_matrices"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.trim",

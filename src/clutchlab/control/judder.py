@@ -91,8 +91,8 @@ class JudderModes:
 
     def __str__(self) -> str:
         op = self.operating_point
-        sliding = [f"{r.element} {r.mode} at {r.slip_rad_s:.4g} rad/s, d tau/d w_rel = {r.damping_Nms_rad:.4g} N m s/rad"
-                   for r in self.friction.itertuples()]
+        sliding = [f"{r.element} {r.mode} at {r.slip_rad_s:.4g} rad/s, d tau/d w_rel = {r.damping_Nms_rad:.4g} "
+                   "N m s/rad" for r in self.friction.itertuples()]
         lines = [f"{op.system.name} at t = {op.t:g} s: {len(self.table)} oscillating mode"
                  f"{'' if len(self.table) == 1 else 's'}{'; JUDDER (a mode grows)' if self.unstable else ''}"]
         for r in self.table.itertuples():
@@ -217,7 +217,8 @@ def judder_modes(system, op: OperatingPoint | None = None, *, run_to: float | No
         v = np.abs(vectors[:, k])
         pick = speeds if speeds else list(range(len(red.states)))
         weights = v[pick] if speeds else v[pick] / scale[pick]
-        rows.append({"frequency_Hz": float(lam.imag / (2 * math.pi)), "natural_frequency_Hz": float(mag / (2 * math.pi)),
+        rows.append({"frequency_Hz": float(lam.imag / (2 * math.pi)),
+                     "natural_frequency_Hz": float(mag / (2 * math.pi)),
                      "damping_1": float(-lam.real / mag), "growth_rate_1_s": float(lam.real),
                      "state": red.states[pick[int(np.argmax(weights))]].column, "unstable": bool(lam.real > 0.0)})
     table = pd.DataFrame(rows, columns=["frequency_Hz", "natural_frequency_Hz", "damping_1", "growth_rate_1_s",

@@ -33,8 +33,8 @@ from ..errors import ParameterError
 from ..system import System, evaluate
 from ..trim import OperatingPoint, input_scale, resolve, state_scale
 
-__all__ = ["jacobians", "reduced_matrices", "Reduced", "linearize", "nonlinear_iosystem", "frequency_table", "pole_sweep", "loop_margins",
-           "write_linear_model", "signal_name"]
+__all__ = ["jacobians", "reduced_matrices", "Reduced", "linearize", "nonlinear_iosystem", "frequency_table",
+           "pole_sweep", "loop_margins", "write_linear_model", "signal_name"]
 
 #: relative step of the central differences (about the cube root of the machine epsilon)
 FD_STEP = 6e-6
@@ -247,7 +247,9 @@ def linearize(system: System, op: OperatingPoint | None = None, inputs=None, out
     Raises
     ------
     ParameterError
-        Unknown names, a system without the requested inputs, an algebraic block that is singular.
+        Unknown names, a system without the requested inputs or without any (python-control cannot hold a model
+        with outputs and no inputs: :func:`reduced_matrices` and :func:`clutchlab.control.judder_modes` take one),
+        an algebraic block that is singular.
     """
     import control
 
