@@ -235,12 +235,30 @@ def test_a_timeline_along_the_example_launch(tmp_path, capsys):
     assert tl.growth_rate_1_s[3] == pytest.approx(single.table.growth_rate_1_s.max(), rel=1e-6)
     with pytest.raises(ParameterError, match=r"increasing"):
         judder_timeline(system, [0.3, 0.2])
-    out = tmp_path / "timeline.csv"
+    out, png = tmp_path / "timeline.csv", tmp_path / "timeline.png"
     assert main(["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
-                 "--run-to", "0.2 s", "--run-to", "0.5 s", "-o", str(out)]) == 0
+                 "--run-to", "0.2 s", "--run-to", "0.5 s", "-o", str(out), "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     table = pd.read_csv(out)
     assert list(table.time_s) == [0.2, 0.5] and table["clutch.damping_Nms_rad"][1] == pytest.approx(full, rel=1e-6)
     assert "clutch.damping_Nms_rad" in capsys.readouterr().out
     line = one_line_error(capsys, ["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
                                    "--run-to", "0.5 s", "--run-to", "0.2 s"])
     assert "must increase" in line
+    line = one_line_error(capsys, ["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
+                                   "--run-to", "0.5 s", "--plot", str(tmp_path / "one.png")])
+    assert "--plot draws a timeline" in line and not (tmp_path / "one.png").exists()
+
+
+def test_the_judder_figure_shades_where_a_mode_grows():
+    from clutchlab.control.plots import judder_figure
+
+    timeline = pd.DataFrame({"time_s": [0.0, 0.1, 0.2, 0.3], "frequency_Hz": [10.0, 10.5, 10.8, 3.5],
+                             "damping_1": [0.05, -0.01, -0.05, 0.1], "growth_rate_1_s": [-3.0, 0.7, 3.4, -2.2],
+                             "state": ["x.w_rad_s"] * 4, "unstable": [False, True, True, False],
+                             "c.damping_Nms_rad": [np.nan, -0.2, -0.35, np.nan]})
+    fig = judder_figure(timeline, title="t")
+    spans = [p for p in fig.axes[0].patches]
+    assert len(spans) == 2                                    # the two times a mode grows, shaded to the next
+    assert [line.get_label() for line in fig.axes[2].get_lines()][0] == "c"
+    np.testing.assert_allclose(fig.axes[0].get_lines()[0].get_ydata(), [5.0, -1.0, -5.0, 10.0])   # in percent

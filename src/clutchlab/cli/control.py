@@ -84,6 +84,9 @@ def register(subparsers) -> None:
                           "damped mode and the sliding elements' damping at each time)")
     jud.add_argument("-o", "--output", help="file to write: .json (modes, friction elements, verdict; a timeline's "
                                             "rows) or .csv (the modes; a timeline's rows)")
+    jud.add_argument("--plot", metavar="PNG", help="with --run-to repeated: also write the timeline's figure (damping "
+                                                   "ratio and frequency of the least damped mode, the sliding "
+                                                   "elements' damping; where a mode grows shaded)")
     jud.set_defaults(func=_judder)
     design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
                             description="Linearise the model at a steady state (one input, one output), design "
@@ -265,14 +268,15 @@ def _linearize(args) -> int:
 def _judder(args) -> int:
     import json
 
-    from ..io.files import atomic_to_csv, atomic_write_text, check_writable
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_bytes, atomic_write_text
     from ..units import to_si
     from ..control.judder import judder_modes, judder_timeline
 
-    if args.output is not None:
-        if not args.output.lower().endswith((".json", ".csv")):
-            raise ParameterError(f"-o {args.output}: expected a .json or .csv file")
-        check_writable(args.output, args.force)
+    if args.output is not None and not args.output.lower().endswith((".json", ".csv")):
+        raise ParameterError(f"-o {args.output}: expected a .json or .csv file")
+    if args.plot is not None and len(args.run_to) < 2:
+        raise ParameterError("--plot draws a timeline: give --run-to two or more times")
+    outputs = OutputSet([args.output, args.plot], args.force)   # checked before the run; written together
     if args.run_to:
         if any((args.at, args.set, args.hold, args.target, args.free, args.mode)):
             raise ParameterError("--run-to analyses the state a run reaches; drop the trim options "
@@ -283,12 +287,26 @@ def _judder(args) -> int:
             if any(b <= a for a, b in zip(times, times[1:])):
                 raise ParameterError(f"--run-to: a timeline's times must increase (got {', '.join(args.run_to)})")
             table = judder_timeline(system, times)
-            if args.output is not None:
-                if args.output.lower().endswith(".json"):
-                    atomic_write_text(args.output, json.dumps({"model": system.name, "timeline": table.to_dict(
-                        orient="records")}, indent=1), overwrite=args.force)
-                else:
-                    atomic_to_csv(table, args.output, overwrite=args.force)
+            png = None
+            if args.plot is not None:
+                import matplotlib.pyplot as plt
+
+                from ..control.plots import judder_figure
+
+                fig = judder_figure(table, title=f"{system.name}: judder along the run")
+                buf = io.BytesIO()
+                fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+                plt.close(fig)
+                png = buf.getvalue()
+            with outputs:
+                if args.output is not None and args.output.lower().endswith(".json"):
+                    atomic_write_text(outputs.staged(args.output), json.dumps(
+                        {"model": system.name, "timeline": table.to_dict(orient="records")}, indent=1),
+                        overwrite=args.force)
+                elif args.output is not None:
+                    atomic_to_csv(table, outputs.staged(args.output), overwrite=args.force)
+                if png is not None:
+                    atomic_write_bytes(outputs.staged(args.plot), png, overwrite=args.force)
             print(table.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
             return 0
         result = judder_modes(system, run_to=times[0])
@@ -297,11 +315,12 @@ def _judder(args) -> int:
         if len(points) != 1:
             raise ParameterError("judder analyses one operating point: give one --at")
         result = judder_modes(points[0][2])
-    if args.output is not None:
-        if args.output.lower().endswith(".json"):
-            atomic_write_text(args.output, json.dumps(result.to_dict(), indent=1), overwrite=args.force)
-        else:
-            atomic_to_csv(result.table, args.output, overwrite=args.force)
+    with outputs:
+        if args.output is not None and args.output.lower().endswith(".json"):
+            atomic_write_text(outputs.staged(args.output), json.dumps(result.to_dict(), indent=1),
+                              overwrite=args.force)
+        elif args.output is not None:
+            atomic_to_csv(result.table, outputs.staged(args.output), overwrite=args.force)
     print(result)
     return 0
 

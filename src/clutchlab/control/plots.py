@@ -17,7 +17,7 @@ def _column_unit(column: str) -> str:
     label = column_label(column)
     return label[label.index("[") + 1:-1] if "[" in label else "1"
 
-__all__ = ["bode_figure", "nyquist_figure", "pole_map_figure"]
+__all__ = ["bode_figure", "nyquist_figure", "pole_map_figure", "judder_figure"]
 
 
 def _fitted(label: str, fig, rows: int = 2, fontsize: float = 10.0) -> str:
@@ -171,4 +171,49 @@ def nyquist_figure(loops, frequencies_hz=None, *, title: str = "", radius: float
     legend_outside(ax)
     if title:
         ax.set_title(title)
+    return fig
+
+
+def judder_figure(timeline, *, title: str = ""):
+    """The judder analysis along a run (:func:`clutchlab.control.judder_timeline`): the least damped oscillating
+    mode's damping ratio and frequency over time, the times where it grows shaded, and each sliding friction
+    element's damping ``d tau/d w_rel`` (negative: it feeds the modes).
+
+    Parameters
+    ----------
+    timeline : pandas.DataFrame
+        From :func:`clutchlab.control.judder_timeline`.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = new_figure(3, 1, width=7.5, height=7.5, sharex=True)
+    t = timeline["time_s"].to_numpy(dtype=float)
+    unstable = timeline["unstable"].to_numpy(dtype=bool)
+    ax = axes[0]
+    ax.plot(t, 100.0 * timeline["damping_1"].to_numpy(dtype=float), "o-", ms=3, label="least damped mode")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_ylabel("damping ratio [%]")
+    axes[1].plot(t, timeline["frequency_Hz"].to_numpy(dtype=float), "o-", ms=3, color="C1")
+    axes[1].set_ylabel("its frequency [Hz]")
+    elements = [c for c in timeline.columns if c.endswith(".damping_Nms_rad")]
+    for k, column in enumerate(elements):
+        axes[2].plot(t, timeline[column].to_numpy(dtype=float), "o-", ms=3, color=f"C{k + 2}",
+                     label=column.removesuffix(".damping_Nms_rad"))
+    axes[2].axhline(0.0, color="k", lw=0.8)
+    axes[2].set_ylabel("d tau/d w_rel [N m s/rad]")
+    axes[2].set_xlabel("time [s]")
+    for a in axes:
+        a.grid(True, alpha=0.3)
+        for k in np.flatnonzero(unstable):   # (the span to the next analysis time, or half the spacing at the end)
+            right = t[k + 1] if k + 1 < t.size else t[k] + 0.5 * (t[k] - t[k - 1] if k else 1.0)
+            a.axvspan(t[k], right, color="C3", alpha=0.12, lw=0)
+    axes[0].legend(loc="best", fontsize=8, title="shaded: a mode grows (judder)", title_fontsize=8)
+    if elements:
+        axes[2].legend(loc="best", fontsize=8)
+    if title:
+        axes[0].set_title(title)
     return fig
