@@ -242,6 +242,11 @@ def test_a_timeline_along_the_example_launch(tmp_path, capsys):
     table = pd.read_csv(out)
     assert list(table.time_s) == [0.2, 0.5] and table["clutch.damping_Nms_rad"][1] == pytest.approx(full, rel=1e-6)
     assert "clutch.damping_Nms_rad" in capsys.readouterr().out
+    js = tmp_path / "timeline.json"   # (standard JSON: the clutch's damping while it is free is null, not NaN)
+    assert main(["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
+                 "--run-to", "0.05 s", "--run-to", "0.5 s", "-o", str(js)]) == 0
+    rows = json.loads(js.read_text(), parse_constant=lambda c: pytest.fail(f"{c} in the JSON"))["timeline"]
+    assert rows[0]["clutch.damping_Nms_rad"] is None and rows[1]["clutch.damping_Nms_rad"] == pytest.approx(full)
     line = one_line_error(capsys, ["control", "judder", "driveline", str(ROOT / "examples" / "driveline_judder.toml"),
                                    "--run-to", "0.5 s", "--run-to", "0.2 s"])
     assert "must increase" in line

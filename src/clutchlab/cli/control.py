@@ -300,9 +300,9 @@ def _judder(args) -> int:
                 png = buf.getvalue()
             with outputs:
                 if args.output is not None and args.output.lower().endswith(".json"):
+                    rows = table.astype(object).where(table.notna(), None).to_dict(orient="records")   # NaN: null
                     atomic_write_text(outputs.staged(args.output), json.dumps(
-                        {"model": system.name, "timeline": table.to_dict(orient="records")}, indent=1),
-                        overwrite=args.force)
+                        {"model": system.name, "timeline": rows}, indent=1, allow_nan=False), overwrite=args.force)
                 elif args.output is not None:
                     atomic_to_csv(table, outputs.staged(args.output), overwrite=args.force)
                 if png is not None:
