@@ -120,12 +120,16 @@ def _point(system, op, run_to, rtol) -> OperatingPoint:
     t = float(run_to)
     if not (math.isfinite(t) and t >= 0.0):
         raise ParameterError(f"{system.name}: run_to = {run_to!r} s must be a finite time >= 0")
-    sim = Simulation(system, rtol=rtol)
-    if t > 0.0:
+    return _reached(Simulation(system, rtol=rtol), t)
+
+
+def _reached(sim: Simulation, t: float) -> OperatingPoint:
+    """The operating point a run reaches at ``t`` (advanced there if it is earlier): its state, inputs and modes."""
+    if t > sim.time:
         sim.advance(t)   # (raises if the run fails)
-        if abs(sim.time - t) > 1e-9 * max(1.0, t):
-            raise ParameterError(f"{system.name}: the run ended at {sim.time:g} s, before run_to = {t:g} s")
-    return OperatingPoint(system, t, sim.x.copy(), sim.u.copy(), sim.m.copy())
+    if abs(sim.time - t) > 1e-9 * max(1.0, t):
+        raise ParameterError(f"{sim.system.name}: the run ended at {sim.time:g} s, before {t:g} s")
+    return OperatingPoint(sim.system, t, sim.x.copy(), sim.u.copy(), sim.m.copy())
 
 
 def friction_damping(op: OperatingPoint):
@@ -257,11 +261,7 @@ def judder_timeline(system: System, times, *, rtol: float | None = None):
     sim = Simulation(system, rtol=rtol)
     rows = []
     for t in ts:
-        if t > sim.time:
-            sim.advance(float(t))   # (raises if the run fails)
-        if abs(sim.time - t) > 1e-9 * max(1.0, t):
-            raise ParameterError(f"{system.name}: the run ended at {sim.time:g} s, before {t:g} s")
-        jm = judder_modes(OperatingPoint(system, float(t), sim.x.copy(), sim.u.copy(), sim.m.copy()))
+        jm = judder_modes(_reached(sim, float(t)))
         row = {"time_s": float(t), "frequency_Hz": math.nan, "damping_1": math.nan, "growth_rate_1_s": math.nan,
                "state": "", "unstable": jm.unstable}
         if len(jm.table):

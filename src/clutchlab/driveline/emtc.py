@@ -183,9 +183,9 @@ def _coupling(t, x, m, net, e, j):
     xs = b[B_X:B_X + N_STATE]
     us = b[B_U:B_U + N_IN]
     ep = block_row(e, j)
-    h = net.elem[e.conf[j][F_ROW], K.E_HEAT]
-    if h >= 0:   # its losses heat a thermal mass: its friction map is read at that mass's temperature
-        temp = x[int(net.thermal[h, K.T_STATE]) + K.TS_TEMP]
+    r = e.conf[j][F_ROW]
+    if net.elem[r, K.E_HEAT] >= 0:   # its losses heat a thermal mass: its friction map is read at that temperature
+        temp = K.heat_port_temperature(net, r, x, np.nan)
         if ep.fmem[S.FM_TEMP] != temp:
             ep.fmem[S.FM_TEMP] = temp
             ep.fmem[S.FM_KEY] = np.nan   # (its last evaluation, kept by its point, was at another temperature)

@@ -634,10 +634,7 @@ def working_point_shift(p, r, x):
     wear growing with the energy ``E`` [J] it dissipated (wear proportional to the friction work: Archard's law at a
     constant friction coefficient, ``k_w`` [m/J]) and its stack expanding ``e`` [m/K] with the temperature ``T``
     [degC] of the thermal mass its losses heat (``T_ref`` without one)."""
-    temp = p.coef[r, C_T_REF]
-    h = p.elem[r, E_HEAT]
-    if h >= 0:
-        temp = x[int(p.thermal[h, T_STATE]) + TS_TEMP]
+    temp = heat_port_temperature(p, r, x, p.coef[r, C_T_REF])
     wear = p.coef[r, C_WEAR0] + p.coef[r, C_WEAR_RATE] * max(x[2 * p.inertia.shape[0] + r], 0.0)
     return -wear + p.coef[r, C_EXPANSION] * (temp - p.coef[r, C_T_REF])
 
@@ -1311,6 +1308,16 @@ def temperatures(p):
     the friction laws that fade read (:func:`fade_factor`)."""
     o = _offsets(p)
     return p.work[o.temp:o.shift]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def heat_port_temperature(p, r, x, default):
+    """Temperature [degC] in the state ``x`` of the thermal mass element row ``r``'s losses heat (its heat port:
+    ``elem[r, E_HEAT]``), ``default`` where they heat none."""
+    h = p.elem[r, E_HEAT]
+    if h < 0:
+        return default
+    return x[int(p.thermal[h, T_STATE]) + TS_TEMP]
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
