@@ -225,6 +225,40 @@ def test_friction_map_in_bench(magnet):
     np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), _eq15(slip["fn1_N"].to_numpy(), mu, g), rtol=1e-9)
 
 
+def test_the_friction_map_is_read_at_the_input_temperature_with_that_source(magnet):
+    """BenchOptions(coupling_temperature="input"): the map is read at the held input coupling_temperature (a heat
+    port's, [2] Sec. 5), not at the scenario's temperature_c; the run equals a run at that scenario temperature."""
+    from clutchlab.emtc import FrictionMap
+    from clutchlab.emtc.system import BenchOptions, U_TEMP, bench_system
+    from clutchlab.system import simulate
+
+    g = CouplingGeometry()
+    fm = FrictionMap([0.0, 5.0, 50.0], [0.0, 100.0], [[0.10, 0.06], [0.08, 0.05], [0.06, 0.04]])
+    opts = dict(friction_map=fm, coupling=g)
+
+    def run(temperature_c, source, u_temp=None):
+        s = bench_system(magnet, BenchScenario(duration=0.4, speed_difference=0.3, temperature_c=temperature_c),
+                         options=BenchOptions(coupling_temperature=source, **opts))
+        if u_temp is not None:
+            u0 = s.u0.copy()
+            u0[U_TEMP] = u_temp
+            s = s.variant(u0=u0)
+        return simulate(s, 0.4, output_step=0.01).to_dataframe()
+
+    at_input = run(20.0, "input", u_temp=80.0)
+    np.testing.assert_array_equal(at_input["t1_Nm"], run(80.0, "parameter")["t1_Nm"])
+    at_parameter = run(20.0, "parameter", u_temp=80.0)   # (the input unread with the parameter source)
+    np.testing.assert_array_equal(at_parameter["t1_Nm"], run(20.0, "parameter")["t1_Nm"])
+    slip = at_input[(at_input["coupling_mode"] == "slipping") & (at_input["time_s"] > 0.1)]
+    assert len(slip) > 10
+    mu = np.array([fm(v, 80.0) for v in slip["slip_speed_rad_s"]])
+    np.testing.assert_allclose(slip[["t1_Nm", "t2_Nm", "t3_Nm"]].to_numpy(), _eq15(slip["fn1_N"].to_numpy(), mu, g),
+                               rtol=1e-9)
+    assert not np.allclose(slip["t1_Nm"], at_parameter.loc[slip.index, "t1_Nm"], rtol=0.1)
+    with pytest.raises(ParameterError, match="coupling_temperature = 'port'"):
+        BenchOptions(coupling_temperature="port")
+
+
 def test_lugre_in_bench_reaches_stribeck_steady_state(magnet):
     from clutchlab.emtc import LuGreParameters, lugre_steady_state
 

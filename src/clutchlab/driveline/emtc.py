@@ -37,7 +37,9 @@ The armature events (``armature_rest``, ``armature_contact``, ``armature_leave_r
 Its ports (:meth:`Driveline.emtc <clutchlab.driveline.network.Driveline.emtc>`: ``torque_request``, ``throttle``,
 ``coil_current``) are network signals, inputs included; :func:`hold` puts their values at the evaluation's time into
 the model's inputs (``torque_request``, ``throttle``, ``coil_current_command``), which the packed model reads as its
-drum-bench co-simulation does.
+drum-bench co-simulation does.  A coupling whose losses heat a thermal mass (``heat_from``) is packed with
+``temperature_source = TEMPERATURE_INPUT``, and :func:`_coupling` puts the mass's temperature into its input
+``coupling_temperature``: its friction map is read there, as the drum bench's is at an input temperature.
 
 States: per coupling its seven (:data:`clutchlab.emtc.system.STATES`; its two shaft speeds follow the flanges,
 integrated from their accelerations and reset to them at every event, its Torsen twist stays zero), after the
@@ -184,11 +186,9 @@ def _coupling(t, x, m, net, e, j):
     us = b[B_U:B_U + N_IN]
     ep = block_row(e, j)
     r = e.conf[j][F_ROW]
-    if net.elem[r, K.E_HEAT] >= 0:   # its losses heat a thermal mass: its friction map is read at that temperature
-        temp = K.heat_port_temperature(net, r, x, np.nan)
-        if ep.fmem[S.FM_TEMP] != temp:
-            ep.fmem[S.FM_TEMP] = temp
-            ep.fmem[S.FM_KEY] = np.nan   # (its last evaluation, kept by its point, was at another temperature)
+    if net.elem[r, K.E_HEAT] >= 0:   # its losses heat a thermal mass: the model's input coupling_temperature is
+        # that mass's temperature (its friction map is read there: packed with TEMPERATURE_INPUT, Driveline.emtc)
+        us[S.U_TEMP] = K.heat_port_temperature(net, r, x, ep.coupling.temperature_c)
     dispatch.rhs(t, xs, us, e.mbuf[j], ep, b[B_DX:B_DX + N_STATE], b[B_G:B_G + N_SWITCH])
     dispatch.outputs(t, xs, us, e.mbuf[j], ep, b[B_Y:N_BUF])   # (the same point: the model reuses it)
     cap = b[B_Y + _Y_CAP] if e.mbuf[j][_ARM] == _CONTACT else 0.0

@@ -1608,6 +1608,10 @@ class Driveline:
                     packed = packed._replace(reference_source=S.REFERENCE_CURRENT)
                 if ports["throttle"] is not None:         # the map's throttle read from the port (u), not a ramp
                     packed = packed._replace(throttle=np.zeros((2, 0)))
+                if any(el.name in tm.heat_from for tm in self._thermal.values()):
+                    # its losses heat a thermal mass: the friction map at that mass's temperature, the input
+                    # coupling_temperature its network writes (clutchlab.driveline.emtc._coupling)
+                    packed = packed._replace(temperature_source=S.TEMPERATURE_INPUT)
                 out.append((el, packed, magnet))
         return out
 

@@ -107,6 +107,9 @@ INPUTS = (
     ("drum_speed_rear", "m_s", "rear drum surface speed"),
     ("coil_current_command", "A", "coil current set point of the current drive (BenchOptions(coil_drive='current'): "
                                   "replaces the torque controller of Eqs. 6-7 and 31)"),
+    ("coupling_temperature", "degC", "temperature of the coupling's friction pack, at which its friction map is "
+                                     "read (BenchOptions(coupling_temperature='input'): a network's thermal mass "
+                                     "that its losses heat, Sec. 5; else the scenario's temperature_c)"),
 )
 #: switching functions and their crossing direction (the mode changes of [1] Fig. 11: falling through zero)
 SWITCHING = (
@@ -158,8 +161,9 @@ X_OMEGA_F, X_OMEGA_R = indices(STATES, "omega_f", "omega_r")
 ARM_REST, ARM_FREE, ARM_CONTACT = indices(MODE_VALUES[_M_ARM], "rest", "free", "contact")
 OPEN, SLIPPING, LOCKED = indices(MODE_VALUES[_M_CPL], "open", "slipping", "locked")
 NEGATIVE, POSITIVE = indices(MODE_VALUES[_M_DIR], "negative", "positive")
-U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR, U_COIL = indices(
-    INPUTS, "torque_request", "throttle", "drum_speed_front", "drum_speed_rear", "coil_current_command")
+U_TORQUE, U_THROTTLE, U_DRUM_FRONT, U_DRUM_REAR, U_COIL, U_TEMP = indices(
+    INPUTS, "torque_request", "throttle", "drum_speed_front", "drum_speed_rear", "coil_current_command",
+    "coupling_temperature")
 #: the friction laws of ``EmtcParams.friction_mode`` and the torque-reference sources of ``reference_source``
 #: (REFERENCE_CURRENT: the coil current from the input, no torque controller)
 FRICTION_MODES = ("constant", "map", "lugre")
@@ -167,6 +171,12 @@ REFERENCE_SOURCES = ("map", "table", "input", "current")
 FRICTION_CONSTANT, FRICTION_MAP, FRICTION_LUGRE = indices(FRICTION_MODES, "constant", "map", "lugre")
 REFERENCE_MAP, REFERENCE_TABLE, REFERENCE_INPUT, REFERENCE_CURRENT = indices(
     REFERENCE_SOURCES, "map", "table", "input", "current")
+#: where the friction map's temperature comes from (``EmtcParams.temperature_source``): the coupling's parameter
+#: ``temperature_c``, or the input ``coupling_temperature`` (a heat port: [2] Sec. 5, the coupling's heat)
+TEMPERATURE_SOURCES = ("parameter", "input")
+TEMPERATURE_PARAMETER, TEMPERATURE_INPUT = indices(TEMPERATURE_SOURCES, "parameter", "input")
+#: [degC] the range of the input coupling_temperature: the scenario's temperature_c's
+TEMPERATURE_RANGE = tuple({f.name: f for f in dataclasses.fields(BenchScenario)}["temperature_c"].metadata["bounds"])
 
 # model errors (negative codes of the hooks)
 ERR_PLANT_MEMORY, ERR_CONTROLLER_MEMORY = -1, -2
@@ -202,6 +212,8 @@ AUX = ("magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque"
     AUX, "magnet_force", "fn1", "t1", "t2", "t3", "coupling_torque", "lock_torque", "transmission_torque",
     "capacity_locked", "locked_case", "fn2", "engine_torque", "throttle")
 N_AUX = len(AUX)
+#: the point (t, x, modes, inputs) of an evaluation, as its key in the float memory (FMEM "key")
+KEY = slots(("time", 1), ("states", len(STATES)), ("modes", len(MODE_NAMES)), ("inputs", len(INPUTS)))
 #: per-run float memories and scratch (EmtcParams.fmem)
 FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torque_reference", 1), ("feasible", 1),
              ("z", 1), ("t_last", 1), ("dw_last", 1), ("dv_last", 1),
@@ -212,23 +224,22 @@ FMEM = slots(("plant_input", 1), ("controller_input", 1), ("command", 1), ("torq
              ("split", 6),                # element torques and capacities of the torque split
              ("derivative", len(STATES)), ("switching", len(SWITCHING)),     # scratch
              # the point (t, x, modes, inputs) of the last evaluation; NaN once a memory or mode may have changed
-             ("key", 1 + len(STATES) + len(MODE_NAMES) + len(INPUTS)),
+             ("key", KEY.total),
              ("last_derivative", len(STATES)), ("last_switching", len(SWITCHING)),   # of the last evaluation
              ("moving_weights", GAP_TABLES),      # airgap weights of the plant tables at the last evaluation, moving
              ("plant_segment", 9),        # the plant magnet's force as a quadratic in the coil current on the
              #                              stretch of the last evaluation (lo, hi, a0, a1, a2, kind:
              #                              hysteresis.kernels.peek_segment), the stack version (IM_PVER), last
              #                              input and airgap it is for
-             ("controller_segment", 8),   # the controller model's rising stretch (hysteresis.kernels.invert_combined)
-             # the temperature [degC] the friction map is read at when a network's thermal mass gives it (the mass
-             # the coupling's losses heat, clutchlab.driveline.emtc); NaN: the coupling's own temperature_c
-             ("heat_port_temperature", 1))
+             ("controller_segment", 8))   # the controller model's rising stretch (hysteresis.kernels.invert_combined)
 (FM_PU, FM_CU, FM_CMD, FM_TREF, FM_FEASIBLE, FM_Z, FM_TLAST, FM_DWLAST, FM_DVLAST, FM_GW, FM_CW, FM_ULAST, FM_AUX, FM_SPLIT,
- FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG, FM_TEMP) = FMEM.of(
+ FM_DX, FM_G, FM_KEY, FM_DXM, FM_GM, FM_FW, FM_SEG, FM_CSEG) = FMEM.of(
     "plant_input", "controller_input", "command", "torque_reference", "feasible", "z", "t_last", "dw_last",
     "dv_last", "plant_weights", "controller_weights", "inputs_at_restart", "aux", "split", "derivative", "switching", "key",
-    "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment",
-    "heat_port_temperature")
+    "last_derivative", "last_switching", "moving_weights", "plant_segment", "controller_segment")
+#: where the point's time, states, modes and inputs lie in the key (``fmem[FM_KEY:]``)
+KEY_X, KEY_M, KEY_U = KEY.of("states", "modes", "inputs")
+N_STATE_KEY, N_MODE_KEY, N_INPUT_KEY = len(STATES), len(MODE_NAMES), len(INPUTS)
 N_FMEM = FMEM.total
 #: controller log (one row per sample, for the per-sample view of simulate_bench)
 LOG_COLUMNS = ("command", "torque_reference", "throttle", "feasible")
@@ -347,6 +358,7 @@ class EmtcParams(NamedTuple):
     sample_time: float
     friction_mode: int
     reference_source: int
+    temperature_source: int
     n_airgaps: int
     n_cells: int
     n_ctl_cells: int
@@ -826,9 +838,9 @@ def _rhs(t, x, u, m, p, dx, g):
         # slide along zero until a step happened to end past it; see docs/emtc.md)
         sl = 1.0 if m[2] == POSITIVE else -1.0
         if p.friction_mode == FRICTION_MAP:
-            # at the coupling's temperature, or at its heat port's in a network (the paper's future work: the
-            # coupling's heat, Sec. 5; FM_TEMP is NaN without one)
-            temp = fmem[FM_TEMP] if fmem[FM_TEMP] == fmem[FM_TEMP] else c.temperature_c
+            # at the coupling's temperature, or at its heat port's (the input coupling_temperature: a network's
+            # thermal mass that the coupling's losses heat, the paper's future work, Sec. 5)
+            temp = u[U_TEMP] if p.temperature_source == TEMPERATURE_INPUT else c.temperature_c
             m1 = bilinear(_cold(p.cold, p.layout, L_FMAP_SPEED), _cold(p.cold, p.layout, L_FMAP_TEMP),
                           shaped(_cold(p.cold, p.layout, L_FMAP_MU), (p.n_fmap_speed, p.n_fmap_temp)), abs(dw), temp)
             m2 = m1
@@ -888,13 +900,13 @@ def _rhs(t, x, u, m, p, dx, g):
     dx[1] = (tc - a_r) * v.inv_inertia_rear  # [1], Eq. 27 (rows 2 and 4)
     _switching(x, m, a, c.unlock_margin, aux, grid, p.imem[IM_FALLING], g)
     fmem[FM_KEY] = t
-    for i in range(7):
-        fmem[FM_KEY + 1 + i] = x[i]
+    for i in range(N_STATE_KEY):
+        fmem[FM_KEY + KEY_X + i] = x[i]
         fmem[FM_DXM + i] = dx[i]
-    for i in range(3):
-        fmem[FM_KEY + 8 + i] = m[i]
-    for i in range(5):
-        fmem[FM_KEY + 11 + i] = u[i]
+    for i in range(N_MODE_KEY):
+        fmem[FM_KEY + KEY_M + i] = m[i]
+    for i in range(N_INPUT_KEY):
+        fmem[FM_KEY + KEY_U + i] = u[i]
     for k in range(N_SWITCH):
         fmem[FM_GM + k] = g[k]
 
@@ -915,14 +927,14 @@ def _same_point(t, x, u, m, fmem):
     """
     if not abs(fmem[FM_KEY] - t) <= 4e-15 * max(1.0, abs(t)):
         return False
-    for i in range(7):
-        if fmem[FM_KEY + 1 + i] != x[i]:
+    for i in range(N_STATE_KEY):
+        if fmem[FM_KEY + KEY_X + i] != x[i]:
             return False
-    for i in range(3):
-        if fmem[FM_KEY + 8 + i] != m[i]:
+    for i in range(N_MODE_KEY):
+        if fmem[FM_KEY + KEY_M + i] != m[i]:
             return False
-    for i in range(5):
-        if fmem[FM_KEY + 11 + i] != u[i]:
+    for i in range(N_INPUT_KEY):
+        if fmem[FM_KEY + KEY_U + i] != u[i]:
             return False
     return True
 
@@ -1082,6 +1094,7 @@ def params_template() -> EmtcParams:
     return EmtcParams(
         vehicle=record(VEHICLE_DTYPE), coupling=zeros(CouplingData), actuator=record(ACTUATOR_DTYPE),
         geometry=geometry, lugre=(0.0,) * 6, sample_time=0.0, friction_mode=0, reference_source=0,
+        temperature_source=0,
         n_airgaps=0, n_cells=0, n_ctl_cells=0, n_fmap_speed=0, n_fmap_temp=0, n_map_throttle=0, n_map_speed=0,
         layout=(0,) * (2 * N_LAYOUT), throttle=f2, plant_tables=f4, plant_grid=f1, plant_stack=f1.copy(),
         plant_prefix=f2.copy(), plant_comb=f4.copy(), controller_table=f4.copy(), imem=i1, fmem=f1.copy(),
@@ -1258,6 +1271,11 @@ class BenchOptions:
         ``"controller"``: the torque controller sets the coil current command at every sample (Eqs. 6-7,
         31); ``"current"``: the coil is driven at the held input ``coil_current_command`` [A] (a current
         amplifier on a test bench; trimming the coil at a current, a linear model from the command).
+    coupling_temperature : {"parameter", "input"}
+        Where the friction map's temperature comes from: ``"parameter"``, the scenario's ``temperature_c``;
+        ``"input"``, the held input ``coupling_temperature`` [degC] (a heat port: a network's thermal mass that
+        the coupling's losses heat, or a host's thermal model; [2] Sec. 5).  Without a friction map the
+        temperature is read by nothing.
     memory_capacity : int
         Entries of each hysteresis memory stack (a run whose memory fills up is repeated with four
         times the capacity by :func:`simulate` and :func:`~clutchlab.emtc.simulate_bench`).
@@ -1272,10 +1290,14 @@ class BenchOptions:
     torque_reference: object = None
     coil_drive: str = "controller"
     memory_capacity: int = 64
+    coupling_temperature: str = "parameter"
 
     def __post_init__(self):
         if self.coil_drive not in ("controller", "current"):
             raise ParameterError(f"coil_drive = {self.coil_drive!r}: expected 'controller' or 'current'")
+        if self.coupling_temperature not in TEMPERATURE_SOURCES:
+            raise ParameterError(f"coupling_temperature = {self.coupling_temperature!r}: expected "
+                                 f"{' or '.join(repr(q) for q in TEMPERATURE_SOURCES)}")
         if self.friction_map is not None and self.lugre is not None:
             raise ParameterError("give either friction_map or lugre, not both")
         if not (isinstance(self.memory_capacity, (int, np.integer)) and self.memory_capacity >= 4):
@@ -1450,7 +1472,6 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     fmem[FM_KEY] = np.nan
     fmem[FM_SEG:FM_SEG + 9] = np.nan
     fmem[FM_CSEG:FM_CSEG + 8] = np.nan
-    fmem[FM_TEMP] = np.nan   # (the coupling's temperature_c; a network's heat port writes its mass's)
     if not 1 <= scenario.gear <= len(vehicle.gear_ratios):
         raise ParameterError(f"BenchScenario: gear = {scenario.gear}: the vehicle has gears 1 to "
                              f"{len(vehicle.gear_ratios)} (VehicleParameters.gear_ratios)")
@@ -1478,6 +1499,7 @@ def _pack(magnet, scenario, vehicle, options, cosimulation, n_samples):
     return magnet, given_options, EmtcParams(
         vehicle=veh, coupling=cpl, actuator=act, geometry=tuple(geo), lugre=tuple(lugre),
         sample_time=float(scenario.sample_time), friction_mode=int(fmode), reference_source=int(ref_src),
+        temperature_source=int(TEMPERATURE_SOURCES.index(options.coupling_temperature)),
         n_airgaps=int(magnet.n_airgaps), n_cells=int(n), n_ctl_cells=int(nc),
         n_fmap_speed=int(np.shape(fmap[2])[0]), n_fmap_temp=int(np.shape(fmap[2])[1]),
         n_map_throttle=int(torque_map.torque.shape[0]), n_map_speed=int(torque_map.torque.shape[1]),
@@ -1541,7 +1563,7 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
     x0 = np.array([free_rolling_speed(vf, vehicle.tyre_radius, ic), free_rolling_speed(vr, vehicle.tyre_radius, ic),
                    0.0, 0.0, 0.0,
                    magnet.grid[0], magnet.grid[0]])
-    u0 = np.array([0.0, scenario.throttle_start, vf, vr, magnet.grid[0]])
+    u0 = np.array([0.0, scenario.throttle_start, vf, vr, magnet.grid[0], scenario.temperature_c])
     first_step = min(1e-4, scenario.sample_time)
     # the coil current command within the magnet's calibrated currents (the drive's current limit)
     current_range = (float(magnet.grid[0]), float(magnet.grid[-1]))
@@ -1551,7 +1573,8 @@ def bench_system(magnet=None, scenario=None, vehicle=None, options: BenchOptions
                           ATOL.copy(), switching=SWITCHING, events=EVENTS, mode_names=MODE_NAMES,
                           mode_values=MODE_VALUES, inputs=INPUTS, u0=u0, method="dopri", rtol=1e-6,
                           first_step=first_step, event_tol=1e-12, element_name=_element_name,
-                          error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range},
+                          error_messages=dict(ERROR_MESSAGES), limits={"coil_current_command": current_range,
+                                                               "coupling_temperature": TEMPERATURE_RANGE},
                           decided_at_start=DECIDED_AT_START)
         if len(_TEMPLATES) < 64:
             _TEMPLATES[(first_step, current_range)] = template

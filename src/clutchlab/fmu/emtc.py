@@ -173,12 +173,14 @@ class EmtcCoSimulation(ContractCoSimulation):
                             start_on_drums=True)
 
     def input_vector(self, inputs: dict) -> np.ndarray:
-        """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear, coil_current_command]`` from the
-        FMI ``inputs`` (the coil current command is unused: the FMU's coupling runs its torque controller)."""
+        """``u = [torque_request, throttle, drum_speed_front, drum_speed_rear, coil_current_command,
+        coupling_temperature]`` from the FMI ``inputs`` (the coil current command and the temperature are unused:
+        the FMU's coupling runs its torque controller, with the constant friction coefficients)."""
         thr = inputs["throttle"]
         if not 0.0 <= thr <= 1.0:
             raise ParameterError(f"input throttle = {thr!r}: must be within [0, 1]")
-        return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"], 0.0])
+        return np.array([inputs["torque_request"], thr, inputs["drum_speed_front"], inputs["drum_speed_rear"], 0.0,
+                         self._scenario.temperature_c])
 
     def output_sources(self) -> list:
         """The FMI outputs: outputs, states (by column) and modes of the ``emtc_bench`` system."""
@@ -215,7 +217,7 @@ class EmtcCoSimulation(ContractCoSimulation):
         A full memory replays the steps with a larger one."""
         while True:
             held = self.simulation.u
-            held[0], held[1], held[2], held[3], held[4] = uv
+            held[:] = uv
             try:
                 y = self.simulation.step(target)
                 break
@@ -283,7 +285,7 @@ class EmtcCoSimulation(ContractCoSimulation):
         torque, throttle, front, rear = u
         if (step_in_time(self.time, t, dt) and -_INF < torque < _INF
                 and 0.0 <= throttle <= 1.0 and -_INF < front < _INF and -_INF < rear < _INF):
-            uv = (torque, throttle, front, rear, 0.0)  # (as input_vector)
+            uv = (torque, throttle, front, rear, 0.0, self._scenario.temperature_c)  # (as input_vector)
         else:  # every check of do_step, in its order
             _check_time("EmtcCoSimulation", self.time, t, dt)
             uv = tuple(self.input_vector(self.resolve_inputs({v.name: x for v, x in zip(self.inputs, u)})).tolist())
