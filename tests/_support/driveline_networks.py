@@ -6,6 +6,8 @@ from hypothesis import assume
 from hypothesis import strategies as st
 
 from clutchlab.driveline import Driveline, Signal
+from clutchlab.emtc import FrictionMap
+from clutchlab.emtc.system import BenchOptions
 from clutchlab.errors import ParameterError
 
 
@@ -94,7 +96,10 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
     inertia turning.  ``with_components``: links may also be wet clutches (their force port a ramp, a constant, a
     sine, a pulse or the product of a network input and a ramp) and EMTC couplings (their default scenario and
-    controller, or a port: a torque request ramp, a throttle ramp, a coil current step or a network input), and at
+    controller, or a port: a torque request ramp, a throttle ramp, a coil current step or a network input;
+    sometimes with a friction map that fades with temperature and a thermal mass its losses heat, whose temperature
+    the map is read at) and E-clutches (seed 000, Model 0-4 static curves under a bearing ramp or sine; sometimes
+    worn, wearing and expanding with a thermal mass they heat: their working point shifts during the run), and at
     least one link is one of them.  ``settled_only``: none of the elements whose decisions at zero speed or at
     their limit are the open rounding-floor family of docs/driveline.md (lossy gears, bearing friction, brakes)."""
     n = draw(st.integers(2, 4))
@@ -107,8 +112,8 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
         a, b = f"J{i}", f"J{i + 1}"
         kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc"] + ([] if settled_only else ["lossy", "table"])
         if with_components:
-            kinds += ["wet", "emtc"]
-        kind = draw(st.sampled_from(["wet", "emtc"] if i == forced else kinds))
+            kinds += ["wet", "emtc", "eclutch"]
+        kind = draw(st.sampled_from(["wet", "emtc", "eclutch"] if i == forced else kinds))
         if kind == "wet":   # its force port: any signal within [0, 8 kN], or a network input (held at its start)
             top = draw(st.floats(300.0, 3000.0))
             force = draw(st.sampled_from([
@@ -129,7 +134,32 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
                      "input": {"torque_request": Signal.input(f"e{i}_request")}, "": {}}[port]
             if port == "input":
                 d.input(f"e{i}_request", unit="Nm", start=draw(st.floats(0.0, 200.0)))
-            d.emtc(f"e{i}", a, b, **ports)
+            heated = draw(st.booleans())
+            options = None
+            if heated:   # its friction map fades over 100 K, read at the temperature of the mass it heats
+                fade = draw(st.floats(0.5, 1.0))
+                options = BenchOptions(friction_map=FrictionMap(
+                    [0.0, 5.0, 50.0], [0.0, 150.0], [[0.11, 0.11 * fade], [0.10, 0.10 * fade], [0.09, 0.09 * fade]]))
+            d.emtc(f"e{i}", a, b, options=options, **ports)
+            if heated:
+                d.thermal_mass(f"h{i}", draw(st.floats(5.0, 500.0)), T0=draw(st.floats(20.0, 90.0)),
+                               conductance=draw(st.floats(0.0, 5.0)), heat_from=(f"e{i}",))
+        elif kind == "eclutch":   # the bearing released (8 mm) to engaged (0), or breathing about a point
+            stroke = draw(st.floats(1e-3, 8e-3))
+            position = draw(st.sampled_from([
+                Signal.ramp(-stroke, draw(st.floats(0.05, 0.4)), start=draw(st.floats(0.0, 0.2)), offset=stroke),
+                Signal.sine(0.5 * stroke, draw(st.floats(1.0, 6.0)), offset=draw(st.floats(0.5, 1.0)) * stroke),
+                Signal.constant(stroke)]))
+            model = draw(st.integers(0, 4))
+            shifted = model != 3 and draw(st.booleans())   # (Model 3 lifts off beyond 10 mm once worn)
+            if shifted:   # worn, wearing with its friction work and expanding with the mass it heats (Sec. 7, iii)
+                d.eclutch(f"x{i}", a, b, position, model=model, points=41, travel=10e-3, wear_max=4e-4,
+                          wear=draw(st.floats(0.0, 1e-4)), wear_rate=draw(st.sampled_from([0.0, 1e-9, 5e-8])),
+                          expansion=draw(st.sampled_from([0.0, 3.6e-7])))
+                d.thermal_mass(f"h{i}", draw(st.floats(50.0, 2000.0)), T0=draw(st.floats(20.0, 80.0)),
+                               conductance=draw(st.floats(0.0, 5.0)), heat_from=(f"x{i}",))
+            else:
+                d.eclutch(f"x{i}", a, b, position, model=model, points=41)
         elif kind == "spring":
             d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
         elif kind == "backlash":

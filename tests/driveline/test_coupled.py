@@ -264,12 +264,27 @@ def test_check_invariants_runs_in_a_network_with_components(scenarios, kind):
 @settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(networks(with_components=True))
 def test_invariants_hold_on_random_networks_with_components(d):
-    """Random chains of plain elements with wet clutches and EMTC couplings among their links (at least one): every
-    invariant holds at every accepted step (the compiled check) and in the samples (checked from the columns by code
-    independent of the kernel: energy balance, modes consistent with the relative speeds, one-way clutches)."""
+    """Random chains of plain elements with wet clutches, EMTC couplings and E-clutches among their links (at least
+    one; heated couplings whose maps fade, worn and expanding E-clutches): every invariant holds at every accepted
+    step (the compiled check) and in the samples (checked from the columns by code independent of the kernel: energy
+    balance, modes consistent with the relative speeds, one-way clutches, the thermal masses' heat balance)."""
     res = d.simulate(0.6, output_step=2e-3, rtol=1e-9, check_invariants=True)
     assert res.ok
-    _check_columns(d, res.to_dataframe(), res.events)
+    df = res.to_dataframe()
+    _check_columns(d, df, res.events)
+    _check_heat(d, df)
+
+
+def _check_heat(d, df):
+    """Each thermal mass (an EMTC coupling's whose friction map fades with it, a worn and expanding E-clutch's) holds
+    what its elements dissipated less what it gave its ambient, ``C (T - T0) + Q_out = sum of E_diss``, and no
+    element dissipates negative energy; from the columns, independent of the kernel."""
+    for tm in d._thermal.values():
+        heat = tm.capacity * (df[f"{tm.name}.temperature_C"] - tm.T0) + df[f"{tm.name}.heat_out_J"]
+        dissipated = sum(df[f"{name}.dissipated_J"] for name in tm.heat_from)
+        scale = 1.0 + float(np.abs(dissipated).max())
+        assert np.all(np.diff(dissipated) >= -1e-9 * scale), tm.name
+        np.testing.assert_allclose(heat, dissipated, rtol=0, atol=1e-7 * scale, err_msg=tm.name)
 
 
 # derandomised, as the plain networks' property (test_invariants), but at rtol 1e-8 and 1e-11: a wet clutch that
