@@ -376,7 +376,20 @@ def check_judder(work, out):
     assert "JUDDER" in out
 
 
+def check_shift(work, out):
+    import json
+
+    doc = json.loads((work / "shift.json").read_text())
+    m = doc["metrics"]
+    assert doc["order"] == "upshift" and doc["start_s"] < doc["handover_s"] < doc["lockup_s"]
+    assert 0.49 < doc["start_s"] < 0.52 and 0.9 < doc["lockup_s"] < 0.96           # c2 applied from 0.5 s
+    assert m["oncoming_energy_J"] > 1000.0 > 1.0 > m["offgoing_energy_J"]         # c1 slides for a few ms
+    assert m["acceleration_dip_m_s2"] > 0.5 and m["jerk_peak_m_s3"] > 10.0
+    assert "lock-up at" in out and _is_png(work / "shift.png")
+
+
 CHECKS = {
+    "shift.json": check_shift,
     "judder.json": check_judder,
     "awd.csv": check_awd,
     "lin.json": check_lin,

@@ -150,3 +150,22 @@ def test_warmup_group_compiles_what_the_section_runs():
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["warm"] > 0
     assert out["new"] == []
+
+
+def test_the_dual_clutch_upshift_shows_its_shift_quality(section):
+    """The DCT example's shift: its figure, and its metrics' table equal to shift_quality of a direct run."""
+    from clutchlab.control.shift import shift_quality
+    from clutchlab.demo.driveline import SHIFTS
+
+    names = {i.name for i in section.items if isinstance(i, Figure)}
+    assert "driveline_dct_upshift_shift" in names and "driveline_dct_upshift_speeds" in names
+    tables = {i.name: i.frame for i in section.items if isinstance(i, Table)}
+    shown = tables["driveline_dct_upshift_shift_quality"].set_index("metric")
+    spec = load_driveline(ROOT / "examples" / "driveline_dct_upshift.toml")
+    res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=spec.output_step)
+    q = shift_quality(res, **SHIFTS["dct_upshift.toml"])
+    for k, v in q.metrics.items():
+        assert shown.loc[k, "value"] == pytest.approx(v, rel=1e-9, nan_ok=True), k
+    assert shown.loc["jerk_peak_m_s3", "unit"] == "m_s3"
+    text = " ".join(i.text for i in section.items if hasattr(i, "text"))
+    assert f"the inertia phase {1e3 * q.metrics['inertia_phase_s']:.0f} ms" in text

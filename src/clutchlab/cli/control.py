@@ -1,4 +1,5 @@
-"""``clutchlab control trim|linearize|bode|judder|design MODEL ...``: a thin layer over :mod:`clutchlab.control`.
+"""``clutchlab control trim|linearize|bode|judder|design MODEL ...`` and ``clutchlab control shift SOURCE``: a thin
+layer over :mod:`clutchlab.control`.
 
 ``clutchlab control trim eclutch --at "4 mm" -o op.json``
     the steady state holding the release bearing at 4 mm (motor voltage solved for);
@@ -11,6 +12,9 @@
     the oscillating modes of the network in the mode its run is in at 0.3 s (frequency, damping ratio, growth
     rate) and the damping each sliding clutch adds to them: judder where a mode grows (``--run-to`` repeated:
     a timeline along the run);
+``clutchlab control shift examples/driveline_dct_upshift.toml --offgoing c1 --oncoming c2 --shaft wheels``
+    with ``--engine engine --radius "0.3 m" -o shift.json``: the phases and quality metrics of a clutch-to-clutch
+    shift in the network's run (or in a CSV record of a run or a rig);
 ``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
     with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
     "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
@@ -88,6 +92,39 @@ def register(subparsers) -> None:
                                                    "ratio and frequency of the least damped mode, the sliding "
                                                    "elements' damping; where a mode grows shaded)")
     jud.set_defaults(func=_judder)
+    shift = sub.add_parser("shift", help="shift quality of a clutch-to-clutch gear shift (a run or a rig's record)",
+                           description="The phases (torque phase, inertia phase) and the quality metrics of one "
+                                       "clutch-to-clutch shift: its times, the output's acceleration dip, jerk and "
+                                       "vibration dose value, the lock-up slip rate, the engine's flare and each "
+                                       "clutch's heat. SOURCE is a driveline (TOML: simulated with its [simulation] "
+                                       "settings) or a CSV of a run or a rig's record with the clutches' "
+                                       "<name>.tau_Nm and <name>.w_rel_rad_s, the output's speed and time_s at a "
+                                       "constant interval.",
+                           epilog="Documentation: docs/control.md (Shift quality)")
+    shift.add_argument("source", help="driveline description (.toml) or record (.csv)")
+    shift.add_argument("--offgoing", required=True, metavar="CLUTCH", help="the off-going clutch, e.g. c1")
+    shift.add_argument("--oncoming", required=True, metavar="CLUTCH", help="the on-coming clutch, e.g. c2")
+    shift.add_argument("--shaft", required=True, metavar="NAME",
+                       help="the output's speed (the output shaft's or the wheels'): an inertia (its <name>.w_rad_s) "
+                            "or a column, e.g. wheels")
+    shift.add_argument("--engine", default=None, metavar="NAME", help="the engine's speed, for its flare")
+    shift.add_argument("--radius", default=None,
+                       help="travel per radian of the output (tyre radius over the axle ratio behind it), e.g. "
+                            "'0.3 m': the acceleration in m/s^2 (default: the output's angular acceleration)")
+    shift.add_argument("--start", default=None, help="the shift's start, e.g. '0.5 s' (default: from the columns)")
+    shift.add_argument("--threshold", type=float, default=0.02,
+                       help="share of the largest torque and slip below which a clutch carries nothing or is "
+                            "locked (default 0.02)")
+    shift.add_argument("--settle", default="0.3 s", help="read the acceleration this long after the shift's end "
+                                                         "(default 0.3 s)")
+    shift.add_argument("--filter", default=None, help="low-pass the output's speed at this frequency before it is "
+                                                      "differentiated, for a rig's record, e.g. '20 Hz'")
+    shift.add_argument("-o", "--output", dest="write", default=None,
+                       help="file to write: .json (phases and metrics) or .csv (the metrics' table)")
+    shift.add_argument("--plot", metavar="PNG", help="also write the shift's figure: speeds, clutch torques, "
+                                                     "acceleration and jerk, its phases shaded")
+    shift.add_argument("--force", action="store_true", help="overwrite the files")
+    shift.set_defaults(func=_shift)
     design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
                             description="Linearise the model at a steady state (one input, one output), design "
                                         "the PI C(s) = Kp (1 + 1/(Ti s)) giving the phase margin at the crossover "
@@ -322,6 +359,63 @@ def _judder(args) -> int:
         elif args.output is not None:
             atomic_to_csv(result.table, outputs.staged(args.output), overwrite=args.force)
     print(result)
+    return 0
+
+
+def _shift(args) -> int:
+    """``control shift``: the phases and metrics of a clutch-to-clutch shift in a simulated network or a record."""
+    import json
+
+    from ..control.shift import shift_quality
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_bytes, atomic_write_text
+    from ..units import to_si
+
+    if args.write is not None and not args.write.lower().endswith((".json", ".csv")):
+        raise ParameterError(f"-o {args.write}: expected a .json or .csv file")
+    if args.plot is not None and not args.plot.lower().endswith(".png"):
+        raise ParameterError(f"--plot {args.plot}: expected a .png file")
+    outputs = OutputSet([args.write, args.plot], args.force)   # checked before the run; written together
+    options = dict(offgoing=args.offgoing, oncoming=args.oncoming, output=args.shaft, engine=args.engine,
+                   threshold=args.threshold, settle=to_si(args.settle, "s", name="--settle"),
+                   radius=None if args.radius is None else to_si(args.radius, "m", name="--radius"),
+                   start=None if args.start is None else to_si(args.start, "s", name="--start"),
+                   filter_Hz=None if args.filter is None else to_si(args.filter, "Hz", name="--filter"))
+    if args.source.lower().endswith(".toml"):
+        from ..driveline.description import load_driveline
+
+        spec = load_driveline(args.source)
+        if spec.t_end is None or spec.output_step is None:
+            raise ParameterError(f"{args.source}: shift quality needs [simulation] t_end and output_step (samples at "
+                                 "a constant interval)")
+        source = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step,
+                                         output_step=spec.output_step)
+    elif args.source.lower().endswith(".csv"):
+        source = args.source
+    else:
+        raise ParameterError(f"{args.source}: expected a driveline description (.toml) or a record (.csv)")
+    q = shift_quality(source, **options)
+    png = None
+    if args.plot is not None:
+        import matplotlib.pyplot as plt
+
+        from ..control.plots import shift_figure
+
+        from pathlib import Path
+
+        fig = shift_figure(q, title=f"{Path(args.source).name}: {q.order}, {args.offgoing} to {args.oncoming}")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+        plt.close(fig)
+        png = buf.getvalue()
+    with outputs:
+        if png is not None:
+            atomic_write_bytes(outputs.staged(args.plot), png, overwrite=args.force)
+        if args.write is not None and args.write.lower().endswith(".json"):
+            atomic_write_text(outputs.staged(args.write), json.dumps(q.to_dict(), indent=1, allow_nan=False),
+                              overwrite=args.force)
+        elif args.write is not None:
+            atomic_to_csv(q.table(), outputs.staged(args.write), overwrite=args.force)
+    print(q)
     return 0
 
 

@@ -13,6 +13,8 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   active mode, the damping a sliding clutch adds to them (negative where its friction falls with the slip speed),
   and the oscillation in a band of a run or a measurement;
   :func:`loop_margins` -- gain, phase and stability margins of loops, checked by the Nyquist criterion;
+* :func:`shift_quality` -- the phases and quality metrics of a clutch-to-clutch gear shift (times, acceleration
+  dip, jerk, vibration dose value, lock-up slip rate, engine flare, the clutches' heat) in a run or a rig's record;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
 * :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling;
 * :func:`time_steps`, :func:`fixed_step_error` -- fixed-step (HIL frame) runs: wall time per frame and
@@ -29,7 +31,8 @@ import importlib
 __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem", "jacobians", "frequency_table", "pole_sweep",
            "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
            "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes",
-           "judder_timeline", "friction_damping", "oscillation", "Oscillation", "reduced_matrices"]
+           "judder_timeline", "friction_damping", "oscillation", "Oscillation", "reduced_matrices", "shift_quality",
+           "ShiftQuality"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.trim",
@@ -49,6 +52,8 @@ _WHERE = {
     "friction_damping": "clutchlab.control.judder",
     "oscillation": "clutchlab.control.judder",
     "Oscillation": "clutchlab.control.judder",
+    "shift_quality": "clutchlab.control.shift",
+    "ShiftQuality": "clutchlab.control.shift",
     "closed_loop": "clutchlab.control.loop",
     "ClosedLoopResult": "clutchlab.control.loop",
     "PI": "clutchlab.control.design",

@@ -17,7 +17,7 @@ def _column_unit(column: str) -> str:
     label = column_label(column)
     return label[label.index("[") + 1:-1] if "[" in label else "1"
 
-__all__ = ["bode_figure", "nyquist_figure", "pole_map_figure", "judder_figure"]
+__all__ = ["bode_figure", "nyquist_figure", "pole_map_figure", "judder_figure", "shift_figure"]
 
 
 def _fitted(label: str, fig, rows: int = 2, fontsize: float = 10.0) -> str:
@@ -214,6 +214,68 @@ def judder_figure(timeline, *, title: str = ""):
     axes[0].legend(loc="best", fontsize=8, title="shaded: a mode grows (judder)", title_fontsize=8)
     if elements:
         axes[2].legend(loc="best", fontsize=8)
+    if title:
+        axes[0].set_title(title)
+    return fig
+
+
+def shift_figure(quality, *, title: str = ""):
+    """A clutch-to-clutch shift and its phases (:func:`clutchlab.control.shift_quality`): the engine's speed and the
+    clutches' slip speeds [rpm], their torques, the output's acceleration (its level before the shift and its dip
+    marked) and its jerk, with the torque phase and the inertia phase shaded and the shift's end, the hand-over and
+    the lock-up marked.
+
+    Parameters
+    ----------
+    quality : ShiftQuality
+        From :func:`clutchlab.control.shift_quality` (its ``trace``).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    q = quality
+    tr = q.trace
+    t = tr["time_s"].to_numpy(dtype=float)
+    span = max(q.end_s - q.start_s, 0.05)   # (drawn: a quarter of the shift before it, half of it after)
+    keep = (t >= q.start_s - 0.25 * span) & (t <= q.end_s + 0.5 * span)
+    t = t[keep]
+    acc = next(c for c in tr.columns if c.startswith("acceleration_"))
+    jerk = next(c for c in tr.columns if c.startswith("jerk_"))
+    a_unit, j_unit = acc.removeprefix("acceleration_"), jerk.removeprefix("jerk_")
+    pretty = {"m_s2": "m/s²", "rad_s2": "rad/s²", "m_s3": "m/s³", "rad_s3": "rad/s³"}
+    rpm = 30.0 / np.pi
+    fig, axes = new_figure(4, 1, width=7.5, height=9.0, sharex=True)
+    off, on = q.columns["offgoing"], q.columns["oncoming"]
+    if "engine_speed_rad_s" in tr.columns:
+        axes[0].plot(t, rpm * tr["engine_speed_rad_s"].to_numpy(float)[keep], color="k", label="engine")
+    axes[0].plot(t, rpm * tr["offgoing_slip_rad_s"].to_numpy(float)[keep], color="C0", label=f"{off} slip (off-going)")
+    axes[0].plot(t, rpm * tr["oncoming_slip_rad_s"].to_numpy(float)[keep], color="C1", label=f"{on} slip (on-coming)")
+    axes[0].set_ylabel("speed [rpm]")
+    axes[1].plot(t, tr["offgoing_torque_Nm"].to_numpy(float)[keep], color="C0", label=off)
+    axes[1].plot(t, tr["oncoming_torque_Nm"].to_numpy(float)[keep], color="C1", label=on)
+    axes[1].set_ylabel("|clutch torque| [N m]")
+    before = q.metrics[f"acceleration_before_{a_unit}"]
+    dip = q.metrics[f"acceleration_dip_{a_unit}"]
+    axes[2].plot(t, tr[acc].to_numpy(float)[keep], color="C2", label="acceleration")
+    axes[2].axhline(before, color="0.4", lw=0.8, ls="--", label="before the shift")
+    axes[2].axhline(before - dip, color="C3", lw=0.8, ls=":", label=f"dip {dip:.3g} {pretty.get(a_unit, a_unit)}")
+    axes[2].set_ylabel(f"acceleration [{pretty.get(a_unit, a_unit)}]")
+    axes[3].plot(t, tr[jerk].to_numpy(float)[keep], color="C4")
+    axes[3].set_ylabel(f"jerk [{pretty.get(j_unit, j_unit)}]")
+    axes[3].set_xlabel("time [s]")
+    first, second = ((q.start_s, q.handover_s), (q.handover_s, q.lockup_s)) if q.order == "upshift" else (
+        (q.lockup_s, q.handover_s), (q.start_s, q.lockup_s))
+    for a in axes:
+        a.grid(True, alpha=0.3)
+        a.axvspan(*first, color="C0", alpha=0.10, lw=0)
+        a.axvspan(*second, color="C1", alpha=0.10, lw=0)
+    for a in axes[:3]:
+        legend_outside(a)
+    axes[3].text(1.02, 0.5, "shaded:\ntorque phase (blue),\ninertia phase (orange)", transform=axes[3].transAxes,
+                 fontsize=8, va="center")
     if title:
         axes[0].set_title(title)
     return fig

@@ -20,11 +20,15 @@ import pandas as pd
 
 from ..report import Figure, Section, Table, Text
 
-__all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_example", "mode_intervals",
+__all__ = ["EXAMPLES", "SHIFTS", "PROVENANCE", "demo_section", "example_items", "run_example", "mode_intervals",
            "header_comment"]
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
-EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml")
+EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml")
+
+#: examples that are a clutch-to-clutch shift: file -> the arguments of :func:`clutchlab.control.shift_quality` (the
+#: section adds the shift's figure and its metrics)
+SHIFTS = {"dct_upshift.toml": dict(offgoing="c1", oncoming="c2", output="wheels", engine="engine", radius=0.3)}
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "
@@ -234,10 +238,37 @@ def example_items(name: str, progress=None) -> tuple:
              f"dissipated): the integrator's error at rtol = {spec.rtol:g}, not a modelling error (the energy "
              f"states are integrated with the motion)."),
     ]
+    if name in SHIFTS:
+        items += _shift_items(stem, d.name, result, SHIFTS[name])
     params = _network_parameters(stem, d)
     step = "every accepted step" if spec.output_step is None else f"{spec.output_step:g} s"
     params[f"{stem}: simulation"] = f"t_end = {spec.t_end:g} s, output step {step}, rtol = {spec.rtol:g}"
     return items, params, run
+
+
+def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
+    """The shift quality of an example that is a clutch-to-clutch shift: its figure, metrics and a text."""
+    from ..control.plots import shift_figure
+    from ..control.shift import shift_quality
+
+    q = shift_quality(result, **arguments)
+    m = q.metrics
+    return [
+        Figure(f"driveline_{stem}_shift", shift_figure(q, title=f"{name}: shift quality"),
+               f"The {q.order} from {arguments['offgoing']} to {arguments['oncoming']}: the engine's speed and the "
+               "clutches' slips, their torques, the vehicle's acceleration (its level before the shift and its dip "
+               "marked) and jerk; the torque phase (the on-coming clutch takes the engine's torque) and the inertia "
+               "phase (it pulls the engine down to the new gear's speed) shaded."),
+        Table(f"driveline_{stem}_shift_quality", q.table()[["metric", "value", "unit", "description"]],
+              f"Shift quality of {name!r} (clutchlab.control.shift_quality, from the run's columns)",
+              float_format="{:.4g}"),
+        Text(f"Shift quality (docs/control.md, \"Shift quality\"): the torque phase lasts "
+             f"{1e3 * m['torque_phase_s']:.0f} ms and the inertia phase {1e3 * m['inertia_phase_s']:.0f} ms; the "
+             f"vehicle's acceleration dips by {m['acceleration_dip_m_s2']:.2f} m/s^2 from "
+             f"{m['acceleration_before_m_s2']:.2f} m/s^2, the jerk peaks at {m['jerk_peak_m_s3']:.0f} m/s^3 where "
+             f"the on-coming clutch locks (its slip falling at {m['lockup_slip_rate_rad_s2']:.0f} rad/s^2) and the "
+             f"half shafts ring, and the on-coming clutch takes {m['oncoming_energy_J'] / 1e3:.1f} kJ."),
+    ]
 
 
 def demo_section(progress=None) -> Section:

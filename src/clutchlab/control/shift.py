@@ -1,0 +1,319 @@
+"""Shift quality: the phases and the metrics of a clutch-to-clutch gear shift (a dual-clutch or planetary automatic
+transmission's power shift), from a run or from a rig's record.
+
+A power upshift hands the drive from the off-going clutch to the on-coming one in two phases:
+
+* the **torque phase**: the on-coming clutch, slipping, takes up the torque while the off-going one, still stuck,
+  lets go of it; the engine keeps its speed and the output torque sags towards the higher gear's (the torque
+  hole);
+* the **inertia phase**: the off-going clutch carries nothing, the on-coming one slides and pulls the engine
+  down to the new gear's speed; it ends when the on-coming clutch locks, and the step of its friction torque
+  there (the slip's rate at lock-up times the inertia it stops) is the lock-up shock.
+
+A power-on downshift runs the phases the other way round (the off-going clutch slips first so the engine can
+speed up, then the on-coming one takes the torque).  The seeds do not treat shifts; the metrics are the ones shift
+calibration uses (the vehicle's longitudinal acceleration, its jerk and vibration dose value, the phases' times,
+the engine's flare and the clutches' heat), each defined below from sampled columns only, so a simulated run and a
+rig's record are measured by the same code (docs/control.md, "Shift quality").
+
+* :func:`shift_quality` -- the phases and metrics of one shift: :class:`ShiftQuality`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["ShiftQuality", "shift_quality", "METRICS"]
+
+#: the metrics of :class:`ShiftQuality` (name, unit, description); ``{a}`` is the unit of the acceleration
+#: (``m_s2`` with a radius, else ``rad_s2``), ``{j}`` of the jerk, ``{v}`` of the vibration dose value
+METRICS = (
+    ("shift_time_s", "s", "from the shift's start to its end (the later of the hand-over and the lock-up)"),
+    ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (upshift), from the "
+                            "lock-up to the hand-over (downshift)"),
+    ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (upshift), from "
+                             "the start to the lock-up (downshift)"),
+    ("acceleration_before_{a}", "{a}", "the output's acceleration at the start (mean over the pre-window)"),
+    ("acceleration_dip_{a}", "{a}", "the torque hole: the acceleration at the start less its least value during "
+                                    "the shift"),
+    ("acceleration_peak_to_peak_{a}", "{a}", "the largest less the least acceleration from the start to the end of "
+                                             "the settling window"),
+    ("jerk_peak_{j}", "{j}", "the largest |d a/dt| from the start to the end of the settling window"),
+    ("vdv_{v}", "{v}", "vibration dose value of the acceleration's change from its value at the start, "
+                       "(integral of (a - a_before)^4 dt)^(1/4) over the shift and the settling window "
+                       "(ISO 2631-1's form, without its frequency weighting)"),
+    ("lockup_slip_rate_rad_s2", "rad_s2", "|d w_rel / dt| of the on-coming clutch over the last sample interval "
+                                          "in which it slides before it locks (the lock-up shock's cause)"),
+    ("engine_flare_rad_s", "rad_s", "the engine's (input's) largest speed during the shift less its speed at the "
+                                    "start (NaN without an engine column)"),
+    ("offgoing_energy_J", "J", "heat of the off-going clutch during the shift, integral of |tau w_rel| dt"),
+    ("oncoming_energy_J", "J", "heat of the on-coming clutch during the shift, integral of |tau w_rel| dt"),
+    ("offgoing_peak_power_W", "W", "largest |tau w_rel| of the off-going clutch during the shift"),
+    ("oncoming_peak_power_W", "W", "largest |tau w_rel| of the on-coming clutch during the shift"),
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class ShiftQuality:
+    """The phases and metrics of one shift (:func:`shift_quality`).
+
+    Attributes
+    ----------
+    start_s, handover_s, lockup_s, end_s : float
+        The shift's start, the off-going clutch's hand-over (its torque below the threshold), the on-coming
+        clutch's lock-up (its slip within the threshold from there to the end of the record) and the end
+        (the later of the two) [s].
+    order : str
+        ``"upshift"`` (torque phase, then inertia phase: the hand-over before the lock-up) or ``"downshift"``
+        (inertia phase first).
+    metrics : dict
+        Name (with its unit's suffix, :data:`METRICS`) -> value.
+    columns : dict
+        The columns read: ``output``, ``offgoing``, ``oncoming``, ``engine``.
+    trace : pandas.DataFrame
+        The samples the metrics were read from: ``time_s``, the acceleration and the jerk (their units' suffixes
+        as the metrics'), the two clutches' ``|tau|`` [N m], ``|w_rel|`` [rad/s] and ``|tau w_rel|`` [W], and
+        the engine's speed where there is one (:func:`clutchlab.control.plots.shift_figure` draws them).
+    """
+
+    start_s: float
+    handover_s: float
+    lockup_s: float
+    end_s: float
+    order: str
+    metrics: dict
+    columns: dict
+    trace: object = dataclasses.field(default=None, repr=False, compare=False)
+
+    def to_dict(self) -> dict:
+        """Everything as plain numbers and strings (JSON; NaN as None)."""
+        def plain(v):
+            return None if isinstance(v, float) and not math.isfinite(v) else v
+
+        return {"start_s": self.start_s, "handover_s": self.handover_s, "lockup_s": self.lockup_s,
+                "end_s": self.end_s, "order": self.order, "columns": dict(self.columns),
+                "metrics": {k: plain(float(v)) for k, v in self.metrics.items()}}
+
+    def table(self):
+        """The metrics as a DataFrame: ``metric``, ``value``, ``unit``, ``description``."""
+        import pandas as pd
+
+        units, docs = self._described()
+        return pd.DataFrame({"metric": list(self.metrics), "value": [float(v) for v in self.metrics.values()],
+                             "unit": [units[k] for k in self.metrics], "description": [docs[k] for k in self.metrics]})
+
+    def _described(self):
+        a = "m_s2" if "acceleration_dip_m_s2" in self.metrics else "rad_s2"
+        j, v = ("m_s3", "m_s1_75") if a == "m_s2" else ("rad_s3", "rad_s1_75")
+        units, docs = {}, {}
+        for name, unit, doc in METRICS:
+            key = name.format(a=a, j=j, v=v)
+            units[key], docs[key] = unit.format(a=a, j=j, v=v), doc
+        return units, docs
+
+    def __str__(self) -> str:
+        units, _ = self._described()
+        head = (f"{self.order} from {self.start_s:.4f} s: hand-over at {self.handover_s:.4f} s, lock-up at "
+                f"{self.lockup_s:.4f} s")
+        rows = [f"  {k:<34s} {v:>12.5g} {units[k]}" for k, v in self.metrics.items()]
+        return "\n".join([head, *rows])
+
+
+def _trapezoid(y, x) -> float:
+    """The trapezoid rule's integral of samples ``y`` over ``x`` (0 for fewer than two)."""
+    return float(np.sum((y[1:] + y[:-1]) * np.diff(x)) / 2.0) if len(x) > 1 else 0.0
+
+
+def _column(frame, name: str, suffix: str, what: str, label: str) -> str:
+    """The column of ``name``: itself if it is one, else ``<name>.<suffix>`` (``label``: the source, for the
+    message)."""
+    if name in frame.columns:
+        return name
+    col = f"{name}.{suffix}"
+    if col not in frame.columns:
+        raise ParameterError(f"{label}: {what} {name!r}: no column {name!r} or {col!r} (columns: "
+                             f"{', '.join(map(str, frame.columns))})")
+    return col
+
+
+def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: str | None = None,
+                  radius: float | None = None, start: float | None = None, threshold: float = 0.02,
+                  settle: float = 0.3, pre: float = 0.05, filter_Hz: float | None = None) -> ShiftQuality:
+    """The phases and the quality metrics of one clutch-to-clutch shift in a run or a rig's record.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame, SimulationResult or str
+        Samples with ``time_s`` at a constant interval: a run (its ``to_dataframe()``), or a CSV file of a run or
+        a rig's record (any dialect :func:`clutchlab.io.files.read_table` reads) with the columns below.
+    offgoing, oncoming : str
+        The two clutches: their columns ``<name>.tau_Nm`` (friction torque [N m]) and ``<name>.w_rel_rad_s``
+        (slip speed [rad/s]) are read.
+    output : str
+        The output shaft's (or the vehicle's) speed: a column, or an inertia whose ``<name>.w_rad_s`` is read.
+    engine : str, optional
+        The engine's (the transmission input's) speed, for the flare: a column or an inertia.
+    radius : float, optional
+        [m] the vehicle's travel per radian of ``output`` (the tyre's rolling radius over the axle ratio behind
+        it): the acceleration in m/s^2, the jerk in m/s^3; without it, the output's angular acceleration.
+    start : float, optional
+        [s] the shift's start; default: the first sample at which the on-coming clutch carries more than
+        ``threshold`` of the largest torque of the two clutches, or the off-going clutch, stuck before, slides
+        by more than ``threshold`` of the largest slip of the two, whichever comes first.
+    threshold : float
+        Fraction (0, 0.5) of the largest torque, and of the largest slip, below which a clutch counts as carrying
+        nothing, and as locked.
+    settle : float
+        [s] the acceleration, jerk and dose value are read up to this long after the shift's end (the lock-up
+        shock rings in the driveline's first mode).
+    pre : float
+        [s] the acceleration before the shift is the mean over this long before its start.
+    filter_Hz : float, optional
+        A rig's acceleration is noisy: the output's speed is low-pass filtered at this frequency (fourth-order
+        Butterworth, forwards and backwards: no phase shift) before it is differentiated.  None: no filter (a
+        simulated run).
+
+    Returns
+    -------
+    ShiftQuality
+
+    Notes
+    -----
+    The acceleration is the output speed's central difference (``numpy.gradient``, second order), times
+    ``radius``; the jerk the acceleration's.  The energies and peak powers integrate ``|tau w_rel|`` of the two
+    clutches by the trapezoid rule over ``[start, end]``, which equals the clutch's dissipated energy to the
+    sampling's error.  The phases are found from the columns alone (no events), as on a rig: the hand-over is the
+    first sample from the start on at which the off-going clutch carries at most the threshold, the lock-up the
+    first sample from which the on-coming clutch's slip stays within the threshold to the end of the record: each
+    is off its instant (the start late, the hand-over and the lock-up early) by at most the threshold's share of
+    its ramp (the threshold times the largest slip over the slip's rate at lock-up, for the lock-up) plus one
+    sample.  A simulated run's columns are exact: a smaller threshold (``1e-4``) puts the instants on the events.
+    The acceleration, jerk and dose value are read to the end of the settling window or of the record,
+    whichever comes first.
+    """
+    from ..io.files import read_table
+
+    if hasattr(frame, "to_dataframe"):
+        frame = frame.to_dataframe()
+    label = "shift_quality" if hasattr(frame, "columns") else str(frame)   # (a file: its path in the messages)
+    head = frame if hasattr(frame, "columns") else read_table(frame, ["time_s"], name=label)
+    cols = {"output": _column(head, output, "w_rad_s", "output", label),
+            "offgoing": offgoing, "oncoming": oncoming,
+            "engine": None if engine is None else _column(head, engine, "w_rad_s", "engine", label)}
+    need = ["time_s", cols["output"]] + [f"{c}.{q}" for c in (offgoing, oncoming) for q in ("tau_Nm", "w_rel_rad_s")]
+    need += [cols["engine"]] if cols["engine"] else []
+    for c in need:
+        if c not in head.columns:
+            raise ParameterError(f"{label}: no column {c!r} (columns: {', '.join(map(str, head.columns))})")
+    df = read_table(head, need, name=label)
+    if not 0.0 < threshold < 0.5:
+        raise ParameterError(f"shift_quality: threshold = {threshold!r} must lie in (0, 0.5)")
+    for name, value in (("settle", settle), ("pre", pre)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
+            raise ParameterError(f"shift_quality: {name} = {value!r} s must be finite and >= 0")
+    if radius is not None and not (math.isfinite(radius) and radius > 0.0):
+        raise ParameterError(f"shift_quality: radius = {radius!r} m must be finite and > 0")
+    t = df["time_s"].to_numpy(float)
+    if t.size < 8:
+        raise ParameterError(f"shift_quality: needs at least 8 samples (got {t.size})")
+    dt = np.diff(t)
+    h = float(np.median(dt))
+    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
+        raise ParameterError(f"shift_quality: time_s must be sampled at a constant interval (from {dt.min():g} to "
+                             f"{dt.max():g} s); resample it first")
+    tau_off, tau_on = (np.abs(df[f"{c}.tau_Nm"].to_numpy(float)) for c in (offgoing, oncoming))
+    w_off, w_on = (np.abs(df[f"{c}.w_rel_rad_s"].to_numpy(float)) for c in (offgoing, oncoming))
+    t_ref = max(tau_off.max(), tau_on.max())
+    w_ref = max(w_off.max(), w_on.max())
+    if not t_ref > 0.0:
+        raise ParameterError(f"shift_quality: neither {offgoing} nor {oncoming} carries any torque")
+    t_thr, w_thr = threshold * t_ref, threshold * w_ref
+
+    def first(mask, frm=0, what=""):
+        idx = np.flatnonzero(mask[frm:])
+        if idx.size == 0:
+            raise ParameterError(f"shift_quality: {what} within the record (to {t[-1]:g} s)")
+        return frm + int(idx[0])
+
+    if start is None:
+        i_on = first(tau_on > t_thr, what=f"{oncoming} never carries more than {threshold:g} of the largest torque")
+        stuck = np.flatnonzero(w_off <= w_thr)
+        i_slip = len(t)
+        if stuck.size:
+            slid = np.flatnonzero(w_off[stuck[0]:] > w_thr)
+            i_slip = stuck[0] + int(slid[0]) if slid.size else len(t)
+        i0 = min(i_on, i_slip)
+    else:
+        if not (isinstance(start, (int, float)) and t[0] <= start < t[-1]):
+            raise ParameterError(f"shift_quality: start = {start!r} s is outside the record [{t[0]:g}, {t[-1]:g}] s")
+        i0 = int(np.searchsorted(t, start - 1e-12 * max(1.0, abs(start))))
+    i_hand = first(tau_off <= t_thr, i0, f"{offgoing} never lets go of its torque after {t[i0]:g} s")
+    moving = np.flatnonzero(w_on > w_thr)
+    i_lock = int(moving[-1]) + 1 if moving.size else 0
+    if i_lock >= len(t):
+        raise ParameterError(f"shift_quality: {oncoming} does not lock within the record (its slip is "
+                             f"{w_on[-1]:g} rad/s at {t[-1]:g} s)")
+    i_lock = max(i_lock, i0)
+    i_end = max(i_hand, i_lock)
+    upshift = i_hand <= i_lock
+    ts, th, tl, te = t[i0], t[i_hand], t[i_lock], t[i_end]
+
+    speed = df[cols["output"]].to_numpy(float)
+    if filter_Hz is not None:
+        from scipy import signal
+
+        nyquist = 0.5 / h
+        if not (math.isfinite(filter_Hz) and 0.0 < filter_Hz < nyquist):
+            raise ParameterError(f"shift_quality: filter_Hz = {filter_Hz!r} must lie in (0, {nyquist:g}) Hz, the "
+                                 f"Nyquist frequency of the samples")
+        speed = signal.sosfiltfilt(signal.butter(4, filter_Hz, fs=1.0 / h, output="sos"), speed)
+    scale = 1.0 if radius is None else float(radius)
+    acc = np.gradient(speed, t) * scale
+    jerk = np.gradient(acc, t)
+    before = (t >= ts - pre - 1e-12) & (t <= ts + 1e-12)
+    a0 = float(np.mean(acc[before]))
+    shift = slice(i0, i_end + 1)
+    window = (t >= ts - 1e-12) & (t <= te + settle + 1e-12)
+    tw = t[window]
+    dev4 = (acc[window] - a0) ** 4
+    vdv = _trapezoid(dev4, tw) ** 0.25
+    p_off = tau_off * w_off
+    p_on = tau_on * w_on
+    # (the last interval both of whose ends slide: the lock-up may fall inside the one after it)
+    slip_rate = (w_on[i_lock - 2] - w_on[i_lock - 1]) / h if i_lock >= 2 else math.nan
+    flare = math.nan
+    if cols["engine"] is not None:
+        we = df[cols["engine"]].to_numpy(float)
+        flare = float(np.max(we[shift]) - we[i0])
+    a, j, v = ("m_s2", "m_s3", "m_s1_75") if radius is not None else ("rad_s2", "rad_s3", "rad_s1_75")
+    values = {
+        "shift_time_s": te - ts,
+        "torque_phase_s": (th - ts) if upshift else (th - tl),
+        "inertia_phase_s": (tl - th) if upshift else (tl - ts),
+        f"acceleration_before_{a}": a0,
+        f"acceleration_dip_{a}": a0 - float(np.min(acc[shift])),
+        f"acceleration_peak_to_peak_{a}": float(np.ptp(acc[window])),
+        f"jerk_peak_{j}": float(np.max(np.abs(jerk[window]))),
+        f"vdv_{v}": vdv,
+        "lockup_slip_rate_rad_s2": abs(float(slip_rate)),
+        "engine_flare_rad_s": flare,
+        "offgoing_energy_J": _trapezoid(p_off[shift], t[shift]),
+        "oncoming_energy_J": _trapezoid(p_on[shift], t[shift]),
+        "offgoing_peak_power_W": float(np.max(p_off[shift])),
+        "oncoming_peak_power_W": float(np.max(p_on[shift])),
+    }
+    import pandas as pd
+
+    trace = pd.DataFrame({"time_s": t, f"acceleration_{a}": acc, f"jerk_{j}": jerk,
+                          "offgoing_torque_Nm": tau_off, "oncoming_torque_Nm": tau_on,
+                          "offgoing_slip_rad_s": w_off, "oncoming_slip_rad_s": w_on,
+                          "offgoing_power_W": p_off, "oncoming_power_W": p_on})
+    if cols["engine"] is not None:
+        trace["engine_speed_rad_s"] = df[cols["engine"]].to_numpy(float)
+    return ShiftQuality(float(ts), float(th), float(tl), float(te), "upshift" if upshift else "downshift",
+                        values, cols, trace)

@@ -1,0 +1,232 @@
+"""Shift quality (clutchlab.control.shift): the phases and metrics of a clutch-to-clutch shift against closed forms
+of a designed record, and against the events and the clutches' own dissipation in a dual-clutch upshift run."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from clutchlab.control.shift import shift_quality
+from clutchlab.errors import ParameterError
+
+H = 1e-4                 # [s] the record's sample interval
+T, W = 200.0, 100.0      # [N m], [rad/s] the clutches' torque and the on-coming clutch's slip before the shift
+A0, D, L0, L = 2.0, 1.5, 0.21, 0.3   # the output's acceleration, its dip sin^2 from L0 over L [rad/s^2], [s]
+FLARE = 7.0              # [rad/s] the engine's flare, sin^2 over [0.21, 0.31] s
+THR = 0.0237             # (thresholds between samples: the detected instants are the next sample)
+
+
+def _record(downshift=False):
+    """A designed upshift: the off-going clutch hands T over to the on-coming one linearly over [0.2, 0.3] s (the
+    torque phase), the on-coming one's slip falls linearly from W to 0 over [0.3, 0.5] s (the inertia phase); the
+    output's acceleration dips by D sin^2 over [0.21, 0.51] s; the engine flares by FLARE, then falls."""
+    t = np.round(np.arange(0.0, 1.0 + H / 2, H), 12)
+    ramp = np.clip((t - 0.2) / 0.1, 0.0, 1.0)
+    u = np.clip(t - L0, 0.0, L)
+    integral = u / 2 - L / (4 * math.pi) * np.sin(2 * math.pi * u / L)
+    bump = np.where((t > 0.21) & (t < 0.31), np.sin(math.pi * (t - 0.21) / 0.1) ** 2, 0.0)
+    frame = pd.DataFrame({
+        "time_s": t,
+        "c1.tau_Nm": T * (1.0 - ramp),
+        "c2.tau_Nm": -T * ramp,          # (signs are the clutches' own: magnitudes are read)
+        "c1.w_rel_rad_s": np.where(t > 0.3, -50.0 * (t - 0.3), 0.0),
+        "c2.w_rel_rad_s": W * np.clip(1.0 - (t - 0.3) / 0.2, 0.0, 1.0),
+        "out.w_rad_s": 10.0 + A0 * t - D * integral,
+        "engine.w_rad_s": 300.0 + FLARE * bump - 100.0 * np.clip((t - 0.31) / 0.19, 0.0, 1.0),
+    })
+    return frame
+
+
+def _e_on(a, b):
+    """The closed form of the integral of |tau_on w_on| from a to b (a in the torque phase, b in the inertia phase)."""
+    torque = T * W * ((0.3 - 0.2) ** 2 - (a - 0.2) ** 2) / (2 * 0.1)    # T (t-0.2)/0.1 * W over [a, 0.3]
+    inertia = T * W * ((b - 0.3) - (b - 0.3) ** 2 / (2 * 0.2))          # T * W (1 - (t-0.3)/0.2) over [0.3, b]
+    return torque + inertia
+
+
+def test_the_phases_and_metrics_of_a_designed_upshift_are_its_closed_forms():
+    q = shift_quality(_record(), offgoing="c1", oncoming="c2", output="out", engine="engine", threshold=THR)
+    # the instants: the first sample past the threshold's crossing of each ramp
+    assert q.order == "upshift"
+    assert 0.2 + 0.1 * THR < q.start_s <= 0.2 + 0.1 * THR + H
+    assert 0.3 - 0.1 * THR <= q.handover_s < 0.3 - 0.1 * THR + H
+    assert 0.5 - 0.2 * THR <= q.lockup_s < 0.5 - 0.2 * THR + H
+    assert q.end_s == q.lockup_s
+    m = q.metrics
+    assert m["shift_time_s"] == pytest.approx(q.lockup_s - q.start_s, abs=1e-12)
+    assert m["torque_phase_s"] == pytest.approx(q.handover_s - q.start_s, abs=1e-12)
+    assert m["inertia_phase_s"] == pytest.approx(q.lockup_s - q.handover_s, abs=1e-12)
+    assert m["acceleration_before_rad_s2"] == pytest.approx(A0, rel=1e-9)
+    assert m["acceleration_dip_rad_s2"] == pytest.approx(D, rel=1e-6)
+    assert m["acceleration_peak_to_peak_rad_s2"] == pytest.approx(D, rel=1e-6)
+    assert m["jerk_peak_rad_s3"] == pytest.approx(D * math.pi / L, rel=1e-4)
+    assert m["vdv_rad_s1_75"] == pytest.approx(D * (L * 35.0 / 128.0) ** 0.25, rel=1e-5)   # int sin^8 = 35 L/128
+    assert m["lockup_slip_rate_rad_s2"] == pytest.approx(W / 0.2, rel=1e-9)
+    assert m["engine_flare_rad_s"] == pytest.approx(FLARE, rel=1e-9)
+    assert m["oncoming_energy_J"] == pytest.approx(_e_on(q.start_s, q.lockup_s), rel=1e-6)
+    assert m["oncoming_peak_power_W"] == pytest.approx(T * W, rel=1e-12)
+    assert m["offgoing_energy_J"] == 0.0 and m["offgoing_peak_power_W"] == 0.0   # (stuck until it carries nothing)
+
+
+def test_a_radius_gives_the_vehicle_acceleration_and_a_filter_keeps_the_metrics_of_a_smooth_record():
+    r = 0.3 / 3.5
+    q = shift_quality(_record(), offgoing="c1", oncoming="c2", output="out.w_rad_s", radius=r, threshold=THR)
+    m = q.metrics
+    assert m["acceleration_dip_m_s2"] == pytest.approx(D * r, rel=1e-6)
+    assert m["jerk_peak_m_s3"] == pytest.approx(D * r * math.pi / L, rel=1e-4)
+    assert m["vdv_m_s1_75"] == pytest.approx(D * r * (L * 35.0 / 128.0) ** 0.25, rel=1e-5)
+    assert math.isnan(m["engine_flare_rad_s"])
+    # a noisy record (a rig's): the filtered acceleration's dip within 2 % where the raw one's is far off
+    rng = np.random.default_rng(7)
+    noisy = _record()
+    noisy["out.w_rad_s"] += rng.normal(0.0, 1e-4, len(noisy))
+    raw = shift_quality(noisy, offgoing="c1", oncoming="c2", output="out", threshold=THR)
+    filtered = shift_quality(noisy, offgoing="c1", oncoming="c2", output="out", threshold=THR, filter_Hz=20.0)
+    assert abs(raw.metrics["acceleration_dip_rad_s2"] - D) > 0.2
+    assert filtered.metrics["acceleration_dip_rad_s2"] == pytest.approx(D, rel=0.02)
+
+
+def test_a_downshift_runs_its_inertia_phase_first():
+    """The same record with the off-going clutch sliding from 0.15 s (the engine speeds up) and still carrying its
+    torque until 0.6 s, after the on-coming one has locked at 0.5 s."""
+    f = _record()
+    t = f["time_s"].to_numpy()
+    f["c1.w_rel_rad_s"] = np.where(t > 0.15, 20.0, 0.0)
+    f["c1.tau_Nm"] = T * np.clip(1.0 - (t - 0.5) / 0.1, 0.0, 1.0)
+    f["c2.tau_Nm"] = T * np.clip((t - 0.5) / 0.1, 0.0, 1.0)
+    q = shift_quality(f, offgoing="c1", oncoming="c2", output="out", threshold=THR)
+    assert q.order == "downshift"
+    assert 0.15 <= q.start_s <= 0.15 + 1.5 * H   # (the off-going clutch's slip, before the on-coming one's torque)
+    assert 0.6 - 0.1 * THR <= q.handover_s < 0.6 - 0.1 * THR + H
+    assert q.metrics["inertia_phase_s"] == pytest.approx(q.lockup_s - q.start_s)
+    assert q.metrics["torque_phase_s"] == pytest.approx(q.handover_s - q.lockup_s)
+    assert q.metrics["offgoing_energy_J"] == pytest.approx(
+        20.0 * T * ((q.handover_s - q.start_s) - (q.handover_s - 0.5) ** 2 / (2 * 0.1)), rel=1e-6)
+
+
+def test_bad_records_are_refused_with_the_reason():
+    f = _record()
+    with pytest.raises(ParameterError, match="no column 'c3.tau_Nm'"):
+        shift_quality(f, offgoing="c1", oncoming="c3", output="out")
+    with pytest.raises(ParameterError, match="output 'shaft': no column"):
+        shift_quality(f, offgoing="c1", oncoming="c2", output="shaft")
+    g = f.copy()
+    g.loc[len(g) // 2:, "c2.w_rel_rad_s"] = 5.0
+    with pytest.raises(ParameterError, match="c2 does not lock within the record"):
+        shift_quality(g, offgoing="c1", oncoming="c2", output="out")
+    g = f.drop(index=[100])
+    with pytest.raises(ParameterError, match="constant interval"):
+        shift_quality(g, offgoing="c1", oncoming="c2", output="out")
+    g = f.copy()
+    g.loc[3, "out.w_rad_s"] = np.nan
+    with pytest.raises(Exception, match="out.w_rad_s"):
+        shift_quality(g, offgoing="c1", oncoming="c2", output="out")
+    with pytest.raises(ParameterError, match="threshold"):
+        shift_quality(f, offgoing="c1", oncoming="c2", output="out", threshold=0.7)
+    with pytest.raises(ParameterError, match="start = 2.0 s is outside the record"):
+        shift_quality(f, offgoing="c1", oncoming="c2", output="out", start=2.0)
+
+
+def test_a_csv_record_and_the_result_s_forms(tmp_path):
+    path = tmp_path / "rig.csv"
+    _record().to_csv(path, index=False)
+    q = shift_quality(str(path), offgoing="c1", oncoming="c2", output="out", threshold=THR)
+    ref = shift_quality(_record(), offgoing="c1", oncoming="c2", output="out", threshold=THR)
+    for k, v in ref.metrics.items():
+        assert q.metrics[k] == pytest.approx(v, rel=1e-9, nan_ok=True), k
+    doc = json.loads(json.dumps(q.to_dict(), allow_nan=False))
+    assert doc["order"] == "upshift" and doc["metrics"]["engine_flare_rad_s"] is None
+    table = q.table()
+    assert list(table["metric"]) == list(q.metrics)
+    assert table.set_index("metric").loc["jerk_peak_rad_s3", "unit"] == "rad_s3"
+    assert "lock-up at" in str(q)
+
+
+def test_a_dual_clutch_upshift_run_against_its_events_and_its_clutches_heat():
+    """The dual-clutch upshift of examples/driveline_dct_upshift.toml: with a fine threshold the lock-up the columns
+    give is the on-coming clutch's stick event and the hand-over the off-going clutch's release (its normal force
+    gone) to a sample; at the default threshold the lock-up is early by at most the threshold's share of the slip
+    over its rate at lock-up; the energies are the clutches' own dissipated energy over the shift within 1e-3."""
+    from clutchlab.driveline.description import load_driveline
+
+    spec = load_driveline("examples/driveline_dct_upshift.toml")
+    res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, output_step=spec.output_step)
+    frame = res.to_dataframe()
+    ev = res.events
+    stick = float(ev[(ev["element"] == "c2") & (ev["event"] == "stick")]["time_s"].iloc[0])
+    free = float(ev[(ev["element"] == "c1") & (ev["event"] == "free")]["time_s"].iloc[0])
+    start = float(ev[(ev["element"] == "c2") & (ev["event"] == "backward")]["time_s"].iloc[0])
+    h = spec.output_step
+    fine = shift_quality(res, offgoing="c1", oncoming="c2", output="wheels", engine="engine", radius=0.3,
+                         threshold=1e-4)
+    assert fine.order == "upshift"
+    assert start <= fine.start_s <= start + h + 1e-9
+    assert stick - h <= fine.lockup_s <= stick + h
+    assert free - h <= fine.handover_s <= free + h
+    q = shift_quality(res, offgoing="c1", oncoming="c2", output="wheels", engine="engine", radius=0.3)
+    w_ref = max(frame["c1.w_rel_rad_s"].abs().max(), frame["c2.w_rel_rad_s"].abs().max())
+    early = 0.02 * w_ref / q.metrics["lockup_slip_rate_rad_s2"]
+    assert stick - early - 2 * h <= q.lockup_s <= stick
+    t = frame["time_s"]
+    heat = {c: float(np.interp(q.end_s, t, frame[f"{c}.dissipated_J"]) - np.interp(q.start_s, t,
+                                                                                 frame[f"{c}.dissipated_J"]))
+            for c in ("c1", "c2")}
+    scale = sum(heat.values())   # (c1 slides for 7 ms, a few samples: its heat is read to the samples' error)
+    for side, c in (("offgoing", "c1"), ("oncoming", "c2")):
+        assert q.metrics[f"{side}_energy_J"] == pytest.approx(heat[c], rel=1e-3, abs=1e-6 * scale), side
+    assert q.metrics["oncoming_energy_J"] > 1000.0
+    assert q.metrics["acceleration_dip_m_s2"] > 0.5 and q.metrics["jerk_peak_m_s3"] > 10.0
+
+
+def test_the_command_line_reads_a_record_and_writes_json_or_csv_together_or_not_at_all(tmp_path, capsys):
+    from cli_checks import one_line_error
+
+    from clutchlab.cli import main
+
+    rig = tmp_path / "rig.csv"
+    _record().to_csv(rig, index=False)
+    js, csv = tmp_path / "shift.json", tmp_path / "shift.csv"
+    common = ["control", "shift", str(rig), "--offgoing", "c1", "--oncoming", "c2", "--shaft", "out",
+              "--engine", "engine", "--threshold", str(THR), "--radius", "300 mm"]
+    assert main([*common, "-o", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    assert doc["metrics"]["acceleration_dip_m_s2"] == pytest.approx(D * 0.3, rel=1e-6)
+    assert doc["metrics"]["engine_flare_rad_s"] == pytest.approx(FLARE, rel=1e-9)
+    assert "lock-up at" in capsys.readouterr().out
+    assert main([*common, "-o", str(csv), "--settle", "100 ms", "--start", "0.2 s"]) == 0
+    table = pd.read_csv(csv, comment="#").set_index("metric")
+    assert table.loc["jerk_peak_m_s3", "unit"] == "m_s3" and table.loc["shift_time_s", "value"] == pytest.approx(
+        0.5 - 0.2 * THR - 0.2, abs=2 * H)
+    before = js.read_text()
+    line = one_line_error(capsys, [*common, "-o", str(js), "--plot", str(tmp_path / "s.png")])   # (exists: --force)
+    assert "exists" in line and js.read_text() == before and not (tmp_path / "s.png").exists()
+    assert main([*common, "-o", str(js), "--plot", str(tmp_path / "s.png"), "--force"]) == 0
+    assert (tmp_path / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    line = one_line_error(capsys, [*common[:-2], "--radius", "3 s", "-o", str(tmp_path / "x.json")])
+    assert "--radius" in line and not (tmp_path / "x.json").exists()
+    line = one_line_error(capsys, [*common[:6], "c9", *common[7:], "-o", str(tmp_path / "y.json")])
+    assert f"{rig}: no column 'c9.tau_Nm'" in line and not (tmp_path / "y.json").exists()   # (the file named)
+    line = one_line_error(capsys, ["control", "shift", str(tmp_path / "rig.mf4"), "--offgoing", "c1", "--oncoming",
+                                   "c2", "--shaft", "out"])
+    assert "expected a driveline description (.toml) or a record (.csv)" in line
+
+
+def test_the_shift_figure_shades_the_phases_and_marks_the_dip():
+    from clutchlab.control.plots import shift_figure
+
+    q = shift_quality(_record(), offgoing="c1", oncoming="c2", output="out", engine="engine", threshold=THR)
+    fig = shift_figure(q, title="t")
+    for ax in fig.axes:
+        spans = [p for p in ax.patches]
+        assert len(spans) == 2                               # the torque phase and the inertia phase
+        box = spans[0].get_window_extent(fig.canvas.get_renderer()).transformed(ax.transData.inverted())
+        assert (box.x0, box.x1) == pytest.approx((q.start_s, q.handover_s), abs=1e-9)
+    labels = [line.get_label() for line in fig.axes[2].get_lines()]
+    assert labels[0] == "acceleration" and labels[2].startswith("dip 1.5")
+    np.testing.assert_allclose(fig.axes[0].get_lines()[0].get_ydata().max(), (300.0 + FLARE) * 30.0 / math.pi,
+                               rtol=1e-9)   # the engine in rpm
+    assert list(q.trace.columns[:3]) == ["time_s", "acceleration_rad_s2", "jerk_rad_s3"]
