@@ -9,6 +9,9 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis_budget import examples
 
 from clutchlab.control.shift import shift_quality
 from clutchlab.errors import ParameterError
@@ -230,3 +233,35 @@ def test_the_shift_figure_shades_the_phases_and_marks_the_dip():
     np.testing.assert_allclose(fig.axes[0].get_lines()[0].get_ydata().max(), (300.0 + FLARE) * 30.0 / math.pi,
                                rtol=1e-9)   # the engine in rpm
     assert list(q.trace.columns[:3]) == ["time_s", "acceleration_rad_s2", "jerk_rad_s3"]
+
+
+@settings(max_examples=examples(25), deadline=None)
+@given(torque=st.floats(1.0, 5e3), slip=st.floats(1.0, 500.0), t1=st.floats(0.05, 0.5),
+       torque_phase=st.floats(0.02, 0.3), inertia_phase=st.floats(0.05, 0.6), threshold=st.floats(0.005, 0.2),
+       h=st.sampled_from([1e-4, 5e-4, 1e-3]))
+def test_the_phases_of_any_designed_upshift_are_found_within_their_bounds(torque, slip, t1, torque_phase,
+                                                                          inertia_phase, threshold, h):
+    """Random linear hand-overs and slip ramps: each instant lies within the threshold's share of its ramp and one
+    sample of the true one, on the side the threshold puts it, and the on-coming clutch's heat is the closed form
+    over the detected window to the trapezoid rule's error on one kink."""
+    t2, t3 = t1 + torque_phase, t1 + torque_phase + inertia_phase
+    t = np.arange(0.0, t3 + 0.3, h)
+    ramp = np.clip((t - t1) / torque_phase, 0.0, 1.0)
+    w_on = slip * np.clip(1.0 - (t - t2) / inertia_phase, 0.0, 1.0)
+    frame = pd.DataFrame({"time_s": t, "c1.tau_Nm": torque * (1.0 - ramp), "c2.tau_Nm": torque * ramp,
+                          "c1.w_rel_rad_s": np.zeros_like(t), "c2.w_rel_rad_s": w_on, "out.w_rad_s": 3.0 * t})
+    q = shift_quality(frame, offgoing="c1", oncoming="c2", output="out", threshold=threshold)
+    eps = 1e-9
+    assert t1 + threshold * torque_phase - eps <= q.start_s <= t1 + threshold * torque_phase + h + eps
+    assert t2 - threshold * torque_phase - eps <= q.handover_s <= t2 - threshold * torque_phase + h + eps
+    assert t3 - threshold * inertia_phase - eps <= q.lockup_s <= t3 - threshold * inertia_phase + h + eps
+    assert q.order == "upshift" and q.metrics["acceleration_dip_rad_s2"] == pytest.approx(0.0, abs=1e-6)
+    assert q.metrics["lockup_slip_rate_rad_s2"] == pytest.approx(slip / inertia_phase, rel=1e-6)
+
+    def heat(a, b):   # integral of torque * ramp * w_on from a to b (a in the torque phase, b in the inertia phase)
+        up = torque * slip * ((t2 - t1) ** 2 - (a - t1) ** 2) / (2 * torque_phase)
+        down = torque * slip * ((b - t2) - (b - t2) ** 2 / (2 * inertia_phase))
+        return up + down
+
+    kink = torque * slip * h   # (the trapezoid's error over the interval holding the hand-over's kink)
+    assert q.metrics["oncoming_energy_J"] == pytest.approx(heat(q.start_s, q.lockup_s), abs=kink)
