@@ -213,9 +213,15 @@ def test_the_command_line_reads_a_record_and_writes_json_or_csv_together_or_not_
     assert "--radius" in line and not (tmp_path / "x.json").exists()
     line = one_line_error(capsys, [*common[:6], "c9", *common[7:], "-o", str(tmp_path / "y.json")])
     assert f"{rig}: no column 'c9.tau_Nm'" in line and not (tmp_path / "y.json").exists()   # (the file named)
+    line = one_line_error(capsys, ["control", "shift", str(tmp_path / "rig.xlsx"), "--offgoing", "c1", "--oncoming",
+                                   "c2", "--shaft", "out"])
+    assert "expected a driveline description (.toml) or a record (.csv, .parquet, .mf4)" in line
     line = one_line_error(capsys, ["control", "shift", str(tmp_path / "rig.mf4"), "--offgoing", "c1", "--oncoming",
                                    "c2", "--shaft", "out"])
-    assert "expected a driveline description (.toml) or a record (.csv)" in line
+    assert "rig.mf4: no such file" in line
+    line = one_line_error(capsys, ["control", "shift", "examples/driveline_dct_upshift.toml", "--offgoing", "c1",
+                                   "--oncoming", "c2", "--shaft", "wheels", "--rate", "1 kHz"])
+    assert "--channel-map, --rate and --dbc read a record" in line
 
 
 def test_the_shift_figure_shades_the_phases_and_marks_the_dip():
@@ -265,3 +271,39 @@ def test_the_phases_of_any_designed_upshift_are_found_within_their_bounds(torque
 
     kink = torque * slip * h   # (the trapezoid's error over the interval holding the hand-over's kink)
     assert q.metrics["oncoming_energy_J"] == pytest.approx(heat(q.start_s, q.lockup_s), abs=kink)
+
+
+def test_a_rig_s_mdf_log_through_a_channel_map_gives_the_record_s_metrics(tmp_path, capsys):
+    """The designed record as a rig logs it (MDF 4, the logger's names, rpm, km/h): read through a channel map into
+    clutchlab's names and SI units, with the vehicle's speed in m/s as the output, the metrics are those of the
+    record in rad/s with the tyre's radius, to the unit conversions' rounding."""
+    from clutchlab.cli import main
+    from clutchlab.io import read_measurement
+    from clutchlab.io.mdf import write_mdf
+
+    f, r, rpm = _record(), 0.3, 30.0 / math.pi
+    channels = {"T_K1": f["c1.tau_Nm"], "T_K2": f["c2.tau_Nm"], "dn_K1": rpm * f["c1.w_rel_rad_s"],
+                "dn_K2": rpm * f["c2.w_rel_rad_s"], "n_mot": rpm * f["engine.w_rad_s"],
+                "v_fzg": 3.6 * r * f["out.w_rad_s"]}
+    units = {"T_K1": "Nm", "T_K2": "Nm", "dn_K1": "rpm", "dn_K2": "rpm", "n_mot": "rpm", "v_fzg": "km/h"}
+    log = write_mdf(tmp_path / "rig.mf4", f["time_s"].to_numpy(), {k: np.asarray(v) for k, v in channels.items()},
+                    units, comment="synthetic: the designed record of tests/control_design/test_shift.py")
+    names = {"c1.tau_Nm": "T_K1", "c2.tau_Nm": "T_K2", "c1.w_rel_rad_s": "dn_K1", "c2.w_rel_rad_s": "dn_K2",
+             "engine.w_rad_s": "n_mot", "vehicle.v_m_s": "v_fzg"}
+    (tmp_path / "map.toml").write_text("".join(f'[channels."{k}"]\nsource = "{v}"\n\n' for k, v in names.items()))
+    ref = shift_quality(f, offgoing="c1", oncoming="c2", output="out", engine="engine", radius=r, threshold=THR)
+    rec = read_measurement(log, tmp_path / "map.toml")
+    q = shift_quality(rec, offgoing="c1", oncoming="c2", output="vehicle.v_m_s", engine="engine", threshold=THR)
+    assert (q.start_s, q.handover_s, q.lockup_s) == (ref.start_s, ref.handover_s, ref.lockup_s)
+    for k, v in ref.metrics.items():
+        assert q.metrics[k] == pytest.approx(v, rel=1e-6, abs=1e-9), k   # (the jerk: a second difference)
+    with pytest.raises(ParameterError, match="is a speed in m/s: give no radius"):
+        shift_quality(rec, offgoing="c1", oncoming="c2", output="vehicle.v_m_s", radius=r)
+    out = tmp_path / "shift.json"
+    assert main(["control", "shift", str(log), "--channel-map", str(tmp_path / "map.toml"), "--rate", "10 kHz",
+                 "--offgoing", "c1", "--oncoming", "c2", "--shaft", "vehicle.v_m_s", "--threshold", str(THR),
+                 "-o", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["metrics"]["acceleration_dip_m_s2"] == pytest.approx(D * r, rel=1e-6)
+    assert doc["lockup_s"] == pytest.approx(ref.lockup_s, abs=1e-9)
+    capsys.readouterr()

@@ -101,7 +101,14 @@ def register(subparsers) -> None:
                                        "<name>.tau_Nm and <name>.w_rel_rad_s, the output's speed and time_s at a "
                                        "constant interval.",
                            epilog="Documentation: docs/control.md (Shift quality)")
-    shift.add_argument("source", help="driveline description (.toml) or record (.csv)")
+    shift.add_argument("source", help="driveline description (.toml), or a record (.csv, .parquet, .mf4)")
+    shift.add_argument("--channel-map", metavar="MAP.toml",
+                       help="a record's channels to clutchlab names and SI units (as for clutchlab convert): "
+                            "<clutch>.tau_Nm, <clutch>.w_rel_rad_s, the output's speed, time_s")
+    shift.add_argument("--rate", default=None, help="resample the record onto a uniform time base at this rate, "
+                                                    "e.g. '1 kHz' (a record logged at several rates)")
+    shift.add_argument("--dbc", action="append", metavar="DATABASE",
+                       help="CAN database (.dbc, .arxml) decoding an MDF bus log's frames (repeatable)")
     shift.add_argument("--offgoing", required=True, metavar="CLUTCH", help="the off-going clutch, e.g. c1")
     shift.add_argument("--oncoming", required=True, metavar="CLUTCH", help="the on-coming clutch, e.g. c2")
     shift.add_argument("--shaft", required=True, metavar="NAME",
@@ -380,6 +387,8 @@ def _shift(args) -> int:
                    radius=None if args.radius is None else to_si(args.radius, "m", name="--radius"),
                    start=None if args.start is None else to_si(args.start, "s", name="--start"),
                    filter_Hz=None if args.filter is None else to_si(args.filter, "Hz", name="--filter"))
+    if args.source.lower().endswith(".toml") and (args.channel_map or args.rate or args.dbc):
+        raise ParameterError("--channel-map, --rate and --dbc read a record; a driveline's run has clutchlab's names")
     if args.source.lower().endswith(".toml"):
         from ..driveline.description import load_driveline
 
@@ -389,10 +398,14 @@ def _shift(args) -> int:
                                  "a constant interval)")
         source = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step,
                                          output_step=spec.output_step)
-    elif args.source.lower().endswith(".csv"):
-        source = args.source
+    elif args.source.lower().endswith((".csv", ".txt", ".parquet", ".mf4", ".mdf")):
+        from ..io import read_measurement
+
+        rate = None if args.rate is None else to_si(args.rate, "Hz", name="--rate")
+        source = read_measurement(args.source, args.channel_map, rate=rate, databases=tuple(args.dbc or ()))
     else:
-        raise ParameterError(f"{args.source}: expected a driveline description (.toml) or a record (.csv)")
+        raise ParameterError(f"{args.source}: expected a driveline description (.toml) or a record (.csv, "
+                             ".parquet, .mf4)")
     q = shift_quality(source, **options)
     png = None
     if args.plot is not None:

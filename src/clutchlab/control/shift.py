@@ -148,14 +148,18 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
 
     Parameters
     ----------
-    frame : pandas.DataFrame, SimulationResult or str
-        Samples with ``time_s`` at a constant interval: a run (its ``to_dataframe()``), or a CSV file of a run or
-        a rig's record (any dialect :func:`clutchlab.io.files.read_table` reads) with the columns below.
+    frame : pandas.DataFrame, SimulationResult, Measurement, str or Path
+        Samples with ``time_s`` at a constant interval: a run (its ``to_dataframe()``), a record read by
+        :func:`clutchlab.io.read_measurement` (a rig's CSV, Parquet, MDF 4 or CAN log through a channel map into
+        clutchlab's names and SI units, resampled with its ``rate``), or such a file whose channels already carry
+        the names below (read without a map).
     offgoing, oncoming : str
         The two clutches: their columns ``<name>.tau_Nm`` (friction torque [N m]) and ``<name>.w_rel_rad_s``
         (slip speed [rad/s]) are read.
     output : str
-        The output shaft's (or the vehicle's) speed: a column, or an inertia whose ``<name>.w_rad_s`` is read.
+        The output shaft's (or the wheels') speed: a column, or an inertia whose ``<name>.w_rad_s`` is read; or the
+        vehicle's speed, a column whose name ends in ``_m_s`` [m/s] (a rig's or a CAN log's), whose derivative is
+        the acceleration in m/s^2 without a ``radius``.
     engine : str, optional
         The engine's (the transmission input's) speed, for the flare: a column or an inertia.
     radius : float, optional
@@ -198,10 +202,18 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     """
     from ..io.files import read_table
 
-    if hasattr(frame, "to_dataframe"):
+    label = "shift_quality"
+    if hasattr(frame, "source") and hasattr(frame, "frame"):   # a Measurement: its file in the messages
+        label = str(frame.source.path or label)
+        frame = frame.frame
+    elif hasattr(frame, "to_dataframe"):
         frame = frame.to_dataframe()
-    label = "shift_quality" if hasattr(frame, "columns") else str(frame)   # (a file: its path in the messages)
-    head = frame if hasattr(frame, "columns") else read_table(frame, ["time_s"], name=label)
+    elif not hasattr(frame, "columns"):   # a file: its path in the messages
+        from ..io import read_measurement
+
+        label = str(frame)
+        frame = read_measurement(frame).frame
+    head = frame
     cols = {"output": _column(head, output, "w_rad_s", "output", label),
             "offgoing": offgoing, "oncoming": oncoming,
             "engine": None if engine is None else _column(head, engine, "w_rad_s", "engine", label)}
@@ -218,6 +230,9 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
             raise ParameterError(f"shift_quality: {name} = {value!r} s must be finite and >= 0")
     if radius is not None and not (math.isfinite(radius) and radius > 0.0):
         raise ParameterError(f"shift_quality: radius = {radius!r} m must be finite and > 0")
+    linear = cols["output"].endswith("_m_s")   # (the vehicle's speed [m/s]: its derivative is in m/s^2 already)
+    if linear and radius is not None:
+        raise ParameterError(f"shift_quality: output {cols['output']!r} is a speed in m/s: give no radius")
     t = df["time_s"].to_numpy(float)
     if t.size < 8:
         raise ParameterError(f"shift_quality: needs at least 8 samples (got {t.size})")
@@ -290,7 +305,7 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     if cols["engine"] is not None:
         we = df[cols["engine"]].to_numpy(float)
         flare = float(np.max(we[shift]) - we[i0])
-    a, j, v = ("m_s2", "m_s3", "m_s1_75") if radius is not None else ("rad_s2", "rad_s3", "rad_s1_75")
+    a, j, v = ("m_s2", "m_s3", "m_s1_75") if radius is not None or linear else ("rad_s2", "rad_s3", "rad_s1_75")
     values = {
         "shift_time_s": te - ts,
         "torque_phase_s": (th - ts) if upshift else (th - tl),
