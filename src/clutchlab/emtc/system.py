@@ -1008,10 +1008,12 @@ def _restart(t, x, u, m, p, log):
             k += 1
         imem[IM_KNEXT] = k
         changed = True
-    # held inputs that jumped (a resumed co-simulation step, or the start) may leave a mode inconsistent
+    # held inputs that jumped (a resumed co-simulation step, or the start) may leave a mode inconsistent (not the
+    # coupling's temperature: it moves the kinetic coefficient of its friction map only, which no mode's switching
+    # function reads, and a network's heat port changes it at every restart)
     jumped = False
     for q in range(u.shape[0]):
-        if u[q] != fmem[FM_ULAST + q]:
+        if q != U_TEMP and u[q] != fmem[FM_ULAST + q]:
             jumped = True
             fmem[FM_ULAST + q] = u[q]
     if jumped:
