@@ -13,7 +13,7 @@ A power upshift hands the drive from the off-going clutch to the on-coming one i
 A power-on downshift runs the phases the other way round (the off-going clutch slips first so the engine can
 speed up, then the on-coming one takes the torque).  The seeds do not treat shifts; the metrics are the ones shift
 calibration uses (the vehicle's longitudinal acceleration, its jerk and vibration dose value, the phases' times,
-the engine's flare and the clutches' heat), each defined below from sampled columns only, so a simulated run and a
+the engine's flare and the off-going clutch's tie-up, and the clutches' heat), each defined below from sampled columns only, so a simulated run and a
 rig's record are measured by the same code (docs/control.md, "Shift quality").
 
 * :func:`shift_quality` -- the phases and metrics of one shift: :class:`ShiftQuality`.
@@ -49,8 +49,11 @@ METRICS = (
                        "(ISO 2631-1's form, without its frequency weighting)"),
     ("lockup_slip_rate_rad_s2", "rad_s2", "|d w_rel / dt| of the on-coming clutch over the last sample interval "
                                           "in which it slides before it locks (the lock-up shock's cause)"),
-    ("engine_flare_rad_s", "rad_s", "the engine's (input's) largest speed during the shift less its speed at the "
-                                    "start (NaN without an engine column)"),
+    ("flare_rad_s", "rad_s", "the off-going clutch's largest slip the way it drove before the start, during the "
+                             "shift: the engine running ahead of the old gear (an upshift's off-going clutch "
+                             "released too early; a downshift's inertia phase)"),
+    ("tie_up_Nm", "Nm", "the largest torque the off-going clutch carries against the way it carried the drive "
+                        "before the start (it brakes the engine against the on-coming one): released too late"),
     ("offgoing_energy_J", "J", "heat of the off-going clutch during the shift, integral of |tau w_rel| dt"),
     ("oncoming_energy_J", "J", "heat of the on-coming clutch during the shift, integral of |tau w_rel| dt"),
     ("offgoing_peak_power_W", "W", "largest |tau w_rel| of the off-going clutch during the shift"),
@@ -161,7 +164,8 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         vehicle's speed, a column whose name ends in ``_m_s`` [m/s] (a rig's or a CAN log's), whose derivative is
         the acceleration in m/s^2 without a ``radius``.
     engine : str, optional
-        The engine's (the transmission input's) speed, for the flare: a column or an inertia.
+        The engine's (the transmission input's) speed, drawn by :func:`clutchlab.control.plots.shift_figure`: a
+        column or an inertia.
     radius : float, optional
         [m] the vehicle's travel per radian of ``output`` (the tyre's rolling radius over the axle ratio behind
         it): the acceleration in m/s^2, the jerk in m/s^3; without it, the output's angular acceleration.
@@ -241,7 +245,8 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
         raise ParameterError(f"shift_quality: time_s must be sampled at a constant interval (from {dt.min():g} to "
                              f"{dt.max():g} s); resample it first")
-    tau_off, tau_on = (np.abs(df[f"{c}.tau_Nm"].to_numpy(float)) for c in (offgoing, oncoming))
+    signed_off = df[f"{offgoing}.tau_Nm"].to_numpy(float)
+    tau_off, tau_on = np.abs(signed_off), np.abs(df[f"{oncoming}.tau_Nm"].to_numpy(float))
     w_off, w_on = (np.abs(df[f"{c}.w_rel_rad_s"].to_numpy(float)) for c in (offgoing, oncoming))
     t_ref = max(tau_off.max(), tau_on.max())
     w_ref = max(w_off.max(), w_on.max())
@@ -301,10 +306,13 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     p_on = tau_on * w_on
     # (the last interval both of whose ends slide: the lock-up may fall inside the one after it)
     slip_rate = (w_on[i_lock - 2] - w_on[i_lock - 1]) / h if i_lock >= 2 else math.nan
-    flare = math.nan
-    if cols["engine"] is not None:
-        we = df[cols["engine"]].to_numpy(float)
-        flare = float(np.max(we[shift]) - we[i0])
+    # the off-going clutch's drive before the start: the sign of its torque at its largest over the pre-window
+    pre_off = signed_off[before]
+    way = float(np.sign(pre_off[np.argmax(np.abs(pre_off))])) if pre_off.size else 0.0
+    tie_up = max(0.0, float(np.max(-way * signed_off[shift]))) if way != 0.0 else 0.0
+    # (a sliding clutch's torque has its slip's sign: slipping the way its torque drove, the driving side runs ahead)
+    slip_off = df[f"{offgoing}.w_rel_rad_s"].to_numpy(float)
+    flare = max(0.0, float(np.max(way * slip_off[shift]))) if way != 0.0 else 0.0
     a, j, v = ("m_s2", "m_s3", "m_s1_75") if radius is not None or linear else ("rad_s2", "rad_s3", "rad_s1_75")
     values = {
         "shift_time_s": te - ts,
@@ -316,7 +324,8 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         f"jerk_peak_{j}": float(np.max(np.abs(jerk[window]))),
         f"vdv_{v}": vdv,
         "lockup_slip_rate_rad_s2": abs(float(slip_rate)),
-        "engine_flare_rad_s": flare,
+        "flare_rad_s": flare,
+        "tie_up_Nm": tie_up,
         "offgoing_energy_J": _trapezoid(p_off[shift], t[shift]),
         "oncoming_energy_J": _trapezoid(p_on[shift], t[shift]),
         "offgoing_peak_power_W": float(np.max(p_off[shift])),
@@ -331,4 +340,4 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     if cols["engine"] is not None:
         trace["engine_speed_rad_s"] = df[cols["engine"]].to_numpy(float)
     return ShiftQuality(float(ts), float(th), float(tl), float(te), "upshift" if upshift else "downshift",
-                        values, cols, trace)
+                        {k: float(v) for k, v in values.items()}, cols, trace)
