@@ -279,7 +279,7 @@ def _check_heat(d, df):
     """Each thermal mass (an EMTC coupling's whose friction map fades with it, a worn and expanding E-clutch's) holds
     what its elements dissipated less what it gave its ambient, ``C (T - T0) + Q_out = sum of E_diss``, and no
     element dissipates negative energy; from the columns, independent of the kernel."""
-    for tm in d._thermal.values():
+    for tm in d.thermal_masses:
         heat = tm.capacity * (df[f"{tm.name}.temperature_C"] - tm.T0) + df[f"{tm.name}.heat_out_J"]
         dissipated = sum(df[f"{name}.dissipated_J"] for name in tm.heat_from)
         scale = 1.0 + float(np.abs(dissipated).max())

@@ -132,7 +132,8 @@ def test_every_lossy_element_kind_heats_its_mass_with_its_loss(law):
     lost = df["dissipated_energy_J"].to_numpy()
     heat = 1.0 * (df["node.temperature_C"] - 25.0) + df["node.heat_out_J"]
     assert lost[-1] > 0.3
-    for e in d._thermal["node"].heat_from:   # every kind contributes (spring3 has no damper)
+    (node,) = d.thermal_masses
+    for e in node.heat_from:   # every kind contributes (spring3 has no damper)
         assert (df[f"{e}.dissipated_J"].iloc[-1] > 1e-3) == (e != "spring3"), e
     assert np.max(np.abs(heat - lost)) < 1e-7 * lost[-1]
     assert df["node.loss_power_W"].min() > -1e-6 * df["node.loss_power_W"].max()
@@ -308,7 +309,7 @@ def test_the_heat_balance_and_its_bounds_hold_on_random_networks(d, data):
     d = _with_masses(d, data)
     res = d.simulate(1.0, output_step=2e-3, rtol=1e-9, check_invariants=True)
     df = res.to_dataframe()
-    masses = list(d._thermal.values())
+    masses = list(d.thermal_masses)
     heat = sum(m.capacity * (df[f"{m.name}.temperature_C"] - m.T0) + df[f"{m.name}.heat_out_J"] for m in masses)
     given = sum(df[f"{n}.dissipated_J"] for m in masses for n in m.heat_from) if any(m.heat_from for m in masses) \
         else 0.0 * heat

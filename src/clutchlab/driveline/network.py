@@ -563,7 +563,9 @@ class _Element:
 
 @dataclass(frozen=True)
 class _ThermalMass:
-    """A thermal mass (:meth:`Driveline.thermal_mass`): SI, temperatures in degC."""
+    """A thermal mass (:meth:`Driveline.thermal_mass`): SI, temperatures in degC; read-only, as
+    :attr:`Driveline.thermal_masses` lists them (``name``, ``capacity`` [J/K], ``T0`` [degC], ``conductance``
+    [W/K], ``ambient`` [degC], ``heat_from``: the elements whose losses flow into it)."""
     name: str
     capacity: float      # [J/K]
     T0: float            # initial temperature [degC]
@@ -1886,6 +1888,12 @@ class Driveline:
         return tuple(ElementInfo(e.name, e.kind_name, e.a or GROUND, e.b or GROUND,
                                  (e.sup or GROUND) if e.kind == K.K_GEAR else None, self._element_line(e))
                      for e in self._elements)
+
+    @property
+    def thermal_masses(self) -> tuple:
+        """The network's thermal masses in the order they were added, each a frozen record (``name``, ``capacity``
+        [J/K], ``T0`` [degC], ``conductance`` [W/K], ``ambient`` [degC], ``heat_from``): a read-only view."""
+        return tuple(self._thermal.values())
 
     def without(self, *names: str) -> "Driveline":
         """A copy of this network without the inertias and elements ``names`` (this one is left as it is): to run a
