@@ -13,8 +13,9 @@ A power upshift hands the drive from the off-going clutch to the on-coming one i
 A power-on downshift runs the phases the other way round (the off-going clutch slips first so the engine can
 speed up, then the on-coming one takes the torque).  The seeds do not treat shifts; the metrics are the ones shift
 calibration uses (the vehicle's longitudinal acceleration, its jerk and vibration dose value, the phases' times,
-the engine's flare and the off-going clutch's tie-up, and the clutches' heat), each defined below from sampled columns only, so a simulated run and a
-rig's record are measured by the same code (docs/control.md, "Shift quality").
+the engine's flare and the off-going clutch's tie-up, and the clutches' heat), each defined below from sampled
+columns only, so a simulated run and a rig's record are measured by the same code (docs/control.md, "Shift
+quality").
 
 * :func:`shift_quality` -- the phases and metrics of one shift: :class:`ShiftQuality`.
 """
