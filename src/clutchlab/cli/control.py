@@ -160,6 +160,16 @@ def register(subparsers) -> None:
     top.set_defaults(func=lambda args: (top.print_help(), 2)[1])
 
 
+def _png(fig) -> bytes:
+    """A figure as PNG bytes (120 dpi, tight), the figure closed: written with its command's other outputs."""
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
 def _common(p) -> None:
     p.add_argument("model", choices=MODELS, help="model (its bundled parameters; a driveline from its FILE)")
     p.add_argument("file", nargs="?", default=None, help="driveline description (TOML); the others take none")
@@ -333,15 +343,9 @@ def _judder(args) -> int:
             table = judder_timeline(system, times)
             png = None
             if args.plot is not None:
-                import matplotlib.pyplot as plt
-
                 from ..control.plots import judder_figure
 
-                fig = judder_figure(table, title=f"{system.name}: judder along the run")
-                buf = io.BytesIO()
-                fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-                plt.close(fig)
-                png = buf.getvalue()
+                png = _png(judder_figure(table, title=f"{system.name}: judder along the run"))
             with outputs:
                 if args.output is not None and args.output.lower().endswith(".json"):
                     rows = table.astype(object).where(table.notna(), None).to_dict(orient="records")   # NaN: null
@@ -409,17 +413,11 @@ def _shift(args) -> int:
     q = shift_quality(source, **options)
     png = None
     if args.plot is not None:
-        import matplotlib.pyplot as plt
+        from pathlib import Path
 
         from ..control.plots import shift_figure
 
-        from pathlib import Path
-
-        fig = shift_figure(q, title=f"{Path(args.source).name}: {q.order}, {args.offgoing} to {args.oncoming}")
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        png = buf.getvalue()
+        png = _png(shift_figure(q, title=f"{Path(args.source).name}: {q.order}, {args.offgoing} to {args.oncoming}"))
     with outputs:
         if png is not None:
             atomic_write_bytes(outputs.staged(args.plot), png, overwrite=args.force)
@@ -465,14 +463,9 @@ def _bode(args) -> int:
 
     from ..control.plots import bode_figure
 
-    fig = bode_figure([(label, sys) for label, _, _, sys in models], f, over=over)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
+    png = _png(bode_figure([(label, sys) for label, _, _, sys in models], f, over=over))
     with outputs:
-        atomic_write_bytes(outputs.staged(args.output), buf.getvalue(), overwrite=args.force)
+        atomic_write_bytes(outputs.staged(args.output), png, overwrite=args.force)
         if args.table:
             atomic_to_csv(pd.concat(tables, ignore_index=True), outputs.staged(args.table), overwrite=args.force)
         if args.poles:

@@ -301,6 +301,17 @@ class Oscillation:
     band_Hz: tuple
 
 
+def sample_interval(t, what: str) -> float:
+    """The constant interval [s] of the sample times ``t`` (within 1e-6 of their median spacing); else a
+    :class:`~clutchlab.errors.ParameterError` naming ``what`` (a record's filters and differences need it)."""
+    dt = np.diff(t)
+    h = float(np.median(dt))
+    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
+        raise ParameterError(f"{what}: time_s must be sampled at a constant interval (from {dt.min():g} to "
+                             f"{dt.max():g} s); resample it first")
+    return h
+
+
 def oscillation(frame, column: str, band_Hz, *, start: float | None = None, end: float | None = None) -> Oscillation:
     """The oscillation of one column of a sampled run or measurement in a frequency band: the time-domain measure
     of judder (a launch's vehicle or gearbox speed, a rig's torque).
@@ -340,11 +351,7 @@ def oscillation(frame, column: str, band_Hz, *, start: float | None = None, end:
     y = frame[column].to_numpy(dtype=float)
     if t.size < 16 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
         raise ParameterError(f"oscillation: {column} needs at least 16 finite samples (got {t.size})")
-    dt = np.diff(t)
-    h = float(np.median(dt))
-    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
-        raise ParameterError(f"oscillation: {column}: time_s must be sampled at a constant interval (from "
-                             f"{dt.min():g} to {dt.max():g} s); resample it first")
+    h = sample_interval(t, f"oscillation: {column}")
     try:
         lo, hi = (float(b) for b in band_Hz)
     except (TypeError, ValueError):

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from .judder import sample_interval
 
 __all__ = ["ShiftQuality", "shift_quality", "METRICS"]
 
@@ -241,11 +242,7 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     t = df["time_s"].to_numpy(float)
     if t.size < 8:
         raise ParameterError(f"shift_quality: needs at least 8 samples (got {t.size})")
-    dt = np.diff(t)
-    h = float(np.median(dt))
-    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
-        raise ParameterError(f"shift_quality: time_s must be sampled at a constant interval (from {dt.min():g} to "
-                             f"{dt.max():g} s); resample it first")
+    h = sample_interval(t, label)
     signed_off = df[f"{offgoing}.tau_Nm"].to_numpy(float)
     tau_off, tau_on = np.abs(signed_off), np.abs(df[f"{oncoming}.tau_Nm"].to_numpy(float))
     w_off, w_on = (np.abs(df[f"{c}.w_rel_rad_s"].to_numpy(float)) for c in (offgoing, oncoming))
