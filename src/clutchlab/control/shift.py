@@ -160,7 +160,9 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         the names below (read without a map).
     offgoing, oncoming : str
         The two clutches: their columns ``<name>.tau_Nm`` (friction torque [N m]) and ``<name>.w_rel_rad_s``
-        (slip speed [rad/s]) are read.
+        (slip speed [rad/s]) are read, in one sign convention: a sliding clutch's torque has its slip's sign
+        (clutchlab's and the Modelica library's; where a rig's logger differs, negate one of the two columns of
+        its record first), which the flare and the tie-up read.
     output : str
         The output shaft's (or the wheels') speed: a column, or an inertia whose ``<name>.w_rad_s`` is read; or the
         vehicle's speed, a column whose name ends in ``_m_s`` [m/s] (a rig's or a CAN log's), whose derivative is
