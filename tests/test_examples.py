@@ -388,7 +388,20 @@ def check_shift(work, out):
     assert "lock-up at" in out and _is_png(work / "shift.png")
 
 
+def check_dct_sweep(work, out):
+    frame = pd.read_parquet(work / "results_dct" / "results.parquet").set_index(
+        ["c1.normal.time_scale", "c2.normal.value_scale"])
+    assert len(frame) == 15
+    assert frame.loc[(0.6, 1.0), "shift.flare_rad_s"] > 30.0 and frame.loc[(0.6, 1.0), "shift.tie_up_Nm"] == 0.0
+    assert frame.loc[(1.3, 1.0), "shift.tie_up_Nm"] > 100.0 and frame.loc[(1.3, 1.0), "shift.flare_rad_s"] == 0.0
+    assert frame.loc[(1.0, 1.0), "shift.tie_up_Nm"] < 20.0 and frame.loc[(1.0, 1.0), "shift.flare_rad_s"] == 0.0
+    # (the tie-up grows with the release's delay at each on-coming capacity)
+    for k in (0.8, 1.0, 1.1):
+        assert frame.xs(k, level=1)["shift.tie_up_Nm"].loc[[1.0, 1.15, 1.3]].is_monotonic_increasing
+
+
 CHECKS = {
+    "results_dct/": check_dct_sweep,
     "shift.json": check_shift,
     "judder.json": check_judder,
     "awd.csv": check_awd,

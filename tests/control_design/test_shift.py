@@ -1,4 +1,4 @@
-"""Shift quality (clutchlab.control.shift): the phases and metrics of a clutch-to-clutch shift against closed forms
+"""Shift quality (clutchlab.driveline.shift): the phases and metrics of a clutch-to-clutch shift against closed forms
 of a designed record, and against the events and the clutches' own dissipation in a dual-clutch upshift run."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis_budget import examples
 
-from clutchlab.control.shift import shift_quality
+from clutchlab.driveline.shift import shift_quality
 from clutchlab.errors import ParameterError
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
@@ -350,3 +350,52 @@ def test_a_late_release_ties_up_and_an_early_one_flares_in_the_dual_clutch_upshi
         assert m["flare_rad_s"] > 30.0 and m["tie_up_Nm"] < 1.0
     else:
         assert m["tie_up_Nm"] < 20.0 and m["flare_rad_s"] < 6.0
+
+
+def test_the_file_s_shift_table_feeds_the_command_line_and_the_sweep_s_shift_outputs(tmp_path, capsys):
+    """The example's [shift] table: `clutchlab control shift FILE` needs no names, and the driveline sweep's
+    `shift.<metric>` outputs over the off-going clutch's release stretched in time (its table's time_scale) equal
+    shift_quality of each variant's own run; released early (0.6) it flares, late (1.3) it ties up."""
+    import tomllib
+
+    from cli_checks import one_line_error
+
+    from clutchlab.cli import main
+    from clutchlab.driveline.description import load_driveline, parse_driveline
+    from clutchlab.driveline.variants import DrivelineDocument
+    from clutchlab.sweep import driveline as S
+
+    path = ROOT / "examples" / "driveline_dct_upshift.toml"
+    spec = load_driveline(path)
+    assert spec.shift == {"offgoing": "c1", "oncoming": "c2", "output": "wheels", "engine": "engine", "radius": 0.3}
+    out = tmp_path / "shift.json"
+    assert main(["control", "shift", str(path), "-o", str(out)]) == 0
+    capsys.readouterr()
+    ref = shift_quality(spec.driveline.simulate(spec.t_end, rtol=spec.rtol, output_step=spec.output_step),
+                        **spec.shift)
+    assert json.loads(out.read_text())["metrics"]["jerk_peak_m_s3"] == pytest.approx(ref.metrics["jerk_peak_m_s3"],
+                                                                                    rel=1e-12)
+    scenario = {**tomllib.loads(path.read_text()), "_source": str(path)}
+    described = S.describe(scenario)["outputs"]
+    assert described["shift.tie_up_Nm"] == "N*m" and "shift.jerk_peak_m_s3" in described
+    outputs = ["shift.flare_rad_s", "shift.tie_up_Nm", "shift.jerk_peak_m_s3", "shift.shift_time_s", "status"]
+    variants = pd.DataFrame({"c1.normal.time_scale": [0.6, 1.0, 1.3]}).rename_axis("variant_id")
+    got = S.run_batch(variants, scenario, outputs)
+    doc = DrivelineDocument(scenario, scenario["_source"])
+    for vid, row in variants.iterrows():
+        one = doc.load(row.to_dict())
+        q = shift_quality(one.driveline.simulate(one.t_end, rtol=one.rtol, output_step=one.output_step),
+                          **one.shift)
+        for name in outputs[:-1]:
+            assert got.loc[vid, name] == pytest.approx(q.metrics[name.removeprefix("shift.")], rel=1e-6, abs=1e-9)
+    assert got.loc[0, "shift.flare_rad_s"] > 30.0 and got.loc[2, "shift.tie_up_Nm"] > 100.0
+    # the table's refusals, naming the file and the key
+    text = tomllib.loads(path.read_text())
+    for change, message in (({"offgoing": "c9"}, "shift.offgoing = 'c9': expected the name of a friction element"),
+                            ({"output": "c1"}, "shift.output = 'c1': expected the name of an inertia"),
+                            ({"radius": "3 s"}, "shift.radius"), ({"gear": 2}, "shift.gear: unknown field")):
+        bad = {**text, "shift": {**text["shift"], **change}}
+        with pytest.raises(ParameterError, match=message):
+            parse_driveline(bad, "dct.toml")
+    line = one_line_error(capsys, ["control", "shift", str(ROOT / "examples" / "driveline_coupled_clutches.toml")])
+    assert "give --offgoing, --oncoming, --shaft (or a [shift] table in the driveline file)" in line

@@ -154,8 +154,7 @@ def test_warmup_group_compiles_what_the_section_runs():
 
 def test_the_dual_clutch_upshift_shows_its_shift_quality(section):
     """The DCT example's shift: its figure, and its metrics' table equal to shift_quality of a direct run."""
-    from clutchlab.control.shift import shift_quality
-    from clutchlab.demo.driveline import SHIFTS
+    from clutchlab.driveline.shift import shift_quality
 
     names = {i.name for i in section.items if isinstance(i, Figure)}
     assert "driveline_dct_upshift_shift" in names and "driveline_dct_upshift_speeds" in names
@@ -163,7 +162,7 @@ def test_the_dual_clutch_upshift_shows_its_shift_quality(section):
     shown = tables["driveline_dct_upshift_shift_quality"].set_index("metric")
     spec = load_driveline(ROOT / "examples" / "driveline_dct_upshift.toml")
     res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=spec.output_step)
-    q = shift_quality(res, **SHIFTS["dct_upshift.toml"])
+    q = shift_quality(res, **spec.shift)   # (the file's [shift] table)
     for k, v in q.metrics.items():
         assert shown.loc[k, "value"] == pytest.approx(v, rel=1e-9, nan_ok=True), k
     assert shown.loc["jerk_peak_m_s3", "unit"] == "m_s3"

@@ -109,21 +109,21 @@ def register(subparsers) -> None:
                                                     "e.g. '1 kHz' (a record logged at several rates)")
     shift.add_argument("--dbc", action="append", metavar="DATABASE",
                        help="CAN database (.dbc, .arxml) decoding an MDF bus log's frames (repeatable)")
-    shift.add_argument("--offgoing", required=True, metavar="CLUTCH", help="the off-going clutch, e.g. c1")
-    shift.add_argument("--oncoming", required=True, metavar="CLUTCH", help="the on-coming clutch, e.g. c2")
-    shift.add_argument("--shaft", required=True, metavar="NAME",
+    shift.add_argument("--offgoing", metavar="CLUTCH", help="the off-going clutch, e.g. c1 (a driveline: default its [shift] table's)")
+    shift.add_argument("--oncoming", metavar="CLUTCH", help="the on-coming clutch, e.g. c2 (a driveline: default its [shift] table's)")
+    shift.add_argument("--shaft", metavar="NAME",
                        help="the output's speed (the output shaft's or the wheels'): an inertia (its <name>.w_rad_s) "
-                            "or a column, e.g. wheels")
+                            "or a column, e.g. wheels (a driveline: default its [shift] table's output)")
     shift.add_argument("--engine", default=None, metavar="NAME", help="the engine's speed, for its flare")
     shift.add_argument("--radius", default=None,
                        help="travel per radian of the output (tyre radius over the axle ratio behind it), e.g. "
                             "'0.3 m': the acceleration in m/s^2 (default: the output's angular acceleration)")
     shift.add_argument("--start", default=None, help="the shift's start, e.g. '0.5 s' (default: from the columns)")
-    shift.add_argument("--threshold", type=float, default=0.02,
+    shift.add_argument("--threshold", type=float, default=None,
                        help="share of the largest torque and slip below which a clutch carries nothing or is "
                             "locked (default 0.02)")
-    shift.add_argument("--settle", default="0.3 s", help="read the acceleration this long after the shift's end "
-                                                         "(default 0.3 s)")
+    shift.add_argument("--settle", default=None, help="read the acceleration this long after the shift's end "
+                                                      "(default 0.3 s)")
     shift.add_argument("--filter", default=None, help="low-pass the output's speed at this frequency before it is "
                                                       "differentiated, for a rig's record, e.g. '20 Hz'")
     shift.add_argument("-o", "--output", dest="write", default=None,
@@ -377,7 +377,7 @@ def _shift(args) -> int:
     """``control shift``: the phases and metrics of a clutch-to-clutch shift in a simulated network or a record."""
     import json
 
-    from ..control.shift import shift_quality
+    from ..driveline.shift import shift_quality
     from ..io.files import OutputSet, atomic_to_csv, atomic_write_bytes, atomic_write_text
     from ..units import to_si
 
@@ -386,11 +386,12 @@ def _shift(args) -> int:
     if args.plot is not None and not args.plot.lower().endswith(".png"):
         raise ParameterError(f"--plot {args.plot}: expected a .png file")
     outputs = OutputSet([args.write, args.plot], args.force)   # checked before the run; written together
-    options = dict(offgoing=args.offgoing, oncoming=args.oncoming, output=args.shaft, engine=args.engine,
-                   threshold=args.threshold, settle=to_si(args.settle, "s", name="--settle"),
-                   radius=None if args.radius is None else to_si(args.radius, "m", name="--radius"),
-                   start=None if args.start is None else to_si(args.start, "s", name="--start"),
-                   filter_Hz=None if args.filter is None else to_si(args.filter, "Hz", name="--filter"))
+    given = dict(offgoing=args.offgoing, oncoming=args.oncoming, output=args.shaft, engine=args.engine,
+                 threshold=args.threshold, settle=None if args.settle is None else to_si(args.settle, "s",
+                                                                                         name="--settle"),
+                 radius=None if args.radius is None else to_si(args.radius, "m", name="--radius"),
+                 start=None if args.start is None else to_si(args.start, "s", name="--start"),
+                 filter_Hz=None if args.filter is None else to_si(args.filter, "Hz", name="--filter"))
     if args.source.lower().endswith(".toml") and (args.channel_map or args.rate or args.dbc):
         raise ParameterError("--channel-map, --rate and --dbc read a record; a driveline's run has clutchlab's names")
     if args.source.lower().endswith(".toml"):
@@ -402,14 +403,21 @@ def _shift(args) -> int:
                                  "a constant interval)")
         source = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step,
                                          output_step=spec.output_step)
+        file_shift = spec.shift or {}
     elif args.source.lower().endswith((".csv", ".txt", ".parquet", ".mf4", ".mdf")):
         from ..io import read_measurement
 
         rate = None if args.rate is None else to_si(args.rate, "Hz", name="--rate")
         source = read_measurement(args.source, args.channel_map, rate=rate, databases=tuple(args.dbc or ()))
+        file_shift = {}
     else:
         raise ParameterError(f"{args.source}: expected a driveline description (.toml) or a record (.csv, "
                              ".parquet, .mf4)")
+    options = {**file_shift, **{k: v for k, v in given.items() if v is not None}}   # (the options win over the file)
+    missing = [flag for flag, key in (("--offgoing", "offgoing"), ("--oncoming", "oncoming"), ("--shaft", "output"))
+               if key not in options]
+    if missing:
+        raise ParameterError(f"{args.source}: give {', '.join(missing)} (or a [shift] table in the driveline file)")
     q = shift_quality(source, **options)
     png = None
     if args.plot is not None:

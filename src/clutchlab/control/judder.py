@@ -35,6 +35,7 @@ import math
 
 import numpy as np
 
+from ..driveline.shift import sample_interval
 from ..errors import ParameterError
 from ..system import Simulation, System
 from ..trim import OperatingPoint, state_scale
@@ -299,17 +300,6 @@ class Oscillation:
     rms: float
     frequency_Hz: float
     band_Hz: tuple
-
-
-def sample_interval(t, what: str) -> float:
-    """The constant interval [s] of the sample times ``t`` (within 1e-6 of their median spacing); else a
-    :class:`~clutchlab.errors.ParameterError` naming ``what`` (a record's filters and differences need it)."""
-    dt = np.diff(t)
-    h = float(np.median(dt))
-    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
-        raise ParameterError(f"{what}: time_s must be sampled at a constant interval (from {dt.min():g} to "
-                             f"{dt.max():g} s); resample it first")
-    return h
 
 
 def oscillation(frame, column: str, band_Hz, *, start: float | None = None, end: float | None = None) -> Oscillation:

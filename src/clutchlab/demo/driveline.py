@@ -20,15 +20,11 @@ import pandas as pd
 
 from ..report import Figure, Section, Table, Text
 
-__all__ = ["EXAMPLES", "SHIFTS", "PROVENANCE", "demo_section", "example_items", "run_example", "mode_intervals",
+__all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_example", "mode_intervals",
            "header_comment"]
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
 EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml")
-
-#: examples that are a clutch-to-clutch shift: file -> the arguments of :func:`clutchlab.control.shift_quality` (the
-#: section adds the shift's figure and its metrics)
-SHIFTS = {"dct_upshift.toml": dict(offgoing="c1", oncoming="c2", output="wheels", engine="engine", radius=0.3)}
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "
@@ -238,8 +234,8 @@ def example_items(name: str, progress=None) -> tuple:
              f"dissipated): the integrator's error at rtol = {spec.rtol:g}, not a modelling error (the energy "
              f"states are integrated with the motion)."),
     ]
-    if name in SHIFTS:
-        items += _shift_items(stem, d.name, result, SHIFTS[name])
+    if spec.shift:   # (a file with a [shift] table: the shift's figure and its metrics)
+        items += _shift_items(stem, d.name, result, spec.shift)
     params = _network_parameters(stem, d)
     step = "every accepted step" if spec.output_step is None else f"{spec.output_step:g} s"
     params[f"{stem}: simulation"] = f"t_end = {spec.t_end:g} s, output step {step}, rtol = {spec.rtol:g}"
@@ -249,7 +245,7 @@ def example_items(name: str, progress=None) -> tuple:
 def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
     """The shift quality of an example that is a clutch-to-clutch shift: its figure, metrics and a text."""
     from ..control.plots import shift_figure
-    from ..control.shift import shift_quality
+    from ..driveline.shift import shift_quality
 
     q = shift_quality(result, **arguments)
     m = q.metrics

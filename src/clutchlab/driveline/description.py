@@ -26,6 +26,12 @@
     peak = 1.1
     normal = { sine = { amplitude = 1, frequency = "0.2 Hz", phase = "90 deg" } }
 
+    [shift]                   # optional: the clutch-to-clutch shift the network makes (a dual-clutch upshift)
+    offgoing = "c1"           # friction elements of the network
+    oncoming = "c2"
+    output = "wheels"         # an inertia; engine, the engine's (optional)
+    radius = "0.3 m"          # optional, as threshold, settle, pre (clutchlab.driveline.shift.shift_quality)
+
 Component tables are the registered component kinds, each declared once with its fields' units,
 defaults and physical ranges (:mod:`clutchlab.component`, :mod:`clutchlab.driveline.components`;
 ``clutchlab driveline components [KIND]``, docs/components.md); a value outside its range is refused
@@ -161,6 +167,9 @@ class DrivelineFile:
         Relative tolerance (default 1e-8).
     max_step : float or None
         Largest step [s].
+    shift : dict or None
+        The ``[shift]`` table: the keyword arguments of :func:`clutchlab.driveline.shift.shift_quality` for the
+        clutch-to-clutch shift the network makes (``clutchlab control shift FILE``, the sweep's ``shift.<metric>``).
     """
 
     driveline: Driveline
@@ -168,6 +177,7 @@ class DrivelineFile:
     output_step: float | None = None
     rtol: float = 1e-8
     max_step: float | None = None
+    shift: dict | None = None
 
 
 def _quantity(value, unit, key, src):
@@ -469,7 +479,7 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
                              f"reads a file), not {type(doc).__name__}")
     base = Path(base) if base is not None else Path(src).parent
     by_domain = {dom: tables(dom) for dom in ("rotational", "translational")}
-    known = {"driveline", "simulation", "input", *by_domain["rotational"], *by_domain["translational"]}
+    known = {"driveline", "simulation", "input", "shift", *by_domain["rotational"], *by_domain["translational"]}
     for top in doc:
         if top not in known:
             raise ParameterError(f"{src}: unknown table [{top}] (known: {', '.join(sorted(known))})")
@@ -497,7 +507,7 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
         if k == "rtol":
             check_rtol(v, f"{src}: simulation.rtol")   # (the one rule of every model: at least RTOL_MIN)
     for top in doc:
-        if top in known and top not in table_fields and top not in ("driveline", "simulation", "input"):
+        if top in known and top not in table_fields and top not in ("driveline", "simulation", "input", "shift"):
             other = "translational" if domain == "rotational" else "rotational"
             raise ParameterError(f"{src}: [{top}] belongs to a {other} driveline (this one is {domain}; set "
                                  f"[driveline] domain)")
@@ -544,4 +554,34 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
         raise ParameterError(f"{src}: {exc}") from None
     _declare_inputs(d, declared, uses, src)
     return DrivelineFile(d, settings.get("t_end"), settings.get("output_step"), settings.get("rtol", 1e-8),
-                         settings.get("max_step"))
+                         settings.get("max_step"), _shift(doc.get("shift"), d, src))
+
+
+def _shift(table, d: Driveline, src: str):
+    """The ``[shift]`` table: the keyword arguments of :func:`clutchlab.driveline.shift.shift_quality` for the shift
+    the network makes (names checked against it, quantities in SI), or None without one."""
+    from .shift import SHIFT_FIELDS
+
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ParameterError(f"{src}: [shift] must be a table (offgoing, oncoming, output, ...)")
+    for k in table:
+        if k not in SHIFT_FIELDS:
+            raise ParameterError(f"{src}: shift.{k}: unknown field (known: {', '.join(SHIFT_FIELDS)})")
+    for k in ("offgoing", "oncoming", "output"):
+        if k not in table:
+            raise ParameterError(f"{src}: [shift]: missing field {k!r}")
+    friction, bodies = set(d.friction_names), set(d.inertia_names)
+    out = {}
+    for k, v in table.items():
+        if SHIFT_FIELDS[k] is not None:
+            out[k] = _quantity(v, SHIFT_FIELDS[k], f"shift.{k}", src)
+            continue
+        kinds = friction if k in ("offgoing", "oncoming") else bodies
+        if not isinstance(v, str) or v not in kinds:
+            what = "a friction element" if k in ("offgoing", "oncoming") else "an inertia"
+            raise ParameterError(f"{src}: shift.{k} = {v!r}: expected the name of {what} of the network "
+                                 f"({', '.join(sorted(kinds))})")
+        out[k] = v
+    return out

@@ -41,6 +41,9 @@ Outputs per variant (names carry their unit, as the driveline's columns):
 ``<variable>_max_<unit>``             unit   largest value over the samples
 ``<variable>_final_<unit>``           unit   value at ``t_end``
 ``<speed>_jerk_<unit>3``              /s^2   largest ``abs(d^2 w / dt^2)`` of a speed over the samples
+``shift.<metric>``                    unit   with a ``[shift]`` table in the file: the quality of its shift
+                                             (:func:`clutchlab.driveline.shift.shift_quality`; NaN where the
+                                             variant's shift does not complete)
 ====================================  =====  =============================================================
 
 The metrics of the last four rows exist for every state and output of the network, named by its column
@@ -69,6 +72,7 @@ from ..numerics.status import Status
 from ..units import COLUMN_UNITS
 from ..sweep.targets import check_outputs, nan_frame, rows
 from ..system import batch_groups, simulate, simulate_batch
+from ..driveline.shift import metric_names, shift_quality
 from ..driveline.variants import DrivelineDocument
 
 __all__ = ["run_batch", "describe", "check_variants", "referenced_files", "outputs_of", "metrics_of", "REDUCTIONS",
@@ -132,13 +136,16 @@ def _metric(time, values, reduction) -> float:
     return float(np.max(np.abs(np.gradient(np.gradient(values, time), time))))
 
 
-def outputs_of(driveline) -> dict:
+def outputs_of(driveline, shift=None) -> dict:
     """The sweep outputs of a driveline network, name -> unit.
 
     Parameters
     ----------
     driveline : Driveline
         The network of the scenario.
+    shift : dict, optional
+        The file's ``[shift]`` table (:attr:`~clutchlab.driveline.description.DrivelineFile.shift`): its shift's
+        quality metrics are outputs ``shift.<metric>`` (:func:`clutchlab.driveline.shift.metric_names`).
     """
     system = driveline.system()
     out = {}
@@ -152,7 +159,24 @@ def outputs_of(driveline) -> dict:
     out.update({"dissipated_energy_J": "J", "energy_error_J": "J", "status": "1"})
     for name, (unit, *_) in metrics_of(system).items():
         out.setdefault(name, unit)
+    if shift:
+        for name, unit in metric_names("radius" in shift).items():
+            out[f"shift.{name}"] = COLUMN_UNITS[unit][0] if unit in COLUMN_UNITS else unit
     return out
+
+
+def _shift_metrics(system, time, states, outputs, shift, wanted) -> dict:
+    """The ``shift.<metric>`` outputs of one variant: :func:`clutchlab.driveline.shift.shift_quality` of its samples
+    (the network's columns), NaN where its shift does not complete within the run (no hand-over or lock-up)."""
+    if not any(name.startswith("shift.") for name in wanted):
+        return {}
+    frame = pd.DataFrame({"time_s": time, **{v.column: states[:, i] for i, v in enumerate(system.states)},
+                          **{v.column: outputs[:, i] for i, v in enumerate(system.outputs)}})
+    try:
+        q = shift_quality(frame, **shift)
+    except ParameterError:
+        return {}
+    return {f"shift.{k}": v for k, v in q.metrics.items()}
 
 
 def describe(scenario) -> dict:
@@ -166,7 +190,7 @@ def describe(scenario) -> dict:
     doc, base = _base(scenario)
     return {"parameters": {p.name: p.unit for p in (*doc.parameters.values(), *doc.input_starts.values(),
                                                     *doc.signal_parameters.values())},
-            "outputs": outputs_of(base.driveline)}
+            "outputs": outputs_of(base.driveline, base.shift)}
 
 
 def referenced_files(scenario) -> list:
@@ -221,7 +245,7 @@ def _last_sticks(events) -> dict:
     return stick.groupby([variant, stick["element"]])["time_s"].max().to_dict()
 
 
-def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metrics=None):
+def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metrics=None, shift=None):
     """Outputs of one variant: its samples ``states`` (n, n_x), ``outputs`` (n, n_y) at ``time``, ``{element: last
     stick}``, and the metrics of :func:`metrics_of` named in ``wanted`` (``metrics``: those of ``system``, or of
     any variant of the same network: the variants share their variables)."""
@@ -247,6 +271,8 @@ def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metric
         got[f"{element}.last_stick_s"] = last_stick.get(element, np.nan)
     got["dissipated_energy_J"] = outputs[-1, system.output_index("dissipated_energy")]
     got["energy_error_J"] = float(np.max(np.abs(outputs[:, system.output_index("energy_error")])))
+    if shift:
+        got.update(_shift_metrics(system, time, states, outputs, shift, wanted))
     return got
 
 
@@ -268,7 +294,7 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
         Same index, one column per output (NaN where a variant failed or has no value).
     """
     doc, base = _base(scenario)
-    check_outputs("driveline", outputs, outputs_of(base.driveline))
+    check_outputs("driveline", outputs, outputs_of(base.driveline, base.shift))
     built = _systems(doc, variants)
     if not built:
         return nan_frame(variants.index, outputs)
@@ -287,10 +313,11 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
             if dropped[j]:  # more events than the batch keeps: this variant again, alone, with every event
                 one = simulate(_system(doc, vid, row), t_end, check=False, **options)
                 alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
-                got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics)
+                got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics,
+                              base.shift)
             else:
                 mine = {e: sticks[(j, e)] for e in system.mode_names if (j, e) in sticks}
                 got = _reduce(system, res.time, res.states[j], res.outputs[j], mine, int(res.status[j]), outputs,
-                              metrics)
+                              metrics, base.shift)
             values[k] = [got.get(name, np.nan) for name in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))

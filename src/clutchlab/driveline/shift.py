@@ -28,9 +28,8 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from .judder import sample_interval
 
-__all__ = ["ShiftQuality", "shift_quality", "METRICS"]
+__all__ = ["ShiftQuality", "shift_quality", "METRICS", "metric_names", "sample_interval", "SHIFT_FIELDS"]
 
 #: the metrics of :class:`ShiftQuality` (name, unit, description); ``{a}`` is the unit of the acceleration
 #: (``m_s2`` with a radius, else ``rad_s2``), ``{j}`` of the jerk, ``{v}`` of the vibration dose value
@@ -61,6 +60,19 @@ METRICS = (
     ("offgoing_peak_power_W", "W", "largest |tau w_rel| of the off-going clutch during the shift"),
     ("oncoming_peak_power_W", "W", "largest |tau w_rel| of the on-coming clutch during the shift"),
 )
+
+
+#: the keys of a driveline file's ``[shift]`` table (the shift its network makes, for ``clutchlab control shift`` and
+#: the sweep's ``shift.<metric>`` outputs): key -> SI unit of a quantity, or None for a name of the network
+SHIFT_FIELDS = {"offgoing": None, "oncoming": None, "output": None, "engine": None, "radius": "m", "threshold": "1",
+                "settle": "s", "pre": "s"}
+
+
+def metric_names(vehicle: bool) -> dict:
+    """The metrics' names (:data:`METRICS`) -> their units, with the acceleration in m/s^2 (``vehicle``: a radius
+    given, or the vehicle's speed as the output) or in rad/s^2."""
+    a, j, v = ("m_s2", "m_s3", "m_s1_75") if vehicle else ("rad_s2", "rad_s3", "rad_s1_75")
+    return {name.format(a=a, j=j, v=v): unit.format(a=a, j=j, v=v) for name, unit, _ in METRICS}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,6 +139,17 @@ class ShiftQuality:
                 f"{self.lockup_s:.4f} s")
         rows = [f"  {k:<34s} {v:>12.5g} {units[k]}" for k, v in self.metrics.items()]
         return "\n".join([head, *rows])
+
+
+def sample_interval(t, what: str) -> float:
+    """The constant interval [s] of the sample times ``t`` (within 1e-6 of their median spacing); else a
+    :class:`~clutchlab.errors.ParameterError` naming ``what`` (a record's filters and differences need it)."""
+    dt = np.diff(t)
+    h = float(np.median(dt))
+    if not h > 0 or np.max(np.abs(dt - h)) > 1e-6 * h:
+        raise ParameterError(f"{what}: time_s must be sampled at a constant interval (from {dt.min():g} to "
+                             f"{dt.max():g} s); resample it first")
+    return h
 
 
 def _trapezoid(y, x) -> float:
