@@ -369,7 +369,9 @@ def test_the_file_s_shift_table_feeds_the_command_line_and_the_sweep_s_shift_out
     spec = load_driveline(path)
     assert spec.shift == {"offgoing": "c1", "oncoming": "c2", "output": "wheels", "engine": "engine", "radius": 0.3}
     out = tmp_path / "shift.json"
-    assert main(["control", "shift", str(path), "-o", str(out)]) == 0
+    png = tmp_path / "shift.png"
+    assert main(["control", "shift", str(path), "-o", str(out), "--plot", str(png)]) == 0   # (names from the file)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     capsys.readouterr()
     ref = shift_quality(spec.driveline.simulate(spec.t_end, rtol=spec.rtol, output_step=spec.output_step),
                         **spec.shift)

@@ -14,7 +14,7 @@ layer over :mod:`clutchlab.control`.
     a timeline along the run);
 ``clutchlab control shift examples/driveline_dct_upshift.toml --offgoing c1 --oncoming c2 --shaft wheels``
     with ``--engine engine --radius "0.3 m" -o shift.json``: the phases and quality metrics of a clutch-to-clutch
-    shift in the network's run (or in a CSV record of a run or a rig);
+    shift in the network's run (or in a record of a run or a rig; a driveline's [shift] table names the clutches);
 ``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
     with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
     "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
@@ -95,9 +95,10 @@ def register(subparsers) -> None:
     shift = sub.add_parser("shift", help="shift quality of a clutch-to-clutch gear shift (a run or a rig's record)",
                            description="The phases (torque phase, inertia phase) and the quality metrics of one "
                                        "clutch-to-clutch shift: its times, the output's acceleration dip, jerk and "
-                                       "vibration dose value, the lock-up slip rate, the engine's flare and each "
-                                       "clutch's heat. SOURCE is a driveline (TOML: simulated with its [simulation] "
-                                       "settings) or a CSV of a run or a rig's record with the clutches' "
+                                       "vibration dose value, the lock-up slip rate, the off-going clutch's flare "
+                                       "and tie-up and each clutch's heat. SOURCE is a driveline (TOML: simulated "
+                                       "with its [simulation] settings; its [shift] table names the clutches) or a "
+                                       "record of a run or a rig (CSV, Parquet, MDF 4) with the clutches' "
                                        "<name>.tau_Nm and <name>.w_rel_rad_s, the output's speed and time_s at a "
                                        "constant interval.",
                            epilog="Documentation: docs/control.md (Shift quality)")
@@ -109,12 +110,14 @@ def register(subparsers) -> None:
                                                     "e.g. '1 kHz' (a record logged at several rates)")
     shift.add_argument("--dbc", action="append", metavar="DATABASE",
                        help="CAN database (.dbc, .arxml) decoding an MDF bus log's frames (repeatable)")
-    shift.add_argument("--offgoing", metavar="CLUTCH", help="the off-going clutch, e.g. c1 (a driveline: default its [shift] table's)")
-    shift.add_argument("--oncoming", metavar="CLUTCH", help="the on-coming clutch, e.g. c2 (a driveline: default its [shift] table's)")
+    shift.add_argument("--offgoing", metavar="CLUTCH",
+                       help="the off-going clutch, e.g. c1 (a driveline: default its [shift] table's)")
+    shift.add_argument("--oncoming", metavar="CLUTCH",
+                       help="the on-coming clutch, e.g. c2 (a driveline: default its [shift] table's)")
     shift.add_argument("--shaft", metavar="NAME",
                        help="the output's speed (the output shaft's or the wheels'): an inertia (its <name>.w_rad_s) "
                             "or a column, e.g. wheels (a driveline: default its [shift] table's output)")
-    shift.add_argument("--engine", default=None, metavar="NAME", help="the engine's speed, for its flare")
+    shift.add_argument("--engine", default=None, metavar="NAME", help="the engine's speed, drawn in the figure")
     shift.add_argument("--radius", default=None,
                        help="travel per radian of the output (tyre radius over the axle ratio behind it), e.g. "
                             "'0.3 m': the acceleration in m/s^2 (default: the output's angular acceleration)")
@@ -425,7 +428,8 @@ def _shift(args) -> int:
 
         from ..control.plots import shift_figure
 
-        png = _png(shift_figure(q, title=f"{Path(args.source).name}: {q.order}, {args.offgoing} to {args.oncoming}"))
+        png = _png(shift_figure(q, title=f"{Path(args.source).name}: {q.order}, {q.columns['offgoing']} to "
+                                         f"{q.columns['oncoming']}"))
     with outputs:
         if png is not None:
             atomic_write_bytes(outputs.staged(args.plot), png, overwrite=args.force)
