@@ -222,8 +222,8 @@ def judder_figure(timeline, *, title: str = ""):
 def shift_figure(quality, *, title: str = ""):
     """A clutch-to-clutch shift and its phases (:func:`clutchlab.control.shift_quality`): the engine's speed and the
     clutches' slip speeds [rpm], their torques, the output's acceleration (its level before the shift and its dip
-    marked) and its jerk, with the torque phase and the inertia phase shaded and the shift's end, the hand-over and
-    the lock-up marked.
+    marked) and its jerk, with the torque phase and the inertia phase shaded (bounded by the start, the hand-over
+    and the lock-up).
 
     Parameters
     ----------

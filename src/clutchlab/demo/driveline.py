@@ -249,6 +249,8 @@ def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
 
     q = shift_quality(result, **arguments)
     m = q.metrics
+    a, j = ("m_s2", "m_s3") if "acceleration_dip_m_s2" in m else ("rad_s2", "rad_s3")   # (with a radius: the vehicle's)
+    au, ju = a.replace("_s", "/s^"), j.replace("_s", "/s^")
     return [
         Figure(f"driveline_{stem}_shift", shift_figure(q, title=f"{name}: shift quality"),
                f"The {q.order} from {arguments['offgoing']} to {arguments['oncoming']}: the engine's speed and the "
@@ -260,8 +262,8 @@ def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
               float_format="{:.4g}"),
         Text(f"Shift quality (docs/control.md, \"Shift quality\"): the torque phase lasts "
              f"{1e3 * m['torque_phase_s']:.0f} ms and the inertia phase {1e3 * m['inertia_phase_s']:.0f} ms; the "
-             f"vehicle's acceleration dips by {m['acceleration_dip_m_s2']:.2f} m/s^2 from "
-             f"{m['acceleration_before_m_s2']:.2f} m/s^2, the jerk peaks at {m['jerk_peak_m_s3']:.0f} m/s^3 where "
+             f"output's acceleration dips by {m['acceleration_dip_' + a]:.2f} {au} from "
+             f"{m['acceleration_before_' + a]:.2f} {au}, the jerk peaks at {m['jerk_peak_' + j]:.0f} {ju} where "
              f"the on-coming clutch locks (its slip falling at {m['lockup_slip_rate_rad_s2']:.0f} rad/s^2) and the "
              f"half shafts ring, and the on-coming clutch takes {m['oncoming_energy_J'] / 1e3:.1f} kJ."),
     ]
