@@ -125,13 +125,8 @@ class ShiftQuality:
                              "unit": [units[k] for k in self.metrics], "description": [docs[k] for k in self.metrics]})
 
     def _described(self):
-        a = "m_s2" if "acceleration_dip_m_s2" in self.metrics else "rad_s2"
-        j, v = ("m_s3", "m_s1_75") if a == "m_s2" else ("rad_s3", "rad_s1_75")
-        units, docs = {}, {}
-        for name, unit, doc in METRICS:
-            key = name.format(a=a, j=j, v=v)
-            units[key], docs[key] = unit.format(a=a, j=j, v=v), doc
-        return units, docs
+        units = metric_names("acceleration_dip_m_s2" in self.metrics)
+        return units, dict(zip(units, (doc for _, _, doc in METRICS)))
 
     def __str__(self) -> str:
         units, _ = self._described()

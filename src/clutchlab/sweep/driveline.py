@@ -165,15 +165,14 @@ def outputs_of(driveline, shift=None) -> dict:
     return out
 
 
-def _shift_metrics(system, time, states, outputs, shift, wanted) -> dict:
+def _shift_metrics(frame, shift, wanted) -> dict:
     """The ``shift.<metric>`` outputs of one variant: :func:`clutchlab.driveline.shift.shift_quality` of its samples
-    (the network's columns), NaN where its shift does not complete within the run (no hand-over or lock-up)."""
+    (``frame()``: its run's :meth:`~clutchlab.result.SimulationResult.to_dataframe`, built only when a shift metric is
+    wanted), NaN where its shift does not complete within the run (no hand-over or lock-up)."""
     if not any(name.startswith("shift.") for name in wanted):
         return {}
-    frame = pd.DataFrame({"time_s": time, **{v.column: states[:, i] for i, v in enumerate(system.states)},
-                          **{v.column: outputs[:, i] for i, v in enumerate(system.outputs)}})
     try:
-        q = shift_quality(frame, **shift)
+        q = shift_quality(frame(), **shift)
     except ParameterError:
         return {}
     return {f"shift.{k}": v for k, v in q.metrics.items()}
@@ -245,10 +244,11 @@ def _last_sticks(events) -> dict:
     return stick.groupby([variant, stick["element"]])["time_s"].max().to_dict()
 
 
-def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metrics=None, shift=None):
+def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metrics=None, shift=None, frame=None):
     """Outputs of one variant: its samples ``states`` (n, n_x), ``outputs`` (n, n_y) at ``time``, ``{element: last
     stick}``, and the metrics of :func:`metrics_of` named in ``wanted`` (``metrics``: those of ``system``, or of
-    any variant of the same network: the variants share their variables)."""
+    any variant of the same network: the variants share their variables); with the file's ``[shift]`` table
+    (``shift``), its ``shift.<metric>`` from ``frame()``, the variant's samples as a DataFrame."""
     got = {"status": float(status)}
     if not Status(int(status)).ok:
         return got
@@ -272,7 +272,7 @@ def _reduce(system, time, states, outputs, last_stick, status, wanted=(), metric
     got["dissipated_energy_J"] = outputs[-1, system.output_index("dissipated_energy")]
     got["energy_error_J"] = float(np.max(np.abs(outputs[:, system.output_index("energy_error")])))
     if shift:
-        got.update(_shift_metrics(system, time, states, outputs, shift, wanted))
+        got.update(_shift_metrics(frame, shift, wanted))
     return got
 
 
@@ -314,10 +314,10 @@ def run_batch(variants: pd.DataFrame, scenario, outputs) -> pd.DataFrame:
                 one = simulate(_system(doc, vid, row), t_end, check=False, **options)
                 alone = {e: t for (_, e), t in _last_sticks(one.events).items()}
                 got = _reduce(system, one.time, one.states, one.outputs, alone, int(one.status), outputs, metrics,
-                              base.shift)
+                              base.shift, one.to_dataframe)
             else:
                 mine = {e: sticks[(j, e)] for e in system.mode_names if (j, e) in sticks}
                 got = _reduce(system, res.time, res.states[j], res.outputs[j], mine, int(res.status[j]), outputs,
-                              metrics, base.shift)
+                              metrics, base.shift, lambda j=j: res.to_dataframe(variant=j))
             values[k] = [got.get(name, np.nan) for name in outputs]
     return pd.DataFrame(values, index=variants.index, columns=list(outputs))
