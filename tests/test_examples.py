@@ -347,6 +347,19 @@ def check_awd(work, out):
     assert "energy balance" in out
 
 
+def check_torque_converter(work, out):
+    frame = _csv(work / "tc.csv")
+    events = _csv(work / "tc_events.csv")
+    assert len(frame) == 501 and frame.time_s.iloc[-1] == 5.0          # [simulation] output_step 10 ms
+    assert list(events[events.component == "lockup"].event) == ["backward", "stick"]   # closes, locks up once
+    first = frame.iloc[0]   # at idle against a held turbine: T_p = (w_p / K_0)^2, T_t = TR_0 T_p
+    assert -first["converter.tau_Nm"] == pytest.approx((750.0 / 130.0) ** 2, rel=1e-9)
+    assert first["converter.tau_b_Nm"] == pytest.approx(2.1 * -first["converter.tau_Nm"], rel=1e-8)   # (CSV digits)
+    assert frame["converter.loss_power_W"].min() > -1e-9 and frame["fluid.temperature_C"].max() > 60.2
+    assert frame["converter.speed_ratio_1"].iloc[-1] == pytest.approx(1.0, abs=1e-9)   # locked: no slip
+    assert "energy balance" in out
+
+
 def check_lin(work, out):
     import json
 
@@ -401,6 +414,7 @@ def check_dct_sweep(work, out):
 
 
 CHECKS = {
+    "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
     "shift.json": check_shift,
     "judder.json": check_judder,

@@ -57,6 +57,8 @@ FIELD_KINDS = {
     "path": "a file, relative to the network file",
     "map": "a table of its own format (the field's description)",
     "losstable": "rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2] (MSL lossTable)",
+    "rows": "a table of rows, one number or quantity per column; the field's unit gives the columns' units, "
+            "separated by \"|\" (\"1 | rad/s/(N*m)**0.5 | 1\")",
     "thermal": "the name of a thermal mass ([thermal_mass.NAME]): a heat port of the component",
     "names": "a list of the names of other components of the network",
     "temperature_table": "a table of rows [T, value] over a temperature (T in degC or with its unit)",
@@ -80,7 +82,8 @@ class Field:
         One of :data:`FIELD_KINDS`.
     unit : str
         SI unit in pint notation of a number (``"N"``, ``"kg*m**2"``, ``"rad/s"``, ``"degC"``, ``"1"``);
-        for a signal or characteristic, the unit of its values.  Ignored by the other kinds.
+        for a signal or characteristic, the unit of its values; for ``"rows"``, each column's, separated by
+        ``"|"``.  Ignored by the other kinds.
     required : bool
         The table must give it.
     default : float, str, bool or None
@@ -441,7 +444,7 @@ def _default_text(f: Field) -> str:
 
 
 def _unit_text(f: Field) -> str:
-    if f.kind in ("quantity", "signal", "characteristic", "curve"):
+    if f.kind in ("quantity", "signal", "characteristic", "curve", "rows"):
         return f.unit
     if f.kind == "choice":
         return " / ".join(f.choices)

@@ -92,7 +92,8 @@ normal = { input = "press" }
 def networks(draw, with_unrelated=False, with_components=False, settled_only=False):
     """A random network: a chain of 2-4 inertias whose links are springs, backlash, gears (ideal, a constant
     efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
-    clutch); sometimes a clutch closing a loop from the first to the last, a second clutch in parallel with one,
+    clutch), torque converters (with or without a coast table); sometimes a clutch closing a loop from the first
+    to the last, a second clutch in parallel with one,
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
     inertia turning.  ``with_components``: links may also be wet clutches (their force port a ramp, a constant, a
     sine, a pulse or the product of a network input and a ramp) and EMTC couplings (their default scenario and
@@ -110,7 +111,8 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
     forced = draw(st.integers(0, n - 2)) if with_components else -1
     for i in range(n - 1):
         a, b = f"J{i}", f"J{i + 1}"
-        kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc"] + ([] if settled_only else ["lossy", "table"])
+        kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc", "converter"] + (
+            [] if settled_only else ["lossy", "table"])
         if with_components:
             kinds += ["wet", "emtc", "eclutch"]
         kind = draw(st.sampled_from(["wet", "emtc", "eclutch"] if i == forced else kinds))
@@ -160,6 +162,11 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
                                conductance=draw(st.floats(0.0, 5.0)), heat_from=(f"x{i}",))
             else:
                 d.eclutch(f"x{i}", a, b, position, model=model, points=41)
+        elif kind == "converter":   # K of 1-10 rad/s/sqrt(N m): 1-100 N m at 10 rad/s; TR 1-2.5 at stall
+            k0, tr0 = draw(st.floats(1.0, 10.0)), draw(st.floats(1.0, 2.5))
+            table = [[0.0, k0, tr0], [0.5, 1.2 * k0, 0.5 * (1.0 + tr0)], [0.9, 3.0 * k0, 1.0]]
+            coast = [[0.0, 1.1 * k0], [0.9, 3.0 * k0]] if draw(st.booleans()) else None
+            d.torque_converter(f"v{i}", a, b, table, coast_table=coast)
         elif kind == "spring":
             d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
         elif kind == "backlash":

@@ -654,6 +654,12 @@ def _check_columns(d, df, events=None):
     wmax = max(1.0, df.filter(like=".w_rad_s").abs().max().max())
     scale = max(1.0, df["input_work_J"].abs().max(), df["kinetic_energy_J"].max(), df["dissipated_energy_J"].max())
     assert np.abs(df["energy_error_J"]).max() < 1e-6 * scale
+    for name in (c.removesuffix(".speed_ratio_1") for c in df.columns if c.endswith(".speed_ratio_1")):
+        # a torque converter generates no power, and its turbine's torque has the impeller's sign while it drives
+        assert df[f"{name}.loss_power_W"].min() >= -1e-9 * scale, name
+        assert np.all(np.diff(df[f"{name}.dissipated_J"].to_numpy()) >= -1e-9 * scale), name
+        drive = ((df[f"{name}.speed_ratio_1"] >= 0.0) & (df[f"{name}.speed_ratio_1"] < 1.0)).to_numpy()
+        assert np.all(df[f"{name}.tau_Nm"].to_numpy()[drive] * df[f"{name}.tau_b_Nm"].to_numpy()[drive] <= 0.0), name
     for e in d._elements:
         if f"{e.name}.mode_1" not in df.columns:
             continue

@@ -1171,10 +1171,11 @@ def test_model_exchange_of_each_model_agrees_with_its_cosimulation(tmp_path, mod
 
 
 @pytest.mark.parametrize("example", ["driveline_test_friction", "driveline_wet_sae2", "driveline_emtc_awd",
-                                     "driveline_eclutch_launch"])
+                                     "driveline_eclutch_launch", "driveline_torque_converter"])
 def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     """Every example network (one-way clutches and bearing friction, the wet clutch's and the EMTC's grafts, the
-    E-clutch with its actuator) as a native FMU, run in FMPy without clutchlab against the Python
+    E-clutch with its actuator, a torque converter with its lock-up clutch and a thermal mass) as a native FMU, run
+    in FMPy without clutchlab against the Python
     co-simulation; and for model exchange under CVode."""
     cls = DrivelineCoSimulation.for_description(EXAMPLE.parent / f"{example}.toml")
     lines = []
@@ -1203,6 +1204,16 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
         _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
     if example == "driveline_wet_sae2":
         _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
+    if example == "driveline_torque_converter":   # a looser converter, set by the host: the FMU writes its K's factor
+        _, svs = _variables(path)
+        assert svs["converter.k_scale"].get("causality") == "parameter"
+        (tmp_path / "looser").mkdir()
+        native = _fmpy_run(tmp_path / "looser", path, n, dt, {"converter.k_scale": 1.15})
+        python = _python_run(cls, n, dt, {"converter.k_scale": 1.15})
+        for name in python:
+            _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
+        base = _python_run(cls, n, dt)
+        assert python["converter.tau"][0] == pytest.approx(base["converter.tau"][0] / 1.15 ** 2, rel=1e-12)   # stall
 
 
 def _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, line):

@@ -24,7 +24,7 @@ __all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_examp
            "header_comment"]
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
-EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml")
+EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml", "torque_converter.toml")
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "
@@ -236,6 +236,9 @@ def example_items(name: str, progress=None) -> tuple:
     ]
     if spec.shift:   # (a file with a [shift] table: the shift's figure and its metrics)
         items += _shift_items(stem, d.name, result, spec.shift)
+    for e in d.elements:   # (a torque converter: its operating points over the speed ratio)
+        if e.kind == "torque_converter":
+            items += _converter_items(stem, d.name, frame, e.name)
     params = _network_parameters(stem, d)
     step = "every accepted step" if spec.output_step is None else f"{spec.output_step:g} s"
     params[f"{stem}: simulation"] = f"t_end = {spec.t_end:g} s, output step {step}, rtol = {spec.rtol:g}"
@@ -266,6 +269,28 @@ def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
              f"{m['acceleration_before_' + a]:.2f} {au}, the jerk peaks at {m['jerk_peak_' + j]:.0f} {ju} where "
              f"the on-coming clutch locks (its slip falling at {m['lockup_slip_rate_rad_s2']:.0f} rad/s^2) and the "
              f"half shafts ring, and the on-coming clutch takes {m['oncoming_energy_J'] / 1e3:.1f} kJ."),
+    ]
+
+
+def _converter_items(stem: str, name: str, frame, converter: str) -> list:
+    """A torque converter's operating points in the run (:func:`~clutchlab.driveline.plots.converter_figure`) and a
+    text with its stall torque ratio, its best efficiency and the heat it gave the fluid."""
+    from ..driveline.plots import converter_figure, converter_points
+
+    pts = converter_points(frame, converter)
+    best = pts.loc[pts["efficiency_1"].idxmax()] if len(pts) else None
+    text = (f"The torque converter {converter!r} multiplied the engine's torque by up to "
+            f"{pts['torque_ratio_1'].max():.2f} (the speed ratio {pts['speed_ratio_1'].min():.2f}) and drove at "
+            f"its best with an efficiency of {best['efficiency_1']:.2f} (speed ratio {best['speed_ratio_1']:.2f}); "
+            f"it turned {frame[f'{converter}.dissipated_J'].iloc[-1] / 1e3:.1f} kJ into heat in its fluid "
+            "(docs/driveline.md, \"Torque converter\")." if best is not None else
+            f"The torque converter {converter!r} never drove in this run.")
+    return [
+        Figure(f"driveline_{stem}_{converter}", converter_figure(frame, converter, title=f"{name}: {converter}"),
+               "The converter's capacity factor K = ω_p/√T_p, torque ratio T_t/T_p and efficiency over the speed "
+               "ratio ω_t/ω_p at the run's samples where the impeller drove, coloured by time: its table's "
+               "characteristic as the launch went through it, read from the run's columns."),
+        Text(text),
     ]
 
 

@@ -284,6 +284,21 @@ BUILTIN = (
         Field("loss_table", "losstable", description="MSL lossTable rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]"),
         _SUPPORT,
     ), _method("gear"), f"{_MSL}.Components.IdealGear, LossyGear", _BOTH),
+    Component("torque_converter", "A hydrodynamic torque converter: impeller torque w_p |w_p| / K(SR)^2, turbine "
+                                  "torque TR(SR) times it, the stator's reaction on a support.", (
+        _flange("a", "the impeller's body (the engine's side)"),
+        _flange("b", "the turbine's body (the gearbox's side)"),
+        Field("table", "rows", "1 | rad/s/(N*m)**0.5 | 1", required=True,
+              description="rows [SR, K, TR]: speed ratio w_t/w_p in [0, 1), increasing; capacity factor K = "
+                          "w_p/sqrt(T_p) (\"150 rpm/(N m)^0.5\"); torque ratio T_t/T_p, TR SR <= 1"),
+        Field("coast_table", "rows", "1 | rad/s/(N*m)**0.5",
+              description="rows [w_p/w_t, K] while the turbine drives (TR = 1); default the drive table's K"),
+        _flange("support", "the housing's body the stator's reaction acts on (default the ground)", required=False),
+        Field("k_scale", "quantity", "1", default=1.0, positive=True,
+              description="factor on both tables' K: a looser (> 1) or tighter converter, matched to the engine (a "
+                          "sweep's or an FMU host's parameter; the torques scale with 1/k_scale^2)"),
+    ), _method("torque_converter"), "SAE J643 (K, TR over SR); continuous coast and reversal: "
+                                    "clutchlab.driveline.kernel.converter_torques", ("rotational",)),
     Component("torque", "A torque source (a force source in a translational network).", (
         _FLANGE,
         Field("torque", "signal", "N*m", required=True, description="torque on the flange"),

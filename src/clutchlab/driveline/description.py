@@ -40,7 +40,9 @@ phi0), ``spring_damper`` (a, b, c, d, phi_rel0),
 ``spring`` (a, b, curve = rows ``[phi, tau]``, interpolation = "linear" or "pchip", d, phi_rel0),
 ``backlash`` (a, b, c, b_gap, d, phi_rel0, damping_law = "kelvin_voigt" (default) or "msl": MSL
 ``ElastoBacklash``'s), ``gear`` (a, b, ratio, efficiency or loss_table = rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1,
-tau_bf2]`` as MSL's ``lossTable``, support = the housing's inertia), ``torque`` (flange, torque, support), ``speed``
+tau_bf2]`` as MSL's ``lossTable``, support = the housing's inertia), ``torque_converter`` (a = the impeller, b = the
+turbine, table = rows ``[SR, K, TR]`` with K in any unit of rad/s/sqrt(N m), ``"130 rpm/(N m)^0.5"``, coast_table =
+rows ``[SR, K]``, support), ``torque`` (flange, torque, support), ``speed``
 (flange, speed), ``position`` (flange, position), ``clutch`` (a, b, fn_max, mu, peak, cgeo, normal; or mu_map = a
 friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
 temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support; mu_map, radius, temperature),
@@ -127,7 +129,8 @@ def field_units(domain: str = "rotational") -> dict:
 #: field kinds whose value carries the field's unit
 _UNIT_KINDS = ("quantity", "signal", "characteristic", "curve")
 #: field kinds that are not quantities: a choice among words, a whole number, a file (relative to the description)
-NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable", "thermal", "names", "temperature_table")
+NOT_QUANTITIES = ("choice", "int", "path", "bool", "map", "losstable", "thermal", "names", "temperature_table",
+                  "rows")
 SIGNAL_FIELDS = {
     "constant": None,
     "step": {"height": "value", "start": "s", "offset": "value"},
@@ -281,6 +284,21 @@ def _loss_table(value, key, src, speed_unit="rad/s", torque_unit="N*m"):
     return rows
 
 
+def _rows(value, units, key, src):
+    """A table of rows (a ``"rows"`` field): one entry per column of ``units`` (a number in SI or a quantity with its
+    unit), converted to SI."""
+    units = [u.strip() for u in units.split("|")]
+    shown = "[" + ", ".join(units) + "]"
+    if not isinstance(value, list) or not value:
+        raise ParameterError(f"{src}: {key} = {value!r}: expected rows {shown}")
+    out = []
+    for i, row in enumerate(value):
+        if not (isinstance(row, list) and len(row) == len(units)):
+            raise ParameterError(f"{src}: {key}[{i}] = {row!r}: expected a row of {len(units)} {shown}")
+        out.append([_quantity(v, u, f"{key}[{i}][{j}]", src) for j, (v, u) in enumerate(zip(row, units))])
+    return out
+
+
 def _engine_map(value, key, src):
     """An engine's torque map: ``{ speeds = [...], throttles = [...], torques = [[...], ...] }`` (a row of
     torques per speed) or the full-load rows ``[[w, T], ...]``, converted to SI."""
@@ -359,6 +377,8 @@ def _field_value(field, v, fkey, src, base, uses, speed_unit, angle_unit):
         return _engine_map(v, fkey, src)
     if kind == "losstable":
         return _loss_table(v, fkey, src, speed_unit, "N*m" if speed_unit == "rad/s" else "N")
+    if kind == "rows":
+        return _rows(v, field.unit, fkey, src)
     if kind == "int":
         if not isinstance(v, int) or isinstance(v, bool):
             raise ParameterError(f"{src}: {fkey} = {v!r}: expected a whole number")

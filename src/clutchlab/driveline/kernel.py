@@ -49,9 +49,9 @@ _ZERO = np.int64(0)
 # Every integer below is generated from a declaration (:mod:`clutchlab.numerics.layout`): the position of a name
 # in its tuple, or an offset of consecutive slots.
 #: element kinds (DrivelineParams.elem[:, E_KIND])
-ELEMENT_KINDS = ("spring", "friction", "source", "gear", "motion")
-K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION = indices(
-    ELEMENT_KINDS, "spring", "friction", "source", "gear", "motion")
+ELEMENT_KINDS = ("spring", "friction", "source", "gear", "motion", "converter")
+K_SPRING, K_FRICTION, K_SOURCE, K_GEAR, K_MOTION, K_CONVERTER = indices(
+    ELEMENT_KINDS, "spring", "friction", "source", "gear", "motion", "converter")
 #: friction laws: cgeo * fn * mu(|w|); table(|w|) (bearing friction); freewheel; a clutch model with states of its
 #: own (its sliding torque and static limit set by the model's hooks before each evaluation of the network:
 #: :func:`set_external`, :mod:`clutchlab.driveline.wet`)
@@ -104,10 +104,12 @@ SIGNAL_KINDS = ("const", "step", "ramp", "sine", "table", "sampled", "pulse", "t
     "product", "input")
 N_SIG = slots(("kind", 1), ("parameters", 8)).total
 #: columns of ``elem`` (ints): "aux" is a curve's kind (0 linear, 1 pchip) or an engine map's throttle points;
-#: "mode" the element's index in m; "state" that of a controller state; "support" a gear's support (housing)
+#: "mode" the element's index in m; "state" that of a controller state; "support" a gear's or a torque converter's
+#: support (housing)
 #: inertia, -1 the ground; "heat" the thermal mass (row of ``thermal``) its losses flow into, -1 none; "fade" and
 #: "fade_n" a friction element's factor over that mass's temperature: its table's start in ``data`` (-1 none) and
-#: its number of rows (temperatures, then factors; :func:`fade_factor`); "spread" a gear's part in the initial
+#: its number of rows (temperatures, then factors; :func:`fade_factor`) (a torque converter's table: E_TABLE,
+#: E_TABLE_N drive rows, E_AUX coast rows, :func:`converter_torques`); "spread" a gear's part in the initial
 #: speeds left out of the description (:func:`derive_speeds`): 0 none, +d its flange b's speed derived from flange
 #: a's, -d flange a's from flange b's, d the derived flange's depth below the speed it follows; "spread_support" 1
 #: where the gear's support speed enters that derivation (given in the description), 0 where it is taken as rest;
@@ -146,13 +148,14 @@ N_LINK = len(LINK_COLUMNS)
 #: E_TABLE; a backlash: its gap); a friction element (a table: speed grid | values at E_TABLE; with a normal-force
 #: curve of E_AUX points: its data offset and lift-off input; the factor on its friction coefficient); a gear,
 #: w_a = ratio * w_b (its loss table, MSL lossTable: E_TABLE_N rows of |w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2,
-#: stored column by column at E_TABLE);
+#: stored column by column at E_TABLE); a torque converter's factor on its K (its tables at E_TABLE);
 #: an engine's idle controller: set speed [rad/s], gains [N m s/rad], [N m/rad], torque limit [N m]
 COEF_COLUMNS = {
     "spring": ("stiffness", "damping", "phi0", "gap"),
     "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale", "levels", "wear0", "wear_rate", "expansion",
                  "t_ref"),
     "gear": ("ratio",),
+    "converter": ("k_scale",),
     "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
 }
 C_STIFF, C_DAMP, C_PHI0, C_GAP = indices(COEF_COLUMNS["spring"], "stiffness", "damping", "phi0", "gap")
@@ -164,6 +167,8 @@ C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF, C_MU_SCALE = indices(
 C_LEVELS, C_WEAR0, C_WEAR_RATE, C_EXPANSION, C_T_REF = indices(
     COEF_COLUMNS["friction"], "levels", "wear0", "wear_rate", "expansion", "t_ref")
 C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
+#: a torque converter's factor on its capacity factors K (both tables): a looser (> 1) or tighter converter
+C_K_SCALE = indices(COEF_COLUMNS["converter"], "k_scale")
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = indices(
     COEF_COLUMNS["engine"], "idle_speed", "idle_kp", "idle_ki", "idle_max")
 N_COEF = max(len(columns) for columns in COEF_COLUMNS.values())
@@ -1038,6 +1043,91 @@ def gear_speed(p, r, x, n):
     return _speed(x, n, p.elem[r, E_A]) - _speed(x, n, p.elem[r, E_SUP])
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _converter_row(data, start, n, col, s):
+    """Capacity ``C = 1/K^2`` [N m s^2/rad^2] and column ``col`` (the torque ratio; -1: none, 1) of a torque
+    converter's table of ``n`` rows at ``data[start:]`` (speed ratios in [0, 1), then capacity factors ``K``
+    [rad/s/sqrt(N m)], then torque ratios), at speed ratio ``0 <= s <= 1``: ``K`` and ``TR`` linear between the
+    rows (as the tables are measured, SAE J643), held below the first; from the last row to ``s = 1`` the capacity
+    falls linearly to 0 with ``TR`` held (no torque without slip: near ``s = 1`` a fluid coupling's torque is
+    proportional to its slip)."""
+    last = data[start + n - 1]
+    if s >= last:
+        k = data[start + 2 * n - 1]
+        tr = 1.0 if col < 0 else data[start + col * n + n - 1]
+        return (1.0 - s) / (1.0 - last) / (k * k), tr
+    if s <= data[start]:
+        k = data[start + n]
+        return 1.0 / (k * k), 1.0 if col < 0 else data[start + col * n]
+    lo, w = bracket(data[start:start + n], s)
+    k = data[start + n + lo] + w * (data[start + n + lo + 1] - data[start + n + lo])
+    o = start + col * n + lo
+    tr = 1.0 if col < 0 else data[o] + w * (data[o + 1] - data[o])
+    return 1.0 / (k * k), tr
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def converter_torques(p, r, x, n):
+    """Torques [N m] of torque converter row ``r`` on its impeller (flange a), its turbine (flange b) and its
+    support (the stator's one-way clutch to the housing), and its speed ratio [-]: ``(tau_a, tau_b, sr)``, the
+    support taking ``-(tau_a + tau_b)``.
+
+    Speeds against the support, ``w_p = w_a - w_s``, ``w_t = w_b - w_s``.  Drive (``|w_p| >= |w_t|``, the impeller
+    drives; speed ratio ``SR = w_t / w_p``): the impeller torque ``T_p = w_p |w_p| / K(SR)^2`` (the capacity factor
+    ``K = w_p / sqrt(T_p)``, SAE J643) and the turbine torque ``T_t = TR(SR) T_p``: ``tau_a = -T_p``, ``tau_b =
+    T_t``, the stator's reaction ``T_p - T_t`` on the support.  Coast (``|w_t| > |w_p|``, the turbine drives; its
+    ratio ``s = w_p / w_t``): the stator free-wheels, ``TR = 1``, and ``T = w_t |w_t| / K_c(s)^2`` brakes the turbine
+    and drives the impeller (``tau_b = -T``, ``tau_a = T``), ``K_c`` the coast table's or, without one, the drive
+    table's at ``s`` (Chrono's reflection).  Both tables' ``K`` are multiplied by the converter's ``k_scale``
+    (``coef[r, C_K_SCALE]``).  A driven member turning against its driver (``SR`` or ``s`` in [-1, 0),
+    a car rolling back against an idling engine) keeps the capacity at ``SR = 0`` and brings ``TR`` linearly to 1 at
+    ``-1``, and the coast capacity linearly to the drive table's at ``SR = 0``: the law is continuous at every speed
+    pair (homogeneous of degree 2), with ``tau = 0`` at equal speeds and at rest, and its loss ``-(tau_a w_p + tau_b
+    w_t) = T_p w_p (1 - TR SR)`` is >= 0 wherever ``TR(SR) SR <= 1`` (checked when the converter is built)."""
+    ws = _speed(x, n, p.elem[r, E_SUP])
+    wp = _speed(x, n, p.elem[r, E_A]) - ws
+    wt = _speed(x, n, p.elem[r, E_B]) - ws
+    start, nd, nc = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX]
+    scale = 1.0 / (p.coef[r, C_K_SCALE] * p.coef[r, C_K_SCALE])   # (K times k_scale: the capacity over its square)
+    sr = wt / wp if wp != 0.0 else 0.0
+    if wp == 0.0 and wt == 0.0:
+        return 0.0, 0.0, sr
+    if abs(wp) >= abs(wt):   # drive: the impeller drives
+        s = wt / wp
+        if s >= 0.0:
+            c, tr = _converter_row(p.data, start, nd, 2, s)
+        else:
+            c, tr0 = _converter_row(p.data, start, nd, 2, 0.0)
+            tr = tr0 + (tr0 - 1.0) * s
+        tp = scale * c * wp * abs(wp)
+        return -tp, tr * tp, sr
+    s = wp / wt   # coast: the turbine drives
+    cstart, cn = (start + 3 * nd, nc) if nc > 0 else (start, nd)
+    if s >= 0.0:
+        c, _one = _converter_row(p.data, cstart, cn, -1, s)
+    else:
+        cc0, _one = _converter_row(p.data, cstart, cn, -1, 0.0)
+        cd0, _tr = _converter_row(p.data, start, nd, 2, 0.0)
+        c = cc0 + (cc0 - cd0) * s
+    tc = scale * c * wt * abs(wt)
+    return tc, -tc, sr
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def converter_power(p, r, x, n):
+    """Power [W] torque converter row ``r`` dissipates: what its three flanges give it, ``-(tau_a (w_a - w_s) + tau_b
+    (w_b - w_s))`` (:func:`converter_torques`; the support's torque is the rest of the balance)."""
+    ta, tb, _sr = converter_torques(p, r, x, n)
+    ws = _speed(x, n, p.elem[r, E_SUP])
+    return -(ta * (_speed(x, n, p.elem[r, E_A]) - ws) + tb * (_speed(x, n, p.elem[r, E_B]) - ws))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _has_support(kind):
+    """Does an element of ``kind`` act on a support (its ``E_SUP`` column): a gear and a torque converter."""
+    return kind == K_GEAR or kind == K_CONVERTER
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _gear_mode(p, r, m):
     """The mode of gear row ``r`` (``GEAR_STUCK`` for an ideal one, which has none)."""
@@ -1080,7 +1170,8 @@ def _add(F, i, v):
 def evaluate_network(t, x, m, p, acc, tau):
     """Accelerations ``acc`` [rad/s^2] of the inertias and the torque ``tau`` [N m] of every element.
 
-    Spring-dampers :func:`spring_torque`; torque sources: their signal (acting on flange b, positive
+    Spring-dampers :func:`spring_torque`; torque converters :func:`converter_torques` (on flanges a, b and the
+    support); torque sources: their signal (acting on flange b, positive
     accelerating it, so ``tau`` is stored with the element convention as minus the source torque);
     sliding friction ``+-friction_torque``; free friction 0; the bearing-friction part of a rolling lossy gear
     (its constant torques ``-ratio c`` on flange b and ``+ratio c`` on the support, :func:`gear_transfer`);
@@ -1111,6 +1202,13 @@ def evaluate_network(t, x, m, p, acc, tau):
         elif kind == K_SOURCE:
             tq = -(signal_at(p, p.elem[r, E_SIGNAL], t) if p.elem[r, E_LAW] == SOURCE_SIGNAL
                    else source_torque(p, r, t, x, n))
+        elif kind == K_CONVERTER:   # three torques: impeller, turbine, the stator's reaction on the support
+            ta, tb, _sr = converter_torques(p, r, x, n)
+            tau[r] = ta
+            for i, v in ((p.elem[r, E_A], ta), (p.elem[r, E_B], tb), (p.elem[r, E_SUP], -(ta + tb))):
+                _add(F, i, v)
+                _add(Fa, i, abs(v))
+            continue
         else:
             continue
         tau[r] = tq
@@ -3364,7 +3462,7 @@ def _flanges_max(v, elem, r):
         out = max(out, abs(v[a]))
     if b >= 0:
         out = max(out, abs(v[b]))
-    if elem[r, E_KIND] == K_GEAR and elem[r, E_SUP] >= 0:
+    if _has_support(elem[r, E_KIND]) and elem[r, E_SUP] >= 0:
         out = max(out, abs(v[elem[r, E_SUP]]))
     return out
 
@@ -3386,7 +3484,7 @@ def _item_wtol(p, r, x, n):
     (at least 1 rad/s)."""
     n_ = p.inertia.shape[0]
     w = 1.0
-    for i in (p.elem[r, E_A], p.elem[r, E_B], p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1):
+    for i in (p.elem[r, E_A], p.elem[r, E_B], p.elem[r, E_SUP] if _has_support(p.elem[r, E_KIND]) else -1):
         if i >= 0:
             w = max(w, abs(x[n_ + i]))
     return 1e-9 * w
@@ -3807,13 +3905,13 @@ def _one_search_per_instant(t, m, p, log, old):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _flange(p, r, q):
-    """Inertia of flange ``q`` of element row ``r``: 0 flange a, 1 flange b, 2 a gear's support; -1 for the ground
-    (or no support)."""
+    """Inertia of flange ``q`` of element row ``r``: 0 flange a, 1 flange b, 2 a gear's or a torque converter's
+    support; -1 for the ground (or no support)."""
     if q == 0:
         return p.elem[r, E_A]
     if q == 1:
         return p.elem[r, E_B]
-    return p.elem[r, E_SUP] if p.elem[r, E_KIND] == K_GEAR else -1
+    return p.elem[r, E_SUP] if _has_support(p.elem[r, E_KIND]) else -1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4594,7 +4692,7 @@ def loss_power(p, r, x, n, m, tau):
     """Power [W] element row ``r`` (not a source) dissipates, MSL ``lossPower``, with ``tau`` its torque: the rate of
     its dissipated energy: a friction element's ``tau w_rel``; a spring-damper's ``(tau - tau_c) w_rel``, its
     damper's part (``tau_c`` the spring's); a gear's :func:`gear_power` (its mesh and bearing losses, zero for an
-    ideal or a stuck one but for the constraints' drift)."""
+    ideal or a stuck one but for the constraints' drift); a torque converter's :func:`converter_power`."""
     kind = p.elem[r, E_KIND]
     w_rel = relative_speed(p, r, x, n)
     if kind == K_SPRING:
@@ -4602,6 +4700,8 @@ def loss_power(p, r, x, n, m, tau):
         return (tau - tc) * w_rel
     if kind == K_GEAR:   # the power the gear takes from its flanges
         return gear_power(p, r, x, n, m, tau)
+    if kind == K_CONVERTER:   # the power its three flanges give it
+        return converter_power(p, r, x, n)
     return tau * w_rel
 
 
@@ -4759,6 +4859,12 @@ def driveline_outputs(t, x, u, m, p, y):
             continue
         y[q] = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         q += 1
+        if kind == K_CONVERTER:   # the turbine's torque, the speed ratio, the loss power
+            _ta, tb, sr = converter_torques(p, r, x, n)
+            y[q] = tb
+            y[q + 1] = sr
+            y[q + 2] = converter_power(p, r, x, n)
+            q += 3
         if kind == K_SPRING:
             spring += spring_energy(p, r, x, n, m)
     for k in range(nf):
@@ -5058,7 +5164,7 @@ def check_invariants(t, x, m, p):
       the element's inertias, what the event location and a stuck element's drift leave);
     * a one-way clutch never transmits torque in its free direction (beyond its clutch's) and never turns backward;
     * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding), and so does
-      every sliding friction element's (its law's magnitude is >= 0);
+      every sliding friction element's (its law's magnitude is >= 0) and every torque converter's;
     * a backlash in its gap is not beyond an edge moving on outward, and one released beyond an edge (a damped contact
       that separated there) is not where its contact would push (either: a contact missed);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
@@ -5115,6 +5221,12 @@ def check_invariants(t, x, m, p):
             # (with the mode agreeing with the speed, checked above; at rest a drift of w_a has either sign)
             f, c = gear_transfer(p, r, mode, abs(w_a))
             if ((1.0 - f) * (-tau[r]) + c) * GEAR_CODES[mode] < -10.0 * noise:
+                return -(INV_BASE + N_INV * r + INV_LOSS)
+    for r in range(ne):   # a torque converter's loss (its tables were checked for TR SR <= 1; rounding aside)
+        if p.elem[r, E_KIND] == K_CONVERTER:
+            ta, tb, _sr = converter_torques(p, r, x, n)
+            scale = (abs(ta) + abs(tb)) * 1e9 * _item_wtol(p, r, x, n)   # [W]: its torques times its fastest speed
+            if converter_power(p, r, x, n) < -1e-12 * scale:
                 return -(INV_BASE + N_INV * r + INV_LOSS)
     for j in range(p.swit.shape[0]):
         r = p.swit[j]

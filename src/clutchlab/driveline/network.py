@@ -602,6 +602,26 @@ class ElementInfo:
     summary: str
 
 
+def _converter_table(name, key, rows, ncol):
+    """A torque converter's table (:meth:`Driveline.torque_converter`): ``ncol`` columns ``[SR, K, TR]`` (or ``[SR,
+    K]``), checked: speed ratios in [0, 1) increasing, capacity factors and torque ratios finite and > 0."""
+    what = "[SR, K, TR]" if ncol == 3 else "[SR, K]"
+    try:
+        t = np.asarray(rows, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: {key} = {rows!r} must be rows {what}") from None
+    if t.ndim != 2 or t.shape[1] != ncol or t.shape[0] < 1 or not np.all(np.isfinite(t)):
+        raise ParameterError(f"{name}: {key} must be rows of {ncol} finite numbers {what}, got shape {t.shape}")
+    sr = t[:, 0]
+    if sr[0] < 0.0 or sr[-1] >= 1.0 or np.any(np.diff(sr) <= 0.0):
+        raise ParameterError(f"{name}: {key} speed ratios {sr.tolist()} must increase within [0, 1) (the capacity "
+                             "falls to 0 at 1 by itself)")
+    bad = t[np.any(t[:, 1:] <= 0.0, axis=1)]
+    if bad.size:
+        raise ParameterError(f"{name}: {key} row {bad[0].tolist()}: capacity factor and torque ratio must be > 0")
+    return t
+
+
 def _adds(kind: str):
     """Marks a :class:`Driveline` method as adding elements of ``kind`` (:attr:`ElementInfo.kind`)."""
     def wrap(method):
@@ -1065,6 +1085,70 @@ class Driveline:
             rows = np.array([[0.0, eta, eta, 0.0, 0.0]])
         table = tuple(rows.T.ravel())
         self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio,), table=table, sup=sup))
+        return self
+
+    @_adds("torque_converter")
+    def torque_converter(self, name: str, a, b, table, coast_table=None, support=None,
+                         k_scale: float = 1.0) -> "Driveline":
+        """A hydrodynamic torque converter: impeller on flange a, turbine on flange b, the stator's one-way clutch on
+        a support (:func:`clutchlab.driveline.kernel.converter_torques`).
+
+        Driving (``|w_p| >= |w_t|``, speeds against the support): impeller torque ``T_p = w_p |w_p| / K(SR)^2`` and
+        turbine torque ``T_t = TR(SR) T_p`` at the speed ratio ``SR = w_t / w_p`` (capacity factor ``K`` and torque
+        ratio ``TR``, SAE J643), the stator's reaction ``T_p - T_t`` on the support.  Coasting (the turbine faster)
+        the stator free-wheels: ``TR = 1`` and ``K`` from ``coast_table`` at ``w_p / w_t`` (default the drive
+        table's).  From the table's last speed ratio to 1 the capacity ``1/K^2`` falls linearly to 0 (no torque
+        without slip).  The law is continuous at every pair of speeds, at rest included; its loss ``T_p w_p - T_t
+        w_t`` (columns ``<name>.loss_power_W``, ``<name>.dissipated_J``) is >= 0.  A lock-up clutch is a
+        :meth:`clutch` between the same flanges.
+
+        Parameters
+        ----------
+        name, a, b : str
+            The converter, its impeller's and its turbine's inertias.
+        table : array_like
+            Rows ``[SR, K, TR]``: speed ratio in [0, 1), increasing from its first row; capacity factor ``K`` > 0
+            [rad/s/sqrt(N m)] (``K [rpm/sqrt(N m)] * pi/30``); torque ratio ``TR`` > 0, with ``TR SR <= 1`` at every
+            speed ratio (the converter never generates power) and ``TR <= 1`` in the last row.
+        coast_table : array_like, optional
+            Rows ``[w_p / w_t, K]`` of the coast mode, as ``table``'s first two columns.
+        support : str, optional
+            The housing's inertia (the stator's reaction acts there); default the ground.
+        k_scale : float
+            Factor on both tables' ``K`` [-], > 0: a looser (> 1) or tighter converter, matched to an engine by a
+            sweep or an FMU host (the torques scale with ``1/k_scale^2``).
+        """
+        if self.domain != "rotational":
+            raise ParameterError(f"{name}: a torque converter belongs to a rotational network")
+        k_scale = _finite(name, "k_scale", k_scale, positive=True)
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        sup = self._flange(name, "support", support)
+        if sup is not None and sup in (a, b):
+            raise ParameterError(f"{name}: support = {sup!r} is also one of its flanges")
+        drive = _converter_table(name, "table", table, 3)
+        sr, tr = drive[:, 0], drive[:, 2]
+        # TR SR <= 1 on every segment: a product of two linear functions, largest at an end or at its vertex
+        for lo in range(len(sr) - 1):
+            s0, s1, t0, t1 = sr[lo], sr[lo + 1], tr[lo], tr[lo + 1]
+            slope = (t1 - t0) / (s1 - s0)
+            probes = [s0, s1]
+            if slope < 0.0:
+                vertex = 0.5 * (slope * s0 - t0) / slope
+                if s0 < vertex < s1:
+                    probes.append(vertex)
+            for v in probes:
+                if (t0 + slope * (v - s0)) * v > 1.0 + 1e-12:
+                    raise ParameterError(f"{name}: table: TR * SR = {(t0 + slope * (v - s0)) * v:.6g} > 1 at SR = "
+                                         f"{v:.6g}: the converter would generate power (its efficiency TR SR is at "
+                                         "most 1)")
+        if tr[-1] > 1.0:
+            raise ParameterError(f"{name}: table: TR = {tr[-1]:g} > 1 in its last row (held up to SR = 1, where the "
+                                 "efficiency TR SR must stay <= 1)")
+        coast = () if coast_table is None else _converter_table(name, "coast_table", coast_table, 2)
+        data = tuple(drive.T.ravel()) + (() if coast_table is None else tuple(coast.T.ravel()))
+        self._elements.append(_Element(K.K_CONVERTER, name, a, b, (k_scale,), table=data, sup=sup,
+                                       aux=0 if coast_table is None else len(coast)))
         return self
 
     @staticmethod
@@ -1822,6 +1906,13 @@ class Driveline:
                          and e.table[3 * nrow] == e.table[4 * nrow] == 0.0 else f", loss table of {nrow} rows")
             if e.sup is not None:
                 what += f", on support {e.sup}"
+        elif e.kind == K.K_CONVERTER:
+            nd = (len(e.table) - 2 * e.aux) // 3
+            what = (f"torque converter, K = {e.table[nd] * e.coef[0]:g} rad/s/sqrt(N m)"
+                    + (f" (k_scale {e.coef[0]:g})" if e.coef[0] != 1.0 else "")
+                    + f" and TR = {e.table[2 * nd]:g} at stall, table of {nd} rows"
+                    + (f", coast table of {e.aux} rows" if e.aux else "")
+                    + (f", on support {e.sup}" if e.sup is not None else ""))
         elif e.kind == K.K_SPRING and e.law == K.SPRING_CURVE:
             what = f"spring curve of {len(e.table) // 4} points, d = {e.coef[1]:g} {dm}"
         elif e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH:
@@ -1886,7 +1977,8 @@ class Driveline:
         flanges, a gear's support, its :meth:`describe` line): a read-only view; change a network through its
         methods or its file."""
         return tuple(ElementInfo(e.name, e.kind_name, e.a or GROUND, e.b or GROUND,
-                                 (e.sup or GROUND) if e.kind == K.K_GEAR else None, self._element_line(e))
+                                 (e.sup or GROUND) if e.kind in (K.K_GEAR, K.K_CONVERTER) else None,
+                                 self._element_line(e))
                      for e in self._elements)
 
     @property
@@ -1975,6 +2067,8 @@ class Driveline:
                 elem[r, K.E_TABLE] = len(data)
                 if e.kind == K.K_GEAR:
                     elem[r, K.E_TABLE_N] = len(e.table) // 5
+                elif e.kind == K.K_CONVERTER:   # drive rows [SR, K, TR], then e.aux coast rows [SR, K]
+                    elem[r, K.E_TABLE_N] = (len(e.table) - 2 * e.aux) // 3
                 elif e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
                     elem[r, K.E_TABLE_N] = (len(e.table) - e.aux) // (1 + e.aux)
                 elif e.map_t:
@@ -2219,6 +2313,14 @@ class Driveline:
             elif e.kind == K.K_GEAR:
                 states.append((f"{e.name}.dissipated", "J", f"energy lost in {e.name} (its mesh and bearing losses)"))
                 outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} on flange a (on flange b: -ratio {tn})"))
+            elif e.kind == K.K_CONVERTER:   # (kernel.driveline_outputs: tau, w_rel, tau_b, speed ratio, loss)
+                states.append((f"{e.name}.dissipated", "J", f"energy lost in {e.name} (heat in its fluid)"))
+                outputs += [(f"{e.name}.{tn}", tu, f"{word} of {e.name} on its impeller, flange a (-T_p driving)"),
+                            (f"{e.name}.{rn}", ru, f"relative speed of {e.name}, turbine minus impeller"),
+                            (f"{e.name}.{tn}_b", tu, f"{word} of {e.name} on its turbine, flange b (T_t driving)"),
+                            (f"{e.name}.speed_ratio", "1", f"speed ratio of {e.name}, turbine over impeller "
+                                                           "against its support (0 with the impeller at rest)"),
+                            (f"{e.name}.loss_power", "W", f"power {e.name} dissipates, T_p w_p - T_t w_t")]
             else:
                 states.append((f"{e.name}.dissipated", "J", f"energy dissipated in {e.name}"))
                 outputs.append((f"{e.name}.{tn}", tu, f"{word} of {e.name} (on flange b: -{tn})"))

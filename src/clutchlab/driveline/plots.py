@@ -2,7 +2,8 @@
 
 :func:`driveline_figure` draws a whole run on one page (``clutchlab driveline simulate --plot``); the
 demo report draws one figure per quantity: :func:`speeds_figure`, :func:`friction_torques_figure`,
-:func:`modes_figure` and :func:`energy_figure`.
+:func:`modes_figure` and :func:`energy_figure`, and a torque converter's operating points
+(:func:`converter_figure`).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import numpy as np
 from ..plotting import legend_outside, new_figure
 
 __all__ = ["driveline_figure", "speeds_figure", "friction_torques_figure", "modes_figure", "energy_figure",
-           "EVENT_STYLES", "MODE_COLORS"]
+           "converter_figure", "converter_points", "EVENT_STYLES", "MODE_COLORS"]
 
 #: line style of an event mark per event (the mode entered): colour, line style
 EVENT_STYLES = {"stick": ("#2ca02c", "-"), "forward": ("#1f77b4", "--"), "backward": ("#d62728", "--"),
@@ -201,3 +202,65 @@ def energy_figure(frame, *, title: str = ""):
     axes[1].set_ylabel("balance error [µJ]")
     axes[1].set_xlabel("time [s]")
     return _finish(fig, list(axes), title)
+
+
+def converter_points(frame, name, *, share=1e-3):
+    """A torque converter's operating points in drive, from its columns only (a run's, or a rig's record mapped to
+    those names): ``<name>.tau_Nm`` (-T_p), ``<name>.tau_b_Nm`` (T_t), ``<name>.w_rel_rad_s`` (w_t - w_p) and
+    ``<name>.speed_ratio_1`` (SR).
+
+    Returns a DataFrame with ``time_s``, ``speed_ratio_1``, ``capacity_factor_rpm_sqrtNm`` (K = w_p / sqrt(T_p),
+    w_p = -w_rel / (1 - SR)), ``torque_ratio_1`` (T_t / T_p) and ``efficiency_1`` (TR SR), at the samples where the
+    impeller drives (0 <= SR < 1) with an impeller torque above ``share`` of its largest.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The columns above and ``time_s``.
+    name : str
+        The converter.
+    share : float
+        The smallest impeller torque drawn, a share of the largest [-] (a point near no torque has no K).
+    """
+    import pandas as pd
+
+    tp = -frame[f"{name}.tau_Nm"].to_numpy(dtype=float)
+    tt = frame[f"{name}.tau_b_Nm"].to_numpy(dtype=float)
+    sr = frame[f"{name}.speed_ratio_1"].to_numpy(dtype=float)
+    w_rel = frame[f"{name}.w_rel_rad_s"].to_numpy(dtype=float)
+    keep = (sr >= 0.0) & (sr < 1.0) & (tp > share * max(float(np.max(np.abs(tp), initial=0.0)), 1e-300))
+    wp = -w_rel[keep] / (1.0 - sr[keep])
+    tr = tt[keep] / tp[keep]
+    return pd.DataFrame({"time_s": frame["time_s"].to_numpy()[keep], "speed_ratio_1": sr[keep],
+                         "capacity_factor_rpm_sqrtNm": wp / np.sqrt(tp[keep]) * 30.0 / np.pi,
+                         "torque_ratio_1": tr, "efficiency_1": tr * sr[keep]})
+
+
+def converter_figure(frame, name, *, title: str = ""):
+    """A torque converter's characteristic as the run (or a record) went through it: capacity factor K
+    [rpm/sqrt(N m)], torque ratio and efficiency over the speed ratio, each point coloured by its time
+    (:func:`converter_points`).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        ``SimulationResult.to_dataframe()`` of a driveline run with the converter ``name``.
+    name : str
+        The converter.
+    title : str
+        Title of the figure.
+    """
+    pts = converter_points(frame, name)
+    fig, axes = new_figure(width=8.0, height=6.4, nrows=3, sharex=True)
+    quantities = (("capacity_factor_rpm_sqrtNm", "K [rpm/√(N·m)]"), ("torque_ratio_1", "torque ratio TR [-]"),
+                  ("efficiency_1", "efficiency TR·SR [-]"))
+    for ax, (col, label) in zip(axes, quantities):
+        art = ax.scatter(pts["speed_ratio_1"], pts[col], c=pts["time_s"], s=8, cmap="viridis")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("speed ratio SR = ω_t/ω_p [-]")
+    axes[-1].set_xlim(0.0, 1.0)
+    fig.colorbar(art, ax=list(axes), label="time [s]")
+    if title:
+        axes[0].set_title(title, fontsize=10)
+    return fig
