@@ -168,3 +168,26 @@ def test_the_dual_clutch_upshift_shows_its_shift_quality(section):
     assert shown.loc["jerk_peak_m_s3", "unit"] == "m_s3"
     text = " ".join(i.text for i in section.items if hasattr(i, "text"))
     assert f"the inertia phase {1e3 * q.metrics['inertia_phase_s']:.0f} ms" in text
+
+
+def test_the_torque_converter_launch_shows_its_operating_points(section):
+    """The converter example: its figure, and its text's torque ratio and efficiency equal to the operating points of
+    a direct run, which follow the file's table (K in rpm/sqrt(N m), TR) where the impeller drives."""
+    from clutchlab.driveline.plots import converter_points
+
+    names = {i.name for i in section.items if isinstance(i, Figure)}
+    assert "driveline_torque_converter_converter" in names and "driveline_torque_converter_speeds" in names
+    spec = load_driveline(ROOT / "examples" / "driveline_torque_converter.toml")
+    res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=spec.output_step)
+    pts = converter_points(res.to_dataframe(), "converter")
+    sr = pts["speed_ratio_1"].to_numpy()
+    table = np.array([[0.0, 130, 2.1], [0.2, 133, 1.8], [0.4, 140, 1.5], [0.6, 155, 1.25], [0.8, 200, 1.02],
+                      [0.85, 230, 1.0], [0.9, 300, 1.0]])
+    inside = sr <= 0.9
+    assert inside.sum() > 100
+    assert np.allclose(pts["capacity_factor_rpm_sqrtNm"][inside], np.interp(sr[inside], table[:, 0], table[:, 1]),
+                       rtol=1e-9)
+    assert np.allclose(pts["torque_ratio_1"], np.interp(sr, table[:, 0], table[:, 2]), rtol=1e-9)
+    text = " ".join(i.text for i in section.items if hasattr(i, "text"))
+    assert f"by up to {pts['torque_ratio_1'].max():.2f}" in text
+    assert f"efficiency of {pts['efficiency_1'].max():.2f}" in text

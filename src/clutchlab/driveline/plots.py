@@ -258,6 +258,9 @@ def converter_figure(frame, name, *, title: str = ""):
         art = ax.scatter(pts["speed_ratio_1"], pts[col], c=pts["time_s"], s=8, cmap="viridis")
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
+    low = pts["capacity_factor_rpm_sqrtNm"][pts["speed_ratio_1"] <= 0.95]
+    if len(low):   # (K grows without bound as the slip vanishes: the axis shows the table's range)
+        axes[0].set_ylim(0.0, 1.5 * float(low.max()))
     axes[-1].set_xlabel("speed ratio SR = ω_t/ω_p [-]")
     axes[-1].set_xlim(0.0, 1.0)
     fig.colorbar(art, ax=list(axes), label="time [s]")
