@@ -360,6 +360,16 @@ def check_torque_converter(work, out):
     assert "energy balance" in out
 
 
+def check_at_shift(work, out):
+    report = json.loads((work / "at_shift.json").read_text())
+    assert report["order"] == "upshift" and report["columns"]["offgoing"] == "b1"   # the file's [shift] table
+    m = report["metrics"]
+    assert 1.0 < report["start_s"] < report["handover_s"] < report["lockup_s"] < 1.3
+    assert m["tie_up_Nm"] < 20.0 and m["flare_rad_s"] < 1e-6   # b1 released in time: little tie-up, no flare
+    assert 0.0 < m["acceleration_dip_m_s2"] < m["acceleration_before_m_s2"]
+    assert "upshift" in out
+
+
 def check_lin(work, out):
     import json
 
@@ -414,6 +424,7 @@ def check_dct_sweep(work, out):
 
 
 CHECKS = {
+    "at_shift.json": check_at_shift,
     "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
     "shift.json": check_shift,

@@ -92,8 +92,9 @@ normal = { input = "press" }
 def networks(draw, with_unrelated=False, with_components=False, settled_only=False):
     """A random network: a chain of 2-4 inertias whose links are springs, backlash, gears (ideal, a constant
     efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
-    clutch), torque converters (with or without a coast table); sometimes a clutch closing a loop from the first
-    to the last, a second clutch in parallel with one,
+    clutch), torque converters (with or without a coast table), planetary sets (the link's inertias the sun and the
+    ring, a carrier of its own, sometimes held by a brake that lets go); sometimes a clutch closing a loop from the
+    first to the last, a second clutch in parallel with one,
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
     inertia turning.  ``with_components``: links may also be wet clutches (their force port a ramp, a constant, a
     sine, a pulse or the product of a network input and a ramp) and EMTC couplings (their default scenario and
@@ -111,7 +112,7 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
     forced = draw(st.integers(0, n - 2)) if with_components else -1
     for i in range(n - 1):
         a, b = f"J{i}", f"J{i + 1}"
-        kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc", "converter"] + (
+        kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc", "converter", "planetary"] + (
             [] if settled_only else ["lossy", "table"])
         if with_components:
             kinds += ["wet", "emtc", "eclutch"]
@@ -167,6 +168,13 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
             table = [[0.0, k0, tr0], [0.5, 1.2 * k0, 0.5 * (1.0 + tr0)], [0.9, 3.0 * k0, 1.0]]
             coast = [[0.0, 1.1 * k0], [0.9, 3.0 * k0]] if draw(st.booleans()) else None
             d.torque_converter(f"v{i}", a, b, table, coast_table=coast)
+        elif kind == "planetary":   # sun a, ring b, the carrier an inertia of its own (at rest at the start)
+            d.inertia(f"P{i}", J=draw(st.floats(0.05, 1.0)))
+            d.planetary(f"s{i}", a, f"P{i}", b, ratio=draw(st.floats(1.2, 4.0)),
+                        efficiency=draw(st.sampled_from([1.0, 1.0, 0.95])) if not settled_only else 1.0)
+            if not settled_only and draw(st.booleans()):   # the carrier held by a brake, released later
+                d.brake(f"pb{i}", f"P{i}", fn_max=draw(st.floats(1.0, 40.0)), mu=0.5,
+                        normal=Signal.ramp(-1.0, 0.2, start=draw(st.floats(0.1, 0.6)), offset=1.0))
         elif kind == "spring":
             d.spring_damper(f"k{i}", a, b, c=draw(st.floats(1.0, 200.0)), d=draw(st.floats(0.0, 2.0)))
         elif kind == "backlash":

@@ -177,6 +177,8 @@ def test_the_torque_converter_launch_shows_its_operating_points(section):
 
     names = {i.name for i in section.items if isinstance(i, Figure)}
     assert "driveline_torque_converter_converter" in names and "driveline_torque_converter_speeds" in names
+    # the automatic's upshift: its converter and its shift, as any file with a converter and a [shift] table
+    assert {"driveline_at_upshift_converter", "driveline_at_upshift_shift"} <= names
     spec = load_driveline(ROOT / "examples" / "driveline_torque_converter.toml")
     res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=spec.output_step)
     pts = converter_points(res.to_dataframe(), "converter")

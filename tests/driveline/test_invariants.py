@@ -664,8 +664,8 @@ def _check_columns(d, df, events=None):
         if f"{e.name}.mode_1" not in df.columns:
             continue
         mode = df[f"{e.name}.mode_1"].to_numpy()
-        if e.kind == 3:            # a lossy gear: its speed w_a against the ground (no support here)
-            w = df[f"{e.a}.w_rad_s"].to_numpy()
+        if e.kind == 3:            # a lossy gear: its speed w_a against its support (a planetary set's carrier)
+            w = df[f"{e.a}.w_rad_s"].to_numpy() - (df[f"{e.sup}.w_rad_s"].to_numpy() if e.sup else 0.0)
             loss_rate = np.diff(df[f"{e.name}.dissipated_J"].to_numpy())
             assert np.all(loss_rate >= -1e-7 * scale), e.name
         else:

@@ -24,7 +24,8 @@ __all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_examp
            "header_comment"]
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
-EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml", "torque_converter.toml")
+EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml", "torque_converter.toml",
+            "at_upshift.toml")
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "
@@ -302,10 +303,14 @@ def demo_section(progress=None) -> Section:
     progress : callable, optional
         Told what is being done (a message string).
     """
+    import matplotlib
+
     items, params = [], {}
-    for name in EXAMPLES:
-        more, p, _ = example_items(name, progress)
-        items += more
-        params.update(p)
+    # (the section's figures stay open until the report renders and closes them: more than pyplot's 20)
+    with matplotlib.rc_context({"figure.max_open_warning": 0}):
+        for name in EXAMPLES:
+            more, p, _ = example_items(name, progress)
+            items += more
+            params.update(p)
     return Section("Drivelines: friction elements with exact stick/slip (simulated)", items,
                    provenance=PROVENANCE, parameters=params, synthetic=True)

@@ -284,6 +284,19 @@ BUILTIN = (
         Field("loss_table", "losstable", description="MSL lossTable rows [|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]"),
         _SUPPORT,
     ), _method("gear"), f"{_MSL}.Components.IdealGear, LossyGear", _BOTH),
+    Component("planetary", "A planetary gear set: (1 + ratio) w_carrier = w_sun + ratio w_ring, tau_ring = ratio "
+                           "tau_sun; a gear in the carrier's frame, ideal or lossy.", (
+        _flange("sun", "the sun's body (\"ground\": held)"),
+        _flange("carrier", "the carrier's body (\"ground\": held)"),
+        _flange("ring", "the ring's body (\"ground\": held)"),
+        Field("ratio", "quantity", "1", required=True, minimum=1.0,
+              description="ring teeth over sun teeth (> 1)"),
+        Field("efficiency", "quantity", "1", default=1.0, positive=True, maximum=1.0,
+              description="the stationary train's mesh efficiency, in the carrier's frame (instead of loss_table)"),
+        Field("loss_table", "losstable",
+              description="MSL lossTable rows [|w_sun - w_carrier|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]"),
+    ), _method("planetary"), f"{_MSL}.Components.IdealPlanetary; LossyGear in the carrier's frame (Pelchen, Otter, "
+                             "Schweiger 2002)", ("rotational",)),
     Component("torque_converter", "A hydrodynamic torque converter: impeller torque w_p |w_p| / K(SR)^2, turbine "
                                   "torque TR(SR) times it, the stator's reaction on a support.", (
         _flange("a", "the impeller's body (the engine's side)"),

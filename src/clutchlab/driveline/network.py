@@ -1087,6 +1087,38 @@ class Driveline:
         self._elements.append(_Element(K.K_GEAR, name, a, b, (ratio,), table=table, sup=sup))
         return self
 
+    @_adds("planetary")
+    def planetary(self, name: str, sun, carrier, ring, ratio: float, efficiency: float = 1.0,
+                  loss_table=None) -> "Driveline":
+        """A planetary gear set (MSL ``IdealPlanetary``): ``(1 + ratio) w_carrier = w_sun + ratio w_ring``, ``tau_ring
+        = ratio tau_sun``, ``tau_carrier = -(1 + ratio) tau_sun``, ``ratio`` the ring's teeth over the sun's.
+
+        It is the :meth:`gear` that the set is in its carrier's frame (Willis): flange a the sun, flange b the ring,
+        the carrier its support, the stationary ratio ``(w_sun - w_c) / (w_ring - w_c) = -ratio``; so a held member
+        (a brake on the sun, the carrier on the ground) and a clutch that locks two members together give a
+        transmission's gears, and its losses are MSL ``LossyGear``'s in the carrier's frame (``efficiency`` the
+        stationary train's, Pelchen, Otter and Schweiger 2002).  Its columns are the gear's: ``<name>.tau_Nm`` the
+        torque on the sun (the ring's ``ratio`` times it, the carrier's ``-(1 + ratio)`` times it, when ideal),
+        ``<name>.mode_1`` and ``<name>.dissipated_J`` with losses.
+
+        Parameters
+        ----------
+        name, sun, carrier, ring : str
+            The set and its three members' inertias ("ground" for a member held fixed).
+        ratio : float
+            Ring teeth over sun teeth [-], > 1 (MSL's ``ratio = 100/50``).
+        efficiency, loss_table
+            As :meth:`gear`'s, in the carrier's frame.
+        """
+        if self.domain != "rotational":
+            raise ParameterError(f"{name}: a planetary gear set belongs to a rotational network")
+        ratio = _finite(name, "ratio", ratio, positive=True)
+        if ratio <= 1.0:
+            raise ParameterError(f"{name}: ratio = {ratio:g}: a planetary set's ring has more teeth than its sun "
+                                 "(ratio = ring teeth / sun teeth > 1)")
+        return self.gear(name, sun, ring, -ratio, efficiency=efficiency, loss_table=loss_table,
+                         support=None if carrier == GROUND else carrier)
+
     @_adds("torque_converter")
     def torque_converter(self, name: str, a, b, table, coast_table=None, support=None,
                          k_scale: float = 1.0) -> "Driveline":
@@ -1901,10 +1933,12 @@ class Driveline:
         if e.kind == K.K_GEAR:
             nrow = len(e.table) // 5
             what = f"gear, {wn}_a = {e.coef[0]:g} {wn}_b"
+            if e.kind_name == "planetary":
+                what = f"planetary, ring/sun teeth {-e.coef[0]:g}, sun {a}, ring {b}, carrier {e.sup or GROUND}"
             if self._is_lossy(e):
                 what += (f", efficiency {e.table[nrow]:g}" if nrow == 1 and e.table[nrow] == e.table[2 * nrow]
                          and e.table[3 * nrow] == e.table[4 * nrow] == 0.0 else f", loss table of {nrow} rows")
-            if e.sup is not None:
+            if e.sup is not None and e.kind_name != "planetary":
                 what += f", on support {e.sup}"
         elif e.kind == K.K_CONVERTER:
             nd = (len(e.table) - 2 * e.aux) // 3
