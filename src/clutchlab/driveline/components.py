@@ -317,6 +317,19 @@ BUILTIN = (
         Field("torque", "signal", "N*m", required=True, description="torque on the flange"),
         _SUPPORT,
     ), _source("torque"), f"{_MSL}.Sources.Torque", _BOTH, ("force", {"torque": "force"})),
+    Component("speed_torque", "A torque that depends on the flange's speed: tau_nominal |w/w_nominal|^k (k 1 or 2), "
+                              "in one direction both ways round or turning with the speed.", (
+        _FLANGE,
+        Field("tau_nominal", "quantity", "N*m", required=True,
+              description="accelerating torque at the nominal speed (negative: a load in positive rotation)"),
+        Field("w_nominal", "quantity", "rad/s", required=True, positive=True, description="nominal speed"),
+        Field("law", "choice", default="quadratic", choices=("linear", "quadratic"),
+              description="the speed's exponent: 1 or 2"),
+        Field("torque_direction", "bool", default=True,
+              description="the same direction of torque in both directions of rotation (MSL's TorqueDirection)"),
+        _SUPPORT,
+    ), _method("speed_torque"), f"{_MSL}.Sources.LinearSpeedDependentTorque, QuadraticSpeedDependentTorque",
+        ("rotational",)),
     Component("speed", "A speed source: the flange follows the signal, whatever torque it takes.", (
         _FLANGE,
         Field("speed", "signal", "rad/s", required=True, description="speed of the flange (continuous)"),

@@ -61,9 +61,10 @@ LAW_CLUTCH, LAW_TABLE, LAW_ONEWAY, LAW_EXTERNAL = indices(FRICTION_LAWS, "clutch
 SPRING_LAWS = ("linear", "curve", "backlash")
 SPRING_LINEAR, SPRING_CURVE, SPRING_BACKLASH = indices(SPRING_LAWS, "linear", "curve", "backlash")
 #: torque sources (K_SOURCE): a signal, or an engine (a torque map over speed and throttle plus an idle-speed PI
-#: controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``)
-SOURCE_LAWS = ("signal", "engine")
-SOURCE_SIGNAL, SOURCE_ENGINE = indices(SOURCE_LAWS, "signal", "engine")
+#: controller whose integral is a state of the network: ``x[2 n + ne + elem[r, E_STATE]]``), or a torque that
+#: depends on the flange's speed (MSL ``Linear-``, ``QuadraticSpeedDependentTorque``: :func:`speed_torque`)
+SOURCE_LAWS = ("signal", "engine", "speed")
+SOURCE_SIGNAL, SOURCE_ENGINE, SOURCE_SPEED = indices(SOURCE_LAWS, "signal", "engine", "speed")
 #: motion sources (K_MOTION): prescribed speed or position of flange b
 MOTION_LAWS = ("speed", "position")
 MOTION_SPEED, MOTION_POSITION = indices(MOTION_LAWS, "speed", "position")
@@ -157,6 +158,7 @@ COEF_COLUMNS = {
     "gear": ("ratio",),
     "converter": ("k_scale",),
     "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
+    "speed_torque": ("tau_nominal", "w_nominal", "exponent", "same_direction"),
 }
 C_STIFF, C_DAMP, C_PHI0, C_GAP = indices(COEF_COLUMNS["spring"], "stiffness", "damping", "phi0", "gap")
 C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF, C_MU_SCALE = indices(
@@ -171,6 +173,11 @@ C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
 C_K_SCALE = indices(COEF_COLUMNS["converter"], "k_scale")
 C_IDLE_W, C_IDLE_KP, C_IDLE_KI, C_IDLE_MAX = indices(
     COEF_COLUMNS["engine"], "idle_speed", "idle_kp", "idle_ki", "idle_max")
+#: a speed-dependent torque source: its nominal torque [N m] at its nominal speed [rad/s], the exponent of the speed
+#: (1 linear, 2 quadratic) and 1 where the torque keeps its direction in both directions of rotation (MSL's
+#: ``TorqueDirection``), 0 where it turns with the speed
+C_TAU_NOM, C_W_NOM, C_EXPONENT, C_SAME_DIRECTION = indices(
+    COEF_COLUMNS["speed_torque"], "tau_nominal", "w_nominal", "exponent", "same_direction")
 N_COEF = max(len(columns) for columns in COEF_COLUMNS.values())
 # modes of a lossy gear (after the switched springs' in the mode vector; MSL LossyGear): stuck (locked), or rolling
 # forward (w_a > 0) or backward, with the flange that drives (MSL's quadrants: tau_eta >= 0 forward is quadrant 1,
@@ -772,12 +779,28 @@ def engine_torque(p, r, t, x, n):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def source_torque(p, r, t, x, n):
-    """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, or an
-    engine's (:func:`engine_torque`)."""
+    """Torque [N m] a torque source row ``r`` applies to its flange b (reaction on a): its signal, an engine's
+    (:func:`engine_torque`) or a speed-dependent torque's (:func:`speed_torque`)."""
     if p.elem[r, E_LAW] == SOURCE_ENGINE:
         tq, _rate = engine_torque(p, r, t, x, n)
         return tq
+    if p.elem[r, E_LAW] == SOURCE_SPEED:
+        return speed_torque(p, r, _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A]))
     return signal_at(p, p.elem[r, E_SIGNAL], t)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def speed_torque(p, r, w):
+    """Accelerating torque [N m] of speed-dependent torque source row ``r`` at its flange's speed ``w`` [rad/s]
+    against its support (MSL ``Sources.LinearSpeedDependentTorque``, ``QuadraticSpeedDependentTorque``):
+    ``tau_nominal |w / w_nominal|^k`` with ``TorqueDirection`` (the same direction both ways round: a fan's load
+    with a negative ``tau_nominal`` in positive rotation), else ``tau_nominal sign(w) |w / w_nominal|^k``
+    (``tau_nominal w / w_nominal`` for ``k = 1``, ``tau_nominal w |w| / w_nominal^2`` for ``k = 2``); ``k`` 1 or 2."""
+    v = abs(w / p.coef[r, C_W_NOM])
+    mag = p.coef[r, C_TAU_NOM] * (v if p.coef[r, C_EXPONENT] == 1.0 else v * v)
+    if p.coef[r, C_SAME_DIRECTION] != 0.0 or w >= 0.0:
+        return mag
+    return -mag
 
 
 # ----------------------------------------------------------------- springs

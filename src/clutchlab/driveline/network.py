@@ -1235,6 +1235,46 @@ class Driveline:
         self._elements.append(_Element(K.K_SOURCE, name, a, b, signal=Signal.of(signal, f"{name}: torque")))
         return self
 
+    @_adds("speed_torque")
+    def speed_torque(self, name: str, flange, tau_nominal: float, w_nominal: float, law: str = "quadratic",
+                     torque_direction: bool = True, support=None) -> "Driveline":
+        """A torque that depends on the flange's speed ``w`` against ``support`` (MSL ``Sources.
+        LinearSpeedDependentTorque``, ``QuadraticSpeedDependentTorque``): accelerating ``tau_nominal |w /
+        w_nominal|^k`` (``k`` 1 for ``law="linear"``, 2 for ``"quadratic"``) with ``torque_direction`` (MSL's
+        ``TorqueDirection``: the same direction both ways round), else ``tau_nominal sign(w) |w / w_nominal|^k``.
+        A negative ``tau_nominal`` is a load in positive rotation (a fan, a vehicle's air drag); its work is the
+        source's ``work_J`` (negative for a load).
+
+        Parameters
+        ----------
+        name, flange : str
+            The source and the inertia it acts on.
+        tau_nominal : float
+            Torque at the nominal speed [N m].
+        w_nominal : float
+            Nominal speed [rad/s], > 0.
+        law : str
+            ``"linear"`` or ``"quadratic"``.
+        torque_direction : bool
+            The same direction of torque in both directions of rotation (MSL's default).
+        support : str, optional
+            The inertia the reaction acts on; default the ground.
+        """
+        name = self._new_name(name)
+        b = self._flange(name, "flange", flange)
+        if b is None:
+            raise ParameterError(f"{name}: a torque source needs an inertia as its flange, not the ground")
+        a = self._flange(name, "support", support)
+        if a == b:
+            raise ParameterError(f"{name}: flange and support are both {a!r}")
+        laws = {"linear": 1.0, "quadratic": 2.0}
+        if law not in laws:
+            raise ParameterError(f"{name}: law = {law!r} (known: 'linear', 'quadratic')")
+        coef = (_finite(name, "tau_nominal", tau_nominal), _finite(name, "w_nominal", w_nominal, positive=True),
+                laws[law], 1.0 if torque_direction else 0.0)
+        self._elements.append(_Element(K.K_SOURCE, name, a, b, coef, K.SOURCE_SPEED, model=law))
+        return self
+
     @_adds("engine")
     def engine(self, name: str, flange, torque_map, throttle=1.0, idle_speed: float | None = None,
                idle_kp: float = 2.0, idle_ki: float = 20.0, idle_torque_max: float = 50.0, support=None) -> "Driveline":
@@ -1925,6 +1965,10 @@ class Driveline:
         a, b = e.a or GROUND, e.b or GROUND
         if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE:
             return f"{a} --({e.name}: {e.model}, throttle {e.signal.describe()})--> [{b}]"
+        if e.kind == K.K_SOURCE and e.law == K.SOURCE_SPEED:
+            both = "both ways round" if e.coef[3] else "turning with the speed"
+            return (f"{a} --({e.name}: {e.model} speed-dependent {u['words'][2]} {e.coef[0]:g} {tu} at "
+                    f"{e.coef[1]:g} {wu}, {both})--> [{b}]")
         if e.kind == K.K_SOURCE:
             return f"{a} --({e.name}: {u['words'][2]} {e.signal.describe(tu)})--> [{b}]"
         if e.kind == K.K_MOTION:

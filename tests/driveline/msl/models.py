@@ -193,6 +193,26 @@ def directions():
     return n
 
 
+#: SimpleGearShift's ring flange is massless in MSL; a clutchlab element joins inertias, so the ring has this one
+#: (in both runs: the reference solves the same network, and in 1st the held ring does not move)
+RING_J = 1e-3
+
+
+def simple_gear_shift():
+    """Examples.SimpleGearShift: a 20 N m step at 0.5 s on the engine (J 1) on the sun of an IdealPlanetary (ratio
+    75/50), the load (J 10, QuadraticSpeedDependentTorque -20 N m at 100 rpm) on its carrier; the Brake (cgeo 2,
+    fn_max 100) holds the ring with 1 - ramp, the Clutch (cgeo 2, fn_max 100) locks sun and ring with the ramp
+    (height 1 from 2 s over 0.1 s); mu 0.5, peak 1 (MSL's defaults)."""
+    n = Network()
+    n.inertia("engine", 1.0).inertia("ring", RING_J).inertia("load", 10.0)
+    n.torque("torqueStep", "engine", step(20.0, 0.0, 0.5))
+    n.planetary("idealPlanetary", "engine", "load", "ring", 75.0 / 50.0)
+    n.quadratic_torque("quadraticSpeedDependentTorque", "load", -20.0, 10.471975511966)
+    n.clutch("clutch", "engine", "ring", 100.0, ramp(1.0, 0.1, 0.0, 2.0), mu=0.5, cgeo=2.0)
+    n.brake("brake", "ring", 100.0, ramp(-1.0, 0.1, 1.0, 2.0), mu=0.5, cgeo=2.0)
+    return n
+
+
 MODELS = {
     "coupled_clutches": (coupled_clutches, 1.5, 1e-3),
     "friction": (friction, 3.0, 1e-3),
@@ -209,4 +229,5 @@ MODELS = {
     "directions": (directions, 2.0, 1e-3),
     "backlash": (backlash, 1.0, 1e-3),
     "test_bearing_conversion": (test_bearing_conversion, 0.5, 1e-3),
+    "simple_gear_shift": (simple_gear_shift, 5.0, 1e-2),
 }

@@ -153,6 +153,19 @@ class Network:
         """Sources.Torque: ``flange`` gets +tau, ``support`` -tau."""
         return self._add("torque", name, a=support, b=flange, u=signal)
 
+    def quadratic_torque(self, name, flange, tau_nominal, w_nominal, torque_direction=True):
+        """Sources.QuadraticSpeedDependentTorque: the flange gets tau = tau_nominal (w/w_nominal)^2 (with
+        TorqueDirection; else signed by w)."""
+        def law(w):
+            q = tau_nominal * (w / w_nominal) ** 2
+            return q if torque_direction or w >= 0.0 else -q
+        return self._add("torque", name, b=flange, u=None, law=law)
+
+    def planetary(self, name, sun, carrier, ring, ratio):
+        """IdealPlanetary: (1 + ratio) w_carrier = w_sun + ratio w_ring; tau the sun flange's (MSL sun.tau)."""
+        self._add("planetary", name, a=sun, b=ring, s=carrier, ratio=ratio)
+        return self
+
     def spring_damper(self, name, a, b, c=0.0, d=0.0, phi_rel0=0.0):
         """SpringDamper (Damper: c = 0): tau = c (phi_rel - phi_rel0) + d w_rel."""
         return self._add("spring_damper", name, a, b, c=c, d=d, phi_rel0=phi_rel0)
@@ -264,9 +277,9 @@ class Network:
         for el in self.elements:
             m = modes.get(el.name)
             if el.kind == "torque":
-                u = el.p["u"](t)
-                F += self._e(el.b, u) - self._e(el.a, u)
                 wb = y[el.b] - (0.0 if el.a is None else y[el.a])
+                u = el.p["u"](t) if el.p.get("u") is not None else el.p["law"](wb)
+                F += self._e(el.b, u) - self._e(el.a, u)
                 out[el.name] = {"tau": u, "power": u * wb}
             elif el.kind in ("spring_damper", "backlash"):
                 w_rel, phi_rel = self._rel(el, y)
@@ -293,6 +306,13 @@ class Network:
                     tau = 0.0 if fn <= 0 else el.p["mu"] * el.p["cgeo"] * fn
                 F += self._e(el.a, tau) - self._e(el.b, tau)
                 out[el.name] = {"tau": tau}
+            elif el.kind == "planetary":   # sun + ratio ring - (1 + ratio) carrier = 0, workless
+                r = el.p["ratio"]
+                cvec = self._e(el.a) + self._e(el.b, r) - self._e(el.s, 1.0 + r)
+                D.append(cvec)
+                C.append(cvec)
+                owner.append((el.name, 0))
+                out[el.name] = {"tau": None}
             elif el.kind == "gear":
                 r = el.p["ratio"]
                 cvec = self._e(el.a) - self._e(el.b, r) + self._e(el.s, r - 1.0)
@@ -677,7 +697,7 @@ class Result:
                     continue
                 tau = out[el.name]["tau"]
                 # clutchlab reports a gear's torque ON flange a (the inertia there receives -tau_a)
-                cols[f"{el.name}.tau_Nm"][k] = -tau if el.kind in ("gear", "lossy_gear") else tau
+                cols[f"{el.name}.tau_Nm"][k] = -tau if el.kind in ("gear", "lossy_gear", "planetary") else tau
                 if el.kind == "lossy_gear":
                     cols[f"{el.name}.mode_1"][k] = MODE_CODE[md[el.name]]
             for j, e in enumerate(sources):
