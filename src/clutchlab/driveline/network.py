@@ -556,7 +556,7 @@ class _Element:
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
     emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
-    sup: str | None = None    # a gear's support (housing) inertia; None: the ground
+    sup: str | None = None    # a gear's or a torque converter's support (housing), a planetary set's carrier; None: the ground
     fade: tuple = ()          # a friction element's factor over its heat port's temperature: temperatures, factors
     kind_name: str = ""       # what added it: a builder's name ("clutch", "brake", ...) or a component's type
 
@@ -590,8 +590,9 @@ class ElementInfo:
     ``name``: the element's name (its result columns' prefix); ``kind``: what added it, the name of the
     :class:`Driveline` method (``"clutch"``, ``"brake"``, ``"gear"``, ``"wet_clutch"``, ...) or of the
     component type of a driveline file (``"cone_clutch"``); ``flange_a``, ``flange_b``: the inertias it acts
-    between (``"ground"`` for the fixed ground: a brake's ``flange_a`` is its support); ``support``: a
-    gear's housing inertia (``"ground"`` if fixed, ``None`` for other elements); ``summary``: its line of
+    between (``"ground"`` for the fixed ground: a brake's ``flange_a`` is its support; a planetary set's are its
+    sun and ring); ``support``: a gear's or a torque converter's housing inertia, a planetary set's carrier
+    (``"ground"`` if fixed, ``None`` for other elements); ``summary``: its line of
     :meth:`Driveline.describe`."""
 
     name: str
