@@ -556,7 +556,7 @@ class _Element:
     wet: dict | None = None   # a wet clutch: its clutch, bench, friction law, force profile and temperatures
     reference: Signal | None = None   # an E-clutch with its actuator: the bearing position reference
     emtc: dict | None = None  # an EMTC coupling: its magnet, scenario, vehicle and options
-    sup: str | None = None    # a gear's or a torque converter's support (housing), a planetary set's carrier; None: the ground
+    sup: str | None = None    # a gear's or converter's support (housing), a planetary's carrier; None: the ground
     fade: tuple = ()          # a friction element's factor over its heat port's temperature: temperatures, factors
     kind_name: str = ""       # what added it: a builder's name ("clutch", "brake", ...) or a component's type
 
