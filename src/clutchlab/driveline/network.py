@@ -1223,16 +1223,22 @@ class Driveline:
         rate at 0 are the flange's initial angle and speed.  (For a ramp or table, prescribe the speed.)"""
         return self._motion(name, flange, signal, K.MOTION_POSITION, "position")
 
-    @_adds("torque")
-    def torque(self, name: str, flange, signal, support=None) -> "Driveline":
-        """A torque source [N m] accelerating ``flange`` (its reaction on ``support``, default the ground)."""
-        name = self._new_name(name)
+    def _source_flanges(self, name, flange, support):
+        """A torque source's support and flange, ``(a, b)``: the flange an inertia, the support another or the
+        ground."""
         b = self._flange(name, "flange", flange)
         if b is None:
             raise ParameterError(f"{name}: a torque source needs an inertia as its flange, not the ground")
         a = self._flange(name, "support", support)
         if a == b:
             raise ParameterError(f"{name}: flange and support are both {a!r}")
+        return a, b
+
+    @_adds("torque")
+    def torque(self, name: str, flange, signal, support=None) -> "Driveline":
+        """A torque source [N m] accelerating ``flange`` (its reaction on ``support``, default the ground)."""
+        name = self._new_name(name)
+        a, b = self._source_flanges(name, flange, support)
         self._elements.append(_Element(K.K_SOURCE, name, a, b, signal=Signal.of(signal, f"{name}: torque")))
         return self
 
@@ -1262,12 +1268,7 @@ class Driveline:
             The inertia the reaction acts on; default the ground.
         """
         name = self._new_name(name)
-        b = self._flange(name, "flange", flange)
-        if b is None:
-            raise ParameterError(f"{name}: a torque source needs an inertia as its flange, not the ground")
-        a = self._flange(name, "support", support)
-        if a == b:
-            raise ParameterError(f"{name}: flange and support are both {a!r}")
+        a, b = self._source_flanges(name, flange, support)
         laws = {"linear": 1.0, "quadratic": 2.0}
         if law not in laws:
             raise ParameterError(f"{name}: law = {law!r} (known: 'linear', 'quadratic')")
