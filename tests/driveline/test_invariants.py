@@ -727,7 +727,8 @@ def test_invariants_hold_on_random_networks(d):
 @given(networks(with_unrelated=True))
 def test_an_unrelated_element_changes_nothing(d):
     """A network run with and without an inertia of its own elsewhere (braked, driven by a sine: events of its
-    own): the network's speeds agree within 1e-6 of their range and its events within 1e-6 s.  (Backlash
+    own): the network's speeds agree within 1e-6 of their range and its events within 1e-6 s, or within what a
+    speed error of 1e-7 moves an ill-conditioned one (:func:`_event_time_tolerance`).  (Backlash
     included: a gap's turning points are located, so a touch of its edge within a step is found whatever the step
     sequence another element brings.)"""
     alone = d.without("U", *(e.name for e in d.elements if e.name.startswith("U")))
@@ -742,7 +743,60 @@ def test_an_unrelated_element_changes_nothing(d):
     ea = [(t, el, ev) for t, el, ev in _inside(_mode_events(both), 1.0) if not str(el).startswith("U")]
     eb = _inside(_mode_events(one), 1.0)
     assert [e[1:] for e in ea] == [e[1:] for e in eb]
-    assert all(abs(x[0] - y[0]) <= EVENT_TIME_TOL for x, y in zip(ea, eb))
+    wmax = max(1.0, b.filter(like=".w_rad_s").abs().max().max())
+    assert all(abs(x[0] - y[0]) <= _event_time_tolerance(b, y, wmax) for x, y in zip(ea, eb)), (ea, eb)
+
+
+def _event_time_tolerance(frame, event, wmax, window=0.01):
+    """EVENT_TIME_TOL, or more where an event's instant is ill-conditioned: a relative speed that reaches zero with a
+    small relative acceleration ``a`` (a weak coupling, such as a torque converter near equal speeds, whose torque
+    vanishes with the slip: fiftieth session, a one-way clutch overrunning by 4.5e-6 rad/s for 29 ms under 1e-4 N m)
+    moves by ``delta / |a|`` for a speed error ``delta``; ``delta`` is 1e-7 of the network's largest speed, ten times
+    below the speeds' own criterion (1e-6 of their range).  ``a`` is the slope of the element's ``w_rel`` over the ``window`` of samples before the
+    event, at most 1 ms.  Only an element that sticks is timed by its speed; a break-away (its speed 0 before) or
+    any other event keeps EVENT_TIME_TOL, as does an element without the column."""
+    t, element, kind = event
+    col = f"{element}.w_rel_rad_s"
+    if kind != "stick" or col not in frame.columns:
+        return EVENT_TIME_TOL
+    tt = frame["time_s"].to_numpy()
+    keep = (tt < t - 1e-9) & (tt >= t - window)
+    if keep.sum() < 2:
+        return EVENT_TIME_TOL
+    slope = abs(np.polyfit(tt[keep], frame[col].to_numpy()[keep], 1)[0])
+    return min(max(EVENT_TIME_TOL, 1e-7 * wmax / max(slope, 1e-300)), 1e-3)
+
+
+def _weak_converter_network(with_unrelated):
+    """The network random draws found (fiftieth session): a torque converter turning backward near equal speeds (its
+    torque ~1e-4 N m) drives a one-way clutch's flange a, which its flange b, let go by a backlash, overruns by at
+    most 4.5e-6 rad/s for 29 ms before it locks again."""
+    d = Driveline("weak").inertia("J0", 1.5, w0=-2.0).inertia("J1", 1.0).inertia("J2", 1.0).inertia("J3", 0.25)
+    d.torque_converter("v0", "J0", "J1", [[0.0, 4.0, 1.0], [0.5, 4.8, 1.0], [0.9, 12.0, 1.0]])
+    d.one_way_clutch("f1", "J1", "J2").backlash("k2", "J2", "J3", c=22.0, b_gap=0.25, d=0.0)
+    d.clutch("loop", "J0", "J3", fn_max=1.0, mu=0.5).torque("T0", "J0", Signal.sine(4.0, 0.5))
+    if with_unrelated:
+        d.inertia("U", 1.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5).torque("UT", "U", Signal.sine(0.0, 1.0))
+    return d
+
+
+def test_an_ill_conditioned_stick_moves_with_the_tolerance_not_with_unrelated_elements():
+    """The weak converter's lock-up of the one-way clutch (relative acceleration ~5e-4 rad/s^2) moves by 3e-5 s
+    between the runs with and without an unrelated inertia at rtol = 1e-10, within its conditioning
+    (:func:`_event_time_tolerance`), and by < 1e-6 s at rtol = 1e-12: the integration error, not a decision that
+    depends on the other element."""
+    def stick(d, rtol):
+        r = d.simulate(1.0, output_step=2e-3, rtol=rtol)
+        ev = r.events[(r.events.element == "f1") & (r.events.event == "stick")]
+        return r, float(ev.time_s.iloc[-1])
+    one, t1 = stick(_weak_converter_network(False), 1e-10)
+    _, t2 = stick(_weak_converter_network(True), 1e-10)
+    b = one.to_dataframe()
+    wmax = max(1.0, b.filter(like=".w_rad_s").abs().max().max())
+    assert 1e-6 < abs(t1 - t2) <= _event_time_tolerance(b, (t1, "f1", "stick"), wmax)
+    _, u1 = stick(_weak_converter_network(False), 1e-12)
+    _, u2 = stick(_weak_converter_network(True), 1e-12)
+    assert abs(u1 - u2) < 1e-6 and abs(u1 - t1) < 1e-4
 
 
 def _edge_gear_network(with_unrelated):
