@@ -411,6 +411,25 @@ def check_shift(work, out):
     assert "lock-up at" in out and _is_png(work / "shift.png")
 
 
+def check_converter_sweep(work, out):
+    frame = pd.read_parquet(work / "results_tc" / "results.parquet").set_index(
+        ["converter.k_scale", "lockup.normal.time_scale"])
+    assert len(frame) == 15
+    nominal = frame.loc[(1.0, 1.0)]   # the example itself: its run's own numbers
+    assert nominal["vehicle.w_final_rad_s"] == pytest.approx(30.292424, rel=1e-5)
+    # at idle against the held car the converter takes T_p w = w^3 / (k_scale K_0)^2: 1/0.64 more at 0.8
+    assert frame.loc[(0.8, 1.0), "converter.loss_power_max_W"] == pytest.approx(
+        nominal["converter.loss_power_max_W"] / 0.64, rel=1e-9)
+    assert nominal["converter.loss_power_max_W"] == pytest.approx((750 * np.pi / 30) ** 3 / (130 * np.pi / 30) ** 2,
+                                                                  rel=1e-9)
+    for scale in (0.8, 1.0, 1.2):     # a looser converter slips more and heats its fluid more
+        at = frame.xs(scale, level=1)
+        assert at["converter.dissipated_final_J"].is_monotonic_increasing
+        assert at["fluid.temperature_max_C"].is_monotonic_increasing
+    for k in (0.8, 1.0, 1.25):        # a later lock-up leaves the converter slipping longer
+        assert frame.xs(k, level=0)["converter.dissipated_final_J"].is_monotonic_increasing
+
+
 def check_dct_sweep(work, out):
     frame = pd.read_parquet(work / "results_dct" / "results.parquet").set_index(
         ["c1.normal.time_scale", "c2.normal.value_scale"])
@@ -424,6 +443,7 @@ def check_dct_sweep(work, out):
 
 
 CHECKS = {
+    "results_tc/": check_converter_sweep,
     "at_shift.json": check_at_shift,
     "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
