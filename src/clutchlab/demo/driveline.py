@@ -281,7 +281,7 @@ def _converter_items(stem: str, name: str, frame, converter: str) -> list:
     pts = converter_points(frame, converter)
     best = pts.loc[pts["efficiency_1"].idxmax()] if len(pts) else None
     text = (f"The torque converter {converter!r} multiplied the engine's torque by up to "
-            f"{pts['torque_ratio_1'].max():.2f} (the speed ratio {pts['speed_ratio_1'].min():.2f}) and drove at "
+            f"{pts['torque_ratio_1'].max():.2f} (at the speed ratio {pts['speed_ratio_1'].min():.2f}) and drove at "
             f"its best with an efficiency of {best['efficiency_1']:.2f} (speed ratio {best['speed_ratio_1']:.2f}); "
             f"it turned {frame[f'{converter}.dissipated_J'].iloc[-1] / 1e3:.1f} kJ into heat in its fluid "
             "(docs/driveline.md, \"Torque converter\")." if best is not None else
@@ -290,7 +290,7 @@ def _converter_items(stem: str, name: str, frame, converter: str) -> list:
         Figure(f"driveline_{stem}_{converter}", converter_figure(frame, converter, title=f"{name}: {converter}"),
                "The converter's capacity factor K = ω_p/√T_p, torque ratio T_t/T_p and efficiency over the speed "
                "ratio ω_t/ω_p at the run's samples where the impeller drove, coloured by time: its table's "
-               "characteristic as the launch went through it, read from the run's columns."),
+               "characteristic as the run went through it, read from the run's columns."),
         Text(text),
     ]
 
