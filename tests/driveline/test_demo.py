@@ -192,4 +192,10 @@ def test_the_torque_converter_launch_shows_its_operating_points(section):
     assert np.allclose(pts["torque_ratio_1"], np.interp(sr, table[:, 0], table[:, 2]), rtol=1e-9)
     text = " ".join(i.text for i in section.items if hasattr(i, "text"))
     assert f"by up to {pts['torque_ratio_1'].max():.2f}" in text
-    assert f"efficiency of {pts['efficiency_1'].max():.2f}" in text
+    # the share of the impeller's work passed on: 1 - lost / taken, the impeller's work from the engine's speed
+    df = res.to_dataframe()
+    power, t = (-df["converter.tau_Nm"] * df["engine.w_rad_s"]).to_numpy(), df["time_s"].to_numpy()
+    taken = float(np.sum(0.5 * np.diff(t) * (power[1:] + power[:-1])))
+    lost = df["converter.dissipated_J"].iloc[-1]
+    assert 0.0 < lost < taken
+    assert f"its impeller took {taken / 1e3:.1f} kJ, of which it passed {100 * (1 - lost / taken):.0f} %" in text

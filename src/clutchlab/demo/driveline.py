@@ -239,7 +239,7 @@ def example_items(name: str, progress=None) -> tuple:
         items += _shift_items(stem, d.name, result, spec.shift)
     for e in d.elements:   # (a torque converter: its operating points over the speed ratio)
         if e.kind == "torque_converter":
-            items += _converter_items(stem, d.name, frame, e.name)
+            items += _converter_items(stem, d.name, frame, e)
     params = _network_parameters(stem, d)
     step = "every accepted step" if spec.output_step is None else f"{spec.output_step:g} s"
     params[f"{stem}: simulation"] = f"t_end = {spec.t_end:g} s, output step {step}, rtol = {spec.rtol:g}"
@@ -273,21 +273,28 @@ def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
     ]
 
 
-def _converter_items(stem: str, name: str, frame, converter: str) -> list:
+def _converter_items(stem: str, name: str, frame, converter) -> list:
     """A torque converter's operating points in the run (:func:`~clutchlab.driveline.plots.converter_figure`) and a
-    text with its stall torque ratio, its best efficiency and the heat it gave the fluid."""
+    text with its largest torque ratio and the share of the impeller's work it passed on (``converter`` its
+    :class:`~clutchlab.driveline.ElementInfo`)."""
     from ..driveline.plots import converter_figure, converter_points
 
-    pts = converter_points(frame, converter)
-    best = pts.loc[pts["efficiency_1"].idxmax()] if len(pts) else None
-    text = (f"The torque converter {converter!r} multiplied the engine's torque by up to "
-            f"{pts['torque_ratio_1'].max():.2f} (at the speed ratio {pts['speed_ratio_1'].min():.2f}) and drove at "
-            f"its best with an efficiency of {best['efficiency_1']:.2f} (speed ratio {best['speed_ratio_1']:.2f}); "
-            f"it turned {frame[f'{converter}.dissipated_J'].iloc[-1] / 1e3:.1f} kJ into heat in its fluid "
-            "(docs/driveline.md, \"Torque converter\")." if best is not None else
-            f"The torque converter {converter!r} never drove in this run.")
+    c = converter.name
+    pts = converter_points(frame, c)
+    t = frame["time_s"].to_numpy()
+    ws = 0.0 if converter.support == "ground" else frame[f"{converter.support}.w_rad_s"].to_numpy()
+    power = -frame[f"{c}.tau_Nm"].to_numpy() * (frame[f"{converter.flange_a}.w_rad_s"].to_numpy() - ws)
+    taken = float(np.sum(0.5 * np.diff(t) * (power[1:] + power[:-1])))   # [J] the impeller's work (trapezoids)
+    lost = float(frame[f"{c}.dissipated_J"].iloc[-1])
+    text = f"The torque converter {c!r} "
+    if len(pts):
+        text += (f"multiplied the engine's torque by up to {pts['torque_ratio_1'].max():.2f} (at the speed ratio "
+                 f"{pts['speed_ratio_1'].min():.2f}); ")
+    text += (f"its impeller took {taken / 1e3:.1f} kJ, of which it passed {100.0 * (1.0 - lost / taken):.0f} % to "
+             f"the turbine and turned {lost / 1e3:.1f} kJ into heat in its fluid (docs/driveline.md, \"Torque "
+             "converter\")." if taken > 0.0 else "its impeller took no work in this run.")
     return [
-        Figure(f"driveline_{stem}_{converter}", converter_figure(frame, converter, title=f"{name}: {converter}"),
+        Figure(f"driveline_{stem}_{c}", converter_figure(frame, c, title=f"{name}: {c}"),
                "The converter's capacity factor K = ω_p/√T_p, torque ratio T_t/T_p and efficiency over the speed "
                "ratio ω_t/ω_p at the run's samples where the impeller drove, coloured by time: its table's "
                "characteristic as the run went through it, read from the run's columns."),
