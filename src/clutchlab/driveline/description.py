@@ -272,23 +272,14 @@ LOSS_TABLE_COLUMNS = ("w", "eta_mf1", "eta_mf2", "tau_bf1", "tau_bf2")
 def _loss_table(value, key, src, speed_unit="rad/s", torque_unit="N*m"):
     """A gear's loss table: rows ``[|w_a|, eta_mf1, eta_mf2, tau_bf1, tau_bf2]`` (speed, two efficiencies, two
     bearing friction torques), each entry a number in SI or a quantity with its unit, converted to SI."""
-    if not isinstance(value, list) or not value:
-        raise ParameterError(f"{src}: {key} = {value!r}: expected rows [w, eta_mf1, eta_mf2, tau_bf1, tau_bf2]")
-    units = (speed_unit, "1", "1", torque_unit, torque_unit)
-    rows = []
-    for i, row in enumerate(value):
-        if not (isinstance(row, list) and len(row) == 5):
-            raise ParameterError(f"{src}: {key}[{i}] = {row!r}: expected a row of 5 "
-                                 f"[{', '.join(LOSS_TABLE_COLUMNS)}]")
-        rows.append([_quantity(v, u, f"{key}[{i}][{j}]", src) for j, (v, u) in enumerate(zip(row, units))])
-    return rows
+    return _rows(value, "|".join((speed_unit, "1", "1", torque_unit, torque_unit)), key, src, LOSS_TABLE_COLUMNS)
 
 
-def _rows(value, units, key, src):
+def _rows(value, units, key, src, names=None):
     """A table of rows (a ``"rows"`` field): one entry per column of ``units`` (a number in SI or a quantity with its
-    unit), converted to SI."""
+    unit), converted to SI; errors show the columns by ``names`` (default their units)."""
     units = [u.strip() for u in units.split("|")]
-    shown = "[" + ", ".join(units) + "]"
+    shown = "[" + ", ".join(names or units) + "]"
     if not isinstance(value, list) or not value:
         raise ParameterError(f"{src}: {key} = {value!r}: expected rows {shown}")
     out = []

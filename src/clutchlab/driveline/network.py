@@ -1117,8 +1117,7 @@ class Driveline:
         if ratio <= 1.0:
             raise ParameterError(f"{name}: ratio = {ratio:g}: a planetary set's ring has more teeth than its sun "
                                  "(ratio = ring teeth / sun teeth > 1)")
-        return self.gear(name, sun, ring, -ratio, efficiency=efficiency, loss_table=loss_table,
-                         support=None if carrier == GROUND else carrier)
+        return self.gear(name, sun, ring, -ratio, efficiency=efficiency, loss_table=loss_table, support=carrier)
 
     @_adds("torque_converter")
     def torque_converter(self, name: str, a, b, table, coast_table=None, support=None,
