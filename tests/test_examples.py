@@ -370,6 +370,20 @@ def check_at_shift(work, out):
     assert "upshift" in out
 
 
+def check_amt_shift(work, out):
+    report = json.loads((work / "amt_shift.json").read_text())
+    assert report["kind"] == "interrupted" and report["order"] == "upshift"   # the file's [shift] table
+    assert report["columns"]["clutch"] == "clutch" and report["columns"]["oncoming"] == "s2"
+    m = report["metrics"]
+    # the clutch opens at 0.72 s, 2nd's dogs engage after its cone slid, the clutch locks before 1.45 s
+    assert report["start_s"] == 0.4 and 0.71 < report["handover_s"] <= 0.72 < report["lockup_s"] < report["end_s"]
+    assert report["end_s"] < 1.45 and 0.05 < m["synchronisation_time_s"] < 0.2
+    assert m["acceleration_dip_m_s2"] > m["acceleration_before_m_s2"] > 0.0   # the drive interrupted: it decelerates
+    assert 0.0 < m["synchroniser_energy_J"] < m["clutch_energy_J"]
+    assert (work / "amt_shift.png").read_bytes()[:4] == b"\x89PNG"
+    assert "gear in at" in out
+
+
 def check_lin(work, out):
     import json
 
@@ -445,6 +459,7 @@ def check_dct_sweep(work, out):
 CHECKS = {
     "results_tc/": check_converter_sweep,
     "at_shift.json": check_at_shift,
+    "amt_shift.json": check_amt_shift,
     "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
     "shift.json": check_shift,

@@ -92,7 +92,8 @@ normal = { input = "press" }
 def networks(draw, with_unrelated=False, with_components=False, settled_only=False):
     """A random network: a chain of 2-4 inertias whose links are springs, backlash, gears (ideal, a constant
     efficiency in (0.2, 1], or a loss table with bearing friction), clutches, one-way clutches (plain or with a
-    clutch), torque converters (with or without a coast table), planetary sets (the link's inertias the sun and the
+    clutch), synchronisers (their sleeves pushed by a sine, a pulse or a constant, or never), torque converters (with
+    or without a coast table), planetary sets (the link's inertias the sun and the
     ring, a carrier of its own, sometimes held by a brake that lets go); sometimes a clutch closing a loop from the
     first to the last, a second clutch in parallel with one,
     bearing friction or a brake on an inertia; sine, ramp or step torques; started at rest or with the first
@@ -103,7 +104,8 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
     the map is read at) and E-clutches (seed 000, Model 0-4 static curves under a bearing ramp or sine; sometimes
     worn, wearing and expanding with a thermal mass they heat: their working point shifts during the run), and at
     least one link is one of them.  ``settled_only``: none of the elements whose decisions at zero speed or at
-    their limit are the open rounding-floor family of docs/driveline.md (lossy gears, bearing friction, brakes)."""
+    their limit are the open rounding-floor family of docs/driveline.md (lossy gears, bearing friction, brakes), and
+    no synchronisers (their limit jumps with their force's sign)."""
     n = draw(st.integers(2, 4))
     d = Driveline("random")
     w0 = draw(st.sampled_from([0.0, 0.0, 3.0, -2.0]))
@@ -113,7 +115,7 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
     for i in range(n - 1):
         a, b = f"J{i}", f"J{i + 1}"
         kinds = ["spring", "backlash", "gear", "clutch", "oneway", "owc", "converter", "planetary"] + (
-            [] if settled_only else ["lossy", "table"])
+            [] if settled_only else ["lossy", "table", "synchro"])
         if with_components:
             kinds += ["wet", "emtc", "eclutch"]
         kind = draw(st.sampled_from(["wet", "emtc", "eclutch"] if i == forced else kinds))
@@ -195,6 +197,14 @@ def networks(draw, with_unrelated=False, with_components=False, settled_only=Fal
             d.clutch(f"c{i}", a, b, fn_max=draw(st.floats(0.0, 60.0)), mu=0.5, peak=draw(st.floats(1.0, 1.5)),
                      normal=draw(st.sampled_from([1.0, Signal.ramp(1.0, 0.3, start=0.1),
                                                   Signal.sine(1.0, 2.0, phase=1.0)])))
+        elif kind == "synchro":   # its sleeve pushed (a sine's positive half-waves, a pulse, held) or never
+            force = draw(st.sampled_from([Signal.sine(draw(st.floats(50.0, 400.0)), draw(st.floats(0.5, 4.0))),
+                                          Signal.pulse(draw(st.floats(50.0, 400.0)), 0.5, draw(st.floats(0.2, 0.6)),
+                                                       start=draw(st.floats(0.0, 0.2))),
+                                          Signal.constant(draw(st.floats(50.0, 400.0))), Signal.constant(0.0)]))
+            d.synchronizer(f"y{i}", a, b, force, cone_radius=draw(st.floats(0.02, 0.06)),
+                           dog_capacity=draw(st.floats(2.0, 80.0)), mu=draw(st.floats(0.05, 0.11)),
+                           cones=draw(st.integers(1, 3)))
         elif kind == "oneway":
             d.one_way_clutch(f"f{i}", a, b)
         else:

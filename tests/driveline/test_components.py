@@ -59,7 +59,7 @@ def test_every_builtin_kind_is_declared_with_the_defaults_of_its_method():
     kinds = {c.kind for c in BUILTIN}
     assert kinds == {"inertia", "spring_damper", "spring", "backlash", "gear", "torque", "speed", "position", "clutch",
                      "brake", "bearing_friction", "one_way_clutch", "eclutch", "engine", "wet_clutch", "emtc",
-                     "torque_converter", "planetary", "speed_torque",
+                     "torque_converter", "planetary", "speed_torque", "synchronizer",
                      "thermal_mass", "thermal_conductor"}
     for comp in BUILTIN:
         sig = inspect.signature(getattr(Driveline, comp.kind)).parameters

@@ -199,3 +199,22 @@ def test_the_torque_converter_launch_shows_its_operating_points(section):
     lost = df["converter.dissipated_J"].iloc[-1]
     assert 0.0 < lost < taken
     assert f"its impeller took {taken / 1e3:.1f} kJ, of which it passed {100 * (1 - lost / taken):.0f} %" in text
+
+
+def test_the_amt_upshift_shows_its_interrupted_shift(section):
+    """The AMT example: its shift's figure and its metrics' table equal to shift_quality of a direct run (an
+    interrupted shift, through the file's [shift] table with its clutch), and the text's numbers from them."""
+    from clutchlab.driveline.shift import shift_quality
+
+    names = {i.name for i in section.items if isinstance(i, Figure)}
+    assert {"driveline_amt_upshift_shift", "driveline_amt_upshift_speeds"} <= names
+    tables = {i.name: i.frame for i in section.items if isinstance(i, Table)}
+    shown = tables["driveline_amt_upshift_shift_quality"].set_index("metric")
+    spec = load_driveline(ROOT / "examples" / "driveline_amt_upshift.toml")
+    res = spec.driveline.simulate(spec.t_end, rtol=spec.rtol, max_step=spec.max_step, output_step=spec.output_step)
+    q = shift_quality(res, **spec.shift)
+    assert q.kind == "interrupted" and list(shown.index) == list(q.metrics)
+    for k, v in q.metrics.items():
+        assert shown.loc[k, "value"] == pytest.approx(v, rel=1e-9, nan_ok=True), k
+    text = " ".join(i.text for i in section.items if hasattr(i, "text"))
+    assert f"the drive is interrupted for {1e3 * q.metrics['torque_interruption_s']:.0f} ms" in text

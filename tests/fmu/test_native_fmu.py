@@ -1171,10 +1171,12 @@ def test_model_exchange_of_each_model_agrees_with_its_cosimulation(tmp_path, mod
 
 
 @pytest.mark.parametrize("example", ["driveline_test_friction", "driveline_wet_sae2", "driveline_emtc_awd",
-                                     "driveline_eclutch_launch", "driveline_torque_converter"])
+                                     "driveline_eclutch_launch", "driveline_torque_converter",
+                                     "driveline_amt_upshift"])
 def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     """Every example network (one-way clutches and bearing friction, the wet clutch's and the EMTC's grafts, the
-    E-clutch with its actuator, a torque converter with its lock-up clutch and a thermal mass) as a native FMU, run
+    E-clutch with its actuator, a torque converter with its lock-up clutch and a thermal mass, an AMT's clutch and
+    synchronisers) as a native FMU, run
     in FMPy without clutchlab against the Python
     co-simulation; and for model exchange under CVode."""
     cls = DrivelineCoSimulation.for_description(EXAMPLE.parent / f"{example}.toml")
@@ -1214,6 +1216,23 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
             _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
         base = _python_run(cls, n, dt)
         assert python["converter.tau"][0] == pytest.approx(base["converter.tau"][0] / 1.15 ** 2, rel=1e-12)   # stall
+    if example == "driveline_amt_upshift":   # a larger cone on 2nd's synchroniser, set by the host
+        _, svs = _variables(path)
+        assert svs["s2.cone_radius"].get("causality") == "parameter"
+        (tmp_path / "cone").mkdir()
+        native = _fmpy_run(tmp_path / "cone", path, n, dt, {"s2.cone_radius": 0.06})
+        python = _python_run(cls, n, dt, {"s2.cone_radius": 0.06})
+        for name in python:
+            _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
+        # the cone's torque grows with its radius: 2nd's synchroniser engages sooner (its slip at zero earlier)
+        base = _python_run(cls, n, dt)
+
+        def engaged(run):   # the first sample from mid-run on at which 2nd's slip is gone
+            w = np.abs(run["s2.w_rel"])
+            return n // 2 + int(np.flatnonzero(w[n // 2:] <= 1e-9 * w.max())[0])
+
+        engaged = [engaged(run) for run in (base, python)]
+        assert engaged[1] < engaged[0]
 
 
 def _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, line):

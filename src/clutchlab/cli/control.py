@@ -15,6 +15,8 @@ layer over :mod:`clutchlab.control`.
 ``clutchlab control shift examples/driveline_dct_upshift.toml --offgoing c1 --oncoming c2 --shaft wheels``
     with ``--engine engine --radius "0.3 m" -o shift.json``: the phases and quality metrics of a clutch-to-clutch
     shift in the network's run (or in a record of a run or a rig; a driveline's [shift] table names the clutches);
+    with ``--clutch``, an automated manual transmission's interrupted shift (``--offgoing``, ``--oncoming``: its
+    synchronisers);
 ``clutchlab control design eclutch --at "4 mm" -u motor_voltage -y bearing_position --crossover "5 Hz" ...``
     with ``--phase-margin "60 deg" -o pi.json``: the PI for that margin (JSON); with ``--run run.csv --step
     "0.5 mm"`` also the nonlinear model run with it in the loop for a reference step.
@@ -118,6 +120,9 @@ def register(subparsers) -> None:
                        help="the output's speed (the output shaft's or the wheels'): an inertia (its <name>.w_rad_s) "
                             "or a column, e.g. wheels (a driveline: default its [shift] table's output)")
     shift.add_argument("--engine", default=None, metavar="NAME", help="the engine's speed, drawn in the figure")
+    shift.add_argument("--clutch", default=None, metavar="CLUTCH",
+                       help="an automated manual transmission's clutch: the shift is an interrupted one, "
+                            "--offgoing and --oncoming its synchronisers (a driveline: default its [shift] table's)")
     shift.add_argument("--radius", default=None,
                        help="travel per radian of the output (tyre radius over the axle ratio behind it), e.g. "
                             "'0.3 m': the acceleration in m/s^2 (default: the output's angular acceleration)")
@@ -390,6 +395,7 @@ def _shift(args) -> int:
         raise ParameterError(f"--plot {args.plot}: expected a .png file")
     outputs = OutputSet([args.write, args.plot], args.force)   # checked before the run; written together
     given = dict(offgoing=args.offgoing, oncoming=args.oncoming, output=args.shaft, engine=args.engine,
+                 clutch=args.clutch,
                  threshold=args.threshold, settle=None if args.settle is None else to_si(args.settle, "s",
                                                                                          name="--settle"),
                  radius=None if args.radius is None else to_si(args.radius, "m", name="--radius"),

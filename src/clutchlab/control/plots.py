@@ -220,10 +220,12 @@ def judder_figure(timeline, *, title: str = ""):
 
 
 def shift_figure(quality, *, title: str = ""):
-    """A clutch-to-clutch shift and its phases (:func:`clutchlab.control.shift_quality`): the engine's speed and the
+    """A gear shift and its phases (:func:`clutchlab.control.shift_quality`): the engine's speed and the
     clutches' slip speeds [rpm], their torques, the output's acceleration (its level before the shift and its dip
     marked) and its jerk, with the torque phase and the inertia phase shaded (bounded by the start, the hand-over
-    and the lock-up).
+    and the lock-up).  An interrupted (AMT) shift's: the clutch's and the synchronisers' slips and torques, with the
+    release, the neutral and synchronisation, and the closing shaded (bounded by the start, the clutch's opening,
+    the dogs' engagement and the clutch's lock-up).
 
     Parameters
     ----------
@@ -249,13 +251,19 @@ def shift_figure(quality, *, title: str = ""):
     rpm = 30.0 / np.pi
     fig, axes = new_figure(4, 1, width=7.5, height=9.0, sharex=True)
     off, on = q.columns["offgoing"], q.columns["oncoming"]
+    interrupted = q.kind == "interrupted"
     if "engine_speed_rad_s" in tr.columns:
         axes[0].plot(t, rpm * tr["engine_speed_rad_s"].to_numpy(float)[keep], color="k", label="engine")
     axes[0].plot(t, rpm * tr["offgoing_slip_rad_s"].to_numpy(float)[keep], color="C0", label=f"{off} slip (off-going)")
     axes[0].plot(t, rpm * tr["oncoming_slip_rad_s"].to_numpy(float)[keep], color="C1", label=f"{on} slip (on-coming)")
+    if interrupted:
+        axes[0].plot(t, rpm * tr["clutch_slip_rad_s"].to_numpy(float)[keep], color="C3",
+                     label=f"{q.columns['clutch']} slip (clutch)")
     axes[0].set_ylabel("speed [rpm]")
     axes[1].plot(t, tr["offgoing_torque_Nm"].to_numpy(float)[keep], color="C0", label=off)
     axes[1].plot(t, tr["oncoming_torque_Nm"].to_numpy(float)[keep], color="C1", label=on)
+    if interrupted:
+        axes[1].plot(t, tr["clutch_torque_Nm"].to_numpy(float)[keep], color="C3", label=q.columns["clutch"])
     axes[1].set_ylabel("|clutch torque| [N m]")
     before = q.metrics[f"acceleration_before_{a_unit}"]
     dip = q.metrics[f"acceleration_dip_{a_unit}"]
@@ -266,16 +274,20 @@ def shift_figure(quality, *, title: str = ""):
     axes[3].plot(t, tr[jerk].to_numpy(float)[keep], color="C4")
     axes[3].set_ylabel(f"jerk [{pretty.get(j_unit, j_unit)}]")
     axes[3].set_xlabel("time [s]")
-    first, second = ((q.start_s, q.handover_s), (q.handover_s, q.lockup_s)) if q.order == "upshift" else (
-        (q.lockup_s, q.handover_s), (q.start_s, q.lockup_s))
+    if interrupted:
+        spans = ((q.start_s, q.handover_s), (q.handover_s, q.lockup_s), (q.lockup_s, q.end_s))
+        legend = "shaded:\nrelease (blue),\nneutral and\nsynchronisation\n(orange),\nclosing (green)"
+    else:
+        spans = ((q.start_s, q.handover_s), (q.handover_s, q.lockup_s)) if q.order == "upshift" else (
+            (q.lockup_s, q.handover_s), (q.start_s, q.lockup_s))
+        legend = "shaded:\ntorque phase (blue),\ninertia phase (orange)"
     for a in axes:
         a.grid(True, alpha=0.3)
-        a.axvspan(*first, color="C0", alpha=0.10, lw=0)
-        a.axvspan(*second, color="C1", alpha=0.10, lw=0)
+        for k, span in enumerate(spans):
+            a.axvspan(*span, color=f"C{k}", alpha=0.10, lw=0)
     for a in axes[:3]:
         legend_outside(a)
-    axes[3].text(1.02, 0.5, "shaded:\ntorque phase (blue),\ninertia phase (orange)", transform=axes[3].transAxes,
-                 fontsize=8, va="center")
+    axes[3].text(1.02, 0.5, legend, transform=axes[3].transAxes, fontsize=8, va="center")
     if title:
         axes[0].set_title(title)
     return fig

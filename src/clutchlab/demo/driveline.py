@@ -25,7 +25,7 @@ __all__ = ["EXAMPLES", "PROVENANCE", "demo_section", "example_items", "run_examp
 
 #: bundled descriptions shown by the demo, in this order (files in ``clutchlab/driveline/data``)
 EXAMPLES = ("coupled_clutches.toml", "eclutch_launch.toml", "dct_upshift.toml", "torque_converter.toml",
-            "at_upshift.toml")
+            "at_upshift.toml", "amt_upshift.toml")
 
 PROVENANCE = ("Simulated (synthetic) data, not measured: clutchlab's driveline networks run from the descriptions "
               "bundled with clutchlab (clutchlab/driveline/data, the same files as examples/driveline_*.toml) on "
@@ -247,7 +247,8 @@ def example_items(name: str, progress=None) -> tuple:
 
 
 def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
-    """The shift quality of an example that is a clutch-to-clutch shift: its figure, metrics and a text."""
+    """The shift quality of an example with a ``[shift]`` table (a clutch-to-clutch or an AMT's interrupted shift):
+    its figure, metrics and a text."""
     from ..control.plots import shift_figure
     from ..driveline.shift import shift_quality
 
@@ -255,15 +256,35 @@ def _shift_items(stem: str, name: str, result, arguments: dict) -> list:
     m = q.metrics
     a, j = ("m_s2", "m_s3") if "acceleration_dip_m_s2" in m else ("rad_s2", "rad_s3")   # (with a radius: the vehicle's)
     au, ju = a.replace("_s", "/s^"), j.replace("_s", "/s^")
+    table = Table(f"driveline_{stem}_shift_quality", q.table()[["metric", "value", "unit", "description"]],
+                  f"Shift quality of {name!r} (clutchlab.control.shift_quality, from the run's columns)",
+                  float_format="{:.4g}")
+    if q.kind == "interrupted":
+        return [
+            Figure(f"driveline_{stem}_shift", shift_figure(q, title=f"{name}: shift quality"),
+                   f"The automated manual transmission's {q.order} from {arguments['offgoing']} to "
+                   f"{arguments['oncoming']} through the clutch {arguments['clutch']}: the engine's speed, the "
+                   "clutch's and the synchronisers' slips and torques, the vehicle's acceleration (its level before "
+                   "the shift and its dip marked) and jerk; the release (the engine's torque taken down, the clutch "
+                   "opened), the neutral and synchronisation (the old sleeve out, the new cone pulling the input "
+                   "shaft onto the new gear's speed until its dogs engage) and the closing shaded."),
+            table,
+            Text(f"Shift quality (docs/control.md, \"Shift quality\"): the drive is interrupted for "
+                 f"{1e3 * m['torque_interruption_s']:.0f} ms of the shift's {1e3 * m['shift_time_s']:.0f} ms; the "
+                 f"synchroniser {arguments['oncoming']} takes {1e3 * m['synchronisation_time_s']:.0f} ms and "
+                 f"{m['synchroniser_energy_J']:.0f} J to bring its gear to speed; the vehicle's acceleration dips "
+                 f"by {m['acceleration_dip_' + a]:.2f} {au} from {m['acceleration_before_' + a]:.2f} {au} (the "
+                 f"torque hole), and the clutch, closing onto a slip that falls at "
+                 f"{m['lockup_slip_rate_rad_s2']:.0f} rad/s^2 as it locks, takes {m['clutch_energy_J'] / 1e3:.1f} "
+                 f"kJ; the jerk peaks at {m['jerk_peak_' + j]:.0f} {ju}."),
+        ]
     return [
         Figure(f"driveline_{stem}_shift", shift_figure(q, title=f"{name}: shift quality"),
                f"The {q.order} from {arguments['offgoing']} to {arguments['oncoming']}: the engine's speed and the "
                "clutches' slips, their torques, the vehicle's acceleration (its level before the shift and its dip "
                "marked) and jerk; the torque phase (the on-coming clutch takes the engine's torque) and the inertia "
                "phase (it pulls the engine down to the new gear's speed) shaded."),
-        Table(f"driveline_{stem}_shift_quality", q.table()[["metric", "value", "unit", "description"]],
-              f"Shift quality of {name!r} (clutchlab.control.shift_quality, from the run's columns)",
-              float_format="{:.4g}"),
+        table,
         Text(f"Shift quality (docs/control.md, \"Shift quality\"): the torque phase lasts "
              f"{1e3 * m['torque_phase_s']:.0f} ms and the inertia phase {1e3 * m['inertia_phase_s']:.0f} ms; the "
              f"output's acceleration dips by {m['acceleration_dip_' + a]:.2f} {au} from "

@@ -345,6 +345,25 @@ BUILTIN = (
     Component("brake", "A brake between a flange and its support (the ground by default).", (
         _FLANGE, *_friction_fields(), _SUPPORT,
     ), _clutch_like("brake"), f"{_MSL}.Components.Brake", _BOTH),
+    Component("synchronizer", "A gear's synchroniser: a cone clutch that pulls the speeds together while the shift "
+                              "force pushes the sleeve, then dogs that hold the gear in.", (
+        _flange("a", "the shaft the sleeve's hub turns with"),
+        _flange("b", "the gear's idler (the body its gear pair turns)"),
+        Field("force", "signal", "N", required=True,
+              description="shift force on the sleeve: > 0 pushes it towards the gear (held in while > 0), <= 0 "
+                          "takes it out (neutral)"),
+        Field("cone_radius", "quantity", "m", required=True, positive=True, description="mean radius of the cone"),
+        Field("dog_capacity", "quantity", "N*m", required=True, positive=True,
+              description="the most torque the engaged dogs hold"),
+        Field("mu", "characteristic", "1", default=0.1, minimum=0.0, maximum=FRICTION_COEFFICIENT_MAX,
+              description="cone friction coefficient (0.08-0.12 in oil), below tan(cone_angle): a number or rows "
+                          "[w_rad_s, mu]"),
+        Field("cone_angle", "quantity", "rad", default=0.11344640137963143, positive=True, maximum=0.7853981633974483,
+              description="half angle of the cone (\"6.5 deg\")"),
+        Field("cones", "int", default=1, minimum=1, maximum=3, description="cone surfaces: 1, 2 or 3"),
+    ), _method("synchronizer"), "a cone clutch (normal force F / sin(alpha) on n cones: torque n mu F R_c / "
+                                "sin(alpha)) and a dog clutch: clutchlab.driveline.kernel.static_limit",
+        ("rotational",)),
     Component("bearing_friction", "Bearing friction against a support; never free.", (
         _FLANGE,
         Field("torque", "characteristic", "N*m", default=1.0, minimum=0.0,

@@ -27,10 +27,10 @@
     normal = { sine = { amplitude = 1, frequency = "0.2 Hz", phase = "90 deg" } }
 
     [shift]                   # optional: the clutch-to-clutch shift the network makes (a dual-clutch upshift)
-    offgoing = "c1"           # friction elements of the network
-    oncoming = "c2"
+    offgoing = "c1"           # friction elements of the network (an AMT's: its synchronisers, and clutch = its
+    oncoming = "c2"           # clutch)
     output = "wheels"         # an inertia; engine, the engine's (optional)
-    radius = "0.3 m"          # optional, as threshold, settle, pre (clutchlab.driveline.shift.shift_quality)
+    radius = "0.3 m"          # optional, as threshold, settle, pre, start (clutchlab.driveline.shift.shift_quality)
 
 Component tables are the registered component kinds, each declared once with its fields' units,
 defaults and physical ranges (:mod:`clutchlab.component`, :mod:`clutchlab.driveline.components`;
@@ -48,7 +48,8 @@ friction map ``.json`` of ``clutchlab wet identify`` with radius [m] and
 temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support; mu_map, radius, temperature),
 ``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b; fn_max, mu, peak, cgeo, normal: MSL's
-``OneWayClutch``), ``eclutch`` (a, b, position [m], model
+``OneWayClutch``), ``synchronizer`` (a = the shaft, b = the gear's idler, force [N] on the sleeve, cone_radius,
+dog_capacity, mu, cone_angle, cones: an AMT's or manual gearbox's), ``eclutch`` (a, b, position [m], model
 0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak; actuator = true: the
 position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
 (flange, torque_map = ``{ speeds, throttles, torques }`` or full-load rows ``[[w, T], ...]``, throttle,
@@ -172,7 +173,7 @@ class DrivelineFile:
         Largest step [s].
     shift : dict or None
         The ``[shift]`` table: the keyword arguments of :func:`clutchlab.driveline.shift.shift_quality` for the
-        clutch-to-clutch shift the network makes (``clutchlab control shift FILE``, the sweep's ``shift.<metric>``).
+        shift the network makes (clutch-to-clutch, or an AMT's with ``clutch``) (``clutchlab control shift FILE``, the sweep's ``shift.<metric>``).
     """
 
     driveline: Driveline
@@ -589,9 +590,9 @@ def _shift(table, d: Driveline, src: str):
         if SHIFT_FIELDS[k] is not None:
             out[k] = _quantity(v, SHIFT_FIELDS[k], f"shift.{k}", src)
             continue
-        kinds = friction if k in ("offgoing", "oncoming") else bodies
+        kinds = friction if k in ("offgoing", "oncoming", "clutch") else bodies
         if not isinstance(v, str) or v not in kinds:
-            what = "a friction element" if k in ("offgoing", "oncoming") else "an inertia"
+            what = "a friction element" if k in ("offgoing", "oncoming", "clutch") else "an inertia"
             raise ParameterError(f"{src}: shift.{k} = {v!r}: expected the name of {what} of the network "
                                  f"({', '.join(sorted(kinds))})")
         out[k] = v

@@ -154,7 +154,7 @@ N_LINK = len(LINK_COLUMNS)
 COEF_COLUMNS = {
     "spring": ("stiffness", "damping", "phi0", "gap"),
     "friction": ("fn_max", "cgeo", "peak", "ncurve", "liftoff", "mu_scale", "levels", "wear0", "wear_rate", "expansion",
-                 "t_ref"),
+                 "t_ref", "dog"),
     "gear": ("ratio",),
     "converter": ("k_scale",),
     "engine": ("idle_speed", "idle_kp", "idle_ki", "idle_max"),
@@ -168,6 +168,9 @@ C_FN_MAX, C_CGEO, C_PEAK, C_NCURVE, C_LIFTOFF, C_MU_SCALE = indices(
 #: expansion [m/K] and the temperature [degC] at which its curve is the model's
 C_LEVELS, C_WEAR0, C_WEAR_RATE, C_EXPANSION, C_T_REF = indices(
     COEF_COLUMNS["friction"], "levels", "wear0", "wear_rate", "expansion", "t_ref")
+#: a synchroniser (a cone clutch and a dog clutch on one sleeve): its dogs' torque capacity [N m], its static limit
+#: while the sleeve is pushed in (0: a plain clutch, whose static limit is ``peak`` times its sliding torque at rest)
+C_DOG = indices(COEF_COLUMNS["friction"], "dog")
 C_RATIO = indices(COEF_COLUMNS["gear"], "ratio")
 #: a torque converter's factor on its capacity factors K (both tables): a looser (> 1) or tighter converter
 C_K_SCALE = indices(COEF_COLUMNS["converter"], "k_scale")
@@ -713,9 +716,19 @@ def _is_free(p, r, t):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def static_limit(p, r, t):
     """Static limit ``peak * tau0`` [N m] of friction element row ``r`` at time ``t`` (a one-way clutch: its
-    clutch's, the most it holds against overrunning)."""
+    clutch's, the most it holds against overrunning).
+
+    A synchroniser (a cone clutch and a dog clutch on one shift sleeve, ``C_DOG`` > 0; docs/driveline.md,
+    "Synchronisers"; the seeds do not treat gearboxes): while the sleeve's shift force pushes it towards its gear
+    the blocker ring holds the sleeve back as long as the cone slides, with the element's sliding torque
+    ``cones mu F R_c / sin(alpha)`` (``cgeo = cones R_c / sin(alpha)``, the normal force the shift force ``F``).
+    Where the speeds meet the dogs engage: stuck, it holds up to the dogs' capacity ``C_DOG`` [N m].  A force of zero
+    or less takes the sleeve out: the element is free then, as a clutch without a normal force is
+    (:func:`_is_free`), so its limit is never read there.  The sleeve's travel and the dogs' lash take no time."""
     if p.elem[r, E_LAW] == LAW_EXTERNAL:
         return external_value(p, p.elem[r, E_AUX], 1, t)
+    if p.coef[r, C_DOG] > 0.0:
+        return p.coef[r, C_DOG]
     return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 

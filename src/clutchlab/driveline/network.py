@@ -1814,6 +1814,71 @@ class Driveline:
         return self._friction(name, a, b, K.LAW_ONEWAY, self._characteristic(name, "mu", mu), peak, fn_max, cgeo,
                               None if fn_max == 0.0 else normal, mu_temperature, mu_scale)
 
+    @_adds("synchronizer")
+    def synchronizer(self, name: str, a, b, force, cone_radius: float, dog_capacity: float, mu=0.1,
+                     cone_angle: float = math.radians(6.5), cones: int = 1) -> "Driveline":
+        """A synchroniser between a shaft ``a`` and a gear's idler ``b`` on it: a cone clutch and a dog
+        clutch on one shift sleeve, as an automated manual transmission (AMT) or a manual gearbox engages a gear.
+
+        The sleeve's shift force ``force`` [N] (a signal: a shift actuator's force, or a network input) pushes it
+        towards the gear while positive.  While the speeds differ the blocker ring holds the sleeve back and the
+        cone slides with the torque ``cones mu F cone_radius / sin(cone_angle)`` (a clutch with ``cgeo = cones
+        cone_radius / sin(cone_angle)`` and the normal force ``F``), which pulls the speeds together.  Where they
+        meet the dogs engage (event ``stick``) and hold up to ``dog_capacity`` [N m] while the force stays
+        positive: the gear is in.  A force of zero or less takes the sleeve out (neutral; event ``free``): a gear
+        is held in by a positive force, and a synchroniser at zero force never engages.  The sleeve's travel, the
+        dogs' lash and the blocker's indexing take no time here
+        (:func:`~clutchlab.driveline.kernel.static_limit`; docs/driveline.md, "Synchronisers").
+
+        Parameters
+        ----------
+        name : str
+            Its name (unique among the network's components).
+        a, b : str
+            The two bodies it joins: the shaft its sleeve's hub turns with and the gear's idler (a friction element
+            acts alike both ways round).
+        force : float, Signal, tuple or str
+            The shift force [N] on the sleeve (a number, a :class:`Signal`, ``(times, values)`` or a network
+            input's name).
+        cone_radius : float
+            Mean radius of the friction cone [m] (> 0).
+        dog_capacity : float
+            The most torque [N m] the engaged dogs hold (> 0); beyond it the element slides at the cone's torque.
+        mu : float or table
+            Friction coefficient of the cone (oil-lubricated brass, carbon or molybdenum linings: 0.08-0.12), a
+            number or rows ``[w_rad_s, mu]`` over the slip speed.
+        cone_angle : float
+            Half angle of the cone [rad] (default 6.5 degrees; in (0, pi/4]).  Where ``mu >= tan(cone_angle)``
+            the cone would stay locked after the force is taken off; that is refused.
+        cones : int
+            Number of cone surfaces: 1 (single cone), 2 (double) or 3 (triple).
+        """
+        name = self._new_name(name)
+        a, b = self._two(name, a, b)
+        radius = _finite(name, "cone_radius", cone_radius, positive=True)
+        dog = _finite(name, "dog_capacity", dog_capacity, positive=True)
+        angle = _finite(name, "cone_angle", cone_angle, positive=True)
+        if not angle <= math.pi / 4:
+            raise ParameterError(f"{name}: cone_angle = {math.degrees(angle):g} deg must lie in (0, 45] deg (a "
+                                 "synchroniser's cone half angle is 6-8 deg)")
+        if isinstance(cones, bool) or not isinstance(cones, (int, np.integer)) or cones not in (1, 2, 3):
+            raise ParameterError(f"{name}: cones = {cones!r} must be 1, 2 or 3 (cone surfaces)")
+        table = self._characteristic(name, "mu", mu)
+        mu_max = max(table[len(table) // 2:])
+        if mu_max >= math.tan(angle):
+            raise ParameterError(f"{name}: mu = {mu_max:g} is not below tan(cone_angle) = {math.tan(angle):.4g} "
+                                 f"(cone_angle {math.degrees(angle):g} deg): the cone would lock itself and not "
+                                 "release when the force is taken off; use a larger cone_angle or a smaller mu")
+        cgeo = cones * radius / math.sin(angle)
+        self._friction(name, a, b, K.LAW_CLUTCH, table, 1.0, 1.0, cgeo, Signal.of(force, f"{name}: force"))
+        el = self._elements[-1]
+        coef = list(el.coef) + [0.0] * (K.C_DOG + 1 - len(el.coef))
+        coef[K.C_DOG] = dog
+        el.coef = tuple(coef)
+        el.model = (f"synchroniser, {cones} cone{'s' if cones > 1 else ''} at {radius * 1e3:g} mm, "
+                    f"{math.degrees(angle):g} deg, dogs {dog:g} N m")
+        return self
+
     # ---- the system
     # ---- heat
     def thermal_mass(self, name: str, capacity: float, T0: float = 20.0, conductance: float = 0.0,
@@ -1999,6 +2064,10 @@ class Driveline:
                     + (", MSL damping law" if e.aux == K.LASH_MSL else ""))
         elif e.kind == K.K_SPRING:
             what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
+        elif e.kind == K.K_FRICTION and len(e.coef) > K.C_DOG and e.coef[K.C_DOG] > 0.0:
+            n = len(e.table) // 2
+            char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
+            what = f"{e.model}, mu {char}, shift force {e.signal.describe('N')}"
         elif e.law == K.LAW_ONEWAY:
             what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
                     f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")

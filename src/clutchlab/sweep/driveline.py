@@ -160,7 +160,7 @@ def outputs_of(driveline, shift=None) -> dict:
     for name, (unit, *_) in metrics_of(system).items():
         out.setdefault(name, unit)
     if shift:
-        for name, unit in metric_names("radius" in shift).items():
+        for name, unit in metric_names("radius" in shift, "clutch" in shift).items():
             out[f"shift.{name}"] = COLUMN_UNITS[unit][0] if unit in COLUMN_UNITS else unit
     return out
 
