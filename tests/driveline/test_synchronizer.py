@@ -38,11 +38,11 @@ def cone_torque(mu, force, radius, cones=1, angle=ANGLE):
     return cones * mu * force * radius / math.sin(angle)
 
 
-def pair(w1=100.0, w2=20.0, j1=0.02, j2=0.5, force=500.0, dog=300.0, cones=1):
+def pair(w1=100.0, w2=20.0, j1=0.02, j2=0.5, force=500.0, dog=300.0, cones=1, side="positive"):
     d = Driveline("pair")
     d.inertia("shaft", J=j1, w0=w1)
     d.inertia("idler", J=j2, w0=w2)
-    d.synchronizer("s", "shaft", "idler", force, cone_radius=0.04, dog_capacity=dog, mu=0.1, cones=cones)
+    d.synchronizer("s", "shaft", "idler", force, cone_radius=0.04, dog_capacity=dog, mu=0.1, cones=cones, side=side)
     return d
 
 
@@ -51,13 +51,15 @@ def events_of(result, name):
     return ev[ev["element"] == name].reset_index(drop=True)
 
 
-@pytest.mark.parametrize("cones", [1, 3])
-def test_a_constant_force_synchronises_two_free_inertias_in_the_closed_form_time(cones):
+@pytest.mark.parametrize("cones, side", [(1, "positive"), (3, "positive"), (2, "negative")])
+def test_a_constant_force_synchronises_two_free_inertias_in_the_closed_form_time(cones, side):
     # the cone's constant torque T brings the slip dw to zero at dw / (T (1/J1 + 1/J2)), dissipating the relative
-    # motion's kinetic energy J1 J2 dw^2 / (2 (J1 + J2)); the speeds then stay at the momentum's mean (dogs in)
+    # motion's kinetic energy J1 J2 dw^2 / (2 (J1 + J2)); the speeds then stay at the momentum's mean (dogs in).  A
+    # synchroniser on a sleeve's other side is pushed by the force's negative values: -500 N is its 500 N
     j1, j2, w1, w2, force = 0.02, 0.5, 100.0, 20.0, 500.0
-    r = pair(w1, w2, j1, j2, force, cones=cones).simulate(0.5, rtol=1e-10, output_step=1e-3,
-                                                          check_invariants=True)
+    signal = force if side == "positive" else -force
+    r = pair(w1, w2, j1, j2, signal, cones=cones, side=side).simulate(0.5, rtol=1e-10, output_step=1e-3,
+                                                                      check_invariants=True)
     T = cone_torque(0.1, force, 0.04, cones)
     t_sync = (w1 - w2) / (T * (1.0 / j1 + 1.0 / j2))
     ev = events_of(r, "s")
@@ -138,6 +140,35 @@ def test_a_sleeve_pushed_again_synchronises_and_engages_again():
     assert kinds[0] == "stick" and kinds.count("free") >= 2 and kinds.count("stick") >= 2
     for t0 in (0.2, 0.6):   # out at the pulse's falling edges
         assert (abs(ev.loc[ev["event"] == "free", "time_s"] - t0) < 1e-9).any()
+
+
+def test_one_fork_moves_a_sleeve_between_two_gears():
+    # a 1-2 sleeve: two synchronisers on one fork's force, one each side; the force's sign picks the gear, zero is
+    # neutral.  The shaft turns between two idlers held at 10 and 30 rad/s (speed sources): pushed one way the cone
+    # brings the shaft to that idler's speed and the dogs hold it there, then the other way
+    d = Driveline("sleeve")
+    d.inertia("shaft", J=0.05, w0=20.0)
+    d.inertia("idler1", J=1.0, w0=10.0)
+    d.inertia("idler2", J=1.0, w0=30.0)
+    d.speed("hold1", "idler1", 10.0)
+    d.speed("hold2", "idler2", 30.0)
+    fork = Signal.table([0.0, 0.3, 0.31, 0.6, 0.61], [300.0, 300.0, 0.0, 0.0, -300.0])
+    d.synchronizer("s1", "shaft", "idler1", fork, cone_radius=0.04, dog_capacity=500.0)
+    d.synchronizer("s2", "shaft", "idler2", fork, cone_radius=0.04, dog_capacity=500.0, side="negative")
+    r = d.simulate(1.0, rtol=1e-10, output_step=1e-3, check_invariants=True)
+    T = cone_torque(0.1, 300.0, 0.04)
+    first = [(e, k) for e, k in zip(r.events["element"], r.events["event"])]
+    assert first == [("s1", "stick"), ("s1", "free"), ("s2", "forward"), ("s2", "stick")]
+    times = r.events["time_s"].to_numpy()
+    assert times[0] == pytest.approx(10.0 / (T / 0.05), rel=1e-9)   # the shaft alone slowed by the cone
+    assert times[1] == pytest.approx(0.31, abs=1e-9) and times[2] == pytest.approx(0.6, abs=1e-9)
+    # and sped up by 2nd's cone, its force ramped over 10 ms (half its torque's impulse over the ramp: 5 ms lost)
+    assert times[3] == pytest.approx(0.605 + 20.0 / (T / 0.05), rel=1e-9)
+    df = r.to_dataframe()
+    assert df["shaft.w_rad_s"].iloc[-1] == pytest.approx(30.0, rel=1e-12)
+    assert (df.loc[(df["time_s"] > 0.25) & (df["time_s"] < 0.3), "shaft.w_rad_s"] - 10.0).abs().max() < 1e-9
+    # the effective shift force of each side: the fork's positive part on s1, its negative part on s2
+    assert df["s2.fn_N"].iloc[-1] == pytest.approx(300.0) and df["s1.fn_N"].iloc[-1] == pytest.approx(-300.0)
 
 
 def test_the_amt_example_shifts_with_its_events_and_balances(tmp_path):
@@ -243,6 +274,7 @@ def test_the_file_format_reads_units_and_refuses_what_a_synchroniser_cannot_be(t
     assert "2 cones at 40 mm, 7 deg, dogs 500 N m" in line
     for sync, words in (({"mu": 0.12}, "tan(cone_angle)"), ({"cone_angle": "50 deg"}, "cone_angle"),
                         ({"cones": 4}, "cones"), ({"dog_capacity": "0 N m"}, "dog_capacity"),
+                        ({"side": "both"}, "side"),
                         ({"cone_radius": "-1 mm"}, "cone_radius")):
         with pytest.raises(ParameterError, match=re.escape(words)) as info:
             parse_driveline(_doc(**sync), "x.toml")

@@ -1207,32 +1207,32 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
     if example == "driveline_wet_sae2":
         _a_host_sets_the_wet_clutch_s_own_parameters(tmp_path, path, cls, n, dt, lines[0])
     if example == "driveline_torque_converter":   # a looser converter, set by the host: the FMU writes its K's factor
-        _, svs = _variables(path)
-        assert svs["converter.k_scale"].get("causality") == "parameter"
-        (tmp_path / "looser").mkdir()
-        native = _fmpy_run(tmp_path / "looser", path, n, dt, {"converter.k_scale": 1.15})
-        python = _python_run(cls, n, dt, {"converter.k_scale": 1.15})
-        for name in python:
-            _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
-        base = _python_run(cls, n, dt)
+        python, base = _a_host_sets(tmp_path, path, cls, n, dt, energy, "converter.k_scale", 1.15)
         assert python["converter.tau"][0] == pytest.approx(base["converter.tau"][0] / 1.15 ** 2, rel=1e-12)   # stall
     if example == "driveline_amt_upshift":   # a larger cone on 2nd's synchroniser, set by the host
-        _, svs = _variables(path)
-        assert svs["s2.cone_radius"].get("causality") == "parameter"
-        (tmp_path / "cone").mkdir()
-        native = _fmpy_run(tmp_path / "cone", path, n, dt, {"s2.cone_radius": 0.06})
-        python = _python_run(cls, n, dt, {"s2.cone_radius": 0.06})
-        for name in python:
-            _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
-        # the cone's torque grows with its radius: 2nd's synchroniser engages sooner (its slip at zero earlier)
-        base = _python_run(cls, n, dt)
+        python, base = _a_host_sets(tmp_path, path, cls, n, dt, energy, "s2.cone_radius", 0.06)
 
         def engaged(run):   # the first sample from mid-run on at which 2nd's slip is gone
             w = np.abs(run["s2.w_rel"])
             return n // 2 + int(np.flatnonzero(w[n // 2:] <= 1e-9 * w.max())[0])
 
-        engaged = [engaged(run) for run in (base, python)]
-        assert engaged[1] < engaged[0]
+        # the cone's torque grows with its radius: 2nd's synchroniser engages sooner
+        assert engaged(python) < engaged(base)
+
+
+def _a_host_sets(tmp_path, path, cls, n, dt, energy, name, value):
+    """A host sets the network's parameter ``name`` (a component's declared number) to ``value``: it is a parameter
+    of the FMU, and the native run equals the Python co-simulation built with it.  Returns that run's outputs and
+    the unchanged network's."""
+    _, svs = _variables(path)
+    assert svs[name].get("causality") == "parameter"
+    folder = tmp_path / name.replace(".", "_")
+    folder.mkdir()
+    native = _fmpy_run(folder, path, n, dt, {name: value})
+    python = _python_run(cls, n, dt, {name: value})
+    for out in python:
+        _close(native[out], python[out], out, floor=1e-12 * energy if out == "energy_error" else 1e-12)
+    return python, _python_run(cls, n, dt)
 
 
 def _a_host_sets_the_coupling_s_own_parameters(tmp_path, path, cls, n, dt, line):

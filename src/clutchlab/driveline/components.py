@@ -350,8 +350,8 @@ BUILTIN = (
         _flange("a", "the shaft the sleeve's hub turns with"),
         _flange("b", "the gear's idler (the body its gear pair turns)"),
         Field("force", "signal", "N", required=True,
-              description="shift force on the sleeve: > 0 pushes it towards the gear (held in while > 0), <= 0 "
-                          "takes it out (neutral)"),
+              description="shift force on the sleeve: of side's sign it pushes the sleeve towards the gear (held "
+                          "in while it lasts); zero or the other sign takes it out (neutral)"),
         Field("cone_radius", "quantity", "m", required=True, positive=True, description="mean radius of the cone"),
         Field("dog_capacity", "quantity", "N*m", required=True, positive=True,
               description="the most torque the engaged dogs hold"),
@@ -361,6 +361,9 @@ BUILTIN = (
         Field("cone_angle", "quantity", "rad", default=0.11344640137963143, positive=True, maximum=0.7853981633974483,
               description="half angle of the cone (\"6.5 deg\")"),
         Field("cones", "int", default=1, minimum=1, maximum=3, description="cone surfaces: 1, 2 or 3"),
+        Field("side", "choice", default="positive", choices=("positive", "negative"),
+              description="which sign of force pushes the sleeve towards this gear (a 1-2 sleeve: two "
+                          "synchronisers on one fork's force, one each side)"),
     ), _method("synchronizer"), "a cone clutch (normal force F / sin(alpha) on n cones: torque n mu F R_c / "
                                 "sin(alpha)) and a dog clutch: clutchlab.driveline.kernel.static_limit",
         ("rotational",)),

@@ -173,7 +173,8 @@ class DrivelineFile:
         Largest step [s].
     shift : dict or None
         The ``[shift]`` table: the keyword arguments of :func:`clutchlab.driveline.shift.shift_quality` for the
-        shift the network makes (clutch-to-clutch, or an AMT's with ``clutch``) (``clutchlab control shift FILE``, the sweep's ``shift.<metric>``).
+        shift the network makes, clutch-to-clutch or an AMT's with ``clutch`` (``clutchlab control shift FILE``,
+        the sweep's ``shift.<metric>``).
     """
 
     driveline: Driveline

@@ -1816,7 +1816,7 @@ class Driveline:
 
     @_adds("synchronizer")
     def synchronizer(self, name: str, a, b, force, cone_radius: float, dog_capacity: float, mu=0.1,
-                     cone_angle: float = math.radians(6.5), cones: int = 1) -> "Driveline":
+                     cone_angle: float = math.radians(6.5), cones: int = 1, side: str = "positive") -> "Driveline":
         """A synchroniser between a shaft ``a`` and a gear's idler ``b`` on it: a cone clutch and a dog
         clutch on one shift sleeve, as an automated manual transmission (AMT) or a manual gearbox engages a gear.
 
@@ -1852,6 +1852,11 @@ class Driveline:
             the cone would stay locked after the force is taken off; that is refused.
         cones : int
             Number of cone surfaces: 1 (single cone), 2 (double) or 3 (triple).
+        side : str
+            ``"positive"``: the positive values of ``force`` push the sleeve towards this gear; ``"negative"``: its
+            negative values do (the shift force is then ``-force``).  A sleeve between two gears (a 1-2 sleeve)
+            driven by one shift fork is two synchronisers on one signal, one on each side: the fork's force
+            pushes towards one gear or the other, and zero is neutral.
         """
         name = self._new_name(name)
         a, b = self._two(name, a, b)
@@ -1869,14 +1874,19 @@ class Driveline:
             raise ParameterError(f"{name}: mu = {mu_max:g} is not below tan(cone_angle) = {math.tan(angle):.4g} "
                                  f"(cone_angle {math.degrees(angle):g} deg): the cone would lock itself and not "
                                  "release when the force is taken off; use a larger cone_angle or a smaller mu")
+        if side not in ("positive", "negative"):
+            raise ParameterError(f"{name}: side = {side!r} must be 'positive' or 'negative' (which sign of the "
+                                 "force pushes the sleeve towards this gear)")
         cgeo = cones * radius / math.sin(angle)
         self._friction(name, a, b, K.LAW_CLUTCH, table, 1.0, 1.0, cgeo, Signal.of(force, f"{name}: force"))
         el = self._elements[-1]
         coef = list(el.coef) + [0.0] * (K.C_DOG + 1 - len(el.coef))
         coef[K.C_DOG] = dog
+        coef[K.C_FN_MAX] = 1.0 if side == "positive" else -1.0   # (the shift force: fn_max times the signal)
         el.coef = tuple(coef)
         el.model = (f"synchroniser, {cones} cone{'s' if cones > 1 else ''} at {radius * 1e3:g} mm, "
-                    f"{math.degrees(angle):g} deg, dogs {dog:g} N m")
+                    f"{math.degrees(angle):g} deg, dogs {dog:g} N m" + (", pushed by -force" if side == "negative"
+                                                                        else ""))
         return self
 
     # ---- the system

@@ -16,11 +16,12 @@ speed up, then the on-coming one takes the torque).
 An automated manual transmission (AMT) shifts with the drive **interrupted**: the engine's torque is taken down and
 the clutch opens (the release), the off-going gear's sleeve is pulled out, the on-coming gear's synchroniser pulls
 the input shaft onto the new gear's speed and its dogs engage (the synchronisation), and the clutch closes again
-(the closing) while the engine's torque comes back.  The vehicle coasts through the torque interruption.  The seeds do not treat shifts; the metrics are the ones shift
-calibration uses (the vehicle's longitudinal acceleration, its jerk and vibration dose value, the phases' times,
-the engine's flare and the off-going clutch's tie-up, and the clutches' heat), each defined below from sampled
-columns only, so a simulated run and a rig's record are measured by the same code (docs/control.md, "Shift
-quality").
+(the closing) while the engine's torque comes back.  The vehicle coasts through the torque interruption.
+
+The seeds do not treat shifts; the metrics are the ones shift calibration uses (the vehicle's longitudinal
+acceleration, its jerk and vibration dose value, the phases' times, the engine's flare and the off-going clutch's
+tie-up, and the clutches' heat), each defined below from sampled columns only, so a simulated run and a rig's record
+are measured by the same code (docs/control.md, "Shift quality").
 
 * :func:`shift_quality` -- the phases and metrics of one shift: :class:`ShiftQuality`.
 """
@@ -34,16 +35,12 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["ShiftQuality", "shift_quality", "METRICS", "metric_names", "sample_interval", "SHIFT_FIELDS"]
+__all__ = ["ShiftQuality", "shift_quality", "METRICS", "INTERRUPTED_METRICS", "metric_names", "sample_interval",
+           "SHIFT_FIELDS"]
 
-#: the metrics of :class:`ShiftQuality` (name, unit, description); ``{a}`` is the unit of the acceleration
-#: (``m_s2`` with a radius, else ``rad_s2``), ``{j}`` of the jerk, ``{v}`` of the vibration dose value
-METRICS = (
-    ("shift_time_s", "s", "from the shift's start to its end (the later of the hand-over and the lock-up)"),
-    ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (upshift), from the "
-                            "lock-up to the hand-over (downshift)"),
-    ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (upshift), from "
-                             "the start to the lock-up (downshift)"),
+#: the metrics of what the driver feels, the same for every kind of shift (name, unit, description), as
+#: :data:`METRICS`
+_RIDE = (
     ("acceleration_before_{a}", "{a}", "the output's acceleration at the start (mean over the pre-window)"),
     ("acceleration_dip_{a}", "{a}", "the torque hole: the acceleration at the start less its least value during "
                                     "the shift"),
@@ -53,6 +50,17 @@ METRICS = (
     ("vdv_{v}", "{v}", "vibration dose value of the acceleration's change from its value at the start, "
                        "(integral of (a - a_before)^4 dt)^(1/4) over the shift and the settling window "
                        "(ISO 2631-1's form, without its frequency weighting)"),
+)
+
+#: the metrics of :class:`ShiftQuality` (name, unit, description); ``{a}`` is the unit of the acceleration
+#: (``m_s2`` with a radius, else ``rad_s2``), ``{j}`` of the jerk, ``{v}`` of the vibration dose value
+METRICS = (
+    ("shift_time_s", "s", "from the shift's start to its end (the later of the hand-over and the lock-up)"),
+    ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (upshift), from the "
+                            "lock-up to the hand-over (downshift)"),
+    ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (upshift), from "
+                             "the start to the lock-up (downshift)"),
+    *_RIDE,
     ("lockup_slip_rate_rad_s2", "rad_s2", "|d w_rel / dt| of the on-coming clutch over the last sample interval "
                                           "in which it slides before it locks (the lock-up shock's cause)"),
     ("flare_rad_s", "rad_s", "the off-going clutch's largest slip the way it drove before the start, during the "
@@ -79,15 +87,7 @@ INTERRUPTED_METRICS = (
     ("closing_time_s", "s", "from the dogs' engagement to the clutch's lock-up"),
     ("torque_interruption_s", "s", "the clutch carries nothing: from its opening to its first torque after the "
                                    "dogs' engagement"),
-    ("acceleration_before_{a}", "{a}", "the output's acceleration at the start (mean over the pre-window)"),
-    ("acceleration_dip_{a}", "{a}", "the torque hole: the acceleration at the start less its least value during "
-                                    "the shift"),
-    ("acceleration_peak_to_peak_{a}", "{a}", "the largest less the least acceleration from the start to the end of "
-                                             "the settling window"),
-    ("jerk_peak_{j}", "{j}", "the largest |d a/dt| from the start to the end of the settling window"),
-    ("vdv_{v}", "{v}", "vibration dose value of the acceleration's change from its value at the start, "
-                       "(integral of (a - a_before)^4 dt)^(1/4) over the shift and the settling window "
-                       "(ISO 2631-1's form, without its frequency weighting)"),
+    *_RIDE,
     ("lockup_slip_rate_rad_s2", "rad_s2", "|d w_rel / dt| of the clutch over the last sample interval in which it "
                                           "slides before it locks (the lock-up shock's cause)"),
     ("pull_out_torque_Nm", "Nm", "the largest torque the off-going synchroniser carries from the clutch's opening "
