@@ -675,6 +675,13 @@ def _check_columns(d, df, events=None):
                 assert np.all(w >= -1e-6 * wmax), e.name
                 if e.coef[0] == 0.0:
                     assert np.all(tq <= 1e-9 * (1.0 + np.abs(tq).max())), e.name
+            if e.kind_name == "synchronizer":   # engaged only while its sleeve is pushed (or a push starts there),
+                fn = df[f"{e.name}.fn_N"].to_numpy()   # within its dogs' capacity; taken out, free, carrying nothing
+                # (and at least its cone's torque at rest: cgeo fn mu(0))
+                limit = np.maximum(e.coef[K.C_DOG], e.coef[K.C_CGEO] * fn * e.table[len(e.table) // 2])
+                assert np.all(fn[mode == 0] >= 0.0), e.name
+                assert np.all(np.abs(tq[mode == 0]) <= limit[mode == 0] * (1.0 + 1e-9)), e.name
+                assert np.all(tq[mode == 2] == 0.0) and np.all(mode[fn < 0.0] == 2), e.name
         assert np.all(w[mode == 1] >= -1e-6 * wmax), e.name
         assert np.all(w[mode == -1] <= 1e-6 * wmax), e.name
         assert np.all(np.abs(w[mode == 0]) <= 1e-6 * wmax), e.name

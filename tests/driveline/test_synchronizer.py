@@ -312,3 +312,24 @@ def test_a_sweep_over_the_sleeve_force_reads_the_interrupted_shift(tmp_path):
     q = shift_quality(direct.driveline.simulate(direct.t_end, rtol=direct.rtol, output_step=direct.output_step),
                       **direct.shift)
     assert sync[1.0] == pytest.approx(q.metrics["synchronisation_time_s"], rel=1e-9)
+
+
+def test_a_cone_stronger_than_its_dogs_holds_what_it_slides_with():
+    # found by the random networks (thorough profile): a 2 N m dog beside a cone that slides with 2.02 N m.  The
+    # engaged element's static limit is at least the cone's torque at rest, so it stays stuck while the load stays
+    # below the cone's torque, and breaks away (sliding the way the load drives it) only beyond it
+    T = cone_torque(0.1, 300.0, 0.05)
+    dog = 0.5 * T
+    d = Driveline("strong cone")
+    d.inertia("shaft", J=0.1, w0=0.0)
+    d.inertia("idler", J=0.4, w0=0.0)
+    d.torque("drive", "shaft", Signal.ramp(2.0 * T, 1.0))
+    d.synchronizer("s", "shaft", "idler", 300.0, cone_radius=0.05, dog_capacity=dog, mu=0.1)
+    r = d.simulate(1.0, rtol=1e-10, output_step=1e-3, check_invariants=True)
+    ev = events_of(r, "s")
+    # held: the idler's share of the ramp, 0.8 (2 T t), reaches the cone's torque at t = 1/1.6
+    assert list(ev["event"]) == ["backward"]
+    assert ev["time_s"][0] == pytest.approx(1.0 / 1.6, rel=1e-8)
+    df = r.to_dataframe()
+    after = df["time_s"] > ev["time_s"][0] + 1e-3
+    assert (df.loc[after, "s.w_rel_rad_s"] < 0.0).all()   # the shaft runs ahead: the slip the mode names

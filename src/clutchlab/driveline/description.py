@@ -49,7 +49,7 @@ temperature [degC]), ``brake`` (flange, fn_max, mu, peak, cgeo, normal, support;
 ``bearing_friction``
 (flange, torque, peak, support), ``one_way_clutch`` (a, b; fn_max, mu, peak, cgeo, normal: MSL's
 ``OneWayClutch``), ``synchronizer`` (a = the shaft, b = the gear's idler, force [N] on the sleeve, cone_radius,
-dog_capacity, mu, cone_angle, cones: an AMT's or manual gearbox's), ``eclutch`` (a, b, position [m], model
+dog_capacity, mu, cone_angle, cones, side: an AMT's or manual gearbox's), ``eclutch`` (a, b, position [m], model
 0-4, parameters = an E-clutch parameter file relative to this one, travel, points, peak; actuator = true: the
 position is the reference of its actuator's position controller, actuator_step, pre_roll, settle), ``engine``
 (flange, torque_map = ``{ speeds, throttles, torques }`` or full-load rows ``[[w, T], ...]``, throttle,

@@ -722,14 +722,16 @@ def static_limit(p, r, t):
     "Synchronisers"; the seeds do not treat gearboxes): while the sleeve's shift force pushes it towards its gear
     the blocker ring holds the sleeve back as long as the cone slides, with the element's sliding torque
     ``cones mu F R_c / sin(alpha)`` (``cgeo = cones R_c / sin(alpha)``, the normal force the shift force ``F``).
-    Where the speeds meet the dogs engage: stuck, it holds up to the dogs' capacity ``C_DOG`` [N m].  (Its
+    Where the speeds meet the dogs engage: stuck, it holds up to the dogs' capacity ``C_DOG`` [N m], and at least
+    the cone's torque at rest (the cone is still pressed: a static limit below the sliding torque would let the
+    element break away into a slip its torque then drives the other way, as a clutch with ``peak < 1``).  (Its
     ``fn_max`` is 1, or -1 for a synchroniser on a sleeve's other side: the shift force is then ``-force``.)  A
     force of zero or less takes the sleeve out: the element is free then, as a clutch without a normal force is
     (:func:`_is_free`), so its limit is never read there.  The sleeve's travel and the dogs' lash take no time."""
     if p.elem[r, E_LAW] == LAW_EXTERNAL:
         return external_value(p, p.elem[r, E_AUX], 1, t)
     if p.coef[r, C_DOG] > 0.0:
-        return p.coef[r, C_DOG]
+        return max(p.coef[r, C_DOG], friction_torque(p, r, t, 0.0))
     return p.coef[r, C_PEAK] * friction_torque(p, r, t, 0.0)
 
 

@@ -1821,12 +1821,12 @@ class Driveline:
         clutch on one shift sleeve, as an automated manual transmission (AMT) or a manual gearbox engages a gear.
 
         The sleeve's shift force ``force`` [N] (a signal: a shift actuator's force, or a network input) pushes it
-        towards the gear while positive.  While the speeds differ the blocker ring holds the sleeve back and the
+        towards the gear while positive (negative, with ``side = "negative"``).  While the speeds differ the blocker ring holds the sleeve back and the
         cone slides with the torque ``cones mu F cone_radius / sin(cone_angle)`` (a clutch with ``cgeo = cones
         cone_radius / sin(cone_angle)`` and the normal force ``F``), which pulls the speeds together.  Where they
-        meet the dogs engage (event ``stick``) and hold up to ``dog_capacity`` [N m] while the force stays
-        positive: the gear is in.  A force of zero or less takes the sleeve out (neutral; event ``free``): a gear
-        is held in by a positive force, and a synchroniser at zero force never engages.  The sleeve's travel, the
+        meet the dogs engage (event ``stick``) and hold up to ``dog_capacity`` [N m] while the force keeps pushing:
+        the gear is in.  A force of zero (or of the other sign) takes the sleeve out (neutral; event ``free``): a
+        gear is held in by a pushing force, and a synchroniser at zero force never engages.  The sleeve's travel, the
         dogs' lash and the blocker's indexing take no time here
         (:func:`~clutchlab.driveline.kernel.static_limit`; docs/driveline.md, "Synchronisers").
 
@@ -1843,7 +1843,8 @@ class Driveline:
         cone_radius : float
             Mean radius of the friction cone [m] (> 0).
         dog_capacity : float
-            The most torque [N m] the engaged dogs hold (> 0); beyond it the element slides at the cone's torque.
+            The most torque [N m] the engaged dogs hold (> 0; the element holds at least the cone's torque at rest,
+            whichever is larger); beyond it the element slides at the cone's torque.
         mu : float or table
             Friction coefficient of the cone (oil-lubricated brass, carbon or molybdenum linings: 0.08-0.12), a
             number or rows ``[w_rad_s, mu]`` over the slip speed.
