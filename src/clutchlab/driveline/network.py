@@ -2075,10 +2075,6 @@ class Driveline:
                     + (", MSL damping law" if e.aux == K.LASH_MSL else ""))
         elif e.kind == K.K_SPRING:
             what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
-        elif e.kind == K.K_FRICTION and len(e.coef) > K.C_DOG and e.coef[K.C_DOG] > 0.0:
-            n = len(e.table) // 2
-            char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
-            what = f"{e.model}, mu {char}, shift force {e.signal.describe('N')}"
         elif e.law == K.LAW_ONEWAY:
             what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
                     f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")
@@ -2100,6 +2096,8 @@ class Driveline:
                 char += f" x mu_scale {e.coef[K.C_MU_SCALE]:g}"
             if e.law == K.LAW_TABLE:
                 what = f"bearing friction {char} {tu}, peak {e.coef[2]:g}"
+            elif len(e.coef) > K.C_DOG and e.coef[K.C_DOG] > 0.0:   # a synchroniser
+                what = f"{e.model}, mu {char}, shift force {e.signal.describe('N')}"
             elif e.reference is not None:
                 what = f"{e.model}, bearing reference {e.reference.describe('m')}"
             elif e.ncurve and e.levels:

@@ -358,8 +358,7 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         return int(np.searchsorted(t, s0 - 1e-12 * max(1.0, abs(s0))))
 
     if clutch is not None:
-        signed_c = df[f"{clutch}.tau_Nm"].to_numpy(float)
-        tau_c, w_c = np.abs(signed_c), np.abs(df[f"{clutch}.w_rel_rad_s"].to_numpy(float))
+        tau_c, w_c = (np.abs(df[f"{clutch}.{q}"].to_numpy(float)) for q in ("tau_Nm", "w_rel_rad_s"))
         if not tau_c.max() > 0.0:
             raise ParameterError(f"shift_quality: the clutch {clutch} carries no torque")
         c_thr, cw_thr = threshold * tau_c.max(), threshold * w_c.max()
