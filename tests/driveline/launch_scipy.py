@@ -141,10 +141,8 @@ def clamp_force_samples(path=EXAMPLE):
     E-clutch actuator model once; nothing of the driveline kernel is used."""
     from clutchlab.driveline.description import load_driveline
     d = load_driveline(str(path)).driveline
-    el = [e for e in d._elements if e.name == "clutch"][0]
-    pts = el.signal.points
-    n = len(pts) // 2
-    return np.array(pts[:n], dtype=float), np.array(pts[n:], dtype=float)
+    times, values = d.signal("clutch").breakpoints("the clamp force", "N")
+    return np.array(times, dtype=float), np.array(values, dtype=float)
 
 
 class ClampForce:
@@ -541,24 +539,32 @@ def reference(t_end=5.0, rtol=1e-12, grid=None, atol=None, fn_samples=None, max_
 def check_parameters(driveline):
     """Cross-check the constants above against a built clutchlab network (its element parameters, not its
     kernel): raises AssertionError naming the first that differs."""
-    el = {e.name: e for e in driveline._elements}
-    inert = driveline._inertias
+    from clutchlab.eclutch.models import ClutchModel
+
+    el = {e.name: e.arguments for e in driveline.elements}
+    inert = {b.name: b.arguments for b in driveline.inertias}
     for nm, j in (("engine", J_ENG), ("flywheel", J_FLY), ("input_shaft", J_IN), ("output_shaft", J_OUT),
                   ("axle", J_AXLE), ("vehicle", J_VEH)):
-        assert math.isclose(inert[nm][0], j, rel_tol=1e-15), nm
-    assert math.isclose(inert["engine"][1], W0_ENG, rel_tol=1e-15)
-    assert math.isclose(el["ice"].coef[0], IDLE_W, rel_tol=1e-15)
-    assert tuple(el["ice"].coef[1:]) == (IDLE_KP, IDLE_KI, IDLE_MAX)
-    tab = el["ice"].table
-    assert np.allclose(tab[:6], MAP_W, rtol=1e-15) and tuple(tab[6:8]) == MAP_TH
-    assert np.allclose(np.reshape(tab[8:], (6, 2)), MAP_T, rtol=0)
-    assert tuple(el["dmf"].coef[:2]) == (DMF_C, DMF_D)
-    assert math.isclose(el["clutch"].coef[1], N_FACES * R_EFF, rel_tol=1e-15) and el["clutch"].coef[2] == PEAK_CL
-    assert tuple(el["clutch"].table) == (0.0, MU_CL)
-    assert (el["gearbox"].coef[0], el["final_drive"].coef[0]) == (R_GEARBOX, R_FINAL)
-    c = el["driveshaft"].coef
-    assert (c[0], c[1], c[2]) == (LASH_C, LASH_D, 0.0) and math.isclose(c[3], LASH_B, rel_tol=1e-15)
-    assert tuple(el["road"].table) == ROAD_W + ROAD_T and el["road"].coef[2] == PEAK_ROAD
+        assert math.isclose(inert[nm]["J"], j, rel_tol=1e-15), nm
+    assert math.isclose(inert["engine"]["w0"], W0_ENG, rel_tol=1e-15)
+    ice = el["ice"]
+    assert math.isclose(ice["idle_speed"], IDLE_W, rel_tol=1e-15)
+    assert (ice["idle_kp"], ice["idle_ki"], ice["idle_torque_max"]) == (IDLE_KP, IDLE_KI, IDLE_MAX)
+    speeds, throttles, torques = ice["torque_map"]
+    assert np.allclose(speeds, MAP_W, rtol=1e-15) and tuple(throttles) == MAP_TH
+    assert np.allclose(torques, MAP_T, rtol=0)
+    assert (el["dmf"]["c"], el["dmf"]["d"]) == (DMF_C, DMF_D)
+    clutch = el["clutch"]   # (its friction radius and coefficient are its axial model's)
+    model = ClutchModel.preset(clutch["model"], clutch["parameters"])
+    assert math.isclose(N_FACES * model.r_eff, N_FACES * R_EFF, rel_tol=1e-15) and clutch["peak"] == PEAK_CL
+    assert model.mu == MU_CL and clutch["actuator"] is True
+    assert (el["gearbox"]["ratio"], el["final_drive"]["ratio"]) == (R_GEARBOX, R_FINAL)
+    assert el["gearbox"]["efficiency"] == el["final_drive"]["efficiency"] == 1.0
+    c = el["driveshaft"]
+    assert (c["c"], c["d"], c["phi_rel0"], c["damping_law"]) == (LASH_C, LASH_D, 0.0, "kelvin_voigt")
+    assert math.isclose(c["b_gap"], LASH_B, rel_tol=1e-15)
+    assert np.array_equal(np.asarray(el["road"]["torque"]).T.ravel(), ROAD_W + ROAD_T) \
+        and el["road"]["peak"] == PEAK_ROAD
     return True
 
 

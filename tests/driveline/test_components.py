@@ -213,6 +213,9 @@ def test_the_element_listing_names_a_file_s_component_types(tmp_path, cone):
     direct = Driveline("cone").inertia("J1", J1, w0=W0).inertia("J2", J2)
     cone_clutch.CONE_CLUTCH.build(direct, "c", a="J1", b="J2", force=F, r_mean=R)
     assert direct.elements[0].kind == "clutch"   # built through the method: the method's name
+    # changed in a copy (Driveline.replace: through the method it built with, its arguments): still a cone clutch
+    twice = d.replace("c", cgeo=2.0 * e.arguments["cgeo"])
+    assert twice.elements[0].kind == "cone_clutch" and twice.elements[0].arguments["cgeo"] == 2.0 * e.arguments["cgeo"]
 
 
 def test_a_flat_disc_is_the_networks_clutch(tmp_path, cone):

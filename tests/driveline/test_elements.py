@@ -7,6 +7,7 @@ arcs, energy integrals computed by SciPy's adaptive quadrature), not from the pa
 from __future__ import annotations
 
 import math
+import tomllib
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from scipy import integrate
 
 from clutchlab.curves import Curve
 from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline.description import parse_driveline
 from clutchlab.errors import DataError, ParameterError
 from hypothesis_budget import examples
 
@@ -705,6 +707,84 @@ def test_the_element_listing_is_what_each_method_added():
     assert [e.name for e in Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements] \
         == ["G"] and Driveline("g").inertia("A", 1.0).inertia("B", 1.0).gear("G", "A", "B", 2.0).elements[0].support \
         == "ground"
+
+
+def test_the_listing_gives_each_element_s_arguments_and_each_body_s():
+    """``ElementInfo.arguments``: the arguments of the call that added an element, by the method's names, defaults
+    filled in, its name and flanges left out (``ElementInfo`` names them), read-only; ``Driveline.inertias``: each
+    body's ``J``, ``w0``, ``phi0`` as given (``None`` where the network derives it); a file's values arrive in SI."""
+    d = (Driveline("listing")
+         .inertia("J1", 1.0, w0=10.0).inertia("J2", 2.0).inertia("H", 5.0)
+         .torque("T", "J1", Signal.step(10.0))
+         .gear("G", "J1", "J2", ratio=3.0, efficiency=0.9, support="H")
+         .clutch("C", "J1", "J2", fn_max=100.0))
+    t, g, c = d.elements
+    assert dict(t.arguments) == {"signal": Signal.step(10.0)}
+    assert dict(g.arguments) == {"ratio": 3.0, "efficiency": 0.9, "loss_table": None}
+    assert dict(c.arguments) == {"fn_max": 100.0, "mu": 0.5, "peak": 1.0, "cgeo": 1.0, "normal": 1.0, "radius": None,
+                                 "temperature": None, "mu_scale": 1.0, "mu_temperature": None}
+    with pytest.raises(TypeError):
+        c.arguments["mu"] = 0.3
+    assert [(b.name, b.kind, dict(b.arguments)) for b in d.inertias] == [
+        ("J1", "inertia", {"J": 1.0, "w0": 10.0, "phi0": None}), ("J2", "inertia", {"J": 2.0, "w0": None, "phi0": None}),
+        ("H", "inertia", {"J": 5.0, "w0": None, "phi0": None})]
+    f = parse_driveline(tomllib.loads('''
+[inertia.J1]
+J = "1 kg m^2"
+w0 = "600 rpm"
+[inertia.J2]
+J = "2 kg m^2"
+[clutch.c]
+a = "J1"
+b = "J2"
+fn_max = "2 kN"
+mu = 0.3
+'''), "args.toml").driveline
+    assert f.inertias[0].arguments["w0"] == pytest.approx(20.0 * math.pi, rel=1e-15)
+    assert (f.elements[0].arguments["fn_max"], f.elements[0].arguments["mu"]) == (2000.0, 0.3)
+    assert f.signal("c") == Signal.constant(1.0) and d.signal("T") == Signal.step(10.0)
+    with pytest.raises(ParameterError, match="listing: no element 'X'"):
+        d.signal("X")
+
+
+def test_a_replaced_element_runs_as_one_built_so_and_leaves_the_original_whole():
+    """``Driveline.replace``: a clutch's normal force and an inertia's start speed changed in a copy give the closed
+    forms of the network built so (two inertias ``J1``, ``J2`` slipping at ``mu fn``: stuck at ``w0 / (mu fn (1/J1
+    + 1/J2))``, at ``J1 w0 / (J1 + J2)``); the original keeps its own; the element keeps its place and its heat port;
+    an argument the method has not, a bad value and an unknown name are refused naming them."""
+    d = Driveline("what-if").inertia("J1", J=1.0, w0=10.0).inertia("J2", J=3.0)
+    d.clutch("c", "J1", "J2", fn_max=10.0, mu=0.5).brake("b", "J2", fn_max=0.0)
+    d.thermal_mass("disc", capacity=100.0, heat_from=["c"])
+
+    def lock(net):
+        r = net.simulate(4.0, rtol=1e-10)
+        (t,) = [t for t, el, ev in zip(r.events.time_s, r.events.element, r.events.event) if (el, ev) == ("c", "stick")]
+        return t, r.to_dataframe()
+
+    stronger = d.replace("c", fn_max=20.0)
+    faster = d.replace("J1", w0=20.0)
+    assert [e.name for e in stronger.elements] == ["c", "b"] and stronger.elements[0].arguments["fn_max"] == 20.0
+    assert d.elements[0].arguments["fn_max"] == 10.0 and d.inertias[0].arguments["w0"] == 10.0
+    t, df = lock(d)
+    assert t == pytest.approx(10.0 / (0.5 * 10.0 * (1.0 + 1.0 / 3.0)), rel=1e-9)
+    t, df = lock(stronger)
+    assert t == pytest.approx(10.0 / (0.5 * 20.0 * (1.0 + 1.0 / 3.0)), rel=1e-9)
+    assert df["J2.w_rad_s"].iloc[-1] == pytest.approx(2.5, rel=1e-9)
+    # the heat port kept: the disc takes the clutch's losses, J1 J2 w0^2 / (2 (J1 + J2))
+    assert 100.0 * (df["disc.temperature_C"].iloc[-1] - 20.0) == pytest.approx(37.5, rel=1e-8)
+    t, df = lock(faster)
+    assert t == pytest.approx(20.0 / (0.5 * 10.0 * (1.0 + 1.0 / 3.0)), rel=1e-9)
+    assert df["J2.w_rad_s"].iloc[-1] == pytest.approx(5.0, rel=1e-9)
+    with pytest.raises(ParameterError, match=r"c: replace: clutch has no argument 'force' \(it has a, b, fn_max, mu"):
+        d.replace("c", force=1.0)
+    with pytest.raises(ParameterError, match="J1: replace: inertia has no argument 'm'"):
+        d.replace("J1", m=1.0)
+    with pytest.raises(ParameterError, match="c: mu = -1.0 must be >= 0"):
+        d.replace("c", mu=-1.0)
+    with pytest.raises(ParameterError, match="what-if: replace: no inertia or element 'x'"):
+        d.replace("x", mu=0.3)
+    moved = d.replace("b", flange="J1")   # (flanges are arguments too)
+    assert moved.elements[1].flange_b == "J1" and d.elements[1].flange_b == "J2"
 
 
 def test_a_network_without_a_part_runs_as_one_built_without_it_and_leaves_the_original_whole():

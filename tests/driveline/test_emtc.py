@@ -295,10 +295,10 @@ def test_an_emtc_coupling_s_actuator_and_geometry_are_parameters_of_its_network(
     changes = {"emtc.actuator.airgap_open": 1.0e-3, "emtc.actuator.free_travel": 0.45e-3,
                "emtc.coupling.cam_ratio": 5.5}
     loaded = doc.load(changes)
-    e = next(e for e in loaded.driveline._elements if e.emtc)
+    options = next(e for e in loaded.driveline.elements if e.kind == "emtc").arguments["options"]
     actuator = bench["actuator"].replace(airgap_open=1.0e-3, free_travel=0.45e-3)
     coupling = bench["coupling"].replace(cam_ratio=5.5)
-    assert e.emtc["options"].actuator == actuator and e.emtc["options"].coupling == coupling
+    assert options.actuator == actuator and options.coupling == coupling
     # the same values from a scenario file (the sets' own reader): the same run
     text = (examples / "emtc_scenario.toml").read_text()
     folder = tmp_path / "files"

@@ -19,7 +19,7 @@ from clutchlab.driveline import Driveline, Signal
 from clutchlab.driveline.bench import drum_bench
 from clutchlab.driveline.description import load_driveline
 from clutchlab.emtc import system as S
-from clutchlab.emtc.bench import load_scenario
+from clutchlab.emtc.bench import BenchScenario, load_scenario
 from clutchlab.errors import ParameterError
 from clutchlab.system import simulate
 
@@ -170,7 +170,8 @@ torque_request = { input = "T" }
     assert [(v.name, v.unit, v.start) for v in cls.inputs] == [("T", "N.m", 80.0)]
     sim = cls()
     sim.initial_outputs({})
-    sample = float(load_driveline(path).driveline._elements[-1].emtc["scenario"].sample_time)
+    assert load_driveline(path).driveline.elements[-1].arguments["scenario"] is None   # (the default scenario's)
+    sample = BenchScenario().sample_time
     assert sample == pytest.approx(0.002)
     dt, change = 0.0005, 21                                       # the request steps to 150 N m at t = 10.5 ms
     refs = [sim.do_step(k * dt, dt, {"T": 80.0 if k < change else 150.0})["c.torque_reference"] for k in range(40)]

@@ -274,20 +274,23 @@ def test_the_thermal_states_and_outputs_are_declared_with_their_units():
 
 
 # ----------------------------------------------------------------- random networks
+#: the element kinds that are sources (they dissipate nothing: no heat port)
+SOURCES = ("torque", "force", "speed", "position", "speed_torque", "engine")
+
+
 def _with_masses(d, data):
     """Thermal masses (1-3) over the network's elements that dissipate (not sources), each element heating one
     drawn mass or none, with drawn conductances, ambients and links."""
     nm = data.draw(st.integers(1, 3))
-    names = [e.name for e in d._elements if e.kind not in (K.K_SOURCE, K.K_MOTION) and e.wet is None
-             and e.emtc is None]
+    names = [e.name for e in d.elements if e.kind not in SOURCES + ("wet_clutch", "emtc")]
     owner = {n: data.draw(st.integers(-1, nm - 1)) for n in names}
-    for e in d._elements:   # some heated clutches, brakes and one-way clutches fade (set on the element: the
-        # networks are drawn before their masses)
-        if e.kind == K.K_FRICTION and e.law in (K.LAW_CLUTCH, K.LAW_ONEWAY) and owner.get(e.name, -1) >= 0 \
-                and data.draw(st.booleans()):
+    for e in d.elements:   # some heated clutches, brakes and one-way clutches fade (the networks are drawn before
+        # their masses: the element again with the argument, Driveline.replace)
+        if "mu_temperature" in e.arguments and owner.get(e.name, -1) >= 0 and data.draw(st.booleans()):
             lo = data.draw(st.floats(-20.0, 60.0))
-            e.fade = (lo, lo + data.draw(st.floats(1.0, 100.0)), data.draw(st.floats(0.0, 1.5)),
-                      data.draw(st.floats(0.0, 1.5)))
+            d = d.replace(e.name, mu_temperature=[[lo, data.draw(st.floats(0.0, 1.5))],
+                                                  [lo + data.draw(st.floats(1.0, 100.0)),
+                                                   data.draw(st.floats(0.0, 1.5))]])
     for k in range(nm):
         d.thermal_mass(f"m{k}", capacity=data.draw(st.floats(0.1, 50.0)), T0=data.draw(st.floats(-20.0, 90.0)),
                        conductance=data.draw(st.sampled_from([0.0, data.draw(st.floats(0.0, 5.0))])),

@@ -24,7 +24,7 @@ from hypothesis import given, settings
 from driveline_networks import gear_loop, indeterminate_loop, networks
 from hypothesis_budget import examples
 
-from clutchlab.driveline import Driveline, Signal
+from clutchlab.driveline import GROUND, Driveline, Signal
 from clutchlab.driveline import kernel as K
 from clutchlab.errors import SimulationError
 from clutchlab.system import Simulation, simulate
@@ -660,25 +660,30 @@ def _check_columns(d, df, events=None):
         assert np.all(np.diff(df[f"{name}.dissipated_J"].to_numpy()) >= -1e-9 * scale), name
         drive = ((df[f"{name}.speed_ratio_1"] >= 0.0) & (df[f"{name}.speed_ratio_1"] < 1.0)).to_numpy()
         assert np.all(df[f"{name}.tau_Nm"].to_numpy()[drive] * df[f"{name}.tau_b_Nm"].to_numpy()[drive] <= 0.0), name
-    for e in d._elements:
+    for e in d.elements:
         if f"{e.name}.mode_1" not in df.columns:
             continue
         mode = df[f"{e.name}.mode_1"].to_numpy()
-        if e.kind == 3:            # a lossy gear: its speed w_a against its support (a planetary set's carrier)
-            w = df[f"{e.a}.w_rad_s"].to_numpy() - (df[f"{e.sup}.w_rad_s"].to_numpy() if e.sup else 0.0)
+        if e.kind in ("gear", "planetary"):   # a lossy gear: its speed w_a against its support (a planetary set's
+            # carrier, its support; its flange a the sun)
+            w = df[f"{e.flange_a}.w_rad_s"].to_numpy() - (df[f"{e.support}.w_rad_s"].to_numpy()
+                                                          if e.support not in (None, GROUND) else 0.0)
             loss_rate = np.diff(df[f"{e.name}.dissipated_J"].to_numpy())
             assert np.all(loss_rate >= -1e-7 * scale), e.name
         else:
             w = df[f"{e.name}.w_rel_rad_s"].to_numpy()
             tq = df[f"{e.name}.tau_Nm"].to_numpy()
-            if e.law == 2:        # a one-way clutch: never backward, no torque for overrunning beyond its clutch's
+            if e.kind == "one_way_clutch":   # never backward, no torque for overrunning beyond its clutch's
                 assert np.all(w >= -1e-6 * wmax), e.name
-                if e.coef[0] == 0.0:
+                if e.arguments["fn_max"] == 0.0:
                     assert np.all(tq <= 1e-9 * (1.0 + np.abs(tq).max())), e.name
-            if e.kind_name == "synchronizer":   # engaged only while its sleeve is pushed (or a push starts there),
+            if e.kind == "synchronizer":   # engaged only while its sleeve is pushed (or a push starts there),
                 fn = df[f"{e.name}.fn_N"].to_numpy()   # within its dogs' capacity; taken out, free, carrying nothing
-                # (and at least its cone's torque at rest: cgeo fn mu(0))
-                limit = np.maximum(e.coef[K.C_DOG], e.coef[K.C_CGEO] * fn * e.table[len(e.table) // 2])
+                # (and at least its cone's torque at rest: cones R_c / sin(alpha) fn mu, a number in these draws)
+                args = e.arguments
+                assert np.ndim(args["mu"]) == 0, "a table mu: read it at rest here"
+                cone = args["cones"] * args["cone_radius"] / math.sin(args["cone_angle"]) * fn * args["mu"]
+                limit = np.maximum(args["dog_capacity"], cone)
                 assert np.all(fn[mode == 0] >= 0.0), e.name
                 assert np.all(np.abs(tq[mode == 0]) <= limit[mode == 0] * (1.0 + 1e-9)), e.name
                 assert np.all(tq[mode == 2] == 0.0) and np.all(mode[fn < 0.0] == 2), e.name
@@ -1945,7 +1950,7 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
     speed peaks at exactly the free inertia's speed at t = 0.375 s stuck for 28 us at rtol 1e-7 and 1e-8, where its
     speed was 4.4e-9 rad/s above the exact peak, and not at 1e-9 or tighter; a backlash whose contact torque dips
     to -1.8e-4 N m (its range 73 N m) and back was released for 275 us at rtol 1e-11 and not at 1e-8.)"""
-    lash = {e.name: e for e in d._elements if e.kind == K.K_SPRING and e.law == K.SPRING_BACKLASH}
+    lash = {e.name: e for e in d.elements if e.kind == "backlash"}
     touches, last = [], {}     # (positions in ev, element, its event leaving, t1, t2)
     for k, (t, el, event) in enumerate(ev):
         before = last.get(el)
@@ -1982,8 +1987,8 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
             e = lash[el]
 
             def twist(frame, e=e):
-                phi = [frame[f"{q}.phi_rad"].to_numpy() if q is not None else 0.0 for q in (e.a, e.b)]
-                return np.abs(phi[1] - phi[0] - e.coef[K.C_PHI0]) - 0.5 * e.coef[K.C_GAP]
+                phi = [frame[f"{q}.phi_rad"].to_numpy() if q != GROUND else 0.0 for q in (e.flange_a, e.flange_b)]
+                return np.abs(phi[1] - phi[0] - e.arguments["phi_rel0"]) - 0.5 * e.arguments["b_gap"]
 
             near, span = twist(sampled), max(1.0, np.ptp(twist(frame_other)))
         elif el in lash:     # in contact, its torque grazes zero (the contact would pull: released)

@@ -396,7 +396,7 @@ torque = { product = ["2 N m", { exponentials = { out_max = 1, rise_time = 0.15,
 
 def test_toml_signals_are_the_python_ones():
     d = parse_driveline(tomllib.loads(_TOML), "signals.toml").driveline
-    got = {e.name: e.signal for e in d._elements}
+    got = {name: d.signal(name) for name in d.element_names}
     assert got["T1"] == SIGNALS["pulse"][0]
     assert got["T2"] == SIGNALS["trapezoid"][0]
     assert got["T3"] == SIGNALS["exponentials"][0]

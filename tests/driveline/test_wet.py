@@ -41,8 +41,9 @@ def test_sae2_example_equals_the_wet_bench(bench_run):
     clutch, bench, scenario, times, ref, lockup = bench_run
     f = load_driveline(EXAMPLES / "driveline_wet_sae2.toml")
     d = f.driveline
-    assert d._inertias["dyno"][0] == bench.total_inertia
-    assert math.isclose(d._inertias["dyno"][1], scenario.initial_slip_speed, rel_tol=1e-14)
+    dyno = {b.name: b for b in d.inertias}["dyno"].arguments
+    assert dyno["J"] == bench.total_inertia
+    assert math.isclose(dyno["w0"], scenario.initial_slip_speed, rel_tol=1e-14)
     r = d.simulate(f.t_end, rtol=1e-9, sample_times=times)
     df = r.to_dataframe()
     ev = r.events
@@ -167,7 +168,7 @@ def test_wet_clutch_file_errors(tmp_path):
         parse_driveline(doc, "x.toml", tmp_path)
     del doc["wet_clutch"]["c"]["clutch"]
     f = parse_driveline(doc, "x.toml", tmp_path)
-    assert f.driveline._elements[0].wet["temperature0"] == 60.0
+    assert f.driveline.elements[0].arguments["temperature0"] == 60.0
 
 
 def test_wet_clutch_in_the_co_simulation_and_the_sweep_variants():
@@ -186,8 +187,7 @@ def test_wet_clutch_in_the_co_simulation_and_the_sweep_variants():
         y = sim.do_step(t, 0.01, {})
         t += 0.01
     f = load_driveline(path)
-    d = f.driveline
-    d._elements[0].wet["temperature0"] = 90.0
+    d = f.driveline.replace("clutch", temperature0=90.0)
     ref = d.simulate(0.8, rtol=f.rtol, sample_times=[0.8]).to_dataframe().iloc[-1]
     assert abs(y["dyno.w"] - ref["dyno.w_rad_s"]) < 1e-5
     assert abs(y["clutch.temperature"] - ref["clutch.temperature_C"]) < 1e-5
@@ -294,9 +294,9 @@ def test_a_wet_clutch_s_parameter_sets_are_parameters_of_its_network(tmp_path):
     changes = {"clutch.clutch.r_outer": 0.085, "clutch.clutch.n_c": 7.0, "clutch.clutch.m_lining": 0.0019,
                "clutch.bench.actuator_time_constant": 0.03}
     loaded = doc.load(changes)
-    wet = next(e for e in loaded.driveline._elements if e.wet)
-    assert wet.wet["clutch"] == paper.replace(r_outer=0.085, n_c=7, m_lining=0.0019)
-    assert wet.wet["bench"] == bench.replace(actuator_time_constant=0.03)
+    wet = next(e for e in loaded.driveline.elements if e.kind == "wet_clutch").arguments
+    assert wet["clutch"] == paper.replace(r_outer=0.085, n_c=7, m_lining=0.0019)
+    assert wet["bench"] == bench.replace(actuator_time_constant=0.03)
     # the same values from files the description names (an independent route: the sets' own readers)
     folder = tmp_path / "files"
     folder.mkdir()

@@ -7,7 +7,7 @@ Its component kinds are declared in :mod:`clutchlab.driveline.components` (regis
 imported) on the contract of :mod:`clutchlab.component`.
 """
 
-from .network import GROUND, Driveline, ElementInfo, Signal
+from .network import GROUND, Driveline, ElementInfo, InertiaInfo, Signal
 from .components import BUILTIN
 
-__all__ = ["Driveline", "Signal", "GROUND", "BUILTIN", "ElementInfo"]
+__all__ = ["Driveline", "Signal", "GROUND", "BUILTIN", "ElementInfo", "InertiaInfo"]

@@ -21,10 +21,12 @@ from __future__ import annotations
 import copy
 import functools
 import hashlib
+import inspect
 import math
 import pickle
 import sys
-from dataclasses import dataclass
+import types
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,7 +39,7 @@ from ..system import System, register_model, simulate as _simulate, start_checks
 from . import kernel as K
 
 
-__all__ = ["Driveline", "Signal", "GROUND", "ElementInfo"]
+__all__ = ["Driveline", "Signal", "GROUND", "ElementInfo", "InertiaInfo"]
 
 GROUND = "ground"
 
@@ -559,6 +561,7 @@ class _Element:
     sup: str | None = None    # a gear's or converter's support (housing), a planetary's carrier; None: the ground
     fade: tuple = ()          # a friction element's factor over its heat port's temperature: temperatures, factors
     kind_name: str = ""       # what added it: a builder's name ("clutch", "brake", ...) or a component's type
+    call: tuple = ()          # (the Driveline method that added it, its arguments by name: ElementInfo.arguments)
 
 
 @dataclass(frozen=True)
@@ -593,7 +596,11 @@ class ElementInfo:
     between (``"ground"`` for the fixed ground: a brake's ``flange_a`` is its support; a planetary set's are its
     sun and ring); ``support``: a gear's or a torque converter's housing inertia, a planetary set's carrier
     (``"ground"`` if fixed, ``None`` for other elements); ``summary``: its line of
-    :meth:`Driveline.describe`."""
+    :meth:`Driveline.describe`; ``arguments``: the arguments of the method call that added it, by the method's
+    parameter names (its name and flanges left out), defaults filled in, as given: SI numbers, :class:`Signal`
+    objects, tables, parameter sets (a driveline file's loader calls the same methods with its values in SI, its
+    parameter files read), a read-only mapping.  ``d.replace(name, mu=0.3)`` is a copy with some of them changed
+    (:meth:`Driveline.replace`)."""
 
     name: str
     kind: str
@@ -601,6 +608,19 @@ class ElementInfo:
     flange_b: str
     support: str | None
     summary: str
+    arguments: types.MappingProxyType = field(default_factory=lambda: types.MappingProxyType({}), hash=False)
+
+
+@dataclass(frozen=True)
+class InertiaInfo:
+    """One body of a :class:`Driveline`, as :attr:`Driveline.inertias` lists it (a read-only view): ``name``;
+    ``kind``: ``"inertia"`` or ``"mass"`` (a translational network's); ``arguments``: ``J``, ``w0``, ``phi0`` [kg
+    m^2, rad/s, rad] of :meth:`Driveline.inertia` (``m``, ``v0``, ``s0`` [kg, m/s, m] of :meth:`Driveline.mass`) as
+    given, SI, ``None`` for a start value left out (the network derives it: :meth:`Driveline.derived_speeds`)."""
+
+    name: str
+    kind: str
+    arguments: types.MappingProxyType = field(default_factory=lambda: types.MappingProxyType({}), hash=False)
 
 
 def _converter_table(name, key, rows, ncol):
@@ -623,15 +643,30 @@ def _converter_table(name, key, rows, ncol):
     return t
 
 
+#: the arguments of an element's method that place it (its name and flanges): :class:`ElementInfo` names them
+#: itself, so they are not among its :attr:`~ElementInfo.arguments` (:meth:`Driveline.replace` keeps them)
+_PLACES = ("name", "a", "b", "flange", "support", "sun", "carrier", "ring")
+
+
 def _adds(kind: str):
-    """Marks a :class:`Driveline` method as adding elements of ``kind`` (:attr:`ElementInfo.kind`)."""
+    """Marks a :class:`Driveline` method as adding elements of ``kind`` (:attr:`ElementInfo.kind`), and keeps the
+    call on each element it adds: the method's name and its arguments by name, defaults filled in
+    (:attr:`ElementInfo.arguments`; :meth:`Driveline.replace` calls it again with some changed)."""
     def wrap(method):
+        signature = []   # (inspect.signature once, at the first call: not at import)
+
         @functools.wraps(method)
         def run(self, *args, **kwargs):
             n = len(self._elements)
             out = method(self, *args, **kwargs)
+            if not signature:
+                signature.append(inspect.signature(method))
+            bound = signature[0].bind(self, *args, **kwargs)
+            bound.apply_defaults()
+            call = (method.__name__, types.MappingProxyType(dict(list(bound.arguments.items())[1:])))
             for e in self._elements[n:]:
                 e.kind_name = kind
+                e.call = call
             return out
         return run
     return wrap
@@ -2135,8 +2170,85 @@ class Driveline:
         methods or its file."""
         return tuple(ElementInfo(e.name, e.kind_name, e.a or GROUND, e.b or GROUND,
                                  (e.sup or GROUND) if e.kind in (K.K_GEAR, K.K_CONVERTER) else None,
-                                 self._element_line(e))
+                                 self._element_line(e), self._arguments(e))
                      for e in self._elements)
+
+    @staticmethod
+    def _arguments(e):
+        """The public arguments of the call that added element ``e`` (:attr:`ElementInfo.arguments`): its name and
+        the flanges :class:`ElementInfo` names are left out."""
+        return types.MappingProxyType({k: v for k, v in e.call[1].items() if k not in _PLACES}) if e.call \
+            else types.MappingProxyType({})
+
+    def _labels(self) -> tuple:
+        """The argument names of a body: :meth:`inertia`'s or :meth:`mass`'s."""
+        return ("J", "w0", "phi0") if self.domain == "rotational" else ("m", "v0", "s0")
+
+    @property
+    def inertias(self) -> tuple:
+        """The network's bodies in the order they were added (the order of their angles, then speeds, in the state
+        vector), each an :class:`InertiaInfo` (name, ``"inertia"`` or ``"mass"``, its arguments): a read-only view;
+        :meth:`replace` changes one in a copy."""
+        kind = "inertia" if self.domain == "rotational" else "mass"
+        return tuple(InertiaInfo(n, kind, types.MappingProxyType(dict(zip(self._labels(), v))))
+                     for n, v in self._inertias.items())
+
+    def signal(self, name: str):
+        """The :class:`Signal` element ``name`` reads, as the network holds it (``None`` for an element without
+        one): a torque or motion source's; a clutch's, brake's or one-way clutch's normal-force factor; a
+        synchroniser's shift force [N]; a wet clutch's actuator force reference [N]; an E-clutch's bearing position
+        [m] or, with its actuator, the clamp force [N] the actuator's run gives, sampled (:meth:`Signal.sampled`:
+        ``d.signal("clutch").breakpoints("clamp force")`` are its samples), which the network reads linearly
+        between samples."""
+        for e in self._elements:
+            if e.name == name:
+                return e.signal
+        raise ParameterError(f"{self.name}: no element {name!r} (elements: {', '.join(self.element_names) or 'none'})")
+
+    @property
+    def element_names(self) -> tuple:
+        """The elements' names in the order they were added."""
+        return tuple(e.name for e in self._elements)
+
+    def replace(self, name: str, **changes) -> "Driveline":
+        """A copy of this network with some arguments of the inertia or element ``name`` changed (this one is left as
+        it is): ``d.replace("clutch1", mu=0.3)``, ``d.replace("J1", w0=10.0)``.  The element is added again by the
+        method that added it (:attr:`ElementInfo.arguments`), with its other arguments as they were, in its place, so
+        it is checked as any new element is (its flanges may change too); a file's component keeps its kind.  An
+        argument the method has not is refused naming the ones it has."""
+        out = self.without()
+        if name in self._inertias:
+            labels = self._labels()
+            self._refuse_unknown(name, "inertia" if self.domain == "rotational" else "mass", changes, labels)
+            args = {**dict(zip(labels, self._inertias[name])), **changes}
+            kept, out._inertias = list(out._inertias.items()), {}
+            for n, v in kept:
+                if n == name:
+                    out._body(name, tuple(args[q] for q in labels), labels)
+                else:
+                    out._inertias[n] = v
+            return out
+        at = [k for k, e in enumerate(out._elements) if e.name == name]
+        if not at:
+            raise ParameterError(f"{self.name}: replace: no inertia or element {name!r}")
+        old = out._elements.pop(at[0])
+        method, args = old.call
+        self._refuse_unknown(name, method, changes, [k for k in args if k != "name"])
+        n = len(out._elements)
+        getattr(out, method)(**{**args, **changes})
+        added = out._elements[n:]
+        del out._elements[n:]
+        for e in added:
+            e.kind_name = old.kind_name
+        out._elements[at[0]:at[0]] = added
+        return out
+
+    @staticmethod
+    def _refuse_unknown(name, what, changes, known) -> None:
+        unknown = [k for k in changes if k not in known]
+        if unknown:
+            raise ParameterError(f"{name}: replace: {what} has no argument {unknown[0]!r} (it has "
+                                 f"{', '.join(known)})")
 
     @property
     def thermal_masses(self) -> tuple:
