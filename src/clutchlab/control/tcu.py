@@ -1,0 +1,235 @@
+"""A transmission controller (TCU) for an automated manual transmission: a gear command, carried out by a sequence.
+
+An automated manual transmission (AMT) shifts as a driver of a manual gearbox does: it takes the engine's torque
+down, opens the clutch, moves the sleeve of the gear it leaves to neutral, pushes the sleeve of the gear it selects
+until its synchroniser has pulled the speeds together and its dogs are in, and closes the clutch while the torque
+comes back (docs/control.md, "A transmission controller").  Which steps wait for the drive train is what an open-loop
+schedule cannot do: the sleeve comes out when the off-going synchroniser is free, and the clutch closes when the
+on-coming one is engaged, however long its cone takes.
+
+:class:`AmtController` is that sequence as a sampled controller for :func:`~clutchlab.control.closed_loop`: it reads
+the synchronisers' modes (``s1.mode``: 2 free, 0 engaged), sets the network inputs of the engine's torque, the
+clutch's normal-force factor and the shift forks' forces, and logs its phases by name
+(:attr:`AmtController.phases`).  It is written against the system contract (names of inputs and outputs), not
+against a driveline's internals: any model with those inputs and outputs takes it, and an FMU host that carries
+out the same sequence drives the FMU's inputs of the same names.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ParameterError, SimulationError
+
+__all__ = ["AmtGear", "AmtController", "PHASES"]
+
+#: the controller's phases, in the order of a shift (``drive`` between shifts)
+PHASES = ("drive", "torque_down", "clutch_open", "neutral", "synchronise", "clutch_close")
+#: a synchroniser's modes as its ``<name>.mode`` output gives them (MSL's values, 2 for free)
+_ENGAGED, _FREE = 0.0, 2.0
+
+
+@dataclass(frozen=True)
+class AmtGear:
+    """One gear of an AMT: the synchroniser that engages it, the network input of the fork that moves its
+    sleeve, and the sign of that fork's force that pushes towards it (``+1`` or ``-1``: a 1-2 sleeve's fork pushes
+    towards 1st with one sign and towards 2nd with the other; the synchroniser's ``side``)."""
+
+    synchronizer: str
+    fork: str
+    side: int = 1
+
+    def __post_init__(self):
+        if self.side not in (1, -1):
+            raise ParameterError(f"gear of {self.synchronizer}: side = {self.side!r} must be 1 or -1")
+
+
+def _positive(name, value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"AmtController: {name} = {value!r} must be a number") from None
+    if not (math.isfinite(v) and v > 0.0):
+        raise ParameterError(f"AmtController: {name} = {value!r} must be finite and > 0")
+    return v
+
+
+class AmtController:
+    """The shift sequence of an AMT's controller, as a function controller ``f(t, y, memory) -> u`` of
+    :func:`~clutchlab.control.closed_loop`.
+
+    Parameters
+    ----------
+    gears : dict
+        ``{gear number: AmtGear(synchronizer, fork, side)}``: the gears it selects.
+    start_gear : int
+        The gear engaged at the start (its synchroniser stuck, its fork pushing).
+    commands : sequence of (float, int)
+        The gear command: ``(time [s], gear)`` pairs.  A command comes into effect at the first sample at or
+        after its time once the shift before it has ended (a driver's lever, a shift map's output); a command of
+        the gear engaged is no shift.
+    clutch_input, torque_input : str
+        The network inputs of the clutch's normal-force factor (1 closed, 0 open) and of the engine's torque [N m].
+    torque : float
+        The engine's torque while in gear [N m] (the driver's demand).
+    drag : float
+        The engine's torque while the clutch is open [N m] (a fuel cut's drag, <= 0: the engine slows towards the
+        new gear's speed).
+    fork_force : float
+        The fork's force on an engaged sleeve and while synchronising [N] (> 0).
+    torque_down, clutch_open, fork_ramp, clutch_close : float
+        Durations [s] (> 0) of the ramps: the torque to 0, the clutch's factor to 0 (while the torque goes to the
+        drag), each fork force to 0 or to its push, the clutch's factor back to 1 (while the torque comes back).
+    sync_timeout : float
+        The longest a synchronisation may take [s]: beyond it the run stops with a
+        :class:`~clutchlab.errors.SimulationError` naming the synchroniser (a fork too weak for its cone, a
+        gear that cannot be reached).
+
+    The controller measures its synchronisers' modes, :attr:`measured` (the first entries of ``measure``; more
+    may follow, for the record), and actuates :attr:`actuated`.  Each phase change is logged by name with its time
+    and gear, :attr:`phases`; the phases of a shift are :data:`PHASES`.  A new run (a sample at ``t`` below the last
+    one) starts it again from ``start_gear``.
+    """
+
+    def __init__(self, gears: dict, start_gear: int, commands, *, clutch_input: str, torque_input: str,
+                 torque: float, drag: float = 0.0, fork_force: float = 600.0, torque_down: float = 0.3,
+                 clutch_open: float = 0.07, fork_ramp: float = 0.03, clutch_close: float = 0.4,
+                 sync_timeout: float = 0.5):
+        if not isinstance(gears, dict) or not gears or not all(isinstance(g, AmtGear) for g in gears.values()):
+            raise ParameterError("AmtController: gears must be {gear number: AmtGear(synchronizer, fork, side)}")
+        self.gears = dict(gears)
+        if start_gear not in self.gears:
+            raise ParameterError(f"AmtController: start_gear = {start_gear!r} is not among the gears "
+                                 f"{sorted(self.gears)}")
+        self.start_gear = start_gear
+        cmds = []
+        for entry in commands:
+            try:
+                t, g = entry
+            except (TypeError, ValueError):
+                raise ParameterError(f"AmtController: a command {entry!r} must be (time [s], gear)") from None
+            if g not in self.gears:
+                raise ParameterError(f"AmtController: the command at {t!r} s selects gear {g!r}, not among the "
+                                     f"gears {sorted(self.gears)}")
+            if not math.isfinite(float(t)):
+                raise ParameterError(f"AmtController: a command's time {t!r} must be finite")
+            cmds.append((float(t), g))
+        self.commands = tuple(sorted(cmds, key=lambda c: c[0]))
+        self.clutch_input, self.torque_input = str(clutch_input), str(torque_input)
+        self.torque = float(torque)
+        self.drag = float(drag)
+        if not (math.isfinite(self.torque) and math.isfinite(self.drag) and self.drag <= 0.0):
+            raise ParameterError(f"AmtController: torque = {torque!r} must be finite and drag = {drag!r} finite "
+                                 "and <= 0 (the engine's drag while the clutch is open)")
+        self.fork_force = _positive("fork_force", fork_force)
+        self.torque_down = _positive("torque_down", torque_down)
+        self.clutch_open = _positive("clutch_open", clutch_open)
+        self.fork_ramp = _positive("fork_ramp", fork_ramp)
+        self.clutch_close = _positive("clutch_close", clutch_close)
+        self.sync_timeout = _positive("sync_timeout", sync_timeout)
+        synchros = [g.synchronizer for g in self.gears.values()]
+        if len(set(synchros)) != len(synchros):
+            raise ParameterError(f"AmtController: two gears share a synchroniser ({synchros})")
+        #: the outputs it reads, in this order: each gear's synchroniser's mode
+        self.measured = tuple(f"{s}.mode" for s in synchros)
+        forks = list(dict.fromkeys(g.fork for g in self.gears.values()))
+        #: the inputs it sets, in this order: the engine's torque, the clutch's factor, each fork's force
+        self.actuated = (self.torque_input, self.clutch_input, *forks)
+        self._fork_at = {f: 2 + k for k, f in enumerate(forks)}
+        self._mode_at = {g: k for k, g in enumerate(self.gears)}
+        self._reset()
+
+    def _reset(self):
+        self._gear, self._target = self.start_gear, None
+        self._phase, self._since = "drive", 0.0
+        self._next = 0       # the next command to take
+        self._last = -math.inf
+        self._log = [(0.0, "drive", self.start_gear)]
+
+    def _enter(self, phase, t):
+        self._phase, self._since = phase, t
+        self._log.append((t, phase, self._target if self._target is not None else self._gear))
+
+    @property
+    def phases(self) -> pd.DataFrame:
+        """The phases entered in the last run: ``time_s``, ``phase`` (:data:`PHASES`) and ``gear`` (the gear
+        selected: the one a shift goes to, from its ``torque_down`` on)."""
+        t, p, g = zip(*self._log)
+        return pd.DataFrame({"time_s": np.array(t, dtype=float), "phase": list(p), "gear": list(g)})
+
+    def __call__(self, t: float, y, memory=None):
+        """The inputs :attr:`actuated` at sample time ``t`` [s] from the measured modes ``y`` (:attr:`measured`
+        first)."""
+        if t < self._last:
+            self._reset()
+        self._last = t
+        y = np.asarray(y, dtype=float)
+        if y.size < len(self.measured):
+            raise ParameterError(f"AmtController: it measures {len(self.measured)} signals first "
+                                 f"({', '.join(self.measured)}); got {y.size}")
+        mode = {g: y[k] for g, k in self._mode_at.items()}
+        while True:   # (a phase whose condition holds at once hands over within the sample)
+            before = self._phase
+            self._advance(t, mode)
+            if self._phase == before:
+                break
+        return self._outputs(t)
+
+    def _ramp(self, t, duration):
+        return min(max((t - self._since) / duration, 0.0), 1.0)
+
+    def _advance(self, t, mode):
+        phase = self._phase
+        if phase == "drive":
+            while self._next < len(self.commands) and self.commands[self._next][0] <= t:
+                _, g = self.commands[self._next]
+                self._next += 1
+                if g != self._gear:
+                    self._target = g
+                    self._enter("torque_down", t)
+                    return
+        elif phase == "torque_down" and self._ramp(t, self.torque_down) >= 1.0:
+            self._enter("clutch_open", t)
+        elif phase == "clutch_open" and self._ramp(t, self.clutch_open) >= 1.0:
+            self._enter("neutral", t)
+        elif phase == "neutral" and self._ramp(t, self.fork_ramp) >= 1.0 and mode[self._gear] == _FREE:
+            self._enter("synchronise", t)
+        elif phase == "synchronise":
+            if mode[self._target] == _ENGAGED:
+                self._enter("clutch_close", t)
+            elif t - self._since > self.sync_timeout:
+                g = self.gears[self._target]
+                raise SimulationError(f"AmtController: {g.synchronizer} has not engaged gear {self._target} within "
+                                      f"sync_timeout = {self.sync_timeout:g} s of the push at {self._since:.6g} s "
+                                      f"(at {t:.6g} s: mode {mode[self._target]:g}); a stronger fork_force or a "
+                                      "longer sync_timeout")
+        elif phase == "clutch_close" and self._ramp(t, self.clutch_close) >= 1.0:
+            self._gear, self._target = self._target, None
+            self._enter("drive", t)
+
+    def _outputs(self, t):
+        u = np.zeros(len(self.actuated))
+        phase = self._phase
+        torque, clutch = self.torque, 1.0
+        held = self._gear          # the gear whose fork pushes (the one engaged, until neutral)
+        push = 1.0
+        if phase == "torque_down":
+            torque = self.torque * (1.0 - self._ramp(t, self.torque_down))
+        elif phase == "clutch_open":
+            s = self._ramp(t, self.clutch_open)
+            torque, clutch = self.drag * s, 1.0 - s
+        elif phase == "neutral":
+            torque, clutch, push = self.drag, 0.0, 1.0 - self._ramp(t, self.fork_ramp)
+        elif phase == "synchronise":
+            torque, clutch, held, push = self.drag, 0.0, self._target, self._ramp(t, self.fork_ramp)
+        elif phase == "clutch_close":
+            s = self._ramp(t, self.clutch_close)
+            torque, clutch, held = self.drag + (self.torque - self.drag) * s, s, self._target
+        u[0], u[1] = torque, clutch
+        gear = self.gears[held]
+        u[self._fork_at[gear.fork]] = gear.side * self.fork_force * push
+        return u

@@ -1,0 +1,135 @@
+"""The AMT's transmission controller (clutchlab.control.AmtController) on the AMT example with its inputs as ports:
+the sequence of a gear command, the phases that wait on the synchronisers, the cone's torque while it synchronises,
+and the refusals."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clutchlab.control import AmtController, AmtGear, closed_loop
+from clutchlab.driveline import Signal
+from clutchlab.driveline.description import load_driveline
+from clutchlab.errors import ParameterError, SimulationError
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
+H = 1e-3                                           # the controller's sample time [s]
+GEARS = {1: AmtGear("s1", "fork", 1), 2: AmtGear("s2", "fork", -1)}
+FORK, MU, R_C, ALPHA = 600.0, 0.1, 0.045, math.radians(6.5)   # the example's synchronisers
+RECORD = ["s2.tau", "input_shaft.w", "output_shaft.w", "energy_error", "input_work"]
+
+
+@pytest.fixture(scope="module")
+def amt():
+    """The AMT example with its engine torque, clutch factor and shift fork as network inputs (its own tables
+    replaced by ports: ``Driveline.replace``)."""
+    d = load_driveline(ROOT / "examples" / "driveline_amt_upshift.toml").driveline.without()
+    d.input("torque_command", unit="Nm", start=150.0).input("clutch_command", unit="1", start=1.0)
+    d.input("fork", unit="N", start=FORK)
+    d = (d.replace("engine_torque", signal=Signal.input("torque_command"))
+         .replace("clutch", normal=Signal.input("clutch_command"))
+         .replace("s1", force=Signal.input("fork")).replace("s2", force=Signal.input("fork")))
+    return d.system(1e-8)
+
+
+def _tcu(commands, **kw):
+    return AmtController(GEARS, 1, commands, clutch_input="clutch_command", torque_input="torque_command",
+                         torque=150.0, drag=-30.0, fork_force=kw.pop("fork_force", FORK), **kw)
+
+
+def _run(system, tcu, t_end):
+    return closed_loop(system, tcu, H, t_end, measure=list(tcu.measured) + RECORD, actuate=list(tcu.actuated))
+
+
+def _event(res, element, event):
+    ev = res.events
+    return ev.time_s[(ev.element == element) & (ev.event == event)].to_numpy()
+
+
+def test_a_gear_command_shifts_up_and_down_waiting_on_the_synchronisers(amt):
+    """An upshift at 0.4 s and a downshift at 2.2 s: the phases in order; the ramps take their durations (to a
+    sample); the sleeve goes in once the off-going synchroniser is free, and the clutch closes once the on-coming one
+    is engaged, each within one sample of the network's event; while it synchronises the cone carries
+    ``mu F R_c / sin(alpha)``; the gears' ratios after each shift; the energy balance."""
+    tcu = _tcu([(0.4, 2), (2.2, 1)])
+    res = _run(amt, tcu, 3.5)
+    ph = tcu.phases
+    shift = ["torque_down", "clutch_open", "neutral", "synchronise", "clutch_close", "drive"]
+    assert list(ph.phase) == ["drive"] + shift + shift
+    assert list(ph.gear) == [1] + [2] * 6 + [1] * 6
+    t = dict()
+    for k, (name, gear) in enumerate(zip(ph.phase, ph.gear)):
+        t[(name, gear)] = ph.time_s[k]
+    for gear, off, on in ((2, "s1", "s2"), (1, "s2", "s1")):
+        assert abs(t[("clutch_open", gear)] - t[("torque_down", gear)] - tcu.torque_down) <= H + 1e-12
+        assert abs(t[("neutral", gear)] - t[("clutch_open", gear)] - tcu.clutch_open) <= H + 1e-12
+        assert abs(t[("drive", gear)] - t[("clutch_close", gear)] - tcu.clutch_close) <= H + 1e-12
+        free = _event(res, off, "free")
+        free = free[free > t[("neutral", gear)]][0]
+        assert 0.0 < t[("synchronise", gear)] - free <= H + 1e-12
+        stick = _event(res, on, "stick")
+        stick = stick[stick > t[("synchronise", gear)]][0]
+        assert 0.0 < t[("clutch_close", gear)] - stick <= H + 1e-12
+    df = res.frame
+    at = df.set_index(np.round(df.time_s / H).astype(int))
+    sync = at.loc[int(round((t[("synchronise", 2)] + tcu.fork_ramp) / H)) + 5]
+    assert sync["s2.tau_Nm"] == pytest.approx(-MU * FORK * R_C / math.sin(ALPHA), rel=1e-9)  # (on flange a: -T_c)
+    assert sync["fork_N"] == -FORK and sync["clutch_command_1"] == 0.0 and sync["torque_command_Nm"] == -30.0
+    for time, ratio in ((0.39, 3.5), (2.1, 2.0), (3.5, 3.5)):
+        row = at.loc[int(round(time / H))]
+        assert row["input_shaft.w_rad_s"] / row["output_shaft.w_rad_s"] == pytest.approx(ratio, rel=1e-9)
+    assert at.loc[int(round(2.1 / H))]["fork_N"] == -FORK and at.loc[390]["fork_N"] == FORK
+    assert np.abs(df["energy_error_J"]).max() < 1e-6 * df["input_work_J"].abs().max()
+
+
+def test_the_clutch_waits_for_a_slower_synchronisation(amt):
+    """A quarter of the fork's force: the cone's torque is a quarter, so the input shaft takes about four times as
+    long to reach 2nd's speed (its inertia against the vehicle's, some 130 times larger on that shaft), and the
+    clutch still closes only once 2nd is in, within one sample."""
+    times = {}
+    for force in (FORK, FORK / 4):
+        tcu = _tcu([(0.4, 2)], fork_force=force)
+        res = _run(amt, tcu, 2.0)
+        ph = tcu.phases.set_index("phase").time_s
+        stick = _event(res, "s2", "stick")[0]
+        assert 0.0 < ph["clutch_close"] - stick <= H + 1e-12
+        # (the push rises over its ramp, held a sample at a time: the ramp loses about half its length)
+        times[force] = stick - (ph["synchronise"] + 0.5 * tcu.fork_ramp)
+    assert times[FORK / 4] / times[FORK] == pytest.approx(4.0, rel=0.02)
+
+
+def test_a_synchronisation_that_cannot_finish_stops_the_run(amt):
+    with pytest.raises(SimulationError, match=r"s2 has not engaged gear 2 within sync_timeout = 0\.2 s of the push"):
+        _run(amt, _tcu([(0.4, 2)], fork_force=5.0, sync_timeout=0.2), 2.0)
+
+
+def test_a_command_of_the_gear_engaged_is_no_shift_and_a_new_run_starts_again(amt):
+    tcu = _tcu([(0.2, 1)])
+    res = _run(amt, tcu, 0.5)
+    assert list(tcu.phases.phase) == ["drive"] and (res.frame["fork_N"] == FORK).all()
+    tcu = _tcu([(0.4, 2)])
+    _run(amt, tcu, 1.2)
+    first = tcu.phases
+    _run(amt, tcu, 1.2)
+    assert tcu.phases.equals(first)
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(start_gear=3), r"start_gear = 3 is not among the gears \[1, 2\]"),
+    (dict(commands=[(0.4, 5)]), r"the command at 0\.4 s selects gear 5"),
+    (dict(commands=[0.4]), r"a command 0\.4 must be \(time \[s\], gear\)"),
+    (dict(drag=10.0), r"drag = 10\.0 finite and <= 0"),
+    (dict(clutch_open=0.0), r"clutch_open = 0\.0 must be finite and > 0"),
+    (dict(fork_force=float("nan")), r"fork_force = nan must be finite and > 0"),
+    (dict(gears={1: AmtGear("s1", "fork"), 2: AmtGear("s1", "fork", -1)}), r"two gears share a synchroniser"),
+])
+def test_bad_settings_are_refused_naming_them(change, message):
+    kw = dict(gears=GEARS, start_gear=1, commands=[(0.4, 2)], clutch_input="clutch_command",
+              torque_input="torque_command", torque=150.0, drag=-30.0)
+    kw.update(change)
+    with pytest.raises(ParameterError, match=message):
+        AmtController(**kw)
+    with pytest.raises(ParameterError, match="side = 0 must be 1 or -1"):
+        AmtGear("s1", "fork", 0)
