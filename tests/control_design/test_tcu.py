@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from clutchlab.control import AmtController, AmtGear, closed_loop
+from clutchlab.control import AmtController, AmtGear, closed_loop, shift_quality
 from clutchlab.driveline import Signal
 from clutchlab.driveline.description import load_driveline
 from clutchlab.errors import ParameterError, SimulationError
@@ -98,6 +98,24 @@ def test_the_clutch_waits_for_a_slower_synchronisation(amt):
         # (the push rises over its ramp, held a sample at a time: the ramp loses about half its length)
         times[force] = stick - (ph["synchronise"] + 0.5 * tcu.fork_ramp)
     assert times[FORK / 4] / times[FORK] == pytest.approx(4.0, rel=0.02)
+
+
+def test_the_controller_s_shift_is_measured_as_the_schedule_s_and_interrupts_the_drive_for_less(amt):
+    """``shift_quality`` reads the closed loop's record as it reads a run (the same column names): the gear is in
+    where 2nd engages, and since the controller closes the clutch as soon as it is, the drive is interrupted for less
+    than under the example's schedule, which waits to 1.05 s whatever the cone does."""
+    tcu = _tcu([(0.4, 2)])
+    cols = ["clutch.tau", "clutch.w_rel", "s1.tau", "s1.w_rel", "s2.tau", "s2.w_rel", "wheels.w", "engine.w"]
+    res = closed_loop(amt, tcu, H, 2.0, measure=list(tcu.measured) + cols, actuate=list(tcu.actuated))
+    how = dict(clutch="clutch", offgoing="s1", oncoming="s2", output="wheels", engine="engine", radius=0.3, start=0.4)
+    q = shift_quality(res.frame, **how)
+    schedule = load_driveline(ROOT / "examples" / "driveline_amt_upshift.toml").driveline
+    ref = shift_quality(schedule.simulate(2.0, rtol=1e-8, output_step=H).to_dataframe(), **how)
+    assert (q.kind, q.order) == ("interrupted", "upshift")
+    # (an interrupted shift's lock-up: the gear in, where the slip is within its threshold on the 1 ms samples)
+    assert abs(q.lockup_s - _event(res, "s2", "stick")[0]) <= 2 * H
+    assert q.metrics["torque_interruption_s"] < 0.6 * ref.metrics["torque_interruption_s"]
+    assert q.metrics["shift_time_s"] < ref.metrics["shift_time_s"] - 0.1
 
 
 def test_a_synchronisation_that_cannot_finish_stops_the_run(amt):
