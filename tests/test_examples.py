@@ -49,7 +49,8 @@ def _key(args: list[str]) -> str:
 
 
 def _outputs(args):
-    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot", "--events", "--poles", "--table")]
+    return [args[i + 1] for i, a in enumerate(args) if a in ("-o", "--output", "--plot", "--events", "--poles", "--table",
+                                                          "--phases")]
 
 
 def test_every_readme_line_is_a_clutchlab_command_with_existing_inputs():
@@ -384,6 +385,18 @@ def check_amt_shift(work, out):
     assert "gear in at" in out
 
 
+def check_amt_tcu(work, out):
+    run = pd.read_csv(work / "amt_tcu.csv")
+    phases = pd.read_csv(work / "amt_tcu_phases.csv")
+    shift = ["torque_down", "clutch_open", "neutral", "synchronise", "clutch_close", "drive"]
+    assert list(phases.phase) == ["drive"] + shift + shift and list(phases.gear) == [1] + [2] * 6 + [1] * 6
+    ratio = run["input_shaft.w_rad_s"] / run["output_shaft.w_rad_s"]
+    in2nd = run.time_s.between(phases.time_s[6], 2.2)       # in 2nd between the shifts, in 1st after the second
+    assert np.allclose(ratio[in2nd], 2.0, rtol=1e-8) and np.isclose(ratio.iloc[-1], 3.5, rtol=1e-8)
+    assert set(run.fork_N[in2nd]) == {-600.0} and run.clutch_command_1.iloc[-1] == 1.0
+    assert "upshift (interrupted) from 0.4000 s" in out   # the file's [shift]: the first shift's quality
+
+
 def check_lin(work, out):
     import json
 
@@ -460,6 +473,7 @@ CHECKS = {
     "results_tc/": check_converter_sweep,
     "at_shift.json": check_at_shift,
     "amt_shift.json": check_amt_shift,
+    "amt_tcu.csv": check_amt_tcu,
     "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
     "shift.json": check_shift,

@@ -5,16 +5,21 @@ and the refusals."""
 from __future__ import annotations
 
 import math
+import tomllib
 
 import numpy as np
+import pandas as pd
 import pytest
 
+from cli_checks import one_line_error
+from clutchlab.cli import main
 from clutchlab.control import AmtController, AmtGear, closed_loop, shift_quality
 from clutchlab.driveline import Signal
-from clutchlab.driveline.description import load_driveline
+from clutchlab.driveline.description import load_driveline, parse_driveline
 from clutchlab.errors import ParameterError, SimulationError
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
+EXAMPLE = ROOT / "examples" / "driveline_amt_tcu.toml"   # the same network with its inputs and [tcu] in the file
 H = 1e-3                                           # the controller's sample time [s]
 GEARS = {1: AmtGear("s1", "fork", 1), 2: AmtGear("s2", "fork", -1)}
 FORK, MU, R_C, ALPHA = 600.0, 0.1, 0.045, math.radians(6.5)   # the example's synchronisers
@@ -151,3 +156,57 @@ def test_bad_settings_are_refused_naming_them(change, message):
         AmtController(**kw)
     with pytest.raises(ParameterError, match="side = 0 must be 1 or -1"):
         AmtGear("s1", "fork", 0)
+
+
+def test_the_file_s_controller_runs_from_the_command_line_as_the_python_one(amt, tmp_path, capsys):
+    """``clutchlab control tcu`` on ``examples/driveline_amt_tcu.toml`` (its inputs declared as ports, its [tcu]
+    table the controller above): the same phases, the same run to rounding, the network's events, the upshift's
+    quality from its [shift] table (the record up to the downshift's command); nothing is overwritten without
+    --force."""
+    out, phases, events = tmp_path / "run.csv", tmp_path / "phases.csv", tmp_path / "events.csv"
+    argv = ["control", "tcu", str(EXAMPLE), "-o", str(out), "--phases", str(phases), "--events", str(events)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "13 phases of AmtController" in printed and "upshift (interrupted) from 0.4000 s" in printed
+    tcu = _tcu([(0.4, 2), (2.2, 1)])
+    res = _run(amt, tcu, 3.5)
+    got = pd.read_csv(phases)
+    assert list(got.phase) == list(tcu.phases.phase) and list(got.gear) == list(tcu.phases.gear)
+    np.testing.assert_allclose(got.time_s, tcu.phases.time_s, rtol=0, atol=1e-12)
+    run = pd.read_csv(out)
+    for col in ("input_shaft.w_rad_s", "s2.tau_Nm", "fork_N", "clutch_command_1", "torque_command_Nm"):
+        np.testing.assert_allclose(run[col], res.frame[col], rtol=1e-8, atol=1e-9)   # (the CSV's 9 digits)
+    assert {"s1.mode_1", "s2.mode_1", "wheels.w_rad_s", "energy_error_J"} <= set(run.columns)
+    ev = pd.read_csv(events)
+    assert list(ev.event[ev.element == "s2"]) == list(res.events.event[res.events.element == "s2"])
+    assert main(argv) != 0 and "--force" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.update(extra=1), r"tcu\.extra: unknown field"),
+    (lambda t: t.pop("torque"), r"\[tcu\]: missing field 'torque'"),
+    (lambda t: t["gears"]["2"].update(synchronizer="clutch"), r"tcu\.gears\.2\.synchronizer = 'clutch': expected a "
+                                                               r"synchronizer of the network \(s1, s2\)"),
+    (lambda t: t["gears"]["2"].update(fork="fork2"), r"tcu\.gears\.2\.fork = 'fork2': expected a network input"),
+    (lambda t: t["gears"]["2"].update(side=2), r"tcu\.gears\.2\.side = 2: expected 1 or -1"),
+    (lambda t: t["gears"].update(x=t["gears"].pop("2")), r"tcu\.gears\.x = 'x': expected a gear's number"),
+    (lambda t: t.update(commands=[["0.4 s"]]), r"tcu\.commands must be rows \[time, gear\]"),
+    (lambda t: t.update(commands=[["0.4 kg", 2]]), r"tcu\.commands\[0\]"),
+    (lambda t: t.update(clutch_input="throttle"), r"tcu\.clutch_input = 'throttle': expected a network input"),
+    (lambda t: t.update(fork_force="600 N m"), r"tcu\.fork_force"),
+])
+def test_a_bad_tcu_table_is_refused_naming_the_file_and_the_field(edit, message, tmp_path, capsys):
+    doc = tomllib.loads(EXAMPLE.read_text())
+    edit(doc["tcu"])
+    with pytest.raises(ParameterError, match=message):
+        parse_driveline(doc, "amt.toml")
+
+
+def test_the_command_line_refuses_a_file_without_a_tcu_and_a_controller_it_cannot_build(tmp_path, capsys):
+    line = one_line_error(capsys, ["control", "tcu", str(ROOT / "examples" / "driveline_amt_upshift.toml")])
+    assert "driveline_amt_upshift.toml: no [tcu] table" in line
+    bad = tmp_path / "amt.toml"
+    bad.write_text(EXAMPLE.read_text().replace('drag = "-30 N m"', 'drag = "30 N m"'))
+    line = one_line_error(capsys, ["control", "tcu", str(bad), "-o", str(tmp_path / "run.csv")])
+    assert "amt.toml: [tcu] AmtController: torque = 150.0 must be finite and drag = 30.0 finite and <= 0" in line
+    assert not (tmp_path / "run.csv").exists()

@@ -140,6 +140,22 @@ def register(subparsers) -> None:
                                                      "acceleration and jerk, its phases shaded")
     shift.add_argument("--force", action="store_true", help="overwrite the files")
     shift.set_defaults(func=_shift)
+    tcu = sub.add_parser("tcu", help="an automated manual transmission's gear command, carried out by its controller",
+                         description="Run a driveline whose [tcu] table declares an automated manual transmission's "
+                                     "controller (AmtController in Python): its gear command carried out as "
+                                     "the shift sequence (torque down, clutch open, neutral, synchronise, clutch "
+                                     "closed), waiting on the synchronisers, in the loop with the network at its "
+                                     "sample time. Prints the phases and, with a [shift] table, the first shift's "
+                                     "quality (the record up to the next shift's command).",
+                         epilog="Documentation: docs/control.md (A transmission controller for the AMT)")
+    tcu.add_argument("source", help="driveline description (.toml) with a [tcu] table")
+    tcu.add_argument("-o", "--output", dest="write", default=None,
+                     help="the run at the controller's samples (.csv): every state and output, and the inputs it set")
+    tcu.add_argument("--events", default=None, help="the network's events (.csv): time_s, event, element")
+    tcu.add_argument("--phases", default=None, help="the controller's phases (.csv): time_s, phase, gear")
+    tcu.add_argument("--t-end", default=None, help="end time, e.g. '3 s' (default: [simulation] t_end)")
+    tcu.add_argument("--force", action="store_true", help="overwrite the files")
+    tcu.set_defaults(func=_tcu)
     design = sub.add_parser("design", help="PI for a phase margin at an operating point, and its closed-loop run",
                             description="Linearise the model at a steady state (one input, one output), design "
                                         "the PI C(s) = Kp (1 + 1/(Ti s)) giving the phase margin at the crossover "
@@ -445,6 +461,56 @@ def _shift(args) -> int:
         elif args.write is not None:
             atomic_to_csv(q.table(), outputs.staged(args.write), overwrite=args.force)
     print(q)
+    return 0
+
+
+def _tcu(args) -> int:
+    """``control tcu``: a driveline's gear command carried out by its [tcu] table's controller, in the loop."""
+    from ..control.loop import closed_loop
+    from ..control.tcu import SAMPLE_TIME, AmtController
+    from ..driveline.description import load_driveline
+    from ..driveline.shift import shift_quality
+    from ..io.files import OutputSet, atomic_to_csv
+    from ..units import to_si
+
+    for flag, path in (("-o", args.write), ("--events", args.events), ("--phases", args.phases)):
+        if path is not None and not path.lower().endswith(".csv"):
+            raise ParameterError(f"{flag} {path}: expected a .csv file")
+    outputs = OutputSet([args.write, args.events, args.phases], args.force)   # checked before the run
+    spec = load_driveline(args.source)
+    if spec.tcu is None:
+        raise ParameterError(f"{args.source}: no [tcu] table (the controller's gears, start_gear, commands, "
+                             "torque_input, clutch_input, torque: docs/control.md)")
+    t_end = to_si(args.t_end, "s", name="--t-end") if args.t_end is not None else spec.t_end
+    if t_end is None or not t_end > 0.0:
+        raise ParameterError(f"{args.source}: give --t-end or [simulation] t_end (> 0)")
+    try:
+        controller = AmtController.from_table(spec.tcu)
+    except ParameterError as exc:
+        raise ParameterError(f"{args.source}: [tcu] {exc}") from None
+    system = spec.driveline.system(spec.rtol)
+    record = [v.name for v in (*system.states, *system.outputs) if v.name not in controller.measured]
+    res = closed_loop(system, controller, spec.tcu.get("sample_time", SAMPLE_TIME), t_end,
+                      measure=[*controller.measured, *record], actuate=list(controller.actuated),
+                      max_step=spec.max_step)
+    phases = controller.phases
+    quality = None
+    if spec.shift is not None:   # the first shift's: the record up to the next shift's command
+        starts = phases.time_s[phases.phase == "torque_down"].to_numpy()
+        frame = res.frame if starts.size < 2 else res.frame[res.frame.time_s < starts[1]]
+        quality = shift_quality(frame, **spec.shift)
+    with outputs:
+        if args.write is not None:
+            atomic_to_csv(res.frame, outputs.staged(args.write), overwrite=args.force)
+        if args.events is not None:
+            atomic_to_csv(res.events, outputs.staged(args.events), overwrite=args.force)
+        if args.phases is not None:
+            atomic_to_csv(phases, outputs.staged(args.phases), overwrite=args.force)
+    print(f"{args.source}: {len(phases)} phases of {controller.__class__.__name__}")
+    for t, phase, gear in zip(phases.time_s, phases.phase, phases.gear):
+        print(f"  {t:9.4f} s  {phase:<13s} gear {gear}")
+    if quality is not None:
+        print(quality)
     return 0
 
 

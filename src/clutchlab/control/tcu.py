@@ -25,10 +25,12 @@ import pandas as pd
 
 from ..errors import ParameterError, SimulationError
 
-__all__ = ["AmtGear", "AmtController", "PHASES"]
+__all__ = ["AmtGear", "AmtController", "PHASES", "SAMPLE_TIME"]
 
 #: the controller's phases, in the order of a shift (``drive`` between shifts)
 PHASES = ("drive", "torque_down", "clutch_open", "neutral", "synchronise", "clutch_close")
+#: the controller's sample time [s] where a driveline file's ``[tcu]`` table gives none
+SAMPLE_TIME = 1e-3
 #: a synchroniser's modes as its ``<name>.mode`` output gives them (MSL's values, 2 for free)
 _ENGAGED, _FREE = 0.0, 2.0
 
@@ -142,6 +144,15 @@ class AmtController:
         self._fork_at = {f: 2 + k for k, f in enumerate(forks)}
         self._mode_at = {g: k for k, g in enumerate(self.gears)}
         self._reset()
+
+    @classmethod
+    def from_table(cls, table: dict) -> "AmtController":
+        """The controller of a driveline file's ``[tcu]`` table as its loader reads it
+        (:attr:`clutchlab.driveline.description.DrivelineFile.tcu`: SI, gears as ``{number: (synchronizer, fork,
+        side)}``; its ``sample_time`` is the loop's, not the controller's)."""
+        kw = {k: v for k, v in table.items() if k != "sample_time"}
+        kw["gears"] = {g: AmtGear(*spec) for g, spec in kw["gears"].items()}
+        return cls(**kw)
 
     def _reset(self):
         self._gear, self._target = self.start_gear, None

@@ -175,6 +175,10 @@ class DrivelineFile:
         The ``[shift]`` table: the keyword arguments of :func:`clutchlab.driveline.shift.shift_quality` for the
         shift the network makes, clutch-to-clutch or an AMT's with ``clutch`` (``clutchlab control shift FILE``,
         the sweep's ``shift.<metric>``).
+    tcu : dict or None
+        The ``[tcu]`` table: the keyword arguments of :class:`clutchlab.control.AmtController` (an automated
+        manual transmission's controller carrying out a gear command; names checked against the network,
+        quantities in SI) and its ``sample_time`` [s] (``clutchlab control tcu FILE``; :data:`TCU_FIELDS`).
     """
 
     driveline: Driveline
@@ -183,6 +187,16 @@ class DrivelineFile:
     rtol: float = 1e-8
     max_step: float | None = None
     shift: dict | None = None
+    tcu: dict | None = None
+
+
+#: the fields of a ``[tcu]`` table (:class:`clutchlab.control.AmtController`'s arguments and the controller's sample
+#: time): name -> unit of a quantity, or the kind of a value that is not one
+TCU_FIELDS = {"gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
+              "clutch_input": "input", "torque": "N*m", "drag": "N*m", "fork_force": "N", "torque_down": "s",
+              "clutch_open": "s", "fork_ramp": "s", "clutch_close": "s", "sync_timeout": "s", "sample_time": "s"}
+#: the fields of one gear of a ``[tcu]`` table's ``gears``
+TCU_GEAR_FIELDS = ("synchronizer", "fork", "side")
 
 
 def _quantity(value, unit, key, src):
@@ -492,7 +506,8 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
                              f"reads a file), not {type(doc).__name__}")
     base = Path(base) if base is not None else Path(src).parent
     by_domain = {dom: tables(dom) for dom in ("rotational", "translational")}
-    known = {"driveline", "simulation", "input", "shift", *by_domain["rotational"], *by_domain["translational"]}
+    known = {"driveline", "simulation", "input", "shift", "tcu", *by_domain["rotational"],
+             *by_domain["translational"]}
     for top in doc:
         if top not in known:
             raise ParameterError(f"{src}: unknown table [{top}] (known: {', '.join(sorted(known))})")
@@ -520,7 +535,8 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
         if k == "rtol":
             check_rtol(v, f"{src}: simulation.rtol")   # (the one rule of every model: at least RTOL_MIN)
     for top in doc:
-        if top in known and top not in table_fields and top not in ("driveline", "simulation", "input", "shift"):
+        if top in known and top not in table_fields and top not in ("driveline", "simulation", "input", "shift",
+                                                                     "tcu"):
             other = "translational" if domain == "rotational" else "rotational"
             raise ParameterError(f"{src}: [{top}] belongs to a {other} driveline (this one is {domain}; set "
                                  f"[driveline] domain)")
@@ -567,7 +583,76 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
         raise ParameterError(f"{src}: {exc}") from None
     _declare_inputs(d, declared, uses, src)
     return DrivelineFile(d, settings.get("t_end"), settings.get("output_step"), settings.get("rtol", 1e-8),
-                         settings.get("max_step"), _shift(doc.get("shift"), d, src))
+                         settings.get("max_step"), _shift(doc.get("shift"), d, src), _tcu(doc.get("tcu"), d, src))
+
+
+def _gear_number(value, key, src):
+    """A gear's number: a whole number (a TOML key "1" or a value 1)."""
+    try:
+        g = int(value)
+    except (TypeError, ValueError):
+        g = None
+    if g is None or isinstance(value, bool) or str(g) != str(value).strip():
+        raise ParameterError(f"{src}: {key} = {value!r}: expected a gear's number (a whole number)")
+    return g
+
+
+def _tcu(table, d: Driveline, src: str):
+    """The ``[tcu]`` table: the keyword arguments of :class:`clutchlab.control.AmtController` for the network's gear
+    command and its ``sample_time`` (names checked against the network: the gears' synchronisers, the network inputs
+    it sets; quantities in SI), or None without one.  The controller checks the rest as it is built."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ParameterError(f"{src}: [tcu] must be a table (gears, start_gear, commands, ...)")
+    for k in table:
+        if k not in TCU_FIELDS:
+            raise ParameterError(f"{src}: tcu.{k}: unknown field (known: {', '.join(TCU_FIELDS)})")
+    for k in ("gears", "start_gear", "commands", "torque_input", "clutch_input", "torque"):
+        if k not in table:
+            raise ParameterError(f"{src}: [tcu]: missing field {k!r}")
+    synchros = {e.name for e in d.elements if e.kind == "synchronizer"}
+    out = {}
+    for k, v in table.items():
+        kind, key = TCU_FIELDS[k], f"tcu.{k}"
+        if kind == "gears":
+            if not isinstance(v, dict) or not v:
+                raise ParameterError(f"{src}: {key} must be a table of gears, e.g. 1 = {{ synchronizer = \"s1\", "
+                                     "fork = \"fork\", side = 1 }")
+            gears = {}
+            for g, spec in v.items():
+                where = f"{key}.{g}"
+                number = _gear_number(g, where, src)
+                if not isinstance(spec, dict) or any(f not in TCU_GEAR_FIELDS for f in spec) \
+                        or not {"synchronizer", "fork"} <= set(spec):
+                    raise ParameterError(f"{src}: {where} must be {{ synchronizer = ..., fork = ..., side = 1 or -1 "
+                                         "}")
+                if spec["synchronizer"] not in synchros:
+                    raise ParameterError(f"{src}: {where}.synchronizer = {spec['synchronizer']!r}: expected a "
+                                         f"synchronizer of the network ({', '.join(sorted(synchros)) or 'none'})")
+                if spec["fork"] not in d.inputs:
+                    raise ParameterError(f"{src}: {where}.fork = {spec['fork']!r}: expected a network input "
+                                         f"([input.NAME]: {', '.join(d.inputs) or 'none'})")
+                side = spec.get("side", 1)
+                if side not in (1, -1) or isinstance(side, bool):
+                    raise ParameterError(f"{src}: {where}.side = {side!r}: expected 1 or -1")
+                gears[number] = (spec["synchronizer"], spec["fork"], int(side))
+            out[k] = gears
+        elif kind == "gear":
+            out[k] = _gear_number(v, key, src)
+        elif kind == "commands":
+            if not isinstance(v, list) or not all(isinstance(c, list) and len(c) == 2 for c in v):
+                raise ParameterError(f"{src}: {key} must be rows [time, gear], e.g. [[\"0.4 s\", 2]]")
+            out[k] = [(_quantity(t, "s", f"{key}[{i}]", src), _gear_number(g, f"{key}[{i}]", src))
+                      for i, (t, g) in enumerate(v)]
+        elif kind == "input":
+            if v not in d.inputs:
+                raise ParameterError(f"{src}: {key} = {v!r}: expected a network input ([input.NAME]: "
+                                     f"{', '.join(d.inputs) or 'none'})")
+            out[k] = v
+        else:
+            out[k] = _quantity(v, kind, key, src)
+    return out
 
 
 def _shift(table, d: Driveline, src: str):
