@@ -1220,6 +1220,41 @@ def test_every_example_network_exports_and_equals_clutchlab(tmp_path, example):
         assert engaged(python) < engaged(base)
 
 
+def test_an_amt_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_network(tmp_path):
+    """The AMT with its engine torque, clutch factor and shift fork as network inputs
+    (``examples/driveline_amt_tcu.toml``) as a native FMU: the three are FMI inputs.  The inputs clutchlab's AMT
+    controller (its ``[tcu]`` table) set in the loop through the upshift, held by FMPy over the same 1 ms
+    communication steps (a TCU in a host), give the FMU the closed loop's run: the synchronisers' modes sample for
+    sample, the speeds to the solver's tolerance, and the Python co-simulation's outputs to 1e-9."""
+    from clutchlab.control import AmtController, closed_loop
+    from clutchlab.driveline.description import load_driveline
+
+    source = EXAMPLE.parent / "driveline_amt_tcu.toml"
+    cls = DrivelineCoSimulation.for_description(source)
+    assert [(v.name, v.unit) for v in cls.inputs] == [("torque_command", "N.m"), ("clutch_command", "1"),
+                                                       ("fork", "N")]
+    path = export_native_fmu(cls, tmp_path / "amt.fmu", platforms=["linux64"])
+    _, svs = _variables(path)
+    assert all(svs[name].get("causality") == "input" for name in ("torque_command", "clutch_command", "fork"))
+    spec = load_driveline(source)
+    tcu = AmtController.from_table(spec.tcu)
+    n, dt = 1500, 1e-3                        # through the upshift (0.4-1.33 s)
+    loop = closed_loop(spec.driveline.system(spec.rtol), tcu, dt, n * dt, actuate=list(tcu.actuated),
+                       measure=[*tcu.measured, "input_shaft.w", "wheels.w"])
+    inputs = {name: loop.frame[column].to_numpy() for name, column in
+              zip(tcu.actuated, ("torque_command_Nm", "clutch_command_1", "fork_N"))}
+    assert list(tcu.phases.phase)[-1] == "drive" and {600.0, -600.0} <= set(inputs["fork"])   # (1st, then 2nd)
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(cls, n, dt, inputs=inputs)
+    energy = max(float(np.max(np.abs(python[k]))) for k in ("input_work", "kinetic_energy"))
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
+    for name in ("s1.mode", "s2.mode"):
+        np.testing.assert_array_equal(native[name], loop.frame[f"{name}_1"].to_numpy(), err_msg=name)
+    for name in ("input_shaft.w", "wheels.w"):
+        np.testing.assert_allclose(native[name], loop.frame[f"{name}_rad_s"].to_numpy(), rtol=1e-7, err_msg=name)
+
+
 def _a_host_sets(tmp_path, path, cls, n, dt, energy, name, value):
     """A host sets the network's parameter ``name`` (a component's declared number) to ``value``: it is a parameter
     of the FMU, and the native run equals the Python co-simulation built with it.  Returns that run's outputs and
