@@ -586,6 +586,19 @@ def parse_driveline(doc: dict, source: str, base=None, set_changes: dict | None 
                          settings.get("max_step"), _shift(doc.get("shift"), d, src), _tcu(doc.get("tcu"), d, src))
 
 
+def _check_table(table, name, fields, required, src) -> None:
+    """A top-level table ``[name]`` of known ``fields`` with its ``required`` ones (errors name the file, the table and
+    the field)."""
+    if not isinstance(table, dict):
+        raise ParameterError(f"{src}: [{name}] must be a table ({', '.join(required)}, ...)")
+    for k in table:
+        if k not in fields:
+            raise ParameterError(f"{src}: {name}.{k}: unknown field (known: {', '.join(fields)})")
+    for k in required:
+        if k not in table:
+            raise ParameterError(f"{src}: [{name}]: missing field {k!r}")
+
+
 def _gear_number(value, key, src):
     """A gear's number: a whole number (a TOML key "1" or a value 1)."""
     try:
@@ -603,14 +616,8 @@ def _tcu(table, d: Driveline, src: str):
     it sets; quantities in SI), or None without one.  The controller checks the rest as it is built."""
     if table is None:
         return None
-    if not isinstance(table, dict):
-        raise ParameterError(f"{src}: [tcu] must be a table (gears, start_gear, commands, ...)")
-    for k in table:
-        if k not in TCU_FIELDS:
-            raise ParameterError(f"{src}: tcu.{k}: unknown field (known: {', '.join(TCU_FIELDS)})")
-    for k in ("gears", "start_gear", "commands", "torque_input", "clutch_input", "torque"):
-        if k not in table:
-            raise ParameterError(f"{src}: [tcu]: missing field {k!r}")
+    _check_table(table, "tcu", TCU_FIELDS, ("gears", "start_gear", "commands", "torque_input", "clutch_input",
+                                           "torque"), src)
     synchros = {e.name for e in d.elements if e.kind == "synchronizer"}
     out = {}
     for k, v in table.items():
@@ -662,14 +669,7 @@ def _shift(table, d: Driveline, src: str):
 
     if table is None:
         return None
-    if not isinstance(table, dict):
-        raise ParameterError(f"{src}: [shift] must be a table (offgoing, oncoming, output, ...)")
-    for k in table:
-        if k not in SHIFT_FIELDS:
-            raise ParameterError(f"{src}: shift.{k}: unknown field (known: {', '.join(SHIFT_FIELDS)})")
-    for k in ("offgoing", "oncoming", "output"):
-        if k not in table:
-            raise ParameterError(f"{src}: [shift]: missing field {k!r}")
+    _check_table(table, "shift", SHIFT_FIELDS, ("offgoing", "oncoming", "output"), src)
     friction, bodies = set(d.friction_names), set(d.inertia_names)
     out = {}
     for k, v in table.items():
