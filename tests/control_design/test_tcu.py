@@ -159,6 +159,29 @@ def test_the_controller_never_closes_the_clutch_onto_neutral_whatever_the_comman
     assert np.abs(df["energy_error_J"]).max() < 1e-6 * df["input_work_J"].abs().max()
 
 
+def test_each_shift_of_a_run_is_listed_and_measured_with_its_own_synchronisers(amt):
+    """``AmtController.shifts``: one row per shift (its command, its return to drive, the gears and synchronisers it
+    leaves and selects; a shift the run cut short has no end); ``AmtController.shift_quality``: each shift that ended,
+    measured on the record between its neighbours with its own synchronisers and its command as its start (the
+    upshift's equals ``shift_quality`` on the record up to the downshift); the shift's own names are refused."""
+    tcu = _tcu([(0.4, 2), (2.2, 1)])
+    cols = ["clutch.tau", "clutch.w_rel", "s1.tau", "s1.w_rel", "s2.tau", "s2.w_rel", "wheels.w", "engine.w"]
+    res = closed_loop(amt, tcu, H, 2.6, measure=list(tcu.measured) + cols, actuate=list(tcu.actuated))
+    shifts = tcu.shifts
+    assert list(shifts.columns) == ["start_s", "end_s", "from_gear", "to_gear", "offgoing", "oncoming"]
+    assert shifts[["start_s", "from_gear", "to_gear", "offgoing", "oncoming"]].values.tolist() == [
+        [0.4, 1, 2, "s1", "s2"], [2.2, 2, 1, "s2", "s1"]]
+    assert shifts.end_s[0] == pytest.approx(1.33, abs=1e-12) and math.isnan(shifts.end_s[1])   # (cut at 2.6 s)
+    how = dict(clutch="clutch", output="wheels", engine="engine", radius=0.3)
+    (up,) = tcu.shift_quality(res.frame, **how)
+    ref = shift_quality(res.frame[res.frame.time_s < 2.2], offgoing="s1", oncoming="s2", start=0.4, **how)
+    assert up.metrics == ref.metrics and (up.start_s, up.lockup_s, up.end_s) == (ref.start_s, ref.lockup_s, ref.end_s)
+    with pytest.raises(ParameterError, match="offgoing, start come from each shift"):
+        tcu.shift_quality(res.frame, offgoing="s1", start=0.4, **how)
+    with pytest.raises(ParameterError, match="give clutch"):
+        tcu.shift_quality(res.frame, output="wheels")
+
+
 def test_a_synchronisation_that_cannot_finish_stops_the_run(amt):
     with pytest.raises(SimulationError, match=r"s2 has not engaged gear 2 within sync_timeout = 0\.2 s of the push"):
         _run(amt, _tcu([(0.4, 2)], fork_force=5.0, sync_timeout=0.2), 2.0)
@@ -200,10 +223,16 @@ def test_the_file_s_controller_runs_from_the_command_line_as_the_python_one(amt,
     quality from its [shift] table (the record up to the downshift's command); nothing is overwritten without
     --force."""
     out, phases, events = tmp_path / "run.csv", tmp_path / "phases.csv", tmp_path / "events.csv"
-    argv = ["control", "tcu", str(EXAMPLE), "-o", str(out), "--phases", str(phases), "--events", str(events)]
+    quality = tmp_path / "quality.json"
+    argv = ["control", "tcu", str(EXAMPLE), "-o", str(out), "--phases", str(phases), "--events", str(events),
+            "--quality", str(quality)]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert "13 phases of AmtController" in printed and "upshift (interrupted) from 0.4000 s" in printed
+    assert "downshift (interrupted) from 2.2000 s" in printed   # (every shift's quality, its own synchronisers)
+    report = __import__("json").loads(quality.read_text())
+    assert [(q["order"], q["start_s"], q["columns"]["offgoing"], q["columns"]["oncoming"]) for q in report] == [
+        ("upshift", 0.4, "s1", "s2"), ("downshift", 2.2, "s2", "s1")]
     tcu = _tcu([(0.4, 2), (2.2, 1)])
     res = _run(amt, tcu, 3.5)
     got = pd.read_csv(phases)

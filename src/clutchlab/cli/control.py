@@ -145,14 +145,16 @@ def register(subparsers) -> None:
                                      "controller (AmtController in Python): its gear command carried out as "
                                      "the shift sequence (torque down, clutch open, neutral, synchronise, clutch "
                                      "closed), waiting on the synchronisers, in the loop with the network at its "
-                                     "sample time. Prints the phases and, with a [shift] table, the first shift's "
-                                     "quality (the record up to the next shift's command).",
+                                     "sample time. Prints the phases and, with a [shift] table (the clutch, the "
+                                     "output, the engine, the radius), every shift's quality.",
                          epilog="Documentation: docs/control.md (A transmission controller for the AMT)")
     tcu.add_argument("source", help="driveline description (.toml) with a [tcu] table")
     tcu.add_argument("-o", "--output", dest="write", default=None,
                      help="the run at the controller's samples (.csv): every state and output, and the inputs it set")
     tcu.add_argument("--events", default=None, help="the network's events (.csv): time_s, event, element")
     tcu.add_argument("--phases", default=None, help="the controller's phases (.csv): time_s, phase, gear")
+    tcu.add_argument("--quality", default=None, help="every shift's quality (.json: a list, as control shift's); "
+                                                     "needs a [shift] table")
     tcu.add_argument("--t-end", default=None, help="end time, e.g. '3 s' (default: [simulation] t_end)")
     tcu.add_argument("--force", action="store_true", help="overwrite the files")
     tcu.set_defaults(func=_tcu)
@@ -466,18 +468,22 @@ def _shift(args) -> int:
 
 def _tcu(args) -> int:
     """``control tcu``: a driveline's gear command carried out by its [tcu] table's controller, in the loop."""
+    import json
+
     from ..control.loop import closed_loop
     from ..control.tcu import SAMPLE_TIME, AmtController
     from ..driveline.description import load_driveline
-    from ..driveline.shift import shift_quality
-    from ..io.files import OutputSet, atomic_to_csv
+    from ..io.files import OutputSet, atomic_to_csv, atomic_write_text
     from ..units import to_si
 
-    for flag, path in (("-o", args.write), ("--events", args.events), ("--phases", args.phases)):
-        if path is not None and not path.lower().endswith(".csv"):
-            raise ParameterError(f"{flag} {path}: expected a .csv file")
-    outputs = OutputSet([args.write, args.events, args.phases], args.force)   # checked before the run
+    for flag, path, end in (("-o", args.write, ".csv"), ("--events", args.events, ".csv"),
+                            ("--phases", args.phases, ".csv"), ("--quality", args.quality, ".json")):
+        if path is not None and not path.lower().endswith(end):
+            raise ParameterError(f"{flag} {path}: expected a {end} file")
     spec = load_driveline(args.source)
+    if args.quality is not None and spec.shift is None:
+        raise ParameterError(f"{args.source}: --quality needs a [shift] table (its clutch, output, engine, radius)")
+    outputs = OutputSet([args.write, args.events, args.phases, args.quality], args.force)   # checked before the run
     if spec.tcu is None:
         raise ParameterError(f"{args.source}: no [tcu] table (the controller's gears, start_gear, commands, "
                              "torque_input, clutch_input, torque: docs/control.md)")
@@ -494,11 +500,10 @@ def _tcu(args) -> int:
                       measure=[*controller.measured, *record], actuate=list(controller.actuated),
                       max_step=spec.max_step)
     phases = controller.phases
-    quality = None
-    if spec.shift is not None:   # the first shift's: the record up to the next shift's command
-        starts = phases.time_s[phases.phase == "torque_down"].to_numpy()
-        frame = res.frame if starts.size < 2 else res.frame[res.frame.time_s < starts[1]]
-        quality = shift_quality(frame, **spec.shift)
+    qualities = []
+    if spec.shift is not None:   # every shift's, with its own synchronisers and start ([shift]: the rest)
+        qualities = controller.shift_quality(res.frame, **{k: v for k, v in spec.shift.items()
+                                                            if k not in ("offgoing", "oncoming", "start")})
     with outputs:
         if args.write is not None:
             atomic_to_csv(res.frame, outputs.staged(args.write), overwrite=args.force)
@@ -506,11 +511,14 @@ def _tcu(args) -> int:
             atomic_to_csv(res.events, outputs.staged(args.events), overwrite=args.force)
         if args.phases is not None:
             atomic_to_csv(phases, outputs.staged(args.phases), overwrite=args.force)
+        if args.quality is not None:
+            atomic_write_text(outputs.staged(args.quality), json.dumps([q.to_dict() for q in qualities], indent=1,
+                                                                       allow_nan=False), overwrite=args.force)
     print(f"{args.source}: {len(phases)} phases of {controller.__class__.__name__}")
     for t, phase, gear in zip(phases.time_s, phases.phase, phases.gear):
         print(f"  {t:9.4f} s  {phase:<13s} gear {gear}")
-    if quality is not None:
-        print(quality)
+    for q in qualities:
+        print(q)
     return 0
 
 

@@ -172,6 +172,53 @@ class AmtController:
         t, p, g = zip(*self._log)
         return pd.DataFrame({"time_s": np.array(t, dtype=float), "phase": list(p), "gear": list(g)})
 
+    @property
+    def shifts(self) -> pd.DataFrame:
+        """The shifts of the last run, one row each: ``start_s`` (its ``torque_down``), ``end_s`` (back in
+        ``drive``; NaN where the run ended first), ``from_gear``, ``to_gear``, and the ``offgoing`` and
+        ``oncoming`` synchronisers."""
+        rows, current = [], None
+        for t, phase, gear in self._log:
+            if phase == "torque_down":
+                current = [t, math.nan, rows[-1][3] if rows else self.start_gear, gear]
+                rows.append(current)
+            elif phase == "drive" and current is not None:
+                current[1] = t
+        return pd.DataFrame({"start_s": [r[0] for r in rows], "end_s": [r[1] for r in rows],
+                             "from_gear": [r[2] for r in rows], "to_gear": [r[3] for r in rows],
+                             "offgoing": [self.gears[r[2]].synchronizer for r in rows],
+                             "oncoming": [self.gears[r[3]].synchronizer for r in rows]})
+
+    def shift_quality(self, frame, **options) -> list:
+        """The quality of each shift of the last run that ended (:func:`clutchlab.control.shift_quality`, an
+        interrupted shift): ``frame`` the loop's record (:attr:`~clutchlab.control.ClosedLoopResult.frame` with the
+        columns the metrics read: the clutch's and the two synchronisers' ``tau`` and ``w_rel``, the output's and
+        the engine's speeds), ``options`` the function's (``clutch``, ``output``, ``engine``, ``radius``,
+        ``threshold``, ``settle``, ...; a driveline file's ``[shift]`` table).  Each shift is read on the record
+        from the end of the one before (the start) to the start of the next (the end), with its own synchronisers
+        and its command as its start.  Returns a list of :class:`~clutchlab.control.ShiftQuality`, one per shift
+        in :attr:`shifts` that ended."""
+        from ..driveline.shift import shift_quality
+
+        own = [k for k in ("offgoing", "oncoming", "start") if k in options]
+        if own:
+            raise ParameterError(f"AmtController.shift_quality: {', '.join(own)} come from each shift; leave them "
+                                 "out")
+        if "clutch" not in options:
+            raise ParameterError("AmtController.shift_quality: give clutch, the main clutch's element (its torque "
+                                 "and slip columns)")
+        shifts = self.shifts
+        t = np.asarray(frame["time_s"], dtype=float)
+        out = []
+        for k, row in shifts.iterrows():
+            if math.isnan(row.end_s):
+                continue
+            lo = shifts.end_s.iloc[k - 1] if k else -math.inf
+            hi = shifts.start_s.iloc[k + 1] if k + 1 < len(shifts) else math.inf
+            out.append(shift_quality(frame[(t >= lo) & (t < hi)], offgoing=row.offgoing, oncoming=row.oncoming,
+                                     start=row.start_s, **options))
+        return out
+
     def __call__(self, t: float, y, memory=None):
         """The inputs :attr:`actuated` at sample time ``t`` [s] from the measured modes ``y`` (:attr:`measured`
         first)."""
