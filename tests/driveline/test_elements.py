@@ -6,7 +6,9 @@ arcs, energy integrals computed by SciPy's adaptive quadrature), not from the pa
 
 from __future__ import annotations
 
+import copy
 import math
+import pickle
 import tomllib
 
 import numpy as np
@@ -725,6 +727,9 @@ def test_the_listing_gives_each_element_s_arguments_and_each_body_s():
                                  "temperature": None, "mu_scale": 1.0, "mu_temperature": None}
     with pytest.raises(TypeError):
         c.arguments["mu"] = 0.3
+    # the network and its listing pickle and copy (a sweep's workers, a user's cache): the arguments are plain data
+    again = pickle.loads(pickle.dumps(d))
+    assert again.elements == d.elements and again.inertias == d.inertias and copy.deepcopy(d).elements == d.elements
     assert [(b.name, b.kind, dict(b.arguments)) for b in d.inertias] == [
         ("J1", "inertia", {"J": 1.0, "w0": 10.0, "phi0": None}), ("J2", "inertia", {"J": 2.0, "w0": None, "phi0": None}),
         ("H", "inertia", {"J": 5.0, "w0": None, "phi0": None})]

@@ -25,7 +25,7 @@ import inspect
 import math
 import pickle
 import sys
-import types
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,7 +39,7 @@ from ..system import System, register_model, simulate as _simulate, start_checks
 from . import kernel as K
 
 
-__all__ = ["Driveline", "Signal", "GROUND", "ElementInfo", "InertiaInfo"]
+__all__ = ["Driveline", "Signal", "GROUND", "ElementInfo", "InertiaInfo", "Arguments"]
 
 GROUND = "ground"
 
@@ -586,6 +586,34 @@ class _ThermalLink:
     conductance: float   # [W/K]
 
 
+class Arguments(Mapping):
+    """The arguments of the call that added an element or a body (:attr:`ElementInfo.arguments`,
+    :attr:`InertiaInfo.arguments`): a read-only mapping of the method's parameter names to the values given (a copy;
+    picklable, as the network is)."""
+
+    __slots__ = ("_values",)
+
+    def __init__(self, values=()):
+        self._values = dict(values)
+
+    def __getitem__(self, key):
+        return self._values[key]
+
+    def __iter__(self):
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __eq__(self, other):
+        return dict(self._values) == dict(other) if isinstance(other, Mapping) else NotImplemented
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"Arguments({self._values!r})"
+
+
 @dataclass(frozen=True)
 class ElementInfo:
     """One element of a :class:`Driveline`, as :attr:`Driveline.elements` lists it (a read-only view).
@@ -608,7 +636,7 @@ class ElementInfo:
     flange_b: str
     support: str | None
     summary: str
-    arguments: types.MappingProxyType = field(default_factory=lambda: types.MappingProxyType({}), hash=False)
+    arguments: Arguments = field(default_factory=Arguments, hash=False)
 
 
 @dataclass(frozen=True)
@@ -620,7 +648,7 @@ class InertiaInfo:
 
     name: str
     kind: str
-    arguments: types.MappingProxyType = field(default_factory=lambda: types.MappingProxyType({}), hash=False)
+    arguments: Arguments = field(default_factory=Arguments, hash=False)
 
 
 def _converter_table(name, key, rows, ncol):
@@ -663,7 +691,7 @@ def _adds(kind: str):
                 signature.append(inspect.signature(method))
             bound = signature[0].bind(self, *args, **kwargs)
             bound.apply_defaults()
-            call = (method.__name__, types.MappingProxyType(dict(list(bound.arguments.items())[1:])))
+            call = (method.__name__, dict(list(bound.arguments.items())[1:]))
             for e in self._elements[n:]:
                 e.kind_name = kind
                 e.call = call
@@ -2177,8 +2205,7 @@ class Driveline:
     def _arguments(e):
         """The public arguments of the call that added element ``e`` (:attr:`ElementInfo.arguments`): its name and
         the flanges :class:`ElementInfo` names are left out."""
-        return types.MappingProxyType({k: v for k, v in e.call[1].items() if k not in _PLACES}) if e.call \
-            else types.MappingProxyType({})
+        return Arguments({k: v for k, v in e.call[1].items() if k not in _PLACES} if e.call else {})
 
     def _labels(self) -> tuple:
         """The argument names of a body: :meth:`inertia`'s or :meth:`mass`'s."""
@@ -2190,7 +2217,7 @@ class Driveline:
         vector), each an :class:`InertiaInfo` (name, ``"inertia"`` or ``"mass"``, its arguments): a read-only view;
         :meth:`replace` changes one in a copy."""
         kind = "inertia" if self.domain == "rotational" else "mass"
-        return tuple(InertiaInfo(n, kind, types.MappingProxyType(dict(zip(self._labels(), v))))
+        return tuple(InertiaInfo(n, kind, Arguments(zip(self._labels(), v)))
                      for n, v in self._inertias.items())
 
     def signal(self, name: str):
