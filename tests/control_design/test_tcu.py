@@ -202,6 +202,7 @@ def test_a_command_of_the_gear_engaged_is_no_shift_and_a_new_run_starts_again(am
     (dict(start_gear=3), r"start_gear = 3 is not among the gears \[1, 2\]"),
     (dict(commands=[(0.4, 5)]), r"the command at 0\.4 s selects gear 5"),
     (dict(commands=[0.4]), r"a command 0\.4 must be \(time \[s\], gear\)"),
+    (dict(commands=[("soon", 2)]), r"the command \('soon', 2\): its time must be a finite number"),
     (dict(drag=10.0), r"drag = 10\.0 finite and <= 0"),
     (dict(clutch_open=0.0), r"clutch_open = 0\.0 must be finite and > 0"),
     (dict(fork_force=float("nan")), r"fork_force = nan must be finite and > 0"),
@@ -259,6 +260,8 @@ def test_the_file_s_controller_runs_from_the_command_line_as_the_python_one(amt,
     (lambda t: t.update(commands=[["0.4 kg", 2]]), r"tcu\.commands\[0\]"),
     (lambda t: t.update(clutch_input="throttle"), r"tcu\.clutch_input = 'throttle': expected a network input"),
     (lambda t: t.update(fork_force="600 N m"), r"tcu\.fork_force"),
+    (lambda t: t["gears"]["1"].update(synchronizer=["s1"]), r"tcu\.gears\.1\.synchronizer = \['s1'\]: expected a "),
+    (lambda t: t.update(sample_time="0 ms"), r"tcu\.sample_time = '0 ms': must be > 0"),
 ])
 def test_a_bad_tcu_table_is_refused_naming_the_file_and_the_field(edit, message, tmp_path, capsys):
     doc = tomllib.loads(EXAMPLE.read_text())

@@ -117,9 +117,13 @@ class AmtController:
             if g not in self.gears:
                 raise ParameterError(f"AmtController: the command at {t!r} s selects gear {g!r}, not among the "
                                      f"gears {sorted(self.gears)}")
-            if not math.isfinite(float(t)):
-                raise ParameterError(f"AmtController: a command's time {t!r} must be finite")
-            cmds.append((float(t), g))
+            try:
+                t = float(t)
+            except (TypeError, ValueError):
+                t = math.nan
+            if not math.isfinite(t):
+                raise ParameterError(f"AmtController: the command {entry!r}: its time must be a finite number [s]")
+            cmds.append((t, g))
         self.commands = tuple(sorted(cmds, key=lambda c: c[0]))
         self.clutch_input, self.torque_input = str(clutch_input), str(torque_input)
         self.torque = float(torque)

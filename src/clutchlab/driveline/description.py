@@ -634,7 +634,7 @@ def _tcu(table, d: Driveline, src: str):
                         or not {"synchronizer", "fork"} <= set(spec):
                     raise ParameterError(f"{src}: {where} must be {{ synchronizer = ..., fork = ..., side = 1 or -1 "
                                          "}")
-                if spec["synchronizer"] not in synchros:
+                if not isinstance(spec["synchronizer"], str) or spec["synchronizer"] not in synchros:
                     raise ParameterError(f"{src}: {where}.synchronizer = {spec['synchronizer']!r}: expected a "
                                          f"synchronizer of the network ({', '.join(sorted(synchros)) or 'none'})")
                 if spec["fork"] not in d.inputs:
@@ -659,6 +659,8 @@ def _tcu(table, d: Driveline, src: str):
             out[k] = v
         else:
             out[k] = _quantity(v, kind, key, src)
+    if not out.get("sample_time", 1.0) > 0.0:
+        raise ParameterError(f"{src}: tcu.sample_time = {table['sample_time']!r}: must be > 0 [s]")
     return out
 
 
