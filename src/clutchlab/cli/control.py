@@ -471,7 +471,7 @@ def _tcu(args) -> int:
     import json
 
     from ..control.loop import closed_loop
-    from ..control.tcu import SAMPLE_TIME, AmtController
+    from ..control.tcu import SAMPLE_TIME, SHIFT_OWN, AmtController
     from ..driveline.description import load_driveline
     from ..io.files import OutputSet, atomic_to_csv, atomic_write_text
     from ..units import to_si
@@ -503,7 +503,7 @@ def _tcu(args) -> int:
     qualities = []
     if spec.shift is not None:   # every shift's, with its own synchronisers and start ([shift]: the rest)
         qualities = controller.shift_quality(res.frame, **{k: v for k, v in spec.shift.items()
-                                                            if k not in ("offgoing", "oncoming", "start")})
+                                                            if k not in SHIFT_OWN})
     with outputs:
         if args.write is not None:
             atomic_to_csv(res.frame, outputs.staged(args.write), overwrite=args.force)

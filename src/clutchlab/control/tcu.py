@@ -25,12 +25,15 @@ import pandas as pd
 
 from ..errors import ParameterError, SimulationError
 
-__all__ = ["AmtGear", "AmtController", "PHASES", "SAMPLE_TIME"]
+__all__ = ["AmtGear", "AmtController", "PHASES", "SAMPLE_TIME", "SHIFT_OWN"]
 
 #: the controller's phases, in the order of a shift (``drive`` between shifts)
 PHASES = ("drive", "torque_down", "clutch_open", "neutral", "synchronise", "clutch_close")
 #: the controller's sample time [s] where a driveline file's ``[tcu]`` table gives none
 SAMPLE_TIME = 1e-3
+#: what each shift of a run gives :func:`~clutchlab.control.shift_quality` itself (:meth:`AmtController.shift_quality`):
+#: a file's ``[shift]`` table's values of these are left out for it
+SHIFT_OWN = ("offgoing", "oncoming", "start")
 #: a synchroniser's modes as its ``<name>.mode`` output gives them (MSL's values, 2 for free)
 _ENGAGED, _FREE = 0.0, 2.0
 
@@ -204,7 +207,7 @@ class AmtController:
         in :attr:`shifts` that ended."""
         from ..driveline.shift import shift_quality
 
-        own = [k for k in ("offgoing", "oncoming", "start") if k in options]
+        own = [k for k in SHIFT_OWN if k in options]
         if own:
             raise ParameterError(f"AmtController.shift_quality: {', '.join(own)} come from each shift; leave them "
                                  "out")
