@@ -395,6 +395,10 @@ def check_amt_tcu(work, out):
     assert np.allclose(ratio[in2nd], 2.0, rtol=1e-8) and np.isclose(ratio.iloc[-1], 3.5, rtol=1e-8)
     assert set(run.fork_N[in2nd]) == {-600.0} and run.clutch_command_1.iloc[-1] == 1.0
     assert "upshift (interrupted) from 0.4000 s" in out   # the file's [shift]: the first shift's quality
+    closes = run.set_index(np.round(run.time_s * 1e3).astype(int)).loc[round(phases.time_s[11] * 1e3)]
+    # (the downshift's blip: the engine at 1st's speed when the clutch closes, at 3.5 times the output shaft's)
+    assert abs(closes["engine.w_rad_s"] - 3.5 * closes["output_shaft.w_rad_s"]) < 10.0
+    assert run.torque_command_Nm.max() == 250.0
 
 
 def check_lin(work, out):

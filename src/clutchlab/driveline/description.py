@@ -194,9 +194,10 @@ class DrivelineFile:
 #: time): name -> unit of a quantity, or the kind of a value that is not one
 TCU_FIELDS = {"gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
               "clutch_input": "input", "torque": "N*m", "drag": "N*m", "fork_force": "N", "torque_down": "s",
-              "clutch_open": "s", "fork_ramp": "s", "clutch_close": "s", "sync_timeout": "s", "sample_time": "s"}
+              "clutch_open": "s", "fork_ramp": "s", "clutch_close": "s", "sync_timeout": "s", "sample_time": "s",
+              "speed_match": "N*m*s/rad", "engine_speed": "variable", "output_speed": "variable", "torque_max": "N*m"}
 #: the fields of one gear of a ``[tcu]`` table's ``gears``
-TCU_GEAR_FIELDS = ("synchronizer", "fork", "side")
+TCU_GEAR_FIELDS = ("synchronizer", "fork", "side", "ratio")
 
 
 def _quantity(value, unit, key, src):
@@ -613,7 +614,8 @@ def _gear_number(value, key, src):
 def _tcu(table, d: Driveline, src: str):
     """The ``[tcu]`` table: the keyword arguments of :class:`clutchlab.control.AmtController` for the network's gear
     command and its ``sample_time`` (names checked against the network: the gears' synchronisers, the network inputs
-    it sets; quantities in SI), or None without one.  The controller checks the rest as it is built."""
+    it sets, the speeds its speed matching reads; quantities in SI; a gear as ``(synchronizer, fork, side, ratio)``),
+    or None without one.  The controller checks the rest as it is built."""
     if table is None:
         return None
     _check_table(table, "tcu", TCU_FIELDS, ("gears", "start_gear", "commands", "torque_input", "clutch_input",
@@ -643,7 +645,13 @@ def _tcu(table, d: Driveline, src: str):
                 side = spec.get("side", 1)
                 if side not in (1, -1) or isinstance(side, bool):
                     raise ParameterError(f"{src}: {where}.side = {side!r}: expected 1 or -1")
-                gears[number] = (spec["synchronizer"], spec["fork"], int(side))
+                ratio = spec.get("ratio")
+                if ratio is not None:
+                    ratio = _quantity(ratio, "1", f"{where}.ratio", src)
+                    if ratio == 0.0:
+                        raise ParameterError(f"{src}: {where}.ratio = {spec['ratio']!r}: expected the gear's ratio "
+                                             "(the clutch's driven speed over the output speed), not 0")
+                gears[number] = (spec["synchronizer"], spec["fork"], int(side), ratio)
             out[k] = gears
         elif kind == "gear":
             out[k] = _gear_number(v, key, src)
@@ -653,9 +661,16 @@ def _tcu(table, d: Driveline, src: str):
             out[k] = [(_quantity(t, "s", f"{key}[{i}]", src), _gear_number(g, f"{key}[{i}]", src))
                       for i, (t, g) in enumerate(v)]
         elif kind == "input":
-            if v not in d.inputs:
+            if not isinstance(v, str) or v not in d.inputs:
                 raise ParameterError(f"{src}: {key} = {v!r}: expected a network input ([input.NAME]: "
                                      f"{', '.join(d.inputs) or 'none'})")
+            out[k] = v
+        elif kind == "variable":
+            states, outputs = d.variables()
+            if not isinstance(v, str) or v not in {name for name, *_ in (*states, *outputs)}:
+                speeds = ", ".join(name for name, unit, _ in states if unit in ("rad_s", "m_s"))
+                raise ParameterError(f"{src}: {key} = {v!r}: expected a state or output of the network, a speed "
+                                     f"({speeds or 'none'})")
             out[k] = v
         else:
             out[k] = _quantity(v, kind, key, src)
