@@ -646,6 +646,14 @@ def test_the_energy_balance_at_events_follows_the_tolerance():
 # (the strategy: driveline_networks.networks, shared with test_inputs.py)
 
 
+#: how far an element's sampled ``dissipated_J`` may step back between samples, of the run's energy scale: it is the
+#: integral of a loss >= 0 (checked at the samples), integrated as a state within its absolute tolerance (rtol J),
+#: and Dormand-Prince's fifth weight is negative, so a step whose true increment is below that error may come out
+#: below zero (a converter's impeller held by a bearing, its turbine starting from rest: -1.19e-9 J at rtol 1e-9,
+#: the thorough profile's seed 1200)
+DISSIPATION_STEP_BACK = 1e-7
+
+
 def _check_columns(d, df, events=None):
     """The invariants from the sampled columns, by code independent of the kernel's check (a sample at an event's
     instant, a source's jump, holds the modes before they settle there: left out)."""
@@ -657,7 +665,7 @@ def _check_columns(d, df, events=None):
     for name in (c.removesuffix(".speed_ratio_1") for c in df.columns if c.endswith(".speed_ratio_1")):
         # a torque converter generates no power, and its turbine's torque has the impeller's sign while it drives
         assert df[f"{name}.loss_power_W"].min() >= -1e-9 * scale, name
-        assert np.all(np.diff(df[f"{name}.dissipated_J"].to_numpy()) >= -1e-9 * scale), name
+        assert np.all(np.diff(df[f"{name}.dissipated_J"].to_numpy()) >= -DISSIPATION_STEP_BACK * scale), name
         drive = ((df[f"{name}.speed_ratio_1"] >= 0.0) & (df[f"{name}.speed_ratio_1"] < 1.0)).to_numpy()
         assert np.all(df[f"{name}.tau_Nm"].to_numpy()[drive] * df[f"{name}.tau_b_Nm"].to_numpy()[drive] <= 0.0), name
     for e in d.elements:
@@ -669,7 +677,7 @@ def _check_columns(d, df, events=None):
             w = df[f"{e.flange_a}.w_rad_s"].to_numpy() - (df[f"{e.support}.w_rad_s"].to_numpy()
                                                           if e.support not in (None, GROUND) else 0.0)
             loss_rate = np.diff(df[f"{e.name}.dissipated_J"].to_numpy())
-            assert np.all(loss_rate >= -1e-7 * scale), e.name
+            assert np.all(loss_rate >= -DISSIPATION_STEP_BACK * scale), e.name
         else:
             w = df[f"{e.name}.w_rel_rad_s"].to_numpy()
             tq = df[f"{e.name}.tau_Nm"].to_numpy()
