@@ -17,7 +17,8 @@ model (E-clutch, wet clutch, EMTC bench, driveline networks) and for a user's ow
   dip, jerk, vibration dose value, lock-up slip rate, engine flare, the clutches' heat) in a run or a rig's record;
 * :func:`closed_loop` -- a discrete controller (python-control or a function) in the loop with any model;
   :class:`AmtController` -- an automated manual transmission's controller (TCU): a gear command carried out by the
-  shift sequence, waiting on the synchronisers;
+  shift sequence, waiting on the synchronisers; :class:`DctController` -- a dual-clutch transmission's: power
+  shifts, the off-going clutch released where the on-coming one has taken the torque over;
 * :func:`pi_for_phase_margin`, :class:`ScheduledPI` -- a PI for a phase margin, gain scheduling;
 * :func:`time_steps`, :func:`fixed_step_error` -- fixed-step (HIL frame) runs: wall time per frame and
   the error against the adaptive solution (``simulate(..., fixed_step=1e-3)`` runs the core's fixed-step
@@ -34,7 +35,7 @@ __all__ = ["OperatingPoint", "operating_point", "linearize", "nonlinear_iosystem
            "loop_margins", "write_linear_model", "OperatingPointError", "closed_loop", "ClosedLoopResult", "PI",
            "pi_for_phase_margin", "ScheduledPI", "time_steps", "fixed_step_error", "judder_modes", "JudderModes",
            "judder_timeline", "friction_damping", "oscillation", "Oscillation", "reduced_matrices", "shift_quality",
-           "ShiftQuality", "AmtController", "AmtGear"]
+           "ShiftQuality", "AmtController", "AmtGear", "DctController", "DctGear"]
 
 _WHERE = {
     "OperatingPoint": "clutchlab.trim",
@@ -58,6 +59,8 @@ _WHERE = {
     "ShiftQuality": "clutchlab.driveline.shift",
     "AmtController": "clutchlab.control.tcu",
     "AmtGear": "clutchlab.control.tcu",
+    "DctController": "clutchlab.control.dct",
+    "DctGear": "clutchlab.control.dct",
     "closed_loop": "clutchlab.control.loop",
     "ClosedLoopResult": "clutchlab.control.loop",
     "PI": "clutchlab.control.design",

@@ -25,7 +25,7 @@ import pandas as pd
 
 from ..errors import ParameterError, SimulationError
 
-__all__ = ["AmtGear", "AmtController", "PHASES", "SAMPLE_TIME", "SHIFT_OWN"]
+__all__ = ["AmtGear", "AmtController", "GearCommand", "PHASES", "SAMPLE_TIME", "SHIFT_OWN"]
 
 #: the controller's phases, in the order of a shift (``drive`` between shifts)
 PHASES = ("drive", "torque_down", "clutch_open", "neutral", "synchronise", "clutch_close")
@@ -75,7 +75,137 @@ def _positive(name, value, zero=False):
     return v
 
 
-class AmtController:
+class GearCommand:
+    """What a transmission controller of :mod:`clutchlab.control` shares (:class:`AmtController`,
+    :class:`~clutchlab.control.dct.DctController`): its gear command, the log of its phases by name, its shifts and
+    their quality, and the call of a function controller of :func:`~clutchlab.control.closed_loop`.  A subclass
+    gives ``gears`` (``{number: gear}``), ``start_gear``, :attr:`measured`, :attr:`actuated`, ``_read`` (the
+    measured values of a sample), ``_advance`` (the phase changes at a sample), ``_outputs`` (the inputs it sets)
+    and ``_element`` (a gear's shifting element, named in :attr:`shifts`)."""
+
+    #: the phases of its shifts, ``drive`` first (between shifts)
+    PHASES: tuple = ("drive",)
+
+    def _commands(self, commands) -> tuple:
+        """The gear command as ``((time [s], gear), ...)`` in time order, checked against the gears."""
+        who = type(self).__name__
+        cmds = []
+        for entry in commands:
+            try:
+                t, g = entry
+            except (TypeError, ValueError):
+                raise ParameterError(f"{who}: a command {entry!r} must be (time [s], gear)") from None
+            if g not in self.gears:
+                raise ParameterError(f"{who}: the command at {t!r} s selects gear {g!r}, not among the gears "
+                                     f"{sorted(self.gears)}")
+            try:
+                t = float(t)
+            except (TypeError, ValueError):
+                t = math.nan
+            if not math.isfinite(t):
+                raise ParameterError(f"{who}: the command {entry!r}: its time must be a finite number [s]")
+            cmds.append((t, g))
+        return tuple(sorted(cmds, key=lambda c: c[0]))
+
+    def _reset(self):
+        self._gear, self._target = self.start_gear, None
+        self._phase, self._since = "drive", 0.0
+        self._next = 0       # the next command to take
+        self._last = -math.inf
+        self._log = [(0.0, "drive", self.start_gear)]
+
+    def _enter(self, phase, t):
+        self._phase, self._since = phase, t
+        self._log.append((t, phase, self._target if self._target is not None else self._gear))
+
+    def _command(self, t):
+        """The gear of the next command due at ``t`` that selects another gear (those that select the gear engaged
+        are taken and dropped), or None."""
+        while self._next < len(self.commands) and self.commands[self._next][0] <= t:
+            _, g = self.commands[self._next]
+            self._next += 1
+            if g != self._gear:
+                return g
+        return None
+
+    @property
+    def phases(self) -> pd.DataFrame:
+        """The phases entered in the last run: ``time_s``, ``phase`` (:attr:`PHASES`) and ``gear`` (the gear
+        selected: the one a shift goes to, from its first phase on)."""
+        t, p, g = zip(*self._log)
+        return pd.DataFrame({"time_s": np.array(t, dtype=float), "phase": list(p), "gear": list(g)})
+
+    @property
+    def shifts(self) -> pd.DataFrame:
+        """The shifts of the last run, one row each: ``start_s`` (its command: its first phase), ``end_s`` (back in
+        ``drive``; NaN where the run ended first), ``from_gear``, ``to_gear``, and the ``offgoing`` and
+        ``oncoming`` elements (an AMT's synchronisers, a dual-clutch transmission's clutches)."""
+        rows, current, before = [], None, "drive"
+        for t, phase, gear in self._log:
+            if phase != "drive" and before == "drive":
+                current = [t, math.nan, rows[-1][3] if rows else self.start_gear, gear]
+                rows.append(current)
+            elif phase == "drive" and current is not None:
+                current[1] = t
+            before = phase
+        return pd.DataFrame({"start_s": [r[0] for r in rows], "end_s": [r[1] for r in rows],
+                             "from_gear": [r[2] for r in rows], "to_gear": [r[3] for r in rows],
+                             "offgoing": [self._element(r[2]) for r in rows],
+                             "oncoming": [self._element(r[3]) for r in rows]})
+
+    def _quality_options(self, options) -> None:
+        """Refuse what each shift gives :func:`~clutchlab.control.shift_quality` itself (:data:`SHIFT_OWN`)."""
+        own = [k for k in SHIFT_OWN if k in options]
+        if own:
+            raise ParameterError(f"{type(self).__name__}.shift_quality: {', '.join(own)} come from each shift; leave "
+                                 "them out")
+
+    def shift_quality(self, frame, **options) -> list:
+        """The quality of each shift of the last run that ended (:func:`clutchlab.control.shift_quality`):
+        ``frame`` the loop's record (:attr:`~clutchlab.control.ClosedLoopResult.frame` with the columns the metrics
+        read: the shifting elements' ``tau`` and ``w_rel``, the output's and the engine's speeds), ``options`` the
+        function's (``output``, ``engine``, ``radius``, ``threshold``, ``settle``, ...; a driveline file's
+        ``[shift]`` table).  Each shift is read on the record from the end of the one before (the start) to the
+        start of the next (the end), with its own elements and its command as its start.  Returns a list of
+        :class:`~clutchlab.control.ShiftQuality`, one per shift in :attr:`shifts` that ended."""
+        from ..driveline.shift import shift_quality
+
+        self._quality_options(options)
+        shifts = self.shifts
+        t = np.asarray(frame["time_s"], dtype=float)
+        out = []
+        for k, row in shifts.iterrows():
+            if math.isnan(row.end_s):
+                continue
+            lo = shifts.end_s.iloc[k - 1] if k else -math.inf
+            hi = shifts.start_s.iloc[k + 1] if k + 1 < len(shifts) else math.inf
+            out.append(shift_quality(frame[(t >= lo) & (t < hi)], offgoing=row.offgoing, oncoming=row.oncoming,
+                                     start=row.start_s, **options))
+        return out
+
+    def __call__(self, t: float, y, memory=None):
+        """The inputs :attr:`actuated` at sample time ``t`` [s] from the measured values ``y`` (:attr:`measured`
+        first)."""
+        if t < self._last:
+            self._reset()
+        self._last = t
+        y = np.asarray(y, dtype=float)
+        if y.size < len(self.measured):
+            raise ParameterError(f"{type(self).__name__}: it measures {len(self.measured)} signals first "
+                                 f"({', '.join(self.measured)}); got {y.size}")
+        seen = self._read(t, y)
+        while True:   # (a phase whose condition holds at once hands over within the sample)
+            before = self._phase
+            self._advance(t, seen)
+            if self._phase == before:
+                break
+        return self._outputs(t)
+
+    def _ramp(self, t, duration):
+        return min(max((t - self._since) / duration, 0.0), 1.0)
+
+
+class AmtController(GearCommand):
     """The shift sequence of an AMT's controller, as a function controller ``f(t, y, memory) -> u`` of
     :func:`~clutchlab.control.closed_loop`.
 
@@ -128,6 +258,8 @@ class AmtController:
     shift are :data:`PHASES`.  A new run (a sample at ``t`` below the last one) starts it again from ``start_gear``.
     """
 
+    PHASES = PHASES
+
     def __init__(self, gears: dict, start_gear: int, commands, *, clutch_input: str, torque_input: str,
                  torque: float, drag: float = 0.0, fork_force: float = 600.0, torque_down: float = 0.3,
                  clutch_open: float = 0.07, fork_ramp: float = 0.03, clutch_close: float = 0.4,
@@ -140,23 +272,7 @@ class AmtController:
             raise ParameterError(f"AmtController: start_gear = {start_gear!r} is not among the gears "
                                  f"{sorted(self.gears)}")
         self.start_gear = start_gear
-        cmds = []
-        for entry in commands:
-            try:
-                t, g = entry
-            except (TypeError, ValueError):
-                raise ParameterError(f"AmtController: a command {entry!r} must be (time [s], gear)") from None
-            if g not in self.gears:
-                raise ParameterError(f"AmtController: the command at {t!r} s selects gear {g!r}, not among the "
-                                     f"gears {sorted(self.gears)}")
-            try:
-                t = float(t)
-            except (TypeError, ValueError):
-                t = math.nan
-            if not math.isfinite(t):
-                raise ParameterError(f"AmtController: the command {entry!r}: its time must be a finite number [s]")
-            cmds.append((t, g))
-        self.commands = tuple(sorted(cmds, key=lambda c: c[0]))
+        self.commands = self._commands(commands)
         self.clutch_input, self.torque_input = str(clutch_input), str(torque_input)
         self.torque = float(torque)
         self.drag = float(drag)
@@ -200,46 +316,18 @@ class AmtController:
     def from_table(cls, table: dict) -> "AmtController":
         """The controller of a driveline file's ``[tcu]`` table as its loader reads it
         (:attr:`clutchlab.driveline.description.DrivelineFile.tcu`: SI, gears as ``{number: (synchronizer, fork,
-        side)}``; its ``sample_time`` is the loop's, not the controller's)."""
+        side, ratio)}``, the ratio None where the file gives none; its ``sample_time`` is the loop's, not the
+        controller's)."""
         kw = {k: v for k, v in table.items() if k != "sample_time"}
-        kw["gears"] = {g: AmtGear(*spec) for g, spec in kw["gears"].items()}   # (synchronizer, fork, side[, ratio])
+        kw["gears"] = {g: AmtGear(*spec) for g, spec in kw["gears"].items()}
         return cls(**kw)
 
     def _reset(self):
-        self._gear, self._target = self.start_gear, None
-        self._phase, self._since = "drive", 0.0
-        self._next = 0       # the next command to take
+        super()._reset()
         self._speeds = (0.0, 0.0)   # the engine's and the output speed at the last sample [rad/s] (speed matching)
-        self._last = -math.inf
-        self._log = [(0.0, "drive", self.start_gear)]
 
-    def _enter(self, phase, t):
-        self._phase, self._since = phase, t
-        self._log.append((t, phase, self._target if self._target is not None else self._gear))
-
-    @property
-    def phases(self) -> pd.DataFrame:
-        """The phases entered in the last run: ``time_s``, ``phase`` (:data:`PHASES`) and ``gear`` (the gear
-        selected: the one a shift goes to, from its ``torque_down`` on)."""
-        t, p, g = zip(*self._log)
-        return pd.DataFrame({"time_s": np.array(t, dtype=float), "phase": list(p), "gear": list(g)})
-
-    @property
-    def shifts(self) -> pd.DataFrame:
-        """The shifts of the last run, one row each: ``start_s`` (its ``torque_down``), ``end_s`` (back in
-        ``drive``; NaN where the run ended first), ``from_gear``, ``to_gear``, and the ``offgoing`` and
-        ``oncoming`` synchronisers."""
-        rows, current = [], None
-        for t, phase, gear in self._log:
-            if phase == "torque_down":
-                current = [t, math.nan, rows[-1][3] if rows else self.start_gear, gear]
-                rows.append(current)
-            elif phase == "drive" and current is not None:
-                current[1] = t
-        return pd.DataFrame({"start_s": [r[0] for r in rows], "end_s": [r[1] for r in rows],
-                             "from_gear": [r[2] for r in rows], "to_gear": [r[3] for r in rows],
-                             "offgoing": [self.gears[r[2]].synchronizer for r in rows],
-                             "oncoming": [self.gears[r[3]].synchronizer for r in rows]})
+    def _element(self, gear):
+        return self.gears[gear].synchronizer
 
     def shift_quality(self, frame, **options) -> list:
         """The quality of each shift of the last run that ended (:func:`clutchlab.control.shift_quality`, an
@@ -250,50 +338,21 @@ class AmtController:
         from the end of the one before (the start) to the start of the next (the end), with its own synchronisers
         and its command as its start.  Returns a list of :class:`~clutchlab.control.ShiftQuality`, one per shift
         in :attr:`shifts` that ended."""
-        from ..driveline.shift import shift_quality
-
-        own = [k for k in SHIFT_OWN if k in options]
-        if own:
-            raise ParameterError(f"AmtController.shift_quality: {', '.join(own)} come from each shift; leave them "
-                                 "out")
+        self._quality_options(options)
         if "clutch" not in options:
             raise ParameterError("AmtController.shift_quality: give clutch, the main clutch's element (its torque "
                                  "and slip columns)")
-        shifts = self.shifts
-        t = np.asarray(frame["time_s"], dtype=float)
-        out = []
-        for k, row in shifts.iterrows():
-            if math.isnan(row.end_s):
-                continue
-            lo = shifts.end_s.iloc[k - 1] if k else -math.inf
-            hi = shifts.start_s.iloc[k + 1] if k + 1 < len(shifts) else math.inf
-            out.append(shift_quality(frame[(t >= lo) & (t < hi)], offgoing=row.offgoing, oncoming=row.oncoming,
-                                     start=row.start_s, **options))
-        return out
+        return super().shift_quality(frame, **options)
 
-    def __call__(self, t: float, y, memory=None):
-        """The inputs :attr:`actuated` at sample time ``t`` [s] from the measured modes ``y`` (:attr:`measured`
-        first)."""
-        if t < self._last:
-            self._reset()
-        self._last = t
-        y = np.asarray(y, dtype=float)
-        if y.size < len(self.measured):
-            raise ParameterError(f"AmtController: it measures {len(self.measured)} signals first "
-                                 f"({', '.join(self.measured)}); got {y.size}")
-        mode = {g: y[k] for g, k in self._mode_at.items()}
+    def _read(self, t, y):
+        """The synchronisers' modes by gear (and, matching speeds, the speeds kept)."""
         if self.speed_match:
             n = len(self._mode_at)
             self._speeds = (float(y[n]), float(y[n + 1]))
             if not all(math.isfinite(w) for w in self._speeds):
                 raise SimulationError(f"AmtController: the measured speeds {self.engine_speed} = {self._speeds[0]!r}, "
                                       f"{self.output_speed} = {self._speeds[1]!r} at {t:.6g} s")
-        while True:   # (a phase whose condition holds at once hands over within the sample)
-            before = self._phase
-            self._advance(t, mode)
-            if self._phase == before:
-                break
-        return self._outputs(t)
+        return {g: y[k] for g, k in self._mode_at.items()}
 
     def _match(self):
         """The engine's torque while the clutch is open [N m]: ``drag``, or with ``speed_match`` the torque that
@@ -304,19 +363,13 @@ class AmtController:
         gap = self.gears[self._target].ratio * w_out - w_e
         return min(max(self.speed_match * gap, self.drag), self.torque_max)
 
-    def _ramp(self, t, duration):
-        return min(max((t - self._since) / duration, 0.0), 1.0)
-
     def _advance(self, t, mode):
         phase = self._phase
         if phase == "drive":
-            while self._next < len(self.commands) and self.commands[self._next][0] <= t:
-                _, g = self.commands[self._next]
-                self._next += 1
-                if g != self._gear:
-                    self._target = g
-                    self._enter("torque_down", t)
-                    return
+            g = self._command(t)
+            if g is not None:
+                self._target = g
+                self._enter("torque_down", t)
         elif phase == "torque_down" and self._ramp(t, self.torque_down) >= 1.0:
             self._enter("clutch_open", t)
         elif phase == "clutch_open" and self._ramp(t, self.clutch_open) >= 1.0:
