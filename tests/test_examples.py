@@ -401,6 +401,18 @@ def check_amt_tcu(work, out):
     assert run.torque_command_Nm.max() == 250.0
 
 
+def check_dct_tcu(work, out):
+    run = pd.read_csv(work / "dct_tcu.csv")
+    phases = pd.read_csv(work / "dct_tcu_phases.csv")
+    assert list(phases.phase) == ["drive", "torque_phase", "inertia_phase", "lock", "drive", "inertia_phase",
+                                  "torque_phase", "drive"] and list(phases.gear) == [1] + [2] * 4 + [1] * 3
+    ratio = run["engine.w_rad_s"] / run["output_shaft.w_rad_s"]
+    in2nd = run.time_s.between(phases.time_s[4], 1.5)        # in 2nd between the shifts, in 1st after the second
+    assert np.allclose(ratio[in2nd], 2.0, rtol=1e-6) and np.isclose(ratio.iloc[-1], 3.5, rtol=1e-6)
+    assert (run[["c1_command_1", "c2_command_1"]].max(axis=1) > 0.0).all()   # (a power shift: never both open)
+    assert "upshift from 0.5000 s" in out and "downshift from 1.5000 s" in out
+
+
 def check_lin(work, out):
     import json
 
@@ -478,6 +490,7 @@ CHECKS = {
     "at_shift.json": check_at_shift,
     "amt_shift.json": check_amt_shift,
     "amt_tcu.csv": check_amt_tcu,
+    "dct_tcu.csv": check_dct_tcu,
     "tc.csv": check_torque_converter,
     "results_dct/": check_dct_sweep,
     "shift.json": check_shift,

@@ -204,3 +204,68 @@ def test_bad_settings_are_refused_naming_them(change, message):
         DctController(**kw)
     with pytest.raises(ParameterError, match=r"ratio = 0 must be a finite number > 0"):
         DctGear("c1", "c1_command", 0)
+
+
+EXAMPLE = ROOT / "examples" / "driveline_dct_tcu.toml"   # the same network with its inputs and [tcu] in the file
+
+
+def test_the_file_s_controller_runs_from_the_command_line_as_the_python_one(dct, tmp_path, capsys):
+    """``clutchlab control tcu`` on ``examples/driveline_dct_tcu.toml`` (``type = "dct"``): the same phases and run
+    as the Python controller with the file's settings, every shift's quality from its [shift] table (each with its
+    own clutches); nothing is overwritten without --force."""
+    import json
+
+    import pandas as pd
+
+    from clutchlab.cli import main
+
+    out, phases, quality = tmp_path / "run.csv", tmp_path / "phases.csv", tmp_path / "quality.json"
+    argv = ["control", "tcu", str(EXAMPLE), "-o", str(out), "--phases", str(phases), "--quality", str(quality)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "8 phases of DctController" in printed and "upshift from 0.5000 s" in printed
+    report = json.loads(quality.read_text())
+    assert [(q["order"], q["start_s"], q["columns"]["offgoing"], q["columns"]["oncoming"]) for q in report] == [
+        ("upshift", 0.5, "c1", "c2"), ("downshift", 1.5, "c2", "c1")]
+    tcu = _tcu([(0.5, 2), (1.5, 1)])
+    res = _run(dct, tcu, 2.6)
+    got = pd.read_csv(phases)
+    assert list(got.phase) == list(tcu.phases.phase) and list(got.gear) == list(tcu.phases.gear)
+    np.testing.assert_allclose(got.time_s, tcu.phases.time_s, rtol=0, atol=1e-12)
+    run = pd.read_csv(out)
+    for col in ("engine.w_rad_s", "c1.tau_Nm", "c2_command_1", "torque_command_Nm"):
+        np.testing.assert_allclose(run[col], res.frame[col], rtol=1e-8, atol=1e-9)   # (the CSV's 9 digits)
+    assert main(argv) != 0 and "--force" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.update(type="cvt"), r"tcu\.type = 'cvt': expected one of amt, dct"),
+    (lambda t: t.update(clutch_input="c1_command"), r"tcu\.clutch_input: unknown field \(known: type, gears, "),
+    (lambda t: t.pop("engine_speed"), r"\[tcu\]: missing field 'engine_speed'"),
+    (lambda t: t["gears"]["2"].update(clutch="wheels"), r"tcu\.gears\.2\.clutch = 'wheels': expected a clutch of the "
+                                                        r"network \(c1, c2\)"),
+    (lambda t: t["gears"]["2"].update(input="fork"), r"tcu\.gears\.2\.input = 'fork': expected a network input"),
+    (lambda t: t["gears"]["2"].pop("ratio"), r"tcu\.gears\.2 must be \{ clutch = \.\.\., input = \.\.\., ratio"),
+    (lambda t: t["gears"]["2"].update(ratio=-2.0), r"tcu\.gears\.2\.ratio = -2\.0: expected the gear's ratio"),
+    (lambda t: t.update(handover="0.1 N"), r"tcu\.handover"),
+    (lambda t: t.update(output_speed="output_shaft.v"), r"tcu\.output_speed = 'output_shaft\.v': expected a state"),
+])
+def test_a_bad_dct_table_is_refused_naming_the_file_and_the_field(edit, message):
+    import tomllib
+
+    from clutchlab.driveline.description import parse_driveline
+
+    doc = tomllib.loads(EXAMPLE.read_text())
+    edit(doc["tcu"])
+    with pytest.raises(ParameterError, match=message):
+        parse_driveline(doc, "dct.toml")
+
+
+def test_the_command_line_refuses_a_controller_it_cannot_build(tmp_path, capsys):
+    from cli_checks import one_line_error
+
+    bad = tmp_path / "dct.toml"
+    bad.write_text(EXAMPLE.read_text().replace("fill = 0.7 ", "fill = 1.7 "))
+    line = one_line_error(capsys, ["control", "tcu", str(bad), "-o", str(tmp_path / "run.csv")])
+    assert "dct.toml: [tcu] DctController: fill = 1.7 must be <= 1" in line
+    assert not (tmp_path / "run.csv").exists()

@@ -1255,6 +1255,38 @@ def test_an_amt_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_netwo
         np.testing.assert_allclose(native[name], loop.frame[f"{name}_rad_s"].to_numpy(), rtol=1e-7, err_msg=name)
 
 
+def test_a_dct_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_network(tmp_path):
+    """The dual-clutch transmission with its engine torque and its two clutches' factors as network inputs
+    (``examples/driveline_dct_tcu.toml``) as a native FMU: the inputs clutchlab's DCT controller set in the loop
+    through the power upshift, held by FMPy over the same 1 ms steps, give the FMU the closed loop's run (the
+    clutches' modes sample for sample, the speeds to the solver's tolerance, the Python co-simulation's outputs to
+    1e-9)."""
+    from clutchlab.control import DctController, closed_loop
+    from clutchlab.driveline.description import load_driveline
+
+    source = EXAMPLE.parent / "driveline_dct_tcu.toml"
+    cls = DrivelineCoSimulation.for_description(source)
+    assert [v.name for v in cls.inputs] == ["torque_command", "c1_command", "c2_command"]
+    path = export_native_fmu(cls, tmp_path / "dct.fmu", platforms=["linux64"])
+    spec = load_driveline(source)
+    tcu = DctController.from_table(spec.tcu)
+    n, dt = 1200, 1e-3                        # through the upshift (0.5-1.1 s)
+    loop = closed_loop(spec.driveline.system(spec.rtol), tcu, dt, n * dt, actuate=list(tcu.actuated),
+                       measure=[*tcu.measured, "wheels.w"])
+    inputs = {name: loop.frame[column].to_numpy() for name, column in
+              zip(tcu.actuated, ("torque_command_Nm", "c1_command_1", "c2_command_1"))}
+    assert list(tcu.phases.phase) == ["drive", "torque_phase", "inertia_phase", "lock", "drive"]
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(cls, n, dt, inputs=inputs)
+    energy = max(float(np.max(np.abs(python[k]))) for k in ("input_work", "kinetic_energy"))
+    for name in python:
+        _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
+    for name in ("c1.mode", "c2.mode"):
+        np.testing.assert_array_equal(native[name], loop.frame[f"{name}_1"].to_numpy(), err_msg=name)
+    for name in ("engine.w", "wheels.w"):
+        np.testing.assert_allclose(native[name], loop.frame[f"{name}_rad_s"].to_numpy(), rtol=1e-7, err_msg=name)
+
+
 def _a_host_sets(tmp_path, path, cls, n, dt, energy, name, value):
     """A host sets the network's parameter ``name`` (a component's declared number) to ``value``: it is a parameter
     of the FMU, and the native run equals the Python co-simulation built with it.  Returns that run's outputs and

@@ -140,14 +140,17 @@ def register(subparsers) -> None:
                                                      "acceleration and jerk, its phases shaded")
     shift.add_argument("--force", action="store_true", help="overwrite the files")
     shift.set_defaults(func=_shift)
-    tcu = sub.add_parser("tcu", help="an automated manual transmission's gear command, carried out by its controller",
-                         description="Run a driveline whose [tcu] table declares an automated manual transmission's "
-                                     "controller (AmtController in Python): its gear command carried out as "
-                                     "the shift sequence (torque down, clutch open, neutral, synchronise, clutch "
-                                     "closed), waiting on the synchronisers, in the loop with the network at its "
-                                     "sample time. Prints the phases and, with a [shift] table (the clutch, the "
-                                     "output, the engine, the radius), every shift's quality.",
-                         epilog="Documentation: docs/control.md (A transmission controller for the AMT)")
+    tcu = sub.add_parser("tcu", help="a transmission's gear command (an AMT's or a DCT's), carried out by its controller",
+                         description="Run a driveline whose [tcu] table declares a transmission's controller: an "
+                                     "automated manual transmission's (AmtController in Python: torque down, clutch "
+                                     "open, neutral, synchronise, clutch closed, waiting on the synchronisers) or, "
+                                     "with type = \"dct\", a dual-clutch transmission's (DctController: power "
+                                     "shifts, the hand-over where the off-going clutch carries nothing), in the loop "
+                                     "with the network at its sample time. Prints the phases and, with a [shift] "
+                                     "table (the output, the engine, the radius; an AMT's clutch), every shift's "
+                                     "quality.",
+                         epilog="Documentation: docs/control.md (A transmission controller for the AMT, A "
+                                "power-shift controller for the DCT)")
     tcu.add_argument("source", help="driveline description (.toml) with a [tcu] table")
     tcu.add_argument("-o", "--output", dest="write", default=None,
                      help="the run at the controller's samples (.csv): every state and output, and the inputs it set")
@@ -471,6 +474,7 @@ def _tcu(args) -> int:
     import json
 
     from ..control.loop import closed_loop
+    from ..control.dct import DctController
     from ..control.tcu import SAMPLE_TIME, SHIFT_OWN, AmtController
     from ..driveline.description import load_driveline
     from ..io.files import OutputSet, atomic_to_csv, atomic_write_text
@@ -485,13 +489,13 @@ def _tcu(args) -> int:
         raise ParameterError(f"{args.source}: --quality needs a [shift] table (its clutch, output, engine, radius)")
     outputs = OutputSet([args.write, args.events, args.phases, args.quality], args.force)   # checked before the run
     if spec.tcu is None:
-        raise ParameterError(f"{args.source}: no [tcu] table (the controller's gears, start_gear, commands, "
-                             "torque_input, clutch_input, torque: docs/control.md)")
+        raise ParameterError(f"{args.source}: no [tcu] table (the controller's type, gears, start_gear, commands, "
+                             "inputs and torque: docs/control.md)")
     t_end = to_si(args.t_end, "s", name="--t-end") if args.t_end is not None else spec.t_end
     if t_end is None or not t_end > 0.0:
         raise ParameterError(f"{args.source}: give --t-end or [simulation] t_end (> 0)")
     try:
-        controller = AmtController.from_table(spec.tcu)
+        controller = (DctController if spec.tcu.get("type") == "dct" else AmtController).from_table(spec.tcu)
     except ParameterError as exc:
         raise ParameterError(f"{args.source}: [tcu] {exc}") from None
     system = spec.driveline.system(spec.rtol)

@@ -167,6 +167,15 @@ class DctController(GearCommand):
         self._at = {g: k for k, g in enumerate(self.gears)}
         self._reset()
 
+    @classmethod
+    def from_table(cls, table: dict) -> "DctController":
+        """The controller of a driveline file's ``[tcu]`` table with ``type = "dct"`` as its loader reads it
+        (:attr:`clutchlab.driveline.description.DrivelineFile.tcu`: SI, gears as ``{number: (clutch, input,
+        ratio)}``; its ``sample_time`` is the loop's, not the controller's)."""
+        kw = {k: v for k, v in table.items() if k not in ("sample_time", "type")}
+        kw["gears"] = {g: DctGear(*spec) for g, spec in kw["gears"].items()}
+        return cls(**kw)
+
     def _reset(self):
         super()._reset()
         self._drive_sign = 1.0   # the sign of the off-going clutch's torque while it drives (at the command)

@@ -318,7 +318,7 @@ class AmtController(GearCommand):
         (:attr:`clutchlab.driveline.description.DrivelineFile.tcu`: SI, gears as ``{number: (synchronizer, fork,
         side, ratio)}``, the ratio None where the file gives none; its ``sample_time`` is the loop's, not the
         controller's)."""
-        kw = {k: v for k, v in table.items() if k != "sample_time"}
+        kw = {k: v for k, v in table.items() if k not in ("sample_time", "type")}
         kw["gears"] = {g: AmtGear(*spec) for g, spec in kw["gears"].items()}
         return cls(**kw)
 

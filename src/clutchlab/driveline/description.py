@@ -195,9 +195,19 @@ class DrivelineFile:
 TCU_FIELDS = {"gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
               "clutch_input": "input", "torque": "N*m", "drag": "N*m", "fork_force": "N", "torque_down": "s",
               "clutch_open": "s", "fork_ramp": "s", "clutch_close": "s", "sync_timeout": "s", "sample_time": "s",
-              "speed_match": "N*m*s/rad", "engine_speed": "variable", "output_speed": "variable", "torque_max": "N*m"}
+              "speed_match": "N*m*s/rad", "engine_speed": "variable", "output_speed": "variable", "torque_max": "N*m",
+              "type": "type"}
 #: the fields of one gear of a ``[tcu]`` table's ``gears``
 TCU_GEAR_FIELDS = ("synchronizer", "fork", "side", "ratio")
+#: the fields of a ``[tcu]`` table with ``type = "dct"`` (:class:`clutchlab.control.DctController`'s arguments and the
+#: controller's sample time)
+DCT_FIELDS = {"type": "type", "gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
+              "torque": "N*m", "engine_speed": "variable", "output_speed": "variable", "fill": "1", "handover": "s",
+              "rise": "s", "restore": "s", "torque_cut": "1", "slip": "1", "shift_timeout": "s", "sample_time": "s"}
+#: the fields of one gear of a dual-clutch ``[tcu]`` table's ``gears``
+DCT_GEAR_FIELDS = ("clutch", "input", "ratio")
+#: the transmission controllers a ``[tcu]`` table's ``type`` names (``"amt"`` where it names none)
+TCU_TYPES = ("amt", "dct")
 
 
 def _quantity(value, unit, key, src):
@@ -612,47 +622,33 @@ def _gear_number(value, key, src):
 
 
 def _tcu(table, d: Driveline, src: str):
-    """The ``[tcu]`` table: the keyword arguments of :class:`clutchlab.control.AmtController` for the network's gear
-    command and its ``sample_time`` (names checked against the network: the gears' synchronisers, the network inputs
-    it sets, the speeds its speed matching reads; quantities in SI; a gear as ``(synchronizer, fork, side, ratio)``),
-    or None without one.  The controller checks the rest as it is built."""
+    """The ``[tcu]`` table: its ``type`` (``"amt"``, the default, or ``"dct"``), the keyword arguments of its
+    controller (:class:`clutchlab.control.AmtController`, :class:`clutchlab.control.DctController`) for the network's
+    gear command and its ``sample_time`` (names checked against the network: the gears' synchronisers or clutches, the
+    network inputs it sets, the speeds it reads; quantities in SI; an AMT's gear as ``(synchronizer, fork, side,
+    ratio)``, a DCT's as ``(clutch, input, ratio)``), or None without one.  The controller checks the rest as it is
+    built."""
     if table is None:
         return None
-    _check_table(table, "tcu", TCU_FIELDS, ("gears", "start_gear", "commands", "torque_input", "clutch_input",
-                                           "torque"), src)
-    synchros = {e.name for e in d.elements if e.kind == "synchronizer"}
-    out = {}
+    kind_of = table.get("type", "amt") if isinstance(table, dict) else "amt"
+    if kind_of not in TCU_TYPES:
+        raise ParameterError(f"{src}: tcu.type = {kind_of!r}: expected one of {', '.join(TCU_TYPES)}")
+    dct = kind_of == "dct"
+    fields = DCT_FIELDS if dct else TCU_FIELDS
+    _check_table(table, "tcu", fields, ("gears", "start_gear", "commands", "torque_input", "torque")
+                 + (("engine_speed", "output_speed") if dct else ("clutch_input",)), src)
+    out = {"type": kind_of}
     for k, v in table.items():
-        kind, key = TCU_FIELDS[k], f"tcu.{k}"
+        kind, key = fields[k], f"tcu.{k}"
+        if kind == "type":
+            continue
         if kind == "gears":
             if not isinstance(v, dict) or not v:
-                raise ParameterError(f"{src}: {key} must be a table of gears, e.g. 1 = {{ synchronizer = \"s1\", "
-                                     "fork = \"fork\", side = 1 }")
-            gears = {}
-            for g, spec in v.items():
-                where = f"{key}.{g}"
-                number = _gear_number(g, where, src)
-                if not isinstance(spec, dict) or any(f not in TCU_GEAR_FIELDS for f in spec) \
-                        or not {"synchronizer", "fork"} <= set(spec):
-                    raise ParameterError(f"{src}: {where} must be {{ synchronizer = ..., fork = ..., side = 1 or -1 "
-                                         "}")
-                if not isinstance(spec["synchronizer"], str) or spec["synchronizer"] not in synchros:
-                    raise ParameterError(f"{src}: {where}.synchronizer = {spec['synchronizer']!r}: expected a "
-                                         f"synchronizer of the network ({', '.join(sorted(synchros)) or 'none'})")
-                if spec["fork"] not in d.inputs:
-                    raise ParameterError(f"{src}: {where}.fork = {spec['fork']!r}: expected a network input "
-                                         f"([input.NAME]: {', '.join(d.inputs) or 'none'})")
-                side = spec.get("side", 1)
-                if side not in (1, -1) or isinstance(side, bool):
-                    raise ParameterError(f"{src}: {where}.side = {side!r}: expected 1 or -1")
-                ratio = spec.get("ratio")
-                if ratio is not None:
-                    ratio = _quantity(ratio, "1", f"{where}.ratio", src)
-                    if ratio == 0.0:
-                        raise ParameterError(f"{src}: {where}.ratio = {spec['ratio']!r}: expected the gear's ratio "
-                                             "(the clutch's driven speed over the output speed), not 0")
-                gears[number] = (spec["synchronizer"], spec["fork"], int(side), ratio)
-            out[k] = gears
+                raise ParameterError(f"{src}: {key} must be a table of gears, e.g. 1 = " + (
+                    "{ clutch = \"c1\", input = \"c1_command\", ratio = 3.5 }" if dct else
+                    "{ synchronizer = \"s1\", fork = \"fork\", side = 1 }"))
+            out[k] = {_gear_number(g, f"{key}.{g}", src): (_dct_gear if dct else _amt_gear)(spec, d, f"{key}.{g}", src)
+                      for g, spec in v.items()}
         elif kind == "gear":
             out[k] = _gear_number(v, key, src)
         elif kind == "commands":
@@ -661,9 +657,7 @@ def _tcu(table, d: Driveline, src: str):
             out[k] = [(_quantity(t, "s", f"{key}[{i}]", src), _gear_number(g, f"{key}[{i}]", src))
                       for i, (t, g) in enumerate(v)]
         elif kind == "input":
-            if not isinstance(v, str) or v not in d.inputs:
-                raise ParameterError(f"{src}: {key} = {v!r}: expected a network input ([input.NAME]: "
-                                     f"{', '.join(d.inputs) or 'none'})")
+            _network_input(v, d, key, src)
             out[k] = v
         elif kind == "variable":
             states, outputs = d.variables()
@@ -677,6 +671,50 @@ def _tcu(table, d: Driveline, src: str):
     if not out.get("sample_time", 1.0) > 0.0:
         raise ParameterError(f"{src}: tcu.sample_time = {table['sample_time']!r}: must be > 0 [s]")
     return out
+
+
+def _network_input(v, d: Driveline, key: str, src: str) -> None:
+    if not isinstance(v, str) or v not in d.inputs:
+        raise ParameterError(f"{src}: {key} = {v!r}: expected a network input ([input.NAME]: "
+                             f"{', '.join(d.inputs) or 'none'})")
+
+
+def _amt_gear(spec, d: Driveline, where: str, src: str) -> tuple:
+    """An AMT's gear of a ``[tcu]`` table: ``(synchronizer, fork, side, ratio)``."""
+    synchros = {e.name for e in d.elements if e.kind == "synchronizer"}
+    if not isinstance(spec, dict) or any(f not in TCU_GEAR_FIELDS for f in spec) \
+            or not {"synchronizer", "fork"} <= set(spec):
+        raise ParameterError(f"{src}: {where} must be {{ synchronizer = ..., fork = ..., side = 1 or -1 }}")
+    if not isinstance(spec["synchronizer"], str) or spec["synchronizer"] not in synchros:
+        raise ParameterError(f"{src}: {where}.synchronizer = {spec['synchronizer']!r}: expected a "
+                             f"synchronizer of the network ({', '.join(sorted(synchros)) or 'none'})")
+    _network_input(spec["fork"], d, f"{where}.fork", src)
+    side = spec.get("side", 1)
+    if side not in (1, -1) or isinstance(side, bool):
+        raise ParameterError(f"{src}: {where}.side = {side!r}: expected 1 or -1")
+    ratio = spec.get("ratio")
+    if ratio is not None:
+        ratio = _quantity(ratio, "1", f"{where}.ratio", src)
+        if ratio == 0.0:
+            raise ParameterError(f"{src}: {where}.ratio = {spec['ratio']!r}: expected the gear's ratio "
+                                 "(the clutch's driven speed over the output speed), not 0")
+    return spec["synchronizer"], spec["fork"], int(side), ratio
+
+
+def _dct_gear(spec, d: Driveline, where: str, src: str) -> tuple:
+    """A dual-clutch transmission's gear of a ``[tcu]`` table: ``(clutch, input, ratio)``."""
+    clutches = {e.name for e in d.elements if e.kind == "clutch"}
+    if not isinstance(spec, dict) or set(spec) != set(DCT_GEAR_FIELDS):
+        raise ParameterError(f"{src}: {where} must be {{ clutch = ..., input = ..., ratio = ... }}")
+    if not isinstance(spec["clutch"], str) or spec["clutch"] not in clutches:
+        raise ParameterError(f"{src}: {where}.clutch = {spec['clutch']!r}: expected a clutch of the network "
+                             f"({', '.join(sorted(clutches)) or 'none'})")
+    _network_input(spec["input"], d, f"{where}.input", src)
+    ratio = _quantity(spec["ratio"], "1", f"{where}.ratio", src)
+    if not ratio > 0.0:
+        raise ParameterError(f"{src}: {where}.ratio = {spec['ratio']!r}: expected the gear's ratio (the clutch's "
+                             "driven speed over the output speed), > 0")
+    return spec["clutch"], spec["input"], ratio
 
 
 def _shift(table, d: Driveline, src: str):
