@@ -184,7 +184,8 @@ def test_a_hand_over_that_cannot_happen_stops_the_run(dct):
 
 
 @pytest.mark.parametrize("change, message", [
-    (dict(gears={1: DctGear("c1", "c1_command", 3.5)}), r"at least two"),
+    (dict(gears={1: DctGear("c1", "c1_command", 3.5)}),
+     r"gears must be \{gear number: DctGear\(clutch, input, ratio\)\}, at least 2"),
     (dict(gears={1: DctGear("c1", "u", 3.5), 2: DctGear("c1", "v", 2.0)}), r"a clutch and an input of its own"),
     (dict(start_gear=3), r"start_gear = 3 is not among the gears \[1, 2\]"),
     (dict(commands=[(0.5, 4)]), r"the command at 0\.5 s selects gear 4"),

@@ -1244,15 +1244,8 @@ def test_an_amt_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_netwo
     inputs = {name: loop.frame[column].to_numpy() for name, column in
               zip(tcu.actuated, ("torque_command_Nm", "clutch_command_1", "fork_N"))}
     assert list(tcu.phases.phase)[-1] == "drive" and {600.0, -600.0} <= set(inputs["fork"])   # (1st, then 2nd)
-    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
-    python = _python_run(cls, n, dt, inputs=inputs)
-    energy = max(float(np.max(np.abs(python[k]))) for k in ("input_work", "kinetic_energy"))
-    for name in python:
-        _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
-    for name in ("s1.mode", "s2.mode"):
-        np.testing.assert_array_equal(native[name], loop.frame[f"{name}_1"].to_numpy(), err_msg=name)
-    for name in ("input_shaft.w", "wheels.w"):
-        np.testing.assert_allclose(native[name], loop.frame[f"{name}_rad_s"].to_numpy(), rtol=1e-7, err_msg=name)
+    _a_host_drives(tmp_path, path, cls, loop, n, dt, inputs, modes=("s1.mode", "s2.mode"),
+                   speeds=("input_shaft.w", "wheels.w"))
 
 
 def test_a_dct_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_network(tmp_path):
@@ -1276,14 +1269,22 @@ def test_a_dct_controller_drives_the_native_fmu_s_inputs_as_it_drives_the_networ
     inputs = {name: loop.frame[column].to_numpy() for name, column in
               zip(tcu.actuated, ("torque_command_Nm", "c1_command_1", "c2_command_1"))}
     assert list(tcu.phases.phase) == ["drive", "torque_phase", "inertia_phase", "lock", "drive"]
+    _a_host_drives(tmp_path, path, cls, loop, n, dt, inputs, modes=("c1.mode", "c2.mode"),
+                   speeds=("engine.w", "wheels.w"))
+
+
+def _a_host_drives(tmp_path, path, cls, loop, n, dt, inputs, modes, speeds):
+    """FMPy drives the native FMU at ``path`` with the ``inputs`` a controller set in the closed ``loop``, held over
+    its ``n`` steps of ``dt``: its outputs equal the Python co-simulation's (1e-12), its ``modes`` the loop's sample
+    for sample, its ``speeds`` the loop's to the solver's tolerance."""
     native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
     python = _python_run(cls, n, dt, inputs=inputs)
     energy = max(float(np.max(np.abs(python[k]))) for k in ("input_work", "kinetic_energy"))
     for name in python:
         _close(native[name], python[name], name, floor=1e-12 * energy if name == "energy_error" else 1e-12)
-    for name in ("c1.mode", "c2.mode"):
+    for name in modes:
         np.testing.assert_array_equal(native[name], loop.frame[f"{name}_1"].to_numpy(), err_msg=name)
-    for name in ("engine.w", "wheels.w"):
+    for name in speeds:
         np.testing.assert_allclose(native[name], loop.frame[f"{name}_rad_s"].to_numpy(), rtol=1e-7, err_msg=name)
 
 

@@ -140,7 +140,8 @@ def register(subparsers) -> None:
                                                      "acceleration and jerk, its phases shaded")
     shift.add_argument("--force", action="store_true", help="overwrite the files")
     shift.set_defaults(func=_shift)
-    tcu = sub.add_parser("tcu", help="a transmission's gear command (an AMT's or a DCT's), carried out by its controller",
+    tcu = sub.add_parser("tcu", help="a transmission's gear command (an AMT's or a DCT's), carried out by its "
+                                     "controller",
                          description="Run a driveline whose [tcu] table declares a transmission's controller: an "
                                      "automated manual transmission's (AmtController in Python: torque down, clutch "
                                      "open, neutral, synchronise, clutch closed, waiting on the synchronisers) or, "

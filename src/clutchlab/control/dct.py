@@ -125,15 +125,7 @@ class DctController(GearCommand):
     def __init__(self, gears: dict, start_gear: int, commands, *, torque_input: str, torque: float,
                  engine_speed: str, output_speed: str, fill: float = 0.7, handover: float = 0.1, rise: float = 0.15,
                  restore: float = 0.15, torque_cut: float = 0.0, slip: float = 0.3, shift_timeout: float = 1.0):
-        if not isinstance(gears, dict) or len(gears) < 2 or not all(isinstance(g, DctGear) for g in gears.values()):
-            raise ParameterError("DctController: gears must be {gear number: DctGear(clutch, input, ratio)}, at "
-                                 "least two")
-        self.gears = dict(gears)
-        if start_gear not in self.gears:
-            raise ParameterError(f"DctController: start_gear = {start_gear!r} is not among the gears "
-                                 f"{sorted(self.gears)}")
-        self.start_gear = start_gear
-        self.commands = self._commands(commands)
+        self._set_gears(gears, start_gear, commands, DctGear, least=2)
         clutches = [g.clutch for g in self.gears.values()]
         inputs = [g.input for g in self.gears.values()]
         if len(set(clutches)) != len(clutches) or len(set(inputs)) != len(inputs):

@@ -86,6 +86,20 @@ class GearCommand:
     #: the phases of its shifts, ``drive`` first (between shifts)
     PHASES: tuple = ("drive",)
 
+    def _set_gears(self, gears, start_gear, commands, kind, least: int = 1) -> None:
+        """Keep ``gears`` (``{number: kind}``, at least ``least`` of them), ``start_gear`` and the gear command,
+        checked."""
+        who = type(self).__name__
+        if not isinstance(gears, dict) or len(gears) < least or not all(isinstance(g, kind) for g in gears.values()):
+            fields = ", ".join(kind.__dataclass_fields__)
+            raise ParameterError(f"{who}: gears must be {{gear number: {kind.__name__}({fields})}}"
+                                 + (f", at least {least}" if least > 1 else ""))
+        self.gears = dict(gears)
+        if start_gear not in self.gears:
+            raise ParameterError(f"{who}: start_gear = {start_gear!r} is not among the gears {sorted(self.gears)}")
+        self.start_gear = start_gear
+        self.commands = self._commands(commands)
+
     def _commands(self, commands) -> tuple:
         """The gear command as ``((time [s], gear), ...)`` in time order, checked against the gears."""
         who = type(self).__name__
@@ -265,14 +279,7 @@ class AmtController(GearCommand):
                  clutch_open: float = 0.07, fork_ramp: float = 0.03, clutch_close: float = 0.4,
                  sync_timeout: float = 0.5, speed_match: float = 0.0, engine_speed: str | None = None,
                  output_speed: str | None = None, torque_max: float | None = None):
-        if not isinstance(gears, dict) or not gears or not all(isinstance(g, AmtGear) for g in gears.values()):
-            raise ParameterError("AmtController: gears must be {gear number: AmtGear(synchronizer, fork, side)}")
-        self.gears = dict(gears)
-        if start_gear not in self.gears:
-            raise ParameterError(f"AmtController: start_gear = {start_gear!r} is not among the gears "
-                                 f"{sorted(self.gears)}")
-        self.start_gear = start_gear
-        self.commands = self._commands(commands)
+        self._set_gears(gears, start_gear, commands, AmtGear)
         self.clutch_input, self.torque_input = str(clutch_input), str(torque_input)
         self.torque = float(torque)
         self.drag = float(drag)
