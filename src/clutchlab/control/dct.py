@@ -139,13 +139,14 @@ class DctController(GearCommand):
         self.torque = float(torque)
         if not math.isfinite(self.torque):
             raise ParameterError(f"DctController: torque = {torque!r} must be finite")
-        self.fill = _positive("fill", fill)
-        self.handover = _positive("handover", handover)
-        self.rise = _positive("rise", rise)
-        self.restore = _positive("restore", restore)
-        self.torque_cut = _positive("torque_cut", torque_cut, zero=True)
-        self.slip = _positive("slip", slip, zero=True)
-        self.shift_timeout = _positive("shift_timeout", shift_timeout)
+        who = "DctController"
+        self.fill = _positive("fill", fill, who=who)
+        self.handover = _positive("handover", handover, who=who)
+        self.rise = _positive("rise", rise, who=who)
+        self.restore = _positive("restore", restore, who=who)
+        self.torque_cut = _positive("torque_cut", torque_cut, zero=True, who=who)
+        self.slip = _positive("slip", slip, zero=True, who=who)
+        self.shift_timeout = _positive("shift_timeout", shift_timeout, who=who)
         for what, v, hi in (("fill", self.fill, 1.0), ("torque_cut", self.torque_cut, 1.0 - 1e-12),
                             ("slip", self.slip, 1.0 - 1e-12)):
             if v > hi:
@@ -171,7 +172,6 @@ class DctController(GearCommand):
     def _reset(self):
         super()._reset()
         self._drive_sign = 1.0   # the sign of the off-going clutch's torque while it drives (at the command)
-        self._factor = {g: (1.0 if g == self.start_gear else 0.0) for g in self.gears}
         self._from = 1.0         # the off-going factor where the last ramp started
 
     def _element(self, gear):
@@ -237,7 +237,7 @@ class DctController(GearCommand):
         if phase == "drive":
             f[self._gear] = 1.0
         else:
-            old, new, s = self._gear, self._target, None
+            old, new = self._gear, self._target
             if phase == "torque_phase" and self._up():
                 f[old], f[new] = 1.0, self.fill * self._ramp(t, self.handover)
             elif phase == "inertia_phase" and self._up():

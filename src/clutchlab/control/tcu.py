@@ -65,13 +65,14 @@ class AmtGear:
             object.__setattr__(self, "ratio", r)
 
 
-def _positive(name, value, zero=False):
+def _positive(name, value, zero=False, who="AmtController"):
+    """``value`` as a float, finite and > 0 (``zero``: >= 0), or a ParameterError naming the controller ``who``."""
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ParameterError(f"AmtController: {name} = {value!r} must be a number") from None
+        raise ParameterError(f"{who}: {name} = {value!r} must be a number") from None
     if not (math.isfinite(v) and (v >= 0.0 if zero else v > 0.0)):
-        raise ParameterError(f"AmtController: {name} = {value!r} must be finite and {'>=' if zero else '>'} 0")
+        raise ParameterError(f"{who}: {name} = {value!r} must be finite and {'>=' if zero else '>'} 0")
     return v
 
 

@@ -176,9 +176,11 @@ class DrivelineFile:
         shift the network makes, clutch-to-clutch or an AMT's with ``clutch`` (``clutchlab control shift FILE``,
         the sweep's ``shift.<metric>``).
     tcu : dict or None
-        The ``[tcu]`` table: the keyword arguments of :class:`clutchlab.control.AmtController` (an automated
-        manual transmission's controller carrying out a gear command; names checked against the network,
-        quantities in SI) and its ``sample_time`` [s] (``clutchlab control tcu FILE``; :data:`TCU_FIELDS`).
+        The ``[tcu]`` table: its ``type`` (``"amt"`` or ``"dct"``), the keyword arguments of its controller
+        (:class:`clutchlab.control.AmtController`, an automated manual transmission's, :data:`TCU_FIELDS`;
+        :class:`clutchlab.control.DctController`, a dual-clutch transmission's, :data:`DCT_FIELDS`: a gear command
+        carried out; names checked against the network, quantities in SI) and its ``sample_time`` [s]
+        (``clutchlab control tcu FILE``).
     """
 
     driveline: Driveline
