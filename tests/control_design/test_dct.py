@@ -176,6 +176,21 @@ def test_a_power_shift_never_interrupts_the_drive_whatever_the_commands(dct, com
     assert np.abs(df["energy_error_J"]).max() < 1e-6 * df["input_work_J"].abs().max()
 
 
+def test_the_controller_s_decisions_do_not_move_with_the_tolerance(dct):
+    """Its decisions are taken at its samples from the network's values, so a tighter integration takes every one at
+    the same sample (rtol 1e-8 and 1e-11: the phases equal), and the run moves by the integration's error only."""
+    runs = {}
+    for rtol in (1e-8, 1e-11):
+        tcu = _tcu([(0.5, 2), (1.5, 1)])
+        measure = list(tcu.measured) + ["wheels.w"]
+        runs[rtol] = (closed_loop(dct, tcu, H, 2.6, measure=measure, actuate=list(tcu.actuated), rtol=rtol),
+                      tcu.phases)
+    (a, pa), (b, pb) = runs[1e-8], runs[1e-11]
+    assert pa.equals(pb)
+    w = a.frame["engine.w_rad_s"]
+    assert np.abs(w - b.frame["engine.w_rad_s"]).max() < 1e-8 * np.abs(w).max()   # (7e-12 measured)
+
+
 def test_a_hand_over_that_cannot_happen_stops_the_run(dct):
     """An on-coming clutch filled to 5 % cannot take the engine's torque over: the off-going one keeps carrying it,
     and the run stops after ``shift_timeout`` with an error naming the shift."""
