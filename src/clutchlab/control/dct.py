@@ -111,8 +111,8 @@ class DctController(GearCommand):
       on-coming factor ``s`` and the off-going factor from where the inertia phase left it down to 0 over
       ``handover``.
 
-    These are power-on shifts (the engine drives); a shift at the engine's drag goes through the same sequence, whose
-    hand-over then happens at once.
+    These are power-on shifts (the engine drives); coast shifts at the engine's drag are neither designed for nor
+    tested.
 
     It measures :attr:`measured` (each gear clutch's ``mode``, then each one's ``tau``, then the two speeds; more may
     follow, for the record) and actuates :attr:`actuated` (the engine's torque, then each gear clutch's factor).  Each
