@@ -103,7 +103,8 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
     coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
     assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
                        DC.coupled_accept, DC._watch_rates]
-    assert [e.dispatcher for e in outline._ENTRIES if e.group == "emtc"] == [ES._evaluate_into, ES._update]
+    assert [e.dispatcher for e in outline._ENTRIES if e.group == "emtc"] == [ES._evaluate_into, ES._update,
+                                                                             ES._controller]
     assert all(e.group is None for e in outline._ENTRIES if e.dispatcher.py_func.__module__ == K.__name__)
     outline.prepare()
     for fn in (K._repair, K.settle, K.driveline_rhs, K._solve_stuck, K._margin_rates, K._eliminate):
@@ -238,7 +239,7 @@ from clutchlab.numerics import outline
 model = bundled_magnet()
 res = simulate_bench(model, BenchScenario(duration=0.3), controller_model=model)
 out = {{}}
-for fn in (S._evaluate_into, S._update):
+for fn in (S._evaluate_into, S._update, S._controller):
     entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
     out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
 print(json.dumps([out, len(res.events.time_s)]))
@@ -246,8 +247,8 @@ print(json.dumps([out, len(res.events.time_s)]))
 
 
 def test_the_emtc_bench_calls_its_hooks_through_the_outlined_signatures():
-    """The EMTC's evaluation at a point and its event update run through their addresses, with the very types they
-    are outlined for (:mod:`clutchlab.emtc.system`): each compiled once, for that signature only.  A signature drift (a
+    """The EMTC's evaluation at a point, its event update and its controller sample run through their addresses, with
+    the very types they are outlined for (:mod:`clutchlab.emtc.system`): each compiled once, for that signature only.  A signature drift (a
     new field of :class:`~clutchlab.emtc.system.EmtcParams` the template lacks) would compile a second, linked copy
     into every function of the core that calls the hook.  (A fresh process, running only the bench.)"""
     import json
@@ -257,7 +258,7 @@ def test_the_emtc_bench_calls_its_hooks_through_the_outlined_signatures():
     proc = subprocess.run([sys.executable, "-c", _BENCH.format()], capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out, events = json.loads(proc.stdout.strip().splitlines()[-1])
-    assert out == {"_evaluate_into": [True], "_update": [True]}, out
+    assert out == {"_evaluate_into": [True], "_update": [True], "_controller": [True]}, out
     assert events > 0   # (the run had events: its update hook ran)
 
 
@@ -279,6 +280,26 @@ def test_the_emtc_hooks_do_not_contain_the_outlined_functions():
             assert bodies.search(ir)
         else:
             assert outline.RESOLVE_SYMBOL in ir and not bodies.search(ir), fn.__name__
+
+
+def test_the_emtc_restart_calls_its_controller_through_its_address():
+    """The EMTC's restart hook (a run's start, each break: linked into several functions of the core) calls the
+    controller sample through its address: its code holds none of the controller's force and inverse (Eqs. 11-15,
+    6-7), which the controller's own code does hold.  One compiled copy of the controller gives every caller the same
+    command to the last bit; linked copies, optimised with fast-math flags each in its caller, need not (a 1-ulp
+    difference between a co-simulation stepping across sample instants and one stepping on them, once in CI)."""
+    from clutchlab.emtc import system as S
+
+    bodies = re.compile(r"_ZN\w*(22commanded_magnet_force|15invert_combined)B")
+    t, x, u, _, p = S._hook_args()
+    for fn, sig in ((S._restart, S._hook_args(S._log_type())), (S._controller, (t, x, u, p))):
+        fresh = numba.njit(fn.py_func)   # (not from numba's cache: its code is kept to be read)
+        fresh.compile(sig)
+        ir = fresh.inspect_llvm(sig)
+        if fn is S._controller:   # the controller itself holds them: the pattern finds what it looks for
+            assert bodies.search(ir)
+        else:
+            assert outline.RESOLVE_SYMBOL in ir and not bodies.search(ir)
 
 
 def test_the_emtc_template_has_the_type_of_a_packed_bench():

@@ -1000,7 +1000,7 @@ def _restart(t, x, u, m, p, log):
     ts = p.sample_time
     k = imem[IM_KNEXT]
     if t >= k * ts - 1e-9 * ts:  # a controller sample is due (break time, or a resumed run that starts on it)
-        _controller(t, x, u, p)
+        _controller_outlined(t, x, u, p)   # (one compiled copy: the same command from every caller)
         k += 1
         if k * ts <= t + 1e-9 * ts:   # a run that starts far past the samples so far (a trim at t = 1e12 s, #33):
             k = int(np.floor((t + 1e-9 * ts) / ts))   # to the next sample at once, not one sample at a time
@@ -1068,7 +1068,7 @@ def run_controller(p, t, x, u):
     p = byref(borrow(p))  # the hooks' own specialisation (compiled once, with the core's)
     k = p.imem[IM_KNEXT]
     if t >= k * p.sample_time - 1e-9 * p.sample_time:
-        _controller(t, x, u, p)
+        _controller_outlined(t, x, u, p)
         p.imem[IM_KNEXT] = k + 1
 
 
@@ -1119,6 +1119,20 @@ _log_type = log_type
 
 _evaluate_outlined = outlined(_evaluate_into, lambda: _hook_args(), types.none, group="emtc")
 _update_outlined = outlined(_update, lambda: _hook_args(types.int64, _log_type()), types.int64, group="emtc")
+
+
+def _controller_args():
+    """The types of :func:`_controller`'s arguments ``(t, x, u, p)``: those of a hook without ``m``."""
+    t, x, u, _, p = _hook_args()
+    return t, x, u, p
+
+
+# The controller sample, called through its address from every function of the core that restarts (a run's start,
+# its breaks, with either integrator) and from run_controller: one compiled copy.  Linked, each caller held its own
+# copy, which LLVM optimised with the fast-math flags in that caller's context: two copies could round the command
+# differently in its last bit (seen once in CI: a co-simulation stepping over sample instants and one stepping on
+# them gave commands 1 ulp apart, tests/fmu/test_cosim.py).  A sample is rare (2 ms): the call costs nothing.
+_controller_outlined = outlined(_controller, _controller_args, types.none, group="emtc")
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=FASTMATH)
