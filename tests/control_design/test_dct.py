@@ -149,6 +149,98 @@ def test_the_power_on_downshift_brings_the_engine_to_the_new_gear_s_speed_before
     assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(3.5, rel=1e-6)
 
 
+COAST = -40.0                                      # the engine's drag when the driver lifts off [N m]
+
+
+@pytest.fixture(scope="module")
+def coasting():
+    """The DCT example coasting in 1st: the engine's torque at its drag, the half shafts wound for it (the drag
+    through 1st and the final drive, about 300 N m at the wheels, against the example's 1631 N m of drive)."""
+    d = load_driveline(SCHEDULE).driveline.without()
+    d.input("torque_command", unit="Nm", start=COAST).input("c1_command", unit="1", start=1.0)
+    d.input("c2_command", unit="1", start=0.0)
+    d = (d.replace("engine_torque", signal=Signal.input("torque_command"))
+         .replace("c1", normal=Signal.input("c1_command")).replace("c2", normal=Signal.input("c2_command"))
+         .replace("wheels", phi0=0.03))
+    return d.system(1e-8)
+
+
+def _coast(commands, **kw):
+    return DctController(GEARS, 1, commands, torque_input="torque_command", torque=COAST, engine_speed="engine.w",
+                         output_speed="output_shaft.w", **kw)
+
+
+def _sliding_engine(df, rows):
+    """``J_e (w[k + 1] - w[k]) / h`` and ``T + u1 C`` at ``rows``: the engine under its torque and c1 sliding with the
+    engine slower than the odd shaft (c1 pulls it up), c2 open -- where both are the same, the closed form holds."""
+    w = df["engine.w_rad_s"].to_numpy()
+    return (J_E * np.diff(w)[rows] / H,
+            df["torque_command_Nm"].to_numpy()[rows] + df["c1_command_1"].to_numpy()[rows] * CAPACITY)
+
+
+def test_a_coast_upshift_lets_the_engine_fall_under_its_drag_before_it_hands_over(coasting):
+    """An upshift while coasting: the engine's drag moves it *towards* 2nd's (lower) speed, so the inertia phase comes
+    first: c1 eases to ``coast_slip`` (0: open) and the engine falls under its drag alone, ``J_e (w[k + 1] - w[k]) /
+    h = T + u1 C`` at every sample where c1 slides (1e-6 N m); the hand-over starts at the first sample where the
+    engine has come down to ``2 w_out``, and c2 then closes nearly synchronously.  The sequence of a power-on
+    upshift (torque phase first) cannot do this shift: c2, sliding with the engine above its speed, pushes the drive
+    forward while c1 carries the drag backward, so c1's torque never reaches zero (the two clutches fight)."""
+    tcu = _coast([(0.3, 2)])
+    res = _run(coasting, tcu, 1.3)
+    ph = tcu.phases
+    assert list(ph.phase) == ["drive", "inertia_phase", "torque_phase", "drive"]
+    df = res.frame
+    w_e, w_out = df["engine.w_rad_s"].to_numpy(), df["output_shaft.w_rad_s"].to_numpy()
+    k = int(round(ph.time_s.iloc[2] / H))
+    assert w_e[k] <= 2.0 * w_out[k] and w_e[k - 1] > 2.0 * w_out[k - 1]
+    phase = _phase_at(ph, df.time_s.to_numpy())
+    rows = np.flatnonzero((phase[:-1] == "inertia_phase") & (df["c1.mode_1"].to_numpy()[1:] != 0.0))
+    assert rows.size > 400 and np.all(df["c2_command_1"].to_numpy()[rows] == 0.0)
+    accel, closed = _sliding_engine(df, rows)
+    np.testing.assert_allclose(accel, closed, rtol=0, atol=1e-6)
+    assert np.all(df["c1_command_1"].to_numpy()[(phase == "inertia_phase")][-10:] == tcu.coast_slip)
+    q = tcu.shift_quality(df, **HOW)[0]
+    assert q.metrics["tie_up_Nm"] < 1.0 and q.metrics["oncoming_energy_J"] < 1.0
+    end = df.iloc[-1]
+    assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(2.0, rel=1e-6)
+    assert np.abs(df["energy_error_J"]).max() < 1e-7 * df["input_work_J"].abs().max()
+
+
+def test_a_coast_downshift_hands_the_drag_over_and_then_pulls_the_engine_up(coasting):
+    """A downshift while coasting: the drag moves the engine *away* from 1st's (higher) speed, so the torque phase
+    comes first: c1 fills until c2 carries no drag (c1, sliding with the engine below its speed, pulls the engine up
+    and brakes the output, the drag's direction), then c2 opens and c1 rises from the factor it had at the hand-over
+    to 1 over ``rise`` (no step: a coast's drag is handed over early, at a low factor), pulling the engine up to 1st's
+    speed, ``J_e (w[k + 1] - w[k]) / h = T + u1 C`` (1e-6 N m); the lock within a sample of c1's stick."""
+    tcu = _coast([(0.3, 2), (1.4, 1)])
+    res = _run(coasting, tcu, 2.2)
+    ph = tcu.phases
+    assert list(ph.phase) == ["drive", "inertia_phase", "torque_phase", "drive", "torque_phase", "inertia_phase",
+                              "lock", "drive"]
+    df = res.frame
+    phase = _phase_at(ph, df.time_s.to_numpy())
+    after = df.time_s.to_numpy() >= 1.4
+    k = int(round(ph.time_s.iloc[5] / H))
+    tau2 = df["c2.tau_Nm"].to_numpy() * np.sign(df["c2.tau_Nm"].iloc[int(round(1.4 / H))])
+    assert tau2[k] <= 0.0 < tau2[k - 1]
+    u1 = df["c1_command_1"].to_numpy()
+    handed = tcu.fill * (ph.time_s.iloc[5] - 1.4) / tcu.handover
+    assert handed < 0.5 * tcu.fill and u1[k] == pytest.approx(handed, abs=1e-12)
+    shifting = np.flatnonzero(after & np.isin(phase, ["torque_phase", "inertia_phase"]))
+    steps = np.abs(np.diff(u1[shifting]))
+    assert steps.max() <= max(tcu.fill / tcu.handover, (1.0 - handed) / tcu.rise) * H + 1e-12
+    rows = np.flatnonzero(after[:-1] & (phase[:-1] == "inertia_phase") & (df["c1.mode_1"].to_numpy()[1:] != 0.0))
+    assert rows.size > 50 and np.all(df["c2_command_1"].to_numpy()[rows] == 0.0)
+    accel, closed = _sliding_engine(df, rows)
+    np.testing.assert_allclose(accel, closed, rtol=0, atol=1e-6)
+    stick = _event(res, "c1", "stick")
+    stick = stick[stick > 1.4][0]
+    assert 0.0 < ph.time_s.iloc[6] - stick <= H + 1e-12
+    end = df.iloc[-1]
+    assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(3.5, rel=1e-6)
+    assert np.abs(df["energy_error_J"]).max() < 1e-7 * df["input_work_J"].abs().max()
+
+
 @settings(max_examples=examples(6), deadline=None, derandomize=True)
 @given(st.lists(st.tuples(st.floats(0.05, 2.5), st.sampled_from([1, 2])), min_size=1, max_size=3),
        st.floats(0.0, 0.6), st.floats(0.55, 1.0))
@@ -208,6 +300,7 @@ def test_a_hand_over_that_cannot_happen_stops_the_run(dct):
     (dict(fill=0.0), r"DctController: fill = 0\.0 must be finite and > 0"),
     (dict(torque_cut=1.0), r"torque_cut = 1\.0 must be < 1"),
     (dict(slip=-0.1), r"DctController: slip = -0\.1 must be finite and >= 0"),
+    (dict(coast_slip=1.0), r"DctController: coast_slip = 1\.0 must be < 1"),
     (dict(handover=float("nan")), r"handover = nan must be finite and > 0"),
     (dict(engine_speed=""), r"engine_speed = '' must be a name"),
     (dict(torque=math.inf), r"torque = inf must be finite"),
@@ -275,6 +368,19 @@ def test_a_bad_dct_table_is_refused_naming_the_file_and_the_field(edit, message)
     edit(doc["tcu"])
     with pytest.raises(ParameterError, match=message):
         parse_driveline(doc, "dct.toml")
+
+
+def test_the_file_s_coast_slip_reaches_the_controller():
+    """``[tcu] coast_slip`` (a coast upshift's off-going factor) is read with the other fields and given to the
+    controller; left out, it is the controller's default (0: the off-going clutch opens)."""
+    import tomllib
+
+    from clutchlab.driveline.description import parse_driveline
+
+    doc = tomllib.loads(EXAMPLE.read_text())
+    assert DctController.from_table(parse_driveline(doc, "dct.toml").tcu).coast_slip == 0.0
+    doc["tcu"]["coast_slip"] = 0.1
+    assert DctController.from_table(parse_driveline(doc, "dct.toml").tcu).coast_slip == 0.1
 
 
 def test_the_command_line_refuses_a_controller_it_cannot_build(tmp_path, capsys):

@@ -1,10 +1,12 @@
 """A transmission controller (TCU) for a dual-clutch transmission: a gear command carried out as a power shift.
 
 A dual-clutch transmission (DCT) shifts without interrupting the drive: one clutch hands the engine's torque over to
-the other (the *torque phase*), and the on-coming clutch's slip brings the engine to the new gear's speed (the
-*inertia phase*).  An upshift does the torque phase first; a power-on downshift does the inertia phase first (the
-engine must speed up, which the off-going clutch's slip lets it do) and hands over once the engine has reached the new
-gear's speed (docs/control.md, "A power-shift controller for the DCT").  The two things an open-loop pressure schedule
+the other (the *torque phase*), and a clutch's slip brings the engine to the new gear's speed (the *inertia phase*).
+Where the engine's own torque moves it away from the new gear's speed (a power-on upshift, a coast downshift), the
+torque phase comes first and the on-coming clutch then pulls the engine over; where its torque moves it towards that
+speed (a power-on downshift, a coast upshift), the inertia phase comes first, the off-going clutch slipping, and the
+hand-over follows once the engine has reached the new gear's speed (docs/control.md, "A power-shift controller for
+the DCT").  The two things an open-loop pressure schedule
 cannot know, and this controller waits for, are when the on-coming clutch has taken over the torque (the off-going
 clutch's torque has fallen to zero: released earlier the engine flares, later the two clutches fight, the tie-up) and
 when the engine has reached the new gear's speed.
@@ -78,8 +80,8 @@ class DctController(GearCommand):
         The outputs it reads: the engine's speed [rad/s] (e.g. ``"engine.w"``) and the output speed the gears' ratios
         refer to (e.g. ``"output_shaft.w"``).
     fill : float
-        The on-coming clutch's factor at the end of an upshift's torque phase (0, 1]: enough capacity to take the
-        engine's torque over (default 0.7).
+        The on-coming clutch's factor at the end of a torque phase that comes first (0, 1]: enough capacity to take
+        the engine's torque over (default 0.7).
     handover : float
         The duration [s] (> 0) of the torque phase's ramps: the on-coming clutch's factor up, and on a downshift the
         off-going clutch's down (default 0.1).
@@ -92,27 +94,32 @@ class DctController(GearCommand):
         The fraction [0, 1) of the engine's torque taken away through an upshift's inertia phase (ignition retard):
         the on-coming clutch's excess capacity pulls the engine down faster and dissipates less (default 0).
     slip : float
-        A downshift's off-going factor in its inertia phase [0, 1): the off-going clutch is ramped from 1 down to it
-        over ``handover``, below the engine's torque, so that the engine speeds up towards the new gear (default
+        A power-on downshift's off-going factor in its inertia phase [0, 1): the off-going clutch is ramped from 1 down
+        to it over ``handover``, below the engine's torque, so that the engine speeds up towards the new gear (default
         0.3).
+    coast_slip : float
+        The same for a coast upshift [0, 1): the off-going clutch's capacity must fall below the engine's drag for the
+        drag to slow the engine down (default 0: the off-going clutch opens).
     shift_timeout : float
         The longest a phase that waits on the drive train may take [s] (> 0): beyond it the run stops with a
         :class:`~clutchlab.errors.SimulationError` naming the phase and the clutches (default 1).
 
-    The sequence (docs/control.md, "A power-shift controller for the DCT"), ``s`` each ramp's fraction:
+    The sequence (docs/control.md, "A power-shift controller for the DCT"), ``s`` each ramp's fraction; a shift is
+    *power-on* where ``torque > 0`` (the engine drives), a *coast* shift where ``torque <= 0`` (the engine's drag):
 
-    * **upshift** (the new gear's ratio lower): ``torque_phase``: the on-coming factor ``fill s`` over ``handover``,
-      the off-going closed, until the off-going clutch's torque has fallen to zero (its sign at the command's
-      sample, or it is no longer stuck): then it opens at once; ``inertia_phase``: the on-coming factor ``fill + (1
-      - fill) s`` over ``rise`` and the engine's torque ``(1 - torque_cut) torque`` until the on-coming clutch
-      sticks; ``lock``: the factor 1 and the torque back over ``restore``.
-    * **downshift** (the new gear's ratio higher): ``inertia_phase``: the off-going factor ``1 - (1 - slip) s`` over
-      ``handover`` until the engine has reached the new gear's speed, ``ratio w_out``; ``torque_phase``: the
-      on-coming factor ``s`` and the off-going factor from where the inertia phase left it down to 0 over
-      ``handover``.
-
-    These are power-on shifts (the engine drives); coast shifts at the engine's drag are neither designed for nor
-    tested.
+    * **torque phase first** (a power-on upshift, the new gear's ratio lower; a coast downshift, higher): the engine's
+      torque moves it away from the new gear's speed, so the on-coming clutch, sliding, can take the drive over at
+      once.  ``torque_phase``: the on-coming factor ``fill s`` over ``handover``, the off-going closed, until the
+      off-going clutch's torque has fallen to zero (its sign at the command's sample, or it is no longer stuck):
+      then it opens at once; ``inertia_phase``: the on-coming factor ``f_h + (1 - f_h) s`` over ``rise``, from the
+      factor ``f_h`` it had at the hand-over (``fill`` at the most: a coast downshift's drag is handed over early, at
+      a low factor), and the engine's torque ``(1 - torque_cut) torque``, until the on-coming clutch sticks;
+      ``lock``: the factor 1 and the torque back over ``restore``.
+    * **inertia phase first** (a power-on downshift; a coast upshift): the engine's torque moves it towards the new
+      gear's speed once the off-going clutch slips.  ``inertia_phase``: the off-going factor ``1 - (1 - slip) s``
+      (``coast_slip`` in a coast upshift) over ``handover`` until the engine has reached the new gear's speed,
+      ``ratio w_out`` (from below in a downshift, from above in an upshift); ``torque_phase``: the on-coming factor
+      ``s`` and the off-going factor from where the inertia phase left it down to 0 over ``handover``.
 
     It measures :attr:`measured` (each gear clutch's ``mode``, then each one's ``tau``, then the two speeds; more may
     follow, for the record) and actuates :attr:`actuated` (the engine's torque, then each gear clutch's factor).  Each
@@ -124,7 +131,8 @@ class DctController(GearCommand):
 
     def __init__(self, gears: dict, start_gear: int, commands, *, torque_input: str, torque: float,
                  engine_speed: str, output_speed: str, fill: float = 0.7, handover: float = 0.1, rise: float = 0.15,
-                 restore: float = 0.15, torque_cut: float = 0.0, slip: float = 0.3, shift_timeout: float = 1.0):
+                 restore: float = 0.15, torque_cut: float = 0.0, slip: float = 0.3, coast_slip: float = 0.0,
+                 shift_timeout: float = 1.0):
         self._set_gears(gears, start_gear, commands, DctGear, least=2)
         clutches = [g.clutch for g in self.gears.values()]
         inputs = [g.input for g in self.gears.values()]
@@ -146,9 +154,10 @@ class DctController(GearCommand):
         self.restore = _positive("restore", restore, who=who)
         self.torque_cut = _positive("torque_cut", torque_cut, zero=True, who=who)
         self.slip = _positive("slip", slip, zero=True, who=who)
+        self.coast_slip = _positive("coast_slip", coast_slip, zero=True, who=who)
         self.shift_timeout = _positive("shift_timeout", shift_timeout, who=who)
         for what, v, hi in (("fill", self.fill, 1.0), ("torque_cut", self.torque_cut, 1.0 - 1e-12),
-                            ("slip", self.slip, 1.0 - 1e-12)):
+                            ("slip", self.slip, 1.0 - 1e-12), ("coast_slip", self.coast_slip, 1.0 - 1e-12)):
             if v > hi:
                 raise ParameterError(f"DctController: {what} = {v!r} must be {'<= 1' if what == 'fill' else '< 1'}")
         #: the outputs it reads, in this order: each gear clutch's mode, each one's torque, the engine's speed, the
@@ -173,6 +182,7 @@ class DctController(GearCommand):
         super()._reset()
         self._drive_sign = 1.0   # the sign of the off-going clutch's torque while it drives (at the command)
         self._from = 1.0         # the off-going factor where the last ramp started
+        self._handed = 0.0       # the on-coming factor at the hand-over (a torque phase that comes first)
 
     def _element(self, gear):
         return self.gears[gear].clutch
@@ -189,6 +199,21 @@ class DctController(GearCommand):
     def _up(self):
         return self.gears[self._target].ratio < self.gears[self._gear].ratio
 
+    def _torque_first(self):
+        """The shift under way does its torque phase first: the engine's torque moves it away from the new gear's
+        speed (a power-on upshift, a coast downshift)."""
+        return (self.torque > 0.0) == self._up()
+
+    def _reached(self, seen):
+        """The engine has reached the new gear's speed ``ratio w_out``: from below in a downshift, from above in an
+        upshift (an inertia phase that comes first)."""
+        gap = seen["w_e"] - self.gears[self._target].ratio * seen["w_out"]
+        return gap <= 0.0 if self._up() else gap >= 0.0
+
+    def _slip(self):
+        """The off-going factor an inertia phase that comes first ramps down to."""
+        return self.slip if self.torque > 0.0 else self.coast_slip
+
     def _timeout(self, t, what):
         if t - self._since > self.shift_timeout:
             old, new = self.gears[self._gear].clutch, self.gears[self._target].clutch
@@ -203,27 +228,28 @@ class DctController(GearCommand):
             if g is not None:
                 self._target = g
                 self._drive_sign = 1.0 if seen["tau"][self._gear] >= 0.0 else -1.0
-                self._enter("torque_phase" if self._up() else "inertia_phase", t)
-        elif phase == "torque_phase" and self._up():
+                self._enter("torque_phase" if self._torque_first() else "inertia_phase", t)
+        elif phase == "torque_phase" and self._torque_first():
             # the on-coming clutch has taken the torque over: the off-going one carries none (or slides)
             if seen["tau"][self._gear] * self._drive_sign <= 0.0 or seen["mode"][self._gear] != _STUCK:
+                self._handed = self.fill * self._ramp(t, self.handover)
                 self._enter("inertia_phase", t)
             else:
                 self._timeout(t, "handed the torque over (the off-going clutch still carries it)")
-        elif phase == "inertia_phase" and self._up():
+        elif phase == "inertia_phase" and self._torque_first():
             if seen["mode"][self._target] == _STUCK:
                 self._enter("lock", t)
             else:
                 self._timeout(t, "locked the on-coming clutch")
         elif phase == "lock" and self._ramp(t, self.restore) >= 1.0:
             self._finish(t)
-        elif phase == "inertia_phase":   # (a downshift: the engine up to the new gear's speed)
-            if seen["w_e"] >= self.gears[self._target].ratio * seen["w_out"]:
-                self._from = 1.0 - (1.0 - self.slip) * self._ramp(t, self.handover)
+        elif phase == "inertia_phase":   # (first: the engine to the new gear's speed under its own torque)
+            if self._reached(seen):
+                self._from = 1.0 - (1.0 - self._slip()) * self._ramp(t, self.handover)
                 self._enter("torque_phase", t)
             else:
                 self._timeout(t, "brought the engine to the new gear's speed")
-        elif phase == "torque_phase" and self._ramp(t, self.handover) >= 1.0:   # (a downshift's hand-over done)
+        elif phase == "torque_phase" and self._ramp(t, self.handover) >= 1.0:   # (the hand-over after it, done)
             self._finish(t)
 
     def _finish(self, t):
@@ -238,17 +264,17 @@ class DctController(GearCommand):
             f[self._gear] = 1.0
         else:
             old, new = self._gear, self._target
-            if phase == "torque_phase" and self._up():
+            if phase == "torque_phase" and self._torque_first():
                 f[old], f[new] = 1.0, self.fill * self._ramp(t, self.handover)
-            elif phase == "inertia_phase" and self._up():
-                f[new] = self.fill + (1.0 - self.fill) * self._ramp(t, self.rise)
+            elif phase == "inertia_phase" and self._torque_first():
+                f[new] = self._handed + (1.0 - self._handed) * self._ramp(t, self.rise)
                 torque = (1.0 - self.torque_cut) * self.torque
             elif phase == "lock":
                 f[new] = 1.0
                 torque = (1.0 - self.torque_cut * (1.0 - self._ramp(t, self.restore))) * self.torque
             elif phase == "inertia_phase":
-                f[old] = 1.0 - (1.0 - self.slip) * self._ramp(t, self.handover)
-            else:   # (a downshift's torque phase)
+                f[old] = 1.0 - (1.0 - self._slip()) * self._ramp(t, self.handover)
+            else:   # (the torque phase after an inertia phase)
                 s = self._ramp(t, self.handover)
                 f[old], f[new] = self._from * (1.0 - s), s
         u[0] = torque

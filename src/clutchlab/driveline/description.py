@@ -205,7 +205,8 @@ TCU_GEAR_FIELDS = ("synchronizer", "fork", "side", "ratio")
 #: controller's sample time)
 DCT_FIELDS = {"type": "type", "gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
               "torque": "N*m", "engine_speed": "variable", "output_speed": "variable", "fill": "1", "handover": "s",
-              "rise": "s", "restore": "s", "torque_cut": "1", "slip": "1", "shift_timeout": "s", "sample_time": "s"}
+              "rise": "s", "restore": "s", "torque_cut": "1", "slip": "1", "coast_slip": "1", "shift_timeout": "s",
+              "sample_time": "s"}
 #: the fields of one gear of a dual-clutch ``[tcu]`` table's ``gears``
 DCT_GEAR_FIELDS = ("clutch", "input", "ratio")
 #: the transmission controllers a ``[tcu]`` table's ``type`` names (``"amt"`` where it names none)
