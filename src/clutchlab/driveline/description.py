@@ -641,6 +641,7 @@ def _tcu(table, d: Driveline, src: str):
     _check_table(table, "tcu", fields, ("gears", "start_gear", "commands", "torque_input", "torque")
                  + (("engine_speed", "output_speed") if dct else ("clutch_input",)), src)
     out = {"type": kind_of}
+    variables = None   # (the network's states and outputs, listed once, where a field names one)
     for k, v in table.items():
         kind, key = fields[k], f"tcu.{k}"
         if kind == "type":
@@ -663,7 +664,9 @@ def _tcu(table, d: Driveline, src: str):
             _network_input(v, d, key, src)
             out[k] = v
         elif kind == "variable":
-            states, outputs = d.variables()
+            if variables is None:
+                variables = d.variables()
+            states, outputs = variables
             if not isinstance(v, str) or v not in {name for name, *_ in (*states, *outputs)}:
                 speeds = ", ".join(name for name, unit, _ in states if unit in ("rad_s", "m_s"))
                 raise ParameterError(f"{src}: {key} = {v!r}: expected a state or output of the network, a speed "
