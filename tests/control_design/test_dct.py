@@ -140,7 +140,7 @@ def test_the_power_on_downshift_brings_the_engine_to_the_new_gear_s_speed_before
                                rtol=0, atol=1e-12)
     assert tcu.slip <= df["c2_command_1"].iloc[k] < 1.0
     down = tcu.shift_quality(df, **HOW)[1]
-    assert (down.order, down.columns["oncoming"]) == ("downshift", "c1")
+    assert (down.order, down.sequence, down.columns["oncoming"]) == ("downshift", "inertia_first", "c1")
     assert down.metrics["oncoming_energy_J"] < 1.0 < 1000.0 < down.metrics["offgoing_energy_J"]
     u = df[["c1_command_1", "c2_command_1"]].to_numpy()
     assert np.all(u.max(axis=1) > 0.0)
@@ -200,6 +200,10 @@ def test_a_coast_upshift_lets_the_engine_fall_under_its_drag_before_it_hands_ove
     np.testing.assert_allclose(accel, closed, rtol=0, atol=1e-6)
     assert np.all(df["c1_command_1"].to_numpy()[(phase == "inertia_phase")][-10:] == tcu.coast_slip)
     q = tcu.shift_quality(df, **HOW)[0]
+    # the direction from the speeds; the sequence as the record shows it: c1 lets go of the drag as it opens, before c2
+    # locks, with nothing carried in between (coast_slip = 0), which reads as the hand-over first
+    assert (q.order, q.sequence) == ("upshift", "torque_first")
+    assert q.handover_s < q.lockup_s <= ph.time_s.iloc[2]   # (c2 within the threshold of its slip: early)
     assert q.metrics["tie_up_Nm"] < 1.0 and q.metrics["oncoming_energy_J"] < 1.0
     end = df.iloc[-1]
     assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(2.0, rel=1e-6)
@@ -236,6 +240,8 @@ def test_a_coast_downshift_hands_the_drag_over_and_then_pulls_the_engine_up(coas
     stick = _event(res, "c1", "stick")
     stick = stick[stick > 1.4][0]
     assert 0.0 < ph.time_s.iloc[6] - stick <= H + 1e-12
+    down = tcu.shift_quality(df, **HOW)[1]
+    assert (down.order, down.sequence, down.columns["oncoming"]) == ("downshift", "torque_first", "c1")
     end = df.iloc[-1]
     assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(3.5, rel=1e-6)
     assert np.abs(df["energy_error_J"]).max() < 1e-7 * df["input_work_J"].abs().max()
@@ -332,7 +338,8 @@ def test_the_file_s_controller_runs_from_the_command_line_as_the_python_one(dct,
     argv = ["control", "tcu", str(EXAMPLE), "-o", str(out), "--phases", str(phases), "--quality", str(quality)]
     assert main(argv) == 0
     printed = capsys.readouterr().out
-    assert "8 phases of DctController" in printed and "upshift from 0.5000 s" in printed
+    assert "8 phases of DctController" in printed and "upshift (torque phase first) from 0.5000 s" in printed
+    assert "downshift (inertia phase first) from 1.5000 s" in printed
     report = json.loads(quality.read_text())
     assert [(q["order"], q["start_s"], q["columns"]["offgoing"], q["columns"]["oncoming"]) for q in report] == [
         ("upshift", 0.5, "c1", "c2"), ("downshift", 1.5, "c2", "c1")]

@@ -109,6 +109,28 @@ def test_a_radius_gives_the_vehicle_acceleration_and_a_filter_keeps_the_metrics_
     assert filtered.metrics["acceleration_dip_rad_s2"] == pytest.approx(D, rel=0.02)
 
 
+def test_a_shift_s_direction_comes_from_the_engine_s_speed_and_its_sequence_from_its_phases():
+    """The designed upshift's record with the engine's speed made to rise across the shift (a coast downshift runs its
+    torque phase first): ``order`` is the direction the engine's speed over the output's takes, ``"downshift"``, and
+    ``sequence`` the phases' order, ``"torque_first"``; its text names both.  Without the engine column the order is
+    the sequence's name as a power-on shift's; the designed downshift (inertia phase first) with an engine whose
+    speed over the output's falls is a coast upshift's reading."""
+    f = _record()
+    t = f["time_s"].to_numpy()
+    f["engine.w_rad_s"] = 150.0 + 100.0 * np.clip((t - 0.3) / 0.2, 0.0, 1.0)
+    q = shift_quality(f, offgoing="c1", oncoming="c2", output="out", engine="engine", threshold=THR)
+    assert (q.order, q.sequence) == ("downshift", "torque_first")
+    assert str(q).startswith("downshift (torque phase first) from ") and q.to_dict()["sequence"] == "torque_first"
+    plain = shift_quality(f, offgoing="c1", oncoming="c2", output="out", threshold=THR)
+    assert (plain.order, plain.sequence) == ("upshift", "torque_first")
+    d = _record()
+    d["c1.w_rel_rad_s"] = np.where(t > 0.15, 20.0, 0.0)
+    d["c1.tau_Nm"] = T * np.clip(1.0 - (t - 0.5) / 0.1, 0.0, 1.0)
+    d["c2.tau_Nm"] = T * np.clip((t - 0.5) / 0.1, 0.0, 1.0)
+    coast = shift_quality(d, offgoing="c1", oncoming="c2", output="out", engine="engine", threshold=THR)
+    assert (coast.order, coast.sequence) == ("upshift", "inertia_first")   # (the record's engine falls by 100 rad/s)
+
+
 def test_a_downshift_runs_its_inertia_phase_first():
     """The same record with the off-going clutch sliding from 0.15 s (the engine speeds up) and still carrying its
     torque until 0.6 s, after the on-coming one has locked at 0.5 s."""

@@ -11,7 +11,10 @@ A power upshift hands the drive from the off-going clutch to the on-coming one i
   there (the slip's rate at lock-up times the inertia it stops) is the lock-up shock.
 
 A power-on downshift runs the phases the other way round (the off-going clutch slips first so the engine can
-speed up, then the on-coming one takes the torque).
+speed up, then the on-coming one takes the torque); so does a coast upshift (the engine's drag slows it once the
+off-going clutch slips), while a coast downshift runs them as a power-on upshift does.  A shift's direction (up or
+down: the engine's speed over the output's falls or rises) and its sequence (torque phase first or inertia phase
+first) are therefore two things, :attr:`ShiftQuality.order` and :attr:`ShiftQuality.sequence`.
 
 An automated manual transmission (AMT) shifts with the drive **interrupted**: the engine's torque is taken down and
 the clutch opens (the release), the off-going gear's sleeve is pulled out, the on-coming gear's synchroniser pulls
@@ -56,16 +59,16 @@ _RIDE = (
 #: (``m_s2`` with a radius, else ``rad_s2``), ``{j}`` of the jerk, ``{v}`` of the vibration dose value
 METRICS = (
     ("shift_time_s", "s", "from the shift's start to its end (the later of the hand-over and the lock-up)"),
-    ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (upshift), from the "
-                            "lock-up to the hand-over (downshift)"),
-    ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (upshift), from "
-                             "the start to the lock-up (downshift)"),
+    ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (torque phase first), "
+                            "from the lock-up to the hand-over (inertia phase first)"),
+    ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (torque phase "
+                             "first), from the start to the lock-up (inertia phase first)"),
     *_RIDE,
     ("lockup_slip_rate_rad_s2", "rad_s2", "|d w_rel / dt| of the on-coming clutch over the last sample interval "
                                           "in which it slides before it locks (the lock-up shock's cause)"),
     ("flare_rad_s", "rad_s", "the off-going clutch's largest slip the way it drove before the start, during the "
-                             "shift: the engine running ahead of the old gear (an upshift's off-going clutch "
-                             "released too early; a downshift's inertia phase)"),
+                             "shift: the engine running ahead of the old gear (an off-going clutch released too "
+                             "early where the torque phase comes first; the inertia phase where it comes first)"),
     ("tie_up_Nm", "Nm", "the largest torque the off-going clutch carries against the way it carried the drive "
                         "before the start (it brakes the engine against the on-coming one): released too late"),
     ("offgoing_energy_J", "J", "heat of the off-going clutch during the shift, integral of |tau w_rel| dt"),
@@ -126,9 +129,10 @@ class ShiftQuality:
         (the later of the two) [s].  An interrupted shift's (``kind == "interrupted"``): the start, the clutch's
         opening, the on-coming synchroniser's dogs engaging and the clutch's lock-up.
     order : str
-        ``"upshift"`` (torque phase, then inertia phase: the hand-over before the lock-up) or ``"downshift"``
-        (inertia phase first); an interrupted shift's from the engine's speed over the output's, falling or rising
-        across the shift (``"shift"`` without an engine column).
+        ``"upshift"`` or ``"downshift"``: the engine's speed over the output's falls or rises from the start to the
+        end (read where there is an ``engine`` column and the two differ).  A power shift without one is named by
+        its sequence as a power-on shift would be: ``"upshift"`` where the torque phase comes first, else
+        ``"downshift"`` (a coast shift's is then the other way round); an interrupted shift's is ``"shift"``.
     metrics : dict
         Name (with its unit's suffix, :data:`METRICS`) -> value.
     columns : dict
@@ -141,6 +145,10 @@ class ShiftQuality:
     kind : str
         ``"power"`` (a clutch-to-clutch shift) or ``"interrupted"`` (an AMT's, through its clutch and
         synchronisers).
+    sequence : str
+        A power shift's phases in their order: ``"torque_first"`` (the hand-over before the lock-up: a power-on
+        upshift, a coast downshift) or ``"inertia_first"`` (a power-on downshift, a coast upshift); ``""`` for an
+        interrupted shift.
     """
 
     start_s: float
@@ -152,6 +160,7 @@ class ShiftQuality:
     columns: dict
     trace: object = dataclasses.field(default=None, repr=False, compare=False)
     kind: str = "power"
+    sequence: str = ""
 
     def to_dict(self) -> dict:
         """Everything as plain numbers and strings (JSON; NaN as None)."""
@@ -159,7 +168,8 @@ class ShiftQuality:
             return None if isinstance(v, float) and not math.isfinite(v) else v
 
         return {"kind": self.kind, "start_s": self.start_s, "handover_s": self.handover_s,
-                "lockup_s": self.lockup_s, "end_s": self.end_s, "order": self.order, "columns": dict(self.columns),
+                "lockup_s": self.lockup_s, "end_s": self.end_s, "order": self.order, "sequence": self.sequence,
+                "columns": dict(self.columns),
                 "metrics": {k: plain(float(v)) for k, v in self.metrics.items()}}
 
     def table(self):
@@ -181,8 +191,9 @@ class ShiftQuality:
             head = (f"{self.order} (interrupted) from {self.start_s:.4f} s: clutch open at {self.handover_s:.4f} s, "
                     f"gear in at {self.lockup_s:.4f} s, clutch locked at {self.end_s:.4f} s")
         else:
-            head = (f"{self.order} from {self.start_s:.4f} s: hand-over at {self.handover_s:.4f} s, lock-up at "
-                    f"{self.lockup_s:.4f} s")
+            first = {"torque_first": " (torque phase first)", "inertia_first": " (inertia phase first)"}
+            head = (f"{self.order}{first.get(self.sequence, '')} from {self.start_s:.4f} s: hand-over at "
+                    f"{self.handover_s:.4f} s, lock-up at {self.lockup_s:.4f} s")
         rows = [f"  {k:<34s} {v:>12.5g} {units[k]}" for k, v in self.metrics.items()]
         return "\n".join([head, *rows])
 
@@ -357,6 +368,18 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     def at(s0):
         return int(np.searchsorted(t, s0 - 1e-12 * max(1.0, abs(s0))))
 
+    def direction(i_from, i_to):
+        """``"upshift"`` or ``"downshift"``: the engine's speed over the output's falls or rises from sample
+        ``i_from`` to ``i_to``; None without an engine column, or where the two ratios cannot be told apart."""
+        if cols["engine"] is None:
+            return None
+        rows = [i_from, i_to]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r0, r1 = np.abs(df[cols["engine"]].to_numpy(float)[rows] / df[cols["output"]].to_numpy(float)[rows])
+        if not (math.isfinite(r0) and math.isfinite(r1)) or r0 == r1:
+            return None
+        return "upshift" if r1 < r0 else "downshift"
+
     if clutch is not None:
         tau_c, w_c = (np.abs(df[f"{clutch}.{q}"].to_numpy(float)) for q in ("tau_Nm", "w_rel_rad_s"))
         if not tau_c.max() > 0.0:
@@ -389,12 +412,7 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         i_end = locks(w_c, cw_thr, f"the clutch {clutch}", i_in)
         i_back = first(tau_c > c_thr, i_in, f"the clutch {clutch} never carries torque again after {t[i_in]:g} s")
         ts, th, tl, te = t[i0], t[i_open], t[i_in], t[i_end]
-        order = "shift"
-        if cols["engine"] is not None:
-            ratio = df[cols["engine"]].to_numpy(float) / df[cols["output"]].to_numpy(float)
-            r0, r1 = abs(ratio[i0]), abs(ratio[i_end])
-            if math.isfinite(r0) and math.isfinite(r1) and r0 != r1:
-                order = "upshift" if r1 < r0 else "downshift"
+        order = direction(i0, i_end) or "shift"
     else:
         t_ref = max(tau_off.max(), tau_on.max())
         w_ref = max(w_off.max(), w_on.max())
@@ -415,8 +433,8 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         i_hand = first(tau_off <= t_thr, i0, f"{offgoing} never lets go of its torque after {t[i0]:g} s")
         i_lock = locks(w_on, w_thr, oncoming, i0)
         i_end = max(i_hand, i_lock)
-        upshift = i_hand <= i_lock
-        order = "upshift" if upshift else "downshift"
+        upshift = i_hand <= i_lock   # (the sequence: torque phase first)
+        order = direction(i0, i_end) or ("upshift" if upshift else "downshift")
         ts, th, tl, te = t[i0], t[i_hand], t[i_lock], t[i_end]
 
     speed = df[cols["output"]].to_numpy(float)
@@ -505,4 +523,5 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         trace["engine_speed_rad_s"] = df[cols["engine"]].to_numpy(float)
     return ShiftQuality(float(ts), float(th), float(tl), float(te), order,
                         {k: float(v) for k, v in values.items()}, cols, trace,
-                        "power" if clutch is None else "interrupted")
+                        "power" if clutch is None else "interrupted",
+                        "" if clutch is not None else ("torque_first" if upshift else "inertia_first"))
