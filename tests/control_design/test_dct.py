@@ -247,6 +247,36 @@ def test_a_coast_downshift_hands_the_drag_over_and_then_pulls_the_engine_up(coas
     assert np.abs(df["energy_error_J"]).max() < 1e-7 * df["input_work_J"].abs().max()
 
 
+def test_a_tip_out_makes_the_next_shift_a_coast_shift(dct):
+    """The driver's demand as rows: 150 N m, lifted off to -40 N m (the drag) over 1.2-1.25 s.  The upshift at 0.5 s
+    is a power-on one (its torque phase first); the downshift at 1.6 s, after the tip-out, a coast one, also torque
+    phase first (a power-on downshift would start with its inertia phase): c1 takes the drag over, then pulls the
+    engine up to 1st's speed, ``J_e (w[k + 1] - w[k]) / h = T + u1 C`` while it slides alone.  Between the shifts the
+    engine's torque is the demand at each sample."""
+    demand = [(0.0, TORQUE), (1.2, TORQUE), (1.25, COAST)]
+    tcu = DctController(GEARS, 1, [(0.5, 2), (1.6, 1)], torque_input="torque_command", torque=demand,
+                        engine_speed="engine.w", output_speed="output_shaft.w")
+    assert tcu.torque == ((0.0, TORQUE), (1.2, TORQUE), (1.25, COAST))
+    res = _run(dct, tcu, 2.4)
+    ph = tcu.phases
+    assert list(ph.phase) == ["drive", "torque_phase", "inertia_phase", "lock", "drive", "torque_phase",
+                              "inertia_phase", "lock", "drive"]
+    df = res.frame
+    t = df.time_s.to_numpy()
+    phase = _phase_at(ph, t)
+    drive = phase == "drive"
+    np.testing.assert_allclose(df["torque_command_Nm"].to_numpy()[drive],
+                               np.interp(t[drive], *zip(*demand)), rtol=0, atol=1e-12)
+    rows = np.flatnonzero((t[:-1] > 1.6) & (phase[:-1] == "inertia_phase") & (df["c1.mode_1"].to_numpy()[1:] != 0.0))
+    assert rows.size > 20 and np.all(df["c2_command_1"].to_numpy()[rows] == 0.0)
+    accel, closed = _sliding_engine(df, rows)
+    np.testing.assert_allclose(accel, closed, rtol=0, atol=1e-6)
+    down = tcu.shift_quality(df, **HOW)[1]
+    assert (down.order, down.sequence) == ("downshift", "torque_first")
+    end = df.iloc[-1]
+    assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(3.5, rel=1e-6)
+
+
 @settings(max_examples=examples(6), deadline=None, derandomize=True)
 @given(st.lists(st.tuples(st.floats(0.05, 2.5), st.sampled_from([1, 2])), min_size=1, max_size=3),
        st.floats(0.0, 0.6), st.floats(0.55, 1.0))
@@ -309,7 +339,9 @@ def test_a_hand_over_that_cannot_happen_stops_the_run(dct):
     (dict(coast_slip=1.0), r"DctController: coast_slip = 1\.0 must be < 1"),
     (dict(handover=float("nan")), r"handover = nan must be finite and > 0"),
     (dict(engine_speed=""), r"engine_speed = '' must be a name"),
-    (dict(torque=math.inf), r"torque = inf must be finite"),
+    (dict(torque=math.inf), r"torque = inf must be a finite number"),
+    (dict(torque=[(0.0, 150.0), (0.0, -40.0)]), r"rows \(time \[s\], torque \[N m\]\) of finite numbers with "
+                                                r"increasing times"),
 ])
 def test_bad_settings_are_refused_naming_them(change, message):
     kw = dict(gears=GEARS, start_gear=1, commands=[(0.5, 2)], torque_input="torque_command", torque=TORQUE,
@@ -377,9 +409,10 @@ def test_a_bad_dct_table_is_refused_naming_the_file_and_the_field(edit, message)
         parse_driveline(doc, "dct.toml")
 
 
-def test_the_file_s_coast_slip_reaches_the_controller():
+def test_the_file_s_coast_slip_and_demand_rows_reach_the_controller():
     """``[tcu] coast_slip`` (a coast upshift's off-going factor) is read with the other fields and given to the
-    controller; left out, it is the controller's default (0: the off-going clutch opens)."""
+    controller (left out, the controller's default: 0, the off-going clutch opens); ``torque`` may be rows [time,
+    torque] with units (a tip-out), converted to SI; rows that are not pairs are refused naming the field."""
     import tomllib
 
     from clutchlab.driveline.description import parse_driveline
@@ -387,7 +420,13 @@ def test_the_file_s_coast_slip_reaches_the_controller():
     doc = tomllib.loads(EXAMPLE.read_text())
     assert DctController.from_table(parse_driveline(doc, "dct.toml").tcu).coast_slip == 0.0
     doc["tcu"]["coast_slip"] = 0.1
-    assert DctController.from_table(parse_driveline(doc, "dct.toml").tcu).coast_slip == 0.1
+    doc["tcu"]["torque"] = [["0 s", "150 N m"], ["1200 ms", "150 N m"], ["1.25 s", "-40 N m"]]
+    tcu = DctController.from_table(parse_driveline(doc, "dct.toml").tcu)
+    assert tcu.coast_slip == 0.1 and tcu.torque == ((0.0, 150.0), (1.2, 150.0), (1.25, -40.0))
+    assert tcu.demand(1.225) == pytest.approx(55.0) and tcu.demand(9.0) == -40.0
+    doc["tcu"]["torque"] = [["0 s", "150 N m", "1 s"]]
+    with pytest.raises(ParameterError, match=r"dct\.toml: tcu\.torque must be a torque or rows \[time, torque\]"):
+        parse_driveline(doc, "dct.toml")
 
 
 def test_the_command_line_refuses_a_controller_it_cannot_build(tmp_path, capsys):

@@ -58,6 +58,25 @@ class DctGear:
         object.__setattr__(self, "ratio", r)
 
 
+def _demand_profile(torque):
+    """``(torque, (times, values))``: the driver's demand as given (a float, or a tuple of ``(time, torque)`` rows)
+    and as arrays to interpolate; a :class:`~clutchlab.errors.ParameterError` naming what is wrong."""
+    bad = ParameterError(f"DctController: torque = {torque!r} must be a finite number [N m], or rows (time [s], "
+                         "torque [N m]) of finite numbers with increasing times")
+    if isinstance(torque, (int, float, np.number)) and not isinstance(torque, bool):
+        value = float(torque)
+        if not math.isfinite(value):
+            raise bad
+        return value, (np.zeros(1), np.array([value]))
+    try:
+        rows = np.array([(float(a), float(b)) for a, b in torque], dtype=float)
+    except (TypeError, ValueError):
+        raise bad from None
+    if rows.ndim != 2 or rows.shape[0] < 1 or not np.all(np.isfinite(rows)) or np.any(np.diff(rows[:, 0]) <= 0.0):
+        raise bad
+    return tuple(map(tuple, rows.tolist())), (rows[:, 0].copy(), rows[:, 1].copy())
+
+
 class DctController(GearCommand):
     """The power shifts of a dual-clutch transmission's controller, as a function controller ``f(t, y, memory) -> u``
     of :func:`~clutchlab.control.closed_loop`.
@@ -74,8 +93,9 @@ class DctController(GearCommand):
         (a command during a shift waits for it to end; one of the gear engaged is no shift).
     torque_input : str
         The network input of the engine's torque [N m].
-    torque : float
-        The engine's torque, the driver's demand [N m].
+    torque : float or sequence of (float, float)
+        The engine's torque, the driver's demand [N m]: a number, or rows ``(time [s], torque [N m])`` with
+        increasing times, linear between them and held beyond (a tip-in or a tip-out: :meth:`demand`).
     engine_speed, output_speed : str
         The outputs it reads: the engine's speed [rad/s] (e.g. ``"engine.w"``) and the output speed the gears' ratios
         refer to (e.g. ``"output_shaft.w"``).
@@ -105,7 +125,8 @@ class DctController(GearCommand):
         :class:`~clutchlab.errors.SimulationError` naming the phase and the clutches (default 1).
 
     The sequence (docs/control.md, "A power-shift controller for the DCT"), ``s`` each ramp's fraction; a shift is
-    *power-on* where ``torque > 0`` (the engine drives), a *coast* shift where ``torque <= 0`` (the engine's drag):
+    *power-on* where the demand at its command is above 0 (the engine drives), a *coast* shift where it is not (the
+    engine's drag), and keeps that sequence to its end; ``torque`` below is the demand at each sample:
 
     * **torque phase first** (a power-on upshift, the new gear's ratio lower; a coast downshift, higher): the engine's
       torque moves it away from the new gear's speed, so the on-coming clutch, sliding, can take the drive over at
@@ -144,9 +165,7 @@ class DctController(GearCommand):
             if not isinstance(v, str) or not v:
                 raise ParameterError(f"DctController: {what} = {v!r} must be a name")
         self.torque_input, self.engine_speed, self.output_speed = torque_input, engine_speed, output_speed
-        self.torque = float(torque)
-        if not math.isfinite(self.torque):
-            raise ParameterError(f"DctController: torque = {torque!r} must be finite")
+        self.torque, self._demand = _demand_profile(torque)
         who = "DctController"
         self.fill = _positive("fill", fill, who=who)
         self.handover = _positive("handover", handover, who=who)
@@ -183,6 +202,7 @@ class DctController(GearCommand):
         self._drive_sign = 1.0   # the sign of the off-going clutch's torque while it drives (at the command)
         self._from = 1.0         # the off-going factor where the last ramp started
         self._handed = 0.0       # the on-coming factor at the hand-over (a torque phase that comes first)
+        self._power_on = True    # the shift under way is a power-on one (the demand at its command above 0)
 
     def _element(self, gear):
         return self.gears[gear].clutch
@@ -199,10 +219,15 @@ class DctController(GearCommand):
     def _up(self):
         return self.gears[self._target].ratio < self.gears[self._gear].ratio
 
+    def demand(self, t: float) -> float:
+        """The driver's demand [N m] at ``t`` [s] (``torque``)."""
+        times, values = self._demand
+        return float(np.interp(t, times, values))
+
     def _torque_first(self):
         """The shift under way does its torque phase first: the engine's torque moves it away from the new gear's
         speed (a power-on upshift, a coast downshift)."""
-        return (self.torque > 0.0) == self._up()
+        return self._power_on == self._up()
 
     def _reached(self, seen):
         """The engine has reached the new gear's speed ``ratio w_out``: from below in a downshift, from above in an
@@ -212,7 +237,7 @@ class DctController(GearCommand):
 
     def _slip(self):
         """The off-going factor an inertia phase that comes first ramps down to."""
-        return self.slip if self.torque > 0.0 else self.coast_slip
+        return self.slip if self._power_on else self.coast_slip
 
     def _timeout(self, t, what):
         if t - self._since > self.shift_timeout:
@@ -228,6 +253,7 @@ class DctController(GearCommand):
             if g is not None:
                 self._target = g
                 self._drive_sign = 1.0 if seen["tau"][self._gear] >= 0.0 else -1.0
+                self._power_on = self.demand(t) > 0.0
                 self._enter("torque_phase" if self._torque_first() else "inertia_phase", t)
         elif phase == "torque_phase" and self._torque_first():
             # the on-coming clutch has taken the torque over: the off-going one carries none (or slides)
@@ -258,7 +284,8 @@ class DctController(GearCommand):
 
     def _outputs(self, t):
         u = np.zeros(len(self.actuated))
-        phase, torque = self._phase, self.torque
+        phase, demand = self._phase, self.demand(t)
+        torque = demand
         f = {g: 0.0 for g in self.gears}
         if phase == "drive":
             f[self._gear] = 1.0
@@ -268,10 +295,10 @@ class DctController(GearCommand):
                 f[old], f[new] = 1.0, self.fill * self._ramp(t, self.handover)
             elif phase == "inertia_phase" and self._torque_first():
                 f[new] = self._handed + (1.0 - self._handed) * self._ramp(t, self.rise)
-                torque = (1.0 - self.torque_cut) * self.torque
+                torque = (1.0 - self.torque_cut) * demand
             elif phase == "lock":
                 f[new] = 1.0
-                torque = (1.0 - self.torque_cut * (1.0 - self._ramp(t, self.restore))) * self.torque
+                torque = (1.0 - self.torque_cut * (1.0 - self._ramp(t, self.restore))) * demand
             elif phase == "inertia_phase":
                 f[old] = 1.0 - (1.0 - self._slip()) * self._ramp(t, self.handover)
             else:   # (the torque phase after an inertia phase)

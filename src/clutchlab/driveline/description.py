@@ -204,7 +204,7 @@ TCU_GEAR_FIELDS = ("synchronizer", "fork", "side", "ratio")
 #: the fields of a ``[tcu]`` table with ``type = "dct"`` (:class:`clutchlab.control.DctController`'s arguments and the
 #: controller's sample time)
 DCT_FIELDS = {"type": "type", "gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
-              "torque": "N*m", "engine_speed": "variable", "output_speed": "variable", "fill": "1", "handover": "s",
+              "torque": "demand", "engine_speed": "variable", "output_speed": "variable", "fill": "1", "handover": "s",
               "rise": "s", "restore": "s", "torque_cut": "1", "slip": "1", "coast_slip": "1", "shift_timeout": "s",
               "sample_time": "s"}
 #: the fields of one gear of a dual-clutch ``[tcu]`` table's ``gears``
@@ -663,6 +663,15 @@ def _tcu(table, d: Driveline, src: str):
         elif kind == "input":
             _network_input(v, d, key, src)
             out[k] = v
+        elif kind == "demand":   # a torque, or rows [time, torque] (a DCT driver's tip-in or tip-out)
+            if isinstance(v, list):
+                if not all(isinstance(r, list) and len(r) == 2 for r in v):
+                    raise ParameterError(f"{src}: {key} must be a torque or rows [time, torque], e.g. "
+                                         "[[\"0 s\", \"150 N m\"], [\"1 s\", \"-40 N m\"]]")
+                out[k] = [(_quantity(a, "s", f"{key}[{i}]", src), _quantity(b, "N*m", f"{key}[{i}]", src))
+                          for i, (a, b) in enumerate(v)]
+            else:
+                out[k] = _quantity(v, "N*m", key, src)
         elif kind == "variable":
             if variables is None:
                 variables = d.variables()
