@@ -265,7 +265,8 @@ def test_a_command_of_the_gear_engaged_is_no_shift_and_a_new_run_starts_again(am
     (dict(commands=[(0.4, 5)]), r"the command at 0\.4 s selects gear 5"),
     (dict(commands=[0.4]), r"a command 0\.4 must be \(time \[s\], gear\)"),
     (dict(commands=[("soon", 2)]), r"the command \('soon', 2\): its time must be a finite number"),
-    (dict(drag=10.0), r"drag = 10\.0 finite and <= 0"),
+    (dict(drag=10.0), r"drag = 10\.0 must be finite and <= 0"),
+    (dict(torque=math.nan), r"AmtController: torque = nan must be a finite number"),
     (dict(clutch_open=0.0), r"clutch_open = 0\.0 must be finite and > 0"),
     (dict(fork_force=float("nan")), r"fork_force = nan must be finite and > 0"),
     (dict(gears={1: AmtGear("s1", "fork"), 2: AmtGear("s1", "fork", -1)}), r"two gears share a synchroniser"),
@@ -353,7 +354,7 @@ def test_the_command_line_refuses_a_file_without_a_tcu_and_a_controller_it_canno
     bad = tmp_path / "amt.toml"
     bad.write_text(EXAMPLE.read_text().replace('drag = "-30 N m"', 'drag = "30 N m"'))
     line = one_line_error(capsys, ["control", "tcu", str(bad), "-o", str(tmp_path / "run.csv")])
-    assert "amt.toml: [tcu] AmtController: torque = 150.0 must be finite and drag = 30.0 finite and <= 0" in line
+    assert "amt.toml: [tcu] AmtController: drag = 30.0 must be finite and <= 0" in line
     assert not (tmp_path / "run.csv").exists()
     text = EXAMPLE.read_text()
     at = text.index("\n[tcu]")   # (1st's ratio in the controller's table, not the network's gear)
@@ -361,3 +362,31 @@ def test_the_command_line_refuses_a_file_without_a_tcu_and_a_controller_it_canno
     line = one_line_error(capsys, ["control", "tcu", str(bad), "-o", str(tmp_path / "run.csv")])
     assert "amt.toml: [tcu] AmtController: speed_match needs every gear's ratio; gear(s) [1] have none" in line
     assert not (tmp_path / "run.csv").exists()
+
+
+def test_the_amt_s_demand_may_be_rows_and_its_torque_follows_them(amt):
+    """The driver's demand as rows (the DCT controller's :meth:`~clutchlab.control.GearCommand.demand`): held
+    constant, the same run as the number, sample for sample; rising from 100 to 150 N m over 0.1-0.3 s before an
+    upshift at 0.4 s, the engine's torque is the demand at each sample in gear, the torque's ramp down starts from
+    the demand at each sample, and the full-load bound of the speed matching defaults to the largest demand."""
+    flat = _tcu([(0.4, 2)], **MATCH)
+    rows = AmtController(GEARS, 1, [(0.4, 2)], clutch_input="clutch_command", torque_input="torque_command",
+                         torque=[(0.0, 150.0), (5.0, 150.0)], drag=DRAG, fork_force=FORK, **MATCH)
+    a, b = _run(amt, flat, 1.2), _run(amt, rows, 1.2)
+    assert a.frame.equals(b.frame) and flat.phases.equals(rows.phases)
+    demand = [(0.0, 100.0), (0.1, 100.0), (0.3, 150.0)]
+    tip = AmtController(GEARS, 1, [(0.4, 2)], clutch_input="clutch_command", torque_input="torque_command",
+                        torque=demand, drag=DRAG, fork_force=FORK)
+    assert tip.torque_max == 150.0 and tip.demand(0.2) == pytest.approx(125.0)
+    res = _run(amt, tip, 1.2)
+    df = res.frame
+    t = df.time_s.to_numpy()
+    first = t < 0.4
+    np.testing.assert_allclose(df["torque_command_Nm"].to_numpy()[first], np.interp(t[first], *zip(*demand)),
+                               rtol=0, atol=1e-12)
+    down = (t >= 0.4) & (t < 0.4 + tip.torque_down)
+    ramp = 1.0 - (t[down] - 0.4) / tip.torque_down
+    np.testing.assert_allclose(df["torque_command_Nm"].to_numpy()[down], 150.0 * ramp, rtol=0, atol=1e-9)
+    with pytest.raises(ParameterError, match=r"AmtController: torque = \[\(0\.0, 1\.0\), \(0\.0, 2\.0\)\] must be"):
+        AmtController(GEARS, 1, [(0.4, 2)], clutch_input="clutch_command", torque_input="torque_command",
+                      torque=[(0.0, 1.0), (0.0, 2.0)], drag=DRAG)

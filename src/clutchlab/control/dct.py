@@ -58,25 +58,6 @@ class DctGear:
         object.__setattr__(self, "ratio", r)
 
 
-def _demand_profile(torque):
-    """``(torque, (times, values))``: the driver's demand as given (a float, or a tuple of ``(time, torque)`` rows)
-    and as arrays to interpolate; a :class:`~clutchlab.errors.ParameterError` naming what is wrong."""
-    bad = ParameterError(f"DctController: torque = {torque!r} must be a finite number [N m], or rows (time [s], "
-                         "torque [N m]) of finite numbers with increasing times")
-    if isinstance(torque, (int, float, np.number)) and not isinstance(torque, bool):
-        value = float(torque)
-        if not math.isfinite(value):
-            raise bad
-        return value, (np.zeros(1), np.array([value]))
-    try:
-        rows = np.array([(float(a), float(b)) for a, b in torque], dtype=float)
-    except (TypeError, ValueError):
-        raise bad from None
-    if rows.ndim != 2 or rows.shape[0] < 1 or not np.all(np.isfinite(rows)) or np.any(np.diff(rows[:, 0]) <= 0.0):
-        raise bad
-    return tuple(map(tuple, rows.tolist())), (rows[:, 0].copy(), rows[:, 1].copy())
-
-
 class DctController(GearCommand):
     """The power shifts of a dual-clutch transmission's controller, as a function controller ``f(t, y, memory) -> u``
     of :func:`~clutchlab.control.closed_loop`.
@@ -165,7 +146,7 @@ class DctController(GearCommand):
             if not isinstance(v, str) or not v:
                 raise ParameterError(f"DctController: {what} = {v!r} must be a name")
         self.torque_input, self.engine_speed, self.output_speed = torque_input, engine_speed, output_speed
-        self.torque, self._demand = _demand_profile(torque)
+        self._set_demand(torque)
         who = "DctController"
         self.fill = _positive("fill", fill, who=who)
         self.handover = _positive("handover", handover, who=who)
@@ -218,11 +199,6 @@ class DctController(GearCommand):
 
     def _up(self):
         return self.gears[self._target].ratio < self.gears[self._gear].ratio
-
-    def demand(self, t: float) -> float:
-        """The driver's demand [N m] at ``t`` [s] (``torque``)."""
-        times, values = self._demand
-        return float(np.interp(t, times, values))
 
     def _torque_first(self):
         """The shift under way does its torque phase first: the engine's torque moves it away from the new gear's

@@ -76,6 +76,25 @@ def _positive(name, value, zero=False, who="AmtController"):
     return v
 
 
+def _demand_profile(torque, who):
+    """``(torque, (times, values))``: the driver's demand as given (a float, or a tuple of ``(time, torque)`` rows)
+    and as arrays to interpolate; a :class:`~clutchlab.errors.ParameterError` naming what is wrong."""
+    bad = ParameterError(f"{who}: torque = {torque!r} must be a finite number [N m], or rows (time [s], "
+                         "torque [N m]) of finite numbers with increasing times")
+    if isinstance(torque, (int, float, np.number)) and not isinstance(torque, bool):
+        value = float(torque)
+        if not math.isfinite(value):
+            raise bad
+        return value, (np.zeros(1), np.array([value]))
+    try:
+        rows = np.array([(float(a), float(b)) for a, b in torque], dtype=float)
+    except (TypeError, ValueError):
+        raise bad from None
+    if rows.ndim != 2 or rows.shape[0] < 1 or not np.all(np.isfinite(rows)) or np.any(np.diff(rows[:, 0]) <= 0.0):
+        raise bad
+    return tuple(map(tuple, rows.tolist())), (rows[:, 0].copy(), rows[:, 1].copy())
+
+
 class GearCommand:
     """What a transmission controller of :mod:`clutchlab.control` shares (:class:`AmtController`,
     :class:`~clutchlab.control.dct.DctController`): its gear command, the log of its phases by name, its shifts and
@@ -219,6 +238,16 @@ class GearCommand:
     def _ramp(self, t, duration):
         return min(max((t - self._since) / duration, 0.0), 1.0)
 
+    def _set_demand(self, torque):
+        """:attr:`torque` as given (a number, or rows ``(time [s], torque [N m])`` as a tuple) and the arrays
+        :meth:`demand` interpolates."""
+        self.torque, self._demand = _demand_profile(torque, type(self).__name__)
+
+    def demand(self, t: float) -> float:
+        """The driver's demand [N m] at ``t`` [s]: ``torque``, linear between its rows and held beyond them."""
+        times, values = self._demand
+        return float(np.interp(t, times, values))
+
 
 class AmtController(GearCommand):
     """The shift sequence of an AMT's controller, as a function controller ``f(t, y, memory) -> u`` of
@@ -236,8 +265,9 @@ class AmtController(GearCommand):
         the gear engaged is no shift.
     clutch_input, torque_input : str
         The network inputs of the clutch's normal-force factor (1 closed, 0 open) and of the engine's torque [N m].
-    torque : float
-        The engine's torque while in gear [N m] (the driver's demand).
+    torque : float or sequence of (float, float)
+        The engine's torque while in gear [N m] (the driver's demand): a number, or rows ``(time [s], torque [N m])``
+        with increasing times, linear between them and held beyond (:meth:`demand`).
     drag : float
         The engine's torque while the clutch is open [N m] (a fuel cut's drag, <= 0: the engine slows towards the
         new gear's speed).
@@ -265,7 +295,7 @@ class AmtController(GearCommand):
         (e.g. ``"engine.w"``) and the output speed the gears' ratios refer to (e.g. ``"output_shaft.w"``).
     torque_max : float, optional
         The most torque the speed matching commands [N m] (the engine's full-load torque at those speeds;
-        default ``max(torque, 0)``).
+        default the largest demand, or 0).
 
     The controller measures its synchronisers' modes and, matching speeds, the engine's and the output speed,
     :attr:`measured` (the first entries of ``measure``; more may follow, for the record), and actuates
@@ -282,11 +312,11 @@ class AmtController(GearCommand):
                  output_speed: str | None = None, torque_max: float | None = None):
         self._set_gears(gears, start_gear, commands, AmtGear)
         self.clutch_input, self.torque_input = str(clutch_input), str(torque_input)
-        self.torque = float(torque)
+        self._set_demand(torque)
         self.drag = float(drag)
-        if not (math.isfinite(self.torque) and math.isfinite(self.drag) and self.drag <= 0.0):
-            raise ParameterError(f"AmtController: torque = {torque!r} must be finite and drag = {drag!r} finite "
-                                 "and <= 0 (the engine's drag while the clutch is open)")
+        if not (math.isfinite(self.drag) and self.drag <= 0.0):
+            raise ParameterError(f"AmtController: drag = {drag!r} must be finite and <= 0 (the engine's drag while "
+                                 "the clutch is open)")
         self.fork_force = _positive("fork_force", fork_force)
         self.torque_down = _positive("torque_down", torque_down)
         self.clutch_open = _positive("clutch_open", clutch_open)
@@ -294,7 +324,7 @@ class AmtController(GearCommand):
         self.clutch_close = _positive("clutch_close", clutch_close)
         self.sync_timeout = _positive("sync_timeout", sync_timeout)
         self.speed_match = _positive("speed_match", speed_match, zero=True)
-        self.torque_max = (max(self.torque, 0.0) if torque_max is None else
+        self.torque_max = (max(float(self._demand[1].max()), 0.0) if torque_max is None else
                            _positive("torque_max", torque_max, zero=True))
         self.engine_speed, self.output_speed = engine_speed, output_speed
         if self.speed_match:
@@ -400,11 +430,12 @@ class AmtController(GearCommand):
     def _outputs(self, t):
         u = np.zeros(len(self.actuated))
         phase = self._phase
-        torque, clutch = self.torque, 1.0
+        demand = self.demand(t)
+        torque, clutch = demand, 1.0
         held = self._gear          # the gear whose fork pushes (the one engaged, until neutral)
         push = 1.0
         if phase == "torque_down":
-            torque = self.torque * (1.0 - self._ramp(t, self.torque_down))
+            torque = demand * (1.0 - self._ramp(t, self.torque_down))
         elif phase == "clutch_open":
             s = self._ramp(t, self.clutch_open)
             torque, clutch = self.drag * s, 1.0 - s
@@ -414,7 +445,7 @@ class AmtController(GearCommand):
             torque, clutch, held, push = self._match(), 0.0, self._target, self._ramp(t, self.fork_ramp)
         elif phase == "clutch_close":
             s = self._ramp(t, self.clutch_close)
-            torque, clutch, held = (1.0 - s) * self._match() + s * self.torque, s, self._target
+            torque, clutch, held = (1.0 - s) * self._match() + s * demand, s, self._target
         u[0], u[1] = torque, clutch
         gear = self.gears[held]
         u[self._fork_at[gear.fork]] = gear.side * self.fork_force * push

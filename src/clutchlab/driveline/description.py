@@ -195,7 +195,7 @@ class DrivelineFile:
 #: the fields of a ``[tcu]`` table (:class:`clutchlab.control.AmtController`'s arguments and the controller's sample
 #: time): name -> unit of a quantity, or the kind of a value that is not one
 TCU_FIELDS = {"gears": "gears", "start_gear": "gear", "commands": "commands", "torque_input": "input",
-              "clutch_input": "input", "torque": "N*m", "drag": "N*m", "fork_force": "N", "torque_down": "s",
+              "clutch_input": "input", "torque": "demand", "drag": "N*m", "fork_force": "N", "torque_down": "s",
               "clutch_open": "s", "fork_ramp": "s", "clutch_close": "s", "sync_timeout": "s", "sample_time": "s",
               "speed_match": "N*m*s/rad", "engine_speed": "variable", "output_speed": "variable", "torque_max": "N*m",
               "type": "type"}
