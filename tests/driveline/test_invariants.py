@@ -761,6 +761,32 @@ def test_a_synchroniser_pushed_to_the_run_s_end_at_its_force_s_zero_keeps_the_in
     _check_columns(d, df, res.events)
 
 
+def test_a_brake_slowing_a_stuck_group_through_a_parabola_sticks_where_it_stops():
+    """Four inertias (1, 1, 0.5, 1 kg m^2) held together by three clutches, from rest under two ramps (8 t and 40 t
+    N m), a brake of 10.8 N m stepped on at 7/64 s (the thorough profile's seed 1407 drew it with a spring): the group
+    decelerates on a parabola, ``3.5 w = 24 (t^2 - t0^2) - 10.8 (t - t0) + 24 t0^2``, which Dormand-Prince integrates
+    exactly, so its steps grow across the dip.  The brake sticks where the speed reaches zero, ``24 t^2 - 10.8 t +
+    10.8 t0 = 0``: t = 3/16 s, and breaks away where the ramps reach its limit, ``48 t = 10.8``: t = 0.225 s; the
+    speed never goes negative.  (Stepped over, the brake slid on to -0.0096 rad/s, driving the group backward.)"""
+    d = Driveline("brake_dip")
+    for name, J in (("J0", 1.0), ("J1", 1.0), ("J2", 0.5), ("J3", 1.0)):
+        d.inertia(name, J=J, w0=0.0)
+    d.clutch("c0", "J0", "J1", fn_max=10.0, mu=0.5, peak=1.0)
+    d.clutch("c2", "J2", "J3", fn_max=2.0, mu=0.5, peak=1.0)
+    d.clutch("loop", "J0", "J3", fn_max=5.0, mu=0.5, peak=1.0)
+    d.clutch("brake", GROUND, "J1", fn_max=27.0, mu=0.4, peak=1.0, normal=Signal.step(1.0, 0.109375))
+    d.torque("T0", "J0", Signal.ramp(2.5, 0.3125))
+    d.torque("T1", "J1", Signal.ramp(30.0, 0.75))
+    for rtol in (1e-6, 1e-9):
+        res = d.simulate(0.4, output_step=2e-3, rtol=rtol, check_invariants=True)
+        ev = res.events[res.events.element == "brake"]
+        assert list(ev.event) == ["forward", "stick", "forward"]
+        np.testing.assert_allclose(ev.time_s, [0.109375, 3.0 / 16.0, 0.225], rtol=0, atol=1e-6)
+        df = res.to_dataframe()
+        assert df["brake.w_rel_rad_s"].min() >= -1e-9
+        _check_columns(d, df, res.events)
+
+
 # derandomised in every profile: random draws still find rare networks started from rest whose first decision is
 # taken at the rounding floor (a lossy gear whose loss table has no bearing friction, so its stuck band is empty,
 # carrying 1e-16 N m from a sine at its zero: it rolls "forward" at zero speed in one step sequence and stays stuck
@@ -1397,8 +1423,16 @@ def test_a_one_way_clutch_between_lossy_gears_locks_where_its_input_overtakes_it
         for rtol in (1e-7, 1e-10, 1e-12):
             res = network(unrelated).simulate(1.0, rtol=rtol, output_step=2e-3, check_invariants=True)
             ev = _mode_events(res)
-            at = sorted((el, e) for t, el, e in ev if abs(t - 7.0 / 12.0) < 1e-6)
+            # f1 sticks at 7/12 s, where J1 turns forward, or where J1 came to rest beside J2 at rest, 0.58241 s: from
+            # there to 7/12 s every inertia is at rest (speeds of 1e-18 rad/s), so "stuck" and "sliding at zero speed"
+            # are the same motion, and which label a run gives depends on its step sequence (the rounding floor's
+            # family, docs/driveline.md); likewise g2's start forward
+            at = sorted((el, e) for t, el, e in ev if 0.5824 < t < 7.0 / 12.0 + 1e-6)
             assert ("f1", "stick") in at and ("g2", "forward") in at, (unrelated, rtol, ev)
+            stuck = [t for t, el, e in ev if el == "f1" and e == "stick" and t > 0.5824][0]
+            fine = network(unrelated).simulate(7.0 / 12.0 - 1e-4, rtol=rtol, output_step=1e-4).to_dataframe()
+            rest = fine[fine.time_s > stuck + 1e-4]
+            assert rest.empty or rest.filter(like=".w_rad_s").abs().max().max() < 1e-12, (unrelated, rtol, stuck)
             release = [t for t, el, e in ev if el == "f1" and e == "forward" and t > 0.59]
             assert release and abs(release[0] - 11.0 / 12.0) < 1e-6, (unrelated, rtol, ev)
             df = res.to_dataframe()

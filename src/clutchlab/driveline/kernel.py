@@ -206,7 +206,11 @@ SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn")
 N_SW = len(SPRING_SWITCHING)
 G_LASH_TURN = indices(SPRING_SWITCHING, "turn")
 #: a sliding element's relative speed below this share of the largest speed (at least 1) is watched for its turning
-#: point (G_TURN), so that a dip through zero shorter than a step is not stepped over
+#: point (G_TURN), so that a dip through zero shorter than a step is not stepped over; so is one that is slowing down
+#: at any speed (its turning function then starts the step below zero, and a step that ends speeding up again, past
+#: the slow band, still sees it cross: a brake decelerating a stuck group from 0.08 rad/s under ramps, whose speed
+#: is a parabola Dormand-Prince integrates exactly, stepped from above the band to above it across a 78 ms dip to
+#: -0.0096 rad/s, the brake driving the group backward, the thorough profile's seed 1407)
 TURN_WATCH = 1e-2
 #: relative size of rounding in the torques of the constraint set (the thresholds of the stick/slip decisions
 #: and of the switching functions that watch them, which must agree: after a decision every function watching it
@@ -4636,11 +4640,13 @@ def driveline_rhs(t, x, u, m, p, dx, g):
                 g[N_G * k + G_NEAR] = g[N_G * k + G_BREAK] - NEAR_LIMIT * lim
                 if g[N_G * k + G_NEAR] < 0.0:
                     g[N_G * k + G_TURN] = 0.0
-        if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL and \
-                abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
+        if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL:
             a_rel = (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
             # (plus the rounding of an acceleration: a speed held at rest by other elements has no turning point)
-            g[N_G * k + G_TURN] = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
+            turn = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
+            # watched while slow, and while slowing down at any speed (:data:`TURN_WATCH`)
+            if turn < 0.0 or abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
+                g[N_G * k + G_TURN] = turn
         if p.elem[r, E_LAW] != LAW_CLUTCH or p.elem[r, E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif p.elem[r, E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
@@ -4719,9 +4725,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         w_a = gear_speed(p, r, x, n)
         forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
         g[q] = (w_a if forward else -w_a) + slack[nf + j]
-        if abs(w_a) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
-            a_a = _item_acc(p, acc, nf + j)
-            g[q + GG_TURN] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
+        a_a = _item_acc(p, acc, nf + j)
+        turn = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
+        if turn < 0.0 or abs(w_a) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):   # (slow, or slowing down)
+            g[q + GG_TURN] = turn
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + GG_FLANGE] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
