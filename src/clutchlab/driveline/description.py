@@ -663,7 +663,7 @@ def _tcu(table, d: Driveline, src: str):
         elif kind == "input":
             _network_input(v, d, key, src)
             out[k] = v
-        elif kind == "demand":   # a torque, or rows [time, torque] (a DCT driver's tip-in or tip-out)
+        elif kind == "demand":   # a torque, or rows [time, torque] (the driver's tip-in or tip-out)
             if isinstance(v, list):
                 if not all(isinstance(r, list) and len(r) == 2 for r in v):
                     raise ParameterError(f"{src}: {key} must be a torque or rows [time, torque], e.g. "
