@@ -262,6 +262,14 @@ def test_the_emtc_bench_calls_its_hooks_through_the_outlined_signatures():
     assert events > 0   # (the run had events: its update hook ran)
 
 
+def _fresh_llvm(fn, sig) -> str:
+    """The LLVM text of ``fn`` compiled for ``sig`` afresh (not from numba's cache, whose code is not kept to be
+    read)."""
+    fresh = numba.njit(fn.py_func)
+    fresh.compile(sig)
+    return fresh.inspect_llvm(sig)
+
+
 def test_the_emtc_hooks_do_not_contain_the_outlined_functions():
     """The EMTC's registered update hook and its evaluation at a point, compiled for the hooks' signature, call the
     update and the right-hand side through their addresses: their code holds neither the update's memory commit nor
@@ -273,9 +281,7 @@ def test_the_emtc_hooks_do_not_contain_the_outlined_functions():
     bodies = re.compile(r"_ZN\w*(4_rhs|7_commit|7_switch)B")   # compiled names: defined, declared or inlined
     for fn, sig in ((S._update_hook, S._hook_args(types.int64, S._log_type())), (S._evaluate, S._hook_args()),
                     (S._update, S._hook_args(types.int64, S._log_type()))):
-        fresh = numba.njit(fn.py_func)   # (not from numba's cache: its code is kept to be read)
-        fresh.compile(sig)
-        ir = fresh.inspect_llvm(sig)
+        ir = _fresh_llvm(fn, sig)
         if fn is S._update:   # the update itself holds them: the pattern finds what it looks for
             assert bodies.search(ir)
         else:
@@ -291,11 +297,8 @@ def test_the_emtc_restart_calls_its_controller_through_its_address():
     from clutchlab.emtc import system as S
 
     bodies = re.compile(r"_ZN\w*(22commanded_magnet_force|15invert_combined)B")
-    t, x, u, _, p = S._hook_args()
-    for fn, sig in ((S._restart, S._hook_args(S._log_type())), (S._controller, (t, x, u, p))):
-        fresh = numba.njit(fn.py_func)   # (not from numba's cache: its code is kept to be read)
-        fresh.compile(sig)
-        ir = fresh.inspect_llvm(sig)
+    for fn, sig in ((S._restart, S._hook_args(S._log_type())), (S._controller, S._controller_args())):
+        ir = _fresh_llvm(fn, sig)
         if fn is S._controller:   # the controller itself holds them: the pattern finds what it looks for
             assert bodies.search(ir)
         else:
