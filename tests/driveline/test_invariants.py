@@ -787,6 +787,37 @@ def test_a_brake_slowing_a_stuck_group_through_a_parabola_sticks_where_it_stops(
         _check_columns(d, df, res.events)
 
 
+@pytest.mark.parametrize("torque", [30.0, -7.0, -7.5 - 1e-6, -30.0])
+def test_a_sliding_element_s_turning_function_is_its_acceleration_at_any_speed(torque):
+    """The turning functions of a clutch sliding at 100 rad/s and of a lossy gear rolling at 100 rad/s are their
+    relative accelerations towards their sliding directions, slowing down or speeding up (closed forms below),
+    continuous through zero: a function that read 1 while fast and speeding up jumped from about 0 to 1 at its
+    root, which the event iteration brackets only by bisection (CoupledClutches: 2,079 right-hand sides where
+    1,279 do).  The clutch (5 N m sliding) couples J1 (1 kg m^2, 100 rad/s) and J2 (0.5 kg m^2, at rest) under a
+    torque T on J2: ``w_rel = w2 - w1 < 0`` (backward), ``a_rel = 2 T + 10 + 5``, its turning function ``-a_rel``.
+    The gear (ratio 2, efficiency 0.9) drives J4 (2 kg m^2) from J3 (1 kg m^2, 100 rad/s) under T on J3: flange
+    a drives forward, ``T - tau_a = 1 a3`` and ``2 eta tau_a = 2 a4 = a3``: ``a3 = T / (1 + 1 / (2 eta))``."""
+    from clutchlab.system import evaluate
+
+    d = Driveline("turning")
+    d.inertia("J1", J=1.0, w0=100.0)
+    d.inertia("J2", J=0.5, w0=0.0)
+    d.clutch("c", "J1", "J2", fn_max=10.0, mu=0.5, peak=1.0)
+    d.torque("T", "J2", Signal.constant(torque))
+    d.inertia("J3", J=1.0, w0=100.0)
+    d.inertia("J4", J=2.0, w0=50.0)
+    d.gear("g", "J3", "J4", ratio=2.0, efficiency=0.9)
+    d.torque("T3", "J3", Signal.constant(torque))
+    system = d.system()
+    _, g, _ = evaluate(system)
+    names = [name for name, _ in system.switching]
+    a_rel = 2.0 * torque + 15.0
+    np.testing.assert_allclose(g[names.index("c.turn")], -a_rel, rtol=1e-9, atol=1e-9)
+    if torque > 0.0:   # (forward, a driving: backward its quadrants change; the clutch alone then)
+        a3 = torque / (1.0 + 1.0 / (2.0 * 0.9))
+        np.testing.assert_allclose(g[names.index("g.turn")], a3, rtol=1e-9, atol=1e-9)
+
+
 # derandomised in every profile: random draws still find rare networks started from rest whose first decision is
 # taken at the rounding floor (a lossy gear whose loss table has no bearing friction, so its stuck band is empty,
 # carrying 1e-16 N m from a sine at its zero: it rolls "forward" at zero speed in one step sequence and stays stuck

@@ -205,13 +205,14 @@ GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break
 SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn")
 N_SW = len(SPRING_SWITCHING)
 G_LASH_TURN = indices(SPRING_SWITCHING, "turn")
-#: a sliding element's relative speed below this share of the largest speed (at least 1) is watched for its turning
-#: point (G_TURN), so that a dip through zero shorter than a step is not stepped over; so is one that is slowing down
-#: at any speed (its turning function then starts the step below zero, and a step that ends speeding up again, past
-#: the slow band, still sees it cross: a brake decelerating a stuck group from 0.08 rad/s under ramps, whose speed
-#: is a parabola Dormand-Prince integrates exactly, stepped from above the band to above it across a 78 ms dip to
-#: -0.0096 rad/s, the brake driving the group backward, the thorough profile's seed 1407)
-TURN_WATCH = 1e-2
+# A sliding element's (and a rolling lossy gear's) turning function is its relative acceleration towards its
+# sliding direction at every speed (G_TURN, GG_TURN; rising through zero: a minimum of its speed), so that a dip
+# through zero shorter than a step is not stepped over: a brake decelerating a stuck group from 0.08 rad/s under
+# ramps, whose speed is a parabola Dormand-Prince integrates exactly, was stepped from 0.08 rad/s across a 78 ms dip
+# to -0.0096 rad/s and back, the brake driving the group backward (the thorough profile's seed 1407), where the
+# function watched only speeds below 1e-2 of the largest.  It is continuous: a function that read 1 while fast and
+# speeding up jumped from about 0 to 1 at its root, which the Illinois iteration brackets only by bisection (40
+# iterations to the event tolerance: CoupledClutches took 2,079 right-hand sides where 1,201 do)
 #: relative size of rounding in the torques of the constraint set (the thresholds of the stick/slip decisions
 #: and of the switching functions that watch them, which must agree: after a decision every function watching it
 #: is > 0, so that its next crossing is seen)
@@ -4615,8 +4616,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
         mk = m[k]
         g[N_G * k + G_STICK] = w_rel + slack[k] if mk == FORWARD else -w_rel + slack[k] if mk == BACKWARD else 1.0
-        # the turning point of a slow sliding speed (rising through zero: the relative acceleration turns towards
-        # the sliding direction), located so that a dip of the speed through zero within a step is seen
+        # the turning point of a sliding speed (rising through zero: the relative acceleration turns towards the
+        # sliding direction), located so that a dip of the speed through zero within a step is seen (G_TURN)
         g[N_G * k + G_TURN] = 1.0
         g[N_G * k + G_NEAR] = 1.0
         if mk != STUCK:
@@ -4643,10 +4644,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         if (mk == FORWARD or mk == BACKWARD) and p.elem[r, E_LAW] != LAW_EXTERNAL:
             a_rel = (0.0 if p.elem[r, E_B] < 0 else acc[p.elem[r, E_B]]) - (0.0 if p.elem[r, E_A] < 0 else acc[p.elem[r, E_A]])
             # (plus the rounding of an acceleration: a speed held at rest by other elements has no turning point)
-            turn = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
-            # watched while slow, and while slowing down at any speed (:data:`TURN_WATCH`)
-            if turn < 0.0 or abs(w_rel) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):
-                g[N_G * k + G_TURN] = turn
+            g[N_G * k + G_TURN] = (a_rel if mk == FORWARD else -a_rel) + _item_anoise(p, r, acc)
         if p.elem[r, E_LAW] != LAW_CLUTCH or p.elem[r, E_SIGNAL] < 0:
             g[N_G * k + G_NORMAL] = 1.0
         elif p.elem[r, E_AUX] > 0:   # a normal-force curve: the input's distance to lift-off (the force is 0 beyond)
@@ -4726,9 +4724,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         forward = mode == GEAR_FWD_A or mode == GEAR_FWD_B
         g[q] = (w_a if forward else -w_a) + slack[nf + j]
         a_a = _item_acc(p, acc, nf + j)
-        turn = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
-        if turn < 0.0 or abs(w_a) < TURN_WATCH * 1e9 * _item_wtol(p, r, x, n):   # (slow, or slowing down)
-            g[q + GG_TURN] = turn
+        g[q + GG_TURN] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + GG_FLANGE] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
 
