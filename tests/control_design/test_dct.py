@@ -200,10 +200,13 @@ def test_a_coast_upshift_lets_the_engine_fall_under_its_drag_before_it_hands_ove
     np.testing.assert_allclose(accel, closed, rtol=0, atol=1e-6)
     assert np.all(df["c1_command_1"].to_numpy()[(phase == "inertia_phase")][-10:] == tcu.coast_slip)
     q = tcu.shift_quality(df, **HOW)[0]
-    # the direction from the speeds; the sequence as the record shows it: c1 lets go of the drag as it opens, before c2
-    # locks, with nothing carried in between (coast_slip = 0), which reads as the hand-over first
-    assert (q.order, q.sequence) == ("upshift", "torque_first")
+    # the direction from the speeds; the sequence from the record: c1 lets go of the drag as it opens, before c2
+    # locks, with nothing carried in between (coast_slip = 0): no torque phase before the inertia phase (read as
+    # "torque_first" before, from the hand-over's coming first alone)
+    assert (q.order, q.sequence) == ("upshift", "inertia_first")
     assert q.handover_s < q.lockup_s <= ph.time_s.iloc[2]   # (c2 within the threshold of its slip: early)
+    assert q.metrics["torque_phase_s"] == 0.0
+    assert q.metrics["inertia_phase_s"] == pytest.approx(q.lockup_s - q.start_s, abs=1e-12)
     assert q.metrics["tie_up_Nm"] < 1.0 and q.metrics["oncoming_energy_J"] < 1.0
     end = df.iloc[-1]
     assert end["engine.w_rad_s"] / end["output_shaft.w_rad_s"] == pytest.approx(2.0, rel=1e-6)

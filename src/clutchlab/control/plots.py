@@ -279,7 +279,7 @@ def shift_figure(quality, *, title: str = ""):
         legend = "shaded:\nrelease (blue),\nneutral and\nsynchronisation\n(orange),\nclosing (green)"
     else:
         spans = ((q.start_s, q.handover_s), (q.handover_s, q.lockup_s)) if q.sequence == "torque_first" else (
-            (q.lockup_s, q.handover_s), (q.start_s, q.lockup_s))
+            (q.lockup_s, max(q.handover_s, q.lockup_s)), (q.start_s, q.lockup_s))
         legend = "shaded:\ntorque phase (blue),\ninertia phase (orange)"
     for a in axes:
         a.grid(True, alpha=0.3)

@@ -60,7 +60,8 @@ _RIDE = (
 METRICS = (
     ("shift_time_s", "s", "from the shift's start to its end (the later of the hand-over and the lock-up)"),
     ("torque_phase_s", "s", "both clutches carry torque: from the start to the hand-over (torque phase first), "
-                            "from the lock-up to the hand-over (inertia phase first)"),
+                            "from the lock-up to the hand-over (inertia phase first; 0 where the off-going clutch "
+                            "let go before the lock-up)"),
     ("inertia_phase_s", "s", "the on-coming clutch slides alone: from the hand-over to the lock-up (torque phase "
                              "first), from the start to the lock-up (inertia phase first)"),
     *_RIDE,
@@ -146,9 +147,10 @@ class ShiftQuality:
         ``"power"`` (a clutch-to-clutch shift) or ``"interrupted"`` (an AMT's, through its clutch and
         synchronisers).
     sequence : str
-        A power shift's phases in their order: ``"torque_first"`` (the hand-over before the lock-up: a power-on
-        upshift, a coast downshift) or ``"inertia_first"`` (a power-on downshift, a coast upshift); ``""`` for an
-        interrupted shift.
+        A power shift's phases in their order: ``"torque_first"`` (the hand-over before the lock-up, the on-coming
+        clutch carrying torque by then: a power-on upshift, a coast downshift) or ``"inertia_first"`` (a power-on
+        downshift, a coast upshift, also one whose off-going clutch lets go before the on-coming one takes anything
+        up); ``""`` for an interrupted shift.
     """
 
     start_s: float
@@ -433,8 +435,12 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         i_hand = first(tau_off <= t_thr, i0, f"{offgoing} never lets go of its torque after {t[i0]:g} s")
         i_lock = locks(w_on, w_thr, oncoming, i0)
         i_end = max(i_hand, i_lock)
-        upshift = i_hand <= i_lock   # (the sequence: torque phase first)
-        order = direction(i0, i_end) or ("upshift" if upshift else "downshift")
+        # the sequence: torque phase first where the off-going clutch hands its torque over before the on-coming one
+        # locks *and* the on-coming one carries torque by then (it took the torque over); an off-going clutch that
+        # lets go with nothing taking over (a coast upshift easing it open: the drag then slows the engine) runs the
+        # inertia phase first, the on-coming clutch taking the torque up only as it locks
+        torque_first = i_hand <= i_lock and bool(np.max(tau_on[i0:i_hand + 1]) > t_thr)
+        order = direction(i0, i_end) or ("upshift" if torque_first else "downshift")
         ts, th, tl, te = t[i0], t[i_hand], t[i_lock], t[i_end]
 
     speed = df[cols["output"]].to_numpy(float)
@@ -508,8 +514,8 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
         flare = max(0.0, float(np.max(way * slip_off[shift]))) if way != 0.0 else 0.0
         values = {
             "shift_time_s": te - ts,
-            "torque_phase_s": (th - ts) if upshift else (th - tl),
-            "inertia_phase_s": (tl - th) if upshift else (tl - ts),
+            "torque_phase_s": (th - ts) if torque_first else max(0.0, th - tl),
+            "inertia_phase_s": (tl - th) if torque_first else (tl - ts),
             **ride,
             "lockup_slip_rate_rad_s2": slip_rate(w_on, i_lock),
             "flare_rad_s": flare,
@@ -524,4 +530,4 @@ def shift_quality(frame, *, offgoing: str, oncoming: str, output: str, engine: s
     return ShiftQuality(float(ts), float(th), float(tl), float(te), order,
                         {k: float(v) for k, v in values.items()}, cols, trace,
                         "power" if clutch is None else "interrupted",
-                        "" if clutch is not None else ("torque_first" if upshift else "inertia_first"))
+                        "" if clutch is not None else ("torque_first" if torque_first else "inertia_first"))
