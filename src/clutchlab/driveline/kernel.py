@@ -4568,7 +4568,7 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     [degC] and heat given to its ambient [J] (:func:`thermal_rates`).  Switching functions, five per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
-    (either way: free or engaged), the turning point of a slow sliding speed, or of a stuck one's margin near its
+    (either way: free or engaged), the turning point of a sliding speed, or of a stuck one's margin near its
     limit (0.0 here, its rate from :func:`driveline_watch`: a brief overload is found), and a stuck one's margin less
     :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near); then three per switched
     spring.  A
@@ -5009,7 +5009,7 @@ def driveline_update(t, x, u, m, p, k, log):
         return 0
     kf = k // N_G
     if k % N_G == G_TURN or k % N_G == G_NEAR:
-        # a slow sliding speed's or a stuck margin's turning point, or a stuck element coming near its limit: a step
+        # a sliding speed's or a stuck margin's turning point, or a stuck element coming near its limit: a step
         # ends there, nothing changes
         return 0
     old = m.copy()
