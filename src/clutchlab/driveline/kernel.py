@@ -211,8 +211,8 @@ G_LASH_TURN = indices(SPRING_SWITCHING, "turn")
 # ramps, whose speed is a parabola Dormand-Prince integrates exactly, was stepped from 0.08 rad/s across a 78 ms dip
 # to -0.0096 rad/s and back, the brake driving the group backward (the thorough profile's seed 1407), where the
 # function watched only speeds below 1e-2 of the largest.  It is continuous: a function that read 1 while fast and
-# speeding up jumped from about 0 to 1 at its root, which the Illinois iteration brackets only by bisection (40
-# iterations to the event tolerance: CoupledClutches took 2,079 right-hand sides where 1,201 do)
+# speeding up jumped from about 0 to 1 at its root, which the Illinois iteration brackets only by bisection after 40
+# secant steps (numerics.core._illinois): CoupledClutches took 2,079 right-hand sides where it takes 1,279 now
 #: relative size of rounding in the torques of the constraint set (the thresholds of the stick/slip decisions
 #: and of the switching functions that watch them, which must agree: after a decision every function watching it
 #: is > 0, so that its next crossing is seen)
