@@ -813,7 +813,7 @@ def test_a_sliding_element_s_turning_function_is_its_acceleration_at_any_speed(t
     names = [name for name, _ in system.switching]
     a_rel = 2.0 * torque + 15.0
     np.testing.assert_allclose(g[names.index("c.turn")], -a_rel, rtol=1e-9, atol=1e-9)
-    if torque > 0.0:   # (forward, a driving: backward its quadrants change; the clutch alone then)
+    if torque > 0.0:   # (flange a drives only while T > 0; where b drives, another quadrant: the clutch alone there)
         a3 = torque / (1.0 + 1.0 / (2.0 * 0.9))
         np.testing.assert_allclose(g[names.index("g.turn")], a3, rtol=1e-9, atol=1e-9)
 
