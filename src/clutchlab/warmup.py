@@ -72,8 +72,9 @@ def _warm_driveline() -> None:
 
 
 def _warm_components() -> None:
-    # the one kernel of every network with model components (wet clutches and EMTC couplings, any number and mix:
-    # clutchlab.driveline.coupled); the plain network's functions it calls are the driveline group's
+    # the components' own functions (wet clutches and EMTC couplings, any number and mix: their hooks and equations,
+    # called through their addresses by the one kernel of every network, clutchlab.driveline.coupled, which the
+    # driveline group compiles)
     from .driveline import Driveline, Signal
 
     d = Driveline("warmup_components")
@@ -104,13 +105,14 @@ GROUPS = {"eclutch": _warm_eclutch, "wet": _warm_wet, "emtc": _warm_emtc, "drive
 
 #: groups that compile many of the same functions, dealt to one process together and in this order, so that the later
 #: ones load what the first compiled instead of compiling it again in another process at the same time: the
-#: components' one kernel calls the plain network's functions (the stuck-set solve, the event iteration: about 30 s of
-#: one core), and the control group evaluates the E-clutch's and the EMTC's kernels (17 s alone, 2.4 s after them)
+#: components' functions run in the driveline's one kernel (every network's; with the stuck-set solve and the event
+#: iteration it calls), and the control group evaluates the E-clutch's and the EMTC's kernels (17 s alone, 2.4 s after them)
 LOTS = (("driveline", "components"), ("eclutch", "emtc", "control"), ("wet",))
 
 #: each group's first compilation after the groups before it in its lot [s of one core] (2-core VM, 2026-12-03, empty
-#: cache, one process per lot): how :func:`run_parallel` deals the lots to its processes
-COSTS = {"driveline": 75.0, "components": 62.0, "emtc": 41.0, "eclutch": 36.0, "wet": 15.0, "control": 2.4}
+#: cache, one process per lot; the driveline's and the components' scaled by the fifty-sixth session's measurement of
+#: one kernel for every network, docs/architecture.md): how :func:`run_parallel` deals the lots to its processes
+COSTS = {"driveline": 90.0, "components": 42.0, "emtc": 41.0, "eclutch": 36.0, "wet": 15.0, "control": 2.4}
 
 
 def lots(names) -> list:

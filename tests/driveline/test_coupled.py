@@ -228,8 +228,9 @@ def test_a_dual_clutch_shift_conserves_energy():
 
 
 def test_every_mix_of_components_is_one_compiled_type(scenarios):
-    """Wet clutches alone, EMTCs alone, two EMTCs of different sizes, both kinds together: the parameters have one
-    numba type, so the kernel compiled for one serves all (a mix never run before compiles nothing)."""
+    """Wet clutches alone, EMTCs alone, two EMTCs of different sizes, both kinds together, and no component at all: the
+    parameters have one numba type, so the kernel compiled for one serves all (a mix never run before compiles
+    nothing; a plain network is a network with no component rows)."""
     vehicle, sc1, o1, sc2, o2 = scenarios
     wet = Driveline("w")
     _dyno(wet, "c", WetClutch.paper(), 100.0, 2000.0, 80.0)
@@ -239,8 +240,11 @@ def test_every_mix_of_components_is_one_compiled_type(scenarios):
     both = drum_bench(sc1, vehicle)
     _dyno(both, "c1", WetClutch.paper(), 100.0, 2000.0, 80.0)
     _dyno(both, "c2", WetClutch.paper(n_c=6), 100.0, 2000.0, 80.0)
-    kinds = {numba.typeof(d.system().params) for d in (wet, one, two, both)}
-    assert len(kinds) == 1
+    plain = Driveline("p")
+    plain.inertia("a", J=1.0, w0=1.0).inertia("b", J=2.0)
+    plain.clutch("c", "a", "b", fn_max=10.0, normal=1.0)
+    kinds = {numba.typeof(d.system().params) for d in (wet, one, two, both, plain)}
+    assert len(kinds) == 1 and type(plain.system().params) is CoupledParams
 
 
 @pytest.mark.parametrize("kind", ["wet", "emtc"])

@@ -417,9 +417,9 @@ def test_the_start_derives_the_speeds_left_out_as_the_build_does(d):
     words = [w for where, w, _ in system.decided_at_start if where == "x"]
     x = x0.copy()
     x[words] = np.nan
-    assert K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params) == 0
+    assert K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params.net) == 0
     assert np.array_equal(x, x0)
-    p = system.params
+    p = system.params.net
     carried = sorted(n + p.elem[r, K.E_B if p.elem[r, K.E_SPREAD] > 0 else K.E_A]
                      for r in range(p.elem.shape[0]) if p.elem[r, K.E_SPREAD] != 0)
     assert sorted(words) == carried and set(carried) <= {n + i for i in derived}
@@ -443,8 +443,8 @@ def test_a_host_s_speed_and_ratio_are_carried_along_the_gears_by_the_start():
     x = system.x0.copy()
     n = 4
     x[n + 0] = 6.0
-    system.params.coef[0, K.C_RATIO] = 3.0
-    K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params)
+    system.params.net.coef[0, K.C_RATIO] = 3.0
+    K.driveline_start(0.0, x, np.zeros(0), system.m0.copy(), system.params.net)
     assert (x[n + 1], x[n + 2]) == (6.0 / 3.0, -4.0 * (6.0 / 3.0))
 
 

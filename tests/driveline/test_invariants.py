@@ -176,7 +176,7 @@ def test_the_debug_check_catches_a_stuck_element_beyond_its_limit():
     d.torque("T", "J", 5.0)
     d.brake("b", "J", fn_max=2.0, mu=0.5)
     s = d.system(1e-8, check_invariants=True)
-    p = s.params
+    p = s.params.net   # (the network's own parameters: a plain network is a CoupledParams with no component rows)
     x0 = s.x0.copy()
     m0 = s.m0.copy()    # a state the settle never makes: the check itself, at t = 0.5 s
     m0[0] = K.STUCK

@@ -151,3 +151,34 @@ def test_a_model_run_twice_through_the_fast_entry_gives_the_same_record(method):
     assert first.states[-1, 0] != first.states[0, 0]
     hit = fast_entry(type(system.params), method, "advance").known.get(id(system.params))
     assert hit is not None and hit[0] is system.params and len(hit[1]) >= 1
+
+
+class _Outer(NamedTuple):
+    inner: _P
+    shared: _P
+
+
+@numba.njit
+def _nested(q, a):
+    return q.inner.scale[0] * a.sum() + q.shared.scale[0] + q.inner.shift + q.shared.shift
+
+
+def test_a_structure_of_structures_is_typed_from_its_members_and_never_reinterpreted():
+    """A structure not seen before, whose members are (a plain network: its own, and the empty component blocks every
+    network shares), is typed from its members' remembered types and runs the overload numba would choose; a member of
+    another type (int64 data, a strided view) is typed again: a wrong overload would read int64 data as float64."""
+    fast = _FastEntry(_nested)
+    shared = _p(3.0, 0.25)
+    a = np.arange(4.0)
+    for k in range(6):   # new structures, one member shared by all of them
+        q = _Outer(_p(2.0 + k, 0.5), shared)
+        assert fast(q, a) == _nested.py_func(q, a)
+    assert len(_nested.overloads) == 1
+    q = _Outer(_P(np.array([2]), 0.5), shared)   # int64 scale: another type, another overload
+    assert fast(q, a) == 2 * 6.0 + 3.0 + 0.75
+    q = _Outer(_P((np.arange(4.0) + 2.0)[::2], 0.5), shared)   # a strided view: another layout
+    assert fast(q, a) == 2.0 * 6.0 + 3.0 + 0.75
+    assert len(_nested.overloads) == 3
+    for args in ((q, a), (_Outer(_p(5.0, 0.5), shared), a), (_Outer(_p(5.0, 0.5), shared), np.arange(4))):
+        assert fast(*args) == _nested.py_func(*args)   # each overload found again by its type, not mistaken
+    assert entry._typeof_structure(_nested, q) == _nested.typeof_pyval(q)

@@ -101,8 +101,9 @@ def test_prepare_compiles_every_outlined_function_of_the_driveline():
     lazy = [K._repair_space, K._small_solve, K.shifted_curve, K.shifted_liftoff, K.friction_map, K.check_invariants]
     assert [e.dispatcher for e in outline._ENTRIES if e.lazy] == lazy
     coupled = [e.dispatcher for e in outline._ENTRIES if e.group == "coupled"]
-    assert coupled == [DC._evaluate, DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
-                       DC.coupled_accept, DC._watch_rates]
+    assert coupled == [DC._evaluate, DC._components_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart,
+                       DC.coupled_accept, DC._watch_rates, DC._components_start, DC._components_next_break,
+                       DC._keep_rows]
     assert [e.dispatcher for e in outline._ENTRIES if e.group == "emtc"] == [ES._evaluate_into, ES._update,
                                                                              ES._controller]
     assert all(e.group is None for e in outline._ENTRIES if e.dispatcher.py_func.__module__ == K.__name__)
@@ -128,7 +129,9 @@ from clutchlab.driveline.description import load_driveline
 load_driveline(Path(r"{examples}") / "driveline_coupled_clutches.toml").driveline.simulate(0.05)
 print(json.dumps([len(K.check_invariants.overloads), len(K._repair_space.overloads), len(K._small_solve.overloads),
                   len(K.settle.overloads),
-                  len(DC.coupled_update.overloads) + len(DC.coupled_rhs.overloads) + len(DC._evaluate.overloads)]))
+                  len(DC.coupled_update.overloads) + len(DC._components_rhs.overloads) + len(DC._evaluate.overloads)
+                  + len(DC._components_start.overloads) + len(DC._components_next_break.overloads)
+                  + len(DC._keep_rows.overloads)]))
 """
 
 
@@ -202,7 +205,8 @@ for name in ("coupled_clutches", "wet_sae2", "emtc_awd", "eclutch_launch"):
 from clutchlab.driveline import coupled as DC
 out = {{}}
 for fn in (K.settle, K._solve_stuck, K._repair, K.check_invariants, K.driveline_rhs, K._margin_rates, DC._evaluate,
-           DC.coupled_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart, DC.coupled_accept):
+           DC._components_rhs, DC.coupled_outputs, DC.coupled_update, DC.coupled_restart, DC.coupled_accept,
+           DC._components_start, DC._components_next_break, DC._keep_rows):
     entry = next(e for e in outline._ENTRIES if e.dispatcher is fn)
     out[fn.__name__] = [sig == entry.sig() for sig in fn.overloads]
 print(json.dumps(out))
@@ -226,7 +230,8 @@ def test_the_example_networks_call_the_driveline_through_the_outlined_signatures
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     names = ("settle", "_solve_stuck", "_repair", "check_invariants", "driveline_rhs", "_margin_rates", "_evaluate",
-             "coupled_rhs", "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept")
+             "_components_rhs", "coupled_outputs", "coupled_update", "coupled_restart", "coupled_accept",
+             "_components_start", "_components_next_break", "_keep_rows")
     assert out == {name: [True] for name in names}, out
 
 

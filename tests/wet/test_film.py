@@ -138,3 +138,22 @@ def test_squeeze_film_coefficient_from_reynolds_pressure():
     assert squeeze_film_coefficient(ro, ri) * mu * 1e-3 / h**3 == pytest.approx(w, rel=1e-8)
     # opening gives suction of the same size
     assert squeeze_film_force(h, -v, mu, ro, ri) == pytest.approx(-w, rel=1e-12)
+
+
+def test_the_gw_table_is_made_where_a_kernel_is_compiled_not_at_import():
+    """The compiled asperity law's Greenwood-Williamson table needs ``scipy.special`` (a quarter of a second to import,
+    which every network paid once the coupled parameter type, with its wet block, became every network's): importing
+    clutchlab's wet and driveline packages does not import it, and the compiled law reads the table of
+    :func:`gw_table` (a fresh process)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, clutchlab.wet, clutchlab.driveline, clutchlab.driveline.coupled\n"
+            "print('scipy.special' in sys.modules)\n"
+            "from clutchlab.wet.film import asperity_force_scalar, gw_table, gw_lookup\n"
+            "t0, dt, v, d = gw_table()\n"
+            "want = 0.01 * 1e6 * gw_lookup.py_func(2.0, t0, dt, v, 0, d, 0, v.shape[0])\n"
+            "print(asperity_force_scalar(2e-6, 1e-6, 0.01, 1e6) == want)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["False", "True"]

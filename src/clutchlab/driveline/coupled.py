@@ -7,7 +7,11 @@ DrivelineParams`), a :class:`~clutchlab.driveline.wet.WetBlock` of its wet clutc
 couplings' parameter structures are stacked as rows whatever their sizes (:func:`clutchlab.numerics.borrow.
 stack_rows`; each coupling its own magnet and maps), so the type, and with it the compiled kernel, is the same for
 a dual-clutch transmission of two wet clutches, a front and a rear EMTC, a wet clutch with an EMTC or any other
-mix: a network of known component kinds never run before compiles nothing (issue #31).
+mix: a network of known component kinds never run before compiles nothing (issue #31).  A network without
+components is one too (:meth:`CoupledParams.plain`: empty blocks), so one kernel serves every network: each hook
+first asks whether the network has a component row (:func:`_plain`) and, without one, is the plain network's own
+hook of :mod:`~clutchlab.driveline.kernel`, linked as before (the same steps and numbers); the components' parts
+are called through their addresses (group ``"coupled"``), so a plain network never compiles them.
 
 Layout (what :meth:`Driveline.system <clutchlab.driveline.network.Driveline.system>` names): states, switching
 functions, modes and named elements are the network's, then each wet clutch's, then each coupling's; outputs the
@@ -44,6 +48,20 @@ class CoupledParams(NamedTuple):
     net: DrivelineParams
     wet: DW.WetBlock
     emtc: DE.EmtcBlock
+
+    @classmethod
+    def plain(cls, net: DrivelineParams) -> "CoupledParams":
+        """The parameters of a network without model components: its own, with empty blocks of wet clutches and EMTC
+        couplings (one type, and one compiled kernel, for every network)."""
+        return cls(net, *_no_components())
+
+
+@functools.lru_cache(maxsize=1)
+def _no_components():
+    """The empty blocks of a network without model components, built once and shared (built anew, the layout of
+    their rows took 3 ms a run: a plain network's run of CoupledClutches is 1.7 ms); none of their arrays has an
+    element to write."""
+    return DW.block([], []), DE.block([], [])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -139,7 +157,29 @@ def _model_held(m, before, net):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _plain(w, e):
+    """True for a network without model components (no wet clutch, no EMTC coupling): every hook is then the plain
+    network's own (:mod:`clutchlab.driveline.kernel`), so such a network runs as it did on its own parameter type,
+    and the components' functions, called through their addresses, are never compiled for it."""
+    return w.conf.shape[0] == 0 and e.conf.shape[0] == 0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_rhs(t, x, u, m, p, dx, g):
+    """The right-hand side and switching functions (the core's stages): a plain network's own
+    (:func:`kernel.driveline_rhs`, linked into the stages), or with model components :func:`_components_rhs` through
+    its address (the components' equations are not linked into the core's loop: one loop serves every network)."""
+    w = member(p, "wet")
+    e = member(p, "emtc")
+    if _plain(w, e):
+        K.driveline_rhs(t, x, u, m, member(p, "net"), dx, g)
+    else:
+        _rhs_outlined(t, x, u, m, p, dx, g)
+    return None
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _components_rhs(t, x, u, m, p, dx, g):
     """The network's right-hand side and switching functions, then each component's."""
     net = member(p, "net")
     w = member(p, "wet")
@@ -267,6 +307,14 @@ def coupled_next_break(t, m, p):
     """The next corner of the network's signals or a wet clutch's force profile, or a coupling's next controller
     sample."""
     tb = K.driveline_next_break(t, m, member(p, "net"))
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        return tb
+    return _components_next_break_outlined(t, m, p, tb)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _components_next_break(t, m, p, tb):
+    """:func:`coupled_next_break`'s components (through its address: a plain network never compiles it)."""
     tb = DW.next_break(t, m, member(p, "wet"), tb)
     return DE.next_break(t, member(p, "emtc"), tb)
 
@@ -305,8 +353,11 @@ def coupled_watch(t, x, u, m, p, dx, g, k):
     stayed stuck at twice its limit (found by the invariant check once it ran for these networks)."""
     w = member(p, "wet")
     e = member(p, "emtc")
-    nx, ng, nm = _network_sizes(w, e)
     net = member(p, "net")
+    if _plain(w, e):
+        K.driveline_watch(t, x, u, m, net, dx, g, k)
+        return
+    nx, ng, nm = _network_sizes(w, e)
     if k < ng and _wants_rates(m, g, net.fric.shape[0], k):   # (rare: a stuck element near its limit)
         _watch_rates_outlined(t, x, u, m, p, dx, g, k)
 
@@ -327,7 +378,15 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_prepare(p):
     """Once per call of the core: each wet clutch's and each EMTC coupling's parameter structure built from its row of
-    its block (:func:`clutchlab.numerics.borrow.keep_rows`), which their hooks then read by reference."""
+    its block (:func:`clutchlab.numerics.borrow.keep_rows`), which their hooks then read by reference; nothing for a
+    plain network."""
+    if not _plain(member(p, "wet"), member(p, "emtc")):
+        _keep_rows_outlined(p)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _keep_rows(p):
+    """:func:`coupled_prepare`'s rows (through its address: a plain network never compiles them)."""
     keep_rows(member(p, "wet"))
     keep_rows(member(p, "emtc"))
 
@@ -350,7 +409,7 @@ def coupled_jacobian(t, x, u, m, p, J):
 @functools.lru_cache(maxsize=1)
 def _params_type():
     """numba type of the reference to a :class:`CoupledParams` every hook takes (one type for every network)."""
-    empty = CoupledParams(K.params_template(), DW.block([], []), DE.block([], []))
+    empty = CoupledParams.plain(K.params_template())
     return ByRef(numba.typeof(empty))
 
 
@@ -369,7 +428,7 @@ def _hook_args(*rest):
 
 _evaluate_outlined = outlined(_evaluate, lambda: (types.float64, _F1, _F1, _I1, *_member_types()), types.none,
                               group="coupled")
-_rhs_outlined = outlined(coupled_rhs, lambda: _hook_args(_F1, _F1), types.none, group="coupled")
+_rhs_outlined = outlined(_components_rhs, lambda: _hook_args(_F1, _F1), types.none, group="coupled")
 _outputs_outlined = outlined(coupled_outputs, lambda: _hook_args(_F1), types.none, group="coupled")
 _update_outlined = outlined(coupled_update, lambda: _hook_args(types.int64, K._log_type()), types.int64,
                             group="coupled")
@@ -381,32 +440,44 @@ _watch_rates_outlined = outlined(_watch_rates, lambda: _hook_args(_F1, _F1, type
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_rhs_event(t, x, u, m, p, dx, g):
-    """:func:`coupled_rhs` through its address (the core's ``rhs_event`` hook: locating a root, the step to it, a
-    break)."""
-    _rhs_outlined(t, x, u, m, p, dx, g)
+    """:func:`_components_rhs` through its address (the core's ``rhs_event`` hook: locating a root, the step to it, a
+    break); a plain network's own."""
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        K.driveline_rhs_event(t, x, u, m, member(p, "net"), dx, g)
+    else:
+        _rhs_outlined(t, x, u, m, p, dx, g)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_outputs_hook(t, x, u, m, p, y):
-    """:func:`coupled_outputs` through its address (the core's ``outputs`` hook)."""
-    _outputs_outlined(t, x, u, m, p, y)
+    """:func:`coupled_outputs` through its address (the core's ``outputs`` hook); a plain network's own."""
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        K.driveline_outputs(t, x, u, m, member(p, "net"), y)
+    else:
+        _outputs_outlined(t, x, u, m, p, y)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_update_hook(t, x, u, m, p, k, log):
-    """:func:`coupled_update` through its address (the core's ``update`` hook)."""
+    """:func:`coupled_update` through its address (the core's ``update`` hook); a plain network's own."""
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        return K.driveline_update(t, x, u, m, member(p, "net"), k, log)
     return _update_outlined(t, x, u, m, p, k, log)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_restart_hook(t, x, u, m, p, log):
-    """:func:`coupled_restart` through its address (the core's ``restart`` hook)."""
+    """:func:`coupled_restart` through its address (the core's ``restart`` hook); a plain network's own."""
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        return K.driveline_restart(t, x, u, m, member(p, "net"), log)
     return _restart_outlined(t, x, u, m, p, log)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_accept_hook(t, x, u, m, p):
-    """:func:`coupled_accept` through its address (the core's ``accept`` hook)."""
+    """:func:`coupled_accept` through its address (the core's ``accept`` hook); a plain network's own."""
+    if _plain(member(p, "wet"), member(p, "emtc")):
+        return K.driveline_accept(t, x, u, m, member(p, "net"))
     return _accept_outlined(t, x, u, m, p)
 
 
@@ -421,8 +492,15 @@ def coupled_start(t, x, u, m, p):
     masses, roughness and radii of a wet clutch and the airgaps of a coupling in the network.  The components' own
     modes are their builders' (their restart at the start settles them)."""
     code = K._start_outlined(t, x, u, m, member(p, "net"))
-    if code:
+    if code or _plain(member(p, "wet"), member(p, "emtc")):
         return code
+    return _components_start_outlined(t, x, u, m, p)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _components_start(t, x, u, m, p):
+    """:func:`coupled_start`'s components: what each derives from its parameters alone (through its address: a
+    plain network never compiles it)."""
     w = member(p, "wet")
     for j in range(w.conf.shape[0]):
         code = DW.W.wet_start(t, x, u, m, row(member(w, "params"), j))
@@ -435,6 +513,13 @@ def coupled_start(t, x, u, m, p):
         if code:
             return DE.error_code(code, j)
     return 0
+
+
+_components_start_outlined = outlined(_components_start, lambda: _hook_args(), types.int64, group="coupled")
+_components_next_break_outlined = outlined(_components_next_break,
+                                           lambda: (types.float64, _I1, _params_type(), types.float64), types.float64,
+                                           group="coupled")
+_keep_rows_outlined = outlined(_keep_rows, lambda: (_params_type(),), types.none, group="coupled")
 
 
 dispatch.register(CoupledParams, rhs=coupled_rhs, outputs=coupled_outputs_hook, update=coupled_update_hook,

@@ -5452,6 +5452,9 @@ def driveline_start_hook(t, x, u, m, p):
     return _start_outlined(t, x, u, m, p)
 
 
+# the network's own hooks for its own parameter type (a System on a bare DrivelineParams runs them);
+# Driveline.system runs every network on clutchlab.driveline.coupled.CoupledParams, whose hooks are these for a
+# network without model components (one compiled kernel for every network)
 dispatch.register(DrivelineParams, rhs=driveline_rhs, outputs=driveline_outputs, update=driveline_update,
                   restart=driveline_restart, accept=driveline_accept, next_break=driveline_next_break,
                   jacobian=driveline_jacobian, rhs_event=driveline_rhs_event, watch=driveline_watch,

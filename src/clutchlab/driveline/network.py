@@ -2717,6 +2717,10 @@ class Driveline:
             events = K.EVENTS + W.EVENTS + S.EVENTS
             error_messages = {code - DE.ERROR_STRIDE * j: f"{el.name}: {text}" for j, (el, *_) in enumerate(emtcs)
                               for code, text in S.ERROR_MESSAGES.items()}
+        else:   # (one compiled kernel for every network: a plain one is a network with no component rows)
+            from . import coupled as DC
+
+            p = DC.CoupledParams.plain(p)
 
         names_rows = [e.name for e in self._elements]
         invariant_messages = {-(K.INV_BASE + K.N_INV * r + kind): f"invariant violated: {nm}: {what}"
@@ -2755,7 +2759,7 @@ class Driveline:
                       mode_values=mode_values, method="dopri", rtol=float(rtol), max_step=max_step, event_tol=1e-12,
                       element_name=element_name, error_messages=error_messages,
                       decided_at_start=(("m", 0, len(named_modes)),
-                                        ("params.net.work" if wet or emtcs else "params.work", -1, None))
+                                        ("params.net.work", -1, None))
                       + tuple(("x", n + i, n + i + 1) for i in derived)   # (kernel.derive_speeds)
                       + (tuple((f"params.wet.params.constants.data.{name}", 0, None)
                                for name in W.DERIVED_CONSTANTS) if wet else ())

@@ -38,7 +38,7 @@ from functools import lru_cache
 
 import numba
 import numpy as np
-from scipy import special
+from numba.extending import overload
 
 from ..errors import ParameterError
 
@@ -284,6 +284,8 @@ def gw_integral(t, order=1.5):
     numpy.ndarray or float
         F_n(t) [-]; ``F_1.5(0) = 0.43002``.
     """
+    from scipy import special   # (here: scipy.special takes a quarter of a second to import)
+
     t = np.asarray(t, dtype=float)
     d = special.pbdv(-order - 1.0, t)[0]
     out = special.gamma(order + 1.0) / _SQRT2PI * np.exp(-0.25 * t * t) * d
@@ -364,10 +366,24 @@ def gw_table(t_min: float = -12.0, t_max: float = 8.0, n: int = 2001):
     return float(t[0]), float(t[1] - t[0]), values, ders
 
 
-#: the table the compiled model uses (:func:`asperity_force_scalar`): module constants, which numba
-#: compiles into the code -- a fixed approximation of a special function, not a parameter of the model
-GW_T0, GW_DT, GW_VALUES, GW_DERS = gw_table()
-GW_N = GW_VALUES.shape[0]
+def _gw_constants():
+    """``(t0, dt, values, derivatives, n)`` of :func:`gw_table`: the table the compiled model uses
+    (:func:`asperity_force_scalar`), as constants of its code -- a fixed approximation of a special function, not a
+    parameter of the model.  Computed where a kernel that reads it is compiled (its overload below), not when
+    clutchlab is imported: the table needs ``scipy.special``, a quarter of a second to import, and a cached kernel
+    carries the numbers in its code."""
+    t0, dt, values, ders = gw_table()
+    return t0, dt, values, ders, values.shape[0]
+
+
+@overload(_gw_constants)
+def _gw_constants_compiled():
+    t0, dt, values, ders, n = _gw_constants()
+
+    def impl():   # (the arrays are closure constants: numba freezes them into the code)
+        return t0, dt, values, ders, n
+
+    return impl
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
@@ -425,8 +441,8 @@ def asperity_force_scalar(h, sigma, area, pressure_scale):
 
     Greenwood and Williamson [3], Eq. 11, as used by Deur et al. [4]:
     ``p_c = 4/3 E' eta sqrt(beta) sigma^{3/2} F_{3/2}(h/sigma)``, with
-    ``F_{3/2}`` from the cubic-Hermite table of :func:`gw_table` (``GW_VALUES``,
-    ``GW_DERS``: constants of the compiled code).
+    ``F_{3/2}`` from the cubic-Hermite table of :func:`gw_table` (constants of the compiled code,
+    :func:`_gw_constants`).
 
     Parameters
     ----------
@@ -448,7 +464,8 @@ def asperity_force_scalar(h, sigma, area, pressure_scale):
     -----
     Assumptions as :func:`asperity_contact_pressure`.
     """
-    return area * pressure_scale * gw_lookup(h / sigma, GW_T0, GW_DT, GW_VALUES, 0, GW_DERS, 0, GW_N)  # [3], Eq. 11
+    t0, dt, values, ders, n = _gw_constants()
+    return area * pressure_scale * gw_lookup(h / sigma, t0, dt, values, 0, ders, 0, n)  # [3], Eq. 11
 
 
 @numba.njit(cache=True, nogil=True)

@@ -304,7 +304,7 @@ class WetParams(NamedTuple):
     values of a map), located by the ``*_start`` / ``*_n`` constants.  Build
     a fresh structure per run and per batch variant (:func:`fresh_buffers`,
     :func:`variant_parameters`).  The Greenwood-Williamson table is a
-    constant of the compiled code (:data:`clutchlab.wet.film.GW_VALUES`).
+    constant of the compiled code (:func:`clutchlab.wet.film.asperity_force_scalar`).
 
     Two arrays on purpose (measured): numba passes the structure by value,
     field by field, to every hook call (six per step), and keeps an atomic
