@@ -157,11 +157,11 @@ def _model_held(m, before, net):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _plain(w, e):
-    """True for a network without model components (no wet clutch, no EMTC coupling): every hook is then the plain
+def _plain(p):
+    """True for the network ``p`` (a reference to its :class:`CoupledParams`) without model components (no wet clutch, no EMTC coupling): every hook is then the plain
     network's own (:mod:`clutchlab.driveline.kernel`), so such a network runs as it did on its own parameter type,
     and the components' functions, called through their addresses, are never compiled for it."""
-    return w.conf.shape[0] == 0 and e.conf.shape[0] == 0
+    return member(p, "wet").conf.shape[0] == 0 and member(p, "emtc").conf.shape[0] == 0
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -169,9 +169,7 @@ def coupled_rhs(t, x, u, m, p, dx, g):
     """The right-hand side and switching functions (the core's stages): a plain network's own
     (:func:`kernel.driveline_rhs`, linked into the stages), or with model components :func:`_components_rhs` through
     its address (the components' equations are not linked into the core's loop: one loop serves every network)."""
-    w = member(p, "wet")
-    e = member(p, "emtc")
-    if _plain(w, e):
+    if _plain(p):
         K.driveline_rhs(t, x, u, m, member(p, "net"), dx, g)
     else:
         _rhs_outlined(t, x, u, m, p, dx, g)
@@ -307,7 +305,7 @@ def coupled_next_break(t, m, p):
     """The next corner of the network's signals or a wet clutch's force profile, or a coupling's next controller
     sample."""
     tb = K.driveline_next_break(t, m, member(p, "net"))
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         return tb
     return _components_next_break_outlined(t, m, p, tb)
 
@@ -354,7 +352,7 @@ def coupled_watch(t, x, u, m, p, dx, g, k):
     w = member(p, "wet")
     e = member(p, "emtc")
     net = member(p, "net")
-    if _plain(w, e):
+    if _plain(p):
         K.driveline_watch(t, x, u, m, net, dx, g, k)
         return
     nx, ng, nm = _network_sizes(w, e)
@@ -380,7 +378,7 @@ def coupled_prepare(p):
     """Once per call of the core: each wet clutch's and each EMTC coupling's parameter structure built from its row of
     its block (:func:`clutchlab.numerics.borrow.keep_rows`), which their hooks then read by reference; nothing for a
     plain network."""
-    if not _plain(member(p, "wet"), member(p, "emtc")):
+    if not _plain(p):
         _keep_rows_outlined(p)
 
 
@@ -442,7 +440,7 @@ _watch_rates_outlined = outlined(_watch_rates, lambda: _hook_args(_F1, _F1, type
 def coupled_rhs_event(t, x, u, m, p, dx, g):
     """:func:`_components_rhs` through its address (the core's ``rhs_event`` hook: locating a root, the step to it, a
     break); a plain network's own."""
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         K.driveline_rhs_event(t, x, u, m, member(p, "net"), dx, g)
     else:
         _rhs_outlined(t, x, u, m, p, dx, g)
@@ -451,7 +449,7 @@ def coupled_rhs_event(t, x, u, m, p, dx, g):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_outputs_hook(t, x, u, m, p, y):
     """:func:`coupled_outputs` through its address (the core's ``outputs`` hook); a plain network's own."""
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         K.driveline_outputs(t, x, u, m, member(p, "net"), y)
     else:
         _outputs_outlined(t, x, u, m, p, y)
@@ -460,7 +458,7 @@ def coupled_outputs_hook(t, x, u, m, p, y):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_update_hook(t, x, u, m, p, k, log):
     """:func:`coupled_update` through its address (the core's ``update`` hook); a plain network's own."""
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         return K.driveline_update(t, x, u, m, member(p, "net"), k, log)
     return _update_outlined(t, x, u, m, p, k, log)
 
@@ -468,7 +466,7 @@ def coupled_update_hook(t, x, u, m, p, k, log):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_restart_hook(t, x, u, m, p, log):
     """:func:`coupled_restart` through its address (the core's ``restart`` hook); a plain network's own."""
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         return K.driveline_restart(t, x, u, m, member(p, "net"), log)
     return _restart_outlined(t, x, u, m, p, log)
 
@@ -476,7 +474,7 @@ def coupled_restart_hook(t, x, u, m, p, log):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_accept_hook(t, x, u, m, p):
     """:func:`coupled_accept` through its address (the core's ``accept`` hook); a plain network's own."""
-    if _plain(member(p, "wet"), member(p, "emtc")):
+    if _plain(p):
         return K.driveline_accept(t, x, u, m, member(p, "net"))
     return _accept_outlined(t, x, u, m, p)
 
@@ -492,7 +490,7 @@ def coupled_start(t, x, u, m, p):
     masses, roughness and radii of a wet clutch and the airgaps of a coupling in the network.  The components' own
     modes are their builders' (their restart at the start settles them)."""
     code = K._start_outlined(t, x, u, m, member(p, "net"))
-    if code or _plain(member(p, "wet"), member(p, "emtc")):
+    if code or _plain(p):
         return code
     return _components_start_outlined(t, x, u, m, p)
 

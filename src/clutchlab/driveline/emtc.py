@@ -51,7 +51,6 @@ network and its wet clutches).
 
 from __future__ import annotations
 
-import functools
 from typing import NamedTuple
 
 import numba
@@ -122,21 +121,14 @@ class EmtcBlock(NamedTuple):
     rows: np.ndarray
 
 
-@functools.lru_cache(maxsize=1)
-def _template():
-    """An :class:`~clutchlab.emtc.system.EmtcParams` of a tiny magnet: the types of an empty :class:`EmtcBlock`."""
-    from ..emtc.bench import BenchScenario, VehicleParameters
-    from ..hysteresis import Preisach
-
-    return S.pack_parameters(Preisach([0.0, 1.0], np.zeros((2, 2))), BenchScenario(), VehicleParameters(),
-                             S.BenchOptions())
-
-
 def block(params, conf) -> EmtcBlock:
     """The block of the couplings packed as ``params`` (a list of :class:`~clutchlab.emtc.system.EmtcParams`) with
-    their layouts ``conf`` (rows ``F_*``); no coupling for empty lists."""
+    their layouts ``conf`` (rows ``F_*``); no coupling for empty lists (its types those of
+    :func:`~clutchlab.emtc.system.params_template`, built without a compiled function: packed from a magnet, every
+    plain network's first run compiled the magnet's tables and the start's derivations, 8 functions, and every later
+    process loaded them)."""
     n = len(params)
-    stacked = stack_rows(params, template=None if params else _template())
+    stacked = stack_rows(params, template=None if params else S.params_template())
     return EmtcBlock(stacked, np.array(conf, dtype=np.int64).reshape(n, N_CONF), np.zeros((n, N_BUF)),
                      np.zeros((n, N_MODE), dtype=np.int64), OUTPUT_INDEX.copy(), np.zeros((n, row_words(stacked))))
 

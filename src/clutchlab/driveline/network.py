@@ -2541,7 +2541,9 @@ class Driveline:
         again from the initial speeds a host sets).  A one-way clutch may not start turning backward."""
         m = np.zeros(p.fric.size + p.swit.size + p.lossy.size, dtype=np.int64)
         u0 = np.array([v[1] for v in self._inputs.values()], dtype=float)
-        # (through the core's entry, as a run calls it: one compiled specialisation, the run's)
+        # (through the core's entry on the network's own parameters: a run calls only its loop, and this start entry
+        # compiles in 0.3 s, where the start entry of the run's type, CoupledParams, links every coupled hook the
+        # start may call, 3.3 s on a fresh machine: measured, fifty-seventh session)
         code = core.start(p, 0.0, np.ascontiguousarray(x0, dtype=float), u0, m)
         if code < 0 and not start_checks_deferred():
             raise ParameterError(self._start_refusal((-code - K.INV_BASE) // K.N_INV, p, x0))

@@ -1083,7 +1083,8 @@ def run_controller(p, t, x, u):
 # of its time, against 2 % for these two (docs/architecture.md).
 def params_template() -> EmtcParams:
     """An :class:`EmtcParams` of tiny arrays: the numba type of every bench's (for the signatures of the functions
-    called through their addresses; ``tests/numerics/test_outline.py`` checks it against packed benches)."""
+    called through their addresses, and the types of a driveline's empty EMTC block; built without a compiled
+    function; ``tests/numerics/test_outline.py`` checks it against packed benches)."""
     f1, f2, f4, i1 = np.zeros(1), np.zeros((1, 1)), np.zeros((1, 1, 1, 1)), np.zeros(1, np.int64)
 
     def zeros(cls):
