@@ -200,6 +200,11 @@ def record(log, t, code, element):
         log.count[1] += 1
 
 
+#: a switching function whose value at an earlier root is within this fraction of its values at the step's ends
+#: reads zero to its rounding there, and is read again just before (:func:`_locate`)
+ZERO_READ = 1e-9
+
+
 @numba.njit(cache=True, nogil=True, inline="always")
 def _crossed(a, b, d):
     """True if a switching value went from ``a`` to ``b`` through zero in direction ``d`` (4: a waypoint either
@@ -268,7 +273,9 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
     ``g0``, except that a function starting exactly on zero (after the event
     that put it there: a ball on the ground, a clutch that just broke away)
     takes its sign from a probe just after the start (``theta`` = 1e-6), so a
-    return through zero later in the same step is still seen.
+    return through zero later in the same step is still seen.  A function
+    located after an earlier root is looked for only before it; one that reads
+    zero to its rounding there (:data:`ZERO_READ`) is read again just before.
     """
     best = 2.0
     kbest = -1
@@ -298,13 +305,30 @@ def _locate(p, t, h, x0, f0, x1, f1, rc, u, m, g0, g1, gdir, mass, event_tol, xe
         hi = min(1.0, best)
         glo = ga[k]
         if hi < 1.0:
-            # an earlier root is known: only look before it
-            _dense(hi, h, x0, f0, x1, f1, rc, mass, xe)
-            model.rhs_event(t + hi * h, xe, u, m, p, fe, ge)
-            model.watch(t + hi * h, xe, u, m, p, fe, ge, k)
-            n_rhs += 1
-            if not _crossed(glo, ge[k], gdir[k]):
+            # an earlier root is known: only look before it.  A function that reads zero to its rounding there may
+            # have crossed before and come back to it: read again just before (a stuck element's break-away function,
+            # lim + noise - |tau|, beyond an E-clutch's lift-off, where its limit is 0: its load passed through zero
+            # at the instant a one-way clutch's turning point, driven by the same torque, was the earliest root, and
+            # the break-away 86 us before it was stepped over; random draws, fifty-seventh session).  One call site
+            # for the evaluation (the right-hand side is linked into this function for some models)
+            probe = hi
+            found = False
+            for _pass in range(2):
+                _dense(probe, h, x0, f0, x1, f1, rc, mass, xe)
+                model.rhs_event(t + probe * h, xe, u, m, p, fe, ge)
+                model.watch(t + probe * h, xe, u, m, p, fe, ge, k)
+                n_rhs += 1
+                if _crossed(glo, ge[k], gdir[k]):
+                    found = True
+                    break
+                if abs(ge[k]) > ZERO_READ * max(abs(glo), abs(g1[k])):
+                    break
+                probe = hi - max(1e-6, 64.0 * event_tol / h)
+                if probe <= lo:
+                    break
+            if not found:
                 continue
+            hi = probe
             ghi = ge[k]
         else:
             ghi = g1[k]
