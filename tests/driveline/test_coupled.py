@@ -336,6 +336,33 @@ def test_a_wet_clutch_breaking_away_slowly_follows_the_tolerance_from_1e_8():
     assert [e[1:] for e in _mode_events(res[1e-8])] == [e[1:] for e in _mode_events(res[1e-12])]
 
 
+def test_a_wet_clutch_whose_load_outruns_its_capacity_within_a_step_breaks_away():
+    """The network random draws found (fifty-seventh session, seed 2038 of the components' tolerance property): a wet
+    clutch at a constant 300 N between J1 (a 9.5 N m sine at 0.3 Hz) and J2, J0 on a spring to J1 and a 1 N clutch
+    to J2.  Its capacity grows as the film squeezes, but the load grows faster from 0.013977 s: it slides backward
+    at its capacity until 0.02126 s, when the capacity catches up and it sticks again.  Before, a clutch model's
+    margin was not watched near its limit (only the network's own friction elements were), so a step over the
+    overload (25 ms at rtol 1e-8, or whenever a run ended at 0.03 s) saw the margin positive at both ends: the clutch
+    stayed stuck, up to 1 % beyond its capacity for 5 ms, at rtol 1e-8 and 1e-10 but not at 1e-7, 1e-9 or 1e-11."""
+    d = Driveline("wet overload within a step")
+    d.inertia("J0", J=0.25, w0=0.0).inertia("J1", J=0.875).inertia("J2", J=1.0)
+    d.spring_damper("k0", "J0", "J1", c=1.0, d=0.0)
+    d.wet_clutch("w1", "J1", "J2", force=Signal.constant(300.0))
+    d.clutch("loop", "J0", "J2", fn_max=1.0, mu=0.5)
+    d.torque("T1", "J1", Signal.sine(9.5, 0.304688))
+    for rtol, t_end in ((1e-7, 0.6), (1e-8, 0.6), (1e-10, 0.6), (1e-8, 0.03), (1e-9, 0.03)):
+        res = d.simulate(t_end, rtol=rtol, output_step=1e-3)
+        ev = res.events
+        w1 = [(float(t), str(e)) for t, el, e in zip(ev.time_s, ev.element, ev.event) if el == "w1" and t < 0.03]
+        assert [e for _t, e in w1] == ["backward", "stick"], (rtol, t_end, w1)
+        assert abs(w1[0][0] - 0.013977) < 1e-5 and abs(w1[1][0] - 0.02126) < 2e-4, (rtol, t_end, w1)
+        # stuck, the clutch carries its load within its static capacity at every sample (sliding, at it)
+        f = res.to_dataframe()
+        stuck = f["w1.mode_1"].to_numpy() == 0
+        tau, cap = np.abs(f["w1.tau_Nm"].to_numpy()), f["w1.static_capacity_Nm"].to_numpy()
+        assert np.all(tau[stuck] <= cap[stuck] * (1.0 + 1e-9) + 1e-12), (rtol, t_end)
+
+
 def test_a_wet_clutch_carrying_an_identical_ones_sliding_torque_breaks_away_with_it():
     """The network the thorough profile drew (thirty-second session, seed 502 of the components' invariants
     property): two identical wet clutches in series at a constant 300 N, w1 between J1 (driven by a -12 N m 5 Hz

@@ -158,9 +158,10 @@ def _model_held(m, before, net):
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _plain(p):
-    """True for the network ``p`` (a reference to its :class:`CoupledParams`) without model components (no wet clutch, no EMTC coupling): every hook is then the plain
-    network's own (:mod:`clutchlab.driveline.kernel`), so such a network runs as it did on its own parameter type,
-    and the components' functions, called through their addresses, are never compiled for it."""
+    """True for the network ``p`` (a reference to its :class:`CoupledParams`) without model components (no wet
+    clutch, no EMTC coupling): every hook is then the plain network's own (:mod:`clutchlab.driveline.kernel`), so
+    such a network runs as it did on its own parameter type, and a run never compiles the components' functions,
+    called through their addresses (a native FMU compiles them all)."""
     return member(p, "wet").conf.shape[0] == 0 and member(p, "emtc").conf.shape[0] == 0
 
 
