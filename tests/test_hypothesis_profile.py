@@ -64,3 +64,15 @@ def test_ci_draws_do_not_depend_on_the_modules_imported_before(tmp_path):
     assert _draws(tmp_path, switch=False, preload=False) != _draws(tmp_path, switch=False, preload=True)
     # and the CI profile removes it
     assert _draws(tmp_path, switch=True, preload=False) == _draws(tmp_path, switch=True, preload=True)
+
+
+def test_the_pinned_properties_draw_at_random_only_in_the_draws_profile(monkeypatch):
+    """``pinned()`` (the ``derandomize`` of the properties whose random draws find the open rounding-floor family)
+    is True in the ``ci``, ``dev`` and ``thorough`` profiles and False in ``draws``, which scales like
+    ``thorough``."""
+    sys.path.insert(0, str(SUPPORT))
+    import hypothesis_budget as hb
+
+    for name, pinned, factor in (("ci", True, 1), ("dev", True, 3), ("thorough", True, 20), ("draws", False, 20)):
+        monkeypatch.setenv("HYPOTHESIS_PROFILE", name)
+        assert hb.profile() == name and hb.pinned() is pinned and hb.examples(10) == 10 * factor

@@ -8,6 +8,9 @@ variable ``CI`` is set, as ``.ci/run`` does, else ``dev``):
   so a CI worker draws what a local ``CI=true`` run of the same test draws.
 - ``dev`` (a developer's run): new random examples every run, 3x the count.
 - ``thorough``: 20x the count (and 2,000 for tests that set none).
+- ``draws``: as ``thorough``, and the properties pinned to derandomised draws in every other profile
+  (:func:`pinned`: their random draws find the open rounding-floor family) draw at random too, so
+  ``--hypothesis-seed=N`` varies them (the random-network draws of issue #30).
 
 Tests that fix their count write ``@settings(max_examples=examples(N))`` so the
 profile scales them too; a bare ``max_examples=N`` would pin it in every profile.
@@ -20,7 +23,7 @@ import os
 from hypothesis import settings
 
 #: multiplier of each test's own example count, per profile
-FACTORS = {"ci": 1, "dev": 3, "thorough": 20}
+FACTORS = {"ci": 1, "dev": 3, "thorough": 20, "draws": 20}
 
 
 def profile() -> str:
@@ -31,6 +34,17 @@ def profile() -> str:
 def examples(n: int) -> int:
     """Example count for a test whose CI count is ``n``."""
     return int(n) * FACTORS.get(profile(), 1)
+
+
+def pinned() -> bool:
+    """``derandomize`` for a property pinned to derandomised draws: True but in the ``draws`` profile.
+
+    A property whose random draws find networks of the open rounding-floor family (docs/driveline.md, "Open")
+    writes ``@settings(derandomize=pinned())``: a developer's run stays reproducible, and ``HYPOTHESIS_PROFILE=draws
+    python -m pytest --hypothesis-seed=N`` draws new networks (a ``derandomize=True`` in the decorator overrides
+    every profile, so before this a seed did not vary them).
+    """
+    return profile() != "draws"
 
 
 def without_local_constants() -> bool:
@@ -57,6 +71,7 @@ def load() -> None:
     settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
     settings.register_profile("thorough", max_examples=2000, deadline=None, print_blob=True)
     settings.register_profile("dev", max_examples=300, deadline=None, print_blob=True)
+    settings.register_profile("draws", max_examples=2000, deadline=None, print_blob=True, derandomize=False)
     settings.load_profile(profile())
     if profile() == "ci":
         without_local_constants()

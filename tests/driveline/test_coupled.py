@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 from driveline_networks import networks
-from hypothesis_budget import examples
+from hypothesis_budget import examples, pinned
 
 from clutchlab.driveline import Driveline, Signal
 from clutchlab.driveline.bench import drum_bench
@@ -302,7 +302,7 @@ def _check_heat(d, df):
 # at their limit differ between tolerances (two CI runs and a local one drew three such networks: a lossy gear
 # rolling forward at rtol 1e-11 only, a bearing and a brake sticking in another order), the open rounding-floor
 # family of docs/driveline.md; the invariants property above keeps them.
-@settings(max_examples=examples(10), deadline=None, derandomize=True,
+@settings(max_examples=examples(10), deadline=None, derandomize=pinned(),
           suppress_health_check=[HealthCheck.too_slow])
 @given(networks(with_components=True, settled_only=True))
 def test_the_result_follows_the_tolerance_on_random_networks_with_components(d):
@@ -458,13 +458,13 @@ def test_a_one_way_clutch_grazing_at_an_exact_tie_is_a_touch_within_the_toleranc
     same_at_two_tolerances(d, 0.6, rtols=(1e-8, 1e-11))
 
 
-def test_a_backlash_released_for_an_instant_is_a_touch_within_the_tolerance():
+def test_a_backlash_released_for_an_instant_is_found_at_every_tolerance():
     """The network the thorough profile drew without ``settled_only`` (twenty-fourth session, seed 11): two
     backlashes, a pulsed wet clutch, bearing friction, a torque ramp and a sine.  Near 0.511 s the torque of the
-    contact k1 dips to zero and back: at rtol 1e-11 it reaches zero and the contact is released for 275 us (it
-    must not pull), at 1e-8 the dip stays within the tolerance (-1.8e-4 N m of a 73 N m range) and no event
-    comes.  The tolerance property counts that pair as no difference, because the other run's torque stays within
-    1e-5 of its range of zero through it."""
+    contact k1 dips through zero and back: it separates and is released for 275 us (it must not pull).  Until the
+    fifty-eighth session a step at rtol 1e-8 spanned the dip (-1.8e-4 N m of a 73 N m range), no event came, and
+    the tolerance property forgave the pair as a touch within the tolerance; the contact's torque is now watched
+    near separation (``kernel._lash_near``), and rtol 1e-8 and 1e-11 find the same release within 2 us."""
     d = Driveline("released for an instant")
     d.inertia("J0", J=1.6535264531531597, w0=3.0).inertia("J1", J=0.5212586861437773)
     d.inertia("J2", J=1.1).inertia("J3", J=1.259043294081933)
@@ -477,8 +477,11 @@ def test_a_backlash_released_for_an_instant_is_a_touch_within_the_tolerance():
     lo = _mode_events(d.simulate(0.6, rtol=1e-8, output_step=2e-3))
     hi = _mode_events(d.simulate(0.6, rtol=1e-11, output_step=2e-3))
     touch = [e for e in hi if e[1] == "k1" and 0.5105 < e[0] < 0.512]
-    assert [e[2] for e in touch] == ["separate", "contact"] and touch[1][0] - touch[0][0] < 5e-4
-    assert [e[1:] for e in hi if e not in touch] == [e[1:] for e in lo]
+    assert [e[2] for e in touch] == ["separate", "contact"] and 2.7e-4 < touch[1][0] - touch[0][0] < 2.8e-4
+    found = [e for e in lo if e[1] == "k1" and 0.5105 < e[0] < 0.512]
+    assert [e[2] for e in found] == ["separate", "contact"]
+    assert abs(found[0][0] - touch[0][0]) < 2e-6 and abs(found[1][0] - touch[1][0]) < 2e-6
+    assert [e[1:] for e in hi] == [e[1:] for e in lo]
     same_at_two_tolerances(d, 0.6, rtols=(1e-8, 1e-11))
 
 

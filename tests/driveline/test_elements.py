@@ -615,6 +615,47 @@ def test_a_backlash_impact_breaks_a_stuck_bearing_away_at_once():
     assert list(brk.event)[:1] == ["forward"] and float(brk.time_s.iloc[0]) == pytest.approx(t_contact, abs=1e-12)
 
 
+def _dipping_contact_network():
+    """The network of a random draw (seed 2033 of the fifty-seventh session's draws): a torque ramp on J2 drives,
+    through a damped backlash k1, J1 behind a one-way clutch, and through a torque converter J3, which a clutch
+    closes back onto J0.  k1's contact torque dips below zero for 0.7 ms at 0.2773 s."""
+    d = Driveline("dip")
+    d.inertia("J0", J=1.5, w0=0.0).inertia("J1", J=0.5625).inertia("J2", J=1.90234375).inertia("J3", J=0.5)
+    d.one_way_clutch("f0", "J0", "J1", fn_max=0.0, mu=0.5, peak=1.0)
+    d.backlash("k1", "J1", "J2", c=376.0, b_gap=0.023693754507450204, d=0.765625)
+    d.torque_converter("v2", "J2", "J3", table=[[0.0, 2.03125, 1.0], [0.5, 2.4375, 1.0], [0.9, 6.09375, 1.0]])
+    d.clutch("loop", "J0", "J3", fn_max=1.0, mu=0.5, peak=1.0, normal=1.0)
+    d.torque("T2", "J2", Signal.ramp(25.875, 0.13))
+    return d
+
+
+def test_a_backlash_contact_whose_torque_dips_through_zero_within_a_step_separates():
+    """A damped contact whose torque dips below zero for 0.7 ms separates and closes again at every tolerance.
+    At rtol 1e-7 and 1e-9 one step spanned the dip and the contact was held while it pulled (its separation
+    function, the torque over c, positive at both ends of the step); the contact's torque is now watched near
+    separation (``kernel._lash_near``: a waypoint as it comes within a tenth of the torques on its flanges, and
+    inside that band its turning point, where the core looks at the separation function again)."""
+    d = _dipping_contact_network()
+    runs = {}
+    for rtol in (1e-7, 1e-8, 1e-9, 1e-11):
+        ev = d.simulate(0.3, rtol=rtol, output_step=2e-3).events
+        k1 = ev[(ev.element == "k1") & (ev.time_s > 0.27)]
+        runs[rtol] = list(zip(k1.time_s, k1.event))
+    ref = runs[1e-11]
+    assert [e for _t, e in ref] == ["separate", "contact"]
+    assert ref[0][0] == pytest.approx(0.27732, abs=2e-5) and ref[1][0] == pytest.approx(0.27801, abs=2e-5)
+    for rtol, events in runs.items():
+        # (the times follow the tolerance: the dip's torque crosses zero at a few N m/ms)
+        assert [e for _t, e in events] == ["separate", "contact"], (rtol, events)
+        assert abs(events[0][0] - ref[0][0]) < 1e3 * rtol and abs(events[1][0] - ref[1][0]) < 1e3 * rtol
+    # densely sampled across the dip at the coarse tolerance: in contact the backlash never pulls
+    times = np.linspace(0.2765, 0.2790, 251)
+    df = d.simulate(0.28, rtol=1e-7, sample_times=times).to_dataframe()
+    contact = df["k1"].isin(["upper", "lower"])   # (separated beyond its edge it is "upper_released", torque 0)
+    assert contact.any() and (~contact).any()
+    assert (df["k1.tau_Nm"][contact] >= -1e-6).all(), df["k1.tau_Nm"][contact].min()
+
+
 # ----------------------------------------------------------------- lossy gears
 def test_lossy_gear_takes_the_loss_from_the_driving_side():
     """Torque ``T`` on J1 (flange a), gear ``w1 = i w2`` with efficiency ``eta`` to J2.  While J1 drives, J2 is

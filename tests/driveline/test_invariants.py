@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from driveline_networks import gear_loop, indeterminate_loop, networks
-from hypothesis_budget import examples
+from hypothesis_budget import examples, pinned
 
 from clutchlab.driveline import GROUND, Driveline, Signal
 from clutchlab.driveline import kernel as K
@@ -240,6 +240,20 @@ def test_the_debug_check_names_a_released_backlash_that_would_push():
     m0 = system.m0.copy()
     m0[list(system.mode_names).index("k0")] = K.LASH_UPPER_RELEASED
     with pytest.raises(SimulationError, match="k0.*released where its contact would push"):
+        _forced(system.replace(x0=x0), m0, 0.1)
+
+
+def test_the_debug_check_names_a_backlash_contact_that_pulls():
+    """The gap invariant in contact: a backlash started in its upper contact inside its gap and moving back (its
+    contact torque over c, ``phi - b/2 + d/c w_rel``, below zero: it would pull) is reported at once."""
+    d = _rattle()
+    system = d.system(1e-8, check_invariants=True)
+    x0 = system.x0.copy()
+    x0[system.state_index("J1.phi")] = 0.0          # inside the gap (its upper edge at 0.0156 rad)
+    x0[system.state_index("J1.w")] = -1.0           # and moving back
+    m0 = system.m0.copy()
+    m0[list(system.mode_names).index("k0")] = K.LASH_UPPER
+    with pytest.raises(SimulationError, match="k0.*in contact where it pulls"):
         _forced(system.replace(x0=x0), m0, 0.1)
 
 
@@ -818,11 +832,12 @@ def test_a_sliding_element_s_turning_function_is_its_acceleration_at_any_speed(t
         np.testing.assert_allclose(g[names.index("g.turn")], a3, rtol=1e-9, atol=1e-9)
 
 
-# derandomised in every profile: random draws still find rare networks started from rest whose first decision is
-# taken at the rounding floor (a lossy gear whose loss table has no bearing friction, so its stuck band is empty,
-# carrying 1e-16 N m from a sine at its zero: it rolls "forward" at zero speed in one step sequence and stays stuck
-# in another, a choice between two descriptions of the same motion; docs/driveline.md "Friction semantics")
-@settings(max_examples=examples(10), deadline=None, derandomize=True)
+# derandomised in every profile but ``draws`` (hypothesis_budget.pinned): random draws still find rare networks
+# started from rest whose first decision is taken at the rounding floor (a lossy gear whose loss table has no
+# bearing friction, so its stuck band is empty, carrying 1e-16 N m from a sine at its zero: it rolls "forward" at
+# zero speed in one step sequence and stays stuck in another, a choice between two descriptions of the same motion;
+# docs/driveline.md "Friction semantics")
+@settings(max_examples=examples(10), deadline=None, derandomize=pinned())
 @given(networks(with_unrelated=True))
 def test_an_unrelated_element_changes_nothing(d):
     """A network run with and without an inertia of its own elsewhere (braked, driven by a sine: events of its
@@ -1965,7 +1980,7 @@ def test_a_locked_loop_at_rest_keeps_its_split_within_its_bounds_from_sample_to_
         assert np.max(np.abs(bal)) < 1e-12
 
 
-@settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
+@settings(max_examples=examples(10), deadline=None, derandomize=pinned())   # (as the one above)
 @given(networks())
 def test_samples_change_nothing_on_random_networks(d):
     """Whatever the network, the result is the same sampled every 2 ms or at every accepted step: the outputs at a
@@ -1986,7 +2001,7 @@ def test_samples_change_nothing_on_random_networks(d):
     assert np.all(np.abs(xa - xb) <= 1e-9 * scale + 1e-12), (xa, xb)
 
 
-@settings(max_examples=examples(10), deadline=None, derandomize=True)   # (as the one above)
+@settings(max_examples=examples(10), deadline=None, derandomize=pinned())   # (as the one above)
 @given(networks())
 def test_the_result_follows_the_tolerance_on_random_networks(d):
     """At rtol 1e-7 and 1e-10 the same events (elements and modes) and speeds within 1e-4 of their range: the

@@ -13,7 +13,7 @@ import itertools
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from hypothesis_budget import examples
+from hypothesis_budget import examples, pinned
 from scipy.optimize import linprog, minimize
 
 from clutchlab.driveline import kernel as K
@@ -129,7 +129,7 @@ def _feasible_sets(G, h, w, theta=None):
     return out
 
 
-@settings(max_examples=examples(40), deadline=None, derandomize=True)
+@settings(max_examples=examples(40), deadline=None, derandomize=pinned())
 @given(seed=st.integers(0, 2**32 - 1), m=st.integers(2, 8), d=st.integers(2, 5),
        shift=st.floats(-0.05, 0.05), small=st.booleans())
 def test_the_warm_split_search_finds_the_optimum_whatever_its_hint(seed, m, d, shift, small):
@@ -180,7 +180,7 @@ def test_a_hint_one_pivot_away_is_taken_without_enumerating():
     assert not np.array_equal(hint[1:4], kept[1:4])
 
 
-@settings(max_examples=examples(60), deadline=None, derandomize=True)
+@settings(max_examples=examples(60), deadline=None, derandomize=pinned())
 @given(seed=st.integers(0, 2**32 - 1), m=st.integers(1, 30), d=st.integers(1, 8), zero=st.integers(0, 3),
        shift=st.floats(-2.0, 2.0))
 def test_the_cold_solves_find_scipy_s_optima_in_up_to_eight_dimensions(seed, m, d, zero, shift):

@@ -267,3 +267,31 @@ def test_the_start_derives_the_vehicle_and_actuator_numbers_the_packing_derived(
         getattr(bad.params, record)[0][name] = value
         with pytest.raises(SimulationError, match=message):
             core_simulate(bad, 0.05)
+
+
+_NRT_CALLER = """
+import numba
+from clutchlab.emtc import system as S
+p = S.params_template()
+
+@numba.njit(_nrt=False)
+def caller(a, c, l, t):
+    return S.derive_actuator(a, c, l, t)
+
+print("code", caller(p.actuator, p.cold, p.layout, p.controller_table))
+"""
+
+
+def test_derive_actuator_compiles_first_under_a_caller_without_reference_counting(tmp_path):
+    """``derive_actuator`` allocates, and numba compiles a callee with its caller's flags unless it declares its
+    own: it declares ``_nrt=True``, so a caller compiled without reference counting (a driveline's component start
+    was) that compiles it first, on an empty cache, links it (without the declaration numba refuses ``np.zeros``:
+    "Only accept returning of array passed into the function as argument").  The template's zero airgaps are
+    refused (``ERR_AIRGAP``)."""
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    proc = subprocess.run([sys.executable, "-c", _NRT_CALLER], capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert f"code {S.ERR_AIRGAP}" in proc.stdout

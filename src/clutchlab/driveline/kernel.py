@@ -189,7 +189,7 @@ GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_driv
 GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(
     GEAR_VALUES, "stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
-# switching functions: five per friction element, then three per switched spring (``swit``: backlash and curves),
+# switching functions: five per friction element, then four per switched spring (``swit``: backlash and curves),
 # then four per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point, its
 # band's pieces)
 FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near")
@@ -200,11 +200,12 @@ N_G = len(FRICTION_SWITCHING)
 GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn", "piece")
 N_GEAR_G = len(GEAR_SWITCHING)
 GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
-#: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends) and the
-#: turning points of a backlash's deflection in its gap (G_LASH_TURN)
-SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn")
+#: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends), the turning
+#: points of a backlash's deflection in its gap or of its contact's torque near separation (G_LASH_TURN), and in
+#: contact the contact's torque less :data:`NEAR_SEPARATION` of the torques on its flanges (G_LASH_NEAR, a waypoint)
+SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn", "near")
 N_SW = len(SPRING_SWITCHING)
-G_LASH_TURN = indices(SPRING_SWITCHING, "turn")
+G_LASH_TURN, G_LASH_NEAR = indices(SPRING_SWITCHING, "turn", "near")
 # A sliding element's (and a rolling lossy gear's) turning function is its relative acceleration towards its
 # sliding direction at every speed (G_TURN, GG_TURN; rising through zero: a minimum of its speed), so that a dip
 # through zero shorter than a step is not stepped over: a brake decelerating a stuck group from 0.08 rad/s under
@@ -4570,17 +4571,19 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged), the turning point of a sliding speed, or of a stuck one's margin near its
     limit (0.0 here, its rate from :func:`driveline_watch`: a brief overload is found), and a stuck one's margin less
-    :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near); then three per switched
+    :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near); then four per switched
     spring.  A
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
     pull); released beyond an edge (Kelvin-Voigt's damped separation), first ``tau / c`` signed positive while it
     would pull (contact again), then the distance beyond the edge (into the gap); with MSL's damping law, the two
     of its mode that fall through zero at its kinks
-    (:func:`_lash_msl_switching`); third, in the gap, the relative speed plus its rounding width on the nearer
-    edge's side (its turning points, either way: a step ends there, and the edges' functions get the core's second
-    look, so a touch of an edge within a step is found).  A curve spring: the deflection above the segment's lower
-    point and below its upper one (either falling through zero moves it to the next segment), third unused.  Then
+    (:func:`_lash_msl_switching`); third, in the gap, the relative speed signed towards the nearer edge less its
+    rounding width (rising through zero just past an extreme: a step ends there, and the edges' functions get the
+    core's second look, so a touch of an edge within a step is found), in contact near separation the contact
+    torque's turning point; fourth, in contact, the waypoint of its torque coming near separation
+    (:func:`_lash_near`).  A curve spring: the deflection above the segment's lower point and below its upper one
+    (either falling through zero moves it to the next segment), third and fourth unused.  Then
     four per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
     ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed; stuck,
@@ -4655,12 +4658,14 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             g[N_G * k + G_NORMAL] = _liftoff(p, r) - signal_at(p, p.elem[r, E_SIGNAL], t)
         else:
             g[N_G * k + G_NORMAL] = signal_at(p, p.elem[r, E_SIGNAL], t)
+    fabs = _torque_magnitudes(p)
     for j in range(p.swit.shape[0]):
         r = p.swit[j]
         phi = _spring_deflection(p, r, x, n)
         mode = m[nf + j]
         q = N_G * nf + N_SW * j
         g[q + G_LASH_TURN] = 1.0
+        g[q + G_LASH_NEAR] = 1.0
         if p.elem[r, E_LAW] == SPRING_CURVE:   # the points bounding the segment: below (falls through) and above
             s0, mp = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
             g[q] = phi - p.data[s0 + mode - 1] if mode > 0 else 1.0
@@ -4668,14 +4673,21 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             continue
         b2 = 0.5 * p.coef[r, C_GAP]
         if mode == LASH_GAP:
-            # the turning points of the deflection in the gap (the relative speed through zero at its extremes,
-            # either way), located so that a touch of an edge within a step (the deflection crosses it and comes
-            # back: free flight is a parabola the step control does not see) is found: the edges' functions get
-            # the core's second look at the turning point's root.  The rounding width of the speed is added on the
-            # side of the edge the deflection is nearer (the root lies just past the extreme; a gap at rest has none)
+            # the turning points of the deflection in the gap towards the nearer edge (rising through zero: the
+            # relative speed signed towards that edge falls through zero at the extreme), located so that a touch of
+            # an edge within a step (the deflection crosses it and comes back: free flight is a parabola the step
+            # control does not see) is found: the edges' functions get the core's second look at the turning
+            # point's root.  Less the rounding width of the speed (the root lies just past the extreme; a gap at
+            # rest has none).  (An extreme away from the nearer edge touches nothing; at phi = 0 the function
+            # falls, which is no crossing)
             w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             wt = _item_wtol(p, r, x, n)
-            g[q + G_LASH_TURN] = w_rel + (wt if phi > 0.0 else -wt)
+            g[q + G_LASH_TURN] = -w_rel - wt if phi > 0.0 else w_rel - wt
+        elif mode == LASH_UPPER or mode == LASH_LOWER:
+            # in contact near separation: a waypoint as the contact's torque comes near zero, and inside that band
+            # the turning point of that torque, so that a dip through zero shorter than a step is found
+            # (:func:`_lash_near`)
+            g[q + G_LASH_NEAR], g[q + G_LASH_TURN] = _lash_near(p, r, x, n, _lash_side(mode), acc, fabs)
         if _lash_msl(p, r):
             g0, g1 = _lash_msl_switching(p, r, x, n, mode, phi)
             g[q] = g0
@@ -4816,6 +4828,39 @@ def gear_power(p, r, x, n, m, tau):
         tb = -ratio * (f * tau + c)
     ts = -tau - tb
     return -(tau * _speed(x, n, p.elem[r, E_A]) + tb * _speed(x, n, p.elem[r, E_B]) + ts * _speed(x, n, p.elem[r, E_SUP]))
+
+
+#: a backlash in contact whose contact torque is below this share of the largest sum of torque magnitudes on its
+#: flanges is near separation (:func:`_lash_near`): a step ends as it comes into that band, and inside it the
+#: contact torque's turning points are located
+NEAR_SEPARATION = 0.1
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _lash_near(p, r, x, n, s, acc, fabs):
+    """The two switching functions of backlash row ``r`` in contact on side ``s`` (+1 upper, -1 lower) that watch
+    its separation within a step: ``(near, turn)``.
+
+    ``near`` [rad]: the contact's torque over ``c`` (:func:`_lash_contact`, > 0 while it pushes) less
+    :data:`NEAR_SEPARATION` of the larger sum of torque magnitudes on its flanges over ``c`` (a waypoint, falling
+    through zero: a step ends as the contact comes near separation).  ``turn`` [rad/s]: inside that band, the
+    contact torque's rate over ``c``, ``s (w_rel + d/c a_rel)``, plus the rounding of a speed and of an
+    acceleration (rising through zero just past its minimum, where the core looks at the separation function again:
+    a dip of the torque through zero and back within one step is found; a contact at rest has none); 1 outside it.
+    Without them a contact whose torque dipped below zero for 0.7 ms inside one step was held while it pulled
+    (random draws, fifty-seventh session); watched at every extreme, the E-clutch launch's driveshaft took 27 % more
+    right-hand sides, so only the extremes near separation are (fifty-eighth session)."""
+    push = _lash_contact(p, r, x, n, s)[1]
+    c = p.coef[r, C_STIFF]
+    a, b = p.elem[r, E_A], p.elem[r, E_B]
+    scale = max(fabs[a] if a >= 0 else 0.0, fabs[b] if b >= 0 else 0.0)
+    near = push - NEAR_SEPARATION * scale / c
+    if near >= 0.0:
+        return near, 1.0
+    lag = p.coef[r, C_DAMP] / c
+    w_rel = _speed(x, n, b) - _speed(x, n, a)
+    a_rel = (0.0 if b < 0 else acc[b]) - (0.0 if a < 0 else acc[a])
+    return near, s * (w_rel + lag * a_rel) + _item_wtol(p, r, x, n) + lag * _item_anoise(p, r, acc)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4966,8 +5011,8 @@ def driveline_update(t, x, u, m, p, k, log):
         return 0
     if k >= N_G * nf:
         j = (k - N_G * nf) // N_SW
-        if (k - N_G * nf) % N_SW == G_LASH_TURN:   # a backlash's turning point in its gap: a step ends there
-            return 0
+        if (k - N_G * nf) % N_SW == G_LASH_TURN or (k - N_G * nf) % N_SW == G_LASH_NEAR:
+            return 0   # a backlash's turning point, or its contact coming near separation: a step ends there
         r = p.swit[j]
         n = p.inertia.shape[0]
         if p.elem[r, E_LAW] == SPRING_CURVE:   # onto the next segment, below or above (no event: not a mode of interest)
@@ -5191,7 +5236,7 @@ INVARIANTS = ("stuck beyond its static limit", "mode inconsistent with the sign 
               "one-way clutch transmits torque in its free direction", "negative loss (power generated)",
               "energy balance beyond its tolerance",
               "backlash in its gap beyond an edge moving outward, or released where its contact would push (a "
-              "contact missed)",
+              "contact missed), or in contact where it pulls (a separation missed)",
               "its loss table, extrapolated beyond its last row, gives an efficiency <= 0 at the speed the gear "
               "turns at; give rows up to the speeds the run reaches",
               "a one-way clutch cannot start with flange b slower than flange a (it never slides backward)")
@@ -5212,7 +5257,8 @@ def check_invariants(t, x, m, p):
     * every rolling lossy gear's loss torque opposes its motion, so its loss power is >= 0 (to rounding), and so does
       every sliding friction element's (its law's magnitude is >= 0) and every torque converter's;
     * a backlash in its gap is not beyond an edge moving on outward, and one released beyond an edge (a damped contact
-      that separated there) is not where its contact would push (either: a contact missed);
+      that separated there) is not where its contact would push (either: a contact missed); one in contact does not
+      pull (a separation missed);
     * the energy balance (input work - dissipated - change of the stored energy) within ``check[1]`` of the energy
       that flowed plus 1 J (the integrator's absolute error in the energy states while little has flowed), and the
       thermal masses' heat balance (heat stored plus heat given to the ambients against the energy their elements
@@ -5291,6 +5337,12 @@ def check_invariants(t, x, m, p):
             _beyond, push = _lash_contact(p, r, x, n, 1.0 if m[nf + j] == LASH_UPPER_RELEASED else -1.0)
             if push > 1e-6 * max(1.0, 0.5 * p.coef[r, C_GAP]) + p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * 1e3 * \
                     _item_wtol(p, r, x, n):
+                return -(INV_BASE + N_INV * r + INV_GAP)
+        elif p.elem[r, E_LAW] == SPRING_BACKLASH and (m[nf + j] == LASH_UPPER or m[nf + j] == LASH_LOWER):
+            # in contact (either damping law): never where it pulls (tau / c past zero the other way, the same width)
+            _beyond, push = _lash_contact(p, r, x, n, _lash_side(m[nf + j]))
+            if push < -(1e-6 * max(1.0, 0.5 * p.coef[r, C_GAP]) + p.coef[r, C_DAMP] / p.coef[r, C_STIFF] * 1e3 *
+                        _item_wtol(p, r, x, n)):
                 return -(INV_BASE + N_INV * r + INV_GAP)
     if p.check[1] > 0.0:
         kinetic, spring, work, lost = 0.0, 0.0, 0.0, 0.0

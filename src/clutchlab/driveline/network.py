@@ -2670,12 +2670,15 @@ class Driveline:
         switching = tuple((f"{f}.{what}", d) for f in fric
                           for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3)))
         swit = [self._elements[r] for r in p.swit]
-        # (every function of a switched spring falls through zero; a backlash's edges get the core's second look at
-        # the root of its turning point in the gap, direction -2: a touch of an edge within a step is located)
+        # (a switched spring's edges fall through zero; a backlash's get the core's second look at the root of its
+        # turning point (rising: in the gap towards the nearer edge, in contact the contact torque's minimum near
+        # separation), direction -2: a touch of an edge or a separation within a step is located; its contact coming
+        # near separation is a waypoint, -3)
         switching += tuple((f"{e.name}.{side}", d) for e in swit
-                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 0))
+                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 1), ("near", -3))
                                            if e.law == K.SPRING_BACKLASH else
-                                           (("segment_below", -1), ("segment_above", -1), ("turn", -1))))
+                                           (("segment_below", -1), ("segment_above", -1), ("turn", -1),
+                                            ("near", -3))))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
         switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
                            for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1), ("piece", 4)))

@@ -1198,7 +1198,10 @@ def _outside(gaps, lo, hi):
     return n > 1 and (lo < gaps[0] - 1e-12 or hi > gaps[n - 1] + 1e-12)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+# (reference-counted whoever compiles it first: numba compiles a callee with its caller's flags unless it declares
+# its own, and it allocates; a driveline's component start, compiled without, failed on an empty cache once it
+# was the first to compile it, fifty-seventh session)
+@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=True)
 def derive_actuator(actuator, cold, layout, table):
     """What a run derives from the actuator's parameters (:data:`DERIVED_ACTUATOR`), written into its record
     ``actuator[0]`` (:data:`ACTUATOR_DTYPE`): the current lags' rates, and into ``table`` (``(1, N, N, 4)``,
