@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from .tcu import GearCommand, _positive
+from .checks import positive
+from .tcu import GearCommand
 
 __all__ = ["DctGear", "DctController", "DCT_PHASES"]
 
@@ -148,14 +149,14 @@ class DctController(GearCommand):
         self.torque_input, self.engine_speed, self.output_speed = torque_input, engine_speed, output_speed
         self._set_demand(torque)
         who = "DctController"
-        self.fill = _positive("fill", fill, who=who)
-        self.handover = _positive("handover", handover, who=who)
-        self.rise = _positive("rise", rise, who=who)
-        self.restore = _positive("restore", restore, who=who)
-        self.torque_cut = _positive("torque_cut", torque_cut, zero=True, who=who)
-        self.slip = _positive("slip", slip, zero=True, who=who)
-        self.coast_slip = _positive("coast_slip", coast_slip, zero=True, who=who)
-        self.shift_timeout = _positive("shift_timeout", shift_timeout, who=who)
+        self.fill = positive("fill", fill, who=who)
+        self.handover = positive("handover", handover, who=who)
+        self.rise = positive("rise", rise, who=who)
+        self.restore = positive("restore", restore, who=who)
+        self.torque_cut = positive("torque_cut", torque_cut, zero=True, who=who)
+        self.slip = positive("slip", slip, zero=True, who=who)
+        self.coast_slip = positive("coast_slip", coast_slip, zero=True, who=who)
+        self.shift_timeout = positive("shift_timeout", shift_timeout, who=who)
         for what, v, hi in (("fill", self.fill, 1.0), ("torque_cut", self.torque_cut, 1.0 - 1e-12),
                             ("slip", self.slip, 1.0 - 1e-12), ("coast_slip", self.coast_slip, 1.0 - 1e-12)):
             if v > hi:

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ParameterError, SimulationError
+from .checks import positive
 
 __all__ = ["AmtGear", "AmtController", "GearCommand", "PHASES", "SAMPLE_TIME", "SHIFT_OWN"]
 
@@ -63,17 +64,6 @@ class AmtGear:
                 raise ParameterError(f"gear of {self.synchronizer}: ratio = {self.ratio!r} must be a finite number, "
                                      "not 0")
             object.__setattr__(self, "ratio", r)
-
-
-def _positive(name, value, zero=False, who="AmtController"):
-    """``value`` as a float, finite and > 0 (``zero``: >= 0), or a ParameterError naming the controller ``who``."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{who}: {name} = {value!r} must be a number") from None
-    if not (math.isfinite(v) and (v >= 0.0 if zero else v > 0.0)):
-        raise ParameterError(f"{who}: {name} = {value!r} must be finite and {'>=' if zero else '>'} 0")
-    return v
 
 
 def _demand_profile(torque, who):
@@ -317,15 +307,15 @@ class AmtController(GearCommand):
         if not (math.isfinite(self.drag) and self.drag <= 0.0):
             raise ParameterError(f"AmtController: drag = {drag!r} must be finite and <= 0 (the engine's drag while "
                                  "the clutch is open)")
-        self.fork_force = _positive("fork_force", fork_force)
-        self.torque_down = _positive("torque_down", torque_down)
-        self.clutch_open = _positive("clutch_open", clutch_open)
-        self.fork_ramp = _positive("fork_ramp", fork_ramp)
-        self.clutch_close = _positive("clutch_close", clutch_close)
-        self.sync_timeout = _positive("sync_timeout", sync_timeout)
-        self.speed_match = _positive("speed_match", speed_match, zero=True)
+        self.fork_force = positive("fork_force", fork_force)
+        self.torque_down = positive("torque_down", torque_down)
+        self.clutch_open = positive("clutch_open", clutch_open)
+        self.fork_ramp = positive("fork_ramp", fork_ramp)
+        self.clutch_close = positive("clutch_close", clutch_close)
+        self.sync_timeout = positive("sync_timeout", sync_timeout)
+        self.speed_match = positive("speed_match", speed_match, zero=True)
         self.torque_max = (max(float(self._demand[1].max()), 0.0) if torque_max is None else
-                           _positive("torque_max", torque_max, zero=True))
+                           positive("torque_max", torque_max, zero=True))
         self.engine_speed, self.output_speed = engine_speed, output_speed
         if self.speed_match:
             for what, v in (("engine_speed", engine_speed), ("output_speed", output_speed)):
