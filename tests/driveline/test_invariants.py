@@ -760,6 +760,33 @@ def test_invariants_hold_on_random_networks(d):
     _check_columns(d, res.to_dataframe(), res.events)
 
 
+def test_a_lossy_gear_reaching_rest_as_its_loop_breaks_away_reverses_at_once():
+    """The network of a random draw (seed 2072 of the fifty-eighth session's draws): a lossy gear g0 (efficiency
+    0.96875) rolling backward in a loop a clutch closes, with bearing friction and a brake.  At 0.5758349 s its speed
+    reaches zero as the loop's clutch, the bearing and the brake break away together; the search released it
+    backward again (its quadrant changed, its direction not), and its stick function kept the slack of its earlier
+    motion, so it started that motion below zero, a rounding past the root: the gear turned forward, labelled
+    backward, for 0.46 ms, until another event searched it again.  An item the search releases from the stuck mode
+    its own crossing put it in now gets the slack of one released from stuck, and its reversal is located 1.7 ns
+    later.  The samples keep every invariant (what the random property checks from the columns)."""
+    d = Driveline("loop")
+    d.inertia("J0", J=1.0, w0=-2.0).inertia("J1", J=0.5).inertia("J2", J=1.0).inertia("J3", J=1.0)
+    d.gear("g0", "J0", "J1", ratio=1.15625, efficiency=0.96875)
+    d.spring_damper("k1", "J1", "J2", c=1.0, d=0.0)
+    d.gear("g2", "J2", "J3", ratio=3.25, loss_table=[[0.0, 0.625, 0.375, 0.5, 1.0], [20.0, 0.675, 0.375, 0.75, 1.0]])
+    d.clutch("loop", "J0", "J3", fn_max=17.0, mu=0.5, peak=1.0, normal=1.0)
+    d.bearing_friction("bearing", "J2", torque=1.0, peak=1.0)
+    d.brake("brake", "J1", fn_max=22.0, mu=0.4, peak=1.0, normal=Signal.step(1.0, 0.5))
+    d.torque("T2", "J2", Signal.sine(-13.0, 1.5))
+    d.torque("T3", "J3", Signal.sine(-4.0, 0.5))
+    for rtol in (1e-9, 1e-11):
+        res = d.simulate(1.0, output_step=2e-3, rtol=rtol, check_invariants=True)
+        _check_columns(d, res.to_dataframe(), res.events)
+        g0 = [(t, e) for t, e in _events(res, "g0") if 0.5758 < t < 0.577]
+        assert [e for _t, e in g0] == ["b_drives", "forward"], (rtol, g0)
+        assert g0[0][0] == pytest.approx(0.5758349, abs=1e-6) and g0[1][0] - g0[0][0] < 1e-6, (rtol, g0)
+
+
 def test_a_synchroniser_pushed_to_the_run_s_end_at_its_force_s_zero_keeps_the_invariants():
     """Two inertias at rest joined by a synchroniser whose sleeve a 50 N sine at 0.5 Hz pushes for the whole 1 s run
     (the thorough profile's seed 1402): the force's zero falls on the run's end, where its sample is -3.8e-14 N (sin
