@@ -4392,7 +4392,7 @@ def settle(t, x, m, p, log, old, origin):
     # starts from stuck too, though no event names it: its speed at the located root is a rounding past zero, maybe
     # the wrong way, which the slack covers.  Without it, a lossy gear whose speed reached zero as a group broke away
     # rolled on "backward" with its stick function below zero from the start, so its forward motion was never seen
-    # (0.33 ms, random draws seed 2072, fifty-eighth session))
+    # (0.46 ms, random draws seed 2072, fifty-eighth session))
     for k in range(nf):
         released = m[k] != STUCK and m[k] != FREE and entry[k] == STUCK
         if m[k] != old[k] or released:
