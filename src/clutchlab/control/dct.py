@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError, SimulationError
-from .checks import positive
+from ._checks import positive
 from .tcu import GearCommand
 
 __all__ = ["DctGear", "DctController", "DCT_PHASES"]

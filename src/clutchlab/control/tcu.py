@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ParameterError, SimulationError
-from .checks import positive
+from ._checks import positive
 
 __all__ = ["AmtGear", "AmtController", "GearCommand", "PHASES", "SAMPLE_TIME", "SHIFT_OWN"]
 

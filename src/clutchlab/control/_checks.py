@@ -1,4 +1,5 @@
-"""Checks of the controllers' parameters, shared by the transmission controllers (:mod:`.tcu`, :mod:`.dct`)."""
+"""Checks of the controllers' parameters, shared by the transmission controllers (:mod:`.tcu`, :mod:`.dct`); not part
+of the public API."""
 
 from __future__ import annotations
 
