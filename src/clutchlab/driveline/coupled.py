@@ -500,10 +500,10 @@ def coupled_start(t, x, u, m, p):
 def _components_start(t, x, u, m, p):
     """:func:`coupled_start`'s components: what each derives from its parameters alone (through its address: a
     plain network never runs it).  Reference-counted: the EMTC's derivation allocates its index arrays
-    (:func:`clutchlab.emtc.system.derive_actuator`), and a callee compiled first from here takes this function's
-    flags (numba's ``nrt`` is inherited): without reference counting its ``np.zeros`` does not compile.  It was
-    compiled first from Python by every plain network's empty EMTC block, packed from a magnet, until that block
-    was typed from ``params_template``; a native FMU of a plain network then failed to build on an empty cache."""
+    (:func:`clutchlab.emtc.system.derive_actuator`), and a callee without flags of its own compiled first from here
+    takes this function's (numba's ``nrt`` is inherited).  A native FMU of a plain network once failed to build on
+    an empty cache that way (fifty-seventh session); ``derive_actuator`` now declares ``_nrt=True`` itself
+    (fifty-eighth session, tested from a caller without it), and this function keeps the flag it was tested with."""
     w = member(p, "wet")
     for j in range(w.conf.shape[0]):
         code = DW.W.wet_start(t, x, u, m, row(member(w, "params"), j))
