@@ -32,6 +32,8 @@ from clutchlab.driveline.description import load_driveline, parse_driveline
 from clutchlab.driveline.variants import DrivelineDocument
 from clutchlab.errors import ParameterError
 
+from .msl.reference import converter_torques as reference_torques
+
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "driveline_torque_converter.toml"
 RPM = math.pi / 30.0
 #: a passenger car's converter (the example's): rows [SR, K rad/s/sqrt(N m), TR]
@@ -41,41 +43,7 @@ COAST = [[0.0, 160 * RPM], [0.5, 180 * RPM], [0.9, 320 * RPM]]
 
 
 # ----------------------------------------------------------------- the law, written again from its equations
-def _capacity(table, s, torque_ratio=True):
-    """``(1/K^2, TR)`` of ``table`` at ``0 <= s <= 1``: K and TR linear between rows, held below the first; from the
-    last row the capacity falls linearly to 0 at 1."""
-    t = np.asarray(table, dtype=float)
-    sr, k = t[:, 0], t[:, 1]
-    tr = t[:, 2] if torque_ratio else np.ones(len(t))
-    if s >= sr[-1]:
-        return (1.0 - s) / (1.0 - sr[-1]) / k[-1] ** 2, tr[-1]
-    kk = np.interp(s, sr, k)
-    return 1.0 / kk ** 2, float(np.interp(s, sr, tr))
-
-
-def reference_torques(wp, wt, table, coast=None):
-    """Torques on the impeller and the turbine ``(tau_p, tau_t)``, speeds against the support."""
-    coast = [row[:2] for row in table] if coast is None else coast
-    if wp == 0.0 and wt == 0.0:
-        return 0.0, 0.0
-    if abs(wp) >= abs(wt):
-        s = wt / wp
-        c0, tr0 = _capacity(table, 0.0)
-        if s >= 0.0:
-            c, tr = _capacity(table, s)
-        else:   # the turbine turning against the impeller: TR from its stall value to 1 at s = -1
-            c, tr = c0, tr0 + (tr0 - 1.0) * s
-        tp = c * wp * abs(wp)
-        return -tp, tr * tp
-    s = wp / wt
-    if s >= 0.0:
-        c, _ = _capacity(coast, s, torque_ratio=False)
-    else:   # the coast capacity from its value at 0 to the drive table's at stall, at s = -1
-        cc0, _ = _capacity(coast, 0.0, torque_ratio=False)
-        cd0, _ = _capacity(table, 0.0)
-        c = cc0 + (cc0 - cd0) * s
-    tt = c * wt * abs(wt)
-    return tt, -tt
+# (``reference_torques``: msl/reference.py's ``converter_torques``, which the reference engine's networks use too)
 
 
 def _kernel_torques(d, wp, wt, ws=0.0):

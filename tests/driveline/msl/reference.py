@@ -4,7 +4,10 @@ The specification is the Modelica Standard Library (4.x) source: ``Interfaces.Pa
 friction elements built on it (``Components.Clutch``, ``Brake``, ``BearingFriction``),
 ``Components.OneWayClutch``, ``Components.LossyGear`` (Pelchen, Otter and Schweiger 2002),
 ``Components.IdealGear``, ``Components.ElastoBacklash``, ``Components.SpringDamper`` and the
-``Modelica.Blocks.Sources`` signals.  Nothing here imports clutchlab.
+``Modelica.Blocks.Sources`` signals.  Two elements MSL does not have are written from docs/driveline.md's
+equations, for random networks that use them: the torque converter (``converter_torques``, also the law of
+``tests/driveline/test_converter.py``) and clutchlab's Kelvin-Voigt backlash contact (``backlash(...,
+law="kelvin_voigt")``, with its released modes).  Nothing here imports clutchlab.
 
 Method: the speeds and angles of the inertias are the states (SciPy ``solve_ivp``, DOP853, rtol 1e-12).
 For a fixed set of modes, the accelerations and the constraint torques solve one linear system:
@@ -116,6 +119,50 @@ def table1d(rows):
     return f
 
 
+# ----------------------------------------------------------------------------- a torque converter
+def converter_capacity(table, s, torque_ratio=True):
+    """``(1/K^2, TR)`` of ``table`` at ``0 <= s <= 1``: K and TR linear between rows, held below the first; from the
+    last row the capacity falls linearly to 0 at 1."""
+    t = np.asarray(table, dtype=float)
+    sr, k = t[:, 0], t[:, 1]
+    tr = t[:, 2] if torque_ratio else np.ones(len(t))
+    if s >= sr[-1]:
+        return (1.0 - s) / (1.0 - sr[-1]) / k[-1] ** 2, tr[-1]
+    kk = np.interp(s, sr, k)
+    return 1.0 / kk ** 2, float(np.interp(s, sr, tr))
+
+
+def converter_torques(wp, wt, table, coast=None):
+    """A hydrodynamic torque converter's torques on the impeller and the turbine ``(tau_p, tau_t)`` at their speeds
+    against the support (the support receives ``-(tau_p + tau_t)``), written from docs/driveline.md's "Torque
+    converter" (SAE J643's law made continuous at every pair of speeds), not from clutchlab: driving, ``T_p = w_p
+    |w_p| / K(SR)^2`` and ``T_t = TR(SR) T_p`` at ``SR = w_t / w_p``; coasting (``|w_t| > |w_p|``) ``TR = 1`` with
+    the coast table's ``K`` at ``w_p / w_t`` (default the drive table's); a driven member turning against its
+    driver keeps the stall capacity and brings ``TR`` (or the coast capacity) linearly to the other side's at a
+    ratio of -1; from the table's last row to a ratio of 1 the capacity ``1/K^2`` falls linearly to 0."""
+    coast = [row[:2] for row in table] if coast is None else coast
+    if wp == 0.0 and wt == 0.0:
+        return 0.0, 0.0
+    if abs(wp) >= abs(wt):
+        s = wt / wp
+        c0, tr0 = converter_capacity(table, 0.0)
+        if s >= 0.0:
+            c, tr = converter_capacity(table, s)
+        else:   # the turbine turning against the impeller: TR from its stall value to 1 at s = -1
+            c, tr = c0, tr0 + (tr0 - 1.0) * s
+        tp = c * wp * abs(wp)
+        return -tp, tr * tp
+    s = wp / wt
+    if s >= 0.0:
+        c, _ = converter_capacity(coast, s, torque_ratio=False)
+    else:   # the coast capacity from its value at 0 to the drive table's at stall, at s = -1
+        cc0, _ = converter_capacity(coast, 0.0, torque_ratio=False)
+        cd0, _ = converter_capacity(table, 0.0)
+        c = cc0 + (cc0 - cd0) * s
+    tt = c * wt * abs(wt)
+    return tt, -tt
+
+
 # ----------------------------------------------------------------------------- the network
 @dataclass
 class Element:
@@ -170,9 +217,19 @@ class Network:
         """SpringDamper (Damper: c = 0): tau = c (phi_rel - phi_rel0) + d w_rel."""
         return self._add("spring_damper", name, a, b, c=c, d=d, phi_rel0=phi_rel0)
 
-    def backlash(self, name, a, b, c, d, b_gap, phi_rel0=0.0):
-        """ElastoBacklash (b > bEps), its damping law limited so the contact never pulls."""
-        return self._add("backlash", name, a, b, c=c, d=d, bmax=b_gap / 2.0, phi_rel0=phi_rel0)
+    def backlash(self, name, a, b, c, d, b_gap, phi_rel0=0.0, law="msl"):
+        """ElastoBacklash (b > bEps), its damping law limited so the contact never pulls (``law="msl"``); or
+        clutchlab's documented contact (``law="kelvin_voigt"``, docs/driveline.md "Backlash and nonlinear
+        springs"; not MSL's): in contact tau = c delta + d w_rel (delta the deflection beyond the edge), the
+        contact ends where that torque would pull, into the gap at the edge or *released* beyond it (no torque,
+        the spring relaxing through its damper) until the torque would push again or delta returns to zero."""
+        kind = "backlash" if law == "msl" else "kv_backlash"
+        return self._add(kind, name, a, b, c=c, d=d, bmax=b_gap / 2.0, phi_rel0=phi_rel0)
+
+    def torque_converter(self, name, a, b, table, coast=None, support=None):
+        """A hydrodynamic torque converter, impeller on ``a``, turbine on ``b``, the stator's reaction on
+        ``support`` (:func:`converter_torques`; MSL has no converter)."""
+        return self._add("converter", name, a, b, support, table=table, coast=coast)
 
     def clutch(self, name, a, b, fn_max, normal: Sig, mu=0.5, peak=1.0, cgeo=1.0):
         """Clutch: tau0 = mu(0) cgeo fn, fn = fn_max f_normalized, free if fn <= 0."""
@@ -290,6 +347,26 @@ class Network:
                     tau, loss = self.backlash_tau(el.p, phi_rel, w_rel)
                 F += self._e(el.a, tau) - self._e(el.b, tau)
                 out[el.name] = {"tau": tau, "power": loss}
+            elif el.kind == "kv_backlash":
+                w_rel, phi_rel = self._rel(el, y)
+                diff = phi_rel - el.p["phi_rel0"]
+                tau, loss = 0.0, 0.0
+                if m in ("upper", "lower"):
+                    delta = diff - el.p["bmax"] if m == "upper" else diff + el.p["bmax"]
+                    tau = el.p["c"] * delta + el.p["d"] * w_rel
+                    loss = el.p["d"] * w_rel * w_rel
+                elif m in ("upper_released", "lower_released"):
+                    delta = diff - el.p["bmax"] if m == "upper_released" else diff + el.p["bmax"]
+                    loss = -el.p["c"] * delta * w_rel      # the deflected spring relaxes through its damper
+                F += self._e(el.a, tau) - self._e(el.b, tau)
+                out[el.name] = {"tau": tau, "power": loss}
+            elif el.kind == "converter":
+                ws = 0.0 if el.s is None else y[el.s]
+                wp = (0.0 if el.a is None else y[el.a]) - ws
+                wt = (0.0 if el.b is None else y[el.b]) - ws
+                ta, tb = converter_torques(wp, wt, el.p["table"], el.p["coast"])
+                F += self._e(el.a, ta) + self._e(el.b, tb) - self._e(el.s, ta + tb)
+                out[el.name] = {"tau": ta, "tau_b": tb, "power": -(ta * wp + tb * wt)}
             elif el.kind in ("friction", "one_way"):
                 w_rel, _ = self._rel(el, y)
                 cvec = self._e(el.b) - self._e(el.a)
@@ -448,7 +525,41 @@ class Network:
                 if p["d"] > 0:
                     add(kinks, 0.0, (el.name, "kink"))
                     add(lambda t, y, el=el: kinks(t, y, el, 1), 0.0, (el.name, "kink"))
+            elif el.kind == "kv_backlash":
+                def rel(t, y, el=el, edge=1.0):
+                    w_rel, phi_rel = self._rel(el, y)
+                    return phi_rel - el.p["phi_rel0"] - edge * el.p["bmax"], w_rel
+
+                def push(t, y, el=el, edge=1.0):
+                    delta, w_rel = rel(t, y, el, edge)
+                    return el.p["c"] * delta + el.p["d"] * w_rel
+                if m == "gap":
+                    add(lambda t, y, el=el: rel(t, y, el, 1.0)[0], 1.0, (el.name, "contact+"))
+                    add(lambda t, y, el=el: rel(t, y, el, -1.0)[0], -1.0, (el.name, "contact-"))
+                else:
+                    s = 1.0 if m.startswith("upper") else -1.0
+                    if m in ("upper", "lower"):       # the contact torque would pull: separate
+                        add(lambda t, y, el=el, s=s: push(t, y, el, s), -s, (el.name, "separate"))
+                    else:                             # released: pushes again, or back at the edge
+                        add(lambda t, y, el=el, s=s: push(t, y, el, s), s, (el.name, "push"))
+                        add(lambda t, y, el=el, s=s: rel(t, y, el, s)[0], -s, (el.name, "into_gap"))
         return evs
+
+    def _backlash_event(self, el, what, t, y, modes):
+        """The new mode of Kelvin-Voigt backlash ``el`` at its event ``what``."""
+        if what in ("contact+", "contact-"):
+            return "upper" if what == "contact+" else "lower"
+        if what == "into_gap":
+            return "gap"
+        up = modes[el.name].startswith("upper")
+        if what == "push":
+            return "upper" if up else "lower"
+        # separate: at the edge into the gap, beyond it released
+        _w, phi_rel = self._rel(el, y)
+        delta = phi_rel - el.p["phi_rel0"] - (1.0 if up else -1.0) * el.p["bmax"]
+        if abs(delta) <= 1e-12 * max(1.0, el.p["bmax"]):
+            return "gap"
+        return "upper_released" if up else "lower_released"
 
     # mode logic --------------------------------------------------------------------------
     def _initial_modes(self, t, y):
@@ -466,6 +577,10 @@ class Network:
                 wa = self._gear_w(el, y)
                 modes[el.name] = FWD if wa > 0 else BWD if wa < 0 else STUCK
                 modes[el.name + ".q"] = 1.0
+            elif el.kind == "kv_backlash":
+                diff = self._rel(el, y)[1] - el.p["phi_rel0"]
+                bmax = el.p["bmax"]
+                modes[el.name] = "upper" if diff > bmax else "lower" if diff < -bmax else "gap"
         return modes
 
     def settle(self, t, y, modes, log, tol=1e-10, eps=1e-9):
@@ -546,7 +661,7 @@ class Network:
         n = self.n
         sources = [e for e in self.elements if e.kind == "torque"]
         lossy = [e for e in self.elements if e.kind in ("friction", "one_way", "lossy_gear", "spring_damper",
-                                                        "backlash")]
+                                                        "backlash", "kv_backlash", "converter")]
         ny = 2 * n + len(sources) + len(lossy)
         y = np.zeros(ny)
         y[:n] = self.w0
@@ -608,6 +723,12 @@ class Network:
                 at_start = te - t < 1e-12
                 for tag in hits:
                     name, what = tag
+                    if what == "quadrant" and at_start:
+                        # the crossing just applied, seen again where the new quadrant's integration starts
+                        # (tau_eta is zero there): flipping it back would run the gear in the quadrant its
+                        # tau_eta has just left (the settle still flips a quadrant whose sign disagrees)
+                        disabled.add(tag)
+                        continue
                     if what in ("kink", "normal"):
                         if at_start:
                             disabled.add(tag)
@@ -631,6 +752,10 @@ class Network:
                             modes[name + ".q"] = 1.0 if eta >= 0 else -1.0
                     elif what == "quadrant":
                         modes[name + ".q"] = -modes[name + ".q"]
+                    elif what in ("contact+", "contact-", "separate", "push", "into_gap"):
+                        el = next(e for e in self.elements if e.name == name)
+                        modes[name] = self._backlash_event(el, what, te, ye[:2 * n], modes)
+                        log.append((te, name, modes[name]))
                 if not at_start:
                     disabled = set()
                 self.settle(te, ye[:2 * n], modes, log)
