@@ -164,6 +164,11 @@ def converter_torques(wp, wt, table, coast=None):
 
 
 # ----------------------------------------------------------------------------- the network
+class Indeterminate(RuntimeError):
+    """A statically indeterminate set of constraints in a strict network (:attr:`Network.strict`): the torques the
+    constraints carry are not unique, and which split holds decides the next break-away."""
+
+
 @dataclass
 class Element:
     kind: str
@@ -177,9 +182,12 @@ class Element:
 class Network:
     """Inertias joined by MSL Rotational elements (build it with the methods, then :meth:`simulate`)."""
 
-    def __init__(self):
+    def __init__(self, strict=False):
         self.names, self.J, self.w0, self.phi0 = [], [], [], []
         self.elements: list[Element] = []
+        #: refuse a statically indeterminate set of constraints (:class:`Indeterminate`) instead of taking the
+        #: least-squares split: the split decides break-aways, and MSL's equations are singular there
+        self.strict = strict
 
     # bodies and elements ---------------------------------------------------------------
     def inertia(self, name, J, w0=0.0, phi0=0.0):
@@ -422,6 +430,8 @@ class Network:
         for j in range(nc):
             A[:n, n + j] = D[j]
             A[n + j, :n] = C[j]
+        if self.strict and nc and np.linalg.matrix_rank(np.array(C), tol=1e-9) < nc:
+            raise Indeterminate(f"t = {t!r}: constraints {[o[0] for o in owner]} hold one motion twice")
         try:
             x = np.linalg.solve(A, rhs)
         except np.linalg.LinAlgError:
@@ -654,10 +664,12 @@ class Network:
         raise RuntimeError(f"mode iteration did not converge at t = {t!r}")
 
     # the run -----------------------------------------------------------------------------
-    def simulate(self, t_end, t_out, rtol=1e-12, atol=1e-12, max_step=1e-3, breaks=()):
+    def simulate(self, t_end, t_out, rtol=1e-12, atol=1e-12, max_step=1e-3, breaks=(), partial=False):
         """Integrate to ``t_end``; return a :class:`Result` sampled at ``t_out``.  ``max_step`` bounds the
         step so that no switching function crosses zero and back within one step (a locked network has
-        no error to limit it)."""
+        no error to limit it).  ``partial``: a strict network that meets a statically indeterminate set of
+        constraints (:class:`Indeterminate`) ends the run there, its result's ``reached`` the time it got to
+        (``t_end`` for a whole run)."""
         n = self.n
         sources = [e for e in self.elements if e.kind == "torque"]
         lossy = [e for e in self.elements if e.kind in ("friction", "one_way", "lossy_gear", "spring_damper",
@@ -694,77 +706,87 @@ class Network:
             return rhs
 
         disabled = set()
-        while t < t_end:
-            t_stop = min(x for x in tb if x > t)
-            md = dict(modes)
-            evs = [e for e in self._event_functions(md) if e[2] not in disabled]
-            funs = []
-            for fun, direction, _tag in evs:
-                def g(tt, yy, fun=fun):
-                    return fun(tt, yy[:2 * n])
-                g.terminal, g.direction = True, direction
-                funs.append(g)
-            sol = solve_ivp(rhs_for(md), (t, t_stop), y, method="DOP853", rtol=rtol, atol=atol,
-                            max_step=max_step, events=funs, dense_output=True)
-            if sol.status < 0:
-                raise RuntimeError(sol.message)
-            te, ye = sol.t[-1], sol.y[:, -1].copy()
-            segments.append((t, te, sol.sol, md))
-            if sol.status == 1:
-                hits = [evs[i][2] for i in range(len(evs)) if len(sol.t_events[i])
-                        and abs(sol.t_events[i][-1] - te) <= 1e-13]
-                if any(tag[1] == "zero" for tag in hits):
-                    # an element on the same motion reaches zero speed at the same instant (a bearing on a
-                    # lossy gear's shaft): its root may be dropped as later by an ulp, or land an ulp past
-                    # zero, with the processor's rounding; it is stuck too (the settle releases it if its
-                    # torque is beyond its limit)
-                    hits += [tag for (fun, _d, tag) in evs if tag[1] == "zero" and tag not in hits
-                             and abs(fun(te, ye[:2 * n])) < 1e-12]
-                at_start = te - t < 1e-12
-                for tag in hits:
-                    name, what = tag
-                    if what == "quadrant" and at_start:
-                        # the crossing just applied, seen again where the new quadrant's integration starts
-                        # (tau_eta is zero there): flipping it back would run the gear in the quadrant its
-                        # tau_eta has just left (the settle still flips a quadrant whose sign disagrees)
-                        disabled.add(tag)
-                        continue
-                    if what in ("kink", "normal"):
-                        if at_start:
+        reached = t_end
+        try:
+            while t < t_end:
+                t_stop = min(x for x in tb if x > t)
+                md = dict(modes)
+                evs = [e for e in self._event_functions(md) if e[2] not in disabled]
+                funs = []
+                for fun, direction, _tag in evs:
+                    def g(tt, yy, fun=fun):
+                        return fun(tt, yy[:2 * n])
+                    g.terminal, g.direction = True, direction
+                    funs.append(g)
+                sol = solve_ivp(rhs_for(md), (t, t_stop), y, method="DOP853", rtol=rtol, atol=atol,
+                                max_step=max_step, events=funs, dense_output=True)
+                if sol.status < 0:
+                    raise RuntimeError(sol.message)
+                te, ye = sol.t[-1], sol.y[:, -1].copy()
+                segments.append((t, te, sol.sol, md))
+                if sol.status == 1:
+                    hits = [evs[i][2] for i in range(len(evs)) if len(sol.t_events[i])
+                            and abs(sol.t_events[i][-1] - te) <= 1e-13]
+                    if any(tag[1] == "zero" for tag in hits):
+                        # an element on the same motion reaches zero speed at the same instant (a bearing on a
+                        # lossy gear's shaft): its root may be dropped as later by an ulp, or land an ulp past
+                        # zero, with the processor's rounding; it is stuck too (the settle releases it if its
+                        # torque is beyond its limit)
+                        hits += [tag for (fun, _d, tag) in evs if tag[1] == "zero" and tag not in hits
+                                 and abs(fun(te, ye[:2 * n])) < 1e-12]
+                    at_start = te - t < 1e-12
+                    for tag in hits:
+                        name, what = tag
+                        if what in ("quadrant", "zero") and at_start:
+                            # the crossing just applied, seen again where the new mode's integration starts
+                            # (tau_eta or the speed is zero there): flipping it back would run the gear in the
+                            # quadrant its tau_eta has just left, or stick an element released at zero speed (the
+                            # settle, which ran at this instant, sticks one that would accelerate against its
+                            # direction, and flips a quadrant whose sign disagrees)
                             disabled.add(tag)
-                        continue
-                    if at_start and (tag, t) in fired:      # applied once already here: it does not hold
-                        disabled.add(tag)
-                        continue
-                    if at_start:
-                        fired.add((tag, t))
-                    if what == "zero":
-                        modes[name] = STUCK
-                        log.append((te, name, STUCK))
-                    elif what in ("break+", "break-"):
-                        modes[name] = FWD if what == "break+" else BWD
-                        log.append((te, name, modes[name]))
-                        el = next(e for e in self.elements if e.name == name)
-                        if el.kind == "lossy_gear":
-                            o = self.solve(te, ye[:2 * n], md)[1][name]
-                            bfa = self._loss(el, 0.0)[4]
-                            eta = o["tau"] - bfa if modes[name] == FWD else o["tau"] + bfa
-                            modes[name + ".q"] = 1.0 if eta >= 0 else -1.0
-                    elif what == "quadrant":
-                        modes[name + ".q"] = -modes[name + ".q"]
-                    elif what in ("contact+", "contact-", "separate", "push", "into_gap"):
-                        el = next(e for e in self.elements if e.name == name)
-                        modes[name] = self._backlash_event(el, what, te, ye[:2 * n], modes)
-                        log.append((te, name, modes[name]))
-                if not at_start:
-                    disabled = set()
-                self.settle(te, ye[:2 * n], modes, log)
-            else:
-                disabled = set()
-                if te < t_end:
+                            continue
+                        if what in ("kink", "normal"):
+                            if at_start:
+                                disabled.add(tag)
+                            continue
+                        if at_start and (tag, t) in fired:      # applied once already here: it does not hold
+                            disabled.add(tag)
+                            continue
+                        if at_start:
+                            fired.add((tag, t))
+                        if what == "zero":
+                            modes[name] = STUCK
+                            log.append((te, name, STUCK))
+                        elif what in ("break+", "break-"):
+                            modes[name] = FWD if what == "break+" else BWD
+                            log.append((te, name, modes[name]))
+                            el = next(e for e in self.elements if e.name == name)
+                            if el.kind == "lossy_gear":
+                                o = self.solve(te, ye[:2 * n], md)[1][name]
+                                bfa = self._loss(el, 0.0)[4]
+                                eta = o["tau"] - bfa if modes[name] == FWD else o["tau"] + bfa
+                                modes[name + ".q"] = 1.0 if eta >= 0 else -1.0
+                        elif what == "quadrant":
+                            modes[name + ".q"] = -modes[name + ".q"]
+                        elif what in ("contact+", "contact-", "separate", "push", "into_gap"):
+                            el = next(e for e in self.elements if e.name == name)
+                            modes[name] = self._backlash_event(el, what, te, ye[:2 * n], modes)
+                            log.append((te, name, modes[name]))
+                    if not at_start:
+                        disabled = set()
                     self.settle(te, ye[:2 * n], modes, log)
-            t, y = te, ye
-        return Result(self, segments, log, initial, np.asarray(t_out, float), sources, lossy)
+                else:
+                    disabled = set()
+                    if te < t_end:
+                        self.settle(te, ye[:2 * n], modes, log)
+                t, y = te, ye
+        except Indeterminate:
+            if not partial or not segments:
+                raise
+            reached = segments[-1][1]   # (the samples after it hold that segment's end: not a result)
+        res = Result(self, segments, log, initial, np.asarray(t_out, float), sources, lossy)
+        res.reached = reached
+        return res
 
 
 def collapse(log):
