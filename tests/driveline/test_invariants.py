@@ -835,7 +835,8 @@ def test_the_loop_of_seed_2072_follows_the_independent_msl_solution():
             ours = [(t, el, e) for t, el, e in _mode_events(res) if 0.01 < t < 0.62]
     assert errors[1e-11] < 5e-9 and errors[1e-9] < 2e-7 and errors[1e-6] < 1e-4, errors
     assert errors[1e-11] < errors[1e-9] < errors[1e-6], errors
-    theirs = sorted(((float(t), el, e) for t, el, e in ref.events if 0.01 < t < 0.62), key=lambda q: (round(q[0], 7), q[1]))
+    theirs = sorted(((float(t), el, e) for t, el, e in ref.events if 0.01 < t < 0.62),
+                    key=lambda q: (round(q[0], 7), q[1]))
     ours = sorted(ours, key=lambda q: (round(q[0], 7), q[1]))
     assert [(el, e) for _t, el, e in ours] == [(el, e) for _t, el, e in theirs], (ours, theirs)
     assert max(abs(a[0] - b[0]) for a, b in zip(ours, theirs)) < 1e-7
