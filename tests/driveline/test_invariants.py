@@ -928,7 +928,10 @@ def test_a_sliding_element_s_turning_function_is_its_acceleration_at_any_speed(t
 def test_an_unrelated_element_changes_nothing(d):
     """A network run with and without an inertia of its own elsewhere (braked, driven by a sine: events of its
     own): the network's speeds agree within 1e-6 of their range and its events within 1e-6 s, or within what a
-    speed error of 1e-7 moves an ill-conditioned one (:func:`_event_time_tolerance`).  (Backlash
+    speed error of 1e-7 moves an ill-conditioned one (:func:`_event_time_tolerance`).  A touch one run has and the
+    other has not, where the other's grazing quantity stays within its error of zero, is not a difference
+    (:func:`_grazing_touches`, the tolerance property's rule: seed 2062 of the fifty-eighth session's draws, a
+    one-way clutch touching for 0.4 us at a sine's zero with everything at rest).  (Backlash
     included: a gap's turning points are located, so a touch of its edge within a step is found whatever the step
     sequence another element brings.)"""
     alone = d.without("U", *(e.name for e in d.elements if e.name.startswith("U")))
@@ -942,6 +945,11 @@ def test_an_unrelated_element_changes_nothing(d):
             assert np.max(np.abs(a[col] - b[col])) <= 1e-6 * span, col
     ea = [(t, el, ev) for t, el, ev in _inside(_mode_events(both), 1.0) if not str(el).startswith("U")]
     eb = _inside(_mode_events(one), 1.0)
+    if [e[1:] for e in ea] != [e[1:] for e in eb]:   # a touch one run has, where the other grazed (as below)
+        drop_a = _grazing_touches(ea, eb, alone, 1.0, kw["rtol"], b)
+        drop_b = _grazing_touches(eb, ea, d, 1.0, kw["rtol"], a)
+        ea = [e for k, e in enumerate(ea) if k not in drop_a]
+        eb = [e for k, e in enumerate(eb) if k not in drop_b]
     assert [e[1:] for e in ea] == [e[1:] for e in eb]
     wmax = max(1.0, b.filter(like=".w_rad_s").abs().max().max())
     assert all(abs(x[0] - y[0]) <= _event_time_tolerance(b, y, wmax) for x, y in zip(ea, eb)), (ea, eb)

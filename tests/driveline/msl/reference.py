@@ -744,6 +744,7 @@ class Network:
             return rhs
 
         disabled = set()
+        quiet = 0                    # short segments in a row that ended with no event
         reached = t_end
         try:
             while t < t_end:
@@ -751,8 +752,10 @@ class Network:
                 if disabled:
                     # functions seen at zero where this segment starts are off only for a short segment: the run
                     # ends it, settles and takes them back (a normal force's sine that takes a clutch out at one
-                    # zero must engage it at the next)
-                    t_stop = min(t_stop, t + REENABLE)
+                    # zero must engage it at the next).  One that stays at zero (a free wheel at rest with nothing
+                    # driving it) is seen again at every start: the segments double, up to 1 ms (a crossing
+                    # missed meanwhile is the settle's error, "slides against its mode")
+                    t_stop = min(t_stop, t + min(REENABLE * 2.0 ** quiet, 1e-3))
                 md = dict(modes)
                 evs = [e for e in self._event_functions(md) if e[2] not in disabled]
                 funs = []
@@ -811,8 +814,10 @@ class Network:
                             log.append((te, name, modes[name]))
                     if not at_start:
                         disabled = set()
+                        quiet = 0
                     self.settle(te, ye[:2 * n], modes, log)
                 else:
+                    quiet = quiet + 1 if disabled else 0
                     disabled = set()
                     if te < t_end:
                         self.settle(te, ye[:2 * n], modes, log)
