@@ -4,10 +4,10 @@ The specification is the Modelica Standard Library (4.x) source: ``Interfaces.Pa
 friction elements built on it (``Components.Clutch``, ``Brake``, ``BearingFriction``),
 ``Components.OneWayClutch``, ``Components.LossyGear`` (Pelchen, Otter and Schweiger 2002),
 ``Components.IdealGear``, ``Components.ElastoBacklash``, ``Components.SpringDamper`` and the
-``Modelica.Blocks.Sources`` signals.  Two elements MSL does not have are written from docs/driveline.md's
+``Modelica.Blocks.Sources`` signals.  Three elements MSL does not have are written from docs/driveline.md's
 equations, for random networks that use them: the torque converter (``converter_torques``, also the law of
-``tests/driveline/test_converter.py``) and clutchlab's Kelvin-Voigt backlash contact (``backlash(...,
-law="kelvin_voigt")``, with its released modes).  Nothing here imports clutchlab.
+``tests/driveline/test_converter.py``), clutchlab's Kelvin-Voigt backlash contact (``backlash(...,
+law="kelvin_voigt")``, with its released modes) and the synchroniser.  Nothing here imports clutchlab.
 
 Method: the speeds and angles of the inertias are the states (SciPy ``solve_ivp``, DOP853, rtol 1e-12).
 For a fixed set of modes, the accelerations and the constraint torques solve one linear system:
@@ -255,6 +255,19 @@ class Network:
         """Brake: a clutch between the support (flange a here) and the flange."""
         return self.clutch(name, support, flange, fn_max, normal, mu, peak, cgeo)
 
+    def synchronizer(self, name, a, b, force: Sig, cone_radius, dog_capacity, mu=0.1, cone_angle=math.radians(6.5),
+                     cones=1, side="positive"):
+        """A synchroniser (docs/driveline.md "Synchronisers and the automated manual transmission", not MSL): a
+        friction element whose cone slides with ``cones mu F R_c / sin(alpha)`` under the shift force ``F``
+        (``-force`` with ``side="negative"``), free while ``F <= 0``, and stuck holds up to the dogs' capacity
+        (never less than the cone's torque)."""
+        sign = 1.0 if side == "positive" else -1.0
+        cgeo = cones * cone_radius / math.sin(cone_angle)
+        shift = Sig(lambda t: sign * force(t), force.breaks, force.crosses_zero)
+        return self._add("friction", name, a, b, slide=lambda w, t: mu * cgeo * shift(t),
+                         free=lambda t: shift(t) <= 0.0,
+                         peak=1.0, normal=shift, limit=lambda t: max(dog_capacity, mu * cgeo * shift(t)))
+
     def bearing_friction(self, name, flange, tau_pos=1.0, peak=1.0, support=None):
         """BearingFriction: tau = tau_pos(|w|), never free."""
         tf = table1d(tau_pos if isinstance(tau_pos, (list, tuple)) else [[0.0, tau_pos]])
@@ -474,6 +487,8 @@ class Network:
     def _limit(self, el, t):
         """Static limit of a stuck friction element (peak tau0) or a locked one-way clutch (tau0_max)."""
         if el.kind == "friction":
+            if "limit" in el.p:          # a synchroniser's dogs
+                return el.p["limit"](t)
             return el.p["peak"] * el.p["slide"](0.0, t)
         fn = el.p["fn"](t)
         return el.p["low"] if fn <= 0 else el.p["peak2"] * el.p["mu"] * el.p["cgeo"] * fn
