@@ -11,10 +11,12 @@ the speeds are compared.
 
 The reference decides its modes by its own event iteration (``Network.settle``), integrates each mode with SciPy's
 DOP853 at rtol 1e-12 and restarts at every event.  Its limits are not clutchlab's errors, and the property leaves
-out what it cannot decide (``_reference_cannot``): a statically indeterminate stuck set (MSL's equations are
-singular there; a least-squares split would decide the next break-away by its choice, where clutchlab holds while
-any split holds), compared up to the instant the reference meets it (``Network(strict=True)``,
-``simulate(partial=True)``); and a mode iteration that does not converge (a lossy gear with no consistent quadrant).
+out what it cannot decide (``_reference_cannot``).  Where MSL's equations are singular, a statically indeterminate
+stuck set, the strict reference (``Network(strict=True)``) holds the set while some split of its torques holds (a
+linear program, ``Network._holding_split``; a least-squares split would decide the next break-away by its choice);
+a locked lossy gear whose torques move in that split (its band is not convex in them) ends the comparison at that
+instant (``simulate(partial=True)``), and so does a mode iteration that does not converge (a lossy gear with no
+consistent quadrant).
 Every disagreement found while this was written was the reference's (docs/driveline.md, "Tests against Modelica").
 """
 

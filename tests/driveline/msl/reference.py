@@ -191,9 +191,12 @@ class Network:
     def __init__(self, strict=False):
         self.names, self.J, self.w0, self.phi0 = [], [], [], []
         self.elements: list[Element] = []
-        #: refuse a statically indeterminate set of constraints (:class:`Indeterminate`) instead of taking the
-        #: least-squares split: the split decides break-aways, and MSL's equations are singular there
+        #: a statically indeterminate set of constraints holds while some split of its torques holds
+        #: (:meth:`_holding_split`) instead of taking the least-squares split, which decides break-aways by its
+        #: choice (MSL's equations are singular there); :class:`Indeterminate` where that cannot be written
         self.strict = strict
+        self.margin = None
+        self._memo = None
 
     # bodies and elements ---------------------------------------------------------------
     def inertia(self, name, J, w0=0.0, phi0=0.0):
@@ -351,9 +354,24 @@ class Network:
             return (0.0, 0.0) if tc + td >= 0 else (tc + max(tc, td), max(tc, td) * w_rel)
         return 0.0, 0.0
 
-    def solve(self, t, y, modes):
+    def solve(self, t, y, modes, split=True):
         """Accelerations and every element's torque for fixed modes.  Returns (a, out) with out[name] a
-        dict: tau (MSL's element torque; a gear's tau_a), power (its loss or, for a source, its power)."""
+        dict: tau (MSL's element torque; a gear's tau_a), power (its loss or, for a source, its power).
+        ``split=False``: an indeterminate stuck set's torques as any split (the accelerations, the same for every
+        split, are what the integration needs; :meth:`_holding_split` solves a linear program).  The last split
+        solved is kept for the same time, state and modes (the event functions ask for it in turn)."""
+        key = None
+        if split and self.strict:
+            key = (float(t), np.asarray(y[:2 * self.n], float).tobytes(), tuple(sorted(modes.items())))
+            if self._memo is not None and self._memo[0] == key:
+                self.margin = self._memo[2]
+                return self._memo[1]
+        result = self._solve(t, y, modes, split)
+        if key is not None:
+            self._memo = (key, result, self.margin)
+        return result
+
+    def _solve(self, t, y, modes, split):
         n = self.n
         M = np.diag(self.J)
         F = np.zeros(n)
@@ -450,14 +468,19 @@ class Network:
         for j in range(nc):
             A[:n, n + j] = D[j]
             A[n + j, :n] = C[j]
-        if self.strict and nc and np.linalg.matrix_rank(np.array(C), tol=1e-9) < nc:
-            raise Indeterminate(f"t = {t!r}: constraints {[o[0] for o in owner]} hold one motion twice")
-        try:
-            x = np.linalg.solve(A, rhs)
-        except np.linalg.LinAlgError:
-            # constraints that hold the same motion twice (a stuck bearing on the flange of a locked gear):
-            # the torques are not unique (MSL: a singular system); take the least-squares split
+        self.margin = None
+        deficient = self.strict and nc and np.linalg.matrix_rank(np.array(C), tol=1e-9) < nc
+        if deficient and split:
+            x = self._holding_split(t, A, rhs, np.array(D), owner, modes)
+        elif deficient:
             x = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        else:
+            try:
+                x = np.linalg.solve(A, rhs)
+            except np.linalg.LinAlgError:
+                # constraints that hold the same motion twice (a stuck bearing on the flange of a locked gear):
+                # the torques are not unique (MSL: a singular system); take the least-squares split
+                x = np.linalg.lstsq(A, rhs, rcond=None)[0]
         acc = x[:n]
         for j, (name, slot) in enumerate(owner):
             out[name]["tau" if slot == 0 else "tau_b"] = float(x[n + j])
@@ -483,6 +506,55 @@ class Network:
                 o.update(w_a=wa, a_a=aa, power=o["loss"] * wa)
         return acc, out
 
+    def _holding_split(self, t, A, rhs, D, owner, modes):
+        """The accelerations and constraint torques of a statically indeterminate stuck set (a strict network):
+        the accelerations are unique, the torques ``lambda0 + N z`` over the null space ``N`` of the constraint
+        directions.  Of those splits, the one farthest inside every stuck friction element's and locked one-way
+        clutch's limit: the linear program ``min s`` over ``(z, s)`` with each ``|tau_k| - limit_k <= s`` (a
+        one-way clutch's ``tau_k - limit_k <= s``: it holds any torque the other way).  ``self.margin`` is its
+        ``s``: the set holds while some split holds (``s <= 0``), and the element whose excess is ``s`` breaks
+        away first where none does (:meth:`settle`, the furthest beyond its limit).  Rigid-body Coulomb friction's
+        reading where MSL's equations are singular; written here with SciPy's ``linprog``, not from clutchlab.
+        Raises :class:`Indeterminate` where a locked lossy gear's torques move along the null space (its band is
+        not convex in them)."""
+        from scipy.linalg import null_space
+        from scipy.optimize import linprog
+
+        n = len(self.J)
+        x = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        lam0 = x[n:]
+        N = null_space(D.T, rcond=1e-10)
+        k = N.shape[1]
+        by_name = {e.name: e for e in self.elements}
+        rows, bounds = [], []
+        for j, (name, _slot) in enumerate(owner):
+            el = by_name[name]
+            if el.kind == "lossy_gear" and np.abs(N[j]).max(initial=0.0) > 1e-12:
+                raise Indeterminate(f"t = {t!r}: a locked lossy gear {name} in an indeterminate stuck set")
+            if el.kind in ("friction", "one_way") and modes.get(name) == STUCK:
+                lim = self._limit(el, t)
+                rows.append(np.r_[N[j], -1.0])
+                bounds.append(lim - lam0[j])
+                if el.kind == "friction":
+                    rows.append(np.r_[-N[j], -1.0])
+                    bounds.append(lim + lam0[j])
+        if not rows or k == 0:
+            return x
+        big = 1e9
+        res = linprog(np.r_[np.zeros(k), 1.0], A_ub=np.array(rows), b_ub=np.array(bounds),
+                      bounds=[(-big, big)] * k + [(-big, big)], method="highs")
+        if res.status != 0:
+            raise Indeterminate(f"t = {t!r}: the split's linear program failed ({res.message})")
+        x = x.copy()
+        x[n:] = lam0 + N @ res.x[:k]
+        self.margin = float(res.x[k])
+        return x
+
+    def _split_margin(self, t, y, modes):
+        """The indeterminate stuck set's margin (:meth:`_holding_split`), -1 where the set is determinate."""
+        self.solve(t, y, modes)
+        return -1.0 if self.margin is None else self.margin
+
     # events ------------------------------------------------------------------------------
     def _limit(self, el, t):
         """Static limit of a stuck friction element (peak tau0) or a locked one-way clutch (tau0_max)."""
@@ -506,6 +578,9 @@ class Network:
 
         def add(fun, direction, tag):
             evs.append((fun, direction, tag))
+
+        if self.strict:     # an indeterminate stuck set stops holding where no split holds
+            add(lambda t, y: self._split_margin(t, y, modes), 1.0, ("stuck set", "no split holds"))
 
         for el in self.elements:
             m = modes.get(el.name)
@@ -747,7 +822,7 @@ class Network:
 
         def rhs_for(md):
             def rhs(tt, yy):
-                acc, out = self.solve(tt, yy, md)
+                acc, out = self.solve(tt, yy, md, split=False)
                 dy = np.zeros(ny)
                 dy[:n] = acc
                 dy[n:2 * n] = yy[:n]

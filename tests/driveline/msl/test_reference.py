@@ -127,3 +127,28 @@ def test_friction_with_a_speed_table_and_peak():
     t0 = brentq(w, 1e-3, 0.3, xtol=1e-14)
     stuck_or_fwd = [e for e in r.log if e[0] > 0][0]
     assert stuck_or_fwd[0] == pytest.approx(t0, abs=1e-9)
+
+
+def test_a_strict_network_holds_an_indeterminate_pair_while_some_split_holds():
+    """Two clutches in parallel (limits 1 and 3 N m) between J1 = 1 and J2 = 3 kg m^2 at rest, a torque ramp 10 t
+    N m on J1: the pair carries ``J2 / (J1 + J2) 10 t = 7.5 t`` and holds until that reaches the sum of the limits,
+    t = 4 / 7.5 s, where both break away together (closed form).  MSL's equations are singular here; the
+    least-squares split (the non-strict network) halves the load and lets the weaker clutch go at t = 1 / 3.75 s
+    (the same motion, another label), the strict network's linear program (``Network._holding_split``) does not."""
+    def pair(strict):
+        from . import reference as R
+
+        net = R.Network(strict=strict)
+        net.inertia("J1", 1.0).inertia("J2", 3.0)
+        net.clutch("c1", "J1", "J2", fn_max=2.0, normal=R.constant(1.0), mu=0.5)
+        net.clutch("c2", "J1", "J2", fn_max=6.0, normal=R.constant(1.0), mu=0.5)
+        net.torque("T", "J1", R.ramp(10.0, 1.0))
+        return net.simulate(1.0, np.linspace(0.0, 1.0, 11))
+
+    strict = pair(True)
+    assert sorted(e for _t, e, _m in strict.events) == ["c1", "c2"]
+    assert [t for t, _e, _m in strict.events] == pytest.approx([4.0 / 7.5] * 2, abs=1e-9)
+    assert all(m == "backward" for _t, _e, m in strict.events)        # (w_rel = w2 - w1 < 0: J1 driven)
+    loose = pair(False)
+    assert _times(loose, "c1") == pytest.approx([1.0 / 3.75], abs=1e-9)
+    np.testing.assert_allclose(strict.columns["J1.w_rad_s"], loose.columns["J1.w_rad_s"], atol=1e-9)
