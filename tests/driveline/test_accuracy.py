@@ -200,43 +200,10 @@ def test_launch_error_shrinks_with_rtol():
     assert err[1e-9]["event"] < 2e-7 and err[1e-9]["engine"] < 1e-4 and err[1e-9]["vehicle"] < 2e-6, err[1e-9]
 
 
-def _rattle_scipy(J0, J1, c, b2, amplitude, frequency, grid):
-    """An undamped backlash between J0 (driven by ``amplitude sin(2 pi frequency t)``) and J1, solved by mode (gap
-    0, upper +1, lower -1), each mode's smooth equations (the contact torque ``c (phi - s b/2)``, zero in the gap)
-    by DOP853 at rtol 1e-13, restarted at every edge crossing: J1's speed on ``grid`` and the crossings' times."""
-    from scipy.integrate import solve_ivp
-
-    def rhs(mode):
-        def f(t, y):
-            tau = c * (y[2] - y[0] - mode * b2) if mode else 0.0
-            return [y[1], (amplitude * np.sin(2 * np.pi * frequency * t) + tau) / J0, y[3], -tau / J1]
-        return f
-
-    def edge(s, direction):
-        def e(t, y):
-            return y[2] - y[0] - s * b2
-        e.terminal, e.direction = True, direction
-        return e
-
-    t, y, mode, w1, events = 0.0, np.zeros(4), 0, np.full(grid.shape, np.nan), []
-    while t < grid[-1]:
-        sol = solve_ivp(rhs(mode), (t, grid[-1]), y, method="DOP853", rtol=1e-13, atol=1e-13, dense_output=True,
-                        events=[edge(1, 1), edge(-1, -1)] if mode == 0 else [edge(mode, -mode)])
-        inside = (grid >= t) & (grid <= sol.t[-1])
-        if inside.any():
-            w1[inside] = sol.sol(grid[inside])[3]
-        if sol.status != 1:
-            break
-        k = 0 if len(sol.t_events[0]) else 1
-        t, y = sol.t_events[k][0], sol.y_events[k][0]
-        mode = (1 if k == 0 else -1) if mode == 0 else 0
-        events.append(t)
-    return w1, np.array(events)
-
-
 def test_an_undamped_rattle_follows_the_tolerance_against_its_independent_solution():
     """An undamped backlash (c = 406 N m/rad, gap 0.0625 rad) between 0.5 and 0.0625 kg m^2 under a 25 N m sine at
-    1 Hz rattles through 16 contacts and separations in 1 s, against its SciPy solution by mode.  Elastic impacts
+    1 Hz rattles through 16 contacts and separations in 1 s, against its SciPy solution by mode (the reference
+    engine, ``msl/reference.py``).  Elastic impacts
     amplify the integration error (about 1,000 rtol of the speeds' range), so the random tolerance property's
     1e-4 of the range between rtol 1e-7 and 1e-10 is at its edge (random draws, fifty-eighth session: 1.01e-4;
     1.4e-5 less on the code before the gap's turning points watched only the nearer edge, whose extra step ends
@@ -245,14 +212,20 @@ def test_an_undamped_rattle_follows_the_tolerance_against_its_independent_soluti
     events within MSL's 1e-6 s from rtol 1e-9 and the speeds within its 2e-3 of the range at the default."""
     from clutchlab.driveline import Driveline, Signal
 
+    from .msl.translate import to_reference
+
     J0, J1, c, gap, amplitude = 0.5, 0.0625, 406.0, 0.0625, 25.0
     grid = np.linspace(0.0, 1.0, 501)
-    w_ref, ev_ref = _rattle_scipy(J0, J1, c, gap / 2, amplitude, 1.0, grid)
-    assert len(ev_ref) == 16 and not np.isnan(w_ref).any()
     d = Driveline("rattle")
     d.inertia("J0", J=J0).inertia("J1", J=J1)
     d.backlash("k0", "J0", "J1", c=c, b_gap=gap, d=0.0)
     d.torque("T0", "J0", Signal.sine(amplitude, 1.0))
+    # the reference engine by mode (gap, upper, lower: the contact torque c (phi - s b/2), zero in the gap), each
+    # mode's smooth equations by DOP853 at rtol 1e-13, restarted at every edge crossing
+    ref = to_reference(d, strict=False).simulate(1.0, grid, rtol=1e-13, atol=1e-13)
+    w_ref = ref.columns["J1.w_rad_s"]
+    ev_ref = np.array([t for t, element, _mode in ref.events if element == "k0"])
+    assert len(ev_ref) == 16 and not np.isnan(w_ref).any()
     span = np.ptp(w_ref)
     speed, event = [], []
     for rtol in (1e-7, 1e-8, 1e-9, 1e-10, 1e-11):

@@ -634,15 +634,9 @@ def _dipping_contact_reference(t_end, times):
     contact law and the converter written from docs/driveline.md's equations, the one-way clutch and the clutch
     from MSL's, SciPy DOP853 at rtol 1e-12 restarted at every event; its steps at most 0.1 ms, so that the 0.7 ms
     dip cannot hide within one)."""
-    from .msl import reference as R
+    from .msl.translate import to_reference
 
-    net = R.Network()
-    net.inertia("J0", 1.5).inertia("J1", 0.5625).inertia("J2", 1.90234375).inertia("J3", 0.5)
-    net.one_way_clutch("f0", "J0", "J1")
-    net.backlash("k1", "J1", "J2", c=376.0, d=0.765625, b_gap=0.023693754507450204, law="kelvin_voigt")
-    net.torque_converter("v2", "J2", "J3", [[0.0, 2.03125, 1.0], [0.5, 2.4375, 1.0], [0.9, 6.09375, 1.0]])
-    net.clutch("loop", "J0", "J3", fn_max=1.0, normal=R.constant(1.0), mu=0.5, peak=1.0)
-    net.torque("T2", "J2", R.ramp(25.875, 0.13))
+    net = to_reference(_dipping_contact_network(), strict=False)
     return net.simulate(t_end, times, max_step=1e-4)
 
 
