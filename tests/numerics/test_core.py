@@ -257,6 +257,23 @@ def test_break_times_end_steps_and_restart_the_model(method):
 
 
 @pytest.mark.parametrize("method", METHODS)
+def test_a_run_recorded_at_every_step_goes_on_across_its_buffers_without_a_restart(method):
+    """A run recorded at every accepted step fills buffers of 256, 512, 1024, ... rows and the core resumes it in a
+    new one each time (``RECORD_FULL``).  Before issue #30's seed 2074 each resumption called the model's
+    ``restart`` as an input change would: the toy counted 11 restarts where its breaks give 8, and a driveline
+    searched its stuck sets again at a buffer's end, so its result depended on where the buffers ended.  Now the
+    run goes on as one call (``core.RESUME_NOTE``): the restarts are those of the breaks, and the states are the
+    sampled run's to the last bit."""
+    system = toys.sine_system(0, period=0.25, method=method)
+    every = simulate(system, 2.0, max_step=1e-3, first_step=1e-3)   # 2,000 steps: four buffers
+    assert every.stats["accepted_steps"] > 256 + 512 + 1024
+    sampled = simulate(system, 2.0, max_step=1e-3, first_step=1e-3, output_step=0.5)
+    assert every.stats["final_modes"][0] == sampled.stats["final_modes"][0] == 8   # t0 and 7 breaks
+    assert every.stats["final_state"][0] == sampled.stats["final_state"][0]
+    assert np.all(np.diff(every.modes[:, 0]) >= 0) and every.modes[-1, 0] == 8
+
+
+@pytest.mark.parametrize("method", METHODS)
 def test_resumed_advance_matches_one_run(method):
     system = toys.belt_system(method=method)
     one = simulate(system, 1.5, rtol=1e-9, output_step=0.5)

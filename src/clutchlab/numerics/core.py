@@ -713,6 +713,18 @@ def _clip_step(h, t, t_stop, max_step):
     return h, False
 
 
+#: Why a call resumed after ``RECORD_FULL`` skips the model's ``restart``.  A run recorded at every accepted step
+#: (``simulate`` without samples) fills buffers of 256, 512, ... rows and is resumed in a new one each time.  A
+#: restart there is no event of the model: a driveline searched its stuck sets again and its first derivative was
+#: evaluated anew, so the run's result depended on where its buffers ended (two torque converters in series, issue
+#: #30's seed 2074: the final speeds 7.8e-9 apart, sampled or not, from the buffer's end at step 256 on).  A resumed
+#: record now goes on as one call would: with Dormand-Prince to the last bit (its first stage is the same
+#: evaluation at the same point); Rodas3 still evaluates its Jacobian anew there, as at the start of any call, where
+#: one call might have reused the step before's (``Options.jac_every``): a difference within its error control, not
+#: a decision of the model.
+RESUME_NOTE = "a record resumed after RECORD_FULL goes on as one run: no restart"
+
+
 @numba.njit(cache=True, nogil=True, forceinline=True)
 def _save_state(sf, si, t, h, i_rec, status, owners):
     """End of an ``advance``: the solver state saved; ``owners`` (the loop's work arrays) live until here."""
@@ -792,7 +804,8 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if r < 0:   # (an initial state the model cannot start from)
             si[SI_MODEL_CODE] = r
             return _save_state(sf, si, t, h, si[SI_IREC], MODEL_ERROR, owners)
-    model.restart(t, x, u, m, p, log)
+    if si[SI_STATUS] != RECORD_FULL:   # (a record resumed in a new buffer: RESUME_NOTE)
+        model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, k1, g0)
     model.watch(t, x, u, m, p, k1, g0, -1)
     si[SI_NRHS] += 1
@@ -1199,7 +1212,8 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
         if r < 0:   # (an initial state the model cannot start from)
             si[SI_MODEL_CODE] = r
             return _save_state(sf, si, t, h, si[SI_IREC], MODEL_ERROR, owners)
-    model.restart(t, x, u, m, p, log)
+    if si[SI_STATUS] != RECORD_FULL:   # (a record resumed in a new buffer: RESUME_NOTE)
+        model.restart(t, x, u, m, p, log)
     model.rhs(t, x, u, m, p, f0, g0)
     model.watch(t, x, u, m, p, f0, g0, -1)
     si[SI_NRHS] += 1
@@ -1470,6 +1484,9 @@ def advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m, 
         Sample times [s]; empty records every accepted step into the record
         buffers until they are full (status ``RECORD_FULL``: resume with
         ``si[SI_IREC] = 0``); record buffers of length 0 record nothing.
+        A resumed record goes on as one run: every other call starts with
+        the model's ``restart`` (the inputs may have changed), a call after
+        ``RECORD_FULL`` does not (:data:`RESUME_NOTE`).
     rec_t, rec_x, rec_m, rec_y : ndarray
         Record buffers (time, states, modes, outputs); ``rec_y`` is written
         only if ``want_y``.
