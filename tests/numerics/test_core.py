@@ -274,6 +274,20 @@ def test_a_run_recorded_at_every_step_goes_on_across_its_buffers_without_a_resta
 
 
 @pytest.mark.parametrize("method", METHODS)
+def test_a_record_full_at_a_break_leaves_the_break_to_no_one(method):
+    """The first buffer of an every-step record (256 rows: the start and 255 steps) fills at the toy's first break,
+    0.25 s, where steps of 0.25/255 s end.  A call that ended there with ``RECORD_FULL`` before taking the break, and
+    a resumption that takes no restart, skipped it: the restarts counted 7, not 8 (the sixtieth session's seed 2090,
+    a brake whose normal force stepped on at that instant was left free until the next break).  The break is taken
+    before the call ends."""
+    system = toys.sine_system(0, period=0.25, method=method)
+    h = 0.25 / 255
+    every = simulate(system, 2.0, max_step=h, first_step=h, rtol=1e-6, atol=1e-6)   # (steps of max_step)
+    assert np.any(np.abs(every.time[255:257] - 0.25) == 0.0)   # (the buffer's last row or the next one's first)
+    assert every.stats["final_modes"][0] == 8   # t0 and 7 breaks
+
+
+@pytest.mark.parametrize("method", METHODS)
 def test_resumed_advance_matches_one_run(method):
     system = toys.belt_system(method=method)
     one = simulate(system, 1.5, rtol=1e-9, output_step=0.5)

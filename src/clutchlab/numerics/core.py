@@ -718,7 +718,9 @@ def _clip_step(h, t, t_stop, max_step):
 #: restart there is no event of the model: a driveline searched its stuck sets again and its first derivative was
 #: evaluated anew, so the run's result depended on where its buffers ended (two torque converters in series, issue
 #: #30's seed 2074: the final speeds 7.8e-9 apart, sampled or not, from the buffer's end at step 256 on).  A resumed
-#: record now goes on as one call would: with Dormand-Prince to the last bit (its first stage is the same
+#: record now goes on as one call would (a call ends with ``RECORD_FULL`` only after the break at its last instant,
+#: if there is one, is taken: a resumption at a break skipped it, the sixtieth session's seed 2090, a brake applied
+#: at 0.5 s left free until the next break at 0.75 s): with Dormand-Prince to the last bit (its first stage is the same
 #: evaluation at the same point); Rodas3 still evaluates its Jacobian anew there, as at the start of any call, where
 #: one call might have reused the step before's (``Options.jac_every``): a difference within its error control, not
 #: a decision of the model.
@@ -829,9 +831,6 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     n_dips = 0
     waypoint_retry = False
     while t < t_end:
-        status = _run_limit(si, opt, grid, cap, i_rec)
-        if status != SUCCESS:
-            break
         t_stop = t_end if t_end < tb else tb
         if t_stop - t <= 1e-12 * max(1.0, abs(t_stop)):
             t = t_stop
@@ -839,6 +838,11 @@ def _advance_dopri(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
                 break
             tb = _at_break(p, t, x, u, m, log, k1, g0, si)
             continue
+        # (after the break at t, not before it: a call that ends here with RECORD_FULL leaves no break to the call
+        # that resumes it, which does not restart: RESUME_NOTE)
+        status = _run_limit(si, opt, grid, cap, i_rec)
+        if status != SUCCESS:
+            break
         h, last = _clip_step(h, t, t_stop, opt.max_step)
         for k in range(ng):   # (per function: the first inner stage it changed sign at; _locate sets ga anew)
             ga[k] = 2.0
@@ -1238,10 +1242,10 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     hf = opt.fixed_step
     fixed = hf > 0.0
     while t < t_end:
-        status = _run_limit(si, opt, grid, cap, i_rec)
-        if status != SUCCESS:
-            break
         if fixed:
+            status = _run_limit(si, opt, grid, cap, i_rec)   # (its breaks are taken within its steps)
+            if status != SUCCESS:
+                break
             # ---- fixed-step mode (a HIL frame): one step to the next point of the grid t0 + k hf (t_end if it
             # comes first), the same work every step: Jacobian, df/dt, two stages and two right-hand sides;
             # no error control; switching functions and break times are looked at the step end only
@@ -1308,6 +1312,9 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
             need_jac = True
             jac_stale = True
             continue
+        status = _run_limit(si, opt, grid, cap, i_rec)   # (after the break at t: as Dormand-Prince's)
+        if status != SUCCESS:
+            break
         if need_jac:
             if jac_age >= opt.jac_every or jac_stale:
                 if not model.jacobian(t, x, u, m, p, J):
