@@ -39,7 +39,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from clutchlab.driveline.description import load_driveline
 
