@@ -1167,6 +1167,76 @@ def converter_power(p, r, x, n):
     return -(ta * (_speed(x, n, p.elem[r, E_A]) - ws) + tb * (_speed(x, n, p.elem[r, E_B]) - ws))
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _piece_of(data, start, nrows, s):
+    """``(k, lo, hi)``: the piece of ``[-1, 1]`` holding the speed ratio ``s`` between the corners of a converter
+    table's law (:func:`_converter_row` and :func:`converter_torques`): -1, 0, the table's speed ratios inside ``(0,
+    1)``, 1; ``k`` counted from -1 up, ``lo`` and ``hi`` its ends."""
+    k = 0
+    lo = -1.0
+    if s < 0.0:
+        return 0, -1.0, 0.0
+    k = 1
+    lo = 0.0
+    for i in range(nrows):
+        b = data[start + i]
+        if b <= 0.0 or b >= 1.0:
+            continue
+        if s < b:
+            return k, lo, b
+        k += 1
+        lo = b
+    return k, lo, 1.0
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _pieces(data, start, nrows):
+    """The number of pieces :func:`_piece_of` counts on ``[-1, 1]``."""
+    k = 2
+    for i in range(nrows):
+        b = data[start + i]
+        if 0.0 < b < 1.0:
+            k += 1
+    return k
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def converter_piece(p, r, x, n):
+    """The waypoint function of torque converter row ``r`` [-]: zero at each corner of its law, of alternating sign
+    from one piece to the next (a waypoint either way: a step ends just past each corner, where the law's slope
+    jumps, so that the error follows the tolerance there; docs/driveline.md, "Torque converter").
+
+    The law depends on the direction of ``(w_p, w_t)`` only (homogeneous of degree 2).  Around that circle: drive
+    with ``w_p > 0`` (``SR = w_t/w_p`` from -1 to 1), coast with ``w_t > 0`` (``s = w_p/w_t`` from 1 to -1), drive
+    with ``w_p < 0``, coast with ``w_t < 0``; the corners of each at -1, 0, its table's speed ratios and 1 (where
+    drive and coast meet).  Piece ``k`` around the circle, between corners ``lo`` and ``hi`` of its ratio ``s``:
+    ``(-1)^k (s - lo)(hi - s) / (hi - lo)^2``.  The pieces are even in number (the law is odd: the corners come in
+    opposite pairs), so the sign alternates all the way round.  1 (no waypoint) where both speeds are within
+    1000 times their rounding width of the support's (a converter at rest: its direction is a rounding)."""
+    ws = _speed(x, n, p.elem[r, E_SUP])
+    wp = _speed(x, n, p.elem[r, E_A]) - ws
+    wt = _speed(x, n, p.elem[r, E_B]) - ws
+    if max(abs(wp), abs(wt)) <= 1e3 * _item_wtol(p, r, x, n):
+        return 1.0
+    start, nd, nc = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX]
+    cstart, cn = (start + 3 * nd, nc) if nc > 0 else (start, nd)
+    pd = _pieces(p.data, start, nd)
+    pc = _pieces(p.data, cstart, cn)
+    if abs(wp) >= abs(wt):   # drive: increasing s around the circle
+        s = wt / wp
+        k, lo, hi = _piece_of(p.data, start, nd, s)
+        if wp < 0.0:
+            k += pd + pc
+    else:                    # coast: decreasing s around the circle
+        s = wp / wt
+        k, lo, hi = _piece_of(p.data, cstart, cn, s)
+        k = pd + (pc - 1 - k)
+        if wt < 0.0:
+            k += pd + pc
+    v = (s - lo) * (hi - s) / ((hi - lo) * (hi - lo))
+    return v if k % 2 == 0 else -v
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _has_support(kind):
     """Does an element of ``kind`` act on a support (its ``E_SUP`` column): a gear and a torque converter."""
@@ -4599,8 +4669,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
     ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed; stuck,
     ``T_a`` of one without bearing friction (a waypoint either way: a step ends where its band closes; 1 within a
-    rounding floor of zero or in a set with several null directions).
-    Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0.
+    rounding floor of zero or in a set with several null directions).  Then one per torque converter
+    (:func:`converter_piece`: zero at each corner of its law, alternating in sign; a waypoint either way).
+    Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0 (but the
+    waypoints, of either sign).
     """
     if u.shape[0] > 0 and hold_inputs(p.data, u):
         forget_signals(p)
@@ -4754,6 +4826,12 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[q + GG_TURN] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + GG_FLANGE] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
+    # then one per torque converter, in element order: the corners of its law (a waypoint either way)
+    q = N_G * nf + N_SW * nsw + N_GEAR_G * p.lossy.shape[0]
+    for r in range(p.elem.shape[0]):
+        if p.elem[r, E_KIND] == K_CONVERTER:
+            g[q] = converter_piece(p, r, x, n)
+            q += 1
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")   # (in the right-hand side's loop: no call per element)
@@ -5004,6 +5082,8 @@ def driveline_update(t, x, u, m, p, k, log):
         forget_signals(p)
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
+    if k >= N_G * nf + N_SW * nsw + N_GEAR_G * p.lossy.shape[0]:   # a torque converter's corner: a step ends there
+        return 0
     if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
         j = (k - N_G * nf - N_SW * nsw) // N_GEAR_G
         which = (k - N_G * nf - N_SW * nsw) % N_GEAR_G
