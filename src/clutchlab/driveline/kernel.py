@@ -1171,9 +1171,7 @@ def converter_power(p, r, x, n):
 def _piece_of(data, start, nrows, s):
     """``(k, lo, hi)``: the piece of ``[-1, 1]`` holding the speed ratio ``s`` between the corners of a converter
     table's law (:func:`_converter_row` and :func:`converter_torques`): -1, 0, the table's speed ratios inside ``(0,
-    1)``, 1; ``k`` counted from -1 up, ``lo`` and ``hi`` its ends."""
-    k = 0
-    lo = -1.0
+    1)``, 1; ``k`` the piece's number (0 the one from -1 to 0), ``lo`` and ``hi`` its ends."""
     if s < 0.0:
         return 0, -1.0, 0.0
     k = 1
