@@ -2138,11 +2138,11 @@ def test_a_run_recorded_at_every_step_is_the_run_sampled_or_advanced_in_one_call
     converters' law: the core resumed the every-step record in a new buffer after its first 256 steps and called
     the network's ``restart`` there, as for an input change, so the run started again (its first stage evaluated
     anew, a driveline's stuck sets searched again) at a point that depends on the buffer's size; this network's
-    steps (177 of 460 rejected: its law has kinks where the speed ratio passes its rows and where drive turns into
-    coast) carried the rounding to 1e-8.  A resumed record now goes on as one call (``core.RESUME_NOTE``): the three
+    steps (177 of 460 rejected, its law's corners then stepped over) carried the rounding to 1e-8.  A resumed record now goes on as one call (``core.RESUME_NOTE``): the three
     runs end on the same state to the last bit, with the same events, and the speeds follow the independent
     reference engine (:mod:`.msl.reference`, MSL's equations and the converter law of docs/driveline.md) within
-    the tolerance's accuracy: its error falls with rtol (2.4e-5 and 2.2e-7 of their range at rtol 1e-7 and 1e-9)."""
+    the tolerance's accuracy: its error falls with rtol (1.6e-6 and 1.6e-8 of their range at rtol 1e-7 and 1e-9;
+    2.4e-5 and 2.2e-7 before the converter's corners were waypoints, ``test_converter.py``)."""
     from .msl.translate import to_reference
 
     d = _two_converters_in_series()

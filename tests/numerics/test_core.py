@@ -260,7 +260,8 @@ def test_break_times_end_steps_and_restart_the_model(method):
 def test_a_run_recorded_at_every_step_goes_on_across_its_buffers_without_a_restart(method):
     """A run recorded at every accepted step fills buffers of 256, 512, 1024, ... rows and the core resumes it in a
     new one each time (``RECORD_FULL``).  Before issue #30's seed 2074 each resumption called the model's
-    ``restart`` as an input change would: the toy counted 11 restarts where its breaks give 8, and a driveline
+    ``restart`` as an input change would: the toy counted 11 (Dormand-Prince) and 34 (Rodas3) restarts where its
+    breaks give 8, and a driveline
     searched its stuck sets again at a buffer's end, so its result depended on where the buffers ended.  Now the
     run goes on as one call (``core.RESUME_NOTE``): the restarts are those of the breaks, and the states are the
     sampled run's to the last bit."""
