@@ -176,7 +176,7 @@ def _corner_angles(table, coast):
 def test_the_waypoint_function_passes_zero_at_every_corner_of_the_law_and_nowhere_else(table, coast, speed):
     """``kernel.converter_piece`` around the circle of directions of ``(w_p, w_t)``: it changes sign at each corner
     of the law (from :func:`_corner_angles`, the equations of docs/driveline.md) and keeps its sign between two,
-    so a step ends at each corner and only there; within 1e-12 of zero at a corner; bounded by 1/4."""
+    so a step ends at each corner and only there; within 1e-9 of zero at a corner; bounded by 1/4."""
     coast_rows = [row[:2] for row in table[::-1]][::-1] if coast else None
     assume(min(np.diff([row[0] for row in table])) > 1e-6)   # (two corners a rounding apart are one)
     try:
