@@ -3637,6 +3637,16 @@ def _item_set(p, m, i, direction):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def _item_way(p, m, i):
+    """The way item ``i`` (a friction element, then the lossy gears) moves in its mode: 0 stuck (or free), +1
+    forward, -1 backward (the inverse of :func:`_item_set`)."""
+    nf = p.fric.shape[0]
+    if i < nf:
+        return np.int64(1) if m[i] == FORWARD else np.int64(-1) if m[i] == BACKWARD else _ZERO
+    return np.int64(GEAR_CODES[m[p.elem[p.lossy[i - nf], E_MODE]]])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _item_speed(p, x, n, i):
     """Relative speed [rad/s] of item ``i``: a friction element's ``w_b - w_a``, a lossy gear's ``w_a - w_s``."""
     r = _item_row(p, i)
@@ -4212,6 +4222,8 @@ def settle(t, x, m, p, log, old, origin):
                 nc += 1
                 _item_set(p, m, i, _ZERO)
         forced = np.zeros(ni, dtype=np.int64)
+        marks_order = np.empty(nc + 1, dtype=np.int64)   # (the items the tie-break marked, in the order it did)
+        nmarks = _ZERO
         xp = np.empty(x.shape[0])
         for _tie in range(nc + 1):
             # ---- the search over the candidates (every one stuck first; ``forced`` items count as overloaded)
@@ -4405,12 +4417,59 @@ def settle(t, x, m, p, log, old, origin):
                     # (1): its load has a sign there, and taken from t + T_TIE, the way of a gear carrying torque in a
                     # loop moved the loop's clutch 1e-7 beyond its limit in the next round, slipping it for 0.7 ns)
                     forced[iw] = dw
+                    marks_order[nmarks] = iw
+                    nmarks += 1
                     marked = True
                 # (the work array as the probe found it -- evaluated at t again instead, the splits' warm starts
                 # the probe had moved stayed moved, as in :func:`_probe_fails`)
                 _put_back(p, saved)
             if not marked:
                 break
+        # ---- the fewest released.  The tie-break marks one item per round, the one beyond its limit at t + T_TIE
+        # with those marked before released; a later one's release may take away the load that put an earlier one
+        # beyond (a one-way clutch that overruns once a self-locking gear at efficiency 0.5 rolls: the gear, marked
+        # first because it shared the clutch's load with a brake, then carries nothing).  Each marked item, the last
+        # first, is put stuck again where the modes then agree with the forces at t (:func:`_consistent`) and at t +
+        # T_TIE (:func:`_probe_fails`, the stuck ones included), and it is not beyond its limit there by the test
+        # that marked it.  Without it, whether such a gear rolled on at zero speed or stayed stuck depended on
+        # whether the clutch's own crossing fell in the same search: with an unrelated element or without it (random
+        # draws seed 2097, sixty-first session; docs/driveline.md)
+        for q in range(nmarks - 1, -1, -1):
+            i = marks_order[q]
+            if _item_stuck(p, m, i):
+                continue
+            mq = m.copy()
+            saved = p.work.copy()
+            fi = forced[i]
+            forced[i] = 0
+            _item_set(p, m, i, _ZERO)
+            _evaluate(t, x, m, p, acc, tau)
+            pk = np.empty(max(nc, 1), dtype=np.int64)
+            npk = _ZERO
+            for c in range(nc):
+                dirs[c] = _item_way(p, m, cand[c])
+                if dirs[c] != 0:
+                    pk[npk] = c
+                    npk += 1
+            ok = _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced) and \
+                not _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pk, npk, True)
+            if ok:
+                # (and within what it holds at t + T_TIE by the test that marked it: not beyond, where the probe
+                # allows a stuck item the rounding.  With the probe's test alone, a gear beyond its band by less than
+                # that at t + T_TIE was kept stuck and crossed again 1.5 us later, then 0.34, 0.15, 0.07 us ...:
+                # eight searches, each interval about half the last, before it rolled, random draws seed 2106)
+                again = p.work.copy()
+                _evaluate_ahead(t, x, xp, m, p, acc, tau, np.empty(p.lossy.shape[0], dtype=np.int64))
+                ex1 = _item_excess(t + T_TIE, p, tau, i, False)[0]
+                if i < nf and ex1 >= 0.0 and _past_limit(t + T_TIE, p, tau, i)[0] <= 0.0:
+                    ex1 = -1e-300   # (exactly on its limit there: it holds, as the tie-break reads it)
+                ok = ex1 < 0.0
+                _put_back(p, again)
+            if not ok:
+                for k in range(m.shape[0]):
+                    m[k] = mq[k]
+                forced[i] = fi
+                _put_back(p, saved)
         for j in range(n):
             xp[j] = x[n + j]
         _project_speeds(t, x, m, p, comp, reach)

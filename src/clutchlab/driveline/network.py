@@ -2139,8 +2139,12 @@ class Driveline:
         elif e.kind == K.K_SPRING:
             what = f"spring-damper c = {e.coef[0]:g} {st}, d = {e.coef[1]:g} {dm}"
         elif e.law == K.LAW_ONEWAY:
+            n = len(e.table) // 2
+            char = f"{e.table[n]:g}" if n == 1 else f"table of {n} points"
+            normal = "" if e.signal is None else f", normal {e.signal.describe()}"
             what = ("one-way clutch (b overruns a freely)" if e.coef[0] == 0.0 else
-                    f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, peak {e.coef[2]:g}")
+                    f"one-way clutch (b overruns a), clutch fn_max = {e.coef[0]:g} N, mu {char}, "
+                    f"peak {e.coef[2]:g}{normal}")
         elif e.law == K.LAW_EXTERNAL and e.emtc is not None:
             sc = e.emtc["scenario"]
             what = (f"{e.model}, gear {sc.gear}, throttle {sc.throttle_start:g} -> {sc.throttle_end:g} over "
