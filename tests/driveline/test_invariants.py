@@ -1078,7 +1078,7 @@ def test_of_two_one_way_clutches_in_series_from_rest_only_the_driven_one_overrun
     same_without_the_unrelated(network(True))
 
 
-def test_a_one_way_clutch_leaving_rest_at_the_rounding_floor_is_timed_by_its_load():
+def test_a_one_way_clutch_leaving_rest_at_the_rounding_floor_is_compared_by_its_motion():
     """Random draws seed 2097: a one-way clutch whose clutch has no normal force until 0.5 s, loaded from rest
     through two springs by a sine, so its load grows as t^5.  It must overrun from the start; it leaves rest where
     its load leaves the rounding floor (2.6e-12 N m, 9.5 ms), an instant the runs with and without an unrelated
