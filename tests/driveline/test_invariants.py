@@ -1078,6 +1078,29 @@ def test_of_two_one_way_clutches_in_series_from_rest_only_the_driven_one_overrun
     same_without_the_unrelated(network(True))
 
 
+def test_a_clutch_without_capacity_hit_through_a_backlash_slides_the_way_it_is_driven():
+    """Random draws seed 2120 (sixty-first session): J0 at -2 rad/s closes a backlash on J1 at 0.03125 s; a clutch
+    whose capacity is below the rounding floor (1.9e-152 N) joins J1 to J2, at rest.  At the contact the clutch
+    carries no torque and has no relative acceleration (the contact's torque starts at zero), so it is released the
+    way its torque's rounding points; 10 ns later J1 is pushed backward, so it slides ``forward`` (``w_b - w_a >
+    0``).  The subset with it ``backward`` fails the probe there; it is now turned (``kernel._flip_turning``)
+    instead of leaving the search to its last resort, which released it ``backward`` for 10 us before it turned, in
+    the run without the unrelated inertia only."""
+    def network(with_unrelated):
+        d = Driveline("random")
+        d.inertia("J0", J=1.0, w0=-2.0).inertia("J1", J=1.0).inertia("J2", J=1.0)
+        d.backlash("k0", "J0", "J1", c=10.0, b_gap=0.125, d=0.0)
+        d.clutch("c1", "J1", "J2", fn_max=1.9263598998744536e-152, mu=0.5)
+        if with_unrelated:
+            d.inertia("U", J=1.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5).torque("UT", "U", Signal.sine(0.0, 1.0))
+        return d
+    for with_unrelated in (True, False):
+        r = network(with_unrelated).simulate(1.0, output_step=2e-3, rtol=1e-10)
+        ev = [(round(t, 9), el, kind) for t, el, kind in _mode_events(r) if el == "c1"]
+        assert ev == [(0.03125, "c1", "forward")], ev
+    same_without_the_unrelated(network(True))
+
+
 def test_a_one_way_clutch_leaving_rest_at_the_rounding_floor_is_compared_by_its_motion():
     """Random draws seed 2097: a one-way clutch whose clutch has no normal force until 0.5 s, loaded from rest
     through two springs by a sine, so its load grows as t^5.  It must overrun from the start; it leaves rest where
