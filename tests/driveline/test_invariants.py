@@ -1083,7 +1083,7 @@ def test_a_clutch_without_capacity_hit_through_a_backlash_slides_the_way_it_is_d
     whose capacity is below the rounding floor (1.9e-152 N) joins J1 to J2, at rest.  At the contact the clutch
     carries no torque and has no relative acceleration (the contact's torque starts at zero), so it is released the
     way its torque's rounding points; 10 ns later J1 is pushed backward, so it slides ``forward`` (``w_b - w_a >
-    0``).  The subset with it ``backward`` fails the probe there; it is now turned (``kernel._flip_turning``)
+    0``).  The subset with it ``backward`` fails the probe there; it is now turned (``kernel._probe``, its turn)
     instead of leaving the search to its last resort, which released it ``backward`` for 10 us before it turned, in
     the run without the unrelated inertia only."""
     def network(with_unrelated):
@@ -2151,7 +2151,7 @@ def test_a_locked_loop_breaks_away_with_its_one_way_clutch_overrunning():
     the run went on 68 us so); with the quadrant kept, the loop clutch was released at zero acceleration and slid
     backward against its forward torque for 68 us.  Now a released item at rest in acceleration must accelerate
     its own way at ``te + T_TIE`` too, and where none agrees with the items the probe marked, the search is repeated
-    with each subset held to ``te + T_TIE`` (``kernel._probe_fails``).  Checked at three tolerances and two output
+    with each subset held to ``te + T_TIE`` (``kernel._probe``).  Checked at three tolerances and two output
     grids: the events, the speeds on the closed form until f2 engages at 0.5 s, f2's torque zero while it overruns
     as a bare freewheel, the motion's end at one instant at every tolerance."""
     te = math.asin(0.8) / (2 * math.pi)

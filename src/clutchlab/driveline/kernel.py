@@ -3821,21 +3821,36 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
     return turned
 
 
+#: what :func:`_probe` finds: the subset holds beyond ``t``; it fails there; it fails, and released items at zero
+#: acceleration that turn back there were turned the other way (try the subset again)
+PROBE_HOLDS, PROBE_FAILS, PROBE_TURNED = 0, 1, 2
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
-def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
-    """True if a released item of ``pick`` whose relative acceleration at ``t`` is within :data:`TIE_BAND` rounding
-    floors of zero accelerates against its direction at ``t + T_TIE`` (angles and speeds advanced by the decided
-    motion, as the tie-break in :func:`settle`): its way is a tie at first order that the load's rate decides, and
-    this subset is no solution beyond ``t``.  (A loop clutch released at the instant its torque reached its limit,
-    with the loop's one-way clutch stuck, started at zero acceleration and slid backward against its forward
-    torque for 68 us, the one-way clutch then stuck 8 N m deep, until its slip crossed the rounding width; the
-    solution is the one-way clutch overrunning with the loop clutch stuck, #30.)  ``stuck_too``: probe in any case,
-    and fail too if a stuck candidate is beyond its limit there (not at it to rounding).
+def _probe(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too, turn):
+    """:data:`PROBE_FAILS` if a released item of ``pick`` whose relative acceleration at ``t`` is within
+    :data:`TIE_BAND` rounding floors of zero accelerates against its direction at ``t + T_TIE`` (angles and speeds
+    advanced by the decided motion, as the tie-break in :func:`settle`): its way is a tie at first order that the
+    load's rate decides, and this subset is no solution beyond ``t``.  (A loop clutch released at the instant its
+    torque reached its limit, with the loop's one-way clutch stuck, started at zero acceleration and slid backward
+    against its forward torque for 68 us, the one-way clutch then stuck 8 N m deep, until its slip crossed the
+    rounding width; the solution is the one-way clutch overrunning with the loop clutch stuck, #30.)
+    ``stuck_too``: probe in any case, and fail too if a stuck candidate is beyond its limit there (not at it to
+    rounding).  Else :data:`PROBE_HOLDS`.
+
+    ``turn``: every such item that turns back is turned the other way (``m`` and ``dirs``; a one-way clutch cannot),
+    and :data:`PROBE_TURNED` returned if one was, for the search to try the subset again.  An item released from
+    rest with no torque and no acceleration at the instant (a clutch whose capacity is below the rounding floor,
+    where a backlash closes: the contact's torque starts at zero) is released the way the sign of its torque's
+    rounding points; without the turn no subset agreed, and the search's last resort released it the rounding's
+    way: it slid ``backward`` for 10 us, then ``forward``, in one run, and ``forward`` at once in the run with an
+    unrelated inertia (random draws seed 2120, sixty-first session).
 
     It leaves the work array (the evaluation at ``t``: accelerations, torques, holds, the splits' warm starts) and
-    the quadrants as it found them.  (Evaluated at ``t`` again instead, a set at its group's edge that held in the
-    search's evaluation held no more -- at the edge the split follows the warm starts, which the probe had moved --
-    and a lossy gear was kept stuck 0.11 N m beyond its band.)"""
+    the quadrants as it found them (but those it turns).  (Evaluated at ``t`` again instead, a set at its group's
+    edge that held in the search's evaluation held no more -- at the edge the split follows the warm starts, which
+    the probe had moved -- and a lossy gear was kept stuck 0.11 N m beyond its band.)"""
+    nf = p.fric.shape[0]
     tie = stuck_too
     near = np.zeros(s, dtype=np.bool_)
     for q in range(s):
@@ -3843,15 +3858,20 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
         near[q] = abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc)
         tie = tie or near[q]
     if not tie:
-        return False
+        return PROBE_HOLDS
     saved = p.work.copy()
     _evaluate_ahead(t, x, xp, m, p, acc, tau, np.empty(p.lossy.shape[0], dtype=np.int64))
     turns = False
+    turned = False
     for q in range(s):
         c = pick[q]
         i = cand[c]
         if near[q] and _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
             turns = True
+            if turn and not (i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY):
+                dirs[c] = -dirs[c]
+                _item_set(p, m, i, dirs[c])
+                turned = True
     if stuck_too:
         for c in range(nc):
             i = cand[c]
@@ -3859,43 +3879,7 @@ def _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s, stuck_too):
                     not _tied(t + T_TIE, p, tau, i):
                 turns = True
     _put_back(p, saved)
-    return turns
-
-
-@numba.njit(cache=True, nogil=True, _nrt=True)
-def _flip_turning(t, x, xp, m, p, acc, tau, cand, dirs, pick, s, nf):
-    """Turn every released item of ``pick`` whose relative acceleration at ``t`` is within :data:`TIE_BAND` rounding
-    floors of zero and which accelerates against its direction at ``t + T_TIE`` (the test of :func:`_probe_fails`)
-    the other way (a one-way clutch cannot); True if one turned.  ``dirs`` follows; the work array is left as found.
-
-    An item released from rest with no torque and no acceleration at the instant (a clutch whose capacity is below
-    the rounding floor, where a backlash closes: the contact's torque starts at zero) is released the way the sign
-    of its torque's rounding points, and that subset fails the probe when it accelerates the other way 10 ns later.
-    Without the turn no subset agreed, and the search's last resort released it the rounding's way: it slid
-    ``backward`` for 10 us, then ``forward``, in one run, and ``forward`` at once in the run with an unrelated
-    inertia (random draws seed 2120, sixty-first session)."""
-    near = np.zeros(s, dtype=np.bool_)
-    tie = False
-    for q in range(s):
-        i = cand[pick[q]]
-        near[q] = abs(_item_acc(p, acc, i)) <= TIE_BAND * _item_anoise(p, _item_row(p, i), acc)
-        tie = tie or near[q]
-    if not tie:
-        return False
-    saved = p.work.copy()
-    _evaluate_ahead(t, x, xp, m, p, acc, tau, np.empty(p.lossy.shape[0], dtype=np.int64))
-    turned = False
-    for q in range(s):
-        c = pick[q]
-        i = cand[c]
-        if near[q] and _item_acc(p, acc, i) * dirs[c] < -_item_anoise(p, _item_row(p, i), acc):
-            if i < nf and p.elem[p.fric[i], E_LAW] == LAW_ONEWAY:
-                continue
-            dirs[c] = -dirs[c]
-            _item_set(p, m, i, dirs[c])
-            turned = True
-    _put_back(p, saved)
-    return turned
+    return PROBE_TURNED if turned else PROBE_FAILS if turns else PROBE_HOLDS
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -3904,7 +3888,7 @@ def _evaluate_ahead(t, x, xp, m, p, acc, tau, quad):
     thermal masses' temperatures advanced by the motion decided at ``t`` (``xp``: ``x`` plus ``T_TIE`` times its rates,
     an error of order ``T_TIE**2``)
     and each lossy gear's quadrant kept as decided at ``t``: the probe of the tie-break in :func:`settle` and of
-    :func:`_probe_fails`.  (A released gear whose quadrant flips by ``t + T_TIE`` keeps the one decided at ``t`` --
+    :func:`_probe`.  (A released gear whose quadrant flips by ``t + T_TIE`` keeps the one decided at ``t`` --
     taken over, a gear released in a rigid loop carried the other quadrant's split at ``t``, which put a one-way
     clutch 0.63 N m the free way, #30.)  ``quad``: room for the quadrants (one per lossy gear), the caller's:
     compiled without reference counting, this function allocates nothing (docs/architecture.md)."""
@@ -4337,13 +4321,11 @@ def settle(t, x, m, p, log, old, origin):
                                 # few times
                                 for _flip in range(s + 1):
                                     if _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, marks):
-                                        if _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s,
-                                                        attempt == 1):
-                                            # not a solution beyond t (one turns back, or one breaks away); one
-                                            # released at zero acceleration that turns back there goes the other
-                                            # way, and the subset is tried again (:func:`_flip_turning`)
-                                            if not _flip_turning(t, x, xp, m, p, acc, tau, cand, dirs, pick, s, nf):
-                                                break
+                                        probe = _probe(t, x, xp, m, p, acc, tau, cand, nc, dirs, pick, s,
+                                                       attempt == 1, True)
+                                        if probe == PROBE_FAILS:
+                                            break   # not a solution beyond t (one turns back, or one breaks away)
+                                        if probe == PROBE_TURNED:   # (one at zero acceleration turned: again)
                                             _evaluate(t, x, m, p, acc, tau)
                                             continue
                                         found = True
@@ -4396,7 +4378,7 @@ def settle(t, x, m, p, log, old, origin):
             # so it changed with the tolerance or with an unrelated element (a self-locking gear stuck for 1.6 ps, or
             # 0.6 ns, in one run and rolling in the other: issue #30).  (Written out here, as the search above: as
             # functions of their own they compiled 2.5 s more; the probe's evaluation is :func:`_evaluate_ahead`, as
-            # in :func:`_probe_fails`.)
+            # in :func:`_probe`.)
             near = False
             marked = False
             for c in range(nc):
@@ -4463,7 +4445,7 @@ def settle(t, x, m, p, log, old, origin):
                     nmarks += 1
                     marked = True
                 # (the work array as the probe found it -- evaluated at t again instead, the splits' warm starts
-                # the probe had moved stayed moved, as in :func:`_probe_fails`)
+                # the probe had moved stayed moved, as in :func:`_probe`)
                 _put_back(p, saved)
             if not marked:
                 break
@@ -4472,7 +4454,7 @@ def settle(t, x, m, p, log, old, origin):
         # beyond (a one-way clutch that overruns once a self-locking gear at efficiency 0.5 rolls: the gear, marked
         # first because it shared the clutch's load with a brake, then carries nothing).  Each marked item, the last
         # first, is put stuck again where the modes then agree with the forces at t (:func:`_consistent`) and at t +
-        # T_TIE (:func:`_probe_fails`, the stuck ones included), and it is not beyond its limit there by the test
+        # T_TIE (:func:`_probe`, the stuck ones included), and it is not beyond its limit there by the test
         # that marked it.  Without it, whether such a gear rolled on at zero speed or stayed stuck depended on
         # whether the clutch's own crossing fell in the same search: with an unrelated element or without it (random
         # draws seed 2097, sixty-first session; docs/driveline.md)
@@ -4494,7 +4476,7 @@ def settle(t, x, m, p, log, old, origin):
                     pk[npk] = c
                     npk += 1
             ok = _consistent(t, x, m, p, acc, tau, cand, nc, dirs, old, forced) and \
-                not _probe_fails(t, x, xp, m, p, acc, tau, cand, nc, dirs, pk, npk, True)
+                _probe(t, x, xp, m, p, acc, tau, cand, nc, dirs, pk, npk, True, False) == PROBE_HOLDS
             if ok:
                 # (and within what it holds at t + T_TIE by the test that marked it: not beyond, where the probe
                 # allows a stuck item the rounding.  With the probe's test alone, a gear beyond its band by less than
