@@ -3823,7 +3823,8 @@ def _flip_released(p, m, acc, cand, dirs, pick, s, nf):
 
 #: what :func:`_probe` finds: the subset holds beyond ``t``; it fails there; it fails, and released items at zero
 #: acceleration that turn back there were turned the other way (try the subset again)
-PROBE_HOLDS, PROBE_FAILS, PROBE_TURNED = 0, 1, 2
+PROBE_OUTCOMES = ("holds", "fails", "turned")
+PROBE_HOLDS, PROBE_FAILS, PROBE_TURNED = indices(PROBE_OUTCOMES, "holds", "fails", "turned")
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
