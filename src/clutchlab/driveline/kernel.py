@@ -189,14 +189,16 @@ GEAR_VALUES = ("stuck", "forward_a_drives", "forward_b_drives", "backward_a_driv
 GEAR_STUCK, GEAR_FWD_A, GEAR_FWD_B, GEAR_BWD_A, GEAR_BWD_B = indices(
     GEAR_VALUES, "stuck", "forward_a_drives", "forward_b_drives", "backward_a_drives", "backward_b_drives")
 GEAR_CODES = np.array([0.0, 1.0, 1.0, -1.0, -1.0])   # MSL LossyGear.mode: Stuck 0, Forward 1, Backward -1
-# switching functions: five per friction element, then four per switched spring (``swit``: backlash and curves),
+# switching functions: six per friction element, then four per switched spring (``swit``: backlash and curves),
 # then four per lossy gear (``lossy``: its stick or break-away function, its driving flange's, its turning point, its
-# band's pieces)
-FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near")
-G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR = indices(FRICTION_SWITCHING, "stick", "break", "normal", "turn", "near")
+# band's pieces or its loss table's rows)
+FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near", "row")
+G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR, G_ROW = indices(FRICTION_SWITCHING, "stick", "break", "normal", "turn",
+                                                            "near", "row")
 N_G = len(FRICTION_SWITCHING)
 #: a lossy gear's: its stick or break-away function, its driving flange's, its turning point, and (stuck) the piece
-#: of its band (a waypoint where the torque it carries passes zero, its band's corner without bearing friction)
+#: of its band (a waypoint where the torque it carries passes zero, its band's corner without bearing friction) or
+#: (rolling) of its loss table (a waypoint at each speed row, :func:`gear_row`)
 GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn", "piece")
 N_GEAR_G = len(GEAR_SWITCHING)
 GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
@@ -540,6 +542,78 @@ def friction_map(data, start, nw, nt, w, temp):
     a = data[j0] + fw * (data[j0 + 1] - data[j0])
     b = data[j1] + fw * (data[j1 + 1] - data[j1])
     return a + ft * (b - a)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _corner(data, start, first, nrows, clamp, i):
+    """Corner ``i`` of :func:`row_waypoint`: the rows ``data[start + first:start + first + nrows]``, then ``clamp``."""
+    return data[start + first + i] if i < nrows else clamp
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def row_waypoint(data, start, first, nrows, clamp, s):
+    """The waypoint function [-] of a law over a speed ``s >= 0`` [rad/s] whose slope jumps at its corners (the rows
+    ``data[start + first:start + first + nrows]``, increasing, then ``clamp`` where it is finite, beyond them): zero
+    at each corner and nowhere else, of alternating sign from one piece to the next (as a torque converter's,
+    :func:`converter_piece`), so that a step ends just past each corner and the error follows the tolerance there.
+    Piece ``k`` between corners ``lo`` and ``hi``: ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; the first (from 0, no
+    corner: a sliding element's speed there is its stick event) ``(hi - s)/hi``; beyond the last ``(-1)^k (s -
+    lo)/s``.  1 (no waypoint) for a law without corners."""
+    nc = nrows + (1 if clamp < np.inf else 0)
+    if nc <= 0:
+        return 1.0
+    k = 0
+    while k < nc and _corner(data, start, first, nrows, clamp, k) <= s:
+        k += 1
+    if k == 0:
+        hi = _corner(data, start, first, nrows, clamp, 0)
+        return (hi - s) / hi
+    lo = _corner(data, start, first, nrows, clamp, k - 1)
+    if k == nc:
+        v = (s - lo) / s
+    else:
+        hi = _corner(data, start, first, nrows, clamp, k)
+        v = (s - lo) * (hi - s) / ((hi - lo) * (hi - lo))
+    return v if k % 2 == 0 else -v
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def friction_row(p, r, w_abs):
+    """The waypoint function [-] of sliding friction element row ``r`` at ``|w_rel| = w_abs`` [rad/s]
+    (:func:`row_waypoint`): the corners of its sliding torque over the speed, where the slope jumps.  A table
+    (:func:`_characteristic`): its first row where it is above 0 (held below it), its inner rows (linear between
+    them) and the speed at which its extrapolation beyond the last two rows reaches 0 (held at 0 beyond it); a
+    friction map (:func:`friction_map`): its speed nodes but the first (0; bilinear, held beyond the last); an
+    external law (a wet clutch, an EMTC coupling: its own model), a constant or a two-row rising table: none (1).
+    Until the sixty-second session a step spanned a corner and the error did not follow the tolerance there (a
+    clutch with four rows sliding to lock-up: 1.1e-4 of the speeds' range at rtol 1e-6, #30)."""
+    if p.elem[r, E_LAW] == LAW_EXTERNAL:
+        return 1.0
+    start, n = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
+    if p.elem[r, E_MAP_T] > 0:
+        return row_waypoint(p.data, start, 1, n - 1, np.inf, w_abs)
+    if n <= 1:
+        return 1.0
+    first = 0 if p.data[start] > 0.0 else 1
+    clamp = np.inf
+    y0, y1 = p.data[start + 2 * n - 2], p.data[start + 2 * n - 1]
+    if y1 < y0:   # (falls to 0 beyond the last row, held there)
+        x0, x1 = p.data[start + n - 2], p.data[start + n - 1]
+        clamp = x1 + y1 * (x1 - x0) / (y0 - y1)
+    return row_waypoint(p.data, start, first, n - 1 - first, clamp, w_abs)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def gear_row(p, r, w_abs):
+    """The waypoint function [-] of rolling lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (:func:`row_waypoint`):
+    its loss table's speed rows where its law's slope jumps: the first where it is above 0 (held below it) and the
+    inner ones (linear between them); 1 for a table of one row.  (An extrapolation beyond the last row that reaches
+    an efficiency of 1 or a bearing friction of 0 is held there: a corner not watched.)"""
+    start, n = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N]
+    if n <= 1:
+        return 1.0
+    first = 0 if p.data[start] > 0.0 else 1
+    return row_waypoint(p.data, start, first, n - 1 - first, np.inf, w_abs)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4729,12 +4803,13 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     ``tau_src * w_b`` (torque and motion sources), the dissipation of the others: ``tau * w_rel`` less
     the rate of the energy a spring stores (``(tau - tau_c) w_rel``; a gear's is zero but for drift); then
     the integral of each engine's idle controller [N m] (:func:`engine_torque`); then each thermal mass's temperature
-    [degC] and heat given to its ambient [J] (:func:`thermal_rates`).  Switching functions, five per friction element: the relative speed of a sliding element in its
+    [degC] and heat given to its ambient [J] (:func:`thermal_rates`).  Switching functions, six per friction element: the relative speed of a sliding element in its
     direction (falls through zero: it sticks or reverses), the holding limit minus the torque of a stuck
     one (falls through zero: break-away; a one-way clutch's ``-tau``), the normalised normal force
     (either way: free or engaged), the turning point of a sliding speed, or of a stuck one's margin near its
     limit (0.0 here, its rate from :func:`driveline_watch`: a brief overload is found), and a stuck one's margin less
-    :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near); then four per switched
+    :data:`NEAR_LIMIT` of its limit (a waypoint: a step ends as the margin comes near), and a sliding one's corners of
+    its law over the speed (:func:`friction_row`: a table's rows; a waypoint either way); then four per switched
     spring.  A
     backlash, for its upper and lower side, each falling through zero: in the gap the distance to the edge
     (``b/2 - phi``, ``phi + b/2``: contact), in contact ``tau / c`` signed positive (separation, as the torque would
@@ -4751,7 +4826,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
     ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed; stuck,
     ``T_a`` of one without bearing friction (a waypoint either way: a step ends where its band closes; 1 within a
-    rounding floor of zero or in a set with several null directions).  Then one per torque converter
+    rounding floor of zero or in a set with several null directions), rolling, the rows of its loss table
+    (:func:`gear_row`: a waypoint either way).  Then one per torque converter
     (:func:`converter_piece`: zero at each corner of its law, alternating in sign; a waypoint either way).
     Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0 (but the
     waypoints, of either sign).
@@ -4788,6 +4864,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # sliding direction), located so that a dip of the speed through zero within a step is seen (G_TURN)
         g[N_G * k + G_TURN] = 1.0
         g[N_G * k + G_NEAR] = 1.0
+        # sliding, the corners of its law over the speed (a friction table's rows: a waypoint either way)
+        g[N_G * k + G_ROW] = friction_row(p, r, abs(w_rel)) if (mk == FORWARD or mk == BACKWARD) else 1.0
         if mk != STUCK:
             g[N_G * k + G_BREAK] = 1.0
         else:
@@ -4908,6 +4986,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         g[q + GG_TURN] = (a_a if forward else -a_a) + _item_anoise(p, r, acc)
         te = gear_tau_eta(p, r, mode, -tau[r], abs(w_a))
         g[q + GG_FLANGE] = (te + noise) if mode == GEAR_FWD_A or mode == GEAR_BWD_B else (noise - te)
+        # rolling, the corners of its loss table over |w_a| (its speed rows: a waypoint either way)
+        g[q + GG_PIECE] = gear_row(p, r, abs(w_a))
     # then one per torque converter, in element order: the corners of its law (a waypoint either way)
     q = N_G * nf + N_SW * nsw + N_GEAR_G * p.lossy.shape[0]
     for r in range(p.elem.shape[0]):
@@ -5169,8 +5249,8 @@ def driveline_update(t, x, u, m, p, k, log):
     if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
         j = (k - N_G * nf - N_SW * nsw) // N_GEAR_G
         which = (k - N_G * nf - N_SW * nsw) % N_GEAR_G
-        if which == GG_TURN or which == GG_PIECE:   # a turning point, a corner of a stuck one's band: a step ends
-            return 0                                   # there, nothing changes
+        if which == GG_TURN or which == GG_PIECE:   # a turning point, a corner of a stuck one's band or of a
+            return 0                                   # rolling one's loss table: a step ends there, nothing changes
         mi = p.elem[p.lossy[j], E_MODE]
         old = m.copy()
         mode = m[mi]
@@ -5230,9 +5310,9 @@ def driveline_update(t, x, u, m, p, k, log):
         settle_outlined(t, x, m, p, log, m.copy(), r)
         return 0
     kf = k // N_G
-    if k % N_G == G_TURN or k % N_G == G_NEAR:
-        # a sliding speed's or a stuck margin's turning point, or a stuck element coming near its limit: a step
-        # ends there, nothing changes
+    if k % N_G == G_TURN or k % N_G == G_NEAR or k % N_G == G_ROW:
+        # a sliding speed's or a stuck margin's turning point, a stuck element coming near its limit, or a corner of a
+        # sliding one's law: a step ends there, nothing changes
         return 0
     old = m.copy()
     if k % N_G == G_STICK and (m[kf] == FORWARD or m[kf] == BACKWARD):

@@ -2672,7 +2672,8 @@ class Driveline:
         states, outputs = self.variables()
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric
-                          for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3)))
+                          for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3),
+                                          ("row", 4)))
         swit = [self._elements[r] for r in p.swit]
         # (a switched spring's edges fall through zero; a backlash's get the core's second look at the root of its
         # turning point (rising: in the gap towards the nearer edge, in contact the contact torque's minimum near

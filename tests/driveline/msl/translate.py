@@ -35,6 +35,20 @@ def _signal(s, t_end=2.0):
     return None
 
 
+def _table(v):
+    """A number or a characteristic ``[[w, value], ...]`` as the reference takes it; None for a table whose last two
+    rows fall (clutchlab holds an extrapolation below zero at zero, the reference's MSL ``LastTwoPoints`` does not:
+    only tables that cannot reach it are compared) or one with a negative row."""
+    if isinstance(v, (int, float)):
+        return float(v)
+    rows = np.atleast_2d(np.asarray(v, dtype=float))
+    if rows.ndim != 2 or rows.shape[1] != 2 or np.any(rows[:, 1] < 0.0):
+        return None
+    if len(rows) >= 2 and rows[-1, 1] < rows[-2, 1]:
+        return None
+    return [list(map(float, r)) for r in rows]
+
+
 def to_reference(d, strict=True):
     """The network ``d`` as a :class:`reference.Network` (``strict``: :attr:`reference.Network.strict`), its initial
     speeds clutchlab's (the speeds a description leaves out are carried along the gears:
@@ -61,9 +75,11 @@ def to_reference(d, strict=True):
             net.gear(e.name, a, b, args["ratio"], support=e.support, loss_table=table)
         elif e.kind in ("clutch", "brake"):
             normal = _signal(args["normal"])
-            if normal is None or not isinstance(args["mu"], (int, float)):
+            mu = _table(args["mu"])
+            if (normal is None or mu is None or args.get("mu_scale", 1.0) != 1.0
+                    or args.get("mu_temperature") is not None):
                 return None
-            net.clutch(e.name, a, b, fn_max=args["fn_max"], normal=normal, mu=args["mu"], peak=args["peak"],
+            net.clutch(e.name, a, b, fn_max=args["fn_max"], normal=normal, mu=mu, peak=args["peak"],
                        cgeo=args["cgeo"])
         elif e.kind == "synchronizer":
             force = _signal(args["force"])
@@ -72,9 +88,10 @@ def to_reference(d, strict=True):
             net.synchronizer(e.name, a, b, force, args["cone_radius"], args["dog_capacity"], mu=args["mu"],
                              cone_angle=args["cone_angle"], cones=args["cones"], side=args["side"])
         elif e.kind == "bearing_friction":
-            if not isinstance(args["torque"], (int, float)):
+            torque = _table(args["torque"])
+            if torque is None:
                 return None
-            net.bearing_friction(e.name, b, tau_pos=args["torque"], peak=args["peak"], support=a)
+            net.bearing_friction(e.name, b, tau_pos=torque, peak=args["peak"], support=a)
         elif e.kind == "one_way_clutch":
             normal = _signal(args["normal"])
             if normal is None or not isinstance(args["mu"], (int, float)):
