@@ -201,6 +201,10 @@ N_G = len(FRICTION_SWITCHING)
 #: (rolling) of its loss table (a waypoint at each speed row, :func:`gear_row`)
 GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn", "piece")
 N_GEAR_G = len(GEAR_SWITCHING)
+#: an engine's, after the torque converters' (waypoints either way, :func:`engine_corners`): the corners of its map
+#: over its speed and over its throttle, and the edges of its idle controller's clip
+ENGINE_SWITCHING = ("speed_row", "throttle_row", "idle_clip")
+N_ENGINE_G = len(ENGINE_SWITCHING)
 GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends), the turning
 #: points of a backlash's deflection in its gap or of its contact's torque near separation (G_LASH_TURN), and in
@@ -847,6 +851,52 @@ def engine_map(data, start, ns, nt, w, throttle):
     f10 = data[v0 + i1 * nt + j]
     f11 = data[v0 + i1 * nt + j1]
     return (1.0 - a) * ((1.0 - b) * f00 + b * f01) + a * ((1.0 - b) * f10 + b * f11)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def grid_waypoint(data, start, n, s):
+    """The waypoint function [-] of a law read on the grid ``data[start:start + n]`` (increasing) at ``s``, linear
+    between its nodes and held beyond both ends, so that its slope jumps at every node: zero at each node and nowhere
+    else, of alternating sign from one piece to the next (:func:`row_waypoint` over a signed variable).  Piece ``k``
+    between nodes ``lo`` and ``hi``: ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; before the first node ``(c0 - s)/(c0 -
+    s + w)``, beyond the last ``(-1)^n (s - c)/(s - c + w)``, ``w`` the grid's width.  1 for a grid of one node (a
+    law constant in ``s``)."""
+    if n < 2:
+        return 1.0
+    first = data[start]
+    last = data[start + n - 1]
+    width = last - first
+    k = 0
+    while k < n and data[start + k] <= s:
+        k += 1
+    if k == 0:
+        v = (first - s) / ((first - s) + width)
+    elif k == n:
+        v = (s - last) / ((s - last) + width)
+    else:
+        lo = data[start + k - 1]
+        hi = data[start + k]
+        v = (s - lo) * (hi - s) / ((hi - lo) * (hi - lo))
+    return v if k % 2 == 0 else -v
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def engine_corners(p, r, t, x, n):
+    """The waypoint functions [-] of engine row ``r`` (:data:`ENGINE_SWITCHING`), where its torque's slope jumps:
+    its map's speed nodes (:func:`grid_waypoint` at its crankshaft's speed against its support), its throttle nodes
+    (at the throttle signal) and the edges of its idle controller's clip at 0 and ``T_idle,max``
+    (``cmd (T_max - cmd)/T_max^2``, ``cmd = kp (w_idle - w) + I``: :func:`engine_torque`; 1 without the controller).
+    Until the sixty-second session a step spanned them: an engine on a six-row full-load curve accelerating a damper
+    was 6.4e-5 of its speed range off an independent solution at rtol 1e-6 and 2.0e-7 at 1e-9 (#30)."""
+    w = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
+    start, ns, nt = p.elem[r, E_TABLE], p.elem[r, E_TABLE_N], p.elem[r, E_AUX]
+    g_speed = grid_waypoint(p.data, start, ns, w)
+    g_throttle = grid_waypoint(p.data, start + ns, nt, signal_at(p, p.elem[r, E_SIGNAL], t)) if nt > 1 else 1.0
+    top = p.coef[r, C_IDLE_MAX]
+    if top <= 0.0:
+        return g_speed, g_throttle, 1.0
+    cmd = p.coef[r, C_IDLE_KP] * (p.coef[r, C_IDLE_W] - w) + x[2 * n + p.elem.shape[0] + p.elem[r, E_STATE]]
+    return g_speed, g_throttle, cmd * (top - cmd) / (top * top)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4828,7 +4878,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     ``T_a`` of one without bearing friction (a waypoint either way: a step ends where its band closes; 1 within a
     rounding floor of zero or in a set with several null directions), rolling, the rows of its loss table
     (:func:`gear_row`: a waypoint either way).  Then one per torque converter
-    (:func:`converter_piece`: zero at each corner of its law, alternating in sign; a waypoint either way).
+    (:func:`converter_piece`: zero at each corner of its law, alternating in sign; a waypoint either way).  Then
+    three per engine (:func:`engine_corners`: its map's speed and throttle nodes, its idle clip's edges; waypoints).
     Every threshold is the one :func:`settle` decides with, so after a decision each function is > 0 (but the
     waypoints, of either sign).
     """
@@ -4994,6 +5045,11 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         if p.elem[r, E_KIND] == K_CONVERTER:
             g[q] = converter_piece(p, r, x, n)
             q += 1
+    # then three per engine, in element order: the corners of its map and the edges of its idle clip (waypoints)
+    for r in range(p.elem.shape[0]):
+        if p.elem[r, E_KIND] == K_SOURCE and p.elem[r, E_LAW] == SOURCE_ENGINE:
+            g[q], g[q + 1], g[q + 2] = engine_corners(p, r, t, x, n)
+            q += N_ENGINE_G
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")   # (in the right-hand side's loop: no call per element)
@@ -5244,8 +5300,8 @@ def driveline_update(t, x, u, m, p, k, log):
         forget_signals(p)
     nf = p.fric.shape[0]
     nsw = p.swit.shape[0]
-    if k >= N_G * nf + N_SW * nsw + N_GEAR_G * p.lossy.shape[0]:   # a torque converter's corner: a step ends there
-        return 0
+    if k >= N_G * nf + N_SW * nsw + N_GEAR_G * p.lossy.shape[0]:   # a torque converter's or an engine's corner: a
+        return 0                                                     # step ends there
     if k >= N_G * nf + N_SW * nsw:   # a lossy gear: stopped (it sticks or reverses), overloaded, or its quadrant
         j = (k - N_G * nf - N_SW * nsw) // N_GEAR_G
         which = (k - N_G * nf - N_SW * nsw) % N_GEAR_G

@@ -2689,6 +2689,9 @@ class Driveline:
                            for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1), ("piece", 4)))
         # a torque converter's corners (kernel.converter_piece: a waypoint either way, in element order)
         switching += tuple((f"{e.name}.piece", 4) for e in self._elements if e.kind == K.K_CONVERTER)
+        # an engine's corners (kernel.engine_corners: its map's speed and throttle nodes, its idle clip's edges)
+        switching += tuple((f"{e.name}.{what}", 4) for e in self._elements
+                           if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE for what in K.ENGINE_SWITCHING)
         mode_names = named
         swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_KV_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)
