@@ -608,6 +608,25 @@ def friction_row(p, r, w_abs):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
+def friction_temperature_row(p, r):
+    """The waypoint function [-] of friction element row ``r`` over the temperature [degC] of the thermal mass its
+    losses heat (:func:`grid_waypoint`: zero at each node, of alternating sign): its fade table's rows
+    (``mu_temperature``, :func:`fade_factor`: linear between them, held beyond) times a friction map's temperature
+    nodes (:func:`friction_map`: bilinear, held beyond).  1 without a heat port or either law.  Where the temperature
+    crosses a row the sliding torque's slope jumps, as at a friction table's rows over the speed
+    (:func:`friction_row`)."""
+    if p.elem[r, E_HEAT] < 0 or p.elem[r, E_LAW] == LAW_EXTERNAL:
+        return 1.0
+    temp = temperatures(p)[p.elem[r, E_HEAT]]
+    v = 1.0
+    if p.elem[r, E_FADE] >= 0:
+        v *= grid_waypoint(p.data, p.elem[r, E_FADE], p.elem[r, E_FADE_N], temp)
+    if p.elem[r, E_MAP_T] > 1:
+        v *= grid_waypoint(p.data, p.elem[r, E_TABLE] + p.elem[r, E_TABLE_N], p.elem[r, E_MAP_T], temp)
+    return v
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def gear_row(p, r, w_abs):
     """The waypoint function [-] of rolling lossy gear row ``r`` at ``|w_a| = w_abs`` [rad/s] (:func:`row_waypoint`):
     its loss table's speed rows where its law's slope jumps: the first where it is above 0 (held below it) and the
@@ -4915,8 +4934,10 @@ def driveline_rhs(t, x, u, m, p, dx, g):
         # sliding direction), located so that a dip of the speed through zero within a step is seen (G_TURN)
         g[N_G * k + G_TURN] = 1.0
         g[N_G * k + G_NEAR] = 1.0
-        # sliding, the corners of its law over the speed (a friction table's rows: a waypoint either way)
-        g[N_G * k + G_ROW] = friction_row(p, r, abs(w_rel)) if (mk == FORWARD or mk == BACKWARD) else 1.0
+        # sliding, the corners of its law over the speed (a friction table's rows) and over its heat port's temperature
+        # (its fade table's rows, a friction map's temperature nodes): a waypoint either way, zero at each (a product)
+        g[N_G * k + G_ROW] = (friction_row(p, r, abs(w_rel)) * friction_temperature_row(p, r)
+                              if (mk == FORWARD or mk == BACKWARD) else 1.0)
         if mk != STUCK:
             g[N_G * k + G_BREAK] = 1.0
         else:
