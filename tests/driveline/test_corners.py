@@ -437,3 +437,38 @@ def test_a_grids_waypoint_passes_zero_at_every_node_and_nowhere_else(gaps, first
         assert f(c - eps) * f(c + eps) < 0, c
         assert abs(f(c)) <= 1e-9
     assert K.grid_waypoint(data, 1, 1, nodes[0] + 1.0) == 1.0
+
+
+def test_a_gear_leaving_rest_driven_from_flange_b_rolls_as_flange_b_drives():
+    """The draw (the draws profile's seed 2 of the random table networks) that found a tie in the reference engine: a
+    gear (ratio -1.41) with a loss table whose bearing friction is the same in both quadrants (``tau_bf1 = tau_bf2``,
+    so ``tau_bf_a = 0``) between two inertias at rest, a sine on flange b's.  Each time the sine's torque passes the
+    bearing friction the gear leaves rest with ``tau_a = 0``, and MSL's ``startForward``'s ``tau_eta >= 0`` picked
+    quadrant 1 (flange a drives) in the reference, where flange b drives it: forward, the reference's speeds were 1.8
+    times clutchlab's (its acceleration ``r (T - r tau_bf2)/(J_b + r^2 J_a/eta_mf2)`` with ``eta_mf1`` in place of
+    ``1/eta_mf2``), while backward both picked the right one (which quadrant the tie took was a rounding: with the
+    numbers rounded to two digits both are right).  The reference now decides that tie the way ``tau_eta``
+    goes; clutchlab's speeds agree with it to 1e-6 of their range, and its acceleration in the forward phase is
+    quadrant 2's closed form."""
+    # (the draw's numbers, to the last digit: whether the reference's tie took the wrong quadrant was a rounding)
+    r, ja, jb = -1.408553761482606, 1.5365402065424285, 1.1386297173961137
+    eta = bf = 0.6583083515657432
+    table = [[0.0, eta, eta, bf, bf], [2.0, 0.5, 0.5, 0.0, 0.0], [12.0, 0.5, 0.5, 0.0, 0.0]]
+    sine = Signal.sine(1.0, 1.408553761482606, phase=4.983287655362938)
+    d = (Driveline("quadrant").inertia("J0", ja).inertia("J1", jb).gear("g0", "J0", "J1", r, loss_table=table)
+         .torque("T1", "J1", sine))
+    times = np.linspace(0.0, 1.0, 2001)
+    ref = to_reference(d).simulate(1.0, times, max_step=2e-4)
+    df = d.simulate(1.0, rtol=1e-10, sample_times=times).to_dataframe()
+    span = float(np.ptp(ref.columns["J0.w_rad_s"]))
+    err = max(float(np.max(np.abs(df[c].to_numpy() - ref.columns[c]))) for c in ("J0.w_rad_s", "J1.w_rad_s"))
+    assert err <= 1e-6 * span, (err, span)
+    forward = (df["g0.mode_1"].to_numpy() == 1.0) & (df["J0.w_rad_s"].to_numpy() > 0.0)
+    assert forward.sum() > 20
+    w_a = df["J0.w_rad_s"].to_numpy()
+    acc = np.gradient(w_a, times)
+    k = np.flatnonzero(forward)[len(np.flatnonzero(forward)) // 4]   # (early in the phase: flange b drives)
+    e2 = eta + (0.5 - eta) * w_a[k] / 2.0
+    b2 = bf * (1.0 - w_a[k] / 2.0)
+    want = r * (sine.value_and_rate(times[k])[0] - r * b2) / (jb + r * r * ja / e2)   # (a_a = r a_b)
+    assert acc[k] == pytest.approx(want, rel=1e-4)

@@ -3851,6 +3851,8 @@ def _item_excess(t, p, tau, i, sticking):
             lim = external_value(p, p.elem[r, E_AUX], 2, t)
         thr = max(lim, noise)
         d = 1 if tq > 0.0 else -1
+        if thr == np.inf:   # (a one-way clutch loaded the way it locks: it holds any torque; (|tau| - inf)/inf
+            return -1.0, d  # was NaN, which every reader took as "holds" only because NaN >= 0 is False)
         return (abs(tq) - thr) / thr, d
     margin, width, d = gear_margin(p, r, -tau[r], _holds(p)[i - nf], noise)
     return -margin / width, d

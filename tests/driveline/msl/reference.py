@@ -782,7 +782,16 @@ class Network:
                     bfa = self._loss(el, o["w_a"])[4]
                     eta = o["tau"] - bfa if m == FWD else o["tau"] + bfa
                     q = modes[el.name + ".q"]
-                    if (eta >= 0) != (q > 0) and abs(eta) > scale(o["tau"]):
+                    tie = abs(eta) <= scale(o["tau"]) and abs(o["w_a"]) < eps
+                    if tie:
+                        # a tie as it leaves rest (tau_eta = 0 to rounding: startForward/startBackward's ">= 0" took
+                        # quadrant 1 or 4 whichever flange drives): the way tau_eta goes, LOOK later in this quadrant.
+                        # (A gear with tau_bf1 = tau_bf2, so tau_bf_a = 0, breaking away forward under a sine on flange
+                        # b from rest: tau_a is 0 there, the gear ran in quadrant 1, a driving, at 1.8 times the
+                        # acceleration of quadrant 2; the sixty-second session's random table networks)
+                        ta_later = later(el.name, "tau")
+                        eta = ta_later - bfa if m == FWD else ta_later + bfa
+                    if (eta >= 0) != (q > 0) and (abs(eta) > scale(o["tau"]) or (tie and eta != 0.0)):
                         modes[el.name + ".q"] = -q
                         change = ("quadrant", None)
                         break
