@@ -53,8 +53,11 @@ def solve(scen, clutch, bench, law, t_end=None, grid=(), rtol=1e-12):
         Profiles, drive (``motor``), initial speed and temperatures.
     clutch, bench : WetClutch, Bench
         Parameters (read field by field, as documented in ``docs/wet.md``).
-    law : ParametricFriction
-        mu_f = mu0 + mu_t (T - T_ref) + mu_e exp(-|v| / v_s), not below 0.
+    law : ParametricFriction or FrictionMap
+        mu_f = mu0 + mu_t (T - T_ref) + mu_e exp(-|v| / v_s), not below 0; or a two-dimensional friction map,
+        bilinear in (|v|, T) between its nodes and held beyond them, read here from its grids and values with
+        ``np.interp`` (not the package's kernel).  With a map, every segment also ends where ``|v|`` or ``T``
+        reaches a node (the map's slope jumps there), and the run goes on from it.
     t_end : float, optional
         End time [s] (default: the scenario's duration).
     grid : array_like
@@ -70,6 +73,12 @@ def solve(scen, clutch, bench, law, t_end=None, grid=(), rtol=1e-12):
         :data:`STATES` at ``grid``.
     """
     t_end = scen.duration if t_end is None else t_end
+    is_map = hasattr(law, "speed_grid")
+    if is_map:
+        gv, gt = np.asarray(law.speed_grid, float), np.asarray(law.temperature_grid, float)
+        vals = np.asarray(law.values, float)
+        if vals.ndim != 2 or getattr(law, "force_grid", None) is not None and np.size(law.force_grid) > 1:
+            raise ValueError("engagement_scipy: a two-dimensional friction map only")
     nc, sig, area, reff = clutch.n_c, clutch.sigma, clutch.friction_area, clutch.r_eff
     mu1, mu2, mu3, mu4 = clutch.viscosity
     coef = 4.0 / 3.0 * clutch.contact_modulus * clutch.asperity_density * math.sqrt(clutch.asperity_radius) * sig**1.5
@@ -92,7 +101,11 @@ def solve(scen, clutch, bench, law, t_end=None, grid=(), rtol=1e-12):
         fc = area * coef * _f32(s)                                                      # Greenwood-Williamson
         v = reff * w
         v_abs = mode * v if mode else abs(v)
-        muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-v_abs / law.v_s), 0.0)
+        if is_map:
+            row = [float(np.interp(v_abs, gv, vals[j])) for j in range(len(gt))]
+            muf = float(np.interp(temp, gt, row))
+        else:
+            muf = max(law.mu0 + law.mu_t * (temp - law.t_ref) + law.mu_e * math.exp(-v_abs / law.v_s), 0.0)
         cap = reff * nc * muf * fc                                                      # [1] Eq. 4
         if free_motor:
             td, dint = 0.0, 0.0
@@ -157,6 +170,15 @@ def solve(scen, clutch, bench, law, t_end=None, grid=(), rtol=1e-12):
             leave.direction, stop.direction, contact.direction, lock.direction, breakaway.direction = 1, -1, -1, -1, 1
             watched = [e for e, on in ((leave, at_stop), (stop, not at_stop), (contact, open_film),
                                        (lock, mode != 0), (breakaway, mode == 0)) if on]
+            nodes = []
+            if is_map and mode != 0:   # (a map's nodes while sliding; not the one the segment starts on)
+                for node in gv:
+                    if abs(abs(reff * y[W]) - node) > 1e-12 * (1.0 + node):
+                        nodes.append(lambda tt, yy, node=node: abs(reff * yy[W]) - node)
+                for node in gt:
+                    if abs(y[T] - node) > 1e-12 * (1.0 + abs(node)):
+                        nodes.append(lambda tt, yy, node=node: yy[T] - node)
+            watched = watched + nodes
             for e in watched:
                 e.terminal = True
             sol = solve_ivp(lambda tt, yy: terms(tt, yy, mode, at_stop)[0], (t, t_seg), y, method="DOP853",
@@ -170,6 +192,8 @@ def solve(scen, clutch, bench, law, t_end=None, grid=(), rtol=1e-12):
                 continue
             for ev, times in zip(watched, sol.t_events):
                 if not (len(times) and times[-1] == t):
+                    continue
+                if ev in nodes:   # (a node of the map: the segment ends there, nothing changes)
                     continue
                 if ev is leave:
                     at_stop = False

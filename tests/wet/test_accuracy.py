@@ -108,3 +108,35 @@ def test_a_piston_turning_at_its_speed_limit_follows_the_tolerance():
     loose, default, tight = (err[r][0] for r in RTOLS)
     assert tight < default / 3 < loose / 9, err
     assert err[DEFAULT][0] < BOUND["piston"] and err[DEFAULT][1] < BOUND["event"], err
+
+
+def _coarse_map():
+    """A coarse friction map sampled from the bench's law (six slip velocities from 0 to 12 m/s, four temperatures
+    from 20 to 140 degC; bilinear between them and held beyond, :class:`clutchlab.wet.friction.FrictionMap`): its
+    slope jumps at every node, as an identified map's does."""
+    from clutchlab.wet.friction import FrictionMap
+
+    gv = np.array([0.0, 0.5, 1.5, 3.0, 6.0, 12.0])
+    gt = np.array([20.0, 60.0, 100.0, 140.0])
+    return FrictionMap(gv, gt, np.array([[float(LAW.mu(v, t)) for v in gv] for t in gt]))
+
+
+@pytest.mark.parametrize("motor, bound_default, bound_tight", [("free", 2e-4, 1e-6), ("speed", 2e-5, 2e-7)])
+def test_an_engagement_on_a_friction_map_follows_the_tolerance(motor, bound_default, bound_tight):
+    """The engagement on a coarse friction map (:func:`_coarse_map`) against the independent solution, which reads
+    the map with ``np.interp`` and ends a segment at each node.  The slip speed's error [rad/s, of 157] at the default
+    rtol 1e-7 and at 1e-9, before (the sixty-second session, 29dc4e9) / now that a sliding clutch's switching function
+    ``friction_row`` passes zero at each node of its map (a waypoint): the dynamometer 1.9e-3 / 1.0e-4 and 1.0e-5 /
+    4.5e-7, the bench motor 3.7e-4 / 7.7e-6 and 7.2e-6 / 8.1e-8.  Before, the error at the default was that of rtol
+    1e-5 (1.8e-3 / 3.5e-4)."""
+    fmap = _coarse_map()
+    scen = EngagementProtocol().scenario(CLUTCH, motor)
+    grid = np.linspace(0.0, scen.duration, 1201)
+    ref_events, ref = ref_wet.solve(scen, CLUTCH, BENCH, fmap, grid=grid)
+    assert [n for _, n in ref_events] == ["leave", "contact", "lockup"]
+    err = {}
+    for rtol in (DEFAULT, 1e-9):
+        res = simulate_engagement(CLUTCH, scen, bench=BENCH, friction=fmap, rtol=rtol, sample_times=grid).result
+        assert list(res.events.event) == ["piston_leaves_stop", "contact", "lockup"], rtol
+        err[rtol] = float(np.max(np.abs(res["slip_speed_rad_s"] - ref[:, ref_wet.W])))
+    assert err[DEFAULT] < bound_default and err[1e-9] < bound_tight, err

@@ -209,7 +209,8 @@ def test_model_is_registered_and_describes_itself():
     assert isinstance(system, System) and system.name == "wet" and isinstance(system.params, W.WetParams)
     assert system.state_columns[:3] == ("piston_position_m", "actuator_force_N", "slip_speed_rad_s")
     assert [name for name, _ in system.switching] == ["lockup", "breakaway", "contact", "piston_leaves_stop",
-                                                      "piston_reaches_stop", "piston_runs", "piston_turns"]
+                                                      "piston_reaches_stop", "piston_runs", "piston_turns",
+                                                      "friction_row"]
     assert set(system.events) == {"contact", "separation", "lockup", "breakaway", "slip_reversal",
                                   "piston_reaches_stop", "piston_leaves_stop"}
     assert set(W.CONSTANTS_DTYPE.names) == {name for name, _, _ in W.CONSTANTS}

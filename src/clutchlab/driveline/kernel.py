@@ -37,7 +37,7 @@ from numba.core import types
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
 from ..numerics.core import record
-from ..numerics.interp import bracket, bracket_range
+from ..numerics.interp import bracket, bracket_range, grid_waypoint
 from ..numerics.layout import indices, slots
 from ..numerics.outline import log_type, outlined
 from ..numerics.rosenbrock import lu_factor, lu_solve
@@ -870,33 +870,6 @@ def engine_map(data, start, ns, nt, w, throttle):
     f10 = data[v0 + i1 * nt + j]
     f11 = data[v0 + i1 * nt + j1]
     return (1.0 - a) * ((1.0 - b) * f00 + b * f01) + a * ((1.0 - b) * f10 + b * f11)
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def grid_waypoint(data, start, n, s):
-    """The waypoint function [-] of a law read on the grid ``data[start:start + n]`` (increasing) at ``s``, linear
-    between its nodes and held beyond both ends, so that its slope jumps at every node: zero at each node and nowhere
-    else, of alternating sign from one piece to the next (:func:`row_waypoint` over a signed variable).  Piece ``k``
-    between nodes ``lo`` and ``hi``: ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; before the first node ``(c0 - s)/(c0 -
-    s + w)``, beyond the last ``(-1)^n (s - c)/(s - c + w)``, ``w`` the grid's width.  1 for a grid of one node (a
-    law constant in ``s``)."""
-    if n < 2:
-        return 1.0
-    first = data[start]
-    last = data[start + n - 1]
-    width = last - first
-    k = 0
-    while k < n and data[start + k] <= s:
-        k += 1
-    if k == 0:
-        v = (first - s) / ((first - s) + width)
-    elif k == n:
-        v = (s - last) / ((s - last) + width)
-    else:
-        lo = data[start + k - 1]
-        hi = data[start + k]
-        v = (s - lo) * (hi - s) / ((hi - lo) * (hi - lo))
-    return v if k % 2 == 0 else -v
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

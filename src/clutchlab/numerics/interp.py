@@ -50,3 +50,32 @@ def segment_range(grid, start, stop, x):
         else:
             hi = mid
     return lo
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def grid_waypoint(data, start, n, s):
+    """The waypoint function [-] of a law read on the grid ``data[start:start + n]`` (increasing) at ``s``, linear
+    between its nodes and held beyond both ends, so that its slope jumps at every node: zero at each node and nowhere
+    else, of alternating sign from one piece to the next (as a torque converter's corners,
+    :func:`clutchlab.driveline.kernel.converter_piece`).  Piece ``k`` between nodes ``lo`` and ``hi``:
+    ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; before the first node ``(c0 - s)/(c0 -
+    s + w)``, beyond the last ``(-1)^n (s - c)/(s - c + w)``, ``w`` the grid's width.  1 for a grid of one node (a
+    law constant in ``s``).  A waypoint switching function (direction 4): a step ends just past each node, so that the
+    error of a law read on a grid (a friction table or map, an engine map) follows the tolerance there."""
+    if n < 2:
+        return 1.0
+    first = data[start]
+    last = data[start + n - 1]
+    width = last - first
+    k = 0
+    while k < n and data[start + k] <= s:
+        k += 1
+    if k == 0:
+        v = (first - s) / ((first - s) + width)
+    elif k == n:
+        v = (s - last) / ((s - last) + width)
+    else:
+        lo = data[start + k - 1]
+        hi = data[start + k]
+        v = (s - lo) * (hi - s) / ((hi - lo) * (hi - lo))
+    return v if k % 2 == 0 else -v
