@@ -364,3 +364,21 @@ def test_every_value_in_a_declared_range_is_taken_by_the_component(spec):
         assert kind == "gear" and table["ratio"] == 0.0, (kind, table, exc)
         return
     net.system(1e-8)   # and it packs
+
+
+def test_each_kinds_layout_names_every_switching_function_of_the_kernel():
+    """The network's switching functions are named and given their directions from the kernel's declarations, one
+    entry per function the kernel writes (``FRICTION_LAYOUT`` beside ``FRICTION_SWITCHING``, and the gear's and the
+    engine's): a function added to one and not the other would shift every name after it."""
+    from clutchlab.driveline import kernel as K
+
+    for layout, functions in ((K.FRICTION_LAYOUT, K.FRICTION_SWITCHING), (K.GEAR_LAYOUT, K.GEAR_SWITCHING),
+                              (K.ENGINE_LAYOUT, K.ENGINE_SWITCHING)):
+        assert len(layout) == len(functions), (layout, functions)
+        assert all(d in (-3, -2, -1, 0, 1, 4) for _, d in layout)
+    d = (Driveline("names").inertia("J0", 1.0).inertia("J1", 1.0)
+         .clutch("c", "J0", "J1", fn_max=1.0).gear("g", "J0", "J1", 2.0, efficiency=0.9)
+         .engine("e", "J0", [[0.0, 10.0], [100.0, 20.0]]))
+    names = [n for n, _ in d.system(1e-8).switching]
+    assert names[:6] == ["c.stick", "c.breakaway", "c.normal", "c.turn", "c.near", "c.row"]
+    assert names[-7:] == ["g.stick", "g.quadrant", "g.turn", "g.piece", "e.speed_row", "e.throttle_row", "e.idle_clip"]

@@ -196,15 +196,21 @@ FRICTION_SWITCHING = ("stick", "break", "normal", "turn", "near", "row")
 G_STICK, G_BREAK, G_NORMAL, G_TURN, G_NEAR, G_ROW = indices(FRICTION_SWITCHING, "stick", "break", "normal", "turn",
                                                             "near", "row")
 N_G = len(FRICTION_SWITCHING)
+#: how a network's layout names each of them (``<element>.<name>``) and the way the core reads its crossing (-1/1:
+#: falling/rising, 0: either, -2: falling with a second look at a turning point's root, -3/4: a waypoint falling/either
+#: way), in the order of :data:`FRICTION_SWITCHING` (and so for :data:`GEAR_LAYOUT`, :data:`ENGINE_LAYOUT`)
+FRICTION_LAYOUT = (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3), ("row", 4))
 #: a lossy gear's: its stick or break-away function, its driving flange's, its turning point, and (stuck) the piece
 #: of its band (a waypoint where the torque it carries passes zero, its band's corner without bearing friction) or
 #: (rolling) of its loss table (a waypoint at each speed row, :func:`gear_row`)
 GEAR_SWITCHING = ("stick_or_break", "driving_flange", "turn", "piece")
 N_GEAR_G = len(GEAR_SWITCHING)
+GEAR_LAYOUT = (("stick", -2), ("quadrant", -1), ("turn", 1), ("piece", 4))
 #: an engine's, after the torque converters' (waypoints either way, :func:`engine_corners`): the corners of its map
 #: over its speed and over its throttle, and the edges of its idle controller's clip
 ENGINE_SWITCHING = ("speed_row", "throttle_row", "idle_clip")
 N_ENGINE_G = len(ENGINE_SWITCHING)
+ENGINE_LAYOUT = tuple((name, 4) for name in ENGINE_SWITCHING)
 GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends), the turning
 #: points of a backlash's deflection in its gap or of its contact's torque near separation (G_LASH_TURN), and in

@@ -2671,9 +2671,7 @@ class Driveline:
         x0 = self.initial_state()
         states, outputs = self.variables()
         fric = self.friction_names
-        switching = tuple((f"{f}.{what}", d) for f in fric
-                          for what, d in (("stick", -2), ("breakaway", -2), ("normal", 0), ("turn", 1), ("near", -3),
-                                          ("row", 4)))
+        switching = tuple((f"{f}.{what}", d) for f in fric for what, d in K.FRICTION_LAYOUT)
         swit = [self._elements[r] for r in p.swit]
         # (a switched spring's edges fall through zero; a backlash's get the core's second look at the root of its
         # turning point (rising: in the gap towards the nearer edge, in contact the contact torque's minimum near
@@ -2685,13 +2683,12 @@ class Driveline:
                                            (("segment_below", -1), ("segment_above", -1), ("turn", -1),
                                             ("near", -3))))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
-        switching += tuple((f"{e.name}.{what}", d) for e in self._lossy
-                           for what, d in (("stick", -2), ("quadrant", -1), ("turn", 1), ("piece", 4)))
+        switching += tuple((f"{e.name}.{what}", d) for e in self._lossy for what, d in K.GEAR_LAYOUT)
         # a torque converter's corners (kernel.converter_piece: a waypoint either way, in element order)
         switching += tuple((f"{e.name}.piece", 4) for e in self._elements if e.kind == K.K_CONVERTER)
         # an engine's corners (kernel.engine_corners: its map's speed and throttle nodes, its idle clip's edges)
-        switching += tuple((f"{e.name}.{what}", 4) for e in self._elements
-                           if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE for what in K.ENGINE_SWITCHING)
+        switching += tuple((f"{e.name}.{what}", d) for e in self._elements
+                           if e.kind == K.K_SOURCE and e.law == K.SOURCE_ENGINE for what, d in K.ENGINE_LAYOUT)
         mode_names = named
         swit_values = tuple((K.LASH_MSL_VALUES if e.aux == K.LASH_MSL else K.LASH_KV_VALUES)
                             if e.law == K.SPRING_BACKLASH else tuple(f"segment {i}" for i in range(len(e.table) // 4 + 1)) for e in swit)

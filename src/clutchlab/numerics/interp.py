@@ -58,9 +58,8 @@ def grid_waypoint(data, start, n, s):
     between its nodes and held beyond both ends, so that its slope jumps at every node: zero at each node and nowhere
     else, of alternating sign from one piece to the next (as a torque converter's corners,
     :func:`clutchlab.driveline.kernel.converter_piece`).  Piece ``k`` between nodes ``lo`` and ``hi``:
-    ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; before the first node ``(c0 - s)/(c0 -
-    s + w)``, beyond the last ``(-1)^n (s - c)/(s - c + w)``, ``w`` the grid's width.  1 for a grid of one node (a
-    law constant in ``s``).  A waypoint switching function (direction 4): a step ends just past each node, so that the
+    ``(-1)^k (s - lo)(hi - s)/(hi - lo)^2``; before the first node ``(c0 - s)/(c0 - s + w)``, beyond the last
+    ``(-1)^n (s - c)/(s - c + w)``, ``w`` the grid's width.  1 for a grid of one node (a law constant in ``s``).  A waypoint switching function (direction 4): a step ends just past each node, so that the
     error of a law read on a grid (a friction table or map, an engine map) follows the tolerance there."""
     if n < 2:
         return 1.0
