@@ -4612,7 +4612,7 @@ def settle(t, x, m, p, log, old, origin):
                 ex1 = _item_excess(t + T_TIE, p, tau, i, False)[0]
                 if i < nf and ex1 >= 0.0 and _past_limit(t + T_TIE, p, tau, i)[0] <= 0.0:
                     ex1 = -1e-300   # (exactly on its limit there: it holds, as the tie-break reads it)
-                ok = not ex1 >= 0.0   # (as marked: a one-way clutch the locking way has no excess, NaN)
+                ok = not ex1 >= 0.0   # (as marked: the test the tie-break marks with)
                 _put_back(p, again)
             if not ok:
                 for k in range(m.shape[0]):
