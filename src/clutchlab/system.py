@@ -139,7 +139,9 @@ class System:
         the core looks at again at the earliest root of a step (a dip through zero and back before it is located);
         +-3: a waypoint, the same direction, whose crossing asks only for a step end just past it (no event: the
         Dormand-Prince step is taken again to 1 % past its root; the driveline's stuck elements coming near their
-        limits); 4: a waypoint either way (the EMTC's coil current crossing a Preisach grid line, or turning).
+        limits); 4: a waypoint either way (the EMTC's coil current crossing a Preisach grid line, or turning); 5: a
+        waypoint either way located even where an event function crosses later in the step (a backlash's gap centre,
+        where its turning-point function changes its meaning: :data:`clutchlab.numerics.core.WAYPOINT_ALWAYS`).
     events : tuple of str
         Event names by code (what the hooks record).
     mode_names : tuple of str

@@ -237,3 +237,38 @@ def test_an_undamped_rattle_follows_the_tolerance_against_its_independent_soluti
     assert max(event[2:]) < 1e-6 and speed[1] < 2e-3, (speed, event)
     default = d.simulate(1.0, output_step=2e-3).to_dataframe()["J1.w_rad_s"].to_numpy()
     assert np.max(np.abs(default - w_ref)) / span < 2e-3
+
+
+def test_a_backlash_touch_beyond_the_gap_s_centre_is_found_at_every_tolerance():
+    """Random draws seed 2137 (issue #30): a damped backlash between a free inertia (-2 rad/s) and one on a bearing
+    and a brake.  After the first contact the twist crosses the gap towards its lower edge, touches it for 12 ms
+    (0.3802727 s to 0.3994713 s, the reference engine's solution by mode) and turns back.  At rtol 1e-10 the step
+    from 0.253 s ran to the bearing's stick at 0.4927 s: across the gap's centre, where the turning-point function
+    changes its edge and falls, and the extreme beyond, where it rises, its ends of one sign, so the contact was
+    stepped over and the run went on 5.1e-4 rad/s off (1e-3 of the speeds' range, found by the tolerance property
+    as an error that did not shrink with the tolerance).  The gap's centre is now a waypoint that no later event
+    skips (``numerics.core.WAYPOINT_ALWAYS``): at every tolerance the contact is found, the events are the
+    reference's (within 1e-6 s from rtol 1e-8; 1.2e-6 s at 1e-7) and the speeds follow the tolerance against it
+    (7.8e-7 rad/s at rtol 1e-7 to 6.2e-11 at 1e-11).  It fails on the code before (rtol 1e-10)."""
+    from clutchlab.driveline import Driveline, Signal
+
+    from .msl.translate import to_reference
+
+    d = Driveline("random")
+    d.inertia("J0", J=1.0, w0=-2.0).inertia("J1", J=0.4375)
+    d.backlash("k0", "J0", "J1", c=102.0, b_gap=0.09375, d=1.5)
+    d.bearing_friction("bearing", "J1", torque=2.5)
+    d.brake("brake", "J1", fn_max=1.0, mu=0.4, normal=Signal.step(1.0, 0.125))
+    grid = np.linspace(0.0, 1.0, 501)
+    ref = to_reference(d, strict=False).simulate(1.0, grid, rtol=1e-12, atol=1e-12)
+    contacts = [t for t, element, mode in ref.events if element == "k0" and mode in ("upper", "lower")]
+    assert len(contacts) == 3 and abs(contacts[1] - 0.3802727) < 1e-6
+    errors = []
+    for rtol in (1e-7, 1e-8, 1e-9, 1e-10, 1e-11):
+        res = d.simulate(1.0, rtol=rtol, sample_times=grid)
+        ours = res.events.time_s[(res.events.element == "k0") & (res.events.event == "contact")].to_numpy()
+        assert ours.size == 3 and np.max(np.abs(ours - contacts)) < (1e-5 if rtol > 1e-8 else 1e-6), (rtol, ours)
+        f = res.to_dataframe()
+        errors.append(max(np.max(np.abs(f[c].to_numpy() - ref.columns[c])) for c in ("J0.w_rad_s", "J1.w_rad_s")))
+    assert all(b < a / 5.0 for a, b in zip(errors, errors[1:])), errors
+    assert errors[3] < 1e-8, errors

@@ -29,6 +29,7 @@ NOT_INDICES = {
     "SPACE_SLOTS": "a capacity: the stuck-set repair's warm starts kept",
     "TERMINAL": "a code a model's update returns (0 is go on, negative an error)",
     "RESTART": "a code a model's update returns",
+    "WAYPOINT_ALWAYS": "a switching function's crossing direction (the core's codes: +-1, +-2, +-3, 4, 5)",
     "ADVANCE": "a bit of a session call's request",
     "OUTPUTS": "a bit of a session call's request",
     "ALGEBRAIC_FAILED": "a model error code of the model exchange",

@@ -214,7 +214,8 @@ ENGINE_LAYOUT = tuple((name, 4) for name in ENGINE_SWITCHING)
 GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break", "driving_flange", "turn", "piece")
 #: switching functions per switched spring (backlash, curve spring): its two edges (or segment ends), the turning
 #: points of a backlash's deflection in its gap or of its contact's torque near separation (G_LASH_TURN), and in
-#: contact the contact's torque less :data:`NEAR_SEPARATION` of the torques on its flanges (G_LASH_NEAR, a waypoint)
+#: contact the contact's torque less :data:`NEAR_SEPARATION` of the torques on its flanges (G_LASH_NEAR, a waypoint;
+#: in the gap, the deflection from the gap's centre: a waypoint there, either way)
 SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn", "near")
 N_SW = len(SPRING_SWITCHING)
 G_LASH_TURN, G_LASH_NEAR = indices(SPRING_SWITCHING, "turn", "near")
@@ -4870,7 +4871,8 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     rounding width (rising through zero just past an extreme: a step ends there, and the edges' functions get the
     core's second look, so a touch of an edge within a step is found), in contact near separation the contact
     torque's turning point; fourth, in contact, the waypoint of its torque coming near separation
-    (:func:`_lash_near`).  A curve spring: the deflection above the segment's lower point and below its upper one
+    (:func:`_lash_near`), in the gap the waypoint of its centre, where the third changes its edge (both located
+    even where a later event ends the step: :data:`clutchlab.numerics.core.WAYPOINT_ALWAYS`).  A curve spring: the deflection above the segment's lower point and below its upper one
     (either falling through zero moves it to the next segment), third and fourth unused.  Then
     four per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
@@ -4979,6 +4981,11 @@ def driveline_rhs(t, x, u, m, p, dx, g):
             w_rel = _speed(x, n, p.elem[r, E_B]) - _speed(x, n, p.elem[r, E_A])
             wt = _item_wtol(p, r, x, n)
             g[q + G_LASH_TURN] = -w_rel - wt if phi > 0.0 else w_rel - wt
+            # where the deflection passes the gap's centre that function jumps (the nearer edge changes), so a step
+            # across the centre and the extreme beyond it sees it fall and rise again, its ends of one sign: the
+            # centre is a waypoint either way, located even where a later event ends the step
+            # (numerics.core.WAYPOINT_ALWAYS; issue #30, random draws seed 2137)
+            g[q + G_LASH_NEAR] = phi
         elif mode == LASH_UPPER or mode == LASH_LOWER:
             # in contact near separation: a waypoint as the contact's torque comes near zero, and inside that band
             # the turning point of that torque, so that a dip through zero shorter than a step is found

@@ -2676,9 +2676,10 @@ class Driveline:
         # (a switched spring's edges fall through zero; a backlash's get the core's second look at the root of its
         # turning point (rising: in the gap towards the nearer edge, in contact the contact torque's minimum near
         # separation), direction -2: a touch of an edge or a separation within a step is located; its contact coming
-        # near separation is a waypoint, -3)
+        # near separation, and in the gap its centre, are waypoints either way located even where a later event ends
+        # the step, 5: numerics.core.WAYPOINT_ALWAYS)
         switching += tuple((f"{e.name}.{side}", d) for e in swit
-                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 1), ("near", -3))
+                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 1), ("near", 5))
                                            if e.law == K.SPRING_BACKLASH else
                                            (("segment_below", -1), ("segment_above", -1), ("turn", -1),
                                             ("near", -3))))
