@@ -3070,3 +3070,27 @@ def test_a_break_away_just_before_a_lift_off_is_not_stepped_over():
     tau, fn = abs(float(frame["x1.tau_Nm"].iloc[-1])), float(frame["x1.fn_N"].iloc[-1])
     capacity = 0.27 * 0.2052 * fn
     assert tau <= capacity and capacity - tau < 1e-3 * capacity, (tau, capacity)
+
+
+@pytest.mark.parametrize("w0", [5e-10, 1e-9, 1.001e-9])
+def test_a_clutch_engaging_from_zero_force_between_sides_a_rounding_apart_sticks_and_dissipates(w0):
+    """Random draws seed 2146 (sixty-third session), the energy property: a clutch whose normal force rises from zero
+    (a sine) between J1, on a damper to J0, and J2, turning at ``w0`` rad/s, within the clutch's rounding width of
+    J1 (1e-9 rad/s).  The start put the clutch at rest (its sides' speeds projected to one, 5e-10 rad/s) and released
+    it ``forward`` (its capacity is zero at t = 0); its stick function kept the slack of a motion it never had and
+    started on zero, so when its own friction torque, growing with the force, drove the slip backward no crossing
+    showed: it slid ``forward`` at a backward slip for 0.5 s, accelerating both sides apart and dissipating -0.024 J
+    (``check_invariants`` named it).  Released by the search, it now starts from rest as one its own crossing put
+    stuck does (``kernel.settle``'s slack): it sticks 17.8 us after the start, as it does from 1.001e-9 rad/s,
+    just outside the rounding width, where the search never saw it.  It fails on the code before."""
+    d = Driveline("random")
+    d.inertia("J0", J=1.0).inertia("J1", J=1.0).inertia("J2", J=1.0, w0=w0)
+    d.spring_damper("k0", "J0", "J1", c=0.0, d=1.0)
+    d.clutch("c1", "J1", "J2", fn_max=1.0, mu=0.5, peak=1.0, normal=Signal.sine(1.0, 1.0))
+    res = d.simulate(1.0, output_step=5e-3, rtol=1e-9, check_invariants=True)
+    f = res.to_dataframe()
+    assert np.all(np.diff(f["c1.dissipated_J"].to_numpy()) >= -1e-15)
+    ev = list(zip(res.events.time_s, res.events.event))
+    assert ev[0][1] == "stick" and 1.7e-5 < ev[0][0] < 1.9e-5, ev
+    assert [e for _t, e in ev] == ["stick", "forward", "free"] and abs(ev[2][0] - 0.5) < 1e-9, ev
+    assert f.filter(like=".w_rad_s").abs().max().max() < 1e-8   # (a rounding of rest: nothing drives the network)

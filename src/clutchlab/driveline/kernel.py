@@ -4339,6 +4339,9 @@ def settle(t, x, m, p, log, old, origin):
             w_tol = _item_wtol(p, r, x, n)
             m[k] = FORWARD if w_rel > w_tol else BACKWARD if w_rel < -w_tol else STUCK
     ni = nf + nl
+    # (the items this search put at rest, in any pass: their speeds were put to rest with the stuck ones', so one it
+    # released starts from rest, as one its own crossing put stuck does: the slack below)
+    searched = np.zeros(ni, dtype=np.bool_)
     comp = np.empty(n, dtype=np.int64)
     _components(p, comp)
     reach = np.empty(n, dtype=np.bool_)
@@ -4365,6 +4368,7 @@ def settle(t, x, m, p, log, old, origin):
             if _item_stuck(p, m, i) or _item_passed_rest(p, m, x, n, i, acc) or \
                     abs(_item_speed(p, x, n, i)) <= _item_wtol(p, _item_row(p, i), x, n):
                 cand[nc] = i
+                searched[i] = True
                 nc += 1
                 _item_set(p, m, i, _ZERO)
         forced = np.zeros(ni, dtype=np.int64)
@@ -4670,8 +4674,14 @@ def settle(t, x, m, p, log, old, origin):
     # the wrong way, which the slack covers.  Without it, a lossy gear whose speed reached zero as a group broke away
     # rolled on "backward" with its stick function below zero from the start, so its forward motion was never seen
     # (0.46 ms, random draws seed 2072, fifty-eighth session))
+    # An item the search put at rest and released the way it slid before (no event: the same mode) starts from rest
+    # too: its speed was put to rest with the stuck set's, so its stick function, left at the slack of its earlier
+    # motion, started on zero and the motion the wrong way that followed was no crossing.  Random draws seed 2146 (the
+    # sixty-third session): a clutch whose normal force rises from zero at the start, its sides 1e-9 rad/s apart
+    # (within its rounding width), put at rest and released ``forward`` (its capacity zero at the instant), slid on
+    # ``forward`` while its slip ran backward under its own growing friction torque for 0.5 s, dissipating -0.024 J.
     for k in range(nf):
-        released = m[k] != STUCK and m[k] != FREE and entry[k] == STUCK
+        released = m[k] != STUCK and m[k] != FREE and (entry[k] == STUCK or searched[k])
         if m[k] != old[k] or released:
             w_rel = _item_speed(p, x, n, k)
             w_tol = _item_wtol(p, p.fric[k], x, n)
@@ -4683,7 +4693,7 @@ def settle(t, x, m, p, log, old, origin):
     for j in range(nl):
         mi = p.elem[p.lossy[j], E_MODE]
         new, was = m[mi], old[mi]
-        if new != GEAR_STUCK and entry[mi] == GEAR_STUCK and GEAR_CODES[new] == GEAR_CODES[was]:
+        if new != GEAR_STUCK and (entry[mi] == GEAR_STUCK or searched[nf + j]) and GEAR_CODES[new] == GEAR_CODES[was]:
             slack[nf + j] = _start_slack(_item_speed(p, x, n, nf + j), _item_wtol(p, p.lossy[j], x, n),
                                          GEAR_CODES[new], True)
         if new == was:
@@ -4693,7 +4703,7 @@ def settle(t, x, m, p, log, old, origin):
             ev = EV_STICK if new == GEAR_STUCK else (EV_FORWARD if GEAR_CODES[new] > 0 else EV_BACKWARD)
             w_a = _item_speed(p, x, n, nf + j)
             w_tol = _item_wtol(p, p.lossy[j], x, n)
-            slack[nf + j] = _start_slack(w_a, w_tol, GEAR_CODES[new], was == GEAR_STUCK)
+            slack[nf + j] = _start_slack(w_a, w_tol, GEAR_CODES[new], was == GEAR_STUCK or searched[nf + j])
         else:
             ev = EV_DRIVE_A if new == GEAR_FWD_A or new == GEAR_BWD_A else EV_DRIVE_B
         record(log, t, ev, nf + nsw + j)
