@@ -4882,8 +4882,9 @@ def driveline_rhs(t, x, u, m, p, dx, g):
     core's second look, so a touch of an edge within a step is found), in contact near separation the contact
     torque's turning point; fourth, in contact, the waypoint of its torque coming near separation
     (:func:`_lash_near`), in the gap the waypoint of its centre, where the third changes its edge (both located
-    even where a later event ends the step: :data:`clutchlab.numerics.core.WAYPOINT_ALWAYS`).  A curve spring: the deflection above the segment's lower point and below its upper one
-    (either falling through zero moves it to the next segment), third and fourth unused.  Then
+    even where a later event ends the step: :data:`clutchlab.numerics.core.WAYPOINT_ALWAYS`).  A curve spring: the
+    deflection above the segment's lower point and below its upper one (either falling through zero moves it to
+    the next segment), third and fourth unused.  Then
     four per lossy gear: stuck, the margin of the loss torque it holds within its band (:func:`gear_band`; falls
     through zero: it rolls); rolling, its speed in its direction (falls through zero: it sticks or reverses) and
     ``+-tau_eta`` (falls through zero: the other flange drives); the turning point of a slow rolling speed; stuck,

@@ -217,8 +217,8 @@ WAYPOINT_ALWAYS = 5
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _crossed(a, b, d):
-    """True if a switching value went from ``a`` to ``b`` through zero in direction ``d`` (4: a waypoint either
-    way)."""
+    """True if a switching value went from ``a`` to ``b`` through zero in direction ``d`` (4 and
+    :data:`WAYPOINT_ALWAYS`: waypoints either way)."""
     if d == 4 or d == WAYPOINT_ALWAYS:
         d = 0
     if d >= 0 and a < 0.0 and b >= 0.0:
