@@ -373,12 +373,18 @@ def test_each_kinds_layout_names_every_switching_function_of_the_kernel():
     from clutchlab.driveline import kernel as K
 
     for layout, functions in ((K.FRICTION_LAYOUT, K.FRICTION_SWITCHING), (K.GEAR_LAYOUT, K.GEAR_SWITCHING),
-                              (K.ENGINE_LAYOUT, K.ENGINE_SWITCHING)):
+                              (K.ENGINE_LAYOUT, K.ENGINE_SWITCHING), (K.BACKLASH_LAYOUT, K.SPRING_SWITCHING),
+                              (K.CURVE_LAYOUT, K.SPRING_SWITCHING)):
         assert len(layout) == len(functions), (layout, functions)
-        assert all(d in (-3, -2, -1, 0, 1, 4) for _, d in layout)
+        assert all(d in (-3, -2, -1, 0, 1, 4, 5) for _, d in layout)
     d = (Driveline("names").inertia("J0", 1.0).inertia("J1", 1.0)
          .clutch("c", "J0", "J1", fn_max=1.0).gear("g", "J0", "J1", 2.0, efficiency=0.9)
          .engine("e", "J0", [[0.0, 10.0], [100.0, 20.0]]))
     names = [n for n, _ in d.system(1e-8).switching]
     assert names[:6] == ["c.stick", "c.breakaway", "c.normal", "c.turn", "c.near", "c.row"]
     assert names[-7:] == ["g.stick", "g.quadrant", "g.turn", "g.piece", "e.speed_row", "e.throttle_row", "e.idle_clip"]
+    springs = (Driveline("springs").inertia("J0", 1.0).inertia("J1", 1.0).inertia("J2", 1.0)
+               .backlash("k", "J0", "J1", c=10.0, b_gap=0.1).spring("s", "J1", "J2", [[-1.0, -2.0], [0.0, 0.0], [1.0, 3.0]]))
+    assert springs.system(1e-8).switching == (
+        ("k.gap_upper", -2), ("k.gap_lower", -2), ("k.turn", 1), ("k.near", 5),
+        ("s.segment_below", -1), ("s.segment_above", -1), ("s.turn", -1), ("s.near", -3))

@@ -809,21 +809,23 @@ def _floor_labels(ev, frame, d, other=None):
     element so: the two lists are filtered alike where a torque lies at the threshold."""
     info = {e.name: e for e in d.elements}
 
-    def at_rest(frame, t, el):
-        tt = frame["time_s"].to_numpy()
+    def scaled(f):   # (a run's samples, its times, its largest torque and speed: each at least 1)
+        return (f, f["time_s"].to_numpy(), max(1.0, f.filter(like=".tau_Nm").abs().max().max()),
+                max(1.0, f.filter(like=".w_rad_s").abs().max().max()))
+
+    def at_rest(run, t, el):
+        f, tt, tau_scale, w_scale = run
         after = tt > t + 1e-9
         e = info.get(el)
         if e is None or not after.any():
             return False
-        tau_scale = max(1.0, frame.filter(like=".tau_Nm").abs().max().max())
-        w_scale = max(1.0, frame.filter(like=".w_rad_s").abs().max().max())
         k = int(np.flatnonzero(after)[0])
         flanges = [q for q in (e.flange_a, e.flange_b, e.support) if q and q != GROUND]
         columns = [(f"{el}.tau_Nm", tau_scale)] + [(f"{q}.w_rad_s", w_scale) for q in flanges]
-        return all(c in frame.columns and abs(frame[c].iloc[k]) <= FLOOR * scale for c, scale in columns)
+        return all(c in f.columns and abs(f[c].iloc[k]) <= FLOOR * scale for c, scale in columns)
 
-    return [(t, el, label) for t, el, label in ev
-            if not (at_rest(frame, t, el) or (other is not None and at_rest(other, t, el)))]
+    runs = [scaled(x) for x in (frame, other) if x is not None]
+    return [(t, el, label) for t, el, label in ev if not any(at_rest(run, t, el) for run in runs)]
 
 
 @settings(max_examples=examples(25), deadline=None)

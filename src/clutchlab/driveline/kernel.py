@@ -36,7 +36,7 @@ from numba.core import types
 
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, borrow, shaped
-from ..numerics.core import record
+from ..numerics.core import WAYPOINT_ALWAYS, record
 from ..numerics.interp import bracket, bracket_range, grid_waypoint
 from ..numerics.layout import indices, slots
 from ..numerics.outline import log_type, outlined
@@ -218,6 +218,13 @@ GG_BREAK, GG_FLANGE, GG_TURN, GG_PIECE = indices(GEAR_SWITCHING, "stick_or_break
 #: in the gap, the deflection from the gap's centre: a waypoint there, either way)
 SPRING_SWITCHING = ("upper_edge", "lower_edge", "turn", "near")
 N_SW = len(SPRING_SWITCHING)
+#: their names and directions, by the spring's law: a backlash's edges fall through zero and get the core's second
+#: look at the root of its turning point (rising: in the gap towards the nearer edge, in contact the contact torque's
+#: minimum near separation), -2, so a touch of an edge or a separation within a step is located; its contact coming
+#: near separation, and in the gap its centre, are waypoints either way that a later event does not skip
+#: (WAYPOINT_ALWAYS).  A curve spring's segment ends fall through zero; its third and fourth are unused
+BACKLASH_LAYOUT = (("gap_upper", -2), ("gap_lower", -2), ("turn", 1), ("near", WAYPOINT_ALWAYS))
+CURVE_LAYOUT = (("segment_below", -1), ("segment_above", -1), ("turn", -1), ("near", -3))
 G_LASH_TURN, G_LASH_NEAR = indices(SPRING_SWITCHING, "turn", "near")
 # A sliding element's (and a rolling lossy gear's) turning function is its relative acceleration towards its
 # sliding direction at every speed (G_TURN, GG_TURN; rising through zero: a minimum of its speed), so that a dip

@@ -2673,16 +2673,9 @@ class Driveline:
         fric = self.friction_names
         switching = tuple((f"{f}.{what}", d) for f in fric for what, d in K.FRICTION_LAYOUT)
         swit = [self._elements[r] for r in p.swit]
-        # (a switched spring's edges fall through zero; a backlash's get the core's second look at the root of its
-        # turning point (rising: in the gap towards the nearer edge, in contact the contact torque's minimum near
-        # separation), direction -2: a touch of an edge or a separation within a step is located; its contact coming
-        # near separation, and in the gap its centre, are waypoints either way located even where a later event ends
-        # the step, 5: numerics.core.WAYPOINT_ALWAYS)
+        # (a switched spring's, by its law: kernel.BACKLASH_LAYOUT, kernel.CURVE_LAYOUT)
         switching += tuple((f"{e.name}.{side}", d) for e in swit
-                           for side, d in ((("gap_upper", -2), ("gap_lower", -2), ("turn", 1), ("near", 5))
-                                           if e.law == K.SPRING_BACKLASH else
-                                           (("segment_below", -1), ("segment_above", -1), ("turn", -1),
-                                            ("near", -3))))
+                           for side, d in (K.BACKLASH_LAYOUT if e.law == K.SPRING_BACKLASH else K.CURVE_LAYOUT))
         named = fric + tuple(e.name for e in swit) + tuple(e.name for e in self._lossy)
         switching += tuple((f"{e.name}.{what}", d) for e in self._lossy for what, d in K.GEAR_LAYOUT)
         # a torque converter's corners (kernel.converter_piece: a waypoint either way, in element order)
