@@ -801,9 +801,11 @@ def simulate(system: System, t_end: float, *, rtol: float | None = None, atol=No
     x = system.x0.copy()
     m = system.m0.copy()
     u = system.u0.copy()
-    sf, si = core.new_solver_state(float(t0))
     log = core.new_log(EVENT_CAPACITY)
     advance = core.advance_rodas if system.method == "rodas" or opt.fixed_step > 0.0 else core.advance_dopri
+    # (a record of every step may be resumed in new buffers: room for Rodas3 to keep its Jacobian across them,
+    # core.RESUME_NOTE)
+    sf, si = core.new_solver_state(float(t0), nx if ts is None and advance is core.advance_rodas else 0)
     if ts is not None:
         check_allocation(ts.size, nx + ny + nm + 1, f"{ts.size} samples of {system.name}")
         # every recorded row is written whole (time, states, modes and, if asked, outputs)

@@ -91,6 +91,12 @@ __all__ = ["Options", "EventLog", "new_log", "record", "new_solver_state", "adva
 SOLVER_FLOATS = ("time", "step", "start")
 SF_T, SF_H, SF_T0 = indices(SOLVER_FLOATS, "time", "step", "start")
 N_SF = len(SOLVER_FLOATS)
+#: what Rodas3 keeps after them for a record resumed in a new buffer (``RECORD_FULL``, :data:`RESUME_NOTE`), where the
+#: caller made room (:func:`new_solver_state` with ``n``): the age of its Jacobian in accepted steps, whether it is
+#: stale (1.0) or not (0.0), then the Jacobian itself, ``n * n`` numbers row by row
+RODAS_KEPT = ("jacobian_age", "jacobian_stale")
+SK_AGE, SK_STALE = indices(RODAS_KEPT, "jacobian_age", "jacobian_stale")
+N_SK = len(RODAS_KEPT)
 #: its integers: steps accepted and rejected, right-hand sides and Jacobians evaluated, the status, the next row of
 #: the record, whether the run has started, the model's error code
 SOLVER_INTS = ("accepted", "rejected", "rhs_evaluations", "jacobians", "status", "record_row", "started",
@@ -180,9 +186,11 @@ def new_log(capacity: int) -> EventLog:
     return EventLog(np.empty(capacity), ints[:capacity], ints[capacity:], np.zeros(2, dtype=np.int64))
 
 
-def new_solver_state(t0: float):
-    """Solver state ``(sf, si)`` of a run that starts at ``t0``."""
-    sf = np.zeros(N_SF)
+def new_solver_state(t0: float, n: int = 0):
+    """Solver state ``(sf, si)`` of a run that starts at ``t0``.  ``n`` > 0: room after the floats for Rodas3 to keep
+    the Jacobian of a model of ``n`` states across a record resumed in a new buffer (:data:`RODAS_KEPT`,
+    :data:`RESUME_NOTE`); a Dormand-Prince run ignores it."""
+    sf = np.zeros(N_SF + (N_SK + n * n if n > 0 else 0))
     sf[SF_T] = t0
     return sf, np.zeros(N_SI, dtype=np.int64)
 
@@ -735,10 +743,13 @@ def _clip_step(h, t, t_stop, max_step):
 #: record now goes on as one call would (a call ends with ``RECORD_FULL`` only after the break at its last instant,
 #: if there is one, is taken: a resumption at a break skipped it, the sixtieth session's seed 2090, a brake applied
 #: at 0.5 s left free until the next break at 0.75 s): with Dormand-Prince to the last bit (its first stage is the same
-#: evaluation at the same point); Rodas3 still evaluates its Jacobian anew there, as at the start of any call, where
-#: one call might have reused the step before's (``Options.jac_every``): a difference within its error control, not
-#: a decision of the model (``ClutchDynamics(ClutchModel.preset(0))`` under issue #30's 0-8-0 mm profile, 847 steps
-#: and one resumption at its rtol 1e-5: 1.2e-7 J of its 9.8 J input work and 1e-10 m/s from its sampled run).
+#: evaluation at the same point), and with Rodas3 where the solver state has room for its Jacobian
+#: (:data:`RODAS_KEPT`; ``simulate`` makes it): the resumed call takes up the Jacobian, its age and staleness where the
+#: call before left them (``Options.jac_every``) and factors the iteration matrix again from it, which gives the
+#: same numbers as the one call's reuse.  Without that room it evaluated its Jacobian anew at every resumption, as at
+#: the start of any call: ``ClutchDynamics(ClutchModel.preset(0))`` under issue #30's 0-8-0 mm profile (847 steps,
+#: one resumption, its rtol 1e-5) took 218 Jacobians against 217 sampled and ended 1.2e-7 J of its 9.8 J input work
+#: and 1e-10 m/s from its sampled run (the sixty-fourth session; now the same to the last bit).
 RESUME_NOTE = "a record resumed after RECORD_FULL goes on as one run: no restart"
 
 
@@ -1256,6 +1267,17 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     h_fact = 0.0  # the step size of the factored iteration matrix (0: none)
     hf = opt.fixed_step
     fixed = hf > 0.0
+    # a record resumed in a new buffer takes up the Jacobian where the call before left it (RESUME_NOTE), where the
+    # solver state has room for it; the iteration matrix is factored again from it (h_fact 0): the same numbers
+    kept = sf.shape[0] >= N_SF + N_SK + n * n
+    if kept and si[SI_STATUS] == RECORD_FULL:
+        jac_age = np.int64(sf[N_SF + SK_AGE])
+        jac_stale = sf[N_SF + SK_STALE] != 0.0
+        o = N_SF + N_SK
+        for i in range(n):
+            for j in range(n):
+                J[i, j] = sf[o + i * n + j]
+        plan_reduction(J, mass, iw)
     while t < t_end:
         if fixed:
             status = _run_limit(si, opt, grid, cap, i_rec)   # (its breaks are taken within its steps)
@@ -1439,6 +1461,13 @@ def _advance_rodas(p, x, m, u, t_end, sf, si, opt, log, ts, rec_t, rec_x, rec_m,
     if grid and status == SUCCESS:  # samples at the end time itself (rounding) hold the final state
         i_rec = _record_held(p, t, min(t_end * (1.0 + 1e-12), t + 1e-9), x, u, m, ts, rec_t, rec_x, rec_m, rec_y,
                              want_y, i_rec)
+    if kept and status == RECORD_FULL:   # (for the call that resumes the record: above)
+        sf[N_SF + SK_AGE] = jac_age
+        sf[N_SF + SK_STALE] = 1.0 if jac_stale else 0.0
+        o = N_SF + N_SK
+        for i in range(n):
+            for j in range(n):
+                sf[o + i * n + j] = J[i, j]
     return _save_state(sf, si, t, h, i_rec, status, owners)
 
 
