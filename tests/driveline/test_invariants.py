@@ -1370,6 +1370,128 @@ def test_of_two_one_way_clutches_in_series_from_rest_only_the_driven_one_overrun
     same_without_the_unrelated(network(True))
 
 
+def _gear_at_rest_beside_a_bearing_whose_load_passes_zero(with_unrelated=True):
+    """Random draws seed 2106 (fifty-ninth session): J0 on a 1 N m bearing, a self-locking gear g0 (ratio -1,
+    efficiency 0.75, no bearing friction: its band closes at zero load) to J1, a torque converter to J2, a lossy
+    gear g2 to J3, a 2 N m sine on J3, everything from rest."""
+    d = Driveline("random")
+    for name in ("J0", "J1", "J2", "J3"):
+        d.inertia(name, J=1.0, w0=0.0 if name == "J0" else None)
+    d.gear("g0", "J0", "J1", ratio=-1.0, efficiency=0.75)
+    d.torque_converter("v1", "J1", "J2", table=[[0.0, 1.0, 1.0], [0.5, 1.2, 1.0], [0.9, 3.0, 1.0]])
+    d.gear("g2", "J2", "J3", ratio=-1.0, loss_table=[[0.0, 1.0, 0.5, 0.0, 0.0], [20.0, 1.0, 0.5, 0.0, 0.0]])
+    d.bearing_friction("bearing", "J0", torque=1.0, peak=1.0)
+    d.torque("T3", "J3", Signal.sine(2.0, 2.0))
+    if with_unrelated:
+        d.inertia("U", J=1.0, w0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5).torque("UT", "U", Signal.sine(1.0, 1.0))
+    return d
+
+
+def test_a_stuck_gear_beside_a_bearing_holds_within_its_band_as_its_load_passes_zero():
+    """Random draws seed 2106: g0 is stuck and the bearing holds J0, so the two lock one motion and split J1's load
+    (the converter's torque, ``prop. w_J2 |w_J2|``, passing through zero where g2 reverses at 0.876936 s).  The
+    split of that pair is repaired into g0's band to the rounding of the pair's own torques (``kernel._repair_blocks``),
+    not to that of g2 elsewhere in the stuck set carrying 2 N m: so repaired, a split holding 3e-13 N m beyond a band
+    3e-13 N m wide was left as it was, and g0's break-away function, widened by its own rounding of 1e-12 N m, dipped
+    below zero for a few microseconds after the load's zero.  With the unrelated inertia a step ended in the dip
+    (0.8769386 s): g0 was released ``backward`` and labelled rolling at zero speed to the end of the run, holding
+    the rolling law's 0.75 of its load against 0.7558 stuck; without it the step spanned the dip.  Now g0 holds
+    within its band at every step, and stays stuck in both runs with the same torque."""
+    from clutchlab.system import evaluate
+
+    ends = []
+    for with_unrelated in (True, False):
+        d = _gear_at_rest_beside_a_bearing_whose_load_passes_zero(with_unrelated)
+        system = d.system(rtol=1e-10)
+        r = d.simulate(1.0, rtol=1e-10)   # (every step)
+        assert not [e for e in _mode_events(r) if e[1] == "g0"], _mode_events(r)
+        f = r.to_dataframe()
+        assert (f["g0.mode_1"] == 0.0).all() and f["J0.w_rad_s"].abs().max() < 1e-12
+        ends.append(f["g0.tau_Nm"].iloc[-1])
+        # the hold within the band itself (not within its rounding's widening) at every step about the load's zero
+        p = system.params.net
+        rg = int(p.lossy[0])
+        t, x, m = np.asarray(r.time), np.asarray(r.states), np.asarray(r.modes)
+        near = np.nonzero((t > 0.8769) & (t < 0.8771))[0]
+        assert len(near) >= 1
+        for k in near:
+            evaluate(system, t[k], x[k], None, m[k])   # (the kernel's own evaluation, into its work array)
+            _acc, tau = K._acc_tau(p)
+            lo, hi = K.gear_band(p, rg, -tau[rg])
+            hold = K._holds(p)[0]
+            assert lo - 1e-3 * (hi - lo) <= hold <= hi + 1e-3 * (hi - lo), (t[k], lo, hold, hi)
+    np.testing.assert_allclose(ends[0], ends[1], rtol=1e-9)
+    assert abs(ends[0] + 2.0164e-3) < 1e-6
+    same_without_the_unrelated(_gear_at_rest_beside_a_bearing_whose_load_passes_zero())
+
+
+def _three_gears_coming_to_rest():
+    """Random draws seed 2125's second network: J0 (3 rad/s) on a 1 N m bearing and a brake that closes at 0.25 s,
+    three lossy gears in a chain to J3, whose output nothing else loads: g0 (ratio -2, efficiency 0.25) and g2 (-3,
+    0.5) self-locking, g1 (-1, 0.875) between them not; a 1 N m sine at 1 Hz on J2."""
+    d = Driveline("random")
+    d.inertia("J0", J=1.0, w0=3.0)
+    for name in ("J1", "J2", "J3"):
+        d.inertia(name, J=1.0)
+    d.gear("g0", "J0", "J1", ratio=-2.0, efficiency=0.25)
+    d.gear("g1", "J1", "J2", ratio=-1.0, efficiency=0.875)
+    d.gear("g2", "J2", "J3", ratio=-3.0, efficiency=0.5)
+    d.bearing_friction("bearing", "J0", torque=1.0)
+    d.brake("brake", "J0", fn_max=8.0, mu=0.4, normal=Signal.step(1.0, 0.25))
+    d.torque("T2", "J2", Signal.sine(1.0, 1.0))
+    return d
+
+
+def test_three_gears_coming_to_rest_together_all_hold_whatever_the_tolerance():
+    """The chain comes to rest at 0.9906446 s, where the brake sticks.  Every gear then holds: g2 carries nothing
+    (its output is free and its band closes at zero load: it holds only there), g1 passes the sine's torque T2 to
+    g0 with ``T_a`` between ``T2 / eta`` and ``eta T2`` (its band), g0 and the friction on J0 take it.  The stuck
+    set has four null directions; its split is :func:`kernel._repair_space`'s.  On the code before, the largest
+    margin any split keeps was 0 (g2's band has no width where it holds) and read as 9e-33 by rounding; the
+    nearest split asked to keep half of that found none, the split was left outside g1's and g2's bands, and g1 was
+    released ``forward`` -- rolling at zero speed, pinned by its stuck neighbours, for the rest of the run -- at
+    rtol 1e-7, 1e-8, 1e-9 and 1e-11 and not at 1e-10 (the tolerance property).  Now a margin below
+    ``THETA_FLOOR`` is none, and a gear whose band closes at the split that holds keeps it with no margin while
+    the others keep theirs (``kernel._close_bands``)."""
+    from clutchlab.system import evaluate
+
+    d = _three_gears_coming_to_rest()
+    for rtol in (1e-7, 1e-8, 1e-9, 1e-10, 1e-11):
+        r = d.simulate(1.0, rtol=rtol, output_step=2e-3)
+        ev = _mode_events(r)
+        at = sorted((el, kind) for t, el, kind in ev if abs(t - 0.9906446) < 1e-6)
+        assert ("brake", "stick") in at and ("g0", "stick") in at and ("g1", "stick") in at, (rtol, ev)
+        assert not [e for e in ev if e[0] > 0.9906456 and e[1] != "g2"], (rtol, ev)
+        f = r.to_dataframe()
+        after = f[f["time_s"] > 0.9907]
+        assert (after["g1.mode_1"] == 0.0).all() and (after["g0.mode_1"] == 0.0).all(), rtol
+        # (g2 stuck, or rolling at zero speed under no load: it carries nothing either way)
+        assert after["g2.tau_Nm"].abs().max() < 1e-12 and after["J3.w_rad_s"].abs().max() < 1e-12, rtol
+    # the split at the instant, every gear stuck, against the closed form
+    system = d.system(rtol=1e-8)
+    r = d.simulate(1.0, rtol=1e-8)   # (every step)
+    p = system.params.net
+    t, x, m = np.asarray(r.time), np.asarray(r.states), np.asarray(r.modes)
+    k = int(np.nonzero(t >= 0.99064)[0][0])
+    assert abs(t[k] - 0.9906446) < 1e-6
+    mk = m[k].copy()
+    for j in range(p.lossy.shape[0]):
+        mk[p.elem[p.lossy[j], K.E_MODE]] = K.GEAR_STUCK
+    evaluate(system, t[k], x[k], None, mk)
+    _acc, tau = K._acc_tau(p)
+    holds = K._holds(p)
+    for j in range(p.lossy.shape[0]):
+        rg = int(p.lossy[j])
+        lo, hi = K.gear_band(p, rg, -tau[rg])
+        assert lo - 1e-15 <= holds[j] <= hi + 1e-15, (d.elements[rg].name, lo, holds[j], hi)
+    t2, eta = np.sin(2.0 * np.pi * t[k]), 0.875
+    names = [e.name for e in d.elements]
+    ta1, ta2 = -tau[names.index("g1")], -tau[names.index("g2")]
+    assert abs(ta2) < 1e-15
+    assert min(t2 / eta, eta * t2) <= ta1 <= max(t2 / eta, eta * t2), (ta1, t2)
+    same_at_two_tolerances(d, 1.0)
+
+
 def test_a_clutch_without_capacity_hit_through_a_backlash_slides_the_way_it_is_driven():
     """Random draws seed 2120 (sixty-first session): J0 at -2 rad/s closes a backlash on J1 at 0.03125 s; a clutch
     whose capacity is below the rounding floor (1.9e-152 N) joins J1 to J2, at rest.  At the contact the clutch

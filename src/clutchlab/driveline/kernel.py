@@ -3076,6 +3076,16 @@ def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
         _piece_bound(2 * j + 1, dn, gk, gq, gl, gw, V, lam, d, mf + 2 * j + 1, G, h, w)
 
 
+#: the largest margin a stuck set keeps (:func:`_repair_space`, a fraction of its members' widths) below which it is
+#: a rounding of zero: where no split keeps half of it, the split that holds with no margin is looked at for a lossy
+#: gear whose band is closed there (a self-locking gear whose output is free holds only while it carries nothing),
+#: which then keeps its band with no margin while the others keep theirs (:func:`_close_bands`).  Asked to keep half of
+#: the 9e-33 the rounding left, the nearest-split programme found none and the split was left outside the bands: a
+#: gear between two self-locking ones was released and rolled at zero speed, pinned by its neighbours, at four
+#: tolerances of five (random draws seed 2125, #30)
+THETA_FLOOR = 1e-12
+
+
 #: the largest margin the search over every gear's pieces (:func:`_pieces_margin`) needs to know: beyond twice
 #: ``SPACE_MARGIN`` the margin kept is ``SPACE_MARGIN`` whatever it is (a bound ``theta <= PIECES_CAP``, which also
 #: keeps the programmes of its partial combinations, where a gear's edge is not yet bounded, from growing without
@@ -3140,6 +3150,32 @@ def _pieces_code(ng, dig):
     return code
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _close_bands(p, stuck, ng, gk, gq, gw, V, lam, z, d, tol):
+    """Zero width (:func:`_repair_space`'s second round) for each stuck lossy gear whose band is closed, to ``tol``,
+    at the split ``lam + V z``: a self-locking gear whose output is free can carry only nothing, its band's two edges
+    meeting there, so every split that holds the set keeps it on its band with no margin, and a margin asked of it
+    asks none of the others (the largest margin the set keeps is then 0).  A bound of zero width is kept with no
+    margin, as a one-way clutch's free side (:func:`_lp_max`), and the margin is the other members'.  Returns True
+    if a width changed.  (Random draws seed 2125: such a gear beside a non-locking gear between two self-locking
+    ones; with no margin the nearest split put the middle gear on its band's edge, and it was released there, at
+    one tolerance of five, to roll at zero speed pinned by its neighbours, #30.)"""
+    changed = False
+    for j in range(ng):
+        if gw[j] == 0.0:
+            continue
+        k, q = gk[j], gq[j]
+        r = -int(stuck[k]) - 1
+        ta = lam[q]
+        for f in range(d):
+            ta += V[q, f] * z[f]
+        lo, hi = gear_band(p, r, -ta)
+        if hi - lo <= tol:
+            gw[j] = 0.0
+            changed = True
+    return changed
+
+
 @numba.njit(cache=True, nogil=True, _nrt=True)
 def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     """:func:`_repair` where a statically indeterminate set has two or more null directions (a rigid loop with a
@@ -3157,7 +3193,9 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     held the set; the margin kept and the nearest split are then those of the combination found).  The split is
     kept where it keeps ``theta`` of each member's width (its limit's span, its band's width) from its bounds,
     ``theta`` 1 % or half the largest margin any split has (a linear programme over ``z`` and ``theta`` per combination,
-    :func:`_combo_margin`), and otherwise moved to the nearest split that does (the least ``|V z|``, a quadratic
+    :func:`_combo_margin`; where that is below :data:`THETA_FLOOR`, a rounding of zero, a gear whose band is closed
+    at the split found keeps it with no margin, and the others keep theirs, in a second round: :func:`_close_bands`),
+    and otherwise moved to the nearest split that does (the least ``|V z|``, a quadratic
     programme per combination, :func:`_combo_nearest`): continuous in the torques while one combination of pieces
     holds the set (it may move to another where that one closes), and every member keeps a margin until no split
     holds (the group must slip; the split is then left as it is, for :func:`settle` to decide).
@@ -3285,61 +3323,83 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     sc = np.zeros((2, max(mm, d + 1)))   # (the cold solves' step and shifted bounds: _lp_max, _qp_nearest)
     Rq = np.zeros((d + 1, d + 1))        # (and the triangle of their QR, M holding its Q)
     small = d <= ENUMERATED_DIMENSIONS   # (enumerated where the hints fail; above, the simplex and active sets)
-    # the largest margin any split keeps, per combination of pieces (with three or more stuck lossy gears, the
-    # pieces of the torques they carry now first: combination -1)
-    deep = ng > 2
-    thc = np.empty(ncomb)
-    best_theta = -np.inf
-    for comb in range(ncomb):
-        _combo_bounds(-1 if deep else comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
-        nr = _span_basis(G, m, d, R, GR, zt)
-        thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size * comb, tol, small)
-        best_theta = max(best_theta, thc[comb])
-    # with three or more (4**ng combinations): where the current pieces keep less than PIECES_CAP (a margin near
-    # zero is not enough: at 1e-15 no split keeping half of it is found), the last combination that held the set
-    # (its warm start in slot 1, its code + 1 in slot 2), and where that keeps less too, every combination by branch
-    # and bound
-    pick = -1
-    dig = np.empty(2 * ng, dtype=np.int64)   # (the branch and bound's digits)
-    if deep and best_theta < PIECES_CAP:
-        o_code = o_sp + 2 * size
-        last = int(hint[o_code]) - 1
-        if last >= 0 and last != _pieces_code(ng, gc):
-            _combo_bounds(last, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+    # (two rounds where the first finds no margin beyond rounding: a stuck lossy gear whose band is closed at the
+    # nearest split that holds -- it can carry only what it carries there -- keeps its band with no margin in the
+    # second, whose margin is then the other members': :func:`_close_bands`, :data:`THETA_FLOOR`)
+    for rnd in range(2):
+        # the largest margin any split keeps, per combination of pieces (with three or more stuck lossy gears, the
+        # pieces of the torques they carry now first: combination -1)
+        deep = ng > 2
+        thc = np.empty(ncomb)
+        best_theta = -np.inf
+        for comb in range(ncomb):
+            _combo_bounds(-1 if deep else comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
             nr = _span_basis(G, m, d, R, GR, zt)
-            th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size, tol, small)
-            if th > best_theta:
-                best_theta, pick = th, last
-        if best_theta < PIECES_CAP:
-            th, code = _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M, b,
-                                      yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
-            if code >= 0:
-                best_theta, pick = th, code
-                hint[o_code] = code + 1.0
-                hint[o_sp + size] = -1.0            # (its warm start: found anew at its next use)
-                hint[o_sp + size + nk + 2] = -1.0
-    if not best_theta >= 0.0:
-        return False   # no split holds: the group must slip
-    theta = min(SPACE_MARGIN, 0.5 * best_theta)
-    # the nearest split that keeps theta, over the combinations that can keep it (with three or more stuck lossy
-    # gears, in the combination that keeps the largest margin found: the current pieces', or ``pick``)
-    best_n = np.inf
-    if deep:
-        _combo_bounds(pick, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
-        best_n = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zb, sc, Rq, hint,
-                                o_sp + (size if pick >= 0 else 0) + nk + 2, tol, small)
-    for comb in range(0 if deep else ncomb):
-        if not thc[comb] >= theta:
+            thc[comb] = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size * comb, tol,
+                                      small)
+            best_theta = max(best_theta, thc[comb])
+        # with three or more (4**ng combinations): where the current pieces keep less than PIECES_CAP (a margin near
+        # zero is not enough: at 1e-15 no split keeping half of it is found), the last combination that held the set
+        # (its warm start in slot 1, its code + 1 in slot 2), and where that keeps less too, every combination by branch
+        # and bound
+        pick = -1
+        dig = np.empty(2 * ng, dtype=np.int64)   # (the branch and bound's digits)
+        if deep and best_theta < PIECES_CAP:
+            o_code = o_sp + 2 * size
+            last = int(hint[o_code]) - 1
+            if last >= 0 and last != _pieces_code(ng, gc):
+                _combo_bounds(last, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+                nr = _span_basis(G, m, d, R, GR, zt)
+                th = _combo_margin(GR, w, h, nr, m, idx, base, M, b, yb, sc, Rq, hint, o_sp + size, tol, small)
+                if th > best_theta:
+                    best_theta, pick = th, last
+            if best_theta < PIECES_CAP:
+                th, code = _pieces_margin(ng, gk, gq, gl, gw, V, lam, d, mf, G, h, w, best_theta, dig, idx, base, M, b,
+                                          yb, zt, R, GR, sc, Rq, np.empty(size), tol, small)
+                if code >= 0:
+                    best_theta, pick = th, code
+                    hint[o_code] = code + 1.0
+                    hint[o_sp + size] = -1.0            # (its warm start: found anew at its next use)
+                    hint[o_sp + size + nk + 2] = -1.0
+        if not best_theta >= 0.0:
+            return False   # no split holds: the group must slip
+        theta = min(SPACE_MARGIN, 0.5 * best_theta)
+        probe = False
+        for attempt in range(2):
+            # the nearest split that keeps theta, over the combinations that can keep it (with three or more stuck
+            # lossy gears, in the combination that keeps the largest margin found: the current pieces', or ``pick``)
+            best_n = np.inf
+            if deep:
+                _combo_bounds(pick, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+                best_n = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zb, sc, Rq, hint,
+                                        o_sp + (size if pick >= 0 else 0) + nk + 2, tol, small)
+            for comb in range(0 if deep else ncomb):
+                if not thc[comb] >= theta:
+                    continue
+                _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
+                nz = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zc, sc, Rq, hint,
+                                    o_sp + size * comb + nk + 2, tol, small)
+                if nz < best_n:
+                    best_n = nz
+                    for f in range(d):
+                        zb[f] = zc[f]
+            if best_n < np.inf or rnd == 1 or theta == 0.0 or not best_theta < THETA_FLOOR:
+                break
+            # (none keeps half a margin below THETA_FLOOR, a rounding of 0: the split that holds with none, to look
+            # for a gear whose band is closed there)
+            theta = 0.0
+            probe = True
+        # where the largest margin is a rounding of 0 and a gear's band is closed at the split found (or, where none
+        # keeps half of it, at the split that holds with none), that gear keeps its band with no margin and the others
+        # keep theirs, in a second round.  Where no band is closed the set is at its group's edge and is left as
+        # before: the probe's split is not taken (at a loop's edge, held there with no margin, a one-way clutch
+        # carried 1.9 N m the free way at the next evaluation)
+        if rnd == 0 and best_n < np.inf and best_theta < THETA_FLOOR and \
+                _close_bands(p, stuck, ng, gk, gq, gw, V, lam, zb, d, tol):
             continue
-        _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w)
-        nz = _combo_nearest(G, d, h, w, theta, m, idx, base, M, b, zt, zc, sc, Rq, hint,
-                            o_sp + size * comb + nk + 2, tol, small)
-        if nz < best_n:
-            best_n = nz
-            for f in range(d):
-                zb[f] = zc[f]
-    if best_n == np.inf:
-        return False
+        if best_n == np.inf or probe:
+            return False
+        break
     if best_n == 0.0:
         return False   # (the split already keeps theta)
     for k in range(ns):
@@ -3351,13 +3411,15 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
+def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, scale):
     """:func:`_repair` for each block of a stuck set whose members fall into blocks that share no inertia (stuck
     members in linked groups of their own, :func:`_components`): ``A`` is then block-diagonal, with a null
     direction per redundant block, and the whole set's null space has more than one dimension, so :func:`_repair`
     on it did nothing (a lossy gear at its band's edge held beyond it, its network's split moved by a second brake
     applied elsewhere, #30).  Each block of two or more members is repaired on its own, as in a network of that
-    block alone.  Returns False (nothing done) if the set is one block."""
+    block alone, to the tolerance of its own torques: ``scale[k]`` [N m] is member ``k``'s torque and the largest
+    on its inertias, and is replaced by the largest of its block (the repair's tolerance is ``NOISE`` times it).
+    Returns False (nothing done) if the set is one block."""
     nk = _nk(p)
     wk = p.work
     lay = _offsets(p)
@@ -3390,6 +3452,17 @@ def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
                     lab[k] = lo_lab
                     lab[j] = lo_lab
                     changed = True
+    # (each member's scale the largest of its block's: a block's split is moved into its bounds to its own
+    # torques' rounding, not to a block's elsewhere carrying newton metres -- repaired to 2e-12 N m, the
+    # tolerance of a gear's 2 N m elsewhere in the set, a lossy gear at rest beside a bearing held a loss 3e-13
+    # N m beyond its band as its load passed zero, so its break-away function, widened by its own rounding of
+    # 1e-12 N m, dipped below zero for a few microseconds: a step that ended in the dip released it and it
+    # rolled at zero speed for the rest of the run, a step that spanned the dip kept it stuck; random draws
+    # seed 2106, #30)
+    for k in range(ns):
+        for j in range(ns):
+            if lab[j] == lab[k] and scale[j] > scale[k]:
+                scale[k] = scale[j]
     one = True
     for k in range(ns):
         if lab[k] != 0.0:
@@ -3398,9 +3471,11 @@ def _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, v, tmp, cand, trial, tol):
         return False
     for b in range(ns):
         nc = 0
+        tol = 0.0
         for k in range(ns):
             if lab[k] == b:
                 nc += 1
+                tol = NOISE * scale[k]
         if nc < 2:
             continue
         Ac = shaped(wk[lay.m:lay.m + nc * nc], (nc, nc))
@@ -3636,20 +3711,24 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         # made the tolerance 2e-12 N m where this set carries 1e-11, and a lossy gear holding nothing was left with
         # 4e-12 N m of a bearing's load and rolled at the first step with that inertia beside the network and not
         # without it, #30)
+        # (``res``, free here: each member's torque and the largest on its inertias, then its block's largest,
+        # :func:`_repair_blocks`)
         big = 0.0
         for k in range(ns):
-            big = max(big, abs(lam[k]))
+            bk = abs(lam[k])
             for q in range(3):
                 i = int(flf[3 * k + q])
                 if i >= 0:
-                    big = max(big, abs(F[i]))
+                    bk = max(bk, abs(F[i]))
+            res[k] = bk
+            big = max(big, bk)
         # (relative to the torques only: a split is moved into the bounds before the switching functions, whose
         # floor is NOISE (1 + torque), see it leave them -- else which comes first is a rounding, and a stuck lossy
         # gear beside a bearing rolled or held by the step sequence, #30)
         tol = NOISE * big
         # (the column order of the elimination in iwork: the factorisation's pivots are not needed any more; lam + z
         # v keeps the constraints, v being A's null vector to rounding)
-        if not _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, vnull, vtmp, cand, trial, tol):
+        if not _repair_blocks(p, stuck, ns, A, lam, lo, hi, flf, vnull, vtmp, cand, trial, res):
             if not _repair_outlined(p, stuck, ns, A, S, p.iwork, lam, lo, hi, vnull, vtmp, cand, trial, tol) and \
                     _several_null_known(p, A, ns):
                 _repair_space_outlined(p, stuck, ns, A, lam, lo, hi, tol)
@@ -3657,9 +3736,10 @@ def _solve_stuck(t, x, p, m, stuck, ns, F, tau, speeds):
         # the network's choice here, and "on its limit" must not read as "beyond it" by a rounding (the tie-break in
         # settle keeps a member exactly on its limit at t + T_TIE stuck, while another member takes the growth, #30)
         for k in range(ns):
-            if hi[k] < lam[k] <= hi[k] + tol:
+            tk = NOISE * res[k]   # (its block's tolerance, as the repair's)
+            if hi[k] < lam[k] <= hi[k] + tk:
                 lam[k] = hi[k]
-            elif lo[k] - tol <= lam[k] < lo[k]:
+            elif lo[k] - tk <= lam[k] < lo[k]:
                 lam[k] = lo[k]
     hold = _holds(p)
     Fa = _torque_magnitudes(p)
