@@ -3326,6 +3326,8 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
     # (two rounds where the first finds no margin beyond rounding: a stuck lossy gear whose band is closed at the
     # nearest split that holds -- it can carry only what it carries there -- keeps its band with no margin in the
     # second, whose margin is then the other members': :func:`_close_bands`, :data:`THETA_FLOOR`)
+    n1 = np.inf          # (the first round's nearest split, where it found one and a second round follows)
+    z1 = np.zeros(d)
     for rnd in range(2):
         # the largest margin any split keeps, per combination of pieces (with three or more stuck lossy gears, the
         # pieces of the torques they carry now first: combination -1)
@@ -3362,6 +3364,11 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
                     hint[o_sp + size] = -1.0            # (its warm start: found anew at its next use)
                     hint[o_sp + size + nk + 2] = -1.0
         if not best_theta >= 0.0:
+            if n1 < np.inf:   # (the second round holds where the first held: the first's split)
+                best_n = n1
+                for f in range(d):
+                    zb[f] = z1[f]
+                break
             return False   # no split holds: the group must slip
         theta = min(SPACE_MARGIN, 0.5 * best_theta)
         probe = False
@@ -3396,7 +3403,16 @@ def _repair_space(p, stuck, ns, A, lam, lo, hi, tol):
         # carried 1.9 N m the free way at the next evaluation)
         if rnd == 0 and best_n < np.inf and best_theta < THETA_FLOOR and \
                 _close_bands(p, stuck, ng, gk, gq, gw, V, lam, zb, d, tol):
+            if not probe:
+                n1 = best_n
+                for f in range(d):
+                    z1[f] = zb[f]
             continue
+        if best_n == np.inf and n1 < np.inf:   # (as above)
+            best_n = n1
+            for f in range(d):
+                zb[f] = z1[f]
+            break
         if best_n == np.inf or probe:
             return False
         break
