@@ -1176,6 +1176,43 @@ def test_a_slow_gear_s_stick_is_timed_by_its_rolling_speed():
     np.testing.assert_array_equal(f["g0.w_rel_rad_s"], f["J0.w_rad_s"])
 
 
+def _lossy_gear_under_a_tiny_sine(with_unrelated=True):
+    """Random draws seed 2196 (sixty-fifth session): a lossy gear (ratio -1.5, efficiency 0.625) between J0 and a
+    free J1, a 2e-4 N m sine on J0, from rest."""
+    d = Driveline("random")
+    d.inertia("J0", J=1.0, w0=0.0).inertia("J1", J=0.25, w0=0.0)
+    d.gear("g0", "J0", "J1", ratio=-1.5, efficiency=0.625)
+    d.torque("T0", "J0", Signal.sine(2e-4, 1.0))
+    if with_unrelated:
+        d.inertia("U", J=1.0, w0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5).torque("UT", "U", Signal.sine(0.0, 2.0))
+    return d
+
+
+def test_a_reversal_is_timed_by_its_speed():
+    """Seed 2196: the gear rolls forward from rest, J1 drives it back through the gear from 0.5 s (``b_drives``),
+    and its speed, at most 6e-5 rad/s, falls through zero at 0.9019 s at about 1e-4 rad/s^2: it reverses
+    (``backward``) without sticking (beyond its band there).  The two runs, with and without the unrelated inertia,
+    put the reversal 3.0 us apart (0.9019262 and 0.9019232 s; the same on the code before the sixty-fifth session's
+    kernel changes), the speeds the same; a speed error of 1e-7 rad/s moves that instant by 1 ms.  A reversal is a
+    speed's zero crossing as a stick is, and is now timed by its speed (:func:`_event_time_tolerance`); the
+    property's comparison failed before.  A break-away from rest keeps its own rules."""
+    d = _lossy_gear_under_a_tiny_sine()
+    same_without_the_unrelated(d)
+    r = _lossy_gear_under_a_tiny_sine(False).simulate(1.0, output_step=2e-3, rtol=1e-10)
+    f = _with_gear_speeds(_lossy_gear_under_a_tiny_sine(False), r.to_dataframe())
+    ev = [e for e in _mode_events(r) if e[2] == "backward"]
+    assert len(ev) == 1 and abs(ev[0][0] - 0.90192) < 1e-5, ev
+    assert 1e-4 < _event_time_tolerance(f, ev[0], 1.0) <= 1e-3
+    # (made up: the same element entering ``forward`` from rest, or ``backward`` while it moved backward, is no
+    # reversal, and keeps EVENT_TIME_TOL)
+    tt = f["time_s"].to_numpy()
+    rest = f.assign(**{"g0.w_rel_rad_s": np.where(tt < ev[0][0], 0.0, f["g0.w_rel_rad_s"]),
+                       "g0.tau_Nm": 1.0})
+    assert _event_time_tolerance(rest, (ev[0][0], "g0", "forward"), 1.0) == EVENT_TIME_TOL
+    assert _event_time_tolerance(f.assign(**{"g0.tau_Nm": 1.0, "g0.w_rel_rad_s": -f["g0.w_rel_rad_s"].abs() - 1.0}),
+                                 (ev[0][0], "g0", "backward"), 1.0) == EVENT_TIME_TOL
+
+
 def _braked_shaft_and_a_bearing():
     """Random draws seed 2067: a clutch between an inertia on a bearing and a shaft that a one-way clutch and a
     brake hold at rest, under a sine."""
@@ -1280,10 +1317,21 @@ def _event_time_tolerance(frame, event, wmax, window=0.01):
       at 0.97 and 1.2 ms in another draw.)  A torque error of 1e-7 of the largest moves such an instant by more
       than the window anyway, for a load that is a rounding 2 ms before.  The speeds are compared in any case.  A
       break-away where the load reaches a limit, or jumps, keeps EVENT_TIME_TOL.
+    - A reversal (``forward`` or ``backward`` entered while the element moved the other way up to the instant) is a
+      speed's zero crossing too, and is timed by its speed as a stick is.
     - Any other event keeps EVENT_TIME_TOL, as does an element without the column."""
     t, element, kind = event
     tt = frame["time_s"].to_numpy()
     if kind in ("forward", "backward"):
+        speed = f"{element}.w_rel_rad_s"
+        if speed in frame.columns:
+            w = frame[speed].to_numpy()[(tt < t - 1e-9) & (tt >= t - window)]
+            if w.size and (w[-1] > 0.0 if kind == "backward" else w[-1] < 0.0):
+                # a reversal: it moved the other way up to the instant, whose time is its speed's zero crossing, as
+                # a stick's (random draws seed 2196, sixty-fifth session: a lossy gear under a 2e-4 N m sine whose
+                # speed, at most 6e-5 rad/s, falls through zero at 1e-4 rad/s^2, reversed 3.0 us apart with and
+                # without the unrelated inertia, the speeds the same)
+                return _speed_shift(frame, speed, t, wmax, window)
         col = f"{element}.tau_Nm"
         if col not in frame.columns:
             return EVENT_TIME_TOL
@@ -1297,6 +1345,13 @@ def _event_time_tolerance(frame, event, wmax, window=0.01):
     col = f"{element}.w_rel_rad_s"
     if kind != "stick" or col not in frame.columns:
         return EVENT_TIME_TOL
+    return _speed_shift(frame, col, t, wmax, window)
+
+
+def _speed_shift(frame, col, t, wmax, window):
+    """How far a speed error of 1e-7 of ``wmax`` moves the instant ``t`` where column ``col`` reaches zero, from the
+    ``window`` of samples before it (:func:`_event_time_tolerance`): between EVENT_TIME_TOL and 1 ms."""
+    tt = frame["time_s"].to_numpy()
     keep = (tt < t - 1e-9) & (tt >= t - window)
     if keep.sum() < 2:
         return EVENT_TIME_TOL
@@ -2850,7 +2905,12 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
     the way to another label (``stick`` then ``free``), where the other run goes to that label directly near t2, is
     a grazing the same way, the stick alone: seed 2057 of the draws profile, a synchroniser whose slip meets zero
     tangentially as its shift force falls to zero, stuck for 1.5 us before ``free`` in one run and ``free`` in the
-    other."""
+    other.  And a slide on the way to a stick (``forward`` then ``stick``), where the other run sticks directly near
+    t2, the slide alone: seed 2209 of the draws profile (sixty-fifth session), a brake applied at 0.6 s, the instant
+    its inertia's speed, driven by a 5 Hz sine from rest, passes through zero; the speed there is the integration
+    error (5.5e-9, 1.9e-9, 1.2e-10, 6.1e-12 rad/s at rtol 1e-7 to 1e-10), which the brake stops in 27 and 14 ns at
+    1e-7 and 1e-8 (``forward``, then ``stick``) and which is within its rounding width at 1e-9 and 1e-10 (``stick``
+    at once)."""
     lash = {e.name: e for e in d.elements if e.kind == "backlash"}
     touches, last = [], {}     # (positions in ev, element, its event leaving, t1, t2, the label a stick led to)
     for k, (t, el, event) in enumerate(ev):
@@ -2866,6 +2926,10 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
                 continue
         else:       # a stick, or a reversal of its sliding (an element with no capacity to speak of), and back (not
             if first == event or event == "stick":   # a stuck element's slip and stick: a break-away one run misses)
+                if event == "stick" and first in ("forward", "backward"):
+                    # a slide on the way to a stick, which the other run takes directly (the mirror of a stick on
+                    # the way to another label, below)
+                    touches.append(({k_first}, el, first, t1, t, event))
                 continue
             prior = [e for e in ev[:k_first] if e[1] == el]     # the mode before the touch: its last event's, or
             before = prior[-1][2] if prior else (           # the one it started in (both runs start alike)
@@ -2907,6 +2971,34 @@ def _grazing_touches(ev, other, d, t_end, rtol_other, frame_other) -> set:
         if np.max(np.abs(near)) <= TOUCH_RESOLUTION * span:
             drop |= positions
     return drop
+
+
+def _brake_applied_where_its_inertia_turns():
+    """Random draws seed 2209 (sixty-fifth session): J0 and J1 on an ideal gear (ratio -1), a 1 N m sine at 5 Hz on
+    J0 from rest, and a brake on J0 applied at 0.6 s, where J0's speed, ``(1 - cos 10 pi t) / (20 pi)``, is zero."""
+    d = Driveline("random")
+    d.inertia("J0", J=1.0, w0=0.0).inertia("J1", J=1.0, w0=0.0)
+    d.gear("g0", "J0", "J1", ratio=-1.0)
+    d.brake("brake", "J0", fn_max=1.0, mu=0.4, normal=Signal.step(1.0, 0.6))
+    d.torque("T0", "J0", Signal.sine(1.0, 5.0))
+    return d
+
+
+def test_a_slide_on_the_way_to_a_stick_the_other_run_takes_directly_is_a_grazing():
+    """Seed 2209: at rtol 1e-7 the brake slides ``forward`` for 27 ns at 0.6 s, stopping the 5.5e-9 rad/s the
+    integration left J0 where it is exactly at rest, then sticks; at 1e-10 it sticks at once.  The slide is read as
+    a grazing (:func:`_grazing_touches`): the other run sticks there directly and its slip stays at zero across.  The
+    tolerance property's comparison failed before.  Made up: where the other run does not stick near the slide's
+    end, the slide stays a difference."""
+    d = _brake_applied_where_its_inertia_turns()
+    same_at_two_tolerances(d, 1.0)
+    lo = d.simulate(1.0, rtol=1e-7, output_step=2e-3)
+    hi = d.simulate(1.0, rtol=1e-10, output_step=2e-3)
+    ev_lo, ev_hi = _inside(_mode_events(lo), 1.0), _inside(_mode_events(hi), 1.0)
+    assert [e[1:] for e in ev_lo[:2]] == [("brake", "forward"), ("brake", "stick")] and ev_lo[1][0] - 0.6 < 1e-7
+    assert ev_hi[0][1:] == ("brake", "stick") and abs(ev_hi[0][0] - 0.6) < 1e-9
+    assert _grazing_touches(ev_lo, ev_hi, d, 1.0, 1e-10, hi.to_dataframe()) == {0}
+    assert _grazing_touches(ev_lo, ev_hi[1:], d, 1.0, 1e-10, hi.to_dataframe()) == set()
 
 
 def test_the_debug_check_from_the_command_line(tmp_path):
