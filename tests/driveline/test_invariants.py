@@ -1570,6 +1570,36 @@ def test_a_clutch_without_capacity_hit_through_a_backlash_slides_the_way_it_is_d
     same_without_the_unrelated(network(True))
 
 
+def test_a_small_clutch_hit_through_a_backlash_is_released_the_way_it_breaks_away():
+    """Random draws seed 2195 (sixty-fifth session): as seed 2120, with a capacity above the rounding floor.  A
+    one-way clutch, an undamped backlash and a clutch of 3e-8 N m (fn_max 5.96e-8 N) in a chain from rest, a -3 N m
+    sine at 0.5 Hz on J1; the backlash closes at 0.5978980 s.  The clutch carries half the contact's torque, which
+    starts at a rounding (6e-14 N m) and reaches twice its capacity 10 ns later: the tie-break marks it at t + T_TIE.
+    It was released the way its load pointed at t, a rounding: ``forward`` with the unrelated inertia, ``backward``
+    against its own torque for 18 us without it.  An item that carries no more than its rounding floor at t is now
+    marked with the way it breaks away at t + T_TIE, as a gear whose band has no width was (``kernel.settle``):
+    ``forward`` in both runs.  On the code before, the run without the unrelated inertia slid ``backward``."""
+    def network(with_unrelated):
+        d = Driveline("random")
+        for name in ("J0", "J1", "J2", "J3"):
+            d.inertia(name, J=1.0, w0=0.0)
+        d.one_way_clutch("f0", "J0", "J1")
+        d.backlash("k1", "J1", "J2", c=10.0, b_gap=0.28125, d=0.0)
+        d.clutch("c2", "J2", "J3", fn_max=5.96046e-08, mu=0.5, peak=1.0)
+        d.torque("T1", "J1", Signal.sine(-3.0, 0.5))
+        if with_unrelated:
+            d.inertia("U", J=1.0, w0=0.0).brake("Ubrake", "U", fn_max=1.0, mu=0.5).torque("UT", "U",
+                                                                                       Signal.sine(0.0, 1.0))
+        return d
+    for with_unrelated in (True, False):
+        r = network(with_unrelated).simulate(1.0, output_step=2e-3, rtol=1e-10)
+        ev = [(round(t, 7), el, kind) for t, el, kind in _mode_events(r) if el == "c2"]
+        assert ev == [(0.597898, "c2", "forward")], ev
+        f = r.to_dataframe()
+        assert (f["c2.w_rel_rad_s"] >= -1e-12).all() and (f["c2.dissipated_J"] >= -1e-20).all()
+    same_without_the_unrelated(network(True))
+
+
 def test_a_one_way_clutch_leaving_rest_at_the_rounding_floor_is_compared_by_its_motion():
     """Random draws seed 2097: a one-way clutch whose clutch has no normal force until 0.5 s, loaded from rest
     through two springs by a sine, so its load grows as t^5.  It must overrun from the start; it leaves rest where
