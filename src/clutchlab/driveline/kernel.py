@@ -3077,12 +3077,12 @@ def _combo_bounds(comb, ng, gk, gq, gl, gw, gc, V, lam, d, mf, G, h, w):
 
 
 #: the largest margin a stuck set keeps (:func:`_repair_space`, a fraction of its members' widths) below which it is
-#: a rounding of zero: where no split keeps half of it, the split that holds with no margin is looked at for a lossy
-#: gear whose band is closed there (a self-locking gear whose output is free holds only while it carries nothing),
-#: which then keeps its band with no margin while the others keep theirs (:func:`_close_bands`).  Asked to keep half of
-#: the 9e-33 the rounding left, the nearest-split programme found none and the split was left outside the bands: a
-#: gear between two self-locking ones was released and rolled at zero speed, pinned by its neighbours, at four
-#: tolerances of five (random draws seed 2125, #30)
+#: a rounding of zero: the split found (or, where none keeps half of it, the split that holds with no margin) is
+#: looked at for a lossy gear whose band is closed there (a self-locking gear whose output is free holds only while
+#: it carries nothing), which then keeps its band with no margin while the others keep theirs (:func:`_close_bands`).
+#: Asked to keep half of the 9e-33 the rounding left, the nearest-split programme found none and the split was left
+#: outside the bands: a gear between two self-locking ones was released and rolled at zero speed, pinned by its
+#: neighbours, at four tolerances of five (random draws seed 2125, #30)
 THETA_FLOOR = 1e-12
 
 
