@@ -1600,6 +1600,43 @@ def test_a_small_clutch_hit_through_a_backlash_is_released_the_way_it_breaks_awa
     same_without_the_unrelated(network(True))
 
 
+def _loop_with_a_gear_of_efficiency(eta):
+    """Random draws seed 2226 (sixty-fifth session): a rigid loop, J0 -g0- J1 -one-way clutch- J2 -g2- J3 and a
+    clutch from J3 to J0, with a bearing and a brake on J1 and a 12.4 N m sine at 4.94 Hz on J2, from rest; g0 of
+    efficiency ``eta``."""
+    d = Driveline("random")
+    for name, inertia in (("J0", 0.49691476811325747), ("J1", 0.4992347744220576), ("J2", 1.8250054841964005),
+                          ("J3", 0.8227643182943855)):
+        d.inertia(name, J=inertia, w0=0.0 if name == "J0" else None)
+    d.gear("g0", "J0", "J1", ratio=-0.9, efficiency=eta)
+    d.one_way_clutch("f1", "J1", "J2", fn_max=1.1, mu=0.5, peak=1.5, normal=Signal.step(1.0, 0.17721384559416278))
+    d.gear("g2", "J2", "J3", ratio=-3.1389956408360558, efficiency=0.310131910653651)
+    d.clutch("loop", "J0", "J3", fn_max=31.063624790848134, mu=0.5)
+    d.bearing_friction("bearing", "J1", torque=0.18948732442905, peak=1.3)
+    d.brake("brake", "J1", fn_max=3.3959542307338766, mu=0.4, normal=Signal.step(1.0, 0.5778034791573499))
+    d.torque("T2", "J2", Signal.sine(12.44285768015581, 4.942430796245287))
+    return d
+
+
+def test_a_gear_within_rounding_of_ideal_is_ideal():
+    """Seed 2226: g0's efficiency 1 - 1.1e-16 makes its stuck band 2.2e-16 of its torque wide, below the rounding
+    floor of its stick/slip decisions (1e-12 of the torques).  From 0.762 s every item of the loop is stuck; at
+    rtol 1e-9 the run stopped advancing at 0.7955 s (recorded at every step; sampled, at 0.8188 s), its steps of no
+    length until ``max_steps``.  Efficiencies within ``network.ETA_IDEAL`` (1e-12) of 1 without bearing friction are
+    now an ideal gear: the run is the one with efficiency 1 to the last bit.  A gear 1e-9 below 1 keeps its
+    losses."""
+    from clutchlab.driveline.network import ETA_IDEAL
+
+    assert ETA_IDEAL == 1e-12
+    runs = [simulate(_loop_with_a_gear_of_efficiency(eta).system(rtol=1e-9), 1.0, max_steps=20000)
+            for eta in (1.0 - 1.1e-16, 1.0)]
+    assert list(runs[0].events.itertuples(index=False)) == list(runs[1].events.itertuples(index=False))
+    np.testing.assert_array_equal(runs[0].states[-1], runs[1].states[-1])
+    assert "g0.mode_1" not in runs[0].to_dataframe().columns
+    lossy = _loop_with_a_gear_of_efficiency(1.0 - 1e-9)
+    assert "g0.mode_1" in lossy.simulate(0.1, output_step=1e-2).to_dataframe().columns
+
+
 def test_a_one_way_clutch_leaving_rest_at_the_rounding_floor_is_compared_by_its_motion():
     """Random draws seed 2097: a one-way clutch whose clutch has no normal force until 0.5 s, loaded from rest
     through two springs by a sine, so its load grows as t^5.  It must overrun from the start; it leaves rest where
