@@ -327,18 +327,6 @@ def _network_sizes(w, e):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _wants_rates(m, g, nf, k):
-    """True where :func:`kernel.driveline_watch` takes margin rates: a stuck element's turn function marked 0.0 (the
-    one read, ``k``, or any, ``k < 0``)."""
-    if k >= 0:
-        return k < K.N_G * nf and k % K.N_G == K.G_TURN and m[k // K.N_G] == K.STUCK and g[k] == 0.0
-    for j in range(nf):
-        if m[j] == K.STUCK and g[K.N_G * j + K.G_TURN] == 0.0:
-            return True
-    return False
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
 def coupled_watch(t, x, u, m, p, dx, g, k):
     """The network's ``watch`` (:func:`kernel.driveline_watch`: the margin rates of its stuck elements near their
     limits, where the core compares switching functions) on its own states, functions and modes; nothing for a
@@ -357,7 +345,7 @@ def coupled_watch(t, x, u, m, p, dx, g, k):
         K.driveline_watch(t, x, u, m, net, dx, g, k)
         return
     nx, ng, nm = _network_sizes(w, e)
-    if k < ng and _wants_rates(m, g, net.fric.shape[0], k):   # (rare: a stuck element near its limit)
+    if k < ng and K.wants_rates(net, m, g, k):   # (rare: a stuck item near its limit)
         _watch_rates_outlined(t, x, u, m, p, dx, g, k)
 
 
