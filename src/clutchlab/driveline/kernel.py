@@ -4299,7 +4299,8 @@ def _flange(p, r, q):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _components(p, comp):
     """The linked groups of inertias: ``comp[i]`` the lowest inertia linked to inertia ``i`` through elements
-    (any element between two inertias, a gear's support included; the ground links nothing, it does not move)."""
+    (any element between two inertias, a gear's support included; the ground links nothing, it does not move).
+    ``comp``: int64, or a float scratch of the work array (:func:`_margin_rates`)."""
     n = p.inertia.shape[0]
     for i in range(n):
         comp[i] = i
@@ -4958,30 +4959,9 @@ def _edge_crossed(p, m, g, gs):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _labels(p, lab):
-    """:func:`_components` into the float scratch ``lab``: the lowest inertia linked to each inertia."""
-    n = p.inertia.shape[0]
-    for i in range(n):
-        lab[i] = i
-    changed = True
-    while changed:
-        changed = False
-        for r in range(p.elem.shape[0]):
-            lo = float(n)
-            for q in range(3):
-                i = _flange(p, r, q)
-                if i >= 0:
-                    lo = min(lo, lab[i])
-            for q in range(3):
-                i = _flange(p, r, q)
-                if i >= 0 and lab[i] != lo:
-                    lab[i] = lo
-                    changed = True
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
 def _group_of(p, r, lab):
-    """The label (:func:`_labels`) of element row ``r``'s linked group of inertias (-1: it links only the ground)."""
+    """The label (:func:`_components`, into a float scratch) of element row ``r``'s linked group of inertias (-1: it
+    links only the ground)."""
     for q in range(3):
         i = _flange(p, r, q)
         if i >= 0:
@@ -4992,7 +4972,7 @@ def _group_of(p, r, lab):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _edge_rate(p, m, g, gs, lab, c):
     """The lowest rate [N m/s] over :data:`T_RATE` of the break-away functions of the stuck items of the linked group
-    of inertias ``c`` that the probe of :func:`_margin_rates` finds past zero where they were not at ``t``, or inf.
+    of inertias ``c`` (labels ``lab``, :func:`_group_of`) that the probe of :func:`_margin_rates` finds past zero where they were not at ``t``, or inf.
 
     In a statically indeterminate stuck set the margin of each member is that of the split chosen, not a function of
     the state alone: past the set's edge (no split holds) the regularised split is no longer moved into the bounds,
@@ -5068,7 +5048,7 @@ def _margin_rates(t, x, u, m, p, dx, g):
     crossed = _edge_crossed(p, m, g, gs)
     beyond = _edge_beyond(p, m, g)
     if crossed or beyond:
-        _labels(p, lab)
+        _components(p, lab)
     for j in range(nf + nl):
         q = _turn_index(p, j)
         qb, r = _stuck_breaks(p, m, j)
