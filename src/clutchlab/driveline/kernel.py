@@ -4907,15 +4907,13 @@ T_RATE = 1e-6
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _stuck_breaks(p, m, j):
-    """Index of the break-away function of stuck item ``j`` (a friction element's, then ``nf +`` a lossy gear's) and
-    its element row, or ``(-1, -1)`` where the item is not stuck."""
-    nf = p.fric.shape[0]
-    if j < nf:
-        return (N_G * j + G_BREAK, p.fric[j]) if m[j] == STUCK else (-1, -1)
-    r = p.lossy[j - nf]
-    if m[p.elem[r, E_MODE]] != GEAR_STUCK:
+    """Index of the break-away function of item ``j`` (a friction element, then the lossy gears) and its element row
+    (:func:`_item_row`), or ``(-1, -1)`` where the item is not stuck (:func:`_item_stuck`)."""
+    if not _item_stuck(p, m, j):
         return -1, -1
-    return N_G * nf + N_SW * p.swit.shape[0] + N_GEAR_G * (j - nf) + GG_BREAK, r
+    nf = p.fric.shape[0]
+    q = N_G * j + G_BREAK if j < nf else N_G * nf + N_SW * p.swit.shape[0] + N_GEAR_G * (j - nf) + GG_BREAK
+    return q, _item_row(p, j)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -4928,32 +4926,12 @@ def _turn_index(p, j):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _edge_beyond(p, m, g):
-    """Whether a stuck item's break-away function is below zero at ``t`` (its set past its edge within a step)."""
-    for j in range(p.fric.shape[0] + p.lossy.shape[0]):
-        q, _r = _stuck_breaks(p, m, j)
-        if q >= 0 and g[q] < 0.0:
-            return True
-    return False
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
 def _group_beyond(p, m, g, lab, c):
-    """Whether a stuck item of the linked group of inertias ``c`` has its break-away function below zero."""
+    """Whether a stuck item of the linked group of inertias ``c`` has its break-away function below zero at ``t``
+    (its set past its edge within a step)."""
     for j in range(p.fric.shape[0] + p.lossy.shape[0]):
         q, r = _stuck_breaks(p, m, j)
         if q >= 0 and g[q] < 0.0 and _group_of(p, r, lab) == c:
-            return True
-    return False
-
-
-@numba.njit(cache=True, nogil=True, _nrt=False)
-def _edge_crossed(p, m, g, gs):
-    """Whether the probe of :func:`_margin_rates` finds a stuck item's break-away function past zero where it was
-    not at ``t``."""
-    for j in range(p.fric.shape[0] + p.lossy.shape[0]):
-        q, _r = _stuck_breaks(p, m, j)
-        if q >= 0 and g[q] >= 0.0 and gs[q] < 0.0:
             return True
     return False
 
@@ -4972,7 +4950,8 @@ def _group_of(p, r, lab):
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _edge_rate(p, m, g, gs, lab, c):
     """The lowest rate [N m/s] over :data:`T_RATE` of the break-away functions of the stuck items of the linked group
-    of inertias ``c`` (labels ``lab``, :func:`_group_of`) that the probe of :func:`_margin_rates` finds past zero where they were not at ``t``, or inf.
+    of inertias ``c`` (labels ``lab``, :func:`_group_of`) that the probe of :func:`_margin_rates` finds past zero
+    where they were not at ``t``, or inf.
 
     In a statically indeterminate stuck set the margin of each member is that of the split chosen, not a function of
     the state alone: past the set's edge (no split holds) the regularised split is no longer moved into the bounds,
@@ -5045,24 +5024,19 @@ def _margin_rates(t, x, u, m, p, dx, g):
     _rhs_outlined(t + T_RATE, xs, u, m, p, ds, gs)
     observe(p, False)
     lab = wk[o + 2 * n + ne + nl + p.thermal.shape[0]:o + 3 * n + ne + nl + p.thermal.shape[0]]
-    crossed = _edge_crossed(p, m, g, gs)
-    beyond = _edge_beyond(p, m, g)
-    if crossed or beyond:
-        _components(p, lab)
+    _components(p, lab)
     for j in range(nf + nl):
         q = _turn_index(p, j)
         qb, r = _stuck_breaks(p, m, j)
         if qb < 0 or g[q] != 0.0:
             continue
-        c = _group_of(p, r, lab) if crossed or beyond else -1.0
-        if beyond and _group_beyond(p, m, g, lab, c):
+        c = _group_of(p, r, lab)
+        if _group_beyond(p, m, g, lab, c):
             # (its group is past its edge at t: positive, so that the turning point found is the edge, where the
             # core's second look at the break-away functions finds them below zero)
             g[q] = 1.0
             continue
-        rate = (gs[qb] - g[qb]) / T_RATE
-        if crossed:
-            rate = min(rate, _edge_rate(p, m, g, gs, lab, c))
+        rate = min((gs[qb] - g[qb]) / T_RATE, _edge_rate(p, m, g, gs, lab, c))
         # (plus ten rounding floors over the difference's step: a margin that stays put has no turning point)
         g[q] = rate + 10.0 * _item_noise(p, r, tau) / T_RATE
     for i in range(n):
