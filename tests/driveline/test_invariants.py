@@ -3409,6 +3409,35 @@ def _edge_of_the_stuck_set(d, t_lo, t_hi, rtol=1e-10):
     return hi
 
 
+def _loop_at_its_edge_holds(t):
+    """Independent of the kernel: whether the loop of :func:`_loop_with_a_one_way_clutch_at_its_edge`, every member
+    stuck and every inertia at rest, has a split within every member's bounds at ``t`` (SciPy's HiGHS on the static
+    balance of J0, J1, J2, as :func:`_loop_group_holds`).  Columns: the one-way clutch's torque ``f0`` (+ on J0, - on
+    J1; no clutch of its own: nothing overrunning, any locking), the gear's ``lg = -T_a`` and ``L``, the clutch's
+    (+ on J0, - on J2, at most 8.734375 N m)."""
+    r = 3.1796875
+    a_eq = np.array([[1.0, 0.0, 0.0, 1.0], [-1.0, 1.0, 0.0, 0.0], [0.0, -r, -r, -1.0]])
+    b_eq = np.array([-4.671875 * math.sin(2 * math.pi * 3.5 * t), 0.0,
+                     8.5625 * math.sin(2 * math.pi * 0.30078125 * t)])
+    bounds = [(None, 0.0), (None, None), (None, None), (-8.734375, 8.734375)]
+    return _split_exists(a_eq, b_eq, bounds, ((1, 2, _band_lines(1.0, 0.75, 0.0, 0.0)),))
+
+
+def _gear_chain_holds(draw, t):
+    """Independent of the kernel: whether the chain of :func:`_three_self_locking_gears_between_two_sines`, every gear
+    stuck and every inertia at rest, has a split within every gear's band at ``t`` (SciPy's HiGHS on the static
+    balance of J0 - J3).  Columns per gear ``k`` from ``Jk`` to ``Jk+1``: ``lg = -T_a`` (+1 on ``Jk``) and ``L``
+    (MSL ``flange_b.tau = -ratio (flange_a.tau - tauLoss)``: ``-ratio`` times each on ``Jk+1``)."""
+    gears, amp, _edge_t = SEED_2261[draw]
+    a_eq = np.zeros((4, 6))
+    for k, (ratio, _eta) in enumerate(gears):
+        a_eq[k, 2 * k] = 1.0
+        a_eq[k + 1, 2 * k] = a_eq[k + 1, 2 * k + 1] = -ratio
+    b_eq = np.array([-amp * math.sin(2 * math.pi * 2.0625 * t), 0.0, -2.0 * math.sin(2 * math.pi * 4.0 * t), 0.0])
+    return _split_exists(a_eq, b_eq, [(None, None)] * 6,
+                         tuple((2 * k, 2 * k + 1, _band_lines(eta, eta, 0.0, 0.0)) for k, (_r, eta) in enumerate(gears)))
+
+
 def _loop_with_a_one_way_clutch_at_its_edge():
     """Random draws seed 2257: a loop of three stuck members at rest, the one-way clutch f0 (no clutch of its own: it
     holds only against overrunning), the lossy gear g1 (1 forward, 0.75 backward) and the clutch ``loop`` (limit
@@ -3438,6 +3467,7 @@ def test_a_loop_reaching_its_edge_just_after_a_step_end_slides_whatever_the_samp
     d = _loop_with_a_one_way_clutch_at_its_edge()
     edge = _edge_of_the_stuck_set(d, 0.78, 0.785)
     assert abs(edge - 0.7828984) < 1e-6, edge
+    assert abs(_edge(_loop_at_its_edge_holds, 0.78, 0.785) - edge) < 1e-6   # (HiGHS: independent of the kernel)
     for t_end, step in ((1.0, 2e-3), (0.8, 2e-3), (1.0, None), (1.0, 5e-4)):
         r = d.simulate(t_end, output_step=step, rtol=1e-9, check_invariants=True)
         ev = [e for e in _mode_events(r) if e[0] > 0.5]
@@ -3485,6 +3515,7 @@ def test_three_self_locking_gears_roll_where_no_split_holds_whatever_the_toleran
     steps crossed it from outside that band).  Both draws fail on the code before."""
     edge = _edge_of_the_stuck_set(_three_self_locking_gears_between_two_sines(draw=draw), 0.2, 0.25)
     assert abs(edge - SEED_2261[draw][2]) < 1e-6, edge
+    assert abs(_edge(functools.partial(_gear_chain_holds, draw), 0.2, 0.25) - edge) < 1e-6   # (HiGHS)
     for with_unrelated in (False, True):
         d = _three_self_locking_gears_between_two_sines(with_unrelated, draw)
         for rtol in (1e-7, 1e-10, 1e-12):
