@@ -82,6 +82,13 @@ def _warm_components() -> None:
     d.wet_clutch("w", "a", "b", force=Signal.ramp(1000.0, 0.01))
     d.emtc("e", "b", "c")
     d.simulate(0.01, output_step=0.005)
+    # the E-clutch with its actuator in the network: the network on Rodas3, the actuator's hooks (group
+    # eclutch_network) and its run with a held reference (its pre-roll)
+    d = Driveline("warmup_actuator")
+    d.inertia("a", J=1.0, w0=10.0).inertia("b", J=1.0)
+    d.eclutch("x", "a", "b", Signal.ramp(-1e-3, 0.01, offset=8e-3), actuator=True, pre_roll=0.01,
+              actuator_in_network=True)
+    d.simulate(0.01, rtol=1e-4, output_step=0.005)
 
 
 def _warm_control() -> None:

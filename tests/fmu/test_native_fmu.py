@@ -382,6 +382,66 @@ def test_network_inputs_are_fmu_inputs(built, tmp_path):
         _close(native[name], python[name], name)
 
 
+#: an engine driving a shaft through the E-clutch with its actuator, its bearing reference a network input
+PEDAL_TOML = """
+[driveline]
+name = "pedal"
+
+[input.pedal]
+start = "8 mm"
+description = "bearing position reference"
+
+[inertia.engine]
+J = "0.2 kg m^2"
+w0 = "150 rad/s"
+
+[inertia.shaft]
+J = "0.5 kg m^2"
+
+[torque.drive]
+flange = "engine"
+torque = "20 N m"
+
+[eclutch.clutch]
+a = "engine"
+b = "shaft"
+position = { input = "pedal" }
+actuator = true
+pre_roll = "0.2 s"
+
+[bearing_friction.load]
+flange = "shaft"
+torque = "5 N m"
+
+[simulation]
+rtol = 1e-6
+"""
+
+
+def test_the_eclutch_pedal_is_an_input_of_the_native_fmu(tmp_path):
+    """The E-clutch with its actuator in the network (issue #32: its bearing reference an FMU input): the native FMU
+    (Rodas3 inside, the actuator's states among the network's) takes the pedal as an input in metres and gives the
+    numbers of the Python co-simulation of the same network, with the pedal moved at the communication points, in
+    FMPy without clutchlab."""
+    (tmp_path / "pedal.toml").write_text(PEDAL_TOML)
+    cls = DrivelineCoSimulation.for_description(tmp_path / "pedal.toml")
+    lines = []
+    path = export_native_fmu(cls, tmp_path / "pedal.fmu", platforms=["linux64"], report=lines.append)
+    _, svs = _variables(path)
+    pedal = svs["pedal"]
+    assert pedal.get("causality") == "input" and pedal.find("Real").get("unit") == "m"
+    assert float(pedal.find("Real").get("start")) == pytest.approx(8e-3)
+    assert svs["clutch.normal_force"].get("causality") == "output"
+    n, dt = 60, 1e-2
+    k = np.arange(n + 1)
+    inputs = {"pedal": np.clip(8e-3 - 1e-4 * np.maximum(k - 10, 0), 2e-3, 8e-3)}
+    native = _fmpy_run(tmp_path, path, n, dt, inputs=inputs)
+    python = _python_run(cls, n, dt, inputs=inputs)
+    assert python["clutch.normal_force"][-1] > 1000.0   # the pedal closed the clutch
+    for name in python:
+        _close(native[name], python[name], name)
+
+
 _FMI3_HOST = r"""
 import json, sys
 import numpy as np

@@ -396,6 +396,10 @@ BUILTIN = (
         Field("pre_roll", "quantity", "s", default=1.0, minimum=0.0,
               description="actuator run before t = 0 (settles its controller)"),
         Field("settle", "quantity", "s", default=0.5, minimum=0.0, description="actuator run after the reference ends"),
+        Field("actuator_in_network", "bool",
+              description="integrate the actuator with the network (its reference read at every evaluation: a "
+                          "network input may drive it) instead of solving it ahead; left out: where position reads "
+                          "an input"),
         _MU_TEMPERATURE,
         Field("wear", "quantity", "m", default=0.0, minimum=0.0, maximum=0.01,
               description="facing wear at the start (both faces): the cushion pre-strain less it",

@@ -34,6 +34,7 @@ from numba.core import types
 from ..numerics import dispatch
 from ..numerics.borrow import ByRef, keep_rows, member, row
 from ..numerics.outline import hook_args, outlined
+from . import eclutch as DA
 from . import emtc as DE
 from . import kernel as K
 from . import wet as DW
@@ -48,6 +49,7 @@ class CoupledParams(NamedTuple):
     net: DrivelineParams
     wet: DW.WetBlock
     emtc: DE.EmtcBlock
+    ecl: DA.EClutchBlock
 
     @classmethod
     def plain(cls, net: DrivelineParams) -> "CoupledParams":
@@ -61,11 +63,11 @@ def _no_components():
     """The empty blocks of a network without model components, built once and shared (built anew, the layout of
     their rows took 3 ms a run: a plain network's run of CoupledClutches is 1.7 ms); none of their arrays has an
     element to write."""
-    return DW.block([], []), DE.block([], [])
+    return DW.block([], []), DE.block([], []), DA.block([], [])
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _hold(t, u, net, w, e):
+def _hold(t, u, net, w, e, a):
     """Every component's ports at ``t`` (a wet clutch's force, an EMTC coupling's torque request, throttle and coil
     current: each a network signal), after the network's held inputs are brought up to the core's ``u`` (the
     components are evaluated before the network's right-hand side, which would do that); the network's signals are
@@ -76,18 +78,21 @@ def _hold(t, u, net, w, e):
     K.refresh_signals(net, t)
     DW.hold(t, net, w)
     DE.hold(t, net, e)
+    DA.hold(t, net, a)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _evaluate(t, x, u, m, net, w, e):
+def _evaluate(t, x, u, m, net, w, e, a):
     """Every component at the network's state (its ports first, :func:`_hold`): its derivatives and switching values
     into its block's scratch, its torques into the network's.  (Without reference counting: only the EMTC's own
     hooks keep it, called where a network has a coupling.)"""
-    _hold(t, u, net, w, e)
+    _hold(t, u, net, w, e, a)
     if w.conf.shape[0] > 0:
         DW.evaluate(t, x, m, net, w)
     if e.conf.shape[0] > 0:
         DE.evaluate(t, x, m, net, e)
+    if a.conf.shape[0] > 0:
+        _eclutch_evaluate_outlined(t, x, m, net, a)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -119,12 +124,13 @@ def _with_rates(t, x, u, m, p):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     if not _at_rest(x, m, net):
-        _evaluate_outlined(t, x, u, m, net, w, e)   # (the torques at t, without rates)
+        _evaluate_outlined(t, x, u, m, net, w, e, a)   # (the torques at t, without rates)
         return
-    nx, ng, nm = _network_sizes(w, e)
+    nx, ng, nm = _network_sizes(w, e, a)
     dx = np.empty(x.shape[0])
-    g = np.empty(ng + w.conf.shape[0] * DW.N_SWITCH + e.conf.shape[0] * DE.N_SWITCH)
+    g = np.empty(ng + w.conf.shape[0] * DW.N_SWITCH + e.conf.shape[0] * DE.N_SWITCH + _switching_count(a))
     _rhs_outlined(t, x, u, m, p, dx, g)
     nj = K.external_count(net)
     v0 = np.empty(3 * nj)
@@ -132,12 +138,12 @@ def _with_rates(t, x, u, m, p):
         for q in range(3):
             v0[3 * j + q] = K.external_value(net, j, q, t)   # (as the components set them: no rate yet)
     t1 = t + K.T_RATE
-    _evaluate_outlined(t1, x + K.T_RATE * dx, u, m, net, w, e)
+    _evaluate_outlined(t1, x + K.T_RATE * dx, u, m, net, w, e, a)
     d = np.empty(3 * nj)
     for j in range(nj):
         for q in range(3):
             d[3 * j + q] = (K.external_value(net, j, q, t1) - v0[3 * j + q]) / K.T_RATE
-    _evaluate_outlined(t, x, u, m, net, w, e)   # (the components' own scratch back at t, as their calls read it)
+    _evaluate_outlined(t, x, u, m, net, w, e, a)   # (the components' own scratch back at t, as their calls read it)
     for j in range(nj):
         K.set_external_rates(net, j, t, d[3 * j], d[3 * j + 1], d[3 * j + 2])
 
@@ -162,7 +168,8 @@ def _plain(p):
     clutch, no EMTC coupling): every hook is then the plain network's own (:mod:`clutchlab.driveline.kernel`), so
     such a network runs as it did on its own parameter type, and a run never compiles the components' functions,
     called through their addresses (a native FMU compiles them all)."""
-    return member(p, "wet").conf.shape[0] == 0 and member(p, "emtc").conf.shape[0] == 0
+    return (member(p, "wet").conf.shape[0] == 0 and member(p, "emtc").conf.shape[0] == 0
+            and member(p, "ecl").conf.shape[0] == 0)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -183,13 +190,16 @@ def _components_rhs(t, x, u, m, p, dx, g):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
-    _evaluate(t, x, u, m, net, w, e)
+    a = member(p, "ecl")
+    _evaluate(t, x, u, m, net, w, e, a)
     K.driveline_rhs(t, x, u, m, net, dx, g)
     acc = K.accelerations(net)
     if w.conf.shape[0] > 0:   # (a kind the network has none of costs no call)
         DW.derivatives(net, w, acc, dx, g)
     if e.conf.shape[0] > 0:
         DE.derivatives(net, e, acc, dx, g)
+    if a.conf.shape[0] > 0:
+        DA.derivatives(a, dx, g)
     return None
 
 
@@ -199,12 +209,15 @@ def coupled_outputs(t, x, u, m, p, y):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     K.observe(net, True)   # (an observer: K.driveline_outputs, which ends the mark)
-    _evaluate_outlined(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e, a)
     K.driveline_outputs(t, x, u, m, net, y)
-    q = y.shape[0] - w.conf.shape[0] * DW.N_KEPT - e.conf.shape[0] * e.index.shape[0]
+    q = y.shape[0] - w.conf.shape[0] * DW.N_KEPT - e.conf.shape[0] * e.index.shape[0] - a.conf.shape[0] * DA.N_OUT
     q = DW.outputs(w, y, q)
-    DE.outputs(e, y, q)
+    q = DE.outputs(e, y, q)
+    if a.conf.shape[0] > 0:
+        _eclutch_outputs_outlined(t, x, m, a, y, q)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=True)
@@ -215,9 +228,10 @@ def coupled_update(t, x, u, m, p, k, log):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     _sync(x, m, net, w, e)
     nw, ne = w.conf.shape[0], e.conf.shape[0]
-    ng = w.conf[0][DW.F_G] if nw > 0 else e.conf[0][DE.F_G]
+    nx, ng, nm = _network_sizes(w, e, a)
     if k < ng:
         before = m.copy()
         _with_rates(t, x, u, m, p)   # (the components' torques at t, and their rates where an item is at rest)
@@ -234,14 +248,18 @@ def coupled_update(t, x, u, m, p, k, log):
             K.settle_outlined(t, x, m, net, log, m.copy(), net.fric[k // K.N_G])
         _sync(x, m, net, w, e)
         return res
-    _evaluate_outlined(t, x, u, m, net, w, e)   # (the component's hook reads its scratch at t)
+    _evaluate_outlined(t, x, u, m, net, w, e, a)   # (the component's hook reads its scratch at t)
     if nw > 0 and k < ng + nw * DW.N_SWITCH:
         res = DW.call(t, x, m, w, (k - ng) // DW.N_SWITCH, (k - ng) % DW.N_SWITCH, log)
-    elif ne > 0:   # (an EMTC's functions, DE.N_SWITCH each: its coil current's grid lines and turns among them)
+    elif ne > 0 and k < ng + nw * DW.N_SWITCH + ne * DE.N_SWITCH:
+        # (an EMTC's functions, DE.N_SWITCH each: its coil current's grid lines and turns among them)
         ke = k - ng - nw * DW.N_SWITCH
         res = DE.call(t, x, m, net, e, ke // DE.N_SWITCH, ke % DE.N_SWITCH, log)
-    else:
-        return 0
+    else:   # (an E-clutch's actuator: its functions, as many as its model has)
+        j = DA.switching_row(a, k)
+        if j < 0:
+            return 0
+        res = _eclutch_call_outlined(t, x, m, a, j, k - a.conf[j][DA.F_G], log)
     if res < 0:
         return res
     _with_rates(t, x, u, m, p)   # the network's modes at the component's new state
@@ -257,8 +275,9 @@ def coupled_restart(t, x, u, m, p, log):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     _sync(x, m, net, w, e)
-    _evaluate_outlined(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e, a)
     changed = False
     for j in range(w.conf.shape[0]):
         if DW.call(t, x, m, w, j, np.int64(-1), log) != 0:
@@ -266,7 +285,11 @@ def coupled_restart(t, x, u, m, p, log):
     for j in range(e.conf.shape[0]):
         if DE.call(t, x, m, net, e, j, np.int64(-1), log) != 0:
             changed = True
-    _with_rates(t, x, u, m, p)
+    for j in range(a.conf.shape[0]):
+        res = _eclutch_call_outlined(t, x, m, a, j, np.int64(-1), log)
+        if res != 0:
+            changed = True
+    _with_rates(t, x, u, m, p)   # (the components' torques at their new states: an actuator's restart moves them)
     if K.driveline_restart(t, x, u, m, net, log):
         changed = True
     _sync(x, m, net, w, e)
@@ -282,11 +305,17 @@ def coupled_accept(t, x, u, m, p):
     net = member(p, "net")
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     DW.accept(t, x, u, m, w)
-    _hold(t, u, net, w, e)
+    _hold(t, u, net, w, e, a)
     res = DE.accept(t, x, u, m, net, e)
     if res < 0:
         return res
+    changed = 0
+    if a.conf.shape[0] > 0:
+        changed = _eclutch_accept_outlined(t, x, m, a)
+        if changed < 0:
+            return changed
     if net.lossy.shape[0] > 0:
         res = K.table_error(x, net)
         if res != 0:
@@ -296,9 +325,11 @@ def coupled_accept(t, x, u, m, p):
         return res
     if net.check[0] != 0.0:
         K.observe(net, True)   # (a debug option changes no decision: K.driveline_accept ends the mark)
-        _evaluate_outlined(t, x, u, m, net, w, e)
-        return K.driveline_accept(t, x, u, m, net)
-    return 0
+        _evaluate_outlined(t, x, u, m, net, w, e, a)
+        res = K.driveline_accept(t, x, u, m, net)
+        if res != 0:
+            return res
+    return changed   # (1: an actuator's stuck coordinate's velocity was set to zero, the core evaluates again)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -315,15 +346,26 @@ def coupled_next_break(t, m, p):
 def _components_next_break(t, m, p, tb):
     """:func:`coupled_next_break`'s components (through its address: a plain network never compiles it)."""
     tb = DW.next_break(t, m, member(p, "wet"), tb)
-    return DE.next_break(t, member(p, "emtc"), tb)
+    return DE.next_break(t, member(p, "emtc"), tb)   # (an E-clutch's actuator reads its port: no corner of its own)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _network_sizes(w, e):
+def _network_sizes(w, e, a):
     """The numbers of the network's own states, switching functions and modes (the first component's offsets)."""
     if w.conf.shape[0] > 0:
         return w.conf[0][DW.F_X], w.conf[0][DW.F_G], w.conf[0][DW.F_M]
-    return e.conf[0][DE.F_X], e.conf[0][DE.F_G], e.conf[0][DE.F_M]
+    if e.conf.shape[0] > 0:
+        return e.conf[0][DE.F_X], e.conf[0][DE.F_G], e.conf[0][DE.F_M]
+    return a.conf[0][DA.F_X], a.conf[0][DA.F_G], a.conf[0][DA.F_M]
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _switching_count(a):
+    """The switching functions of the E-clutches' actuators (each as many as its model has)."""
+    n = 0
+    for j in range(a.conf.shape[0]):
+        n += a.conf[j][DA.F_NG]
+    return n
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -340,11 +382,12 @@ def coupled_watch(t, x, u, m, p, dx, g, k):
     stayed stuck at twice its limit (found by the invariant check once it ran for these networks)."""
     w = member(p, "wet")
     e = member(p, "emtc")
+    a = member(p, "ecl")
     net = member(p, "net")
     if _plain(p):
         K.driveline_watch(t, x, u, m, net, dx, g, k)
         return
-    nx, ng, nm = _network_sizes(w, e)
+    nx, ng, nm = _network_sizes(w, e, a)
     if k < ng and K.wants_rates(net, m, g, k):   # (rare: a stuck item near its limit)
         _watch_rates_outlined(t, x, u, m, p, dx, g, k)
 
@@ -354,12 +397,13 @@ def _watch_rates(t, x, u, m, p, dx, g, k):
     """:func:`coupled_watch`'s rates (reference-counted: it allocates the moved state)."""
     w = member(p, "wet")
     e = member(p, "emtc")
-    nx, ng, nm = _network_sizes(w, e)
+    a = member(p, "ecl")
+    nx, ng, nm = _network_sizes(w, e, a)
     net = member(p, "net")
     xs = x + K.T_RATE * dx
-    _evaluate_outlined(t + K.T_RATE, xs, u, m, net, w, e)
+    _evaluate_outlined(t + K.T_RATE, xs, u, m, net, w, e, a)
     K.driveline_watch(t, x[:nx], u, m[:nm], net, dx[:nx], g[:ng], k)
-    _evaluate_outlined(t, x, u, m, net, w, e)
+    _evaluate_outlined(t, x, u, m, net, w, e, a)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -423,6 +467,15 @@ _restart_outlined = outlined(coupled_restart, lambda: _hook_args(K._log_type()),
 _accept_outlined = outlined(coupled_accept, lambda: _hook_args(), types.int64, group="coupled")
 _watch_rates_outlined = outlined(_watch_rates, lambda: _hook_args(_F1, _F1, types.int64), types.none,
                                  group="coupled")
+# an E-clutch's actuator model (its hooks, linked into these four: compiled where a network first has one)
+_eclutch_evaluate_outlined = outlined(DA.evaluate, lambda: (types.float64, _F1, _I1, _member_types()[0],
+                                                            _member_types()[3]), types.none, group="eclutch_network")
+_eclutch_call_outlined = outlined(DA.call, lambda: (types.float64, _F1, _I1, _member_types()[3], types.int64,
+                                                    types.int64, K._log_type()), types.int64, group="eclutch_network")
+_eclutch_accept_outlined = outlined(DA.accept, lambda: (types.float64, _F1, _I1, _member_types()[3]), types.int64,
+                                   group="eclutch_network")
+_eclutch_outputs_outlined = outlined(DA.outputs, lambda: (types.float64, _F1, _I1, _member_types()[3], _F1,
+                                                          types.int64), types.int64, group="eclutch_network")
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -503,6 +556,9 @@ def _components_start(t, x, u, m, p):
         code = DE.S.derive_actuator(r.actuator, r.cold, r.layout, r.controller_table)
         if code:
             return DE.error_code(code, j)
+    a = member(p, "ecl")
+    if a.conf.shape[0] > 0:
+        return DA.start(t, x, m, a)
     return 0
 
 

@@ -1430,6 +1430,14 @@ dispatch.register(EClutchParams, rhs=rhs, outputs=outputs, update=update, restar
                   next_break=next_break, jacobian=jacobian, time_derivative=time_derivative, start=eclutch_start)
 
 
+def params_template() -> EClutchParams:
+    """An :class:`EClutchParams` of tiny arrays: the numba type of every packed E-clutch's (the types of a driveline's
+    empty E-clutch block, :mod:`clutchlab.driveline.eclutch`; built without a compiled function or a model)."""
+    f1, f2, i1, i2 = np.zeros(1), np.zeros((1, 1)), np.zeros(1, np.int64), np.zeros((1, 1), np.int64)
+    return EClutchParams(0, 0, 0, f1, f1.copy(), f1.copy(), f2, i2, i1, f2.copy(), f2.copy(), i2.copy(), f2.copy(), 0,
+                         0.0, 0.0, f2.copy(), f1.copy(), i1.copy(), f2.copy(), f2.copy(), i2.copy(), f2.copy())
+
+
 # ---------------------------------------------------------------- packing and the System
 def _node_aligned(network) -> dict:
     """Coordinates aligned with nodes: ``x = A q + b u + c`` with ``q`` = positions of the independent nodes.
