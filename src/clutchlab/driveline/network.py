@@ -2314,7 +2314,7 @@ class Driveline:
         synchroniser's shift force [N]; a wet clutch's actuator force reference [N]; an E-clutch's bearing position
         [m] or, with its actuator, the clamp force [N] the actuator's run gives, sampled (:meth:`Signal.sampled`:
         ``d.signal("clutch").breakpoints("clamp force")`` are its samples), which the network reads linearly
-        between samples."""
+        between samples; with its actuator in the network, the bearing position reference [m] its actuator follows."""
         for e in self._elements:
             if e.name == name:
                 return e.signal
@@ -2861,6 +2861,8 @@ class Driveline:
         freqs = [f.row[2] for e in self._elements if e.signal is not None
                  for f in (e.signal.factors or (e.signal,)) if f.row[0] == K.SIG_SINE]
         max_step = min((0.125 / f for f in freqs if f > 0), default=math.inf)
+        # an actuator's own largest step (10 ms: its runs are tested with it), as the network's default
+        max_step = min([max_step] + [es.max_step for _, _, es, *_ in ecls])
         inputs = tuple((n, unit, d or f"network input {n}") for n, (unit, _start, d) in self._inputs.items())
         u0 = np.array([v[1] for v in self._inputs.values()], dtype=float) if inputs else None
         return System(name=self.name, params=p, states=states, outputs=outputs, inputs=inputs, u0=u0, x0=x0,
