@@ -420,6 +420,7 @@ def _keep_rows(p):
     """:func:`coupled_prepare`'s rows (through its address: a plain network never compiles them)."""
     keep_rows(member(p, "wet"))
     keep_rows(member(p, "emtc"))
+    keep_rows(member(p, "ecl"))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)

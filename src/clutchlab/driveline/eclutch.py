@@ -43,7 +43,7 @@ import numpy as np
 from ..eclutch import system as ES
 from ..eclutch.models import torque_of_clamp_force
 from ..numerics import dispatch
-from ..numerics.borrow import member, row, stack_rows
+from ..numerics.borrow import block_row, row_words, stack_rows
 from ..numerics.layout import slots
 from . import kernel as K
 from .block import conf_slots
@@ -74,12 +74,17 @@ class EClutchBlock(NamedTuple):
     """The E-clutches with their actuators of a network (rows ``j``, none or more): ``params``, their
     :class:`~clutchlab.eclutch.system.EClutchParams` (position mode, the held input) stacked as rows
     (:func:`clutchlab.numerics.borrow.stack_rows`: any number of them, each with its own axial model, is one type),
-    ``conf[j]`` (int64, the layout ``F_*``) and ``buf[j]`` (float, scratch ``B_*``).  A member of
-    :class:`clutchlab.driveline.coupled.CoupledParams`."""
+    ``conf[j]`` (int64, the layout ``F_*``), ``buf[j]`` (float, scratch ``B_*``) and ``rows[j]`` (float64, the
+    component's :class:`~clutchlab.eclutch.system.EClutchParams` built from its row once per call of the core,
+    :func:`clutchlab.numerics.borrow.keep_rows`, read by reference, ``block_row``: so its hooks are the very
+    specialisations the E-clutch's own sessions run, by reference; by value they were compiled again as callees of
+    this block, and numba's cache then gave a Python call of ``eclutch_start`` that callee's code, which crashed
+    the process).  A member of :class:`clutchlab.driveline.coupled.CoupledParams`."""
 
     params: ES.EClutchParams
     conf: np.ndarray
     buf: np.ndarray
+    rows: np.ndarray
 
 
 @functools.lru_cache(maxsize=1)
@@ -93,7 +98,8 @@ def block(params, conf) -> EClutchBlock:
     n = len(params)
     conf = np.array(conf, dtype=np.int64).reshape(n, N_CONF)
     width = int(max((1 + c[F_NX] + c[F_NG] + c[F_NY] for c in conf), default=1))
-    return EClutchBlock(stack_rows(params, template=None if params else _template()), conf, np.zeros((n, width)))
+    stacked = stack_rows(params, template=None if params else _template())
+    return EClutchBlock(stacked, conf, np.zeros((n, width)), np.zeros((n, row_words(stacked))))
 
 
 def element_names(name: str, assembly) -> tuple:
@@ -117,7 +123,7 @@ def _clutch(t, x, m, net, a, j):
     cf = a.conf[j]
     nx, ng = cf[F_NX], cf[F_NG]
     b = a.buf[j]
-    ep = row(member(a, "params"), j)
+    ep = block_row(a, j)
     xo, mo = cf[F_X], cf[F_M]
     d0 = B_DX
     dispatch.rhs(t, x[xo:xo + nx], b[B_U:B_U + 1], m[mo:mo + cf[F_NM]], ep, b[d0:d0 + nx], b[d0 + nx:d0 + nx + ng])
@@ -155,7 +161,7 @@ def outputs(t, x, m, a, y, q):
         xo, mo = cf[F_X], cf[F_M]
         y0 = B_DX + nx + ng
         ys = b[y0:y0 + cf[F_NY]]
-        dispatch.outputs(t, x[xo:xo + nx], b[B_U:B_U + 1], m[mo:mo + cf[F_NM]], row(member(a, "params"), j), ys)
+        dispatch.outputs(t, x[xo:xo + nx], b[B_U:B_U + 1], m[mo:mo + cf[F_NM]], block_row(a, j), ys)
         for i in range(N_OUT):
             y[q + i] = ys[i]
         q += N_OUT
@@ -198,7 +204,7 @@ def call(t, x, m, a, j, k, log):
     xs = x[xo:xo + cf[F_NX]]
     ms = m[mo:mo + cf[F_NM]]
     us = b[B_U:B_U + 1]
-    ep = row(member(a, "params"), j)
+    ep = block_row(a, j)
     start = log.count[0]
     if k >= 0:
         res = dispatch.update(t, xs, us, ms, ep, k, log)
@@ -217,7 +223,7 @@ def accept(t, x, m, a):
         cf = a.conf[j]
         xo, mo = cf[F_X], cf[F_M]
         res = dispatch.accept(t, x[xo:xo + cf[F_NX]], a.buf[j][B_U:B_U + 1], m[mo:mo + cf[F_NM]],
-                              row(member(a, "params"), j))
+                              block_row(a, j))
         if res < 0:
             return error_code(res, j)
         if res > 0:
@@ -234,7 +240,7 @@ def start(t, x, m, a):
         cf = a.conf[j]
         xo, mo = cf[F_X], cf[F_M]
         code = dispatch.start(t, x[xo:xo + cf[F_NX]], a.buf[j][B_U:B_U + 1], m[mo:mo + cf[F_NM]],
-                              row(member(a, "params"), j))
+                              block_row(a, j))
         if code:
             return error_code(code, j)
     return 0
