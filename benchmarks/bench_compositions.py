@@ -6,7 +6,8 @@ Usage: ``python benchmarks/bench_compositions.py [--networks 20] [--seed 0]``  (
 1. An empty numba cache (``NUMBA_CACHE_DIR`` in a temporary folder); ``python -m clutchlab warmup`` on it, timed.
 2. ``--networks`` random networks (seeded): a chain of 3-6 inertias, an engine or a torque source on the first, a
    road load on the last, and between them elements drawn from every kind: clutches, spring-dampers, gears,
-   one-way clutches, backlash, wet clutches, EMTC couplings and the E-clutch with its actuator; every network
+   one-way clutches, backlash, wet clutches, EMTC couplings and the E-clutch with its actuator (solved ahead, and
+   in the network: ``eclutch_network``, the network then on Rodas3); every network
    holds at least one model component, and every kind appears over the set.  Each is written as a driveline
    TOML file.
 3. Each file is loaded and simulated for 0.2 s in a fresh Python process that counts numba's compilations
@@ -30,8 +31,9 @@ import time
 
 import numpy as np
 
-KINDS = ("clutch", "spring_damper", "gear", "one_way_clutch", "backlash", "wet_clutch", "emtc", "eclutch")
-MODELS = ("wet_clutch", "emtc", "eclutch")
+KINDS = ("clutch", "spring_damper", "gear", "one_way_clutch", "backlash", "wet_clutch", "emtc", "eclutch",
+         "eclutch_network")
+MODELS = ("wet_clutch", "emtc", "eclutch", "eclutch_network")
 
 _CHILD = textwrap.dedent("""
     import sys, time
@@ -75,6 +77,10 @@ def _element(kind: str, name: str, a: str, b: str, rng) -> str:
         return (f'[eclutch.{name}]\na = "{a}"\nb = "{b}"\nactuator = true\nactuator_step = "2 ms"\n'
                 'pre_roll = "0.2 s"\nsettle = "0.05 s"\n'
                 'position = { table = { times = [0, 0.05, 0.15], values = ["8 mm", "8 mm", "0 mm"] } }\n')
+    if kind == "eclutch_network":   # (its actuator's states integrated with the network's)
+        return (f'[eclutch.{name}]\na = "{a}"\nb = "{b}"\nactuator = true\nactuator_in_network = true\n'
+                'pre_roll = "0.05 s"\n'
+                'position = { table = { times = [0, 0.05, 0.15], values = ["8 mm", "8 mm", "2 mm"] } }\n')
     raise ValueError(kind)
 
 
