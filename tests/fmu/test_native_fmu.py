@@ -443,8 +443,8 @@ def test_the_eclutch_pedal_is_an_input_of_the_native_fmu(tmp_path):
     # model exchange: FMPy's CVode integrates the network and the actuator (its massless tip solved inside the FMU),
     # locating the actuator's stick/slip and the clutch's from the event indicators.  Over the engagement, every
     # millisecond, as the E-clutch's own FMU is compared (test_native_fmu_of_the_eclutch), the pedal held at 3 mm
-    # from the start.  (Ramped at 0.1 m/s, CVode stops at its 500 steps per output interval at the ramp's start,
-    # while the E-clutch's own FMU runs that ramp: docs/fmu.md, limits)
+    # from the start.  (Ramped at 0.1 m/s, CVode at rtol 1e-8 stops at its 500 steps per output interval at the
+    # ramp's start, as the E-clutch's own FMU does at 1e-10: FMPy's staircase of a continuous input, docs/fmu.md)
     root, svs = _variables(path)
     assert root.find("ModelExchange") is not None and "der(clutch.actuator.x_tip)" not in svs
     assert "der(clutch.actuator.bearing_position)" in svs and "der(engine.w)" in svs
