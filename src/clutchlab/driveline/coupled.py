@@ -1,9 +1,11 @@
-"""A network with model components: wet clutches (:mod:`clutchlab.driveline.wet`) and EMTC couplings
-(:mod:`clutchlab.driveline.emtc`), any number of each, in one compiled kernel.
+"""A network with model components: wet clutches (:mod:`clutchlab.driveline.wet`), EMTC couplings
+(:mod:`clutchlab.driveline.emtc`) and E-clutches with their actuators (:mod:`clutchlab.driveline.eclutch`), any
+number of each, in one compiled kernel.
 
 The network's parameters are a :class:`CoupledParams`: the plain network (:class:`~clutchlab.driveline.kernel.
 DrivelineParams`), a :class:`~clutchlab.driveline.wet.WetBlock` of its wet clutches and an
-:class:`~clutchlab.driveline.emtc.EmtcBlock` of its couplings, each a block of rows (none or more).  The
+:class:`~clutchlab.driveline.emtc.EmtcBlock` of its couplings and an :class:`~clutchlab.driveline.eclutch.
+EClutchBlock` of its E-clutches' actuators, each a block of rows (none or more).  The
 couplings' parameter structures are stacked as rows whatever their sizes (:func:`clutchlab.numerics.borrow.
 stack_rows`; each coupling its own magnet and maps), so the type, and with it the compiled kernel, is the same for
 a dual-clutch transmission of two wet clutches, a front and a rear EMTC, a wet clutch with an EMTC or any other
@@ -11,13 +13,15 @@ mix: a network of known component kinds never run before compiles nothing (issue
 components is one too (:meth:`CoupledParams.plain`: empty blocks), so one kernel serves every network: each hook
 first asks whether the network has a component row (:func:`_plain`) and, without one, is the plain network's own
 hook of :mod:`~clutchlab.driveline.kernel`, linked as before (the same steps and numbers); the components' parts
-are called through their addresses (group ``"coupled"``), so a plain network never compiles them.
+are called through their addresses (group ``"coupled"``; an actuator's, group ``"eclutch_network"``), so a plain
+network never compiles them.
 
 Layout (what :meth:`Driveline.system <clutchlab.driveline.network.Driveline.system>` names): states, switching
-functions, modes and named elements are the network's, then each wet clutch's, then each coupling's; outputs the
-network's, then each wet clutch's :data:`~clutchlab.driveline.wet.OUTPUTS`, then each coupling's
-:data:`~clutchlab.driveline.emtc.OUTPUTS`; events the network's :data:`~clutchlab.driveline.kernel.EVENTS`, then the
-wet model's, then the EMTC's.  Every evaluation first gives each component's sliding torque and static limit to
+functions, modes and named elements are the network's, then each wet clutch's, then each coupling's, then each
+actuator's; outputs the network's, then each wet clutch's :data:`~clutchlab.driveline.wet.OUTPUTS`, then each
+coupling's :data:`~clutchlab.driveline.emtc.OUTPUTS`, then each actuator's :data:`~clutchlab.driveline.eclutch.
+OUTPUTS`; events the network's :data:`~clutchlab.driveline.kernel.EVENTS`, then the wet model's, the EMTC's and the
+E-clutch's.  Every evaluation first gives each component's sliding torque and static limit to
 the network (:func:`~clutchlab.driveline.kernel.set_external`), then the network's friction state machine decides
 stick and slip for all of them at once (one stuck-set solve over the network).
 """
